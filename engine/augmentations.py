@@ -1,0 +1,231 @@
+"""Augmenting maps h: R^p -> R for one degree of redundancy, eq. (9), with exact gradients.
+
+The paper's analytic maps: Manipulator 1, (32) ``e1_optimal``, (33) ``e1_taylor``, (36)
+``e2_optimal``; Manipulator 2, (38) ``paper_cubic`` as printed. A map is evaluated batched:
+``value`` (..., p) -> (...,), ``gradient`` (..., p) -> (..., p).
+"""
+
+from __future__ import annotations
+
+import abc
+from collections.abc import Mapping
+from typing import ClassVar
+
+import numpy as np
+
+from engine.exceptions import InvalidInputError
+from engine.validation import FloatArray, finite
+
+
+class AugmentingMap(abc.ABC):
+    """h: R^p -> R^(p-r) with p - r = 1, eq. (9); dh/dx is its exact gradient."""
+
+    name: ClassVar[str]
+    p: int
+
+    @abc.abstractmethod
+    def value(self, x: FloatArray) -> FloatArray:
+        """h(x): (..., p) -> (...,)."""
+
+    @abc.abstractmethod
+    def gradient(self, x: FloatArray) -> FloatArray:
+        """dh/dx: (..., p) -> (..., p)."""
+
+    @property
+    def parameters(self) -> dict[str, float]:
+        """The map's parameters, as a JSON-friendly dict."""
+        return {}
+
+    def __repr__(self) -> str:
+        args = ", ".join(f"{k}={v!r}" for k, v in self.parameters.items())
+        return f"{type(self).__name__}({args})"
+
+
+def _sqrt1p(x1: FloatArray) -> FloatArray:
+    return np.sqrt(1.0 + x1**2)
+
+
+class E1Optimal(AugmentingMap):
+    """E1-optimal map of Manipulator 1, eq. (32).
+
+    h(x) = x3 C1 sqrt(1 + x1^2) / g(x1)^(1/3),  g = x1 sqrt(1 + x1^2) + asinh(x1) + C2,
+    with the real cube root; g' = 2 sqrt(1 + x1^2). Undefined where g(x1) = 0.
+    """
+
+    name = "e1_optimal"
+    p = 3
+
+    def __init__(self, C1: float = 1.0, C2: float = 1.0) -> None:
+        self.C1 = finite(C1, "C1")
+        self.C2 = finite(C2, "C2")
+        if self.C1 == 0:
+            raise InvalidInputError("C1 must be nonzero: with C1 = 0, h = 0 and dh = 0 everywhere")
+
+    @property
+    def parameters(self) -> dict[str, float]:
+        return {"C1": self.C1, "C2": self.C2}
+
+    def _g(self, x1: FloatArray) -> FloatArray:
+        return x1 * _sqrt1p(x1) + np.arcsinh(x1) + self.C2
+
+    def value(self, x: FloatArray) -> FloatArray:
+        x = np.asarray(x, dtype=float)
+        x1, x3 = x[..., 0], x[..., 2]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return x3 * self.C1 * _sqrt1p(x1) / np.cbrt(self._g(x1))
+
+    def gradient(self, x: FloatArray) -> FloatArray:
+        x = np.asarray(x, dtype=float)
+        x1, x3 = x[..., 0], x[..., 2]
+        s, g = _sqrt1p(x1), self._g(x1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            cg = np.cbrt(g)
+            f = self.C1 * s / cg
+            df = self.C1 * (x1 / (s * cg) - (2.0 / 3.0) * s**2 / (cg * g))
+        return np.stack([x3 * df, np.zeros_like(x1), f], axis=-1)
+
+
+class E2Optimal(AugmentingMap):
+    """E2-optimal map of Manipulator 1, eq. (36): h = x3 (a x1 + b) sqrt(1 + x1^2)."""
+
+    name = "e2_optimal"
+    p = 3
+
+    def __init__(self, a: float = 0.0, b: float = 1.0) -> None:
+        self.a = finite(a, "a")
+        self.b = finite(b, "b")
+        if self.a == 0 and self.b == 0:
+            raise InvalidInputError("a and b must not both be 0: h would vanish identically")
+
+    @property
+    def parameters(self) -> dict[str, float]:
+        return {"a": self.a, "b": self.b}
+
+    def value(self, x: FloatArray) -> FloatArray:
+        x = np.asarray(x, dtype=float)
+        x1, x3 = x[..., 0], x[..., 2]
+        return x3 * (self.a * x1 + self.b) * _sqrt1p(x1)
+
+    def gradient(self, x: FloatArray) -> FloatArray:
+        x = np.asarray(x, dtype=float)
+        x1, x3 = x[..., 0], x[..., 2]
+        s = _sqrt1p(x1)
+        f = (self.a * x1 + self.b) * s
+        df = self.a * s + (self.a * x1 + self.b) * x1 / s
+        return np.stack([x3 * df, np.zeros_like(x1), f], axis=-1)
+
+
+class E1Taylor(AugmentingMap):
+    """Taylor approximation (33) of (32) with C1 = C2 = 1: h = x3 (1 - 2 x1 / 3) sqrt(1 + x1^2)."""
+
+    name = "e1_taylor"
+    p = 3
+
+    def __init__(self) -> None:
+        self._e2 = E2Optimal(a=-2.0 / 3.0, b=1.0)
+
+    def value(self, x: FloatArray) -> FloatArray:
+        return self._e2.value(x)
+
+    def gradient(self, x: FloatArray) -> FloatArray:
+        return self._e2.gradient(x)
+
+
+class Polynomial2(AugmentingMap):
+    """A polynomial in two joint variables, h = sum c_ij u^i v^j with (u, v) = (x_a, x_b).
+
+    Parameters
+    ----------
+    coefficients : mapping (i, j) -> c_ij
+        Monomial exponents of u and v and their coefficients.
+    variables : (int, int)
+        0-based indices a, b of the joint variables u = x_a, v = x_b.
+    p : int
+        Configuration-space dimension.
+    """
+
+    name = "polynomial"
+
+    def __init__(
+        self,
+        coefficients: Mapping[tuple[int, int], float],
+        variables: tuple[int, int] = (1, 2),
+        p: int = 3,
+    ) -> None:
+        self.coefficients = {(int(i), int(j)): finite(c, f"c{i}{j}") for (i, j), c in coefficients.items()}
+        self.variables = variables
+        self.p = p
+
+    @property
+    def parameters(self) -> dict[str, float]:
+        return {f"c{i}{j}": c for (i, j), c in sorted(self.coefficients.items())}
+
+    def value(self, x: FloatArray) -> FloatArray:
+        x = np.asarray(x, dtype=float)
+        u, v = x[..., self.variables[0]], x[..., self.variables[1]]
+        return sum((c * u**i * v**j for (i, j), c in self.coefficients.items()), np.zeros_like(u))
+
+    def gradient(self, x: FloatArray) -> FloatArray:
+        x = np.asarray(x, dtype=float)
+        u, v = x[..., self.variables[0]], x[..., self.variables[1]]
+        du, dv = np.zeros_like(u), np.zeros_like(u)
+        for (i, j), c in self.coefficients.items():
+            if i:
+                du = du + c * i * u ** (i - 1) * v**j
+            if j:
+                dv = dv + c * j * u**i * v ** (j - 1)
+        g = np.zeros(x.shape)
+        g[..., self.variables[0]] = du
+        g[..., self.variables[1]] = dv
+        return g
+
+
+#: Coefficients of (38), x = x2, y = x3, keyed by (power of x2, power of x3).
+PAPER_CUBIC_COEFFICIENTS: dict[tuple[int, int], float] = {
+    (3, 0): 0.0006,
+    (0, 3): -0.2205,
+    (2, 1): 0.3469,
+    (1, 2): 0.0009,
+    (2, 0): 0.0005,
+    (0, 2): 0.0006,
+    (1, 1): -0.7501,
+    (1, 0): -0.0007,
+    (0, 1): 0.1381,
+    (0, 0): -0.0005,
+}
+
+
+class PaperCubic(Polynomial2):
+    """The cubic fit (38) of Manipulator 2's E2-optimal map, exactly as printed, h = h(x2, x3).
+
+    Its gradient is the exact one; the printed j32, j33 of (39) are not the gradient of (38)
+    (see docs/paper-errata.md).
+    """
+
+    name = "paper_cubic"
+
+    def __init__(self) -> None:
+        super().__init__(PAPER_CUBIC_COEFFICIENTS, variables=(1, 2), p=3)
+
+    @property
+    def parameters(self) -> dict[str, float]:
+        return {}
+
+
+class PaperCubicPrintedGradient(PaperCubic):
+    """(38) with the printed j32, j33 of (39) used as its 'gradient' (for the errata only).
+
+    These are not the derivatives of (38): j32 has 0.0012 x2^2 (should be 0.0018), j33 has
+    -0.4410 x3^2 (should be -0.6615) and -0.0007 x2 (should be -0.7501 x2).
+    """
+
+    name = "paper_cubic_printed_gradient"
+
+    def gradient(self, x: FloatArray) -> FloatArray:
+        x = np.asarray(x, dtype=float)
+        x2, x3 = x[..., 1], x[..., 2]
+        j32 = 0.0012 * x2**2 + 0.6938 * x2 * x3 + 0.0009 * x3**2 + 0.001 * x2 - 0.7501 * x3 - 0.0007
+        j33 = (
+            -0.4410 * x3**2 + 0.3469 * x2**2 + 0.0018 * x2 * x3 + 0.0012 * x3 - 0.0007 * x2 + 0.1381
+        )
+        return np.stack([np.zeros_like(x2), j32, j33], axis=-1)

@@ -1,0 +1,50 @@
+"""Typed errors of the engine.
+
+Every error says what is wrong and how to fix it; the singular ones carry the configuration.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+class JikError(Exception):
+    """Base class of every error raised by jik."""
+
+
+class InvalidInputError(JikError, ValueError):
+    """An argument has the wrong shape, a non-finite value or an out-of-range parameter."""
+
+
+class SingularConfigurationError(JikError):
+    """The configuration is a kinematic or algorithmic singularity.
+
+    Parameters
+    ----------
+    message : str
+        What is singular and what to do about it.
+    configuration : array_like, shape (p,)
+        The offending configuration.
+    """
+
+    def __init__(self, message: str, configuration) -> None:
+        self.configuration = np.asarray(configuration, dtype=float)
+        super().__init__(f"{message} at x = {format_vector(self.configuration)}")
+
+
+class KinematicSingularityError(SingularConfigurationError):
+    """The Jacobian J(x) loses rank: m(x) = sqrt(det J J^T) vanishes (eq. (8) undefined)."""
+
+
+class AlgorithmicSingularityError(SingularConfigurationError):
+    """The extended Jacobian [J; dh] is singular: eq. (11) undefined."""
+
+
+class OneFormUndefinedError(SingularConfigurationError):
+    """The normalised one-form omega (omega J^T = 0) cannot be normalised (section 4)."""
+
+
+def format_vector(v) -> str:
+    """Short readable form of a vector for error messages."""
+    v = np.atleast_1d(np.asarray(v, dtype=float))
+    return "(" + ", ".join(f"{t:.6g}" for t in v.ravel()) + ")"

@@ -1,0 +1,208 @@
+"""Right inverses of the Jacobian: the pseudoinverse, eq. (8), and the extended Jacobian inverse, eq. (11).
+
+Pure linear-algebra functions work on Jacobians; the :class:`Inverse` classes bind them to a
+kinematics (and an augmenting map) and raise typed errors that name the configuration.
+Nothing here forms an explicit matrix inverse: every product J# e is a linear solve.
+"""
+
+from __future__ import annotations
+
+import abc
+
+import numpy as np
+
+from engine.augmentations import AugmentingMap
+from engine.exceptions import (
+    AlgorithmicSingularityError,
+    InvalidInputError,
+    KinematicSingularityError,
+)
+from engine.kinematics import SINGULAR_MANIPULABILITY, Kinematics
+from engine.validation import FloatArray
+
+#: |det [J; dh]| / (product of its row norms) below this counts as an algorithmic singularity.
+SINGULAR_EXTENDED = 1e-10
+
+
+def _safe_solve(A: FloatArray, b: FloatArray, bad: FloatArray) -> FloatArray:
+    """Solve A z = b over a batch, skipping (and zeroing) the members flagged ``bad``."""
+    if np.any(bad):
+        eye = np.broadcast_to(np.eye(A.shape[-1]), A.shape)
+        A = np.where(bad[..., None, None], eye, A)
+    z = np.linalg.solve(A, b)
+    return np.where(bad[..., None, None], 0.0, z) if np.any(bad) else z
+
+
+def pseudoinverse(J: FloatArray) -> FloatArray:
+    """Jacobian pseudoinverse J^T (J J^T)^(-1), eq. (8).
+
+    Parameters
+    ----------
+    J : ndarray, shape (..., r, p)
+
+    Returns
+    -------
+    ndarray, shape (..., p, r)
+        Computed as J^T solve(J J^T, I); NaN where J J^T is singular.
+    """
+    Jt = np.swapaxes(J, -1, -2)
+    M = J @ Jt
+    r = J.shape[-2]
+    bad = np.abs(np.linalg.det(M)) < SINGULAR_MANIPULABILITY**2
+    W = _safe_solve(M, np.broadcast_to(np.eye(r), M.shape).copy(), bad)
+    out = Jt @ W
+    return np.where(bad[..., None, None], np.nan, out)
+
+
+def extended_jacobian(J: FloatArray, dh: FloatArray) -> FloatArray:
+    """The extended Jacobian [J; dh] of l = (k, h), eq. (10): shape (..., p, p)."""
+    return np.concatenate([J, dh[..., None, :]], axis=-2)
+
+
+def extended_singularity(Jbar: FloatArray) -> FloatArray:
+    """Hadamard ratio |det Jbar| / prod(row norms) in [0, 1]: 0 means singular."""
+    norms = np.prod(np.linalg.norm(Jbar, axis=-1), axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(norms > 0, np.abs(np.linalg.det(Jbar)) / norms, 0.0)
+
+
+def extended_inverse(J: FloatArray, dh: FloatArray) -> FloatArray:
+    """Extended Jacobian inverse, eq. (11): the first r columns of [J; dh]^(-1).
+
+    Parameters
+    ----------
+    J : ndarray, shape (..., r, p)
+    dh : ndarray, shape (..., p)
+
+    Returns
+    -------
+    ndarray, shape (..., p, r)
+        Computed as solve([J; dh], [I_r; 0]); NaN where [J; dh] is singular.
+    """
+    Jbar = extended_jacobian(J, dh)
+    r, p = J.shape[-2:]
+    bad = extended_singularity(Jbar) < SINGULAR_EXTENDED
+    rhs = np.zeros(Jbar.shape[:-2] + (p, r))
+    rhs[..., :r, :] = np.eye(r)
+    out = _safe_solve(Jbar, rhs, bad)
+    return np.where(bad[..., None, None], np.nan, out)
+
+
+class Inverse(abc.ABC):
+    """A right inverse J#(x) of the Jacobian of a kinematics (J J# = I_r), used in eq. (7)."""
+
+    name: str
+    kinematics: Kinematics
+
+    @abc.abstractmethod
+    def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """J#(x) e for a batch, without raising.
+
+        Returns
+        -------
+        v : ndarray, shape (..., p)
+            J#(x) e, zero where singular.
+        singular : ndarray of bool, shape (...,)
+            Where J#(x) is undefined.
+        """
+
+    @abc.abstractmethod
+    def matrix(self, x: FloatArray) -> FloatArray:
+        """J#(x): (..., p) -> (..., p, r); raises a typed error at a singular configuration."""
+
+    @abc.abstractmethod
+    def singular_error(self, x: FloatArray) -> Exception:
+        """The typed error describing a singularity of this inverse at configuration ``x``."""
+
+    def augmenting_value(self, x: FloatArray) -> FloatArray | None:
+        """h(x) for the extended inverse, None for the pseudoinverse."""
+        return None
+
+    def apply(self, x: FloatArray, e: FloatArray) -> FloatArray:
+        """J#(x) e, shape (..., p); raises at a singular configuration."""
+        x = self.kinematics.check(x)
+        e = self.kinematics.check_task(e, "e")
+        v, bad = self.apply_masked(x, e)
+        self._raise_if(x, bad)
+        return v
+
+    def _raise_if(self, x: FloatArray, bad: FloatArray) -> None:
+        bad = np.atleast_1d(bad)
+        if np.any(bad):
+            raise self.singular_error(np.reshape(x, (-1, x.shape[-1]))[np.flatnonzero(bad.ravel())[0]])
+
+
+class Pseudoinverse(Inverse):
+    """The Jacobian pseudoinverse J^T (J J^T)^(-1), eq. (8), of a kinematics."""
+
+    name = "pseudoinverse"
+
+    def __init__(self, kinematics: Kinematics) -> None:
+        self.kinematics = kinematics
+
+    def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
+        J = self.kinematics.jacobian(x)
+        Jt = np.swapaxes(J, -1, -2)
+        M = J @ Jt
+        bad = np.sqrt(np.abs(np.linalg.det(M))) < SINGULAR_MANIPULABILITY
+        w = _safe_solve(M, e[..., None], bad)
+        return (Jt @ w)[..., 0], bad
+
+    def matrix(self, x: FloatArray) -> FloatArray:
+        x = self.kinematics.check(x)
+        out = pseudoinverse(self.kinematics.jacobian(x))
+        self._raise_if(x, np.isnan(out[..., 0, 0]))
+        return out
+
+    def singular_error(self, x: FloatArray) -> Exception:
+        return KinematicSingularityError(
+            f"the pseudoinverse (8) of {self.kinematics.name} is undefined: J J^T is singular; "
+            "start away from the singular set",
+            x,
+        )
+
+
+class ExtendedInverse(Inverse):
+    """The extended Jacobian inverse, eq. (11), of a kinematics augmented by a map h, eq. (9).
+
+    By construction J J^E# = I_r and dh J^E# = 0, eq. (12), so h is constant along eq. (7).
+    """
+
+    name = "extended"
+
+    def __init__(self, kinematics: Kinematics, augmenting_map: AugmentingMap) -> None:
+        if kinematics.p - kinematics.r != 1:
+            raise InvalidInputError("the extended inverse here needs one degree of redundancy")
+        if augmenting_map.p != kinematics.p:
+            raise InvalidInputError(
+                f"augmenting map {augmenting_map.name!r} is defined on R^{augmenting_map.p}, "
+                f"but {kinematics.name} has p = {kinematics.p}"
+            )
+        self.kinematics = kinematics
+        self.augmenting_map = augmenting_map
+
+    def augmenting_value(self, x: FloatArray) -> FloatArray:
+        return self.augmenting_map.value(x)
+
+    def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
+        Jbar = extended_jacobian(self.kinematics.jacobian(x), self.augmenting_map.gradient(x))
+        finite = np.all(np.isfinite(Jbar), axis=(-1, -2))
+        Jbar = np.where(finite[..., None, None], Jbar, np.eye(Jbar.shape[-1]))
+        bad = ~finite | (extended_singularity(Jbar) < SINGULAR_EXTENDED)
+        rhs = np.concatenate([e, np.zeros(e.shape[:-1] + (1,))], axis=-1)
+        v = _safe_solve(Jbar, rhs[..., None], bad)[..., 0]
+        return v, bad
+
+    def matrix(self, x: FloatArray) -> FloatArray:
+        x = self.kinematics.check(x)
+        out = extended_inverse(self.kinematics.jacobian(x), self.augmenting_map.gradient(x))
+        self._raise_if(x, ~np.isfinite(out[..., 0, 0]))
+        return out
+
+    def singular_error(self, x: FloatArray) -> Exception:
+        return AlgorithmicSingularityError(
+            f"the extended Jacobian [J; dh] of {self.kinematics.name} with augmenting map "
+            f"{self.augmenting_map.name!r} is singular (algorithmic singularity, eq. (11)); "
+            "choose another start or augmentation parameters",
+            x,
+        )

@@ -1,0 +1,189 @@
+"""Kinematics k: R^p -> R^r with analytic Jacobians (paper, eqs. (4), (30), (37)).
+
+Every method is batched over leading axes: ``x`` of shape (..., p) gives (..., r) and (..., r, p).
+"""
+
+from __future__ import annotations
+
+import abc
+from typing import ClassVar
+
+import numpy as np
+
+from engine.exceptions import InvalidInputError, KinematicSingularityError
+from engine.validation import FloatArray, as_points, positive
+
+#: m(x) below this counts as a kinematic singularity.
+SINGULAR_MANIPULABILITY = 1e-9
+
+
+def kernel_cofactors(J: FloatArray) -> FloatArray:
+    """Generalised cross product of the rows of J, for one degree of redundancy.
+
+    Parameters
+    ----------
+    J : ndarray, shape (..., r, r + 1)
+
+    Returns
+    -------
+    c : ndarray, shape (..., r + 1)
+        ``c_i = (-1)^(r + 1 + i) det(J without column i)`` (1-based i), so that J c = 0,
+        ``det [J; c^T] = |c|^2`` and, by Cauchy-Binet, ``|c| = sqrt(det J J^T) = m(x)``.
+    """
+    r, p = J.shape[-2:]
+    if p != r + 1:
+        raise InvalidInputError(f"kernel_cofactors needs p = r + 1, got r = {r}, p = {p}")
+    minors = np.stack([np.linalg.det(np.delete(J, i, axis=-1)) for i in range(p)], axis=-1)
+    signs = np.array([(-1.0) ** (r + 1 + i) for i in range(1, p + 1)])
+    return minors * signs
+
+
+class Kinematics(abc.ABC):
+    """k: R^p -> R^r with p - r degrees of redundancy (paper, eq. (4)).
+
+    Subclasses implement only :meth:`forward` and :meth:`jacobian`; the kernel, the
+    manipulability and singularity checks follow from the Jacobian.
+    """
+
+    name: ClassVar[str]
+    p: int  # configuration-space dimension
+    r: int  # task-space dimension
+    #: +1 or -1: sign applied to the cofactor vector to fix the orientation of K(x).
+    kernel_orientation: ClassVar[float] = 1.0
+    #: Names of the configuration variables, for plots and messages.
+    variable_names: tuple[str, ...] = ()
+
+    @abc.abstractmethod
+    def forward(self, x: FloatArray) -> FloatArray:
+        """k(x): (..., p) -> (..., r)."""
+
+    @abc.abstractmethod
+    def jacobian(self, x: FloatArray) -> FloatArray:
+        """J(x) = dk/dx: (..., p) -> (..., r, p)."""
+
+    @property
+    def parameters(self) -> dict[str, object]:
+        """The kinematic parameters, as a JSON-friendly dict."""
+        return {}
+
+    def check(self, x, name: str = "x") -> FloatArray:
+        """Validate configurations: finite, shape (..., p)."""
+        return as_points(x, self.p, name)
+
+    def check_task(self, y, name: str = "y") -> FloatArray:
+        """Validate task-space points: finite, shape (..., r)."""
+        return as_points(y, self.r, name)
+
+    def kernel(self, x: FloatArray) -> FloatArray:
+        """Unit kernel vector K(x) of J(x), shape (..., p) (one degree of redundancy).
+
+        Notes
+        -----
+        Orientation: K = s c / |c| with c the cofactor vector of :func:`kernel_cofactors`
+        (``det [J; c^T] > 0``) and s = ``kernel_orientation``. For Manipulators 1 and 2 s is
+        chosen so that the last component of K is positive, the paper's convention (sec. 5),
+        which matters for the term -2 dh K of E2, eq. (19).
+        """
+        c = self.kernel_orientation * kernel_cofactors(self.jacobian(x))
+        norm = np.linalg.norm(c, axis=-1, keepdims=True)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return c / norm
+
+    def manipulability(self, x: FloatArray) -> FloatArray:
+        """m(x) = sqrt(det J J^T), shape (...,) (paper, after eq. (18))."""
+        J = self.jacobian(x)
+        return np.sqrt(np.maximum(np.linalg.det(J @ np.swapaxes(J, -1, -2)), 0.0))
+
+    def is_singular(self, x: FloatArray, tol: float = SINGULAR_MANIPULABILITY) -> FloatArray:
+        """Boolean mask (...,): where m(x) < tol, i.e. J(x) loses rank."""
+        return self.manipulability(x) < tol
+
+    def require_regular(self, x: FloatArray, what: str = "configuration") -> None:
+        """Raise :class:`KinematicSingularityError` naming the first singular configuration."""
+        bad = np.atleast_1d(self.is_singular(x))
+        if np.any(bad):
+            xb = np.reshape(x, (-1, self.p))[np.flatnonzero(bad.ravel())[0]]
+            raise KinematicSingularityError(
+                f"the {what} is a kinematic singularity of {self.name} (J loses rank, "
+                f"m(x) < {SINGULAR_MANIPULABILITY:g}); move it away from the singular set",
+                xb,
+            )
+
+
+class Manipulator1(Kinematics):
+    """Manipulator 1 in its normal form, k(x) = (x1, x2 + x1 x3), eq. (30).
+
+    J = [[1, 0, 0], [x3, 1, x1]], m(x) = sqrt(1 + x1^2) (the printed M is garbled),
+    K(x) = (0, -x1, 1) / sqrt(1 + x1^2), last component positive as in the paper.
+    """
+
+    name = "manipulator1"
+    p = 3
+    r = 2
+    kernel_orientation = 1.0
+    variable_names = ("x1", "x2", "x3")
+
+    def forward(self, x: FloatArray) -> FloatArray:
+        x = np.asarray(x, dtype=float)
+        return np.stack([x[..., 0], x[..., 1] + x[..., 0] * x[..., 2]], axis=-1)
+
+    def jacobian(self, x: FloatArray) -> FloatArray:
+        x = np.asarray(x, dtype=float)
+        J = np.zeros((*x.shape[:-1], 2, 3))
+        J[..., 0, 0] = 1.0
+        J[..., 1, 0] = x[..., 2]
+        J[..., 1, 1] = 1.0
+        J[..., 1, 2] = x[..., 0]
+        return J
+
+    def manipulability(self, x: FloatArray) -> FloatArray:
+        """m(x) = sqrt(det J J^T) = sqrt(1 + x1^2) (paper, sec. 5.1)."""
+        x = np.asarray(x, dtype=float)
+        return np.sqrt(1.0 + x[..., 0] ** 2)
+
+
+class Manipulator2(Kinematics):
+    """Manipulator 2: an XY gantry with a revolute arm, k(x) = (x2 + l cos x3, x1 + l sin x3), eq. (37).
+
+    J = [[0, 1, -l sin x3], [1, 0, l cos x3]], m = sqrt(1 + l^2) (the printed M is garbled),
+    K(x) = (-l cos x3, l sin x3, 1) / m, last component positive as in the paper.
+
+    Parameters
+    ----------
+    l : float
+        Arm length, > 0 (default 1).
+    """
+
+    name = "manipulator2"
+    p = 3
+    r = 2
+    kernel_orientation = -1.0
+    variable_names = ("x1", "x2", "x3")
+
+    def __init__(self, l: float = 1.0) -> None:
+        self.l = positive(l, "arm length l")
+
+    @property
+    def parameters(self) -> dict[str, object]:
+        return {"l": self.l}
+
+    def forward(self, x: FloatArray) -> FloatArray:
+        x = np.asarray(x, dtype=float)
+        return np.stack(
+            [x[..., 1] + self.l * np.cos(x[..., 2]), x[..., 0] + self.l * np.sin(x[..., 2])],
+            axis=-1,
+        )
+
+    def jacobian(self, x: FloatArray) -> FloatArray:
+        x = np.asarray(x, dtype=float)
+        J = np.zeros((*x.shape[:-1], 2, 3))
+        J[..., 0, 1] = 1.0
+        J[..., 0, 2] = -self.l * np.sin(x[..., 2])
+        J[..., 1, 0] = 1.0
+        J[..., 1, 2] = self.l * np.cos(x[..., 2])
+        return J
+
+    def manipulability(self, x: FloatArray) -> FloatArray:
+        """m(x) = sqrt(1 + l^2), constant (sec. 5.2; the printed M is garbled)."""
+        x = np.asarray(x, dtype=float)
+        return np.full(x.shape[:-1], np.sqrt(1.0 + self.l**2))
