@@ -18,6 +18,7 @@ from engine.exceptions import (
     KinematicSingularityError,
 )
 from engine.kinematics import SINGULAR_MANIPULABILITY, Kinematics
+from engine.linalg import solve_small
 from engine.validation import FloatArray
 
 #: |det [J; dh]| / (product of its row norms) below this counts as an algorithmic singularity.
@@ -142,11 +143,10 @@ class Pseudoinverse(Inverse):
 
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
         J = self.kinematics.jacobian(x)
-        Jt = np.swapaxes(J, -1, -2)
-        M = J @ Jt
-        bad = np.sqrt(np.abs(np.linalg.det(M))) < SINGULAR_MANIPULABILITY
-        w = _safe_solve(M, e[..., None], bad)
-        return (Jt @ w)[..., 0], bad
+        w, d = solve_small(J @ np.swapaxes(J, -1, -2), e)  # (J J^T) w = e
+        bad = ~(np.sqrt(np.abs(d)) >= SINGULAR_MANIPULABILITY)  # also catches NaN
+        v = np.einsum("...ji,...j->...i", J, w)  # J^T w
+        return np.where(bad[..., None], 0.0, v), bad
 
     def matrix(self, x: FloatArray) -> FloatArray:
         x = self.kinematics.check(x)
@@ -186,12 +186,11 @@ class ExtendedInverse(Inverse):
 
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
         Jbar = extended_jacobian(self.kinematics.jacobian(x), self.augmenting_map.gradient(x))
-        finite = np.all(np.isfinite(Jbar), axis=(-1, -2))
-        Jbar = np.where(finite[..., None, None], Jbar, np.eye(Jbar.shape[-1]))
-        bad = ~finite | (extended_singularity(Jbar) < SINGULAR_EXTENDED)
-        rhs = np.concatenate([e, np.zeros(e.shape[:-1] + (1,))], axis=-1)
-        v = _safe_solve(Jbar, rhs[..., None], bad)[..., 0]
-        return v, bad
+        rhs = np.concatenate([e, np.zeros(e.shape[:-1] + (1,))], axis=-1)  # [e; 0]
+        v, d = solve_small(Jbar, rhs)
+        norms = np.prod(np.linalg.norm(Jbar, axis=-1), axis=-1)
+        bad = ~(np.abs(d) >= SINGULAR_EXTENDED * norms) | ~np.all(np.isfinite(v), axis=-1)
+        return np.where(bad[..., None], 0.0, v), bad
 
     def matrix(self, x: FloatArray) -> FloatArray:
         x = self.kinematics.check(x)

@@ -1,0 +1,87 @@
+"""The ``jik`` command: ``jik serve``, ``jik reproduce NAME [--json]``, ``jik bench [NAME]``."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import sys
+
+#: Reproductions: name -> module in engine.reproductions with run() and format_text().
+REPRODUCTIONS = {
+    "table1": "Table 1: repeatability of Manipulator 2, pseudoinverse vs extended (38)",
+    "manipulator1": "Manipulator 1: E1 and E2 of (32), (33), (36) and the symbolic checks",
+    "manipulator2": "Manipulator 2: E2 synthesis, cubic fit, Table 1 with e2_synthesized",
+    "unicycle": "Unicycle, section 6.2: runs from A and B with both inverses",
+}
+
+
+def _progress(fraction: float) -> None:
+    sys.stderr.write(f"\r  progress {100 * fraction:5.1f}%")
+    if fraction >= 1:
+        sys.stderr.write("\n")
+    sys.stderr.flush()
+
+
+def reproduce(args: argparse.Namespace) -> int:
+    module = importlib.import_module(f"engine.reproductions.{args.name}")
+    kwargs = {}
+    if args.name == "table1" and args.printed_gradient:
+        kwargs["printed_gradient"] = True
+    elif args.name != "table1" and not args.json:
+        kwargs["progress"] = _progress
+    result = module.run(**kwargs)
+    if args.json:
+        print(json.dumps(result))
+    else:
+        print(module.format_text(result))
+    return 0
+
+
+def serve(args: argparse.Namespace) -> int:
+    from app.server import run_server
+
+    run_server(host=args.host, port=args.port, scene_port=args.scene_port)
+    return 0
+
+
+def bench(args: argparse.Namespace) -> int:
+    from benchmarks import run_benchmarks
+
+    return run_benchmarks(args.names, quick=args.quick)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="jik", description="jik: a lab for repeatable Jacobian inverse kinematics"
+    )
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("serve", help="start the REST API and the dashboard")
+    p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
+    p.add_argument("--port", type=int, default=8000, help="HTTP port of the API and page")
+    p.add_argument("--scene-port", type=int, default=8080, help="port of the viser 3D scene")
+    p.set_defaults(func=serve)
+
+    p = sub.add_parser("reproduce", help="recompute a result of the paper")
+    p.add_argument("name", choices=sorted(REPRODUCTIONS), help="; ".join(
+        f"{k}: {v}" for k, v in REPRODUCTIONS.items()))
+    p.add_argument("--json", action="store_true", help="print machine-readable JSON")
+    p.add_argument(
+        "--printed-gradient",
+        action="store_true",
+        help="table1 only: use the printed j32, j33 of (39) instead of the gradient of (38)",
+    )
+    p.set_defaults(func=reproduce)
+
+    p = sub.add_parser("bench", help="run the benchmarks (medians, ratios to straightforward code)")
+    p.add_argument("names", nargs="*", help="benchmarks to run (default: all)")
+    p.add_argument("--quick", action="store_true", help="fewer repetitions, for a smoke test")
+    p.set_defaults(func=bench)
+
+    args = parser.parse_args(argv)
+    return args.func(args)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

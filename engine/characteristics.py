@@ -1,0 +1,383 @@
+"""Geometric synthesis of an augmenting map by characteristics, one degree of redundancy (section 4).
+
+The one-form omega annihilates J^T (omega J^T = 0) and is normalised by one component,
+``omega[fixed_index] = 1``. A linear homotopy Phi_s contracts every configuration onto a reference
+leaf along the components transverse to the leaves, eqs. (21), (22), (45); the augmenting map h is
+the end point z(0) of the characteristic (28) started at z(1) = z, eq. (29). Its exact gradient
+comes from the variational equations along the same characteristic.
+
+The characteristic is solved by spectral (Chebyshev-Lobatto) collocation in s on [0, 1] with
+Newton's method, for a whole batch at once; the variational equations are the linearisation of
+the same collocation system, so the gradient is exact for the computed h.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from engine.augmentations import AugmentingMap
+from engine.exceptions import InvalidInputError, OneFormUndefinedError, format_vector
+from engine.kinematics import Kinematics, kernel_cofactors
+from engine.unicycle import Unicycle
+from engine.validation import FloatArray, as_vector, count, finite
+
+#: |kernel component fixed_index| <= ONE_FORM_TOL |kernel| counts as "omega undefined".
+ONE_FORM_TOL = 1e-9
+#: Default number of collocation nodes in s (including s = 0 and s = 1).
+COLLOCATION_NODES = 20
+#: Newton iterations on the collocation system before giving up.
+NEWTON_MAX = 30
+#: Newton stops when the largest update is below this (relative to 1 + |z|).
+NEWTON_TOL = 1e-14
+
+
+def kernel_cofactors_derivative(J: FloatArray, H: FloatArray) -> FloatArray:
+    """Derivative of the kernel cofactor vector c(J(x)) with respect to x.
+
+    Parameters
+    ----------
+    J : ndarray, shape (..., r, r + 1)
+        Jacobian.
+    H : ndarray, shape (..., r, r + 1, r + 1)
+        Its derivative, ``H[..., i, j, k] = d J_ij / d x_k``.
+
+    Returns
+    -------
+    dc : ndarray, shape (..., p, p)
+        ``dc[..., i, k] = d c_i / d x_k``.
+
+    Notes
+    -----
+    c is the generalised cross product of the rows of J, multilinear in them, so
+    dc/dx_k = sum_j c(J with row j replaced by dJ_j/dx_k).
+    """
+    r, p = J.shape[-2:]
+    Jm = np.broadcast_to(J[..., None, None, :, :], (*J.shape[:-2], r, p, r, p)).copy()
+    for j in range(r):
+        Jm[..., j, :, j, :] = np.swapaxes(H[..., j, :, :], -1, -2)
+    return np.swapaxes(kernel_cofactors(Jm).sum(axis=-3), -1, -2)
+
+
+def _one_form_parts(J, H, fixed_index):
+    """omega (..., p), d omega/dx (..., p, p) or None, and the 'undefined' mask (...,)."""
+    c = kernel_cofactors(J)
+    cf = c[..., fixed_index]
+    bad = np.abs(cf) <= ONE_FORM_TOL * np.linalg.norm(c, axis=-1)
+    cf = np.where(bad, 1.0, cf)
+    omega = c / cf[..., None]
+    if H is None:
+        return omega, None, bad
+    dc = kernel_cofactors_derivative(J, H)
+    domega = (dc - omega[..., :, None] * dc[..., fixed_index, None, :]) / cf[..., None, None]
+    return omega, domega, bad
+
+
+def _check_index(kinematics: Kinematics, fixed_index) -> int:
+    if kinematics.p - kinematics.r != 1:
+        raise InvalidInputError("characteristics synthesis here needs one degree of redundancy")
+    return count(fixed_index, "fixed_index", 0, kinematics.p - 1)
+
+
+def _undefined_error(kinematics, x, bad, fixed_index, where=""):
+    xb = np.reshape(x, (-1, kinematics.p))[np.flatnonzero(np.ravel(bad))[0]]
+    return OneFormUndefinedError(
+        f"the one-form omega (omega J^T = 0) of {kinematics.name} cannot be normalised by its "
+        f"component {fixed_index} (0-based): that kernel component vanishes{where}",
+        xb,
+    )
+
+
+def one_form(kinematics: Kinematics, x, fixed_index: int) -> FloatArray:
+    """The one-form omega spanning the annihilator of J^T, normalised by one component (sec. 4).
+
+    Parameters
+    ----------
+    kinematics : Kinematics
+        With p = r + 1.
+    x : array_like, shape (..., p)
+    fixed_index : int
+        0-based component set to 1 (the unicycle of sec. 6.1 uses lambda11, index 1).
+
+    Returns
+    -------
+    omega : ndarray, shape (..., p)
+        omega = c / c[fixed_index] with c the kernel cofactor vector, so omega J^T = 0.
+
+    Raises
+    ------
+    OneFormUndefinedError
+        Where |c[fixed_index]| <= ONE_FORM_TOL |c|, naming the configuration.
+    """
+    fixed_index = _check_index(kinematics, fixed_index)
+    x = kinematics.check(x)
+    omega, _, bad = _one_form_parts(kinematics.jacobian(x), None, fixed_index)
+    if np.any(bad):
+        raise _undefined_error(kinematics, x, bad, fixed_index)
+    return omega
+
+
+def one_form_derivative(
+    kinematics: Kinematics, x, fixed_index: int
+) -> tuple[FloatArray, FloatArray]:
+    """omega (..., p) and its derivative d omega_i / d x_k (..., p, p).
+
+    Needs ``kinematics.hessian`` (or ``kinematics.derivatives``); d omega follows analytically
+    from the derivative of the kernel cofactors, :func:`kernel_cofactors_derivative`.
+    """
+    fixed_index = _check_index(kinematics, fixed_index)
+    x = kinematics.check(x)
+    J, H = _derivatives(kinematics, x)
+    omega, domega, bad = _one_form_parts(J, H, fixed_index)
+    if np.any(bad):
+        raise _undefined_error(kinematics, x, bad, fixed_index)
+    return omega, domega
+
+
+def _derivatives(kinematics, x):
+    if hasattr(kinematics, "derivatives"):
+        return kinematics.derivatives(x)
+    if hasattr(kinematics, "hessian"):
+        return kinematics.jacobian(x), kinematics.hessian(x)
+    raise InvalidInputError(f"{kinematics.name} has no hessian(); d omega needs second derivatives")
+
+
+class LinearHomotopy:
+    """Phi_t(x) = t x + (1 - t) x_ref on the components transverse to the leaves, eq. (45).
+
+    The leaf coordinate z = x[fixed_index] is left unchanged, so Phi_1 = id, Phi_0 maps onto the
+    reference leaf {x : x_j = x_ref_j for j != fixed_index} and Phi_s o Phi_t = Phi_st.
+    X(x) = dPhi_t/dt at t = 1 = x - x_ref (zero in the z component), eq. (21), and
+    t dPhi_t/dt = X(Phi_t), eq. (22).
+    """
+
+    def __init__(self, reference, fixed_index: int) -> None:
+        self.reference = as_vector(reference, np.size(reference), "reference point").copy()
+        self.fixed_index = count(fixed_index, "fixed_index", 0, self.reference.size - 1)
+        self.reference[self.fixed_index] = 0.0
+        self.transverse = np.ones(self.reference.size)
+        self.transverse[self.fixed_index] = 0.0
+
+    def __call__(self, x: FloatArray, t) -> FloatArray:
+        """Phi_t(x): x (..., p), t broadcastable to x[..., 0]."""
+        t = np.asarray(t, dtype=float)[..., None]
+        return x + (t - 1.0) * self.field(x)
+
+    def field(self, x: FloatArray) -> FloatArray:
+        """X(x), eq. (21)."""
+        return (x - self.reference) * self.transverse
+
+
+@functools.lru_cache(maxsize=8)
+def collocation(n: int) -> tuple[FloatArray, FloatArray]:
+    """Chebyshev-Lobatto nodes s (n,) on [0, 1] (s[0] = 0, s[-1] = 1) and the matrix W (n, n).
+
+    ``(W g)_i`` is the integral from s_i to 1 of the interpolating polynomial of g at the nodes.
+    """
+    cheb = np.polynomial.chebyshev
+    u = -np.cos(np.pi * np.arange(n) / (n - 1))  # [-1, 1], increasing
+    V = cheb.chebvander(u, n - 1)  # (n, n)
+    A = np.empty((n, n))
+    for k in range(n):
+        P = cheb.chebint(np.eye(n)[k])
+        A[:, k] = cheb.chebval(1.0, P) - cheb.chebval(u, P)
+    W = 0.5 * A @ np.linalg.inv(V)
+    s = 0.5 * (u + 1.0)
+    s.flags.writeable = False
+    W.flags.writeable = False
+    return s, W
+
+
+class CharacteristicsMap(AugmentingMap):
+    """Augmenting map h(y, z) = z(0) of the characteristic (28), eq. (29), with its exact gradient.
+
+    Parameters
+    ----------
+    kinematics : Kinematics
+        p = r + 1, with ``hessian`` (needed for d omega).
+    reference : array_like, shape (p,)
+        A point of the reference leaf (its z component is ignored).
+    fixed_index : int
+        0-based index of the leaf coordinate z; omega is normalised with omega_z = 1.
+    nodes : int
+        Collocation nodes in s (default :data:`COLLOCATION_NODES`).
+    on_undefined : {"raise", "nan"}
+        What :meth:`value` and :meth:`gradient` do where omega is undefined along the
+        characteristic (or Newton fails): raise :class:`OneFormUndefinedError`, or return NaN
+        (the extended inverse then reports an algorithmic singularity there).
+
+    Notes
+    -----
+    With Phi_s(y, z) = x_ref + s y (transverse), z (leaf), X(Phi_s) = s Y where Y = X(x), so
+    eq. (28) reads dz/ds = -F(Phi_s)/s = -omega(Phi_s(y, z)) Y: regular at s = 0. The
+    variational equations for S = dz(s)/d(y, z(1)) are
+    dS/ds = G_z S + G_y, S(1) = (0, ..., 1), with G_z = -(d omega/dz) Y and
+    G_y = -s (d omega/dy) Y - omega_y; then dh = S(0).
+    """
+
+    name = "characteristics"
+
+    def __init__(
+        self,
+        kinematics: Kinematics,
+        reference,
+        fixed_index: int,
+        nodes: int = COLLOCATION_NODES,
+        on_undefined: str = "raise",
+    ) -> None:
+        self.kinematics = kinematics
+        self.p = kinematics.p
+        self.fixed_index = _check_index(kinematics, fixed_index)
+        self.homotopy = LinearHomotopy(as_vector(reference, self.p, "reference"), fixed_index)
+        self.nodes = count(nodes, "collocation nodes", 4, 200)
+        if on_undefined not in ("raise", "nan"):
+            raise InvalidInputError(f"on_undefined must be 'raise' or 'nan', got {on_undefined!r}")
+        self.on_undefined = on_undefined
+        self._cache: tuple[FloatArray, tuple] | None = None
+
+    def characteristic(self, x) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """Solve the characteristic (28) through each x, batched.
+
+        Returns
+        -------
+        s : ndarray, shape (n,)
+            Collocation nodes, s[0] = 0, s[-1] = 1.
+        z : ndarray, shape (..., n)
+            z(s) at the nodes; h(x) = z[..., 0].
+        dh : ndarray, shape (..., p)
+            Exact gradient of h = z(0) (variational equations).
+        failed : ndarray of bool, shape (...,), and the first failing point (p,) or None
+        """
+        x = self.kinematics.check(x)
+        shape = x.shape[:-1]
+        xb = x.reshape(-1, self.p)
+        s, W = collocation(self.nodes)
+        f = self.fixed_index
+        Y = self.homotopy.field(xb)  # (B, p)
+        base = self.homotopy(xb, 0.0)[:, None, :] + s[:, None] * Y[:, None, :]  # (B, n, p)
+        Z = np.repeat(xb[:, f : f + 1], s.size, axis=1)  # (B, n), initial guess z(s) = z(1)
+        eye = np.eye(s.size)
+        with np.errstate(all="ignore"):
+            for _ in range(NEWTON_MAX):
+                pts = base.copy()
+                pts[..., f] = Z
+                omega, domega, bad = _one_form_parts(*_derivatives(self.kinematics, pts), f)
+                G = -np.einsum("bnk,bk->bn", omega, Y)
+                Gz = -np.einsum("bnk,bk->bn", domega[..., f], Y)
+                A = eye + W * Gz[:, None, :]
+                R = Z - xb[:, f : f + 1] + G @ W.T
+                dZ = np.linalg.solve(A, R[..., None])[..., 0]
+                dZ = np.where(np.isfinite(dZ), dZ, np.nan)
+                Z = Z - dZ
+                step = np.max(np.abs(dZ) / (1.0 + np.abs(Z)), axis=-1, initial=0.0)
+                if not np.any(step > NEWTON_TOL):  # NaN members stop too; flagged below
+                    break
+            pts = base.copy()
+            pts[..., f] = Z
+            omega, domega, bad = _one_form_parts(*_derivatives(self.kinematics, pts), f)
+            Gz = -np.einsum("bnk,bk->bn", domega[..., f], Y)
+            Gy = -s[:, None] * np.einsum("bnkj,bk->bnj", domega, Y) - omega  # (B, n, p)
+            A = eye + W * Gz[:, None, :]
+            rhs = -(W @ Gy)  # d/dy_j columns, (B, n, p)
+            rhs[..., f] = 1.0  # d/dz(1) column
+            S = np.linalg.solve(A, rhs)
+        failed = np.any(bad, axis=-1) | ~np.all(np.isfinite(S[:, 0, :]), axis=-1)
+        failed |= ~np.all(np.isfinite(Z), axis=-1)
+        failed |= ~(step <= 1e3 * NEWTON_TOL)
+        where = None
+        if np.any(failed):
+            i = np.flatnonzero(failed)[0]
+            j = np.flatnonzero(bad[i])
+            where = (pts[i, j[0]], s[j[0]], xb[i]) if j.size else (None, None, xb[i])
+        self._where = where
+        return s, Z.reshape(*shape, s.size), S[:, 0, :].reshape(*shape, self.p), failed.reshape(shape)
+
+    def evaluate(self, x) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """h(x) (...,), dh/dx (..., p) and the failure mask (...,), without raising."""
+        x = self.kinematics.check(x)
+        if self._cache is not None and self._cache[0].shape == x.shape:
+            if np.array_equal(self._cache[0], x):
+                return self._cache[1]
+        _, Z, dh, failed = self.characteristic(x)
+        h = np.where(failed, np.nan, Z[..., 0])
+        dh = np.where(failed[..., None], np.nan, dh)
+        out = (h, dh, failed)
+        self._cache = (x.copy(), out, self._where)
+        return out
+
+    def _raise_if(self, failed) -> None:
+        if self.on_undefined == "raise" and np.any(failed):
+            phi, s, x = self._cache[2]
+            if phi is None:
+                raise OneFormUndefinedError(
+                    "the characteristic (28) of h could not be resolved (Newton on the "
+                    "collocation system did not converge; omega blows up along it)",
+                    x,
+                )
+            raise OneFormUndefinedError(
+                f"h(x) is undefined: along its characteristic (28), at s = {s:.3g}, "
+                f"Phi_s = {format_vector(phi)}, the kernel component {self.fixed_index} "
+                f"(0-based) of {self.kinematics.name} vanishes, so omega cannot be normalised",
+                x,
+            )
+
+    def value(self, x: FloatArray) -> FloatArray:
+        """h(x) = z(0), eq. (29): (..., p) -> (...,)."""
+        h, _, failed = self.evaluate(x)
+        self._raise_if(failed)
+        return h
+
+    def gradient(self, x: FloatArray) -> FloatArray:
+        """dh/dx from the variational equations: (..., p) -> (..., p)."""
+        _, dh, failed = self.evaluate(x)
+        self._raise_if(failed)
+        return dh
+
+
+class UnicycleCharacteristics(CharacteristicsMap):
+    """The unicycle's augmenting map of section 6.1: reference leaf E_{a,0} = a e1 + R e2.
+
+    y1 = l10 - a, y2 = l20, y3 = l21, z = l11 (eq. (45), (46)); omega is normalised with
+    omega2 = 1 (1-based), i.e. ``fixed_index = 1``.
+
+    Parameters
+    ----------
+    kinematics : Unicycle
+        The unicycle (its q0 and T define omega and so h).
+    a : float
+        Reference leaf parameter, a != 0 (omega is undefined at lambda10 = 0).
+    """
+
+    name = "characteristics"
+
+    def __init__(
+        self,
+        kinematics: Unicycle | None = None,
+        a: float = 1.0,
+        nodes: int = COLLOCATION_NODES,
+        on_undefined: str = "raise",
+    ) -> None:
+        self.a = finite(a, "a")
+        if self.a == 0:
+            raise InvalidInputError(
+                "a must be nonzero: omega is undefined on lambda10 = 0, so the reference "
+                "leaf E_{a,0} = a e1 + R e2 needs a != 0"
+            )
+        kinematics = Unicycle() if kinematics is None else kinematics
+        super().__init__(kinematics, (self.a, 0.0, 0.0, 0.0), 1, nodes, on_undefined)
+
+    @property
+    def parameters(self) -> dict[str, float]:
+        return {"a": self.a}
+
+
+__all__ = [
+    "CharacteristicsMap",
+    "LinearHomotopy",
+    "UnicycleCharacteristics",
+    "collocation",
+    "kernel_cofactors_derivative",
+    "one_form",
+    "one_form_derivative",
+]

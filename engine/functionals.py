@@ -1,0 +1,336 @@
+"""Approximation error functionals E1, eq. (13)/(14), and E2, eq. (18)/(19), by Gauss quadrature.
+
+Both are integrals over a box of the joint space. The box is given by the variables that are
+integrated over (``region``); every other joint variable is held at a fixed value (``fixed``,
+default 0) and not integrated over, as in the paper's reduction h = h(x2, x3) for Manipulator 2.
+A tensor Gauss-Legendre rule with ``nodes`` points per integrated variable is evaluated in one
+batch.
+
+Orientation of K: ``Kinematics.kernel`` returns the unit kernel vector with the paper's sign
+(last component positive for Manipulators 1 and 2). E1 does not depend on it; E2 does, through
+the term -2 dh K of (19), so flipping the sign of h changes E2 unless K is flipped too.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from engine.augmentations import AugmentingMap
+from engine.exceptions import InvalidInputError
+from engine.inverses import (
+    SINGULAR_EXTENDED,
+    extended_inverse,
+    extended_jacobian,
+    extended_singularity,
+    pseudoinverse,
+)
+from engine.kinematics import Kinematics
+from engine.validation import FloatArray, count, finite
+
+Region = Mapping[str, tuple[float, float]]
+
+
+@dataclass(frozen=True)
+class FunctionalValue:
+    """The value of an error functional over a box of the joint space.
+
+    Attributes
+    ----------
+    value : float
+        The integral; for E1, quadrature points where [J; dh] is singular are excluded (the
+        integrand is infinite there), for E2 they are included (the integrand (19) is finite).
+    region : dict
+        ``{"x2": (lo, hi), ...}``: the integrated variables.
+    n_points : int
+        Number of quadrature points.
+    singular_points : ndarray, shape (k, p)
+        Quadrature points where the extended Jacobian [J; dh] is singular (or dh not finite).
+    fixed : dict
+        Values of the joint variables not integrated over.
+    min_abs_dh_k : float
+        min |dh K| over the quadrature points: E1 is singular where dh K = 0 (eq. (14)), and a
+        sign change of dh K inside the region makes E1 infinite.
+    """
+
+    value: float
+    region: dict[str, tuple[float, float]]
+    n_points: int
+    singular_points: np.ndarray
+    fixed: dict[str, float] = field(default_factory=dict)
+    min_abs_dh_k: float = float("nan")
+
+    def as_dict(self) -> dict:
+        """JSON-friendly form."""
+        return {
+            "value": self.value,
+            "region": {k: list(v) for k, v in self.region.items()},
+            "fixed": dict(self.fixed),
+            "n_points": self.n_points,
+            "n_singular": int(self.singular_points.shape[0]),
+            "singular_points": self.singular_points.tolist(),
+            "min_abs_dh_k": self.min_abs_dh_k,
+        }
+
+
+def check_region(
+    kinematics: Kinematics, region: Region, fixed: Mapping[str, float] | None = None
+) -> tuple[dict[str, tuple[float, float]], dict[str, float]]:
+    """Validate a box region and the fixed values of the other variables.
+
+    Returns
+    -------
+    region : dict name -> (lo, hi), in the kinematics' variable order
+    fixed : dict name -> value for every variable not in ``region`` (default 0)
+    """
+    names = tuple(kinematics.variable_names) or tuple(f"x{i + 1}" for i in range(kinematics.p))
+    if not isinstance(region, Mapping) or not region:
+        raise InvalidInputError(f"region must be a non-empty mapping of {names} to (lo, hi)")
+    fixed = dict(fixed or {})
+    for name in (*region, *fixed):
+        if name not in names:
+            raise InvalidInputError(f"unknown joint variable {name!r}; use one of {names}")
+    both = set(region) & set(fixed)
+    if both:
+        raise InvalidInputError(f"variables {sorted(both)} are both integrated over and fixed")
+    box: dict[str, tuple[float, float]] = {}
+    for name in names:
+        if name not in region:
+            continue
+        try:
+            lo, hi = region[name]
+        except (TypeError, ValueError) as exc:
+            raise InvalidInputError(f"region[{name!r}] must be a pair (lo, hi)") from exc
+        lo, hi = finite(lo, f"lower bound of {name}"), finite(hi, f"upper bound of {name}")
+        if not lo < hi:
+            raise InvalidInputError(f"region[{name!r}] must have lo < hi, got ({lo}, {hi})")
+        box[name] = (lo, hi)
+    fix = {n: finite(fixed.get(n, 0.0), f"fixed {n}") for n in names if n not in box}
+    return box, fix
+
+
+def quadrature(
+    kinematics: Kinematics,
+    region: Region,
+    nodes: int = 16,
+    fixed: Mapping[str, float] | None = None,
+) -> tuple[FloatArray, FloatArray, dict, dict]:
+    """Tensor Gauss-Legendre rule over a box of the joint space.
+
+    Returns
+    -------
+    x : ndarray, shape (n, p)
+        Quadrature points, n = nodes ** len(region).
+    w : ndarray, shape (n,)
+        Weights (they sum to the box volume).
+    region, fixed : dict
+        The validated region and fixed values.
+    """
+    nodes = count(nodes, "nodes", 1, 400)
+    box, fix = check_region(kinematics, region, fixed)
+    names = tuple(kinematics.variable_names) or tuple(f"x{i + 1}" for i in range(kinematics.p))
+    t, tw = np.polynomial.legendre.leggauss(nodes)
+    axes, weights = [], []
+    for lo, hi in box.values():
+        axes.append(0.5 * (hi + lo) + 0.5 * (hi - lo) * t)
+        weights.append(0.5 * (hi - lo) * tw)
+    grids = np.meshgrid(*axes, indexing="ij")
+    w = np.ones(grids[0].shape)
+    for i, wi in enumerate(weights):
+        shape = [1] * len(weights)
+        shape[i] = -1
+        w = w * wi.reshape(shape)
+    x = np.empty((w.size, kinematics.p))
+    k = 0
+    for i, name in enumerate(names):
+        if name in box:
+            x[:, i] = grids[k].ravel()
+            k += 1
+        else:
+            x[:, i] = fix[name]
+    return x, w.ravel(), box, fix
+
+
+def _singular_mask(J: FloatArray, dh: FloatArray) -> FloatArray:
+    """Where [J; dh] is singular or dh is not finite, shape (n,)."""
+    ok = np.all(np.isfinite(dh), axis=-1)
+    dh_safe = np.where(ok[:, None], dh, 0.0)
+    return ~ok | (extended_singularity(extended_jacobian(J, dh_safe)) < SINGULAR_EXTENDED)
+
+
+def e1_integrand(J: FloatArray, dh: FloatArray) -> FloatArray:
+    """||J^P# - J^E#||_F^2 of eq. (13), shape (...,); NaN where [J; dh] is singular."""
+    D = pseudoinverse(J) - extended_inverse(J, dh)
+    return np.sum(D**2, axis=(-1, -2))
+
+
+def e2_integrand(J: FloatArray, K: FloatArray, m: FloatArray, dh: FloatArray) -> FloatArray:
+    """||E1^(-1) E2 - I||_F^2 m of eq. (18), shape (...,).
+
+    E1^(-1) = [J; dh] (16) and E2 = [J^P#, K] (17), so no inverse of the extended Jacobian is
+    needed: the integrand equals (dh P dh^T - 2 dh K + 1) m, eq. (19), and is finite everywhere.
+    """
+    Jbar = extended_jacobian(J, dh)  # (..., p, p)
+    E2 = np.concatenate([pseudoinverse(J), K[..., :, None]], axis=-1)  # (..., p, p)
+    D = Jbar @ E2 - np.eye(J.shape[-1])
+    return np.sum(D**2, axis=(-1, -2)) * m
+
+
+def _evaluate(
+    which: str,
+    kinematics: Kinematics,
+    augmenting_map: AugmentingMap,
+    region: Region,
+    nodes: int,
+    fixed: Mapping[str, float] | None,
+) -> FunctionalValue:
+    if kinematics.p - kinematics.r != 1:
+        raise InvalidInputError("the error functionals here need one degree of redundancy")
+    if augmenting_map.p != kinematics.p:
+        raise InvalidInputError(
+            f"augmenting map {augmenting_map.name!r} is defined on R^{augmenting_map.p}, "
+            f"but {kinematics.name} has p = {kinematics.p}"
+        )
+    x, w, box, fix = quadrature(kinematics, region, nodes, fixed)
+    kinematics.require_regular(x, "integration region (a quadrature point)")
+    J = kinematics.jacobian(x)
+    with np.errstate(all="ignore"):
+        dh = np.asarray(augmenting_map.gradient(x), dtype=float)
+    bad = _singular_mask(J, dh)
+    dh_safe = np.where(bad[:, None], 0.0, dh)
+    K = kinematics.kernel(x)
+    dhk = np.einsum("np,np->n", dh_safe, K)
+    if which == "e1":
+        f = np.where(bad, 0.0, e1_integrand(J, np.where(bad[:, None], K, dh_safe)))
+    else:
+        f = e2_integrand(J, K, kinematics.manipulability(x), dh_safe)
+    return FunctionalValue(
+        value=float(np.dot(w, f)),
+        region=box,
+        n_points=int(w.size),
+        singular_points=x[bad],
+        fixed=fix,
+        min_abs_dh_k=float(np.min(np.abs(np.where(bad, 0.0, dhk)))),
+    )
+
+
+def error_functional_e1(
+    kinematics: Kinematics,
+    augmenting_map: AugmentingMap,
+    region: Region,
+    *,
+    nodes: int = 16,
+    fixed: Mapping[str, float] | None = None,
+) -> FunctionalValue:
+    """E1(h) = integral of ||J^P#(x) - J^E#(x)||_F^2 over a box, eq. (13) (= (14)).
+
+    Parameters
+    ----------
+    kinematics : Kinematics
+        With one degree of redundancy.
+    augmenting_map : AugmentingMap
+        h, eq. (9); only its gradient enters.
+    region : mapping name -> (lo, hi)
+        The integrated variables, e.g. ``{"x1": (0, 1), "x3": (0.5, 1.5)}``.
+    nodes : int
+        Gauss-Legendre points per integrated variable.
+    fixed : mapping name -> value, optional
+        Values of the variables not integrated over (default 0).
+
+    Returns
+    -------
+    FunctionalValue
+        Quadrature points where [J; dh] is singular are excluded from the value and listed in
+        ``singular_points``.
+
+    Notes
+    -----
+    J^P# - J^E# = K W with W = (dh K)^(-1) dh J^P#, so the integrand is
+    dh P dh^T / (dh K)^2 - 1: it blows up like (dh K)^(-2) where dh K = 0 (non-integrable if
+    dh K changes sign inside the region); ``min_abs_dh_k`` reports how close the region is.
+    E1 is invariant under h -> phi(h) for monotone phi and does not depend on K's orientation.
+    """
+    return _evaluate("e1", kinematics, augmenting_map, region, nodes, fixed)
+
+
+def error_functional_e2(
+    kinematics: Kinematics,
+    augmenting_map: AugmentingMap,
+    region: Region,
+    *,
+    nodes: int = 16,
+    fixed: Mapping[str, float] | None = None,
+) -> FunctionalValue:
+    """E2(h) = integral of ||E1^(-1) E2 - I||_F^2 m(x) over a box, eq. (18) (= (19)).
+
+    Parameters are as in :func:`error_functional_e1`.
+
+    Notes
+    -----
+    The integrand (dh P dh^T - 2 dh K + 1) m with P = J^P# J^P#^T + K K^T, eq. (19), is a
+    quadratic in dh; it is finite where [J; dh] is singular, so such points are included in
+    the value and reported. K is the unit kernel with the paper's orientation (last component
+    positive for Manipulators 1 and 2); E2 is not invariant under h -> -h.
+    """
+    return _evaluate("e2", kinematics, augmenting_map, region, nodes, fixed)
+
+
+def parameter_sensitivity(
+    kinematics: Kinematics,
+    factory: Callable[..., AugmentingMap],
+    parameters: Mapping[str, float],
+    region: Region,
+    *,
+    functional: str = "e2",
+    span: float = 1.0,
+    samples: int = 21,
+    nodes: int = 16,
+    fixed: Mapping[str, float] | None = None,
+) -> dict:
+    """The value of E1 or E2 at the given parameters and how it changes as each one moves.
+
+    Parameters
+    ----------
+    factory : callable
+        ``factory(**parameters) -> AugmentingMap``, e.g. ``E2Optimal`` or ``E1Optimal``.
+    parameters : mapping name -> value
+        The current parameters (C1, C2 or a, b).
+    functional : {"e1", "e2"}
+    span, samples : float, int
+        Each parameter is swept over [v - span, v + span] with ``samples`` values, the others
+        held; parameter values where the map cannot be built are reported as None.
+
+    Returns
+    -------
+    dict
+        ``{"value", "gradient": {name: dE/dname (central differences, step 1e-4)},
+        "sweeps": {name: {"values": [...], "functional": [...]}}}``.
+    """
+    if functional not in ("e1", "e2"):
+        raise InvalidInputError(f"functional must be 'e1' or 'e2', got {functional!r}")
+    samples = count(samples, "samples", 2, 201)
+    span = finite(span, "span")
+    evaluate = error_functional_e1 if functional == "e1" else error_functional_e2
+    base = {k: finite(v, k) for k, v in parameters.items()}
+
+    def at(params: dict) -> float | None:
+        try:
+            amap = factory(**params)
+        except InvalidInputError:
+            return None
+        v = evaluate(kinematics, amap, region, nodes=nodes, fixed=fixed).value
+        return v if np.isfinite(v) else None
+
+    out: dict = {"value": at(base), "gradient": {}, "sweeps": {}}
+    step = 1e-4
+    for name, v in base.items():
+        hi, lo = at({**base, name: v + step}), at({**base, name: v - step})
+        out["gradient"][name] = None if hi is None or lo is None else (hi - lo) / (2 * step)
+        grid = np.linspace(v - span, v + span, samples)
+        out["sweeps"][name] = {
+            "values": grid.tolist(),
+            "functional": [at({**base, name: float(g)}) for g in grid],
+        }
+    return out

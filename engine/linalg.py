@@ -1,0 +1,47 @@
+"""Small batched linear solves with few numpy calls (the solver's hot path).
+
+``np.linalg.solve`` on (n, 2, 2) or (n, 3, 3) stacks spends most of its time in per-call overhead;
+Cramer's rule written out is exact for these sizes and several times faster.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from engine.validation import FloatArray
+
+
+def det_small(A: FloatArray) -> FloatArray:
+    """Determinant of (..., n, n) with n <= 3 written out, else ``np.linalg.det``."""
+    n = A.shape[-1]
+    if n == 2:
+        return A[..., 0, 0] * A[..., 1, 1] - A[..., 0, 1] * A[..., 1, 0]
+    if n == 3:
+        return np.einsum("...i,...i->...", A[..., 0, :], np.cross(A[..., 1, :], A[..., 2, :]))
+    return np.linalg.det(A)
+
+
+def solve_small(A: FloatArray, b: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Solve A z = b for a batch; returns z (..., n) and det(A) (...,).
+
+    Members with det(A) = 0 get non-finite z; callers mask them with their own criterion.
+    """
+    n = A.shape[-1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if n == 2:
+            d = det_small(A)
+            z0 = (A[..., 1, 1] * b[..., 0] - A[..., 0, 1] * b[..., 1]) / d
+            z1 = (A[..., 0, 0] * b[..., 1] - A[..., 1, 0] * b[..., 0]) / d
+            return np.stack([z0, z1], axis=-1), d
+        if n == 3:
+            # Rows a0, a1, a2: A^-1 = [a1 x a2, a2 x a0, a0 x a1]^T / det
+            a0, a1, a2 = A[..., 0, :], A[..., 1, :], A[..., 2, :]
+            c0, c1, c2 = np.cross(a1, a2), np.cross(a2, a0), np.cross(a0, a1)
+            d = np.einsum("...i,...i->...", a0, c0)
+            z = (c0 * b[..., 0:1] + c1 * b[..., 1:2] + c2 * b[..., 2:3]) / d[..., None]
+            return z, d
+    d = np.linalg.det(A)
+    ok = np.abs(d) > 0
+    safe = np.where(ok[..., None, None], A, np.eye(n))
+    z = np.linalg.solve(safe, b[..., None])[..., 0]
+    return np.where(ok[..., None], z, np.nan), d

@@ -1,0 +1,307 @@
+"""Catalogue of robots and augmenting maps with their parameters, ranges and defaults.
+
+The REST API, the CLI and the dashboard build everything from here, so no client hard-codes a
+range. Each robot lists its augmentations; each parameter its default and range.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+from engine import augmentations as aug
+from engine.augmentations import AugmentingMap
+from engine.exceptions import InvalidInputError
+from engine.inverses import ExtendedInverse, Inverse, Pseudoinverse
+from engine.kinematics import Kinematics, Manipulator1, Manipulator2
+from engine.validation import finite
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A scalar parameter with its default and closed range [minimum, maximum]."""
+
+    name: str
+    default: float
+    minimum: float
+    maximum: float
+    description: str
+    nonzero: bool = False
+
+    def check(self, value) -> float:
+        """Validate ``value``; the message names the parameter and its range."""
+        v = finite(value, self.name)
+        if not self.minimum <= v <= self.maximum:
+            raise InvalidInputError(
+                f"{self.name} must be in [{self.minimum:g}, {self.maximum:g}], got {v:g}"
+            )
+        if self.nonzero and v == 0:
+            raise InvalidInputError(f"{self.name} must be nonzero ({self.description})")
+        return v
+
+    def as_dict(self) -> dict:
+        return {
+            "name": self.name,
+            "default": self.default,
+            "minimum": self.minimum,
+            "maximum": self.maximum,
+            "description": self.description,
+            "nonzero": self.nonzero,
+        }
+
+
+def _check_params(specs: tuple[Parameter, ...], values: Mapping[str, object], what: str) -> dict:
+    known = {p.name for p in specs}
+    unknown = set(values) - known
+    if unknown:
+        raise InvalidInputError(
+            f"unknown parameter(s) {sorted(unknown)} for {what}; known: {sorted(known) or 'none'}"
+        )
+    return {p.name: p.check(values.get(p.name, p.default)) for p in specs}
+
+
+@dataclass(frozen=True)
+class AugmentationSpec:
+    """An augmenting map h of the paper, eq. (9), and how to build it."""
+
+    name: str
+    equation: str
+    description: str
+    parameters: tuple[Parameter, ...]
+    factory: Callable[..., AugmentingMap] = field(repr=False)
+
+    def build(self, kinematics: Kinematics, **values) -> AugmentingMap:
+        return self.factory(kinematics, **_check_params(self.parameters, values, self.name))
+
+    def as_dict(self) -> dict:
+        return {
+            "name": self.name,
+            "equation": self.equation,
+            "description": self.description,
+            "parameters": [p.as_dict() for p in self.parameters],
+        }
+
+
+@dataclass(frozen=True)
+class VectorSpec:
+    """A vector-valued robot parameter (the unicycle's initial pose q0)."""
+
+    name: str
+    default: tuple[float, ...]
+    minimum: tuple[float, ...]
+    maximum: tuple[float, ...]
+    description: str
+    presets: Mapping[str, tuple[float, ...]] = field(default_factory=dict)
+
+    def check(self, value) -> tuple[float, ...]:
+        try:
+            v = tuple(finite(t, self.name) for t in value)
+        except TypeError as exc:
+            raise InvalidInputError(f"{self.name} must be a list of {len(self.default)} numbers") from exc
+        if len(v) != len(self.default):
+            raise InvalidInputError(
+                f"{self.name} must have {len(self.default)} components, got {len(v)}"
+            )
+        for i, (t, lo, hi) in enumerate(zip(v, self.minimum, self.maximum, strict=True)):
+            if not lo <= t <= hi:
+                raise InvalidInputError(f"{self.name}[{i}] must be in [{lo:g}, {hi:g}], got {t:g}")
+        return v
+
+    def as_dict(self) -> dict:
+        return {
+            "name": self.name,
+            "default": list(self.default),
+            "minimum": list(self.minimum),
+            "maximum": list(self.maximum),
+            "description": self.description,
+            "presets": {k: list(v) for k, v in self.presets.items()},
+        }
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    """A robot of the paper: its kinematics, defaults and augmentations."""
+
+    name: str
+    title: str
+    description: str
+    equation: str
+    p: int
+    r: int
+    variable_names: tuple[str, ...]
+    task_names: tuple[str, ...]
+    parameters: tuple[Parameter, ...]
+    vector_parameters: tuple[VectorSpec, ...]
+    factory: Callable[..., Kinematics] = field(repr=False)
+    default_x0: tuple[float, ...] = ()
+    default_target: tuple[float, ...] = ()
+    default_path: tuple[tuple[float, ...], ...] = ()
+    default_mode: str = "continuous"
+    default_gamma: float = 1.0
+    x_range: tuple[tuple[float, float], ...] = ()
+    augmentations: tuple[AugmentationSpec, ...] = ()
+    default_augmentation: str = ""
+
+    def build(self, **values) -> Kinematics:
+        scalars = {k: v for k, v in values.items() if k not in {p.name for p in self.vector_parameters}}
+        args = _check_params(self.parameters, scalars, self.name)
+        for vp in self.vector_parameters:
+            args[vp.name] = vp.check(values.get(vp.name, vp.default))
+        return self.factory(**args)
+
+    def augmentation(self, name: str | None) -> AugmentationSpec:
+        name = name or self.default_augmentation
+        for a in self.augmentations:
+            if a.name == name:
+                return a
+        raise InvalidInputError(
+            f"unknown augmentation {name!r} for {self.name}; "
+            f"choose one of {[a.name for a in self.augmentations]}"
+        )
+
+    def as_dict(self) -> dict:
+        return {
+            "name": self.name,
+            "title": self.title,
+            "description": self.description,
+            "equation": self.equation,
+            "p": self.p,
+            "r": self.r,
+            "variable_names": list(self.variable_names),
+            "task_names": list(self.task_names),
+            "parameters": [p.as_dict() for p in self.parameters]
+            + [v.as_dict() for v in self.vector_parameters],
+            "default_x0": list(self.default_x0),
+            "default_target": list(self.default_target),
+            "default_path": [list(t) for t in self.default_path],
+            "default_mode": self.default_mode,
+            "default_gamma": self.default_gamma,
+            "x_range": [list(t) for t in self.x_range],
+            "augmentations": [a.as_dict() for a in self.augmentations],
+            "default_augmentation": self.default_augmentation,
+        }
+
+
+_AB = 5.0
+MANIPULATOR1 = RobotSpec(
+    name="manipulator1",
+    title="Manipulator 1",
+    description="3DOF manipulator in the normal form k(x) = (x1, x2 + x1 x3)",
+    equation="(30)",
+    p=3,
+    r=2,
+    variable_names=("x1", "x2", "x3"),
+    task_names=("y1", "y2"),
+    parameters=(),
+    vector_parameters=(),
+    factory=Manipulator1,
+    default_x0=(0.5, 0.5, 1.0),
+    default_target=(0.8, 1.5),
+    default_path=((0.8, 1.0), (0.8, 1.6), (0.3, 1.6), (0.5, 1.0)),
+    x_range=((-2.0, 2.0), (-2.0, 2.0), (-2.0, 2.0)),
+    augmentations=(
+        AugmentationSpec(
+            "e2_optimal",
+            "(36)",
+            "E2-optimal h = x3 (a x1 + b) sqrt(1 + x1^2)",
+            (
+                Parameter("a", 0.0, -_AB, _AB, "integration constant a of (36)"),
+                Parameter("b", 1.0, -_AB, _AB, "integration constant b of (36)"),
+            ),
+            lambda kin, a, b: aug.E2Optimal(a, b),
+        ),
+        AugmentationSpec(
+            "e1_optimal",
+            "(32)",
+            "E1 map h = x3 C1 sqrt(1 + x1^2) / (x1 sqrt(1 + x1^2) + asinh x1 + C2)^(1/3)",
+            (
+                Parameter("C1", 1.0, -_AB, _AB, "integration constant C1 of (32)", nonzero=True),
+                Parameter("C2", 1.0, -_AB, _AB, "integration constant C2 of (32)"),
+            ),
+            lambda kin, C1, C2: aug.E1Optimal(C1, C2),
+        ),
+        AugmentationSpec(
+            "e1_taylor",
+            "(33)",
+            "Taylor approximation h = x3 (1 - 2 x1 / 3) sqrt(1 + x1^2)",
+            (),
+            lambda kin: aug.E1Taylor(),
+        ),
+    ),
+    default_augmentation="e2_optimal",
+)
+
+MANIPULATOR2 = RobotSpec(
+    name="manipulator2",
+    title="Manipulator 2",
+    description="XY gantry with a revolute arm: k(x) = (x2 + l cos x3, x1 + l sin x3)",
+    equation="(37)",
+    p=3,
+    r=2,
+    variable_names=("x1", "x2", "x3"),
+    task_names=("y1", "y2"),
+    parameters=(Parameter("l", 1.0, 0.1, 5.0, "arm length"),),
+    vector_parameters=(),
+    factory=Manipulator2,
+    default_x0=(0.0, 0.0, math.pi / 2),
+    default_target=(0.0, 2.0),
+    default_path=((1.0, 1.0), (1.0, 2.0), (0.0, 2.0), (0.0, 1.0)),
+    x_range=((-3.0, 3.0), (-3.0, 3.0), (-math.pi, 2 * math.pi)),
+    augmentations=(
+        AugmentationSpec(
+            "paper_cubic",
+            "(38)",
+            "the paper's cubic fit h(x2, x3), exactly as printed, with its exact gradient",
+            (),
+            lambda kin: aug.PaperCubic(),
+        ),
+    ),
+    default_augmentation="paper_cubic",
+)
+
+ROBOTS: dict[str, RobotSpec] = {s.name: s for s in (MANIPULATOR1, MANIPULATOR2)}
+
+
+def register_robot(spec: RobotSpec) -> None:
+    """Add a robot to the catalogue (used by modules that define further kinematics)."""
+    ROBOTS[spec.name] = spec
+
+
+def register_augmentation(robot: str, spec: AugmentationSpec, *, default: bool = False) -> None:
+    """Add an augmenting map to a robot's list (used by the synthesis modules)."""
+    r = ROBOTS[robot]
+    others = tuple(a for a in r.augmentations if a.name != spec.name)
+    ROBOTS[robot] = RobotSpec(
+        **{
+            **r.__dict__,
+            "augmentations": (*others, spec),
+            "default_augmentation": spec.name if default else r.default_augmentation,
+        }
+    )
+
+
+def robot_spec(name: str) -> RobotSpec:
+    """The spec of robot ``name``; a clear error listing the known ones otherwise."""
+    try:
+        return ROBOTS[name]
+    except KeyError:
+        raise InvalidInputError(f"unknown robot {name!r}; choose one of {sorted(ROBOTS)}") from None
+
+
+def make_inverse(
+    kinematics: Kinematics,
+    algorithm: str,
+    augmentation: str | None = None,
+    augmentation_parameters: Mapping[str, object] | None = None,
+    robot: str | None = None,
+) -> Inverse:
+    """The pseudoinverse (8) or the extended inverse (11) with a named augmenting map."""
+    if algorithm == "pseudoinverse":
+        return Pseudoinverse(kinematics)
+    if algorithm == "extended":
+        spec = robot_spec(robot or kinematics.name).augmentation(augmentation)
+        return ExtendedInverse(kinematics, spec.build(kinematics, **(augmentation_parameters or {})))
+    raise InvalidInputError(
+        f"algorithm must be 'pseudoinverse' or 'extended', got {algorithm!r}"
+    )

@@ -1,0 +1,149 @@
+"""Repeatability test of an IK algorithm on a closed task-space path (paper, sec. 5.2.1, Table 1).
+
+An algorithm is repeatable when closed paths in the task space give closed paths in the joint
+space. The extended Jacobian inverse (11) is repeatable by design; the pseudoinverse (8) is not.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from engine.exceptions import InvalidInputError
+from engine.inverses import Inverse
+from engine.solver import SolveResult, solve
+from engine.validation import FloatArray, count
+
+#: Largest number of cycles and of path points accepted.
+MAX_CYCLES = 1000
+MAX_PATH_POINTS = 100
+#: The path is closed by a return leg to k(x0) when its last point is farther than this.
+CLOSE_TOL = 1e-12
+
+
+@dataclass(frozen=True)
+class RepeatabilityResult:
+    """Configurations along a closed path driven ``cycles`` times.
+
+    Attributes
+    ----------
+    targets : ndarray, shape (L, r) or (n, L, r)
+        The task point of every leg of one cycle (the given path, closed by k(x0) if needed).
+    legs : ndarray, shape (cycles * L, p) or (n, cycles * L, p)
+        Configuration after each leg.
+    cycle_end : ndarray, shape (cycles, p) or (n, cycles, p)
+    drift : ndarray, shape (cycles,) or (n, cycles)
+        ||cycle_end[c] - x0||.
+    success : bool or ndarray of bool, shape (n,)
+    message : str or tuple of str
+    leg_results : list of SolveResult
+        Every leg with its trajectory (single start with ``record=True`` only).
+    """
+
+    x0: FloatArray
+    targets: FloatArray
+    legs: FloatArray
+    cycle_end: FloatArray
+    drift: FloatArray
+    success: bool | FloatArray
+    message: str | tuple[str, ...]
+    leg_results: list[SolveResult]
+
+
+def closed_path(kinematics, x0: FloatArray, path: FloatArray) -> FloatArray:
+    """Legs of one cycle: the path, closed by k(x0) when its last point differs (batched over x0).
+
+    Returns shape (n, L, r) for x0 of shape (n, p).
+    """
+    home = kinematics.forward(x0)  # (n, r)
+    pts = np.broadcast_to(path, (len(x0), *path.shape))
+    if np.any(np.linalg.norm(path[-1] - home, axis=-1) > CLOSE_TOL):
+        pts = np.concatenate([pts, home[:, None, :]], axis=1)
+    return pts
+
+
+def repeatability(
+    inverse: Inverse,
+    x0,
+    path,
+    cycles: int = 1,
+    *,
+    gamma: float = 1.0,
+    mode: str = "continuous",
+    tol: float = 1e-10,
+    max_iterations: int | None = None,
+    record: bool = False,
+) -> RepeatabilityResult:
+    """Drive the robot through ``path`` and back to k(x0), ``cycles`` times, each leg by eq. (7).
+
+    Parameters
+    ----------
+    inverse : Inverse
+    x0 : array_like, shape (p,) or (n, p)
+        Start configuration(s); a batch runs every leg as one vectorized solve.
+    path : array_like, shape (L, r)
+        Task points visited in order; k(x0) is appended when the last point differs from it.
+    cycles : int
+        1 to 1000.
+    gamma, mode, tol, max_iterations
+        As in :func:`engine.solver.solve`.
+    record : bool
+        Keep every leg's trajectory (single start only).
+
+    Returns
+    -------
+    RepeatabilityResult
+        A member whose leg fails (singularity, divergence) stops there: ``success`` is False, its
+        message names the leg, and its remaining configurations are NaN.
+    """
+    kin = inverse.kinematics
+    x0 = kin.check(x0, "x0")
+    path = kin.check_task(path, "path")
+    if path.ndim != 2 or len(path) < 1:
+        raise InvalidInputError("path must be a list of task points, shape (L, r) with L >= 1")
+    if len(path) > MAX_PATH_POINTS:
+        raise InvalidInputError(f"path has {len(path)} points; at most {MAX_PATH_POINTS} allowed")
+    cycles = count(cycles, "cycles", 1, MAX_CYCLES)
+    single = x0.ndim == 1
+    xb = np.atleast_2d(x0)
+    if xb.ndim != 2:
+        raise InvalidInputError("x0 must be one configuration or a 2-D batch")
+    targets = closed_path(kin, xb, path)  # (n, L, r)
+    n, L = targets.shape[:2]
+    legs = np.full((n, cycles * L, kin.p), np.nan)
+    alive = np.ones(n, dtype=bool)
+    messages = ["repeatability run completed"] * n
+    current = xb.copy()
+    leg_results: list[SolveResult] = []
+    for c in range(cycles):
+        for j in range(L):
+            ids = np.flatnonzero(alive)
+            if ids.size == 0:
+                break
+            res = solve(
+                inverse,
+                current[ids],
+                targets[ids, j],
+                gamma=gamma,
+                mode=mode,
+                tol=tol,
+                max_iterations=max_iterations,
+                record=record and single,
+            )
+            if record and single:
+                leg_results.append(res[0])
+            current[ids] = res.x
+            legs[ids, c * L + j] = res.x
+            for k in np.flatnonzero(~res.success):
+                alive[ids[k]] = False
+                messages[ids[k]] = f"cycle {c + 1}, leg {j + 1} failed: {res.message[k]}"
+                legs[ids[k], c * L + j] = np.nan
+    cycle_end = legs[:, L - 1 :: L]
+    drift = np.linalg.norm(cycle_end - xb[:, None, :], axis=-1)
+    if single:
+        return RepeatabilityResult(
+            xb[0], targets[0], legs[0], cycle_end[0], drift[0], bool(alive[0]), messages[0],
+            leg_results,
+        )
+    return RepeatabilityResult(xb, targets, legs, cycle_end, drift, alive, tuple(messages), [])

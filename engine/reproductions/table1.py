@@ -1,0 +1,73 @@
+"""Table 1 of the paper: repeatability of Manipulator 2 on the closed path (1,1), (1,2), (0,2), (0,1).
+
+The pseudoinverse column is reproduced to four decimals. The extended column is what the cubic
+(38), as printed and with its exact gradient, gives; it differs from the printed column
+(docs/paper-errata.md).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from engine.augmentations import PaperCubic, PaperCubicPrintedGradient
+from engine.inverses import ExtendedInverse, Pseudoinverse
+from engine.kinematics import Manipulator2
+from engine.repeatability import repeatability
+
+X0 = (0.0, 0.0, math.pi / 2)
+PATH = ((1.0, 1.0), (1.0, 2.0), (0.0, 2.0), (0.0, 1.0))
+#: Table 1 as printed (rows x0, x1f, ..., x4f).
+PRINTED = {
+    "pseudoinverse": [
+        [0, 0, 1.5708],
+        [0.1132, 0.5379, 1.0904],
+        [1.0432, 0.7093, 1.2759],
+        [1.0198, 0.1980, 1.7701],
+        [0.0529, 0.3210, 1.8976],
+    ],
+    "extended": [
+        [0, 0, 1.5708],
+        [0.1208, 0.5235, 1.0741],
+        [1.1208, 0.5235, 1.0741],
+        [1, 0, 1.5708],
+        [0, 0, 1.5708],
+    ],
+}
+
+
+def rows(inverse) -> list[list[float]]:
+    """x0 and the configuration after each leg of Table 1's path (continuous algorithm (7))."""
+    res = repeatability(inverse, np.array(X0), np.array(PATH), cycles=1)
+    return [list(X0)] + res.legs.tolist()
+
+
+def run(printed_gradient: bool = False) -> dict:
+    """Table 1 recomputed: {"pseudoinverse": 5 rows, "extended": 5 rows, "augmentation": ...}."""
+    kin = Manipulator2()
+    h = PaperCubicPrintedGradient() if printed_gradient else PaperCubic()
+    return {
+        "pseudoinverse": rows(Pseudoinverse(kin)),
+        "extended": rows(ExtendedInverse(kin, h)),
+        "augmentation": h.name,
+    }
+
+
+def format_text(result: dict) -> str:
+    """Table 1 laid out as in the paper, with the printed values beside ours."""
+    labels = ["A  x0 ", "B  x1f", "C  x2f", "D  x3f", "A  x4f"]
+    out = []
+    for alg, title in (("extended", "Extended Jacobian"), ("pseudoinverse", "Jacobian pseudoinverse")):
+        extra = f" (augmentation {result['augmentation']})" if alg == "extended" else ""
+        out.append(f"Algorithm: {title}{extra}")
+        out.append(f"{'':8}{'x1':>9}{'x2':>9}{'x3':>9}   | printed{'':20}")
+        for lab, row, pr in zip(labels, result[alg], PRINTED[alg], strict=True):
+            ours = "".join(f"{v:9.4f}" for v in row)
+            theirs = "".join(f"{v:9.4f}" for v in pr)
+            out.append(f"{lab:8}{ours}   |{theirs}")
+        out.append("")
+    out.append("Rows: x0 = (0, 0, pi/2) (task point (0, 1)), then after the legs to (1,1), (1,2),")
+    out.append("(0,2), (0,1). The extended column of the paper is not reproduced by (38): see")
+    out.append("docs/paper-errata.md.")
+    return "\n".join(out)

@@ -1,0 +1,394 @@
+"""The continuation (Wazewski-Davidenko) IK algorithm, eq. (7), batched over start configurations.
+
+Continuous mode integrates dx/dtheta = -gamma J#(x) (k(x) - y_d) with an embedded 8(5,3)
+Dormand-Prince pair (DOP853, the coefficients of SciPy's ``solve_ivp``), each batch member with its
+own adaptive step. It integrates in tau = gamma theta, so x(theta) does not depend on gamma at all:
+gamma only rescales theta (NOTES.md). Discrete mode iterates x <- x - gamma J#(x) (k(x) - y_d), as
+in section 6.2.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.integrate._ivp import dop853_coefficients as _dop
+
+from engine.exceptions import InvalidInputError
+from engine.inverses import Inverse
+from engine.validation import FloatArray, count, positive
+
+_NS = _dop.N_STAGES
+_A = _dop.A[:_NS, :_NS]
+_B = _dop.B
+_E3 = _dop.E3
+_E5 = _dop.E5
+_SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0
+_EXPONENT = -1.0 / 8.0  # error estimator of order 7
+
+#: Tolerances of the continuous integrator on x (relative and absolute).
+RTOL = 1e-12
+ATOL = 1e-12
+#: Largest |x| before a run counts as diverged.
+DIVERGED_NORM = 1e8
+
+_RUNNING, _CONVERGED, _SINGULAR, _MAX_STEPS, _DIVERGED, _STALLED = range(6)
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """One run of eq. (7), point by point (accepted steps or iterations).
+
+    Attributes
+    ----------
+    theta : ndarray, shape (m,)
+        Continuation parameter theta (continuous) or iteration number (discrete).
+    x : ndarray, shape (m, p)
+    y : ndarray, shape (m, r)
+        k(x).
+    error : ndarray, shape (m,)
+        ||k(x) - y_d||.
+    h : ndarray, shape (m,) or None
+        h(x) for the extended inverse (constant along the continuous flow, eq. (12)).
+    """
+
+    theta: FloatArray
+    x: FloatArray
+    y: FloatArray
+    error: FloatArray
+    h: FloatArray | None
+
+
+@dataclass(frozen=True)
+class SolveResult:
+    """Result of one solve, in SciPy's vocabulary (``x``, ``success``, ``message``, ``nit``)."""
+
+    x: FloatArray
+    y: FloatArray
+    error: float
+    success: bool
+    message: str
+    nit: int
+    trajectory: Trajectory | None
+    mode: str
+    gamma: float
+    algorithm: str
+
+
+@dataclass(frozen=True)
+class BatchSolveResult:
+    """Results of a batch of solves; index it for a :class:`SolveResult` with its trajectory."""
+
+    x: FloatArray  # (n, p)
+    y: FloatArray  # (n, r)
+    error: FloatArray  # (n,)
+    success: FloatArray  # (n,) bool
+    message: tuple[str, ...]
+    nit: FloatArray  # (n,) int
+    mode: str
+    gamma: float
+    algorithm: str
+    _inverse: Inverse = field(repr=False)
+    _y_d: FloatArray = field(repr=False)
+    # Recorded points: member index, theta, x of every accepted step, in order.
+    _rec_member: FloatArray | None = field(repr=False, default=None)
+    _rec_theta: FloatArray | None = field(repr=False, default=None)
+    _rec_x: FloatArray | None = field(repr=False, default=None)
+
+    def __len__(self) -> int:
+        return len(self.x)
+
+    def trajectory(self, i: int) -> Trajectory:
+        """The trajectory of member ``i`` (requires ``record=True``)."""
+        if self._rec_member is None:
+            raise InvalidInputError("trajectories were not recorded; solve with record=True")
+        sel = self._rec_member == i
+        xs = self._rec_x[sel]
+        ys = self._inverse.kinematics.forward(xs)
+        h = self._inverse.augmenting_value(xs)
+        return Trajectory(
+            theta=self._rec_theta[sel],
+            x=xs,
+            y=ys,
+            error=np.linalg.norm(ys - self._y_d[i], axis=-1),
+            h=None if h is None else np.asarray(h),
+        )
+
+    def __getitem__(self, i: int) -> SolveResult:
+        return SolveResult(
+            x=self.x[i],
+            y=self.y[i],
+            error=float(self.error[i]),
+            success=bool(self.success[i]),
+            message=self.message[i],
+            nit=int(self.nit[i]),
+            trajectory=self.trajectory(i) if self._rec_member is not None else None,
+            mode=self.mode,
+            gamma=self.gamma,
+            algorithm=self.algorithm,
+        )
+
+
+def _rhs(inverse: Inverse, x: FloatArray, y_d: FloatArray):
+    """-J#(x) (k(x) - y_d) per unit tau = gamma theta; also e and the singular mask."""
+    e = inverse.kinematics.forward(x) - y_d
+    v, bad = inverse.apply_masked(x, e)
+    return -v, e, bad
+
+
+def _initial_step(inverse, x, f, y_d, rtol, atol):
+    """Hairer-Norsett-Wanner starting step, per member (as scipy's ``select_initial_step``)."""
+    p = x.shape[-1]
+    scale = atol + np.abs(x) * rtol
+    d0 = np.sqrt(np.sum((x / scale) ** 2, axis=-1) / p)
+    d1 = np.sqrt(np.sum((f / scale) ** 2, axis=-1) / p)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        h0 = np.where((d0 < 1e-5) | (d1 < 1e-5), 1e-6, 0.01 * d0 / d1)
+    f1, _, _ = _rhs(inverse, x + h0[:, None] * f, y_d)
+    d2 = np.sqrt(np.sum(((f1 - f) / scale) ** 2, axis=-1) / p) / h0
+    dm = np.maximum(d1, d2)
+    with np.errstate(divide="ignore"):
+        h1 = np.where(dm <= 1e-15, np.maximum(1e-6, h0 * 1e-3), (0.01 / dm) ** (1.0 / 8.0))
+    return np.minimum(100 * h0, h1)
+
+
+def _continuous(inverse, x0, y_d, tol, max_steps, record, rtol=RTOL, atol=ATOL):
+    """Batched DOP853 on dx/dtau = -J# e until ||e|| < tol; see module docstring."""
+    n, p = x0.shape
+    x = x0.copy()
+    tau = np.zeros(n)
+    f, e, bad = _rhs(inverse, x, y_d)
+    err0 = np.linalg.norm(e, axis=-1)
+    status = np.full(n, _RUNNING)
+    status[bad] = _SINGULAR
+    status[err0 < tol] = _CONVERGED
+    # exp(-tau) decay: tau_needed = ln(err0 / tol); far past that the run has stalled.
+    tau_cap = np.log(np.maximum(err0, tol) / tol) + 40.0
+    h = _initial_step(inverse, x, f, y_d, rtol, atol)
+    nsteps = np.zeros(n, dtype=int)
+    last_bad = np.zeros(n, dtype=bool)
+    rec = [(np.arange(n), tau.copy(), x.copy())] if record else None
+    K = np.empty((_NS + 1, n, p))
+    while True:
+        idx = np.flatnonzero(status == _RUNNING)
+        if idx.size == 0:
+            break
+        m = idx.size
+        xs, hs, yds = x[idx], h[idx], y_d[idx]
+        Ks = K[:, :m]
+        Ks[0] = f[idx]
+        stage_bad = np.zeros(m, dtype=bool)
+        for s in range(1, _NS):
+            dx = np.tensordot(_A[s, :s], Ks[:s], axes=1) * hs[:, None]
+            Ks[s], _, b = _rhs(inverse, xs + dx, yds)
+            stage_bad |= b
+        x_new = xs + hs[:, None] * np.tensordot(_B, Ks[:_NS], axes=1)
+        f_new, e_new, b = _rhs(inverse, x_new, yds)
+        stage_bad |= b
+        Ks[_NS] = f_new
+        scale = atol + np.maximum(np.abs(xs), np.abs(x_new)) * rtol
+        err5 = np.sum((np.tensordot(_E5, Ks, axes=1) / scale) ** 2, axis=-1)
+        err3 = np.sum((np.tensordot(_E3, Ks, axes=1) / scale) ** 2, axis=-1)
+        denom = err5 + 0.01 * err3
+        with np.errstate(divide="ignore", invalid="ignore"):
+            enorm = np.where(denom > 0, hs * err5 / np.sqrt(denom * p), 0.0)
+            enorm = np.where(np.isfinite(enorm), enorm, np.inf)
+            factor = np.where(
+                enorm == 0, _MAX_FACTOR, np.clip(_SAFETY * enorm**_EXPONENT, _MIN_FACTOR, _MAX_FACTOR)
+            )
+        accept = (enorm < 1.0) & ~stage_bad
+        factor = np.where(accept, factor, np.minimum(factor, 1.0))
+        factor = np.where(stage_bad, _MIN_FACTOR, factor)
+        last_bad[idx] = stage_bad
+        h[idx] = hs * factor
+
+        ai = idx[accept]
+        x[ai] = x_new[accept]
+        f[ai] = f_new[accept]
+        tau[ai] += hs[accept]
+        nsteps[idx] += 1
+        if record:
+            rec.append((ai, tau[ai].copy(), x[ai].copy()))
+        err = np.linalg.norm(e_new[accept], axis=-1)
+        status[ai[err < tol]] = _CONVERGED
+        run = idx[status[idx] == _RUNNING]
+        tiny = h[run] < 1e-12 * (1.0 + tau[run])
+        status[run[tiny & last_bad[run]]] = _SINGULAR
+        status[run[tiny & ~last_bad[run]]] = _STALLED
+        status[run[tau[run] > tau_cap[run]]] = _STALLED
+        status[run[np.linalg.norm(x[run], axis=-1) > DIVERGED_NORM]] = _DIVERGED
+        status[run[(nsteps[run] >= max_steps) & (status[run] == _RUNNING)]] = _MAX_STEPS
+    return x, tau, status, nsteps, rec
+
+
+def _discrete(inverse, x0, y_d, gamma, tol, max_iterations, record):
+    """x <- x - gamma J#(x) (k(x) - y_d) (section 6.2) until ||e|| < tol."""
+    n = x0.shape[0]
+    x = x0.copy()
+    e = inverse.kinematics.forward(x) - y_d
+    err = np.linalg.norm(e, axis=-1)
+    err0 = err.copy()
+    status = np.full(n, _RUNNING)
+    status[err < tol] = _CONVERGED
+    nit = np.zeros(n, dtype=int)
+    rec = [(np.arange(n), np.zeros(n), x.copy())] if record else None
+    for k in range(1, max_iterations + 1):
+        idx = np.flatnonzero(status == _RUNNING)
+        if idx.size == 0:
+            break
+        v, bad = inverse.apply_masked(x[idx], e[idx])
+        status[idx[bad]] = _SINGULAR
+        ok = idx[~bad]
+        x[ok] -= gamma * v[~bad]
+        nit[ok] = k
+        e[ok] = inverse.kinematics.forward(x[ok]) - y_d[ok]
+        err[ok] = np.linalg.norm(e[ok], axis=-1)
+        if record:
+            rec.append((ok, np.full(ok.size, float(k)), x[ok].copy()))
+        fin = np.isfinite(err[ok]) & (np.linalg.norm(x[ok], axis=-1) < DIVERGED_NORM)
+        status[ok[~fin | (err[ok] > 1e6 * np.maximum(err0[ok], 1.0))]] = _DIVERGED
+        status[ok[fin & (err[ok] < tol)]] = _CONVERGED
+    status[status == _RUNNING] = _MAX_STEPS
+    return x, nit.astype(float), status, nit, rec
+
+
+def _message(status, nit, err, tol, mode, x, inverse, max_iterations) -> str:
+    from engine.exceptions import format_vector
+
+    steps = "steps" if mode == "continuous" else "iterations"
+    if status == _CONVERGED:
+        if nit == 0:
+            return f"already at the target (error {err:.3g} < {tol:g}): no motion"
+        return f"converged: task error {err:.3g} < {tol:g} after {nit} {steps}"
+    if status == _SINGULAR:
+        return str(inverse.singular_error(x)) + "; the run stopped there"
+    if status == _DIVERGED:
+        return (
+            f"diverged after {nit} {steps} (error {err:.3g}); "
+            + ("lower gamma" if mode == "discrete" else "the target may be unreachable")
+        )
+    if status == _STALLED:
+        return (
+            f"stalled after {nit} {steps} at error {err:.3g}: the step size collapsed near a "
+            "singularity or the target is unreachable"
+        )
+    return (
+        f"did not converge within {max_iterations} {steps} (error {err:.3g} >= {tol:g}); "
+        "raise max_iterations or gamma"
+    )
+
+
+def solve(
+    inverse: Inverse,
+    x0,
+    y_d,
+    *,
+    gamma: float = 1.0,
+    mode: str = "continuous",
+    tol: float = 1e-10,
+    max_iterations: int | None = None,
+    record: bool = True,
+) -> SolveResult | BatchSolveResult:
+    """Solve k(x) = y_d by the continuation algorithm (7) with the right inverse J#.
+
+    Parameters
+    ----------
+    inverse : Inverse
+        :class:`~engine.inverses.Pseudoinverse` (8) or :class:`~engine.inverses.ExtendedInverse` (11).
+    x0 : array_like, shape (p,) or (n, p)
+        Start configuration(s); a batch is solved in one vectorized run.
+    y_d : array_like, shape (r,) or (n, r)
+        Target task point(s).
+    gamma : float
+        Decay rate > 0 of eq. (5). In continuous mode it only rescales theta; in discrete mode
+        it is the step and must be < 2 (near the solution the error shrinks by |1 - gamma|).
+    mode : {"continuous", "discrete"}
+    tol : float
+        Stop when ||k(x) - y_d|| < tol.
+    max_iterations : int, optional
+        Cap on integrator steps (continuous, default 20000) or iterations (discrete, default 2000).
+    record : bool
+        Keep the whole trajectory.
+
+    Returns
+    -------
+    SolveResult for one start, BatchSolveResult for a batch. A run that does not converge
+    (singularity reached, divergence, step cap) has ``success=False`` and a message saying why.
+
+    Raises
+    ------
+    InvalidInputError
+        Wrong shapes, non-finite values, gamma <= 0 (or >= 2 in discrete mode), bad tol.
+    KinematicSingularityError, AlgorithmicSingularityError
+        When a start configuration is singular for ``inverse``.
+    """
+    kin = inverse.kinematics
+    x0 = kin.check(x0, "x0")
+    y_d = kin.check_task(y_d, "target y_d")
+    single = x0.ndim == 1 and y_d.ndim == 1
+    if x0.ndim > 2 or y_d.ndim > 2:
+        raise InvalidInputError("x0 and y_d must be one point or a 2-D batch of points")
+    xb = np.atleast_2d(x0)
+    yb = np.broadcast_to(np.atleast_2d(y_d), (max(len(xb), len(np.atleast_2d(y_d))), kin.r))
+    if len(xb) != len(yb):
+        if len(xb) == 1:
+            xb = np.broadcast_to(xb, (len(yb), kin.p))
+        else:
+            raise InvalidInputError(
+                f"x0 has {len(xb)} configurations but y_d has {len(np.atleast_2d(y_d))} targets"
+            )
+    xb, yb = np.array(xb), np.array(yb)
+    gamma = positive(gamma, "gamma")
+    tol = positive(tol, "tol")
+    if tol < 1e-14:
+        raise InvalidInputError(f"tol must be >= 1e-14 (double precision), got {tol:g}")
+    if mode not in ("continuous", "discrete"):
+        raise InvalidInputError(f"mode must be 'continuous' or 'discrete', got {mode!r}")
+    if mode == "discrete" and gamma >= 2:
+        raise InvalidInputError(
+            f"gamma must be < 2 in discrete mode (got {gamma:g}): the error shrinks by "
+            "|1 - gamma| per iteration near the solution"
+        )
+    default_cap = 20000 if mode == "continuous" else 2000
+    cap = count(default_cap if max_iterations is None else max_iterations, "max_iterations", 1, 10**6)
+
+    _, bad = inverse.apply_masked(xb, kin.forward(xb) - yb)
+    if np.any(bad):
+        raise inverse.singular_error(xb[np.flatnonzero(bad)[0]])
+
+    if mode == "continuous":
+        x, tau, status, nit, rec = _continuous(inverse, xb, yb, tol, cap, record)
+        theta_scale = 1.0 / gamma
+    else:
+        x, tau, status, nit, rec = _discrete(inverse, xb, yb, gamma, tol, cap, record)
+        theta_scale = 1.0
+    y = kin.forward(x)
+    err = np.linalg.norm(y - yb, axis=-1)
+    messages = tuple(
+        _message(s, int(k), float(er), tol, mode, xi, inverse, cap)
+        for s, k, er, xi in zip(status, nit, err, x, strict=True)
+    )
+    rec_m = rec_t = rec_x = None
+    if record:
+        rec_m = np.concatenate([r[0] for r in rec])
+        rec_t = np.concatenate([r[1] for r in rec]) * theta_scale
+        rec_x = np.concatenate([r[2] for r in rec])
+        order = np.argsort(rec_m, kind="stable")
+        rec_m, rec_t, rec_x = rec_m[order], rec_t[order], rec_x[order]
+    batch = BatchSolveResult(
+        x=x,
+        y=y,
+        error=err,
+        success=status == _CONVERGED,
+        message=messages,
+        nit=nit,
+        mode=mode,
+        gamma=gamma,
+        algorithm=inverse.name,
+        _inverse=inverse,
+        _y_d=yb,
+        _rec_member=rec_m,
+        _rec_theta=rec_t,
+        _rec_x=rec_x,
+    )
+    return batch[0] if single else batch

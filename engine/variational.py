@@ -1,0 +1,401 @@
+"""Synthesis of the E2-optimal augmenting map by a Ritz method, eqs. (19)-(20).
+
+For one degree of redundancy, E2(h) = integral of (dh P dh^T - 2 dh K + 1) m dx, eq. (19), is a
+convex quadratic functional of h whose Euler equation is the linear elliptic PDE (20),
+div(m P grad h) = div(m K), with the natural boundary condition n . (m P grad h - m K) = 0 on
+the boundary of the region. Instead of discretising (20), E2 is minimised directly over a tensor
+Legendre basis on the box (a spectral Ritz-Galerkin method), with a tensor Gauss-Legendre rule:
+the minimiser solves one dense symmetric positive definite linear system A c = b with
+
+    A_st = integral of grad(phi_s) R grad(phi_t),  b_s = integral of grad(phi_s) . m K,
+
+R = m P restricted to the integrated variables (the paper's R(x) = m(x) P(x), sec. 5.2).
+
+Additive constant: E2 depends on dh only, so the natural-boundary minimiser is unique up to a
+constant. The constant Legendre mode P_0...P_0 is left out of the basis, which pins the mean of h
+over the box to zero (every other tensor Legendre polynomial has zero mean).
+
+Orientation: K has the paper's orientation (last component positive for Manipulators 1 and 2).
+The term -2 dh K makes E2 prefer dh K > 0, so the synthesised h increases along K.
+
+Dirichlet data g (optional) are imposed at the tensor Gauss-Lobatto-Legendre nodes of the box's
+boundary, which determine the trace of a tensor polynomial uniquely; the constrained minimiser is
+found from the KKT system.
+"""
+
+from __future__ import annotations
+
+import functools
+import string
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.polynomial import legendre as L
+from scipy import linalg
+
+from engine.augmentations import AugmentingMap, Polynomial2
+from engine.exceptions import InvalidInputError
+from engine.functionals import Region, check_region, error_functional_e2
+from engine.inverses import pseudoinverse
+from engine.kinematics import Kinematics, Manipulator2
+from engine.validation import FloatArray, count
+
+#: Extra Gauss points per variable beyond the basis degree (R is not polynomial, e.g. cos 2 x3).
+EXTRA_NODES = 8
+
+#: Default region of Manipulator 2 (sec. 5.2).
+MANIPULATOR2_REGION: dict[str, tuple[float, float]] = {"x2": (-1.0, 1.0), "x3": (0.0, np.pi)}
+
+#: Default basis degree (per variable) of the Manipulator 2 synthesis.
+MANIPULATOR2_DEGREE = 24
+
+
+def _derivative_matrix(n: int) -> FloatArray:
+    """D (n+1, n+1) with P_i'(t) = sum_k D[k, i] P_k(t) for Legendre P_0..P_n."""
+    D = np.zeros((n + 1, n + 1))
+    if n:
+        D[:n, :] = L.legder(np.eye(n + 1), axis=0)
+    return D
+
+
+def _vander(t: FloatArray, n: int) -> tuple[FloatArray, FloatArray]:
+    """Legendre values and derivatives, each (..., n + 1), at reference points t."""
+    V = L.legvander(t, n)
+    return V, V @ _derivative_matrix(n)
+
+
+def _lgl_nodes(n: int) -> FloatArray:
+    """Gauss-Lobatto-Legendre nodes of degree n: -1, roots of P_n', 1."""
+    if n == 1:
+        return np.array([-1.0, 1.0])
+    inner = L.legroots(L.legder(np.eye(n + 1)[n]))
+    return np.concatenate([[-1.0], np.sort(inner.real), [1.0]])
+
+
+class SynthesizedMap(AugmentingMap):
+    """h(x) = sum c_ij.. P_i(t_a) P_j(t_b) .., a tensor Legendre polynomial on a box, eq. (9).
+
+    Parameters
+    ----------
+    coefficients : ndarray, shape (n_1 + 1, ..., n_d + 1)
+        Legendre coefficients; axis k belongs to the k-th variable of ``region``.
+    region : dict name -> (lo, hi)
+        The box; t = (2 x - lo - hi) / (hi - lo) maps it onto [-1, 1]^d.
+    variables : tuple of int
+        0-based indices of the region's variables in x.
+    p : int
+        Configuration-space dimension.
+
+    Notes
+    -----
+    A polynomial, so value and gradient are continuous everywhere (outside the box it is the
+    polynomial continuation). Batched over leading axes of x.
+    """
+
+    name = "e2_synthesized"
+
+    def __init__(
+        self,
+        coefficients: FloatArray,
+        region: Mapping[str, tuple[float, float]],
+        variables: Sequence[int],
+        p: int,
+    ) -> None:
+        self.coefficients = np.asarray(coefficients, dtype=float)
+        self.region = {k: (float(a), float(b)) for k, a, b in ((k, *v) for k, v in region.items())}
+        self.variables = tuple(int(v) for v in variables)
+        self.p = int(p)
+        if self.coefficients.ndim != len(self.variables) or len(self.region) != len(self.variables):
+            raise InvalidInputError("coefficients, region and variables must have one axis each")
+        lo = np.array([v[0] for v in self.region.values()])
+        hi = np.array([v[1] for v in self.region.values()])
+        self._center, self._scale = 0.5 * (lo + hi), 2.0 / (hi - lo)  # t = (x - c) * scale
+        d = len(self.variables)
+        letters = string.ascii_lowercase[:d]
+        self._contract = ",".join(f"...{c}" for c in letters) + f",{letters}->..."
+
+    @property
+    def parameters(self) -> dict[str, float]:
+        return {f"degree_{k}": float(n - 1) for k, n in zip(self.region, self.coefficients.shape)}
+
+    def _bases(self, x: FloatArray) -> list[tuple[FloatArray, FloatArray]]:
+        x = np.asarray(x, dtype=float)
+        return [
+            _vander((x[..., v] - self._center[k]) * self._scale[k], n - 1)
+            for k, (v, n) in enumerate(zip(self.variables, self.coefficients.shape))
+        ]
+
+    def value(self, x: FloatArray) -> FloatArray:
+        bases = self._bases(x)
+        return np.einsum(self._contract, *(V for V, _ in bases), self.coefficients)
+
+    def gradient(self, x: FloatArray) -> FloatArray:
+        x = np.asarray(x, dtype=float)
+        bases = self._bases(x)
+        g = np.zeros(x.shape)
+        for k, v in enumerate(self.variables):
+            mats = [dV if i == k else V for i, (V, dV) in enumerate(bases)]
+            g[..., v] = np.einsum(self._contract, *mats, self.coefficients) * self._scale[k]
+        return g
+
+
+@dataclass(frozen=True)
+class SynthesisResult:
+    """The E2-optimal augmenting map on a box and what it achieves.
+
+    Attributes
+    ----------
+    augmenting_map : SynthesizedMap
+        Named ``"e2_synthesized"``; usable by ``ExtendedInverse`` directly.
+    e2 : float
+        E2 of the map on the region (Ritz value, same quadrature as the solve).
+    polynomial : Polynomial2 or None
+        Least-squares cubic (total degree 3, like (38)) of the map over the region, in the
+        region's variables; None for a three-variable region.
+    polynomial_e2 : float
+        E2 of that cubic on the region (NaN when there is none).
+    grid : dict
+        ``{name_1: [...], name_2: [...], "h": [[...]]}``, h on a uniform grid of the first two
+        region variables (h[i][j] at name_1[i], name_2[j]; others at the box centre).
+    convergence : list of dict
+        ``{"degree", "n_unknowns", "e2"}`` for the resolutions computed, the last the result.
+    region, fixed : dict
+        The box and the values of the variables not integrated over.
+    degree : int
+        Basis degree per variable.
+    """
+
+    augmenting_map: SynthesizedMap
+    e2: float
+    polynomial: Polynomial2 | None
+    polynomial_e2: float
+    grid: dict
+    convergence: list[dict]
+    region: dict[str, tuple[float, float]] = field(default_factory=dict)
+    fixed: dict[str, float] = field(default_factory=dict)
+    degree: int = 0
+
+    def polynomial_coefficients(self) -> dict[str, float]:
+        """Cubic coefficients keyed like ``"x2^2 x3^1"`` (JSON-friendly)."""
+        if self.polynomial is None:
+            return {}
+        a, b = (f"x{v + 1}" for v in self.polynomial.variables)
+        return {f"{a}^{i} {b}^{j}": c for (i, j), c in sorted(self.polynomial.coefficients.items())}
+
+
+class _Problem:
+    """Quadrature data of E2 on a box: R = m P and f = m K restricted to the region's variables."""
+
+    def __init__(self, kinematics: Kinematics, box: dict, fix: dict, nodes: Sequence[int]):
+        names = tuple(kinematics.variable_names)
+        self.names = names
+        self.box, self.fix = box, fix
+        self.variables = [names.index(n) for n in box]
+        lo = np.array([v[0] for v in box.values()])
+        hi = np.array([v[1] for v in box.values()])
+        self.scale = 2.0 / (hi - lo)
+        rules = [L.leggauss(n) for n in nodes]
+        self.t = [r[0] for r in rules]
+        grids = np.meshgrid(*self.t, indexing="ij")
+        w = functools.reduce(np.multiply.outer, [r[1] for r in rules]) / np.prod(self.scale)
+        x = np.empty((w.size, kinematics.p))
+        for i, n in enumerate(names):
+            x[:, i] = fix[n] if n in fix else 0.0
+        for k, v in enumerate(self.variables):
+            x[:, v] = 0.5 * (lo[k] + hi[k]) + grids[k].ravel() / self.scale[k]
+        kinematics.require_regular(x, "synthesis region (a quadrature point)")
+        J = kinematics.jacobian(x)
+        K = kinematics.kernel(x)
+        m = kinematics.manipulability(x)
+        Jp = pseudoinverse(J)
+        P = Jp @ np.swapaxes(Jp, -1, -2) + K[:, :, None] * K[:, None, :]  # (n, p, p)
+        idx = np.array(self.variables)
+        self.w = w.ravel()
+        self.R = (m[:, None, None] * P)[:, idx][:, :, idx]  # (n, d, d)
+        self.f = (m[:, None] * K)[:, idx]  # (n, d)
+        self.constant = float(np.dot(self.w, m))  # E2 of h = const
+
+    def system(self, degrees: Sequence[int]) -> tuple[FloatArray, FloatArray]:
+        """Stiffness A (nb, nb) and load b (nb,) over the full tensor basis (constant included)."""
+        d = len(degrees)
+        bases = [_vander(t, n) for t, n in zip(self.t, degrees)]
+        G = []
+        for k in range(d):
+            mats = [dV if i == k else V for i, (V, dV) in enumerate(bases)]
+            G.append(functools.reduce(np.kron, mats) * self.scale[k])  # (n_q, nb)
+        A = np.zeros((G[0].shape[1],) * 2)
+        for a in range(d):
+            for b in range(a, d):
+                blk = G[a].T @ ((self.w * self.R[:, a, b])[:, None] * G[b])
+                A += blk if a == b else blk + blk.T
+        b = sum(G[a].T @ (self.w * self.f[:, a]) for a in range(d))
+        return A, b
+
+
+def _solve(
+    problem: _Problem,
+    degrees: Sequence[int],
+    dirichlet: Callable | None,
+    kinematics: Kinematics,
+) -> tuple[FloatArray, float]:
+    """Ritz minimiser of E2: coefficients (n_1 + 1, ..., n_d + 1) and its E2 value."""
+    A, b = problem.system(degrees)
+    shape = tuple(n + 1 for n in degrees)
+    if dirichlet is None:
+        # Drop the constant mode: mean(h) = 0 over the box, A is then positive definite.
+        c = np.zeros(A.shape[0])
+        c[1:] = linalg.solve(A[1:, 1:], b[1:], assume_a="pos")
+    else:
+        nodes = [_lgl_nodes(n) for n in degrees]
+        grid = np.stack(np.meshgrid(*nodes, indexing="ij"), axis=-1).reshape(-1, len(degrees))
+        on_boundary = np.any(np.isclose(np.abs(grid), 1.0), axis=1)
+        tb = grid[on_boundary]  # (nc, d) reference boundary nodes
+        C = functools.reduce(
+            lambda X, Y: np.einsum("ni,nj->nij", X, Y).reshape(X.shape[0], -1),
+            [L.legvander(tb[:, k], n) for k, n in enumerate(degrees)],
+        )
+        x = np.empty((tb.shape[0], kinematics.p))
+        names = tuple(kinematics.variable_names)
+        for i, n in enumerate(names):
+            x[:, i] = problem.fix.get(n, 0.0)
+        lo = np.array([v[0] for v in problem.box.values()])
+        hi = np.array([v[1] for v in problem.box.values()])
+        for k, v in enumerate(problem.variables):
+            x[:, v] = 0.5 * (lo[k] + hi[k]) + tb[:, k] / problem.scale[k]
+        g = np.asarray(dirichlet(x), dtype=float).reshape(-1)
+        if g.shape[0] != x.shape[0] or not np.all(np.isfinite(g)):
+            raise InvalidInputError("dirichlet(x) must return one finite value per point of x")
+        nc = C.shape[0]
+        KKT = np.block([[A, C.T], [C, np.zeros((nc, nc))]])
+        c = linalg.solve(KKT, np.concatenate([b, g]), assume_a="sym")[: A.shape[0]]
+    e2 = problem.constant + float(c @ A @ c) - 2.0 * float(c @ b)
+    return c.reshape(shape), e2
+
+
+def _cubic_fit(amap: SynthesizedMap, problem: _Problem) -> Polynomial2:
+    """L2(region) least-squares fit of h by a cubic in two variables, like (38)."""
+    u = problem.box
+    (a, (alo, ahi)), (b, (blo, bhi)) = list(u.items())
+    ta, tb = np.meshgrid(*problem.t, indexing="ij")
+    xa = 0.5 * (alo + ahi) + 0.5 * (ahi - alo) * ta.ravel()
+    xb = 0.5 * (blo + bhi) + 0.5 * (bhi - blo) * tb.ravel()
+    x = np.zeros((xa.size, amap.p))
+    x[:, problem.variables[0]], x[:, problem.variables[1]] = xa, xb
+    for name, val in problem.fix.items():
+        x[:, problem.names.index(name)] = val
+    powers = [(i, j) for i in range(4) for j in range(4) if i + j <= 3]
+    M = np.stack([xa**i * xb**j for i, j in powers], axis=1)
+    sw = np.sqrt(problem.w)
+    coef, *_ = np.linalg.lstsq(M * sw[:, None], amap.value(x) * sw, rcond=None)
+    return Polynomial2(dict(zip(powers, coef.tolist())), tuple(problem.variables), amap.p)
+
+
+def _plot_grid(amap: SynthesizedMap, problem: _Problem, n: int = 41) -> dict:
+    names = list(problem.box)
+    x0 = np.zeros(amap.p)
+    for name, val in problem.fix.items():
+        x0[problem.names.index(name)] = val
+    for name, (lo, hi) in problem.box.items():
+        x0[problem.names.index(name)] = 0.5 * (lo + hi)
+    a, b = (np.linspace(*problem.box[k], n) for k in names[:2])
+    x = np.broadcast_to(x0, (n, n, amap.p)).copy()
+    x[..., problem.variables[0]] = a[:, None]
+    x[..., problem.variables[1]] = b[None, :]
+    return {names[0]: a.tolist(), names[1]: b.tolist(), "h": amap.value(x).tolist()}
+
+
+def synthesize_e2(
+    kinematics: Kinematics,
+    region: Region,
+    *,
+    degree: int | Sequence[int] = 16,
+    dirichlet: Callable[[FloatArray], FloatArray] | None = None,
+    fixed: Mapping[str, float] | None = None,
+    progress: Callable[[float], None] | None = None,
+    convergence_degrees: Sequence[int] = (),
+) -> SynthesisResult:
+    """Minimise E2, eq. (19), over augmenting maps h of the region's variables (Ritz method).
+
+    Parameters
+    ----------
+    kinematics : Kinematics
+        With one degree of redundancy (p - r = 1).
+    region : mapping name -> (lo, hi)
+        Two or three integrated joint variables (h depends on these only); the others are held
+        at ``fixed`` (default 0), as in the paper's reduction h = h(x2, x3) for Manipulator 2.
+    degree : int or sequence of int
+        Legendre degree per variable (the error decays exponentially with it for smooth data).
+    dirichlet : callable, optional
+        ``g(x) (n, p) -> (n,)``: boundary values of h. Default: natural boundary conditions
+        n . (m P grad h - m K) = 0, with mean(h) = 0 over the box pinning the constant.
+    fixed : mapping name -> value, optional
+    progress : callable, optional
+        Called with a fraction in [0, 1] as the work proceeds.
+    convergence_degrees : sequence of int
+        Lower degrees to solve as well, to show the convergence of E2 with resolution.
+
+    Returns
+    -------
+    SynthesisResult
+    """
+    if kinematics.p - kinematics.r != 1:
+        raise InvalidInputError("synthesize_e2 needs one degree of redundancy (p - r = 1)")
+    box, fix = check_region(kinematics, region, fixed)
+    d = len(box)
+    if d not in (2, 3):
+        raise InvalidInputError(f"the region must have two or three variables, got {list(box)}")
+    degs = [degree] * d if np.ndim(degree) == 0 else list(degree)
+    if len(degs) != d:
+        raise InvalidInputError(f"degree needs one value per region variable ({d}), got {degree}")
+    degs = [count(n, "degree", 1, 64 if d == 2 else 16) for n in degs]
+    levels = sorted({count(n, "convergence degree", 1, max(degs)) for n in convergence_degrees})
+    levels = [n for n in levels if n < min(degs)]
+    plan = [[n] * d for n in levels] + [degs]
+    cost = np.array([float(np.prod(np.add(q, 1))) ** 2 for q in plan])
+    done = 0.0
+    problem = _Problem(kinematics, box, fix, [n + EXTRA_NODES for n in degs])
+    if progress is not None:
+        progress(0.05)
+    convergence = []
+    for q, c in zip(plan, cost):
+        coef, e2 = _solve(problem, q, dirichlet, kinematics)
+        convergence.append({"degree": max(q), "n_unknowns": int(np.prod(np.add(q, 1))), "e2": e2})
+        done += c
+        if progress is not None:
+            progress(0.05 + 0.85 * done / cost.sum())
+    amap = SynthesizedMap(coef, box, problem.variables, kinematics.p)
+    poly, poly_e2 = None, float("nan")
+    if d == 2:
+        poly = _cubic_fit(amap, problem)
+        poly_e2 = error_functional_e2(kinematics, poly, box, nodes=32, fixed=fix).value
+    result = SynthesisResult(
+        augmenting_map=amap,
+        e2=convergence[-1]["e2"],
+        polynomial=poly,
+        polynomial_e2=poly_e2,
+        grid=_plot_grid(amap, problem),
+        convergence=convergence,
+        region=box,
+        fixed=fix,
+        degree=max(degs),
+    )
+    if progress is not None:
+        progress(1.0)
+    return result
+
+
+@functools.lru_cache(maxsize=8)
+def default_manipulator2_synthesis(l: float = 1.0) -> SynthesisResult:
+    """E2-optimal h(x2, x3) of Manipulator 2 on x2 in [-1, 1], x3 in [0, pi] (sec. 5.2), cached.
+
+    Natural boundary conditions, mean(h) = 0 over the box, x1 = 0 (the integrand does not
+    depend on x1), Legendre degree ``MANIPULATOR2_DEGREE`` with the convergence in E2 shown
+    at lower degrees.
+    """
+    return synthesize_e2(
+        Manipulator2(l),
+        MANIPULATOR2_REGION,
+        degree=MANIPULATOR2_DEGREE,
+        convergence_degrees=(2, 4, 6, 8, 12, 16, 20),
+    )
