@@ -29,19 +29,25 @@ def _e1_closed(a: float, b: float) -> float:
 
     With h = x3 f(x1), dh P dh^T / (dh K)^2 - 1 = x3^2 (s f'/f - x1/s)^2 + x1^2/s^2, s = m(x).
     """
-    g = lambda x1: X3_SQUARE * a**2 * (1 + x1**2) / (a * x1 + b) ** 2 + x1**2 / (1 + x1**2)
-    return integrate.quad(g, 0.0, 1.0, epsabs=1e-14, epsrel=1e-14)[0]
+
+    def g(x1):
+        return X3_SQUARE * a**2 * (1 + x1**2) / (a * x1 + b) ** 2 + x1**2 / (1 + x1**2)
+
+    return integrate.quad(g, 0.0, 1.0, epsabs=1e-13, epsrel=1e-13, limit=200)[0]
 
 
 def _e2_closed(a: float, b: float) -> float:
-    """E2 of (36) on REGION1: dh K = a x1 + b, dh P dh^T = x3^2 a^2 s^2 + (a x1 + b)^2 (1 + 2 x1^2)/s^2."""
+    """E2 of (36) on REGION1.
+
+    dh K = a x1 + b and dh P dh^T = x3^2 a^2 s^2 + (a x1 + b)^2 (1 + 2 x1^2) / s^2.
+    """
 
     def g(x1):
         s2 = 1 + x1**2
         f = a * x1 + b
         return np.sqrt(s2) * (X3_SQUARE * a**2 * s2 + f**2 * (1 + 2 * x1**2) / s2 - 2 * f + 1)
 
-    return integrate.quad(g, 0.0, 1.0, epsabs=1e-14, epsrel=1e-14)[0]
+    return integrate.quad(g, 0.0, 1.0, epsabs=1e-13, epsrel=1e-13, limit=200)[0]
 
 
 class _Negated(AugmentingMap):
@@ -92,7 +98,7 @@ def test_integrands_equal_paper_forms_14_and_19():
 
 
 def test_singular_points_are_reported_not_dropped_silently():
-    """dh K = 0 on the line x3 = c through Gauss nodes: those points are listed, E1 excludes them."""
+    """dh K = 0 on a line x3 = c through Gauss nodes: the points are listed, E1 excludes them."""
     nodes = 8
     x, _, _, _ = quadrature(Manipulator2(), REGION2, nodes)
     c = float(np.unique(x[:, 2])[3])
