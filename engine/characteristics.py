@@ -1,4 +1,4 @@
-"""Geometric synthesis of an augmenting map by characteristics, one degree of redundancy (section 4).
+"""Synthesis of an augmenting map by characteristics, one degree of redundancy (section 4).
 
 The one-form omega annihilates J^T (omega J^T = 0) and is normalised by one component,
 ``omega[fixed_index] = 1``. A linear homotopy Phi_s contracts every configuration onto a reference
@@ -19,18 +19,49 @@ import numpy as np
 
 from engine.augmentations import AugmentingMap
 from engine.exceptions import InvalidInputError, OneFormUndefinedError, format_vector
-from engine.kinematics import Kinematics, kernel_cofactors
+from engine.kinematics import SINGULAR_MANIPULABILITY, Kinematics, kernel_cofactors
 from engine.unicycle import Unicycle
 from engine.validation import FloatArray, as_vector, count, finite
 
-#: |kernel component fixed_index| <= ONE_FORM_TOL |kernel| counts as "omega undefined".
+#: |kernel component fixed_index| <= ONE_FORM_TOL |kernel| counts as "omega undefined" (so does a
+#: kinematic singularity, |kernel cofactors| = m(x) < SINGULAR_MANIPULABILITY).
 ONE_FORM_TOL = 1e-9
 #: Default number of collocation nodes in s (including s = 0 and s = 1).
-COLLOCATION_NODES = 20
+COLLOCATION_NODES = 24
 #: Newton iterations on the collocation system before giving up.
 NEWTON_MAX = 30
 #: Newton stops when the largest update is below this (relative to 1 + |z|).
 NEWTON_TOL = 1e-14
+
+
+def cofactors(J: FloatArray) -> FloatArray:
+    """Kernel cofactor vector of J (..., r, r + 1), as :func:`engine.kinematics.kernel_cofactors`.
+
+    For r = 3 it is expanded in 2 x 2 minors of the last two rows (elementwise, much faster than
+    batched determinants); other sizes fall back to the generic determinant formula.
+    """
+    if J.shape[-2:] != (3, 4):
+        return kernel_cofactors(J)
+    R1, R2, R3 = J[..., 0, :], J[..., 1, :], J[..., 2, :]
+
+    def m(a, b):
+        return R2[..., a] * R3[..., b] - R2[..., b] * R3[..., a]
+
+    m01, m02, m03, m12, m13, m23 = m(0, 1), m(0, 2), m(0, 3), m(1, 2), m(1, 3), m(2, 3)
+
+    def det(i, j, k, mjk, mik, mij):
+        return R1[..., i] * mjk - R1[..., j] * mik + R1[..., k] * mij
+
+    # c_i = (-1)^(4 + i) det(J without column i), 1-based i
+    return np.stack(
+        [
+            -det(1, 2, 3, m23, m13, m12),
+            det(0, 2, 3, m23, m03, m02),
+            -det(0, 1, 3, m13, m03, m01),
+            det(0, 1, 2, m12, m02, m01),
+        ],
+        axis=-1,
+    )
 
 
 def kernel_cofactors_derivative(J: FloatArray, H: FloatArray) -> FloatArray:
@@ -57,14 +88,15 @@ def kernel_cofactors_derivative(J: FloatArray, H: FloatArray) -> FloatArray:
     Jm = np.broadcast_to(J[..., None, None, :, :], (*J.shape[:-2], r, p, r, p)).copy()
     for j in range(r):
         Jm[..., j, :, j, :] = np.swapaxes(H[..., j, :, :], -1, -2)
-    return np.swapaxes(kernel_cofactors(Jm).sum(axis=-3), -1, -2)
+    return np.swapaxes(cofactors(Jm).sum(axis=-3), -1, -2)
 
 
 def _one_form_parts(J, H, fixed_index):
     """omega (..., p), d omega/dx (..., p, p) or None, and the 'undefined' mask (...,)."""
-    c = kernel_cofactors(J)
+    c = cofactors(J)
     cf = c[..., fixed_index]
-    bad = np.abs(cf) <= ONE_FORM_TOL * np.linalg.norm(c, axis=-1)
+    norm = np.linalg.norm(c, axis=-1)  # = m(x), Cauchy-Binet
+    bad = (np.abs(cf) <= ONE_FORM_TOL * norm) | ~(norm >= SINGULAR_MANIPULABILITY)
     cf = np.where(bad, 1.0, cf)
     omega = c / cf[..., None]
     if H is None:
@@ -291,7 +323,12 @@ class CharacteristicsMap(AugmentingMap):
             j = np.flatnonzero(bad[i])
             where = (pts[i, j[0]], s[j[0]], xb[i]) if j.size else (None, None, xb[i])
         self._where = where
-        return s, Z.reshape(*shape, s.size), S[:, 0, :].reshape(*shape, self.p), failed.reshape(shape)
+        return (
+            s,
+            Z.reshape(*shape, s.size),
+            S[:, 0, :].reshape(*shape, self.p),
+            failed.reshape(shape),
+        )
 
     def evaluate(self, x) -> tuple[FloatArray, FloatArray, FloatArray]:
         """h(x) (...,), dh/dx (..., p) and the failure mask (...,), without raising."""
@@ -376,6 +413,7 @@ __all__ = [
     "CharacteristicsMap",
     "LinearHomotopy",
     "UnicycleCharacteristics",
+    "cofactors",
     "collocation",
     "kernel_cofactors_derivative",
     "one_form",
