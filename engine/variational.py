@@ -61,7 +61,8 @@ def _derivative_matrix(n: int) -> FloatArray:
 
 def _vander(t: FloatArray, n: int) -> tuple[FloatArray, FloatArray]:
     """Legendre values and derivatives, each (..., n + 1), at reference points t."""
-    V = L.legvander(t, n)
+    t = np.asarray(t, dtype=float)
+    V = L.legvander(t, n).reshape(*t.shape, n + 1)
     return V, V @ _derivative_matrix(n)
 
 
@@ -117,13 +118,14 @@ class SynthesizedMap(AugmentingMap):
 
     @property
     def parameters(self) -> dict[str, float]:
-        return {f"degree_{k}": float(n - 1) for k, n in zip(self.region, self.coefficients.shape)}
+        shape = self.coefficients.shape
+        return {f"degree_{k}": float(n - 1) for k, n in zip(self.region, shape, strict=True)}
 
     def _bases(self, x: FloatArray) -> list[tuple[FloatArray, FloatArray]]:
         x = np.asarray(x, dtype=float)
         return [
             _vander((x[..., v] - self._center[k]) * self._scale[k], n - 1)
-            for k, (v, n) in enumerate(zip(self.variables, self.coefficients.shape))
+            for k, (v, n) in enumerate(zip(self.variables, self.coefficients.shape, strict=True))
         ]
 
     def value(self, x: FloatArray) -> FloatArray:
@@ -219,7 +221,7 @@ class _Problem:
     def system(self, degrees: Sequence[int]) -> tuple[FloatArray, FloatArray]:
         """Stiffness A (nb, nb) and load b (nb,) over the full tensor basis (constant included)."""
         d = len(degrees)
-        bases = [_vander(t, n) for t, n in zip(self.t, degrees)]
+        bases = [_vander(t, n) for t, n in zip(self.t, degrees, strict=True)]
         G = []
         for k in range(d):
             mats = [dV if i == k else V for i, (V, dV) in enumerate(bases)]
@@ -276,7 +278,7 @@ def _solve(
 def _cubic_fit(amap: SynthesizedMap, problem: _Problem) -> Polynomial2:
     """L2(region) least-squares fit of h by a cubic in two variables, like (38)."""
     u = problem.box
-    (a, (alo, ahi)), (b, (blo, bhi)) = list(u.items())
+    (_, (alo, ahi)), (_, (blo, bhi)) = list(u.items())
     ta, tb = np.meshgrid(*problem.t, indexing="ij")
     xa = 0.5 * (alo + ahi) + 0.5 * (ahi - alo) * ta.ravel()
     xb = 0.5 * (blo + bhi) + 0.5 * (bhi - blo) * tb.ravel()
@@ -288,7 +290,8 @@ def _cubic_fit(amap: SynthesizedMap, problem: _Problem) -> Polynomial2:
     M = np.stack([xa**i * xb**j for i, j in powers], axis=1)
     sw = np.sqrt(problem.w)
     coef, *_ = np.linalg.lstsq(M * sw[:, None], amap.value(x) * sw, rcond=None)
-    return Polynomial2(dict(zip(powers, coef.tolist())), tuple(problem.variables), amap.p)
+    coefficients = dict(zip(powers, coef.tolist(), strict=True))
+    return Polynomial2(coefficients, tuple(problem.variables), amap.p)
 
 
 def _plot_grid(amap: SynthesizedMap, problem: _Problem, n: int = 41) -> dict:
@@ -358,7 +361,7 @@ def synthesize_e2(
     if progress is not None:
         progress(0.05)
     convergence = []
-    for q, c in zip(plan, cost):
+    for q, c in zip(plan, cost, strict=True):
         coef, e2 = _solve(problem, q, dirichlet, kinematics)
         convergence.append({"degree": max(q), "n_unknowns": int(np.prod(np.add(q, 1))), "e2": e2})
         done += c
