@@ -18,7 +18,7 @@ from engine.validation import FloatArray, as_points, as_vector, count, positive
 #: Gauss-Legendre nodes per quadrature panel.
 PANEL_NODES = 16
 #: Largest phase change [rad] of q3 (and of sin t) allowed within one panel.
-PANEL_PHASE = 3.0
+PANEL_PHASE = 6.0
 
 
 @functools.lru_cache(maxsize=64)
