@@ -1,0 +1,110 @@
+"""The FastAPI application: ``create_app()`` wires the routers, the error handlers and the pool.
+
+Errors have one shape. Bad input (pydantic validation, or the engine refusing it) is HTTP 422 in
+FastAPI's list format, ``{"detail": [{"loc": ["body", <field>...], "msg": "<field>: <problem>",
+"type": ...}]}``, the message always starting with the field. A request that cannot be served in
+time is 503 ``{"detail": "..."}`` (with Retry-After); anything unexpected is 500
+``{"detail": "internal error: ..."}``, never an HTML page or a dropped connection.
+"""
+
+from __future__ import annotations
+
+import logging
+from contextlib import asynccontextmanager
+
+from fastapi import FastAPI, Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import JSONResponse
+
+from app.routers import health, repeatability, robots, solve, synthesize
+from app.schemas import AUGMENTATION_MODELS, ROBOT_MODELS
+from app.service import ComputeError, ComputePool, RequestError, ServiceUnavailable, Settings
+
+log = logging.getLogger("jik.api")
+_TAGS = set(ROBOT_MODELS) | set(AUGMENTATION_MODELS)
+
+
+def _field(loc) -> str:
+    """Field path of a pydantic location: ``("body", "robot", "manipulator2", "l")`` -> ``robot.l``.
+
+    Indices become ``x0[2]``; the discriminator tag of a union member is dropped.
+    """
+    parts = [str(p) for p in loc if p != "body"]
+    if len(parts) > 2 and parts[0] in ("robot", "augmentation") and parts[1] in _TAGS:
+        del parts[1]
+    out: list[str] = []
+    for p in parts:
+        if p.isdigit() and out:
+            out[-1] += f"[{p}]"
+        else:
+            out.append(p)
+    return ".".join(out) or "body"
+
+
+def _validation_detail(errors) -> list[dict]:
+    detail = []
+    for e in errors:
+        loc = list(e.get("loc", ()))
+        msg = str(e.get("msg", "invalid"))
+        if e.get("type") == "extra_forbidden":
+            msg = "unknown field; remove it"
+        elif e.get("type") == "union_tag_invalid":
+            ctx = e.get("ctx") or {}
+            msg = f"unknown name {ctx.get('tag')!r}; choose one of {ctx.get('expected_tags')}"
+        detail.append({"loc": loc, "msg": f"{_field(loc)}: {msg}", "type": str(e.get("type"))})
+    return detail
+
+
+def create_app(settings: Settings | None = None) -> FastAPI:
+    """The jik REST API. ``settings`` (default: from the environment) sizes the compute pool."""
+    pool = ComputePool(settings)
+
+    @asynccontextmanager
+    async def lifespan(app: FastAPI):
+        await pool.warm_up()
+        yield
+        pool.close()
+
+    app = FastAPI(
+        title="jik",
+        version="0.1.0",
+        summary="Repeatable Jacobian inverse kinematics: pseudoinverse vs extended Jacobian, "
+        "and synthesis of augmenting maps (Tchon, Karpinska, Janiak 2009).",
+        lifespan=lifespan,
+    )
+    app.state.pool = pool
+
+    @app.exception_handler(RequestValidationError)
+    async def _invalid(request: Request, exc: RequestValidationError) -> JSONResponse:
+        return JSONResponse(status_code=422, content={"detail": _validation_detail(exc.errors())})
+
+    @app.exception_handler(RequestError)
+    async def _refused(request: Request, exc: RequestError) -> JSONResponse:
+        loc = ["body", *exc.field.replace("[", ".").replace("]", "").split(".")]
+        return JSONResponse(
+            status_code=422,
+            content={"detail": [{"loc": loc, "msg": str(exc), "type": "value_error"}]},
+        )
+
+    @app.exception_handler(ServiceUnavailable)
+    async def _busy(request: Request, exc: ServiceUnavailable) -> JSONResponse:
+        return JSONResponse(
+            status_code=503, content={"detail": str(exc)}, headers={"Retry-After": "1"}
+        )
+
+    @app.exception_handler(ComputeError)
+    async def _compute(request: Request, exc: ComputeError) -> JSONResponse:
+        log.error("computation failed: %s", exc)
+        return JSONResponse(status_code=500, content={"detail": f"internal error: {exc}"})
+
+    @app.exception_handler(Exception)
+    async def _unexpected(request: Request, exc: Exception) -> JSONResponse:
+        log.exception("unexpected error")
+        return JSONResponse(
+            status_code=500, content={"detail": f"internal error: {type(exc).__name__}: {exc}"}
+        )
+
+    for module in (health, robots, solve, repeatability, synthesize):
+        app.include_router(module.router)
+    # Dashboard: app.include_router(...) goes here.
+    return app

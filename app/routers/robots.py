@@ -1,0 +1,15 @@
+"""GET /robots: the catalogue, enough for a client to build its controls."""
+
+from fastapi import APIRouter, Request
+
+from app.schemas import RobotsResponse
+from app.service import robots_response
+
+router = APIRouter(tags=["robots"])
+
+
+@router.get("/robots", response_model=RobotsResponse)
+async def robots(request: Request) -> RobotsResponse:
+    """Every robot: p, r, parameter ranges, default start, target and path, and its
+    augmentations with their parameters, ranges and defaults; plus the request limits."""
+    return robots_response(request.app.state.pool.settings.timeout)

@@ -1,0 +1,29 @@
+"""POST /synthesize: an augmenting map h on a box, synthesized or from the catalogue."""
+
+from fastapi import APIRouter, Request
+
+from app.schemas import (
+    ErrorResponse,
+    SynthesisMethodsResponse,
+    SynthesizeRequest,
+    SynthesizeResponse,
+)
+from app.service import synthesis_methods
+
+router = APIRouter(tags=["synthesize"])
+
+
+@router.get("/synthesize", response_model=SynthesisMethodsResponse)
+async def methods() -> SynthesisMethodsResponse:
+    """The synthesis methods this server offers and which engine components are installed."""
+    return synthesis_methods()
+
+
+@router.post(
+    "/synthesize",
+    response_model=SynthesizeResponse,
+    responses={503: {"model": ErrorResponse, "description": "busy or over the time limit"}},
+)
+async def synthesize(req: SynthesizeRequest, request: Request) -> dict:
+    """h on a grid of the box, its coefficients and E1, E2 over the box."""
+    return await request.app.state.pool.run("synthesize", req.model_dump(mode="json"))

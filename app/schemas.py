@@ -1,0 +1,379 @@
+"""Request and response models of the REST API (JSON, snake_case).
+
+Robot and augmentation models are generated from the engine's catalogue
+(:data:`engine.registry.ROBOTS`) when this module is imported: one model per robot with its
+parameters and their ranges, discriminated by ``name``, and one per augmenting map. A robot or map
+the catalogue gains appears in the API, its OpenAPI schema and the fuzz test with no change here.
+
+Pydantic checks types, ranges, finiteness (``allow_inf_nan=False``: NaN and inf are rejected) and
+size bounds. What needs the registry (vector lengths against p and r, an augmentation that belongs
+to the robot, a singular start) is checked by :mod:`app.service`, which names the field.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Literal, Union
+
+from pydantic import BaseModel, ConfigDict, Field, create_model
+
+from engine.registry import ROBOTS, AugmentationSpec, RobotSpec
+from engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
+
+#: Largest configuration / task dimension accepted before the registry check.
+MAX_DIMENSION = 16
+#: Largest step / iteration cap a request may ask for.
+MAX_ITERATIONS = 20000
+#: Trajectories longer than this are downsampled (first and last points kept).
+MAX_TRAJECTORY_POINTS = 2000
+
+FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
+#: A float that is null where the engine produced NaN or inf (a failed or diverged run).
+MaybeFloat = float | None
+
+
+def _camel(name: str) -> str:
+    return "".join(part.capitalize() for part in name.replace("-", "_").split("_"))
+
+
+def _scalar_field(p) -> tuple[Any, Any]:
+    extra = " (nonzero)" if p.nonzero else ""
+    return (
+        Annotated[
+            float,
+            Field(
+                ge=p.minimum,
+                le=p.maximum,
+                allow_inf_nan=False,
+                description=f"{p.description}{extra}; default {p.default:g}",
+            ),
+        ],
+        p.default,
+    )
+
+
+def _vector_field(v) -> tuple[Any, Any]:
+    items = tuple(
+        Annotated[float, Field(ge=lo, le=hi, allow_inf_nan=False)]
+        for lo, hi in zip(v.minimum, v.maximum, strict=True)
+    )
+    return (
+        Annotated[tuple[items], Field(description=f"{v.description}; default {list(v.default)}")],
+        tuple(v.default),
+    )
+
+
+def _robot_model(spec: RobotSpec) -> type[BaseModel]:
+    fields: dict[str, Any] = {"name": (Literal[spec.name], ...)}
+    for p in spec.parameters:
+        fields[p.name] = _scalar_field(p)
+    for v in spec.vector_parameters:
+        fields[v.name] = _vector_field(v)
+    return create_model(
+        f"{_camel(spec.name)}Robot",
+        __config__=ConfigDict(extra="forbid", title=spec.title),
+        __doc__=f"{spec.title}: {spec.description}, eq. {spec.equation}.",
+        **fields,
+    )
+
+
+def _augmentation_model(name: str, specs: list[AugmentationSpec]) -> type[BaseModel]:
+    fields: dict[str, Any] = {"name": (Literal[name], ...)}
+    for spec in specs:
+        for p in spec.parameters:
+            fields.setdefault(p.name, _scalar_field(p))
+    first = specs[0]
+    return create_model(
+        f"{_camel(name)}Augmentation",
+        __config__=ConfigDict(extra="forbid"),
+        __doc__=f"Augmenting map {name}, eq. {first.equation}: {first.description}.",
+        **fields,
+    )
+
+
+def _union(models: list[type[BaseModel]]) -> Any:
+    if len(models) == 1:
+        return models[0]
+    return Annotated[Union[tuple(models)], Field(discriminator="name")]  # noqa: UP007
+
+
+ROBOT_MODELS: dict[str, type[BaseModel]] = {name: _robot_model(s) for name, s in ROBOTS.items()}
+_by_name: dict[str, list[AugmentationSpec]] = {}
+for _spec in ROBOTS.values():
+    for _a in _spec.augmentations:
+        _by_name.setdefault(_a.name, []).append(_a)
+AUGMENTATION_MODELS: dict[str, type[BaseModel]] = {
+    name: _augmentation_model(name, specs) for name, specs in _by_name.items()
+}
+for _m in (*ROBOT_MODELS.values(), *AUGMENTATION_MODELS.values()):
+    globals()[_m.__name__] = _m  # importable by name (pickling, introspection)
+
+Robot = _union(list(ROBOT_MODELS.values()))
+Augmentation = _union(list(AUGMENTATION_MODELS.values()))
+
+Algorithm = Literal["pseudoinverse", "extended"]
+Mode = Literal["continuous", "discrete"]
+Vector = Annotated[list[FiniteFloat], Field(min_length=1, max_length=MAX_DIMENSION)]
+
+
+class _Request(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+    robot: Robot = Field(
+        description="the robot and its parameters, e.g. {'name': 'manipulator2', 'l': 1}"
+    )
+    algorithm: Algorithm = Field(
+        description="'pseudoinverse' (eq. (8)) or 'extended' (extended Jacobian inverse, eq. (11))"
+    )
+    augmentation: Augmentation | None = Field(
+        None,
+        description="augmenting map h of the extended inverse with its parameters; "
+        "default: the robot's default augmentation (ignored by the pseudoinverse)",
+    )
+    x0: Vector = Field(description="start configuration, length p of the robot")
+    gamma: Annotated[float, Field(gt=0, le=1e6, allow_inf_nan=False)] | None = Field(
+        None,
+        description="decay rate > 0 of eq. (5) (discrete: the step, < 2); default: the robot's",
+    )
+    mode: Mode | None = Field(
+        None, description="'continuous' (ODE) or 'discrete' (iterations); default: the robot's"
+    )
+    tolerance: Annotated[float, Field(ge=1e-14, le=1.0, allow_inf_nan=False)] = Field(
+        1e-10, description="stop when ||k(x) - target|| < tolerance"
+    )
+    max_iterations: Annotated[int, Field(ge=1, le=MAX_ITERATIONS)] | None = Field(
+        None,
+        description="cap on integrator steps (continuous) or iterations (discrete) per solve",
+    )
+
+
+class SolveRequest(_Request):
+    """One run of the continuation algorithm (7) from x0 to a target task point."""
+
+    target: Vector = Field(description="target task point, length r of the robot")
+
+
+class RepeatabilityRequest(_Request):
+    """Drive the robot ``cycles`` times around a closed task-space path (Table 1)."""
+
+    path: Annotated[list[Vector], Field(min_length=1, max_length=MAX_PATH_POINTS)] = Field(
+        description=f"task points visited in order, 1 to {MAX_PATH_POINTS}; k(x0) closes it"
+    )
+    cycles: Annotated[int, Field(ge=1, le=MAX_CYCLES)] = Field(1, description=f"1 to {MAX_CYCLES}")
+
+
+class AugmentationUsed(BaseModel):
+    """The augmenting map a run used, with every parameter (defaults filled in)."""
+
+    name: str
+    parameters: dict[str, float]
+
+
+class RobotUsed(BaseModel):
+    """The robot a run used, with every parameter (defaults filled in)."""
+
+    name: str
+    parameters: dict[str, float | list[float]]
+
+
+class Trajectory(BaseModel):
+    """The run point by point (accepted integrator steps or iterations)."""
+
+    theta: list[MaybeFloat] = Field(description="continuation parameter, or iteration number")
+    x: list[list[MaybeFloat]] = Field(description="configurations, shape (m, p)")
+    y: list[list[MaybeFloat]] = Field(description="k(x), shape (m, r)")
+    error: list[MaybeFloat] = Field(description="||k(x) - target||, shape (m,)")
+    h: list[MaybeFloat] | None = Field(None, description="h(x) for the extended inverse")
+    points: int = Field(description="points of the full trajectory before downsampling")
+    downsampled: bool
+
+
+class SolveResponse(BaseModel):
+    robot: RobotUsed
+    algorithm: Algorithm
+    augmentation: AugmentationUsed | None
+    mode: Mode
+    gamma: float
+    tolerance: float
+    x: list[MaybeFloat] = Field(
+        description="final configuration (null entries if the run diverged)"
+    )
+    y: list[MaybeFloat] = Field(description="k(x)")
+    error: MaybeFloat = Field(description="||k(x) - target||")
+    converged: bool
+    message: str
+    iterations: int = Field(description="integrator steps or iterations taken")
+    trajectory: Trajectory
+
+
+class RepeatabilityResponse(BaseModel):
+    robot: RobotUsed
+    algorithm: Algorithm
+    augmentation: AugmentationUsed | None
+    mode: Mode
+    gamma: float
+    cycles: int
+    targets: list[list[float]] = Field(description="task point of each leg of one cycle (closed)")
+    legs: list[list[MaybeFloat]] = Field(
+        description="configuration after each leg, all cycles (null after a failed leg)"
+    )
+    cycle_end: list[list[MaybeFloat]] = Field(description="configuration at the end of each cycle")
+    drift: list[MaybeFloat] = Field(description="||cycle_end[c] - x0|| per cycle")
+    max_drift: MaybeFloat
+    repeatable: bool = Field(description="every leg succeeded and max drift < 1e-6")
+    success: bool
+    message: str
+
+
+class ParameterInfo(BaseModel):
+    name: str
+    default: float | list[float]
+    minimum: float | list[float]
+    maximum: float | list[float]
+    description: str
+    nonzero: bool = False
+    presets: dict[str, list[float]] | None = None
+
+
+class AugmentationInfo(BaseModel):
+    name: str
+    equation: str
+    description: str
+    parameters: list[ParameterInfo]
+
+
+class RobotInfo(BaseModel):
+    name: str
+    title: str
+    description: str
+    equation: str
+    p: int
+    r: int
+    variable_names: list[str]
+    task_names: list[str]
+    parameters: list[ParameterInfo]
+    default_x0: list[float]
+    default_target: list[float]
+    default_path: list[list[float]]
+    default_mode: Mode
+    default_gamma: float
+    x_range: list[list[float]]
+    augmentations: list[AugmentationInfo]
+    default_augmentation: str
+    algorithms: list[Algorithm]
+    modes: list[Mode]
+
+
+class Limits(BaseModel):
+    max_cycles: int
+    max_path_points: int
+    max_iterations: int
+    max_trajectory_points: int
+    request_timeout_s: float
+
+
+class RobotsResponse(BaseModel):
+    robots: list[RobotInfo]
+    limits: Limits
+
+
+SynthesisMethod = Literal["evaluate", "e2_variational"]
+Bound = Annotated[float, Field(ge=-100.0, le=100.0, allow_inf_nan=False)]
+
+
+class SynthesizeRequest(BaseModel):
+    """Synthesize or evaluate an augmenting map h over a box of the joint space."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    robot: Robot
+    method: SynthesisMethod = Field(
+        "evaluate",
+        description="'evaluate': a catalogue map (analytic or already synthesized) on the box; "
+        "'e2_variational': minimise E2 (eq. (19)) by the Ritz method (engine.variational)",
+    )
+    augmentation: Augmentation | None = Field(
+        None, description="for 'evaluate': the map and its parameters (default: the robot's)"
+    )
+    region: dict[str, tuple[Bound, Bound]] | None = Field(
+        None,
+        max_length=3,
+        description="box {variable: [lo, hi]} (2 variables for a grid); default: the last two "
+        "variables over the robot's x_range",
+    )
+    fixed: dict[str, FiniteFloat] | None = Field(
+        None,
+        max_length=MAX_DIMENSION,
+        description="values of the variables not in the box (default 0)",
+    )
+    nodes: Annotated[int, Field(ge=2, le=24)] = Field(
+        12, description="Gauss-Legendre nodes per variable for E1 and E2"
+    )
+    degree: Annotated[int, Field(ge=1, le=24)] = Field(
+        10, description="'e2_variational': Legendre degree per variable"
+    )
+    grid: Annotated[int, Field(ge=3, le=61)] = Field(21, description="grid points per axis for h")
+
+
+class FunctionalInfo(BaseModel):
+    value: MaybeFloat
+    n_points: int
+    n_singular: int
+    min_abs_dh_k: MaybeFloat
+
+
+class SynthesisGrid(BaseModel):
+    axes: dict[str, list[float]] = Field(description="the two grid variables and their values")
+    h: list[list[MaybeFloat]] = Field(description="h[i][j] at (axis 1 [i], axis 2 [j])")
+
+
+class SynthesizeResponse(BaseModel):
+    robot: RobotUsed
+    method: SynthesisMethod
+    augmentation: AugmentationUsed
+    region: dict[str, list[float]]
+    fixed: dict[str, float]
+    grid: SynthesisGrid | None
+    coefficients: dict[str, float] = Field(
+        description="polynomial coefficients, when there are any"
+    )
+    functionals: dict[str, FunctionalInfo | None] = Field(
+        description="E1 (eq. (13)) and E2 (eq. (18)) of the map on the box; null if unavailable"
+    )
+    convergence: list[dict[str, float]] = Field(
+        description="'e2_variational': E2 against the Legendre degree"
+    )
+    available: dict[str, bool] = Field(description="which synthesis components are installed")
+    message: str
+
+
+class SynthesisMethodsResponse(BaseModel):
+    methods: list[SynthesisMethod]
+    available: dict[str, bool]
+    notes: dict[str, str]
+
+
+class ErrorResponse(BaseModel):
+    """A request that could not be served now (503) or an unexpected failure (500)."""
+
+    detail: str
+
+
+class HealthResponse(BaseModel):
+    status: Literal["ok"]
+
+
+__all__ = [
+    "AUGMENTATION_MODELS",
+    "ROBOT_MODELS",
+    "Augmentation",
+    "ErrorResponse",
+    "HealthResponse",
+    "RepeatabilityRequest",
+    "RepeatabilityResponse",
+    "Robot",
+    "RobotsResponse",
+    "SolveRequest",
+    "SolveResponse",
+    "SynthesizeRequest",
+    "SynthesizeResponse",
+]

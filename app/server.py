@@ -1,0 +1,25 @@
+"""``jik serve``: the REST API under uvicorn (and the dashboard's viser scene)."""
+
+from __future__ import annotations
+
+import uvicorn
+
+from app.main import create_app
+
+
+def run_server(host: str = "127.0.0.1", port: int = 8000, scene_port: int = 8080) -> None:
+    """Serve the API on ``host:port`` until interrupted.
+
+    Parameters
+    ----------
+    host : str
+        Address to bind; 127.0.0.1 by default (use 0.0.0.0 in a container).
+    port : int
+        HTTP port of the API (OpenAPI docs at /docs).
+    scene_port : int
+        Port of the viser 3D scene.
+    """
+    app = create_app()
+    # --- dashboard: start the viser scene on scene_port here (2-3 lines) -----------------
+    # ---------------------------------------------------------------------------------------
+    uvicorn.run(app, host=host, port=port, log_level="info", access_log=False)

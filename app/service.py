@@ -1,0 +1,882 @@
+"""Service layer: API schemas to engine calls, and where and how the heavy work runs.
+
+Two layers:
+
+* Plain synchronous functions (``robots_response``, ``solve_request``, ``solve_batch``,
+  ``repeatability_request``, ``synthesize_request``) turn a request model into engine calls and
+  the result into a response model. They raise :class:`RequestError` naming the offending field.
+  The dashboard calls them directly.
+* :class:`ComputePool` runs them for the HTTP API off the event loop, in worker *processes*:
+  numpy-heavy Python loops hold the GIL, and a computation that overruns its time limit can only
+  be stopped by ending its process. Concurrent ``/solve`` requests with the same robot, algorithm,
+  augmentation, mode, gamma, tolerance and iteration cap are micro-batched: the first one opens a
+  short window (``JIK_BATCH_WINDOW_MS``, default 2 ms), every compatible request arriving until a
+  worker is free joins it, and the batch is solved by ONE engine call with x0 of shape (n, p) and
+  targets (n, r) (each member keeps its own adaptive step, so its result is the same as alone).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import concurrent.futures
+import importlib
+import json
+import os
+import socket
+import subprocess
+import sys
+import threading
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from multiprocessing.connection import Connection
+from typing import Any
+
+import numpy as np
+
+from app import schemas as S
+from engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
+from engine.registry import ROBOTS, RobotSpec, make_inverse
+from engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS, repeatability
+from engine.solver import solve
+
+#: A run whose largest drift is below this is called repeatable.
+REPEATABLE_DRIFT = 1e-6
+
+
+class RequestError(ValueError):
+    """A request the engine cannot serve: HTTP 422 with a message that names ``field``."""
+
+    def __init__(self, field: str, message: str) -> None:
+        self.field = field
+        self.message = message
+        super().__init__(f"{field}: {message}")
+
+
+class ServiceUnavailable(RuntimeError):
+    """No compute slot freed in time, or the computation overran its time limit: HTTP 503."""
+
+
+class ComputeError(RuntimeError):
+    """An unexpected failure inside a worker: HTTP 500 with its description."""
+
+
+# --------------------------------------------------------------------------------------------
+# Conversions
+
+
+def _nullable(a) -> Any:
+    """ndarray -> nested lists with None where not finite (JSON has no NaN)."""
+    a = np.asarray(a, dtype=float)
+    if a.ndim == 0:
+        return float(a) if np.isfinite(a) else None
+    obj = a.astype(object)
+    obj[~np.isfinite(a)] = None
+    return obj.tolist()
+
+
+def _downsample(m: int, limit: int = S.MAX_TRAJECTORY_POINTS) -> np.ndarray:
+    """Indices of at most ``limit`` of ``m`` points, evenly spread, first and last kept."""
+    if m <= limit:
+        return np.arange(m)
+    return np.unique(np.linspace(0, m - 1, limit).round().astype(int))
+
+
+@dataclass
+class _Setup:
+    """Everything a run needs, validated against the registry."""
+
+    spec: RobotSpec
+    kinematics: Any
+    inverse: Any
+    robot: S.RobotUsed
+    augmentation: S.AugmentationUsed | None
+    mode: str
+    gamma: float
+    tolerance: float
+    max_iterations: int | None
+    extra: dict = field(default_factory=dict)
+
+
+def _robot(req_robot) -> tuple[RobotSpec, Any, S.RobotUsed]:
+    try:
+        spec = ROBOTS[req_robot.name]
+    except KeyError:
+        raise RequestError(
+            "robot.name", f"unknown robot {req_robot.name!r}; choose one of {sorted(ROBOTS)}"
+        ) from None
+    params = req_robot.model_dump(exclude={"name"})
+    try:
+        kin = spec.build(**params)
+    except (InvalidInputError, TypeError) as exc:
+        raise RequestError("robot", str(exc)) from None
+    used = {
+        k: [float(t) for t in v] if isinstance(v, tuple | list) else float(v)
+        for k, v in params.items()
+    }
+    return spec, kin, S.RobotUsed(name=spec.name, parameters=used)
+
+
+def _augmentation(spec: RobotSpec, kin, req_aug):
+    """The augmenting map named in the request (or the robot's default), built and checked."""
+    name = req_aug.name if req_aug is not None else None
+    try:
+        aspec = spec.augmentation(name)
+    except InvalidInputError as exc:
+        raise RequestError("augmentation.name", str(exc)) from None
+    given = req_aug.model_dump(exclude={"name"}, exclude_unset=True) if req_aug is not None else {}
+    known = {p.name for p in aspec.parameters}
+    unknown = sorted(set(given) - known)
+    if unknown:
+        raise RequestError(
+            f"augmentation.{unknown[0]}",
+            f"{aspec.name} of {spec.name} has no parameter {unknown[0]!r}; "
+            f"its parameters: {sorted(known) or 'none'}",
+        )
+    values = {p.name: given.get(p.name, p.default) for p in aspec.parameters}
+    try:
+        amap = aspec.build(kin, **values)
+    except InvalidInputError as exc:
+        raise RequestError("augmentation", str(exc)) from None
+    return aspec, amap, S.AugmentationUsed(name=aspec.name, parameters=values)
+
+
+def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
+    spec, kin, robot_used = _robot(req.robot)
+    aug_used = None
+    if req.algorithm == "extended":
+        aspec, _, aug_used = _augmentation(spec, kin, req.augmentation)
+        try:
+            inverse = make_inverse(kin, "extended", aspec.name, aug_used.parameters, spec.name)
+        except InvalidInputError as exc:
+            raise RequestError("augmentation", str(exc)) from None
+    else:
+        inverse = make_inverse(kin, "pseudoinverse")
+    if len(req.x0) != spec.p:
+        raise RequestError(
+            "x0", f"must have {spec.p} components (p of {spec.name}), got {len(req.x0)}"
+        )
+    mode = req.mode or spec.default_mode
+    gamma = spec.default_gamma if req.gamma is None else float(req.gamma)
+    if mode == "discrete" and gamma >= 2:
+        raise RequestError(
+            "gamma",
+            f"must be < 2 in discrete mode, got {gamma:g} (near the solution the error shrinks "
+            "by |1 - gamma| per iteration)",
+        )
+    return _Setup(
+        spec, kin, inverse, robot_used, aug_used, mode, gamma, req.tolerance, req.max_iterations
+    )
+
+
+def _check_task_point(spec: RobotSpec, y, name: str) -> None:
+    if len(y) != spec.r:
+        raise RequestError(name, f"must have {spec.r} components (r of {spec.name}), got {len(y)}")
+
+
+def _check_start(setup: _Setup, x0: np.ndarray) -> np.ndarray:
+    """Mask (n,) of singular starts for the chosen inverse; x0 of shape (n, p)."""
+    kin = setup.kinematics
+    _, bad = setup.inverse.apply_masked(x0, np.zeros((len(x0), kin.r)) + 1.0)
+    return np.atleast_1d(bad)
+
+
+def _singular_message(setup: _Setup, x0) -> str:
+    return str(setup.inverse.singular_error(np.asarray(x0, dtype=float)))
+
+
+_ENGINE_FIELDS = ("x0", "target", "gamma", "tol", "max_iterations", "path", "cycles", "mode")
+
+
+def _engine_error(exc: JikError) -> RequestError:
+    """An engine error as a RequestError; the field is read off the engine's message."""
+    if isinstance(exc, SingularConfigurationError):
+        return RequestError("x0", str(exc))
+    text = str(exc)
+    first = text.split(" ", 1)[0]
+    name = {"tol": "tolerance", "y_d": "target"}.get(first, first)
+    if first not in _ENGINE_FIELDS and name not in _ENGINE_FIELDS:
+        name = "request"
+    return RequestError(name, text)
+
+
+def _trajectory(traj) -> S.Trajectory:
+    m = len(traj.theta)
+    idx = _downsample(m)
+    return S.Trajectory(
+        theta=_nullable(traj.theta[idx]),
+        x=_nullable(traj.x[idx]),
+        y=_nullable(traj.y[idx]),
+        error=_nullable(traj.error[idx]),
+        h=None if traj.h is None else _nullable(np.asarray(traj.h)[idx]),
+        points=m,
+        downsampled=len(idx) < m,
+    )
+
+
+def _solve_response(setup: _Setup, res) -> S.SolveResponse:
+    return S.SolveResponse(
+        robot=setup.robot,
+        algorithm=setup.inverse.name,
+        augmentation=setup.augmentation,
+        mode=setup.mode,
+        gamma=setup.gamma,
+        tolerance=setup.tolerance,
+        x=_nullable(res.x),
+        y=_nullable(res.y),
+        error=_nullable(res.error),
+        converged=bool(res.success),
+        message=res.message,
+        iterations=int(res.nit),
+        trajectory=_trajectory(res.trajectory),
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# Plain service functions
+
+
+def robots_response(timeout: float | None = None) -> S.RobotsResponse:
+    """The catalogue: every robot with p, r, parameters, defaults and augmentations."""
+    robots = [
+        S.RobotInfo(
+            **spec.as_dict(),
+            algorithms=["pseudoinverse", "extended"],
+            modes=["continuous", "discrete"],
+        )
+        for spec in ROBOTS.values()
+    ]
+    limits = S.Limits(
+        max_cycles=MAX_CYCLES,
+        max_path_points=MAX_PATH_POINTS,
+        max_iterations=S.MAX_ITERATIONS,
+        max_trajectory_points=S.MAX_TRAJECTORY_POINTS,
+        request_timeout_s=float(timeout if timeout is not None else settings_from_env().timeout),
+    )
+    return S.RobotsResponse(robots=robots, limits=limits)
+
+
+def batch_key(req: S.SolveRequest) -> str:
+    """Requests with equal keys can share one batched engine call."""
+    d = req.model_dump(exclude={"x0", "target"})
+    if req.algorithm == "pseudoinverse":
+        d["augmentation"] = None
+    return json.dumps(d, sort_keys=True, default=str)
+
+
+def solve_batch(reqs: list[S.SolveRequest]) -> list[S.SolveResponse | RequestError]:
+    """Solve requests sharing one :func:`batch_key` in ONE batched engine call.
+
+    Each member is validated on its own (lengths, singular start): a bad member gets its
+    :class:`RequestError` in its slot and does not affect the others.
+    """
+    if not reqs:
+        return []
+    if len({batch_key(r) for r in reqs}) != 1:
+        raise ValueError("solve_batch needs requests with equal batch keys")
+    try:
+        setup = _setup(reqs[0])
+    except RequestError as exc:
+        return [exc] * len(reqs)
+    out: list[S.SolveResponse | RequestError | None] = [None] * len(reqs)
+    ok: list[int] = []
+    for i, r in enumerate(reqs):
+        try:
+            if len(r.x0) != setup.spec.p:
+                raise RequestError(
+                    "x0",
+                    f"must have {setup.spec.p} components (p of {setup.spec.name}), "
+                    f"got {len(r.x0)}",
+                )
+            _check_task_point(setup.spec, r.target, "target")
+            ok.append(i)
+        except RequestError as exc:
+            out[i] = exc
+    if ok:
+        x0 = np.array([reqs[i].x0 for i in ok], dtype=float)
+        y_d = np.array([reqs[i].target for i in ok], dtype=float)
+        bad = _check_start(setup, x0)
+        for k in np.flatnonzero(bad):
+            out[ok[k]] = RequestError("x0", _singular_message(setup, x0[k]) + "; move the start")
+        keep = np.flatnonzero(~bad)
+        if keep.size:
+            try:
+                batch = solve(
+                    setup.inverse,
+                    x0[keep],
+                    y_d[keep],
+                    gamma=setup.gamma,
+                    mode=setup.mode,
+                    tol=setup.tolerance,
+                    max_iterations=setup.max_iterations,
+                    record=True,
+                )
+            except JikError as exc:
+                err = _engine_error(exc)
+                for k in keep:
+                    out[ok[k]] = err
+            else:
+                for j, k in enumerate(keep):
+                    out[ok[k]] = _solve_response(setup, batch[j])
+    return out  # type: ignore[return-value]
+
+
+def solve_request(req: S.SolveRequest) -> S.SolveResponse:
+    """One run of eq. (7) from ``req.x0`` to ``req.target``; raises :class:`RequestError`."""
+    (res,) = solve_batch([req])
+    if isinstance(res, RequestError):
+        raise res
+    return res
+
+
+def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityResponse:
+    """The closed path of ``req`` driven ``req.cycles`` times (Table 1); drift per cycle."""
+    setup = _setup(req)
+    for i, pt in enumerate(req.path):
+        _check_task_point(setup.spec, pt, f"path[{i}]")
+    x0 = np.array(req.x0, dtype=float)
+    if _check_start(setup, x0[None])[0]:
+        raise RequestError("x0", _singular_message(setup, x0) + "; move the start")
+    try:
+        res = repeatability(
+            setup.inverse,
+            x0,
+            np.array(req.path, dtype=float),
+            cycles=req.cycles,
+            gamma=setup.gamma,
+            mode=setup.mode,
+            tol=setup.tolerance,
+            max_iterations=setup.max_iterations,
+        )
+    except JikError as exc:
+        raise _engine_error(exc) from None
+    drift = np.asarray(res.drift, dtype=float)
+    finite = bool(np.all(np.isfinite(drift)))
+    max_drift = float(np.max(drift)) if finite else float("nan")
+    return S.RepeatabilityResponse(
+        robot=setup.robot,
+        algorithm=setup.inverse.name,
+        augmentation=setup.augmentation,
+        mode=setup.mode,
+        gamma=setup.gamma,
+        cycles=req.cycles,
+        targets=np.asarray(res.targets, dtype=float).tolist(),
+        legs=_nullable(res.legs),
+        cycle_end=_nullable(res.cycle_end),
+        drift=_nullable(drift),
+        max_drift=_nullable(max_drift),
+        repeatable=bool(res.success) and finite and max_drift < REPEATABLE_DRIFT,
+        success=bool(res.success),
+        message=res.message,
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# Synthesis
+
+
+def _optional(module: str, *names: str):
+    """The named attributes of ``module`` if it imports and has them all, else None."""
+    try:
+        mod = importlib.import_module(module)
+    except Exception:  # a module under development may fail in any way
+        return None
+    if not all(hasattr(mod, n) for n in names):
+        return None
+    return tuple(getattr(mod, n) for n in names)
+
+
+def synthesis_available() -> dict[str, bool]:
+    """Which synthesis components can be imported right now."""
+    return {
+        "error_functionals": _optional(
+            "engine.functionals", "error_functional_e1", "error_functional_e2"
+        )
+        is not None,
+        "e2_variational": _optional("engine.variational", "synthesize_e2") is not None,
+        "characteristics": any(
+            a.name == "characteristics" for s in ROBOTS.values() for a in s.augmentations
+        ),
+    }
+
+
+def synthesis_methods() -> S.SynthesisMethodsResponse:
+    avail = synthesis_available()
+    methods = ["evaluate"] + (["e2_variational"] if avail["e2_variational"] else [])
+    return S.SynthesisMethodsResponse(
+        methods=methods,
+        available=avail,
+        notes={
+            "evaluate": "any map of the catalogue (GET /robots): h on a grid of the box, "
+            "polynomial coefficients, E1 and E2 on the box",
+            "e2_variational": "minimise E2 (eq. (19)) over h of the box variables (Ritz method, "
+            "engine.variational.synthesize_e2)"
+            + ("" if avail["e2_variational"] else " - not installed"),
+            "error_functionals": "E1 (13) and E2 (18) by Gauss quadrature (engine.functionals)"
+            + ("" if avail["error_functionals"] else " - not installed"),
+        },
+    )
+
+
+def _region(spec: RobotSpec, req: S.SynthesizeRequest):
+    names = list(spec.variable_names)
+    if req.region is None:  # the whole x_range box (the last three variables at most)
+        region = {n: tuple(spec.x_range[names.index(n)]) for n in names[-3:]}
+    else:
+        region = {k: (float(lo), float(hi)) for k, (lo, hi) in req.region.items()}
+    for k, (lo, hi) in region.items():
+        if k not in names:
+            raise RequestError(f"region.{k}", f"unknown variable {k!r}; {spec.name} has {names}")
+        if not lo < hi:
+            raise RequestError(f"region.{k}", f"needs lo < hi, got [{lo:g}, {hi:g}]")
+    if not region:
+        raise RequestError("region", f"give at least one variable of {names}")
+    fixed = dict(req.fixed or {})
+    for k in fixed:
+        if k not in names:
+            raise RequestError(f"fixed.{k}", f"unknown variable {k!r}; {spec.name} has {names}")
+        if k in region:
+            raise RequestError(f"fixed.{k}", "is also a region variable")
+    return names, region, fixed
+
+
+def _grid_axes(amap, names, region, base) -> list[str]:
+    """The two region variables along which h varies most (mean |dh/dx_i| on seeded samples)."""
+    if len(region) <= 2:
+        return list(region)
+    rng = np.random.default_rng(0)
+    x = np.broadcast_to(base, (256, len(base))).copy()
+    for k, (lo, hi) in region.items():
+        x[:, names.index(k)] = rng.uniform(lo, hi, 256)
+    with np.errstate(all="ignore"):
+        try:
+            g = np.abs(np.asarray(amap.gradient(x), dtype=float))
+        except JikError:
+            return list(region)[:2]
+    score = {k: float(np.nanmean(g[:, names.index(k)])) for k in region}
+    top = sorted(region, key=lambda k: -(score[k] if np.isfinite(score[k]) else -1.0))[:2]
+    return [k for k in region if k in top]
+
+
+def _grid(amap, names, region, fixed, p: int, n: int) -> S.SynthesisGrid | None:
+    if len(region) < 2:
+        return None
+    base = np.zeros(p)
+    for k, v in fixed.items():
+        base[names.index(k)] = v
+    for k, (lo, hi) in region.items():
+        base[names.index(k)] = 0.5 * (lo + hi)
+    axes = _grid_axes(amap, names, region, base)
+    a, b = (np.linspace(*region[k], n) for k in axes)
+    x = np.broadcast_to(base, (n, n, p)).copy()
+    x[..., names.index(axes[0])] = a[:, None]
+    x[..., names.index(axes[1])] = b[None, :]
+    with np.errstate(all="ignore"):
+        try:
+            h = np.asarray(amap.value(x), dtype=float)
+        except JikError:  # a map that raises where it is undefined: evaluate point by point
+            h = np.full((n, n), np.nan)
+            for i in range(n):
+                for j in range(n):
+                    try:
+                        h[i, j] = float(amap.value(x[i, j]))
+                    except JikError:
+                        pass
+    return S.SynthesisGrid(axes={axes[0]: a.tolist(), axes[1]: b.tolist()}, h=_nullable(h))
+
+
+def _functional_info(fv) -> S.FunctionalInfo:
+    return S.FunctionalInfo(
+        value=_nullable(fv.value),
+        n_points=int(fv.n_points),
+        n_singular=int(np.asarray(fv.singular_points).shape[0]),
+        min_abs_dh_k=_nullable(getattr(fv, "min_abs_dh_k", float("nan"))),
+    )
+
+
+def _functionals(kin, amap, region, fixed, nodes) -> tuple[dict, list[str]]:
+    funcs = _optional("engine.functionals", "error_functional_e1", "error_functional_e2")
+    notes: list[str] = []
+    if funcs is None:
+        return {"e1": None, "e2": None}, ["engine.functionals is not installed: no E1, E2"]
+    out = {}
+    for label, fn in zip(("e1", "e2"), funcs, strict=True):
+        try:
+            out[label] = _functional_info(fn(kin, amap, region, nodes=nodes, fixed=fixed))
+        except JikError as exc:
+            out[label] = None
+            notes.append(f"{label.upper()} not evaluated: {exc}")
+    return out, notes
+
+
+def _coefficients(amap) -> dict[str, float]:
+    coef = getattr(amap, "coefficients", None)
+    if not isinstance(coef, dict):
+        return {}
+    a, b = (f"x{v + 1}" for v in getattr(amap, "variables", (0, 1)))
+    return {f"{a}^{i} {b}^{j}": float(c) for (i, j), c in sorted(coef.items())}
+
+
+def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
+    """Evaluate a catalogue map, or synthesize an E2-optimal one, over a box (section 3)."""
+    spec, kin, robot_used = _robot(req.robot)
+    names, region, fixed = _region(spec, req)
+    avail = synthesis_available()
+    convergence: list[dict[str, float]] = []
+    coefficients: dict[str, float] = {}
+    notes: list[str] = []
+    if req.method == "e2_variational":
+        found = _optional("engine.variational", "synthesize_e2")
+        if found is None:
+            raise RequestError(
+                "method",
+                "'e2_variational' is not available: engine.variational.synthesize_e2 "
+                "is not installed; use 'evaluate'",
+            )
+        if req.augmentation is not None:
+            raise RequestError("augmentation", "'e2_variational' synthesizes h; give no map")
+        try:
+            result = found[0](kin, region, degree=req.degree, fixed=fixed)
+        except JikError as exc:
+            raise RequestError("region", str(exc)) from None
+        amap = result.augmenting_map
+        aug_used = S.AugmentationUsed(name=getattr(amap, "name", "e2_synthesized"), parameters={})
+        convergence = [
+            {k: float(v) for k, v in row.items() if isinstance(v, int | float)}
+            for row in result.convergence
+        ]
+        poly = getattr(result, "polynomial", None)
+        if poly is not None:
+            coefficients = _coefficients(poly)
+            notes.append(
+                f"E2 of the synthesized map {result.e2:.6g}; of its cubic fit "
+                f"{result.polynomial_e2:.6g}"
+            )
+        region, fixed = dict(result.region) or region, dict(result.fixed) or fixed
+    else:
+        _, amap, aug_used = _augmentation(spec, kin, req.augmentation)
+        coefficients = _coefficients(amap)
+    functionals, more = _functionals(kin, amap, region, fixed, req.nodes)
+    notes += more
+    all_fixed = {n: float(fixed.get(n, 0.0)) for n in names if n not in region}
+    return S.SynthesizeResponse(
+        robot=robot_used,
+        method=req.method,
+        augmentation=aug_used,
+        region={k: [float(lo), float(hi)] for k, (lo, hi) in region.items()},
+        fixed=all_fixed,
+        grid=_grid(amap, names, region, all_fixed, spec.p, req.grid),
+        coefficients=coefficients,
+        functionals=functionals,
+        convergence=convergence,
+        available=avail,
+        message="; ".join(notes) or "ok",
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# Worker processes
+
+
+def _solve_payload(items: list[dict]) -> list[tuple[str, Any]]:
+    reqs = [S.SolveRequest.model_validate(d) for d in items]
+    out = []
+    for res in solve_batch(reqs):
+        if isinstance(res, RequestError):
+            out.append(("request_error", (res.field, res.message)))
+        else:
+            out.append(("ok", res.model_dump(mode="json")))
+    return out
+
+
+_HANDLERS: dict[str, Callable[[Any], Any]] = {
+    "ping": lambda payload: "pong",
+    "solve": _solve_payload,
+    "repeatability": lambda d: repeatability_request(
+        S.RepeatabilityRequest.model_validate(d)
+    ).model_dump(mode="json"),
+    "synthesize": lambda d: synthesize_request(S.SynthesizeRequest.model_validate(d)).model_dump(
+        mode="json"
+    ),
+}
+
+
+def _worker_main(conn) -> None:
+    """Loop of a worker process: (kind, payload) in, (status, result) out."""
+    while True:
+        try:
+            kind, payload = conn.recv()
+        except (EOFError, OSError):
+            return
+        try:
+            msg = ("ok", _HANDLERS[kind](payload))
+        except RequestError as exc:
+            msg = ("request_error", (exc.field, exc.message))
+        except JikError as exc:
+            err = _engine_error(exc)
+            msg = ("request_error", (err.field, err.message))
+        except Exception as exc:  # reported to the client as a 500 with its text
+            msg = ("error", f"{type(exc).__name__}: {exc}")
+        conn.send(msg)
+
+
+def _worker_entry(fd: int) -> None:
+    """Entry point of a worker process started by :class:`_Worker` (``python -c``)."""
+    from multiprocessing.connection import Connection
+
+    _worker_main(Connection(fd))
+
+
+class _Worker:
+    """A worker process (a fresh interpreter, so nothing of the server's state is inherited)."""
+
+    def __init__(self) -> None:
+        parent, child = socket.socketpair()
+        fd = child.fileno()
+        env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+        self.process = subprocess.Popen(
+            [sys.executable, "-c", f"from app.service import _worker_entry; _worker_entry({fd})"],
+            pass_fds=[fd],
+            env=env,
+            stdin=subprocess.DEVNULL,
+        )
+        child.close()
+        self.conn = Connection(parent.detach())
+
+    def call(self, kind: str, payload, timeout: float):
+        """Blocking round trip (runs in a thread); TimeoutError when it overruns."""
+        self.conn.send((kind, payload))
+        if not self.conn.poll(max(timeout, 0.0)):
+            raise TimeoutError
+        return self.conn.recv()
+
+    def kill(self) -> None:
+        self.process.kill()
+        self.process.wait(5)
+        self.conn.close()
+
+
+@dataclass(frozen=True)
+class Settings:
+    """How the API runs its computations (from the environment by :func:`settings_from_env`)."""
+
+    workers: int = 2
+    timeout: float = 20.0
+    batching: bool = True
+    batch_window: float = 0.002
+    max_batch: int = 64
+
+
+def settings_from_env() -> Settings:
+    """``JIK_WORKERS`` (default: CPU count, 1..8), ``JIK_TIMEOUT`` [s] (default 20),
+    ``JIK_BATCH`` (``0`` disables micro-batching), ``JIK_BATCH_WINDOW_MS`` (default 2)."""
+    env = os.environ
+    return Settings(
+        workers=max(1, min(8, int(env.get("JIK_WORKERS", os.cpu_count() or 2)))),
+        timeout=float(env.get("JIK_TIMEOUT", 20.0)),
+        batching=env.get("JIK_BATCH", "1").lower() not in ("0", "false", "no", "off"),
+        batch_window=float(env.get("JIK_BATCH_WINDOW_MS", 2.0)) / 1000.0,
+    )
+
+
+@dataclass
+class _Pending:
+    payload: dict
+    future: asyncio.Future
+    deadline: float
+
+
+class ComputePool:
+    """Worker processes with a bound on concurrent computations and a time limit per request.
+
+    At most ``settings.workers`` computations run at once; a request that gets no worker before
+    its deadline, or whose computation overruns it, fails with :class:`ServiceUnavailable` (the
+    overrunning worker is killed and replaced). The asyncio side is rebuilt when it is used from
+    another event loop (test clients), the processes are kept.
+    """
+
+    def __init__(self, settings: Settings | None = None) -> None:
+        self.settings = settings or settings_from_env()
+        self._workers: list[_Worker] = []
+        self._lock = threading.Lock()
+        self._threads = concurrent.futures.ThreadPoolExecutor(
+            max_workers=self.settings.workers, thread_name_prefix="jik-compute"
+        )
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._idle: asyncio.Queue[_Worker] | None = None
+        self._pending: dict[str, list[_Pending]] = {}
+        self._tasks: set[asyncio.Task] = set()
+        #: Engine calls made and requests served by them (for tests and the benchmark).
+        self.stats = {"solve_calls": 0, "solve_requests": 0, "timeouts": 0}
+
+    # -- lifecycle
+    def start(self) -> None:
+        """Start the worker processes (idempotent)."""
+        with self._lock:
+            while len(self._workers) < self.settings.workers:
+                self._workers.append(_Worker())
+
+    def close(self) -> None:
+        with self._lock:
+            for w in self._workers:
+                w.kill()
+            self._workers.clear()
+            self._loop = self._idle = None
+
+    def _bind(self) -> asyncio.Queue[_Worker]:
+        loop = asyncio.get_running_loop()
+        if self._loop is not loop or self._idle is None:
+            self.start()
+            self._loop = loop
+            self._idle = asyncio.Queue()
+            self._pending = {}
+            for w in self._workers:
+                self._idle.put_nowait(w)
+        return self._idle
+
+    async def warm_up(self) -> None:
+        """Start the workers and wait until each has imported the engine."""
+        idle = self._bind()
+        deadline = self._loop.time() + 120.0
+        got = [await self._acquire(deadline) for _ in range(self.settings.workers)]
+        try:
+            await asyncio.gather(
+                *(
+                    self._loop.run_in_executor(self._threads, w.call, "ping", None, 120.0)
+                    for w in got
+                )
+            )
+        finally:
+            for w in got:
+                idle.put_nowait(w)
+
+    # -- core
+    async def _acquire(self, deadline: float) -> _Worker:
+        idle = self._bind()
+        remaining = deadline - self._loop.time()
+        try:
+            if remaining <= 0:
+                raise TimeoutError
+            return await asyncio.wait_for(idle.get(), remaining)
+        except TimeoutError:
+            self.stats["timeouts"] += 1
+            raise ServiceUnavailable(
+                f"server busy: no compute slot became free within the time limit of "
+                f"{self.settings.timeout:g} s ({self.settings.workers} computations run at once); "
+                "retry later"
+            ) from None
+
+    async def _call(self, worker: _Worker, kind: str, payload, deadline: float):
+        loop = self._loop
+        try:
+            msg = await loop.run_in_executor(
+                self._threads, worker.call, kind, payload, deadline - loop.time()
+            )
+        except TimeoutError:
+            self.stats["timeouts"] += 1
+            self._replace(worker)
+            raise ServiceUnavailable(
+                f"the computation exceeded the time limit of {self.settings.timeout:g} s and "
+                "was stopped; ask for less work (fewer cycles or path points, a lower "
+                "max_iterations, a smaller grid)"
+            ) from None
+        except (EOFError, OSError) as exc:
+            self._replace(worker)
+            raise ServiceUnavailable(f"the compute worker stopped unexpectedly ({exc!r})") from None
+        self._idle.put_nowait(worker)
+        return msg
+
+    def _replace(self, worker: _Worker) -> None:
+        worker.kill()
+        with self._lock:
+            if worker in self._workers:
+                self._workers.remove(worker)
+            fresh = _Worker()
+            self._workers.append(fresh)
+        self._idle.put_nowait(fresh)
+
+    @staticmethod
+    def _unwrap(msg):
+        status, value = msg
+        if status == "ok":
+            return value
+        if status == "request_error":
+            raise RequestError(*value)
+        raise ComputeError(value)
+
+    async def run(self, kind: str, payload) -> Any:
+        """Run handler ``kind`` on ``payload`` in a worker, within the time limit."""
+        self._bind()
+        deadline = self._loop.time() + self.settings.timeout
+        worker = await self._acquire(deadline)
+        return self._unwrap(await self._call(worker, kind, payload, deadline))
+
+    # -- micro-batched solves
+    async def solve(self, req: S.SolveRequest) -> dict:
+        """One /solve request; micro-batched with compatible concurrent ones."""
+        self._bind()
+        payload = req.model_dump(mode="json")
+        if not self.settings.batching:
+            self.stats["solve_calls"] += 1
+            self.stats["solve_requests"] += 1
+            (res,) = await self.run("solve", [payload])
+            return self._unwrap(res)
+        loop = self._loop
+        deadline = loop.time() + self.settings.timeout
+        key = batch_key(req)
+        fut = loop.create_future()
+        queue = self._pending.setdefault(key, [])
+        queue.append(_Pending(payload, fut, deadline))
+        if len(queue) == 1:
+            task = loop.create_task(self._flush(key, first=True))
+            self._tasks.add(task)
+            task.add_done_callback(self._tasks.discard)
+        try:
+            return self._unwrap(await asyncio.wait_for(fut, deadline - loop.time()))
+        except TimeoutError:
+            self.stats["timeouts"] += 1
+            raise ServiceUnavailable(
+                f"the solve did not finish within the time limit of {self.settings.timeout:g} s "
+                "(server overloaded or a very long run); retry later or lower max_iterations"
+            ) from None
+
+    async def _flush(self, key: str, first: bool) -> None:
+        loop = self._loop
+        if first and self.settings.batch_window > 0:
+            await asyncio.sleep(self.settings.batch_window)
+        queue = self._pending.get(key, [])
+        if not queue:
+            return
+        try:
+            worker = await self._acquire(max(p.deadline for p in queue))
+        except ServiceUnavailable as exc:
+            for p in self._pending.pop(key, []):
+                if not p.future.done():
+                    p.future.set_exception(exc)
+            return
+        # Everything compatible that arrived while we waited for the worker joins the batch.
+        queue = [p for p in self._pending.pop(key, []) if not p.future.done()]
+        items, rest = queue[: self.settings.max_batch], queue[self.settings.max_batch :]
+        if rest:
+            self._pending[key] = rest
+            task = loop.create_task(self._flush(key, first=False))
+            self._tasks.add(task)
+            task.add_done_callback(self._tasks.discard)
+        if not items:
+            self._idle.put_nowait(worker)
+            return
+        self.stats["solve_calls"] += 1
+        self.stats["solve_requests"] += len(items)
+        try:
+            status, results = await self._call(
+                worker, "solve", [p.payload for p in items], max(p.deadline for p in items)
+            )
+            if status != "ok":
+                raise ComputeError(results) if status == "error" else RequestError(*results)
+        except Exception as exc:  # handed to every waiting request
+            for p in items:
+                if not p.future.done():
+                    p.future.set_exception(exc)
+            return
+        for p, res in zip(items, results, strict=True):
+            if not p.future.done():
+                p.future.set_result(res)
