@@ -14,6 +14,7 @@ the same collocation system, so the gradient is exact for the computed h.
 from __future__ import annotations
 
 import functools
+import itertools
 
 import numpy as np
 
@@ -37,34 +38,38 @@ NEWTON_TOL = 1e-12
 WARM_RADIUS = 0.5
 
 
+def _levi_civita(p: int) -> FloatArray:
+    eps = np.zeros((p,) * p)
+    for perm in itertools.permutations(range(p)):
+        eps[perm] = np.linalg.det(np.eye(p)[list(perm)])
+    return eps
+
+
+#: Levi-Civita symbol of R^4, shape (4, 4, 4, 4), and its reshapes for contracting two rows:
+#: _E23[(k, l), (i, j)] = _E13[(j, l), (i, k)] = _E12[(j, k), (i, l)] = eps_ijkl.
+_EPS4 = _levi_civita(4)
+_E23 = _EPS4.transpose(2, 3, 0, 1).reshape(16, 16)
+_E13 = _EPS4.transpose(1, 3, 0, 2).reshape(16, 16)
+_E12 = _EPS4.transpose(1, 2, 0, 3).reshape(16, 16)
+
+
+def _contract(E: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
+    """The 4 x 4 matrix E : (a outer b), e.g. P23_ij = eps_ijkl a_k b_l: (..., 4, 4)."""
+    return ((a[..., :, None] * b[..., None, :]).reshape(*a.shape[:-1], 16) @ E).reshape(
+        *a.shape[:-1], 4, 4
+    )
+
+
 def cofactors(J: FloatArray) -> FloatArray:
     """Kernel cofactor vector of J (..., r, r + 1), as :func:`engine.kinematics.kernel_cofactors`.
 
-    For r = 3 it is expanded in 2 x 2 minors of the last two rows (elementwise, much faster than
-    batched determinants); other sizes fall back to the generic determinant formula.
+    For r = 3, c_i = -eps_ijkl J_1j J_2k J_3l (Levi-Civita), a few einsum calls instead of
+    batched determinants; other sizes fall back to the generic determinant formula.
     """
     if J.shape[-2:] != (3, 4):
         return kernel_cofactors(J)
-    R1, R2, R3 = J[..., 0, :], J[..., 1, :], J[..., 2, :]
-
-    def m(a, b):
-        return R2[..., a] * R3[..., b] - R2[..., b] * R3[..., a]
-
-    m01, m02, m03, m12, m13, m23 = m(0, 1), m(0, 2), m(0, 3), m(1, 2), m(1, 3), m(2, 3)
-
-    def det(i, j, k, mjk, mik, mij):
-        return R1[..., i] * mjk - R1[..., j] * mik + R1[..., k] * mij
-
-    # c_i = (-1)^(4 + i) det(J without column i), 1-based i
-    return np.stack(
-        [
-            -det(1, 2, 3, m23, m13, m12),
-            det(0, 2, 3, m23, m03, m02),
-            -det(0, 1, 3, m13, m03, m01),
-            det(0, 1, 2, m12, m02, m01),
-        ],
-        axis=-1,
-    )
+    P23 = _contract(_E23, J[..., 1, :], J[..., 2, :])
+    return -(P23 @ J[..., 0, :, None])[..., 0]
 
 
 def kernel_cofactors_derivative(J: FloatArray, H: FloatArray) -> FloatArray:
@@ -88,10 +93,14 @@ def kernel_cofactors_derivative(J: FloatArray, H: FloatArray) -> FloatArray:
     dc/dx_k = sum_j c(J with row j replaced by dJ_j/dx_k).
     """
     r, p = J.shape[-2:]
+    if (r, p) == (3, 4):
+        R1, R2, R3 = J[..., 0, :], J[..., 1, :], J[..., 2, :]
+        P23, P13, P12 = _contract(_E23, R2, R3), _contract(_E13, R1, R3), _contract(_E12, R1, R2)
+        return -(P23 @ H[..., 0, :, :] + P13 @ H[..., 1, :, :] + P12 @ H[..., 2, :, :])
     Jm = np.broadcast_to(J[..., None, None, :, :], (*J.shape[:-2], r, p, r, p)).copy()
     for j in range(r):
         Jm[..., j, :, j, :] = np.swapaxes(H[..., j, :, :], -1, -2)
-    return np.swapaxes(cofactors(Jm).sum(axis=-3), -1, -2)
+    return np.swapaxes(kernel_cofactors(Jm).sum(axis=-3), -1, -2)
 
 
 def _one_form_parts(J, H, fixed_index):

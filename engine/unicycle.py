@@ -68,6 +68,48 @@ def panels_for(lam: FloatArray, length: float) -> int:
     return max(1, int(np.ceil(rate * length / PANEL_PHASE)))
 
 
+def _derivative_map() -> FloatArray:
+    """Constant (72, 60) matrix taking [V, l10 V, l11 V] (V = moments of cos q3, sin q3) to the
+    flattened J (12 entries, row 3 set separately) and Hessian (48 entries)."""
+    P = np.zeros((72, 60))
+
+    def add(entries, terms):
+        # terms: (block, moment index, sign); block 0 = 1, 1 = l10, 2 = l11; Mc_k = k, Ms_k = 12 + k
+        for e in entries:
+            for block, v, sign in terms:
+                P[24 * block + v, e] += sign
+
+    def j(i, k):
+        return 4 * i + k
+
+    def h(i, a, b):
+        return [12 + 16 * i + 4 * a + b] + ([12 + 16 * i + 4 * b + a] if a != b else [])
+
+    c, s_ = 0, 12
+    add([j(0, 0)], [(0, c + 0, 1)])
+    add([j(0, 1)], [(0, c + 1, 1)])
+    add([j(0, 2)], [(1, s_ + 2, -1), (2, s_ + 4, -1)])
+    add([j(0, 3)], [(1, s_ + 3, -1), (2, s_ + 5, -1)])
+    add([j(1, 0)], [(0, s_ + 0, 1)])
+    add([j(1, 1)], [(0, s_ + 1, 1)])
+    add([j(1, 2)], [(1, c + 2, 1), (2, c + 4, 1)])
+    add([j(1, 3)], [(1, c + 3, 1), (2, c + 5, 1)])
+    # d2 (u1 cos q3): -(a b^T + b a^T) sin q3 - u1 cos q3 b b^T; d2 (u1 sin q3): + cos q3, - sin q3
+    for i, (cross, bb, sign) in enumerate(((s_, c, -1), (c, s_, 1))):
+        add(h(i, 0, 2), [(0, cross + 2, sign)])
+        add(h(i, 0, 3), [(0, cross + 3, sign)])
+        add(h(i, 1, 2), [(0, cross + 4, sign)])
+        add(h(i, 1, 3), [(0, cross + 5, sign)])
+        add(h(i, 2, 2), [(1, bb + 6, -1), (2, bb + 9, -1)])
+        add(h(i, 2, 3), [(1, bb + 7, -1), (2, bb + 10, -1)])
+        add(h(i, 3, 3), [(1, bb + 8, -1), (2, bb + 11, -1)])
+    P.flags.writeable = False
+    return P
+
+
+_DERIVATIVE_MAP = _derivative_map()
+
+
 class Unicycle(Kinematics):
     """Unicycle (40) with Fourier controls (41): k(lambda) = q(T), eq. (42); p = 4, r = 3.
 
@@ -145,30 +187,26 @@ class Unicycle(Kinematics):
         """The Jacobian (..., 3, 4) and the Hessian (..., 3, 4, 4) from one set of quadratures.
 
         The Hessian is None when ``hessian`` is False.
+
+        Notes
+        -----
+        Every entry of J and of the Hessian is linear in the moments int e^(i q3) G with
+        coefficients 1, l10 or l11 (u1-weighted moments), so all of them come from one product
+        with the constant matrix :data:`_DERIVATIVE_MAP` (few numpy calls: this is a hot path
+        of the characteristics synthesis).
         """
         x = np.asarray(x, dtype=float)
-        Mc, Ms = self._moments(x)
-        l10, l11 = x[..., 0:1], x[..., 1:2]
-        J = np.zeros((*x.shape[:-1], 3, 4))
-        J[..., 0, 0], J[..., 0, 1] = Mc[..., 0], Mc[..., 1]
-        J[..., 1, 0], J[..., 1, 1] = Ms[..., 0], Ms[..., 1]
-        # u1-weighted moments: int u1 f = l10 int f + l11 int s f, f in (t, C, t^2, tC, C^2)
-        uc = l10 * Mc[..., [2, 3, 6, 7, 8]] + l11 * Mc[..., [4, 5, 9, 10, 11]]
-        us = l10 * Ms[..., [2, 3, 6, 7, 8]] + l11 * Ms[..., [4, 5, 9, 10, 11]]
-        J[..., 0, 2], J[..., 0, 3] = -us[..., 0], -us[..., 1]
-        J[..., 1, 2], J[..., 1, 3] = uc[..., 0], uc[..., 1]
+        t, G = _moment_basis(self.T, panels_for(x, self.T))
+        q3 = self.q0[2] + x[..., 2:3] * t + x[..., 3:4] * (1.0 - np.cos(t))  # (..., N) [rad]
+        M = np.exp(1j * q3) @ G  # int cos q3 G + i int sin q3 G, (..., 12)
+        V = np.concatenate([M.real, M.imag], axis=-1)  # (..., 24)
+        V = np.concatenate([V, x[..., 0:1] * V, x[..., 1:2] * V], axis=-1)  # (..., 72)
+        out = V @ (_DERIVATIVE_MAP if hessian else _DERIVATIVE_MAP[:, :12])
+        J = out[..., :12].reshape(*x.shape[:-1], 3, 4)
         J[..., 2, 2], J[..., 2, 3] = self.T, 1.0 - np.cos(self.T)
         if not hessian:
             return J, None
-        H = np.zeros((*x.shape[:-1], 3, 4, 4))
-        # cross terms (a b^T + b a^T): rows (l10, l11) x columns (l20, l21)
-        H[..., 0, 0:2, 2:4] = -Ms[..., [2, 3, 4, 5]].reshape(*x.shape[:-1], 2, 2)
-        H[..., 1, 0:2, 2:4] = Mc[..., [2, 3, 4, 5]].reshape(*x.shape[:-1], 2, 2)
-        H[..., 0, 2, 2], H[..., 0, 2, 3], H[..., 0, 3, 3] = -uc[..., 2], -uc[..., 3], -uc[..., 4]
-        H[..., 1, 2, 2], H[..., 1, 2, 3], H[..., 1, 3, 3] = -us[..., 2], -us[..., 3], -us[..., 4]
-        H[..., 0:2, 3, 2] = H[..., 0:2, 2, 3]
-        H[..., 0:2, 2:4, 0:2] = np.swapaxes(H[..., 0:2, 0:2, 2:4], -1, -2)
-        return J, H
+        return J, out[..., 12:].reshape(*x.shape[:-1], 3, 4, 4)
 
     def path(self, lam, t, intervals: int | None = None) -> FloatArray:
         """The pose q(t) on a time grid for given controls: shape (..., len(t), 3).
