@@ -1,0 +1,732 @@
+"""Server-side state of the dashboard: one source of truth, recomputed when a control changes.
+
+The page (over ``/api/dashboard/*``) and the viser scene (through its GUI callbacks) both change
+the same :class:`Dashboard`; every change is validated against the registry, bumps a generation
+counter and wakes one worker thread. The worker solves both algorithms (the pseudoinverse (8) and
+the extended inverse (11)) leg by leg with :func:`engine.solver.solve`, so that a newer change
+cancels a stale computation between legs, builds the figures once and pushes them to every
+subscriber (server-sent events for the page, a callback for the scene).
+
+Continuous mode integrates in tau = gamma theta (see :mod:`engine.solver`): x(theta) does not
+depend on gamma, so the worker solves at gamma = 1 and divides theta by gamma, and a gamma change
+in continuous mode only rescales the theta axis without a new integration.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from engine.exceptions import InvalidInputError, JikError
+from engine.registry import ROBOTS, make_inverse, robot_spec
+from engine.repeatability import MAX_PATH_POINTS, closed_path
+from engine.solver import solve
+from engine.validation import count, positive
+
+ALGORITHMS = ("pseudoinverse", "extended")
+#: One colour per algorithm, used in the scene and in every plot.
+COLORS = {"pseudoinverse": "#d62728", "extended": "#1f77b4"}
+LABELS = {"pseudoinverse": "pseudoinverse J^P# (8)", "extended": "extended Jacobian J^E# (11)"}
+#: Largest number of cycles offered by the dashboard (the engine accepts more).
+MAX_DASHBOARD_CYCLES = 20
+#: Time grid points of one unicycle platform path q(t).
+UNICYCLE_TIME_POINTS = 96
+DEFAULT_ROBOT = "manipulator2"
+
+
+class Cancelled(Exception):
+    """A newer change superseded the computation."""
+
+
+@dataclass(frozen=True)
+class DashboardState:
+    """Every control of the dashboard (JSON-friendly)."""
+
+    robot: str
+    robot_parameters: dict
+    augmentation: str
+    augmentation_parameters: dict
+    gamma: float
+    mode: str
+    x0: tuple[float, ...]
+    task: str  # "path": closed path driven ``cycles`` times; "target": one solve
+    target: tuple[float, ...]
+    path: tuple[tuple[float, ...], ...]
+    cycles: int
+    tol: float = 1e-10
+
+    def as_dict(self) -> dict:
+        return {
+            "robot": self.robot,
+            "robot_parameters": {
+                k: list(v) if isinstance(v, tuple | list) else v
+                for k, v in self.robot_parameters.items()
+            },
+            "augmentation": self.augmentation,
+            "augmentation_parameters": dict(self.augmentation_parameters),
+            "gamma": self.gamma,
+            "mode": self.mode,
+            "x0": list(self.x0),
+            "task": self.task,
+            "target": list(self.target),
+            "path": [list(p) for p in self.path],
+            "cycles": self.cycles,
+            "tol": self.tol,
+        }
+
+
+def default_state(robot: str = DEFAULT_ROBOT) -> DashboardState:
+    """The registry's defaults for ``robot``."""
+    spec = robot_spec(robot)
+    aug = spec.augmentation(None)
+    params = {p.name: p.default for p in spec.parameters}
+    params.update({v.name: tuple(v.default) for v in spec.vector_parameters})
+    return DashboardState(
+        robot=spec.name,
+        robot_parameters=params,
+        augmentation=aug.name,
+        augmentation_parameters={p.name: p.default for p in aug.parameters},
+        gamma=float(spec.default_gamma),
+        mode=spec.default_mode,
+        x0=tuple(float(v) for v in spec.default_x0),
+        task="path" if spec.default_path else "target",
+        target=tuple(float(v) for v in spec.default_target),
+        path=tuple(tuple(float(v) for v in p) for p in spec.default_path),
+        cycles=3 if spec.default_path else 1,
+    )
+
+
+def updated_state(state: DashboardState, patch: Mapping[str, object]) -> DashboardState:
+    """Apply a partial change and validate the result against the registry.
+
+    Changing ``robot`` starts from that robot's defaults; changing ``augmentation`` resets its
+    parameters to their defaults. Nested parameter dicts are merged.
+
+    Raises
+    ------
+    InvalidInputError
+        Unknown keys, or any value the registry or the engine rejects (the message says which).
+    """
+    known = set(DashboardState.__dataclass_fields__)
+    unknown = set(patch) - known
+    if unknown:
+        raise InvalidInputError(
+            f"unknown dashboard field(s) {sorted(unknown)}; known: {sorted(known)}"
+        )
+    if "robot" in patch and patch["robot"] != state.robot:
+        state = default_state(str(patch["robot"]))
+    if "augmentation" in patch and patch["augmentation"] != state.augmentation:
+        aug = robot_spec(state.robot).augmentation(str(patch["augmentation"]))
+        state = replace(
+            state,
+            augmentation=aug.name,
+            augmentation_parameters={p.name: p.default for p in aug.parameters},
+        )
+    values: dict = {}
+    for key, value in patch.items():
+        if key in ("robot", "augmentation"):
+            continue
+        if key == "robot_parameters":
+            value = {**state.robot_parameters, **dict(value)}
+        elif key == "augmentation_parameters":
+            value = {**state.augmentation_parameters, **dict(value)}
+        values[key] = value
+    return validate(replace(state, **values))
+
+
+def validate(state: DashboardState) -> DashboardState:
+    """Check every field through the registry and the engine's validators; normalise types."""
+    spec = robot_spec(state.robot)
+    kin = spec.build(**state.robot_parameters)
+    given, given_aug = state.robot_parameters, state.augmentation_parameters
+    scalars = {p.name: p.check(given.get(p.name, p.default)) for p in spec.parameters}
+    vectors = {v.name: v.check(given.get(v.name, v.default)) for v in spec.vector_parameters}
+    aug = spec.augmentation(state.augmentation)
+    aug_params = {p.name: p.check(given_aug.get(p.name, p.default)) for p in aug.parameters}
+    x0 = kin.check(state.x0, "x0")
+    if x0.ndim != 1:
+        raise InvalidInputError(f"x0 must be one configuration of length {kin.p}")
+    target = kin.check_task(state.target, "target")
+    if target.ndim != 1:
+        raise InvalidInputError(f"target must be one task point of length {kin.r}")
+    if state.task not in ("path", "target"):
+        raise InvalidInputError(f"task must be 'path' or 'target', got {state.task!r}")
+    path = kin.check_task(state.path, "path") if len(state.path) else np.zeros((0, kin.r))
+    if state.task == "path" and (path.ndim != 2 or len(path) < 1):
+        raise InvalidInputError("a closed-path task needs at least one path point")
+    if len(path) > MAX_PATH_POINTS:
+        raise InvalidInputError(f"path has {len(path)} points; at most {MAX_PATH_POINTS} allowed")
+    if state.mode not in ("continuous", "discrete"):
+        raise InvalidInputError(f"mode must be 'continuous' or 'discrete', got {state.mode!r}")
+    gamma = positive(state.gamma, "gamma")
+    if state.mode == "discrete" and gamma >= 2:
+        raise InvalidInputError(f"gamma must be < 2 in discrete mode, got {gamma:g}")
+    return DashboardState(
+        robot=spec.name,
+        robot_parameters={**scalars, **vectors},
+        augmentation=aug.name,
+        augmentation_parameters=aug_params,
+        gamma=gamma,
+        mode=state.mode,
+        x0=tuple(float(v) for v in x0),
+        task=state.task,
+        target=tuple(float(v) for v in target),
+        path=tuple(tuple(float(v) for v in p) for p in path),
+        cycles=count(state.cycles, "cycles", 1, MAX_DASHBOARD_CYCLES),
+        tol=positive(state.tol, "tol"),
+    )
+
+
+@dataclass(frozen=True)
+class AlgorithmRun:
+    """One algorithm driven through every leg of the task, point by point.
+
+    Attributes
+    ----------
+    theta : ndarray, shape (m,)
+        Continuation parameter, cumulative over the legs (iterations in discrete mode).
+    x : ndarray, shape (m, p)
+    y : ndarray, shape (m, r)
+    error : ndarray, shape (m,)
+        Distance to the current leg's target.
+    h : ndarray, shape (m,) or None
+        The augmenting map along the run (extended inverse only).
+    leg : ndarray of int, shape (m,)
+        Leg index (cycle * legs_per_cycle + leg) of every point.
+    leg_end : ndarray, shape (n_legs_done, p)
+    drift : ndarray, shape (cycles_done,)
+        ||x at the end of cycle c - x0|| (closed-path task only, else empty).
+    platform : ndarray, shape (m, T, 3) or None
+        Unicycle only: the platform path q(t) for the controls of every iteration.
+    """
+
+    algorithm: str
+    theta: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    error: np.ndarray
+    h: np.ndarray | None
+    leg: np.ndarray
+    leg_end: np.ndarray
+    drift: np.ndarray
+    success: bool
+    message: str
+    seconds: float
+    platform: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class DashboardResult:
+    """Both runs for one state, with what the figures need to label them."""
+
+    state: DashboardState
+    generation: int
+    title: str
+    variable_names: tuple[str, ...]
+    task_names: tuple[str, ...]
+    targets: np.ndarray  # (L, r) legs of one cycle
+    runs: dict[str, AlgorithmRun]
+    time: np.ndarray | None = None  # unicycle time grid [s]
+    augmenting: dict | None = None  # h on a grid, see augmenting_grid()
+    seconds: float = 0.0
+    cached: dict = field(default_factory=dict)
+
+
+def _leg_targets(kin, state: DashboardState) -> np.ndarray:
+    if state.task == "target":
+        return np.asarray([state.target])
+    return closed_path(kin, np.asarray([state.x0]), np.asarray(state.path))[0]
+
+
+def _run_legs(inverse, state, targets, cycles, progress, cancelled) -> AlgorithmRun:
+    """Drive ``inverse`` through the legs as :func:`engine.repeatability.repeatability` does."""
+    t0 = time.perf_counter()
+    x0 = np.asarray(state.x0)
+    # Continuous mode: solve at gamma = 1 (theta = tau); the caller rescales theta by 1/gamma.
+    gamma = 1.0 if state.mode == "continuous" else state.gamma
+    current, offset = x0, 0.0
+    parts, ends, drift = [], [], []
+    success, message = True, "completed"
+    L = len(targets)
+    for c in range(cycles):
+        for j in range(L):
+            if cancelled():
+                raise Cancelled
+            res = solve(inverse, current, targets[j], gamma=gamma, mode=state.mode, tol=state.tol)
+            tr = res.trajectory
+            parts.append((tr.theta + offset, tr.x, tr.y, tr.error, tr.h, c * L + j))
+            offset += float(tr.theta[-1])
+            progress()
+            if not res.success:
+                success, message = False, f"cycle {c + 1}, leg {j + 1}: {res.message}"
+                break
+            current = res.x
+            ends.append(res.x)
+        if not success:
+            break
+        if state.task == "path":
+            drift.append(float(np.linalg.norm(current - x0)))
+    return AlgorithmRun(
+        algorithm=inverse.name,
+        theta=np.concatenate([p[0] for p in parts]),
+        x=np.concatenate([p[1] for p in parts]),
+        y=np.concatenate([p[2] for p in parts]),
+        error=np.concatenate([p[3] for p in parts]),
+        h=None if parts[0][4] is None else np.concatenate([p[4] for p in parts]),
+        leg=np.concatenate([np.full(len(p[0]), p[5]) for p in parts]),
+        leg_end=np.asarray(ends).reshape(-1, len(x0)),
+        drift=np.asarray(drift),
+        success=success,
+        message=message
+        if not success
+        else (
+            f"{len(ends)} legs converged"
+            + (f", drift after cycle {len(drift)}: {drift[-1]:.3g}" if drift else "")
+        ),
+        seconds=time.perf_counter() - t0,
+    )
+
+
+def _cache_key(state: DashboardState, algorithm: str) -> str:
+    d = state.as_dict()
+    if algorithm == "pseudoinverse":
+        d.pop("augmentation"), d.pop("augmentation_parameters")
+    if state.mode == "continuous":
+        d.pop("gamma")
+    return json.dumps(d, sort_keys=True)
+
+
+def compute(
+    state: DashboardState,
+    generation: int = 0,
+    *,
+    progress: Callable[[float], None] | None = None,
+    cancelled: Callable[[], bool] = lambda: False,
+    cache: dict | None = None,
+) -> DashboardResult:
+    """Solve the state's task with both algorithms.
+
+    Parameters
+    ----------
+    progress : callable, optional
+        Called with the fraction of legs done, in [0, 1].
+    cancelled : callable
+        Polled between legs; when it returns True the computation raises :class:`Cancelled`.
+    cache : dict, optional
+        Runs keyed by everything they depend on (gamma excluded in continuous mode); reused
+        and filled.
+
+    Raises
+    ------
+    Cancelled, JikError
+        A singular start configuration raises the engine's typed error.
+    """
+    t0 = time.perf_counter()
+    spec = robot_spec(state.robot)
+    kin = spec.build(**state.robot_parameters)
+    targets = _leg_targets(kin, state)
+    cycles = state.cycles if state.task == "path" else 1
+    total = 2 * cycles * len(targets)
+    done = [0]
+    cache = {} if cache is None else cache
+    keys = {a: _cache_key(state, a) for a in ALGORITHMS}
+    todo = [a for a in ALGORITHMS if keys[a] not in cache]
+    done[0] = (len(ALGORITHMS) - len(todo)) * cycles * len(targets)
+
+    def step() -> None:
+        done[0] += 1
+        if progress is not None:
+            progress(done[0] / total)
+
+    runs: dict[str, AlgorithmRun] = {}
+    for algorithm in ALGORITHMS:
+        if algorithm in todo:
+            inverse = make_inverse(
+                kin, algorithm, state.augmentation, state.augmentation_parameters, spec.name
+            )
+            run = _run_legs(inverse, state, targets, cycles, step, cancelled)
+            if hasattr(kin, "path"):
+                t = np.linspace(0.0, float(kin.T), UNICYCLE_TIME_POINTS)
+                run = replace(run, platform=kin.path(run.x, t))
+            cache[keys[algorithm]] = run
+        run = cache[keys[algorithm]]
+        if state.mode == "continuous":
+            run = replace(run, theta=run.theta / state.gamma)
+        runs[algorithm] = run
+    if len(cache) > 64:
+        for k in list(cache)[: len(cache) - 64]:
+            del cache[k]
+    return DashboardResult(
+        state=state,
+        generation=generation,
+        title=spec.title,
+        variable_names=tuple(spec.variable_names),
+        task_names=tuple(spec.task_names),
+        targets=targets,
+        runs=runs,
+        time=np.linspace(0.0, float(kin.T), UNICYCLE_TIME_POINTS) if hasattr(kin, "path") else None,
+        augmenting=augmenting_grid(kin, state, runs),
+        seconds=time.perf_counter() - t0,
+        cached={a: a not in todo for a in ALGORITHMS},
+    )
+
+
+def augmenting_axes(amap, x: np.ndarray) -> tuple[int, int]:
+    """The two joint variables h depends on most along the configurations ``x`` (n, p)."""
+    with np.errstate(all="ignore"):
+        g = np.abs(np.asarray(amap.gradient(x), dtype=float))
+    weight = np.nan_to_num(np.mean(g, axis=0)) * (np.ptp(x, axis=0) + 1.0)
+    i, j = sorted(np.argsort(-weight, kind="stable")[:2])
+    return int(i), int(j)
+
+
+def augmenting_grid(kin, state: DashboardState, runs: Mapping[str, AlgorithmRun], n: int = 61):
+    """h on a grid over the two variables it depends on most, other variables at x0.
+
+    The box covers both trajectories with a margin, clipped to the robot's x_range.
+    Returns None when h cannot be evaluated on the grid.
+    """
+    spec = robot_spec(state.robot)
+    try:
+        amap = spec.augmentation(state.augmentation).build(kin, **state.augmentation_parameters)
+        xs = np.concatenate([r.x for r in runs.values()])
+        i, j = augmenting_axes(amap, xs)
+        box = []
+        for k in (i, j):
+            lo, hi = float(np.min(xs[:, k])), float(np.max(xs[:, k]))
+            pad = 0.25 * (hi - lo) + 0.25
+            lo, hi = lo - pad, hi + pad
+            if spec.x_range:
+                lo, hi = max(lo, spec.x_range[k][0]), min(hi, spec.x_range[k][1])
+            box.append((lo, hi))
+        if n > 25 and kin.p > 3:
+            n = 25  # the unicycle's h solves a collocation problem per point
+        u, v = np.linspace(*box[0], n), np.linspace(*box[1], n)
+        X = np.broadcast_to(np.asarray(state.x0, dtype=float), (n, n, kin.p)).copy()
+        X[..., i] = u[None, :]
+        X[..., j] = v[:, None]
+        with np.errstate(all="ignore"):
+            H = np.asarray(amap.value(X.reshape(-1, kin.p)), dtype=float).reshape(n, n)
+    except (JikError, ValueError, ArithmeticError):
+        return None
+    H = np.where(np.isfinite(H), H, np.nan)
+    return {"axes": (i, j), "u": u, "v": v, "h": H, "box": box, "map": amap, "kinematics": kin}
+
+
+def error_functionals(result: DashboardResult, nodes: int = 12) -> dict | None:
+    """E1 (13) and E2 (18) of the current map over the heat-map box, or None if unavailable."""
+    grid = result.augmenting
+    if grid is None:
+        return None
+    try:
+        from engine.functionals import error_functional_e1, error_functional_e2
+    except ImportError:
+        return None
+    names = result.variable_names
+    i, j = grid["axes"]
+    region = {names[i]: tuple(grid["box"][0]), names[j]: tuple(grid["box"][1])}
+    fixed = {names[k]: float(result.state.x0[k]) for k in range(len(names)) if k not in (i, j)}
+    out = {"region": {k: list(v) for k, v in region.items()}, "fixed": fixed, "nodes": nodes}
+    for key, fn in (("E1", error_functional_e1), ("E2", error_functional_e2)):
+        try:
+            value = fn(grid["kinematics"], grid["map"], region, nodes=nodes, fixed=fixed)
+            out[key] = value.value if np.isfinite(value.value) else None
+            out[f"{key}_singular_points"] = int(value.singular_points.shape[0])
+        except (JikError, ValueError, ArithmeticError) as exc:
+            out[key] = None
+            out[f"{key}_error"] = str(exc)
+    return out
+
+
+def robots_catalogue() -> list[dict]:
+    """Every robot of the registry with its parameters, ranges and defaults."""
+    return [spec.as_dict() for spec in ROBOTS.values()]
+
+
+@dataclass(frozen=True)
+class Event:
+    """A message to the subscribers: ``data`` is the JSON sent to the page."""
+
+    kind: str  # "state" | "progress" | "result" | "functionals" | "error"
+    generation: int
+    data: str
+    result: DashboardResult | None = None
+
+
+def _json(obj) -> str:
+    return json.dumps(obj, separators=(",", ":"), allow_nan=False, default=_jsonable)
+
+
+def _jsonable(v):
+    if isinstance(v, np.ndarray):
+        return v.tolist()
+    if isinstance(v, np.generic):
+        return v.item()
+    raise TypeError(f"not JSON serialisable: {type(v).__name__}")
+
+
+def summary(result: DashboardResult) -> dict:
+    """Numbers shown beside the plots: per algorithm success, message, drift, final x."""
+    out = {}
+    for a, run in result.runs.items():
+        out[a] = {
+            "success": run.success,
+            "message": run.message,
+            "drift": [float(d) for d in run.drift],
+            "x_final": [float(v) for v in run.x[-1]],
+            "h_change": None if run.h is None else float(np.max(run.h) - np.min(run.h)),
+            "points": len(run.theta),
+            "seconds": round(run.seconds, 4),
+            "cached": bool(result.cached.get(a, False)),
+        }
+    return out
+
+
+class Dashboard:
+    """The live dashboard: one state, a worker thread, and subscribers.
+
+    Parameters
+    ----------
+    state : DashboardState, optional
+        Initial state (registry defaults of :data:`DEFAULT_ROBOT`).
+    debounce : float
+        Seconds the worker waits after a change for a newer one (slider drags send many).
+    """
+
+    def __init__(self, state: DashboardState | None = None, *, debounce: float = 0.02) -> None:
+        self._cond = threading.Condition()
+        self._state = validate(state or default_state())
+        self._generation = 1
+        self._done = 0  # last generation whose computation finished (or failed)
+        self._debounce = debounce
+        self._changed_at = {1: time.perf_counter()}
+        self._listeners: list[Callable[[Event], None]] = []
+        self._cache: dict = {}
+        self._latest: dict[str, Event] = {}
+        self.result: DashboardResult | None = None
+        self.functionals: dict | None = None
+        self._thread: threading.Thread | None = None
+        self._stopped = False
+
+    # -- public API -------------------------------------------------------------------------
+    @property
+    def state(self) -> DashboardState:
+        return self._state
+
+    @property
+    def generation(self) -> int:
+        return self._generation
+
+    def start(self) -> None:
+        """Start the worker thread (idempotent)."""
+        with self._cond:
+            if self._thread is None:
+                self._thread = threading.Thread(
+                    target=self._work, name="jik-dashboard", daemon=True
+                )
+                self._thread.start()
+
+    def stop(self) -> None:
+        with self._cond:
+            self._stopped = True
+            self._cond.notify_all()
+
+    def update(
+        self, patch: Mapping[str, object], source: str = "page"
+    ) -> tuple[int, DashboardState]:
+        """Validate and apply a change; the worker recomputes. Returns (generation, state)."""
+        with self._cond:
+            state = updated_state(self._state, patch)
+            if state == self._state:
+                return self._generation, state
+            self._state = state
+            self._generation += 1
+            generation = self._generation
+            self._changed_at[generation] = time.perf_counter()
+            self._cond.notify_all()
+        self._emit(
+            Event("state", generation, _json(self._state_message(generation, state, source)))
+        )
+        self.start()
+        return generation, state
+
+    def subscribe(self, listener: Callable[[Event], None]) -> Callable[[], None]:
+        """Call ``listener(event)`` on every event (from the worker thread); replay the latest."""
+        with self._cond:
+            self._listeners.append(listener)
+            kinds = ("state", "result", "functionals")
+            latest = [self._latest[k] for k in kinds if k in self._latest]
+        for event in latest:
+            listener(event)
+        self.start()
+
+        def unsubscribe() -> None:
+            with self._cond:
+                if listener in self._listeners:
+                    self._listeners.remove(listener)
+
+        return unsubscribe
+
+    def wait(self, generation: int | None = None, timeout: float = 30.0) -> bool:
+        """Block until the computation of ``generation`` (default: current) has finished."""
+        self.start()
+        deadline = time.monotonic() + timeout
+        with self._cond:
+            target = self._generation if generation is None else generation
+            while self._done < target:
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    return False
+                self._cond.wait(left)
+        return True
+
+    def snapshot(self) -> dict:
+        """The current state and the summary of the last result."""
+        with self._cond:
+            result = self.result
+            return {
+                "generation": self._generation,
+                "computed_generation": None if result is None else result.generation,
+                "state": self._state.as_dict(),
+                "summary": None if result is None else summary(result),
+                "functionals": self.functionals,
+            }
+
+    # -- worker -----------------------------------------------------------------------------
+    def _state_message(self, generation: int, state: DashboardState, source: str) -> dict:
+        return {"type": "state", "generation": generation, "state": state.as_dict(),
+                "source": source}  # fmt: skip
+
+    def _emit(self, event: Event) -> None:
+        with self._cond:
+            if event.kind in ("state", "result", "functionals", "error"):
+                self._latest[event.kind] = event
+            listeners = list(self._listeners)
+        for listener in listeners:
+            listener(event)
+
+    def _work(self) -> None:
+        while True:
+            with self._cond:
+                while self._done >= self._generation and not self._stopped:
+                    self._cond.wait()
+                if self._stopped:
+                    return
+                # Debounce: wait until no change arrived for ``debounce`` seconds.
+                while True:
+                    seen = self._generation
+                    self._cond.wait(self._debounce)
+                    if self._generation == seen or self._stopped:
+                        break
+                generation, state = self._generation, self._state
+            self._compute(generation, state)
+
+    def _finish(self, generation: int) -> None:
+        with self._cond:
+            self._done = max(self._done, generation)
+            self._cond.notify_all()
+
+    def _compute(self, generation: int, state: DashboardState) -> None:
+        from app.figures import augmenting_figure, figures_for
+
+        started = self._changed_at.get(generation, time.perf_counter())
+        t0 = time.perf_counter()
+        last = [0.0]
+
+        def progress(fraction: float) -> None:
+            now = time.perf_counter()
+            if now - last[0] > 0.1 or fraction >= 1:
+                last[0] = now
+                self._emit(Event("progress", generation, _json({
+                    "type": "progress", "generation": generation, "fraction": fraction,
+                    "elapsed": now - t0,
+                })))  # fmt: skip
+
+        try:
+            result = compute(
+                state, generation, progress=progress,
+                cancelled=lambda: self._generation != generation, cache=self._cache,
+            )  # fmt: skip
+        except Cancelled:
+            return
+        except (JikError, ValueError) as exc:
+            self._emit(Event("error", generation, _json({
+                "type": "error", "generation": generation, "message": str(exc)})))  # fmt: skip
+            self._finish(generation)
+            return
+        figures = figures_for(result, None)
+        ready = time.perf_counter()
+        head = {
+            "type": "result", "generation": generation, "state": state.as_dict(),
+            "summary": summary(result), "colors": COLORS, "labels": LABELS,
+            "timing": {"compute": result.seconds, "figures": ready - t0 - result.seconds,
+                       "server_total": ready - started},
+        }  # fmt: skip
+        data = (
+            _json(head)[:-1]
+            + ',"figures":{'
+            + ",".join(f'"{k}":{f.to_json()}' for k, f in figures.items())
+            + "}}"
+        )
+        with self._cond:
+            self.result, self.functionals = result, None
+            self._changed_at = {g: t for g, t in self._changed_at.items() if g > generation}
+        self._emit(Event("result", generation, data, result))
+        self._finish(generation)
+        # Second phase: E1 and E2 of the current map (quadrature) refine the h panel.
+        if self._generation != generation:
+            return
+        functionals = error_functionals(result)
+        if functionals is None or self._generation != generation:
+            return
+        fig = augmenting_figure(result, functionals)
+        with self._cond:
+            self.functionals = functionals
+        self._emit(Event("functionals", generation, _json(
+            {"type": "functionals", "generation": generation, "functionals": functionals}
+        )[:-1] + ',"figures":{"augmenting":' + fig.to_json() + "}}"))  # fmt: skip
+
+
+def export_json(result: DashboardResult, functionals: dict | None = None) -> dict:
+    """The current result as plain JSON: the state, and both runs point by point."""
+    runs = {}
+    for a, run in result.runs.items():
+        runs[a] = {
+            "success": run.success,
+            "message": run.message,
+            "theta": run.theta,
+            "x": run.x,
+            "y": run.y,
+            "error": run.error,
+            "h": run.h,
+            "leg": run.leg,
+            "leg_end": run.leg_end,
+            "drift": run.drift,
+        }
+        if run.platform is not None:
+            runs[a]["platform_final"] = run.platform[-1]
+    return json.loads(_json({
+        "robot": result.title, "state": result.state.as_dict(), "generation": result.generation,
+        "variable_names": result.variable_names, "task_names": result.task_names,
+        "targets": result.targets, "runs": runs, "functionals": functionals,
+    }))  # fmt: skip
+
+
+def export_csv(result: DashboardResult) -> str:
+    """One row per trajectory point: algorithm, leg, theta, x..., y..., error, h."""
+    names, tasks = result.variable_names, result.task_names
+    header = ["algorithm", "leg", "theta", *names, *tasks, "error", "h"]
+    lines = [",".join(header)]
+    for a, run in result.runs.items():
+        h = run.h if run.h is not None else np.full(len(run.theta), np.nan)
+        for k in range(len(run.theta)):
+            vals = [a, str(int(run.leg[k]) + 1), repr(float(run.theta[k]))]
+            vals += [repr(float(v)) for v in run.x[k]] + [repr(float(v)) for v in run.y[k]]
+            vals += [repr(float(run.error[k])), "" if np.isnan(h[k]) else repr(float(h[k]))]
+            lines.append(",".join(vals))
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,362 @@
+"""Plotly figures of a dashboard result: pure functions ``DashboardResult -> go.Figure``.
+
+Colours are fixed per algorithm (:data:`app.dashboard.COLORS`), the same as in the 3D scene.
+The figures follow the paper: task-space paths (Figs. 5, 6), joint trajectories against theta
+(Figs. 7-9), the repeatability drift per cycle with the Table 1 numbers, and for the unicycle the
+platform paths in the (q1, q2) plane and the controls against the iteration (Figs. 11-14).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import plotly.graph_objects as go
+
+from app.dashboard import ALGORITHMS, COLORS, LABELS, DashboardResult
+
+#: Units of the joint and task variables, by robot (the registry does not carry units).
+UNITS = {
+    "manipulator1": (("m", "m", "1"), ("m", "m")),
+    "manipulator2": (("m", "m", "rad"), ("m", "m")),
+    "unicycle": (("m/s", "m/s", "rad/s", "rad/s"), ("m", "m", "rad")),
+}
+PANEL_HEIGHT = 340
+_AXIS = dict(
+    gridcolor="#e6e6e6", zerolinecolor="#b0b0b0", linecolor="#888", showline=True, mirror=True,
+    ticks="outside", automargin=True,
+)  # fmt: skip
+# A small explicit template: the named ones ("plotly_white") cost ~25 ms per figure to apply.
+_TEMPLATE = go.layout.Template(
+    layout=dict(paper_bgcolor="white", plot_bgcolor="white", xaxis=_AXIS, yaxis=_AXIS,
+                colorway=["#d62728", "#1f77b4", "#2ca02c", "#9467bd"])
+)  # fmt: skip
+_LAYOUT = dict(
+    template=_TEMPLATE,
+    height=PANEL_HEIGHT,
+    margin=dict(l=60, r=20, t=48, b=48),
+    legend=dict(orientation="h", yanchor="bottom", y=1.0, xanchor="right", x=1.0),
+    font=dict(size=11),
+    hovermode="closest",
+    uirevision="keep",  # keep the user's zoom across updates of the same robot
+)
+_SYMBOLS = {"pseudoinverse": "circle", "extended": "diamond"}
+
+
+def _units(result: DashboardResult) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    joint, task = UNITS.get(result.state.robot, ((), ()))
+    p, r = len(result.variable_names), len(result.task_names)
+    return (joint or ("",) * p), (task or ("",) * r)
+
+
+def _label(name: str, unit: str) -> str:
+    return f"{name} [{unit}]" if unit else name
+
+
+def is_unicycle(result: DashboardResult) -> bool:
+    """Results with platform paths (the unicycle) get the platform figures."""
+    return any(r.platform is not None for r in result.runs.values())
+
+
+def _theta_label(result: DashboardResult) -> str:
+    if result.state.mode == "discrete":
+        return "iteration"
+    return f"θ (continuation parameter, γ = {result.state.gamma:g})"
+
+
+def _leg_names(n: int) -> list[str]:
+    return [chr(ord("A") + i) if i < 26 else f"P{i + 1}" for i in range(n)]
+
+
+def _figure(data: list, title: str, **layout) -> go.Figure:
+    """One-shot construction: plotly validates once (incremental updates cost ~10x more)."""
+    base = {**_LAYOUT, "title": dict(text=title, font=dict(size=13))}
+    return go.Figure(data=data, layout={**base, **layout})
+
+
+def _stacked_axes(n: int, gap: float = 0.04) -> dict:
+    """Layout of n y-axes stacked over one shared x-axis (instead of make_subplots)."""
+    h = (1.0 - gap * (n - 1)) / n
+    out = {}
+    for k in range(n):
+        top = 1.0 - k * (h + gap)
+        lo, hi = max(0.0, round(top - h, 6)), min(1.0, round(top, 6))
+        out["yaxis" if k == 0 else f"yaxis{k + 1}"] = dict(domain=[lo, hi], anchor="x")
+    out["xaxis"] = dict(anchor=f"y{n}" if n > 1 else "y")
+    return out
+
+
+def task_space_figure(result: DashboardResult) -> go.Figure:
+    """End-effector paths of both algorithms in the task plane (paper, Figs. 5 and 6)."""
+    _, tu = _units(result)
+    n1, n2 = result.task_names[:2]
+    data = []
+    for a in ALGORITHMS:
+        run = result.runs[a]
+        data.append(
+            go.Scatter(
+                x=run.y[:, 0], y=run.y[:, 1], mode="lines", name=LABELS[a],
+                line=dict(color=COLORS[a], width=4 if a == "pseudoinverse" else 1.8,
+                          dash="solid" if a == "pseudoinverse" else "dash"),
+                customdata=np.stack([run.theta, run.leg + 1], axis=-1),
+                hovertemplate=f"{n1} = %{{x:.4f}}<br>{n2} = %{{y:.4f}}"
+                "<br>θ = %{customdata[0]:.3g}<br>leg %{customdata[1]}<extra>" + a + "</extra>",
+            )
+        )  # fmt: skip
+    tg = result.targets
+    x0y = result.runs["pseudoinverse"].y[0]
+    data.append(
+        go.Scatter(
+            x=tg[:, 0], y=tg[:, 1], mode="markers+text", name="targets",
+            text=_leg_names(len(tg)), textposition="top right",
+            marker=dict(color="black", size=9, symbol="x"),
+            hovertemplate=f"%{{text}}: ({n1}, {n2}) = (%{{x:.3f}}, %{{y:.3f}})<extra></extra>",
+        )
+    )  # fmt: skip
+    data.append(
+        go.Scatter(
+            x=[x0y[0]], y=[x0y[1]], mode="markers", name="start k(x0)",
+            marker=dict(color="#2ca02c", size=12, symbol="circle-open", line=dict(width=2)),
+            hovertemplate="start (%{x:.3f}, %{y:.3f})<extra></extra>",
+        )
+    )  # fmt: skip
+    return _figure(
+        data,
+        "Task-space paths (Figs. 5, 6)",
+        xaxis=dict(title=_label(n1, tu[0])),
+        yaxis=dict(title=_label(n2, tu[1]), scaleanchor="x", scaleratio=1),
+    )
+
+
+def joint_figure(result: DashboardResult) -> go.Figure:
+    """Every joint variable against theta for both algorithms (Figs. 7-9; Figs. 11-14 b, c)."""
+    ju, _ = _units(result)
+    names = result.variable_names
+    data = []
+    for a in ALGORITHMS:
+        run = result.runs[a]
+        for k, name in enumerate(names):
+            data.append(
+                go.Scatter(
+                    x=run.theta, y=run.x[:, k], mode="lines", name=LABELS[a],
+                    legendgroup=a, showlegend=k == 0, line=dict(color=COLORS[a], width=1.8),
+                    xaxis="x", yaxis="y" if k == 0 else f"y{k + 1}",
+                    hovertemplate=f"{name} = %{{y:.5f}}<br>θ = %{{x:.4g}}<extra>{a}</extra>",
+                )
+            )  # fmt: skip
+    axes = _stacked_axes(len(names))
+    for k, name in enumerate(names):
+        axes["yaxis" if k == 0 else f"yaxis{k + 1}"]["title"] = _label(name, ju[k])
+    axes["xaxis"]["title"] = _theta_label(result)
+    title = (
+        "Controls λ against the iteration (Figs. 11-14 b, c)"
+        if is_unicycle(result)
+        else "Joint trajectories (Figs. 7-9)"
+    )
+    return _figure(data, title, height=110 * len(names) + 110, **axes)
+
+
+def drift_figure(result: DashboardResult) -> go.Figure:
+    """Repeatability drift ||x(end of cycle c) - x0|| per cycle, log scale (Table 1's point).
+
+    For a single-target task (and the unicycle) the task error against theta is shown instead.
+    """
+    data = []
+    closed = result.state.task == "path"
+    for a in ALGORITHMS:
+        run = result.runs[a]
+        if closed:
+            data.append(
+                go.Scatter(
+                    x=np.arange(1, len(run.drift) + 1), y=np.maximum(run.drift, 1e-16),
+                    mode="lines+markers", name=LABELS[a], line=dict(color=COLORS[a], width=2),
+                    marker=dict(symbol=_SYMBOLS[a], size=9),
+                    hovertemplate="cycle %{x}: drift %{y:.3e}<extra>" + a + "</extra>",
+                )
+            )  # fmt: skip
+        else:
+            data.append(
+                go.Scatter(
+                    x=run.theta, y=np.maximum(run.error, 1e-16), mode="lines", name=LABELS[a],
+                    line=dict(color=COLORS[a], width=2),
+                    hovertemplate="‖k(x) − y_d‖ = %{y:.3e}<br>θ = %{x:.4g}<extra>" + a + "</extra>",
+                )
+            )  # fmt: skip
+    if closed:
+        return _figure(
+            data,
+            "Repeatability: joint drift after each closed cycle",
+            xaxis=dict(title="cycle", dtick=1),
+            yaxis=dict(title="‖x(end of cycle) − x0‖ (log)", type="log", exponentformat="power"),
+        )
+    return _figure(
+        data,
+        "Convergence: task error",
+        xaxis=dict(title=_theta_label(result)),
+        yaxis=dict(title="‖k(x) − y_d‖ (log)", type="log", exponentformat="power"),
+    )
+
+
+def table_figure(result: DashboardResult) -> go.Figure:
+    """The configuration after every leg for both algorithms, as in Table 1 of the paper."""
+    names = result.variable_names
+    L = len(result.targets)
+    legs = _leg_names(L)
+    rows = max(len(result.runs[a].leg_end) for a in ALGORITHMS)
+    point = ["start x0"] + [
+        f"{c // L + 1}: {legs[c % L]} {_fmt_point(result.targets[c % L])}" for c in range(rows)
+    ]
+    cols: list[list[str]] = [point]
+    header = ["cycle: point"]
+    for a in ALGORITHMS:
+        ends = np.vstack([np.asarray(result.state.x0)[None, :], result.runs[a].leg_end])
+        for k, name in enumerate(names):
+            header.append(f"{'J^P#' if a == 'pseudoinverse' else 'J^E#'} {name}")
+            cols.append([f"{v:.4f}" for v in ends[:, k]] + [""] * (rows + 1 - len(ends)))
+    fills = ["#f4f4f4"] + ["#fbe3e3" if h.startswith("J^P#") else "#e1ecf7" for h in header[1:]]
+    table = go.Table(
+        header=dict(values=header, fill_color=fills, font=dict(size=11), align="center"),
+        cells=dict(values=cols, font=dict(size=11, family="monospace"), align="right",
+                   fill_color=[["white", "#f7f7f7"] * (rows + 1)]),
+    )  # fmt: skip
+    return _figure(
+        [table], "Configurations after each leg (Table 1)", margin=dict(l=10, r=10, t=40, b=10)
+    )
+
+
+def _fmt_point(p) -> str:
+    return "(" + ", ".join(f"{v:.3g}" for v in p) + ")"
+
+
+def platform_figure(result: DashboardResult, max_paths: int = 12) -> go.Figure:
+    """Unicycle platform paths q(t) in the (q1, q2) plane, per iteration (Figs. 11-14 a)."""
+    _, tu = _units(result)
+    data = []
+    annotations = []
+    for col, a in enumerate(ALGORITHMS, start=1):
+        xa, ya = ("x", "y") if col == 1 else ("x2", "y2")
+        P = result.runs[a].platform
+        m = len(P)
+        show = sorted(set(np.geomspace(1, m, num=max_paths).astype(int) - 1) | {0, m - 1})
+        for n, i in enumerate(show):
+            last = i == m - 1
+            data.append(
+                go.Scatter(
+                    x=P[i, :, 0], y=P[i, :, 1], mode="lines", xaxis=xa, yaxis=ya,
+                    name=LABELS[a] if last else f"{a} iteration {i}", legendgroup=a,
+                    showlegend=last, line=dict(color=COLORS[a], width=3 if last else 1),
+                    opacity=1.0 if last else 0.2 + 0.5 * n / max(len(show), 1),
+                    customdata=result.time,
+                    hovertemplate=f"iteration {i}<br>q1 = %{{x:.3f}}<br>q2 = %{{y:.3f}}"
+                    "<br>t = %{customdata:.2f}<extra>" + a + "</extra>",
+                )
+            )  # fmt: skip
+        q0 = result.state.robot_parameters.get("q0", P[0, 0])
+        target = result.state.target
+        data.append(
+            go.Scatter(
+                x=[q0[0], target[0]], y=[q0[1], target[1]], xaxis=xa, yaxis=ya,
+                mode="markers+text", text=["q0", "target"], textposition="top center",
+                marker=dict(color=["#2ca02c", "black"], size=10, symbol=["circle", "x"]),
+                showlegend=False, hovertemplate="%{text}: (%{x:.3f}, %{y:.3f})<extra></extra>",
+            )
+        )  # fmt: skip
+        annotations.append(
+            dict(text=LABELS[a], xref=f"{xa} domain", yref=f"{ya} domain", x=0.5, y=1.0,
+                 yanchor="bottom", showarrow=False, font=dict(size=11, color=COLORS[a]))
+        )  # fmt: skip
+    return _figure(
+        data,
+        "Platform paths q(t) per iteration (Figs. 11-14 a)",
+        xaxis=dict(domain=[0, 0.48], title=_label("q1", tu[0])),
+        xaxis2=dict(domain=[0.52, 1], title=_label("q1", tu[0]), matches="x"),
+        yaxis=dict(title=_label("q2", tu[1]), scaleanchor="x", scaleratio=1),
+        yaxis2=dict(anchor="x2", matches="y", showticklabels=False),
+        annotations=annotations,
+        margin=dict(l=60, r=20, t=70, b=48),
+    )
+
+
+def augmenting_figure(result: DashboardResult, functionals: dict | None = None) -> go.Figure:
+    """Contours of the augmenting map h over two joint variables with both trajectories on top.
+
+    The extended Jacobian keeps h constant (eq. (12)), so its trajectory follows a level curve;
+    the pseudoinverse crosses them. The title carries E1 (13) and E2 (18) over the plotted box.
+    """
+    ju, _ = _units(result)
+    grid = result.augmenting
+    title = f"Augmenting map h: {result.state.augmentation}"
+    if grid is None:
+        return _figure([], title + " (cannot be evaluated here)")
+    i, j = grid["axes"]
+    ni, nj = result.variable_names[i], result.variable_names[j]
+    H = grid["h"]
+    finite = H[np.isfinite(H)]
+    zmin, zmax = np.percentile(finite, [2, 98]) if finite.size else (0.0, 1.0)
+    data = [
+        go.Contour(
+            x=grid["u"], y=grid["v"], z=H, colorscale="Viridis", zmin=zmin, zmax=zmax,
+            ncontours=24, contours=dict(showlabels=True, labelfont=dict(size=9, color="white")),
+            colorbar=dict(title=dict(text="h", side="right"), thickness=12),
+            hovertemplate=f"{ni} = %{{x:.3f}}<br>{nj} = %{{y:.3f}}<br>h = %{{z:.4f}}"
+            "<extra></extra>",
+            name="h", showlegend=False,
+        )
+    ]  # fmt: skip
+    for a in ALGORITHMS:
+        run = result.runs[a]
+        data.append(
+            go.Scatter(
+                x=run.x[:, i], y=run.x[:, j], mode="lines", name=LABELS[a],
+                line=dict(color=COLORS[a] if a == "extended" else "#ff7f7f", width=2.5),
+                hovertemplate=f"{ni} = %{{x:.4f}}<br>{nj} = %{{y:.4f}}<extra>{a}</extra>",
+            )
+        )  # fmt: skip
+    x0 = result.state.x0
+    data.append(
+        go.Scatter(
+            x=[x0[i]], y=[x0[j]], mode="markers", name="x0",
+            marker=dict(color="white", size=10, line=dict(color="black", width=2)),
+            hovertemplate="x0<extra></extra>",
+        )
+    )  # fmt: skip
+    if functionals:
+        parts = []
+        for key in ("E1", "E2"):
+            v = functionals.get(key)
+            parts.append(f"{key} = {v:.4g}" if v is not None else f"{key} undefined")
+        title += " · " + ", ".join(parts) + " on this box"
+    fixed = [f"{n} = {x0[k]:.3g}" for k, n in enumerate(result.variable_names) if k not in (i, j)]
+    annotations = []
+    if fixed:
+        annotations.append(
+            dict(text="slice at " + ", ".join(fixed), xref="paper", yref="paper", x=1, y=1.0,
+                 xanchor="right", yanchor="bottom", showarrow=False,
+                 font=dict(size=10, color="#555"))
+        )  # fmt: skip
+    return _figure(
+        data,
+        title,
+        xaxis=dict(title=_label(ni, ju[i])),
+        yaxis=dict(title=_label(nj, ju[j])),
+        annotations=annotations,
+        legend=dict(orientation="h", yanchor="top", y=-0.25, xanchor="left", x=0),
+        margin=dict(l=60, r=20, t=48, b=80),
+    )
+
+
+def figures_for(result: DashboardResult, functionals: dict | None = None) -> dict[str, go.Figure]:
+    """Every panel of the dashboard for ``result``, keyed by panel id."""
+    if is_unicycle(result):
+        return {
+            "task": platform_figure(result),
+            "joints": joint_figure(result),
+            "drift": drift_figure(result),
+            "table": table_figure(result),
+            "augmenting": augmenting_figure(result, functionals),
+        }
+    return {
+        "task": task_space_figure(result),
+        "joints": joint_figure(result),
+        "drift": drift_figure(result),
+        "table": table_figure(result),
+        "augmenting": augmenting_figure(result, functionals),
+    }

@@ -1,0 +1,164 @@
+"""The dashboard's server-side state: validation, computation, caching, events, export."""
+
+from __future__ import annotations
+
+import json
+import threading
+
+import numpy as np
+import pytest
+
+from app.dashboard import (
+    Cancelled,
+    Dashboard,
+    compute,
+    default_state,
+    export_csv,
+    export_json,
+    updated_state,
+)
+from engine.exceptions import InvalidInputError
+from engine.registry import ROBOTS, make_inverse, robot_spec
+from engine.repeatability import repeatability
+from engine.solver import solve
+
+
+@pytest.mark.parametrize("robot", sorted(ROBOTS))
+def test_defaults_come_from_the_registry(robot):
+    spec = robot_spec(robot)
+    state = default_state(robot)
+    assert state.x0 == tuple(spec.default_x0)
+    assert state.augmentation == spec.default_augmentation
+    assert state.gamma == spec.default_gamma and state.mode == spec.default_mode
+    assert updated_state(state, {}) == state
+
+
+def test_changing_the_robot_starts_from_its_defaults():
+    state = updated_state(default_state("manipulator2"), {"gamma": 3.0})
+    m1 = updated_state(state, {"robot": "manipulator1", "cycles": 2})
+    assert m1.robot == "manipulator1" and m1.cycles == 2
+    assert m1.x0 == tuple(robot_spec("manipulator1").default_x0)
+    assert m1.gamma == robot_spec("manipulator1").default_gamma
+
+
+def test_parameters_merge_and_augmentation_resets_its_parameters():
+    s = updated_state(default_state("manipulator1"), {"augmentation_parameters": {"a": 0.5}})
+    assert s.augmentation_parameters == {"a": 0.5, "b": 1.0}
+    s = updated_state(s, {"augmentation": "e1_optimal"})
+    assert s.augmentation_parameters == {"C1": 1.0, "C2": 1.0}
+
+
+@pytest.mark.parametrize(
+    ("patch", "message"),
+    [
+        ({"gamma": 0}, "gamma must be > 0"),
+        ({"mode": "discrete", "gamma": 2.5}, "gamma must be < 2 in discrete mode"),
+        ({"x0": [1, 2]}, "x0 must have shape"),
+        ({"cycles": 0}, "cycles"),
+        ({"robot_parameters": {"l": 99}}, "l must be in [0.1, 5]"),
+        ({"augmentation": "nope"}, "unknown augmentation 'nope'"),
+        ({"speed": 1}, "unknown dashboard field(s) ['speed']"),
+        ({"robot": "r2d2"}, "unknown robot 'r2d2'"),
+    ],
+)
+def test_bad_changes_are_refused_with_a_message(patch, message):
+    with pytest.raises(InvalidInputError) as err:
+        updated_state(default_state("manipulator2"), patch)
+    assert message in str(err.value)
+
+
+def test_closed_path_matches_the_engine_repeatability_test():
+    """The leg-by-leg loop gives the same leg ends and drift as engine.repeatability."""
+    state = updated_state(default_state("manipulator2"), {"cycles": 2})
+    result = compute(state)
+    kin = robot_spec("manipulator2").build()
+    for a in ("pseudoinverse", "extended"):
+        ref = repeatability(make_inverse(kin, a, robot="manipulator2"), state.x0, state.path, 2)
+        run = result.runs[a]
+        np.testing.assert_allclose(run.leg_end, ref.legs, atol=1e-9)
+        np.testing.assert_allclose(run.drift, ref.drift, atol=1e-9)
+        assert run.success
+    assert result.runs["pseudoinverse"].drift[-1] > 0.5
+    assert result.runs["extended"].drift[-1] < 1e-8
+
+
+def test_gamma_in_continuous_mode_rescales_theta_without_a_new_integration():
+    cache: dict = {}
+    s1 = updated_state(default_state("manipulator2"), {"task": "target"})
+    r1 = compute(s1, cache=cache)
+    s2 = updated_state(s1, {"gamma": 4.0})
+    r2 = compute(s2, cache=cache)
+    assert r2.cached == {"pseudoinverse": True, "extended": True}
+    inv = make_inverse(robot_spec("manipulator2").build(), "pseudoinverse")
+    direct = solve(inv, s2.x0, s2.target, gamma=4.0)
+    run = r2.runs["pseudoinverse"]
+    np.testing.assert_allclose(run.theta, direct.trajectory.theta, rtol=1e-12)
+    np.testing.assert_allclose(run.x, direct.trajectory.x, atol=1e-12)
+    np.testing.assert_allclose(r1.runs["pseudoinverse"].theta, 4.0 * run.theta, rtol=1e-12)
+
+
+def test_only_the_extended_run_is_recomputed_for_a_new_augmentation_parameter():
+    cache: dict = {}
+    s = updated_state(default_state("manipulator1"), {"task": "target"})
+    compute(s, cache=cache)
+    r = compute(updated_state(s, {"augmentation_parameters": {"a": 0.3}}), cache=cache)
+    assert r.cached == {"pseudoinverse": True, "extended": False}
+
+
+def test_a_newer_change_cancels_the_computation():
+    calls = []
+    with pytest.raises(Cancelled):
+        compute(default_state("manipulator2"), cancelled=lambda: calls.append(1) or len(calls) > 1)
+    assert len(calls) == 2  # stopped before the second leg
+
+
+def test_progress_reaches_one():
+    fractions = []
+    compute(updated_state(default_state("manipulator1"), {"cycles": 1}), progress=fractions.append)
+    assert fractions == sorted(fractions) and fractions[-1] == pytest.approx(1.0)
+
+
+def test_live_dashboard_pushes_state_and_result_events():
+    dashboard = Dashboard(updated_state(default_state("manipulator2"), {"task": "target"}))
+    events = []
+    got_result = threading.Event()
+
+    def listener(event):
+        events.append(event)
+        if event.kind == "result" and event.generation >= 2:
+            got_result.set()
+
+    unsubscribe = dashboard.subscribe(listener)
+    generation, state = dashboard.update({"x0": [0.1, 0.0, 1.5]}, source="test")
+    assert generation == 2 and state.x0 == (0.1, 0.0, 1.5)
+    assert got_result.wait(60)
+    unsubscribe()
+    dashboard.stop()
+    kinds = [e.kind for e in events]
+    assert "state" in kinds and "result" in kinds
+    result = next(e for e in events if e.kind == "result" and e.generation == 2)
+    body = json.loads(result.data)
+    assert body["state"]["x0"] == [0.1, 0.0, 1.5]
+    assert set(body["figures"]) == {"task", "joints", "drift", "table", "augmenting"}
+    assert body["summary"]["extended"]["success"]
+    assert dashboard.snapshot()["computed_generation"] == 2
+
+
+def test_a_refused_change_leaves_the_state_alone():
+    dashboard = Dashboard()
+    before = dashboard.state
+    with pytest.raises(InvalidInputError):
+        dashboard.update({"gamma": -1})
+    assert dashboard.state == before and dashboard.generation == 1
+
+
+def test_export_has_every_point_of_both_runs():
+    result = compute(updated_state(default_state("manipulator1"), {"task": "target"}))
+    rows = export_csv(result).strip().split("\n")
+    assert rows[0] == "algorithm,leg,theta,x1,x2,x3,y1,y2,error,h"
+    n = sum(len(r.theta) for r in result.runs.values())
+    assert len(rows) == 1 + n
+    body = export_json(result)
+    assert len(body["runs"]["extended"]["x"]) == len(result.runs["extended"].x)
+    last = rows[-1].split(",")
+    assert last[0] == "extended" and float(last[8]) < 1e-9

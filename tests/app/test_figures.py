@@ -1,0 +1,128 @@
+"""Figure builders: pure functions of a dashboard result (no server)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from app.dashboard import COLORS, LABELS, compute, default_state, error_functionals, updated_state
+from app.figures import (
+    augmenting_figure,
+    drift_figure,
+    figures_for,
+    joint_figure,
+    table_figure,
+    task_space_figure,
+)
+from engine.registry import ROBOTS
+
+
+@pytest.fixture(scope="module")
+def path_result():
+    """Manipulator 2, the paper's closed path A-B-C-D-A driven twice."""
+    return compute(updated_state(default_state("manipulator2"), {"cycles": 2}))
+
+
+@pytest.fixture(scope="module")
+def target_result():
+    return compute(updated_state(default_state("manipulator1"), {"task": "target"}))
+
+
+def _colors(fig) -> dict[str, str]:
+    named = [t for t in fig.data if t.type == "scatter" and t.name in LABELS.values()]
+    return {t.name: t.line.color for t in named}
+
+
+def test_task_space_paths_use_one_colour_per_algorithm(path_result):
+    fig = task_space_figure(path_result)
+    assert _colors(fig) == {LABELS[a]: COLORS[a] for a in COLORS}
+    assert fig.layout.xaxis.title.text == "y1 [m]"
+    assert fig.layout.yaxis.title.text == "y2 [m]"
+    targets = next(t for t in fig.data if t.name == "targets")
+    assert list(targets.text) == ["A", "B", "C", "D"]
+    np.testing.assert_allclose(targets.x, [1, 1, 0, 0])
+    # Both end-effector paths pass through every target (the solver's tol is 1e-10).
+    for a, run in path_result.runs.items():
+        for target in path_result.targets:
+            assert np.min(np.linalg.norm(run.y - target, axis=1)) < 1e-8, a
+
+
+def test_joint_figure_has_one_axis_per_joint_with_units(path_result):
+    fig = joint_figure(path_result)
+    titles = [fig.layout[f"yaxis{'' if k == 0 else k + 1}"].title.text for k in range(3)]
+    assert titles == ["x1 [m]", "x2 [m]", "x3 [rad]"]
+    assert fig.layout.xaxis.title.text.startswith("θ")
+    assert len(fig.data) == 6
+    run = path_result.runs["pseudoinverse"]
+    np.testing.assert_allclose(fig.data[2].y, run.x[:, 2])
+    assert all(t.hovertemplate for t in fig.data)
+
+
+def test_drift_is_log_scale_and_separates_the_algorithms(path_result):
+    fig = drift_figure(path_result)
+    assert fig.layout.yaxis.type == "log"
+    drift = {t.name: np.asarray(t.y) for t in fig.data}
+    assert drift[LABELS["pseudoinverse"]].shape == (2,)
+    # Table 1's message: the pseudoinverse drifts, the extended Jacobian returns.
+    assert np.all(drift[LABELS["pseudoinverse"]] > 0.1)
+    assert np.all(drift[LABELS["extended"]] < 1e-8)
+    assert drift[LABELS["pseudoinverse"]][1] > drift[LABELS["pseudoinverse"]][0]
+
+
+def test_table_lists_every_leg_end_like_table1(path_result):
+    fig = table_figure(path_result)
+    cells = fig.data[0].cells.values
+    assert cells[0][0] == "start x0"
+    assert len(cells[0]) == 1 + 2 * 4
+    assert list(fig.data[0].header.values[1:4]) == ["J^P# x1", "J^P# x2", "J^P# x3"]
+    # After the first leg (to A = (1, 1)), the configurations of the two algorithms.
+    for col, (a, k) in enumerate([(a, k) for a in COLORS for k in range(3)], start=1):
+        assert float(cells[col][1]) == pytest.approx(path_result.runs[a].leg_end[0, k], abs=1e-4)
+
+
+def test_augmenting_map_contours_with_the_extended_run_on_a_level_set(path_result):
+    functionals = error_functionals(path_result)
+    fig = augmenting_figure(path_result, functionals)
+    contour = fig.data[0]
+    assert contour.type == "contour"
+    assert np.asarray(contour.z).shape == (len(contour.y), len(contour.x))
+    # PaperCubic depends on (x2, x3): those are the plotted axes.
+    assert fig.layout.xaxis.title.text == "x2 [m]"
+    assert fig.layout.yaxis.title.text == "x3 [rad]"
+    assert "E1 = " in fig.layout.title.text and "E2 = " in fig.layout.title.text
+    assert functionals["E1"] > 0 and functionals["E2"] > 0
+    h = path_result.runs["extended"].h
+    assert np.ptp(h) < 1e-9
+
+
+def test_single_target_shows_convergence_instead_of_drift(target_result):
+    fig = drift_figure(target_result)
+    assert fig.layout.title.text.startswith("Convergence")
+    for t in fig.data:
+        assert t.y[-1] < 1e-9 and t.y[0] > 0.1
+
+
+def test_every_panel_serialises_to_plotly_json(path_result, target_result):
+    for result in (path_result, target_result):
+        figs = figures_for(result)
+        assert set(figs) == {"task", "joints", "drift", "table", "augmenting"}
+        for fig in figs.values():
+            parsed = json.loads(fig.to_json())
+            assert parsed["data"] and parsed["layout"]["title"]["text"]
+
+
+@pytest.mark.skipif("unicycle" not in ROBOTS, reason="the unicycle is not in the registry yet")
+def test_unicycle_platform_paths_and_controls():
+    state = default_state("unicycle")
+    result = compute(state)
+    figs = figures_for(result)
+    task = figs["task"]
+    assert task.layout.title.text.startswith("Platform paths")
+    finals = [t for t in task.data if t.name in LABELS.values()]
+    assert len(finals) == 2
+    for t in finals:
+        # The last iteration's platform path ends at the target pose.
+        assert np.hypot(t.x[-1] - state.target[0], t.y[-1] - state.target[1]) < 1e-6
+    assert figs["joints"].layout.title.text.startswith("Controls")
