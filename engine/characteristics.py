@@ -72,6 +72,14 @@ def cofactors(J: FloatArray) -> FloatArray:
     return -(P23 @ J[..., 0, :, None])[..., 0]
 
 
+def _cofactors_and_derivative34(J: FloatArray, H: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """c (..., 4) and dc/dx (..., 4, 4) for r = 3 from the Levi-Civita contractions."""
+    R1, R2, R3 = J[..., 0, :], J[..., 1, :], J[..., 2, :]
+    P23, P13, P12 = _contract(_E23, R2, R3), _contract(_E13, R1, R3), _contract(_E12, R1, R2)
+    c = -(P23 @ R1[..., None])[..., 0]
+    return c, -(P23 @ H[..., 0, :, :] + P13 @ H[..., 1, :, :] + P12 @ H[..., 2, :, :])
+
+
 def kernel_cofactors_derivative(J: FloatArray, H: FloatArray) -> FloatArray:
     """Derivative of the kernel cofactor vector c(J(x)) with respect to x.
 
@@ -94,9 +102,7 @@ def kernel_cofactors_derivative(J: FloatArray, H: FloatArray) -> FloatArray:
     """
     r, p = J.shape[-2:]
     if (r, p) == (3, 4):
-        R1, R2, R3 = J[..., 0, :], J[..., 1, :], J[..., 2, :]
-        P23, P13, P12 = _contract(_E23, R2, R3), _contract(_E13, R1, R3), _contract(_E12, R1, R2)
-        return -(P23 @ H[..., 0, :, :] + P13 @ H[..., 1, :, :] + P12 @ H[..., 2, :, :])
+        return _cofactors_and_derivative34(J, H)[1]
     Jm = np.broadcast_to(J[..., None, None, :, :], (*J.shape[:-2], r, p, r, p)).copy()
     for j in range(r):
         Jm[..., j, :, j, :] = np.swapaxes(H[..., j, :, :], -1, -2)
@@ -105,7 +111,11 @@ def kernel_cofactors_derivative(J: FloatArray, H: FloatArray) -> FloatArray:
 
 def _one_form_parts(J, H, fixed_index):
     """omega (..., p), d omega/dx (..., p, p) or None, and the 'undefined' mask (...,)."""
-    c = cofactors(J)
+    if H is not None and J.shape[-2:] == (3, 4):
+        c, dc = _cofactors_and_derivative34(J, H)
+    else:
+        c = cofactors(J)
+        dc = None if H is None else kernel_cofactors_derivative(J, H)
     cf = c[..., fixed_index]
     norm = np.linalg.norm(c, axis=-1)  # = m(x), Cauchy-Binet
     bad = (np.abs(cf) <= ONE_FORM_TOL * norm) | ~(norm >= SINGULAR_MANIPULABILITY)
@@ -113,7 +123,6 @@ def _one_form_parts(J, H, fixed_index):
     omega = c / cf[..., None]
     if H is None:
         return omega, None, bad
-    dc = kernel_cofactors_derivative(J, H)
     domega = (dc - omega[..., :, None] * dc[..., fixed_index, None, :]) / cf[..., None, None]
     return omega, domega, bad
 

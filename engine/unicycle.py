@@ -36,8 +36,8 @@ def _panel_rule(a: float, b: float, panels: int) -> tuple[FloatArray, FloatArray
 
 
 @functools.lru_cache(maxsize=64)
-def _moment_basis(T: float, panels: int) -> tuple[FloatArray, FloatArray]:
-    """Quadrature nodes t (N,) and the weighted basis G (N, 12) of the moments on [0, T].
+def _moment_basis(T: float, panels: int) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Nodes t (N,), C = 1 - cos t (N,) and the weighted basis G (N, 12) of the moments on [0, T].
 
     Columns: 1, s, t, C, s t, s C, t^2, t C, C^2, s t^2, s t C, s C^2 with s = sin t,
     C = 1 - cos t (the derivatives of u1 and q3 with respect to lambda).
@@ -48,7 +48,8 @@ def _moment_basis(T: float, panels: int) -> tuple[FloatArray, FloatArray]:
     cols = [one, s, t, C, s * t, s * C, t * t, t * C, C * C, s * t * t, s * t * C, s * C * C]
     G = np.stack(cols, axis=-1) * w[:, None]
     G.flags.writeable = False
-    return t, G
+    C.flags.writeable = False
+    return t, C, G
 
 
 def panels_for(lam: FloatArray, length: float) -> int:
@@ -152,8 +153,8 @@ class Unicycle(Kinematics):
 
     def _moments(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
         """Mc = int cos q3 G, Ms = int sin q3 G: shapes (..., 12) each."""
-        t, G = _moment_basis(self.T, panels_for(x, self.T))
-        q3 = self.q0[2] + x[..., 2:3] * t + x[..., 3:4] * (1.0 - np.cos(t))  # (..., N) [rad]
+        t, C, G = _moment_basis(self.T, panels_for(x, self.T))
+        q3 = self.q0[2] + x[..., 2:3] * t + x[..., 3:4] * C  # (..., N) [rad]
         return np.cos(q3) @ G, np.sin(q3) @ G
 
     def forward(self, x: FloatArray) -> FloatArray:
@@ -196,8 +197,8 @@ class Unicycle(Kinematics):
         of the characteristics synthesis).
         """
         x = np.asarray(x, dtype=float)
-        t, G = _moment_basis(self.T, panels_for(x, self.T))
-        q3 = self.q0[2] + x[..., 2:3] * t + x[..., 3:4] * (1.0 - np.cos(t))  # (..., N) [rad]
+        t, C, G = _moment_basis(self.T, panels_for(x, self.T))
+        q3 = self.q0[2] + x[..., 2:3] * t + x[..., 3:4] * C  # (..., N) [rad]
         M = np.exp(1j * q3) @ G  # int cos q3 G + i int sin q3 G, (..., 12)
         V = np.concatenate([M.real, M.imag], axis=-1)  # (..., 24)
         V = np.concatenate([V, x[..., 0:1] * V, x[..., 1:2] * V], axis=-1)  # (..., 72)
