@@ -1,0 +1,39 @@
+"""Shared fixtures of the API tests: one app (and its two worker processes) per session."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from fastapi.testclient import TestClient
+
+from app.main import create_app
+from app.service import Settings
+
+X0_M2 = [0.0, 0.0, math.pi / 2]
+TABLE1_PATH = [[1.0, 1.0], [1.0, 2.0], [0.0, 2.0], [0.0, 1.0]]
+
+
+@pytest.fixture(scope="session")
+def api():
+    """httpx-based TestClient driving the ASGI app (lifespan on: workers started and stopped)."""
+    with TestClient(create_app(Settings(workers=2, timeout=60.0))) as client:
+        yield client
+
+
+def solve_body(**over) -> dict:
+    """A valid /solve request for Manipulator 2 (Table 1's start), with overrides."""
+    body = {
+        "robot": {"name": "manipulator2", "l": 1.0},
+        "algorithm": "pseudoinverse",
+        "x0": X0_M2,
+        "target": [1.0, 1.0],
+    }
+    body.update(over)
+    return body
+
+
+def messages(response) -> list[str]:
+    """The ``msg`` of every error of a 422 response."""
+    assert response.status_code == 422, response.text
+    return [e["msg"] for e in response.json()["detail"]]

@@ -1,0 +1,136 @@
+"""Bad input: HTTP 422 whose message names the field and the problem; never a 5xx."""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.app.conftest import TABLE1_PATH, X0_M2, messages, solve_body
+
+
+def _rep(**over) -> dict:
+    body = {
+        "robot": {"name": "manipulator2"},
+        "algorithm": "pseudoinverse",
+        "x0": X0_M2,
+        "path": TABLE1_PATH,
+    }
+    body.update(over)
+    return body
+
+
+@pytest.mark.parametrize(
+    ("body", "expected"),
+    [
+        (solve_body(x0=[0.0, 0.0]), "x0: must have 3 components (p of manipulator2), got 2"),
+        (solve_body(target=[1.0, 1.0, 1.0]), "target: must have 2 components (r of manipulator2)"),
+        (solve_body(x0=[]), "x0: List should have at least 1 item"),
+        (solve_body(x0="abc"), "x0: Input should be a valid list"),
+        (solve_body(robot={"name": "puma560"}), "robot: unknown name 'puma560'; choose one of"),
+        (solve_body(robot={"l": 1.0}), "robot: Unable to extract tag using discriminator 'name'"),
+        (solve_body(robot={"name": "manipulator2", "l": 9}), "robot.l: Input should be less than"),
+        (solve_body(robot={"name": "manipulator2", "q": 1}), "robot.q: unknown field"),
+        (solve_body(algorithm="transpose"), "algorithm: Input should be 'pseudoinverse' or"),
+        (
+            solve_body(algorithm="extended", augmentation={"name": "nope"}),
+            "augmentation: unknown name 'nope'",
+        ),
+        (
+            solve_body(algorithm="extended", augmentation={"name": "e2_optimal"}),
+            "augmentation.name: unknown augmentation 'e2_optimal' for manipulator2",
+        ),
+        (solve_body(gamma=0), "gamma: Input should be greater than 0"),
+        (solve_body(gamma=-1.5), "gamma: Input should be greater than 0"),
+        (solve_body(mode="discrete", gamma=2.5), "gamma: must be < 2 in discrete mode"),
+        (solve_body(mode="sideways"), "mode: Input should be 'continuous' or 'discrete'"),
+        (solve_body(tolerance=0), "tolerance: Input should be greater than or equal to 0.0000000000000"),
+        (solve_body(max_iterations=0), "max_iterations: Input should be greater than or equal"),
+        (solve_body(max_iterations=10**7), "max_iterations: Input should be less than or equal"),
+        (solve_body(extra=1), "extra: unknown field; remove it"),
+        (_rep(cycles=1001), "cycles: Input should be less than or equal to 1000"),
+        (_rep(cycles=0), "cycles: Input should be greater than or equal to 1"),
+        (_rep(path=[[0.0, 1.0]] * 101), "path: List should have at most 100 items"),
+        (_rep(path=[]), "path: List should have at least 1 item"),
+        (_rep(path=[[1.0, 1.0], [1.0, 2.0, 3.0]]), "path[1]: must have 2 components"),
+    ],
+)
+def test_bad_input_names_the_field(api, body, expected):
+    url = "/repeatability" if "path" in body else "/solve"
+    r = api.post(url, json=body)
+    assert r.status_code == 422, r.text
+    assert any(m.startswith(expected) for m in messages(r)), messages(r)
+
+
+@pytest.mark.parametrize(
+    ("raw", "expected"),
+    [
+        ('"x0": [0, 0, NaN]', "x0[2]: Input should be a finite number"),
+        ('"x0": [0, Infinity, 1]', "x0[1]: Input should be a finite number"),
+        ('"x0": [0, -Infinity, 1]', "x0[1]: Input should be a finite number"),
+        ('"x0": [0, 0, 1], "gamma": NaN', "gamma: Input should be a finite number"),
+        ('"x0": [0, 0, 1], "robot": {"name": "manipulator2", "l": NaN}', "robot.l: Input should"),
+    ],
+)
+def test_nan_and_inf_are_rejected(api, raw, expected):
+    """JSON extensions NaN / Infinity parse in Python; they must still be refused."""
+    base = '{"robot": {"name": "manipulator2"}, "algorithm": "pseudoinverse", "target": [1, 1]'
+    if '"robot"' in raw:
+        base = '{"algorithm": "pseudoinverse", "target": [1, 1]'
+    r = api.post(
+        "/solve", content=base + ", " + raw + "}", headers={"content-type": "application/json"}
+    )
+    assert any(m.startswith(expected) for m in messages(r)), messages(r)
+
+
+def test_nan_in_path_is_rejected(api):
+    raw = (
+        '{"robot": {"name": "manipulator2"}, "algorithm": "extended", "x0": [0, 0, 1.5],'
+        ' "path": [[1, 1], [NaN, 2]]}'
+    )
+    r = api.post("/repeatability", content=raw, headers={"content-type": "application/json"})
+    assert messages(r) == ["path[1][0]: Input should be a finite number"]
+
+
+def test_algorithmically_singular_start(api):
+    """[J; dh] singular at x0 (dh K = 0 at x1 = -b/a for (36)): 422 naming x0."""
+    body = {
+        "robot": {"name": "manipulator1"},
+        "algorithm": "extended",
+        "augmentation": {"name": "e2_optimal", "a": 1.0, "b": 0.0},
+        "x0": [0.0, 0.5, 1.0],
+        "target": [0.8, 1.5],
+    }
+    (msg,) = messages(api.post("/solve", json=body))
+    assert msg.startswith("x0: the extended Jacobian [J; dh] of manipulator1")
+    assert "algorithmic singularity" in msg and "at x = (0, 0.5, 1)" in msg
+    rep = {k: v for k, v in body.items() if k != "target"} | {"path": [[0.8, 1.5]]}
+    (msg,) = messages(api.post("/repeatability", json=rep))
+    assert msg.startswith("x0: ") and "algorithmic singularity" in msg
+
+
+def test_augmentation_parameter_refused_by_the_registry(api):
+    """C1 = 0 makes (32) vanish identically: the registry's message, under the field."""
+    body = solve_body(
+        robot={"name": "manipulator1"},
+        x0=[0.5, 0.5, 1.0],
+        algorithm="extended",
+        augmentation={"name": "e1_optimal", "C1": 0.0},
+    )
+    (msg,) = messages(api.post("/solve", json=body))
+    assert msg.startswith("augmentation: C1 must be nonzero")
+
+
+def test_malformed_json(api):
+    r = api.post("/solve", content="{not json", headers={"content-type": "application/json"})
+    assert r.status_code == 422
+    assert "JSON decode error" in r.json()["detail"][0]["msg"]
+
+
+def test_missing_fields(api):
+    msgs = messages(api.post("/solve", json={}))
+    for name in ("robot", "algorithm", "x0", "target"):
+        assert f"{name}: Field required" in msgs
+
+
+def test_wrong_method_and_unknown_path_are_4xx(api):
+    assert api.get("/solve").status_code == 405
+    assert api.get("/nowhere").status_code == 404

@@ -1,0 +1,70 @@
+"""POST /repeatability: Table 1 through the API, and the extended inverse's repeatability."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from engine.reproductions.table1 import PRINTED
+from tests.app.conftest import TABLE1_PATH, X0_M2
+
+
+def _body(**over) -> dict:
+    body = {
+        "robot": {"name": "manipulator2"},
+        "algorithm": "pseudoinverse",
+        "x0": X0_M2,
+        "path": TABLE1_PATH,
+        "cycles": 1,
+    }
+    body.update(over)
+    return body
+
+
+def test_table1_pseudoinverse_column(api):
+    """The four legs of Table 1 reproduce the printed pseudoinverse column to four decimals."""
+    r = api.post("/repeatability", json=_body())
+    assert r.status_code == 200, r.text
+    b = r.json()
+    np.testing.assert_allclose(b["legs"], PRINTED["pseudoinverse"][1:], atol=6e-5)
+    np.testing.assert_allclose(b["targets"], TABLE1_PATH)  # (0, 1) = k(x0) closes the path
+    assert len(b["cycle_end"]) == 1 and len(b["drift"]) == 1
+    np.testing.assert_allclose(b["drift"][0], np.linalg.norm(np.subtract(b["legs"][-1], X0_M2)))
+    assert b["drift"][0] > 0.3  # the pseudoinverse is not repeatable
+    assert b["repeatable"] is False and b["success"] is True
+
+
+def test_pseudoinverse_drift_grows_over_cycles(api):
+    b = api.post("/repeatability", json=_body(cycles=3)).json()
+    assert len(b["legs"]) == 12 and len(b["cycle_end"]) == 3
+    np.testing.assert_allclose(b["cycle_end"], [b["legs"][3], b["legs"][7], b["legs"][11]])
+    assert b["max_drift"] == max(b["drift"])
+    assert not b["repeatable"]
+
+
+def test_extended_inverse_drift_below_1e_8(api):
+    """The extended Jacobian inverse (11) with (38) is repeatable: drift < 1e-8 every cycle."""
+    b = api.post("/repeatability", json=_body(algorithm="extended", cycles=5)).json()
+    assert b["success"], b["message"]
+    assert len(b["drift"]) == 5
+    assert max(b["drift"]) < 1e-8
+    assert b["repeatable"] is True
+    # the path's end points are visited, so legs land on k^-1(target) with constant h
+    np.testing.assert_allclose(b["cycle_end"][-1], X0_M2, atol=1e-8)
+
+
+def test_open_path_is_closed_by_the_start(api):
+    """A path that does not end at k(x0) gets a return leg to k(x0)."""
+    b = api.post("/repeatability", json=_body(path=[[1.0, 1.0], [1.0, 2.0]])).json()
+    np.testing.assert_allclose(b["targets"], [[1.0, 1.0], [1.0, 2.0], [0.0, 1.0]], atol=1e-12)
+    assert len(b["legs"]) == 3
+
+
+def test_unicycle_like_defaults_come_from_the_registry(api):
+    """mode and gamma default to the robot's (continuous, 1 for the manipulators)."""
+    b = api.post(
+        "/repeatability",
+        json=_body(
+            robot={"name": "manipulator1"}, x0=[0.5, 0.5, 1.0], path=[[0.8, 1.0], [0.8, 1.6]]
+        ),
+    ).json()
+    assert b["mode"] == "continuous" and b["gamma"] == 1.0

@@ -1,0 +1,145 @@
+"""POST /solve: numbers, trajectories, defaults, and the batched path."""
+
+from __future__ import annotations
+
+import asyncio
+import math
+
+import httpx
+import numpy as np
+
+from app.main import create_app
+from app.service import Settings
+from tests.app.conftest import X0_M2, solve_body
+
+# Table 1, pseudoinverse column, first leg: x1f after (0, 1) -> (1, 1).
+X1F = [0.1132, 0.5379, 1.0904]
+
+
+def test_solve_pseudoinverse_manipulator2(api):
+    r = api.post("/solve", json=solve_body())
+    assert r.status_code == 200, r.text
+    b = r.json()
+    assert b["converged"] is True
+    assert b["message"].startswith("converged")
+    np.testing.assert_allclose(b["x"], X1F, atol=6e-5)
+    np.testing.assert_allclose(b["y"], [1.0, 1.0], atol=1e-9)
+    assert b["error"] < 1e-10
+    assert b["mode"] == "continuous" and b["gamma"] == 1.0
+    t = b["trajectory"]
+    m = len(t["theta"])
+    assert m == t["points"] > 10 and not t["downsampled"]
+    assert len(t["x"]) == len(t["y"]) == len(t["error"]) == m
+    assert t["h"] is None
+    np.testing.assert_allclose(t["x"][0], X0_M2)
+    assert t["error"][-1] == b["error"]
+    assert np.all(np.diff(t["theta"]) > 0)
+    # the task error decays like exp(-gamma theta), eq. (6)
+    e = np.array(t["error"])
+    np.testing.assert_allclose(e, e[0] * np.exp(-np.array(t["theta"])), rtol=1e-6, atol=1e-11)
+
+
+def test_solve_extended_keeps_h_constant(api):
+    """Extended inverse (11): h(x) is constant along the run, eq. (12)."""
+    r = api.post("/solve", json=solve_body(algorithm="extended"))
+    b = r.json()
+    assert r.status_code == 200 and b["converged"]
+    assert b["augmentation"] == {"name": "paper_cubic", "parameters": {}}
+    h = np.array(b["trajectory"]["h"])
+    assert h.shape == (len(b["trajectory"]["theta"]),)
+    assert np.ptp(h) < 1e-9
+
+
+def test_solve_manipulator1_with_parameters_and_discrete_mode(api):
+    body = {
+        "robot": {"name": "manipulator1"},
+        "algorithm": "extended",
+        "augmentation": {"name": "e1_optimal", "C1": 2.0},
+        "x0": [0.5, 0.5, 1.0],
+        "target": [0.8, 1.5],
+        "mode": "discrete",
+        "gamma": 0.5,
+        "tolerance": 1e-8,
+    }
+    b = api.post("/solve", json=body).json()
+    assert b["augmentation"] == {"name": "e1_optimal", "parameters": {"C1": 2.0, "C2": 1.0}}
+    assert b["mode"] == "discrete" and b["converged"]
+    assert b["error"] < 1e-8
+    # iterations are numbered 0, 1, 2, ...
+    np.testing.assert_allclose(b["trajectory"]["theta"], np.arange(len(b["trajectory"]["theta"])))
+    assert b["iterations"] == len(b["trajectory"]["theta"]) - 1
+
+
+def test_solve_not_converged_is_200_with_reason(api):
+    """A run that hits max_iterations is a result (converged false), not an error."""
+    b = api.post("/solve", json=solve_body(max_iterations=3)).json()
+    assert b["converged"] is False
+    assert "did not converge within 3 steps" in b["message"]
+
+
+def test_gamma_only_rescales_theta(api):
+    """Continuous mode: x(theta) does not depend on gamma, theta scales as 1/gamma (NOTES.md)."""
+    a = api.post("/solve", json=solve_body(gamma=1.0)).json()
+    b = api.post("/solve", json=solve_body(gamma=4.0)).json()
+    np.testing.assert_allclose(a["x"], b["x"], atol=1e-12)
+    np.testing.assert_allclose(np.array(a["trajectory"]["theta"]) / 4, b["trajectory"]["theta"])
+
+
+async def _concurrent(app, bodies):
+    transport = httpx.ASGITransport(app=app)
+    async with httpx.AsyncClient(transport=transport, base_url="http://test") as client:
+        return await asyncio.gather(*(client.post("/solve", json=b) for b in bodies))
+
+
+def test_concurrent_solves_are_batched_and_equal_to_single_solves(api):
+    """16 concurrent compatible requests share few engine calls; each result is its own."""
+    rng = np.random.default_rng(1)
+    targets = rng.uniform([0.2, 0.8], [1.2, 1.8], size=(16, 2))
+    bodies = [solve_body(target=t.tolist()) for t in targets]
+    app = create_app(Settings(workers=1, timeout=60.0, batch_window=0.005))
+    try:
+        responses = asyncio.run(_concurrent(app, bodies))
+        stats = app.state.pool.stats
+    finally:
+        app.state.pool.close()
+    assert [r.status_code for r in responses] == [200] * 16
+    assert stats["solve_requests"] == 16
+    assert stats["solve_calls"] <= 4, stats
+    for body, r in zip(bodies, responses, strict=True):
+        single = api.post("/solve", json=body).json()
+        np.testing.assert_allclose(r.json()["x"], single["x"], atol=1e-12)
+        np.testing.assert_allclose(r.json()["y"], body["target"], atol=1e-9)
+
+
+def test_unbatched_mode_makes_one_call_per_request():
+    bodies = [solve_body(target=[0.5 + 0.1 * i, 1.5]) for i in range(4)]
+    app = create_app(Settings(workers=1, timeout=60.0, batching=False))
+    try:
+        responses = asyncio.run(_concurrent(app, bodies))
+        stats = app.state.pool.stats
+    finally:
+        app.state.pool.close()
+    assert all(r.status_code == 200 for r in responses)
+    assert stats["solve_calls"] == stats["solve_requests"] == 4
+
+
+def test_a_bad_member_does_not_spoil_its_batch():
+    """One singular start among compatible requests: 422 for it, 200 for the others."""
+    good = {
+        "robot": {"name": "manipulator1"},
+        "algorithm": "extended",
+        "augmentation": {"name": "e2_optimal", "a": 1.0, "b": 0.0},
+        "x0": [0.5, 0.5, 1.0],
+        "target": [0.8, 1.5],
+    }
+    bad = {**good, "x0": [0.0, 0.5, 1.0]}  # dh K = 0 at x1 = -b/a = 0
+    app = create_app(Settings(workers=1, timeout=60.0, batch_window=0.01))
+    try:
+        responses = asyncio.run(_concurrent(app, [good, bad, good]))
+        stats = app.state.pool.stats
+    finally:
+        app.state.pool.close()
+    assert [r.status_code for r in responses] == [200, 422, 200]
+    assert stats["solve_calls"] == 1
+    assert "algorithmic singularity" in responses[1].json()["detail"][0]["msg"]
+    assert math.isclose(responses[0].json()["x"][0], 0.8, abs_tol=1e-9)
