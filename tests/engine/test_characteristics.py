@@ -200,3 +200,30 @@ def test_invalid_parameters(kin):
     with pytest.raises(InvalidInputError):
         UnicycleCharacteristics(kin).value([1.0, 2.0, 3.0])
     assert UnicycleCharacteristics(kin, a=2.0).parameters == {"a": 2.0}
+
+
+def _h_ode(kin, lam, rhs_kind, a=1.0):
+    y = np.array([lam[0] - a, lam[2], lam[3]])
+
+    def rhs(s, z):
+        w = one_form(kin, np.array([a + s * y[0], z[0], s * y[1], s * y[2]]), 1)
+        if rhs_kind == "printed":  # the right-hand side printed after (28)
+            return [w[0] * y[0] - w[3] * y[2]]
+        return [-(w[0] * y[0] + w[2] * y[1] + w[3] * y[2])]  # -F(Phi_s)/s from (28)
+
+    sol = solve_ivp(rhs, (1.0, 0.0), [lam[1]], method="DOP853", rtol=1e-12, atol=1e-12)
+    return sol.y[0, -1]
+
+
+@pytest.mark.parametrize("rhs_kind, holds", [("derived", True), ("printed", False)])
+def test_printed_rhs_after_28_violates_24(kin, rhs_kind, holds):
+    """(24) omega X = dh X / (dh/dz) holds for h from -F(Phi_s)/s, not from the printed RHS."""
+    x = np.array([1.5, 0.3, -0.4, 0.6])
+    eps = 1e-5
+    dh = np.array(
+        [(_h_ode(kin, x + eps * e, rhs_kind) - _h_ode(kin, x - eps * e, rhs_kind)) / (2 * eps)
+         for e in np.eye(4)]
+    )  # fmt: skip
+    X = np.array([x[0] - 1.0, 0.0, x[2], x[3]])
+    residual = abs(one_form(kin, x, 1) @ X - dh @ X / dh[1])
+    assert (residual < 1e-6) if holds else (residual > 0.1)  # printed: 0.26
