@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import signal
 import sys
 
 #: Reproductions: name -> module in engine.reproductions with run() and format_text().
@@ -52,6 +53,8 @@ def bench(args: argparse.Namespace) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
+    if hasattr(signal, "SIGPIPE"):  # `jik reproduce table1 | head` ends quietly
+        signal.signal(signal.SIGPIPE, signal.SIG_DFL)
     parser = argparse.ArgumentParser(
         prog="jik", description="jik: a lab for repeatable Jacobian inverse kinematics"
     )
@@ -64,8 +67,11 @@ def main(argv: list[str] | None = None) -> int:
     p.set_defaults(func=serve)
 
     p = sub.add_parser("reproduce", help="recompute a result of the paper")
-    p.add_argument("name", choices=sorted(REPRODUCTIONS), help="; ".join(
-        f"{k}: {v}" for k, v in REPRODUCTIONS.items()))
+    p.add_argument(
+        "name",
+        choices=sorted(REPRODUCTIONS),
+        help="; ".join(f"{k}: {v}" for k, v in REPRODUCTIONS.items()),
+    )
     p.add_argument("--json", action="store_true", help="print machine-readable JSON")
     p.add_argument(
         "--printed-gradient",

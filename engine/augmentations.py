@@ -152,7 +152,9 @@ class Polynomial2(AugmentingMap):
         variables: tuple[int, int] = (1, 2),
         p: int = 3,
     ) -> None:
-        self.coefficients = {(int(i), int(j)): finite(c, f"c{i}{j}") for (i, j), c in coefficients.items()}
+        self.coefficients = {
+            (int(i), int(j)): finite(c, f"c{i}{j}") for (i, j), c in coefficients.items()
+        }
         self.variables = variables
         self.p = p
 

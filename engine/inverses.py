@@ -1,4 +1,4 @@
-"""Right inverses of the Jacobian: the pseudoinverse, eq. (8), and the extended Jacobian inverse, eq. (11).
+"""Right inverses of the Jacobian: pseudoinverse, eq. (8), and extended Jacobian inverse, eq. (11).
 
 Pure linear-algebra functions work on Jacobians; the :class:`Inverse` classes bind them to a
 kinematics (and an augmenting map) and raise typed errors that name the configuration.
@@ -130,7 +130,9 @@ class Inverse(abc.ABC):
     def _raise_if(self, x: FloatArray, bad: FloatArray) -> None:
         bad = np.atleast_1d(bad)
         if np.any(bad):
-            raise self.singular_error(np.reshape(x, (-1, x.shape[-1]))[np.flatnonzero(bad.ravel())[0]])
+            raise self.singular_error(
+                np.reshape(x, (-1, x.shape[-1]))[np.flatnonzero(bad.ravel())[0]]
+            )
 
 
 class Pseudoinverse(Inverse):

@@ -98,7 +98,9 @@ class VectorSpec:
         try:
             v = tuple(finite(t, self.name) for t in value)
         except TypeError as exc:
-            raise InvalidInputError(f"{self.name} must be a list of {len(self.default)} numbers") from exc
+            raise InvalidInputError(
+                f"{self.name} must be a list of {len(self.default)} numbers"
+            ) from exc
         if len(v) != len(self.default):
             raise InvalidInputError(
                 f"{self.name} must have {len(self.default)} components, got {len(v)}"
@@ -144,7 +146,9 @@ class RobotSpec:
     default_augmentation: str = ""
 
     def build(self, **values) -> Kinematics:
-        scalars = {k: v for k, v in values.items() if k not in {p.name for p in self.vector_parameters}}
+        scalars = {
+            k: v for k, v in values.items() if k not in {p.name for p in self.vector_parameters}
+        }
         args = _check_params(self.parameters, scalars, self.name)
         for vp in self.vector_parameters:
             args[vp.name] = vp.check(values.get(vp.name, vp.default))
@@ -301,7 +305,7 @@ def make_inverse(
         return Pseudoinverse(kinematics)
     if algorithm == "extended":
         spec = robot_spec(robot or kinematics.name).augmentation(augmentation)
-        return ExtendedInverse(kinematics, spec.build(kinematics, **(augmentation_parameters or {})))
-    raise InvalidInputError(
-        f"algorithm must be 'pseudoinverse' or 'extended', got {algorithm!r}"
-    )
+        return ExtendedInverse(
+            kinematics, spec.build(kinematics, **(augmentation_parameters or {}))
+        )
+    raise InvalidInputError(f"algorithm must be 'pseudoinverse' or 'extended', got {algorithm!r}")

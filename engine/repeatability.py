@@ -54,11 +54,12 @@ class RepeatabilityResult:
 def closed_path(kinematics, x0: FloatArray, path: FloatArray) -> FloatArray:
     """Legs of one cycle: the path, closed by k(x0) when its last point differs (batched over x0).
 
+    ``path`` is (L, r), shared by all starts, or (n, L, r), one path per start.
     Returns shape (n, L, r) for x0 of shape (n, p).
     """
     home = kinematics.forward(x0)  # (n, r)
-    pts = np.broadcast_to(path, (len(x0), *path.shape))
-    if np.any(np.linalg.norm(path[-1] - home, axis=-1) > CLOSE_TOL):
+    pts = np.broadcast_to(path, (len(x0), *path.shape[-2:]))
+    if np.any(np.linalg.norm(pts[:, -1] - home, axis=-1) > CLOSE_TOL):
         pts = np.concatenate([pts, home[:, None, :]], axis=1)
     return pts
 
@@ -82,8 +83,9 @@ def repeatability(
     inverse : Inverse
     x0 : array_like, shape (p,) or (n, p)
         Start configuration(s); a batch runs every leg as one vectorized solve.
-    path : array_like, shape (L, r)
-        Task points visited in order; k(x0) is appended when the last point differs from it.
+    path : array_like, shape (L, r) or (n, L, r)
+        Task points visited in order (one path for all starts, or one per start); k(x0) is
+        appended when the last point differs from it.
     cycles : int
         1 to 1000.
     gamma, mode, tol, max_iterations
@@ -100,15 +102,19 @@ def repeatability(
     kin = inverse.kinematics
     x0 = kin.check(x0, "x0")
     path = kin.check_task(path, "path")
-    if path.ndim != 2 or len(path) < 1:
+    if path.ndim not in (2, 3) or path.shape[-2] < 1:
         raise InvalidInputError("path must be a list of task points, shape (L, r) with L >= 1")
-    if len(path) > MAX_PATH_POINTS:
-        raise InvalidInputError(f"path has {len(path)} points; at most {MAX_PATH_POINTS} allowed")
+    if path.shape[-2] > MAX_PATH_POINTS:
+        raise InvalidInputError(
+            f"path has {path.shape[-2]} points; at most {MAX_PATH_POINTS} allowed"
+        )
     cycles = count(cycles, "cycles", 1, MAX_CYCLES)
     single = x0.ndim == 1
     xb = np.atleast_2d(x0)
     if xb.ndim != 2:
         raise InvalidInputError("x0 must be one configuration or a 2-D batch")
+    if path.ndim == 3 and len(path) != len(xb):
+        raise InvalidInputError(f"{len(path)} paths given for {len(xb)} start configurations")
     targets = closed_path(kin, xb, path)  # (n, L, r)
     n, L = targets.shape[:2]
     legs = np.full((n, cycles * L, kin.p), np.nan)
@@ -143,7 +149,13 @@ def repeatability(
     drift = np.linalg.norm(cycle_end - xb[:, None, :], axis=-1)
     if single:
         return RepeatabilityResult(
-            xb[0], targets[0], legs[0], cycle_end[0], drift[0], bool(alive[0]), messages[0],
+            xb[0],
+            targets[0],
+            legs[0],
+            cycle_end[0],
+            drift[0],
+            bool(alive[0]),
+            messages[0],
             leg_results,
         )
     return RepeatabilityResult(xb, targets, legs, cycle_end, drift, alive, tuple(messages), [])

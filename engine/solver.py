@@ -1,9 +1,12 @@
 """The continuation (Wazewski-Davidenko) IK algorithm, eq. (7), batched over start configurations.
 
-Continuous mode integrates dx/dtheta = -gamma J#(x) (k(x) - y_d) with an embedded 8(5,3)
-Dormand-Prince pair (DOP853, the coefficients of SciPy's ``solve_ivp``), each batch member with its
-own adaptive step. It integrates in tau = gamma theta, so x(theta) does not depend on gamma at all:
-gamma only rescales theta (NOTES.md). Discrete mode iterates x <- x - gamma J#(x) (k(x) - y_d), as
+Continuous mode follows the trajectory of dx/dtheta = -gamma J#(x) (k(x) - y_d) with two
+adaptive high-order methods: Chebyshev-Picard iteration on the equivalent homotopy form (spectral,
+adaptive segments; :mod:`engine.picard`), and, where that cannot resolve the path or a very small
+tolerance needs it, an embedded 8(5,3) Dormand-Prince pair (DOP853, the coefficients of SciPy's
+``solve_ivp``) on (7) itself, each batch member with its own adaptive step. Both work in
+tau = gamma theta, so x(theta) does not depend on gamma at all: gamma only rescales theta
+(NOTES.md). Discrete mode iterates x <- x - gamma J#(x) (k(x) - y_d), as
 in section 6.2.
 """
 
@@ -16,6 +19,7 @@ from scipy.integrate._ivp import dop853_coefficients as _dop
 
 from engine.exceptions import InvalidInputError
 from engine.inverses import Inverse
+from engine.picard import picard_path
 from engine.validation import FloatArray, count, positive
 
 _NS = _dop.N_STAGES
@@ -152,18 +156,18 @@ def _initial_step(inverse, x, f, y_d, rtol, atol):
     return np.minimum(100 * h0, h1)
 
 
-def _continuous(inverse, x0, y_d, tol, max_steps, record, rtol=RTOL, atol=ATOL):
-    """Batched DOP853 on dx/dtau = -J# e until ||e|| < tol; see module docstring."""
+def _dop853(inverse, x0, y_d, tol, max_steps, record, tau0, rtol=RTOL, atol=ATOL):
+    """Batched DOP853 on dx/dtau = -J# e from tau = tau0 until ||e|| < tol."""
     n, p = x0.shape
     x = x0.copy()
-    tau = np.zeros(n)
+    tau = tau0.copy()
     f, e, bad = _rhs(inverse, x, y_d)
     err0 = np.linalg.norm(e, axis=-1)
     status = np.full(n, _RUNNING)
     status[bad] = _SINGULAR
     status[err0 < tol] = _CONVERGED
     # exp(-tau) decay: tau_needed = ln(err0 / tol); far past that the run has stalled.
-    tau_cap = np.log(np.maximum(err0, tol) / tol) + 40.0
+    tau_cap = tau0 + np.log(np.maximum(err0, tol) / tol) + 40.0
     h = _initial_step(inverse, x, f, y_d, rtol, atol)
     nsteps = np.zeros(n, dtype=int)
     last_bad = np.zeros(n, dtype=bool)
@@ -194,7 +198,9 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, rtol=RTOL, atol=ATOL):
             enorm = np.where(denom > 0, hs * err5 / np.sqrt(denom * p), 0.0)
             enorm = np.where(np.isfinite(enorm), enorm, np.inf)
             factor = np.where(
-                enorm == 0, _MAX_FACTOR, np.clip(_SAFETY * enorm**_EXPONENT, _MIN_FACTOR, _MAX_FACTOR)
+                enorm == 0,
+                _MAX_FACTOR,
+                np.clip(_SAFETY * enorm**_EXPONENT, _MIN_FACTOR, _MAX_FACTOR),
             )
         accept = (enorm < 1.0) & ~stage_bad
         factor = np.where(accept, factor, np.minimum(factor, 1.0))
@@ -219,6 +225,54 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, rtol=RTOL, atol=ATOL):
         status[run[np.linalg.norm(x[run], axis=-1) > DIVERGED_NORM]] = _DIVERGED
         status[run[(nsteps[run] >= max_steps) & (status[run] == _RUNNING)]] = _MAX_STEPS
     return x, tau, status, nsteps, rec
+
+
+def _continuous(inverse, x0, y_d, tol, max_steps, record):
+    """Chebyshev-Picard on the homotopy form (engine.picard), then DOP853 where needed.
+
+    Members that Picard integrates to sigma = 1 with error < tol are done. The others (an
+    unresolved path near a singularity, or an end-point error above a very small tol) continue
+    with DOP853 on (7) itself from their last point, at tau = -ln(1 - sigma) (or ln(e0 / e)).
+    """
+    n = len(x0)
+    e0 = inverse.kinematics.forward(x0) - y_d
+    err0 = np.linalg.norm(e0, axis=-1)
+    moving = np.flatnonzero(err0 >= tol)
+    x = x0.copy()
+    tau = np.zeros(n)
+    status = np.full(n, _CONVERGED)
+    nit = np.zeros(n, dtype=int)
+    rec = [(np.arange(n), tau.copy(), x.copy())] if record else None
+    if moving.size == 0:
+        return x, tau, status, nit, rec
+    x1, done, sigma, sweeps, prec = picard_path(inverse, x0[moving], e0[moving], max_steps)
+    nit[moving] = sweeps
+    if record:
+        for mem, sig, xs in prec:
+            keep = sig > 0
+            rec.append((moving[mem[keep]], -np.log1p(-sig[keep]), xs[keep]))
+    x[moving] = x1
+    err1 = np.linalg.norm(inverse.kinematics.forward(x1) - y_d[moving], axis=-1)
+    with np.errstate(divide="ignore"):
+        tau_end = np.where(
+            done,
+            np.log(err0[moving] / np.maximum(err1, 1e-3 * tol)),
+            -np.log1p(-np.minimum(sigma, 1 - 1e-16)),
+        )
+    tau[moving] = tau_end
+    good = done & (err1 < tol)
+    if record:
+        rec.append((moving[good], tau_end[good], x1[good]))
+    rest = moving[~good]
+    if rest.size:
+        xr, taur, st, steps, rrec = _dop853(
+            inverse, x1[~good], y_d[rest], tol, max_steps, record, tau_end[~good]
+        )
+        x[rest], tau[rest], status[rest] = xr, taur, st
+        nit[rest] += steps
+        if record:
+            rec.extend((rest[m], t, xs) for m, t, xs in rrec[1:])
+    return x, tau, status, nit, rec
 
 
 def _discrete(inverse, x0, y_d, gamma, tol, max_iterations, record):
@@ -253,7 +307,6 @@ def _discrete(inverse, x0, y_d, gamma, tol, max_iterations, record):
 
 
 def _message(status, nit, err, tol, mode, x, inverse, max_iterations) -> str:
-    from engine.exceptions import format_vector
 
     steps = "steps" if mode == "continuous" else "iterations"
     if status == _CONVERGED:
@@ -263,9 +316,8 @@ def _message(status, nit, err, tol, mode, x, inverse, max_iterations) -> str:
     if status == _SINGULAR:
         return str(inverse.singular_error(x)) + "; the run stopped there"
     if status == _DIVERGED:
-        return (
-            f"diverged after {nit} {steps} (error {err:.3g}); "
-            + ("lower gamma" if mode == "discrete" else "the target may be unreachable")
+        return f"diverged after {nit} {steps} (error {err:.3g}); " + (
+            "lower gamma" if mode == "discrete" else "the target may be unreachable"
         )
     if status == _STALLED:
         return (
@@ -294,7 +346,7 @@ def solve(
     Parameters
     ----------
     inverse : Inverse
-        :class:`~engine.inverses.Pseudoinverse` (8) or :class:`~engine.inverses.ExtendedInverse` (11).
+        The pseudoinverse (8) or the extended Jacobian inverse (11).
     x0 : array_like, shape (p,) or (n, p)
         Start configuration(s); a batch is solved in one vectorized run.
     y_d : array_like, shape (r,) or (n, r)
@@ -350,17 +402,19 @@ def solve(
             "|1 - gamma| per iteration near the solution"
         )
     default_cap = 20000 if mode == "continuous" else 2000
-    cap = count(default_cap if max_iterations is None else max_iterations, "max_iterations", 1, 10**6)
+    cap = count(
+        default_cap if max_iterations is None else max_iterations, "max_iterations", 1, 10**6
+    )
 
     _, bad = inverse.apply_masked(xb, kin.forward(xb) - yb)
     if np.any(bad):
         raise inverse.singular_error(xb[np.flatnonzero(bad)[0]])
 
     if mode == "continuous":
-        x, tau, status, nit, rec = _continuous(inverse, xb, yb, tol, cap, record)
+        x, _, status, nit, rec = _continuous(inverse, xb, yb, tol, cap, record)
         theta_scale = 1.0 / gamma
     else:
-        x, tau, status, nit, rec = _discrete(inverse, xb, yb, gamma, tol, cap, record)
+        x, _, status, nit, rec = _discrete(inverse, xb, yb, gamma, tol, cap, record)
         theta_scale = 1.0
     y = kin.forward(x)
     err = np.linalg.norm(y - yb, axis=-1)

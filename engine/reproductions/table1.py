@@ -1,4 +1,4 @@
-"""Table 1 of the paper: repeatability of Manipulator 2 on the closed path (1,1), (1,2), (0,2), (0,1).
+"""Table 1 of the paper: repeatability of Manipulator 2 on the path (1,1), (1,2), (0,2), (0,1).
 
 The pseudoinverse column is reproduced to four decimals. The extended column is what the cubic
 (38), as printed and with its exact gradient, gives; it differs from the printed column
@@ -58,7 +58,10 @@ def format_text(result: dict) -> str:
     """Table 1 laid out as in the paper, with the printed values beside ours."""
     labels = ["A  x0 ", "B  x1f", "C  x2f", "D  x3f", "A  x4f"]
     out = []
-    for alg, title in (("extended", "Extended Jacobian"), ("pseudoinverse", "Jacobian pseudoinverse")):
+    for alg, title in (
+        ("extended", "Extended Jacobian"),
+        ("pseudoinverse", "Jacobian pseudoinverse"),
+    ):
         extra = f" (augmentation {result['augmentation']})" if alg == "extended" else ""
         out.append(f"Algorithm: {title}{extra}")
         out.append(f"{'':8}{'x1':>9}{'x2':>9}{'x3':>9}   | printed{'':20}")

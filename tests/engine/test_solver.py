@@ -1,0 +1,137 @@
+import math
+
+import numpy as np
+import pytest
+
+from engine.augmentations import E2Optimal, PaperCubic
+from engine.exceptions import AlgorithmicSingularityError, InvalidInputError
+from engine.inverses import ExtendedInverse, Pseudoinverse
+from engine.kinematics import Manipulator1, Manipulator2
+from engine.reproductions.table1 import PRINTED
+from engine.reproductions.table1 import run as table1
+from engine.solver import solve
+
+X0 = np.array([0.0, 0.0, math.pi / 2])
+
+
+def test_table1_pseudoinverse_column_to_four_decimals():
+    """Table 1's pseudoinverse column, all twelve printed numbers."""
+    rows = np.array(table1()["pseudoinverse"])
+    np.testing.assert_allclose(rows, PRINTED["pseudoinverse"], atol=5e-5)
+
+
+def test_table1_extended_column_closes_the_path():
+    rows = np.array(table1()["extended"])
+    np.testing.assert_allclose(rows[-1], X0, atol=1e-9)
+
+
+@pytest.mark.parametrize("gamma", [0.05, 1.0, 30.0])
+def test_continuous_result_does_not_depend_on_gamma(gamma):
+    """gamma only rescales theta: same end point, theta scaled by 1/gamma."""
+    inv = Pseudoinverse(Manipulator2())
+    ref = solve(inv, X0, [1, 1], gamma=1.0)
+    res = solve(inv, X0, [1, 1], gamma=gamma)
+    np.testing.assert_allclose(res.x, ref.x, atol=1e-12)
+    np.testing.assert_allclose(res.trajectory.theta * gamma, ref.trajectory.theta, rtol=1e-12)
+
+
+def test_continuous_error_decays_exponentially_eq5():
+    """Along (7) the task error obeys e(theta) = e0 exp(-gamma theta), eq. (5)."""
+    res = solve(Pseudoinverse(Manipulator2()), X0, [0, 2], gamma=2.0)
+    tr = res.trajectory
+    assert res.success and res.error < 1e-10
+    np.testing.assert_allclose(
+        tr.error, tr.error[0] * np.exp(-2.0 * tr.theta), rtol=1e-7, atol=1e-12
+    )
+
+
+def test_extended_conserves_h_along_continuous_flow():
+    res = solve(ExtendedInverse(Manipulator2(), PaperCubic()), X0, [1, 1])
+    assert res.success
+    np.testing.assert_allclose(res.trajectory.h, res.trajectory.h[0], atol=1e-10)
+
+
+def test_discrete_mode_approaches_continuous_as_gamma_goes_to_zero():
+    """x <- x - gamma J# e is Euler's method for (7): its end point error is O(gamma)."""
+    inv = Pseudoinverse(Manipulator2())
+    ref = solve(inv, X0, [1, 1]).x
+    gaps = []
+    for gamma in (0.2, 0.1, 0.05, 0.025):
+        res = solve(inv, X0, [1, 1], gamma=gamma, mode="discrete", max_iterations=5000)
+        assert res.success, res.message
+        gaps.append(np.linalg.norm(res.x - ref))
+    ratios = np.array(gaps[:-1]) / np.array(gaps[1:])
+    assert np.all(ratios > 1.8) and np.all(ratios < 2.2), gaps
+    assert gaps[-1] < 5e-3
+
+
+def test_discrete_newton_step_converges_fast():
+    res = solve(Pseudoinverse(Manipulator2()), X0, [1, 1], gamma=1.0, mode="discrete")
+    assert res.success and res.nit < 10 and res.error < 1e-10
+
+
+def test_already_at_target_no_motion():
+    """Already at the target: no motion."""
+    kin = Manipulator2()
+    res = solve(Pseudoinverse(kin), X0, kin.forward(X0))
+    assert res.success and res.nit == 0 and "no motion" in res.message
+    np.testing.assert_array_equal(res.x, X0)
+
+
+def test_batch_equals_individual_solves():
+    kin = Manipulator1()
+    inv = ExtendedInverse(kin, E2Optimal(0.2, 1.0))
+    rng = np.random.default_rng(5)
+    x0 = rng.uniform(0, 1, (7, 3))
+    yd = kin.forward(x0) + rng.uniform(-0.5, 0.5, (7, 2))
+    batch = solve(inv, x0, yd)
+    assert np.all(batch.success)
+    for i in range(7):
+        one = solve(inv, x0[i], yd[i])
+        np.testing.assert_allclose(batch.x[i], one.x, atol=1e-9)
+        tr = batch[i].trajectory
+        np.testing.assert_allclose(tr.x[-1], batch.x[i])
+        assert tr.theta[0] == 0 and np.all(np.diff(tr.theta) > 0)
+
+
+def test_iteration_cap_gives_failure_with_message():
+    res = solve(
+        Pseudoinverse(Manipulator2()), X0, [1, 1], gamma=0.01, mode="discrete", max_iterations=3
+    )
+    assert not res.success
+    assert "did not converge within 3 iterations" in res.message
+
+
+def test_unreachable_pass_through_algorithmic_singularity_stops_with_message():
+    """(36) with a = 1, b = 0 is singular on x1 = 0: driving x1 across 0 must stop, not hang."""
+    inv = ExtendedInverse(Manipulator1(), E2Optimal(a=1.0, b=0.0))
+    res = solve(inv, [0.5, 0.2, 1.0], [-0.5, 0.2])
+    assert not res.success
+    assert "singular" in res.message or "stalled" in res.message
+
+
+def test_singular_start_raises_typed_error():
+    inv = ExtendedInverse(Manipulator1(), E2Optimal(a=1.0, b=0.0))
+    with pytest.raises(AlgorithmicSingularityError, match=r"x = \(0, 0.2, 1\)"):
+        solve(inv, [0.0, 0.2, 1.0], [1.0, 1.0])
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"x0": [0, 0]}, "x0 must have shape"),
+        ({"x0": [0, np.nan, 1]}, "x0 contains NaN"),
+        ({"y_d": [1, 2, 3]}, "target y_d must have shape"),
+        ({"y_d": [np.inf, 1]}, "NaN or infinite"),
+        ({"gamma": 0}, "gamma must be > 0"),
+        ({"gamma": -1}, "gamma must be > 0"),
+        ({"gamma": 2.5, "mode": "discrete"}, "gamma must be < 2"),
+        ({"mode": "magic"}, "mode must be"),
+        ({"tol": 0}, "tol must be > 0"),
+        ({"max_iterations": 0}, "max_iterations must be between"),
+    ],
+)
+def test_bad_input_is_rejected_with_a_clear_message(kwargs, match):
+    args = {"x0": X0, "y_d": [1, 1]} | kwargs
+    with pytest.raises(InvalidInputError, match=match):
+        solve(Pseudoinverse(Manipulator2()), args.pop("x0"), args.pop("y_d"), **args)
