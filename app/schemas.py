@@ -297,8 +297,8 @@ class SynthesizeRequest(BaseModel):
     region: dict[str, tuple[Bound, Bound]] | None = Field(
         None,
         max_length=3,
-        description="box {variable: [lo, hi]} (2 variables for a grid); default: the last two "
-        "variables over the robot's x_range",
+        description="box {variable: [lo, hi]} (2 or 3 variables); default: the robot's x_range "
+        "over all (at most 3) variables, over the last two for 'e2_variational'",
     )
     fixed: dict[str, FiniteFloat] | None = Field(
         None,

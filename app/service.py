@@ -419,8 +419,9 @@ def synthesis_methods() -> S.SynthesisMethodsResponse:
 
 def _region(spec: RobotSpec, req: S.SynthesizeRequest):
     names = list(spec.variable_names)
-    if req.region is None:  # the whole x_range box (the last three variables at most)
-        region = {n: tuple(spec.x_range[names.index(n)]) for n in names[-3:]}
+    if req.region is None:  # x_range box: all (<= 3) variables, or the last two to synthesize
+        keep = names[-2:] if req.method == "e2_variational" else names[-3:]
+        region = {n: tuple(spec.x_range[names.index(n)]) for n in keep}
     else:
         region = {k: (float(lo), float(hi)) for k, (lo, hi) in req.region.items()}
     for k, (lo, hi) in region.items():
@@ -601,7 +602,8 @@ _HANDLERS: dict[str, Callable[[Any], Any]] = {
 
 
 def _worker_main(conn) -> None:
-    """Loop of a worker process: (kind, payload) in, (status, result) out."""
+    """Worker process loop: say "ready", then (kind, payload) in, (status, result) out."""
+    conn.send(("ready", None))
     while True:
         try:
             kind, payload = conn.recv()
@@ -621,9 +623,11 @@ def _worker_main(conn) -> None:
 
 def _worker_entry(fd: int) -> None:
     """Entry point of a worker process started by :class:`_Worker` (``python -c``)."""
-    from multiprocessing.connection import Connection
-
     _worker_main(Connection(fd))
+
+
+#: Longest wait for a new worker to import the engine (not counted in a request's time limit).
+WORKER_BOOT_TIMEOUT = 120.0
 
 
 class _Worker:
@@ -641,9 +645,18 @@ class _Worker:
         )
         child.close()
         self.conn = Connection(parent.detach())
+        self.ready = False
+
+    def wait_ready(self) -> None:
+        if not self.ready:
+            if not self.conn.poll(WORKER_BOOT_TIMEOUT):
+                raise OSError("worker did not start")
+            self.conn.recv()
+            self.ready = True
 
     def call(self, kind: str, payload, timeout: float):
-        """Blocking round trip (runs in a thread); TimeoutError when it overruns."""
+        """Blocking round trip (runs in a thread); TimeoutError when the computation overruns."""
+        self.wait_ready()
         self.conn.send((kind, payload))
         if not self.conn.poll(max(timeout, 0.0)):
             raise TimeoutError
@@ -657,7 +670,11 @@ class _Worker:
 
 @dataclass(frozen=True)
 class Settings:
-    """How the API runs its computations (from the environment by :func:`settings_from_env`)."""
+    """How the API runs its computations (from the environment by :func:`settings_from_env`).
+
+    ``timeout`` bounds both phases of a request: waiting for a compute slot (then 503 "busy")
+    and the computation itself (then 503 "exceeded", and the worker is killed and replaced).
+    """
 
     workers: int = 2
     timeout: float = 20.0
@@ -678,20 +695,29 @@ def settings_from_env() -> Settings:
     )
 
 
+def _retrieve(future: asyncio.Future) -> None:
+    """Mark an abandoned request's exception as seen (no 'never retrieved' warning)."""
+    if not future.cancelled():
+        future.exception()
+
+
 @dataclass
 class _Pending:
     payload: dict
     future: asyncio.Future
     deadline: float
+    dispatched: bool = False
+    abandoned: bool = False
 
 
 class ComputePool:
     """Worker processes with a bound on concurrent computations and a time limit per request.
 
-    At most ``settings.workers`` computations run at once; a request that gets no worker before
-    its deadline, or whose computation overruns it, fails with :class:`ServiceUnavailable` (the
-    overrunning worker is killed and replaced). The asyncio side is rebuilt when it is used from
-    another event loop (test clients), the processes are kept.
+    At most ``settings.workers`` computations run at once. A request that gets no worker within
+    ``settings.timeout`` fails with :class:`ServiceUnavailable` ("busy"); a computation that runs
+    longer than ``settings.timeout`` is stopped by killing its worker (a new one replaces it) and
+    its requests fail with :class:`ServiceUnavailable` ("exceeded"). The asyncio side is rebuilt
+    when the pool is used from another event loop (test clients); the processes are kept.
     """
 
     def __init__(self, settings: Settings | None = None) -> None:
@@ -699,23 +725,24 @@ class ComputePool:
         self._workers: list[_Worker] = []
         self._lock = threading.Lock()
         self._threads = concurrent.futures.ThreadPoolExecutor(
-            max_workers=self.settings.workers, thread_name_prefix="jik-compute"
+            max_workers=self.settings.workers + 1, thread_name_prefix="jik-compute"
         )
         self._loop: asyncio.AbstractEventLoop | None = None
         self._idle: asyncio.Queue[_Worker] | None = None
         self._pending: dict[str, list[_Pending]] = {}
         self._tasks: set[asyncio.Task] = set()
         #: Engine calls made and requests served by them (for tests and the benchmark).
-        self.stats = {"solve_calls": 0, "solve_requests": 0, "timeouts": 0}
+        self.stats = {"solve_calls": 0, "solve_requests": 0, "busy": 0, "exceeded": 0}
 
     # -- lifecycle
     def start(self) -> None:
-        """Start the worker processes (idempotent)."""
+        """Start the worker processes (idempotent, non-blocking)."""
         with self._lock:
             while len(self._workers) < self.settings.workers:
                 self._workers.append(_Worker())
 
     def close(self) -> None:
+        """Stop every worker process."""
         with self._lock:
             for w in self._workers:
                 w.kill()
@@ -735,21 +762,28 @@ class ComputePool:
 
     async def warm_up(self) -> None:
         """Start the workers and wait until each has imported the engine."""
-        idle = self._bind()
-        deadline = self._loop.time() + 120.0
-        got = [await self._acquire(deadline) for _ in range(self.settings.workers)]
-        try:
-            await asyncio.gather(
-                *(
-                    self._loop.run_in_executor(self._threads, w.call, "ping", None, 120.0)
-                    for w in got
-                )
-            )
-        finally:
-            for w in got:
-                idle.put_nowait(w)
+        self._bind()
+        with self._lock:
+            workers = list(self._workers)
+        await asyncio.gather(
+            *(self._loop.run_in_executor(self._threads, w.wait_ready) for w in workers)
+        )
+
+    def _spawn(self, coro) -> asyncio.Task:
+        task = self._loop.create_task(coro)
+        self._tasks.add(task)
+        task.add_done_callback(self._tasks.discard)
+        return task
 
     # -- core
+    def _busy(self) -> ServiceUnavailable:
+        self.stats["busy"] += 1
+        return ServiceUnavailable(
+            f"server busy: no compute slot became free within the time limit of "
+            f"{self.settings.timeout:g} s ({self.settings.workers} computations run at once); "
+            "retry later"
+        )
+
     async def _acquire(self, deadline: float) -> _Worker:
         idle = self._bind()
         remaining = deadline - self._loop.time()
@@ -758,26 +792,22 @@ class ComputePool:
                 raise TimeoutError
             return await asyncio.wait_for(idle.get(), remaining)
         except TimeoutError:
-            self.stats["timeouts"] += 1
-            raise ServiceUnavailable(
-                f"server busy: no compute slot became free within the time limit of "
-                f"{self.settings.timeout:g} s ({self.settings.workers} computations run at once); "
-                "retry later"
-            ) from None
+            raise self._busy() from None
 
-    async def _call(self, worker: _Worker, kind: str, payload, deadline: float):
+    async def _dispatch(self, worker: _Worker, kind: str, payload):
+        """Run one computation on ``worker``; it is killed if it overruns the time limit."""
         loop = self._loop
         try:
             msg = await loop.run_in_executor(
-                self._threads, worker.call, kind, payload, deadline - loop.time()
+                self._threads, worker.call, kind, payload, self.settings.timeout
             )
         except TimeoutError:
-            self.stats["timeouts"] += 1
+            self.stats["exceeded"] += 1
             self._replace(worker)
             raise ServiceUnavailable(
                 f"the computation exceeded the time limit of {self.settings.timeout:g} s and "
                 "was stopped; ask for less work (fewer cycles or path points, a lower "
-                "max_iterations, a smaller grid)"
+                "max_iterations, a smaller grid or degree)"
             ) from None
         except (EOFError, OSError) as exc:
             self._replace(worker)
@@ -804,11 +834,10 @@ class ComputePool:
         raise ComputeError(value)
 
     async def run(self, kind: str, payload) -> Any:
-        """Run handler ``kind`` on ``payload`` in a worker, within the time limit."""
+        """Run handler ``kind`` on ``payload`` in a worker (waits and runs within the limits)."""
         self._bind()
-        deadline = self._loop.time() + self.settings.timeout
-        worker = await self._acquire(deadline)
-        return self._unwrap(await self._call(worker, kind, payload, deadline))
+        worker = await self._acquire(self._loop.time() + self.settings.timeout)
+        return self._unwrap(await self._dispatch(worker, kind, payload))
 
     # -- micro-batched solves
     async def solve(self, req: S.SolveRequest) -> dict:
@@ -821,58 +850,55 @@ class ComputePool:
             (res,) = await self.run("solve", [payload])
             return self._unwrap(res)
         loop = self._loop
-        deadline = loop.time() + self.settings.timeout
+        entry = _Pending(payload, loop.create_future(), loop.time() + self.settings.timeout)
+        entry.future.add_done_callback(_retrieve)
         key = batch_key(req)
-        fut = loop.create_future()
         queue = self._pending.setdefault(key, [])
-        queue.append(_Pending(payload, fut, deadline))
+        queue.append(entry)
         if len(queue) == 1:
-            task = loop.create_task(self._flush(key, first=True))
-            self._tasks.add(task)
-            task.add_done_callback(self._tasks.discard)
+            self._spawn(self._flush(key, first=True))
         try:
-            return self._unwrap(await asyncio.wait_for(fut, deadline - loop.time()))
+            return self._unwrap(
+                await asyncio.wait_for(asyncio.shield(entry.future), entry.deadline - loop.time())
+            )
         except TimeoutError:
-            self.stats["timeouts"] += 1
-            raise ServiceUnavailable(
-                f"the solve did not finish within the time limit of {self.settings.timeout:g} s "
-                "(server overloaded or a very long run); retry later or lower max_iterations"
-            ) from None
+            if entry.dispatched:  # computing: bounded by the computation's own time limit
+                return self._unwrap(await entry.future)
+            entry.abandoned = True
+            raise self._busy() from None
 
     async def _flush(self, key: str, first: bool) -> None:
-        loop = self._loop
         if first and self.settings.batch_window > 0:
             await asyncio.sleep(self.settings.batch_window)
-        queue = self._pending.get(key, [])
+        queue = [p for p in self._pending.get(key, []) if not p.abandoned]
         if not queue:
+            self._pending.pop(key, None)
             return
         try:
             worker = await self._acquire(max(p.deadline for p in queue))
-        except ServiceUnavailable as exc:
+        except ServiceUnavailable:
             for p in self._pending.pop(key, []):
+                p.abandoned = True
                 if not p.future.done():
-                    p.future.set_exception(exc)
+                    p.future.set_exception(self._busy())
             return
         # Everything compatible that arrived while we waited for the worker joins the batch.
-        queue = [p for p in self._pending.pop(key, []) if not p.future.done()]
+        queue = [p for p in self._pending.pop(key, []) if not p.abandoned]
         items, rest = queue[: self.settings.max_batch], queue[self.settings.max_batch :]
         if rest:
             self._pending[key] = rest
-            task = loop.create_task(self._flush(key, first=False))
-            self._tasks.add(task)
-            task.add_done_callback(self._tasks.discard)
+            self._spawn(self._flush(key, first=False))
         if not items:
             self._idle.put_nowait(worker)
             return
+        for p in items:
+            p.dispatched = True
         self.stats["solve_calls"] += 1
         self.stats["solve_requests"] += len(items)
         try:
-            status, results = await self._call(
-                worker, "solve", [p.payload for p in items], max(p.deadline for p in items)
-            )
-            if status != "ok":
-                raise ComputeError(results) if status == "error" else RequestError(*results)
-        except Exception as exc:  # handed to every waiting request
+            msg = await self._dispatch(worker, "solve", [p.payload for p in items])
+            results = self._unwrap(msg)
+        except Exception as exc:  # handed to every request of the batch
             for p in items:
                 if not p.future.done():
                     p.future.set_exception(exc)

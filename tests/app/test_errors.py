@@ -42,7 +42,7 @@ def _rep(**over) -> dict:
         (solve_body(gamma=-1.5), "gamma: Input should be greater than 0"),
         (solve_body(mode="discrete", gamma=2.5), "gamma: must be < 2 in discrete mode"),
         (solve_body(mode="sideways"), "mode: Input should be 'continuous' or 'discrete'"),
-        (solve_body(tolerance=0), "tolerance: Input should be greater than or equal to 0.0000000000000"),
+        (solve_body(tolerance=0), "tolerance: Input should be greater than or equal to 0.000"),
         (solve_body(max_iterations=0), "max_iterations: Input should be greater than or equal"),
         (solve_body(max_iterations=10**7), "max_iterations: Input should be less than or equal"),
         (solve_body(extra=1), "extra: unknown field; remove it"),

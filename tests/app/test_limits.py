@@ -1,0 +1,86 @@
+"""Heavy work runs off the event loop, with a bound on concurrency and a time limit (503)."""
+
+from __future__ import annotations
+
+import asyncio
+import time
+
+import httpx
+
+from app.main import create_app
+from app.service import Settings
+from tests.app.conftest import TABLE1_PATH, X0_M2, solve_body
+
+HEAVY = {
+    "robot": {"name": "manipulator2"},
+    "algorithm": "pseudoinverse",
+    "x0": X0_M2,
+    "path": TABLE1_PATH,
+    "cycles": 1000,  # ~4000 solves: far beyond a 1.5 s limit
+}
+
+
+def _client(app) -> httpx.AsyncClient:
+    transport = httpx.ASGITransport(app=app)
+    return httpx.AsyncClient(transport=transport, base_url="http://test", timeout=60)
+
+
+async def _overrun(app):
+    async with _client(app) as c:
+        await app.state.pool.warm_up()
+        heavy = asyncio.create_task(c.post("/repeatability", json=HEAVY))
+        await asyncio.sleep(0.2)
+        queued = asyncio.create_task(c.post("/solve", json=solve_body()))
+        health = []
+        while not heavy.done():
+            t = time.perf_counter()
+            r = await c.get("/health")
+            health.append((r.status_code, time.perf_counter() - t))
+            await asyncio.sleep(0.05)
+        return await heavy, await queued, health
+
+
+def test_overrun_is_stopped_and_health_stays_responsive():
+    """A 1000-cycle run overruns its 1.5 s limit: 503, its worker is killed and replaced, and
+    the solve queued behind it is then served. /health answers quickly throughout."""
+    app = create_app(Settings(workers=1, timeout=1.5))
+    try:
+        heavy, queued, health = asyncio.run(_overrun(app))
+        stats = app.state.pool.stats
+    finally:
+        app.state.pool.close()
+    assert heavy.status_code == 503
+    assert "exceeded the time limit of 1.5 s and was stopped" in heavy.json()["detail"]
+    assert heavy.headers["retry-after"] == "1"
+    assert stats["exceeded"] == 1
+    assert queued.status_code == 200 and queued.json()["converged"]
+    assert len(health) >= 5
+    assert all(code == 200 for code, _ in health)
+    assert max(dt for _, dt in health) < 0.5
+
+
+async def _held(app):
+    async with _client(app) as c:
+        pool = app.state.pool
+        await pool.warm_up()
+        worker = await pool._acquire(pool._loop.time() + 5)  # every slot taken
+        try:
+            solve = asyncio.create_task(c.post("/solve", json=solve_body()))
+            rep = asyncio.create_task(c.post("/repeatability", json={**HEAVY, "cycles": 1}))
+            health = await c.get("/health")
+            return await solve, await rep, health
+        finally:
+            pool._idle.put_nowait(worker)
+
+
+def test_no_free_slot_is_busy_503():
+    """Every worker busy for longer than the limit: 503 'server busy' for each request kind."""
+    app = create_app(Settings(workers=1, timeout=0.5))
+    try:
+        solve, rep, health = asyncio.run(_held(app))
+    finally:
+        app.state.pool.close()
+    assert health.status_code == 200
+    for r in (solve, rep):
+        assert r.status_code == 503
+        assert r.json()["detail"].startswith("server busy: no compute slot became free within")
