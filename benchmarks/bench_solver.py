@@ -1,0 +1,133 @@
+"""Solver speed: jik's continuous mode against straightforward ``solve_ivp`` code, same tolerance.
+
+1. One continuous leg of Manipulator 2 (Table 1's first leg, pseudoinverse): ``engine.solver.solve``
+   against ``solve_ivp`` (default RK45, and DOP853 for reference) with rtol = atol = 1e-12 and a
+   terminal event at task error 1e-10.
+2. 4096 start configurations through Table 1's four-leg path: one batched
+   ``engine.repeatability.repeatability`` call against the straightforward code run leg by leg
+   (a subset of starts, timed per leg).
+"""
+
+from __future__ import annotations
+
+import math
+import statistics
+import time
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from engine.inverses import Pseudoinverse
+from engine.kinematics import Manipulator2
+from engine.repeatability import repeatability
+from engine.solver import ATOL, RTOL, solve
+
+X0 = np.array([0.0, 0.0, math.pi / 2])
+PATH = np.array([(1.0, 1.0), (1.0, 2.0), (0.0, 2.0), (0.0, 1.0)])
+TOL = 1e-10
+
+
+def straightforward_leg(kin, x0, y_d, method="RK45"):
+    """The textbook implementation: solve_ivp on (7) until ||e|| < TOL, gamma = 1."""
+
+    def f(_t, x):
+        J = kin.jacobian(x)
+        return -J.T @ np.linalg.solve(J @ J.T, kin.forward(x) - y_d)
+
+    def reached(_t, x):
+        return np.linalg.norm(kin.forward(x) - y_d) - TOL
+
+    reached.terminal = True
+    sol = solve_ivp(f, (0, 200), x0, method=method, rtol=RTOL, atol=ATOL, events=reached)
+    return sol.y[:, -1]
+
+
+def median_time(fn, repeat: int) -> float:
+    times = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t)
+    return statistics.median(times)
+
+
+def run(quick: bool = False) -> dict:
+    kin = Manipulator2()
+    inv = Pseudoinverse(kin)
+    rep = 5 if quick else 21
+    y_d = PATH[0]
+    ours = median_time(lambda: solve(inv, X0, y_d, record=False), rep)
+    rk45 = median_time(lambda: straightforward_leg(kin, X0, y_d), max(3, rep // 4))
+    dop = median_time(lambda: straightforward_leg(kin, X0, y_d, "DOP853"), max(3, rep // 4))
+    gap = np.linalg.norm(solve(inv, X0, y_d).x - straightforward_leg(kin, X0, y_d, "DOP853"))
+
+    n = 512 if quick else 4096
+    rng = np.random.default_rng(0)
+    # Starts on the self-motion manifold k(x0) = (0, 1) of Table 1's x0, so that every start
+    # runs exactly the four legs (1,1), (1,2), (0,2), (0,1).
+    x3 = rng.uniform(1.0, 2.1, n)
+    starts = np.column_stack([1.0 - np.sin(x3), -np.cos(x3), x3])
+    t = time.perf_counter()
+    res = repeatability(inv, starts, PATH, cycles=1)
+    batch_total = time.perf_counter() - t
+    legs = len(res.targets[0])
+    batch_per_leg = batch_total / (n * legs)
+    sub = 4 if quick else 16
+    per_leg = []
+    for x in starts[:sub]:
+        cur = x
+        for y in res.targets[0]:
+            t = time.perf_counter()
+            cur = straightforward_leg(kin, cur, y)
+            per_leg.append(time.perf_counter() - t)
+    straight_leg = statistics.median(per_leg)
+    ref = np.array(
+        [straightforward_leg(kin, starts[0], y) for y in res.targets[0][:1]]
+    )  # same first leg
+    return {
+        "single_leg": {
+            "jik_ms": 1e3 * ours,
+            "solve_ivp_rk45_ms": 1e3 * rk45,
+            "solve_ivp_dop853_ms": 1e3 * dop,
+            "ratio_rk45": rk45 / ours,
+            "ratio_dop853": dop / ours,
+            "end_point_difference": float(gap),
+        },
+        "batch": {
+            "starts": n,
+            "legs": legs,
+            "succeeded": int(np.sum(res.success)),
+            "jik_total_s": batch_total,
+            "jik_per_leg_ms": 1e3 * batch_per_leg,
+            "straightforward_per_leg_ms": 1e3 * straight_leg,
+            "straightforward_sample": sub * legs,
+            "ratio": straight_leg / batch_per_leg,
+            "first_leg_difference": float(np.linalg.norm(res.legs[0, 0] - ref[0])),
+        },
+    }
+
+
+def main(quick: bool = False) -> dict:
+    r = run(quick)
+    s, b = r["single_leg"], r["batch"]
+    print("One continuous leg of Manipulator 2 (tol 1e-10, rtol = atol = 1e-12), medians:")
+    print(f"  jik solve               {s['jik_ms']:9.2f} ms")
+    for name, key in (("RK45", "rk45"), ("DOP853", "dop853")):
+        ms, ratio = s[f"solve_ivp_{key}_ms"], s[f"ratio_{key}"]
+        print(f"  solve_ivp {name:<14}{ms:9.2f} ms   ratio {ratio:6.1f}x")
+    print(f"  |x_jik - x_dop853|      {s['end_point_difference']:.2e}")
+    print(f"{b['starts']} starts through Table 1's {b['legs']}-leg path (pseudoinverse):")
+    print(
+        f"  jik batched             {b['jik_total_s']:9.2f} s total, "
+        f"{b['jik_per_leg_ms']:.4f} ms per start per leg ({b['succeeded']} succeeded)"
+    )
+    print(
+        f"  straightforward         {b['straightforward_per_leg_ms']:9.2f} ms per leg "
+        f"(median of {b['straightforward_sample']} legs)   ratio {b['ratio']:7.0f}x"
+    )
+    print(f"  |first leg jik - solve_ivp| {b['first_leg_difference']:.2e}")
+    return r
+
+
+if __name__ == "__main__":
+    main()
