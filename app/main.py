@@ -2,9 +2,11 @@
 
 Errors have one shape. Bad input (pydantic validation, or the engine refusing it) is HTTP 422 in
 FastAPI's list format, ``{"detail": [{"loc": ["body", <field>...], "msg": "<field>: <problem>",
-"type": ...}]}``, the message always starting with the field. A request that cannot be served in
-time is 503 ``{"detail": "..."}`` (with Retry-After); anything unexpected is 500
-``{"detail": "internal error: ..."}``, never an HTML page or a dropped connection.
+"type": ...}]}``, the message always starting with the field; so is a computation stopped at the
+time limit (the field that sizes the work, e.g. ``cycles``). A request that finds no free compute
+slot within the time limit is 503 ``{"detail": "server busy: ..."}`` with Retry-After; anything
+unexpected is 500 ``{"detail": "internal error: ..."}``, never an HTML page or a dropped
+connection.
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 
-from app.routers import health, repeatability, robots, solve, synthesize
+from app.routers import dashboard, health, repeatability, robots, solve, synthesize
 from app.schemas import AUGMENTATION_MODELS, ROBOT_MODELS
 from app.service import ComputeError, ComputePool, RequestError, ServiceUnavailable, Settings
 
@@ -106,5 +108,5 @@ def create_app(settings: Settings | None = None) -> FastAPI:
 
     for module in (health, robots, solve, repeatability, synthesize):
         app.include_router(module.router)
-    # Dashboard: app.include_router(...) goes here.
+    app.include_router(dashboard.router)
     return app

@@ -21,5 +21,9 @@ def run_server(host: str = "127.0.0.1", port: int = 8000, scene_port: int = 8080
     """
     app = create_app()
     # --- dashboard: start the viser scene on scene_port here (2-3 lines) -----------------
+    from app.routers.dashboard import dashboard_for
+    from app.scene import start_scene
+
+    app.state.scene_port = start_scene(dashboard_for(app), host, scene_port).port
     # ---------------------------------------------------------------------------------------
     uvicorn.run(app, host=host, port=port, log_level="info", access_log=False)

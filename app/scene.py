@@ -1,0 +1,774 @@
+"""The dashboard's 3D scene in viser: both algorithms as mechanisms, animated, with a GUI.
+
+The scene only reads the dashboard's results and writes to scene handles; its GUI (built from
+the registry) and the draggable start point change the one :class:`~app.dashboard.Dashboard`
+state, exactly like the page's controls. The task plane is the world XY plane (z up).
+
+Drawn mechanisms
+----------------
+- Manipulator 2 (37): an XY gantry, a beam at height x1 on two rails, a carriage at x2 on the
+  beam, and a revolute arm of length l at angle x3; the end effector is the task point.
+- Manipulator 1 (30), schematic of its normal form k(x) = (x1, x2 + x1 x3): a slider at height
+  x2 on the vertical guide, a lever of slope x3 pivoting on it, and a vertical runner at x1;
+  the task point W = (x1, x2 + x1 x3) is where the lever crosses the runner.
+- The unicycle (40): a platform with two wheels and a heading nose at the pose q(t).
+
+The pseudoinverse is the translucent red ghost, the extended Jacobian the solid blue robot (the
+colours of every plot); the grey ghost is the start configuration x0.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import threading
+import time
+
+import numpy as np
+import viser
+
+from app.dashboard import ALGORITHMS, COLORS, MAX_DASHBOARD_CYCLES, Dashboard, Event
+from engine.exceptions import InvalidInputError
+from engine.registry import ROBOTS, robot_spec
+
+FPS = 25.0
+#: Seconds of animation per leg (manipulators) or per shown iteration (unicycle) at speed 1.
+SECONDS_PER_LEG = 1.6
+#: Unicycle iterations shown in the animation (geometrically spaced, the last always).
+UNICYCLE_SHOWN = 10
+_Z = {"pseudoinverse": 0.10, "extended": 0.0}
+_OPACITY = {"pseudoinverse": 0.55, "extended": None}
+HOME_COLOR = (150, 150, 150)
+
+
+def _rgb(hex_color: str) -> tuple[int, int, int]:
+    h = hex_color.lstrip("#")
+    return int(h[0:2], 16), int(h[2:4], 16), int(h[4:6], 16)
+
+
+def yaw_quaternion(angle: float) -> tuple[float, float, float, float]:
+    """wxyz of a rotation by ``angle`` [rad] about the z axis."""
+    return (math.cos(angle / 2), 0.0, 0.0, math.sin(angle / 2))
+
+
+def quaternion_yaw(wxyz) -> float:
+    """Rotation about z of a quaternion (its other rotations are ignored)."""
+    w, x, y, z = (float(v) for v in wxyz)
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+# -- the start point as a draggable pose, and back --------------------------------------------
+def gizmo_pose(robot: str, x0, robot_parameters: dict) -> tuple[tuple[float, float], float]:
+    """Where the start-point gizmo sits: ((X, Y), yaw) in the task plane.
+
+    Manipulator 2: the carriage (x2, x1), yaw x3. Manipulator 1: the task point
+    W = (x1, x2 + x1 x3), yaw atan(x3) (the lever's slope). Unicycle: the initial pose q0.
+    """
+    if robot == "manipulator2":
+        return (x0[1], x0[0]), x0[2]
+    if robot == "manipulator1":
+        return (x0[0], x0[1] + x0[0] * x0[2]), math.atan(x0[2])
+    q0 = robot_parameters["q0"]
+    return (q0[0], q0[1]), q0[2]
+
+
+def start_from_gizmo(robot: str, xy, yaw: float, state) -> dict:
+    """The dashboard change for a gizmo moved to ``xy`` with rotation ``yaw`` (inverse of above).
+
+    Manipulator 1 keeps x3 = tan(yaw) within a slope of +-20 (the lever cannot turn vertical).
+    """
+    X, Y = float(xy[0]), float(xy[1])
+    if robot == "manipulator2":
+        x3 = float(state.x0[2]) + math.remainder(yaw - float(state.x0[2]), 2 * math.pi)
+        return {"x0": [Y, X, x3]}
+    if robot == "manipulator1":
+        x3 = math.tan(max(-1.52, min(1.52, yaw)))
+        return {"x0": [X, Y - X * x3, x3]}
+    q0 = list(state.robot_parameters["q0"])
+    q3 = q0[2] + math.remainder(yaw - q0[2], 2 * math.pi)
+    return {"robot_parameters": {"q0": [X, Y, q3]}}
+
+
+# -- animation timelines ------------------------------------------------------------------------
+class Timeline:
+    """Configurations of both algorithms as functions of one playback position s in [0, length]."""
+
+    def __init__(self, result) -> None:
+        self.result = result
+        self.unicycle = any(r.platform is not None for r in result.runs.values())
+        if self.unicycle:
+            m = min(len(r.platform) for r in result.runs.values())
+            shown = np.unique(np.geomspace(1, m, num=UNICYCLE_SHOWN).astype(int) - 1)
+            self.shown = np.union1d(shown, [0, m - 1]).astype(int)
+            self.length = float(len(self.shown))
+        else:
+            self.theta_end = max(float(r.theta[-1]) for r in result.runs.values())
+            legs = int(max(r.leg.max() for r in result.runs.values())) + 1
+            self.leg_theta = self.theta_end / legs
+            self.length = float(legs)
+
+    def at(self, s: float) -> dict[str, np.ndarray]:
+        """Per algorithm: the configuration x (manipulators) or pose q (unicycle) at ``s``."""
+        s = min(max(s, 0.0), self.length)
+        out = {}
+        if self.unicycle:
+            i = min(int(s), len(self.shown) - 1)
+            frac = s - i if s < self.length else 1.0
+            for a, run in self.result.runs.items():
+                P = run.platform[min(self.shown[i], len(run.platform) - 1)]
+                j = frac * (len(P) - 1)
+                j0 = min(int(j), len(P) - 2)
+                out[a] = P[j0] + (j - j0) * (P[j0 + 1] - P[j0])
+            return out
+        theta = s * self.leg_theta
+        for a, run in self.result.runs.items():
+            out[a] = np.array(
+                [np.interp(theta, run.theta, run.x[:, k]) for k in range(run.x.shape[1])]
+            )
+        return out
+
+    def iteration(self, s: float) -> int | None:
+        if not self.unicycle:
+            return None
+        return int(self.shown[min(int(s), len(self.shown) - 1)])
+
+
+# -- mechanisms ---------------------------------------------------------------------------------
+class _Mechanism:
+    """Scene nodes of one robot copy (one algorithm, or the grey start ghost)."""
+
+    def __init__(self, scene, root: str, color, opacity, z: float, state, extent) -> None:
+        self.scene, self.root, self.color, self.opacity, self.z = scene, root, color, opacity, z
+        self.state, self.extent = state, extent
+        self.build()
+
+    def box(self, name, dims, position=(0.0, 0.0, 0.0), wxyz=(1.0, 0.0, 0.0, 0.0), color=None):
+        return self.scene.add_box(
+            f"{self.root}/{name}",
+            color=color or self.color,
+            dimensions=dims,
+            opacity=self.opacity,
+            position=position,
+            wxyz=wxyz,
+            cast_shadow=False,
+        )
+
+    def ball(self, name, radius, position=(0.0, 0.0, 0.0), color=None):
+        return self.scene.add_icosphere(
+            f"{self.root}/{name}",
+            radius=radius,
+            color=color or self.color,
+            opacity=self.opacity,
+            position=position,
+            cast_shadow=False,
+            subdivisions=2,
+        )
+
+    def build(self) -> None: ...
+
+    def pose(self, x) -> None: ...
+
+
+class _Gantry(_Mechanism):
+    """Manipulator 2: XY gantry (prismatic x1 vertical, x2 horizontal) with a revolute arm."""
+
+    def build(self) -> None:
+        (lo, hi), _ = self.extent
+        self.span = (lo, hi)
+        self.l = float(self.state.robot_parameters["l"])
+        self.beam = self.box("beam", (hi - lo, 0.07, 0.05))
+        self.carriage = self.scene.add_frame(f"{self.root}/carriage", show_axes=False)
+        self.box("carriage/body", (0.2, 0.2, 0.09))
+        self.ball("carriage/joint", 0.06, (0.0, 0.0, 0.07), color=(40, 40, 40))
+        self.box("carriage/arm", (self.l, 0.06, 0.04), (self.l / 2, 0.0, 0.07))
+        self.ball("carriage/effector", 0.07, (self.l, 0.0, 0.07))
+
+    def pose(self, x) -> None:
+        lo, hi = self.span
+        self.beam.position = ((lo + hi) / 2, float(x[0]), self.z)
+        self.carriage.position = (float(x[1]), float(x[0]), self.z + 0.05)
+        self.carriage.wxyz = yaw_quaternion(float(x[2]))
+
+
+class _NormalForm(_Mechanism):
+    """Manipulator 1 (30): slider x2 on the vertical guide, lever of slope x3, runner at x1."""
+
+    def build(self) -> None:
+        _, (lo, hi) = self.extent
+        self.runner = self.box("runner", (0.05, hi - lo, 0.04))
+        self.runner_span = (lo, hi)
+        self.slider = self.box("slider", (0.18, 0.14, 0.08))
+        self.lever = self.scene.add_frame(f"{self.root}/lever", show_axes=False)
+        self.box("lever/bar", (6.0, 0.045, 0.03), (0.0, 0.0, 0.05))
+        self.ball("lever/pivot", 0.06, (0.0, 0.0, 0.05), color=(40, 40, 40))
+        self.point = self.ball("W", 0.08)
+
+    def pose(self, x) -> None:
+        x1, x2, x3 = (float(v) for v in x)
+        lo, hi = self.runner_span
+        self.runner.position = (x1, (lo + hi) / 2, self.z)
+        self.slider.position = (0.0, x2, self.z)
+        self.lever.position = (0.0, x2, self.z)
+        self.lever.wxyz = yaw_quaternion(math.atan(x3))
+        self.point.position = (x1, x2 + x1 * x3, self.z + 0.08)
+
+
+class _Platform(_Mechanism):
+    """The unicycle: a wheeled platform at pose (q1, q2, q3), nose pointing along the heading."""
+
+    def build(self) -> None:
+        self.frame = self.scene.add_frame(f"{self.root}/platform", show_axes=False)
+        self.box("platform/body", (0.7, 0.45, 0.18), (0.0, 0.0, 0.2))
+        self.box("platform/nose", (0.3, 0.12, 0.08), (0.45, 0.0, 0.2))
+        axle = (math.cos(math.pi / 4), math.sin(math.pi / 4), 0.0, 0.0)  # cylinder axis -> y
+        for side in (-1, 1):
+            self.scene.add_cylinder(
+                f"{self.root}/platform/wheel{side}",
+                radius=0.16,
+                height=0.08,
+                color=(50, 50, 50),
+                opacity=self.opacity,
+                position=(0.0, side * 0.28, 0.16),
+                wxyz=axle,
+                cast_shadow=False,
+            )
+
+    def pose(self, q) -> None:
+        self.frame.position = (float(q[0]), float(q[1]), self.z)
+        self.frame.wxyz = yaw_quaternion(float(q[2]))
+
+
+_MECHANISMS = {"manipulator1": _NormalForm, "manipulator2": _Gantry}
+
+
+def _polyline(points: np.ndarray) -> np.ndarray:
+    """(n, 3) points -> (n - 1, 2, 3) segments."""
+    return np.stack([points[:-1], points[1:]], axis=1)
+
+
+# -- the scene ----------------------------------------------------------------------------------
+class DashboardScene:
+    """A viser server showing the dashboard's current result and editing its state.
+
+    Parameters
+    ----------
+    dashboard : Dashboard
+    host, port : str, int
+        Where viser serves its client (the page frames it in an iframe).
+    """
+
+    def __init__(self, dashboard: Dashboard, host: str = "127.0.0.1", port: int = 8080) -> None:
+        self.dashboard = dashboard
+        self.server = viser.ViserServer(host=host, port=port, label="jik scene", verbose=False)
+        self.server.scene.set_up_direction("+z")
+        self.server.gui.configure_theme(control_width="small", show_logo=False)
+        self.server.gui.main_panel.dock_right()
+        self.server.gui.main_panel.set_width(300)
+        self._framed: str | None = None
+        self._syncing = False
+        self._dragging = False
+        self._lock = threading.RLock()
+        self._timeline: Timeline | None = None
+        self._mechanisms: dict[str, _Mechanism] = {}
+        self._s = 0.0
+        self.drawn_generation = 0
+        self._structure: tuple | None = None
+        self._controls: dict[str, object] = {}
+        self._folders: list = []
+        self._last_drag = 0.0
+        self._build_static_gui()
+        self.server.scene.add_grid(
+            "/grid",
+            width=20,
+            height=20,
+            cell_size=0.5,
+            section_size=1.0,
+            position=(0.0, 0.0, -0.06),
+        )
+        self._unsubscribe = dashboard.subscribe(self._on_event)
+        self._thread = threading.Thread(target=self._animate, name="jik-scene", daemon=True)
+        self._thread.start()
+
+    @property
+    def port(self) -> int:
+        return self.server.get_port()
+
+    def stop(self) -> None:
+        self._unsubscribe()
+        self.server.stop()
+
+    # -- GUI ------------------------------------------------------------------------------
+    def _build_static_gui(self) -> None:
+        gui = self.server.gui
+        p, e = COLORS["pseudoinverse"], COLORS["extended"]
+        gui.add_markdown(
+            order=0,
+            content=f"<span style='color:{p}'>■ pseudoinverse J^P# (8)</span>, translucent · "
+            f"<span style='color:{e}'>■ extended Jacobian J^E# (11)</span>, solid · "
+            "grey: start x0",
+        )
+        with gui.add_folder("Playback", order=1):
+            self.play = gui.add_button("Pause", icon=None)
+            self.speed = gui.add_slider("speed", min=0.1, max=5.0, step=0.1, initial_value=1.0)
+            self.scrub = gui.add_slider("position", min=0.0, max=1.0, step=0.001, initial_value=0.0)
+            self.status = gui.add_markdown("computing…")
+            self.progress = gui.add_progress_bar(0.0, visible=False, animated=True)
+        self.playing = True
+
+        @self.play.on_click
+        def _(_) -> None:
+            self.playing = not self.playing
+            self.play.label = "Pause" if self.playing else "Play"
+
+        @self.scrub.on_update
+        def _(_) -> None:
+            if self._syncing or self._timeline is None:
+                return
+            self.playing = False
+            self.play.label = "Play"
+            self._s = float(self.scrub.value) * self._timeline.length
+
+    def _change(self, patch: dict) -> None:
+        if self._syncing:
+            return
+        try:
+            self.dashboard.update(patch, source="scene")
+        except InvalidInputError as exc:
+            self.status.content = f"**refused:** {exc}"
+
+    def _rebuild_controls(self, state) -> None:
+        """GUI inputs for ``state``'s robot, from the registry (no hard-coded ranges)."""
+        gui = self.server.gui
+        for folder in self._folders:
+            folder.remove()
+        self._folders, self._controls = [], {}
+        spec = robot_spec(state.robot)
+        c = self._controls
+        self._syncing = True
+        try:
+            with gui.add_folder("Robot and algorithm", order=2) as f:
+                self._folders.append(f)
+                c["robot"] = gui.add_dropdown("robot", list(ROBOTS), initial_value=state.robot)
+                c["robot"].on_update(lambda e: self._change({"robot": e.target.value}))
+                for p in spec.parameters:
+                    h = gui.add_slider(
+                        p.name,
+                        min=p.minimum,
+                        max=p.maximum,
+                        step=(p.maximum - p.minimum) / 200,
+                        initial_value=state.robot_parameters[p.name],
+                        hint=p.description,
+                    )
+                    h.on_update(
+                        lambda e, n=p.name: self._change({"robot_parameters": {n: e.target.value}})
+                    )
+                    c[f"robot_parameters.{p.name}"] = h
+                for v in spec.vector_parameters:
+                    h = gui.add_vector3(
+                        v.name,
+                        tuple(state.robot_parameters[v.name]),
+                        min=tuple(v.minimum),
+                        max=tuple(v.maximum),
+                        step=0.1,
+                        hint=v.description,
+                    )
+                    h.on_update(
+                        lambda e, n=v.name: self._change(
+                            {"robot_parameters": {n: list(e.target.value)}}
+                        )
+                    )
+                    c[f"robot_parameters.{v.name}"] = h
+                    for name, preset in v.presets.items():
+                        b = gui.add_button(
+                            f"{v.name} = {name} {tuple(round(t, 2) for t in preset)}"
+                        )
+                        b.on_click(
+                            lambda _, n=v.name, q=list(preset): self._change(
+                                {"robot_parameters": {n: q}}
+                            )
+                        )
+                c["mode"] = gui.add_dropdown(
+                    "mode", ["continuous", "discrete"], initial_value=state.mode
+                )
+                c["mode"].on_update(
+                    lambda e: self._change(
+                        {
+                            "mode": e.target.value,
+                            "gamma": min(self.dashboard.state.gamma, 1.0)
+                            if e.target.value == "discrete"
+                            else self.dashboard.state.gamma,
+                        }
+                    )
+                )
+                gmax = 1.99 if state.mode == "discrete" else 10.0
+                c["gamma"] = gui.add_slider(
+                    "gamma",
+                    min=0.01,
+                    max=gmax,
+                    step=0.01,
+                    initial_value=min(state.gamma, gmax),
+                    hint="decay rate of the task error, eq. (5)",
+                )
+                c["gamma"].on_update(lambda e: self._change({"gamma": e.target.value}))
+                aug = spec.augmentation(state.augmentation)
+                c["augmentation"] = gui.add_dropdown(
+                    "augmenting map h", [a.name for a in spec.augmentations], initial_value=aug.name
+                )
+                c["augmentation"].on_update(
+                    lambda e: self._change({"augmentation": e.target.value})
+                )
+                for p in aug.parameters:
+                    h = gui.add_slider(
+                        p.name,
+                        min=p.minimum,
+                        max=p.maximum,
+                        step=(p.maximum - p.minimum) / 200,
+                        initial_value=state.augmentation_parameters[p.name],
+                        hint=p.description,
+                    )
+                    h.on_update(
+                        lambda e, n=p.name: self._change(
+                            {"augmentation_parameters": {n: e.target.value}}
+                        )
+                    )
+                    c[f"augmentation_parameters.{p.name}"] = h
+            with gui.add_folder("Start and task", order=3) as f:
+                self._folders.append(f)
+                for i, name in enumerate(spec.variable_names):
+                    lo, hi = spec.x_range[i] if spec.x_range else (-10.0, 10.0)
+                    h = gui.add_slider(
+                        f"x0: {name}",
+                        min=lo,
+                        max=hi,
+                        step=(hi - lo) / 400,
+                        initial_value=min(max(state.x0[i], lo), hi),
+                    )
+                    h.on_update(lambda e, k=i: self._set_x0(k, e.target.value))
+                    c[f"x0.{i}"] = h
+                if spec.default_path:
+                    c["task"] = gui.add_dropdown(
+                        "task", ["path", "target"], initial_value=state.task
+                    )
+                    c["task"].on_update(lambda e: self._change({"task": e.target.value}))
+                if state.task == "path":
+                    c["path"] = gui.add_text(
+                        "closed path",
+                        _path_text(state.path),
+                        hint="task points 'y1, y2; y1, y2; ...'",
+                    )
+                    c["path"].on_update(lambda e: self._set_path(e.target.value))
+                    c["cycles"] = gui.add_slider(
+                        "cycles",
+                        min=1,
+                        max=MAX_DASHBOARD_CYCLES,
+                        step=1,
+                        initial_value=state.cycles,
+                    )
+                    c["cycles"].on_update(lambda e: self._change({"cycles": int(e.target.value)}))
+                else:
+                    add = gui.add_vector2 if len(state.target) == 2 else gui.add_vector3
+                    c["target"] = add("target", tuple(state.target), step=0.1)
+                    c["target"].on_update(lambda e: self._change({"target": list(e.target.value)}))
+        finally:
+            self._syncing = False
+
+    def _set_x0(self, k: int, value: float) -> None:
+        x0 = list(self.dashboard.state.x0)
+        x0[k] = float(value)
+        self._change({"x0": x0})
+
+    def _set_path(self, text: str) -> None:
+        try:
+            path = [[float(v) for v in p.split(",")] for p in text.split(";") if p.strip()]
+        except ValueError:
+            self.status.content = "**refused:** the path must be 'y1, y2; y1, y2; ...'"
+            return
+        self._change({"path": path})
+
+    def _sync_controls(self, state) -> None:
+        values = {
+            "robot": state.robot,
+            "mode": state.mode,
+            "gamma": state.gamma,
+            "augmentation": state.augmentation,
+            "task": state.task,
+            "cycles": state.cycles,
+            "path": _path_text(state.path),
+            "target": tuple(state.target),
+        }
+        values.update({f"x0.{i}": v for i, v in enumerate(state.x0)})
+        values.update(
+            {
+                f"robot_parameters.{k}": (tuple(v) if isinstance(v, list | tuple) else v)
+                for k, v in state.robot_parameters.items()
+            }
+        )
+        values.update(
+            {f"augmentation_parameters.{k}": v for k, v in state.augmentation_parameters.items()}
+        )
+        self._syncing = True
+        try:
+            for key, handle in self._controls.items():
+                if key in values:
+                    try:
+                        handle.value = values[key]
+                    except (ValueError, AssertionError):
+                        pass
+        finally:
+            self._syncing = False
+
+    # -- events ---------------------------------------------------------------------------
+    def _on_event(self, event: Event) -> None:
+        try:
+            if event.kind == "state":
+                self._on_state(self.dashboard.state)
+            elif event.kind == "progress":
+                msg = json.loads(event.data)
+                if event.generation == self.dashboard.generation and msg["elapsed"] > 0.5:
+                    self.progress.visible = msg["fraction"] < 1
+                    self.progress.value = min(100.0, 100.0 * msg["fraction"])
+                    self.status.content = f"computing… {100 * msg['fraction']:.0f}%"
+            elif event.kind == "result" and event.result is not None:
+                self._draw(event.result)
+            elif event.kind == "error":
+                self.progress.visible = False
+                self.status.content = f"**error:** {json.loads(event.data)['message']}"
+        except Exception as exc:  # never let a drawing error kill the worker thread
+            self.status.content = f"**scene error:** {type(exc).__name__}: {exc}"
+
+    def _on_state(self, state) -> None:
+        structure = (state.robot, state.augmentation, state.task, state.mode)
+        with self._lock:
+            if structure != self._structure:
+                self._structure = structure
+                self._rebuild_controls(state)
+            else:
+                self._sync_controls(state)
+            self._place_gizmo(state)
+
+    def _place_gizmo(self, state) -> None:
+        if self._dragging:
+            return
+        (X, Y), yaw = gizmo_pose(state.robot, state.x0, state.robot_parameters)
+        gizmo = getattr(self, "gizmo", None)
+        if gizmo is None or getattr(self, "_gizmo_robot", None) != state.robot:
+            if gizmo is not None:
+                gizmo.remove()
+            scale = 1.2 if state.robot == "unicycle" else 0.5
+            self.gizmo = self.server.scene.add_transform_controls(
+                "/start",
+                scale=scale,
+                active_axes=(True, True, False),
+                depth_test=False,
+                position=(X, Y, 0.3),
+                wxyz=yaw_quaternion(yaw),
+            )
+            self._gizmo_robot = state.robot
+            self.server.scene.add_label("/start/label", "drag: start point", position=(0, 0, 0.15))
+            self.gizmo.on_update(self._on_drag)
+        else:
+            self.gizmo.position = (X, Y, 0.3)
+            self.gizmo.wxyz = yaw_quaternion(yaw)
+
+    def _on_drag(self, event) -> None:
+        self._dragging = event.phase != "end"
+        now = time.monotonic()
+        if event.phase == "update" and now - self._last_drag < 0.15:
+            return
+        self._last_drag = now
+        state = self.dashboard.state
+        pos = event.target.position
+        patch = start_from_gizmo(state.robot, pos[:2], quaternion_yaw(event.target.wxyz), state)
+        self._change(patch)
+
+    # -- drawing --------------------------------------------------------------------------
+    def _draw(self, result) -> None:
+        scene = self.server.scene
+        state = result.state
+        with self._lock, self.server.atomic():
+            scene.remove_by_name("/robot")
+            scene.add_frame("/robot", show_axes=False)
+            self._mechanisms = {}
+            timeline = Timeline(result)
+            extent = _extent(result)
+            if timeline.unicycle:
+                self._draw_unicycle(result, timeline)
+            else:
+                cls = _MECHANISMS.get(state.robot)
+                if cls is not None:
+                    home = cls(scene, "/robot/home", HOME_COLOR, 0.25, -0.03, state, extent)
+                    home.pose(np.asarray(state.x0))
+                    for a in ALGORITHMS:
+                        self._mechanisms[a] = cls(
+                            scene, f"/robot/{a}", _rgb(COLORS[a]), _OPACITY[a], _Z[a], state, extent
+                        )
+                self._draw_traces(result, extent)
+            if self._framed != state.robot:
+                self._framed = state.robot
+                self._frame_camera(extent)
+            self._timeline = timeline
+            self._s = 0.0
+            self._pose(0.0)
+            self.drawn_generation = result.generation
+            self.dashboard.scene_status = {"generation": result.generation, "robot": state.robot}
+        self.progress.visible = False
+        p, e = result.runs["pseudoinverse"], result.runs["extended"]
+        if state.task == "path" and len(p.drift) and len(e.drift):
+            self.status.content = (
+                f"generation {result.generation}: drift after {len(p.drift)} cycles — "
+                f"pseudoinverse **{p.drift[-1]:.3g}**, extended **{e.drift[-1]:.2g}**"
+            )
+        else:
+            self.status.content = f"generation {result.generation}: {p.message}; {e.message}"
+
+    def _frame_camera(self, extent) -> None:
+        """Look at the task plane from the front, tilted, so the whole workspace is in view."""
+        (xlo, xhi), (ylo, yhi) = extent
+        center = np.array([(xlo + xhi) / 2, (ylo + yhi) / 2, 0.0])
+        size = max(xhi - xlo, yhi - ylo)
+        position = center + np.array([0.0, -0.75 * size, 1.05 * size])
+        self.server.initial_camera.look_at = center
+        self.server.initial_camera.position = position
+        for client in self.server.get_clients().values():
+            with client.atomic():
+                client.camera.look_at = center
+                client.camera.position = position
+
+    def _draw_traces(self, result, extent) -> None:
+        scene = self.server.scene
+        (xlo, xhi), (ylo, yhi) = extent
+        if result.state.robot == "manipulator2":
+            scene.add_box(
+                "/robot/rails/left",
+                color=(90, 90, 90),
+                dimensions=(0.06, yhi - ylo, 0.05),
+                position=(xlo, (ylo + yhi) / 2, -0.02),
+            )
+            scene.add_box(
+                "/robot/rails/right",
+                color=(90, 90, 90),
+                dimensions=(0.06, yhi - ylo, 0.05),
+                position=(xhi, (ylo + yhi) / 2, -0.02),
+            )
+        elif result.state.robot == "manipulator1":
+            scene.add_box(
+                "/robot/guide",
+                color=(90, 90, 90),
+                dimensions=(0.06, yhi - ylo, 0.05),
+                position=(0.0, (ylo + yhi) / 2, -0.02),
+            )
+        for a in ALGORITHMS:
+            run = result.runs[a]
+            y = run.y
+            pts = np.column_stack([y[:, 0], y[:, 1], np.full(len(y), _Z[a] + 0.16)])
+            scene.add_line_segments(
+                f"/robot/trace/{a}/task",
+                _polyline(pts),
+                _rgb(COLORS[a]),
+                thickness=0.025 if a == "pseudoinverse" else 0.015,
+            )
+            if result.state.robot == "manipulator2":
+                # The carriage path (x2, x1) is the joint path: closed for J^E#, not for J^P#.
+                pts = np.column_stack([run.x[:, 1], run.x[:, 0], np.full(len(y), _Z[a] + 0.1)])
+                scene.add_line_segments(
+                    f"/robot/trace/{a}/joints", _polyline(pts), _rgb(COLORS[a]), thickness=0.008
+                )
+        for k, target in enumerate(result.targets):
+            scene.add_icosphere(
+                f"/robot/targets/{k}",
+                radius=0.05,
+                color=(0, 0, 0),
+                position=(target[0], target[1], 0.2),
+            )
+            scene.add_label(
+                f"/robot/targets/{k}/label",
+                chr(ord("A") + k) if k < 26 else str(k),
+                position=(0.05, 0.05, 0.05),
+            )
+
+    def _draw_unicycle(self, result, timeline: Timeline) -> None:
+        scene = self.server.scene
+        state = result.state
+        target = _Platform(scene, "/robot/target", (0, 0, 0), 0.3, 0.0, state, None)
+        target.pose(state.target)
+        q0 = state.robot_parameters["q0"]
+        home = _Platform(scene, "/robot/home", HOME_COLOR, 0.3, 0.0, state, None)
+        home.pose(q0)
+        for a in ALGORITHMS:
+            run = result.runs[a]
+            rgb = np.asarray(_rgb(COLORS[a]), dtype=float)
+            for n, i in enumerate(timeline.shown):
+                i = min(int(i), len(run.platform) - 1)
+                P = run.platform[i]
+                last = n == len(timeline.shown) - 1
+                mix = 1.0 if last else 0.3 + 0.5 * n / len(timeline.shown)
+                color = tuple(int(v) for v in (255 - mix * (255 - rgb)))
+                pts = np.column_stack([P[:, 0], P[:, 1], np.full(len(P), 0.02 + _Z[a] * 0.2)])
+                scene.add_line_segments(
+                    f"/robot/trace/{a}/{n}",
+                    _polyline(pts),
+                    color,
+                    thickness=0.06 if last else 0.025,
+                )
+            self._mechanisms[a] = _Platform(
+                scene, f"/robot/{a}", _rgb(COLORS[a]), _OPACITY[a], _Z[a] * 0.5, state, None
+            )
+
+    def _pose(self, s: float) -> None:
+        if self._timeline is None:
+            return
+        configs = self._timeline.at(s)
+        for a, m in self._mechanisms.items():
+            m.pose(configs[a])
+
+    # -- animation ------------------------------------------------------------------------
+    def _animate(self) -> None:
+        last, last_gui = time.monotonic(), 0.0
+        while True:
+            time.sleep(1.0 / FPS)
+            now = time.monotonic()
+            dt, last = now - last, now
+            timeline = self._timeline
+            if timeline is None or not self.playing:
+                if timeline is not None and not self.playing:
+                    with self._lock:
+                        self._pose(self._s)
+                continue
+            with self._lock:
+                self._s += dt * float(self.speed.value) / SECONDS_PER_LEG
+                if self._s > timeline.length + 0.5:  # hold the end for a moment, then loop
+                    self._s = 0.0
+                self._pose(self._s)
+            if now - last_gui > 0.25:
+                last_gui = now
+                self._syncing = True
+                try:
+                    self.scrub.value = round(min(self._s / timeline.length, 1.0), 3)
+                finally:
+                    self._syncing = False
+
+
+def _path_text(path) -> str:
+    return "; ".join(", ".join(f"{v:g}" for v in p) for p in path)
+
+
+def _extent(result) -> tuple[tuple[float, float], tuple[float, float]]:
+    """Box of the task plane used by the mechanisms (rails, runner), covering both runs."""
+    if any(r.platform is not None for r in result.runs.values()):
+        ys = np.concatenate([r.platform.reshape(-1, 3) for r in result.runs.values()])
+        ys = np.vstack([ys, [result.state.target]])
+        lo, hi = ys.min(axis=0)[:2] - 1.0, ys.max(axis=0)[:2] + 1.0
+        return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
+    ys = np.concatenate([r.y for r in result.runs.values()])
+    xs = np.concatenate([r.x for r in result.runs.values()])
+    lo = np.minimum(ys.min(axis=0)[:2], 0.0) - 0.6
+    hi = np.maximum(ys.max(axis=0)[:2], 1.0) + 0.6
+    if result.state.robot == "manipulator2":
+        lo[0] = min(lo[0], xs[:, 1].min() - 0.4)
+        hi[0] = max(hi[0], xs[:, 1].max() + 0.4)
+    return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
+
+
+def start_scene(dashboard: Dashboard, host: str, port: int) -> DashboardScene:
+    """Start the viser scene for ``dashboard`` on ``host:port``."""
+    return DashboardScene(dashboard, host=host, port=port)

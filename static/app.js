@@ -1,0 +1,305 @@
+// jik dashboard: follows the server's one state over server-sent events and draws its figures.
+// Controls are built from GET /robots (ranges, defaults) and change the state with
+// POST /api/dashboard/state; the viser scene (iframe) changes the same state.
+"use strict";
+
+const PANELS = ["task", "drift", "joints", "augmenting", "table"];
+const PLOT_CONFIG = { responsive: true, displaylogo: false, modeBarButtonsToRemove: ["lasso2d", "select2d"] };
+const jik = (window.jik = {
+  catalogue: null, config: null, state: null, generation: 0, shownGeneration: 0,
+  pending: new Map(), latencies: [], lastLatency: null, firstUpdate: null,
+});
+
+const $ = (sel) => document.querySelector(sel);
+const el = (tag, attrs = {}, ...children) => {
+  const e = document.createElement(tag);
+  for (const [k, v] of Object.entries(attrs)) {
+    if (k === "dataset") Object.assign(e.dataset, v);
+    else if (k in e && k !== "list") e[k] = v;
+    else e.setAttribute(k, v);
+  }
+  for (const c of children) e.append(c);
+  return e;
+};
+const fmt = (v, d = 3) => (Math.abs(v) >= 1e4 || (Math.abs(v) < 1e-3 && v !== 0) ? v.toExponential(2) : (+v).toFixed(d));
+
+function robotSpec(name) {
+  return jik.catalogue.robots.find((r) => r.name === name);
+}
+
+// ---------------------------------------------------------------- sending changes
+let sendTimer = null;
+let queued = {};
+let queuedSince = null;
+function change(patch, { now = false } = {}) {
+  for (const [k, v] of Object.entries(patch)) {
+    if (v && typeof v === "object" && !Array.isArray(v) && queued[k]) queued[k] = { ...queued[k], ...v };
+    else queued[k] = v;
+  }
+  if (queuedSince === null) queuedSince = performance.now();
+  clearTimeout(sendTimer);
+  sendTimer = setTimeout(flush, now ? 0 : 30);
+}
+
+async function flush() {
+  const patch = queued;
+  const since = queuedSince;
+  queued = {};
+  queuedSince = null;
+  if (!Object.keys(patch).length) return;
+  const res = await fetch("/api/dashboard/state", {
+    method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(patch),
+  });
+  const body = await res.json();
+  if (!res.ok) {
+    setStatus(body.detail.map((d) => d.msg).join("; "), true);
+    return;
+  }
+  jik.pending.set(body.generation, since);
+}
+
+// ---------------------------------------------------------------- controls
+function slider(label, { min, max, step, value, log = false, onInput, id }) {
+  const toPos = (v) => (log ? Math.log10(v) : v);
+  const fromPos = (p) => (log ? 10 ** p : p);
+  const input = el("input", {
+    type: "range", min: toPos(min), max: toPos(max), step: log ? (toPos(max) - toPos(min)) / 200 : step,
+    value: toPos(value), id,
+  });
+  const show = (v) => (Number.isInteger(step) && !log ? String(Math.round(v)) : fmt(v));
+  const out = el("output", {}, show(value));
+  input.addEventListener("input", () => {
+    const v = +fromPos(+input.value).toPrecision(4);
+    out.textContent = show(v);
+    onInput(v);
+  });
+  input.setValue = (v) => { input.value = toPos(v); out.textContent = show(v); };
+  return el("label", {}, el("span", {}, label, " ", out), input);
+}
+
+function numberBox(label, { min, max, step, value, onChange, id }) {
+  const input = el("input", { type: "number", min, max, step, value: +(+value).toFixed(4), id });
+  input.addEventListener("change", () => onChange(+input.value));
+  input.setValue = (v) => { input.value = +(+v).toFixed(4); };
+  return el("label", {}, label, input);
+}
+
+function select(label, options, value, onChange, id) {
+  const s = el("select", { id });
+  for (const [v, text] of options) s.append(el("option", { value: v, selected: v === value }, text));
+  s.addEventListener("change", () => onChange(s.value));
+  s.setValue = (v) => { s.value = v; };
+  return el("label", {}, label, s);
+}
+
+const bound = new Map(); // state path -> input with setValue
+
+function buildControls(state) {
+  const form = $("#controls");
+  form.replaceChildren();
+  bound.clear();
+  const spec = robotSpec(state.robot);
+  const bind = (key, label) => { bound.set(key, label.querySelector("input,select")); return label; };
+
+  const main = el("fieldset");
+  main.append(bind("robot", select("robot", jik.catalogue.robots.map((r) => [r.name, r.title]), state.robot,
+    (v) => change({ robot: v }, { now: true }), "ctl-robot")));
+  main.append(bind("mode", select("mode", (spec.modes || ["continuous", "discrete"]).map((m) => [m, m]), state.mode,
+    (v) => change({ mode: v, gamma: v === "discrete" ? Math.min(state.gamma, 1) : state.gamma }, { now: true }), "ctl-mode")));
+  const gmax = state.mode === "discrete" ? 1.99 : 10;
+  main.append(bind("gamma", slider("γ (decay rate)", {
+    min: 0.01, max: gmax, value: Math.min(state.gamma, gmax), log: true, id: "ctl-gamma",
+    onInput: (v) => change({ gamma: v }),
+  })));
+  form.append(main);
+
+  const params = el("fieldset");
+  for (const p of spec.parameters) {
+    if (Array.isArray(p.default)) {
+      const value = state.robot_parameters[p.name];
+      p.default.forEach((_, i) => params.append(bind(`robot_parameters.${p.name}.${i}`, numberBox(`${p.name}[${i + 1}]`, {
+        min: p.minimum[i], max: p.maximum[i], step: 0.1, value: value[i], id: `ctl-${p.name}-${i}`,
+        onChange: (v) => { const q = [...jik.state.robot_parameters[p.name]]; q[i] = v; change({ robot_parameters: { [p.name]: q } }); },
+      }))));
+      for (const [name, preset] of Object.entries(p.presets || {})) {
+        params.append(el("button", { type: "button", id: `ctl-preset-${name}`, title: `${p.name} = (${preset.map((v) => fmt(v)).join(", ")})`,
+          onclick: () => change({ robot_parameters: { [p.name]: preset } }, { now: true }) }, `${p.name} = ${name}`));
+      }
+    } else {
+      params.append(bind(`robot_parameters.${p.name}`, slider(p.name, {
+        min: p.minimum, max: p.maximum, step: (p.maximum - p.minimum) / 200, value: state.robot_parameters[p.name],
+        id: `ctl-${p.name}`, onInput: (v) => change({ robot_parameters: { [p.name]: v } }),
+      })));
+    }
+  }
+  params.append(bind("augmentation", select("augmenting map h", spec.augmentations.map((a) => [a.name, `${a.name} ${a.equation}`]),
+    state.augmentation, (v) => change({ augmentation: v }, { now: true }), "ctl-augmentation")));
+  const aug = spec.augmentations.find((a) => a.name === state.augmentation);
+  for (const p of aug.parameters) {
+    params.append(bind(`augmentation_parameters.${p.name}`, slider(p.name, {
+      min: p.minimum, max: p.maximum, step: (p.maximum - p.minimum) / 200, value: state.augmentation_parameters[p.name],
+      id: `ctl-aug-${p.name}`, onInput: (v) => change({ augmentation_parameters: { [p.name]: v } }),
+    })));
+  }
+  form.append(params);
+
+  const start = el("fieldset");
+  spec.variable_names.forEach((name, i) => {
+    const [lo, hi] = spec.x_range[i] || [-10, 10];
+    start.append(bind(`x0.${i}`, slider(`x0: ${name}`, {
+      min: lo, max: hi, step: (hi - lo) / 400, value: state.x0[i], id: `ctl-x0-${i}`,
+      onInput: (v) => { const x = [...jik.state.x0]; x[i] = v; jik.state.x0 = x; change({ x0: x }); },
+    })));
+  });
+  form.append(start);
+
+  const task = el("fieldset");
+  if (spec.default_path.length) {
+    task.append(bind("task", select("task", [["path", "closed path"], ["target", "single target"]], state.task,
+      (v) => change({ task: v }, { now: true }), "ctl-task")));
+  }
+  if (state.task === "path") {
+    const text = el("input", { type: "text", id: "ctl-path", value: state.path.map((p) => p.join(", ")).join("; ") });
+    text.addEventListener("change", () => change({ path: text.value.split(";").map((p) => p.split(",").map(Number)) }));
+    text.setValue = (v) => { text.value = v.map((p) => p.join(", ")).join("; "); };
+    bound.set("path", text);
+    task.append(el("label", {}, "path (task points; closed back to k(x0))", text));
+    task.append(bind("cycles", slider("cycles", {
+      min: 1, max: jik.config.max_cycles || 20, step: 1, value: state.cycles, id: "ctl-cycles",
+      onInput: (v) => change({ cycles: Math.round(v) }),
+    })));
+  } else {
+    spec.task_names.forEach((name, i) => task.append(bind(`target.${i}`, numberBox(`target ${name}`, {
+      step: 0.1, value: state.target[i], id: `ctl-target-${i}`,
+      onChange: (v) => { const t = [...jik.state.target]; t[i] = v; change({ target: t }); },
+    }))));
+  }
+  form.append(task);
+}
+
+function syncControls(state) {
+  for (const [key, input] of bound) {
+    if (document.activeElement === input) continue;
+    const value = key.split(".").reduce((o, k) => (o == null ? o : o[k]), state);
+    if (value !== undefined && input.setValue) input.setValue(value);
+  }
+}
+
+// ---------------------------------------------------------------- events
+function setStatus(text, error = false) {
+  const s = $("#status-text");
+  s.textContent = text;
+  s.classList.toggle("error", error);
+}
+
+function showProgress(fraction, elapsed) {
+  const box = $("#progress");
+  // Only computations longer than half a second get a progress bar.
+  box.hidden = !(elapsed > 0.5 && fraction < 1);
+  $("#progress-bar").style.width = `${Math.round(100 * fraction)}%`;
+  $("#progress-text").textContent = `computing ${Math.round(100 * fraction)}%`;
+}
+
+function onState(msg) {
+  const rebuild = !jik.state || jik.state.robot !== msg.state.robot || jik.state.augmentation !== msg.state.augmentation
+    || jik.state.task !== msg.state.task || jik.state.mode !== msg.state.mode;
+  jik.state = msg.state;
+  jik.generation = Math.max(jik.generation, msg.generation);
+  if (rebuild) buildControls(msg.state);
+  else syncControls(msg.state);
+  if (msg.generation > jik.shownGeneration) setStatus(`computing generation ${msg.generation}…`);
+}
+
+async function drawFigures(figures) {
+  await Promise.all(Object.entries(figures).map(([key, fig]) => {
+    const div = document.getElementById(`plot-${key}`);
+    return div ? Plotly.react(div, fig.data, fig.layout, PLOT_CONFIG) : null;
+  }));
+}
+
+async function onResult(msg) {
+  if (msg.generation < jik.shownGeneration) return;
+  if (!jik.state) onState({ state: msg.state, generation: msg.generation });
+  await drawFigures(msg.figures);
+  const now = performance.now();
+  jik.shownGeneration = msg.generation;
+  document.body.dataset.generation = msg.generation;
+  document.body.dataset.robot = msg.state.robot;
+  for (const [g, since] of [...jik.pending]) {
+    if (g <= msg.generation) {
+      jik.lastLatency = { generation: msg.generation, ms: now - since, server: msg.timing };
+      jik.latencies.push(jik.lastLatency);
+      jik.pending.delete(g);
+    }
+  }
+  if (jik.firstUpdate === null) jik.firstUpdate = now;
+  showProgress(1, 0);
+  renderVerdict(msg);
+  const t = msg.timing;
+  const lat = jik.lastLatency && jik.lastLatency.generation === msg.generation ? ` · control → plots ${Math.round(jik.lastLatency.ms)} ms` : "";
+  $("#timing").textContent = `generation ${msg.generation}: compute ${Math.round(1000 * t.compute)} ms, figures ${Math.round(1000 * t.figures)} ms${lat}`;
+  setStatus(msg.generation < jik.generation ? `computing generation ${jik.generation}…` : `up to date (generation ${msg.generation})`);
+}
+
+function renderVerdict(msg) {
+  const p = msg.summary.pseudoinverse;
+  const e = msg.summary.extended;
+  const box = $("#verdict");
+  const fail = [p, e].filter((s) => !s.success).map((s) => s.message);
+  if (msg.state.task === "path" && p.drift.length && e.drift.length) {
+    const n = Math.min(p.drift.length, e.drift.length);
+    box.innerHTML = `After <b>${n}</b> cycle${n > 1 ? "s" : ""} of the closed path, the joints of the
+      <b class="p">pseudoinverse</b> end <b class="p">${fmt(p.drift[n - 1])}</b> away from x0 and the drift grows each cycle;
+      the <b class="e">extended Jacobian</b> returns to within <b class="e">${fmt(e.drift[n - 1])}</b>.
+      <span class="why">Why: J<sup>P#</sup> picks the minimum-norm joint velocity, which has no memory of the start, so a
+      closed task path need not close in the joints. J<sup>E#</sup> adds the equation h(x) = h(x0) (h changed by
+      ${e.h_change === null ? "—" : fmt(e.h_change)} along its run): each task point then has one configuration on that level set,
+      so closed task paths give closed joint paths.</span>`;
+  } else {
+    box.innerHTML = `Both algorithms drive the task error to the target: <b class="p">pseudoinverse</b> ${p.message};
+      <b class="e">extended Jacobian</b> ${e.message}.
+      <span class="why">The extended Jacobian keeps h constant (eq. (12)); compare the paths and the controls.</span>`;
+  }
+  if (fail.length) box.innerHTML += ` <span class="error">${fail.join(" · ")}</span>`;
+}
+
+async function onFunctionals(msg) {
+  if (msg.generation !== jik.shownGeneration) return;
+  await drawFigures(msg.figures);
+}
+
+function connect() {
+  const source = new EventSource("/api/dashboard/events");
+  const on = (kind, fn) => source.addEventListener(kind, (ev) => fn(JSON.parse(ev.data)));
+  let chain = Promise.resolve();
+  const serial = (fn) => (msg) => { chain = chain.then(() => fn(msg)).catch((err) => setStatus(String(err), true)); };
+  on("state", onState);
+  on("progress", (msg) => { if (msg.generation === jik.generation) showProgress(msg.fraction, msg.elapsed); });
+  on("result", serial(onResult));
+  on("functionals", serial(onFunctionals));
+  on("error", (msg) => { if (msg.generation === jik.generation) { showProgress(1, 0); setStatus(msg.message, true); } });
+  source.onerror = () => setStatus("connection lost; reconnecting…", true);
+}
+
+async function main() {
+  for (const a of ["pseudoinverse", "extended"]) document.documentElement.style.setProperty(`--${a}`, "");
+  const [config, catalogue] = await Promise.all([
+    fetch("/api/dashboard/config").then((r) => r.json()),
+    fetch("/robots").then((r) => r.json()),
+  ]);
+  jik.config = config;
+  jik.catalogue = catalogue;
+  for (const [a, c] of Object.entries(config.colors)) document.documentElement.style.setProperty(`--${a}`, c);
+  const frame = $("#scene");
+  if (config.scene_port) {
+    frame.src = `${location.protocol}//${location.hostname}:${config.scene_port}/`;
+  } else {
+    frame.hidden = true;
+    const note = $("#scene-note");
+    note.hidden = false;
+    note.textContent = "The 3D scene runs with `jik serve` (viser on the scene port).";
+  }
+  connect();
+}
+
+main().catch((err) => setStatus(String(err), true));
