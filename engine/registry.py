@@ -8,13 +8,15 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from engine import augmentations as aug
 from engine.augmentations import AugmentingMap
+from engine.characteristics import UnicycleCharacteristics
 from engine.exceptions import InvalidInputError
 from engine.inverses import ExtendedInverse, Inverse, Pseudoinverse
 from engine.kinematics import Kinematics, Manipulator1, Manipulator2
+from engine.unicycle import Unicycle
 from engine.validation import finite
 
 
@@ -264,7 +266,81 @@ MANIPULATOR2 = RobotSpec(
     default_augmentation="paper_cubic",
 )
 
-ROBOTS: dict[str, RobotSpec] = {s.name: s for s in (MANIPULATOR1, MANIPULATOR2)}
+
+def _e2_synthesized(kin: Manipulator2) -> AugmentingMap:
+    from engine.variational import default_manipulator2_synthesis
+
+    return default_manipulator2_synthesis(kin.l).augmenting_map
+
+
+MANIPULATOR2 = replace(
+    MANIPULATOR2,
+    augmentations=(
+        *MANIPULATOR2.augmentations,
+        AugmentationSpec(
+            "e2_synthesized",
+            "(20)",
+            "E2-optimal h(x2, x3) on x2 in [-1, 1], x3 in [0, pi], synthesized by a spectral Ritz "
+            "solve of the Euler equation (20) (computed once per arm length, about a second)",
+            (),
+            _e2_synthesized,
+        ),
+    ),
+)
+
+#: Section 6.2's start poses of the platform.
+POSE_A = (5.0, 0.0, math.pi / 2)
+POSE_B = (-5.0, 5.0, math.pi / 2)
+
+UNICYCLE = RobotSpec(
+    name="unicycle",
+    title="Unicycle",
+    description="unicycle (40) driven by Fourier controls (41): k(lambda) = q(T), eq. (42)",
+    equation="(40)-(42)",
+    p=4,
+    r=3,
+    variable_names=("lambda10", "lambda11", "lambda20", "lambda21"),
+    task_names=("q1", "q2", "q3"),
+    parameters=(Parameter("T", 2 * math.pi, 0.5, 20.0, "control horizon T [s]"),),
+    vector_parameters=(
+        VectorSpec(
+            "q0",
+            POSE_A,
+            (-20.0, -20.0, -2 * math.pi),
+            (20.0, 20.0, 2 * math.pi),
+            "initial pose (q1 [m], q2 [m], q3 [rad])",
+            presets={"A": POSE_A, "B": POSE_B},
+        ),
+    ),
+    factory=lambda T, q0: Unicycle(q0=q0, T=T),
+    default_x0=(0.5, -0.25, 0.3, -0.25),
+    default_target=(1.0, 0.0, -math.pi / 2),
+    default_path=((1.0, 0.0, -math.pi / 2), (3.0, 2.0, 0.0)),
+    default_mode="discrete",
+    default_gamma=0.1,
+    x_range=((-3.0, 3.0), (-3.0, 3.0), (-3.0, 3.0), (-3.0, 3.0)),
+    augmentations=(
+        AugmentationSpec(
+            "characteristics",
+            "(28), (29), (45)",
+            "h by the method of characteristics toward the reference leaf E_{a,0} = a e1 + R e2",
+            (
+                Parameter(
+                    "a",
+                    1.0,
+                    -5.0,
+                    5.0,
+                    "reference leaf lambda10 = a (omega undefined at 0)",
+                    nonzero=True,
+                ),
+            ),
+            lambda kin, a: UnicycleCharacteristics(kin, a),
+        ),
+    ),
+    default_augmentation="characteristics",
+)
+
+ROBOTS: dict[str, RobotSpec] = {s.name: s for s in (MANIPULATOR1, MANIPULATOR2, UNICYCLE)}
 
 
 def register_robot(spec: RobotSpec) -> None:
@@ -276,12 +352,10 @@ def register_augmentation(robot: str, spec: AugmentationSpec, *, default: bool =
     """Add an augmenting map to a robot's list (used by the synthesis modules)."""
     r = ROBOTS[robot]
     others = tuple(a for a in r.augmentations if a.name != spec.name)
-    ROBOTS[robot] = RobotSpec(
-        **{
-            **r.__dict__,
-            "augmentations": (*others, spec),
-            "default_augmentation": spec.name if default else r.default_augmentation,
-        }
+    ROBOTS[robot] = replace(
+        r,
+        augmentations=(*others, spec),
+        default_augmentation=spec.name if default else r.default_augmentation,
     )
 
 
