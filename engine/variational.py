@@ -48,7 +48,7 @@ EXTRA_NODES = 8
 MANIPULATOR2_REGION: dict[str, tuple[float, float]] = {"x2": (-1.0, 1.0), "x3": (0.0, np.pi)}
 
 #: Default basis degree (per variable) of the Manipulator 2 synthesis.
-MANIPULATOR2_DEGREE = 24
+MANIPULATOR2_DEGREE = 16
 
 
 def _derivative_matrix(n: int) -> FloatArray:
@@ -415,7 +415,7 @@ def synthesize_manipulator2(
         Manipulator2(l),
         MANIPULATOR2_REGION,
         degree=MANIPULATOR2_DEGREE,
-        convergence_degrees=(2, 4, 6, 8, 12, 16, 20),
+        convergence_degrees=(2, 4, 6, 8, 12),
         progress=progress,
     )
 
