@@ -1,0 +1,57 @@
+"""The `jik reproduce` commands print what the issues promise (JSON contracts and tables)."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from app.cli import main
+from engine.reproductions.table1 import PRINTED
+
+
+def run_cli(capsys, *argv):
+    assert main(list(argv)) == 0
+    return capsys.readouterr().out
+
+
+def test_table1_json_contract(capsys):
+    out = json.loads(run_cli(capsys, "reproduce", "table1", "--json"))
+    assert set(out) == {"pseudoinverse", "extended", "augmentation"}
+    assert out["augmentation"] == "paper_cubic"
+    assert np.shape(out["pseudoinverse"]) == (5, 3) and np.shape(out["extended"]) == (5, 3)
+    np.testing.assert_allclose(out["pseudoinverse"], PRINTED["pseudoinverse"], atol=5e-5)
+    np.testing.assert_allclose(out["extended"][0], [0, 0, math.pi / 2])
+
+
+def test_table1_text_has_both_columns_and_printed_values(capsys):
+    out = run_cli(capsys, "reproduce", "table1")
+    assert "Jacobian pseudoinverse" in out and "Extended Jacobian" in out
+    assert out.count("1.0432") == 2  # ours and the printed value on row C
+
+
+def test_manipulator1_json_contract(capsys):
+    out = json.loads(run_cli(capsys, "reproduce", "manipulator1", "--json"))
+    assert out["region"] == {"x1": [0, 1], "x2": [0, 1], "x3": [0.5, 1.5]}
+    for functional in ("E1", "E2"):
+        assert set(out[functional]) >= {"e1_optimal", "e1_taylor", "e2_optimal"}
+        assert all(np.isfinite(v) and v >= 0 for v in out[functional].values())
+    # E1 of (36) with a = 0, b = 1 has the closed form 1 - pi/4 on this region.
+    assert out["E1"]["e2_optimal"] == pytest.approx(1 - math.pi / 4, abs=1e-8)
+    assert "symbolic" in out
+
+
+def test_manipulator2_json_contract(capsys):
+    out = json.loads(run_cli(capsys, "reproduce", "manipulator2", "--json"))
+    assert out["region"] == {"x2": [-1, 1], "x3": [0, math.pi]}
+    assert out["E2"]["e2_synthesized"] < 0.1 * out["E2"]["paper_cubic"]
+    assert len(out["polynomial"]) >= 10
+    rows = np.array(out["table1_extended"])
+    assert rows.shape == (5, 3)
+    np.testing.assert_allclose(rows[-1], rows[0], atol=1e-8)  # repeatable
+
+
+def test_unknown_reproduction_is_rejected(capsys):
+    with pytest.raises(SystemExit):
+        main(["reproduce", "table2"])
+    assert "invalid choice" in capsys.readouterr().err
