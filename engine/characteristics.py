@@ -34,6 +34,9 @@ NEWTON_MAX = 30
 #: Newton stops when the largest update is below this (relative to 1 + |z|); by quadratic
 #: convergence z is then exact to rounding, and dh (linearised one update earlier) to ~NEWTON_TOL.
 NEWTON_TOL = 1e-12
+#: Largest relative size of the last three Chebyshev coefficients of z(s) accepted before the
+#: characteristic is solved again on a finer nested grid (2n - 1, then 4n - 3 nodes).
+TAIL_TOL = 1e-12
 #: Warm-start Newton from the previous characteristics when x moved by at most this (max norm).
 WARM_RADIUS = 0.5
 
@@ -242,6 +245,24 @@ def collocation(n: int) -> tuple[FloatArray, FloatArray]:
     return s, W
 
 
+@functools.lru_cache(maxsize=8)
+def _chebyshev_analysis(n: int) -> FloatArray:
+    """(n, n) matrix: values at the Lobatto nodes of :func:`collocation` -> Chebyshev coeffs."""
+    u = -np.cos(np.pi * np.arange(n) / (n - 1))
+    out = np.linalg.inv(np.polynomial.chebyshev.chebvander(u, n - 1))
+    out.flags.writeable = False
+    return out
+
+
+@functools.lru_cache(maxsize=8)
+def _chebyshev_resample(n_from: int, n_to: int) -> FloatArray:
+    """(n_to, n_from) matrix interpolating from one Lobatto grid onto another."""
+    u = -np.cos(np.pi * np.arange(n_to) / (n_to - 1))
+    out = np.polynomial.chebyshev.chebvander(u, n_from - 1) @ _chebyshev_analysis(n_from)
+    out.flags.writeable = False
+    return out
+
+
 class CharacteristicsMap(AugmentingMap):
     """Augmenting map h(y, z) = z(0) of the characteristic (28), eq. (29), with its exact gradient.
 
@@ -289,6 +310,39 @@ class CharacteristicsMap(AugmentingMap):
         self.on_undefined = on_undefined
         self._cache: tuple | None = None
 
+    def _collocate(self, xb, Y, n, guess):
+        """Newton on the n-node collocation system of (28) and its variational system.
+
+        Returns Z (B, n), S (B, n, p), the 'omega undefined' mask (B, n), the last Newton
+        step (B,), the points Phi_s (B, n, p) and the Chebyshev tail of Z (B,) (error estimate).
+        """
+        s, W = collocation(n)
+        f = self.fixed_index
+        base = self.homotopy(xb, 0.0)[:, None, :] + s[:, None] * Y[:, None, :]  # (B, n, p)
+        z1 = xb[:, f : f + 1]
+        Z = np.repeat(z1, n, axis=1) if guess is None else guess  # cold: z(s) = z(1)
+        eye = np.eye(n)
+        with np.errstate(all="ignore"):
+            for _ in range(NEWTON_MAX):
+                pts = base.copy()
+                pts[..., f] = Z
+                omega, domega, bad = _one_form_parts(*_derivatives(self.kinematics, pts), f)
+                DY = np.einsum("bnkj,bk->bnj", domega, Y)  # (d omega / dx) Y, (B, n, p)
+                A = eye - W * DY[:, None, :, f]  # I + W diag(G_z), G_z = -(d omega/dz) Y
+                R = Z - z1 - (omega @ Y[:, :, None])[..., 0] @ W.T  # G = -omega Y
+                dZ = np.linalg.solve(A, R[..., None])[..., 0]
+                Z = Z - dZ
+                step = np.max(np.abs(dZ) / (1.0 + np.abs(Z)), axis=-1, initial=0.0)
+                if not np.any(step > NEWTON_TOL):  # NaN members stop too; flagged by caller
+                    break
+            Gy = -s[:, None] * DY - omega  # (B, n, p)
+            rhs = -(W @ Gy)  # d/dy_j columns
+            rhs[..., f] = 1.0  # d/dz(1) column
+            S = np.linalg.solve(A, rhs)
+            coef = Z @ _chebyshev_analysis(n).T  # Chebyshev coefficients of z(s)
+        tail = np.max(np.abs(coef[:, -3:]), axis=-1) / (1.0 + np.max(np.abs(Z), axis=-1))
+        return Z, S, bad, step, pts, tail
+
     def characteristic(
         self, x, guess=None
     ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
@@ -298,7 +352,7 @@ class CharacteristicsMap(AugmentingMap):
         ----------
         x : array_like, shape (..., p)
         guess : ndarray, shape (..., n), optional
-            Initial z(s) at the nodes for Newton (default: z(s) = z(1)).
+            Initial z(s) at the n = ``nodes`` nodes for Newton (default: z(s) = z(1)).
 
         Returns
         -------
@@ -315,52 +369,49 @@ class CharacteristicsMap(AugmentingMap):
         -----
         Every Newton iteration evaluates omega and d omega at all nodes; the last update is at
         most NEWTON_TOL (relative), so the variational system, linearised at that last
-        evaluation, gives dh consistent with h to about NEWTON_TOL.
+        evaluation, gives dh consistent with h to about NEWTON_TOL. Members whose last three
+        Chebyshev coefficients of z(s) exceed TAIL_TOL (a steep characteristic, e.g. one that
+        passes near a zero of the normalising kernel component) are solved again on the nested
+        Lobatto grids of 2n - 1 and 4n - 3 nodes; results are returned on the n base nodes.
         """
         x = self.kinematics.check(x)
         shape = x.shape[:-1]
         xb = x.reshape(-1, self.p)
-        s, W = collocation(self.nodes)
-        f = self.fixed_index
+        n = self.nodes
         Y = self.homotopy.field(xb)  # (B, p)
-        base = self.homotopy(xb, 0.0)[:, None, :] + s[:, None] * Y[:, None, :]  # (B, n, p)
-        if guess is None:
-            Z = np.repeat(xb[:, f : f + 1], s.size, axis=1)  # z(s) = z(1)
-        else:
-            Z = np.array(guess, dtype=float).reshape(-1, s.size)
-        eye = np.eye(s.size)
-        z1 = xb[:, f : f + 1]
-        with np.errstate(all="ignore"):
-            for _ in range(NEWTON_MAX):
-                pts = base.copy()
-                pts[..., f] = Z
-                omega, domega, bad = _one_form_parts(*_derivatives(self.kinematics, pts), f)
-                DY = np.einsum("bnkj,bk->bnj", domega, Y)  # (d omega / dx) Y, (B, n, p)
-                A = eye - W * DY[:, None, :, f]  # I + W diag(G_z), G_z = -(d omega/dz) Y
-                R = Z - z1 - (omega @ Y[:, :, None])[..., 0] @ W.T  # G = -omega Y
-                dZ = np.linalg.solve(A, R[..., None])[..., 0]
-                Z = Z - dZ
-                step = np.max(np.abs(dZ) / (1.0 + np.abs(Z)), axis=-1, initial=0.0)
-                if not np.any(step > NEWTON_TOL):  # NaN members stop too; flagged below
-                    break
-            Gy = -s[:, None] * DY - omega  # (B, n, p)
-            rhs = -(W @ Gy)  # d/dy_j columns
-            rhs[..., f] = 1.0  # d/dz(1) column
-            S = np.linalg.solve(A, rhs)
-        failed = np.any(bad, axis=-1) | ~np.all(np.isfinite(S[:, 0, :]), axis=-1)
+        g = None if guess is None else np.array(guess, dtype=float).reshape(-1, n)
+        Z, S, bad_nodes, step, pts, tail = self._collocate(xb, Y, n, g)
+        bad = np.any(bad_nodes, axis=-1)
+        active, Zc, m_prev = np.arange(len(xb)), Z, n
+        for level in (1, 2):
+            need = ~(tail[active] <= TAIL_TOL) & np.isfinite(tail[active]) & ~bad[active]
+            if not np.any(need):
+                break
+            active, Zc = active[need], Zc[need]
+            m = (n - 1) * 2**level + 1
+            Zf, Sf, badf, stepf, _, tailf = self._collocate(
+                xb[active], Y[active], m, Zc @ _chebyshev_resample(m_prev, m).T
+            )
+            ok = (stepf <= NEWTON_TOL) & ~np.any(badf, axis=-1) & np.all(np.isfinite(Sf), (1, 2))
+            sub = 2**level  # nested grids: every sub-th fine node is a base node
+            upd = active[ok]
+            Z[upd], S[upd], step[upd], tail[upd] = (
+                Zf[ok, ::sub],
+                Sf[ok, ::sub],
+                stepf[ok],
+                tailf[ok],
+            )
+            active, Zc, m_prev = active[ok], Zf[ok], m
+        failed = bad | ~np.all(np.isfinite(S[:, 0, :]), axis=-1)
         failed |= ~np.all(np.isfinite(Z), axis=-1) | ~(step <= NEWTON_TOL)
         where = None
+        s0 = collocation(n)[0]
         if np.any(failed):
             i = np.flatnonzero(failed)[0]
-            j = np.flatnonzero(bad[i])
-            where = (pts[i, j[0]], s[j[0]], xb[i]) if j.size else (None, None, xb[i])
+            j = np.flatnonzero(bad_nodes[i])
+            where = (pts[i, j[0]], s0[j[0]], xb[i]) if j.size else (None, None, xb[i])
         self._where = where
-        return (
-            s,
-            Z.reshape(*shape, s.size),
-            S.reshape(*shape, s.size, self.p),
-            failed.reshape(shape),
-        )
+        return s0, Z.reshape(*shape, n), S.reshape(*shape, n, self.p), failed.reshape(shape)
 
     def evaluate(self, x) -> tuple[FloatArray, FloatArray, FloatArray]:
         """h(x) (...,), dh/dx (..., p) and the failure mask (...,), without raising.

@@ -52,11 +52,12 @@ def test_discrete_steps_do_not_conserve_h_but_continuous_does(result):
 
 
 def test_start_b_extended_discrete_stops_with_a_message(result):
-    """From B the extended discrete run leaves lambda10 > 0 and diverges: stopped, explained."""
+    """From B the extended discrete run leaves lambda10 > 0 (h breaks down): stopped, explained."""
     r = result["B"]["extended"]
     assert not r["success"]
     assert "lambda10 crossed 0" in r["message"]
-    assert "diverged" in r["message"] or "undefined" in r["message"]
+    reasons = ("diverged", "undefined", "could not be resolved", "singular")
+    assert any(reason in r["message"] for reason in reasons)
     assert all(v is None or np.isfinite(v) for v in r["lambda"])
     assert result["B"]["pseudoinverse"]["success"]
 
@@ -72,4 +73,4 @@ def test_paths_similar_from_a_not_from_b(result):
 def test_format_text_mentions_every_run(result):
     text = repro.format_text(result)
     assert text.count("pseudoinverse") >= 4 and text.count("extended") >= 4
-    assert "lambda diverged" in text
+    assert "lambda10 crossed 0" in text
