@@ -358,6 +358,10 @@ class ErrorResponse(BaseModel):
     detail: str
 
 
+#: OpenAPI entry of the 503 every computing endpoint may answer.
+BUSY = {503: {"model": ErrorResponse, "description": "server busy: no compute slot in time"}}
+
+
 class HealthResponse(BaseModel):
     status: Literal["ok"]
 

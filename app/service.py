@@ -668,12 +668,22 @@ class _Worker:
         self.conn.close()
 
 
+#: The field that sizes the work of each computation kind, and how to ask for less.
+_WORK_FIELDS = {
+    "solve": ("max_iterations", "a lower max_iterations or a larger tolerance"),
+    "repeatability": ("cycles", "fewer cycles or path points, a lower max_iterations"),
+    "synthesize": ("degree", "a lower degree or fewer nodes, a smaller grid or region"),
+}
+
+
 @dataclass(frozen=True)
 class Settings:
     """How the API runs its computations (from the environment by :func:`settings_from_env`).
 
-    ``timeout`` bounds both phases of a request: waiting for a compute slot (then 503 "busy")
-    and the computation itself (then 503 "exceeded", and the worker is killed and replaced).
+    ``timeout`` bounds both phases of a request: waiting for a compute slot (then 503 "server
+    busy", retry later) and the computation itself (then 422 naming the field that sizes the
+    work, e.g. ``cycles``: the request asks for more than the limit allows; the worker is killed
+    and replaced).
     """
 
     workers: int = 2
@@ -714,10 +724,11 @@ class ComputePool:
     """Worker processes with a bound on concurrent computations and a time limit per request.
 
     At most ``settings.workers`` computations run at once. A request that gets no worker within
-    ``settings.timeout`` fails with :class:`ServiceUnavailable` ("busy"); a computation that runs
-    longer than ``settings.timeout`` is stopped by killing its worker (a new one replaces it) and
-    its requests fail with :class:`ServiceUnavailable` ("exceeded"). The asyncio side is rebuilt
-    when the pool is used from another event loop (test clients); the processes are kept.
+    ``settings.timeout`` fails with :class:`ServiceUnavailable` (503, "busy"); a computation that
+    runs longer than ``settings.timeout`` is stopped by killing its worker (a new one replaces it)
+    and its requests fail with a :class:`RequestError` (422) naming the field that sizes the
+    work. The asyncio side is rebuilt when the pool is used from another event loop (test
+    clients); the processes are kept.
     """
 
     def __init__(self, settings: Settings | None = None) -> None:
@@ -804,10 +815,11 @@ class ComputePool:
         except TimeoutError:
             self.stats["exceeded"] += 1
             self._replace(worker)
-            raise ServiceUnavailable(
+            field, less = _WORK_FIELDS.get(kind, ("request", "less work"))
+            raise RequestError(
+                field,
                 f"the computation exceeded the time limit of {self.settings.timeout:g} s and "
-                "was stopped; ask for less work (fewer cycles or path points, a lower "
-                "max_iterations, a smaller grid or degree)"
+                f"was stopped; ask for less work ({less})",
             ) from None
         except (EOFError, OSError) as exc:
             self._replace(worker)

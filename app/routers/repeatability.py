@@ -2,7 +2,7 @@
 
 from fastapi import APIRouter, Request
 
-from app.schemas import ErrorResponse, RepeatabilityRequest, RepeatabilityResponse
+from app.schemas import BUSY, RepeatabilityRequest, RepeatabilityResponse
 
 router = APIRouter(tags=["repeatability"])
 
@@ -10,7 +10,7 @@ router = APIRouter(tags=["repeatability"])
 @router.post(
     "/repeatability",
     response_model=RepeatabilityResponse,
-    responses={503: {"model": ErrorResponse, "description": "busy or over the time limit"}},
+    responses=BUSY,
 )
 async def repeatability(req: RepeatabilityRequest, request: Request) -> dict:
     """Configurations after each leg, at each cycle end, and the drift from x0 per cycle."""

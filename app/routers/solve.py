@@ -2,7 +2,7 @@
 
 from fastapi import APIRouter, Request
 
-from app.schemas import ErrorResponse, SolveRequest, SolveResponse
+from app.schemas import BUSY, SolveRequest, SolveResponse
 
 router = APIRouter(tags=["solve"])
 
@@ -10,7 +10,7 @@ router = APIRouter(tags=["solve"])
 @router.post(
     "/solve",
     response_model=SolveResponse,
-    responses={503: {"model": ErrorResponse, "description": "busy or over the time limit"}},
+    responses=BUSY,
 )
 async def solve(req: SolveRequest, request: Request) -> dict:
     """Solve k(x) = target from x0 with the pseudoinverse (8) or the extended inverse (11)."""

@@ -3,7 +3,7 @@
 from fastapi import APIRouter, Request
 
 from app.schemas import (
-    ErrorResponse,
+    BUSY,
     SynthesisMethodsResponse,
     SynthesizeRequest,
     SynthesizeResponse,
@@ -22,7 +22,7 @@ async def methods() -> SynthesisMethodsResponse:
 @router.post(
     "/synthesize",
     response_model=SynthesizeResponse,
-    responses={503: {"model": ErrorResponse, "description": "busy or over the time limit"}},
+    responses=BUSY,
 )
 async def synthesize(req: SynthesizeRequest, request: Request) -> dict:
     """h on a grid of the box, its coefficients and E1, E2 over the box."""

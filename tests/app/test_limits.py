@@ -41,17 +41,19 @@ async def _overrun(app):
 
 
 def test_overrun_is_stopped_and_health_stays_responsive():
-    """A 1000-cycle run overruns its 1.5 s limit: 503, its worker is killed and replaced, and
-    the solve queued behind it is then served. /health answers quickly throughout."""
+    """A 1000-cycle run overruns its 1.5 s limit: 422 naming cycles, its worker is killed and
+    replaced, and the solve queued behind it is then served. /health answers quickly meanwhile."""
     app = create_app(Settings(workers=1, timeout=1.5))
     try:
         heavy, queued, health = asyncio.run(_overrun(app))
         stats = app.state.pool.stats
     finally:
         app.state.pool.close()
-    assert heavy.status_code == 503
-    assert "exceeded the time limit of 1.5 s and was stopped" in heavy.json()["detail"]
-    assert heavy.headers["retry-after"] == "1"
+    assert heavy.status_code == 422
+    (err,) = heavy.json()["detail"]
+    assert err["loc"] == ["body", "cycles"]
+    assert err["msg"].startswith("cycles: the computation exceeded the time limit of 1.5 s and")
+    assert "fewer cycles or path points" in err["msg"]
     assert stats["exceeded"] == 1
     assert queued.status_code == 200 and queued.json()["converged"]
     assert len(health) >= 5
@@ -84,3 +86,4 @@ def test_no_free_slot_is_busy_503():
     for r in (solve, rep):
         assert r.status_code == 503
         assert r.json()["detail"].startswith("server busy: no compute slot became free within")
+        assert r.headers["retry-after"] == "1"
