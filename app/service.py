@@ -20,7 +20,6 @@ from __future__ import annotations
 import asyncio
 import concurrent.futures
 import importlib
-import json
 import os
 import socket
 import subprocess
@@ -257,10 +256,8 @@ def robots_response(timeout: float | None = None) -> S.RobotsResponse:
 
 def batch_key(req: S.SolveRequest) -> str:
     """Requests with equal keys can share one batched engine call."""
-    d = req.model_dump(exclude={"x0", "target"})
-    if req.algorithm == "pseudoinverse":
-        d["augmentation"] = None
-    return json.dumps(d, sort_keys=True, default=str)
+    exclude = {"x0", "target"} | ({"augmentation"} if req.algorithm == "pseudoinverse" else set())
+    return req.model_dump_json(exclude=exclude)
 
 
 def solve_batch(reqs: list[S.SolveRequest]) -> list[S.SolveResponse | RequestError]:
@@ -578,25 +575,29 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
 # Worker processes
 
 
-def _solve_payload(items: list[dict]) -> list[tuple[str, Any]]:
-    reqs = [S.SolveRequest.model_validate(d) for d in items]
+def _solve_payload(items: list[bytes]) -> list[tuple[str, Any]]:
+    reqs = [S.SolveRequest.model_validate_json(b) for b in items]
     out = []
     for res in solve_batch(reqs):
         if isinstance(res, RequestError):
             out.append(("request_error", (res.field, res.message)))
         else:
-            out.append(("ok", res.model_dump(mode="json")))
+            out.append(("ok", res.model_dump_json().encode()))
     return out
 
 
+# Workers take requests and give responses as JSON bytes: (de)serialization and validation run in
+# the workers, in parallel, and the event loop only passes bytes along.
 _HANDLERS: dict[str, Callable[[Any], Any]] = {
     "ping": lambda payload: "pong",
     "solve": _solve_payload,
-    "repeatability": lambda d: repeatability_request(
-        S.RepeatabilityRequest.model_validate(d)
-    ).model_dump(mode="json"),
-    "synthesize": lambda d: synthesize_request(S.SynthesizeRequest.model_validate(d)).model_dump(
-        mode="json"
+    "repeatability": lambda b: (
+        repeatability_request(S.RepeatabilityRequest.model_validate_json(b))
+        .model_dump_json()
+        .encode()
+    ),
+    "synthesize": lambda b: (
+        synthesize_request(S.SynthesizeRequest.model_validate_json(b)).model_dump_json().encode()
     ),
 }
 
@@ -713,7 +714,7 @@ def _retrieve(future: asyncio.Future) -> None:
 
 @dataclass
 class _Pending:
-    payload: dict
+    payload: bytes
     future: asyncio.Future
     deadline: float
     dispatched: bool = False
@@ -846,16 +847,19 @@ class ComputePool:
         raise ComputeError(value)
 
     async def run(self, kind: str, payload) -> Any:
-        """Run handler ``kind`` on ``payload`` in a worker (waits and runs within the limits)."""
+        """Run handler ``kind`` on ``payload`` in a worker (waits and runs within the limits).
+
+        For the API kinds the payload is the request and the result the response, as JSON bytes.
+        """
         self._bind()
         worker = await self._acquire(self._loop.time() + self.settings.timeout)
         return self._unwrap(await self._dispatch(worker, kind, payload))
 
     # -- micro-batched solves
-    async def solve(self, req: S.SolveRequest) -> dict:
-        """One /solve request; micro-batched with compatible concurrent ones."""
+    async def solve(self, req: S.SolveRequest) -> bytes:
+        """One /solve request (JSON response bytes); micro-batched with compatible ones."""
         self._bind()
-        payload = req.model_dump(mode="json")
+        payload = req.model_dump_json().encode()
         if not self.settings.batching:
             self.stats["solve_calls"] += 1
             self.stats["solve_requests"] += 1

@@ -1,6 +1,6 @@
 """POST /repeatability: a closed task-space path driven several times (Table 1)."""
 
-from fastapi import APIRouter, Request
+from fastapi import APIRouter, Request, Response
 
 from app.schemas import BUSY, RepeatabilityRequest, RepeatabilityResponse
 
@@ -12,6 +12,7 @@ router = APIRouter(tags=["repeatability"])
     response_model=RepeatabilityResponse,
     responses=BUSY,
 )
-async def repeatability(req: RepeatabilityRequest, request: Request) -> dict:
+async def repeatability(req: RepeatabilityRequest, request: Request) -> Response:
     """Configurations after each leg, at each cycle end, and the drift from x0 per cycle."""
-    return await request.app.state.pool.run("repeatability", req.model_dump(mode="json"))
+    body = await request.app.state.pool.run("repeatability", req.model_dump_json().encode())
+    return Response(body, media_type="application/json")

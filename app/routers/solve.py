@@ -1,6 +1,6 @@
 """POST /solve: one run of the continuation algorithm (7), micro-batched with its neighbours."""
 
-from fastapi import APIRouter, Request
+from fastapi import APIRouter, Request, Response
 
 from app.schemas import BUSY, SolveRequest, SolveResponse
 
@@ -12,6 +12,10 @@ router = APIRouter(tags=["solve"])
     response_model=SolveResponse,
     responses=BUSY,
 )
-async def solve(req: SolveRequest, request: Request) -> dict:
-    """Solve k(x) = target from x0 with the pseudoinverse (8) or the extended inverse (11)."""
-    return await request.app.state.pool.solve(req)
+async def solve(req: SolveRequest, request: Request) -> Response:
+    """Solve k(x) = target from x0 with the pseudoinverse (8) or the extended inverse (11).
+
+    The body comes from a worker as JSON already validated against ``SolveResponse``.
+    """
+    body = await request.app.state.pool.solve(req)
+    return Response(body, media_type="application/json")

@@ -1,6 +1,6 @@
 """POST /synthesize: an augmenting map h on a box, synthesized or from the catalogue."""
 
-from fastapi import APIRouter, Request
+from fastapi import APIRouter, Request, Response
 
 from app.schemas import (
     BUSY,
@@ -24,6 +24,7 @@ async def methods() -> SynthesisMethodsResponse:
     response_model=SynthesizeResponse,
     responses=BUSY,
 )
-async def synthesize(req: SynthesizeRequest, request: Request) -> dict:
+async def synthesize(req: SynthesizeRequest, request: Request) -> Response:
     """h on a grid of the box, its coefficients and E1, E2 over the box."""
-    return await request.app.state.pool.run("synthesize", req.model_dump(mode="json"))
+    body = await request.app.state.pool.run("synthesize", req.model_dump_json().encode())
+    return Response(body, media_type="application/json")
