@@ -446,8 +446,10 @@ class CharacteristicsMap(AugmentingMap):
             phi, s, x = self._cache[2]
             if phi is None:
                 raise OneFormUndefinedError(
-                    "the characteristic (28) of h could not be resolved (Newton on the "
-                    "collocation system did not converge; omega blows up along it)",
+                    "h(x) is undefined: its characteristic (28) could not be resolved (Newton "
+                    "on the collocation system, up to 4n - 3 nodes, did not converge): it runs "
+                    f"into a near-zero of the kernel component {self.fixed_index} (0-based) of "
+                    f"{self.kinematics.name}, where omega and dz/ds blow up",
                     x,
                 )
             raise OneFormUndefinedError(

@@ -83,8 +83,10 @@ def _diagnose(lam, h, strict, stopped_singular) -> tuple[int | None, list[str]]:
                 else (f"; h jumped from {h[k - 1]:.4g} to {h[k]:.4g}" if np.isfinite(h[k]) else "")
             )
             notes.append(
-                f"lambda10 crossed 0 at iteration {k} (lambda10 = {lam[k, 0]:.4g}): the leaves "
-                f"E_(a,alpha) need lambda10 != 0, there omega blows up{jump}"
+                f"lambda10 crossed 0 at iteration {k} (lambda10 = {lam[k, 0]:.4g}): outside the "
+                f"foliation's domain (leaves E_(a,alpha) need lambda10 != 0), the characteristic "
+                f"from the reference leaf lambda10 = a passes lambda10 = 0, near which the "
+                f"normalising kernel component of omega can vanish{jump}"
             )
     if big.size:
         stop = int(big[0])
