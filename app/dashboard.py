@@ -14,7 +14,9 @@ in continuous mode only rescales the theta axis without a new integration.
 
 from __future__ import annotations
 
+import hashlib
 import json
+import logging
 import threading
 import time
 from collections.abc import Callable, Mapping
@@ -37,6 +39,7 @@ MAX_DASHBOARD_CYCLES = 20
 #: Time grid points of one unicycle platform path q(t).
 UNICYCLE_TIME_POINTS = 96
 DEFAULT_ROBOT = "manipulator2"
+log = logging.getLogger("jik.dashboard")
 
 
 class Cancelled(Exception):
@@ -84,6 +87,8 @@ def default_state(robot: str = DEFAULT_ROBOT) -> DashboardState:
     """The registry's defaults for ``robot``."""
     spec = robot_spec(robot)
     aug = spec.augmentation(None)
+    # A platform (the unicycle) starts with the paper's experiment of sec. 6.2: one target.
+    closed = bool(spec.default_path) and not hasattr(spec.build(), "path")
     params = {p.name: p.default for p in spec.parameters}
     params.update({v.name: tuple(v.default) for v in spec.vector_parameters})
     return DashboardState(
@@ -94,10 +99,10 @@ def default_state(robot: str = DEFAULT_ROBOT) -> DashboardState:
         gamma=float(spec.default_gamma),
         mode=spec.default_mode,
         x0=tuple(float(v) for v in spec.default_x0),
-        task="path" if spec.default_path else "target",
+        task="path" if closed else "target",
         target=tuple(float(v) for v in spec.default_target),
         path=tuple(tuple(float(v) for v in p) for p in spec.default_path),
-        cycles=3 if spec.default_path else 1,
+        cycles=3 if closed else 1,
     )
 
 
@@ -243,7 +248,54 @@ def _leg_targets(kin, state: DashboardState) -> np.ndarray:
     return closed_path(kin, np.asarray([state.x0]), np.asarray(state.path))[0]
 
 
-def _run_legs(inverse, state, targets, cycles, progress, cancelled) -> AlgorithmRun:
+#: Discrete mode runs in chunks of this many iterations, so that a newer change cancels it.
+CHUNK = 40
+#: Iteration cap of one discrete leg (the engine's default).
+MAX_DISCRETE_ITERATIONS = 2000
+
+
+def _solve_leg(inverse, x, target, state, gamma, cancelled, partial=lambda f: None):
+    """One leg: a solve, or in discrete mode a chain of short solves (the same iterates).
+
+    The discrete iteration x <- x - gamma J#(x) e(x) has no memory, so stopping after CHUNK
+    iterations and restarting from the last iterate reproduces the uninterrupted sequence.
+    Returns (theta, x, y, error, h, success, message) of the whole leg.
+    """
+    if state.mode == "continuous":
+        res = solve(inverse, x, target, gamma=gamma, mode="continuous", tol=state.tol)
+        tr = res.trajectory
+        return tr.theta, tr.x, tr.y, tr.error, tr.h, res.success, res.message, res.x
+    pieces, done = [], 0
+    while True:
+        res = solve(inverse, x, target, gamma=gamma, mode="discrete", tol=state.tol,
+                    max_iterations=CHUNK)  # fmt: skip
+        tr = res.trajectory
+        first = 0 if not pieces else 1  # a chunk starts where the previous one ended
+        pieces.append((tr.theta[first:] + done, tr.x[first:], tr.y[first:], tr.error[first:],
+                       None if tr.h is None else tr.h[first:]))  # fmt: skip
+        done += res.nit
+        x = res.x
+        if res.success or res.nit < CHUNK or done >= MAX_DISCRETE_ITERATIONS:
+            break
+        if cancelled():
+            raise Cancelled
+        # The error decays geometrically: the fraction of the way to tol, on a log scale.
+        e0, e = float(pieces[0][3][0]), float(res.error)
+        partial(np.clip(np.log(e0 / e) / np.log(e0 / state.tol), 0.0, 0.99) if e0 > e > 0 else 0)
+    message = res.message
+    if not res.success and res.nit == CHUNK:
+        message = (
+            f"did not converge within {done} iterations (error {res.error:.3g}); "
+            "raise gamma or move the start"
+        )
+    elif res.success:
+        message = f"converged: task error {res.error:.3g} after {done} iterations"
+    cat = [np.concatenate([p[k] for p in pieces]) for k in range(4)]
+    h = None if pieces[0][4] is None else np.concatenate([p[4] for p in pieces])
+    return (*cat, h, res.success, message, res.x)
+
+
+def _run_legs(inverse, state, targets, cycles, progress, cancelled, partial) -> AlgorithmRun:
     """Drive ``inverse`` through the legs as :func:`engine.repeatability.repeatability` does."""
     t0 = time.perf_counter()
     x0 = np.asarray(state.x0)
@@ -251,22 +303,35 @@ def _run_legs(inverse, state, targets, cycles, progress, cancelled) -> Algorithm
     gamma = 1.0 if state.mode == "continuous" else state.gamma
     current, offset = x0, 0.0
     parts, ends, drift = [], [], []
-    success, message = True, "completed"
+    success, message, last_message = True, "completed", ""
     L = len(targets)
     for c in range(cycles):
         for j in range(L):
             if cancelled():
                 raise Cancelled
-            res = solve(inverse, current, targets[j], gamma=gamma, mode=state.mode, tol=state.tol)
-            tr = res.trajectory
-            parts.append((tr.theta + offset, tr.x, tr.y, tr.error, tr.h, c * L + j))
-            offset += float(tr.theta[-1])
-            progress()
-            if not res.success:
-                success, message = False, f"cycle {c + 1}, leg {j + 1}: {res.message}"
+            try:
+                leg = _solve_leg(inverse, current, targets[j], state, gamma, cancelled, partial)
+            except JikError as exc:
+                # A map undefined on the way (an algorithmic singularity, a characteristic that
+                # cannot be resolved) stops this algorithm; the other one is still shown.
+                y = inverse.kinematics.forward(current)
+                h = inverse.augmenting_value(current[None, :])
+                parts.append((np.array([offset]), current[None, :], y[None, :],
+                              np.array([np.linalg.norm(y - targets[j])]),
+                              None if h is None else np.asarray(h), c * L + j))  # fmt: skip
+                success, message = False, f"cycle {c + 1}, leg {j + 1} stopped: {exc}"
+                progress()
                 break
-            current = res.x
-            ends.append(res.x)
+            theta, xs, ys, err, h, ok, msg, x_end = leg
+            parts.append((theta + offset, xs, ys, err, h, c * L + j))
+            offset += float(theta[-1])
+            progress()
+            if not ok:
+                success, message = False, f"cycle {c + 1}, leg {j + 1}: {msg}"
+                break
+            current = x_end
+            ends.append(x_end)
+            last_message = msg
         if not success:
             break
         if state.task == "path":
@@ -284,6 +349,8 @@ def _run_legs(inverse, state, targets, cycles, progress, cancelled) -> Algorithm
         success=success,
         message=message
         if not success
+        else last_message
+        if len(ends) == 1
         else (
             f"{len(ends)} legs converged"
             + (f", drift after cycle {len(drift)}: {drift[-1]:.3g}" if drift else "")
@@ -308,6 +375,7 @@ def compute(
     progress: Callable[[float], None] | None = None,
     cancelled: Callable[[], bool] = lambda: False,
     cache: dict | None = None,
+    with_augmenting: bool = True,
 ) -> DashboardResult:
     """Solve the state's task with both algorithms.
 
@@ -320,6 +388,8 @@ def compute(
     cache : dict, optional
         Runs keyed by everything they depend on (gamma excluded in continuous mode); reused
         and filled.
+    with_augmenting : bool
+        Evaluate h on a grid for the h panel now (see :func:`augmenting_grid`).
 
     Raises
     ------
@@ -343,13 +413,17 @@ def compute(
         if progress is not None:
             progress(done[0] / total)
 
+    def partial(fraction: float) -> None:
+        if progress is not None:
+            progress((done[0] + float(fraction)) / total)
+
     runs: dict[str, AlgorithmRun] = {}
     for algorithm in ALGORITHMS:
         if algorithm in todo:
             inverse = make_inverse(
                 kin, algorithm, state.augmentation, state.augmentation_parameters, spec.name
             )
-            run = _run_legs(inverse, state, targets, cycles, step, cancelled)
+            run = _run_legs(inverse, state, targets, cycles, step, cancelled, partial)
             if hasattr(kin, "path"):
                 t = np.linspace(0.0, float(kin.T), UNICYCLE_TIME_POINTS)
                 run = replace(run, platform=kin.path(run.x, t))
@@ -370,7 +444,7 @@ def compute(
         targets=targets,
         runs=runs,
         time=np.linspace(0.0, float(kin.T), UNICYCLE_TIME_POINTS) if hasattr(kin, "path") else None,
-        augmenting=augmenting_grid(kin, state, runs),
+        augmenting=augmenting_grid(kin, state, runs) if with_augmenting else None,
         seconds=time.perf_counter() - t0,
         cached={a: a not in todo for a in ALGORITHMS},
     )
@@ -379,10 +453,19 @@ def compute(
 def augmenting_axes(amap, x: np.ndarray) -> tuple[int, int]:
     """The two joint variables h depends on most along the configurations ``x`` (n, p)."""
     with np.errstate(all="ignore"):
-        g = np.abs(np.asarray(amap.gradient(x), dtype=float))
-    weight = np.nan_to_num(np.mean(g, axis=0)) * (np.ptp(x, axis=0) + 1.0)
+        if hasattr(amap, "evaluate"):
+            g = np.abs(np.asarray(amap.evaluate(x)[1], dtype=float))
+        else:
+            g = np.abs(np.asarray(amap.gradient(x), dtype=float))
+    weight = np.nan_to_num(np.nanmean(g, axis=0)) * (np.ptp(x, axis=0) + 1.0)
     i, j = sorted(np.argsort(-weight, kind="stable")[:2])
     return int(i), int(j)
+
+
+def expensive_map(amap) -> bool:
+    """Maps evaluated by solving a problem per point (characteristics): h is computed after
+    the runs have been shown, on a coarser grid."""
+    return hasattr(amap, "evaluate")
 
 
 def augmenting_grid(kin, state: DashboardState, runs: Mapping[str, AlgorithmRun], n: int = 61):
@@ -404,14 +487,18 @@ def augmenting_grid(kin, state: DashboardState, runs: Mapping[str, AlgorithmRun]
             if spec.x_range:
                 lo, hi = max(lo, spec.x_range[k][0]), min(hi, spec.x_range[k][1])
             box.append((lo, hi))
-        if n > 25 and kin.p > 3:
-            n = 25  # the unicycle's h solves a collocation problem per point
+        if expensive_map(amap):
+            n = min(n, 15)  # h solves a collocation problem per point
         u, v = np.linspace(*box[0], n), np.linspace(*box[1], n)
         X = np.broadcast_to(np.asarray(state.x0, dtype=float), (n, n, kin.p)).copy()
         X[..., i] = u[None, :]
         X[..., j] = v[:, None]
         with np.errstate(all="ignore"):
-            H = np.asarray(amap.value(X.reshape(-1, kin.p)), dtype=float).reshape(n, n)
+            if hasattr(amap, "evaluate"):  # maps that can be undefined at some points
+                H = np.asarray(amap.evaluate(X.reshape(-1, kin.p))[0], dtype=float)
+            else:
+                H = np.asarray(amap.value(X.reshape(-1, kin.p)), dtype=float)
+        H = H.reshape(n, n)
     except (JikError, ValueError, ArithmeticError):
         return None
     H = np.where(np.isfinite(H), H, np.nan)
@@ -423,6 +510,8 @@ def error_functionals(result: DashboardResult, nodes: int = 12) -> dict | None:
     grid = result.augmenting
     if grid is None:
         return None
+    if expensive_map(grid["map"]):
+        nodes = min(nodes, 6)
     try:
         from engine.functionals import error_functional_e1, error_functional_e2
     except ImportError:
@@ -507,9 +596,13 @@ class Dashboard:
         self._changed_at = {1: time.perf_counter()}
         self._listeners: list[Callable[[Event], None]] = []
         self._cache: dict = {}
-        self._latest: dict[str, Event] = {}
+        self._latest: dict[str, Event] = {
+            "state": Event("state", 1, _json(self._state_message(1, self._state, "initial")))
+        }
         self.result: DashboardResult | None = None
         self.functionals: dict | None = None
+        #: What the 3D scene last drew (set by app.scene), for the page and the tests.
+        self.scene_status: dict = {}
         self._thread: threading.Thread | None = None
         self._stopped = False
 
@@ -595,6 +688,7 @@ class Dashboard:
                 "state": self._state.as_dict(),
                 "summary": None if result is None else summary(result),
                 "functionals": self.functionals,
+                "scene": dict(self.scene_status),
             }
 
     # -- worker -----------------------------------------------------------------------------
@@ -624,7 +718,14 @@ class Dashboard:
                     if self._generation == seen or self._stopped:
                         break
                 generation, state = self._generation, self._state
-            self._compute(generation, state)
+            try:
+                self._compute(generation, state)
+            except Exception as exc:  # keep the worker alive; the page shows the message
+                log.exception("dashboard computation failed")
+                message = f"internal error: {type(exc).__name__}: {exc}"
+                self._emit(Event("error", generation, _json(
+                    {"type": "error", "generation": generation, "message": message})))  # fmt: skip
+                self._finish(generation)
 
     def _finish(self, generation: int) -> None:
         with self._cond:
@@ -647,10 +748,15 @@ class Dashboard:
                     "elapsed": now - t0,
                 })))  # fmt: skip
 
+        spec = robot_spec(state.robot)
         try:
+            kin = spec.build(**state.robot_parameters)
+            amap = spec.augmentation(state.augmentation).build(kin, **state.augmentation_parameters)
+            deferred = expensive_map(amap)
             result = compute(
                 state, generation, progress=progress,
                 cancelled=lambda: self._generation != generation, cache=self._cache,
+                with_augmenting=not deferred,
             )  # fmt: skip
         except Cancelled:
             return
@@ -667,10 +773,12 @@ class Dashboard:
             "timing": {"compute": result.seconds, "figures": ready - t0 - result.seconds,
                        "server_total": ready - started},
         }  # fmt: skip
+        texts = {k: f.to_json() for k, f in figures.items()}
+        head["digests"] = {k: hashlib.md5(t.encode()).hexdigest()[:16] for k, t in texts.items()}
         data = (
             _json(head)[:-1]
             + ',"figures":{'
-            + ",".join(f'"{k}":{f.to_json()}' for k, f in figures.items())
+            + ",".join(f'"{k}":{t}' for k, t in texts.items())
             + "}}"
         )
         with self._cond:
@@ -678,11 +786,18 @@ class Dashboard:
             self._changed_at = {g: t for g, t in self._changed_at.items() if g > generation}
         self._emit(Event("result", generation, data, result))
         self._finish(generation)
-        # Second phase: E1 and E2 of the current map (quadrature) refine the h panel.
+        # Second phase: h on a grid when it is expensive, then E1 and E2 (quadrature).
         if self._generation != generation:
             return
+        if deferred:
+            grid = augmenting_grid(kin, state, result.runs)
+            if self._generation != generation:
+                return
+            result = replace(result, augmenting=grid)
+            with self._cond:
+                self.result = result
         functionals = error_functionals(result)
-        if functionals is None or self._generation != generation:
+        if self._generation != generation or (functionals is None and not deferred):
             return
         fig = augmenting_figure(result, functionals)
         with self._cond:

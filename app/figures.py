@@ -19,7 +19,7 @@ UNITS = {
     "manipulator2": (("m", "m", "rad"), ("m", "m")),
     "unicycle": (("m/s", "m/s", "rad/s", "rad/s"), ("m", "m", "rad")),
 }
-PANEL_HEIGHT = 340
+PANEL_HEIGHT = 380
 _AXIS = dict(
     gridcolor="#e6e6e6", zerolinecolor="#b0b0b0", linecolor="#888", showline=True, mirror=True,
     ticks="outside", automargin=True,
@@ -32,8 +32,8 @@ _TEMPLATE = go.layout.Template(
 _LAYOUT = dict(
     template=_TEMPLATE,
     height=PANEL_HEIGHT,
-    margin=dict(l=60, r=20, t=48, b=48),
-    legend=dict(orientation="h", yanchor="bottom", y=1.0, xanchor="right", x=1.0),
+    margin=dict(l=64, r=20, t=40, b=100),
+    legend=dict(orientation="h", yanchor="top", y=-0.2, xanchor="left", x=0, font=dict(size=10)),
     font=dict(size=11),
     hovermode="closest",
     uirevision="keep",  # keep the user's zoom across updates of the same robot
@@ -68,7 +68,7 @@ def _leg_names(n: int) -> list[str]:
 
 def _figure(data: list, title: str, **layout) -> go.Figure:
     """One-shot construction: plotly validates once (incremental updates cost ~10x more)."""
-    base = {**_LAYOUT, "title": dict(text=title, font=dict(size=13))}
+    base = {**_LAYOUT, "title": dict(text=title, font=dict(size=13), x=0.01, xanchor="left")}
     return go.Figure(data=data, layout={**base, **layout})
 
 
@@ -151,7 +151,8 @@ def joint_figure(result: DashboardResult) -> go.Figure:
         if is_unicycle(result)
         else "Joint trajectories (Figs. 7-9)"
     )
-    return _figure(data, title, height=110 * len(names) + 110, **axes)
+    legend = dict(_LAYOUT["legend"], y=-0.5 / len(names))
+    return _figure(data, title, height=120 * len(names) + 150, legend=legend, **axes)
 
 
 def drift_figure(result: DashboardResult) -> go.Figure:
@@ -237,7 +238,7 @@ def platform_figure(result: DashboardResult, max_paths: int = 12) -> go.Figure:
         m = len(P)
         show = sorted(set(np.geomspace(1, m, num=max_paths).astype(int) - 1) | {0, m - 1})
         for n, i in enumerate(show):
-            last = i == m - 1
+            last = bool(i == m - 1)
             data.append(
                 go.Scatter(
                     x=P[i, :, 0], y=P[i, :, 1], mode="lines", xaxis=xa, yaxis=ya,
@@ -271,7 +272,7 @@ def platform_figure(result: DashboardResult, max_paths: int = 12) -> go.Figure:
         yaxis=dict(title=_label("q2", tu[1]), scaleanchor="x", scaleratio=1),
         yaxis2=dict(anchor="x2", matches="y", showticklabels=False),
         annotations=annotations,
-        margin=dict(l=60, r=20, t=70, b=48),
+        margin=dict(l=64, r=20, t=64, b=100),
     )
 
 
@@ -285,7 +286,7 @@ def augmenting_figure(result: DashboardResult, functionals: dict | None = None) 
     grid = result.augmenting
     title = f"Augmenting map h: {result.state.augmentation}"
     if grid is None:
-        return _figure([], title + " (cannot be evaluated here)")
+        return _figure([], title + " (computing h on a grid…)")
     i, j = grid["axes"]
     ni, nj = result.variable_names[i], result.variable_names[j]
     H = grid["h"]
@@ -324,6 +325,8 @@ def augmenting_figure(result: DashboardResult, functionals: dict | None = None) 
             v = functionals.get(key)
             parts.append(f"{key} = {v:.4g}" if v is not None else f"{key} undefined")
         title += " · " + ", ".join(parts) + " on this box"
+        if any(functionals.get(f"{k}_error") for k in ("E1", "E2")):
+            title += " (h is not defined on all of it)"
     fixed = [f"{n} = {x0[k]:.3g}" for k, n in enumerate(result.variable_names) if k not in (i, j)]
     annotations = []
     if fixed:
@@ -338,8 +341,6 @@ def augmenting_figure(result: DashboardResult, functionals: dict | None = None) 
         xaxis=dict(title=_label(ni, ju[i])),
         yaxis=dict(title=_label(nj, ju[j])),
         annotations=annotations,
-        legend=dict(orientation="h", yanchor="top", y=-0.25, xanchor="left", x=0),
-        margin=dict(l=60, r=20, t=48, b=80),
     )
 
 

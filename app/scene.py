@@ -319,6 +319,7 @@ class DashboardScene:
         def _(_) -> None:
             self.playing = not self.playing
             self.play.label = "Pause" if self.playing else "Play"
+            self.dashboard.scene_status["playing"] = self.playing
 
         @self.scrub.on_update
         def _(_) -> None:
@@ -326,6 +327,7 @@ class DashboardScene:
                 return
             self.playing = False
             self.play.label = "Play"
+            self.dashboard.scene_status["playing"] = False
             self._s = float(self.scrub.value) * self._timeline.length
 
     def _change(self, patch: dict) -> None:
@@ -610,7 +612,9 @@ class DashboardScene:
             self._s = 0.0
             self._pose(0.0)
             self.drawn_generation = result.generation
-            self.dashboard.scene_status = {"generation": result.generation, "robot": state.robot}
+            self.dashboard.scene_status.update(
+                generation=result.generation, robot=state.robot, playing=self.playing
+            )
         self.progress.visible = False
         p, e = result.runs["pseudoinverse"], result.runs["extended"]
         if state.task == "path" and len(p.drift) and len(e.drift):
@@ -627,12 +631,12 @@ class DashboardScene:
         center = np.array([(xlo + xhi) / 2, (ylo + yhi) / 2, 0.0])
         size = max(xhi - xlo, yhi - ylo)
         position = center + np.array([0.0, -0.75 * size, 1.05 * size])
-        self.server.initial_camera.look_at = center
         self.server.initial_camera.position = position
+        self.server.initial_camera.look_at = center
         for client in self.server.get_clients().values():
             with client.atomic():
-                client.camera.look_at = center
                 client.camera.position = position
+                client.camera.look_at = center
 
     def _draw_traces(self, result, extent) -> None:
         scene = self.server.scene

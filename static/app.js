@@ -47,15 +47,19 @@ async function flush() {
   queued = {};
   queuedSince = null;
   if (!Object.keys(patch).length) return;
+  // Any result newer than the last generation known now answers this change (the result can
+  // arrive before the POST's response).
+  if (!jik.pending.has(jik.generation)) jik.pending.set(jik.generation, since);
   const res = await fetch("/api/dashboard/state", {
     method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(patch),
   });
   const body = await res.json();
   if (!res.ok) {
     setStatus(body.detail.map((d) => d.msg).join("; "), true);
+    jik.pending.delete(jik.generation);
     return;
   }
-  jik.pending.set(body.generation, since);
+  jik.generation = Math.max(jik.generation, body.generation);
 }
 
 // ---------------------------------------------------------------- controls
@@ -210,24 +214,32 @@ function onState(msg) {
   if (msg.generation > jik.shownGeneration) setStatus(`computing generation ${msg.generation}…`);
 }
 
-async function drawFigures(figures) {
+const drawn = {}; // panel -> digest of the figure on screen
+async function drawFigures(figures, digests = {}) {
   await Promise.all(Object.entries(figures).map(([key, fig]) => {
     const div = document.getElementById(`plot-${key}`);
-    return div ? Plotly.react(div, fig.data, fig.layout, PLOT_CONFIG) : null;
+    if (!div || (digests[key] && drawn[key] === digests[key])) return null; // unchanged panel
+    drawn[key] = digests[key];
+    return Plotly.react(div, fig.data, fig.layout, PLOT_CONFIG);
   }));
 }
 
 async function onResult(msg) {
   if (msg.generation < jik.shownGeneration) return;
   if (!jik.state) onState({ state: msg.state, generation: msg.generation });
-  await drawFigures(msg.figures);
+  await drawFigures(msg.figures, msg.digests);
   const now = performance.now();
   jik.shownGeneration = msg.generation;
   document.body.dataset.generation = msg.generation;
   document.body.dataset.robot = msg.state.robot;
-  for (const [g, since] of [...jik.pending]) {
-    if (g <= msg.generation) {
-      jik.lastLatency = { generation: msg.generation, ms: now - since, server: msg.timing };
+  for (const [before, since] of [...jik.pending]) {
+    if (msg.generation > before) {
+      const g = before;
+      jik.lastLatency = {
+        generation: msg.generation, ms: now - since, server: msg.timing,
+        arrived: msg.browser.arrived - since, parse: msg.browser.parsed - msg.browser.arrived,
+        draw: now - msg.browser.parsed,
+      };
       jik.latencies.push(jik.lastLatency);
       jik.pending.delete(g);
     }
@@ -275,7 +287,12 @@ function connect() {
   const serial = (fn) => (msg) => { chain = chain.then(() => fn(msg)).catch((err) => setStatus(String(err), true)); };
   on("state", onState);
   on("progress", (msg) => { if (msg.generation === jik.generation) showProgress(msg.fraction, msg.elapsed); });
-  on("result", serial(onResult));
+  source.addEventListener("result", (ev) => {
+    const arrived = performance.now();
+    const msg = JSON.parse(ev.data);
+    msg.browser = { arrived, parsed: performance.now() };
+    serial(onResult)(msg);
+  });
   on("functionals", serial(onFunctionals));
   on("error", (msg) => { if (msg.generation === jik.generation) { showProgress(1, 0); setStatus(msg.message, true); } });
   source.onerror = () => setStatus("connection lost; reconnecting…", true);

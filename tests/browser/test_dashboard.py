@@ -1,0 +1,229 @@
+"""The dashboard in a real browser: Debian's chromium driven by Playwright against `jik serve`.
+
+Nothing is installed here: the test uses /usr/bin/chromium (``.ci/run`` installs it) and is
+skipped with a reason when it is missing. Screenshots go to tests/artifacts/.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from pathlib import Path
+
+import pytest
+
+pytestmark = pytest.mark.browser
+
+CHROMIUM = "/usr/bin/chromium"
+ARGS = [
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--no-first-run",
+]
+ARTIFACTS = Path(__file__).resolve().parents[1] / "artifacts"
+PANELS = ("task", "drift", "joints", "augmenting", "table")
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _get(url: str) -> dict:
+    with urllib.request.urlopen(url, timeout=5) as r:
+        return json.loads(r.read())
+
+
+@pytest.fixture(scope="module")
+def served():
+    """`jik serve` on free ports; yields (base url, scene port)."""
+    if not os.path.exists(CHROMIUM):
+        pytest.skip(f"{CHROMIUM} not found: install Debian's chromium (.ci/run does)")
+    pytest.importorskip("playwright.sync_api", reason="playwright (Python package) not installed")
+    port, scene_port = _free_port(), _free_port()
+    log = open(ARTIFACTS / "jik-serve.log", "w") if ARTIFACTS.is_dir() else subprocess.DEVNULL
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "app.cli", "serve", "--port", str(port), "--scene-port",
+         str(scene_port)],
+        cwd=ROOT, stdout=log, stderr=subprocess.STDOUT,
+    )  # fmt: skip
+    base = f"http://127.0.0.1:{port}"
+    deadline = time.monotonic() + 30
+    while True:
+        try:
+            if _get(f"{base}/health")["status"] == "ok":
+                break
+        except OSError:
+            pass
+        if proc.poll() is not None or time.monotonic() > deadline:
+            proc.kill()
+            pytest.fail("jik serve did not answer /health within 30 s")
+        time.sleep(0.2)
+    yield base, scene_port
+    proc.terminate()
+    try:
+        proc.wait(10)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+
+
+def _wait_generation(page, at_least: int, timeout: float = 20_000) -> int:
+    page.wait_for_function(
+        f"Number(document.body.dataset.generation) >= {at_least}", timeout=timeout
+    )
+    return int(page.evaluate("document.body.dataset.generation"))
+
+
+def _set_slider(page, selector: str, value: float) -> int:
+    """Move a range input like a user (input event); returns the generation before."""
+    before = int(page.evaluate("jik.generation"))
+    page.eval_on_selector(
+        selector,
+        "(el, v) => { el.value = v; el.dispatchEvent(new Event('input', {bubbles: true})); }",
+        value,
+    )
+    return before
+
+
+def _latency(page, after: int) -> str:
+    """Control change to plots redrawn, measured in the page, with the server's share."""
+    page.wait_for_function(
+        f"jik.lastLatency && jik.lastLatency.generation > {after}", timeout=20_000
+    )
+    lat = page.evaluate("jik.lastLatency")
+    t = lat["server"]
+    return (
+        f"{lat['ms']:.0f} ms (server: compute {1000 * t['compute']:.0f} ms, figures "
+        f"{1000 * t['figures']:.0f} ms, change to event {1000 * t['server_total']:.0f} ms; "
+        f"page: event arrived at {lat['arrived']:.0f} ms, JSON parse {lat['parse']:.0f} ms, "
+        f"plotly redraw {lat['draw']:.0f} ms)"
+    )
+
+
+def _wait_scene(base: str, condition, timeout: float = 20.0, what: str = "") -> dict:
+    """Poll what the viser scene reports having drawn until ``condition(status)``."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        scene = _get(f"{base}/api/dashboard/state")["scene"]
+        if condition(scene):
+            return scene
+        time.sleep(0.05)
+    pytest.fail(f"the scene did not {what or 'reach the expected state'} within {timeout} s")
+
+
+def _scene_generation(base: str, generation: int, timeout: float = 20.0) -> dict:
+    return _wait_scene(
+        base, lambda s: s.get("generation", 0) >= generation, timeout, f"draw {generation}"
+    )
+
+
+def _trace(page, panel: str, index: int, axis: str) -> list[float]:
+    return page.evaluate(
+        f"Array.from(document.getElementById('plot-{panel}')._fullData[{index}].{axis})"
+    )
+
+
+def test_dashboard_follows_controls_in_chromium(served):
+    from playwright.sync_api import sync_playwright
+
+    base, scene_port = served
+    ARTIFACTS.mkdir(exist_ok=True)
+    external, errors, latencies = [], [], {}
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        page = browser.new_page(viewport={"width": 1600, "height": 1000})
+        page.on(
+            "request",
+            lambda r: (
+                external.append(r.url)
+                if not r.url.startswith(("http://127.0.0.1", "data:", "blob:"))
+                else None
+            ),
+        )
+        page.on("pageerror", lambda e: errors.append(str(e)))
+        page.goto(base + "/")
+
+        # The plotly panels and the viser canvas (inside the iframe on the scene port).
+        generation = _wait_generation(page, 1, timeout=60_000)
+        for panel in PANELS:
+            page.locator(f"#plot-{panel} .main-svg").first.wait_for(timeout=20_000)
+        assert page.get_attribute("#scene", "src") == f"http://127.0.0.1:{scene_port}/"
+        scene = page.frame_locator("#scene")
+        scene.locator("canvas").first.wait_for(timeout=30_000)
+        _scene_generation(base, generation)
+        # Pause the animation (viser's GUI) so that screenshots of the scene are comparable.
+        # dispatch_event: software WebGL keeps the frame busy, Playwright's actionability
+        # checks on click() would wait for it to settle.
+        scene.get_by_role("button", name="Pause").dispatch_event("click")
+        _wait_scene(base, lambda s: s.get("playing") is False)
+        # Headless chromium renders WebGL in software; viser says so in a toast: close it.
+        toast = scene.locator(".mantine-Notification-root button")
+        if toast.count():
+            toast.first.dispatch_event("click")
+        page.screenshot(path=str(ARTIFACTS / "dashboard-1-manipulator2.png"))
+        scene_before = page.locator("#scene").screenshot()
+        verdict = page.inner_text("#verdict")
+        assert "pseudoinverse" in verdict and "extended Jacobian" in verdict
+
+        # gamma: in continuous mode it rescales theta (the joint plot's axis), nothing else.
+        theta_before = max(_trace(page, "joints", 0, "x"))
+        before = _set_slider(page, "#ctl-gamma", 0.30103)  # log10(2): gamma = 2
+        latencies["gamma (manipulator 2)"] = _latency(page, before)
+        theta_after = max(_trace(page, "joints", 0, "x"))
+        gamma = _get(f"{base}/api/dashboard/state")["state"]["gamma"]
+        assert gamma == pytest.approx(2.0, rel=0.02)  # the slider snaps to its step
+        assert theta_after == pytest.approx(theta_before / gamma, rel=1e-6)
+
+        # The start point: x0 moves, every trajectory and the scene change.
+        task_before = _trace(page, "task", 0, "x")
+        before = _set_slider(page, "#ctl-x0-0", 0.45)
+        latencies["start point x1 (manipulator 2)"] = _latency(page, before)
+        generation = _wait_generation(page, before + 1)
+        assert _get(f"{base}/api/dashboard/state")["state"]["x0"][0] == pytest.approx(0.45)
+        assert _trace(page, "task", 0, "x") != task_before
+        _scene_generation(base, generation)
+        page.wait_for_timeout(300)  # let the WebGL canvas paint the new frame
+        scene_after = page.locator("#scene").screenshot()
+        assert scene_after != scene_before, "the 3D scene did not change with the start point"
+        page.screenshot(path=str(ARTIFACTS / "dashboard-2-moved.png"))
+
+        # Manipulator 1 (and the unicycle when the registry has it), then back.
+        robots = [r["name"] for r in _get(f"{base}/robots")["robots"]]
+        for robot in [r for r in ("unicycle", "manipulator1") if r in robots]:
+            before = int(page.evaluate("jik.generation"))
+            page.select_option("#ctl-robot", robot)
+            latencies[f"switch to {robot}"] = _latency(page, before)
+            page.wait_for_function(f"document.body.dataset.robot === '{robot}'")
+            _scene_generation(base, _wait_generation(page, before + 1), timeout=30)
+            # The h panel is filled in a second phase (E1, E2; h on a grid for the unicycle).
+            page.wait_for_function(
+                "!document.querySelector('#plot-augmenting .gtitle').textContent"
+                ".includes('computing')",
+                timeout=30_000,
+            )
+            page.wait_for_timeout(300)
+            page.screenshot(path=str(ARTIFACTS / f"dashboard-3-{robot}.png"))
+        before = int(page.evaluate("jik.generation"))
+        page.select_option("#ctl-robot", "manipulator2")
+        latencies["switch back to manipulator2"] = _latency(page, before)
+        page.wait_for_function("document.body.dataset.robot === 'manipulator2'")
+        page.screenshot(path=str(ARTIFACTS / "dashboard-4-back.png"))
+
+        csv = page.evaluate("fetch('/api/dashboard/export.csv').then(r => r.text())")
+        assert csv.startswith("algorithm,leg,theta,x1,x2,x3,y1,y2,error,h")
+        browser.close()
+
+    for what, text in latencies.items():
+        print(f"latency control -> plots updated, {what}: {text}")
+    assert not external, f"requests left the machine: {external}"
+    assert not errors, f"errors in the page: {errors}"
