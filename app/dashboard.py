@@ -587,7 +587,7 @@ class Dashboard:
         Seconds the worker waits after a change for a newer one (slider drags send many).
     """
 
-    def __init__(self, state: DashboardState | None = None, *, debounce: float = 0.02) -> None:
+    def __init__(self, state: DashboardState | None = None, *, debounce: float = 0.01) -> None:
         self._cond = threading.Condition()
         self._state = validate(state or default_state())
         self._generation = 1
@@ -596,6 +596,7 @@ class Dashboard:
         self._changed_at = {1: time.perf_counter()}
         self._listeners: list[Callable[[Event], None]] = []
         self._cache: dict = {}
+        self._figures: dict[tuple[str, str], str] = {}  # (panel, key) -> figure JSON
         self._latest: dict[str, Event] = {
             "state": Event("state", 1, _json(self._state_message(1, self._state, "initial")))
         }
@@ -733,7 +734,7 @@ class Dashboard:
             self._cond.notify_all()
 
     def _compute(self, generation: int, state: DashboardState) -> None:
-        from app.figures import augmenting_figure, figures_for
+        from app.figures import PANELS, augmenting_figure, figures_for, gamma_free_panels
 
         started = self._changed_at.get(generation, time.perf_counter())
         t0 = time.perf_counter()
@@ -765,7 +766,15 @@ class Dashboard:
                 "type": "error", "generation": generation, "message": str(exc)})))  # fmt: skip
             self._finish(generation)
             return
-        figures = figures_for(result, None)
+        # Panels that do not depend on gamma are reused from the last result with the same key.
+        key = _cache_key(state, "extended")
+        reuse = {k for k in gamma_free_panels(result) if (k, key) in self._figures}
+        texts = {k: self._figures[(k, key)] for k in reuse}
+        texts.update(
+            {k: f.to_json() for k, f in figures_for(result, None, only=set(PANELS) - reuse).items()}
+        )
+        texts = {k: texts[k] for k in PANELS}
+        self._figures = {(k, key): texts[k] for k in gamma_free_panels(result)}
         ready = time.perf_counter()
         head = {
             "type": "result", "generation": generation, "state": state.as_dict(),
@@ -773,7 +782,6 @@ class Dashboard:
             "timing": {"compute": result.seconds, "figures": ready - t0 - result.seconds,
                        "server_total": ready - started},
         }  # fmt: skip
-        texts = {k: f.to_json() for k, f in figures.items()}
         head["digests"] = {k: hashlib.md5(t.encode()).hexdigest()[:16] for k, t in texts.items()}
         data = (
             _json(head)[:-1]

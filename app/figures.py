@@ -20,6 +20,8 @@ UNITS = {
     "unicycle": (("m/s", "m/s", "rad/s", "rad/s"), ("m", "m", "rad")),
 }
 PANEL_HEIGHT = 380
+#: Panel ids, in the page's order.
+PANELS = ("task", "drift", "joints", "augmenting", "table")
 _AXIS = dict(
     gridcolor="#e6e6e6", zerolinecolor="#b0b0b0", linecolor="#888", showline=True, mirror=True,
     ticks="outside", automargin=True,
@@ -96,9 +98,9 @@ def task_space_figure(result: DashboardResult) -> go.Figure:
                 x=run.y[:, 0], y=run.y[:, 1], mode="lines", name=LABELS[a],
                 line=dict(color=COLORS[a], width=4 if a == "pseudoinverse" else 1.8,
                           dash="solid" if a == "pseudoinverse" else "dash"),
-                customdata=np.stack([run.theta, run.leg + 1], axis=-1),
+                customdata=run.leg + 1,  # (theta stays out: this panel does not depend on gamma)
                 hovertemplate=f"{n1} = %{{x:.4f}}<br>{n2} = %{{y:.4f}}"
-                "<br>θ = %{customdata[0]:.3g}<br>leg %{customdata[1]}<extra>" + a + "</extra>",
+                "<br>leg %{customdata}<extra>" + a + "</extra>",
             )
         )  # fmt: skip
     tg = result.targets
@@ -344,20 +346,23 @@ def augmenting_figure(result: DashboardResult, functionals: dict | None = None) 
     )
 
 
-def figures_for(result: DashboardResult, functionals: dict | None = None) -> dict[str, go.Figure]:
-    """Every panel of the dashboard for ``result``, keyed by panel id."""
-    if is_unicycle(result):
-        return {
-            "task": platform_figure(result),
-            "joints": joint_figure(result),
-            "drift": drift_figure(result),
-            "table": table_figure(result),
-            "augmenting": augmenting_figure(result, functionals),
-        }
-    return {
-        "task": task_space_figure(result),
-        "joints": joint_figure(result),
-        "drift": drift_figure(result),
-        "table": table_figure(result),
-        "augmenting": augmenting_figure(result, functionals),
+def gamma_free_panels(result: DashboardResult) -> set[str]:
+    """Panels that do not change with gamma in continuous mode (theta is not on their axes)."""
+    if result.state.mode != "continuous":
+        return set()
+    panels = {"table", "augmenting"} | ({"task"} if not is_unicycle(result) else set())
+    return panels | ({"drift"} if result.state.task == "path" else set())
+
+
+def figures_for(
+    result: DashboardResult, functionals: dict | None = None, only: set[str] | None = None
+) -> dict[str, go.Figure]:
+    """The panels of the dashboard for ``result`` (all, or those in ``only``), keyed by id."""
+    builders = {
+        "task": platform_figure if is_unicycle(result) else task_space_figure,
+        "joints": joint_figure,
+        "drift": drift_figure,
+        "table": table_figure,
+        "augmenting": lambda r: augmenting_figure(r, functionals),
     }
+    return {k: f(result) for k, f in builders.items() if only is None or k in only}

@@ -727,22 +727,24 @@ class DashboardScene:
 
     # -- animation ------------------------------------------------------------------------
     def _animate(self) -> None:
-        last, last_gui = time.monotonic(), 0.0
+        last, last_gui, posed = time.monotonic(), 0.0, (None, None)
         while True:
             time.sleep(1.0 / FPS)
             now = time.monotonic()
             dt, last = now - last, now
             timeline = self._timeline
-            if timeline is None or not self.playing:
-                if timeline is not None and not self.playing:
-                    with self._lock:
-                        self._pose(self._s)
+            if timeline is None:
                 continue
             with self._lock:
-                self._s += dt * float(self.speed.value) / SECONDS_PER_LEG
-                if self._s > timeline.length + 0.5:  # hold the end for a moment, then loop
-                    self._s = 0.0
-                self._pose(self._s)
+                if self.playing:
+                    self._s += dt * float(self.speed.value) / SECONDS_PER_LEG
+                    if self._s > timeline.length + 0.5:  # hold the end a moment, then loop
+                        self._s = 0.0
+                if posed != (timeline, self._s):  # paused: send nothing until scrubbed
+                    posed = (timeline, self._s)
+                    self._pose(self._s)
+            if not self.playing:
+                continue
             if now - last_gui > 0.25:
                 last_gui = now
                 self._syncing = True

@@ -38,7 +38,7 @@ function change(patch, { now = false } = {}) {
   }
   if (queuedSince === null) queuedSince = performance.now();
   clearTimeout(sendTimer);
-  sendTimer = setTimeout(flush, now ? 0 : 30);
+  sendTimer = setTimeout(flush, now ? 0 : 20);
 }
 
 async function flush() {

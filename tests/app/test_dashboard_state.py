@@ -162,3 +162,28 @@ def test_export_has_every_point_of_both_runs():
     assert len(body["runs"]["extended"]["x"]) == len(result.runs["extended"].x)
     last = rows[-1].split(",")
     assert last[0] == "extended" and float(last[8]) < 1e-9
+
+
+def test_a_gamma_change_redraws_only_the_panels_with_theta_on_an_axis():
+    """Continuous mode: x(theta) does not depend on gamma, so only the joint plot changes."""
+    dashboard = Dashboard(updated_state(default_state("manipulator2"), {"cycles": 1}))
+    results = {}
+    done = threading.Event()
+
+    def listener(event):
+        if event.kind == "result":
+            results[event.generation] = json.loads(event.data)
+            if event.generation >= 2:
+                done.set()
+
+    dashboard.subscribe(listener)
+    assert dashboard.wait(1, timeout=60)
+    dashboard.update({"gamma": 2.5})
+    assert done.wait(60)
+    dashboard.stop()
+    first, second = results[1], results[2]
+    changed = {k for k in first["digests"] if first["digests"][k] != second["digests"][k]}
+    assert changed == {"joints"}
+    theta1 = second["summary"]["pseudoinverse"]["points"]
+    assert theta1 == first["summary"]["pseudoinverse"]["points"]
+    assert second["summary"]["extended"]["cached"] is True
