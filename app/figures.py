@@ -296,8 +296,10 @@ def augmenting_figure(result: DashboardResult, functionals: dict | None = None) 
     zmin, zmax = np.percentile(finite, [2, 98]) if finite.size else (0.0, 1.0)
     data = [
         go.Contour(
-            x=grid["u"], y=grid["v"], z=H, colorscale="Viridis", zmin=zmin, zmax=zmax,
-            ncontours=24, contours=dict(showlabels=True, labelfont=dict(size=9, color="white")),
+            x=grid["u"], y=grid["v"], z=H, zmin=zmin, zmax=zmax,
+            # A neutral scale, so that the red and blue runs on top stay the algorithms' colours.
+            colorscale=[[0.0, "#fdfdfd"], [1.0, "#9a9a9a"]],
+            ncontours=24, contours=dict(showlabels=True, labelfont=dict(size=9, color="#333")),
             colorbar=dict(title=dict(text="h", side="right"), thickness=12),
             hovertemplate=f"{ni} = %{{x:.3f}}<br>{nj} = %{{y:.3f}}<br>h = %{{z:.4f}}"
             "<extra></extra>",
@@ -309,7 +311,7 @@ def augmenting_figure(result: DashboardResult, functionals: dict | None = None) 
         data.append(
             go.Scatter(
                 x=run.x[:, i], y=run.x[:, j], mode="lines", name=LABELS[a],
-                line=dict(color=COLORS[a] if a == "extended" else "#ff7f7f", width=2.5),
+                line=dict(color=COLORS[a], width=2.5),
                 hovertemplate=f"{ni} = %{{x:.4f}}<br>{nj} = %{{y:.4f}}<extra>{a}</extra>",
             )
         )  # fmt: skip
@@ -326,9 +328,10 @@ def augmenting_figure(result: DashboardResult, functionals: dict | None = None) 
         for key in ("E1", "E2"):
             v = functionals.get(key)
             parts.append(f"{key} = {v:.4g}" if v is not None else f"{key} undefined")
-        title += " · " + ", ".join(parts) + " on this box"
+        title += "<br><sup>" + ", ".join(parts) + " on this box"
         if any(functionals.get(f"{k}_error") for k in ("E1", "E2")):
             title += " (h is not defined on all of it)"
+        title += "</sup>"
     fixed = [f"{n} = {x0[k]:.3g}" for k, n in enumerate(result.variable_names) if k not in (i, j)]
     annotations = []
     if fixed:

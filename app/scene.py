@@ -199,7 +199,7 @@ class _NormalForm(_Mechanism):
         self.runner_span = (lo, hi)
         self.slider = self.box("slider", (0.18, 0.14, 0.08))
         self.lever = self.scene.add_frame(f"{self.root}/lever", show_axes=False)
-        self.box("lever/bar", (6.0, 0.045, 0.03), (0.0, 0.0, 0.05))
+        self.box("lever/bar", (3.5, 0.045, 0.03), (0.0, 0.0, 0.05))
         self.ball("lever/pivot", 0.06, (0.0, 0.0, 0.05), color=(40, 40, 40))
         self.point = self.ball("W", 0.08)
 

@@ -200,6 +200,7 @@ function showProgress(fraction, elapsed) {
   const box = $("#progress");
   // Only computations longer than half a second get a progress bar.
   box.hidden = !(elapsed > 0.5 && fraction < 1);
+  if (!box.hidden) jik.progressShown = (jik.progressShown || 0) + 1;
   $("#progress-bar").style.width = `${Math.round(100 * fraction)}%`;
   $("#progress-text").textContent = `computing ${Math.round(100 * fraction)}%`;
 }

@@ -187,3 +187,44 @@ def test_a_gamma_change_redraws_only_the_panels_with_theta_on_an_axis():
     theta1 = second["summary"]["pseudoinverse"]["points"]
     assert theta1 == first["summary"]["pseudoinverse"]["points"]
     assert second["summary"]["extended"]["cached"] is True
+
+
+@pytest.mark.parametrize(
+    ("robot", "x0"),
+    [("manipulator2", (0.3, -0.4, 2.0)), ("manipulator1", (0.7, 0.2, -0.6)), ("unicycle", None)],
+)
+def test_the_start_point_gizmo_round_trips(robot, x0):
+    """Dragging the gizmo to where it already is leaves the start point unchanged."""
+    from app.scene import gizmo_pose, quaternion_yaw, start_from_gizmo, yaw_quaternion
+
+    state = default_state(robot)
+    if x0 is not None:
+        state = updated_state(state, {"x0": list(x0)})
+    xy, yaw = gizmo_pose(robot, state.x0, state.robot_parameters)
+    yaw = quaternion_yaw(yaw_quaternion(yaw))
+    patch = start_from_gizmo(robot, xy, yaw, state)
+    moved = updated_state(state, patch)
+    np.testing.assert_allclose(moved.x0, state.x0, atol=1e-12)
+    np.testing.assert_allclose(
+        moved.robot_parameters.get("q0", 0), state.robot_parameters.get("q0", 0), atol=1e-12
+    )
+
+
+def test_manipulator2_gizmo_moves_the_carriage():
+    from app.scene import start_from_gizmo
+
+    state = default_state("manipulator2")
+    patch = start_from_gizmo("manipulator2", (0.4, 0.25), np.pi / 2 + 0.1, state)
+    assert patch == {"x0": [0.25, 0.4, pytest.approx(np.pi / 2 + 0.1)]}
+
+
+def test_animation_timeline_ends_at_the_last_configuration():
+    from app.scene import Timeline
+
+    result = compute(updated_state(default_state("manipulator2"), {"cycles": 1}))
+    timeline = Timeline(result)
+    assert timeline.length == len(result.targets)
+    start, end = timeline.at(0.0), timeline.at(timeline.length)
+    for a, run in result.runs.items():
+        np.testing.assert_allclose(start[a], run.x[0], atol=1e-12)
+        np.testing.assert_allclose(end[a], run.x[-1], atol=1e-9)

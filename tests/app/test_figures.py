@@ -92,6 +92,7 @@ def test_augmenting_map_contours_with_the_extended_run_on_a_level_set(path_resul
     assert fig.layout.xaxis.title.text == "x2 [m]"
     assert fig.layout.yaxis.title.text == "x3 [rad]"
     assert "E1 = " in fig.layout.title.text and "E2 = " in fig.layout.title.text
+    assert [t.line.color for t in fig.data[1:3]] == [COLORS["pseudoinverse"], COLORS["extended"]]
     assert functionals["E1"] > 0 and functionals["E2"] > 0
     h = path_result.runs["extended"].h
     assert np.ptp(h) < 1e-9

@@ -201,8 +201,12 @@ def test_dashboard_follows_controls_in_chromium(served):
         robots = [r["name"] for r in _get(f"{base}/robots")["robots"]]
         for robot in [r for r in ("unicycle", "manipulator1") if r in robots]:
             before = int(page.evaluate("jik.generation"))
+            page.evaluate("jik.progressShown = 0")
             page.select_option("#ctl-robot", robot)
             latencies[f"switch to {robot}"] = _latency(page, before)
+            if page.evaluate("jik.lastLatency.server.compute") > 1.0:
+                # A computation longer than half a second shows the progress bar on the way.
+                assert page.evaluate("jik.progressShown") > 0, f"no progress shown for {robot}"
             page.wait_for_function(f"document.body.dataset.robot === '{robot}'")
             _scene_generation(base, _wait_generation(page, before + 1), timeout=30)
             # The h panel is filled in a second phase (E1, E2; h on a grid for the unicycle).
