@@ -249,7 +249,7 @@ def _leg_targets(kin, state: DashboardState) -> np.ndarray:
 
 
 #: Discrete mode runs in chunks of this many iterations, so that a newer change cancels it.
-CHUNK = 40
+CHUNK = 80
 #: Iteration cap of one discrete leg (the engine's default).
 MAX_DISCRETE_ITERATIONS = 2000
 

@@ -228,3 +228,43 @@ def test_animation_timeline_ends_at_the_last_configuration():
     for a, run in result.runs.items():
         np.testing.assert_allclose(start[a], run.x[0], atol=1e-12)
         np.testing.assert_allclose(end[a], run.x[-1], atol=1e-9)
+
+
+def test_page_static_files_and_state_api():
+    """The page, plotly.js from the plotly package, and the state endpoints over HTTP."""
+    from fastapi.testclient import TestClient
+
+    from app.main import create_app
+
+    app = create_app()
+    client = TestClient(app)  # no lifespan: the dashboard does not use the compute pool
+    page = client.get("/")
+    assert page.status_code == 200 and 'id="plot-task"' in page.text
+    assert "http" not in page.text.replace("http-equiv", "")  # nothing from the network
+    js = client.get("/static/vendor/plotly.min.js")
+    assert js.status_code == 200 and js.headers["content-type"].startswith("text/javascript")
+    assert client.get("/static/app.js").status_code == 200
+    assert client.get("/static/..%2Fpyproject.toml").status_code == 404
+    assert client.get("/static/__init__.py").status_code == 404
+    config = client.get("/api/dashboard/config").json()
+    assert config["colors"] == {"pseudoinverse": "#d62728", "extended": "#1f77b4"}
+
+    bad = client.post("/api/dashboard/state", json={"gamma": -1})
+    assert bad.status_code == 422
+    assert bad.json()["detail"][0] == {
+        "loc": ["body", "gamma"], "msg": "gamma must be > 0, got -1.0", "type": "value_error"
+    }  # fmt: skip
+    assert client.post("/api/dashboard/state", content=b"[1]").status_code == 422
+    ok = client.post("/api/dashboard/state", json={"task": "target", "x0": [0.2, 0.1, 1.4]})
+    assert ok.status_code == 200 and ok.json()["state"]["x0"] == [0.2, 0.1, 1.4]
+    dashboard = app.state.dashboard
+    assert dashboard.wait(ok.json()["generation"], timeout=60)
+    snapshot = client.get("/api/dashboard/state").json()
+    assert snapshot["computed_generation"] == ok.json()["generation"]
+    assert snapshot["summary"]["extended"]["success"]
+    csv = client.get("/api/dashboard/export.csv")
+    assert csv.status_code == 200 and csv.text.startswith("algorithm,leg,theta,x1")
+    body = client.get("/api/dashboard/export.json").json()
+    assert body["state"]["x0"] == [0.2, 0.1, 1.4]
+    assert len(body["runs"]["pseudoinverse"]["x"][0]) == 3
+    dashboard.stop()
