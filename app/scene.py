@@ -276,6 +276,7 @@ class DashboardScene:
         self._controls: dict[str, object] = {}
         self._folders: list = []
         self._last_drag = 0.0
+        self._stopped = False
         self._build_static_gui()
         self.server.scene.add_grid(
             "/grid",
@@ -294,7 +295,9 @@ class DashboardScene:
         return self.server.get_port()
 
     def stop(self) -> None:
+        self._stopped = True
         self._unsubscribe()
+        self._thread.join(timeout=2.0)
         self.server.stop()
 
     # -- GUI ------------------------------------------------------------------------------
@@ -728,7 +731,7 @@ class DashboardScene:
     # -- animation ------------------------------------------------------------------------
     def _animate(self) -> None:
         last, last_gui, posed = time.monotonic(), 0.0, (None, None)
-        while True:
+        while not self._stopped:
             time.sleep(1.0 / FPS)
             now = time.monotonic()
             dt, last = now - last, now

@@ -268,3 +268,40 @@ def test_page_static_files_and_state_api():
     assert body["state"]["x0"] == [0.2, 0.1, 1.4]
     assert len(body["runs"]["pseudoinverse"]["x"][0]) == 3
     dashboard.stop()
+
+
+def test_viser_gui_and_drag_change_the_one_state():
+    """The scene's GUI and its start-point gizmo write to the same Dashboard as the page."""
+    import socket
+    import time
+    from types import SimpleNamespace
+
+    from app.scene import DashboardScene, yaw_quaternion
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    dashboard = Dashboard(updated_state(default_state("manipulator2"), {"task": "target"}))
+    scene = DashboardScene(dashboard, port=port)
+    try:
+        assert dashboard.wait(1, timeout=60)
+        deadline = time.monotonic() + 30
+        while dashboard.scene_status.get("generation", 0) < 1 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert dashboard.scene_status["robot"] == "manipulator2"
+        scene._controls["gamma"].value = 2.5  # what a slider move in the viser GUI does
+        assert dashboard.state.gamma == 2.5
+        target = SimpleNamespace(position=(0.4, 0.25, 0.3), wxyz=yaw_quaternion(1.7))
+        scene._on_drag(SimpleNamespace(phase="end", target=target))
+        np.testing.assert_allclose(dashboard.state.x0, (0.25, 0.4, 1.7), atol=1e-12)
+        assert dashboard.wait(timeout=60)
+        deadline = time.monotonic() + 30
+        while dashboard.scene_status["generation"] < dashboard.generation:
+            assert time.monotonic() < deadline, "the scene did not redraw"
+            time.sleep(0.05)
+        # A change from elsewhere (the page) moves the scene's GUI.
+        dashboard.update({"gamma": 0.5})
+        assert scene._controls["gamma"].value == 0.5
+    finally:
+        scene.stop()
+        dashboard.stop()
