@@ -265,25 +265,40 @@ def _solve_leg(inverse, x, target, state, gamma, cancelled, partial=lambda f: No
         res = solve(inverse, x, target, gamma=gamma, mode="continuous", tol=state.tol)
         tr = res.trajectory
         return tr.theta, tr.x, tr.y, tr.error, tr.h, res.success, res.message, res.x
-    pieces, done = [], 0
+    pieces, done, chunk, stopped = [], 0, CHUNK, None
     while True:
-        res = solve(inverse, x, target, gamma=gamma, mode="discrete", tol=state.tol,
-                    max_iterations=CHUNK)  # fmt: skip
+        try:
+            res = solve(inverse, x, target, gamma=gamma, mode="discrete", tol=state.tol,
+                        max_iterations=chunk)  # fmt: skip
+        except JikError as exc:
+            # The map is undefined somewhere in this chunk: redo it one iteration at a time to
+            # keep every iterate before the stop (the platform paths up to there).
+            if chunk == 1:
+                stopped = exc
+                break
+            chunk = 1
+            continue
         tr = res.trajectory
         first = 0 if not pieces else 1  # a chunk starts where the previous one ended
         pieces.append((tr.theta[first:] + done, tr.x[first:], tr.y[first:], tr.error[first:],
                        None if tr.h is None else tr.h[first:]))  # fmt: skip
         done += res.nit
         x = res.x
-        if res.success or res.nit < CHUNK or done >= MAX_DISCRETE_ITERATIONS:
+        if res.success or res.nit < chunk or done >= MAX_DISCRETE_ITERATIONS:
             break
         if cancelled():
             raise Cancelled
         # The error decays geometrically: the fraction of the way to tol, on a log scale.
         e0, e = float(pieces[0][3][0]), float(res.error)
         partial(np.clip(np.log(e0 / e) / np.log(e0 / state.tol), 0.0, 0.99) if e0 > e > 0 else 0)
+    if stopped is not None:
+        if not pieces:
+            raise stopped
+        cat = [np.concatenate([p[k] for p in pieces]) for k in range(4)]
+        h = None if pieces[0][4] is None else np.concatenate([p[4] for p in pieces])
+        return (*cat, h, False, f"stopped after {done} iterations: {stopped}", x)
     message = res.message
-    if not res.success and res.nit == CHUNK:
+    if not res.success and res.nit == chunk:
         message = (
             f"did not converge within {done} iterations (error {res.error:.3g}); "
             "raise gamma or move the start"

@@ -97,7 +97,7 @@ class Timeline:
         self.result = result
         self.unicycle = any(r.platform is not None for r in result.runs.values())
         if self.unicycle:
-            m = min(len(r.platform) for r in result.runs.values())
+            m = max(len(r.platform) for r in result.runs.values())
             shown = np.unique(np.geomspace(1, m, num=UNICYCLE_SHOWN).astype(int) - 1)
             self.shown = np.union1d(shown, [0, m - 1]).astype(int)
             self.length = float(len(self.shown))

@@ -268,12 +268,14 @@ function renderVerdict(msg) {
       closed task path need not close in the joints. J<sup>E#</sup> adds the equation h(x) = h(x0) (h changed by
       ${e.h_change === null ? "—" : fmt(e.h_change)} along its run): each task point then has one configuration on that level set,
       so closed task paths give closed joint paths.</span>`;
-  } else {
+  } else if (!fail.length) {
     box.innerHTML = `Both algorithms drive the task error to the target: <b class="p">pseudoinverse</b> ${p.message};
       <b class="e">extended Jacobian</b> ${e.message}.
       <span class="why">The extended Jacobian keeps h constant (eq. (12)); compare the paths and the controls.</span>`;
+  } else {
+    box.innerHTML = `<b class="p">pseudoinverse</b>: ${p.message}. <b class="e">extended Jacobian</b>: ${e.message}.`;
   }
-  if (fail.length) box.innerHTML += ` <span class="error">${fail.join(" · ")}</span>`;
+  if (fail.length) box.innerHTML += ` <span class="error">Stopped: ${fail.join(" · ")}</span>`;
 }
 
 async function onFunctionals(msg) {
