@@ -34,9 +34,14 @@ NEWTON_MAX = 30
 #: Newton stops when the largest update is below this (relative to 1 + |z|); by quadratic
 #: convergence z is then exact to rounding, and dh (linearised one update earlier) to ~NEWTON_TOL.
 NEWTON_TOL = 1e-12
+#: On fine grids rounding can keep updates above NEWTON_TOL: an update below NEWTON_FLOOR that
+#: did not shrink by 4x (quadratic convergence would shrink it far more) counts as converged.
+NEWTON_FLOOR = 1e-9
 #: Largest relative size of the last three Chebyshev coefficients of z(s) accepted before the
-#: characteristic is solved again on a finer nested grid (2n - 1, then 4n - 3 nodes).
-TAIL_TOL = 1e-12
+#: characteristic is solved again on a finer nested grid (2n - 1 nodes, see REFINE_LEVELS).
+TAIL_TOL = 1e-10
+#: Refinement levels (grids of (n - 1) 2^k + 1 nodes, k = 1 .. REFINE_LEVELS).
+REFINE_LEVELS = 1
 #: Warm-start Newton from the previous characteristics when x moved by at most this (max norm).
 WARM_RADIUS = 0.5
 
@@ -310,11 +315,19 @@ class CharacteristicsMap(AugmentingMap):
         self.on_undefined = on_undefined
         self._cache: tuple | None = None
 
+    def moments_ignore(self, f: int) -> bool:
+        """Whether the kinematics' quadrature moments ignore the leaf coordinate x[f].
+
+        True for the unicycle with z = lambda10 or lambda11 (q3 depends on lambda20, lambda21
+        only): Newton, which varies only z, then reuses the moments of the base points.
+        """
+        return isinstance(self.kinematics, Unicycle) and f in (0, 1)
+
     def _collocate(self, xb, Y, n, guess):
         """Newton on the n-node collocation system of (28) and its variational system.
 
-        Returns Z (B, n), S (B, n, p), the 'omega undefined' mask (B, n), the last Newton
-        step (B,), the points Phi_s (B, n, p) and the Chebyshev tail of Z (B,) (error estimate).
+        Returns Z (B, n), S (B, n, p), the 'omega undefined' mask (B, n), Newton's convergence
+        flags (B,), the points Phi_s (B, n, p) and the Chebyshev tail of Z (B,) (error estimate).
         """
         s, W = collocation(n)
         f = self.fixed_index
@@ -322,18 +335,31 @@ class CharacteristicsMap(AugmentingMap):
         z1 = xb[:, f : f + 1]
         Z = np.repeat(z1, n, axis=1) if guess is None else guess  # cold: z(s) = z(1)
         eye = np.eye(n)
+        kin = self.kinematics
+        # Quadrature moments that do not depend on the leaf coordinate are computed once.
+        fixed = getattr(kin, "moments", None) if self.moments_ignore(f) else None
+        mom = None if fixed is None else fixed(base)
+
+        def derivs(pts):
+            return _derivatives(kin, pts) if mom is None else kin.derivatives(pts, moments=mom)
+
         with np.errstate(all="ignore"):
+            prev = np.full(len(xb), np.inf)
+            conv = np.zeros(len(xb), dtype=bool)
             for _ in range(NEWTON_MAX):
                 pts = base.copy()
                 pts[..., f] = Z
-                omega, domega, bad = _one_form_parts(*_derivatives(self.kinematics, pts), f)
+                omega, domega, bad = _one_form_parts(*derivs(pts), f)
                 DY = np.einsum("bnkj,bk->bnj", domega, Y)  # (d omega / dx) Y, (B, n, p)
                 A = eye - W * DY[:, None, :, f]  # I + W diag(G_z), G_z = -(d omega/dz) Y
                 R = Z - z1 - (omega @ Y[:, :, None])[..., 0] @ W.T  # G = -omega Y
                 dZ = np.linalg.solve(A, R[..., None])[..., 0]
                 Z = Z - dZ
                 step = np.max(np.abs(dZ) / (1.0 + np.abs(Z)), axis=-1, initial=0.0)
-                if not np.any(step > NEWTON_TOL):  # NaN members stop too; flagged by caller
+                # converged: below NEWTON_TOL, or stalled at the rounding floor of a fine grid
+                conv |= (step <= NEWTON_TOL) | ((step <= NEWTON_FLOOR) & (step > 0.25 * prev))
+                prev = step
+                if np.all(conv | ~np.isfinite(step)):  # NaN members are flagged by the caller
                     break
             Gy = -s[:, None] * DY - omega  # (B, n, p)
             rhs = -(W @ Gy)  # d/dy_j columns
@@ -341,7 +367,7 @@ class CharacteristicsMap(AugmentingMap):
             S = np.linalg.solve(A, rhs)
             coef = Z @ _chebyshev_analysis(n).T  # Chebyshev coefficients of z(s)
         tail = np.max(np.abs(coef[:, -3:]), axis=-1) / (1.0 + np.max(np.abs(Z), axis=-1))
-        return Z, S, bad, step, pts, tail
+        return Z, S, bad, conv & np.isfinite(step), pts, tail
 
     def characteristic(
         self, x, guess=None
@@ -372,7 +398,7 @@ class CharacteristicsMap(AugmentingMap):
         evaluation, gives dh consistent with h to about NEWTON_TOL. Members whose last three
         Chebyshev coefficients of z(s) exceed TAIL_TOL (a steep characteristic, e.g. one that
         passes near a zero of the normalising kernel component) are solved again on the nested
-        Lobatto grids of 2n - 1 and 4n - 3 nodes; results are returned on the n base nodes.
+        Lobatto grid of 2n - 1 nodes (REFINE_LEVELS); results are returned on the n base nodes.
         """
         x = self.kinematics.check(x)
         shape = x.shape[:-1]
@@ -380,30 +406,25 @@ class CharacteristicsMap(AugmentingMap):
         n = self.nodes
         Y = self.homotopy.field(xb)  # (B, p)
         g = None if guess is None else np.array(guess, dtype=float).reshape(-1, n)
-        Z, S, bad_nodes, step, pts, tail = self._collocate(xb, Y, n, g)
+        Z, S, bad_nodes, conv, pts, tail = self._collocate(xb, Y, n, g)
         bad = np.any(bad_nodes, axis=-1)
         active, Zc, m_prev = np.arange(len(xb)), Z, n
-        for level in (1, 2):
+        for level in range(1, REFINE_LEVELS + 1):
             need = ~(tail[active] <= TAIL_TOL) & np.isfinite(tail[active]) & ~bad[active]
             if not np.any(need):
                 break
             active, Zc = active[need], Zc[need]
             m = (n - 1) * 2**level + 1
-            Zf, Sf, badf, stepf, _, tailf = self._collocate(
+            Zf, Sf, badf, convf, _, tailf = self._collocate(
                 xb[active], Y[active], m, Zc @ _chebyshev_resample(m_prev, m).T
             )
-            ok = (stepf <= NEWTON_TOL) & ~np.any(badf, axis=-1) & np.all(np.isfinite(Sf), (1, 2))
+            ok = convf & ~np.any(badf, axis=-1) & np.all(np.isfinite(Sf), (1, 2))
             sub = 2**level  # nested grids: every sub-th fine node is a base node
             upd = active[ok]
-            Z[upd], S[upd], step[upd], tail[upd] = (
-                Zf[ok, ::sub],
-                Sf[ok, ::sub],
-                stepf[ok],
-                tailf[ok],
-            )
+            Z[upd], S[upd], tail[upd] = Zf[ok, ::sub], Sf[ok, ::sub], tailf[ok]
             active, Zc, m_prev = active[ok], Zf[ok], m
         failed = bad | ~np.all(np.isfinite(S[:, 0, :]), axis=-1)
-        failed |= ~np.all(np.isfinite(Z), axis=-1) | ~(step <= NEWTON_TOL)
+        failed |= ~np.all(np.isfinite(Z), axis=-1) | ~conv
         where = None
         s0 = collocation(n)[0]
         if np.any(failed):
@@ -447,7 +468,7 @@ class CharacteristicsMap(AugmentingMap):
             if phi is None:
                 raise OneFormUndefinedError(
                     "h(x) is undefined: its characteristic (28) could not be resolved (Newton "
-                    "on the collocation system, up to 4n - 3 nodes, did not converge): it runs "
+                    "on the collocation system did not converge): it runs "
                     f"into a near-zero of the kernel component {self.fixed_index} (0-based) of "
                     f"{self.kinematics.name}, where omega and dz/ds blow up",
                     x,

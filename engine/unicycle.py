@@ -199,10 +199,25 @@ class Unicycle(Kinematics):
         """
         return self.derivatives(x, hessian=True)[1]
 
-    def derivatives(self, x: FloatArray, hessian: bool = True) -> tuple[FloatArray, FloatArray]:
+    def moments(self, x: FloatArray) -> FloatArray:
+        """The moments [int cos q3 G, int sin q3 G] (..., 24) of the quadrature basis.
+
+        They depend on lambda20, lambda21 only (q3 does not involve lambda10, lambda11), so a
+        caller that varies only lambda10, lambda11 (the characteristics of section 6.1 vary
+        lambda11 during Newton) computes them once and passes them to :meth:`derivatives`.
+        """
+        x = np.asarray(x, dtype=float)
+        t, C, G = _moment_basis(self.T, nodes_for(x, self.T))
+        q3 = self.q0[2] + x[..., 2:3] * t + x[..., 3:4] * C  # (..., N) [rad]
+        return np.concatenate([np.cos(q3) @ G, np.sin(q3) @ G], axis=-1)  # no complex exp: slower
+
+    def derivatives(
+        self, x: FloatArray, hessian: bool = True, moments: FloatArray | None = None
+    ) -> tuple[FloatArray, FloatArray]:
         """The Jacobian (..., 3, 4) and the Hessian (..., 3, 4, 4) from one set of quadratures.
 
-        The Hessian is None when ``hessian`` is False.
+        The Hessian is None when ``hessian`` is False. ``moments`` (from :meth:`moments` at
+        points with the same lambda20, lambda21) skips the quadrature.
 
         Notes
         -----
@@ -212,11 +227,7 @@ class Unicycle(Kinematics):
         of the characteristics synthesis).
         """
         x = np.asarray(x, dtype=float)
-        t, C, G = _moment_basis(self.T, nodes_for(x, self.T))
-        q3 = self.q0[2] + x[..., 2:3] * t + x[..., 3:4] * C  # (..., N) [rad]
-        V = np.concatenate(
-            [np.cos(q3) @ G, np.sin(q3) @ G], axis=-1
-        )  # (..., 24); np.exp(1j q3) is slower
+        V = self.moments(x) if moments is None else moments  # (..., 24)
         V = np.concatenate([V, x[..., 0:1] * V, x[..., 1:2] * V], axis=-1)  # (..., 72)
         out = V @ (_DERIVATIVE_MAP if hessian else _DERIVATIVE_MAP[:, :12])
         J = out[..., :12].reshape(*x.shape[:-1], 3, 4)
