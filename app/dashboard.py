@@ -483,7 +483,7 @@ def expensive_map(amap) -> bool:
     return hasattr(amap, "evaluate")
 
 
-def augmenting_grid(kin, state: DashboardState, runs: Mapping[str, AlgorithmRun], n: int = 61):
+def augmenting_grid(kin, state: DashboardState, runs: Mapping[str, AlgorithmRun], n: int = 41):
     """h on a grid over the two variables it depends on most, other variables at x0.
 
     The box covers both trajectories with a margin, clipped to the robot's x_range.

@@ -312,7 +312,11 @@ async function main() {
   for (const [a, c] of Object.entries(config.colors)) document.documentElement.style.setProperty(`--${a}`, c);
   const frame = $("#scene");
   if (config.scene_port) {
-    frame.src = `${location.protocol}//${location.hostname}:${config.scene_port}/`;
+    // On a loopback address, name the other loopback host: a different site gets its own
+    // renderer process, so the scene's WebGL does not hold up the plots on this page.
+    const swap = { "127.0.0.1": "localhost", localhost: "127.0.0.1" };
+    const host = swap[location.hostname] || location.hostname;
+    frame.src = `${location.protocol}//${host}:${config.scene_port}/`;
   } else {
     frame.hidden = true;
     const note = $("#scene-note");

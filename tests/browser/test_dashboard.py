@@ -146,7 +146,7 @@ def test_dashboard_follows_controls_in_chromium(served):
             "request",
             lambda r: (
                 external.append(r.url)
-                if not r.url.startswith(("http://127.0.0.1", "data:", "blob:"))
+                if not r.url.startswith(("http://127.0.0.1", "http://localhost", "data:", "blob:"))
                 else None
             ),
         )
@@ -157,7 +157,8 @@ def test_dashboard_follows_controls_in_chromium(served):
         generation = _wait_generation(page, 1, timeout=60_000)
         for panel in PANELS:
             page.locator(f"#plot-{panel} .main-svg").first.wait_for(timeout=20_000)
-        assert page.get_attribute("#scene", "src") == f"http://127.0.0.1:{scene_port}/"
+        # The scene is framed from the other loopback name (its own renderer process).
+        assert page.get_attribute("#scene", "src") == f"http://localhost:{scene_port}/"
         scene = page.frame_locator("#scene")
         scene.locator("canvas").first.wait_for(timeout=30_000)
         _scene_generation(base, generation)
