@@ -40,6 +40,9 @@ NEWTON_FLOOR = 1e-9
 #: Largest relative size of the last three Chebyshev coefficients of z(s) accepted before the
 #: characteristic is solved again on a finer nested grid (2n - 1 nodes, see REFINE_LEVELS).
 TAIL_TOL = 1e-10
+#: A Chebyshev tail still above this after refinement means the characteristic is not resolved
+#: (it runs into a near-zero of omega's normalising component): h is reported undefined there.
+TAIL_FAIL = 1e-6
 #: Refinement levels (grids of (n - 1) 2^k + 1 nodes, k = 1 .. REFINE_LEVELS).
 REFINE_LEVELS = 1
 #: Warm-start Newton from the previous characteristics when x moved by at most this (max norm).
@@ -424,7 +427,7 @@ class CharacteristicsMap(AugmentingMap):
             Z[upd], S[upd], tail[upd] = Zf[ok, ::sub], Sf[ok, ::sub], tailf[ok]
             active, Zc, m_prev = active[ok], Zf[ok], m
         failed = bad | ~np.all(np.isfinite(S[:, 0, :]), axis=-1)
-        failed |= ~np.all(np.isfinite(Z), axis=-1) | ~conv
+        failed |= ~np.all(np.isfinite(Z), axis=-1) | ~conv | ~(tail <= TAIL_FAIL)
         where = None
         s0 = collocation(n)[0]
         if np.any(failed):
@@ -468,7 +471,7 @@ class CharacteristicsMap(AugmentingMap):
             if phi is None:
                 raise OneFormUndefinedError(
                     "h(x) is undefined: its characteristic (28) could not be resolved (Newton "
-                    "on the collocation system did not converge): it runs "
+                    "on the collocation system did not converge or z(s) is unresolved): it runs "
                     f"into a near-zero of the kernel component {self.fixed_index} (0-based) of "
                     f"{self.kinematics.name}, where omega and dz/ds blow up",
                     x,
