@@ -612,8 +612,9 @@ class DashboardScene:
                 self._framed = state.robot
                 self._frame_camera(extent)
             self._timeline = timeline
-            self._s = 0.0
-            self._pose(0.0)
+            # Playing: from the start. Paused: at the end, where the drift of J^P# shows.
+            self._s = 0.0 if self.playing else timeline.length
+            self._pose(self._s)
             self.drawn_generation = result.generation
             self.dashboard.scene_status.update(
                 generation=result.generation, robot=state.robot, playing=self.playing

@@ -168,9 +168,11 @@ def test_dashboard_follows_controls_in_chromium(served):
         scene.get_by_role("button", name="Pause").dispatch_event("click")
         _wait_scene(base, lambda s: s.get("playing") is False)
         # Headless chromium renders WebGL in software; viser says so in a toast: close it.
-        toast = scene.locator(".mantine-Notification-root button")
-        if toast.count():
-            toast.first.dispatch_event("click")
+        close = scene.locator(".mantine-Notification-closeButton")
+        if close.count():
+            close.first.dispatch_event("click")
+            close.first.wait_for(state="detached", timeout=10_000)
+        page.wait_for_timeout(1500)  # the canvas fades in and repaints after the toast
         page.screenshot(path=str(ARTIFACTS / "dashboard-1-manipulator2.png"))
         scene_before = page.locator("#scene").screenshot()
         verdict = page.inner_text("#verdict")
