@@ -31,6 +31,22 @@ class AugmentingMap(abc.ABC):
     def gradient(self, x: FloatArray) -> FloatArray:
         """dh/dx: (..., p) -> (..., p)."""
 
+    def value_masked(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """h(x) and where it is undefined (NaN there), without raising."""
+        h = np.asarray(self.value(x), dtype=float)
+        return h, ~np.isfinite(h)
+
+    def gradient_masked(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """dh/dx and where h is undefined, without raising (the solver's view).
+
+        Returns
+        -------
+        dh : ndarray, shape (..., p)
+        undefined : ndarray of bool, shape (...,)
+        """
+        dh = self.gradient(x)
+        return dh, ~np.all(np.isfinite(dh), axis=-1)
+
     @property
     def parameters(self) -> dict[str, float]:
         """The map's parameters, as a JSON-friendly dict."""

@@ -495,6 +495,20 @@ class CharacteristicsMap(AugmentingMap):
         self._raise_if(failed)
         return dh
 
+    def value_masked(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """h(x) with NaN and a mask where it is undefined, whatever ``on_undefined`` says."""
+        h, _, failed = self.evaluate(x)
+        return h, np.asarray(failed, dtype=bool)
+
+    def gradient_masked(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """dh/dx with NaN rows and a mask where h is undefined, whatever ``on_undefined`` says.
+
+        The solver evaluates trial points (Runge-Kutta stages, Picard nodes) off the final path;
+        one undefined trial point must stop that member only, not raise for the whole batch.
+        """
+        _, dh, failed = self.evaluate(x)
+        return dh, np.asarray(failed, dtype=bool)
+
 
 class UnicycleCharacteristics(CharacteristicsMap):
     """The unicycle's augmenting map of section 6.1: reference leaf E_{a,0} = a e1 + R e2.

@@ -184,14 +184,18 @@ class ExtendedInverse(Inverse):
         self.augmenting_map = augmenting_map
 
     def augmenting_value(self, x: FloatArray) -> FloatArray:
-        return self.augmenting_map.value(x)
+        """h(x), NaN where h is undefined (a run can stop at such a point)."""
+        return self.augmenting_map.value_masked(x)[0]
 
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
-        Jbar = extended_jacobian(self.kinematics.jacobian(x), self.augmenting_map.gradient(x))
+        dh, undefined = self.augmenting_map.gradient_masked(x)
+        dh = np.where(undefined[..., None], 0.0, dh)  # keeps the solve below free of NaN
+        Jbar = extended_jacobian(self.kinematics.jacobian(x), dh)
         rhs = np.concatenate([e, np.zeros(e.shape[:-1] + (1,))], axis=-1)  # [e; 0]
         v, d = solve_small(Jbar, rhs)
         norms = np.prod(np.linalg.norm(Jbar, axis=-1), axis=-1)
-        bad = ~(np.abs(d) >= SINGULAR_EXTENDED * norms) | ~np.all(np.isfinite(v), axis=-1)
+        bad = undefined | ~(np.abs(d) >= SINGULAR_EXTENDED * norms)
+        bad |= ~np.all(np.isfinite(v), axis=-1)
         return np.where(bad[..., None], 0.0, v), bad
 
     def matrix(self, x: FloatArray) -> FloatArray:
@@ -201,6 +205,14 @@ class ExtendedInverse(Inverse):
         return out
 
     def singular_error(self, x: FloatArray) -> Exception:
+        _, undefined = self.augmenting_map.gradient_masked(np.asarray(x, dtype=float)[None])
+        if undefined[0]:
+            return AlgorithmicSingularityError(
+                f"the augmenting map {self.augmenting_map.name!r} is undefined (its gradient "
+                "cannot be evaluated), so the extended Jacobian inverse (11) is undefined; "
+                "choose another start or augmentation parameters",
+                x,
+            )
         return AlgorithmicSingularityError(
             f"the extended Jacobian [J; dh] of {self.kinematics.name} with augmenting map "
             f"{self.augmenting_map.name!r} is singular (algorithmic singularity, eq. (11)); "

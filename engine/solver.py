@@ -33,6 +33,8 @@ _EXPONENT = -1.0 / 8.0  # error estimator of order 7
 #: Tolerances of the continuous integrator on x (relative and absolute).
 RTOL = 1e-12
 ATOL = 1e-12
+#: Picard sweeps per member in method "auto" before DOP853 takes over.
+PICARD_BUDGET = 80
 #: Largest |x| before a run counts as diverged.
 DIVERGED_NORM = 1e8
 
@@ -53,7 +55,8 @@ class Trajectory:
     error : ndarray, shape (m,)
         ||k(x) - y_d||.
     h : ndarray, shape (m,) or None
-        h(x) for the extended inverse (constant along the continuous flow, eq. (12)).
+        h(x) for the extended inverse (constant along the continuous flow, eq. (12)); NaN at a
+        point where h is undefined (a run stopped there).
     """
 
     theta: FloatArray
@@ -227,7 +230,7 @@ def _dop853(inverse, x0, y_d, tol, max_steps, record, tau0, rtol=RTOL, atol=ATOL
     return x, tau, status, nsteps, rec
 
 
-def _continuous(inverse, x0, y_d, tol, max_steps, record):
+def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto"):
     """Chebyshev-Picard on the homotopy form (engine.picard), then DOP853 where needed.
 
     Members that Picard integrates to sigma = 1 with error < tol are done. The others (an
@@ -245,7 +248,18 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record):
     rec = [(np.arange(n), tau.copy(), x.copy())] if record else None
     if moving.size == 0:
         return x, tau, status, nit, rec
-    x1, done, sigma, sweeps, prec = picard_path(inverse, x0[moving], e0[moving], max_steps)
+    if method == "dop853":
+        xr, taur, st, steps, rrec = _dop853(
+            inverse, x0[moving], y_d[moving], tol, max_steps, record, np.zeros(moving.size)
+        )
+        x[moving], tau[moving], status[moving], nit[moving] = xr, taur, st, steps
+        if record:
+            rec.extend((moving[m], t, xs) for m, t, xs in rrec[1:])
+        return x, tau, status, nit, rec
+    # Picard pays (DEGREE + 1) evaluations of J# per sweep: on a path that needs many halvings
+    # (near a singularity) DOP853 is cheaper, so Picard gets a budget and DOP853 takes over.
+    budget = max_steps if method == "picard" else min(max_steps, PICARD_BUDGET)
+    x1, done, sigma, sweeps, prec = picard_path(inverse, x0[moving], e0[moving], budget)
     nit[moving] = sweeps
     if record:
         for mem, sig, xs in prec:
@@ -340,6 +354,7 @@ def solve(
     tol: float = 1e-10,
     max_iterations: int | None = None,
     record: bool = True,
+    method: str = "auto",
 ) -> SolveResult | BatchSolveResult:
     """Solve k(x) = y_d by the continuation algorithm (7) with the right inverse J#.
 
@@ -361,6 +376,10 @@ def solve(
         Cap on integrator steps (continuous, default 20000) or iterations (discrete, default 2000).
     record : bool
         Keep the whole trajectory.
+    method : {"auto", "picard", "dop853"}
+        Continuous mode only: Chebyshev-Picard with a sweep budget and DOP853 after it
+        ("auto"), Picard alone (DOP853 only where it fails), or DOP853 alone. "dop853" suits
+        maps that are expensive per point (the unicycle's characteristics map).
 
     Returns
     -------
@@ -394,6 +413,8 @@ def solve(
     tol = positive(tol, "tol")
     if tol < 1e-14:
         raise InvalidInputError(f"tol must be >= 1e-14 (double precision), got {tol:g}")
+    if method not in ("auto", "picard", "dop853"):
+        raise InvalidInputError(f"method must be 'auto', 'picard' or 'dop853', got {method!r}")
     if mode not in ("continuous", "discrete"):
         raise InvalidInputError(f"mode must be 'continuous' or 'discrete', got {mode!r}")
     if mode == "discrete" and gamma >= 2:
@@ -411,7 +432,7 @@ def solve(
         raise inverse.singular_error(xb[np.flatnonzero(bad)[0]])
 
     if mode == "continuous":
-        x, _, status, nit, rec = _continuous(inverse, xb, yb, tol, cap, record)
+        x, _, status, nit, rec = _continuous(inverse, xb, yb, tol, cap, record, method)
         theta_scale = 1.0 / gamma
     else:
         x, _, status, nit, rec = _discrete(inverse, xb, yb, gamma, tol, cap, record)

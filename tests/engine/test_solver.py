@@ -135,3 +135,46 @@ def test_bad_input_is_rejected_with_a_clear_message(kwargs, match):
     args = {"x0": X0, "y_d": [1, 1]} | kwargs
     with pytest.raises(InvalidInputError, match=match):
         solve(Pseudoinverse(Manipulator2()), args.pop("x0"), args.pop("y_d"), **args)
+
+
+@pytest.mark.parametrize("method", ["picard", "dop853"])
+def test_methods_agree(method):
+    """Chebyshev-Picard and DOP853 follow the same trajectory of (7)."""
+    inv = ExtendedInverse(Manipulator2(), PaperCubic())
+    ref = solve(inv, X0, [1, 2], method="auto")
+    res = solve(inv, X0, [1, 2], method=method)
+    assert res.success
+    np.testing.assert_allclose(res.x, ref.x, atol=1e-9)
+
+
+def test_unknown_method_is_rejected():
+    with pytest.raises(InvalidInputError, match="method must be"):
+        solve(Pseudoinverse(Manipulator2()), X0, [1, 1], method="euler")
+
+
+UNICYCLE_START = [0.5, -0.25, 0.3, -0.25]
+UNICYCLE_TARGET = [1.0, 0.0, -math.pi / 2]
+
+
+def test_undefined_h_at_a_trial_point_does_not_abort_the_run():
+    """The map raises where h is undefined, but trial points of the integrator must not:
+    from pose A the continuous extended run converges with h conserved."""
+    from engine.registry import make_inverse, robot_spec
+
+    kin = robot_spec("unicycle").build(q0=[5.0, 0.0, math.pi / 2])
+    res = solve(make_inverse(kin, "extended"), UNICYCLE_START, UNICYCLE_TARGET, gamma=0.1)
+    assert res.success, res.message
+    np.testing.assert_allclose(res.trajectory.h, res.trajectory.h[0], atol=1e-9)
+
+
+def test_run_into_undefined_h_stops_with_message_and_nan():
+    """From pose B the discrete extended run leaves the domain of h: stop, say why, NaN h."""
+    from engine.registry import make_inverse, robot_spec
+
+    kin = robot_spec("unicycle").build(q0=[-5.0, 5.0, math.pi / 2])
+    res = solve(
+        make_inverse(kin, "extended"), UNICYCLE_START, UNICYCLE_TARGET, gamma=0.1, mode="discrete"
+    )
+    assert not res.success
+    assert "'characteristics' is undefined" in res.message and "stopped" in res.message
+    assert np.isnan(res.trajectory.h[-1]) and np.all(np.isfinite(res.trajectory.h[:-1]))
