@@ -112,7 +112,11 @@ Augmentation = _union(list(AUGMENTATION_MODELS.values()))
 
 Algorithm = Literal["pseudoinverse", "extended"]
 Mode = Literal["continuous", "discrete"]
-Vector = Annotated[list[FiniteFloat], Field(min_length=1, max_length=MAX_DIMENSION)]
+#: Largest |coordinate| of a configuration or task point (radians, lengths, control amplitudes):
+#: beyond it the kinematics only overflow, and the unicycle's quadrature would need huge grids.
+COORDINATE_BOUND = 1000.0
+Coordinate = Annotated[float, Field(ge=-COORDINATE_BOUND, le=COORDINATE_BOUND, allow_inf_nan=False)]
+Vector = Annotated[list[Coordinate], Field(min_length=1, max_length=MAX_DIMENSION)]
 
 
 class _Request(BaseModel):
@@ -297,16 +301,17 @@ class SynthesizeRequest(BaseModel):
     region: dict[str, tuple[Bound, Bound]] | None = Field(
         None,
         max_length=3,
-        description="box {variable: [lo, hi]} (2 or 3 variables); default: the robot's x_range "
-        "over all (at most 3) variables, over the last two for 'e2_variational'",
+        description="box {variable: [lo, hi]} (2 or 3 variables); default: the last 3 (2 for "
+        "'e2_variational') variables, each over a tenth of its x_range either side of the "
+        "robot's default start",
     )
     fixed: dict[str, FiniteFloat] | None = Field(
         None,
         max_length=MAX_DIMENSION,
-        description="values of the variables not in the box (default 0)",
+        description="values of the variables not in the box (default: the default start)",
     )
     nodes: Annotated[int, Field(ge=2, le=24)] = Field(
-        12, description="Gauss-Legendre nodes per variable for E1 and E2"
+        8, description="Gauss-Legendre nodes per variable for E1 and E2"
     )
     degree: Annotated[int, Field(ge=1, le=24)] = Field(
         10, description="'e2_variational': Legendre degree per variable"

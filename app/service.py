@@ -167,6 +167,44 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
     )
 
 
+def precheck(req: S.SolveRequest | S.RepeatabilityRequest | S.SynthesizeRequest) -> None:
+    """The registry checks that need no numerics (names, lengths, discrete gamma).
+
+    Run on the event loop before a request is sent to a worker, so bad requests are answered at
+    once even when every worker is busy. The workers repeat them (the plain service functions
+    are complete on their own).
+    """
+    spec = ROBOTS.get(req.robot.name)
+    if spec is None:
+        raise RequestError(
+            "robot.name", f"unknown robot {req.robot.name!r}; choose one of {sorted(ROBOTS)}"
+        )
+    if isinstance(req, S.SynthesizeRequest):
+        _region(spec, req)
+        return
+    if req.algorithm == "extended" and req.augmentation is not None:
+        try:
+            spec.augmentation(req.augmentation.name)
+        except InvalidInputError as exc:
+            raise RequestError("augmentation.name", str(exc)) from None
+    if len(req.x0) != spec.p:
+        raise RequestError(
+            "x0", f"must have {spec.p} components (p of {spec.name}), got {len(req.x0)}"
+        )
+    if isinstance(req, S.SolveRequest):
+        _check_task_point(spec, req.target, "target")
+    else:
+        for i, pt in enumerate(req.path):
+            _check_task_point(spec, pt, f"path[{i}]")
+    gamma = spec.default_gamma if req.gamma is None else float(req.gamma)
+    if (req.mode or spec.default_mode) == "discrete" and gamma >= 2:
+        raise RequestError(
+            "gamma",
+            f"must be < 2 in discrete mode, got {gamma:g} (near the solution the error shrinks "
+            "by |1 - gamma| per iteration)",
+        )
+
+
 def _check_task_point(spec: RobotSpec, y, name: str) -> None:
     if len(y) != spec.r:
         raise RequestError(name, f"must have {spec.r} components (r of {spec.name}), got {len(y)}")
@@ -414,11 +452,26 @@ def synthesis_methods() -> S.SynthesisMethodsResponse:
     )
 
 
+def default_region(spec: RobotSpec, size: int) -> dict[str, tuple[float, float]]:
+    """The last ``size`` variables, each over a box around the default start.
+
+    Half-width: a tenth of the variable's ``x_range``, clipped to it. The other variables are
+    held at the default start (where the robot's maps are defined), not at 0.
+    """
+    names = list(spec.variable_names)
+    region = {}
+    for n in names[-size:]:
+        i = names.index(n)
+        lo, hi = spec.x_range[i]
+        c, w = spec.default_x0[i], 0.1 * (hi - lo)
+        region[n] = (max(lo, c - w), min(hi, c + w))
+    return region
+
+
 def _region(spec: RobotSpec, req: S.SynthesizeRequest):
     names = list(spec.variable_names)
-    if req.region is None:  # x_range box: all (<= 3) variables, or the last two to synthesize
-        keep = names[-2:] if req.method == "e2_variational" else names[-3:]
-        region = {n: tuple(spec.x_range[names.index(n)]) for n in keep}
+    if req.region is None:
+        region = default_region(spec, 2 if req.method == "e2_variational" else 3)
     else:
         region = {k: (float(lo), float(hi)) for k, (lo, hi) in req.region.items()}
     for k, (lo, hi) in region.items():
@@ -428,8 +481,9 @@ def _region(spec: RobotSpec, req: S.SynthesizeRequest):
             raise RequestError(f"region.{k}", f"needs lo < hi, got [{lo:g}, {hi:g}]")
     if not region:
         raise RequestError("region", f"give at least one variable of {names}")
-    fixed = dict(req.fixed or {})
-    for k in fixed:
+    fixed = {n: float(v) for n, v in zip(names, spec.default_x0, strict=False) if n not in region}
+    fixed.update(req.fixed or {})
+    for k in req.fixed or {}:
         if k not in names:
             raise RequestError(f"fixed.{k}", f"unknown variable {k!r}; {spec.name} has {names}")
         if k in region:
@@ -442,9 +496,9 @@ def _grid_axes(amap, names, region, base) -> list[str]:
     if len(region) <= 2:
         return list(region)
     rng = np.random.default_rng(0)
-    x = np.broadcast_to(base, (256, len(base))).copy()
+    x = np.broadcast_to(base, (64, len(base))).copy()
     for k, (lo, hi) in region.items():
-        x[:, names.index(k)] = rng.uniform(lo, hi, 256)
+        x[:, names.index(k)] = rng.uniform(lo, hi, 64)
     with np.errstate(all="ignore"):
         try:
             g = np.abs(np.asarray(amap.gradient(x), dtype=float))
@@ -617,6 +671,9 @@ def _worker_main(conn) -> None:
         except JikError as exc:
             err = _engine_error(exc)
             msg = ("request_error", (err.field, err.message))
+        except MemoryError:
+            field, less = _WORK_FIELDS.get(kind, ("request", "less work"))
+            msg = ("request_error", (field, f"the computation ran out of memory; ask for {less}"))
         except Exception as exc:  # reported to the client as a 500 with its text
             msg = ("error", f"{type(exc).__name__}: {exc}")
         conn.send(msg)
@@ -673,7 +730,7 @@ class _Worker:
 _WORK_FIELDS = {
     "solve": ("max_iterations", "a lower max_iterations or a larger tolerance"),
     "repeatability": ("cycles", "fewer cycles or path points, a lower max_iterations"),
-    "synthesize": ("degree", "a lower degree or fewer nodes, a smaller grid or region"),
+    "synthesize": ("region", "a smaller region, fewer nodes, a smaller grid or a lower degree"),
 }
 
 
@@ -858,6 +915,7 @@ class ComputePool:
     # -- micro-batched solves
     async def solve(self, req: S.SolveRequest) -> bytes:
         """One /solve request (JSON response bytes); micro-batched with compatible ones."""
+        precheck(req)
         self._bind()
         payload = req.model_dump_json().encode()
         if not self.settings.batching:

@@ -3,6 +3,7 @@
 from fastapi import APIRouter, Request, Response
 
 from app.schemas import BUSY, RepeatabilityRequest, RepeatabilityResponse
+from app.service import precheck
 
 router = APIRouter(tags=["repeatability"])
 
@@ -14,5 +15,6 @@ router = APIRouter(tags=["repeatability"])
 )
 async def repeatability(req: RepeatabilityRequest, request: Request) -> Response:
     """Configurations after each leg, at each cycle end, and the drift from x0 per cycle."""
+    precheck(req)
     body = await request.app.state.pool.run("repeatability", req.model_dump_json().encode())
     return Response(body, media_type="application/json")

@@ -8,7 +8,7 @@ from app.schemas import (
     SynthesizeRequest,
     SynthesizeResponse,
 )
-from app.service import synthesis_methods
+from app.service import precheck, synthesis_methods
 
 router = APIRouter(tags=["synthesize"])
 
@@ -26,5 +26,6 @@ async def methods() -> SynthesisMethodsResponse:
 )
 async def synthesize(req: SynthesizeRequest, request: Request) -> Response:
     """h on a grid of the box, its coefficients and E1, E2 over the box."""
+    precheck(req)
     body = await request.app.state.pool.run("synthesize", req.model_dump_json().encode())
     return Response(body, media_type="application/json")

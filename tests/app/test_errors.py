@@ -134,3 +134,12 @@ def test_missing_fields(api):
 def test_wrong_method_and_unknown_path_are_4xx(api):
     assert api.get("/solve").status_code == 405
     assert api.get("/nowhere").status_code == 404
+
+
+def test_coordinates_are_bounded(api):
+    """Finite but absurd coordinates are refused before they reach the engine."""
+    (msg,) = messages(api.post("/solve", json=solve_body(x0=[0.0, 1e17, 1.0])))
+    assert msg == "x0[1]: Input should be less than or equal to 1000"
+    body = {**_rep(), "path": [[1.0, -1e175]]}
+    (msg,) = messages(api.post("/repeatability", json=body))
+    assert msg == "path[0][1]: Input should be greater than or equal to -1000"

@@ -50,7 +50,7 @@ def test_evaluate_manipulator1_map_picks_the_axes_where_h_varies(api):
     }
     b = api.post("/synthesize", json=body).json()
     assert b["augmentation"] == {"name": "e2_optimal", "parameters": {"a": 0.5, "b": 1.0}}
-    assert set(b["region"]) == {"x1", "x2", "x3"}  # default: the x_range box
+    assert set(b["region"]) == {"x1", "x2", "x3"}  # default: a box around the default start
     assert list(b["grid"]["axes"]) == ["x1", "x3"]  # h = x3 (a x1 + b) sqrt(1 + x1^2)
     x1, x3 = np.meshgrid(*b["grid"]["axes"].values(), indexing="ij")
     x = np.stack([x1, np.zeros_like(x1), x3], axis=-1)
