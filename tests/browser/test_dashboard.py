@@ -127,6 +127,19 @@ def _scene_generation(base: str, generation: int, timeout: float = 20.0) -> dict
     )
 
 
+def _settled(page, timeout: float = 15.0) -> bytes:
+    """A screenshot of the (paused) scene once two in a row agree: viser fades the canvas in."""
+    deadline = time.monotonic() + timeout
+    shot = page.locator("#scene").screenshot()
+    while time.monotonic() < deadline:
+        page.wait_for_timeout(400)
+        again = page.locator("#scene").screenshot()
+        if again == shot:
+            return shot
+        shot = again
+    return shot
+
+
 def _trace(page, panel: str, index: int, axis: str) -> list[float]:
     return page.evaluate(
         f"Array.from(document.getElementById('plot-{panel}')._fullData[{index}].{axis})"
@@ -172,9 +185,8 @@ def test_dashboard_follows_controls_in_chromium(served):
         if close.count():
             close.first.dispatch_event("click")
             close.first.wait_for(state="detached", timeout=10_000)
-        page.wait_for_timeout(1500)  # the canvas fades in and repaints after the toast
+        scene_before = _settled(page)
         page.screenshot(path=str(ARTIFACTS / "dashboard-1-manipulator2.png"))
-        scene_before = page.locator("#scene").screenshot()
         verdict = page.inner_text("#verdict")
         assert "pseudoinverse" in verdict and "extended Jacobian" in verdict
 
@@ -195,8 +207,7 @@ def test_dashboard_follows_controls_in_chromium(served):
         assert _get(f"{base}/api/dashboard/state")["state"]["x0"][0] == pytest.approx(0.45)
         assert _trace(page, "task", 0, "x") != task_before
         _scene_generation(base, generation)
-        page.wait_for_timeout(300)  # let the WebGL canvas paint the new frame
-        scene_after = page.locator("#scene").screenshot()
+        scene_after = _settled(page)
         assert scene_after != scene_before, "the 3D scene did not change with the start point"
         page.screenshot(path=str(ARTIFACTS / "dashboard-2-moved.png"))
 
