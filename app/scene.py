@@ -202,6 +202,8 @@ class _NormalForm(_Mechanism):
         self.box("lever/bar", (3.5, 0.045, 0.03), (0.0, 0.0, 0.05))
         self.ball("lever/pivot", 0.06, (0.0, 0.0, 0.05), color=(40, 40, 40))
         self.point = self.ball("W", 0.08)
+        if self.root.endswith("extended"):
+            self.scene.add_label(f"{self.root}/W/label", "W (task point)", position=(0.08, 0.08, 0))
 
     def pose(self, x) -> None:
         x1, x2, x3 = (float(v) for v in x)
