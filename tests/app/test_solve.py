@@ -143,3 +143,24 @@ def test_a_bad_member_does_not_spoil_its_batch():
     assert stats["solve_calls"] == 1
     assert "algorithmic singularity" in responses[1].json()["detail"][0]["msg"]
     assert math.isclose(responses[0].json()["x"][0], 0.8, abs_tol=1e-9)
+
+
+def test_every_registered_robot_solves_with_its_defaults(api):
+    """Default start and target of every robot in the registry, its default mode and gamma
+    (continuous, 1 for the manipulators; discrete, 0.1 for the unicycle once registered)."""
+    from engine.registry import ROBOTS
+
+    for name, spec in ROBOTS.items():
+        body = {
+            "robot": {"name": name},
+            "algorithm": "pseudoinverse",
+            "x0": list(spec.default_x0),
+            "target": list(spec.default_target),
+        }
+        r = api.post("/solve", json=body)
+        assert r.status_code == 200, (name, r.text)
+        b = r.json()
+        assert (b["mode"], b["gamma"]) == (spec.default_mode, spec.default_gamma), name
+        assert b["converged"], (name, b["message"])
+        assert len(b["x"]) == spec.p and len(b["y"]) == spec.r
+        np.testing.assert_allclose(b["y"], spec.default_target, atol=1e-9)
