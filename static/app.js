@@ -7,7 +7,7 @@ const PANELS = ["task", "drift", "joints", "augmenting", "table"];
 const PLOT_CONFIG = { responsive: true, displaylogo: false, modeBarButtonsToRemove: ["lasso2d", "select2d"] };
 const jik = (window.jik = {
   catalogue: null, config: null, state: null, generation: 0, shownGeneration: 0,
-  pending: new Map(), latencies: [], lastLatency: null, firstUpdate: null,
+  pending: new Map(), latencies: [], lastLatency: null, firstUpdate: null, panelDraw: {},
 });
 
 const $ = (sel) => document.querySelector(sel);
@@ -221,7 +221,10 @@ async function drawFigures(figures, digests = {}) {
     const div = document.getElementById(`plot-${key}`);
     if (!div || (digests[key] && drawn[key] === digests[key])) return null; // unchanged panel
     drawn[key] = digests[key];
-    return Plotly.react(div, fig.data, fig.layout, PLOT_CONFIG);
+    const t0 = performance.now(); // until this panel's redraw resolved (panels share one thread)
+    return Plotly.react(div, fig.data, fig.layout, PLOT_CONFIG).then(() => {
+      jik.panelDraw[key] = Math.round(performance.now() - t0);
+    });
   }));
 }
 
