@@ -52,7 +52,7 @@ class RequestError(ValueError):
 
 
 class ServiceUnavailable(RuntimeError):
-    """No compute slot freed in time, or the computation overran its time limit: HTTP 503."""
+    """No compute slot became free within the time limit (or a worker died): HTTP 503."""
 
 
 class ComputeError(RuntimeError):
@@ -150,10 +150,6 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
             raise RequestError("augmentation", str(exc)) from None
     else:
         inverse = make_inverse(kin, "pseudoinverse")
-    if len(req.x0) != spec.p:
-        raise RequestError(
-            "x0", f"must have {spec.p} components (p of {spec.name}), got {len(req.x0)}"
-        )
     mode = req.mode or spec.default_mode
     gamma = spec.default_gamma if req.gamma is None else float(req.gamma)
     if mode == "discrete" and gamma >= 2:
@@ -187,10 +183,7 @@ def precheck(req: S.SolveRequest | S.RepeatabilityRequest | S.SynthesizeRequest)
             spec.augmentation(req.augmentation.name)
         except InvalidInputError as exc:
             raise RequestError("augmentation.name", str(exc)) from None
-    if len(req.x0) != spec.p:
-        raise RequestError(
-            "x0", f"must have {spec.p} components (p of {spec.name}), got {len(req.x0)}"
-        )
+    _check_configuration(spec, req.x0)
     if isinstance(req, S.SolveRequest):
         _check_task_point(spec, req.target, "target")
     else:
@@ -203,6 +196,11 @@ def precheck(req: S.SolveRequest | S.RepeatabilityRequest | S.SynthesizeRequest)
             f"must be < 2 in discrete mode, got {gamma:g} (near the solution the error shrinks "
             "by |1 - gamma| per iteration)",
         )
+
+
+def _check_configuration(spec: RobotSpec, x0) -> None:
+    if len(x0) != spec.p:
+        raise RequestError("x0", f"must have {spec.p} components (p of {spec.name}), got {len(x0)}")
 
 
 def _check_task_point(spec: RobotSpec, y, name: str) -> None:
@@ -316,12 +314,7 @@ def solve_batch(reqs: list[S.SolveRequest]) -> list[S.SolveResponse | RequestErr
     ok: list[int] = []
     for i, r in enumerate(reqs):
         try:
-            if len(r.x0) != setup.spec.p:
-                raise RequestError(
-                    "x0",
-                    f"must have {setup.spec.p} components (p of {setup.spec.name}), "
-                    f"got {len(r.x0)}",
-                )
+            _check_configuration(setup.spec, r.x0)
             _check_task_point(setup.spec, r.target, "target")
             ok.append(i)
         except RequestError as exc:
@@ -366,6 +359,7 @@ def solve_request(req: S.SolveRequest) -> S.SolveResponse:
 def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityResponse:
     """The closed path of ``req`` driven ``req.cycles`` times (Table 1); drift per cycle."""
     setup = _setup(req)
+    _check_configuration(setup.spec, req.x0)
     for i, pt in enumerate(req.path):
         _check_task_point(setup.spec, pt, f"path[{i}]")
     x0 = np.array(req.x0, dtype=float)

@@ -164,3 +164,20 @@ def test_every_registered_robot_solves_with_its_defaults(api):
         assert b["converged"], (name, b["message"])
         assert len(b["x"]) == spec.p and len(b["y"]) == spec.r
         np.testing.assert_allclose(b["y"], spec.default_target, atol=1e-9)
+
+
+def test_service_batch_isolates_a_bad_first_member():
+    """The plain service function (used by the dashboard): a wrong-length first member gets its
+    own error, the others are solved."""
+    from app.schemas import SolveRequest
+    from app.service import RequestError, solve_batch
+
+    reqs = [
+        SolveRequest.model_validate(solve_body(x0=[0.0, 0.0])),
+        SolveRequest.model_validate(solve_body()),
+        SolveRequest.model_validate(solve_body(target=[0.5, 1.5])),
+    ]
+    out = solve_batch(reqs)
+    assert isinstance(out[0], RequestError) and out[0].field == "x0"
+    np.testing.assert_allclose(out[1].x, X1F, atol=6e-5)
+    np.testing.assert_allclose(out[2].y, [0.5, 1.5], atol=1e-9)
