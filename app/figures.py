@@ -323,23 +323,21 @@ def augmenting_figure(result: DashboardResult, functionals: dict | None = None) 
             hovertemplate="x0<extra></extra>",
         )
     )  # fmt: skip
+    sub = []
     if functionals:
         parts = []
         for key in ("E1", "E2"):
             v = functionals.get(key)
             parts.append(f"{key} = {v:.4g}" if v is not None else f"{key} undefined")
-        title += "<br><sup>" + ", ".join(parts) + " on this box"
+        sub.append(", ".join(parts) + " on this box")
         if any(functionals.get(f"{k}_error") for k in ("E1", "E2")):
-            title += " (h is not defined on all of it)"
-        title += "</sup>"
+            sub[-1] += " (h is not defined on all of it)"
     fixed = [f"{n} = {x0[k]:.3g}" for k, n in enumerate(result.variable_names) if k not in (i, j)]
-    annotations = []
     if fixed:
-        annotations.append(
-            dict(text="slice at " + ", ".join(fixed), xref="paper", yref="paper", x=1, y=1.0,
-                 xanchor="right", yanchor="bottom", showarrow=False,
-                 font=dict(size=10, color="#555"))
-        )  # fmt: skip
+        sub.append("slice at " + ", ".join(fixed))
+    if sub:
+        title += "<br><sup>" + " · ".join(sub) + "</sup>"
+    annotations: list = []
     return _figure(
         data,
         title,
