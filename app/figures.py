@@ -325,16 +325,16 @@ def augmenting_figure(result: DashboardResult, functionals: dict | None = None) 
     )  # fmt: skip
     sub = []
     if functionals:
-        parts = []
-        for key in ("E1", "E2"):
-            v = functionals.get(key)
-            parts.append(f"{key} = {v:.4g}" if v is not None else f"{key} undefined")
-        sub.append(", ".join(parts) + " on this box")
-        if any(functionals.get(f"{k}_error") for k in ("E1", "E2")):
-            sub[-1] += " (h is not defined on all of it)"
+        values = {k: functionals.get(k) for k in ("E1", "E2")}
+        if all(v is None for v in values.values()):
+            sub.append("E1, E2 undefined: h is not defined on all of this box")
+        else:
+            sub.append(", ".join(
+                f"{k} = {v:.4g}" if v is not None else f"{k} undefined" for k, v in values.items()
+            ) + " on this box")  # fmt: skip
     fixed = [f"{n} = {x0[k]:.3g}" for k, n in enumerate(result.variable_names) if k not in (i, j)]
     if fixed:
-        sub.append("slice at " + ", ".join(fixed))
+        sub.append("at " + ", ".join(fixed))
     if sub:
         title += "<br><sup>" + " · ".join(sub) + "</sup>"
     annotations: list = []
