@@ -92,7 +92,7 @@ def picard_path(inverse, x0: FloatArray, e0: FloatArray, max_sweeps_total: int):
         v, bad = inverse.apply_masked(Xa.reshape(m * nn, p), e.reshape(m * nn, -1))
         G = -v.reshape(m, nn, p)
         bad = bad.reshape(m, nn).any(axis=1)
-        Xn = xa[act, None, :] + (H[act] / 2.0)[:, None, None] * np.einsum("jl,mlp->mjp", S, G)
+        Xn = xa[act, None, :] + (H[act] / 2.0)[:, None, None] * (S @ G)  # S (nn, nn) @ (m, nn, p)
         scale = 1.0 + np.abs(Xn)
         diff = np.max(np.abs(Xn - Xa) / scale, axis=(1, 2))
         X[act] = Xn
@@ -102,7 +102,7 @@ def picard_path(inverse, x0: FloatArray, e0: FloatArray, max_sweeps_total: int):
         conv = (diff < SWEEP_TOL) & ~bad
         if np.any(conv):
             ci = act[conv]
-            coef = np.einsum("kj,mjp->mkp", T, X[ci])
+            coef = T @ X[ci]  # (k, nn, p) Chebyshev coefficients
             tail = np.max(np.abs(coef[:, -2:, :]), axis=(1, 2))
             resolved = tail < TAIL_TOL * (1.0 + np.max(np.abs(coef), axis=(1, 2)))
             acc = ci[resolved]
