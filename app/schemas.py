@@ -342,18 +342,16 @@ class SynthesizeResponse(BaseModel):
         description="polynomial coefficients, when there are any"
     )
     functionals: dict[str, FunctionalInfo | None] = Field(
-        description="E1 (eq. (13)) and E2 (eq. (18)) of the map on the box; null if unavailable"
+        description="E1 (13) and E2 (18) of the map on the box; null where undefined (see message)"
     )
     convergence: list[dict[str, float]] = Field(
         description="'e2_variational': E2 against the Legendre degree"
     )
-    available: dict[str, bool] = Field(description="which synthesis components are installed")
     message: str
 
 
 class SynthesisMethodsResponse(BaseModel):
     methods: list[SynthesisMethod]
-    available: dict[str, bool]
     notes: dict[str, str]
 
 

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import asyncio
 import concurrent.futures
-import importlib
 import os
 import socket
 import subprocess
@@ -34,9 +33,11 @@ import numpy as np
 
 from app import schemas as S
 from engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
+from engine.functionals import error_functional_e1, error_functional_e2
 from engine.registry import ROBOTS, RobotSpec, make_inverse
 from engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS, repeatability
 from engine.solver import solve
+from engine.variational import synthesize_e2
 
 #: A run whose largest drift is below this is called repeatable.
 REPEATABLE_DRIFT = 1e-6
@@ -403,45 +404,15 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
 # Synthesis
 
 
-def _optional(module: str, *names: str):
-    """The named attributes of ``module`` if it imports and has them all, else None."""
-    try:
-        mod = importlib.import_module(module)
-    except Exception:  # a module under development may fail in any way
-        return None
-    if not all(hasattr(mod, n) for n in names):
-        return None
-    return tuple(getattr(mod, n) for n in names)
-
-
-def synthesis_available() -> dict[str, bool]:
-    """Which synthesis components can be imported right now."""
-    return {
-        "error_functionals": _optional(
-            "engine.functionals", "error_functional_e1", "error_functional_e2"
-        )
-        is not None,
-        "e2_variational": _optional("engine.variational", "synthesize_e2") is not None,
-        "characteristics": any(
-            a.name == "characteristics" for s in ROBOTS.values() for a in s.augmentations
-        ),
-    }
-
-
 def synthesis_methods() -> S.SynthesisMethodsResponse:
-    avail = synthesis_available()
-    methods = ["evaluate"] + (["e2_variational"] if avail["e2_variational"] else [])
     return S.SynthesisMethodsResponse(
-        methods=methods,
-        available=avail,
+        methods=["evaluate", "e2_variational"],
         notes={
             "evaluate": "any map of the catalogue (GET /robots): h on a grid of the box, "
             "polynomial coefficients, E1 and E2 on the box",
             "e2_variational": "minimise E2 (eq. (19)) over h of the box variables (Ritz method, "
-            "engine.variational.synthesize_e2)"
-            + ("" if avail["e2_variational"] else " - not installed"),
-            "error_functionals": "E1 (13) and E2 (18) by Gauss quadrature (engine.functionals)"
-            + ("" if avail["error_functionals"] else " - not installed"),
+            "engine.variational.synthesize_e2)",
+            "error_functionals": "E1 (13) and E2 (18) by Gauss quadrature (engine.functionals)",
         },
     )
 
@@ -540,12 +511,9 @@ def _functional_info(fv) -> S.FunctionalInfo:
 
 
 def _functionals(kin, amap, region, fixed, nodes) -> tuple[dict, list[str]]:
-    funcs = _optional("engine.functionals", "error_functional_e1", "error_functional_e2")
     notes: list[str] = []
-    if funcs is None:
-        return {"e1": None, "e2": None}, ["engine.functionals is not installed: no E1, E2"]
     out = {}
-    for label, fn in zip(("e1", "e2"), funcs, strict=True):
+    for label, fn in (("e1", error_functional_e1), ("e2", error_functional_e2)):
         try:
             out[label] = _functional_info(fn(kin, amap, region, nodes=nodes, fixed=fixed))
         except JikError as exc:
@@ -566,22 +534,14 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
     """Evaluate a catalogue map, or synthesize an E2-optimal one, over a box (section 3)."""
     spec, kin, robot_used = _robot(req.robot)
     names, region, fixed = _region(spec, req)
-    avail = synthesis_available()
     convergence: list[dict[str, float]] = []
     coefficients: dict[str, float] = {}
     notes: list[str] = []
     if req.method == "e2_variational":
-        found = _optional("engine.variational", "synthesize_e2")
-        if found is None:
-            raise RequestError(
-                "method",
-                "'e2_variational' is not available: engine.variational.synthesize_e2 "
-                "is not installed; use 'evaluate'",
-            )
         if req.augmentation is not None:
             raise RequestError("augmentation", "'e2_variational' synthesizes h; give no map")
         try:
-            result = found[0](kin, region, degree=req.degree, fixed=fixed)
+            result = synthesize_e2(kin, region, degree=req.degree, fixed=fixed)
         except JikError as exc:
             raise RequestError("region", str(exc)) from None
         amap = result.augmenting_map
@@ -614,7 +574,6 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         coefficients=coefficients,
         functionals=functionals,
         convergence=convergence,
-        available=avail,
         message="; ".join(notes) or "ok",
     )
 

@@ -26,6 +26,7 @@ from engine.inverses import (
     extended_jacobian,
     extended_singularity,
     pseudoinverse,
+    require_compatible,
 )
 from engine.kinematics import Kinematics
 from engine.validation import FloatArray, count, finite
@@ -186,13 +187,7 @@ def _evaluate(
     nodes: int,
     fixed: Mapping[str, float] | None,
 ) -> FunctionalValue:
-    if kinematics.p - kinematics.r != 1:
-        raise InvalidInputError("the error functionals here need one degree of redundancy")
-    if augmenting_map.p != kinematics.p:
-        raise InvalidInputError(
-            f"augmenting map {augmenting_map.name!r} is defined on R^{augmenting_map.p}, "
-            f"but {kinematics.name} has p = {kinematics.p}"
-        )
+    require_compatible(kinematics, augmenting_map, "the error functionals")
     x, w, box, fix = quadrature(kinematics, region, nodes, fixed)
     kinematics.require_regular(x, "integration region (a quadrature point)")
     J = kinematics.jacobian(x)

@@ -89,6 +89,17 @@ def extended_inverse(J: FloatArray, dh: FloatArray) -> FloatArray:
     return np.where(bad[..., None, None], np.nan, out)
 
 
+def require_compatible(kinematics: Kinematics, augmenting_map: AugmentingMap, what: str) -> None:
+    """Check one degree of redundancy (p - r = 1) and that h is defined on R^p."""
+    if kinematics.p - kinematics.r != 1:
+        raise InvalidInputError(f"{what} here needs one degree of redundancy (p - r = 1)")
+    if augmenting_map.p != kinematics.p:
+        raise InvalidInputError(
+            f"augmenting map {augmenting_map.name!r} is defined on R^{augmenting_map.p}, "
+            f"but {kinematics.name} has p = {kinematics.p}"
+        )
+
+
 class Inverse(abc.ABC):
     """A right inverse J#(x) of the Jacobian of a kinematics (J J# = I_r), used in eq. (7)."""
 
@@ -173,13 +184,7 @@ class ExtendedInverse(Inverse):
     name = "extended"
 
     def __init__(self, kinematics: Kinematics, augmenting_map: AugmentingMap) -> None:
-        if kinematics.p - kinematics.r != 1:
-            raise InvalidInputError("the extended inverse here needs one degree of redundancy")
-        if augmenting_map.p != kinematics.p:
-            raise InvalidInputError(
-                f"augmenting map {augmenting_map.name!r} is defined on R^{augmenting_map.p}, "
-                f"but {kinematics.name} has p = {kinematics.p}"
-            )
+        require_compatible(kinematics, augmenting_map, "the extended inverse")
         self.kinematics = kinematics
         self.augmenting_map = augmenting_map
 

@@ -343,22 +343,6 @@ UNICYCLE = RobotSpec(
 ROBOTS: dict[str, RobotSpec] = {s.name: s for s in (MANIPULATOR1, MANIPULATOR2, UNICYCLE)}
 
 
-def register_robot(spec: RobotSpec) -> None:
-    """Add a robot to the catalogue (used by modules that define further kinematics)."""
-    ROBOTS[spec.name] = spec
-
-
-def register_augmentation(robot: str, spec: AugmentationSpec, *, default: bool = False) -> None:
-    """Add an augmenting map to a robot's list (used by the synthesis modules)."""
-    r = ROBOTS[robot]
-    others = tuple(a for a in r.augmentations if a.name != spec.name)
-    ROBOTS[robot] = replace(
-        r,
-        augmentations=(*others, spec),
-        default_augmentation=spec.name if default else r.default_augmentation,
-    )
-
-
 def robot_spec(name: str) -> RobotSpec:
     """The spec of robot ``name``; a clear error listing the known ones otherwise."""
     try:
