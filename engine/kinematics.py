@@ -143,7 +143,7 @@ class Manipulator1(Kinematics):
 
 
 class Manipulator2(Kinematics):
-    """Manipulator 2, an XY gantry with a revolute arm: k = (x2 + l cos x3, x1 + l sin x3), eq. (37).
+    """Manipulator 2, an XY gantry with a revolute arm: k = (x2 + l cos x3, x1 + l sin x3), (37).
 
     J = [[0, 1, -l sin x3], [1, 0, l cos x3]], m = sqrt(1 + l^2) (the printed M is garbled),
     K(x) = (-l cos x3, l sin x3, 1) / m, last component positive as in the paper.
