@@ -610,8 +610,10 @@ class Dashboard:
         self._debounce = debounce
         self._changed_at = {1: time.perf_counter()}
         self._listeners: list[Callable[[Event], None]] = []
+        self._fast = 0  # the first ``_fast`` listeners are the quick ones
         self._cache: dict = {}
         self._figures: dict[tuple[str, str], str] = {}  # (panel, key) -> figure JSON
+        self._functionals_cache: dict[str, dict | None] = {}
         self._latest: dict[str, Event] = {
             "state": Event("state", 1, _json(self._state_message(1, self._state, "initial")))
         }
@@ -664,10 +666,20 @@ class Dashboard:
         self.start()
         return generation, state
 
-    def subscribe(self, listener: Callable[[Event], None]) -> Callable[[], None]:
-        """Call ``listener(event)`` on every event (from the worker thread); replay the latest."""
+    def subscribe(
+        self, listener: Callable[[Event], None], *, last: bool = False
+    ) -> Callable[[], None]:
+        """Call ``listener(event)`` on every event (from the worker thread); replay the latest.
+
+        ``last``: a slow listener (the 3D scene draws in it) is called after the others, so
+        that it does not hold up the events queued for the page.
+        """
         with self._cond:
-            self._listeners.append(listener)
+            if last:
+                self._listeners.append(listener)
+            else:
+                self._listeners.insert(self._fast, listener)
+                self._fast += 1
             kinds = ("state", "result", "functionals")
             latest = [self._latest[k] for k in kinds if k in self._latest]
         for event in latest:
@@ -677,6 +689,8 @@ class Dashboard:
         def unsubscribe() -> None:
             with self._cond:
                 if listener in self._listeners:
+                    if self._listeners.index(listener) < self._fast:
+                        self._fast -= 1
                     self._listeners.remove(listener)
 
         return unsubscribe
@@ -749,7 +763,13 @@ class Dashboard:
             self._cond.notify_all()
 
     def _compute(self, generation: int, state: DashboardState) -> None:
-        from app.figures import PANELS, augmenting_figure, figures_for, gamma_free_panels
+        from app.figures import (
+            PANELS,
+            augmenting_figure,
+            augmenting_title,
+            figures_for,
+            gamma_free_panels,
+        )
 
         started = self._changed_at.get(generation, time.perf_counter())
         t0 = time.perf_counter()
@@ -819,15 +839,24 @@ class Dashboard:
             result = replace(result, augmenting=grid)
             with self._cond:
                 self.result = result
-        functionals = error_functionals(result)
+        # E1, E2 depend on what the grid does (not on gamma in continuous mode): reused.
+        if key in self._functionals_cache:
+            functionals = self._functionals_cache[key]
+        else:
+            functionals = error_functionals(result)
+            self._functionals_cache = {key: functionals}
         if self._generation != generation or (functionals is None and not deferred):
             return
-        fig = augmenting_figure(result, functionals)
+        message = {"type": "functionals", "generation": generation, "functionals": functionals}
         with self._cond:
             self.functionals = functionals
-        self._emit(Event("functionals", generation, _json(
-            {"type": "functionals", "generation": generation, "functionals": functionals}
-        )[:-1] + ',"figures":{"augmenting":' + fig.to_json() + "}}"))  # fmt: skip
+        if deferred:  # the h panel was a placeholder: the whole figure
+            fig = augmenting_figure(result, functionals)
+            data = _json(message)[:-1] + ',"figures":{"augmenting":' + fig.to_json() + "}}"
+        else:  # the h panel is on screen: only its title changes (no redraw of the contours)
+            message["titles"] = {"augmenting": augmenting_title(result, functionals)}
+            data = _json(message)
+        self._emit(Event("functionals", generation, data))
 
 
 def export_json(result: DashboardResult, functionals: dict | None = None) -> dict:

@@ -288,7 +288,7 @@ class DashboardScene:
             section_size=1.0,
             position=(0.0, 0.0, -0.06),
         )
-        self._unsubscribe = dashboard.subscribe(self._on_event)
+        self._unsubscribe = dashboard.subscribe(self._on_event, last=True)
         self._thread = threading.Thread(target=self._animate, name="jik-scene", daemon=True)
         self._thread.start()
 

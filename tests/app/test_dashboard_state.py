@@ -189,6 +189,33 @@ def test_a_gamma_change_redraws_only_the_panels_with_theta_on_an_axis():
     assert second["summary"]["extended"]["cached"] is True
 
 
+def test_slow_listeners_come_last_and_functionals_only_retitle_the_h_panel():
+    """The scene subscribes with last=True: the page's events are queued before it draws.
+    With h already on screen, the E1/E2 event carries the h panel's new title, not a figure."""
+    dashboard = Dashboard(updated_state(default_state("manipulator2"), {"cycles": 1}))
+    order, functionals = [], threading.Event()
+    messages = {}
+
+    def slow(event):
+        order.append(("slow", event.kind, event.generation))
+
+    def fast(event):
+        order.append(("fast", event.kind, event.generation))
+        if event.kind == "functionals" and event.generation == 2:
+            messages[event.generation] = json.loads(event.data)
+            functionals.set()
+
+    dashboard.subscribe(slow, last=True)
+    dashboard.subscribe(fast)
+    dashboard.update({"x0": [0.45, 0.0, 1.5]})
+    assert functionals.wait(60)
+    dashboard.stop()
+    assert [who for who, kind, g in order if kind == "result" and g == 2] == ["fast", "slow"]
+    body = messages[2]
+    assert "figures" not in body
+    assert "E1 = " in body["titles"]["augmenting"]
+
+
 @pytest.mark.parametrize(
     ("robot", "x0"),
     [("manipulator2", (0.3, -0.4, 2.0)), ("manipulator1", (0.7, 0.2, -0.6)), ("unicycle", None)],

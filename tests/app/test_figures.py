@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import plotly.graph_objects as go
 import pytest
 
 from app.dashboard import COLORS, LABELS, compute, default_state, error_functionals, updated_state
@@ -112,6 +113,10 @@ def test_every_panel_serialises_to_plotly_json(path_result, target_result):
         for fig in figs.values():
             parsed = json.loads(fig.to_json())
             assert parsed["data"] and parsed["layout"]["title"]["text"]
+            # The builders skip plotly's validation for speed: every property must still be
+            # valid (go.Figure validates a plain dict and raises on an unknown property).
+            go.Figure(parsed)
+        go.Figure(augmenting_figure(result, error_functionals(result)).to_dict())
 
 
 @pytest.mark.skipif("unicycle" not in ROBOTS, reason="the unicycle is not in the registry yet")
@@ -127,3 +132,5 @@ def test_unicycle_platform_paths_and_controls():
         # The last iteration's platform path ends at the target pose.
         assert np.hypot(t.x[-1] - state.target[0], t.y[-1] - state.target[1]) < 1e-6
     assert figs["joints"].layout.title.text.startswith("Controls")
+    for fig in figs.values():
+        go.Figure(fig.to_dict())  # valid plotly (the builders skip the validation)

@@ -170,7 +170,9 @@ def test_dashboard_follows_controls_in_chromium(served):
         # The plotly panels and the viser canvas (inside the iframe on the scene port).
         generation = _wait_generation(page, 1, timeout=60_000)
         for panel in PANELS:
-            page.locator(f"#plot-{panel} .main-svg").first.wait_for(timeout=20_000)
+            # Table 1 is an HTML table (faster than plotly's), the other panels plotly's SVG.
+            drawn = "table" if panel == "table" else ".main-svg"
+            page.locator(f"#plot-{panel} {drawn}").first.wait_for(timeout=20_000)
         # The scene is framed from the other loopback name (its own renderer process).
         assert page.get_attribute("#scene", "src") == f"http://localhost:{scene_port}/"
         scene = page.frame_locator("#scene")
