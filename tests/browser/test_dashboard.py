@@ -140,6 +140,18 @@ def _settled(page, timeout: float = 15.0) -> bytes:
     return shot
 
 
+def _scene_client_shows(page, generation: int, timeout: float = 30_000) -> None:
+    """Wait until the viser client (in the iframe) renders the scene status of ``generation``
+    or a later one: the status travels on the same websocket after the scene's nodes."""
+    frame = next(f for f in page.frames if f.parent_frame is not None)
+    frame.wait_for_function(
+        """(g) => [...document.body.innerText.matchAll(/generation (\\d+):/g)]
+            .some((m) => Number(m[1]) >= g)""",
+        arg=generation,
+        timeout=timeout,
+    )
+
+
 def _trace(page, panel: str, index: int, axis: str) -> list[float]:
     return page.evaluate(
         f"Array.from(document.getElementById('plot-{panel}')._fullData[{index}].{axis})"
@@ -222,6 +234,7 @@ def test_dashboard_follows_controls_in_chromium(served):
 
         # Manipulator 1 (and the unicycle when the registry has it), then back.
         robots = [r["name"] for r in _get(f"{base}/robots")["robots"]]
+        scenes = {"manipulator2": scene_after}
         for robot in [r for r in ("unicycle", "manipulator1") if r in robots]:
             before = int(page.evaluate("jik.generation"))
             page.evaluate("jik.progressShown = 0")
@@ -231,19 +244,27 @@ def test_dashboard_follows_controls_in_chromium(served):
                 # A computation longer than half a second shows the progress bar on the way.
                 assert page.evaluate("jik.progressShown") > 0, f"no progress shown for {robot}"
             page.wait_for_function(f"document.body.dataset.robot === '{robot}'")
-            _scene_generation(base, _wait_generation(page, before + 1), timeout=30)
+            generation = _wait_generation(page, before + 1)
+            _scene_generation(base, generation, timeout=30)
             # The h panel is filled in a second phase (E1, E2; h on a grid for the unicycle).
             page.wait_for_function(
                 "!document.querySelector('#plot-augmenting .gtitle').textContent"
                 ".includes('computing')",
                 timeout=30_000,
             )
-            page.wait_for_timeout(300)
+            # The software-WebGL iframe lags the plots: wait until the viser client shows this
+            # generation's status (sent with the scene's nodes), then until the canvas settles.
+            _scene_client_shows(page, generation)
+            shot = _settled(page)
+            assert shot not in scenes.values(), f"the 3D scene did not change for {robot}"
+            scenes[robot] = shot
             page.screenshot(path=str(ARTIFACTS / f"dashboard-3-{robot}.png"))
         before = int(page.evaluate("jik.generation"))
         page.select_option("#ctl-robot", "manipulator2")
         latencies["switch back to manipulator2"] = _latency(page, before)
         page.wait_for_function("document.body.dataset.robot === 'manipulator2'")
+        _scene_client_shows(page, _wait_generation(page, before + 1))
+        _settled(page)
         page.screenshot(path=str(ARTIFACTS / "dashboard-4-back.png"))
 
         csv = page.evaluate("fetch('/api/dashboard/export.csv').then(r => r.text())")
