@@ -122,6 +122,7 @@ def kernel_cofactors_derivative(J: FloatArray, H: FloatArray) -> FloatArray:
 
 def _one_form_parts(J, H, fixed_index):
     """omega (..., p), d omega/dx (..., p, p) or None, and the 'undefined' mask (...,)."""
+    dc: FloatArray | None
     if H is not None and J.shape[-2:] == (3, 4):
         c, dc = _cofactors_and_derivative34(J, H)
     else:
@@ -132,7 +133,7 @@ def _one_form_parts(J, H, fixed_index):
     bad = (np.abs(cf) <= ONE_FORM_TOL * norm) | ~(norm >= SINGULAR_MANIPULABILITY)
     cf = np.where(bad, 1.0, cf)
     omega = c / cf[..., None]
-    if H is None:
+    if dc is None:  # H is None
         return omega, None, bad
     domega = (dc - omega[..., :, None] * dc[..., fixed_index, None, :]) / cf[..., None, None]
     return omega, domega, bad
@@ -340,11 +341,12 @@ class CharacteristicsMap(AugmentingMap):
         eye = np.eye(n)
         kin = self.kinematics
         # Quadrature moments that do not depend on the leaf coordinate are computed once.
-        fixed = getattr(kin, "moments", None) if self.moments_ignore(f) else None
-        mom = None if fixed is None else fixed(base)
+        # moments_ignore(f) implies kin is a Unicycle.
+        uni = kin if isinstance(kin, Unicycle) and self.moments_ignore(f) else None
+        mom = None if uni is None else uni.moments(base)
 
-        def derivs(pts):
-            return _derivatives(kin, pts) if mom is None else kin.derivatives(pts, moments=mom)
+        def derivs(pts: FloatArray) -> tuple[FloatArray, FloatArray]:
+            return _derivatives(kin, pts) if uni is None else uni.derivatives(pts, moments=mom)
 
         with np.errstate(all="ignore"):
             prev = np.full(len(xb), np.inf)
@@ -467,6 +469,7 @@ class CharacteristicsMap(AugmentingMap):
 
     def _raise_if(self, failed) -> None:
         if self.on_undefined == "raise" and np.any(failed):
+            assert self._cache is not None  # evaluate() ran first and filled it
             phi, s, x = self._cache[2]
             if phi is None:
                 raise OneFormUndefinedError(

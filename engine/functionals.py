@@ -13,7 +13,7 @@ the term -2 dh K of (19), so flipping the sign of h changes E2 unless K is flipp
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -31,7 +31,8 @@ from engine.inverses import (
 from engine.kinematics import Kinematics
 from engine.validation import FloatArray, count, finite
 
-Region = Mapping[str, tuple[float, float]]
+# name -> (lo, hi); any two-item sequence (JSON gives lists), validated by check_region.
+Region = Mapping[str, Sequence[float]]
 
 
 @dataclass(frozen=True)

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
+from typing import Literal
 
 from engine import augmentations as aug
 from engine.augmentations import AugmentingMap
@@ -141,7 +142,7 @@ class RobotSpec:
     default_x0: tuple[float, ...] = ()
     default_target: tuple[float, ...] = ()
     default_path: tuple[tuple[float, ...], ...] = ()
-    default_mode: str = "continuous"
+    default_mode: Literal["continuous", "discrete"] = "continuous"
     default_gamma: float = 1.0
     x_range: tuple[tuple[float, float], ...] = ()
     augmentations: tuple[AugmentationSpec, ...] = ()

@@ -7,12 +7,13 @@ space. The extended Jacobian inverse (11) is repeatable by design; the pseudoinv
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
 from engine.exceptions import InvalidInputError
 from engine.inverses import Inverse
-from engine.solver import SolveResult, solve
+from engine.solver import BatchSolveResult, SolveResult, solve
 from engine.validation import FloatArray, count
 
 #: Largest number of cycles and of path points accepted.
@@ -127,15 +128,19 @@ def repeatability(
             ids = np.flatnonzero(alive)
             if ids.size == 0:
                 break
-            res = solve(
-                inverse,
-                current[ids],
-                targets[ids, j],
-                gamma=gamma,
-                mode=mode,
-                tol=tol,
-                max_iterations=max_iterations,
-                record=record and single,
+            # current[ids] is (k, p), so solve returns a batch.
+            res = cast(
+                BatchSolveResult,
+                solve(
+                    inverse,
+                    current[ids],
+                    targets[ids, j],
+                    gamma=gamma,
+                    mode=mode,
+                    tol=tol,
+                    max_iterations=max_iterations,
+                    record=record and single,
+                ),
             )
             if record and single:
                 leg_results.append(res[0])

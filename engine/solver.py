@@ -107,7 +107,8 @@ class BatchSolveResult:
 
     def trajectory(self, i: int) -> Trajectory:
         """The trajectory of member ``i`` (requires ``record=True``)."""
-        if self._rec_member is None:
+        # The three recordings are set together (all or none).
+        if self._rec_member is None or self._rec_theta is None or self._rec_x is None:
             raise InvalidInputError("trajectories were not recorded; solve with record=True")
         sel = self._rec_member == i
         xs = self._rec_x[sel]
@@ -159,6 +160,10 @@ def _initial_step(inverse, x, f, y_d, rtol, atol):
     return np.minimum(100 * h0, h1)
 
 
+# Recorded steps: (member indices (k,), theta (k,), x (k, p)) per accepted step.
+_Record = list[tuple[FloatArray, FloatArray, FloatArray]]
+
+
 def _dop853(inverse, x0, y_d, tol, max_steps, record, tau0, rtol=RTOL, atol=ATOL):
     """Batched DOP853 on dx/dtau = -J# e from tau = tau0 until ||e|| < tol."""
     n, p = x0.shape
@@ -174,7 +179,7 @@ def _dop853(inverse, x0, y_d, tol, max_steps, record, tau0, rtol=RTOL, atol=ATOL
     h = _initial_step(inverse, x, f, y_d, rtol, atol)
     nsteps = np.zeros(n, dtype=int)
     last_bad = np.zeros(n, dtype=bool)
-    rec = [(np.arange(n), tau.copy(), x.copy())] if record else None
+    rec: _Record | None = [(np.arange(n), tau.copy(), x.copy())] if record else None
     K = np.empty((_NS + 1, n, p))
     while True:
         idx = np.flatnonzero(status == _RUNNING)
@@ -216,7 +221,7 @@ def _dop853(inverse, x0, y_d, tol, max_steps, record, tau0, rtol=RTOL, atol=ATOL
         f[ai] = f_new[accept]
         tau[ai] += hs[accept]
         nsteps[idx] += 1
-        if record:
+        if rec is not None:
             rec.append((ai, tau[ai].copy(), x[ai].copy()))
         err = np.linalg.norm(e_new[accept], axis=-1)
         status[ai[err < tol]] = _CONVERGED
@@ -245,7 +250,7 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto"):
     tau = np.zeros(n)
     status = np.full(n, _CONVERGED)
     nit = np.zeros(n, dtype=int)
-    rec = [(np.arange(n), tau.copy(), x.copy())] if record else None
+    rec: _Record | None = [(np.arange(n), tau.copy(), x.copy())] if record else None
     if moving.size == 0:
         return x, tau, status, nit, rec
     if method == "dop853":
@@ -253,7 +258,7 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto"):
             inverse, x0[moving], y_d[moving], tol, max_steps, record, np.zeros(moving.size)
         )
         x[moving], tau[moving], status[moving], nit[moving] = xr, taur, st, steps
-        if record:
+        if rec is not None:
             rec.extend((moving[m], t, xs) for m, t, xs in rrec[1:])
         return x, tau, status, nit, rec
     # Picard pays (DEGREE + 1) evaluations of J# per sweep: on a path that needs many halvings
@@ -261,7 +266,7 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto"):
     budget = max_steps if method == "picard" else min(max_steps, PICARD_BUDGET)
     x1, done, sigma, sweeps, prec = picard_path(inverse, x0[moving], e0[moving], budget)
     nit[moving] = sweeps
-    if record:
+    if rec is not None:
         for mem, sig, xs in prec:
             keep = sig > 0
             rec.append((moving[mem[keep]], -np.log1p(-sig[keep]), xs[keep]))
@@ -275,7 +280,7 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto"):
         )
     tau[moving] = tau_end
     good = done & (err1 < tol)
-    if record:
+    if rec is not None:
         rec.append((moving[good], tau_end[good], x1[good]))
     rest = moving[~good]
     if rest.size:
@@ -284,7 +289,7 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto"):
         )
         x[rest], tau[rest], status[rest] = xr, taur, st
         nit[rest] += steps
-        if record:
+        if rec is not None:
             rec.extend((rest[m], t, xs) for m, t, xs in rrec[1:])
     return x, tau, status, nit, rec
 
@@ -299,7 +304,7 @@ def _discrete(inverse, x0, y_d, gamma, tol, max_iterations, record):
     status = np.full(n, _RUNNING)
     status[err < tol] = _CONVERGED
     nit = np.zeros(n, dtype=int)
-    rec = [(np.arange(n), np.zeros(n), x.copy())] if record else None
+    rec: _Record | None = [(np.arange(n), np.zeros(n), x.copy())] if record else None
     for k in range(1, max_iterations + 1):
         idx = np.flatnonzero(status == _RUNNING)
         if idx.size == 0:
@@ -311,7 +316,7 @@ def _discrete(inverse, x0, y_d, gamma, tol, max_iterations, record):
         nit[ok] = k
         e[ok] = inverse.kinematics.forward(x[ok]) - y_d[ok]
         err[ok] = np.linalg.norm(e[ok], axis=-1)
-        if record:
+        if rec is not None:
             rec.append((ok, np.full(ok.size, float(k)), x[ok].copy()))
         fin = np.isfinite(err[ok]) & (np.linalg.norm(x[ok], axis=-1) < DIVERGED_NORM)
         status[ok[~fin | (err[ok] > 1e6 * np.maximum(err0[ok], 1.0))]] = _DIVERGED

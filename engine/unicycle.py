@@ -8,6 +8,7 @@ q(T) of the unicycle (40) started at q0 (eq. (42)).
 from __future__ import annotations
 
 import functools
+from typing import Literal, overload
 
 import numpy as np
 
@@ -211,9 +212,17 @@ class Unicycle(Kinematics):
         q3 = self.q0[2] + x[..., 2:3] * t + x[..., 3:4] * C  # (..., N) [rad]
         return np.concatenate([np.cos(q3) @ G, np.sin(q3) @ G], axis=-1)  # no complex exp: slower
 
+    @overload
+    def derivatives(
+        self, x: FloatArray, hessian: Literal[True] = ..., moments: FloatArray | None = ...
+    ) -> tuple[FloatArray, FloatArray]: ...
+    @overload
+    def derivatives(
+        self, x: FloatArray, hessian: Literal[False], moments: FloatArray | None = ...
+    ) -> tuple[FloatArray, None]: ...
     def derivatives(
         self, x: FloatArray, hessian: bool = True, moments: FloatArray | None = None
-    ) -> tuple[FloatArray, FloatArray]:
+    ) -> tuple[FloatArray, FloatArray | None]:
         """The Jacobian (..., 3, 4) and the Hessian (..., 3, 4, 4) from one set of quadratures.
 
         The Hessian is None when ``hessian`` is False. ``moments`` (from :meth:`moments` at

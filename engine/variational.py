@@ -29,6 +29,7 @@ import functools
 import string
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 from numpy.polynomial import legendre as L
@@ -231,8 +232,9 @@ class _Problem:
             for b in range(a, d):
                 blk = G[a].T @ ((self.w * self.R[:, a, b])[:, None] * G[b])
                 A += blk if a == b else blk + blk.T
-        b = sum(G[a].T @ (self.w * self.f[:, a]) for a in range(d))
-        return A, b
+        # A zero-vector start (not sum()'s int 0) keeps b typed as an array; same values.
+        rhs = sum((G[a].T @ (self.w * self.f[:, a]) for a in range(d)), np.zeros(A.shape[0]))
+        return A, rhs
 
 
 def _sub_basis(full: Sequence[int], degrees: Sequence[int]) -> FloatArray:
@@ -304,7 +306,8 @@ def _cubic_fit(amap: SynthesizedMap, problem: _Problem) -> Polynomial2:
     sw = np.sqrt(problem.w)
     coef, *_ = np.linalg.lstsq(M * sw[:, None], amap.value(x) * sw, rcond=None)
     coefficients = dict(zip(powers, coef.tolist(), strict=True))
-    return Polynomial2(coefficients, tuple(problem.variables), amap.p)
+    va, vb = problem.variables  # two region variables (the caller checks d == 2)
+    return Polynomial2(coefficients, (va, vb), amap.p)
 
 
 def _plot_grid(amap: SynthesizedMap, problem: _Problem, n: int = 41) -> dict:
@@ -314,7 +317,7 @@ def _plot_grid(amap: SynthesizedMap, problem: _Problem, n: int = 41) -> dict:
         x0[problem.names.index(name)] = val
     for name, (lo, hi) in problem.box.items():
         x0[problem.names.index(name)] = 0.5 * (lo + hi)
-    a, b = (np.linspace(*problem.box[k], n) for k in names[:2])
+    a, b = (np.linspace(problem.box[k][0], problem.box[k][1], n) for k in names[:2])
     x = np.broadcast_to(x0, (n, n, amap.p)).copy()
     x[..., problem.variables[0]] = a[:, None]
     x[..., problem.variables[1]] = b[None, :]
@@ -361,7 +364,7 @@ def synthesize_e2(
     d = len(box)
     if d not in (2, 3):
         raise InvalidInputError(f"the region must have two or three variables, got {list(box)}")
-    degs = [degree] * d if np.ndim(degree) == 0 else list(degree)
+    degs = [degree] * d if np.ndim(degree) == 0 else list(cast(Sequence[int], degree))
     if len(degs) != d:
         raise InvalidInputError(f"degree needs one value per region variable ({d}), got {degree}")
     degs = [count(n, "degree", 1, 64 if d == 2 else 16) for n in degs]

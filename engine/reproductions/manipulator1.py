@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Callable
+from typing import TypedDict
 
 import numpy as np
 from scipy import optimize
@@ -22,8 +23,16 @@ from engine.variational import synthesize_e2
 
 REGION = {"x1": (0.0, 1.0), "x2": (0.0, 1.0), "x3": (0.5, 1.5)}
 NODES = 24
+
+
+class _Recovery(TypedDict):
+    a: float
+    b: float
+    degrees: tuple[int, ...]
+
+
 #: Dirichlet recovery test: (36) with these a, b on the (x1, x3) box, x2 = 0.
-RECOVERY = {"a": 0.3, "b": 1.0, "degrees": (2, 4, 6, 8, 10, 12)}
+RECOVERY: _Recovery = {"a": 0.3, "b": 1.0, "degrees": (2, 4, 6, 8, 10, 12)}
 
 
 def _maps() -> dict:

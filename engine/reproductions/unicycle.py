@@ -19,13 +19,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import cast
 
 import numpy as np
 
 from engine.characteristics import UnicycleCharacteristics
 from engine.exceptions import JikError
 from engine.inverses import ExtendedInverse, Pseudoinverse
-from engine.solver import solve
+from engine.solver import SolveResult, solve
 from engine.unicycle import Unicycle
 
 STARTS = {"A": (5.0, 0.0, math.pi / 2), "B": (-5.0, 5.0, math.pi / 2)}
@@ -109,15 +110,16 @@ def _run_one(kin, inverse, strict, mode) -> dict:
         # An undefined h reaches the solver as NaN in [J; dh] (flagged singular there); the
         # 'invalid value' warning of that determinant is expected and diagnosed below.
         with np.errstate(invalid="ignore"):
-            res = solve(
+            res = cast(SolveResult, solve(  # one start configuration: a single result
                 inverse, LAMBDA0, Y_D, gamma=GAMMA, mode=mode, tol=TOL,
                 max_iterations=MAX_ITERATIONS if mode == "discrete" else None, record=True,
-            )  # fmt: skip
+            ))  # fmt: skip
     except JikError as exc:
         out.update(success=False, message=f"could not start: {exc}", lambda_=list(LAMBDA0))
         out["lambda"] = out.pop("lambda_")
         return out
     tr = res.trajectory
+    assert tr is not None  # record=True
     lam, err = tr.x, tr.error
     h = None if tr.h is None else np.asarray(tr.h, dtype=float)
     stop, notes = _diagnose(lam, h, strict, not res.success and "singular" in res.message)
@@ -140,6 +142,7 @@ def _run_one(kin, inverse, strict, mode) -> dict:
     if mode == "continuous":
         out["theta_history"] = _floats(tr.theta[:n])
     if extended:
+        assert h is not None  # the extended inverse records h along the path
         hs = h[:n]
         drift = np.abs(hs - hs[0])
         out.update(
