@@ -7,6 +7,7 @@ import importlib
 import json
 import signal
 import sys
+from typing import Any
 
 #: Reproductions: name -> module in engine.reproductions with run() and format_text().
 REPRODUCTIONS = {
@@ -26,7 +27,7 @@ def _progress(fraction: float) -> None:
 
 def reproduce(args: argparse.Namespace) -> int:
     module = importlib.import_module(f"engine.reproductions.{args.name}")
-    kwargs = {}
+    kwargs: dict[str, Any] = {}
     if args.name == "table1" and args.printed_gradient:
         kwargs["printed_gradient"] = True
     elif args.name != "table1" and not args.json:

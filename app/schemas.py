@@ -12,7 +12,7 @@ to the robot, a singular start) is checked by :mod:`app.service`, which names th
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Literal, Union
+from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeAlias, Union
 
 from pydantic import BaseModel, ConfigDict, Field, create_model
 
@@ -57,7 +57,8 @@ def _vector_field(v) -> tuple[Any, Any]:
         for lo, hi in zip(v.minimum, v.maximum, strict=True)
     )
     return (
-        Annotated[tuple[items], Field(description=f"{v.description}; default {list(v.default)}")],
+        # The item types are built at runtime (one per coordinate): a dynamic type by design.
+        Annotated[tuple[items], Field(description=f"{v.description}; default {list(v.default)}")],  # type: ignore[valid-type]
         tuple(v.default),
     )
 
@@ -107,8 +108,14 @@ AUGMENTATION_MODELS: dict[str, type[BaseModel]] = {
 for _m in (*ROBOT_MODELS.values(), *AUGMENTATION_MODELS.values()):
     globals()[_m.__name__] = _m  # importable by name (pickling, introspection)
 
-Robot = _union(list(ROBOT_MODELS.values()))
-Augmentation = _union(list(AUGMENTATION_MODELS.values()))
+if TYPE_CHECKING:
+    # Generated from the catalogue at import time (above), so their fields are invisible to a
+    # static checker: type them as Any there.
+    Robot: TypeAlias = Any
+    Augmentation: TypeAlias = Any
+else:
+    Robot = _union(list(ROBOT_MODELS.values()))
+    Augmentation = _union(list(AUGMENTATION_MODELS.values()))
 
 Algorithm = Literal["pseudoinverse", "extended"]
 Mode = Literal["continuous", "discrete"]
@@ -362,7 +369,9 @@ class ErrorResponse(BaseModel):
 
 
 #: OpenAPI entry of the 503 every computing endpoint may answer.
-BUSY = {503: {"model": ErrorResponse, "description": "server busy: no compute slot in time"}}
+BUSY: dict[int | str, dict[str, Any]] = {
+    503: {"model": ErrorResponse, "description": "server busy: no compute slot in time"}
+}
 
 
 class HealthResponse(BaseModel):

@@ -27,7 +27,7 @@ import threading
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from multiprocessing.connection import Connection
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -36,7 +36,7 @@ from engine.exceptions import InvalidInputError, JikError, SingularConfiguration
 from engine.functionals import error_functional_e1, error_functional_e2
 from engine.registry import ROBOTS, RobotSpec, make_inverse
 from engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS, repeatability
-from engine.solver import solve
+from engine.solver import BatchSolveResult, solve
 from engine.variational import synthesize_e2
 
 #: A run whose largest drift is below this is called repeatable.
@@ -90,7 +90,7 @@ class _Setup:
     inverse: Any
     robot: S.RobotUsed
     augmentation: S.AugmentationUsed | None
-    mode: str
+    mode: S.Mode
     gamma: float
     tolerance: float
     max_iterations: int | None
@@ -329,15 +329,19 @@ def solve_batch(reqs: list[S.SolveRequest]) -> list[S.SolveResponse | RequestErr
         keep = np.flatnonzero(~bad)
         if keep.size:
             try:
-                batch = solve(
-                    setup.inverse,
-                    x0[keep],
-                    y_d[keep],
-                    gamma=setup.gamma,
-                    mode=setup.mode,
-                    tol=setup.tolerance,
-                    max_iterations=setup.max_iterations,
-                    record=True,
+                # x0[keep] is (k, p), so solve returns a batch.
+                batch = cast(
+                    BatchSolveResult,
+                    solve(
+                        setup.inverse,
+                        x0[keep],
+                        y_d[keep],
+                        gamma=setup.gamma,
+                        mode=setup.mode,
+                        tol=setup.tolerance,
+                        max_iterations=setup.max_iterations,
+                        record=True,
+                    ),
                 )
             except JikError as exc:
                 err = _engine_error(exc)
@@ -346,7 +350,7 @@ def solve_batch(reqs: list[S.SolveRequest]) -> list[S.SolveResponse | RequestErr
             else:
                 for j, k in enumerate(keep):
                     out[ok[k]] = _solve_response(setup, batch[j])
-    return out  # type: ignore[return-value]
+    return cast(list[S.SolveResponse | RequestError], out)  # every slot was filled above
 
 
 def solve_request(req: S.SolveRequest) -> S.SolveResponse:
@@ -396,7 +400,7 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
         max_drift=_nullable(max_drift),
         repeatable=bool(res.success) and finite and max_drift < REPEATABLE_DRIFT,
         success=bool(res.success),
-        message=res.message,
+        message=cast(str, res.message),  # one start configuration: one message
     )
 
 
@@ -483,7 +487,7 @@ def _grid(amap, names, region, fixed, p: int, n: int) -> S.SynthesisGrid | None:
     for k, (lo, hi) in region.items():
         base[names.index(k)] = 0.5 * (lo + hi)
     axes = _grid_axes(amap, names, region, base)
-    a, b = (np.linspace(*region[k], n) for k in axes)
+    a, b = (np.linspace(region[k][0], region[k][1], n) for k in axes)
     x = np.broadcast_to(base, (n, n, p)).copy()
     x[..., names.index(axes[0])] = a[:, None]
     x[..., names.index(axes[1])] = b[None, :]
@@ -512,7 +516,7 @@ def _functional_info(fv) -> S.FunctionalInfo:
 
 def _functionals(kin, amap, region, fixed, nodes) -> tuple[dict, list[str]]:
     notes: list[str] = []
-    out = {}
+    out: dict[str, S.FunctionalInfo | None] = {}
     for label, fn in (("e1", error_functional_e1), ("e2", error_functional_e2)):
         try:
             out[label] = _functional_info(fn(kin, amap, region, nodes=nodes, fixed=fixed))
@@ -584,7 +588,7 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
 
 def _solve_payload(items: list[bytes]) -> list[tuple[str, Any]]:
     reqs = [S.SolveRequest.model_validate_json(b) for b in items]
-    out = []
+    out: list[tuple[str, Any]] = []
     for res in solve_batch(reqs):
         if isinstance(res, RequestError):
             out.append(("request_error", (res.field, res.message)))
@@ -782,17 +786,29 @@ class ComputePool:
                 self._idle.put_nowait(w)
         return self._idle
 
+    @property
+    def _bound_loop(self) -> asyncio.AbstractEventLoop:
+        """The event loop of the last :meth:`_bind` (only used after it)."""
+        assert self._loop is not None, "ComputePool used before _bind()"
+        return self._loop
+
+    @property
+    def _bound_idle(self) -> asyncio.Queue[_Worker]:
+        """The idle-worker queue of the last :meth:`_bind` (only used after it)."""
+        assert self._idle is not None, "ComputePool used before _bind()"
+        return self._idle
+
     async def warm_up(self) -> None:
         """Start the workers and wait until each has imported the engine."""
         self._bind()
         with self._lock:
             workers = list(self._workers)
         await asyncio.gather(
-            *(self._loop.run_in_executor(self._threads, w.wait_ready) for w in workers)
+            *(self._bound_loop.run_in_executor(self._threads, w.wait_ready) for w in workers)
         )
 
     def _spawn(self, coro) -> asyncio.Task:
-        task = self._loop.create_task(coro)
+        task = self._bound_loop.create_task(coro)
         self._tasks.add(task)
         task.add_done_callback(self._tasks.discard)
         return task
@@ -808,7 +824,7 @@ class ComputePool:
 
     async def _acquire(self, deadline: float) -> _Worker:
         idle = self._bind()
-        remaining = deadline - self._loop.time()
+        remaining = deadline - self._bound_loop.time()
         try:
             if remaining <= 0:
                 raise TimeoutError
@@ -818,7 +834,7 @@ class ComputePool:
 
     async def _dispatch(self, worker: _Worker, kind: str, payload):
         """Run one computation on ``worker``; it is killed if it overruns the time limit."""
-        loop = self._loop
+        loop = self._bound_loop
         try:
             msg = await loop.run_in_executor(
                 self._threads, worker.call, kind, payload, self.settings.timeout
@@ -835,7 +851,7 @@ class ComputePool:
         except (EOFError, OSError) as exc:
             self._replace(worker)
             raise ServiceUnavailable(f"the compute worker stopped unexpectedly ({exc!r})") from None
-        self._idle.put_nowait(worker)
+        self._bound_idle.put_nowait(worker)
         return msg
 
     def _replace(self, worker: _Worker) -> None:
@@ -845,7 +861,7 @@ class ComputePool:
                 self._workers.remove(worker)
             fresh = _Worker()
             self._workers.append(fresh)
-        self._idle.put_nowait(fresh)
+        self._bound_idle.put_nowait(fresh)
 
     @staticmethod
     def _unwrap(msg):
@@ -862,7 +878,7 @@ class ComputePool:
         For the API kinds the payload is the request and the result the response, as JSON bytes.
         """
         self._bind()
-        worker = await self._acquire(self._loop.time() + self.settings.timeout)
+        worker = await self._acquire(self._bound_loop.time() + self.settings.timeout)
         return self._unwrap(await self._dispatch(worker, kind, payload))
 
     # -- micro-batched solves
@@ -876,7 +892,7 @@ class ComputePool:
             self.stats["solve_requests"] += 1
             (res,) = await self.run("solve", [payload])
             return self._unwrap(res)
-        loop = self._loop
+        loop = self._bound_loop
         entry = _Pending(payload, loop.create_future(), loop.time() + self.settings.timeout)
         entry.future.add_done_callback(_retrieve)
         key = batch_key(req)
@@ -916,7 +932,7 @@ class ComputePool:
             self._pending[key] = rest
             self._spawn(self._flush(key, first=False))
         if not items:
-            self._idle.put_nowait(worker)
+            self._bound_idle.put_nowait(worker)
             return
         for p in items:
             p.dispatched = True
