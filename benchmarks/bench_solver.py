@@ -37,7 +37,7 @@ def straightforward_leg(kin, x0, y_d, method="RK45"):
     def reached(_t, x):
         return np.linalg.norm(kin.forward(x) - y_d) - TOL
 
-    reached.terminal = True
+    reached.terminal = True  # type: ignore[attr-defined]  # solve_ivp reads event attributes off the function
     sol = solve_ivp(f, (0, 200), x0, method=method, rtol=RTOL, atol=ATOL, events=reached)
     return sol.y[:, -1]
 

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import statistics
 import time
+from collections.abc import Callable
+from typing import TypeVar, cast
 
 import numpy as np
 from numpy.polynomial import legendre as L
@@ -55,15 +57,21 @@ def naive_synthesis(degree: int = MANIPULATOR2_DEGREE) -> float:
     return const - float(c @ b[1:])
 
 
-def _median_time(fn, repeats: int) -> tuple[float, float, object]:
+_T = TypeVar("_T")
+
+
+def _median_time(fn: Callable[[], _T], repeats: int) -> tuple[float, float, _T]:
     """Median wall-clock and CPU (process) time of ``repeats`` calls, and the last result."""
-    wall, cpu, out = [], [], None
+    wall: list[float] = []
+    cpu: list[float] = []
+    out: _T | None = None
     for _ in range(repeats):
         t0, c0 = time.perf_counter(), time.process_time()
         out = fn()
         wall.append(time.perf_counter() - t0)
         cpu.append(time.process_time() - c0)
-    return statistics.median(wall), statistics.median(cpu), out
+    # median() raises on repeats < 1, so out is fn()'s result when this returns.
+    return statistics.median(wall), statistics.median(cpu), cast(_T, out)
 
 
 def run(repeats: int = 5) -> dict:

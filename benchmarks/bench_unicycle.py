@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import statistics
 import time
+from collections.abc import Callable
+from typing import TypeVar, cast
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -68,15 +70,21 @@ class StraightforwardCharacteristics(AugmentingMap):
         return out.reshape(x.shape)
 
 
-def _timed(fn, repeats: int) -> tuple[float, float, object]:
+_T = TypeVar("_T")
+
+
+def _timed(fn: Callable[[], _T], repeats: int) -> tuple[float, float, _T]:
     """Median wall and CPU seconds of ``fn()`` over ``repeats`` calls, and its last result."""
-    wall, cpu, out = [], [], None
+    wall: list[float] = []
+    cpu: list[float] = []
+    out: _T | None = None
     for _ in range(repeats):
         w0, c0 = time.perf_counter(), time.process_time()
         out = fn()
         wall.append(time.perf_counter() - w0)
         cpu.append(time.process_time() - c0)
-    return statistics.median(wall), statistics.median(cpu), out
+    # median() raises on repeats < 1, so out is fn()'s result when this returns.
+    return statistics.median(wall), statistics.median(cpu), cast(_T, out)
 
 
 def run(quick: bool = False) -> dict:
