@@ -547,6 +547,83 @@ def error_functionals(result: DashboardResult, nodes: int = 12) -> dict | None:
     return out
 
 
+#: Values of each parameter in the E1/E2 sweep of the dashboard (over v - 1 .. v + 1).
+SENSITIVITY_SAMPLES = 11
+
+
+def sensitivity(
+    result: DashboardResult,
+    functionals: dict | None,
+    cancelled: Callable[[], bool] = lambda: False,
+) -> dict:
+    """How E1 (13) and E2 (18) change with the parameters of the current map (issue 5).
+
+    Over the same box and fixed variables as ``functionals`` (see :func:`error_functionals`):
+
+    * a map with parameters (C1, C2 or a, b): ``{"kind": "parameters", "parameters": {...},
+      "E1": ..., "E2": ...}``, each from :func:`engine.functionals.parameter_sensitivity`
+      (the value, the gradient and a sweep of every parameter over v - 1 .. v + 1);
+    * a map without parameters: ``{"kind": "alternatives", "maps": [{"name", "E1", "E2",
+      "current"}]}``, the functionals of every map the robot offers, at their defaults;
+    * ``{"kind": "unavailable", "reason": ...}`` when they cannot be evaluated here.
+
+    ``cancelled`` is polled before every evaluation of a functional (raises :class:`Cancelled`).
+    """
+    grid = result.augmenting
+    if grid is None:
+        return {"kind": "unavailable", "reason": "h could not be evaluated on a grid"}
+    if functionals is None:
+        return {"kind": "unavailable", "reason": "E1, E2 could not be evaluated"}
+    state = result.state
+    if expensive_map(grid["map"]):
+        return {"kind": "unavailable", "reason": "each value of E1, E2 of this map solves a "
+                "collocation problem per node: no sweep in the dashboard"}  # fmt: skip
+    if functionals.get("E1") is None and functionals.get("E2") is None:
+        return {"kind": "unavailable", "reason": "E1, E2 are undefined on this box"}
+    from engine.functionals import (
+        error_functional_e1,
+        error_functional_e2,
+        parameter_sensitivity,
+    )
+
+    spec = robot_spec(state.robot)
+    kin, nodes, fixed = grid["kinematics"], functionals["nodes"], functionals["fixed"]
+    region = {k: tuple(v) for k, v in functionals["region"].items()}
+    aug = spec.augmentation(state.augmentation)
+
+    def build(other, **params):
+        if cancelled():
+            raise Cancelled
+        return other.build(kin, **params)
+
+    try:
+        if aug.parameters:
+            out: dict = {"kind": "parameters", "parameters": dict(state.augmentation_parameters)}
+            for key in ("E1", "E2"):
+                out[key] = parameter_sensitivity(
+                    kin, lambda **p: build(aug, **p), state.augmentation_parameters, region,
+                    functional=key.lower(), span=1.0, samples=SENSITIVITY_SAMPLES, nodes=nodes,
+                    fixed=fixed,
+                )  # fmt: skip
+            return out
+        maps = []
+        for other in spec.augmentations:
+            amap = build(other, **{p.name: p.default for p in other.parameters})
+            if expensive_map(amap):
+                continue
+            row: dict = {"name": other.name, "current": other.name == aug.name}
+            for key, fn in (("E1", error_functional_e1), ("E2", error_functional_e2)):
+                try:
+                    v = fn(kin, amap, region, nodes=nodes, fixed=fixed).value
+                    row[key] = float(v) if np.isfinite(v) else None
+                except (JikError, ValueError, ArithmeticError):
+                    row[key] = None
+            maps.append(row)
+        return {"kind": "alternatives", "maps": maps}
+    except (JikError, ValueError, ArithmeticError) as exc:
+        return {"kind": "unavailable", "reason": str(exc)}
+
+
 def robots_catalogue() -> list[dict]:
     """Every robot of the registry with its parameters, ranges and defaults."""
     return [spec.as_dict() for spec in ROBOTS.values()]
@@ -560,6 +637,10 @@ class Event:
     generation: int
     data: str
     result: DashboardResult | None = None
+
+
+def _digest(text: str) -> str:
+    return hashlib.md5(text.encode()).hexdigest()[:16]
 
 
 def _json(obj) -> str:
@@ -769,6 +850,7 @@ class Dashboard:
             augmenting_title,
             figures_for,
             gamma_free_panels,
+            sensitivity_figure,
         )
 
         started = self._changed_at.get(generation, time.perf_counter())
@@ -805,9 +887,11 @@ class Dashboard:
         key = _cache_key(state, "extended")
         reuse = {k for k in gamma_free_panels(result) if (k, key) in self._figures}
         texts = {k: self._figures[(k, key)] for k in reuse}
-        texts.update(
-            {k: f.to_json() for k, f in figures_for(result, None, only=set(PANELS) - reuse).items()}
-        )
+        sens = self._functionals_cache.get(key, (None, None))[1]
+        texts.update({
+            k: f.to_json()
+            for k, f in figures_for(result, None, set(PANELS) - reuse, sensitivity=sens).items()
+        })  # fmt: skip
         texts = {k: texts[k] for k in PANELS}
         self._figures = {(k, key): texts[k] for k in gamma_free_panels(result)}
         ready = time.perf_counter()
@@ -817,7 +901,7 @@ class Dashboard:
             "timing": {"compute": result.seconds, "figures": ready - t0 - result.seconds,
                        "server_total": ready - started},
         }  # fmt: skip
-        head["digests"] = {k: hashlib.md5(t.encode()).hexdigest()[:16] for k, t in texts.items()}
+        head["digests"] = {k: _digest(t) for k, t in texts.items()}
         data = (
             _json(head)[:-1]
             + ',"figures":{'
@@ -839,23 +923,35 @@ class Dashboard:
             result = replace(result, augmenting=grid)
             with self._cond:
                 self.result = result
-        # E1, E2 depend on what the grid does (not on gamma in continuous mode): reused.
+        # E1, E2 and their sensitivity depend on what the grid does (not on gamma in
+        # continuous mode): reused.
         if key in self._functionals_cache:
-            functionals = self._functionals_cache[key]
+            functionals, sens = self._functionals_cache[key]
         else:
             functionals = error_functionals(result)
-            self._functionals_cache = {key: functionals}
-        if self._generation != generation or (functionals is None and not deferred):
+            try:
+                sens = sensitivity(result, functionals, lambda: self._generation != generation)
+            except Cancelled:
+                return
+            self._functionals_cache = {key: (functionals, sens)}
+        if self._generation != generation:
             return
-        message = {"type": "functionals", "generation": generation, "functionals": functionals}
+        message = {"type": "functionals", "generation": generation, "functionals": functionals,
+                   "sensitivity": sens}  # fmt: skip
         with self._cond:
             self.functionals = functionals
+        figures = {"sensitivity": sensitivity_figure(result, sens).to_json()}
         if deferred:  # the h panel was a placeholder: the whole figure
-            fig = augmenting_figure(result, functionals)
-            data = _json(message)[:-1] + ',"figures":{"augmenting":' + fig.to_json() + "}}"
-        else:  # the h panel is on screen: only its title changes (no redraw of the contours)
+            figures["augmenting"] = augmenting_figure(result, functionals).to_json()
+        elif functionals is not None:  # h is on screen: only its title changes (no redraw)
             message["titles"] = {"augmenting": augmenting_title(result, functionals)}
-            data = _json(message)
+        message["digests"] = {k: _digest(t) for k, t in figures.items()}
+        data = (
+            _json(message)[:-1]
+            + ',"figures":{'
+            + ",".join(f'"{k}":{t}' for k, t in figures.items())
+            + "}}"
+        )
         self._emit(Event("functionals", generation, data))
 
 

@@ -21,7 +21,7 @@ UNITS = {
 }
 PANEL_HEIGHT = 380
 #: Panel ids, in the page's order.
-PANELS = ("task", "drift", "joints", "augmenting", "table")
+PANELS = ("task", "drift", "joints", "augmenting", "sensitivity", "table")
 _AXIS = dict(
     gridcolor="#e6e6e6", zerolinecolor="#b0b0b0", linecolor="#888", showline=True, mirror=True,
     ticks="outside", automargin=True,
@@ -368,6 +368,88 @@ def augmenting_title(result: DashboardResult, functionals: dict | None = None) -
     return title
 
 
+#: Colours of the functionals (the algorithms keep red and blue).
+E_COLORS = {"E1": "#2ca02c", "E2": "#9467bd"}
+
+
+def sensitivity_figure(result: DashboardResult, sens: dict | None = None) -> go.Figure:
+    """E1 (13) and E2 (18) of the current map and how they change (issue 5).
+
+    With parameters: each functional against each parameter (swept around its current value,
+    which is marked), on a log scale. Without: the functionals of the robot's other maps.
+    ``sens`` comes from :func:`app.dashboard.sensitivity` (the dashboard's second phase).
+    """
+    aug = result.state.augmentation
+    if sens is None:
+        return _figure([], f"E1, E2 of {aug}: computing…")
+    if sens["kind"] == "unavailable":
+        return _figure([], f"E1, E2 of {aug}<br><sup>{sens['reason']}</sup>")
+    log = dict(type="log", exponentformat="power")
+    if sens["kind"] == "alternatives":
+        maps = sens["maps"]
+        names = [m["name"] + (" (current)" if m["current"] else "") for m in maps]
+        data = [
+            _trace("bar", x=names, y=[m[k] for m in maps], name=k,
+                   marker=dict(color=E_COLORS[k],
+                               line=dict(color=["black" if m["current"] else E_COLORS[k]
+                                                for m in maps], width=2)),
+                   hovertemplate="%{x}: " + k + " = %{y:.4g}<extra></extra>")
+            for k in ("E1", "E2")
+        ]  # fmt: skip
+        return _figure(
+            data,
+            f"E1 (13), E2 (18) of the maps of this robot<br><sup>{aug} has no parameters: "
+            "the alternatives on the same box</sup>",
+            barmode="group",
+            yaxis=dict(title="E (log)", **log),
+        )
+    params = sens["parameters"]
+    names = list(params)
+    n = len(names)
+    data, layout = [], {}
+    gap = 0.08
+    width = (1.0 - gap * (n - 1)) / n
+    for c, name in enumerate(names):
+        xa, ya = ("x", "y") if c == 0 else (f"x{c + 1}", f"y{c + 1}")
+        for k in ("E1", "E2"):
+            sweep = sens[k]["sweeps"][name]
+            data.append(_trace("scatter", x=sweep["values"], y=sweep["functional"],
+                               mode="lines", name=k, legendgroup=k, showlegend=c == 0,
+                               line=dict(color=E_COLORS[k], width=2), xaxis=xa, yaxis=ya,
+                               hovertemplate=f"{name} = %{{x:.3g}}<br>{k} = %{{y:.4g}}"
+                               "<extra></extra>"))  # fmt: skip
+            if sens[k]["value"] is not None:
+                data.append(_trace("scatter", x=[params[name]], y=[sens[k]["value"]],
+                                   mode="markers", name=f"current {k}", showlegend=False,
+                                   marker=dict(color="white", size=9,
+                                               line=dict(color=E_COLORS[k], width=2)),
+                                   xaxis=xa, yaxis=ya,
+                                   hovertemplate=f"current {name} = %{{x:.3g}}<br>{k} = "
+                                   "%{y:.4g}<extra></extra>"))  # fmt: skip
+        lo = c * (width + gap)
+        layout["xaxis" if c == 0 else f"xaxis{c + 1}"] = dict(
+            domain=[round(lo, 6), round(min(1.0, lo + width), 6)], title=name,
+            anchor=ya,
+        )  # fmt: skip
+        layout["yaxis" if c == 0 else f"yaxis{c + 1}"] = dict(
+            anchor=xa, **log, **({"title": "E (log)"} if c == 0 else {})
+        )
+    slopes = []
+    for k in ("E1", "E2"):
+        g = sens[k]["gradient"]
+        slopes.append(", ".join(
+            f"∂{k}/∂{p} = {g[p]:.3g}" if g.get(p) is not None else f"∂{k}/∂{p} undefined"
+            for p in names
+        ))  # fmt: skip
+    at = ", ".join(f"{p} = {v:.3g}" for p, v in params.items())
+    return _figure(
+        data,
+        f"E1 (13), E2 (18) as the parameters of {aug} move (at {at})"
+        f"<br><sup>{'; '.join(slopes)}</sup>",
+        **layout,
+    )
+
+
 def gamma_free_panels(result: DashboardResult) -> set[str]:
     """Panels that do not change with gamma in continuous mode (theta is not on their axes)."""
     if result.state.mode != "continuous":
@@ -377,7 +459,10 @@ def gamma_free_panels(result: DashboardResult) -> set[str]:
 
 
 def figures_for(
-    result: DashboardResult, functionals: dict | None = None, only: set[str] | None = None
+    result: DashboardResult,
+    functionals: dict | None = None,
+    only: set[str] | None = None,
+    sensitivity: dict | None = None,
 ) -> dict[str, go.Figure]:
     """The panels of the dashboard for ``result`` (all, or those in ``only``), keyed by id."""
     builders = {
@@ -386,5 +471,6 @@ def figures_for(
         "drift": drift_figure,
         "table": table_figure,
         "augmenting": lambda r: augmenting_figure(r, functionals),
+        "sensitivity": lambda r: sensitivity_figure(r, sensitivity),
     }
     return {k: f(result) for k, f in builders.items() if only is None or k in only}

@@ -3,7 +3,7 @@
 // POST /api/dashboard/state; the viser scene (iframe) changes the same state.
 "use strict";
 
-const PANELS = ["task", "drift", "joints", "augmenting", "table"];
+const PANELS = ["task", "drift", "joints", "augmenting", "sensitivity", "table"];
 const PLOT_CONFIG = { responsive: true, displaylogo: false, modeBarButtonsToRemove: ["lasso2d", "select2d"] };
 const jik = (window.jik = {
   catalogue: null, config: null, state: null, generation: 0, shownGeneration: 0,
@@ -332,7 +332,7 @@ function renderVerdict(msg) {
 
 async function onFunctionals(msg) {
   if (msg.generation !== jik.shownGeneration) return;
-  if (msg.figures) await drawFigures(msg.figures);
+  if (msg.figures) await drawFigures(msg.figures, msg.digests);
   // Only a title changed: relayout it instead of redrawing the panel.
   await Promise.all(Object.entries(msg.titles || {}).map(([key, text]) => {
     const div = document.getElementById(`plot-${key}`);

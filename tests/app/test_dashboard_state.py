@@ -139,7 +139,7 @@ def test_live_dashboard_pushes_state_and_result_events():
     result = next(e for e in events if e.kind == "result" and e.generation == 2)
     body = json.loads(result.data)
     assert body["state"]["x0"] == [0.1, 0.0, 1.5]
-    assert set(body["figures"]) == {"task", "joints", "drift", "table", "augmenting"}
+    assert set(body["figures"]) == {"task", "joints", "drift", "table", "augmenting", "sensitivity"}
     assert body["summary"]["extended"]["success"]
     assert dashboard.snapshot()["computed_generation"] == 2
 
@@ -212,8 +212,9 @@ def test_slow_listeners_come_last_and_functionals_only_retitle_the_h_panel():
     dashboard.stop()
     assert [who for who, kind, g in order if kind == "result" and g == 2] == ["fast", "slow"]
     body = messages[2]
-    assert "figures" not in body
+    assert set(body["figures"]) == {"sensitivity"}  # the h panel is retitled, not redrawn
     assert "E1 = " in body["titles"]["augmenting"]
+    assert body["sensitivity"]["kind"] == "alternatives"  # paper_cubic has no parameters
 
 
 @pytest.mark.parametrize(

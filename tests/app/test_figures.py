@@ -8,12 +8,21 @@ import numpy as np
 import plotly.graph_objects as go
 import pytest
 
-from app.dashboard import COLORS, LABELS, compute, default_state, error_functionals, updated_state
+from app.dashboard import (
+    COLORS,
+    LABELS,
+    compute,
+    default_state,
+    error_functionals,
+    sensitivity,
+    updated_state,
+)
 from app.figures import (
     augmenting_figure,
     drift_figure,
     figures_for,
     joint_figure,
+    sensitivity_figure,
     table_figure,
     task_space_figure,
 )
@@ -109,10 +118,12 @@ def test_single_target_shows_convergence_instead_of_drift(target_result):
 def test_every_panel_serialises_to_plotly_json(path_result, target_result):
     for result in (path_result, target_result):
         figs = figures_for(result)
-        assert set(figs) == {"task", "joints", "drift", "table", "augmenting"}
-        for fig in figs.values():
+        assert set(figs) == {"task", "joints", "drift", "table", "augmenting", "sensitivity"}
+        for key, fig in figs.items():
             parsed = json.loads(fig.to_json())
-            assert parsed["data"] and parsed["layout"]["title"]["text"]
+            # (the sensitivity panel waits for the second phase: a title, no data yet)
+            assert parsed["data"] or key == "sensitivity"
+            assert parsed["layout"]["title"]["text"]
             # The builders skip plotly's validation for speed: every property must still be
             # valid (go.Figure validates a plain dict and raises on an unknown property).
             go.Figure(parsed)
@@ -134,3 +145,42 @@ def test_unicycle_platform_paths_and_controls():
     assert figs["joints"].layout.title.text.startswith("Controls")
     for fig in figs.values():
         go.Figure(fig.to_dict())  # valid plotly (the builders skip the validation)
+
+
+def test_sensitivity_sweeps_each_parameter_through_the_current_value():
+    """Issue 5: E1, E2 at the current (a, b) of e2_optimal and how they change as a, b move."""
+    result = compute(updated_state(default_state("manipulator1"), {"task": "target"}))
+    functionals = error_functionals(result)
+    sens = sensitivity(result, functionals)
+    assert sens["kind"] == "parameters" and set(sens["parameters"]) == {"a", "b"}
+    for key in ("E1", "E2"):
+        assert sens[key]["value"] == pytest.approx(functionals[key], rel=1e-9)
+        for name, v in sens["parameters"].items():
+            sweep = sens[key]["sweeps"][name]
+            assert sweep["values"][0] == pytest.approx(v - 1) and len(sweep["values"]) > 5
+            mid = len(sweep["values"]) // 2  # the sweep passes through the current value
+            assert sweep["functional"][mid] == pytest.approx(sens[key]["value"], rel=1e-9)
+    fig = sensitivity_figure(result, sens)
+    go.Figure(fig.to_dict())
+    assert "as the parameters of e2_optimal move" in fig.layout.title.text
+    assert fig.layout.xaxis.title.text == "a" and fig.layout.xaxis2.title.text == "b"
+    marked = [t for t in fig.data if t.mode == "markers"]
+    assert sorted((t.x[0], t.y[0]) for t in marked) == sorted(
+        (sens["parameters"][p], sens[k]["value"]) for p in ("a", "b") for k in ("E1", "E2")
+    )
+
+
+def test_sensitivity_without_parameters_compares_the_alternatives(path_result):
+    """paper_cubic has no parameters: the E2 values of the robot's other maps are shown."""
+    sens = sensitivity(path_result, error_functionals(path_result))
+    assert sens["kind"] == "alternatives"
+    names = [m["name"] for m in sens["maps"]]
+    assert set(names) == {"paper_cubic", "e2_synthesized"}
+    current = next(m for m in sens["maps"] if m["current"])
+    assert current["name"] == "paper_cubic"
+    assert current["E2"] == pytest.approx(error_functionals(path_result)["E2"], rel=1e-9)
+    fig = sensitivity_figure(path_result, sens)
+    go.Figure(fig.to_dict())
+    assert "no parameters" in fig.layout.title.text
+    assert [t.name for t in fig.data] == ["E1", "E2"]
+    assert "computing" in sensitivity_figure(path_result, None).layout.title.text

@@ -29,7 +29,7 @@ ARGS = [
     "--no-first-run",
 ]
 ARTIFACTS = Path(__file__).resolve().parents[1] / "artifacts"
-PANELS = ("task", "drift", "joints", "augmenting", "table")
+PANELS = ("task", "drift", "joints", "augmenting", "sensitivity", "table")
 ROOT = Path(__file__).resolve().parents[2]
 
 
@@ -140,6 +140,18 @@ def _settled(page, timeout: float = 15.0) -> bytes:
     return shot
 
 
+def _second_phase_drawn(page, timeout: float = 30_000) -> None:
+    """The h panel and the E1/E2 sensitivity panel are filled in a second phase (E1, E2 and
+    their sweeps; h on a grid for the unicycle): wait until neither says 'computing'."""
+    page.wait_for_function(
+        """['augmenting', 'sensitivity'].every((k) => {
+            const t = document.querySelector(`#plot-${k} .gtitle`);
+            return t && !t.textContent.includes('computing');
+        })""",
+        timeout=timeout,
+    )
+
+
 def _scene_client_shows(page, generation: int, timeout: float = 30_000) -> None:
     """Wait until the viser client (in the iframe) renders the scene status of ``generation``
     or a later one: the status travels on the same websocket after the scene's nodes."""
@@ -247,11 +259,7 @@ def test_dashboard_follows_controls_in_chromium(served):
             generation = _wait_generation(page, before + 1)
             _scene_generation(base, generation, timeout=30)
             # The h panel is filled in a second phase (E1, E2; h on a grid for the unicycle).
-            page.wait_for_function(
-                "!document.querySelector('#plot-augmenting .gtitle').textContent"
-                ".includes('computing')",
-                timeout=30_000,
-            )
+            _second_phase_drawn(page)
             # The software-WebGL iframe lags the plots: wait until the viser client shows this
             # generation's status (sent with the scene's nodes), then until the canvas settles.
             _scene_client_shows(page, generation)
@@ -266,6 +274,12 @@ def test_dashboard_follows_controls_in_chromium(served):
         _scene_client_shows(page, _wait_generation(page, before + 1))
         _settled(page)
         page.screenshot(path=str(ARTIFACTS / "dashboard-4-back.png"))
+        # Every panel, below the fold too (E1/E2 against the alternatives, Table 1).
+        _second_phase_drawn(page)
+        sens = page.text_content("#plot-sensitivity .gtitle")
+        assert "paper_cubic has no parameters" in sens, sens
+        assert page.locator("#plot-table table tbody tr").count() > 1
+        page.screenshot(path=str(ARTIFACTS / "dashboard-5-full.png"), full_page=True)
 
         csv = page.evaluate("fetch('/api/dashboard/export.csv').then(r => r.text())")
         assert csv.startswith("algorithm,leg,theta,x1,x2,x3,y1,y2,error,h")
