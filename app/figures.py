@@ -444,8 +444,8 @@ def sensitivity_figure(result: DashboardResult, sens: dict | None = None) -> go.
     at = ", ".join(f"{p} = {v:.3g}" for p, v in params.items())
     return _figure(
         data,
-        f"E1 (13), E2 (18) as the parameters of {aug} move (at {at})"
-        f"<br><sup>{'; '.join(slopes)}</sup>",
+        f"E1 (13), E2 (18) as the parameters of {aug} move"
+        f"<br><sup>at {at} (circles): {'; '.join(slopes)}</sup>",
         **layout,
     )
 
