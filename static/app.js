@@ -281,6 +281,12 @@ async function onResult(msg) {
   if (msg.generation < jik.shownGeneration) return;
   if (!jik.state) onState({ state: msg.state, generation: msg.generation });
   await drawFigures(msg.figures, msg.digests);
+  // Panels the second phase redraws (E1/E2) are dimmed until then, not redrawn empty.
+  for (const key of msg.stale || []) {
+    const div = document.getElementById(`plot-${key}`);
+    if (div) div.classList.add("stale");
+    drawn[key] = undefined;
+  }
   const now = performance.now();
   jik.shownGeneration = msg.generation;
   document.body.dataset.generation = msg.generation;
@@ -333,6 +339,10 @@ function renderVerdict(msg) {
 async function onFunctionals(msg) {
   if (msg.generation !== jik.shownGeneration) return;
   if (msg.figures) await drawFigures(msg.figures, msg.digests);
+  for (const key of Object.keys(msg.figures || {})) {
+    const div = document.getElementById(`plot-${key}`);
+    if (div) div.classList.remove("stale");
+  }
   // Only a title changed: relayout it instead of redrawing the panel.
   await Promise.all(Object.entries(msg.titles || {}).map(([key, text]) => {
     const div = document.getElementById(`plot-${key}`);

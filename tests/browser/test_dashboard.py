@@ -146,7 +146,8 @@ def _second_phase_drawn(page, timeout: float = 30_000) -> None:
     page.wait_for_function(
         """['augmenting', 'sensitivity'].every((k) => {
             const t = document.querySelector(`#plot-${k} .gtitle`);
-            return t && !t.textContent.includes('computing');
+            const stale = document.getElementById(`plot-${k}`).classList.contains('stale');
+            return t && !stale && !t.textContent.includes('computing');
         })""",
         timeout=timeout,
     )
