@@ -680,10 +680,11 @@ class Dashboard:
     state : DashboardState, optional
         Initial state (registry defaults of :data:`DEFAULT_ROBOT`).
     debounce : float
-        Seconds the worker waits after a change for a newer one (slider drags send many).
+        Seconds the worker waits after a change for a newer one (short: the page already
+        coalesces a slider drag into one request in flight at a time).
     """
 
-    def __init__(self, state: DashboardState | None = None, *, debounce: float = 0.01) -> None:
+    def __init__(self, state: DashboardState | None = None, *, debounce: float = 0.002) -> None:
         self._cond = threading.Condition()
         self._state = validate(state or default_state())
         self._generation = 1
