@@ -521,7 +521,12 @@ def augmenting_grid(kin, state: DashboardState, runs: Mapping[str, AlgorithmRun]
 
 
 def error_functionals(result: DashboardResult, nodes: int = 12) -> dict | None:
-    """E1 (13) and E2 (18) of the current map over the heat-map box, or None if unavailable."""
+    """E1 (13) and E2 (18) of the current map, or None if unavailable.
+
+    Over the robot's design region from the registry (the boxes of sec. 5, the ones
+    ``jik reproduce`` uses) where it has one, so the values do not move with the start point and
+    a synthesized map is judged on the box it was built for; else over the heat-map box.
+    """
     grid = result.augmenting
     if grid is None:
         return None
@@ -533,9 +538,15 @@ def error_functionals(result: DashboardResult, nodes: int = 12) -> dict | None:
         return None
     names = result.variable_names
     i, j = grid["axes"]
-    region = {names[i]: tuple(grid["box"][0]), names[j]: tuple(grid["box"][1])}
-    fixed = {names[k]: float(result.state.x0[k]) for k in range(len(names)) if k not in (i, j)}
-    out = {"region": {k: list(v) for k, v in region.items()}, "fixed": fixed, "nodes": nodes}
+    design = robot_spec(result.state.robot).functional_region
+    region = dict(design) or {names[i]: tuple(grid["box"][0]), names[j]: tuple(grid["box"][1])}
+    fixed = {n: float(result.state.x0[k]) for k, n in enumerate(names) if n not in region}
+    out = {
+        "region": {k: list(v) for k, v in region.items()},
+        "fixed": fixed,
+        "nodes": nodes,
+        "design_region": bool(design),
+    }
     for key, fn in (("E1", error_functional_e1), ("E2", error_functional_e2)):
         try:
             value = fn(grid["kinematics"], grid["map"], region, nodes=nodes, fixed=fixed)

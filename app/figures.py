@@ -354,12 +354,16 @@ def augmenting_title(result: DashboardResult, functionals: dict | None = None) -
     sub = []
     if functionals:
         values = {k: functionals.get(k) for k in ("E1", "E2")}
+        where = "the plotted box"
+        if functionals.get("design_region"):
+            where = ", ".join(f"{k} ∈ [{lo:.3g}, {hi:.3g}]" for k, (lo, hi)
+                              in functionals["region"].items())  # fmt: skip
         if all(v is None for v in values.values()):
-            sub.append("E1, E2 undefined: h is not defined on all of this box")
+            sub.append(f"E1, E2 undefined: h is not defined on all of {where}")
         else:
             sub.append(", ".join(
                 f"{k} = {v:.4g}" if v is not None else f"{k} undefined" for k, v in values.items()
-            ) + " on this box")  # fmt: skip
+            ) + f" on {where}")  # fmt: skip
     fixed = [f"{n} = {x0[k]:.3g}" for k, n in enumerate(result.variable_names) if k not in (i, j)]
     if fixed:
         sub.append("at " + ", ".join(fixed))

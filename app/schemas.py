@@ -270,6 +270,9 @@ class RobotInfo(BaseModel):
     x_range: list[list[float]]
     augmentations: list[AugmentationInfo]
     default_augmentation: str
+    functional_region: dict[str, list[float]] = Field(
+        description="the box of the paper's E1/E2 comparisons (sec. 5); empty if none"
+    )
     algorithms: list[Algorithm]
     modes: list[Mode]
 

@@ -19,6 +19,7 @@ from engine.inverses import ExtendedInverse, Inverse, Pseudoinverse
 from engine.kinematics import Kinematics, Manipulator1, Manipulator2
 from engine.unicycle import Unicycle
 from engine.validation import finite
+from engine.variational import MANIPULATOR2_REGION
 
 
 @dataclass(frozen=True)
@@ -147,6 +148,8 @@ class RobotSpec:
     x_range: tuple[tuple[float, float], ...] = ()
     augmentations: tuple[AugmentationSpec, ...] = ()
     default_augmentation: str = ""
+    #: The box on which the paper evaluates E1, E2 (sec. 5); empty where it gives none.
+    functional_region: Mapping[str, tuple[float, float]] = field(default_factory=dict)
 
     def build(self, **values) -> Kinematics:
         scalars = {
@@ -187,10 +190,14 @@ class RobotSpec:
             "x_range": [list(t) for t in self.x_range],
             "augmentations": [a.as_dict() for a in self.augmentations],
             "default_augmentation": self.default_augmentation,
+            "functional_region": {k: list(v) for k, v in self.functional_region.items()},
         }
 
 
 _AB = 5.0
+#: The box of sec. 5.1 on which E1, E2 of Manipulator 1's maps are compared.
+MANIPULATOR1_REGION = {"x1": (0.0, 1.0), "x2": (0.0, 1.0), "x3": (0.5, 1.5)}
+
 MANIPULATOR1 = RobotSpec(
     name="manipulator1",
     title="Manipulator 1",
@@ -237,6 +244,7 @@ MANIPULATOR1 = RobotSpec(
         ),
     ),
     default_augmentation="e2_optimal",
+    functional_region=MANIPULATOR1_REGION,
 )
 
 MANIPULATOR2 = RobotSpec(
@@ -265,6 +273,7 @@ MANIPULATOR2 = RobotSpec(
         ),
     ),
     default_augmentation="paper_cubic",
+    functional_region=MANIPULATOR2_REGION,
 )
 
 

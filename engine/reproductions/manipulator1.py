@@ -18,10 +18,11 @@ from scipy import optimize
 from engine.augmentations import E1Optimal, E1Taylor, E2Optimal
 from engine.functionals import error_functional_e1, error_functional_e2
 from engine.kinematics import Manipulator1
+from engine.registry import MANIPULATOR1_REGION
 from engine.symbolic import findings_summary, manipulator1_findings
 from engine.variational import synthesize_e2
 
-REGION = {"x1": (0.0, 1.0), "x2": (0.0, 1.0), "x3": (0.5, 1.5)}
+REGION = MANIPULATOR1_REGION
 NODES = 24
 
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from engine.registry import ROBOTS
 
 
@@ -37,6 +39,7 @@ def test_robots_lists_the_whole_registry(api):
     m2 = next(r for r in body["robots"] if r["name"] == "manipulator2")
     assert m2["parameters"][0]["name"] == "l"
     assert m2["parameters"][0]["minimum"] == 0.1
+    assert m2["functional_region"] == {"x2": [-1.0, 1.0], "x3": [0.0, math.pi]}
     assert body["limits"]["max_cycles"] == 1000
     assert body["limits"]["max_path_points"] == 100
 
