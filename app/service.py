@@ -69,6 +69,8 @@ def _nullable(a) -> Any:
     a = np.asarray(a, dtype=float)
     if a.ndim == 0:
         return float(a) if np.isfinite(a) else None
+    if np.isfinite(a).all():
+        return a.tolist()
     obj = a.astype(object)
     obj[~np.isfinite(a)] = None
     return obj.tolist()

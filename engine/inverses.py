@@ -18,7 +18,7 @@ from engine.exceptions import (
     KinematicSingularityError,
 )
 from engine.kinematics import SINGULAR_MANIPULABILITY, Kinematics
-from engine.linalg import solve_small
+from engine.linalg import gram, solve_small
 from engine.validation import FloatArray
 
 #: |det [J; dh]| / (product of its row norms) below this counts as an algorithmic singularity.
@@ -156,7 +156,7 @@ class Pseudoinverse(Inverse):
 
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
         J = self.kinematics.jacobian(x)
-        w, d = solve_small(J @ np.swapaxes(J, -1, -2), e)  # (J J^T) w = e
+        w, d = solve_small(gram(J), e)  # (J J^T) w = e
         bad = ~(np.sqrt(np.abs(d)) >= SINGULAR_MANIPULABILITY)  # also catches NaN
         v = np.einsum("...ji,...j->...i", J, w)  # J^T w
         return np.where(bad[..., None], 0.0, v), bad

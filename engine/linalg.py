@@ -11,6 +11,20 @@ import numpy as np
 from engine.validation import FloatArray
 
 
+def gram(J: FloatArray) -> FloatArray:
+    """J J^T for a batch of small (..., r, p) matrices, entry by entry.
+
+    ``J @ J^T`` on stacks of 2 x 3 matrices runs numpy's generic matmul loop per member and costs
+    about three times as much as these r (r + 1) / 2 row dot products.
+    """
+    r = J.shape[-2]
+    M = np.empty((*J.shape[:-1], r))
+    for i in range(r):
+        for j in range(i, r):
+            M[..., i, j] = M[..., j, i] = np.einsum("...k,...k->...", J[..., i, :], J[..., j, :])
+    return M
+
+
 def det_small(A: FloatArray) -> FloatArray:
     """Determinant of (..., n, n) with n <= 3 written out, else ``np.linalg.det``."""
     n = A.shape[-1]

@@ -13,6 +13,7 @@ in section 6.2.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 from scipy.integrate._ivp import dop853_coefficients as _dop
@@ -110,17 +111,25 @@ class BatchSolveResult:
         # The three recordings are set together (all or none).
         if self._rec_member is None or self._rec_theta is None or self._rec_x is None:
             raise InvalidInputError("trajectories were not recorded; solve with record=True")
-        sel = self._rec_member == i
-        xs = self._rec_x[sel]
-        ys = self._inverse.kinematics.forward(xs)
-        h = self._inverse.augmenting_value(xs)
+        ys, h, err, bounds = self._recorded
+        sel = slice(bounds[i], bounds[i + 1])
         return Trajectory(
             theta=self._rec_theta[sel],
-            x=xs,
-            y=ys,
-            error=np.linalg.norm(ys - self._y_d[i], axis=-1),
-            h=None if h is None else np.asarray(h),
+            x=self._rec_x[sel],
+            y=ys[sel],
+            error=err[sel],
+            h=None if h is None else h[sel],
         )
+
+    @cached_property
+    def _recorded(self):
+        """k(x), h(x), ||k(x) - y_d|| of every recorded point at once, and each member's slice."""
+        assert self._rec_member is not None and self._rec_x is not None
+        ys = self._inverse.kinematics.forward(self._rec_x)
+        h = self._inverse.augmenting_value(self._rec_x)
+        err = np.linalg.norm(ys - self._y_d[self._rec_member], axis=-1)
+        bounds = np.searchsorted(self._rec_member, np.arange(len(self.x) + 1))  # sorted members
+        return ys, None if h is None else np.asarray(h), err, bounds
 
     def __getitem__(self, i: int) -> SolveResult:
         return SolveResult(
