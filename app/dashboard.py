@@ -21,13 +21,15 @@ import threading
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
+from typing import cast
 
 import numpy as np
 
 from engine.exceptions import InvalidInputError, JikError
 from engine.registry import ROBOTS, make_inverse, robot_spec
 from engine.repeatability import MAX_PATH_POINTS, closed_path
-from engine.solver import solve
+from engine.solver import SolveResult, solve
+from engine.unicycle import Unicycle
 from engine.validation import count, positive
 
 ALGORITHMS = ("pseudoinverse", "extended")
@@ -89,7 +91,7 @@ def default_state(robot: str = DEFAULT_ROBOT) -> DashboardState:
     aug = spec.augmentation(None)
     # A platform (the unicycle) starts with the paper's experiment of sec. 6.2: one target.
     closed = bool(spec.default_path) and not hasattr(spec.build(), "path")
-    params = {p.name: p.default for p in spec.parameters}
+    params: dict[str, object] = {p.name: p.default for p in spec.parameters}
     params.update({v.name: tuple(v.default) for v in spec.vector_parameters})
     return DashboardState(
         robot=spec.name,
@@ -137,9 +139,9 @@ def updated_state(state: DashboardState, patch: Mapping[str, object]) -> Dashboa
         if key in ("robot", "augmentation"):
             continue
         if key == "robot_parameters":
-            value = {**state.robot_parameters, **dict(value)}
+            value = {**state.robot_parameters, **dict(cast("Mapping[str, object]", value))}
         elif key == "augmentation_parameters":
-            value = {**state.augmentation_parameters, **dict(value)}
+            value = {**state.augmentation_parameters, **dict(cast("Mapping[str, object]", value))}
         values[key] = value
     return validate(replace(state, **values))
 
@@ -262,14 +264,19 @@ def _solve_leg(inverse, x, target, state, gamma, cancelled, partial=lambda f: No
     Returns (theta, x, y, error, h, success, message) of the whole leg.
     """
     if state.mode == "continuous":
-        res = solve(inverse, x, target, gamma=gamma, mode="continuous", tol=state.tol)
+        # One start configuration: a single result, recorded (record=True by default).
+        res = cast(
+            SolveResult, solve(inverse, x, target, gamma=gamma, mode="continuous", tol=state.tol)
+        )
         tr = res.trajectory
+        assert tr is not None  # record=True
         return tr.theta, tr.x, tr.y, tr.error, tr.h, res.success, res.message, res.x
-    pieces, done, chunk, stopped = [], 0, CHUNK, None
+    pieces: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]] = []
+    done, chunk, stopped = 0, CHUNK, None
     while True:
         try:
-            res = solve(inverse, x, target, gamma=gamma, mode="discrete", tol=state.tol,
-                        max_iterations=chunk)  # fmt: skip
+            res = cast(SolveResult, solve(inverse, x, target, gamma=gamma, mode="discrete",
+                                          tol=state.tol, max_iterations=chunk))  # fmt: skip
         except JikError as exc:
             # The map is undefined somewhere in this chunk: redo it one iteration at a time to
             # keep every iterate before the stop (the platform paths up to there).
@@ -279,6 +286,7 @@ def _solve_leg(inverse, x, target, state, gamma, cancelled, partial=lambda f: No
             chunk = 1
             continue
         tr = res.trajectory
+        assert tr is not None  # record=True
         first = 0 if not pieces else 1  # a chunk starts where the previous one ended
         pieces.append((tr.theta[first:] + done, tr.x[first:], tr.y[first:], tr.error[first:],
                        None if tr.h is None else tr.h[first:]))  # fmt: skip
@@ -440,7 +448,7 @@ def compute(
             )
             run = _run_legs(inverse, state, targets, cycles, step, cancelled, partial)
             if hasattr(kin, "path"):
-                t = np.linspace(0.0, float(kin.T), UNICYCLE_TIME_POINTS)
+                t = np.linspace(0.0, float(cast(Unicycle, kin).T), UNICYCLE_TIME_POINTS)
                 run = replace(run, platform=kin.path(run.x, t))
             cache[keys[algorithm]] = run
         run = cache[keys[algorithm]]
@@ -458,7 +466,9 @@ def compute(
         task_names=tuple(spec.task_names),
         targets=targets,
         runs=runs,
-        time=np.linspace(0.0, float(kin.T), UNICYCLE_TIME_POINTS) if hasattr(kin, "path") else None,
+        time=np.linspace(0.0, float(cast(Unicycle, kin).T), UNICYCLE_TIME_POINTS)
+        if hasattr(kin, "path")
+        else None,
         augmenting=augmenting_grid(kin, state, runs) if with_augmenting else None,
         seconds=time.perf_counter() - t0,
         cached={a: a not in todo for a in ALGORITHMS},
@@ -706,7 +716,8 @@ class Dashboard:
         self._fast = 0  # the first ``_fast`` listeners are the quick ones
         self._cache: dict = {}
         self._figures: dict[tuple[str, str], str] = {}  # (panel, key) -> figure JSON
-        self._functionals_cache: dict[str, dict | None] = {}
+        # key -> (E1/E2 functionals or None, their sensitivity)
+        self._functionals_cache: dict[str, tuple[dict | None, dict]] = {}
         self._latest: dict[str, Event] = {
             "state": Event("state", 1, _json(self._state_message(1, self._state, "initial")))
         }

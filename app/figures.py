@@ -245,6 +245,7 @@ def platform_figure(result: DashboardResult, max_paths: int = 12) -> go.Figure:
     for col, a in enumerate(ALGORITHMS, start=1):
         xa, ya = ("x", "y") if col == 1 else ("x2", "y2")
         P = result.runs[a].platform
+        assert P is not None  # drawn only for the unicycle, whose runs all carry platform paths
         m = len(P)
         show = sorted(set(np.geomspace(1, m, num=max_paths).astype(int) - 1) | {0, m - 1})
         for n, i in enumerate(show):

@@ -23,6 +23,7 @@ import json
 import math
 import threading
 import time
+from typing import Any, cast
 
 import numpy as np
 import viser
@@ -275,7 +276,9 @@ class DashboardScene:
         self._s = 0.0
         self.drawn_generation = 0
         self._structure: tuple | None = None
-        self._controls: dict[str, object] = {}
+        # viser declares the setter of a GUI handle's ``value`` apart from its getter, so mypy
+        # sees a read-only property; assigning it is viser's API (ignores marked "viser: settable").
+        self._controls: dict[str, viser.GuiInputHandle[Any]] = {}
         self._folders: list = []
         self._last_drag = 0.0
         self._stopped = False
@@ -351,6 +354,8 @@ class DashboardScene:
         self._folders, self._controls = [], {}
         spec = robot_spec(state.robot)
         c = self._controls
+        # The lambdas' default arguments bind the loop variables; mypy cannot type such a lambda
+        # against the callback type (python/mypy#15459), hence the ignores marked "mypy#15459".
         self._syncing = True
         try:
             with gui.add_folder("Robot and algorithm", order=2) as f:
@@ -358,7 +363,7 @@ class DashboardScene:
                 c["robot"] = gui.add_dropdown("robot", list(ROBOTS), initial_value=state.robot)
                 c["robot"].on_update(lambda e: self._change({"robot": e.target.value}))
                 for p in spec.parameters:
-                    h = gui.add_slider(
+                    h: viser.GuiInputHandle[Any] = gui.add_slider(
                         p.name,
                         min=p.minimum,
                         max=p.maximum,
@@ -367,20 +372,20 @@ class DashboardScene:
                         hint=p.description,
                     )
                     h.on_update(
-                        lambda e, n=p.name: self._change({"robot_parameters": {n: e.target.value}})
+                        lambda e, n=p.name: self._change({"robot_parameters": {n: e.target.value}})  # type: ignore[misc]  # mypy#15459
                     )
                     c[f"robot_parameters.{p.name}"] = h
                 for v in spec.vector_parameters:
                     h = gui.add_vector3(
                         v.name,
                         tuple(state.robot_parameters[v.name]),
-                        min=tuple(v.minimum),
-                        max=tuple(v.maximum),
+                        min=cast("tuple[float, float, float]", tuple(v.minimum)),
+                        max=cast("tuple[float, float, float]", tuple(v.maximum)),
                         step=0.1,
                         hint=v.description,
                     )
                     h.on_update(
-                        lambda e, n=v.name: self._change(
+                        lambda e, n=v.name: self._change(  # type: ignore[misc]  # mypy#15459
                             {"robot_parameters": {n: list(e.target.value)}}
                         )
                     )
@@ -390,7 +395,7 @@ class DashboardScene:
                             f"{v.name} = {name} {tuple(round(t, 2) for t in preset)}"
                         )
                         b.on_click(
-                            lambda _, n=v.name, q=list(preset): self._change(
+                            lambda _, n=v.name, q=list(preset): self._change(  # type: ignore[misc]  # mypy#15459
                                 {"robot_parameters": {n: q}}
                             )
                         )
@@ -434,7 +439,7 @@ class DashboardScene:
                         hint=p.description,
                     )
                     h.on_update(
-                        lambda e, n=p.name: self._change(
+                        lambda e, n=p.name: self._change(  # type: ignore[misc]  # mypy#15459
                             {"augmentation_parameters": {n: e.target.value}}
                         )
                     )
@@ -450,7 +455,7 @@ class DashboardScene:
                         step=(hi - lo) / 400,
                         initial_value=min(max(state.x0[i], lo), hi),
                     )
-                    h.on_update(lambda e, k=i: self._set_x0(k, e.target.value))
+                    h.on_update(lambda e, k=i: self._set_x0(k, e.target.value))  # type: ignore[misc]  # mypy#15459
                     c[f"x0.{i}"] = h
                 if spec.default_path:
                     c["task"] = gui.add_dropdown(
@@ -518,7 +523,7 @@ class DashboardScene:
             for key, handle in self._controls.items():
                 if key in values:
                     try:
-                        handle.value = values[key]
+                        handle.value = values[key]  # type: ignore[misc]  # viser: settable
                     except (ValueError, AssertionError):
                         pass
         finally:
@@ -533,7 +538,7 @@ class DashboardScene:
                 msg = json.loads(event.data)
                 if event.generation == self.dashboard.generation and msg["elapsed"] > 0.5:
                     self.progress.visible = msg["fraction"] < 1
-                    self.progress.value = min(100.0, 100.0 * msg["fraction"])
+                    self.progress.value = min(100.0, 100.0 * msg["fraction"])  # type: ignore[misc]  # viser: settable
                     self.status.content = f"computing… {100 * msg['fraction']:.0f}%"
             elif event.kind == "result" and event.result is not None:
                 self._draw(event.result)
@@ -712,7 +717,9 @@ class DashboardScene:
                 P = run.platform[i]
                 last = n == len(timeline.shown) - 1
                 mix = 1.0 if last else 0.3 + 0.5 * n / len(timeline.shown)
-                color = tuple(int(v) for v in (255 - mix * (255 - rgb)))
+                color = cast(
+                    "tuple[int, int, int]", tuple(int(v) for v in (255 - mix * (255 - rgb)))
+                )
                 pts = np.column_stack([P[:, 0], P[:, 1], np.full(len(P), 0.02 + _Z[a] * 0.2)])
                 scene.add_line_segments(
                     f"/robot/trace/{a}/{n}",
@@ -733,6 +740,7 @@ class DashboardScene:
 
     # -- animation ------------------------------------------------------------------------
     def _animate(self) -> None:
+        posed: tuple[Timeline | None, float | None]
         last, last_gui, posed = time.monotonic(), 0.0, (None, None)
         while not self._stopped:
             time.sleep(1.0 / FPS)
@@ -755,7 +763,7 @@ class DashboardScene:
                 last_gui = now
                 self._syncing = True
                 try:
-                    self.scrub.value = round(min(self._s / timeline.length, 1.0), 3)
+                    self.scrub.value = round(min(self._s / timeline.length, 1.0), 3)  # type: ignore[misc]  # viser: settable
                 finally:
                     self._syncing = False
 

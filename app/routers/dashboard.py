@@ -12,7 +12,13 @@ from pathlib import Path
 
 import plotly
 from fastapi import APIRouter, FastAPI, Request
-from fastapi.responses import FileResponse, JSONResponse, PlainTextResponse, StreamingResponse
+from fastapi.responses import (
+    FileResponse,
+    JSONResponse,
+    PlainTextResponse,
+    Response,
+    StreamingResponse,
+)
 
 import static
 from app.dashboard import (
@@ -55,7 +61,7 @@ async def plotly_js() -> FileResponse:
 
 
 @router.get("/static/{name}", include_in_schema=False)
-async def static_file(name: str) -> FileResponse:
+async def static_file(name: str) -> Response:
     path = STATIC_DIR / name
     if path.suffix not in _MEDIA or path.parent != STATIC_DIR or not path.is_file():
         return JSONResponse(status_code=404, content={"detail": f"no static file {name!r}"})
