@@ -19,7 +19,7 @@ from engine.inverses import ExtendedInverse, Inverse, Pseudoinverse
 from engine.kinematics import Kinematics, Manipulator1, Manipulator2
 from engine.unicycle import Unicycle
 from engine.validation import finite
-from engine.variational import MANIPULATOR2_REGION
+from engine.variational import MANIPULATOR2_REGION, default_manipulator2_synthesis
 
 
 @dataclass(frozen=True)
@@ -278,8 +278,6 @@ MANIPULATOR2 = RobotSpec(
 
 
 def _e2_synthesized(kin: Manipulator2) -> AugmentingMap:
-    from engine.variational import default_manipulator2_synthesis
-
     return default_manipulator2_synthesis(kin.l).augmenting_map
 
 

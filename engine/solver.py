@@ -335,7 +335,6 @@ def _discrete(inverse, x0, y_d, gamma, tol, max_iterations, record):
 
 
 def _message(status, nit, err, tol, mode, x, inverse, max_iterations) -> str:
-
     steps = "steps" if mode == "continuous" else "iterations"
     if status == _CONVERGED:
         if nit == 0:

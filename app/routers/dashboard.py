@@ -159,12 +159,18 @@ async def events(request: Request) -> StreamingResponse:
     )
 
 
-@router.get("/api/dashboard/export.json")
-async def export_result_json(request: Request) -> JSONResponse:
-    """The current result, every trajectory point of both algorithms, as JSON."""
+async def _finished(request: Request):
+    """The live dashboard, after waiting (up to 60 s) for its first result."""
     dashboard = dashboard_for(request.app)
     if dashboard.result is None:
         await asyncio.to_thread(dashboard.wait, None, 60.0)
+    return dashboard
+
+
+@router.get("/api/dashboard/export.json")
+async def export_result_json(request: Request) -> JSONResponse:
+    """The current result, every trajectory point of both algorithms, as JSON."""
+    dashboard = await _finished(request)
     if dashboard.result is None:
         return JSONResponse(status_code=503, content={"detail": "no result computed yet"})
     body = export_json(dashboard.result, dashboard.functionals)
@@ -176,9 +182,7 @@ async def export_result_json(request: Request) -> JSONResponse:
 @router.get("/api/dashboard/export.csv")
 async def export_result_csv(request: Request) -> PlainTextResponse:
     """The current result as CSV: one row per trajectory point and algorithm."""
-    dashboard = dashboard_for(request.app)
-    if dashboard.result is None:
-        await asyncio.to_thread(dashboard.wait, None, 60.0)
+    dashboard = await _finished(request)
     if dashboard.result is None:
         return PlainTextResponse("no result computed yet\n", status_code=503)
     return PlainTextResponse(

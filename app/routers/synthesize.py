@@ -15,7 +15,7 @@ router = APIRouter(tags=["synthesize"])
 
 @router.get("/synthesize", response_model=SynthesisMethodsResponse)
 async def methods() -> SynthesisMethodsResponse:
-    """The synthesis methods this server offers and which engine components are installed."""
+    """The synthesis methods this server offers, with a note on each."""
     return synthesis_methods()
 
 
