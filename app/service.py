@@ -20,16 +20,19 @@ from __future__ import annotations
 import asyncio
 import concurrent.futures
 import os
+import pickle
 import socket
+import struct
 import subprocess
 import sys
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from multiprocessing.connection import Connection
-from typing import Any, cast
+from typing import Any, TypeVar, cast
 
 import numpy as np
+import pydantic_core
 
 from app import schemas as S
 from engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
@@ -38,6 +41,8 @@ from engine.registry import ROBOTS, RobotSpec, make_inverse
 from engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS, repeatability
 from engine.solver import BatchSolveResult, solve
 from engine.variational import synthesize_e2
+
+_R = TypeVar("_R")
 
 #: A run whose largest drift is below this is called repeatable.
 REPEATABLE_DRIFT = 1e-6
@@ -269,6 +274,47 @@ def _solve_response(setup: _Setup, res) -> S.SolveResponse:
     )
 
 
+def _trajectory_dict(traj) -> dict[str, Any]:
+    """:func:`_trajectory` as plain JSON-ready data, without building the pydantic model."""
+    m = len(traj.theta)
+    idx = _downsample(m)
+    return {
+        "theta": _nullable(traj.theta[idx]),
+        "x": _nullable(traj.x[idx]),
+        "y": _nullable(traj.y[idx]),
+        "error": _nullable(traj.error[idx]),
+        "h": None if traj.h is None else _nullable(np.asarray(traj.h)[idx]),
+        "points": m,
+        "downsampled": bool(len(idx) < m),
+    }
+
+
+def _solve_response_json(setup: _Setup, res) -> bytes:
+    """The JSON document of :func:`_solve_response`, built without model validation.
+
+    The worker's hot path: validating a response model costs about as much as a small solve.
+    ``tests/app/test_solve.py`` checks that both give the same document.
+    """
+    doc = {
+        "robot": setup.robot.model_dump(mode="json"),
+        "algorithm": setup.inverse.name,
+        "augmentation": (
+            None if setup.augmentation is None else setup.augmentation.model_dump(mode="json")
+        ),
+        "mode": setup.mode,
+        "gamma": float(setup.gamma),
+        "tolerance": float(setup.tolerance),
+        "x": _nullable(res.x),
+        "y": _nullable(res.y),
+        "error": _nullable(res.error),
+        "converged": bool(res.success),
+        "message": str(res.message),
+        "iterations": int(res.nit),
+        "trajectory": _trajectory_dict(res.trajectory),
+    }
+    return pydantic_core.to_json(doc)
+
+
 # --------------------------------------------------------------------------------------------
 # Plain service functions
 
@@ -305,6 +351,14 @@ def solve_batch(reqs: list[S.SolveRequest]) -> list[S.SolveResponse | RequestErr
     Each member is validated on its own (lengths, singular start): a bad member gets its
     :class:`RequestError` in its slot and does not affect the others.
     """
+    return _solve_batch(reqs, _solve_response)
+
+
+def _solve_batch(
+    reqs: list[S.SolveRequest], respond: Callable[[_Setup, Any], _R]
+) -> list[_R | RequestError]:
+    """:func:`solve_batch` with ``respond`` turning a member's result into its response (the
+    model, or JSON bytes in the workers)."""
     if not reqs:
         return []
     if len({batch_key(r) for r in reqs}) != 1:
@@ -313,7 +367,7 @@ def solve_batch(reqs: list[S.SolveRequest]) -> list[S.SolveResponse | RequestErr
         setup = _setup(reqs[0])
     except RequestError as exc:
         return [exc] * len(reqs)
-    out: list[S.SolveResponse | RequestError | None] = [None] * len(reqs)
+    out: list[_R | RequestError | None] = [None] * len(reqs)
     ok: list[int] = []
     for i, r in enumerate(reqs):
         try:
@@ -351,8 +405,8 @@ def solve_batch(reqs: list[S.SolveRequest]) -> list[S.SolveResponse | RequestErr
                     out[ok[k]] = err
             else:
                 for j, k in enumerate(keep):
-                    out[ok[k]] = _solve_response(setup, batch[j])
-    return cast(list[S.SolveResponse | RequestError], out)  # every slot was filled above
+                    out[ok[k]] = respond(setup, batch[j])
+    return cast(list[_R | RequestError], out)  # every slot was filled above
 
 
 def solve_request(req: S.SolveRequest) -> S.SolveResponse:
@@ -591,11 +645,11 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
 def _solve_payload(items: list[bytes]) -> list[tuple[str, Any]]:
     reqs = [S.SolveRequest.model_validate_json(b) for b in items]
     out: list[tuple[str, Any]] = []
-    for res in solve_batch(reqs):
+    for res in _solve_batch(reqs, _solve_response_json):
         if isinstance(res, RequestError):
             out.append(("request_error", (res.field, res.message)))
         else:
-            out.append(("ok", res.model_dump_json().encode()))
+            out.append(("ok", res))
     return out
 
 
@@ -647,6 +701,19 @@ def _worker_entry(fd: int) -> None:
 WORKER_BOOT_TIMEOUT = 120.0
 
 
+def _frame(buf: bytearray) -> tuple[int | None, int]:
+    """Payload size and offset of a :class:`~multiprocessing.connection.Connection` message
+    starting in ``buf`` (size None until the header is complete)."""
+    if len(buf) < 4:
+        return None, 0
+    (size,) = struct.unpack("!i", buf[:4])
+    if size != -1:
+        return size, 4
+    if len(buf) < 12:
+        return None, 0
+    return struct.unpack("!Q", buf[4:12])[0], 12
+
+
 class _Worker:
     """A worker process (a fresh interpreter, so nothing of the server's state is inherited)."""
 
@@ -670,14 +737,6 @@ class _Worker:
                 raise OSError("worker did not start")
             self.conn.recv()
             self.ready = True
-
-    def call(self, kind: str, payload, timeout: float):
-        """Blocking round trip (runs in a thread); TimeoutError when the computation overruns."""
-        self.wait_ready()
-        self.conn.send((kind, payload))
-        if not self.conn.poll(max(timeout, 0.0)):
-            raise TimeoutError
-        return self.conn.recv()
 
     def kill(self) -> None:
         self.process.kill()
@@ -708,6 +767,8 @@ class Settings:
     batching: bool = True
     batch_window: float = 0.002
     max_batch: int = 64
+    #: A batch is split among idle workers only into shares of at least this many requests.
+    min_share: int = 4
 
 
 def settings_from_env() -> Settings:
@@ -835,12 +896,20 @@ class ComputePool:
             raise self._busy() from None
 
     async def _dispatch(self, worker: _Worker, kind: str, payload):
-        """Run one computation on ``worker``; it is killed if it overruns the time limit."""
+        """Run one computation on ``worker``; it is killed if it overruns the time limit.
+
+        The event loop itself waits for the worker's socket to become readable (no thread per
+        computation: a thread would wait for the GIL, up to the 5 ms switch interval, while the
+        loop serves other requests).
+        """
         loop = self._bound_loop
         try:
-            msg = await loop.run_in_executor(
-                self._threads, worker.call, kind, payload, self.settings.timeout
-            )
+            if not worker.ready:  # a freshly started worker: importing the engine takes a while
+                await loop.run_in_executor(self._threads, worker.wait_ready)
+            deadline = loop.time() + self.settings.timeout
+            os.set_blocking(worker.conn.fileno(), True)  # uvloop's add_reader made it non-blocking
+            worker.conn.send((kind, payload))
+            msg = await self._reply(worker, deadline)
         except TimeoutError:
             self.stats["exceeded"] += 1
             self._replace(worker)
@@ -853,8 +922,60 @@ class ComputePool:
         except (EOFError, OSError) as exc:
             self._replace(worker)
             raise ServiceUnavailable(f"the compute worker stopped unexpectedly ({exc!r})") from None
+        except asyncio.CancelledError:  # the request went away: collect the reply in the back
+            if worker.ready:
+                self._spawn(self._drain(worker, loop.time() + self.settings.timeout))
+            else:
+                self._replace(worker)
+            raise
         self._bound_idle.put_nowait(worker)
         return msg
+
+    async def _reply(self, worker: _Worker, deadline: float):
+        """The worker's reply, read in the event loop as it arrives, until ``deadline``.
+
+        The reply is framed as by :class:`multiprocessing.connection.Connection` (which the worker
+        uses): a 4-byte big-endian length (-1, then 8 bytes, for huge messages), then a pickle.
+        Each readiness callback reads once, so it never blocks whether or not the event loop
+        (uvloop does) has made the socket non-blocking.
+        """
+        loop = self._bound_loop
+        fd = worker.conn.fileno()
+        done: asyncio.Future = loop.create_future()
+        buf = bytearray()
+
+        def readable() -> None:
+            try:
+                chunk = os.read(fd, 1 << 20)
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError as exc:
+                if not done.done():
+                    done.set_exception(exc)
+                return
+            if not chunk:
+                if not done.done():
+                    done.set_exception(EOFError("the worker closed its connection"))
+                return
+            buf.extend(chunk)
+            size, start = _frame(buf)
+            if size is not None and len(buf) >= start + size and not done.done():
+                done.set_result(pickle.loads(memoryview(buf)[start : start + size]))
+
+        loop.add_reader(fd, readable)
+        try:
+            return await asyncio.wait_for(done, max(deadline - loop.time(), 0.0))
+        finally:
+            loop.remove_reader(fd)
+
+    async def _drain(self, worker: _Worker, deadline: float) -> None:
+        """Wait out an abandoned computation, then give the worker back (or replace it)."""
+        try:
+            await self._reply(worker, deadline)
+        except (TimeoutError, EOFError, OSError):
+            self._replace(worker)
+        else:
+            self._bound_idle.put_nowait(worker)
 
     def _replace(self, worker: _Worker) -> None:
         worker.kill()
@@ -936,10 +1057,25 @@ class ComputePool:
         if not items:
             self._bound_idle.put_nowait(worker)
             return
+        # A large batch is shared among the workers that are idle right now: two half batches on
+        # two cores finish sooner than one whole batch on one.
+        workers = [worker]
+        while (
+            len(items) >= (len(workers) + 1) * self.settings.min_share
+            and not self._bound_idle.empty()
+        ):
+            workers.append(self._bound_idle.get_nowait())
         for p in items:
             p.dispatched = True
-        self.stats["solve_calls"] += 1
+        self.stats["solve_calls"] += len(workers)
         self.stats["solve_requests"] += len(items)
+        shares = np.array_split(np.arange(len(items)), len(workers))
+        for w, share in zip(workers[1:], shares[1:], strict=True):
+            self._spawn(self._solve_share(w, [items[i] for i in share]))
+        await self._solve_share(workers[0], [items[i] for i in shares[0]])
+
+    async def _solve_share(self, worker: _Worker, items: list[_Pending]) -> None:
+        """Solve ``items`` in ONE engine call on ``worker`` and hand each its result."""
         try:
             msg = await self._dispatch(worker, "solve", [p.payload for p in items])
             results = self._unwrap(msg)

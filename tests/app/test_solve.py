@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import asyncio
+import json
 import math
 
 import httpx
 import numpy as np
+import pytest
 
 from app.main import create_app
 from app.service import Settings
@@ -111,6 +113,23 @@ def test_concurrent_solves_are_batched_and_equal_to_single_solves(api):
         np.testing.assert_allclose(r.json()["y"], body["target"], atol=1e-9)
 
 
+def test_a_large_batch_is_shared_among_idle_workers(api):
+    """16 requests in one window with two idle workers: two engine calls of 8, same results."""
+    rng = np.random.default_rng(2)
+    bodies = [solve_body(target=t.tolist()) for t in rng.uniform([0.2, 0.8], [1.2, 1.8], (16, 2))]
+    app = create_app(Settings(workers=2, timeout=60.0, batch_window=0.05))
+    try:
+        responses = asyncio.run(_concurrent(app, bodies))
+        stats = app.state.pool.stats
+    finally:
+        app.state.pool.close()
+    assert [r.status_code for r in responses] == [200] * 16
+    assert (stats["solve_calls"], stats["solve_requests"]) == (2, 16), stats
+    for body, r in zip(bodies, responses, strict=True):
+        single = api.post("/solve", json=body).json()
+        np.testing.assert_allclose(r.json()["x"], single["x"], atol=1e-12)
+
+
 def test_unbatched_mode_makes_one_call_per_request():
     bodies = [solve_body(target=[0.5 + 0.1 * i, 1.5]) for i in range(4)]
     app = create_app(Settings(workers=1, timeout=60.0, batching=False))
@@ -181,3 +200,29 @@ def test_service_batch_isolates_a_bad_first_member():
     assert isinstance(out[0], RequestError) and out[0].field == "x0"
     np.testing.assert_allclose(out[1].x, X1F, atol=6e-5)
     np.testing.assert_allclose(out[2].y, [0.5, 1.5], atol=1e-9)
+
+
+@pytest.mark.parametrize(
+    "over",
+    [
+        {},
+        {"algorithm": "extended", "augmentation": {"name": "paper_cubic"}},
+        {"algorithm": "extended", "augmentation": {"name": "e2_synthesized"}},
+        {"mode": "discrete", "gamma": 0.5},
+        {"mode": "discrete", "gamma": 1e-3, "max_iterations": 2500},  # downsampled trajectory
+        {"max_iterations": 3, "target": [1.9, 0.6]},  # not converged
+        {"robot": {"name": "manipulator1"}, "x0": [0.3, 0.2, 0.1], "target": [0.5, 0.4]},
+    ],
+)
+def test_worker_json_is_the_validated_response(over):
+    """The workers' JSON (built without pydantic) is the validated model's document: the same
+    keys and the same float values (only the spelling of exponents differs)."""
+    from app.schemas import SolveRequest, SolveResponse
+    from app.service import _solve_batch, _solve_response_json, solve_batch
+
+    req = SolveRequest.model_validate(solve_body(**over))
+    (model,) = solve_batch([req])
+    (raw,) = _solve_batch([req], _solve_response_json)
+    assert isinstance(model, SolveResponse) and isinstance(raw, bytes)
+    assert json.loads(raw) == json.loads(model.model_dump_json())
+    SolveResponse.model_validate_json(raw)

@@ -1,0 +1,85 @@
+"""ComputePool plumbing: the event loop reads worker replies as they arrive, in any size."""
+
+from __future__ import annotations
+
+import asyncio
+import importlib.util
+import socket
+import struct
+import threading
+from multiprocessing.connection import Connection
+
+import numpy as np
+import pytest
+
+from app.service import ComputePool, Settings, _frame
+
+LOOPS = ["asyncio"] + (["uvloop"] if importlib.util.find_spec("uvloop") else [])
+
+
+def _run(coro, loop_kind: str):
+    """Run ``coro`` on a fresh asyncio or uvloop event loop (uvicorn uses uvloop when present;
+    its add_reader makes the socket non-blocking)."""
+    if loop_kind == "uvloop":
+        import uvloop
+
+        loop = uvloop.new_event_loop()
+    else:
+        loop = asyncio.new_event_loop()
+    try:
+        return loop.run_until_complete(coro)
+    finally:
+        loop.close()
+
+
+class _FakeWorker:
+    """The pool's end of a socket pair; a thread plays the worker on the other end."""
+
+    def __init__(self) -> None:
+        a, b = socket.socketpair()
+        self.conn = Connection(a.detach())
+        self.peer = Connection(b.detach())
+        self.ready = True
+
+
+@pytest.mark.parametrize("loop_kind", LOOPS)
+@pytest.mark.parametrize("size", [10, 70_000, 5_000_000])
+def test_reply_of_any_size_is_read_whole(size, loop_kind):
+    """Small (one read), medium and multi-megabyte replies (many reads) arrive intact."""
+    payload = ("ok", np.arange(size, dtype=np.uint8).tobytes())
+    fake = _FakeWorker()
+
+    async def main():
+        pool = ComputePool(Settings(workers=1))
+        pool._loop = asyncio.get_running_loop()
+        sender = threading.Thread(target=fake.peer.send, args=(payload,))
+        sender.start()
+        got = await pool._reply(fake, pool._loop.time() + 10)
+        sender.join()
+        return got
+
+    assert _run(main(), loop_kind) == payload
+
+
+@pytest.mark.parametrize("loop_kind", LOOPS)
+def test_reply_from_a_dead_worker_is_eof_and_a_silent_one_times_out(loop_kind):
+    async def main(close: bool):
+        fake = _FakeWorker()
+        pool = ComputePool(Settings(workers=1))
+        pool._loop = asyncio.get_running_loop()
+        if close:
+            fake.peer.close()
+        await pool._reply(fake, pool._loop.time() + 0.2)
+
+    with pytest.raises(EOFError):
+        _run(main(close=True), loop_kind)
+    with pytest.raises(TimeoutError):
+        _run(main(close=False), loop_kind)
+
+
+def test_frame_headers():
+    assert _frame(bytearray(b"\x00\x00")) == (None, 0)
+    assert _frame(bytearray(struct.pack("!i", 300) + b"x")) == (300, 4)
+    huge = struct.pack("!i", -1) + struct.pack("!Q", 3_000_000_000)
+    assert _frame(bytearray(huge[:8])) == (None, 0)
+    assert _frame(bytearray(huge)) == (3_000_000_000, 12)
