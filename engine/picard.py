@@ -86,18 +86,29 @@ def picard_path(inverse, x0: FloatArray, e0: FloatArray, max_sweeps_total: int):
         act = np.flatnonzero(~done & ~failed)
         if act.size == 0:
             break
+        # The working set: the active members' iterates, errors and segment data, compact.
+        # Sweeps run on it without any indexing until something happens to one member (it
+        # converges, meets a singularity, or reaches a sweep limit).
         m = act.size
-        Xa = X[act]
-        e = np.broadcast_to(e0[act, None, :], (m, nn, e0.shape[-1]))
-        v, bad = inverse.apply_masked(Xa.reshape(m * nn, p), e.reshape(m * nn, -1))
-        G = -v.reshape(m, nn, p)
+        Xw = X[act]  # (m, nn, p)
+        Ew = np.repeat(e0[act], nn, axis=0)  # (m * nn, r)
+        base = xa[act, None, :]  # (m, 1, p)
+        half = (H[act] / 2.0)[:, None, None]
+        # sweeps this working set may run before a per-segment or total limit is reached
+        room = int(np.min(np.minimum(MAX_SWEEPS - sweeps_seg[act], max_sweeps_total - sweeps[act])))
+        k = 0
+        while True:
+            v, bad = inverse.apply_masked(Xw.reshape(m * nn, p), Ew)
+            Xn = base - half * (S @ v.reshape(m, nn, p))  # S (nn, nn) @ (m, nn, p)
+            diff = np.max(np.abs(Xn - Xw) / (1.0 + np.abs(Xn)), axis=(1, 2))
+            Xw = Xn
+            k += 1
+            if k >= room or np.any(bad) or not diff.min() >= SWEEP_TOL:  # (NaN is an event)
+                break
         bad = bad.reshape(m, nn).any(axis=1)
-        Xn = xa[act, None, :] + (H[act] / 2.0)[:, None, None] * (S @ G)  # S (nn, nn) @ (m, nn, p)
-        scale = 1.0 + np.abs(Xn)
-        diff = np.max(np.abs(Xn - Xa) / scale, axis=(1, 2))
-        X[act] = Xn
-        sweeps_seg[act] += 1
-        sweeps[act] += 1
+        X[act] = Xw
+        sweeps_seg[act] += k
+        sweeps[act] += k
         bad |= ~np.isfinite(diff)
         conv = (diff < SWEEP_TOL) & ~bad
         if np.any(conv):
