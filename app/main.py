@@ -18,6 +18,8 @@ from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 
+from app.errors import busy_response, compute_error_response, request_error_response
+from app.fastpath import SolveFastPath
 from app.routers import dashboard, health, repeatability, robots, solve, synthesize
 from app.schemas import AUGMENTATION_MODELS, ROBOT_MODELS
 from app.service import ComputeError, ComputePool, RequestError, ServiceUnavailable, Settings
@@ -57,8 +59,9 @@ def _validation_detail(errors) -> list[dict]:
     return detail
 
 
-def create_app(settings: Settings | None = None) -> FastAPI:
-    """The jik REST API. ``settings`` (default: from the environment) sizes the compute pool."""
+def create_app(settings: Settings | None = None, fast_solve: bool = True) -> FastAPI:
+    """The jik REST API. ``settings`` (default: from the environment) sizes the compute pool;
+    ``fast_solve`` serves well-formed /solve requests on a short path (:mod:`app.fastpath`)."""
     pool = ComputePool(settings)
 
     @asynccontextmanager
@@ -82,22 +85,15 @@ def create_app(settings: Settings | None = None) -> FastAPI:
 
     @app.exception_handler(RequestError)
     async def _refused(request: Request, exc: RequestError) -> JSONResponse:
-        loc = ["body", *exc.field.replace("[", ".").replace("]", "").split(".")]
-        return JSONResponse(
-            status_code=422,
-            content={"detail": [{"loc": loc, "msg": str(exc), "type": "value_error"}]},
-        )
+        return request_error_response(exc)
 
     @app.exception_handler(ServiceUnavailable)
     async def _busy(request: Request, exc: ServiceUnavailable) -> JSONResponse:
-        return JSONResponse(
-            status_code=503, content={"detail": str(exc)}, headers={"Retry-After": "1"}
-        )
+        return busy_response(exc)
 
     @app.exception_handler(ComputeError)
     async def _compute(request: Request, exc: ComputeError) -> JSONResponse:
-        log.error("computation failed: %s", exc)
-        return JSONResponse(status_code=500, content={"detail": f"internal error: {exc}"})
+        return compute_error_response(exc)
 
     @app.exception_handler(Exception)
     async def _unexpected(request: Request, exc: Exception) -> JSONResponse:
@@ -109,4 +105,6 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     for module in (health, robots, solve, repeatability, synthesize):
         app.include_router(module.router)
     app.include_router(dashboard.router)
+    if fast_solve:
+        app.add_middleware(SolveFastPath, pool=pool)
     return app

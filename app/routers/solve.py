@@ -15,7 +15,9 @@ router = APIRouter(tags=["solve"])
 async def solve(req: SolveRequest, request: Request) -> Response:
     """Solve k(x) = target from x0 with the pseudoinverse (8) or the extended inverse (11).
 
-    The body comes from a worker as JSON already validated against ``SolveResponse``.
+    The body comes from a worker as the JSON of a ``SolveResponse``. Under ``create_app()``
+    well-formed JSON requests are answered by :class:`app.fastpath.SolveFastPath` with the same
+    pool and error mapping; this route describes the endpoint and answers everything else.
     """
     body = await request.app.state.pool.solve(req)
     return Response(body, media_type="application/json")
