@@ -171,30 +171,48 @@ class Polynomial2(AugmentingMap):
         self.coefficients = {
             (int(i), int(j)): finite(c, f"c{i}{j}") for (i, j), c in coefficients.items()
         }
+        if any(i < 0 or j < 0 for i, j in self.coefficients):
+            raise InvalidInputError(
+                f"polynomial exponents must be >= 0, got {sorted(self.coefficients)}"
+            )
         self.variables = variables
         self.p = p
+        # c_ij as a matrix indexed by the powers of u and v
+        keys = list(self.coefficients) or [(0, 0)]
+        self._matrix = np.zeros((max(i for i, _ in keys) + 1, max(j for _, j in keys) + 1))
+        for (i, j), c in self.coefficients.items():
+            self._matrix[i, j] += c
 
     @property
     def parameters(self) -> dict[str, float]:
         return {f"c{i}{j}": c for (i, j), c in sorted(self.coefficients.items())}
 
-    def value(self, x: FloatArray) -> FloatArray:
+    def _powers(self, x: FloatArray):
+        """Powers u^k, v^k (..., degree + 1), their derivatives, and the coefficient matrix.
+
+        h = U C V^T with U = (1, u, u^2, ...), so h and dh cost a few array operations
+        whatever the number of terms (the hot path of the extended inverse).
+        """
         x = np.asarray(x, dtype=float)
-        u, v = x[..., self.variables[0]], x[..., self.variables[1]]
-        return sum((c * u**i * v**j for (i, j), c in self.coefficients.items()), np.zeros_like(u))
+        C = self._matrix
+        ku, kv = np.arange(C.shape[0], dtype=float), np.arange(C.shape[1], dtype=float)
+        U = x[..., self.variables[0], None] ** ku
+        V = x[..., self.variables[1], None] ** kv
+        dU = np.zeros_like(U)
+        dU[..., 1:] = ku[1:] * U[..., :-1]
+        dV = np.zeros_like(V)
+        dV[..., 1:] = kv[1:] * V[..., :-1]
+        return x, U, V, dU, dV, C
+
+    def value(self, x: FloatArray) -> FloatArray:
+        _, U, V, _, _, C = self._powers(x)
+        return np.einsum("...i,ij,...j->...", U, C, V)
 
     def gradient(self, x: FloatArray) -> FloatArray:
-        x = np.asarray(x, dtype=float)
-        u, v = x[..., self.variables[0]], x[..., self.variables[1]]
-        du, dv = np.zeros_like(u), np.zeros_like(u)
-        for (i, j), c in self.coefficients.items():
-            if i:
-                du = du + c * i * u ** (i - 1) * v**j
-            if j:
-                dv = dv + c * j * u**i * v ** (j - 1)
+        x, U, V, dU, dV, C = self._powers(x)
         g = np.zeros(x.shape)
-        g[..., self.variables[0]] = du
-        g[..., self.variables[1]] = dv
+        g[..., self.variables[0]] = np.einsum("...i,ij,...j->...", dU, C, V)
+        g[..., self.variables[1]] = np.einsum("...i,ij,...j->...", U, C, dV)
         return g
 
 

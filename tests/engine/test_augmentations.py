@@ -61,6 +61,7 @@ def test_printed_j32_j33_are_not_the_gradient_of_38():
         (lambda: aug.E1Optimal(C1=0), "C1 must be nonzero"),
         (lambda: aug.E2Optimal(a=0, b=0), "must not both be 0"),
         (lambda: aug.E2Optimal(a=np.nan), "a must be finite"),
+        (lambda: aug.Polynomial2({(-1, 0): 1.0}), "exponents must be >= 0"),
     ],
 )
 def test_bad_parameters(make, match):
