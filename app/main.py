@@ -22,7 +22,14 @@ from app.errors import busy_response, compute_error_response, request_error_resp
 from app.fastpath import SolveFastPath
 from app.routers import dashboard, health, repeatability, robots, solve, synthesize
 from app.schemas import AUGMENTATION_MODELS, ROBOT_MODELS
-from app.service import ComputeError, ComputePool, RequestError, ServiceUnavailable, Settings
+from app.service import (
+    ComputeError,
+    ComputePool,
+    RequestError,
+    ServiceUnavailable,
+    Settings,
+    env_flag,
+)
 
 log = logging.getLogger("jik.api")
 _TAGS = set(ROBOT_MODELS) | set(AUGMENTATION_MODELS)
@@ -59,9 +66,12 @@ def _validation_detail(errors) -> list[dict]:
     return detail
 
 
-def create_app(settings: Settings | None = None, fast_solve: bool = True) -> FastAPI:
+def create_app(settings: Settings | None = None, fast_solve: bool | None = None) -> FastAPI:
     """The jik REST API. ``settings`` (default: from the environment) sizes the compute pool;
-    ``fast_solve`` serves well-formed /solve requests on a short path (:mod:`app.fastpath`)."""
+    ``fast_solve`` serves well-formed /solve requests on a short path (:mod:`app.fastpath`;
+    default on, ``JIK_FAST_SOLVE=0`` turns it off)."""
+    if fast_solve is None:
+        fast_solve = env_flag("JIK_FAST_SOLVE")
     pool = ComputePool(settings)
 
     @asynccontextmanager

@@ -771,6 +771,14 @@ class Settings:
     min_share: int = 4
 
 
+def env_flag(name: str, default: bool = True) -> bool:
+    """An on/off environment variable: ``0``, ``false``, ``no`` or ``off`` is off."""
+    value = os.environ.get(name)
+    if value is None:
+        return default
+    return value.strip().lower() not in ("0", "false", "no", "off")
+
+
 def settings_from_env() -> Settings:
     """``JIK_WORKERS`` (default: CPU count, 1..8), ``JIK_TIMEOUT`` [s] (default 20),
     ``JIK_BATCH`` (``0`` disables micro-batching), ``JIK_BATCH_WINDOW_MS`` (default 2)."""
@@ -778,7 +786,7 @@ def settings_from_env() -> Settings:
     return Settings(
         workers=max(1, min(8, int(env.get("JIK_WORKERS", os.cpu_count() or 2)))),
         timeout=float(env.get("JIK_TIMEOUT", 20.0)),
-        batching=env.get("JIK_BATCH", "1").lower() not in ("0", "false", "no", "off"),
+        batching=env_flag("JIK_BATCH"),
         batch_window=float(env.get("JIK_BATCH_WINDOW_MS", 2.0)) / 1000.0,
     )
 

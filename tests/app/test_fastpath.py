@@ -89,3 +89,12 @@ def test_other_routes_pass_through(clients):
     assert fast.get("/health").json() == {"status": "ok"}
     assert fast.get("/solve").status_code == 405
     assert _fast_path(fast.app).served == served
+
+
+def test_env_turns_the_fast_path_off(monkeypatch):
+    monkeypatch.setenv("JIK_FAST_SOLVE", "0")
+    app = create_app(Settings(workers=1))
+    assert not any(m.cls is SolveFastPath for m in app.user_middleware)
+    monkeypatch.delenv("JIK_FAST_SOLVE")
+    app = create_app(Settings(workers=1))
+    assert any(m.cls is SolveFastPath for m in app.user_middleware)
