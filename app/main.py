@@ -6,7 +6,7 @@ FastAPI's list format, ``{"detail": [{"loc": ["body", <field>...], "msg": "<fiel
 time limit (the field that sizes the work, e.g. ``cycles``). A request that finds no free compute
 slot within the time limit is 503 ``{"detail": "server busy: ..."}`` with Retry-After; anything
 unexpected is 500 ``{"detail": "internal error: ..."}``, never an HTML page or a dropped
-connection.
+connection. A body over 1 MiB is 413 ``{"detail": "request body of ... bytes is larger ..."}``.
 """
 
 from __future__ import annotations
@@ -18,7 +18,12 @@ from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 
-from app.errors import busy_response, compute_error_response, request_error_response
+from app.errors import (
+    BodyLimit,
+    busy_response,
+    compute_error_response,
+    request_error_response,
+)
 from app.fastpath import SolveFastPath
 from app.routers import dashboard, health, repeatability, robots, solve, synthesize
 from app.schemas import AUGMENTATION_MODELS, ROBOT_MODELS
@@ -32,6 +37,8 @@ from app.service import (
 )
 
 log = logging.getLogger("jik.api")
+#: Largest request body accepted (413 beyond): the largest valid request is a few kilobytes.
+MAX_BODY_BYTES = 1 << 20
 _TAGS = set(ROBOT_MODELS) | set(AUGMENTATION_MODELS)
 
 
@@ -117,4 +124,5 @@ def create_app(settings: Settings | None = None, fast_solve: bool | None = None)
     app.include_router(dashboard.router)
     if fast_solve:
         app.add_middleware(SolveFastPath, pool=pool)
+    app.add_middleware(BodyLimit, limit=MAX_BODY_BYTES)  # outermost: before any body is read
     return app

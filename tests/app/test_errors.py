@@ -143,3 +143,22 @@ def test_coordinates_are_bounded(api):
     body = {**_rep(), "path": [[1.0, -1e175]]}
     (msg,) = messages(api.post("/repeatability", json=body))
     assert msg == "path[0][1]: Input should be greater than or equal to -1000"
+
+
+@pytest.mark.parametrize("path", ["/solve", "/repeatability", "/synthesize"])
+def test_oversized_body_is_413_with_a_message(api, path):
+    body = '{"pad": "' + "x" * (2 << 20) + '"}'
+    r = api.post(path, content=body, headers={"content-type": "application/json"})
+    assert r.status_code == 413
+    assert "larger than the limit of 1048576 bytes" in r.json()["detail"]
+
+
+@pytest.mark.parametrize("path", ["/solve", "/repeatability", "/synthesize"])
+def test_oversized_body_without_a_length_is_413(api, path):
+    def chunks():  # sent chunked, without Content-Length
+        for _ in range(40):
+            yield b"x" * 65536
+
+    r = api.post(path, content=chunks(), headers={"content-type": "application/json"})
+    assert r.status_code == 413
+    assert "more than 1048576 bytes" in r.json()["detail"]
