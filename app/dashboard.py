@@ -391,6 +391,35 @@ def _cache_key(state: DashboardState, algorithm: str) -> str:
     return json.dumps(d, sort_keys=True)
 
 
+def functionals_key(state: DashboardState) -> str:
+    """Everything E1, E2 and their sensitivity depend on (see :func:`error_functionals`).
+
+    On a robot's design region: the robot, the map and the start values of the variables
+    outside the region (held fixed); the path, the cycles, gamma and the rest of x0 do not
+    matter. Without a design region the box follows the runs: everything they depend on.
+    """
+    spec = robot_spec(state.robot)
+    design = spec.functional_region
+    if not design:
+        return _cache_key(state, "extended")
+    d = state.as_dict()
+    fixed = {n: d["x0"][k] for k, n in enumerate(spec.variable_names) if n not in design}
+    return json.dumps(
+        {k: d[k] for k in ("robot", "robot_parameters", "augmentation",
+                           "augmentation_parameters")} | {"fixed": fixed},
+        sort_keys=True,
+    )  # fmt: skip
+
+
+def runs_key(state: DashboardState) -> tuple[str, ...]:
+    """Everything the runs of both algorithms depend on, up to the scale of theta.
+
+    Two states with the same key have the same configurations along the same legs (in
+    continuous mode gamma only divides theta, see the module's docstring).
+    """
+    return tuple(_cache_key(state, a) for a in ALGORITHMS)
+
+
 def compute(
     state: DashboardState,
     generation: int = 0,
@@ -568,6 +597,8 @@ def error_functionals(result: DashboardResult, nodes: int = 12) -> dict | None:
     return out
 
 
+#: Seconds between a result and the start of its second phase (E1, E2, their sweeps).
+SECOND_PHASE_DELAY = 0.3
 #: Values of each parameter in the E1/E2 sweep of the dashboard (over v - 1 .. v + 1).
 SENSITIVITY_SAMPLES = 11
 
@@ -911,13 +942,16 @@ class Dashboard:
         reuse = {k for k in gamma_free_panels(result) if (k, key) in self._figures}
         texts = {k: self._figures[(k, key)] for k in reuse}
         # The E1/E2 panel is drawn in the second phase; until then the page dims the old one
-        # ("stale") instead of redrawing a placeholder (20-40 ms of the page's redraw).
-        cached = self._functionals_cache.get(key)
+        # ("stale") instead of redrawing a placeholder (20-40 ms of the page's redraw). Known
+        # functionals (same map, same fixed variables) are drawn at once.
+        fkey = functionals_key(state)
+        cached = self._functionals_cache.get(fkey)
         stale = set() if cached else {"sensitivity"}
         todo = set(PANELS) - reuse - stale
-        sens = cached[1] if cached else None
+        functionals, sens = cached if cached else (None, None)
         texts.update({
-            k: f.to_json() for k, f in figures_for(result, None, todo, sensitivity=sens).items()
+            k: f.to_json()
+            for k, f in figures_for(result, functionals, todo, sensitivity=sens).items()
         })  # fmt: skip
         texts = {k: texts[k] for k in PANELS if k not in stale}
         self._figures = {(k, key): texts[k] for k in gamma_free_panels(result)}
@@ -937,11 +971,19 @@ class Dashboard:
             + "}}"
         )
         with self._cond:
-            self.result, self.functionals = result, None
+            self.result, self.functionals = result, functionals
             self._changed_at = {g: t for g, t in self._changed_at.items() if g > generation}
         self._emit(Event("result", generation, data, result))
         self._finish(generation)
-        # Second phase: h on a grid when it is expensive, then E1 and E2 (quadrature).
+        # Second phase: h on a grid when it is expensive, then E1 and E2 (quadrature). It starts
+        # once the page and the scene had time to draw the first (it would compete with them
+        # for the CPU), unless a newer change came meanwhile.
+        if cached and not deferred:
+            return
+        with self._cond:
+            self._cond.wait_for(
+                lambda: self._generation != generation or self._stopped, SECOND_PHASE_DELAY
+            )
         if self._generation != generation:
             return
         if deferred:
@@ -953,15 +995,15 @@ class Dashboard:
                 self.result = result
         # E1, E2 and their sensitivity depend on what the grid does (not on gamma in
         # continuous mode): reused.
-        if key in self._functionals_cache:
-            functionals, sens = self._functionals_cache[key]
+        if cached:
+            functionals, sens = cached
         else:
             functionals = error_functionals(result)
             try:
                 sens = sensitivity(result, functionals, lambda: self._generation != generation)
             except Cancelled:
                 return
-            self._functionals_cache = {key: (functionals, sens)}
+            self._functionals_cache = {fkey: (functionals, sens)}
         if self._generation != generation:
             return
         message = {"type": "functionals", "generation": generation, "functionals": functionals,

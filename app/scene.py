@@ -28,7 +28,7 @@ from typing import Any, cast
 import numpy as np
 import viser
 
-from app.dashboard import ALGORITHMS, COLORS, MAX_DASHBOARD_CYCLES, Dashboard, Event
+from app.dashboard import ALGORITHMS, COLORS, MAX_DASHBOARD_CYCLES, Dashboard, Event, runs_key
 from engine.exceptions import InvalidInputError
 from engine.registry import ROBOTS, robot_spec
 
@@ -244,6 +244,33 @@ class _Platform(_Mechanism):
 _MECHANISMS = {"manipulator1": _NormalForm, "manipulator2": _Gantry}
 
 
+def _add_floor_grid(scene, half: float = 10.0, cell: float = 0.5, section: float = 1.0) -> None:
+    """A grid on the task plane (z slightly below 0) drawn as two sets of line segments.
+
+    viser's ``add_grid`` shades every pixel of its plane; in software WebGL (no GPU) that is a
+    fifth of each frame, line segments cost next to nothing.
+    """
+    ticks = np.arange(-half, half + cell / 2, cell)
+    on_section = np.isclose(np.remainder(ticks + half, section), 0.0) | np.isclose(
+        np.remainder(ticks + half, section), section
+    )
+    z = -0.06
+    for name, where, color in (
+        ("cells", ticks[~on_section], (200, 200, 200)),
+        ("sections", ticks[on_section], (140, 140, 140)),
+    ):
+        n = len(where)
+        lines = np.zeros((2 * n, 2, 3))
+        lines[:n, :, 0] = where[:, None]  # along y
+        lines[:n, 0, 1], lines[:n, 1, 1] = -half, half
+        lines[n:, :, 1] = where[:, None]  # along x
+        lines[n:, 0, 0], lines[n:, 1, 0] = -half, half
+        lines[..., 2] = z
+        scene.add_line_segments(
+            f"/grid/{name}", lines, color, thickness=1.0, thickness_units="screen"
+        )
+
+
 def _polyline(points: np.ndarray) -> np.ndarray:
     """(n, 3) points -> (n - 1, 2, 3) segments."""
     return np.stack([points[:-1], points[1:]], axis=1)
@@ -264,6 +291,9 @@ class DashboardScene:
         self.dashboard = dashboard
         self.server = viser.ViserServer(host=host, port=port, label="jik scene", verbose=False)
         self.server.scene.set_up_direction("+z")
+        # Nothing here casts a shadow (every node is added with cast_shadow=False): without the
+        # default lights' shadow map pass each frame costs a third less in software WebGL.
+        self.server.scene.configure_default_lights(cast_shadow=False)
         self.server.gui.configure_theme(control_width="small", show_logo=False)
         self.server.gui.main_panel.dock_right()
         self.server.gui.main_panel.set_width(300)
@@ -275,6 +305,7 @@ class DashboardScene:
         self._mechanisms: dict[str, _Mechanism] = {}
         self._s = 0.0
         self.drawn_generation = 0
+        self._drawn_runs: tuple[str, ...] | None = None  # runs_key of what the scene shows
         self._structure: tuple | None = None
         # viser declares the setter of a GUI handle's ``value`` apart from its getter, so mypy
         # sees a read-only property; assigning it is viser's API (ignores marked "viser: settable").
@@ -283,14 +314,7 @@ class DashboardScene:
         self._last_drag = 0.0
         self._stopped = False
         self._build_static_gui()
-        self.server.scene.add_grid(
-            "/grid",
-            width=20,
-            height=20,
-            cell_size=0.5,
-            section_size=1.0,
-            position=(0.0, 0.0, -0.06),
-        )
+        _add_floor_grid(self.server.scene)
         self._unsubscribe = dashboard.subscribe(self._on_event, last=True)
         self._thread = threading.Thread(target=self._animate, name="jik-scene", daemon=True)
         self._thread.start()
@@ -597,7 +621,18 @@ class DashboardScene:
     def _draw(self, result) -> None:
         scene = self.server.scene
         state = result.state
+        drawn = runs_key(state)
+        if drawn == self._drawn_runs:
+            # The same configurations (gamma in continuous mode only rescales theta; the
+            # animation runs per leg): nothing in the scene changes but its status. A redraw
+            # would cost the client a quarter second of frames (software WebGL here).
+            with self._lock:  # (the timeline on screen plays the same legs)
+                self.drawn_generation = result.generation
+                self.dashboard.scene_status.update(generation=result.generation)
+            self._show_status(result)
+            return
         with self._lock, self.server.atomic():
+            self._drawn_runs = drawn
             scene.remove_by_name("/robot")
             scene.add_frame("/robot", show_axes=False)
             self._mechanisms = {}
@@ -626,6 +661,10 @@ class DashboardScene:
             self.dashboard.scene_status.update(
                 generation=result.generation, robot=state.robot, playing=self.playing
             )
+        self._show_status(result)
+
+    def _show_status(self, result) -> None:
+        state = result.state
         self.progress.visible = False
         p, e = result.runs["pseudoinverse"], result.runs["extended"]
         if state.task == "path" and len(p.drift) and len(e.drift):

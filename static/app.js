@@ -296,6 +296,7 @@ async function onResult(msg) {
       const g = before;
       jik.lastLatency = {
         generation: msg.generation, ms: now - since, server: msg.timing,
+        changedAt: performance.timeOrigin + since, // epoch ms: comparable with the scene's frame
         arrived: msg.browser.arrived - since, parse: msg.browser.parsed - msg.browser.arrived,
         draw: now - msg.browser.parsed,
       };

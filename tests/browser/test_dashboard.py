@@ -95,19 +95,50 @@ def _set_slider(page, selector: str, value: float) -> int:
     return before
 
 
-def _latency(page, after: int) -> str:
-    """Control change to plots redrawn, measured in the page, with the server's share."""
+# Installed in the viser client (the iframe): the wall-clock time at which each "generation N:"
+# status first shows. The status is sent after the scene's nodes, on the same websocket.
+_SCENE_WATCH = """() => {
+    if (window.jikSceneShown) return;
+    window.jikSceneShown = {};
+    const note = () => {
+        for (const m of document.body.textContent.matchAll(/generation (\\d+):/g)) {
+            if (!(m[1] in window.jikSceneShown)) {
+                window.jikSceneShown[m[1]] = performance.timeOrigin + performance.now();
+            }
+        }
+    };
+    new MutationObserver(note).observe(document.body,
+        {childList: true, subtree: true, characterData: true});
+    note();
+}"""
+
+
+def _scene_frame(page):
+    return next(f for f in page.frames if f.parent_frame is not None)
+
+
+def _latency(page, after: int) -> tuple[float, str]:
+    """Control change to plots redrawn and to the scene's update shown, measured in the
+    browser (both frames' clocks are wall-clock ms), with the server's share.
+
+    Returns (the larger of the two in ms, a description).
+    """
     page.wait_for_function(
         f"jik.lastLatency && jik.lastLatency.generation > {after}", timeout=20_000
     )
     lat = page.evaluate("jik.lastLatency")
+    frame = _scene_frame(page)
+    shown = f"Object.entries(jikSceneShown).filter(([g]) => Number(g) >= {lat['generation']})"
+    frame.wait_for_function(f"{shown}.length > 0", timeout=30_000)
+    scene = frame.evaluate(f"Math.min(...{shown}.map(([, t]) => t))") - lat["changedAt"]
     t = lat["server"]
-    return (
-        f"{lat['ms']:.0f} ms (server: compute {1000 * t['compute']:.0f} ms, figures "
-        f"{1000 * t['figures']:.0f} ms, change to event {1000 * t['server_total']:.0f} ms; "
-        f"page: event arrived at {lat['arrived']:.0f} ms, JSON parse {lat['parse']:.0f} ms, "
-        f"plotly redraw {lat['draw']:.0f} ms)"
+    text = (
+        f"plots {lat['ms']:.0f} ms, scene {scene:.0f} ms (server: compute "
+        f"{1000 * t['compute']:.0f} ms, figures {1000 * t['figures']:.0f} ms, change to event "
+        f"{1000 * t['server_total']:.0f} ms; page: event arrived at {lat['arrived']:.0f} ms, "
+        f"JSON parse {lat['parse']:.0f} ms, plotly redraw {lat['draw']:.0f} ms)"
     )
+    return max(lat["ms"], scene), text
 
 
 def _wait_scene(base: str, condition, timeout: float = 20.0, what: str = "") -> dict:
@@ -219,6 +250,7 @@ def test_dashboard_follows_controls_in_chromium(served):
                 close.first.wait_for(state="detached", timeout=3_000)
             except PlaywrightTimeout:
                 continue
+        _scene_frame(page).evaluate(_SCENE_WATCH)
         scene_before = _settled(page)
         page.screenshot(path=str(ARTIFACTS / "dashboard-1-manipulator2.png"))
         verdict = page.inner_text("#verdict")
@@ -245,6 +277,17 @@ def test_dashboard_follows_controls_in_chromium(served):
         assert scene_after != scene_before, "the 3D scene did not change with the start point"
         page.screenshot(path=str(ARTIFACTS / "dashboard-2-moved.png"))
 
+        # The arm length and the number of cycles (one drift point per cycle).
+        _second_phase_drawn(page)
+        before = _set_slider(page, "#ctl-l", 1.2)
+        latencies["arm length l (manipulator 2)"] = _latency(page, before)
+        l_now = _get(f"{base}/api/dashboard/state")["state"]["robot_parameters"]["l"]
+        assert l_now == pytest.approx(1.2, abs=0.03)  # the slider snaps to its step
+        _second_phase_drawn(page)
+        before = _set_slider(page, "#ctl-cycles", 4)
+        latencies["cycles (manipulator 2)"] = _latency(page, before)
+        assert _trace(page, "drift", 0, "x") == [1, 2, 3, 4]
+
         # Manipulator 1 (and the unicycle when the registry has it), then back.
         robots = [r["name"] for r in _get(f"{base}/robots")["robots"]]
         scenes = {"manipulator2": scene_after}
@@ -268,6 +311,17 @@ def test_dashboard_follows_controls_in_chromium(served):
             assert shot not in scenes.values(), f"the 3D scene did not change for {robot}"
             scenes[robot] = shot
             page.screenshot(path=str(ARTIFACTS / f"dashboard-3-{robot}.png"))
+            if robot == "manipulator1":
+                # A parameter of the map (36), then another map: E1/E2 and h follow.
+                before = _set_slider(page, "#ctl-aug-a", 0.5)
+                latencies["map parameter a (manipulator 1)"] = _latency(page, before)
+                _second_phase_drawn(page)
+                assert "a = 0.5" in page.text_content("#plot-sensitivity .gtitle")
+                before = int(page.evaluate("jik.generation"))
+                page.select_option("#ctl-augmentation", "e1_optimal")
+                latencies["augmenting map (manipulator 1)"] = _latency(page, before)
+                _second_phase_drawn(page)
+                assert "e1_optimal" in page.text_content("#plot-augmenting .gtitle")
         before = int(page.evaluate("jik.generation"))
         page.select_option("#ctl-robot", "manipulator2")
         latencies["switch back to manipulator2"] = _latency(page, before)
@@ -286,7 +340,9 @@ def test_dashboard_follows_controls_in_chromium(served):
         assert csv.startswith("algorithm,leg,theta,x1,x2,x3,y1,y2,error,h")
         browser.close()
 
-    for what, text in latencies.items():
-        print(f"latency control -> plots updated, {what}: {text}")
+    for what, (worst, text) in latencies.items():
+        print(f"latency control -> plots and scene updated, {what}: {worst:.0f} ms: {text}")
+    worst = max(ms for what, (ms, _) in latencies.items() if "unicycle" not in what)
+    print(f"latency control -> plots and scene updated, slowest manipulator change: {worst:.0f} ms")
     assert not external, f"requests left the machine: {external}"
     assert not errors, f"errors in the page: {errors}"
