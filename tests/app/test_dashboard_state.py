@@ -4,17 +4,21 @@ from __future__ import annotations
 
 import json
 import threading
+import time
 
 import numpy as np
 import pytest
 
 from app.dashboard import (
+    SECOND_PHASE_DELAY,
     Cancelled,
     Dashboard,
     compute,
     default_state,
     export_csv,
     export_json,
+    functionals_key,
+    runs_key,
     updated_state,
 )
 from engine.exceptions import InvalidInputError
@@ -217,6 +221,57 @@ def test_slow_listeners_come_last_and_functionals_only_retitle_the_h_panel():
     assert set(body["figures"]) == {"sensitivity"}  # the h panel is retitled, not redrawn
     assert "E1 = " in body["titles"]["augmenting"]
     assert body["sensitivity"]["kind"] == "alternatives"  # paper_cubic has no parameters
+
+
+def test_functionals_are_keyed_by_the_map_and_the_variables_held_fixed():
+    """E1, E2 on Manipulator 2's design region (x2, x3) hold x1 at its start value: x2, x3,
+    the path, the cycles and gamma leave them alone; x1, l and the map do not."""
+    m2 = default_state("manipulator2")
+    key = functionals_key(m2)
+    for patch in ({"x0": [0.0, 0.4, 1.2]}, {"cycles": 5}, {"gamma": 3.0},
+                  {"path": [[1.0, 1.0], [0.5, 2.0]]}):  # fmt: skip
+        assert functionals_key(updated_state(m2, patch)) == key, patch
+    for patch in ({"x0": [0.3, 0.0, 1.5]}, {"robot_parameters": {"l": 1.5}},
+                  {"augmentation": "e2_synthesized"}):  # fmt: skip
+        assert functionals_key(updated_state(m2, patch)) != key, patch
+    # Manipulator 1's region covers every variable: no start value matters.
+    m1 = default_state("manipulator1")
+    assert functionals_key(updated_state(m1, {"x0": [0.1, 0.2, 0.3]})) == functionals_key(m1)
+    assert functionals_key(
+        updated_state(m1, {"augmentation_parameters": {"a": 0.5}})
+    ) != functionals_key(m1)
+
+
+def test_runs_key_ignores_gamma_only_in_continuous_mode():
+    state = default_state("manipulator2")
+    assert runs_key(updated_state(state, {"gamma": 3.0})) == runs_key(state)
+    discrete = updated_state(state, {"mode": "discrete", "gamma": 0.5})
+    assert runs_key(updated_state(discrete, {"gamma": 0.8})) != runs_key(discrete)
+
+
+def test_known_functionals_are_drawn_with_the_first_result():
+    """A change of the cycles keeps E1, E2: the result carries the E1/E2 panel and the h
+    panel's title at once, nothing is dimmed and no second phase follows."""
+    dashboard = Dashboard(updated_state(default_state("manipulator2"), {"cycles": 1}))
+    events, second = [], threading.Event()
+
+    def listener(event):
+        events.append((event.kind, event.generation, event.data))
+        if event.kind == "functionals" and event.generation == 1:
+            second.set()
+
+    dashboard.subscribe(listener)
+    assert second.wait(60)
+    generation, _ = dashboard.update({"cycles": 2})
+    assert dashboard.wait(generation, timeout=60)
+    time.sleep(2 * SECOND_PHASE_DELAY)
+    dashboard.stop()
+    result = next(json.loads(d) for k, g, d in events if k == "result" and g == generation)
+    assert result["stale"] == []
+    assert "sensitivity" in result["figures"]
+    assert "E1 = " in result["figures"]["augmenting"]["layout"]["title"]["text"]
+    assert not [g for k, g, _ in events if k == "functionals" and g == generation]
+    assert dashboard.functionals is not None and dashboard.functionals["E1"] is not None
 
 
 @pytest.mark.parametrize(
