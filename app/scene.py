@@ -244,6 +244,11 @@ class _Platform(_Mechanism):
 _MECHANISMS = {"manipulator1": _NormalForm, "manipulator2": _Gantry}
 
 
+# Every line (traces, grid) is sized in pixels: viser's world-unit lines solve a ray-segment
+# distance per fragment and redraw each line in a second blended pass; the four traces of a
+# manipulator doubled the cost of a frame in software WebGL (no GPU).
+
+
 def _add_floor_grid(scene, half: float = 10.0, cell: float = 0.5, section: float = 1.0) -> None:
     """A grid on the task plane (z slightly below 0) drawn as two sets of line segments.
 
@@ -719,13 +724,18 @@ class DashboardScene:
                 f"/robot/trace/{a}/task",
                 _polyline(pts),
                 _rgb(COLORS[a]),
-                thickness=0.025 if a == "pseudoinverse" else 0.015,
+                thickness=3.0 if a == "pseudoinverse" else 2.0,
+                thickness_units="screen",  # pixels, see above _add_floor_grid
             )
             if result.state.robot == "manipulator2":
                 # The carriage path (x2, x1) is the joint path: closed for J^E#, not for J^P#.
                 pts = np.column_stack([run.x[:, 1], run.x[:, 0], np.full(len(y), _Z[a] + 0.1)])
                 scene.add_line_segments(
-                    f"/robot/trace/{a}/joints", _polyline(pts), _rgb(COLORS[a]), thickness=0.008
+                    f"/robot/trace/{a}/joints",
+                    _polyline(pts),
+                    _rgb(COLORS[a]),
+                    thickness=1.2,
+                    thickness_units="screen",
                 )
         for k, target in enumerate(result.targets):
             scene.add_icosphere(
@@ -764,7 +774,8 @@ class DashboardScene:
                     f"/robot/trace/{a}/{n}",
                     _polyline(pts),
                     color,
-                    thickness=0.06 if last else 0.025,
+                    thickness=3.5 if last else 1.5,
+                    thickness_units="screen",
                 )
             self._mechanisms[a] = _Platform(
                 scene, f"/robot/{a}", _rgb(COLORS[a]), _OPACITY[a], _Z[a] * 0.5, state, None
