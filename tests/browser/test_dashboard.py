@@ -2,6 +2,10 @@
 
 Nothing is installed here: the test uses /usr/bin/chromium (``.ci/run`` installs it) and is
 skipped with a reason when it is missing. Screenshots go to tests/artifacts/.
+
+Each control change prints its latency to the plots (measured in the page) and to the scene (the
+viser client in the iframe showing the new generation's status), for issue 4's targets: no
+timing is asserted, the numbers depend on the machine.
 """
 
 from __future__ import annotations
