@@ -249,8 +249,8 @@ def test_dashboard_follows_controls_in_chromium(served):
         for _ in range(3):
             if not close.count():
                 break
-            close.first.dispatch_event("click")
-            try:
+            try:  # (the toast can close itself between count() and the click)
+                close.first.dispatch_event("click", timeout=3_000)
                 close.first.wait_for(state="detached", timeout=3_000)
             except PlaywrightTimeout:
                 continue
