@@ -977,15 +977,17 @@ class Dashboard:
         self._finish(generation)
         # Second phase: h on a grid when it is expensive, then E1 and E2 (quadrature). It starts
         # once the page and the scene had time to draw the first (it would compete with them
-        # for the CPU), unless a newer change came meanwhile.
-        if cached and not deferred:
-            return
-        with self._cond:
-            self._cond.wait_for(
-                lambda: self._generation != generation or self._stopped, SECOND_PHASE_DELAY
-            )
-        if self._generation != generation:
-            return
+        # for the CPU), unless a newer change came meanwhile. Known functionals went out with
+        # the result: their event only carries the h panel's title (a reused panel can lack it,
+        # and a page that connects now gets this event with the latest result).
+        known = bool(cached) and not deferred
+        if not known:
+            with self._cond:
+                self._cond.wait_for(
+                    lambda: self._generation != generation or self._stopped, SECOND_PHASE_DELAY
+                )
+            if self._generation != generation:
+                return
         if deferred:
             grid = augmenting_grid(kin, state, result.runs)
             if self._generation != generation:
@@ -1010,7 +1012,7 @@ class Dashboard:
                    "sensitivity": sens}  # fmt: skip
         with self._cond:
             self.functionals = functionals
-        figures = {"sensitivity": sensitivity_figure(result, sens).to_json()}
+        figures = {} if known else {"sensitivity": sensitivity_figure(result, sens).to_json()}
         if deferred:  # the h panel was a placeholder: the whole figure
             figures["augmenting"] = augmenting_figure(result, functionals).to_json()
         elif functionals is not None:  # h is on screen: only its title changes (no redraw)

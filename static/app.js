@@ -344,10 +344,11 @@ async function onFunctionals(msg) {
     const div = document.getElementById(`plot-${key}`);
     if (div) div.classList.remove("stale");
   }
-  // Only a title changed: relayout it instead of redrawing the panel.
+  // Only a title changed: relayout it instead of redrawing the panel (when it differs).
   await Promise.all(Object.entries(msg.titles || {}).map(([key, text]) => {
     const div = document.getElementById(`plot-${key}`);
-    return div && div.layout && Plotly.relayout(div, { "title.text": text });
+    if (!div || !div.layout || (div.layout.title || {}).text === text) return null;
+    return Plotly.relayout(div, { "title.text": text });
   }));
 }
 

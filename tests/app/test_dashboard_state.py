@@ -251,7 +251,8 @@ def test_runs_key_ignores_gamma_only_in_continuous_mode():
 
 def test_known_functionals_are_drawn_with_the_first_result():
     """A change of the cycles keeps E1, E2: the result carries the E1/E2 panel and the h
-    panel's title at once, nothing is dimmed and no second phase follows."""
+    panel's title at once, nothing is dimmed, and the functionals event that follows carries
+    no figure (only the h panel's title, for pages that connect later)."""
     dashboard = Dashboard(updated_state(default_state("manipulator2"), {"cycles": 1}))
     events, second = [], threading.Event()
 
@@ -270,7 +271,11 @@ def test_known_functionals_are_drawn_with_the_first_result():
     assert result["stale"] == []
     assert "sensitivity" in result["figures"]
     assert "E1 = " in result["figures"]["augmenting"]["layout"]["title"]["text"]
-    assert not [g for k, g, _ in events if k == "functionals" and g == generation]
+    (after,) = [json.loads(d) for k, g, d in events if k == "functionals" and g == generation]
+    assert after["figures"] == {}
+    assert (
+        after["titles"]["augmenting"] == result["figures"]["augmenting"]["layout"]["title"]["text"]
+    )
     assert dashboard.functionals is not None and dashboard.functionals["E1"] is not None
 
 
