@@ -83,3 +83,33 @@ def test_frame_headers():
     huge = struct.pack("!i", -1) + struct.pack("!Q", 3_000_000_000)
     assert _frame(bytearray(huge[:8])) == (None, 0)
     assert _frame(bytearray(huge)) == (3_000_000_000, 12)
+
+
+def test_a_cancelled_request_gives_its_worker_back_after_the_reply():
+    """A request cancelled mid-computation (e.g. at shutdown): the worker finishes, its reply is
+    drained in the background and the same process serves the next request."""
+    from app.schemas import RepeatabilityRequest
+    from tests.app.conftest import TABLE1_PATH, X0_M2
+
+    body = RepeatabilityRequest.model_validate(
+        {"robot": {"name": "manipulator2"}, "algorithm": "pseudoinverse", "x0": X0_M2,
+         "path": TABLE1_PATH, "cycles": 150}
+    ).model_dump_json().encode()  # fmt: skip
+
+    async def main():
+        pool = ComputePool(Settings(workers=1, timeout=60.0))
+        try:
+            await pool.warm_up()
+            pid = pool._workers[0].process.pid
+            task = asyncio.create_task(pool.run("repeatability", body))
+            await asyncio.sleep(0.2)
+            task.cancel()
+            with pytest.raises(asyncio.CancelledError):
+                await task
+            assert await pool.run("ping", None) == "pong"
+            return pid, [w.process.pid for w in pool._workers], dict(pool.stats)
+        finally:
+            pool.close()
+
+    pid, pids, stats = asyncio.run(main())
+    assert pids == [pid] and stats["exceeded"] == 0
