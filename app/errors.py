@@ -46,6 +46,10 @@ def error_response(exc: Exception) -> JSONResponse | None:
     return None
 
 
+def _too_large(detail: str) -> JSONResponse:
+    return JSONResponse(status_code=413, content={"detail": detail})
+
+
 class _TooLarge(HTTPException):
     """Raised while reading an over-long body; an HTTPException so that FastAPI's routes pass it
     on (to their 413 handler) instead of reporting a body they could not parse."""
@@ -74,10 +78,7 @@ class BodyLimit:
             return
         for name, value in scope.get("headers", ()):
             if name == b"content-length" and value.isdigit() and int(value) > self.limit:
-                message = self._message(str(int(value)))
-                await JSONResponse(status_code=413, content={"detail": message})(
-                    scope, receive, send
-                )
+                await _too_large(self._message(str(int(value))))(scope, receive, send)
                 return
         seen = 0
         started = False
@@ -100,6 +101,4 @@ class BodyLimit:
         except _TooLarge as exc:  # from the /solve fast path, which has no handlers
             if started:
                 raise
-            await JSONResponse(status_code=413, content={"detail": exc.detail})(
-                scope, receive, send
-            )
+            await _too_large(exc.detail)(scope, receive, send)

@@ -242,40 +242,8 @@ def _engine_error(exc: JikError) -> RequestError:
     return RequestError(name, text)
 
 
-def _trajectory(traj) -> S.Trajectory:
-    m = len(traj.theta)
-    idx = _downsample(m)
-    return S.Trajectory(
-        theta=_nullable(traj.theta[idx]),
-        x=_nullable(traj.x[idx]),
-        y=_nullable(traj.y[idx]),
-        error=_nullable(traj.error[idx]),
-        h=None if traj.h is None else _nullable(np.asarray(traj.h)[idx]),
-        points=m,
-        downsampled=len(idx) < m,
-    )
-
-
-def _solve_response(setup: _Setup, res) -> S.SolveResponse:
-    return S.SolveResponse(
-        robot=setup.robot,
-        algorithm=setup.inverse.name,
-        augmentation=setup.augmentation,
-        mode=setup.mode,
-        gamma=setup.gamma,
-        tolerance=setup.tolerance,
-        x=_nullable(res.x),
-        y=_nullable(res.y),
-        error=_nullable(res.error),
-        converged=bool(res.success),
-        message=res.message,
-        iterations=int(res.nit),
-        trajectory=_trajectory(res.trajectory),
-    )
-
-
-def _trajectory_dict(traj) -> dict[str, Any]:
-    """:func:`_trajectory` as plain JSON-ready data, without building the pydantic model."""
+def _trajectory_document(traj) -> dict[str, Any]:
+    """A run's trajectory as JSON-ready data (the fields of ``S.Trajectory``), downsampled."""
     m = len(traj.theta)
     idx = _downsample(m)
     return {
@@ -289,13 +257,9 @@ def _trajectory_dict(traj) -> dict[str, Any]:
     }
 
 
-def _solve_response_json(setup: _Setup, res) -> bytes:
-    """The JSON document of :func:`_solve_response`, built without model validation.
-
-    The worker's hot path: validating a response model costs about as much as a small solve.
-    ``tests/app/test_solve.py`` checks that both give the same document.
-    """
-    doc = {
+def _solve_document(setup: _Setup, res) -> dict[str, Any]:
+    """One solve's response as JSON-ready data (the fields of ``S.SolveResponse``)."""
+    return {
         "robot": setup.robot.model_dump(mode="json"),
         "algorithm": setup.inverse.name,
         "augmentation": (
@@ -310,9 +274,19 @@ def _solve_response_json(setup: _Setup, res) -> bytes:
         "converged": bool(res.success),
         "message": str(res.message),
         "iterations": int(res.nit),
-        "trajectory": _trajectory_dict(res.trajectory),
+        "trajectory": _trajectory_document(res.trajectory),
     }
-    return pydantic_core.to_json(doc)
+
+
+def _solve_response(setup: _Setup, res) -> S.SolveResponse:
+    return S.SolveResponse.model_validate(_solve_document(setup, res))
+
+
+def _solve_response_json(setup: _Setup, res) -> bytes:
+    """The JSON of :func:`_solve_response` without validating the model (the workers' hot
+    path: validation costs about as much as a small solve). ``tests/app/test_solve.py`` checks
+    that both give the same document."""
+    return pydantic_core.to_json(_solve_document(setup, res))
 
 
 # --------------------------------------------------------------------------------------------

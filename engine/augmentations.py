@@ -187,32 +187,32 @@ class Polynomial2(AugmentingMap):
     def parameters(self) -> dict[str, float]:
         return {f"c{i}{j}": c for (i, j), c in sorted(self.coefficients.items())}
 
-    def _powers(self, x: FloatArray):
-        """Powers u^k, v^k (..., degree + 1), their derivatives, and the coefficient matrix.
+    def _powers(self, x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """U = (1, u, u^2, ...), V likewise (..., degree + 1), and their derivatives dU, dV.
 
-        h = U C V^T with U = (1, u, u^2, ...), so h and dh cost a few array operations
-        whatever the number of terms (the hot path of the extended inverse).
+        h = U C V^T with C = ``self._matrix``: h and dh cost a few array operations whatever the
+        number of terms (the hot path of the extended inverse).
         """
         x = np.asarray(x, dtype=float)
-        C = self._matrix
-        ku, kv = np.arange(C.shape[0], dtype=float), np.arange(C.shape[1], dtype=float)
+        ku = np.arange(self._matrix.shape[0], dtype=float)
+        kv = np.arange(self._matrix.shape[1], dtype=float)
         U = x[..., self.variables[0], None] ** ku
         V = x[..., self.variables[1], None] ** kv
         dU = np.zeros_like(U)
         dU[..., 1:] = ku[1:] * U[..., :-1]
         dV = np.zeros_like(V)
         dV[..., 1:] = kv[1:] * V[..., :-1]
-        return x, U, V, dU, dV, C
+        return U, V, dU, dV
 
     def value(self, x: FloatArray) -> FloatArray:
-        _, U, V, _, _, C = self._powers(x)
-        return np.einsum("...i,ij,...j->...", U, C, V)
+        U, V, _, _ = self._powers(x)
+        return np.einsum("...i,ij,...j->...", U, self._matrix, V)
 
     def gradient(self, x: FloatArray) -> FloatArray:
-        x, U, V, dU, dV, C = self._powers(x)
-        g = np.zeros(x.shape)
-        g[..., self.variables[0]] = np.einsum("...i,ij,...j->...", dU, C, V)
-        g[..., self.variables[1]] = np.einsum("...i,ij,...j->...", U, C, dV)
+        U, V, dU, dV = self._powers(x)
+        g = np.zeros(np.shape(x))
+        g[..., self.variables[0]] = np.einsum("...i,ij,...j->...", dU, self._matrix, V)
+        g[..., self.variables[1]] = np.einsum("...i,ij,...j->...", U, self._matrix, dV)
         return g
 
 

@@ -93,17 +93,23 @@ async def _concurrent(app, bodies):
         return await asyncio.gather(*(client.post("/solve", json=b) for b in bodies))
 
 
+def _post_concurrently(settings: Settings, bodies: list[dict]):
+    """POST every body at once to a fresh app with ``settings``; its responses and pool stats."""
+    app = create_app(settings)
+    try:
+        return asyncio.run(_concurrent(app, bodies)), dict(app.state.pool.stats)
+    finally:
+        app.state.pool.close()
+
+
 def test_concurrent_solves_are_batched_and_equal_to_single_solves(api):
     """16 concurrent compatible requests share few engine calls; each result is its own."""
     rng = np.random.default_rng(1)
     targets = rng.uniform([0.2, 0.8], [1.2, 1.8], size=(16, 2))
     bodies = [solve_body(target=t.tolist()) for t in targets]
-    app = create_app(Settings(workers=1, timeout=60.0, batch_window=0.005))
-    try:
-        responses = asyncio.run(_concurrent(app, bodies))
-        stats = app.state.pool.stats
-    finally:
-        app.state.pool.close()
+    responses, stats = _post_concurrently(
+        Settings(workers=1, timeout=60.0, batch_window=0.005), bodies
+    )
     assert [r.status_code for r in responses] == [200] * 16
     assert stats["solve_requests"] == 16
     assert stats["solve_calls"] <= 4, stats
@@ -117,12 +123,9 @@ def test_a_large_batch_is_shared_among_idle_workers(api):
     """16 requests in one window with two idle workers: two engine calls of 8, same results."""
     rng = np.random.default_rng(2)
     bodies = [solve_body(target=t.tolist()) for t in rng.uniform([0.2, 0.8], [1.2, 1.8], (16, 2))]
-    app = create_app(Settings(workers=2, timeout=60.0, batch_window=0.05))
-    try:
-        responses = asyncio.run(_concurrent(app, bodies))
-        stats = app.state.pool.stats
-    finally:
-        app.state.pool.close()
+    responses, stats = _post_concurrently(
+        Settings(workers=2, timeout=60.0, batch_window=0.05), bodies
+    )
     assert [r.status_code for r in responses] == [200] * 16
     assert (stats["solve_calls"], stats["solve_requests"]) == (2, 16), stats
     for body, r in zip(bodies, responses, strict=True):
@@ -132,12 +135,7 @@ def test_a_large_batch_is_shared_among_idle_workers(api):
 
 def test_unbatched_mode_makes_one_call_per_request():
     bodies = [solve_body(target=[0.5 + 0.1 * i, 1.5]) for i in range(4)]
-    app = create_app(Settings(workers=1, timeout=60.0, batching=False))
-    try:
-        responses = asyncio.run(_concurrent(app, bodies))
-        stats = app.state.pool.stats
-    finally:
-        app.state.pool.close()
+    responses, stats = _post_concurrently(Settings(workers=1, timeout=60.0, batching=False), bodies)
     assert all(r.status_code == 200 for r in responses)
     assert stats["solve_calls"] == stats["solve_requests"] == 4
 
@@ -152,12 +150,9 @@ def test_a_bad_member_does_not_spoil_its_batch():
         "target": [0.8, 1.5],
     }
     bad = {**good, "x0": [0.0, 0.5, 1.0]}  # dh K = 0 at x1 = -b/a = 0
-    app = create_app(Settings(workers=1, timeout=60.0, batch_window=0.01))
-    try:
-        responses = asyncio.run(_concurrent(app, [good, bad, good]))
-        stats = app.state.pool.stats
-    finally:
-        app.state.pool.close()
+    responses, stats = _post_concurrently(
+        Settings(workers=1, timeout=60.0, batch_window=0.01), [good, bad, good]
+    )
     assert [r.status_code for r in responses] == [200, 422, 200]
     assert stats["solve_calls"] == 1
     assert "algorithmic singularity" in responses[1].json()["detail"][0]["msg"]
