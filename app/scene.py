@@ -23,6 +23,7 @@ import json
 import math
 import threading
 import time
+from collections.abc import Callable
 from typing import Any, cast
 
 import numpy as np
@@ -167,6 +168,10 @@ class _Mechanism:
 
     def build(self) -> None: ...
 
+    def resize(self, state, extent) -> None:
+        """Follow a new arm length or task-plane box in place (no node is re-created)."""
+        self.state, self.extent = state, extent
+
     def pose(self, x) -> None: ...
 
 
@@ -176,13 +181,23 @@ class _Gantry(_Mechanism):
     def build(self) -> None:
         (lo, hi), _ = self.extent
         self.span = (lo, hi)
-        self.l = float(self.state.robot_parameters["l"])
+        l = float(self.state.robot_parameters["l"])
         self.beam = self.box("beam", (hi - lo, 0.07, 0.05))
         self.carriage = self.scene.add_frame(f"{self.root}/carriage", show_axes=False)
         self.box("carriage/body", (0.2, 0.2, 0.09))
         self.ball("carriage/joint", 0.06, (0.0, 0.0, 0.07), color=(40, 40, 40))
-        self.box("carriage/arm", (self.l, 0.06, 0.04), (self.l / 2, 0.0, 0.07))
-        self.ball("carriage/effector", 0.07, (self.l, 0.0, 0.07))
+        self.arm = self.box("carriage/arm", (l, 0.06, 0.04), (l / 2, 0.0, 0.07))
+        self.effector = self.ball("carriage/effector", 0.07, (l, 0.0, 0.07))
+
+    def resize(self, state, extent) -> None:
+        super().resize(state, extent)
+        (lo, hi), _ = extent
+        self.span = (lo, hi)
+        l = float(state.robot_parameters["l"])
+        self.beam.dimensions = (hi - lo, 0.07, 0.05)
+        self.arm.dimensions = (l, 0.06, 0.04)
+        self.arm.position = (l / 2, 0.0, 0.07)
+        self.effector.position = (l, 0.0, 0.07)
 
     def pose(self, x) -> None:
         lo, hi = self.span
@@ -205,6 +220,12 @@ class _NormalForm(_Mechanism):
         self.point = self.ball("W", 0.08)
         if self.root.endswith("extended"):
             self.scene.add_label(f"{self.root}/W/label", "W (task point)", position=(0.08, 0.08, 0))
+
+    def resize(self, state, extent) -> None:
+        super().resize(state, extent)
+        _, (lo, hi) = extent
+        self.runner.dimensions = (0.05, hi - lo, 0.04)
+        self.runner_span = (lo, hi)
 
     def pose(self, x) -> None:
         x1, x2, x3 = (float(v) for v in x)
@@ -281,6 +302,47 @@ def _polyline(points: np.ndarray) -> np.ndarray:
     return np.stack([points[:-1], points[1:]], axis=1)
 
 
+def _fixtures(result, extent) -> dict[str, tuple[str, dict, dict]]:
+    """The parts of a manipulator's scene besides the mechanisms, by node name: (kind, the
+    values that follow the result, the fixed style). The rails (Manipulator 2) or the guide
+    (Manipulator 1) span the task-plane box; the task paths of both algorithms, and for
+    Manipulator 2 the carriage paths (x2, x1), which are the joint paths: closed for J^E#,
+    not for J^P#; the targets of the path's legs."""
+    (xlo, xhi), (ylo, yhi) = extent
+    robot = result.state.robot
+    grey: dict = {"color": (90, 90, 90)}
+    out: dict[str, tuple[str, dict, dict]] = {}
+    rail = (0.06, yhi - ylo, 0.05)
+    if robot == "manipulator2":
+        for side, x in (("left", xlo), ("right", xhi)):
+            out[f"/robot/rails/{side}"] = (
+                "box", {"dimensions": rail, "position": (x, (ylo + yhi) / 2, -0.02)}, grey
+            )  # fmt: skip
+    elif robot == "manipulator1":
+        out["/robot/guide"] = (
+            "box", {"dimensions": rail, "position": (0.0, (ylo + yhi) / 2, -0.02)}, grey
+        )  # fmt: skip
+    for a in ALGORITHMS:
+        run = result.runs[a]
+        line = {"colors": _rgb(COLORS[a]), "thickness_units": "screen"}  # pixels, see above
+        task = np.column_stack([run.y[:, 0], run.y[:, 1], np.full(len(run.y), _Z[a] + 0.16)])
+        out[f"/robot/trace/{a}/task"] = (
+            "line", {"points": _polyline(task)},
+            {**line, "thickness": 3.0 if a == "pseudoinverse" else 2.0},
+        )  # fmt: skip
+        if robot == "manipulator2":
+            joints = np.column_stack([run.x[:, 1], run.x[:, 0], np.full(len(run.x), _Z[a] + 0.1)])
+            out[f"/robot/trace/{a}/joints"] = (
+                "line", {"points": _polyline(joints)}, {**line, "thickness": 1.2}
+            )  # fmt: skip
+    for k, target in enumerate(result.targets):
+        out[f"/robot/targets/{k}"] = (
+            "ball", {"position": (float(target[0]), float(target[1]), 0.2)},
+            {"radius": 0.05, "color": (0, 0, 0)},
+        )  # fmt: skip
+    return out
+
+
 # -- the scene ----------------------------------------------------------------------------------
 class DashboardScene:
     """A viser server showing the dashboard's current result and editing its state.
@@ -308,10 +370,13 @@ class DashboardScene:
         self._lock = threading.RLock()
         self._timeline: Timeline | None = None
         self._mechanisms: dict[str, _Mechanism] = {}
+        self._home: _Mechanism | None = None  # the grey copy at the start x0
         self._s = 0.0
         self.drawn_generation = 0
         self._drawn_runs: tuple[str, ...] | None = None  # runs_key of what the scene shows
         self._structure: tuple | None = None
+        self._layout: tuple | None = None  # (robot, task, targets) of the nodes on screen
+        self._fixtures: dict[str, Any] = {}  # handles of the nodes of _fixtures(), by name
         # viser declares the setter of a GUI handle's ``value`` apart from its getter, so mypy
         # sees a read-only property; assigning it is viser's API (ignores marked "viser: settable").
         self._controls: dict[str, viser.GuiInputHandle[Any]] = {}
@@ -585,7 +650,6 @@ class DashboardScene:
                 self._rebuild_controls(state)
             else:
                 self._sync_controls(state)
-            self._place_gizmo(state)
 
     def _place_gizmo(self, state) -> None:
         if self._dragging:
@@ -638,23 +702,42 @@ class DashboardScene:
             return
         with self._lock, self.server.atomic():
             self._drawn_runs = drawn
-            scene.remove_by_name("/robot")
-            scene.add_frame("/robot", show_axes=False)
-            self._mechanisms = {}
             timeline = Timeline(result)
             extent = _extent(result)
-            if timeline.unicycle:
-                self._draw_unicycle(result, timeline)
-            else:
-                cls = _MECHANISMS.get(state.robot)
-                if cls is not None:
-                    home = cls(scene, "/robot/home", HOME_COLOR, 0.25, -0.03, state, extent)
-                    home.pose(np.asarray(state.x0))
-                    for a in ALGORITHMS:
-                        self._mechanisms[a] = cls(
-                            scene, f"/robot/{a}", _rgb(COLORS[a]), _OPACITY[a], _Z[a], state, extent
+            # The start-point gizmo moves with the drawing it belongs to, in the same batch: moved
+            # on the change itself it would start the client's frames (a quarter second of
+            # software WebGL here) while the result is computed, and the result would wait for them.
+            self._place_gizmo(state)
+            layout = (state.robot, state.task, len(result.targets))
+            if timeline.unicycle or layout != self._layout:
+                self._layout = None if timeline.unicycle else layout
+                scene.remove_by_name("/robot")
+                scene.add_frame("/robot", show_axes=False)
+                self._mechanisms, self._fixtures, self._home = {}, {}, None
+                if timeline.unicycle:
+                    self._draw_unicycle(result, timeline)
+                else:
+                    cls = _MECHANISMS.get(state.robot)
+                    if cls is not None:
+                        self._home = cls(
+                            scene, "/robot/home", HOME_COLOR, 0.25, -0.03, state, extent
                         )
-                self._draw_traces(result, extent)
+                        self._mechanisms = {
+                            a: cls(scene, f"/robot/{a}", _rgb(COLORS[a]), _OPACITY[a], _Z[a],
+                                   state, extent)
+                            for a in ALGORITHMS
+                        }  # fmt: skip
+                    self._add_fixtures(result, extent)
+            else:
+                # Same robot, task and number of targets: the nodes stay and take the new
+                # values (re-creating them costs the client a remount of every node).
+                for m in [*self._mechanisms.values(), *([self._home] if self._home else [])]:
+                    m.resize(state, extent)
+                for name, (_, values, _) in _fixtures(result, extent).items():
+                    for key, value in values.items():
+                        setattr(self._fixtures[name], key, value)
+            if self._home is not None:
+                self._home.pose(np.asarray(state.x0))
             if self._framed != state.robot:
                 self._framed = state.robot
                 self._frame_camera(extent)
@@ -693,57 +776,15 @@ class DashboardScene:
                 client.camera.position = position
                 client.camera.look_at = center
 
-    def _draw_traces(self, result, extent) -> None:
+    def _add_fixtures(self, result, extent) -> None:
+        """Create the rails or guide, the traces and the targets (see :func:`_fixtures`)."""
         scene = self.server.scene
-        (xlo, xhi), (ylo, yhi) = extent
-        if result.state.robot == "manipulator2":
-            scene.add_box(
-                "/robot/rails/left",
-                color=(90, 90, 90),
-                dimensions=(0.06, yhi - ylo, 0.05),
-                position=(xlo, (ylo + yhi) / 2, -0.02),
-            )
-            scene.add_box(
-                "/robot/rails/right",
-                color=(90, 90, 90),
-                dimensions=(0.06, yhi - ylo, 0.05),
-                position=(xhi, (ylo + yhi) / 2, -0.02),
-            )
-        elif result.state.robot == "manipulator1":
-            scene.add_box(
-                "/robot/guide",
-                color=(90, 90, 90),
-                dimensions=(0.06, yhi - ylo, 0.05),
-                position=(0.0, (ylo + yhi) / 2, -0.02),
-            )
-        for a in ALGORITHMS:
-            run = result.runs[a]
-            y = run.y
-            pts = np.column_stack([y[:, 0], y[:, 1], np.full(len(y), _Z[a] + 0.16)])
-            scene.add_line_segments(
-                f"/robot/trace/{a}/task",
-                _polyline(pts),
-                _rgb(COLORS[a]),
-                thickness=3.0 if a == "pseudoinverse" else 2.0,
-                thickness_units="screen",  # pixels, see above _add_floor_grid
-            )
-            if result.state.robot == "manipulator2":
-                # The carriage path (x2, x1) is the joint path: closed for J^E#, not for J^P#.
-                pts = np.column_stack([run.x[:, 1], run.x[:, 0], np.full(len(y), _Z[a] + 0.1)])
-                scene.add_line_segments(
-                    f"/robot/trace/{a}/joints",
-                    _polyline(pts),
-                    _rgb(COLORS[a]),
-                    thickness=1.2,
-                    thickness_units="screen",
-                )
-        for k, target in enumerate(result.targets):
-            scene.add_icosphere(
-                f"/robot/targets/{k}",
-                radius=0.05,
-                color=(0, 0, 0),
-                position=(target[0], target[1], 0.2),
-            )
+        add: dict[str, Callable[..., Any]] = {
+            "box": scene.add_box, "line": scene.add_line_segments, "ball": scene.add_icosphere
+        }  # fmt: skip
+        for name, (kind, values, style) in _fixtures(result, extent).items():
+            self._fixtures[name] = add[kind](name, **style, **values)
+        for k in range(len(result.targets)):
             scene.add_label(
                 f"/robot/targets/{k}/label",
                 chr(ord("A") + k) if k < 26 else str(k),

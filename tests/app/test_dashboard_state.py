@@ -395,3 +395,45 @@ def test_viser_gui_and_drag_change_the_one_state():
     finally:
         scene.stop()
         dashboard.stop()
+
+
+def test_scene_follows_a_new_result_in_place():
+    """A change that keeps the robot, the task and the number of targets moves the scene's
+    nodes instead of re-creating them; the start-point gizmo moves with the drawing."""
+    import socket
+
+    from app.scene import DashboardScene, _polyline, gizmo_pose
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    # (k(x0) off the path's points for both: the closed path has the same number of legs)
+    first = updated_state(default_state("manipulator2"), {"x0": [0.4, 0.0, 1.5]})
+    dashboard = Dashboard(first)
+    scene = DashboardScene(dashboard, port=port)
+    try:
+        assert dashboard.wait(1, timeout=60)
+        second = updated_state(first, {"x0": [0.45, 0.1, 1.4], "robot_parameters": {"l": 1.3}})
+        scene._draw(compute(first, 101))
+        fixtures, mechanisms = dict(scene._fixtures), dict(scene._mechanisms)
+        scene._draw(compute(second, 102))
+        assert scene._fixtures.keys() == fixtures.keys()
+        assert all(scene._fixtures[k] is v for k, v in fixtures.items())
+        assert all(scene._mechanisms[k] is v for k, v in mechanisms.items())
+        result = compute(second, 103)
+        y = result.runs["extended"].y
+        np.testing.assert_allclose(
+            scene._fixtures["/robot/trace/extended/task"].points[:, :, :2],
+            _polyline(np.column_stack([y, np.zeros(len(y))]))[:, :, :2],
+            rtol=1e-6,  # viser keeps float32
+        )
+        assert scene._mechanisms["extended"].arm.dimensions[0] == pytest.approx(1.3)
+        (X, Y), _ = gizmo_pose("manipulator2", second.x0, second.robot_parameters)
+        np.testing.assert_allclose(scene.gizmo.position, (X, Y, 0.3))
+        # Another robot: new nodes.
+        scene._draw(compute(default_state("manipulator1"), 104))
+        assert "/robot/guide" in scene._fixtures and "/robot/rails/left" not in scene._fixtures
+        assert scene._fixtures["/robot/targets/0"] is not fixtures["/robot/targets/0"]
+    finally:
+        scene.stop()
+        dashboard.stop()
