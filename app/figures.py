@@ -25,6 +25,9 @@ PANELS = ("task", "drift", "joints", "augmenting", "sensitivity", "table")
 _AXIS = dict(
     gridcolor="#e6e6e6", zerolinecolor="#b0b0b0", linecolor="#888", showline=True, mirror=True,
     ticks="outside", automargin=True,
+    # plotly's default on linear axes, "hide past div", measures every tick label's box
+    # (a forced layout each) on every redraw: ~10 ms per panel here.
+    ticklabeloverflow="allow",
 )  # fmt: skip
 # A small explicit template: the named ones ("plotly_white") cost ~25 ms per figure to apply.
 _TEMPLATE = go.layout.Template(
@@ -310,7 +313,9 @@ def augmenting_figure(result: DashboardResult, functionals: dict | None = None) 
             # No labels on the level curves: placing them costs the page 100-250 ms per redraw;
             # the colour bar and the hover give the levels.
             ncontours=24, contours=dict(showlabels=False),
-            colorbar=dict(title=dict(text="h", side="right"), thickness=12),
+            colorbar=dict(
+                title=dict(text="h", side="right"), thickness=12, ticklabeloverflow="allow"
+            ),
             hovertemplate=f"{ni} = %{{x:.3f}}<br>{nj} = %{{y:.3f}}<br>h = %{{z:.4f}}"
             "<extra></extra>",
             name="h", showlegend=False,
