@@ -297,8 +297,43 @@ def _add_floor_grid(scene, half: float = 10.0, cell: float = 0.5, section: float
         )
 
 
-def _polyline(points: np.ndarray) -> np.ndarray:
-    """(n, 3) points -> (n - 1, 2, 3) segments."""
+#: Largest distance of a drawn trace from the computed path, as a fraction of the scene's size
+#: (about a third of a pixel at the dashboard's size).
+TRACE_TOLERANCE = 1e-3
+
+
+def simplify(points: np.ndarray, tol: float) -> np.ndarray:
+    """The points of the polyline ``points`` (n, d) that keep it within ``tol`` of every
+    original point (Ramer-Douglas-Peucker; the first and the last are always kept).
+
+    A trace costs the viser client per segment: in software WebGL (no GPU) a thousand segments
+    add about 15 ms to every frame. The continuous task paths are straight between targets, eq.
+    (5), so most of their recorded points lie on a line.
+    """
+    n = len(points)
+    keep = np.zeros(n, dtype=bool)
+    keep[[0, -1]] = True
+    stack = [(0, n - 1)]
+    while stack:
+        i, j = stack.pop()
+        if j <= i + 1:
+            continue
+        a, d = points[i], points[j] - points[i]
+        rel = points[i + 1 : j] - a
+        L2 = float(d @ d)
+        t = np.clip(rel @ d / L2, 0.0, 1.0) if L2 > 0 else np.zeros(len(rel))
+        dist = np.linalg.norm(rel - t[:, None] * d, axis=1)
+        k = int(np.argmax(dist))
+        if dist[k] > tol:
+            m = i + 1 + k
+            keep[m] = True
+            stack += [(i, m), (m, j)]
+    return points[keep]
+
+
+def _polyline(points: np.ndarray, tol: float = 0.0) -> np.ndarray:
+    """(n, 3) points -> segments (m - 1, 2, 3) of the polyline simplified to within ``tol``."""
+    points = simplify(points, tol) if tol > 0 and len(points) > 2 else points
     return np.stack([points[:-1], points[1:]], axis=1)
 
 
@@ -309,6 +344,7 @@ def _fixtures(result, extent) -> dict[str, tuple[str, dict, dict]]:
     Manipulator 2 the carriage paths (x2, x1), which are the joint paths: closed for J^E#,
     not for J^P#; the targets of the path's legs."""
     (xlo, xhi), (ylo, yhi) = extent
+    tol = TRACE_TOLERANCE * max(xhi - xlo, yhi - ylo)
     robot = result.state.robot
     grey: dict = {"color": (90, 90, 90)}
     out: dict[str, tuple[str, dict, dict]] = {}
@@ -327,13 +363,13 @@ def _fixtures(result, extent) -> dict[str, tuple[str, dict, dict]]:
         line = {"colors": _rgb(COLORS[a]), "thickness_units": "screen"}  # pixels, see above
         task = np.column_stack([run.y[:, 0], run.y[:, 1], np.full(len(run.y), _Z[a] + 0.16)])
         out[f"/robot/trace/{a}/task"] = (
-            "line", {"points": _polyline(task)},
+            "line", {"points": _polyline(task, tol)},
             {**line, "thickness": 3.0 if a == "pseudoinverse" else 2.0},
         )  # fmt: skip
         if robot == "manipulator2":
             joints = np.column_stack([run.x[:, 1], run.x[:, 0], np.full(len(run.x), _Z[a] + 0.1)])
             out[f"/robot/trace/{a}/joints"] = (
-                "line", {"points": _polyline(joints)}, {**line, "thickness": 1.2}
+                "line", {"points": _polyline(joints, tol)}, {**line, "thickness": 1.2}
             )  # fmt: skip
     for k, target in enumerate(result.targets):
         out[f"/robot/targets/{k}"] = (
@@ -361,6 +397,10 @@ class DashboardScene:
         # Nothing here casts a shadow (every node is added with cast_shadow=False): without the
         # default lights' shadow map pass each frame costs a third less in software WebGL.
         self.server.scene.configure_default_lights(cast_shadow=False)
+        # Lit by the default lights alone: with viser's default environment map every pixel of a
+        # mesh samples it, and in software WebGL a view filled by one box takes 109 ms a frame
+        # instead of 45 ms.
+        self.server.scene.configure_environment_map(hdri=None)
         self.server.gui.configure_theme(control_width="small", show_logo=False)
         self.server.gui.main_panel.dock_right()
         self.server.gui.main_panel.set_width(300)
@@ -794,6 +834,8 @@ class DashboardScene:
     def _draw_unicycle(self, result, timeline: Timeline) -> None:
         scene = self.server.scene
         state = result.state
+        (xlo, xhi), (ylo, yhi) = _extent(result)
+        tol = TRACE_TOLERANCE * max(xhi - xlo, yhi - ylo)
         target = _Platform(scene, "/robot/target", (0, 0, 0), 0.3, 0.0, state, None)
         target.pose(state.target)
         q0 = state.robot_parameters["q0"]
@@ -813,7 +855,7 @@ class DashboardScene:
                 pts = np.column_stack([P[:, 0], P[:, 1], np.full(len(P), 0.02 + _Z[a] * 0.2)])
                 scene.add_line_segments(
                     f"/robot/trace/{a}/{n}",
-                    _polyline(pts),
+                    _polyline(pts, tol),
                     color,
                     thickness=3.5 if last else 1.5,
                     thickness_units="screen",

@@ -402,7 +402,7 @@ def test_scene_follows_a_new_result_in_place():
     nodes instead of re-creating them; the start-point gizmo moves with the drawing."""
     import socket
 
-    from app.scene import DashboardScene, _polyline, gizmo_pose
+    from app.scene import TRACE_TOLERANCE, DashboardScene, _extent, _polyline, gizmo_pose
 
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -421,10 +421,12 @@ def test_scene_follows_a_new_result_in_place():
         assert all(scene._fixtures[k] is v for k, v in fixtures.items())
         assert all(scene._mechanisms[k] is v for k, v in mechanisms.items())
         result = compute(second, 103)
+        (xlo, xhi), (ylo, yhi) = _extent(result)
+        tol = TRACE_TOLERANCE * max(xhi - xlo, yhi - ylo)
         y = result.runs["extended"].y
         np.testing.assert_allclose(
             scene._fixtures["/robot/trace/extended/task"].points[:, :, :2],
-            _polyline(np.column_stack([y, np.zeros(len(y))]))[:, :, :2],
+            _polyline(np.column_stack([y, np.full(len(y), 0.16)]), tol)[:, :, :2],
             rtol=1e-6,  # viser keeps float32
         )
         assert scene._mechanisms["extended"].arm.dimensions[0] == pytest.approx(1.3)
@@ -437,3 +439,34 @@ def test_scene_follows_a_new_result_in_place():
     finally:
         scene.stop()
         dashboard.stop()
+
+
+def _distance_to_polyline(points: np.ndarray, line: np.ndarray) -> np.ndarray:
+    """Distance of each point to the polyline ``line`` (m, d)."""
+    a, b = line[:-1], line[1:]
+    d = b - a
+    rel = points[:, None, :] - a[None]
+    t = np.clip(np.einsum("nmd,md->nm", rel, d) / np.maximum(np.einsum("md,md->m", d, d), 1e-300),
+                0.0, 1.0)  # fmt: skip
+    return np.min(np.linalg.norm(rel - t[..., None] * d[None], axis=-1), axis=1)
+
+
+@pytest.mark.parametrize("robot", ["manipulator1", "manipulator2"])
+def test_scene_traces_stay_within_their_tolerance(robot):
+    """The scene draws each path with far fewer segments, never farther than the tolerance from
+    any computed point; the ends are kept."""
+    from app.scene import TRACE_TOLERANCE, _extent, simplify
+
+    result = compute(default_state(robot))
+    (xlo, xhi), (ylo, yhi) = _extent(result)
+    tol = TRACE_TOLERANCE * max(xhi - xlo, yhi - ylo)
+    for run in result.runs.values():
+        for path in (run.y, run.x):
+            kept = simplify(path, tol)
+            assert len(kept) < len(path) / 4
+            np.testing.assert_array_equal(kept[[0, -1]], path[[0, -1]])
+            assert _distance_to_polyline(path, kept).max() <= tol
+    line = np.column_stack([np.linspace(0, 1, 50), np.linspace(0, 2, 50)])
+    assert len(simplify(line, 1e-12)) == 2
+    corner = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]])
+    np.testing.assert_array_equal(simplify(corner, 0.1), corner)
