@@ -17,9 +17,12 @@ from __future__ import annotations
 import hashlib
 import json
 import logging
+import multiprocessing
 import threading
 import time
 from collections.abc import Callable, Mapping
+from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field, replace
 from typing import cast
 
@@ -382,6 +385,108 @@ def _run_legs(inverse, state, targets, cycles, progress, cancelled, partial) -> 
     )
 
 
+def algorithm_run(
+    state: DashboardState,
+    algorithm: str,
+    targets: np.ndarray,
+    cycles: int,
+    progress: Callable[[], None] = lambda: None,
+    cancelled: Callable[[], bool] = lambda: False,
+    partial: Callable[[float], None] = lambda f: None,
+    kin=None,
+) -> AlgorithmRun:
+    """One algorithm through ``cycles`` cycles of the legs to ``targets`` (see :func:`compute`);
+    for the unicycle with the platform paths q(t) of its iterates. ``kin``: the state's
+    kinematics when the caller has built it."""
+    spec = robot_spec(state.robot)
+    kin = spec.build(**state.robot_parameters) if kin is None else kin
+    inverse = make_inverse(
+        kin, algorithm, state.augmentation, state.augmentation_parameters, spec.name
+    )
+    run = _run_legs(inverse, state, targets, cycles, progress, cancelled, partial)
+    if hasattr(kin, "path"):
+        t = np.linspace(0.0, float(cast(Unicycle, kin).T), UNICYCLE_TIME_POINTS)
+        run = replace(run, platform=kin.path(run.x, t))
+    return run
+
+
+# The generation counter the offload process compares its own against (set by _offload_init).
+_newest_generation = None
+
+
+def _offload_init(newest) -> None:
+    global _newest_generation
+    _newest_generation = newest
+
+
+def _offload_ready() -> bool:
+    return True  # importing this module (numpy, the engine) is the warm-up
+
+
+def _offload_run(state, algorithm, targets, cycles, generation) -> AlgorithmRun:
+    def cancelled() -> bool:
+        return _newest_generation is not None and _newest_generation.value > generation
+
+    return algorithm_run(state, algorithm, targets, cycles, cancelled=cancelled)
+
+
+class Offload:
+    """A second process for the dashboard's computation (one worker, spawned).
+
+    :func:`compute` runs the pseudoinverse here and the extended inverse in its own thread at the
+    same time: on two cores a change costs the slower of the two instead of their sum. A newer
+    change cancels the offloaded run between legs through a shared generation counter (see
+    :meth:`newest`). If the process dies, the run is redone in the calling thread and a new
+    process is started.
+    """
+
+    def __init__(self) -> None:
+        self._context = multiprocessing.get_context("spawn")  # (the server has threads: no fork)
+        self._newest = self._context.Value("q", 0, lock=False)
+        self._lock = threading.Lock()
+        self._pool = self._start()
+
+    def _start(self) -> ProcessPoolExecutor:
+        pool = ProcessPoolExecutor(
+            max_workers=1, mp_context=self._context, initializer=_offload_init,
+            initargs=(self._newest,),
+        )  # fmt: skip
+        pool.submit(_offload_ready)  # start and import now, not on the first change
+        return pool
+
+    def newest(self, generation: int) -> None:
+        """The dashboard's newest generation: older offloaded runs stop at their next leg."""
+        self._newest.value = generation
+
+    def submit(self, state, algorithm, targets, cycles, generation) -> Future:
+        with self._lock:
+            try:
+                return self._pool.submit(
+                    _offload_run, state, algorithm, targets, cycles, generation
+                )
+            except (BrokenProcessPool, RuntimeError):
+                self._pool = self._start()
+                return self._pool.submit(
+                    _offload_run, state, algorithm, targets, cycles, generation
+                )
+
+    def result(self, future: Future, fallback: Callable[[], AlgorithmRun]) -> AlgorithmRun:
+        """The offloaded run (Cancelled and the engine's errors propagate); if the process
+        died, ``fallback()`` computes it here."""
+        try:
+            return future.result()
+        except BrokenProcessPool:
+            log.warning("the dashboard's second process died; restarting it")
+            with self._lock:
+                self._pool.shutdown(wait=False, cancel_futures=True)
+                self._pool = self._start()
+            return fallback()
+
+    def close(self) -> None:
+        with self._lock:
+            self._pool.shutdown(wait=False, cancel_futures=True)
+
+
 def _cache_key(state: DashboardState, algorithm: str) -> str:
     d = state.as_dict()
     if algorithm == "pseudoinverse":
@@ -428,6 +533,7 @@ def compute(
     cancelled: Callable[[], bool] = lambda: False,
     cache: dict | None = None,
     with_augmenting: bool = True,
+    offload: Offload | None = None,
 ) -> DashboardResult:
     """Solve the state's task with both algorithms.
 
@@ -442,6 +548,9 @@ def compute(
         and filled.
     with_augmenting : bool
         Evaluate h on a grid for the h panel now (see :func:`augmenting_grid`).
+    offload : Offload, optional
+        A second process: the pseudoinverse runs there, concurrently with the extended
+        inverse here (same results).
 
     Raises
     ------
@@ -460,26 +569,34 @@ def compute(
     todo = [a for a in ALGORITHMS if keys[a] not in cache]
     done[0] = (len(ALGORITHMS) - len(todo)) * cycles * len(targets)
 
+    weight = [1]
+
     def step() -> None:
-        done[0] += 1
+        done[0] += weight[0]
         if progress is not None:
-            progress(done[0] / total)
+            progress(min(done[0] / total, 1.0))
 
     def partial(fraction: float) -> None:
         if progress is not None:
-            progress((done[0] + float(fraction)) / total)
+            progress(min((done[0] + weight[0] * float(fraction)) / total, 1.0))
 
+    # With a second process, the pseudoinverse runs there while this thread runs the extended
+    # inverse (the two are independent); each local leg then stands for two in the progress.
+    remote: Future | None = None
+    local = list(todo)
+    if offload is not None and len(todo) == 2:
+        remote = offload.submit(state, "pseudoinverse", targets, cycles, generation)
+        local.remove("pseudoinverse")
+        weight[0] = 2
+    for algorithm in local:
+        cache[keys[algorithm]] = algorithm_run(
+            state, algorithm, targets, cycles, step, cancelled, partial, kin
+        )
+    if offload is not None and remote is not None:
+        cache[keys["pseudoinverse"]] = offload.result(remote, lambda: algorithm_run(
+            state, "pseudoinverse", targets, cycles, cancelled=cancelled, kin=kin))  # fmt: skip
     runs: dict[str, AlgorithmRun] = {}
     for algorithm in ALGORITHMS:
-        if algorithm in todo:
-            inverse = make_inverse(
-                kin, algorithm, state.augmentation, state.augmentation_parameters, spec.name
-            )
-            run = _run_legs(inverse, state, targets, cycles, step, cancelled, partial)
-            if hasattr(kin, "path"):
-                t = np.linspace(0.0, float(cast(Unicycle, kin).T), UNICYCLE_TIME_POINTS)
-                run = replace(run, platform=kin.path(run.x, t))
-            cache[keys[algorithm]] = run
         run = cache[keys[algorithm]]
         if state.mode == "continuous":
             run = replace(run, theta=run.theta / state.gamma)
@@ -734,10 +851,19 @@ class Dashboard:
     debounce : float
         Seconds the worker waits after a change for a newer one (short: the page already
         coalesces a slider drag into one request in flight at a time).
+    offload : bool
+        Run one algorithm in a second process (:class:`Offload`); ``jik serve`` does.
     """
 
-    def __init__(self, state: DashboardState | None = None, *, debounce: float = 0.002) -> None:
+    def __init__(
+        self,
+        state: DashboardState | None = None,
+        *,
+        debounce: float = 0.002,
+        offload: bool = False,
+    ) -> None:
         self._cond = threading.Condition()
+        self._offload = Offload() if offload else None
         self._state = validate(state or default_state())
         self._generation = 1
         self._done = 0  # last generation whose computation finished (or failed)
@@ -781,6 +907,8 @@ class Dashboard:
         with self._cond:
             self._stopped = True
             self._cond.notify_all()
+        if self._offload is not None:
+            self._offload.close()
 
     def update(
         self, patch: Mapping[str, object], source: str = "page"
@@ -794,6 +922,8 @@ class Dashboard:
             self._generation += 1
             generation = self._generation
             self._changed_at[generation] = time.perf_counter()
+            if self._offload is not None:
+                self._offload.newest(generation)
             self._cond.notify_all()
         self._emit(
             Event("state", generation, _json(self._state_message(generation, state, source)))
@@ -928,7 +1058,7 @@ class Dashboard:
             result = compute(
                 state, generation, progress=progress,
                 cancelled=lambda: self._generation != generation, cache=self._cache,
-                with_augmenting=not deferred,
+                with_augmenting=not deferred, offload=self._offload,
             )  # fmt: skip
         except Cancelled:
             return

@@ -20,10 +20,11 @@ def run_server(host: str = "127.0.0.1", port: int = 8000, scene_port: int = 8080
         Port of the viser 3D scene.
     """
     app = create_app()
-    # --- dashboard: start the viser scene on scene_port here (2-3 lines) -----------------
-    from app.routers.dashboard import dashboard_for
+    from app.dashboard import Dashboard
     from app.scene import start_scene
+    from app.service import env_flag
 
-    app.state.scene_port = start_scene(dashboard_for(app), host, scene_port).port
-    # ---------------------------------------------------------------------------------------
+    # The dashboard runs one algorithm in a second process (JIK_DASHBOARD_OFFLOAD=0: not).
+    app.state.dashboard = Dashboard(offload=env_flag("JIK_DASHBOARD_OFFLOAD"))
+    app.state.scene_port = start_scene(app.state.dashboard, host, scene_port).port
     uvicorn.run(app, host=host, port=port, log_level="info", access_log=False)

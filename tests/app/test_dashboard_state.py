@@ -470,3 +470,34 @@ def test_scene_traces_stay_within_their_tolerance(robot):
     assert len(simplify(line, 1e-12)) == 2
     corner = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]])
     np.testing.assert_array_equal(simplify(corner, 0.1), corner)
+
+
+def test_offloaded_computation_is_the_same_and_can_be_cancelled():
+    """The second process computes the pseudoinverse exactly as the thread does; a newer
+    generation cancels it; if it dies, the run is redone here and a new process serves."""
+    from app.dashboard import Offload
+
+    offload = Offload()
+    try:
+        for robot in ("manipulator1", "manipulator2"):
+            state = default_state(robot)
+            here, there = compute(state), compute(state, 7, offload=offload)
+            for a in here.runs:
+                np.testing.assert_array_equal(here.runs[a].x, there.runs[a].x)
+                np.testing.assert_array_equal(here.runs[a].theta, there.runs[a].theta)
+                assert here.runs[a].message == there.runs[a].message
+            assert there.cached == {"pseudoinverse": False, "extended": False}
+        state = updated_state(default_state("manipulator2"), {"cycles": 5})
+        offload.newest(9)
+        with pytest.raises(Cancelled):
+            compute(state, 8, offload=offload)
+        for process in list(offload._pool._processes.values()):
+            process.kill()
+            process.join()
+        again = compute(state, 10, offload=offload)
+        np.testing.assert_array_equal(
+            again.runs["pseudoinverse"].x, compute(state).runs["pseudoinverse"].x
+        )
+        assert compute(state, 11, offload=offload).runs["pseudoinverse"].success
+    finally:
+        offload.close()
