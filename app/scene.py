@@ -415,7 +415,7 @@ class DashboardScene:
         self.drawn_generation = 0
         self._drawn_runs: tuple[str, ...] | None = None  # runs_key of what the scene shows
         self._structure: tuple | None = None
-        self._layout: tuple | None = None  # (robot, task, targets) of the nodes on screen
+        self._layout: tuple | None = None  # (robot, task) of the nodes on screen
         self._fixtures: dict[str, Any] = {}  # handles of the nodes of _fixtures(), by name
         # viser declares the setter of a GUI handle's ``value`` apart from its getter, so mypy
         # sees a read-only property; assigning it is viser's API (ignores marked "viser: settable").
@@ -748,7 +748,7 @@ class DashboardScene:
             # on the change itself it would start the client's frames (a quarter second of
             # software WebGL here) while the result is computed, and the result would wait for them.
             self._place_gizmo(state)
-            layout = (state.robot, state.task, len(result.targets))
+            layout = (state.robot, state.task)
             if timeline.unicycle or layout != self._layout:
                 self._layout = None if timeline.unicycle else layout
                 scene.remove_by_name("/robot")
@@ -769,13 +769,11 @@ class DashboardScene:
                         }  # fmt: skip
                     self._add_fixtures(result, extent)
             else:
-                # Same robot, task and number of targets: the nodes stay and take the new
+                # Same robot and task: the nodes stay and take the new
                 # values (re-creating them costs the client a remount of every node).
                 for m in [*self._mechanisms.values(), *([self._home] if self._home else [])]:
                     m.resize(state, extent)
-                for name, (_, values, _) in _fixtures(result, extent).items():
-                    for key, value in values.items():
-                        setattr(self._fixtures[name], key, value)
+                self._place_fixtures(result, extent)
             if self._home is not None:
                 self._home.pose(np.asarray(state.x0))
             if self._framed != state.robot:
@@ -818,18 +816,32 @@ class DashboardScene:
 
     def _add_fixtures(self, result, extent) -> None:
         """Create the rails or guide, the traces and the targets (see :func:`_fixtures`)."""
+        self._fixtures = {}
+        self._place_fixtures(result, extent)
+
+    def _place_fixtures(self, result, extent) -> None:
+        """Give the fixtures on screen the values of ``result``: existing nodes are moved, a
+        target the path gained is added, one it lost is removed."""
         scene = self.server.scene
         add: dict[str, Callable[..., Any]] = {
             "box": scene.add_box, "line": scene.add_line_segments, "ball": scene.add_icosphere
         }  # fmt: skip
-        for name, (kind, values, style) in _fixtures(result, extent).items():
-            self._fixtures[name] = add[kind](name, **style, **values)
-        for k in range(len(result.targets)):
-            scene.add_label(
-                f"/robot/targets/{k}/label",
-                chr(ord("A") + k) if k < 26 else str(k),
-                position=(0.05, 0.05, 0.05),
-            )
+        wanted = _fixtures(result, extent)
+        for name in [n for n in self._fixtures if n not in wanted]:
+            self._fixtures.pop(name).remove()
+        for name, (kind, values, style) in wanted.items():
+            if name not in self._fixtures:
+                self._fixtures[name] = add[kind](name, **style, **values)
+                if name.startswith("/robot/targets/"):
+                    k = int(name.rsplit("/", 1)[1])
+                    scene.add_label(
+                        f"{name}/label",
+                        chr(ord("A") + k) if k < 26 else str(k),
+                        position=(0.05, 0.05, 0.05),
+                    )
+                continue
+            for key, value in values.items():
+                setattr(self._fixtures[name], key, value)
 
     def _draw_unicycle(self, result, timeline: Timeline) -> None:
         scene = self.server.scene

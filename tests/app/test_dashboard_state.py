@@ -398,8 +398,9 @@ def test_viser_gui_and_drag_change_the_one_state():
 
 
 def test_scene_follows_a_new_result_in_place():
-    """A change that keeps the robot, the task and the number of targets moves the scene's
-    nodes instead of re-creating them; the start-point gizmo moves with the drawing."""
+    """A change that keeps the robot and the task moves the scene's nodes instead of
+    re-creating them (a target the closed path gains or loses is added or removed); the
+    start-point gizmo moves with the drawing."""
     import socket
 
     from app.scene import TRACE_TOLERANCE, DashboardScene, _extent, _polyline, gizmo_pose
@@ -420,6 +421,12 @@ def test_scene_follows_a_new_result_in_place():
         assert scene._fixtures.keys() == fixtures.keys()
         assert all(scene._fixtures[k] is v for k, v in fixtures.items())
         assert all(scene._mechanisms[k] is v for k, v in mechanisms.items())
+        # The default start maps onto the path's last point: one target fewer, the rest stays.
+        scene._draw(compute(default_state("manipulator2"), 105))
+        assert scene._fixtures.keys() == fixtures.keys() - {"/robot/targets/4"}
+        assert all(scene._fixtures[k] is v for k, v in fixtures.items() if k in scene._fixtures)
+        scene._draw(compute(second, 106))
+        assert scene._fixtures.keys() == fixtures.keys()
         result = compute(second, 103)
         (xlo, xhi), (ylo, yhi) = _extent(result)
         tol = TRACE_TOLERANCE * max(xhi - xlo, yhi - ylo)
