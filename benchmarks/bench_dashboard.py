@@ -1,0 +1,67 @@
+"""Dashboard computation: both algorithms in one thread vs the pseudoinverse offloaded.
+
+What a control change costs the server before the page and the scene can redraw:
+:func:`app.dashboard.compute` of the registry's default state (both algorithms through the
+closed path, h on a grid), with a fresh cache each time (a new start point). Straightforward:
+the two algorithms one after the other in the calling thread. jik serve: the pseudoinverse in a
+second process (:class:`app.dashboard.Offload`) while the thread runs the extended inverse.
+Wall-clock medians; each offloaded run is checked to give the same configurations.
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+
+import numpy as np
+
+from app.dashboard import Offload, compute, default_state, updated_state
+
+ROBOTS = ("manipulator2", "manipulator1", "unicycle")
+
+
+def _timed(robot: str, repeats: int, offload: Offload | None) -> float:
+    state = default_state(robot)
+    walls = []
+    for k in range(repeats):
+        if robot != "unicycle":  # a new start point each time (no cached run)
+            x0 = np.asarray(state.x0) + 0.01 * (k + 1)
+            state = updated_state(default_state(robot), {"x0": x0.tolist()})
+        t0 = time.perf_counter()
+        result = compute(state, k + 1, offload=offload)
+        walls.append(time.perf_counter() - t0)
+        if offload is not None and k == 0:
+            serial = compute(state)
+            for a, run in serial.runs.items():
+                assert np.array_equal(run.x, result.runs[a].x), f"{robot}: {a} differs"
+    return statistics.median(walls)
+
+
+def run(quick: bool = False) -> dict:
+    offload = Offload()
+    try:
+        compute(default_state("manipulator2"), offload=offload)  # the process is up and warm
+        out = {}
+        for robot in ROBOTS:
+            repeats = (2 if quick else 5) if robot == "unicycle" else (5 if quick else 21)
+            serial = _timed(robot, repeats, None)
+            offloaded = _timed(robot, repeats, offload)
+            out[robot] = {"serial_ms": 1e3 * serial, "offloaded_ms": 1e3 * offloaded,
+                          "ratio": serial / offloaded, "repeats": repeats}  # fmt: skip
+        return out
+    finally:
+        offload.close()
+
+
+def main(quick: bool = False) -> None:
+    r = run(quick=quick)
+    print(f"{'default state':16}{'one thread':>12}{'offloaded':>12}{'ratio':>8}{'runs':>6}")
+    for robot, v in r.items():
+        print(
+            f"{robot:16}{v['serial_ms']:10.1f}ms{v['offloaded_ms']:10.1f}ms"
+            f"{v['ratio']:8.2f}{v['repeats']:6d}"
+        )
+
+
+if __name__ == "__main__":
+    main()
