@@ -210,12 +210,14 @@ class _NormalForm(_Mechanism):
     """Manipulator 1 (30): slider x2 on the vertical guide, lever of slope x3, runner at x1."""
 
     def build(self) -> None:
-        _, (lo, hi) = self.extent
+        (xlo, xhi), (lo, hi) = self.extent
         self.runner = self.box("runner", (0.05, hi - lo, 0.04))
         self.runner_span = (lo, hi)
         self.slider = self.box("slider", (0.18, 0.14, 0.08))
         self.lever = self.scene.add_frame(f"{self.root}/lever", show_axes=False)
-        self.box("lever/bar", (3.5, 0.045, 0.03), (0.0, 0.0, 0.05))
+        # Along the lever from x = xlo to x = xhi of the task-plane box when level: shorter in x
+        # when it tilts, so it stays in the framed view.
+        self.bar = self.box("lever/bar", (xhi - xlo, 0.045, 0.03), ((xlo + xhi) / 2, 0.0, 0.05))
         self.ball("lever/pivot", 0.06, (0.0, 0.0, 0.05), color=(40, 40, 40))
         self.point = self.ball("W", 0.08)
         if self.root.endswith("extended"):
@@ -223,9 +225,11 @@ class _NormalForm(_Mechanism):
 
     def resize(self, state, extent) -> None:
         super().resize(state, extent)
-        _, (lo, hi) = extent
+        (xlo, xhi), (lo, hi) = extent
         self.runner.dimensions = (0.05, hi - lo, 0.04)
         self.runner_span = (lo, hi)
+        self.bar.dimensions = (xhi - xlo, 0.045, 0.03)
+        self.bar.position = ((xlo + xhi) / 2, 0.0, 0.05)
 
     def pose(self, x) -> None:
         x1, x2, x3 = (float(v) for v in x)
