@@ -18,6 +18,8 @@ import hashlib
 import json
 import logging
 import multiprocessing
+import multiprocessing.connection
+import os
 import threading
 import time
 from collections.abc import Callable, Mapping
@@ -417,6 +419,16 @@ _newest_generation = None
 def _offload_init(newest) -> None:
     global _newest_generation
     _newest_generation = newest
+    # Leave with the server, however it ends (a killed server would leave this process behind).
+    parent = multiprocessing.parent_process()
+    if parent is not None:
+        sentinel = parent.sentinel
+
+        def watch() -> None:
+            multiprocessing.connection.wait([sentinel])
+            os._exit(0)
+
+        threading.Thread(target=watch, name="jik-offload-parent", daemon=True).start()
 
 
 def _offload_ready() -> bool:

@@ -27,4 +27,7 @@ def run_server(host: str = "127.0.0.1", port: int = 8000, scene_port: int = 8080
     # The dashboard runs one algorithm in a second process (JIK_DASHBOARD_OFFLOAD=0: not).
     app.state.dashboard = Dashboard(offload=env_flag("JIK_DASHBOARD_OFFLOAD"))
     app.state.scene_port = start_scene(app.state.dashboard, host, scene_port).port
-    uvicorn.run(app, host=host, port=port, log_level="info", access_log=False)
+    try:
+        uvicorn.run(app, host=host, port=port, log_level="info", access_log=False)
+    finally:
+        app.state.dashboard.stop()

@@ -508,3 +508,51 @@ def test_offloaded_computation_is_the_same_and_can_be_cancelled():
         assert compute(state, 11, offload=offload).runs["pseudoinverse"].success
     finally:
         offload.close()
+
+
+def test_offload_process_leaves_with_a_killed_server(tmp_path):
+    """A server that is killed (no shutdown) does not leave its second process behind."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+    from pathlib import Path
+
+    script = (
+        "import time\n"
+        "from app.dashboard import Offload, compute, default_state\n"
+        "if __name__ == '__main__':\n"
+        "    offload = Offload()\n"
+        "    compute(default_state('manipulator2'), offload=offload)\n"
+        "    print(*offload._pool._processes, flush=True)\n"
+        "    time.sleep(60)\n"
+    )
+    path = tmp_path / "server.py"
+    path.write_text(script)
+    root = Path(__file__).resolve().parents[2]
+    proc = subprocess.Popen(
+        [sys.executable, str(path)], stdout=subprocess.PIPE, text=True, cwd=root,
+        env={**os.environ, "PYTHONPATH": str(root)},
+    )  # fmt: skip
+    try:
+        child = int(proc.stdout.readline().split()[0])
+        os.kill(child, 0)  # alive
+        proc.send_signal(signal.SIGKILL)
+        proc.wait(10)
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline:
+            try:
+                os.kill(child, 0)
+            except ProcessLookupError:
+                break
+            try:  # reap it if it became our grandchild's zombie in this process group
+                os.waitpid(child, os.WNOHANG)
+            except ChildProcessError:
+                pass
+            time.sleep(0.05)
+        else:
+            os.kill(child, signal.SIGKILL)
+            pytest.fail("the offload process outlived its killed server")
+    finally:
+        proc.kill()
