@@ -54,8 +54,6 @@ def bench(args: argparse.Namespace) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
-    if hasattr(signal, "SIGPIPE"):  # `jik reproduce table1 | head` ends quietly
-        signal.signal(signal.SIGPIPE, signal.SIG_DFL)
     parser = argparse.ArgumentParser(
         prog="jik", description="jik: a lab for repeatable Jacobian inverse kinematics"
     )
@@ -87,7 +85,16 @@ def main(argv: list[str] | None = None) -> int:
     p.set_defaults(func=bench)
 
     args = parser.parse_args(argv)
-    return args.func(args)
+    if args.func is serve or not hasattr(signal, "SIGPIPE"):
+        # The server keeps Python's handling: a client or worker that goes away is an EPIPE
+        # error where it is written to, not the end of the server.
+        return args.func(args)
+    # `jik reproduce table1 | head` ends quietly (and the caller's handling comes back after).
+    previous = signal.signal(signal.SIGPIPE, signal.SIG_DFL)
+    try:
+        return args.func(args)
+    finally:
+        signal.signal(signal.SIGPIPE, previous)
 
 
 if __name__ == "__main__":

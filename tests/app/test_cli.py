@@ -55,3 +55,28 @@ def test_unknown_reproduction_is_rejected(capsys):
     with pytest.raises(SystemExit):
         main(["reproduce", "table2"])
     assert "invalid choice" in capsys.readouterr().err
+
+
+def test_only_the_printing_commands_die_quietly_on_a_closed_pipe(monkeypatch):
+    """`jik reproduce ... | head` ends quietly; `jik serve` keeps Python's handling of SIGPIPE
+    (a worker or client that goes away must not end the server), and main() leaves the
+    caller's handling as it found it."""
+    import signal
+
+    import app.cli as cli
+
+    seen = {}
+    monkeypatch.setattr(
+        cli,
+        "reproduce",
+        lambda a: seen.setdefault("reproduce", signal.getsignal(signal.SIGPIPE)) and 0,
+    )
+    monkeypatch.setattr(
+        cli, "serve", lambda a: seen.setdefault("serve", signal.getsignal(signal.SIGPIPE)) and 0
+    )
+    before = signal.getsignal(signal.SIGPIPE)
+    cli.main(["reproduce", "table1"])
+    cli.main(["serve"])
+    assert seen["reproduce"] == signal.SIG_DFL
+    assert seen["serve"] == before != signal.SIG_DFL
+    assert signal.getsignal(signal.SIGPIPE) == before
