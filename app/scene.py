@@ -773,8 +773,8 @@ class DashboardScene:
                         }  # fmt: skip
                     self._add_fixtures(result, extent)
             else:
-                # Same robot and task: the nodes stay and take the new
-                # values (re-creating them costs the client a remount of every node).
+                # Same robot and task: the nodes stay and take the new values (re-creating them
+                # costs the client a remount of every node).
                 for m in [*self._mechanisms.values(), *([self._home] if self._home else [])]:
                     m.resize(state, extent)
                 self._place_fixtures(result, extent)
