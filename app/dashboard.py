@@ -14,6 +14,7 @@ in continuous mode only rescales the theta axis without a new integration.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import logging
@@ -470,17 +471,18 @@ class Offload:
         """The dashboard's newest generation: older offloaded runs stop at their next leg."""
         self._newest.value = generation
 
+    def _restart(self) -> None:
+        self._pool.shutdown(wait=False, cancel_futures=True)
+        self._pool = self._start()
+
     def submit(self, state, algorithm, targets, cycles, generation) -> Future:
+        job = functools.partial(_offload_run, state, algorithm, targets, cycles, generation)
         with self._lock:
             try:
-                return self._pool.submit(
-                    _offload_run, state, algorithm, targets, cycles, generation
-                )
-            except (BrokenProcessPool, RuntimeError):
-                self._pool = self._start()
-                return self._pool.submit(
-                    _offload_run, state, algorithm, targets, cycles, generation
-                )
+                return self._pool.submit(job)
+            except (BrokenProcessPool, RuntimeError):  # died, or shut down after a death
+                self._restart()
+                return self._pool.submit(job)
 
     def result(self, future: Future, fallback: Callable[[], AlgorithmRun]) -> AlgorithmRun:
         """The offloaded run (Cancelled and the engine's errors propagate); if the process
@@ -490,8 +492,7 @@ class Offload:
         except BrokenProcessPool:
             log.warning("the dashboard's second process died; restarting it")
             with self._lock:
-                self._pool.shutdown(wait=False, cancel_futures=True)
-                self._pool = self._start()
+                self._restart()
             return fallback()
 
     def close(self) -> None:
@@ -575,35 +576,32 @@ def compute(
     targets = _leg_targets(kin, state)
     cycles = state.cycles if state.task == "path" else 1
     total = 2 * cycles * len(targets)
-    done = [0]
     cache = {} if cache is None else cache
     keys = {a: _cache_key(state, a) for a in ALGORITHMS}
     todo = [a for a in ALGORITHMS if keys[a] not in cache]
-    done[0] = (len(ALGORITHMS) - len(todo)) * cycles * len(targets)
+    done = [(len(ALGORITHMS) - len(todo)) * cycles * len(targets)]  # legs, cached runs included
 
-    weight = [1]
+    # With a second process, the pseudoinverse runs there while this thread runs the extended
+    # inverse (the two are independent); each local leg then stands for two in the progress.
+    remote: Future | None = None
+    if offload is not None and len(todo) == 2:
+        remote = offload.submit(state, "pseudoinverse", targets, cycles, generation)
+    weight = 1 if remote is None else 2
 
     def step() -> None:
-        done[0] += weight[0]
+        done[0] += weight
         if progress is not None:
             progress(min(done[0] / total, 1.0))
 
     def partial(fraction: float) -> None:
         if progress is not None:
-            progress(min((done[0] + weight[0] * float(fraction)) / total, 1.0))
+            progress(min((done[0] + weight * float(fraction)) / total, 1.0))
 
-    # With a second process, the pseudoinverse runs there while this thread runs the extended
-    # inverse (the two are independent); each local leg then stands for two in the progress.
-    remote: Future | None = None
-    local = list(todo)
-    if offload is not None and len(todo) == 2:
-        remote = offload.submit(state, "pseudoinverse", targets, cycles, generation)
-        local.remove("pseudoinverse")
-        weight[0] = 2
-    for algorithm in local:
-        cache[keys[algorithm]] = algorithm_run(
-            state, algorithm, targets, cycles, step, cancelled, partial, kin
-        )
+    for algorithm in todo:
+        if remote is None or algorithm != "pseudoinverse":
+            cache[keys[algorithm]] = algorithm_run(
+                state, algorithm, targets, cycles, step, cancelled, partial, kin
+            )
     if offload is not None and remote is not None:
         cache[keys["pseudoinverse"]] = offload.result(remote, lambda: algorithm_run(
             state, "pseudoinverse", targets, cycles, cancelled=cancelled, kin=kin))  # fmt: skip
@@ -826,6 +824,12 @@ def _digest(text: str) -> str:
 
 def _json(obj) -> str:
     return json.dumps(obj, separators=(",", ":"), allow_nan=False, default=_jsonable)
+
+
+def _with_figures(message: dict, figures: Mapping[str, str]) -> str:
+    """The JSON of ``message`` with a "figures" object of already serialized figures."""
+    body = ",".join(f'"{k}":{t}' for k, t in figures.items())
+    return _json(message)[:-1] + ',"figures":{' + body + "}}"
 
 
 def _jsonable(v):
@@ -1106,12 +1110,7 @@ class Dashboard:
         }  # fmt: skip
         head["digests"] = {k: _digest(t) for k, t in texts.items()}
         head["stale"] = sorted(stale)
-        data = (
-            _json(head)[:-1]
-            + ',"figures":{'
-            + ",".join(f'"{k}":{t}' for k, t in texts.items())
-            + "}}"
-        )
+        data = _with_figures(head, texts)
         with self._cond:
             self.result, self.functionals = result, functionals
             self._changed_at = {g: t for g, t in self._changed_at.items() if g > generation}
@@ -1160,13 +1159,7 @@ class Dashboard:
         elif functionals is not None:  # h is on screen: only its title changes (no redraw)
             message["titles"] = {"augmenting": augmenting_title(result, functionals)}
         message["digests"] = {k: _digest(t) for k, t in figures.items()}
-        data = (
-            _json(message)[:-1]
-            + ',"figures":{'
-            + ",".join(f'"{k}":{t}' for k, t in figures.items())
-            + "}}"
-        )
-        self._emit(Event("functionals", generation, data))
+        self._emit(Event("functionals", generation, _with_figures(message, figures)))
 
 
 def export_json(result: DashboardResult, functionals: dict | None = None) -> dict:

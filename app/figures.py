@@ -338,14 +338,11 @@ def augmenting_figure(result: DashboardResult, functionals: dict | None = None) 
             hovertemplate="x0<extra></extra>",
         )
     )  # fmt: skip
-    title = augmenting_title(result, functionals)
-    annotations: list = []
     return _figure(
         data,
-        title,
+        augmenting_title(result, functionals),
         xaxis=dict(title=_label(ni, ju[i])),
         yaxis=dict(title=_label(nj, ju[j])),
-        annotations=annotations,
     )
 
 

@@ -335,6 +335,12 @@ def simplify(points: np.ndarray, tol: float) -> np.ndarray:
     return points[keep]
 
 
+def _trace_tolerance(extent) -> float:
+    """:data:`TRACE_TOLERANCE` of the task-plane box ``extent`` (see :func:`_extent`)."""
+    (xlo, xhi), (ylo, yhi) = extent
+    return TRACE_TOLERANCE * max(xhi - xlo, yhi - ylo)
+
+
 def _polyline(points: np.ndarray, tol: float = 0.0) -> np.ndarray:
     """(n, 3) points -> segments (m - 1, 2, 3) of the polyline simplified to within ``tol``."""
     points = simplify(points, tol) if tol > 0 and len(points) > 2 else points
@@ -348,7 +354,7 @@ def _fixtures(result, extent) -> dict[str, tuple[str, dict, dict]]:
     Manipulator 2 the carriage paths (x2, x1), which are the joint paths: closed for J^E#,
     not for J^P#; the targets of the path's legs."""
     (xlo, xhi), (ylo, yhi) = extent
-    tol = TRACE_TOLERANCE * max(xhi - xlo, yhi - ylo)
+    tol = _trace_tolerance(extent)
     robot = result.state.robot
     grey: dict = {"color": (90, 90, 90)}
     out: dict[str, tuple[str, dict, dict]] = {}
@@ -759,7 +765,7 @@ class DashboardScene:
                 scene.add_frame("/robot", show_axes=False)
                 self._mechanisms, self._fixtures, self._home = {}, {}, None
                 if timeline.unicycle:
-                    self._draw_unicycle(result, timeline)
+                    self._draw_unicycle(result, timeline, extent)
                 else:
                     cls = _MECHANISMS.get(state.robot)
                     if cls is not None:
@@ -771,12 +777,13 @@ class DashboardScene:
                                    state, extent)
                             for a in ALGORITHMS
                         }  # fmt: skip
-                    self._add_fixtures(result, extent)
+                    self._place_fixtures(result, extent)
             else:
                 # Same robot and task: the nodes stay and take the new values (re-creating them
                 # costs the client a remount of every node).
-                for m in [*self._mechanisms.values(), *([self._home] if self._home else [])]:
-                    m.resize(state, extent)
+                for m in (*self._mechanisms.values(), self._home):
+                    if m is not None:
+                        m.resize(state, extent)
                 self._place_fixtures(result, extent)
             if self._home is not None:
                 self._home.pose(np.asarray(state.x0))
@@ -818,14 +825,10 @@ class DashboardScene:
                 client.camera.position = position
                 client.camera.look_at = center
 
-    def _add_fixtures(self, result, extent) -> None:
-        """Create the rails or guide, the traces and the targets (see :func:`_fixtures`)."""
-        self._fixtures = {}
-        self._place_fixtures(result, extent)
-
     def _place_fixtures(self, result, extent) -> None:
-        """Give the fixtures on screen the values of ``result``: existing nodes are moved, a
-        target the path gained is added, one it lost is removed."""
+        """Give the fixtures (rails or guide, traces, targets; see :func:`_fixtures`) the values
+        of ``result``: existing nodes are moved, missing ones (all, after a rebuild; a target
+        the path gained) are added, ones it lost are removed."""
         scene = self.server.scene
         add: dict[str, Callable[..., Any]] = {
             "box": scene.add_box, "line": scene.add_line_segments, "ball": scene.add_icosphere
@@ -847,11 +850,10 @@ class DashboardScene:
             for key, value in values.items():
                 setattr(self._fixtures[name], key, value)
 
-    def _draw_unicycle(self, result, timeline: Timeline) -> None:
+    def _draw_unicycle(self, result, timeline: Timeline, extent) -> None:
         scene = self.server.scene
         state = result.state
-        (xlo, xhi), (ylo, yhi) = _extent(result)
-        tol = TRACE_TOLERANCE * max(xhi - xlo, yhi - ylo)
+        tol = _trace_tolerance(extent)
         target = _Platform(scene, "/robot/target", (0, 0, 0), 0.3, 0.0, state, None)
         target.pose(state.target)
         q0 = state.robot_parameters["q0"]
