@@ -85,6 +85,40 @@ def _figure(data: list, title: str, **layout) -> go.Figure:
     return go.Figure(data=data, layout={**base, **layout}, _validate=False)
 
 
+def nice_range(values, pad: float = 0.05, from_zero: bool = False) -> list[float] | None:
+    """An axis range around ``values``: padded by ``pad`` of their span, then widened to
+    multiples of a 1-2-5 step near a tenth of the span (``from_zero``: from 0, unpadded).
+
+    Nearby data give the same range, so a small change of a control leaves the figure's layout
+    unchanged and the page moves only the traces (``Plotly.animate`` in static/app.js, a third
+    of a full redraw). None when there is nothing finite to show (plotly then autoranges).
+    """
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    if not v.size:
+        return None
+    lo, hi = float(v.min()), float(v.max())
+    span = hi - lo if hi > lo else max(abs(hi), 1.0) * 0.1
+    raw = span / 10
+    step = 10.0 ** np.floor(np.log10(raw))
+    step *= next(m for m in (1, 2, 5, 10) if m * step >= raw)
+    if from_zero:  # (an axis like theta: the data start at its left edge)
+        return [0.0, round(float(np.ceil(hi / step) * step), 12)]
+    lo = float(np.floor((lo - pad * span) / step) * step)
+    return [round(lo, 12), round(float(np.ceil((hi + pad * span) / step) * step), 12)]
+
+
+def _log_range(values) -> list[float] | None:
+    """A log axis's range (decades, as plotly takes it) to the half decade around the
+    positive ``values``, with a half decade of margin: stable like :func:`nice_range`."""
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v) & (v > 0)]
+    if not v.size:
+        return None
+    lo, hi = np.log10(v.min()), np.log10(v.max())
+    return [float(np.floor(2 * lo) / 2 - 0.5), float(np.ceil(2 * hi) / 2 + 0.5)]
+
+
 def _stacked_axes(n: int, gap: float = 0.04) -> dict:
     """Layout of n y-axes stacked over one shared x-axis (instead of make_subplots)."""
     h = (1.0 - gap * (n - 1)) / n
@@ -131,12 +165,14 @@ def task_space_figure(result: DashboardResult) -> go.Figure:
             hovertemplate="start (%{x:.3f}, %{y:.3f})<extra></extra>",
         )
     )  # fmt: skip
+    points = np.vstack([result.runs[a].y[:, :2] for a in ALGORITHMS] + [tg[:, :2]])
     return _figure(
         data,
         "Task-space paths (Figs. 5, 6)",
-        xaxis=dict(title=_label(n1, tu[0])),
-        yaxis=dict(title=_label(n2, tu[1]), scaleanchor="x", scaleratio=1),
-    )
+        xaxis=dict(title=_label(n1, tu[0]), range=nice_range(points[:, 0])),
+        yaxis=dict(title=_label(n2, tu[1]), range=nice_range(points[:, 1]), scaleanchor="x",
+                   scaleratio=1),
+    )  # fmt: skip
 
 
 def joint_figure(result: DashboardResult) -> go.Figure:
@@ -156,9 +192,13 @@ def joint_figure(result: DashboardResult) -> go.Figure:
                 )
             )  # fmt: skip
     axes = _stacked_axes(len(names))
+    runs = [result.runs[a] for a in ALGORITHMS]
     for k, name in enumerate(names):
-        axes["yaxis" if k == 0 else f"yaxis{k + 1}"]["title"] = _label(name, ju[k])
+        axis = axes["yaxis" if k == 0 else f"yaxis{k + 1}"]
+        axis["title"] = _label(name, ju[k])
+        axis["range"] = nice_range(np.concatenate([r.x[:, k] for r in runs]))
     axes["xaxis"]["title"] = _theta_label(result)
+    axes["xaxis"]["range"] = nice_range(np.concatenate([r.theta for r in runs]), from_zero=True)
     title = (
         "Controls λ against the iteration (Figs. 11-14 b, c)"
         if is_unicycle(result)
@@ -194,19 +234,24 @@ def drift_figure(result: DashboardResult) -> go.Figure:
                     hovertemplate="‖k(x) − y_d‖ = %{y:.3e}<br>θ = %{x:.4g}<extra>" + a + "</extra>",
                 )
             )  # fmt: skip
+    ys = np.concatenate([np.asarray(t["y"], dtype=float) for t in data])
     if closed:
+        cycles = max(len(result.runs[a].drift) for a in ALGORITHMS)
         return _figure(
             data,
             "Repeatability: joint drift after each closed cycle",
-            xaxis=dict(title="cycle", dtick=1),
-            yaxis=dict(title="‖x(end of cycle) − x0‖ (log)", type="log", exponentformat="power"),
-        )
+            xaxis=dict(title="cycle", dtick=1, range=[0.5, cycles + 0.5]),
+            yaxis=dict(title="‖x(end of cycle) − x0‖ (log)", type="log", exponentformat="power",
+                       range=_log_range(ys)),
+        )  # fmt: skip
+    theta = np.concatenate([result.runs[a].theta for a in ALGORITHMS])
     return _figure(
         data,
         "Convergence: task error",
-        xaxis=dict(title=_theta_label(result)),
-        yaxis=dict(title="‖k(x) − y_d‖ (log)", type="log", exponentformat="power"),
-    )
+        xaxis=dict(title=_theta_label(result), range=nice_range(theta, from_zero=True)),
+        yaxis=dict(title="‖k(x) − y_d‖ (log)", type="log", exponentformat="power",
+                   range=_log_range(ys)),
+    )  # fmt: skip
 
 
 def table_figure(result: DashboardResult) -> go.Figure:

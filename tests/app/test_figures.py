@@ -22,6 +22,7 @@ from app.figures import (
     drift_figure,
     figures_for,
     joint_figure,
+    nice_range,
     sensitivity_figure,
     table_figure,
     task_space_figure,
@@ -207,3 +208,39 @@ def test_functionals_use_the_design_region_and_rank_the_synthesized_map_first(pa
     assert functionals["E2"] == pytest.approx(ref.value, rel=1e-12)
     alternatives = {m["name"]: m for m in sensitivity(path_result, functionals)["maps"]}
     assert alternatives["e2_synthesized"]["E2"] < 0.05 * alternatives["paper_cubic"]["E2"]
+
+
+def test_nice_range_pads_the_data_and_rounds_to_a_step():
+    assert nice_range([-0.41, 1.39]) == [-0.6, 1.6]  # span 1.8: padded 0.09, step 0.2
+    assert nice_range([0.0, 446.5], from_zero=True) == [0.0, 450.0]
+    assert nice_range([5.0, 5.0]) == [4.95, 5.05]  # one value: a tenth of it around
+    assert nice_range([0.0, 0.0]) == [-0.01, 0.01]
+    assert nice_range([np.nan, np.inf]) is None  # plotly autoranges
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        v = rng.normal(size=20) * 10.0 ** rng.uniform(-6, 6)
+        lo, hi = nice_range(v)
+        span = v.max() - v.min()
+        assert lo <= v.min() - 0.05 * span and hi >= v.max() + 0.05 * span
+        assert lo >= v.min() - 0.3 * span and hi <= v.max() + 0.3 * span
+
+
+def test_axis_ranges_hold_the_data_and_stay_put_for_a_small_change(path_result):
+    """The page moves traces without a redraw when the layout is unchanged (static/app.js):
+    a nearby start point keeps every range; the ranges hold every plotted point."""
+    here, nearby = (
+        compute(updated_state(path_result.state, {"x0": [x1, 0.0, np.pi / 2]}))
+        for x1 in (0.45, 0.46)
+    )  # (the browser test's step)
+    for build in (task_space_figure, joint_figure, drift_figure):
+        fig, fig2 = build(here), build(nearby)
+        assert fig.layout.to_plotly_json() == fig2.layout.to_plotly_json(), build.__name__
+        for t in fig.data:
+            for axis, values in (("x", t.x), ("y", t.y)):
+                name = f"{axis}axis" + (getattr(t, f"{axis}axis") or axis)[1:]
+                layout_axis = fig.layout[name]
+                lo, hi = layout_axis.range
+                v = np.asarray(values, dtype=float)
+                if layout_axis.type == "log":
+                    v = np.log10(v)
+                assert lo <= v.min() and v.max() <= hi, (build.__name__, name)
