@@ -8,6 +8,7 @@ const PLOT_CONFIG = { responsive: true, displaylogo: false, modeBarButtonsToRemo
 const jik = (window.jik = {
   catalogue: null, config: null, state: null, generation: 0, shownGeneration: 0,
   pending: new Map(), latencies: [], lastLatency: null, firstUpdate: null, panelDraw: {}, panelSync: {},
+  panelMoved: {},
 });
 
 const $ = (sel) => document.querySelector(sel);
@@ -256,6 +257,18 @@ function drawTable(div, fig) {
   );
 }
 
+// A figure that differs from the one on screen only in its traces' data (same layout, axis
+// ranges included: the server rounds them, app/figures.py nice_range) moves its traces with
+// Plotly.animate, without a redraw of axes, legend and titles: a third of Plotly.react's cost.
+const DATA_KEYS = ["x", "y", "customdata"];
+const MOVE = { transition: { duration: 0 }, frame: { duration: 0, redraw: false }, mode: "immediate" };
+const skeletons = {}; // panel -> the drawn figure without its data (JSON), when it can move
+function skeleton(fig) {
+  if (!fig.data.length || !fig.data.every((t) => t.type === "scatter")) return null;
+  const strip = (t) => Object.fromEntries(Object.entries(t).map(([k, v]) => [k, DATA_KEYS.includes(k) || v]));
+  return JSON.stringify([fig.layout, fig.data.map(strip)]);
+}
+
 const drawn = {}; // panel -> digest of the figure on screen
 async function drawFigures(figures, digests = {}) {
   await Promise.all(Object.entries(figures).map(([key, fig]) => {
@@ -264,12 +277,19 @@ async function drawFigures(figures, digests = {}) {
     drawn[key] = digests[key];
     const t0 = performance.now(); // until this panel's redraw resolved (panels share one thread)
     if (isTable(fig)) {
+      skeletons[key] = null;
       drawTable(div, fig);
       jik.panelSync[key] = jik.panelDraw[key] = Math.round(performance.now() - t0);
       return null;
     }
     div.classList.remove("html-table");
-    const p = Plotly.react(div, fig.data, fig.layout, PLOT_CONFIG);
+    const skel = skeleton(fig); // (before plotly fills the layout in)
+    const move = skel !== null && skeletons[key] === skel && div.data;
+    skeletons[key] = skel;
+    jik.panelMoved[key] = Boolean(move);
+    const p = move
+      ? Plotly.animate(div, { data: fig.data.map((t) => Object.fromEntries(DATA_KEYS.filter((k) => k in t).map((k) => [k, t[k]]))) }, MOVE)
+      : Plotly.react(div, fig.data, fig.layout, PLOT_CONFIG);
     jik.panelSync[key] = Math.round(performance.now() - t0); // the synchronous share
     return p.then(() => {
       jik.panelDraw[key] = Math.round(performance.now() - t0);
@@ -348,6 +368,7 @@ async function onFunctionals(msg) {
   await Promise.all(Object.entries(msg.titles || {}).map(([key, text]) => {
     const div = document.getElementById(`plot-${key}`);
     if (!div || !div.layout || (div.layout.title || {}).text === text) return null;
+    skeletons[key] = null; // (the layout on screen is no longer the figure's)
     return Plotly.relayout(div, { "title.text": text });
   }));
 }

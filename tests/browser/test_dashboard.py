@@ -206,6 +206,26 @@ def _trace(page, panel: str, index: int, axis: str) -> list[float]:
     )
 
 
+# A panel the page moved (Plotly.animate: same layout, new data) must look as a full redraw of
+# the server's figure makes it look (Plotly.react, the page's other path): the traces' SVG paths
+# and the tick labels, before and after a redraw of the latest result's figure (replayed by a new
+# event stream).
+_MOVED_AS_DRAWN = """async (key) => {
+    const source = new EventSource('/api/dashboard/events');
+    const msg = await new Promise((resolve) => source.addEventListener('result', (ev) => {
+        source.close(); resolve(JSON.parse(ev.data)); }));
+    const div = document.getElementById(`plot-${key}`);
+    const look = () => [...div.querySelectorAll('.scatterlayer path, .xtick text, .ytick text')]
+        .map((n) => n.getAttribute('d') || n.textContent);
+    const moved = look();
+    const fig = msg.figures[key];
+    await Plotly.react(div, fig.data, fig.layout, PLOT_CONFIG);
+    const drawn = look();
+    return {same: JSON.stringify(moved) === JSON.stringify(drawn), n: drawn.length,
+            generation: msg.generation};
+}"""
+
+
 def test_dashboard_follows_controls_in_chromium(served):
     from playwright.sync_api import TimeoutError as PlaywrightTimeout
     from playwright.sync_api import sync_playwright
@@ -276,6 +296,18 @@ def test_dashboard_follows_controls_in_chromium(served):
         generation = _wait_generation(page, before + 1)
         assert _get(f"{base}/api/dashboard/state")["state"]["x0"][0] == pytest.approx(0.45)
         assert _trace(page, "task", 0, "x") != task_before
+        # A nudge of the start point keeps every axis range (app/figures.py rounds them): the
+        # page moves those panels' traces instead of redrawing them, and they must look the
+        # same as a full drawing of the server's figure.
+        before = _set_slider(page, "#ctl-x0-0", 0.46)
+        latencies["start point x1, small step (manipulator 2)"] = _latency(page, before)
+        generation = _wait_generation(page, before + 1)
+        moved = [k for k, v in page.evaluate("jik.panelMoved").items() if v]
+        assert {"task", "drift"} <= set(moved), page.evaluate("jik.panelMoved")
+        for key in moved:
+            check = page.evaluate(_MOVED_AS_DRAWN, key)
+            assert check["generation"] == generation and check["n"] > 5, check
+            assert check["same"], f"the moved {key} panel differs from its full redraw"
         _scene_generation(base, generation)
         scene_after = _settled(page)
         assert scene_after != scene_before, "the 3D scene did not change with the start point"
