@@ -857,6 +857,12 @@ def summary(result: DashboardResult) -> dict:
     return out
 
 
+#: Robots whose default state the idle dashboard solves ahead (:meth:`Dashboard._prefetch`).
+#: Not the unicycle: its ~1 s would hold the CPU that a change made meanwhile needs (its
+#: switch shows progress instead).
+PREFETCH_ROBOTS = ("manipulator1", "manipulator2")
+
+
 class Dashboard:
     """The live dashboard: one state, a worker thread, and subscribers.
 
@@ -1031,12 +1037,36 @@ class Dashboard:
                 generation, state = self._generation, self._state
             try:
                 self._compute(generation, state)
+                self._prefetch(generation)
             except Exception as exc:  # keep the worker alive; the page shows the message
                 log.exception("dashboard computation failed")
                 message = f"internal error: {type(exc).__name__}: {exc}"
                 self._emit(Event("error", generation, _json(
                     {"type": "error", "generation": generation, "message": message})))  # fmt: skip
                 self._finish(generation)
+
+    def _prefetch(self, generation: int) -> None:
+        """While no change comes, solve the other robots' default states into the run cache:
+        switching robot starts from those defaults (:func:`updated_state`), so the switch then
+        only draws (Manipulator 1: ~90 ms of computation less in the browser test).
+
+        Only :data:`PREFETCH_ROBOTS`; any change cancels it between legs.
+        """
+        for robot in PREFETCH_ROBOTS:
+            state = default_state(robot)
+            if self._generation != generation or self._stopped:
+                return
+            if robot == self._state.robot or all(
+                _cache_key(state, a) in self._cache for a in ALGORITHMS
+            ):
+                continue
+            try:
+                compute(
+                    state, generation, cancelled=lambda: self._generation != generation,
+                    cache=self._cache, with_augmenting=False, offload=self._offload,
+                )  # fmt: skip
+            except (Cancelled, JikError, ValueError):
+                return
 
     def _finish(self, generation: int) -> None:
         with self._cond:

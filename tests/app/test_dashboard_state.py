@@ -10,9 +10,11 @@ import numpy as np
 import pytest
 
 from app.dashboard import (
+    ALGORITHMS,
     SECOND_PHASE_DELAY,
     Cancelled,
     Dashboard,
+    _cache_key,
     compute,
     default_state,
     export_csv,
@@ -556,3 +558,33 @@ def test_offload_process_leaves_with_a_killed_server(tmp_path):
             pytest.fail("the offload process outlived its killed server")
     finally:
         proc.kill()
+
+
+def test_an_idle_dashboard_solves_the_other_manipulator_ahead():
+    """A robot switch starts from that robot's defaults: solved while the dashboard is idle,
+    the switch reuses both runs, the same as computed on the switch."""
+    dashboard = Dashboard(updated_state(default_state("manipulator2"), {"cycles": 1}))
+    other = default_state("manipulator1")
+    assert dashboard.wait(1, 60)
+    deadline = time.monotonic() + 60
+    while not all(_cache_key(other, a) in dashboard._cache for a in ALGORITHMS):
+        assert time.monotonic() < deadline, "manipulator1 was not solved ahead"
+        time.sleep(0.05)
+    generation, _ = dashboard.update({"robot": "manipulator1"})
+    assert dashboard.wait(generation, 60)
+    result = dashboard.result
+    dashboard.stop()
+    assert result is not None and result.cached == {a: True for a in ALGORITHMS}
+    fresh = compute(other)
+    for a in ALGORITHMS:
+        np.testing.assert_array_equal(result.runs[a].x, fresh.runs[a].x)
+
+
+def test_solving_ahead_stops_for_a_change():
+    dashboard = Dashboard(updated_state(default_state("manipulator2"), {"cycles": 1}))
+    dashboard._generation = 2  # (not started) a change came after generation 1
+    dashboard._prefetch(1)
+    assert not dashboard._cache
+    dashboard._prefetch(2)  # idle at the newest generation
+    other = default_state("manipulator1")
+    assert {_cache_key(other, a) for a in ALGORITHMS} == set(dashboard._cache)
