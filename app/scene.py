@@ -34,6 +34,9 @@ from engine.exceptions import InvalidInputError
 from engine.registry import ROBOTS, robot_spec
 
 FPS = 25.0
+#: Seconds between a change of the controls' structure (robot, map, task, mode) and the new
+#: controls in the scene's panel (:meth:`DashboardScene._on_state`).
+CONTROLS_DELAY = 0.3
 #: Seconds of animation per leg (manipulators) or per shown iteration (unicycle) at speed 1.
 SECONDS_PER_LEG = 1.6
 #: Unicycle iterations shown in the animation (geometrically spaced, the last always).
@@ -695,11 +698,32 @@ class DashboardScene:
     def _on_state(self, state) -> None:
         structure = (state.robot, state.augmentation, state.task, state.mode)
         with self._lock:
-            if structure != self._structure:
-                self._structure = structure
+            if structure == self._structure:
+                if self._folders:
+                    self._sync_controls(state)
+                return
+            first = self._structure is None
+            self._structure = structure
+            if first:
                 self._rebuild_controls(state)
-            else:
-                self._sync_controls(state)
+                return
+            # Other controls: the old ones go at once, the new ones come CONTROLS_DELAY later,
+            # after the drawing of the new result in the usual case. Mounting a folder of
+            # inputs takes the client's main thread 100-150 ms (software rendering here): done
+            # with the state change, it held up the new scene by as much.
+            for folder in self._folders:
+                folder.remove()
+            self._folders, self._controls = [], {}
+        timer = threading.Timer(CONTROLS_DELAY, self._controls_for, args=(structure,))
+        timer.daemon = True
+        timer.start()
+
+    def _controls_for(self, structure: tuple) -> None:
+        with self._lock:
+            state = self.dashboard.state
+            if self._stopped or structure != self._structure or self._folders:
+                return  # a newer structure has its own timer
+            self._rebuild_controls(state)
 
     def _place_gizmo(self, state) -> None:
         if self._dragging:

@@ -368,7 +368,7 @@ def test_viser_gui_and_drag_change_the_one_state():
     import time
     from types import SimpleNamespace
 
-    from app.scene import DashboardScene, yaw_quaternion
+    from app.scene import CONTROLS_DELAY, DashboardScene, yaw_quaternion
 
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -394,6 +394,21 @@ def test_viser_gui_and_drag_change_the_one_state():
         # A change from elsewhere (the page) moves the scene's GUI.
         dashboard.update({"gamma": 0.5})
         assert scene._controls["gamma"].value == 0.5
+        # Another robot: its controls replace the old ones CONTROLS_DELAY later; of two quick
+        # switches the last one's.
+        dashboard.update({"robot": "manipulator1"})
+        assert not scene._controls and not scene._folders
+        deadline = time.monotonic() + 10
+        while "robot" not in scene._controls:
+            assert time.monotonic() < deadline, "no controls for manipulator1"
+            time.sleep(0.02)
+        assert scene._controls["robot"].value == "manipulator1"
+        assert "augmentation_parameters.a" in scene._controls
+        dashboard.update({"robot": "manipulator2"})
+        dashboard.update({"robot": "unicycle"})
+        time.sleep(CONTROLS_DELAY + 0.5)
+        assert scene._controls["robot"].value == "unicycle" and len(scene._folders) == 2
+        assert "robot_parameters.q0" in scene._controls
     finally:
         scene.stop()
         dashboard.stop()
