@@ -387,8 +387,16 @@ function connect() {
     serial(onResult)(msg);
   });
   on("functionals", serial(onFunctionals));
-  on("error", (msg) => { if (msg.generation === jik.generation) { showProgress(1, 0); setStatus(msg.message, true); } });
-  source.onerror = () => setStatus("connection lost; reconnecting…", true);
+  // The server's "error" events carry data; the connection's own error events do not (both
+  // reach the "error" listeners).
+  source.addEventListener("error", (ev) => {
+    if (ev.data === undefined) {
+      setStatus("connection lost; reconnecting…", true);
+      return;
+    }
+    const msg = JSON.parse(ev.data);
+    if (msg.generation === jik.generation) { showProgress(1, 0); setStatus(msg.message, true); }
+  });
 }
 
 async function main() {
