@@ -895,6 +895,7 @@ class Dashboard:
         self._fast = 0  # the first ``_fast`` listeners are the quick ones
         self._cache: dict = {}
         self._figures: dict[tuple[str, str], str] = {}  # (panel, key) -> figure JSON
+        self._layouts: dict[str, tuple[tuple, dict]] = {}  # panel -> (robot, task), last layout
         # key -> (E1/E2 functionals or None, their sensitivity)
         self._functionals_cache: dict[str, tuple[dict | None, dict]] = {}
         self._latest: dict[str, Event] = {
@@ -1080,6 +1081,7 @@ class Dashboard:
             augmenting_title,
             figures_for,
             gamma_free_panels,
+            keep_ranges,
             sensitivity_figure,
         )
 
@@ -1125,10 +1127,15 @@ class Dashboard:
         stale = set() if cached else {"sensitivity"}
         todo = set(PANELS) - reuse - stale
         functionals, sens = cached if cached else (None, None)
-        texts.update({
-            k: f.to_json()
-            for k, f in figures_for(result, functionals, todo, sensitivity=sens).items()
-        })  # fmt: skip
+        # Sticky axes (keep_ranges): against the layout each panel last went out with, for the
+        # same robot and task.
+        figures = figures_for(result, functionals, todo, sensitivity=sens)
+        layout_key = (state.robot, state.task)
+        for k, f in figures.items():
+            shown = self._layouts.get(k)
+            keep_ranges(f, shown[1] if shown is not None and shown[0] == layout_key else None)
+            self._layouts[k] = (layout_key, f.layout.to_plotly_json())
+            texts[k] = f.to_json()
         texts = {k: texts[k] for k in PANELS if k not in stale}
         self._figures = {(k, key): texts[k] for k in gamma_free_panels(result)}
         ready = time.perf_counter()

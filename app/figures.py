@@ -119,6 +119,47 @@ def _log_range(values) -> list[float] | None:
     return [float(np.floor(2 * lo) / 2 - 0.5), float(np.ceil(2 * hi) / 2 + 0.5)]
 
 
+#: An axis keeps its range while the data span at least this fraction of it (:func:`keep_ranges`).
+KEEP_FILL = 0.5
+
+
+def _axis_data(fig: go.Figure) -> dict[str, list]:
+    """The values plotted along each axis of ``fig`` (layout name -> sequences)."""
+    out: dict[str, list] = {}
+    for t in fig.data:
+        for axis in ("x", "y"):
+            values = getattr(t, axis, None)
+            if values is not None:
+                ref = getattr(t, f"{axis}axis", None) or axis
+                out.setdefault(f"{axis}axis{ref[1:]}", []).append(values)
+    return out
+
+
+def keep_ranges(fig: go.Figure, before: dict | None) -> go.Figure:
+    """Sticky axes: an axis of ``fig`` takes the range it had in ``before`` (the layout of the
+    panel on screen, as JSON) when the new data lie inside it and span at least
+    :data:`KEEP_FILL` of it. Dragging a slider then does not make the axes jump, and the page
+    moves the lines without redrawing the panel (static/app.js). Axes with a fixed tick step
+    (the cycles of the drift panel), without a range or with categories are left alone."""
+    if not before:
+        return fig
+    for name, arrays in _axis_data(fig).items():
+        axis, old = fig.layout[name], (before.get(name) or {}).get("range")
+        if axis.range is None or old is None or axis.dtick is not None:
+            continue
+        try:
+            v = np.concatenate([np.asarray(a, dtype=float).ravel() for a in arrays])
+        except ValueError:  # (categories: not a numeric axis)
+            continue
+        if axis.type == "log":
+            v = np.log10(v[v > 0])
+        v = v[np.isfinite(v)]
+        lo, hi = float(old[0]), float(old[1])
+        if v.size and lo <= v.min() and v.max() <= hi and np.ptp(v) >= KEEP_FILL * (hi - lo):
+            axis.range = (lo, hi)
+    return fig
+
+
 def _stacked_axes(n: int, gap: float = 0.04) -> dict:
     """Layout of n y-axes stacked over one shared x-axis (instead of make_subplots)."""
     h = (1.0 - gap * (n - 1)) / n

@@ -22,6 +22,7 @@ from app.figures import (
     drift_figure,
     figures_for,
     joint_figure,
+    keep_ranges,
     nice_range,
     sensitivity_figure,
     table_figure,
@@ -244,3 +245,28 @@ def test_axis_ranges_hold_the_data_and_stay_put_for_a_small_change(path_result):
                 if layout_axis.type == "log":
                     v = np.log10(v)
                 assert lo <= v.min() and v.max() <= hi, (build.__name__, name)
+
+
+def test_axes_keep_their_range_while_the_data_fill_it(path_result):
+    """Sticky axes (keep_ranges): the range on screen stays while the new data lie inside it
+    and span at least half of it; otherwise the new figure's own range; never on the drift
+    panel's cycle axis (a fixed tick step) or on categories."""
+    fig = task_space_figure(path_result)
+    own = fig.layout.xaxis.range
+    lo, hi = min(fig.data[0].x.min(), fig.data[2].x.min()), max(fig.data[0].x.max(), 1.0)
+    wide = {"xaxis": {"range": [lo - 0.4, hi + 0.4]}, "yaxis": {"range": [-100.0, 100.0]}}
+    kept = keep_ranges(task_space_figure(path_result), wide)
+    assert kept.layout.xaxis.range == (lo - 0.4, hi + 0.4)  # inside, filled >= half
+    assert kept.layout.yaxis.range == fig.layout.yaxis.range  # far too wide: its own
+    inside = {"xaxis": {"range": [lo + 0.1, hi]}}  # cuts the data: its own
+    assert keep_ranges(task_space_figure(path_result), inside).layout.xaxis.range == own
+    drift = drift_figure(path_result)
+    before = {"xaxis": {"range": [0.0, 3.0]}, "yaxis": {"range": [-17.0, 2.0]}}
+    kept = keep_ranges(drift_figure(path_result), before)
+    assert kept.layout.xaxis.range == drift.layout.xaxis.range  # dtick = 1: never kept
+    assert kept.layout.yaxis.range == (-17.0, 2.0)  # log axis: in decades
+    sens = sensitivity_figure(path_result, sensitivity(path_result, error_functionals(path_result)))
+    keep_ranges(sens, sens.layout.to_plotly_json())  # (the alternatives by name: no error)
+    bars = go.Figure(go.Bar(x=["a", "b"], y=[1.0, 2.0]), layout={"xaxis": {"range": [-0.5, 1.5]}})
+    assert keep_ranges(bars, {"xaxis": {"range": [-1, 2]}}).layout.xaxis.range == (-0.5, 1.5)
+    assert keep_ranges(fig, None) is fig
