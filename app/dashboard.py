@@ -324,8 +324,15 @@ def _solve_leg(inverse, x, target, state, gamma, cancelled, partial=lambda f: No
     return (*cat, h, res.success, message, res.x)
 
 
-def _run_legs(inverse, state, targets, cycles, progress, cancelled, partial) -> AlgorithmRun:
-    """Drive ``inverse`` through the legs as :func:`engine.repeatability.repeatability` does."""
+def _run_legs(
+    inverse, state, targets, cycles, progress, cancelled, partial, resume=None
+) -> AlgorithmRun:
+    """Drive ``inverse`` through the legs as :func:`engine.repeatability.repeatability` does.
+
+    ``resume``: a successful run of fewer cycles of the same legs, whose cycles are kept; the
+    legs go on from its end (the same numbers as a run from the start: a leg depends only on
+    where it starts and its target).
+    """
     t0 = time.perf_counter()
     x0 = np.asarray(state.x0)
     # Continuous mode: solve at gamma = 1 (theta = tau); the caller rescales theta by 1/gamma.
@@ -334,7 +341,13 @@ def _run_legs(inverse, state, targets, cycles, progress, cancelled, partial) -> 
     parts, ends, drift = [], [], []
     success, message, last_message = True, "completed", ""
     L = len(targets)
-    for c in range(cycles):
+    first = 0
+    if resume is not None:
+        first = len(resume.drift)
+        parts.append((resume.theta, resume.x, resume.y, resume.error, resume.h, resume.leg))
+        ends, drift = list(resume.leg_end), list(resume.drift)
+        current, offset = resume.leg_end[-1], float(resume.theta[-1])
+    for c in range(first, cycles):
         for j in range(L):
             if cancelled():
                 raise Cancelled
@@ -372,20 +385,35 @@ def _run_legs(inverse, state, targets, cycles, progress, cancelled, partial) -> 
         y=np.concatenate([p[2] for p in parts]),
         error=np.concatenate([p[3] for p in parts]),
         h=None if parts[0][4] is None else np.concatenate([p[4] for p in parts]),
-        leg=np.concatenate([np.full(len(p[0]), p[5]) for p in parts]),
+        leg=np.concatenate([np.broadcast_to(p[5], len(p[0])) for p in parts]),
         leg_end=np.asarray(ends).reshape(-1, len(x0)),
         drift=np.asarray(drift),
         success=success,
-        message=message
-        if not success
-        else last_message
-        if len(ends) == 1
-        else (
-            f"{len(ends)} legs converged"
-            + (f", drift after cycle {len(drift)}: {drift[-1]:.3g}" if drift else "")
-        ),
+        message=message if not success else _legs_message(len(ends), drift, last_message),
         seconds=time.perf_counter() - t0,
     )
+
+
+def _legs_message(legs: int, drift, last_message: str) -> str:
+    """The message of a successful run of ``legs`` legs."""
+    if legs == 1:
+        return last_message
+    return f"{legs} legs converged" + (
+        f", drift after cycle {len(drift)}: {drift[-1]:.3g}" if len(drift) else ""
+    )
+
+
+def first_cycles(run: AlgorithmRun, cycles: int, legs: int) -> AlgorithmRun:
+    """The first ``cycles`` cycles of a successful closed-path run of ``legs`` legs a cycle:
+    what a run of that many cycles gives (see :func:`_run_legs`)."""
+    keep = run.leg < cycles * legs
+    drift = run.drift[:cycles]
+    return replace(
+        run, theta=run.theta[keep], x=run.x[keep], y=run.y[keep], error=run.error[keep],
+        h=None if run.h is None else run.h[keep], leg=run.leg[keep],
+        leg_end=run.leg_end[: cycles * legs], drift=drift,
+        message=_legs_message(cycles * legs, drift, run.message), seconds=0.0,
+    )  # fmt: skip
 
 
 def algorithm_run(
@@ -397,16 +425,17 @@ def algorithm_run(
     cancelled: Callable[[], bool] = lambda: False,
     partial: Callable[[float], None] = lambda f: None,
     kin=None,
+    resume: AlgorithmRun | None = None,
 ) -> AlgorithmRun:
     """One algorithm through ``cycles`` cycles of the legs to ``targets`` (see :func:`compute`);
     for the unicycle with the platform paths q(t) of its iterates. ``kin``: the state's
-    kinematics when the caller has built it."""
+    kinematics when the caller has built it; ``resume``: see :func:`_run_legs`."""
     spec = robot_spec(state.robot)
     kin = spec.build(**state.robot_parameters) if kin is None else kin
     inverse = make_inverse(
         kin, algorithm, state.augmentation, state.augmentation_parameters, spec.name
     )
-    run = _run_legs(inverse, state, targets, cycles, progress, cancelled, partial)
+    run = _run_legs(inverse, state, targets, cycles, progress, cancelled, partial, resume)
     if hasattr(kin, "path"):
         t = np.linspace(0.0, float(cast(Unicycle, kin).T), UNICYCLE_TIME_POINTS)
         run = replace(run, platform=kin.path(run.x, t))
@@ -538,6 +567,22 @@ def runs_key(state: DashboardState) -> tuple[str, ...]:
     return tuple(_cache_key(state, a) for a in ALGORITHMS)
 
 
+def _other_cycles(cache: dict, state: DashboardState, algorithm: str, legs: int):
+    """A cached successful run of the same closed path with another number of cycles: the
+    closest with more cycles, else the longest with fewer; None if there is none."""
+    if state.task != "path" or legs < 2:
+        return None
+    found = {}
+    for c in range(1, MAX_DASHBOARD_CYCLES + 1):
+        run = cache.get(_cache_key(replace(state, cycles=c), algorithm))
+        if c != state.cycles and run is not None and run.success and run.platform is None:
+            found[c] = run
+    more = [c for c in found if c > state.cycles]
+    if more:
+        return found[min(more)]
+    return found[max(found)] if found else None
+
+
 def compute(
     state: DashboardState,
     generation: int = 0,
@@ -579,12 +624,19 @@ def compute(
     cache = {} if cache is None else cache
     keys = {a: _cache_key(state, a) for a in ALGORITHMS}
     todo = [a for a in ALGORITHMS if keys[a] not in cache]
+    # Another number of cycles of the same legs: its first cycles are this run's, or this run
+    # goes on from its end (cycles slider: only the new legs are solved).
+    other = {a: _other_cycles(cache, state, a, len(targets)) for a in todo}
+    for a in [a for a in todo if other[a] is not None and len(other[a].drift) >= cycles]:
+        cache[keys[a]] = first_cycles(other[a], cycles, len(targets))
+        todo.remove(a)
     done = [(len(ALGORITHMS) - len(todo)) * cycles * len(targets)]  # legs, cached runs included
+    done[0] += sum(len(other[a].leg_end) for a in todo if other[a] is not None)
 
     # With a second process, the pseudoinverse runs there while this thread runs the extended
     # inverse (the two are independent); each local leg then stands for two in the progress.
     remote: Future | None = None
-    if offload is not None and len(todo) == 2:
+    if offload is not None and len(todo) == 2 and not any(other[a] for a in todo):
         remote = offload.submit(state, "pseudoinverse", targets, cycles, generation)
     weight = 1 if remote is None else 2
 
@@ -600,8 +652,9 @@ def compute(
     for algorithm in todo:
         if remote is None or algorithm != "pseudoinverse":
             cache[keys[algorithm]] = algorithm_run(
-                state, algorithm, targets, cycles, step, cancelled, partial, kin
-            )
+                state, algorithm, targets, cycles, step, cancelled, partial, kin,
+                resume=other[algorithm],
+            )  # fmt: skip
     if offload is not None and remote is not None:
         cache[keys["pseudoinverse"]] = offload.result(remote, lambda: algorithm_run(
             state, "pseudoinverse", targets, cycles, cancelled=cancelled, kin=kin))  # fmt: skip

@@ -603,3 +603,30 @@ def test_solving_ahead_stops_for_a_change():
     dashboard._prefetch(2)  # idle at the newest generation
     other = default_state("manipulator1")
     assert {_cache_key(other, a) for a in ALGORITHMS} == set(dashboard._cache)
+
+
+@pytest.mark.parametrize("mode", ["continuous", "discrete"])
+def test_another_number_of_cycles_reuses_the_cycles_already_solved(mode):
+    """More cycles go on from the end of a cached run, fewer are its first cycles: the same
+    numbers as a run from the start (a leg depends only on its start and its target)."""
+    state = updated_state(default_state("manipulator2"), {"mode": mode, "gamma": 0.5})
+    cache: dict = {}
+    compute(updated_state(state, {"cycles": 3}), cache=cache)
+    legs = []
+    grown = compute(
+        updated_state(state, {"cycles": 5}), cache=cache,
+        progress=lambda f: legs.append(f),
+    )  # fmt: skip
+    shrunk = compute(updated_state(state, {"cycles": 2}), cache=cache)
+    assert shrunk.cached == {a: True for a in ALGORITHMS}
+    L = len(grown.targets)  # 3 of 5 cycles known: the progress starts after them
+    assert legs[0] == pytest.approx((2 * 3 * L + 1) / (2 * 5 * L))
+    for result, cycles in ((grown, 5), (shrunk, 2)):
+        fresh = compute(updated_state(state, {"cycles": cycles}))
+        for a in ALGORITHMS:
+            got, want = result.runs[a], fresh.runs[a]
+            for name in ("theta", "x", "y", "error", "leg", "leg_end", "drift"):
+                np.testing.assert_array_equal(getattr(got, name), getattr(want, name), name)
+            if want.h is not None:
+                np.testing.assert_array_equal(got.h, want.h)
+            assert (got.success, got.message) == (want.success, want.message)
