@@ -465,11 +465,11 @@ def _offload_ready() -> bool:
     return True  # importing this module (numpy, the engine) is the warm-up
 
 
-def _offload_run(state, algorithm, targets, cycles, generation) -> AlgorithmRun:
+def _offload_run(state, algorithm, targets, cycles, generation, resume=None) -> AlgorithmRun:
     def cancelled() -> bool:
         return _newest_generation is not None and _newest_generation.value > generation
 
-    return algorithm_run(state, algorithm, targets, cycles, cancelled=cancelled)
+    return algorithm_run(state, algorithm, targets, cycles, cancelled=cancelled, resume=resume)
 
 
 class Offload:
@@ -504,8 +504,9 @@ class Offload:
         self._pool.shutdown(wait=False, cancel_futures=True)
         self._pool = self._start()
 
-    def submit(self, state, algorithm, targets, cycles, generation) -> Future:
-        job = functools.partial(_offload_run, state, algorithm, targets, cycles, generation)
+    def submit(self, state, algorithm, targets, cycles, generation, resume=None) -> Future:
+        """Run :func:`algorithm_run` there (``resume``: see :func:`_run_legs`)."""
+        job = functools.partial(_offload_run, state, algorithm, targets, cycles, generation, resume)
         with self._lock:
             try:
                 return self._pool.submit(job)
@@ -636,8 +637,10 @@ def compute(
     # With a second process, the pseudoinverse runs there while this thread runs the extended
     # inverse (the two are independent); each local leg then stands for two in the progress.
     remote: Future | None = None
-    if offload is not None and len(todo) == 2 and not any(other[a] for a in todo):
-        remote = offload.submit(state, "pseudoinverse", targets, cycles, generation)
+    if offload is not None and len(todo) == 2:
+        remote = offload.submit(
+            state, "pseudoinverse", targets, cycles, generation, other["pseudoinverse"]
+        )
     weight = 1 if remote is None else 2
 
     def step() -> None:
@@ -657,7 +660,8 @@ def compute(
             )  # fmt: skip
     if offload is not None and remote is not None:
         cache[keys["pseudoinverse"]] = offload.result(remote, lambda: algorithm_run(
-            state, "pseudoinverse", targets, cycles, cancelled=cancelled, kin=kin))  # fmt: skip
+            state, "pseudoinverse", targets, cycles, cancelled=cancelled, kin=kin,
+            resume=other["pseudoinverse"]))  # fmt: skip
     runs: dict[str, AlgorithmRun] = {}
     for algorithm in ALGORITHMS:
         run = cache[keys[algorithm]]

@@ -511,6 +511,15 @@ def test_offloaded_computation_is_the_same_and_can_be_cancelled():
                 np.testing.assert_array_equal(here.runs[a].theta, there.runs[a].theta)
                 assert here.runs[a].message == there.runs[a].message
             assert there.cached == {"pseudoinverse": False, "extended": False}
+        # More cycles go on from the cached run, over there too.
+        cache: dict = {}
+        base = default_state("manipulator2")
+        compute(updated_state(base, {"cycles": 2}), 7, cache=cache, offload=offload)
+        grown = compute(updated_state(base, {"cycles": 4}), 7, cache=cache, offload=offload)
+        fresh = compute(updated_state(base, {"cycles": 4}))
+        for a in grown.runs:
+            np.testing.assert_array_equal(grown.runs[a].x, fresh.runs[a].x)
+            np.testing.assert_array_equal(grown.runs[a].leg, fresh.runs[a].leg)
         state = updated_state(default_state("manipulator2"), {"cycles": 5})
         offload.newest(9)
         with pytest.raises(Cancelled):
