@@ -98,14 +98,20 @@ def nice_range(values, pad: float = 0.05, from_zero: bool = False) -> list[float
     if not v.size:
         return None
     lo, hi = float(v.min()), float(v.max())
-    span = hi - lo if hi > lo else max(abs(hi), 1.0) * 0.1
+    span = hi - lo
+    if span <= 1e-9 * max(abs(lo), abs(hi)):  # constant up to rounding: a tenth around
+        span = max(abs(hi), 1.0) * 0.1
     raw = span / 10
     step = 10.0 ** np.floor(np.log10(raw))
     step *= next(m for m in (1, 2, 5, 10) if m * step >= raw)
+
+    def tidy(x: float) -> float:  # (0.30000000000000004 -> 0.3)
+        return float(f"{x:.12g}")
+
     if from_zero:  # (an axis like theta: the data start at its left edge)
-        return [0.0, round(float(np.ceil(hi / step) * step), 12)]
-    lo = float(np.floor((lo - pad * span) / step) * step)
-    return [round(lo, 12), round(float(np.ceil((hi + pad * span) / step) * step), 12)]
+        return [0.0, tidy(np.ceil(hi / step) * step)]
+    return [tidy(np.floor((lo - pad * span) / step) * step),
+            tidy(np.ceil((hi + pad * span) / step) * step)]  # fmt: skip
 
 
 def _log_range(values) -> list[float] | None:

@@ -217,6 +217,9 @@ def test_nice_range_pads_the_data_and_rounds_to_a_step():
     assert nice_range([5.0, 5.0]) == [4.95, 5.05]  # one value: a tenth of it around
     assert nice_range([0.0, 0.0]) == [-0.01, 0.01]
     assert nice_range([np.nan, np.inf]) is None  # plotly autoranges
+    assert nice_range([0.5, 0.5 + 1e-15]) == [0.49, 0.51]  # constant up to rounding
+    lo, hi = nice_range([1e-12, 3e-12])  # tiny but real spans keep their scale
+    assert lo < 1e-12 and 3e-12 < hi < 4e-12
     rng = np.random.default_rng(3)
     for _ in range(200):
         v = rng.normal(size=20) * 10.0 ** rng.uniform(-6, 6)
