@@ -869,7 +869,7 @@ def robots_catalogue() -> list[dict]:
 class Event:
     """A message to the subscribers: ``data`` is the JSON sent to the page."""
 
-    kind: str  # "state" | "progress" | "result" | "functionals" | "error"
+    kind: str  # "state" | "progress" | "result" | "functionals" | "error" | "ahead" (no data)
     generation: int
     data: str
     result: DashboardResult | None = None
@@ -1106,7 +1106,8 @@ class Dashboard:
     def _prefetch(self, generation: int) -> None:
         """While no change comes, solve the other robots' default states into the run cache:
         switching robot starts from those defaults (:func:`updated_state`), so the switch then
-        only draws (Manipulator 1: ~90 ms of computation less in the browser test).
+        only draws (Manipulator 1: ~90 ms of computation less in the browser test). Each is
+        announced by an ``ahead`` event (the scene builds its nodes, hidden).
 
         Only :data:`PREFETCH_ROBOTS`; any change cancels it between legs.
         """
@@ -1119,12 +1120,14 @@ class Dashboard:
             ):
                 continue
             try:
-                compute(
+                result = compute(
                     state, generation, cancelled=lambda: self._generation != generation,
                     cache=self._cache, with_augmenting=False, offload=self._offload,
                 )  # fmt: skip
             except (Cancelled, JikError, ValueError):
                 return
+            # For the 3D scene, which builds the robot's nodes ahead (hidden); not for the page.
+            self._emit(Event("ahead", generation, "", result))
 
     def _finish(self, generation: int) -> None:
         with self._cond:

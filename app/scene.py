@@ -350,7 +350,7 @@ def _polyline(points: np.ndarray, tol: float = 0.0) -> np.ndarray:
     return np.stack([points[:-1], points[1:]], axis=1)
 
 
-def _fixtures(result, extent) -> dict[str, tuple[str, dict, dict]]:
+def _fixtures(result, extent, root: str = "/robot") -> dict[str, tuple[str, dict, dict]]:
     """The parts of a manipulator's scene besides the mechanisms, by node name: (kind, the
     values that follow the result, the fixed style). The rails (Manipulator 2) or the guide
     (Manipulator 1) span the task-plane box; the task paths of both algorithms, and for
@@ -364,28 +364,28 @@ def _fixtures(result, extent) -> dict[str, tuple[str, dict, dict]]:
     rail = (0.06, yhi - ylo, 0.05)
     if robot == "manipulator2":
         for side, x in (("left", xlo), ("right", xhi)):
-            out[f"/robot/rails/{side}"] = (
+            out[f"{root}/rails/{side}"] = (
                 "box", {"dimensions": rail, "position": (x, (ylo + yhi) / 2, -0.02)}, grey
             )  # fmt: skip
     elif robot == "manipulator1":
-        out["/robot/guide"] = (
+        out[f"{root}/guide"] = (
             "box", {"dimensions": rail, "position": (0.0, (ylo + yhi) / 2, -0.02)}, grey
         )  # fmt: skip
     for a in ALGORITHMS:
         run = result.runs[a]
         line = {"colors": _rgb(COLORS[a]), "thickness_units": "screen"}  # pixels, see above
         task = np.column_stack([run.y[:, 0], run.y[:, 1], np.full(len(run.y), _Z[a] + 0.16)])
-        out[f"/robot/trace/{a}/task"] = (
+        out[f"{root}/trace/{a}/task"] = (
             "line", {"points": _polyline(task, tol)},
             {**line, "thickness": 3.0 if a == "pseudoinverse" else 2.0},
         )  # fmt: skip
         if robot == "manipulator2":
             joints = np.column_stack([run.x[:, 1], run.x[:, 0], np.full(len(run.x), _Z[a] + 0.1)])
-            out[f"/robot/trace/{a}/joints"] = (
+            out[f"{root}/trace/{a}/joints"] = (
                 "line", {"points": _polyline(joints, tol)}, {**line, "thickness": 1.2}
             )  # fmt: skip
     for k, target in enumerate(result.targets):
-        out[f"/robot/targets/{k}"] = (
+        out[f"{root}/targets/{k}"] = (
             "ball", {"position": (float(target[0]), float(target[1]), 0.2)},
             {"radius": 0.05, "color": (0, 0, 0)},
         )  # fmt: skip
@@ -430,6 +430,10 @@ class DashboardScene:
         self._structure: tuple | None = None
         self._layout: tuple | None = None  # (robot, task) of the nodes on screen
         self._fixtures: dict[str, Any] = {}  # handles of the nodes of _fixtures(), by name
+        self._root = "/robot"  # the frame of the nodes on screen
+        # Node sets of the manipulators' layouts drawn so far, hidden when not on screen:
+        # (robot, task) -> {"frame", "mechanisms", "home", "fixtures", "root"}.
+        self._sets: dict[tuple, dict[str, Any]] = {}
         # viser declares the setter of a GUI handle's ``value`` apart from its getter, so mypy
         # sees a read-only property; assigning it is viser's API (ignores marked "viser: settable").
         self._controls: dict[str, viser.GuiInputHandle[Any]] = {}
@@ -438,6 +442,7 @@ class DashboardScene:
         self._stopped = False
         self._build_static_gui()
         _add_floor_grid(self.server.scene)
+        self.server.scene.add_frame("/robot", show_axes=False)
         self._unsubscribe = dashboard.subscribe(self._on_event, last=True)
         self._thread = threading.Thread(target=self._animate, name="jik-scene", daemon=True)
         self._thread.start()
@@ -689,6 +694,8 @@ class DashboardScene:
                     self.status.content = f"computing… {100 * msg['fraction']:.0f}%"
             elif event.kind == "result" and event.result is not None:
                 self._draw(event.result)
+            elif event.kind == "ahead" and event.result is not None:
+                self._prebuild(event.result)
             elif event.kind == "error":
                 self.progress.visible = False
                 self.status.content = f"**error:** {json.loads(event.data)['message']}"
@@ -762,7 +769,6 @@ class DashboardScene:
 
     # -- drawing --------------------------------------------------------------------------
     def _draw(self, result) -> None:
-        scene = self.server.scene
         state = result.state
         drawn = runs_key(state)
         if drawn == self._drawn_runs:
@@ -784,31 +790,11 @@ class DashboardScene:
             self._place_gizmo(state)
             layout = (state.robot, state.task)
             if timeline.unicycle or layout != self._layout:
-                self._layout = None if timeline.unicycle else layout
-                scene.remove_by_name("/robot")
-                scene.add_frame("/robot", show_axes=False)
-                self._mechanisms, self._fixtures, self._home = {}, {}, None
-                if timeline.unicycle:
-                    self._draw_unicycle(result, timeline, extent)
-                else:
-                    cls = _MECHANISMS.get(state.robot)
-                    if cls is not None:
-                        self._home = cls(
-                            scene, "/robot/home", HOME_COLOR, 0.25, -0.03, state, extent
-                        )
-                        self._mechanisms = {
-                            a: cls(scene, f"/robot/{a}", _rgb(COLORS[a]), _OPACITY[a], _Z[a],
-                                   state, extent)
-                            for a in ALGORITHMS
-                        }  # fmt: skip
-                    self._place_fixtures(result, extent)
+                self._switch_set(None if timeline.unicycle else layout, result, timeline, extent)
             else:
                 # Same robot and task: the nodes stay and take the new values (re-creating them
                 # costs the client a remount of every node).
-                for m in (*self._mechanisms.values(), self._home):
-                    if m is not None:
-                        m.resize(state, extent)
-                self._place_fixtures(result, extent)
+                self._update_set(self._sets[layout], result, extent)
             if self._home is not None:
                 self._home.pose(np.asarray(state.x0))
             if self._framed != state.robot:
@@ -823,6 +809,74 @@ class DashboardScene:
                 generation=result.generation, robot=state.robot, playing=self.playing
             )
         self._show_status(result)
+
+    def _switch_set(self, layout: tuple | None, result, timeline: Timeline, extent) -> None:
+        """Show the node set of ``layout`` (robot, task), or the unicycle's when None, and hide
+        the others. A manipulator's set is built when first needed (or ahead, see
+        :meth:`_prebuild`) and then kept: showing it again moves its nodes, which costs the
+        client far less than mounting new ones. The unicycle's paths are drawn anew each time."""
+        scene = self.server.scene
+        if self._layout is None and self._root != "/robot":
+            scene.remove_by_name(self._root)  # the unicycle's
+        self._layout = layout
+        for key, entry in self._sets.items():
+            if key != layout:
+                entry["frame"].visible = False
+        if layout is None:
+            self._root = "/robot/unicycle"
+            scene.add_frame(self._root, show_axes=False)
+            self._mechanisms, self._fixtures, self._home = {}, {}, None
+            self._draw_unicycle(result, timeline, extent)
+            return
+        if layout not in self._sets:
+            entry = self._build_set(result, extent, visible=True)
+        else:
+            entry = self._sets[layout]
+            entry["frame"].visible = True
+            self._update_set(entry, result, extent)
+        self._root, self._fixtures = entry["root"], entry["fixtures"]
+        self._mechanisms, self._home = entry["mechanisms"], entry["home"]
+
+    def _build_set(self, result, extent, visible: bool) -> dict[str, Any]:
+        """The nodes of ``result``'s manipulator and task under their own frame."""
+        scene = self.server.scene
+        state = result.state
+        root = f"/robot/{state.robot}-{state.task}"
+        entry: dict[str, Any] = {
+            "root": root, "frame": scene.add_frame(root, show_axes=False, visible=visible),
+            "mechanisms": {}, "home": None, "fixtures": {},
+        }  # fmt: skip
+        cls = _MECHANISMS.get(state.robot)
+        if cls is not None:
+            entry["home"] = cls(scene, f"{root}/home", HOME_COLOR, 0.25, -0.03, state, extent)
+            entry["mechanisms"] = {
+                a: cls(scene, f"{root}/{a}", _rgb(COLORS[a]), _OPACITY[a], _Z[a], state, extent)
+                for a in ALGORITHMS
+            }
+        self._place_fixtures(result, extent, root, entry["fixtures"])
+        self._sets[(state.robot, state.task)] = entry
+        return entry
+
+    def _update_set(self, entry: dict[str, Any], result, extent) -> None:
+        for m in (*entry["mechanisms"].values(), entry["home"]):
+            if m is not None:
+                m.resize(result.state, extent)
+        self._place_fixtures(result, extent, entry["root"], entry["fixtures"])
+
+    def _prebuild(self, result) -> None:
+        """Build the hidden node set of a result solved ahead (the other manipulator's
+        defaults, see ``Dashboard._prefetch``): switching to it then only moves nodes."""
+        state = result.state
+        layout = (state.robot, state.task)
+        if state.robot not in _MECHANISMS or layout in self._sets:
+            return
+        with self._lock, self.server.atomic():
+            if layout not in self._sets:
+                entry = self._build_set(result, _extent(result), visible=False)
+                for a, m in entry["mechanisms"].items():
+                    m.pose(result.runs[a].x[-1])
+                if entry["home"] is not None:
+                    entry["home"].pose(np.asarray(state.x0))
 
     def _show_status(self, result) -> None:
         state = result.state
@@ -849,21 +903,22 @@ class DashboardScene:
                 client.camera.position = position
                 client.camera.look_at = center
 
-    def _place_fixtures(self, result, extent) -> None:
-        """Give the fixtures (rails or guide, traces, targets; see :func:`_fixtures`) the values
-        of ``result``: existing nodes are moved, missing ones (all, after a rebuild; a target
-        the path gained) are added, ones it lost are removed."""
+    def _place_fixtures(self, result, extent, root: str, fixtures: dict[str, Any]) -> None:
+        """Give the fixtures under ``root`` (rails or guide, traces, targets; see
+        :func:`_fixtures`; their handles in ``fixtures``) the values of ``result``: existing
+        nodes are moved, missing ones (all, in a new set; a target the path gained) are added,
+        ones it lost are removed."""
         scene = self.server.scene
         add: dict[str, Callable[..., Any]] = {
             "box": scene.add_box, "line": scene.add_line_segments, "ball": scene.add_icosphere
         }  # fmt: skip
-        wanted = _fixtures(result, extent)
-        for name in [n for n in self._fixtures if n not in wanted]:
-            self._fixtures.pop(name).remove()
+        wanted = _fixtures(result, extent, root)
+        for name in [n for n in fixtures if n not in wanted]:
+            fixtures.pop(name).remove()
         for name, (kind, values, style) in wanted.items():
-            if name not in self._fixtures:
-                self._fixtures[name] = add[kind](name, **style, **values)
-                if name.startswith("/robot/targets/"):
+            if name not in fixtures:
+                fixtures[name] = add[kind](name, **style, **values)
+                if name.startswith(f"{root}/targets/"):
                     k = int(name.rsplit("/", 1)[1])
                     scene.add_label(
                         f"{name}/label",
@@ -872,16 +927,16 @@ class DashboardScene:
                     )
                 continue
             for key, value in values.items():
-                setattr(self._fixtures[name], key, value)
+                setattr(fixtures[name], key, value)
 
     def _draw_unicycle(self, result, timeline: Timeline, extent) -> None:
         scene = self.server.scene
         state = result.state
         tol = _trace_tolerance(extent)
-        target = _Platform(scene, "/robot/target", (0, 0, 0), 0.3, 0.0, state, None)
+        target = _Platform(scene, f"{self._root}/target", (0, 0, 0), 0.3, 0.0, state, None)
         target.pose(state.target)
         q0 = state.robot_parameters["q0"]
-        home = _Platform(scene, "/robot/home", HOME_COLOR, 0.3, 0.0, state, None)
+        home = _Platform(scene, f"{self._root}/home", HOME_COLOR, 0.3, 0.0, state, None)
         home.pose(q0)
         for a in ALGORITHMS:
             run = result.runs[a]
@@ -896,14 +951,14 @@ class DashboardScene:
                 )
                 pts = np.column_stack([P[:, 0], P[:, 1], np.full(len(P), 0.02 + _Z[a] * 0.2)])
                 scene.add_line_segments(
-                    f"/robot/trace/{a}/{n}",
+                    f"{self._root}/trace/{a}/{n}",
                     _polyline(pts, tol),
                     color,
                     thickness=3.5 if last else 1.5,
                     thickness_units="screen",
                 )
             self._mechanisms[a] = _Platform(
-                scene, f"/robot/{a}", _rgb(COLORS[a]), _OPACITY[a], _Z[a] * 0.5, state, None
+                scene, f"{self._root}/{a}", _rgb(COLORS[a]), _OPACITY[a], _Z[a] * 0.5, state, None
             )
 
     def _pose(self, s: float) -> None:

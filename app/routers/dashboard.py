@@ -119,6 +119,10 @@ def _invalid(field: str, message: str) -> JSONResponse:
     )
 
 
+#: The events the page follows (the dashboard also announces results solved ahead).
+PAGE_EVENTS = ("state", "progress", "result", "functionals", "error")
+
+
 @router.get("/api/dashboard/events")
 async def events(request: Request) -> StreamingResponse:
     """Server-sent events: ``state``, ``progress``, ``result``, ``functionals``, ``error``.
@@ -147,6 +151,8 @@ async def events(request: Request) -> StreamingResponse:
                     continue
                 # A newer result makes queued progress of older generations pointless.
                 if event.kind == "progress" and event.generation < dashboard.generation:
+                    continue
+                if event.kind not in PAGE_EVENTS:  # (results solved ahead: for the scene)
                     continue
                 yield f"event: {event.kind}\nid: {event.generation}\ndata: {event.data}\n\n"
         finally:

@@ -429,6 +429,7 @@ def test_scene_follows_a_new_result_in_place():
     first = updated_state(default_state("manipulator2"), {"x0": [0.4, 0.0, 1.5]})
     dashboard = Dashboard(first)
     scene = DashboardScene(dashboard, port=port)
+    M2 = "/robot/manipulator2-path"
     try:
         assert dashboard.wait(1, timeout=60)
         second = updated_state(first, {"x0": [0.45, 0.1, 1.4], "robot_parameters": {"l": 1.3}})
@@ -440,7 +441,7 @@ def test_scene_follows_a_new_result_in_place():
         assert all(scene._mechanisms[k] is v for k, v in mechanisms.items())
         # The default start maps onto the path's last point: one target fewer, the rest stays.
         scene._draw(compute(default_state("manipulator2"), 105))
-        assert scene._fixtures.keys() == fixtures.keys() - {"/robot/targets/4"}
+        assert scene._fixtures.keys() == fixtures.keys() - {f"{M2}/targets/4"}
         assert all(scene._fixtures[k] is v for k, v in fixtures.items() if k in scene._fixtures)
         scene._draw(compute(second, 106))
         assert scene._fixtures.keys() == fixtures.keys()
@@ -449,17 +450,32 @@ def test_scene_follows_a_new_result_in_place():
         tol = TRACE_TOLERANCE * max(xhi - xlo, yhi - ylo)
         y = result.runs["extended"].y
         np.testing.assert_allclose(
-            scene._fixtures["/robot/trace/extended/task"].points[:, :, :2],
+            scene._fixtures[f"{M2}/trace/extended/task"].points[:, :, :2],
             _polyline(np.column_stack([y, np.full(len(y), 0.16)]), tol)[:, :, :2],
             rtol=1e-6,  # viser keeps float32
         )
         assert scene._mechanisms["extended"].arm.dimensions[0] == pytest.approx(1.3)
         (X, Y), _ = gizmo_pose("manipulator2", second.x0, second.robot_parameters)
         np.testing.assert_allclose(scene.gizmo.position, (X, Y, 0.3))
-        # Another robot: new nodes.
+        # Another robot: its own nodes; the first robot's are hidden, and shown again (moved,
+        # not re-created) when it comes back.
+        fixtures, mechanisms = dict(scene._fixtures), dict(scene._mechanisms)
         scene._draw(compute(default_state("manipulator1"), 104))
-        assert "/robot/guide" in scene._fixtures and "/robot/rails/left" not in scene._fixtures
-        assert scene._fixtures["/robot/targets/0"] is not fixtures["/robot/targets/0"]
+        assert set(scene._fixtures) >= {"/robot/manipulator1-path/guide"}
+        assert not any(k.startswith(M2) for k in scene._fixtures)
+        assert scene._sets[("manipulator2", "path")]["frame"].visible is False
+        scene._draw(compute(second, 107))
+        assert scene._sets[("manipulator2", "path")]["frame"].visible is True
+        assert scene._sets[("manipulator1", "path")]["frame"].visible is False
+        assert all(scene._fixtures[k] is v for k, v in fixtures.items())
+        assert all(scene._mechanisms[k] is v for k, v in mechanisms.items())
+        # A result solved ahead: its nodes are built hidden, and shown by its result.
+        other = compute(updated_state(default_state("manipulator1"), {"task": "target"}), 108)
+        scene._prebuild(other)
+        ahead = scene._sets[("manipulator1", "target")]
+        assert ahead["frame"].visible is False and ahead["mechanisms"]
+        scene._draw(other)
+        assert ahead["frame"].visible is True and scene._mechanisms is ahead["mechanisms"]
     finally:
         scene.stop()
         dashboard.stop()
