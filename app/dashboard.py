@@ -1126,6 +1126,9 @@ class Dashboard:
                 )  # fmt: skip
             except (Cancelled, JikError, ValueError):
                 return
+            except Exception:  # (work ahead: logged, never shown as the current result's error)
+                log.exception("solving %s ahead failed", robot)
+                return
             # For the 3D scene, which builds the robot's nodes ahead (hidden); not for the page.
             self._emit(Event("ahead", generation, "", result))
 
