@@ -4,7 +4,10 @@
 "use strict";
 
 const PANELS = ["task", "drift", "joints", "augmenting", "sensitivity", "table"];
-const PLOT_CONFIG = { responsive: true, displaylogo: false, modeBarButtonsToRemove: ["lasso2d", "select2d"] };
+// No plotly mode bar: it is rebuilt with every full redraw (10-20 % of the redraw in the browser
+// test); each panel has its own PNG/SVG buttons instead (panelTools), and drag-to-zoom with
+// double-click to reset work without it.
+const PLOT_CONFIG = { responsive: true, displaylogo: false, displayModeBar: false };
 const jik = (window.jik = {
   catalogue: null, config: null, state: null, generation: 0, shownGeneration: 0,
   pending: new Map(), latencies: [], lastLatency: null, firstUpdate: null, panelDraw: {}, panelSync: {},
@@ -269,6 +272,16 @@ function skeleton(fig) {
   return JSON.stringify([fig.layout, fig.data.map(strip)]);
 }
 
+// The panel's own buttons (once): save it as PNG or SVG, as plotly draws it.
+function panelTools(div, key) {
+  if (div.querySelector(":scope > .panel-tools")) return;
+  const save = (format) => el("button", {
+    type: "button", className: "tool", title: `save this panel as ${format.toUpperCase()}`,
+    onclick: () => Plotly.downloadImage(div, { format, filename: `jik-${key}`, scale: format === "png" ? 2 : 1 }),
+  }, format.toUpperCase());
+  div.append(el("div", { className: "panel-tools", title: "drag to zoom, double-click to reset" }, save("png"), save("svg")));
+}
+
 const drawn = {}; // panel -> digest of the figure on screen
 async function drawFigures(figures, digests = {}) {
   await Promise.all(Object.entries(figures).map(([key, fig]) => {
@@ -290,6 +303,7 @@ async function drawFigures(figures, digests = {}) {
     const p = move
       ? Plotly.animate(div, { data: fig.data.map((t) => Object.fromEntries(DATA_KEYS.filter((k) => k in t).map((k) => [k, t[k]]))) }, MOVE)
       : Plotly.react(div, fig.data, fig.layout, PLOT_CONFIG);
+    panelTools(div, key);
     jik.panelSync[key] = Math.round(performance.now() - t0); // the synchronous share
     return p.then(() => {
       jik.panelDraw[key] = Math.round(performance.now() - t0);

@@ -383,6 +383,12 @@ def test_dashboard_follows_controls_in_chromium(served):
         assert page.locator("#plot-table table tbody tr").count() > 1
         page.screenshot(path=str(ARTIFACTS / "dashboard-5-full.png"), full_page=True)
 
+        # A panel's own buttons save it (plotly's mode bar is off).
+        with page.expect_download(timeout=20_000) as saved:
+            page.locator("#plot-task .panel-tools button", has_text="PNG").click()
+        path = saved.value.path()
+        assert saved.value.suggested_filename == "jik-task.png"
+        assert path is not None and Path(path).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
         csv = page.evaluate("fetch('/api/dashboard/export.csv').then(r => r.text())")
         assert csv.startswith("algorithm,leg,theta,x1,x2,x3,y1,y2,error,h")
         browser.close()
