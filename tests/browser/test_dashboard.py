@@ -389,6 +389,8 @@ def test_dashboard_follows_controls_in_chromium(served):
         path = saved.value.path()
         assert saved.value.suggested_filename == "jik-task.png"
         assert path is not None and Path(path).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        # The off-screen warm-up after loading ran once and left nothing behind.
+        assert page.evaluate("jik.warmed === true && !document.querySelector('.warmup')")
         csv = page.evaluate("fetch('/api/dashboard/export.csv').then(r => r.text())")
         assert csv.startswith("algorithm,leg,theta,x1,x2,x3,y1,y2,error,h")
         browser.close()
