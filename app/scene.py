@@ -37,6 +37,9 @@ FPS = 25.0
 #: Seconds between a change of the controls' structure (robot, map, task, mode) and the new
 #: controls in the scene's panel (:meth:`DashboardScene._on_state`).
 CONTROLS_DELAY = 0.3
+#: The frame of the unicycle's nodes, drawn anew for each result (the manipulators' are kept,
+#: one frame per robot and task: :meth:`DashboardScene._switch_set`).
+UNICYCLE_ROOT = "/robot/unicycle"
 #: Seconds of animation per leg (manipulators) or per shown iteration (unicycle) at speed 1.
 SECONDS_PER_LEG = 1.6
 #: Unicycle iterations shown in the animation (geometrically spaced, the last always).
@@ -350,7 +353,7 @@ def _polyline(points: np.ndarray, tol: float = 0.0) -> np.ndarray:
     return np.stack([points[:-1], points[1:]], axis=1)
 
 
-def _fixtures(result, extent, root: str = "/robot") -> dict[str, tuple[str, dict, dict]]:
+def _fixtures(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
     """The parts of a manipulator's scene besides the mechanisms, by node name: (kind, the
     values that follow the result, the fixed style). The rails (Manipulator 2) or the guide
     (Manipulator 1) span the task-plane box; the task paths of both algorithms, and for
@@ -430,7 +433,6 @@ class DashboardScene:
         self._structure: tuple | None = None
         self._layout: tuple | None = None  # (robot, task) of the nodes on screen
         self._fixtures: dict[str, Any] = {}  # handles of the nodes of _fixtures(), by name
-        self._root = "/robot"  # the frame of the nodes on screen
         # Node sets of the manipulators' layouts drawn so far, hidden when not on screen:
         # (robot, task) -> {"frame", "mechanisms", "home", "fixtures", "root"}.
         self._sets: dict[tuple, dict[str, Any]] = {}
@@ -816,15 +818,14 @@ class DashboardScene:
         :meth:`_prebuild`) and then kept: showing it again moves its nodes, which costs the
         client far less than mounting new ones. The unicycle's paths are drawn anew each time."""
         scene = self.server.scene
-        if self._layout is None and self._root != "/robot":
-            scene.remove_by_name(self._root)  # the unicycle's
+        if self._timeline is not None and self._timeline.unicycle:  # (the drawing on screen)
+            scene.remove_by_name(UNICYCLE_ROOT)
         self._layout = layout
         for key, entry in self._sets.items():
             if key != layout:
                 entry["frame"].visible = False
         if layout is None:
-            self._root = "/robot/unicycle"
-            scene.add_frame(self._root, show_axes=False)
+            scene.add_frame(UNICYCLE_ROOT, show_axes=False)
             self._mechanisms, self._fixtures, self._home = {}, {}, None
             self._draw_unicycle(result, timeline, extent)
             return
@@ -834,8 +835,11 @@ class DashboardScene:
             entry = self._sets[layout]
             entry["frame"].visible = True
             self._update_set(entry, result, extent)
-        self._root, self._fixtures = entry["root"], entry["fixtures"]
-        self._mechanisms, self._home = entry["mechanisms"], entry["home"]
+        self._fixtures, self._mechanisms, self._home = (
+            entry["fixtures"],
+            entry["mechanisms"],
+            entry["home"],
+        )
 
     def _build_set(self, result, extent, visible: bool) -> dict[str, Any]:
         """The nodes of ``result``'s manipulator and task under their own frame."""
@@ -868,15 +872,15 @@ class DashboardScene:
         defaults, see ``Dashboard._prefetch``): switching to it then only moves nodes."""
         state = result.state
         layout = (state.robot, state.task)
-        if state.robot not in _MECHANISMS or layout in self._sets:
+        if state.robot not in _MECHANISMS:
             return
         with self._lock, self.server.atomic():
-            if layout not in self._sets:
-                entry = self._build_set(result, _extent(result), visible=False)
-                for a, m in entry["mechanisms"].items():
-                    m.pose(result.runs[a].x[-1])
-                if entry["home"] is not None:
-                    entry["home"].pose(np.asarray(state.x0))
+            if layout in self._sets:
+                return
+            entry = self._build_set(result, _extent(result), visible=False)
+            for a, m in entry["mechanisms"].items():
+                m.pose(result.runs[a].x[-1])
+            entry["home"].pose(np.asarray(state.x0))
 
     def _show_status(self, result) -> None:
         state = result.state
@@ -933,10 +937,10 @@ class DashboardScene:
         scene = self.server.scene
         state = result.state
         tol = _trace_tolerance(extent)
-        target = _Platform(scene, f"{self._root}/target", (0, 0, 0), 0.3, 0.0, state, None)
+        target = _Platform(scene, f"{UNICYCLE_ROOT}/target", (0, 0, 0), 0.3, 0.0, state, None)
         target.pose(state.target)
         q0 = state.robot_parameters["q0"]
-        home = _Platform(scene, f"{self._root}/home", HOME_COLOR, 0.3, 0.0, state, None)
+        home = _Platform(scene, f"{UNICYCLE_ROOT}/home", HOME_COLOR, 0.3, 0.0, state, None)
         home.pose(q0)
         for a in ALGORITHMS:
             run = result.runs[a]
@@ -951,14 +955,20 @@ class DashboardScene:
                 )
                 pts = np.column_stack([P[:, 0], P[:, 1], np.full(len(P), 0.02 + _Z[a] * 0.2)])
                 scene.add_line_segments(
-                    f"{self._root}/trace/{a}/{n}",
+                    f"{UNICYCLE_ROOT}/trace/{a}/{n}",
                     _polyline(pts, tol),
                     color,
                     thickness=3.5 if last else 1.5,
                     thickness_units="screen",
                 )
             self._mechanisms[a] = _Platform(
-                scene, f"{self._root}/{a}", _rgb(COLORS[a]), _OPACITY[a], _Z[a] * 0.5, state, None
+                scene,
+                f"{UNICYCLE_ROOT}/{a}",
+                _rgb(COLORS[a]),
+                _OPACITY[a],
+                _Z[a] * 0.5,
+                state,
+                None,
             )
 
     def _pose(self, s: float) -> None:
