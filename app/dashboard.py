@@ -1140,12 +1140,11 @@ class Dashboard:
     def _compute(self, generation: int, state: DashboardState) -> None:
         from app.figures import (
             PANELS,
-            augmenting_figure,
             augmenting_title,
-            figures_for,
+            figure_json,
+            figure_specs,
             gamma_free_panels,
             keep_ranges,
-            sensitivity_figure,
         )
 
         started = self._changed_at.get(generation, time.perf_counter())
@@ -1192,13 +1191,13 @@ class Dashboard:
         functionals, sens = cached if cached else (None, None)
         # Sticky axes (keep_ranges): against the layout each panel last went out with, for the
         # same robot and task.
-        figures = figures_for(result, functionals, todo, sensitivity=sens)
+        figures = figure_specs(result, functionals, todo, sensitivity=sens)
         layout_key = (state.robot, state.task)
         for k, f in figures.items():
             shown = self._layouts.get(k)
             keep_ranges(f, shown[1] if shown is not None and shown[0] == layout_key else None)
-            self._layouts[k] = (layout_key, f.layout.to_plotly_json())
-            texts[k] = f.to_json()
+            self._layouts[k] = (layout_key, f["layout"])
+            texts[k] = figure_json(f)
         texts = {k: texts[k] for k in PANELS if k not in stale}
         self._figures = {(k, key): texts[k] for k in gamma_free_panels(result)}
         ready = time.perf_counter()
@@ -1253,13 +1252,15 @@ class Dashboard:
                    "sensitivity": sens}  # fmt: skip
         with self._cond:
             self.functionals = functionals
-        figures = {} if known else {"sensitivity": sensitivity_figure(result, sens).to_json()}
+        panels = set() if known else {"sensitivity"}
         if deferred:  # the h panel was a placeholder: the whole figure
-            figures["augmenting"] = augmenting_figure(result, functionals).to_json()
+            panels.add("augmenting")
         elif functionals is not None:  # h is on screen: only its title changes (no redraw)
             message["titles"] = {"augmenting": augmenting_title(result, functionals)}
-        message["digests"] = {k: _digest(t) for k, t in figures.items()}
-        self._emit(Event("functionals", generation, _with_figures(message, figures)))
+        specs = figure_specs(result, functionals, panels, sensitivity=sens)
+        redrawn = {k: figure_json(f) for k, f in specs.items()}
+        message["digests"] = {k: _digest(t) for k, t in redrawn.items()}
+        self._emit(Event("functionals", generation, _with_figures(message, redrawn)))
 
 
 def export_json(result: DashboardResult, functionals: dict | None = None) -> dict:

@@ -1,5 +1,9 @@
 """Plotly figures of a dashboard result: pure functions ``DashboardResult -> go.Figure``.
 
+Each figure is built as a plain figure dict first (its "spec"): the dashboard serializes those
+directly (:func:`figure_specs`, :func:`figure_json`), 5x faster than through ``go.Figure``
+and ``to_json``, on every change of a control.
+
 Colours are fixed per algorithm (:data:`app.dashboard.COLORS`), the same as in the 3D scene.
 The figures follow the paper: task-space paths (Figs. 5, 6), joint trajectories against theta
 (Figs. 7-9), the repeatability drift per cycle with the Table 1 numbers, and for the unicycle the
@@ -7,6 +11,10 @@ platform paths in the (q1, q2) plane and the controls against the iteration (Fig
 """
 
 from __future__ import annotations
+
+import base64
+import json
+import math
 
 import numpy as np
 import plotly.graph_objects as go
@@ -30,7 +38,7 @@ _AXIS = dict(
     ticklabeloverflow="allow",
 )  # fmt: skip
 # A small explicit template: the named ones ("plotly_white") cost ~25 ms per figure to apply.
-_TEMPLATE = go.layout.Template(
+_TEMPLATE = dict(
     layout=dict(paper_bgcolor="white", plot_bgcolor="white", xaxis=_AXIS, yaxis=_AXIS,
                 colorway=["#d62728", "#1f77b4", "#2ca02c", "#9467bd"])
 )  # fmt: skip
@@ -81,14 +89,59 @@ def _trace(kind: str, **props) -> dict:
 _NO_LEGEND = dict(showlegend=False, margin=dict(l=64, r=20, t=48, b=48))
 
 
-def _figure(data: list, title: str, **layout) -> go.Figure:
-    """One-shot construction without plotly's property validation (~2.5x faster: the server
-    builds every panel on each change); tests/app/test_figures.py validates every figure."""
+def _figure(data: list, title: str, **layout) -> dict:
+    """A figure dict (a spec) with the panels' common layout, not validated by plotly (the
+    server builds every panel on each change); tests/app/test_figures.py validates every one."""
     base = {**_LAYOUT, "title": dict(text=title, font=dict(size=13), x=0.01, xanchor="left")}
     for key, axis in layout.items():  # an axis title given as text (validation did this)
         if key.startswith(("xaxis", "yaxis")) and isinstance(axis.get("title"), str):
             layout[key] = {**axis, "title": {"text": axis["title"]}}
-    return go.Figure(data=data, layout={**base, **layout}, _validate=False)
+    return {"data": data, "layout": {**base, **layout}}
+
+
+def _go(spec: dict) -> go.Figure:
+    return go.Figure(data=spec["data"], layout=spec["layout"], _validate=False)
+
+
+#: numpy dtypes plotly.js takes as typed arrays (base64), by their plotly.js names.
+_TYPED = {"float64": "f8", "float32": "f4", "int32": "i4", "uint32": "u4", "int16": "i2",
+          "uint16": "u2", "int8": "i1", "uint8": "u1"}  # fmt: skip
+
+
+def _typed_array(v: np.ndarray):
+    """``v`` as plotly.js's typed-array spec (base64 of the bytes, as plotly.py >= 6 sends it);
+    64-bit integers narrowed to 32 bits, anything else as a list."""
+    if v.dtype.kind in "iu" and v.size and v.dtype.itemsize == 8:
+        if np.iinfo(np.int32).min <= v.min() and v.max() <= np.iinfo(np.int32).max:
+            v = v.astype(np.int32)
+    name = _TYPED.get(str(v.dtype))
+    if name is None or not v.size:
+        return _plain(v.tolist())
+    out = {"dtype": name, "bdata": base64.b64encode(v.tobytes()).decode("ascii")}
+    if v.ndim > 1:
+        out["shape"] = ", ".join(str(n) for n in v.shape)
+    return out
+
+
+def _plain(v):
+    """``v`` with numpy values made JSON's (arrays typed) and non-finite numbers null."""
+    if isinstance(v, dict):
+        return {k: _plain(x) for k, x in v.items()}
+    if isinstance(v, list | tuple):
+        return [_plain(x) for x in v]
+    if isinstance(v, np.ndarray):
+        return _typed_array(v)
+    if isinstance(v, float | np.floating):
+        return float(v) if math.isfinite(v) else None
+    if isinstance(v, np.integer | np.bool_):
+        return v.item()
+    return v
+
+
+def figure_json(spec: dict) -> str:
+    """The JSON plotly.js reads for a figure dict (what ``go.Figure(spec).to_json()`` gives,
+    about 5x faster: no property objects, no deep copies)."""
+    return json.dumps(_plain(spec), separators=(",", ":"), allow_nan=False)
 
 
 def nice_range(values, pad: float = 0.05, from_zero: bool = False) -> list[float] | None:
@@ -135,41 +188,42 @@ def _log_range(values) -> list[float] | None:
 KEEP_FILL = 0.5
 
 
-def _axis_data(fig: go.Figure) -> dict[str, list]:
-    """The values plotted along each axis of ``fig`` (layout name -> sequences)."""
+def _axis_data(spec: dict) -> dict[str, list]:
+    """The values plotted along each axis of a figure dict (layout name -> sequences)."""
     out: dict[str, list] = {}
-    for t in fig.data:
+    for t in spec["data"]:
         for axis in ("x", "y"):
-            values = getattr(t, axis, None)
+            values = t.get(axis)
             if values is not None:
-                ref = getattr(t, f"{axis}axis", None) or axis
+                ref = t.get(f"{axis}axis") or axis
                 out.setdefault(f"{axis}axis{ref[1:]}", []).append(values)
     return out
 
 
-def keep_ranges(fig: go.Figure, before: dict | None) -> go.Figure:
-    """Sticky axes: an axis of ``fig`` takes the range it had in ``before`` (the layout of the
-    panel on screen, as JSON) when the new data lie inside it and span at least
+def keep_ranges(spec: dict, before: dict | None) -> dict:
+    """Sticky axes: an axis of the figure dict ``spec`` takes the range it had in ``before``
+    (the layout of the panel on screen) when the new data lie inside it and span at least
     :data:`KEEP_FILL` of it. Dragging a slider then does not make the axes jump, and the page
     moves the lines without redrawing the panel (static/app.js). Axes with a fixed tick step
     (the cycles of the drift panel), without a range or with categories are left alone."""
     if not before:
-        return fig
-    for name, arrays in _axis_data(fig).items():
-        axis, old = fig.layout[name], (before.get(name) or {}).get("range")
-        if axis.range is None or old is None or axis.dtick is not None:
+        return spec
+    layout = spec["layout"]
+    for name, arrays in _axis_data(spec).items():
+        axis, old = layout.get(name) or {}, (before.get(name) or {}).get("range")
+        if axis.get("range") is None or old is None or axis.get("dtick") is not None:
             continue
         try:
             v = np.concatenate([np.asarray(a, dtype=float).ravel() for a in arrays])
         except ValueError:  # (categories: not a numeric axis)
             continue
-        if axis.type == "log":
+        if axis.get("type") == "log":
             v = np.log10(v[v > 0])
         v = v[np.isfinite(v)]
         lo, hi = float(old[0]), float(old[1])
         if v.size and lo <= v.min() and v.max() <= hi and np.ptp(v) >= KEEP_FILL * (hi - lo):
-            axis.range = (lo, hi)
-    return fig
+            layout[name] = {**axis, "range": [lo, hi]}
+    return spec
 
 
 def _stacked_axes(n: int, gap: float = 0.04) -> dict:
@@ -184,7 +238,7 @@ def _stacked_axes(n: int, gap: float = 0.04) -> dict:
     return out
 
 
-def task_space_figure(result: DashboardResult) -> go.Figure:
+def _task_space(result: DashboardResult) -> dict:
     """End-effector paths of both algorithms in the task plane (paper, Figs. 5 and 6)."""
     _, tu = _units(result)
     n1, n2 = result.task_names[:2]
@@ -230,7 +284,7 @@ def task_space_figure(result: DashboardResult) -> go.Figure:
     )  # fmt: skip
 
 
-def joint_figure(result: DashboardResult) -> go.Figure:
+def _joints(result: DashboardResult) -> dict:
     """Every joint variable against theta for both algorithms (Figs. 7-9; Figs. 11-14 b, c)."""
     ju, _ = _units(result)
     names = result.variable_names
@@ -262,7 +316,7 @@ def joint_figure(result: DashboardResult) -> go.Figure:
     return _figure(data, title, height=120 * len(names) + 100, **_NO_LEGEND, **axes)
 
 
-def drift_figure(result: DashboardResult) -> go.Figure:
+def _drift(result: DashboardResult) -> dict:
     """Repeatability drift ||x(end of cycle c) - x0|| per cycle, log scale (Table 1's point).
 
     For a single-target task (and the unicycle) the task error against theta is shown instead.
@@ -310,7 +364,7 @@ def drift_figure(result: DashboardResult) -> go.Figure:
     )  # fmt: skip
 
 
-def table_figure(result: DashboardResult) -> go.Figure:
+def _table(result: DashboardResult) -> dict:
     """The configuration after every leg for both algorithms, as in Table 1 of the paper."""
     names = result.variable_names
     L = len(result.targets)
@@ -328,9 +382,11 @@ def table_figure(result: DashboardResult) -> go.Figure:
             cols.append([f"{v:.4f}" for v in ends[:, k]] + [""] * (rows + 1 - len(ends)))
     fills = ["#f4f4f4"] + ["#fbe3e3" if h.startswith("J^P#") else "#e1ecf7" for h in header[1:]]
     table = _trace("table",
-        header=dict(values=header, fill_color=fills, font=dict(size=11), align="center"),
+        # (fill=dict(color=...): plotly.py's "fill_color" shorthand is expanded only by its
+        # validation, which the builders skip; the page reads fill.color)
+        header=dict(values=header, fill=dict(color=fills), font=dict(size=11), align="center"),
         cells=dict(values=cols, font=dict(size=11, family="monospace"), align="right",
-                   fill_color=[["white", "#f7f7f7"] * (rows + 1)]),
+                   fill=dict(color=[["white", "#f7f7f7"] * (rows + 1)])),
     )  # fmt: skip
     return _figure(
         [table], "Configurations after each leg (Table 1)", margin=dict(l=10, r=10, t=40, b=10)
@@ -341,7 +397,7 @@ def _fmt_point(p) -> str:
     return "(" + ", ".join(f"{v:.3g}" for v in p) + ")"
 
 
-def platform_figure(result: DashboardResult, max_paths: int = 12) -> go.Figure:
+def _platform(result: DashboardResult, max_paths: int = 12) -> dict:
     """Unicycle platform paths q(t) in the (q1, q2) plane, per iteration (Figs. 11-14 a)."""
     _, tu = _units(result)
     data = []
@@ -392,7 +448,7 @@ def platform_figure(result: DashboardResult, max_paths: int = 12) -> go.Figure:
     )
 
 
-def augmenting_figure(result: DashboardResult, functionals: dict | None = None) -> go.Figure:
+def _augmenting(result: DashboardResult, functionals: dict | None = None) -> dict:
     """Contours of the augmenting map h over two joint variables with both trajectories on top.
 
     The extended Jacobian keeps h constant (eq. (12)), so its trajectory follows a level curve;
@@ -483,7 +539,7 @@ def augmenting_title(result: DashboardResult, functionals: dict | None = None) -
 E_COLORS = {"E1": "#2ca02c", "E2": "#9467bd"}
 
 
-def sensitivity_figure(result: DashboardResult, sens: dict | None = None) -> go.Figure:
+def _sensitivity(result: DashboardResult, sens: dict | None = None) -> dict:
     """E1 (13) and E2 (18) of the current map and how they change (issue 5).
 
     With parameters: each functional against each parameter (swept around its current value,
@@ -569,6 +625,25 @@ def gamma_free_panels(result: DashboardResult) -> set[str]:
     return panels | ({"drift"} if result.state.task == "path" else set())
 
 
+def figure_specs(
+    result: DashboardResult,
+    functionals: dict | None = None,
+    only: set[str] | None = None,
+    sensitivity: dict | None = None,
+) -> dict[str, dict]:
+    """The panels of the dashboard for ``result`` (all, or those in ``only``) as figure dicts,
+    keyed by id: what the dashboard serializes with :func:`figure_json`."""
+    builders = {
+        "task": _platform if is_unicycle(result) else _task_space,
+        "joints": _joints,
+        "drift": _drift,
+        "table": _table,
+        "augmenting": lambda r: _augmenting(r, functionals),
+        "sensitivity": lambda r: _sensitivity(r, sensitivity),
+    }
+    return {k: f(result) for k, f in builders.items() if only is None or k in only}
+
+
 def figures_for(
     result: DashboardResult,
     functionals: dict | None = None,
@@ -576,12 +651,44 @@ def figures_for(
     sensitivity: dict | None = None,
 ) -> dict[str, go.Figure]:
     """The panels of the dashboard for ``result`` (all, or those in ``only``), keyed by id."""
-    builders = {
-        "task": platform_figure if is_unicycle(result) else task_space_figure,
-        "joints": joint_figure,
-        "drift": drift_figure,
-        "table": table_figure,
-        "augmenting": lambda r: augmenting_figure(r, functionals),
-        "sensitivity": lambda r: sensitivity_figure(r, sensitivity),
-    }
-    return {k: f(result) for k, f in builders.items() if only is None or k in only}
+    return {k: _go(v) for k, v in figure_specs(result, functionals, only, sensitivity).items()}
+
+
+# The figures as plotly objects, for notebooks and tests.
+
+
+def task_space_figure(result: DashboardResult) -> go.Figure:
+    """End-effector paths of both algorithms in the task plane (paper, Figs. 5 and 6)."""
+    return _go(_task_space(result))
+
+
+def joint_figure(result: DashboardResult) -> go.Figure:
+    """Every joint variable against theta for both algorithms (Figs. 7-9; Figs. 11-14 b, c)."""
+    return _go(_joints(result))
+
+
+def drift_figure(result: DashboardResult) -> go.Figure:
+    """Repeatability drift per closed cycle, log scale (Table 1), or the task error against
+    theta for a single target."""
+    return _go(_drift(result))
+
+
+def table_figure(result: DashboardResult) -> go.Figure:
+    """The configuration after every leg for both algorithms, as in Table 1 of the paper."""
+    return _go(_table(result))
+
+
+def platform_figure(result: DashboardResult, max_paths: int = 12) -> go.Figure:
+    """Unicycle platform paths q(t) in the (q1, q2) plane, per iteration (Figs. 11-14 a)."""
+    return _go(_platform(result, max_paths))
+
+
+def augmenting_figure(result: DashboardResult, functionals: dict | None = None) -> go.Figure:
+    """Contours of h over two joint variables with both trajectories on top; E1 (13) and
+    E2 (18) in the title."""
+    return _go(_augmenting(result, functionals))
+
+
+def sensitivity_figure(result: DashboardResult, sens: dict | None = None) -> go.Figure:
+    """E1 (13) and E2 (18) of the current map and how they change with its parameters."""
+    return _go(_sensitivity(result, sens))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import base64
 import json
 
 import numpy as np
@@ -20,6 +21,8 @@ from app.dashboard import (
 from app.figures import (
     augmenting_figure,
     drift_figure,
+    figure_json,
+    figure_specs,
     figures_for,
     joint_figure,
     keep_ranges,
@@ -130,6 +133,59 @@ def test_every_panel_serialises_to_plotly_json(path_result, target_result):
             # valid (go.Figure validates a plain dict and raises on an unknown property).
             go.Figure(parsed)
         go.Figure(augmenting_figure(result, error_functionals(result)).to_dict())
+
+
+_DTYPES = {"f8": "<f8", "f4": "<f4", "i4": "<i4", "u4": "<u4", "i2": "<i2", "u2": "<u2",
+           "i1": "i1", "u1": "u1"}  # fmt: skip
+
+
+def _decoded(v):
+    """JSON from plotly with its typed arrays (base64) read back as float arrays."""
+    if isinstance(v, dict) and "bdata" in v:
+        a = np.frombuffer(base64.b64decode(v["bdata"]), dtype=_DTYPES[v["dtype"]])
+        shape = tuple(int(n) for n in v["shape"].split(",")) if "shape" in v else a.shape
+        return a.reshape(shape).astype(float)
+    if isinstance(v, dict):
+        return {k: _decoded(x) for k, x in v.items()}
+    if isinstance(v, list):
+        return [_decoded(x) for x in v]
+    return v
+
+
+def _same(a, b, where="") -> None:
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        assert np.array_equal(np.asarray(a, float), np.asarray(b, float), equal_nan=True), where
+    elif isinstance(a, dict):
+        assert isinstance(b, dict) and set(a) == set(b), (where, set(a) ^ set(b))
+        for k in a:
+            _same(a[k], b[k], f"{where}.{k}")
+    elif isinstance(a, list):
+        assert isinstance(b, list) and len(a) == len(b), where
+        for i, (x, y) in enumerate(zip(a, b, strict=True)):
+            _same(x, y, f"{where}[{i}]")
+    else:
+        assert a == b, (where, a, b)
+
+
+def test_the_dashboards_json_is_plotlys(path_result, target_result):
+    """The dashboard serializes figure dicts itself (figure_json, 5x faster than plotly's
+    to_json): the page must get what plotly.py would send, typed arrays included."""
+    for result in (path_result, target_result):
+        functionals = error_functionals(result)
+        sens = sensitivity(result, functionals)
+        for key, spec in figure_specs(result, functionals, sensitivity=sens).items():
+            ours = json.loads(figure_json(spec))
+            theirs = json.loads(go.Figure(spec).to_json())  # (validated, too)
+            _same(_decoded(ours), _decoded(theirs), key)
+    # numpy scalars, non-finite numbers (null) and 2-D arrays (with their shape)
+    spec = {"data": [{"type": "heatmap", "z": np.array([[1.0, np.nan], [2.0, 3.0]]),
+                      "x": [np.float64(0.5), float("inf")], "y": np.arange(2)}],
+            "layout": {"title": {"text": "t"}}}  # fmt: skip
+    ours = json.loads(figure_json(spec))
+    assert ours["data"][0]["x"] == [0.5, None]
+    assert ours["data"][0]["z"]["shape"] == "2, 2" and ours["data"][0]["y"]["dtype"] == "i4"
+    plotlys = go.Figure(data=spec["data"], layout=spec["layout"], _validate=False).to_json()
+    _same(_decoded(ours)["data"], _decoded(json.loads(plotlys))["data"])  # (no template here)
 
 
 @pytest.mark.skipif("unicycle" not in ROBOTS, reason="the unicycle is not in the registry yet")
@@ -254,22 +310,29 @@ def test_axes_keep_their_range_while_the_data_fill_it(path_result):
     """Sticky axes (keep_ranges): the range on screen stays while the new data lie inside it
     and span at least half of it; otherwise the new figure's own range; never on the drift
     panel's cycle axis (a fixed tick step) or on categories."""
-    fig = task_space_figure(path_result)
-    own = fig.layout.xaxis.range
-    lo, hi = min(fig.data[0].x.min(), fig.data[2].x.min()), max(fig.data[0].x.max(), 1.0)
+
+    def spec(key: str, **kw) -> dict:
+        return figure_specs(path_result, only={key}, **kw)[key]
+
+    fig = spec("task")
+    own = fig["layout"]["xaxis"]["range"]
+    x = fig["data"]
+    lo, hi = min(x[0]["x"].min(), x[2]["x"].min()), max(x[0]["x"].max(), 1.0)
     wide = {"xaxis": {"range": [lo - 0.4, hi + 0.4]}, "yaxis": {"range": [-100.0, 100.0]}}
-    kept = keep_ranges(task_space_figure(path_result), wide)
-    assert kept.layout.xaxis.range == (lo - 0.4, hi + 0.4)  # inside, filled >= half
-    assert kept.layout.yaxis.range == fig.layout.yaxis.range  # far too wide: its own
+    kept = keep_ranges(spec("task"), wide)["layout"]
+    assert kept["xaxis"]["range"] == [lo - 0.4, hi + 0.4]  # inside, filled >= half
+    assert kept["yaxis"]["range"] == fig["layout"]["yaxis"]["range"]  # far too wide: its own
     inside = {"xaxis": {"range": [lo + 0.1, hi]}}  # cuts the data: its own
-    assert keep_ranges(task_space_figure(path_result), inside).layout.xaxis.range == own
-    drift = drift_figure(path_result)
+    assert keep_ranges(spec("task"), inside)["layout"]["xaxis"]["range"] == own
+    drift = spec("drift")["layout"]
     before = {"xaxis": {"range": [0.0, 3.0]}, "yaxis": {"range": [-17.0, 2.0]}}
-    kept = keep_ranges(drift_figure(path_result), before)
-    assert kept.layout.xaxis.range == drift.layout.xaxis.range  # dtick = 1: never kept
-    assert kept.layout.yaxis.range == (-17.0, 2.0)  # log axis: in decades
-    sens = sensitivity_figure(path_result, sensitivity(path_result, error_functionals(path_result)))
-    keep_ranges(sens, sens.layout.to_plotly_json())  # (the alternatives by name: no error)
-    bars = go.Figure(go.Bar(x=["a", "b"], y=[1.0, 2.0]), layout={"xaxis": {"range": [-0.5, 1.5]}})
-    assert keep_ranges(bars, {"xaxis": {"range": [-1, 2]}}).layout.xaxis.range == (-0.5, 1.5)
+    kept = keep_ranges(spec("drift"), before)["layout"]
+    assert kept["xaxis"]["range"] == drift["xaxis"]["range"]  # dtick = 1: never kept
+    assert kept["yaxis"]["range"] == [-17.0, 2.0]  # log axis: in decades
+    sens = spec("sensitivity", sensitivity=sensitivity(path_result, error_functionals(path_result)))
+    keep_ranges(sens, sens["layout"])  # (the alternatives by name: no error)
+    bars = {"data": [{"type": "bar", "x": ["a", "b"], "y": [1.0, 2.0]}],
+            "layout": {"xaxis": {"range": [-0.5, 1.5]}}}  # fmt: skip
+    assert keep_ranges(bars, {"xaxis": {"range": [-1, 2]}})["layout"]["xaxis"]["range"] == [
+        -0.5, 1.5]  # fmt: skip
     assert keep_ranges(fig, None) is fig
