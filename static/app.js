@@ -260,16 +260,39 @@ function drawTable(div, fig) {
   );
 }
 
-// A figure that differs from the one on screen only in its traces' data (same layout, axis
-// ranges included: the server rounds them, app/figures.py nice_range) moves its traces with
-// Plotly.animate, without a redraw of axes, legend and titles: a third of Plotly.react's cost.
+// A figure that differs from the one on screen only in its traces' data and its axis ranges
+// (same titles, same trace styles) moves its traces with Plotly.animate: the axes take their
+// new ranges and ticks, without a redraw of titles, margins and the rest; a third of
+// Plotly.react's cost. The server rounds the ranges (app/figures.py nice_range) and keeps them
+// while the data fill them (keep_ranges), so that most changes do not even touch the axes.
 const DATA_KEYS = ["x", "y", "customdata"];
 const MOVE = { transition: { duration: 0 }, frame: { duration: 0, redraw: false }, mode: "immediate" };
-const skeletons = {}; // panel -> the drawn figure without its data (JSON), when it can move
+const skeletons = {}; // panel -> the drawn figure without its data and ranges (JSON), when it can move
+const isAxis = (k) => /^[xy]axis[0-9]*$/.test(k);
 function skeleton(fig) {
   if (!fig.data.length || !fig.data.every((t) => t.type === "scatter")) return null;
+  // Axes tied to another one's scale (scaleanchor) are constrained by a full drawing only:
+  // such a panel moves only with the same ranges.
+  const tied = Object.entries(fig.layout).some(([k, a]) => isAxis(k) && a.scaleanchor);
   const strip = (t) => Object.fromEntries(Object.entries(t).map(([k, v]) => [k, DATA_KEYS.includes(k) || v]));
-  return JSON.stringify([fig.layout, fig.data.map(strip)]);
+  const layout = tied ? fig.layout : Object.fromEntries(Object.entries(fig.layout).map(
+    ([k, v]) => [k, isAxis(k) && v.range ? { ...v, range: true } : v]));
+  return JSON.stringify([layout, fig.data.map(strip)]);
+}
+const ranges = (layout) => JSON.stringify(Object.keys(layout).filter(isAxis).sort()
+  .map((k) => [k, (layout[k] || {}).range || null]));
+const asked = {}; // panel -> the axis ranges of the figure last drawn in it (JSON)
+// The traces' data, and the axis ranges when they changed: not when the user zoomed the
+// panel (its ranges on screen are not the ones drawn); then null, and Plotly.react keeps the
+// user's view (uirevision).
+function moveFrame(div, key, fig) {
+  const data = fig.data.map((t) => Object.fromEntries(DATA_KEYS.filter((k) => k in t).map((k) => [k, t[k]])));
+  const want = ranges(fig.layout);
+  if (want === asked[key]) return { data };
+  if (ranges(div.layout) !== asked[key]) return null;
+  const layout = {};
+  for (const [k, a] of Object.entries(fig.layout)) if (isAxis(k) && a.range) layout[k] = { range: a.range };
+  return { data, layout };
 }
 
 // The panel's own buttons (once): save it as PNG or SVG, as plotly draws it.
@@ -284,6 +307,7 @@ function panelTools(div, key) {
 
 const drawn = {}; // panel -> digest of the figure on screen
 async function drawFigures(figures, digests = {}) {
+  jik.drawnNow = {}; // panel -> "moved" or "drawn" with its ms, this call's (for the latency)
   await Promise.all(Object.entries(figures).map(([key, fig]) => {
     const div = document.getElementById(`plot-${key}`);
     if (!div || (digests[key] && drawn[key] === digests[key])) return null; // unchanged panel
@@ -297,16 +321,18 @@ async function drawFigures(figures, digests = {}) {
     }
     div.classList.remove("html-table");
     const skel = skeleton(fig); // (before plotly fills the layout in)
-    const move = skel !== null && skeletons[key] === skel && div.data;
+    const frame = skel !== null && skeletons[key] === skel && div.data ? moveFrame(div, key, fig) : null;
     skeletons[key] = skel;
-    jik.panelMoved[key] = Boolean(move);
-    const p = move
-      ? Plotly.animate(div, { data: fig.data.map((t) => Object.fromEntries(DATA_KEYS.filter((k) => k in t).map((k) => [k, t[k]]))) }, MOVE)
+    asked[key] = ranges(fig.layout);
+    jik.panelMoved[key] = Boolean(frame);
+    const p = frame
+      ? Plotly.animate(div, frame, MOVE)
       : Plotly.react(div, fig.data, fig.layout, PLOT_CONFIG);
     panelTools(div, key);
     jik.panelSync[key] = Math.round(performance.now() - t0); // the synchronous share
     return p.then(() => {
       jik.panelDraw[key] = Math.round(performance.now() - t0);
+      jik.drawnNow[key] = `${frame ? "moved" : "drawn"} ${jik.panelDraw[key]} ms`;
     });
   }));
 }
@@ -356,7 +382,7 @@ async function onResult(msg) {
         generation: msg.generation, ms: now - since, server: msg.timing,
         changedAt: performance.timeOrigin + since, // epoch ms: comparable with the scene's frame
         arrived: msg.browser.arrived - since, parse: msg.browser.parsed - msg.browser.arrived,
-        draw: now - msg.browser.parsed,
+        draw: now - msg.browser.parsed, panels: jik.drawnNow,
       };
       jik.latencies.push(jik.lastLatency);
       jik.pending.delete(g);
