@@ -267,32 +267,41 @@ function drawTable(div, fig) {
 // while the data fill them (keep_ranges), so that most changes do not even touch the axes.
 const DATA_KEYS = ["x", "y", "customdata"];
 const MOVE = { transition: { duration: 0 }, frame: { duration: 0, redraw: false }, mode: "immediate" };
-const skeletons = {}; // panel -> the drawn figure without its data and ranges (JSON), when it can move
 const isAxis = (k) => /^[xy]axis[0-9]*$/.test(k);
-function skeleton(fig) {
-  if (!fig.data.length || !fig.data.every((t) => t.type === "scatter")) return null;
-  // Axes tied to another one's scale (scaleanchor) are constrained by a full drawing only:
-  // such a panel moves only with the same ranges.
-  const tied = Object.entries(fig.layout).some(([k, a]) => isAxis(k) && a.scaleanchor);
+const axisRanges = (layout) => Object.fromEntries(Object.keys(layout || {}).filter(isAxis).sort()
+  .map((k) => [k, layout[k].range || null]));
+// The figure without its data and axis ranges (JSON): what must stay for a move.
+function shape(fig) {
   const strip = (t) => Object.fromEntries(Object.entries(t).map(([k, v]) => [k, DATA_KEYS.includes(k) || v]));
-  const layout = tied ? fig.layout : Object.fromEntries(Object.entries(fig.layout).map(
+  const layout = Object.fromEntries(Object.entries(fig.layout).map(
     ([k, v]) => [k, isAxis(k) && v.range ? { ...v, range: true } : v]));
   return JSON.stringify([layout, fig.data.map(strip)]);
 }
-const ranges = (layout) => JSON.stringify(Object.keys(layout).filter(isAxis).sort()
-  .map((k) => [k, (layout[k] || {}).range || null]));
-const asked = {}; // panel -> the axis ranges of the figure last drawn in it (JSON)
-// The traces' data, and the axis ranges when they changed: not when the user zoomed the
-// panel (its ranges on screen are not the ones drawn); then null, and Plotly.react keeps the
-// user's view (uirevision).
-function moveFrame(div, key, fig) {
-  const data = fig.data.map((t) => Object.fromEntries(DATA_KEYS.filter((k) => k in t).map((k) => [k, t[k]])));
-  const want = ranges(fig.layout);
-  if (want === asked[key]) return { data };
-  if (ranges(div.layout) !== asked[key]) return null;
-  const layout = {};
-  for (const [k, a] of Object.entries(fig.layout)) if (isAxis(k) && a.range) layout[k] = { range: a.range };
-  return { data, layout };
+const onScreen = {}; // panel -> {shape, ranges: JSON, held: ranges asked for, shown: JSON after drawing}
+
+// How a panel takes its new figure: {frame} to move it (Plotly.animate), or null to draw it.
+function plan(div, key, fig) {
+  const last = onScreen[key];
+  const same = Boolean(last && div.data && last.shape === shape(fig));
+  // The user zoomed (the ranges on screen are not those plotly drew): the figure keeps the
+  // ranges it had, so that plotly keeps the user's view (uirevision keeps a user's edit only
+  // while the figure's own value stays); a double-click goes back to them.
+  const zoomed = same && last.shown && JSON.stringify(axisRanges(div.layout)) !== last.shown;
+  if (zoomed) {
+    for (const [k, r] of Object.entries(last.held)) if (fig.layout[k] && r) fig.layout[k] = { ...fig.layout[k], range: r };
+  }
+  const held = axisRanges(fig.layout);
+  const ranges = JSON.stringify(held);
+  const newRanges = same && ranges !== last.ranges;
+  // shown: the ranges plotly draws for these (constrained by scaleanchor, say), taken after the
+  // drawing; while the user's zoom stays, those of the same ranges before.
+  onScreen[key] = { shape: shape(fig), ranges, held, shown: zoomed ? last.shown : null };
+  // Only scatter traces move; axes tied by scaleanchor are constrained by a full drawing only.
+  const tied = Object.entries(fig.layout).some(([k, a]) => isAxis(k) && a.scaleanchor);
+  if (!same || !fig.data.every((t) => t.type === "scatter") || (newRanges && tied)) return null;
+  const frame = { data: fig.data.map((t) => Object.fromEntries(DATA_KEYS.filter((k) => k in t).map((k) => [k, t[k]]))) };
+  if (newRanges) frame.layout = Object.fromEntries(Object.entries(held).filter(([, r]) => r).map(([k, r]) => [k, { range: r }]));
+  return frame;
 }
 
 // The panel's own buttons (once): save it as PNG or SVG, as plotly draws it.
@@ -314,16 +323,13 @@ async function drawFigures(figures, digests = {}) {
     drawn[key] = digests[key];
     const t0 = performance.now(); // until this panel's redraw resolved (panels share one thread)
     if (isTable(fig)) {
-      skeletons[key] = null;
+      onScreen[key] = null;
       drawTable(div, fig);
       jik.panelSync[key] = jik.panelDraw[key] = Math.round(performance.now() - t0);
       return null;
     }
     div.classList.remove("html-table");
-    const skel = skeleton(fig); // (before plotly fills the layout in)
-    const frame = skel !== null && skeletons[key] === skel && div.data ? moveFrame(div, key, fig) : null;
-    skeletons[key] = skel;
-    asked[key] = ranges(fig.layout);
+    const frame = plan(div, key, fig); // (before plotly fills the layout in)
     jik.panelMoved[key] = Boolean(frame);
     const p = frame
       ? Plotly.animate(div, frame, MOVE)
@@ -331,6 +337,7 @@ async function drawFigures(figures, digests = {}) {
     panelTools(div, key);
     jik.panelSync[key] = Math.round(performance.now() - t0); // the synchronous share
     return p.then(() => {
+      if (onScreen[key] && onScreen[key].shown === null) onScreen[key].shown = JSON.stringify(axisRanges(div.layout));
       jik.panelDraw[key] = Math.round(performance.now() - t0);
       jik.drawnNow[key] = `${frame ? "moved" : "drawn"} ${jik.panelDraw[key]} ms`;
     });
@@ -435,7 +442,7 @@ async function onFunctionals(msg) {
   await Promise.all(Object.entries(msg.titles || {}).map(([key, text]) => {
     const div = document.getElementById(`plot-${key}`);
     if (!div || !div.layout || (div.layout.title || {}).text === text) return null;
-    skeletons[key] = null; // (the layout on screen is no longer the figure's)
+    onScreen[key] = null; // (the layout on screen is no longer the figure's)
     return Plotly.relayout(div, { "title.text": text });
   }));
 }

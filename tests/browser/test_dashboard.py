@@ -244,6 +244,15 @@ _MOVED_AS_DRAWN = """async (key) => {
 }"""
 
 
+# The layout of a panel's figure in the server's latest result (a new event stream replays it).
+_SERVER_FIGURE = """async (key) => {
+    const source = new EventSource('/api/dashboard/events');
+    const msg = await new Promise((resolve) => source.addEventListener('result', (ev) => {
+        source.close(); resolve(JSON.parse(ev.data)); }));
+    return msg.figures[key].layout;
+}"""
+
+
 def _check_moved(page, generation: int) -> set[str]:
     """The panels the page moved for ``generation`` look as a full drawing of the same figure
     would (same tick labels at the same places, every line and marker within 1.5 px)."""
@@ -407,6 +416,28 @@ def test_dashboard_follows_controls_in_chromium(served):
         path = saved.value.path()
         assert saved.value.suggested_filename == "jik-task.png"
         assert path is not None and Path(path).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        # A panel the user zoomed keeps the view through a change that moves its axes (the page
+        # redraws it instead of moving the ranges; plotly's uirevision keeps the zoom).
+        box = page.locator("#plot-joints .nsewdrag").first.bounding_box()
+        assert box is not None
+        y = box["y"] + box["height"] / 2
+        page.mouse.move(box["x"] + 0.3 * box["width"], y)
+        page.mouse.down()
+        page.mouse.move(box["x"] + 0.45 * box["width"], y, steps=4)
+        page.mouse.move(box["x"] + 0.6 * box["width"], y, steps=4)
+        page.mouse.up()
+        xrange = "document.getElementById('plot-joints').layout.xaxis.range"
+        zoomed = page.evaluate(xrange)
+        assert zoomed[0] > 0, zoomed  # (the panel's own range starts at theta = 0)
+        before = _set_slider(page, "#ctl-x0-0", 0.45)
+        _latency(page, before)
+        assert page.evaluate(xrange) == pytest.approx(zoomed)
+        # A double-click goes back to the panel's ranges, which then follow the figures again.
+        page.mouse.dblclick(box["x"] + 0.5 * box["width"], y)
+        page.wait_for_function(f"{xrange}[0] === 0")
+        before = _set_slider(page, "#ctl-x0-0", 0.0)
+        _latency(page, before)
+        assert page.evaluate(xrange) == page.evaluate(_SERVER_FIGURE, "joints")["xaxis"]["range"]
         # The off-screen warm-up after loading ran once and left nothing behind.
         assert page.evaluate("jik.warmed === true && !document.querySelector('.warmup')")
         csv = page.evaluate("fetch('/api/dashboard/export.csv').then(r => r.text())")
