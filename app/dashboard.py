@@ -593,6 +593,7 @@ def compute(
     cache: dict | None = None,
     with_augmenting: bool = True,
     offload: Offload | None = None,
+    grid_before: dict | None = None,
 ) -> DashboardResult:
     """Solve the state's task with both algorithms.
 
@@ -610,6 +611,9 @@ def compute(
     offload : Offload, optional
         A second process: the pseudoinverse runs there, concurrently with the extended
         inverse here (same results).
+    grid_before : dict, optional
+        The h grid on screen, whose box the new grid keeps when it fits (see
+        :func:`augmenting_grid`).
 
     Raises
     ------
@@ -682,7 +686,9 @@ def compute(
         time=np.linspace(0.0, float(cast(Unicycle, kin).T), UNICYCLE_TIME_POINTS)
         if hasattr(kin, "path")
         else None,
-        augmenting=augmenting_grid(kin, state, runs) if with_augmenting else None,
+        augmenting=augmenting_grid(kin, state, runs, before=grid_before)
+        if with_augmenting
+        else None,
         seconds=time.perf_counter() - t0,
         cached={a: a not in todo for a in ALGORITHMS},
     )
@@ -706,11 +712,21 @@ def expensive_map(amap) -> bool:
     return hasattr(amap, "evaluate")
 
 
-def augmenting_grid(kin, state: DashboardState, runs: Mapping[str, AlgorithmRun], n: int = 41):
+#: The h panel keeps its box while the trajectories fill at least this fraction of it.
+BOX_FILL = 0.5
+
+
+def augmenting_grid(
+    kin, state: DashboardState, runs: Mapping[str, AlgorithmRun], n: int = 41,
+    before: dict | None = None,
+):  # fmt: skip
     """h on a grid over the two variables it depends on most, other variables at x0.
 
-    The box covers both trajectories with a margin, clipped to the robot's x_range.
-    Returns None when h cannot be evaluated on the grid.
+    The box covers both trajectories with a margin, clipped to the robot's x_range. The box of
+    ``before`` (the grid on screen) is kept while the trajectories lie inside it and span at
+    least :data:`BOX_FILL` of it, like the other panels' axes (``app.figures.keep_ranges``): a
+    small change then gives the same grid, often the same h, and the page moves only the
+    trajectories. Returns None when h cannot be evaluated on the grid.
     """
     spec = robot_spec(state.robot)
     try:
@@ -727,6 +743,14 @@ def augmenting_grid(kin, state: DashboardState, runs: Mapping[str, AlgorithmRun]
             box.append((lo, hi))
         if expensive_map(amap):
             n = min(n, 15)  # h solves a collocation problem per point
+        if before is not None and tuple(before["axes"]) == (i, j) and before["n"] == n:
+            inside = all(
+                b_lo <= np.min(xs[:, k]) and np.max(xs[:, k]) <= b_hi
+                and hi - lo >= BOX_FILL * (b_hi - b_lo)
+                for k, (lo, hi), (b_lo, b_hi) in zip((i, j), box, before["box"], strict=True)
+            )  # fmt: skip
+            if inside:
+                box = [tuple(b) for b in before["box"]]
         u, v = np.linspace(*box[0], n), np.linspace(*box[1], n)
         X = np.broadcast_to(np.asarray(state.x0, dtype=float), (n, n, kin.p)).copy()
         X[..., i] = u[None, :]
@@ -740,7 +764,8 @@ def augmenting_grid(kin, state: DashboardState, runs: Mapping[str, AlgorithmRun]
     except (JikError, ValueError, ArithmeticError):
         return None
     H = np.where(np.isfinite(H), H, np.nan)
-    return {"axes": (i, j), "u": u, "v": v, "h": H, "box": box, "map": amap, "kinematics": kin}
+    return {"axes": (i, j), "u": u, "v": v, "h": H, "box": box, "n": n, "map": amap,
+            "kinematics": kin}  # fmt: skip
 
 
 def error_functionals(result: DashboardResult, nodes: int = 12) -> dict | None:
@@ -1161,6 +1186,14 @@ class Dashboard:
                 })))  # fmt: skip
 
         spec = robot_spec(state.robot)
+        # The h panel's box stays while it fits (augmenting_grid), for the same robot and task.
+        on_screen = self.result
+        grid_before = (
+            on_screen.augmenting
+            if on_screen is not None
+            and (on_screen.state.robot, on_screen.state.task) == (state.robot, state.task)
+            else None
+        )
         try:
             kin = spec.build(**state.robot_parameters)
             amap = spec.augmentation(state.augmentation).build(kin, **state.augmentation_parameters)
@@ -1168,7 +1201,7 @@ class Dashboard:
             result = compute(
                 state, generation, progress=progress,
                 cancelled=lambda: self._generation != generation, cache=self._cache,
-                with_augmenting=not deferred, offload=self._offload,
+                with_augmenting=not deferred, offload=self._offload, grid_before=grid_before,
             )  # fmt: skip
         except Cancelled:
             return
@@ -1229,7 +1262,7 @@ class Dashboard:
             if self._generation != generation:
                 return
         if deferred:
-            grid = augmenting_grid(kin, state, result.runs)
+            grid = augmenting_grid(kin, state, result.runs, before=grid_before)
             if self._generation != generation:
                 return
             result = replace(result, augmenting=grid)

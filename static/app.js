@@ -270,11 +270,14 @@ const MOVE = { transition: { duration: 0 }, frame: { duration: 0, redraw: false 
 const isAxis = (k) => /^[xy]axis[0-9]*$/.test(k);
 const axisRanges = (layout) => Object.fromEntries(Object.keys(layout || {}).filter(isAxis).sort()
   .map((k) => [k, layout[k].range || null]));
-// The figure without its data and axis ranges (JSON): what must stay for a move.
+// The figure without its lines' data, axis ranges and title text (JSON): what must stay for a
+// move. Other traces (the h panel's contours) must stay whole: only scatter traces move. (A new
+// title text, as the h panel's "at x1 = ...", is set after the move: a relayout of the title.)
+const moves = (t) => t.type === "scatter";
 function shape(fig) {
-  const strip = (t) => Object.fromEntries(Object.entries(t).map(([k, v]) => [k, DATA_KEYS.includes(k) || v]));
+  const strip = (t) => (moves(t) ? Object.fromEntries(Object.entries(t).map(([k, v]) => [k, DATA_KEYS.includes(k) || v])) : t);
   const layout = Object.fromEntries(Object.entries(fig.layout).map(
-    ([k, v]) => [k, isAxis(k) && v.range ? { ...v, range: true } : v]));
+    ([k, v]) => [k, (isAxis(k) && v.range ? { ...v, range: true } : k === "title" ? { ...v, text: true } : v)]));
   return JSON.stringify([layout, fig.data.map(strip)]);
 }
 const onScreen = {}; // panel -> {shape, ranges: JSON, held: ranges asked for, shown: JSON after drawing}
@@ -296,10 +299,11 @@ function plan(div, key, fig) {
   // shown: the ranges plotly draws for these (constrained by scaleanchor, say), taken after the
   // drawing; while the user's zoom stays, those of the same ranges before.
   onScreen[key] = { shape: shape(fig), ranges, held, shown: zoomed ? last.shown : null };
-  // Only scatter traces move; axes tied by scaleanchor are constrained by a full drawing only.
+  // Axes tied by scaleanchor are constrained by a full drawing only.
   const tied = Object.entries(fig.layout).some(([k, a]) => isAxis(k) && a.scaleanchor);
-  if (!same || !fig.data.every((t) => t.type === "scatter") || (newRanges && tied)) return null;
-  const frame = { data: fig.data.map((t) => Object.fromEntries(DATA_KEYS.filter((k) => k in t).map((k) => [k, t[k]]))) };
+  const traces = fig.data.flatMap((t, i) => (moves(t) ? [i] : []));
+  if (!same || !traces.length || (newRanges && tied)) return null;
+  const frame = { traces, data: traces.map((i) => Object.fromEntries(DATA_KEYS.filter((k) => k in fig.data[i]).map((k) => [k, fig.data[i][k]]))) };
   if (newRanges) frame.layout = Object.fromEntries(Object.entries(held).filter(([, r]) => r).map(([k, r]) => [k, { range: r }]));
   return frame;
 }
@@ -331,8 +335,10 @@ async function drawFigures(figures, digests = {}) {
     div.classList.remove("html-table");
     const frame = plan(div, key, fig); // (before plotly fills the layout in)
     jik.panelMoved[key] = Boolean(frame);
+    const title = (fig.layout.title || {}).text;
     const p = frame
-      ? Plotly.animate(div, frame, MOVE)
+      ? Plotly.animate(div, frame, MOVE).then(() => title === (div.layout.title || {}).text
+        || Plotly.relayout(div, { "title.text": title }))
       : Plotly.react(div, fig.data, fig.layout, PLOT_CONFIG);
     panelTools(div, key);
     jik.panelSync[key] = Math.round(performance.now() - t0); // the synchronous share
@@ -442,8 +448,7 @@ async function onFunctionals(msg) {
   await Promise.all(Object.entries(msg.titles || {}).map(([key, text]) => {
     const div = document.getElementById(`plot-${key}`);
     if (!div || !div.layout || (div.layout.title || {}).text === text) return null;
-    onScreen[key] = null; // (the layout on screen is no longer the figure's)
-    return Plotly.relayout(div, { "title.text": text });
+    return Plotly.relayout(div, { "title.text": text }); // (the panel can still move: see shape)
   }));
 }
 

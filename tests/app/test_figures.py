@@ -267,6 +267,28 @@ def test_functionals_use_the_design_region_and_rank_the_synthesized_map_first(pa
     assert alternatives["e2_synthesized"]["E2"] < 0.05 * alternatives["paper_cubic"]["E2"]
 
 
+def test_the_h_grid_keeps_its_box_while_the_trajectories_fill_it(path_result):
+    """The h panel's box stays for a nearby start point (the page then moves only the
+    trajectories: h over (x2, x3) does not depend on x1, the grid is the same), and follows
+    trajectories that leave it or shrink to less than half of it."""
+    grid = path_result.augmenting
+    state = path_result.state
+    near = compute(updated_state(state, {"x0": [0.45, 0.0, np.pi / 2]}), grid_before=grid)
+    assert near.augmenting["box"] == grid["box"]
+    assert np.array_equal(near.augmenting["h"], grid["h"], equal_nan=True)
+    assert (
+        compute(updated_state(state, {"x0": [0.45, 0.0, np.pi / 2]})).augmenting["box"]
+        != (grid["box"])
+    )  # (its own box without the one on screen)
+    small = dict(grid, box=[(lo, lo + 0.3 * (hi - lo)) for lo, hi in grid["box"]])
+    away = compute(updated_state(state, {"x0": [0.45, 0.0, np.pi / 2]}), grid_before=small)
+    assert away.augmenting["box"] != small["box"]  # (the trajectories leave it)
+    wide = dict(grid, box=[(lo - 10.0, hi + 10.0) for lo, hi in grid["box"]])
+    assert compute(state, grid_before=wide).augmenting["box"] == grid["box"]  # (under half)
+    other = dict(grid, axes=(0, 2))
+    assert compute(state, grid_before=other).augmenting["box"] == grid["box"]
+
+
 def test_nice_range_pads_the_data_and_rounds_to_a_step():
     assert nice_range([-0.41, 1.39]) == [-0.6, 1.6]  # span 1.8: padded 0.09, step 0.2
     assert nice_range([0.0, 446.5], from_zero=True) == [0.0, 450.0]
