@@ -978,6 +978,11 @@ class Dashboard:
         self._cache: dict = {}
         self._figures: dict[tuple[str, str], str] = {}  # (panel, key) -> figure JSON
         self._layouts: dict[str, tuple[tuple, dict]] = {}  # panel -> (robot, task), last layout
+        # Results solved ahead (_prefetch): what went to the page, by robot, and since when
+        # the current robot is on screen (the generation of its first result).
+        self._ahead_sent: dict[str, tuple] = {}
+        self._latest_ahead: dict[str, Event] = {}
+        self._robot_since = 0
         # key -> (E1/E2 functionals or None, their sensitivity)
         self._functionals_cache: dict[str, tuple[dict | None, dict]] = {}
         self._latest: dict[str, Event] = {
@@ -1052,6 +1057,7 @@ class Dashboard:
                 self._fast += 1
             kinds = ("state", "result", "functionals")
             latest = [self._latest[k] for k in kinds if k in self._latest]
+            latest += [e for r, e in self._latest_ahead.items() if r != self._state.robot]
         for event in latest:
             listener(event)
         self.start()
@@ -1131,31 +1137,78 @@ class Dashboard:
     def _prefetch(self, generation: int) -> None:
         """While no change comes, solve the other robots' default states into the run cache:
         switching robot starts from those defaults (:func:`updated_state`), so the switch then
-        only draws (Manipulator 1: ~90 ms of computation less in the browser test). Each is
-        announced by an ``ahead`` event (the scene builds its nodes, hidden).
+        only draws (Manipulator 1: ~90 ms of computation less in the browser test).
+
+        Each is announced by an ``ahead`` event with the figures the switch will show: the
+        page draws them off screen and shows them on the switch (when they are the same), the
+        3D scene builds the robot's nodes, hidden (from the event's result, given when the
+        runs were solved now). A robot is announced again after every switch of robot (the
+        page has shown what it drew ahead) or when its figures change.
 
         Only :data:`PREFETCH_ROBOTS`; any change cancels it between legs.
         """
+        from app.figures import PANELS
+
         for robot in PREFETCH_ROBOTS:
             state = default_state(robot)
             if self._generation != generation or self._stopped:
                 return
-            if robot == self._state.robot or all(
-                _cache_key(state, a) in self._cache for a in ALGORITHMS
-            ):
+            if robot == self._state.robot:
                 continue
+            solved = all(_cache_key(state, a) in self._cache for a in ALGORITHMS)
             try:
+                spec = robot_spec(robot)
+                kin = spec.build(**state.robot_parameters)
+                amap = spec.augmentation(state.augmentation).build(
+                    kin, **state.augmentation_parameters
+                )
                 result = compute(
                     state, generation, cancelled=lambda: self._generation != generation,
-                    cache=self._cache, with_augmenting=False, offload=self._offload,
+                    cache=self._cache, with_augmenting=not expensive_map(amap),
+                    offload=self._offload,
                 )  # fmt: skip
+                # The figures as the switch will make them (see _compute: no panel to reuse
+                # from another robot; the E1/E2 panel waits for the second phase unless known).
+                cached = self._functionals_cache.get(functionals_key(state))
+                functionals, sens = cached if cached else (None, None)
+                todo = set(PANELS) - (set() if cached else {"sensitivity"})
+                texts = self._panel_texts(result, functionals, sens, todo, remember=False)
             except (Cancelled, JikError, ValueError):
                 return
             except Exception:  # (work ahead: logged, never shown as the current result's error)
                 log.exception("solving %s ahead failed", robot)
                 return
-            # For the 3D scene, which builds the robot's nodes ahead (hidden); not for the page.
-            self._emit(Event("ahead", generation, "", result))
+            digests = {k: _digest(t) for k, t in texts.items()}
+            sent = (self._robot_since, digests)
+            if solved and self._ahead_sent.get(robot) == sent:
+                continue
+            self._ahead_sent[robot] = sent
+            head = {"type": "ahead", "generation": generation, "robot": robot,
+                    "digests": digests}  # fmt: skip
+            event = Event(
+                "ahead", generation, _with_figures(head, texts), None if solved else result
+            )
+            with self._cond:
+                self._latest_ahead[robot] = event
+            self._emit(event)
+
+    def _panel_texts(
+        self, result: DashboardResult, functionals, sens, todo: set[str], remember: bool
+    ) -> dict[str, str]:
+        """The JSON of the panels in ``todo``, with sticky axes (keep_ranges): against the
+        layout each panel last went out with, for the same robot and task. ``remember``: these
+        panels go out now (a result, not one solved ahead)."""
+        from app.figures import figure_json, figure_specs, keep_ranges
+
+        layout_key = (result.state.robot, result.state.task)
+        texts = {}
+        for k, f in figure_specs(result, functionals, todo, sensitivity=sens).items():
+            shown = self._layouts.get(k)
+            keep_ranges(f, shown[1] if shown is not None and shown[0] == layout_key else None)
+            if remember:
+                self._layouts[k] = (layout_key, f["layout"])
+            texts[k] = figure_json(f)
+        return texts
 
     def _finish(self, generation: int) -> None:
         with self._cond:
@@ -1169,7 +1222,6 @@ class Dashboard:
             figure_json,
             figure_specs,
             gamma_free_panels,
-            keep_ranges,
         )
 
         started = self._changed_at.get(generation, time.perf_counter())
@@ -1222,15 +1274,7 @@ class Dashboard:
         stale = set() if cached else {"sensitivity"}
         todo = set(PANELS) - reuse - stale
         functionals, sens = cached if cached else (None, None)
-        # Sticky axes (keep_ranges): against the layout each panel last went out with, for the
-        # same robot and task.
-        figures = figure_specs(result, functionals, todo, sensitivity=sens)
-        layout_key = (state.robot, state.task)
-        for k, f in figures.items():
-            shown = self._layouts.get(k)
-            keep_ranges(f, shown[1] if shown is not None and shown[0] == layout_key else None)
-            self._layouts[k] = (layout_key, f["layout"])
-            texts[k] = figure_json(f)
+        texts.update(self._panel_texts(result, functionals, sens, todo, remember=True))
         texts = {k: texts[k] for k in PANELS if k not in stale}
         self._figures = {(k, key): texts[k] for k in gamma_free_panels(result)}
         ready = time.perf_counter()
@@ -1244,6 +1288,8 @@ class Dashboard:
         head["stale"] = sorted(stale)
         data = _with_figures(head, texts)
         with self._cond:
+            if self.result is None or self.result.state.robot != state.robot:
+                self._robot_since = generation
             self.result, self.functionals = result, functionals
             self._changed_at = {g: t for g, t in self._changed_at.items() if g > generation}
         self._emit(Event("result", generation, data, result))

@@ -119,15 +119,17 @@ def _invalid(field: str, message: str) -> JSONResponse:
     )
 
 
-#: The events the page follows (the dashboard also announces results solved ahead).
-PAGE_EVENTS = ("state", "progress", "result", "functionals", "error")
+#: The events the page follows.
+PAGE_EVENTS = ("state", "progress", "result", "functionals", "error", "ahead")
 
 
 @router.get("/api/dashboard/events")
 async def events(request: Request) -> StreamingResponse:
-    """Server-sent events: ``state``, ``progress``, ``result``, ``functionals``, ``error``.
+    """Server-sent events: ``state``, ``progress``, ``result``, ``functionals``, ``error``,
+    ``ahead``.
 
-    Each event's data is JSON; a ``result`` carries every panel as a plotly figure.
+    Each event's data is JSON; a ``result`` carries every panel as a plotly figure, an
+    ``ahead`` the panels of another robot's default state, solved ahead for a switch.
     """
     dashboard = dashboard_for(request.app)
     loop = asyncio.get_running_loop()
@@ -152,7 +154,7 @@ async def events(request: Request) -> StreamingResponse:
                 # A newer result makes queued progress of older generations pointless.
                 if event.kind == "progress" and event.generation < dashboard.generation:
                     continue
-                if event.kind not in PAGE_EVENTS:  # (results solved ahead: for the scene)
+                if event.kind not in PAGE_EVENTS:
                     continue
                 yield f"event: {event.kind}\nid: {event.generation}\ndata: {event.data}\n\n"
         finally:

@@ -620,6 +620,51 @@ def test_an_idle_dashboard_solves_the_other_manipulator_ahead():
         np.testing.assert_array_equal(result.runs[a].x, fresh.runs[a].x)
 
 
+def test_the_figures_solved_ahead_are_those_of_the_switch():
+    """An ``ahead`` event carries the other robot's panels as the switch will send them (the
+    page draws them off screen and shows them on the switch when the digests agree); it is
+    not sent again for a change of the same robot, and again after a switch back."""
+    dashboard = Dashboard(updated_state(default_state("manipulator2"), {"cycles": 1}))
+    events: list = []
+    dashboard.subscribe(events.append)
+
+    def announced(robot: str, since: int) -> list[dict]:
+        return [json.loads(e.data) for e in events[since:]
+                if e.kind == "ahead" and json.loads(e.data)["robot"] == robot]  # fmt: skip
+
+    def settle(generation: int, robot: str, since: int) -> dict:
+        assert dashboard.wait(generation, 60)
+        deadline = time.monotonic() + 60
+        while not announced(robot, since):
+            assert time.monotonic() < deadline, f"{robot} was not announced"
+            time.sleep(0.05)
+        return announced(robot, since)[-1]
+
+    try:
+        ahead = settle(1, "manipulator1", 0)
+        assert set(ahead["digests"]) >= {"task", "joints", "drift", "augmenting"}
+        n = len(events)
+        generation, _ = dashboard.update({"gamma": 2.0})  # (the same robot: not announced again)
+        assert dashboard.wait(generation, 60)
+        time.sleep(0.5)
+        assert not announced("manipulator1", n)
+        generation, _ = dashboard.update({"robot": "manipulator1"})
+        assert dashboard.wait(generation, 60)
+        result = next(json.loads(e.data) for e in reversed(events) if e.kind == "result")
+        assert result["state"]["robot"] == "manipulator1"
+        for key, digest in ahead["digests"].items():
+            assert result["digests"][key] == digest, key
+            assert result["figures"][key] == ahead["figures"][key], key
+        n = len(events)
+        back = settle(generation, "manipulator2", n)  # (the other one now)
+        assert back["figures"]["task"]["data"]
+        generation, _ = dashboard.update({"robot": "manipulator2"})
+        again = settle(generation, "manipulator1", len(events))  # (shown: announced again)
+        assert again["digests"] == ahead["digests"]
+    finally:
+        dashboard.stop()
+
+
 def test_solving_ahead_stops_for_a_change():
     dashboard = Dashboard(updated_state(default_state("manipulator2"), {"cycles": 1}))
     dashboard._generation = 2  # (not started) a change came after generation 1
