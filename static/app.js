@@ -282,7 +282,8 @@ function shape(fig) {
 }
 const onScreen = {}; // panel -> {shape, ranges: JSON, held: ranges asked for, shown: JSON after drawing}
 
-// How a panel takes its new figure: {frame} to move it (Plotly.animate), or null to draw it.
+// How a panel takes its new figure: {frame, relayout} to move it (Plotly.animate, then
+// Plotly.relayout when that has anything), or null to draw it (Plotly.react).
 function plan(div, key, fig) {
   const last = onScreen[key];
   const same = Boolean(last && div.data && last.shape === shape(fig));
@@ -299,13 +300,17 @@ function plan(div, key, fig) {
   // shown: the ranges plotly draws for these (constrained by scaleanchor, say), taken after the
   // drawing; while the user's zoom stays, those of the same ranges before.
   onScreen[key] = { shape: shape(fig), ranges, held, shown: zoomed ? last.shown : null };
-  // Axes tied by scaleanchor are constrained by a full drawing only.
-  const tied = Object.entries(fig.layout).some(([k, a]) => isAxis(k) && a.scaleanchor);
   const traces = fig.data.flatMap((t, i) => (moves(t) ? [i] : []));
-  if (!same || !traces.length || (newRanges && tied)) return null;
+  if (!same || !traces.length) return null;
   const frame = { traces, data: traces.map((i) => Object.fromEntries(DATA_KEYS.filter((k) => k in fig.data[i]).map((k) => [k, fig.data[i][k]]))) };
-  if (newRanges) frame.layout = Object.fromEntries(Object.entries(held).filter(([, r]) => r).map(([k, r]) => [k, { range: r }]));
-  return frame;
+  // After the move, a relayout: a new title text (the h panel's "at x1 = ..."), and the new axis
+  // ranges, as a zoom sets them (the ranges of an animation frame miss stacked axes, and do
+  // not constrain the task plane's equal scales).
+  const relayout = {};
+  const title = (fig.layout.title || {}).text;
+  if (title !== ((div.layout || {}).title || {}).text) relayout["title.text"] = title;
+  if (newRanges) for (const [k, r] of Object.entries(held)) if (r) relayout[`${k}.range`] = r;
+  return { frame, relayout };
 }
 
 // The panel's own buttons (once): save it as PNG or SVG, as plotly draws it.
@@ -343,19 +348,18 @@ async function drawFigures(figures, digests = {}, robot = null) {
         return null;
       }
       div.classList.remove("html-table");
-      const frame = plan(div, key, fig); // (before plotly fills the layout in)
-      jik.panelMoved[key] = Boolean(frame);
-      const title = (fig.layout.title || {}).text;
-      const p = frame
-        ? Plotly.animate(div, frame, MOVE).then(() => title === (div.layout.title || {}).text
-          || Plotly.relayout(div, { "title.text": title }))
+      const move = plan(div, key, fig); // (before plotly fills the layout in)
+      jik.panelMoved[key] = Boolean(move);
+      const p = move
+        ? Plotly.animate(div, move.frame, MOVE).then(() => !Object.keys(move.relayout).length
+          || Plotly.relayout(div, move.relayout))
         : Plotly.react(div, fig.data, fig.layout, PLOT_CONFIG);
       panelTools(div, key);
       jik.panelSync[key] = Math.round(performance.now() - t0); // the synchronous share
       return p.then(() => {
         if (onScreen[key] && onScreen[key].shown === null) onScreen[key].shown = JSON.stringify(axisRanges(div.layout));
         jik.panelDraw[key] = Math.round(performance.now() - t0);
-        jik.drawnNow[key] = `${frame ? "moved" : "drawn"} ${jik.panelDraw[key]} ms`;
+        jik.drawnNow[key] = `${move ? "moved" : "drawn"} ${jik.panelDraw[key]} ms`;
       });
     }));
   } finally {

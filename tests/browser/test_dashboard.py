@@ -234,18 +234,32 @@ _MOVED_AS_DRAWN = """async (key) => {
     const at = (n) => (n.getAttribute('transform') || '') + ' ' + (n.getAttribute('x') || '')
         + ',' + (n.getAttribute('y') || '');
     const ticks = '.xtick text, .ytick text, .gtitle';
-    const look = () => ({
-        ticks: [...div.querySelectorAll(ticks)].map((n) => n.textContent),
-        // lines, markers, text, grid lines and the tick labels' places
-        paths: [...div.querySelectorAll(`.scatterlayer path, .scatterlayer text, .gridlayer path,
-            ${ticks}`)].map((n) => (n.getAttribute('d') || '') + ' ' + at(n)),
-    });
+    const numbers = (d) => (d || '').match(/-?[0-9.]+(e-?[0-9]+)?/g) || [];
+    const letters = (d) => (d || '').replace(/-?[0-9.]+(e-?[0-9]+)?/g, '');
+    // Ticks and grid lines in the order of their axis, label and place (a relayout of the
+    // ranges appends new ones at the end of the document), lines and markers in the traces'.
+    const byPlace = (a, b) => { const x = numbers(a).map(Number), y = numbers(b).map(Number);
+        for (let k = 0; k < Math.min(x.length, y.length); k++) {
+            if (Math.abs(x[k] - y[k]) > 2) return x[k] - y[k]; }
+        return x.length - y.length; };
+    const all = (sel) => [...div.querySelectorAll(sel)];
+    const tick = (n) => n.closest('[class*="tick"]')?.getAttribute('class') + ':' + n.textContent;
+    const look = () => {
+        const labels = all(ticks).map((n) => [tick(n), (n.getAttribute('d') || '') + ' ' + at(n)])
+            .sort(([a, p], [b, q]) => (a < b ? -1 : a > b ? 1 : byPlace(p, q)));
+        return {
+            ticks: labels.map(([t]) => t),
+            paths: [...all('.scatterlayer path, .scatterlayer text')
+                        .map((n) => (n.getAttribute('d') || '') + ' ' + at(n)),
+                    ...all('.gridlayer path').map((n) => (n.getAttribute('d') || '') + ' ' + at(n))
+                        .sort(byPlace),
+                    ...labels.map(([, p]) => p)],
+        };
+    };
     const moved = look();
     const fig = msg.figures[key];
     await Plotly.react(div, fig.data, fig.layout, PLOT_CONFIG);
     const drawn = look();
-    const numbers = (d) => (d || '').match(/-?[0-9.]+(e-?[0-9]+)?/g) || [];
-    const letters = (d) => (d || '').replace(/-?[0-9.]+(e-?[0-9]+)?/g, '');
     // A line drawn at a scale a pixel apart can keep other vertices (plotly simplifies
     // lines): two polylines are compared by the distance of each one's vertices to the other.
     const polyline = (d) => /^M[-0-9.,eL]+\\s+,$/.test(d);
@@ -390,11 +404,19 @@ def test_dashboard_follows_controls_in_chromium(served):
         _second_phase_drawn(page)
         before = _set_slider(page, "#ctl-l", 1.2)
         latencies["arm length l (manipulator 2)"] = _latency(page, before)
+        _check_moved(page, _wait_generation(page, before + 1))
         l_now = _get(f"{base}/api/dashboard/state")["state"]["robot_parameters"]["l"]
         assert l_now == pytest.approx(1.2, abs=0.03)  # the slider snaps to its step
         _second_phase_drawn(page)
         before = _set_slider(page, "#ctl-cycles", 4)
         latencies["cycles (manipulator 2)"] = _latency(page, before)
+        _check_moved(page, _wait_generation(page, before + 1))
+        # A longer arm widens the task plane: its equal-scale axes take the new ranges by a
+        # relayout after the move (plotly constrains them), as a full drawing would.
+        _second_phase_drawn(page)
+        before = _set_slider(page, "#ctl-l", 2.0)
+        latencies["arm length l, longer (manipulator 2)"] = _latency(page, before)
+        assert "task" in _check_moved(page, _wait_generation(page, before + 1))
         assert _trace(page, "drift", 0, "x") == [1, 2, 3, 4]
 
         # Manipulator 1 (and the unicycle when the registry has it), then back.
