@@ -260,12 +260,12 @@ function drawTable(div, fig) {
   );
 }
 
-// A figure that differs from the one on screen only in its traces' data and its axis ranges
-// (same titles, same trace styles) moves its traces with Plotly.animate: the axes take their
-// new ranges and ticks, without a redraw of titles, margins and the rest; a third of
+// A figure that differs from the one on screen only in its lines' data, its axis ranges and
+// its title text (same styles, same contours) moves its lines with Plotly.animate, then takes
+// the new ranges and title by Plotly.relayout: no redraw of the rest, a third of
 // Plotly.react's cost. The server rounds the ranges (app/figures.py nice_range) and keeps them
 // while the data fill them (keep_ranges), so that most changes do not even touch the axes.
-const DATA_KEYS = ["x", "y", "customdata"];
+const DATA_KEYS = ["x", "y", "customdata", "text"];
 const MOVE = { transition: { duration: 0 }, frame: { duration: 0, redraw: false }, mode: "immediate" };
 const isAxis = (k) => /^[xy]axis[0-9]*$/.test(k);
 const axisRanges = (layout) => Object.fromEntries(Object.keys(layout || {}).filter(isAxis).sort()
