@@ -377,6 +377,10 @@ function dropAhead(robot) {
 }
 async function onAhead(msg) {
   if (!jik.state || msg.robot === jik.state.robot) return;
+  const have = ahead.robots[msg.robot];
+  const keys = Object.keys(msg.figures).filter((k) => have && have[k]);
+  if (keys.length && keys.length === Object.keys(have).length && keys.every((k) => have[k].digest === msg.digests[k]
+    && have[k].width === document.getElementById(`plot-${k}`).getBoundingClientRect().width)) return; // (drawn already)
   const token = (ahead.tokens[msg.robot] = (ahead.tokens[msg.robot] || 0) + 1); // (a newer one stops this)
   dropAhead(msg.robot);
   let box = document.querySelector(".ahead");

@@ -423,6 +423,9 @@ def test_dashboard_follows_controls_in_chromium(served):
         robots = [r["name"] for r in _get(f"{base}/robots")["robots"]]
         scenes = {"manipulator2": scene_after}
         for robot in [r for r in ("unicycle", "manipulator1") if r in robots]:
+            if robot == "manipulator1":
+                # The idle page has drawn Manipulator 1's panels ahead (off screen).
+                page.wait_for_function("Object.keys(ahead.robots.manipulator1 || {}).length >= 4")
             before = int(page.evaluate("jik.generation"))
             page.evaluate("jik.progressShown = 0")
             page.select_option("#ctl-robot", robot)
