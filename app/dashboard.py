@@ -1143,7 +1143,8 @@ class Dashboard:
         page draws them off screen and shows them on the switch (when they are the same), the
         3D scene builds the robot's nodes, hidden (from the event's result, given when the
         runs were solved now). A robot is announced again after every switch of robot (the
-        page has shown what it drew ahead) or when its figures change.
+        page has shown what it drew ahead); meanwhile its figures stay the same (no sticky
+        axes or known E1/E2 carry over from another robot) and nothing is done again.
 
         Only :data:`PREFETCH_ROBOTS`; any change cancels it between legs.
         """
@@ -1156,6 +1157,9 @@ class Dashboard:
             if robot == self._state.robot:
                 continue
             solved = all(_cache_key(state, a) in self._cache for a in ALGORITHMS)
+            sent = self._ahead_sent.get(robot)
+            if solved and sent is not None and sent[0] == self._robot_since:
+                continue  # (its figures stay the same while the robot on screen stays)
             try:
                 spec = robot_spec(robot)
                 kin = spec.build(**state.robot_parameters)
