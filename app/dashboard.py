@@ -706,6 +706,13 @@ def augmenting_axes(amap, x: np.ndarray) -> tuple[int, int]:
     return int(i), int(j)
 
 
+def kinematics_and_map(state: DashboardState):
+    """The state's kinematics and its augmenting map h, built from the registry."""
+    spec = robot_spec(state.robot)
+    kin = spec.build(**state.robot_parameters)
+    return kin, spec.augmentation(state.augmentation).build(kin, **state.augmentation_parameters)
+
+
 def expensive_map(amap) -> bool:
     """Maps evaluated by solving a problem per point (characteristics): h is computed after
     the runs have been shown, on a coarser grid."""
@@ -894,7 +901,7 @@ def robots_catalogue() -> list[dict]:
 class Event:
     """A message to the subscribers: ``data`` is the JSON sent to the page."""
 
-    kind: str  # "state" | "progress" | "result" | "functionals" | "error" | "ahead" (no data)
+    kind: str  # "state" | "progress" | "result" | "functionals" | "error" | "ahead"
     generation: int
     data: str
     result: DashboardResult | None = None
@@ -978,9 +985,10 @@ class Dashboard:
         self._cache: dict = {}
         self._figures: dict[tuple[str, str], str] = {}  # (panel, key) -> figure JSON
         self._layouts: dict[str, tuple[tuple, dict]] = {}  # panel -> (robot, task), last layout
-        # Results solved ahead (_prefetch): what went to the page, by robot, and since when
-        # the current robot is on screen (the generation of its first result).
-        self._ahead_sent: dict[str, tuple] = {}
+        # Results solved ahead (_prefetch): when each robot's went to the page (the value of
+        # _robot_since then), the latest by robot, and since when the robot on screen is
+        # (the generation of its first result).
+        self._ahead_sent: dict[str, int] = {}
         self._latest_ahead: dict[str, Event] = {}
         self._robot_since = 0
         # key -> (E1/E2 functionals or None, their sensitivity)
@@ -1157,36 +1165,29 @@ class Dashboard:
             if robot == self._state.robot:
                 continue
             solved = all(_cache_key(state, a) in self._cache for a in ALGORITHMS)
-            sent = self._ahead_sent.get(robot)
-            if solved and sent is not None and sent[0] == self._robot_since:
+            if solved and self._ahead_sent.get(robot) == self._robot_since:
                 continue  # (its figures stay the same while the robot on screen stays)
             try:
-                spec = robot_spec(robot)
-                kin = spec.build(**state.robot_parameters)
-                amap = spec.augmentation(state.augmentation).build(
-                    kin, **state.augmentation_parameters
-                )
+                _, amap = kinematics_and_map(state)
                 result = compute(
                     state, generation, cancelled=lambda: self._generation != generation,
                     cache=self._cache, with_augmenting=not expensive_map(amap),
                     offload=self._offload,
                 )  # fmt: skip
-                # The figures as the switch will make them (see _compute: no panel to reuse
-                # from another robot; the E1/E2 panel waits for the second phase unless known).
-                cached = self._functionals_cache.get(functionals_key(state))
-                functionals, sens = cached if cached else (None, None)
-                todo = set(PANELS) - (set() if cached else {"sensitivity"})
-                texts = self._panel_texts(result, functionals, sens, todo, remember=False)
+                # The figures as the switch will make them (see _compute; no panel to reuse
+                # from another robot).
+                cached, stale = self._known_functionals(state)
+                functionals, sens = cached or (None, None)
+                texts = self._panel_texts(
+                    result, functionals, sens, set(PANELS) - stale, remember=False
+                )
             except (Cancelled, JikError, ValueError):
                 return
             except Exception:  # (work ahead: logged, never shown as the current result's error)
                 log.exception("solving %s ahead failed", robot)
                 return
             digests = {k: _digest(t) for k, t in texts.items()}
-            sent = (self._robot_since, digests)
-            if solved and self._ahead_sent.get(robot) == sent:
-                continue
-            self._ahead_sent[robot] = sent
+            self._ahead_sent[robot] = self._robot_since
             head = {"type": "ahead", "generation": generation, "robot": robot,
                     "digests": digests}  # fmt: skip
             event = Event(
@@ -1195,6 +1196,14 @@ class Dashboard:
             with self._cond:
                 self._latest_ahead[robot] = event
             self._emit(event)
+
+    def _known_functionals(self, state: DashboardState) -> tuple[tuple | None, set[str]]:
+        """E1/E2 and their sensitivity for ``state`` when known (same map, same fixed
+        variables), and the panels that wait for the second phase: the E1/E2 panel unless
+        known (the page dims it meanwhile instead of redrawing a placeholder, 20-40 ms of its
+        redraw)."""
+        cached = self._functionals_cache.get(functionals_key(state))
+        return cached, (set() if cached else {"sensitivity"})
 
     def _panel_texts(
         self, result: DashboardResult, functionals, sens, todo: set[str], remember: bool
@@ -1241,7 +1250,6 @@ class Dashboard:
                     "elapsed": now - t0,
                 })))  # fmt: skip
 
-        spec = robot_spec(state.robot)
         # The h panel's box stays while it fits (augmenting_grid), for the same robot and task.
         on_screen = self.result
         grid_before = (
@@ -1251,8 +1259,7 @@ class Dashboard:
             else None
         )
         try:
-            kin = spec.build(**state.robot_parameters)
-            amap = spec.augmentation(state.augmentation).build(kin, **state.augmentation_parameters)
+            kin, amap = kinematics_and_map(state)
             deferred = expensive_map(amap)
             result = compute(
                 state, generation, progress=progress,
@@ -1270,14 +1277,9 @@ class Dashboard:
         key = _cache_key(state, "extended")
         reuse = {k for k in gamma_free_panels(result) if (k, key) in self._figures}
         texts = {k: self._figures[(k, key)] for k in reuse}
-        # The E1/E2 panel is drawn in the second phase; until then the page dims the old one
-        # ("stale") instead of redrawing a placeholder (20-40 ms of the page's redraw). Known
-        # functionals (same map, same fixed variables) are drawn at once.
-        fkey = functionals_key(state)
-        cached = self._functionals_cache.get(fkey)
-        stale = set() if cached else {"sensitivity"}
+        cached, stale = self._known_functionals(state)
         todo = set(PANELS) - reuse - stale
-        functionals, sens = cached if cached else (None, None)
+        functionals, sens = cached or (None, None)
         texts.update(self._panel_texts(result, functionals, sens, todo, remember=True))
         texts = {k: texts[k] for k in PANELS if k not in stale}
         self._figures = {(k, key): texts[k] for k in gamma_free_panels(result)}
@@ -1328,7 +1330,7 @@ class Dashboard:
                 sens = sensitivity(result, functionals, lambda: self._generation != generation)
             except Cancelled:
                 return
-            self._functionals_cache = {fkey: (functionals, sens)}
+            self._functionals_cache = {functionals_key(state): (functionals, sens)}
         if self._generation != generation:
             return
         message = {"type": "functionals", "generation": generation, "functionals": functionals,

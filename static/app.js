@@ -363,17 +363,16 @@ async function drawFigures(figures, digests = {}, robot = null) {
       });
     }));
   } finally {
-    for (const p of Object.values(pre)) if (p.div.isConnected && p.div.closest(".ahead")) { Plotly.purge(p.div); p.div.remove(); }
+    discard(Object.values(pre).filter((p) => p.div.closest(".ahead"))); // (those not shown)
   }
 }
 
 // Another robot's panels, drawn off screen from an "ahead" event (its default state, solved
 // while the page was idle): a switch to that robot shows them at once instead of drawing four
 // plotly figures (150-250 ms in the browser test), when the result's figure is the same.
-const ahead = { robots: {}, tokens: {} }; // robots: robot -> panel -> {div, digest}
-function dropAhead(robot) {
-  for (const p of Object.values(ahead.robots[robot] || {})) { Plotly.purge(p.div); p.div.remove(); }
-  delete ahead.robots[robot];
+const ahead = { robots: {}, tokens: {} }; // robots: robot -> panel -> {div, digest, width}
+function discard(panels) {
+  for (const p of panels) { Plotly.purge(p.div); p.div.remove(); }
 }
 async function onAhead(msg) {
   if (!jik.state || msg.robot === jik.state.robot) return;
@@ -382,7 +381,8 @@ async function onAhead(msg) {
   if (keys.length && keys.length === Object.keys(have).length && keys.every((k) => have[k].digest === msg.digests[k]
     && have[k].width === document.getElementById(`plot-${k}`).getBoundingClientRect().width)) return; // (drawn already)
   const token = (ahead.tokens[msg.robot] = (ahead.tokens[msg.robot] || 0) + 1); // (a newer one stops this)
-  dropAhead(msg.robot);
+  discard(Object.values(ahead.robots[msg.robot] || {}));
+  delete ahead.robots[msg.robot];
   let box = document.querySelector(".ahead");
   if (!box) {
     box = el("div", { className: "ahead", style: "position:absolute;left:-10000px;top:0" });
@@ -404,7 +404,7 @@ async function onAhead(msg) {
     panels[key] = { div, digest: msg.digests[key], width };
   }
   if (token === ahead.tokens[msg.robot] && msg.robot !== jik.state.robot) ahead.robots[msg.robot] = panels;
-  else for (const p of Object.values(panels)) { Plotly.purge(p.div); p.div.remove(); }
+  else discard(Object.values(panels));
 }
 function showAhead(div, pre, key, fig) {
   pre.id = div.id;
