@@ -157,9 +157,9 @@ class Pseudoinverse(Inverse):
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
         J = self.kinematics.jacobian(x)
         w, d = solve_small(gram(J), e)  # (J J^T) w = e
-        bad = ~(np.sqrt(np.abs(d)) >= SINGULAR_MANIPULABILITY)  # also catches NaN
+        bad = ~(np.abs(d) >= SINGULAR_MANIPULABILITY**2)  # m = sqrt(det); also catches NaN
         v = np.einsum("...ji,...j->...i", J, w)  # J^T w
-        return np.where(bad[..., None], 0.0, v), bad
+        return (np.where(bad[..., None], 0.0, v) if bad.any() else v), bad
 
     def matrix(self, x: FloatArray) -> FloatArray:
         x = self.kinematics.check(x)
@@ -200,8 +200,8 @@ class ExtendedInverse(Inverse):
         v, d = solve_small(Jbar, rhs)
         norms = np.prod(np.linalg.norm(Jbar, axis=-1), axis=-1)
         bad = undefined | ~(np.abs(d) >= SINGULAR_EXTENDED * norms)
-        bad |= ~np.all(np.isfinite(v), axis=-1)
-        return np.where(bad[..., None], 0.0, v), bad
+        bad |= ~np.isfinite(v).all(axis=-1)
+        return (np.where(bad[..., None], 0.0, v) if bad.any() else v), bad
 
     def matrix(self, x: FloatArray) -> FloatArray:
         x = self.kinematics.check(x)

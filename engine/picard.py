@@ -11,10 +11,18 @@ every sweep evaluates J# at all nodes of all batch members in one vectorized cal
 about twenty evaluations instead of several hundred for a step-by-step Runge-Kutta method.
 Segments are halved when the iteration does not contract or the Chebyshev tail shows the path
 is not resolved; members that cannot be resolved are handed back to the caller (DOP853 fallback).
+
+A member may come with a guess: the nodes of an earlier, nearby path (the same leg of the
+previous cycle of a closed path, say). A segment whose nodes are among the guess's starts its
+sweeps from the guess's values there, shifted to the segment's start, instead of from a constant.
+The sweeps, their convergence test and the resolution test are the same, so the result is the same
+fixed point to the sweep tolerance; only the number of sweeps falls (on a repeatable algorithm's
+second cycle, from about eight per leg to one or two).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from functools import lru_cache
 
 import numpy as np
@@ -31,6 +39,11 @@ SWEEP_TOL = 1e-13
 TAIL_TOL = 1e-12
 #: Segments shorter than this are given up (the path is near a singularity).
 MIN_SEGMENT = 1e-4
+#: A guess's node is used for a segment's node when their sigma differ by at most this.
+GUESS_MATCH = 1e-12
+
+#: A guess for one member: sigma (k,) ascending, ending at 1, and x there (k, p).
+Guess = tuple[FloatArray, FloatArray]
 
 
 @lru_cache(maxsize=4)
@@ -46,7 +59,24 @@ def chebyshev_operators(n: int) -> tuple[FloatArray, FloatArray, FloatArray]:
     return t, S, T
 
 
-def picard_path(inverse, x0: FloatArray, e0: FloatArray, max_sweeps_total: int):
+def _seeded(guess: Guess, a: float, h: float, unit: FloatArray, start: FloatArray):
+    """The guess's values at the nodes of the segment [a, a + h], moved to begin at ``start``;
+    None when the guess does not have all of them."""
+    gs, gx = guess
+    sig = a + h * unit
+    j = np.searchsorted(gs, sig - GUESS_MATCH)
+    if j[-1] >= len(gs) or not np.max(np.abs(gs[j] - sig)) <= GUESS_MATCH:
+        return None
+    return gx[j] - gx[j[0]] + start
+
+
+def picard_path(
+    inverse,
+    x0: FloatArray,
+    e0: FloatArray,
+    max_sweeps_total: int,
+    guess: Sequence[Guess | None] | None = None,
+):
     """Integrate (*) for a batch; see module docstring.
 
     Parameters
@@ -57,6 +87,9 @@ def picard_path(inverse, x0: FloatArray, e0: FloatArray, max_sweeps_total: int):
         k(x0) - y_d.
     max_sweeps_total : int
         Cap on Picard sweeps per member.
+    guess : sequence of (sigma (k,), x (k, p)) or None, optional
+        Per member, the nodes of a nearby path with sigma ascending and its last node at
+        sigma = 1 (see module docstring), or None.
 
     Returns
     -------
@@ -82,6 +115,18 @@ def picard_path(inverse, x0: FloatArray, e0: FloatArray, max_sweeps_total: int):
     done = np.zeros(n, dtype=bool)
     failed = np.zeros(n, dtype=bool)
     records = []
+    guesses = [None] * n if guess is None else list(guess)
+
+    def seed(ids) -> None:
+        """Start the new segments of members ``ids`` from their guesses where those fit."""
+        for i in ids:
+            g = guesses[i]
+            values = None if g is None else _seeded(g, a[i], H[i], unit, xa[i])
+            if values is not None:
+                X[i] = values
+
+    if guess is not None:
+        seed(range(n))
     while True:
         act = np.flatnonzero(~done & ~failed)
         if act.size == 0:
@@ -100,10 +145,13 @@ def picard_path(inverse, x0: FloatArray, e0: FloatArray, max_sweeps_total: int):
         while True:
             v, bad = inverse.apply_masked(Xw.reshape(m * nn, p), Ew)
             Xn = base - half * (S @ v.reshape(m, nn, p))  # S (nn, nn) @ (m, nn, p)
-            diff = np.max(np.abs(Xn - Xw) / (1.0 + np.abs(Xn)), axis=(1, 2))
+            # (ndarray methods and in-place ufuncs: this loop is mostly per-call overhead)
+            change = np.abs(Xn - Xw)
+            change /= np.abs(Xn) + 1.0
+            diff = change.max(axis=(1, 2))
             Xw = Xn
             k += 1
-            if k >= room or np.any(bad) or not diff.min() >= SWEEP_TOL:  # (NaN is an event)
+            if k >= room or bad.any() or not diff.min() >= SWEEP_TOL:  # (NaN is an event)
                 break
         bad = bad.reshape(m, nn).any(axis=1)
         X[act] = Xw
@@ -134,6 +182,8 @@ def picard_path(inverse, x0: FloatArray, e0: FloatArray, max_sweeps_total: int):
                 H[acc] = np.minimum(H[acc], np.maximum(1.0 - a[acc], 0.0))
                 sweeps_seg[acc] = 0
                 X[acc] = xa[acc, None, :]
+                if guess is not None:
+                    seed(acc[~fin])
             halve_res = ci[~resolved]
         else:
             halve_res = np.zeros(0, dtype=int)
@@ -143,6 +193,8 @@ def picard_path(inverse, x0: FloatArray, e0: FloatArray, max_sweeps_total: int):
             H[halve] /= 2.0
             sweeps_seg[halve] = 0
             X[halve] = xa[halve, None, :]
+            if guess is not None:
+                seed(halve)
             failed[halve[H[halve] < MIN_SEGMENT]] = True
         failed |= ~done & (sweeps >= max_sweeps_total)
     return xa, done, a, sweeps, records

@@ -12,6 +12,7 @@ in section 6.2.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 
@@ -20,7 +21,7 @@ from scipy.integrate._ivp import dop853_coefficients as _dop
 
 from engine.exceptions import InvalidInputError
 from engine.inverses import Inverse
-from engine.picard import picard_path
+from engine.picard import Guess, picard_path
 from engine.validation import FloatArray, count, positive
 
 _NS = _dop.N_STAGES
@@ -244,7 +245,44 @@ def _dop853(inverse, x0, y_d, tol, max_steps, record, tau0, rtol=RTOL, atol=ATOL
     return x, tau, status, nsteps, rec
 
 
-def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto"):
+def _guesses(guess, n: int, p: int, gamma: float) -> list[Guess | None] | None:
+    """Picard guesses (sigma, x) from earlier trajectories (see :func:`solve`), validated."""
+    if guess is None:
+        return None
+    items = [guess] if isinstance(guess, Trajectory) else list(guess)
+    if len(items) != n:
+        raise InvalidInputError(
+            f"guess has {len(items)} trajectories for {n} start configurations; give one "
+            "Trajectory (or None) per start"
+        )
+    out: list[Guess | None] = []
+    for k, tr in enumerate(items):
+        if tr is None:
+            out.append(None)
+            continue
+        if not isinstance(tr, Trajectory):
+            raise InvalidInputError(
+                f"guess[{k}] must be a Trajectory (a SolveResult's .trajectory) or None"
+            )
+        theta = np.asarray(tr.theta, dtype=float)
+        x = np.asarray(tr.x, dtype=float)
+        if theta.ndim != 1 or x.shape != (len(theta), p) or len(theta) < 2:
+            raise InvalidInputError(
+                f"guess[{k}] must have theta of shape (m,) and x of shape (m, {p}), m >= 2"
+            )
+        if not (np.all(np.isfinite(theta)) and np.all(np.isfinite(x))):
+            raise InvalidInputError(f"guess[{k}] contains NaN or infinite values")
+        if np.any(np.diff(theta) <= 0):
+            raise InvalidInputError(f"guess[{k}].theta must be increasing")
+        # The homotopy parameter of (*) in engine.picard: sigma = 1 - exp(-gamma theta); the
+        # last point of a converged leg is its end, sigma = 1.
+        sigma = -np.expm1(-gamma * (theta - theta[0]))
+        sigma[-1] = 1.0
+        out.append((sigma, x))
+    return out
+
+
+def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto", guess=None):
     """Chebyshev-Picard on the homotopy form (engine.picard), then DOP853 where needed.
 
     Members that Picard integrates to sigma = 1 with error < tol are done. The others (an
@@ -273,7 +311,10 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto"):
     # Picard pays (DEGREE + 1) evaluations of J# per sweep: on a path that needs many halvings
     # (near a singularity) DOP853 is cheaper, so Picard gets a budget and DOP853 takes over.
     budget = max_steps if method == "picard" else min(max_steps, PICARD_BUDGET)
-    x1, done, sigma, sweeps, prec = picard_path(inverse, x0[moving], e0[moving], budget)
+    x1, done, sigma, sweeps, prec = picard_path(
+        inverse, x0[moving], e0[moving], budget,
+        None if guess is None else [guess[i] for i in moving],
+    )  # fmt: skip
     nit[moving] = sweeps
     if rec is not None:
         for mem, sig, xs in prec:
@@ -368,6 +409,7 @@ def solve(
     max_iterations: int | None = None,
     record: bool = True,
     method: str = "auto",
+    guess: Trajectory | Sequence[Trajectory | None] | None = None,
 ) -> SolveResult | BatchSolveResult:
     """Solve k(x) = y_d by the continuation algorithm (7) with the right inverse J#.
 
@@ -393,6 +435,11 @@ def solve(
         Continuous mode only: Chebyshev-Picard with a sweep budget and DOP853 after it
         ("auto"), Picard alone (DOP853 only where it fails), or DOP853 alone. "dop853" suits
         maps that are expensive per point (the unicycle's characteristics map).
+    guess : Trajectory, or a sequence of Trajectory or None (one per start), optional
+        Continuous mode: the trajectory of a nearby earlier solve with the same gamma, such as
+        the same leg in the previous cycle of a closed path. Picard starts its sweeps from it
+        where its nodes are those of a segment (:mod:`engine.picard`). The result is the same
+        to the sweep tolerance; only the work falls. It is not used by DOP853.
 
     Returns
     -------
@@ -430,6 +477,9 @@ def solve(
         raise InvalidInputError(f"method must be 'auto', 'picard' or 'dop853', got {method!r}")
     if mode not in ("continuous", "discrete"):
         raise InvalidInputError(f"mode must be 'continuous' or 'discrete', got {mode!r}")
+    if guess is not None and mode != "continuous":
+        raise InvalidInputError("guess applies to continuous mode only")
+    guesses = _guesses(guess, len(xb), kin.p, gamma)
     if mode == "discrete" and gamma >= 2:
         raise InvalidInputError(
             f"gamma must be < 2 in discrete mode (got {gamma:g}): the error shrinks by "
@@ -445,7 +495,7 @@ def solve(
         raise inverse.singular_error(xb[np.flatnonzero(bad)[0]])
 
     if mode == "continuous":
-        x, _, status, nit, rec = _continuous(inverse, xb, yb, tol, cap, record, method)
+        x, _, status, nit, rec = _continuous(inverse, xb, yb, tol, cap, record, method, guesses)
         theta_scale = 1.0 / gamma
     else:
         x, _, status, nit, rec = _discrete(inverse, xb, yb, gamma, tol, cap, record)

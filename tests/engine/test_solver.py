@@ -178,3 +178,84 @@ def test_run_into_undefined_h_stops_with_message_and_nan():
     assert not res.success
     assert "'characteristics' is undefined" in res.message and "stopped" in res.message
     assert np.isnan(res.trajectory.h[-1]) and np.all(np.isfinite(res.trajectory.h[:-1]))
+
+
+# -- warm start (guess): the same fixed point, fewer Picard sweeps ------------------------------
+
+
+def test_guess_of_the_same_leg_gives_the_same_path_in_one_or_two_sweeps():
+    """The extended inverse is repeatable: a closed path's second cycle repeats the first, and
+    with the first cycle's leg as its guess a leg takes one or two sweeps instead of ~ten."""
+    inv = ExtendedInverse(Manipulator2(), PaperCubic())
+    cold = solve(inv, X0, [1, 2])
+    warm = solve(inv, X0, [1, 2], guess=cold.trajectory)
+    assert cold.nit >= 6 and warm.nit <= 2, (cold.nit, warm.nit)
+    assert warm.success
+    np.testing.assert_allclose(warm.x, cold.x, atol=1e-12)
+    np.testing.assert_allclose(warm.trajectory.theta, cold.trajectory.theta, atol=1e-12)
+    np.testing.assert_allclose(warm.trajectory.x, cold.trajectory.x, atol=1e-12)
+
+
+@pytest.mark.parametrize("shift", [1e-3, 0.1, 0.6])
+@pytest.mark.parametrize("algorithm", ["pseudoinverse", "extended"])
+def test_guess_from_a_nearby_or_distant_start_changes_nothing_but_the_work(algorithm, shift):
+    """Picard only starts from the guess: its convergence and resolution tests are the cold
+    start's, so the end point agrees to the sweep tolerance however good the guess is."""
+    kin = Manipulator2()
+    inv = Pseudoinverse(kin) if algorithm == "pseudoinverse" else ExtendedInverse(kin, PaperCubic())
+    other = solve(inv, X0 + shift, [1.0 - shift, 2.0])
+    cold = solve(inv, X0, [1, 2])
+    warm = solve(inv, X0, [1, 2], guess=other.trajectory)
+    assert warm.success
+    np.testing.assert_allclose(warm.x, cold.x, atol=1e-11)
+    np.testing.assert_allclose(kin.forward(warm.x), [1, 2], atol=1e-10)
+
+
+def test_guess_with_another_gamma_is_harmless():
+    """The guess's theta is read with this solve's gamma: a wrong one matches no node, and the
+    solve starts cold."""
+    inv = Pseudoinverse(Manipulator2())
+    cold = solve(inv, X0, [1, 2])
+    warm = solve(inv, X0, [1, 2], gamma=3.0, guess=cold.trajectory)
+    assert warm.nit == cold.nit
+    np.testing.assert_allclose(warm.x, cold.x, atol=1e-12)
+
+
+def test_guess_per_member_in_a_batch():
+    inv = ExtendedInverse(Manipulator2(), PaperCubic())
+    starts = np.array([X0, X0 + 0.05])
+    cold = solve(inv, starts, [1, 2])
+    warm = solve(inv, starts, [1, 2], guess=[cold.trajectory(0), None])
+    assert warm.nit[0] <= 2 and warm.nit[1] == cold.nit[1]
+    np.testing.assert_allclose(warm.x, cold.x, atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("guess", "kwargs", "match"),
+    [
+        ("good", {"mode": "discrete"}, "continuous mode only"),
+        ([None, None], {}, "2 trajectories for 1 start"),
+        ("text", {}, r"guess\[0\] must be a Trajectory"),
+        ("short", {}, r"x of shape \(m, 3\), m >= 2"),
+        ("nan", {}, "NaN or infinite"),
+        ("backwards", {}, "theta must be increasing"),
+    ],
+)
+def test_bad_guess_is_rejected_with_a_clear_message(guess, kwargs, match):
+    from dataclasses import replace
+
+    inv = Pseudoinverse(Manipulator2())
+    tr = solve(inv, X0, [1, 2]).trajectory
+    bad = (
+        {
+            "good": tr,
+            "text": ["not a trajectory"],
+            "short": replace(tr, x=tr.x[:, :2]),
+            "nan": replace(tr, x=np.where(np.arange(len(tr.x))[:, None] == 3, np.nan, tr.x)),
+            "backwards": replace(tr, theta=tr.theta[::-1]),
+        }.get(guess, guess)
+        if isinstance(guess, str)
+        else guess
+    )
+    with pytest.raises(InvalidInputError, match=match):
+        solve(inv, X0, [1, 2], guess=bad, **kwargs)
