@@ -34,7 +34,7 @@ import numpy as np
 from engine.exceptions import InvalidInputError, JikError
 from engine.registry import ROBOTS, make_inverse, robot_spec
 from engine.repeatability import MAX_PATH_POINTS, closed_path
-from engine.solver import SolveResult, solve
+from engine.solver import SolveResult, Trajectory, solve
 from engine.unicycle import Unicycle
 from engine.validation import count, positive
 
@@ -262,18 +262,19 @@ CHUNK = 80
 MAX_DISCRETE_ITERATIONS = 2000
 
 
-def _solve_leg(inverse, x, target, state, gamma, cancelled, partial=lambda f: None):
+def _solve_leg(inverse, x, target, state, gamma, cancelled, partial=lambda f: None, guess=None):
     """One leg: a solve, or in discrete mode a chain of short solves (the same iterates).
 
     The discrete iteration x <- x - gamma J#(x) e(x) has no memory, so stopping after CHUNK
     iterations and restarting from the last iterate reproduces the uninterrupted sequence.
-    Returns (theta, x, y, error, h, success, message) of the whole leg.
+    ``guess``: continuous mode, the same leg's trajectory in the previous cycle (see
+    :func:`engine.solver.solve`). Returns (theta, x, y, error, h, success, message) of the
+    whole leg.
     """
     if state.mode == "continuous":
         # One start configuration: a single result, recorded (record=True by default).
-        res = cast(
-            SolveResult, solve(inverse, x, target, gamma=gamma, mode="continuous", tol=state.tol)
-        )
+        res = cast(SolveResult, solve(inverse, x, target, gamma=gamma, mode="continuous",
+                                      tol=state.tol, guess=guess))  # fmt: skip
         tr = res.trajectory
         assert tr is not None  # record=True
         return tr.theta, tr.x, tr.y, tr.error, tr.h, res.success, res.message, res.x
@@ -332,6 +333,11 @@ def _run_legs(
     ``resume``: a successful run of fewer cycles of the same legs, whose cycles are kept; the
     legs go on from its end (the same numbers as a run from the start: a leg depends only on
     where it starts and its target).
+
+    In continuous mode each leg after the first cycle starts its Picard sweeps from the same leg
+    of the previous cycle (``guess`` of :func:`engine.solver.solve`): for the extended inverse,
+    repeatable, that is the path itself and a leg then costs one or two sweeps instead of about
+    eight.
     """
     t0 = time.perf_counter()
     x0 = np.asarray(state.x0)
@@ -342,17 +348,22 @@ def _run_legs(
     success, message, last_message = True, "completed", ""
     L = len(targets)
     first = 0
+    guides: list[Trajectory | None] = [None] * L  # leg j of the previous cycle
     if resume is not None:
         first = len(resume.drift)
         parts.append((resume.theta, resume.x, resume.y, resume.error, resume.h, resume.leg))
         ends, drift = list(resume.leg_end), list(resume.drift)
         current, offset = resume.leg_end[-1], float(resume.theta[-1])
+        if state.mode == "continuous":
+            guides = [_leg_trajectory(resume, (first - 1) * L + j) for j in range(L)]
     for c in range(first, cycles):
         for j in range(L):
             if cancelled():
                 raise Cancelled
             try:
-                leg = _solve_leg(inverse, current, targets[j], state, gamma, cancelled, partial)
+                leg = _solve_leg(
+                    inverse, current, targets[j], state, gamma, cancelled, partial, guides[j]
+                )
             except JikError as exc:
                 # A map undefined on the way (an algorithmic singularity, a characteristic that
                 # cannot be resolved) stops this algorithm; the other one is still shown.
@@ -366,6 +377,8 @@ def _run_legs(
                 break
             theta, xs, ys, err, h, ok, msg, x_end = leg
             parts.append((theta + offset, xs, ys, err, h, c * L + j))
+            if state.mode == "continuous" and ok:
+                guides[j] = Trajectory(theta=theta, x=xs, y=ys, error=err, h=h)
             offset += float(theta[-1])
             progress()
             if not ok:
@@ -392,6 +405,15 @@ def _run_legs(
         message=message if not success else _legs_message(len(ends), drift, last_message),
         seconds=time.perf_counter() - t0,
     )
+
+
+def _leg_trajectory(run: AlgorithmRun, k: int) -> Trajectory | None:
+    """Leg ``k`` of a run as a trajectory (theta from the leg's start), None if not there."""
+    at = run.leg == k
+    if np.count_nonzero(at) < 2:
+        return None
+    return Trajectory(theta=run.theta[at] - run.theta[at][0], x=run.x[at], y=run.y[at],
+                      error=run.error[at], h=None if run.h is None else run.h[at])  # fmt: skip
 
 
 def _legs_message(legs: int, drift, last_message: str) -> str:

@@ -88,6 +88,35 @@ def test_closed_path_matches_the_engine_repeatability_test():
     assert result.runs["extended"].drift[-1] < 1e-8
 
 
+def test_later_cycles_start_from_the_previous_cycle_and_agree_with_a_cold_start(monkeypatch):
+    """Each leg after the first cycle is guessed by the same leg of the cycle before (see
+    engine.picard): the extended inverse, repeatable, then takes one or two sweeps a leg."""
+    import engine.solver
+
+    state = default_state("manipulator2")
+    sweeps: list[int] = []
+    picard = engine.solver.picard_path
+
+    def counted(*args, **kwargs):
+        out = picard(*args, **kwargs)
+        sweeps.append(int(out[3][0]))
+        return out
+
+    monkeypatch.setattr(engine.solver, "picard_path", counted)
+    warm = compute(state)
+    L = len(warm.targets)
+    per_run = {a: sweeps[k * 3 * L : (k + 1) * 3 * L] for k, a in enumerate(ALGORITHMS)}
+    first, later = per_run["extended"][:L], per_run["extended"][L:]
+    assert sum(first) >= 20 and max(later) <= 2, per_run  # (cold: 13, 2, 13, 2)
+    monkeypatch.setattr(engine.solver, "_guesses", lambda *args: None)
+    cold = compute(state)
+    for a in ALGORITHMS:
+        np.testing.assert_allclose(warm.runs[a].leg_end, cold.runs[a].leg_end, atol=1e-12)
+        np.testing.assert_allclose(warm.runs[a].x, cold.runs[a].x, atol=1e-12)
+        np.testing.assert_allclose(warm.runs[a].theta, cold.runs[a].theta, atol=1e-9)
+    assert warm.runs["extended"].drift[-1] < 1e-13
+
+
 def test_gamma_in_continuous_mode_rescales_theta_without_a_new_integration():
     cache: dict = {}
     s1 = updated_state(default_state("manipulator2"), {"task": "target"})
