@@ -6,6 +6,9 @@
 2. 4096 start configurations through Table 1's four-leg path: one batched
    ``engine.repeatability.repeatability`` call against the straightforward code run leg by leg
    (a subset of starts, timed per leg).
+3. Three cycles of Table 1's path for one start with the extended inverse (paper_cubic), leg by
+   leg as the dashboard runs them: each leg from a cold start against each leg after the first
+   cycle guessed by the same leg of the cycle before (``solve(..., guess=)``).
 """
 
 from __future__ import annotations
@@ -13,14 +16,16 @@ from __future__ import annotations
 import math
 import statistics
 import time
+from typing import cast
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from engine.inverses import Pseudoinverse
+from engine.augmentations import PaperCubic
+from engine.inverses import ExtendedInverse, Pseudoinverse
 from engine.kinematics import Manipulator2
-from engine.repeatability import repeatability
-from engine.solver import ATOL, RTOL, solve
+from engine.repeatability import closed_path, repeatability
+from engine.solver import ATOL, RTOL, SolveResult, solve
 
 X0 = np.array([0.0, 0.0, math.pi / 2])
 PATH = np.array([(1.0, 1.0), (1.0, 2.0), (0.0, 2.0), (0.0, 1.0)])
@@ -49,6 +54,21 @@ def median_time(fn, repeat: int) -> float:
         fn()
         times.append(time.perf_counter() - t)
     return statistics.median(times)
+
+
+def cycles_leg_by_leg(inverse, x0, cycles: int, guessed: bool):
+    """``cycles`` cycles of Table 1's path (closed), one solve per leg; returns the leg ends
+    and the Picard sweeps."""
+    targets = closed_path(inverse.kinematics, x0[None], PATH)[0]
+    guides: list = [None] * len(targets)
+    cur, ends, sweeps = x0, [], 0
+    for _ in range(cycles):
+        for j, y in enumerate(targets):
+            res = cast(SolveResult, solve(inverse, cur, y, guess=guides[j] if guessed else None))
+            guides[j], cur = res.trajectory, res.x
+            ends.append(cur)
+            sweeps += res.nit
+    return np.array(ends), sweeps
 
 
 def run(quick: bool = False) -> dict:
@@ -84,7 +104,21 @@ def run(quick: bool = False) -> dict:
     ref = np.array(
         [straightforward_leg(kin, starts[0], y) for y in res.targets[0][:1]]
     )  # same first leg
+    ext = ExtendedInverse(kin, PaperCubic())
+    cold_ends, cold_sweeps = cycles_leg_by_leg(ext, X0, 3, guessed=False)
+    warm_ends, warm_sweeps = cycles_leg_by_leg(ext, X0, 3, guessed=True)
+    cold_t = median_time(lambda: cycles_leg_by_leg(ext, X0, 3, guessed=False), rep)
+    warm_t = median_time(lambda: cycles_leg_by_leg(ext, X0, 3, guessed=True), rep)
     return {
+        "cycles": {
+            "legs": len(cold_ends),
+            "cold_ms": 1e3 * cold_t,
+            "guessed_ms": 1e3 * warm_t,
+            "ratio": cold_t / warm_t,
+            "cold_sweeps": int(cold_sweeps),
+            "guessed_sweeps": int(warm_sweeps),
+            "leg_end_difference": float(np.max(np.abs(cold_ends - warm_ends))),
+        },
         "single_leg": {
             "jik_ms": 1e3 * ours,
             "solve_ivp_rk45_ms": 1e3 * rk45,
@@ -126,6 +160,14 @@ def main(quick: bool = False) -> dict:
         f"(median of {b['straightforward_sample']} legs)   ratio {b['ratio']:7.0f}x"
     )
     print(f"  |first leg jik - solve_ivp| {b['first_leg_difference']:.2e}")
+    c = r["cycles"]
+    print(f"3 cycles of Table 1's path, extended inverse, {c['legs']} legs one by one:")
+    print(f"  every leg cold          {c['cold_ms']:9.2f} ms ({c['cold_sweeps']} sweeps)")
+    print(
+        f"  guessed by cycle before {c['guessed_ms']:9.2f} ms ({c['guessed_sweeps']} sweeps)"
+        f"   ratio {c['ratio']:6.2f}x"
+    )
+    print(f"  max |leg end difference| {c['leg_end_difference']:.2e}")
     return r
 
 

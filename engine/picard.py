@@ -76,6 +76,7 @@ def picard_path(
     e0: FloatArray,
     max_sweeps_total: int,
     guess: Sequence[Guess | None] | None = None,
+    check_start: bool = False,
 ):
     """Integrate (*) for a batch; see module docstring.
 
@@ -90,6 +91,10 @@ def picard_path(
     guess : sequence of (sigma (k,), x (k, p)) or None, optional
         Per member, the nodes of a nearby path with sigma ascending and its last node at
         sigma = 1 (see module docstring), or None.
+    check_start : bool
+        Raise ``inverse.singular_error`` at a start configuration where J# is undefined. The
+        first sweep evaluates J# there (every segment's first node is its start), so this costs
+        nothing; without it such a member is halved down to MIN_SEGMENT and fails.
 
     Returns
     -------
@@ -127,6 +132,7 @@ def picard_path(
 
     if guess is not None:
         seed(range(n))
+    first = check_start
     while True:
         act = np.flatnonzero(~done & ~failed)
         if act.size == 0:
@@ -144,6 +150,11 @@ def picard_path(
         k = 0
         while True:
             v, bad = inverse.apply_masked(Xw.reshape(m * nn, p), Ew)
+            if first:  # (every member, at its start: node 0)
+                first = False
+                at_start = bad.reshape(m, nn)[:, 0]
+                if at_start.any():
+                    raise inverse.singular_error(x0[act[np.argmax(at_start)]])
             Xn = base - half * (S @ v.reshape(m, nn, p))  # S (nn, nn) @ (m, nn, p)
             # (ndarray methods and in-place ufuncs: this loop is mostly per-call overhead)
             change = np.abs(Xn - Xw)

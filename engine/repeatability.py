@@ -123,6 +123,11 @@ def repeatability(
     messages = ["repeatability run completed"] * n
     current = xb.copy()
     leg_results: list[SolveResult] = []
+    # One start in continuous mode: each leg after the first cycle starts its Picard sweeps from
+    # the same leg of the cycle before (solve's guess; the extended inverse then repeats it in
+    # one or two sweeps a leg). Batches do without: a guess is per member.
+    guided = single and mode == "continuous"
+    guides: list = [None] * L
     for c in range(cycles):
         for j in range(L):
             ids = np.flatnonzero(alive)
@@ -139,9 +144,12 @@ def repeatability(
                     mode=mode,
                     tol=tol,
                     max_iterations=max_iterations,
-                    record=record and single,
+                    record=(record or guided) and single,
+                    guess=[guides[j]] if guided else None,
                 ),
             )
+            if guided and res.success[0]:
+                guides[j] = res.trajectory(0)
             if record and single:
                 leg_results.append(res[0])
             current[ids] = res.x

@@ -293,6 +293,9 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto", guess=N
     e0 = inverse.kinematics.forward(x0) - y_d
     err0 = np.linalg.norm(e0, axis=-1)
     moving = np.flatnonzero(err0 >= tol)
+    # A singular start raises. Picard's first sweep evaluates J# at every moving start: only
+    # the members already at their target (and every start for DOP853 alone) are checked here.
+    _check_start(inverse, x0, e0, slice(None) if method == "dop853" else err0 < tol)
     x = x0.copy()
     tau = np.zeros(n)
     status = np.full(n, _CONVERGED)
@@ -313,7 +316,7 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto", guess=N
     budget = max_steps if method == "picard" else min(max_steps, PICARD_BUDGET)
     x1, done, sigma, sweeps, prec = picard_path(
         inverse, x0[moving], e0[moving], budget,
-        None if guess is None else [guess[i] for i in moving],
+        None if guess is None else [guess[i] for i in moving], check_start=True,
     )  # fmt: skip
     nit[moving] = sweeps
     if rec is not None:
@@ -344,11 +347,21 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto", guess=N
     return x, tau, status, nit, rec
 
 
+def _check_start(inverse, x0, e0, which) -> None:
+    """Raise the inverse's typed error at the first singular start among ``x0[which]``."""
+    x, e = x0[which], e0[which]
+    if len(x):
+        _, bad = inverse.apply_masked(x, e)
+        if bad.any():
+            raise inverse.singular_error(x[np.flatnonzero(bad)[0]])
+
+
 def _discrete(inverse, x0, y_d, gamma, tol, max_iterations, record):
     """x <- x - gamma J#(x) (k(x) - y_d) (section 6.2) until ||e|| < tol."""
     n = x0.shape[0]
     x = x0.copy()
     e = inverse.kinematics.forward(x) - y_d
+    _check_start(inverse, x, e, slice(None))
     err = np.linalg.norm(e, axis=-1)
     err0 = err.copy()
     status = np.full(n, _RUNNING)
@@ -489,10 +502,6 @@ def solve(
     cap = count(
         default_cap if max_iterations is None else max_iterations, "max_iterations", 1, 10**6
     )
-
-    _, bad = inverse.apply_masked(xb, kin.forward(xb) - yb)
-    if np.any(bad):
-        raise inverse.singular_error(xb[np.flatnonzero(bad)[0]])
 
     if mode == "continuous":
         x, _, status, nit, rec = _continuous(inverse, xb, yb, tol, cap, record, method, guesses)

@@ -67,6 +67,34 @@ def test_batch_of_starts_matches_single_runs():
         np.testing.assert_allclose(batch.legs[i], one.legs, atol=1e-9)
 
 
+@pytest.mark.parametrize("algorithm", ["pseudoinverse", "extended"])
+def test_one_start_guesses_later_cycles_and_agrees_with_the_batch(algorithm, monkeypatch):
+    """A single start guesses each leg after the first cycle by the cycle before (solve's
+    guess); a batch does not. The legs agree to the sweep tolerance, and the repeatable
+    extended inverse runs its later cycles in one or two sweeps a leg."""
+    import engine.solver
+
+    kin = Manipulator2()
+    inv = Pseudoinverse(kin) if algorithm == "pseudoinverse" else ExtendedInverse(kin, PaperCubic())
+    x0 = np.array([0, 0, math.pi / 2])
+    path = [(1, 1), (1, 2), (0, 2), (0, 1)]
+    sweeps: list[int] = []
+    picard = engine.solver.picard_path
+
+    def counted(*args, **kwargs):
+        out = picard(*args, **kwargs)
+        sweeps.append(int(out[3][0]))
+        return out
+
+    monkeypatch.setattr(engine.solver, "picard_path", counted)
+    one = repeatability(inv, x0, path, cycles=3)
+    monkeypatch.undo()
+    batch = repeatability(inv, np.array([x0, x0]), path, cycles=3)
+    np.testing.assert_allclose(one.legs, batch.legs[0], atol=1e-12)
+    if algorithm == "extended":
+        assert max(sweeps[4:]) <= 2 and sum(sweeps[:4]) >= 20, sweeps
+
+
 def test_record_keeps_every_leg_trajectory():
     kin = Manipulator2()
     res = repeatability(Pseudoinverse(kin), [0, 0, math.pi / 2], [(1, 1), (0, 1)], record=True)

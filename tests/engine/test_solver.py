@@ -110,10 +110,21 @@ def test_unreachable_pass_through_algorithmic_singularity_stops_with_message():
     assert "singular" in res.message or "stalled" in res.message
 
 
-def test_singular_start_raises_typed_error():
+@pytest.mark.parametrize(
+    "kwargs",
+    [{}, {"method": "picard"}, {"method": "dop853"}, {"mode": "discrete", "gamma": 0.5}],
+)
+def test_singular_start_raises_typed_error(kwargs):
+    """Continuous Picard finds a singular start in its first sweep (it evaluates J# there);
+    DOP853 alone and discrete mode check it first."""
     inv = ExtendedInverse(Manipulator1(), E2Optimal(a=1.0, b=0.0))
     with pytest.raises(AlgorithmicSingularityError, match=r"x = \(0, 0.2, 1\)"):
-        solve(inv, [0.0, 0.2, 1.0], [1.0, 1.0])
+        solve(inv, [0.0, 0.2, 1.0], [1.0, 1.0], **kwargs)
+    # in a batch, moving or already at its target
+    at_target = inv.kinematics.forward(np.array([0.0, 0.2, 1.0]))
+    for y in ([1.0, 1.0], at_target):
+        with pytest.raises(AlgorithmicSingularityError, match=r"x = \(0, 0.2, 1\)"):
+            solve(inv, [[0.5, 0.5, 1.0], [0.0, 0.2, 1.0]], [[1.0, 1.0], y], **kwargs)
 
 
 @pytest.mark.parametrize(
