@@ -561,19 +561,72 @@ def _cache_key(state: DashboardState, algorithm: str) -> str:
     return json.dumps(d, sort_keys=True)
 
 
+def inert_variables(kin, amap, box: tuple[tuple[float, float], ...], samples: int = 8):
+    """Joint variables x_k that neither J nor h nor dh depends on.
+
+    At seeded points of ``box`` (one interval per variable), shifting x_k must leave J, h and dh
+    bitwise unchanged (NaN where undefined included): an expression without x_k evaluates the
+    same, one that merely cancels it would not and counts as dependent. A slice of h at x_k's
+    start value then does not depend on that value, nor do E1 (13) and E2 (18), whose integrands
+    are functions of J and dh. Maps that solve a problem per point are not probed (empty set).
+    """
+    if expensive_map(amap):
+        return frozenset()
+    lo, hi = np.array(box, dtype=float).T
+    X = np.random.default_rng(0).uniform(lo, hi, (samples, len(lo)))
+
+    def probe(x):
+        with np.errstate(all="ignore"):
+            return (kin.jacobian(x), amap.value_masked(x)[0], amap.gradient_masked(x)[0])
+
+    at = probe(X)
+    inert = set()
+    for k in range(len(lo)):
+        shifted = X.copy()
+        shifted[:, k] += 0.371 * (hi[k] - lo[k])
+        again = probe(shifted)
+        if all(np.array_equal(a, b, equal_nan=True) for a, b in zip(at, again, strict=True)):
+            inert.add(k)
+    return frozenset(inert)
+
+
+@functools.lru_cache(maxsize=64)
+def _inert_for(key: str) -> frozenset[int]:
+    d = json.loads(key)
+    spec = robot_spec(d["robot"])
+    kin = spec.build(**d["robot_parameters"])
+    amap = spec.augmentation(d["augmentation"]).build(kin, **d["augmentation_parameters"])
+    box = spec.x_range or ((-1.0, 1.0),) * kin.p
+    return inert_variables(kin, amap, box)
+
+
+def state_inert_variables(state: DashboardState) -> frozenset[int]:
+    """:func:`inert_variables` of the state's kinematics and map over the robot's x_range
+    (cached per robot, map and parameters)."""
+    d = state.as_dict()
+    keys = ("robot", "robot_parameters", "augmentation", "augmentation_parameters")
+    return _inert_for(json.dumps({k: d[k] for k in keys}, sort_keys=True))
+
+
 def functionals_key(state: DashboardState) -> str:
     """Everything E1, E2 and their sensitivity depend on (see :func:`error_functionals`).
 
     On a robot's design region: the robot, the map and the start values of the variables
-    outside the region (held fixed); the path, the cycles, gamma and the rest of x0 do not
-    matter. Without a design region the box follows the runs: everything they depend on.
+    outside the region (held fixed) that J or dh depends on (:func:`inert_variables`); the path,
+    the cycles, gamma and the rest of x0 do not matter. Without a design region the box follows
+    the runs: everything they depend on.
     """
     spec = robot_spec(state.robot)
     design = spec.functional_region
     if not design:
         return _cache_key(state, "extended")
     d = state.as_dict()
-    fixed = {n: d["x0"][k] for k, n in enumerate(spec.variable_names) if n not in design}
+    inert = state_inert_variables(state)
+    fixed = {
+        n: d["x0"][k]
+        for k, n in enumerate(spec.variable_names)
+        if n not in design and k not in inert
+    }
     return json.dumps(
         {k: d[k] for k in ("robot", "robot_parameters", "augmentation",
                            "augmentation_parameters")} | {"fixed": fixed},

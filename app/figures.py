@@ -19,7 +19,7 @@ import math
 import numpy as np
 import plotly.graph_objects as go
 
-from app.dashboard import ALGORITHMS, COLORS, LABELS, DashboardResult
+from app.dashboard import ALGORITHMS, COLORS, LABELS, DashboardResult, state_inert_variables
 
 #: Units of the joint and task variables, by robot (the registry does not carry units).
 UNITS = {
@@ -526,7 +526,14 @@ def augmenting_title(result: DashboardResult, functionals: dict | None = None) -
             sub.append(", ".join(
                 f"{k} = {v:.4g}" if v is not None else f"{k} undefined" for k, v in values.items()
             ) + f" on {where}")  # fmt: skip
-    fixed = [f"{n} = {x0[k]:.3g}" for k, n in enumerate(result.variable_names) if k not in (i, j)]
+    # The slice's other variables, unless neither h nor J depends on them (Manipulator 2's x1
+    # for h(x2, x3)): their values would say nothing, and the title would change with them.
+    inert = state_inert_variables(result.state)
+    fixed = [
+        f"{n} = {x0[k]:.3g}"
+        for k, n in enumerate(result.variable_names)
+        if k not in (i, j) and k not in inert
+    ]
     if fixed:
         sub.append("at " + ", ".join(fixed))
     sub.append("○ x0")

@@ -272,7 +272,8 @@ const axisRanges = (layout) => Object.fromEntries(Object.keys(layout || {}).filt
   .map((k) => [k, layout[k].range || null]));
 // The figure without its lines' data, axis ranges and title text (JSON): what must stay for a
 // move. Other traces (the h panel's contours) must stay whole: only scatter traces move. (A new
-// title text, as the h panel's "at x1 = ...", is set after the move: a relayout of the title.)
+// title text, as the h panel's E1/E2 that a second phase fills in, is set after the move: a
+// relayout of the title.)
 const moves = (t) => t.type === "scatter";
 function shape(fig) {
   const strip = (t) => (moves(t) ? Object.fromEntries(Object.entries(t).map(([k, v]) => [k, DATA_KEYS.includes(k) || v])) : t);
@@ -303,7 +304,7 @@ function plan(div, key, fig) {
   const traces = fig.data.flatMap((t, i) => (moves(t) ? [i] : []));
   if (!same || !traces.length) return null;
   const frame = { traces, data: traces.map((i) => Object.fromEntries(DATA_KEYS.filter((k) => k in fig.data[i]).map((k) => [k, fig.data[i][k]]))) };
-  // After the move, a relayout: a new title text (the h panel's "at x1 = ..."), and the new axis
+  // After the move, a relayout: a new title text (the h panel's E1/E2), and the new axis
   // ranges, as a zoom sets them (the ranges of an animation frame miss stacked axes, and do
   // not constrain the task plane's equal scales).
   const relayout = {};

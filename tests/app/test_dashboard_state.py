@@ -255,15 +255,15 @@ def test_slow_listeners_come_last_and_functionals_only_retitle_the_h_panel():
 
 
 def test_functionals_are_keyed_by_the_map_and_the_variables_held_fixed():
-    """E1, E2 on Manipulator 2's design region (x2, x3) hold x1 at its start value: x2, x3,
-    the path, the cycles and gamma leave them alone; x1, l and the map do not."""
+    """E1, E2 on Manipulator 2's design region (x2, x3) hold x1 at its start value, but neither
+    J nor h(x2, x3) depends on x1: x0, the path, the cycles and gamma leave them alone; l and
+    the map do not."""
     m2 = default_state("manipulator2")
     key = functionals_key(m2)
-    for patch in ({"x0": [0.0, 0.4, 1.2]}, {"cycles": 5}, {"gamma": 3.0},
-                  {"path": [[1.0, 1.0], [0.5, 2.0]]}):  # fmt: skip
+    for patch in ({"x0": [0.0, 0.4, 1.2]}, {"x0": [0.3, 0.0, 1.5]}, {"cycles": 5},
+                  {"gamma": 3.0}, {"path": [[1.0, 1.0], [0.5, 2.0]]}):  # fmt: skip
         assert functionals_key(updated_state(m2, patch)) == key, patch
-    for patch in ({"x0": [0.3, 0.0, 1.5]}, {"robot_parameters": {"l": 1.5}},
-                  {"augmentation": "e2_synthesized"}):  # fmt: skip
+    for patch in ({"robot_parameters": {"l": 1.5}}, {"augmentation": "e2_synthesized"}):
         assert functionals_key(updated_state(m2, patch)) != key, patch
     # Manipulator 1's region covers every variable: no start value matters.
     m1 = default_state("manipulator1")
@@ -271,6 +271,34 @@ def test_functionals_are_keyed_by_the_map_and_the_variables_held_fixed():
     assert functionals_key(
         updated_state(m1, {"augmentation_parameters": {"a": 0.5}})
     ) != functionals_key(m1)
+
+
+def test_inert_variables_are_those_j_h_and_dh_ignore():
+    """Shifting x_k must leave J, h and dh unchanged; a map with a constant dh/dx_k still
+    depends on x_k through its value."""
+    from app.dashboard import inert_variables
+    from engine.augmentations import E2Optimal, PaperCubic, Polynomial2
+    from engine.kinematics import Manipulator1, Manipulator2
+
+    box = ((-2.0, 2.0), (-2.0, 2.0), (0.0, 3.0))
+    m2 = Manipulator2()
+    assert inert_variables(m2, PaperCubic(), box) == {0}  # J(x3), h(x2, x3)
+    assert inert_variables(Manipulator1(), E2Optimal(0.5, 1.0), box) == {1}  # J(x1, x3), h(x1, x3)
+    assert inert_variables(m2, Polynomial2({(1, 0): 1.0}, variables=(1, 2), p=3), box) == {0}
+    # h = x1 + x2: dh = (1, 1, 0) does not change with x1 or x2, h does; J depends on x3
+    h = Polynomial2({(1, 0): 1.0, (0, 1): 1.0}, variables=(0, 1), p=3)
+    assert inert_variables(m2, h, box) == frozenset()
+
+
+def test_the_h_panel_names_only_the_fixed_variables_h_depends_on():
+    """Manipulator 2's h(x2, x3) is drawn over (x2, x3): its title does not name x1, so a
+    change of x1 leaves the title (and the E1/E2 in it) as they are."""
+    from app.figures import augmenting_title
+
+    state = default_state("manipulator2")
+    a = compute(state)
+    b = compute(updated_state(state, {"x0": [0.45, 0.0, state.x0[2]]}))
+    assert "x1 =" not in augmenting_title(a) and augmenting_title(a) == augmenting_title(b)
 
 
 def test_runs_key_ignores_gamma_only_in_continuous_mode():
