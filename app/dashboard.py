@@ -579,14 +579,17 @@ def inert_variables(kin, amap, box: tuple[tuple[float, float], ...], samples: in
         with np.errstate(all="ignore"):
             return (kin.jacobian(x), amap.value_masked(x)[0], amap.gradient_masked(x)[0])
 
-    at = probe(X)
     inert = set()
-    for k in range(len(lo)):
-        shifted = X.copy()
-        shifted[:, k] += 0.371 * (hi[k] - lo[k])
-        again = probe(shifted)
-        if all(np.array_equal(a, b, equal_nan=True) for a, b in zip(at, again, strict=True)):
-            inert.add(k)
+    try:
+        at = probe(X)
+        for k in range(len(lo)):
+            shifted = X.copy()
+            shifted[:, k] += 0.371 * (hi[k] - lo[k])
+            again = probe(shifted)
+            if all(np.array_equal(a, b, equal_nan=True) for a, b in zip(at, again, strict=True)):
+                inert.add(k)
+    except (JikError, ValueError, ArithmeticError):  # a map that cannot be probed: all matter
+        return frozenset()
     return frozenset(inert)
 
 

@@ -289,6 +289,12 @@ def test_inert_variables_are_those_j_h_and_dh_ignore():
     h = Polynomial2({(1, 0): 1.0, (0, 1): 1.0}, variables=(0, 1), p=3)
     assert inert_variables(m2, h, box) == frozenset()
 
+    class Unprobeable(PaperCubic):  # a map that raises where it is probed: every variable counts
+        def value_masked(self, x):
+            raise ValueError("cannot evaluate here")
+
+    assert inert_variables(m2, Unprobeable(), box) == frozenset()
+
 
 def test_the_h_panel_names_only_the_fixed_variables_h_depends_on():
     """Manipulator 2's h(x2, x3) is drawn over (x2, x3): its title does not name x1, so a
