@@ -593,14 +593,7 @@ def inert_variables(kin, amap, box: tuple[tuple[float, float], ...], samples: in
     return frozenset(inert)
 
 
-@functools.lru_cache(maxsize=64)
-def _inert_for(key: str) -> frozenset[int]:
-    d = json.loads(key)
-    spec = robot_spec(d["robot"])
-    kin = spec.build(**d["robot_parameters"])
-    amap = spec.augmentation(d["augmentation"]).build(kin, **d["augmentation_parameters"])
-    box = spec.x_range or ((-1.0, 1.0),) * kin.p
-    return inert_variables(kin, amap, box)
+_inert_cache: dict[str, frozenset[int]] = {}
 
 
 def state_inert_variables(state: DashboardState) -> frozenset[int]:
@@ -608,14 +601,21 @@ def state_inert_variables(state: DashboardState) -> frozenset[int]:
     (cached per robot, map and parameters)."""
     d = state.as_dict()
     keys = ("robot", "robot_parameters", "augmentation", "augmentation_parameters")
-    return _inert_for(json.dumps({k: d[k] for k in keys}, sort_keys=True))
+    key = json.dumps({k: d[k] for k in keys}, sort_keys=True)
+    if key not in _inert_cache:
+        kin, amap = kinematics_and_map(state)
+        box = robot_spec(state.robot).x_range or ((-1.0, 1.0),) * kin.p
+        if len(_inert_cache) >= 64:  # (slider values of l, a, b: keep the recent ones)
+            del _inert_cache[next(iter(_inert_cache))]
+        _inert_cache[key] = inert_variables(kin, amap, box)
+    return _inert_cache[key]
 
 
 def functionals_key(state: DashboardState) -> str:
     """Everything E1, E2 and their sensitivity depend on (see :func:`error_functionals`).
 
     On a robot's design region: the robot, the map and the start values of the variables
-    outside the region (held fixed) that J or dh depends on (:func:`inert_variables`); the path,
+    outside the region (held fixed) that J, h or dh depends on (:func:`inert_variables`); the path,
     the cycles, gamma and the rest of x0 do not matter. Without a design region the box follows
     the runs: everything they depend on.
     """

@@ -27,6 +27,7 @@ from engine.exceptions import InvalidInputError
 from engine.registry import ROBOTS, make_inverse, robot_spec
 from engine.repeatability import repeatability
 from engine.solver import solve
+from tests.helpers import count_picard_sweeps
 
 
 @pytest.mark.parametrize("robot", sorted(ROBOTS))
@@ -94,15 +95,7 @@ def test_later_cycles_start_from_the_previous_cycle_and_agree_with_a_cold_start(
     import engine.solver
 
     state = default_state("manipulator2")
-    sweeps: list[int] = []
-    picard = engine.solver.picard_path
-
-    def counted(*args, **kwargs):
-        out = picard(*args, **kwargs)
-        sweeps.append(int(out[3][0]))
-        return out
-
-    monkeypatch.setattr(engine.solver, "picard_path", counted)
+    sweeps = count_picard_sweeps(monkeypatch)
     warm = compute(state)
     L = len(warm.targets)
     per_run = {a: sweeps[k * 3 * L : (k + 1) * 3 * L] for k, a in enumerate(ALGORITHMS)}

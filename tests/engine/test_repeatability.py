@@ -8,6 +8,7 @@ from engine.exceptions import InvalidInputError
 from engine.inverses import ExtendedInverse, Pseudoinverse
 from engine.kinematics import Manipulator1, Manipulator2
 from engine.repeatability import repeatability
+from tests.helpers import count_picard_sweeps
 
 RNG = np.random.default_rng(1983)
 
@@ -72,21 +73,11 @@ def test_one_start_guesses_later_cycles_and_agrees_with_the_batch(algorithm, mon
     """A single start guesses each leg after the first cycle by the cycle before (solve's
     guess); a batch does not. The legs agree to the sweep tolerance, and the repeatable
     extended inverse runs its later cycles in one or two sweeps a leg."""
-    import engine.solver
-
     kin = Manipulator2()
     inv = Pseudoinverse(kin) if algorithm == "pseudoinverse" else ExtendedInverse(kin, PaperCubic())
     x0 = np.array([0, 0, math.pi / 2])
     path = [(1, 1), (1, 2), (0, 2), (0, 1)]
-    sweeps: list[int] = []
-    picard = engine.solver.picard_path
-
-    def counted(*args, **kwargs):
-        out = picard(*args, **kwargs)
-        sweeps.append(int(out[3][0]))
-        return out
-
-    monkeypatch.setattr(engine.solver, "picard_path", counted)
+    sweeps = count_picard_sweeps(monkeypatch)
     one = repeatability(inv, x0, path, cycles=3)
     monkeypatch.undo()
     batch = repeatability(inv, np.array([x0, x0]), path, cycles=3)
