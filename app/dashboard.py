@@ -784,10 +784,11 @@ def augmenting_axes(amap, x: np.ndarray) -> tuple[int, int]:
     return int(i), int(j)
 
 
-def kinematics_and_map(state: DashboardState):
-    """The state's kinematics and its augmenting map h, built from the registry."""
+def kinematics_and_map(state: DashboardState, kin=None):
+    """The state's kinematics (``kin`` when the caller has built it) and its augmenting map h,
+    built from the registry."""
     spec = robot_spec(state.robot)
-    kin = spec.build(**state.robot_parameters)
+    kin = spec.build(**state.robot_parameters) if kin is None else kin
     return kin, spec.augmentation(state.augmentation).build(kin, **state.augmentation_parameters)
 
 
@@ -815,7 +816,7 @@ def augmenting_grid(
     """
     spec = robot_spec(state.robot)
     try:
-        amap = spec.augmentation(state.augmentation).build(kin, **state.augmentation_parameters)
+        _, amap = kinematics_and_map(state, kin)
         xs = np.concatenate([r.x for r in runs.values()])
         i, j = augmenting_axes(amap, xs)
         box = []
