@@ -806,6 +806,7 @@ class DashboardScene:
             # Playing: from the start. Paused: at the end, where the drift of J^P# shows.
             self._s = 0.0 if self.playing else timeline.length
             self._pose(self._s)
+            self._show_position(timeline)
             self.drawn_generation = result.generation
             self.dashboard.scene_status.update(
                 generation=result.generation, robot=state.robot, playing=self.playing
@@ -979,6 +980,14 @@ class DashboardScene:
             m.pose(configs[a])
 
     # -- animation ------------------------------------------------------------------------
+    def _show_position(self, timeline: Timeline) -> None:
+        """The position slider at the playback position (not a change of it by the user)."""
+        self._syncing = True
+        try:
+            self.scrub.value = round(min(self._s / timeline.length, 1.0), 3)  # type: ignore[misc]  # viser: settable
+        finally:
+            self._syncing = False
+
     def _animate(self) -> None:
         posed: tuple[Timeline | None, float | None]
         last, last_gui, posed = time.monotonic(), 0.0, (None, None)
@@ -1001,11 +1010,7 @@ class DashboardScene:
                 continue
             if now - last_gui > 0.25:
                 last_gui = now
-                self._syncing = True
-                try:
-                    self.scrub.value = round(min(self._s / timeline.length, 1.0), 3)  # type: ignore[misc]  # viser: settable
-                finally:
-                    self._syncing = False
+                self._show_position(timeline)
 
 
 def _path_text(path) -> str:

@@ -532,6 +532,11 @@ def test_scene_follows_a_new_result_in_place():
         assert ahead["frame"].visible is False and ahead["mechanisms"]
         scene._draw(other)
         assert ahead["frame"].visible is True and scene._mechanisms is ahead["mechanisms"]
+        # Paused, a new result is drawn at its end, and the position slider says so.
+        scene.playing = False
+        scene._draw(compute(first, 109))
+        assert scene._timeline is not None and scene._s == scene._timeline.length
+        assert scene.scrub.value == 1.0
     finally:
         scene.stop()
         dashboard.stop()
