@@ -1029,6 +1029,10 @@ def summary(result: DashboardResult) -> dict:
 #: Not the unicycle: its ~1 s would hold the CPU that a change made meanwhile needs (its
 #: switch shows progress instead).
 PREFETCH_ROBOTS = ("manipulator1", "manipulator2")
+#: Longest hold of the scene's animation that one request may ask for (the page renews its
+#: hold while the pointer stays on the controls), and the most holders kept at once.
+MAX_HOLD_SECONDS = 10.0
+MAX_HOLDERS = 64
 
 
 class Dashboard:
@@ -1079,6 +1083,7 @@ class Dashboard:
         self.functionals: dict | None = None
         #: What the 3D scene last drew (set by app.scene), for the page and the tests.
         self.scene_status: dict = {}
+        self._holds: dict[str, float] = {}  # holder -> monotonic time its hold ends
         self._thread: threading.Thread | None = None
         self._stopped = False
 
@@ -1127,6 +1132,42 @@ class Dashboard:
         )
         self.start()
         return generation, state
+
+    def hold(self, holder: str, seconds: float) -> float:
+        """Hold the 3D scene's animation still for ``seconds`` from now on behalf of
+        ``holder`` (0 ends that holder's hold). The animation goes on when no hold is left.
+
+        The page holds it while the pointer is on its controls: a playing scene keeps viser's
+        client rendering, and in software WebGL that takes over a core, which the change the
+        user is about to make needs (see ``docs/benchmarks.md``, Dashboard latency).
+
+        Returns the seconds until the last hold ends (0: the animation is not held).
+        """
+        seconds = float(seconds)
+        if not 0.0 <= seconds <= MAX_HOLD_SECONDS:  # (False for NaN)
+            raise InvalidInputError(
+                f"seconds must be in [0, {MAX_HOLD_SECONDS:g}] (got {seconds!r}); "
+                "renew a longer hold, and send 0 to end it"
+            )
+        if not (isinstance(holder, str) and 0 < len(holder) <= 64):
+            raise InvalidInputError("holder must be a string of 1 to 64 characters")
+        now = time.monotonic()
+        with self._cond:
+            holds = {h: t for h, t in self._holds.items() if t > now and h != holder}
+            if seconds > 0.0:
+                if len(holds) >= MAX_HOLDERS:
+                    raise InvalidInputError(
+                        f"the scene is already held by {MAX_HOLDERS} holders; "
+                        "let a hold end (seconds 0) first"
+                    )
+                holds[holder] = now + seconds
+            self._holds = holds
+            return max(holds.values(), default=now) - now
+
+    def held(self) -> bool:
+        """Whether some hold of the scene's animation (:meth:`hold`) is on now."""
+        now = time.monotonic()
+        return any(t > now for t in self._holds.values())
 
     def subscribe(
         self, listener: Callable[[Event], None], *, last: bool = False

@@ -19,6 +19,7 @@ colours of every plot); the grey ghost is the start configuration x0.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import threading
@@ -42,6 +43,10 @@ CONTROLS_DELAY = 0.3
 UNICYCLE_ROOT = "/robot/unicycle"
 #: Seconds of animation per leg (manipulators) or per shown iteration (unicycle) at speed 1.
 SECONDS_PER_LEG = 1.6
+#: Seconds the animation holds still after a change made in the scene (its GUI, the gizmo):
+#: the next change of a drag is then computed and drawn without the animation's frames (the
+#: page holds it while the pointer is on its controls; viser does not say where the pointer is).
+EDIT_HOLD = 1.5
 #: Unicycle iterations shown in the animation (geometrically spaced, the last always).
 UNICYCLE_SHOWN = 10
 _Z = {"pseudoinverse": 0.10, "extended": 0.0}
@@ -428,6 +433,7 @@ class DashboardScene:
         self._mechanisms: dict[str, _Mechanism] = {}
         self._home: _Mechanism | None = None  # the grey copy at the start x0
         self._s = 0.0
+        self._posed: tuple[Timeline | None, float] = (None, 0.0)  # what the mechanisms show
         self.drawn_generation = 0
         self._drawn_runs: tuple[str, ...] | None = None  # runs_key of what the scene shows
         self._structure: tuple | None = None
@@ -442,6 +448,7 @@ class DashboardScene:
         self._folders: list = []
         self._last_drag = 0.0
         self._stopped = False
+        dashboard.scene_status["held"] = False
         self._build_static_gui()
         _add_floor_grid(self.server.scene)
         self.server.scene.add_frame("/robot", show_axes=False)
@@ -499,6 +506,9 @@ class DashboardScene:
             self.dashboard.update(patch, source="scene")
         except InvalidInputError as exc:
             self.status.content = f"**refused:** {exc}"
+            return
+        with contextlib.suppress(InvalidInputError):  # (held by too many pages: it is held)
+            self.dashboard.hold("scene-edit", EDIT_HOLD)
 
     def _rebuild_controls(self, state) -> None:
         """GUI inputs for ``state``'s robot, from the registry (no hard-coded ranges)."""
@@ -803,8 +813,9 @@ class DashboardScene:
                 self._framed = state.robot
                 self._frame_camera(extent)
             self._timeline = timeline
-            # Playing: from the start. Paused: at the end, where the drift of J^P# shows.
-            self._s = 0.0 if self.playing else timeline.length
+            # Playing: from the start. Paused or held: at the end, where the drift of J^P#
+            # shows (when a hold ends, the animation starts over from there).
+            self._s = 0.0 if self.playing and not self.dashboard.held() else timeline.length
             self._pose(self._s)
             self._show_position(timeline)
             self.drawn_generation = result.generation
@@ -975,6 +986,7 @@ class DashboardScene:
     def _pose(self, s: float) -> None:
         if self._timeline is None:
             return
+        self._posed = (self._timeline, s)
         configs = self._timeline.at(s)
         for a, m in self._mechanisms.items():
             m.pose(configs[a])
@@ -989,8 +1001,7 @@ class DashboardScene:
             self._syncing = False
 
     def _animate(self) -> None:
-        posed: tuple[Timeline | None, float | None]
-        last, last_gui, posed = time.monotonic(), 0.0, (None, None)
+        last, last_gui = time.monotonic(), 0.0
         while not self._stopped:
             time.sleep(1.0 / FPS)
             now = time.monotonic()
@@ -999,14 +1010,20 @@ class DashboardScene:
             if timeline is None:
                 continue
             with self._lock:
-                if self.playing:
+                # Held (Dashboard.hold: the pointer is on the page's controls): still, as if
+                # paused, until the hold ends.
+                held = self.playing and self.dashboard.held()
+                if held != self.dashboard.scene_status.get("held", False):
+                    self.dashboard.scene_status["held"] = held
+                moving = self.playing and not held
+                if moving:
                     self._s += dt * float(self.speed.value) / SECONDS_PER_LEG
                     if self._s > timeline.length + 0.5:  # hold the end a moment, then loop
                         self._s = 0.0
-                if posed != (timeline, self._s):  # paused: send nothing until scrubbed
-                    posed = (timeline, self._s)
+                # Paused or held: nothing to send until scrubbed (or drawn, which poses too).
+                if self._posed != (timeline, self._s):
                     self._pose(self._s)
-            if not self.playing:
+            if not moving:
                 continue
             if now - last_gui > 0.25:
                 last_gui = now

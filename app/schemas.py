@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeAlias, Union
 
 from pydantic import BaseModel, ConfigDict, Field, create_model
 
+from app.dashboard import MAX_HOLD_SECONDS
 from engine.registry import ROBOTS, AugmentationSpec, RobotSpec
 from engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
 
@@ -381,12 +382,35 @@ class HealthResponse(BaseModel):
     status: Literal["ok"]
 
 
+class HoldRequest(BaseModel):
+    """``POST /api/dashboard/hold``: hold the 3D scene's animation still for a while."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    holder: str = Field(
+        min_length=1,
+        max_length=64,
+        pattern=r"^[A-Za-z0-9_-]+$",
+        description="who holds it (the page: a random id per tab); each holder has one hold",
+    )
+    seconds: Annotated[float, Field(ge=0.0, le=MAX_HOLD_SECONDS, allow_inf_nan=False)] = Field(
+        description=f"how long from now, at most {MAX_HOLD_SECONDS:g} (renew a longer hold); "
+        "0 ends the holder's hold"
+    )
+
+
+class HoldResponse(BaseModel):
+    held_seconds: float = Field(description="seconds until the last hold ends; 0: not held")
+
+
 __all__ = [
     "AUGMENTATION_MODELS",
     "ROBOT_MODELS",
     "Augmentation",
     "ErrorResponse",
     "HealthResponse",
+    "HoldRequest",
+    "HoldResponse",
     "RepeatabilityRequest",
     "RepeatabilityResponse",
     "Robot",

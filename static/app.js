@@ -73,6 +73,48 @@ async function flush() {
   }
 }
 
+// ---------------------------------------------------------------- holding the scene still
+// While the pointer is on the controls (or the keyboard works in them), the 3D scene's animation
+// holds still (POST /api/dashboard/hold, renewed while it lasts; the server ends a hold that is
+// not renewed). A playing scene keeps viser's client rendering, and without a GPU that takes
+// more than a core, which the change about to be made needs to be computed and drawn.
+const HOLD_SECONDS = 4;
+const hold = {
+  holder: Math.random().toString(36).slice(2, 12) || "page", pointer: false, keyboard: false, timer: null,
+};
+
+function sendHold(seconds) {
+  fetch("/api/dashboard/hold", {
+    method: "POST", headers: { "Content-Type": "application/json" }, keepalive: true,
+    body: JSON.stringify({ holder: hold.holder, seconds }),
+  }).catch(() => {}); // (a lost hold only lets the animation go on)
+}
+
+function updateHold() {
+  const on = Boolean(jik.config && jik.config.scene_port) && (hold.pointer || hold.keyboard);
+  if (on && hold.timer === null) {
+    sendHold(HOLD_SECONDS);
+    hold.timer = setInterval(() => sendHold(HOLD_SECONDS), (HOLD_SECONDS * 1000) / 2);
+  } else if (!on && hold.timer !== null) {
+    clearInterval(hold.timer);
+    hold.timer = null;
+    sendHold(0);
+  }
+  $("#controls").classList.toggle("holding", on);
+}
+
+function watchHold() {
+  const form = $("#controls");
+  form.addEventListener("pointerenter", () => { hold.pointer = true; updateHold(); });
+  form.addEventListener("pointerleave", () => { hold.pointer = false; updateHold(); });
+  // Keyboard focus only: a click leaves the focus on the control after the pointer has gone.
+  form.addEventListener("focusin", (ev) => { hold.keyboard = ev.target.matches(":focus-visible"); updateHold(); });
+  form.addEventListener("focusout", (ev) => {
+    if (!form.contains(ev.relatedTarget)) { hold.keyboard = false; updateHold(); }
+  });
+  window.addEventListener("pagehide", () => { hold.pointer = hold.keyboard = false; updateHold(); });
+}
+
 // ---------------------------------------------------------------- controls
 function slider(label, { min, max, step, value, log = false, onInput, id }) {
   const toPos = (v) => (log ? Math.log10(v) : v);
@@ -570,6 +612,7 @@ async function main() {
     note.hidden = false;
     note.textContent = "The 3D scene runs with `jik serve` (viser on the scene port).";
   }
+  watchHold();
   connect();
 }
 

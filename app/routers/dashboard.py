@@ -30,6 +30,7 @@ from app.dashboard import (
     export_csv,
     export_json,
 )
+from app.schemas import HoldRequest, HoldResponse
 from engine.exceptions import InvalidInputError
 
 router = APIRouter(tags=["dashboard"])
@@ -103,6 +104,20 @@ async def post_state(request: Request) -> JSONResponse:
     except InvalidInputError as exc:
         return _invalid(_field_of(str(exc), patch), str(exc))
     return JSONResponse({"generation": generation, "state": state.as_dict()})
+
+
+@router.post("/api/dashboard/hold", response_model=HoldResponse)
+async def post_hold(body: HoldRequest, request: Request) -> HoldResponse | JSONResponse:
+    """Hold the 3D scene's animation still for ``seconds`` (0 ends the hold).
+
+    The page holds it while the pointer is on its controls, so that a change is computed and
+    drawn without the scene's frames taking the CPU (see :meth:`app.dashboard.Dashboard.hold`).
+    """
+    try:
+        held = dashboard_for(request.app).hold(body.holder, body.seconds)
+    except InvalidInputError as exc:  # (too many holders)
+        return _invalid("holder", str(exc))
+    return HoldResponse(held_seconds=held)
 
 
 def _field_of(message: str, patch: dict) -> str:

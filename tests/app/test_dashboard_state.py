@@ -418,6 +418,102 @@ def test_page_static_files_and_state_api():
     dashboard.stop()
 
 
+def test_the_hold_api_keeps_one_hold_per_holder_and_refuses_bad_values():
+    """POST /api/dashboard/hold: each holder has one hold, which ends by itself or with 0."""
+    from fastapi.testclient import TestClient
+
+    from app.dashboard import MAX_HOLD_SECONDS, MAX_HOLDERS
+    from app.main import create_app
+
+    app = create_app()
+    client = TestClient(app)
+    dashboard = app.state.dashboard = Dashboard()  # (never started: holds need no computation)
+    for body, field in [
+        ({"holder": "page", "seconds": -1}, "seconds"),
+        ({"holder": "page", "seconds": MAX_HOLD_SECONDS + 1}, "seconds"),
+        ({"holder": "page", "seconds": "long"}, "seconds"),
+        ({"holder": "", "seconds": 1}, "holder"),
+        ({"holder": "a b", "seconds": 1}, "holder"),
+        ({"holder": "x" * 65, "seconds": 1}, "holder"),
+        ({"seconds": 1}, "holder"),
+        ({"holder": "page", "seconds": 1, "extra": 1}, "extra"),
+    ]:
+        r = client.post("/api/dashboard/hold", json=body)
+        assert r.status_code == 422, body
+        assert r.json()["detail"][0]["loc"][-1] == field, r.json()
+    nan = client.post("/api/dashboard/hold", content=b'{"holder": "page", "seconds": NaN}',
+                      headers={"Content-Type": "application/json"})  # fmt: skip
+    assert nan.status_code == 422 and not dashboard.held()
+    with pytest.raises(InvalidInputError, match="seconds must be in"):
+        dashboard.hold("page", float("nan"))
+
+    r = client.post("/api/dashboard/hold", json={"holder": "page", "seconds": 4})
+    assert r.status_code == 200 and 3.5 < r.json()["held_seconds"] <= 4.0
+    assert dashboard.held()
+    assert 0.5 < dashboard.hold("other", 1.0) <= 4.0  # (the longer hold is the page's)
+    r = client.post("/api/dashboard/hold", json={"holder": "page", "seconds": 0})
+    assert r.status_code == 200 and 0.5 < r.json()["held_seconds"] <= 1.0  # "other" holds on
+    assert dashboard.held()
+    # a renewal replaces the holder's hold
+    assert dashboard.hold("other", 0.05) == pytest.approx(0.05, abs=1e-6)
+    time.sleep(0.1)
+    assert not dashboard.held()  # ended by itself
+    for k in range(MAX_HOLDERS):
+        dashboard.hold(f"h{k}", 5.0)
+    full = client.post("/api/dashboard/hold", json={"holder": "one-more", "seconds": 1})
+    assert full.status_code == 422 and "let a hold end" in full.json()["detail"][0]["msg"]
+    renewal = client.post("/api/dashboard/hold", json={"holder": "h0", "seconds": 1})
+    assert renewal.status_code == 200
+
+
+def test_a_hold_stills_the_playing_scene_until_it_ends():
+    """While held (the page's pointer on its controls), the playing scene sends no animation
+    frames and shows a new result at its end; when the hold ends, it plays on from there."""
+    import socket
+
+    from app.scene import DashboardScene
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    dashboard = Dashboard()
+    scene = DashboardScene(dashboard, port=port)
+
+    def until(condition, what: str, timeout: float = 30.0) -> None:
+        deadline = time.monotonic() + timeout
+        while not condition():
+            assert time.monotonic() < deadline, what
+            time.sleep(0.02)
+
+    try:
+        until(lambda: dashboard.scene_status.get("generation", 0) >= 1, "no first drawing")
+        assert scene.playing and dashboard.scene_status["held"] is False
+        s0 = scene._s
+        until(lambda: scene._s != s0, "the animation does not play")
+        dashboard.hold("test", 3.0)
+        until(lambda: dashboard.scene_status["held"] is True, "the hold is not seen")
+        posed = []
+        for m in scene._mechanisms.values():  # every pose the animation sends from now on
+            m.pose = lambda x, _pose=m.pose: (posed.append(x), _pose(x))
+        held_at = scene._s
+        time.sleep(0.5)
+        assert scene._s == held_at and not posed
+        second = updated_state(dashboard.state, {"x0": [0.3, 0.0, 1.5]})
+        scene._draw(compute(second, 50))  # a new result while held: shown at its end
+        assert scene._timeline is not None and scene._s == scene._timeline.length
+        assert scene.scrub.value == 1.0
+        n = len(posed)
+        time.sleep(0.3)
+        assert len(posed) == n, "frames sent while held"
+        dashboard.hold("test", 0.0)
+        until(lambda: dashboard.scene_status["held"] is False, "the hold did not end")
+        until(lambda: scene._s < scene._timeline.length, "the animation did not start over")
+        assert scene.playing
+    finally:
+        scene.stop()
+        dashboard.stop()
+
+
 def test_viser_gui_and_drag_change_the_one_state():
     """The scene's GUI and its start-point gizmo write to the same Dashboard as the page."""
     import socket
@@ -439,6 +535,7 @@ def test_viser_gui_and_drag_change_the_one_state():
         assert dashboard.scene_status["robot"] == "manipulator2"
         scene._controls["gamma"].value = 2.5  # what a slider move in the viser GUI does
         assert dashboard.state.gamma == 2.5
+        assert dashboard.held()  # the animation holds still for the drag's next change
         target = SimpleNamespace(position=(0.4, 0.25, 0.3), wxyz=yaw_quaternion(1.7))
         scene._on_drag(SimpleNamespace(phase="end", target=target))
         np.testing.assert_allclose(dashboard.state.x0, (0.25, 0.4, 1.7), atol=1e-12)
