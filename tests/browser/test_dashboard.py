@@ -118,6 +118,21 @@ _SCENE_WATCH = """() => {
 }"""
 
 
+# Installed in the viser client too: the wall-clock time of its last WebGL frame (three.js
+# clears the canvas at the start of every frame it renders).
+_FRAME_WATCH = """() => {
+    if (window.jikLastFrame !== undefined) return;
+    window.jikLastFrame = performance.now();
+    for (const C of [WebGL2RenderingContext, WebGLRenderingContext]) {
+        const clear = C.prototype.clear;
+        C.prototype.clear = function (...args) {
+            window.jikLastFrame = performance.now();
+            return clear.apply(this, args);
+        };
+    }
+}"""
+
+
 def _scene_frame(page):
     return next(f for f in page.frames if f.parent_frame is not None)
 
@@ -363,6 +378,7 @@ def test_dashboard_follows_controls_in_chromium(served):
             except PlaywrightTimeout:
                 continue
         _scene_frame(page).evaluate(_SCENE_WATCH)
+        _scene_frame(page).evaluate(_FRAME_WATCH)
         scene_before = _settled(page)
         page.screenshot(path=str(ARTIFACTS / "dashboard-1-manipulator2.png"))
         verdict = page.inner_text("#verdict")
@@ -513,9 +529,13 @@ def test_dashboard_follows_controls_in_chromium(served):
 
         # The same kinds of change with the animation playing, the scene's default (it renders
         # without pause then). Other values than above, so that no run comes from the
-        # dashboard's cache.
+        # dashboard's cache. Each time the pointer comes from outside the controls, with the
+        # scene animating, as a user's would: on the controls the animation holds still (the
+        # page's hold), and the change is made once viser's client has stopped rendering, the
+        # quarter second after the last animation frame that a user takes to reach a control.
         scene.get_by_role("button", name="Play").dispatch_event("click")
         _wait_scene(base, lambda s: s.get("playing") is True)
+        frame = _scene_frame(page)
         for what, selector, value in [
             ("gamma", "#ctl-gamma", 0.47712),  # log10(3)
             ("start point x1", "#ctl-x0-0", 0.39),
@@ -527,6 +547,12 @@ def test_dashboard_follows_controls_in_chromium(served):
             ("map parameter a", "#ctl-aug-a", -0.5),
             ("switch back to manipulator2", "#ctl-robot", "manipulator2"),
         ]:
+            page.mouse.move(800, 25)  # the header: off the controls, the scene animates
+            _wait_scene(base, lambda s: s.get("held") is False)
+            frame.wait_for_function("performance.now() - jikLastFrame < 50", polling=20)
+            page.hover(selector)
+            _wait_scene(base, lambda s: s.get("held") is True)
+            frame.wait_for_function("performance.now() - jikLastFrame > 100", polling=20)
             if selector == "#ctl-robot":
                 page.wait_for_function(f"Object.keys(ahead.robots.{value} || {{}}).length >= 4")
                 before = int(page.evaluate("jik.generation"))
