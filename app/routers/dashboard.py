@@ -2,7 +2,8 @@
 
 ``GET /`` serves ``static/index.html``; plotly.js comes from the installed plotly package, the
 3D scene from viser on the scene port: nothing is fetched from the network. The page changes the
-state with ``POST /api/dashboard/state`` and follows it on ``GET /api/dashboard/events``.
+state with ``POST /api/dashboard/state`` and follows it on ``GET /api/dashboard/events``; it holds
+the scene's animation still while the pointer is on its controls (``POST /api/dashboard/hold``).
 """
 
 from __future__ import annotations

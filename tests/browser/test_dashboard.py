@@ -564,6 +564,13 @@ def test_dashboard_follows_controls_in_chromium(served):
             assert _get(f"{base}/api/dashboard/state")["scene"]["playing"] is True
             _second_phase_drawn(page)
             _scene_generation(base, generation)
+        # The pointer is still on the controls: the page says the animation is held.
+        note = "getComputedStyle(document.querySelector('#controls'), '::after').content"
+        assert "held while you edit" in page.evaluate(note)
+        page.screenshot(path=str(ARTIFACTS / "dashboard-6-held.png"))
+        page.mouse.move(800, 25)
+        _wait_scene(base, lambda s: s.get("held") is False, what="play on when the pointer left")
+        assert page.evaluate(note) == "none"
         browser.close()
 
     for what, (worst, text) in latencies.items():
