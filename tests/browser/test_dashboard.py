@@ -571,6 +571,12 @@ def test_dashboard_follows_controls_in_chromium(served):
         page.mouse.move(800, 25)
         _wait_scene(base, lambda s: s.get("held") is False, what="play on when the pointer left")
         assert page.evaluate(note) == "none"
+        # The keyboard in the controls holds it too; a click elsewhere lets it go on.
+        page.focus("#ctl-cycles")
+        page.keyboard.press("Shift+Tab")
+        _wait_scene(base, lambda s: s.get("held") is True, what="hold for the keyboard")
+        page.mouse.click(800, 25)
+        _wait_scene(base, lambda s: s.get("held") is False, what="play on after the keyboard")
         browser.close()
 
     for what, (worst, text) in latencies.items():
