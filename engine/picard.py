@@ -18,6 +18,9 @@ sweeps from the guess's values there, shifted to the segment's start, instead of
 The sweeps, their convergence test and the resolution test are the same, so the result is the same
 fixed point to the sweep tolerance; only the number of sweeps falls (on a repeatable algorithm's
 second cycle, from about eight per leg to one or two).
+
+:func:`picard_chain` makes such guesses for a chain of legs, each starting where the one before
+ends (a closed path): all legs are swept together, each from the current end of the one before.
 """
 
 from __future__ import annotations
@@ -44,6 +47,8 @@ GUESS_MATCH = 1e-12
 
 #: A guess for one member: sigma (k,) ascending, ending at 1, and x there (k, p).
 Guess = tuple[FloatArray, FloatArray]
+#: Sweeps of :func:`picard_chain` before it gives up.
+CHAIN_SWEEPS = 80
 
 
 @lru_cache(maxsize=4)
@@ -209,3 +214,50 @@ def picard_path(
             failed[halve[H[halve] < MIN_SEGMENT]] = True
         failed |= ~done & (sweeps >= max_sweeps_total)
     return xa, done, a, sweeps, records
+
+
+def picard_chain(inverse, x0: FloatArray, y: FloatArray, max_sweeps: int = CHAIN_SWEEPS):
+    """Guesses for legs solved one after another: leg j from the end of leg j - 1 to y[j].
+
+    Solved leg by leg, L legs cost L times the sweeps of one (about ten for the pseudoinverse,
+    whose legs in a later cycle are not those of the cycle before). Here each sweep of (*)
+    updates every leg at once on the segment [0, 1], leg j from the current end of leg j - 1
+    (and e0 = k(that end) - y[j]): one vectorized evaluation of J# a sweep for all legs, and
+    about L more sweeps than one leg needs, as each leg settles a sweep after the one before.
+
+    Nothing is checked but the sweeps' convergence (:data:`SWEEP_TOL`): the result is a guess
+    for :func:`picard_path` (through ``engine.solver.solve(guess=)``), which sweeps each leg
+    again from it with its own tests and gives its own fixed point; a guess only saves sweeps.
+
+    Parameters
+    ----------
+    inverse : Inverse
+    x0 : ndarray, shape (p,)
+        Start of the first leg.
+    y : ndarray, shape (L, r)
+        Targets of the legs.
+    max_sweeps : int
+
+    Returns
+    -------
+    (sigma (DEGREE + 1,), X (L, DEGREE + 1, p)) : the nodes of [0, 1] and each leg's values
+    there, or None when a leg meets a singular J#, a value is not finite, or the sweeps do not
+    settle within ``max_sweeps``.
+    """
+    t, S, _ = chebyshev_operators(DEGREE)
+    nn, p, L = t.size, x0.shape[-1], len(y)
+    forward = inverse.kinematics.forward
+    X = np.broadcast_to(x0, (L, nn, p)).copy()
+    for _ in range(max_sweeps):
+        starts = np.concatenate([x0[None], X[:-1, -1]])  # (L, p)
+        e0 = forward(starts) - y
+        v, bad = inverse.apply_masked(X.reshape(L * nn, p), np.repeat(e0, nn, axis=0))
+        if bad.any():
+            return None
+        Xn = starts[:, None, :] - 0.5 * (S @ v.reshape(L, nn, p))  # segment [0, 1]: half = 0.5
+        change = np.abs(Xn - X)
+        change /= np.abs(Xn) + 1.0
+        X = Xn
+        if not change.max() >= SWEEP_TOL:  # (NaN: not settled)
+            return ((t + 1.0) / 2.0, X) if np.all(np.isfinite(X)) else None
+    return None

@@ -21,7 +21,7 @@ from scipy.integrate._ivp import dop853_coefficients as _dop
 
 from engine.exceptions import InvalidInputError
 from engine.inverses import Inverse
-from engine.picard import Guess, picard_path
+from engine.picard import Guess, picard_chain, picard_path
 from engine.validation import FloatArray, count, positive
 
 _NS = _dop.N_STAGES
@@ -280,6 +280,56 @@ def _guesses(guess, n: int, p: int, gamma: float) -> list[Guess | None] | None:
         sigma[-1] = 1.0
         out.append((sigma, x))
     return out
+
+
+def chain_guesses(inverse: Inverse, x0, y_d, *, gamma: float = 1.0) -> list[Trajectory] | None:
+    """Guesses for solving legs one after another in continuous mode: leg j from where leg
+    j - 1 ends, to ``y_d[j]`` (a closed path's legs, cycle after cycle).
+
+    Pass ``guesses[j]`` as ``guess`` of the solve of leg j (:func:`solve`): the results are
+    the same to the sweep tolerance; each leg then takes one or two Picard sweeps instead of
+    about ten, and the guesses cost about three legs' worth (:func:`engine.picard.picard_chain`;
+    ``jik bench solver``).
+
+    Parameters
+    ----------
+    inverse : Inverse
+    x0 : array_like, shape (p,)
+        Start of the first leg.
+    y_d : array_like, shape (L, r)
+        The legs' targets.
+    gamma : float
+        The decay rate the legs will be solved with (it only sets their theta).
+
+    Returns
+    -------
+    list of L Trajectory (at the Chebyshev nodes of each leg), or None when the legs
+    cannot all be swept on one segment each (a singular J# on the way, a path that needs finer
+    segments): solve them without guesses then.
+    """
+    kin = inverse.kinematics
+    x0 = kin.check(x0, "x0")
+    y_d = kin.check_task(y_d, "y_d")
+    gamma = positive(gamma, "gamma")
+    if x0.ndim != 1 or y_d.ndim != 2 or len(y_d) == 0:
+        raise InvalidInputError(
+            f"x0 must be one configuration (p,) and y_d the legs' targets (L, r), L >= 1; "
+            f"got shapes {x0.shape} and {y_d.shape}"
+        )
+    chained = picard_chain(inverse, x0, y_d)
+    if chained is None:
+        return None
+    sigma, X = chained
+    # sigma = 1 - exp(-gamma theta) (engine.picard); the last node, sigma = 1, is the leg's end
+    # and stands at any later theta (see _guesses).
+    theta = -np.log1p(-sigma[:-1]) / gamma
+    theta = np.append(theta, theta[-1] + 1.0)
+    y = kin.forward(X)  # (L, nodes, r)
+    error = np.linalg.norm(y - y_d[:, None, :], axis=-1)
+    return [
+        Trajectory(theta=theta, x=X[j], y=y[j], error=error[j], h=inverse.augmenting_value(X[j]))
+        for j in range(len(X))
+    ]
 
 
 def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto", guess=None):

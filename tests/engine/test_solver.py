@@ -270,3 +270,63 @@ def test_bad_guess_is_rejected_with_a_clear_message(guess, kwargs, match):
     )
     with pytest.raises(InvalidInputError, match=match):
         solve(inv, X0, [1, 2], guess=bad, **kwargs)
+
+
+# Table 1's closed path (sec. 5.2) from X0, three cycles: 12 legs, each from the end of the last.
+TABLE1_LEGS = np.tile([[1.0, 1.0], [1.0, 2.0], [0.0, 2.0], [0.0, 1.0]], (3, 1))
+
+
+@pytest.mark.parametrize("gamma", [1.0, 0.5])
+@pytest.mark.parametrize("algorithm", ["pseudoinverse", "extended"])
+def test_chain_guesses_give_each_leg_in_one_or_two_sweeps_and_the_same_path(
+    algorithm, gamma, monkeypatch
+):
+    """chain_guesses sweeps the legs of a closed path together; solved one after another from
+    them, each leg takes one or two sweeps (about ten cold for the pseudoinverse) and ends where
+    the cold solve ends, to the sweep tolerance; its trajectory is the cold one."""
+    from engine.solver import chain_guesses
+    from tests.helpers import count_picard_sweeps
+
+    kin = Manipulator2()
+    inv = Pseudoinverse(kin) if algorithm == "pseudoinverse" else ExtendedInverse(kin, PaperCubic())
+    guesses = chain_guesses(inv, X0, TABLE1_LEGS, gamma=gamma)
+    assert guesses is not None and len(guesses) == len(TABLE1_LEGS)
+    np.testing.assert_allclose(guesses[0].x[0], X0, atol=1e-15)
+    sweeps = count_picard_sweeps(monkeypatch)
+    runs = {}
+    for name, guessed in (("cold", False), ("chained", True)):
+        x, ends, paths = X0, [], []
+        for j, target in enumerate(TABLE1_LEGS):
+            res = solve(inv, x, target, gamma=gamma, guess=guesses[j] if guessed else None)
+            assert res.success, res.message
+            x = res.x
+            ends.append(x)
+            paths.append(res.trajectory)
+        runs[name] = (np.array(ends), paths)
+    cold, chained = sweeps[: len(TABLE1_LEGS)], sweeps[len(TABLE1_LEGS) :]
+    assert max(chained) <= 2 and sum(cold) >= 3 * len(TABLE1_LEGS), (cold, chained)
+    np.testing.assert_allclose(runs["chained"][0], runs["cold"][0], atol=1e-12)
+    for a, b in zip(runs["chained"][1], runs["cold"][1], strict=True):
+        np.testing.assert_allclose(a.theta, b.theta, atol=1e-9)
+        np.testing.assert_allclose(a.x, b.x, atol=1e-12)
+    if algorithm == "pseudoinverse":  # Table 1's column (four decimals): the first cycle
+        np.testing.assert_allclose(runs["chained"][0][:4], PRINTED[algorithm][1:], atol=6e-5)
+
+
+def test_chain_guesses_refuse_bad_input_and_give_none_at_a_singularity():
+    from engine.solver import chain_guesses
+
+    inv = Pseudoinverse(Manipulator2())
+    for kwargs, match in [
+        ({"x0": [[0, 0, 1]]}, "one configuration"),
+        ({"x0": [0, np.nan, 1]}, "x0 contains NaN"),
+        ({"y_d": [1.0, 2.0]}, r"legs' targets \(L, r\)"),
+        ({"y_d": [[1.0, 2.0, 3.0]]}, "must have shape"),
+        ({"gamma": 0.0}, "gamma must be > 0"),
+    ]:
+        args = {"x0": X0, "y_d": TABLE1_LEGS} | kwargs
+        with pytest.raises(InvalidInputError, match=match):
+            chain_guesses(inv, args.pop("x0"), args.pop("y_d"), **args)
+    # (36) with a = 1, b = 0 is singular on x1 = 0, which the second leg has to cross.
+    singular = ExtendedInverse(Manipulator1(), E2Optimal(a=1.0, b=0.0))
+    assert chain_guesses(singular, [0.5, 0.2, 1.0], [[0.6, 0.2], [-0.5, 0.2]]) is None
