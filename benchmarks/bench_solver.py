@@ -9,6 +9,9 @@
 3. Three cycles of Table 1's path for one start with the extended inverse (paper_cubic), leg by
    leg as the dashboard runs them: each leg from a cold start against each leg after the first
    cycle guessed by the same leg of the cycle before (``solve(..., guess=)``).
+4. The same with the pseudoinverse, whose legs do not repeat: each leg cold, guessed by the
+   cycle before, and guessed by a chain of its cycle's legs swept together
+   (``engine.solver.chain_guesses``, what the dashboard does for it).
 """
 
 from __future__ import annotations
@@ -25,7 +28,7 @@ from engine.augmentations import PaperCubic
 from engine.inverses import ExtendedInverse, Pseudoinverse
 from engine.kinematics import Manipulator2
 from engine.repeatability import closed_path, repeatability
-from engine.solver import ATOL, RTOL, SolveResult, solve
+from engine.solver import ATOL, RTOL, SolveResult, chain_guesses, solve
 
 X0 = np.array([0.0, 0.0, math.pi / 2])
 PATH = np.array([(1.0, 1.0), (1.0, 2.0), (0.0, 2.0), (0.0, 1.0)])
@@ -56,15 +59,18 @@ def median_time(fn, repeat: int) -> float:
     return statistics.median(times)
 
 
-def cycles_leg_by_leg(inverse, x0, cycles: int, guessed: bool):
+def cycles_leg_by_leg(inverse, x0, cycles: int, guessed: bool, chained: bool = False):
     """``cycles`` cycles of Table 1's path (closed), one solve per leg; returns the leg ends
-    and the Picard sweeps."""
+    and the Picard sweeps. ``guessed``: each leg after the first cycle guessed by the same leg
+    of the cycle before; ``chained``: each cycle's legs guessed by a chain from its start."""
     targets = closed_path(inverse.kinematics, x0[None], PATH)[0]
     guides: list = [None] * len(targets)
     cur, ends, sweeps = x0, [], 0
     for _ in range(cycles):
+        chain = chain_guesses(inverse, cur, targets) if chained else None
         for j, y in enumerate(targets):
-            res = cast(SolveResult, solve(inverse, cur, y, guess=guides[j] if guessed else None))
+            guess = chain[j] if chain is not None else guides[j] if guessed else None
+            res = cast(SolveResult, solve(inverse, cur, y, guess=guess))
             guides[j], cur = res.trajectory, res.x
             ends.append(cur)
             sweeps += res.nit
@@ -109,7 +115,22 @@ def run(quick: bool = False) -> dict:
     warm_ends, warm_sweeps = cycles_leg_by_leg(ext, X0, 3, guessed=True)
     cold_t = median_time(lambda: cycles_leg_by_leg(ext, X0, 3, guessed=False), rep)
     warm_t = median_time(lambda: cycles_leg_by_leg(ext, X0, 3, guessed=True), rep)
+    pinv = {
+        how: (cycles_leg_by_leg(inv, X0, 3, guessed=how == "cycle", chained=how == "chain"),
+              median_time(lambda h=how: cycles_leg_by_leg(inv, X0, 3, guessed=h == "cycle",
+                                                          chained=h == "chain"), rep))
+        for how in ("cold", "cycle", "chain")
+    }  # fmt: skip
     return {
+        "pinv_cycles": {
+            "legs": len(pinv["cold"][0][0]),
+            **{f"{how}_ms": 1e3 * t for how, (_, t) in pinv.items()},
+            **{f"{how}_sweeps": int(sw) for how, ((_, sw), _) in pinv.items()},
+            "ratio": pinv["cold"][1] / pinv["chain"][1],
+            "leg_end_difference": float(
+                max(np.max(np.abs(pinv["cold"][0][0] - e)) for (e, _), _ in pinv.values())
+            ),
+        },
         "cycles": {
             "legs": len(cold_ends),
             "cold_ms": 1e3 * cold_t,
@@ -166,6 +187,16 @@ def main(quick: bool = False) -> dict:
     print(
         f"  guessed by cycle before {c['guessed_ms']:9.2f} ms ({c['guessed_sweeps']} sweeps)"
         f"   ratio {c['ratio']:6.2f}x"
+    )
+    print(f"  max |leg end difference| {c['leg_end_difference']:.2e}")
+    c = r["pinv_cycles"]
+    print(f"3 cycles of Table 1's path, pseudoinverse, {c['legs']} legs one by one:")
+    print(f"  every leg cold          {c['cold_ms']:9.2f} ms ({c['cold_sweeps']} sweeps)")
+    print(f"  guessed by cycle before {c['cycle_ms']:9.2f} ms ({c['cycle_sweeps']} sweeps)")
+    print(
+        f"  chained per cycle       {c['chain_ms']:9.2f} ms ({c['chain_sweeps']} sweeps of the"
+        " legs, after the chains')"
+        f"   ratio {c['ratio']:6.2f}x (cold / chained)"
     )
     print(f"  max |leg end difference| {c['leg_end_difference']:.2e}")
     return r
