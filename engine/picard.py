@@ -217,7 +217,8 @@ def picard_path(
 
 
 def picard_chain(inverse, x0: FloatArray, y: FloatArray, max_sweeps: int = CHAIN_SWEEPS):
-    """Guesses for legs solved one after another: leg j from the end of leg j - 1 to y[j].
+    """Guesses for legs of eq. (7) solved one after another: leg j from the end of leg j - 1
+    to y[j].
 
     Solved leg by leg, L legs cost L times the sweeps of one (about ten for the pseudoinverse,
     whose legs in a later cycle are not those of the cycle before). Here each sweep of (*)

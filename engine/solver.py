@@ -283,8 +283,8 @@ def _guesses(guess, n: int, p: int, gamma: float) -> list[Guess | None] | None:
 
 
 def chain_guesses(inverse: Inverse, x0, y_d, *, gamma: float = 1.0) -> list[Trajectory] | None:
-    """Guesses for solving legs one after another in continuous mode: leg j from where leg
-    j - 1 ends, to ``y_d[j]`` (a closed path's legs, cycle after cycle).
+    """Guesses for solving legs of eq. (7) one after another in continuous mode: leg j from
+    where leg j - 1 ends, to ``y_d[j]`` (a closed path's legs, cycle after cycle).
 
     Pass ``guesses[j]`` as ``guess`` of the solve of leg j (:func:`solve`): the results are
     the same to the sweep tolerance; each leg then takes one or two Picard sweeps instead of
