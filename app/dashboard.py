@@ -33,8 +33,8 @@ import numpy as np
 
 from engine.exceptions import InvalidInputError, JikError
 from engine.registry import ROBOTS, make_inverse, robot_spec
-from engine.repeatability import MAX_PATH_POINTS, closed_path
-from engine.solver import SolveResult, Trajectory, chain_guesses, solve
+from engine.repeatability import MAX_PATH_POINTS, closed_path, cycle_guesses
+from engine.solver import SolveResult, Trajectory, solve
 from engine.unicycle import Unicycle
 from engine.validation import count, positive
 
@@ -338,7 +338,8 @@ def _run_legs(
     of the previous cycle (``guess`` of :func:`engine.solver.solve`): for the extended inverse,
     repeatable, that is the path itself and a leg then costs one or two sweeps instead of about
     eight. The pseudoinverse's legs start from guesses swept for all legs of their cycle
-    together (:func:`engine.solver.chain_guesses`): one or two sweeps a leg instead of about ten.
+    together: one or two sweeps a leg instead of about ten (both:
+    :func:`engine.repeatability.cycle_guesses`).
     """
     t0 = time.perf_counter()
     x0 = np.asarray(state.x0)
@@ -357,27 +358,18 @@ def _run_legs(
         current, offset = resume.leg_end[-1], float(resume.theta[-1])
         if state.mode == "continuous":
             guides = [_leg_trajectory(resume, (first - 1) * L + j) for j in range(L)]
-    # The pseudoinverse's legs in a cycle are not those of the cycle before (it drifts): each
-    # cycle's legs start from guesses swept for all of them at once from the cycle's start
-    # (chain_guesses; None where the chain cannot be swept: the legs are solved unguessed), so
-    # a cycle's numbers depend only on where it starts, as before. The extended inverse's
-    # later cycles repeat its first and are guessed from it; a chain of its first cycle saves
-    # nothing measurable. The chain evaluates J# about three times as often as the legs would,
-    # so it pays only where an evaluation costs little beyond numpy's per-call overhead: not
-    # for the unicycle's kinematics.
-    chain = (
-        state.mode == "continuous" and inverse.name == "pseudoinverse"
-        and not hasattr(inverse.kinematics, "path") and L > 1
-    )  # fmt: skip
     for c in range(first, cycles):
-        chained = chain_guesses(inverse, current, targets, gamma=gamma) if chain else None
+        guesses = (
+            cycle_guesses(inverse, current, targets, guides, gamma)
+            if state.mode == "continuous"
+            else guides
+        )
         for j in range(L):
             if cancelled():
                 raise Cancelled
-            guess = guides[j] if chained is None else chained[j]
             try:
                 leg = _solve_leg(
-                    inverse, current, targets[j], state, gamma, cancelled, partial, guess
+                    inverse, current, targets[j], state, gamma, cancelled, partial, guesses[j]
                 )
             except JikError as exc:
                 # A map undefined on the way (an algorithmic singularity, a characteristic that

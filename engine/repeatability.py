@@ -13,7 +13,8 @@ import numpy as np
 
 from engine.exceptions import InvalidInputError
 from engine.inverses import Inverse
-from engine.solver import BatchSolveResult, SolveResult, solve
+from engine.solver import BatchSolveResult, SolveResult, Trajectory, chain_guesses, solve
+from engine.unicycle import Unicycle
 from engine.validation import FloatArray, count
 
 #: Largest number of cycles and of path points accepted.
@@ -63,6 +64,30 @@ def closed_path(kinematics, x0: FloatArray, path: FloatArray) -> FloatArray:
     if np.any(np.linalg.norm(pts[:, -1] - home, axis=-1) > CLOSE_TOL):
         pts = np.concatenate([pts, home[:, None, :]], axis=1)
     return pts
+
+
+def cycle_guesses(
+    inverse: Inverse, start, targets, guides: list[Trajectory | None], gamma: float = 1.0
+) -> list[Trajectory | None]:
+    """Picard guesses for one cycle's legs of a closed path from ``start`` (continuous mode,
+    one start): the ``guess`` of each leg's :func:`engine.solver.solve`, eq. (7).
+
+    The extended inverse is repeatable: a leg repeats the same leg of the cycle before, so
+    ``guides`` (those legs' trajectories, None in the first cycle) are its guesses, and a leg
+    then takes one or two sweeps. The pseudoinverse drifts, so the cycle before saves almost
+    nothing: its legs are swept together from ``start`` (:func:`engine.solver.chain_guesses`),
+    one or two sweeps a leg instead of about ten, and a cycle's numbers depend only on its
+    start. A chain evaluates J# about three times as often as the legs would, so it pays only
+    where an evaluation costs little beyond numpy's per-call overhead: not for the unicycle.
+    """
+    if (
+        inverse.name == "pseudoinverse" and len(targets) > 1
+        and not isinstance(inverse.kinematics, Unicycle)
+    ):  # fmt: skip
+        chained = chain_guesses(inverse, start, targets, gamma=gamma)
+        if chained is not None:
+            return list(chained)
+    return list(guides)
 
 
 def repeatability(
@@ -123,12 +148,12 @@ def repeatability(
     messages = ["repeatability run completed"] * n
     current = xb.copy()
     leg_results: list[SolveResult] = []
-    # One start in continuous mode: each leg after the first cycle starts its Picard sweeps from
-    # the same leg of the cycle before (solve's guess; the extended inverse then repeats it in
-    # one or two sweeps a leg). Batches do without: a guess is per member.
+    # One start in continuous mode: each leg starts its Picard sweeps from a guess
+    # (cycle_guesses). Batches do without: a guess is per member.
     guided = single and mode == "continuous"
     guides: list = [None] * L
     for c in range(cycles):
+        guesses = cycle_guesses(inverse, current[0], targets[0], guides, gamma) if guided else []
         for j in range(L):
             ids = np.flatnonzero(alive)
             if ids.size == 0:
@@ -145,7 +170,7 @@ def repeatability(
                     tol=tol,
                     max_iterations=max_iterations,
                     record=(record or guided) and single,
-                    guess=[guides[j]] if guided else None,
+                    guess=[guesses[j]] if guided else None,
                 ),
             )
             if guided and res.success[0]:
