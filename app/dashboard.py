@@ -1144,7 +1144,9 @@ class Dashboard:
         """Hold the 3D scene's animation still for ``seconds`` from now on behalf of
         ``holder`` (0 ends that holder's hold). The animation goes on when no hold is left.
 
-        The page holds it while the pointer is on its controls: a playing scene keeps viser's
+        The page holds it while the pointer is on its controls or on the scene's GUI panel
+        (``static/scene_hold.js`` tells the page), and the scene for a moment after a change
+        made in it (:data:`app.scene.EDIT_HOLD`): a playing scene keeps viser's
         client rendering, and in software WebGL that takes over a core, which the change the
         user is about to make needs (see ``docs/benchmarks.md``, Dashboard latency).
 

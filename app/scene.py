@@ -25,11 +25,13 @@ import math
 import threading
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any, cast
 
 import numpy as np
 import viser
 
+import static
 from app.dashboard import ALGORITHMS, COLORS, MAX_DASHBOARD_CYCLES, Dashboard, Event, runs_key
 from engine.exceptions import InvalidInputError
 from engine.registry import ROBOTS, robot_spec
@@ -44,9 +46,14 @@ UNICYCLE_ROOT = "/robot/unicycle"
 #: Seconds of animation per leg (manipulators) or per shown iteration (unicycle) at speed 1.
 SECONDS_PER_LEG = 1.6
 #: Seconds the animation holds still after a change made in the scene (its GUI, the gizmo):
-#: the next change of a drag is then computed and drawn without the animation's frames (the
-#: page holds it while the pointer is on its controls; viser does not say where the pointer is).
+#: the next change of a drag is then computed and drawn without the animation's frames. (The
+#: page holds it while the pointer is on its controls or on the scene's GUI panel, where
+#: :data:`CLIENT_SCRIPT` tells it; a drag of the gizmo starts with a change, its press.)
 EDIT_HOLD = 1.5
+#: Script run in every viser client: it tells the framing page when the pointer (or the keyboard)
+#: is on the scene's GUI panel, so that the page holds the animation still there as it does on its
+#: own controls.
+CLIENT_SCRIPT = Path(static.__file__).resolve().parent / "scene_hold.js"
 #: Unicycle iterations shown in the animation (geometrically spaced, the last always).
 UNICYCLE_SHOWN = 10
 _Z = {"pseudoinverse": 0.10, "extended": 0.0}
@@ -450,6 +457,7 @@ class DashboardScene:
         self._stopped = False
         dashboard.scene_status["held"] = False
         self._build_static_gui()
+        self.gui_hold = _run_in_clients(self.server, CLIENT_SCRIPT.read_text(encoding="utf-8"))
         _add_floor_grid(self.server.scene)
         self.server.scene.add_frame("/robot", show_axes=False)
         self._unsubscribe = dashboard.subscribe(self._on_event, last=True)
@@ -1010,7 +1018,7 @@ class DashboardScene:
             if timeline is None:
                 continue
             with self._lock:
-                # Held (Dashboard.hold: the pointer is on the page's controls): still, as if
+                # Held (Dashboard.hold: the pointer is on the controls): still, as if
                 # paused, until the hold ends.
                 held = self.playing and self.dashboard.held()
                 if held != self.dashboard.scene_status.get("held", False):
@@ -1028,6 +1036,22 @@ class DashboardScene:
             if now - last_gui > 0.25:
                 last_gui = now
                 self._show_position(timeline)
+
+
+def _run_in_clients(server: viser.ViserServer, source: str) -> bool:
+    """Run ``source`` in every client of ``server``, those that connect later too.
+
+    viser runs scripts in its client for its own use (plotly.js) and has no public call for it:
+    this queues the same message. Returns False, leaving the scene as it is, when this viser
+    lacks it (the page's hold then covers the page's controls only, and a change made in the
+    scene holds the animation from that change on, :data:`EDIT_HOLD`).
+    """
+    message = getattr(getattr(viser, "_messages", None), "RunJavascriptMessage", None)
+    queue = getattr(getattr(server, "_websock_server", None), "queue_message", None)
+    if message is None or queue is None:
+        return False
+    queue(message(source=source))
+    return True
 
 
 def _path_text(path) -> str:

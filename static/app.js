@@ -77,11 +77,14 @@ async function flush() {
 // While the pointer is on the controls (or the keyboard works in them), the 3D scene's animation
 // holds still (POST /api/dashboard/hold, renewed while it lasts; the server ends a hold that is
 // not renewed). A playing scene keeps viser's client rendering, and without a GPU that takes
-// more than a core, which the change about to be made needs to be computed and drawn.
+// more than a core, which the change about to be made needs to be computed and drawn. The same
+// holds on the scene's own GUI panel: the viser client says so (static/scene_hold.js).
 const HOLD_SECONDS = 4;
 const hold = {
-  holder: Math.random().toString(36).slice(2, 12) || "page", pointer: false, keyboard: false, timer: null,
+  holder: Math.random().toString(36).slice(2, 12) || "page", pointer: false, keyboard: false,
+  scenePointer: false, sceneKeyboard: false, sceneMessages: 0, timer: null,
 };
+jik.hold = hold; // (read by the browser test)
 
 function sendHold(seconds) {
   fetch("/api/dashboard/hold", {
@@ -91,7 +94,8 @@ function sendHold(seconds) {
 }
 
 function updateHold() {
-  const on = Boolean(jik.config && jik.config.scene_port) && (hold.pointer || hold.keyboard);
+  const on = Boolean(jik.config && jik.config.scene_port) && (
+    hold.pointer || hold.keyboard || hold.scenePointer || hold.sceneKeyboard);
   if (on && hold.timer === null) {
     sendHold(HOLD_SECONDS);
     hold.timer = setInterval(() => sendHold(HOLD_SECONDS), (HOLD_SECONDS * 1000) / 2);
@@ -112,7 +116,26 @@ function watchHold() {
   form.addEventListener("focusout", (ev) => {
     if (!form.contains(ev.relatedTarget)) { hold.keyboard = false; updateHold(); }
   });
-  window.addEventListener("pagehide", () => { hold.pointer = hold.keyboard = false; updateHold(); });
+  window.addEventListener("pagehide", () => {
+    hold.pointer = hold.keyboard = hold.scenePointer = hold.sceneKeyboard = false;
+    updateHold();
+  });
+  // The scene's GUI panel (static/scene_hold.js): only messages from the scene's frame, of the
+  // one expected shape. The frame may not hear the pointer leave: a move on this page ends its
+  // pointer's hold.
+  const frame = $("#scene");
+  window.addEventListener("message", (ev) => {
+    if (ev.source !== frame.contentWindow || ev.origin !== new URL(frame.src).origin) return;
+    const d = ev.data;
+    if (!d || d.jik !== "scene-hold" || typeof d.pointer !== "boolean" || typeof d.keyboard !== "boolean") return;
+    hold.sceneMessages += 1;
+    hold.scenePointer = d.pointer;
+    hold.sceneKeyboard = d.keyboard;
+    updateHold();
+  });
+  document.addEventListener("pointermove", (ev) => {
+    if (ev.target !== frame && hold.scenePointer) { hold.scenePointer = false; updateHold(); }
+  }, { passive: true });
 }
 
 // ---------------------------------------------------------------- controls

@@ -512,6 +512,13 @@ def test_a_hold_stills_the_playing_scene_until_it_ends():
         until(lambda: dashboard.scene_status["held"] is False, "the hold did not end")
         until(lambda: scene._s < scene._timeline.length, "the animation did not start over")
         assert scene.playing
+        # Every viser client, those connecting later too, runs the script that tells the page
+        # when the pointer is on the scene's GUI panel (the browser test uses it).
+        from app.scene import CLIENT_SCRIPT
+
+        buffer = scene.server._websock_server._broadcast_buffer.message_from_id.values()
+        scripts = [m.source for m in buffer if type(m).__name__ == "RunJavascriptMessage"]
+        assert scene.gui_hold and scripts == [CLIENT_SCRIPT.read_text(encoding="utf-8")]
     finally:
         scene.stop()
         dashboard.stop()

@@ -133,6 +133,42 @@ _FRAME_WATCH = """() => {
 }"""
 
 
+# Installed in the page: the wall-clock time at which each generation's plots are drawn (the page
+# sets body[data-generation] once they are), for changes made in the scene's GUI.
+_DRAWN_WATCH = """() => {
+    if (window.jikDrawnAt) return;
+    window.jikDrawnAt = {};
+    new MutationObserver(() => {
+        const g = document.body.dataset.generation;
+        if (!(g in jikDrawnAt)) jikDrawnAt[g] = performance.timeOrigin + performance.now();
+    }).observe(document.body, {attributes: true, attributeFilter: ["data-generation"]});
+}"""
+
+# Installed in the viser client: the wall-clock time of the last press (a slider of viser's GUI
+# takes its value on the press).
+_PRESS_WATCH = """() => {
+    if (window.jikPressed !== undefined) return;
+    window.jikPressed = 0;
+    document.addEventListener("pointerdown",
+        () => { window.jikPressed = performance.timeOrigin + performance.now(); }, true);
+}"""
+
+# The box of the track of the slider of viser's GUI labelled ``label`` (a press there sets the
+# value), in the viser client's viewport.
+_SCENE_SLIDER = """(label) => {
+    for (const el of document.querySelectorAll(".mantine-Slider-root")) {
+        let row = el;
+        for (let i = 0; i < 4 && row; i++) row = row.parentElement;
+        if (row && row.innerText.split("\\n")[0].trim() === label) {
+            const track = el.querySelector(".mantine-Slider-trackContainer") || el;
+            const r = track.getBoundingClientRect();
+            return {x: r.x, y: r.y, width: r.width, height: r.height};
+        }
+    }
+    return null;
+}"""
+
+
 def _scene_frame(page):
     return next(f for f in page.frames if f.parent_frame is not None)
 
@@ -161,6 +197,26 @@ def _latency(page, after: int) -> tuple[float, str]:
         + ")"
     )
     return max(lat["ms"], scene), text
+
+
+def _scene_latency(page, after: int) -> tuple[float, str]:
+    """Press on a slider of the scene's GUI (the viser client) to the plots redrawn in the page
+    and to the scene's update shown, both frames' wall-clock ms.
+
+    Returns (the larger of the two in ms, a description).
+    """
+    page.wait_for_function(f"Object.keys(jikDrawnAt).some((g) => Number(g) > {after})")
+    frame = _scene_frame(page)
+    pressed = frame.evaluate("jikPressed")
+    generation, drawn = min(
+        (int(g), t) for g, t in page.evaluate("jikDrawnAt").items() if int(g) > after
+    )
+    shown = f"Object.entries(jikSceneShown).filter(([g]) => Number(g) >= {generation})"
+    frame.wait_for_function(f"{shown}.length > 0", timeout=30_000)
+    scene = frame.evaluate(f"Math.min(...{shown}.map(([, t]) => t))") - pressed
+    timing = page.text_content("#timing")  # ("generation N: compute ... ms, figures ... ms")
+    plots = drawn - pressed
+    return max(plots, scene), f"plots {plots:.0f} ms, scene {scene:.0f} ms ({timing})"
 
 
 def _wait_scene(base: str, condition, timeout: float = 20.0, what: str = "") -> dict:
@@ -577,6 +633,46 @@ def test_dashboard_follows_controls_in_chromium(served):
         _wait_scene(base, lambda s: s.get("held") is True, what="hold for the keyboard")
         page.mouse.click(800, 25)
         _wait_scene(base, lambda s: s.get("held") is False, what="play on after the keyboard")
+
+        # Changes made in the scene's own GUI, with the animation playing: on viser's panel the
+        # animation holds still too (static/scene_hold.js tells the page), not on its Playback
+        # folder nor on the canvas, where the user watches the robots.
+        page.evaluate(_DRAWN_WATCH)
+        frame.evaluate(_PRESS_WATCH)
+        iframe = page.locator("#scene").bounding_box()
+        assert iframe is not None
+        for what, label, fraction in [
+            ("arm length l", "l", 0.3),
+            ("start point x1", "x0: x1", 0.6),
+            ("gamma", "gamma", 0.25),
+            ("cycles", "cycles", 0.2),
+        ]:
+            page.mouse.move(800, 25)
+            _wait_scene(base, lambda s: s.get("held") is False)
+            frame.wait_for_function("performance.now() - jikLastFrame < 50", polling=20)
+            box = frame.evaluate(_SCENE_SLIDER, label)
+            assert box is not None, f"no slider '{label}' in the scene's GUI"
+            x = iframe["x"] + box["x"] + fraction * box["width"]
+            y = iframe["y"] + box["y"] + box["height"] / 2
+            page.mouse.move(x, y)
+            _wait_scene(base, lambda s: s.get("held") is True, what=f"hold on the scene's {label}")
+            frame.wait_for_function("performance.now() - jikLastFrame > 100", polling=20)
+            before = int(page.evaluate("jik.generation"))
+            page.mouse.down()
+            page.mouse.up()
+            latencies[f"{what}, scene GUI (playing)"] = _scene_latency(page, before)
+            _second_phase_drawn(page)
+            _scene_generation(base, _wait_generation(page, before + 1))
+        assert page.evaluate("document.querySelector('#controls').classList.contains('holding')")
+        # The canvas and the Playback folder let it play.
+        page.mouse.move(iframe["x"] + 60, iframe["y"] + iframe["height"] / 2)
+        _wait_scene(base, lambda s: s.get("held") is False, what="play on over the canvas")
+        heard = page.evaluate("jik.hold.sceneMessages")
+        box = frame.evaluate(_SCENE_SLIDER, "speed")
+        page.mouse.move(iframe["x"] + box["x"] + 10, iframe["y"] + box["y"] + 4)
+        page.wait_for_function(f"jik.hold.sceneMessages > {heard}")
+        assert page.evaluate("jik.hold.scenePointer") is False
+        assert _get(f"{base}/api/dashboard/state")["scene"]["held"] is False
         browser.close()
 
     for what, (worst, text) in latencies.items():
