@@ -663,7 +663,9 @@ def test_dashboard_follows_controls_in_chromium(served):
             latencies[f"{what}, scene GUI (playing)"] = _scene_latency(page, before)
             _second_phase_drawn(page)
             _scene_generation(base, _wait_generation(page, before + 1))
-        assert page.evaluate("document.querySelector('#controls').classList.contains('holding')")
+        # The pointer is still on the scene's panel: the page says the animation is held.
+        assert "held while you edit" in page.evaluate(note)
+        page.screenshot(path=str(ARTIFACTS / "dashboard-7-scene-held.png"))
         # The canvas and the Playback folder let it play.
         page.mouse.move(iframe["x"] + 60, iframe["y"] + iframe["height"] / 2)
         _wait_scene(base, lambda s: s.get("held") is False, what="play on over the canvas")
