@@ -1014,10 +1014,12 @@ class DashboardScene:
             time.sleep(1.0 / FPS)
             now = time.monotonic()
             dt, last = now - last, now
-            timeline = self._timeline
-            if timeline is None:
-                continue
             with self._lock:
+                # (Read under the lock: a timeline read before a drawing swapped it would differ
+                # from the one just posed, and pose the new one again.)
+                timeline = self._timeline
+                if timeline is None:
+                    continue
                 # Held (Dashboard.hold: the pointer is on the controls): still, as if
                 # paused, until the hold ends.
                 held = self.playing and self.dashboard.held()
