@@ -336,9 +336,9 @@ const isAxis = (k) => /^[xy]axis[0-9]*$/.test(k);
 const axisRanges = (layout) => Object.fromEntries(Object.keys(layout || {}).filter(isAxis).sort()
   .map((k) => [k, layout[k].range || null]));
 // The figure without its lines' data, axis ranges and title text (JSON): what must stay for a
-// move. Other traces (the h panel's contours) must stay whole: only scatter traces move. (A new
-// title text, as the h panel's E1/E2 that a second phase fills in, is set after the move: a
-// relayout of the title.)
+// move. (A new title text, as the h panel's E1/E2 that a second phase fills in, is set after the
+// move: a relayout of the title.) Only figures of scatter traces move: Plotly.animate drops the
+// layer of any trace it cannot animate, and the h panel's map (a contour) would vanish.
 const moves = (t) => t.type === "scatter";
 function shape(fig) {
   const strip = (t) => (moves(t) ? Object.fromEntries(Object.entries(t).map(([k, v]) => [k, DATA_KEYS.includes(k) || v])) : t);
@@ -367,7 +367,7 @@ function plan(div, key, fig) {
   // drawing; while the user's zoom stays, those of the same ranges before.
   onScreen[key] = { shape: shape(fig), ranges, held, shown: zoomed ? last.shown : null };
   const traces = fig.data.flatMap((t, i) => (moves(t) ? [i] : []));
-  if (!same || !traces.length) return null;
+  if (!same || !traces.length || traces.length < fig.data.length) return null;
   const frame = { traces, data: traces.map((i) => Object.fromEntries(DATA_KEYS.filter((k) => k in fig.data[i]).map((k) => [k, fig.data[i][k]]))) };
   // After the move, a relayout: a new title text (the h panel's E1/E2), and the new axis
   // ranges, as a zoom sets them (the ranges of an animation frame miss stacked axes, and do
