@@ -17,6 +17,7 @@ from engine.augmentations import PaperCubic
 from engine.functionals import error_functional_e2
 from engine.inverses import ExtendedInverse, Pseudoinverse
 from engine.kinematics import Manipulator2
+from engine.reproductions.table1 import cell
 from engine.reproductions.table1 import rows as table1_rows
 from engine.symbolic import findings_summary, manipulator2_findings
 from engine.variational import (
@@ -110,7 +111,7 @@ def format_text(result: dict) -> str:
         dist = result["distance_to_pseudoinverse"].get(name)
         for i, row in enumerate(result["table1"][name]):
             d = f"  [{dist[i]:.4f}]" if dist else ""
-            out.append(f"    {labels[i]} " + " ".join(f"{v:>9.4f}" for v in row) + d)
+            out.append(f"    {labels[i]} " + " ".join(cell(v) for v in row) + d)
     if result["symbolic"]["findings"]:
         out += ["", "Symbolic checks (sympy):"]
         for f in result["symbolic"]["findings"]:

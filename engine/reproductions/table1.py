@@ -54,6 +54,12 @@ def run(printed_gradient: bool = False) -> dict:
     }
 
 
+def cell(value: float, width: int = 9) -> str:
+    """``value`` to four decimals in ``width`` columns, as Table 1 prints it: a round-off zero
+    such as -1e-16 prints 0.0000, not -0.0000."""
+    return f"{round(float(value), 4) + 0.0:{width}.4f}"
+
+
 def format_text(result: dict) -> str:
     """Table 1 laid out as in the paper, with the printed values beside ours."""
     labels = ["A  x0 ", "B  x1f", "C  x2f", "D  x3f", "A  x4f"]
@@ -66,8 +72,8 @@ def format_text(result: dict) -> str:
         out.append(f"Algorithm: {title}{extra}")
         out.append(f"{'':8}{'x1':>9}{'x2':>9}{'x3':>9}   | printed{'':20}")
         for lab, row, pr in zip(labels, result[alg], PRINTED[alg], strict=True):
-            ours = "".join(f"{v:9.4f}" for v in row)
-            theirs = "".join(f"{v:9.4f}" for v in pr)
+            ours = "".join(cell(v) for v in row)
+            theirs = "".join(cell(v) for v in pr)
             out.append(f"{lab:8}{ours}   |{theirs}")
         out.append("")
     out.append("Rows: x0 = (0, 0, pi/2) (task point (0, 1)), then after the legs to (1,1), (1,2),")

@@ -28,6 +28,9 @@ def test_table1_text_has_both_columns_and_printed_values(capsys):
     out = run_cli(capsys, "reproduce", "table1")
     assert "Jacobian pseudoinverse" in out and "Extended Jacobian" in out
     assert out.count("1.0432") == 2  # ours and the printed value on row C
+    # Rows D and A of the extended column have x2 = 0 up to round-off (about -1e-16), printed
+    # as a zero without a sign.
+    assert "-0.0000" not in out and " 0.0000" in out
 
 
 def test_manipulator1_json_contract(capsys):
