@@ -11,6 +11,7 @@ animation paused (as for the screenshots), then again while it plays (the defaul
 
 from __future__ import annotations
 
+import base64
 import json
 import os
 import socket
@@ -145,12 +146,43 @@ _DRAWN_WATCH = """() => {
 }"""
 
 # Installed in the viser client: the wall-clock time of the last press (a slider of viser's GUI
-# takes its value on the press).
+# takes its value on the press) and of the last move (a drag of the gizmo).
 _PRESS_WATCH = """() => {
     if (window.jikPressed !== undefined) return;
-    window.jikPressed = 0;
+    window.jikPressed = window.jikMoved = 0;
     document.addEventListener("pointerdown",
         () => { window.jikPressed = performance.timeOrigin + performance.now(); }, true);
+    document.addEventListener("pointermove",
+        () => { window.jikMoved = performance.timeOrigin + performance.now(); }, true);
+}"""
+
+# In the page: where a colour shows in a PNG (base64) of the scene's frame, as the centre and
+# the main direction of its pixels (found by the covariance of their places).
+_FIND_COLOUR = """async ({png, rgb}) => {
+    const img = new Image();
+    img.src = "data:image/png;base64," + png;
+    await img.decode();
+    const canvas = document.createElement("canvas");
+    canvas.width = img.width;
+    canvas.height = img.height;
+    const ctx = canvas.getContext("2d");
+    ctx.drawImage(img, 0, 0);
+    const px = ctx.getImageData(0, 0, img.width, img.height).data;
+    const xs = [], ys = [];
+    for (let i = 0; i < px.length; i += 4) {
+        const d = Math.abs(px[i] - rgb[0]) + Math.abs(px[i + 1] - rgb[1])
+            + Math.abs(px[i + 2] - rgb[2]);
+        if (d < 40) { xs.push((i / 4) % img.width); ys.push(Math.floor(i / 4 / img.width)); }
+    }
+    const n = xs.length, mean = (v) => v.reduce((a, b) => a + b, 0) / n;
+    const mx = mean(xs), my = mean(ys);
+    let sxx = 0, syy = 0, sxy = 0;
+    for (let k = 0; k < n; k++) {
+        const dx = xs[k] - mx, dy = ys[k] - my;
+        sxx += dx * dx; syy += dy * dy; sxy += dx * dy;
+    }
+    const angle = 0.5 * Math.atan2(2 * sxy, sxx - syy);
+    return {n, x: mx, y: my, ux: Math.cos(angle), uy: Math.sin(angle)};
 }"""
 
 # The box of the track of the slider of viser's GUI labelled ``label`` (a press there sets the
@@ -199,15 +231,16 @@ def _latency(page, after: int) -> tuple[float, str]:
     return max(lat["ms"], scene), text
 
 
-def _scene_latency(page, after: int) -> tuple[float, str]:
-    """Press on a slider of the scene's GUI (the viser client) to the plots redrawn in the page
-    and to the scene's update shown, both frames' wall-clock ms.
+def _scene_latency(page, after: int, since: str = "jikPressed") -> tuple[float, str]:
+    """A press on a slider of the scene's GUI (the viser client), or the move of a drag there
+    (``since="jikMoved"``), to the plots redrawn in the page and to the scene's update shown,
+    both frames' wall-clock ms.
 
     Returns (the larger of the two in ms, a description).
     """
     page.wait_for_function(f"Object.keys(jikDrawnAt).some((g) => Number(g) > {after})")
     frame = _scene_frame(page)
-    pressed = frame.evaluate("jikPressed")
+    pressed = frame.evaluate(since)
     generation, drawn = min(
         (int(g), t) for g, t in page.evaluate("jikDrawnAt").items() if int(g) > after
     )
@@ -687,6 +720,31 @@ def test_dashboard_follows_controls_in_chromium(served):
         page.wait_for_function(f"jik.hold.sceneMessages > {heard}")
         assert page.evaluate("jik.hold.scenePointer") is False
         assert _get(f"{base}/api/dashboard/state")["scene"]["held"] is False
+
+        # The start point dragged in the scene, by its gizmo's x arrow (drei's colour #ff2060,
+        # found in a screenshot), with the animation playing. The pointer on the canvas does not
+        # hold it; the press is a change, which does (app/scene.py EDIT_HOLD).
+        page.mouse.move(800, 25)
+        _wait_scene(base, lambda s: s.get("held") is False)
+        frame.wait_for_function("performance.now() - jikLastFrame < 50", polling=20)
+        png = base64.b64encode(page.locator("#scene").screenshot()).decode()
+        arrow = page.evaluate(_FIND_COLOUR, {"png": png, "rgb": [255, 32, 96]})
+        assert arrow["n"] > 10, f"the gizmo's x arrow is not in view: {arrow}"
+        x, y = iframe["x"] + arrow["x"], iframe["y"] + arrow["y"]
+        x0 = _get(f"{base}/api/dashboard/state")["state"]["x0"]
+        page.mouse.move(x, y)
+        before = int(page.evaluate("jik.generation"))
+        page.mouse.down()
+        _wait_scene(base, lambda s: s.get("held") is True, what="hold on the gizmo's press")
+        generation = _wait_generation(page, before + 1)  # (the press: the same state)
+        _scene_generation(base, generation)
+        frame.wait_for_function("performance.now() - jikLastFrame > 100", polling=20)
+        page.mouse.move(x + 25 * arrow["ux"], y + 25 * arrow["uy"])
+        what = "start point, dragged in the scene (playing)"
+        latencies[what] = _scene_latency(page, generation, since="jikMoved")
+        page.mouse.up()
+        _second_phase_drawn(page)
+        assert _get(f"{base}/api/dashboard/state")["state"]["x0"] != x0
         browser.close()
 
     for what, (worst, text) in latencies.items():
