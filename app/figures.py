@@ -15,6 +15,7 @@ from __future__ import annotations
 import base64
 import json
 import math
+from typing import Any
 
 import numpy as np
 import plotly.graph_objects as go
@@ -453,6 +454,12 @@ def _augmenting(result: DashboardResult, functionals: dict | None = None) -> dic
 
     The extended Jacobian keeps h constant (eq. (12)), so its trajectory follows a level curve;
     the pseudoinverse crosses them. The title carries E1 (13) and E2 (18) over the plotted box.
+
+    The trajectories and the start x0 are layout shapes over the contour trace, not traces: a
+    change that keeps h on its box then moves them by a relayout of the shapes, a few ms in the
+    page, and the contours stay (plotly's animation of traces would drop a contour's layer, and
+    drawing the panel anew takes ten times as long). Hover gives h; the joint values along
+    the runs are in the joint panel.
     """
     ju, _ = _units(result)
     grid = result.augmenting
@@ -479,30 +486,32 @@ def _augmenting(result: DashboardResult, functionals: dict | None = None) -> dic
             name="h", showlegend=False,
         )
     ]  # fmt: skip
-    for a in ALGORITHMS:
-        run = result.runs[a]
-        data.append(
-            _trace("scatter",
-                x=run.x[:, i], y=run.x[:, j], mode="lines", name=LABELS[a],
-                line=dict(color=COLORS[a], width=2.5),
-                hovertemplate=f"{ni} = %{{x:.4f}}<br>{nj} = %{{y:.4f}}<extra>{a}</extra>",
-            )
-        )  # fmt: skip
+    shapes: list[dict[str, Any]] = [
+        dict(type="path", path=_svg_path(result.runs[a].x[:, i], result.runs[a].x[:, j]),
+             line=dict(color=COLORS[a], width=2.5), name=LABELS[a])
+        for a in ALGORITHMS
+    ]  # fmt: skip
     x0 = result.state.x0
-    data.append(
-        _trace("scatter",
-            x=[x0[i]], y=[x0[j]], mode="markers", name="x0",
-            marker=dict(color="white", size=10, line=dict(color="black", width=2)),
-            hovertemplate="x0<extra></extra>",
-        )
+    shapes.append(  # (a circle of 10 px at x0, whatever the axes' scales)
+        dict(type="circle", xsizemode="pixel", ysizemode="pixel", xanchor=float(x0[i]),
+             yanchor=float(x0[j]), x0=-5, x1=5, y0=-5, y1=5, fillcolor="white",
+             line=dict(color="black", width=2), name="x0")
     )  # fmt: skip
     return _figure(
         data,
         augmenting_title(result, functionals),
         **_NO_LEGEND,
+        shapes=shapes,
         xaxis=dict(title=_label(ni, ju[i])),
         yaxis=dict(title=_label(nj, ju[j])),
     )
+
+
+def _svg_path(x: np.ndarray, y: np.ndarray) -> str:
+    """A polyline through (x, y) in data coordinates, as a plotly path shape takes it (six
+    significant digits: under a pixel at a hundredfold zoom of a panel)."""
+    points = "L".join(f"{u:.6g},{v:.6g}" for u, v in zip(x.tolist(), y.tolist(), strict=True))
+    return "M" + points
 
 
 def augmenting_title(result: DashboardResult, functionals: dict | None = None) -> str:

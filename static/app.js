@@ -325,25 +325,26 @@ function drawTable(div, fig) {
   );
 }
 
-// A figure that differs from the one on screen only in its lines' data, its axis ranges and
-// its title text (same styles, same contours) moves its lines with Plotly.animate, then takes
-// the new ranges and title by Plotly.relayout: no redraw of the rest, a third of
-// Plotly.react's cost. The server rounds the ranges (app/figures.py nice_range) and keeps them
+// A figure that differs from the one on screen only in its lines' data, its axis ranges, its
+// title text and its shapes (same styles, same contours) moves its lines with Plotly.animate,
+// then takes the new ranges, title and shapes by Plotly.relayout: no redraw of the rest, a third
+// of Plotly.react's cost. The server rounds the ranges (app/figures.py nice_range) and keeps them
 // while the data fill them (keep_ranges), so that most changes do not even touch the axes.
 const DATA_KEYS = ["x", "y", "customdata", "text"];
 const MOVE = { transition: { duration: 0 }, frame: { duration: 0, redraw: false }, mode: "immediate" };
 const isAxis = (k) => /^[xy]axis[0-9]*$/.test(k);
 const axisRanges = (layout) => Object.fromEntries(Object.keys(layout || {}).filter(isAxis).sort()
   .map((k) => [k, layout[k].range || null]));
-// The figure without its lines' data, axis ranges and title text (JSON): what must stay for a
-// move. (A new title text, as the h panel's E1/E2 that a second phase fills in, is set after the
-// move: a relayout of the title.) Only figures of scatter traces move: Plotly.animate drops the
-// layer of any trace it cannot animate, and the h panel's map (a contour) would vanish.
+// The figure without its lines' data, axis ranges, title text and shapes (JSON): what must stay
+// for a move. (A new title text, as the h panel's E1/E2 that a second phase fills in, is set
+// after the move: a relayout of the title.) Plotly.animate drops the layer of any trace it
+// cannot animate: scatter traces move only in figures of scatter traces. The h panel's runs are
+// shapes over its map (a contour, app/figures.py), moved by the relayout alone.
 const moves = (t) => t.type === "scatter";
 function shape(fig) {
   const strip = (t) => (moves(t) ? Object.fromEntries(Object.entries(t).map(([k, v]) => [k, DATA_KEYS.includes(k) || v])) : t);
   const layout = Object.fromEntries(Object.entries(fig.layout).map(
-    ([k, v]) => [k, (isAxis(k) && v.range ? { ...v, range: true } : k === "title" ? { ...v, text: true } : v)]));
+    ([k, v]) => [k, (isAxis(k) && v.range ? { ...v, range: true } : k === "title" ? { ...v, text: true } : k === "shapes" || v)]));
   return JSON.stringify([layout, fig.data.map(strip)]);
 }
 const onScreen = {}; // panel -> {shape, ranges: JSON, held: ranges asked for, shown: JSON after drawing}
@@ -365,10 +366,11 @@ function plan(div, key, fig) {
   const newRanges = same && ranges !== last.ranges;
   // shown: the ranges plotly draws for these (constrained by scaleanchor, say), taken after the
   // drawing; while the user's zoom stays, those of the same ranges before.
-  onScreen[key] = { shape: shape(fig), ranges, held, shown: zoomed ? last.shown : null };
+  const shapes = JSON.stringify(fig.layout.shapes || []);
+  onScreen[key] = { shape: shape(fig), ranges, held, shown: zoomed ? last.shown : null, shapes };
   const traces = fig.data.flatMap((t, i) => (moves(t) ? [i] : []));
-  if (!same || !traces.length || traces.length < fig.data.length) return null;
-  const frame = { traces, data: traces.map((i) => Object.fromEntries(DATA_KEYS.filter((k) => k in fig.data[i]).map((k) => [k, fig.data[i][k]]))) };
+  if (!same || (traces.length && traces.length < fig.data.length)) return null;
+  const frame = traces.length ? { traces, data: traces.map((i) => Object.fromEntries(DATA_KEYS.filter((k) => k in fig.data[i]).map((k) => [k, fig.data[i][k]]))) } : null;
   // After the move, a relayout: a new title text (the h panel's E1/E2), and the new axis
   // ranges, as a zoom sets them (the ranges of an animation frame miss stacked axes, and do
   // not constrain the task plane's equal scales).
@@ -376,6 +378,7 @@ function plan(div, key, fig) {
   const title = (fig.layout.title || {}).text;
   if (title !== ((div.layout || {}).title || {}).text) relayout["title.text"] = title;
   if (newRanges) for (const [k, r] of Object.entries(held)) if (r) relayout[`${k}.range`] = r;
+  if (shapes !== last.shapes) relayout.shapes = fig.layout.shapes || [];
   return { frame, relayout };
 }
 
@@ -417,8 +420,8 @@ async function drawFigures(figures, digests = {}, robot = null) {
       const move = plan(div, key, fig); // (before plotly fills the layout in)
       jik.panelMoved[key] = Boolean(move);
       const p = move
-        ? Plotly.animate(div, move.frame, MOVE).then(() => !Object.keys(move.relayout).length
-          || Plotly.relayout(div, move.relayout))
+        ? (move.frame ? Plotly.animate(div, move.frame, MOVE) : Promise.resolve())
+          .then(() => !Object.keys(move.relayout).length || Plotly.relayout(div, move.relayout))
         : Plotly.react(div, fig.data, fig.layout, PLOT_CONFIG);
       panelTools(div, key);
       jik.panelSync[key] = Math.round(performance.now() - t0); // the synchronous share

@@ -107,7 +107,14 @@ def test_augmenting_map_contours_with_the_extended_run_on_a_level_set(path_resul
     assert fig.layout.xaxis.title.text == "x2 [m]"
     assert fig.layout.yaxis.title.text == "x3 [rad]"
     assert "E1 = " in fig.layout.title.text and "E2 = " in fig.layout.title.text
-    assert [t.line.color for t in fig.data[1:3]] == [COLORS["pseudoinverse"], COLORS["extended"]]
+    # The runs and x0 are shapes over the contours (moved by a relayout, app/figures.py).
+    runs = fig.layout.shapes[:2]
+    assert [s.line.color for s in runs] == [COLORS["pseudoinverse"], COLORS["extended"]]
+    ext = path_result.runs["extended"].x
+    corners = [tuple(map(float, p.split(","))) for p in runs[1].path[1:].split("L")]
+    assert np.allclose(corners, ext[:, 1:3], rtol=1e-4, atol=1e-4)
+    x0 = fig.layout.shapes[2]
+    assert (x0.xanchor, x0.yanchor) == tuple(path_result.state.x0[1:3])
     assert functionals["E1"] > 0 and functionals["E2"] > 0
     h = path_result.runs["extended"].h
     assert np.ptp(h) < 1e-9
