@@ -21,6 +21,7 @@ import numpy as np
 import plotly.graph_objects as go
 
 from app.dashboard import ALGORITHMS, COLORS, LABELS, DashboardResult, state_inert_variables
+from engine.reproductions.table1 import cell
 
 #: Units of the joint and task variables, by robot (the registry does not carry units).
 UNITS = {
@@ -380,7 +381,7 @@ def _table(result: DashboardResult) -> dict:
         ends = np.vstack([np.asarray(result.state.x0)[None, :], result.runs[a].leg_end])
         for k, name in enumerate(names):
             header.append(f"{'J^P#' if a == 'pseudoinverse' else 'J^E#'} {name}")
-            cols.append([f"{v:.4f}" for v in ends[:, k]] + [""] * (rows + 1 - len(ends)))
+            cols.append([cell(v, 0) for v in ends[:, k]] + [""] * (rows + 1 - len(ends)))
     fills = ["#f4f4f4"] + ["#fbe3e3" if h.startswith("J^P#") else "#e1ecf7" for h in header[1:]]
     table = _trace("table",
         # (fill=dict(color=...): plotly.py's "fill_color" shorthand is expanded only by its

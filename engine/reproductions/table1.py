@@ -55,8 +55,8 @@ def run(printed_gradient: bool = False) -> dict:
 
 
 def cell(value: float, width: int = 9) -> str:
-    """``value`` to four decimals in ``width`` columns, as Table 1 prints it: a round-off zero
-    such as -1e-16 prints 0.0000, not -0.0000."""
+    """``value`` to four decimals in ``width`` columns (0: as wide as it takes), as Table 1
+    prints it: a round-off zero such as -1e-16 prints 0.0000, not -0.0000."""
     return f"{round(float(value), 4) + 0.0:{width}.4f}"
 
 
