@@ -353,7 +353,8 @@ const onScreen = {}; // panel -> {shape, ranges: JSON, held: ranges asked for, s
 // Plotly.relayout when that has anything), or null to draw it (Plotly.react).
 function plan(div, key, fig) {
   const last = onScreen[key];
-  const same = Boolean(last && div.data && last.shape === shape(fig));
+  const figShape = shape(fig); // (JSON of the whole figure but its lines: once per panel)
+  const same = Boolean(last && div.data && last.shape === figShape);
   // The user zoomed (the ranges on screen are not those plotly drew): the figure keeps the
   // ranges it had, so that plotly keeps the user's view (uirevision keeps a user's edit only
   // while the figure's own value stays); a double-click goes back to them.
@@ -367,7 +368,7 @@ function plan(div, key, fig) {
   // shown: the ranges plotly draws for these (constrained by scaleanchor, say), taken after the
   // drawing; while the user's zoom stays, those of the same ranges before.
   const shapes = JSON.stringify(fig.layout.shapes || []);
-  onScreen[key] = { shape: shape(fig), ranges, held, shown: zoomed ? last.shown : null, shapes };
+  onScreen[key] = { shape: figShape, ranges, held, shown: zoomed ? last.shown : null, shapes };
   const traces = fig.data.flatMap((t, i) => (moves(t) ? [i] : []));
   if (!same || (traces.length && traces.length < fig.data.length)) return null;
   const frame = traces.length ? { traces, data: traces.map((i) => Object.fromEntries(DATA_KEYS.filter((k) => k in fig.data[i]).map((k) => [k, fig.data[i][k]]))) } : null;
