@@ -11,7 +11,7 @@ const PLOT_CONFIG = { responsive: true, displaylogo: false, displayModeBar: fals
 const jik = (window.jik = {
   catalogue: null, config: null, state: null, generation: 0, shownGeneration: 0,
   pending: new Map(), latencies: [], lastLatency: null, firstUpdate: null, panelDraw: {}, panelSync: {},
-  panelMoved: {},
+  panelMoved: {}, panelPlan: {},
 });
 
 const $ = (sel) => document.querySelector(sel);
@@ -347,7 +347,17 @@ function shape(fig) {
     ([k, v]) => [k, (isAxis(k) && v.range ? { ...v, range: true } : k === "title" ? { ...v, text: true } : k === "shapes" || v)]));
   return JSON.stringify([layout, fig.data.map(strip)]);
 }
-const onScreen = {}; // panel -> {shape, ranges: JSON, held: ranges asked for, shown: JSON after drawing}
+const onScreen = {}; // panel -> what plan() compares a new figure with (screenEntry)
+// The figure on screen as plan() compares a new one with it: its shape, axis ranges (held: those
+// asked for; shown: JSON of those plotly drew, null until drawn), shapes and lines' data (JSON;
+// typed arrays come as base64 text).
+function screenEntry(fig, figShape, held, shown) {
+  return {
+    shape: figShape, ranges: JSON.stringify(held), held, shown,
+    shapes: JSON.stringify(fig.layout.shapes || []),
+    data: fig.data.map((t) => (moves(t) ? JSON.stringify(DATA_KEYS.map((k) => t[k])) : null)),
+  };
+}
 
 // How a panel takes its new figure: {frame, relayout} to move it (Plotly.animate, then
 // Plotly.relayout when that has anything), or null to draw it (Plotly.react).
@@ -363,23 +373,28 @@ function plan(div, key, fig) {
     for (const [k, r] of Object.entries(last.held)) if (fig.layout[k] && r) fig.layout[k] = { ...fig.layout[k], range: r };
   }
   const held = axisRanges(fig.layout);
-  const ranges = JSON.stringify(held);
-  const newRanges = same && ranges !== last.ranges;
-  // shown: the ranges plotly draws for these (constrained by scaleanchor, say), taken after the
-  // drawing; while the user's zoom stays, those of the same ranges before.
-  const shapes = JSON.stringify(fig.layout.shapes || []);
-  onScreen[key] = { shape: figShape, ranges, held, shown: zoomed ? last.shown : null, shapes };
+  // (shown: while the user's zoom stays, that of the same ranges before.)
+  const entry = (onScreen[key] = screenEntry(fig, figShape, held, zoomed ? last.shown : null));
+  const newRanges = same && entry.ranges !== last.ranges;
   const traces = fig.data.flatMap((t, i) => (moves(t) ? [i] : []));
   if (!same || (traces.length && traces.length < fig.data.length)) return null;
-  const frame = traces.length ? { traces, data: traces.map((i) => Object.fromEntries(DATA_KEYS.filter((k) => k in fig.data[i]).map((k) => [k, fig.data[i][k]]))) } : null;
+  // Only the lines that changed move (a new map leaves the pseudoinverse's as they are).
+  const changed = traces.filter((i) => entry.data[i] !== last.data[i]);
+  const frame = changed.length ? { traces: changed, data: changed.map((i) => Object.fromEntries(DATA_KEYS.filter((k) => k in fig.data[i]).map((k) => [k, fig.data[i][k]]))) } : null;
   // After the move, a relayout: a new title text (the h panel's E1/E2), and the new axis
   // ranges, as a zoom sets them (the ranges of an animation frame miss stacked axes, and do
-  // not constrain the task plane's equal scales).
+  // not constrain the task plane's equal scales). Only the axes whose range changed, each of
+  // which plotly redraws; all of them where one axis is scaled to another.
   const relayout = {};
   const title = (fig.layout.title || {}).text;
   if (title !== ((div.layout || {}).title || {}).text) relayout["title.text"] = title;
-  if (newRanges) for (const [k, r] of Object.entries(held)) if (r) relayout[`${k}.range`] = r;
-  if (shapes !== last.shapes) relayout.shapes = fig.layout.shapes || [];
+  const anchored = Object.keys(fig.layout).some((k) => isAxis(k) && fig.layout[k].scaleanchor);
+  if (newRanges) {
+    for (const [k, r] of Object.entries(held)) {
+      if (r && (anchored || JSON.stringify(r) !== JSON.stringify(last.held[k]))) relayout[`${k}.range`] = r;
+    }
+  }
+  if (entry.shapes !== last.shapes) relayout.shapes = fig.layout.shapes || [];
   return { frame, relayout };
 }
 
@@ -420,6 +435,8 @@ async function drawFigures(figures, digests = {}, robot = null) {
       div.classList.remove("html-table");
       const move = plan(div, key, fig); // (before plotly fills the layout in)
       jik.panelMoved[key] = Boolean(move);
+      // (What moved: the lines animated and the keys relayouted; for the browser test.)
+      jik.panelPlan[key] = move && { lines: move.frame ? move.frame.traces : [], relayout: Object.keys(move.relayout) };
       const p = move
         ? (move.frame ? Plotly.animate(div, move.frame, MOVE) : Promise.resolve())
           .then(() => !Object.keys(move.relayout).length || Plotly.relayout(div, move.relayout))
@@ -484,8 +501,7 @@ function showAhead(div, pre, key, fig) {
   Plotly.purge(div);
   div.replaceWith(pre);
   panelTools(pre, key);
-  onScreen[key] = { shape: shape(fig), ranges: JSON.stringify(axisRanges(fig.layout)), held: axisRanges(fig.layout),
-    shown: JSON.stringify(axisRanges(pre.layout)) };
+  onScreen[key] = screenEntry(fig, shape(fig), axisRanges(fig.layout), JSON.stringify(axisRanges(pre.layout)));
 }
 
 // plotly's code runs unoptimised at first: the first redraws after loading took 30-50 ms more

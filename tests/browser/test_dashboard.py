@@ -661,6 +661,15 @@ def test_dashboard_follows_controls_in_chromium(served):
             else:
                 before = _set_slider(page, selector, value)
             latencies[f"{what} (playing)"] = _latency(page, before)
+            if what == "map parameter a":
+                # The first change after a switch shown from panels drawn ahead moves them as
+                # any other: only the lines that changed (a new map leaves J^P#'s), and a
+                # relayout of only what changed (no shapes where there are none).
+                plans = page.evaluate("jik.panelPlan")
+                assert plans["joints"]["lines"] == [3, 4, 5], plans  # J^E#'s x1, x2, x3
+                assert plans["task"]["lines"] == [1], plans
+                for key in ("task", "joints", "drift"):
+                    assert "shapes" not in plans[key]["relayout"], plans
             generation = _wait_generation(page, before + 1)
             assert _get(f"{base}/api/dashboard/state")["scene"]["playing"] is True
             _second_phase_drawn(page)
