@@ -531,12 +531,15 @@ def test_dashboard_follows_controls_in_chromium(served):
         before = _set_slider(page, "#ctl-cycles", 4)
         latencies["cycles (manipulator 2)"] = _latency(page, before)
         _check_moved(page, _wait_generation(page, before + 1))
-        # A longer arm widens the task plane: its equal-scale axes take the new ranges by a
-        # relayout after the move (plotly constrains them), as a full drawing would.
+        # A longer arm widens the task plane: its equal-scale axes take new ranges, and the
+        # panel is drawn anew (cheaper than a relayout that redoes plotly's constraints after
+        # the move); the joint panel moves, its new ranges relayouted.
         _second_phase_drawn(page)
         before = _set_slider(page, "#ctl-l", 2.0)
         latencies["arm length l, longer (manipulator 2)"] = _latency(page, before)
-        assert "task" in _check_moved(page, _wait_generation(page, before + 1))
+        assert page.evaluate("jik.lastLatency.panels.task").startswith("drawn")
+        assert "joints" in _check_moved(page, _wait_generation(page, before + 1))
+        assert any(k.endswith(".range") for k in page.evaluate("jik.panelPlan.joints.relayout"))
         assert _trace(page, "drift", 0, "x") == [1, 2, 3, 4]
 
         # Manipulator 1 (and the unicycle when the registry has it), then back.
