@@ -11,7 +11,7 @@ const PLOT_CONFIG = { responsive: true, displaylogo: false, displayModeBar: fals
 const jik = (window.jik = {
   catalogue: null, config: null, state: null, generation: 0, shownGeneration: 0,
   pending: new Map(), latencies: [], lastLatency: null, firstUpdate: null, panelDraw: {}, panelSync: {},
-  panelMoved: {}, panelPlan: {},
+  panelPlan: {},
 });
 
 const $ = (sel) => document.querySelector(sel);
@@ -423,7 +423,7 @@ async function drawFigures(figures, digests = {}, robot = null) {
       const t0 = performance.now(); // until this panel's redraw resolved (panels share one thread)
       if (pre[key] && pre[key].digest === digests[key] && pre[key].width === div.getBoundingClientRect().width) {
         showAhead(div, pre[key].div, key, fig);
-        jik.panelMoved[key] = false;
+        jik.panelPlan[key] = null;
         jik.panelSync[key] = jik.panelDraw[key] = Math.round(performance.now() - t0);
         jik.drawnNow[key] = `ahead ${jik.panelDraw[key]} ms`;
         return null;
@@ -436,8 +436,8 @@ async function drawFigures(figures, digests = {}, robot = null) {
       }
       div.classList.remove("html-table");
       const move = plan(div, key, fig); // (before plotly fills the layout in)
-      jik.panelMoved[key] = Boolean(move);
-      // (What moved: the lines animated and the keys relayouted; for the browser test.)
+      // (How it moved, null when drawn: the lines animated and the keys relayouted; for the
+      // browser test.)
       jik.panelPlan[key] = move && { lines: move.frame ? move.frame.traces : [], relayout: Object.keys(move.relayout) };
       const p = move
         ? (move.frame ? Plotly.animate(div, move.frame, MOVE) : Promise.resolve())

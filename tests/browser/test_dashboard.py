@@ -504,7 +504,7 @@ def test_dashboard_follows_controls_in_chromium(served):
         # A jump of the start point changes axis ranges: panels with the same titles and
         # styles move their traces and axes (static/app.js), and must look fully drawn.
         moved = _check_moved(page, generation)
-        assert "joints" in moved, page.evaluate("jik.panelMoved")
+        assert "joints" in moved, page.evaluate("jik.panelPlan")
         # A nudge of the start point keeps every axis range (app/figures.py rounds them): the
         # page moves those panels' traces instead of redrawing them, and they must look the
         # same as a full drawing of the server's figure.
@@ -514,7 +514,7 @@ def test_dashboard_follows_controls_in_chromium(served):
         moved = _check_moved(page, generation)
         # (the h panel keeps its box, app/dashboard.py augmenting_grid, and h there: only the
         # trajectories over the contours move, shapes moved by a relayout)
-        assert {"task", "drift", "augmenting"} <= moved, page.evaluate("jik.panelMoved")
+        assert {"task", "drift", "augmenting"} <= moved, page.evaluate("jik.panelPlan")
         _scene_generation(base, generation)
         scene_after = _settled(page)
         assert scene_after != scene_before, "the 3D scene did not change with the start point"
