@@ -92,21 +92,34 @@ def gizmo_pose(robot: str, x0, robot_parameters: dict) -> tuple[tuple[float, flo
     return (q0[0], q0[1]), q0[2]
 
 
+#: Coordinates of a start point from the gizmo that differ from the state's by no more than this
+#: keep the state's value: the round trip through the gizmo's pose (a quaternion, a rotation of
+#: the axes) is exact only to rounding, and a press on the gizmo must not be a change.
+GIZMO_ROUNDING = 1e-9
+
+
+def _snapped(values, before) -> list[float]:
+    pairs = zip(values, map(float, before), strict=True)
+    return [b if abs(v - b) <= GIZMO_ROUNDING else v for v, b in pairs]
+
+
 def start_from_gizmo(robot: str, xy, yaw: float, state) -> dict:
     """The dashboard change for a gizmo moved to ``xy`` with rotation ``yaw`` (inverse of above).
 
     Manipulator 1 keeps x3 = tan(yaw) within a slope of +-20 (the lever cannot turn vertical).
+    Coordinates within :data:`GIZMO_ROUNDING` of the state's keep their value: a gizmo where
+    the state puts it gives the state's start point exactly.
     """
     X, Y = float(xy[0]), float(xy[1])
     if robot == "manipulator2":
         x3 = float(state.x0[2]) + math.remainder(yaw - float(state.x0[2]), 2 * math.pi)
-        return {"x0": [Y, X, x3]}
+        return {"x0": _snapped([Y, X, x3], state.x0)}
     if robot == "manipulator1":
         x3 = math.tan(max(-1.52, min(1.52, yaw)))
-        return {"x0": [X, Y - X * x3, x3]}
+        return {"x0": _snapped([X, Y - X * x3, x3], state.x0)}
     q0 = list(state.robot_parameters["q0"])
     q3 = q0[2] + math.remainder(yaw - q0[2], 2 * math.pi)
-    return {"robot_parameters": {"q0": [X, Y, q3]}}
+    return {"robot_parameters": {"q0": _snapped([X, Y, q3], q0)}}
 
 
 # -- animation timelines ------------------------------------------------------------------------

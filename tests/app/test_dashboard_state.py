@@ -342,10 +342,16 @@ def test_known_functionals_are_drawn_with_the_first_result():
 
 @pytest.mark.parametrize(
     ("robot", "x0"),
-    [("manipulator2", (0.3, -0.4, 2.0)), ("manipulator1", (0.7, 0.2, -0.6)), ("unicycle", None)],
+    [
+        ("manipulator2", (0.3, -0.4, 2.0)),
+        ("manipulator2", None),  # x3 = pi/2: the quaternion's round trip is off by an ulp
+        ("manipulator1", (0.7, 0.2, -0.6)),
+        ("unicycle", None),
+    ],
 )
 def test_the_start_point_gizmo_round_trips(robot, x0):
-    """Dragging the gizmo to where it already is leaves the start point unchanged."""
+    """Dragging the gizmo to where it already is leaves the start point unchanged, exactly: a
+    press on the gizmo is no change (the dashboard would solve both runs again)."""
     from app.scene import gizmo_pose, quaternion_yaw, start_from_gizmo, yaw_quaternion
 
     state = default_state(robot)
@@ -354,11 +360,7 @@ def test_the_start_point_gizmo_round_trips(robot, x0):
     xy, yaw = gizmo_pose(robot, state.x0, state.robot_parameters)
     yaw = quaternion_yaw(yaw_quaternion(yaw))
     patch = start_from_gizmo(robot, xy, yaw, state)
-    moved = updated_state(state, patch)
-    np.testing.assert_allclose(moved.x0, state.x0, atol=1e-12)
-    np.testing.assert_allclose(
-        moved.robot_parameters.get("q0", 0), state.robot_parameters.get("q0", 0), atol=1e-12
-    )
+    assert updated_state(state, patch) == state
 
 
 def test_manipulator2_gizmo_moves_the_carriage():
