@@ -50,6 +50,9 @@ SECONDS_PER_LEG = 1.6
 #: page holds it while the pointer is on its controls or on the scene's GUI panel, where
 #: :data:`CLIENT_SCRIPT` tells it; a drag of the gizmo starts with a change, its press.)
 EDIT_HOLD = 1.5
+#: Seconds between two changes of the start point while its gizmo is dragged (each starts a
+#: computation; the dashboard solves only the newest state, but every change is an event).
+DRAG_INTERVAL = 0.15
 #: Script run in every viser client: it tells the framing page when the pointer (or the keyboard)
 #: is on the scene's GUI panel, so that the page holds the animation still there as it does on its
 #: own controls.
@@ -446,7 +449,7 @@ class DashboardScene:
         self.server.gui.main_panel.dock_right()
         self.server.gui.main_panel.set_width(300)
         self._framed: str | None = None
-        self._syncing = False
+        self._local = threading.local()  # see _syncing
         self._dragging = False
         self._lock = threading.RLock()
         self._timeline: Timeline | None = None
@@ -466,7 +469,9 @@ class DashboardScene:
         # sees a read-only property; assigning it is viser's API (ignores marked "viser: settable").
         self._controls: dict[str, viser.GuiInputHandle[Any]] = {}
         self._folders: list = []
-        self._last_drag = 0.0
+        self._last_drag = 0.0  # when a move of the gizmo last changed the state
+        self._drag_token = 0  # counts the gizmo's events (a deferred move checks it)
+        self._drag_lock = threading.Lock()
         self._stopped = False
         dashboard.scene_status["held"] = False
         self._build_static_gui()
@@ -476,6 +481,19 @@ class DashboardScene:
         self._unsubscribe = dashboard.subscribe(self._on_event, last=True)
         self._thread = threading.Thread(target=self._animate, name="jik-scene", daemon=True)
         self._thread.start()
+
+    @property
+    def _syncing(self) -> bool:
+        """Whether this thread is setting the GUI's values to the state's (the update callbacks
+        that viser calls from within the assignment are then not a user's change).
+
+        Per thread: a user's change, which viser's thread delivers, is never dropped while the
+        animation's thread moves the position slider or the worker syncs the controls."""
+        return getattr(self._local, "syncing", False)
+
+    @_syncing.setter
+    def _syncing(self, value: bool) -> None:
+        self._local.syncing = value
 
     @property
     def port(self) -> int:
@@ -790,15 +808,37 @@ class DashboardScene:
             self.gizmo.wxyz = yaw_quaternion(yaw)
 
     def _on_drag(self, event) -> None:
+        """The gizmo pressed, moved or released: the start point follows.
+
+        The press holds the animation (:meth:`_change`); it changes nothing unless the gizmo
+        is off the state's pose. Moves change the state at most once per
+        :data:`DRAG_INTERVAL`; a move within it is applied when it ends, unless a newer event
+        came meanwhile (the last pose of a drag that stops always arrives). The release
+        applies the final pose.
+        """
         self._dragging = event.phase != "end"
-        now = time.monotonic()
-        if event.phase == "update" and now - self._last_drag < 0.15:
-            return
-        self._last_drag = now
-        state = self.dashboard.state
-        pos = event.target.position
-        patch = start_from_gizmo(state.robot, pos[:2], quaternion_yaw(event.target.wxyz), state)
-        self._change(patch)
+        pose = (tuple(map(float, event.target.position)), tuple(map(float, event.target.wxyz)))
+        with self._drag_lock:
+            self._drag_token += 1
+            wait = self._last_drag + DRAG_INTERVAL - time.monotonic()
+            if event.phase == "update" and wait > 0:
+                timer = threading.Timer(wait, self._drag_to, args=(pose, self._drag_token))
+                timer.daemon = True
+                timer.start()
+                return
+        self._drag_to(pose, None, counts=event.phase == "update")
+
+    def _drag_to(self, pose, token: int | None, counts: bool = True) -> None:
+        """Apply a gizmo pose (``token``: that of a deferred move, dropped if a newer event
+        came since; ``counts``: a move, which starts a new :data:`DRAG_INTERVAL`)."""
+        position, wxyz = pose
+        with self._drag_lock:  # (a deferred move and a newer event apply in their order)
+            if token is not None and token != self._drag_token:
+                return
+            if counts:
+                self._last_drag = time.monotonic()
+            state = self.dashboard.state
+            self._change(start_from_gizmo(state.robot, position[:2], quaternion_yaw(wxyz), state))
 
     # -- drawing --------------------------------------------------------------------------
     def _draw(self, result) -> None:

@@ -532,7 +532,7 @@ def test_viser_gui_and_drag_change_the_one_state():
     import time
     from types import SimpleNamespace
 
-    from app.scene import CONTROLS_DELAY, DashboardScene, yaw_quaternion
+    from app.scene import CONTROLS_DELAY, DRAG_INTERVAL, DashboardScene, yaw_quaternion
 
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -551,6 +551,25 @@ def test_viser_gui_and_drag_change_the_one_state():
         target = SimpleNamespace(position=(0.4, 0.25, 0.3), wxyz=yaw_quaternion(1.7))
         scene._on_drag(SimpleNamespace(phase="end", target=target))
         np.testing.assert_allclose(dashboard.state.x0, (0.25, 0.4, 1.7), atol=1e-12)
+        # A press where the gizmo is holds the animation and changes nothing; the first move
+        # right after it is applied at once; a second within DRAG_INTERVAL when that ends,
+        # though no event follows (the pose a drag rests at).
+        generation = dashboard.generation
+        scene._on_drag(SimpleNamespace(phase="start", target=target))
+        assert dashboard.generation == generation and dashboard.held()
+        moved = SimpleNamespace(position=(0.5, 0.25, 0.3), wxyz=yaw_quaternion(1.7))
+        scene._on_drag(SimpleNamespace(phase="update", target=moved))
+        np.testing.assert_allclose(dashboard.state.x0, (0.25, 0.5, 1.7), atol=1e-12)
+        rest = SimpleNamespace(position=(0.55, 0.3, 0.3), wxyz=yaw_quaternion(1.7))
+        scene._on_drag(SimpleNamespace(phase="update", target=rest))
+        assert dashboard.state.x0[1] == pytest.approx(0.5)  # (deferred)
+        time.sleep(DRAG_INTERVAL + 0.1)
+        np.testing.assert_allclose(dashboard.state.x0, (0.3, 0.55, 1.7), atol=1e-12)
+        # A deferred move that a newer event overtakes is dropped.
+        scene._on_drag(SimpleNamespace(phase="update", target=moved))
+        scene._on_drag(SimpleNamespace(phase="end", target=rest))
+        time.sleep(DRAG_INTERVAL + 0.1)
+        np.testing.assert_allclose(dashboard.state.x0, (0.3, 0.55, 1.7), atol=1e-12)
         assert dashboard.wait(timeout=60)
         deadline = time.monotonic() + 30
         while dashboard.scene_status["generation"] < dashboard.generation:
@@ -559,6 +578,23 @@ def test_viser_gui_and_drag_change_the_one_state():
         # A change from elsewhere (the page) moves the scene's GUI.
         dashboard.update({"gamma": 0.5})
         assert scene._controls["gamma"].value == 0.5
+        # A user's change while another thread sets the GUI's values (the animation's
+        # position slider, the worker's sync) is kept: only that thread's callbacks are its own.
+        syncing, release = threading.Event(), threading.Event()
+
+        def sync_elsewhere() -> None:
+            scene._syncing = True
+            syncing.set()
+            release.wait(10)
+            scene._syncing = False
+
+        other = threading.Thread(target=sync_elsewhere)
+        other.start()
+        assert syncing.wait(10)
+        scene._controls["gamma"].value = 1.5  # (viser's thread, for a user)
+        release.set()
+        other.join()
+        assert dashboard.state.gamma == 1.5
         # Another robot: its controls replace the old ones CONTROLS_DELAY later; of two quick
         # switches the last one's.
         dashboard.update({"robot": "manipulator1"})
