@@ -9,7 +9,9 @@ from importlib import metadata
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-SHIPPED = ("engine", "app", "benchmarks", "static")  # pyproject's [tool.setuptools] packages
+PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+#: The top-level packages that ``pip install .`` ships.
+SHIPPED = sorted({p.split(".")[0] for p in PYPROJECT["tool"]["setuptools"]["packages"]})
 
 
 def _name(requirement: str) -> str:
@@ -20,8 +22,7 @@ def _name(requirement: str) -> str:
 
 def _runtime_distributions() -> set[str]:
     """The declared dependencies and, installed here, everything they require (no extras)."""
-    declared = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["dependencies"]
-    todo, seen = [_name(r) for r in declared], set()
+    todo, seen = [_name(r) for r in PYPROJECT["project"]["dependencies"]], set()
     while todo:
         name = todo.pop()
         if name in seen:
