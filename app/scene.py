@@ -50,8 +50,6 @@ SECONDS_PER_LEG = 1.6
 #: page holds it while the pointer is on its controls or on the scene's GUI panel, where
 #: :data:`CLIENT_SCRIPT` tells it; a drag of the gizmo starts with a change, its press.)
 EDIT_HOLD = 1.5
-#: The Play/Pause button while a hold keeps the playing animation still.
-HELD_LABEL = "Pause (held while you edit)"
 #: Seconds between two changes of the start point while its gizmo is dragged (each starts a
 #: computation; the dashboard solves only the newest state, but every change is an event).
 DRAG_INTERVAL = 0.15
@@ -528,7 +526,7 @@ class DashboardScene:
         @self.play.on_click
         def _(_) -> None:
             self.playing = not self.playing
-            self._label_play()
+            self.play.label = "Pause" if self.playing else "Play"
             self.dashboard.scene_status["playing"] = self.playing
 
         @self.scrub.on_update
@@ -536,21 +534,9 @@ class DashboardScene:
             if self._syncing or self._timeline is None:
                 return
             self.playing = False
-            self._label_play()
+            self.play.label = "Play"
             self.dashboard.scene_status["playing"] = False
             self._s = float(self.scrub.value) * self._timeline.length
-
-    def _label_play(self) -> None:
-        """The Play/Pause button says what a press does, and that a playing animation stands
-        still while it is held (the pointer on the controls, :meth:`Dashboard.hold`)."""
-        if not self.playing:
-            label = "Play"
-        elif self.dashboard.scene_status.get("held", False):
-            label = HELD_LABEL
-        else:
-            label = "Pause"
-        if self.play.label != label:
-            self.play.label = label
 
     def _change(self, patch: dict) -> None:
         if self._syncing:
@@ -1092,7 +1078,6 @@ class DashboardScene:
                 held = self.playing and self.dashboard.held()
                 if held != self.dashboard.scene_status.get("held", False):
                     self.dashboard.scene_status["held"] = held
-                    self._label_play()
                 moving = self.playing and not held
                 if moving:
                     self._s += dt * float(self.speed.value) / SECONDS_PER_LEG

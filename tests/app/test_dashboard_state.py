@@ -473,11 +473,10 @@ def test_the_hold_api_keeps_one_hold_per_holder_and_refuses_bad_values():
 
 def test_a_hold_stills_the_playing_scene_until_it_ends():
     """While held (the page's pointer on its controls), the playing scene sends no animation
-    frames and shows a new result at its end, and its Play/Pause button says it is held; when
-    the hold ends, it plays on from there."""
+    frames and shows a new result at its end; when the hold ends, it plays on from there."""
     import socket
 
-    from app.scene import HELD_LABEL, DashboardScene
+    from app.scene import DashboardScene
 
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -494,12 +493,10 @@ def test_a_hold_stills_the_playing_scene_until_it_ends():
     try:
         until(lambda: dashboard.scene_status.get("generation", 0) >= 1, "no first drawing")
         assert scene.playing and dashboard.scene_status["held"] is False
-        assert scene.play.label == "Pause"
         s0 = scene._s
         until(lambda: scene._s != s0, "the animation does not play")
         dashboard.hold("test", 3.0)
         until(lambda: dashboard.scene_status["held"] is True, "the hold is not seen")
-        until(lambda: scene.play.label == HELD_LABEL, "the button does not say it is held")
         posed = []
         for m in scene._mechanisms.values():  # every pose the animation sends from now on
             m.pose = lambda x, _pose=m.pose: (posed.append(x), _pose(x))
@@ -516,13 +513,7 @@ def test_a_hold_stills_the_playing_scene_until_it_ends():
         dashboard.hold("test", 0.0)
         until(lambda: dashboard.scene_status["held"] is False, "the hold did not end")
         until(lambda: scene._s < scene._timeline.length, "the animation did not start over")
-        assert scene.playing and scene.play.label == "Pause"
-        # Paused (as the button's press pauses), a hold changes nothing: the button says Play.
-        scene.playing = False
-        scene._label_play()
-        dashboard.hold("test", 3.0)
-        time.sleep(0.3)
-        assert dashboard.scene_status["held"] is False and scene.play.label == "Play"
+        assert scene.playing
         # Every viser client, those connecting later too, runs the script that tells the page
         # when the pointer is on the scene's GUI panel (the browser test uses it).
         from app.scene import CLIENT_SCRIPT
