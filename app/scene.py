@@ -470,7 +470,8 @@ class DashboardScene:
         self._controls: dict[str, viser.GuiInputHandle[Any]] = {}
         self._folders: list = []
         self._last_drag = 0.0  # when a move of the gizmo last changed the state
-        self._drag_token = 0  # counts the gizmo's events (a deferred move checks it)
+        self._drag_pending: tuple | None = None  # the newest move within DRAG_INTERVAL
+        self._drag_timer: threading.Timer | None = None  # applies it when the interval ends
         self._drag_lock = threading.Lock()
         self._stopped = False
         dashboard.scene_status["held"] = False
@@ -812,33 +813,45 @@ class DashboardScene:
 
         The press holds the animation (:meth:`_change`); it changes nothing unless the gizmo
         is off the state's pose. Moves change the state at most once per
-        :data:`DRAG_INTERVAL`; a move within it is applied when it ends, unless a newer event
-        came meanwhile (the last pose of a drag that stops always arrives). The release
-        applies the final pose.
+        :data:`DRAG_INTERVAL`; the newest move within it is applied when it ends, unless a
+        press, a release or a later move applied meanwhile (the last pose of a drag that stops
+        always arrives). The release applies the final pose.
         """
         self._dragging = event.phase != "end"
         pose = (tuple(map(float, event.target.position)), tuple(map(float, event.target.wxyz)))
         with self._drag_lock:
-            self._drag_token += 1
             wait = self._last_drag + DRAG_INTERVAL - time.monotonic()
             if event.phase == "update" and wait > 0:
-                timer = threading.Timer(wait, self._drag_to, args=(pose, self._drag_token))
-                timer.daemon = True
-                timer.start()
+                # One timer per interval, for the newest of the moves within it.
+                self._drag_pending = pose
+                if self._drag_timer is None:
+                    self._drag_timer = threading.Timer(wait, self._drag_deferred)
+                    self._drag_timer.daemon = True
+                    self._drag_timer.start()
                 return
-        self._drag_to(pose, None, counts=event.phase == "update")
+            if self._drag_timer is not None:  # this newer event overtakes the deferred move
+                self._drag_timer.cancel()
+                self._drag_timer = self._drag_pending = None
+            self._drag_to(pose, counts=event.phase == "update")
 
-    def _drag_to(self, pose, token: int | None, counts: bool = True) -> None:
-        """Apply a gizmo pose (``token``: that of a deferred move, dropped if a newer event
-        came since; ``counts``: a move, which starts a new :data:`DRAG_INTERVAL`)."""
-        position, wxyz = pose
-        with self._drag_lock:  # (a deferred move and a newer event apply in their order)
-            if token is not None and token != self._drag_token:
+    def _drag_deferred(self) -> None:
+        """The end of an interval: apply the newest move made within it, unless a newer event
+        overtook it (then this timer is no longer the scene's)."""
+        with self._drag_lock:
+            if threading.current_thread() is not self._drag_timer:
                 return
-            if counts:
-                self._last_drag = time.monotonic()
-            state = self.dashboard.state
-            self._change(start_from_gizmo(state.robot, position[:2], quaternion_yaw(wxyz), state))
+            pose, self._drag_pending, self._drag_timer = self._drag_pending, None, None
+            assert pose is not None  # (set with the timer)
+            self._drag_to(pose, counts=True)
+
+    def _drag_to(self, pose, counts: bool) -> None:
+        """Apply a gizmo pose, with ``_drag_lock`` held (``counts``: a move, which starts a new
+        :data:`DRAG_INTERVAL`)."""
+        position, wxyz = pose
+        if counts:
+            self._last_drag = time.monotonic()
+        state = self.dashboard.state
+        self._change(start_from_gizmo(state.robot, position[:2], quaternion_yaw(wxyz), state))
 
     # -- drawing --------------------------------------------------------------------------
     def _draw(self, result) -> None:
