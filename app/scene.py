@@ -450,6 +450,7 @@ class DashboardScene:
         self.server.gui.main_panel.set_width(300)
         self._framed: str | None = None
         self._local = threading.local()  # see _syncing
+        self._sync_pending = False  # a state change whose values the GUI has yet to show
         self._dragging = False
         self._lock = threading.RLock()
         self._timeline: Timeline | None = None
@@ -749,6 +750,7 @@ class DashboardScene:
             elif event.kind == "ahead" and event.result is not None:
                 self._prebuild(event.result)
             elif event.kind == "error":
+                self._sync_now()
                 self.progress.visible = False
                 self.status.content = f"**error:** {json.loads(event.data)['message']}"
         except Exception as exc:  # never let a drawing error kill the worker thread
@@ -758,8 +760,10 @@ class DashboardScene:
         structure = (state.robot, state.augmentation, state.task, state.mode)
         with self._lock:
             if structure == self._structure:
-                if self._folders:
-                    self._sync_controls(state)
+                # The GUI takes the new values with the result's drawing (_sync_now), not now:
+                # the viser client's re-render of its inputs would take a share of the two
+                # cores that the computation of the change needs (docs/benchmarks.md).
+                self._sync_pending = True
                 return
             first = self._structure is None
             self._structure = structure
@@ -854,6 +858,14 @@ class DashboardScene:
         self._change(start_from_gizmo(state.robot, position[:2], quaternion_yaw(wxyz), state))
 
     # -- drawing --------------------------------------------------------------------------
+    def _sync_now(self) -> None:
+        """Show the state's values in the GUI if a change came since (see :meth:`_on_state`);
+        with a result's drawing, in the same batch, or with its error."""
+        with self._lock:
+            if self._sync_pending and self._folders:
+                self._sync_controls(self.dashboard.state)
+            self._sync_pending = False
+
     def _draw(self, result) -> None:
         state = result.state
         drawn = runs_key(state)
@@ -863,6 +875,7 @@ class DashboardScene:
             # would cost the client a quarter second of frames (software WebGL here).
             with self._lock:  # (the timeline on screen plays the same legs)
                 self.drawn_generation = result.generation
+                self._sync_now()
                 self.dashboard.scene_status.update(generation=result.generation)
             self._show_status(result)
             return
@@ -893,6 +906,7 @@ class DashboardScene:
             self._pose(self._s)
             self._show_position(timeline)
             self.drawn_generation = result.generation
+            self._sync_now()
             self.dashboard.scene_status.update(
                 generation=result.generation, robot=state.robot, playing=self.playing
             )

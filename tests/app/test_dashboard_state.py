@@ -575,9 +575,17 @@ def test_viser_gui_and_drag_change_the_one_state():
         while dashboard.scene_status["generation"] < dashboard.generation:
             assert time.monotonic() < deadline, "the scene did not redraw"
             time.sleep(0.05)
-        # A change from elsewhere (the page) moves the scene's GUI.
-        dashboard.update({"gamma": 0.5})
+        # A change from elsewhere (the page) moves the scene's GUI, with the drawing of its
+        # result (the viser client's main thread stays free for the computation meanwhile).
+        generation, _ = dashboard.update({"gamma": 0.5})
+        deadline = time.monotonic() + 30
+        while dashboard.scene_status["generation"] < generation:
+            assert time.monotonic() < deadline, "the scene did not draw the change"
+            time.sleep(0.02)
         assert scene._controls["gamma"].value == 0.5
+        # Not before: a state event leaves the GUI's inputs as they are until its drawing.
+        scene._on_state(updated_state(dashboard.state, {"gamma": 0.7}))
+        assert scene._controls["gamma"].value == 0.5 and scene._sync_pending
         # A user's change while another thread sets the GUI's values (the animation's
         # position slider, the worker's sync) is kept: only that thread's callbacks are its own.
         syncing, release = threading.Event(), threading.Event()
