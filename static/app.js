@@ -569,6 +569,11 @@ async function onResult(msg) {
     drawn[key] = undefined;
   }
   const now = performance.now();
+  // (every result's, those of changes made in the scene too: epoch ms, for the browser test)
+  jik.lastDrawn = {
+    generation: msg.generation, arrivedAt: performance.timeOrigin + msg.browser.arrived,
+    draw: now - msg.browser.parsed, panels: jik.drawnNow,
+  };
   jik.shownGeneration = msg.generation;
   document.body.dataset.generation = msg.generation;
   document.body.dataset.robot = msg.state.robot;

@@ -249,7 +249,15 @@ def _scene_latency(page, after: int, since: str = "jikPressed") -> tuple[float, 
     scene = frame.evaluate(f"Math.min(...{shown}.map(([, t]) => t))") - pressed
     timing = page.text_content("#timing")  # ("generation N: compute ... ms, figures ... ms")
     plots = drawn - pressed
-    return max(plots, scene), f"plots {plots:.0f} ms, scene {scene:.0f} ms ({timing})"
+    page_side = ""
+    last = page.evaluate("jik.lastDrawn")
+    if last["generation"] == generation:  # (a newer result can follow at once)
+        page_side = (
+            f"; page: event arrived at {last['arrivedAt'] - pressed:.0f} ms, plotly redraw "
+            f"{last['draw']:.0f} ms: "
+            + ", ".join(f"{k} {v}" for k, v in sorted(last["panels"].items()))
+        )
+    return max(plots, scene), f"plots {plots:.0f} ms, scene {scene:.0f} ms ({timing}{page_side})"
 
 
 def _wait_scene(base: str, condition, timeout: float = 20.0, what: str = "") -> dict:
