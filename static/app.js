@@ -513,8 +513,10 @@ function showAhead(div, pre, key, fig) {
 // shapes and title). Each step waits for an idle moment with no change in flight (up to 5 s),
 // so that this work does not hold up a change the user makes meanwhile.
 const WARM_ROUNDS = 3;
+// (Safari has no requestIdleCallback: a short timeout there.)
+const whenIdle = window.requestIdleCallback ? window.requestIdleCallback.bind(window) : (callback) => setTimeout(callback, 50);
 const idle = (until = performance.now() + 5000) => new Promise((resolve) => {
-  const wait = () => requestIdleCallback(
+  const wait = () => whenIdle(
     () => (jik.pending.size && performance.now() < until ? setTimeout(wait, 50) : resolve()), { timeout: 1000 });
   wait();
 });
