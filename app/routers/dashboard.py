@@ -38,7 +38,12 @@ router = APIRouter(tags=["dashboard"])
 
 STATIC_DIR = Path(static.__file__).resolve().parent
 PLOTLY_JS = Path(plotly.__file__).resolve().parent / "package_data" / "plotly.min.js"
-_MEDIA = {".html": "text/html", ".js": "text/javascript", ".css": "text/css"}
+_MEDIA = {
+    ".html": "text/html",
+    ".js": "text/javascript",
+    ".css": "text/css",
+    ".svg": "image/svg+xml",
+}
 #: Seconds between keep-alive comments on the event stream.
 HEARTBEAT = 15.0
 

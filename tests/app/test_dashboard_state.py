@@ -397,6 +397,10 @@ def test_page_static_files_and_state_api():
     js = client.get("/static/vendor/plotly.min.js")
     assert js.status_code == 200 and js.headers["content-type"].startswith("text/javascript")
     assert client.get("/static/app.js").status_code == 200
+    # The page's icon, from the package (browsers ask for /favicon.ico without one).
+    assert '<link rel="icon" href="/static/favicon.svg"' in page.text
+    icon = client.get("/static/favicon.svg")
+    assert icon.status_code == 200 and icon.headers["content-type"].startswith("image/svg+xml")
     assert client.get("/static/..%2Fpyproject.toml").status_code == 404
     assert client.get("/static/__init__.py").status_code == 404
     config = client.get("/api/dashboard/config").json()
