@@ -341,6 +341,12 @@ const axisRanges = (layout) => Object.fromEntries(Object.keys(layout || {}).filt
 // cannot animate: scatter traces move only in figures of scatter traces. The h panel's runs are
 // shapes over its map (a contour, app/figures.py), moved by the relayout alone.
 const moves = (t) => t.type === "scatter";
+// The indices of a figure's lines (the traces Plotly.animate moves), and the animation frame
+// that gives the lines `traces` of `data` their data.
+const lineIndices = (fig) => fig.data.flatMap((t, i) => (moves(t) ? [i] : []));
+const moveFrame = (data, traces) => ({
+  traces, data: traces.map((i) => Object.fromEntries(DATA_KEYS.filter((k) => k in data[i]).map((k) => [k, data[i][k]]))),
+});
 function shape(fig) {
   const strip = (t) => (moves(t) ? Object.fromEntries(Object.entries(t).map(([k, v]) => [k, DATA_KEYS.includes(k) || v])) : t);
   const layout = Object.fromEntries(Object.entries(fig.layout).map(
@@ -376,7 +382,7 @@ function plan(div, key, fig) {
   // (shown: while the user's zoom stays, that of the same ranges before.)
   const entry = (onScreen[key] = screenEntry(fig, figShape, held, zoomed ? last.shown : null));
   const newRanges = same && entry.ranges !== last.ranges;
-  const traces = fig.data.flatMap((t, i) => (moves(t) ? [i] : []));
+  const traces = lineIndices(fig);
   if (!same || (traces.length && traces.length < fig.data.length)) return null;
   // New ranges where an axis is scaled to another (the task plane): drawn anew. plotly's relayout
   // redoes the constraints after the move, which costs more than Plotly.react (33-40 ms against
@@ -384,7 +390,7 @@ function plan(div, key, fig) {
   if (newRanges && Object.keys(fig.layout).some((k) => isAxis(k) && fig.layout[k].scaleanchor)) return null;
   // Only the lines that changed move (a new map leaves the pseudoinverse's as they are).
   const changed = traces.filter((i) => entry.data[i] !== last.data[i]);
-  const frame = changed.length ? { traces: changed, data: changed.map((i) => Object.fromEntries(DATA_KEYS.filter((k) => k in fig.data[i]).map((k) => [k, fig.data[i][k]]))) } : null;
+  const frame = changed.length ? moveFrame(fig.data, changed) : null;
   // After the move, a relayout: a new title text (the h panel's E1/E2), and the new axis
   // ranges, as a zoom sets them (the ranges of an animation frame miss stacked axes): only the
   // axes whose range changed, each of which plotly redraws.
@@ -529,7 +535,7 @@ async function warmUp(figures) {
       if (isTable(fig) || !fig.data.length) continue;
       const div = el("div");
       box.append(div);
-      const lines = fig.data.flatMap((t, i) => (moves(t) ? [i] : []));
+      const lines = lineIndices(fig);
       const ranges = Object.entries(axisRanges(fig.layout)).filter(([, r]) => Array.isArray(r) && r.length === 2);
       for (let i = 0; i < WARM_ROUNDS; i++) {
         await idle();
@@ -540,9 +546,7 @@ async function warmUp(figures) {
       for (let i = 0; i < WARM_ROUNDS; i++) {
         await idle();
         if (lines.length === fig.data.length) {
-          const data = JSON.parse(JSON.stringify(fig.data));
-          const frame = { traces: lines, data: lines.map((k) => Object.fromEntries(DATA_KEYS.filter((d) => d in data[k]).map((d) => [d, data[k][d]]))) };
-          await Plotly.animate(div, frame, MOVE);
+          await Plotly.animate(div, moveFrame(JSON.parse(JSON.stringify(fig.data)), lines), MOVE);
           steps.animate += 1;
         }
         // (other ranges every other round: the axes are drawn anew, as for a jump of x0)
@@ -586,7 +590,7 @@ async function onResult(msg) {
         generation: msg.generation, ms: now - since, server: msg.timing,
         changedAt: performance.timeOrigin + since, // epoch ms: comparable with the scene's frame
         arrived: msg.browser.arrived - since, parse: msg.browser.parsed - msg.browser.arrived,
-        draw: now - msg.browser.parsed, panels: jik.drawnNow,
+        draw: jik.lastDrawn.draw, panels: jik.drawnNow,
       };
       jik.latencies.push(jik.lastLatency);
       jik.pending.delete(g);
