@@ -205,6 +205,42 @@ def _scene_frame(page):
     return next(f for f in page.frames if f.parent_frame is not None)
 
 
+def _scene_shown_at(page, generation: int, timeout: float = 30_000) -> float:
+    """When the viser client first showed the status of ``generation`` or a later one
+    (wall-clock ms, from ``_SCENE_WATCH``).
+
+    Polled on a timer, not on the client's animation frames: the times are the observer's, and
+    a wait must not depend on the frames it would measure. If the status does not come, the
+    failure says what the client shows, what the server's scene drew, and whether the client
+    still renders frames.
+    """
+    from playwright.sync_api import TimeoutError as PlaywrightTimeout
+
+    frame = _scene_frame(page)
+    shown = f"Object.entries(jikSceneShown).filter(([g]) => Number(g) >= {generation})"
+    try:
+        frame.wait_for_function(f"{shown}.length > 0", timeout=timeout, polling=50)
+    except PlaywrightTimeout:
+        client = frame.evaluate(
+            """async () => ({
+                shown: jikSceneShown,
+                status: [...document.body.innerText.matchAll(/.{0,60}generation.{0,60}/g)]
+                    .map((m) => m[0]),
+                frames: await Promise.race([
+                    new Promise((r) => requestAnimationFrame(() => r("yes"))),
+                    new Promise((r) => setTimeout(() => r("none within 2 s"), 2000))]),
+            })"""
+        )
+        base = page.url.split("/", 3)[:3]
+        server = _get("/".join(base) + "/api/dashboard/state")["scene"]
+        pytest.fail(
+            f"the viser client did not show generation {generation} within {timeout / 1000:.0f} "
+            f"s: the client shows {client['status']} (first seen: {client['shown']}), "
+            f"its frames: {client['frames']}; the server's scene: {server}"
+        )
+    return frame.evaluate(f"Math.min(...{shown}.map(([, t]) => t))")
+
+
 def _latency(page, after: int) -> tuple[float, str]:
     """Control change to plots redrawn and to the scene's update shown, measured in the
     browser (both frames' clocks are wall-clock ms), with the server's share.
@@ -215,10 +251,7 @@ def _latency(page, after: int) -> tuple[float, str]:
         f"jik.lastLatency && jik.lastLatency.generation > {after}", timeout=20_000
     )
     lat = page.evaluate("jik.lastLatency")
-    frame = _scene_frame(page)
-    shown = f"Object.entries(jikSceneShown).filter(([g]) => Number(g) >= {lat['generation']})"
-    frame.wait_for_function(f"{shown}.length > 0", timeout=30_000)
-    scene = frame.evaluate(f"Math.min(...{shown}.map(([, t]) => t))") - lat["changedAt"]
+    scene = _scene_shown_at(page, lat["generation"]) - lat["changedAt"]
     t = lat["server"]
     text = (
         f"plots {lat['ms']:.0f} ms, scene {scene:.0f} ms (server: compute "
@@ -244,9 +277,7 @@ def _scene_latency(page, after: int, since: str = "jikPressed") -> tuple[float, 
     generation, drawn = min(
         (int(g), t) for g, t in page.evaluate("jikDrawnAt").items() if int(g) > after
     )
-    shown = f"Object.entries(jikSceneShown).filter(([g]) => Number(g) >= {generation})"
-    frame.wait_for_function(f"{shown}.length > 0", timeout=30_000)
-    scene = frame.evaluate(f"Math.min(...{shown}.map(([, t]) => t))") - pressed
+    scene = _scene_shown_at(page, generation) - pressed
     timing = page.text_content("#timing")  # ("generation N: compute ... ms, figures ... ms")
     plots = drawn - pressed
     page_side = ""
