@@ -205,14 +205,61 @@ def _scene_frame(page):
     return next(f for f in page.frames if f.parent_frame is not None)
 
 
+# The browser's console warnings and errors, of the page and its frames (for _scene_diagnosis).
+_CONSOLE: list[str] = []
+
+
+def _scene_diagnosis(page) -> str:
+    """What the viser client shows and does, and what the server's scene drew: for a failure
+    of a wait on the client."""
+    client = _scene_frame(page).evaluate(
+        """async () => ({
+            status: [...document.body.innerText.matchAll(/.{0,60}generation.{0,60}/g)]
+                .map((m) => m[0]),
+            shown: window.jikSceneShown,
+            sinceLastFrame: performance.now() - window.jikLastFrame,
+            animationFrames: await Promise.race([
+                new Promise((r) => requestAnimationFrame(() => r("yes"))),
+                new Promise((r) => setTimeout(() => r("none within 2 s"), 2000))]),
+            contextLost: [...document.querySelectorAll("canvas")].map((c) => {
+                const gl = c.getContext("webgl2") || c.getContext("webgl");
+                return gl ? gl.isContextLost() : null;
+            }),
+            visibility: document.visibilityState,
+        })"""
+    )
+    base = "/".join(page.url.split("/", 3)[:3])
+    server = _get(f"{base}/api/dashboard/state")["scene"]
+    return (
+        f"the viser client: {client}; the server's scene: {server}; the browser's last "
+        f"console warnings and errors: {_CONSOLE[-8:]}"
+    )
+
+
+def _scene_rendering(page, rendering: bool, timeout: float = 30_000) -> None:
+    """Wait until the viser client renders (a WebGL frame within the last 50 ms), or until it
+    is still (no frame for 100 ms); the failure says what the client does."""
+    from playwright.sync_api import TimeoutError as PlaywrightTimeout
+
+    condition = "< 50" if rendering else "> 100"
+    try:
+        _scene_frame(page).wait_for_function(
+            f"performance.now() - jikLastFrame {condition}", polling=20, timeout=timeout
+        )
+    except PlaywrightTimeout:
+        pytest.fail(
+            f"the viser client was not {'rendering' if rendering else 'still'} within "
+            f"{timeout / 1000:.0f} s: {_scene_diagnosis(page)}"
+        )
+
+
 def _scene_shown_at(page, generation: int, timeout: float = 30_000) -> float:
     """When the viser client first showed the status of ``generation`` or a later one
     (wall-clock ms, from ``_SCENE_WATCH``).
 
     Polled on a timer, not on the client's animation frames: the times are the observer's, and
     a wait must not depend on the frames it would measure. If the status does not come, the
-    failure says what the client shows, what the server's scene drew, and whether the client
-    still renders frames.
+    failure says what the client shows and does (:func:`_scene_diagnosis`).
     """
     from playwright.sync_api import TimeoutError as PlaywrightTimeout
 
@@ -221,22 +268,9 @@ def _scene_shown_at(page, generation: int, timeout: float = 30_000) -> float:
     try:
         frame.wait_for_function(f"{shown}.length > 0", timeout=timeout, polling=50)
     except PlaywrightTimeout:
-        client = frame.evaluate(
-            """async () => ({
-                shown: jikSceneShown,
-                status: [...document.body.innerText.matchAll(/.{0,60}generation.{0,60}/g)]
-                    .map((m) => m[0]),
-                frames: await Promise.race([
-                    new Promise((r) => requestAnimationFrame(() => r("yes"))),
-                    new Promise((r) => setTimeout(() => r("none within 2 s"), 2000))]),
-            })"""
-        )
-        base = page.url.split("/", 3)[:3]
-        server = _get("/".join(base) + "/api/dashboard/state")["scene"]
         pytest.fail(
-            f"the viser client did not show generation {generation} within {timeout / 1000:.0f} "
-            f"s: the client shows {client['status']} (first seen: {client['shown']}), "
-            f"its frames: {client['frames']}; the server's scene: {server}"
+            f"the viser client did not show generation {generation} within "
+            f"{timeout / 1000:.0f} s: {_scene_diagnosis(page)}"
         )
     return frame.evaluate(f"Math.min(...{shown}.map(([, t]) => t))")
 
@@ -488,6 +522,14 @@ def test_dashboard_follows_controls_in_chromium(served):
             ),
         )
         page.on("pageerror", lambda e: errors.append(str(e)))
+        page.on(
+            "console",
+            lambda m: (
+                _CONSOLE.append(f"{m.type}: {m.text[:200]}")
+                if m.type in ("error", "warning") and "GPU stall due to ReadPixels" not in m.text
+                else None
+            ),
+        )
         page.goto(base + "/")
 
         # The plotly panels and the viser canvas (inside the iframe on the scene port).
@@ -696,10 +738,10 @@ def test_dashboard_follows_controls_in_chromium(served):
         ]:
             page.mouse.move(800, 25)  # the header: off the controls, the scene animates
             _wait_scene(base, lambda s: s.get("held") is False)
-            frame.wait_for_function("performance.now() - jikLastFrame < 50", polling=20)
+            _scene_rendering(page, True)
             page.hover(selector)
             _wait_scene(base, lambda s: s.get("held") is True)
-            frame.wait_for_function("performance.now() - jikLastFrame > 100", polling=20)
+            _scene_rendering(page, False)
             if selector == "#ctl-robot":
                 page.wait_for_function(f"Object.keys(ahead.robots.{value} || {{}}).length >= 4")
                 before = int(page.evaluate("jik.generation"))
@@ -749,14 +791,14 @@ def test_dashboard_follows_controls_in_chromium(served):
         ]:
             page.mouse.move(800, 25)
             _wait_scene(base, lambda s: s.get("held") is False)
-            frame.wait_for_function("performance.now() - jikLastFrame < 50", polling=20)
+            _scene_rendering(page, True)
             box = frame.evaluate(_SCENE_SLIDER, label)
             assert box is not None, f"no slider '{label}' in the scene's GUI"
             x = iframe["x"] + box["x"] + fraction * box["width"]
             y = iframe["y"] + box["y"] + box["height"] / 2
             page.mouse.move(x, y)
             _wait_scene(base, lambda s: s.get("held") is True, what=f"hold on the scene's {label}")
-            frame.wait_for_function("performance.now() - jikLastFrame > 100", polling=20)
+            _scene_rendering(page, False)
             before = int(page.evaluate("jik.generation"))
             page.mouse.down()
             page.mouse.up()
@@ -781,7 +823,7 @@ def test_dashboard_follows_controls_in_chromium(served):
         # hold it; the press is a change, which does (app/scene.py EDIT_HOLD).
         page.mouse.move(800, 25)
         _wait_scene(base, lambda s: s.get("held") is False)
-        frame.wait_for_function("performance.now() - jikLastFrame < 50", polling=20)
+        _scene_rendering(page, True)
         png = base64.b64encode(page.locator("#scene").screenshot()).decode()
         arrow = page.evaluate(_FIND_COLOUR, {"png": png, "rgb": [255, 32, 96]})
         assert arrow["n"] > 10, f"the gizmo's x arrow is not in view: {arrow}"
@@ -793,7 +835,7 @@ def test_dashboard_follows_controls_in_chromium(served):
         _wait_scene(base, lambda s: s.get("held") is True, what="hold on the gizmo's press")
         # The press holds the animation but is no change: nothing is solved again.
         assert _get(f"{base}/api/dashboard/state")["generation"] == before
-        frame.wait_for_function("performance.now() - jikLastFrame > 100", polling=20)
+        _scene_rendering(page, False)
         page.mouse.move(x + 25 * arrow["ux"], y + 25 * arrow["uy"])
         what = "start point, dragged in the scene (playing)"
         latencies[what] = _scene_latency(page, before, since="jikMoved")
