@@ -205,7 +205,7 @@ def _scene_frame(page):
     return next(f for f in page.frames if f.parent_frame is not None)
 
 
-# The browser's console warnings and errors, of the page and its frames (for _scene_diagnosis).
+# The browser's console warnings and errors and the page's uncaught errors (for _scene_diagnosis).
 _CONSOLE: list[str] = []
 
 
@@ -521,7 +521,7 @@ def test_dashboard_follows_controls_in_chromium(served):
                 else None
             ),
         )
-        page.on("pageerror", lambda e: errors.append(str(e)))
+        page.on("pageerror", lambda e: (errors.append(str(e)), _CONSOLE.append(f"pageerror: {e}")))
         page.on(
             "console",
             lambda m: (
