@@ -239,51 +239,49 @@ def _scene_diagnosis(page) -> str:
     )
 
 
+def _wait_in_scene(page, condition: str, failing: str, polling: int, timeout: float) -> None:
+    """Wait in the viser client until ``condition`` (JS) holds, polled every ``polling`` ms on a
+    timer; on a timeout, fail with "the viser client ``failing``" and what it shows and does."""
+    from playwright.sync_api import TimeoutError as PlaywrightTimeout
+
+    try:
+        _scene_frame(page).wait_for_function(condition, polling=polling, timeout=timeout)
+    except PlaywrightTimeout:
+        pytest.fail(
+            f"the viser client {failing} within {timeout / 1000:.0f} s: {_scene_diagnosis(page)}"
+        )
+
+
 def _scene_rendering(page, rendering: bool, timeout: float = 30_000) -> None:
     """Wait until the viser client renders (three WebGL frames within the last second: more
-    than its idle heartbeat of one a second), or until it is still (no frame for 100 ms); the
-    failure says what the client does.
+    than its idle heartbeat of one a second), or until it is still (no frame for 100 ms).
 
     (Not "a frame within the last 50 ms": a frame holds the client's main thread, where this is
     polled, until chromium has read it back, and on a loaded machine that takes longer than
     50 ms, so that such a moment never comes while the scene plays.)
     """
-    from playwright.sync_api import TimeoutError as PlaywrightTimeout
-
-    condition = (
-        "jikFrames.length >= 3 && performance.now() - jikFrames[jikFrames.length - 3] < 1000"
-        if rendering
-        else "performance.now() - jikLastFrame > 100"
-    )
-    try:
-        _scene_frame(page).wait_for_function(condition, polling=20, timeout=timeout)
-    except PlaywrightTimeout:
-        pytest.fail(
-            f"the viser client was not {'rendering' if rendering else 'still'} within "
-            f"{timeout / 1000:.0f} s: {_scene_diagnosis(page)}"
+    if rendering:
+        condition = (
+            "jikFrames.length >= 3 && performance.now() - jikFrames[jikFrames.length - 3] < 1000"
         )
+    else:
+        condition = "performance.now() - jikLastFrame > 100"
+    failing = f"was not {'rendering' if rendering else 'still'}"
+    _wait_in_scene(page, condition, failing, polling=20, timeout=timeout)
 
 
 def _scene_shown_at(page, generation: int, timeout: float = 30_000) -> float:
     """When the viser client first showed the status of ``generation`` or a later one
-    (wall-clock ms, from ``_SCENE_WATCH``).
+    (wall-clock ms, from ``_SCENE_WATCH``; the status travels on the same websocket after the
+    scene's nodes).
 
     Polled on a timer, not on the client's animation frames: the times are the observer's, and
-    a wait must not depend on the frames it would measure. If the status does not come, the
-    failure says what the client shows and does (:func:`_scene_diagnosis`).
+    a wait must not depend on the frames it would measure.
     """
-    from playwright.sync_api import TimeoutError as PlaywrightTimeout
-
-    frame = _scene_frame(page)
     shown = f"Object.entries(jikSceneShown).filter(([g]) => Number(g) >= {generation})"
-    try:
-        frame.wait_for_function(f"{shown}.length > 0", timeout=timeout, polling=50)
-    except PlaywrightTimeout:
-        pytest.fail(
-            f"the viser client did not show generation {generation} within "
-            f"{timeout / 1000:.0f} s: {_scene_diagnosis(page)}"
-        )
-    return frame.evaluate(f"Math.min(...{shown}.map(([, t]) => t))")
+    failing = f"did not show generation {generation}"
+    _wait_in_scene(page, f"{shown}.length > 0", failing, polling=50, timeout=timeout)
+    return _scene_frame(page).evaluate(f"Math.min(...{shown}.map(([, t]) => t))")
 
 
 def _latency(page, after: int) -> tuple[float, str]:
@@ -375,18 +373,6 @@ def _second_phase_drawn(page, timeout: float = 30_000) -> None:
             const stale = document.getElementById(`plot-${k}`).classList.contains('stale');
             return t && !stale && !t.textContent.includes('computing');
         })""",
-        timeout=timeout,
-    )
-
-
-def _scene_client_shows(page, generation: int, timeout: float = 30_000) -> None:
-    """Wait until the viser client (in the iframe) renders the scene status of ``generation``
-    or a later one: the status travels on the same websocket after the scene's nodes."""
-    frame = next(f for f in page.frames if f.parent_frame is not None)
-    frame.wait_for_function(
-        """(g) => [...document.body.innerText.matchAll(/generation (\\d+):/g)]
-            .some((m) => Number(m[1]) >= g)""",
-        arg=generation,
         timeout=timeout,
     )
 
@@ -660,7 +646,7 @@ def test_dashboard_follows_controls_in_chromium(served):
             _second_phase_drawn(page)
             # The software-WebGL iframe lags the plots: wait until the viser client shows this
             # generation's status (sent with the scene's nodes), then until the canvas settles.
-            _scene_client_shows(page, generation)
+            _scene_shown_at(page, generation)
             shot = _settled(page)
             assert shot not in scenes.values(), f"the 3D scene did not change for {robot}"
             scenes[robot] = shot
@@ -680,7 +666,7 @@ def test_dashboard_follows_controls_in_chromium(served):
         page.select_option("#ctl-robot", "manipulator2")
         latencies["switch back to manipulator2"] = _latency(page, before)
         page.wait_for_function("document.body.dataset.robot === 'manipulator2'")
-        _scene_client_shows(page, _wait_generation(page, before + 1))
+        _scene_shown_at(page, _wait_generation(page, before + 1))
         _settled(page)
         page.screenshot(path=str(ARTIFACTS / "dashboard-4-back.png"))
         # Every panel, below the fold too (E1/E2 against the alternatives, Table 1).
