@@ -345,6 +345,30 @@ def _wait_scene(base: str, condition, timeout: float = 20.0, what: str = "") -> 
     pytest.fail(f"the scene did not {what or 'reach the expected state'} within {timeout} s")
 
 
+def _point_in_scene(page, x: float, y: float, timeout: float = 20.0) -> None:
+    """Move the pointer to (x, y) on the page, in the viser client's frame, until the page hears
+    the client's pointer state from there. The client sends an unchanged state at most every
+    150 ms (static/scene_hold.js), so a move that follows the one before closely (a loaded
+    machine delays the earlier one's event) sends nothing: move by a pixel again until it does."""
+    from playwright.sync_api import TimeoutError as PlaywrightTimeout
+
+    deadline = time.monotonic() + timeout
+    step = 0
+    while True:
+        heard = page.evaluate("jik.hold.sceneMessages")
+        page.mouse.move(x + step % 2, y)
+        try:
+            page.wait_for_function(f"jik.hold.sceneMessages > {heard}", timeout=500)
+            return
+        except PlaywrightTimeout:
+            step += 1
+            if time.monotonic() > deadline:
+                pytest.fail(
+                    f"the page heard no pointer state from the scene at ({x}, {y}) "
+                    f"in {timeout} s ({step} moves)"
+                )
+
+
 def _scene_generation(base: str, generation: int, timeout: float = 20.0) -> dict:
     return _wait_scene(
         base, lambda s: s.get("generation", 0) >= generation, timeout, f"draw {generation}"
@@ -808,10 +832,8 @@ def test_dashboard_follows_controls_in_chromium(served):
         # The canvas and the Playback folder let it play.
         page.mouse.move(iframe["x"] + 60, iframe["y"] + iframe["height"] / 2)
         _wait_scene(base, lambda s: s.get("held") is False, what="play on over the canvas")
-        heard = page.evaluate("jik.hold.sceneMessages")
         box = frame.evaluate(_SCENE_SLIDER, "speed")
-        page.mouse.move(iframe["x"] + box["x"] + 10, iframe["y"] + box["y"] + 4)
-        page.wait_for_function(f"jik.hold.sceneMessages > {heard}")
+        _point_in_scene(page, iframe["x"] + box["x"] + 10, iframe["y"] + box["y"] + 4)
         assert page.evaluate("jik.hold.scenePointer") is False
         assert _get(f"{base}/api/dashboard/state")["scene"]["held"] is False
 
