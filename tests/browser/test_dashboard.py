@@ -12,11 +12,13 @@ animation paused (as for the screenshots), then again while it plays (the defaul
 from __future__ import annotations
 
 import base64
+import bisect
 import json
 import os
 import socket
 import subprocess
 import sys
+import threading
 import time
 import urllib.request
 from pathlib import Path
@@ -37,6 +39,47 @@ ARGS = [
 ARTIFACTS = Path(__file__).resolve().parents[1] / "artifacts"
 PANELS = ("task", "drift", "joints", "augmenting", "sensitivity", "table")
 ROOT = Path(__file__).resolve().parents[2]
+
+
+class _Steal:
+    """What the hypervisor took of this machine's CPUs while the test ran: the steal column of
+    Linux's /proc/stat (all CPUs, in ticks of 10 ms), read every 20 ms in a thread. A latency is
+    printed with the share of CPU time stolen during it; this machine's slow hours are hours
+    of steal (docs/benchmarks.md). Nothing is read where /proc/stat is missing."""
+
+    def __init__(self, period: float = 0.02) -> None:
+        self.samples: list[tuple[float, int, int]] = []  # (epoch s, steal ticks, all ticks)
+        self._stop = threading.Event()
+        if self._read() is not None:
+            threading.Thread(target=self._run, args=(period,), daemon=True).start()
+
+    @staticmethod
+    def _read() -> tuple[float, int, int] | None:
+        try:
+            with open("/proc/stat") as f:
+                ticks = [int(v) for v in f.readline().split()[1:9]]
+        except (OSError, ValueError):
+            return None
+        return (time.time(), ticks[7], sum(ticks)) if len(ticks) == 8 else None
+
+    def _run(self, period: float) -> None:
+        while not self._stop.wait(period):
+            sample = self._read()
+            if sample is not None:
+                self.samples.append(sample)
+
+    def stop(self) -> None:
+        self._stop.set()
+
+    def percent(self, t0: float, t1: float) -> float | None:
+        """Steal in % of all CPU time from the last sample at or before ``t0`` to the first at
+        or after ``t1`` (epoch s); None without such samples."""
+        times = [s[0] for s in self.samples]
+        i, j = bisect.bisect_right(times, t0) - 1, bisect.bisect_left(times, t1)
+        if i < 0 or j >= len(times):
+            return None
+        (_, s0, a0), (_, s1, a1) = self.samples[i], self.samples[j]
+        return 100.0 * (s1 - s0) / (a1 - a0) if a1 > a0 else None
 
 
 def _free_port() -> int:
@@ -284,11 +327,11 @@ def _scene_shown_at(page, generation: int, timeout: float = 30_000) -> float:
     return _scene_frame(page).evaluate(f"Math.min(...{shown}.map(([, t]) => t))")
 
 
-def _latency(page, after: int) -> tuple[float, str]:
+def _latency(page, after: int) -> tuple[float, str, float]:
     """Control change to plots redrawn and to the scene's update shown, measured in the
     browser (both frames' clocks are wall-clock ms), with the server's share.
 
-    Returns (the larger of the two in ms, a description).
+    Returns (the larger of the two in ms, a description, the change's epoch s).
     """
     page.wait_for_function(
         f"jik.lastLatency && jik.lastLatency.generation > {after}", timeout=20_000
@@ -304,15 +347,15 @@ def _latency(page, after: int) -> tuple[float, str]:
         + ", ".join(f"{k} {v}" for k, v in sorted(lat["panels"].items()))
         + ")"
     )
-    return max(lat["ms"], scene), text
+    return max(lat["ms"], scene), text, lat["changedAt"] / 1000
 
 
-def _scene_latency(page, after: int, since: str = "jikPressed") -> tuple[float, str]:
+def _scene_latency(page, after: int, since: str = "jikPressed") -> tuple[float, str, float]:
     """A press on a slider of the scene's GUI (the viser client), or the move of a drag there
     (``since="jikMoved"``), to the plots redrawn in the page and to the scene's update shown,
     both frames' wall-clock ms.
 
-    Returns (the larger of the two in ms, a description).
+    Returns (the larger of the two in ms, a description, the press's or move's epoch s).
     """
     page.wait_for_function(f"Object.keys(jikDrawnAt).some((g) => Number(g) > {after})")
     frame = _scene_frame(page)
@@ -331,7 +374,8 @@ def _scene_latency(page, after: int, since: str = "jikPressed") -> tuple[float, 
             f"{last['draw']:.0f} ms: "
             + ", ".join(f"{k} {v}" for k, v in sorted(last["panels"].items()))
         )
-    return max(plots, scene), f"plots {plots:.0f} ms, scene {scene:.0f} ms ({timing}{page_side})"
+    text = f"plots {plots:.0f} ms, scene {scene:.0f} ms ({timing}{page_side})"
+    return max(plots, scene), text, pressed / 1000
 
 
 def _wait_scene(base: str, condition, timeout: float = 20.0, what: str = "") -> dict:
@@ -524,7 +568,15 @@ def _check_moved(page, generation: int, how: str = "moved") -> set[str]:
     return moved
 
 
-def test_dashboard_follows_controls_in_chromium(served):
+@pytest.fixture
+def steal():
+    """The CPU steal sampler (:class:`_Steal`), stopped after the test."""
+    sampler = _Steal()
+    yield sampler
+    sampler.stop()
+
+
+def test_dashboard_follows_controls_in_chromium(served, steal):
     from playwright.sync_api import TimeoutError as PlaywrightTimeout
     from playwright.sync_api import sync_playwright
 
@@ -863,9 +915,17 @@ def test_dashboard_follows_controls_in_chromium(served):
         assert _get(f"{base}/api/dashboard/state")["state"]["x0"] != x0
         browser.close()
 
-    for what, (worst, text) in latencies.items():
+    for what, (worst, text, t0) in latencies.items():
+        stolen = steal.percent(t0, t0 + worst / 1000)
+        text += "" if stolen is None else f"; cpu steal {stolen:.0f} %"
         print(f"latency control -> plots and scene updated, {what}: {worst:.0f} ms: {text}")
-    worst = max(ms for what, (ms, _) in latencies.items() if "unicycle" not in what)
+    worst = max(ms for what, (ms, *_) in latencies.items() if "unicycle" not in what)
     print(f"latency control -> plots and scene updated, slowest manipulator change: {worst:.0f} ms")
+    if steal.samples:
+        (t0, s0, a0), (t1, s1, a1) = steal.samples[0], steal.samples[-1]
+        print(
+            f"cpu steal over the test's {t1 - t0:.0f} s: {100 * (s1 - s0) / max(a1 - a0, 1):.1f} % "
+            "(CPU time the hypervisor gave to others; slow hours are hours of steal)"
+        )
     assert not external, f"requests left the machine: {external}"
     assert not errors, f"errors in the page: {errors}"
