@@ -326,9 +326,11 @@ function drawTable(div, fig) {
 }
 
 // A figure that differs from the one on screen only in its lines' data, its axis ranges, its
-// title text and its shapes (same styles, same contours) moves its lines with Plotly.animate,
-// then takes the new ranges, title and shapes by Plotly.relayout: no redraw of the rest, a third
-// of Plotly.react's cost. The server rounds the ranges (app/figures.py nice_range) and keeps them
+// title text and its shapes (same styles, same contours) takes the new ranges, title and shapes
+// by Plotly.relayout, then moves its lines with Plotly.animate: no redraw of the rest, a third
+// of Plotly.react's cost. Both run in the same task, so that the browser paints the panel once:
+// with the move first, plotly ran the relayout in a task after the next frame, which showed the
+// new lines on the old axes. The server rounds the ranges (app/figures.py nice_range) and keeps them
 // while the data fill them (keep_ranges), so that most changes do not even touch the axes.
 const DATA_KEYS = ["x", "y", "customdata", "text"];
 const MOVE = { transition: { duration: 0 }, frame: { duration: 0, redraw: false }, mode: "immediate" };
@@ -337,7 +339,7 @@ const axisRanges = (layout) => Object.fromEntries(Object.keys(layout || {}).filt
   .map((k) => [k, layout[k].range || null]));
 // The figure without its lines' data, axis ranges, title text and shapes (JSON): what must stay
 // for a move. (A new title text, as the h panel's E1/E2 that a second phase fills in, is set
-// after the move: a relayout of the title.) Plotly.animate drops the layer of any trace it
+// with the move: a relayout of the title.) Plotly.animate drops the layer of any trace it
 // cannot animate: scatter traces move only in figures of scatter traces. The h panel's runs are
 // shapes over its map (a contour, app/figures.py), moved by the relayout alone.
 const moves = (t) => t.type === "scatter";
@@ -365,8 +367,8 @@ function screenEntry(fig, figShape, held, shown) {
   };
 }
 
-// How a panel takes its new figure: {frame, relayout} to move it (Plotly.animate, then
-// Plotly.relayout when that has anything), or null to draw it (Plotly.react).
+// How a panel takes its new figure: {frame, relayout} to move it (Plotly.relayout when that has
+// anything, then Plotly.animate when the lines changed), or null to draw it (Plotly.react).
 function plan(div, key, fig) {
   const last = onScreen[key];
   const figShape = shape(fig); // (JSON of the whole figure but its lines: once per panel)
@@ -385,13 +387,13 @@ function plan(div, key, fig) {
   const traces = lineIndices(fig);
   if (!same || (traces.length && traces.length < fig.data.length)) return null;
   // New ranges where an axis is scaled to another (the task plane): drawn anew. plotly's relayout
-  // redoes the constraints after the move, which costs more than Plotly.react (33-40 ms against
-  // 23 in the page alone).
+  // redoes the constraints there, which costs more than Plotly.react (33-40 ms against 23 in the
+  // page alone).
   if (newRanges && Object.keys(fig.layout).some((k) => isAxis(k) && fig.layout[k].scaleanchor)) return null;
   // Only the lines that changed move (a new map leaves the pseudoinverse's as they are).
   const changed = traces.filter((i) => entry.data[i] !== last.data[i]);
   const frame = changed.length ? moveFrame(fig.data, changed) : null;
-  // After the move, a relayout: a new title text (the h panel's E1/E2), and the new axis
+  // Before the move, a relayout: a new title text (the h panel's E1/E2), and the new axis
   // ranges, as a zoom sets them (the ranges of an animation frame miss stacked axes): only the
   // axes whose range changed, each of which plotly redraws.
   const relayout = {};
@@ -446,8 +448,8 @@ async function drawFigures(figures, digests = {}, robot = null) {
       // browser test.)
       jik.panelPlan[key] = move && { lines: move.frame ? move.frame.traces : [], relayout: Object.keys(move.relayout) };
       const p = move
-        ? (move.frame ? Plotly.animate(div, move.frame, MOVE) : Promise.resolve())
-          .then(() => !Object.keys(move.relayout).length || Plotly.relayout(div, move.relayout))
+        ? (Object.keys(move.relayout).length ? Plotly.relayout(div, move.relayout) : Promise.resolve())
+          .then(() => !move.frame || Plotly.animate(div, move.frame, MOVE))
         : Plotly.react(div, fig.data, fig.layout, PLOT_CONFIG);
       panelTools(div, key);
       jik.panelSync[key] = Math.round(performance.now() - t0); // the synchronous share

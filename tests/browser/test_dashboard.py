@@ -550,6 +550,30 @@ _SERVER_FIGURE = """async (key) => {
 }"""
 
 
+# Installed in the page: the calls of Plotly.relayout and Plotly.animate on the joint panel, each
+# with whether a frame came since the relayout (null before one), until jikJointCallsDone().
+_JOINT_CALLS = """() => {
+  const calls = (window.jikJointCalls = []);
+  let since = null;
+  const wrap = (name) => {
+    const original = Plotly[name];
+    Plotly[name] = function (gd, ...args) {
+      if (gd && gd.id === "plot-joints") {
+        calls.push([name, since && since.framed]);
+        if (name === "relayout") {
+          const mark = (since = { framed: false });
+          requestAnimationFrame(() => { mark.framed = true; });
+        }
+      }
+      return original.call(this, gd, ...args);
+    };
+    return () => { Plotly[name] = original; };
+  };
+  const undo = [wrap("relayout"), wrap("animate")];
+  window.jikJointCallsDone = () => undo.forEach((u) => u());
+}"""
+
+
 def _check_moved(page, generation: int, how: str = "moved") -> set[str]:
     """The panels the page moved for ``generation`` (or showed from those it drew ahead,
     ``how="ahead"``) look as a full drawing of the same figure would (same tick labels and
@@ -686,14 +710,21 @@ def test_dashboard_follows_controls_in_chromium(served, steal):
         latencies["cycles (manipulator 2)"] = _latency(page, before)
         _check_moved(page, _wait_generation(page, before + 1))
         # A longer arm widens the task plane: its equal-scale axes take new ranges, and the
-        # panel is drawn anew (cheaper than a relayout that redoes plotly's constraints after
-        # the move); the joint panel moves, its new ranges relayouted.
+        # panel is drawn anew (cheaper than a relayout that redoes plotly's constraints); the
+        # joint panel moves, its new ranges relayouted first, in the same task as the move: no
+        # frame shows its new lines on the old axes.
         _second_phase_drawn(page)
+        page.evaluate(_JOINT_CALLS)
         before = _set_slider(page, "#ctl-l", 2.0)
         latencies["arm length l, longer (manipulator 2)"] = _latency(page, before)
         assert page.evaluate("jik.lastLatency.panels.task").startswith("drawn")
         assert "joints" in _check_moved(page, _wait_generation(page, before + 1))
         assert any(k.endswith(".range") for k in page.evaluate("jik.panelPlan.joints.relayout"))
+        calls = page.evaluate("jikJointCalls")
+        page.evaluate("jikJointCallsDone()")
+        assert calls == [["relayout", None], ["animate", False]], (
+            f"the joint panel's relayout and move, with whether a frame came between: {calls}"
+        )
         assert _trace(page, "drift", 0, "x") == [1, 2, 3, 4]
 
         # Manipulator 1 (and the unicycle when the registry has it), then back.
