@@ -53,6 +53,15 @@ EDIT_HOLD = 1.5
 #: Seconds between two changes of the start point while its gizmo is dragged (each starts a
 #: computation; the dashboard solves only the newest state, but every change is an event).
 DRAG_INTERVAL = 0.15
+#: Seconds between a result's event and the scene's drawing of it while a browser shows the
+#: scene. The page's plotly redraw and the viser client's update (its React pass and its frames,
+#: software WebGL on a machine without a GPU) run at the same moment on the same cores: on this
+#: 2-core machine the slowest changes' plots waited for the scene's frames. Drawn 40 ms later,
+#: the slowest kinds were shown sooner in the browser test (medians: the drag 275 -> 214 ms, the
+#: cycles from the scene's GUI 217 -> 174, the longer arm 214 -> 196), the quickest later (the
+#: start point 168 -> 188): the scene's share rose by 28-53 ms (docs/benchmarks.md, "Dashboard
+#: latency"). With no browser there is nothing to share the cores with, and no wait.
+SCENE_DELAY = 0.04
 #: Script run in every viser client: it tells the framing page when the pointer (or the keyboard)
 #: is on the scene's GUI panel, so that the page holds the animation still there as it does on its
 #: own controls.
@@ -746,6 +755,8 @@ class DashboardScene:
                     self.progress.value = min(100.0, 100.0 * msg["fraction"])  # type: ignore[misc]  # viser: settable
                     self.status.content = f"computing… {100 * msg['fraction']:.0f}%"
             elif event.kind == "result" and event.result is not None:
+                if self.server.get_clients():  # (the page's listener has queued its event)
+                    time.sleep(SCENE_DELAY)
                 self._draw(event.result)
             elif event.kind == "ahead" and event.result is not None:
                 self._prebuild(event.result)

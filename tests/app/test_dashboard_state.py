@@ -530,6 +530,46 @@ def test_a_hold_stills_the_playing_scene_until_it_ends():
         dashboard.stop()
 
 
+def test_the_scene_draws_a_result_after_the_page_only_while_a_browser_shows_it(monkeypatch):
+    """With a viser client connected the scene draws a result SCENE_DELAY after its event, so
+    that the page's redraw and the client's frames do not start at once on the same cores; with
+    none it draws at once."""
+    import socket
+    from types import SimpleNamespace
+
+    import app.scene as scene_module
+    from app.scene import SCENE_DELAY, DashboardScene
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    dashboard = Dashboard()
+    scene = DashboardScene(dashboard, port=port)
+    try:
+        assert dashboard.wait(1, timeout=60)
+        event = dashboard._latest["result"]
+        calls: list[tuple] = []
+        here = threading.current_thread()
+
+        def sleep(seconds: float) -> None:  # (this thread's; the scene's own threads sleep)
+            if threading.current_thread() is here:
+                calls.append(("sleep", seconds))
+            else:
+                time.sleep(seconds)
+
+        monkeypatch.setattr(scene_module, "time", SimpleNamespace(**{**vars(time), "sleep": sleep}))
+        monkeypatch.setattr(scene, "_draw", lambda result: calls.append(("draw", result)))
+        scene._on_event(event)
+        assert calls == [("draw", event.result)]
+        calls.clear()
+        monkeypatch.setattr(scene.server, "get_clients", lambda: {0: object()})
+        scene._on_event(event)
+        assert calls == [("sleep", SCENE_DELAY), ("draw", event.result)]
+    finally:
+        scene.stop()
+        dashboard.stop()
+
+
 def test_viser_gui_and_drag_change_the_one_state():
     """The scene's GUI and its start-point gizmo write to the same Dashboard as the page."""
     import socket
