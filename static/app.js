@@ -330,8 +330,8 @@ function drawTable(div, fig) {
 // by Plotly.relayout, then moves its lines with Plotly.animate: no redraw of the rest, a third
 // of Plotly.react's cost. Both run in the same task, so that the browser paints the panel once:
 // with the move first, plotly ran the relayout in a task after the next frame, which showed the
-// new lines on the old axes. The server rounds the ranges (app/figures.py nice_range) and keeps them
-// while the data fill them (keep_ranges), so that most changes do not even touch the axes.
+// new lines on the old axes. The server rounds the ranges (app/figures.py nice_range) and keeps
+// them while the data fill them (keep_ranges), so that most changes do not even touch the axes.
 const DATA_KEYS = ["x", "y", "customdata", "text"];
 const MOVE = { transition: { duration: 0 }, frame: { duration: 0, redraw: false }, mode: "immediate" };
 const isAxis = (k) => /^[xy]axis[0-9]*$/.test(k);
