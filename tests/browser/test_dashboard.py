@@ -953,9 +953,10 @@ def test_dashboard_follows_controls_in_chromium(served, steal):
     worst = max(ms for what, (ms, *_) in latencies.items() if "unicycle" not in what)
     print(f"latency control -> plots and scene updated, slowest manipulator change: {worst:.0f} ms")
     if steal.samples:
-        (t0, s0, a0), (t1, s1, a1) = steal.samples[0], steal.samples[-1]
+        first, last = steal.samples[0][0], steal.samples[-1][0]
+        stolen = steal.percent(first, last)
         print(
-            f"cpu steal over the test's {t1 - t0:.0f} s: {100 * (s1 - s0) / max(a1 - a0, 1):.1f} % "
+            f"cpu steal over the test's {last - first:.0f} s: {stolen or 0.0:.1f} % "
             "(CPU time the hypervisor gave to others; slow hours are hours of steal)"
         )
     assert not external, f"requests left the machine: {external}"
