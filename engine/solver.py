@@ -2,12 +2,12 @@
 
 Continuous mode follows the trajectory of dx/dtheta = -gamma J#(x) (k(x) - y_d) with two
 adaptive high-order methods: Chebyshev-Picard iteration on the equivalent homotopy form (spectral,
-adaptive segments; :mod:`engine.picard`), and, where that cannot resolve the path or a very small
-tolerance needs it, an embedded 8(5,3) Dormand-Prince pair (DOP853, the coefficients of SciPy's
-``solve_ivp``) on (7) itself, each batch member with its own adaptive step. Both work in
-tau = gamma theta, so x(theta) does not depend on gamma at all: gamma only rescales theta
-(NOTES.md). Discrete mode iterates x <- x - gamma J#(x) (k(x) - y_d), as
-in section 6.2.
+adaptive segments; :mod:`jik.engine.picard`), and, where that cannot resolve the path or a very
+small tolerance needs it, an embedded 8(5,3) Dormand-Prince pair (DOP853, the coefficients of
+SciPy's ``solve_ivp``, :mod:`jik.engine.dop853`) on (7) itself, each batch member with its own
+adaptive step. Both work in tau = gamma theta, so x(theta) does not depend on gamma at all:
+gamma only rescales theta (NOTES.md). Discrete mode iterates x <- x - gamma J#(x) (k(x) - y_d),
+as in section 6.2.
 """
 
 from __future__ import annotations
@@ -17,15 +17,15 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
-from scipy.integrate._ivp import dop853_coefficients as _dop
 
-from engine.exceptions import InvalidInputError
-from engine.inverses import Inverse
-from engine.picard import Guess, picard_chain, picard_path
-from engine.validation import FloatArray, count, positive
+from jik.engine import dop853 as _dop
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.inverses import Inverse
+from jik.engine.picard import Guess, picard_chain, picard_path
+from jik.engine.validation import FloatArray, count, positive
 
 _NS = _dop.N_STAGES
-_A = _dop.A[:_NS, :_NS]
+_A = _dop.A
 _B = _dop.B
 _E3 = _dop.E3
 _E5 = _dop.E5
@@ -288,7 +288,7 @@ def chain_guesses(inverse: Inverse, x0, y_d, *, gamma: float = 1.0) -> list[Traj
 
     Pass ``guesses[j]`` as ``guess`` of the solve of leg j (:func:`solve`): the results are
     the same to the sweep tolerance; each leg then takes one or two Picard sweeps instead of
-    about ten, and the guesses cost about three legs' worth (:func:`engine.picard.picard_chain`;
+    about ten, and the guesses cost about three legs' worth (:func:`jik.engine.picard.picard_chain`;
     ``jik bench solver``).
 
     Parameters
@@ -501,7 +501,7 @@ def solve(
     guess : Trajectory, or a sequence of Trajectory or None (one per start), optional
         Continuous mode: the trajectory of a nearby earlier solve with the same gamma, such as
         the same leg in the previous cycle of a closed path. Picard starts its sweeps from it
-        where its nodes are those of a segment (:mod:`engine.picard`). The result is the same
+        where its nodes are those of a segment (:mod:`jik.engine.picard`). The result is the same
         to the sweep tolerance; only the work falls. It is not used by DOP853.
 
     Returns
