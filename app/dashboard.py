@@ -3,11 +3,11 @@
 The page (over ``/api/dashboard/*``) and the viser scene (through its GUI callbacks) both change
 the same :class:`Dashboard`; every change is validated against the registry, bumps a generation
 counter and wakes one worker thread. The worker solves both algorithms (the pseudoinverse (8) and
-the extended inverse (11)) leg by leg with :func:`engine.solver.solve`, so that a newer change
+the extended inverse (11)) leg by leg with :func:`jik.engine.solver.solve`, so that a newer change
 cancels a stale computation between legs, builds the figures once and pushes them to every
 subscriber (server-sent events for the page, a callback for the scene).
 
-Continuous mode integrates in tau = gamma theta (see :mod:`engine.solver`): x(theta) does not
+Continuous mode integrates in tau = gamma theta (see :mod:`jik.engine.solver`): x(theta) does not
 depend on gamma, so the worker solves at gamma = 1 and divides theta by gamma, and a gamma change
 in continuous mode only rescales the theta axis without a new integration.
 """
@@ -31,12 +31,12 @@ from typing import cast
 
 import numpy as np
 
-from engine.exceptions import InvalidInputError, JikError
-from engine.registry import ROBOTS, make_inverse, robot_spec
-from engine.repeatability import MAX_PATH_POINTS, closed_path, cycle_guesses
-from engine.solver import SolveResult, Trajectory, solve
-from engine.unicycle import Unicycle
-from engine.validation import count, positive
+from jik.engine.exceptions import InvalidInputError, JikError
+from jik.engine.registry import ROBOTS, make_inverse, robot_spec
+from jik.engine.repeatability import MAX_PATH_POINTS, closed_path, cycle_guesses
+from jik.engine.solver import SolveResult, Trajectory, solve
+from jik.engine.unicycle import Unicycle
+from jik.engine.validation import count, positive
 
 ALGORITHMS = ("pseudoinverse", "extended")
 #: One colour per algorithm, used in the scene and in every plot.
@@ -268,7 +268,7 @@ def _solve_leg(inverse, x, target, state, gamma, cancelled, partial=lambda f: No
     The discrete iteration x <- x - gamma J#(x) e(x) has no memory, so stopping after CHUNK
     iterations and restarting from the last iterate reproduces the uninterrupted sequence.
     ``guess``: continuous mode, the same leg's trajectory in the previous cycle (see
-    :func:`engine.solver.solve`). Returns (theta, x, y, error, h, success, message) of the
+    :func:`jik.engine.solver.solve`). Returns (theta, x, y, error, h, success, message) of the
     whole leg.
     """
     if state.mode == "continuous":
@@ -328,18 +328,18 @@ def _solve_leg(inverse, x, target, state, gamma, cancelled, partial=lambda f: No
 def _run_legs(
     inverse, state, targets, cycles, progress, cancelled, partial, resume=None
 ) -> AlgorithmRun:
-    """Drive ``inverse`` through the legs as :func:`engine.repeatability.repeatability` does.
+    """Drive ``inverse`` through the legs as :func:`jik.engine.repeatability.repeatability` does.
 
     ``resume``: a successful run of fewer cycles of the same legs, whose cycles are kept; the
     legs go on from its end (the same numbers as a run from the start: a leg depends only on
     where it starts and its target).
 
     In continuous mode each leg after the first cycle starts its Picard sweeps from the same leg
-    of the previous cycle (``guess`` of :func:`engine.solver.solve`): for the extended inverse,
+    of the previous cycle (``guess`` of :func:`jik.engine.solver.solve`): for the extended inverse,
     repeatable, that is the path itself and a leg then costs one or two sweeps instead of about
     eight. The pseudoinverse's legs start from guesses swept for all legs of their cycle
     together: one or two sweeps a leg instead of about ten (both:
-    :func:`engine.repeatability.cycle_guesses`).
+    :func:`jik.engine.repeatability.cycle_guesses`).
     """
     t0 = time.perf_counter()
     x0 = np.asarray(state.x0)
@@ -874,7 +874,7 @@ def error_functionals(result: DashboardResult, nodes: int = 12) -> dict | None:
     if expensive_map(grid["map"]):
         nodes = min(nodes, 6)
     try:
-        from engine.functionals import error_functional_e1, error_functional_e2
+        from jik.engine.functionals import error_functional_e1, error_functional_e2
     except ImportError:
         return None
     names = result.variable_names
@@ -915,7 +915,7 @@ def sensitivity(
     Over the same box and fixed variables as ``functionals`` (see :func:`error_functionals`):
 
     * a map with parameters (C1, C2 or a, b): ``{"kind": "parameters", "parameters": {...},
-      "E1": ..., "E2": ...}``, each from :func:`engine.functionals.parameter_sensitivity`
+      "E1": ..., "E2": ...}``, each from :func:`jik.engine.functionals.parameter_sensitivity`
       (the value, the gradient and a sweep of every parameter over v - 1 .. v + 1);
     * a map without parameters: ``{"kind": "alternatives", "maps": [{"name", "E1", "E2",
       "current"}]}``, the functionals of every map the robot offers, at their defaults;
@@ -934,7 +934,7 @@ def sensitivity(
                 "collocation problem per node: no sweep in the dashboard"}  # fmt: skip
     if functionals.get("E1") is None and functionals.get("E2") is None:
         return {"kind": "unavailable", "reason": "E1, E2 are undefined on this box"}
-    from engine.functionals import (
+    from jik.engine.functionals import (
         error_functional_e1,
         error_functional_e2,
         parameter_sensitivity,
@@ -1146,7 +1146,7 @@ class Dashboard:
 
         The page holds it while the pointer is on its controls or on the scene's GUI panel
         (``static/scene_hold.js`` tells the page), and the scene for a moment after a change
-        made in it (:data:`app.scene.EDIT_HOLD`): a playing scene keeps viser's
+        made in it (:data:`jik.app.scene.EDIT_HOLD`): a playing scene keeps viser's
         client rendering, and in software WebGL that takes over a core, which the change the
         user is about to make needs (see ``docs/benchmarks.md``, Dashboard latency).
 
@@ -1285,7 +1285,7 @@ class Dashboard:
 
         Only :data:`PREFETCH_ROBOTS`; any change cancels it between legs.
         """
-        from app.figures import PANELS
+        from jik.app.figures import PANELS
 
         for robot in PREFETCH_ROBOTS:
             state = default_state(robot)
@@ -1340,7 +1340,7 @@ class Dashboard:
         """The JSON of the panels in ``todo``, with sticky axes (keep_ranges): against the
         layout each panel last went out with, for the same robot and task. ``remember``: these
         panels go out now (a result, not one solved ahead)."""
-        from app.figures import figure_json, figure_specs, keep_ranges
+        from jik.app.figures import figure_json, figure_specs, keep_ranges
 
         layout_key = (result.state.robot, result.state.task)
         texts = {}
@@ -1358,7 +1358,7 @@ class Dashboard:
             self._cond.notify_all()
 
     def _compute(self, generation: int, state: DashboardState) -> None:
-        from app.figures import (
+        from jik.app.figures import (
             PANELS,
             augmenting_title,
             figure_json,

@@ -14,7 +14,7 @@ from fastapi import HTTPException
 from fastapi.responses import JSONResponse
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from app.service import ComputeError, RequestError, ServiceUnavailable
+from jik.app.service import ComputeError, RequestError, ServiceUnavailable
 
 log = logging.getLogger("jik.api")
 

@@ -17,17 +17,19 @@ from contextlib import asynccontextmanager
 from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
+from fastapi_offline import FastAPIOffline
 
-from app.errors import (
+from jik import __version__
+from jik.app.errors import (
     BodyLimit,
     busy_response,
     compute_error_response,
     request_error_response,
 )
-from app.fastpath import SolveFastPath
-from app.routers import dashboard, health, repeatability, robots, solve, synthesize
-from app.schemas import AUGMENTATION_MODELS, ROBOT_MODELS
-from app.service import (
+from jik.app.fastpath import SolveFastPath
+from jik.app.routers import dashboard, health, repeatability, robots, solve, synthesize
+from jik.app.schemas import AUGMENTATION_MODELS, ROBOT_MODELS
+from jik.app.service import (
     ComputeError,
     ComputePool,
     RequestError,
@@ -75,7 +77,7 @@ def _validation_detail(errors) -> list[dict]:
 
 def create_app(settings: Settings | None = None, fast_solve: bool | None = None) -> FastAPI:
     """The jik REST API. ``settings`` (default: from the environment) sizes the compute pool;
-    ``fast_solve`` serves well-formed /solve requests on a short path (:mod:`app.fastpath`;
+    ``fast_solve`` serves well-formed /solve requests on a short path (:mod:`jik.app.fastpath`;
     default on, ``JIK_FAST_SOLVE=0`` turns it off)."""
     if fast_solve is None:
         fast_solve = env_flag("JIK_FAST_SOLVE")
@@ -87,9 +89,11 @@ def create_app(settings: Settings | None = None, fast_solve: bool | None = None)
         yield
         pool.close()
 
-    app = FastAPI(
+    # /docs and /redoc with Swagger UI's and ReDoc's files from the fastapi-offline package: the
+    # API's documentation works on a machine without internet, and loads nothing from a CDN.
+    app = FastAPIOffline(
         title="jik",
-        version="0.1.0",
+        version=__version__,
         summary="Repeatable Jacobian inverse kinematics: pseudoinverse vs extended Jacobian, "
         "and synthesis of augmenting maps (Tchon, Karpinska, Janiak 2009).",
         lifespan=lifespan,

@@ -1,7 +1,7 @@
 """The dashboard's 3D scene in viser: both algorithms as mechanisms, animated, with a GUI.
 
 The scene only reads the dashboard's results and writes to scene handles; its GUI (built from
-the registry) and the draggable start point change the one :class:`~app.dashboard.Dashboard`
+the registry) and the draggable start point change the one :class:`~jik.app.dashboard.Dashboard`
 state, exactly like the page's controls. The task plane is the world XY plane (z up).
 
 Drawn mechanisms
@@ -31,10 +31,10 @@ from typing import Any, cast
 import numpy as np
 import viser
 
-import static
-from app.dashboard import ALGORITHMS, COLORS, MAX_DASHBOARD_CYCLES, Dashboard, Event, runs_key
-from engine.exceptions import InvalidInputError
-from engine.registry import ROBOTS, robot_spec
+from jik import static
+from jik.app.dashboard import ALGORITHMS, COLORS, MAX_DASHBOARD_CYCLES, Dashboard, Event, runs_key
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.registry import ROBOTS, robot_spec
 
 FPS = 25.0
 #: Seconds between a change of the controls' structure (robot, map, task, mode) and the new

@@ -1,13 +1,13 @@
 """Request and response models of the REST API (JSON, snake_case).
 
 Robot and augmentation models are generated from the engine's catalogue
-(:data:`engine.registry.ROBOTS`) when this module is imported: one model per robot with its
+(:data:`jik.engine.registry.ROBOTS`) when this module is imported: one model per robot with its
 parameters and their ranges, discriminated by ``name``, and one per augmenting map. A robot or map
 the catalogue gains appears in the API, its OpenAPI schema and the fuzz test with no change here.
 
 Pydantic checks types, ranges, finiteness (``allow_inf_nan=False``: NaN and inf are rejected) and
 size bounds. What needs the registry (vector lengths against p and r, an augmentation that belongs
-to the robot, a singular start) is checked by :mod:`app.service`, which names the field.
+to the robot, a singular start) is checked by :mod:`jik.app.service`, which names the field.
 """
 
 from __future__ import annotations
@@ -16,9 +16,9 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeAlias, Union
 
 from pydantic import BaseModel, ConfigDict, Field, create_model
 
-from app.dashboard import MAX_HOLD_SECONDS
-from engine.registry import ROBOTS, AugmentationSpec, RobotSpec
-from engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
+from jik.app.dashboard import MAX_HOLD_SECONDS
+from jik.engine.registry import ROBOTS, AugmentationSpec, RobotSpec
+from jik.engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
 
 #: Largest configuration / task dimension accepted before the registry check.
 MAX_DIMENSION = 16

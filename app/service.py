@@ -34,13 +34,13 @@ from typing import Any, TypeVar, cast
 import numpy as np
 import pydantic_core
 
-from app import schemas as S
-from engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
-from engine.functionals import error_functional_e1, error_functional_e2
-from engine.registry import ROBOTS, RobotSpec, make_inverse
-from engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS, repeatability
-from engine.solver import BatchSolveResult, solve
-from engine.variational import synthesize_e2
+from jik.app import schemas as S
+from jik.engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
+from jik.engine.functionals import error_functional_e1, error_functional_e2
+from jik.engine.registry import ROBOTS, RobotSpec, make_inverse
+from jik.engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS, repeatability
+from jik.engine.solver import BatchSolveResult, solve
+from jik.engine.variational import synthesize_e2
 
 _R = TypeVar("_R")
 
@@ -696,7 +696,11 @@ class _Worker:
         fd = child.fileno()
         env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
         self.process = subprocess.Popen(
-            [sys.executable, "-c", f"from app.service import _worker_entry; _worker_entry({fd})"],
+            [
+                sys.executable,
+                "-c",
+                f"from jik.app.service import _worker_entry; _worker_entry({fd})",
+            ],
             pass_fds=[fd],
             env=env,
             stdin=subprocess.DEVNULL,

@@ -24,7 +24,7 @@ def run_benchmarks(names: list[str] | None = None, quick: bool = False) -> int:
         print(f"unknown benchmark(s) {unknown}; available: {available()}")
         return 2
     for name in names:
-        module = importlib.import_module(f"benchmarks.bench_{name}")
+        module = importlib.import_module(f"jik.benchmarks.bench_{name}")
         print(f"== {name} ==", flush=True)
         if "quick" in inspect.signature(module.main).parameters:
             module.main(quick=quick)

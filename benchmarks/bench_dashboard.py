@@ -1,10 +1,10 @@
 """Dashboard computation: both algorithms in one thread vs the pseudoinverse offloaded.
 
 What a control change costs the server before the page and the scene can redraw:
-:func:`app.dashboard.compute` of the registry's default state (both algorithms through the
+:func:`jik.app.dashboard.compute` of the registry's default state (both algorithms through the
 closed path, h on a grid), with a fresh cache each time (a new start point). Straightforward:
 the two algorithms one after the other in the calling thread. jik serve: the pseudoinverse in a
-second process (:class:`app.dashboard.Offload`) while the thread runs the extended inverse.
+second process (:class:`jik.app.dashboard.Offload`) while the thread runs the extended inverse.
 Wall-clock medians; each offloaded run is checked to give the same configurations.
 """
 
@@ -15,7 +15,7 @@ import time
 
 import numpy as np
 
-from app.dashboard import Offload, compute, default_state, updated_state
+from jik.app.dashboard import Offload, compute, default_state, updated_state
 
 ROBOTS = ("manipulator2", "manipulator1", "unicycle")
 

@@ -24,11 +24,11 @@ from typing import cast
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from engine.augmentations import PaperCubic
-from engine.inverses import ExtendedInverse, Pseudoinverse
-from engine.kinematics import Manipulator2
-from engine.repeatability import closed_path, repeatability
-from engine.solver import ATOL, RTOL, SolveResult, chain_guesses, solve
+from jik.engine.augmentations import PaperCubic
+from jik.engine.inverses import ExtendedInverse, Pseudoinverse
+from jik.engine.kinematics import Manipulator2
+from jik.engine.repeatability import closed_path, repeatability
+from jik.engine.solver import ATOL, RTOL, SolveResult, chain_guesses, solve
 
 X0 = np.array([0.0, 0.0, math.pi / 2])
 PATH = np.array([(1.0, 1.0), (1.0, 2.0), (0.0, 2.0), (0.0, 1.0)])

@@ -1,8 +1,8 @@
 """Benchmark: the default Manipulator 2 E2 synthesis vs a straightforward implementation.
 
-jik: :func:`engine.variational.synthesize_manipulator2` (tensor Legendre degree 16, 288 unknowns,
-batched quadrature data, Ritz system assembled once by matrix products, plus the lower-degree
-convergence solves, the cubic fit and its E2).
+jik: :func:`jik.engine.variational.synthesize_manipulator2` (tensor Legendre degree 16, 288
+unknowns, batched quadrature data, Ritz system assembled once by matrix products, plus the
+lower-degree convergence solves, the cubic fit and its E2).
 Straightforward: the same Ritz problem at the same degree and quadrature, assembled point by
 point in a Python loop (kinematics, P and the outer products of the basis gradients per
 quadrature point), then one dense solve. Both must give the same E2.
@@ -18,9 +18,9 @@ from typing import TypeVar, cast
 import numpy as np
 from numpy.polynomial import legendre as L
 
-from engine.inverses import pseudoinverse
-from engine.kinematics import Manipulator2
-from engine.variational import (
+from jik.engine.inverses import pseudoinverse
+from jik.engine.kinematics import Manipulator2
+from jik.engine.variational import (
     EXTRA_NODES,
     MANIPULATOR2_DEGREE,
     MANIPULATOR2_REGION,

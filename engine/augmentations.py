@@ -13,8 +13,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from engine.exceptions import InvalidInputError
-from engine.validation import FloatArray, finite
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.validation import FloatArray, finite
 
 
 class AugmentingMap(abc.ABC):

@@ -18,11 +18,11 @@ import itertools
 
 import numpy as np
 
-from engine.augmentations import AugmentingMap
-from engine.exceptions import InvalidInputError, OneFormUndefinedError, format_vector
-from engine.kinematics import SINGULAR_MANIPULABILITY, Kinematics, kernel_cofactors
-from engine.unicycle import Unicycle
-from engine.validation import FloatArray, as_vector, count, finite
+from jik.engine.augmentations import AugmentingMap
+from jik.engine.exceptions import InvalidInputError, OneFormUndefinedError, format_vector
+from jik.engine.kinematics import SINGULAR_MANIPULABILITY, Kinematics, kernel_cofactors
+from jik.engine.unicycle import Unicycle
+from jik.engine.validation import FloatArray, as_vector, count, finite
 
 #: |kernel component fixed_index| <= ONE_FORM_TOL |kernel| counts as "omega undefined" (so does a
 #: kinematic singularity, |kernel cofactors| = m(x) < SINGULAR_MANIPULABILITY).
@@ -72,7 +72,8 @@ def _contract(E: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
 
 
 def cofactors(J: FloatArray) -> FloatArray:
-    """Kernel cofactor vector of J (..., r, r + 1), as :func:`engine.kinematics.kernel_cofactors`.
+    """Kernel cofactor vector of J (..., r, r + 1), as
+    :func:`jik.engine.kinematics.kernel_cofactors`.
 
     For r = 3, c_i = -eps_ijkl J_1j J_2k J_3l (Levi-Civita), a few einsum calls instead of
     batched determinants; other sizes fall back to the generic determinant formula.

@@ -18,9 +18,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from engine.augmentations import AugmentingMap
-from engine.exceptions import InvalidInputError
-from engine.inverses import (
+from jik.engine.augmentations import AugmentingMap
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.inverses import (
     SINGULAR_EXTENDED,
     extended_inverse,
     extended_jacobian,
@@ -28,8 +28,8 @@ from engine.inverses import (
     pseudoinverse,
     require_compatible,
 )
-from engine.kinematics import Kinematics
-from engine.validation import FloatArray, count, finite
+from jik.engine.kinematics import Kinematics
+from jik.engine.validation import FloatArray, count, finite
 
 # name -> (lo, hi); any two-item sequence (JSON gives lists), validated by check_region.
 Region = Mapping[str, Sequence[float]]

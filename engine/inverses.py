@@ -11,15 +11,15 @@ import abc
 
 import numpy as np
 
-from engine.augmentations import AugmentingMap
-from engine.exceptions import (
+from jik.engine.augmentations import AugmentingMap
+from jik.engine.exceptions import (
     AlgorithmicSingularityError,
     InvalidInputError,
     KinematicSingularityError,
 )
-from engine.kinematics import SINGULAR_MANIPULABILITY, Kinematics
-from engine.linalg import gram, solve_small
-from engine.validation import FloatArray
+from jik.engine.kinematics import SINGULAR_MANIPULABILITY, Kinematics
+from jik.engine.linalg import gram, solve_small
+from jik.engine.validation import FloatArray
 
 #: |det [J; dh]| / (product of its row norms) below this counts as an algorithmic singularity.
 SINGULAR_EXTENDED = 1e-10

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from engine.validation import FloatArray
+from jik.engine.validation import FloatArray
 
 
 def gram(J: FloatArray) -> FloatArray:

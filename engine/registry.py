@@ -11,15 +11,15 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Literal
 
-from engine import augmentations as aug
-from engine.augmentations import AugmentingMap
-from engine.characteristics import UnicycleCharacteristics
-from engine.exceptions import InvalidInputError
-from engine.inverses import ExtendedInverse, Inverse, Pseudoinverse
-from engine.kinematics import Kinematics, Manipulator1, Manipulator2
-from engine.unicycle import Unicycle
-from engine.validation import finite
-from engine.variational import MANIPULATOR2_REGION, default_manipulator2_synthesis
+from jik.engine import augmentations as aug
+from jik.engine.augmentations import AugmentingMap
+from jik.engine.characteristics import UnicycleCharacteristics
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.inverses import ExtendedInverse, Inverse, Pseudoinverse
+from jik.engine.kinematics import Kinematics, Manipulator1, Manipulator2
+from jik.engine.unicycle import Unicycle
+from jik.engine.validation import finite
+from jik.engine.variational import MANIPULATOR2_REGION, default_manipulator2_synthesis
 
 
 @dataclass(frozen=True)

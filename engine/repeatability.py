@@ -11,11 +11,11 @@ from typing import cast
 
 import numpy as np
 
-from engine.exceptions import InvalidInputError
-from engine.inverses import Inverse
-from engine.solver import BatchSolveResult, SolveResult, Trajectory, chain_guesses, solve
-from engine.unicycle import Unicycle
-from engine.validation import FloatArray, count
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.inverses import Inverse
+from jik.engine.solver import BatchSolveResult, SolveResult, Trajectory, chain_guesses, solve
+from jik.engine.unicycle import Unicycle
+from jik.engine.validation import FloatArray, count
 
 #: Largest number of cycles and of path points accepted.
 MAX_CYCLES = 1000
@@ -70,12 +70,12 @@ def cycle_guesses(
     inverse: Inverse, start, targets, guides: list[Trajectory | None], gamma: float = 1.0
 ) -> list[Trajectory | None]:
     """Picard guesses for one cycle's legs of a closed path from ``start`` (continuous mode,
-    one start): the ``guess`` of each leg's :func:`engine.solver.solve`, eq. (7).
+    one start): the ``guess`` of each leg's :func:`jik.engine.solver.solve`, eq. (7).
 
     The extended inverse is repeatable: a leg repeats the same leg of the cycle before, so
     ``guides`` (those legs' trajectories, None in the first cycle) are its guesses, and a leg
     then takes one or two sweeps. The pseudoinverse drifts, so the cycle before saves almost
-    nothing: its legs are swept together from ``start`` (:func:`engine.solver.chain_guesses`),
+    nothing: its legs are swept together from ``start`` (:func:`jik.engine.solver.chain_guesses`),
     one or two sweeps a leg instead of about ten, and a cycle's numbers depend only on its
     start. A chain evaluates J# about three times as often as the legs would, so it pays only
     where an evaluation costs little beyond numpy's per-call overhead: not for the unicycle.
@@ -115,7 +115,7 @@ def repeatability(
     cycles : int
         1 to 1000.
     gamma, mode, tol, max_iterations
-        As in :func:`engine.solver.solve`.
+        As in :func:`jik.engine.solver.solve`.
     record : bool
         Keep every leg's trajectory (single start only).
 

@@ -35,12 +35,12 @@ import numpy as np
 from numpy.polynomial import legendre as L
 from scipy import linalg
 
-from engine.augmentations import AugmentingMap, Polynomial2
-from engine.exceptions import InvalidInputError
-from engine.functionals import Region, check_region, error_functional_e2
-from engine.inverses import pseudoinverse
-from engine.kinematics import Kinematics, Manipulator2
-from engine.validation import FloatArray, count
+from jik.engine.augmentations import AugmentingMap, Polynomial2
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.functionals import Region, check_region, error_functional_e2
+from jik.engine.inverses import pseudoinverse
+from jik.engine.kinematics import Kinematics, Manipulator2
+from jik.engine.validation import FloatArray, count
 
 #: Extra Gauss points per variable beyond the basis degree (R is not polynomial, e.g. cos 2 x3).
 EXTRA_NODES = 8

@@ -1,4 +1,9 @@
-"""The ``jik`` command: ``jik serve``, ``jik reproduce NAME [--json]``, ``jik bench [NAME]``."""
+"""The ``jik`` command (also ``python -m jik``): ``jik serve``, ``jik reproduce NAME [--json]``,
+``jik bench [NAME]``.
+
+Only ``serve`` needs the web parts (the ``jik[app]`` extra); the others run on the engine alone,
+so this module imports nothing of :mod:`jik.app` until ``serve`` asks for it.
+"""
 
 from __future__ import annotations
 
@@ -9,13 +14,19 @@ import signal
 import sys
 from typing import Any
 
-#: Reproductions: name -> module in engine.reproductions with run() and format_text().
+#: Reproductions: name -> module in jik.engine.reproductions with run() and format_text().
 REPRODUCTIONS = {
     "table1": "Table 1: repeatability of Manipulator 2, pseudoinverse vs extended (38)",
     "manipulator1": "Manipulator 1: E1 and E2 of (32), (33), (36) and the symbolic checks",
     "manipulator2": "Manipulator 2: E2 synthesis, cubic fit, Table 1 with e2_synthesized",
     "unicycle": "Unicycle, section 6.2: runs from A and B with both inverses",
 }
+
+
+#: The top-level modules of the ``jik[app]`` extra (a benchmark of the web parts needs them).
+WEB_PACKAGES = frozenset(
+    {"fastapi", "fastapi_offline", "starlette", "uvicorn", "viser", "plotly", "httpx"}
+)
 
 
 def _progress(fraction: float) -> None:
@@ -26,7 +37,7 @@ def _progress(fraction: float) -> None:
 
 
 def reproduce(args: argparse.Namespace) -> int:
-    module = importlib.import_module(f"engine.reproductions.{args.name}")
+    module = importlib.import_module(f"jik.engine.reproductions.{args.name}")
     kwargs: dict[str, Any] = {}
     if args.name == "table1" and args.printed_gradient:
         kwargs["printed_gradient"] = True
@@ -40,23 +51,53 @@ def reproduce(args: argparse.Namespace) -> int:
     return 0
 
 
-def serve(args: argparse.Namespace) -> int:
-    from app.server import run_server
+#: What installs the web parts, for the message of a command that needs them.
+APP_EXTRA_HINT = "pip install 'jik[app]'"
 
-    run_server(host=args.host, port=args.port, scene_port=args.scene_port)
+
+def missing_app_extra(error: ModuleNotFoundError) -> int:
+    """Say which command installs the web parts that ``error`` found missing; exit code 2.
+
+    Re-raises an error about any other module: that is a fault, not a missing extra.
+    """
+    if not error.name or error.name.split(".")[0] not in WEB_PACKAGES:
+        raise error
+    sys.stderr.write(
+        f"jik: this command needs the web parts of jik, and {error.name!r} is not installed.\n"
+        f"Install them with:  {APP_EXTRA_HINT}\n"
+    )
+    return 2
+
+
+def serve(args: argparse.Namespace) -> int:
+    try:
+        from jik.app.server import PortInUse, run_server
+    except ModuleNotFoundError as error:
+        return missing_app_extra(error)
+    try:
+        run_server(host=args.host, port=args.port, scene_port=args.scene_port)
+    except PortInUse as busy:
+        sys.stderr.write(f"jik serve: {busy}\n")
+        return 2
     return 0
 
 
 def bench(args: argparse.Namespace) -> int:
-    from benchmarks import run_benchmarks
+    from jik.benchmarks import run_benchmarks
 
-    return run_benchmarks(args.names, quick=args.quick)
+    try:
+        return run_benchmarks(args.names, quick=args.quick)
+    except ModuleNotFoundError as error:
+        return missing_app_extra(error)
 
 
 def main(argv: list[str] | None = None) -> int:
+    from jik import __version__
+
     parser = argparse.ArgumentParser(
         prog="jik", description="jik: a lab for repeatable Jacobian inverse kinematics"
     )
+    parser.add_argument("--version", action="version", version=f"jik {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("serve", help="start the REST API and the dashboard")

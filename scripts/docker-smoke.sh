@@ -3,8 +3,10 @@
 #   1. debootstrap a minimal bookworm rootfs with Python 3.11 and import it as the base image
 #      localhost/python:3.11-slim (skipped when that image already exists);
 #   2. buildah bud --isolation chroot --build-arg BASE=localhost/python:3.11-slim -t jik .
-#   3. start `jik serve` inside a working container (buildah run --isolation chroot) and fetch
-#      /health from inside it.
+#   3. inside a working container (buildah run --isolation chroot), as the image's user: run
+#      `jik reproduce table1`, start `jik serve`, fetch /health, /robots, /solve and /docs, wait
+#      for the dashboard's first result over HTTP, and stop the server with SIGTERM (what
+#      `docker stop` sends), checking that it exits cleanly.
 # Usage: scripts/docker-smoke.sh [IMAGE]   (default IMAGE=localhost/jik:smoke)
 #   JIK_SMOKE_REBUILD_BASE=1 rebuilds the base image; JIK_SMOKE_BASE_ONLY=1 stops after it.
 # Not run in CI (slow); CI only lints the Dockerfile (tests/app/test_docker.py).
@@ -74,7 +76,7 @@ buildah inspect --type image --format \
   'user={{.OCIv1.Config.User}} ports={{.OCIv1.Config.ExposedPorts}} cmd={{.OCIv1.Config.Cmd}}' \
   "$IMAGE"
 
-step "serve and GET /health inside the container"
+step "reproduce table1, serve, and query the dashboard inside the container"
 CTR=$(buildah from "$IMAGE")
 trap 'buildah rm "$CTR" >/dev/null 2>&1 || true' EXIT
 PORT=${JIK_SMOKE_PORT:-18000}
@@ -83,6 +85,7 @@ SCENE=${JIK_SMOKE_SCENE_PORT:-18080}
 # clashes with servers already running on the host. The image's user (10001) runs the server.
 buildah run --isolation chroot --user 10001:10001 "$CTR" -- sh -c "
   id
+  jik reproduce table1 || exit 1
   jik serve --host 127.0.0.1 --port $PORT --scene-port $SCENE >/tmp/serve.log 2>&1 &
   pid=\$!
   python - <<PY
@@ -102,7 +105,19 @@ for _ in range(120):
             body = json.load(r)
             print('POST /solve ->', r.status, 'x =', [round(v, 4) for v in body['x']],
                   'converged =', body['converged'])
-        sys.exit(0)
+        with urllib.request.urlopen('http://127.0.0.1:$PORT/docs', timeout=10) as r:
+            page = r.read().decode()
+            print('GET /docs ->', r.status, 'cdn' not in page.lower() and 'assets served locally')
+        for _ in range(240):
+            with urllib.request.urlopen('http://127.0.0.1:$PORT/api/dashboard/state',
+                                        timeout=10) as r:
+                snapshot = json.load(r)
+            if snapshot.get('summary'):
+                print('dashboard: first result', json.dumps(snapshot['summary'])[:300])
+                sys.exit(0)
+            time.sleep(0.5)
+        print('dashboard computed no result')
+        sys.exit(1)
     except OSError:
         time.sleep(0.5)
 print('server did not answer; log:')
@@ -110,7 +125,12 @@ print(open('/tmp/serve.log').read())
 sys.exit(1)
 PY
   rc=\$?
-  kill \$pid
+  kill -TERM \$pid
+  wait \$pid
+  stopped=\$?
+  echo \"jik serve exited \$stopped after SIGTERM\"
+  if grep -qE 'resource_tracker|Traceback' /tmp/serve.log; then cat /tmp/serve.log; exit 1; fi
+  [ \$stopped -eq 0 ] || { cat /tmp/serve.log; exit 1; }
   exit \$rc
 "
 step "smoke test passed"

@@ -18,15 +18,15 @@ def central_difference(f, x: np.ndarray, eps: float = 1e-6) -> np.ndarray:
 def count_picard_sweeps(monkeypatch) -> list[int]:
     """Record the sweeps of the first member of every Picard call the solver makes from now on
     (``engine.solver.picard_path`` wrapped for the test)."""
-    import engine.solver
+    from jik.engine import solver as engine_solver
 
     sweeps: list[int] = []
-    picard = engine.solver.picard_path
+    picard = engine_solver.picard_path
 
     def counted(*args, **kwargs):
         out = picard(*args, **kwargs)
         sweeps.append(int(out[3][0]))
         return out
 
-    monkeypatch.setattr(engine.solver, "picard_path", counted)
+    monkeypatch.setattr(engine_solver, "picard_path", counted)
     return sweeps

@@ -1,5 +1,6 @@
-"""What the shipped code imports is installed by ``pip install .`` alone (no test extras): the
-README's first command, then ``jik serve``, ``jik reproduce`` or ``jik bench``."""
+"""What the shipped code imports is installed by its own install line: the engine (and the ``jik``
+command's root package) by ``pip install jik`` alone, the web parts and benchmarks by
+``pip install 'jik[app]'``."""
 
 import ast
 import re
@@ -8,10 +9,12 @@ import tomllib
 from importlib import metadata
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
-#: The top-level packages that ``pip install .`` ships.
-SHIPPED = sorted({p.split(".")[0] for p in PYPROJECT["tool"]["setuptools"]["packages"]})
+#: Source folder -> the extra its imports may come from (None: the plain install).
+EXTRA_OF = {"jik": None, "engine": None, "app": "app", "static": "app", "benchmarks": "app"}
 
 
 def _name(requirement: str) -> str:
@@ -20,9 +23,24 @@ def _name(requirement: str) -> str:
     return re.sub(r"[-_.]+", "-", match[0]).lower()
 
 
-def _runtime_distributions() -> set[str]:
+def _linked_folders() -> set[str]:
+    """``jik`` and the top-level folders that jik/ links in as its subpackages."""
+    links = {p for p in (ROOT / "jik").iterdir() if p.is_symlink()}
+    for link in links:
+        assert link.resolve() == ROOT / link.name, f"jik/{link.name} must link to ../{link.name}"
+    return {"jik", *(link.name for link in links)}
+
+
+def _declared(extra: str | None) -> list[str]:
+    requirements = list(PYPROJECT["project"]["dependencies"])
+    if extra:
+        requirements += PYPROJECT["project"]["optional-dependencies"][extra]
+    return [r for r in requirements if not r.startswith("jik")]
+
+
+def _runtime_distributions(extra: str | None) -> set[str]:
     """The declared dependencies and, installed here, everything they require (no extras)."""
-    todo, seen = [_name(r) for r in PYPROJECT["project"]["dependencies"]], set()
+    todo, seen = [_name(r) for r in _declared(extra)], set()
     while todo:
         name = todo.pop()
         if name in seen:
@@ -36,33 +54,45 @@ def _runtime_distributions() -> set[str]:
     return seen
 
 
-def _third_party_imports() -> dict[str, str]:
-    """Top-level modules imported by the shipped packages -> a file that imports it."""
+def _third_party_imports(folder: str) -> dict[str, str]:
+    """Top-level modules imported by the code in ``folder`` -> a file that imports it."""
     found: dict[str, str] = {}
-    for package in SHIPPED:
-        for path in sorted((ROOT / package).rglob("*.py")):
-            for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-                if isinstance(node, ast.Import):
-                    names = [alias.name for alias in node.names]
-                elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
-                    names = [node.module]
-                else:
-                    continue
-                for top in {n.split(".")[0] for n in names}:
-                    if top not in sys.stdlib_module_names and top not in SHIPPED:
-                        found.setdefault(top, str(path.relative_to(ROOT)))
+    for path in sorted((ROOT / folder).rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                names = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                names = [node.module]
+            else:
+                continue
+            for top in {n.split(".")[0] for n in names}:
+                if top not in sys.stdlib_module_names and top != "jik":
+                    found.setdefault(top, str(path.relative_to(ROOT)))
     return found
 
 
-def test_shipped_code_imports_only_runtime_dependencies():
-    runtime = _runtime_distributions()
+def test_every_installed_folder_has_a_declared_extra():
+    assert _linked_folders() == set(EXTRA_OF)
+
+
+def test_packages_are_discovered_not_listed():
+    """setuptools finds jik and every subpackage: a new one cannot be left out of the wheel."""
+    setuptools = PYPROJECT["tool"]["setuptools"]
+    assert setuptools["packages"]["find"]["include"] == ["jik", "jik.*"]
+
+
+@pytest.mark.parametrize("folder", sorted(EXTRA_OF))
+def test_shipped_code_imports_only_its_install_lines_dependencies(folder):
+    extra = EXTRA_OF[folder]
+    runtime = _runtime_distributions(extra)
     providers = metadata.packages_distributions()
     missing = {
         module: where
-        for module, where in _third_party_imports().items()
+        for module, where in _third_party_imports(folder).items()
         if not {_name(d) for d in providers.get(module, [module])} & runtime
     }
+    line = "pip install jik" + (f"[{extra}]" if extra else "")
     assert not missing, (
-        f"imported by shipped code but not installed by `pip install .`: {missing}; "
-        "add them to [project] dependencies in pyproject.toml"
+        f"imported by {folder}/ but not installed by `{line}`: {missing}; "
+        "declare them in pyproject.toml (or move the import to the web parts)"
     )

@@ -21,8 +21,8 @@ from fastapi.responses import (
     StreamingResponse,
 )
 
-import static
-from app.dashboard import (
+from jik import static
+from jik.app.dashboard import (
     COLORS,
     LABELS,
     MAX_DASHBOARD_CYCLES,
@@ -31,8 +31,8 @@ from app.dashboard import (
     export_csv,
     export_json,
 )
-from app.schemas import HoldRequest, HoldResponse
-from engine.exceptions import InvalidInputError
+from jik.app.schemas import HoldRequest, HoldResponse
+from jik.engine.exceptions import InvalidInputError
 
 router = APIRouter(tags=["dashboard"])
 
@@ -96,7 +96,7 @@ async def get_state(request: Request) -> dict:
 async def post_state(request: Request) -> JSONResponse:
     """Change some controls: ``{"gamma": 2}``, ``{"x0": [...]}``, ``{"robot": "manipulator1"}``.
 
-    The body is a partial :class:`~app.dashboard.DashboardState`; the answer is the new
+    The body is a partial :class:`~jik.app.dashboard.DashboardState`; the answer is the new
     generation and state (422 with the engine's message for a value it refuses).
     """
     try:
@@ -117,7 +117,7 @@ async def post_hold(body: HoldRequest, request: Request) -> HoldResponse | JSONR
     """Hold the 3D scene's animation still for ``seconds`` (0 ends the hold).
 
     The page holds it while the pointer is on its controls, so that a change is computed and
-    drawn without the scene's frames taking the CPU (see :meth:`app.dashboard.Dashboard.hold`).
+    drawn without the scene's frames taking the CPU (see :meth:`jik.app.dashboard.Dashboard.hold`).
     """
     try:
         held = dashboard_for(request.app).hold(body.holder, body.seconds)

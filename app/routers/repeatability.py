@@ -2,8 +2,8 @@
 
 from fastapi import APIRouter, Request, Response
 
-from app.schemas import BUSY, RepeatabilityRequest, RepeatabilityResponse
-from app.service import precheck
+from jik.app.schemas import BUSY, RepeatabilityRequest, RepeatabilityResponse
+from jik.app.service import precheck
 
 router = APIRouter(tags=["repeatability"])
 

@@ -2,8 +2,8 @@
 
 from fastapi import APIRouter, Request
 
-from app.schemas import RobotsResponse
-from app.service import robots_response
+from jik.app.schemas import RobotsResponse
+from jik.app.service import robots_response
 
 router = APIRouter(tags=["robots"])
 

@@ -2,13 +2,13 @@
 
 from fastapi import APIRouter, Request, Response
 
-from app.schemas import (
+from jik.app.schemas import (
     BUSY,
     SynthesisMethodsResponse,
     SynthesizeRequest,
     SynthesizeResponse,
 )
-from app.service import precheck, synthesis_methods
+from jik.app.service import precheck, synthesis_methods
 
 router = APIRouter(tags=["synthesize"])
 

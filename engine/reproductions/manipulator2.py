@@ -13,14 +13,14 @@ from collections.abc import Callable
 
 import numpy as np
 
-from engine.augmentations import PaperCubic
-from engine.functionals import error_functional_e2
-from engine.inverses import ExtendedInverse, Pseudoinverse
-from engine.kinematics import Manipulator2
-from engine.reproductions.table1 import cell
-from engine.reproductions.table1 import rows as table1_rows
-from engine.symbolic import findings_summary, manipulator2_findings
-from engine.variational import (
+from jik.engine.augmentations import PaperCubic
+from jik.engine.functionals import error_functional_e2
+from jik.engine.inverses import ExtendedInverse, Pseudoinverse
+from jik.engine.kinematics import Manipulator2
+from jik.engine.reproductions.table1 import cell
+from jik.engine.reproductions.table1 import rows as table1_rows
+from jik.engine.symbolic import findings_summary, manipulator2_findings
+from jik.engine.variational import (
     MANIPULATOR2_DEGREE,
     MANIPULATOR2_REGION,
     synthesize_e2,

@@ -2,7 +2,7 @@
 
 The discrete algorithm (7), lambda <- lambda - gamma J#(lambda) (k(lambda) - y_d), runs with the
 pseudoinverse (44) and the extended inverse (47) built from the characteristics map of section
-6.1 (:class:`~engine.characteristics.UnicycleCharacteristics`, a = 1). The continuous algorithm
+6.1 (:class:`~jik.engine.characteristics.UnicycleCharacteristics`, a = 1). The continuous algorithm
 is run as well, to show that h is conserved there (eq. (12)) and not by finite steps.
 
 Stopping: ||k(lambda) - y_d|| < TOL = 1e-10. The kinematics is accurate to ~1e-12 (quadrature vs
@@ -23,11 +23,11 @@ from typing import cast
 
 import numpy as np
 
-from engine.characteristics import UnicycleCharacteristics
-from engine.exceptions import JikError
-from engine.inverses import ExtendedInverse, Pseudoinverse
-from engine.solver import SolveResult, solve
-from engine.unicycle import Unicycle
+from jik.engine.characteristics import UnicycleCharacteristics
+from jik.engine.exceptions import JikError
+from jik.engine.inverses import ExtendedInverse, Pseudoinverse
+from jik.engine.solver import SolveResult, solve
+from jik.engine.unicycle import Unicycle
 
 STARTS = {"A": (5.0, 0.0, math.pi / 2), "B": (-5.0, 5.0, math.pi / 2)}
 LAMBDA0 = (0.5, -0.25, 0.3, -0.25)

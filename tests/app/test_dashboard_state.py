@@ -9,7 +9,7 @@ import time
 import numpy as np
 import pytest
 
-from app.dashboard import (
+from jik.app.dashboard import (
     ALGORITHMS,
     SECOND_PHASE_DELAY,
     Cancelled,
@@ -23,10 +23,10 @@ from app.dashboard import (
     runs_key,
     updated_state,
 )
-from engine.exceptions import InvalidInputError
-from engine.registry import ROBOTS, make_inverse, robot_spec
-from engine.repeatability import repeatability
-from engine.solver import solve
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.registry import ROBOTS, make_inverse, robot_spec
+from jik.engine.repeatability import repeatability
+from jik.engine.solver import solve
 from tests.helpers import count_picard_sweeps
 
 
@@ -94,7 +94,7 @@ def test_later_cycles_start_from_the_previous_cycle_and_agree_with_a_cold_start(
     engine.picard): the extended inverse, repeatable, then takes one or two sweeps a leg. The
     pseudoinverse's legs are guessed by a chain of all its legs (engine.solver.chain_guesses):
     one or two sweeps a leg too. Both give the numbers of a cold start."""
-    import engine.solver
+    from jik.engine import solver as engine_solver
 
     state = default_state("manipulator2")
     sweeps = count_picard_sweeps(monkeypatch)
@@ -104,7 +104,7 @@ def test_later_cycles_start_from_the_previous_cycle_and_agree_with_a_cold_start(
     first, later = per_run["extended"][:L], per_run["extended"][L:]
     assert sum(first) >= 20 and max(later) <= 2, per_run  # (cold: 13, 2, 13, 2)
     assert max(per_run["pseudoinverse"]) <= 2, per_run  # (cold: 8 to 12 a leg)
-    monkeypatch.setattr(engine.solver, "_guesses", lambda *args: None)
+    monkeypatch.setattr(engine_solver, "_guesses", lambda *args: None)
     cold = compute(state)
     for a in ALGORITHMS:
         np.testing.assert_allclose(warm.runs[a].leg_end, cold.runs[a].leg_end, atol=1e-12)
@@ -272,9 +272,9 @@ def test_functionals_are_keyed_by_the_map_and_the_variables_held_fixed():
 def test_inert_variables_are_those_j_h_and_dh_ignore():
     """Shifting x_k must leave J, h and dh unchanged; a map with a constant dh/dx_k still
     depends on x_k through its value."""
-    from app.dashboard import inert_variables
-    from engine.augmentations import E2Optimal, PaperCubic, Polynomial2
-    from engine.kinematics import Manipulator1, Manipulator2
+    from jik.app.dashboard import inert_variables
+    from jik.engine.augmentations import E2Optimal, PaperCubic, Polynomial2
+    from jik.engine.kinematics import Manipulator1, Manipulator2
 
     box = ((-2.0, 2.0), (-2.0, 2.0), (0.0, 3.0))
     m2 = Manipulator2()
@@ -295,7 +295,7 @@ def test_inert_variables_are_those_j_h_and_dh_ignore():
 def test_the_h_panel_names_only_the_fixed_variables_h_depends_on():
     """Manipulator 2's h(x2, x3) is drawn over (x2, x3): its title does not name x1, so a
     change of x1 leaves the title (and the E1/E2 in it) as they are."""
-    from app.figures import augmenting_title
+    from jik.app.figures import augmenting_title
 
     state = default_state("manipulator2")
     a = compute(state)
@@ -352,7 +352,7 @@ def test_known_functionals_are_drawn_with_the_first_result():
 def test_the_start_point_gizmo_round_trips(robot, x0):
     """Dragging the gizmo to where it already is leaves the start point unchanged, exactly: a
     press on the gizmo is no change (the dashboard would solve both runs again)."""
-    from app.scene import gizmo_pose, quaternion_yaw, start_from_gizmo, yaw_quaternion
+    from jik.app.scene import gizmo_pose, quaternion_yaw, start_from_gizmo, yaw_quaternion
 
     state = default_state(robot)
     if x0 is not None:
@@ -364,7 +364,7 @@ def test_the_start_point_gizmo_round_trips(robot, x0):
 
 
 def test_manipulator2_gizmo_moves_the_carriage():
-    from app.scene import start_from_gizmo
+    from jik.app.scene import start_from_gizmo
 
     state = default_state("manipulator2")
     patch = start_from_gizmo("manipulator2", (0.4, 0.25), np.pi / 2 + 0.1, state)
@@ -372,7 +372,7 @@ def test_manipulator2_gizmo_moves_the_carriage():
 
 
 def test_animation_timeline_ends_at_the_last_configuration():
-    from app.scene import Timeline
+    from jik.app.scene import Timeline
 
     result = compute(updated_state(default_state("manipulator2"), {"cycles": 1}))
     timeline = Timeline(result)
@@ -387,7 +387,7 @@ def test_page_static_files_and_state_api():
     """The page, plotly.js from the plotly package, and the state endpoints over HTTP."""
     from fastapi.testclient import TestClient
 
-    from app.main import create_app
+    from jik.app.main import create_app
 
     app = create_app()
     client = TestClient(app)  # no lifespan: the dashboard does not use the compute pool
@@ -431,8 +431,8 @@ def test_the_hold_api_keeps_one_hold_per_holder_and_refuses_bad_values():
     """POST /api/dashboard/hold: each holder has one hold, which ends by itself or with 0."""
     from fastapi.testclient import TestClient
 
-    from app.dashboard import MAX_HOLD_SECONDS, MAX_HOLDERS
-    from app.main import create_app
+    from jik.app.dashboard import MAX_HOLD_SECONDS, MAX_HOLDERS
+    from jik.app.main import create_app
 
     app = create_app()
     client = TestClient(app)
@@ -480,7 +480,7 @@ def test_a_hold_stills_the_playing_scene_until_it_ends():
     frames and shows a new result at its end; when the hold ends, it plays on from there."""
     import socket
 
-    from app.scene import DashboardScene
+    from jik.app.scene import DashboardScene
 
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -520,7 +520,7 @@ def test_a_hold_stills_the_playing_scene_until_it_ends():
         assert scene.playing
         # Every viser client, those connecting later too, runs the script that tells the page
         # when the pointer is on the scene's GUI panel (the browser test uses it).
-        from app.scene import CLIENT_SCRIPT
+        from jik.app.scene import CLIENT_SCRIPT
 
         buffer = scene.server._websock_server._broadcast_buffer.message_from_id.values()
         scripts = [m.source for m in buffer if type(m).__name__ == "RunJavascriptMessage"]
@@ -537,8 +537,8 @@ def test_the_scene_draws_a_result_after_the_page_only_while_a_browser_shows_it(m
     import socket
     from types import SimpleNamespace
 
-    import app.scene as scene_module
-    from app.scene import SCENE_DELAY, DashboardScene
+    from jik.app import scene as scene_module
+    from jik.app.scene import SCENE_DELAY, DashboardScene
 
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -576,7 +576,7 @@ def test_viser_gui_and_drag_change_the_one_state():
     import time
     from types import SimpleNamespace
 
-    from app.scene import CONTROLS_DELAY, DRAG_INTERVAL, DashboardScene, yaw_quaternion
+    from jik.app.scene import CONTROLS_DELAY, DRAG_INTERVAL, DashboardScene, yaw_quaternion
 
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -673,7 +673,7 @@ def test_scene_follows_a_new_result_in_place():
     start-point gizmo moves with the drawing."""
     import socket
 
-    from app.scene import TRACE_TOLERANCE, DashboardScene, _extent, _polyline, gizmo_pose
+    from jik.app.scene import TRACE_TOLERANCE, DashboardScene, _extent, _polyline, gizmo_pose
 
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -753,7 +753,7 @@ def _distance_to_polyline(points: np.ndarray, line: np.ndarray) -> np.ndarray:
 def test_scene_traces_stay_within_their_tolerance(robot):
     """The scene draws each path with far fewer segments, never farther than the tolerance from
     any computed point; the ends are kept."""
-    from app.scene import TRACE_TOLERANCE, _extent, simplify
+    from jik.app.scene import TRACE_TOLERANCE, _extent, simplify
 
     result = compute(default_state(robot))
     (xlo, xhi), (ylo, yhi) = _extent(result)
@@ -773,7 +773,7 @@ def test_scene_traces_stay_within_their_tolerance(robot):
 def test_offloaded_computation_is_the_same_and_can_be_cancelled():
     """The second process computes the pseudoinverse exactly as the thread does; a newer
     generation cancels it; if it dies, the run is redone here and a new process serves."""
-    from app.dashboard import Offload
+    from jik.app.dashboard import Offload
 
     offload = Offload()
     try:
@@ -821,7 +821,7 @@ def test_offload_process_leaves_with_a_killed_server(tmp_path):
 
     script = (
         "import time\n"
-        "from app.dashboard import Offload, compute, default_state\n"
+        "from jik.app.dashboard import Offload, compute, default_state\n"
         "if __name__ == '__main__':\n"
         "    offload = Offload()\n"
         "    compute(default_state('manipulator2'), offload=offload)\n"

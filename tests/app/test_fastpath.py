@@ -7,9 +7,9 @@ import json
 import pytest
 from fastapi.testclient import TestClient
 
-from app.fastpath import SolveFastPath
-from app.main import create_app
-from app.service import Settings
+from jik.app.fastpath import SolveFastPath
+from jik.app.main import create_app
+from jik.app.service import Settings
 from tests.app.conftest import solve_body
 
 JSON = {"content-type": "application/json"}

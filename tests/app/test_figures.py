@@ -9,7 +9,7 @@ import numpy as np
 import plotly.graph_objects as go
 import pytest
 
-from app.dashboard import (
+from jik.app.dashboard import (
     COLORS,
     LABELS,
     compute,
@@ -18,7 +18,7 @@ from app.dashboard import (
     sensitivity,
     updated_state,
 )
-from app.figures import (
+from jik.app.figures import (
     augmenting_figure,
     drift_figure,
     figure_json,
@@ -31,7 +31,7 @@ from app.figures import (
     table_figure,
     task_space_figure,
 )
-from engine.registry import ROBOTS
+from jik.engine.registry import ROBOTS
 
 
 @pytest.fixture(scope="module")
@@ -258,8 +258,8 @@ def test_functionals_use_the_design_region_and_rank_the_synthesized_map_first(pa
     """E1/E2 are taken on the paper's box for Manipulator 2 (x2 in [-1, 1], x3 in [0, pi]),
     the values of `jik reproduce manipulator2`, whatever the start point; there the synthesized
     map beats the printed cubic (38) by far."""
-    from engine.functionals import error_functional_e2
-    from engine.registry import robot_spec
+    from jik.engine.functionals import error_functional_e2
+    from jik.engine.registry import robot_spec
 
     functionals = error_functionals(path_result)
     region = robot_spec("manipulator2").functional_region

@@ -14,9 +14,9 @@ import schemathesis
 from hypothesis import HealthCheck, settings
 from schemathesis.checks import not_a_server_error, response_schema_conformance
 
-from app.main import create_app
-from app.service import Settings
-from engine.registry import ROBOTS
+from jik.app.main import create_app
+from jik.app.service import Settings
+from jik.engine.registry import ROBOTS
 
 APP = create_app(Settings(workers=2, timeout=3.0))
 # Only this module's operations: other routers (the dashboard) are tested by their owners.

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from engine.registry import ROBOTS
+from jik.engine.registry import ROBOTS
 
 
 def test_health(api):

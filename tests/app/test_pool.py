@@ -12,7 +12,7 @@ from multiprocessing.connection import Connection
 import numpy as np
 import pytest
 
-from app.service import ComputePool, Settings, _frame
+from jik.app.service import ComputePool, Settings, _frame
 
 LOOPS = ["asyncio"] + (["uvloop"] if importlib.util.find_spec("uvloop") else [])
 
@@ -88,7 +88,7 @@ def test_frame_headers():
 def test_a_cancelled_request_gives_its_worker_back_after_the_reply():
     """A request cancelled mid-computation (e.g. at shutdown): the worker finishes, its reply is
     drained in the background and the same process serves the next request."""
-    from app.schemas import RepeatabilityRequest
+    from jik.app.schemas import RepeatabilityRequest
     from tests.app.conftest import TABLE1_PATH, X0_M2
 
     body = RepeatabilityRequest.model_validate(

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from engine.reproductions.table1 import PRINTED
+from jik.engine.reproductions.table1 import PRINTED
 from tests.app.conftest import TABLE1_PATH, X0_M2
 
 

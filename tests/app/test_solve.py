@@ -10,8 +10,8 @@ import httpx
 import numpy as np
 import pytest
 
-from app.main import create_app
-from app.service import Settings
+from jik.app.main import create_app
+from jik.app.service import Settings
 from tests.app.conftest import X0_M2, solve_body
 
 # Table 1, pseudoinverse column, first leg: x1f after (0, 1) -> (1, 1).
@@ -162,7 +162,7 @@ def test_a_bad_member_does_not_spoil_its_batch():
 def test_every_registered_robot_solves_with_its_defaults(api):
     """Default start and target of every robot in the registry, its default mode and gamma
     (continuous, 1 for the manipulators; discrete, 0.1 for the unicycle once registered)."""
-    from engine.registry import ROBOTS
+    from jik.engine.registry import ROBOTS
 
     for name, spec in ROBOTS.items():
         body = {
@@ -183,8 +183,8 @@ def test_every_registered_robot_solves_with_its_defaults(api):
 def test_service_batch_isolates_a_bad_first_member():
     """The plain service function (used by the dashboard): a wrong-length first member gets its
     own error, the others are solved."""
-    from app.schemas import SolveRequest
-    from app.service import RequestError, solve_batch
+    from jik.app.schemas import SolveRequest
+    from jik.app.service import RequestError, solve_batch
 
     reqs = [
         SolveRequest.model_validate(solve_body(x0=[0.0, 0.0])),
@@ -212,8 +212,8 @@ def test_service_batch_isolates_a_bad_first_member():
 def test_worker_json_is_the_validated_response(over):
     """The workers' JSON (built without pydantic) is the validated model's document: the same
     keys and the same float values (only the spelling of exponents differs)."""
-    from app.schemas import SolveRequest, SolveResponse
-    from app.service import _solve_batch, _solve_response_json, solve_batch
+    from jik.app.schemas import SolveRequest, SolveResponse
+    from jik.app.service import _solve_batch, _solve_response_json, solve_batch
 
     req = SolveRequest.model_validate(solve_body(**over))
     (model,) = solve_batch([req])

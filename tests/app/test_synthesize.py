@@ -6,9 +6,9 @@ import math
 
 import numpy as np
 
-from engine.augmentations import E2Optimal, PaperCubic
-from engine.functionals import error_functional_e2
-from engine.kinematics import Manipulator1, Manipulator2
+from jik.engine.augmentations import E2Optimal, PaperCubic
+from jik.engine.functionals import error_functional_e2
+from jik.engine.kinematics import Manipulator1, Manipulator2
 
 REGION = {"x2": [-1.0, 1.0], "x3": [0.0, math.pi]}
 

@@ -102,7 +102,7 @@ def served():
     port, scene_port = _free_port(), _free_port()
     log = open(ARTIFACTS / "jik-serve.log", "w") if ARTIFACTS.is_dir() else subprocess.DEVNULL
     proc = subprocess.Popen(
-        [sys.executable, "-m", "app.cli", "serve", "--port", str(port), "--scene-port",
+        [sys.executable, "-m", "jik", "serve", "--port", str(port), "--scene-port",
          str(scene_port)],
         cwd=ROOT, stdout=log, stderr=subprocess.STDOUT,
     )  # fmt: skip

@@ -1,8 +1,8 @@
 import numpy as np
 import pytest
 
-from engine import augmentations as aug
-from engine.exceptions import InvalidInputError
+from jik.engine import augmentations as aug
+from jik.engine.exceptions import InvalidInputError
 from tests.helpers import central_difference
 
 RNG = np.random.default_rng(38)

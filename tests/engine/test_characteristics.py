@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from engine.characteristics import (
+from jik.engine.characteristics import (
     CharacteristicsMap,
     LinearHomotopy,
     UnicycleCharacteristics,
@@ -15,10 +15,10 @@ from engine.characteristics import (
     one_form,
     one_form_derivative,
 )
-from engine.exceptions import InvalidInputError, OneFormUndefinedError
-from engine.inverses import ExtendedInverse
-from engine.kinematics import Manipulator2, kernel_cofactors
-from engine.unicycle import Unicycle
+from jik.engine.exceptions import InvalidInputError, OneFormUndefinedError
+from jik.engine.inverses import ExtendedInverse
+from jik.engine.kinematics import Manipulator2, kernel_cofactors
+from jik.engine.unicycle import Unicycle
 
 LAMBDA0 = np.array([0.5, -0.25, 0.3, -0.25])
 Q0_A = (5.0, 0.0, np.pi / 2)

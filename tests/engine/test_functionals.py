@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from engine.augmentations import AugmentingMap, E1Optimal, E2Optimal, PaperCubic, Polynomial2
-from engine.exceptions import InvalidInputError
-from engine.functionals import (
+from jik.engine.augmentations import AugmentingMap, E1Optimal, E2Optimal, PaperCubic, Polynomial2
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.functionals import (
     e1_integrand,
     e2_integrand,
     error_functional_e1,
@@ -16,8 +16,8 @@ from engine.functionals import (
     parameter_sensitivity,
     quadrature,
 )
-from engine.inverses import pseudoinverse
-from engine.kinematics import Manipulator1, Manipulator2
+from jik.engine.inverses import pseudoinverse
+from jik.engine.kinematics import Manipulator1, Manipulator2
 
 REGION1 = {"x1": (0.0, 1.0), "x2": (0.0, 1.0), "x3": (0.5, 1.5)}
 REGION2 = {"x2": (-1.0, 1.0), "x3": (0.0, np.pi)}

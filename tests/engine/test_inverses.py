@@ -1,10 +1,10 @@
 import numpy as np
 import pytest
 
-from engine.augmentations import E1Optimal, E2Optimal, PaperCubic
-from engine.exceptions import AlgorithmicSingularityError, InvalidInputError
-from engine.inverses import ExtendedInverse, Pseudoinverse, extended_inverse, pseudoinverse
-from engine.kinematics import Manipulator1, Manipulator2
+from jik.engine.augmentations import E1Optimal, E2Optimal, PaperCubic
+from jik.engine.exceptions import AlgorithmicSingularityError, InvalidInputError
+from jik.engine.inverses import ExtendedInverse, Pseudoinverse, extended_inverse, pseudoinverse
+from jik.engine.kinematics import Manipulator1, Manipulator2
 
 RNG = np.random.default_rng(12)
 CASES = [
@@ -72,7 +72,7 @@ def test_algorithmic_singularity_names_the_configuration():
 
 
 def test_dimension_mismatch_is_rejected():
-    from engine.augmentations import Polynomial2
+    from jik.engine.augmentations import Polynomial2
 
     with pytest.raises(InvalidInputError, match="R\\^4"):
         ExtendedInverse(Manipulator2(), Polynomial2({(1, 0): 1.0}, variables=(0, 3), p=4))

@@ -1,8 +1,8 @@
 import numpy as np
 import pytest
 
-from engine.exceptions import InvalidInputError, KinematicSingularityError
-from engine.kinematics import Kinematics, Manipulator1, Manipulator2
+from jik.engine.exceptions import InvalidInputError, KinematicSingularityError
+from jik.engine.kinematics import Kinematics, Manipulator1, Manipulator2
 from tests.helpers import central_difference
 
 RNG = np.random.default_rng(20091204)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from engine.linalg import cofactor_rows, det_small, gram, solve_small
+from jik.engine.linalg import cofactor_rows, det_small, gram, solve_small
 
 
 @pytest.mark.parametrize("n", [2, 3, 4])

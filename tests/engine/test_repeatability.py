@@ -3,11 +3,11 @@ import math
 import numpy as np
 import pytest
 
-from engine.augmentations import E1Optimal, E2Optimal, PaperCubic
-from engine.exceptions import InvalidInputError
-from engine.inverses import ExtendedInverse, Pseudoinverse
-from engine.kinematics import Manipulator1, Manipulator2
-from engine.repeatability import repeatability
+from jik.engine.augmentations import E1Optimal, E2Optimal, PaperCubic
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.inverses import ExtendedInverse, Pseudoinverse
+from jik.engine.kinematics import Manipulator1, Manipulator2
+from jik.engine.repeatability import repeatability
 from tests.helpers import count_picard_sweeps
 
 RNG = np.random.default_rng(1983)

@@ -3,13 +3,13 @@ import math
 import numpy as np
 import pytest
 
-from engine.augmentations import E2Optimal, PaperCubic
-from engine.exceptions import AlgorithmicSingularityError, InvalidInputError
-from engine.inverses import ExtendedInverse, Pseudoinverse
-from engine.kinematics import Manipulator1, Manipulator2
-from engine.reproductions.table1 import PRINTED
-from engine.reproductions.table1 import run as table1
-from engine.solver import solve
+from jik.engine.augmentations import E2Optimal, PaperCubic
+from jik.engine.exceptions import AlgorithmicSingularityError, InvalidInputError
+from jik.engine.inverses import ExtendedInverse, Pseudoinverse
+from jik.engine.kinematics import Manipulator1, Manipulator2
+from jik.engine.reproductions.table1 import PRINTED
+from jik.engine.reproductions.table1 import run as table1
+from jik.engine.solver import solve
 
 X0 = np.array([0.0, 0.0, math.pi / 2])
 
@@ -170,7 +170,7 @@ UNICYCLE_TARGET = [1.0, 0.0, -math.pi / 2]
 def test_undefined_h_at_a_trial_point_does_not_abort_the_run():
     """The map raises where h is undefined, but trial points of the integrator must not:
     from pose A the continuous extended run converges with h conserved."""
-    from engine.registry import make_inverse, robot_spec
+    from jik.engine.registry import make_inverse, robot_spec
 
     kin = robot_spec("unicycle").build(q0=[5.0, 0.0, math.pi / 2])
     res = solve(make_inverse(kin, "extended"), UNICYCLE_START, UNICYCLE_TARGET, gamma=0.1)
@@ -180,7 +180,7 @@ def test_undefined_h_at_a_trial_point_does_not_abort_the_run():
 
 def test_run_into_undefined_h_stops_with_message_and_nan():
     """From pose B the discrete extended run leaves the domain of h: stop, say why, NaN h."""
-    from engine.registry import make_inverse, robot_spec
+    from jik.engine.registry import make_inverse, robot_spec
 
     kin = robot_spec("unicycle").build(q0=[-5.0, 5.0, math.pi / 2])
     res = solve(
@@ -284,7 +284,7 @@ def test_chain_guesses_give_each_leg_in_one_or_two_sweeps_and_the_same_path(
     """chain_guesses sweeps the legs of a closed path together; solved one after another from
     them, each leg takes one or two sweeps (about ten cold for the pseudoinverse) and ends where
     the cold solve ends, to the sweep tolerance; its trajectory is the cold one."""
-    from engine.solver import chain_guesses
+    from jik.engine.solver import chain_guesses
     from tests.helpers import count_picard_sweeps
 
     kin = Manipulator2()
@@ -314,7 +314,7 @@ def test_chain_guesses_give_each_leg_in_one_or_two_sweeps_and_the_same_path(
 
 
 def test_chain_guesses_refuse_bad_input_and_give_none_at_a_singularity():
-    from engine.solver import chain_guesses
+    from jik.engine.solver import chain_guesses
 
     inv = Pseudoinverse(Manipulator2())
     for kwargs, match in [

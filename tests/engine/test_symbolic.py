@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from engine.augmentations import E1Optimal, E2Optimal
-from engine.functionals import error_functional_e1
-from engine.inverses import pseudoinverse
-from engine.kinematics import Manipulator1, Manipulator2
-from engine.symbolic import (
+from jik.engine.augmentations import E1Optimal, E2Optimal
+from jik.engine.functionals import error_functional_e1
+from jik.engine.inverses import pseudoinverse
+from jik.engine.kinematics import Manipulator1, Manipulator2
+from jik.engine.symbolic import (
     X,
     euler_equation_e2,
     kinematics_quantities,

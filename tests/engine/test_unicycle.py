@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from engine.exceptions import InvalidInputError
-from engine.unicycle import Unicycle
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.unicycle import Unicycle
 
 ODE_TOL = 1e-9  # quadrature vs solve_ivp(rtol=1e-12)
 FD_STEP = 1e-6

@@ -8,8 +8,8 @@ import json
 import numpy as np
 import pytest
 
-from engine.reproductions import unicycle as repro
-from engine.unicycle import Unicycle
+from jik.engine.reproductions import unicycle as repro
+from jik.engine.unicycle import Unicycle
 
 
 @pytest.fixture(scope="module")

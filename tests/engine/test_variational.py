@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 from scipy import optimize
 
-from engine.augmentations import E2Optimal, PaperCubic, Polynomial2
-from engine.exceptions import InvalidInputError
-from engine.functionals import error_functional_e2, quadrature
-from engine.inverses import ExtendedInverse, Pseudoinverse, pseudoinverse
-from engine.kinematics import Manipulator1, Manipulator2
-from engine.repeatability import repeatability
-from engine.variational import (
+from jik.engine.augmentations import E2Optimal, PaperCubic, Polynomial2
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.functionals import error_functional_e2, quadrature
+from jik.engine.inverses import ExtendedInverse, Pseudoinverse, pseudoinverse
+from jik.engine.kinematics import Manipulator1, Manipulator2
+from jik.engine.repeatability import repeatability
+from jik.engine.variational import (
     MANIPULATOR2_REGION,
     SynthesizedMap,
     default_manipulator2_synthesis,
