@@ -471,7 +471,8 @@ def algorithm_run(
     return run
 
 
-# The generation counter the offload process compares its own against (set by _offload_init).
+# Each lane's newest generation, which the offload processes compare theirs against (set by
+# _offload_init): lane k is one dashboard session's.
 _newest_generation = None
 
 
@@ -494,48 +495,69 @@ def _offload_ready() -> bool:
     return True  # importing this module (numpy, the engine) is the warm-up
 
 
-def _offload_run(state, algorithm, targets, cycles, generation, resume=None) -> AlgorithmRun:
+def _offload_run(lane, state, algorithm, targets, cycles, generation, resume=None) -> AlgorithmRun:
     def cancelled() -> bool:
-        return _newest_generation is not None and _newest_generation.value > generation
+        return _newest_generation is not None and _newest_generation[lane] > generation
 
     return algorithm_run(state, algorithm, targets, cycles, cancelled=cancelled, resume=resume)
 
 
+#: Most lanes (dashboard sessions) one :class:`Offload` serves at once.
+MAX_LANES = 1024
+
+
 class Offload:
-    """A second process for the dashboard's computation (one worker, spawned).
+    """Processes that the dashboards share for their computation (spawned, first come first
+    served).
 
     :func:`compute` runs the pseudoinverse here and the extended inverse in its own thread at the
-    same time: on two cores a change costs the slower of the two instead of their sum. A newer
-    change cancels the offloaded run between legs through a shared generation counter (see
-    :meth:`newest`). If the process dies, the run is redone in the calling thread and a new
-    process is started.
+    same time: on two cores a change costs the slower of the two instead of their sum. Each
+    dashboard takes a :meth:`lane`; a newer change in that dashboard cancels its offloaded run
+    between legs through the lane's generation counter in shared memory. If a process dies, the
+    run is redone in the calling thread and the pool is started anew.
+
+    Parameters
+    ----------
+    workers : int
+        Processes in the pool.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, workers: int = 1) -> None:
         self._context = multiprocessing.get_context("spawn")  # (the server has threads: no fork)
-        self._newest = self._context.Value("q", 0, lock=False)
+        self._newest = self._context.Array("q", MAX_LANES, lock=False)
+        self._free = list(range(MAX_LANES - 1, -1, -1))
+        self._workers = workers
         self._lock = threading.Lock()
         self._pool = self._start()
 
     def _start(self) -> ProcessPoolExecutor:
         pool = ProcessPoolExecutor(
-            max_workers=1, mp_context=self._context, initializer=_offload_init,
+            max_workers=self._workers, mp_context=self._context, initializer=_offload_init,
             initargs=(self._newest,),
         )  # fmt: skip
-        pool.submit(_offload_ready)  # start and import now, not on the first change
+        for _ in range(self._workers):
+            pool.submit(_offload_ready)  # start and import now, not on the first change
         return pool
 
-    def newest(self, generation: int) -> None:
-        """The dashboard's newest generation: older offloaded runs stop at their next leg."""
-        self._newest.value = generation
+    def lane(self) -> OffloadLane:
+        """A lane for one dashboard (:class:`OffloadLane`; close it when the dashboard stops)."""
+        with self._lock:
+            if not self._free:
+                raise RuntimeError(f"all {MAX_LANES} lanes of the dashboards' pool are taken")
+            lane = self._free.pop()
+        self._newest[lane] = 0
+        return OffloadLane(self, lane)
+
+    def _release(self, lane: int) -> None:
+        with self._lock:
+            self._newest[lane] = 0
+            self._free.append(lane)
 
     def _restart(self) -> None:
         self._pool.shutdown(wait=False, cancel_futures=True)
         self._pool = self._start()
 
-    def submit(self, state, algorithm, targets, cycles, generation, resume=None) -> Future:
-        """Run :func:`algorithm_run` there (``resume``: see :func:`_run_legs`)."""
-        job = functools.partial(_offload_run, state, algorithm, targets, cycles, generation, resume)
+    def _submit(self, job) -> Future:
         with self._lock:
             try:
                 return self._pool.submit(job)
@@ -543,13 +565,11 @@ class Offload:
                 self._restart()
                 return self._pool.submit(job)
 
-    def result(self, future: Future, fallback: Callable[[], AlgorithmRun]) -> AlgorithmRun:
-        """The offloaded run (Cancelled and the engine's errors propagate); if the process
-        died, ``fallback()`` computes it here."""
+    def _result(self, future: Future, fallback: Callable[[], AlgorithmRun]) -> AlgorithmRun:
         try:
             return future.result()
         except BrokenProcessPool:
-            log.warning("the dashboard's second process died; restarting it")
+            log.warning("a dashboard compute process died; restarting the pool")
             with self._lock:
                 self._restart()
             return fallback()
@@ -557,6 +577,34 @@ class Offload:
     def close(self) -> None:
         with self._lock:
             self._pool.shutdown(wait=False, cancel_futures=True)
+
+
+class OffloadLane:
+    """One dashboard's way into an :class:`Offload`: its runs, and their cancellation."""
+
+    def __init__(self, offload: Offload, lane: int) -> None:
+        self._offload = offload
+        self._lane = lane
+
+    def newest(self, generation: int) -> None:
+        """The dashboard's newest generation: its older offloaded runs stop at their next leg."""
+        self._offload._newest[self._lane] = generation
+
+    def submit(self, state, algorithm, targets, cycles, generation, resume=None) -> Future:
+        """Run :func:`algorithm_run` there (``resume``: see :func:`algorithm_run`)."""
+        job = functools.partial(
+            _offload_run, self._lane, state, algorithm, targets, cycles, generation, resume
+        )
+        return self._offload._submit(job)
+
+    def result(self, future: Future, fallback: Callable[[], AlgorithmRun]) -> AlgorithmRun:
+        """The offloaded run (Cancelled and the engine's errors propagate); if the process
+        died, ``fallback()`` computes it here."""
+        return self._offload._result(future, fallback)
+
+    def close(self) -> None:
+        """Give the lane back (the pool goes on serving the other dashboards)."""
+        self._offload._release(self._lane)
 
 
 def _cache_key(state: DashboardState, algorithm: str) -> str:
@@ -677,7 +725,7 @@ def compute(
     cancelled: Callable[[], bool] = lambda: False,
     cache: dict | None = None,
     with_augmenting: bool = True,
-    offload: Offload | None = None,
+    offload: OffloadLane | None = None,
     grid_before: dict | None = None,
 ) -> DashboardResult:
     """Solve the state's task with both algorithms.
@@ -693,9 +741,9 @@ def compute(
         and filled.
     with_augmenting : bool
         Evaluate h on a grid for the h panel now (see :func:`augmenting_grid`).
-    offload : Offload, optional
-        A second process: the pseudoinverse runs there, concurrently with the extended
-        inverse here (same results).
+    offload : OffloadLane, optional
+        A lane of the shared compute processes: the pseudoinverse runs there, concurrently with
+        the extended inverse here (same results).
     grid_before : dict, optional
         The h grid on screen, whose box the new grid keeps when it fits (see
         :func:`augmenting_grid`).
@@ -899,8 +947,6 @@ def error_functionals(result: DashboardResult, nodes: int = 12) -> dict | None:
     return out
 
 
-#: Seconds between a result and the start of its second phase (E1, E2, their sweeps).
-SECOND_PHASE_DELAY = 0.3
 #: Values of each parameter in the E1/E2 sweep of the dashboard (over v - 1 .. v + 1).
 SENSITIVITY_SAMPLES = 11
 
@@ -1036,14 +1082,10 @@ def summary(result: DashboardResult) -> dict:
 #: Not the unicycle: its ~1 s would hold the CPU that a change made meanwhile needs (its
 #: switch shows progress instead).
 PREFETCH_ROBOTS = ("manipulator1", "manipulator2")
-#: Longest hold of the scene's animation that one request may ask for (the page renews its
-#: hold while the pointer stays on the controls), and the most holders kept at once.
-MAX_HOLD_SECONDS = 10.0
-MAX_HOLDERS = 64
 
 
 class Dashboard:
-    """The live dashboard: one state, a worker thread, and subscribers.
+    """One session's live dashboard: one state, a worker thread, and subscribers.
 
     Parameters
     ----------
@@ -1052,8 +1094,9 @@ class Dashboard:
     debounce : float
         Seconds the worker waits after a change for a newer one (short: the page already
         coalesces a slider drag into one request in flight at a time).
-    offload : bool
-        Run one algorithm in a second process (:class:`Offload`); ``jik serve`` does.
+    offload : Offload, optional
+        Compute processes shared with other dashboards: one algorithm runs there, in this
+        dashboard's own lane (:meth:`Offload.lane`); ``jik serve`` gives one.
     """
 
     def __init__(
@@ -1061,10 +1104,10 @@ class Dashboard:
         state: DashboardState | None = None,
         *,
         debounce: float = 0.002,
-        offload: bool = False,
+        offload: Offload | None = None,
     ) -> None:
         self._cond = threading.Condition()
-        self._offload = Offload() if offload else None
+        self._offload = offload.lane() if offload is not None else None
         self._state = validate(state or default_state())
         self._generation = 1
         self._done = 0  # last generation whose computation finished (or failed)
@@ -1090,7 +1133,6 @@ class Dashboard:
         self.functionals: dict | None = None
         #: What the 3D scene last drew (set by app.scene), for the page and the tests.
         self.scene_status: dict = {}
-        self._holds: dict[str, float] = {}  # holder -> monotonic time its hold ends
         self._thread: threading.Thread | None = None
         self._stopped = False
 
@@ -1122,61 +1164,40 @@ class Dashboard:
     def update(
         self, patch: Mapping[str, object], source: str = "page"
     ) -> tuple[int, DashboardState]:
-        """Validate and apply a change; the worker recomputes. Returns (generation, state)."""
+        """Validate and apply a change; the worker recomputes. Returns (generation, state).
+
+        A change the registry refuses raises :class:`InvalidInputError` and is announced to
+        every listener as a ``refused`` event (the page and the scene both show it, and their
+        controls go back to the values in force).
+        """
+        refusal: InvalidInputError | None = None
         with self._cond:
-            state = updated_state(self._state, patch)
-            if state == self._state:
-                return self._generation, state
-            self._state = state
-            self._generation += 1
-            generation = self._generation
-            self._changed_at[generation] = time.perf_counter()
-            if self._offload is not None:
-                self._offload.newest(generation)
-            self._cond.notify_all()
+            try:
+                state = updated_state(self._state, patch)
+            except InvalidInputError as exc:
+                refusal = exc
+                generation, state = self._generation, self._state
+            else:
+                if state == self._state:
+                    return self._generation, state
+                self._state = state
+                self._generation += 1
+                generation = self._generation
+                self._changed_at[generation] = time.perf_counter()
+                if self._offload is not None:
+                    self._offload.newest(generation)
+                self._cond.notify_all()
+        if refusal is not None:
+            refused = {"type": "refused", "generation": generation, "source": source,
+                       "fields": sorted(map(str, patch)), "message": str(refusal),
+                       "state": state.as_dict()}  # fmt: skip
+            self._emit(Event("refused", generation, _json(refused)))
+            raise refusal
         self._emit(
             Event("state", generation, _json(self._state_message(generation, state, source)))
         )
         self.start()
         return generation, state
-
-    def hold(self, holder: str, seconds: float) -> float:
-        """Hold the 3D scene's animation still for ``seconds`` from now on behalf of
-        ``holder`` (0 ends that holder's hold). The animation goes on when no hold is left.
-
-        The page holds it while the pointer is on its controls or on the scene's GUI panel
-        (``static/scene_hold.js`` tells the page), and the scene for a moment after a change
-        made in it (:data:`jik.app.scene.EDIT_HOLD`): a playing scene keeps viser's
-        client rendering, and in software WebGL that takes over a core, which the change the
-        user is about to make needs (see ``docs/benchmarks.md``, Dashboard latency).
-
-        Returns the seconds until the last hold ends (0: the animation is not held).
-        """
-        seconds = float(seconds)
-        if not 0.0 <= seconds <= MAX_HOLD_SECONDS:  # (False for NaN)
-            raise InvalidInputError(
-                f"seconds must be in [0, {MAX_HOLD_SECONDS:g}] (got {seconds!r}); "
-                "renew a longer hold, and send 0 to end it"
-            )
-        if not (isinstance(holder, str) and 0 < len(holder) <= 64):
-            raise InvalidInputError("holder must be a string of 1 to 64 characters")
-        now = time.monotonic()
-        with self._cond:
-            holds = {h: t for h, t in self._holds.items() if t > now and h != holder}
-            if seconds > 0.0:
-                if len(holds) >= MAX_HOLDERS:
-                    raise InvalidInputError(
-                        f"the scene is already held by {MAX_HOLDERS} holders; "
-                        "let a hold end (seconds 0) first"
-                    )
-                holds[holder] = now + seconds
-            self._holds = holds
-            return max(holds.values(), default=now) - now
-
-    def held(self) -> bool:
-        """Whether some hold of the scene's animation (:meth:`hold`) is on now."""
-        now = time.monotonic()
-        return any(t > now for t in self._holds.values())
 
     def subscribe(
         self, listener: Callable[[Event], None], *, last: bool = False
@@ -1429,17 +1450,12 @@ class Dashboard:
             self._changed_at = {g: t for g, t in self._changed_at.items() if g > generation}
         self._emit(Event("result", generation, data, result))
         self._finish(generation)
-        # Second phase: h on a grid when it is expensive, then E1 and E2 (quadrature). It starts
-        # once the page and the scene had time to draw the first (it would compete with them
-        # for the CPU), unless a newer change came meanwhile. Known functionals went out with
+        # Second phase: h on a grid when it is expensive, then E1 and E2 (quadrature), unless a
+        # newer change came meanwhile. Known functionals went out with
         # the result: their event only carries the h panel's title (a reused panel can lack it,
         # and a page that connects now gets this event with the latest result).
         known = bool(cached) and not deferred
         if not known:
-            with self._cond:
-                self._cond.wait_for(
-                    lambda: self._generation != generation or self._stopped, SECOND_PHASE_DELAY
-                )
             if self._generation != generation:
                 return
         if deferred:

@@ -27,7 +27,7 @@ from jik.app.errors import (
     request_error_response,
 )
 from jik.app.fastpath import SolveFastPath
-from jik.app.routers import dashboard, health, repeatability, robots, solve, synthesize
+from jik.app.routers import dashboard, health, repeatability, robots, sessions, solve, synthesize
 from jik.app.schemas import AUGMENTATION_MODELS, ROBOT_MODELS
 from jik.app.service import (
     ComputeError,
@@ -88,6 +88,9 @@ def create_app(settings: Settings | None = None, fast_solve: bool | None = None)
         await pool.warm_up()
         yield
         pool.close()
+        store = getattr(app.state, "sessions", None)
+        if store is not None:
+            store.close()
 
     # /docs and /redoc with Swagger UI's and ReDoc's files from the fastapi-offline package: the
     # API's documentation works on a machine without internet, and loads nothing from a CDN.
@@ -126,6 +129,7 @@ def create_app(settings: Settings | None = None, fast_solve: bool | None = None)
     for module in (health, robots, solve, repeatability, synthesize):
         app.include_router(module.router)
     app.include_router(dashboard.router)
+    app.include_router(sessions.router)
     if fast_solve:
         app.add_middleware(SolveFastPath, pool=pool)
     app.add_middleware(BodyLimit, limit=MAX_BODY_BYTES)  # outermost: before any body is read

@@ -19,53 +19,29 @@ colours of every plot); the grey ghost is the start configuration x0.
 
 from __future__ import annotations
 
-import contextlib
 import json
 import math
 import threading
 import time
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any, cast
 
 import numpy as np
 import viser
 
-from jik import static
 from jik.app.dashboard import ALGORITHMS, COLORS, MAX_DASHBOARD_CYCLES, Dashboard, Event, runs_key
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS, robot_spec
 
 FPS = 25.0
-#: Seconds between a change of the controls' structure (robot, map, task, mode) and the new
-#: controls in the scene's panel (:meth:`DashboardScene._on_state`).
-CONTROLS_DELAY = 0.3
 #: The frame of the unicycle's nodes, drawn anew for each result (the manipulators' are kept,
 #: one frame per robot and task: :meth:`DashboardScene._switch_set`).
 UNICYCLE_ROOT = "/robot/unicycle"
 #: Seconds of animation per leg (manipulators) or per shown iteration (unicycle) at speed 1.
 SECONDS_PER_LEG = 1.6
-#: Seconds the animation holds still after a change made in the scene (its GUI, the gizmo):
-#: the next change of a drag is then computed and drawn without the animation's frames. (The
-#: page holds it while the pointer is on its controls or on the scene's GUI panel, where
-#: :data:`CLIENT_SCRIPT` tells it; a drag of the gizmo starts with a change, its press.)
-EDIT_HOLD = 1.5
 #: Seconds between two changes of the start point while its gizmo is dragged (each starts a
 #: computation; the dashboard solves only the newest state, but every change is an event).
 DRAG_INTERVAL = 0.15
-#: Seconds between a result's event and the scene's drawing of it while a browser shows the
-#: scene. The page's plotly redraw and the viser client's update (its React pass and its frames,
-#: software WebGL on a machine without a GPU) run at the same moment on the same cores: on this
-#: 2-core machine the slowest changes' plots waited for the scene's frames. Drawn 40 ms later,
-#: the slowest kinds were shown sooner in the browser test (medians: the drag 275 -> 214 ms, the
-#: cycles from the scene's GUI 217 -> 174, the longer arm 214 -> 196), the quickest later (the
-#: start point 168 -> 188): the scene's share rose by 28-53 ms (docs/benchmarks.md, "Dashboard
-#: latency"). With no browser there is nothing to share the cores with, and no wait.
-SCENE_DELAY = 0.04
-#: Script run in every viser client: it tells the framing page when the pointer (or the keyboard)
-#: is on the scene's GUI panel, so that the page holds the animation still there as it does on its
-#: own controls.
-CLIENT_SCRIPT = Path(static.__file__).resolve().parent / "scene_hold.js"
 #: Unicycle iterations shown in the animation (geometrically spaced, the last always).
 UNICYCLE_SHOWN = 10
 _Z = {"pseudoinverse": 0.10, "extended": 0.0}
@@ -443,23 +419,24 @@ class DashboardScene:
         Where viser serves its client (the page frames it in an iframe).
     """
 
-    def __init__(self, dashboard: Dashboard, host: str = "127.0.0.1", port: int = 8080) -> None:
+    def __init__(
+        self, dashboard: Dashboard, host: str = "127.0.0.1", port: int = 0, low_end: bool = False
+    ) -> None:
         self.dashboard = dashboard
+        # Its own viser server on a loopback port: the page reaches it only through the API's
+        # proxy (jik.app.routers.scene), which knows the session.
         self.server = viser.ViserServer(host=host, port=port, label="jik scene", verbose=False)
         self.server.scene.set_up_direction("+z")
-        # Nothing here casts a shadow (every node is added with cast_shadow=False): without the
-        # default lights' shadow map pass each frame costs a third less in software WebGL.
-        self.server.scene.configure_default_lights(cast_shadow=False)
-        # Lit by the default lights alone: with viser's default environment map every pixel of a
-        # mesh samples it, and in software WebGL a view filled by one box takes 109 ms a frame
-        # instead of 45 ms.
-        self.server.scene.configure_environment_map(hdri=None)
+        if low_end:
+            # The page asks for this only when its browser reports a software WebGL renderer:
+            # without shadows and the environment map a frame costs that renderer far less.
+            self.server.scene.configure_default_lights(cast_shadow=False)
+            self.server.scene.configure_environment_map(hdri=None)
         self.server.gui.configure_theme(control_width="small", show_logo=False)
         self.server.gui.main_panel.dock_right()
         self.server.gui.main_panel.set_width(300)
         self._framed: str | None = None
         self._local = threading.local()  # see _syncing
-        self._sync_pending = False  # a state change whose values the GUI has yet to show
         self._dragging = False
         self._lock = threading.RLock()
         self._timeline: Timeline | None = None
@@ -484,9 +461,7 @@ class DashboardScene:
         self._drag_timer: threading.Timer | None = None  # applies it when the interval ends
         self._drag_lock = threading.Lock()
         self._stopped = False
-        dashboard.scene_status["held"] = False
         self._build_static_gui()
-        self.gui_hold = _run_in_clients(self.server, CLIENT_SCRIPT.read_text(encoding="utf-8"))
         _add_floor_grid(self.server.scene)
         self.server.scene.add_frame("/robot", show_axes=False)
         self._unsubscribe = dashboard.subscribe(self._on_event, last=True)
@@ -554,11 +529,10 @@ class DashboardScene:
             return
         try:
             self.dashboard.update(patch, source="scene")
-        except InvalidInputError as exc:
-            self.status.content = f"**refused:** {exc}"
+        except InvalidInputError:
+            # The dashboard's "refused" event shows the refusal here and on the page, and the
+            # controls go back to the values in force.
             return
-        with contextlib.suppress(InvalidInputError):  # (held by too many pages: it is held)
-            self.dashboard.hold("scene-edit", EDIT_HOLD)
 
     def _rebuild_controls(self, state) -> None:
         """GUI inputs for ``state``'s robot, from the registry (no hard-coded ranges)."""
@@ -755,9 +729,10 @@ class DashboardScene:
                     self.progress.value = min(100.0, 100.0 * msg["fraction"])  # type: ignore[misc]  # viser: settable
                     self.status.content = f"computing… {100 * msg['fraction']:.0f}%"
             elif event.kind == "result" and event.result is not None:
-                if self.server.get_clients():  # (the page's listener has queued its event)
-                    time.sleep(SCENE_DELAY)
                 self._draw(event.result)
+            elif event.kind == "refused":
+                self._sync_now()
+                self.status.content = f"**refused:** {json.loads(event.data)['message']}"
             elif event.kind == "ahead" and event.result is not None:
                 self._prebuild(event.result)
             elif event.kind == "error":
@@ -771,32 +746,12 @@ class DashboardScene:
         structure = (state.robot, state.augmentation, state.task, state.mode)
         with self._lock:
             if structure == self._structure:
-                # The GUI takes the new values with the result's drawing (_sync_now), not now:
-                # the viser client's re-render of its inputs would take a share of the two
-                # cores that the computation of the change needs (docs/benchmarks.md).
-                self._sync_pending = True
+                self._sync_controls(state)
                 return
-            first = self._structure is None
             self._structure = structure
-            if first:
-                self._rebuild_controls(state)
-                return
-            # Other controls: the old ones go at once, the new ones come CONTROLS_DELAY later,
-            # after the drawing of the new result in the usual case. Mounting a folder of
-            # inputs takes the client's main thread 100-150 ms (software rendering here): done
-            # with the state change, it held up the new scene by as much.
             for folder in self._folders:
                 folder.remove()
             self._folders, self._controls = [], {}
-        timer = threading.Timer(CONTROLS_DELAY, self._controls_for, args=(structure,))
-        timer.daemon = True
-        timer.start()
-
-    def _controls_for(self, structure: tuple) -> None:
-        with self._lock:
-            state = self.dashboard.state
-            if self._stopped or structure != self._structure or self._folders:
-                return  # a newer structure has its own timer
             self._rebuild_controls(state)
 
     def _place_gizmo(self, state) -> None:
@@ -826,11 +781,10 @@ class DashboardScene:
     def _on_drag(self, event) -> None:
         """The gizmo pressed, moved or released: the start point follows.
 
-        The press holds the animation (:meth:`_change`); it changes nothing unless the gizmo
-        is off the state's pose. Moves change the state at most once per
-        :data:`DRAG_INTERVAL`; the newest move within it is applied when it ends, unless a
-        press, a release or a later move applied meanwhile (the last pose of a drag that stops
-        always arrives). The release applies the final pose.
+        The press changes nothing unless the gizmo is off the state's pose. Moves change the
+        state at most once per :data:`DRAG_INTERVAL`; the newest move within it is applied when
+        it ends, unless a press, a release or a later move applied meanwhile (the last pose of a
+        drag that stops always arrives). The release applies the final pose.
         """
         self._dragging = event.phase != "end"
         pose = (tuple(map(float, event.target.position)), tuple(map(float, event.target.wxyz)))
@@ -870,12 +824,10 @@ class DashboardScene:
 
     # -- drawing --------------------------------------------------------------------------
     def _sync_now(self) -> None:
-        """Show the state's values in the GUI if a change came since (see :meth:`_on_state`);
-        with a result's drawing, in the same batch, or with its error."""
+        """Show the values in force in the GUI (after a drawing, an error or a refusal)."""
         with self._lock:
-            if self._sync_pending and self._folders:
+            if self._folders:
                 self._sync_controls(self.dashboard.state)
-            self._sync_pending = False
 
     def _draw(self, result) -> None:
         state = result.state
@@ -911,9 +863,8 @@ class DashboardScene:
                 self._framed = state.robot
                 self._frame_camera(extent)
             self._timeline = timeline
-            # Playing: from the start. Paused or held: at the end, where the drift of J^P#
-            # shows (when a hold ends, the animation starts over from there).
-            self._s = 0.0 if self.playing and not self.dashboard.held() else timeline.length
+            # Playing: from the start. Paused: at the end, where the drift of J^P# shows.
+            self._s = 0.0 if self.playing else timeline.length
             self._pose(self._s)
             self._show_position(timeline)
             self.drawn_generation = result.generation
@@ -1111,17 +1062,12 @@ class DashboardScene:
                 timeline = self._timeline
                 if timeline is None:
                     continue
-                # Held (Dashboard.hold: the pointer is on the controls): still, as if
-                # paused, until the hold ends.
-                held = self.playing and self.dashboard.held()
-                if held != self.dashboard.scene_status.get("held", False):
-                    self.dashboard.scene_status["held"] = held
-                moving = self.playing and not held
+                moving = self.playing
                 if moving:
                     self._s += dt * float(self.speed.value) / SECONDS_PER_LEG
                     if self._s > timeline.length + 0.5:  # hold the end a moment, then loop
                         self._s = 0.0
-                # Paused or held: nothing to send until scrubbed (or drawn, which poses too).
+                # Paused: nothing to send until scrubbed (or drawn, which poses too).
                 if self._posed != (timeline, self._s):
                     self._pose(self._s)
             if not moving:
@@ -1129,22 +1075,6 @@ class DashboardScene:
             if now - last_gui > 0.25:
                 last_gui = now
                 self._show_position(timeline)
-
-
-def _run_in_clients(server: viser.ViserServer, source: str) -> bool:
-    """Run ``source`` in every client of ``server``, those that connect later too.
-
-    viser runs scripts in its client for its own use (plotly.js) and has no public call for it:
-    this queues the same message. Returns False, leaving the scene as it is, when this viser
-    lacks it (the page's hold then covers the page's controls only, and a change made in the
-    scene holds the animation from that change on, :data:`EDIT_HOLD`).
-    """
-    message = getattr(getattr(viser, "_messages", None), "RunJavascriptMessage", None)
-    queue = getattr(getattr(server, "_websock_server", None), "queue_message", None)
-    if message is None or queue is None:
-        return False
-    queue(message(source=source))
-    return True
 
 
 def _path_text(path) -> str:
@@ -1168,6 +1098,6 @@ def _extent(result) -> tuple[tuple[float, float], tuple[float, float]]:
     return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
 
 
-def start_scene(dashboard: Dashboard, host: str, port: int) -> DashboardScene:
-    """Start the viser scene for ``dashboard`` on ``host:port``."""
-    return DashboardScene(dashboard, host=host, port=port)
+def start_scene(dashboard: Dashboard, low_end: bool = False) -> DashboardScene:
+    """Start the viser scene for one session's ``dashboard``, on a free loopback port."""
+    return DashboardScene(dashboard, low_end=low_end)

@@ -16,7 +16,6 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeAlias, Union
 
 from pydantic import BaseModel, ConfigDict, Field, create_model
 
-from jik.app.dashboard import MAX_HOLD_SECONDS
 from jik.engine.registry import ROBOTS, AugmentationSpec, RobotSpec
 from jik.engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
 
@@ -382,25 +381,21 @@ class HealthResponse(BaseModel):
     status: Literal["ok"]
 
 
-class HoldRequest(BaseModel):
-    """``POST /api/dashboard/hold``: hold the 3D scene's animation still for a while."""
+class SessionCreate(BaseModel):
+    """``POST /api/sessions``: a new dashboard session (one per browser tab)."""
 
     model_config = ConfigDict(extra="forbid")
 
-    holder: str = Field(
-        min_length=1,
-        max_length=64,
-        pattern=r"^[A-Za-z0-9_-]+$",
-        description="who holds it (the page: a random id per tab); each holder has one hold",
+    state: dict[str, Any] = Field(
+        default_factory=dict,
+        description="the dashboard fields that differ from the defaults (a link's state); "
+        "validated like a change (POST /api/sessions/{id}/state)",
     )
-    seconds: Annotated[float, Field(ge=0.0, le=MAX_HOLD_SECONDS, allow_inf_nan=False)] = Field(
-        description=f"how long from now, at most {MAX_HOLD_SECONDS:g} (renew a longer hold); "
-        "0 ends the holder's hold"
+    low_end: bool = Field(
+        default=False,
+        description="draw the 3D scene without shadows or environment map (the page asks for "
+        "this when its browser reports a software WebGL renderer)",
     )
-
-
-class HoldResponse(BaseModel):
-    held_seconds: float = Field(description="seconds until the last hold ends; 0: not held")
 
 
 __all__ = [
@@ -409,12 +404,11 @@ __all__ = [
     "Augmentation",
     "ErrorResponse",
     "HealthResponse",
-    "HoldRequest",
-    "HoldResponse",
     "RepeatabilityRequest",
     "RepeatabilityResponse",
     "Robot",
     "RobotsResponse",
+    "SessionCreate",
     "SolveRequest",
     "SolveResponse",
     "SynthesizeRequest",

@@ -1,8 +1,9 @@
-"""``jik serve``: the REST API under uvicorn (and the dashboard's viser scene).
+"""``jik serve``: the REST API, the dashboard and its 3D scenes under uvicorn, on one port.
 
-Both ports are taken before anything says the server started: a busy port is reported with the
-option that changes it, and the API's socket is handed to uvicorn already bound, so nothing can
-take it in between.
+The port is taken before anything says the server started: a busy port is reported with the
+option that changes it, and the socket is handed to uvicorn already bound, so nothing can take it
+in between. Each dashboard session's 3D scene is a viser server on a loopback port of its own,
+reached only through the API's proxy (:mod:`jik.app.routers.sessions`).
 """
 
 from __future__ import annotations
@@ -14,6 +15,8 @@ import socket
 import uvicorn
 
 from jik.app.main import create_app
+from jik.app.scene import start_scene
+from jik.app.sessions import SessionLimits, SessionStore
 
 
 class PortInUse(RuntimeError):
@@ -43,47 +46,34 @@ def _stopped(signum: int, frame: object) -> None:
     """The signal that uvicorn raises again after its graceful shutdown: nothing more to do."""
 
 
-def run_server(host: str = "127.0.0.1", port: int = 8000, scene_port: int = 8080) -> None:
-    """Serve the API on ``host:port`` until interrupted (SIGINT or SIGTERM).
+def run_server(host: str = "127.0.0.1", port: int = 8000) -> None:
+    """Serve the API and the dashboard on ``host:port`` until interrupted (SIGINT or SIGTERM).
 
     Parameters
     ----------
     host : str
         Address to bind; 127.0.0.1 by default (use 0.0.0.0 in a container).
     port : int
-        HTTP port of the API (OpenAPI docs at /docs).
-    scene_port : int
-        Port of the viser 3D scene.
+        HTTP port of the API (OpenAPI docs at /docs), the page and its scenes.
 
     Raises
     ------
     PortInUse
-        If either port is taken, before anything is started.
+        If the port is taken, before anything is started.
     """
-    api_socket = bind(host, port, "--port")
-    try:
-        bind(host, scene_port, "--scene-port").close()  # viser binds it itself, just below
-    except PortInUse:
-        api_socket.close()
-        raise
+    sock = bind(host, port, "--port")
     app = create_app()
-    from jik.app.dashboard import Dashboard
-    from jik.app.scene import start_scene
-    from jik.app.service import env_flag
-
-    # The dashboard runs one algorithm in a second process (JIK_DASHBOARD_OFFLOAD=0: not).
-    app.state.dashboard = Dashboard(offload=env_flag("JIK_DASHBOARD_OFFLOAD"))
-    app.state.scene_port = start_scene(app.state.dashboard, host, scene_port).port
-    # uvicorn shuts down gracefully on SIGINT and SIGTERM, restores the handlers it found and then
-    # raises the signal again. With these handlers that second signal only ends the wait, so the
-    # dashboard and its worker processes are stopped below and the command exits 0, as a server
-    # asked to stop should (`docker stop` sends SIGTERM).
+    # The sessions' second processes (JIK_DASHBOARD_WORKERS, default 1) start with the store.
+    app.state.sessions = SessionStore(SessionLimits.from_env(), scene_factory=start_scene)
+    # uvicorn shuts down gracefully on SIGINT and SIGTERM (the lifespan stops the sessions and
+    # the workers), restores the handlers it found and then raises the signal again. With these
+    # handlers that second signal only ends the wait, and the command exits 0, as a server asked
+    # to stop should (`docker stop` sends SIGTERM).
     previous = {sig: signal.signal(sig, _stopped) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         config = uvicorn.Config(app, host=host, port=port, log_level="info", access_log=False)
-        uvicorn.Server(config).run(sockets=[api_socket])
+        uvicorn.Server(config).run(sockets=[sock])
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
-        app.state.dashboard.stop()
-        api_socket.close()
+        sock.close()

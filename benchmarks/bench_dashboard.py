@@ -15,12 +15,12 @@ import time
 
 import numpy as np
 
-from jik.app.dashboard import Offload, compute, default_state, updated_state
+from jik.app.dashboard import Offload, OffloadLane, compute, default_state, updated_state
 
 ROBOTS = ("manipulator2", "manipulator1", "unicycle")
 
 
-def _timed(robot: str, repeats: int, offload: Offload | None) -> float:
+def _timed(robot: str, repeats: int, offload: OffloadLane | None) -> float:
     state = default_state(robot)
     walls = []
     for k in range(repeats):
@@ -38,7 +38,8 @@ def _timed(robot: str, repeats: int, offload: Offload | None) -> float:
 
 
 def run(quick: bool = False) -> dict:
-    offload = Offload()
+    pool = Offload()
+    offload = pool.lane()
     try:
         compute(default_state("manipulator2"), offload=offload)  # the process is up and warm
         out = {}
@@ -51,6 +52,7 @@ def run(quick: bool = False) -> dict:
         return out
     finally:
         offload.close()
+        pool.close()
 
 
 def main(quick: bool = False) -> None:

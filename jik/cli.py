@@ -75,7 +75,7 @@ def serve(args: argparse.Namespace) -> int:
     except ModuleNotFoundError as error:
         return missing_app_extra(error)
     try:
-        run_server(host=args.host, port=args.port, scene_port=args.scene_port)
+        run_server(host=args.host, port=args.port)
     except PortInUse as busy:
         sys.stderr.write(f"jik serve: {busy}\n")
         return 2
@@ -102,8 +102,7 @@ def main(argv: list[str] | None = None) -> int:
 
     p = sub.add_parser("serve", help="start the REST API and the dashboard")
     p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
-    p.add_argument("--port", type=int, default=8000, help="HTTP port of the API and page")
-    p.add_argument("--scene-port", type=int, default=8080, help="port of the viser 3D scene")
+    p.add_argument("--port", type=int, default=8000, help="HTTP port of the API, page and scene")
     p.set_defaults(func=serve)
 
     p = sub.add_parser("reproduce", help="recompute a result of the paper")

@@ -1,18 +1,16 @@
-// jik dashboard: follows the server's one state over server-sent events and draws its figures.
-// Controls are built from GET /robots (ranges, defaults) and change the state with
-// POST /api/dashboard/state; the viser scene (iframe) changes the same state.
+// jik dashboard: one session per tab. The page creates its session from the state in its URL
+// (POST /api/sessions), follows it over server-sent events and draws its figures; controls are
+// built from GET /robots (ranges, defaults) and change the session's state
+// (POST /api/sessions/{id}/state). The viser scene (iframe) shows and changes the same session.
 "use strict";
 
 const PANELS = ["task", "drift", "joints", "augmenting", "sensitivity", "table"];
-// No plotly mode bar: it is rebuilt with every full redraw (10-20 % of the redraw in the browser
-// test); each panel has its own PNG/SVG buttons instead (panelTools), and drag-to-zoom with
-// double-click to reset work without it.
-const PLOT_CONFIG = { responsive: true, displaylogo: false, displayModeBar: false };
-const jik = (window.jik = {
-  catalogue: null, config: null, state: null, generation: 0, shownGeneration: 0,
-  pending: new Map(), latencies: [], lastLatency: null, firstUpdate: null, panelDraw: {}, panelSync: {},
-  panelPlan: {},
-});
+const PLOT_CONFIG = { responsive: true, displaylogo: false };
+const jik = {
+  session: null, catalogue: null, config: null, state: null, generation: 0, shownGeneration: 0,
+  pending: new Map(), lastLatency: null,
+};
+const api = (path) => `/api/sessions/${jik.session}${path}`;
 
 const $ = (sel) => document.querySelector(sel);
 const el = (tag, attrs = {}, ...children) => {
@@ -57,12 +55,14 @@ async function flush() {
   // arrive before the POST's response).
   if (!jik.pending.has(jik.generation)) jik.pending.set(jik.generation, since);
   try {
-    const res = await fetch("/api/dashboard/state", {
+    const res = await fetch(api("/state"), {
       method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(patch),
     });
     const body = await res.json();
     if (!res.ok) {
-      setStatus(body.detail.map((d) => d.msg).join("; "), true);
+      // (the session's "refused" event shows it and puts the controls back; this covers a
+      // refusal of the request itself)
+      setStatus(Array.isArray(body.detail) ? body.detail.map((d) => d.msg).join("; ") : body.detail, true);
       jik.pending.delete(jik.generation);
       return;
     }
@@ -71,71 +71,6 @@ async function flush() {
     inFlight = false;
     if (Object.keys(queued).length) flush();
   }
-}
-
-// ---------------------------------------------------------------- holding the scene still
-// While the pointer is on the controls (or the keyboard works in them), the 3D scene's animation
-// holds still (POST /api/dashboard/hold, renewed while it lasts; the server ends a hold that is
-// not renewed). A playing scene keeps viser's client rendering, and without a GPU that takes
-// more than a core, which the change about to be made needs to be computed and drawn. The same
-// holds on the scene's own GUI panel: the viser client says so (static/scene_hold.js).
-const HOLD_SECONDS = 4;
-const hold = {
-  holder: Math.random().toString(36).slice(2, 12) || "page", pointer: false, keyboard: false,
-  scenePointer: false, sceneKeyboard: false, sceneMessages: 0, timer: null,
-};
-jik.hold = hold; // (read by the browser test)
-
-function sendHold(seconds) {
-  fetch("/api/dashboard/hold", {
-    method: "POST", headers: { "Content-Type": "application/json" }, keepalive: true,
-    body: JSON.stringify({ holder: hold.holder, seconds }),
-  }).catch(() => {}); // (a lost hold only lets the animation go on)
-}
-
-function updateHold() {
-  const on = Boolean(jik.config && jik.config.scene_port) && (
-    hold.pointer || hold.keyboard || hold.scenePointer || hold.sceneKeyboard);
-  if (on && hold.timer === null) {
-    sendHold(HOLD_SECONDS);
-    hold.timer = setInterval(() => sendHold(HOLD_SECONDS), (HOLD_SECONDS * 1000) / 2);
-  } else if (!on && hold.timer !== null) {
-    clearInterval(hold.timer);
-    hold.timer = null;
-    sendHold(0);
-  }
-  $("#controls").classList.toggle("holding", on);
-}
-
-function watchHold() {
-  const form = $("#controls");
-  form.addEventListener("pointerenter", () => { hold.pointer = true; updateHold(); });
-  form.addEventListener("pointerleave", () => { hold.pointer = false; updateHold(); });
-  // Keyboard focus only: a click leaves the focus on the control after the pointer has gone.
-  form.addEventListener("focusin", (ev) => { hold.keyboard = ev.target.matches(":focus-visible"); updateHold(); });
-  form.addEventListener("focusout", (ev) => {
-    if (!form.contains(ev.relatedTarget)) { hold.keyboard = false; updateHold(); }
-  });
-  window.addEventListener("pagehide", () => {
-    hold.pointer = hold.keyboard = hold.scenePointer = hold.sceneKeyboard = false;
-    updateHold();
-  });
-  // The scene's GUI panel (static/scene_hold.js): only messages from the scene's frame, of the
-  // one expected shape. The frame may not hear the pointer leave: a move on this page ends its
-  // pointer's hold.
-  const frame = $("#scene");
-  window.addEventListener("message", (ev) => {
-    if (ev.source !== frame.contentWindow || ev.origin !== new URL(frame.src).origin) return;
-    const d = ev.data;
-    if (!d || d.jik !== "scene-hold" || typeof d.pointer !== "boolean" || typeof d.keyboard !== "boolean") return;
-    hold.sceneMessages += 1;
-    hold.scenePointer = d.pointer;
-    hold.sceneKeyboard = d.keyboard;
-    updateHold();
-  });
-  document.addEventListener("pointermove", (ev) => {
-    if (ev.target !== frame && hold.scenePointer) { hold.scenePointer = false; updateHold(); }
-  }, { passive: true });
 }
 
 // ---------------------------------------------------------------- controls
@@ -276,7 +211,6 @@ function showProgress(fraction, elapsed) {
   const box = $("#progress");
   // Only computations longer than half a second get a progress bar.
   box.hidden = !(elapsed > 0.5 && fraction < 1);
-  if (!box.hidden) jik.progressShown = (jik.progressShown || 0) + 1;
   $("#progress-bar").style.width = `${Math.round(100 * fraction)}%`;
   $("#progress-text").textContent = `computing ${Math.round(100 * fraction)}%`;
 }
@@ -288,11 +222,12 @@ function onState(msg) {
   jik.generation = Math.max(jik.generation, msg.generation);
   if (rebuild) buildControls(msg.state);
   else syncControls(msg.state);
+  rememberInUrl(msg.state);
   if (msg.generation > jik.shownGeneration) setStatus(`computing generation ${msg.generation}…`);
 }
 
-// A figure that is one plotly table is drawn as an HTML table: the same cells, ~10x faster
-// than plotly's SVG table (40-110 ms a redraw on this machine).
+// A figure that is one plotly table is drawn as an HTML table: the same cells, drawn far faster
+// than plotly's SVG table (docs/benchmarks.md).
 function isTable(fig) {
   return fig.data.length === 1 && fig.data[0].type === "table";
 }
@@ -420,7 +355,6 @@ function panelTools(div, key) {
 
 const drawn = {}; // panel -> digest of the figure on screen
 async function drawFigures(figures, digests = {}, robot = null) {
-  jik.drawnNow = {}; // panel -> "moved", "drawn" or "ahead" with its ms, this call's (for the latency)
   const pre = (robot && ahead.robots[robot]) || {};
   if (robot) delete ahead.robots[robot];
   try {
@@ -428,35 +362,24 @@ async function drawFigures(figures, digests = {}, robot = null) {
       const div = document.getElementById(`plot-${key}`);
       if (!div || (digests[key] && drawn[key] === digests[key])) return null; // unchanged panel
       drawn[key] = digests[key];
-      const t0 = performance.now(); // until this panel's redraw resolved (panels share one thread)
       if (pre[key] && pre[key].digest === digests[key] && pre[key].width === div.getBoundingClientRect().width) {
         showAhead(div, pre[key].div, key, fig);
-        jik.panelPlan[key] = null;
-        jik.panelSync[key] = jik.panelDraw[key] = Math.round(performance.now() - t0);
-        jik.drawnNow[key] = `ahead ${jik.panelDraw[key]} ms`;
         return null;
       }
       if (isTable(fig)) {
         onScreen[key] = null;
         drawTable(div, fig);
-        jik.panelSync[key] = jik.panelDraw[key] = Math.round(performance.now() - t0);
         return null;
       }
       div.classList.remove("html-table");
       const move = plan(div, key, fig); // (before plotly fills the layout in)
-      // (How it moved, null when drawn: the lines animated and the keys relayouted; for the
-      // browser test.)
-      jik.panelPlan[key] = move && { lines: move.frame ? move.frame.traces : [], relayout: Object.keys(move.relayout) };
       const p = move
         ? (Object.keys(move.relayout).length ? Plotly.relayout(div, move.relayout) : Promise.resolve())
           .then(() => !move.frame || Plotly.animate(div, move.frame, MOVE))
         : Plotly.react(div, fig.data, fig.layout, PLOT_CONFIG);
       panelTools(div, key);
-      jik.panelSync[key] = Math.round(performance.now() - t0); // the synchronous share
       return p.then(() => {
         if (onScreen[key] && onScreen[key].shown === null) onScreen[key].shown = JSON.stringify(axisRanges(div.layout));
-        jik.panelDraw[key] = Math.round(performance.now() - t0);
-        jik.drawnNow[key] = `${move ? "moved" : "drawn"} ${jik.panelDraw[key]} ms`;
       });
     }));
   } finally {
@@ -466,7 +389,7 @@ async function drawFigures(figures, digests = {}, robot = null) {
 
 // Another robot's panels, drawn off screen from an "ahead" event (its default state, solved
 // while the page was idle): a switch to that robot shows them at once instead of drawing four
-// plotly figures (150-250 ms in the browser test), when the result's figure is the same.
+// plotly figures, when the result's figure is the same.
 const ahead = { robots: {}, tokens: {} }; // robots: robot -> panel -> {div, digest, width}
 function discard(panels) {
   for (const p of panels) { Plotly.purge(p.div); p.div.remove(); }
@@ -514,58 +437,6 @@ function showAhead(div, pre, key, fig) {
   onScreen[key] = screenEntry(fig, shape(fig), axisRanges(fig.layout), JSON.stringify(axisRanges(pre.layout)));
 }
 
-// plotly's code runs unoptimised at first: the first changes after loading were drawn 30-50 ms
-// slower than later ones in the browser test. Once, half a second after the first result, each
-// panel's figure goes off screen the two ways a change takes (drawFigures), three times each:
-// drawn (Plotly.react), then moved (Plotly.animate of its lines, Plotly.relayout of its ranges,
-// shapes and title). Each step waits for an idle moment with no change in flight (up to 5 s),
-// so that this work does not hold up a change the user makes meanwhile.
-const WARM_ROUNDS = 3;
-// (Safari has no requestIdleCallback: a short timeout there.)
-const whenIdle = window.requestIdleCallback ? window.requestIdleCallback.bind(window) : (callback) => setTimeout(callback, 50);
-const idle = (until = performance.now() + 5000) => new Promise((resolve) => {
-  const wait = () => whenIdle(
-    () => (jik.pending.size && performance.now() < until ? setTimeout(wait, 50) : resolve()), { timeout: 1000 });
-  wait();
-});
-async function warmUp(figures) {
-  const steps = { react: 0, animate: 0, relayout: 0 }; // (read by the browser test)
-  const box = el("div", { className: "warmup", style: "position:absolute;left:-5000px;top:0;width:700px" });
-  document.body.append(box);
-  try {
-    for (const fig of Object.values(figures)) {
-      if (isTable(fig) || !fig.data.length) continue;
-      const div = el("div");
-      box.append(div);
-      const lines = lineIndices(fig);
-      const ranges = Object.entries(axisRanges(fig.layout)).filter(([, r]) => Array.isArray(r) && r.length === 2);
-      for (let i = 0; i < WARM_ROUNDS; i++) {
-        await idle();
-        const copy = JSON.parse(JSON.stringify(fig)); // new arrays: a full redraw each time
-        await Plotly.react(div, copy.data, copy.layout, PLOT_CONFIG);
-        steps.react += 1;
-      }
-      for (let i = 0; i < WARM_ROUNDS; i++) {
-        await idle();
-        if (lines.length === fig.data.length) {
-          await Plotly.animate(div, moveFrame(JSON.parse(JSON.stringify(fig.data)), lines), MOVE);
-          steps.animate += 1;
-        }
-        // (other ranges every other round: the axes are drawn anew, as for a jump of x0)
-        const relayout = { "title.text": `${(fig.layout.title || {}).text || ""} ${i}` };
-        for (const [k, [lo, hi]] of ranges) relayout[`${k}.range`] = i % 2 ? [lo, hi] : [lo - 0.1 * (hi - lo), hi];
-        if (fig.layout.shapes) relayout.shapes = JSON.parse(JSON.stringify(fig.layout.shapes)); // (its own)
-        await Plotly.relayout(div, relayout);
-        steps.relayout += 1;
-      }
-      Plotly.purge(div);
-    }
-  } finally {
-    box.remove();
-    jik.warmed = steps;
-  }
-}
-
 async function onResult(msg) {
   if (msg.generation < jik.shownGeneration) return;
   if (!jik.state) onState({ state: msg.state, generation: msg.generation });
@@ -577,30 +448,15 @@ async function onResult(msg) {
     drawn[key] = undefined;
   }
   const now = performance.now();
-  // (every result's, those of changes made in the scene too: epoch ms, for the browser test)
-  jik.lastDrawn = {
-    generation: msg.generation, arrivedAt: performance.timeOrigin + msg.browser.arrived,
-    draw: now - msg.browser.parsed, panels: jik.drawnNow,
-  };
   jik.shownGeneration = msg.generation;
   document.body.dataset.generation = msg.generation;
   document.body.dataset.robot = msg.state.robot;
   for (const [before, since] of [...jik.pending]) {
     if (msg.generation > before) {
       const g = before;
-      jik.lastLatency = {
-        generation: msg.generation, ms: now - since, server: msg.timing,
-        changedAt: performance.timeOrigin + since, // epoch ms: comparable with the scene's frame
-        arrived: msg.browser.arrived - since, parse: msg.browser.parsed - msg.browser.arrived,
-        draw: jik.lastDrawn.draw, panels: jik.drawnNow,
-      };
-      jik.latencies.push(jik.lastLatency);
+      jik.lastLatency = { generation: msg.generation, ms: now - since };
       jik.pending.delete(g);
     }
-  }
-  if (jik.firstUpdate === null) {
-    jik.firstUpdate = now;
-    setTimeout(() => warmUp(msg.figures), 500);
   }
   showProgress(1, 0);
   renderVerdict(msg);
@@ -650,18 +506,14 @@ async function onFunctionals(msg) {
 }
 
 function connect() {
-  const source = new EventSource("/api/dashboard/events");
+  const source = new EventSource(api("/events"));
   const on = (kind, fn) => source.addEventListener(kind, (ev) => fn(JSON.parse(ev.data)));
   let chain = Promise.resolve();
   const serial = (fn) => (msg) => { chain = chain.then(() => fn(msg)).catch((err) => setStatus(String(err), true)); };
   on("state", onState);
   on("progress", (msg) => { if (msg.generation === jik.generation) showProgress(msg.fraction, msg.elapsed); });
-  source.addEventListener("result", (ev) => {
-    const arrived = performance.now();
-    const msg = JSON.parse(ev.data);
-    msg.browser = { arrived, parsed: performance.now() };
-    serial(onResult)(msg);
-  });
+  on("result", serial(onResult));
+  on("refused", onRefused);
   on("functionals", serial(onFunctionals));
   on("ahead", (msg) => { onAhead(msg).catch((err) => console.warn("drawing ahead:", err)); });
   // The server's "error" events carry data; the connection's own error events do not (both
@@ -676,6 +528,65 @@ function connect() {
   });
 }
 
+// A change the session refused (from this page or from the scene): the controls show the
+// values in force again, and the refusal stays in the header until the next change.
+function onRefused(msg) {
+  jik.pending.delete(jik.generation);
+  onState({ state: msg.state, generation: msg.generation });
+  setStatus(`refused (${msg.source === "scene" ? "in the 3D scene" : "here"}): ${msg.message}`, true);
+}
+
+// ---------------------------------------------------------------- the session and its link
+// The page's URL holds the state (?state=<JSON of the dashboard's fields>): a copied link, or a
+// reload, starts a new session with the same state.
+function rememberInUrl(state) {
+  const url = new URL(location.href);
+  url.searchParams.set("state", JSON.stringify(state));
+  history.replaceState(null, "", url);
+}
+function stateFromUrl() {
+  const text = new URL(location.href).searchParams.get("state");
+  if (!text) return {};
+  try {
+    const state = JSON.parse(text);
+    return state && typeof state === "object" && !Array.isArray(state) ? state : {};
+  } catch (err) {
+    setStatus(`the link's state is not valid JSON (${err.message}); starting from the defaults`, true);
+    return {};
+  }
+}
+// A software WebGL renderer (no GPU) draws the scene without shadows and environment map.
+function softwareRenderer() {
+  try {
+    const gl = document.createElement("canvas").getContext("webgl");
+    const info = gl && gl.getExtension("WEBGL_debug_renderer_info");
+    const name = info ? gl.getParameter(info.UNMASKED_RENDERER_WEBGL) : "";
+    return /swiftshader|llvmpipe|software|softpipe/i.test(name);
+  } catch (err) {
+    return false;
+  }
+}
+async function openSession(state) {
+  const res = await fetch("/api/sessions", {
+    method: "POST", headers: { "Content-Type": "application/json" },
+    body: JSON.stringify({ state, low_end: softwareRenderer() }),
+  });
+  const body = await res.json();
+  if (res.status === 422 && Object.keys(state).length) {
+    setStatus(`the link's state was refused (${body.detail.map((d) => d.msg).join("; ")}); starting from the defaults`, true);
+    return openSession({});
+  }
+  if (!res.ok) throw new Error(typeof body.detail === "string" ? body.detail : JSON.stringify(body.detail));
+  return body;
+}
+function copyLink() {
+  const button = $("#copy-link");
+  navigator.clipboard.writeText(location.href).then(
+    () => { button.textContent = "link copied"; },
+    () => { button.textContent = "copy the address bar"; },
+  );
+}
+
 async function main() {
   for (const a of ["pseudoinverse", "extended"]) document.documentElement.style.setProperty(`--${a}`, "");
   const [config, catalogue] = await Promise.all([
@@ -685,21 +596,27 @@ async function main() {
   jik.config = config;
   jik.catalogue = catalogue;
   for (const [a, c] of Object.entries(config.colors)) document.documentElement.style.setProperty(`--${a}`, c);
+  const session = await openSession(stateFromUrl());
+  jik.session = session.id;
+  $("#export-json").href = api("/export.json");
+  $("#export-csv").href = api("/export.csv");
+  $("#copy-link").addEventListener("click", copyLink);
+  onState({ state: session.state, generation: session.generation });
   const frame = $("#scene");
-  if (config.scene_port) {
-    // On a loopback address, name the other loopback host: a different site gets its own
-    // renderer process, so the scene's WebGL does not hold up the plots on this page.
-    const swap = { "127.0.0.1": "localhost", localhost: "127.0.0.1" };
-    const host = swap[location.hostname] || location.hostname;
-    frame.src = `${location.protocol}//${host}:${config.scene_port}/`;
+  if (session.scene) {
+    const ws = `${location.protocol === "https:" ? "wss" : "ws"}://${location.host}${api("/scene")}`;
+    frame.src = `/scene/?websocket=${encodeURIComponent(ws)}`;
   } else {
     frame.hidden = true;
     const note = $("#scene-note");
     note.hidden = false;
-    note.textContent = "The 3D scene runs with `jik serve` (viser on the scene port).";
+    note.textContent = "The 3D scene runs with `jik serve`.";
   }
-  watchHold();
   connect();
+  // A closing tab ends its session at once (otherwise it expires when idle); a tab restored from
+  // the browser's page cache then starts a new one from its URL.
+  addEventListener("pagehide", () => { fetch(api(""), { method: "DELETE", keepalive: true }); });
+  addEventListener("pageshow", (ev) => { if (ev.persisted) location.reload(); });
 }
 
 main().catch((err) => setStatus(String(err), true));

@@ -11,7 +11,6 @@ import pytest
 
 from jik.app.dashboard import (
     ALGORITHMS,
-    SECOND_PHASE_DELAY,
     Cancelled,
     Dashboard,
     _cache_key,
@@ -324,9 +323,13 @@ def test_known_functionals_are_drawn_with_the_first_result():
 
     dashboard.subscribe(listener)
     assert second.wait(60)
+    second.clear()
     generation, _ = dashboard.update({"cycles": 2})
     assert dashboard.wait(generation, timeout=60)
-    time.sleep(2 * SECOND_PHASE_DELAY)
+    deadline = time.monotonic() + 60
+    while not any(k == "functionals" and g == generation for k, g, _ in events):
+        assert time.monotonic() < deadline, "no functionals event for the change"
+        time.sleep(0.02)
     dashboard.stop()
     result = next(json.loads(d) for k, g, d in events if k == "result" and g == generation)
     assert result["stale"] == []
@@ -383,200 +386,13 @@ def test_animation_timeline_ends_at_the_last_configuration():
         np.testing.assert_allclose(end[a], run.x[-1], atol=1e-9)
 
 
-def test_page_static_files_and_state_api():
-    """The page, plotly.js from the plotly package, and the state endpoints over HTTP."""
-    from fastapi.testclient import TestClient
-
-    from jik.app.main import create_app
-
-    app = create_app()
-    client = TestClient(app)  # no lifespan: the dashboard does not use the compute pool
-    page = client.get("/")
-    assert page.status_code == 200 and 'id="plot-task"' in page.text
-    assert "http" not in page.text.replace("http-equiv", "")  # nothing from the network
-    js = client.get("/static/vendor/plotly.min.js")
-    assert js.status_code == 200 and js.headers["content-type"].startswith("text/javascript")
-    assert client.get("/static/app.js").status_code == 200
-    # The page's icon, from the package (browsers ask for /favicon.ico without one).
-    assert '<link rel="icon" href="/static/favicon.svg"' in page.text
-    icon = client.get("/static/favicon.svg")
-    assert icon.status_code == 200 and icon.headers["content-type"].startswith("image/svg+xml")
-    assert client.get("/static/..%2Fpyproject.toml").status_code == 404
-    assert client.get("/static/__init__.py").status_code == 404
-    config = client.get("/api/dashboard/config").json()
-    assert config["colors"] == {"pseudoinverse": "#d62728", "extended": "#1f77b4"}
-
-    bad = client.post("/api/dashboard/state", json={"gamma": -1})
-    assert bad.status_code == 422
-    assert bad.json()["detail"][0] == {
-        "loc": ["body", "gamma"], "msg": "gamma must be > 0, got -1.0", "type": "value_error"
-    }  # fmt: skip
-    assert client.post("/api/dashboard/state", content=b"[1]").status_code == 422
-    ok = client.post("/api/dashboard/state", json={"task": "target", "x0": [0.2, 0.1, 1.4]})
-    assert ok.status_code == 200 and ok.json()["state"]["x0"] == [0.2, 0.1, 1.4]
-    dashboard = app.state.dashboard
-    assert dashboard.wait(ok.json()["generation"], timeout=60)
-    snapshot = client.get("/api/dashboard/state").json()
-    assert snapshot["computed_generation"] == ok.json()["generation"]
-    assert snapshot["summary"]["extended"]["success"]
-    csv = client.get("/api/dashboard/export.csv")
-    assert csv.status_code == 200 and csv.text.startswith("algorithm,leg,theta,x1")
-    body = client.get("/api/dashboard/export.json").json()
-    assert body["state"]["x0"] == [0.2, 0.1, 1.4]
-    assert len(body["runs"]["pseudoinverse"]["x"][0]) == 3
-    dashboard.stop()
-
-
-def test_the_hold_api_keeps_one_hold_per_holder_and_refuses_bad_values():
-    """POST /api/dashboard/hold: each holder has one hold, which ends by itself or with 0."""
-    from fastapi.testclient import TestClient
-
-    from jik.app.dashboard import MAX_HOLD_SECONDS, MAX_HOLDERS
-    from jik.app.main import create_app
-
-    app = create_app()
-    client = TestClient(app)
-    dashboard = app.state.dashboard = Dashboard()  # (never started: holds need no computation)
-    for body, field in [
-        ({"holder": "page", "seconds": -1}, "seconds"),
-        ({"holder": "page", "seconds": MAX_HOLD_SECONDS + 1}, "seconds"),
-        ({"holder": "page", "seconds": "long"}, "seconds"),
-        ({"holder": "", "seconds": 1}, "holder"),
-        ({"holder": "a b", "seconds": 1}, "holder"),
-        ({"holder": "x" * 65, "seconds": 1}, "holder"),
-        ({"seconds": 1}, "holder"),
-        ({"holder": "page", "seconds": 1, "extra": 1}, "extra"),
-    ]:
-        r = client.post("/api/dashboard/hold", json=body)
-        assert r.status_code == 422, body
-        assert r.json()["detail"][0]["loc"][-1] == field, r.json()
-    nan = client.post("/api/dashboard/hold", content=b'{"holder": "page", "seconds": NaN}',
-                      headers={"Content-Type": "application/json"})  # fmt: skip
-    assert nan.status_code == 422 and not dashboard.held()
-    with pytest.raises(InvalidInputError, match="seconds must be in"):
-        dashboard.hold("page", float("nan"))
-
-    r = client.post("/api/dashboard/hold", json={"holder": "page", "seconds": 4})
-    assert r.status_code == 200 and 3.5 < r.json()["held_seconds"] <= 4.0
-    assert dashboard.held()
-    assert 0.5 < dashboard.hold("other", 1.0) <= 4.0  # (the longer hold is the page's)
-    r = client.post("/api/dashboard/hold", json={"holder": "page", "seconds": 0})
-    assert r.status_code == 200 and 0.5 < r.json()["held_seconds"] <= 1.0  # "other" holds on
-    assert dashboard.held()
-    # a renewal replaces the holder's hold
-    assert dashboard.hold("other", 0.05) == pytest.approx(0.05, abs=1e-6)
-    time.sleep(0.1)
-    assert not dashboard.held()  # ended by itself
-    for k in range(MAX_HOLDERS):
-        dashboard.hold(f"h{k}", 5.0)
-    full = client.post("/api/dashboard/hold", json={"holder": "one-more", "seconds": 1})
-    assert full.status_code == 422 and "let a hold end" in full.json()["detail"][0]["msg"]
-    renewal = client.post("/api/dashboard/hold", json={"holder": "h0", "seconds": 1})
-    assert renewal.status_code == 200
-
-
-def test_a_hold_stills_the_playing_scene_until_it_ends():
-    """While held (the page's pointer on its controls), the playing scene sends no animation
-    frames and shows a new result at its end; when the hold ends, it plays on from there."""
-    import socket
-
-    from jik.app.scene import DashboardScene
-
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
-    dashboard = Dashboard()
-    scene = DashboardScene(dashboard, port=port)
-
-    def until(condition, what: str, timeout: float = 30.0) -> None:
-        deadline = time.monotonic() + timeout
-        while not condition():
-            assert time.monotonic() < deadline, what
-            time.sleep(0.02)
-
-    try:
-        until(lambda: dashboard.scene_status.get("generation", 0) >= 1, "no first drawing")
-        assert scene.playing and dashboard.scene_status["held"] is False
-        s0 = scene._s
-        until(lambda: scene._s != s0, "the animation does not play")
-        dashboard.hold("test", 3.0)
-        until(lambda: dashboard.scene_status["held"] is True, "the hold is not seen")
-        posed = []
-        for m in scene._mechanisms.values():  # every pose the animation sends from now on
-            m.pose = lambda x, _pose=m.pose: (posed.append(x), _pose(x))
-        held_at = scene._s
-        time.sleep(0.5)
-        assert scene._s == held_at and not posed
-        second = updated_state(dashboard.state, {"x0": [0.3, 0.0, 1.5]})
-        scene._draw(compute(second, 50))  # a new result while held: shown at its end
-        assert scene._timeline is not None and scene._s == scene._timeline.length
-        assert scene.scrub.value == 1.0
-        n = len(posed)
-        time.sleep(0.3)
-        assert len(posed) == n, "frames sent while held"
-        dashboard.hold("test", 0.0)
-        until(lambda: dashboard.scene_status["held"] is False, "the hold did not end")
-        until(lambda: scene._s < scene._timeline.length, "the animation did not start over")
-        assert scene.playing
-        # Every viser client, those connecting later too, runs the script that tells the page
-        # when the pointer is on the scene's GUI panel (the browser test uses it).
-        from jik.app.scene import CLIENT_SCRIPT
-
-        buffer = scene.server._websock_server._broadcast_buffer.message_from_id.values()
-        scripts = [m.source for m in buffer if type(m).__name__ == "RunJavascriptMessage"]
-        assert scene.gui_hold and scripts == [CLIENT_SCRIPT.read_text(encoding="utf-8")]
-    finally:
-        scene.stop()
-        dashboard.stop()
-
-
-def test_the_scene_draws_a_result_after_the_page_only_while_a_browser_shows_it(monkeypatch):
-    """With a viser client connected the scene draws a result SCENE_DELAY after its event, so
-    that the page's redraw and the client's frames do not start at once on the same cores; with
-    none it draws at once."""
-    import socket
-    from types import SimpleNamespace
-
-    from jik.app import scene as scene_module
-    from jik.app.scene import SCENE_DELAY, DashboardScene
-
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
-    dashboard = Dashboard()
-    scene = DashboardScene(dashboard, port=port)
-    try:
-        assert dashboard.wait(1, timeout=60)
-        event = dashboard._latest["result"]
-        calls: list[tuple] = []
-        here = threading.current_thread()
-
-        def sleep(seconds: float) -> None:  # (this thread's; the scene's own threads sleep)
-            if threading.current_thread() is here:
-                calls.append(("sleep", seconds))
-            else:
-                time.sleep(seconds)
-
-        monkeypatch.setattr(scene_module, "time", SimpleNamespace(**{**vars(time), "sleep": sleep}))
-        monkeypatch.setattr(scene, "_draw", lambda result: calls.append(("draw", result)))
-        scene._on_event(event)
-        assert calls == [("draw", event.result)]
-        calls.clear()
-        monkeypatch.setattr(scene.server, "get_clients", lambda: {0: object()})
-        scene._on_event(event)
-        assert calls == [("sleep", SCENE_DELAY), ("draw", event.result)]
-    finally:
-        scene.stop()
-        dashboard.stop()
-
-
 def test_viser_gui_and_drag_change_the_one_state():
     """The scene's GUI and its start-point gizmo write to the same Dashboard as the page."""
     import socket
     import time
     from types import SimpleNamespace
 
-    from jik.app.scene import CONTROLS_DELAY, DRAG_INTERVAL, DashboardScene, yaw_quaternion
+    from jik.app.scene import DRAG_INTERVAL, DashboardScene, yaw_quaternion
 
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -591,16 +407,15 @@ def test_viser_gui_and_drag_change_the_one_state():
         assert dashboard.scene_status["robot"] == "manipulator2"
         scene._controls["gamma"].value = 2.5  # what a slider move in the viser GUI does
         assert dashboard.state.gamma == 2.5
-        assert dashboard.held()  # the animation holds still for the drag's next change
         target = SimpleNamespace(position=(0.4, 0.25, 0.3), wxyz=yaw_quaternion(1.7))
         scene._on_drag(SimpleNamespace(phase="end", target=target))
         np.testing.assert_allclose(dashboard.state.x0, (0.25, 0.4, 1.7), atol=1e-12)
-        # A press where the gizmo is holds the animation and changes nothing; the first move
+        # A press where the gizmo is changes nothing; the first move
         # right after it is applied at once; a second within DRAG_INTERVAL when that ends,
         # though no event follows (the pose a drag rests at).
         generation = dashboard.generation
         scene._on_drag(SimpleNamespace(phase="start", target=target))
-        assert dashboard.generation == generation and dashboard.held()
+        assert dashboard.generation == generation
         moved = SimpleNamespace(position=(0.5, 0.25, 0.3), wxyz=yaw_quaternion(1.7))
         scene._on_drag(SimpleNamespace(phase="update", target=moved))
         np.testing.assert_allclose(dashboard.state.x0, (0.25, 0.5, 1.7), atol=1e-12)
@@ -619,17 +434,14 @@ def test_viser_gui_and_drag_change_the_one_state():
         while dashboard.scene_status["generation"] < dashboard.generation:
             assert time.monotonic() < deadline, "the scene did not redraw"
             time.sleep(0.05)
-        # A change from elsewhere (the page) moves the scene's GUI, with the drawing of its
-        # result (the viser client's main thread stays free for the computation meanwhile).
-        generation, _ = dashboard.update({"gamma": 0.5})
-        deadline = time.monotonic() + 30
-        while dashboard.scene_status["generation"] < generation:
-            assert time.monotonic() < deadline, "the scene did not draw the change"
-            time.sleep(0.02)
+        # A change from elsewhere (the page) moves the scene's GUI at once.
+        dashboard.update({"gamma": 0.5})
         assert scene._controls["gamma"].value == 0.5
-        # Not before: a state event leaves the GUI's inputs as they are until its drawing.
-        scene._on_state(updated_state(dashboard.state, {"gamma": 0.7}))
-        assert scene._controls["gamma"].value == 0.5 and scene._sync_pending
+        # A value the dashboard refuses puts the GUI back to the value in force and says so.
+        scene._controls["gamma"].value = -1.0
+        assert dashboard.state.gamma == 0.5
+        assert scene._controls["gamma"].value == 0.5
+        assert "refused" in scene.status.content and "gamma" in scene.status.content
         # A user's change while another thread sets the GUI's values (the animation's
         # position slider, the worker's sync) is kept: only that thread's callbacks are its own.
         syncing, release = threading.Event(), threading.Event()
@@ -647,19 +459,12 @@ def test_viser_gui_and_drag_change_the_one_state():
         release.set()
         other.join()
         assert dashboard.state.gamma == 1.5
-        # Another robot: its controls replace the old ones CONTROLS_DELAY later; of two quick
-        # switches the last one's.
+        # Another robot: its controls replace the old ones at once.
         dashboard.update({"robot": "manipulator1"})
-        assert not scene._controls and not scene._folders
-        deadline = time.monotonic() + 10
-        while "robot" not in scene._controls:
-            assert time.monotonic() < deadline, "no controls for manipulator1"
-            time.sleep(0.02)
         assert scene._controls["robot"].value == "manipulator1"
         assert "augmentation_parameters.a" in scene._controls
         dashboard.update({"robot": "manipulator2"})
         dashboard.update({"robot": "unicycle"})
-        time.sleep(CONTROLS_DELAY + 0.5)
         assert scene._controls["robot"].value == "unicycle" and len(scene._folders) == 2
         assert "robot_parameters.q0" in scene._controls
     finally:
@@ -775,7 +580,8 @@ def test_offloaded_computation_is_the_same_and_can_be_cancelled():
     generation cancels it; if it dies, the run is redone here and a new process serves."""
     from jik.app.dashboard import Offload
 
-    offload = Offload()
+    pool = Offload()
+    offload = pool.lane()
     try:
         for robot in ("manipulator1", "manipulator2"):
             state = default_state(robot)
@@ -798,7 +604,7 @@ def test_offloaded_computation_is_the_same_and_can_be_cancelled():
         offload.newest(9)
         with pytest.raises(Cancelled):
             compute(state, 8, offload=offload)
-        for process in list(offload._pool._processes.values()):
+        for process in list(pool._pool._processes.values()):
             process.kill()
             process.join()
         again = compute(state, 10, offload=offload)
@@ -808,6 +614,7 @@ def test_offloaded_computation_is_the_same_and_can_be_cancelled():
         assert compute(state, 11, offload=offload).runs["pseudoinverse"].success
     finally:
         offload.close()
+        pool.close()
 
 
 def test_offload_process_leaves_with_a_killed_server(tmp_path):
@@ -823,9 +630,9 @@ def test_offload_process_leaves_with_a_killed_server(tmp_path):
         "import time\n"
         "from jik.app.dashboard import Offload, compute, default_state\n"
         "if __name__ == '__main__':\n"
-        "    offload = Offload()\n"
-        "    compute(default_state('manipulator2'), offload=offload)\n"
-        "    print(*offload._pool._processes, flush=True)\n"
+        "    pool = Offload()\n"
+        "    compute(default_state('manipulator2'), offload=pool.lane())\n"
+        "    print(*pool._pool._processes, flush=True)\n"
         "    time.sleep(60)\n"
     )
     path = tmp_path / "server.py"

@@ -1,0 +1,298 @@
+"""Dashboard sessions over HTTP: one per browser tab (:mod:`jik.app.sessions`).
+
+The page creates its session from the state in its URL (``POST /api/sessions``), changes it
+(``POST /api/sessions/{id}/state``), follows it (``GET /api/sessions/{id}/events``, server-sent
+events) and shows its 3D scene, whose websocket goes through
+``/api/sessions/{id}/scene`` to the session's own viser server on a loopback port. The id is a
+random token: only the tab that created the session knows it.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+from typing import Annotated
+from urllib.parse import urlsplit
+
+import websockets
+import websockets.asyncio.client
+from fastapi import APIRouter, Depends, Request, WebSocket
+from fastapi.responses import JSONResponse, PlainTextResponse, StreamingResponse
+from websockets.typing import Subprotocol
+
+from jik.app.dashboard import Event, export_csv, export_json
+from jik.app.schemas import SessionCreate
+from jik.app.sessions import Session, SessionNotFound, SessionsFull, SessionStore
+from jik.engine.exceptions import InvalidInputError
+
+router = APIRouter(tags=["dashboard sessions"])
+#: Seconds between keep-alive comments on the event stream.
+HEARTBEAT = 15.0
+#: The events the page follows.
+PAGE_EVENTS = ("state", "progress", "result", "functionals", "error", "ahead", "refused")
+#: Seconds an export waits for the session's first result.
+EXPORT_WAIT = 60.0
+
+
+def store_of(request: Request) -> SessionStore:
+    """The app's session store (one without 3D scenes unless ``jik serve`` set one up)."""
+    store = getattr(request.app.state, "sessions", None)
+    if store is None:
+        store = request.app.state.sessions = SessionStore()
+    return store
+
+
+Store = Annotated[SessionStore, Depends(store_of)]
+
+
+def _not_found(session_id: str) -> JSONResponse:
+    return JSONResponse(
+        status_code=404,
+        content={"detail": f"no dashboard session {session_id!r} (it expired or never existed); "
+                 "reload the page to start a new one"},
+    )  # fmt: skip
+
+
+def _invalid(loc: tuple[str, ...], message: str) -> JSONResponse:
+    return JSONResponse(
+        status_code=422,
+        content={"detail": [{"loc": ["body", *loc], "msg": message, "type": "value_error"}]},
+    )
+
+
+def _field_of(message: str, patch: dict) -> str:
+    for key in patch:
+        if message.startswith(key) or f" {key}" in message:
+            return key
+    return next(iter(patch), "body")
+
+
+def _created(session: Session) -> dict:
+    dashboard = session.dashboard
+    return {
+        "id": session.id,
+        "generation": dashboard.generation,
+        "state": dashboard.state.as_dict(),
+        "scene": session.scene is not None,
+    }
+
+
+@router.post("/api/sessions", status_code=201)
+async def create_session(body: SessionCreate, store: Store) -> JSONResponse:
+    """A new session whose state is the defaults changed by ``state`` (a link's state)."""
+    try:
+        session = await asyncio.to_thread(store.create, body.state, body.low_end)
+    except InvalidInputError as exc:
+        return _invalid(("state", _field_of(str(exc), body.state)), str(exc))
+    except SessionsFull as exc:
+        return JSONResponse(status_code=503, content={"detail": str(exc)},
+                            headers={"Retry-After": "30"})  # fmt: skip
+    return JSONResponse(status_code=201, content=_created(session))
+
+
+@router.get("/api/sessions/{session_id}")
+async def get_session(session_id: str, store: Store) -> JSONResponse:
+    """The session's state, its generation and the summary of its last result."""
+    try:
+        return JSONResponse(store.get(session_id).dashboard.snapshot())
+    except SessionNotFound:
+        return _not_found(session_id)
+
+
+@router.delete("/api/sessions/{session_id}", status_code=204)
+async def delete_session(session_id: str, store: Store):
+    """End the session now (a closing tab; otherwise it expires when idle)."""
+    try:
+        await asyncio.to_thread(store.delete, session_id)
+    except SessionNotFound:
+        return _not_found(session_id)
+    return PlainTextResponse(status_code=204, content="")
+
+
+@router.post("/api/sessions/{session_id}/state")
+async def post_state(session_id: str, request: Request, store: Store) -> JSONResponse:
+    """Change some controls: ``{"gamma": 2}``, ``{"x0": [...]}``, ``{"robot": "manipulator1"}``.
+
+    The body is a partial dashboard state; the answer is the new generation and state (422 with
+    the engine's message for a value it refuses, which the session's scene shows too).
+    """
+    try:
+        session = store.get(session_id)
+    except SessionNotFound:
+        return _not_found(session_id)
+    try:
+        patch = await request.json()
+    except ValueError:
+        return _invalid((), "the body must be a JSON object")
+    if not isinstance(patch, dict):
+        return _invalid((), "the body must be a JSON object of dashboard fields")
+    try:
+        generation, state = session.dashboard.update(patch, source="page")
+    except InvalidInputError as exc:
+        return _invalid((_field_of(str(exc), patch),), str(exc))
+    return JSONResponse({"generation": generation, "state": state.as_dict()})
+
+
+@router.get("/api/sessions/{session_id}/events")
+async def events(session_id: str, request: Request, store: Store):
+    """Server-sent events of one session: ``state``, ``progress``, ``result``, ``functionals``,
+    ``error``, ``ahead``, ``refused``.
+
+    Each event's data is JSON; a ``result`` carries every panel as a plotly figure, an
+    ``ahead`` the panels of another robot's default state, solved ahead for a switch.
+    """
+    try:
+        session = store.get(session_id)
+    except SessionNotFound:
+        return _not_found(session_id)
+    dashboard = session.dashboard
+    loop = asyncio.get_running_loop()
+    queue: asyncio.Queue[Event] = asyncio.Queue()
+
+    def listener(event: Event) -> None:
+        loop.call_soon_threadsafe(queue.put_nowait, event)
+
+    unsubscribe = dashboard.subscribe(listener)
+    session.users += 1
+
+    async def stream():
+        try:
+            yield "retry: 1000\n\n"
+            while True:
+                try:
+                    event = await asyncio.wait_for(queue.get(), HEARTBEAT)
+                except TimeoutError:
+                    if await request.is_disconnected():
+                        return
+                    yield ": keep-alive\n\n"
+                    continue
+                # A newer result makes queued progress of older generations pointless.
+                if event.kind == "progress" and event.generation < dashboard.generation:
+                    continue
+                if event.kind not in PAGE_EVENTS:
+                    continue
+                yield f"event: {event.kind}\nid: {event.generation}\ndata: {event.data}\n\n"
+        finally:
+            unsubscribe()
+            session.users -= 1
+            session.touch()
+
+    return StreamingResponse(
+        stream(),
+        media_type="text/event-stream",
+        headers={"Cache-Control": "no-cache", "X-Accel-Buffering": "no"},
+    )
+
+
+async def _finished(session: Session):
+    """The session's dashboard, after waiting (up to :data:`EXPORT_WAIT`) for its result."""
+    dashboard = session.dashboard
+    if dashboard.result is None:
+        await asyncio.to_thread(dashboard.wait, None, EXPORT_WAIT)
+    return dashboard
+
+
+@router.get("/api/sessions/{session_id}/export.json")
+async def export_result_json(session_id: str, store: Store) -> JSONResponse:
+    """The session's result, every trajectory point of both algorithms, as JSON."""
+    try:
+        dashboard = await _finished(store.get(session_id))
+    except SessionNotFound:
+        return _not_found(session_id)
+    if dashboard.result is None:
+        return JSONResponse(status_code=503, content={"detail": "no result computed yet"})
+    body = export_json(dashboard.result, dashboard.functionals)
+    return JSONResponse(
+        body, headers={"Content-Disposition": 'attachment; filename="jik-result.json"'}
+    )
+
+
+@router.get("/api/sessions/{session_id}/export.csv")
+async def export_result_csv(session_id: str, store: Store):
+    """The session's result as CSV: one row per trajectory point and algorithm."""
+    try:
+        dashboard = await _finished(store.get(session_id))
+    except SessionNotFound:
+        return _not_found(session_id)
+    if dashboard.result is None:
+        return PlainTextResponse("no result computed yet\n", status_code=503)
+    return PlainTextResponse(
+        export_csv(dashboard.result),
+        media_type="text/csv",
+        headers={"Content-Disposition": 'attachment; filename="jik-result.csv"'},
+    )
+
+
+def same_origin(headers) -> bool:
+    """Whether a request's ``Origin`` (if any) names the host it was sent to: a page of another
+    site may open a websocket to us (browsers do not stop it), and must not drive a session."""
+    origin = headers.get("origin")
+    if origin is None:
+        return True  # not a browser page (curl, a test client)
+    return urlsplit(origin).netloc == headers.get("host", "")
+
+
+@router.websocket("/api/sessions/{session_id}/scene")
+async def scene_socket(websocket: WebSocket, session_id: str) -> None:
+    """The session's 3D scene: the viser client's websocket, relayed to the session's viser
+    server (loopback only). Closes with 4403 for another origin, 4404 for no such session."""
+    if not same_origin(websocket.headers):
+        await websocket.close(code=4403)
+        return
+    store = getattr(websocket.app.state, "sessions", None)
+    try:
+        session = store.get(session_id) if store is not None else None
+    except SessionNotFound:
+        session = None
+    if session is None or session.scene is None:
+        await websocket.close(code=4404)
+        return
+    offered = [Subprotocol(p) for p in websocket.scope.get("subprotocols", [])]
+    port = session.scene.port
+    try:
+        upstream = await websockets.asyncio.client.connect(
+            f"ws://127.0.0.1:{port}", subprotocols=offered or None, max_size=None,
+            compression=None, open_timeout=10,
+        )  # fmt: skip
+    except (OSError, websockets.exceptions.WebSocketException, TimeoutError):
+        await websocket.close(code=1011)
+        return
+    await websocket.accept(subprotocol=upstream.subprotocol)
+    session.users += 1
+    try:
+        await _relay(websocket, upstream)
+    finally:
+        session.users -= 1
+        session.touch()
+        await upstream.close()
+
+
+async def _relay(websocket: WebSocket, upstream) -> None:
+    """Copy messages both ways until either side closes."""
+
+    async def down() -> None:
+        async for message in upstream:
+            if isinstance(message, bytes):
+                await websocket.send_bytes(message)
+            else:
+                await websocket.send_text(message)
+
+    async def up() -> None:
+        while True:
+            message = await websocket.receive()
+            if message["type"] == "websocket.disconnect":
+                return
+            data = message.get("bytes")
+            await upstream.send(data if data is not None else message.get("text", ""))
+
+    tasks = [asyncio.create_task(down()), asyncio.create_task(up())]
+    try:
+        await asyncio.wait(tasks, return_when=asyncio.FIRST_COMPLETED)
+    finally:
+        for task in tasks:
+            task.cancel()
+        for task in tasks:
+            with contextlib.suppress(asyncio.CancelledError, Exception):
+                await task
+        with contextlib.suppress(Exception):
+            await websocket.close()

@@ -1,0 +1,193 @@
+"""Dashboard sessions: one :class:`~jik.app.dashboard.Dashboard` (and its 3D scene) per tab.
+
+Every browser tab creates its own session from the state in its URL; the session's id is a
+random token that only that tab holds, so nobody else sees or changes its state. Sessions are
+bounded in number (:attr:`SessionLimits.max_sessions`) and expire when idle: a session with no
+page listening (event stream) and no scene connected, untouched for ``idle_seconds``, is
+stopped. When the store is full, the session idle the longest makes room; if every session is in
+use the new one is refused (the route answers 503).
+
+The sessions' computations share one bounded pool: each dashboard's second process is the same
+:class:`~jik.app.dashboard.Offload` (``workers`` processes, first come first served), and every
+session's own thread computes the other algorithm.
+"""
+
+from __future__ import annotations
+
+import os
+import secrets
+import threading
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from jik.app.dashboard import Dashboard, Offload, default_state, updated_state
+
+
+class SessionNotFound(KeyError):
+    """No session with that id (never created, or expired)."""
+
+
+class SessionsFull(RuntimeError):
+    """Every session slot is in use; the message says how many and what to do."""
+
+
+@dataclass(frozen=True)
+class SessionLimits:
+    """How many sessions, how long an idle one lives, how many compute processes they share."""
+
+    max_sessions: int = 32
+    idle_seconds: float = 600.0
+    workers: int = 1
+
+    @classmethod
+    def from_env(cls) -> SessionLimits:
+        """``JIK_MAX_SESSIONS``, ``JIK_SESSION_IDLE_SECONDS``, ``JIK_DASHBOARD_WORKERS``."""
+        return cls(
+            max_sessions=max(1, int(os.environ.get("JIK_MAX_SESSIONS", cls.max_sessions))),
+            idle_seconds=max(1.0, float(os.environ.get("JIK_SESSION_IDLE_SECONDS",
+                                                       cls.idle_seconds))),
+            workers=max(0, int(os.environ.get("JIK_DASHBOARD_WORKERS", cls.workers))),
+        )  # fmt: skip
+
+
+@dataclass
+class Session:
+    """One tab's dashboard and, when the server draws scenes, its viser scene."""
+
+    id: str
+    dashboard: Dashboard
+    scene: Any = None  # a jik.app.scene.DashboardScene (.port, .stop()), or None
+    touched: float = field(default_factory=time.monotonic)
+    #: Open event streams and scene connections: a session with any is in use.
+    users: int = 0
+
+    def touch(self) -> None:
+        self.touched = time.monotonic()
+
+    def stop(self) -> None:
+        if self.scene is not None:
+            self.scene.stop()
+        self.dashboard.stop()
+
+
+class SessionStore:
+    """The server's sessions, by id.
+
+    Parameters
+    ----------
+    limits : SessionLimits
+    scene_factory : callable, optional
+        ``scene_factory(dashboard, low_end)`` starts the 3D scene of a new session (``jik
+        serve`` gives :func:`jik.app.scene.start_scene`: a viser server on a loopback port);
+        without it sessions have no scene.
+    """
+
+    def __init__(
+        self,
+        limits: SessionLimits | None = None,
+        scene_factory: Callable[[Dashboard, bool], Any] | None = None,
+    ) -> None:
+        self.limits = limits or SessionLimits()
+        self._scene_factory = scene_factory
+        self._sessions: dict[str, Session] = {}
+        self._lock = threading.Lock()
+        self._offload = Offload(self.limits.workers) if self.limits.workers else None
+        self._closed = threading.Event()
+        self._reaper: threading.Thread | None = None
+
+    def __len__(self) -> int:
+        return len(self._sessions)
+
+    def create(self, patch: Mapping[str, object] | None = None, low_end: bool = False) -> Session:
+        """A new session whose state is the defaults changed by ``patch`` (validated first);
+        ``low_end``: its scene is drawn for a software renderer.
+
+        Raises
+        ------
+        InvalidInputError
+            ``patch`` names an unknown field or a value the registry refuses.
+        SessionsFull
+            Every slot holds a session in use.
+        """
+        state = default_state()
+        if patch:
+            state = updated_state(state, patch)
+        self.expire()
+        with self._lock:
+            if len(self._sessions) >= self.limits.max_sessions:
+                self._evict_idlest()
+            session_id = secrets.token_urlsafe(16)
+            dashboard = Dashboard(state, offload=self._offload)
+            session = Session(session_id, dashboard)
+            self._sessions[session_id] = session
+        if self._scene_factory is not None:
+            session.scene = self._scene_factory(dashboard, low_end)
+        dashboard.start()
+        self._start_reaper()
+        return session
+
+    def _start_reaper(self) -> None:
+        """Expire idle sessions every quarter of the idle limit (at most every 30 s), so that a
+        server nobody opens a new tab on still frees them."""
+        with self._lock:
+            if self._reaper is not None:
+                return
+            period = min(30.0, self.limits.idle_seconds / 4)
+
+            def reap() -> None:
+                while not self._closed.wait(period):
+                    self.expire()
+
+            self._reaper = threading.Thread(target=reap, name="jik-session-reaper", daemon=True)
+            self._reaper.start()
+
+    def get(self, session_id: str) -> Session:
+        """The session ``session_id``, touched; :class:`SessionNotFound` if there is none."""
+        with self._lock:
+            session = self._sessions.get(session_id)
+        if session is None:
+            raise SessionNotFound(session_id)
+        session.touch()
+        return session
+
+    def delete(self, session_id: str) -> None:
+        with self._lock:
+            session = self._sessions.pop(session_id, None)
+        if session is None:
+            raise SessionNotFound(session_id)
+        session.stop()
+
+    def expire(self) -> int:
+        """Stop the sessions idle for longer than the limit; how many were stopped."""
+        deadline = time.monotonic() - self.limits.idle_seconds
+        with self._lock:
+            old = [s for s in self._sessions.values() if s.users == 0 and s.touched < deadline]
+            for session in old:
+                del self._sessions[session.id]
+        for session in old:
+            session.stop()
+        return len(old)
+
+    def _evict_idlest(self) -> None:
+        """Make room (with the lock held): stop the session unused the longest."""
+        idle = [s for s in self._sessions.values() if s.users == 0]
+        if not idle:
+            raise SessionsFull(
+                f"the server has {len(self._sessions)} dashboard sessions in use, its limit; "
+                "close a tab or try again later"
+            )
+        oldest = min(idle, key=lambda s: s.touched)
+        del self._sessions[oldest.id]
+        threading.Thread(target=oldest.stop, name="jik-session-stop", daemon=True).start()
+
+    def close(self) -> None:
+        """Stop every session and the shared compute processes."""
+        self._closed.set()
+        with self._lock:
+            sessions, self._sessions = list(self._sessions.values()), {}
+        for session in sessions:
+            session.stop()
+        if self._offload is not None:
+            self._offload.close()

@@ -1,0 +1,207 @@
+"""Dashboard sessions over HTTP: one per tab, isolated, bounded, expiring (issue 27)."""
+
+from __future__ import annotations
+
+import json
+import time
+
+import pytest
+from fastapi.testclient import TestClient
+from starlette.websockets import WebSocketDisconnect
+
+from jik.app.main import create_app
+from jik.app.sessions import SessionLimits, SessionNotFound, SessionsFull, SessionStore
+
+
+@pytest.fixture
+def app():
+    """The app with a scene-less session store (no lifespan: sessions need no compute pool)."""
+    app = create_app()
+    app.state.sessions = SessionStore(SessionLimits(max_sessions=4, workers=0))
+    yield app
+    app.state.sessions.close()
+
+
+@pytest.fixture
+def client(app):
+    return TestClient(app)
+
+
+def _open(client, state=None) -> dict:
+    r = client.post("/api/sessions", json={"state": state or {}})
+    assert r.status_code == 201, r.text
+    return r.json()
+
+
+def _computed(app, session_id: str) -> None:
+    dashboard = app.state.sessions.get(session_id).dashboard
+    assert dashboard.wait(timeout=60)
+
+
+def test_page_static_files_and_config():
+    """The page, plotly.js from the plotly package, the icon and the dashboard's config."""
+    client = TestClient(create_app())
+    page = client.get("/")
+    assert page.status_code == 200 and 'id="plot-task"' in page.text
+    assert "http" not in page.text.replace("http-equiv", "")  # nothing from the network
+    js = client.get("/static/vendor/plotly.min.js")
+    assert js.status_code == 200 and js.headers["content-type"].startswith("text/javascript")
+    assert client.get("/static/app.js").status_code == 200
+    assert '<link rel="icon" href="/static/favicon.svg"' in page.text
+    icon = client.get("/static/favicon.svg")
+    assert icon.status_code == 200 and icon.headers["content-type"].startswith("image/svg+xml")
+    assert client.get("/static/..%2Fpyproject.toml").status_code == 404
+    assert client.get("/static/__init__.py").status_code == 404
+    config = client.get("/api/dashboard/config").json()
+    assert config["colors"] == {"pseudoinverse": "#d62728", "extended": "#1f77b4"}
+    # The viser client for the sessions' scenes, from the viser package.
+    scene = client.get("/scene/")
+    assert scene.status_code == 200 and "<script" in scene.text
+
+
+def test_each_session_has_its_own_state(app, client):
+    """A change in one session never reaches another; a new one starts from the defaults."""
+    one, two = _open(client), _open(client)
+    assert one["id"] != two["id"] and one["state"] == two["state"]
+    defaults = one["state"]
+    r = client.post(f"/api/sessions/{one['id']}/state",
+                    json={"robot": "manipulator1", "gamma": 2.0})  # fmt: skip
+    assert r.status_code == 200 and r.json()["state"]["robot"] == "manipulator1"
+    assert client.get(f"/api/sessions/{two['id']}").json()["state"] == defaults
+    assert client.get(f"/api/sessions/{one['id']}").json()["state"]["gamma"] == 2.0
+    assert _open(client)["state"] == defaults
+
+
+def test_a_link_state_opens_a_session_with_that_state(app, client):
+    """The state a page keeps in its URL gives a new session the same state and numbers."""
+    first = _open(client)
+    changed = client.post(f"/api/sessions/{first['id']}/state",
+                          json={"x0": [0.2, 0.1, 1.4], "cycles": 2}).json()["state"]  # fmt: skip
+    again = _open(client, changed)
+    assert again["state"] == changed
+    _computed(app, first["id"])
+    _computed(app, again["id"])
+    a = client.get(f"/api/sessions/{first['id']}").json()["summary"]
+    b = client.get(f"/api/sessions/{again['id']}").json()["summary"]
+    for run in (*a.values(), *b.values()):
+        del run["seconds"]  # (the time each took)
+    assert a == b and a["extended"]["success"]
+
+
+@pytest.mark.parametrize(
+    ("state", "field"),
+    [({"gamma": -1}, "gamma"), ({"robot": "nope"}, "robot"), ({"cycles": 0}, "cycles")],
+)
+def test_a_bad_link_state_is_refused_with_its_field(client, state, field):
+    r = client.post("/api/sessions", json={"state": state})
+    assert r.status_code == 422, r.text
+    assert r.json()["detail"][0]["loc"] == ["body", "state", field]
+
+
+def test_bad_changes_name_their_field_and_leave_the_state(client):
+    session = _open(client)
+    url = f"/api/sessions/{session['id']}/state"
+    bad = client.post(url, json={"gamma": -1})
+    assert bad.status_code == 422
+    assert bad.json()["detail"][0] == {
+        "loc": ["body", "gamma"], "msg": "gamma must be > 0, got -1.0", "type": "value_error"
+    }  # fmt: skip
+    assert client.post(url, content=b"[1]").status_code == 422
+    assert client.get(f"/api/sessions/{session['id']}").json()["state"] == session["state"]
+
+
+def test_export_is_per_session(app, client):
+    one, two = _open(client), _open(client)
+    client.post(f"/api/sessions/{one['id']}/state", json={"task": "target", "x0": [0.2, 0.1, 1.4]})
+    _computed(app, one["id"])
+    csv = client.get(f"/api/sessions/{one['id']}/export.csv")
+    assert csv.status_code == 200 and csv.text.startswith("algorithm,leg,theta,x1")
+    body = client.get(f"/api/sessions/{one['id']}/export.json").json()
+    assert body["state"]["x0"] == [0.2, 0.1, 1.4]
+    assert len(body["runs"]["pseudoinverse"]["x"][0]) == 3
+    other = client.get(f"/api/sessions/{two['id']}/export.json").json()
+    assert other["state"]["x0"] == two["state"]["x0"]
+
+
+def test_unknown_and_deleted_sessions_are_404(client):
+    assert client.get("/api/sessions/nope").status_code == 404
+    assert client.post("/api/sessions/nope/state", json={"gamma": 1}).status_code == 404
+    assert client.get("/api/sessions/nope/events").status_code == 404
+    session = _open(client)
+    assert client.delete(f"/api/sessions/{session['id']}").status_code == 204
+    gone = client.get(f"/api/sessions/{session['id']}")
+    assert gone.status_code == 404 and "reload the page" in gone.json()["detail"]
+
+
+def test_a_full_store_evicts_the_idlest_unused_session_or_refuses():
+    store = SessionStore(SessionLimits(max_sessions=2, workers=0))
+    try:
+        a = store.create()
+        b = store.create()
+        b.touch()
+        c = store.create()  # a was idle the longest: it makes room
+        with pytest.raises(SessionNotFound):
+            store.get(a.id)
+        assert len(store) == 2
+        b.users = c.users = 1  # both followed by a tab
+        with pytest.raises(SessionsFull, match="2 dashboard sessions in use"):
+            store.create()
+    finally:
+        store.close()
+
+
+def test_a_full_store_answers_503(app, client):
+    app.state.sessions.close()
+    app.state.sessions = store = SessionStore(SessionLimits(max_sessions=1, workers=0))
+    session = _open(client)
+    store.get(session["id"]).users = 1
+    r = client.post("/api/sessions", json={"state": {}})
+    assert r.status_code == 503 and "in use" in r.json()["detail"]
+    assert r.headers["retry-after"] == "30"
+
+
+def test_idle_sessions_expire_by_themselves():
+    store = SessionStore(SessionLimits(idle_seconds=1.0, workers=0))
+    try:
+        kept, idle = store.create(), store.create()
+        kept.users = 1
+        deadline = time.monotonic() + 10
+        while len(store) > 1:  # the reaper runs every quarter of the idle limit
+            assert time.monotonic() < deadline, "the idle session did not expire"
+            time.sleep(0.05)
+        assert store.get(kept.id) is kept
+        with pytest.raises(SessionNotFound):
+            store.get(idle.id)
+        assert idle.dashboard._stopped  # (its worker thread ended)
+    finally:
+        store.close()
+
+
+def test_a_refused_change_is_an_event_with_the_state_in_force(app, client):
+    """The page and the scene both follow a session's events: a refusal from either is shown
+    by both, with the values in force."""
+    from jik.engine.exceptions import InvalidInputError
+
+    session = _open(client)
+    dashboard = app.state.sessions.get(session["id"]).dashboard
+    events = []
+    dashboard.subscribe(lambda e: events.append(e))
+    with pytest.raises(InvalidInputError):
+        dashboard.update({"gamma": -2}, source="scene")
+    (refused,) = [json.loads(e.data) for e in events if e.kind == "refused"]
+    assert refused["source"] == "scene" and "gamma" in refused["message"]
+    assert refused["fields"] == ["gamma"]
+    assert refused["state"]["gamma"] == session["state"]["gamma"]
+
+
+def test_the_scene_socket_refuses_other_origins_and_unknown_sessions(client):
+    session = _open(client)
+    url = f"/api/sessions/{session['id']}/scene"
+    with pytest.raises(WebSocketDisconnect) as foreign:
+        with client.websocket_connect(url, headers={"origin": "http://evil.example"}):
+            pass
+    assert foreign.value.code == 4403
+    with pytest.raises(WebSocketDisconnect) as unknown:
+        with client.websocket_connect("/api/sessions/nope/scene"):
+            pass
+    assert unknown.value.code == 4404
