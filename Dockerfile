@@ -1,5 +1,5 @@
-# jik: REST API (port 8000) and viser 3D scene (port 8080).
-#   docker build -t jik . && docker run -p 8000:8000 -p 8080:8080 jik
+# jik: REST API, dashboard and its 3D scenes, all on port 8000.
+#   docker build -t jik . && docker run -p 8000:8000 jik
 # BASE can point at any Debian-like image with Python 3.11 or newer and venv
 # (scripts/docker-smoke.sh builds one with debootstrap).
 ARG BASE=python:3.11-slim
@@ -31,5 +31,5 @@ RUN python3 -m venv /opt/jik \
 
 USER 10001:10001
 WORKDIR /home/jik
-EXPOSE 8000 8080
-CMD ["jik", "serve", "--host", "0.0.0.0", "--port", "8000", "--scene-port", "8080"]
+EXPOSE 8000
+CMD ["jik", "serve", "--host", "0.0.0.0", "--port", "8000"]

@@ -80,13 +80,12 @@ step "reproduce table1, serve, and query the dashboard inside the container"
 CTR=$(buildah from "$IMAGE")
 trap 'buildah rm "$CTR" >/dev/null 2>&1 || true' EXIT
 PORT=${JIK_SMOKE_PORT:-18000}
-SCENE=${JIK_SMOKE_SCENE_PORT:-18080}
-# Chroot isolation shares the host's network namespace, so ports other than 8000/8080 avoid
+# Chroot isolation shares the host's network namespace, so a port other than 8000 avoids
 # clashes with servers already running on the host. The image's user (10001) runs the server.
 buildah run --isolation chroot --user 10001:10001 "$CTR" -- sh -c "
   id
   jik reproduce table1 || exit 1
-  jik serve --host 127.0.0.1 --port $PORT --scene-port $SCENE >/tmp/serve.log 2>&1 &
+  jik serve --host 127.0.0.1 --port $PORT >/tmp/serve.log 2>&1 &
   pid=\$!
   python - <<PY
 import json, sys, time, urllib.request
@@ -108,8 +107,14 @@ for _ in range(120):
         with urllib.request.urlopen('http://127.0.0.1:$PORT/docs', timeout=10) as r:
             page = r.read().decode()
             print('GET /docs ->', r.status, 'cdn' not in page.lower() and 'assets served locally')
+        req = urllib.request.Request(
+            'http://127.0.0.1:$PORT/api/sessions', data=json.dumps({'state': {}}).encode(),
+            headers={'content-type': 'application/json'})
+        with urllib.request.urlopen(req, timeout=30) as r:
+            session = json.load(r)['id']
+            print('POST /api/sessions ->', r.status, 'a dashboard session')
         for _ in range(240):
-            with urllib.request.urlopen('http://127.0.0.1:$PORT/api/dashboard/state',
+            with urllib.request.urlopen('http://127.0.0.1:$PORT/api/sessions/' + session,
                                         timeout=10) as r:
                 snapshot = json.load(r)
             if snapshot.get('summary'):

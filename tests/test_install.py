@@ -90,10 +90,10 @@ def test_wheel_installs_one_package_and_serves(wheel, tmp_path):
     table = json.loads(run(bin_dir / "jik", "reproduce", "table1", "--json", cwd=elsewhere))
     assert table["pseudoinverse"], table
 
-    port, scene_port = free_port(), free_port()
+    port = free_port()
     env = {**os.environ, "JIK_WORKERS": "1"}
     server = subprocess.Popen(
-        [bin_dir / "jik", "serve", "--port", str(port), "--scene-port", str(scene_port)],
+        [bin_dir / "jik", "serve", "--port", str(port)],
         cwd=elsewhere, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
     )  # fmt: skip
     try:
@@ -109,13 +109,19 @@ def test_wheel_installs_one_package_and_serves(wheel, tmp_path):
 
 
 def first_dashboard_result(base: str, server: subprocess.Popen) -> dict:
-    """Poll the dashboard over HTTP until it has computed a result; its snapshot."""
+    """Open a dashboard session over HTTP (as the page does) and poll it until it has computed a
+    result; its snapshot."""
     deadline = time.monotonic() + FIRST_RESULT_SECONDS
     last: object = None
+    session = None
     while time.monotonic() < deadline:
         assert server.poll() is None, f"jik serve exited {server.returncode}"
         try:
-            last = httpx.get(f"{base}/api/dashboard/state", timeout=5).json()
+            if session is None:
+                created = httpx.post(f"{base}/api/sessions", json={"state": {}}, timeout=30)
+                assert created.status_code == 201, created.text
+                session = created.json()["id"]
+            last = httpx.get(f"{base}/api/sessions/{session}", timeout=5).json()
         except httpx.TransportError as error:
             last = error
         else:
