@@ -14,6 +14,7 @@ in continuous mode only rescales the theta axis without a new integration.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import json
@@ -31,6 +32,7 @@ from typing import cast
 
 import numpy as np
 
+from jik.app.controls import MAX_DASHBOARD_CYCLES, MODES, controls_message, expand
 from jik.engine.exceptions import InvalidInputError, JikError
 from jik.engine.registry import ROBOTS, make_inverse, robot_spec
 from jik.engine.repeatability import MAX_PATH_POINTS, closed_path, cycle_guesses
@@ -42,8 +44,6 @@ ALGORITHMS = ("pseudoinverse", "extended")
 #: One colour per algorithm, used in the scene and in every plot.
 COLORS = {"pseudoinverse": "#d62728", "extended": "#1f77b4"}
 LABELS = {"pseudoinverse": "pseudoinverse J^P# (8)", "extended": "extended Jacobian J^E# (11)"}
-#: Largest number of cycles offered by the dashboard (the engine accepts more).
-MAX_DASHBOARD_CYCLES = 20
 #: Time grid points of one unicycle platform path q(t).
 UNICYCLE_TIME_POINTS = 96
 DEFAULT_ROBOT = "manipulator2"
@@ -69,7 +69,7 @@ class DashboardState:
     target: tuple[float, ...]
     path: tuple[tuple[float, ...], ...]
     cycles: int
-    tol: float = 1e-10
+    tolerance: float = 1e-10
 
     def as_dict(self) -> dict:
         return {
@@ -87,7 +87,7 @@ class DashboardState:
             "target": list(self.target),
             "path": [list(p) for p in self.path],
             "cycles": self.cycles,
-            "tol": self.tol,
+            "tolerance": self.tolerance,
         }
 
 
@@ -117,24 +117,34 @@ def default_state(robot: str = DEFAULT_ROBOT) -> DashboardState:
 def updated_state(state: DashboardState, patch: Mapping[str, object]) -> DashboardState:
     """Apply a partial change and validate the result against the registry.
 
-    Changing ``robot`` starts from that robot's defaults; changing ``augmentation`` resets its
-    parameters to their defaults. Nested parameter dicts are merged.
+    ``patch`` is keyed by state fields or by control keys (:func:`jik.app.controls.expand`:
+    ``{"x0.1": 0.4}``, ``{"path": "1, 1; 1, 2"}``). Changing ``robot`` starts from that robot's
+    defaults; changing ``augmentation`` resets its parameters to their defaults. Nested
+    parameter dicts are merged.
 
     Raises
     ------
     InvalidInputError
-        Unknown keys, or any value the registry or the engine rejects (the message says which).
+        Unknown keys, or any value the registry or the engine rejects; its ``field`` names the
+        field (a dotted path).
     """
+    patch = expand(state, patch)
     known = set(DashboardState.__dataclass_fields__)
     unknown = set(patch) - known
     if unknown:
         raise InvalidInputError(
-            f"unknown dashboard field(s) {sorted(unknown)}; known: {sorted(known)}"
+            f"unknown dashboard field(s) {sorted(unknown)}; known: {sorted(known)}",
+            sorted(unknown)[0],
         )
     if "robot" in patch and patch["robot"] != state.robot:
+        if not isinstance(patch["robot"], str) or patch["robot"] not in ROBOTS:
+            raise InvalidInputError(
+                f"unknown robot {patch['robot']!r}; choose one of {sorted(ROBOTS)}", "robot"
+            )
         state = default_state(str(patch["robot"]))
     if "augmentation" in patch and patch["augmentation"] != state.augmentation:
-        aug = robot_spec(state.robot).augmentation(str(patch["augmentation"]))
+        with _field("augmentation"):
+            aug = robot_spec(state.robot).augmentation(str(patch["augmentation"]))
         state = replace(
             state,
             augmentation=aug.name,
@@ -144,41 +154,81 @@ def updated_state(state: DashboardState, patch: Mapping[str, object]) -> Dashboa
     for key, value in patch.items():
         if key in ("robot", "augmentation"):
             continue
-        if key == "robot_parameters":
-            value = {**state.robot_parameters, **dict(cast("Mapping[str, object]", value))}
-        elif key == "augmentation_parameters":
-            value = {**state.augmentation_parameters, **dict(cast("Mapping[str, object]", value))}
+        if key in ("robot_parameters", "augmentation_parameters"):
+            if not isinstance(value, Mapping):
+                raise InvalidInputError(f"{key} must be an object of parameters", key)
+            value = {**getattr(state, key), **dict(value)}
         values[key] = value
     return validate(replace(state, **values))
 
 
+@contextlib.contextmanager
+def _field(name: str):
+    """Name ``name`` as the field of an :class:`InvalidInputError` raised within that names
+    none (the registry's and the engine's validators name it only in their message)."""
+    try:
+        yield
+    except InvalidInputError as exc:
+        if exc.field is None:
+            exc.field = name
+        raise
+    except (TypeError, ValueError) as exc:  # a value of the wrong type (a list for a number)
+        raise InvalidInputError(f"{name}: {exc}", name) from None
+
+
 def validate(state: DashboardState) -> DashboardState:
-    """Check every field through the registry and the engine's validators; normalise types."""
+    """Check every field through the registry and the engine's validators; normalise types.
+    Each error names its field (:attr:`InvalidInputError.field`)."""
     spec = robot_spec(state.robot)
-    kin = spec.build(**state.robot_parameters)
     given, given_aug = state.robot_parameters, state.augmentation_parameters
-    scalars = {p.name: p.check(given.get(p.name, p.default)) for p in spec.parameters}
-    vectors = {v.name: v.check(given.get(v.name, v.default)) for v in spec.vector_parameters}
-    aug = spec.augmentation(state.augmentation)
-    aug_params = {p.name: p.check(given_aug.get(p.name, p.default)) for p in aug.parameters}
-    x0 = kin.check(state.x0, "x0")
-    if x0.ndim != 1:
-        raise InvalidInputError(f"x0 must be one configuration of length {kin.p}")
-    target = kin.check_task(state.target, "target")
-    if target.ndim != 1:
-        raise InvalidInputError(f"target must be one task point of length {kin.r}")
+    scalars, vectors = {}, {}
+    for p in spec.parameters:
+        with _field(f"robot_parameters.{p.name}"):
+            scalars[p.name] = p.check(given.get(p.name, p.default))
+    for v in spec.vector_parameters:
+        with _field(f"robot_parameters.{v.name}"):
+            vectors[v.name] = v.check(given.get(v.name, v.default))
+    unknown = set(given) - set(scalars) - set(vectors)
+    if unknown:
+        name = sorted(unknown)[0]
+        raise InvalidInputError(f"{spec.name} has no parameter {name!r}",
+                                f"robot_parameters.{name}")  # fmt: skip
+    with _field("robot_parameters"):
+        kin = spec.build(**scalars, **vectors)
+    with _field("augmentation"):
+        aug = spec.augmentation(state.augmentation)
+    aug_params = {}
+    for p in aug.parameters:
+        with _field(f"augmentation_parameters.{p.name}"):
+            aug_params[p.name] = p.check(given_aug.get(p.name, p.default))
+    with _field("x0"):
+        x0 = kin.check(state.x0, "x0")
+        if x0.ndim != 1:
+            raise InvalidInputError(f"x0 must be one configuration of length {kin.p}")
+    with _field("target"):
+        target = kin.check_task(state.target, "target")
+        if target.ndim != 1:
+            raise InvalidInputError(f"target must be one task point of length {kin.r}")
     if state.task not in ("path", "target"):
-        raise InvalidInputError(f"task must be 'path' or 'target', got {state.task!r}")
-    path = kin.check_task(state.path, "path") if len(state.path) else np.zeros((0, kin.r))
-    if state.task == "path" and (path.ndim != 2 or len(path) < 1):
-        raise InvalidInputError("a closed-path task needs at least one path point")
-    if len(path) > MAX_PATH_POINTS:
-        raise InvalidInputError(f"path has {len(path)} points; at most {MAX_PATH_POINTS} allowed")
-    if state.mode not in ("continuous", "discrete"):
-        raise InvalidInputError(f"mode must be 'continuous' or 'discrete', got {state.mode!r}")
-    gamma = positive(state.gamma, "gamma")
-    if state.mode == "discrete" and gamma >= 2:
-        raise InvalidInputError(f"gamma must be < 2 in discrete mode, got {gamma:g}")
+        raise InvalidInputError(f"task must be 'path' or 'target', got {state.task!r}", "task")
+    with _field("path"):
+        path = kin.check_task(state.path, "path") if len(state.path) else np.zeros((0, kin.r))
+        if state.task == "path" and (path.ndim != 2 or len(path) < 1):
+            raise InvalidInputError("a closed-path task needs at least one path point")
+        if len(path) > MAX_PATH_POINTS:
+            raise InvalidInputError(
+                f"path has {len(path)} points; at most {MAX_PATH_POINTS} allowed"
+            )
+    if state.mode not in MODES:
+        raise InvalidInputError(f"mode must be one of {list(MODES)}, got {state.mode!r}", "mode")
+    with _field("gamma"):
+        gamma = positive(state.gamma, "gamma")
+        if state.mode == "discrete" and gamma >= 2:
+            raise InvalidInputError(f"gamma must be < 2 in discrete mode, got {gamma:g}")
+    with _field("cycles"):
+        cycles = count(state.cycles, "cycles", 1, MAX_DASHBOARD_CYCLES)
+    with _field("tolerance"):
+        tolerance = positive(state.tolerance, "tolerance")
     return DashboardState(
         robot=spec.name,
         robot_parameters={**scalars, **vectors},
@@ -190,8 +240,8 @@ def validate(state: DashboardState) -> DashboardState:
         task=state.task,
         target=tuple(float(v) for v in target),
         path=tuple(tuple(float(v) for v in p) for p in path),
-        cycles=count(state.cycles, "cycles", 1, MAX_DASHBOARD_CYCLES),
-        tol=positive(state.tol, "tol"),
+        cycles=cycles,
+        tolerance=tolerance,
     )
 
 
@@ -274,7 +324,7 @@ def _solve_leg(inverse, x, target, state, gamma, cancelled, partial=lambda f: No
     if state.mode == "continuous":
         # One start configuration: a single result, recorded (record=True by default).
         res = cast(SolveResult, solve(inverse, x, target, gamma=gamma, mode="continuous",
-                                      tol=state.tol, guess=guess))  # fmt: skip
+                                      tol=state.tolerance, guess=guess))  # fmt: skip
         tr = res.trajectory
         assert tr is not None  # record=True
         return tr.theta, tr.x, tr.y, tr.error, tr.h, res.success, res.message, res.x
@@ -283,7 +333,7 @@ def _solve_leg(inverse, x, target, state, gamma, cancelled, partial=lambda f: No
     while True:
         try:
             res = cast(SolveResult, solve(inverse, x, target, gamma=gamma, mode="discrete",
-                                          tol=state.tol, max_iterations=chunk))  # fmt: skip
+                                          tol=state.tolerance, max_iterations=chunk))  # fmt: skip
         except JikError as exc:
             # The map is undefined somewhere in this chunk: redo it one iteration at a time to
             # keep every iterate before the stop (the platform paths up to there).
@@ -304,8 +354,8 @@ def _solve_leg(inverse, x, target, state, gamma, cancelled, partial=lambda f: No
         if cancelled():
             raise Cancelled
         # The error decays geometrically: the fraction of the way to tol, on a log scale.
-        e0, e = float(pieces[0][3][0]), float(res.error)
-        partial(np.clip(np.log(e0 / e) / np.log(e0 / state.tol), 0.0, 0.99) if e0 > e > 0 else 0)
+        e0, e, tol = float(pieces[0][3][0]), float(res.error), state.tolerance
+        partial(np.clip(np.log(e0 / e) / np.log(e0 / tol), 0.0, 0.99) if e0 > e > 0 else 0)
     if stopped is not None:
         if not pieces:
             raise stopped
@@ -1189,8 +1239,8 @@ class Dashboard:
                 self._cond.notify_all()
         if refusal is not None:
             refused = {"type": "refused", "generation": generation, "source": source,
-                       "fields": sorted(map(str, patch)), "message": str(refusal),
-                       "state": state.as_dict()}  # fmt: skip
+                       "field": refusal.field, "message": str(refusal),
+                       "state": state.as_dict(), **controls_message(state)}  # fmt: skip
             self._emit(Event("refused", generation, _json(refused)))
             raise refusal
         self._emit(
@@ -1258,7 +1308,7 @@ class Dashboard:
     # -- worker -----------------------------------------------------------------------------
     def _state_message(self, generation: int, state: DashboardState, source: str) -> dict:
         return {"type": "state", "generation": generation, "state": state.as_dict(),
-                "source": source}  # fmt: skip
+                "source": source, **controls_message(state)}  # fmt: skip
 
     def _emit(self, event: Event) -> None:
         with self._cond:

@@ -30,8 +30,11 @@ UNITS = {
     "unicycle": (("m/s", "m/s", "rad/s", "rad/s"), ("m", "m", "rad")),
 }
 PANEL_HEIGHT = 380
-#: Panel ids, in the page's order.
-PANELS = ("task", "drift", "joints", "augmenting", "sensitivity", "table")
+#: Panel ids, in the page's order, with their size on the page's grid ("wide": a whole row,
+#: "tall": two rows).
+PANEL_SIZES = {"task": "wide", "drift": "", "joints": "tall", "augmenting": "",
+               "sensitivity": "", "table": "wide"}  # fmt: skip
+PANELS = tuple(PANEL_SIZES)
 _AXIS = dict(
     gridcolor="#e6e6e6", zerolinecolor="#b0b0b0", linecolor="#888", showline=True, mirror=True,
     ticks="outside", automargin=True,
@@ -151,7 +154,7 @@ def nice_range(values, pad: float = 0.05, from_zero: bool = False) -> list[float
     multiples of a 1-2-5 step near a tenth of the span (``from_zero``: from 0, unpadded).
 
     Nearby data give the same range, so a small change of a control leaves the figure's layout
-    unchanged and the page moves only the traces (``Plotly.animate`` in static/app.js, a third
+    unchanged and the page moves only the traces (``Plotly.animate`` in static/panels.js, a third
     of a full redraw). None when there is nothing finite to show (plotly then autoranges).
     """
     v = np.asarray(values, dtype=float)
@@ -206,7 +209,7 @@ def keep_ranges(spec: dict, before: dict | None) -> dict:
     """Sticky axes: an axis of the figure dict ``spec`` takes the range it had in ``before``
     (the layout of the panel on screen) when the new data lie inside it and span at least
     :data:`KEEP_FILL` of it. Dragging a slider then does not make the axes jump, and the page
-    moves the lines without redrawing the panel (static/app.js). Axes with a fixed tick step
+    moves the lines without redrawing the panel (static/panels.js). Axes with a fixed tick step
     (the cycles of the drift panel), without a range or with categories are left alone."""
     if not before:
         return spec

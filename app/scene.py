@@ -29,9 +29,9 @@ from typing import Any, cast
 import numpy as np
 import viser
 
-from jik.app.dashboard import ALGORITHMS, COLORS, MAX_DASHBOARD_CYCLES, Dashboard, Event, runs_key
+from jik.app.controls import GROUPS, Control, control_values, controls
+from jik.app.dashboard import ALGORITHMS, COLORS, Dashboard, Event, runs_key
 from jik.engine.exceptions import InvalidInputError
-from jik.engine.registry import ROBOTS, robot_spec
 
 FPS = 25.0
 #: The frame of the unicycle's nodes, drawn anew for each result (the manipulators' are kept,
@@ -455,6 +455,7 @@ class DashboardScene:
         # viser declares the setter of a GUI handle's ``value`` apart from its getter, so mypy
         # sees a read-only property; assigning it is viser's API (ignores marked "viser: settable").
         self._controls: dict[str, viser.GuiInputHandle[Any]] = {}
+        self._options: dict[str, dict[str, str]] = {}  # a select's value -> its label
         self._folders: list = []
         self._last_drag = 0.0  # when a move of the gizmo last changed the state
         self._drag_pending: tuple | None = None  # the newest move within DRAG_INTERVAL
@@ -535,185 +536,75 @@ class DashboardScene:
             return
 
     def _rebuild_controls(self, state) -> None:
-        """GUI inputs for ``state``'s robot, from the registry (no hard-coded ranges)."""
+        """GUI inputs for ``state``: one per control of :func:`jik.app.controls.controls` (the
+        page's are built from the same list), in one folder per group."""
         gui = self.server.gui
         for folder in self._folders:
             folder.remove()
-        self._folders, self._controls = [], {}
-        spec = robot_spec(state.robot)
-        c = self._controls
-        # The lambdas' default arguments bind the loop variables; mypy cannot type such a lambda
-        # against the callback type (python/mypy#15459), hence the ignores marked "mypy#15459".
+        self._folders, self._controls, self._options = [], {}, {}
+        spec = controls(state)
+        values = control_values(state)
         self._syncing = True
         try:
-            with gui.add_folder("Robot and algorithm", order=2) as f:
-                self._folders.append(f)
-                c["robot"] = gui.add_dropdown("robot", list(ROBOTS), initial_value=state.robot)
-                c["robot"].on_update(lambda e: self._change({"robot": e.target.value}))
-                for p in spec.parameters:
-                    h: viser.GuiInputHandle[Any] = gui.add_slider(
-                        p.name,
-                        min=p.minimum,
-                        max=p.maximum,
-                        step=(p.maximum - p.minimum) / 200,
-                        initial_value=state.robot_parameters[p.name],
-                        hint=p.description,
-                    )
-                    h.on_update(
-                        lambda e, n=p.name: self._change({"robot_parameters": {n: e.target.value}})  # type: ignore[misc]  # mypy#15459
-                    )
-                    c[f"robot_parameters.{p.name}"] = h
-                for v in spec.vector_parameters:
-                    h = gui.add_vector3(
-                        v.name,
-                        tuple(state.robot_parameters[v.name]),
-                        min=cast("tuple[float, float, float]", tuple(v.minimum)),
-                        max=cast("tuple[float, float, float]", tuple(v.maximum)),
-                        step=0.1,
-                        hint=v.description,
-                    )
-                    h.on_update(
-                        lambda e, n=v.name: self._change(  # type: ignore[misc]  # mypy#15459
-                            {"robot_parameters": {n: list(e.target.value)}}
-                        )
-                    )
-                    c[f"robot_parameters.{v.name}"] = h
-                    for name, preset in v.presets.items():
-                        b = gui.add_button(
-                            f"{v.name} = {name} {tuple(round(t, 2) for t in preset)}"
-                        )
-                        b.on_click(
-                            lambda _, n=v.name, q=list(preset): self._change(  # type: ignore[misc]  # mypy#15459
-                                {"robot_parameters": {n: q}}
-                            )
-                        )
-                c["mode"] = gui.add_dropdown(
-                    "mode", ["continuous", "discrete"], initial_value=state.mode
-                )
-                c["mode"].on_update(
-                    lambda e: self._change(
-                        {
-                            "mode": e.target.value,
-                            "gamma": min(self.dashboard.state.gamma, 1.0)
-                            if e.target.value == "discrete"
-                            else self.dashboard.state.gamma,
-                        }
-                    )
-                )
-                gmax = 1.99 if state.mode == "discrete" else 10.0
-                c["gamma"] = gui.add_slider(
-                    "gamma",
-                    min=0.01,
-                    max=gmax,
-                    step=0.01,
-                    initial_value=min(state.gamma, gmax),
-                    hint="decay rate of the task error, eq. (5)",
-                )
-                c["gamma"].on_update(lambda e: self._change({"gamma": e.target.value}))
-                aug = spec.augmentation(state.augmentation)
-                c["augmentation"] = gui.add_dropdown(
-                    "augmenting map h", [a.name for a in spec.augmentations], initial_value=aug.name
-                )
-                c["augmentation"].on_update(
-                    lambda e: self._change({"augmentation": e.target.value})
-                )
-                for p in aug.parameters:
-                    h = gui.add_slider(
-                        p.name,
-                        min=p.minimum,
-                        max=p.maximum,
-                        step=(p.maximum - p.minimum) / 200,
-                        initial_value=state.augmentation_parameters[p.name],
-                        hint=p.description,
-                    )
-                    h.on_update(
-                        lambda e, n=p.name: self._change(  # type: ignore[misc]  # mypy#15459
-                            {"augmentation_parameters": {n: e.target.value}}
-                        )
-                    )
-                    c[f"augmentation_parameters.{p.name}"] = h
-            with gui.add_folder("Start and task", order=3) as f:
-                self._folders.append(f)
-                for i, name in enumerate(spec.variable_names):
-                    lo, hi = spec.x_range[i] if spec.x_range else (-10.0, 10.0)
-                    h = gui.add_slider(
-                        f"x0: {name}",
-                        min=lo,
-                        max=hi,
-                        step=(hi - lo) / 400,
-                        initial_value=min(max(state.x0[i], lo), hi),
-                    )
-                    h.on_update(lambda e, k=i: self._set_x0(k, e.target.value))  # type: ignore[misc]  # mypy#15459
-                    c[f"x0.{i}"] = h
-                if spec.default_path:
-                    c["task"] = gui.add_dropdown(
-                        "task", ["path", "target"], initial_value=state.task
-                    )
-                    c["task"].on_update(lambda e: self._change({"task": e.target.value}))
-                if state.task == "path":
-                    c["path"] = gui.add_text(
-                        "closed path",
-                        _path_text(state.path),
-                        hint="task points 'y1, y2; y1, y2; ...'",
-                    )
-                    c["path"].on_update(lambda e: self._set_path(e.target.value))
-                    c["cycles"] = gui.add_slider(
-                        "cycles",
-                        min=1,
-                        max=MAX_DASHBOARD_CYCLES,
-                        step=1,
-                        initial_value=state.cycles,
-                    )
-                    c["cycles"].on_update(lambda e: self._change({"cycles": int(e.target.value)}))
-                else:
-                    add = gui.add_vector2 if len(state.target) == 2 else gui.add_vector3
-                    c["target"] = add("target", tuple(state.target), step=0.1)
-                    c["target"].on_update(lambda e: self._change({"target": list(e.target.value)}))
+            for order, (group, title) in enumerate(GROUPS, start=2):
+                with gui.add_folder(title, order=order) as folder:
+                    self._folders.append(folder)
+                    for control in spec:
+                        if control.group == group:
+                            self._add_control(control, values.get(control.key))
         finally:
             self._syncing = False
 
-    def _set_x0(self, k: int, value: float) -> None:
-        x0 = list(self.dashboard.state.x0)
-        x0[k] = float(value)
-        self._change({"x0": x0})
-
-    def _set_path(self, text: str) -> None:
-        try:
-            path = [[float(v) for v in p.split(",")] for p in text.split(";") if p.strip()]
-        except ValueError:
-            self.status.content = "**refused:** the path must be 'y1, y2; y1, y2; ...'"
+    def _add_control(self, control: Control, value: Any) -> None:
+        """One viser input for ``control``; its changes go to the dashboard by the control's key
+        (:func:`jik.app.controls.expand` makes them a state patch)."""
+        gui, key = self.server.gui, control.key
+        handle: Any
+        if control.kind == "preset":
+            button = gui.add_button(control.label, hint=control.help)
+            button.on_click(lambda _: self._change({key: control.value}))
             return
-        self._change({"path": path})
+        if control.kind == "select":
+            by_label = {label: v for v, label in control.options}
+            labels = self._options[key] = {v: label for v, label in control.options}
+            handle = gui.add_dropdown(control.label, list(by_label), initial_value=labels[value],
+                                      hint=control.help)  # fmt: skip
+            handle.on_update(lambda e: self._change({key: by_label[e.target.value]}))
+        elif control.kind == "slider":
+            handle = gui.add_slider(
+                control.label, min=control.minimum, max=control.maximum, step=control.step,
+                initial_value=min(max(value, control.minimum), control.maximum), hint=control.help,
+            )  # fmt: skip
+            handle.on_update(lambda e: self._change({key: e.target.value}))
+        elif control.kind == "vector" and control.size in (2, 3):
+            add: Any = gui.add_vector2 if control.size == 2 else gui.add_vector3
+            lo = None if control.minimum is None else tuple(control.minimum)
+            hi = None if control.maximum is None else tuple(control.maximum)
+            handle = add(control.label, tuple(value), min=lo, max=hi, step=control.step,
+                         hint=control.help)  # fmt: skip
+            handle.on_update(lambda e: self._change({key: list(e.target.value)}))
+        else:  # text (the path), or a vector of another size: as text, parsed by the server
+            hint = f"{control.help} ({control.format})" if control.format else control.help
+            shown = value if isinstance(value, str) else ", ".join(f"{v:g}" for v in value)
+            handle = gui.add_text(control.label, shown, hint=hint)
+            handle.on_update(lambda e: self._change({key: e.target.value}))
+        self._controls[key] = handle
 
     def _sync_controls(self, state) -> None:
-        values = {
-            "robot": state.robot,
-            "mode": state.mode,
-            "gamma": state.gamma,
-            "augmentation": state.augmentation,
-            "task": state.task,
-            "cycles": state.cycles,
-            "path": _path_text(state.path),
-            "target": tuple(state.target),
-        }
-        values.update({f"x0.{i}": v for i, v in enumerate(state.x0)})
-        values.update(
-            {
-                f"robot_parameters.{k}": (tuple(v) if isinstance(v, list | tuple) else v)
-                for k, v in state.robot_parameters.items()
-            }
-        )
-        values.update(
-            {f"augmentation_parameters.{k}": v for k, v in state.augmentation_parameters.items()}
-        )
+        """Set every input to the value in force (the user's own changes included)."""
+        values = control_values(state)
         self._syncing = True
         try:
             for key, handle in self._controls.items():
-                if key in values:
-                    try:
-                        handle.value = values[key]  # type: ignore[misc]  # viser: settable
-                    except (ValueError, AssertionError):
-                        pass
+                value = values.get(key)
+                if key in self._options and isinstance(value, str):
+                    value = self._options[key].get(value, value)
+                elif isinstance(value, list):
+                    value = tuple(value)
+                try:
+                    handle.value = value  # type: ignore[misc]  # viser: settable
+                except (ValueError, AssertionError):
+                    pass
         finally:
             self._syncing = False
 
@@ -1075,10 +966,6 @@ class DashboardScene:
             if now - last_gui > 0.25:
                 last_gui = now
                 self._show_position(timeline)
-
-
-def _path_text(path) -> str:
-    return "; ".join(", ".join(f"{v:g}" for v in p) for p in path)
 
 
 def _extent(result) -> tuple[tuple[float, float], tuple[float, float]]:

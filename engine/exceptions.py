@@ -13,7 +13,20 @@ class JikError(Exception):
 
 
 class InvalidInputError(JikError, ValueError):
-    """An argument has the wrong shape, a non-finite value or an out-of-range parameter."""
+    """An argument has the wrong shape, a non-finite value or an out-of-range parameter.
+
+    Parameters
+    ----------
+    message : str
+        What is wrong and how to fix it.
+    field : str, optional
+        The input it is about, as a dotted path (``"gamma"``, ``"robot_parameters.l"``), when
+        the raiser knows it: a web client maps the error to that field without reading the text.
+    """
+
+    def __init__(self, message: str, field: str | None = None) -> None:
+        super().__init__(message)
+        self.field = field
 
 
 class SingularConfigurationError(JikError):

@@ -15,7 +15,9 @@ from fastapi import APIRouter
 from fastapi.responses import FileResponse, JSONResponse, Response
 
 from jik import static
-from jik.app.dashboard import COLORS, LABELS, MAX_DASHBOARD_CYCLES
+from jik.app.controls import PROGRESS_AFTER
+from jik.app.dashboard import COLORS, LABELS
+from jik.app.figures import PANEL_SIZES
 
 router = APIRouter(tags=["dashboard"])
 
@@ -59,11 +61,13 @@ async def scene_page() -> FileResponse:
 
 @router.get("/api/dashboard/config")
 async def config() -> dict:
-    """The colour and label of each algorithm, and the dashboard's cycle limit."""
+    """The colour and label of each algorithm, the panels (ids and sizes, in order), and when a
+    computation shows its progress. (Each session's controls come with its state.)"""
     return {
         "colors": COLORS,
         "labels": LABELS,
-        "max_cycles": MAX_DASHBOARD_CYCLES,
+        "panels": [{"id": k, "size": v} for k, v in PANEL_SIZES.items()],
+        "progress_after": PROGRESS_AFTER,
     }
 
 

@@ -20,6 +20,7 @@ from fastapi import APIRouter, Depends, Request, WebSocket
 from fastapi.responses import JSONResponse, PlainTextResponse, StreamingResponse
 from websockets.typing import Subprotocol
 
+from jik.app.controls import controls_message
 from jik.app.dashboard import Event, export_csv, export_json
 from jik.app.schemas import SessionCreate
 from jik.app.sessions import Session, SessionNotFound, SessionsFull, SessionStore
@@ -60,11 +61,9 @@ def _invalid(loc: tuple[str, ...], message: str) -> JSONResponse:
     )
 
 
-def _field_of(message: str, patch: dict) -> str:
-    for key in patch:
-        if message.startswith(key) or f" {key}" in message:
-            return key
-    return next(iter(patch), "body")
+def _loc(exc: InvalidInputError) -> tuple[str, ...]:
+    """Where a refused value is, from the field the error names (a dotted path)."""
+    return tuple((exc.field or "").split(".")) if exc.field else ()
 
 
 def _created(session: Session) -> dict:
@@ -74,6 +73,7 @@ def _created(session: Session) -> dict:
         "generation": dashboard.generation,
         "state": dashboard.state.as_dict(),
         "scene": session.scene is not None,
+        **controls_message(dashboard.state),
     }
 
 
@@ -83,7 +83,7 @@ async def create_session(body: SessionCreate, store: Store) -> JSONResponse:
     try:
         session = await asyncio.to_thread(store.create, body.state, body.low_end)
     except InvalidInputError as exc:
-        return _invalid(("state", _field_of(str(exc), body.state)), str(exc))
+        return _invalid(("state", *_loc(exc)), str(exc))
     except SessionsFull as exc:
         return JSONResponse(status_code=503, content={"detail": str(exc)},
                             headers={"Retry-After": "30"})  # fmt: skip
@@ -129,7 +129,7 @@ async def post_state(session_id: str, request: Request, store: Store) -> JSONRes
     try:
         generation, state = session.dashboard.update(patch, source="page")
     except InvalidInputError as exc:
-        return _invalid((_field_of(str(exc), patch),), str(exc))
+        return _invalid(_loc(exc), str(exc))
     return JSONResponse({"generation": generation, "state": state.as_dict()})
 
 

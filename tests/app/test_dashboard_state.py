@@ -461,11 +461,13 @@ def test_viser_gui_and_drag_change_the_one_state():
         assert dashboard.state.gamma == 1.5
         # Another robot: its controls replace the old ones at once.
         dashboard.update({"robot": "manipulator1"})
-        assert scene._controls["robot"].value == "manipulator1"
+        # (the dropdown shows the robots' titles, as the page's selector does)
+        assert scene._controls["robot"].value == ROBOTS["manipulator1"].title
         assert "augmentation_parameters.a" in scene._controls
         dashboard.update({"robot": "manipulator2"})
         dashboard.update({"robot": "unicycle"})
-        assert scene._controls["robot"].value == "unicycle" and len(scene._folders) == 2
+        assert scene._controls["robot"].value == ROBOTS["unicycle"].title
+        assert len(scene._folders) == 2
         assert "robot_parameters.q0" in scene._controls
     finally:
         scene.stop()

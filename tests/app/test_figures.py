@@ -318,7 +318,7 @@ def test_nice_range_pads_the_data_and_rounds_to_a_step():
 
 
 def test_axis_ranges_hold_the_data_and_stay_put_for_a_small_change(path_result):
-    """The page moves traces without a redraw when the layout is unchanged (static/app.js):
+    """The page moves traces without a redraw when the layout is unchanged (static/panels.js):
     a nearby start point keeps every range; the ranges hold every plotted point."""
     here, nearby = (
         compute(updated_state(path_result.state, {"x0": [x1, 0.0, np.pi / 2]}))

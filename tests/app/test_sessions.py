@@ -9,6 +9,7 @@ import pytest
 from fastapi.testclient import TestClient
 from starlette.websockets import WebSocketDisconnect
 
+from jik.app.figures import PANELS
 from jik.app.main import create_app
 from jik.app.sessions import SessionLimits, SessionNotFound, SessionsFull, SessionStore
 
@@ -42,11 +43,13 @@ def test_page_static_files_and_config():
     """The page, plotly.js from the plotly package, the icon and the dashboard's config."""
     client = TestClient(create_app())
     page = client.get("/")
-    assert page.status_code == 200 and 'id="plot-task"' in page.text
+    assert page.status_code == 200 and 'id="panels"' in page.text
     assert "http" not in page.text.replace("http-equiv", "")  # nothing from the network
     js = client.get("/static/vendor/plotly.min.js")
     assert js.status_code == 200 and js.headers["content-type"].startswith("text/javascript")
-    assert client.get("/static/app.js").status_code == 200
+    for module in ("main", "api", "controls", "panels", "dom"):
+        js = client.get(f"/static/{module}.js")
+        assert js.status_code == 200 and js.headers["content-type"].startswith("text/javascript")
     assert '<link rel="icon" href="/static/favicon.svg"' in page.text
     icon = client.get("/static/favicon.svg")
     assert icon.status_code == 200 and icon.headers["content-type"].startswith("image/svg+xml")
@@ -54,6 +57,7 @@ def test_page_static_files_and_config():
     assert client.get("/static/__init__.py").status_code == 404
     config = client.get("/api/dashboard/config").json()
     assert config["colors"] == {"pseudoinverse": "#d62728", "extended": "#1f77b4"}
+    assert [p["id"] for p in config["panels"]] == list(PANELS)
     # The viser client for the sessions' scenes, from the viser package.
     scene = client.get("/scene/")
     assert scene.status_code == 200 and "<script" in scene.text
@@ -190,7 +194,8 @@ def test_a_refused_change_is_an_event_with_the_state_in_force(app, client):
         dashboard.update({"gamma": -2}, source="scene")
     (refused,) = [json.loads(e.data) for e in events if e.kind == "refused"]
     assert refused["source"] == "scene" and "gamma" in refused["message"]
-    assert refused["fields"] == ["gamma"]
+    assert refused["field"] == "gamma"
+    assert refused["values"]["gamma"] == session["state"]["gamma"]
     assert refused["state"]["gamma"] == session["state"]["gamma"]
 
 

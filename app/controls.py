@@ -1,0 +1,223 @@
+"""The dashboard's controls, described once: the page and the 3D scene are both built from this.
+
+:func:`controls` lists the controls of a dashboard state (its robot, augmenting map, mode and
+task), generated from the engine's registry: keys, labels, help text, kinds, ranges (gamma's per
+mode), steps and options. :func:`control_values` gives each control's value as shown, and
+:func:`expand` turns a change of controls (a patch keyed by control keys, ``{"x0.1": 0.4}``,
+``{"path": "1, 1; 1, 2"}``) into a patch of the dashboard's state. Neither the page
+(``static/controls.js``) nor the scene (:mod:`jik.app.scene`) knows a range, a label or a text
+format of its own.
+
+A control's ``key`` is a dotted path into the state: ``gamma``, ``x0.1`` (one coordinate of the
+start x0), ``robot_parameters.l``, ``robot_parameters.q0`` (a vector parameter, edited whole),
+``augmentation_parameters.a``, ``path`` (edited as text).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass
+from typing import Any
+
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.registry import ROBOTS, robot_spec
+
+#: gamma's range per mode: the decay rate of eq. (5) (continuous), the step of the discrete
+#: iteration, which converges only for 0 < gamma < 2.
+GAMMA_RANGE = {"continuous": (0.01, 10.0), "discrete": (0.01, 1.99)}
+#: Switching to discrete mode takes gamma down to this when it is above (the full Newton step).
+DISCRETE_GAMMA_ON_SWITCH = 1.0
+#: Largest number of cycles offered by the dashboard (the engine accepts more).
+MAX_DASHBOARD_CYCLES = 20
+#: Positions of a slider between its ends (x0's: finer).
+SLIDER_STEPS, X0_STEPS = 200, 400
+#: How a closed path is written in a text box: points separated by ';', coordinates by ','.
+PATH_FORMAT = "y1, y2; y1, y2; ..."
+#: A computation shows its progress once it has run this long [s].
+PROGRESS_AFTER = 0.5
+#: The modes of eq. (7): the ODE, or its Euler iteration with step gamma.
+MODES = ("continuous", "discrete")
+#: What the task selector offers.
+TASKS = (("path", "closed path"), ("target", "single target"))
+#: The groups (fieldsets of the page, folders of the scene), in order.
+GROUPS = (("algorithm", "Robot and algorithm"), ("start", "Start and task"))
+
+
+@dataclass(frozen=True)
+class Control:
+    """One control. ``kind``: ``select`` (``options``), ``slider`` (``minimum``..``maximum`` by
+    ``step``, on a ``log`` scale or not, ``integer`` or not), ``vector`` (``size`` numbers, each
+    within ``minimum``/``maximum`` lists), ``text`` (``format``), ``preset`` (a button that sets
+    ``key`` to ``value``)."""
+
+    key: str
+    label: str
+    kind: str
+    group: str
+    help: str = ""
+    options: tuple[tuple[str, str], ...] = ()
+    minimum: Any = None
+    maximum: Any = None
+    step: float | None = None
+    log: bool = False
+    integer: bool = False
+    size: int = 0
+    format: str = ""
+    value: Any = None
+    id: str = ""
+
+    def as_dict(self) -> dict:
+        out = asdict(self)
+        out["id"] = self.id or element_id(self.key)
+        out["options"] = [list(o) for o in self.options]
+        return {k: v for k, v in out.items() if v not in (None, "", (), [], 0, False)}
+
+
+def controls(state) -> list[Control]:
+    """Every control of ``state`` (a :class:`~jik.app.dashboard.DashboardState`), in order."""
+    spec = robot_spec(state.robot)
+    aug = spec.augmentation(state.augmentation)
+    lo, hi = GAMMA_RANGE[state.mode]
+    out = [
+        Control("robot", "robot", "select", "algorithm", "the robot (section 6 of the paper)",
+                options=tuple((name, ROBOTS[name].title) for name in ROBOTS)),
+        Control("mode", "mode", "select", "algorithm",
+                "continuous: the ODE (7); discrete: the iteration x <- x - gamma J# e",
+                options=tuple((m, m) for m in MODES)),
+        Control("gamma", "γ (decay rate)", "slider", "algorithm",
+                "decay rate of the task error, eq. (5) (discrete mode: the step, below 2)",
+                minimum=lo, maximum=hi, step=0.01, log=True),
+    ]  # fmt: skip
+    for p in spec.parameters:
+        out.append(Control(f"robot_parameters.{p.name}", p.name, "slider", "algorithm",
+                           p.description, minimum=p.minimum, maximum=p.maximum,
+                           step=(p.maximum - p.minimum) / SLIDER_STEPS))  # fmt: skip
+    for v in spec.vector_parameters:
+        out.append(Control(f"robot_parameters.{v.name}", v.name, "vector", "algorithm",
+                           v.description, minimum=list(v.minimum), maximum=list(v.maximum),
+                           step=0.1, size=len(v.default)))  # fmt: skip
+        for name, preset in v.presets.items():
+            shown = ", ".join(f"{t:.2f}" for t in preset)
+            out.append(Control(f"robot_parameters.{v.name}", f"{v.name} = {name} ({shown})",
+                               "preset", "algorithm", f"set {v.name} to the paper's pose {name}",
+                               value=[float(t) for t in preset],
+                               id=f"ctl-preset-{v.name}-{name}"))  # fmt: skip
+    out.append(Control("augmentation", "augmenting map h", "select", "algorithm",
+                       "the map h of the extended Jacobian (11)",
+                       options=tuple((a.name, f"{a.name} {a.equation}")
+                                     for a in spec.augmentations)))  # fmt: skip
+    for p in aug.parameters:
+        out.append(Control(f"augmentation_parameters.{p.name}", p.name, "slider", "algorithm",
+                           p.description, minimum=p.minimum, maximum=p.maximum,
+                           step=(p.maximum - p.minimum) / SLIDER_STEPS))  # fmt: skip
+    for i, name in enumerate(spec.variable_names):
+        lo, hi = spec.x_range[i] if spec.x_range else (-10.0, 10.0)
+        out.append(Control(f"x0.{i}", f"x0: {name}", "slider", "start",
+                           f"start configuration, coordinate {name}",
+                           minimum=lo, maximum=hi, step=(hi - lo) / X0_STEPS))  # fmt: skip
+    if spec.default_path:
+        out.append(Control("task", "task", "select", "start",
+                           "drive a closed path cycle after cycle, or solve for one target",
+                           options=TASKS))  # fmt: skip
+    if state.task == "path":
+        out.append(Control("path", "closed path", "text", "start",
+                           "task points visited in order; the path closes back to k(x0)",
+                           format=PATH_FORMAT))  # fmt: skip
+        cycles = Control("cycles", "cycles", "slider", "start", "times around the path",
+                         minimum=1, maximum=MAX_DASHBOARD_CYCLES, step=1, integer=True)  # fmt: skip
+        out.append(cycles)
+    else:
+        out.append(Control("target", "target", "vector", "start",
+                           f"target task point ({', '.join(spec.task_names)})",
+                           step=0.1, size=len(spec.task_names)))  # fmt: skip
+    return out
+
+
+def element_id(key: str) -> str:
+    """The page's element id of the control ``key``: ``ctl-gamma``, ``ctl-x0-1``, ``ctl-l``
+    (a robot parameter), ``ctl-aug-a`` (a parameter of the map)."""
+    short = key.replace("robot_parameters.", "").replace("augmentation_parameters.", "aug-")
+    return "ctl-" + short.replace(".", "-")
+
+
+def control_values(state) -> dict[str, Any]:
+    """Each control's value as shown (the path as text), by key."""
+    d = state.as_dict()
+    values: dict[str, Any] = {}
+    for c in controls(state):
+        if c.kind == "preset":
+            continue
+        values[c.key] = path_text(state.path) if c.key == "path" else lookup(d, c.key)
+    return values
+
+
+def lookup(state: Mapping[str, Any], key: str) -> Any:
+    """The value at a dotted key of a state's dict."""
+    value: Any = state
+    for part in key.split("."):
+        value = value[int(part)] if isinstance(value, list) else value[part]
+    return value
+
+
+def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
+    """A patch of control keys as a patch of the state's fields: ``{"x0.1": v}`` sets one
+    coordinate of x0, ``{"robot_parameters.l": v}`` one parameter, ``{"path": "1, 1; 1, 2"}``
+    the path from its text (:data:`PATH_FORMAT`). Switching to discrete mode without a gamma
+    takes gamma down to :data:`DISCRETE_GAMMA_ON_SWITCH` when it is above."""
+    out: dict[str, Any] = {}
+    for key, value in patch.items():
+        head, _, rest = key.partition(".")
+        if not rest:
+            out[key] = parse_path_text(value) if key == "path" and isinstance(value, str) else value
+        elif head in ("robot_parameters", "augmentation_parameters"):
+            out.setdefault(head, {})[rest] = value
+        elif head in ("x0", "target") and rest.isdigit():
+            vector = out.setdefault(head, list(getattr(state, head)))
+            if int(rest) >= len(vector):
+                raise InvalidInputError(f"{key}: {head} has {len(vector)} coordinates", key)
+            vector[int(rest)] = value
+        else:
+            raise InvalidInputError(f"unknown dashboard control {key!r}", key)
+    if out.get("mode") == "discrete" and "gamma" not in out and state.mode != "discrete":
+        out["gamma"] = min(state.gamma, DISCRETE_GAMMA_ON_SWITCH)
+    return out
+
+
+def path_text(path) -> str:
+    """A path as text, :data:`PATH_FORMAT`, each coordinate in the fewest digits that give it
+    back exactly (what is shown is what is in force)."""
+    return "; ".join(", ".join(_number(v) for v in p) for p in path)
+
+
+def _number(v: float) -> str:
+    text = repr(float(v))
+    return text[:-2] if text.endswith(".0") else text
+
+
+def parse_path_text(text: str) -> list[list[float]]:
+    """The points of a path written as :data:`PATH_FORMAT`."""
+    points = []
+    for part in text.split(";"):
+        if not part.strip():
+            continue
+        try:
+            point = [float(v) for v in part.split(",")]
+        except ValueError:
+            raise InvalidInputError(
+                f"path must be written '{PATH_FORMAT}', got {text!r}", "path"
+            ) from None
+        if not all(math.isfinite(v) for v in point):
+            raise InvalidInputError("path must have finite coordinates", "path")
+        points.append(point)
+    return points
+
+
+def controls_message(state) -> dict[str, Any]:
+    """What a page needs to show the controls of ``state``: the controls, grouped, and their
+    values."""
+    return {
+        "groups": [list(g) for g in GROUPS],
+        "controls": [c.as_dict() for c in controls(state)],
+        "values": control_values(state),
+    }

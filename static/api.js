@@ -1,0 +1,82 @@
+// The page's session on the server (app/routers/sessions.py): created from a link's state,
+// changed by control keys, followed over server-sent events.
+export const session = { id: null, generation: 0 };
+export const api = (path) => `/api/sessions/${session.id}${path}`;
+
+// A software WebGL renderer (no GPU): the session's scene is then drawn without shadows and
+// environment map. Off for every hardware renderer.
+function softwareRenderer() {
+  try {
+    const gl = document.createElement("canvas").getContext("webgl");
+    const info = gl && gl.getExtension("WEBGL_debug_renderer_info");
+    const name = info ? gl.getParameter(info.UNMASKED_RENDERER_WEBGL) : "";
+    return /swiftshader|llvmpipe|software|softpipe/i.test(name);
+  } catch (err) {
+    return false;
+  }
+}
+
+const detail = (body) => (Array.isArray(body.detail) ? body.detail.map((d) => d.msg).join("; ") : body.detail);
+
+// A new session with ``state`` (a link's); a refused link state falls back to the defaults,
+// calling onRefusedLink(message).
+export async function openSession(state, onRefusedLink) {
+  const res = await fetch("/api/sessions", {
+    method: "POST", headers: { "Content-Type": "application/json" },
+    body: JSON.stringify({ state, low_end: softwareRenderer() }),
+  });
+  const body = await res.json();
+  if (res.status === 422 && Object.keys(state).length) {
+    onRefusedLink(detail(body));
+    return openSession({}, onRefusedLink);
+  }
+  if (!res.ok) throw new Error(detail(body));
+  session.id = body.id;
+  session.generation = body.generation;
+  return body;
+}
+
+// Changes are posted at once; while a POST is in flight, newer changes are merged and sent when
+// it returns (a slider drag sends one request at a time, never a stale backlog). A refusal of
+// the request itself goes to onError (the session's "refused" event covers the rest).
+let queued = {};
+let inFlight = false;
+export function change(patch, onError) {
+  Object.assign(queued, patch);
+  if (!inFlight) flush(onError);
+}
+
+async function flush(onError) {
+  const patch = queued;
+  queued = {};
+  if (!Object.keys(patch).length) return;
+  inFlight = true;
+  try {
+    const res = await fetch(api("/state"), {
+      method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(patch),
+    });
+    const body = await res.json();
+    if (res.ok) session.generation = Math.max(session.generation, body.generation);
+    else if (res.status !== 422) onError(detail(body));
+  } finally {
+    inFlight = false;
+    if (Object.keys(queued).length) flush(onError);
+  }
+}
+
+// Follow the session's events: handlers by kind, each given the parsed data. "lost" is called
+// when the connection drops (the browser reconnects by itself).
+export function follow(handlers, lost) {
+  const source = new EventSource(api("/events"));
+  for (const [kind, fn] of Object.entries(handlers)) {
+    source.addEventListener(kind, (ev) => { if (ev.data !== undefined) fn(JSON.parse(ev.data)); });
+  }
+  source.addEventListener("error", (ev) => { if (ev.data === undefined) lost(); });
+  return source;
+}
+
+// A closing tab ends its session at once (otherwise it expires when idle).
+export function endOnClose() {
+  addEventListener("pagehide", () => { fetch(api(""), { method: "DELETE", keepalive: true }); });
+  addEventListener("pageshow", (ev) => { if (ev.persisted) location.reload(); });
+}

@@ -1,0 +1,17 @@
+// Small DOM helpers shared by the page's modules.
+export const $ = (sel) => document.querySelector(sel);
+
+export const el = (tag, attrs = {}, ...children) => {
+  const e = document.createElement(tag);
+  for (const [k, v] of Object.entries(attrs)) {
+    if (k === "dataset") Object.assign(e.dataset, v);
+    else if (k in e && k !== "list") e[k] = v;
+    else e.setAttribute(k, v);
+  }
+  for (const c of children) e.append(c);
+  return e;
+};
+
+// A number as shown beside a control or in the verdict: 3 decimals, exponent when tiny or huge.
+export const fmt = (v, d = 3) =>
+  (Math.abs(v) >= 1e4 || (Math.abs(v) < 1e-3 && v !== 0) ? v.toExponential(2) : (+v).toFixed(d));

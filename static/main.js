@@ -1,0 +1,146 @@
+// jik dashboard: one session per tab. The page opens its session from the state in its URL,
+// builds its controls from the session's control specification, follows the session's events
+// and draws its panels; the 3D scene (iframe, viser) shows and changes the same session.
+import { change, endOnClose, follow, openSession, session, api } from "./api.js";
+import { showControls } from "./controls.js";
+import { $, fmt } from "./dom.js";
+import { applyFunctionals, drawFigures, layoutPanels, markStale, onAhead } from "./panels.js";
+
+const page = { config: null, state: null, shown: 0 };
+const send = (patch) => change(patch, (message) => setStatus(message, true));
+
+function setStatus(text, error = false) {
+  const s = $("#status-text");
+  s.textContent = text;
+  s.classList.toggle("error", error);
+}
+
+// Only computations running longer than the server's progress_after get a progress bar.
+function showProgress(fraction, elapsed) {
+  $("#progress").hidden = !(elapsed > page.config.progress_after && fraction < 1);
+  $("#progress-bar").style.width = `${Math.round(100 * fraction)}%`;
+  $("#progress-text").textContent = `computing ${Math.round(100 * fraction)}%`;
+}
+
+function onState(msg, force = false) {
+  page.state = msg.state;
+  session.generation = Math.max(session.generation, msg.generation);
+  showControls(msg, send, force);
+  rememberInUrl(msg.state);
+  if (msg.generation > page.shown) setStatus(`computing generation ${msg.generation}…`);
+}
+
+// A change the session refused (made here or in the scene): the controls show the values in
+// force, and the refusal stays in the header until the next result.
+function onRefused(msg) {
+  onState(msg, true);
+  const where = msg.source === "scene" ? "in the 3D scene" : "here";
+  setStatus(`refused (${where}): ${msg.message}`, true);
+}
+
+async function onResult(msg) {
+  if (msg.generation < page.shown) return;
+  await drawFigures(msg.figures, msg.digests, msg.state.robot);
+  markStale(msg.stale || []);
+  page.shown = msg.generation;
+  document.body.dataset.generation = msg.generation;
+  document.body.dataset.robot = msg.state.robot;
+  showProgress(1, 0);
+  renderVerdict(msg);
+  const t = msg.timing;
+  $("#timing").textContent = `generation ${msg.generation}: compute ${Math.round(1000 * t.compute)} ms, figures ${Math.round(1000 * t.figures)} ms`;
+  setStatus(msg.generation < session.generation ? `computing generation ${session.generation}…` : `up to date (generation ${msg.generation})`);
+}
+
+function renderVerdict(msg) {
+  const p = msg.summary.pseudoinverse;
+  const e = msg.summary.extended;
+  const box = $("#verdict");
+  const fail = [p, e].filter((s) => !s.success).map((s) => s.message);
+  if (msg.state.task === "path" && p.drift.length && e.drift.length) {
+    const n = Math.min(p.drift.length, e.drift.length);
+    box.innerHTML = `After <b>${n}</b> cycle${n > 1 ? "s" : ""} of the closed path, the joints of the
+      <b class="p">pseudoinverse</b> end <b class="p">${fmt(p.drift[n - 1])}</b> away from x0 and the drift grows each cycle;
+      the <b class="e">extended Jacobian</b> returns to within <b class="e">${fmt(e.drift[n - 1])}</b>.
+      <span class="why">Why: J<sup>P#</sup> picks the minimum-norm joint velocity, which has no memory of the start, so a
+      closed task path need not close in the joints. J<sup>E#</sup> adds the equation h(x) = h(x0) (h changed by
+      ${e.h_change === null ? "—" : fmt(e.h_change)} along its run): each task point then has one configuration on that level set,
+      so closed task paths give closed joint paths.</span>`;
+  } else if (!fail.length) {
+    box.innerHTML = `Both algorithms drive the task error to the target: <b class="p">pseudoinverse</b> ${p.message};
+      <b class="e">extended Jacobian</b> ${e.message}.
+      <span class="why">The extended Jacobian keeps h constant (eq. (12)); compare the paths and the controls.</span>`;
+  } else {
+    box.innerHTML = `<b class="p">pseudoinverse</b>: ${p.message}. <b class="e">extended Jacobian</b>: ${e.message}.`;
+  }
+  if (fail.length) box.innerHTML += ` <span class="error">Stopped: ${fail.join(" · ")}</span>`;
+}
+
+// ---------------------------------------------------------------- the session and its link
+// The page's URL holds the state (?state=<JSON of the dashboard's fields>): a copied link, or a
+// reload, starts a new session with the same state.
+function rememberInUrl(state) {
+  const url = new URL(location.href);
+  url.searchParams.set("state", JSON.stringify(state));
+  history.replaceState(null, "", url);
+}
+
+function stateFromUrl() {
+  const text = new URL(location.href).searchParams.get("state");
+  if (!text) return {};
+  try {
+    const state = JSON.parse(text);
+    return state && typeof state === "object" && !Array.isArray(state) ? state : {};
+  } catch (err) {
+    setStatus(`the link's state is not valid JSON (${err.message}); starting from the defaults`, true);
+    return {};
+  }
+}
+
+function copyLink() {
+  const button = $("#copy-link");
+  navigator.clipboard.writeText(location.href).then(
+    () => { button.textContent = "link copied"; },
+    () => { button.textContent = "copy the address bar"; },
+  );
+}
+
+function showScene(hasScene) {
+  const frame = $("#scene");
+  if (hasScene) {
+    const ws = `${location.protocol === "https:" ? "wss" : "ws"}://${location.host}${api("/scene")}`;
+    frame.src = `/scene/?websocket=${encodeURIComponent(ws)}`;
+    return;
+  }
+  frame.hidden = true;
+  const note = $("#scene-note");
+  note.hidden = false;
+  note.textContent = "The 3D scene runs with `jik serve`.";
+}
+
+async function main() {
+  page.config = await fetch("/api/dashboard/config").then((r) => r.json());
+  for (const [a, c] of Object.entries(page.config.colors)) document.documentElement.style.setProperty(`--${a}`, c);
+  layoutPanels(page.config.panels);
+  const opened = await openSession(stateFromUrl(),
+    (message) => setStatus(`the link's state was refused (${message}); starting from the defaults`, true));
+  $("#export-json").href = api("/export.json");
+  $("#export-csv").href = api("/export.csv");
+  $("#copy-link").addEventListener("click", copyLink);
+  onState(opened);
+  showScene(opened.scene);
+  let chain = Promise.resolve(); // results and their second phases are drawn in order
+  const serial = (fn) => (msg) => { chain = chain.then(() => fn(msg)).catch((err) => setStatus(String(err), true)); };
+  follow({
+    state: (msg) => onState(msg),
+    refused: onRefused,
+    progress: (msg) => { if (msg.generation === session.generation) showProgress(msg.fraction, msg.elapsed); },
+    result: serial(onResult),
+    functionals: serial((msg) => (msg.generation === page.shown ? applyFunctionals(msg) : null)),
+    ahead: (msg) => { onAhead(msg, () => page.state && page.state.robot).catch((err) => console.warn("drawing ahead:", err)); },
+    error: (msg) => { if (msg.generation === session.generation) { showProgress(1, 0); setStatus(msg.message, true); } },
+  }, () => setStatus("connection lost; reconnecting…", true));
+  endOnClose();
+}
+
+main().catch((err) => setStatus(String(err), true));

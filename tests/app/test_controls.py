@@ -1,0 +1,127 @@
+"""One description of the dashboard's controls (jik.app.controls): from the registry, shown the
+same in the page and the scene, turned into state changes in one place."""
+
+from __future__ import annotations
+
+import pytest
+
+from jik.app.controls import (
+    DISCRETE_GAMMA_ON_SWITCH,
+    GAMMA_RANGE,
+    control_values,
+    controls,
+    expand,
+    parse_path_text,
+    path_text,
+)
+from jik.app.dashboard import default_state, updated_state
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.registry import ROBOTS, robot_spec
+
+
+def _states():
+    for robot in ROBOTS:
+        state = default_state(robot)
+        yield state
+        if robot_spec(robot).default_path:
+            other = "target" if state.task == "path" else "path"
+            yield updated_state(state, {"task": other})
+        yield updated_state(state, {"mode": "discrete"})
+
+
+@pytest.mark.parametrize("state", list(_states()), ids=lambda s: f"{s.robot}-{s.task}-{s.mode}")
+def test_every_control_shows_its_value_and_setting_it_changes_nothing(state):
+    """Each control's shown value, sent back as a change, is the state in force: the page and
+    the scene can always send what they show."""
+    values = control_values(state)
+    for c in controls(state):
+        if c.kind == "preset":
+            continue
+        assert updated_state(state, {c.key: values[c.key]}) == state, c.key
+
+
+@pytest.mark.parametrize("robot", sorted(ROBOTS))
+def test_ranges_and_labels_come_from_the_registry(robot):
+    state = default_state(robot)
+    spec = robot_spec(robot)
+    by_key = {c.key: c for c in controls(state) if c.kind != "preset"}
+    for p in spec.parameters:
+        c = by_key[f"robot_parameters.{p.name}"]
+        assert (c.minimum, c.maximum, c.help) == (p.minimum, p.maximum, p.description)
+    for i, name in enumerate(spec.variable_names):
+        assert by_key[f"x0.{i}"].label == f"x0: {name}"
+    assert [v for v, _ in by_key["robot"].options] == list(ROBOTS)
+    assert [v for v, _ in by_key["augmentation"].options] == [a.name for a in spec.augmentations]
+    aug = spec.augmentation(state.augmentation)
+    assert {k for k in by_key if k.startswith("augmentation_parameters.")} == {
+        f"augmentation_parameters.{p.name}" for p in aug.parameters
+    }
+
+
+def test_gamma_range_follows_the_mode_and_a_switch_to_discrete_clamps_it():
+    state = updated_state(default_state("manipulator2"), {"gamma": 5.0})
+    (gamma,) = [c for c in controls(state) if c.key == "gamma"]
+    assert (gamma.minimum, gamma.maximum) == GAMMA_RANGE["continuous"]
+    discrete = updated_state(state, {"mode": "discrete"})
+    assert discrete.gamma == DISCRETE_GAMMA_ON_SWITCH
+    (gamma,) = [c for c in controls(discrete) if c.key == "gamma"]
+    assert (gamma.minimum, gamma.maximum) == GAMMA_RANGE["discrete"]
+    small = updated_state(updated_state(state, {"gamma": 0.3}), {"mode": "discrete"})
+    assert small.gamma == 0.3  # (within the range: kept)
+
+
+def test_control_keys_expand_into_state_fields():
+    state = default_state("manipulator2")
+    assert expand(state, {"x0.1": 0.5}) == {"x0": [state.x0[0], 0.5, state.x0[2]]}
+    assert expand(state, {"robot_parameters.l": 1.2}) == {"robot_parameters": {"l": 1.2}}
+    assert expand(state, {"path": "1, 1; 1, 2"}) == {"path": [[1.0, 1.0], [1.0, 2.0]]}
+    assert parse_path_text(path_text(state.path)) == [list(p) for p in state.path]
+    with pytest.raises(InvalidInputError) as bad:
+        expand(state, {"x0.7": 1.0})
+    assert bad.value.field == "x0.7"
+    with pytest.raises(InvalidInputError) as text:
+        updated_state(state, {"path": "1, 1; one, 2"})
+    assert text.value.field == "path" and "y1, y2; y1, y2" in str(text.value)
+
+
+@pytest.mark.parametrize(
+    ("patch", "field"),
+    [
+        ({"gamma": -1}, "gamma"),
+        ({"robot_parameters.l": -3}, "robot_parameters.l"),
+        ({"robot_parameters": {"l": "abc"}}, "robot_parameters.l"),
+        ({"robot_parameters": 5}, "robot_parameters"),
+        ({"x0": [1, 2]}, "x0"),
+        ({"augmentation": "nope"}, "augmentation"),
+        ({"cycles": 99}, "cycles"),
+        ({"mode": "discrete", "gamma": 3}, "gamma"),
+        ({"robot": 7}, "robot"),
+        ({"nonsense": 1}, "nonsense"),
+    ],
+)
+def test_refusals_carry_their_field(patch, field):
+    """An error names its field as data (never parsed from its message)."""
+    with pytest.raises(InvalidInputError) as refused:
+        updated_state(default_state("manipulator2"), patch)
+    assert refused.value.field == field
+
+
+def test_the_scene_and_the_page_show_the_same_controls():
+    """The scene's GUI has one input per control of the specification, with its label, and
+    selects show the same option labels as the page."""
+    from jik.app.dashboard import Dashboard
+    from jik.app.scene import DashboardScene
+
+    dashboard = Dashboard(default_state("unicycle"))
+    scene = DashboardScene(dashboard)
+    try:
+        scene._on_state(dashboard.state)
+        spec = {c.key: c for c in controls(dashboard.state) if c.kind != "preset"}
+        assert set(scene._controls) == set(spec)
+        for key, handle in scene._controls.items():
+            assert handle.label == spec[key].label, key
+        robot = scene._controls["robot"]
+        assert list(robot.options) == [label for _, label in spec["robot"].options]
+    finally:
+        scene.stop()
+        dashboard.stop()
