@@ -115,12 +115,12 @@ def test_the_scene_and_the_page_show_the_same_controls():
     dashboard = Dashboard(default_state("unicycle"))
     scene = DashboardScene(dashboard)
     try:
-        scene._on_state(dashboard.state)
+        scene.controls.show(dashboard.state)
         spec = {c.key: c for c in controls(dashboard.state) if c.kind != "preset"}
-        assert set(scene._controls) == set(spec)
-        for key, handle in scene._controls.items():
+        assert set(scene.controls.inputs) == set(spec)
+        for key, handle in scene.controls.inputs.items():
             assert handle.label == spec[key].label, key
-        robot = scene._controls["robot"]
+        robot = scene.controls.inputs["robot"]
         assert list(robot.options) == [label for _, label in spec["robot"].options]
     finally:
         scene.stop()

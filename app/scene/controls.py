@@ -1,0 +1,128 @@
+"""The scene's GUI controls, built from the dashboard's control specification
+(:func:`jik.app.controls.controls`, from which the page builds its own): the same controls,
+labels, ranges and values. A change is sent by its control key, as the page sends it."""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable
+from typing import Any
+
+import viser
+
+from jik.app.controls import GROUPS, Control, control_values, controls
+
+
+class SceneControls:
+    """The inputs of one scene's GUI, one folder per group of the specification.
+
+    Parameters
+    ----------
+    gui : viser.GuiApi
+    send : callable
+        ``send(patch)`` with a patch keyed by control keys (``{"x0.1": 0.4}``).
+    """
+
+    def __init__(self, gui: viser.GuiApi, send: Callable[[dict], None]) -> None:
+        self._gui = gui
+        self._send = send
+        self.inputs: dict[str, Any] = {}  # control key -> viser input handle
+        self.folders: list = []
+        self._options: dict[str, dict[str, str]] = {}  # a select's value -> its label
+        self._shape: list[dict] | None = None  # the specification on screen
+        self._local = threading.local()
+        self._lock = threading.RLock()
+
+    @property
+    def syncing(self) -> bool:
+        """Whether this thread is setting the inputs to the state's values: the callbacks viser
+        calls from within the assignment are then not a user's change. Per thread: a user's
+        change, which viser's thread delivers, is never dropped while another thread syncs."""
+        return getattr(self._local, "syncing", False)
+
+    @syncing.setter
+    def syncing(self, value: bool) -> None:
+        self._local.syncing = value
+
+    def show(self, state) -> None:
+        """Show ``state``: the inputs are built anew when its controls differ from those on
+        screen (another robot, map, mode or task), else set to its values."""
+        spec = controls(state)
+        shape = [c.as_dict() for c in spec]
+        with self._lock:
+            if shape != self._shape:
+                self._shape = shape
+                self._build(spec, control_values(state))
+            else:
+                self.sync(state)
+
+    def sync(self, state) -> None:
+        """Set every input to the value in force (a user's own change included)."""
+        values = control_values(state)
+        self.syncing = True
+        try:
+            for key, handle in self.inputs.items():
+                value = values.get(key)
+                if key in self._options and isinstance(value, str):
+                    value = self._options[key].get(value, value)
+                elif isinstance(value, list):
+                    value = tuple(value)
+                try:
+                    handle.value = value
+                except (ValueError, AssertionError):
+                    pass
+        finally:
+            self.syncing = False
+
+    def _build(self, spec: list[Control], values: dict[str, Any]) -> None:
+        for folder in self.folders:
+            folder.remove()
+        self.folders, self.inputs, self._options = [], {}, {}
+        self.syncing = True
+        try:
+            for order, (group, title) in enumerate(GROUPS, start=2):
+                with self._gui.add_folder(title, order=order) as folder:
+                    self.folders.append(folder)
+                    for control in spec:
+                        if control.group == group:
+                            self._add(control, values.get(control.key))
+        finally:
+            self.syncing = False
+
+    def _change(self, patch: dict) -> None:
+        if not self.syncing:
+            self._send(patch)
+
+    def _add(self, control: Control, value: Any) -> None:
+        """One viser input for ``control``."""
+        gui, key = self._gui, control.key
+        handle: Any
+        if control.kind == "preset":
+            button = gui.add_button(control.label, hint=control.help)
+            button.on_click(lambda _: self._change({key: control.value}))
+            return
+        if control.kind == "select":
+            by_label = {label: v for v, label in control.options}
+            labels = self._options[key] = {v: label for v, label in control.options}
+            handle = gui.add_dropdown(control.label, list(by_label), initial_value=labels[value],
+                                      hint=control.help)  # fmt: skip
+            handle.on_update(lambda e: self._change({key: by_label[e.target.value]}))
+        elif control.kind == "slider":
+            handle = gui.add_slider(
+                control.label, min=control.minimum, max=control.maximum, step=control.step,
+                initial_value=min(max(value, control.minimum), control.maximum), hint=control.help,
+            )  # fmt: skip
+            handle.on_update(lambda e: self._change({key: e.target.value}))
+        elif control.kind == "vector" and control.size in (2, 3):
+            add: Any = gui.add_vector2 if control.size == 2 else gui.add_vector3
+            lo = None if control.minimum is None else tuple(control.minimum)
+            hi = None if control.maximum is None else tuple(control.maximum)
+            handle = add(control.label, tuple(value), min=lo, max=hi, step=control.step,
+                         hint=control.help)  # fmt: skip
+            handle.on_update(lambda e: self._change({key: list(e.target.value)}))
+        else:  # text (the path), or a vector of another size: as text, parsed by the server
+            hint = f"{control.help} ({control.format})" if control.format else control.help
+            shown = value if isinstance(value, str) else ", ".join(f"{v:g}" for v in value)
+            handle = gui.add_text(control.label, shown, hint=hint)
+            handle.on_update(lambda e: self._change({key: e.target.value}))
+        self.inputs[key] = handle

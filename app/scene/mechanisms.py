@@ -1,0 +1,302 @@
+"""The scene's nodes: the mechanisms of the robots (one copy per algorithm and a grey one at the
+start x0), the floor grid, and the fixtures of a result (rails or guide, traces, targets).
+
+- Manipulator 2 (37): an XY gantry, a beam at height x1 on two rails, a carriage at x2 on the
+  beam, and a revolute arm of length l at angle x3; the end effector is the task point.
+- Manipulator 1 (30), schematic of its normal form k(x) = (x1, x2 + x1 x3): a slider at height
+  x2 on the vertical guide, a lever of slope x3 pivoting on it, and a vertical runner at x1;
+  the task point W = (x1, x2 + x1 x3) is where the lever crosses the runner.
+- The unicycle (40): a platform with two wheels and a heading nose at the pose q(t).
+
+The pseudoinverse is the translucent red ghost, the extended Jacobian the solid blue robot (the
+colours of every plot); the grey ghost is the start configuration x0.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from jik.app.dashboard import ALGORITHMS, COLORS
+from jik.app.scene.pose import yaw_quaternion
+
+#: Height of each algorithm's copy above the task plane, and its opacity (None: solid).
+Z = {"pseudoinverse": 0.10, "extended": 0.0}
+OPACITY = {"pseudoinverse": 0.55, "extended": None}
+HOME_COLOR = (150, 150, 150)
+
+
+def rgb(hex_color: str) -> tuple[int, int, int]:
+    h = hex_color.lstrip("#")
+    return int(h[0:2], 16), int(h[2:4], 16), int(h[4:6], 16)
+
+
+class Mechanism:
+    """Scene nodes of one robot copy (one algorithm, or the grey start ghost)."""
+
+    def __init__(self, scene, root: str, color, opacity, z: float, state, extent) -> None:
+        self.scene, self.root, self.color, self.opacity, self.z = scene, root, color, opacity, z
+        self.state, self.extent = state, extent
+        self.build()
+
+    def box(self, name, dims, position=(0.0, 0.0, 0.0), wxyz=(1.0, 0.0, 0.0, 0.0), color=None):
+        return self.scene.add_box(
+            f"{self.root}/{name}",
+            color=color or self.color,
+            dimensions=dims,
+            opacity=self.opacity,
+            position=position,
+            wxyz=wxyz,
+            cast_shadow=False,
+        )
+
+    def ball(self, name, radius, position=(0.0, 0.0, 0.0), color=None):
+        return self.scene.add_icosphere(
+            f"{self.root}/{name}",
+            radius=radius,
+            color=color or self.color,
+            opacity=self.opacity,
+            position=position,
+            cast_shadow=False,
+            subdivisions=2,
+        )
+
+    def build(self) -> None: ...
+
+    def resize(self, state, extent) -> None:
+        """Follow a new arm length or task-plane box in place (no node is re-created)."""
+        self.state, self.extent = state, extent
+
+    def pose(self, x) -> None: ...
+
+
+class Gantry(Mechanism):
+    """Manipulator 2: XY gantry (prismatic x1 vertical, x2 horizontal) with a revolute arm."""
+
+    def build(self) -> None:
+        (lo, hi), _ = self.extent
+        self.span = (lo, hi)
+        l = float(self.state.robot_parameters["l"])
+        self.beam = self.box("beam", (hi - lo, 0.07, 0.05))
+        self.carriage = self.scene.add_frame(f"{self.root}/carriage", show_axes=False)
+        self.box("carriage/body", (0.2, 0.2, 0.09))
+        self.ball("carriage/joint", 0.06, (0.0, 0.0, 0.07), color=(40, 40, 40))
+        self.arm = self.box("carriage/arm", (l, 0.06, 0.04), (l / 2, 0.0, 0.07))
+        self.effector = self.ball("carriage/effector", 0.07, (l, 0.0, 0.07))
+
+    def resize(self, state, extent) -> None:
+        super().resize(state, extent)
+        (lo, hi), _ = extent
+        self.span = (lo, hi)
+        l = float(state.robot_parameters["l"])
+        self.beam.dimensions = (hi - lo, 0.07, 0.05)
+        self.arm.dimensions = (l, 0.06, 0.04)
+        self.arm.position = (l / 2, 0.0, 0.07)
+        self.effector.position = (l, 0.0, 0.07)
+
+    def pose(self, x) -> None:
+        lo, hi = self.span
+        self.beam.position = ((lo + hi) / 2, float(x[0]), self.z)
+        self.carriage.position = (float(x[1]), float(x[0]), self.z + 0.05)
+        self.carriage.wxyz = yaw_quaternion(float(x[2]))
+
+
+class NormalForm(Mechanism):
+    """Manipulator 1 (30): slider x2 on the vertical guide, lever of slope x3, runner at x1."""
+
+    def build(self) -> None:
+        (xlo, xhi), (lo, hi) = self.extent
+        self.runner = self.box("runner", (0.05, hi - lo, 0.04))
+        self.runner_span = (lo, hi)
+        self.slider = self.box("slider", (0.18, 0.14, 0.08))
+        self.lever = self.scene.add_frame(f"{self.root}/lever", show_axes=False)
+        # Along the lever from x = xlo to x = xhi of the task-plane box when level: shorter in x
+        # when it tilts, so it stays in the framed view.
+        self.bar = self.box("lever/bar", (xhi - xlo, 0.045, 0.03), ((xlo + xhi) / 2, 0.0, 0.05))
+        self.ball("lever/pivot", 0.06, (0.0, 0.0, 0.05), color=(40, 40, 40))
+        self.point = self.ball("W", 0.08)
+        if self.root.endswith("extended"):
+            self.scene.add_label(f"{self.root}/W/label", "W (task point)", position=(0.08, 0.08, 0))
+
+    def resize(self, state, extent) -> None:
+        super().resize(state, extent)
+        (xlo, xhi), (lo, hi) = extent
+        self.runner.dimensions = (0.05, hi - lo, 0.04)
+        self.runner_span = (lo, hi)
+        self.bar.dimensions = (xhi - xlo, 0.045, 0.03)
+        self.bar.position = ((xlo + xhi) / 2, 0.0, 0.05)
+
+    def pose(self, x) -> None:
+        x1, x2, x3 = (float(v) for v in x)
+        lo, hi = self.runner_span
+        self.runner.position = (x1, (lo + hi) / 2, self.z)
+        self.slider.position = (0.0, x2, self.z)
+        self.lever.position = (0.0, x2, self.z)
+        self.lever.wxyz = yaw_quaternion(math.atan(x3))
+        self.point.position = (x1, x2 + x1 * x3, self.z + 0.08)
+
+
+class Platform(Mechanism):
+    """The unicycle: a wheeled platform at pose (q1, q2, q3), nose pointing along the heading."""
+
+    def build(self) -> None:
+        self.frame = self.scene.add_frame(f"{self.root}/platform", show_axes=False)
+        self.box("platform/body", (0.7, 0.45, 0.18), (0.0, 0.0, 0.2))
+        self.box("platform/nose", (0.3, 0.12, 0.08), (0.45, 0.0, 0.2))
+        axle = (math.cos(math.pi / 4), math.sin(math.pi / 4), 0.0, 0.0)  # cylinder axis -> y
+        for side in (-1, 1):
+            self.scene.add_cylinder(
+                f"{self.root}/platform/wheel{side}",
+                radius=0.16,
+                height=0.08,
+                color=(50, 50, 50),
+                opacity=self.opacity,
+                position=(0.0, side * 0.28, 0.16),
+                wxyz=axle,
+                cast_shadow=False,
+            )
+
+    def pose(self, q) -> None:
+        self.frame.position = (float(q[0]), float(q[1]), self.z)
+        self.frame.wxyz = yaw_quaternion(float(q[2]))
+
+
+MECHANISMS = {"manipulator1": NormalForm, "manipulator2": Gantry}
+
+
+# Every line (traces, grid) is sized in pixels: viser's world-unit lines solve a ray-segment
+# distance per fragment and redraw each line in a second blended pass; the four traces of a
+# manipulator doubled the cost of a frame in software WebGL (no GPU).
+
+
+def add_floor_grid(scene, half: float = 10.0, cell: float = 0.5, section: float = 1.0) -> None:
+    """A grid on the task plane (z slightly below 0) drawn as two sets of line segments.
+
+    viser's ``add_grid`` shades every pixel of its plane; in software WebGL (no GPU) that is a
+    fifth of each frame, line segments cost next to nothing.
+    """
+    ticks = np.arange(-half, half + cell / 2, cell)
+    on_section = np.isclose(np.remainder(ticks + half, section), 0.0) | np.isclose(
+        np.remainder(ticks + half, section), section
+    )
+    z = -0.06
+    for name, where, color in (
+        ("cells", ticks[~on_section], (200, 200, 200)),
+        ("sections", ticks[on_section], (140, 140, 140)),
+    ):
+        n = len(where)
+        lines = np.zeros((2 * n, 2, 3))
+        lines[:n, :, 0] = where[:, None]  # along y
+        lines[:n, 0, 1], lines[:n, 1, 1] = -half, half
+        lines[n:, :, 1] = where[:, None]  # along x
+        lines[n:, 0, 0], lines[n:, 1, 0] = -half, half
+        lines[..., 2] = z
+        scene.add_line_segments(
+            f"/grid/{name}", lines, color, thickness=1.0, thickness_units="screen"
+        )
+
+
+#: Largest distance of a drawn trace from the computed path, as a fraction of the scene's size
+#: (about a third of a pixel at the dashboard's size).
+TRACE_TOLERANCE = 1e-3
+
+
+def simplify(points: np.ndarray, tol: float) -> np.ndarray:
+    """The points of the polyline ``points`` (n, d) that keep it within ``tol`` of every
+    original point (Ramer-Douglas-Peucker; the first and the last are always kept).
+
+    A trace costs the viser client per segment: in software WebGL (no GPU) a thousand segments
+    add about 15 ms to every frame. The continuous task paths are straight between targets, eq.
+    (5), so most of their recorded points lie on a line.
+    """
+    n = len(points)
+    keep = np.zeros(n, dtype=bool)
+    keep[[0, -1]] = True
+    stack = [(0, n - 1)]
+    while stack:
+        i, j = stack.pop()
+        if j <= i + 1:
+            continue
+        a, d = points[i], points[j] - points[i]
+        rel = points[i + 1 : j] - a
+        L2 = float(d @ d)
+        t = np.clip(rel @ d / L2, 0.0, 1.0) if L2 > 0 else np.zeros(len(rel))
+        dist = np.linalg.norm(rel - t[:, None] * d, axis=1)
+        k = int(np.argmax(dist))
+        if dist[k] > tol:
+            m = i + 1 + k
+            keep[m] = True
+            stack += [(i, m), (m, j)]
+    return points[keep]
+
+
+def trace_tolerance(extent) -> float:
+    """:data:`TRACE_TOLERANCE` of the task-plane box ``extent`` (see :func:`_extent`)."""
+    (xlo, xhi), (ylo, yhi) = extent
+    return TRACE_TOLERANCE * max(xhi - xlo, yhi - ylo)
+
+
+def polyline(points: np.ndarray, tol: float = 0.0) -> np.ndarray:
+    """(n, 3) points -> segments (m - 1, 2, 3) of the polyline simplified to within ``tol``."""
+    points = simplify(points, tol) if tol > 0 and len(points) > 2 else points
+    return np.stack([points[:-1], points[1:]], axis=1)
+
+
+def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
+    """The parts of a manipulator's scene besides the mechanisms, by node name: (kind, the
+    values that follow the result, the fixed style). The rails (Manipulator 2) or the guide
+    (Manipulator 1) span the task-plane box; the task paths of both algorithms, and for
+    Manipulator 2 the carriage paths (x2, x1), which are the joint paths: closed for J^E#,
+    not for J^P#; the targets of the path's legs."""
+    (xlo, xhi), (ylo, yhi) = extent
+    tol = trace_tolerance(extent)
+    robot = result.state.robot
+    grey: dict = {"color": (90, 90, 90)}
+    out: dict[str, tuple[str, dict, dict]] = {}
+    rail = (0.06, yhi - ylo, 0.05)
+    if robot == "manipulator2":
+        for side, x in (("left", xlo), ("right", xhi)):
+            out[f"{root}/rails/{side}"] = (
+                "box", {"dimensions": rail, "position": (x, (ylo + yhi) / 2, -0.02)}, grey
+            )  # fmt: skip
+    elif robot == "manipulator1":
+        out[f"{root}/guide"] = (
+            "box", {"dimensions": rail, "position": (0.0, (ylo + yhi) / 2, -0.02)}, grey
+        )  # fmt: skip
+    for a in ALGORITHMS:
+        run = result.runs[a]
+        line = {"colors": rgb(COLORS[a]), "thickness_units": "screen"}  # pixels, see above
+        task = np.column_stack([run.y[:, 0], run.y[:, 1], np.full(len(run.y), Z[a] + 0.16)])
+        out[f"{root}/trace/{a}/task"] = (
+            "line", {"points": polyline(task, tol)},
+            {**line, "thickness": 3.0 if a == "pseudoinverse" else 2.0},
+        )  # fmt: skip
+        if robot == "manipulator2":
+            joints = np.column_stack([run.x[:, 1], run.x[:, 0], np.full(len(run.x), Z[a] + 0.1)])
+            out[f"{root}/trace/{a}/joints"] = (
+                "line", {"points": polyline(joints, tol)}, {**line, "thickness": 1.2}
+            )  # fmt: skip
+    for k, target in enumerate(result.targets):
+        out[f"{root}/targets/{k}"] = (
+            "ball", {"position": (float(target[0]), float(target[1]), 0.2)},
+            {"radius": 0.05, "color": (0, 0, 0)},
+        )  # fmt: skip
+    return out
+
+
+def extent_of(result) -> tuple[tuple[float, float], tuple[float, float]]:
+    """Box of the task plane used by the mechanisms (rails, runner), covering both runs."""
+    if any(r.platform is not None for r in result.runs.values()):
+        ys = np.concatenate([r.platform.reshape(-1, 3) for r in result.runs.values()])
+        ys = np.vstack([ys, [result.state.target]])
+        lo, hi = ys.min(axis=0)[:2] - 1.0, ys.max(axis=0)[:2] + 1.0
+        return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
+    ys = np.concatenate([r.y for r in result.runs.values()])
+    xs = np.concatenate([r.x for r in result.runs.values()])
+    lo = np.minimum(ys.min(axis=0)[:2], 0.0) - 0.6
+    hi = np.maximum(ys.max(axis=0)[:2], 1.0) + 0.6
+    if result.state.robot == "manipulator2":
+        lo[0] = min(lo[0], xs[:, 1].min() - 0.4)
+        hi[0] = max(hi[0], xs[:, 1].max() + 0.4)
+    return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))

@@ -1,0 +1,244 @@
+"""The 3D scene (jik.app.scene): the start point's gizmo, the timeline, the GUI and the drag
+writing to the session's dashboard, nodes moved in place, traces within their tolerance."""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+import pytest
+
+from jik.app.dashboard import Dashboard, compute, default_state, updated_state
+from jik.app.scene import DashboardScene
+from jik.app.scene.gizmo import DRAG_INTERVAL
+from jik.app.scene.mechanisms import TRACE_TOLERANCE, extent_of, polyline, simplify
+from jik.app.scene.pose import (
+    Timeline,
+    gizmo_pose,
+    quaternion_yaw,
+    start_from_gizmo,
+    yaw_quaternion,
+)
+from jik.engine.registry import ROBOTS
+
+
+@pytest.mark.parametrize(
+    ("robot", "x0"),
+    [
+        ("manipulator2", (0.3, -0.4, 2.0)),
+        ("manipulator2", None),  # x3 = pi/2: the quaternion's round trip is off by an ulp
+        ("manipulator1", (0.7, 0.2, -0.6)),
+        ("unicycle", None),
+    ],
+)
+def test_the_start_point_gizmo_round_trips(robot, x0):
+    """Dragging the gizmo to where it already is leaves the start point unchanged, exactly: a
+    press on the gizmo is no change (the dashboard would solve both runs again)."""
+    state = default_state(robot)
+    if x0 is not None:
+        state = updated_state(state, {"x0": list(x0)})
+    xy, yaw = gizmo_pose(robot, state.x0, state.robot_parameters)
+    yaw = quaternion_yaw(yaw_quaternion(yaw))
+    patch = start_from_gizmo(robot, xy, yaw, state)
+    assert updated_state(state, patch) == state
+
+
+def test_manipulator2_gizmo_moves_the_carriage():
+    state = default_state("manipulator2")
+    patch = start_from_gizmo("manipulator2", (0.4, 0.25), np.pi / 2 + 0.1, state)
+    assert patch == {"x0": [0.25, 0.4, pytest.approx(np.pi / 2 + 0.1)]}
+
+
+def test_animation_timeline_ends_at_the_last_configuration():
+    result = compute(updated_state(default_state("manipulator2"), {"cycles": 1}))
+    timeline = Timeline(result)
+    assert timeline.length == len(result.targets)
+    start, end = timeline.at(0.0), timeline.at(timeline.length)
+    for a, run in result.runs.items():
+        np.testing.assert_allclose(start[a], run.x[0], atol=1e-12)
+        np.testing.assert_allclose(end[a], run.x[-1], atol=1e-9)
+
+
+def test_viser_gui_and_drag_change_the_one_state():
+    """The scene's GUI and its start-point gizmo write to the same Dashboard as the page."""
+    import socket
+    import time
+    from types import SimpleNamespace
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    dashboard = Dashboard(updated_state(default_state("manipulator2"), {"task": "target"}))
+    scene = DashboardScene(dashboard, port=port)
+    try:
+        assert dashboard.wait(1, timeout=60)
+        deadline = time.monotonic() + 30
+        while dashboard.scene_status.get("generation", 0) < 1 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert dashboard.scene_status["robot"] == "manipulator2"
+        scene.controls.inputs["gamma"].value = 2.5  # what a slider move in the viser GUI does
+        assert dashboard.state.gamma == 2.5
+        target = SimpleNamespace(position=(0.4, 0.25, 0.3), wxyz=yaw_quaternion(1.7))
+        scene.gizmo.on_drag(SimpleNamespace(phase="end", target=target))
+        np.testing.assert_allclose(dashboard.state.x0, (0.25, 0.4, 1.7), atol=1e-12)
+        # A press where the gizmo is changes nothing; the first move
+        # right after it is applied at once; a second within DRAG_INTERVAL when that ends,
+        # though no event follows (the pose a drag rests at).
+        generation = dashboard.generation
+        scene.gizmo.on_drag(SimpleNamespace(phase="start", target=target))
+        assert dashboard.generation == generation
+        moved = SimpleNamespace(position=(0.5, 0.25, 0.3), wxyz=yaw_quaternion(1.7))
+        scene.gizmo.on_drag(SimpleNamespace(phase="update", target=moved))
+        np.testing.assert_allclose(dashboard.state.x0, (0.25, 0.5, 1.7), atol=1e-12)
+        rest = SimpleNamespace(position=(0.55, 0.3, 0.3), wxyz=yaw_quaternion(1.7))
+        scene.gizmo.on_drag(SimpleNamespace(phase="update", target=rest))
+        assert dashboard.state.x0[1] == pytest.approx(0.5)  # (deferred)
+        time.sleep(DRAG_INTERVAL + 0.1)
+        np.testing.assert_allclose(dashboard.state.x0, (0.3, 0.55, 1.7), atol=1e-12)
+        # A deferred move that a newer event overtakes is dropped.
+        scene.gizmo.on_drag(SimpleNamespace(phase="update", target=moved))
+        scene.gizmo.on_drag(SimpleNamespace(phase="end", target=rest))
+        time.sleep(DRAG_INTERVAL + 0.1)
+        np.testing.assert_allclose(dashboard.state.x0, (0.3, 0.55, 1.7), atol=1e-12)
+        assert dashboard.wait(timeout=60)
+        deadline = time.monotonic() + 30
+        while dashboard.scene_status["generation"] < dashboard.generation:
+            assert time.monotonic() < deadline, "the scene did not redraw"
+            time.sleep(0.05)
+        # A change from elsewhere (the page) moves the scene's GUI at once.
+        dashboard.update({"gamma": 0.5})
+        assert scene.controls.inputs["gamma"].value == 0.5
+        # A value the dashboard refuses puts the GUI back to the value in force and says so.
+        scene.controls.inputs["gamma"].value = -1.0
+        assert dashboard.state.gamma == 0.5
+        assert scene.controls.inputs["gamma"].value == 0.5
+        assert "refused" in scene.status.content and "gamma" in scene.status.content
+        # A user's change while another thread sets the GUI's values (the animation's
+        # position slider, the worker's sync) is kept: only that thread's callbacks are its own.
+        syncing, release = threading.Event(), threading.Event()
+
+        def sync_elsewhere() -> None:
+            scene.controls.syncing = True
+            syncing.set()
+            release.wait(10)
+            scene.controls.syncing = False
+
+        other = threading.Thread(target=sync_elsewhere)
+        other.start()
+        assert syncing.wait(10)
+        scene.controls.inputs["gamma"].value = 1.5  # (viser's thread, for a user)
+        release.set()
+        other.join()
+        assert dashboard.state.gamma == 1.5
+        # Another robot: its controls replace the old ones at once.
+        dashboard.update({"robot": "manipulator1"})
+        # (the dropdown shows the robots' titles, as the page's selector does)
+        assert scene.controls.inputs["robot"].value == ROBOTS["manipulator1"].title
+        assert "augmentation_parameters.a" in scene.controls.inputs
+        dashboard.update({"robot": "manipulator2"})
+        dashboard.update({"robot": "unicycle"})
+        assert scene.controls.inputs["robot"].value == ROBOTS["unicycle"].title
+        assert len(scene.controls.folders) == 2
+        assert "robot_parameters.q0" in scene.controls.inputs
+    finally:
+        scene.stop()
+        dashboard.stop()
+
+
+def test_scene_follows_a_new_result_in_place():
+    """A change that keeps the robot and the task moves the scene's nodes instead of
+    re-creating them (a target the closed path gains or loses is added or removed); the
+    start-point gizmo moves with the drawing."""
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    # (k(x0) off the path's points for both: the closed path has the same number of legs)
+    first = updated_state(default_state("manipulator2"), {"x0": [0.4, 0.0, 1.5]})
+    dashboard = Dashboard(first)
+    scene = DashboardScene(dashboard, port=port)
+    M2 = "/robot/manipulator2-path"
+    try:
+        assert dashboard.wait(1, timeout=60)
+        second = updated_state(first, {"x0": [0.45, 0.1, 1.4], "robot_parameters": {"l": 1.3}})
+        scene._draw(compute(first, 101))
+        fixtures, mechanisms = dict(scene._fixtures), dict(scene._mechanisms)
+        scene._draw(compute(second, 102))
+        assert scene._fixtures.keys() == fixtures.keys()
+        assert all(scene._fixtures[k] is v for k, v in fixtures.items())
+        assert all(scene._mechanisms[k] is v for k, v in mechanisms.items())
+        # The default start maps onto the path's last point: one target fewer, the rest stays.
+        scene._draw(compute(default_state("manipulator2"), 105))
+        assert scene._fixtures.keys() == fixtures.keys() - {f"{M2}/targets/4"}
+        assert all(scene._fixtures[k] is v for k, v in fixtures.items() if k in scene._fixtures)
+        scene._draw(compute(second, 106))
+        assert scene._fixtures.keys() == fixtures.keys()
+        result = compute(second, 103)
+        (xlo, xhi), (ylo, yhi) = extent_of(result)
+        tol = TRACE_TOLERANCE * max(xhi - xlo, yhi - ylo)
+        y = result.runs["extended"].y
+        np.testing.assert_allclose(
+            scene._fixtures[f"{M2}/trace/extended/task"].points[:, :, :2],
+            polyline(np.column_stack([y, np.full(len(y), 0.16)]), tol)[:, :, :2],
+            rtol=1e-6,  # viser keeps float32
+        )
+        assert scene._mechanisms["extended"].arm.dimensions[0] == pytest.approx(1.3)
+        (X, Y), _ = gizmo_pose("manipulator2", second.x0, second.robot_parameters)
+        np.testing.assert_allclose(scene.gizmo.handle.position, (X, Y, 0.3))
+        # Another robot: its own nodes; the first robot's are hidden, and shown again (moved,
+        # not re-created) when it comes back.
+        fixtures, mechanisms = dict(scene._fixtures), dict(scene._mechanisms)
+        scene._draw(compute(default_state("manipulator1"), 104))
+        assert set(scene._fixtures) >= {"/robot/manipulator1-path/guide"}
+        assert not any(k.startswith(M2) for k in scene._fixtures)
+        assert scene._sets[("manipulator2", "path")]["frame"].visible is False
+        scene._draw(compute(second, 107))
+        assert scene._sets[("manipulator2", "path")]["frame"].visible is True
+        assert scene._sets[("manipulator1", "path")]["frame"].visible is False
+        assert all(scene._fixtures[k] is v for k, v in fixtures.items())
+        assert all(scene._mechanisms[k] is v for k, v in mechanisms.items())
+        # A result solved ahead: its nodes are built hidden, and shown by its result.
+        other = compute(updated_state(default_state("manipulator1"), {"task": "target"}), 108)
+        scene._prebuild(other)
+        ahead = scene._sets[("manipulator1", "target")]
+        assert ahead["frame"].visible is False and ahead["mechanisms"]
+        scene._draw(other)
+        assert ahead["frame"].visible is True and scene._mechanisms is ahead["mechanisms"]
+        # Paused, a new result is drawn at its end, and the position slider says so.
+        scene.playing = False
+        scene._draw(compute(first, 109))
+        assert scene._timeline is not None and scene._s == scene._timeline.length
+        assert scene.scrub.value == 1.0
+    finally:
+        scene.stop()
+        dashboard.stop()
+
+
+def _distance_topolyline(points: np.ndarray, line: np.ndarray) -> np.ndarray:
+    """Distance of each point to the polyline ``line`` (m, d)."""
+    a, b = line[:-1], line[1:]
+    d = b - a
+    rel = points[:, None, :] - a[None]
+    t = np.clip(np.einsum("nmd,md->nm", rel, d) / np.maximum(np.einsum("md,md->m", d, d), 1e-300),
+                0.0, 1.0)  # fmt: skip
+    return np.min(np.linalg.norm(rel - t[..., None] * d[None], axis=-1), axis=1)
+
+
+@pytest.mark.parametrize("robot", ["manipulator1", "manipulator2"])
+def test_scene_traces_stay_within_their_tolerance(robot):
+    """The scene draws each path with far fewer segments, never farther than the tolerance from
+    any computed point; the ends are kept."""
+    result = compute(default_state(robot))
+    (xlo, xhi), (ylo, yhi) = extent_of(result)
+    tol = TRACE_TOLERANCE * max(xhi - xlo, yhi - ylo)
+    for run in result.runs.values():
+        for path in (run.y, run.x):
+            kept = simplify(path, tol)
+            assert len(kept) < len(path) / 4
+            np.testing.assert_array_equal(kept[[0, -1]], path[[0, -1]])
+            assert _distance_topolyline(path, kept).max() <= tol
+    line = np.column_stack([np.linspace(0, 1, 50), np.linspace(0, 2, 50)])
+    assert len(simplify(line, 1e-12)) == 2
+    corner = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]])
+    np.testing.assert_array_equal(simplify(corner, 0.1), corner)
