@@ -385,6 +385,30 @@ class _UndefinedNearTarget(Pseudoinverse):
         return super().apply_masked(x, e)
 
 
+class _ThrownNearTarget(Pseudoinverse):
+    """A right inverse whose step is huge within `radius` of the target: the run diverges."""
+
+    def __init__(self, kinematics, radius: float) -> None:
+        super().__init__(kinematics)
+        self.radius = radius
+
+    def apply_masked(self, x, e):
+        v, bad = super().apply_masked(x, e)
+        near = np.linalg.norm(e, axis=-1) < self.radius
+        return np.where(near[..., None], 1e9 * v / np.linalg.norm(e, axis=-1)[..., None], v), bad
+
+
+def test_a_run_that_diverges_in_a_later_chunk_counts_all_its_iterations():
+    from jik.engine.solver import solve_in_chunks
+
+    inv = _ThrownNearTarget(Manipulator2(), 1e-3)
+    one = solve(inv, X0, [1, 1], gamma=0.3, mode="discrete")
+    assert not one.success and one.message.startswith(f"diverged after {one.nit} iterations")
+    chunk = 5 if one.nit % 5 else 6  # (not at a chunk's end: see solve_in_chunks' Notes)
+    assert one.nit > chunk
+    _same_run(solve_in_chunks(inv, X0, [1, 1], chunk=chunk, gamma=0.3), one)
+
+
 def test_a_typed_error_inside_a_chunk_keeps_every_iterate_before_it():
     """Where one solve raises (the map undefined on the way), the chunks stop with the iterates
     up to the error: the last chunk is redone one iteration at a time."""
