@@ -118,7 +118,7 @@ class Leg:
 
     cycle: int
     index: int
-    members: FloatArray
+    members: np.ndarray
     result: SolveResult | BatchSolveResult
     stopped_by: JikError | None = None
 
