@@ -198,7 +198,7 @@ def test_resume_equals_a_run_from_the_start_bit_for_bit(algorithm, kwargs):
 
 
 def test_resume_a_batch_equals_a_run_from_the_start():
-    starts = RNG.uniform(0, 1, (4, 3)) + [0, 0, 0.5]
+    starts = np.random.default_rng(27).uniform(0, 1, (4, 3)) + [0, 0, 0.5]
     inv = ExtendedInverse(Manipulator1(), E2Optimal(0.5, 1.0))
     path = np.array([(0.5, 1.0), (0.8, 1.5)])
     cold = repeatability(inv, starts, path, cycles=3)
