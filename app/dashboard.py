@@ -2,10 +2,10 @@
 
 The page (over ``/api/dashboard/*``) and the viser scene (through its GUI callbacks) both change
 the same :class:`Dashboard`; every change is validated against the registry, bumps a generation
-counter and wakes one worker thread. The worker solves both algorithms (the pseudoinverse (8) and
-the extended inverse (11)) leg by leg with :func:`jik.engine.solver.solve`, so that a newer change
-cancels a stale computation between legs, builds the figures once and pushes them to every
-subscriber (server-sent events for the page, a callback for the scene).
+counter and wakes one worker thread. The worker drives both algorithms (the pseudoinverse (8) and
+the extended inverse (11)) through the legs with :func:`jik.engine.repeatability.repeatability`,
+whose hooks let a newer change cancel a stale computation between legs, builds the figures once
+and pushes them to every subscriber (server-sent events for the page, a callback for the scene).
 
 Continuous mode integrates in tau = gamma theta (see :mod:`jik.engine.solver`): x(theta) does not
 depend on gamma, so the worker solves at gamma = 1 and divides theta by gamma, and a gamma change
@@ -33,10 +33,10 @@ from typing import cast
 import numpy as np
 
 from jik.app.controls import MAX_DASHBOARD_CYCLES, MODES, controls_message, expand
-from jik.engine.exceptions import InvalidInputError, JikError
+from jik.engine.exceptions import InvalidInputError, JikError, RunCancelled
 from jik.engine.registry import ROBOTS, make_inverse, robot_spec
-from jik.engine.repeatability import MAX_PATH_POINTS, closed_path, cycle_guesses
-from jik.engine.solver import SolveResult, Trajectory, solve
+from jik.engine.repeatability import MAX_PATH_POINTS, Leg, Resume, closed_path, repeatability
+from jik.engine.solver import MAX_ITERATIONS, SolveResult, Trajectory
 from jik.engine.unicycle import Unicycle
 from jik.engine.validation import count, positive
 
@@ -308,146 +308,62 @@ def _leg_targets(kin, state: DashboardState) -> np.ndarray:
 
 #: Discrete mode runs in chunks of this many iterations, so that a newer change cancels it.
 CHUNK = 80
-#: Iteration cap of one discrete leg (the engine's default).
-MAX_DISCRETE_ITERATIONS = 2000
-
-
-def _solve_leg(inverse, x, target, state, gamma, cancelled, partial=lambda f: None, guess=None):
-    """One leg: a solve, or in discrete mode a chain of short solves (the same iterates).
-
-    The discrete iteration x <- x - gamma J#(x) e(x) has no memory, so stopping after CHUNK
-    iterations and restarting from the last iterate reproduces the uninterrupted sequence.
-    ``guess``: continuous mode, the same leg's trajectory in the previous cycle (see
-    :func:`jik.engine.solver.solve`). Returns (theta, x, y, error, h, success, message) of the
-    whole leg.
-    """
-    if state.mode == "continuous":
-        # One start configuration: a single result, recorded (record=True by default).
-        res = cast(SolveResult, solve(inverse, x, target, gamma=gamma, mode="continuous",
-                                      tol=state.tolerance, guess=guess))  # fmt: skip
-        tr = res.trajectory
-        assert tr is not None  # record=True
-        return tr.theta, tr.x, tr.y, tr.error, tr.h, res.success, res.message, res.x
-    pieces: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]] = []
-    done, chunk, stopped = 0, CHUNK, None
-    while True:
-        try:
-            res = cast(SolveResult, solve(inverse, x, target, gamma=gamma, mode="discrete",
-                                          tol=state.tolerance, max_iterations=chunk))  # fmt: skip
-        except JikError as exc:
-            # The map is undefined somewhere in this chunk: redo it one iteration at a time to
-            # keep every iterate before the stop (the platform paths up to there).
-            if chunk == 1:
-                stopped = exc
-                break
-            chunk = 1
-            continue
-        tr = res.trajectory
-        assert tr is not None  # record=True
-        first = 0 if not pieces else 1  # a chunk starts where the previous one ended
-        pieces.append((tr.theta[first:] + done, tr.x[first:], tr.y[first:], tr.error[first:],
-                       None if tr.h is None else tr.h[first:]))  # fmt: skip
-        done += res.nit
-        x = res.x
-        if res.success or res.nit < chunk or done >= MAX_DISCRETE_ITERATIONS:
-            break
-        if cancelled():
-            raise Cancelled
-        # The error decays geometrically: the fraction of the way to tol, on a log scale.
-        e0, e, tol = float(pieces[0][3][0]), float(res.error), state.tolerance
-        partial(np.clip(np.log(e0 / e) / np.log(e0 / tol), 0.0, 0.99) if e0 > e > 0 else 0)
-    if stopped is not None:
-        if not pieces:
-            raise stopped
-        cat = [np.concatenate([p[k] for p in pieces]) for k in range(4)]
-        h = None if pieces[0][4] is None else np.concatenate([p[4] for p in pieces])
-        return (*cat, h, False, f"stopped after {done} iterations: {stopped}", x)
-    message = res.message
-    if not res.success and res.nit == chunk:
-        message = (
-            f"did not converge within {done} iterations (error {res.error:.3g}); "
-            "raise gamma or move the start"
-        )
-    elif res.success:
-        message = f"converged: task error {res.error:.3g} after {done} iterations"
-    cat = [np.concatenate([p[k] for p in pieces]) for k in range(4)]
-    h = None if pieces[0][4] is None else np.concatenate([p[4] for p in pieces])
-    return (*cat, h, res.success, message, res.x)
 
 
 def _run_legs(
     inverse, state, targets, cycles, progress, cancelled, partial, resume=None
 ) -> AlgorithmRun:
-    """Drive ``inverse`` through the legs as :func:`jik.engine.repeatability.repeatability` does.
+    """Drive ``inverse`` through the legs by :func:`jik.engine.repeatability.repeatability`,
+    keeping every point of every leg (its ``on_leg``) with theta cumulative over the legs.
 
     ``resume``: a successful run of fewer cycles of the same legs, whose cycles are kept; the
-    legs go on from its end (the same numbers as a run from the start: a leg depends only on
-    where it starts and its target).
-
-    In continuous mode each leg after the first cycle starts its Picard sweeps from the same leg
-    of the previous cycle (``guess`` of :func:`jik.engine.solver.solve`): for the extended inverse,
-    repeatable, that is the path itself and a leg then costs one or two sweeps instead of about
-    eight. The pseudoinverse's legs start from guesses swept for all legs of their cycle
-    together: one or two sweeps a leg instead of about ten (both:
-    :func:`jik.engine.repeatability.cycle_guesses`).
+    engine goes on from its end with its last cycle's legs as Picard guides (the numbers of a
+    run from the start). Discrete legs run in chunks of :data:`CHUNK` iterations, between which
+    ``cancelled`` is polled and ``partial`` told the leg's progress. A leg whose solve raises (a
+    map undefined where it starts) stops this algorithm; the other one is still shown.
     """
     t0 = time.perf_counter()
     x0 = np.asarray(state.x0)
-    # Continuous mode: solve at gamma = 1 (theta = tau); the caller rescales theta by 1/gamma.
-    gamma = 1.0 if state.mode == "continuous" else state.gamma
-    current, offset = x0, 0.0
-    parts, ends, drift = [], [], []
-    success, message, last_message = True, "completed", ""
+    continuous = state.mode == "continuous"
     L = len(targets)
-    first = 0
-    guides: list[Trajectory | None] = [None] * L  # leg j of the previous cycle
+    parts = []  # (theta, x, y, error, h, leg index) of every leg
+    offset, last, failure = 0.0, "", ""  # (the last leg's message; what stopped the run)
+    earlier = None
     if resume is not None:
-        first = len(resume.drift)
         parts.append((resume.theta, resume.x, resume.y, resume.error, resume.h, resume.leg))
-        ends, drift = list(resume.leg_end), list(resume.drift)
-        current, offset = resume.leg_end[-1], float(resume.theta[-1])
-        if state.mode == "continuous":
-            guides = [_leg_trajectory(resume, (first - 1) * L + j) for j in range(L)]
-    for c in range(first, cycles):
-        guesses = (
-            cycle_guesses(inverse, current, targets, guides, gamma)
-            if state.mode == "continuous"
-            else guides
-        )
-        for j in range(L):
-            if cancelled():
-                raise Cancelled
-            try:
-                leg = _solve_leg(
-                    inverse, current, targets[j], state, gamma, cancelled, partial, guesses[j]
-                )
-            except JikError as exc:
-                # A map undefined on the way (an algorithmic singularity, a characteristic that
-                # cannot be resolved) stops this algorithm; the other one is still shown.
-                y = inverse.kinematics.forward(current)
-                h = inverse.augmenting_value(current[None, :])
-                parts.append((np.array([offset]), current[None, :], y[None, :],
-                              np.array([np.linalg.norm(y - targets[j])]),
-                              None if h is None else np.asarray(h), c * L + j))  # fmt: skip
-                success, message = False, f"cycle {c + 1}, leg {j + 1} stopped: {exc}"
-                progress()
-                break
-            theta, xs, ys, err, h, ok, msg, x_end = leg
-            parts.append((theta + offset, xs, ys, err, h, c * L + j))
-            if state.mode == "continuous" and ok:
-                guides[j] = Trajectory(theta=theta, x=xs, y=ys, error=err, h=h)
-            offset += float(theta[-1])
-            progress()
-            if not ok:
-                success, message = False, f"cycle {c + 1}, leg {j + 1}: {msg}"
-                break
-            current = x_end
-            ends.append(x_end)
-            last_message = msg
-        if not success:
-            break
-        if state.task == "path":
-            drift.append(float(np.linalg.norm(current - x0)))
+        offset = float(resume.theta[-1])
+        done = (len(resume.drift) - 1) * L  # (the legs before its last cycle)
+        guides = [_leg_trajectory(resume, done + j) for j in range(L)] if continuous else []
+        earlier = Resume(resume.leg_end, guides)
+
+    def on_leg(leg: Leg) -> None:
+        nonlocal offset, last, failure
+        res = cast(SolveResult, leg.result)  # (one start, recorded)
+        tr = cast(Trajectory, res.trajectory)
+        parts.append((tr.theta + offset, tr.x, tr.y, tr.error, tr.h, leg.cycle * L + leg.index))
+        offset += float(tr.theta[-1])
+        where = f"cycle {leg.cycle + 1}, leg {leg.index + 1}"
+        if leg.stopped_by is not None:
+            failure = f"{where} stopped: {leg.stopped_by}"
+        elif not res.success:
+            failure = f"{where}: {_leg_message(res)}"
+        else:
+            last = _leg_message(res)
+        progress()
+
+    path, close = (state.path, True) if state.task == "path" else (targets, False)
+    try:
+        run = repeatability(
+            inverse, x0, path, cycles, gamma=1.0 if continuous else state.gamma, mode=state.mode,
+            tol=state.tolerance, record=True, close=close, resume=earlier, on_leg=on_leg,
+            cancelled=cancelled, chunk=None if continuous else CHUNK, on_chunk=partial,
+            on_undefined="stop",
+        )  # fmt: skip
+    except RunCancelled:
+        raise Cancelled from None
+    ends = run.legs[np.isfinite(run.legs).all(axis=1)]
+    cycle_ends = ends[L - 1 :: L] if state.task == "path" else []
+    drift = [float(np.linalg.norm(e - x0)) for e in cycle_ends]
     return AlgorithmRun(
         algorithm=inverse.name,
         theta=np.concatenate([p[0] for p in parts]),
@@ -456,12 +372,26 @@ def _run_legs(
         error=np.concatenate([p[3] for p in parts]),
         h=None if parts[0][4] is None else np.concatenate([p[4] for p in parts]),
         leg=np.concatenate([np.broadcast_to(p[5], len(p[0])) for p in parts]),
-        leg_end=np.asarray(ends).reshape(-1, len(x0)),
+        leg_end=ends,
         drift=np.asarray(drift),
-        success=success,
-        message=message if not success else _legs_message(len(ends), drift, last_message),
+        success=bool(run.success),
+        message=failure or _legs_message(len(ends), drift, last),
         seconds=time.perf_counter() - t0,
     )
+
+
+def _leg_message(res: SolveResult) -> str:
+    """A leg's message; a discrete leg's in the dashboard's words (iterations, not tol)."""
+    if res.mode == "continuous":
+        return res.message
+    if res.success:
+        return f"converged: task error {res.error:.3g} after {res.nit} iterations"
+    if res.nit == MAX_ITERATIONS:  # (the engine's cap, which the dashboard keeps)
+        return (
+            f"did not converge within {res.nit} iterations (error {res.error:.3g}); "
+            "raise gamma or move the start"
+        )
+    return res.message
 
 
 def _leg_trajectory(run: AlgorithmRun, k: int) -> Trajectory | None:

@@ -9,7 +9,7 @@ import numpy as np
 
 
 class JikError(Exception):
-    """Base class of every error raised by jik."""
+    """Base class of every error raised by jik (a cancellation is no error: see RunCancelled)."""
 
 
 class InvalidInputError(JikError, ValueError):
@@ -55,6 +55,14 @@ class AlgorithmicSingularityError(SingularConfigurationError):
 
 class OneFormUndefinedError(SingularConfigurationError):
     """The normalised one-form omega (omega J^T = 0) cannot be normalised (section 4)."""
+
+
+class RunCancelled(Exception):
+    """The caller's ``cancelled()`` said so: a long run stopped between two of its solves.
+
+    Not a :class:`JikError`: nothing is wrong with the run's input, and code that turns engine
+    errors into failed results (a leg that stops a run, an HTTP 422) must let it through.
+    """
 
 
 def format_vector(v) -> str:

@@ -2,18 +2,32 @@
 
 An algorithm is repeatable when closed paths in the task space give closed paths in the joint
 space. The extended Jacobian inverse (11) is repeatable by design; the pseudoinverse (8) is not.
+
+:func:`repeatability` is the one loop over cycles and legs in jik: a batch runs it for a map of
+starts, and an interactive caller (the dashboard) for one start, with hooks for what it shows
+while the run goes on: every leg as it ends (``on_leg``), cancellation between legs and chunks
+(``cancelled``), progress within a long discrete leg (``chunk``, ``on_chunk``), and more cycles
+from the end of a run it already has (``resume``).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import cast
+from functools import partial
 
 import numpy as np
 
-from jik.engine.exceptions import InvalidInputError
+from jik.engine.exceptions import InvalidInputError, JikError, RunCancelled
 from jik.engine.inverses import Inverse
-from jik.engine.solver import BatchSolveResult, SolveResult, Trajectory, chain_guesses, solve
+from jik.engine.solver import (
+    BatchSolveResult,
+    SolveResult,
+    Trajectory,
+    chain_guesses,
+    solve,
+    solve_in_chunks,
+)
 from jik.engine.unicycle import Unicycle
 from jik.engine.validation import FloatArray, count
 
@@ -51,6 +65,62 @@ class RepeatabilityResult:
     success: bool | FloatArray
     message: str | tuple[str, ...]
     leg_results: list[SolveResult]
+
+
+@dataclass(frozen=True)
+class Resume:
+    """Cycles already driven, for :func:`repeatability` to go on from their end.
+
+    A leg of eq. (7) depends only on where it starts and on its target, so going on from the
+    end of c cycles gives the numbers of a run from x0, bit for bit, when the next cycle's Picard
+    guesses are those the run from x0 would use (``guides``).
+
+    Attributes
+    ----------
+    legs : array_like, shape (c * L, p) or (n, c * L, p)
+        The configuration after each leg of the first c cycles: ``legs`` of a run of c cycles
+        (every leg converged) from the same x0, path and settings.
+    guides : sequence of L Trajectory or None
+        Continuous mode, one start: the trajectories of cycle c's legs, each the Picard guess of
+        the same leg of the next cycle (:func:`cycle_guesses`). Without them the extended
+        inverse's next cycle starts its sweeps cold: the same legs to the sweep tolerance.
+    """
+
+    legs: FloatArray
+    guides: Sequence[Trajectory | None] = ()
+
+    @classmethod
+    def of(cls, result: RepeatabilityResult) -> Resume:
+        """Go on from ``result`` (the guides come from its ``leg_results``, if recorded)."""
+        L = result.targets.shape[-2]
+        guides = [r.trajectory for r in result.leg_results[-L:]] if result.leg_results else []
+        return cls(result.legs, guides)
+
+
+@dataclass(frozen=True)
+class Leg:
+    """One leg of a run, as :func:`repeatability` hands it to ``on_leg`` when it ends: eq. (7)
+    from where the leg before ended to the cycle's target ``index``.
+
+    Attributes
+    ----------
+    cycle, index : int
+        The cycle and the leg's place in it, both from 0.
+    members : ndarray of int, shape (k,)
+        The starts that ran it (those still running), as indices into the batch; [0] for one.
+    result : SolveResult or BatchSolveResult
+        One start: its SolveResult, with the leg's trajectory (theta from 0) when ``record``.
+        A batch: the k members' BatchSolveResult.
+    stopped_by : JikError or None
+        With ``on_undefined="stop"``, the error the leg's solve raised; ``result`` is then the
+        leg's start alone (one point, ``success=False``).
+    """
+
+    cycle: int
+    index: int
+    members: np.ndarray
+    result: SolveResult | BatchSolveResult
+    stopped_by: JikError | None = None
 
 
 def closed_path(kinematics, x0: FloatArray, path: FloatArray) -> FloatArray:
@@ -101,6 +171,13 @@ def repeatability(
     tol: float = 1e-10,
     max_iterations: int | None = None,
     record: bool = False,
+    close: bool = True,
+    resume: Resume | None = None,
+    on_leg: Callable[[Leg], None] | None = None,
+    cancelled: Callable[[], bool] | None = None,
+    chunk: int | None = None,
+    on_chunk: Callable[[float], None] | None = None,
+    on_undefined: str = "raise",
 ) -> RepeatabilityResult:
     """Drive the robot through ``path`` and back to k(x0), ``cycles`` times, each leg by eq. (7).
 
@@ -115,15 +192,48 @@ def repeatability(
     cycles : int
         1 to 1000.
     gamma, mode, tol, max_iterations
-        As in :func:`jik.engine.solver.solve`.
+        As in :func:`jik.engine.solver.solve` (a leg's cap).
     record : bool
         Keep every leg's trajectory (single start only).
+    close : bool
+        False: the legs are the points of ``path`` as given, without the return leg to k(x0)
+        (one solve to a target is the run of one such leg).
+    resume : Resume, optional
+        Cycles already driven (:class:`Resume`): the run goes on from their end, and the result
+        is that of a run from x0 (``leg_results`` holds the new legs only).
+    on_leg : callable, optional
+        ``on_leg(leg)`` with a :class:`Leg`, after every leg (the last one too, whether it
+        converged or not). What it raises propagates.
+    cancelled : callable, optional
+        Polled before every leg, and between the chunks of a leg (``chunk``); when it returns
+        True the run raises :class:`jik.engine.exceptions.RunCancelled` there.
+    chunk : int, optional
+        Discrete mode, one start: run each leg as solves of at most ``chunk`` iterations
+        (:func:`jik.engine.solver.solve_in_chunks`: the same iterates), polling ``cancelled`` and
+        calling ``on_chunk`` between them.
+    on_chunk : callable, optional
+        With ``chunk``: ``on_chunk(fraction)`` after each chunk that leaves a leg unfinished,
+        with how far the leg's task error has come toward ``tol`` on a log scale (eq. (5)).
+    on_undefined : {"raise", "stop"}
+        What a leg's solve raising a typed error does (a map undefined where the leg starts,
+        an algorithmic singularity (11) there): "raise" it; or, one start only, "stop" the run
+        there with what it has, as a failed leg whose ``Leg.stopped_by`` is the error.
 
     Returns
     -------
     RepeatabilityResult
         A member whose leg fails (singularity, divergence) stops there: ``success`` is False, its
         message names the leg, and its remaining configurations are NaN.
+
+    Raises
+    ------
+    InvalidInputError
+        Bad shapes, or a hook that does not apply (``chunk`` or ``on_undefined="stop"`` with a
+        batch, ``chunk`` in continuous mode).
+    JikError
+        A leg's solve raised (a singular start configuration) and ``on_undefined`` is "raise".
+    RunCancelled
+        ``cancelled()`` returned True.
     """
     kin = inverse.kinematics
     x0 = kin.check(x0, "x0")
@@ -141,7 +251,18 @@ def repeatability(
         raise InvalidInputError("x0 must be one configuration or a 2-D batch")
     if path.ndim == 3 and len(path) != len(xb):
         raise InvalidInputError(f"{len(path)} paths given for {len(xb)} start configurations")
-    targets = closed_path(kin, xb, path)  # (n, L, r)
+    if on_undefined not in ("raise", "stop"):
+        raise InvalidInputError(f"on_undefined must be 'raise' or 'stop', got {on_undefined!r}")
+    if on_undefined == "stop" and not single:
+        raise InvalidInputError("on_undefined='stop' needs one start configuration")
+    if chunk is not None:
+        chunk = count(chunk, "chunk", 1, 10**6)
+        if mode != "discrete" or not single:
+            raise InvalidInputError("chunk applies to discrete mode with one start configuration")
+    if close:
+        targets = closed_path(kin, xb, path)  # (n, L, r)
+    else:
+        targets = np.broadcast_to(path, (len(xb), *path.shape[-2:]))
     n, L = targets.shape[:2]
     legs = np.full((n, cycles * L, kin.p), np.nan)
     alive = np.ones(n, dtype=bool)
@@ -151,38 +272,61 @@ def repeatability(
     # One start in continuous mode: each leg starts its Picard sweeps from a guess
     # (cycle_guesses). Batches do without: a guess is per member.
     guided = single and mode == "continuous"
-    guides: list = [None] * L
-    for c in range(cycles):
+    guides: list[Trajectory | None] = [None] * L
+    step = partial(solve, inverse, gamma=gamma, mode=mode, tol=tol, max_iterations=max_iterations)
+    first = 0
+    if resume is not None:
+        done, given = _resumed(resume, n, L, kin.p, cycles)
+        first = done.shape[1] // L
+        legs[:, : first * L] = done
+        current = done[:, -1].copy()
+        guides = given or guides
+    for c in range(first, cycles):
+        if not alive.any():
+            break
         guesses = cycle_guesses(inverse, current[0], targets[0], guides, gamma) if guided else []
         for j in range(L):
             ids = np.flatnonzero(alive)
             if ids.size == 0:
                 break
-            # current[ids] is (k, p), so solve returns a batch.
-            res = cast(
-                BatchSolveResult,
-                solve(
-                    inverse,
-                    current[ids],
-                    targets[ids, j],
-                    gamma=gamma,
-                    mode=mode,
-                    tol=tol,
-                    max_iterations=max_iterations,
-                    record=(record or guided) and single,
-                    guess=[guesses[j]] if guided else None,
-                ),
-            )
-            if guided and res.success[0]:
-                guides[j] = res.trajectory(0)
-            if record and single:
-                leg_results.append(res[0])
-            current[ids] = res.x
-            legs[ids, c * L + j] = res.x
-            for k in np.flatnonzero(~res.success):
+            _poll(cancelled, f"before cycle {c + 1}, leg {j + 1}")
+            stopped = None
+            try:
+                if chunk is not None:  # (one start)
+                    res: SolveResult | BatchSolveResult = solve_in_chunks(
+                        inverse, current[0], targets[0, j], chunk=chunk, gamma=gamma, tol=tol,
+                        max_iterations=max_iterations, record=record,
+                        between=_between(cancelled, on_chunk, f"in cycle {c + 1}, leg {j + 1}"),
+                    )  # fmt: skip
+                elif single:  # (a SolveResult: its trajectory guides the next cycle's leg)
+                    guess = [guesses[j]] if guided else None
+                    res = step(current[0], targets[0, j], record=record or guided, guess=guess)
+                else:  # (current[ids] is (k, p): a BatchSolveResult)
+                    res = step(current[ids], targets[ids, j], record=False)
+            except JikError as exc:
+                if on_undefined == "raise":
+                    raise
+                res = _stopped_leg(inverse, current[0], targets[0, j], exc, mode, gamma, record)
+                stopped = exc
+            why: Sequence[str]
+            if isinstance(res, SolveResult):
+                xs, ok, why = res.x[None], np.array([res.success]), (res.message,)
+                if guided and res.success:
+                    guides[j] = res.trajectory
+                if record:
+                    leg_results.append(res)
+            else:
+                xs, ok, why = res.x, res.success, res.message
+            current[ids] = xs
+            legs[ids, c * L + j] = xs
+            for k in np.flatnonzero(~ok):
                 alive[ids[k]] = False
-                messages[ids[k]] = f"cycle {c + 1}, leg {j + 1} failed: {res.message[k]}"
+                messages[ids[k]] = f"cycle {c + 1}, leg {j + 1} " + (
+                    f"stopped: {stopped}" if stopped is not None else f"failed: {why[k]}"
+                )
                 legs[ids[k], c * L + j] = np.nan
+            if on_leg is not None:
+                on_leg(Leg(c, j, ids, res, stopped))
     cycle_end = legs[:, L - 1 :: L]
     drift = np.linalg.norm(cycle_end - xb[:, None, :], axis=-1)
     if single:
@@ -197,3 +341,53 @@ def repeatability(
             leg_results,
         )
     return RepeatabilityResult(xb, targets, legs, cycle_end, drift, alive, tuple(messages), [])
+
+
+def _resumed(resume: Resume, n: int, L: int, p: int, cycles: int):
+    """The legs (n, c * L, p) of ``resume`` and its guides (a list of L, or [])."""
+    done = np.asarray(resume.legs, dtype=float)
+    done = done[None] if done.ndim == 2 and n == 1 else done
+    m = done.shape[1] if done.ndim == 3 else 0
+    if done.shape != (n, m, p) or m == 0 or m % L or m // L > cycles:
+        raise InvalidInputError(
+            f"resume.legs must be the legs of 1 to {cycles} whole cycles of {L} legs, shape "
+            f"(c * {L}, {p}) for one start or (n, c * {L}, {p}); got shape {done.shape}"
+        )
+    if not np.all(np.isfinite(done)):
+        raise InvalidInputError("resume.legs contains NaN: go on only from a run whose legs all "
+                                "converged")  # fmt: skip
+    guides = list(resume.guides)
+    if guides and len(guides) != L:
+        raise InvalidInputError(f"resume.guides must have one trajectory (or None) per leg, {L}")
+    return done, guides
+
+
+def _poll(cancelled: Callable[[], bool] | None, where: str) -> None:
+    if cancelled is not None and cancelled():
+        raise RunCancelled(f"repeatability run cancelled {where}")
+
+
+def _between(cancelled, on_chunk, where: str) -> Callable[[float], None]:
+    """What runs between two chunks of a discrete leg: the cancellation poll, then progress."""
+
+    def between(fraction: float) -> None:
+        _poll(cancelled, where)
+        if on_chunk is not None:
+            on_chunk(fraction)
+
+    return between
+
+
+def _stopped_leg(inverse, x, target, exc, mode, gamma, record) -> SolveResult:
+    """A leg whose solve raised ``exc``: its start alone, as the run's last point."""
+    x = x.copy()
+    y = inverse.kinematics.forward(x)
+    error = np.linalg.norm(y - target)
+    trajectory = None
+    if record:
+        h = inverse.augmenting_value(x[None, :])
+        h = None if h is None else np.asarray(h)
+        trajectory = Trajectory(np.zeros(1), x[None, :], y[None, :], np.array([error]), h)
+    return SolveResult(
+        x, y, float(error), False, str(exc), 0, trajectory, mode, gamma, inverse.name
+    )

@@ -7,19 +7,21 @@ small tolerance needs it, an embedded 8(5,3) Dormand-Prince pair (DOP853, the co
 SciPy's ``solve_ivp``, :mod:`jik.engine.dop853`) on (7) itself, each batch member with its own
 adaptive step. Both work in tau = gamma theta, so x(theta) does not depend on gamma at all:
 gamma only rescales theta (NOTES.md). Discrete mode iterates x <- x - gamma J#(x) (k(x) - y_d),
-as in section 6.2.
+as in section 6.2; :func:`solve_in_chunks` runs it as short solves with a hook between them (for
+progress and cancellation), the same iterates.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
 from functools import cached_property
+from typing import cast
 
 import numpy as np
 
 from jik.engine import dop853 as _dop
-from jik.engine.exceptions import InvalidInputError
+from jik.engine.exceptions import InvalidInputError, JikError
 from jik.engine.inverses import Inverse
 from jik.engine.picard import Guess, picard_chain, picard_path
 from jik.engine.validation import FloatArray, count, positive
@@ -35,6 +37,9 @@ _EXPONENT = -1.0 / 8.0  # error estimator of order 7
 #: Tolerances of the continuous integrator on x (relative and absolute).
 RTOL = 1e-12
 ATOL = 1e-12
+#: Default caps of :func:`solve`: integrator steps (continuous), iterations (discrete).
+MAX_STEPS = 20000
+MAX_ITERATIONS = 2000
 #: Picard sweeps per member in method "auto" before DOP853 takes over.
 PICARD_BUDGET = 80
 #: Largest |x| before a run counts as diverged.
@@ -103,6 +108,8 @@ class BatchSolveResult:
     _rec_member: FloatArray | None = field(repr=False, default=None)
     _rec_theta: FloatArray | None = field(repr=False, default=None)
     _rec_x: FloatArray | None = field(repr=False, default=None)
+    # Each member's outcome (_CONVERGED, _SINGULAR, ...): solve_in_chunks words its message.
+    _status: FloatArray | None = field(repr=False, default=None)
 
     def __len__(self) -> int:
         return len(self.x)
@@ -491,7 +498,8 @@ def solve(
     tol : float
         Stop when ||k(x) - y_d|| < tol.
     max_iterations : int, optional
-        Cap on integrator steps (continuous, default 20000) or iterations (discrete, default 2000).
+        Cap on integrator steps (continuous, default :data:`MAX_STEPS`) or iterations (discrete,
+        default :data:`MAX_ITERATIONS`).
     record : bool
         Keep the whole trajectory.
     method : {"auto", "picard", "dop853"}
@@ -548,7 +556,7 @@ def solve(
             f"gamma must be < 2 in discrete mode (got {gamma:g}): the error shrinks by "
             "|1 - gamma| per iteration near the solution"
         )
-    default_cap = 20000 if mode == "continuous" else 2000
+    default_cap = MAX_STEPS if mode == "continuous" else MAX_ITERATIONS
     cap = count(
         default_cap if max_iterations is None else max_iterations, "max_iterations", 1, 10**6
     )
@@ -587,5 +595,133 @@ def solve(
         _rec_member=rec_m,
         _rec_theta=rec_t,
         _rec_x=rec_x,
+        _status=status,
     )
     return batch[0] if single else batch
+
+
+def solve_in_chunks(
+    inverse: Inverse,
+    x0,
+    y_d,
+    *,
+    chunk: int,
+    gamma: float = 1.0,
+    tol: float = 1e-10,
+    max_iterations: int | None = None,
+    record: bool = True,
+    between: Callable[[float], None] | None = None,
+) -> SolveResult:
+    """Discrete mode of eq. (7) for one start, as solves of at most ``chunk`` iterations each.
+
+    The iteration x <- x - gamma J#(x) (k(x) - y_d) of section 6.2 has no memory: a solve from
+    where the one before stopped goes on with the same sequence, so the iterates, ``nit``, the
+    trajectory and the message are those of one :func:`solve` in discrete mode (see Notes).
+    Between two chunks ``between`` is called: a caller reports progress there, or stops a run
+    that is no longer wanted by raising.
+
+    Parameters
+    ----------
+    inverse : Inverse
+    x0 : array_like, shape (p,)
+    y_d : array_like, shape (r,)
+    chunk : int
+        Iterations per solve, >= 1.
+    gamma, tol, record
+        As in :func:`solve`.
+    max_iterations : int, optional
+        Cap on the iterations of the whole run (default :data:`MAX_ITERATIONS`).
+    between : callable, optional
+        Called after each chunk that leaves the run unfinished, with how far the task error has
+        come from its start value toward ``tol`` on a log scale (it decays geometrically, eq. (5)),
+        a fraction in [0, 0.99]. What it raises propagates.
+
+    Returns
+    -------
+    SolveResult
+        As :func:`solve` gives. A typed error raised inside a chunk (a map undefined where the
+        chunk starts, say) stops the run there: the chunk is redone one iteration at a time to
+        keep every iterate before the error, and the result has ``success=False`` and the message
+        "stopped after N iterations: <the error>".
+
+    Raises
+    ------
+    JikError
+        Raised before the first iteration is kept (a singular start, as in :func:`solve`).
+
+    Notes
+    -----
+    Each chunk is a :func:`solve`, so divergence is judged from the chunk's start error, a chunk
+    that runs all its iterations is followed by the next whatever its last iterate is, and a
+    singular iterate where a chunk starts stops the run as above (one solve would report the
+    singularity with the same iterates). Where a run neither diverges nor meets a singularity,
+    the results agree bit for bit.
+    """
+    kin = inverse.kinematics
+    x = kin.check(x0, "x0")
+    y_d = kin.check_task(y_d, "target y_d")
+    if x.ndim != 1 or y_d.ndim != 1:
+        raise InvalidInputError(
+            f"solve_in_chunks takes one start (p,) and one target (r,); got shapes {x.shape} "
+            f"and {y_d.shape}"
+        )
+    size = count(chunk, "chunk", 1, 10**6)
+    cap = count(MAX_ITERATIONS if max_iterations is None else max_iterations,
+                "max_iterations", 1, 10**6)  # fmt: skip
+    e0 = float(np.linalg.norm(kin.forward(x[None]) - y_d, axis=-1)[0])
+    pieces: list[Trajectory] = []
+    done, status = 0, _RUNNING
+    last: SolveResult | None = None
+    stopped: JikError | None = None
+    while True:
+        try:
+            batch = cast(BatchSolveResult, solve(
+                inverse, x[None], y_d[None], gamma=gamma, mode="discrete", tol=tol,
+                max_iterations=min(size, cap - done), record=record,
+            ))  # fmt: skip
+            res = batch[0]
+        except JikError as exc:
+            if size == 1:
+                stopped = exc
+                break
+            size = 1  # (the chunk again, one iteration at a time: up to the error)
+            continue
+        if res.trajectory is not None:
+            tr = res.trajectory
+            k = 1 if pieces else 0  # (a chunk starts where the one before ended)
+            h = None if tr.h is None else tr.h[k:]
+            pieces.append(Trajectory(tr.theta[k:] + done, tr.x[k:], tr.y[k:], tr.error[k:], h))
+        assert batch._status is not None  # (solve sets it)
+        done, x, last, status = done + res.nit, res.x, res, int(batch._status[0])
+        if res.success or res.nit < size or done >= cap:
+            break
+        if between is not None:
+            between(_fraction(e0, res.error, tol))
+    if last is None:
+        assert stopped is not None
+        raise stopped
+    if stopped is not None:
+        message = f"stopped after {done} iterations: {stopped}"
+    elif status == _SINGULAR:
+        message = last.message  # (names the configuration, not the count)
+    else:
+        message = _message(status, done, last.error, tol, "discrete", last.x, inverse, cap)
+    trajectory = _joined(pieces) if pieces else None
+    return replace(last, message=message, nit=done, trajectory=trajectory)
+
+
+def _joined(pieces: list[Trajectory]) -> Trajectory:
+    """One trajectory of consecutive pieces."""
+
+    def cat(name: str) -> FloatArray:
+        return np.concatenate([getattr(p, name) for p in pieces])
+
+    return Trajectory(theta=cat("theta"), x=cat("x"), y=cat("y"), error=cat("error"),
+                      h=None if pieces[0].h is None else cat("h"))  # fmt: skip
+
+
+def _fraction(e0: float, e: float, tol: float) -> float:
+    """How far the task error has come from e0 toward tol, on a log scale, in [0, 0.99]."""
+    if not e0 > e > 0:
+        return 0.0
+    return float(np.clip(np.log(e0 / e) / np.log(e0 / tol), 0.0, 0.99))

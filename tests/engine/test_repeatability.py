@@ -4,10 +4,11 @@ import numpy as np
 import pytest
 
 from jik.engine.augmentations import E1Optimal, E2Optimal, PaperCubic
-from jik.engine.exceptions import InvalidInputError
+from jik.engine.exceptions import AlgorithmicSingularityError, InvalidInputError, RunCancelled
 from jik.engine.inverses import ExtendedInverse, Pseudoinverse
 from jik.engine.kinematics import Manipulator1, Manipulator2
-from jik.engine.repeatability import repeatability
+from jik.engine.repeatability import Resume, repeatability
+from jik.engine.solver import solve
 from tests.helpers import count_picard_sweeps
 
 RNG = np.random.default_rng(1983)
@@ -109,3 +110,198 @@ def test_bad_input(kwargs, match):
     args = {"path": [(1, 1)], "cycles": 1} | kwargs
     with pytest.raises(InvalidInputError, match=match):
         repeatability(Pseudoinverse(Manipulator2()), [0, 0, 1.0], args["path"], args["cycles"])
+
+
+# -- hooks of the one engine loop (issue 27): on_leg, cancelled, resume, chunk, on_undefined ----
+
+TABLE1_X0 = np.array([0, 0, math.pi / 2])
+TABLE1_PATH = [(1, 1), (1, 2), (0, 2), (0, 1)]
+
+
+def _inverse(algorithm: str):
+    if algorithm == "pseudoinverse":
+        return Pseudoinverse(Manipulator2())
+    return ExtendedInverse(Manipulator2(), PaperCubic())
+
+
+def _same_legs(a, b) -> None:
+    """Two SolveResults of a leg, bit for bit."""
+    assert (a.success, a.nit, a.message) == (b.success, b.nit, b.message)
+    np.testing.assert_array_equal(a.x, b.x)
+    for name in ("theta", "x", "y", "error", "h"):
+        np.testing.assert_array_equal(getattr(a.trajectory, name), getattr(b.trajectory, name))
+
+
+def test_on_leg_sees_every_leg_in_order():
+    """One start: every leg's SolveResult with its trajectory, the run's legs in order. A batch:
+    each leg's BatchSolveResult and the members that ran it."""
+    seen = []
+    res = repeatability(_inverse("extended"), TABLE1_X0, TABLE1_PATH, cycles=2, record=True,
+                        on_leg=seen.append)  # fmt: skip
+    assert [(leg.cycle, leg.index) for leg in seen] == [(c, j) for c in range(2) for j in range(4)]
+    for k, leg in enumerate(seen):
+        assert leg.stopped_by is None and leg.members.tolist() == [0]
+        assert leg.result is res.leg_results[k]
+        np.testing.assert_array_equal(leg.result.x, res.legs[k])
+        np.testing.assert_array_equal(leg.result.trajectory.x[-1], res.legs[k])
+    starts = np.array([TABLE1_X0, TABLE1_X0 + [0.1, 0.0, 0.2], TABLE1_X0 - [0.0, 0.1, 0.1]])
+    seen.clear()
+    batch = repeatability(_inverse("pseudoinverse"), starts, TABLE1_PATH, on_leg=seen.append)
+    assert len(seen) == batch.legs.shape[1] == 5  # (the last point is not k(x0) for two of them)
+    for k, leg in enumerate(seen):
+        assert leg.members.tolist() == [0, 1, 2] and len(leg.result) == 3
+        np.testing.assert_array_equal(leg.result.x, batch.legs[:, k])
+
+
+@pytest.mark.parametrize("batch", [False, True])
+def test_cancelled_stops_between_legs(batch):
+    """cancelled() is polled before every leg: True before the third raises RunCancelled there,
+    after two legs."""
+    polls, seen = [], []
+    x0 = np.array([TABLE1_X0, TABLE1_X0]) if batch else TABLE1_X0
+    with pytest.raises(RunCancelled, match="before cycle 1, leg 3"):
+        repeatability(_inverse("extended"), x0, TABLE1_PATH, cycles=3, on_leg=seen.append,
+                      cancelled=lambda: polls.append(1) or len(polls) == 3)  # fmt: skip
+    assert len(polls) == 3 and len(seen) == 2
+
+
+def test_cancelled_stops_between_the_chunks_of_a_discrete_leg():
+    polls, fractions = [], []
+    with pytest.raises(RunCancelled, match="in cycle 1, leg 1"):
+        repeatability(_inverse("extended"), TABLE1_X0, TABLE1_PATH, gamma=0.3, mode="discrete",
+                      chunk=5, on_chunk=fractions.append,
+                      cancelled=lambda: polls.append(1) or len(polls) == 4)  # fmt: skip
+    assert len(polls) == 4 and len(fractions) == 2  # before the leg, then after chunks 1-3
+
+
+@pytest.mark.parametrize("algorithm", ["pseudoinverse", "extended"])
+@pytest.mark.parametrize(
+    "kwargs", [{}, {"mode": "discrete", "gamma": 0.5}, {"mode": "discrete", "gamma": 0.3,
+                                                        "chunk": 7}]
+)  # fmt: skip
+def test_resume_equals_a_run_from_the_start_bit_for_bit(algorithm, kwargs):
+    """Two cycles, then two more from their end (Resume.of: the legs and, in continuous mode,
+    the last cycle's trajectories as Picard guides): the numbers of four cycles from x0."""
+    inv = _inverse(algorithm)
+    cold = repeatability(inv, TABLE1_X0, TABLE1_PATH, cycles=4, record=True, **kwargs)
+    part = repeatability(inv, TABLE1_X0, TABLE1_PATH, cycles=2, record=True, **kwargs)
+    seen = []
+    rest = repeatability(inv, TABLE1_X0, TABLE1_PATH, cycles=4, record=True, **kwargs,
+                         resume=Resume.of(part), on_leg=seen.append)  # fmt: skip
+    assert cold.success and rest.success and rest.message == cold.message
+    for name in ("legs", "cycle_end", "drift"):
+        np.testing.assert_array_equal(getattr(rest, name), getattr(cold, name), name)
+    assert [leg.cycle for leg in seen] == [2] * 4 + [3] * 4
+    assert len(rest.leg_results) == 8
+    for a, b in zip(rest.leg_results, cold.leg_results[8:], strict=True):
+        _same_legs(a, b)
+
+
+def test_resume_a_batch_equals_a_run_from_the_start():
+    starts = np.random.default_rng(27).uniform(0, 1, (4, 3)) + [0, 0, 0.5]
+    inv = ExtendedInverse(Manipulator1(), E2Optimal(0.5, 1.0))
+    path = np.array([(0.5, 1.0), (0.8, 1.5)])
+    cold = repeatability(inv, starts, path, cycles=3)
+    part = repeatability(inv, starts, path, cycles=1)
+    rest = repeatability(inv, starts, path, cycles=3, resume=Resume(part.legs))
+    np.testing.assert_array_equal(rest.legs, cold.legs)
+    np.testing.assert_array_equal(rest.drift, cold.drift)
+
+
+def test_discrete_chunks_equal_an_unchunked_run():
+    """Legs run as solves of 7 iterations (so that a caller can cancel between them) give the
+    iterates, counts and messages of one solve per leg; the progress grows within a leg."""
+    inv = _inverse("extended")
+    one = repeatability(inv, TABLE1_X0, TABLE1_PATH, cycles=2, gamma=0.3, mode="discrete",
+                        record=True)  # fmt: skip
+    fractions: list[float] = []
+    chunked = repeatability(inv, TABLE1_X0, TABLE1_PATH, cycles=2, gamma=0.3, mode="discrete",
+                            record=True, chunk=7, on_chunk=fractions.append)  # fmt: skip
+    assert one.success and chunked.message == one.message
+    np.testing.assert_array_equal(chunked.legs, one.legs)
+    np.testing.assert_array_equal(chunked.drift, one.drift)
+    for a, b in zip(chunked.leg_results, one.leg_results, strict=True):
+        _same_legs(a, b)
+    assert len(fractions) == sum(-(-r.nit // 7) - 1 for r in one.leg_results) > 0
+    assert all(0 <= f <= 0.99 for f in fractions)
+
+
+def test_a_leg_that_raises_stops_the_run_with_the_legs_before_it(monkeypatch):
+    """on_undefined="stop": a leg whose solve raises (here the second, patched to) ends the run
+    there: the legs before it are kept, the stopped leg is its start alone, the message names
+    it. By default the error propagates."""
+    from jik.engine import repeatability as module
+
+    calls = []
+    original = module.solve
+
+    def second_raises(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 2:
+            raise AlgorithmicSingularityError("h is undefined here", args[1])
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(module, "solve", second_raises)
+    inv = _inverse("extended")
+    seen = []
+    res = repeatability(inv, TABLE1_X0, TABLE1_PATH, cycles=2, record=True, on_leg=seen.append,
+                        on_undefined="stop")  # fmt: skip
+    assert not res.success
+    assert res.message.startswith("cycle 1, leg 2 stopped: h is undefined here at x = ")
+    assert np.all(np.isfinite(res.legs[0])) and np.all(np.isnan(res.legs[1:]))
+    assert len(seen) == 2 and seen[1].stopped_by is not None
+    stop = seen[1].result
+    assert not stop.success and stop.nit == 0 and stop.message == str(seen[1].stopped_by)
+    np.testing.assert_array_equal(stop.trajectory.x, res.legs[:1])
+    np.testing.assert_array_equal(stop.trajectory.theta, [0.0])
+    assert stop.trajectory.h is not None and len(res.leg_results) == 2
+    calls.clear()
+    with pytest.raises(AlgorithmicSingularityError, match="h is undefined here"):
+        repeatability(inv, TABLE1_X0, TABLE1_PATH, cycles=2)
+
+
+def test_a_singular_start_stops_the_first_leg():
+    """(36) with a = 1, b = 0 is singular on x1 = 0: a run from there stops before it moves."""
+    inv = ExtendedInverse(Manipulator1(), E2Optimal(a=1.0, b=0.0))
+    for kwargs in ({}, {"mode": "discrete", "gamma": 0.5, "chunk": 10}):
+        with pytest.raises(AlgorithmicSingularityError):
+            repeatability(inv, [0.0, 0.2, 1.0], [(1.0, 1.0)], **kwargs)
+        res = repeatability(inv, [0.0, 0.2, 1.0], [(1.0, 1.0)], on_undefined="stop", **kwargs)
+        assert not res.success and res.message.startswith("cycle 1, leg 1 stopped: the extended")
+        assert np.all(np.isnan(res.legs))
+
+
+def test_open_legs_are_solves_to_their_targets():
+    """close=False: the path's points as given, no return leg (one leg: one solve)."""
+    inv = _inverse("pseudoinverse")
+    res = repeatability(inv, TABLE1_X0, [(1, 1)], close=False, record=True)
+    assert res.targets.shape == (1, 2)
+    _same_legs(res.leg_results[0], solve(inv, TABLE1_X0, [1, 1]))
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"chunk": 5}, "chunk applies to discrete mode"),
+        ({"chunk": 5, "mode": "discrete", "x0": [TABLE1_X0, TABLE1_X0]}, "chunk applies to"),
+        ({"chunk": 0, "mode": "discrete"}, "chunk must be between"),
+        ({"on_undefined": "ignore"}, "on_undefined must be 'raise' or 'stop'"),
+        ({"on_undefined": "stop", "x0": [TABLE1_X0, TABLE1_X0]}, "needs one start"),
+        ({"resume": "legs", "cycles": 3}, r"whole cycles of 4 legs"),
+        ({"resume": "legs", "cycles": 1}, r"1 to 1 whole cycles"),
+        ({"resume": "nan", "cycles": 3}, "resume.legs contains NaN"),
+        ({"resume": "guides", "cycles": 3}, "one trajectory .or None. per leg, 4"),
+    ],
+)
+def test_bad_hooks_are_refused(kwargs, match):
+    legs = np.tile(TABLE1_X0, (8, 1))
+    resume = {
+        "legs": Resume(legs[:7]) if kwargs.get("cycles") == 3 else Resume(legs),
+        "nan": Resume(np.where(legs > 1, np.nan, legs)),
+        "guides": Resume(legs, [None]),
+    }
+    args = {"x0": TABLE1_X0} | kwargs
+    if "resume" in args:
+        args["resume"] = resume[args["resume"]]
+    with pytest.raises(InvalidInputError, match=match):
+        repeatability(_inverse("pseudoinverse"), args.pop("x0"), TABLE1_PATH, **args)

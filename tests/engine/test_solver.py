@@ -330,3 +330,123 @@ def test_chain_guesses_refuse_bad_input_and_give_none_at_a_singularity():
     # (36) with a = 1, b = 0 is singular on x1 = 0, which the second leg has to cross.
     singular = ExtendedInverse(Manipulator1(), E2Optimal(a=1.0, b=0.0))
     assert chain_guesses(singular, [0.5, 0.2, 1.0], [[0.6, 0.2], [-0.5, 0.2]]) is None
+
+
+# -- discrete mode in chunks (solve_in_chunks): the iterates of one solve ------------------------
+
+
+def _same_run(a, b) -> None:
+    """Two results of eq. (7) with the same numbers, bit for bit."""
+    assert (a.success, a.nit, a.message) == (b.success, b.nit, b.message)
+    np.testing.assert_array_equal(a.x, b.x)
+    for name in ("theta", "x", "y", "error", "h"):
+        np.testing.assert_array_equal(getattr(a.trajectory, name), getattr(b.trajectory, name))
+
+
+@pytest.mark.parametrize("chunk", [1, 7, 80])
+def test_discrete_chunks_give_the_iterates_of_one_solve(chunk):
+    """x <- x - gamma J# e has no memory: solves of `chunk` iterations, each from where the one
+    before stopped, give the same iterates, count and message as one solve; between the chunks
+    the progress fraction grows toward 1."""
+    from jik.engine.solver import solve_in_chunks
+
+    inv = ExtendedInverse(Manipulator2(), PaperCubic())
+    one = solve(inv, X0, [1, 1], gamma=0.3, mode="discrete")
+    fractions: list[float] = []
+    res = solve_in_chunks(inv, X0, [1, 1], chunk=chunk, gamma=0.3, between=fractions.append)
+    assert one.success and one.nit > 60
+    _same_run(res, one)
+    assert len(fractions) == -(-one.nit // chunk) - 1
+    assert fractions == sorted(fractions) and all(0 <= f <= 0.99 for f in fractions)
+
+
+def test_discrete_chunks_stop_at_the_iteration_cap_as_one_solve():
+    from jik.engine.solver import solve_in_chunks
+
+    inv = Pseudoinverse(Manipulator2())
+    one = solve(inv, X0, [1, 1], gamma=0.01, mode="discrete", max_iterations=20)
+    res = solve_in_chunks(inv, X0, [1, 1], chunk=7, gamma=0.01, max_iterations=20)
+    assert not res.success and "did not converge within 20 iterations" in res.message
+    _same_run(res, one)
+    assert solve_in_chunks(inv, X0, [1, 1], chunk=7, gamma=0.01, record=False).trajectory is None
+
+
+class _UndefinedNearTarget(Pseudoinverse):
+    """A right inverse that raises (instead of masking) within `radius` of the target."""
+
+    def __init__(self, kinematics, radius: float) -> None:
+        super().__init__(kinematics)
+        self.radius = radius
+
+    def apply_masked(self, x, e):
+        near = np.linalg.norm(e, axis=-1) < self.radius
+        if np.any(near):
+            raise AlgorithmicSingularityError("undefined near the target", x[np.argmax(near)])
+        return super().apply_masked(x, e)
+
+
+class _ThrownNearTarget(Pseudoinverse):
+    """A right inverse whose step is huge within `radius` of the target: the run diverges."""
+
+    def __init__(self, kinematics, radius: float) -> None:
+        super().__init__(kinematics)
+        self.radius = radius
+
+    def apply_masked(self, x, e):
+        v, bad = super().apply_masked(x, e)
+        near = np.linalg.norm(e, axis=-1) < self.radius
+        return np.where(near[..., None], 1e9 * v / np.linalg.norm(e, axis=-1)[..., None], v), bad
+
+
+def test_a_run_that_diverges_in_a_later_chunk_counts_all_its_iterations():
+    from jik.engine.solver import solve_in_chunks
+
+    inv = _ThrownNearTarget(Manipulator2(), 1e-3)
+    one = solve(inv, X0, [1, 1], gamma=0.3, mode="discrete")
+    assert not one.success and one.message.startswith(f"diverged after {one.nit} iterations")
+    chunk = 5 if one.nit % 5 else 6  # (not at a chunk's end: see solve_in_chunks' Notes)
+    assert one.nit > chunk
+    _same_run(solve_in_chunks(inv, X0, [1, 1], chunk=chunk, gamma=0.3), one)
+
+
+def test_a_typed_error_inside_a_chunk_keeps_every_iterate_before_it():
+    """Where one solve raises (the map undefined on the way), the chunks stop with the iterates
+    up to the error: the last chunk is redone one iteration at a time."""
+    from jik.engine.solver import solve_in_chunks
+
+    kin = Manipulator2()
+    plain = solve(Pseudoinverse(kin), X0, [1, 1], gamma=0.3, mode="discrete")
+    m = int(np.argmax(plain.trajectory.error < 1e-3))  # the first iterate where it raises
+    with pytest.raises(AlgorithmicSingularityError):
+        solve(_UndefinedNearTarget(kin, 1e-3), X0, [1, 1], gamma=0.3, mode="discrete")
+    res = solve_in_chunks(_UndefinedNearTarget(kin, 1e-3), X0, [1, 1], chunk=7, gamma=0.3)
+    assert not res.success and res.nit == m
+    assert res.message.startswith(f"stopped after {m} iterations: undefined near the target")
+    np.testing.assert_array_equal(res.trajectory.x, plain.trajectory.x[: m + 1])
+    np.testing.assert_array_equal(res.x, plain.trajectory.x[m])
+
+
+def test_discrete_chunks_raise_at_a_singular_start_and_let_between_raise():
+    from jik.engine.solver import solve_in_chunks
+
+    singular = ExtendedInverse(Manipulator1(), E2Optimal(a=1.0, b=0.0))
+    with pytest.raises(AlgorithmicSingularityError, match=r"x = \(0, 0.2, 1\)"):
+        solve_in_chunks(singular, [0.0, 0.2, 1.0], [1.0, 1.0], chunk=5, gamma=0.5)
+
+    class Stop(Exception):
+        pass
+
+    def between(fraction: float) -> None:
+        raise Stop
+
+    with pytest.raises(Stop):
+        solve_in_chunks(Pseudoinverse(Manipulator2()), X0, [1, 1], chunk=5, gamma=0.3,
+                        between=between)  # fmt: skip
+    for kwargs, match in [
+        ({"chunk": 0}, "chunk must be between"),
+        ({"x0": [X0, X0]}, r"one start \(p,\) and one target"),
+        ({"gamma": 2.0}, "gamma must be < 2"),
+    ]:
+        args = {"x0": X0, "chunk": 5} | kwargs
+        with pytest.raises(InvalidInputError, match=match):
+            solve_in_chunks(Pseudoinverse(Manipulator2()), args.pop("x0"), [1, 1], **args)
