@@ -20,8 +20,8 @@ from pydantic import ValidationError
 from starlette.responses import Response
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
+from jik.app.compute.schemas import SolveRequest
 from jik.app.errors import error_response
-from jik.app.schemas import SolveRequest
 from jik.app.service import ComputePool
 
 

@@ -20,6 +20,7 @@ from fastapi.responses import JSONResponse
 from fastapi_offline import FastAPIOffline
 
 from jik import __version__
+from jik.app.compute.schemas import AUGMENTATION_MODELS, ROBOT_MODELS
 from jik.app.errors import (
     BodyLimit,
     busy_response,
@@ -28,7 +29,6 @@ from jik.app.errors import (
 )
 from jik.app.fastpath import SolveFastPath
 from jik.app.routers import dashboard, health, repeatability, robots, sessions, solve, synthesize
-from jik.app.schemas import AUGMENTATION_MODELS, ROBOT_MODELS
 from jik.app.service import (
     ComputeError,
     ComputePool,

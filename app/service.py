@@ -34,7 +34,7 @@ from typing import Any, TypeVar, cast
 import numpy as np
 import pydantic_core
 
-from jik.app import schemas as S
+from jik.app.compute import schemas as S
 from jik.engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
 from jik.engine.functionals import error_functional_e1, error_functional_e2
 from jik.engine.registry import ROBOTS, RobotSpec, make_inverse

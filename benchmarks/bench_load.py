@@ -161,7 +161,7 @@ async def _pool_load(duration: float, clients: int, batching: bool) -> dict:
     """The same load on the compute pool in-process: the computation path without HTTP."""
     import dataclasses
 
-    from jik.app.schemas import SolveRequest
+    from jik.app.compute.schemas import SolveRequest
     from jik.app.service import ComputePool, settings_from_env
 
     pool = ComputePool(dataclasses.replace(settings_from_env(), batching=batching))

@@ -2,7 +2,7 @@
 
 from fastapi import APIRouter, Request, Response
 
-from jik.app.schemas import BUSY, RepeatabilityRequest, RepeatabilityResponse
+from jik.app.compute.schemas import BUSY, RepeatabilityRequest, RepeatabilityResponse
 from jik.app.service import precheck
 
 router = APIRouter(tags=["repeatability"])

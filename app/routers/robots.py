@@ -2,7 +2,7 @@
 
 from fastapi import APIRouter, Request
 
-from jik.app.schemas import RobotsResponse
+from jik.app.compute.schemas import RobotsResponse
 from jik.app.service import robots_response
 
 router = APIRouter(tags=["robots"])

@@ -20,9 +20,9 @@ from fastapi import APIRouter, Depends, Request, WebSocket
 from fastapi.responses import JSONResponse, PlainTextResponse, StreamingResponse
 from websockets.typing import Subprotocol
 
+from jik.app.compute.schemas import SessionCreate
 from jik.app.controls import controls_message
 from jik.app.dashboard import Event, export_csv, export_json
-from jik.app.schemas import SessionCreate
 from jik.app.sessions import Session, SessionNotFound, SessionsFull, SessionStore
 from jik.engine.exceptions import InvalidInputError
 

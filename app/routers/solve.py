@@ -2,7 +2,7 @@
 
 from fastapi import APIRouter, Request, Response
 
-from jik.app.schemas import BUSY, SolveRequest, SolveResponse
+from jik.app.compute.schemas import BUSY, SolveRequest, SolveResponse
 
 router = APIRouter(tags=["solve"])
 

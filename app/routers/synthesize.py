@@ -2,7 +2,7 @@
 
 from fastapi import APIRouter, Request, Response
 
-from jik.app.schemas import (
+from jik.app.compute.schemas import (
     BUSY,
     SynthesisMethodsResponse,
     SynthesizeRequest,

@@ -88,7 +88,7 @@ def test_frame_headers():
 def test_a_cancelled_request_gives_its_worker_back_after_the_reply():
     """A request cancelled mid-computation (e.g. at shutdown): the worker finishes, its reply is
     drained in the background and the same process serves the next request."""
-    from jik.app.schemas import RepeatabilityRequest
+    from jik.app.compute.schemas import RepeatabilityRequest
     from tests.app.conftest import TABLE1_PATH, X0_M2
 
     body = RepeatabilityRequest.model_validate(

@@ -183,7 +183,7 @@ def test_every_registered_robot_solves_with_its_defaults(api):
 def test_service_batch_isolates_a_bad_first_member():
     """The plain service function (used by the dashboard): a wrong-length first member gets its
     own error, the others are solved."""
-    from jik.app.schemas import SolveRequest
+    from jik.app.compute.schemas import SolveRequest
     from jik.app.service import RequestError, solve_batch
 
     reqs = [
@@ -212,7 +212,7 @@ def test_service_batch_isolates_a_bad_first_member():
 def test_worker_json_is_the_validated_response(over):
     """The workers' JSON (built without pydantic) is the validated model's document: the same
     keys and the same float values (only the spelling of exponents differs)."""
-    from jik.app.schemas import SolveRequest, SolveResponse
+    from jik.app.compute.schemas import SolveRequest, SolveResponse
     from jik.app.service import _solve_batch, _solve_response_json, solve_batch
 
     req = SolveRequest.model_validate(solve_body(**over))
