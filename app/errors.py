@@ -14,7 +14,7 @@ from fastapi import HTTPException
 from fastapi.responses import JSONResponse
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from jik.app.service import ComputeError, RequestError, ServiceUnavailable
+from jik.app.compute.exceptions import ComputeError, RequestError, ServiceUnavailable
 
 log = logging.getLogger("jik.api")
 

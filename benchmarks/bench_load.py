@@ -162,7 +162,8 @@ async def _pool_load(duration: float, clients: int, batching: bool) -> dict:
     import dataclasses
 
     from jik.app.compute.schemas import SolveRequest
-    from jik.app.service import ComputePool, settings_from_env
+    from jik.app.compute.settings import settings_from_env
+    from jik.app.service import ComputePool
 
     pool = ComputePool(dataclasses.replace(settings_from_env(), batching=batching))
     try:

@@ -12,7 +12,8 @@ from multiprocessing.connection import Connection
 import numpy as np
 import pytest
 
-from jik.app.service import ComputePool, Settings, _frame
+from jik.app.compute.settings import Settings
+from jik.app.service import ComputePool, _frame
 
 LOOPS = ["asyncio"] + (["uvloop"] if importlib.util.find_spec("uvloop") else [])
 

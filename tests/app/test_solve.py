@@ -10,8 +10,8 @@ import httpx
 import numpy as np
 import pytest
 
+from jik.app.compute.settings import Settings
 from jik.app.main import create_app
-from jik.app.service import Settings
 from tests.app.conftest import X0_M2, solve_body
 
 # Table 1, pseudoinverse column, first leg: x1f after (0, 1) -> (1, 1).
@@ -183,8 +183,9 @@ def test_every_registered_robot_solves_with_its_defaults(api):
 def test_service_batch_isolates_a_bad_first_member():
     """The plain service function (used by the dashboard): a wrong-length first member gets its
     own error, the others are solved."""
+    from jik.app.compute.exceptions import RequestError
     from jik.app.compute.schemas import SolveRequest
-    from jik.app.service import RequestError, solve_batch
+    from jik.app.service import solve_batch
 
     reqs = [
         SolveRequest.model_validate(solve_body(x0=[0.0, 0.0])),
