@@ -20,9 +20,9 @@ from pydantic import ValidationError
 from starlette.responses import Response
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
+from jik.app.compute.pool import ComputePool
 from jik.app.compute.schemas import SolveRequest
 from jik.app.errors import error_response
-from jik.app.service import ComputePool
 
 
 def _is_json(scope: Scope) -> bool:

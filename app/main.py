@@ -21,6 +21,7 @@ from fastapi_offline import FastAPIOffline
 
 from jik import __version__
 from jik.app.compute.exceptions import ComputeError, RequestError, ServiceUnavailable
+from jik.app.compute.pool import ComputePool
 from jik.app.compute.schemas import AUGMENTATION_MODELS, ROBOT_MODELS
 from jik.app.compute.settings import Settings, env_flag
 from jik.app.errors import (
@@ -31,7 +32,6 @@ from jik.app.errors import (
 )
 from jik.app.fastpath import SolveFastPath
 from jik.app.routers import dashboard, health, repeatability, robots, sessions, solve, synthesize
-from jik.app.service import ComputePool
 
 log = logging.getLogger("jik.api")
 #: Largest request body accepted (413 beyond): the largest valid request is a few kilobytes.

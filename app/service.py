@@ -1,42 +1,23 @@
-"""Service layer: API schemas to engine calls, and where and how the heavy work runs.
+"""Service layer: API schemas to engine calls.
 
-Two layers:
-
-* Plain synchronous functions (``robots_response``, ``solve_request``, ``solve_batch``,
-  ``repeatability_request``, ``synthesize_request``) turn a request model into engine calls and
-  the result into a response model. They raise :class:`RequestError` naming the offending field.
-  The dashboard calls them directly.
-* :class:`ComputePool` runs them for the HTTP API off the event loop, in worker *processes*:
-  numpy-heavy Python loops hold the GIL, and a computation that overruns its time limit can only
-  be stopped by ending its process. Concurrent ``/solve`` requests with the same robot, algorithm,
-  augmentation, mode, gamma, tolerance and iteration cap are micro-batched: the first one opens a
-  short window (``JIK_BATCH_WINDOW_MS``, default 2 ms), every compatible request arriving until a
-  worker is free joins it, and the batch is solved by ONE engine call with x0 of shape (n, p) and
-  targets (n, r) (each member keeps its own adaptive step, so its result is the same as alone).
+Plain synchronous functions (``robots_response``, ``solve_request``, ``solve_batch``,
+``repeatability_request``, ``synthesize_request``) turn a request model into engine calls and the
+result into a response model. They raise :class:`RequestError` naming the offending field.
+:class:`jik.app.compute.pool.ComputePool` runs them for the HTTP API in worker processes.
 """
 
 from __future__ import annotations
 
-import asyncio
-import concurrent.futures
-import os
-import pickle
-import socket
-import struct
-import subprocess
-import sys
-import threading
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from multiprocessing.connection import Connection
 from typing import Any, TypeVar, cast
 
 import numpy as np
 import pydantic_core
 
 from jik.app.compute import schemas as S
-from jik.app.compute.exceptions import ComputeError, RequestError, ServiceUnavailable
-from jik.app.compute.settings import Settings, settings_from_env
+from jik.app.compute.exceptions import RequestError
+from jik.app.compute.settings import settings_from_env
 from jik.engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
 from jik.engine.functionals import error_functional_e1, error_functional_e2
 from jik.engine.registry import ROBOTS, RobotSpec, make_inverse
@@ -215,7 +196,7 @@ def _singular_message(setup: _Setup, x0) -> str:
 _ENGINE_FIELDS = ("x0", "target", "gamma", "tol", "max_iterations", "path", "cycles", "mode")
 
 
-def _engine_error(exc: JikError) -> RequestError:
+def engine_error(exc: JikError) -> RequestError:
     """An engine error as a RequestError; the field is read off the engine's message."""
     if isinstance(exc, SingularConfigurationError):
         return RequestError("x0", str(exc))
@@ -313,6 +294,12 @@ def solve_batch(reqs: list[S.SolveRequest]) -> list[S.SolveResponse | RequestErr
     return _solve_batch(reqs, _solve_response)
 
 
+def solve_batch_json(reqs: list[S.SolveRequest]) -> list[bytes | RequestError]:
+    """:func:`solve_batch` with each response as its JSON bytes, built without validating the
+    model (the workers' hot path, see :func:`_solve_response_json`)."""
+    return _solve_batch(reqs, _solve_response_json)
+
+
 def _solve_batch(
     reqs: list[S.SolveRequest], respond: Callable[[_Setup, Any], _R]
 ) -> list[_R | RequestError]:
@@ -359,7 +346,7 @@ def _solve_batch(
                     ),
                 )
             except JikError as exc:
-                err = _engine_error(exc)
+                err = engine_error(exc)
                 for k in keep:
                     out[ok[k]] = err
             else:
@@ -397,7 +384,7 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
             max_iterations=setup.max_iterations,
         )
     except JikError as exc:
-        raise _engine_error(exc) from None
+        raise engine_error(exc) from None
     drift = np.asarray(res.drift, dtype=float)
     finite = bool(np.all(np.isfinite(drift)))
     max_drift = float(np.max(drift)) if finite else float("nan")
@@ -595,427 +582,3 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         convergence=convergence,
         message="; ".join(notes) or "ok",
     )
-
-
-# --------------------------------------------------------------------------------------------
-# Worker processes
-
-
-def _solve_payload(items: list[bytes]) -> list[tuple[str, Any]]:
-    reqs = [S.SolveRequest.model_validate_json(b) for b in items]
-    out: list[tuple[str, Any]] = []
-    for res in _solve_batch(reqs, _solve_response_json):
-        if isinstance(res, RequestError):
-            out.append(("request_error", (res.field, res.message)))
-        else:
-            out.append(("ok", res))
-    return out
-
-
-# Workers take requests and give responses as JSON bytes: (de)serialization and validation run in
-# the workers, in parallel, and the event loop only passes bytes along.
-_HANDLERS: dict[str, Callable[[Any], Any]] = {
-    "ping": lambda payload: "pong",
-    "solve": _solve_payload,
-    "repeatability": lambda b: (
-        repeatability_request(S.RepeatabilityRequest.model_validate_json(b))
-        .model_dump_json()
-        .encode()
-    ),
-    "synthesize": lambda b: (
-        synthesize_request(S.SynthesizeRequest.model_validate_json(b)).model_dump_json().encode()
-    ),
-}
-
-
-def _worker_main(conn) -> None:
-    """Worker process loop: say "ready", then (kind, payload) in, (status, result) out."""
-    conn.send(("ready", None))
-    while True:
-        try:
-            kind, payload = conn.recv()
-        except (EOFError, OSError):
-            return
-        try:
-            msg = ("ok", _HANDLERS[kind](payload))
-        except RequestError as exc:
-            msg = ("request_error", (exc.field, exc.message))
-        except JikError as exc:
-            err = _engine_error(exc)
-            msg = ("request_error", (err.field, err.message))
-        except MemoryError:
-            field, less = _WORK_FIELDS.get(kind, ("request", "less work"))
-            msg = ("request_error", (field, f"the computation ran out of memory; ask for {less}"))
-        except Exception as exc:  # reported to the client as a 500 with its text
-            msg = ("error", f"{type(exc).__name__}: {exc}")
-        conn.send(msg)
-
-
-def _worker_entry(fd: int) -> None:
-    """Entry point of a worker process started by :class:`_Worker` (``python -c``)."""
-    _worker_main(Connection(fd))
-
-
-#: Longest wait for a new worker to import the engine (not counted in a request's time limit).
-WORKER_BOOT_TIMEOUT = 120.0
-
-
-def _frame(buf: bytearray) -> tuple[int | None, int]:
-    """Payload size and offset of a :class:`~multiprocessing.connection.Connection` message
-    starting in ``buf`` (size None until the header is complete)."""
-    if len(buf) < 4:
-        return None, 0
-    (size,) = struct.unpack("!i", buf[:4])
-    if size != -1:
-        return size, 4
-    if len(buf) < 12:
-        return None, 0
-    return struct.unpack("!Q", buf[4:12])[0], 12
-
-
-class _Worker:
-    """A worker process (a fresh interpreter, so nothing of the server's state is inherited)."""
-
-    def __init__(self) -> None:
-        parent, child = socket.socketpair()
-        fd = child.fileno()
-        env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
-        self.process = subprocess.Popen(
-            [
-                sys.executable,
-                "-c",
-                f"from jik.app.service import _worker_entry; _worker_entry({fd})",
-            ],
-            pass_fds=[fd],
-            env=env,
-            stdin=subprocess.DEVNULL,
-        )
-        child.close()
-        self.conn = Connection(parent.detach())
-        self.ready = False
-
-    def wait_ready(self) -> None:
-        if not self.ready:
-            if not self.conn.poll(WORKER_BOOT_TIMEOUT):
-                raise OSError("worker did not start")
-            self.conn.recv()
-            self.ready = True
-
-    def kill(self) -> None:
-        self.process.kill()
-        self.process.wait(5)
-        self.conn.close()
-
-
-#: The field that sizes the work of each computation kind, and how to ask for less.
-_WORK_FIELDS = {
-    "solve": ("max_iterations", "a lower max_iterations or a larger tolerance"),
-    "repeatability": ("cycles", "fewer cycles or path points, a lower max_iterations"),
-    "synthesize": ("region", "a smaller region, fewer nodes, a smaller grid or a lower degree"),
-}
-
-
-def _retrieve(future: asyncio.Future) -> None:
-    """Mark an abandoned request's exception as seen (no 'never retrieved' warning)."""
-    if not future.cancelled():
-        future.exception()
-
-
-@dataclass
-class _Pending:
-    payload: bytes
-    future: asyncio.Future
-    deadline: float
-    dispatched: bool = False
-    abandoned: bool = False
-
-
-class ComputePool:
-    """Worker processes with a bound on concurrent computations and a time limit per request.
-
-    At most ``settings.workers`` computations run at once. A request that gets no worker within
-    ``settings.timeout`` fails with :class:`ServiceUnavailable` (503, "busy"); a computation that
-    runs longer than ``settings.timeout`` is stopped by killing its worker (a new one replaces it)
-    and its requests fail with a :class:`RequestError` (422) naming the field that sizes the
-    work. The asyncio side is rebuilt when the pool is used from another event loop (test
-    clients); the processes are kept.
-    """
-
-    def __init__(self, settings: Settings | None = None) -> None:
-        self.settings = settings or settings_from_env()
-        self._workers: list[_Worker] = []
-        self._lock = threading.Lock()
-        self._threads = concurrent.futures.ThreadPoolExecutor(
-            max_workers=self.settings.workers + 1, thread_name_prefix="jik-compute"
-        )
-        self._loop: asyncio.AbstractEventLoop | None = None
-        self._idle: asyncio.Queue[_Worker] | None = None
-        self._pending: dict[str, list[_Pending]] = {}
-        self._tasks: set[asyncio.Task] = set()
-        #: Engine calls made and requests served by them (for tests and the benchmark).
-        self.stats = {"solve_calls": 0, "solve_requests": 0, "busy": 0, "exceeded": 0}
-
-    # -- lifecycle
-    def start(self) -> None:
-        """Start the worker processes (idempotent, non-blocking)."""
-        with self._lock:
-            while len(self._workers) < self.settings.workers:
-                self._workers.append(_Worker())
-
-    def close(self) -> None:
-        """Stop every worker process."""
-        with self._lock:
-            for w in self._workers:
-                w.kill()
-            self._workers.clear()
-            self._loop = self._idle = None
-
-    def _bind(self) -> asyncio.Queue[_Worker]:
-        loop = asyncio.get_running_loop()
-        if self._loop is not loop or self._idle is None:
-            self.start()
-            self._loop = loop
-            self._idle = asyncio.Queue()
-            self._pending = {}
-            for w in self._workers:
-                self._idle.put_nowait(w)
-        return self._idle
-
-    @property
-    def _bound_loop(self) -> asyncio.AbstractEventLoop:
-        """The event loop of the last :meth:`_bind` (only used after it)."""
-        assert self._loop is not None, "ComputePool used before _bind()"
-        return self._loop
-
-    @property
-    def _bound_idle(self) -> asyncio.Queue[_Worker]:
-        """The idle-worker queue of the last :meth:`_bind` (only used after it)."""
-        assert self._idle is not None, "ComputePool used before _bind()"
-        return self._idle
-
-    async def warm_up(self) -> None:
-        """Start the workers and wait until each has imported the engine."""
-        self._bind()
-        with self._lock:
-            workers = list(self._workers)
-        await asyncio.gather(
-            *(self._bound_loop.run_in_executor(self._threads, w.wait_ready) for w in workers)
-        )
-
-    def _spawn(self, coro) -> asyncio.Task:
-        task = self._bound_loop.create_task(coro)
-        self._tasks.add(task)
-        task.add_done_callback(self._tasks.discard)
-        return task
-
-    # -- core
-    def _busy(self) -> ServiceUnavailable:
-        self.stats["busy"] += 1
-        return ServiceUnavailable(
-            f"server busy: no compute slot became free within the time limit of "
-            f"{self.settings.timeout:g} s ({self.settings.workers} computations run at once); "
-            "retry later"
-        )
-
-    async def _acquire(self, deadline: float) -> _Worker:
-        idle = self._bind()
-        remaining = deadline - self._bound_loop.time()
-        try:
-            if remaining <= 0:
-                raise TimeoutError
-            return await asyncio.wait_for(idle.get(), remaining)
-        except TimeoutError:
-            raise self._busy() from None
-
-    async def _dispatch(self, worker: _Worker, kind: str, payload):
-        """Run one computation on ``worker``; it is killed if it overruns the time limit.
-
-        The event loop itself waits for the worker's socket to become readable (no thread per
-        computation: a thread would wait for the GIL, up to the 5 ms switch interval, while the
-        loop serves other requests).
-        """
-        loop = self._bound_loop
-        try:
-            if not worker.ready:  # a freshly started worker: importing the engine takes a while
-                await loop.run_in_executor(self._threads, worker.wait_ready)
-            deadline = loop.time() + self.settings.timeout
-            os.set_blocking(worker.conn.fileno(), True)  # uvloop's add_reader made it non-blocking
-            worker.conn.send((kind, payload))
-            msg = await self._reply(worker, deadline)
-        except TimeoutError:
-            self.stats["exceeded"] += 1
-            self._replace(worker)
-            field, less = _WORK_FIELDS.get(kind, ("request", "less work"))
-            raise RequestError(
-                field,
-                f"the computation exceeded the time limit of {self.settings.timeout:g} s and "
-                f"was stopped; ask for less work ({less})",
-            ) from None
-        except (EOFError, OSError) as exc:
-            self._replace(worker)
-            raise ServiceUnavailable(f"the compute worker stopped unexpectedly ({exc!r})") from None
-        except asyncio.CancelledError:  # the request went away: collect the reply in the back
-            if worker.ready:
-                self._spawn(self._drain(worker, loop.time() + self.settings.timeout))
-            else:
-                self._replace(worker)
-            raise
-        self._bound_idle.put_nowait(worker)
-        return msg
-
-    async def _reply(self, worker: _Worker, deadline: float):
-        """The worker's reply, read in the event loop as it arrives, until ``deadline``.
-
-        The reply is framed as by :class:`multiprocessing.connection.Connection` (which the worker
-        uses): a 4-byte big-endian length (-1, then 8 bytes, for huge messages), then a pickle.
-        Each readiness callback reads once, so it never blocks whether or not the event loop
-        (uvloop does) has made the socket non-blocking.
-        """
-        loop = self._bound_loop
-        fd = worker.conn.fileno()
-        done: asyncio.Future = loop.create_future()
-        buf = bytearray()
-
-        def readable() -> None:
-            try:
-                chunk = os.read(fd, 1 << 20)
-            except (BlockingIOError, InterruptedError):
-                return
-            except OSError as exc:
-                if not done.done():
-                    done.set_exception(exc)
-                return
-            if not chunk:
-                if not done.done():
-                    done.set_exception(EOFError("the worker closed its connection"))
-                return
-            buf.extend(chunk)
-            size, start = _frame(buf)
-            if size is not None and len(buf) >= start + size and not done.done():
-                done.set_result(pickle.loads(memoryview(buf)[start : start + size]))
-
-        loop.add_reader(fd, readable)
-        try:
-            return await asyncio.wait_for(done, max(deadline - loop.time(), 0.0))
-        finally:
-            loop.remove_reader(fd)
-
-    async def _drain(self, worker: _Worker, deadline: float) -> None:
-        """Wait out an abandoned computation, then give the worker back (or replace it)."""
-        try:
-            await self._reply(worker, deadline)
-        except (TimeoutError, EOFError, OSError):
-            self._replace(worker)
-        else:
-            self._bound_idle.put_nowait(worker)
-
-    def _replace(self, worker: _Worker) -> None:
-        worker.kill()
-        with self._lock:
-            if worker in self._workers:
-                self._workers.remove(worker)
-            fresh = _Worker()
-            self._workers.append(fresh)
-        self._bound_idle.put_nowait(fresh)
-
-    @staticmethod
-    def _unwrap(msg):
-        status, value = msg
-        if status == "ok":
-            return value
-        if status == "request_error":
-            raise RequestError(*value)
-        raise ComputeError(value)
-
-    async def run(self, kind: str, payload) -> Any:
-        """Run handler ``kind`` on ``payload`` in a worker (waits and runs within the limits).
-
-        For the API kinds the payload is the request and the result the response, as JSON bytes.
-        """
-        self._bind()
-        worker = await self._acquire(self._bound_loop.time() + self.settings.timeout)
-        return self._unwrap(await self._dispatch(worker, kind, payload))
-
-    # -- micro-batched solves
-    async def solve(self, req: S.SolveRequest) -> bytes:
-        """One /solve request (JSON response bytes); micro-batched with compatible ones."""
-        precheck(req)
-        self._bind()
-        payload = req.model_dump_json().encode()
-        if not self.settings.batching:
-            self.stats["solve_calls"] += 1
-            self.stats["solve_requests"] += 1
-            (res,) = await self.run("solve", [payload])
-            return self._unwrap(res)
-        loop = self._bound_loop
-        entry = _Pending(payload, loop.create_future(), loop.time() + self.settings.timeout)
-        entry.future.add_done_callback(_retrieve)
-        key = batch_key(req)
-        queue = self._pending.setdefault(key, [])
-        queue.append(entry)
-        if len(queue) == 1:
-            self._spawn(self._flush(key, first=True))
-        try:
-            return self._unwrap(
-                await asyncio.wait_for(asyncio.shield(entry.future), entry.deadline - loop.time())
-            )
-        except TimeoutError:
-            if entry.dispatched:  # computing: bounded by the computation's own time limit
-                return self._unwrap(await entry.future)
-            entry.abandoned = True
-            raise self._busy() from None
-
-    async def _flush(self, key: str, first: bool) -> None:
-        if first and self.settings.batch_window > 0:
-            await asyncio.sleep(self.settings.batch_window)
-        queue = [p for p in self._pending.get(key, []) if not p.abandoned]
-        if not queue:
-            self._pending.pop(key, None)
-            return
-        try:
-            worker = await self._acquire(max(p.deadline for p in queue))
-        except ServiceUnavailable:
-            for p in self._pending.pop(key, []):
-                p.abandoned = True
-                if not p.future.done():
-                    p.future.set_exception(self._busy())
-            return
-        # Everything compatible that arrived while we waited for the worker joins the batch.
-        queue = [p for p in self._pending.pop(key, []) if not p.abandoned]
-        items, rest = queue[: self.settings.max_batch], queue[self.settings.max_batch :]
-        if rest:
-            self._pending[key] = rest
-            self._spawn(self._flush(key, first=False))
-        if not items:
-            self._bound_idle.put_nowait(worker)
-            return
-        # A large batch is shared among the workers that are idle right now: two half batches on
-        # two cores finish sooner than one whole batch on one.
-        workers = [worker]
-        while (
-            len(items) >= (len(workers) + 1) * self.settings.min_share
-            and not self._bound_idle.empty()
-        ):
-            workers.append(self._bound_idle.get_nowait())
-        for p in items:
-            p.dispatched = True
-        self.stats["solve_calls"] += len(workers)
-        self.stats["solve_requests"] += len(items)
-        shares = np.array_split(np.arange(len(items)), len(workers))
-        for w, share in zip(workers[1:], shares[1:], strict=True):
-            self._spawn(self._solve_share(w, [items[i] for i in share]))
-        await self._solve_share(workers[0], [items[i] for i in shares[0]])
-
-    async def _solve_share(self, worker: _Worker, items: list[_Pending]) -> None:
-        """Solve ``items`` in ONE engine call on ``worker`` and hand each its result."""
-        try:
-            msg = await self._dispatch(worker, "solve", [p.payload for p in items])
-            results = self._unwrap(msg)
-        except Exception as exc:  # handed to every request of the batch
-            for p in items:
-                if not p.future.done():
-                    p.future.set_exception(exc)
-            return
-        for p, res in zip(items, results, strict=True):
-            if not p.future.done():
-                p.future.set_result(res)

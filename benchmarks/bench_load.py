@@ -14,7 +14,7 @@ reports p50/p99 from its own latency histogram. The httpx clients run too, as a 
 
 Two reference points separate the HTTP stack from the computation: the same 16 clients against
 ``GET /health`` (the HTTP floor, no computation), and the same load on
-:class:`jik.app.service.ComputePool` in-process (the batched computation path without HTTP).
+:class:`jik.app.compute.pool.ComputePool` in-process (the batched computation path without HTTP).
 """
 
 from __future__ import annotations
@@ -161,9 +161,9 @@ async def _pool_load(duration: float, clients: int, batching: bool) -> dict:
     """The same load on the compute pool in-process: the computation path without HTTP."""
     import dataclasses
 
+    from jik.app.compute.pool import ComputePool
     from jik.app.compute.schemas import SolveRequest
     from jik.app.compute.settings import settings_from_env
-    from jik.app.service import ComputePool
 
     pool = ComputePool(dataclasses.replace(settings_from_env(), batching=batching))
     try:

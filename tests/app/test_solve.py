@@ -214,11 +214,11 @@ def test_worker_json_is_the_validated_response(over):
     """The workers' JSON (built without pydantic) is the validated model's document: the same
     keys and the same float values (only the spelling of exponents differs)."""
     from jik.app.compute.schemas import SolveRequest, SolveResponse
-    from jik.app.service import _solve_batch, _solve_response_json, solve_batch
+    from jik.app.service import solve_batch, solve_batch_json
 
     req = SolveRequest.model_validate(solve_body(**over))
     (model,) = solve_batch([req])
-    (raw,) = _solve_batch([req], _solve_response_json)
+    (raw,) = solve_batch_json([req])
     assert isinstance(model, SolveResponse) and isinstance(raw, bytes)
     assert json.loads(raw) == json.loads(model.model_dump_json())
     SolveResponse.model_validate_json(raw)
