@@ -1,9 +1,11 @@
-"""Service layer: API schemas to engine calls.
+"""Service layer: API schemas to engine calls for the robots, solve and repeatability requests.
 
 Plain synchronous functions (``robots_response``, ``solve_request``, ``solve_batch``,
-``repeatability_request``, ``synthesize_request``) turn a request model into engine calls and the
-result into a response model. They raise :class:`RequestError` naming the offending field.
-:class:`jik.app.compute.pool.ComputePool` runs them for the HTTP API in worker processes.
+``repeatability_request``) turn a request model into engine calls and the result into a response
+model. They raise :class:`RequestError` naming the offending field. Synthesis requests have
+their own module (:mod:`jik.app.compute.synthesis`), which builds robots and maps with the
+helpers here; :class:`jik.app.compute.pool.ComputePool` runs both for the HTTP API in worker
+processes.
 """
 
 from __future__ import annotations
@@ -19,11 +21,9 @@ from jik.app.compute import schemas as S
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.settings import settings_from_env
 from jik.engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
-from jik.engine.functionals import error_functional_e1, error_functional_e2
 from jik.engine.registry import ROBOTS, RobotSpec, make_inverse
 from jik.engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS, repeatability
 from jik.engine.solver import BatchSolveResult, solve
-from jik.engine.variational import synthesize_e2
 
 _R = TypeVar("_R")
 
@@ -35,7 +35,7 @@ REPEATABLE_DRIFT = 1e-6
 # Conversions
 
 
-def _nullable(a) -> Any:
+def nullable(a) -> Any:
     """ndarray -> nested lists with None where not finite (JSON has no NaN)."""
     a = np.asarray(a, dtype=float)
     if a.ndim == 0:
@@ -70,7 +70,8 @@ class _Setup:
     extra: dict = field(default_factory=dict)
 
 
-def _robot(req_robot) -> tuple[RobotSpec, Any, S.RobotUsed]:
+def build_robot(req_robot) -> tuple[RobotSpec, Any, S.RobotUsed]:
+    """The robot named in the request, built with its parameters; what it used, filled in."""
     try:
         spec = ROBOTS[req_robot.name]
     except KeyError:
@@ -89,7 +90,7 @@ def _robot(req_robot) -> tuple[RobotSpec, Any, S.RobotUsed]:
     return spec, kin, S.RobotUsed(name=spec.name, parameters=used)
 
 
-def _augmentation(spec: RobotSpec, kin, req_aug):
+def build_augmentation(spec: RobotSpec, kin, req_aug):
     """The augmenting map named in the request (or the robot's default), built and checked."""
     name = req_aug.name if req_aug is not None else None
     try:
@@ -114,10 +115,10 @@ def _augmentation(spec: RobotSpec, kin, req_aug):
 
 
 def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
-    spec, kin, robot_used = _robot(req.robot)
+    spec, kin, robot_used = build_robot(req.robot)
     aug_used = None
     if req.algorithm == "extended":
-        aspec, _, aug_used = _augmentation(spec, kin, req.augmentation)
+        aspec, _, aug_used = build_augmentation(spec, kin, req.augmentation)
         try:
             inverse = make_inverse(kin, "extended", aspec.name, aug_used.parameters, spec.name)
         except InvalidInputError as exc:
@@ -137,47 +138,14 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
     )
 
 
-def precheck(req: S.SolveRequest | S.RepeatabilityRequest | S.SynthesizeRequest) -> None:
-    """The registry checks that need no numerics (names, lengths, discrete gamma).
-
-    Run on the event loop before a request is sent to a worker, so bad requests are answered at
-    once even when every worker is busy. The workers repeat them (the plain service functions
-    are complete on their own).
-    """
-    spec = ROBOTS.get(req.robot.name)
-    if spec is None:
-        raise RequestError(
-            "robot.name", f"unknown robot {req.robot.name!r}; choose one of {sorted(ROBOTS)}"
-        )
-    if isinstance(req, S.SynthesizeRequest):
-        _region(spec, req)
-        return
-    if req.algorithm == "extended" and req.augmentation is not None:
-        try:
-            spec.augmentation(req.augmentation.name)
-        except InvalidInputError as exc:
-            raise RequestError("augmentation.name", str(exc)) from None
-    _check_configuration(spec, req.x0)
-    if isinstance(req, S.SolveRequest):
-        _check_task_point(spec, req.target, "target")
-    else:
-        for i, pt in enumerate(req.path):
-            _check_task_point(spec, pt, f"path[{i}]")
-    gamma = spec.default_gamma if req.gamma is None else float(req.gamma)
-    if (req.mode or spec.default_mode) == "discrete" and gamma >= 2:
-        raise RequestError(
-            "gamma",
-            f"must be < 2 in discrete mode, got {gamma:g} (near the solution the error shrinks "
-            "by |1 - gamma| per iteration)",
-        )
-
-
-def _check_configuration(spec: RobotSpec, x0) -> None:
+def check_configuration(spec: RobotSpec, x0) -> None:
+    """``x0`` has p components."""
     if len(x0) != spec.p:
         raise RequestError("x0", f"must have {spec.p} components (p of {spec.name}), got {len(x0)}")
 
 
-def _check_task_point(spec: RobotSpec, y, name: str) -> None:
+def check_task_point(spec: RobotSpec, y, name: str) -> None:
+    """The task point ``y`` (the request's field ``name``) has r components."""
     if len(y) != spec.r:
         raise RequestError(name, f"must have {spec.r} components (r of {spec.name}), got {len(y)}")
 
@@ -213,11 +181,11 @@ def _trajectory_document(traj) -> dict[str, Any]:
     m = len(traj.theta)
     idx = _downsample(m)
     return {
-        "theta": _nullable(traj.theta[idx]),
-        "x": _nullable(traj.x[idx]),
-        "y": _nullable(traj.y[idx]),
-        "error": _nullable(traj.error[idx]),
-        "h": None if traj.h is None else _nullable(np.asarray(traj.h)[idx]),
+        "theta": nullable(traj.theta[idx]),
+        "x": nullable(traj.x[idx]),
+        "y": nullable(traj.y[idx]),
+        "error": nullable(traj.error[idx]),
+        "h": None if traj.h is None else nullable(np.asarray(traj.h)[idx]),
         "points": m,
         "downsampled": bool(len(idx) < m),
     }
@@ -234,9 +202,9 @@ def _solve_document(setup: _Setup, res) -> dict[str, Any]:
         "mode": setup.mode,
         "gamma": float(setup.gamma),
         "tolerance": float(setup.tolerance),
-        "x": _nullable(res.x),
-        "y": _nullable(res.y),
-        "error": _nullable(res.error),
+        "x": nullable(res.x),
+        "y": nullable(res.y),
+        "error": nullable(res.error),
         "converged": bool(res.success),
         "message": str(res.message),
         "iterations": int(res.nit),
@@ -317,8 +285,8 @@ def _solve_batch(
     ok: list[int] = []
     for i, r in enumerate(reqs):
         try:
-            _check_configuration(setup.spec, r.x0)
-            _check_task_point(setup.spec, r.target, "target")
+            check_configuration(setup.spec, r.x0)
+            check_task_point(setup.spec, r.target, "target")
             ok.append(i)
         except RequestError as exc:
             out[i] = exc
@@ -366,9 +334,9 @@ def solve_request(req: S.SolveRequest) -> S.SolveResponse:
 def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityResponse:
     """The closed path of ``req`` driven ``req.cycles`` times (Table 1); drift per cycle."""
     setup = _setup(req)
-    _check_configuration(setup.spec, req.x0)
+    check_configuration(setup.spec, req.x0)
     for i, pt in enumerate(req.path):
-        _check_task_point(setup.spec, pt, f"path[{i}]")
+        check_task_point(setup.spec, pt, f"path[{i}]")
     x0 = np.array(req.x0, dtype=float)
     if _check_start(setup, x0[None])[0]:
         raise RequestError("x0", _singular_message(setup, x0) + "; move the start")
@@ -396,189 +364,11 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
         gamma=setup.gamma,
         cycles=req.cycles,
         targets=np.asarray(res.targets, dtype=float).tolist(),
-        legs=_nullable(res.legs),
-        cycle_end=_nullable(res.cycle_end),
-        drift=_nullable(drift),
-        max_drift=_nullable(max_drift),
+        legs=nullable(res.legs),
+        cycle_end=nullable(res.cycle_end),
+        drift=nullable(drift),
+        max_drift=nullable(max_drift),
         repeatable=bool(res.success) and finite and max_drift < REPEATABLE_DRIFT,
         success=bool(res.success),
         message=cast(str, res.message),  # one start configuration: one message
-    )
-
-
-# --------------------------------------------------------------------------------------------
-# Synthesis
-
-
-def synthesis_methods() -> S.SynthesisMethodsResponse:
-    return S.SynthesisMethodsResponse(
-        methods=["evaluate", "e2_variational"],
-        notes={
-            "evaluate": "any map of the catalogue (GET /robots): h on a grid of the box, "
-            "polynomial coefficients, E1 and E2 on the box",
-            "e2_variational": "minimise E2 (eq. (19)) over h of the box variables (Ritz method, "
-            "engine.variational.synthesize_e2)",
-            "error_functionals": "E1 (13) and E2 (18) by Gauss quadrature (engine.functionals)",
-        },
-    )
-
-
-def default_region(spec: RobotSpec, size: int) -> dict[str, tuple[float, float]]:
-    """The last ``size`` variables, each over a box around the default start.
-
-    Half-width: a tenth of the variable's ``x_range``, clipped to it. The other variables are
-    held at the default start (where the robot's maps are defined), not at 0.
-    """
-    names = list(spec.variable_names)
-    region = {}
-    for n in names[-size:]:
-        i = names.index(n)
-        lo, hi = spec.x_range[i]
-        c, w = spec.default_x0[i], 0.1 * (hi - lo)
-        region[n] = (max(lo, c - w), min(hi, c + w))
-    return region
-
-
-def _region(spec: RobotSpec, req: S.SynthesizeRequest):
-    names = list(spec.variable_names)
-    if req.region is None:
-        region = default_region(spec, 2 if req.method == "e2_variational" else 3)
-    else:
-        region = {k: (float(lo), float(hi)) for k, (lo, hi) in req.region.items()}
-    for k, (lo, hi) in region.items():
-        if k not in names:
-            raise RequestError(f"region.{k}", f"unknown variable {k!r}; {spec.name} has {names}")
-        if not lo < hi:
-            raise RequestError(f"region.{k}", f"needs lo < hi, got [{lo:g}, {hi:g}]")
-    if not region:
-        raise RequestError("region", f"give at least one variable of {names}")
-    fixed = {n: float(v) for n, v in zip(names, spec.default_x0, strict=False) if n not in region}
-    fixed.update(req.fixed or {})
-    for k in req.fixed or {}:
-        if k not in names:
-            raise RequestError(f"fixed.{k}", f"unknown variable {k!r}; {spec.name} has {names}")
-        if k in region:
-            raise RequestError(f"fixed.{k}", "is also a region variable")
-    return names, region, fixed
-
-
-def _grid_axes(amap, names, region, base) -> list[str]:
-    """The two region variables along which h varies most (mean |dh/dx_i| on seeded samples)."""
-    if len(region) <= 2:
-        return list(region)
-    rng = np.random.default_rng(0)
-    x = np.broadcast_to(base, (64, len(base))).copy()
-    for k, (lo, hi) in region.items():
-        x[:, names.index(k)] = rng.uniform(lo, hi, 64)
-    with np.errstate(all="ignore"):
-        try:
-            g = np.abs(np.asarray(amap.gradient(x), dtype=float))
-        except JikError:
-            return list(region)[:2]
-    score = {k: float(np.nanmean(g[:, names.index(k)])) for k in region}
-    top = sorted(region, key=lambda k: -(score[k] if np.isfinite(score[k]) else -1.0))[:2]
-    return [k for k in region if k in top]
-
-
-def _grid(amap, names, region, fixed, p: int, n: int) -> S.SynthesisGrid | None:
-    if len(region) < 2:
-        return None
-    base = np.zeros(p)
-    for k, v in fixed.items():
-        base[names.index(k)] = v
-    for k, (lo, hi) in region.items():
-        base[names.index(k)] = 0.5 * (lo + hi)
-    axes = _grid_axes(amap, names, region, base)
-    a, b = (np.linspace(region[k][0], region[k][1], n) for k in axes)
-    x = np.broadcast_to(base, (n, n, p)).copy()
-    x[..., names.index(axes[0])] = a[:, None]
-    x[..., names.index(axes[1])] = b[None, :]
-    with np.errstate(all="ignore"):
-        try:
-            h = np.asarray(amap.value(x), dtype=float)
-        except JikError:  # a map that raises where it is undefined: evaluate point by point
-            h = np.full((n, n), np.nan)
-            for i in range(n):
-                for j in range(n):
-                    try:
-                        h[i, j] = float(amap.value(x[i, j]))
-                    except JikError:
-                        pass
-    return S.SynthesisGrid(axes={axes[0]: a.tolist(), axes[1]: b.tolist()}, h=_nullable(h))
-
-
-def _functional_info(fv) -> S.FunctionalInfo:
-    return S.FunctionalInfo(
-        value=_nullable(fv.value),
-        n_points=int(fv.n_points),
-        n_singular=int(np.asarray(fv.singular_points).shape[0]),
-        min_abs_dh_k=_nullable(getattr(fv, "min_abs_dh_k", float("nan"))),
-    )
-
-
-def _functionals(kin, amap, region, fixed, nodes) -> tuple[dict, list[str]]:
-    notes: list[str] = []
-    out: dict[str, S.FunctionalInfo | None] = {}
-    for label, fn in (("e1", error_functional_e1), ("e2", error_functional_e2)):
-        try:
-            out[label] = _functional_info(fn(kin, amap, region, nodes=nodes, fixed=fixed))
-        except JikError as exc:
-            out[label] = None
-            notes.append(f"{label.upper()} not evaluated: {exc}")
-    return out, notes
-
-
-def _coefficients(amap) -> dict[str, float]:
-    coef = getattr(amap, "coefficients", None)
-    if not isinstance(coef, dict):
-        return {}
-    a, b = (f"x{v + 1}" for v in getattr(amap, "variables", (0, 1)))
-    return {f"{a}^{i} {b}^{j}": float(c) for (i, j), c in sorted(coef.items())}
-
-
-def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
-    """Evaluate a catalogue map, or synthesize an E2-optimal one, over a box (section 3)."""
-    spec, kin, robot_used = _robot(req.robot)
-    names, region, fixed = _region(spec, req)
-    convergence: list[dict[str, float]] = []
-    coefficients: dict[str, float] = {}
-    notes: list[str] = []
-    if req.method == "e2_variational":
-        if req.augmentation is not None:
-            raise RequestError("augmentation", "'e2_variational' synthesizes h; give no map")
-        try:
-            result = synthesize_e2(kin, region, degree=req.degree, fixed=fixed)
-        except JikError as exc:
-            raise RequestError("region", str(exc)) from None
-        amap = result.augmenting_map
-        aug_used = S.AugmentationUsed(name=getattr(amap, "name", "e2_synthesized"), parameters={})
-        convergence = [
-            {k: float(v) for k, v in row.items() if isinstance(v, int | float)}
-            for row in result.convergence
-        ]
-        poly = getattr(result, "polynomial", None)
-        if poly is not None:
-            coefficients = _coefficients(poly)
-            notes.append(
-                f"E2 of the synthesized map {result.e2:.6g}; of its cubic fit "
-                f"{result.polynomial_e2:.6g}"
-            )
-        region, fixed = dict(result.region) or region, dict(result.fixed) or fixed
-    else:
-        _, amap, aug_used = _augmentation(spec, kin, req.augmentation)
-        coefficients = _coefficients(amap)
-    functionals, more = _functionals(kin, amap, region, fixed, req.nodes)
-    notes += more
-    all_fixed = {n: float(fixed.get(n, 0.0)) for n in names if n not in region}
-    return S.SynthesizeResponse(
-        robot=robot_used,
-        method=req.method,
-        augmentation=aug_used,
-        region={k: [float(lo), float(hi)] for k, (lo, hi) in region.items()},
-        fixed=all_fixed,
-        grid=_grid(amap, names, region, all_fixed, spec.p, req.grid),
-        coefficients=coefficients,
-        functionals=functionals,
-        convergence=convergence,
-        message="; ".join(notes) or "ok",
     )

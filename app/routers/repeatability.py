@@ -2,8 +2,8 @@
 
 from fastapi import APIRouter, Request, Response
 
+from jik.app.compute.precheck import precheck
 from jik.app.compute.schemas import BUSY, RepeatabilityRequest, RepeatabilityResponse
-from jik.app.service import precheck
 
 router = APIRouter(tags=["repeatability"])
 

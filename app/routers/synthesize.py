@@ -2,13 +2,14 @@
 
 from fastapi import APIRouter, Request, Response
 
+from jik.app.compute.precheck import precheck
 from jik.app.compute.schemas import (
     BUSY,
     SynthesisMethodsResponse,
     SynthesizeRequest,
     SynthesizeResponse,
 )
-from jik.app.service import precheck, synthesis_methods
+from jik.app.compute.synthesis import synthesis_methods
 
 router = APIRouter(tags=["synthesize"])
 
