@@ -25,9 +25,9 @@ import numpy as np
 from jik.app.compute import schemas as S
 from jik.app.compute.exceptions import ComputeError, RequestError, ServiceUnavailable
 from jik.app.compute.precheck import precheck
+from jik.app.compute.requests import batch_key
 from jik.app.compute.settings import Settings, settings_from_env
 from jik.app.compute.worker import WORK_FIELDS, Worker, frame_header
-from jik.app.service import batch_key
 
 
 def _retrieve(future: asyncio.Future) -> None:

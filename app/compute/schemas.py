@@ -7,7 +7,8 @@ the catalogue gains appears in the API, its OpenAPI schema and the fuzz test wit
 
 Pydantic checks types, ranges, finiteness (``allow_inf_nan=False``: NaN and inf are rejected) and
 size bounds. What needs the registry (vector lengths against p and r, an augmentation that belongs
-to the robot, a singular start) is checked by :mod:`jik.app.service`, which names the field.
+to the robot, a singular start) is checked by :mod:`jik.app.compute.requests`, which names the
+field.
 """
 
 from __future__ import annotations

@@ -11,7 +11,7 @@ import numpy as np
 
 from jik.app.compute import schemas as S
 from jik.app.compute.exceptions import RequestError
-from jik.app.service import build_augmentation, build_robot, nullable
+from jik.app.compute.requests import build_augmentation, build_robot, nullable
 from jik.engine.exceptions import JikError
 from jik.engine.functionals import error_functional_e1, error_functional_e2
 from jik.engine.registry import RobotSpec

@@ -19,8 +19,8 @@ from typing import Any
 
 from jik.app.compute import schemas as S
 from jik.app.compute.exceptions import RequestError
+from jik.app.compute.requests import engine_error, repeatability_request, solve_batch_json
 from jik.app.compute.synthesis import synthesize_request
-from jik.app.service import engine_error, repeatability_request, solve_batch_json
 from jik.engine.exceptions import JikError
 
 #: The field that sizes the work of each computation kind, and how to ask for less.

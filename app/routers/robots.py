@@ -2,8 +2,8 @@
 
 from fastapi import APIRouter, Request
 
+from jik.app.compute.requests import robots_response
 from jik.app.compute.schemas import RobotsResponse
-from jik.app.service import robots_response
 
 router = APIRouter(tags=["robots"])
 

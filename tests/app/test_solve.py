@@ -184,8 +184,8 @@ def test_service_batch_isolates_a_bad_first_member():
     """The plain service function (used by the dashboard): a wrong-length first member gets its
     own error, the others are solved."""
     from jik.app.compute.exceptions import RequestError
+    from jik.app.compute.requests import solve_batch
     from jik.app.compute.schemas import SolveRequest
-    from jik.app.service import solve_batch
 
     reqs = [
         SolveRequest.model_validate(solve_body(x0=[0.0, 0.0])),
@@ -213,8 +213,8 @@ def test_service_batch_isolates_a_bad_first_member():
 def test_worker_json_is_the_validated_response(over):
     """The workers' JSON (built without pydantic) is the validated model's document: the same
     keys and the same float values (only the spelling of exponents differs)."""
+    from jik.app.compute.requests import solve_batch, solve_batch_json
     from jik.app.compute.schemas import SolveRequest, SolveResponse
-    from jik.app.service import solve_batch, solve_batch_json
 
     req = SolveRequest.model_validate(solve_body(**over))
     (model,) = solve_batch([req])

@@ -1,4 +1,4 @@
-"""Service layer: API schemas to engine calls for the robots, solve and repeatability requests.
+"""Requests to engine calls: the robots catalogue, solve and repeatability.
 
 Plain synchronous functions (``robots_response``, ``solve_request``, ``solve_batch``,
 ``repeatability_request``) turn a request model into engine calls and the result into a response
