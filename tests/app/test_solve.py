@@ -10,8 +10,8 @@ import httpx
 import numpy as np
 import pytest
 
+from jik.app.api.factory import create_app
 from jik.app.compute.settings import Settings
-from jik.app.main import create_app
 from tests.app.conftest import X0_M2, solve_body
 
 # Table 1, pseudoinverse column, first leg: x1f after (0, 1) -> (1, 1).

@@ -20,18 +20,18 @@ from fastapi.responses import JSONResponse
 from fastapi_offline import FastAPIOffline
 
 from jik import __version__
-from jik.app.compute.exceptions import ComputeError, RequestError, ServiceUnavailable
-from jik.app.compute.pool import ComputePool
-from jik.app.compute.schemas import AUGMENTATION_MODELS, ROBOT_MODELS
-from jik.app.compute.settings import Settings, env_flag
-from jik.app.errors import (
+from jik.app.api.errors import (
     BodyLimit,
     busy_response,
     compute_error_response,
     request_error_response,
 )
-from jik.app.fastpath import SolveFastPath
-from jik.app.routers import dashboard, health, repeatability, robots, sessions, solve, synthesize
+from jik.app.api.fastpath import SolveFastPath
+from jik.app.api.routes import dashboard, health, repeatability, robots, sessions, solve, synthesize
+from jik.app.compute.exceptions import ComputeError, RequestError, ServiceUnavailable
+from jik.app.compute.pool import ComputePool
+from jik.app.compute.schemas import AUGMENTATION_MODELS, ROBOT_MODELS
+from jik.app.compute.settings import Settings, env_flag
 
 log = logging.getLogger("jik.api")
 #: Largest request body accepted (413 beyond): the largest valid request is a few kilobytes.
@@ -72,7 +72,7 @@ def _validation_detail(errors) -> list[dict]:
 
 def create_app(settings: Settings | None = None, fast_solve: bool | None = None) -> FastAPI:
     """The jik REST API. ``settings`` (default: from the environment) sizes the compute pool;
-    ``fast_solve`` serves well-formed /solve requests on a short path (:mod:`jik.app.fastpath`;
+    ``fast_solve`` serves well-formed /solve requests on a short path (:mod:`jik.app.api.fastpath`;
     default on, ``JIK_FAST_SOLVE=0`` turns it off)."""
     if fast_solve is None:
         fast_solve = env_flag("JIK_FAST_SOLVE")

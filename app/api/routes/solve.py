@@ -16,8 +16,9 @@ async def solve(req: SolveRequest, request: Request) -> Response:
     """Solve k(x) = target from x0 with the pseudoinverse (8) or the extended inverse (11).
 
     The body comes from a worker as the JSON of a ``SolveResponse``. Under ``create_app()``
-    well-formed JSON requests are answered by :class:`jik.app.fastpath.SolveFastPath` with the same
-    pool and error mapping; this route describes the endpoint and answers everything else.
+    well-formed JSON requests are answered by :class:`jik.app.api.fastpath.SolveFastPath` with
+    the same pool and error mapping; this route describes the endpoint and answers everything
+    else.
     """
     body = await request.app.state.pool.solve(req)
     return Response(body, media_type="application/json")

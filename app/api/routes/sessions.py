@@ -11,16 +11,16 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
-from typing import Annotated
+from typing import Annotated, Any
 from urllib.parse import urlsplit
 
 import websockets
 import websockets.asyncio.client
 from fastapi import APIRouter, Depends, Request, WebSocket
 from fastapi.responses import JSONResponse, PlainTextResponse, StreamingResponse
+from pydantic import BaseModel, ConfigDict, Field
 from websockets.typing import Subprotocol
 
-from jik.app.compute.schemas import SessionCreate
 from jik.app.controls import controls_message
 from jik.app.dashboard import Event, export_csv, export_json
 from jik.app.sessions import Session, SessionNotFound, SessionsFull, SessionStore
@@ -33,6 +33,23 @@ HEARTBEAT = 15.0
 PAGE_EVENTS = ("state", "progress", "result", "functionals", "error", "ahead", "refused")
 #: Seconds an export waits for the session's first result.
 EXPORT_WAIT = 60.0
+
+
+class SessionCreate(BaseModel):
+    """``POST /api/sessions``: a new dashboard session (one per browser tab)."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    state: dict[str, Any] = Field(
+        default_factory=dict,
+        description="the dashboard fields that differ from the defaults (a link's state); "
+        "validated like a change (POST /api/sessions/{id}/state)",
+    )
+    low_end: bool = Field(
+        default=False,
+        description="draw the 3D scene without shadows or environment map (the page asks for "
+        "this when its browser reports a software WebGL renderer)",
+    )
 
 
 def store_of(request: Request) -> SessionStore:
