@@ -27,7 +27,7 @@ RUN python3 -m venv /opt/jik \
     && useradd --create-home --uid 10001 --gid 10001 --shell /usr/sbin/nologin jik \
     && python -m pip install --no-cache-dir --requirement /wheels/requirements.txt \
     && rm -rf /wheels \
-    && python -c "import jik.app.main, jik.engine.reproductions.table1"
+    && python -c "import jik.app.api.factory, jik.engine.reproductions.table1"
 
 USER 10001:10001
 WORKDIR /home/jik

@@ -71,7 +71,7 @@ def missing_app_extra(error: ModuleNotFoundError) -> int:
 
 def serve(args: argparse.Namespace) -> int:
     try:
-        from jik.app.server import PortInUse, run_server
+        from jik.app.api.server import PortInUse, run_server
     except ModuleNotFoundError as error:
         return missing_app_extra(error)
     try:

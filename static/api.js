@@ -1,4 +1,4 @@
-// The page's session on the server (app/routers/sessions.py): created from a link's state,
+// The page's session on the server (app/api/routes/sessions.py): created from a link's state,
 // changed by control keys, followed over server-sent events.
 export const session = { id: null, generation: 0 };
 export const api = (path) => `/api/sessions/${session.id}${path}`;

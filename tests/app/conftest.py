@@ -7,8 +7,8 @@ import math
 import pytest
 from fastapi.testclient import TestClient
 
-from jik.app.main import create_app
-from jik.app.service import Settings
+from jik.app.api.factory import create_app
+from jik.app.compute.settings import Settings
 
 X0_M2 = [0.0, 0.0, math.pi / 2]
 TABLE1_PATH = [[1.0, 1.0], [1.0, 2.0], [0.0, 2.0], [0.0, 1.0]]

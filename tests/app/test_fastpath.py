@@ -7,9 +7,9 @@ import json
 import pytest
 from fastapi.testclient import TestClient
 
-from jik.app.fastpath import SolveFastPath
-from jik.app.main import create_app
-from jik.app.service import Settings
+from jik.app.api.factory import create_app
+from jik.app.api.fastpath import SolveFastPath
+from jik.app.compute.settings import Settings
 from tests.app.conftest import solve_body
 
 JSON = {"content-type": "application/json"}

@@ -14,8 +14,8 @@ import schemathesis
 from hypothesis import HealthCheck, settings
 from schemathesis.checks import not_a_server_error, response_schema_conformance
 
-from jik.app.main import create_app
-from jik.app.service import Settings
+from jik.app.api.factory import create_app
+from jik.app.compute.settings import Settings
 from jik.engine.registry import ROBOTS
 
 APP = create_app(Settings(workers=2, timeout=3.0))

@@ -7,8 +7,8 @@ import time
 
 import httpx
 
-from jik.app.main import create_app
-from jik.app.service import Settings
+from jik.app.api.factory import create_app
+from jik.app.compute.settings import Settings
 from tests.app.conftest import TABLE1_PATH, X0_M2, solve_body
 
 HEAVY = {

@@ -12,7 +12,9 @@ from multiprocessing.connection import Connection
 import numpy as np
 import pytest
 
-from jik.app.service import ComputePool, Settings, _frame
+from jik.app.compute.pool import ComputePool
+from jik.app.compute.settings import Settings
+from jik.app.compute.worker import frame_header
 
 LOOPS = ["asyncio"] + (["uvloop"] if importlib.util.find_spec("uvloop") else [])
 
@@ -78,17 +80,17 @@ def test_reply_from_a_dead_worker_is_eof_and_a_silent_one_times_out(loop_kind):
 
 
 def test_frame_headers():
-    assert _frame(bytearray(b"\x00\x00")) == (None, 0)
-    assert _frame(bytearray(struct.pack("!i", 300) + b"x")) == (300, 4)
+    assert frame_header(bytearray(b"\x00\x00")) == (None, 0)
+    assert frame_header(bytearray(struct.pack("!i", 300) + b"x")) == (300, 4)
     huge = struct.pack("!i", -1) + struct.pack("!Q", 3_000_000_000)
-    assert _frame(bytearray(huge[:8])) == (None, 0)
-    assert _frame(bytearray(huge)) == (3_000_000_000, 12)
+    assert frame_header(bytearray(huge[:8])) == (None, 0)
+    assert frame_header(bytearray(huge)) == (3_000_000_000, 12)
 
 
 def test_a_cancelled_request_gives_its_worker_back_after_the_reply():
     """A request cancelled mid-computation (e.g. at shutdown): the worker finishes, its reply is
     drained in the background and the same process serves the next request."""
-    from jik.app.schemas import RepeatabilityRequest
+    from jik.app.compute.schemas import RepeatabilityRequest
     from tests.app.conftest import TABLE1_PATH, X0_M2
 
     body = RepeatabilityRequest.model_validate(

@@ -9,8 +9,8 @@ import pytest
 from fastapi.testclient import TestClient
 from starlette.websockets import WebSocketDisconnect
 
+from jik.app.api.factory import create_app
 from jik.app.figures import PANELS
-from jik.app.main import create_app
 from jik.app.sessions import SessionLimits, SessionNotFound, SessionsFull, SessionStore
 
 

@@ -10,8 +10,8 @@ import httpx
 import numpy as np
 import pytest
 
-from jik.app.main import create_app
-from jik.app.service import Settings
+from jik.app.api.factory import create_app
+from jik.app.compute.settings import Settings
 from tests.app.conftest import X0_M2, solve_body
 
 # Table 1, pseudoinverse column, first leg: x1f after (0, 1) -> (1, 1).
@@ -183,8 +183,9 @@ def test_every_registered_robot_solves_with_its_defaults(api):
 def test_service_batch_isolates_a_bad_first_member():
     """The plain service function (used by the dashboard): a wrong-length first member gets its
     own error, the others are solved."""
-    from jik.app.schemas import SolveRequest
-    from jik.app.service import RequestError, solve_batch
+    from jik.app.compute.exceptions import RequestError
+    from jik.app.compute.requests import solve_batch
+    from jik.app.compute.schemas import SolveRequest
 
     reqs = [
         SolveRequest.model_validate(solve_body(x0=[0.0, 0.0])),
@@ -212,12 +213,12 @@ def test_service_batch_isolates_a_bad_first_member():
 def test_worker_json_is_the_validated_response(over):
     """The workers' JSON (built without pydantic) is the validated model's document: the same
     keys and the same float values (only the spelling of exponents differs)."""
-    from jik.app.schemas import SolveRequest, SolveResponse
-    from jik.app.service import _solve_batch, _solve_response_json, solve_batch
+    from jik.app.compute.requests import solve_batch, solve_batch_json
+    from jik.app.compute.schemas import SolveRequest, SolveResponse
 
     req = SolveRequest.model_validate(solve_body(**over))
     (model,) = solve_batch([req])
-    (raw,) = _solve_batch([req], _solve_response_json)
+    (raw,) = solve_batch_json([req])
     assert isinstance(model, SolveResponse) and isinstance(raw, bytes)
     assert json.loads(raw) == json.loads(model.model_dump_json())
     SolveResponse.model_validate_json(raw)

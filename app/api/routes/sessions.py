@@ -11,19 +11,20 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
-from typing import Annotated
+from typing import Any
 from urllib.parse import urlsplit
 
 import websockets
 import websockets.asyncio.client
-from fastapi import APIRouter, Depends, Request, WebSocket
+from fastapi import APIRouter, Request, WebSocket
 from fastapi.responses import JSONResponse, PlainTextResponse, StreamingResponse
+from pydantic import BaseModel, ConfigDict, Field
 from websockets.typing import Subprotocol
 
+from jik.app.api.dependencies import Store
 from jik.app.controls import controls_message
 from jik.app.dashboard import Event, export_csv, export_json
-from jik.app.schemas import SessionCreate
-from jik.app.sessions import Session, SessionNotFound, SessionsFull, SessionStore
+from jik.app.sessions import Session, SessionNotFound, SessionsFull
 from jik.engine.exceptions import InvalidInputError
 
 router = APIRouter(tags=["dashboard sessions"])
@@ -35,15 +36,21 @@ PAGE_EVENTS = ("state", "progress", "result", "functionals", "error", "ahead", "
 EXPORT_WAIT = 60.0
 
 
-def store_of(request: Request) -> SessionStore:
-    """The app's session store (one without 3D scenes unless ``jik serve`` set one up)."""
-    store = getattr(request.app.state, "sessions", None)
-    if store is None:
-        store = request.app.state.sessions = SessionStore()
-    return store
+class SessionCreate(BaseModel):
+    """``POST /api/sessions``: a new dashboard session (one per browser tab)."""
 
+    model_config = ConfigDict(extra="forbid")
 
-Store = Annotated[SessionStore, Depends(store_of)]
+    state: dict[str, Any] = Field(
+        default_factory=dict,
+        description="the dashboard fields that differ from the defaults (a link's state); "
+        "validated like a change (POST /api/sessions/{id}/state)",
+    )
+    low_end: bool = Field(
+        default=False,
+        description="draw the 3D scene without shadows or environment map (the page asks for "
+        "this when its browser reports a software WebGL renderer)",
+    )
 
 
 def _not_found(session_id: str) -> JSONResponse:

@@ -1,8 +1,9 @@
 """POST /solve: one run of the continuation algorithm (7), micro-batched with its neighbours."""
 
-from fastapi import APIRouter, Request, Response
+from fastapi import APIRouter, Response
 
-from jik.app.schemas import BUSY, SolveRequest, SolveResponse
+from jik.app.api.dependencies import Pool
+from jik.app.compute.schemas import BUSY, SolveRequest, SolveResponse
 
 router = APIRouter(tags=["solve"])
 
@@ -12,12 +13,13 @@ router = APIRouter(tags=["solve"])
     response_model=SolveResponse,
     responses=BUSY,
 )
-async def solve(req: SolveRequest, request: Request) -> Response:
+async def solve(req: SolveRequest, pool: Pool) -> Response:
     """Solve k(x) = target from x0 with the pseudoinverse (8) or the extended inverse (11).
 
     The body comes from a worker as the JSON of a ``SolveResponse``. Under ``create_app()``
-    well-formed JSON requests are answered by :class:`jik.app.fastpath.SolveFastPath` with the same
-    pool and error mapping; this route describes the endpoint and answers everything else.
+    well-formed JSON requests are answered by :class:`jik.app.api.fastpath.SolveFastPath` with
+    the same pool and error mapping; this route describes the endpoint and answers everything
+    else.
     """
-    body = await request.app.state.pool.solve(req)
+    body = await pool.solve(req)
     return Response(body, media_type="application/json")

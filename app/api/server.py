@@ -3,7 +3,7 @@
 The port is taken before anything says the server started: a busy port is reported with the
 option that changes it, and the socket is handed to uvicorn already bound, so nothing can take it
 in between. Each dashboard session's 3D scene is a viser server on a loopback port of its own,
-reached only through the API's proxy (:mod:`jik.app.routers.sessions`).
+reached only through the API's proxy (:mod:`jik.app.api.routes.sessions`).
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import socket
 
 import uvicorn
 
-from jik.app.main import create_app
+from jik.app.api.factory import create_app
 from jik.app.scene import start_scene
 from jik.app.sessions import SessionLimits, SessionStore
 

@@ -2,7 +2,7 @@
 
 ``GET /`` serves ``static/index.html``; plotly.js comes from the installed plotly package and the
 scene's page (``/scene/``) from the installed viser package: nothing is fetched from the network.
-Each tab's state lives in its own session (:mod:`jik.app.routers.sessions`).
+Each tab's state lives in its own session (:mod:`jik.app.api.routes.sessions`).
 """
 
 from __future__ import annotations

@@ -1,9 +1,10 @@
 """POST /repeatability: a closed task-space path driven several times (Table 1)."""
 
-from fastapi import APIRouter, Request, Response
+from fastapi import APIRouter, Response
 
-from jik.app.schemas import BUSY, RepeatabilityRequest, RepeatabilityResponse
-from jik.app.service import precheck
+from jik.app.api.dependencies import Pool
+from jik.app.compute.precheck import precheck
+from jik.app.compute.schemas import BUSY, RepeatabilityRequest, RepeatabilityResponse
 
 router = APIRouter(tags=["repeatability"])
 
@@ -13,8 +14,8 @@ router = APIRouter(tags=["repeatability"])
     response_model=RepeatabilityResponse,
     responses=BUSY,
 )
-async def repeatability(req: RepeatabilityRequest, request: Request) -> Response:
+async def repeatability(req: RepeatabilityRequest, pool: Pool) -> Response:
     """Configurations after each leg, at each cycle end, and the drift from x0 per cycle."""
     precheck(req)
-    body = await request.app.state.pool.run("repeatability", req.model_dump_json().encode())
+    body = await pool.run("repeatability", req.model_dump_json().encode())
     return Response(body, media_type="application/json")

@@ -6,9 +6,9 @@ one after the other. FastAPI's routing, middleware, dependency handling and resp
 take about as long per request as everything else together (``jik bench load``: p50 12.5 ms
 with, 9 ms without). This ASGI middleware answers a JSON ``POST /solve`` itself: it validates
 the body with the same model, runs it through the same compute pool and maps errors with the
-same functions (:mod:`jik.app.errors`). Anything else, and any body that fails validation, goes to
-the FastAPI route unchanged (the body is replayed), so validation messages and the OpenAPI
-description come from one place.
+same functions (:mod:`jik.app.api.errors`). Anything else, and any body that fails validation,
+goes to the FastAPI route unchanged (the body is replayed), so validation messages and the
+OpenAPI description come from one place.
 """
 
 from __future__ import annotations
@@ -20,9 +20,9 @@ from pydantic import ValidationError
 from starlette.responses import Response
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from jik.app.errors import error_response
-from jik.app.schemas import SolveRequest
-from jik.app.service import ComputePool
+from jik.app.api.errors import error_response
+from jik.app.compute.pool import ComputePool
+from jik.app.compute.schemas import SolveRequest
 
 
 def _is_json(scope: Scope) -> bool:

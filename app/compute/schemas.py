@@ -7,7 +7,8 @@ the catalogue gains appears in the API, its OpenAPI schema and the fuzz test wit
 
 Pydantic checks types, ranges, finiteness (``allow_inf_nan=False``: NaN and inf are rejected) and
 size bounds. What needs the registry (vector lengths against p and r, an augmentation that belongs
-to the robot, a singular start) is checked by :mod:`jik.app.service`, which names the field.
+to the robot, a singular start) is checked by :mod:`jik.app.compute.requests`, which names the
+field.
 """
 
 from __future__ import annotations
@@ -381,23 +382,6 @@ class HealthResponse(BaseModel):
     status: Literal["ok"]
 
 
-class SessionCreate(BaseModel):
-    """``POST /api/sessions``: a new dashboard session (one per browser tab)."""
-
-    model_config = ConfigDict(extra="forbid")
-
-    state: dict[str, Any] = Field(
-        default_factory=dict,
-        description="the dashboard fields that differ from the defaults (a link's state); "
-        "validated like a change (POST /api/sessions/{id}/state)",
-    )
-    low_end: bool = Field(
-        default=False,
-        description="draw the 3D scene without shadows or environment map (the page asks for "
-        "this when its browser reports a software WebGL renderer)",
-    )
-
-
 __all__ = [
     "AUGMENTATION_MODELS",
     "ROBOT_MODELS",
@@ -408,7 +392,6 @@ __all__ = [
     "RepeatabilityResponse",
     "Robot",
     "RobotsResponse",
-    "SessionCreate",
     "SolveRequest",
     "SolveResponse",
     "SynthesizeRequest",

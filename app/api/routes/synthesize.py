@@ -1,14 +1,16 @@
 """POST /synthesize: an augmenting map h on a box, synthesized or from the catalogue."""
 
-from fastapi import APIRouter, Request, Response
+from fastapi import APIRouter, Response
 
-from jik.app.schemas import (
+from jik.app.api.dependencies import Pool
+from jik.app.compute.precheck import precheck
+from jik.app.compute.schemas import (
     BUSY,
     SynthesisMethodsResponse,
     SynthesizeRequest,
     SynthesizeResponse,
 )
-from jik.app.service import precheck, synthesis_methods
+from jik.app.compute.synthesis import synthesis_methods
 
 router = APIRouter(tags=["synthesize"])
 
@@ -24,8 +26,8 @@ async def methods() -> SynthesisMethodsResponse:
     response_model=SynthesizeResponse,
     responses=BUSY,
 )
-async def synthesize(req: SynthesizeRequest, request: Request) -> Response:
+async def synthesize(req: SynthesizeRequest, pool: Pool) -> Response:
     """h on a grid of the box, its coefficients and E1, E2 over the box."""
     precheck(req)
-    body = await request.app.state.pool.run("synthesize", req.model_dump_json().encode())
+    body = await pool.run("synthesize", req.model_dump_json().encode())
     return Response(body, media_type="application/json")

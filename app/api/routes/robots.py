@@ -1,15 +1,16 @@
 """GET /robots: the catalogue, enough for a client to build its controls."""
 
-from fastapi import APIRouter, Request
+from fastapi import APIRouter
 
-from jik.app.schemas import RobotsResponse
-from jik.app.service import robots_response
+from jik.app.api.dependencies import Pool
+from jik.app.compute.requests import robots_response
+from jik.app.compute.schemas import RobotsResponse
 
 router = APIRouter(tags=["robots"])
 
 
 @router.get("/robots", response_model=RobotsResponse)
-async def robots(request: Request) -> RobotsResponse:
+async def robots(pool: Pool) -> RobotsResponse:
     """Every robot: p, r, parameter ranges, default start, target and path, and its
     augmentations with their parameters, ranges and defaults; plus the request limits."""
-    return robots_response(request.app.state.pool.settings.timeout)
+    return robots_response(pool.settings.timeout)

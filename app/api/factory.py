@@ -1,0 +1,61 @@
+"""The FastAPI application: ``create_app()`` wires the routers, the error handlers and the pool.
+
+Every error's response (422, 503, 500, 413) is described and produced in one place,
+:mod:`jik.app.api.errors`.
+"""
+
+from __future__ import annotations
+
+from contextlib import asynccontextmanager
+
+from fastapi import FastAPI
+from fastapi_offline import FastAPIOffline
+
+from jik import __version__
+from jik.app.api.errors import BodyLimit, add_error_handlers
+from jik.app.api.fastpath import SolveFastPath
+from jik.app.api.routes import dashboard, health, repeatability, robots, sessions, solve, synthesize
+from jik.app.compute.pool import ComputePool
+from jik.app.compute.settings import Settings, env_flag
+
+#: Largest request body accepted (413 beyond): the largest valid request is a few kilobytes.
+MAX_BODY_BYTES = 1 << 20
+
+
+def create_app(settings: Settings | None = None, fast_solve: bool | None = None) -> FastAPI:
+    """The jik REST API. ``settings`` (default: from the environment) sizes the compute pool;
+    ``fast_solve`` serves well-formed /solve requests on a short path (:mod:`jik.app.api.fastpath`;
+    default on, ``JIK_FAST_SOLVE=0`` turns it off)."""
+    if fast_solve is None:
+        fast_solve = env_flag("JIK_FAST_SOLVE")
+    pool = ComputePool(settings)
+
+    @asynccontextmanager
+    async def lifespan(app: FastAPI):
+        await pool.warm_up()
+        yield
+        pool.close()
+        store = getattr(app.state, "sessions", None)
+        if store is not None:
+            store.close()
+
+    # /docs and /redoc with Swagger UI's and ReDoc's files from the fastapi-offline package: the
+    # API's documentation works on a machine without internet, and loads nothing from a CDN.
+    app = FastAPIOffline(
+        title="jik",
+        version=__version__,
+        summary="Repeatable Jacobian inverse kinematics: pseudoinverse vs extended Jacobian, "
+        "and synthesis of augmenting maps (Tchon, Karpinska, Janiak 2009).",
+        lifespan=lifespan,
+    )
+    app.state.pool = pool
+
+    add_error_handlers(app)
+    for module in (health, robots, solve, repeatability, synthesize):
+        app.include_router(module.router)
+    app.include_router(dashboard.router)
+    app.include_router(sessions.router)
+    if fast_solve:
+        app.add_middleware(SolveFastPath, pool=pool)
+    app.add_middleware(BodyLimit, limit=MAX_BODY_BYTES)  # outermost: before any body is read
+    return app

@@ -1,0 +1,18 @@
+"""The compute layer's typed errors; the API's error mapping gives each its HTTP response."""
+
+
+class RequestError(ValueError):
+    """A request the engine cannot serve: HTTP 422 with a message that names ``field``."""
+
+    def __init__(self, field: str, message: str) -> None:
+        self.field = field
+        self.message = message
+        super().__init__(f"{field}: {message}")
+
+
+class ServiceUnavailable(RuntimeError):
+    """No compute slot became free within the time limit (or a worker died): HTTP 503."""
+
+
+class ComputeError(RuntimeError):
+    """An unexpected failure inside a worker: HTTP 500 with its description."""

@@ -1,0 +1,336 @@
+"""The compute pool: runs the request functions off the event loop, in worker processes.
+
+:class:`ComputePool` runs them for the HTTP API in worker *processes*
+(:mod:`jik.app.compute.worker`): numpy-heavy Python loops hold the GIL, and a computation that
+overruns its time limit can only be stopped by ending its process. Concurrent ``/solve``
+requests with the same robot, algorithm, augmentation, mode, gamma, tolerance and iteration cap
+are micro-batched: the first one opens a short window (``JIK_BATCH_WINDOW_MS``, default 2 ms),
+every compatible request arriving until a worker is free joins it, and the batch is solved by
+ONE engine call with x0 of shape (n, p) and targets (n, r) (each member keeps its own adaptive
+step, so its result is the same as alone).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import concurrent.futures
+import os
+import pickle
+import threading
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from jik.app.compute import schemas as S
+from jik.app.compute.exceptions import ComputeError, RequestError, ServiceUnavailable
+from jik.app.compute.precheck import precheck
+from jik.app.compute.requests import batch_key
+from jik.app.compute.settings import Settings, settings_from_env
+from jik.app.compute.worker import WORK_FIELDS, Worker, frame_header
+
+
+def _retrieve(future: asyncio.Future) -> None:
+    """Mark an abandoned request's exception as seen (no 'never retrieved' warning)."""
+    if not future.cancelled():
+        future.exception()
+
+
+@dataclass
+class _Pending:
+    payload: bytes
+    future: asyncio.Future
+    deadline: float
+    dispatched: bool = False
+    abandoned: bool = False
+
+
+class ComputePool:
+    """Worker processes with a bound on concurrent computations and a time limit per request.
+
+    At most ``settings.workers`` computations run at once. A request that gets no worker within
+    ``settings.timeout`` fails with :class:`ServiceUnavailable` (503, "busy"); a computation that
+    runs longer than ``settings.timeout`` is stopped by killing its worker (a new one replaces it)
+    and its requests fail with a :class:`RequestError` (422) naming the field that sizes the
+    work. The asyncio side is rebuilt when the pool is used from another event loop (test
+    clients); the processes are kept.
+    """
+
+    def __init__(self, settings: Settings | None = None) -> None:
+        self.settings = settings or settings_from_env()
+        self._workers: list[Worker] = []
+        self._lock = threading.Lock()
+        self._threads = concurrent.futures.ThreadPoolExecutor(
+            max_workers=self.settings.workers + 1, thread_name_prefix="jik-compute"
+        )
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._idle: asyncio.Queue[Worker] | None = None
+        self._pending: dict[str, list[_Pending]] = {}
+        self._tasks: set[asyncio.Task] = set()
+        #: Engine calls made and requests served by them (for tests and the benchmark).
+        self.stats = {"solve_calls": 0, "solve_requests": 0, "busy": 0, "exceeded": 0}
+
+    # -- lifecycle
+    def start(self) -> None:
+        """Start the worker processes (idempotent, non-blocking)."""
+        with self._lock:
+            while len(self._workers) < self.settings.workers:
+                self._workers.append(Worker())
+
+    def close(self) -> None:
+        """Stop every worker process."""
+        with self._lock:
+            for w in self._workers:
+                w.kill()
+            self._workers.clear()
+            self._loop = self._idle = None
+
+    def _bind(self) -> asyncio.Queue[Worker]:
+        loop = asyncio.get_running_loop()
+        if self._loop is not loop or self._idle is None:
+            self.start()
+            self._loop = loop
+            self._idle = asyncio.Queue()
+            self._pending = {}
+            for w in self._workers:
+                self._idle.put_nowait(w)
+        return self._idle
+
+    @property
+    def _bound_loop(self) -> asyncio.AbstractEventLoop:
+        """The event loop of the last :meth:`_bind` (only used after it)."""
+        assert self._loop is not None, "ComputePool used before _bind()"
+        return self._loop
+
+    @property
+    def _bound_idle(self) -> asyncio.Queue[Worker]:
+        """The idle-worker queue of the last :meth:`_bind` (only used after it)."""
+        assert self._idle is not None, "ComputePool used before _bind()"
+        return self._idle
+
+    async def warm_up(self) -> None:
+        """Start the workers and wait until each has imported the engine."""
+        self._bind()
+        with self._lock:
+            workers = list(self._workers)
+        await asyncio.gather(
+            *(self._bound_loop.run_in_executor(self._threads, w.wait_ready) for w in workers)
+        )
+
+    def _spawn(self, coro) -> asyncio.Task:
+        task = self._bound_loop.create_task(coro)
+        self._tasks.add(task)
+        task.add_done_callback(self._tasks.discard)
+        return task
+
+    # -- core
+    def _busy(self) -> ServiceUnavailable:
+        self.stats["busy"] += 1
+        return ServiceUnavailable(
+            f"server busy: no compute slot became free within the time limit of "
+            f"{self.settings.timeout:g} s ({self.settings.workers} computations run at once); "
+            "retry later"
+        )
+
+    async def _acquire(self, deadline: float) -> Worker:
+        idle = self._bind()
+        remaining = deadline - self._bound_loop.time()
+        try:
+            if remaining <= 0:
+                raise TimeoutError
+            return await asyncio.wait_for(idle.get(), remaining)
+        except TimeoutError:
+            raise self._busy() from None
+
+    async def _dispatch(self, worker: Worker, kind: str, payload):
+        """Run one computation on ``worker``; it is killed if it overruns the time limit.
+
+        The event loop itself waits for the worker's socket to become readable (no thread per
+        computation: a thread would wait for the GIL, up to the 5 ms switch interval, while the
+        loop serves other requests).
+        """
+        loop = self._bound_loop
+        try:
+            if not worker.ready:  # a freshly started worker: importing the engine takes a while
+                await loop.run_in_executor(self._threads, worker.wait_ready)
+            deadline = loop.time() + self.settings.timeout
+            os.set_blocking(worker.conn.fileno(), True)  # uvloop's add_reader made it non-blocking
+            worker.conn.send((kind, payload))
+            msg = await self._reply(worker, deadline)
+        except TimeoutError:
+            self.stats["exceeded"] += 1
+            self._replace(worker)
+            field, less = WORK_FIELDS.get(kind, ("request", "less work"))
+            raise RequestError(
+                field,
+                f"the computation exceeded the time limit of {self.settings.timeout:g} s and "
+                f"was stopped; ask for less work ({less})",
+            ) from None
+        except (EOFError, OSError) as exc:
+            self._replace(worker)
+            raise ServiceUnavailable(f"the compute worker stopped unexpectedly ({exc!r})") from None
+        except asyncio.CancelledError:  # the request went away: collect the reply in the back
+            if worker.ready:
+                self._spawn(self._drain(worker, loop.time() + self.settings.timeout))
+            else:
+                self._replace(worker)
+            raise
+        self._bound_idle.put_nowait(worker)
+        return msg
+
+    async def _reply(self, worker: Worker, deadline: float):
+        """The worker's reply, read in the event loop as it arrives, until ``deadline``.
+
+        The reply is framed as by :class:`multiprocessing.connection.Connection` (which the worker
+        uses): a 4-byte big-endian length (-1, then 8 bytes, for huge messages), then a pickle.
+        Each readiness callback reads once, so it never blocks whether or not the event loop
+        (uvloop does) has made the socket non-blocking.
+        """
+        loop = self._bound_loop
+        fd = worker.conn.fileno()
+        done: asyncio.Future = loop.create_future()
+        buf = bytearray()
+
+        def readable() -> None:
+            try:
+                chunk = os.read(fd, 1 << 20)
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError as exc:
+                if not done.done():
+                    done.set_exception(exc)
+                return
+            if not chunk:
+                if not done.done():
+                    done.set_exception(EOFError("the worker closed its connection"))
+                return
+            buf.extend(chunk)
+            size, start = frame_header(buf)
+            if size is not None and len(buf) >= start + size and not done.done():
+                done.set_result(pickle.loads(memoryview(buf)[start : start + size]))
+
+        loop.add_reader(fd, readable)
+        try:
+            return await asyncio.wait_for(done, max(deadline - loop.time(), 0.0))
+        finally:
+            loop.remove_reader(fd)
+
+    async def _drain(self, worker: Worker, deadline: float) -> None:
+        """Wait out an abandoned computation, then give the worker back (or replace it)."""
+        try:
+            await self._reply(worker, deadline)
+        except (TimeoutError, EOFError, OSError):
+            self._replace(worker)
+        else:
+            self._bound_idle.put_nowait(worker)
+
+    def _replace(self, worker: Worker) -> None:
+        worker.kill()
+        with self._lock:
+            if worker in self._workers:
+                self._workers.remove(worker)
+            fresh = Worker()
+            self._workers.append(fresh)
+        self._bound_idle.put_nowait(fresh)
+
+    @staticmethod
+    def _unwrap(msg):
+        status, value = msg
+        if status == "ok":
+            return value
+        if status == "request_error":
+            raise RequestError(*value)
+        raise ComputeError(value)
+
+    async def run(self, kind: str, payload) -> Any:
+        """Run handler ``kind`` on ``payload`` in a worker (waits and runs within the limits).
+
+        For the API kinds the payload is the request and the result the response, as JSON bytes.
+        """
+        self._bind()
+        worker = await self._acquire(self._bound_loop.time() + self.settings.timeout)
+        return self._unwrap(await self._dispatch(worker, kind, payload))
+
+    # -- micro-batched solves
+    async def solve(self, req: S.SolveRequest) -> bytes:
+        """One /solve request (JSON response bytes); micro-batched with compatible ones."""
+        precheck(req)
+        self._bind()
+        payload = req.model_dump_json().encode()
+        if not self.settings.batching:
+            self.stats["solve_calls"] += 1
+            self.stats["solve_requests"] += 1
+            (res,) = await self.run("solve", [payload])
+            return self._unwrap(res)
+        loop = self._bound_loop
+        entry = _Pending(payload, loop.create_future(), loop.time() + self.settings.timeout)
+        entry.future.add_done_callback(_retrieve)
+        key = batch_key(req)
+        queue = self._pending.setdefault(key, [])
+        queue.append(entry)
+        if len(queue) == 1:
+            self._spawn(self._flush(key, first=True))
+        try:
+            return self._unwrap(
+                await asyncio.wait_for(asyncio.shield(entry.future), entry.deadline - loop.time())
+            )
+        except TimeoutError:
+            if entry.dispatched:  # computing: bounded by the computation's own time limit
+                return self._unwrap(await entry.future)
+            entry.abandoned = True
+            raise self._busy() from None
+
+    async def _flush(self, key: str, first: bool) -> None:
+        if first and self.settings.batch_window > 0:
+            await asyncio.sleep(self.settings.batch_window)
+        queue = [p for p in self._pending.get(key, []) if not p.abandoned]
+        if not queue:
+            self._pending.pop(key, None)
+            return
+        try:
+            worker = await self._acquire(max(p.deadline for p in queue))
+        except ServiceUnavailable:
+            for p in self._pending.pop(key, []):
+                p.abandoned = True
+                if not p.future.done():
+                    p.future.set_exception(self._busy())
+            return
+        # Everything compatible that arrived while we waited for the worker joins the batch.
+        queue = [p for p in self._pending.pop(key, []) if not p.abandoned]
+        items, rest = queue[: self.settings.max_batch], queue[self.settings.max_batch :]
+        if rest:
+            self._pending[key] = rest
+            self._spawn(self._flush(key, first=False))
+        if not items:
+            self._bound_idle.put_nowait(worker)
+            return
+        # A large batch is shared among the workers that are idle right now: two half batches on
+        # two cores finish sooner than one whole batch on one.
+        workers = [worker]
+        while (
+            len(items) >= (len(workers) + 1) * self.settings.min_share
+            and not self._bound_idle.empty()
+        ):
+            workers.append(self._bound_idle.get_nowait())
+        for p in items:
+            p.dispatched = True
+        self.stats["solve_calls"] += len(workers)
+        self.stats["solve_requests"] += len(items)
+        shares = np.array_split(np.arange(len(items)), len(workers))
+        for w, share in zip(workers[1:], shares[1:], strict=True):
+            self._spawn(self._solve_share(w, [items[i] for i in share]))
+        await self._solve_share(workers[0], [items[i] for i in shares[0]])
+
+    async def _solve_share(self, worker: Worker, items: list[_Pending]) -> None:
+        """Solve ``items`` in ONE engine call on ``worker`` and hand each its result."""
+        try:
+            msg = await self._dispatch(worker, "solve", [p.payload for p in items])
+            results = self._unwrap(msg)
+        except Exception as exc:  # handed to every request of the batch
+            for p in items:
+                if not p.future.done():
+                    p.future.set_exception(exc)
+            return
+        for p, res in zip(items, results, strict=True):
+            if not p.future.done():
+                p.future.set_result(res)

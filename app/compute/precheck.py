@@ -1,0 +1,45 @@
+"""The checks of a request that need the registry but no numerics, run before it is queued."""
+
+from __future__ import annotations
+
+from jik.app.compute import schemas as S
+from jik.app.compute.exceptions import RequestError
+from jik.app.compute.requests import check_configuration, check_task_point
+from jik.app.compute.synthesis import synthesis_region
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.registry import ROBOTS
+
+
+def precheck(req: S.SolveRequest | S.RepeatabilityRequest | S.SynthesizeRequest) -> None:
+    """The registry checks that need no numerics (names, lengths, discrete gamma).
+
+    Run on the event loop before a request is sent to a worker, so bad requests are answered at
+    once even when every worker is busy. The workers repeat them (the plain service functions
+    are complete on their own).
+    """
+    spec = ROBOTS.get(req.robot.name)
+    if spec is None:
+        raise RequestError(
+            "robot.name", f"unknown robot {req.robot.name!r}; choose one of {sorted(ROBOTS)}"
+        )
+    if isinstance(req, S.SynthesizeRequest):
+        synthesis_region(spec, req)
+        return
+    if req.algorithm == "extended" and req.augmentation is not None:
+        try:
+            spec.augmentation(req.augmentation.name)
+        except InvalidInputError as exc:
+            raise RequestError("augmentation.name", str(exc)) from None
+    check_configuration(spec, req.x0)
+    if isinstance(req, S.SolveRequest):
+        check_task_point(spec, req.target, "target")
+    else:
+        for i, pt in enumerate(req.path):
+            check_task_point(spec, pt, f"path[{i}]")
+    gamma = spec.default_gamma if req.gamma is None else float(req.gamma)
+    if (req.mode or spec.default_mode) == "discrete" and gamma >= 2:
+        raise RequestError(
+            "gamma",
+            f"must be < 2 in discrete mode, got {gamma:g} (near the solution the error shrinks "
+            "by |1 - gamma| per iteration)",
+        )

@@ -1,0 +1,374 @@
+"""Requests to engine calls: the robots catalogue, solve and repeatability.
+
+Plain synchronous functions (``robots_response``, ``solve_request``, ``solve_batch``,
+``repeatability_request``) turn a request model into engine calls and the result into a response
+model. They raise :class:`RequestError` naming the offending field. Synthesis requests have
+their own module (:mod:`jik.app.compute.synthesis`), which builds robots and maps with the
+helpers here; :class:`jik.app.compute.pool.ComputePool` runs both for the HTTP API in worker
+processes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any, TypeVar, cast
+
+import numpy as np
+import pydantic_core
+
+from jik.app.compute import schemas as S
+from jik.app.compute.exceptions import RequestError
+from jik.app.compute.settings import settings_from_env
+from jik.engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
+from jik.engine.registry import ROBOTS, RobotSpec, make_inverse
+from jik.engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS, repeatability
+from jik.engine.solver import BatchSolveResult, solve
+
+_R = TypeVar("_R")
+
+#: A run whose largest drift is below this is called repeatable.
+REPEATABLE_DRIFT = 1e-6
+
+
+# --------------------------------------------------------------------------------------------
+# Conversions
+
+
+def nullable(a) -> Any:
+    """ndarray -> nested lists with None where not finite (JSON has no NaN)."""
+    a = np.asarray(a, dtype=float)
+    if a.ndim == 0:
+        return float(a) if np.isfinite(a) else None
+    if np.isfinite(a).all():
+        return a.tolist()
+    obj = a.astype(object)
+    obj[~np.isfinite(a)] = None
+    return obj.tolist()
+
+
+def _downsample(m: int, limit: int = S.MAX_TRAJECTORY_POINTS) -> np.ndarray:
+    """Indices of at most ``limit`` of ``m`` points, evenly spread, first and last kept."""
+    if m <= limit:
+        return np.arange(m)
+    return np.unique(np.linspace(0, m - 1, limit).round().astype(int))
+
+
+@dataclass
+class _Setup:
+    """Everything a run needs, validated against the registry."""
+
+    spec: RobotSpec
+    kinematics: Any
+    inverse: Any
+    robot: S.RobotUsed
+    augmentation: S.AugmentationUsed | None
+    mode: S.Mode
+    gamma: float
+    tolerance: float
+    max_iterations: int | None
+    extra: dict = field(default_factory=dict)
+
+
+def build_robot(req_robot) -> tuple[RobotSpec, Any, S.RobotUsed]:
+    """The robot named in the request, built with its parameters; what it used, filled in."""
+    try:
+        spec = ROBOTS[req_robot.name]
+    except KeyError:
+        raise RequestError(
+            "robot.name", f"unknown robot {req_robot.name!r}; choose one of {sorted(ROBOTS)}"
+        ) from None
+    params = req_robot.model_dump(exclude={"name"})
+    try:
+        kin = spec.build(**params)
+    except (InvalidInputError, TypeError) as exc:
+        raise RequestError("robot", str(exc)) from None
+    used = {
+        k: [float(t) for t in v] if isinstance(v, tuple | list) else float(v)
+        for k, v in params.items()
+    }
+    return spec, kin, S.RobotUsed(name=spec.name, parameters=used)
+
+
+def build_augmentation(spec: RobotSpec, kin, req_aug):
+    """The augmenting map named in the request (or the robot's default), built and checked."""
+    name = req_aug.name if req_aug is not None else None
+    try:
+        aspec = spec.augmentation(name)
+    except InvalidInputError as exc:
+        raise RequestError("augmentation.name", str(exc)) from None
+    given = req_aug.model_dump(exclude={"name"}, exclude_unset=True) if req_aug is not None else {}
+    known = {p.name for p in aspec.parameters}
+    unknown = sorted(set(given) - known)
+    if unknown:
+        raise RequestError(
+            f"augmentation.{unknown[0]}",
+            f"{aspec.name} of {spec.name} has no parameter {unknown[0]!r}; "
+            f"its parameters: {sorted(known) or 'none'}",
+        )
+    values = {p.name: given.get(p.name, p.default) for p in aspec.parameters}
+    try:
+        amap = aspec.build(kin, **values)
+    except InvalidInputError as exc:
+        raise RequestError("augmentation", str(exc)) from None
+    return aspec, amap, S.AugmentationUsed(name=aspec.name, parameters=values)
+
+
+def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
+    spec, kin, robot_used = build_robot(req.robot)
+    aug_used = None
+    if req.algorithm == "extended":
+        aspec, _, aug_used = build_augmentation(spec, kin, req.augmentation)
+        try:
+            inverse = make_inverse(kin, "extended", aspec.name, aug_used.parameters, spec.name)
+        except InvalidInputError as exc:
+            raise RequestError("augmentation", str(exc)) from None
+    else:
+        inverse = make_inverse(kin, "pseudoinverse")
+    mode = req.mode or spec.default_mode
+    gamma = spec.default_gamma if req.gamma is None else float(req.gamma)
+    if mode == "discrete" and gamma >= 2:
+        raise RequestError(
+            "gamma",
+            f"must be < 2 in discrete mode, got {gamma:g} (near the solution the error shrinks "
+            "by |1 - gamma| per iteration)",
+        )
+    return _Setup(
+        spec, kin, inverse, robot_used, aug_used, mode, gamma, req.tolerance, req.max_iterations
+    )
+
+
+def check_configuration(spec: RobotSpec, x0) -> None:
+    """``x0`` has p components."""
+    if len(x0) != spec.p:
+        raise RequestError("x0", f"must have {spec.p} components (p of {spec.name}), got {len(x0)}")
+
+
+def check_task_point(spec: RobotSpec, y, name: str) -> None:
+    """The task point ``y`` (the request's field ``name``) has r components."""
+    if len(y) != spec.r:
+        raise RequestError(name, f"must have {spec.r} components (r of {spec.name}), got {len(y)}")
+
+
+def _check_start(setup: _Setup, x0: np.ndarray) -> np.ndarray:
+    """Mask (n,) of singular starts for the chosen inverse; x0 of shape (n, p)."""
+    kin = setup.kinematics
+    _, bad = setup.inverse.apply_masked(x0, np.zeros((len(x0), kin.r)) + 1.0)
+    return np.atleast_1d(bad)
+
+
+def _singular_message(setup: _Setup, x0) -> str:
+    return str(setup.inverse.singular_error(np.asarray(x0, dtype=float)))
+
+
+_ENGINE_FIELDS = ("x0", "target", "gamma", "tol", "max_iterations", "path", "cycles", "mode")
+
+
+def engine_error(exc: JikError) -> RequestError:
+    """An engine error as a RequestError; the field is read off the engine's message."""
+    if isinstance(exc, SingularConfigurationError):
+        return RequestError("x0", str(exc))
+    text = str(exc)
+    first = text.split(" ", 1)[0]
+    name = {"tol": "tolerance", "y_d": "target"}.get(first, first)
+    if first not in _ENGINE_FIELDS and name not in _ENGINE_FIELDS:
+        name = "request"
+    return RequestError(name, text)
+
+
+def _trajectory_document(traj) -> dict[str, Any]:
+    """A run's trajectory as JSON-ready data (the fields of ``S.Trajectory``), downsampled."""
+    m = len(traj.theta)
+    idx = _downsample(m)
+    return {
+        "theta": nullable(traj.theta[idx]),
+        "x": nullable(traj.x[idx]),
+        "y": nullable(traj.y[idx]),
+        "error": nullable(traj.error[idx]),
+        "h": None if traj.h is None else nullable(np.asarray(traj.h)[idx]),
+        "points": m,
+        "downsampled": bool(len(idx) < m),
+    }
+
+
+def _solve_document(setup: _Setup, res) -> dict[str, Any]:
+    """One solve's response as JSON-ready data (the fields of ``S.SolveResponse``)."""
+    return {
+        "robot": setup.robot.model_dump(mode="json"),
+        "algorithm": setup.inverse.name,
+        "augmentation": (
+            None if setup.augmentation is None else setup.augmentation.model_dump(mode="json")
+        ),
+        "mode": setup.mode,
+        "gamma": float(setup.gamma),
+        "tolerance": float(setup.tolerance),
+        "x": nullable(res.x),
+        "y": nullable(res.y),
+        "error": nullable(res.error),
+        "converged": bool(res.success),
+        "message": str(res.message),
+        "iterations": int(res.nit),
+        "trajectory": _trajectory_document(res.trajectory),
+    }
+
+
+def _solve_response(setup: _Setup, res) -> S.SolveResponse:
+    return S.SolveResponse.model_validate(_solve_document(setup, res))
+
+
+def _solve_response_json(setup: _Setup, res) -> bytes:
+    """The JSON of :func:`_solve_response` without validating the model (the workers' hot
+    path: validation costs about as much as a small solve). ``tests/app/test_solve.py`` checks
+    that both give the same document."""
+    return pydantic_core.to_json(_solve_document(setup, res))
+
+
+# --------------------------------------------------------------------------------------------
+# Plain service functions
+
+
+def robots_response(timeout: float | None = None) -> S.RobotsResponse:
+    """The catalogue: every robot with p, r, parameters, defaults and augmentations."""
+    robots = [
+        S.RobotInfo(
+            **spec.as_dict(),
+            algorithms=["pseudoinverse", "extended"],
+            modes=["continuous", "discrete"],
+        )
+        for spec in ROBOTS.values()
+    ]
+    limits = S.Limits(
+        max_cycles=MAX_CYCLES,
+        max_path_points=MAX_PATH_POINTS,
+        max_iterations=S.MAX_ITERATIONS,
+        max_trajectory_points=S.MAX_TRAJECTORY_POINTS,
+        request_timeout_s=float(timeout if timeout is not None else settings_from_env().timeout),
+    )
+    return S.RobotsResponse(robots=robots, limits=limits)
+
+
+def batch_key(req: S.SolveRequest) -> str:
+    """Requests with equal keys can share one batched engine call."""
+    exclude = {"x0", "target"} | ({"augmentation"} if req.algorithm == "pseudoinverse" else set())
+    return req.model_dump_json(exclude=exclude)
+
+
+def solve_batch(reqs: list[S.SolveRequest]) -> list[S.SolveResponse | RequestError]:
+    """Solve requests sharing one :func:`batch_key` in ONE batched engine call.
+
+    Each member is validated on its own (lengths, singular start): a bad member gets its
+    :class:`RequestError` in its slot and does not affect the others.
+    """
+    return _solve_batch(reqs, _solve_response)
+
+
+def solve_batch_json(reqs: list[S.SolveRequest]) -> list[bytes | RequestError]:
+    """:func:`solve_batch` with each response as its JSON bytes, built without validating the
+    model (the workers' hot path, see :func:`_solve_response_json`)."""
+    return _solve_batch(reqs, _solve_response_json)
+
+
+def _solve_batch(
+    reqs: list[S.SolveRequest], respond: Callable[[_Setup, Any], _R]
+) -> list[_R | RequestError]:
+    """:func:`solve_batch` with ``respond`` turning a member's result into its response (the
+    model, or JSON bytes in the workers)."""
+    if not reqs:
+        return []
+    if len({batch_key(r) for r in reqs}) != 1:
+        raise ValueError("solve_batch needs requests with equal batch keys")
+    try:
+        setup = _setup(reqs[0])
+    except RequestError as exc:
+        return [exc] * len(reqs)
+    out: list[_R | RequestError | None] = [None] * len(reqs)
+    ok: list[int] = []
+    for i, r in enumerate(reqs):
+        try:
+            check_configuration(setup.spec, r.x0)
+            check_task_point(setup.spec, r.target, "target")
+            ok.append(i)
+        except RequestError as exc:
+            out[i] = exc
+    if ok:
+        x0 = np.array([reqs[i].x0 for i in ok], dtype=float)
+        y_d = np.array([reqs[i].target for i in ok], dtype=float)
+        bad = _check_start(setup, x0)
+        for k in np.flatnonzero(bad):
+            out[ok[k]] = RequestError("x0", _singular_message(setup, x0[k]) + "; move the start")
+        keep = np.flatnonzero(~bad)
+        if keep.size:
+            try:
+                # x0[keep] is (k, p), so solve returns a batch.
+                batch = cast(
+                    BatchSolveResult,
+                    solve(
+                        setup.inverse,
+                        x0[keep],
+                        y_d[keep],
+                        gamma=setup.gamma,
+                        mode=setup.mode,
+                        tol=setup.tolerance,
+                        max_iterations=setup.max_iterations,
+                        record=True,
+                    ),
+                )
+            except JikError as exc:
+                err = engine_error(exc)
+                for k in keep:
+                    out[ok[k]] = err
+            else:
+                for j, k in enumerate(keep):
+                    out[ok[k]] = respond(setup, batch[j])
+    return cast(list[_R | RequestError], out)  # every slot was filled above
+
+
+def solve_request(req: S.SolveRequest) -> S.SolveResponse:
+    """One run of eq. (7) from ``req.x0`` to ``req.target``; raises :class:`RequestError`."""
+    (res,) = solve_batch([req])
+    if isinstance(res, RequestError):
+        raise res
+    return res
+
+
+def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityResponse:
+    """The closed path of ``req`` driven ``req.cycles`` times (Table 1); drift per cycle."""
+    setup = _setup(req)
+    check_configuration(setup.spec, req.x0)
+    for i, pt in enumerate(req.path):
+        check_task_point(setup.spec, pt, f"path[{i}]")
+    x0 = np.array(req.x0, dtype=float)
+    if _check_start(setup, x0[None])[0]:
+        raise RequestError("x0", _singular_message(setup, x0) + "; move the start")
+    try:
+        res = repeatability(
+            setup.inverse,
+            x0,
+            np.array(req.path, dtype=float),
+            cycles=req.cycles,
+            gamma=setup.gamma,
+            mode=setup.mode,
+            tol=setup.tolerance,
+            max_iterations=setup.max_iterations,
+        )
+    except JikError as exc:
+        raise engine_error(exc) from None
+    drift = np.asarray(res.drift, dtype=float)
+    finite = bool(np.all(np.isfinite(drift)))
+    max_drift = float(np.max(drift)) if finite else float("nan")
+    return S.RepeatabilityResponse(
+        robot=setup.robot,
+        algorithm=setup.inverse.name,
+        augmentation=setup.augmentation,
+        mode=setup.mode,
+        gamma=setup.gamma,
+        cycles=req.cycles,
+        targets=np.asarray(res.targets, dtype=float).tolist(),
+        legs=nullable(res.legs),
+        cycle_end=nullable(res.cycle_end),
+        drift=nullable(drift),
+        max_drift=nullable(max_drift),
+        repeatable=bool(res.success) and finite and max_drift < REPEATABLE_DRIFT,
+        success=bool(res.success),
+        message=cast(str, res.message),  # one start configuration: one message
+    )

@@ -1,0 +1,193 @@
+"""Synthesis over a box: a catalogue map evaluated, or an E2-optimal one synthesized (section 3).
+
+:func:`synthesize_request` turns a ``SynthesizeRequest`` into engine calls
+(:mod:`jik.engine.functionals`, :mod:`jik.engine.variational`) and the result into a
+``SynthesizeResponse``: h on a grid of the box, its coefficients, E1 and E2.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from jik.app.compute import schemas as S
+from jik.app.compute.exceptions import RequestError
+from jik.app.compute.requests import build_augmentation, build_robot, nullable
+from jik.engine.exceptions import JikError
+from jik.engine.functionals import error_functional_e1, error_functional_e2
+from jik.engine.registry import RobotSpec
+from jik.engine.variational import synthesize_e2
+
+
+def synthesis_methods() -> S.SynthesisMethodsResponse:
+    return S.SynthesisMethodsResponse(
+        methods=["evaluate", "e2_variational"],
+        notes={
+            "evaluate": "any map of the catalogue (GET /robots): h on a grid of the box, "
+            "polynomial coefficients, E1 and E2 on the box",
+            "e2_variational": "minimise E2 (eq. (19)) over h of the box variables (Ritz method, "
+            "engine.variational.synthesize_e2)",
+            "error_functionals": "E1 (13) and E2 (18) by Gauss quadrature (engine.functionals)",
+        },
+    )
+
+
+def default_region(spec: RobotSpec, size: int) -> dict[str, tuple[float, float]]:
+    """The last ``size`` variables, each over a box around the default start.
+
+    Half-width: a tenth of the variable's ``x_range``, clipped to it. The other variables are
+    held at the default start (where the robot's maps are defined), not at 0.
+    """
+    names = list(spec.variable_names)
+    region = {}
+    for n in names[-size:]:
+        i = names.index(n)
+        lo, hi = spec.x_range[i]
+        c, w = spec.default_x0[i], 0.1 * (hi - lo)
+        region[n] = (max(lo, c - w), min(hi, c + w))
+    return region
+
+
+def synthesis_region(spec: RobotSpec, req: S.SynthesizeRequest):
+    """The variable names, the box and the fixed values of a synthesis request, checked."""
+    names = list(spec.variable_names)
+    if req.region is None:
+        region = default_region(spec, 2 if req.method == "e2_variational" else 3)
+    else:
+        region = {k: (float(lo), float(hi)) for k, (lo, hi) in req.region.items()}
+    for k, (lo, hi) in region.items():
+        if k not in names:
+            raise RequestError(f"region.{k}", f"unknown variable {k!r}; {spec.name} has {names}")
+        if not lo < hi:
+            raise RequestError(f"region.{k}", f"needs lo < hi, got [{lo:g}, {hi:g}]")
+    if not region:
+        raise RequestError("region", f"give at least one variable of {names}")
+    fixed = {n: float(v) for n, v in zip(names, spec.default_x0, strict=False) if n not in region}
+    fixed.update(req.fixed or {})
+    for k in req.fixed or {}:
+        if k not in names:
+            raise RequestError(f"fixed.{k}", f"unknown variable {k!r}; {spec.name} has {names}")
+        if k in region:
+            raise RequestError(f"fixed.{k}", "is also a region variable")
+    return names, region, fixed
+
+
+def _grid_axes(amap, names, region, base) -> list[str]:
+    """The two region variables along which h varies most (mean |dh/dx_i| on seeded samples)."""
+    if len(region) <= 2:
+        return list(region)
+    rng = np.random.default_rng(0)
+    x = np.broadcast_to(base, (64, len(base))).copy()
+    for k, (lo, hi) in region.items():
+        x[:, names.index(k)] = rng.uniform(lo, hi, 64)
+    with np.errstate(all="ignore"):
+        try:
+            g = np.abs(np.asarray(amap.gradient(x), dtype=float))
+        except JikError:
+            return list(region)[:2]
+    score = {k: float(np.nanmean(g[:, names.index(k)])) for k in region}
+    top = sorted(region, key=lambda k: -(score[k] if np.isfinite(score[k]) else -1.0))[:2]
+    return [k for k in region if k in top]
+
+
+def _grid(amap, names, region, fixed, p: int, n: int) -> S.SynthesisGrid | None:
+    if len(region) < 2:
+        return None
+    base = np.zeros(p)
+    for k, v in fixed.items():
+        base[names.index(k)] = v
+    for k, (lo, hi) in region.items():
+        base[names.index(k)] = 0.5 * (lo + hi)
+    axes = _grid_axes(amap, names, region, base)
+    a, b = (np.linspace(region[k][0], region[k][1], n) for k in axes)
+    x = np.broadcast_to(base, (n, n, p)).copy()
+    x[..., names.index(axes[0])] = a[:, None]
+    x[..., names.index(axes[1])] = b[None, :]
+    with np.errstate(all="ignore"):
+        try:
+            h = np.asarray(amap.value(x), dtype=float)
+        except JikError:  # a map that raises where it is undefined: evaluate point by point
+            h = np.full((n, n), np.nan)
+            for i in range(n):
+                for j in range(n):
+                    try:
+                        h[i, j] = float(amap.value(x[i, j]))
+                    except JikError:
+                        pass
+    return S.SynthesisGrid(axes={axes[0]: a.tolist(), axes[1]: b.tolist()}, h=nullable(h))
+
+
+def _functional_info(fv) -> S.FunctionalInfo:
+    return S.FunctionalInfo(
+        value=nullable(fv.value),
+        n_points=int(fv.n_points),
+        n_singular=int(np.asarray(fv.singular_points).shape[0]),
+        min_abs_dh_k=nullable(getattr(fv, "min_abs_dh_k", float("nan"))),
+    )
+
+
+def _functionals(kin, amap, region, fixed, nodes) -> tuple[dict, list[str]]:
+    notes: list[str] = []
+    out: dict[str, S.FunctionalInfo | None] = {}
+    for label, fn in (("e1", error_functional_e1), ("e2", error_functional_e2)):
+        try:
+            out[label] = _functional_info(fn(kin, amap, region, nodes=nodes, fixed=fixed))
+        except JikError as exc:
+            out[label] = None
+            notes.append(f"{label.upper()} not evaluated: {exc}")
+    return out, notes
+
+
+def _coefficients(amap) -> dict[str, float]:
+    coef = getattr(amap, "coefficients", None)
+    if not isinstance(coef, dict):
+        return {}
+    a, b = (f"x{v + 1}" for v in getattr(amap, "variables", (0, 1)))
+    return {f"{a}^{i} {b}^{j}": float(c) for (i, j), c in sorted(coef.items())}
+
+
+def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
+    """Evaluate a catalogue map, or synthesize an E2-optimal one, over a box (section 3)."""
+    spec, kin, robot_used = build_robot(req.robot)
+    names, region, fixed = synthesis_region(spec, req)
+    convergence: list[dict[str, float]] = []
+    coefficients: dict[str, float] = {}
+    notes: list[str] = []
+    if req.method == "e2_variational":
+        if req.augmentation is not None:
+            raise RequestError("augmentation", "'e2_variational' synthesizes h; give no map")
+        try:
+            result = synthesize_e2(kin, region, degree=req.degree, fixed=fixed)
+        except JikError as exc:
+            raise RequestError("region", str(exc)) from None
+        amap = result.augmenting_map
+        aug_used = S.AugmentationUsed(name=getattr(amap, "name", "e2_synthesized"), parameters={})
+        convergence = [
+            {k: float(v) for k, v in row.items() if isinstance(v, int | float)}
+            for row in result.convergence
+        ]
+        poly = getattr(result, "polynomial", None)
+        if poly is not None:
+            coefficients = _coefficients(poly)
+            notes.append(
+                f"E2 of the synthesized map {result.e2:.6g}; of its cubic fit "
+                f"{result.polynomial_e2:.6g}"
+            )
+        region, fixed = dict(result.region) or region, dict(result.fixed) or fixed
+    else:
+        _, amap, aug_used = build_augmentation(spec, kin, req.augmentation)
+        coefficients = _coefficients(amap)
+    functionals, more = _functionals(kin, amap, region, fixed, req.nodes)
+    notes += more
+    all_fixed = {n: float(fixed.get(n, 0.0)) for n in names if n not in region}
+    return S.SynthesizeResponse(
+        robot=robot_used,
+        method=req.method,
+        augmentation=aug_used,
+        region={k: [float(lo), float(hi)] for k, (lo, hi) in region.items()},
+        fixed=all_fixed,
+        grid=_grid(amap, names, region, all_fixed, spec.p, req.grid),
+        coefficients=coefficients,
+        functionals=functionals,
+        convergence=convergence,
+        message="; ".join(notes) or "ok",
+    )

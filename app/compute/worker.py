@@ -1,0 +1,137 @@
+"""The worker processes: the loop a worker runs, and the server's handle on one.
+
+A worker is a fresh interpreter that imports the engine and then answers ``(kind, payload)``
+messages with ``(status, result)`` over a :class:`~multiprocessing.connection.Connection` on a
+socket pair; :class:`jik.app.compute.pool.ComputePool` sends the requests and reads the replies
+(framed as :func:`frame_header` describes) on its event loop.
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+import struct
+import subprocess
+import sys
+from collections.abc import Callable
+from multiprocessing.connection import Connection
+from typing import Any
+
+from jik.app.compute import schemas as S
+from jik.app.compute.exceptions import RequestError
+from jik.app.compute.requests import engine_error, repeatability_request, solve_batch_json
+from jik.app.compute.synthesis import synthesize_request
+from jik.engine.exceptions import JikError
+
+#: The field that sizes the work of each computation kind, and how to ask for less.
+WORK_FIELDS = {
+    "solve": ("max_iterations", "a lower max_iterations or a larger tolerance"),
+    "repeatability": ("cycles", "fewer cycles or path points, a lower max_iterations"),
+    "synthesize": ("region", "a smaller region, fewer nodes, a smaller grid or a lower degree"),
+}
+
+
+def _solve_payload(items: list[bytes]) -> list[tuple[str, Any]]:
+    reqs = [S.SolveRequest.model_validate_json(b) for b in items]
+    out: list[tuple[str, Any]] = []
+    for res in solve_batch_json(reqs):
+        if isinstance(res, RequestError):
+            out.append(("request_error", (res.field, res.message)))
+        else:
+            out.append(("ok", res))
+    return out
+
+
+# Workers take requests and give responses as JSON bytes: (de)serialization and validation run in
+# the workers, in parallel, and the event loop only passes bytes along.
+_HANDLERS: dict[str, Callable[[Any], Any]] = {
+    "ping": lambda payload: "pong",
+    "solve": _solve_payload,
+    "repeatability": lambda b: (
+        repeatability_request(S.RepeatabilityRequest.model_validate_json(b))
+        .model_dump_json()
+        .encode()
+    ),
+    "synthesize": lambda b: (
+        synthesize_request(S.SynthesizeRequest.model_validate_json(b)).model_dump_json().encode()
+    ),
+}
+
+
+def _worker_main(conn) -> None:
+    """Worker process loop: say "ready", then (kind, payload) in, (status, result) out."""
+    conn.send(("ready", None))
+    while True:
+        try:
+            kind, payload = conn.recv()
+        except (EOFError, OSError):
+            return
+        try:
+            msg = ("ok", _HANDLERS[kind](payload))
+        except RequestError as exc:
+            msg = ("request_error", (exc.field, exc.message))
+        except JikError as exc:
+            err = engine_error(exc)
+            msg = ("request_error", (err.field, err.message))
+        except MemoryError:
+            field, less = WORK_FIELDS.get(kind, ("request", "less work"))
+            msg = ("request_error", (field, f"the computation ran out of memory; ask for {less}"))
+        except Exception as exc:  # reported to the client as a 500 with its text
+            msg = ("error", f"{type(exc).__name__}: {exc}")
+        conn.send(msg)
+
+
+def _worker_entry(fd: int) -> None:
+    """Entry point of a worker process started by :class:`Worker` (``python -c``)."""
+    _worker_main(Connection(fd))
+
+
+#: Longest wait for a new worker to import the engine (not counted in a request's time limit).
+WORKER_BOOT_TIMEOUT = 120.0
+
+
+def frame_header(buf: bytearray) -> tuple[int | None, int]:
+    """Payload size and offset of a :class:`~multiprocessing.connection.Connection` message
+    starting in ``buf`` (size None until the header is complete)."""
+    if len(buf) < 4:
+        return None, 0
+    (size,) = struct.unpack("!i", buf[:4])
+    if size != -1:
+        return size, 4
+    if len(buf) < 12:
+        return None, 0
+    return struct.unpack("!Q", buf[4:12])[0], 12
+
+
+class Worker:
+    """A worker process (a fresh interpreter, so nothing of the server's state is inherited)."""
+
+    def __init__(self) -> None:
+        parent, child = socket.socketpair()
+        fd = child.fileno()
+        env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+        self.process = subprocess.Popen(
+            [
+                sys.executable,
+                "-c",
+                f"from jik.app.compute.worker import _worker_entry; _worker_entry({fd})",
+            ],
+            pass_fds=[fd],
+            env=env,
+            stdin=subprocess.DEVNULL,
+        )
+        child.close()
+        self.conn = Connection(parent.detach())
+        self.ready = False
+
+    def wait_ready(self) -> None:
+        if not self.ready:
+            if not self.conn.poll(WORKER_BOOT_TIMEOUT):
+                raise OSError("worker did not start")
+            self.conn.recv()
+            self.ready = True
+
+    def kill(self) -> None:
+        self.process.kill()
+        self.process.wait(5)
+        self.conn.close()
