@@ -2,8 +2,8 @@
 
 Straightforward: plotly.py's way, a ``go.Figure`` per panel and its ``to_json()`` (what the
 dashboard did until 2026-11-21). jik: the figure dicts serialized directly
-(:func:`jik.app.figures.figure_specs`, :func:`jik.app.figures.figure_json`). Both from the same
-result, checked to decode to the same figures; wall-clock medians.
+(:func:`jik.app.dashboard.figures.figure_specs`, :func:`jik.app.dashboard.figures.figure_json`).
+Both from the same result, checked to decode to the same figures; wall-clock medians.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import time
 import numpy as np
 
 from jik.app.dashboard import compute, default_state
-from jik.app.figures import PANELS, figure_json, figure_specs, figures_for
+from jik.app.dashboard.figures import PANELS, figure_json, figure_specs, figures_for
 
 ROBOTS = ("manipulator2", "manipulator1", "unicycle")
 

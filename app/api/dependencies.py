@@ -7,7 +7,7 @@ from typing import Annotated
 from fastapi import Depends, Request
 
 from jik.app.compute.pool import ComputePool
-from jik.app.sessions import SessionStore
+from jik.app.dashboard.sessions import SessionStore
 
 
 async def pool_of(request: Request) -> ComputePool:

@@ -15,8 +15,8 @@ import socket
 import uvicorn
 
 from jik.app.api.factory import create_app
+from jik.app.dashboard.sessions import SessionLimits, SessionStore
 from jik.app.scene import start_scene
-from jik.app.sessions import SessionLimits, SessionStore
 
 
 class PortInUse(RuntimeError):

@@ -1,6 +1,6 @@
 """The scene's GUI controls, built from the dashboard's control specification
-(:func:`jik.app.controls.controls`, from which the page builds its own): the same controls,
-labels, ranges and values. A change is sent by its control key, as the page sends it."""
+(:func:`jik.app.dashboard.controls.controls`, from which the page builds its own): the same
+controls, labels, ranges and values. A change is sent by its control key, as the page sends it."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from typing import Any
 
 import viser
 
-from jik.app.controls import GROUPS, Control, control_values, controls
+from jik.app.dashboard.controls import GROUPS, Control, control_values, controls
 
 
 class SceneControls:

@@ -1,11 +1,12 @@
-"""One description of the dashboard's controls (jik.app.controls): from the registry, shown the
-same in the page and the scene, turned into state changes in one place."""
+"""One description of the dashboard's controls (jik.app.dashboard.controls): from the
+registry, shown the same in the page and the scene, turned into state changes in one place."""
 
 from __future__ import annotations
 
 import pytest
 
-from jik.app.controls import (
+from jik.app.dashboard import default_state, updated_state
+from jik.app.dashboard.controls import (
     DISCRETE_GAMMA_ON_SWITCH,
     GAMMA_RANGE,
     control_values,
@@ -14,7 +15,6 @@ from jik.app.controls import (
     parse_path_text,
     path_text,
 )
-from jik.app.dashboard import default_state, updated_state
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS, robot_spec
 

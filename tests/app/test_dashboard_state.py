@@ -13,15 +13,15 @@ from jik.app.dashboard import (
     ALGORITHMS,
     Cancelled,
     Dashboard,
-    _cache_key,
     compute,
     default_state,
     export_csv,
     export_json,
-    functionals_key,
     runs_key,
     updated_state,
 )
+from jik.app.dashboard.analysis import functionals_key, inert_variables
+from jik.app.dashboard.model import cache_key
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS, make_inverse, robot_spec
 from jik.engine.repeatability import repeatability
@@ -271,7 +271,6 @@ def test_functionals_are_keyed_by_the_map_and_the_variables_held_fixed():
 def test_inert_variables_are_those_j_h_and_dh_ignore():
     """Shifting x_k must leave J, h and dh unchanged; a map with a constant dh/dx_k still
     depends on x_k through its value."""
-    from jik.app.dashboard import inert_variables
     from jik.engine.augmentations import E2Optimal, PaperCubic, Polynomial2
     from jik.engine.kinematics import Manipulator1, Manipulator2
 
@@ -294,7 +293,7 @@ def test_inert_variables_are_those_j_h_and_dh_ignore():
 def test_the_h_panel_names_only_the_fixed_variables_h_depends_on():
     """Manipulator 2's h(x2, x3) is drawn over (x2, x3): its title does not name x1, so a
     change of x1 leaves the title (and the E1/E2 in it) as they are."""
-    from jik.app.figures import augmenting_title
+    from jik.app.dashboard.figures import augmenting_title
 
     state = default_state("manipulator2")
     a = compute(state)
@@ -440,7 +439,7 @@ def test_an_idle_dashboard_solves_the_other_manipulator_ahead():
     other = default_state("manipulator1")
     assert dashboard.wait(1, 60)
     deadline = time.monotonic() + 60
-    while not all(_cache_key(other, a) in dashboard._cache for a in ALGORITHMS):
+    while not all(cache_key(other, a) in dashboard._cache for a in ALGORITHMS):
         assert time.monotonic() < deadline, "manipulator1 was not solved ahead"
         time.sleep(0.05)
     generation, _ = dashboard.update({"robot": "manipulator1"})
@@ -505,7 +504,7 @@ def test_solving_ahead_stops_for_a_change():
     assert not dashboard._cache
     dashboard._prefetch(2)  # idle at the newest generation
     other = default_state("manipulator1")
-    assert {_cache_key(other, a) for a in ALGORITHMS} == set(dashboard._cache)
+    assert {cache_key(other, a) for a in ALGORITHMS} == set(dashboard._cache)
 
 
 @pytest.mark.parametrize("mode", ["continuous", "discrete"])

@@ -9,16 +9,9 @@ import numpy as np
 import plotly.graph_objects as go
 import pytest
 
-from jik.app.dashboard import (
-    COLORS,
-    LABELS,
-    compute,
-    default_state,
-    error_functionals,
-    sensitivity,
-    updated_state,
-)
-from jik.app.figures import (
+from jik.app.dashboard import COLORS, LABELS, compute, default_state, updated_state
+from jik.app.dashboard.analysis import error_functionals, sensitivity
+from jik.app.dashboard.figures import (
     augmenting_figure,
     drift_figure,
     figure_json,
@@ -110,7 +103,7 @@ def test_augmenting_map_contours_with_the_extended_run_on_a_level_set(path_resul
     assert fig.layout.xaxis.title.text == "x2 [m]"
     assert fig.layout.yaxis.title.text == "x3 [rad]"
     assert "E1 = " in fig.layout.title.text and "E2 = " in fig.layout.title.text
-    # The runs and x0 are shapes over the contours (moved by a relayout, app/figures.py).
+    # The runs and x0 are shapes over the contours (moved by a relayout, app/dashboard/figures.py).
     runs = fig.layout.shapes[:2]
     assert [s.line.color for s in runs] == [COLORS["pseudoinverse"], COLORS["extended"]]
     ext = path_result.runs["extended"].x

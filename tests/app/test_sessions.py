@@ -10,8 +10,8 @@ from fastapi.testclient import TestClient
 from starlette.websockets import WebSocketDisconnect
 
 from jik.app.api.factory import create_app
-from jik.app.figures import PANELS
-from jik.app.sessions import SessionLimits, SessionNotFound, SessionsFull, SessionStore
+from jik.app.dashboard.figures import PANELS
+from jik.app.dashboard.sessions import SessionLimits, SessionNotFound, SessionsFull, SessionStore
 
 
 @pytest.fixture

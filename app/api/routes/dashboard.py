@@ -15,9 +15,9 @@ from fastapi import APIRouter
 from fastapi.responses import FileResponse, JSONResponse, Response
 
 from jik import static
-from jik.app.controls import PROGRESS_AFTER
 from jik.app.dashboard import COLORS, LABELS
-from jik.app.figures import PANEL_SIZES
+from jik.app.dashboard.controls import PROGRESS_AFTER
+from jik.app.dashboard.figures import PANEL_SIZES
 
 router = APIRouter(tags=["dashboard"])
 

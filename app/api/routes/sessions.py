@@ -1,4 +1,4 @@
-"""Dashboard sessions over HTTP: one per browser tab (:mod:`jik.app.sessions`).
+"""Dashboard sessions over HTTP: one per browser tab (:mod:`jik.app.dashboard.sessions`).
 
 The page creates its session from the state in its URL (``POST /api/sessions``), changes it
 (``POST /api/sessions/{id}/state``), follows it (``GET /api/sessions/{id}/events``, server-sent
@@ -22,9 +22,9 @@ from pydantic import BaseModel, ConfigDict, Field
 from websockets.typing import Subprotocol
 
 from jik.app.api.dependencies import Store
-from jik.app.controls import controls_message
 from jik.app.dashboard import Event, export_csv, export_json
-from jik.app.sessions import Session, SessionNotFound, SessionsFull
+from jik.app.dashboard.controls import controls_message
+from jik.app.dashboard.sessions import Session, SessionNotFound, SessionsFull
 from jik.engine.exceptions import InvalidInputError
 
 router = APIRouter(tags=["dashboard sessions"])

@@ -8,8 +8,8 @@ stopped. When the store is full, the session idle the longest makes room; if eve
 use the new one is refused (the route answers 503).
 
 The sessions' computations share one bounded pool: each dashboard's second process is the same
-:class:`~jik.app.dashboard.Offload` (``workers`` processes, first come first served), and every
-session's own thread computes the other algorithm.
+:class:`~jik.app.dashboard.offload.Offload` (``workers`` processes, first come first
+served), and every session's own thread computes the other algorithm.
 """
 
 from __future__ import annotations
@@ -22,7 +22,9 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from jik.app.dashboard import Dashboard, Offload, default_state, updated_state
+from jik.app.dashboard.model import default_state, updated_state
+from jik.app.dashboard.offload import Offload
+from jik.app.dashboard.session import Dashboard
 
 
 class SessionNotFound(KeyError):

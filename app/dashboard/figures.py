@@ -4,7 +4,8 @@ Each figure is built as a plain figure dict first (its "spec"): the dashboard se
 directly (:func:`figure_specs`, :func:`figure_json`), 5x faster than through ``go.Figure``
 and ``to_json``, on every change of a control.
 
-Colours are fixed per algorithm (:data:`jik.app.dashboard.COLORS`), the same as in the 3D scene.
+Colours are fixed per algorithm (:data:`jik.app.dashboard.model.COLORS`), the same as in the
+3D scene.
 The figures follow the paper: task-space paths (Figs. 5, 6), joint trajectories against theta
 (Figs. 7-9), the repeatability drift per cycle with the Table 1 numbers, and for the unicycle the
 platform paths in the (q1, q2) plane and the controls against the iteration (Figs. 11-14).
@@ -20,7 +21,9 @@ from typing import Any
 import numpy as np
 import plotly.graph_objects as go
 
-from jik.app.dashboard import ALGORITHMS, COLORS, LABELS, DashboardResult, state_inert_variables
+from jik.app.dashboard.analysis import state_inert_variables
+from jik.app.dashboard.model import ALGORITHMS, COLORS, LABELS
+from jik.app.dashboard.runs import DashboardResult
 from jik.engine.reproductions.table1 import cell
 
 #: Units of the joint and task variables, by robot (the registry does not carry units).
@@ -564,7 +567,8 @@ def _sensitivity(result: DashboardResult, sens: dict | None = None) -> dict:
 
     With parameters: each functional against each parameter (swept around its current value,
     which is marked), on a log scale. Without: the functionals of the robot's other maps.
-    ``sens`` comes from :func:`jik.app.dashboard.sensitivity` (the dashboard's second phase).
+    ``sens`` comes from :func:`jik.app.dashboard.analysis.sensitivity` (the dashboard's second
+    phase).
     """
     aug = result.state.augmentation
     if sens is None:

@@ -26,6 +26,8 @@ from jik.engine.registry import ROBOTS, robot_spec
 #: gamma's range per mode: the decay rate of eq. (5) (continuous), the step of the discrete
 #: iteration, which converges only for 0 < gamma < 2.
 GAMMA_RANGE = {"continuous": (0.01, 10.0), "discrete": (0.01, 1.99)}
+#: gamma's resolution: the page's log-scale slider and the scene's slider both land on it.
+GAMMA_STEP = 0.001
 #: Switching to discrete mode takes gamma down to this when it is above (the full Newton step).
 DISCRETE_GAMMA_ON_SWITCH = 1.0
 #: Largest number of cycles offered by the dashboard (the engine accepts more).
@@ -87,7 +89,7 @@ def controls(state) -> list[Control]:
                 options=tuple((m, m) for m in MODES)),
         Control("gamma", "γ (decay rate)", "slider", "algorithm",
                 "decay rate of the task error, eq. (5) (discrete mode: the step, below 2)",
-                minimum=lo, maximum=hi, step=0.01, log=True),
+                minimum=lo, maximum=hi, step=GAMMA_STEP, log=True),
     ]  # fmt: skip
     for p in spec.parameters:
         out.append(Control(f"robot_parameters.{p.name}", p.name, "slider", "algorithm",

@@ -1,0 +1,30 @@
+"""The dashboard: one live state per session, solved by both algorithms, drawn as figures.
+
+Modules: :mod:`~jik.app.dashboard.controls` (the controls, described once), :mod:`.model` (the
+state), :mod:`.runs` and :mod:`.results` (a state solved), :mod:`.offload` (the shared compute
+processes), :mod:`.analysis` (h on a grid, E1/E2), :mod:`.figures` (plotly panels),
+:mod:`.messages` (events), :mod:`.session` (the live :class:`Dashboard`), :mod:`.sessions` (one
+per tab, bounded), :mod:`.export` (JSON and CSV). The names below are the public surface.
+"""
+
+from jik.app.dashboard.export import export_csv, export_json
+from jik.app.dashboard.messages import Event
+from jik.app.dashboard.model import (
+    ALGORITHMS,
+    COLORS,
+    LABELS,
+    DashboardState,
+    default_state,
+    runs_key,
+    updated_state,
+)
+from jik.app.dashboard.offload import Offload, OffloadLane
+from jik.app.dashboard.results import compute
+from jik.app.dashboard.runs import AlgorithmRun, Cancelled, DashboardResult
+from jik.app.dashboard.session import Dashboard
+
+__all__ = [
+    "ALGORITHMS", "COLORS", "LABELS", "AlgorithmRun", "Cancelled", "Dashboard",
+    "DashboardResult", "DashboardState", "Event", "Offload", "OffloadLane", "compute",
+    "default_state", "export_csv", "export_json", "runs_key", "updated_state",
+]  # fmt: skip

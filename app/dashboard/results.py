@@ -1,0 +1,158 @@
+"""A dashboard state solved: both algorithms through its task (cached runs reused, more cycles
+going on from fewer), with h on a grid for the h panel.
+
+Continuous mode integrates in tau = gamma theta (see :mod:`jik.engine.solver`): x(theta) does not
+depend on gamma, so the runs are solved at gamma = 1 and theta divided by gamma, and a gamma
+change in continuous mode only rescales the theta axis without a new integration.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from concurrent.futures import Future
+from dataclasses import replace
+from typing import cast
+
+import numpy as np
+
+from jik.app.dashboard.analysis import augmenting_grid
+from jik.app.dashboard.controls import MAX_DASHBOARD_CYCLES
+from jik.app.dashboard.model import ALGORITHMS, DashboardState, cache_key
+from jik.app.dashboard.offload import OffloadLane
+from jik.app.dashboard.runs import (
+    UNICYCLE_TIME_POINTS,
+    AlgorithmRun,
+    DashboardResult,
+    algorithm_run,
+    first_cycles,
+    leg_targets,
+)
+from jik.engine.registry import robot_spec
+from jik.engine.unicycle import Unicycle
+
+
+def other_cycles(cache: dict, state: DashboardState, algorithm: str, legs: int):
+    """A cached successful run of the same closed path with another number of cycles: the
+    closest with more cycles, else the longest with fewer; None if there is none."""
+    if state.task != "path" or legs < 2:
+        return None
+    found = {}
+    for c in range(1, MAX_DASHBOARD_CYCLES + 1):
+        run = cache.get(cache_key(replace(state, cycles=c), algorithm))
+        if c != state.cycles and run is not None and run.success and run.platform is None:
+            found[c] = run
+    more = [c for c in found if c > state.cycles]
+    if more:
+        return found[min(more)]
+    return found[max(found)] if found else None
+
+
+def compute(
+    state: DashboardState,
+    generation: int = 0,
+    *,
+    progress: Callable[[float], None] | None = None,
+    cancelled: Callable[[], bool] = lambda: False,
+    cache: dict | None = None,
+    with_augmenting: bool = True,
+    offload: OffloadLane | None = None,
+    grid_before: dict | None = None,
+) -> DashboardResult:
+    """Solve the state's task with both algorithms.
+
+    Parameters
+    ----------
+    progress : callable, optional
+        Called with the fraction of legs done, in [0, 1].
+    cancelled : callable
+        Polled between legs; when it returns True the computation raises :class:`Cancelled`.
+    cache : dict, optional
+        Runs keyed by everything they depend on (gamma excluded in continuous mode); reused
+        and filled.
+    with_augmenting : bool
+        Evaluate h on a grid for the h panel now (see :func:`augmenting_grid`).
+    offload : OffloadLane, optional
+        A lane of the shared compute processes: the pseudoinverse runs there, concurrently with
+        the extended inverse here (same results).
+    grid_before : dict, optional
+        The h grid on screen, whose box the new grid keeps when it fits (see
+        :func:`augmenting_grid`).
+
+    Raises
+    ------
+    Cancelled, JikError
+        A singular start configuration raises the engine's typed error.
+    """
+    t0 = time.perf_counter()
+    spec = robot_spec(state.robot)
+    kin = spec.build(**state.robot_parameters)
+    targets = leg_targets(kin, state)
+    cycles = state.cycles if state.task == "path" else 1
+    total = 2 * cycles * len(targets)
+    cache = {} if cache is None else cache
+    keys = {a: cache_key(state, a) for a in ALGORITHMS}
+    todo = [a for a in ALGORITHMS if keys[a] not in cache]
+    # Another number of cycles of the same legs: its first cycles are this run's, or this run
+    # goes on from its end (cycles slider: only the new legs are solved).
+    other = {a: other_cycles(cache, state, a, len(targets)) for a in todo}
+    for a in [a for a in todo if other[a] is not None and len(other[a].drift) >= cycles]:
+        cache[keys[a]] = first_cycles(other[a], cycles, len(targets))
+        todo.remove(a)
+    done = [(len(ALGORITHMS) - len(todo)) * cycles * len(targets)]  # legs, cached runs included
+    done[0] += sum(len(other[a].leg_end) for a in todo if other[a] is not None)
+
+    # With a second process, the pseudoinverse runs there while this thread runs the extended
+    # inverse (the two are independent); each local leg then stands for two in the progress.
+    remote: Future | None = None
+    if offload is not None and len(todo) == 2:
+        remote = offload.submit(
+            state, "pseudoinverse", targets, cycles, generation, other["pseudoinverse"]
+        )
+    weight = 1 if remote is None else 2
+
+    def step() -> None:
+        done[0] += weight
+        if progress is not None:
+            progress(min(done[0] / total, 1.0))
+
+    def partial(fraction: float) -> None:
+        if progress is not None:
+            progress(min((done[0] + weight * float(fraction)) / total, 1.0))
+
+    for algorithm in todo:
+        if remote is None or algorithm != "pseudoinverse":
+            cache[keys[algorithm]] = algorithm_run(
+                state, algorithm, targets, cycles, step, cancelled, partial, kin,
+                resume=other[algorithm],
+            )  # fmt: skip
+    if offload is not None and remote is not None:
+        cache[keys["pseudoinverse"]] = offload.result(remote, lambda: algorithm_run(
+            state, "pseudoinverse", targets, cycles, cancelled=cancelled, kin=kin,
+            resume=other["pseudoinverse"]))  # fmt: skip
+    runs: dict[str, AlgorithmRun] = {}
+    for algorithm in ALGORITHMS:
+        run = cache[keys[algorithm]]
+        if state.mode == "continuous":
+            run = replace(run, theta=run.theta / state.gamma)
+        runs[algorithm] = run
+    if len(cache) > 64:
+        for k in list(cache)[: len(cache) - 64]:
+            del cache[k]
+    return DashboardResult(
+        state=state,
+        generation=generation,
+        title=spec.title,
+        variable_names=tuple(spec.variable_names),
+        task_names=tuple(spec.task_names),
+        targets=targets,
+        runs=runs,
+        time=np.linspace(0.0, float(cast(Unicycle, kin).T), UNICYCLE_TIME_POINTS)
+        if hasattr(kin, "path")
+        else None,
+        augmenting=augmenting_grid(kin, state, runs, before=grid_before)
+        if with_augmenting
+        else None,
+        seconds=time.perf_counter() - t0,
+        cached={a: a not in todo for a in ALGORITHMS},
+    )

@@ -1,0 +1,232 @@
+"""One algorithm driven through the legs of a task, point by point, by the engine's one cycle
+loop (:func:`jik.engine.repeatability.repeatability`, legs by eq. (7)), and the result of both
+algorithms for one state (:class:`DashboardResult`)."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from typing import cast
+
+import numpy as np
+
+from jik.app.dashboard.model import DashboardState
+from jik.engine.exceptions import RunCancelled
+from jik.engine.registry import make_inverse, robot_spec
+from jik.engine.repeatability import Leg, Resume, closed_path, repeatability
+from jik.engine.solver import MAX_ITERATIONS, SolveResult, Trajectory
+from jik.engine.unicycle import Unicycle
+
+#: Time grid points of one unicycle platform path q(t).
+UNICYCLE_TIME_POINTS = 96
+
+
+class Cancelled(Exception):
+    """A newer change superseded the computation."""
+
+
+@dataclass(frozen=True)
+class AlgorithmRun:
+    """One algorithm driven through every leg of the task, point by point.
+
+    Attributes
+    ----------
+    theta : ndarray, shape (m,)
+        Continuation parameter, cumulative over the legs (iterations in discrete mode).
+    x : ndarray, shape (m, p)
+    y : ndarray, shape (m, r)
+    error : ndarray, shape (m,)
+        Distance to the current leg's target.
+    h : ndarray, shape (m,) or None
+        The augmenting map along the run (extended inverse only).
+    leg : ndarray of int, shape (m,)
+        Leg index (cycle * legs_per_cycle + leg) of every point.
+    leg_end : ndarray, shape (n_legs_done, p)
+    drift : ndarray, shape (cycles_done,)
+        ||x at the end of cycle c - x0|| (closed-path task only, else empty).
+    platform : ndarray, shape (m, T, 3) or None
+        Unicycle only: the platform path q(t) for the controls of every iteration.
+    """
+
+    algorithm: str
+    theta: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    error: np.ndarray
+    h: np.ndarray | None
+    leg: np.ndarray
+    leg_end: np.ndarray
+    drift: np.ndarray
+    success: bool
+    message: str
+    seconds: float
+    platform: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class DashboardResult:
+    """Both runs for one state, with what the figures need to label them."""
+
+    state: DashboardState
+    generation: int
+    title: str
+    variable_names: tuple[str, ...]
+    task_names: tuple[str, ...]
+    targets: np.ndarray  # (L, r) legs of one cycle
+    runs: dict[str, AlgorithmRun]
+    time: np.ndarray | None = None  # unicycle time grid [s]
+    augmenting: dict | None = None  # h on a grid, see augmenting_grid()
+    seconds: float = 0.0
+    cached: dict = field(default_factory=dict)
+
+
+def leg_targets(kin, state: DashboardState) -> np.ndarray:
+    if state.task == "target":
+        return np.asarray([state.target])
+    return closed_path(kin, np.asarray([state.x0]), np.asarray(state.path))[0]
+
+
+#: Discrete mode runs in chunks of this many iterations, so that a newer change cancels it.
+CHUNK = 80
+
+
+def _run_legs(
+    inverse, state, targets, cycles, progress, cancelled, partial, resume=None
+) -> AlgorithmRun:
+    """Drive ``inverse`` through the legs by :func:`jik.engine.repeatability.repeatability`,
+    keeping every point of every leg (its ``on_leg``) with theta cumulative over the legs.
+
+    ``resume``: a successful run of fewer cycles of the same legs, whose cycles are kept; the
+    engine goes on from its end with its last cycle's legs as Picard guides (the numbers of a
+    run from the start). Discrete legs run in chunks of :data:`CHUNK` iterations, between which
+    ``cancelled`` is polled and ``partial`` told the leg's progress. A leg whose solve raises (a
+    map undefined where it starts) stops this algorithm; the other one is still shown.
+    """
+    t0 = time.perf_counter()
+    x0 = np.asarray(state.x0)
+    continuous = state.mode == "continuous"
+    L = len(targets)
+    parts = []  # (theta, x, y, error, h, leg index) of every leg
+    offset, last, failure = 0.0, "", ""  # (the last leg's message; what stopped the run)
+    earlier = None
+    if resume is not None:
+        parts.append((resume.theta, resume.x, resume.y, resume.error, resume.h, resume.leg))
+        offset = float(resume.theta[-1])
+        done = (len(resume.drift) - 1) * L  # (the legs before its last cycle)
+        guides = [_leg_trajectory(resume, done + j) for j in range(L)] if continuous else []
+        earlier = Resume(resume.leg_end, guides)
+
+    def on_leg(leg: Leg) -> None:
+        nonlocal offset, last, failure
+        res = cast(SolveResult, leg.result)  # (one start, recorded)
+        tr = cast(Trajectory, res.trajectory)
+        parts.append((tr.theta + offset, tr.x, tr.y, tr.error, tr.h, leg.cycle * L + leg.index))
+        offset += float(tr.theta[-1])
+        where = f"cycle {leg.cycle + 1}, leg {leg.index + 1}"
+        if leg.stopped_by is not None:
+            failure = f"{where} stopped: {leg.stopped_by}"
+        elif not res.success:
+            failure = f"{where}: {_leg_message(res)}"
+        else:
+            last = _leg_message(res)
+        progress()
+
+    path, close = (state.path, True) if state.task == "path" else (targets, False)
+    try:
+        run = repeatability(
+            inverse, x0, path, cycles, gamma=1.0 if continuous else state.gamma, mode=state.mode,
+            tol=state.tolerance, record=True, close=close, resume=earlier, on_leg=on_leg,
+            cancelled=cancelled, chunk=None if continuous else CHUNK, on_chunk=partial,
+            on_undefined="stop",
+        )  # fmt: skip
+    except RunCancelled:
+        raise Cancelled from None
+    ends = run.legs[np.isfinite(run.legs).all(axis=1)]
+    cycle_ends = ends[L - 1 :: L] if state.task == "path" else []
+    drift = [float(np.linalg.norm(e - x0)) for e in cycle_ends]
+    return AlgorithmRun(
+        algorithm=inverse.name,
+        theta=np.concatenate([p[0] for p in parts]),
+        x=np.concatenate([p[1] for p in parts]),
+        y=np.concatenate([p[2] for p in parts]),
+        error=np.concatenate([p[3] for p in parts]),
+        h=None if parts[0][4] is None else np.concatenate([p[4] for p in parts]),
+        leg=np.concatenate([np.broadcast_to(p[5], len(p[0])) for p in parts]),
+        leg_end=ends,
+        drift=np.asarray(drift),
+        success=bool(run.success),
+        message=failure or _legs_message(len(ends), drift, last),
+        seconds=time.perf_counter() - t0,
+    )
+
+
+def _leg_message(res: SolveResult) -> str:
+    """A leg's message; a discrete leg's in the dashboard's words (iterations, not tol)."""
+    if res.mode == "continuous":
+        return res.message
+    if res.success:
+        return f"converged: task error {res.error:.3g} after {res.nit} iterations"
+    if res.nit == MAX_ITERATIONS:  # (the engine's cap, which the dashboard keeps)
+        return (
+            f"did not converge within {res.nit} iterations (error {res.error:.3g}); "
+            "raise gamma or move the start"
+        )
+    return res.message
+
+
+def _leg_trajectory(run: AlgorithmRun, k: int) -> Trajectory | None:
+    """Leg ``k`` of a run as a trajectory (theta from the leg's start), None if not there."""
+    at = run.leg == k
+    if np.count_nonzero(at) < 2:
+        return None
+    return Trajectory(theta=run.theta[at] - run.theta[at][0], x=run.x[at], y=run.y[at],
+                      error=run.error[at], h=None if run.h is None else run.h[at])  # fmt: skip
+
+
+def _legs_message(legs: int, drift, last_message: str) -> str:
+    """The message of a successful run of ``legs`` legs."""
+    if legs == 1:
+        return last_message
+    return f"{legs} legs converged" + (
+        f", drift after cycle {len(drift)}: {drift[-1]:.3g}" if len(drift) else ""
+    )
+
+
+def first_cycles(run: AlgorithmRun, cycles: int, legs: int) -> AlgorithmRun:
+    """The first ``cycles`` cycles of a successful closed-path run of ``legs`` legs a cycle:
+    what a run of that many cycles gives (see :func:`_run_legs`)."""
+    keep = run.leg < cycles * legs
+    drift = run.drift[:cycles]
+    return replace(
+        run, theta=run.theta[keep], x=run.x[keep], y=run.y[keep], error=run.error[keep],
+        h=None if run.h is None else run.h[keep], leg=run.leg[keep],
+        leg_end=run.leg_end[: cycles * legs], drift=drift,
+        message=_legs_message(cycles * legs, drift, run.message), seconds=0.0,
+    )  # fmt: skip
+
+
+def algorithm_run(
+    state: DashboardState,
+    algorithm: str,
+    targets: np.ndarray,
+    cycles: int,
+    progress: Callable[[], None] = lambda: None,
+    cancelled: Callable[[], bool] = lambda: False,
+    partial: Callable[[float], None] = lambda f: None,
+    kin=None,
+    resume: AlgorithmRun | None = None,
+) -> AlgorithmRun:
+    """One algorithm through ``cycles`` cycles of the legs to ``targets`` (see :func:`compute`);
+    for the unicycle with the platform paths q(t) of its iterates. ``kin``: the state's
+    kinematics when the caller has built it; ``resume``: see :func:`_run_legs`."""
+    spec = robot_spec(state.robot)
+    kin = spec.build(**state.robot_parameters) if kin is None else kin
+    inverse = make_inverse(
+        kin, algorithm, state.augmentation, state.augmentation_parameters, spec.name
+    )
+    run = _run_legs(inverse, state, targets, cycles, progress, cancelled, partial, resume)
+    if hasattr(kin, "path"):
+        t = np.linspace(0.0, float(cast(Unicycle, kin).T), UNICYCLE_TIME_POINTS)
+        run = replace(run, platform=kin.path(run.x, t))
+    return run

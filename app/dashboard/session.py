@@ -1,0 +1,459 @@
+"""One session's live dashboard: its state, a worker thread that computes each change, and the
+listeners (the page's event stream, the scene) it tells.
+
+Every change is validated (:mod:`jik.app.dashboard.model`), bumps a generation counter and wakes
+the worker, which solves both algorithms (:func:`jik.app.dashboard.results.compute`), builds the
+figures once and pushes them to every listener; a newer change cancels a stale computation
+between legs. Idle, it solves the other manipulator ahead for a switch.
+
+(About 430 lines, one class: the worker's phases, result, second phase and solving ahead,
+share its lock, generation and caches.)
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import replace
+
+from jik.app.dashboard.analysis import (
+    augmenting_grid,
+    error_functionals,
+    expensive_map,
+    functionals_key,
+    kinematics_and_map,
+    sensitivity,
+)
+from jik.app.dashboard.controls import controls_message
+from jik.app.dashboard.figures import (
+    PANELS,
+    augmenting_title,
+    figure_json,
+    figure_specs,
+    gamma_free_panels,
+    keep_ranges,
+)
+from jik.app.dashboard.messages import Event, digest, summary, to_json, with_figures
+from jik.app.dashboard.model import (
+    ALGORITHMS,
+    COLORS,
+    LABELS,
+    DashboardState,
+    cache_key,
+    default_state,
+    updated_state,
+    validate,
+)
+from jik.app.dashboard.offload import Offload
+from jik.app.dashboard.results import compute
+from jik.app.dashboard.runs import Cancelled, DashboardResult
+from jik.engine.exceptions import InvalidInputError, JikError
+
+log = logging.getLogger("jik.dashboard")
+
+#: Robots whose default state the idle dashboard solves ahead (:meth:`Dashboard._prefetch`).
+#: Not the unicycle: its ~1 s would hold the CPU that a change made meanwhile needs (its
+#: switch shows progress instead).
+PREFETCH_ROBOTS = ("manipulator1", "manipulator2")
+
+
+class Dashboard:
+    """One session's live dashboard: one state, a worker thread, and subscribers.
+
+    Parameters
+    ----------
+    state : DashboardState, optional
+        Initial state (registry defaults of :data:`DEFAULT_ROBOT`).
+    debounce : float
+        Seconds the worker waits after a change for a newer one (short: the page already
+        coalesces a slider drag into one request in flight at a time).
+    offload : Offload, optional
+        Compute processes shared with other dashboards: one algorithm runs there, in this
+        dashboard's own lane (:meth:`Offload.lane`); ``jik serve`` gives one.
+    """
+
+    def __init__(
+        self,
+        state: DashboardState | None = None,
+        *,
+        debounce: float = 0.002,
+        offload: Offload | None = None,
+    ) -> None:
+        self._cond = threading.Condition()
+        self._offload = offload.lane() if offload is not None else None
+        self._state = validate(state or default_state())
+        self._generation = 1
+        self._done = 0  # last generation whose computation finished (or failed)
+        self._debounce = debounce
+        self._changed_at = {1: time.perf_counter()}
+        self._listeners: list[Callable[[Event], None]] = []
+        self._fast = 0  # the first ``_fast`` listeners are the quick ones
+        self._cache: dict = {}
+        self._figures: dict[tuple[str, str], str] = {}  # (panel, key) -> figure JSON
+        self._layouts: dict[str, tuple[tuple, dict]] = {}  # panel -> (robot, task), last layout
+        # Results solved ahead (_prefetch): when each robot's went to the page (the value of
+        # _robot_since then), the latest by robot, and since when the robot on screen is
+        # (the generation of its first result).
+        self._ahead_sent: dict[str, int] = {}
+        self._latest_ahead: dict[str, Event] = {}
+        self._robot_since = 0
+        # key -> (E1/E2 functionals or None, their sensitivity)
+        self._functionals_cache: dict[str, tuple[dict | None, dict]] = {}
+        self._latest: dict[str, Event] = {
+            "state": Event("state", 1, to_json(self._state_message(1, self._state, "initial")))
+        }
+        self.result: DashboardResult | None = None
+        self.functionals: dict | None = None
+        #: What the 3D scene last drew (set by app.scene), for the page and the tests.
+        self.scene_status: dict = {}
+        self._thread: threading.Thread | None = None
+        self._stopped = False
+
+    # -- public API -------------------------------------------------------------------------
+    @property
+    def state(self) -> DashboardState:
+        return self._state
+
+    @property
+    def generation(self) -> int:
+        return self._generation
+
+    def start(self) -> None:
+        """Start the worker thread (idempotent)."""
+        with self._cond:
+            if self._thread is None:
+                self._thread = threading.Thread(
+                    target=self._work, name="jik-dashboard", daemon=True
+                )
+                self._thread.start()
+
+    def stop(self) -> None:
+        with self._cond:
+            self._stopped = True
+            self._cond.notify_all()
+        if self._offload is not None:
+            self._offload.close()
+
+    def update(
+        self, patch: Mapping[str, object], source: str = "page"
+    ) -> tuple[int, DashboardState]:
+        """Validate and apply a change; the worker recomputes. Returns (generation, state).
+
+        A change the registry refuses raises :class:`InvalidInputError` and is announced to
+        every listener as a ``refused`` event (the page and the scene both show it, and their
+        controls go back to the values in force).
+        """
+        refusal: InvalidInputError | None = None
+        with self._cond:
+            try:
+                state = updated_state(self._state, patch)
+            except InvalidInputError as exc:
+                refusal = exc
+                generation, state = self._generation, self._state
+            else:
+                if state == self._state:
+                    return self._generation, state
+                self._state = state
+                self._generation += 1
+                generation = self._generation
+                self._changed_at[generation] = time.perf_counter()
+                if self._offload is not None:
+                    self._offload.newest(generation)
+                self._cond.notify_all()
+        if refusal is not None:
+            refused = {"type": "refused", "generation": generation, "source": source,
+                       "field": refusal.field, "message": str(refusal),
+                       "state": state.as_dict(), **controls_message(state)}  # fmt: skip
+            self._emit(Event("refused", generation, to_json(refused)))
+            raise refusal
+        self._emit(
+            Event("state", generation, to_json(self._state_message(generation, state, source)))
+        )
+        self.start()
+        return generation, state
+
+    def subscribe(
+        self, listener: Callable[[Event], None], *, last: bool = False
+    ) -> Callable[[], None]:
+        """Call ``listener(event)`` on every event (from the worker thread); replay the latest.
+
+        ``last``: a slow listener (the 3D scene draws in it) is called after the others, so
+        that it does not hold up the events queued for the page.
+        """
+        with self._cond:
+            if last:
+                self._listeners.append(listener)
+            else:
+                self._listeners.insert(self._fast, listener)
+                self._fast += 1
+            kinds = ("state", "result", "functionals")
+            latest = [self._latest[k] for k in kinds if k in self._latest]
+            latest += [e for r, e in self._latest_ahead.items() if r != self._state.robot]
+        for event in latest:
+            listener(event)
+        self.start()
+
+        def unsubscribe() -> None:
+            with self._cond:
+                if listener in self._listeners:
+                    if self._listeners.index(listener) < self._fast:
+                        self._fast -= 1
+                    self._listeners.remove(listener)
+
+        return unsubscribe
+
+    def wait(self, generation: int | None = None, timeout: float = 30.0) -> bool:
+        """Block until the computation of ``generation`` (default: current) has finished."""
+        self.start()
+        deadline = time.monotonic() + timeout
+        with self._cond:
+            target = self._generation if generation is None else generation
+            while self._done < target:
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    return False
+                self._cond.wait(left)
+        return True
+
+    def snapshot(self) -> dict:
+        """The current state and the summary of the last result."""
+        with self._cond:
+            result = self.result
+            return {
+                "generation": self._generation,
+                "computed_generation": None if result is None else result.generation,
+                "state": self._state.as_dict(),
+                "summary": None if result is None else summary(result),
+                "functionals": self.functionals,
+                "scene": dict(self.scene_status),
+            }
+
+    # -- worker -----------------------------------------------------------------------------
+    def _state_message(self, generation: int, state: DashboardState, source: str) -> dict:
+        return {"type": "state", "generation": generation, "state": state.as_dict(),
+                "source": source, **controls_message(state)}  # fmt: skip
+
+    def _emit(self, event: Event) -> None:
+        with self._cond:
+            if event.kind in ("state", "result", "functionals", "error"):
+                self._latest[event.kind] = event
+            listeners = list(self._listeners)
+        for listener in listeners:
+            listener(event)
+
+    def _work(self) -> None:
+        while True:
+            with self._cond:
+                while self._done >= self._generation and not self._stopped:
+                    self._cond.wait()
+                if self._stopped:
+                    return
+                # Debounce: wait until no change arrived for ``debounce`` seconds.
+                while True:
+                    seen = self._generation
+                    self._cond.wait(self._debounce)
+                    if self._generation == seen or self._stopped:
+                        break
+                generation, state = self._generation, self._state
+            try:
+                self._compute(generation, state)
+                self._prefetch(generation)
+            except Exception as exc:  # keep the worker alive; the page shows the message
+                log.exception("dashboard computation failed")
+                message = f"internal error: {type(exc).__name__}: {exc}"
+                self._emit(Event("error", generation, to_json(
+                    {"type": "error", "generation": generation, "message": message})))  # fmt: skip
+                self._finish(generation)
+
+    def _prefetch(self, generation: int) -> None:
+        """While no change comes, solve the other robots' default states into the run cache:
+        switching robot starts from those defaults (:func:`updated_state`), so the switch then
+        only draws (Manipulator 1: ~90 ms of computation less in the browser test).
+
+        Each is announced by an ``ahead`` event with the figures the switch will show: the
+        page draws them off screen and shows them on the switch (when they are the same), the
+        3D scene builds the robot's nodes, hidden (from the event's result, given when the
+        runs were solved now). A robot is announced again after every switch of robot (the
+        page has shown what it drew ahead); meanwhile its figures stay the same (no sticky
+        axes or known E1/E2 carry over from another robot) and nothing is done again.
+
+        Only :data:`PREFETCH_ROBOTS`; any change cancels it between legs.
+        """
+
+        for robot in PREFETCH_ROBOTS:
+            state = default_state(robot)
+            if self._generation != generation or self._stopped:
+                return
+            if robot == self._state.robot:
+                continue
+            solved = all(cache_key(state, a) in self._cache for a in ALGORITHMS)
+            if solved and self._ahead_sent.get(robot) == self._robot_since:
+                continue  # (its figures stay the same while the robot on screen stays)
+            try:
+                _, amap = kinematics_and_map(state)
+                result = compute(
+                    state, generation, cancelled=lambda: self._generation != generation,
+                    cache=self._cache, with_augmenting=not expensive_map(amap),
+                    offload=self._offload,
+                )  # fmt: skip
+                # The figures as the switch will make them (see _compute; no panel to reuse
+                # from another robot).
+                cached, stale = self._known_functionals(state)
+                functionals, sens = cached or (None, None)
+                texts = self._panel_texts(
+                    result, functionals, sens, set(PANELS) - stale, remember=False
+                )
+            except (Cancelled, JikError, ValueError):
+                return
+            except Exception:  # (work ahead: logged, never shown as the current result's error)
+                log.exception("solving %s ahead failed", robot)
+                return
+            digests = {k: digest(t) for k, t in texts.items()}
+            self._ahead_sent[robot] = self._robot_since
+            head = {"type": "ahead", "generation": generation, "robot": robot,
+                    "digests": digests}  # fmt: skip
+            event = Event(
+                "ahead", generation, with_figures(head, texts), None if solved else result
+            )
+            with self._cond:
+                self._latest_ahead[robot] = event
+            self._emit(event)
+
+    def _known_functionals(self, state: DashboardState) -> tuple[tuple | None, set[str]]:
+        """E1/E2 and their sensitivity for ``state`` when known (same map, same fixed
+        variables), and the panels that wait for the second phase: the E1/E2 panel unless
+        known (the page dims it meanwhile instead of redrawing a placeholder, 20-40 ms of its
+        redraw)."""
+        cached = self._functionals_cache.get(functionals_key(state))
+        return cached, (set() if cached else {"sensitivity"})
+
+    def _panel_texts(
+        self, result: DashboardResult, functionals, sens, todo: set[str], remember: bool
+    ) -> dict[str, str]:
+        """The JSON of the panels in ``todo``, with sticky axes (keep_ranges): against the
+        layout each panel last went out with, for the same robot and task. ``remember``: these
+        panels go out now (a result, not one solved ahead)."""
+
+        layout_key = (result.state.robot, result.state.task)
+        texts = {}
+        for k, f in figure_specs(result, functionals, todo, sensitivity=sens).items():
+            shown = self._layouts.get(k)
+            keep_ranges(f, shown[1] if shown is not None and shown[0] == layout_key else None)
+            if remember:
+                self._layouts[k] = (layout_key, f["layout"])
+            texts[k] = figure_json(f)
+        return texts
+
+    def _finish(self, generation: int) -> None:
+        with self._cond:
+            self._done = max(self._done, generation)
+            self._cond.notify_all()
+
+    def _compute(self, generation: int, state: DashboardState) -> None:
+
+        started = self._changed_at.get(generation, time.perf_counter())
+        t0 = time.perf_counter()
+        last = [0.0]
+
+        def progress(fraction: float) -> None:
+            now = time.perf_counter()
+            if now - last[0] > 0.1 or fraction >= 1:
+                last[0] = now
+                self._emit(Event("progress", generation, to_json({
+                    "type": "progress", "generation": generation, "fraction": fraction,
+                    "elapsed": now - t0,
+                })))  # fmt: skip
+
+        # The h panel's box stays while it fits (augmenting_grid), for the same robot and task.
+        on_screen = self.result
+        grid_before = (
+            on_screen.augmenting
+            if on_screen is not None
+            and (on_screen.state.robot, on_screen.state.task) == (state.robot, state.task)
+            else None
+        )
+        try:
+            kin, amap = kinematics_and_map(state)
+            deferred = expensive_map(amap)
+            result = compute(
+                state, generation, progress=progress,
+                cancelled=lambda: self._generation != generation, cache=self._cache,
+                with_augmenting=not deferred, offload=self._offload, grid_before=grid_before,
+            )  # fmt: skip
+        except Cancelled:
+            return
+        except (JikError, ValueError) as exc:
+            self._emit(Event("error", generation, to_json({
+                "type": "error", "generation": generation, "message": str(exc)})))  # fmt: skip
+            self._finish(generation)
+            return
+        # Panels that do not depend on gamma are reused from the last result with the same key.
+        key = cache_key(state, "extended")
+        reuse = {k for k in gamma_free_panels(result) if (k, key) in self._figures}
+        texts = {k: self._figures[(k, key)] for k in reuse}
+        cached, stale = self._known_functionals(state)
+        todo = set(PANELS) - reuse - stale
+        functionals, sens = cached or (None, None)
+        texts.update(self._panel_texts(result, functionals, sens, todo, remember=True))
+        texts = {k: texts[k] for k in PANELS if k not in stale}
+        self._figures = {(k, key): texts[k] for k in gamma_free_panels(result)}
+        ready = time.perf_counter()
+        head = {
+            "type": "result", "generation": generation, "state": state.as_dict(),
+            "summary": summary(result), "colors": COLORS, "labels": LABELS,
+            "timing": {"compute": result.seconds, "figures": ready - t0 - result.seconds,
+                       "server_total": ready - started},
+        }  # fmt: skip
+        head["digests"] = {k: digest(t) for k, t in texts.items()}
+        head["stale"] = sorted(stale)
+        data = with_figures(head, texts)
+        with self._cond:
+            if self.result is None or self.result.state.robot != state.robot:
+                self._robot_since = generation
+            self.result, self.functionals = result, functionals
+            self._changed_at = {g: t for g, t in self._changed_at.items() if g > generation}
+        self._emit(Event("result", generation, data, result))
+        self._finish(generation)
+        # Second phase: h on a grid when it is expensive, then E1 and E2 (quadrature), unless a
+        # newer change came meanwhile. Known functionals went out with
+        # the result: their event only carries the h panel's title (a reused panel can lack it,
+        # and a page that connects now gets this event with the latest result).
+        known = bool(cached) and not deferred
+        if not known:
+            if self._generation != generation:
+                return
+        if deferred:
+            grid = augmenting_grid(kin, state, result.runs, before=grid_before)
+            if self._generation != generation:
+                return
+            result = replace(result, augmenting=grid)
+            with self._cond:
+                self.result = result
+        # E1, E2 and their sensitivity depend on what the grid does (not on gamma in
+        # continuous mode): reused.
+        if cached:
+            functionals, sens = cached
+        else:
+            functionals = error_functionals(result)
+            try:
+                sens = sensitivity(result, functionals, lambda: self._generation != generation)
+            except Cancelled:
+                return
+            self._functionals_cache = {functionals_key(state): (functionals, sens)}
+        if self._generation != generation:
+            return
+        message = {"type": "functionals", "generation": generation, "functionals": functionals,
+                   "sensitivity": sens}  # fmt: skip
+        with self._cond:
+            self.functionals = functionals
+        panels = set() if known else {"sensitivity"}
+        if deferred:  # the h panel was a placeholder: the whole figure
+            panels.add("augmenting")
+        elif functionals is not None:  # h is on screen: only its title changes (no redraw)
+            message["titles"] = {"augmenting": augmenting_title(result, functionals)}
+        specs = figure_specs(result, functionals, panels, sensitivity=sens)
+        redrawn = {k: figure_json(f) for k, f in specs.items()}
+        message["digests"] = {k: digest(t) for k, t in redrawn.items()}
+        self._emit(Event("functionals", generation, with_figures(message, redrawn)))
