@@ -1,4 +1,4 @@
-// The page's controls, built from the session's control specification (app/controls.py, sent
+// The page's controls, built from the session's control specification (app/dashboard/controls.py, sent
 // with every state): the same controls, labels, ranges and values as the 3D scene's panel. A
 // control's change is sent by its key ({"x0.1": 0.4}); the server turns it into a state change.
 import { el, fmt } from "./dom.js";
@@ -16,7 +16,8 @@ function slider(c, value, send) {
   });
   const out = el("output", {}, show(value));
   input.addEventListener("input", () => {
-    const v = c.integer ? Math.round(fromPos(+input.value)) : +fromPos(+input.value).toPrecision(4);
+    // On the specification's step (as the scene's slider), exactly: k * step, printed short.
+    const v = c.integer ? Math.round(fromPos(+input.value)) : +(Math.round(fromPos(+input.value) / c.step) * c.step).toPrecision(12);
     out.textContent = show(v);
     send(v);
   });

@@ -7,12 +7,19 @@ import { $, fmt } from "./dom.js";
 import { applyFunctionals, drawFigures, layoutPanels, markStale, onAhead } from "./panels.js";
 
 const page = { config: null, state: null, shown: 0 };
-const send = (patch) => change(patch, (message) => setStatus(message, true));
+const send = (patch) => { setNotice(""); change(patch, (message) => setStatus(message, true)); };
 
 function setStatus(text, error = false) {
   const s = $("#status-text");
   s.textContent = text;
   s.classList.toggle("error", error);
+}
+
+// A note that stays beside the status until the user's next change (a refused link's state).
+function setNotice(text) {
+  const n = $("#notice");
+  n.textContent = text;
+  n.hidden = !text;
 }
 
 // Only computations running longer than the server's progress_after get a progress bar.
@@ -92,7 +99,7 @@ function stateFromUrl() {
     const state = JSON.parse(text);
     return state && typeof state === "object" && !Array.isArray(state) ? state : {};
   } catch (err) {
-    setStatus(`the link's state is not valid JSON (${err.message}); starting from the defaults`, true);
+    setNotice(`the link's state is not valid JSON (${err.message}); showing the defaults`);
     return {};
   }
 }
@@ -122,8 +129,9 @@ async function main() {
   page.config = await fetch("/api/dashboard/config").then((r) => r.json());
   for (const [a, c] of Object.entries(page.config.colors)) document.documentElement.style.setProperty(`--${a}`, c);
   layoutPanels(page.config.panels);
+  $("#controls").addEventListener("submit", (ev) => ev.preventDefault()); // (Enter in a box)
   const opened = await openSession(stateFromUrl(),
-    (message) => setStatus(`the link's state was refused (${message}); starting from the defaults`, true));
+    (message) => setNotice(`the link's state was refused (${message}); showing the defaults`));
   $("#export-json").href = api("/export.json");
   $("#export-csv").href = api("/export.csv");
   $("#copy-link").addEventListener("click", copyLink);
