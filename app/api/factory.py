@@ -39,9 +39,11 @@ def create_app(settings: Settings | None = None, fast_solve: bool | None = None)
         if store is not None:
             store.close()
 
-    # /docs and /redoc with Swagger UI's and ReDoc's files from the fastapi-offline package: the
-    # API's documentation works on a machine without internet, and loads nothing from a CDN.
+    # /docs with Swagger UI's files from the fastapi-offline package: the API's documentation
+    # works on a machine without internet, and loads nothing from a CDN. No /redoc: ReDoc's
+    # bundle draws its side menu's logo from cdn.redoc.ly whatever its options.
     app = FastAPIOffline(
+        redoc_url=None,
         title="jik",
         version=__version__,
         summary="Repeatable Jacobian inverse kinematics: pseudoinverse vs extended Jacobian, "
