@@ -125,6 +125,10 @@ Mode = Literal["continuous", "discrete"]
 COORDINATE_BOUND = 1000.0
 Coordinate = Annotated[float, Field(ge=-COORDINATE_BOUND, le=COORDINATE_BOUND, allow_inf_nan=False)]
 Vector = Annotated[list[Coordinate], Field(min_length=1, max_length=MAX_DIMENSION)]
+#: The decay rate of eq. (5) (discrete mode: the step; below 2 there, checked with the mode).
+Gamma = Annotated[float, Field(gt=0, le=1e6, allow_inf_nan=False)]
+#: The task error at which a solve stops.
+Tolerance = Annotated[float, Field(ge=1e-14, le=1.0, allow_inf_nan=False)]
 
 
 class _Request(BaseModel):
@@ -142,16 +146,14 @@ class _Request(BaseModel):
         "default: the robot's default augmentation (ignored by the pseudoinverse)",
     )
     x0: Vector = Field(description="start configuration, length p of the robot")
-    gamma: Annotated[float, Field(gt=0, le=1e6, allow_inf_nan=False)] | None = Field(
+    gamma: Gamma | None = Field(
         None,
         description="decay rate > 0 of eq. (5) (discrete: the step, < 2); default: the robot's",
     )
     mode: Mode | None = Field(
         None, description="'continuous' (ODE) or 'discrete' (iterations); default: the robot's"
     )
-    tolerance: Annotated[float, Field(ge=1e-14, le=1.0, allow_inf_nan=False)] = Field(
-        1e-10, description="stop when ||k(x) - target|| < tolerance"
-    )
+    tolerance: Tolerance = Field(1e-10, description="stop when ||k(x) - target|| < tolerance")
     max_iterations: Annotated[int, Field(ge=1, le=MAX_ITERATIONS)] | None = Field(
         None,
         description="cap on integrator steps (continuous) or iterations (discrete) per solve",

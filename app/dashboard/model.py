@@ -9,18 +9,25 @@ say what a run depends on (gamma only rescales theta in continuous mode, see
 
 from __future__ import annotations
 
-import contextlib
 import json
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from typing import Annotated, Any, Literal
 
-import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from jik.app.dashboard.controls import MAX_DASHBOARD_CYCLES, MODES, expand
+from jik.app.compute.schemas import (
+    AUGMENTATION_MODELS,
+    MAX_DIMENSION,
+    ROBOT_MODELS,
+    Coordinate,
+    Gamma,
+    Mode,
+    Tolerance,
+)
+from jik.app.dashboard.controls import MAX_DASHBOARD_CYCLES, expand
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS, robot_spec
 from jik.engine.repeatability import MAX_PATH_POINTS
-from jik.engine.validation import count, positive
 
 ALGORITHMS = ("pseudoinverse", "extended")
 #: One colour per algorithm, used in the scene and in every plot.
@@ -28,42 +35,36 @@ COLORS = {"pseudoinverse": "#d62728", "extended": "#1f77b4"}
 LABELS = {"pseudoinverse": "pseudoinverse J^P# (8)", "extended": "extended Jacobian J^E# (11)"}
 DEFAULT_ROBOT = "manipulator2"
 
+Point = Annotated[tuple[Coordinate, ...], Field(min_length=1, max_length=MAX_DIMENSION)]
 
-@dataclass(frozen=True)
-class DashboardState:
-    """Every control of the dashboard (JSON-friendly)."""
+
+class DashboardState(BaseModel):
+    """Every control of the dashboard, with the types and bounds of a REST request's fields
+    (:mod:`jik.app.compute.schemas`: the same ``gamma``, ``mode``, ``tolerance``, coordinates
+    and path); the robot's and the map's parameters are checked by the same per-robot and
+    per-map models as a request's ``robot`` and ``augmentation``.
+
+    ``task``: "path", the closed path driven ``cycles`` times; "target", one solve.
+    """
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
 
     robot: str
-    robot_parameters: dict
+    robot_parameters: dict[str, Any]
     augmentation: str
-    augmentation_parameters: dict
-    gamma: float
-    mode: str
-    x0: tuple[float, ...]
-    task: str  # "path": closed path driven ``cycles`` times; "target": one solve
-    target: tuple[float, ...]
-    path: tuple[tuple[float, ...], ...]
-    cycles: int
-    tolerance: float = 1e-10
+    augmentation_parameters: dict[str, Any]
+    gamma: Gamma
+    mode: Mode
+    x0: Point
+    task: Literal["path", "target"]
+    target: Point
+    path: Annotated[tuple[Point, ...], Field(max_length=MAX_PATH_POINTS)]
+    cycles: Annotated[int, Field(ge=1, le=MAX_DASHBOARD_CYCLES)]
+    tolerance: Tolerance = 1e-10
 
     def as_dict(self) -> dict:
-        return {
-            "robot": self.robot,
-            "robot_parameters": {
-                k: list(v) if isinstance(v, tuple | list) else v
-                for k, v in self.robot_parameters.items()
-            },
-            "augmentation": self.augmentation,
-            "augmentation_parameters": dict(self.augmentation_parameters),
-            "gamma": self.gamma,
-            "mode": self.mode,
-            "x0": list(self.x0),
-            "task": self.task,
-            "target": list(self.target),
-            "path": [list(p) for p in self.path],
-            "cycles": self.cycles,
-            "tolerance": self.tolerance,
-        }
+        """The state as JSON data (tuples as lists)."""
+        return self.model_dump(mode="json")
 
 
 def default_state(robot: str = DEFAULT_ROBOT) -> DashboardState:
@@ -90,7 +91,7 @@ def default_state(robot: str = DEFAULT_ROBOT) -> DashboardState:
 
 
 def updated_state(state: DashboardState, patch: Mapping[str, object]) -> DashboardState:
-    """Apply a partial change and validate the result against the registry.
+    """Apply a partial change and validate the result (:func:`validate`).
 
     ``patch`` is keyed by state fields or by control keys (:func:`.controls.expand`:
     ``{"x0.1": 0.4}``, ``{"path": "1, 1; 1, 2"}``). Changing ``robot`` starts from that robot's
@@ -100,124 +101,90 @@ def updated_state(state: DashboardState, patch: Mapping[str, object]) -> Dashboa
     Raises
     ------
     InvalidInputError
-        Unknown keys, or any value the registry or the engine rejects; its ``field`` names the
-        field (a dotted path).
+        An unknown field, or a value the models, the registry or the engine refuse; its
+        ``field`` names the field (a dotted path).
     """
     patch = expand(state, patch)
-    known = set(DashboardState.__dataclass_fields__)
-    unknown = set(patch) - known
-    if unknown:
-        raise InvalidInputError(
-            f"unknown dashboard field(s) {sorted(unknown)}; known: {sorted(known)}",
-            sorted(unknown)[0],
-        )
-    if "robot" in patch and patch["robot"] != state.robot:
-        if not isinstance(patch["robot"], str) or patch["robot"] not in ROBOTS:
+    data = state.as_dict()
+    robot = patch.get("robot", state.robot)
+    if robot != state.robot:
+        if not isinstance(robot, str) or robot not in ROBOTS:
             raise InvalidInputError(
-                f"unknown robot {patch['robot']!r}; choose one of {sorted(ROBOTS)}", "robot"
+                f"robot: unknown robot {robot!r}; choose one of {sorted(ROBOTS)}", "robot"
             )
-        state = default_state(str(patch["robot"]))
-    if "augmentation" in patch and patch["augmentation"] != state.augmentation:
-        with _field("augmentation"):
-            aug = robot_spec(state.robot).augmentation(str(patch["augmentation"]))
-        state = replace(
-            state,
-            augmentation=aug.name,
-            augmentation_parameters={p.name: p.default for p in aug.parameters},
-        )
-    values: dict = {}
+        data = default_state(robot).as_dict()
+    if "augmentation" in patch and patch["augmentation"] != data["augmentation"]:
+        aug = _registered(lambda: robot_spec(robot).augmentation(str(patch["augmentation"])),
+                          "augmentation")  # fmt: skip
+        data["augmentation"] = aug.name
+        data["augmentation_parameters"] = {p.name: p.default for p in aug.parameters}
     for key, value in patch.items():
         if key in ("robot", "augmentation"):
             continue
         if key in ("robot_parameters", "augmentation_parameters"):
             if not isinstance(value, Mapping):
-                raise InvalidInputError(f"{key} must be an object of parameters", key)
-            value = {**getattr(state, key), **dict(value)}
-        values[key] = value
-    return validate(replace(state, **values))
+                raise InvalidInputError(f"{key}: give an object of parameters", key)
+            value = {**data[key], **value}
+        data[key] = value
+    return validate(data)
 
 
-@contextlib.contextmanager
-def _field(name: str):
-    """Name ``name`` as the field of an :class:`InvalidInputError` raised within that names
-    none (the registry's and the engine's validators name it only in their message)."""
+def validate(data: Mapping[str, Any]) -> DashboardState:
+    """A state from ``data``, checked as a REST request is: the model's types and bounds, the
+    robot's and the map's parameters by their request models, then what needs the robot (its
+    kinematics built, vector lengths p and r, gamma < 2 in discrete mode).
+
+    Raises
+    ------
+    InvalidInputError
+        With the first refused field as ``field`` and the message starting with it.
+    """
+    state = _model(DashboardState, data, ())
+    spec = _registered(lambda: robot_spec(state.robot), "robot")
+    params = _model(ROBOT_MODELS[spec.name], {**state.robot_parameters, "name": spec.name},
+                    ("robot_parameters",)).model_dump(exclude={"name"})  # fmt: skip
+    aug = _registered(lambda: spec.augmentation(state.augmentation), "augmentation")
+    aug_params = _model(AUGMENTATION_MODELS[aug.name],
+                        {**state.augmentation_parameters, "name": aug.name},
+                        ("augmentation_parameters",)).model_dump(exclude={"name"})  # fmt: skip
+    kin = _registered(lambda: spec.build(**params), "robot_parameters")
+    _registered(lambda: kin.check(state.x0, "x0"), "x0")
+    _registered(lambda: kin.check_task(state.target, "target"), "target")
+    if state.path:
+        _registered(lambda: kin.check_task(state.path, "path"), "path")
+    elif state.task == "path":
+        raise InvalidInputError("path: a closed-path task needs at least one path point", "path")
+    if state.mode == "discrete" and state.gamma >= 2:
+        raise InvalidInputError(
+            f"gamma: must be < 2 in discrete mode, got {state.gamma:g}", "gamma"
+        )
+    return state.model_copy(update={
+        "robot_parameters": {k: tuple(v) if isinstance(v, list | tuple) else v
+                             for k, v in params.items()},
+        "augmentation_parameters": aug_params,
+    })  # fmt: skip
+
+
+def _model(model: type[BaseModel], data: Mapping[str, Any], prefix: tuple[str, ...]) -> Any:
+    """``model`` validating ``data``; its first error as an :class:`InvalidInputError` naming
+    the field (``prefix`` and the error's location, dotted)."""
     try:
-        yield
+        return model.model_validate(data)
+    except ValidationError as exc:
+        error = exc.errors()[0]
+        loc = (*prefix, *(str(p) for p in error["loc"]))
+        name = ".".join(loc) or "state"
+        msg = "unknown field; remove it" if error["type"] == "extra_forbidden" else error["msg"]
+        raise InvalidInputError(f"{name}: {msg}", name) from None
+
+
+def _registered(check, name: str):
+    """``check()``; an engine's or the registry's refusal as a refusal of field ``name``."""
+    try:
+        return check()
     except InvalidInputError as exc:
-        if exc.field is None:
-            exc.field = name
-        raise
-    except (TypeError, ValueError) as exc:  # a value of the wrong type (a list for a number)
-        raise InvalidInputError(f"{name}: {exc}", name) from None
-
-
-def validate(state: DashboardState) -> DashboardState:
-    """Check every field through the registry and the engine's validators; normalise types.
-    Each error names its field (:attr:`InvalidInputError.field`)."""
-    spec = robot_spec(state.robot)
-    given, given_aug = state.robot_parameters, state.augmentation_parameters
-    scalars, vectors = {}, {}
-    for p in spec.parameters:
-        with _field(f"robot_parameters.{p.name}"):
-            scalars[p.name] = p.check(given.get(p.name, p.default))
-    for v in spec.vector_parameters:
-        with _field(f"robot_parameters.{v.name}"):
-            vectors[v.name] = v.check(given.get(v.name, v.default))
-    unknown = set(given) - set(scalars) - set(vectors)
-    if unknown:
-        name = sorted(unknown)[0]
-        raise InvalidInputError(f"{spec.name} has no parameter {name!r}",
-                                f"robot_parameters.{name}")  # fmt: skip
-    with _field("robot_parameters"):
-        kin = spec.build(**scalars, **vectors)
-    with _field("augmentation"):
-        aug = spec.augmentation(state.augmentation)
-    aug_params = {}
-    for p in aug.parameters:
-        with _field(f"augmentation_parameters.{p.name}"):
-            aug_params[p.name] = p.check(given_aug.get(p.name, p.default))
-    with _field("x0"):
-        x0 = kin.check(state.x0, "x0")
-        if x0.ndim != 1:
-            raise InvalidInputError(f"x0 must be one configuration of length {kin.p}")
-    with _field("target"):
-        target = kin.check_task(state.target, "target")
-        if target.ndim != 1:
-            raise InvalidInputError(f"target must be one task point of length {kin.r}")
-    if state.task not in ("path", "target"):
-        raise InvalidInputError(f"task must be 'path' or 'target', got {state.task!r}", "task")
-    with _field("path"):
-        path = kin.check_task(state.path, "path") if len(state.path) else np.zeros((0, kin.r))
-        if state.task == "path" and (path.ndim != 2 or len(path) < 1):
-            raise InvalidInputError("a closed-path task needs at least one path point")
-        if len(path) > MAX_PATH_POINTS:
-            raise InvalidInputError(
-                f"path has {len(path)} points; at most {MAX_PATH_POINTS} allowed"
-            )
-    if state.mode not in MODES:
-        raise InvalidInputError(f"mode must be one of {list(MODES)}, got {state.mode!r}", "mode")
-    with _field("gamma"):
-        gamma = positive(state.gamma, "gamma")
-        if state.mode == "discrete" and gamma >= 2:
-            raise InvalidInputError(f"gamma must be < 2 in discrete mode, got {gamma:g}")
-    with _field("cycles"):
-        cycles = count(state.cycles, "cycles", 1, MAX_DASHBOARD_CYCLES)
-    with _field("tolerance"):
-        tolerance = positive(state.tolerance, "tolerance")
-    return DashboardState(
-        robot=spec.name,
-        robot_parameters={**scalars, **vectors},
-        augmentation=aug.name,
-        augmentation_parameters=aug_params,
-        gamma=gamma,
-        mode=state.mode,
-        x0=tuple(float(v) for v in x0),
-        task=state.task,
-        target=tuple(float(v) for v in target),
-        path=tuple(tuple(float(v) for v in p) for p in path),
-        cycles=cycles,
-        tolerance=tolerance,
-    )
+        raise InvalidInputError(f"{name}: {exc}" if not str(exc).startswith(name) else str(exc),
+                                exc.field or name) from None  # fmt: skip
 
 
 def cache_key(state: DashboardState, algorithm: str) -> str:

@@ -39,7 +39,7 @@ def other_cycles(cache: dict, state: DashboardState, algorithm: str, legs: int):
         return None
     found = {}
     for c in range(1, MAX_DASHBOARD_CYCLES + 1):
-        run = cache.get(cache_key(replace(state, cycles=c), algorithm))
+        run = cache.get(cache_key(state.model_copy(update={"cycles": c}), algorithm))
         if c != state.cycles and run is not None and run.success and run.platform is None:
             found[c] = run
     more = [c for c in found if c > state.cycles]

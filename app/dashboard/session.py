@@ -83,7 +83,7 @@ class Dashboard:
     ) -> None:
         self._cond = threading.Condition()
         self._offload = offload.lane() if offload is not None else None
-        self._state = validate(state or default_state())
+        self._state = validate((state or default_state()).as_dict())
         self._generation = 1
         self._done = 0  # last generation whose computation finished (or failed)
         self._debounce = debounce

@@ -97,6 +97,8 @@ def test_control_keys_expand_into_state_fields():
         ({"mode": "discrete", "gamma": 3}, "gamma"),
         ({"robot": 7}, "robot"),
         ({"nonsense": 1}, "nonsense"),
+        ({"x0": [1e300, 0.0, 1.0]}, "x0.0"),  # (the API's coordinate bound)
+        ({"tolerance": 0}, "tolerance"),
     ],
 )
 def test_refusals_carry_their_field(patch, field):
@@ -125,3 +127,26 @@ def test_the_scene_and_the_page_show_the_same_controls():
     finally:
         scene.stop()
         dashboard.stop()
+
+
+@pytest.mark.parametrize(
+    ("rest", "dashboard", "field"),
+    [
+        ({"gamma": -1}, {"gamma": -1}, "gamma"),
+        ({"tolerance": 2.0}, {"tolerance": 2.0}, "tolerance"),
+        ({"x0": [1e300, 0.0, 1.0]}, {"x0": [1e300, 0.0, 1.0]}, "x0"),
+        ({"robot": {"name": "manipulator2", "l": 99}}, {"robot_parameters.l": 99}, "l"),
+    ],
+)
+def test_a_dashboard_change_is_refused_as_a_rest_request_is(rest, dashboard, field):
+    """The same pydantic field types and per-robot models check both: the same problem."""
+    from jik.app.compute.schemas import SolveRequest
+
+    body = {"robot": {"name": "manipulator2"}, "algorithm": "pseudoinverse",
+            "x0": [0.0, 0.0, 1.0], "target": [1.0, 1.0], **rest}  # fmt: skip
+    with pytest.raises(Exception) as api:
+        SolveRequest.model_validate(body)
+    with pytest.raises(InvalidInputError) as ours:
+        updated_state(default_state("manipulator2"), dashboard)
+    problem = api.value.errors()[0]["msg"]
+    assert str(ours.value).endswith(problem) and field in ours.value.field

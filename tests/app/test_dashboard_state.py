@@ -57,13 +57,13 @@ def test_parameters_merge_and_augmentation_resets_its_parameters():
 @pytest.mark.parametrize(
     ("patch", "message"),
     [
-        ({"gamma": 0}, "gamma must be > 0"),
-        ({"mode": "discrete", "gamma": 2.5}, "gamma must be < 2 in discrete mode"),
+        ({"gamma": 0}, "gamma: Input should be greater than 0"),
+        ({"mode": "discrete", "gamma": 2.5}, "gamma: must be < 2 in discrete mode"),
         ({"x0": [1, 2]}, "x0 must have shape"),
         ({"cycles": 0}, "cycles"),
-        ({"robot_parameters": {"l": 99}}, "l must be in [0.1, 5]"),
+        ({"robot_parameters": {"l": 99}}, "robot_parameters.l: Input should be less than or"),
         ({"augmentation": "nope"}, "unknown augmentation 'nope'"),
-        ({"speed": 1}, "unknown dashboard field(s) ['speed']"),
+        ({"speed": 1}, "speed: unknown field; remove it"),
         ({"robot": "r2d2"}, "unknown robot 'r2d2'"),
     ],
 )
