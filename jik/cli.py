@@ -75,7 +75,7 @@ def serve(args: argparse.Namespace) -> int:
     except ModuleNotFoundError as error:
         return missing_app_extra(error)
     try:
-        run_server(host=args.host, port=args.port)
+        run_server(host=args.host, port=args.port, allowed_hosts=tuple(args.allowed_host))
     except PortInUse as busy:
         sys.stderr.write(f"jik serve: {busy}\n")
         return 2
@@ -103,6 +103,11 @@ def main(argv: list[str] | None = None) -> int:
     p = sub.add_parser("serve", help="start the REST API and the dashboard")
     p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
     p.add_argument("--port", type=int, default=8000, help="HTTP port of the API, page and scene")
+    p.add_argument(
+        "--allowed-host", action="append", default=[], metavar="NAME",
+        help="a host name the server answers to besides localhost, 127.0.0.1 and [::1] (repeat it; "
+        "also JIK_ALLOWED_HOSTS, comma-separated; '*' for any)",
+    )  # fmt: skip
     p.set_defaults(func=serve)
 
     p = sub.add_parser("reproduce", help="recompute a result of the paper")

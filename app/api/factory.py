@@ -15,6 +15,7 @@ from jik import __version__
 from jik.app.api.errors import BodyLimit, add_error_handlers
 from jik.app.api.fastpath import SolveFastPath
 from jik.app.api.routes import dashboard, health, repeatability, robots, sessions, solve, synthesize
+from jik.app.api.security import SecurityMiddleware, allowed_hosts_from_env
 from jik.app.compute.pool import ComputePool
 from jik.app.compute.settings import Settings, env_flag
 
@@ -22,10 +23,15 @@ from jik.app.compute.settings import Settings, env_flag
 MAX_BODY_BYTES = 1 << 20
 
 
-def create_app(settings: Settings | None = None, fast_solve: bool | None = None) -> FastAPI:
+def create_app(
+    settings: Settings | None = None,
+    fast_solve: bool | None = None,
+    allowed_hosts: tuple[str, ...] | None = None,
+) -> FastAPI:
     """The jik REST API. ``settings`` (default: from the environment) sizes the compute pool;
     ``fast_solve`` serves well-formed /solve requests on a short path (:mod:`jik.app.api.fastpath`;
-    default on, ``JIK_FAST_SOLVE=0`` turns it off)."""
+    default on, ``JIK_FAST_SOLVE=0`` turns it off); ``allowed_hosts``: the host names it answers
+    to besides the loopback names (default: ``JIK_ALLOWED_HOSTS``, :mod:`jik.app.api.security`)."""
     if fast_solve is None:
         fast_solve = env_flag("JIK_FAST_SOLVE")
     pool = ComputePool(settings)
@@ -59,5 +65,8 @@ def create_app(settings: Settings | None = None, fast_solve: bool | None = None)
     app.include_router(sessions.router)
     if fast_solve:
         app.add_middleware(SolveFastPath, pool=pool)
-    app.add_middleware(BodyLimit, limit=MAX_BODY_BYTES)  # outermost: before any body is read
+    app.add_middleware(BodyLimit, limit=MAX_BODY_BYTES)  # before any body is read
+    # Outermost: hosts, origins and content types are checked before anything else runs.
+    hosts = allowed_hosts_from_env(allowed_hosts or ())
+    app.add_middleware(SecurityMiddleware, allowed_hosts=hosts)
     return app

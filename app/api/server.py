@@ -46,7 +46,9 @@ def _stopped(signum: int, frame: object) -> None:
     """The signal that uvicorn raises again after its graceful shutdown: nothing more to do."""
 
 
-def run_server(host: str = "127.0.0.1", port: int = 8000) -> None:
+def run_server(
+    host: str = "127.0.0.1", port: int = 8000, allowed_hosts: tuple[str, ...] = ()
+) -> None:
     """Serve the API and the dashboard on ``host:port`` until interrupted (SIGINT or SIGTERM).
 
     Parameters
@@ -55,6 +57,8 @@ def run_server(host: str = "127.0.0.1", port: int = 8000) -> None:
         Address to bind; 127.0.0.1 by default (use 0.0.0.0 in a container).
     port : int
         HTTP port of the API (OpenAPI docs at /docs), the page and its scenes.
+    allowed_hosts : tuple of str
+        Host names the server answers to besides the loopback names and ``JIK_ALLOWED_HOSTS``.
 
     Raises
     ------
@@ -62,7 +66,7 @@ def run_server(host: str = "127.0.0.1", port: int = 8000) -> None:
         If the port is taken, before anything is started.
     """
     sock = bind(host, port, "--port")
-    app = create_app()
+    app = create_app(allowed_hosts=allowed_hosts)
     # The sessions' second processes (JIK_DASHBOARD_WORKERS, default 1) start with the store.
     app.state.sessions = SessionStore(SessionLimits.from_env(), scene_factory=start_scene)
     # uvicorn shuts down gracefully on SIGINT and SIGTERM (the lifespan stops the sessions and

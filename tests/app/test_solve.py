@@ -89,7 +89,7 @@ def test_gamma_only_rescales_theta(api):
 
 async def _concurrent(app, bodies):
     transport = httpx.ASGITransport(app=app)
-    async with httpx.AsyncClient(transport=transport, base_url="http://test") as client:
+    async with httpx.AsyncClient(transport=transport, base_url="http://127.0.0.1") as client:
         return await asyncio.gather(*(client.post("/solve", json=b) for b in bodies))
 
 

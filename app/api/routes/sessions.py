@@ -12,7 +12,6 @@ from __future__ import annotations
 import asyncio
 import contextlib
 from typing import Any
-from urllib.parse import urlsplit
 
 import websockets
 import websockets.asyncio.client
@@ -230,22 +229,11 @@ async def export_result_csv(session_id: str, store: Store):
     )
 
 
-def same_origin(headers) -> bool:
-    """Whether a request's ``Origin`` (if any) names the host it was sent to: a page of another
-    site may open a websocket to us (browsers do not stop it), and must not drive a session."""
-    origin = headers.get("origin")
-    if origin is None:
-        return True  # not a browser page (curl, a test client)
-    return urlsplit(origin).netloc == headers.get("host", "")
-
-
 @router.websocket("/api/sessions/{session_id}/scene")
 async def scene_socket(websocket: WebSocket, session_id: str) -> None:
     """The session's 3D scene: the viser client's websocket, relayed to the session's viser
-    server (loopback only). Closes with 4403 for another origin, 4404 for no such session."""
-    if not same_origin(websocket.headers):
-        await websocket.close(code=4403)
-        return
+    server (loopback only). Closes with 4404 for no such session (another origin or host never
+    gets here: :mod:`jik.app.api.security`)."""
     store = getattr(websocket.app.state, "sessions", None)
     try:
         session = store.get(session_id) if store is not None else None

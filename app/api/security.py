@@ -1,0 +1,154 @@
+"""Who may talk to the server: allowed hosts, same-origin changes, JSON bodies, safe headers.
+
+One ASGI middleware, outermost, in front of every route, the fast path and the scene's
+websocket relay (docs/security.md has the threat model):
+
+- **Host.** A request whose ``Host`` names no allowed host is refused (HTTP 400, a websocket is
+  closed with 4400): a page of another site that rebinds its DNS name to 127.0.0.1 reaches the
+  server under its own name and is stopped here. Allowed by default: ``localhost``,
+  ``127.0.0.1`` and ``[::1]``, on any port; more with ``JIK_ALLOWED_HOSTS`` (comma-separated,
+  ``*`` for any) or ``jik serve --allowed-host``.
+- **Origin.** A browser sends ``Origin`` with every cross-site POST, DELETE and websocket: one
+  that does not name the host the request was sent to is refused (403; a websocket closed with
+  4403). Requests without ``Origin`` (curl, scripts) are not browsers' and pass.
+- **Content type.** A POST or PUT body must be JSON (``application/json``), else 415: a form or
+  ``text/plain`` post from another site (which browsers send without asking) is never parsed.
+- **Headers.** Every response says ``X-Content-Type-Options: nosniff``, ``Referrer-Policy:
+  no-referrer``, and a ``Content-Security-Policy`` with ``frame-ancestors 'self'`` (with
+  ``X-Frame-Options: SAMEORIGIN``): only our own page may frame the dashboard and its scene.
+  The page and the API load scripts from this server only; the scene's page (viser's client, one
+  file with an inline packed script) also runs inline scripts and workers from ``blob:``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Iterable
+from urllib.parse import urlsplit
+
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+#: Host names allowed by default: the loopback names.
+LOOPBACK_HOSTS = ("localhost", "127.0.0.1", "[::1]", "::1")
+#: Methods that change something, whose body must be JSON and whose origin must be ours.
+CHANGES = frozenset({"POST", "PUT", "PATCH", "DELETE"})
+_BODIES = frozenset({"POST", "PUT", "PATCH"})
+_PAGE_POLICY = (
+    "default-src 'self'; script-src 'self'; style-src 'self' 'unsafe-inline'; "
+    "img-src 'self' data: blob:; connect-src 'self'; worker-src 'self' blob:; "
+    "frame-src 'self'; frame-ancestors 'self'; base-uri 'none'; form-action 'none'; "
+    "object-src 'none'"
+)
+# viser's client: one HTML file whose packed bundle is an inline script that unpacks itself
+# (eval of its own code), with workers and textures from blob: URLs and its websocket to us.
+_SCENE_POLICY = (
+    "default-src 'self'; script-src 'self' 'unsafe-inline' 'unsafe-eval' blob:; "
+    "style-src 'self' 'unsafe-inline'; img-src 'self' data: blob:; font-src 'self' data:; "
+    "connect-src 'self' data: blob:; worker-src 'self' blob:; frame-ancestors 'self'; "
+    "base-uri 'none'; form-action 'none'; object-src 'none'"
+)
+# The API's documentation pages (Swagger UI, ReDoc): their bootstrap is an inline script.
+_DOCS_POLICY = _SCENE_POLICY
+
+
+def allowed_hosts_from_env(extra: Iterable[str] = ()) -> tuple[str, ...]:
+    """The loopback names, ``JIK_ALLOWED_HOSTS`` (comma-separated) and ``extra``."""
+    env = [h.strip() for h in os.environ.get("JIK_ALLOWED_HOSTS", "").split(",") if h.strip()]
+    return (*LOOPBACK_HOSTS, *env, *extra)
+
+
+def _host_name(host: str) -> str:
+    """``example.org:8000`` -> ``example.org``; ``[::1]:8000`` -> ``[::1]``."""
+    if host.startswith("["):
+        return host[: host.find("]") + 1] if "]" in host else host
+    return host.rsplit(":", 1)[0] if host.count(":") == 1 else host
+
+
+def _policy(path: str) -> str:
+    if path.startswith("/scene/"):
+        return _SCENE_POLICY
+    if path == "/docs" or path.startswith("/static-offline-docs"):
+        return _DOCS_POLICY
+    return _PAGE_POLICY
+
+
+class SecurityMiddleware:
+    """See the module's docstring. ``allowed_hosts``: host names (no port), ``*`` for any."""
+
+    def __init__(self, app: ASGIApp, allowed_hosts: Iterable[str] = LOOPBACK_HOSTS) -> None:
+        self.app = app
+        hosts = {h.lower() for h in allowed_hosts}
+        self.any_host = "*" in hosts
+        self.hosts = frozenset(hosts)
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] not in ("http", "websocket"):
+            await self.app(scope, receive, send)
+            return
+        headers = {k.decode("latin-1").lower(): v.decode("latin-1") for k, v in scope["headers"]}
+        host = headers.get("host", "")
+        websocket = scope["type"] == "websocket"
+        refusal = self._refusal(scope, headers, host, websocket)
+        if refusal is not None:
+            status, message = refusal
+            if websocket:
+                await send({"type": "websocket.close", "code": 4000 + status, "reason": message})
+                return
+            await _json(send, status, message)
+            return
+        if websocket:
+            await self.app(scope, receive, send)
+            return
+        policy = _policy(scope.get("path", "")).encode()
+
+        async def secured(message: Message) -> None:
+            if message["type"] == "http.response.start":
+                extra = [
+                    (b"x-content-type-options", b"nosniff"),
+                    (b"referrer-policy", b"no-referrer"),
+                    (b"x-frame-options", b"SAMEORIGIN"),
+                    (b"content-security-policy", policy),
+                ]
+                message["headers"] = [*message.get("headers", []), *extra]
+            await send(message)
+
+        await self.app(scope, receive, secured)
+
+    def _refusal(self, scope: Scope, headers: dict, host: str, websocket: bool):
+        """(status, message) of a refused request, or None."""
+        if not self.any_host and _host_name(host).lower() not in self.hosts:
+            return 400, (
+                f"host {host!r} is not allowed: the server answers to {sorted(self.hosts)} "
+                "(add names with JIK_ALLOWED_HOSTS or jik serve --allowed-host)"
+            )
+        method = scope.get("method", "GET")
+        origin = headers.get("origin")
+        if (websocket or method in CHANGES) and origin is not None:
+            if origin == "null" or urlsplit(origin).netloc.lower() != host.lower():
+                return 403, f"a request from another origin ({origin}) may not change anything"
+        if method in _BODIES:
+            kind = headers.get("content-type", "").split(";")[0].strip().lower()
+            if kind != "application/json" and not kind.endswith("+json"):
+                return 415, (
+                    f"content-type: the body must be JSON (application/json), got "
+                    f"{kind or 'none'!r}"
+                )
+        return None
+
+
+async def _json(send: Send, status: int, message: str) -> None:
+    body: dict[str, object]
+    if status == 415:
+        body = {"detail": [{"loc": ["header", "content-type"], "msg": message,
+                            "type": "unsupported_media_type"}]}  # fmt: skip
+    else:
+        body = {"detail": message}
+    data = json.dumps(body).encode()
+    await send({
+        "type": "http.response.start", "status": status,
+        "headers": [(b"content-type", b"application/json"),
+                    (b"content-length", str(len(data)).encode()),
+                    (b"x-content-type-options", b"nosniff")],
+    })  # fmt: skip
+    await send({"type": "http.response.body", "body": data})
