@@ -22,6 +22,7 @@ def test_swagger_ui_renders_offline(tabs):
 def test_redoc_is_not_served(tabs):
     """ReDoc's bundle draws its side menu's logo from cdn.redoc.ly whatever its options, so the
     server does not offer /redoc: /docs is the API's documentation."""
+    tabs.allow_console(r"^Failed to load resource: .* status of 404")  # (this page's own)
     page = tabs.new_page(tabs.context())
     response = page.goto(f"{tabs.base}/redoc")
     assert response is not None and response.status == 404

@@ -1,0 +1,85 @@
+"""The page's controls and the 3D scene's GUI are two views of one session: a change made in
+either shows in both, and a refused value leaves both showing the value in force."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
+pytestmark = pytest.mark.browser
+
+REFUSED_PATH = "path must be written 'y1, y2; y1, y2; ...', got"
+
+
+def test_a_refused_value_shows_in_both_with_the_value_in_force(tabs):
+    """An unreadable closed path typed on the page, then in the scene, is refused: the page's
+    status and the scene's status say so, and the page's box, the scene's box and the server
+    keep the path in force."""
+    tabs.allow_console(r"status of 422")  # the page's POST of the refused value
+    tab = tabs.open()
+    tab.wait_scene_drawn(1)
+    in_force = tab.controls()["ctl-path"]
+    assert in_force == "1, 1; 1, 2; 0, 2; 0, 1"
+    assert tab.scene_control("closed path")["value"] == in_force
+    generation = tab.snapshot()["generation"]
+    status = tab.page.locator("#status-text")
+
+    path = tab.page.locator("#ctl-path")
+    path.fill("1, x")
+    response = tab.posting(lambda: path.dispatch_event("change"))
+    assert response.status == 422
+    expect(status).to_have_text(f"refused (here): {REFUSED_PATH} '1, x'")
+    expect(status).to_have_class(re.compile(r"\berror\b"))
+    tab.wait_scene_text(f"refused: {REFUSED_PATH} '1, x'")
+    expect(path).to_have_value(in_force)
+    assert tab.scene_control("closed path")["value"] == in_force
+
+    tab.scene_input("closed path").fill("2, y")
+    expect(status).to_have_text(f"refused (in the 3D scene): {REFUSED_PATH} '2, y'")
+    tab.wait_scene_text(f"refused: {REFUSED_PATH} '2, y'")
+    assert tab.scene_control("closed path", like=in_force)["value"] == in_force
+    expect(path).to_have_value(in_force)
+
+    snapshot = tab.snapshot()
+    assert snapshot["generation"] == generation
+    assert snapshot["state"]["path"] == [[1, 1], [1, 2], [0, 2], [0, 1]]
+    assert tab.url_state()["path"] == snapshot["state"]["path"]
+
+
+def test_page_and_scene_show_the_same_values(tabs):
+    """gamma and x1 of the start set on the page show in the scene's sliders; cycles pressed
+    on the scene's slider show on the page's."""
+    tab = tabs.open()
+    tab.wait_scene_drawn(1)
+
+    before = tab.scene_control("γ (decay rate)")["value"]
+    tab.set_slider("#ctl-gamma", 0.30103)  # log10(2), snapped to the slider's step
+    gamma = tab.snapshot()["state"]["gamma"]
+    page_output = tab.page.locator("label", has=tab.page.locator("#ctl-gamma")).locator("output")
+    expect(page_output).to_have_text(f"{gamma:.3f}")
+    scene = tab.scene_control("γ (decay rate)", unlike=before)
+    assert float(scene["value"]) == pytest.approx(gamma, abs=1e-9)
+    # The page's log-scale slider sends 4 significant digits (here 1.972); the scene's number
+    # box shows the 2 decimals of its step (0.01).
+    assert float(scene["shown"]) == pytest.approx(gamma, abs=0.005)
+
+    before = tab.scene_control("x0: x1")["value"]
+    tab.set_slider("#ctl-x0-0", 0.45)
+    x1 = tab.snapshot()["state"]["x0"][0]
+    assert x1 == pytest.approx(0.45, abs=1e-12)
+    scene = tab.scene_control("x0: x1", unlike=before)
+    assert float(scene["value"]) == pytest.approx(x1, abs=1e-9)
+    assert scene["shown"] == "0.45"
+
+    cycles = tab.snapshot()["state"]["cycles"]
+    tab.press_scene_slider("cycles", 0.5)
+    changed = tab.wait_settled(lambda s: s["state"]["cycles"] != cycles, "cycles changed, drawn")
+    cycles = changed["state"]["cycles"]
+    assert 8 <= cycles <= 12  # the middle of 1..20
+    expect(tab.page.locator("#ctl-cycles")).to_have_value(str(cycles))
+    label = tab.page.locator("label", has=tab.page.locator("#ctl-cycles"))
+    expect(label.locator("output")).to_have_text(str(cycles))
+    scene = tab.scene_control("cycles")
+    assert scene["value"] == scene["shown"] == str(cycles)

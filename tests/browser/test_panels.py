@@ -1,0 +1,83 @@
+"""The page's panels: every panel of the configuration drawn, saved as PNG, the session's data
+exported, and a long computation (the unicycle) shown on its way."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+
+expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
+pytestmark = pytest.mark.browser
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def test_every_panel_is_drawn_and_saves_as_png(tabs, config):
+    """Each panel that /api/dashboard/config lists is drawn (plotly's SVG, or an HTML table for
+    the table), and a panel's PNG button downloads jik-<panel>.png."""
+    tab = tabs.open()
+    panels = [p["id"] for p in config["panels"]]
+    assert "table" in panels and len(panels) > 1
+    for panel in panels:
+        drawn = "table tbody tr" if panel == "table" else ".main-svg"
+        expect(tab.page.locator(f"#plot-{panel} {drawn}").first).to_be_visible()
+
+    with tab.page.expect_download() as saved:
+        tab.page.locator("#plot-task .panel-tools button", has_text="PNG").click()
+    assert saved.value.suggested_filename == "jik-task.png"
+    assert Path(saved.value.path()).read_bytes()[:8] == PNG_SIGNATURE
+
+
+def test_exports_download_the_sessions_data(tabs):
+    """The footer's export links download this session's result: CSV, one row per point of
+    either run, and JSON, with the session's state and drifts."""
+    tab = tabs.open()
+    tab.set_slider("#ctl-cycles", 2)
+    snapshot = tab.snapshot()
+    summary = snapshot["summary"]
+
+    with tab.page.expect_download() as saved:
+        tab.page.click("#export-csv")
+    assert saved.value.suggested_filename == "jik-result.csv"
+    rows = Path(saved.value.path()).read_text().splitlines()
+    assert rows[0].startswith("algorithm,leg,theta,x1")
+    assert len(rows) - 1 == sum(run["points"] for run in summary.values())
+
+    with tab.page.expect_download() as saved:
+        tab.page.click("#export-json")
+    assert saved.value.suggested_filename == "jik-result.json"
+    data = json.loads(Path(saved.value.path()).read_text())
+    assert data["state"] == snapshot["state"] and data["state"]["cycles"] == 2
+    assert data["generation"] == snapshot["computed_generation"]
+    for algorithm, run in summary.items():
+        assert data["runs"][algorithm]["drift"] == pytest.approx(run["drift"], rel=1e-12)
+
+
+def test_the_unicycle_shows_its_computations_on_their_way(tabs, config):
+    """A switch to the unicycle shows "computing generation N…" until its plots are drawn; a
+    smaller gamma (ten times the iterations, a few seconds) also shows the progress bar while it
+    runs past config.progress_after, and hides it once drawn."""
+    tab = tabs.open()
+    tab.watch_header()
+    generation = tab.select("#ctl-robot", "unicycle")
+    assert tab.robot == "unicycle" and tab.snapshot()["state"]["mode"] == "discrete"
+    status = tab.page.locator("#status-text")
+    expect(status).to_have_text(f"up to date (generation {generation})")
+    assert f"computing generation {generation}…" in tab.header_seen()["statuses"]
+    expect(tab.page.locator("#plot-task .main-svg").first).to_be_visible()
+
+    tab.watch_header()
+    generation = tab.set_slider("#ctl-gamma", -1.5)  # gamma 0.03 (discrete mode: 0.01..1.99)
+    assert tab.snapshot()["state"]["gamma"] == pytest.approx(0.03, rel=0.05)
+    expect(status).to_have_text(f"up to date (generation {generation})")
+    seen = tab.header_seen()
+    assert f"computing generation {generation}…" in seen["statuses"], seen
+    timing = tab.page.text_content("#timing") or ""
+    match = re.match(rf"generation {generation}: compute (\d+) ms", timing)
+    assert match, timing
+    if int(match.group(1)) > 2000 * config["progress_after"]:
+        assert seen["progress"], f"no progress bar during a computation of {timing}"
+    expect(tab.page.locator("#progress")).to_be_hidden()

@@ -1,0 +1,95 @@
+"""Sessions in the browser (issue 27): every tab has its own state, and a copied link opens a new
+session with the same state and the same numbers."""
+
+from __future__ import annotations
+
+import re
+
+import pytest
+
+expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
+pytestmark = pytest.mark.browser
+
+#: A number the verdict writes with an exponent: a drift at rounding level, which two runs of
+#: the same state need not reproduce digit for digit.
+TINY = re.compile(r"-?\d\.\d+e-\d+")
+
+
+def seen(tab) -> dict:
+    """What a tab shows of its state, and its session on the server."""
+    snapshot = tab.snapshot()
+    return {
+        "url": tab.url_state(),
+        "controls": tab.controls(),
+        "robot": tab.robot,
+        "generation": tab.generation,
+        "status": tab.status(),
+        "session": {k: snapshot[k] for k in ("generation", "state", "summary")},
+        "scene": {k: snapshot["scene"].get(k) for k in ("generation", "robot")},
+    }
+
+
+def test_changes_in_one_tab_leave_another_as_it_was(tabs):
+    """A robot switch, a new gamma and a drag of the start point in tab A's scene change nothing
+    in tab B (its URL, controls, plots, session); a tab opened afterwards has the defaults."""
+    a, b = tabs.open(), tabs.open()
+    assert a.session_id != b.session_id
+    b.wait_scene_drawn(1)
+    before = seen(b)
+    defaults = before["session"]["state"]
+    assert before["url"] == defaults and before["robot"] == "manipulator2"
+
+    generation = a.select("#ctl-robot", "manipulator1")
+    assert a.robot == "manipulator1" and a.snapshot()["state"]["robot"] == "manipulator1"
+    assert seen(b) == before
+
+    generation = a.set_slider("#ctl-gamma", 0.30103)  # log10(2), snapped to the slider's step
+    gamma = a.snapshot()["state"]["gamma"]
+    assert gamma == pytest.approx(2.0, rel=0.02) and a.url_state()["gamma"] == gamma
+    assert seen(b) == before
+
+    a.wait_scene_drawn(generation)
+    a.pause_scene()  # (a still scene: quicker to find the gizmo in and to drag it)
+    assert seen(b) == before
+    x0 = a.snapshot()["state"]["x0"]
+    a.drag_start_point()
+    a.wait_settled(lambda s: s["state"]["x0"] != x0, "A's start point dragged, drawn")
+    assert seen(b) == before
+
+    c = tabs.open()
+    assert c.session_id not in (a.session_id, b.session_id)
+    assert c.snapshot()["state"] == defaults
+    assert c.url_state() == defaults
+    assert c.controls() == before["controls"]
+    assert c.robot == "manipulator2"
+
+
+def test_a_copied_link_opens_the_same_view(tabs):
+    """The link that #copy-link puts on the clipboard opens, in a fresh browser, a new session
+    with the same state, the same controls and the same numbers."""
+    a = tabs.open(permissions=["clipboard-read", "clipboard-write"])
+    a.set_slider("#ctl-x0-0", 0.45)
+    a.set_slider("#ctl-cycles", 4)
+    a.page.click("#copy-link")
+    expect(a.page.locator("#copy-link")).to_have_text("link copied")
+    link = a.page.evaluate("navigator.clipboard.readText()")
+    assert link == a.page.url
+
+    d = tabs.open(link)
+    assert d.session_id != a.session_id
+    state = a.snapshot()["state"]
+    assert state["cycles"] == 4 and state["x0"][0] == pytest.approx(0.45, abs=1e-12)
+    assert d.snapshot()["state"] == state
+    assert d.url_state() == a.url_state() == state
+    assert d.controls() == a.controls()
+    # The same verdict, up to the rounding-level drift of the extended Jacobian.
+    verdicts = [TINY.sub("~0", t.page.inner_text("#verdict")) for t in (a, d)]
+    assert verdicts[0] == verdicts[1] and "After 4 cycles" in verdicts[0]
+    ours, theirs = a.snapshot()["summary"], d.snapshot()["summary"]
+    for algorithm in ("pseudoinverse", "extended"):
+        drift = ours[algorithm]["drift"]
+        assert len(drift) == 4
+        assert theirs[algorithm]["drift"] == pytest.approx(drift, rel=1e-9, abs=1e-12)
+        assert theirs[algorithm]["x_final"] == pytest.approx(
+            ours[algorithm]["x_final"], rel=1e-9, abs=1e-12
+        )
