@@ -4,7 +4,8 @@ What a control change costs the server before the page and the scene can redraw:
 :func:`jik.app.dashboard.compute` of the registry's default state (both algorithms through the
 closed path, h on a grid), with a fresh cache each time (a new start point). Straightforward:
 the two algorithms one after the other in the calling thread. jik serve: the pseudoinverse in a
-second process (:class:`jik.app.dashboard.Offload`) while the thread runs the extended inverse.
+worker of the server's compute pool (:class:`jik.app.dashboard.Offload`, the pool the REST API
+uses, here with one worker) while the thread runs the extended inverse.
 Wall-clock medians; each offloaded run is checked to give the same configurations.
 """
 
@@ -15,6 +16,8 @@ import time
 
 import numpy as np
 
+from jik.app.compute.pool import pool_in_thread
+from jik.app.compute.settings import Settings
 from jik.app.dashboard import Offload, OffloadLane, compute, default_state, updated_state
 
 ROBOTS = ("manipulator2", "manipulator1", "unicycle")
@@ -38,10 +41,9 @@ def _timed(robot: str, repeats: int, offload: OffloadLane | None) -> float:
 
 
 def run(quick: bool = False) -> dict:
-    pool = Offload()
-    offload = pool.lane()
-    try:
-        compute(default_state("manipulator2"), offload=offload)  # the process is up and warm
+    with pool_in_thread(Settings(workers=1, timeout=120.0)) as pool:
+        offload = Offload(pool).lane()
+        compute(default_state("manipulator2"), offload=offload)  # the worker has run one
         out = {}
         for robot in ROBOTS:
             repeats = (2 if quick else 5) if robot == "unicycle" else (5 if quick else 21)
@@ -50,9 +52,6 @@ def run(quick: bool = False) -> dict:
             out[robot] = {"serial_ms": 1e3 * serial, "offloaded_ms": 1e3 * offloaded,
                           "ratio": serial / offloaded, "repeats": repeats}  # fmt: skip
         return out
-    finally:
-        offload.close()
-        pool.close()
 
 
 def main(quick: bool = False) -> None:

@@ -16,7 +16,8 @@ import time
 import numpy as np
 
 from jik.app.dashboard import compute, default_state
-from jik.app.dashboard.figures import PANELS, figure_json, figure_specs, figures_for
+from jik.app.dashboard.figures import figure_specs, figures_for
+from jik.app.dashboard.plotting import PANELS, figure_json
 
 ROBOTS = ("manipulator2", "manipulator1", "unicycle")
 

@@ -49,7 +49,7 @@ function drawTable(div, fig) {
 // by Plotly.relayout, then moves its lines with Plotly.animate: no redraw of the rest, a third
 // of Plotly.react's cost. Both run in the same task, so that the browser paints the panel once:
 // with the move first, plotly ran the relayout in a task after the next frame, which showed the
-// new lines on the old axes. The server rounds the ranges (app/dashboard/figures.py nice_range) and keeps
+// new lines on the old axes. The server rounds the ranges (app/dashboard/plotting.py nice_range) and keeps
 // them while the data fill them (keep_ranges), so that most changes do not even touch the axes.
 const DATA_KEYS = ["x", "y", "customdata", "text"];
 const MOVE = { transition: { duration: 0 }, frame: { duration: 0, redraw: false }, mode: "immediate" };
@@ -60,7 +60,7 @@ const axisRanges = (layout) => Object.fromEntries(Object.keys(layout || {}).filt
 // for a move. (A new title text, as the h panel's E1/E2 that a second phase fills in, is set
 // with the move: a relayout of the title.) Plotly.animate drops the layer of any trace it
 // cannot animate: scatter traces move only in figures of scatter traces. The h panel's runs are
-// shapes over its map (a contour, app/dashboard/figures.py), moved by the relayout alone.
+// shapes over its map (a contour, app/dashboard/map_figures.py), moved by the relayout alone.
 const moves = (t) => t.type === "scatter";
 // The indices of a figure's lines (the traces Plotly.animate moves), and the animation frame
 // that gives the lines `traces` of `data` their data.

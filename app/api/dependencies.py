@@ -19,7 +19,7 @@ def store_of(request: Request) -> SessionStore:
     """The app's session store (one without 3D scenes unless ``jik serve`` set one up)."""
     store = getattr(request.app.state, "sessions", None)
     if store is None:
-        store = request.app.state.sessions = SessionStore()
+        store = request.app.state.sessions = SessionStore(pool=request.app.state.pool)
     return store
 
 

@@ -40,10 +40,10 @@ def create_app(
     async def lifespan(app: FastAPI):
         await pool.warm_up()
         yield
-        pool.close()
         store = getattr(app.state, "sessions", None)
-        if store is not None:
+        if store is not None:  # (first: its dashboards give up their runs in the pool)
             store.close()
+        pool.close()
 
     # /docs with Swagger UI's files from the fastapi-offline package: the API's documentation
     # works on a machine without internet, and loads nothing from a CDN. No /redoc: ReDoc's

@@ -67,8 +67,10 @@ def run_server(
     """
     sock = bind(host, port, "--port")
     app = create_app(allowed_hosts=allowed_hosts)
-    # The sessions' second processes (JIK_DASHBOARD_WORKERS, default 1) start with the store.
-    app.state.sessions = SessionStore(SessionLimits.from_env(), scene_factory=start_scene)
+    # The sessions share the app's compute pool (JIK_WORKERS processes) with the API.
+    app.state.sessions = SessionStore(
+        SessionLimits.from_env(), scene_factory=start_scene, pool=app.state.pool
+    )
     # uvicorn shuts down gracefully on SIGINT and SIGTERM (the lifespan stops the sessions and
     # the workers), restores the handlers it found and then raises the signal again. With these
     # handlers that second signal only ends the wait, and the command exits 0, as a server asked

@@ -14,9 +14,11 @@ from __future__ import annotations
 
 import asyncio
 import concurrent.futures
+import contextlib
 import os
 import pickle
 import threading
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -251,6 +253,21 @@ class ComputePool:
         worker = await self._acquire(self._bound_loop.time() + self.settings.timeout)
         return self._unwrap(await self._dispatch(worker, kind, payload))
 
+    def submit(self, kind: str, payload) -> concurrent.futures.Future:
+        """:meth:`run` from another thread (the dashboards' workers): a future of its result,
+        queued with the API's requests (first come, first served). Cancelling the future gives
+        up the computation (its worker finishes it and is given back).
+
+        Raises
+        ------
+        ServiceUnavailable
+            The pool runs on no event loop (an app started without its lifespan).
+        """
+        loop = self._loop
+        if loop is None or loop.is_closed() or not loop.is_running():
+            raise ServiceUnavailable("the compute pool is not running")
+        return asyncio.run_coroutine_threadsafe(self.run(kind, payload), loop)
+
     # -- micro-batched solves
     async def solve(self, req: S.SolveRequest) -> bytes:
         """One /solve request (JSON response bytes); micro-batched with compatible ones."""
@@ -334,3 +351,21 @@ class ComputePool:
         for p, res in zip(items, results, strict=True):
             if not p.future.done():
                 p.future.set_result(res)
+
+
+@contextlib.contextmanager
+def pool_in_thread(settings: Settings | None = None) -> Iterator[ComputePool]:
+    """A started :class:`ComputePool` on an event loop of its own thread: what a server gives
+    its dashboards, for code that runs outside a server (benchmarks, tests)."""
+    loop = asyncio.new_event_loop()
+    thread = threading.Thread(target=loop.run_forever, name="jik-pool-loop", daemon=True)
+    thread.start()
+    pool = ComputePool(settings)
+    try:
+        asyncio.run_coroutine_threadsafe(pool.warm_up(), loop).result()
+        yield pool
+    finally:
+        pool.close()
+        loop.call_soon_threadsafe(loop.stop)
+        thread.join(10)
+        loop.close()

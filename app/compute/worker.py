@@ -8,6 +8,7 @@ socket pair; :class:`jik.app.compute.pool.ComputePool` sends the requests and re
 
 from __future__ import annotations
 
+import importlib
 import os
 import socket
 import struct
@@ -28,6 +29,7 @@ WORK_FIELDS = {
     "solve": ("max_iterations", "a lower max_iterations or a larger tolerance"),
     "repeatability": ("cycles", "fewer cycles or path points, a lower max_iterations"),
     "synthesize": ("region", "a smaller region, fewer nodes, a smaller grid or a lower degree"),
+    "call": ("cycles", "fewer cycles, a larger gamma or another start"),
 }
 
 
@@ -42,10 +44,23 @@ def _solve_payload(items: list[bytes]) -> list[tuple[str, Any]]:
     return out
 
 
+#: Work that other parts of the server hand to the same workers (``("call", (task, args))``),
+#: by name: the dashboard's offloaded runs. Only these functions can be called.
+TASKS = {"dashboard.run": "jik.app.dashboard.offload:run_offloaded"}
+
+
+def _call(payload: tuple[str, tuple]) -> Any:
+    """Run the task ``payload[0]`` of :data:`TASKS` with the arguments ``payload[1]``."""
+    task, args = payload
+    module, name = TASKS[task].split(":")
+    return getattr(importlib.import_module(module), name)(*args)
+
+
 # Workers take requests and give responses as JSON bytes: (de)serialization and validation run in
 # the workers, in parallel, and the event loop only passes bytes along.
 _HANDLERS: dict[str, Callable[[Any], Any]] = {
     "ping": lambda payload: "pong",
+    "call": _call,
     "solve": _solve_payload,
     "repeatability": lambda b: (
         repeatability_request(S.RepeatabilityRequest.model_validate_json(b))

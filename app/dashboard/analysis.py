@@ -129,9 +129,10 @@ def augmenting_grid(
 
     The box covers both trajectories with a margin, clipped to the robot's x_range. The box of
     ``before`` (the grid on screen) is kept while the trajectories lie inside it and span at
-    least :data:`BOX_FILL` of it, like the other panels' axes (``app.figures.keep_ranges``): a
-    small change then gives the same grid, often the same h, and the page moves only the
-    trajectories. Returns None when h cannot be evaluated on the grid.
+    least :data:`BOX_FILL` of it, like the other panels' axes
+    (:func:`jik.app.dashboard.plotting.keep_ranges`): a small change then gives the same grid,
+    often the same h, and the page moves only the trajectories. Returns None when h cannot be
+    evaluated on the grid.
     """
     spec = robot_spec(state.robot)
     try:

@@ -12,6 +12,7 @@ share its lock, generation and caches.)
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import threading
 import time
@@ -27,14 +28,8 @@ from jik.app.dashboard.analysis import (
     sensitivity,
 )
 from jik.app.dashboard.controls import controls_message
-from jik.app.dashboard.figures import (
-    PANELS,
-    augmenting_title,
-    figure_json,
-    figure_specs,
-    gamma_free_panels,
-    keep_ranges,
-)
+from jik.app.dashboard.figures import figure_specs, gamma_free_panels
+from jik.app.dashboard.map_figures import augmenting_title
 from jik.app.dashboard.messages import Event, digest, summary, to_json, with_figures
 from jik.app.dashboard.model import (
     ALGORITHMS,
@@ -47,8 +42,10 @@ from jik.app.dashboard.model import (
     validate,
 )
 from jik.app.dashboard.offload import Offload
+from jik.app.dashboard.plotting import PANELS, figure_json, keep_ranges
 from jik.app.dashboard.results import compute
 from jik.app.dashboard.runs import Cancelled, DashboardResult
+from jik.app.dashboard.slots import FairSlots
 from jik.engine.exceptions import InvalidInputError, JikError
 
 log = logging.getLogger("jik.dashboard")
@@ -70,8 +67,11 @@ class Dashboard:
         Seconds the worker waits after a change for a newer one (short: the page already
         coalesces a slider drag into one request in flight at a time).
     offload : Offload, optional
-        Compute processes shared with other dashboards: one algorithm runs there, in this
-        dashboard's own lane (:meth:`Offload.lane`); ``jik serve`` gives one.
+        The server's compute pool (shared with the API and the other dashboards): one algorithm
+        runs there, in this dashboard's own lane (:meth:`Offload.lane`); ``jik serve`` gives it.
+    slots : FairSlots, optional
+        Turns for the computations in the sessions' threads (first come, first served), shared
+        by the dashboards of a server.
     """
 
     def __init__(
@@ -80,8 +80,10 @@ class Dashboard:
         *,
         debounce: float = 0.002,
         offload: Offload | None = None,
+        slots: FairSlots | None = None,
     ) -> None:
         self._cond = threading.Condition()
+        self._slots = slots
         self._offload = offload.lane() if offload is not None else None
         self._state = validate((state or default_state()).as_dict())
         self._generation = 1
@@ -293,11 +295,12 @@ class Dashboard:
                 continue  # (its figures stay the same while the robot on screen stays)
             try:
                 _, amap = kinematics_and_map(state)
-                result = compute(
-                    state, generation, cancelled=lambda: self._generation != generation,
-                    cache=self._cache, with_augmenting=not expensive_map(amap),
-                    offload=self._offload,
-                )  # fmt: skip
+                with self._turn():
+                    result = compute(
+                        state, generation, cancelled=lambda: self._generation != generation,
+                        cache=self._cache, with_augmenting=not expensive_map(amap),
+                        offload=self._offload,
+                    )  # fmt: skip
                 # The figures as the switch will make them (see _compute; no panel to reuse
                 # from another robot).
                 cached, stale = self._known_functionals(state)
@@ -351,6 +354,10 @@ class Dashboard:
             self._done = max(self._done, generation)
             self._cond.notify_all()
 
+    def _turn(self):
+        """This session's turn to compute (:class:`FairSlots`), or at once without slots."""
+        return self._slots.slot() if self._slots is not None else contextlib.nullcontext()
+
     def _compute(self, generation: int, state: DashboardState) -> None:
 
         started = self._changed_at.get(generation, time.perf_counter())
@@ -377,11 +384,14 @@ class Dashboard:
         try:
             kin, amap = kinematics_and_map(state)
             deferred = expensive_map(amap)
-            result = compute(
-                state, generation, progress=progress,
-                cancelled=lambda: self._generation != generation, cache=self._cache,
-                with_augmenting=not deferred, offload=self._offload, grid_before=grid_before,
-            )  # fmt: skip
+            with self._turn():
+                if self._generation != generation:  # (a newer change came while it waited)
+                    raise Cancelled
+                result = compute(
+                    state, generation, progress=progress,
+                    cancelled=lambda: self._generation != generation, cache=self._cache,
+                    with_augmenting=not deferred, offload=self._offload, grid_before=grid_before,
+                )  # fmt: skip
         except Cancelled:
             return
         except (JikError, ValueError) as exc:

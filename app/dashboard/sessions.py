@@ -7,9 +7,10 @@ page listening (event stream) and no scene connected, untouched for ``idle_secon
 stopped. When the store is full, the session idle the longest makes room; if every session is in
 use the new one is refused (the route answers 503).
 
-The sessions' computations share one bounded pool: each dashboard's second process is the same
-:class:`~jik.app.dashboard.offload.Offload` (``workers`` processes, first come first
-served), and every session's own thread computes the other algorithm.
+The sessions' computations share the server's one compute pool with the REST API: one
+algorithm of each run goes to its worker processes (:class:`~jik.app.dashboard.offload.Offload`,
+first come first served), and the other is computed in the session's own thread, in turns of
+:class:`~jik.app.dashboard.slots.FairSlots` (at most ``computations`` at once, in the order asked).
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from typing import Any
 from jik.app.dashboard.model import default_state, updated_state
 from jik.app.dashboard.offload import Offload
 from jik.app.dashboard.session import Dashboard
+from jik.app.dashboard.slots import FairSlots
 
 
 class SessionNotFound(KeyError):
@@ -37,21 +39,22 @@ class SessionsFull(RuntimeError):
 
 @dataclass(frozen=True)
 class SessionLimits:
-    """How many sessions, how long an idle one lives, how many compute processes they share."""
+    """How many sessions, how long an idle one lives, how many of their computations run in
+    their threads at once (the other algorithm's runs are the compute pool's, JIK_WORKERS)."""
 
     max_sessions: int = 32
     idle_seconds: float = 600.0
-    workers: int = 1
+    computations: int = max(1, os.cpu_count() or 1)
 
     @classmethod
     def from_env(cls) -> SessionLimits:
-        """``JIK_MAX_SESSIONS``, ``JIK_SESSION_IDLE_SECONDS``, ``JIK_DASHBOARD_WORKERS``."""
+        """``JIK_MAX_SESSIONS``, ``JIK_SESSION_IDLE_SECONDS``, ``JIK_DASHBOARD_COMPUTATIONS``."""
+        env = os.environ
         return cls(
-            max_sessions=max(1, int(os.environ.get("JIK_MAX_SESSIONS", cls.max_sessions))),
-            idle_seconds=max(1.0, float(os.environ.get("JIK_SESSION_IDLE_SECONDS",
-                                                       cls.idle_seconds))),
-            workers=max(0, int(os.environ.get("JIK_DASHBOARD_WORKERS", cls.workers))),
-        )  # fmt: skip
+            max_sessions=max(1, int(env.get("JIK_MAX_SESSIONS", cls.max_sessions))),
+            idle_seconds=max(1.0, float(env.get("JIK_SESSION_IDLE_SECONDS", cls.idle_seconds))),
+            computations=max(1, int(env.get("JIK_DASHBOARD_COMPUTATIONS", cls.computations))),
+        )
 
 
 @dataclass
@@ -84,18 +87,23 @@ class SessionStore:
         ``scene_factory(dashboard, low_end)`` starts the 3D scene of a new session (``jik
         serve`` gives :func:`jik.app.scene.start_scene`: a viser server on a loopback port);
         without it sessions have no scene.
+    pool : ComputePool, optional
+        The server's compute pool (:class:`jik.app.compute.pool.ComputePool`), which the
+        dashboards share with the API; without it each session computes in its own thread.
     """
 
     def __init__(
         self,
         limits: SessionLimits | None = None,
         scene_factory: Callable[[Dashboard, bool], Any] | None = None,
+        pool: Any = None,
     ) -> None:
         self.limits = limits or SessionLimits()
         self._scene_factory = scene_factory
         self._sessions: dict[str, Session] = {}
         self._lock = threading.Lock()
-        self._offload = Offload(self.limits.workers) if self.limits.workers else None
+        self._offload = Offload(pool) if pool is not None else None
+        self._slots = FairSlots(self.limits.computations)
         self._closed = threading.Event()
         self._reaper: threading.Thread | None = None
 
@@ -121,7 +129,7 @@ class SessionStore:
             if len(self._sessions) >= self.limits.max_sessions:
                 self._evict_idlest()
             session_id = secrets.token_urlsafe(16)
-            dashboard = Dashboard(state, offload=self._offload)
+            dashboard = Dashboard(state, offload=self._offload, slots=self._slots)
             session = Session(session_id, dashboard)
             self._sessions[session_id] = session
         if self._scene_factory is not None:
@@ -185,11 +193,9 @@ class SessionStore:
         threading.Thread(target=oldest.stop, name="jik-session-stop", daemon=True).start()
 
     def close(self) -> None:
-        """Stop every session and the shared compute processes."""
+        """Stop every session (the compute pool is the app's, closed with it)."""
         self._closed.set()
         with self._lock:
             sessions, self._sessions = list(self._sessions.values()), {}
         for session in sessions:
             session.stop()
-        if self._offload is not None:
-            self._offload.close()

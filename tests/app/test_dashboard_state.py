@@ -293,7 +293,7 @@ def test_inert_variables_are_those_j_h_and_dh_ignore():
 def test_the_h_panel_names_only_the_fixed_variables_h_depends_on():
     """Manipulator 2's h(x2, x3) is drawn over (x2, x3): its title does not name x1, so a
     change of x1 leaves the title (and the E1/E2 in it) as they are."""
-    from jik.app.dashboard.figures import augmenting_title
+    from jik.app.dashboard.map_figures import augmenting_title
 
     state = default_state("manipulator2")
     a = compute(state)
@@ -343,13 +343,15 @@ def test_known_functionals_are_drawn_with_the_first_result():
 
 
 def test_offloaded_computation_is_the_same_and_can_be_cancelled():
-    """The second process computes the pseudoinverse exactly as the thread does; a newer
-    generation cancels it; if it dies, the run is redone here and a new process serves."""
+    """A worker of the server's compute pool (the REST API's) computes the pseudoinverse exactly
+    as the thread does; a newer generation gives the run up; if the worker dies, the run is
+    redone here and a new worker serves the next."""
+    from jik.app.compute.pool import pool_in_thread
+    from jik.app.compute.settings import Settings
     from jik.app.dashboard import Offload
 
-    pool = Offload()
-    offload = pool.lane()
-    try:
+    with pool_in_thread(Settings(workers=1, timeout=120.0)) as pool:
+        offload = Offload(pool).lane()
         for robot in ("manipulator1", "manipulator2"):
             state = default_state(robot)
             here, there = compute(state), compute(state, 7, offload=offload)
@@ -367,25 +369,24 @@ def test_offloaded_computation_is_the_same_and_can_be_cancelled():
         for a in grown.runs:
             np.testing.assert_array_equal(grown.runs[a].x, fresh.runs[a].x)
             np.testing.assert_array_equal(grown.runs[a].leg, fresh.runs[a].leg)
+        # A newer generation gives up the older run.
         state = updated_state(default_state("manipulator2"), {"cycles": 5})
+        future = offload.submit(state, "pseudoinverse", np.asarray(state.path), 5, 8)
         offload.newest(9)
         with pytest.raises(Cancelled):
-            compute(state, 8, offload=offload)
-        for process in list(pool._pool._processes.values()):
-            process.kill()
-            process.join()
+            offload.result(future, lambda: pytest.fail("no fallback for a cancelled run"))
+        # A worker that dies: the run is computed here, and the next goes to a new worker.
+        for worker in list(pool._workers):
+            worker.process.kill()
         again = compute(state, 10, offload=offload)
         np.testing.assert_array_equal(
             again.runs["pseudoinverse"].x, compute(state).runs["pseudoinverse"].x
         )
         assert compute(state, 11, offload=offload).runs["pseudoinverse"].success
-    finally:
-        offload.close()
-        pool.close()
 
 
-def test_offload_process_leaves_with_a_killed_server(tmp_path):
-    """A server that is killed (no shutdown) does not leave its second process behind."""
+def test_compute_workers_leave_with_a_killed_server(tmp_path):
+    """A server that is killed (no shutdown) does not leave its compute workers behind."""
     import os
     import signal
     import subprocess
@@ -395,11 +396,12 @@ def test_offload_process_leaves_with_a_killed_server(tmp_path):
 
     script = (
         "import time\n"
+        "from jik.app.compute.pool import pool_in_thread\n"
+        "from jik.app.compute.settings import Settings\n"
         "from jik.app.dashboard import Offload, compute, default_state\n"
-        "if __name__ == '__main__':\n"
-        "    pool = Offload()\n"
-        "    compute(default_state('manipulator2'), offload=pool.lane())\n"
-        "    print(*pool._pool._processes, flush=True)\n"
+        "with pool_in_thread(Settings(workers=1)) as pool:\n"
+        "    compute(default_state('manipulator2'), offload=Offload(pool).lane())\n"
+        "    print(*(w.process.pid for w in pool._workers), flush=True)\n"
         "    time.sleep(60)\n"
     )
     path = tmp_path / "server.py"
@@ -420,14 +422,14 @@ def test_offload_process_leaves_with_a_killed_server(tmp_path):
                 os.kill(child, 0)
             except ProcessLookupError:
                 break
-            try:  # reap it if it became our grandchild's zombie in this process group
+            try:  # reap it if it became our zombie
                 os.waitpid(child, os.WNOHANG)
             except ChildProcessError:
                 pass
             time.sleep(0.05)
         else:
             os.kill(child, signal.SIGKILL)
-            pytest.fail("the offload process outlived its killed server")
+            pytest.fail("the compute worker outlived its killed server")
     finally:
         proc.kill()
 

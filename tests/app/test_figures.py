@@ -14,16 +14,14 @@ from jik.app.dashboard.analysis import error_functionals, sensitivity
 from jik.app.dashboard.figures import (
     augmenting_figure,
     drift_figure,
-    figure_json,
     figure_specs,
     figures_for,
     joint_figure,
-    keep_ranges,
-    nice_range,
     sensitivity_figure,
     table_figure,
     task_space_figure,
 )
+from jik.app.dashboard.plotting import figure_json, keep_ranges, nice_range
 from jik.engine.registry import ROBOTS
 
 
@@ -103,7 +101,7 @@ def test_augmenting_map_contours_with_the_extended_run_on_a_level_set(path_resul
     assert fig.layout.xaxis.title.text == "x2 [m]"
     assert fig.layout.yaxis.title.text == "x3 [rad]"
     assert "E1 = " in fig.layout.title.text and "E2 = " in fig.layout.title.text
-    # The runs and x0 are shapes over the contours (moved by a relayout, app/dashboard/figures.py).
+    # The runs and x0 are shapes over the contours (moved by a relayout, see map_figures.py).
     runs = fig.layout.shapes[:2]
     assert [s.line.color for s in runs] == [COLORS["pseudoinverse"], COLORS["extended"]]
     ext = path_result.runs["extended"].x

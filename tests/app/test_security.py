@@ -15,7 +15,7 @@ FOREIGN = "http://evil.example"
 @pytest.fixture
 def app():
     app = create_app(allowed_hosts=("testserver",))
-    app.state.sessions = SessionStore(SessionLimits(max_sessions=4, workers=0))
+    app.state.sessions = SessionStore(SessionLimits(max_sessions=4))
     yield app
     app.state.sessions.close()
 

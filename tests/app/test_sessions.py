@@ -10,7 +10,7 @@ from fastapi.testclient import TestClient
 from starlette.websockets import WebSocketDisconnect
 
 from jik.app.api.factory import create_app
-from jik.app.dashboard.figures import PANELS
+from jik.app.dashboard.plotting import PANELS
 from jik.app.dashboard.sessions import SessionLimits, SessionNotFound, SessionsFull, SessionStore
 
 JSON = {"content-type": "application/json"}
@@ -20,7 +20,7 @@ JSON = {"content-type": "application/json"}
 def app():
     """The app with a scene-less session store (no lifespan: sessions need no compute pool)."""
     app = create_app()
-    app.state.sessions = SessionStore(SessionLimits(max_sessions=4, workers=0))
+    app.state.sessions = SessionStore(SessionLimits(max_sessions=4))
     yield app
     app.state.sessions.close()
 
@@ -142,7 +142,7 @@ def test_unknown_and_deleted_sessions_are_404(client):
 
 
 def test_a_full_store_evicts_the_idlest_unused_session_or_refuses():
-    store = SessionStore(SessionLimits(max_sessions=2, workers=0))
+    store = SessionStore(SessionLimits(max_sessions=2))
     try:
         a = store.create()
         b = store.create()
@@ -160,7 +160,7 @@ def test_a_full_store_evicts_the_idlest_unused_session_or_refuses():
 
 def test_a_full_store_answers_503(app, client):
     app.state.sessions.close()
-    app.state.sessions = store = SessionStore(SessionLimits(max_sessions=1, workers=0))
+    app.state.sessions = store = SessionStore(SessionLimits(max_sessions=1))
     session = _open(client)
     store.get(session["id"]).users = 1
     r = client.post("/api/sessions", json={"state": {}})
@@ -169,7 +169,7 @@ def test_a_full_store_answers_503(app, client):
 
 
 def test_idle_sessions_expire_by_themselves():
-    store = SessionStore(SessionLimits(idle_seconds=1.0, workers=0))
+    store = SessionStore(SessionLimits(idle_seconds=1.0))
     try:
         kept, idle = store.create(), store.create()
         kept.users = 1

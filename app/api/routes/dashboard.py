@@ -17,7 +17,7 @@ from fastapi.responses import FileResponse, JSONResponse, Response
 from jik import static
 from jik.app.dashboard import COLORS, LABELS
 from jik.app.dashboard.controls import PROGRESS_AFTER
-from jik.app.dashboard.figures import PANEL_SIZES
+from jik.app.dashboard.plotting import PANEL_SIZES
 
 router = APIRouter(tags=["dashboard"])
 

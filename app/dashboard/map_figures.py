@@ -1,0 +1,199 @@
+"""The panels of the augmenting map: h on a grid with both runs over it (its title carries E1
+and E2 of section 5), and E1, E2 against the map's parameters or against the robot's other
+maps."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from jik.app.dashboard.analysis import state_inert_variables
+from jik.app.dashboard.model import ALGORITHMS, COLORS, LABELS
+from jik.app.dashboard.plotting import NO_LEGEND, figure, label, trace, units
+from jik.app.dashboard.runs import DashboardResult
+
+
+def augmenting_spec(result: DashboardResult, functionals: dict | None = None) -> dict:
+    """Contours of the augmenting map h over two joint variables with both trajectories on top.
+
+    The extended Jacobian keeps h constant (eq. (12)), so its trajectory follows a level curve;
+    the pseudoinverse crosses them. The title carries E1 (13) and E2 (18) over the plotted box.
+
+    The trajectories and the start x0 are layout shapes over the contour trace, not traces: a
+    change that keeps h on its box then moves them by a relayout of the shapes, a few ms in the
+    page, and the contours stay (plotly's animation of traces would drop a contour's layer, and
+    drawing the panel anew takes ten times as long). Hover gives h; the joint values along
+    the runs are in the joint panel.
+    """
+    ju, _ = units(result)
+    grid = result.augmenting
+    if grid is None:
+        return figure([], augmenting_title(result))
+    i, j = grid["axes"]
+    ni, nj = result.variable_names[i], result.variable_names[j]
+    H = grid["h"]
+    finite = H[np.isfinite(H)]
+    zmin, zmax = np.percentile(finite, [2, 98]) if finite.size else (0.0, 1.0)
+    data = [
+        trace("contour",
+            x=grid["u"], y=grid["v"], z=H, zmin=zmin, zmax=zmax,
+            # A neutral scale, so that the red and blue runs on top stay the algorithms' colours.
+            colorscale=[[0.0, "#fdfdfd"], [1.0, "#9a9a9a"]],
+            # No labels on the level curves: placing them costs the page 100-250 ms per redraw;
+            # the colour bar and the hover give the levels.
+            ncontours=24, contours=dict(showlabels=False),
+            colorbar=dict(
+                title=dict(text="h", side="right"), thickness=12, ticklabeloverflow="allow"
+            ),
+            hovertemplate=f"{ni} = %{{x:.3f}}<br>{nj} = %{{y:.3f}}<br>h = %{{z:.4f}}"
+            "<extra></extra>",
+            name="h", showlegend=False,
+        )
+    ]  # fmt: skip
+    shapes: list[dict[str, Any]] = [
+        dict(type="path", path=_svg_path(result.runs[a].x[:, i], result.runs[a].x[:, j]),
+             line=dict(color=COLORS[a], width=2.5), name=LABELS[a])
+        for a in ALGORITHMS
+    ]  # fmt: skip
+    x0 = result.state.x0
+    shapes.append(  # (a circle of 10 px at x0, whatever the axes' scales)
+        dict(type="circle", xsizemode="pixel", ysizemode="pixel", xanchor=float(x0[i]),
+             yanchor=float(x0[j]), x0=-5, x1=5, y0=-5, y1=5, fillcolor="white",
+             line=dict(color="black", width=2), name="x0")
+    )  # fmt: skip
+    return figure(
+        data,
+        augmenting_title(result, functionals),
+        **NO_LEGEND,
+        shapes=shapes,
+        xaxis=dict(title=label(ni, ju[i])),
+        yaxis=dict(title=label(nj, ju[j])),
+    )
+
+
+def _svg_path(x: np.ndarray, y: np.ndarray) -> str:
+    """A polyline through (x, y) in data coordinates, as a plotly path shape takes it (six
+    significant digits: under a pixel at a hundredfold zoom of a panel)."""
+    points = "L".join(f"{u:.6g},{v:.6g}" for u, v in zip(x.tolist(), y.tolist(), strict=True))
+    return "M" + points
+
+
+def augmenting_title(result: DashboardResult, functionals: dict | None = None) -> str:
+    """Title of the h panel: the map, E1 and E2 on the plotted box, the fixed variables."""
+    title = f"Augmenting map h: {result.state.augmentation}"
+    grid = result.augmenting
+    if grid is None:
+        return title + " (computing h on a grid…)"
+    i, j = grid["axes"]
+    x0 = result.state.x0
+    sub = []
+    if functionals:
+        values = {k: functionals.get(k) for k in ("E1", "E2")}
+        where = "the plotted box"
+        if functionals.get("design_region"):
+            where = ", ".join(f"{k} ∈ [{lo:.3g}, {hi:.3g}]" for k, (lo, hi)
+                              in functionals["region"].items())  # fmt: skip
+        if all(v is None for v in values.values()):
+            sub.append(f"E1, E2 undefined: h is not defined on all of {where}")
+        else:
+            sub.append(", ".join(
+                f"{k} = {v:.4g}" if v is not None else f"{k} undefined" for k, v in values.items()
+            ) + f" on {where}")  # fmt: skip
+    # The slice's other variables, unless neither h nor J depends on them (Manipulator 2's x1
+    # for h(x2, x3)): their values would say nothing, and the title would change with them.
+    inert = state_inert_variables(result.state)
+    fixed = [
+        f"{n} = {x0[k]:.3g}"
+        for k, n in enumerate(result.variable_names)
+        if k not in (i, j) and k not in inert
+    ]
+    if fixed:
+        sub.append("at " + ", ".join(fixed))
+    sub.append("○ x0")
+    if sub:
+        title += "<br><sup>" + " · ".join(sub) + "</sup>"
+    return title
+
+
+#: Colours of the functionals (the algorithms keep red and blue).
+E_COLORS = {"E1": "#2ca02c", "E2": "#9467bd"}
+
+
+def sensitivity_spec(result: DashboardResult, sens: dict | None = None) -> dict:
+    """E1 (13) and E2 (18) of the current map and how they change (issue 5).
+
+    With parameters: each functional against each parameter (swept around its current value,
+    which is marked), on a log scale. Without: the functionals of the robot's other maps.
+    ``sens`` comes from :func:`jik.app.dashboard.analysis.sensitivity` (the dashboard's second
+    phase).
+    """
+    aug = result.state.augmentation
+    if sens is None:
+        return figure([], f"E1, E2 of {aug}: computing…")
+    if sens["kind"] == "unavailable":
+        return figure([], f"E1, E2 of {aug}<br><sup>{sens['reason']}</sup>")
+    log = dict(type="log", exponentformat="power")
+    if sens["kind"] == "alternatives":
+        maps = sens["maps"]
+        names = [m["name"] + (" (current)" if m["current"] else "") for m in maps]
+        data = [
+            trace("bar", x=names, y=[m[k] for m in maps], name=k,
+                   marker=dict(color=E_COLORS[k],
+                               line=dict(color=["black" if m["current"] else E_COLORS[k]
+                                                for m in maps], width=2)),
+                   hovertemplate="%{x}: " + k + " = %{y:.4g}<extra></extra>")
+            for k in ("E1", "E2")
+        ]  # fmt: skip
+        return figure(
+            data,
+            f"E1 (13), E2 (18) of the maps of this robot<br><sup>{aug} has no parameters: "
+            "the alternatives on the same box</sup>",
+            barmode="group",
+            yaxis=dict(title="E (log)", **log),
+        )
+    params = sens["parameters"]
+    names = list(params)
+    n = len(names)
+    data, layout = [], {}
+    gap = 0.08
+    width = (1.0 - gap * (n - 1)) / n
+    for c, name in enumerate(names):
+        xa, ya = ("x", "y") if c == 0 else (f"x{c + 1}", f"y{c + 1}")
+        for k in ("E1", "E2"):
+            sweep = sens[k]["sweeps"][name]
+            data.append(trace("scatter", x=sweep["values"], y=sweep["functional"],
+                               mode="lines", name=k, legendgroup=k, showlegend=c == 0,
+                               line=dict(color=E_COLORS[k], width=2), xaxis=xa, yaxis=ya,
+                               hovertemplate=f"{name} = %{{x:.3g}}<br>{k} = %{{y:.4g}}"
+                               "<extra></extra>"))  # fmt: skip
+            if sens[k]["value"] is not None:
+                data.append(trace("scatter", x=[params[name]], y=[sens[k]["value"]],
+                                   mode="markers", name=f"current {k}", showlegend=False,
+                                   marker=dict(color="white", size=9,
+                                               line=dict(color=E_COLORS[k], width=2)),
+                                   xaxis=xa, yaxis=ya,
+                                   hovertemplate=f"current {name} = %{{x:.3g}}<br>{k} = "
+                                   "%{y:.4g}<extra></extra>"))  # fmt: skip
+        lo = c * (width + gap)
+        layout["xaxis" if c == 0 else f"xaxis{c + 1}"] = dict(
+            domain=[round(lo, 6), round(min(1.0, lo + width), 6)], title=name,
+            anchor=ya,
+        )  # fmt: skip
+        layout["yaxis" if c == 0 else f"yaxis{c + 1}"] = dict(
+            anchor=xa, **log, **({"title": "E (log)"} if c == 0 else {})
+        )
+    slopes = []
+    for k in ("E1", "E2"):
+        g = sens[k]["gradient"]
+        slopes.append(", ".join(
+            f"∂{k}/∂{p} = {g[p]:.3g}" if g.get(p) is not None else f"∂{k}/∂{p} undefined"
+            for p in names
+        ))  # fmt: skip
+    at = ", ".join(f"{p} = {v:.3g}" for p, v in params.items())
+    return figure(
+        data,
+        f"E1 (13), E2 (18) as the parameters of {aug} move"
+        f"<br><sup>at {at} (circles): {'; '.join(slopes)}</sup>",
+        **layout,
+    )

@@ -1,0 +1,233 @@
+"""What every panel shares: units and labels, the style of the axes and traces, figure dicts
+serialized without ``go.Figure`` (typed arrays as base64), and axis ranges that stay put while
+the data fill them (:func:`nice_range`, :func:`keep_ranges`)."""
+
+from __future__ import annotations
+
+import base64
+import json
+import math
+
+import numpy as np
+import plotly.graph_objects as go
+
+from jik.app.dashboard.runs import DashboardResult
+
+#: Units of the joint and task variables, by robot (the registry does not carry units).
+UNITS = {
+    "manipulator1": (("m", "m", "1"), ("m", "m")),
+    "manipulator2": (("m", "m", "rad"), ("m", "m")),
+    "unicycle": (("m/s", "m/s", "rad/s", "rad/s"), ("m", "m", "rad")),
+}
+PANEL_HEIGHT = 380
+#: Panel ids, in the page's order, with their size on the page's grid ("wide": a whole row,
+#: "tall": two rows).
+PANEL_SIZES = {"task": "wide", "drift": "", "joints": "tall", "augmenting": "",
+               "sensitivity": "", "table": "wide"}  # fmt: skip
+PANELS = tuple(PANEL_SIZES)
+AXIS = dict(
+    gridcolor="#e6e6e6", zerolinecolor="#b0b0b0", linecolor="#888", showline=True, mirror=True,
+    ticks="outside", automargin=True,
+    # plotly's default on linear axes, "hide past div", measures every tick label's box
+    # (a forced layout each) on every redraw: ~10 ms per panel here.
+    ticklabeloverflow="allow",
+)  # fmt: skip
+# A small explicit template: the named ones ("plotly_white") cost ~25 ms per figure to apply.
+TEMPLATE = dict(
+    layout=dict(paper_bgcolor="white", plot_bgcolor="white", xaxis=AXIS, yaxis=AXIS,
+                colorway=["#d62728", "#1f77b4", "#2ca02c", "#9467bd"])
+)  # fmt: skip
+LAYOUT = dict(
+    template=TEMPLATE,
+    height=PANEL_HEIGHT,
+    margin=dict(l=64, r=20, t=40, b=100),
+    legend=dict(orientation="h", yanchor="top", y=-0.2, xanchor="left", x=0, font=dict(size=10)),
+    font=dict(size=11),
+    hovermode="closest",
+    uirevision="keep",  # keep the user's zoom across updates of the same robot
+)
+SYMBOLS = {"pseudoinverse": "circle", "extended": "diamond"}
+
+
+def units(result: DashboardResult) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    joint, task = UNITS.get(result.state.robot, ((), ()))
+    p, r = len(result.variable_names), len(result.task_names)
+    return (joint or ("",) * p), (task or ("",) * r)
+
+
+def label(name: str, unit: str) -> str:
+    return f"{name} [{unit}]" if unit else name
+
+
+def is_unicycle(result: DashboardResult) -> bool:
+    """Results with platform paths (the unicycle) get the platform figures."""
+    return any(r.platform is not None for r in result.runs.values())
+
+
+def theta_label(result: DashboardResult) -> str:
+    if result.state.mode == "discrete":
+        return "iteration"
+    return f"θ (continuation parameter, γ = {result.state.gamma:g})"
+
+
+def leg_names(n: int) -> list[str]:
+    return [chr(ord("A") + i) if i < 26 else f"P{i + 1}" for i in range(n)]
+
+
+def trace(kind: str, **props) -> dict:
+    return {"type": kind, **props}
+
+
+#: Layout of the panels whose traces are the two algorithms: no legend (the page's header
+#: names the colours; a legend costs a fifth of a panel's redraw in the browser test), the
+#: other marks named in the title, and the bottom margin the legend took given back.
+NO_LEGEND = dict(showlegend=False, margin=dict(l=64, r=20, t=48, b=48))
+
+
+def figure(data: list, title: str, **layout) -> dict:
+    """A figure dict (a spec) with the panels' common layout, not validated by plotly (the
+    server builds every panel on each change); tests/app/test_figures.py validates every one."""
+    base = {**LAYOUT, "title": dict(text=title, font=dict(size=13), x=0.01, xanchor="left")}
+    for key, axis in layout.items():  # an axis title given as text (validation did this)
+        if key.startswith(("xaxis", "yaxis")) and isinstance(axis.get("title"), str):
+            layout[key] = {**axis, "title": {"text": axis["title"]}}
+    return {"data": data, "layout": {**base, **layout}}
+
+
+def to_go(spec: dict) -> go.Figure:
+    return go.Figure(data=spec["data"], layout=spec["layout"], _validate=False)
+
+
+#: numpy dtypes plotly.js takes as typed arrays (base64), by their plotly.js names.
+TYPED = {"float64": "f8", "float32": "f4", "int32": "i4", "uint32": "u4", "int16": "i2",
+          "uint16": "u2", "int8": "i1", "uint8": "u1"}  # fmt: skip
+
+
+def typed_array(v: np.ndarray):
+    """``v`` as plotly.js's typed-array spec (base64 of the bytes, as plotly.py >= 6 sends it);
+    64-bit integers narrowed to 32 bits, anything else as a list."""
+    if v.dtype.kind in "iu" and v.size and v.dtype.itemsize == 8:
+        if np.iinfo(np.int32).min <= v.min() and v.max() <= np.iinfo(np.int32).max:
+            v = v.astype(np.int32)
+    name = TYPED.get(str(v.dtype))
+    if name is None or not v.size:
+        return plain(v.tolist())
+    out = {"dtype": name, "bdata": base64.b64encode(v.tobytes()).decode("ascii")}
+    if v.ndim > 1:
+        out["shape"] = ", ".join(str(n) for n in v.shape)
+    return out
+
+
+def plain(v):
+    """``v`` with numpy values made JSON's (arrays typed) and non-finite numbers null."""
+    if isinstance(v, dict):
+        return {k: plain(x) for k, x in v.items()}
+    if isinstance(v, list | tuple):
+        return [plain(x) for x in v]
+    if isinstance(v, np.ndarray):
+        return typed_array(v)
+    if isinstance(v, float | np.floating):
+        return float(v) if math.isfinite(v) else None
+    if isinstance(v, np.integer | np.bool_):
+        return v.item()
+    return v
+
+
+def figure_json(spec: dict) -> str:
+    """The JSON plotly.js reads for a figure dict (what ``go.Figure(spec).to_json()`` gives,
+    about 5x faster: no property objects, no deep copies)."""
+    return json.dumps(plain(spec), separators=(",", ":"), allow_nan=False)
+
+
+def nice_range(values, pad: float = 0.05, from_zero: bool = False) -> list[float] | None:
+    """An axis range around ``values``: padded by ``pad`` of their span, then widened to
+    multiples of a 1-2-5 step near a tenth of the span (``from_zero``: from 0, unpadded).
+
+    Nearby data give the same range, so a small change of a control leaves the figure's layout
+    unchanged and the page moves only the traces (``Plotly.animate`` in static/panels.js, a third
+    of a full redraw). None when there is nothing finite to show (plotly then autoranges).
+    """
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    if not v.size:
+        return None
+    lo, hi = float(v.min()), float(v.max())
+    span = hi - lo
+    if span <= 1e-9 * max(abs(lo), abs(hi)):  # constant up to rounding: a tenth around
+        span = max(abs(hi), 1.0) * 0.1
+    raw = span / 10
+    step = 10.0 ** np.floor(np.log10(raw))
+    step *= next(m for m in (1, 2, 5, 10) if m * step >= raw)
+
+    def tidy(x: float) -> float:  # (0.30000000000000004 -> 0.3)
+        return float(f"{x:.12g}")
+
+    if from_zero:  # (an axis like theta: the data start at its left edge)
+        return [0.0, tidy(np.ceil(hi / step) * step)]
+    return [tidy(np.floor((lo - pad * span) / step) * step),
+            tidy(np.ceil((hi + pad * span) / step) * step)]  # fmt: skip
+
+
+def log_range(values) -> list[float] | None:
+    """A log axis's range (decades, as plotly takes it) to the half decade around the
+    positive ``values``, with a half decade of margin: stable like :func:`nice_range`."""
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v) & (v > 0)]
+    if not v.size:
+        return None
+    lo, hi = np.log10(v.min()), np.log10(v.max())
+    return [float(np.floor(2 * lo) / 2 - 0.5), float(np.ceil(2 * hi) / 2 + 0.5)]
+
+
+#: An axis keeps its range while the data span at least this fraction of it (:func:`keep_ranges`).
+KEEP_FILL = 0.5
+
+
+def axis_data(spec: dict) -> dict[str, list]:
+    """The values plotted along each axis of a figure dict (layout name -> sequences)."""
+    out: dict[str, list] = {}
+    for t in spec["data"]:
+        for axis in ("x", "y"):
+            values = t.get(axis)
+            if values is not None:
+                ref = t.get(f"{axis}axis") or axis
+                out.setdefault(f"{axis}axis{ref[1:]}", []).append(values)
+    return out
+
+
+def keep_ranges(spec: dict, before: dict | None) -> dict:
+    """Sticky axes: an axis of the figure dict ``spec`` takes the range it had in ``before``
+    (the layout of the panel on screen) when the new data lie inside it and span at least
+    :data:`KEEP_FILL` of it. Dragging a slider then does not make the axes jump, and the page
+    moves the lines without redrawing the panel (static/panels.js). Axes with a fixed tick step
+    (the cycles of the drift panel), without a range or with categories are left alone."""
+    if not before:
+        return spec
+    layout = spec["layout"]
+    for name, arrays in axis_data(spec).items():
+        axis, old = layout.get(name) or {}, (before.get(name) or {}).get("range")
+        if axis.get("range") is None or old is None or axis.get("dtick") is not None:
+            continue
+        try:
+            v = np.concatenate([np.asarray(a, dtype=float).ravel() for a in arrays])
+        except ValueError:  # (categories: not a numeric axis)
+            continue
+        if axis.get("type") == "log":
+            v = np.log10(v[v > 0])
+        v = v[np.isfinite(v)]
+        lo, hi = float(old[0]), float(old[1])
+        if v.size and lo <= v.min() and v.max() <= hi and np.ptp(v) >= KEEP_FILL * (hi - lo):
+            layout[name] = {**axis, "range": [lo, hi]}
+    return spec
+
+
+def stacked_axes(n: int, gap: float = 0.04) -> dict:
+    """Layout of n y-axes stacked over one shared x-axis (instead of make_subplots)."""
+    h = (1.0 - gap * (n - 1)) / n
+    out = {}
+    for k in range(n):
+        top = 1.0 - k * (h + gap)
+        lo, hi = max(0.0, round(top - h, 6)), min(1.0, round(top, 6))
+        out["yaxis" if k == 0 else f"yaxis{k + 1}"] = dict(domain=[lo, hi], anchor="x")
+    out["xaxis"] = dict(anchor=f"y{n}" if n > 1 else "y")
+    return out
