@@ -8,7 +8,11 @@ the catalogue gains appears in the API, its OpenAPI schema and the fuzz test wit
 Pydantic checks types, ranges, finiteness (``allow_inf_nan=False``: NaN and inf are rejected) and
 size bounds. What needs the registry (vector lengths against p and r, an augmentation that belongs
 to the robot, a singular start) is checked by :mod:`jik.app.compute.requests`, which names the
-field.
+field. The dashboard's state (:mod:`jik.app.dashboard.model`) uses the same field types and the
+same robot and map models.
+
+(About 400 lines: the API's one description of its requests and responses, read top to bottom
+as the OpenAPI document is.)
 """
 
 from __future__ import annotations

@@ -5,6 +5,9 @@ control specification, :mod:`jik.app.scene.controls`) and the draggable start po
 (:mod:`jik.app.scene.gizmo`) change the session's :class:`~jik.app.dashboard.Dashboard`
 exactly like the page's controls. The task plane is the world XY plane (z up); the nodes are
 those of :mod:`jik.app.scene.mechanisms`, posed along :class:`~jik.app.scene.pose.Timeline`.
+
+(About 440 lines, one class: drawing, the node sets kept per robot and the animation share the
+scene's lock, its timeline and its handles; split, each part would reach into the others'.)
 """
 
 from __future__ import annotations
