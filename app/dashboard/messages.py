@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import asyncio
 import hashlib
 import json
+from collections import OrderedDict
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -20,6 +22,40 @@ class Event:
     generation: int
     data: str
     result: DashboardResult | None = None
+
+
+class LatestEvents:
+    """The events a listener has not taken yet, at most one of each kind (the newest; of
+    ``ahead``, one per robot): a listener that reads slowly, or never, holds a bounded amount of
+    memory, and gets the newest of each kind when it reads. The page needs no more: a newer
+    state, result or progress replaces the older one.
+
+    :meth:`put` may be called from any thread; :meth:`get` is awaited on ``loop``.
+    """
+
+    def __init__(self, loop: asyncio.AbstractEventLoop) -> None:
+        self._loop = loop
+        self._events: OrderedDict[tuple[str, str], Event] = OrderedDict()
+        self._ready = asyncio.Event()
+
+    def __len__(self) -> int:
+        return len(self._events)
+
+    def put(self, event: Event) -> None:
+        self._loop.call_soon_threadsafe(self._put, event)
+
+    def _put(self, event: Event) -> None:
+        robot = event.result.state.robot if event.kind == "ahead" and event.result else ""
+        key = (event.kind, robot)
+        self._events.pop(key, None)
+        self._events[key] = event  # (the newest last: the events keep their order)
+        self._ready.set()
+
+    async def get(self) -> Event:
+        while not self._events:
+            self._ready.clear()
+            await self._ready.wait()
+        return self._events.popitem(last=False)[1]
 
 
 def digest(text: str) -> str:

@@ -214,3 +214,31 @@ def test_the_scene_socket_refuses_other_origins_and_unknown_sessions(client):
         with client.websocket_connect("/api/sessions/nope/scene"):
             pass
     assert unknown.value.code == 4404
+
+
+def test_a_listener_that_never_reads_holds_one_event_of_each_kind(app, client):
+    """The event stream of a page that stops reading buffers the newest event of each kind, not
+    one per change (issue 26: ~0.45 MB per change, never released)."""
+    import asyncio
+
+    from jik.app.dashboard.messages import LatestEvents
+
+    session = _open(client)
+    dashboard = app.state.sessions.get(session["id"]).dashboard
+
+    async def changes() -> tuple[int, list]:
+        buffer = LatestEvents(asyncio.get_running_loop())
+        unsubscribe = dashboard.subscribe(buffer.put)
+        for k in range(40):
+            generation, _ = dashboard.update({"gamma": 0.5 + 0.01 * k})
+            await asyncio.to_thread(dashboard.wait, generation, 60)
+        await asyncio.sleep(0.05)  # (the loop takes the last puts)
+        unsubscribe()
+        held = len(buffer)
+        return held, [await buffer.get() for _ in range(held)]
+
+    held, events = asyncio.run(changes())
+    kinds = [e.kind for e in events]
+    assert held <= 7 and len(set(kinds)) == len(kinds), kinds
+    result = next(e for e in events if e.kind == "result")
+    assert result.generation == dashboard.generation  # the newest

@@ -21,8 +21,9 @@ from pydantic import BaseModel, ConfigDict, Field
 from websockets.typing import Subprotocol
 
 from jik.app.api.dependencies import Store
-from jik.app.dashboard import Event, export_csv, export_json
+from jik.app.dashboard import export_csv, export_json
 from jik.app.dashboard.controls import controls_message
+from jik.app.dashboard.messages import LatestEvents
 from jik.app.dashboard.sessions import Session, SessionNotFound, SessionsFull
 from jik.engine.exceptions import InvalidInputError
 
@@ -152,13 +153,8 @@ async def events(session_id: str, request: Request, store: Store):
     except SessionNotFound:
         return _not_found(session_id)
     dashboard = session.dashboard
-    loop = asyncio.get_running_loop()
-    queue: asyncio.Queue[Event] = asyncio.Queue()
-
-    def listener(event: Event) -> None:
-        loop.call_soon_threadsafe(queue.put_nowait, event)
-
-    unsubscribe = dashboard.subscribe(listener)
+    queue = LatestEvents(asyncio.get_running_loop())  # (bounded: one event of each kind)
+    unsubscribe = dashboard.subscribe(queue.put)
     session.users += 1
 
     async def stream():
@@ -171,9 +167,6 @@ async def events(session_id: str, request: Request, store: Store):
                     if await request.is_disconnected():
                         return
                     yield ": keep-alive\n\n"
-                    continue
-                # A newer result makes queued progress of older generations pointless.
-                if event.kind == "progress" and event.generation < dashboard.generation:
                     continue
                 if event.kind not in PAGE_EVENTS:
                     continue
