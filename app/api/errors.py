@@ -22,6 +22,7 @@ from typing import Any
 from fastapi import FastAPI, HTTPException, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
+from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from jik.app.compute.exceptions import ComputeError, RequestError, ServiceUnavailable
@@ -55,6 +56,12 @@ def _validation_detail(errors) -> list[dict]:
         msg = str(e.get("msg", "invalid"))
         if e.get("type") == "extra_forbidden":
             msg = "unknown field; remove it"
+        elif e.get("type") == "json_invalid":  # (loc: the body and the character's position)
+            ctx = e.get("ctx") or {}
+            where = f" at character {loc[1]}" if len(loc) > 1 else ""
+            detail.append({"loc": ["body"], "type": "json_invalid", "msg":
+                           f"body: not valid JSON{where}: {ctx.get('error', msg)}"})  # fmt: skip
+            continue
         elif e.get("type") == "union_tag_invalid":
             ctx = e.get("ctx") or {}
             msg = f"unknown name {ctx.get('tag')!r}; choose one of {ctx.get('expected_tags')}"
@@ -71,6 +78,34 @@ def request_error_response(exc: RequestError) -> JSONResponse:
     return JSONResponse(
         status_code=422, content={"detail": [{"loc": loc, "msg": str(exc), "type": "value_error"}]}
     )
+
+
+#: What FastAPI says of a body it could not parse (a JSON nested too deep, bytes that are not
+#: UTF-8), as a 400 of its own: answered as the client's bad input it is, 422 on ``body``.
+_UNPARSED = "There was an error parsing the body"
+
+
+def unparsed_body_response(exc: Exception) -> JSONResponse:
+    """422 for a body that is not readable JSON (the reason from the parser's error)."""
+    cause = exc.__cause__ if isinstance(exc, StarletteHTTPException) else exc
+    if isinstance(cause, RecursionError):
+        why = "its arrays or objects are nested too deep"
+    elif isinstance(cause, UnicodeDecodeError):
+        why = "it is not UTF-8 text"
+    else:
+        why = "it is not valid JSON"
+    return JSONResponse(status_code=422, content={"detail": [{
+        "loc": ["body"], "msg": f"body: the body cannot be read as JSON: {why}",
+        "type": "json_invalid"}]})  # fmt: skip
+
+
+def http_error_response(exc: StarletteHTTPException) -> JSONResponse:
+    """The framework's HTTP errors (404, 405 with its Allow header, ...) as it answers them,
+    but its unparsed-body 400 as :func:`unparsed_body_response`."""
+    if exc.status_code == 400 and exc.detail == _UNPARSED:
+        return unparsed_body_response(exc)
+    return JSONResponse(status_code=exc.status_code, content={"detail": exc.detail},
+                        headers=getattr(exc, "headers", None))  # fmt: skip
 
 
 def busy_response(exc: ServiceUnavailable) -> JSONResponse:
@@ -96,6 +131,7 @@ _RESPONSES: dict[type[Exception], Callable[[Any], JSONResponse]] = {
     RequestError: request_error_response,
     ServiceUnavailable: busy_response,
     ComputeError: compute_error_response,
+    StarletteHTTPException: http_error_response,
 }
 
 

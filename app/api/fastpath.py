@@ -78,7 +78,7 @@ class SolveFastPath:
         body = b"".join(chunks)
         try:
             req = SolveRequest.model_validate(json.loads(body))  # as FastAPI reads a JSON body
-        except (ValueError, ValidationError):  # the route says what is wrong, in its format
+        except (ValueError, RecursionError, ValidationError):  # the route says what is wrong
             await self.app(scope, _replay(body, receive), send)
             return
         self.served += 1

@@ -122,7 +122,7 @@ def test_augmentation_parameter_refused_by_the_registry(api):
 def test_malformed_json(api):
     r = api.post("/solve", content="{not json", headers={"content-type": "application/json"})
     assert r.status_code == 422
-    assert "JSON decode error" in r.json()["detail"][0]["msg"]
+    assert r.json()["detail"][0]["msg"].startswith("body: not valid JSON at character 1: ")
 
 
 def test_missing_fields(api):
@@ -162,3 +162,45 @@ def test_oversized_body_without_a_length_is_413(api, path):
     r = api.post(path, content=chunks(), headers={"content-type": "application/json"})
     assert r.status_code == 413
     assert "more than 1048576 bytes" in r.json()["detail"]
+
+
+DEEP = b"[" * 50_000 + b"]" * 50_000
+
+
+@pytest.mark.parametrize("path", ["/solve", "/repeatability", "/synthesize", "/api/sessions"])
+def test_a_body_nested_too_deep_is_422_not_500(api, path):
+    """A JSON nested past Python's recursion limit is the client's bad input (it was a 500
+    with the exception's text, issue 26 item 3)."""
+    r = api.post(path, content=DEEP, headers={"content-type": "application/json"})
+    assert r.status_code == 422, r.text
+    (error,) = r.json()["detail"]
+    assert error["loc"] == ["body"] and "nested too deep" in error["msg"]
+    assert "Recursion" not in r.text
+
+
+def test_bad_session_changes_are_422_naming_the_field(api):
+    session = api.post("/api/sessions", json={"state": {}}).json()["id"]
+    url = f"/api/sessions/{session}/state"
+    for body, field in [
+        ({"robot_parameters": "abc"}, "robot_parameters"),
+        ({"robot_parameters": 5}, "robot_parameters"),
+        ({"path": 5}, "path"),
+        ({"augmentation_parameters": [1, 2]}, "augmentation_parameters"),
+    ]:
+        r = api.post(url, json=body)
+        assert r.status_code == 422, (body, r.text)
+        assert r.json()["detail"][0]["loc"] == ["body", field]
+    r = api.post(url, content=DEEP, headers={"content-type": "application/json"})
+    assert r.status_code == 422 and "nested too deep" in r.text
+    api.delete(f"/api/sessions/{session}")
+
+
+@pytest.mark.parametrize(
+    ("body", "says"),
+    [(b'{"robot": ', "not valid JSON at character 10"), (b'{"robot": "\xff"}', "not UTF-8")],
+)
+def test_a_body_that_is_not_json_says_why(api, body, says):
+    """(FastAPI answered these with an undocumented 400 'There was an error parsing the body'.)"""
+    r = api.post("/repeatability", content=body, headers={"content-type": "application/json"})
+    assert r.status_code == 422, r.text
+    assert r.json()["detail"][0]["loc"] == ["body"] and says in r.text

@@ -21,6 +21,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from websockets.typing import Subprotocol
 
 from jik.app.api.dependencies import Store
+from jik.app.api.errors import unparsed_body_response
 from jik.app.dashboard import export_csv, export_json
 from jik.app.dashboard.controls import controls_message
 from jik.app.dashboard.messages import LatestEvents
@@ -129,8 +130,8 @@ async def post_state(session_id: str, request: Request, store: Store) -> JSONRes
         return _not_found(session_id)
     try:
         patch = await request.json()
-    except ValueError:
-        return _invalid((), "the body must be a JSON object")
+    except (ValueError, RecursionError) as exc:
+        return unparsed_body_response(exc)
     if not isinstance(patch, dict):
         return _invalid((), "the body must be a JSON object of dashboard fields")
     try:
