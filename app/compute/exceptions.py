@@ -14,5 +14,10 @@ class ServiceUnavailable(RuntimeError):
     """No compute slot became free within the time limit (or a worker died): HTTP 503."""
 
 
+class WorkerLost(ServiceUnavailable):
+    """A compute worker died or stopped responding (the server's fault, not the request's): it
+    is replaced; a request whose worker died is retried once on a fresh one."""
+
+
 class ComputeError(RuntimeError):
     """An unexpected failure inside a worker: HTTP 500 with its description."""

@@ -25,7 +25,12 @@ from typing import Any
 import numpy as np
 
 from jik.app.compute import schemas as S
-from jik.app.compute.exceptions import ComputeError, RequestError, ServiceUnavailable
+from jik.app.compute.exceptions import (
+    ComputeError,
+    RequestError,
+    ServiceUnavailable,
+    WorkerLost,
+)
 from jik.app.compute.precheck import precheck
 from jik.app.compute.requests import batch_key
 from jik.app.compute.settings import Settings, settings_from_env
@@ -36,6 +41,11 @@ def _retrieve(future: asyncio.Future) -> None:
     """Mark an abandoned request's exception as seen (no 'never retrieved' warning)."""
     if not future.cancelled():
         future.exception()
+
+
+#: A computation that overran its time limit while its worker computed less than this share of
+#: it was not the request's work: the worker hung (the server's fault, 503).
+HUNG = 0.1
 
 
 @dataclass
@@ -156,12 +166,22 @@ class ComputePool:
             if not worker.ready:  # a freshly started worker: importing the engine takes a while
                 await loop.run_in_executor(self._threads, worker.wait_ready)
             deadline = loop.time() + self.settings.timeout
+            cpu = worker.cpu_seconds()
             os.set_blocking(worker.conn.fileno(), True)  # uvloop's add_reader made it non-blocking
             worker.conn.send((kind, payload))
             msg = await self._reply(worker, deadline)
         except TimeoutError:
-            self.stats["exceeded"] += 1
+            used = worker.cpu_seconds() if cpu is not None else None
             self._replace(worker)
+            if cpu is not None and used is not None and used - cpu < HUNG * self.settings.timeout:
+                # The worker hardly computed: it hung (stopped, deadlocked), not the request's
+                # work; the server's fault.
+                raise WorkerLost(
+                    f"the server's compute worker stopped responding (it computed "
+                    f"{used - cpu:.2f} s of the {self.settings.timeout:g} s limit) and was "
+                    "replaced; retry the request"
+                ) from None
+            self.stats["exceeded"] += 1
             field, less = WORK_FIELDS.get(kind, ("request", "less work"))
             raise RequestError(
                 field,
@@ -170,7 +190,10 @@ class ComputePool:
             ) from None
         except (EOFError, OSError) as exc:
             self._replace(worker)
-            raise ServiceUnavailable(f"the compute worker stopped unexpectedly ({exc!r})") from None
+            raise WorkerLost(
+                f"the server's compute worker stopped unexpectedly ({type(exc).__name__}) and "
+                "was replaced"
+            ) from None
         except asyncio.CancelledError:  # the request went away: collect the reply in the back
             if worker.ready:
                 self._spawn(self._drain(worker, loop.time() + self.settings.timeout))
@@ -250,8 +273,23 @@ class ComputePool:
         For the API kinds the payload is the request and the result the response, as JSON bytes.
         """
         self._bind()
-        worker = await self._acquire(self._bound_loop.time() + self.settings.timeout)
-        return self._unwrap(await self._dispatch(worker, kind, payload))
+        return self._unwrap(await self._dispatch_retried(kind, payload))
+
+    async def _dispatch_retried(self, kind: str, payload, worker: Worker | None = None):
+        """:meth:`_dispatch` on ``worker`` (or the next free one); if that worker had died (it
+        died while idle, or with this computation), once more on a fresh one."""
+        for attempt in (1, 2):
+            if worker is None:
+                worker = await self._acquire(self._bound_loop.time() + self.settings.timeout)
+            started = self._bound_loop.time()
+            try:
+                return await self._dispatch(worker, kind, payload)
+            except WorkerLost:
+                hung = self._bound_loop.time() - started >= self.settings.timeout
+                if attempt == 2 or hung:  # (a hung worker has used the request's time up)
+                    raise
+                worker = None
+        raise AssertionError("unreachable")
 
     def submit(self, kind: str, payload) -> concurrent.futures.Future:
         """:meth:`run` from another thread (the dashboards' workers): a future of its result,
@@ -341,7 +379,7 @@ class ComputePool:
     async def _solve_share(self, worker: Worker, items: list[_Pending]) -> None:
         """Solve ``items`` in ONE engine call on ``worker`` and hand each its result."""
         try:
-            msg = await self._dispatch(worker, "solve", [p.payload for p in items])
+            msg = await self._dispatch_retried("solve", [p.payload for p in items], worker)
             results = self._unwrap(msg)
         except Exception as exc:  # handed to every request of the batch
             for p in items:

@@ -146,6 +146,16 @@ class Worker:
             self.conn.recv()
             self.ready = True
 
+    def cpu_seconds(self) -> float | None:
+        """CPU time the worker has used (user and system), from /proc; None where there is no
+        /proc or the process is gone."""
+        try:
+            with open(f"/proc/{self.process.pid}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+            return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+        except (OSError, ValueError, IndexError):
+            return None
+
     def kill(self) -> None:
         self.process.kill()
         self.process.wait(5)

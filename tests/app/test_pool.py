@@ -115,3 +115,51 @@ def test_a_cancelled_request_gives_its_worker_back_after_the_reply():
 
     pid, pids, stats = asyncio.run(main())
     assert pids == [pid] and stats["exceeded"] == 0
+
+
+def _client(settings):
+    from fastapi.testclient import TestClient
+
+    from jik.app.api.factory import create_app
+
+    return TestClient(create_app(settings), base_url="http://127.0.0.1")
+
+
+def test_a_worker_that_died_while_idle_costs_no_request_an_error():
+    """The next request is retried once on a fresh worker (it was a 503, issue 26 item 6)."""
+    from jik.app.compute.settings import Settings
+    from tests.app.conftest import TABLE1_PATH, X0_M2, solve_body
+
+    with _client(Settings(workers=1, timeout=60.0)) as client:
+        pool = client.app.state.pool
+        for path, body in [
+            ("/solve", solve_body()),
+            ("/repeatability", {**solve_body(), "path": TABLE1_PATH, "target": None}),
+        ]:
+            body = {k: v for k, v in body.items() if v is not None}
+            (worker,) = pool._workers
+            worker.process.kill()
+            worker.process.wait(10)
+            r = client.post(path, json=body)
+            assert r.status_code == 200, (path, r.text)
+            assert pool._workers[0] is not worker  # (replaced)
+        assert X0_M2  # (the bodies start there)
+
+
+def test_a_hung_worker_is_the_servers_fault_503_not_the_requests_422():
+    """A worker that stops computing (SIGSTOP) runs out the time limit without using the CPU:
+    503 naming the server, and a fresh worker serves the next request."""
+    import os
+    import signal
+
+    from jik.app.compute.settings import Settings
+    from tests.app.conftest import solve_body
+
+    with _client(Settings(workers=1, timeout=2.0, batching=False)) as client:
+        pool = client.app.state.pool
+        (worker,) = pool._workers
+        os.kill(worker.process.pid, signal.SIGSTOP)
+        r = client.post("/solve", json=solve_body())
+        assert r.status_code == 503, r.text
+        assert "server's compute worker stopped responding" in r.json()["detail"]
+        assert client.post("/solve", json=solve_body()).status_code == 200
