@@ -87,7 +87,7 @@ class ComputePool:
         """Start the worker processes (idempotent, non-blocking)."""
         with self._lock:
             while len(self._workers) < self.settings.workers:
-                self._workers.append(Worker())
+                self._workers.append(Worker(self.settings.worker_memory))
 
     def close(self) -> None:
         """Stop every worker process."""
@@ -254,7 +254,7 @@ class ComputePool:
         with self._lock:
             if worker in self._workers:
                 self._workers.remove(worker)
-            fresh = Worker()
+            fresh = Worker(self.settings.worker_memory)
             self._workers.append(fresh)
         self._bound_idle.put_nowait(fresh)
 

@@ -23,6 +23,9 @@ class Settings:
     max_batch: int = 64
     #: A batch is split among idle workers only into shares of at least this many requests.
     min_share: int = 4
+    #: Address space a worker may use [MB] (0: no limit). A computation that needs more ends
+    #: in a 422 naming what to ask for less of; the worker lives on.
+    worker_memory: int = 1024
 
 
 def env_flag(name: str, default: bool = True) -> bool:
@@ -35,11 +38,13 @@ def env_flag(name: str, default: bool = True) -> bool:
 
 def settings_from_env() -> Settings:
     """``JIK_WORKERS`` (default: CPU count, 1..8), ``JIK_TIMEOUT`` [s] (default 20),
-    ``JIK_BATCH`` (``0`` disables micro-batching), ``JIK_BATCH_WINDOW_MS`` (default 2)."""
+    ``JIK_BATCH`` (``0`` disables micro-batching), ``JIK_BATCH_WINDOW_MS`` (default 2),
+    ``JIK_WORKER_MEMORY_MB`` (default 1024; 0 for no limit)."""
     env = os.environ
     return Settings(
         workers=max(1, min(8, int(env.get("JIK_WORKERS", os.cpu_count() or 2)))),
         timeout=float(env.get("JIK_TIMEOUT", 20.0)),
         batching=env_flag("JIK_BATCH"),
         batch_window=float(env.get("JIK_BATCH_WINDOW_MS", 2.0)) / 1000.0,
+        worker_memory=max(0, int(env.get("JIK_WORKER_MEMORY_MB", Settings.worker_memory))),
     )

@@ -96,8 +96,18 @@ def _worker_main(conn) -> None:
         conn.send(msg)
 
 
-def _worker_entry(fd: int) -> None:
-    """Entry point of a worker process started by :class:`Worker` (``python -c``)."""
+def _worker_entry(fd: int, memory_mb: int = 0) -> None:
+    """Entry point of a worker process started by :class:`Worker` (``python -c``): its address
+    space limited to ``memory_mb`` (0: none), so that a computation too large for it raises
+    MemoryError (a 422) instead of taking the machine's memory."""
+    if memory_mb > 0:
+        try:
+            import resource
+
+            limit = memory_mb * 1024 * 1024
+            resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+        except (ImportError, ValueError, OSError):  # (no such limit here: run without)
+            pass
     _worker_main(Connection(fd))
 
 
@@ -121,7 +131,7 @@ def frame_header(buf: bytearray) -> tuple[int | None, int]:
 class Worker:
     """A worker process (a fresh interpreter, so nothing of the server's state is inherited)."""
 
-    def __init__(self) -> None:
+    def __init__(self, memory_mb: int = 0) -> None:
         parent, child = socket.socketpair()
         fd = child.fileno()
         env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
@@ -129,7 +139,8 @@ class Worker:
             [
                 sys.executable,
                 "-c",
-                f"from jik.app.compute.worker import _worker_entry; _worker_entry({fd})",
+                "from jik.app.compute.worker import _worker_entry; "
+                f"_worker_entry({fd}, {int(memory_mb)})",
             ],
             pass_fds=[fd],
             env=env,
