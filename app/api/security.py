@@ -27,6 +27,7 @@ import os
 from collections.abc import Iterable
 from urllib.parse import urlsplit
 
+from starlette.routing import Match
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 #: Host names allowed by default: the loopback names.
@@ -127,7 +128,7 @@ class SecurityMiddleware:
         if (websocket or method in CHANGES) and origin is not None:
             if origin == "null" or urlsplit(origin).netloc.lower() != host.lower():
                 return 403, f"a request from another origin ({origin}) may not change anything"
-        if method in _BODIES:
+        if method in _BODIES and _routed(scope):
             kind = headers.get("content-type", "").split(";")[0].strip().lower()
             if kind != "application/json" and not kind.endswith("+json"):
                 return 415, (
@@ -135,6 +136,16 @@ class SecurityMiddleware:
                     f"{kind or 'none'!r}"
                 )
         return None
+
+
+def _routed(scope: Scope) -> bool:
+    """Whether a route of the app takes this method at this path (else the router answers,
+    404 or 405 with its Allow header, whatever the body)."""
+    app = scope.get("app")
+    routes = getattr(getattr(app, "router", None), "routes", None)
+    if routes is None:
+        return True
+    return any(route.matches(scope)[0] == Match.FULL for route in routes)
 
 
 async def _json(send: Send, status: int, message: str) -> None:

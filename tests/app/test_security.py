@@ -108,3 +108,21 @@ def test_responses_carry_the_safety_headers(client, path):
     assert "frame-ancestors 'self'" in policy and "default-src 'self'" in policy
     if path in ("/", "/health", "/static/main.js"):
         assert "script-src 'self';" in policy  # (no inline script on our page)
+
+
+def test_a_method_a_route_does_not_take_is_405_with_allow_not_415(client):
+    """The content-type check applies to the routes that take the body; the router answers the
+    rest (405 with its Allow header)."""
+    r = client.put("/api/sessions", content=b"x", headers={"content-type": "text/plain"})
+    assert r.status_code == 405 and r.headers["allow"] == "POST"
+    r = client.post("/health", content=b"x", headers={"content-type": "text/plain"})
+    assert r.status_code == 405 and r.headers["allow"] == "GET"
+
+
+def test_the_openapi_document_gives_the_event_stream_and_the_csv_their_types(client):
+    """(Both were documented as JSON, issue 26 item 8.)"""
+    paths = client.get("/openapi.json").json()["paths"]
+    events = paths["/api/sessions/{session_id}/events"]["get"]["responses"]
+    assert list(events["200"]["content"]) == ["text/event-stream"] and "404" in events
+    csv = paths["/api/sessions/{session_id}/export.csv"]["get"]["responses"]
+    assert list(csv["200"]["content"]) == ["text/csv"] and {"404", "503"} <= set(csv)

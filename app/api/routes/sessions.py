@@ -141,7 +141,22 @@ async def post_state(session_id: str, request: Request, store: Store) -> JSONRes
     return JSONResponse({"generation": generation, "state": state.as_dict()})
 
 
-@router.get("/api/sessions/{session_id}/events")
+class CSVResponse(PlainTextResponse):
+    media_type = "text/csv"
+
+
+#: A session that is not there (expired, deleted, never created).
+_NOT_FOUND: dict[int | str, dict] = {404: {"description": "no such session"}}
+
+
+@router.get(
+    "/api/sessions/{session_id}/events",
+    response_class=StreamingResponse,
+    responses={
+        200: {"description": "the session's events", "content": {"text/event-stream": {}}},
+        **_NOT_FOUND,
+    },
+)
 async def events(session_id: str, request: Request, store: Store):
     """Server-sent events of one session: ``state``, ``progress``, ``result``, ``functionals``,
     ``error``, ``ahead``, ``refused``.
@@ -192,7 +207,10 @@ async def _finished(session: Session):
     return dashboard
 
 
-@router.get("/api/sessions/{session_id}/export.json")
+@router.get(
+    "/api/sessions/{session_id}/export.json",
+    responses={503: {"description": "no result computed yet"}, **_NOT_FOUND},
+)
 async def export_result_json(session_id: str, store: Store) -> JSONResponse:
     """The session's result, every trajectory point of both algorithms, as JSON."""
     try:
@@ -207,7 +225,15 @@ async def export_result_json(session_id: str, store: Store) -> JSONResponse:
     )
 
 
-@router.get("/api/sessions/{session_id}/export.csv")
+@router.get(
+    "/api/sessions/{session_id}/export.csv",
+    response_class=CSVResponse,
+    responses={
+        200: {"description": "one row per trajectory point"},
+        503: {"description": "no result computed yet"},
+        **_NOT_FOUND,
+    },
+)
 async def export_result_csv(session_id: str, store: Store):
     """The session's result as CSV: one row per trajectory point and algorithm."""
     try:
