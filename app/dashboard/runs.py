@@ -143,7 +143,7 @@ def _run_legs(
     except RunCancelled:
         raise Cancelled from None
     ends = run.legs[np.isfinite(run.legs).all(axis=1)]
-    cycle_ends = ends[L - 1 :: L] if state.task == "path" else []
+    cycle_ends = ends[L - 1 :: L] if state.task == "path" else ends[:0]
     drift = [float(np.linalg.norm(e - x0)) for e in cycle_ends]
     return AlgorithmRun(
         algorithm=inverse.name,
