@@ -21,6 +21,23 @@ def api():
         yield client
 
 
+@pytest.fixture
+def app():
+    """An app whose dashboard sessions (at most 4) have no 3D scene, without its lifespan: the
+    sessions compute in their own threads."""
+    from jik.app.dashboard.sessions import SessionLimits, SessionStore
+
+    app = create_app()
+    app.state.sessions = SessionStore(SessionLimits(max_sessions=4))
+    yield app
+    app.state.sessions.close()
+
+
+@pytest.fixture
+def client(app):
+    return TestClient(app)
+
+
 def solve_body(**over) -> dict:
     """A valid /solve request for Manipulator 2 (Table 1's start), with overrides."""
     body = {

@@ -7,22 +7,10 @@ from fastapi.testclient import TestClient
 from starlette.websockets import WebSocketDisconnect
 
 from jik.app.api.factory import create_app
-from jik.app.dashboard.sessions import SessionLimits, SessionStore
 
 FOREIGN = "http://evil.example"
 
 
-@pytest.fixture
-def app():
-    app = create_app(allowed_hosts=("testserver",))
-    app.state.sessions = SessionStore(SessionLimits(max_sessions=4))
-    yield app
-    app.state.sessions.close()
-
-
-@pytest.fixture
-def client(app):
-    return TestClient(app)
 
 
 def test_an_unknown_host_is_refused_on_http_and_websocket(app):

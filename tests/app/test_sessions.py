@@ -16,18 +16,6 @@ from jik.app.dashboard.sessions import SessionLimits, SessionNotFound, SessionsF
 JSON = {"content-type": "application/json"}
 
 
-@pytest.fixture
-def app():
-    """The app with a scene-less session store (no lifespan: sessions need no compute pool)."""
-    app = create_app()
-    app.state.sessions = SessionStore(SessionLimits(max_sessions=4))
-    yield app
-    app.state.sessions.close()
-
-
-@pytest.fixture
-def client(app):
-    return TestClient(app)
 
 
 def _open(client, state=None) -> dict:
