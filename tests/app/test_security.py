@@ -11,8 +11,6 @@ from jik.app.api.factory import create_app
 FOREIGN = "http://evil.example"
 
 
-
-
 def test_an_unknown_host_is_refused_on_http_and_websocket(app):
     """A DNS-rebinding page reaches the server under its own name: refused before any route."""
     rebound = TestClient(app, base_url="http://attacker.example:8000")

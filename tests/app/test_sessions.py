@@ -16,8 +16,6 @@ from jik.app.dashboard.sessions import SessionLimits, SessionNotFound, SessionsF
 JSON = {"content-type": "application/json"}
 
 
-
-
 def _open(client, state=None) -> dict:
     r = client.post("/api/sessions", json={"state": state or {}})
     assert r.status_code == 201, r.text
