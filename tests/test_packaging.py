@@ -54,11 +54,29 @@ def _runtime_distributions(extra: str | None) -> set[str]:
     return seen
 
 
+def _optional(tree: ast.AST) -> set[ast.AST]:
+    """The import statements inside ``try: ... except ImportError``: optional dependencies,
+    whose absence the code handles."""
+    out: set[ast.AST] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Try) and any(
+            isinstance(h.type, ast.Name) and h.type.id in ("ImportError", "ModuleNotFoundError")
+            for h in node.handlers
+        ):
+            out.update(n for stmt in node.body for n in ast.walk(stmt))
+    return out
+
+
 def _third_party_imports(folder: str) -> dict[str, str]:
-    """Top-level modules imported by the code in ``folder`` -> a file that imports it."""
+    """Top-level modules imported by the code in ``folder`` -> a file that imports it (not the
+    optional ones, see :func:`_optional`)."""
     found: dict[str, str] = {}
     for path in sorted((ROOT / folder).rglob("*.py")):
-        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        optional = _optional(tree)
+        for node in ast.walk(tree):
+            if node in optional:
+                continue
             if isinstance(node, ast.Import):
                 names = [alias.name for alias in node.names]
             elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:

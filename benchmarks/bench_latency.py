@@ -1,0 +1,700 @@
+"""Dashboard latency: a control change to the plots and to the 3D scene, medians and p95.
+
+Issue 27's targets: p95 under 300 ms for a manipulator change and under 2 s for the unicycle,
+on a machine without a GPU. A real ``jik serve`` runs on a free loopback port, and the same
+kinds of change are made through it: gamma, the start point x1, the arm length l, the number
+of cycles, the switches from Manipulator 2 to Manipulator 1 and back, then the switch to the
+unicycle and changes of its start point lambda10 and of gamma. Two measurements:
+
+* **Server only** (httpx, no browser): ``POST /api/sessions/{id}/state`` with the control's
+  key, as the page sends it, to the arrival of that generation's ``result`` event on the
+  session's event stream. Straightforward: a fresh session created with the state after the
+  change (``POST /api/sessions``) to its first ``result``: the same state computed cold,
+  without the live session's run cache, the cycles it resumes, the panels it reuses and the
+  other manipulator solved ahead. Its setup (the POST: a viser server per session) is shown
+  apart.
+* **Browser** (Debian's chromium, headless, software WebGL): from the control's ``input`` (a
+  slider) or ``change`` (a select) event, dispatched in the page, to ``body[data-generation]``
+  reaching the new generation (the page sets it once the plots are drawn), and to the viser
+  client in the iframe first showing ``generation N`` (its status, sent after the scene's
+  nodes). Both are MutationObservers on the same wall clock. Straightforward: the page loaded
+  anew with the changed state in its link (``?state=``, what a reload or a copied link does): a
+  new session computes it cold and the page and the scene draw it from nothing, as a
+  dashboard that reloads on every change would; timed from the navigation's start. Changes
+  of each kind alternate between the two.
+
+No value repeats within a session, so that no change finds its runs cached. Each browser page
+is a session of its own (the first switch to the unicycle is never cached). Between changes
+the benchmark waits until the server's processes and the page's plotly calls are idle (their
+background work, E1/E2 and the robot solved ahead, is not part of the next change). The
+machine's load is reported with the figures: the load average, the CPU steal and the CPU that
+other processes used meanwhile.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import os
+import re
+import socket
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+from urllib.parse import parse_qs, quote, urlsplit
+
+import numpy as np
+
+from jik.app.dashboard.controls import element_id
+
+CHROMIUM = "/usr/bin/chromium"
+#: Issue 27: p95 of a change [ms], by family.
+TARGETS_MS = {"manipulator": 300.0, "unicycle": 2000.0}
+#: Seconds a change may take to reach the plots or the scene before the benchmark gives up.
+CHANGE_TIMEOUT = 60.0
+
+
+@dataclass(frozen=True)
+class Change:
+    """One control change: the control ``key`` (as the page sends it) set to ``value``."""
+
+    kind: str
+    family: str  # "manipulator" or "unicycle": which target applies
+    key: str  # "gamma", "x0.0", "robot_parameters.l", "cycles", "robot"
+    value: float | str
+    log: bool = False  # a log-scale slider (its position is log10 of the value)
+
+    @property
+    def selector(self) -> str:
+        return "#" + element_id(self.key)
+
+    @property
+    def event(self) -> str:
+        return "change" if isinstance(self.value, str) else "input"
+
+    @property
+    def position(self) -> float | str:
+        """The page's input value for this change."""
+        if isinstance(self.value, str):
+            return self.value
+        return math.log10(self.value) if self.log else self.value
+
+    def linked(self, state: dict) -> dict:
+        """The state of a link after this change (a robot switch: that robot's defaults)."""
+        if self.key == "robot":
+            return {"robot": self.value}
+        state = json.loads(json.dumps(state))
+        head, _, rest = self.key.partition(".")
+        if head == "x0":
+            state["x0"][int(rest)] = self.value
+        elif rest:
+            state[head][rest] = self.value
+        else:
+            state[head] = self.value
+        return state
+
+
+def plan(sessions: int, rounds: int, unicycle_changes: int) -> list[list[Change]]:
+    """The changes of each session: ``rounds`` rounds of Manipulator 2's controls and the
+    switches to Manipulator 1 and back, then the switch to the unicycle and
+    ``unicycle_changes`` changes of it. A slider's values lie at least two of its steps apart
+    and never repeat within a session, so that no change finds its runs cached."""
+    m, u = "manipulator", "unicycle"
+    out = []
+    for s in range(sessions):
+        changes = []
+        for r in range(rounds):
+            n = s * rounds + r
+            gamma, x1, arm = 1.25 * 1.08**n, 0.06 + 0.03 * n, 1.05 + 0.05 * n
+            changes += [
+                Change("gamma (manipulator2)", m, "gamma", round(gamma, 3), log=True),
+                Change("start point x1 (manipulator2)", m, "x0.0", round(x1, 3)),
+                Change("arm length l (manipulator2)", m, "robot_parameters.l", round(arm, 3)),
+                Change("cycles (manipulator2)", m, "cycles", 4 + n % 3),
+                Change("switch to manipulator1", m, "robot", "manipulator1"),
+                Change("switch to manipulator2", m, "robot", "manipulator2"),
+            ]
+        changes.append(Change("switch to unicycle", u, "robot", "unicycle"))
+        for i in range(unicycle_changes):
+            k = s * unicycle_changes + i
+            if i % 2 == 0:  # lambda10 = 0.5 +- 0.03, 0.06, ...
+                lam = 0.5 + (-1) ** (k // 2) * 0.03 * (k // 4 + 1)
+                changes.append(Change("start point lambda10 (unicycle)", u, "x0.0", round(lam, 3)))
+            else:
+                gamma = 0.1 * 1.04 ** (k + 1)
+                changes.append(Change("gamma (unicycle)", u, "gamma", round(gamma, 3), log=True))
+        out.append(changes)
+    return out
+
+
+def _progress(text: str) -> None:
+    """Where the run is, on one line of a terminal (nothing when stderr is not one)."""
+    if sys.stderr.isatty():
+        sys.stderr.write(f"\r  {text:60}\r")
+        sys.stderr.flush()
+
+
+# -- the machine ------------------------------------------------------------------------------
+_TICK = os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100
+
+
+def _proc_table() -> dict[int, tuple[int, int]]:
+    """pid -> (parent pid, CPU ticks of the process and its reaped children)."""
+    table = {}
+    for name in os.listdir("/proc"):
+        if not name.isdigit():
+            continue
+        try:
+            with open(f"/proc/{name}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        # (fields[0] is the state; utime, stime, cutime, cstime are fields 14-17 of stat(5))
+        table[int(name)] = (int(fields[1]), sum(int(v) for v in fields[11:15]))
+    return table
+
+
+def tree_seconds(pid: int) -> float:
+    """CPU seconds used by ``pid`` and its descendants (reaped ones included); 0 without /proc."""
+    if not os.path.isdir("/proc"):
+        return 0.0
+    table = _proc_table()
+    tree, grew = {pid}, True
+    while grew:
+        more = {p for p, (parent, _) in table.items() if parent in tree} - tree
+        tree |= more
+        grew = bool(more)
+    return sum(table[p][1] for p in tree if p in table) / _TICK
+
+
+def quiet(pid: int, share: float = 0.15, window: float = 0.25, timeout: float = 60.0) -> bool:
+    """Wait until ``pid`` and its descendants used at most ``share`` of one core in each of two
+    consecutive windows of ``window`` s; False if that did not happen within ``timeout`` s."""
+    if not os.path.isdir("/proc"):
+        return True
+    deadline, calm = time.monotonic() + timeout, 0
+    before = tree_seconds(pid)
+    while time.monotonic() < deadline:
+        time.sleep(window)
+        now = tree_seconds(pid)
+        calm = calm + 1 if now - before <= share * window else 0
+        before = now
+        if calm >= 2:
+            return True
+    return False
+
+
+class Machine:
+    """The machine's load over a run: load average, CPU steal, and the CPU that processes other
+    than this one and its descendants (the server, the browser) used meanwhile."""
+
+    def __init__(self) -> None:
+        self.loadavg = self._loadavg()
+        self._cpu = self._stat()
+        self._ours = tree_seconds(os.getpid())
+        self._t = time.monotonic()
+
+    @staticmethod
+    def _loadavg() -> str:
+        try:
+            with open("/proc/loadavg") as f:
+                return " ".join(f.read().split()[:3])
+        except OSError:
+            return "unknown"
+
+    @staticmethod
+    def _stat() -> list[int] | None:
+        try:
+            with open("/proc/stat") as f:
+                return [int(v) for v in f.readline().split()[1:9]]
+        except (OSError, ValueError):
+            return None
+
+    def report(self) -> dict:
+        cpu, wall = self._stat(), time.monotonic() - self._t
+        out: dict = {"loadavg_start": self.loadavg, "loadavg_end": self._loadavg(),
+                     "seconds": wall, "cores": os.cpu_count()}  # fmt: skip
+        if cpu is not None and self._cpu is not None:
+            d = [b - a for a, b in zip(self._cpu, cpu, strict=True)]
+            busy = (d[0] + d[1] + d[2] + d[5] + d[6]) / _TICK  # user nice system irq softirq
+            ours = tree_seconds(os.getpid()) - self._ours
+            out["steal_percent"] = 100.0 * d[7] / max(sum(d), 1)
+            out["our_cores"] = ours / wall
+            out["other_cores"] = max(busy - ours, 0.0) / wall
+        return out
+
+
+# -- the server -------------------------------------------------------------------------------
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@contextlib.contextmanager
+def served() -> Iterator[tuple[str, subprocess.Popen]]:
+    """``jik serve`` (this jik) on a free loopback port: (base URL, its process)."""
+    import httpx
+
+    import jik
+
+    port = _free_port()
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(
+        [str(Path(jik.__file__).resolve().parent.parent), env.get("PYTHONPATH", "")]
+    ).rstrip(os.pathsep)
+    log = tempfile.TemporaryFile("w+")
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "jik", "serve", "--port", str(port)],
+        env=env, stdout=log, stderr=subprocess.STDOUT,
+    )  # fmt: skip
+    base = f"http://127.0.0.1:{port}"
+    try:
+        deadline = time.monotonic() + 60
+        while True:
+            with contextlib.suppress(httpx.HTTPError):
+                if httpx.get(f"{base}/health", timeout=2).status_code == 200:
+                    break
+            if proc.poll() is not None or time.monotonic() > deadline:
+                log.seek(0)
+                raise RuntimeError(f"jik serve did not start:\n{log.read()[-2000:]}")
+            time.sleep(0.1)
+        yield base, proc
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+        log.close()
+
+
+class EventStream:
+    """A session's server-sent events, read in a thread: kind, generation, arrival, data."""
+
+    def __init__(self, base: str, session: str) -> None:
+        import httpx
+
+        self.events: list[tuple[str, int, float, str]] = []
+        self._cond = threading.Condition()
+        self._client = httpx.Client(base_url=base, timeout=httpx.Timeout(10.0, read=None))
+        self._thread = threading.Thread(
+            target=self._read, args=(f"/api/sessions/{session}/events",), daemon=True
+        )
+        self._thread.start()
+
+    def _read(self, path: str) -> None:
+        kind, generation, data = "", 0, []
+        try:
+            with self._client.stream("GET", path) as response:
+                for line in response.iter_lines():
+                    if line.startswith("event: "):
+                        kind = line[7:]
+                    elif line.startswith("id: "):
+                        generation = int(line[4:])
+                    elif line.startswith("data: "):
+                        data.append(line[6:])
+                    elif not line and kind:
+                        arrived = time.perf_counter()
+                        with self._cond:
+                            self.events.append((kind, generation, arrived, "\n".join(data)))
+                            self._cond.notify_all()
+                        kind, data = "", []
+        except Exception:  # (closed by close(), or the server went away)
+            return
+
+    def wait(self, generation: int, timeout: float = CHANGE_TIMEOUT) -> tuple[float, dict]:
+        """The arrival (perf_counter s) and data of the first ``result`` of ``generation`` or
+        later; an ``error`` event of it raises."""
+        deadline = time.monotonic() + timeout
+        with self._cond:
+            while True:
+                for kind, g, arrived, data in self.events:
+                    if g >= generation and kind == "result":
+                        return arrived, json.loads(data)
+                    if g >= generation and kind == "error":
+                        raise RuntimeError(f"generation {g} failed: {data}")
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    raise TimeoutError(f"no result of generation {generation} in {timeout} s")
+                self._cond.wait(left)
+
+    def close(self) -> None:
+        self._client.close()
+
+
+def _timed_session(client, base: str, state: dict | None) -> tuple[str, float, float, dict]:
+    """A new session (of ``state``): its id, the setup (the POST) and the time to its first
+    result [s], and that result."""
+    t0 = time.perf_counter()
+    r = client.post("/api/sessions", json={"state": state or {}})
+    r.raise_for_status()
+    setup = time.perf_counter() - t0
+    session = r.json()["id"]
+    stream = EventStream(base, session)
+    try:
+        arrived, result = stream.wait(1)
+    finally:
+        stream.close()
+    return session, setup, arrived - t0, result
+
+
+def server_only(base: str, pid: int, sessions: list[list[Change]]) -> list[dict]:
+    """Each change through a live session, and as a fresh session of the same state."""
+    import httpx
+
+    samples = []
+    with httpx.Client(base_url=base, timeout=30.0) as client:
+        for p, changes in enumerate(sessions):
+            r = client.post("/api/sessions", json={"state": {}})
+            r.raise_for_status()
+            session = r.json()["id"]
+            stream = EventStream(base, session)
+            try:
+                stream.wait(1)
+                quiet(pid)
+                for i, change in enumerate(changes):
+                    _progress(f"server only: session {p + 1} of {len(sessions)}, change {i + 1}")
+                    t0 = time.perf_counter()
+                    r = client.post(
+                        f"/api/sessions/{session}/state", json={change.key: change.value}
+                    )
+                    r.raise_for_status()
+                    arrived, result = stream.wait(r.json()["generation"])
+                    live = arrived - t0
+                    quiet(pid)
+                    fresh_id, setup, fresh, _ = _timed_session(client, base, r.json()["state"])
+                    client.delete(f"/api/sessions/{fresh_id}")
+                    samples.append({"kind": change.kind, "family": change.family,
+                                    "live_ms": 1e3 * live, "fresh_ms": 1e3 * fresh,
+                                    "setup_ms": 1e3 * setup,
+                                    "compute_ms": 1e3 * result["timing"]["compute"]})  # fmt: skip
+                    quiet(pid)
+            finally:
+                stream.close()
+                client.delete(f"/api/sessions/{session}")
+    return samples
+
+
+# -- the browser ------------------------------------------------------------------------------
+# In every document, from its start: when each generation first shows. The page sets
+# body[data-generation] once a result's plots are drawn; the viser client's status shows
+# "generation N: ..." once the scene has drawn it.
+_WATCH = """(() => {
+    const shown = window.jikShown = {};
+    const now = () => performance.timeOrigin + performance.now();
+    if (location.pathname.startsWith("/scene")) {
+        const note = () => {
+            const text = document.body ? document.body.textContent : "";
+            for (const m of text.matchAll(/generation (\\d+):/g)) {
+                if (!(m[1] in shown)) shown[m[1]] = now();
+            }
+        };
+        new MutationObserver(note).observe(document,
+            {childList: true, subtree: true, characterData: true});
+    } else {
+        new MutationObserver(() => {
+            const g = document.body && document.body.dataset.generation;
+            if (g && !(g in shown)) shown[g] = now();
+        }).observe(document, {attributes: true, subtree: true,
+                              attributeFilter: ["data-generation"]});
+    }
+})();"""
+
+# In the page, once plotly is loaded: the plotly calls in flight, and when the last one began
+# or ended (to wait for the page's background drawing: E1/E2, the panels drawn ahead).
+_PLOTLY_WATCH = """() => {
+    if (window.jikPlotly) return;
+    const watch = window.jikPlotly = {busy: 0, last: performance.now()};
+    for (const name of ["react", "newPlot", "relayout", "animate", "restyle", "update"]) {
+        const call = Plotly[name];
+        Plotly[name] = function (...args) {
+            watch.busy += 1;
+            watch.last = performance.now();
+            const done = () => { watch.busy -= 1; watch.last = performance.now(); };
+            const p = call.apply(this, args);
+            Promise.resolve(p).then(done, done);
+            return p;
+        };
+    }
+}"""
+# No plotly call in flight, and none began or ended within the last 250 ms.
+_IDLE = "() => jikPlotly.busy === 0 && performance.now() - jikPlotly.last > 250"
+# When generation g or a later one first showed (epoch ms), or null. (Functions, not
+# expressions: the page's Content-Security-Policy forbids evaluating strings.)
+_SHOWN = """(g) => {
+    const t = Object.keys(jikShown).filter((k) => Number(k) >= g).map((k) => jikShown[k]);
+    return t.length ? Math.min(...t) : null;
+}"""
+
+_CHANGE = """({selector, event, position}) => {
+    const input = document.querySelector(selector);
+    if (!input) throw new Error(`the page has no control ${selector}`);
+    const old = input.value;
+    input.value = String(position);
+    if (input.value === old) throw new Error(`${selector} is already at ${old}`);
+    const t0 = performance.timeOrigin + performance.now();
+    input.dispatchEvent(new Event(event, {bubbles: true}));
+    return t0;
+}"""
+
+# The page's session, from its scene's address (/scene/?websocket=.../api/sessions/{id}/scene).
+_SESSION = """() => {
+    const src = (document.querySelector("#scene") || {}).src || "";
+    const ws = src ? new URL(src).searchParams.get("websocket") || "" : "";
+    const m = ws.match(/\\/api\\/sessions\\/([^/]+)\\/scene/);
+    return m ? m[1] : null;
+}"""
+
+
+def _playwright():
+    """``playwright.sync_api``, or None: an optional dependency (the ``test`` extra installs
+    it), without which the benchmark measures the server alone."""
+    try:
+        import playwright.sync_api
+    except ImportError:
+        return None
+    return playwright.sync_api
+
+
+class Tab:
+    """A page of the dashboard: its session, its scene's frame, when each generation showed."""
+
+    def __init__(self, page, base: str, pid: int) -> None:
+        self.page, self.base, self.pid = page, base, pid
+        self.ms = CHANGE_TIMEOUT * 1e3
+        self.session: str | None = None  # (known once the page has opened it)
+        self.scene: Any = None  # the viser client's frame (a playwright Frame)
+
+    def opened(self) -> None:
+        """After a navigation: wait for the first result in the page and the scene."""
+        self.page.wait_for_function(_SESSION, timeout=self.ms)
+        self.session = self.page.evaluate(_SESSION)
+        self.scene = self._scene_frame()
+        self.shown_at(1)
+        self.page.evaluate(_PLOTLY_WATCH)
+
+    def _scene_frame(self):
+        deadline = time.monotonic() + CHANGE_TIMEOUT
+        while time.monotonic() < deadline:
+            for frame in self.page.frames:
+                if frame.parent_frame is not None and "/scene/" in frame.url:
+                    return frame
+            self.page.wait_for_timeout(50)
+        raise TimeoutError("the page did not frame its 3D scene")
+
+    def generation(self) -> int:
+        """The session's generation (the server's)."""
+        import httpx
+
+        r = httpx.get(f"{self.base}/api/sessions/{self.session}", timeout=10)
+        r.raise_for_status()
+        return int(r.json()["generation"])
+
+    def shown_at(self, generation: int) -> tuple[float, float]:
+        """When ``generation`` (or a later one) first showed in the plots and in the scene
+        (epoch ms), waiting for both."""
+        out = []
+        for frame in (self.page, self.scene):
+            frame.wait_for_function(_SHOWN, arg=generation, polling=50, timeout=self.ms)
+            out.append(frame.evaluate(_SHOWN, generation))
+        return out[0], out[1]
+
+    def compute_ms(self, generation: int) -> float:
+        """The server's computation of ``generation`` as the page's footer shows it."""
+        text = self.page.evaluate(
+            "() => (document.querySelector('#timing') || {}).textContent || ''"
+        )
+        found = re.match(r"generation (\d+): compute (\d+) ms", text)
+        return float(found[2]) if found and int(found[1]) == generation else math.nan
+
+    def settle(self) -> None:
+        """Wait until the server's processes are idle, then the page's plotly calls."""
+        quiet(self.pid)
+        self.page.wait_for_function(_IDLE, polling=50, timeout=self.ms)
+
+    def change(self, change: Change) -> dict:
+        """The control changed in the page: latencies to the plots and to the scene [ms]."""
+        generation = self.generation() + 1
+        arg = {"selector": change.selector, "event": change.event, "position": change.position}
+        t0 = self.page.evaluate(_CHANGE, arg)
+        plots, scene = self.shown_at(generation)
+        return {"plots_ms": plots - t0, "scene_ms": scene - t0,
+                "compute_ms": self.compute_ms(generation)}  # fmt: skip
+
+    def reload(self, change: Change) -> dict:
+        """The page loaded anew with the changed state in its link: latencies from the
+        navigation's start to the plots and to the scene [ms]."""
+        query = parse_qs(urlsplit(self.page.url).query)
+        state = change.linked(json.loads(query["state"][0]))
+        self.page.goto(f"{self.base}/?state={quote(json.dumps(state))}")
+        t0 = self.page.evaluate("() => performance.timeOrigin")
+        self.opened()
+        plots, scene = self.shown_at(1)
+        return {"plots_ms": plots - t0, "scene_ms": scene - t0, "compute_ms": self.compute_ms(1)}
+
+
+def browser(base: str, pid: int, sessions: list[list[Change]]) -> list[dict]:
+    """Each session's changes in a page of its own, changes of each kind alternating between
+    the page's own update and a reload with the changed state."""
+    import httpx
+
+    samples: list[dict] = []
+    count: dict[str, int] = {}
+    with _playwright().sync_playwright() as pw:
+        chromium = pw.chromium.launch(executable_path=CHROMIUM, args=["--no-sandbox"])
+        try:
+            context = chromium.new_context(viewport={"width": 1600, "height": 1000})
+            context.add_init_script(_WATCH)
+            for p, changes in enumerate(sessions):
+                tab = Tab(context.new_page(), base, pid)
+                tab.page.goto(f"{base}/")
+                tab.opened()
+                tab.settle()
+                for i, change in enumerate(changes):
+                    _progress(f"browser: page {p + 1} of {len(sessions)}, change {i + 1}")
+                    k = count[change.kind] = count.get(change.kind, -1) + 1
+                    mode = "reload" if k % 2 else "jik"
+                    timing = tab.reload(change) if mode == "reload" else tab.change(change)
+                    samples.append({"kind": change.kind, "family": change.family, "mode": mode,
+                                    **timing})  # fmt: skip
+                    tab.settle()
+                tab.page.close()
+                with contextlib.suppress(httpx.HTTPError):
+                    httpx.delete(f"{base}/api/sessions/{tab.session}", timeout=10)
+                quiet(pid)
+        finally:
+            chromium.close()
+    return samples
+
+
+# -- figures ----------------------------------------------------------------------------------
+def _stats(values: list[float]) -> tuple[float, float]:
+    """Median and 95th percentile (linear between order statistics), NaNs left out."""
+    values = [v for v in values if not math.isnan(v)]
+    if not values:
+        return math.nan, math.nan
+    return float(np.median(values)), float(np.percentile(values, 95))
+
+
+def summarize(samples: list[dict], fields: tuple[str, ...], by: str | None = None) -> dict:
+    """Per kind (and per value of ``by``): n, and median and p95 of each of ``fields``; then
+    the rows "all manipulator changes" and "all unicycle changes", which pool the kinds."""
+    groups: dict[tuple[str, str], list[dict]] = {}
+    pooled: dict[tuple[str, str], list[dict]] = {}
+    for s in samples:
+        mode = s[by] if by else ""
+        groups.setdefault((s["kind"], mode), []).append(s)
+        pooled.setdefault((f"all {s['family']} changes", mode), []).append(s)
+    return {
+        key: {"n": len(group)} | {f: _stats([s[f] for s in group]) for f in fields}
+        for key, group in (groups | pooled).items()
+    }
+
+
+def run(quick: bool = False) -> dict:
+    sessions = plan(1, 2, 1) if quick else plan(4, 5, 4)
+    server_sessions = plan(1, 1, 1) if quick else plan(2, 4, 2)
+    out: dict = {"quick": quick}
+    machine = Machine()
+    with served() as (base, proc):
+        samples = server_only(base, proc.pid, server_sessions)
+        out["server"] = summarize(samples, ("live_ms", "fresh_ms", "setup_ms", "compute_ms"))
+        if not os.path.exists(CHROMIUM):
+            out["browser_skipped"] = f"{CHROMIUM} not found (Debian's chromium)"
+        elif _playwright() is None:
+            out["browser_skipped"] = "the playwright package is not installed"
+        else:
+            samples = browser(base, proc.pid, sessions)
+            out["browser"] = summarize(samples, ("plots_ms", "scene_ms", "compute_ms"), "mode")
+            out["browser_samples"] = samples
+    out["machine"] = machine.report()
+    _progress("")
+    return out
+
+
+def _ms(v: float) -> str:
+    return "-" if math.isnan(v) else f"{v:.0f}"
+
+
+def _pair(stats: tuple[float, float]) -> str:
+    """The median and the p95 in ms, 12 characters wide."""
+    return f"{_ms(stats[0]):>6} /{_ms(stats[1]):>4}"
+
+
+def _ratio(a: float, b: float) -> str:
+    return f"{a / b:7.2f}" if not (math.isnan(a) or math.isnan(b)) else f"{'-':>7}"
+
+
+_NONE = {"n": 0, "plots_ms": (math.nan,) * 2, "scene_ms": (math.nan,) * 2,
+         "compute_ms": (math.nan,) * 2}  # fmt: skip
+
+
+def main(quick: bool = False) -> None:
+    r = run(quick=quick)
+    m = r["machine"]
+    print(
+        f"load average {m['loadavg_start']} at the start, {m['loadavg_end']} at the end; "
+        f"{m['cores']} cores, {m['seconds']:.0f} s"
+        + (
+            f"; CPU steal {m['steal_percent']:.1f} %, this benchmark (server, browser) "
+            f"{m['our_cores']:.2f} cores, other processes {m['other_cores']:.2f} cores"
+            if "steal_percent" in m
+            else ""
+        )
+    )
+    print("\nserver only: POST /state -> its result event (live session) vs a fresh session "
+          "of the same state -> its first result; median / p95 [ms]")  # fmt: skip
+    print(f"{'change':34}{'n':>3}{'live':>12}{'fresh':>12}{'ratio':>7}{'setup':>7}{'compute':>9}")
+    for (kind, _), v in r["server"].items():
+        print(
+            f"{kind:34}{v['n']:3d}{_pair(v['live_ms'])}{_pair(v['fresh_ms'])}"
+            f"{_ratio(v['fresh_ms'][0], v['live_ms'][0])}{_ms(v['setup_ms'][0]):>7}"
+            f"{_ms(v['compute_ms'][0]):>9}"
+        )
+    if "browser_skipped" in r:
+        print(f"\nbrowser: skipped, {r['browser_skipped']}")
+        return
+    b = r["browser"]
+    print("\nbrowser: control -> plots drawn, -> scene shown; the page's own update (jik) vs the "
+          "page reloaded with the changed state (reload); median / p95 [ms]")  # fmt: skip
+    print(f"{'':37}{'jik':^33}{'reload':^28}{'ratio':^14}")
+    print(f"{'change':34}{'n':>3}{'plots':>12}{'scene':>12}{'compute':>9}{'n':>4}{'plots':>12}"
+          f"{'scene':>12}{'plots':>7}{'scene':>7}")  # fmt: skip
+    for kind in dict.fromkeys(k for k, _ in b):
+        j, s = b.get((kind, "jik"), _NONE), b.get((kind, "reload"), _NONE)
+        print(
+            f"{kind:34}{j['n']:3d}{_pair(j['plots_ms'])}{_pair(j['scene_ms'])}"
+            f"{_ms(j['compute_ms'][0]):>9}{s['n']:4d}{_pair(s['plots_ms'])}{_pair(s['scene_ms'])}"
+            f"{_ratio(s['plots_ms'][0], j['plots_ms'][0])}"
+            f"{_ratio(s['scene_ms'][0], j['scene_ms'][0])}"
+        )
+    print()
+    for family, target in TARGETS_MS.items():
+        v = b.get((f"all {family} changes", "jik"))
+        if v is None:
+            continue
+        verdicts = [
+            f"{what} {v[f'{what}_ms'][1]:.0f} ms "
+            f"({'met' if v[f'{what}_ms'][1] < target else 'NOT met'})"
+            for what in ("plots", "scene")
+        ]
+        own = [s for s in r["browser_samples"] if s["family"] == family and s["mode"] == "jik"]
+        within = sum(max(s["plots_ms"], s["scene_ms"]) < target for s in own)
+        print(
+            f"target p95 < {target:.0f} ms for a {family} change: "
+            + ", ".join(verdicts)
+            + f"; {within} of {len(own)} changes within it, plots and scene"
+        )
+
+
+if __name__ == "__main__":
+    main()
