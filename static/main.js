@@ -125,6 +125,14 @@ function showScene(hasScene) {
   note.textContent = "The 3D scene runs with `jik serve`.";
 }
 
+// The event stream broke: the server restarted, or the session ended (expired, closed). The
+// browser reconnects by itself; a session the server no longer has is opened anew from the
+// state in the URL (a reload does it).
+function lost() {
+  setStatus("connection lost; reconnecting…", true);
+  fetch(api("")).then((r) => { if (r.status === 404) location.reload(); }).catch(() => {});
+}
+
 async function main() {
   page.config = await fetch("/api/dashboard/config").then((r) => r.json());
   for (const [a, c] of Object.entries(page.config.colors)) document.documentElement.style.setProperty(`--${a}`, c);
@@ -147,7 +155,7 @@ async function main() {
     functionals: serial((msg) => (msg.generation === page.shown ? applyFunctionals(msg) : null)),
     ahead: (msg) => { onAhead(msg, () => page.state && page.state.robot).catch((err) => console.warn("drawing ahead:", err)); },
     error: (msg) => { if (msg.generation === session.generation) { showProgress(1, 0); setStatus(msg.message, true); } },
-  }, () => setStatus("connection lost; reconnecting…", true));
+  }, lost);
   endOnClose();
 }
 

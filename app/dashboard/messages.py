@@ -18,7 +18,9 @@ from jik.app.dashboard.runs import DashboardResult
 class Event:
     """A message to the subscribers: ``data`` is the JSON sent to the page."""
 
-    kind: str  # "state" | "progress" | "result" | "functionals" | "error" | "ahead"
+    #: "state" | "progress" | "result" | "functionals" | "error" | "ahead" | "refused" |
+    #: "closed" (the dashboard stopped)
+    kind: str
     generation: int
     data: str
     result: DashboardResult | None = None
@@ -42,7 +44,10 @@ class LatestEvents:
         return len(self._events)
 
     def put(self, event: Event) -> None:
-        self._loop.call_soon_threadsafe(self._put, event)
+        try:
+            self._loop.call_soon_threadsafe(self._put, event)
+        except RuntimeError:  # (the loop is closed: nobody reads any more)
+            pass
 
     def _put(self, event: Event) -> None:
         robot = event.result.state.robot if event.kind == "ahead" and event.result else ""

@@ -132,11 +132,16 @@ class Dashboard:
                 self._thread.start()
 
     def stop(self) -> None:
+        """End the dashboard: its worker, its runs in the pool; a ``closed`` event tells the
+        listeners (a page's event stream ends, and the page starts a new session)."""
         with self._cond:
+            if self._stopped:
+                return
             self._stopped = True
             self._cond.notify_all()
         if self._offload is not None:
             self._offload.close()
+        self._emit(Event("closed", self._generation, "{}"))
 
     def update(
         self, patch: Mapping[str, object], source: str = "page"

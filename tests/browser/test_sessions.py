@@ -93,3 +93,24 @@ def test_a_copied_link_opens_the_same_view(tabs):
         assert theirs[algorithm]["x_final"] == pytest.approx(
             ours[algorithm]["x_final"], rel=1e-9, abs=1e-12
         )
+
+
+def test_a_tab_whose_session_ended_opens_a_new_one_with_its_state(tabs):
+    """The server ends a session (expired, or the server restarted): its page notices that the
+    session is gone and opens a new one from the state in its link, with the same numbers."""
+    import urllib.request
+
+    # (chromium logs the 404 by which the page learns that its session is gone)
+    tabs.allow_console(r"^Failed to load resource: .* status of 404")
+    tab = tabs.open()
+    tab.wait_drawn(1)
+    tab.select("#ctl-robot", "manipulator1")
+    old, before = tab.session_id, tab.url_state()
+    request = urllib.request.Request(f"{tab.base}/api/sessions/{old}", method="DELETE")
+    urllib.request.urlopen(request, timeout=30).close()
+    tab.page.wait_for_function(
+        "old => !document.getElementById('scene').src.includes(old)", arg=old, timeout=60_000
+    )
+    tab.wait_drawn(1)
+    assert tab.session_id != old and tab.robot == "manipulator1"
+    assert tab.url_state() == before and tab.snapshot()["state"] == before

@@ -184,6 +184,8 @@ async def events(session_id: str, request: Request, store: Store):
                         return
                     yield ": keep-alive\n\n"
                     continue
+                if event.kind == "closed":  # (the session ended: the page opens a new one)
+                    return
                 if event.kind not in PAGE_EVENTS:
                     continue
                 yield f"event: {event.kind}\nid: {event.generation}\ndata: {event.data}\n\n"
