@@ -31,7 +31,7 @@ MAX_ITERATIONS = 20000
 #: Trajectories longer than this are downsampled (first and last points kept).
 MAX_TRAJECTORY_POINTS = 2000
 
-FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
+FiniteFloat = Annotated[float, Field(strict=True, allow_inf_nan=False)]
 #: A float that is null where the engine produced NaN or inf (a failed or diverged run).
 MaybeFloat = float | None
 
@@ -46,6 +46,7 @@ def _scalar_field(p) -> tuple[Any, Any]:
         Annotated[
             float,
             Field(
+                strict=True,
                 ge=p.minimum,
                 le=p.maximum,
                 allow_inf_nan=False,
@@ -58,7 +59,7 @@ def _scalar_field(p) -> tuple[Any, Any]:
 
 def _vector_field(v) -> tuple[Any, Any]:
     items = tuple(
-        Annotated[float, Field(ge=lo, le=hi, allow_inf_nan=False)]
+        Annotated[float, Field(strict=True, ge=lo, le=hi, allow_inf_nan=False)]
         for lo, hi in zip(v.minimum, v.maximum, strict=True)
     )
     return (
@@ -127,12 +128,14 @@ Mode = Literal["continuous", "discrete"]
 #: Largest |coordinate| of a configuration or task point (radians, lengths, control amplitudes):
 #: beyond it the kinematics only overflow, and the unicycle's quadrature would need huge grids.
 COORDINATE_BOUND = 1000.0
-Coordinate = Annotated[float, Field(ge=-COORDINATE_BOUND, le=COORDINATE_BOUND, allow_inf_nan=False)]
+Coordinate = Annotated[
+    float, Field(strict=True, ge=-COORDINATE_BOUND, le=COORDINATE_BOUND, allow_inf_nan=False)
+]
 Vector = Annotated[list[Coordinate], Field(min_length=1, max_length=MAX_DIMENSION)]
 #: The decay rate of eq. (5) (discrete mode: the step; below 2 there, checked with the mode).
-Gamma = Annotated[float, Field(gt=0, le=1e6, allow_inf_nan=False)]
+Gamma = Annotated[float, Field(strict=True, gt=0, le=1e6, allow_inf_nan=False)]
 #: The task error at which a solve stops.
-Tolerance = Annotated[float, Field(ge=1e-14, le=1.0, allow_inf_nan=False)]
+Tolerance = Annotated[float, Field(strict=True, ge=1e-14, le=1.0, allow_inf_nan=False)]
 
 
 class _Request(BaseModel):
@@ -158,7 +161,7 @@ class _Request(BaseModel):
         None, description="'continuous' (ODE) or 'discrete' (iterations); default: the robot's"
     )
     tolerance: Tolerance = Field(1e-10, description="stop when ||k(x) - target|| < tolerance")
-    max_iterations: Annotated[int, Field(ge=1, le=MAX_ITERATIONS)] | None = Field(
+    max_iterations: Annotated[int, Field(strict=True, ge=1, le=MAX_ITERATIONS)] | None = Field(
         None,
         description="cap on integrator steps (continuous) or iterations (discrete) per solve",
     )
@@ -176,7 +179,9 @@ class RepeatabilityRequest(_Request):
     path: Annotated[list[Vector], Field(min_length=1, max_length=MAX_PATH_POINTS)] = Field(
         description=f"task points visited in order, 1 to {MAX_PATH_POINTS}; k(x0) closes it"
     )
-    cycles: Annotated[int, Field(ge=1, le=MAX_CYCLES)] = Field(1, description=f"1 to {MAX_CYCLES}")
+    cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_CYCLES)] = Field(
+        1, description=f"1 to {MAX_CYCLES}"
+    )
 
 
 class AugmentationUsed(BaseModel):
@@ -298,7 +303,7 @@ class RobotsResponse(BaseModel):
 
 
 SynthesisMethod = Literal["evaluate", "e2_variational"]
-Bound = Annotated[float, Field(ge=-100.0, le=100.0, allow_inf_nan=False)]
+Bound = Annotated[float, Field(strict=True, ge=-100.0, le=100.0, allow_inf_nan=False)]
 
 
 class SynthesizeRequest(BaseModel):
@@ -327,13 +332,15 @@ class SynthesizeRequest(BaseModel):
         max_length=MAX_DIMENSION,
         description="values of the variables not in the box (default: the default start)",
     )
-    nodes: Annotated[int, Field(ge=2, le=24)] = Field(
+    nodes: Annotated[int, Field(strict=True, ge=2, le=24)] = Field(
         8, description="Gauss-Legendre nodes per variable for E1 and E2"
     )
-    degree: Annotated[int, Field(ge=1, le=24)] = Field(
+    degree: Annotated[int, Field(strict=True, ge=1, le=24)] = Field(
         10, description="'e2_variational': Legendre degree per variable"
     )
-    grid: Annotated[int, Field(ge=3, le=61)] = Field(21, description="grid points per axis for h")
+    grid: Annotated[int, Field(strict=True, ge=3, le=61)] = Field(
+        21, description="grid points per axis for h"
+    )
 
 
 class FunctionalInfo(BaseModel):

@@ -59,7 +59,7 @@ class DashboardState(BaseModel):
     task: Literal["path", "target"]
     target: Point
     path: Annotated[tuple[Point, ...], Field(max_length=MAX_PATH_POINTS)]
-    cycles: Annotated[int, Field(ge=1, le=MAX_DASHBOARD_CYCLES)]
+    cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_DASHBOARD_CYCLES)]
     tolerance: Tolerance = 1e-10
 
     def as_dict(self) -> dict:

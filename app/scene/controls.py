@@ -112,7 +112,10 @@ class SceneControls:
                 control.label, min=control.minimum, max=control.maximum, step=control.step,
                 initial_value=min(max(value, control.minimum), control.maximum), hint=control.help,
             )  # fmt: skip
-            handle.on_update(lambda e: self._change({key: e.target.value}))
+            if control.integer:  # (viser's slider gives a float)
+                handle.on_update(lambda e: self._change({key: round(e.target.value)}))
+            else:
+                handle.on_update(lambda e: self._change({key: e.target.value}))
         elif control.kind == "vector" and control.size in (2, 3):
             add: Any = gui.add_vector2 if control.size == 2 else gui.add_vector3
             lo = None if control.minimum is None else tuple(control.minimum)

@@ -99,6 +99,9 @@ def test_control_keys_expand_into_state_fields():
         ({"nonsense": 1}, "nonsense"),
         ({"x0": [1e300, 0.0, 1.0]}, "x0.0"),  # (the API's coordinate bound)
         ({"tolerance": 0}, "tolerance"),
+        ({"gamma": True}, "gamma"),  # (a boolean is no number: it was taken as 1)
+        ({"cycles": True}, "cycles"),
+        ({"robot_parameters.l": False}, "robot_parameters.l"),
     ],
 )
 def test_refusals_carry_their_field(patch, field):

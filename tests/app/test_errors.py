@@ -204,3 +204,20 @@ def test_a_body_that_is_not_json_says_why(api, body, says):
     r = api.post("/repeatability", content=body, headers={"content-type": "application/json"})
     assert r.status_code == 422, r.text
     assert r.json()["detail"][0]["loc"] == ["body"] and says in r.text
+
+
+@pytest.mark.parametrize(
+    ("over", "field"),
+    [
+        ({"gamma": True}, "gamma"),
+        ({"tolerance": False}, "tolerance"),
+        ({"max_iterations": True}, "max_iterations"),
+        ({"x0": [0.0, True, 1.5]}, "x0[1]"),
+        ({"robot": {"name": "manipulator2", "l": True}}, "robot.l"),
+        ({"gamma": "2"}, "gamma"),
+    ],
+)
+def test_a_boolean_or_a_string_is_no_number(api, over, field):
+    """(Booleans were taken as 0 and 1, and numeric strings as numbers, issue 26 item 8.)"""
+    (msg,) = messages(api.post("/solve", json=solve_body(**over)))
+    assert msg.startswith(f"{field}: Input should be a valid")

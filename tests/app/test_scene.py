@@ -242,3 +242,16 @@ def test_scene_traces_stay_within_their_tolerance(robot):
     assert len(simplify(line, 1e-12)) == 2
     corner = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]])
     np.testing.assert_array_equal(simplify(corner, 0.1), corner)
+
+
+def test_the_scenes_integer_sliders_send_integers():
+    """viser's slider gives a float; the cycles it sets are an integer (the state is strict)."""
+    dashboard = Dashboard(default_state("manipulator2"))
+    scene = DashboardScene(dashboard)
+    try:
+        scene.controls.show(dashboard.state)
+        scene.controls.inputs["cycles"].value = 4.0  # what a move of the slider gives
+        assert dashboard.state.cycles == 4 and isinstance(dashboard.state.cycles, int)
+    finally:
+        scene.stop()
+        dashboard.stop()
