@@ -1,5 +1,9 @@
 """Synthesis of an augmenting map by characteristics, one degree of redundancy (section 4).
 
+(It stays whole, at about 560 lines: the one-form, the homotopy and the map class share the
+collocation nodes, the Newton system and its linearisation, from which the exact gradient comes;
+split, the gradient would live apart from the system it differentiates.)
+
 The one-form omega annihilates J^T (omega J^T = 0) and is normalised by one component,
 ``omega[fixed_index] = 1``. A linear homotopy Phi_s contracts every configuration onto a reference
 leaf along the components transverse to the leaves, eqs. (21), (22), (45); the augmenting map h is

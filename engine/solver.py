@@ -1,5 +1,9 @@
 """The continuation (Wazewski-Davidenko) IK algorithm, eq. (7), batched over start configurations.
 
+(It stays whole, at about 730 lines: the two continuous integrators, the discrete iteration and
+:func:`solve_in_chunks` share one result type, one stopping rule, one check of the start and one
+message; the DOP853 coefficients and the Picard sweeps already live in modules of their own.)
+
 Continuous mode follows the trajectory of dx/dtheta = -gamma J#(x) (k(x) - y_d) with two
 adaptive high-order methods: Chebyshev-Picard iteration on the equivalent homotopy form (spectral,
 adaptive segments; :mod:`jik.engine.picard`), and, where that cannot resolve the path or a very

@@ -1,5 +1,8 @@
 """Synthesis of the E2-optimal augmenting map by a Ritz method, eqs. (19)-(20).
 
+(It stays whole, at about 430 lines: the basis, the quadrature, the linear system and the map
+it yields all work on the same tensor Legendre grids; the derivation below takes most of it.)
+
 For one degree of redundancy, E2(h) = integral of (dh P dh^T - 2 dh K + 1) m dx, eq. (19), is a
 convex quadratic functional of h whose Euler equation is the linear elliptic PDE (20),
 div(m P grad h) = div(m K), with the natural boundary condition n . (m P grad h - m K) = 0 on

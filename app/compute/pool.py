@@ -1,5 +1,9 @@
 """The compute pool: runs the request functions off the event loop, in worker processes.
 
+(It stays whole, at about 400 lines: the queue of idle workers, their replacement after a death
+or a hang, the micro-batching of /solve and the submissions from other threads share one event
+loop and one idle queue; split, each part would reach into the others'.)
+
 :class:`ComputePool` runs them for the HTTP API in worker *processes*
 (:mod:`jik.app.compute.worker`): numpy-heavy Python loops hold the GIL, and a computation that
 overruns its time limit can only be stopped by ending its process. Concurrent ``/solve``

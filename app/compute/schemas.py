@@ -1,5 +1,8 @@
 """Request and response models of the REST API (JSON, snake_case).
 
+(It stays whole, at about 400 lines: the API's one description of its requests and responses,
+read top to bottom as the OpenAPI document is.)
+
 Robot and augmentation models are generated from the engine's catalogue
 (:data:`jik.engine.registry.ROBOTS`) when this module is imported: one model per robot with its
 parameters and their ranges, discriminated by ``name``, and one per augmenting map. A robot or map
@@ -10,9 +13,6 @@ size bounds. What needs the registry (vector lengths against p and r, an augment
 to the robot, a singular start) is checked by :mod:`jik.app.compute.requests`, which names the
 field. The dashboard's state (:mod:`jik.app.dashboard.model`) uses the same field types and the
 same robot and map models.
-
-(About 400 lines: the API's one description of its requests and responses, read top to bottom
-as the OpenAPI document is.)
 """
 
 from __future__ import annotations

@@ -1,13 +1,14 @@
 """One session's live dashboard: its state, a worker thread that computes each change, and the
 listeners (the page's event stream, the scene) it tells.
 
+(It stays whole, at about 470 lines: one class, whose worker phases (result, second phase,
+solving ahead) share its lock, its generation and its caches.)
+
 Every change is validated (:mod:`jik.app.dashboard.model`), bumps a generation counter and wakes
 the worker, which solves both algorithms (:func:`jik.app.dashboard.results.compute`), builds the
 figures once and pushes them to every listener; a newer change cancels a stale computation
 between legs. Idle, it solves the other manipulator ahead for a switch.
 
-(About 430 lines, one class: the worker's phases, result, second phase and solving ahead,
-share its lock, generation and caches.)
 """
 
 from __future__ import annotations

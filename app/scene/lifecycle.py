@@ -1,13 +1,13 @@
 """A session's 3D scene in viser: both algorithms as mechanisms, animated, with a GUI.
 
+(It stays whole, at about 440 lines: one class whose drawing, node sets kept per robot and
+animation share the scene's lock, its timeline and its handles.)
+
 The scene reads the session's results and writes to scene handles; its GUI (built from the
 control specification, :mod:`jik.app.scene.controls`) and the draggable start point
 (:mod:`jik.app.scene.gizmo`) change the session's :class:`~jik.app.dashboard.Dashboard`
 exactly like the page's controls. The task plane is the world XY plane (z up); the nodes are
 those of :mod:`jik.app.scene.mechanisms`, posed along :class:`~jik.app.scene.pose.Timeline`.
-
-(About 440 lines, one class: drawing, the node sets kept per robot and the animation share the
-scene's lock, its timeline and its handles; split, each part would reach into the others'.)
 """
 
 from __future__ import annotations
@@ -65,12 +65,12 @@ class DashboardScene:
     ) -> None:
         self.dashboard = dashboard
         # Its own viser server on a loopback port: the page reaches it only through the API's
-        # proxy (jik.app.routers.scene), which knows the session.
+        # relay (jik.app.api.routes.sessions), which knows the session.
         self.server = viser.ViserServer(host=host, port=port, label="jik scene", verbose=False)
         self.server.scene.set_up_direction("+z")
         if low_end:
-            # The page asks for this only when its browser reports a software WebGL renderer:
-            # without shadows and the environment map a frame costs that renderer far less.
+            # The low-end mode, which the page asks for only when its browser renders WebGL
+            # without a GPU: without shadows and the environment map a frame costs far less.
             self.server.scene.configure_default_lights(cast_shadow=False)
             self.server.scene.configure_environment_map(hdri=None)
         self.server.gui.configure_theme(control_width="small", show_logo=False)
@@ -198,8 +198,8 @@ class DashboardScene:
         drawn = runs_key(state)
         if drawn == self._drawn_runs:
             # The same configurations (gamma in continuous mode only rescales theta; the
-            # animation runs per leg): nothing in the scene changes but its status. A redraw
-            # would cost the client a quarter second of frames (software WebGL here).
+            # animation runs per leg): nothing in the scene changes but its status, so nothing
+            # is sent but the status (a redraw would make every client render anew).
             with self._lock:  # (the timeline on screen plays the same legs)
                 self.drawn_generation = result.generation
                 self._sync_now()
@@ -210,9 +210,9 @@ class DashboardScene:
             self._drawn_runs = drawn
             timeline = Timeline(result)
             extent = extent_of(result)
-            # The start-point gizmo moves with the drawing it belongs to, in the same batch: moved
-            # on the change itself it would start the client's frames (a quarter second of
-            # software WebGL here) while the result is computed, and the result would wait for them.
+            # The start-point gizmo moves with the drawing it belongs to, in the same batch: the
+            # client shows the start point and the paths that leave it together, never one
+            # without the other.
             self.gizmo.place(state)
             layout = (state.robot, state.task)
             if timeline.unicycle or layout != self._layout:

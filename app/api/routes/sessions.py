@@ -25,7 +25,7 @@ from jik.app.api.errors import unparsed_body_response
 from jik.app.dashboard import export_csv, export_json
 from jik.app.dashboard.controls import controls_message
 from jik.app.dashboard.messages import LatestEvents
-from jik.app.dashboard.sessions import Session, SessionNotFound, SessionsFull
+from jik.app.dashboard.sessions import Session, SessionNotFound
 from jik.engine.exceptions import InvalidInputError
 
 router = APIRouter(tags=["dashboard sessions"])
@@ -49,29 +49,9 @@ class SessionCreate(BaseModel):
     )
     low_end: bool = Field(
         default=False,
-        description="draw the 3D scene without shadows or environment map (the page asks for "
-        "this when its browser reports a software WebGL renderer)",
+        description="draw the 3D scene without shadows or environment map: the low-end mode, "
+        "which the page asks for only when its browser renders WebGL without a GPU",
     )
-
-
-def _not_found(session_id: str) -> JSONResponse:
-    return JSONResponse(
-        status_code=404,
-        content={"detail": f"no dashboard session {session_id!r} (it expired or never existed); "
-                 "reload the page to start a new one"},
-    )  # fmt: skip
-
-
-def _invalid(loc: tuple[str, ...], message: str) -> JSONResponse:
-    return JSONResponse(
-        status_code=422,
-        content={"detail": [{"loc": ["body", *loc], "msg": message, "type": "value_error"}]},
-    )
-
-
-def _loc(exc: InvalidInputError) -> tuple[str, ...]:
-    """Where a refused value is, from the field the error names (a dotted path)."""
-    return tuple((exc.field or "").split(".")) if exc.field else ()
 
 
 def _created(session: Session) -> dict:
@@ -90,30 +70,22 @@ async def create_session(body: SessionCreate, store: Store) -> JSONResponse:
     """A new session whose state is the defaults changed by ``state`` (a link's state)."""
     try:
         session = await asyncio.to_thread(store.create, body.state, body.low_end)
-    except InvalidInputError as exc:
-        return _invalid(("state", *_loc(exc)), str(exc))
-    except SessionsFull as exc:
-        return JSONResponse(status_code=503, content={"detail": str(exc)},
-                            headers={"Retry-After": "30"})  # fmt: skip
+    except InvalidInputError as exc:  # (the link's state is the body's "state")
+        exc.field = f"state.{exc.field}" if exc.field else "state"
+        raise
     return JSONResponse(status_code=201, content=_created(session))
 
 
 @router.get("/api/sessions/{session_id}")
 async def get_session(session_id: str, store: Store) -> JSONResponse:
     """The session's state, its generation and the summary of its last result."""
-    try:
-        return JSONResponse(store.get(session_id).dashboard.snapshot())
-    except SessionNotFound:
-        return _not_found(session_id)
+    return JSONResponse(store.get(session_id).dashboard.snapshot())
 
 
 @router.delete("/api/sessions/{session_id}", status_code=204)
 async def delete_session(session_id: str, store: Store):
     """End the session now (a closing tab; otherwise it expires when idle)."""
-    try:
-        await asyncio.to_thread(store.delete, session_id)
-    except SessionNotFound:
-        return _not_found(session_id)
+    await asyncio.to_thread(store.delete, session_id)
     return PlainTextResponse(status_code=204, content="")
 
 
@@ -124,20 +96,14 @@ async def post_state(session_id: str, request: Request, store: Store) -> JSONRes
     The body is a partial dashboard state; the answer is the new generation and state (422 with
     the engine's message for a value it refuses, which the session's scene shows too).
     """
-    try:
-        session = store.get(session_id)
-    except SessionNotFound:
-        return _not_found(session_id)
+    session = store.get(session_id)
     try:
         patch = await request.json()
     except (ValueError, RecursionError) as exc:
         return unparsed_body_response(exc)
     if not isinstance(patch, dict):
-        return _invalid((), "the body must be a JSON object of dashboard fields")
-    try:
-        generation, state = session.dashboard.update(patch, source="page")
-    except InvalidInputError as exc:
-        return _invalid(_loc(exc), str(exc))
+        raise InvalidInputError("body: give a JSON object of dashboard fields")
+    generation, state = session.dashboard.update(patch, source="page")
     return JSONResponse({"generation": generation, "state": state.as_dict()})
 
 
@@ -164,10 +130,7 @@ async def events(session_id: str, request: Request, store: Store):
     Each event's data is JSON; a ``result`` carries every panel as a plotly figure, an
     ``ahead`` the panels of another robot's default state, solved ahead for a switch.
     """
-    try:
-        session = store.get(session_id)
-    except SessionNotFound:
-        return _not_found(session_id)
+    session = store.get(session_id)
     dashboard = session.dashboard
     queue = LatestEvents(asyncio.get_running_loop())  # (bounded: one event of each kind)
     unsubscribe = dashboard.subscribe(queue.put)
@@ -215,10 +178,7 @@ async def _finished(session: Session):
 )
 async def export_result_json(session_id: str, store: Store) -> JSONResponse:
     """The session's result, every trajectory point of both algorithms, as JSON."""
-    try:
-        dashboard = await _finished(store.get(session_id))
-    except SessionNotFound:
-        return _not_found(session_id)
+    dashboard = await _finished(store.get(session_id))
     if dashboard.result is None:
         return JSONResponse(status_code=503, content={"detail": "no result computed yet"})
     body = export_json(dashboard.result, dashboard.functionals)
@@ -238,10 +198,7 @@ async def export_result_json(session_id: str, store: Store) -> JSONResponse:
 )
 async def export_result_csv(session_id: str, store: Store):
     """The session's result as CSV: one row per trajectory point and algorithm."""
-    try:
-        dashboard = await _finished(store.get(session_id))
-    except SessionNotFound:
-        return _not_found(session_id)
+    dashboard = await _finished(store.get(session_id))
     if dashboard.result is None:
         return PlainTextResponse("no result computed yet\n", status_code=503)
     return PlainTextResponse(
