@@ -9,8 +9,10 @@ field; so is a computation stopped at the time limit (the field that sizes the w
 ``cycles``). A request that finds no free compute slot within the time limit is 503
 ``{"detail": "server busy: ..."}`` with Retry-After; a failure inside a worker, and anything
 unexpected, is 500 ``{"detail": "internal error: ..."}``, never an HTML page or a dropped
-connection. A body over the size limit is 413 ``{"detail": "request body of ... bytes is larger
-..."}`` (:class:`BodyLimit`).
+connection. The dashboard sessions' errors come here too: a refused value (the field it names)
+is 422, a session that is not there 404, a full session store 503 with Retry-After. A body
+over the size limit is 413 ``{"detail": "request body of ... bytes is larger ..."}``
+(:class:`BodyLimit`).
 """
 
 from __future__ import annotations
@@ -27,6 +29,8 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from jik.app.compute.exceptions import ComputeError, RequestError, ServiceUnavailable
 from jik.app.compute.schemas import AUGMENTATION_MODELS, ROBOT_MODELS
+from jik.app.dashboard.sessions import SessionNotFound, SessionsFull
+from jik.engine.exceptions import InvalidInputError
 
 log = logging.getLogger("jik.api")
 _TAGS = set(ROBOT_MODELS) | set(AUGMENTATION_MODELS)
@@ -108,6 +112,24 @@ def http_error_response(exc: StarletteHTTPException) -> JSONResponse:
                         headers=getattr(exc, "headers", None))  # fmt: skip
 
 
+def invalid_input_response(exc: InvalidInputError) -> JSONResponse:
+    """422 for a value the dashboard's model or the engine refused, at the field it names."""
+    loc = ["body", *exc.field.split(".")] if exc.field else ["body"]
+    return JSONResponse(status_code=422, content={"detail": [
+        {"loc": loc, "msg": str(exc), "type": "value_error"}]})  # fmt: skip
+
+
+def session_not_found_response(exc: SessionNotFound) -> JSONResponse:
+    return JSONResponse(status_code=404, content={"detail": (
+        f"no dashboard session {exc.args[0]!r} (it expired or never existed); "
+        "reload the page to start a new one")})  # fmt: skip
+
+
+def sessions_full_response(exc: SessionsFull) -> JSONResponse:
+    return JSONResponse(status_code=503, content={"detail": str(exc)},
+                        headers={"Retry-After": "30"})  # fmt: skip
+
+
 def busy_response(exc: ServiceUnavailable) -> JSONResponse:
     return JSONResponse(status_code=503, content={"detail": str(exc)}, headers={"Retry-After": "1"})
 
@@ -132,6 +154,9 @@ _RESPONSES: dict[type[Exception], Callable[[Any], JSONResponse]] = {
     ServiceUnavailable: busy_response,
     ComputeError: compute_error_response,
     StarletteHTTPException: http_error_response,
+    InvalidInputError: invalid_input_response,
+    SessionNotFound: session_not_found_response,
+    SessionsFull: sessions_full_response,
 }
 
 
