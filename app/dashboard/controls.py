@@ -143,11 +143,12 @@ def element_id(key: str) -> str:
     return "ctl-" + short.replace(".", "-")
 
 
-def control_values(state) -> dict[str, Any]:
-    """Each control's value as shown (the path as text), by key."""
+def control_values(state, spec: list[Control] | None = None) -> dict[str, Any]:
+    """Each control's value as shown (the path as text), by key; ``spec``: the state's
+    :func:`controls` when the caller has them."""
     d = state.as_dict()
     values: dict[str, Any] = {}
-    for c in controls(state):
+    for c in controls(state) if spec is None else spec:
         if c.kind == "preset":
             continue
         values[c.key] = path_text(state.path) if c.key == "path" else lookup(d, c.key)
@@ -218,8 +219,9 @@ def parse_path_text(text: str) -> list[list[float]]:
 def controls_message(state) -> dict[str, Any]:
     """What a page needs to show the controls of ``state``: the controls, grouped, and their
     values."""
+    spec = controls(state)
     return {
         "groups": [list(g) for g in GROUPS],
-        "controls": [c.as_dict() for c in controls(state)],
-        "values": control_values(state),
+        "controls": [c.as_dict() for c in spec],
+        "values": control_values(state, spec),
     }

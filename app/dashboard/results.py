@@ -102,8 +102,9 @@ def compute(
     done = [(len(ALGORITHMS) - len(todo)) * cycles * len(targets)]  # legs, cached runs included
     done[0] += sum(len(other[a].leg_end) for a in todo if other[a] is not None)
 
-    # With a second process, the pseudoinverse runs there while this thread runs the extended
-    # inverse (the two are independent); each local leg then stands for two in the progress.
+    # With a lane of the compute pool, the pseudoinverse runs in a worker while this thread runs
+    # the extended inverse (the two are independent); each local leg then stands for two in the
+    # progress.
     remote: Future | None = None
     if offload is not None and len(todo) == 2:
         remote = offload.submit(

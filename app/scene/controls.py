@@ -52,7 +52,7 @@ class SceneControls:
         with self._lock:
             if shape != self._shape:
                 self._shape = shape
-                self._build(spec, control_values(state))
+                self._build(spec, control_values(state, spec))
             else:
                 self.sync(state)
 
