@@ -9,14 +9,20 @@ reached only through the API's proxy (:mod:`jik.app.api.routes.sessions`).
 from __future__ import annotations
 
 import errno
+import os
 import signal
 import socket
 
 import uvicorn
 
 from jik.app.api.factory import create_app
+from jik.app.api.protocol import READ_SECONDS, with_read_deadline
 from jik.app.dashboard.sessions import SessionLimits, SessionStore
 from jik.app.scene import start_scene
+
+#: Default cap on open connections and running requests (``JIK_MAX_CONNECTIONS``); beyond it
+#: uvicorn answers 503 at once instead of queueing.
+MAX_CONNECTIONS = 1000
 
 
 class PortInUse(RuntimeError):
@@ -77,7 +83,16 @@ def run_server(
     # to stop should (`docker stop` sends SIGTERM).
     previous = {sig: signal.signal(sig, _stopped) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
-        config = uvicorn.Config(app, host=host, port=port, log_level="info", access_log=False)
+        config = uvicorn.Config(
+            app,
+            host=host,
+            port=port,
+            log_level="info",
+            access_log=False,
+            # A request must arrive whole within JIK_READ_SECONDS (slow senders are cut off).
+            http=with_read_deadline(float(os.environ.get("JIK_READ_SECONDS", READ_SECONDS))),
+            limit_concurrency=int(os.environ.get("JIK_MAX_CONNECTIONS", MAX_CONNECTIONS)),
+        )
         uvicorn.Server(config).run(sockets=[sock])
     finally:
         for sig, handler in previous.items():

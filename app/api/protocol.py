@@ -1,0 +1,93 @@
+"""The HTTP protocol ``jik serve`` runs under uvicorn: uvicorn's own, with a deadline for reading.
+
+uvicorn times out an idle keep-alive connection but not one that is sending a request: a client
+that opens a connection and sends nothing, or half of its headers, or part of a declared body,
+keeps a socket and a task for ever (a "slowloris"; 1,000 such connections stayed open). Here every
+request must arrive whole, headers and body, within ``read_seconds`` of its first byte (or of the
+connection, for the first request), however slowly the bytes trickle in:
+
+- headers not complete by then: the connection is answered ``408 Request Timeout`` and closed;
+- headers complete, body not: the connection is closed (the application, still waiting for the
+  body, sees the client disconnect; no response can be sent through it any more).
+
+WebSocket upgrades and responses that take long to compute are not affected: the deadline stops
+when the request has been read.
+"""
+
+from __future__ import annotations
+
+import asyncio
+
+from uvicorn.protocols.http.httptools_impl import HttpToolsProtocol
+
+#: Default seconds a client has to send a whole request (``JIK_READ_SECONDS``).
+READ_SECONDS = 10.0
+
+_TIMEOUT_RESPONSE = (
+    b"HTTP/1.1 408 Request Timeout\r\n"
+    b"content-type: text/plain; charset=utf-8\r\n"
+    b"content-length: 46\r\n"
+    b"connection: close\r\n"
+    b"\r\n"
+    b"request not received in time; send it at once\n"
+)
+
+
+class ReadDeadlineProtocol(HttpToolsProtocol):
+    """uvicorn's httptools protocol with a deadline on reading each request (see the module)."""
+
+    #: Seconds from a request's first byte (or the connection) to its last
+    #: (:func:`with_read_deadline` sets it).
+    read_seconds: float = READ_SECONDS
+
+    def connection_made(self, transport: asyncio.Transport) -> None:  # type: ignore[override]
+        self._read_timer: asyncio.TimerHandle | None = None
+        self._headers_read = False
+        super().connection_made(transport)
+        self._start_reading()
+
+    def connection_lost(self, exc: Exception | None) -> None:
+        self._stop_reading()
+        super().connection_lost(exc)
+
+    def on_message_begin(self) -> None:
+        super().on_message_begin()
+        self._start_reading()  # the next request on a kept-alive connection has its own deadline
+
+    def on_headers_complete(self) -> None:
+        self._headers_read = True
+        super().on_headers_complete()
+
+    def on_message_complete(self) -> None:
+        self._stop_reading()
+        super().on_message_complete()
+
+    def handle_websocket_upgrade(self) -> None:
+        self._stop_reading()
+        super().handle_websocket_upgrade()
+
+    def _start_reading(self) -> None:
+        self._stop_reading()
+        self._headers_read = False
+        self._read_timer = self.loop.call_later(self.read_seconds, self._read_too_slow)
+
+    def _stop_reading(self) -> None:
+        if self._read_timer is not None:
+            self._read_timer.cancel()
+            self._read_timer = None
+
+    def _read_too_slow(self) -> None:
+        self._read_timer = None
+        if self.transport.is_closing():
+            return
+        previous_response_pending = self.cycle is not None and not self.cycle.response_complete
+        if not self._headers_read and not previous_response_pending:
+            self.transport.write(_TIMEOUT_RESPONSE)
+        self.transport.close()
+
+
+def with_read_deadline(seconds: float) -> type[ReadDeadlineProtocol]:
+    """The protocol class for uvicorn's ``http=`` option, with ``seconds`` to read a request."""
+    if not seconds > 0:
+        raise ValueError(f"JIK_READ_SECONDS must be positive, got {seconds}")
+    return type("ReadDeadlineProtocol", (ReadDeadlineProtocol,), {"read_seconds": float(seconds)})

@@ -1,0 +1,132 @@
+"""Slow senders against a real ``jik serve``: a request that does not arrive whole within
+``JIK_READ_SECONDS`` is cut off (408 when its headers are incomplete), however slowly its bytes
+trickle in, and the server answers other clients meanwhile (issue 26, item 7)."""
+
+from __future__ import annotations
+
+import os
+import socket
+import subprocess
+import sys
+import time
+
+import httpx
+import pytest
+
+READ_SECONDS = 1.0
+HALF_SENT = 150
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture(scope="module")
+def server():
+    port = _free_port()
+    env = dict(os.environ, JIK_READ_SECONDS=str(READ_SECONDS), JIK_WORKERS="1")
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "jik", "serve", f"--port={port}"],
+        env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+    )  # fmt: skip
+    base = f"http://127.0.0.1:{port}"
+    deadline = time.monotonic() + 60
+    while True:
+        try:
+            if httpx.get(f"{base}/health", timeout=2).status_code == 200:
+                break
+        except httpx.TransportError:
+            pass
+        assert proc.poll() is None, proc.communicate()[0]
+        assert time.monotonic() < deadline, "server did not start"
+        time.sleep(0.1)
+    yield port, base
+    proc.terminate()
+    log = proc.communicate(timeout=30)[0]
+    assert "Traceback" not in log, log
+
+
+def _connect(port: int, data: bytes) -> socket.socket:
+    s = socket.create_connection(("127.0.0.1", port))
+    if data:
+        s.sendall(data)
+    return s
+
+
+def _read_until_closed(s: socket.socket, timeout: float) -> bytes:
+    """Everything the server sends before closing; fails if it is still open after ``timeout``."""
+    s.settimeout(timeout)
+    received = b""
+    while chunk := s.recv(4096):
+        received += chunk
+    return received
+
+
+def test_half_sent_requests_are_cut_off_and_others_are_served(server):
+    port, base = server
+    silent = [_connect(port, b"") for _ in range(10)]
+    half_headers = [
+        _connect(port, b"GET /health HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: ")
+        for _ in range(HALF_SENT)
+    ]
+    body = b'{"robot": {"name": "manipulator2"}, "x0": [0, 1, 0.5], "target": [1, 1]}'
+    half_bodies = [
+        _connect(
+            port,
+            b"POST /solve HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
+            b"Content-Length: %d\r\n\r\n%s" % (len(body), body[:20]),
+        )
+        for _ in range(10)
+    ]
+    started = time.monotonic()
+    # Meanwhile, a whole request is answered at once.
+    assert httpx.get(f"{base}/health", timeout=5).status_code == 200
+    try:
+        for s in silent + half_headers:
+            assert _read_until_closed(s, timeout=10 * READ_SECONDS).startswith(
+                b"HTTP/1.1 408 Request Timeout"
+            )
+        for s in half_bodies:
+            assert b"200 OK" not in _read_until_closed(s, timeout=10 * READ_SECONDS)
+    finally:
+        for s in silent + half_headers + half_bodies:
+            s.close()
+    assert time.monotonic() - started < 8 * READ_SECONDS
+
+
+def test_trickling_bytes_do_not_extend_the_deadline(server):
+    port, _ = server
+    s = _connect(port, b"G")
+    started = time.monotonic()
+    try:
+        for byte in b"ET /health HTTP/1.1\r\n":
+            time.sleep(READ_SECONDS / 8)
+            try:
+                s.sendall(bytes([byte]))
+            except OSError:
+                break  # closed by the server: what this test expects
+        assert _read_until_closed(s, timeout=10 * READ_SECONDS).startswith(b"HTTP/1.1 408")
+    finally:
+        s.close()
+    assert time.monotonic() - started < 4 * READ_SECONDS
+
+
+def test_a_whole_request_on_a_kept_alive_connection_is_not_cut_off(server):
+    """The deadline covers reading a request, not computing it nor idling between requests."""
+    _, base = server
+    with httpx.Client(base_url=base, timeout=30) as client:
+        for _ in range(3):
+            assert client.get("/health").status_code == 200
+            time.sleep(READ_SECONDS * 0.6)
+        response = client.post(
+            "/solve",
+            json={
+                    "robot": {"name": "manipulator2"},
+                    "algorithm": "pseudoinverse",
+                    "x0": [0, 1, 0.5],
+                    "target": [1, 1.5],
+                },
+        )
+        assert response.status_code == 200, response.text
