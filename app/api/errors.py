@@ -25,23 +25,32 @@ from fastapi import FastAPI, HTTPException, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
+from starlette.routing import Match
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from jik.app.compute.exceptions import ComputeError, RequestError, ServiceUnavailable
-from jik.app.compute.schemas import AUGMENTATION_MODELS, ROBOT_MODELS
+from jik.app.compute.schemas import AUGMENTATION_MODELS, ROBOT_MODELS, ErrorResponse
 from jik.app.dashboard.sessions import SessionNotFound, SessionsFull
 from jik.engine.exceptions import InvalidInputError
+from jik.engine.registry import ROBOTS
 
 log = logging.getLogger("jik.api")
 _TAGS = set(ROBOT_MODELS) | set(AUGMENTATION_MODELS)
+_TYPE_LABELS = {"str", "float", "int", "bool", "constrained-float", "constrained-str"}
 
 
 def _field(loc) -> str:
     """Field path of a pydantic location: ``("body", "robot", "manipulator2", "l")`` -> ``robot.l``.
 
-    Indices become ``x0[2]``; the discriminator tag of a union member is dropped.
+    Indices become ``x0[2]``; the discriminator tag of a union member (a request's robot, a
+    robot's or a map's name) is dropped.
     """
-    parts = [str(p) for p in loc if p != "body"]
+    # (a member of a plain union is labelled by its type: "str", "tuple[float, ...]")
+    parts = [
+        str(p) for p in loc if p != "body" and str(p) not in _TYPE_LABELS and "[" not in str(p)
+    ]
+    if len(parts) > 1 and parts[0] in ROBOTS:
+        del parts[0]
     if len(parts) > 2 and parts[0] in ("robot", "augmentation") and parts[1] in _TAGS:
         del parts[1]
     out: list[str] = []
@@ -53,10 +62,20 @@ def _field(loc) -> str:
     return ".".join(out) or "body"
 
 
+def _location(loc) -> list:
+    """A pydantic location without the labels of union members that are not fields: the
+    request's robot variant (``("body", "manipulator2", "x0")``) and a member labelled by its
+    type (``("body", "path", "str")``)."""
+    out = [p for p in loc if not (isinstance(p, str) and (p in _TYPE_LABELS or "[" in p))]
+    if len(out) > 2 and out[0] == "body" and out[1] in ROBOTS:
+        del out[1]
+    return out
+
+
 def _validation_detail(errors) -> list[dict]:
     detail = []
     for e in errors:
-        loc = list(e.get("loc", ()))
+        loc = _location(e.get("loc", ()))
         msg = str(e.get("msg", "invalid"))
         if e.get("type") == "extra_forbidden":
             msg = "unknown field; remove it"
@@ -69,8 +88,36 @@ def _validation_detail(errors) -> list[dict]:
         elif e.get("type") == "union_tag_invalid":
             ctx = e.get("ctx") or {}
             msg = f"unknown name {ctx.get('tag')!r}; choose one of {ctx.get('expected_tags')}"
+        elif e.get("type") == "unknown_robot":  # (the request's variant, chosen by robot.name)
+            loc = [*loc, "robot"]
+            body = e.get("input")
+            robot = body.get("robot") if isinstance(body, dict) else None
+            name = robot.get("name") if isinstance(robot, dict) else None
+            if isinstance(body, dict) and "robot" not in body:
+                msg = "Field required"
+            elif name is None:
+                msg = f"give the robot, with a name among {sorted(ROBOTS)}"
+            else:
+                msg = f"unknown name {name!r}; choose one of {sorted(ROBOTS)}"
+        elif e.get("type") in ("too_short", "too_long"):
+            msg = _length_message(e.get("loc", ()), e.get("ctx") or {}) or msg
         detail.append({"loc": loc, "msg": f"{_field(loc)}: {msg}", "type": str(e.get("type"))})
     return detail
+
+
+def _length_message(loc, ctx: dict) -> str | None:
+    """A vector of the wrong length for the request's robot (its tag is the location's second
+    part): how many components it needs and why."""
+    parts = [str(p) for p in loc]
+    spec = ROBOTS.get(parts[1]) if len(parts) > 2 else None
+    if (
+        spec is None
+        or parts[2] not in ("x0", "target", "path")
+        or (parts[2] == "path" and len(parts) < 4)
+    ):
+        return None
+    n, what = (spec.p, "p") if parts[2] == "x0" else (len(spec.task_names), "r")
+    return f"must have {n} components ({what} of {spec.name}), got {ctx.get('actual_length')}"
 
 
 def validation_error_response(exc: RequestValidationError) -> JSONResponse:
@@ -168,13 +215,70 @@ def error_response(exc: Exception) -> JSONResponse | None:
     return None
 
 
+def _allowed_methods(request: Request) -> str:
+    """Every method some route takes at the request's path (routes are one per method, and the
+    framework's 405 names only the first one's)."""
+    routes = request.app.router.routes
+    return ", ".join(
+        method for method in ("DELETE", "GET", "HEAD", "OPTIONS", "PATCH", "POST", "PUT")
+        if any(route.matches({**request.scope, "method": method})[0] == Match.FULL
+               for route in routes)
+    )  # fmt: skip
+
+
 def _handler(respond: Callable[[Any], JSONResponse]):
     # A coroutine: Starlette would run a plain function in a thread, where the traceback that
     # unexpected_error_response logs is not the current exception.
     async def handle(request: Request, exc: Exception) -> JSONResponse:
-        return respond(exc)
+        response = respond(exc)
+        if response.status_code == 405:
+            response.headers["Allow"] = _allowed_methods(request)
+        return response
 
     return handle
+
+
+def _error(description: str, schema: str = "ErrorResponse") -> dict:
+    ref = {"$ref": f"#/components/schemas/{schema}"}
+    return {"description": description, "content": {"application/json": {"schema": ref}}}
+
+
+#: The errors that checks before the routes answer (:mod:`jik.app.api.security`, :class:`BodyLimit`,
+#: the session store), as the OpenAPI document lists them for each operation they apply to.
+_ANY_OPERATION = {"400": _error("a host name the server does not answer to")}
+_WITH_BODY = {
+    "403": _error("a change asked from another origin"),
+    "413": _error("a body over 1 MiB"),
+    "415": _error("a body that is not JSON (application/json)", "HTTPValidationError"),
+}
+_IN_SESSION = {"404": _error("no such session (it expired or never existed)")}
+
+
+def document_errors(app: FastAPI) -> None:
+    """Make the app's OpenAPI document list the errors above with the operations' own."""
+    make = app.openapi
+
+    def openapi() -> dict[str, Any]:
+        if app.openapi_schema is None:
+            schema = make()
+            schema.setdefault("components", {}).setdefault("schemas", {}).setdefault(
+                "ErrorResponse", ErrorResponse.model_json_schema()
+            )
+            for path, operations in schema.get("paths", {}).items():
+                for method, operation in operations.items():
+                    responses = operation.setdefault("responses", {})
+                    extra = dict(_ANY_OPERATION)
+                    if method in ("post", "put", "patch", "delete"):
+                        extra |= {k: v for k, v in _WITH_BODY.items() if method != "delete"
+                                  or k == "403"}  # fmt: skip
+                    if "{session_id}" in path:
+                        extra |= _IN_SESSION
+                    for status, response in extra.items():
+                        responses.setdefault(status, response)
+            app.openapi_schema = schema
+        return app.openapi_schema
+
+    app.openapi = openapi  # type: ignore[method-assign]
 
 
 def add_error_handlers(app: FastAPI) -> None:
@@ -182,6 +286,7 @@ def add_error_handlers(app: FastAPI) -> None:
     for kind, respond in _RESPONSES.items():
         app.add_exception_handler(kind, _handler(respond))
     app.add_exception_handler(Exception, _handler(unexpected_error_response))
+    document_errors(app)
 
 
 def _too_large(detail: str) -> JSONResponse:

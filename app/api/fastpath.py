@@ -16,13 +16,16 @@ from __future__ import annotations
 import json
 from typing import Any
 
-from pydantic import ValidationError
+from pydantic import TypeAdapter, ValidationError
 from starlette.responses import Response
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from jik.app.api.errors import error_response
 from jik.app.compute.pool import ComputePool
-from jik.app.compute.schemas import SolveRequest
+from jik.app.compute.schemas import SolveBody
+
+#: The route's body type, checked here as the route would.
+_SOLVE_BODY: TypeAdapter[Any] = TypeAdapter(SolveBody)
 
 
 def _is_json(scope: Scope) -> bool:
@@ -77,7 +80,7 @@ class SolveFastPath:
                 break
         body = b"".join(chunks)
         try:
-            req = SolveRequest.model_validate(json.loads(body))  # as FastAPI reads a JSON body
+            req = _SOLVE_BODY.validate_python(json.loads(body))  # as FastAPI reads the body
         except (ValueError, RecursionError, ValidationError):  # the route says what is wrong
             await self.app(scope, _replay(body, receive), send)
             return

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeAlias, Union
 
-from pydantic import BaseModel, ConfigDict, Field, create_model
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Discriminator, Field, Tag, create_model
 
 from jik.engine.registry import ROBOTS, AugmentationSpec, RobotSpec
 from jik.engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
@@ -32,6 +32,19 @@ MAX_ITERATIONS = 20000
 MAX_TRAJECTORY_POINTS = 2000
 
 FiniteFloat = Annotated[float, Field(strict=True, allow_inf_nan=False)]
+
+
+def _integral(value: Any) -> Any:
+    """A float with no fraction is the integer it equals (JSON Schema's "integer": 49.0 is one)."""
+    return int(value) if isinstance(value, float) and value.is_integer() else value
+
+
+#: Makes a strict ``int`` take what JSON Schema calls an integer (49 or 49.0), never a boolean
+#: or a string: ``Annotated[int, Field(strict=True, ...), INTEGRAL]`` (after the
+#: Field, or the schema loses its bounds).
+INTEGRAL = BeforeValidator(_integral)
+
+
 #: A float that is null where the engine produced NaN or inf (a failed or diverged run).
 MaybeFloat = float | None
 
@@ -133,7 +146,11 @@ Coordinate = Annotated[
 ]
 Vector = Annotated[list[Coordinate], Field(min_length=1, max_length=MAX_DIMENSION)]
 #: The decay rate of eq. (5) (discrete mode: the step; below 2 there, checked with the mode).
-Gamma = Annotated[float, Field(strict=True, gt=0, le=1e6, allow_inf_nan=False)]
+#: Continuous runs depend on gamma only through theta = -log(1 - s) / gamma (theta's scale);
+#: below 1e-6 that scale leaves the floating-point range (from about 1e-100 the integrator
+#: failed with NaN).
+GAMMA_MIN = 1e-6
+Gamma = Annotated[float, Field(strict=True, ge=GAMMA_MIN, le=1e6, allow_inf_nan=False)]
 #: The task error at which a solve stops.
 Tolerance = Annotated[float, Field(strict=True, ge=1e-14, le=1.0, allow_inf_nan=False)]
 
@@ -161,9 +178,11 @@ class _Request(BaseModel):
         None, description="'continuous' (ODE) or 'discrete' (iterations); default: the robot's"
     )
     tolerance: Tolerance = Field(1e-10, description="stop when ||k(x) - target|| < tolerance")
-    max_iterations: Annotated[int, Field(strict=True, ge=1, le=MAX_ITERATIONS)] | None = Field(
-        None,
-        description="cap on integrator steps (continuous) or iterations (discrete) per solve",
+    max_iterations: Annotated[int, Field(strict=True, ge=1, le=MAX_ITERATIONS), INTEGRAL] | None = (
+        Field(
+            None,
+            description="cap on integrator steps (continuous) or iterations (discrete) per solve",
+        )
     )
 
 
@@ -179,7 +198,7 @@ class RepeatabilityRequest(_Request):
     path: Annotated[list[Vector], Field(min_length=1, max_length=MAX_PATH_POINTS)] = Field(
         description=f"task points visited in order, 1 to {MAX_PATH_POINTS}; k(x0) closes it"
     )
-    cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_CYCLES)] = Field(
+    cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_CYCLES), INTEGRAL] = Field(
         1, description=f"1 to {MAX_CYCLES}"
     )
 
@@ -245,6 +264,87 @@ class RepeatabilityResponse(BaseModel):
     repeatable: bool = Field(description="every leg succeeded and max drift < 1e-6")
     success: bool
     message: str
+
+
+def _task_point(spec: RobotSpec) -> Any:
+    r = len(spec.task_names)
+    return Annotated[list[Coordinate], Field(min_length=r, max_length=r)]
+
+
+def _robot_name(body: Any) -> str | None:
+    """The robot's name in a request body (raw JSON data or a model): the variant to check."""
+    robot = body.get("robot") if isinstance(body, dict) else getattr(body, "robot", None)
+    name = robot.get("name") if isinstance(robot, dict) else getattr(robot, "name", None)
+    return name if isinstance(name, str) else None
+
+
+def per_robot(base: type[BaseModel], fields: Any) -> Any:
+    """``base`` made exact for each robot of the catalogue: one model per robot, chosen by
+    ``robot.name``, whose ``robot`` and ``augmentation`` are that robot's and whose vectors have
+    its lengths (``fields(spec)``: the fields that differ from ``base``'s). Their union is what
+    the route takes and what its OpenAPI document shows; each member is still a ``base``."""
+    members = []
+    for name, spec in ROBOTS.items():
+        augmentations = list(dict.fromkeys(a.name for a in spec.augmentations))
+        model = create_model(
+            f"{base.__name__.removesuffix('Request')}{_camel(name)}Request",
+            __base__=base,
+            __doc__=f"{(base.__doc__ or '').strip()} ({spec.title})",
+            robot=(ROBOT_MODELS[name], Field(description=f"{spec.title} and its parameters")),
+            **fields(spec, _union([AUGMENTATION_MODELS[a] for a in augmentations])),
+        )
+        globals()[model.__name__] = model
+        members.append(Annotated[model, Tag(name)])
+    return Annotated[
+        Union[tuple(members)],  # noqa: UP007
+        Discriminator(
+            _robot_name,
+            custom_error_type="unknown_robot",
+            custom_error_message=f"give a robot whose name is one of {sorted(ROBOTS)}",
+        ),
+    ]
+
+
+def _run_fields(spec: RobotSpec, augmentation: Any) -> dict[str, Any]:
+    return {
+        "augmentation": (
+            augmentation | None,
+            Field(
+                None,
+                description=f"augmenting map h of the extended inverse (one of "
+                f"{sorted({a.name for a in spec.augmentations})}); default: "
+                f"{spec.augmentation(None).name} (ignored by the pseudoinverse)",
+            ),
+        ),
+        "x0": (
+            Annotated[list[Coordinate], Field(min_length=spec.p, max_length=spec.p)],
+            Field(description=f"start configuration {list(spec.variable_names)}"),
+        ),
+    }
+
+
+#: ``POST /solve``'s body: a :class:`SolveRequest` with the lengths of its robot.
+SolveBody = per_robot(
+    SolveRequest,
+    lambda spec, aug: {
+        **_run_fields(spec, aug),
+        "target": (_task_point(spec), Field(description=f"target {list(spec.task_names)}")),
+    },
+)
+#: ``POST /repeatability``'s body: a :class:`RepeatabilityRequest` with its robot's lengths.
+RepeatabilityBody = per_robot(
+    RepeatabilityRequest,
+    lambda spec, aug: {
+        **_run_fields(spec, aug),
+        "path": (
+            Annotated[list[_task_point(spec)], Field(min_length=1, max_length=MAX_PATH_POINTS)],  # type: ignore[misc]
+            Field(
+                description=f"task points {list(spec.task_names)} visited in order, 1 to "
+                f"{MAX_PATH_POINTS}; k(x0) closes it"
+            ),
+        ),
+    },
+)
 
 
 class ParameterInfo(BaseModel):
@@ -332,15 +432,53 @@ class SynthesizeRequest(BaseModel):
         max_length=MAX_DIMENSION,
         description="values of the variables not in the box (default: the default start)",
     )
-    nodes: Annotated[int, Field(strict=True, ge=2, le=24)] = Field(
+    nodes: Annotated[int, Field(strict=True, ge=2, le=24), INTEGRAL] = Field(
         8, description="Gauss-Legendre nodes per variable for E1 and E2"
     )
-    degree: Annotated[int, Field(strict=True, ge=1, le=24)] = Field(
+    degree: Annotated[int, Field(strict=True, ge=1, le=24), INTEGRAL] = Field(
         10, description="'e2_variational': Legendre degree per variable"
     )
-    grid: Annotated[int, Field(strict=True, ge=3, le=61)] = Field(
+    grid: Annotated[int, Field(strict=True, ge=3, le=61), INTEGRAL] = Field(
         21, description="grid points per axis for h"
     )
+
+
+def _synthesis_fields(spec: RobotSpec, augmentation: Any) -> dict[str, Any]:
+    names = tuple(spec.variable_names)
+    variable = Literal[names]  # type: ignore[valid-type]
+    return {
+        "augmentation": (
+            augmentation | None,
+            Field(
+                None,
+                description="for 'evaluate': the map and its parameters (one of "
+                f"{sorted({a.name for a in spec.augmentations})}; default: "
+                f"{spec.augmentation(None).name})",
+            ),
+        ),
+        "region": (
+            Annotated[dict[variable, tuple[Bound, Bound]], Field(min_length=1, max_length=3)]
+            | None,
+            Field(
+                None,
+                description=f"box {{variable: [lo, hi]}}, lo < hi, of 1 to 3 of "
+                f"{list(names)} (2 or 3 draw a grid of h; 'e2_variational' needs 2 or 3), none "
+                "of them fixed; default: the last 3 (2 for 'e2_variational') not fixed, each "
+                "over a tenth of its range either side of the default start",
+            ),
+        ),
+        "fixed": (
+            dict[variable, FiniteFloat] | None,
+            Field(
+                None,
+                description="values of the variables not in the box (default: the default start)",
+            ),
+        ),
+    }
+
+
+#: ``POST /synthesize``'s body: a :class:`SynthesizeRequest` with its robot's variables.
+SynthesizeBody = per_robot(SynthesizeRequest, _synthesis_fields)
 
 
 class FunctionalInfo(BaseModel):

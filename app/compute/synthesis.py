@@ -7,6 +7,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Collection
+
 import numpy as np
 
 from jik.app.compute import schemas as S
@@ -31,15 +33,18 @@ def synthesis_methods() -> S.SynthesisMethodsResponse:
     )
 
 
-def default_region(spec: RobotSpec, size: int) -> dict[str, tuple[float, float]]:
-    """The last ``size`` variables, each over a box around the default start.
+def default_region(
+    spec: RobotSpec, size: int, fixed: Collection[str] = ()
+) -> dict[str, tuple[float, float]]:
+    """The last ``size`` variables that are not ``fixed``, each over a box around the default
+    start.
 
     Half-width: a tenth of the variable's ``x_range``, clipped to it. The other variables are
     held at the default start (where the robot's maps are defined), not at 0.
     """
     names = list(spec.variable_names)
     region = {}
-    for n in names[-size:]:
+    for n in [n for n in names if n not in fixed][-size:]:
         i = names.index(n)
         lo, hi = spec.x_range[i]
         c, w = spec.default_x0[i], 0.1 * (hi - lo)
@@ -51,7 +56,7 @@ def synthesis_region(spec: RobotSpec, req: S.SynthesizeRequest):
     """The variable names, the box and the fixed values of a synthesis request, checked."""
     names = list(spec.variable_names)
     if req.region is None:
-        region = default_region(spec, 2 if req.method == "e2_variational" else 3)
+        region = default_region(spec, 2 if req.method == "e2_variational" else 3, req.fixed or {})
     else:
         region = {k: (float(lo), float(hi)) for k, (lo, hi) in req.region.items()}
     for k, (lo, hi) in region.items():

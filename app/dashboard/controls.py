@@ -176,7 +176,7 @@ def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
         elif head in ("robot_parameters", "augmentation_parameters"):
             out.setdefault(head, {})[rest] = value
         elif head in ("x0", "target") and rest.isdigit():
-            vector = out.setdefault(head, list(getattr(state, head)))
+            vector = out[head] = list(out.get(head, getattr(state, head)))
             if int(rest) >= len(vector):
                 raise InvalidInputError(f"{key}: {head} has {len(vector)} coordinates", key)
             vector[int(rest)] = value

@@ -123,10 +123,10 @@ def test_a_whole_request_on_a_kept_alive_connection_is_not_cut_off(server):
         response = client.post(
             "/solve",
             json={
-                    "robot": {"name": "manipulator2"},
-                    "algorithm": "pseudoinverse",
-                    "x0": [0, 1, 0.5],
-                    "target": [1, 1.5],
-                },
+                "robot": {"name": "manipulator2"},
+                "algorithm": "pseudoinverse",
+                "x0": [0, 1, 0.5],
+                "target": [1, 1.5],
+            },
         )
         assert response.status_code == 200, response.text

@@ -85,7 +85,7 @@ def test_synthesize_bad_input(api):
 
     m2 = {"name": "manipulator2"}
     assert msg({"robot": m2, "region": {"x7": [0, 1], "x2": [0, 1]}}).startswith(
-        "region.x7: unknown variable 'x7'"
+        "region.x7: Input should be 'x1', 'x2' or 'x3'"
     )
     assert msg({"robot": m2, "region": {"x2": [1, 0], "x3": [0, 1]}}).startswith(
         "region.x2: needs lo < hi"

@@ -4,7 +4,7 @@ from fastapi import APIRouter, Response
 
 from jik.app.api.dependencies import Pool
 from jik.app.compute.precheck import precheck
-from jik.app.compute.schemas import BUSY, RepeatabilityRequest, RepeatabilityResponse
+from jik.app.compute.schemas import BUSY, RepeatabilityBody, RepeatabilityResponse
 
 router = APIRouter(tags=["repeatability"])
 
@@ -14,7 +14,7 @@ router = APIRouter(tags=["repeatability"])
     response_model=RepeatabilityResponse,
     responses=BUSY,
 )
-async def repeatability(req: RepeatabilityRequest, pool: Pool) -> Response:
+async def repeatability(req: RepeatabilityBody, pool: Pool) -> Response:
     """Configurations after each leg, at each cycle end, and the drift from x0 per cycle."""
     precheck(req)
     body = await pool.run("repeatability", req.model_dump_json().encode())

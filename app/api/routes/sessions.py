@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
-from typing import Any
 
 import websockets
 import websockets.asyncio.client
@@ -21,10 +20,10 @@ from pydantic import BaseModel, ConfigDict, Field
 from websockets.typing import Subprotocol
 
 from jik.app.api.dependencies import Store
-from jik.app.api.errors import unparsed_body_response
 from jik.app.dashboard import export_csv, export_json
 from jik.app.dashboard.controls import controls_message
 from jik.app.dashboard.messages import LatestEvents
+from jik.app.dashboard.model import StatePatch, patch_of
 from jik.app.dashboard.sessions import Session, SessionNotFound
 from jik.engine.exceptions import InvalidInputError
 
@@ -42,16 +41,25 @@ class SessionCreate(BaseModel):
 
     model_config = ConfigDict(extra="forbid")
 
-    state: dict[str, Any] = Field(
-        default_factory=dict,
+    state: StatePatch = Field(  # type: ignore[valid-type]
+        default_factory=StatePatch,
         description="the dashboard fields that differ from the defaults (a link's state); "
         "validated like a change (POST /api/sessions/{id}/state)",
     )
     low_end: bool = Field(
         default=False,
+        strict=True,
         description="draw the 3D scene without shadows or environment map: the low-end mode, "
         "which the page asks for only when its browser renders WebGL without a GPU",
     )
+
+
+#: What a client does next with a new session (OpenAPI links: the id it answers is the path's).
+_SESSION_LINKS = {
+    name: {"operationId": name, "parameters": {"session_id": "$response.body#/id"}}
+    for name in ("get_session", "post_state", "session_events", "export_json", "export_csv",
+                 "delete_session")
+}  # fmt: skip
 
 
 def _created(session: Session) -> dict:
@@ -65,45 +73,39 @@ def _created(session: Session) -> dict:
     }
 
 
-@router.post("/api/sessions", status_code=201)
+@router.post("/api/sessions", status_code=201, responses={201: {"links": _SESSION_LINKS}})
 async def create_session(body: SessionCreate, store: Store) -> JSONResponse:
     """A new session whose state is the defaults changed by ``state`` (a link's state)."""
     try:
-        session = await asyncio.to_thread(store.create, body.state, body.low_end)
+        session = await asyncio.to_thread(store.create, patch_of(body.state), body.low_end)
     except InvalidInputError as exc:  # (the link's state is the body's "state")
         exc.field = f"state.{exc.field}" if exc.field else "state"
         raise
     return JSONResponse(status_code=201, content=_created(session))
 
 
-@router.get("/api/sessions/{session_id}")
+@router.get("/api/sessions/{session_id}", operation_id="get_session")
 async def get_session(session_id: str, store: Store) -> JSONResponse:
     """The session's state, its generation and the summary of its last result."""
     return JSONResponse(store.get(session_id).dashboard.snapshot())
 
 
-@router.delete("/api/sessions/{session_id}", status_code=204)
+@router.delete("/api/sessions/{session_id}", status_code=204, operation_id="delete_session")
 async def delete_session(session_id: str, store: Store):
     """End the session now (a closing tab; otherwise it expires when idle)."""
     await asyncio.to_thread(store.delete, session_id)
     return PlainTextResponse(status_code=204, content="")
 
 
-@router.post("/api/sessions/{session_id}/state")
-async def post_state(session_id: str, request: Request, store: Store) -> JSONResponse:
+@router.post("/api/sessions/{session_id}/state", operation_id="post_state")
+async def post_state(session_id: str, change: StatePatch, store: Store) -> JSONResponse:  # type: ignore[valid-type]
     """Change some controls: ``{"gamma": 2}``, ``{"x0": [...]}``, ``{"robot": "manipulator1"}``.
 
     The body is a partial dashboard state; the answer is the new generation and state (422 with
     the engine's message for a value it refuses, which the session's scene shows too).
     """
     session = store.get(session_id)
-    try:
-        patch = await request.json()
-    except (ValueError, RecursionError) as exc:
-        return unparsed_body_response(exc)
-    if not isinstance(patch, dict):
-        raise InvalidInputError("body: give a JSON object of dashboard fields")
-    generation, state = session.dashboard.update(patch, source="page")
+    generation, state = session.dashboard.update(patch_of(change), source="page")
     return JSONResponse({"generation": generation, "state": state.as_dict()})
 
 
@@ -117,6 +119,7 @@ _NOT_FOUND: dict[int | str, dict] = {404: {"description": "no such session"}}
 
 @router.get(
     "/api/sessions/{session_id}/events",
+    operation_id="session_events",
     response_class=StreamingResponse,
     responses={
         200: {"description": "the session's events", "content": {"text/event-stream": {}}},
@@ -174,6 +177,7 @@ async def _finished(session: Session):
 
 @router.get(
     "/api/sessions/{session_id}/export.json",
+    operation_id="export_json",
     responses={503: {"description": "no result computed yet"}, **_NOT_FOUND},
 )
 async def export_result_json(session_id: str, store: Store) -> JSONResponse:
@@ -189,6 +193,7 @@ async def export_result_json(session_id: str, store: Store) -> JSONResponse:
 
 @router.get(
     "/api/sessions/{session_id}/export.csv",
+    operation_id="export_csv",
     response_class=CSVResponse,
     responses={
         200: {"description": "one row per trajectory point"},

@@ -3,7 +3,7 @@
 from fastapi import APIRouter, Response
 
 from jik.app.api.dependencies import Pool
-from jik.app.compute.schemas import BUSY, SolveRequest, SolveResponse
+from jik.app.compute.schemas import BUSY, SolveBody, SolveResponse
 
 router = APIRouter(tags=["solve"])
 
@@ -13,7 +13,7 @@ router = APIRouter(tags=["solve"])
     response_model=SolveResponse,
     responses=BUSY,
 )
-async def solve(req: SolveRequest, pool: Pool) -> Response:
+async def solve(req: SolveBody, pool: Pool) -> Response:
     """Solve k(x) = target from x0 with the pseudoinverse (8) or the extended inverse (11).
 
     The body comes from a worker as the JSON of a ``SolveResponse``. Under ``create_app()``

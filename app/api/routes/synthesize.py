@@ -7,7 +7,7 @@ from jik.app.compute.precheck import precheck
 from jik.app.compute.schemas import (
     BUSY,
     SynthesisMethodsResponse,
-    SynthesizeRequest,
+    SynthesizeBody,
     SynthesizeResponse,
 )
 from jik.app.compute.synthesis import synthesis_methods
@@ -26,7 +26,7 @@ async def methods() -> SynthesisMethodsResponse:
     response_model=SynthesizeResponse,
     responses=BUSY,
 )
-async def synthesize(req: SynthesizeRequest, pool: Pool) -> Response:
+async def synthesize(req: SynthesizeBody, pool: Pool) -> Response:
     """h on a grid of the box, its coefficients and E1, E2 over the box."""
     precheck(req)
     body = await pool.run("synthesize", req.model_dump_json().encode())

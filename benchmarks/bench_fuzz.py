@@ -1,0 +1,108 @@
+"""``jik bench fuzz``: schemathesis against a running ``jik serve``, every check, positive and
+negative data, examples, coverage, fuzzing and stateful phases (issue 26).
+
+:func:`run_fuzz` starts the server on a free loopback port, runs the schemathesis command with
+:mod:`jik.benchmarks.fuzz_hooks` (what the OpenAPI document cannot say) and reads its summary:
+cases generated, failures, and whether the server logged a traceback. The CI test
+(tests/app/test_fuzz.py) runs it with ~2,000 cases; this benchmark with 10,000 and more.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+
+import httpx
+
+import jik
+
+#: Where ``jik`` is imported from (the source tree, or site-packages): the hooks are found there
+#: from the scratch directory schemathesis runs in.
+_PACKAGE_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(jik.__file__)))
+
+#: Every check schemathesis has.
+PHASES = "examples,fuzzing,stateful"
+
+
+@dataclass
+class FuzzRun:
+    cases: int
+    failures: int
+    seconds: float
+    output: str
+    server_log: str
+
+    @property
+    def clean(self) -> bool:
+        return self.failures == 0 and "Traceback" not in self.server_log and self.cases > 0
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def run_fuzz(max_examples: int, seed: int = 26, timeout: float = 1500.0) -> FuzzRun:
+    """schemathesis with ``max_examples`` per operation and phase against a fresh server."""
+    port = _free_port()
+    # A request waits at most JIK_TIMEOUT for a worker and as long again to compute: within
+    # schemathesis's request timeout (its "response time" check).
+    env = dict(os.environ, JIK_WORKERS="2", JIK_TIMEOUT="20")
+    server = subprocess.Popen(
+        [sys.executable, "-m", "jik", "serve", f"--port={port}"],
+        env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+    )  # fmt: skip
+    base = f"http://127.0.0.1:{port}"
+    try:
+        deadline = time.monotonic() + 60
+        while True:
+            try:
+                if httpx.get(f"{base}/health", timeout=2).status_code == 200:
+                    break
+            except httpx.TransportError:
+                pass
+            if server.poll() is not None or time.monotonic() > deadline:
+                raise RuntimeError("jik serve did not start")
+            time.sleep(0.2)
+        started = time.perf_counter()
+        out = subprocess.run(  # (in a scratch directory: schemathesis writes its cache there)
+            [sys.executable, "-m", "schemathesis.cli", "run", f"{base}/openapi.json",
+             "--checks", "all", "--phases", PHASES, "--max-examples", str(max_examples),
+             "--seed", str(seed), "--workers", "1", "--suppress-health-check", "all",
+             "--continue-on-failure", "--request-timeout", "60", "--no-color"],
+            env=dict(os.environ, SCHEMATHESIS_HOOKS="jik.benchmarks.fuzz_hooks",
+                     PYTHONPATH=os.pathsep.join(filter(None, (_PACKAGE_ROOT,
+                                                              os.environ.get("PYTHONPATH"))))),
+            capture_output=True, text=True, timeout=timeout, cwd=tempfile.mkdtemp(),
+        )  # fmt: skip
+        seconds = time.perf_counter() - started
+    finally:
+        server.terminate()
+        log = server.communicate(timeout=60)[0]
+    text = out.stdout + out.stderr
+    generated = re.search(r"(\d+) generated", text)
+    found = re.search(r"found (\d+) unique failures", text)
+    errors = re.search(r"(\d+) errors?", text.split("SUMMARY")[-1]) if "SUMMARY" in text else None
+    failures = int(found.group(1)) if found else 0
+    failures += int(errors.group(1)) if errors else 0
+    if out.returncode != 0 and failures == 0:
+        failures = 1  # (a run that ended in an error of its own)
+    return FuzzRun(int(generated.group(1)) if generated else 0, failures, seconds, text, log)
+
+
+def main(quick: bool = False) -> None:
+    examples = 20 if quick else 100
+    run = run_fuzz(examples)
+    print(f"schemathesis, all checks, phases {PHASES}, {examples} examples per operation")
+    print(f"  cases {run.cases}, failures {run.failures}, {run.seconds:.0f} s "
+          f"({1000 * run.seconds / max(run.cases, 1):.1f} ms per case), server tracebacks: "
+          f"{run.server_log.count('Traceback')}")  # fmt: skip
+    if not run.clean:
+        print(run.output[-6000:])

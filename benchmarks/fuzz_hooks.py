@@ -1,0 +1,145 @@
+"""schemathesis hooks of ``jik bench fuzz`` and its CI test: what the OpenAPI document cannot say.
+
+The document gives every field's type, range and length, per robot (:mod:`jik.app.compute.schemas`).
+A few rules tie fields together and no JSON Schema states them; a generated *positive* case that
+breaks one is dropped here, because the server rightly refuses it (each refusal is tested case by
+case in tests/app/test_errors.py, test_synthesize.py and test_sessions.py):
+
+- a box's bounds: ``lo < hi``; a variable is in the box or fixed, not both, and some variable
+  is left for the box; ``e2_variational`` synthesizes h on a box of 2 or 3 variables, so it
+  takes no ``augmentation``;
+- discrete mode (asked for, or the robot's default) needs ``gamma < 2``;
+- the chosen inverse must be defined at ``x0`` (the engine says so: a singular start);
+- a dashboard change is checked against the session's robot (its parameters' names, its maps,
+  its vectors' lengths): one that names no robot depends on a state the generator does not
+  know, and one that does is kept only if the dashboard's model takes it on that robot's
+  defaults. (For the sessions' routes this check is the server's own: what the fuzzing tests
+  there is that whatever the model takes the route serves, without a 5xx, and that every
+  response matches the document.)
+
+Every case also has its work capped (cycles, iterations, path points, grid and node counts, and
+coordinates within +-3, where the unicycle's quadrature stays small), so that the run measures
+the API, not the machine: the time and memory limits have tests of their own.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import schemathesis
+from hypothesis import strategies as st
+from pydantic import ValidationError
+
+from jik.app.dashboard.model import StatePatch, default_state, patch_of, updated_state
+from jik.engine.exceptions import InvalidInputError, JikError
+from jik.engine.registry import ROBOTS, make_inverse
+
+#: Caps on the fields that size the work (and on the robot parameters that do: the unicycle's
+#: horizon T sizes its quadrature; T = 19.7 with 300 steps needed 1.7 GB).
+WORK_CAPS = {"cycles": 2, "max_iterations": 300, "degree": 6, "nodes": 4, "grid": 9}
+ROBOT_CAPS = {"T": 2 * math.pi}
+MAX_PATH = 4
+
+
+#: Largest |coordinate| of a start, target or path point sent (the unicycle's controls of
+#: amplitude 10 took over a minute a solve).
+MAX_COORDINATE = 3.0
+
+
+def _clamped(v):
+    if isinstance(v, list):
+        return [_clamped(u) for u in v]
+    if isinstance(v, float | int) and not isinstance(v, bool):
+        return type(v)(max(-MAX_COORDINATE, min(MAX_COORDINATE, v)))
+    return v
+
+
+def _capped(body: dict) -> dict:
+    body = dict(body)
+    for name, cap in WORK_CAPS.items():
+        if isinstance(body.get(name), int | float) and not isinstance(body[name], bool):
+            body[name] = min(body[name], cap)
+    if isinstance(body.get("path"), list):
+        body["path"] = body["path"][:MAX_PATH]
+    for name in ("x0", "target", "path"):
+        if name in body:
+            body[name] = _clamped(body[name])
+    robot = body.get("robot")
+    if isinstance(robot, dict):
+        body["robot"] = {k: min(v, ROBOT_CAPS[k]) if k in ROBOT_CAPS and isinstance(v, float)
+                         else v for k, v in robot.items()}  # fmt: skip
+    return body
+
+
+def _synthesis_ok(body: dict) -> bool:
+    spec = ROBOTS[body["robot"]["name"]]
+    fixed = body.get("fixed") or {}
+    synthesis = body.get("method") == "e2_variational"
+    if body.get("region") is None:  # (the default box: the last variables not fixed)
+        size = min(2 if synthesis else 3, sum(n not in fixed for n in spec.variable_names))
+        return size >= (2 if synthesis else 1) and not (synthesis and body.get("augmentation"))
+    region = body["region"]
+    if any(not lo < hi for lo, hi in region.values()) or set(region) & set(fixed):
+        return False
+    return not synthesis or (len(region) >= 2 and not body.get("augmentation"))
+
+
+def _run_ok(body: dict) -> bool:
+    spec = ROBOTS[body["robot"]["name"]]
+    gamma = body.get("gamma") or spec.default_gamma
+    if (body.get("mode") or spec.default_mode) == "discrete" and gamma >= 2:
+        return False
+    robot = {k: v for k, v in body["robot"].items() if k != "name"}
+    augmentation = body.get("augmentation") or {}
+    try:
+        kinematics = spec.build(**robot)
+        inverse = make_inverse(
+            kinematics, body["algorithm"], augmentation.get("name"),
+            {k: v for k, v in augmentation.items() if k != "name"}, spec.name,
+        )  # fmt: skip
+        inverse.matrix(np.asarray(body["x0"], dtype=float))
+    except JikError:
+        return False
+    return True
+
+
+def _change_ok(body: dict) -> bool:
+    change = body.get("state", body)
+    if not isinstance(change, dict) or "robot" not in change:
+        return False
+    try:
+        state = default_state(change["robot"])
+        updated_state(state, patch_of(StatePatch.model_validate(change)))
+    except (InvalidInputError, ValidationError):
+        return False
+    return True
+
+
+def _positive_case_ok(case) -> bool:
+    body = case.body
+    if not isinstance(body, dict):
+        return True
+    path = case.operation.path
+    if path == "/synthesize":
+        return _synthesis_ok(body)
+    if path in ("/solve", "/repeatability"):
+        return _run_ok(body)
+    if path.startswith("/api/sessions") and case.method == "POST":
+        return _change_ok(body)
+    return True
+
+
+@schemathesis.hook
+def before_generate_case(context, strategy: st.SearchStrategy) -> st.SearchStrategy:
+    def fit(case):
+        if isinstance(case.body, dict):
+            case.body = _capped(case.body)
+        return case
+
+    def keep(case) -> bool:
+        meta = case.meta
+        positive = meta is None or meta.generation.mode.is_positive
+        return not positive or _positive_case_ok(case)
+
+    return strategy.map(fit).filter(keep)
