@@ -1,4 +1,4 @@
-"""Kinematics and augmenting maps given by formulas, parsed by a whitelist grammar into sympy.
+"""A whitelist grammar for formulas (task components, augmenting maps), parsed into sympy.
 
 A user's text is never handed to eval, exec, sympify or parse_expr: a tokenizer and a
 recursive-descent parser accept exactly
