@@ -13,6 +13,8 @@ A definition::
                        {"name": "formula", "h": "x3"}]}
 
 with optional ``x_range`` (one [lo, hi] per variable), ``x0``, ``target``, ``path``, ``title``.
+For p - r > 1 a formula augmentation's ``"h"`` is a list of p - r formulas (the extended inverse
+of :mod:`jik.engine.extended_vector`); the E2 synthesis needs p = r + 1 and says so.
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ import functools
 import json
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -29,6 +31,7 @@ import numpy as np
 
 from jik.engine.augmentations import AugmentingMap
 from jik.engine.exceptions import InvalidInputError
+from jik.engine.extended_vector import VectorExtendedInverse
 from jik.engine.formula_kinematics import FormulaKinematics, FormulaMap
 from jik.engine.functionals import check_region
 from jik.engine.inverses import Inverse
@@ -58,11 +61,14 @@ class Robot:
     kinematics : Kinematics
     definition : dict
         The definition it was built from (JSON-friendly; :func:`robot_from_dict` rebuilds it).
+    map_vectors : mapping label -> tuple of AugmentingMap
+        For p - r > 1: the augmentations that are vectors of p - r formula maps.
     """
 
     spec: RobotSpec
     kinematics: Kinematics
     definition: dict
+    map_vectors: Mapping[str, tuple[AugmentingMap, ...]] = field(default_factory=dict)
 
     def inverse(
         self,
@@ -70,13 +76,18 @@ class Robot:
         augmentation: str | None = None,
         parameters: Mapping[str, object] | None = None,
     ) -> Inverse:
-        """The pseudoinverse (8), or the extended inverse (11) with one of its augmenting maps."""
+        """The pseudoinverse (8), or the extended inverse (11) with one of its augmenting maps
+        (a :class:`~jik.engine.extended_vector.VectorExtendedInverse` for p - r > 1)."""
         if algorithm == "extended" and not self.spec.augmentations:
             raise InvalidInputError(
                 f"robot {self.spec.title!r} has no augmenting map for the extended inverse; add "
                 "one under 'augmentations' ({'name': 'formula', 'h': ...} or 'e2_synthesized')",
                 "augmentation",
             )
+        if algorithm == "extended" and self.map_vectors:
+            name = augmentation or self.spec.default_augmentation
+            if name in self.map_vectors:
+                return VectorExtendedInverse(self.kinematics, self.map_vectors[name])
         return make_inverse(self.kinematics, algorithm, augmentation, parameters, spec=self.spec)
 
 
@@ -180,26 +191,29 @@ def _defaults(kin: Kinematics, d: Mapping, box) -> tuple:
     return tuple(x0.tolist()), tuple(target.tolist()), tuple(map(tuple, path.tolist()))
 
 
-def _augmentations(kin: Kinematics, items, field: str = "augmentations"):
+def _augmentations(kin: Kinematics, items):
     """AugmentationSpecs of ``[{"name": "formula", "h": ...}, {"name": "e2_synthesized", ...}]``,
-    and the synthesis region of the first e2_synthesized (the robot's functional region)."""
+    the synthesis region of the first e2_synthesized (the robot's functional region), and the
+    vectors of p - r formula maps (p > r + 1: ``"h"`` is a list), by label."""
     if not isinstance(items, list):
-        raise InvalidInputError(f"{field} must be a list of augmenting maps", field)
+        raise InvalidInputError("augmentations must be a list of augmenting maps", "augmentations")
     specs: list[AugmentationSpec] = []
     region: dict = {}
+    vectors: dict[str, tuple[AugmentingMap, ...]] = {}
+    k = kin.p - kin.r
     for i, item in enumerate(items):
-        where = f"{field}.{i}"
+        where = f"augmentations.{i}"
         if not isinstance(item, Mapping) or item.get("name") not in ("formula", "e2_synthesized"):
             raise InvalidInputError(
                 f"{where} must be {{'name': 'formula', 'h': ...}} or "
                 "{'name': 'e2_synthesized', 'region': {...}}",
                 where,
             )
-        if kin.p - kin.r != 1:
+        if k != 1 and item["name"] == "e2_synthesized":
             raise InvalidInputError(
-                f"{where}: the extended inverse (11) and the E2 synthesis need one degree of "
-                f"redundancy (p = r + 1); this robot has p = {kin.p}, r = {kin.r} (use the "
-                "pseudoinverse)",
+                f"{where}: the E2 synthesis needs one degree of redundancy (p = r + 1); this "
+                f"robot has p = {kin.p}, r = {kin.r}: give the extended inverse a list of "
+                f"{k} formula maps, {{'name': 'formula', 'h': [...]}}",
                 where,
             )
         label = item.get("label", item["name"])
@@ -209,9 +223,13 @@ def _augmentations(kin: Kinematics, items, field: str = "augmentations"):
         factory: Callable[..., AugmentingMap]
         if item["name"] == "formula":
             unknown = set(item) - {"name", "label", "h", "parameters"}
-            amap = FormulaMap(item.get("h", ""), kin.variable_names, item.get("parameters"),
-                              field=f"{where}.h")  # fmt: skip
-            factory, text = (lambda kin, amap=amap: amap), f"h = {amap.text}"
+            maps = _formula_maps(kin, item, where)
+            if k == 1:
+                factory = lambda kin, amap=maps[0]: amap  # noqa: E731
+            else:
+                vectors[label] = maps
+                factory = _vector_only(label)
+            text = "h = " + ", ".join(m.text for m in maps)
         else:
             unknown = set(item) - {"name", "label", "region", "degree", "fixed"}
             box, fix = _region(kin, item, where)
@@ -222,7 +240,33 @@ def _augmentations(kin: Kinematics, items, field: str = "augmentations"):
         if unknown:
             raise InvalidInputError(f"{where}: unknown key(s) {sorted(unknown)}", where)
         specs.append(AugmentationSpec(label, "(9)", text, (), factory))
-    return tuple(specs), region
+    return tuple(specs), region, vectors
+
+
+def _formula_maps(kin: Kinematics, item: Mapping, where: str) -> tuple[FormulaMap, ...]:
+    """One map for p = r + 1 (``h`` a formula), p - r of them for more (``h`` a list)."""
+    k, h = kin.p - kin.r, item.get("h", "")
+    texts = [h] if k == 1 else h
+    if not isinstance(texts, list) or len(texts) != k:
+        raise InvalidInputError(
+            f"{where}.h must be " + ("a formula" if k == 1 else
+            f"a list of {k} formulas (p - r = {k}: one map per degree of redundancy)"),
+            f"{where}.h",
+        )  # fmt: skip
+    names, params = kin.variable_names, item.get("parameters")
+    fields = [f"{where}.h"] if k == 1 else [f"{where}.h.{j}" for j in range(k)]
+    return tuple(FormulaMap(t, names, params, field=f) for t, f in zip(texts, fields, strict=True))
+
+
+def _vector_only(label: str) -> Callable[..., AugmentingMap]:
+    def refuse(kin: Kinematics) -> AugmentingMap:
+        raise InvalidInputError(
+            f"augmentation {label!r} is a vector of maps (p - r > 1): build its extended "
+            "inverse with Robot.inverse",
+            "augmentation",
+        )
+
+    return refuse
 
 
 def _region(kin: Kinematics, item: Mapping, where: str):
@@ -278,13 +322,13 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
     if kind in ROBOTS:
         base = ROBOTS[kind]
         kin = base.build(**_get(d, "parameters", dict, "a mapping of parameters", {}))
-        extra, _ = _augmentations(kin, d.get("augmentations", []))
+        extra, _, _ = _augmentations(kin, d.get("augmentations", []))
         spec = replace(base, augmentations=(*base.augmentations, *extra)) if extra else base
         return Robot(spec, kin, dict(d))
     kin = _kinematics(kind, d, None if base_dir is None else Path(base_dir))
     box = _x_range(kin, d)
     x0, target, path = _defaults(kin, d, box)
-    augmentations, region = _augmentations(kin, d.get("augmentations", []))
+    augmentations, region, vectors = _augmentations(kin, d.get("augmentations", []))
     title = _get(d, "title", str, "a string", kind.replace("_", " "))
     task_names = {
         "planar_chain": ("x", "y", "phi")[: kin.r],
@@ -300,7 +344,7 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
         default_augmentation=augmentations[0].name if augmentations else "",
         functional_region=region,
     )  # fmt: skip
-    return Robot(spec, kin, dict(d))
+    return Robot(spec, kin, dict(d), vectors)
 
 
 def load_robot(source: str | Path) -> Robot:

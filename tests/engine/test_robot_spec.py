@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from jik.engine.exceptions import FormulaError, InvalidInputError
+from jik.engine.extended_vector import VectorExtendedInverse
 from jik.engine.formula_kinematics import FormulaKinematics
 from jik.engine.kinematics import Manipulator2
 from jik.engine.planar_chain import PlanarChain
@@ -126,20 +127,33 @@ def test_builtin_robots_by_name_with_parameters_and_extra_maps():
     assert load_robot("manipulator1").spec is ROBOTS["manipulator1"]
 
 
-def test_more_than_one_degree_of_redundancy_runs_the_pseudoinverse_only():
-    chain = {"name": "planar_chain", "joints": "RRRRR", "lengths": [0.4] * 5}
+def test_more_than_one_degree_of_redundancy_takes_a_vector_of_formula_maps():
+    chain = {"name": "planar_chain", "joints": "RRRRR", "lengths": [0.6, 0.5, 0.4, 0.3, 0.2],
+             "x0": [0.2, 0.5, 0.6, 0.4, 0.3]}  # fmt: skip
     robot = robot_from_dict(chain)
     assert _run(robot, "pseudoinverse", cycles=2).success
     with pytest.raises(InvalidInputError, match="no augmenting map"):
         robot.inverse("extended")
-    for aug in ({"name": "e2_synthesized", "region": {"x2": [0, 1], "x3": [0, 1]}},
-                {"name": "formula", "h": "x5"}):  # fmt: skip
+    vector = {"name": "formula", "h": ["x3 - x2", "x4 - x3", "x5 - x4"]}
+    robot = robot_from_dict({**chain, "augmentations": [vector]})
+    assert isinstance(robot.inverse("extended"), VectorExtendedInverse)
+    rep = _run(robot, "extended")
+    assert rep.success and np.max(rep.drift) < 1e-9
+    with pytest.raises(InvalidInputError, match="vector of maps"):
+        robot.spec.augmentation("formula").build(robot.kinematics)
+    cases = [
+        ({"name": "e2_synthesized", "region": {"x2": [0, 1], "x3": [0, 1]}}, "augmentations.0",
+         "the E2 synthesis needs one degree of redundancy (p = r + 1); this robot has p = 5, "
+         "r = 2: give the extended inverse a list of 3 formula maps"),
+        ({"name": "formula", "h": "x5"}, "augmentations.0.h", "a list of 3 formulas"),
+        ({"name": "formula", "h": ["x5", "x4"]}, "augmentations.0.h", "a list of 3 formulas"),
+        ({"name": "formula", "h": ["x5", "x4", "x9"]}, "augmentations.0.h.2", "unknown name"),
+    ]  # fmt: skip
+    for aug, field, text in cases:
         with pytest.raises(InvalidInputError) as err:
             robot_from_dict({**chain, "augmentations": [aug]})
-        assert "need one degree of redundancy (p = r + 1); this robot has p = 5, r = 2" in str(
-            err.value
-        )
-        assert err.value.field == "augmentations.0"
+        assert err.value.field == field
+        assert text in str(err.value)
 
 
 @pytest.mark.parametrize(
