@@ -134,6 +134,28 @@ class PlanarChain(Kinematics):
         last = np.broadcast_to(self.revolute.astype(float), (*J.shape[:-2], 1, self.p))
         return np.concatenate([J, last], axis=-2)
 
+    def hessian(self, x: FloatArray) -> FloatArray:
+        """d^2 k_i / dx_j dx_k: (..., p) -> (..., r, p, p) (the characteristics need it).
+
+        Notes
+        -----
+        With v_i = a_i u_i the link vectors, u_i = (cos theta_i, sin theta_i) and R the rotation
+        by +90 degrees: d^2 v_i / dx_j dx_k = -v_i for revolute j, k <= i; R u_i for a revolute
+        j <= i and the prismatic k = i (and symmetrically); 0 otherwise. theta_p is linear in x.
+        """
+        theta, a = self._angles_lengths(x)
+        u = np.stack([np.cos(theta), np.sin(theta)], axis=-1)  # (..., p, 2)
+        v = a[..., None] * u
+        w = np.stack([-u[..., 1], u[..., 0]], axis=-1)  # R u
+        idx = np.arange(self.p)
+        A = (self.revolute[:, None] & (idx[:, None] <= idx[None, :])).astype(float)  # A[j, i]
+        H = -np.einsum("ji,ki,...ic->...cjk", A, A, v)
+        mixed = np.einsum("jk,...kc->...cjk", A * ~self.revolute[None, :], w)
+        H = H + mixed + np.swapaxes(mixed, -1, -2)
+        if self.orientation:
+            H = np.concatenate([H, np.zeros((*H.shape[:-3], 1, self.p, self.p))], axis=-3)
+        return H
+
 
 def _vector(values, n: int, name: str) -> FloatArray:
     """n finite numbers (a JSON list), the message naming ``name`` and the bad entry."""

@@ -5,6 +5,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from jik.engine.augmentations import Polynomial2
+from jik.engine.characteristics import CharacteristicsMap
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.functionals import error_functional_e2
 from jik.engine.inverses import ExtendedInverse, Pseudoinverse, pseudoinverse
@@ -34,6 +35,14 @@ def test_jacobian_matches_finite_differences(kin):
     x = RNG.uniform(-2, 2, (40, kin.p))
     np.testing.assert_allclose(kin.jacobian(x), central_difference(kin.forward, x), atol=1e-8)
     assert kin.jacobian(x[0]).shape == (kin.r, kin.p)
+
+
+@pytest.mark.parametrize("kin", CHAINS, ids=lambda k: k.joints + ("+o" if k.orientation else ""))
+def test_hessian_matches_finite_differences_of_the_jacobian(kin):
+    x = RNG.uniform(-2, 2, (20, kin.p))
+    H = kin.hessian(x)
+    assert H.shape == (20, kin.r, kin.p, kin.p)
+    np.testing.assert_allclose(H, central_difference(kin.jacobian, x), atol=1e-8)
 
 
 def test_the_3r_arm_by_hand():
@@ -124,3 +133,12 @@ def test_bad_definitions_name_the_field(kwargs, field, text):
         PlanarChain(**kwargs)
     assert err.value.field == field
     assert text in str(err.value)
+
+
+def test_characteristics_map_of_the_3r_arm_is_repeatable():
+    """The map by characteristics (section 4), which needs the Hessian, on the 3R arm."""
+    h = CharacteristicsMap(ARM, reference=X0, fixed_index=0)
+    x = X0 + RNG.uniform(-0.2, 0.2, (5, 3))
+    np.testing.assert_allclose(h.gradient(x), central_difference(h.value, x, 1e-5), atol=1e-8)
+    rep = repeatability(ExtendedInverse(ARM, h), X0, PATH, cycles=2)
+    assert rep.success and np.max(rep.drift) < 1e-9
