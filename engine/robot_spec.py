@@ -38,6 +38,7 @@ from jik.engine.inverses import Inverse
 from jik.engine.kinematics import Kinematics
 from jik.engine.planar_chain import PlanarChain
 from jik.engine.registry import ROBOTS, AugmentationSpec, RobotSpec, make_inverse
+from jik.engine.repeatability import MAX_PATH_POINTS
 from jik.engine.validation import as_points, count
 from jik.engine.variational import synthesize_e2
 
@@ -186,8 +187,11 @@ def _defaults(kin: Kinematics, d: Mapping, box) -> tuple:
     target = d.get("target", kin.forward(x0 + moves[1]))
     path = d.get("path", kin.forward(x0 + moves))
     target, path = _points(target, kin.r, "target"), _points(path, kin.r, "path")
-    if target.ndim != 1 or path.ndim != 2:
-        raise InvalidInputError("target must be one task point and path a list of them", "path")
+    if target.ndim != 1:
+        raise InvalidInputError(f"target must be one task point ({kin.r} numbers)", "target")
+    if path.ndim != 2 or not 1 <= len(path) <= MAX_PATH_POINTS:
+        raise InvalidInputError(f"path must be a list of 1 to {MAX_PATH_POINTS} task points",
+                                "path")  # fmt: skip
     return tuple(x0.tolist()), tuple(target.tolist()), tuple(map(tuple, path.tolist()))
 
 

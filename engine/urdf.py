@@ -179,9 +179,11 @@ class UrdfChain(Kinematics):
             if j.mimic is not None and j.type in MOVABLE:
                 raise InvalidInputError(f"joint {j.name!r} on the chain mimics another; mimic "
                                         "joints are not supported", "urdf")  # fmt: skip
-        active = list(movable if active_joints is None else active_joints)
-        if isinstance(active_joints, str):
+        if active_joints is not None and (
+            isinstance(active_joints, str) or not isinstance(active_joints, Sequence)
+        ):
             raise InvalidInputError("active_joints must be a list of joint names", "active_joints")
+        active = list(movable if active_joints is None else active_joints)
         for i, name in enumerate(active):
             if name not in movable:
                 raise InvalidInputError(
@@ -192,6 +194,8 @@ class UrdfChain(Kinematics):
         if len(set(active)) != len(active):
             raise InvalidInputError(f"active_joints repeats a joint: {active}", "active_joints")
         joint_names = {j.name for j in model.robot.joints}
+        if locked is not None and not isinstance(locked, Mapping):
+            raise InvalidInputError("locked must map joint names to values", "locked")
         locked = dict(locked or {})
         for name, value in locked.items():
             if name not in joint_names or name in active:

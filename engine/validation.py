@@ -59,7 +59,11 @@ def finite(value, name: str) -> float:
 
 def count(value, name: str, low: int, high: int) -> int:
     """Check that ``value`` is an integer in [low, high]."""
-    if isinstance(value, bool) or int(value) != value:
+    try:
+        integral = not isinstance(value, bool) and int(value) == value
+    except (TypeError, ValueError, OverflowError):
+        integral = False
+    if not integral:
         raise InvalidInputError(f"{name} must be an integer, got {value!r}")
     v = int(value)
     if not low <= v <= high:

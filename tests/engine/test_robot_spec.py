@@ -1,5 +1,6 @@
 """Robots defined by data: each kind from a dict or a file, their augmentations, their errors."""
 
+import importlib.util
 import json
 import shutil
 from pathlib import Path
@@ -198,3 +199,40 @@ def test_bad_files(tmp_path):
     (tmp_path / "bad.json").write_text("{")
     with pytest.raises(InvalidInputError, match="not valid JSON"):
         load_robot(tmp_path / "bad.json")
+
+
+GOOD = {
+    "planar_chain": {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]},
+    "formula": {k: v for k, v in M2_FORMULA.items() if k != "augmentations"},
+    "manipulator2": {"name": "manipulator2"},
+}
+if importlib.util.find_spec("yourdfpy"):
+    GOOD["urdf"] = {"name": "urdf", "urdf": ARM4.read_text(), "end_link": "tool"}
+#: The keys each kind reads, and one key of another kind (unknown to it).
+KEYS = {
+    "planar_chain": ["joints", "lengths", "offsets", "orientation", "variables"],
+    "formula": ["variables", "task", "parameters", "lengths"],
+    "manipulator2": ["parameters", "joints"],
+    "urdf": ["urdf", "end_link", "active_joints", "task", "locked", "urdf_file"],
+}
+COMMON = ["x_range", "x0", "target", "path", "title", "name", "augmentations"]
+HOSTILE = [None, True, 0, 7, -1.5, float("nan"), float("inf"), "", "x", "R" * 300, [], [1],
+           ["a", "b"], [None], [[1, 2], [3]], {}, {"a": 1}, {"x1": [0, 1]}, [{}],
+           [{"name": "formula"}], [{"name": "e2_synthesized", "region": {"x2": [0, 1],
+           "x3": [0, 1]}, "degree": "a"}], [{"name": "formula", "h": ["x1"]}]]  # fmt: skip
+
+
+@pytest.mark.parametrize("kind", sorted(GOOD))
+def test_hostile_values_in_any_entry_fail_only_with_invalid_input(kind):
+    """Each entry of a valid definition replaced by each of many wrong values: a robot, or an
+    InvalidInputError naming a field, never another exception."""
+    crashes = []
+    for key in KEYS[kind] + COMMON:
+        for value in HOSTILE:
+            try:
+                robot_from_dict({**GOOD[kind], key: value})
+            except InvalidInputError as exc:
+                assert exc.field is None or isinstance(exc.field, str)
+            except Exception as exc:  # collected, to report every crash at once
+                crashes.append(f"{key}={value!r:.40}: {type(exc).__name__}: {exc}")
+    assert crashes == []
