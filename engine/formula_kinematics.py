@@ -19,7 +19,7 @@ from jik.engine.augmentations import AugmentingMap
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.formula import MAX_NAMES, check_name, parse_formula
 from jik.engine.kinematics import Kinematics
-from jik.engine.validation import FloatArray
+from jik.engine.validation import FloatArray, json_number
 
 
 def _names(variables, parameters, what: str) -> tuple[list[str], dict[str, float]]:
@@ -40,10 +40,7 @@ def _names(variables, parameters, what: str) -> tuple[list[str], dict[str, float
         check_name(k, f"parameters.{k}")
         if k in names:
             raise InvalidInputError(f"parameter {k!r} is also a variable", f"parameters.{k}")
-        if isinstance(v, bool) or not isinstance(v, int | float) or not np.isfinite(v):
-            raise InvalidInputError(f"parameters.{k} must be a finite number, got {v!r}",
-                                    f"parameters.{k}")  # fmt: skip
-        values[k] = float(v)
+        values[k] = json_number(v, f"parameters.{k}")
     return names, values
 
 

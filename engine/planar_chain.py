@@ -20,7 +20,7 @@ import numpy as np
 
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.kinematics import Kinematics
-from jik.engine.validation import FloatArray, finite
+from jik.engine.validation import FloatArray, json_number
 
 #: Most joints a chain may have (the REST boundary refuses bigger robots).
 MAX_JOINTS = 32
@@ -164,12 +164,4 @@ def _vector(values, n: int, name: str) -> FloatArray:
     if len(values) != n:
         raise InvalidInputError(f"{name} must have one entry per joint ({n}), got {len(values)}",
                                 name)  # fmt: skip
-    out = []
-    for i, v in enumerate(values):
-        if isinstance(v, bool):
-            raise InvalidInputError(f"{name}[{i}] must be a number, got {v!r}", f"{name}.{i}")
-        try:
-            out.append(finite(v, f"{name}[{i}]"))
-        except InvalidInputError as exc:
-            raise InvalidInputError(str(exc), f"{name}.{i}") from None
-    return np.array(out)
+    return np.array([json_number(v, f"{name}[{i}]", f"{name}.{i}") for i, v in enumerate(values)])

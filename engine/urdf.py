@@ -24,7 +24,7 @@ import numpy as np
 
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.kinematics import Kinematics
-from jik.engine.validation import FloatArray
+from jik.engine.validation import FloatArray, json_number
 
 #: Largest URDF text accepted [bytes].
 MAX_URDF_BYTES = 1_000_000
@@ -203,13 +203,7 @@ class UrdfChain(Kinematics):
                     f"locked joint {name!r} is not a joint of the URDF, or is active",
                     f"locked.{name}",
                 )
-            if (
-                isinstance(value, bool)
-                or not isinstance(value, int | float)
-                or not math.isfinite(value)
-            ):
-                raise InvalidInputError(f"locked.{name} must be a finite number, got {value!r}",
-                                        f"locked.{name}")  # fmt: skip
+            json_number(value, f"locked.{name}")
         if (
             not isinstance(task, str)
             or not task

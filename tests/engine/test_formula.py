@@ -169,7 +169,7 @@ def test_constant_entries_broadcast_over_the_batch():
         ({"variables": ["x1", "x2"], "task": "x1"}, "task", "non-empty list"),
         ({"variables": ["x1", "x2"], "task": ["x1 + y"]}, "task.0", "unknown name 'y'"),
         ({"variables": ["x1", "x2"], "task": ["x1", "x2"][:1], "parameters": {"l": "1"}},
-         "parameters.l", "finite number"),
+         "parameters.l", "must be a number"),
         ({"variables": ["x1", "x2"], "task": ["x1"], "parameters": {"x1": 1.0}},
          "parameters.x1", "also a variable"),
         ({"variables": "x1 x2", "task": ["x1"]}, "variables", "list of names"),

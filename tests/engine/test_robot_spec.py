@@ -219,7 +219,8 @@ COMMON = ["x_range", "x0", "target", "path", "title", "name", "augmentations"]
 HOSTILE = [None, True, 0, 7, -1.5, float("nan"), float("inf"), "", "x", "R" * 300, [], [1],
            ["a", "b"], [None], [[1, 2], [3]], {}, {"a": 1}, {"x1": [0, 1]}, [{}],
            [{"name": "formula"}], [{"name": "e2_synthesized", "region": {"x2": [0, 1],
-           "x3": [0, 1]}, "degree": "a"}], [{"name": "formula", "h": ["x1"]}]]  # fmt: skip
+           "x3": [0, 1]}, "degree": "a"}], [{"name": "formula", "h": ["x1"]}], 10**400,
+           [10**400, 1.0, 1.0], {"l": 10**400}, {"base_yaw": 10**400}]  # fmt: skip
 
 
 @pytest.mark.parametrize("kind", sorted(GOOD))
