@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from jik.engine import robot_kinds
 from jik.engine.augmentations import AugmentingMap
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.extended_vector import VectorExtendedInverse
@@ -44,12 +45,6 @@ from jik.engine.variational import synthesize_e2
 
 #: Largest robot file read by :func:`load_robot` [bytes].
 MAX_FILE_BYTES = 2_000_000
-COMMON = {"name", "title", "x_range", "x0", "target", "path", "augmentations"}
-KINDS: dict[str, set[str]] = {
-    "planar_chain": {"joints", "lengths", "offsets", "orientation"},
-    "formula": {"variables", "task", "parameters"},
-    "urdf": {"urdf", "urdf_file", "end_link", "active_joints", "task", "locked"},
-}
 
 
 @dataclass(frozen=True)
@@ -226,7 +221,7 @@ def _augmentations(kin: Kinematics, items):
                                     f"{where}.label")  # fmt: skip
         factory: Callable[..., AugmentingMap]
         if item["name"] == "formula":
-            unknown = set(item) - {"name", "label", "h", "parameters"}
+            unknown = set(item) - robot_kinds.augmentation_keys("formula")
             maps = _formula_maps(kin, item, where)
             if k == 1:
                 factory = lambda kin, amap=maps[0]: amap  # noqa: E731
@@ -235,7 +230,7 @@ def _augmentations(kin: Kinematics, items):
                 factory = _vector_only(label)
             text = "h = " + ", ".join(m.text for m in maps)
         else:
-            unknown = set(item) - {"name", "label", "region", "degree", "fixed"}
+            unknown = set(item) - robot_kinds.augmentation_keys("e2_synthesized")
             box, fix = _region(kin, item, where)
             degree = count(item.get("degree", 12), f"{where}.degree", 1, 24)
             factory = _synthesis(box, fix, degree)
@@ -311,13 +306,14 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
     if not isinstance(d, Mapping):
         raise InvalidInputError("a robot must be a mapping with a 'name'", "name")
     kind = d.get("name")
-    if not isinstance(kind, str) or kind not in {*KINDS, *ROBOTS}:
+    if not isinstance(kind, str) or kind not in {*robot_kinds.KINDS, *ROBOTS}:
         raise InvalidInputError(
-            f"name must be one of {sorted(KINDS)} or a built-in robot {sorted(ROBOTS)}, "
+            f"name must be one of {sorted(robot_kinds.KINDS)} or a built-in robot "
+            f"{sorted(ROBOTS)}, "
             f"got {kind!r}",
             "name",
         )
-    allowed = COMMON | KINDS.get(kind, {"parameters"})
+    allowed = robot_kinds.keys(kind) | ({"parameters"} if kind in ROBOTS else set())
     unknown = set(d) - allowed
     if unknown:
         key = sorted(map(str, unknown))[0]
