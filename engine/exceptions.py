@@ -29,6 +29,24 @@ class InvalidInputError(JikError, ValueError):
         self.field = field
 
 
+class FormulaError(InvalidInputError):
+    """A formula that the whitelist grammar refuses (:mod:`jik.engine.formula`).
+
+    Parameters
+    ----------
+    message : str
+        What is wrong, naming the field and the position.
+    field : str, optional
+        As for :class:`InvalidInputError` (``"task.0"``, ``"augmentation.h"``).
+    position : int, optional
+        0-based index of the offending character in the formula's text, for an editor to mark.
+    """
+
+    def __init__(self, message: str, field: str | None = None, position: int | None = None):
+        super().__init__(message, field)
+        self.position = position
+
+
 class SingularConfigurationError(JikError):
     """The configuration is a kinematic or algorithmic singularity.
 

@@ -365,13 +365,19 @@ def make_inverse(
     augmentation: str | None = None,
     augmentation_parameters: Mapping[str, object] | None = None,
     robot: str | None = None,
+    *,
+    spec: RobotSpec | None = None,
 ) -> Inverse:
-    """The pseudoinverse (8) or the extended inverse (11) with a named augmenting map."""
+    """The pseudoinverse (8) or the extended inverse (11) with a named augmenting map.
+
+    The map is looked up in ``spec`` (a robot defined by data, :mod:`jik.engine.robot_spec`),
+    else in the spec of ``robot`` (default: the kinematics' name) in :data:`ROBOTS`.
+    """
     if algorithm == "pseudoinverse":
         return Pseudoinverse(kinematics)
     if algorithm == "extended":
-        spec = robot_spec(robot or kinematics.name).augmentation(augmentation)
+        aspec = (spec or robot_spec(robot or kinematics.name)).augmentation(augmentation)
         return ExtendedInverse(
-            kinematics, spec.build(kinematics, **(augmentation_parameters or {}))
+            kinematics, aspec.build(kinematics, **(augmentation_parameters or {}))
         )
     raise InvalidInputError(f"algorithm must be 'pseudoinverse' or 'extended', got {algorithm!r}")

@@ -19,7 +19,7 @@ def as_points(x, size: int, name: str) -> FloatArray:
     """
     try:
         a = np.asarray(x, dtype=float)
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, OverflowError) as exc:
         raise InvalidInputError(f"{name} must be numeric, got {x!r}") from exc
     if a.ndim == 0 or a.shape[-1] != size:
         raise InvalidInputError(
@@ -50,8 +50,8 @@ def finite(value, name: str) -> float:
     """Check that ``value`` is a finite real number."""
     try:
         v = float(value)
-    except (TypeError, ValueError) as exc:
-        raise InvalidInputError(f"{name} must be a number, got {value!r}") from exc
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise InvalidInputError(f"{name} must be a number, got {value!r:.80}") from exc
     if not np.isfinite(v):
         raise InvalidInputError(f"{name} must be finite, got {v}")
     return v
@@ -59,9 +59,26 @@ def finite(value, name: str) -> float:
 
 def count(value, name: str, low: int, high: int) -> int:
     """Check that ``value`` is an integer in [low, high]."""
-    if isinstance(value, bool) or int(value) != value:
+    try:
+        integral = not isinstance(value, bool) and int(value) == value
+    except (TypeError, ValueError, OverflowError):
+        integral = False
+    if not integral:
         raise InvalidInputError(f"{name} must be an integer, got {value!r}")
     v = int(value)
     if not low <= v <= high:
         raise InvalidInputError(f"{name} must be between {low} and {high}, got {v}")
     return v
+
+
+def json_number(value, name: str, field: str | None = None) -> float:
+    """A finite JSON number: an int or a float, not a boolean or a numeric string.
+
+    The error carries ``field`` (default ``name``), for a client to mark the entry.
+    """
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise InvalidInputError(f"{name} must be a number, got {value!r:.80}", field or name)
+    try:
+        return finite(value, name)
+    except InvalidInputError as exc:
+        raise InvalidInputError(str(exc), field or name) from None

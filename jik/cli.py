@@ -14,6 +14,8 @@ import signal
 import sys
 from typing import Any
 
+from jik.robot_commands import add_robot_commands
+
 #: Reproductions: name -> module in jik.engine.reproductions with run() and format_text().
 REPRODUCTIONS = {
     "table1": "Table 1: repeatability of Manipulator 2, pseudoinverse vs extended (38)",
@@ -128,6 +130,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("names", nargs="*", help="benchmarks to run (default: all)")
     p.add_argument("--quick", action="store_true", help="fewer repetitions, for a smoke test")
     p.set_defaults(func=bench)
+
+    add_robot_commands(sub)
 
     args = parser.parse_args(argv)
     if args.func is serve or not hasattr(signal, "SIGPIPE"):

@@ -1,0 +1,92 @@
+"""The extended Jacobian inverse for p - r > 1 degrees of redundancy, eqs. (9)-(12).
+
+The paper treats one degree of redundancy; with p - r of them the augmenting map is a vector
+h = (h_1, ..., h_(p-r)), the extended Jacobian is [J; dh_1; ...; dh_(p-r)] (p x p) and its inverse's
+first r columns are the extended inverse J^E#: J J^E# = I_r and dh_i J^E# = 0 for every i, so
+each h_i is constant along eq. (7) and the algorithm is repeatable, as for p - r = 1. The E1/E2
+functionals and the synthesis of h stay those of one degree of redundancy.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from jik.engine.augmentations import AugmentingMap
+from jik.engine.exceptions import AlgorithmicSingularityError, InvalidInputError
+from jik.engine.inverses import SINGULAR_EXTENDED, Inverse, extended_singularity
+from jik.engine.kinematics import Kinematics
+from jik.engine.linalg import solve_small
+from jik.engine.validation import FloatArray
+
+
+class VectorExtendedInverse(Inverse):
+    """Extended Jacobian inverse (11) with a vector of p - r augmenting maps (see the module).
+
+    Parameters
+    ----------
+    kinematics : Kinematics
+        With p > r.
+    augmenting_maps : sequence of AugmentingMap
+        Exactly p - r maps on R^p; their gradients are the extra rows of the extended Jacobian.
+    """
+
+    name = "extended"
+
+    def __init__(self, kinematics: Kinematics, augmenting_maps: Sequence[AugmentingMap]) -> None:
+        maps = tuple(augmenting_maps)
+        if len(maps) != kinematics.p - kinematics.r:
+            raise InvalidInputError(
+                f"the extended inverse of {kinematics.name} needs p - r = "
+                f"{kinematics.p - kinematics.r} augmenting maps, got {len(maps)}",
+                "augmentation",
+            )
+        for i, m in enumerate(maps):
+            if m.p != kinematics.p:
+                raise InvalidInputError(f"augmenting map {i} is defined on R^{m.p}, but "
+                                        f"{kinematics.name} has p = {kinematics.p}",
+                                        "augmentation")  # fmt: skip
+        self.kinematics = kinematics
+        self.augmenting_maps = maps
+
+    def augmenting_value(self, x: FloatArray) -> FloatArray:
+        """h(x) = (h_1, ..., h_(p-r)), shape (..., p - r); NaN where a map is undefined."""
+        return np.stack([m.value_masked(x)[0] for m in self.augmenting_maps], axis=-1)
+
+    def _extended(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """[J; dh] (..., p, p) (undefined rows zeroed) and where some h_i is undefined."""
+        grads = [m.gradient_masked(x) for m in self.augmenting_maps]
+        dh = np.stack([g for g, _ in grads], axis=-2)  # (..., p - r, p)
+        undefined = np.any(np.stack([u for _, u in grads], axis=-1), axis=-1)
+        dh = np.where(undefined[..., None, None], 0.0, dh)
+        return np.concatenate([self.kinematics.jacobian(x), dh], axis=-2), undefined
+
+    def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
+        Jbar, undefined = self._extended(x)
+        k = len(self.augmenting_maps)
+        rhs = np.concatenate([e, np.zeros((*e.shape[:-1], k))], axis=-1)  # [e; 0]
+        v, d = solve_small(Jbar, rhs)
+        norms = np.prod(np.linalg.norm(Jbar, axis=-1), axis=-1)
+        bad = undefined | ~(np.abs(d) >= SINGULAR_EXTENDED * norms)
+        bad |= ~np.isfinite(v).all(axis=-1)
+        return (np.where(bad[..., None], 0.0, v) if bad.any() else v), bad
+
+    def matrix(self, x: FloatArray) -> FloatArray:
+        """J^E#(x): the first r columns of [J; dh]^(-1), shape (..., p, r)."""
+        x = self.kinematics.check(x)
+        Jbar, undefined = self._extended(x)
+        bad = undefined | (extended_singularity(Jbar) < SINGULAR_EXTENDED)
+        self._raise_if(x, bad)
+        r, p = self.kinematics.r, self.kinematics.p
+        rhs = np.zeros((*Jbar.shape[:-2], p, r))
+        rhs[..., :r, :] = np.eye(r)
+        return np.linalg.solve(Jbar, rhs)
+
+    def singular_error(self, x: FloatArray) -> Exception:
+        return AlgorithmicSingularityError(
+            f"the extended Jacobian [J; dh_1; ...; dh_{len(self.augmenting_maps)}] of "
+            f"{self.kinematics.name} is singular or a map is undefined (algorithmic singularity, "
+            "eq. (11)); choose another start or other maps",
+            x,
+        )

@@ -1,0 +1,118 @@
+"""What a robot definition may contain, kind by kind: one description for validation and editors.
+
+:func:`jik.engine.robot_spec.robot_from_dict` accepts exactly these keys, and a client (the REST
+API, the dashboard's robot editor) builds its form from :func:`robot_kinds` instead of writing
+the fields again. Types: ``"string"``, ``"text"`` (long text), ``"boolean"``, ``"numbers"`` (a
+list), ``"names"`` (a list of names), ``"formulas"`` (a list of formulas), ``"mapping"`` (names to
+numbers), ``"points"`` (a list of lists of numbers), ``"integer"``, ``"augmentations"``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+
+@dataclass(frozen=True)
+class DefinitionField:
+    """One entry of a robot definition."""
+
+    name: str
+    type: str
+    required: bool
+    help: str
+    example: object = None
+
+
+PLANAR_CHAIN = (
+    DefinitionField("joints", "string", True, "joint types in order, base first: R revolute, "
+                    "P prismatic", "RRR"),
+    DefinitionField("lengths", "numbers", True, "link lengths, one per joint", [1.0, 0.8, 0.6]),
+    DefinitionField("offsets", "numbers", False, "joint offsets added to x: angle [rad] for R, "
+                    "extension for P (default 0)"),
+    DefinitionField("orientation", "boolean", False, "also the end's angle as a task component "
+                    "(r = 3; default false: the end point, r = 2)", False),
+)  # fmt: skip
+
+FORMULA = (
+    DefinitionField("variables", "names", True, "joint variable names, in order",
+                    ["x1", "x2", "x3"]),
+    DefinitionField("task", "formulas", True, "task components, formulas in the variables and "
+                    "parameters (sin cos tan exp log sqrt atan2 abs, + - * / **, numbers, pi)",
+                    ["x2 + l*cos(x3)", "x1 + l*sin(x3)"]),
+    DefinitionField("parameters", "mapping", False, "named constants of the formulas",
+                    {"l": 1.0}),
+)  # fmt: skip
+
+URDF = (
+    DefinitionField("urdf", "text", True, "the URDF text (at most 1 MB; meshes are not loaded)"),
+    DefinitionField("urdf_file", "string", False, "instead of urdf, in a robot file only: a path "
+                    "relative to the file's folder"),
+    DefinitionField("end_link", "string", True, "the link whose origin is the end point", "tool"),
+    DefinitionField("active_joints", "names", False, "the joints that move, in order (default: "
+                    "every movable joint from the base to end_link)"),
+    DefinitionField("task", "string", False, "coordinates of the end point: xyz or a subset "
+                    "such as xz (default xyz)", "xyz"),
+    DefinitionField("locked", "mapping", False, "values of the chain's other movable joints "
+                    "(default 0)"),
+)  # fmt: skip
+
+COMMON = (
+    DefinitionField("name", "string", True, "the kind: planar_chain, formula, urdf, or a "
+                    "built-in robot's name"),
+    DefinitionField("title", "string", False, "a name to show"),
+    DefinitionField("x_range", "points", False, "one [lo, hi] per variable (default: joint "
+                    "limits or [-pi, pi])"),
+    DefinitionField("x0", "numbers", False, "start configuration (default 0.5 in each range)"),
+    DefinitionField("target", "numbers", False, "default target of a solve"),
+    DefinitionField("path", "points", False, "default closed path (task points)"),
+    DefinitionField("augmentations", "augmentations", False, "augmenting maps of the extended "
+                    "inverse: {name: formula, h: ...} (h a list of p - r formulas when "
+                    "p - r > 1) or {name: e2_synthesized, region: {...}} (p = r + 1)"),
+)  # fmt: skip
+
+#: The entries of an augmentation, by its name.
+AUGMENTATIONS: dict[str, tuple[DefinitionField, ...]] = {
+    "formula": (
+        DefinitionField("h", "formulas", True, "h as a formula in the variables (p - r = 1), or "
+                        "a list of p - r formulas", "x3"),
+        DefinitionField("parameters", "mapping", False, "named constants of h"),
+        DefinitionField("label", "string", False, "its name among the robot's maps (default "
+                        "formula)"),
+    ),
+    "e2_synthesized": (
+        DefinitionField("region", "mapping", True, "two or three variables to [lo, hi]: the box "
+                        "of the Ritz synthesis of E2, eq. (20)", {"x2": [0.4, 2], "x3": [0.4, 2]}),
+        DefinitionField("degree", "integer", False, "Legendre degree per variable, 1-24 "
+                        "(default 12)", 12),
+        DefinitionField("fixed", "mapping", False, "values of the variables outside the region "
+                        "(default 0)"),
+        DefinitionField("label", "string", False, "its name among the robot's maps (default "
+                        "e2_synthesized)"),
+    ),
+}  # fmt: skip
+
+KINDS: dict[str, tuple[DefinitionField, ...]] = {
+    "planar_chain": PLANAR_CHAIN,
+    "formula": FORMULA,
+    "urdf": URDF,
+}
+
+
+def keys(kind: str) -> set[str]:
+    """The keys a definition of ``kind`` may have (its own and the common ones)."""
+    return {f.name for f in (*KINDS.get(kind, ()), *COMMON)}
+
+
+def augmentation_keys(name: str) -> set[str]:
+    """The keys an augmentation named ``name`` may have."""
+    return {"name", *(f.name for f in AUGMENTATIONS.get(name, ()))}
+
+
+def robot_kinds() -> dict:
+    """``{"kinds": {kind: [field, ...]}, "common": [...], "augmentations": {name: [...]}}``,
+    JSON-friendly."""
+    return {
+        "kinds": {k: [asdict(f) for f in fields] for k, fields in KINDS.items()},
+        "common": [asdict(f) for f in COMMON],
+        "augmentations": {k: [asdict(f) for f in fields] for k, fields in AUGMENTATIONS.items()},
+    }

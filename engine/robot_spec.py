@@ -1,0 +1,376 @@
+"""Robots defined by data: a planar chain, a formula robot, a URDF arm or a built-in one.
+
+:func:`robot_from_dict` validates a JSON-friendly definition, each error naming its field
+(``InvalidInputError.field``, a dotted path such as ``"lengths.1"`` or ``"augmentations.0.h"``),
+and returns a :class:`Robot`: a :class:`~jik.engine.registry.RobotSpec` built for it (p, r,
+ranges, defaults, augmentations) and its kinematics. :func:`load_robot` reads one from a JSON or
+YAML file, or names a built-in robot. The fixed catalogue ``registry.ROBOTS`` is unchanged.
+
+A definition::
+
+    {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6],
+     "augmentations": [{"name": "e2_synthesized", "region": {"x2": [0.4, 2], "x3": [0.4, 2]}},
+                       {"name": "formula", "h": "x3"}]}
+
+with optional ``x_range`` (one [lo, hi] per variable), ``x0``, ``target``, ``path``, ``title``.
+For p - r > 1 a formula augmentation's ``"h"`` is a list of p - r formulas (the extended inverse
+of :mod:`jik.engine.extended_vector`); the E2 synthesis needs p = r + 1 and says so.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from jik.engine import robot_kinds
+from jik.engine.augmentations import AugmentingMap
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.extended_vector import VectorExtendedInverse
+from jik.engine.formula_kinematics import FormulaKinematics, FormulaMap
+from jik.engine.functionals import check_region
+from jik.engine.inverses import Inverse
+from jik.engine.kinematics import Kinematics
+from jik.engine.planar_chain import PlanarChain
+from jik.engine.registry import ROBOTS, AugmentationSpec, RobotSpec, make_inverse
+from jik.engine.repeatability import MAX_PATH_POINTS
+from jik.engine.validation import as_points, count
+from jik.engine.variational import synthesize_e2
+
+#: Largest robot file read by :func:`load_robot` [bytes].
+MAX_FILE_BYTES = 2_000_000
+
+
+@dataclass(frozen=True)
+class Robot:
+    """A robot ready to run: its spec (ranges, defaults, augmentations) and its kinematics.
+
+    Attributes
+    ----------
+    spec : RobotSpec
+    kinematics : Kinematics
+    definition : dict
+        The definition it was built from (JSON-friendly; :func:`robot_from_dict` rebuilds it).
+    map_vectors : mapping label -> tuple of AugmentingMap
+        For p - r > 1: the augmentations that are vectors of p - r formula maps.
+    """
+
+    spec: RobotSpec
+    kinematics: Kinematics
+    definition: dict
+    map_vectors: Mapping[str, tuple[AugmentingMap, ...]] = field(default_factory=dict)
+
+    def inverse(
+        self,
+        algorithm: str = "pseudoinverse",
+        augmentation: str | None = None,
+        parameters: Mapping[str, object] | None = None,
+    ) -> Inverse:
+        """The pseudoinverse (8), or the extended inverse (11) with one of its augmenting maps
+        (a :class:`~jik.engine.extended_vector.VectorExtendedInverse` for p - r > 1)."""
+        if algorithm == "extended" and not self.spec.augmentations:
+            raise InvalidInputError(
+                f"robot {self.spec.title!r} has no augmenting map for the extended inverse; add "
+                "one under 'augmentations' ({'name': 'formula', 'h': ...} or 'e2_synthesized')",
+                "augmentation",
+            )
+        if algorithm == "extended" and self.map_vectors:
+            name = augmentation or self.spec.default_augmentation
+            if name in self.map_vectors:
+                return VectorExtendedInverse(self.kinematics, self.map_vectors[name])
+        return make_inverse(self.kinematics, algorithm, augmentation, parameters, spec=self.spec)
+
+
+def _get(d: Mapping, key: str, kind: type, what: str, default: Any = None) -> Any:
+    if key not in d:
+        if default is None:
+            raise InvalidInputError(f"{key} is required ({what})", key)
+        return default
+    v = d[key]
+    if not isinstance(v, kind):
+        raise InvalidInputError(f"{key} must be {what}, got {v!r:.80}", key)
+    return v
+
+
+def _kinematics(kind: str, d: Mapping, base_dir: Path | None) -> Kinematics:
+    if kind == "planar_chain":
+        return PlanarChain(
+            _get(d, "joints", str, "a string of R and P such as 'RRR'"),
+            _get(d, "lengths", list, "a list of link lengths"),
+            d.get("offsets"),
+            d.get("orientation", False),
+        )
+    if kind == "formula":
+        return FormulaKinematics(
+            _get(d, "variables", list, "a list of variable names"),
+            _get(d, "task", list, "a list of formulas, one per task component"),
+            _get(d, "parameters", dict, "a mapping of names to numbers", {}),
+        )
+    from jik.engine.urdf import UrdfChain  # (imports nothing of yourdfpy until it builds)
+
+    if "urdf" in d and "urdf_file" in d:
+        raise InvalidInputError("give urdf (the text) or urdf_file, not both", "urdf")
+    text = _urdf_file(d, base_dir) if "urdf_file" in d else _get(d, "urdf", str, "URDF text")
+    return UrdfChain(
+        text,
+        _get(d, "end_link", str, "the name of the end link"),
+        d.get("active_joints"),
+        _get(d, "task", str, "'xyz' or a subset such as 'xz'", "xyz"),
+        _get(d, "locked", dict, "a mapping of joint names to values", {}),
+    )
+
+
+def _urdf_file(d: Mapping, base_dir: Path | None) -> str:
+    """The text of ``urdf_file``, a path relative to the robot file's folder, inside it."""
+    from jik.engine.urdf import MAX_URDF_BYTES
+
+    if base_dir is None:
+        raise InvalidInputError("urdf_file is read only from a robot file; give urdf (the text)",
+                                "urdf_file")  # fmt: skip
+    name = _get(d, "urdf_file", str, "a path relative to the robot file")
+    path = (base_dir / name).resolve()
+    if not path.is_relative_to(base_dir.resolve()) or not path.is_file():
+        raise InvalidInputError(f"urdf_file {name!r} is not a file inside {base_dir}", "urdf_file")
+    if path.stat().st_size > MAX_URDF_BYTES:
+        raise InvalidInputError(f"urdf_file is larger than {MAX_URDF_BYTES} bytes", "urdf_file")
+    return path.read_text(encoding="utf-8")
+
+
+def _points(value, size: int, name: str):
+    """``as_points`` with the error's field set to ``name``."""
+    try:
+        return as_points(value, size, name)
+    except InvalidInputError as exc:
+        raise InvalidInputError(str(exc), name) from None
+
+
+def _x_range(kin: Kinematics, d: Mapping) -> tuple[tuple[float, float], ...]:
+    if "x_range" in d:
+        box = _points(d["x_range"], 2, "x_range")
+        if box.shape != (kin.p, 2) or not np.all(box[:, 0] < box[:, 1]):
+            raise InvalidInputError(f"x_range must be {kin.p} pairs [lo, hi] with lo < hi",
+                                    "x_range")  # fmt: skip
+        return tuple((float(a), float(b)) for a, b in box)
+    limits = getattr(kin, "limits", None)
+    if limits is not None:
+        return tuple(limits)
+    if isinstance(kin, PlanarChain):
+        return tuple((-math.pi, math.pi) if rev else (-float(length), float(length))
+                     for rev, length in zip(kin.revolute, kin.lengths, strict=True))  # fmt: skip
+    return ((-math.pi, math.pi),) * kin.p
+
+
+def _defaults(kin: Kinematics, d: Mapping, box) -> tuple:
+    """x0 (given, or 0.5 in each range), a target and a closed path reachable from it."""
+    lo, hi = np.array(box).T
+    if "x0" in d:
+        x0 = _points(d["x0"], kin.p, "x0")
+        if x0.ndim != 1:
+            raise InvalidInputError(f"x0 must be one configuration of {kin.p} numbers", "x0")
+    else:
+        x0 = np.clip(0.5, lo, hi)
+    step = 0.15 * np.minimum(1.0, hi - lo)
+    moves = np.zeros((3, kin.p))
+    moves[0, 0] = moves[1, 0] = step[0]
+    moves[1, -1] = moves[2, -1] = step[-1]
+    target = d.get("target", kin.forward(x0 + moves[1]))
+    path = d.get("path", kin.forward(x0 + moves))
+    target, path = _points(target, kin.r, "target"), _points(path, kin.r, "path")
+    if target.ndim != 1:
+        raise InvalidInputError(f"target must be one task point ({kin.r} numbers)", "target")
+    if path.ndim != 2 or not 1 <= len(path) <= MAX_PATH_POINTS:
+        raise InvalidInputError(f"path must be a list of 1 to {MAX_PATH_POINTS} task points",
+                                "path")  # fmt: skip
+    return tuple(x0.tolist()), tuple(target.tolist()), tuple(map(tuple, path.tolist()))
+
+
+def _augmentations(kin: Kinematics, items):
+    """AugmentationSpecs of ``[{"name": "formula", "h": ...}, {"name": "e2_synthesized", ...}]``,
+    the synthesis region of the first e2_synthesized (the robot's functional region), and the
+    vectors of p - r formula maps (p > r + 1: ``"h"`` is a list), by label."""
+    if not isinstance(items, list):
+        raise InvalidInputError("augmentations must be a list of augmenting maps", "augmentations")
+    specs: list[AugmentationSpec] = []
+    region: dict = {}
+    vectors: dict[str, tuple[AugmentingMap, ...]] = {}
+    k = kin.p - kin.r
+    for i, item in enumerate(items):
+        where = f"augmentations.{i}"
+        if not isinstance(item, Mapping) or item.get("name") not in ("formula", "e2_synthesized"):
+            raise InvalidInputError(
+                f"{where} must be {{'name': 'formula', 'h': ...}} or "
+                "{'name': 'e2_synthesized', 'region': {...}}",
+                where,
+            )
+        if k != 1 and item["name"] == "e2_synthesized":
+            raise InvalidInputError(
+                f"{where}: the E2 synthesis needs one degree of redundancy (p = r + 1); this "
+                f"robot has p = {kin.p}, r = {kin.r}: give the extended inverse a list of "
+                f"{k} formula maps, {{'name': 'formula', 'h': [...]}}",
+                where,
+            )
+        label = item.get("label", item["name"])
+        if not isinstance(label, str) or label in {s.name for s in specs}:
+            raise InvalidInputError(f"{where}.label must be a new name, got {label!r}",
+                                    f"{where}.label")  # fmt: skip
+        factory: Callable[..., AugmentingMap]
+        if item["name"] == "formula":
+            unknown = set(item) - robot_kinds.augmentation_keys("formula")
+            maps = _formula_maps(kin, item, where)
+            if k == 1:
+                factory = lambda kin, amap=maps[0]: amap  # noqa: E731
+            else:
+                vectors[label] = maps
+                factory = _vector_only(label)
+            text = "h = " + ", ".join(m.text for m in maps)
+        else:
+            unknown = set(item) - robot_kinds.augmentation_keys("e2_synthesized")
+            box, fix = _region(kin, item, where)
+            degree = count(item.get("degree", 12), f"{where}.degree", 1, 24)
+            factory = _synthesis(box, fix, degree)
+            text = f"E2-optimal h on {box} by the Ritz solve of (20), degree {degree}"
+            region = region or box
+        if unknown:
+            raise InvalidInputError(f"{where}: unknown key(s) {sorted(unknown)}", where)
+        specs.append(AugmentationSpec(label, "(9)", text, (), factory))
+    return tuple(specs), region, vectors
+
+
+def _formula_maps(kin: Kinematics, item: Mapping, where: str) -> tuple[FormulaMap, ...]:
+    """One map for p = r + 1 (``h`` a formula), p - r of them for more (``h`` a list)."""
+    k, h = kin.p - kin.r, item.get("h", "")
+    texts = [h] if k == 1 else h
+    if not isinstance(texts, list) or len(texts) != k:
+        raise InvalidInputError(
+            f"{where}.h must be " + ("a formula" if k == 1 else
+            f"a list of {k} formulas (p - r = {k}: one map per degree of redundancy)"),
+            f"{where}.h",
+        )  # fmt: skip
+    names, params = kin.variable_names, item.get("parameters")
+    fields = [f"{where}.h"] if k == 1 else [f"{where}.h.{j}" for j in range(k)]
+    return tuple(FormulaMap(t, names, params, field=f) for t, f in zip(texts, fields, strict=True))
+
+
+def _vector_only(label: str) -> Callable[..., AugmentingMap]:
+    def refuse(kin: Kinematics) -> AugmentingMap:
+        raise InvalidInputError(
+            f"augmentation {label!r} is a vector of maps (p - r > 1): build its extended "
+            "inverse with Robot.inverse",
+            "augmentation",
+        )
+
+    return refuse
+
+
+def _region(kin: Kinematics, item: Mapping, where: str):
+    try:
+        box, fix = check_region(kin, item.get("region", {}), item.get("fixed"))
+    except InvalidInputError as exc:
+        raise InvalidInputError(f"{where}.region: {exc}", f"{where}.region") from None
+    if len(box) not in (2, 3):
+        raise InvalidInputError(f"{where}.region must have two or three variables",
+                                f"{where}.region")  # fmt: skip
+    return box, fix
+
+
+def _synthesis(box: dict, fix: dict, degree: int) -> Callable[..., AugmentingMap]:
+    @functools.cache
+    def synthesized(kin: Kinematics) -> AugmentingMap:
+        return synthesize_e2(kin, box, degree=degree, fixed=fix).augmenting_map
+
+    return synthesized
+
+
+def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
+    """Build and validate a robot from its definition (see the module docstring).
+
+    Parameters
+    ----------
+    d : mapping
+        ``{"name": kind, ...}`` with kind ``"planar_chain"``, ``"formula"``, ``"urdf"``, or a
+        built-in robot (``registry.ROBOTS``; its parameters under ``"parameters"``).
+    base_dir : path, optional
+        The folder of the robot file: only then may a URDF be given as ``urdf_file``.
+
+    Raises
+    ------
+    InvalidInputError
+        With ``field`` the dotted path of the offending entry.
+    """
+    if not isinstance(d, Mapping):
+        raise InvalidInputError("a robot must be a mapping with a 'name'", "name")
+    kind = d.get("name")
+    if not isinstance(kind, str) or kind not in {*robot_kinds.KINDS, *ROBOTS}:
+        raise InvalidInputError(
+            f"name must be one of {sorted(robot_kinds.KINDS)} or a built-in robot "
+            f"{sorted(ROBOTS)}, "
+            f"got {kind!r}",
+            "name",
+        )
+    allowed = robot_kinds.keys(kind) | ({"parameters"} if kind in ROBOTS else set())
+    unknown = set(d) - allowed
+    if unknown:
+        key = sorted(map(str, unknown))[0]
+        raise InvalidInputError(f"unknown key {key!r} for a {kind} robot; known: {sorted(allowed)}",
+                                key)  # fmt: skip
+    if kind in ROBOTS:
+        base = ROBOTS[kind]
+        kin = base.build(**_get(d, "parameters", dict, "a mapping of parameters", {}))
+        extra, _, _ = _augmentations(kin, d.get("augmentations", []))
+        spec = replace(base, augmentations=(*base.augmentations, *extra)) if extra else base
+        return Robot(spec, kin, dict(d))
+    kin = _kinematics(kind, d, None if base_dir is None else Path(base_dir))
+    box = _x_range(kin, d)
+    x0, target, path = _defaults(kin, d, box)
+    augmentations, region, vectors = _augmentations(kin, d.get("augmentations", []))
+    title = _get(d, "title", str, "a string", kind.replace("_", " "))
+    task_names = {
+        "planar_chain": ("x", "y", "phi")[: kin.r],
+        "formula": tuple(f"y{i + 1}" for i in range(kin.r)),
+        "urdf": tuple(getattr(kin, "task", "")),
+    }[kind]
+    spec = RobotSpec(
+        name=kind, title=title, description=f"{title}: a {kind} robot defined by data",
+        equation="(4)", p=kin.p, r=kin.r, variable_names=tuple(kin.variable_names),
+        task_names=tuple(task_names), parameters=(), vector_parameters=(),
+        factory=lambda: kin, default_x0=x0, default_target=target, default_path=path,
+        x_range=box, augmentations=augmentations,
+        default_augmentation=augmentations[0].name if augmentations else "",
+        functional_region=region,
+    )  # fmt: skip
+    return Robot(spec, kin, dict(d), vectors)
+
+
+def load_robot(source: str | Path) -> Robot:
+    """A robot from a JSON or YAML file (``.yaml``/``.yml``, needs PyYAML), or a built-in name."""
+    path = Path(source)
+    if not path.is_file():
+        if str(source) in ROBOTS:
+            return robot_from_dict({"name": str(source)})
+        raise InvalidInputError(f"robot {str(source)!r} is neither a file nor a built-in robot "
+                                f"({sorted(ROBOTS)})", "robot")  # fmt: skip
+    if path.stat().st_size > MAX_FILE_BYTES:
+        raise InvalidInputError(f"robot file larger than {MAX_FILE_BYTES} bytes", "robot")
+    text = path.read_text(encoding="utf-8")
+    if path.suffix.lower() in (".yaml", ".yml"):
+        try:
+            import yaml
+        except ImportError:  # PyYAML is optional
+            raise InvalidInputError("YAML robot files need PyYAML (pip install pyyaml); or "
+                                    "write the robot as JSON", "robot") from None  # fmt: skip
+        try:
+            data = yaml.safe_load(text)
+        except yaml.YAMLError as exc:
+            raise InvalidInputError(f"{path.name} is not valid YAML: {exc}", "robot") from None
+    else:
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise InvalidInputError(f"{path.name} is not valid JSON: {exc}", "robot") from None
+    return robot_from_dict(data, base_dir=path.parent)

@@ -1,0 +1,150 @@
+"""``jik solve`` and ``jik repeatability``: a robot from a file or by name, through the engine.
+
+``--robot`` is a JSON or YAML robot file (:func:`jik.engine.robot_spec.load_robot`) or the name of
+a built-in robot. Vectors are comma-separated numbers or constant formulas (``0, 0, pi/2``),
+paths are points separated by ``;`` (``1,1; 1,2; 0,2``). Engine alone: no web package, and the
+engine itself is imported only when a command runs (``jik --help`` and ``jik serve`` stay light).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from jik.engine.robot_spec import Robot
+
+
+def _split(text: str, sep: str) -> list[str]:
+    """``text`` split at ``sep`` outside parentheses (atan2(a, b) stays whole)."""
+    parts, depth, start = [], 0, 0
+    for i, c in enumerate(text):
+        depth += (c == "(") - (c == ")")
+        if c == sep and depth == 0:
+            parts.append(text[start:i])
+            start = i + 1
+    return [*parts, text[start:]]
+
+
+def parse_vector(text: str, option: str) -> list[float]:
+    """``"0, 0, pi/2"`` -> [0.0, 0.0, 1.5707963267948966]; each entry a constant formula."""
+    from jik.engine.formula import parse_formula
+
+    out = []
+    for i, part in enumerate(_split(text, ",")):
+        value = parse_formula(part.strip(), {}, f"{option}[{i}]")
+        out.append(float(value))  # (a constant: the grammar admits no name here)
+    return out
+
+
+def parse_path(text: str, option: str) -> list[list[float]]:
+    """``"1,1; 1,2; 0,2"`` -> [[1, 1], [1, 2], [0, 2]]."""
+    return [parse_vector(p, f"{option}[{i}]") for i, p in enumerate(_split(text, ";")) if p.strip()]
+
+
+def _common(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--robot", required=True,
+                   help="a robot file (.json, .yaml) or a built-in robot's name")  # fmt: skip
+    p.add_argument("--x0", help="start configuration, e.g. '0, 0, pi/2' (default: the robot's)")
+    p.add_argument("--algorithm", choices=("pseudoinverse", "extended"), default="pseudoinverse")
+    p.add_argument("--augmentation", help="augmenting map of the extended inverse (its name)")
+    p.add_argument(
+        "--mode",
+        choices=("continuous", "discrete"),
+        default=None,
+        help="algorithm (7) continuous (ODE) or discrete (default: the robot's)",
+    )
+    p.add_argument("--gamma", type=float, default=None, help="decay rate (discrete: step)")
+    p.add_argument("--json", action="store_true", help="print machine-readable JSON")
+
+
+def _setup(args: argparse.Namespace) -> tuple[Robot, list[float], dict]:
+    from jik.engine.robot_spec import load_robot
+
+    robot = load_robot(args.robot)
+    x0 = parse_vector(args.x0, "--x0") if args.x0 else list(robot.spec.default_x0)
+    settings = {
+        "mode": args.mode or robot.spec.default_mode,
+        "gamma": args.gamma if args.gamma is not None else robot.spec.default_gamma,
+    }
+    return robot, x0, settings
+
+
+def _fmt(v) -> str:
+    return "(" + ", ".join(f"{float(t):.10g}" for t in v) + ")"
+
+
+def solve_command(args: argparse.Namespace) -> int:
+    from jik.engine.solver import solve
+
+    robot, x0, settings = _setup(args)
+    target = parse_vector(args.target, "--target") if args.target else robot.spec.default_target
+    inverse = robot.inverse(args.algorithm, args.augmentation)
+    res = solve(inverse, x0, target, record=False, **settings)
+    out = {
+        "robot": robot.spec.title, "algorithm": inverse.name, "x0": x0,
+        "target": list(target), "x": res.x.tolist(), "y": res.y.tolist(), "error": res.error,
+        "success": res.success, "message": res.message, "nit": res.nit,
+    }  # fmt: skip
+    if args.json:
+        print(json.dumps(out))
+    else:
+        print(f"{out['robot']}, {out['algorithm']}: {res.message}")
+        print(f"  x0 = {_fmt(x0)}\n  x  = {_fmt(res.x)}\n  k(x) = {_fmt(res.y)}, "
+              f"|k(x) - target| = {res.error:.3g}")  # fmt: skip
+    return 0 if res.success else 1
+
+
+def repeatability_command(args: argparse.Namespace) -> int:
+    from jik.engine.repeatability import repeatability
+
+    robot, x0, settings = _setup(args)
+    path = parse_path(args.path, "--path") if args.path else robot.spec.default_path
+    inverse = robot.inverse(args.algorithm, args.augmentation)
+    rep = repeatability(inverse, x0, path, cycles=args.cycles, **settings)
+    out = {
+        "robot": robot.spec.title, "algorithm": inverse.name, "x0": x0,
+        "targets": rep.targets.tolist(), "legs": rep.legs.tolist(),
+        "cycle_end": rep.cycle_end.tolist(), "drift": rep.drift.tolist(),
+        "success": bool(rep.success), "message": rep.message,
+    }  # fmt: skip
+    if args.json:
+        print(json.dumps(out))
+    else:
+        print(f"{out['robot']}, {out['algorithm']}: {rep.message}")
+        print(f"  x0 = {_fmt(x0)}; {len(rep.targets)} legs a cycle")
+        for c, (end, drift) in enumerate(zip(rep.cycle_end, rep.drift, strict=True)):
+            print(f"  cycle {c + 1}: x = {_fmt(end)}, |x - x0| = {drift:.3e}")
+    return 0 if rep.success else 1
+
+
+def _guarded(command):
+    def run(args: argparse.Namespace) -> int:
+        from jik.engine.exceptions import InvalidInputError, JikError
+
+        try:
+            return command(args)
+        except JikError as exc:
+            field = getattr(exc, "field", None)
+            where = f" (field {field})" if isinstance(exc, InvalidInputError) and field else ""
+            sys.stderr.write(f"jik {args.command}: {exc}{where}\n")
+            return 2
+
+    return run
+
+
+def add_robot_commands(sub) -> None:
+    """Register ``solve`` and ``repeatability`` on the ``jik`` command's subparsers."""
+    p = sub.add_parser("solve", help="solve k(x) = target for a robot (file or built-in name)")
+    _common(p)
+    p.add_argument("--target", help="task point, e.g. '1, 1.5' (default: the robot's)")
+    p.set_defaults(func=_guarded(solve_command))
+
+    p = sub.add_parser("repeatability", help="drive a robot around a closed task path")
+    _common(p)
+    p.add_argument("--path", help="task points 'y1,y2; y1,y2; ...' (default: the robot's); "
+                   "the return leg to k(x0) closes it")  # fmt: skip
+    p.add_argument("--cycles", type=int, default=1, help="number of cycles (default 1)")
+    p.set_defaults(func=_guarded(repeatability_command))

@@ -1,0 +1,151 @@
+"""URDF arms: forward kinematics against yourdfpy's, the analytic Jacobian, solve, repeatability."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.formula_kinematics import FormulaMap
+from jik.engine.inverses import ExtendedInverse, Pseudoinverse
+from jik.engine.repeatability import repeatability
+from jik.engine.solver import solve
+from jik.engine.urdf import MAX_URDF_BYTES, UrdfChain, check_mesh_filename
+from tests.helpers import central_difference
+
+yourdfpy = pytest.importorskip("yourdfpy")
+
+ARM4 = Path(__file__).resolve().parents[1] / "data" / "arm4.urdf"
+TEXT = ARM4.read_text(encoding="utf-8")
+RNG = np.random.default_rng(4)
+X0 = np.array([0.3, 0.5, 0.8, 0.6])
+
+
+@pytest.fixture(scope="module")
+def arm():
+    return UrdfChain(TEXT, "tool")
+
+
+@pytest.fixture(scope="module")
+def reference():
+    return yourdfpy.URDF.load(str(ARM4), load_meshes=False)
+
+
+def _yourdfpy_position(model, cfg: dict, link: str) -> np.ndarray:
+    model.update_cfg(cfg)
+    return model.get_transform(link, "base_link")[:3, 3]
+
+
+def test_the_chain_is_read_from_the_urdf(arm):
+    assert arm.joint_names == ("base_yaw", "shoulder", "elbow", "wrist_pitch")
+    assert (arm.p, arm.r, arm.base_link) == (4, 3, "base_link")
+    assert arm.limits[:3] == ((-3.0, 3.0), (-2.0, 2.0), (-2.5, 2.5))
+    assert arm.limits[3] == pytest.approx((-np.pi, np.pi))  # continuous
+
+
+def test_forward_kinematics_matches_yourdfpy(arm, reference):
+    x = RNG.uniform(-2, 2, (10, 4))
+    ours = arm.forward(x)
+    for xi, yi in zip(x, ours, strict=True):
+        theirs = _yourdfpy_position(reference, dict(zip(arm.joint_names, xi, strict=True)), "tool")
+        np.testing.assert_allclose(yi, theirs, atol=1e-12)
+
+
+def test_locked_joints_and_a_task_subset_match_yourdfpy(reference):
+    kin = UrdfChain(TEXT, "tool", ["shoulder", "elbow", "wrist_pitch"], "xz", {"base_yaw": 0.3})
+    assert (kin.p, kin.r) == (3, 2)
+    x = RNG.uniform(-2, 2, (5, 3))
+    for xi, yi in zip(x, kin.forward(x), strict=True):
+        cfg = {"base_yaw": 0.3, **dict(zip(kin.joint_names, xi, strict=True))}
+        np.testing.assert_allclose(yi, _yourdfpy_position(reference, cfg, "tool")[[0, 2]],
+                                   atol=1e-12)  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("end", "active", "task"),
+    [("tool", None, "xyz"), ("tool", ["wrist_pitch", "shoulder", "elbow"], "yz"),
+     ("finger", None, "xyz"), ("finger", ["finger_slide", "elbow", "shoulder"], "zx")],
+)  # fmt: skip
+def test_jacobian_matches_finite_differences(end, active, task):
+    kin = UrdfChain(TEXT, end, active, task)
+    x = RNG.uniform(-2, 2, (30, kin.p))
+    np.testing.assert_allclose(kin.jacobian(x), central_difference(kin.forward, x), atol=1e-8)
+    assert kin.jacobian(x[0]).shape == (kin.r, kin.p)
+
+
+def test_points_run_from_the_base_to_the_end(arm):
+    pts = arm.points(RNG.uniform(-1, 1, (6, 4)))
+    assert pts.shape == (6, 6, 3)  # 5 joints on the chain (one fixed) and the end point
+    np.testing.assert_allclose(pts[:, 0], [[0, 0, 0.05]] * 6)
+
+
+def test_solve_reaches_a_position(arm):
+    target = arm.forward(X0) + np.array([0.05, -0.08, 0.04])
+    res = solve(Pseudoinverse(arm), X0, target)
+    assert res.success
+    np.testing.assert_allclose(arm.forward(res.x), target, atol=1e-9)
+
+
+def test_repeatability_pseudoinverse_drifts_extended_returns(arm):
+    """A closed path around k(x0): the pseudoinverse drifts; h = x4 - x3 (the wrist's pitch
+    against the elbow's) makes it repeatable: h is conserved along eq. (7), eq. (12). (h = x4
+    alone meets an algorithmic singularity on this path: the arm stretches.)"""
+    home = arm.forward(X0)
+    path = home + np.array([[0.1, 0, 0], [0.1, 0.1, 0.05], [0, 0.1, 0.05]])
+    pinv = repeatability(Pseudoinverse(arm), X0, path, cycles=3)
+    ext = repeatability(ExtendedInverse(arm, FormulaMap("x4 - x3", arm.variable_names)), X0, path,
+                        cycles=3)  # fmt: skip
+    assert pinv.success and ext.success
+    assert pinv.drift[-1] > 1e-4
+    assert np.max(ext.drift) < 1e-9
+
+
+def _with_mesh(name: str) -> str:
+    return TEXT.replace('<link name="tool"/>',
+                        f'<link name="tool"><visual><geometry><mesh filename="{name}"/>'
+                        "</geometry></visual></link>")  # fmt: skip
+
+
+@pytest.mark.parametrize("name", ["meshes/tool.stl", "package://arm4/meshes/tool.dae"])
+def test_mesh_paths_inside_the_package_are_accepted(name):
+    assert UrdfChain(_with_mesh(name), "tool").p == 4
+
+
+@pytest.mark.parametrize(
+    "name",
+    ["../secret.stl", "/etc/passwd", "file:///etc/passwd", "package://arm4/../../x.stl",
+     "meshes\\..\\x.stl", "https://example.invalid/x.stl", "C:/x.stl"],
+)  # fmt: skip
+def test_mesh_paths_that_escape_are_refused(name):
+    with pytest.raises(InvalidInputError, match="escapes the robot's folder"):
+        check_mesh_filename(name)
+    with pytest.raises(InvalidInputError, match="escapes"):
+        UrdfChain(_with_mesh(name), "tool")
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field", "text"),
+    [
+        ({"end_link": "hand"}, "end_link", "'hand' is not a link"),
+        ({"end_link": "tool", "active_joints": ["shoulder", "finger_slide"]},
+         "active_joints.1", "not a movable joint on the chain"),
+        ({"end_link": "tool", "active_joints": ["shoulder", "shoulder", "elbow"]},
+         "active_joints", "repeats"),
+        ({"end_link": "tool", "task": "xw"}, "task", "subset"),
+        ({"end_link": "tool", "active_joints": ["shoulder", "elbow"], "task": "xz"},
+         "active_joints", "more joints than task coordinates"),
+        ({"end_link": "tool", "locked": {"nope": 1.0}}, "locked.nope", "not a joint"),
+        ({"end_link": "tool", "urdf": "<robot"}, "urdf", "not a valid URDF"),
+        ({"end_link": "tool", "urdf": 3}, "urdf", "text of a URDF"),
+        ({"end_link": "tool", "urdf": "<robot>" + " " * MAX_URDF_BYTES + "</robot>"}, "urdf",
+         "too large"),
+        ({"end_link": "tool",
+          "urdf": '<!DOCTYPE r [<!ENTITY x SYSTEM "file:///etc/passwd">]>' + TEXT},
+         "urdf", "DOCTYPE"),
+    ],
+)  # fmt: skip
+def test_bad_definitions_name_the_field(kwargs, field, text):
+    with pytest.raises(InvalidInputError) as err:
+        UrdfChain(**{"urdf": TEXT, **kwargs})
+    assert err.value.field == field
+    assert text in str(err.value)

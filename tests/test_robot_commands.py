@@ -1,0 +1,103 @@
+"""`jik solve` and `jik repeatability` with robots from files and by name."""
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from jik.cli import main
+from jik.engine.reproductions.table1 import PRINTED
+from jik.robot_commands import parse_path, parse_vector
+
+ARM4 = Path(__file__).resolve().parent / "data" / "arm4.urdf"
+ARM3R = {
+    "name": "planar_chain",
+    "joints": "RRR",
+    "lengths": [1.0, 0.8, 0.6],
+    "augmentations": [{"name": "e2_synthesized", "region": {"x2": [0.4, 2], "x3": [0.4, 2]}}],
+}
+
+
+@pytest.fixture
+def arm_file(tmp_path):
+    path = tmp_path / "arm.json"
+    path.write_text(json.dumps(ARM3R))
+    return str(path)
+
+
+def run(capsys, *argv, code=0):
+    assert main(list(argv)) == code
+    out = capsys.readouterr()
+    return out.out, out.err
+
+
+def test_vectors_and_paths_are_constant_formulas():
+    assert parse_vector("0, -1e-3, pi/2, atan2(1, 1)", "--x0") == pytest.approx(
+        [0, -1e-3, np.pi / 2, np.pi / 4]
+    )
+    assert parse_path("1,1; 1,2;0 , 2;", "--path") == [[1, 1], [1, 2], [0, 2]]
+
+
+def test_solve_a_planar_arm_from_a_json_file(capsys, arm_file):
+    out, _ = run(capsys, "solve", "--robot", arm_file, "--x0", "0.3, 1, 1", "--target",
+                 "1, 1.5", "--json")  # fmt: skip
+    res = json.loads(out)
+    assert res["success"] and res["algorithm"] == "pseudoinverse"
+    np.testing.assert_allclose(res["y"], [1.0, 1.5], atol=1e-10)
+    text, _ = run(capsys, "solve", "--robot", arm_file, "--x0", "0.3, 1, 1", "--target", "1, 1.5")
+    assert "planar chain, pseudoinverse: converged" in text and "k(x) = (1, 1.5)" in text
+
+
+def test_repeatability_of_the_synthesized_map_from_a_file(capsys, arm_file):
+    path = "1,1.3; 1,1.7; 0.6,1.7"
+    out, _ = run(capsys, "repeatability", "--robot", arm_file, "--x0", "0.3, 1, 1", "--path",
+                 path, "--cycles", "3", "--algorithm", "extended", "--json")  # fmt: skip
+    res = json.loads(out)
+    assert res["success"] and res["algorithm"] == "extended"
+    assert len(res["drift"]) == 3 and max(res["drift"]) < 1e-9
+    assert np.shape(res["legs"]) == (12, 3)
+
+
+def test_repeatability_of_a_builtin_robot_reproduces_table1(capsys):
+    out, _ = run(capsys, "repeatability", "--robot", "manipulator2", "--x0", "0, 0, pi/2",
+                 "--path", "1,1; 1,2; 0,2; 0,1", "--json")  # fmt: skip
+    legs = json.loads(out)["legs"]
+    np.testing.assert_allclose(legs, PRINTED["pseudoinverse"][1:], atol=5e-5)
+    text, _ = run(capsys, "repeatability", "--robot", "manipulator2", "--x0", "0, 0, pi/2",
+                  "--path", "1,1; 1,2; 0,2; 0,1", "--cycles", "2")  # fmt: skip
+    assert "cycle 2:" in text and "|x - x0| = 4.612e-01" in text
+
+
+def test_urdf_robot_from_a_yaml_file(capsys, tmp_path):
+    yaml = pytest.importorskip("yaml")
+    pytest.importorskip("yourdfpy")
+    shutil.copy(ARM4, tmp_path / "arm4.urdf")
+    robot = {"name": "urdf", "urdf_file": "arm4.urdf", "end_link": "tool",
+             "x0": [0.3, 0.5, 0.8, 0.6]}  # fmt: skip
+    (tmp_path / "arm.yaml").write_text(yaml.safe_dump(robot))
+    out, _ = run(capsys, "solve", "--robot", str(tmp_path / "arm.yaml"), "--json")
+    res = json.loads(out)
+    assert res["success"]
+    np.testing.assert_allclose(res["y"], res["target"], atol=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--x0", "0.3, 1"], "x0 must have shape (..., 3)"),
+        (["--x0", "__import__('os')"], "--x0[0]: unexpected character '_' at position 0"),
+        (["--x0", "0, x1, 0"], "--x0[1]: unknown name 'x1'"),
+        (["--target", "1, 2, 3"], "target y_d must have shape (..., 2)"),
+        (["--algorithm", "extended", "--augmentation", "nope"], "unknown augmentation 'nope'"),
+    ],
+)
+def test_bad_input_exits_2_with_the_message(capsys, arm_file, argv, message):
+    _, err = run(capsys, "solve", "--robot", arm_file, *argv, code=2)
+    assert err.startswith("jik solve: ") and message in err
+
+
+def test_unknown_robot_exits_2(capsys):
+    _, err = run(capsys, "repeatability", "--robot", "scara.json", code=2)
+    assert "neither a file nor a built-in robot" in err and "(field robot)" in err
