@@ -57,8 +57,9 @@ class AtlasPlan:
     cycles : int
     n_starts : int
         N, starts per path.
-    parameter : ndarray, shape (N,) or None
-        Arc length s of each start on its path's manifold; None for explicit starts.
+    sampling : (str, int) or None
+        How the arc lengths s of the starts are laid on their curves' common arc: ("grid", 0) or
+        ("sample", seed) (:func:`arc_lengths`); None for explicit starts.
     manifolds : tuple of SelfMotionManifold (one per path) or ()
     explicit : ndarray, shape (N, p) or None
     chunk : int
@@ -70,7 +71,7 @@ class AtlasPlan:
     paths: FloatArray
     cycles: int
     n_starts: int
-    parameter: FloatArray | None
+    sampling: tuple[str, int] | None
     manifolds: tuple[SelfMotionManifold, ...]
     explicit: FloatArray | None
     chunk: int
@@ -96,11 +97,18 @@ class AtlasPlan:
         path, index = np.divmod(runs, self.n_starts)
         if self.explicit is not None:
             return self.explicit[index]
-        assert self.parameter is not None
+        s = self.parameter(index)
         x = np.empty((len(runs), self.inverses[0].kinematics.p))
         for j in np.unique(path):
-            x[path == j] = self.manifolds[j].points(self.parameter[index[path == j]])
+            x[path == j] = self.manifolds[j].points(s[path == j])
         return x
+
+    def parameter(self, index) -> FloatArray | None:
+        """Arc lengths s of starts ``index`` (an int array) on their curves; None when the
+        starts are explicit. Computed on demand: a plan holds nothing of size N."""
+        if self.sampling is None:
+            return None
+        return arc_lengths(np.asarray(index), self.n_starts, self.manifolds[0].arc, *self.sampling)
 
     def targets(self, lo: int, hi: int, starts: FloatArray) -> FloatArray:
         """The legs' targets (n, L, r) of runs lo to hi - 1: path[1:] and k(start)."""
@@ -109,18 +117,22 @@ class AtlasPlan:
         return np.concatenate([self.paths[path, 1:], home], axis=1)
 
 
-def arc_lengths(count_: int, arc: tuple[float, float], sampling: str, seed: int) -> FloatArray:
-    """N arc lengths on [lo, hi]: evenly spaced ends included ("grid"), or uniform random
-    ("sample", from ``seed``, block by block: each index's value is fixed by index and seed)."""
+def arc_lengths(
+    index: FloatArray, n: int, arc: tuple[float, float], sampling: str, seed: int
+) -> FloatArray:
+    """Arc lengths of starts ``index`` (ints in [0, n)) of n on [lo, hi]: evenly spaced, ends
+    included ("grid"), or uniform random ("sample"): drawn from ``seed`` block by block, so
+    each index's value is fixed by the index and the seed, not by what else is asked for."""
     lo, hi = arc
     if sampling == "grid":
-        if count_ == 1:
-            return np.array([lo])
-        return np.clip(lo + (hi - lo) * (np.arange(count_) / (count_ - 1)), lo, hi)
-    blocks = -(-count_ // SAMPLE_BLOCK)
-    u = np.concatenate(
-        [np.random.default_rng([seed, b]).random(SAMPLE_BLOCK) for b in range(blocks)]
-    )[:count_]
+        u = index / (n - 1) if n > 1 else np.zeros(len(index))
+    else:
+        u = np.empty(len(index))
+        block = index // SAMPLE_BLOCK
+        for b in np.unique(block):
+            u[block == b] = np.random.default_rng([seed, int(b)]).random(SAMPLE_BLOCK)[
+                index[block == b] % SAMPLE_BLOCK
+            ]
     return np.clip(lo + (hi - lo) * u, lo, hi)
 
 
@@ -250,7 +262,7 @@ def plan_atlas(
                 f"|k(x) - path[0]| = {off[i]:.3g} > {ON_MANIFOLD_TOL:g}",
                 field="starts",
             )
-        return make(n_starts=len(x), parameter=None, manifolds=(), explicit=x)
+        return make(n_starts=len(x), sampling=None, manifolds=(), explicit=x)
     if n_starts is None or arc is None or reference is None:
         raise InvalidInputError(
             "give explicit starts, or n_starts, arc and a reference configuration", "starts"
@@ -270,8 +282,7 @@ def plan_atlas(
     if not isinstance(arc, Sequence) or len(arc) != 2:
         raise InvalidInputError("arc must be a pair (lo, hi) with lo <= 0 <= hi", field="arc")
     manifolds = _manifolds(kin, paths, ref, arc, box)
-    s = arc_lengths(n, manifolds[0].arc, sampling, seed)
-    return make(n_starts=n, parameter=s, manifolds=manifolds, explicit=None)
+    return make(n_starts=n, sampling=(sampling, seed), manifolds=manifolds, explicit=None)
 
 
 def _manifolds(kin, paths, reference, arc, box) -> tuple[SelfMotionManifold, ...]:

@@ -100,15 +100,17 @@ class Dask:
         self.workers = self.local or 1
         self._client: Any = None
         self._cluster: Any = None
+        self._as_completed: Any = None
 
     def __enter__(self) -> Dask:
         try:
-            from dask.distributed import Client, LocalCluster
+            from dask.distributed import Client, LocalCluster, as_completed
         except ImportError as error:
             raise InvalidInputError(
                 f"a Dask backend needs dask.distributed ({error}); pip install 'jik[atlas]'",
                 field="backend",
             ) from error
+        self._as_completed = as_completed
         if self.local:
             self._cluster = LocalCluster(
                 n_workers=self.local, threads_per_worker=1, processes=True,
@@ -128,12 +130,10 @@ class Dask:
         self._client = self._cluster = None
 
     def imap_unordered(self, fn, tasks):
-        from dask.distributed import as_completed
-
         assert self._client is not None, "enter the backend first"
         client = self._client
         tasks = iter(tasks)
-        queue = as_completed()
+        queue = self._as_completed()
         live = []
         try:
             for task in tasks:

@@ -213,7 +213,7 @@ def run_atlas(
     return AtlasResult(
         plan.algorithms,
         plan.paths,
-        plan.parameter,
+        plan.parameter(np.arange(N)),
         starts.reshape(P, N, p),
         drift.reshape(A, P, N, plan.cycles),
         None if legs is None else legs.reshape(A, P, N, *legs.shape[2:]),
