@@ -98,6 +98,7 @@ class AtlasPlan:
         if self.explicit is not None:
             return self.explicit[index]
         s = self.parameter(index)
+        assert s is not None  # (not explicit: the starts are on traced curves)
         x = np.empty((len(runs), self.inverses[0].kinematics.p))
         for j in np.unique(path):
             x[path == j] = self.manifolds[j].points(s[path == j])
