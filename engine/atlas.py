@@ -36,7 +36,7 @@ MAX_STARTS = 10**9
 MAX_PATHS = 10**4
 MAX_CHUNK = 65536
 #: Default number of starts in a chunk: small enough to stay in cache (``jik bench atlas``).
-DEFAULT_CHUNK = 1024
+DEFAULT_CHUNK = 512
 #: Sampled arc lengths are drawn in blocks of this many indices, each from its own seeded stream,
 #: so the s of a start depends only on its index and the seed.
 SAMPLE_BLOCK = 1024

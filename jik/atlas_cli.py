@@ -55,7 +55,7 @@ def add_atlas_parser(sub) -> None:
                    help="a translation of the path (repeat it; default none)")  # fmt: skip
     p.add_argument("--scale", action="append", type=float, default=[],
                    help="a scale of the path about its first point (default 1)")  # fmt: skip
-    p.add_argument("--chunk", type=int, default=None, help="starts per chunk (default 1024)")
+    p.add_argument("--chunk", type=int, default=None, help="starts per chunk (default 512)")
     where = p.add_mutually_exclusive_group()
     where.add_argument("--processes", type=int, help="run chunks in N local processes")
     where.add_argument("--dask", metavar="ADDRESS", help="a Dask scheduler, or local:N")
@@ -122,7 +122,7 @@ def atlas_command(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from jik.engine.atlas import plan_atlas
+    from jik.engine.atlas import DEFAULT_CHUNK, plan_atlas
     from jik.engine.atlas_backends import backend_for
     from jik.engine.atlas_run import iter_atlas
     from jik.engine.registry import make_inverse, robot_spec
@@ -142,7 +142,7 @@ def _run(args: argparse.Namespace) -> int:
         arc=arc, sampling=args.sampling, seed=args.seed, reference=reference,
         box=None if args.arc else spec.x_range,
         shifts=[_numbers(s, "--shift") for s in args.shift] or None,
-        scales=args.scale or None, chunk=args.chunk or 1024, gamma=spec.default_gamma,
+        scales=args.scale or None, chunk=args.chunk or DEFAULT_CHUNK, gamma=spec.default_gamma,
         mode=spec.default_mode,
     )  # fmt: skip
     out = Path(args.out)
