@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from jik.engine.exceptions import InvalidInputError
+from jik.engine.exceptions import InvalidInputError, SingularConfigurationError
 from jik.engine.inverses import Inverse, Pseudoinverse
 from jik.engine.repeatability import CLOSE_TOL, MAX_CYCLES, MAX_PATH_POINTS
 from jik.engine.self_motion import SelfMotionManifold, project, trace
@@ -289,10 +289,13 @@ def plan_atlas(
 def _manifolds(kin, paths, reference, arc, box) -> tuple[SelfMotionManifold, ...]:
     """Each path's self-motion curve over one arc: the base path's, cut by ``box``."""
     y0 = paths[:, 0]
-    res = solve(
-        Pseudoinverse(kin), np.broadcast_to(reference, (len(y0), kin.p)), y0, tol=1e-12,
-        record=False,
-    )  # fmt: skip
+    try:
+        res = solve(
+            Pseudoinverse(kin), np.broadcast_to(reference, (len(y0), kin.p)), y0, tol=1e-12,
+            record=False,
+        )  # fmt: skip
+    except SingularConfigurationError as error:
+        raise InvalidInputError(str(error), field="reference") from None
     assert isinstance(res, BatchSolveResult)
     if not np.all(res.success):
         j = int(np.argmin(res.success))
