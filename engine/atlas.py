@@ -10,7 +10,7 @@ for one or several inverses.
 
 The path is a loop through its points in order, from the first: a start x lies on k(x) = path[0]
 and the legs of a cycle go to path[1], ..., path[-1] and back to k(x) (as ``repeatability``
-closes them). The work is cut into chunks of starts, each one batched ``repeatability`` call per
+closes them). The work is cut into chunks of starts, each run as batched ``repeatability`` calls per
 inverse (:mod:`jik.engine.atlas_run`); a chunk's numbers depend only on its starts (each member's
 arithmetic in the batched solver is its own), so the atlas is the same whatever the chunking and
 wherever the chunks run (:mod:`jik.engine.atlas_backends`).
@@ -35,8 +35,9 @@ from jik.engine.validation import FloatArray, as_points, count, positive
 MAX_STARTS = 10**9
 MAX_PATHS = 10**4
 MAX_CHUNK = 65536
-#: Default number of starts in a chunk: small enough to stay in cache (``jik bench atlas``).
-DEFAULT_CHUNK = 512
+#: Default number of starts in a chunk, the unit of work handed to a backend: about a second of
+#: work (a progress bar moves, a cancellation is heard), few tasks for a scheduler.
+DEFAULT_CHUNK = 2048
 #: Sampled arc lengths are drawn in blocks of this many indices, each from its own seeded stream,
 #: so the s of a start depends only on its index and the seed.
 SAMPLE_BLOCK = 1024

@@ -55,7 +55,7 @@ def add_atlas_parser(sub) -> None:
                    help="a translation of the path (repeat it; default none)")  # fmt: skip
     p.add_argument("--scale", action="append", type=float, default=[],
                    help="a scale of the path about its first point (default 1)")  # fmt: skip
-    p.add_argument("--chunk", type=int, default=None, help="starts per chunk (default 512)")
+    p.add_argument("--chunk", type=int, default=None, help="starts per chunk (default 2048)")
     where = p.add_mutually_exclusive_group()
     where.add_argument("--processes", type=int, help="run chunks in N local processes")
     where.add_argument("--dask", metavar="ADDRESS", help="a Dask scheduler, or local:N")
