@@ -62,6 +62,8 @@ def add_atlas_parser(sub) -> None:
     p.add_argument("--out", default="atlas.json", help="output JSON (default atlas.json)")
     p.add_argument("--csv", action="store_true", help="also write the CSV for a small atlas")
     p.add_argument("--no-figure", action="store_true", help="write no HTML figure")
+    p.add_argument("--no-leg-ends", action="store_true",
+                   help="leave the leg ends out (a large CSV is then far smaller)")  # fmt: skip
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=atlas_command)
 
@@ -151,10 +153,10 @@ def _run(args: argparse.Namespace) -> int:
     A, P, N, C = len(inverses), len(plan.paths), plan.n_starts, plan.cycles
     keep = not big  # (a small atlas is gathered for the JSON; a large one streams to the CSV)
     every = max(1, plan.size // FIGURE_POINTS)
-    arrays = _Gathered(plan, keep, every)
+    arrays = _Gathered(plan, keep, every, legs=not args.no_leg_ends)
     progress = Progress(args.quiet)
     t0 = time.perf_counter()
-    with _CsvWriter(csv_path, plan) as rows:
+    with _CsvWriter(csv_path, plan, legs=not args.no_leg_ends) as rows:
         for task, chunk in iter_atlas(plan, backend):
             arrays.add(task, chunk)
             rows.add(task, chunk)
@@ -186,7 +188,7 @@ def _run(args: argparse.Namespace) -> int:
             alg: {
                 "drift": _listed(squeeze(arrays.drift[a])),
                 "success": squeeze(arrays.success[a]).tolist(),
-                "leg_ends": _listed(squeeze(arrays.legs[a])),
+                "leg_ends": None if arrays.legs is None else _listed(squeeze(arrays.legs[a])),
                 "failures": {
                     str(run): why for (b, run), why in sorted(arrays.failures.items()) if b == a
                 },
@@ -223,7 +225,7 @@ class _Gathered:
     """What the JSON and the figure need: everything for a small atlas; for a large one the
     last cycle's drift of every ``every``-th run, a summary and the failures."""
 
-    def __init__(self, plan, keep: bool, every: int) -> None:
+    def __init__(self, plan, keep: bool, every: int, legs: bool) -> None:
         import numpy as np
 
         A, P, N, C = len(plan.inverses), len(plan.paths), plan.n_starts, plan.cycles
@@ -239,7 +241,7 @@ class _Gathered:
             self.starts = np.empty((P, N, p))
             self.drift = np.empty((A, P, N, C))
             self.success = np.empty((A, P, N), dtype=bool)
-            self.legs = np.empty((A, P, N, C * plan.legs, p))
+        self.legs = np.empty((A, P, N, C * plan.legs, p)) if keep and legs else None
 
     def add(self, task, chunk) -> None:
         import numpy as np
@@ -256,8 +258,9 @@ class _Gathered:
         if self.keep:
             for name, values in (("drift", chunk.drift), ("success", chunk.success),
                                  ("legs", chunk.leg_ends)):  # fmt: skip
-                flat = getattr(self, name).reshape(len(values), -1, *values.shape[2:])
-                flat[:, lo:hi] = values
+                if getattr(self, name) is not None:
+                    flat = getattr(self, name).reshape(len(values), -1, *values.shape[2:])
+                    flat[:, lo:hi] = values
             self.starts.reshape(-1, self.starts.shape[-1])[lo:hi] = task.starts
 
     def summary(self) -> dict:
@@ -279,8 +282,8 @@ class _Gathered:
 class _CsvWriter:
     """Rows of the CSV in run order (chunks that finish early wait in a small buffer)."""
 
-    def __init__(self, path: Path | None, plan) -> None:
-        self.path, self.plan, self.next = path, plan, 0
+    def __init__(self, path: Path | None, plan, legs: bool) -> None:
+        self.path, self.plan, self.next, self.legs = path, plan, 0, legs
         self.waiting: dict[int, tuple[Any, Any]] = {}
 
     def __enter__(self) -> _CsvWriter:
@@ -300,8 +303,9 @@ class _CsvWriter:
         cols = ["path", "start", "s", *names]
         for alg in self.plan.algorithms:
             cols += [f"{alg}_success"] + [f"{alg}_drift_{c + 1}" for c in range(self.plan.cycles)]
-            cols += [f"{alg}_leg{k + 1}_{v}" for k in range(self.plan.cycles * self.plan.legs)
-                     for v in names]  # fmt: skip
+            if self.legs:
+                cols += [f"{alg}_leg{k + 1}_{v}" for k in range(self.plan.cycles * self.plan.legs)
+                         for v in names]  # fmt: skip
         return cols
 
     def add(self, task, chunk) -> None:
@@ -323,8 +327,9 @@ class _CsvWriter:
         A = chunk.drift.shape[0]
         parts = [(runs // N)[:, None], (runs % N)[:, None], s[:, None], task.starts]
         for a in range(A):
-            parts += [chunk.success[a][:, None], chunk.drift[a],
-                      chunk.leg_ends[a].reshape(len(runs), -1)]  # fmt: skip
+            parts += [chunk.success[a][:, None], chunk.drift[a]]
+            if self.legs:
+                parts.append(chunk.leg_ends[a].reshape(len(runs), -1))
         table = np.concatenate([np.asarray(p, dtype=float) for p in parts], axis=1)
         for row in table:
             self.writer.writerow([_cell(v) for v in row])

@@ -59,11 +59,13 @@ def test_json_holds_inputs_starts_drift_and_leg_ends(tmp_path):
 def test_a_large_atlas_streams_to_csv_and_the_json_keeps_a_summary(tmp_path, monkeypatch):
     """Past JSON_RUNS the arrays go to the CSV, in run order, whatever order chunks finish in."""
     monkeypatch.setattr(atlas_cli, "JSON_RUNS", 10)
-    doc = run(tmp_path, "--chunk", "5", "--shift", "0,0", "--shift", "0.2,0", "--no-figure")
+    doc = run(tmp_path, "--chunk", "5", "--shift", "0,0", "--shift", "0.2,0", "--no-figure",
+              "--no-leg-ends")  # fmt: skip
     assert "results" not in doc and doc["figure"] is None
     assert doc["summary"]["pseudoinverse"]["converged_runs"] == 24
     assert len(doc["paths"]) == 2
     rows = list(csv.DictReader((tmp_path / doc["csv"]).open()))
+    assert not any("leg" in name for name in rows[0])
     assert [(int(r["path"]), int(r["start"])) for r in rows] == [
         (j, i) for j in range(2) for i in range(12)
     ]
