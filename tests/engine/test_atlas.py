@@ -2,6 +2,8 @@
 
 import math
 import re
+import subprocess
+import sys
 import tracemalloc
 
 import numpy as np
@@ -229,6 +231,26 @@ def test_a_bad_path_is_named(path, text):
     with pytest.raises(InvalidInputError, match=re.escape(text)) as info:
         plan_atlas(manipulator2_inverses(), path, n_starts=2, arc=(0, 1), reference=X0)
     assert info.value.field == "path"
+
+
+def test_the_engine_does_not_import_dask():
+    """Dask is imported when a Dask backend is entered, not before: an atlas in-process or in a
+    process pool runs without it installed."""
+    code = (
+        "import sys, math\n"
+        "from jik.engine.atlas import plan_atlas\n"
+        "from jik.engine.atlas_run import run_atlas\n"
+        "from jik.engine.atlas_backends import backend_for\n"
+        "from jik.engine.inverses import Pseudoinverse\n"
+        "from jik.engine.kinematics import Manipulator2\n"
+        "backend_for('dask:local:2')\n"
+        "plan = plan_atlas(Pseudoinverse(Manipulator2()), [(0, 1), (1, 1)], n_starts=2,\n"
+        "                  arc=(-1, 1), reference=(0, 0, math.pi / 2))\n"
+        "run_atlas(plan)\n"
+        "print(sorted(m for m in sys.modules if m.split('.')[0] in ('dask', 'distributed')))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
 
 
 @pytest.mark.parametrize("option", ["threads:2", "processes:0", "processes:x", "dask:local:0"])
