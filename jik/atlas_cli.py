@@ -55,7 +55,12 @@ def add_atlas_parser(sub) -> None:
                    help="a translation of the path (repeat it; default none)")  # fmt: skip
     p.add_argument("--scale", action="append", type=float, default=[],
                    help="a scale of the path about its first point (default 1)")  # fmt: skip
-    p.add_argument("--chunk", type=int, default=None, help="starts per chunk (default 2048)")
+    p.add_argument(
+        "--chunk",
+        type=int,
+        default=None,
+        help="starts per chunk (default: 2048, fewer for small atlases)",
+    )
     where = p.add_mutually_exclusive_group()
     where.add_argument("--processes", type=int, help="run chunks in N local processes")
     where.add_argument("--dask", metavar="ADDRESS", help="a Dask scheduler, or local:N")
@@ -144,8 +149,8 @@ def _run(args: argparse.Namespace) -> int:
         arc=arc, sampling=args.sampling, seed=args.seed, reference=reference,
         box=None if args.arc else spec.x_range,
         shifts=[_numbers(s, "--shift") for s in args.shift] or None,
-        scales=args.scale or None, chunk=args.chunk or DEFAULT_CHUNK, gamma=spec.default_gamma,
-        mode=spec.default_mode,
+        scales=args.scale or None, chunk=args.chunk or default_chunk(args, DEFAULT_CHUNK),
+        gamma=spec.default_gamma, mode=spec.default_mode,
     )  # fmt: skip
     out = Path(args.out)
     big = plan.size > JSON_RUNS
@@ -203,6 +208,13 @@ def _run(args: argparse.Namespace) -> int:
         f"jik atlas: {A} x {plan.size} runs x {C} cycles in {elapsed:.1f} s: {written}\n"
     )
     return 0
+
+
+def default_chunk(args: argparse.Namespace, largest: int) -> int:
+    """Chunks of ``largest`` starts, but at least 16 chunks (of 128 or more) in all: the bar
+    moves and the workers share the last chunks."""
+    runs = args.starts * max(1, len(args.shift)) * max(1, len(args.scale))
+    return max(128, min(largest, -(-runs // 16)))
 
 
 def _param(text: str) -> tuple[str, float]:
