@@ -9,7 +9,8 @@ client goes away, and is dropped ``keep_for`` seconds after it ends (or when can
 
 Limits: at most ``max_running`` atlases compute at once (the others wait, queued), at most
 ``max_jobs`` are kept in all and ``per_client`` queued or running for one client, and one job's
-work (runs x cycles x algorithms) is at most ``max_work``.
+work (legs: runs x cycles x legs x algorithms) is at most ``max_work``, ``max_leg_ends`` with the
+leg ends in the result.
 """
 
 from __future__ import annotations
@@ -20,6 +21,8 @@ import time
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
+import numpy as np
+
 from jik.app.compute.atlas_schemas import AtlasJobResponse, AtlasRequest
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.requests import build_augmentation, build_robot, nullable
@@ -27,6 +30,7 @@ from jik.engine.atlas import AtlasPlan, plan_atlas
 from jik.engine.atlas_run import AtlasResult, run_atlas
 from jik.engine.exceptions import RunCancelled
 from jik.engine.registry import make_inverse
+from jik.engine.repeatability import CLOSE_TOL
 from jik.engine.self_motion import MAX_ARC
 
 
@@ -46,15 +50,18 @@ class AtlasLimits:
     max_jobs: int = 16
     max_running: int = 1
     per_client: int = 2
-    #: runs x cycles x algorithms of one job (about a minute of one core at 0.04 ms a leg)
-    max_work: int = 300_000
+    #: legs of one job, runs x cycles x legs x algorithms (under a minute of one core at 0.04 ms
+    #: a leg, ``jik bench atlas``)
+    max_work: int = 1_200_000
+    #: legs of one job whose ends are sent back (3 numbers each in the JSON: about 12 MB)
+    max_leg_ends: int = 200_000
     #: seconds a job is kept after it ends
     keep_for: float = 600.0
     #: worker processes of a running atlas
     workers: int = 2
 
 
-def plan_request(req: AtlasRequest, max_work: int) -> AtlasPlan:
+def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
     """The request's atlas, planned (curves traced); RequestError or InvalidInputError, each
     naming the field, when it cannot be."""
     spec, kin, _ = build_robot(req.robot)
@@ -72,11 +79,18 @@ def plan_request(req: AtlasRequest, max_work: int) -> AtlasPlan:
         if len(v) != size:
             raise RequestError(name, f"must have {size} components, got {len(v)}")
     paths = len(req.shifts or [0]) * len(req.scales or [0])
-    work = req.starts * paths * req.cycles * len(req.algorithms)
-    if work > max_work:
+    closed = np.linalg.norm(np.subtract(req.path[-1], req.path[0])) <= CLOSE_TOL
+    legs = req.starts * paths * req.cycles * (len(req.path) - closed) * len(req.algorithms)
+    if legs > limits.max_work:
         raise RequestError(
-            "starts", f"starts x paths x cycles x algorithms = {work} is more than {max_work}; "
-            "ask for fewer starts or cycles (or run `jik atlas` for larger atlases)",
+            "starts", f"starts x paths x cycles x legs x algorithms = {legs} is more than "
+            f"{limits.max_work}; ask for fewer starts or cycles (or run `jik atlas` for larger "
+            "atlases)",
+        )  # fmt: skip
+    if req.leg_ends and legs > limits.max_leg_ends:
+        raise RequestError(
+            "leg_ends", f"the ends of {legs} legs are more than the {limits.max_leg_ends} a "
+            "response carries; ask for the drift alone or a smaller atlas",
         )  # fmt: skip
     return plan_atlas(
         inverses, req.path, cycles=req.cycles, n_starts=req.starts,
@@ -145,7 +159,7 @@ class AtlasJobs:
         self.sweep()
         with self._lock:
             self._room(client)
-        plan = plan_request(req, self.limits.max_work)
+        plan = plan_request(req, self.limits)
         job = AtlasJob(secrets.token_urlsafe(12), client, plan, req.leg_ends)
         with self._lock:
             self._room(client)

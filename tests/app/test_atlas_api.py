@@ -67,7 +67,7 @@ def test_a_job_runs_to_its_result_and_outlives_its_request(app, client):
     assert done["status"] == "done", done["error"]
     assert done["progress"] == 1.0 and done["runs_done"] == 6
     res = done["result"]
-    expected = run_atlas(plan_request(AtlasRequest.model_validate(req), 10**6))
+    expected = run_atlas(plan_request(AtlasRequest.model_validate(req), AtlasLimits()))
     np.testing.assert_allclose(res["starts"], expected.starts, rtol=0, atol=1e-12)
     np.testing.assert_allclose(res["parameter"], np.linspace(-2, 2, 6), rtol=0, atol=1e-15)
     for a, alg in enumerate(("pseudoinverse", "extended")):
@@ -104,7 +104,9 @@ def test_one_client_may_run_one_job_at_a_time_here(client):
     [
         ({"starts": 20001}, "starts", "less than or equal to 20000"),
         ({"starts": 20000, "cycles": 50, "algorithms": ["pseudoinverse", "extended"]}, "starts",
-         "= 2000000 is more than 300000"),
+         "legs x algorithms = 8000000 is more than 1200000"),
+        ({"starts": 20000, "cycles": 3, "leg_ends": True}, "leg_ends",
+         "the ends of 240000 legs are more than the 200000"),
         ({"path": [[0.0, 1.0], [1.0, 1.0, 2.0]]}, "path", "must have 2 components, got 3"),
         ({"arc": [1.0, 2.0]}, "arc", "lo <= 0 <= hi"),
         ({"path": [[0.0, 1.0]]}, "path", "at least 2 items"),
