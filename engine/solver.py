@@ -181,6 +181,20 @@ def _initial_step(inverse, x, f, y_d, rtol, atol):
     return np.minimum(100 * h0, h1)
 
 
+def _combine(weights: FloatArray, K: FloatArray) -> FloatArray:
+    """sum_j weights[j] K[j] over the stages K (s, n, p), term by term in a fixed order.
+
+    ``np.tensordot`` hands this to BLAS, whose kernels round a member's sum differently with
+    the batch's size and the member's place in it; a sum of whole arrays does not, so a member's
+    numbers are the same in any batch (an atlas's do not depend on its chunking).
+    """
+    out = np.zeros(K.shape[1:])
+    for w, k in zip(weights, K, strict=True):
+        if w != 0.0:
+            out += w * k
+    return out
+
+
 # Recorded steps: (member indices (k,), theta (k,), x (k, p)) per accepted step.
 _Record = list[tuple[FloatArray, FloatArray, FloatArray]]
 
@@ -212,16 +226,16 @@ def _dop853(inverse, x0, y_d, tol, max_steps, record, tau0, rtol=RTOL, atol=ATOL
         Ks[0] = f[idx]
         stage_bad = np.zeros(m, dtype=bool)
         for s in range(1, _NS):
-            dx = np.tensordot(_A[s, :s], Ks[:s], axes=1) * hs[:, None]
+            dx = _combine(_A[s, :s], Ks[:s]) * hs[:, None]
             Ks[s], _, b = _rhs(inverse, xs + dx, yds)
             stage_bad |= b
-        x_new = xs + hs[:, None] * np.tensordot(_B, Ks[:_NS], axes=1)
+        x_new = xs + hs[:, None] * _combine(_B, Ks[:_NS])
         f_new, e_new, b = _rhs(inverse, x_new, yds)
         stage_bad |= b
         Ks[_NS] = f_new
         scale = atol + np.maximum(np.abs(xs), np.abs(x_new)) * rtol
-        err5 = np.sum((np.tensordot(_E5, Ks, axes=1) / scale) ** 2, axis=-1)
-        err3 = np.sum((np.tensordot(_E3, Ks, axes=1) / scale) ** 2, axis=-1)
+        err5 = np.sum((_combine(_E5, Ks) / scale) ** 2, axis=-1)
+        err3 = np.sum((_combine(_E3, Ks) / scale) ** 2, axis=-1)
         denom = err5 + 0.01 * err3
         with np.errstate(divide="ignore", invalid="ignore"):
             enorm = np.where(denom > 0, hs * err5 / np.sqrt(denom * p), 0.0)

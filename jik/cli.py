@@ -95,6 +95,7 @@ def bench(args: argparse.Namespace) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     from jik import __version__
+    from jik.atlas_cli import add_atlas_parser
 
     parser = argparse.ArgumentParser(
         prog="jik", description="jik: a lab for repeatable Jacobian inverse kinematics"
@@ -125,6 +126,8 @@ def main(argv: list[str] | None = None) -> int:
         help="table1 only: use the printed j32, j33 of (39) instead of the gradient of (38)",
     )
     p.set_defaults(func=reproduce)
+
+    add_atlas_parser(sub)
 
     p = sub.add_parser("bench", help="run the benchmarks (medians, ratios to straightforward code)")
     p.add_argument("names", nargs="*", help="benchmarks to run (default: all)")

@@ -9,7 +9,8 @@ field; so is a computation stopped at the time limit (the field that sizes the w
 ``cycles``). A request that finds no free compute slot within the time limit is 503
 ``{"detail": "server busy: ..."}`` with Retry-After; a failure inside a worker, and anything
 unexpected, is 500 ``{"detail": "internal error: ..."}``, never an HTML page or a dropped
-connection. The dashboard sessions' errors come here too: a refused value (the field it names)
+connection. An atlas job that is not there is 404, too many atlas jobs 429 with Retry-After.
+The dashboard sessions' errors come here too: a refused value (the field it names)
 is 422, a session that is not there 404, a full session store 503 with Retry-After. A body
 over the size limit is 413 ``{"detail": "request body of ... bytes is larger ..."}``
 (:class:`BodyLimit`).
@@ -28,6 +29,7 @@ from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.routing import Match
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
+from jik.app.compute.atlas_jobs import AtlasJobNotFound, AtlasJobsFull
 from jik.app.compute.exceptions import ComputeError, RequestError, ServiceUnavailable
 from jik.app.compute.schemas import AUGMENTATION_MODELS, ROBOT_MODELS, ErrorResponse
 from jik.app.dashboard.sessions import SessionNotFound, SessionsFull
@@ -177,6 +179,16 @@ def sessions_full_response(exc: SessionsFull) -> JSONResponse:
                         headers={"Retry-After": "30"})  # fmt: skip
 
 
+def atlas_job_not_found_response(exc: AtlasJobNotFound) -> JSONResponse:
+    return JSONResponse(status_code=404, content={"detail": (
+        f"no atlas job {exc.args[0]!r} (it was cancelled, or ended and expired)")})  # fmt: skip
+
+
+def atlas_jobs_full_response(exc: AtlasJobsFull) -> JSONResponse:
+    return JSONResponse(status_code=429, content={"detail": str(exc)},
+                        headers={"Retry-After": "10"})  # fmt: skip
+
+
 def busy_response(exc: ServiceUnavailable) -> JSONResponse:
     return JSONResponse(status_code=503, content={"detail": str(exc)}, headers={"Retry-After": "1"})
 
@@ -204,6 +216,8 @@ _RESPONSES: dict[type[Exception], Callable[[Any], JSONResponse]] = {
     InvalidInputError: invalid_input_response,
     SessionNotFound: session_not_found_response,
     SessionsFull: sessions_full_response,
+    AtlasJobNotFound: atlas_job_not_found_response,
+    AtlasJobsFull: atlas_jobs_full_response,
 }
 
 

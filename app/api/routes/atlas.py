@@ -1,0 +1,54 @@
+"""POST /atlas, GET /atlas/{id}, DELETE /atlas/{id}: repeatability atlases as background jobs.
+
+A job is planned and started by POST (202 with its id; 422 for bad input, 429 past the limits),
+read by GET (progress, then the result), and cancelled by DELETE (204). The jobs live in the
+app's :class:`jik.app.compute.atlas_jobs.AtlasJobs` and outlive the requests that made them.
+"""
+
+from typing import Annotated
+
+from fastapi import APIRouter, Depends, Request, Response
+from starlette.concurrency import run_in_threadpool
+
+from jik.app.compute.atlas_jobs import AtlasJobs
+from jik.app.compute.atlas_schemas import AtlasJobResponse, AtlasRequest
+from jik.app.compute.schemas import ErrorResponse
+
+router = APIRouter(tags=["atlas"])
+
+
+def jobs_of(request: Request) -> AtlasJobs:
+    """The app's atlas jobs (made on first use)."""
+    jobs = getattr(request.app.state, "atlas_jobs", None)
+    if jobs is None:
+        jobs = request.app.state.atlas_jobs = AtlasJobs()
+    return jobs
+
+
+Jobs = Annotated[AtlasJobs, Depends(jobs_of)]
+ERRORS: dict[int | str, dict] = {
+    404: {"model": ErrorResponse, "description": "no such job (ended long ago, or cancelled)"},
+    429: {"model": ErrorResponse, "description": "too many atlas jobs; retry later"},
+}
+
+
+@router.post("/atlas", status_code=202, response_model=AtlasJobResponse, responses=ERRORS)
+async def start_atlas(req: AtlasRequest, request: Request, response: Response, jobs: Jobs):
+    """Plan the atlas (the self-motion curves are traced here) and start it as a job."""
+    client = request.client.host if request.client else "unknown"
+    job = await run_in_threadpool(jobs.start, client, req)
+    response.headers["Location"] = f"/atlas/{job.id}"
+    return job.response()
+
+
+@router.get("/atlas/{job_id}", response_model=AtlasJobResponse, responses=ERRORS)
+async def read_atlas(job_id: str, jobs: Jobs):
+    """The job's status and progress; its result once done."""
+    return jobs.get(job_id).response()
+
+
+@router.delete("/atlas/{job_id}", status_code=204, responses=ERRORS)
+async def cancel_atlas(job_id: str, jobs: Jobs) -> Response:
+    """Cancel the job (it stops after the chunk it is on) and forget it."""
+    jobs.cancel(job_id)
+    return Response(status_code=204)

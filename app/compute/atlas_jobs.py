@@ -1,0 +1,241 @@
+"""Atlas jobs of the REST API: started by a request, run in the background, read back later.
+
+An atlas (:mod:`jik.engine.atlas`) takes seconds to minutes, longer than a request may wait, so
+``POST /atlas`` only checks the request and plans the atlas (:func:`plan_request`), then
+:class:`AtlasJobs` runs it in a thread of its own that drives worker processes
+(``engine.atlas_run.run_atlas`` with a ``processes:N`` backend: the numbers work outside the
+server's interpreter and its GIL). A job does not belong to a connection: it runs on when its
+client goes away, and is dropped ``keep_for`` seconds after it ends (or when cancelled).
+
+Limits: at most ``max_running`` atlases compute at once (the others wait, queued), at most
+``max_jobs`` are kept in all and ``per_client`` queued or running for one client, and one job's
+work (legs: runs x cycles x legs x algorithms) is at most ``max_work``, ``max_leg_ends`` with the
+leg ends in the result.
+"""
+
+from __future__ import annotations
+
+import secrets
+import threading
+import time
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+
+from jik.app.compute.atlas_schemas import AtlasJobResponse, AtlasRequest
+from jik.app.compute.exceptions import RequestError
+from jik.app.compute.requests import build_augmentation, build_robot, nullable
+from jik.engine.atlas import AtlasPlan, plan_atlas
+from jik.engine.atlas_run import AtlasResult, run_atlas
+from jik.engine.exceptions import RunCancelled
+from jik.engine.registry import make_inverse
+from jik.engine.repeatability import CLOSE_TOL
+from jik.engine.self_motion import MAX_ARC
+
+
+class AtlasJobNotFound(LookupError):
+    """No job with that id (never made, cancelled, or dropped after ``keep_for``): HTTP 404."""
+
+
+class AtlasJobsFull(RuntimeError):
+    """Too many jobs in all or for this client: HTTP 429 with Retry-After."""
+
+
+Status = Literal["queued", "running", "done", "failed", "cancelled"]
+
+
+@dataclass(frozen=True)
+class AtlasLimits:
+    max_jobs: int = 16
+    max_running: int = 1
+    per_client: int = 2
+    #: legs of one job, runs x cycles x legs x algorithms (under a minute of one core at 0.04 ms
+    #: a leg, ``jik bench atlas``)
+    max_work: int = 1_200_000
+    #: legs of one job whose ends are sent back (3 numbers each in the JSON: about 12 MB)
+    max_leg_ends: int = 200_000
+    #: seconds a job is kept after it ends
+    keep_for: float = 600.0
+    #: worker processes of a running atlas
+    workers: int = 2
+
+
+def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
+    """The request's atlas, planned (curves traced); RequestError or InvalidInputError, each
+    naming the field, when it cannot be."""
+    spec, kin, _ = build_robot(req.robot)
+    inverses = []
+    for algorithm in req.algorithms:
+        if algorithm == "extended":
+            aspec, _, used = build_augmentation(spec, kin, req.augmentation)
+            inverses.append(make_inverse(kin, "extended", aspec.name, used.parameters, spec.name))
+        else:
+            inverses.append(make_inverse(kin, "pseudoinverse"))
+    vectors = [(f"path[{i}]", v, spec.r) for i, v in enumerate(req.path)]
+    vectors += [(f"shifts[{i}]", v, spec.r) for i, v in enumerate(req.shifts or [])]
+    vectors += [("reference", req.reference, spec.p)] if req.reference else []
+    for name, v, size in vectors:
+        if len(v) != size:
+            raise RequestError(name, f"must have {size} components, got {len(v)}")
+    paths = len(req.shifts or [0]) * len(req.scales or [0])
+    closed = np.linalg.norm(np.subtract(req.path[-1], req.path[0])) <= CLOSE_TOL
+    legs = req.starts * paths * req.cycles * (len(req.path) - closed) * len(req.algorithms)
+    if legs > limits.max_work:
+        raise RequestError(
+            "starts", f"starts x paths x cycles x legs x algorithms = {legs} is more than "
+            f"{limits.max_work}; ask for fewer starts or cycles (or run `jik atlas` for larger "
+            "atlases)",
+        )  # fmt: skip
+    if req.leg_ends and legs > limits.max_leg_ends:
+        raise RequestError(
+            "leg_ends", f"the ends of {legs} legs are more than the {limits.max_leg_ends} a "
+            "response carries; ask for the drift alone or a smaller atlas",
+        )  # fmt: skip
+    return plan_atlas(
+        inverses, req.path, cycles=req.cycles, n_starts=req.starts,
+        arc=req.arc or (-MAX_ARC, MAX_ARC), sampling=req.sampling, seed=req.seed,
+        reference=req.reference or spec.default_x0, box=None if req.arc else spec.x_range,
+        shifts=req.shifts, scales=req.scales, gamma=spec.default_gamma, mode=spec.default_mode,
+    )  # fmt: skip
+
+
+def result_document(res: AtlasResult, arc, leg_ends: bool) -> dict[str, Any]:
+    """The fields of :class:`jik.app.compute.atlas_schemas.AtlasResult`."""
+    algs = res.algorithms
+    failures: dict[str, dict[str, str]] = {a: {} for a in algs}
+    for (a, j, i), why in res.failures.items():
+        failures[algs[a]][f"{j},{i}"] = why
+    legs = res.leg_ends if leg_ends else None
+    return {
+        "algorithms": list(algs), "arc": list(arc), "paths": res.paths.tolist(),
+        "parameter": [] if res.parameter is None else res.parameter.tolist(),
+        "starts": res.starts.tolist(),
+        "drift": {a: nullable(res.drift[k]) for k, a in enumerate(algs)},
+        "success": {a: res.success[k].tolist() for k, a in enumerate(algs)},
+        "failures": failures,
+        "leg_ends": None if legs is None else {a: nullable(legs[k]) for k, a in enumerate(algs)},
+    }  # fmt: skip
+
+
+@dataclass
+class AtlasJob:
+    id: str
+    client: str
+    plan: AtlasPlan
+    leg_ends: bool
+    status: Status = "queued"
+    runs_done: int = 0
+    started: float = field(default_factory=time.monotonic)
+    ended: float | None = None
+    error: str | None = None
+    result: dict[str, Any] | None = None
+    cancel: threading.Event = field(default_factory=threading.Event)
+
+    def response(self) -> AtlasJobResponse:
+        end = self.ended if self.ended is not None else time.monotonic()
+        return AtlasJobResponse(
+            id=self.id, status=self.status, runs=self.plan.size, runs_done=self.runs_done,
+            progress=self.runs_done / self.plan.size, elapsed_s=end - self.started,
+            error=self.error, result=self.result,  # type: ignore[arg-type]  # (validated)
+        )  # fmt: skip
+
+    @property
+    def active(self) -> bool:
+        return self.status in ("queued", "running")
+
+
+class AtlasJobs:
+    """The API's atlas jobs (see the module docstring)."""
+
+    def __init__(self, limits: AtlasLimits | None = None) -> None:
+        self.limits = limits or AtlasLimits()
+        self._jobs: dict[str, AtlasJob] = {}
+        self._lock = threading.Lock()
+        self._slots = threading.Semaphore(self.limits.max_running)
+
+    def start(self, client: str, req: AtlasRequest) -> AtlasJob:
+        """Plan the request's atlas and start it as a job (raises before anything is kept)."""
+        self.sweep()
+        with self._lock:
+            self._room(client)
+        plan = plan_request(req, self.limits)
+        job = AtlasJob(secrets.token_urlsafe(12), client, plan, req.leg_ends)
+        with self._lock:
+            self._room(client)
+            self._jobs[job.id] = job
+        threading.Thread(target=self._run, args=(job,), name=f"jik-atlas-{job.id}",
+                         daemon=True).start()  # fmt: skip
+        return job
+
+    def _room(self, client: str) -> None:
+        jobs = self._jobs.values()
+        if len(self._jobs) >= self.limits.max_jobs:
+            raise AtlasJobsFull(f"the server keeps at most {self.limits.max_jobs} atlas jobs; "
+                                "retry when one has ended and expired")  # fmt: skip
+        if sum(j.active and j.client == client for j in jobs) >= self.limits.per_client:
+            raise AtlasJobsFull(f"at most {self.limits.per_client} atlas jobs per client run at "
+                                "once; wait for one to end or cancel it")  # fmt: skip
+
+    def get(self, job_id: str) -> AtlasJob:
+        self.sweep()
+        with self._lock:
+            job = self._jobs.get(job_id)
+        if job is None:
+            raise AtlasJobNotFound(job_id)
+        return job
+
+    def cancel(self, job_id: str) -> None:
+        """Stop the job (after the chunk it is on) and drop it."""
+        job = self.get(job_id)
+        job.cancel.set()
+        with self._lock:
+            self._jobs.pop(job_id, None)
+
+    def sweep(self) -> None:
+        """Drop the jobs that ended more than ``keep_for`` seconds ago."""
+        now = time.monotonic()
+        with self._lock:
+            for job in [j for j in self._jobs.values() if j.ended is not None]:
+                if now - job.ended > self.limits.keep_for:  # type: ignore[operator]
+                    del self._jobs[job.id]
+
+    def close(self) -> None:
+        """Cancel every job."""
+        with self._lock:
+            for job in self._jobs.values():
+                job.cancel.set()
+            self._jobs.clear()
+
+    def _run(self, job: AtlasJob) -> None:
+        while not self._slots.acquire(timeout=0.2):
+            if job.cancel.is_set():
+                return self._end(job, "cancelled")
+        try:
+            job.status = "running"
+            job.started = time.monotonic()
+
+            def progress(done: int, _total: int) -> None:
+                job.runs_done = done
+
+            res = run_atlas(
+                job.plan, f"processes:{self.limits.workers}", on_progress=progress,
+                cancelled=job.cancel.is_set, keep_leg_ends=job.leg_ends,
+            )  # fmt: skip
+            job.result = result_document(res, job.plan.manifolds[0].arc, job.leg_ends)
+            self._end(job, "done")
+        except RunCancelled:
+            self._end(job, "cancelled")
+        except Exception as error:  # (a job's failure is its result, read by GET)
+            job.error = f"{type(error).__name__}: {error}"
+            self._end(job, "failed")
+        finally:
+            self._slots.release()
+
+    @staticmethod
+    def _end(job: AtlasJob, status: Status) -> None:
+        job.status = status
+        job.ended = time.monotonic()
+
+
+__all__ = ["AtlasJobNotFound", "AtlasJobs", "AtlasJobsFull", "AtlasLimits"]

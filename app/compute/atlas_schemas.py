@@ -1,0 +1,103 @@
+"""Request and response models of the atlas jobs (``POST /atlas``, ``GET /atlas/{id}``).
+
+They reuse the field types of :mod:`jik.app.compute.schemas` (robots and maps generated from the
+catalogue, coordinates, vectors, algorithms); what needs the registry or the engine (vector
+lengths, a path the curve tracing refuses, the size of the work) is checked by
+:mod:`jik.app.compute.atlas_jobs` and :func:`jik.engine.atlas.plan_atlas`, which name the field.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from jik.app.compute.schemas import (
+    Algorithm,
+    Augmentation,
+    Coordinate,
+    MaybeFloat,
+    Robot,
+    Vector,
+)
+from jik.engine.repeatability import MAX_PATH_POINTS
+
+#: Largest starts per path, cycles, and paths of a family (shifts, scales) in one request.
+MAX_STARTS = 20000
+MAX_CYCLES = 50
+MAX_FAMILY = 16
+
+Scale = Annotated[float, Field(strict=True, gt=0, le=100.0, allow_inf_nan=False)]
+
+
+class AtlasRequest(BaseModel):
+    """A repeatability atlas: the drift after each cycle of a closed path, for many starts on the
+    self-motion curve of the path's first point (engine.atlas)."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    robot: Robot = Field(description="the robot and its parameters, e.g. {'name': 'manipulator2'}")
+    algorithms: Annotated[list[Algorithm], Field(min_length=1, max_length=2)] = Field(
+        ["pseudoinverse"], description="'pseudoinverse' (8) and/or 'extended' (11)"
+    )
+    augmentation: Augmentation | None = Field(
+        None, description="augmenting map of the extended inverse (default: the robot's)"
+    )
+    path: Annotated[list[Vector], Field(min_length=2, max_length=MAX_PATH_POINTS)] = Field(
+        description="task points, a loop from the first: the starts lie on k(x) = path[0]"
+    )
+    starts: Annotated[int, Field(strict=True, ge=1, le=MAX_STARTS)] = Field(
+        256, description=f"starts per path, 1 to {MAX_STARTS}"
+    )
+    sampling: Literal["grid", "sample"] = Field(
+        "grid", description="arc lengths on a grid (ends included) or sampled uniformly"
+    )
+    seed: Annotated[int, Field(strict=True, ge=0, le=2**31 - 1)] = 0
+    arc: tuple[Coordinate, Coordinate] | None = Field(
+        None, description="(lo, hi), lo <= 0 <= hi: arc lengths of the starts; default: the part "
+        "of the curve inside the robot's configuration box",
+    )  # fmt: skip
+    reference: Vector | None = Field(
+        None, description="s = 0 is where eq. (7) from here meets the curve (default: robot's x0)"
+    )
+    shifts: Annotated[list[Vector], Field(min_length=1, max_length=MAX_FAMILY)] | None = Field(
+        None, description="translations of the path (a family of paths)"
+    )
+    scales: Annotated[list[Scale], Field(min_length=1, max_length=MAX_FAMILY)] | None = Field(
+        None, description="scales of the path about its first point"
+    )
+    cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_CYCLES)] = 3
+    leg_ends: bool = Field(False, description="include every leg's end in the result")
+
+
+class AtlasResult(BaseModel):
+    """The atlas, per algorithm: axes (path, start, cycle), runs = paths x starts."""
+
+    algorithms: list[Algorithm]
+    arc: list[float] = Field(description="the arc lengths the starts span")
+    paths: list[list[list[float]]] = Field(description="(P, L, r): the family's paths")
+    parameter: list[float] = Field(description="(N,): arc length s of each start")
+    starts: list[list[list[float]]] = Field(description="(P, N, p)")
+    drift: dict[str, list[list[list[MaybeFloat]]]] = Field(
+        description="per algorithm (P, N, cycles): ||x after cycle c - x0||; null after a failure"
+    )
+    success: dict[str, list[list[bool]]]
+    failures: dict[str, dict[str, str]] = Field(
+        description="per algorithm, 'path,start' -> why that run failed"
+    )
+    leg_ends: dict[str, list[list[list[list[MaybeFloat]]]]] | None = Field(
+        None, description="per algorithm (P, N, cycles * L, p), when asked for"
+    )
+
+
+class AtlasJobResponse(BaseModel):
+    """An atlas job: its state, progress and, once done, its result."""
+
+    id: str
+    status: Literal["queued", "running", "done", "failed", "cancelled"]
+    runs: int = Field(description="runs per algorithm: paths x starts")
+    runs_done: int
+    progress: float = Field(description="runs_done / runs")
+    elapsed_s: float
+    error: str | None = None
+    result: AtlasResult | None = None

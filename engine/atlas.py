@@ -1,0 +1,319 @@
+"""Repeatability atlas: drift after every cycle of a closed path, over many starts and paths.
+
+The repeatability test of sec. 5.2.1 (Table 1) drives the robot around a closed task path from one
+start x0; the pseudoinverse (8) drifts, the extended inverse (11) does not. The drift depends on
+where on the self-motion manifold of the path's first point the robot starts, and on the path's
+size and place. An atlas runs the test of :func:`jik.engine.repeatability.repeatability` for
+every start of a set (points of the traced manifold at arc lengths s, :mod:`jik.engine.self_motion`,
+or explicit configurations) and every path of a family (translations and scales of a base path),
+for one or several inverses.
+
+The path is a loop through its points in order, from the first: a start x lies on k(x) = path[0]
+and the legs of a cycle go to path[1], ..., path[-1] and back to k(x) (as ``repeatability``
+closes them). The work is cut into chunks of starts, each run as batched ``repeatability`` calls per
+inverse (:mod:`jik.engine.atlas_run`); a chunk's numbers depend only on its starts (each member's
+arithmetic in the batched solver is its own), so the atlas is the same whatever the chunking and
+wherever the chunks run (:mod:`jik.engine.atlas_backends`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from jik.engine.exceptions import InvalidInputError, SingularConfigurationError
+from jik.engine.inverses import Inverse, Pseudoinverse
+from jik.engine.repeatability import CLOSE_TOL, MAX_CYCLES, MAX_PATH_POINTS
+from jik.engine.self_motion import SelfMotionManifold, project, trace
+from jik.engine.solver import BatchSolveResult, solve
+from jik.engine.validation import FloatArray, as_points, count, positive
+
+#: Largest number of starts per path, of paths in a family, and of starts in a chunk.
+MAX_STARTS = 10**9
+MAX_PATHS = 10**4
+MAX_CHUNK = 65536
+#: Default number of starts in a chunk, the unit of work handed to a backend: about a second of
+#: work (a progress bar moves, a cancellation is heard), few tasks for a scheduler.
+DEFAULT_CHUNK = 2048
+#: Sampled arc lengths are drawn in blocks of this many indices, each from its own seeded stream,
+#: so the s of a start depends only on its index and the seed.
+SAMPLE_BLOCK = 1024
+#: An explicit start must lie this close to k(x) = path[0].
+ON_MANIFOLD_TOL = 1e-9
+
+
+@dataclass(frozen=True)
+class AtlasPlan:
+    """Validated inputs of an atlas (made by :func:`plan_atlas`).
+
+    Attributes
+    ----------
+    inverses : tuple of Inverse
+        One or several right inverses of the same kinematics.
+    paths : ndarray, shape (P, L0, r)
+        The family's paths; each is a loop from its first point.
+    cycles : int
+    n_starts : int
+        N, starts per path.
+    sampling : (str, int) or None
+        How the arc lengths s of the starts are laid on their curves' common arc: ("grid", 0) or
+        ("sample", seed) (:func:`arc_lengths`); None for explicit starts.
+    manifolds : tuple of SelfMotionManifold (one per path) or ()
+    explicit : ndarray, shape (N, p) or None
+    chunk : int
+    settings : dict
+        gamma, mode, tol and max_iterations of every leg (:func:`jik.engine.solver.solve`).
+    """
+
+    inverses: tuple[Inverse, ...]
+    paths: FloatArray
+    cycles: int
+    n_starts: int
+    sampling: tuple[str, int] | None
+    manifolds: tuple[SelfMotionManifold, ...]
+    explicit: FloatArray | None
+    chunk: int
+    settings: dict = field(default_factory=dict)
+
+    @property
+    def size(self) -> int:
+        """Number of runs per inverse: paths x starts."""
+        return len(self.paths) * self.n_starts
+
+    @property
+    def legs(self) -> int:
+        """Legs of one cycle: path[1:] and the return to k(x)."""
+        return self.paths.shape[1]
+
+    @property
+    def algorithms(self) -> tuple[str, ...]:
+        return tuple(inv.name for inv in self.inverses)
+
+    def starts(self, lo: int, hi: int) -> FloatArray:
+        """The starts of runs lo to hi - 1 (runs are path-major: run = path * N + start)."""
+        runs = np.arange(lo, hi)
+        path, index = np.divmod(runs, self.n_starts)
+        if self.explicit is not None:
+            return self.explicit[index]
+        s = self.parameter(index)
+        assert s is not None  # (not explicit: the starts are on traced curves)
+        x = np.empty((len(runs), self.inverses[0].kinematics.p))
+        for j in np.unique(path):
+            x[path == j] = self.manifolds[j].points(s[path == j])
+        return x
+
+    def parameter(self, index) -> FloatArray | None:
+        """Arc lengths s of starts ``index`` (an int array) on their curves; None when the
+        starts are explicit. Computed on demand: a plan holds nothing of size N."""
+        if self.sampling is None:
+            return None
+        return arc_lengths(np.asarray(index), self.n_starts, self.manifolds[0].arc, *self.sampling)
+
+    def targets(self, lo: int, hi: int, starts: FloatArray) -> FloatArray:
+        """The legs' targets (n, L, r) of runs lo to hi - 1: path[1:] and k(start)."""
+        path = np.arange(lo, hi) // self.n_starts
+        home = self.inverses[0].kinematics.forward(starts)[:, None, :]
+        return np.concatenate([self.paths[path, 1:], home], axis=1)
+
+
+def arc_lengths(
+    index: FloatArray, n: int, arc: tuple[float, float], sampling: str, seed: int
+) -> FloatArray:
+    """Arc lengths of starts ``index`` (ints in [0, n)) of n on [lo, hi]: evenly spaced, ends
+    included ("grid"), or uniform random ("sample"): drawn from ``seed`` block by block, so
+    each index's value is fixed by the index and the seed, not by what else is asked for."""
+    lo, hi = arc
+    if sampling == "grid":
+        u = index / (n - 1) if n > 1 else np.zeros(len(index))
+    else:
+        u = np.empty(len(index))
+        block = index // SAMPLE_BLOCK
+        for b in np.unique(block):
+            u[block == b] = np.random.default_rng([seed, int(b)]).random(SAMPLE_BLOCK)[
+                index[block == b] % SAMPLE_BLOCK
+            ]
+    return np.clip(lo + (hi - lo) * u, lo, hi)
+
+
+def family(base_path: FloatArray, shifts: FloatArray, scales: FloatArray) -> FloatArray:
+    """Paths (P, L0, r): every shift with every scale, shift-major; a scale acts about the path's
+    first point (the starts' task point), a shift moves the whole path."""
+    rel = base_path - base_path[0]
+    first = base_path[0] + shifts  # (S, r)
+    return (first[:, None, None, :] + scales[None, :, None, None] * rel).reshape(
+        -1, *base_path.shape
+    )
+
+
+def plan_atlas(
+    inverses: Inverse | Sequence[Inverse],
+    path,
+    *,
+    cycles: int = 1,
+    starts=None,
+    n_starts: int | None = None,
+    arc: Sequence[float] | None = None,
+    sampling: str = "grid",
+    seed: int = 0,
+    reference=None,
+    box=None,
+    shifts=None,
+    scales=None,
+    chunk: int = DEFAULT_CHUNK,
+    gamma: float = 1.0,
+    mode: str = "continuous",
+    tol: float = 1e-10,
+    max_iterations: int | None = None,
+) -> AtlasPlan:
+    """Check an atlas's inputs once, here, and trace the manifolds of its starts.
+
+    Parameters
+    ----------
+    inverses : Inverse or sequence of Inverse
+        Of one kinematics k; each gives its own drift.
+    path : array_like, shape (L0, r)
+        The base path, a loop from its first point (2 to 100 points; a last point equal to the
+        first is dropped: the return leg to k(x) closes every loop).
+    cycles : int
+        1 to 1000.
+    starts : array_like, shape (N, p), optional
+        Explicit starts, each on k(x) = path[0] (to 1e-9). Otherwise:
+    n_starts, arc, sampling, seed, reference, box
+        N starts at arc lengths s in ``arc`` = (lo, hi) on the self-motion curve of each path's
+        first point (:func:`jik.engine.self_motion.trace`), on a grid (ends included) or sampled
+        uniformly with ``seed``. s = 0 is where eq. (7) with the pseudoinverse from ``reference``
+        (a configuration, p) reaches the path's first point; with ``box`` ((low, high) per
+        coordinate) the arc is cut where the base path's curve leaves the box, and the same
+        arc is used for every path of the family.
+    shifts : array_like, shape (S, r), optional
+        Translations of the base path (default: none).
+    scales : array_like, shape (Q,), optional
+        Scales of the base path about its first point, > 0 (default 1). The family is every
+        shift with every scale, P = S Q paths.
+    chunk : int
+        Starts per chunk: the batch size and the unit of work, 1 to 65536.
+    gamma, mode, tol, max_iterations
+        Of every leg, as in :func:`jik.engine.solver.solve`.
+
+    Raises
+    ------
+    InvalidInputError
+        Naming the field (``error.field``): path, cycles, starts, n_starts, arc, sampling, seed,
+        reference, box, shifts, scales, chunk, gamma, mode, tol, max_iterations, inverses.
+    """
+    invs = (inverses,) if isinstance(inverses, Inverse) else tuple(inverses)
+    if not invs or not all(isinstance(i, Inverse) for i in invs):
+        raise InvalidInputError("give one or more Inverse objects", field="inverses")
+    kin = invs[0].kinematics
+    if any(i.kinematics is not kin for i in invs):
+        raise InvalidInputError("all inverses must share one kinematics", field="inverses")
+    base_path = _checked(lambda: as_points(path, kin.r, "path"), "path")
+    if base_path.ndim != 2:
+        raise InvalidInputError(f"path must be a list of task points (L, {kin.r})", field="path")
+    if len(base_path) > 2 and np.linalg.norm(base_path[-1] - base_path[0]) <= CLOSE_TOL:
+        base_path = base_path[:-1]
+    if not 2 <= len(base_path) <= MAX_PATH_POINTS:
+        raise InvalidInputError(
+            f"path must have 2 to {MAX_PATH_POINTS} points (a loop from the first), got "
+            f"{len(base_path)}",
+            field="path",
+        )
+    cycles = _checked(lambda: count(cycles, "cycles", 1, MAX_CYCLES), "cycles")
+    chunk = _checked(lambda: count(chunk, "chunk", 1, MAX_CHUNK), "chunk")
+    settings = {
+        "gamma": _checked(lambda: positive(gamma, "gamma"), "gamma"),
+        "mode": mode,
+        "tol": _checked(lambda: positive(tol, "tol"), "tol"),
+        "max_iterations": None if max_iterations is None else _checked(
+            lambda: count(max_iterations, "max_iterations", 1, 10**6), "max_iterations"
+        ),
+    }  # fmt: skip
+    if mode not in ("continuous", "discrete"):
+        raise InvalidInputError(f"mode must be 'continuous' or 'discrete', got {mode!r}", "mode")
+    if mode == "discrete" and settings["gamma"] >= 2:
+        raise InvalidInputError("gamma must be < 2 in discrete mode", field="gamma")
+    shift = np.zeros((1, kin.r)) if shifts is None else _checked(
+        lambda: as_points(shifts, kin.r, "shifts"), "shifts")  # fmt: skip
+    scale = np.ones(1) if scales is None else _checked(
+        lambda: np.asarray(scales, dtype=float), "scales")  # fmt: skip
+    if shift.ndim != 2 or scale.ndim != 1 or not len(shift) or not len(scale):
+        raise InvalidInputError("shifts must be (S, r) and scales (Q,), both non-empty", "shifts")
+    if not np.all(np.isfinite(scale) & (scale > 0)):
+        raise InvalidInputError("scales must be finite and > 0", field="scales")
+    if len(shift) * len(scale) > MAX_PATHS:
+        raise InvalidInputError(f"at most {MAX_PATHS} paths (shifts x scales)", field="shifts")
+    paths = family(base_path, shift, scale)
+
+    def make(**starts_: Any) -> AtlasPlan:
+        return AtlasPlan(
+            inverses=invs, paths=paths, cycles=cycles, chunk=chunk, settings=settings, **starts_
+        )
+
+    if starts is not None:
+        x = _checked(lambda: as_points(starts, kin.p, "starts"), "starts")
+        if x.ndim != 2 or not 1 <= len(x) <= MAX_STARTS:
+            raise InvalidInputError(f"starts must be a list (N, {kin.p}), N >= 1", "starts")
+        off = np.linalg.norm(kin.forward(x)[None] - paths[:, None, 0], axis=-1).max(axis=0)
+        if np.any(off > ON_MANIFOLD_TOL):
+            i = int(np.argmax(off))
+            raise InvalidInputError(
+                f"starts[{i}] is not on the self-motion manifold of every path's first point: "
+                f"|k(x) - path[0]| = {off[i]:.3g} > {ON_MANIFOLD_TOL:g}",
+                field="starts",
+            )
+        return make(n_starts=len(x), sampling=None, manifolds=(), explicit=x)
+    if n_starts is None or arc is None or reference is None:
+        raise InvalidInputError(
+            "give explicit starts, or n_starts, arc and a reference configuration", "starts"
+        )
+    n = _checked(lambda: count(n_starts, "n_starts", 1, MAX_STARTS), "n_starts")
+    if sampling not in ("grid", "sample"):
+        raise InvalidInputError(f"sampling must be 'grid' or 'sample', got {sampling!r}",
+                                "sampling")  # fmt: skip
+    seed = _checked(lambda: count(seed, "seed", 0, 2**63 - 1), "seed")
+    ref = _checked(lambda: kin.check(reference, "reference"), "reference")
+    if ref.ndim != 1:
+        raise InvalidInputError(f"reference must be one configuration ({kin.p},)", "reference")
+    if box is not None:
+        box = _checked(lambda: as_points(box, 2, "box"), "box")
+        if box.shape != (kin.p, 2) or np.any(box[:, 0] >= box[:, 1]):
+            raise InvalidInputError(f"box must be {kin.p} pairs (low, high), low < high", "box")
+    if not isinstance(arc, Sequence) or len(arc) != 2:
+        raise InvalidInputError("arc must be a pair (lo, hi) with lo <= 0 <= hi", field="arc")
+    manifolds = _manifolds(kin, paths, ref, arc, box)
+    return make(n_starts=n, sampling=(sampling, seed), manifolds=manifolds, explicit=None)
+
+
+def _manifolds(kin, paths, reference, arc, box) -> tuple[SelfMotionManifold, ...]:
+    """Each path's self-motion curve over one arc: the base path's, cut by ``box``."""
+    y0 = paths[:, 0]
+    try:
+        res = solve(
+            Pseudoinverse(kin), np.broadcast_to(reference, (len(y0), kin.p)), y0, tol=1e-12,
+            record=False,
+        )  # fmt: skip
+    except SingularConfigurationError as error:
+        raise InvalidInputError(str(error), field="reference") from None
+    assert isinstance(res, BatchSolveResult)
+    if not np.all(res.success):
+        j = int(np.argmin(res.success))
+        raise InvalidInputError(
+            f"eq. (7) from the reference does not reach path {j}'s first point: {res.message[j]}",
+            field="reference",
+        )
+    bases = project(kin, res.x, y0)
+    first = trace(kin, bases[0], arc, box)
+    return (first, *(trace(kin, b, first.arc) for b in bases[1:]))
+
+
+def _checked(check, name: str):
+    """Run ``check`` and tag an InvalidInputError it raises with the field ``name``."""
+    try:
+        return check()
+    except InvalidInputError as error:
+        if error.field is None:
+            error.field = name
+        raise

@@ -1,0 +1,228 @@
+"""Running an atlas (:mod:`jik.engine.atlas`): chunks of starts, each through every inverse.
+
+A chunk is a few batched :func:`jik.engine.repeatability.repeatability` calls per inverse: every
+leg of every start of a batch is one vectorized solve of eq. (7). :func:`run_chunk` is a plain
+module-level function of picklable data, so a process pool or a Dask worker runs it as it is;
+:func:`iter_atlas` hands chunks to a backend (:mod:`jik.engine.atlas_backends`) and yields
+their results as they come, holding at most a few chunks at a time; :func:`run_atlas` gathers
+them into one :class:`AtlasResult`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+
+import numpy as np
+
+from jik.engine.atlas import AtlasPlan
+from jik.engine.atlas_backends import Backend, backend_for
+from jik.engine.exceptions import RunCancelled, SingularConfigurationError
+from jik.engine.inverses import Inverse
+from jik.engine.repeatability import repeatability
+from jik.engine.validation import FloatArray
+
+#: Starts per batched repeatability() call within a chunk: the working set of the Picard sweeps
+#: then stays in cache (``jik bench atlas``: 0.033 ms per start and leg at 512, 0.044 at 2048),
+#: while a chunk, the unit of work a backend hands out, may be larger.
+BATCH = 512
+
+
+@dataclass(frozen=True)
+class ChunkTask:
+    """Runs ``lo`` to ``hi`` - 1 of an atlas: their starts (n, p) and legs' targets (n, L, r)."""
+
+    lo: int
+    hi: int
+    inverses: tuple[Inverse, ...]
+    starts: FloatArray
+    targets: FloatArray
+    cycles: int
+    settings: dict
+
+
+@dataclass(frozen=True)
+class AtlasChunk:
+    """What one chunk gives, per inverse a (leading axis A).
+
+    Attributes
+    ----------
+    lo, hi : int
+        The chunk's runs (run = path * N + start).
+    drift : ndarray, shape (A, n, cycles)
+        ||x after cycle c - x0||, sec. 5.2.1; NaN after a failed leg.
+    leg_ends : ndarray, shape (A, n, cycles * L, p)
+    success : ndarray of bool, shape (A, n)
+    failures : tuple of (a, run, message)
+        The runs whose legs did not all converge, and why.
+    """
+
+    lo: int
+    hi: int
+    drift: FloatArray
+    leg_ends: FloatArray
+    success: FloatArray
+    failures: tuple[tuple[int, int, str], ...]
+
+
+def chunk_task(plan: AtlasPlan, lo: int, hi: int) -> ChunkTask:
+    """The task of runs lo to hi - 1 (its starts computed here, by the caller)."""
+    starts = plan.starts(lo, hi)
+    return ChunkTask(
+        lo, hi, plan.inverses, starts, plan.targets(lo, hi, starts), plan.cycles, plan.settings
+    )
+
+
+def run_chunk(task: ChunkTask) -> AtlasChunk:
+    """Every inverse's repeatability run of the chunk's starts, in batches of :data:`BATCH`."""
+    n, L = task.targets.shape[:2]
+    A, p = len(task.inverses), task.starts.shape[1]
+    drift = np.full((A, n, task.cycles), np.nan)
+    legs = np.full((A, n, task.cycles * L, p), np.nan)
+    success = np.zeros((A, n), dtype=bool)
+    failures: list[tuple[int, int, str]] = []
+    batches = [np.arange(b, min(b + BATCH, n)) for b in range(0, n, BATCH)]
+    for a, inverse in enumerate(task.inverses):
+        for ids, res, why in (r for batch in batches for r in _runs(inverse, task, batch)):
+            if res is None:
+                failures.extend((a, task.lo + int(i), why) for i in ids)
+                continue
+            drift[a, ids], legs[a, ids], success[a, ids] = res.drift, res.legs, res.success
+            failures.extend(
+                (a, task.lo + int(ids[k]), res.message[k]) for k in np.flatnonzero(~res.success)
+            )
+    return AtlasChunk(task.lo, task.hi, drift, legs, success, tuple(failures))
+
+
+def _runs(inverse: Inverse, task: ChunkTask, ids: np.ndarray):
+    """Batched runs of the members ``ids``: (ids, result, "") pairs, or (ids, None, why) for a
+    member whose start or leg start is singular for ``inverse`` (a batched solve raises there
+    for the whole batch: the batch is halved until that member runs alone; every other member's
+    numbers are those of any batch)."""
+    try:
+        res = repeatability(
+            inverse, task.starts[ids], task.targets[ids], task.cycles, close=False, **task.settings
+        )
+    except SingularConfigurationError as error:
+        if len(ids) == 1:
+            yield ids, None, str(error)
+            return
+        half = len(ids) // 2
+        yield from _runs(inverse, task, ids[:half])
+        yield from _runs(inverse, task, ids[half:])
+        return
+    yield ids, res, ""
+
+
+@dataclass(frozen=True)
+class AtlasResult:
+    """An atlas: for every inverse a, path j and start i, the drift after each cycle.
+
+    Attributes
+    ----------
+    algorithms : tuple of str, length A
+    paths : ndarray, shape (P, L0, r)
+    parameter : ndarray, shape (N,) or None
+        Arc length s of each start on its path's self-motion curve (None: explicit starts).
+    starts : ndarray, shape (P, N, p)
+    drift : ndarray, shape (A, P, N, cycles)
+    leg_ends : ndarray, shape (A, P, N, cycles * L, p), or None when not kept
+    success : ndarray of bool, shape (A, P, N)
+    failures : dict
+        (a, j, i) -> why that run failed.
+    """
+
+    algorithms: tuple[str, ...]
+    paths: FloatArray
+    parameter: FloatArray | None
+    starts: FloatArray
+    drift: FloatArray
+    leg_ends: FloatArray | None
+    success: FloatArray
+    failures: dict[tuple[int, int, int], str]
+
+
+def iter_atlas(
+    plan: AtlasPlan,
+    backend: str | Backend | None = None,
+    cancelled: Callable[[], bool] | None = None,
+) -> Iterator[tuple[ChunkTask, AtlasChunk]]:
+    """The atlas's chunks, each with its task, in the order they finish.
+
+    The tasks are made as the backend asks for them and a finished chunk is handed on at once,
+    so memory holds a few chunks (the backend's in-flight bound), whatever ``plan.size``.
+
+    Raises
+    ------
+    RunCancelled
+        ``cancelled()`` returned True (polled after every chunk); work not yet done is dropped.
+    """
+    tasks = (chunk_task(plan, lo, min(lo + plan.chunk, plan.size))
+             for lo in range(0, plan.size, plan.chunk))  # fmt: skip
+    by_lo: dict[int, ChunkTask] = {}
+
+    def kept(items):
+        for task in items:
+            by_lo[task.lo] = task
+            yield task
+
+    with backend_for(backend) as runner:
+        for chunk in runner.imap_unordered(run_chunk, kept(tasks)):
+            yield by_lo.pop(chunk.lo), chunk
+            if cancelled is not None and cancelled():
+                raise RunCancelled(f"atlas cancelled after run {chunk.hi} of {plan.size}")
+
+
+def run_atlas(
+    plan: AtlasPlan,
+    backend: str | Backend | None = None,
+    *,
+    on_progress: Callable[[int, int], None] | None = None,
+    cancelled: Callable[[], bool] | None = None,
+    keep_leg_ends: bool = True,
+) -> AtlasResult:
+    """Run an atlas and gather it (memory: the result's arrays and a few chunks).
+
+    Parameters
+    ----------
+    plan : AtlasPlan
+        From :func:`jik.engine.atlas.plan_atlas`.
+    backend : str or Backend, optional
+        Where chunks run: None or "inprocess" (here), "processes:N" (a local process pool),
+        "dask:ADDRESS" or "dask:local:N" (a Dask cluster); see
+        :func:`jik.engine.atlas_backends.backend_for`. The numbers are the same on each.
+    on_progress : callable, optional
+        ``on_progress(runs_done, runs_total)`` after every chunk.
+    cancelled : callable, optional
+        Polled after every chunk; True stops the atlas with :class:`RunCancelled`.
+    keep_leg_ends : bool
+        Keep every leg's end (A P N cycles L p numbers); False keeps the drift alone.
+    """
+    A, P, N = len(plan.inverses), len(plan.paths), plan.n_starts
+    p = plan.inverses[0].kinematics.p
+    starts = np.empty((P * N, p))
+    drift = np.empty((A, P * N, plan.cycles))
+    legs = np.empty((A, P * N, plan.cycles * plan.legs, p)) if keep_leg_ends else None
+    success = np.empty((A, P * N), dtype=bool)
+    failures: dict[tuple[int, int, int], str] = {}
+    done = 0
+    for task, chunk in iter_atlas(plan, backend, cancelled):
+        sl = slice(chunk.lo, chunk.hi)
+        starts[sl], drift[:, sl], success[:, sl] = task.starts, chunk.drift, chunk.success
+        if legs is not None:
+            legs[:, sl] = chunk.leg_ends
+        for a, run, why in chunk.failures:
+            failures[(a, *divmod(run, N))] = why
+        done += chunk.hi - chunk.lo
+        if on_progress is not None:
+            on_progress(done, plan.size)
+    return AtlasResult(
+        plan.algorithms,
+        plan.paths,
+        plan.parameter(np.arange(N)),
+        starts.reshape(P, N, p),
+        drift.reshape(A, P, N, plan.cycles),
+        None if legs is None else legs.reshape(A, P, N, *legs.shape[2:]),
+        success.reshape(A, P, N),
+        failures,
+    )

@@ -1,0 +1,139 @@
+"""POST /atlas, GET /atlas/{id}, DELETE /atlas/{id}: atlas jobs through the API."""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import pytest
+from fastapi.testclient import TestClient
+
+from jik.app.api.factory import create_app
+from jik.app.compute.atlas_jobs import AtlasJobNotFound, AtlasJobs, AtlasLimits, plan_request
+from jik.app.compute.atlas_schemas import AtlasRequest
+from jik.engine.atlas_run import run_atlas
+from tests.app.conftest import messages
+
+LOOP = [[0.0, 1.0], [1.0, 1.0], [1.0, 2.0], [0.0, 2.0]]
+
+
+def body(**over) -> dict:
+    b = {"robot": {"name": "manipulator2"}, "path": LOOP, "starts": 6, "cycles": 2,
+         "arc": [-2.0, 2.0]}  # fmt: skip
+    b.update(over)
+    return b
+
+
+#: Large enough to be running when it is cancelled (about a minute of work on one core).
+LONG = body(starts=20000, cycles=5, arc=None)
+
+
+@pytest.fixture
+def app():
+    app = create_app()
+    app.state.atlas_jobs = AtlasJobs(AtlasLimits(max_jobs=3, per_client=1, workers=1))
+    yield app
+    app.state.atlas_jobs.close()
+
+
+@pytest.fixture
+def client(app):
+    return TestClient(app)
+
+
+def wait_until_ended(client, job_id: str, limit: float = 300.0) -> dict:
+    """Poll the job until it leaves queued/running (the limit only guards against a hang)."""
+    end = time.monotonic() + limit
+    while time.monotonic() < end:
+        r = client.get(f"/atlas/{job_id}")
+        assert r.status_code == 200, r.text
+        if r.json()["status"] not in ("queued", "running"):
+            return r.json()
+        time.sleep(0.2)
+    raise AssertionError(f"job {job_id} still running after {limit} s")
+
+
+def test_a_job_runs_to_its_result_and_outlives_its_request(app, client):
+    """202 with an id and a Location; another connection reads the result, which is the
+    engine's atlas of the same request (both algorithms, leg ends) to 1e-12."""
+    req = body(algorithms=["pseudoinverse", "extended"], leg_ends=True)
+    r = client.post("/atlas", json=req)
+    assert r.status_code == 202, r.text
+    job = r.json()
+    assert r.headers["location"] == f"/atlas/{job['id']}"
+    assert job["status"] in ("queued", "running") and job["runs"] == 6
+    done = wait_until_ended(TestClient(app), job["id"])
+    assert done["status"] == "done", done["error"]
+    assert done["progress"] == 1.0 and done["runs_done"] == 6
+    res = done["result"]
+    expected = run_atlas(plan_request(AtlasRequest.model_validate(req), AtlasLimits()))
+    np.testing.assert_allclose(res["starts"], expected.starts, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(res["parameter"], np.linspace(-2, 2, 6), rtol=0, atol=1e-15)
+    for a, alg in enumerate(("pseudoinverse", "extended")):
+        drift = np.array(res["drift"][alg], dtype=float)
+        np.testing.assert_allclose(drift, expected.drift[a], rtol=0, atol=1e-12)
+        np.testing.assert_allclose(np.array(res["leg_ends"][alg], dtype=float),
+                                   expected.leg_ends[a], rtol=0, atol=1e-12)  # fmt: skip
+    assert np.min(res["drift"]["pseudoinverse"]) > 1e-3
+    assert np.nanmax(np.array(res["drift"]["extended"], dtype=float)) < 1e-8
+
+
+def test_delete_cancels_a_running_job_and_forgets_it(client):
+    job = client.post("/atlas", json=LONG).json()
+    assert client.delete(f"/atlas/{job['id']}").status_code == 204
+    r = client.get(f"/atlas/{job['id']}")
+    assert r.status_code == 404
+    assert "no atlas job" in r.json()["detail"]
+    # the client's slot is free again
+    again = client.post("/atlas", json=body())
+    assert again.status_code == 202, again.text
+
+
+def test_one_client_may_run_one_job_at_a_time_here(client):
+    first = client.post("/atlas", json=LONG).json()
+    r = client.post("/atlas", json=body())
+    assert r.status_code == 429
+    assert r.headers["retry-after"] == "10"
+    assert "at most 1 atlas jobs per client" in r.json()["detail"]
+    client.delete(f"/atlas/{first['id']}")
+
+
+@pytest.mark.parametrize(
+    ("over", "field", "text"),
+    [
+        ({"starts": 20001}, "starts", "less than or equal to 20000"),
+        ({"starts": 20000, "cycles": 50, "algorithms": ["pseudoinverse", "extended"]}, "starts",
+         "legs x algorithms = 8000000 is more than 1200000"),
+        ({"starts": 20000, "cycles": 3, "leg_ends": True}, "leg_ends",
+         "the ends of 240000 legs are more than the 200000"),
+        ({"path": [[0.0, 1.0], [1.0, 1.0, 2.0]]}, "path", "must have 2 components, got 3"),
+        ({"arc": [1.0, 2.0]}, "arc", "lo <= 0 <= hi"),
+        ({"path": [[0.0, 1.0]]}, "path", "at least 2 items"),
+    ],
+)  # fmt: skip
+def test_bad_or_too_large_requests_are_422_naming_the_field(client, over, field, text):
+    r = client.post("/atlas", json=body(**over))
+    assert any(text in m for m in messages(r)), r.text
+    assert r.json()["detail"][0]["loc"][1] == field
+
+
+def test_unknown_job_is_404(client):
+    assert client.get("/atlas/nope").status_code == 404
+    assert client.delete("/atlas/nope").status_code == 404
+
+
+def test_ended_jobs_are_dropped_after_keep_for():
+    jobs = AtlasJobs(AtlasLimits(keep_for=0.0, workers=1))
+    job = jobs.start("me", AtlasRequest.model_validate(body(starts=2, cycles=1)))
+    end = time.monotonic() + 300
+    while job.ended is None and time.monotonic() < end:
+        time.sleep(0.1)
+    assert job.status == "done"
+    with pytest.raises(AtlasJobNotFound):
+        jobs.get(job.id)
+
+
+def test_reference_must_be_a_configuration(client):
+    r = client.post("/atlas", json=body(reference=[0.0, math.pi / 2]))
+    assert "reference: must have 3 components, got 2" in messages(r)

@@ -1,0 +1,111 @@
+"""`jik atlas` writes what issue 30 promises: inputs, starts, per algorithm drift and leg ends,
+a CSV for large atlases, a figure, and errors that name the input."""
+
+import csv
+import json
+import math
+
+import numpy as np
+import pytest
+
+from jik import atlas_cli
+from jik.cli import main
+from jik.engine.augmentations import PaperCubic
+from jik.engine.inverses import ExtendedInverse, Pseudoinverse
+from jik.engine.kinematics import Manipulator2
+from jik.engine.repeatability import repeatability
+
+TABLE1 = "1,1; 1,2; 0,2; 0,1"
+
+
+def run(tmp_path, *extra, out="atlas.json"):
+    argv = ["atlas", "--robot", "manipulator2", "--path", TABLE1, "--starts", "12", "--cycles",
+            "2", "--quiet", "--out", str(tmp_path / out), *extra]  # fmt: skip
+    assert main(argv) == 0
+    return json.loads((tmp_path / out).read_text())
+
+
+def test_json_holds_inputs_starts_drift_and_leg_ends(tmp_path):
+    """Both algorithms on Table 1's loop from (1, 1): every run is repeatability() from its
+    start (to 1e-10), and the starts lie on k(x) = (1, 1)."""
+    doc = run(tmp_path, "--algorithm", "pseudoinverse", "--algorithm", "extended", "--csv")
+    assert doc["inputs"]["robot"] == "manipulator2" and doc["inputs"]["cycles"] == 2
+    assert doc["inputs"]["algorithms"] == ["pseudoinverse", "extended"]
+    assert doc["legs_per_cycle"] == 4
+    starts = np.array(doc["starts"])
+    assert starts.shape == (12, 3) and len(doc["parameter"]) == 12
+    kin = Manipulator2()
+    np.testing.assert_allclose(kin.forward(starts), np.ones((12, 2)), rtol=0, atol=1e-13)
+    path = [(1.0, 2.0), (0.0, 2.0), (0.0, 1.0)]
+    for alg, inverse in (("pseudoinverse", Pseudoinverse(kin)),
+                         ("extended", ExtendedInverse(kin, PaperCubic()))):  # fmt: skip
+        res = doc["results"][alg]
+        assert np.shape(res["drift"]) == (12, 2) and np.shape(res["leg_ends"]) == (12, 8, 3)
+        for i in (0, 7):
+            one = repeatability(inverse, starts[i], path, cycles=2)
+            assert res["success"][i] == one.success
+            if one.success:
+                np.testing.assert_allclose(res["drift"][i], one.drift, rtol=0, atol=1e-10)
+                np.testing.assert_allclose(res["leg_ends"][i], one.legs, rtol=0, atol=1e-10)
+    rows = list(csv.DictReader((tmp_path / doc["csv"]).open()))
+    assert len(rows) == 12
+    assert float(rows[7]["pseudoinverse_drift_2"]) == pytest.approx(
+        doc["results"]["pseudoinverse"]["drift"][7][1], abs=1e-15
+    )
+    assert float(rows[7]["x3"]) == pytest.approx(starts[7, 2], abs=1e-15)
+    assert (tmp_path / doc["figure"]).read_text().count("Repeatability atlas") >= 1
+
+
+def test_a_large_atlas_streams_to_csv_and_the_json_keeps_a_summary(tmp_path, monkeypatch):
+    """Past JSON_RUNS the arrays go to the CSV, in run order, whatever order chunks finish in."""
+    monkeypatch.setattr(atlas_cli, "JSON_RUNS", 10)
+    doc = run(tmp_path, "--chunk", "5", "--shift", "0,0", "--shift", "0.2,0", "--no-figure",
+              "--no-leg-ends")  # fmt: skip
+    assert "results" not in doc and doc["figure"] is None
+    assert doc["summary"]["pseudoinverse"]["converged_runs"] == 24
+    assert len(doc["paths"]) == 2
+    rows = list(csv.DictReader((tmp_path / doc["csv"]).open()))
+    assert not any("leg" in name for name in rows[0])
+    assert [(int(r["path"]), int(r["start"])) for r in rows] == [
+        (j, i) for j in range(2) for i in range(12)
+    ]
+    drift = np.array([[float(r[f"pseudoinverse_drift_{c}"]) for c in (1, 2)] for r in rows])
+    assert np.nanmax(drift) == pytest.approx(max(doc["summary"]["pseudoinverse"]["max_drift"]))
+
+
+def test_processes_give_the_in_process_numbers(tmp_path):
+    here = run(tmp_path, "--no-figure", out="a.json")
+    there = run(tmp_path, "--no-figure", "--processes", "2", "--chunk", "4", out="b.json")
+    assert there["inputs"]["backend"] == "processes:2"
+    np.testing.assert_allclose(
+        there["results"]["pseudoinverse"]["drift"], here["results"]["pseudoinverse"]["drift"],
+        rtol=0, atol=1e-12,
+    )  # fmt: skip
+
+
+def test_arc_and_sampling_set_the_starts(tmp_path):
+    """--arc lo,hi on a grid: s from lo to hi; on Manipulator 2, s = sqrt(2) (x3 - x3_base)."""
+    doc = run(tmp_path, "--arc=-1,1", "--no-figure")
+    np.testing.assert_allclose(doc["parameter"], np.linspace(-1, 1, 12), atol=1e-15)
+    x3 = np.array(doc["starts"])[:, 2]
+    np.testing.assert_allclose(np.diff(x3), np.diff(doc["parameter"]) / math.sqrt(2), atol=1e-10)
+
+
+@pytest.mark.parametrize(
+    ("extra", "text"),
+    [
+        (["--dask", "local:0"], "local Dask cluster is 'local:N'"),
+        (["--cycles", "0"], "cycles must be between 1 and 1000, got 0 (cycles)"),
+        (["--arc", "1,2"], "lo <= 0 <= hi"),
+    ],
+)
+def test_bad_input_exits_2_and_names_it(tmp_path, capsys, extra, text):
+    argv = ["atlas", "--path", TABLE1, "--quiet", "--out", str(tmp_path / "x.json"), *extra]
+    assert main(argv) == 2
+    assert text in capsys.readouterr().err
+    assert not (tmp_path / "x.json").exists()
+
+
+def test_a_path_that_is_not_numbers_is_refused(tmp_path):
+    with pytest.raises(SystemExit, match="--path must be comma-separated numbers"):
+        main(["atlas", "--path", "1,a; 2,2", "--out", str(tmp_path / "x.json")])
