@@ -3,7 +3,7 @@
 // and draws its panels; the 3D scene (iframe, viser) shows and changes the same session.
 import { change, endOnClose, follow, openSession, session, api } from "./api.js";
 import { showControls } from "./controls.js";
-import { $, fmt } from "./dom.js";
+import { $, el, fmt } from "./dom.js";
 import { applyFunctionals, drawFigures, layoutPanels, markStale, onAhead } from "./panels.js";
 
 const page = { config: null, state: null, shown: 0 };
@@ -54,33 +54,46 @@ async function onResult(msg) {
   document.body.dataset.robot = msg.state.robot;
   showProgress(1, 0);
   renderVerdict(msg);
+  $("#panels").classList.remove("outdated");
+  delete document.body.dataset.failed;
   const t = msg.timing;
   $("#timing").textContent = `generation ${msg.generation}: compute ${Math.round(1000 * t.compute)} ms, figures ${Math.round(1000 * t.figures)} ms`;
   setStatus(msg.generation < session.generation ? `computing generation ${session.generation}…` : `up to date (generation ${msg.generation})`);
 }
 
+// The verdict: the server's sentences about this result (app/dashboard/verdict.py), each
+// coloured by the algorithm it is about.
 function renderVerdict(msg) {
-  const p = msg.summary.pseudoinverse;
-  const e = msg.summary.extended;
   const box = $("#verdict");
-  const fail = [p, e].filter((s) => !s.success).map((s) => s.message);
-  if (msg.state.task === "path" && p.drift.length && e.drift.length) {
-    const n = Math.min(p.drift.length, e.drift.length);
-    box.innerHTML = `After <b>${n}</b> cycle${n > 1 ? "s" : ""} of the closed path, the joints of the
-      <b class="p">pseudoinverse</b> end <b class="p">${fmt(p.drift[n - 1])}</b> away from x0 and the drift grows each cycle;
-      the <b class="e">extended Jacobian</b> returns to within <b class="e">${fmt(e.drift[n - 1])}</b>.
-      <span class="why">Why: J<sup>P#</sup> picks the minimum-norm joint velocity, which has no memory of the start, so a
-      closed task path need not close in the joints. J<sup>E#</sup> adds the equation h(x) = h(x0) (h changed by
-      ${e.h_change === null ? "—" : fmt(e.h_change)} along its run): each task point then has one configuration on that level set,
-      so closed task paths give closed joint paths.</span>`;
-  } else if (!fail.length) {
-    box.innerHTML = `Both algorithms drive the task error to the target: <b class="p">pseudoinverse</b> ${p.message};
-      <b class="e">extended Jacobian</b> ${e.message}.
-      <span class="why">The extended Jacobian keeps h constant (eq. (12)); compare the paths and the controls.</span>`;
-  } else {
-    box.innerHTML = `<b class="p">pseudoinverse</b>: ${p.message}. <b class="e">extended Jacobian</b>: ${e.message}.`;
-  }
-  if (fail.length) box.innerHTML += ` <span class="error">Stopped: ${fail.join(" · ")}</span>`;
+  box.classList.remove("failed");
+  box.replaceChildren(...msg.verdict.map((s) => el("p", {
+    className: [s.role, s.algorithm ? ALGORITHM_CLASS[s.algorithm] : ""].join(" ").trim(),
+  }, s.text)));
+}
+const ALGORITHM_CLASS = { pseudoinverse: "p", extended: "e" };
+
+// A state in a few words: which result a failure leaves on screen.
+function describe(state) {
+  const params = Object.entries(state.robot_parameters)
+    .map(([k, v]) => `${k} = ${Array.isArray(v) ? `(${v.map((x) => fmt(x, 2)).join(", ")})` : fmt(v, 2)}`);
+  return [state.robot, `${state.mode} mode`, `γ = ${fmt(state.gamma)}`, ...params, state.task === "path" ? `closed path, ${state.cycles} cycles` : "single target"].join(", ");
+}
+
+// A generation that failed: its message where the result would be, and which result (if any)
+// the plots still show, dimmed.
+function onError(msg) {
+  if (msg.generation !== session.generation) return;
+  showProgress(1, 0);
+  setStatus(`generation ${msg.generation} failed`, true);
+  document.body.dataset.failed = msg.generation;
+  const box = $("#verdict");
+  box.classList.add("failed");
+  const shown = msg.shown && page.shown ? `The plots below still show generation ${msg.shown.generation} (${describe(msg.shown.state)}), not the controls' values.` : "No result is on screen.";
+  box.replaceChildren(
+    el("p", { className: "failure", id: "failure" }, `Generation ${msg.generation} failed: ${msg.message}`),
+    el("p", { className: "still", id: "still-shown" }, shown),
+  );
+  $("#panels").classList.add("outdated");
 }
 
 // ---------------------------------------------------------------- the session and its link
@@ -154,7 +167,7 @@ async function main() {
     result: serial(onResult),
     functionals: serial((msg) => (msg.generation === page.shown ? applyFunctionals(msg) : null)),
     ahead: (msg) => { onAhead(msg, () => page.state && page.state.robot).catch((err) => console.warn("drawing ahead:", err)); },
-    error: (msg) => { if (msg.generation === session.generation) { showProgress(1, 0); setStatus(msg.message, true); } },
+    error: serial(onError),
   }, lost);
   endOnClose();
 }
