@@ -37,10 +37,17 @@ function drawTable(div, fig) {
     })));
   }
   const title = (fig.layout.title && fig.layout.title.text) || "";
+  const meta = fig.layout.meta || {};
+  // Cells that differ from the paper's printed value: marked, the printed value on hover.
+  for (const [col, row, printed] of meta.differs || []) {
+    const td = body[row] && body[row].children[col];
+    if (td) { td.classList.add("differs"); td.title = `printed: ${printed}`; }
+  }
   div.classList.add("html-table");
   div.replaceChildren(
     el("h3", { className: "table-title" }, title),
     el("div", { className: "table-scroll" }, el("table", {}, el("thead", {}, head), el("tbody", {}, ...body))),
+    ...(meta.notes || []).map((n) => el("p", { className: "table-note" }, n)),
   );
 }
 

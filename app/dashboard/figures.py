@@ -34,7 +34,7 @@ from jik.app.dashboard.plotting import (
     units,
 )
 from jik.app.dashboard.runs import DashboardResult
-from jik.engine.reproductions.table1 import cell
+from jik.app.dashboard.table import table_spec
 
 
 def _task_space(result: DashboardResult) -> dict:
@@ -164,36 +164,9 @@ def _drift(result: DashboardResult) -> dict:
 
 
 def _table(result: DashboardResult) -> dict:
-    """The configuration after every leg for both algorithms, as in Table 1 of the paper."""
-    names = result.variable_names
-    L = len(result.targets)
-    legs = leg_names(L)
-    rows = max(len(result.runs[a].leg_end) for a in ALGORITHMS)
-    point = ["start x0"] + [
-        f"{c // L + 1}: {legs[c % L]} {_fmt_point(result.targets[c % L])}" for c in range(rows)
-    ]
-    cols: list[list[str]] = [point]
-    header = ["cycle: point"]
-    for a in ALGORITHMS:
-        ends = np.vstack([np.asarray(result.state.x0)[None, :], result.runs[a].leg_end])
-        for k, name in enumerate(names):
-            header.append(f"{'J^P#' if a == 'pseudoinverse' else 'J^E#'} {name}")
-            cols.append([cell(v, 0) for v in ends[:, k]] + [""] * (rows + 1 - len(ends)))
-    fills = ["#f4f4f4"] + ["#fbe3e3" if h.startswith("J^P#") else "#e1ecf7" for h in header[1:]]
-    table = trace("table",
-        # (fill=dict(color=...): plotly.py's "fill_color" shorthand is expanded only by its
-        # validation, which the builders skip; the page reads fill.color)
-        header=dict(values=header, fill=dict(color=fills), font=dict(size=11), align="center"),
-        cells=dict(values=cols, font=dict(size=11, family="monospace"), align="right",
-                   fill=dict(color=[["white", "#f7f7f7"] * (rows + 1)])),
-    )  # fmt: skip
-    return figure(
-        [table], "Configurations after each leg (Table 1)", margin=dict(l=10, r=10, t=40, b=10)
-    )
-
-
-def _fmt_point(p) -> str:
-    return "(" + ", ".join(f"{v:.3g}" for v in p) + ")"
+    """Table 1 of the paper beside jik's numbers, or the table of leg ends
+    (:mod:`jik.app.dashboard.table`)."""
+    return table_spec(result)
 
 
 def _platform(result: DashboardResult, max_paths: int = 12) -> dict:
