@@ -2,7 +2,7 @@
 // builds its controls from the session's control specification, follows the session's events
 // and draws its panels; the 3D scene (iframe, viser) shows and changes the same session.
 import { change, endOnClose, follow, openSession, session, api } from "./api.js";
-import { showControls } from "./controls.js";
+import { showControls, showRefusal } from "./controls.js";
 import { $, el, fmt } from "./dom.js";
 import { applyFunctionals, drawFigures, layoutPanels, markStale, onAhead } from "./panels.js";
 
@@ -43,6 +43,7 @@ function onRefused(msg) {
   onState(msg, true);
   const where = msg.source === "scene" ? "in the 3D scene" : "here";
   setStatus(`refused (${where}): ${msg.message}`, true);
+  if (msg.field) showRefusal(msg.field, msg.message);
 }
 
 async function onResult(msg) {

@@ -172,7 +172,9 @@ def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
     for key, value in patch.items():
         head, _, rest = key.partition(".")
         if not rest:
-            out[key] = parse_path_text(value) if key == "path" and isinstance(value, str) else value
+            text = key == "path" and isinstance(value, str)
+            size = len(state.target) if "robot" not in patch else None
+            out[key] = parse_path_text(value, size) if text else value
         elif head in ("robot_parameters", "augmentation_parameters"):
             out.setdefault(head, {})[rest] = value
         elif head in ("x0", "target") and rest.isdigit():
@@ -198,20 +200,26 @@ def _number(v: float) -> str:
     return text[:-2] if text.endswith(".0") else text
 
 
-def parse_path_text(text: str) -> list[list[float]]:
-    """The points of a path written as :data:`PATH_FORMAT`."""
+def parse_path_text(text: str, size: int | None = None) -> list[list[float]]:
+    """The points of a path written as :data:`PATH_FORMAT`; ``size``: the task's dimension,
+    which every point must have. A refusal quotes the point as the user wrote it."""
     points = []
-    for part in text.split(";"):
-        if not part.strip():
-            continue
+    parts = [p for p in text.split(";") if p.strip()]
+    for k, part in enumerate(parts, start=1):
+        where = f"point {k} of {len(parts)}, '{part.strip()}',"
         try:
             point = [float(v) for v in part.split(",")]
         except ValueError:
             raise InvalidInputError(
-                f"path must be written '{PATH_FORMAT}', got {text!r}", "path"
+                f"path: {where} is not numbers separated by ',' (write '{PATH_FORMAT}')", "path"
             ) from None
         if not all(math.isfinite(v) for v in point):
-            raise InvalidInputError("path must have finite coordinates", "path")
+            raise InvalidInputError(f"path: {where} has a coordinate that is not finite", "path")
+        if size is not None and len(point) != size:
+            raise InvalidInputError(
+                f"path: {where} has {len(point)} coordinate{'s' if len(point) > 1 else ''}; "
+                f"each point needs {size} (write '{PATH_FORMAT}')", "path",
+            )  # fmt: skip
         points.append(point)
     return points
 
