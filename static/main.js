@@ -6,7 +6,7 @@ import { showControls, showRefusal } from "./controls.js";
 import { $, el, fmt } from "./dom.js";
 import { applyFunctionals, drawFigures, layoutPanels, markStale, onAhead } from "./panels.js";
 
-const page = { config: null, state: null, shown: 0 };
+const page = { config: null, state: null, shown: 0, shownState: null };
 const send = (patch) => { setNotice(""); change(patch, (message) => setStatus(message, true)); };
 
 function setStatus(text, error = false) {
@@ -24,7 +24,10 @@ function setNotice(text) {
 
 // Only computations running longer than the server's progress_after get a progress bar.
 function showProgress(fraction, elapsed) {
-  $("#progress").hidden = !(elapsed > page.config.progress_after && fraction < 1);
+  const busy = elapsed > page.config.progress_after && fraction < 1;
+  $("#progress-box").hidden = !busy;
+  $("#panels").classList.toggle("pending", busy); // (the plots are the previous result's)
+  $("#cancel").disabled = !page.shownState;
   $("#progress-bar").style.width = `${Math.round(100 * fraction)}%`;
   $("#progress-text").textContent = `computing ${Math.round(100 * fraction)}%`;
 }
@@ -51,6 +54,7 @@ async function onResult(msg) {
   await drawFigures(msg.figures, msg.digests, msg.state.robot);
   markStale(msg.stale || []);
   page.shown = msg.generation;
+  page.shownState = msg.state;
   document.body.dataset.generation = msg.generation;
   document.body.dataset.robot = msg.state.robot;
   showProgress(1, 0);
@@ -59,7 +63,9 @@ async function onResult(msg) {
   delete document.body.dataset.failed;
   const t = msg.timing;
   $("#timing").textContent = `generation ${msg.generation}: compute ${Math.round(1000 * t.compute)} ms, figures ${Math.round(1000 * t.figures)} ms`;
-  setStatus(msg.generation < session.generation ? `computing generation ${session.generation}…` : `up to date (generation ${msg.generation})`);
+  const note = page.cancelled ? `; generation ${page.cancelled.running} was cancelled` : "";
+  page.cancelled = null;
+  setStatus(msg.generation < session.generation ? `computing generation ${session.generation}…` : `up to date (generation ${msg.generation})${note}`);
 }
 
 // The verdict: the server's sentences about this result (app/dashboard/verdict.py), each
@@ -95,6 +101,18 @@ function onError(msg) {
     el("p", { className: "still", id: "still-shown" }, shown),
   );
   $("#panels").classList.add("outdated");
+}
+
+// Cancel the computation in progress: the session goes back to the values of the result on
+// screen (a newer generation stops the running one between legs; that result is cached).
+function cancel() {
+  const running = session.generation;
+  const back = page.shown;
+  $("#progress-box").hidden = true;
+  setNotice("");
+  change(page.shownState, (message) => setStatus(message, true));
+  setStatus(`cancelled generation ${running}; back to the values of generation ${back}`, true);
+  page.cancelled = { running, back };
 }
 
 // ---------------------------------------------------------------- the session and its link
@@ -157,6 +175,7 @@ async function main() {
   $("#export-json").href = api("/export.json");
   $("#export-csv").href = api("/export.csv");
   $("#copy-link").addEventListener("click", copyLink);
+  $("#cancel").addEventListener("click", cancel);
   onState(opened);
   showScene(opened.scene);
   let chain = Promise.resolve(); // results and their second phases are drawn in order

@@ -22,6 +22,7 @@ from typing import Any
 
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS, robot_spec
+from jik.engine.solver import MAX_ITERATIONS, MAX_STEPS
 
 #: gamma's range per mode: the decay rate of eq. (5) (continuous), the step of the discrete
 #: iteration, which converges only for 0 < gamma < 2.
@@ -32,6 +33,8 @@ GAMMA_STEP = 0.001
 DISCRETE_GAMMA_ON_SWITCH = 1.0
 #: Largest number of cycles offered by the dashboard (the engine accepts more).
 MAX_DASHBOARD_CYCLES = 20
+#: The range of the cap on iterations (or integrator steps) per leg.
+MIN_ITERATIONS, MAX_ITERATIONS_CAP = 10, 200_000
 #: Positions of a slider between its ends (x0's: finer).
 SLIDER_STEPS, X0_STEPS = 200, 400
 #: How a closed path is written in a text box: points separated by ';', coordinates by ','.
@@ -91,6 +94,7 @@ def controls(state) -> list[Control]:
                 "decay rate of the task error, eq. (5) (discrete mode: the step, below 2)",
                 minimum=lo, maximum=hi, step=GAMMA_STEP, log=True),
     ]  # fmt: skip
+    out.append(iterations_control(state))
     for p in spec.parameters:
         out.append(Control(f"robot_parameters.{p.name}", p.name, "slider", "algorithm",
                            p.description, minimum=p.minimum, maximum=p.maximum,
@@ -136,6 +140,24 @@ def controls(state) -> list[Control]:
     return out
 
 
+def iterations_control(state) -> Control:
+    """The cap on each leg's iterations (discrete mode) or integrator steps (continuous), which
+    a leg that does not converge names in its message."""
+    what = "iterations" if state.mode == "discrete" else "integrator steps"
+    return Control("max_iterations", f"max {what} per leg", "slider", "algorithm",
+                   f"a leg that has not reached its target after this many {what} stops and "
+                   "says so (raise it for far targets or small γ; the work grows with it)",
+                   minimum=MIN_ITERATIONS, maximum=MAX_ITERATIONS_CAP, step=1, log=True,
+                   integer=True)  # fmt: skip
+
+
+def max_iterations(state) -> int:
+    """The cap in force: the state's, or the engine's default for its mode."""
+    if state.max_iterations is not None:
+        return int(state.max_iterations)
+    return MAX_ITERATIONS if state.mode == "discrete" else MAX_STEPS
+
+
 def element_id(key: str) -> str:
     """The page's element id of the control ``key``: ``ctl-gamma``, ``ctl-x0-1``, ``ctl-l``
     (a robot parameter), ``ctl-aug-a`` (a parameter of the map)."""
@@ -151,7 +173,10 @@ def control_values(state, spec: list[Control] | None = None) -> dict[str, Any]:
     for c in controls(state) if spec is None else spec:
         if c.kind == "preset":
             continue
-        values[c.key] = path_text(state.path) if c.key == "path" else lookup(d, c.key)
+        if c.key == "max_iterations":
+            values[c.key] = max_iterations(state)
+        else:
+            values[c.key] = path_text(state.path) if c.key == "path" else lookup(d, c.key)
     return values
 
 

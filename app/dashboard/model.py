@@ -24,7 +24,13 @@ from jik.app.compute.schemas import (
     Mode,
     Tolerance,
 )
-from jik.app.dashboard.controls import MAX_DASHBOARD_CYCLES, expand
+from jik.app.dashboard.controls import (
+    MAX_DASHBOARD_CYCLES,
+    MAX_ITERATIONS_CAP,
+    MIN_ITERATIONS,
+    expand,
+    max_iterations,
+)
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS, robot_spec
 from jik.engine.repeatability import MAX_PATH_POINTS
@@ -61,6 +67,11 @@ class DashboardState(BaseModel):
     path: Annotated[tuple[Point, ...], Field(max_length=MAX_PATH_POINTS)]
     cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_DASHBOARD_CYCLES)]
     tolerance: Tolerance = 1e-10
+    #: Cap on each leg's iterations (discrete) or integrator steps (continuous); None: the
+    #: engine's default (:func:`jik.engine.solver.solve`).
+    max_iterations: (
+        Annotated[int, Field(strict=True, ge=MIN_ITERATIONS, le=MAX_ITERATIONS_CAP)] | None
+    ) = None
 
     def as_dict(self) -> dict:
         """The state as JSON data (tuples as lists)."""
@@ -158,7 +169,10 @@ def validate(data: Mapping[str, Any]) -> DashboardState:
         raise InvalidInputError(
             f"gamma: must be < 2 in discrete mode, got {state.gamma:g}", "gamma"
         )
+    # The engine's default cap, set by its value, is the default (None): it follows the mode.
+    default_cap = max_iterations(state.model_copy(update={"max_iterations": None}))
     return state.model_copy(update={
+        "max_iterations": None if state.max_iterations == default_cap else state.max_iterations,
         "robot_parameters": {k: tuple(v) if isinstance(v, list | tuple) else v
                              for k, v in params.items()},
         "augmentation_parameters": aug_params,
