@@ -4,7 +4,7 @@
 import { change, endOnClose, follow, openSession, session, api } from "./api.js";
 import { showControls, showRefusal } from "./controls.js";
 import { $, el, fmt } from "./dom.js";
-import { applyFunctionals, drawFigures, layoutPanels, markStale, onAhead } from "./panels.js";
+import { algorithmKey, applyFunctionals, drawFigures, layoutPanels, markStale, onAhead, setExportNote } from "./panels.js";
 
 const page = { config: null, state: null, shown: 0, shownState: null };
 const send = (patch) => { setNotice(""); change(patch, (message) => setStatus(message, true)); };
@@ -55,6 +55,7 @@ async function onResult(msg) {
   markStale(msg.stale || []);
   page.shown = msg.generation;
   page.shownState = msg.state;
+  setExportNote(`jik · generation ${msg.generation} · ${describe(msg.state)}`);
   document.body.dataset.generation = msg.generation;
   document.body.dataset.robot = msg.state.robot;
   showProgress(1, 0);
@@ -168,7 +169,8 @@ function lost() {
 async function main() {
   page.config = await fetch("/api/dashboard/config").then((r) => r.json());
   for (const [a, c] of Object.entries(page.config.colors)) document.documentElement.style.setProperty(`--${a}`, c);
-  layoutPanels(page.config.panels);
+  layoutPanels(page.config.panels, page.config);
+  $("#legend").replaceChildren(algorithmKey(true));
   $("#controls").addEventListener("submit", (ev) => ev.preventDefault()); // (Enter in a box)
   const opened = await openSession(stateFromUrl(),
     (message) => setNotice(`the link's state was refused (${message}); showing the defaults`));

@@ -20,6 +20,7 @@ from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from typing import Any
 
+from jik.app.dashboard.glossary import SYMBOLS
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS, robot_spec
 from jik.engine.solver import MAX_ITERATIONS, MAX_STEPS
@@ -90,19 +91,18 @@ def controls(state) -> list[Control]:
         Control("mode", "mode", "select", "algorithm",
                 "continuous: the ODE (7); discrete: the iteration x <- x - gamma J# e",
                 options=tuple((m, m) for m in MODES)),
-        Control("gamma", "γ (decay rate)", "slider", "algorithm",
-                "decay rate of the task error, eq. (5) (discrete mode: the step, below 2)",
+        Control("gamma", "γ (decay rate)", "slider", "algorithm", SYMBOLS["gamma"],
                 minimum=lo, maximum=hi, step=GAMMA_STEP, log=True),
     ]  # fmt: skip
     out.append(iterations_control(state))
     for p in spec.parameters:
         out.append(Control(f"robot_parameters.{p.name}", p.name, "slider", "algorithm",
-                           p.description, minimum=p.minimum, maximum=p.maximum,
+                           explained(p.name, p.description), minimum=p.minimum, maximum=p.maximum,
                            step=(p.maximum - p.minimum) / SLIDER_STEPS))  # fmt: skip
     for v in spec.vector_parameters:
         out.append(Control(f"robot_parameters.{v.name}", v.name, "vector", "algorithm",
-                           v.description, minimum=list(v.minimum), maximum=list(v.maximum),
-                           step=0.1, size=len(v.default)))  # fmt: skip
+                           explained(v.name, v.description), minimum=list(v.minimum),
+                           maximum=list(v.maximum), step=0.1, size=len(v.default)))  # fmt: skip
         for name, preset in v.presets.items():
             shown = ", ".join(f"{t:.2f}" for t in preset)
             out.append(Control(f"robot_parameters.{v.name}", f"{v.name} = {name} ({shown})",
@@ -110,17 +110,17 @@ def controls(state) -> list[Control]:
                                value=[float(t) for t in preset],
                                id=f"ctl-preset-{v.name}-{name}"))  # fmt: skip
     out.append(Control("augmentation", "augmenting map h", "select", "algorithm",
-                       "the map h of the extended Jacobian (11)",
+                       SYMBOLS["h"] + "; the menu lists the paper's maps for this robot",
                        options=tuple((a.name, f"{a.name} {a.equation}")
                                      for a in spec.augmentations)))  # fmt: skip
     for p in aug.parameters:
         out.append(Control(f"augmentation_parameters.{p.name}", p.name, "slider", "algorithm",
-                           p.description, minimum=p.minimum, maximum=p.maximum,
+                           explained(p.name, p.description), minimum=p.minimum, maximum=p.maximum,
                            step=(p.maximum - p.minimum) / SLIDER_STEPS))  # fmt: skip
     for i, name in enumerate(spec.variable_names):
         lo, hi = spec.x_range[i] if spec.x_range else (-10.0, 10.0)
         out.append(Control(f"x0.{i}", f"x0: {name}", "slider", "start",
-                           f"start configuration, coordinate {name}",
+                           f"start configuration, coordinate {name}. {SYMBOLS['x0']}",
                            minimum=lo, maximum=hi, step=(hi - lo) / X0_STEPS))  # fmt: skip
     if spec.default_path:
         out.append(Control("task", "task", "select", "start",
@@ -138,6 +138,11 @@ def controls(state) -> list[Control]:
                            f"target task point ({', '.join(spec.task_names)})",
                            step=0.1, size=len(spec.task_names)))  # fmt: skip
     return out
+
+
+def explained(name: str, description: str) -> str:
+    """A parameter's description from the registry, with the paper's symbol explained."""
+    return f"{description}. {SYMBOLS[name]}" if name in SYMBOLS else description
 
 
 def iterations_control(state) -> Control:

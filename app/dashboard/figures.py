@@ -17,7 +17,7 @@ import numpy as np
 import plotly.graph_objects as go
 
 from jik.app.dashboard.map_figures import augmenting_spec, sensitivity_spec
-from jik.app.dashboard.model import ALGORITHMS, COLORS, LABELS
+from jik.app.dashboard.model import ALGORITHMS, COLORS, DASH, LABELS
 from jik.app.dashboard.plotting import (
     NO_LEGEND,
     SYMBOLS,
@@ -27,6 +27,7 @@ from jik.app.dashboard.plotting import (
     leg_names,
     log_range,
     nice_range,
+    norm_unit,
     stacked_axes,
     theta_label,
     to_go,
@@ -48,7 +49,7 @@ def _task_space(result: DashboardResult) -> dict:
             trace("scatter",
                 x=run.y[:, 0], y=run.y[:, 1], mode="lines", name=LABELS[a],
                 line=dict(color=COLORS[a], width=4 if a == "pseudoinverse" else 1.8,
-                          dash="solid" if a == "pseudoinverse" else "dash"),
+                          dash=DASH[a]),
                 customdata=run.leg + 1,  # (theta stays out: this panel does not depend on gamma)
                 hovertemplate=f"{n1} = %{{x:.4f}}<br>{n2} = %{{y:.4f}}"
                 "<br>leg %{customdata}<extra>" + a + "</extra>",
@@ -94,7 +95,8 @@ def _joints(result: DashboardResult) -> dict:
             data.append(
                 trace("scatter",
                     x=run.theta, y=run.x[:, k], mode="lines", name=LABELS[a],
-                    legendgroup=a, showlegend=k == 0, line=dict(color=COLORS[a], width=1.8),
+                    legendgroup=a, showlegend=k == 0,
+                    line=dict(color=COLORS[a], width=1.8, dash=DASH[a]),
                     xaxis="x", yaxis="y" if k == 0 else f"y{k + 1}",
                     hovertemplate=f"{name} = %{{y:.5f}}<br>θ = %{{x:.4g}}<extra>{a}</extra>",
                 )
@@ -128,7 +130,8 @@ def _drift(result: DashboardResult) -> dict:
             data.append(
                 trace("scatter",
                     x=np.arange(1, len(run.drift) + 1), y=np.maximum(run.drift, 1e-16),
-                    mode="lines+markers", name=LABELS[a], line=dict(color=COLORS[a], width=2),
+                    mode="lines+markers", name=LABELS[a],
+                    line=dict(color=COLORS[a], width=2, dash=DASH[a]),
                     marker=dict(symbol=SYMBOLS[a], size=9),
                     hovertemplate="cycle %{x}: drift %{y:.3e}<extra>" + a + "</extra>",
                 )
@@ -137,7 +140,7 @@ def _drift(result: DashboardResult) -> dict:
             data.append(
                 trace("scatter",
                     x=run.theta, y=np.maximum(run.error, 1e-16), mode="lines", name=LABELS[a],
-                    line=dict(color=COLORS[a], width=2),
+                    line=dict(color=COLORS[a], width=2, dash=DASH[a]),
                     hovertemplate="‖k(x) − y_d‖ = %{y:.3e}<br>θ = %{x:.4g}<extra>" + a + "</extra>",
                 )
             )  # fmt: skip
@@ -149,7 +152,8 @@ def _drift(result: DashboardResult) -> dict:
             "Repeatability: joint drift after each closed cycle",
             **NO_LEGEND,
             xaxis=dict(title="cycle", dtick=1, range=[0.5, cycles + 0.5]),
-            yaxis=dict(title="‖x(end of cycle) − x0‖ (log)", type="log", exponentformat="power",
+            yaxis=dict(title=f"‖x(end of cycle) − x0‖ {norm_unit(units(result)[0])} (log)",
+                       type="log", exponentformat="power",
                        range=log_range(ys)),
         )  # fmt: skip
     theta = np.concatenate([result.runs[a].theta for a in ALGORITHMS])
@@ -158,7 +162,8 @@ def _drift(result: DashboardResult) -> dict:
         "Convergence: task error",
         **NO_LEGEND,
         xaxis=dict(title=theta_label(result), range=nice_range(theta, from_zero=True)),
-        yaxis=dict(title="‖k(x) − y_d‖ (log)", type="log", exponentformat="power",
+        yaxis=dict(title=f"‖k(x) − y_d‖ {norm_unit(units(result)[1])} (log)", type="log",
+                   exponentformat="power",
                    range=log_range(ys)),
     )  # fmt: skip
 
@@ -186,7 +191,8 @@ def _platform(result: DashboardResult, max_paths: int = 12) -> dict:
                 trace("scatter",
                     x=P[i, :, 0], y=P[i, :, 1], mode="lines", xaxis=xa, yaxis=ya,
                     name=LABELS[a] if last else f"{a} iteration {i}", legendgroup=a,
-                    showlegend=last, line=dict(color=COLORS[a], width=3 if last else 1),
+                    showlegend=last,
+                    line=dict(color=COLORS[a], width=3 if last else 1, dash=DASH[a]),
                     opacity=1.0 if last else 0.2 + 0.5 * n / max(len(show), 1),
                     customdata=result.time,
                     hovertemplate=f"iteration {i}<br>q1 = %{{x:.3f}}<br>q2 = %{{y:.3f}}"

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from jik.app.dashboard.analysis import state_inert_variables
-from jik.app.dashboard.model import ALGORITHMS, COLORS, LABELS
+from jik.app.dashboard.model import ALGORITHMS, COLORS, DASH, LABELS
 from jik.app.dashboard.plotting import NO_LEGEND, figure, label, trace, units
 from jik.app.dashboard.runs import DashboardResult
 
@@ -53,7 +53,7 @@ def augmenting_spec(result: DashboardResult, functionals: dict | None = None) ->
     ]  # fmt: skip
     shapes: list[dict[str, Any]] = [
         dict(type="path", path=_svg_path(result.runs[a].x[:, i], result.runs[a].x[:, j]),
-             line=dict(color=COLORS[a], width=2.5), name=LABELS[a])
+             line=dict(color=COLORS[a], width=2.5, dash=DASH[a]), name=LABELS[a])
         for a in ALGORITHMS
     ]  # fmt: skip
     x0 = result.state.x0

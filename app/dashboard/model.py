@@ -38,6 +38,8 @@ from jik.engine.repeatability import MAX_PATH_POINTS
 ALGORITHMS = ("pseudoinverse", "extended")
 #: One colour per algorithm, used in the scene and in every plot.
 COLORS = {"pseudoinverse": "#d62728", "extended": "#1f77b4"}
+#: One line style per algorithm, in every plot (its robot in the 3D scene: translucent, opaque).
+DASH = {"pseudoinverse": "solid", "extended": "dash"}
 LABELS = {"pseudoinverse": "pseudoinverse J^P# (8)", "extended": "extended Jacobian J^E# (11)"}
 DEFAULT_ROBOT = "manipulator2"
 

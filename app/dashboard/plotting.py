@@ -59,6 +59,15 @@ def label(name: str, unit: str) -> str:
     return f"{name} [{unit}]" if unit else name
 
 
+def norm_unit(unit_names) -> str:
+    """The unit of a Euclidean norm of coordinates in ``unit_names``: one unit, or the units
+    it mixes said so ("1": dimensionless)."""
+    names = [("dimensionless" if u == "1" else u) for u in dict.fromkeys(unit_names) if u]
+    if len(names) <= 1:
+        return f"[{names[0]}]" if names else ""
+    return f"[{' and '.join(names)} mixed]"
+
+
 def is_unicycle(result: DashboardResult) -> bool:
     """Results with platform paths (the unicycle) get the platform figures."""
     return any(r.platform is not None for r in result.runs.values())

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from jik.app.dashboard.messages import h_change
+from jik.app.dashboard.plotting import norm_unit, units
 from jik.app.dashboard.runs import AlgorithmRun, DashboardResult
 
 #: A run is repeatable when its joints come back to x0 within this after every cycle
@@ -55,14 +56,14 @@ def repeatable(run: AlgorithmRun) -> bool | None:
     return bool(np.all(np.asarray(run.drift) < REPEATABLE_DRIFT))
 
 
-def _drift_sentence(algorithm: str, run: AlgorithmRun) -> Sentence:
+def _drift_sentence(algorithm: str, run: AlgorithmRun, unit: str) -> Sentence:
     d = np.asarray(run.drift)
     n = len(d)
     cycles = f"{n} cycle{'s' if n > 1 else ''}"
     if repeatable(run):
         text = (
             f"{NAMES[algorithm]}: repeatable. After each of {cycles} the joints came back "
-            f"to x0 within {g(float(d.max()))} (‖x − x0‖ below {g(REPEATABLE_DRIFT)})."
+            f"to x0 within {g(float(d.max()))} {unit} (‖x − x0‖ below {g(REPEATABLE_DRIFT)})."
         )
     else:
         trend = ""
@@ -71,7 +72,7 @@ def _drift_sentence(algorithm: str, run: AlgorithmRun) -> Sentence:
             trend = (f", growing from {g(float(d[0]))} after cycle 1" if grows
                      else f" (after cycle 1: {g(float(d[0]))})")  # fmt: skip
         text = (f"{NAMES[algorithm]}: not repeatable. After {cycles} the joints end "
-                f"‖x − x0‖ = {g(float(d[-1]))} away from x0{trend}.")  # fmt: skip
+                f"‖x − x0‖ = {g(float(d[-1]))} {unit} away from x0{trend}.")  # fmt: skip
     return Sentence(text, algorithm)
 
 
@@ -134,7 +135,7 @@ def verdict(result: DashboardResult) -> list[dict]:
     for algorithm in ("pseudoinverse", "extended"):
         run = runs[algorithm]
         if path and len(run.drift):
-            out.append(_drift_sentence(algorithm, run))
+            out.append(_drift_sentence(algorithm, run, norm_unit(units(result)[0])))
         elif run.success:
             out.append(Sentence(f"{NAMES[algorithm]}: {run.message}.", algorithm))
         if not run.success:

@@ -22,6 +22,7 @@ import numpy as np
 import viser
 
 from jik.app.dashboard import ALGORITHMS, COLORS, Dashboard, Event, runs_key
+from jik.app.dashboard.help import STYLES
 from jik.app.scene.controls import SceneControls
 from jik.app.scene.gizmo import StartGizmo
 from jik.app.scene.mechanisms import (
@@ -127,9 +128,11 @@ class DashboardScene:
         p, e = COLORS["pseudoinverse"], COLORS["extended"]
         gui.add_markdown(
             order=0,
-            content=f"<span style='color:{p}'>■ pseudoinverse J^P# (8)</span>, translucent · "
-            f"<span style='color:{e}'>■ extended Jacobian J^E# (11)</span>, solid · "
-            "grey: start x0",
+            content=f"<span style='color:{p}'>■ pseudoinverse J^P# (8)</span>: "
+            f"{STYLES['pseudoinverse']['robot']} · "
+            f"<span style='color:{e}'>■ extended Jacobian J^E# (11)</span>: "
+            f"{STYLES['extended']['robot']} · grey: start x0 (the plots: "
+            f"{STYLES['pseudoinverse']['line']} and {STYLES['extended']['line']})",
         )
         with gui.add_folder("Playback", order=1):
             self.play = gui.add_button("Pause", icon=None)

@@ -8,7 +8,7 @@ start x0), the floor grid, and the fixtures of a result (rails or guide, traces,
   the task point W = (x1, x2 + x1 x3) is where the lever crosses the runner.
 - The unicycle (40): a platform with two wheels and a heading nose at the pose q(t).
 
-The pseudoinverse is the translucent red ghost, the extended Jacobian the solid blue robot (the
+The pseudoinverse is the translucent red ghost, the extended Jacobian the opaque blue robot (the
 colours of every plot); the grey ghost is the start configuration x0.
 """
 
