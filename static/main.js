@@ -62,6 +62,7 @@ async function onResult(msg) {
   renderVerdict(msg);
   $("#panels").classList.remove("outdated");
   delete document.body.dataset.failed;
+  exportLinks(msg.generation);
   const t = msg.timing;
   $("#timing").textContent = `generation ${msg.generation}: compute ${Math.round(1000 * t.compute)} ms, figures ${Math.round(1000 * t.figures)} ms`;
   const note = page.cancelled ? `; generation ${page.cancelled.running} was cancelled` : "";
@@ -102,6 +103,25 @@ function onError(msg) {
     el("p", { className: "still", id: "still-shown" }, shown),
   );
   $("#panels").classList.add("outdated");
+  exportLinks(null, `generation ${msg.generation} failed: nothing current to export`);
+}
+
+// The footer's export links: of the generation on screen (named), or off after a failure.
+function exportLinks(generation, why = "") {
+  for (const [id, path, kind] of [["#export-json", "/export.json", "JSON"], ["#export-csv", "/export.csv", "CSV"]]) {
+    const a = $(id);
+    if (generation === null) {
+      a.removeAttribute("href");
+      a.setAttribute("aria-disabled", "true");
+      a.title = why;
+      a.textContent = `export ${kind} (off: ${why})`;
+    } else {
+      a.href = api(path);
+      a.removeAttribute("aria-disabled");
+      a.title = `generation ${generation}: the plots on screen, with its state, verdict, drift and leg ends`;
+      a.textContent = `export ${kind} (generation ${generation})`;
+    }
+  }
 }
 
 // Cancel the computation in progress: the session goes back to the values of the result on
@@ -174,8 +194,6 @@ async function main() {
   $("#controls").addEventListener("submit", (ev) => ev.preventDefault()); // (Enter in a box)
   const opened = await openSession(stateFromUrl(),
     (message) => setNotice(`the link's state was refused (${message}); showing the defaults`));
-  $("#export-json").href = api("/export.json");
-  $("#export-csv").href = api("/export.csv");
   $("#copy-link").addEventListener("click", copyLink);
   $("#cancel").addEventListener("click", cancel);
   onState(opened);

@@ -170,11 +170,35 @@ function panelHead(div, key, plot = true) {
     type: "button", className: "tool", title: `save this panel as ${format.toUpperCase()}, with its legend and state`,
     onclick: () => saveImage(div, key, format),
   }, format.toUpperCase());
+  const csv = el("button", {
+    type: "button", className: "tool", title: "save this table as CSV, with its notes and the state it shows",
+    onclick: () => saveTable(div, key),
+  }, "CSV");
   const tools = el("div", { className: "panel-tools", title: plot ? "drag to zoom, double-click to reset" : "" },
-    info, ...(plot ? [save("png"), save("svg")] : []));
+    info, ...(plot ? [save("png"), save("svg")] : [csv]));
   div.prepend(el("div", { className: "panel-head" }, algorithmKey(), tools), help);
 }
 const panelTools = (div, key) => panelHead(div, key, true);
+
+// A table panel as CSV: '#' lines with the state it shows, its title, notes and the cells that
+// differ from the paper's print, then the table as on screen.
+function saveTable(div, key) {
+  const quote = (v) => (/[",\n]/.test(v) ? `"${v.replace(/"/g, '""')}"` : v);
+  const header = [...div.querySelectorAll("thead th")].map((th) => th.textContent);
+  const rows = [...div.querySelectorAll("tbody tr")].map((tr) => [...tr.children].map((td) => td.textContent));
+  const lines = [`# ${exportNote}`, `# ${div.querySelector(".table-title").textContent}`];
+  for (const note of div.querySelectorAll(".table-note")) lines.push(`# ${note.textContent}`);
+  div.querySelectorAll("td.differs").forEach((td) => {
+    const row = td.parentElement.children[0].textContent;
+    lines.push(`# differs from the print: row ${row}, ${header[td.cellIndex]}: ${td.textContent} (${td.title})`);
+  });
+  lines.push(header.map(quote).join(","), ...rows.map((r) => r.map(quote).join(",")));
+  const link = el("a", { href: URL.createObjectURL(new Blob([`${lines.join("\n")}\n`], { type: "text/csv" })), download: `jik-${key}.csv` });
+  document.body.append(link);
+  link.click();
+  link.remove();
+  setTimeout(() => URL.revokeObjectURL(link.href), 1000);
+}
 
 // The panel as an image: the figure on screen with its legend shown and, under it, the
 // result and state it shows (an image saved alone still says what it is).

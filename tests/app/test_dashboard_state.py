@@ -186,7 +186,11 @@ def test_a_refused_change_leaves_the_state_alone():
 
 def test_export_has_every_point_of_both_runs():
     result = compute(updated_state(default_state("manipulator1"), {"task": "target"}))
-    rows = export_csv(result).strip().split("\n")
+    lines = export_csv(result).strip().split("\n")
+    context = [r for r in lines if r.startswith("#")]
+    assert context[0].startswith("# jik export of generation 0") and '"task":"target"' in context[1]
+    assert any(r.startswith("# extended leg ends") for r in context)
+    rows = lines[len(context) :]
     assert rows[0] == "algorithm,leg,theta,x1,x2,x3,y1,y2,error,h"
     n = sum(len(r.theta) for r in result.runs.values())
     assert len(rows) == 1 + n
