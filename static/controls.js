@@ -68,7 +68,25 @@ export function clearFieldErrors() {
   for (const note of document.querySelectorAll("#controls .field-error")) note.remove();
 }
 
+// A select shown as buttons (c.inline): every option one click away.
+function choice(c, value, send) {
+  const group = el("span", { className: "choice", id: c.id, role: "radiogroup" });
+  group.setAttribute("aria-label", c.label);
+  const buttons = c.options.map(([v, text]) => {
+    const b = el("button", { type: "button", id: `${c.id}-${v}`, onclick: () => { group.setValue(v); send(v); } }, text);
+    b.dataset.value = v;
+    b.setAttribute("role", "radio");
+    return b;
+  });
+  group.append(...buttons);
+  group.setValue = (v) => buttons.forEach((b) => b.setAttribute("aria-checked", String(b.dataset.value === v)));
+  group.setValue(value);
+  // (a div, not a label: a click on a label's text would press its first button)
+  return el("div", { className: "ctl", title: c.help }, el("span", {}, c.label), group);
+}
+
 function select(c, value, send) {
+  if (c.inline) return choice(c, value, send);
   const s = el("select", { id: c.id });
   for (const [v, text] of c.options) s.append(el("option", { value: v, selected: v === value }, text));
   s.addEventListener("change", () => send(s.value));
@@ -129,7 +147,7 @@ export function showControls(msg, change, force = false) {
         if (c.kind === "preset") { set.append(preset(c, send)); continue; }
         const label = BUILD[c.kind](c, msg.values[c.key], send);
         rows.set(c.key, label);
-        inputs.set(c.key, label.querySelector(".slider,.vector,input,select"));
+        inputs.set(c.key, label.querySelector(".slider,.vector,.choice,input,select"));
         set.append(label);
       }
       return set;

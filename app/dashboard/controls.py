@@ -55,7 +55,7 @@ class Control:
     """One control. ``kind``: ``select`` (``options``), ``slider`` (``minimum``..``maximum`` by
     ``step``, on a ``log`` scale or not, ``integer`` or not), ``vector`` (``size`` numbers, each
     within ``minimum``/``maximum`` lists), ``text`` (``format``), ``preset`` (a button that sets
-    ``key`` to ``value``)."""
+    ``key`` to ``value``); ``inline``: a select shown as buttons."""
 
     key: str
     label: str
@@ -72,6 +72,8 @@ class Control:
     format: str = ""
     value: Any = None
     id: str = ""
+    #: A select whose options all show at once (buttons on the page: one click to any).
+    inline: bool = False
 
     def as_dict(self) -> dict:
         out = asdict(self)
@@ -110,9 +112,9 @@ def controls(state) -> list[Control]:
                                value=[float(t) for t in preset],
                                id=f"ctl-preset-{v.name}-{name}"))  # fmt: skip
     out.append(Control("augmentation", "augmenting map h", "select", "algorithm",
-                       SYMBOLS["h"] + "; the menu lists the paper's maps for this robot",
+                       SYMBOLS["h"] + "; one button per map of the paper for this robot",
                        options=tuple((a.name, f"{a.name} {a.equation}")
-                                     for a in spec.augmentations)))  # fmt: skip
+                                     for a in spec.augmentations), inline=True))  # fmt: skip
     for p in aug.parameters:
         out.append(Control(f"augmentation_parameters.{p.name}", p.name, "slider", "algorithm",
                            explained(p.name, p.description), minimum=p.minimum, maximum=p.maximum,

@@ -19,6 +19,7 @@ import numpy as np
 from jik.app.dashboard.messages import h_change
 from jik.app.dashboard.plotting import norm_unit, units
 from jik.app.dashboard.runs import AlgorithmRun, DashboardResult
+from jik.app.dashboard.singular import singular_sentence
 
 #: A run is repeatable when its joints come back to x0 within this after every cycle
 #: (‖x − x0‖ in the joint coordinates' own units).
@@ -145,4 +146,7 @@ def verdict(result: DashboardResult) -> list[dict]:
                                 "failure"))  # fmt: skip
     out += _pseudoinverse_why(runs["pseudoinverse"]) if path else []
     out += _extended_why(result, runs["extended"])
+    warning = singular_sentence(result.state)
+    if warning:
+        out.append(Sentence(warning, "extended", "warning"))
     return [s.as_dict() for s in out]

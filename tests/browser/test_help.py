@@ -46,7 +46,7 @@ def test_controls_explain_the_papers_symbols_and_about_links(tabs):
     gamma = page.locator("label", has=page.locator("#ctl-gamma"))
     assert "decay rate of the task error" in (gamma.get_attribute("title") or "")
     tab.select("#ctl-robot", "manipulator1")
-    tab.select("#ctl-augmentation", "e1_optimal")
+    tab.change(lambda: page.click("#ctl-augmentation-e1_optimal"))
     c1 = page.locator("label", has=page.locator("#ctl-aug-C1"))
     assert "integration constants of the E1-optimal map (32)" in (c1.get_attribute("title") or "")
     tab.select("#ctl-robot", "unicycle")
