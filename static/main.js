@@ -190,6 +190,8 @@ async function main() {
   page.config = await fetch("/api/dashboard/config").then((r) => r.json());
   for (const [a, c] of Object.entries(page.config.colors)) document.documentElement.style.setProperty(`--${a}`, c);
   layoutPanels(page.config.panels, page.config);
+  // The sticky header's height, for the scene below it (style.css --header-h).
+  new ResizeObserver(([entry]) => document.documentElement.style.setProperty("--header-h", `${Math.ceil(entry.target.getBoundingClientRect().height)}px`)).observe($("header"));
   $("#legend").replaceChildren(algorithmKey(true));
   $("#controls").addEventListener("submit", (ev) => ev.preventDefault()); // (Enter in a box)
   const opened = await openSession(stateFromUrl(),

@@ -37,6 +37,9 @@ from jik.app.dashboard.plotting import (
 from jik.app.dashboard.runs import DashboardResult
 from jik.app.dashboard.table import table_spec
 
+#: Names of the algorithms where a panel has little room (its subplots' titles).
+SHORT_LABELS = {"pseudoinverse": "J^P# (8)", "extended": "J^E# (11)"}
+
 
 def _task_space(result: DashboardResult) -> dict:
     """End-effector paths of both algorithms in the task plane (paper, Figs. 5 and 6)."""
@@ -210,7 +213,7 @@ def _platform(result: DashboardResult, max_paths: int = 12) -> dict:
             )
         )  # fmt: skip
         annotations.append(
-            dict(text=LABELS[a], xref=f"{xa} domain", yref=f"{ya} domain", x=0.5, y=1.0,
+            dict(text=SHORT_LABELS[a], xref=f"{xa} domain", yref=f"{ya} domain", x=0.5, y=1.0,
                  yanchor="bottom", showarrow=False, font=dict(size=11, color=COLORS[a]))
         )  # fmt: skip
     return figure(

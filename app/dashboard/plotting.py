@@ -96,7 +96,13 @@ NO_LEGEND = dict(showlegend=False, margin=dict(l=64, r=20, t=48, b=48))
 def figure(data: list, title: str, **layout) -> dict:
     """A figure dict (a spec) with the panels' common layout, not validated by plotly (the
     server builds every panel on each change); tests/app/test_figures.py validates every one."""
-    base = {**LAYOUT, "title": dict(text=title, font=dict(size=13), x=0.01, xanchor="left")}
+    # The title hangs from the top; the top margin has room for each of its lines.
+    base = {**LAYOUT, "title": dict(text=title, font=dict(size=13), x=0.01, xanchor="left",
+                                    yref="container", y=1.0, yanchor="top",
+                                    pad=dict(t=12))}  # fmt: skip
+    margin = dict(layout.get("margin", LAYOUT["margin"]))
+    margin["t"] = max(margin.get("t", 40), 40 + 16 * title.count("<br>"))
+    layout["margin"] = margin
     for key, axis in layout.items():  # an axis title given as text (validation did this)
         if key.startswith(("xaxis", "yaxis")) and isinstance(axis.get("title"), str):
             layout[key] = {**axis, "title": {"text": axis["title"]}}

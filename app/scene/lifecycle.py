@@ -138,6 +138,7 @@ class DashboardScene:
             self.play = gui.add_button("Pause", icon=None)
             self.speed = gui.add_slider("speed", min=0.1, max=5.0, step=0.1, initial_value=1.0)
             self.scrub = gui.add_slider("position", min=0.0, max=1.0, step=0.001, initial_value=0.0)
+            self.counter = gui.add_markdown("")  # (the iteration or leg on show)
             self.status = gui.add_markdown("computing…")
             self.progress = gui.add_progress_bar(0.0, visible=False, animated=True)
         self.playing = True
@@ -414,6 +415,9 @@ class DashboardScene:
         self._syncing = True
         try:
             self.scrub.value = round(min(self._s / timeline.length, 1.0), 3)  # type: ignore[misc]  # viser: settable
+            counter = timeline.counter(self._s)
+            if self.counter.content != counter:
+                self.counter.content = counter
         finally:
             self._syncing = False
 

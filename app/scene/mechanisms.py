@@ -117,7 +117,7 @@ class NormalForm(Mechanism):
         self.ball("lever/pivot", 0.06, (0.0, 0.0, 0.05), color=(40, 40, 40))
         self.point = self.ball("W", 0.08)
         if self.root.endswith("extended"):
-            self.scene.add_label(f"{self.root}/W/label", "W (task point)", position=(0.08, 0.08, 0))
+            self.scene.add_label(f"{self.root}/W/label", "W (task point)", position=(0.0, 0.0, 0.4))
 
     def resize(self, state, extent) -> None:
         super().resize(state, extent)
