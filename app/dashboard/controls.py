@@ -124,6 +124,12 @@ def controls(state) -> list[Control]:
         out.append(Control(f"x0.{i}", f"x0: {name}", "slider", "start",
                            f"start configuration, coordinate {name}. {SYMBOLS['x0']}",
                            minimum=lo, maximum=hi, step=(hi - lo) / X0_STEPS))  # fmt: skip
+    if len(spec.variable_names) > 3:
+        names = spec.variable_names
+        out.append(Control("cspace_axes", "configuration-space axes", "select", "start",
+                           "the three coordinates the configuration-space panel shows",
+                           options=tuple((c, ", ".join(names[int(k)] for k in c))
+                                         for c in ("012", "013", "023", "123"))))  # fmt: skip
     if spec.default_path:
         out.append(Control("task", "task", "select", "start",
                            "drive a closed path cycle after cycle, or solve for one target",
@@ -182,6 +188,8 @@ def control_values(state, spec: list[Control] | None = None) -> dict[str, Any]:
             continue
         if c.key == "max_iterations":
             values[c.key] = max_iterations(state)
+        elif c.key == "cspace_axes":
+            values[c.key] = state.cspace_axes or "012"
         else:
             values[c.key] = path_text(state.path) if c.key == "path" else lookup(d, c.key)
     return values

@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 import plotly.graph_objects as go
 
+from jik.app.dashboard.cspace import cspace_spec
 from jik.app.dashboard.map_figures import augmenting_spec, sensitivity_spec
 from jik.app.dashboard.model import ALGORITHMS, COLORS, DASH, LABELS
 from jik.app.dashboard.plotting import (
@@ -233,7 +234,7 @@ def gamma_free_panels(result: DashboardResult) -> set[str]:
     """Panels that do not change with gamma in continuous mode (theta is not on their axes)."""
     if result.state.mode != "continuous":
         return set()
-    panels = {"table", "augmenting"} | ({"task"} if not is_unicycle(result) else set())
+    panels = {"table", "augmenting", "cspace"} | ({"task"} if not is_unicycle(result) else set())
     return panels | ({"drift"} if result.state.task == "path" else set())
 
 
@@ -250,6 +251,7 @@ def figure_specs(
         "joints": _joints,
         "drift": _drift,
         "table": _table,
+        "cspace": cspace_spec,
         "augmenting": lambda r: augmenting_spec(r, functionals),
         "sensitivity": lambda r: sensitivity_spec(r, sensitivity),
     }
@@ -304,3 +306,9 @@ def augmenting_figure(result: DashboardResult, functionals: dict | None = None) 
 def sensitivity_figure(result: DashboardResult, sens: dict | None = None) -> go.Figure:
     """E1 (13) and E2 (18) of the current map and how they change with its parameters."""
     return to_go(sensitivity_spec(result, sens))
+
+
+def cspace_figure(result: DashboardResult) -> go.Figure:
+    """Both joint paths in configuration space with the level surface h = h(x0) and the
+    self-motion manifolds of the corners."""
+    return to_go(cspace_spec(result))

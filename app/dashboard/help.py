@@ -41,6 +41,11 @@ PANEL_HELP = {
     "sensitivity": "The error functionals E1 (13), Roberts-Maciejewski, and E2 (18), the "
     "manipulability-weighted embedding, of the current map and its alternatives, and how they "
     "change with the map's parameters: lower is closer to the pseudoinverse.",
+    "cspace": "The joint paths x(θ) of both algorithms in configuration space (three "
+    "coordinates), with the level surface h(x) = h(x0) that the extended Jacobian stays on "
+    "(eq. (12)) and, in green, the self-motion manifolds k(x) = y of the path's corners (curves, "
+    "since p − r = 1). A repeatable run is one closed curve on the surface; the pseudoinverse's "
+    "slides along the green curves from cycle to cycle. Drag to turn the view.",
     "table": "The joint configuration at the end of each leg. On the paper's experiment "
     "(Manipulator 2 on the square path), Table 1 of the paper beside jik's numbers.",
 }

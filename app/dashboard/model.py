@@ -71,6 +71,8 @@ class DashboardState(BaseModel):
     tolerance: Tolerance = 1e-10
     #: Cap on each leg's iterations (discrete) or integrator steps (continuous); None: the
     #: engine's default (:func:`jik.engine.solver.solve`).
+    #: The three coordinates the configuration-space panel shows (p = 4): "012" is x1, x2, x3.
+    cspace_axes: Literal["012", "013", "023", "123"] | None = None
     max_iterations: (
         Annotated[int, Field(strict=True, ge=MIN_ITERATIONS, le=MAX_ITERATIONS_CAP)] | None
     ) = None
@@ -175,6 +177,8 @@ def validate(data: Mapping[str, Any]) -> DashboardState:
     default_cap = max_iterations(state.model_copy(update={"max_iterations": None}))
     return state.model_copy(update={
         "max_iterations": None if state.max_iterations == default_cap else state.max_iterations,
+        # (the first three coordinates are the default, and all there is for p = 3)
+        "cspace_axes": None if state.cspace_axes == "012" or kin.p < 4 else state.cspace_axes,
         "robot_parameters": {k: tuple(v) if isinstance(v, list | tuple) else v
                              for k, v in params.items()},
         "augmentation_parameters": aug_params,
@@ -205,6 +209,7 @@ def _registered(check, name: str):
 
 def cache_key(state: DashboardState, algorithm: str) -> str:
     d = state.as_dict()
+    d.pop("cspace_axes")  # (what a panel shows, not what is solved)
     if algorithm == "pseudoinverse":
         d.pop("augmentation"), d.pop("augmentation_parameters")
     if state.mode == "continuous":

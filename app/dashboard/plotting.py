@@ -23,7 +23,7 @@ PANEL_HEIGHT = 380
 #: Panel ids, in the page's order, with their size on the page's grid ("wide": a whole row,
 #: "tall": two rows).
 PANEL_SIZES = {"task": "wide", "drift": "", "joints": "tall", "augmenting": "",
-               "sensitivity": "", "table": "wide"}  # fmt: skip
+               "sensitivity": "", "cspace": "full", "table": "wide"}  # fmt: skip
 PANELS = tuple(PANEL_SIZES)
 AXIS = dict(
     gridcolor="#e6e6e6", zerolinecolor="#b0b0b0", linecolor="#888", showline=True, mirror=True,

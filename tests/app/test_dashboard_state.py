@@ -170,7 +170,7 @@ def test_live_dashboard_pushes_state_and_result_events():
     body = json.loads(result.data)
     assert body["state"]["x0"] == [0.1, 0.0, 1.5]
     # The E1/E2 panel follows in the second phase: the page dims it meanwhile.
-    assert set(body["figures"]) == {"task", "joints", "drift", "table", "augmenting"}
+    assert set(body["figures"]) == {"task", "joints", "drift", "table", "augmenting", "cspace"}
     assert body["stale"] == ["sensitivity"]
     assert body["summary"]["extended"]["success"]
     assert dashboard.snapshot()["computed_generation"] == 2

@@ -138,7 +138,8 @@ def test_single_target_shows_convergence_instead_of_drift(target_result):
 def test_every_panel_serialises_to_plotly_json(path_result, target_result):
     for result in (path_result, target_result):
         figs = figures_for(result)
-        assert set(figs) == {"task", "joints", "drift", "table", "augmenting", "sensitivity"}
+        assert set(figs) == {"task", "joints", "drift", "table", "augmenting", "sensitivity",
+                             "cspace"}  # fmt: skip
         for key, fig in figs.items():
             parsed = json.loads(fig.to_json())
             # (the sensitivity panel waits for the second phase: a title, no data yet)
