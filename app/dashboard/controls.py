@@ -212,9 +212,10 @@ def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
     for key, value in patch.items():
         head, _, rest = key.partition(".")
         if not rest:
-            text = key == "path" and isinstance(value, str)
             size = len(state.target) if "robot" not in patch else None
-            out[key] = parse_path_text(value, size) if text else value
+            out[key] = (
+                parse_path_text(value, size) if key == "path" and isinstance(value, str) else value
+            )
         elif head in ("robot_parameters", "augmentation_parameters"):
             out.setdefault(head, {})[rest] = value
         elif head in ("x0", "target") and rest.isdigit():

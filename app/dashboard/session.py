@@ -1,7 +1,7 @@
 """One session's live dashboard: its state, a worker thread that computes each change, and the
 listeners (the page's event stream, the scene) it tells.
 
-(It stays whole, at about 470 lines: one class, whose worker phases (result, second phase,
+(It stays whole, at about 500 lines: one class, whose worker phases (result, second phase,
 solving ahead) share its lock, its generation and its caches.)
 
 Every change is validated (:mod:`jik.app.dashboard.model`), bumps a generation counter and wakes

@@ -26,7 +26,8 @@ BLOW_UP, JUMP, DEPENDENT = 30.0, 30.0, 1e-6
 def _grid(state: DashboardState, names, region) -> tuple[np.ndarray, list[int]]:
     """The region's grid, other variables at x0: (NODES, ..., p) and the region's axes."""
     axes = [names.index(n) for n in region]
-    lines = [np.linspace(*region[names[k]], NODES) for k in axes]
+    lines = [np.linspace(float(region[names[k]][0]), float(region[names[k]][1]), NODES)
+             for k in axes]  # fmt: skip
     mesh = np.meshgrid(*lines, indexing="ij")
     X = np.broadcast_to(np.asarray(state.x0, dtype=float), (*mesh[0].shape, len(names))).copy()
     for k, m in zip(axes, mesh, strict=True):
