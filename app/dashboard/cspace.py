@@ -24,6 +24,8 @@ AXES_CHOICES = ("012", "013", "023", "123")
 #: Points per run drawn; steps each way along a self-motion manifold; level-surface grid.
 MAX_POINTS, MANIFOLD_STEPS, GRID = 1500, 160, 16
 CSPACE_HEIGHT = 520
+#: The layout key of the panel's 3D axes (not "scene": see :func:`cspace_spec`).
+SCENE = "scene2"
 
 
 def axes_of(result: DashboardResult) -> tuple[int, int, int]:
@@ -174,7 +176,11 @@ def cspace_spec(result: DashboardResult) -> dict:
         zaxis=dict(title=dict(text=names[c])),
         aspectmode="cube",
     )
-    spec = figure(data, f"Configuration space ({shown})<br><sup>{sub}</sup>", scene=scene,
+    # (plotly names a scene's element after its layout key: "scene" would be a second element
+    # with the id of the page's 3D scene, #scene)
+    for t in data:
+        t["scene"] = SCENE
+    spec = figure(data, f"Configuration space ({shown})<br><sup>{sub}</sup>", **{SCENE: scene},
                   height=CSPACE_HEIGHT, showlegend=True,
                   legend=dict(orientation="h", x=0, y=0, yanchor="top", font=dict(size=10)),
                   margin=dict(l=0, r=0, t=40, b=40))  # fmt: skip

@@ -18,6 +18,7 @@ def test_configuration_space_of_both_algorithms(tabs):
     panel = tab.page.locator("#plot-cspace")
     expect(panel.locator(".gtitle")).to_contain_text("Configuration space (x1, x2, x3)")
     expect(panel.locator(".gl-container canvas").first).to_be_visible()
+    expect(tab.page.locator("#scene")).to_have_count(1)  # (its 3D axes take no page's id)
     legend = _legend(tab)
     assert any(t.startswith("level surface h = h(x0)") for t in legend), legend
     assert "self-motion manifolds k(x) = corner" in legend
