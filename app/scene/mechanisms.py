@@ -117,7 +117,9 @@ class NormalForm(Mechanism):
         self.ball("lever/pivot", 0.06, (0.0, 0.0, 0.05), color=(40, 40, 40))
         self.point = self.ball("W", 0.08)
         if self.root.endswith("extended"):
-            self.scene.add_label(f"{self.root}/W/label", "W (task point)", position=(0.0, 0.0, 0.4))
+            self.scene.add_label(  # (below the point: clear of the start gizmo's label)
+                f"{self.root}/W/label", "W (task point)", position=(0.1, -0.2, -0.35)
+            )
 
     def resize(self, state, extent) -> None:
         super().resize(state, extent)
