@@ -15,16 +15,21 @@ from jik.engine.exceptions import JikError
 
 FAILING_GAMMA = 2.5
 MESSAGE = "the start configuration is singular (injected by the test server)"
-real = session.compute
 
 
-def failing(state, *args, **kwargs):
-    if state.gamma == FAILING_GAMMA:
-        raise JikError(MESSAGE)
-    return real(state, *args, **kwargs)
+def serve_failing(port: str) -> int:
+    """`jik serve --port PORT` with the dashboards' compute failing at gamma = 2.5 (patched in
+    this process only: importing this module, as the tests do for MESSAGE, patches nothing)."""
+    real = session.compute
 
+    def failing(state, *args, **kwargs):
+        if state.gamma == FAILING_GAMMA:
+            raise JikError(MESSAGE)
+        return real(state, *args, **kwargs)
 
-session.compute = failing  # type: ignore[assignment]
+    session.compute = failing  # type: ignore[assignment]
+    return main(["serve", "--port", port])
+
 
 if __name__ == "__main__":
-    raise SystemExit(main(["serve", "--port", sys.argv[1]]))
+    raise SystemExit(serve_failing(sys.argv[1]))
