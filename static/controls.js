@@ -6,6 +6,14 @@ import { el, fmt } from "./dom.js";
 let shape = null; // JSON of the controls on screen: rebuilt only when it changes
 const inputs = new Map(); // control key -> element with setValue()
 
+// A number as the user wrote it, or null when it is not one ("abc", "", "1,5").
+export function parseNumber(text) {
+  const t = String(text).trim();
+  return /^[-+]?(\d+\.?\d*|\.\d+)(e[-+]?\d+)?$/i.test(t) ? Number(t) : null;
+}
+
+// A slider and a box for an exact value: the box sends what is typed (the server checks it
+// against the same range), the slider lands on the specification's step.
 function slider(c, value, send) {
   const toPos = (v) => (c.log ? Math.log10(v) : v);
   const fromPos = (p) => (c.log ? 10 ** p : p);
@@ -14,18 +22,71 @@ function slider(c, value, send) {
     type: "range", id: c.id, min: toPos(c.minimum), max: toPos(c.maximum),
     step: c.log ? (toPos(c.maximum) - toPos(c.minimum)) / 200 : c.step, value: toPos(value),
   });
-  const out = el("output", {}, show(value));
+  input.setAttribute("aria-label", c.label);
+  const box = el("input", { type: "text", id: `${c.id}-value`, className: "exact", value: show(value), inputMode: "decimal" });
+  box.setAttribute("aria-label", `${c.label}: exact value`);
   input.addEventListener("input", () => {
     // On the specification's step (as the scene's slider), exactly: k * step, printed short.
     const v = c.integer ? Math.round(fromPos(+input.value)) : +(Math.round(fromPos(+input.value) / c.step) * c.step).toPrecision(12);
-    out.textContent = show(v);
+    box.value = show(v);
     send(v);
   });
-  input.setValue = (v) => { input.value = toPos(v); out.textContent = show(v); };
-  return el("label", { title: c.help }, el("span", {}, c.label, " ", out), input);
+  box.addEventListener("change", () => {
+    const v = parseNumber(box.value);
+    if (v === null) { fieldError(c.key, box.value, "is not a number; nothing was sent"); return; }
+    input.value = toPos(v);
+    send(v, box.value);
+  });
+  const group = el("span", { className: "slider" }, input, box);
+  group.setValue = (v) => { input.value = toPos(v); box.value = show(v); };
+  return el("label", { title: c.help }, el("span", {}, c.label), group);
+}
+
+const rows = new Map(); // control key -> its label (where its errors show)
+
+// An error beside the control ``key``, quoting what the user wrote.
+function fieldError(key, typed, message) {
+  const row = rows.get(key);
+  if (!row) return false;
+  let note = row.querySelector(":scope > .field-error");
+  if (!note) { note = el("span", { className: "field-error", role: "alert" }); row.append(note); }
+  note.textContent = typed === undefined ? message : `“${typed}” ${message}`;
+  return true;
+}
+
+// A refusal of the server (its field, a dotted path) shown beside the control it is about,
+// with the text the user typed there when there was one; whether a control was found.
+const typedText = new Map(); // control key -> the text last sent from a box
+export function showRefusal(field, message) {
+  const key = [...rows.keys()].find((k) => k === field || field.startsWith(`${k}.`) || k.startsWith(`${field}.`));
+  if (!key) return false;
+  const typed = typedText.get(key);
+  return fieldError(key, typed, typed === undefined ? message : `was refused: ${message}`);
+}
+
+export function clearFieldErrors() {
+  for (const note of document.querySelectorAll("#controls .field-error")) note.remove();
+}
+
+// A select shown as buttons (c.inline): every option one click away.
+function choice(c, value, send) {
+  const group = el("span", { className: "choice", id: c.id, role: "radiogroup" });
+  group.setAttribute("aria-label", c.label);
+  const buttons = c.options.map(([v, text]) => {
+    const b = el("button", { type: "button", id: `${c.id}-${v}`, onclick: () => { group.setValue(v); send(v); } }, text);
+    b.dataset.value = v;
+    b.setAttribute("role", "radio");
+    return b;
+  });
+  group.append(...buttons);
+  group.setValue = (v) => buttons.forEach((b) => b.setAttribute("aria-checked", String(b.dataset.value === v)));
+  group.setValue(value);
+  // (a div, not a label: a click on a label's text would press its first button)
+  return el("div", { className: "ctl", title: c.help }, el("span", {}, c.label), group);
 }
 
 function select(c, value, send) {
+  if (c.inline) return choice(c, value, send);
   const s = el("select", { id: c.id });
   for (const [v, text] of c.options) s.append(el("option", { value: v, selected: v === value }, text));
   s.addEventListener("change", () => send(s.value));
@@ -33,12 +94,18 @@ function select(c, value, send) {
   return el("label", { title: c.help }, c.label, s);
 }
 
-// A vector: one number box per coordinate; a change sends the whole vector.
+// A vector: one box per coordinate; a change sends the whole vector, unless a box does not
+// hold a number (then it says so beside the control, in the user's text).
 function vector(c, value, send) {
   const boxes = value.map((v, i) => {
-    const box = el("input", { type: "number", id: `${c.id}-${i}`, step: c.step, value: +(+v).toFixed(4) });
-    if (c.minimum) { box.min = c.minimum[i]; box.max = c.maximum[i]; }
-    box.addEventListener("change", () => send(boxes.map((b) => +b.value)));
+    const box = el("input", { type: "text", inputMode: "decimal", id: `${c.id}-${i}`, className: "coordinate", value: +(+v).toFixed(4) });
+    box.setAttribute("aria-label", `${c.label}, coordinate ${i + 1}`);
+    box.addEventListener("change", () => {
+      const values = boxes.map((b) => parseNumber(b.value));
+      const bad = boxes.find((b, k) => values[k] === null);
+      if (bad) { fieldError(c.key, bad.value, "is not a number; nothing was sent"); return; }
+      send(values, boxes.map((b) => b.value.trim()).join(", "));
+    });
     return box;
   });
   const group = el("span", { className: "vector" }, ...boxes);
@@ -48,7 +115,7 @@ function vector(c, value, send) {
 
 function text(c, value, send) {
   const input = el("input", { type: "text", id: c.id, value, placeholder: c.format });
-  input.addEventListener("change", () => send(input.value));
+  input.addEventListener("change", () => send(input.value, input.value));
   input.setValue = (v) => { input.value = v; };
   return el("label", { title: `${c.help} (${c.format})` }, c.label, input);
 }
@@ -67,14 +134,20 @@ export function showControls(msg, change, force = false) {
   if (next !== shape) {
     shape = next;
     inputs.clear();
+    rows.clear();
     const form = document.getElementById("controls");
     form.replaceChildren(...msg.groups.map(([group, title]) => {
       const set = el("fieldset", { dataset: { group } }, el("legend", {}, title));
       for (const c of msg.controls.filter((k) => k.group === group)) {
-        const send = (v) => change({ [c.key]: v });
+        const send = (v, typed) => {
+          clearFieldErrors();
+          if (typed === undefined) typedText.delete(c.key); else typedText.set(c.key, typed);
+          change({ [c.key]: v });
+        };
         if (c.kind === "preset") { set.append(preset(c, send)); continue; }
         const label = BUILD[c.kind](c, msg.values[c.key], send);
-        inputs.set(c.key, label.querySelector("input,select,.vector"));
+        rows.set(c.key, label);
+        inputs.set(c.key, label.querySelector(".slider,.vector,.choice,input,select"));
         set.append(label);
       }
       return set;

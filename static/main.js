@@ -2,11 +2,11 @@
 // builds its controls from the session's control specification, follows the session's events
 // and draws its panels; the 3D scene (iframe, viser) shows and changes the same session.
 import { change, endOnClose, follow, openSession, session, api } from "./api.js";
-import { showControls } from "./controls.js";
-import { $, fmt } from "./dom.js";
-import { applyFunctionals, drawFigures, layoutPanels, markStale, onAhead } from "./panels.js";
+import { showControls, showRefusal } from "./controls.js";
+import { $, el, fmt } from "./dom.js";
+import { algorithmKey, applyFunctionals, drawFigures, layoutPanels, markStale, onAhead, setExportNote } from "./panels.js";
 
-const page = { config: null, state: null, shown: 0 };
+const page = { config: null, state: null, shown: 0, shownState: null };
 const send = (patch) => { setNotice(""); change(patch, (message) => setStatus(message, true)); };
 
 function setStatus(text, error = false) {
@@ -24,7 +24,10 @@ function setNotice(text) {
 
 // Only computations running longer than the server's progress_after get a progress bar.
 function showProgress(fraction, elapsed) {
-  $("#progress").hidden = !(elapsed > page.config.progress_after && fraction < 1);
+  const busy = elapsed > page.config.progress_after && fraction < 1;
+  $("#progress-box").hidden = !busy;
+  $("#panels").classList.toggle("pending", busy); // (the plots are the previous result's)
+  $("#cancel").disabled = !page.shownState;
   $("#progress-bar").style.width = `${Math.round(100 * fraction)}%`;
   $("#progress-text").textContent = `computing ${Math.round(100 * fraction)}%`;
 }
@@ -43,6 +46,7 @@ function onRefused(msg) {
   onState(msg, true);
   const where = msg.source === "scene" ? "in the 3D scene" : "here";
   setStatus(`refused (${where}): ${msg.message}`, true);
+  if (msg.field) showRefusal(msg.field, msg.message);
 }
 
 async function onResult(msg) {
@@ -50,37 +54,86 @@ async function onResult(msg) {
   await drawFigures(msg.figures, msg.digests, msg.state.robot);
   markStale(msg.stale || []);
   page.shown = msg.generation;
+  page.shownState = msg.state;
+  setExportNote(`jik · generation ${msg.generation} · ${describe(msg.state)}`);
   document.body.dataset.generation = msg.generation;
   document.body.dataset.robot = msg.state.robot;
   showProgress(1, 0);
   renderVerdict(msg);
+  $("#panels").classList.remove("outdated");
+  delete document.body.dataset.failed;
+  exportLinks(msg.generation);
   const t = msg.timing;
   $("#timing").textContent = `generation ${msg.generation}: compute ${Math.round(1000 * t.compute)} ms, figures ${Math.round(1000 * t.figures)} ms`;
-  setStatus(msg.generation < session.generation ? `computing generation ${session.generation}…` : `up to date (generation ${msg.generation})`);
+  const note = page.cancelled ? `; generation ${page.cancelled.running} was cancelled` : "";
+  page.cancelled = null;
+  setStatus(msg.generation < session.generation ? `computing generation ${session.generation}…` : `up to date (generation ${msg.generation})${note}`);
 }
 
+// The verdict: the server's sentences about this result (app/dashboard/verdict.py), each
+// coloured by the algorithm it is about.
 function renderVerdict(msg) {
-  const p = msg.summary.pseudoinverse;
-  const e = msg.summary.extended;
   const box = $("#verdict");
-  const fail = [p, e].filter((s) => !s.success).map((s) => s.message);
-  if (msg.state.task === "path" && p.drift.length && e.drift.length) {
-    const n = Math.min(p.drift.length, e.drift.length);
-    box.innerHTML = `After <b>${n}</b> cycle${n > 1 ? "s" : ""} of the closed path, the joints of the
-      <b class="p">pseudoinverse</b> end <b class="p">${fmt(p.drift[n - 1])}</b> away from x0 and the drift grows each cycle;
-      the <b class="e">extended Jacobian</b> returns to within <b class="e">${fmt(e.drift[n - 1])}</b>.
-      <span class="why">Why: J<sup>P#</sup> picks the minimum-norm joint velocity, which has no memory of the start, so a
-      closed task path need not close in the joints. J<sup>E#</sup> adds the equation h(x) = h(x0) (h changed by
-      ${e.h_change === null ? "—" : fmt(e.h_change)} along its run): each task point then has one configuration on that level set,
-      so closed task paths give closed joint paths.</span>`;
-  } else if (!fail.length) {
-    box.innerHTML = `Both algorithms drive the task error to the target: <b class="p">pseudoinverse</b> ${p.message};
-      <b class="e">extended Jacobian</b> ${e.message}.
-      <span class="why">The extended Jacobian keeps h constant (eq. (12)); compare the paths and the controls.</span>`;
-  } else {
-    box.innerHTML = `<b class="p">pseudoinverse</b>: ${p.message}. <b class="e">extended Jacobian</b>: ${e.message}.`;
+  box.classList.remove("failed");
+  box.replaceChildren(...msg.verdict.map((s) => el("p", {
+    className: [s.role, s.algorithm ? ALGORITHM_CLASS[s.algorithm] : ""].join(" ").trim(),
+  }, s.text)));
+}
+const ALGORITHM_CLASS = { pseudoinverse: "p", extended: "e" };
+
+// A state in a few words: which result a failure leaves on screen.
+function describe(state) {
+  const params = Object.entries(state.robot_parameters)
+    .map(([k, v]) => `${k} = ${Array.isArray(v) ? `(${v.map((x) => fmt(x, 2)).join(", ")})` : fmt(v, 2)}`);
+  return [state.robot, `${state.mode} mode`, `γ = ${fmt(state.gamma)}`, ...params, state.task === "path" ? `closed path, ${state.cycles} cycles` : "single target"].join(", ");
+}
+
+// A generation that failed: its message where the result would be, and which result (if any)
+// the plots still show, dimmed.
+function onError(msg) {
+  if (msg.generation !== session.generation) return;
+  showProgress(1, 0);
+  setStatus(`generation ${msg.generation} failed`, true);
+  document.body.dataset.failed = msg.generation;
+  const box = $("#verdict");
+  box.classList.add("failed");
+  const shown = msg.shown && page.shown ? `The plots below still show generation ${msg.shown.generation} (${describe(msg.shown.state)}), not the controls' values.` : "No result is on screen.";
+  box.replaceChildren(
+    el("p", { className: "failure", id: "failure" }, `Generation ${msg.generation} failed: ${msg.message}`),
+    el("p", { className: "still", id: "still-shown" }, shown),
+  );
+  $("#panels").classList.add("outdated");
+  exportLinks(null, `generation ${msg.generation} failed: nothing current to export`);
+}
+
+// The footer's export links: of the generation on screen (named), or off after a failure.
+function exportLinks(generation, why = "") {
+  for (const [id, path, kind] of [["#export-json", "/export.json", "JSON"], ["#export-csv", "/export.csv", "CSV"]]) {
+    const a = $(id);
+    if (generation === null) {
+      a.removeAttribute("href");
+      a.setAttribute("aria-disabled", "true");
+      a.title = why;
+      a.textContent = `export ${kind} (off: ${why})`;
+    } else {
+      a.href = api(path);
+      a.removeAttribute("aria-disabled");
+      a.title = `generation ${generation}: the plots on screen, with its state, verdict, drift and leg ends`;
+      a.textContent = `export ${kind} (generation ${generation})`;
+    }
   }
-  if (fail.length) box.innerHTML += ` <span class="error">Stopped: ${fail.join(" · ")}</span>`;
+}
+
+// Cancel the computation in progress: the session goes back to the values of the result on
+// screen (a newer generation stops the running one between legs; that result is cached).
+function cancel() {
+  const running = session.generation;
+  const back = page.shown;
+  $("#progress-box").hidden = true;
+  setNotice("");
+  change(page.shownState, (message) => setStatus(message, true));
+  setStatus(`cancelled generation ${running}; back to the values of generation ${back}`, true);
+  page.cancelled = { running, back };
 }
 
 // ---------------------------------------------------------------- the session and its link
@@ -136,13 +189,15 @@ function lost() {
 async function main() {
   page.config = await fetch("/api/dashboard/config").then((r) => r.json());
   for (const [a, c] of Object.entries(page.config.colors)) document.documentElement.style.setProperty(`--${a}`, c);
-  layoutPanels(page.config.panels);
+  layoutPanels(page.config.panels, page.config);
+  // The sticky header's height, for the scene below it (style.css --header-h).
+  new ResizeObserver(([entry]) => document.documentElement.style.setProperty("--header-h", `${Math.ceil(entry.target.getBoundingClientRect().height)}px`)).observe($("header"));
+  $("#legend").replaceChildren(algorithmKey(true));
   $("#controls").addEventListener("submit", (ev) => ev.preventDefault()); // (Enter in a box)
   const opened = await openSession(stateFromUrl(),
     (message) => setNotice(`the link's state was refused (${message}); showing the defaults`));
-  $("#export-json").href = api("/export.json");
-  $("#export-csv").href = api("/export.csv");
   $("#copy-link").addEventListener("click", copyLink);
+  $("#cancel").addEventListener("click", cancel);
   onState(opened);
   showScene(opened.scene);
   let chain = Promise.resolve(); // results and their second phases are drawn in order
@@ -154,7 +209,7 @@ async function main() {
     result: serial(onResult),
     functionals: serial((msg) => (msg.generation === page.shown ? applyFunctionals(msg) : null)),
     ahead: (msg) => { onAhead(msg, () => page.state && page.state.robot).catch((err) => console.warn("drawing ahead:", err)); },
-    error: (msg) => { if (msg.generation === session.generation) { showProgress(1, 0); setStatus(msg.message, true); } },
+    error: serial(onError),
   }, lost);
   endOnClose();
 }

@@ -4,8 +4,27 @@ import { el } from "./dom.js";
 
 export const PLOT_CONFIG = { responsive: true, displaylogo: false };
 
+// The page's configuration (/api/dashboard/config): colours, labels, line styles, panels' help.
+let CONFIG = { colors: {}, labels: {}, styles: {}, panels: [] };
+// What an exported image says under its plot: the result and the state it shows.
+let exportNote = "";
+export function setExportNote(text) { exportNote = text; }
+
+// The key of the algorithms: colour and line style (the same in every panel and in the
+// header), and their robots in the 3D scene.
+export function algorithmKey(withRobot = false) {
+  return el("span", { className: "key-list" }, ...Object.keys(CONFIG.labels).map((a) => {
+    const style = CONFIG.styles[a] || {};
+    const sample = el("i", { className: "line-sample" });
+    sample.style.borderTop = `3px ${style.dash === "solid" ? "solid" : "dashed"} ${CONFIG.colors[a]}`;
+    const words = withRobot ? `${CONFIG.labels[a]}: ${style.line}; ${style.robot} in the 3D scene` : CONFIG.labels[a];
+    return el("span", { className: "key", dataset: { algorithm: a } }, sample, words);
+  }));
+}
+
 // The panels' boxes, in the order and sizes the server gives (/api/dashboard/config).
-export function layoutPanels(panels) {
+export function layoutPanels(panels, config) {
+  CONFIG = config;
   document.getElementById("panels").replaceChildren(
     ...panels.map((p) => el("div", { className: `panel ${p.size}`.trim(), id: `plot-${p.id}` })));
 }
@@ -16,7 +35,7 @@ function isTable(fig) {
   return fig.data.length === 1 && fig.data[0].type === "table";
 }
 
-function drawTable(div, fig) {
+function drawTable(div, fig, key) {
   const t = fig.data[0];
   const fills = (f, col, row) => (Array.isArray(f) ? (Array.isArray(f[col]) ? f[col][row % f[col].length] : f[col]) : f);
   const head = el("tr", {}, ...t.header.values.map((v, c) => {
@@ -37,11 +56,19 @@ function drawTable(div, fig) {
     })));
   }
   const title = (fig.layout.title && fig.layout.title.text) || "";
+  const meta = fig.layout.meta || {};
+  // Cells that differ from the paper's printed value: marked, the printed value on hover.
+  for (const [col, row, printed] of meta.differs || []) {
+    const td = body[row] && body[row].children[col];
+    if (td) { td.classList.add("differs"); td.title = `printed: ${printed}`; }
+  }
   div.classList.add("html-table");
   div.replaceChildren(
     el("h3", { className: "table-title" }, title),
     el("div", { className: "table-scroll" }, el("table", {}, el("thead", {}, head), el("tbody", {}, ...body))),
+    ...(meta.notes || []).map((n) => el("p", { className: "table-note" }, n)),
   );
+  panelHead(div, key, false);
 }
 
 // A figure that differs from the one on screen only in its lines' data, its axis ranges, its
@@ -127,14 +154,67 @@ function plan(div, key, fig) {
   return { frame, relayout };
 }
 
-// The panel's own buttons (once): save it as PNG or SVG, as plotly draws it.
-function panelTools(div, key) {
-  if (div.querySelector(":scope > .panel-tools")) return;
+// A panel's head (once): the key of the algorithms, a "?" that shows what the panel is, and
+// (plots) buttons that save it as PNG or SVG, with its legend and the state it shows.
+function panelHead(div, key, plot = true) {
+  if (div.querySelector(":scope > .panel-head")) return;
+  const help = el("p", { className: "panel-help", id: `help-${key}` }, (CONFIG.panels.find((p) => p.id === key) || {}).help || "");
+  help.hidden = true;
+  const info = el("button", {
+    type: "button", className: "tool info", title: "what this panel shows",
+    onclick: () => { help.hidden = !help.hidden; info.setAttribute("aria-expanded", String(!help.hidden)); },
+  }, "?");
+  info.setAttribute("aria-controls", help.id);
+  info.setAttribute("aria-expanded", "false");
   const save = (format) => el("button", {
-    type: "button", className: "tool", title: `save this panel as ${format.toUpperCase()}`,
-    onclick: () => Plotly.downloadImage(div, { format, filename: `jik-${key}`, scale: format === "png" ? 2 : 1 }),
+    type: "button", className: "tool", title: `save this panel as ${format.toUpperCase()}, with its legend and state`,
+    onclick: () => saveImage(div, key, format),
   }, format.toUpperCase());
-  div.append(el("div", { className: "panel-tools", title: "drag to zoom, double-click to reset" }, save("png"), save("svg")));
+  const csv = el("button", {
+    type: "button", className: "tool", title: "save this table as CSV, with its notes and the state it shows",
+    onclick: () => saveTable(div, key),
+  }, "CSV");
+  const tools = el("div", { className: "panel-tools", title: plot ? "drag to zoom, double-click to reset" : "" },
+    info, ...(plot ? [save("png"), save("svg")] : [csv]));
+  div.prepend(el("div", { className: "panel-head" }, algorithmKey(), tools), help);
+}
+const panelTools = (div, key) => panelHead(div, key, true);
+
+// A table panel as CSV: '#' lines with the state it shows, its title, notes and the cells that
+// differ from the paper's print, then the table as on screen.
+function saveTable(div, key) {
+  const quote = (v) => (/[",\n]/.test(v) ? `"${v.replace(/"/g, '""')}"` : v);
+  const header = [...div.querySelectorAll("thead th")].map((th) => th.textContent);
+  const rows = [...div.querySelectorAll("tbody tr")].map((tr) => [...tr.children].map((td) => td.textContent));
+  const lines = [`# ${exportNote}`, `# ${div.querySelector(".table-title").textContent}`];
+  for (const note of div.querySelectorAll(".table-note")) lines.push(`# ${note.textContent}`);
+  div.querySelectorAll("td.differs").forEach((td) => {
+    const row = td.parentElement.children[0].textContent;
+    lines.push(`# differs from the print: row ${row}, ${header[td.cellIndex]}: ${td.textContent} (${td.title})`);
+  });
+  lines.push(header.map(quote).join(","), ...rows.map((r) => r.map(quote).join(",")));
+  const link = el("a", { href: URL.createObjectURL(new Blob([`${lines.join("\n")}\n`], { type: "text/csv" })), download: `jik-${key}.csv` });
+  document.body.append(link);
+  link.click();
+  link.remove();
+  setTimeout(() => URL.revokeObjectURL(link.href), 1000);
+}
+
+// The panel as an image: the figure on screen with its legend shown and, under it, the
+// result and state it shows (an image saved alone still says what it is).
+function saveImage(div, key, format) {
+  const layout = JSON.parse(JSON.stringify(div.layout));
+  const height = (layout.height || div.clientHeight) + 110;
+  const margin = { ...(layout.margin || {}), b: ((layout.margin || {}).b || 48) + 110 };
+  const note = { text: exportNote, xref: "paper", yref: "paper", x: 0, y: 0, yshift: -margin.b + 14, xanchor: "left", yanchor: "bottom", showarrow: false, font: { size: 9, color: "#444" } };
+  Object.assign(layout, {
+    showlegend: true, height, margin,
+    legend: { orientation: "h", x: 0, xanchor: "left", y: 0, yanchor: "top", yref: "container", font: { size: 10 } },
+    annotations: [...(layout.annotations || []), note],
+  });
+  return Plotly.downloadImage({ data: div.data, layout }, {
+    format, filename: `jik-${key}`, scale: format === "png" ? 2 : 1, width: div.clientWidth, height,
+  });
 }
 
 export const drawn = {}; // panel -> digest of the figure on screen
@@ -152,7 +232,7 @@ export async function drawFigures(figures, digests = {}, robot = null) {
       }
       if (isTable(fig)) {
         onScreen[key] = null;
-        drawTable(div, fig);
+        drawTable(div, fig, key);
         return null;
       }
       div.classList.remove("html-table");

@@ -20,8 +20,10 @@ from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from typing import Any
 
+from jik.app.dashboard.glossary import SYMBOLS
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS, robot_spec
+from jik.engine.solver import MAX_ITERATIONS, MAX_STEPS
 
 #: gamma's range per mode: the decay rate of eq. (5) (continuous), the step of the discrete
 #: iteration, which converges only for 0 < gamma < 2.
@@ -32,6 +34,8 @@ GAMMA_STEP = 0.001
 DISCRETE_GAMMA_ON_SWITCH = 1.0
 #: Largest number of cycles offered by the dashboard (the engine accepts more).
 MAX_DASHBOARD_CYCLES = 20
+#: The range of the cap on iterations (or integrator steps) per leg.
+MIN_ITERATIONS, MAX_ITERATIONS_CAP = 10, 200_000
 #: Positions of a slider between its ends (x0's: finer).
 SLIDER_STEPS, X0_STEPS = 200, 400
 #: How a closed path is written in a text box: points separated by ';', coordinates by ','.
@@ -51,7 +55,7 @@ class Control:
     """One control. ``kind``: ``select`` (``options``), ``slider`` (``minimum``..``maximum`` by
     ``step``, on a ``log`` scale or not, ``integer`` or not), ``vector`` (``size`` numbers, each
     within ``minimum``/``maximum`` lists), ``text`` (``format``), ``preset`` (a button that sets
-    ``key`` to ``value``)."""
+    ``key`` to ``value``); ``inline``: a select shown as buttons."""
 
     key: str
     label: str
@@ -68,6 +72,8 @@ class Control:
     format: str = ""
     value: Any = None
     id: str = ""
+    #: A select whose options all show at once (buttons on the page: one click to any).
+    inline: bool = False
 
     def as_dict(self) -> dict:
         out = asdict(self)
@@ -87,18 +93,18 @@ def controls(state) -> list[Control]:
         Control("mode", "mode", "select", "algorithm",
                 "continuous: the ODE (7); discrete: the iteration x <- x - gamma J# e",
                 options=tuple((m, m) for m in MODES)),
-        Control("gamma", "γ (decay rate)", "slider", "algorithm",
-                "decay rate of the task error, eq. (5) (discrete mode: the step, below 2)",
+        Control("gamma", "γ (decay rate)", "slider", "algorithm", SYMBOLS["gamma"],
                 minimum=lo, maximum=hi, step=GAMMA_STEP, log=True),
     ]  # fmt: skip
+    out.append(iterations_control(state))
     for p in spec.parameters:
         out.append(Control(f"robot_parameters.{p.name}", p.name, "slider", "algorithm",
-                           p.description, minimum=p.minimum, maximum=p.maximum,
+                           explained(p.name, p.description), minimum=p.minimum, maximum=p.maximum,
                            step=(p.maximum - p.minimum) / SLIDER_STEPS))  # fmt: skip
     for v in spec.vector_parameters:
         out.append(Control(f"robot_parameters.{v.name}", v.name, "vector", "algorithm",
-                           v.description, minimum=list(v.minimum), maximum=list(v.maximum),
-                           step=0.1, size=len(v.default)))  # fmt: skip
+                           explained(v.name, v.description), minimum=list(v.minimum),
+                           maximum=list(v.maximum), step=0.1, size=len(v.default)))  # fmt: skip
         for name, preset in v.presets.items():
             shown = ", ".join(f"{t:.2f}" for t in preset)
             out.append(Control(f"robot_parameters.{v.name}", f"{v.name} = {name} ({shown})",
@@ -106,18 +112,24 @@ def controls(state) -> list[Control]:
                                value=[float(t) for t in preset],
                                id=f"ctl-preset-{v.name}-{name}"))  # fmt: skip
     out.append(Control("augmentation", "augmenting map h", "select", "algorithm",
-                       "the map h of the extended Jacobian (11)",
+                       SYMBOLS["h"] + "; one button per map of the paper for this robot",
                        options=tuple((a.name, f"{a.name} {a.equation}")
-                                     for a in spec.augmentations)))  # fmt: skip
+                                     for a in spec.augmentations), inline=True))  # fmt: skip
     for p in aug.parameters:
         out.append(Control(f"augmentation_parameters.{p.name}", p.name, "slider", "algorithm",
-                           p.description, minimum=p.minimum, maximum=p.maximum,
+                           explained(p.name, p.description), minimum=p.minimum, maximum=p.maximum,
                            step=(p.maximum - p.minimum) / SLIDER_STEPS))  # fmt: skip
     for i, name in enumerate(spec.variable_names):
         lo, hi = spec.x_range[i] if spec.x_range else (-10.0, 10.0)
         out.append(Control(f"x0.{i}", f"x0: {name}", "slider", "start",
-                           f"start configuration, coordinate {name}",
+                           f"start configuration, coordinate {name}. {SYMBOLS['x0']}",
                            minimum=lo, maximum=hi, step=(hi - lo) / X0_STEPS))  # fmt: skip
+    if len(spec.variable_names) > 3:
+        names = spec.variable_names
+        out.append(Control("cspace_axes", "configuration-space axes", "select", "start",
+                           "the three coordinates the configuration-space panel shows",
+                           options=tuple((c, ", ".join(names[int(k)] for k in c))
+                                         for c in ("012", "013", "023", "123"))))  # fmt: skip
     if spec.default_path:
         out.append(Control("task", "task", "select", "start",
                            "drive a closed path cycle after cycle, or solve for one target",
@@ -136,6 +148,29 @@ def controls(state) -> list[Control]:
     return out
 
 
+def explained(name: str, description: str) -> str:
+    """A parameter's description from the registry, with the paper's symbol explained."""
+    return f"{description}. {SYMBOLS[name]}" if name in SYMBOLS else description
+
+
+def iterations_control(state) -> Control:
+    """The cap on each leg's iterations (discrete mode) or integrator steps (continuous), which
+    a leg that does not converge names in its message."""
+    what = "iterations" if state.mode == "discrete" else "integrator steps"
+    return Control("max_iterations", f"max {what} per leg", "slider", "algorithm",
+                   f"a leg that has not reached its target after this many {what} stops and "
+                   "says so (raise it for far targets or small γ; the work grows with it)",
+                   minimum=MIN_ITERATIONS, maximum=MAX_ITERATIONS_CAP, step=1, log=True,
+                   integer=True)  # fmt: skip
+
+
+def max_iterations(state) -> int:
+    """The cap in force: the state's, or the engine's default for its mode."""
+    if state.max_iterations is not None:
+        return int(state.max_iterations)
+    return MAX_ITERATIONS if state.mode == "discrete" else MAX_STEPS
+
+
 def element_id(key: str) -> str:
     """The page's element id of the control ``key``: ``ctl-gamma``, ``ctl-x0-1``, ``ctl-l``
     (a robot parameter), ``ctl-aug-a`` (a parameter of the map)."""
@@ -151,7 +186,12 @@ def control_values(state, spec: list[Control] | None = None) -> dict[str, Any]:
     for c in controls(state) if spec is None else spec:
         if c.kind == "preset":
             continue
-        values[c.key] = path_text(state.path) if c.key == "path" else lookup(d, c.key)
+        if c.key == "max_iterations":
+            values[c.key] = max_iterations(state)
+        elif c.key == "cspace_axes":
+            values[c.key] = state.cspace_axes or "012"
+        else:
+            values[c.key] = path_text(state.path) if c.key == "path" else lookup(d, c.key)
     return values
 
 
@@ -172,7 +212,10 @@ def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
     for key, value in patch.items():
         head, _, rest = key.partition(".")
         if not rest:
-            out[key] = parse_path_text(value) if key == "path" and isinstance(value, str) else value
+            size = len(state.target) if "robot" not in patch else None
+            out[key] = (
+                parse_path_text(value, size) if key == "path" and isinstance(value, str) else value
+            )
         elif head in ("robot_parameters", "augmentation_parameters"):
             out.setdefault(head, {})[rest] = value
         elif head in ("x0", "target") and rest.isdigit():
@@ -198,20 +241,26 @@ def _number(v: float) -> str:
     return text[:-2] if text.endswith(".0") else text
 
 
-def parse_path_text(text: str) -> list[list[float]]:
-    """The points of a path written as :data:`PATH_FORMAT`."""
+def parse_path_text(text: str, size: int | None = None) -> list[list[float]]:
+    """The points of a path written as :data:`PATH_FORMAT`; ``size``: the task's dimension,
+    which every point must have. A refusal quotes the point as the user wrote it."""
     points = []
-    for part in text.split(";"):
-        if not part.strip():
-            continue
+    parts = [p for p in text.split(";") if p.strip()]
+    for k, part in enumerate(parts, start=1):
+        where = f"point {k} of {len(parts)}, '{part.strip()}',"
         try:
             point = [float(v) for v in part.split(",")]
         except ValueError:
             raise InvalidInputError(
-                f"path must be written '{PATH_FORMAT}', got {text!r}", "path"
+                f"path: {where} is not numbers separated by ',' (write '{PATH_FORMAT}')", "path"
             ) from None
         if not all(math.isfinite(v) for v in point):
-            raise InvalidInputError("path must have finite coordinates", "path")
+            raise InvalidInputError(f"path: {where} has a coordinate that is not finite", "path")
+        if size is not None and len(point) != size:
+            raise InvalidInputError(
+                f"path: {where} has {len(point)} coordinate{'s' if len(point) > 1 else ''}; "
+                f"each point needs {size} (write '{PATH_FORMAT}')", "path",
+            )  # fmt: skip
         points.append(point)
     return points
 

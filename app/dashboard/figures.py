@@ -16,8 +16,9 @@ from __future__ import annotations
 import numpy as np
 import plotly.graph_objects as go
 
+from jik.app.dashboard.cspace import cspace_spec
 from jik.app.dashboard.map_figures import augmenting_spec, sensitivity_spec
-from jik.app.dashboard.model import ALGORITHMS, COLORS, LABELS
+from jik.app.dashboard.model import ALGORITHMS, COLORS, DASH, LABELS
 from jik.app.dashboard.plotting import (
     NO_LEGEND,
     SYMBOLS,
@@ -27,6 +28,7 @@ from jik.app.dashboard.plotting import (
     leg_names,
     log_range,
     nice_range,
+    norm_unit,
     stacked_axes,
     theta_label,
     to_go,
@@ -34,7 +36,10 @@ from jik.app.dashboard.plotting import (
     units,
 )
 from jik.app.dashboard.runs import DashboardResult
-from jik.engine.reproductions.table1 import cell
+from jik.app.dashboard.table import table_spec
+
+#: Names of the algorithms where a panel has little room (its subplots' titles).
+SHORT_LABELS = {"pseudoinverse": "J^P# (8)", "extended": "J^E# (11)"}
 
 
 def _task_space(result: DashboardResult) -> dict:
@@ -48,7 +53,7 @@ def _task_space(result: DashboardResult) -> dict:
             trace("scatter",
                 x=run.y[:, 0], y=run.y[:, 1], mode="lines", name=LABELS[a],
                 line=dict(color=COLORS[a], width=4 if a == "pseudoinverse" else 1.8,
-                          dash="solid" if a == "pseudoinverse" else "dash"),
+                          dash=DASH[a]),
                 customdata=run.leg + 1,  # (theta stays out: this panel does not depend on gamma)
                 hovertemplate=f"{n1} = %{{x:.4f}}<br>{n2} = %{{y:.4f}}"
                 "<br>leg %{customdata}<extra>" + a + "</extra>",
@@ -94,7 +99,8 @@ def _joints(result: DashboardResult) -> dict:
             data.append(
                 trace("scatter",
                     x=run.theta, y=run.x[:, k], mode="lines", name=LABELS[a],
-                    legendgroup=a, showlegend=k == 0, line=dict(color=COLORS[a], width=1.8),
+                    legendgroup=a, showlegend=k == 0,
+                    line=dict(color=COLORS[a], width=1.8, dash=DASH[a]),
                     xaxis="x", yaxis="y" if k == 0 else f"y{k + 1}",
                     hovertemplate=f"{name} = %{{y:.5f}}<br>θ = %{{x:.4g}}<extra>{a}</extra>",
                 )
@@ -128,7 +134,8 @@ def _drift(result: DashboardResult) -> dict:
             data.append(
                 trace("scatter",
                     x=np.arange(1, len(run.drift) + 1), y=np.maximum(run.drift, 1e-16),
-                    mode="lines+markers", name=LABELS[a], line=dict(color=COLORS[a], width=2),
+                    mode="lines+markers", name=LABELS[a],
+                    line=dict(color=COLORS[a], width=2, dash=DASH[a]),
                     marker=dict(symbol=SYMBOLS[a], size=9),
                     hovertemplate="cycle %{x}: drift %{y:.3e}<extra>" + a + "</extra>",
                 )
@@ -137,7 +144,7 @@ def _drift(result: DashboardResult) -> dict:
             data.append(
                 trace("scatter",
                     x=run.theta, y=np.maximum(run.error, 1e-16), mode="lines", name=LABELS[a],
-                    line=dict(color=COLORS[a], width=2),
+                    line=dict(color=COLORS[a], width=2, dash=DASH[a]),
                     hovertemplate="‖k(x) − y_d‖ = %{y:.3e}<br>θ = %{x:.4g}<extra>" + a + "</extra>",
                 )
             )  # fmt: skip
@@ -149,7 +156,8 @@ def _drift(result: DashboardResult) -> dict:
             "Repeatability: joint drift after each closed cycle",
             **NO_LEGEND,
             xaxis=dict(title="cycle", dtick=1, range=[0.5, cycles + 0.5]),
-            yaxis=dict(title="‖x(end of cycle) − x0‖ (log)", type="log", exponentformat="power",
+            yaxis=dict(title=f"‖x(end of cycle) − x0‖ {norm_unit(units(result)[0])} (log)",
+                       type="log", exponentformat="power",
                        range=log_range(ys)),
         )  # fmt: skip
     theta = np.concatenate([result.runs[a].theta for a in ALGORITHMS])
@@ -158,42 +166,16 @@ def _drift(result: DashboardResult) -> dict:
         "Convergence: task error",
         **NO_LEGEND,
         xaxis=dict(title=theta_label(result), range=nice_range(theta, from_zero=True)),
-        yaxis=dict(title="‖k(x) − y_d‖ (log)", type="log", exponentformat="power",
+        yaxis=dict(title=f"‖k(x) − y_d‖ {norm_unit(units(result)[1])} (log)", type="log",
+                   exponentformat="power",
                    range=log_range(ys)),
     )  # fmt: skip
 
 
 def _table(result: DashboardResult) -> dict:
-    """The configuration after every leg for both algorithms, as in Table 1 of the paper."""
-    names = result.variable_names
-    L = len(result.targets)
-    legs = leg_names(L)
-    rows = max(len(result.runs[a].leg_end) for a in ALGORITHMS)
-    point = ["start x0"] + [
-        f"{c // L + 1}: {legs[c % L]} {_fmt_point(result.targets[c % L])}" for c in range(rows)
-    ]
-    cols: list[list[str]] = [point]
-    header = ["cycle: point"]
-    for a in ALGORITHMS:
-        ends = np.vstack([np.asarray(result.state.x0)[None, :], result.runs[a].leg_end])
-        for k, name in enumerate(names):
-            header.append(f"{'J^P#' if a == 'pseudoinverse' else 'J^E#'} {name}")
-            cols.append([cell(v, 0) for v in ends[:, k]] + [""] * (rows + 1 - len(ends)))
-    fills = ["#f4f4f4"] + ["#fbe3e3" if h.startswith("J^P#") else "#e1ecf7" for h in header[1:]]
-    table = trace("table",
-        # (fill=dict(color=...): plotly.py's "fill_color" shorthand is expanded only by its
-        # validation, which the builders skip; the page reads fill.color)
-        header=dict(values=header, fill=dict(color=fills), font=dict(size=11), align="center"),
-        cells=dict(values=cols, font=dict(size=11, family="monospace"), align="right",
-                   fill=dict(color=[["white", "#f7f7f7"] * (rows + 1)])),
-    )  # fmt: skip
-    return figure(
-        [table], "Configurations after each leg (Table 1)", margin=dict(l=10, r=10, t=40, b=10)
-    )
-
-
-def _fmt_point(p) -> str:
-    return "(" + ", ".join(f"{v:.3g}" for v in p) + ")"
+    """Table 1 of the paper beside jik's numbers, or the table of leg ends
+    (:mod:`jik.app.dashboard.table`)."""
+    return table_spec(result)
 
 
 def _platform(result: DashboardResult, max_paths: int = 12) -> dict:
@@ -213,7 +195,8 @@ def _platform(result: DashboardResult, max_paths: int = 12) -> dict:
                 trace("scatter",
                     x=P[i, :, 0], y=P[i, :, 1], mode="lines", xaxis=xa, yaxis=ya,
                     name=LABELS[a] if last else f"{a} iteration {i}", legendgroup=a,
-                    showlegend=last, line=dict(color=COLORS[a], width=3 if last else 1),
+                    showlegend=last,
+                    line=dict(color=COLORS[a], width=3 if last else 1, dash=DASH[a]),
                     opacity=1.0 if last else 0.2 + 0.5 * n / max(len(show), 1),
                     customdata=result.time,
                     hovertemplate=f"iteration {i}<br>q1 = %{{x:.3f}}<br>q2 = %{{y:.3f}}"
@@ -231,7 +214,7 @@ def _platform(result: DashboardResult, max_paths: int = 12) -> dict:
             )
         )  # fmt: skip
         annotations.append(
-            dict(text=LABELS[a], xref=f"{xa} domain", yref=f"{ya} domain", x=0.5, y=1.0,
+            dict(text=SHORT_LABELS[a], xref=f"{xa} domain", yref=f"{ya} domain", x=0.5, y=1.0,
                  yanchor="bottom", showarrow=False, font=dict(size=11, color=COLORS[a]))
         )  # fmt: skip
     return figure(
@@ -251,7 +234,7 @@ def gamma_free_panels(result: DashboardResult) -> set[str]:
     """Panels that do not change with gamma in continuous mode (theta is not on their axes)."""
     if result.state.mode != "continuous":
         return set()
-    panels = {"table", "augmenting"} | ({"task"} if not is_unicycle(result) else set())
+    panels = {"table", "augmenting", "cspace"} | ({"task"} if not is_unicycle(result) else set())
     return panels | ({"drift"} if result.state.task == "path" else set())
 
 
@@ -268,6 +251,7 @@ def figure_specs(
         "joints": _joints,
         "drift": _drift,
         "table": _table,
+        "cspace": cspace_spec,
         "augmenting": lambda r: augmenting_spec(r, functionals),
         "sensitivity": lambda r: sensitivity_spec(r, sensitivity),
     }
@@ -322,3 +306,9 @@ def augmenting_figure(result: DashboardResult, functionals: dict | None = None) 
 def sensitivity_figure(result: DashboardResult, sens: dict | None = None) -> go.Figure:
     """E1 (13) and E2 (18) of the current map and how they change with its parameters."""
     return to_go(sensitivity_spec(result, sens))
+
+
+def cspace_figure(result: DashboardResult) -> go.Figure:
+    """Both joint paths in configuration space with the level surface h = h(x0) and the
+    self-motion manifolds of the corners."""
+    return to_go(cspace_spec(result))

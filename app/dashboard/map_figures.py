@@ -4,12 +4,13 @@ maps."""
 
 from __future__ import annotations
 
+import textwrap
 from typing import Any
 
 import numpy as np
 
 from jik.app.dashboard.analysis import state_inert_variables
-from jik.app.dashboard.model import ALGORITHMS, COLORS, LABELS
+from jik.app.dashboard.model import ALGORITHMS, COLORS, DASH, LABELS
 from jik.app.dashboard.plotting import NO_LEGEND, figure, label, trace, units
 from jik.app.dashboard.runs import DashboardResult
 
@@ -53,7 +54,7 @@ def augmenting_spec(result: DashboardResult, functionals: dict | None = None) ->
     ]  # fmt: skip
     shapes: list[dict[str, Any]] = [
         dict(type="path", path=_svg_path(result.runs[a].x[:, i], result.runs[a].x[:, j]),
-             line=dict(color=COLORS[a], width=2.5), name=LABELS[a])
+             line=dict(color=COLORS[a], width=2.5, dash=DASH[a]), name=LABELS[a])
         for a in ALGORITHMS
     ]  # fmt: skip
     x0 = result.state.x0
@@ -87,7 +88,7 @@ def augmenting_title(result: DashboardResult, functionals: dict | None = None) -
         return title + " (computing h on a grid…)"
     i, j = grid["axes"]
     x0 = result.state.x0
-    sub = []
+    sub = [] if functionals else ["E1, E2: computing…"]  # (a line now: the title keeps its height)
     if functionals:
         values = {k: functionals.get(k) for k in ("E1", "E2")}
         where = "the plotted box"
@@ -111,13 +112,46 @@ def augmenting_title(result: DashboardResult, functionals: dict | None = None) -
     if fixed:
         sub.append("at " + ", ".join(fixed))
     sub.append("○ x0")
-    if sub:
-        title += "<br><sup>" + " · ".join(sub) + "</sup>"
-    return title
+    return title + "".join(f"<br><sup>{line}</sup>" for line in wrap(sub))
+
+
+#: Characters of a subtitle line that fit a half-width panel at 1280 px.
+SUBTITLE_CHARS = 70
+
+
+def wrap(parts: list[str], width: int = SUBTITLE_CHARS) -> list[str]:
+    """The subtitle's parts joined by " · " into lines of about ``width`` characters (a long
+    part on its own line), so that no panel cuts its subtitle off."""
+    lines: list[str] = []
+    for part in parts:
+        if lines and len(lines[-1]) + 3 + len(part) <= width:
+            lines[-1] += " · " + part
+        else:
+            lines.append(part)
+    return lines
+
+
+def message_figure(title: str, message: str) -> dict:
+    """A panel with nothing to plot: its title, and ``message`` where the plot would be (no
+    empty axes)."""
+    hidden = dict(visible=False)
+    return figure([], title, xaxis=hidden, yaxis=hidden, annotations=[dict(
+        text=message, xref="paper", yref="paper", x=0.5, y=0.5, showarrow=False,
+        font=dict(size=12, color="#555"))])  # fmt: skip
 
 
 #: Colours of the functionals (the algorithms keep red and blue).
 E_COLORS = {"E1": "#2ca02c", "E2": "#9467bd"}
+
+
+def log_ticks(values) -> dict:
+    """Ticks of a log axis over ``values`` that do not crowd: each decade when they span more
+    than one and a half, else 1, 2 and 5 per decade (plotly's default labels 2..9 overlap)."""
+    v = np.asarray([x for x in values if x is not None], dtype=float)
+    v = v[np.isfinite(v) & (v > 0)]
+    if v.size and np.log10(v.max() / v.min()) > 1.5:
+        return dict(dtick=1)
+    return dict(dtick="D2")
 
 
 def sensitivity_spec(result: DashboardResult, sens: dict | None = None) -> dict:
@@ -130,9 +164,9 @@ def sensitivity_spec(result: DashboardResult, sens: dict | None = None) -> dict:
     """
     aug = result.state.augmentation
     if sens is None:
-        return figure([], f"E1, E2 of {aug}: computing…")
+        return message_figure(f"E1, E2 of {aug}: computing…", "computing E1 and E2…")
     if sens["kind"] == "unavailable":
-        return figure([], f"E1, E2 of {aug}<br><sup>{sens['reason']}</sup>")
+        return message_figure(f"E1, E2 of {aug}", "<br>".join(textwrap.wrap(sens["reason"], 50)))
     log = dict(type="log", exponentformat="power")
     if sens["kind"] == "alternatives":
         maps = sens["maps"]
@@ -150,13 +184,15 @@ def sensitivity_spec(result: DashboardResult, sens: dict | None = None) -> dict:
             f"E1 (13), E2 (18) of the maps of this robot<br><sup>{aug} has no parameters: "
             "the alternatives on the same box</sup>",
             barmode="group",
-            yaxis=dict(title="E (log)", **log),
+            yaxis=dict(
+                title="E (log)", **log, **log_ticks([m[k] for m in maps for k in ("E1", "E2")])
+            ),
         )
     params = sens["parameters"]
     names = list(params)
     n = len(names)
     data, layout = [], {}
-    gap = 0.08
+    gap = 0.2  # (room for the next subplot's y tick labels)
     width = (1.0 - gap * (n - 1)) / n
     for c, name in enumerate(names):
         xa, ya = ("x", "y") if c == 0 else (f"x{c + 1}", f"y{c + 1}")
@@ -178,10 +214,11 @@ def sensitivity_spec(result: DashboardResult, sens: dict | None = None) -> dict:
         lo = c * (width + gap)
         layout["xaxis" if c == 0 else f"xaxis{c + 1}"] = dict(
             domain=[round(lo, 6), round(min(1.0, lo + width), 6)], title=name,
-            anchor=ya,
+            anchor=ya, nticks=5,
         )  # fmt: skip
+        ys = [y for k in ("E1", "E2") for y in sens[k]["sweeps"][name]["functional"]]
         layout["yaxis" if c == 0 else f"yaxis{c + 1}"] = dict(
-            anchor=xa, **log, **({"title": "E (log)"} if c == 0 else {})
+            anchor=xa, **log, **log_ticks(ys), **({"title": "E (log)"} if c == 0 else {})
         )
     slopes = []
     for k in ("E1", "E2"):
@@ -191,9 +228,5 @@ def sensitivity_spec(result: DashboardResult, sens: dict | None = None) -> dict:
             for p in names
         ))  # fmt: skip
     at = ", ".join(f"{p} = {v:.3g}" for p, v in params.items())
-    return figure(
-        data,
-        f"E1 (13), E2 (18) as the parameters of {aug} move"
-        f"<br><sup>at {at} (circles): {'; '.join(slopes)}</sup>",
-        **layout,
-    )
+    sub = "".join(f"<br><sup>{line}</sup>" for line in wrap([f"at {at} (circles)", *slopes]))
+    return figure(data, f"E1 (13), E2 (18) as the parameters of {aug} move{sub}", **layout)

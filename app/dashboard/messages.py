@@ -5,6 +5,7 @@ from __future__ import annotations
 import asyncio
 import hashlib
 import json
+import math
 from collections import OrderedDict
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -68,7 +69,28 @@ def digest(text: str) -> str:
 
 
 def to_json(obj) -> str:
-    return json.dumps(obj, separators=(",", ":"), allow_nan=False, default=jsonable)
+    """``obj`` as JSON, NaN and infinities as null (:func:`finite`): the one place where a
+    dashboard's results become JSON (events, exports), so that an undefined h or a diverged
+    iterate never reaches an encoder that refuses it."""
+    return json.dumps(finite(obj), separators=(",", ":"), allow_nan=False, default=jsonable)
+
+
+def finite(v):
+    """``v`` with every non-finite float (NaN, inf) made None, through dicts, lists, tuples
+    and numpy arrays (a float array becomes a list with None where it is not finite)."""
+    if isinstance(v, dict):
+        return {k: finite(x) for k, x in v.items()}
+    if isinstance(v, list | tuple):
+        return [finite(x) for x in v]
+    if isinstance(v, float | np.floating):
+        return float(v) if math.isfinite(v) else None
+    if isinstance(v, np.ndarray) and v.dtype.kind in "fc":
+        if np.isfinite(v).all():
+            return v.tolist()
+        out = v.astype(object)
+        out[~np.isfinite(v)] = None
+        return out.tolist()
+    return v
 
 
 def with_figures(message: dict, figures: Mapping[str, str]) -> str:
@@ -85,6 +107,16 @@ def jsonable(v):
     raise TypeError(f"not JSON serialisable: {type(v).__name__}")
 
 
+def h_change(h) -> float | None:
+    """How much h varied along a run (max - min over its finite values); None without h or
+    without a finite value (h undefined from the start)."""
+    if h is None:
+        return None
+    v = np.asarray(h, dtype=float)
+    v = v[np.isfinite(v)]
+    return float(v.max() - v.min()) if v.size else None
+
+
 def summary(result: DashboardResult) -> dict:
     """Numbers shown beside the plots: per algorithm success, message, drift, final x."""
     out = {}
@@ -94,7 +126,7 @@ def summary(result: DashboardResult) -> dict:
             "message": run.message,
             "drift": [float(d) for d in run.drift],
             "x_final": [float(v) for v in run.x[-1]],
-            "h_change": None if run.h is None else float(np.max(run.h) - np.min(run.h)),
+            "h_change": h_change(run.h),
             "points": len(run.theta),
             "seconds": round(run.seconds, 4),
             "cached": bool(result.cached.get(a, False)),

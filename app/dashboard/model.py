@@ -26,7 +26,13 @@ from jik.app.compute.schemas import (
     Mode,
     Tolerance,
 )
-from jik.app.dashboard.controls import MAX_DASHBOARD_CYCLES, expand
+from jik.app.dashboard.controls import (
+    MAX_DASHBOARD_CYCLES,
+    MAX_ITERATIONS_CAP,
+    MIN_ITERATIONS,
+    expand,
+    max_iterations,
+)
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS, robot_spec
 from jik.engine.repeatability import MAX_PATH_POINTS
@@ -34,6 +40,8 @@ from jik.engine.repeatability import MAX_PATH_POINTS
 ALGORITHMS = ("pseudoinverse", "extended")
 #: One colour per algorithm, used in the scene and in every plot.
 COLORS = {"pseudoinverse": "#d62728", "extended": "#1f77b4"}
+#: One line style per algorithm, in every plot (its robot in the 3D scene: translucent, opaque).
+DASH = {"pseudoinverse": "solid", "extended": "dash"}
 LABELS = {"pseudoinverse": "pseudoinverse J^P# (8)", "extended": "extended Jacobian J^E# (11)"}
 DEFAULT_ROBOT = "manipulator2"
 
@@ -63,6 +71,13 @@ class DashboardState(BaseModel):
     path: Annotated[tuple[Point, ...], Field(max_length=MAX_PATH_POINTS)]
     cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_DASHBOARD_CYCLES), INTEGRAL]
     tolerance: Tolerance = 1e-10
+    #: Cap on each leg's iterations (discrete) or integrator steps (continuous); None: the
+    #: engine's default (:func:`jik.engine.solver.solve`).
+    #: The three coordinates the configuration-space panel shows (p = 4): "012" is x1, x2, x3.
+    cspace_axes: Literal["012", "013", "023", "123"] | None = None
+    max_iterations: (
+        Annotated[int, Field(strict=True, ge=MIN_ITERATIONS, le=MAX_ITERATIONS_CAP)] | None
+    ) = None
 
     def as_dict(self) -> dict:
         """The state as JSON data (tuples as lists)."""
@@ -225,7 +240,12 @@ def validate(data: Mapping[str, Any]) -> DashboardState:
         raise InvalidInputError(
             f"gamma: must be < 2 in discrete mode, got {state.gamma:g}", "gamma"
         )
+    # The engine's default cap, set by its value, is the default (None): it follows the mode.
+    default_cap = max_iterations(state.model_copy(update={"max_iterations": None}))
     return state.model_copy(update={
+        "max_iterations": None if state.max_iterations == default_cap else state.max_iterations,
+        # (the first three coordinates are the default, and all there is for p = 3)
+        "cspace_axes": None if state.cspace_axes == "012" or kin.p < 4 else state.cspace_axes,
         "robot_parameters": {k: tuple(v) if isinstance(v, list | tuple) else v
                              for k, v in params.items()},
         "augmentation_parameters": aug_params,
@@ -256,6 +276,7 @@ def _registered(check, name: str):
 
 def cache_key(state: DashboardState, algorithm: str) -> str:
     d = state.as_dict()
+    d.pop("cspace_axes")  # (what a panel shows, not what is solved)
     if algorithm == "pseudoinverse":
         d.pop("augmentation"), d.pop("augmentation_parameters")
     if state.mode == "continuous":

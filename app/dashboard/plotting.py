@@ -23,7 +23,7 @@ PANEL_HEIGHT = 380
 #: Panel ids, in the page's order, with their size on the page's grid ("wide": a whole row,
 #: "tall": two rows).
 PANEL_SIZES = {"task": "wide", "drift": "", "joints": "tall", "augmenting": "",
-               "sensitivity": "", "table": "wide"}  # fmt: skip
+               "sensitivity": "", "cspace": "full", "table": "wide"}  # fmt: skip
 PANELS = tuple(PANEL_SIZES)
 AXIS = dict(
     gridcolor="#e6e6e6", zerolinecolor="#b0b0b0", linecolor="#888", showline=True, mirror=True,
@@ -59,6 +59,15 @@ def label(name: str, unit: str) -> str:
     return f"{name} [{unit}]" if unit else name
 
 
+def norm_unit(unit_names) -> str:
+    """The unit of a Euclidean norm of coordinates in ``unit_names``: one unit, or the units
+    it mixes said so ("1": dimensionless)."""
+    names = [("dimensionless" if u == "1" else u) for u in dict.fromkeys(unit_names) if u]
+    if len(names) <= 1:
+        return f"[{names[0]}]" if names else ""
+    return f"[{' and '.join(names)} mixed]"
+
+
 def is_unicycle(result: DashboardResult) -> bool:
     """Results with platform paths (the unicycle) get the platform figures."""
     return any(r.platform is not None for r in result.runs.values())
@@ -87,7 +96,13 @@ NO_LEGEND = dict(showlegend=False, margin=dict(l=64, r=20, t=48, b=48))
 def figure(data: list, title: str, **layout) -> dict:
     """A figure dict (a spec) with the panels' common layout, not validated by plotly (the
     server builds every panel on each change); tests/app/test_figures.py validates every one."""
-    base = {**LAYOUT, "title": dict(text=title, font=dict(size=13), x=0.01, xanchor="left")}
+    # The title hangs from the top; the top margin has room for each of its lines.
+    base = {**LAYOUT, "title": dict(text=title, font=dict(size=13), x=0.01, xanchor="left",
+                                    yref="container", y=1.0, yanchor="top",
+                                    pad=dict(t=12))}  # fmt: skip
+    margin = dict(layout.get("margin", LAYOUT["margin"]))
+    margin["t"] = max(margin.get("t", 40), 40 + 16 * title.count("<br>"))
+    layout["margin"] = margin
     for key, axis in layout.items():  # an axis title given as text (validation did this)
         if key.startswith(("xaxis", "yaxis")) and isinstance(axis.get("title"), str):
             layout[key] = {**axis, "title": {"text": axis["title"]}}

@@ -11,11 +11,12 @@ from typing import cast
 
 import numpy as np
 
+from jik.app.dashboard.controls import max_iterations
 from jik.app.dashboard.model import DashboardState
 from jik.engine.exceptions import RunCancelled
 from jik.engine.registry import make_inverse, robot_spec
 from jik.engine.repeatability import Leg, Resume, closed_path, repeatability
-from jik.engine.solver import MAX_ITERATIONS, SolveResult, Trajectory
+from jik.engine.solver import SolveResult, Trajectory
 from jik.engine.unicycle import Unicycle
 
 #: Time grid points of one unicycle platform path q(t).
@@ -106,6 +107,7 @@ def _run_legs(
     t0 = time.perf_counter()
     x0 = np.asarray(state.x0)
     continuous = state.mode == "continuous"
+    cap = max_iterations(state)
     L = len(targets)
     parts = []  # (theta, x, y, error, h, leg index) of every leg
     offset, last, failure = 0.0, "", ""  # (the last leg's message; what stopped the run)
@@ -127,16 +129,17 @@ def _run_legs(
         if leg.stopped_by is not None:
             failure = f"{where} stopped: {leg.stopped_by}"
         elif not res.success:
-            failure = f"{where}: {_leg_message(res)}"
+            failure = f"{where}: {_leg_message(res, cap)}"
         else:
-            last = _leg_message(res)
+            last = _leg_message(res, cap)
         progress()
 
     path, close = (state.path, True) if state.task == "path" else (targets, False)
     try:
         run = repeatability(
             inverse, x0, path, cycles, gamma=1.0 if continuous else state.gamma, mode=state.mode,
-            tol=state.tolerance, record=True, close=close, resume=earlier, on_leg=on_leg,
+            tol=state.tolerance, max_iterations=cap, record=True, close=close,
+            resume=earlier, on_leg=on_leg,
             cancelled=cancelled, chunk=None if continuous else CHUNK, on_chunk=partial,
             on_undefined="stop",
         )  # fmt: skip
@@ -161,18 +164,18 @@ def _run_legs(
     )
 
 
-def _leg_message(res: SolveResult) -> str:
-    """A leg's message; a discrete leg's in the dashboard's words (iterations, not tol)."""
-    if res.mode == "continuous":
-        return res.message
-    if res.success:
-        return f"converged: task error {res.error:.3g} after {res.nit} iterations"
-    if res.nit == MAX_ITERATIONS:  # (the engine's cap, which the dashboard keeps)
+def _leg_message(res: SolveResult, cap: int) -> str:
+    """A leg's message in the dashboard's words: a discrete leg in iterations (not tol), and a
+    leg stopped by the cap (``cap``) naming the control that sets it."""
+    if not res.success and "did not converge within" in res.message:
+        what = "iterations" if res.mode == "discrete" else "integrator steps"
         return (
-            f"did not converge within {res.nit} iterations (error {res.error:.3g}); "
-            "raise gamma or move the start"
+            f"did not converge within {cap} {what} (error {res.error:.3g}); raise "
+            f"“max {what} per leg” (a control above) or γ, or move the start"
         )
-    return res.message
+    if res.mode == "continuous" or not res.success:
+        return res.message
+    return f"converged: task error {res.error:.3g} after {res.nit} iterations"
 
 
 def _leg_trajectory(run: AlgorithmRun, k: int) -> Trajectory | None:

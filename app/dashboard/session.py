@@ -1,7 +1,7 @@
 """One session's live dashboard: its state, a worker thread that computes each change, and the
 listeners (the page's event stream, the scene) it tells.
 
-(It stays whole, at about 470 lines: one class, whose worker phases (result, second phase,
+(It stays whole, at about 500 lines: one class, whose worker phases (result, second phase,
 solving ahead) share its lock, its generation and its caches.)
 
 Every change is validated (:mod:`jik.app.dashboard.model`), bumps a generation counter and wakes
@@ -14,6 +14,7 @@ between legs. Idle, it solves the other manipulator ahead for a switch.
 from __future__ import annotations
 
 import contextlib
+import json
 import logging
 import threading
 import time
@@ -31,7 +32,7 @@ from jik.app.dashboard.analysis import (
 from jik.app.dashboard.controls import controls_message
 from jik.app.dashboard.figures import figure_specs, gamma_free_panels
 from jik.app.dashboard.map_figures import augmenting_title
-from jik.app.dashboard.messages import Event, digest, summary, to_json, with_figures
+from jik.app.dashboard.messages import Event, digest, finite, summary, to_json, with_figures
 from jik.app.dashboard.model import (
     ALGORITHMS,
     COLORS,
@@ -47,6 +48,7 @@ from jik.app.dashboard.plotting import PANELS, figure_json, keep_ranges
 from jik.app.dashboard.results import compute
 from jik.app.dashboard.runs import Cancelled, DashboardResult
 from jik.app.dashboard.slots import FairSlots
+from jik.app.dashboard.verdict import verdict
 from jik.engine.exceptions import InvalidInputError, JikError
 
 log = logging.getLogger("jik.dashboard")
@@ -196,7 +198,9 @@ class Dashboard:
             else:
                 self._listeners.insert(self._fast, listener)
                 self._fast += 1
-            kinds = ("state", "result", "functionals")
+            kinds = ["state", "result", "functionals"]
+            if self._failed():  # (a newer generation failed: a new viewer sees why)
+                kinds.append("error")
             latest = [self._latest[k] for k in kinds if k in self._latest]
             latest += [e for r, e in self._latest_ahead.items() if r != self._state.robot]
         for event in latest:
@@ -225,18 +229,28 @@ class Dashboard:
                 self._cond.wait(left)
         return True
 
+    def _failed(self) -> bool:
+        """Whether the latest error is newer than the result on screen (call with the lock)."""
+        error, result = self._latest.get("error"), self._latest.get("result")
+        return error is not None and (result is None or error.generation > result.generation)
+
     def snapshot(self) -> dict:
-        """The current state and the summary of the last result."""
+        """The current state, the summary of the last result, and the error of a newer
+        generation that failed (None when the result is the newest computed)."""
         with self._cond:
             result = self.result
-            return {
-                "generation": self._generation,
-                "computed_generation": None if result is None else result.generation,
-                "state": self._state.as_dict(),
-                "summary": None if result is None else summary(result),
-                "functionals": self.functionals,
-                "scene": dict(self.scene_status),
-            }
+            error = json.loads(self._latest["error"].data) if self._failed() else None
+            return finite(
+                {
+                    "error": error,
+                    "generation": self._generation,
+                    "computed_generation": None if result is None else result.generation,
+                    "state": self._state.as_dict(),
+                    "summary": None if result is None else summary(result),
+                    "functionals": self.functionals,
+                    "scene": dict(self.scene_status),
+                }
+            )
 
     # -- worker -----------------------------------------------------------------------------
     def _state_message(self, generation: int, state: DashboardState, source: str) -> dict:
@@ -270,10 +284,7 @@ class Dashboard:
                 self._prefetch(generation)
             except Exception as exc:  # keep the worker alive; the page shows the message
                 log.exception("dashboard computation failed")
-                message = f"internal error: {type(exc).__name__}: {exc}"
-                self._emit(Event("error", generation, to_json(
-                    {"type": "error", "generation": generation, "message": message})))  # fmt: skip
-                self._finish(generation)
+                self._failure(generation, f"internal error: {type(exc).__name__}: {exc}")
 
     def _prefetch(self, generation: int) -> None:
         """While no change comes, solve the other robots' default states into the run cache:
@@ -355,6 +366,17 @@ class Dashboard:
             texts[k] = figure_json(f)
         return texts
 
+    def _failure(self, generation: int, message: str) -> None:
+        """Announce that ``generation`` failed with ``message``, and which result (if any)
+        stays on screen: its generation and state (``shown``, None when there is none)."""
+        on_screen = self.result
+        shown = None if on_screen is None else {
+            "generation": on_screen.generation, "state": on_screen.state.as_dict()}  # fmt: skip
+        self._emit(Event("error", generation, to_json({
+            "type": "error", "generation": generation, "message": message,
+            "shown": shown})))  # fmt: skip
+        self._finish(generation)
+
     def _finish(self, generation: int) -> None:
         with self._cond:
             self._done = max(self._done, generation)
@@ -401,9 +423,7 @@ class Dashboard:
         except Cancelled:
             return
         except (JikError, ValueError) as exc:
-            self._emit(Event("error", generation, to_json({
-                "type": "error", "generation": generation, "message": str(exc)})))  # fmt: skip
-            self._finish(generation)
+            self._failure(generation, str(exc))
             return
         # Panels that do not depend on gamma are reused from the last result with the same key.
         key = cache_key(state, "extended")
@@ -418,7 +438,8 @@ class Dashboard:
         ready = time.perf_counter()
         head = {
             "type": "result", "generation": generation, "state": state.as_dict(),
-            "summary": summary(result), "colors": COLORS, "labels": LABELS,
+            "summary": summary(result), "verdict": verdict(result), "colors": COLORS,
+            "labels": LABELS,
             "timing": {"compute": result.seconds, "figures": ready - t0 - result.seconds,
                        "server_total": ready - started},
         }  # fmt: skip

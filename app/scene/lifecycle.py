@@ -22,6 +22,7 @@ import numpy as np
 import viser
 
 from jik.app.dashboard import ALGORITHMS, COLORS, Dashboard, Event, runs_key
+from jik.app.dashboard.help import STYLES
 from jik.app.scene.controls import SceneControls
 from jik.app.scene.gizmo import StartGizmo
 from jik.app.scene.mechanisms import (
@@ -127,14 +128,17 @@ class DashboardScene:
         p, e = COLORS["pseudoinverse"], COLORS["extended"]
         gui.add_markdown(
             order=0,
-            content=f"<span style='color:{p}'>■ pseudoinverse J^P# (8)</span>, translucent · "
-            f"<span style='color:{e}'>■ extended Jacobian J^E# (11)</span>, solid · "
-            "grey: start x0",
+            content=f"<span style='color:{p}'>■ pseudoinverse J^P# (8)</span>: "
+            f"{STYLES['pseudoinverse']['robot']} · "
+            f"<span style='color:{e}'>■ extended Jacobian J^E# (11)</span>: "
+            f"{STYLES['extended']['robot']} · grey: start x0 (the plots: "
+            f"{STYLES['pseudoinverse']['line']} and {STYLES['extended']['line']})",
         )
         with gui.add_folder("Playback", order=1):
             self.play = gui.add_button("Pause", icon=None)
             self.speed = gui.add_slider("speed", min=0.1, max=5.0, step=0.1, initial_value=1.0)
             self.scrub = gui.add_slider("position", min=0.0, max=1.0, step=0.001, initial_value=0.0)
+            self.counter = gui.add_markdown("")  # (the iteration or leg on show)
             self.status = gui.add_markdown("computing…")
             self.progress = gui.add_progress_bar(0.0, visible=False, animated=True)
         self.playing = True
@@ -411,6 +415,9 @@ class DashboardScene:
         self._syncing = True
         try:
             self.scrub.value = round(min(self._s / timeline.length, 1.0), 3)  # type: ignore[misc]  # viser: settable
+            counter = timeline.counter(self._s)
+            if self.counter.content != counter:
+                self.counter.content = counter
         finally:
             self._syncing = False
 

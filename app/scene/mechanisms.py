@@ -8,7 +8,7 @@ start x0), the floor grid, and the fixtures of a result (rails or guide, traces,
   the task point W = (x1, x2 + x1 x3) is where the lever crosses the runner.
 - The unicycle (40): a platform with two wheels and a heading nose at the pose q(t).
 
-The pseudoinverse is the translucent red ghost, the extended Jacobian the solid blue robot (the
+The pseudoinverse is the translucent red ghost, the extended Jacobian the opaque blue robot (the
 colours of every plot); the grey ghost is the start configuration x0.
 """
 
@@ -117,7 +117,9 @@ class NormalForm(Mechanism):
         self.ball("lever/pivot", 0.06, (0.0, 0.0, 0.05), color=(40, 40, 40))
         self.point = self.ball("W", 0.08)
         if self.root.endswith("extended"):
-            self.scene.add_label(f"{self.root}/W/label", "W (task point)", position=(0.08, 0.08, 0))
+            self.scene.add_label(  # (below the point: clear of the start gizmo's label)
+                f"{self.root}/W/label", "W (task point)", position=(0.1, -0.2, -0.35)
+            )
 
     def resize(self, state, extent) -> None:
         super().resize(state, extent)

@@ -107,3 +107,16 @@ class Timeline:
         if not self.unicycle:
             return None
         return int(self.shown[min(int(s), len(self.shown) - 1)])
+
+    def counter(self, s: float) -> str:
+        """What the animation shows at ``s``: the unicycle's iteration (of the discrete
+        algorithm), or the leg of the closed path (its cycle)."""
+        k = self.iteration(s)
+        if k is not None:
+            last = max(len(r.platform) for r in self.result.runs.values()) - 1
+            return f"**iteration {k}** of {last}"
+        legs = max(round(self.length), 1)
+        j = min(int(s), legs - 1)
+        per = len(self.result.targets)
+        cycle = f" (cycle {j // per + 1}, leg {j % per + 1} of {per})" if per < legs else ""
+        return f"**leg {j + 1}** of {legs}{cycle}"

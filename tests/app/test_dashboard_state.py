@@ -170,7 +170,7 @@ def test_live_dashboard_pushes_state_and_result_events():
     body = json.loads(result.data)
     assert body["state"]["x0"] == [0.1, 0.0, 1.5]
     # The E1/E2 panel follows in the second phase: the page dims it meanwhile.
-    assert set(body["figures"]) == {"task", "joints", "drift", "table", "augmenting"}
+    assert set(body["figures"]) == {"task", "joints", "drift", "table", "augmenting", "cspace"}
     assert body["stale"] == ["sensitivity"]
     assert body["summary"]["extended"]["success"]
     assert dashboard.snapshot()["computed_generation"] == 2
@@ -186,7 +186,11 @@ def test_a_refused_change_leaves_the_state_alone():
 
 def test_export_has_every_point_of_both_runs():
     result = compute(updated_state(default_state("manipulator1"), {"task": "target"}))
-    rows = export_csv(result).strip().split("\n")
+    lines = export_csv(result).strip().split("\n")
+    context = [r for r in lines if r.startswith("#")]
+    assert context[0].startswith("# jik export of generation 0") and '"task":"target"' in context[1]
+    assert any(r.startswith("# extended leg ends") for r in context)
+    rows = lines[len(context) :]
     assert rows[0] == "algorithm,leg,theta,x1,x2,x3,y1,y2,error,h"
     n = sum(len(r.theta) for r in result.runs.values())
     assert len(rows) == 1 + n

@@ -77,18 +77,32 @@ def test_drift_is_log_scale_and_separates_the_algorithms(path_result):
     assert drift[LABELS["pseudoinverse"]][1] > drift[LABELS["pseudoinverse"]][0]
 
 
-def test_table_lists_every_leg_end_like_table1(path_result):
+def test_table1_puts_the_printed_columns_beside_jiks(path_result):
+    """On the paper's experiment the table is Table 1: the paper's row labels, jik's columns
+    each followed by the printed one, and the extended cells that differ from the print marked
+    (the errata's first two legs), with the erratum in words."""
     fig = table_figure(path_result)
     cells = fig.data[0].cells.values
-    assert cells[0][0] == "start x0"
-    assert len(cells[0]) == 1 + 2 * 4
-    assert list(fig.data[0].header.values[1:4]) == ["J^P# x1", "J^P# x2", "J^P# x3"]
-    # After the first leg (to A = (1, 1)), the configurations of the two algorithms.
-    for col, (a, k) in enumerate([(a, k) for a in COLORS for k in range(3)], start=1):
+    assert fig.layout.title.text.startswith("Table 1 of the paper")
+    assert list(cells[0][:5]) == ["A  x0", "B  x1f", "C  x2f", "D  x3f", "A  x4f"]
+    header = list(fig.data[0].header.values)
+    assert header[1:7] == [f"J^P# x{k} (jik)" for k in (1, 2, 3)] + [
+        f"J^P# x{k} (printed)" for k in (1, 2, 3)]  # fmt: skip
+    for col, (a, k) in enumerate([("pseudoinverse", k) for k in range(3)], start=1):
         assert float(cells[col][1]) == pytest.approx(path_result.runs[a].leg_end[0, k], abs=1e-4)
+    differs = {(c, r) for c, r, _ in fig.layout.meta["differs"]}
+    assert differs == {(c, r) for c in (7, 8, 9) for r in (1, 2)}
+    assert any("Erratum" in n and "(38)" in n for n in fig.layout.meta["notes"])
     # Round-off zeros (the extended run's x2 back at 0 after a cycle, about -1e-16) print
     # without a sign, as Table 1 prints them.
     assert not any(c == "-0.0000" for col in cells for c in col)
+
+
+def test_off_the_papers_path_the_table_is_plainly_named():
+    result = compute(updated_state(default_state("manipulator2"), {"x0.0": 0.3, "cycles": 1}))
+    fig = table_figure(result)
+    assert "not the paper's Table 1" in fig.layout.title.text
+    assert fig.data[0].cells.values[0][0] == "start x0"
 
 
 def test_augmenting_map_contours_with_the_extended_run_on_a_level_set(path_result):
@@ -124,7 +138,8 @@ def test_single_target_shows_convergence_instead_of_drift(target_result):
 def test_every_panel_serialises_to_plotly_json(path_result, target_result):
     for result in (path_result, target_result):
         figs = figures_for(result)
-        assert set(figs) == {"task", "joints", "drift", "table", "augmenting", "sensitivity"}
+        assert set(figs) == {"task", "joints", "drift", "table", "augmenting", "sensitivity",
+                             "cspace"}  # fmt: skip
         for key, fig in figs.items():
             parsed = json.loads(fig.to_json())
             # (the sensitivity panel waits for the second phase: a title, no data yet)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import time
 
 import pytest
@@ -32,7 +33,10 @@ def test_page_static_files_and_config():
     client = TestClient(create_app())
     page = client.get("/")
     assert page.status_code == 200 and 'id="panels"' in page.text
-    assert "http" not in page.text.replace("http-equiv", "")  # nothing from the network
+    # Nothing from the network: no resource from another origin (a link the reader may follow,
+    # the paper's journal, is not fetched).
+    resources = re.sub(r"<a [^>]*>", "", page.text).replace("http-equiv", "")
+    assert "http" not in resources
     js = client.get("/static/vendor/plotly.min.js")
     assert js.status_code == 200 and js.headers["content-type"].startswith("text/javascript")
     for module in ("main", "api", "controls", "panels", "dom"):
@@ -109,7 +113,8 @@ def test_export_is_per_session(app, client):
     client.post(f"/api/sessions/{one['id']}/state", json={"task": "target", "x0": [0.2, 0.1, 1.4]})
     _computed(app, one["id"])
     csv = client.get(f"/api/sessions/{one['id']}/export.csv")
-    assert csv.status_code == 200 and csv.text.startswith("algorithm,leg,theta,x1")
+    assert csv.status_code == 200 and csv.text.startswith("# jik export of generation")
+    assert "\nalgorithm,leg,theta,x1" in csv.text
     body = client.get(f"/api/sessions/{one['id']}/export.json").json()
     assert body["state"]["x0"] == [0.2, 0.1, 1.4]
     assert len(body["runs"]["pseudoinverse"]["x"][0]) == 3

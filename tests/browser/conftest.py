@@ -44,6 +44,9 @@ ARGS = [
 VIEWPORT = {"width": 1600, "height": 1000}
 #: Milliseconds a wait in a page may take: two cores and software WebGL, with other pages open.
 TIMEOUT = 60_000
+#: The window sizes of the screenshots in tests/artifacts (800 wide: a narrow window).
+SCREEN_SIZES = ((1600, 1000), (1280, 720), (800, 1000))
+ARTIFACTS = ROOT / "tests" / "artifacts"
 #: The colour of the x arrow of the start point's gizmo (drei's PivotControls).
 GIZMO_X_ARROW = (255, 32, 96)
 
@@ -245,6 +248,22 @@ class Tab:
     def select(self, selector: str, value: str) -> int:
         """Choose ``value`` in the select ``selector``; returns the change's generation, drawn."""
         return self.change(lambda: self.page.select_option(selector, value))
+
+    def screenshots(self, name: str) -> list[Path]:
+        """Screenshots of the page at each of :data:`SCREEN_SIZES`, saved as
+        tests/artifacts/<name>-<width>.png (the window goes back to its size after)."""
+        ARTIFACTS.mkdir(parents=True, exist_ok=True)
+        size = self.page.viewport_size
+        paths = []
+        for width, height in SCREEN_SIZES:
+            self.page.set_viewport_size({"width": width, "height": height})
+            self.page.wait_for_function("() => document.fonts.status === 'loaded'")
+            path = ARTIFACTS / f"{name}-{width}.png"
+            self.page.screenshot(path=str(path))
+            paths.append(path)
+        if size is not None:
+            self.page.set_viewport_size(size)
+        return paths
 
     # -- the 3D scene (viser's client in the iframe) ------------------------------------------
     @property

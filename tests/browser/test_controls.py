@@ -10,7 +10,12 @@ import pytest
 expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
 pytestmark = pytest.mark.browser
 
-REFUSED_PATH = "path must be written 'y1, y2; y1, y2; ...', got"
+
+def refused_path(point: str) -> str:
+    """The refusal of a closed path of one point ``point`` that is not numbers."""
+    return f"path: point 1 of 1, '{point}', is not numbers separated by ',' " + (
+        "(write 'y1, y2; y1, y2; ...')"
+    )
 
 
 def test_a_refused_value_shows_in_both_with_the_value_in_force(tabs):
@@ -30,15 +35,15 @@ def test_a_refused_value_shows_in_both_with_the_value_in_force(tabs):
     path.fill("1, x")
     response = tab.posting(lambda: path.dispatch_event("change"))
     assert response.status == 422
-    expect(status).to_have_text(f"refused (here): {REFUSED_PATH} '1, x'")
+    expect(status).to_have_text(f"refused (here): {refused_path('1, x')}")
     expect(status).to_have_class(re.compile(r"\berror\b"))
-    tab.wait_scene_text(f"refused: {REFUSED_PATH} '1, x'")
+    tab.wait_scene_text(f"refused: {refused_path('1, x')}")
     expect(path).to_have_value(in_force)
     assert tab.scene_control("closed path")["value"] == in_force
 
     tab.scene_input("closed path").fill("2, y")
-    expect(status).to_have_text(f"refused (in the 3D scene): {REFUSED_PATH} '2, y'")
-    tab.wait_scene_text(f"refused: {REFUSED_PATH} '2, y'")
+    expect(status).to_have_text(f"refused (in the 3D scene): {refused_path('2, y')}")
+    tab.wait_scene_text(f"refused: {refused_path('2, y')}")
     assert tab.scene_control("closed path", like=in_force)["value"] == in_force
     expect(path).to_have_value(in_force)
 
@@ -57,8 +62,7 @@ def test_page_and_scene_show_the_same_values(tabs):
     before = tab.scene_control("γ (decay rate)")["value"]
     tab.set_slider("#ctl-gamma", 0.30103)  # log10(2), snapped to the slider's step
     gamma = tab.snapshot()["state"]["gamma"]
-    page_output = tab.page.locator("label", has=tab.page.locator("#ctl-gamma")).locator("output")
-    expect(page_output).to_have_text(f"{gamma:.3f}")
+    expect(tab.page.locator("#ctl-gamma-value")).to_have_value(f"{gamma:.3f}")
     scene = tab.scene_control("γ (decay rate)", unlike=before)
     assert float(scene["value"]) == pytest.approx(gamma, abs=1e-9)
     # The page's log-scale slider sends 4 significant digits (here 1.972); the scene's number
@@ -79,7 +83,52 @@ def test_page_and_scene_show_the_same_values(tabs):
     cycles = changed["state"]["cycles"]
     assert 8 <= cycles <= 12  # the middle of 1..20
     expect(tab.page.locator("#ctl-cycles")).to_have_value(str(cycles))
-    label = tab.page.locator("label", has=tab.page.locator("#ctl-cycles"))
-    expect(label.locator("output")).to_have_text(str(cycles))
+    expect(tab.page.locator("#ctl-cycles-value")).to_have_value(str(cycles))
     scene = tab.scene_control("cycles")
     assert scene["value"] == scene["shown"] == str(cycles)
+
+
+def test_errors_show_beside_their_control_in_the_users_text(tabs):
+    """A path with an unreadable point, a target coordinate "abc" and a number box out of range:
+    each error shows beside its control, quoting what was typed; "abc" is not sent as 0."""
+    tabs.allow_console(r"status of 422")
+    tab = tabs.open()
+    page = tab.page
+    path = page.locator("#ctl-path")
+    path.fill("1,1;;abc")
+    assert tab.posting(lambda: path.dispatch_event("change")).status == 422
+    row = page.locator("label", has=path)
+    expect(row.locator(".field-error")).to_have_text(
+        "“1,1;;abc” was refused: path: point 2 of 2, 'abc', is not numbers separated by ',' "
+        "(write 'y1, y2; y1, y2; ...')"
+    )
+
+    tab.select("#ctl-task", "target")
+    generation = tab.snapshot()["generation"]
+    box = page.locator("#ctl-target-1")
+    box.fill("abc")
+    box.dispatch_event("change")
+    target_row = page.locator("label", has=box)
+    expect(target_row.locator(".field-error")).to_have_text(
+        "“abc” is not a number; nothing was sent"
+    )
+    assert tab.snapshot()["generation"] == generation  # (not sent as 0)
+    expect(row.locator(".field-error")).to_have_count(0)  # (the path row is gone, or clear)
+
+    # Every slider has a box for an exact value.
+    for slider in page.locator("#controls input[type=range]").all():
+        expect(page.locator(f"#{slider.get_attribute('id')}-value")).to_be_visible()
+    exact = page.locator("#ctl-gamma-value")
+    exact.fill("0.437")
+    generation = tab.change(lambda: exact.dispatch_event("change"))
+    assert tab.snapshot()["state"]["gamma"] == 0.437
+    cycles = page.locator("#ctl-cycles-value")
+    if cycles.count() == 0:  # (the target task has no cycles: back to the path)
+        tab.select("#ctl-task", "path")
+    cycles.fill("50")
+    assert tab.posting(lambda: cycles.dispatch_event("change")).status == 422
+    expect(page.locator("label", has=cycles).locator(".field-error")).to_have_text(
+        "“50” was refused: cycles: Input should be less than or equal to 20"
+    )
+    expect(cycles).to_have_value("3")  # (the value in force)
+    tab.screenshots("field-errors")

@@ -42,7 +42,11 @@ def test_exports_download_the_sessions_data(tabs):
     with tab.page.expect_download() as saved:
         tab.page.click("#export-csv")
     assert saved.value.suggested_filename == "jik-result.csv"
-    rows = Path(saved.value.path()).read_text().splitlines()
+    lines = Path(saved.value.path()).read_text().splitlines()
+    context = [r for r in lines if r.startswith("#")]
+    assert '"cycles":2' in context[1]  # (the state that produced it)
+    assert any(r.startswith("# pseudoinverse drift after each cycle: ") for r in context)
+    rows = lines[len(context) :]
     assert rows[0].startswith("algorithm,leg,theta,x1")
     assert len(rows) - 1 == sum(run["points"] for run in summary.values())
 
@@ -81,3 +85,23 @@ def test_the_unicycle_shows_its_computations_on_their_way(tabs, config):
     if int(match.group(1)) > 2000 * config["progress_after"]:
         assert seen["progress"], f"no progress bar during a computation of {timing}"
     expect(tab.page.locator("#progress")).to_be_hidden()
+
+
+def test_the_table_saves_as_csv_with_its_notes_and_state(tabs):
+    """The table panel's CSV button saves Table 1 as on screen, after '#' lines with the state
+    it shows, its notes (the erratum) and the cells that differ from the print; the footer's
+    export links name the generation they export."""
+    tab = tabs.open()
+    with tab.page.expect_download() as saved:
+        tab.page.locator("#plot-table .panel-tools button", has_text="CSV").click()
+    assert saved.value.suggested_filename == "jik-table.csv"
+    lines = Path(saved.value.path()).read_text().splitlines()
+    context = [r for r in lines if r.startswith("#")]
+    assert context[0].startswith("# jik · generation 1 · manipulator2, continuous mode")
+    assert any("Erratum" in r for r in context)
+    assert sum(r.startswith("# differs from the print: row B  x1f") for r in context) == 3
+    rows = lines[len(context) :]
+    assert rows[0].startswith("row,J^P# x1 (jik),J^P# x2 (jik)")
+    assert rows[2].startswith("B  x1f,0.1132,0.5379,1.0904,0.1132,0.5379,1.0904")
+    expect(tab.page.locator("#export-json")).to_have_text("export JSON (generation 1)")
+    expect(tab.page.locator("#export-csv")).to_have_text("export CSV (generation 1)")

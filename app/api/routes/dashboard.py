@@ -15,9 +15,7 @@ from fastapi import APIRouter
 from fastapi.responses import FileResponse, JSONResponse, Response
 
 from jik import static
-from jik.app.dashboard import COLORS, LABELS
-from jik.app.dashboard.controls import PROGRESS_AFTER
-from jik.app.dashboard.plotting import PANEL_SIZES
+from jik.app.dashboard.help import page_config
 
 router = APIRouter(tags=["dashboard"])
 
@@ -61,14 +59,10 @@ async def scene_page() -> FileResponse:
 
 @router.get("/api/dashboard/config")
 async def config() -> dict:
-    """The colour and label of each algorithm, the panels (ids and sizes, in order), and when a
-    computation shows its progress. (Each session's controls come with its state.)"""
-    return {
-        "colors": COLORS,
-        "labels": LABELS,
-        "panels": [{"id": k, "size": v} for k, v in PANEL_SIZES.items()],
-        "progress_after": PROGRESS_AFTER,
-    }
+    """The colour, label and line style of each algorithm, the panels (ids, sizes and help, in
+    order), and when a computation shows its progress. (Each session's controls come with its
+    state.)"""
+    return page_config()
 
 
 __all__ = ["router"]

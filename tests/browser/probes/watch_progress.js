@@ -3,7 +3,7 @@
 () => {
   const seen = (window.jikSeen = { progress: false, statuses: [] });
   const look = () => {
-    if (!document.getElementById("progress").hidden) seen.progress = true;
+    if (!document.getElementById("progress-box").hidden) seen.progress = true;
     const text = document.getElementById("status-text").textContent;
     if (seen.statuses[seen.statuses.length - 1] !== text) seen.statuses.push(text);
   };

@@ -1,0 +1,187 @@
+"""The configuration-space panel: for p = 3 (or three coordinates the user picks of the
+unicycle's four), both algorithms' joint paths x(theta), the level surface h(x) = h(x0) that the
+extended Jacobian keeps (eq. (12)), and the self-motion manifolds k(x) = y of the targets of the
+legs (the path's corners): one-dimensional, since p - r = 1 (sec. 2).
+
+A repeatable algorithm's closed task path is a closed curve on the level surface, crossing each
+corner's self-motion manifold where the surface cuts it; the pseudoinverse's path slides along
+those manifolds from cycle to cycle.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from jik.app.dashboard.analysis import expensive_map, kinematics_and_map
+from jik.app.dashboard.model import ALGORITHMS, COLORS, DASH, LABELS
+from jik.app.dashboard.plotting import figure, leg_names, trace
+from jik.app.dashboard.runs import DashboardResult
+from jik.engine.exceptions import JikError
+from jik.engine.registry import robot_spec
+
+#: The choices of three coordinates of a four-dimensional configuration (the unicycle's λ).
+AXES_CHOICES = ("012", "013", "023", "123")
+#: Points per run drawn; steps each way along a self-motion manifold; level-surface grid.
+MAX_POINTS, MANIFOLD_STEPS, GRID = 1500, 160, 16
+CSPACE_HEIGHT = 520
+#: The layout key of the panel's 3D axes (not "scene": see :func:`cspace_spec`).
+SCENE = "scene2"
+
+
+def axes_of(result: DashboardResult) -> tuple[int, int, int]:
+    """The three coordinates shown: all three for p = 3, else the state's choice."""
+    choice = result.state.cspace_axes or AXES_CHOICES[0]
+    return tuple(int(c) for c in choice)  # type: ignore[return-value]
+
+
+def _box(result: DashboardResult) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper corners around both runs, with a margin, within the robot's x_range."""
+    xs = np.concatenate([r.x for r in result.runs.values()])
+    xs = xs[np.isfinite(xs).all(axis=1)]
+    lo, hi = xs.min(axis=0), xs.max(axis=0)
+    pad = 0.25 * (hi - lo) + 0.25
+    lo, hi = lo - pad, hi + pad
+    spec = robot_spec(result.state.robot)
+    if spec.x_range:
+        r = np.asarray(spec.x_range, dtype=float)
+        lo, hi = np.maximum(lo, r[:, 0]), np.minimum(hi, r[:, 1])
+    return lo, hi
+
+
+def _step(kin, x: np.ndarray, targets: np.ndarray, ds: float) -> np.ndarray:
+    """One step of length ``ds`` along the kernel K(x) (midpoint), then two Newton steps back
+    onto k(x) = targets with the pseudoinverse (8); NaN where J J^T is singular."""
+    k1 = kin.kernel(x)
+    k2 = kin.kernel(x + 0.5 * ds * k1)
+    k2 *= np.sign(np.sum(k1 * k2, axis=-1, keepdims=True))  # (the same way along the curve)
+    x = x + ds * k2
+    for _ in range(2):
+        J = kin.jacobian(x)  # (n, r, p)
+        M = J @ np.swapaxes(J, 1, 2)  # (n, r, r)
+        ok = np.isfinite(M).all(axis=(1, 2)) & (np.abs(np.linalg.det(np.nan_to_num(M))) > 1e-12)
+        e = kin.forward(x) - targets  # (n, r)
+        lam = np.full_like(e, np.nan)
+        lam[ok] = np.linalg.solve(M[ok], e[ok][..., None])[..., 0]
+        x = x - np.einsum("nrp,nr->np", J, lam)
+    return x
+
+
+def self_motion(kin, seeds: np.ndarray, targets: np.ndarray, lo, hi) -> np.ndarray:
+    """Points of the self-motion manifolds k(x) = targets through ``seeds``, (n, 2 S + 1, p).
+
+    Notes
+    -----
+    Each manifold is traced both ways from its seed along the unit kernel vector K(x) of J(x)
+    (a midpoint step), each step corrected back onto k(x) = y by two Newton steps with the
+    pseudoinverse (8); points outside the box (widened by half) are NaN, and so is the rest of
+    that branch.
+    """
+    span = hi - lo
+    ds = 0.02 * float(np.linalg.norm(span))
+    branches = []
+    for sign in (1.0, -1.0):
+        x = seeds.astype(float).copy()
+        alive = np.ones(len(x), dtype=bool)
+        pts = []
+        with np.errstate(all="ignore"):
+            for _ in range(MANIFOLD_STEPS):
+                if alive.any():
+                    x[alive] = _step(kin, x[alive], targets[alive], sign * ds)
+                inside = np.all((x >= lo - 0.5 * span) & (x <= hi + 0.5 * span), axis=1)
+                alive &= inside & np.isfinite(x).all(axis=1)
+                pts.append(np.where(alive[:, None], x, np.nan))
+        branches.append(np.stack(pts, axis=1))
+    return np.concatenate([branches[1][:, ::-1], seeds[:, None, :], branches[0]], axis=1)
+
+
+def _level_surface(result: DashboardResult, kin, amap, axes, lo, hi) -> dict | None:
+    """h on a grid of the box (p = 3 only, cheap maps only), as an isosurface at h(x0)."""
+    if kin.p != 3 or expensive_map(amap):
+        return None
+    lines = [np.linspace(lo[k], hi[k], GRID) for k in axes]
+    X = np.stack(np.meshgrid(*lines, indexing="ij"), axis=-1).reshape(-1, 3)
+    # (float32 on the way: half the bytes of a panel sent on every change of its runs)
+    with np.errstate(all="ignore"):
+        H = np.asarray(amap.value(X), dtype=float)
+        h0 = float(np.asarray(amap.value(np.asarray(result.state.x0, dtype=float)[None]))[0])
+    if not np.isfinite(h0) or not np.isfinite(H).any():
+        return None
+    value = np.nan_to_num(H, nan=h0 + 1e9).astype(np.float32)  # (undefined h: far from h0)
+    X = X.astype(np.float32)
+    return trace("isosurface", x=X[:, 0], y=X[:, 1], z=X[:, 2], value=value, isomin=h0,
+                 isomax=h0, surface=dict(count=1),
+                 caps=dict(x=dict(show=False), y=dict(show=False), z=dict(show=False)),
+                 colorscale=[[0, "#9aa5b1"], [1, "#9aa5b1"]],
+                 showscale=False, opacity=0.3, name=f"level surface h = h(x0) = {h0:.4g}",
+                 hoverinfo="skip", showlegend=True)  # fmt: skip
+
+
+def _thin(x: np.ndarray) -> np.ndarray:
+    step = max(1, len(x) // MAX_POINTS)
+    return np.vstack([x[::step], x[-1:]])
+
+
+def cspace_spec(result: DashboardResult) -> dict:
+    """The configuration-space panel (see the module's docstring)."""
+    names = result.variable_names
+    axes = axes_of(result)
+    a, b, c = axes
+    data = []
+    notes = []
+    try:
+        kin, amap = kinematics_and_map(result.state)
+    except (JikError, ValueError) as exc:
+        return figure([], f"Configuration space: {exc}")
+    lo, hi = _box(result)
+    surface = _level_surface(result, kin, amap, axes, lo, hi)
+    if surface is not None:
+        data.append(surface)
+    elif kin.p == 3:
+        notes.append("level surface not drawn: h is solved point by point for this map")
+    else:
+        notes.append(f"the level surface of h lives in {kin.p} dimensions: not drawn")
+    ext = result.runs["extended"]
+    L = len(result.targets)
+    seeds = ext.leg_end[:L] if len(ext.leg_end) >= L else result.runs["pseudoinverse"].leg_end[:L]
+    if len(seeds) == L:
+        with np.errstate(all="ignore"):
+            curves = self_motion(kin, seeds, np.asarray(result.targets, dtype=float), lo, hi)
+        for k, (curve, name) in enumerate(zip(curves, leg_names(L), strict=True)):
+            data.append(trace("scatter3d", x=curve[:, a], y=curve[:, b], z=curve[:, c],
+                              mode="lines", line=dict(color="#2ca02c", width=3),
+                              name="self-motion manifolds k(x) = corner", legendgroup="fibres",
+                              showlegend=k == 0,
+                              hovertemplate=f"k(x) = {name}<extra></extra>"))  # fmt: skip
+    for alg in ALGORITHMS:
+        x = _thin(result.runs[alg].x)
+        data.append(trace("scatter3d", x=x[:, a], y=x[:, b], z=x[:, c], mode="lines",
+                          name=LABELS[alg], line=dict(color=COLORS[alg], width=5 if
+                          alg == "pseudoinverse" else 3, dash=DASH[alg]),
+                          hovertemplate=f"{names[a]} = %{{x:.3f}}<br>{names[b]} = %{{y:.3f}}"
+                          f"<br>{names[c]} = %{{z:.3f}}<extra>{alg}</extra>"))  # fmt: skip
+    x0 = np.asarray(result.state.x0, dtype=float)
+    data.append(trace("scatter3d", x=[x0[a]], y=[x0[b]], z=[x0[c]], mode="markers",
+                      marker=dict(color="white", size=5, line=dict(color="black", width=2)),
+                      name="start x0"))  # fmt: skip
+    shown = ", ".join(names[k] for k in axes)
+    if kin.p > 3:
+        fixed = [n for k, n in enumerate(names) if k not in axes]
+        notes.append(
+            f"{', '.join(fixed)} not shown (the control “configuration-space axes” picks three)"
+        )
+    sub = " · ".join(["green: self-motion manifolds of the corners", *notes])
+    scene = dict(
+        xaxis=dict(title=dict(text=names[a])),
+        yaxis=dict(title=dict(text=names[b])),
+        zaxis=dict(title=dict(text=names[c])),
+        aspectmode="cube",
+    )
+    # (plotly names a scene's element after its layout key: "scene" would be a second element
+    # with the id of the page's 3D scene, #scene)
+    for t in data:
+        t["scene"] = SCENE
+    spec = figure(data, f"Configuration space ({shown})<br><sup>{sub}</sup>", **{SCENE: scene},
+                  height=CSPACE_HEIGHT, showlegend=True,
+                  legend=dict(orientation="h", x=0, y=0, yanchor="top", font=dict(size=10)),
+                  margin=dict(l=0, r=0, t=40, b=40))  # fmt: skip
+    return spec

@@ -1,0 +1,63 @@
+"""The dashboard's words for a reader without the paper: the key of colours and line styles (the
+same in every panel, its exported images and the 3D scene), a short explanation of each panel,
+and of the paper's symbols that controls and panels use. The page gets them from
+:func:`page_config` (``GET /api/dashboard/config``); the controls' help comes with the controls
+(:func:`jik.app.dashboard.controls.controls`, with :data:`jik.app.dashboard.glossary.SYMBOLS`).
+"""
+
+from __future__ import annotations
+
+from jik.app.dashboard.controls import PROGRESS_AFTER
+from jik.app.dashboard.model import COLORS, DASH, LABELS
+from jik.app.dashboard.plotting import PANEL_SIZES
+
+#: How each algorithm is drawn, everywhere: its colour (COLORS), its line style in the plots
+#: (plotly's ``dash``) and its robot in the 3D scene.
+STYLES = {
+    "pseudoinverse": {
+        "dash": DASH["pseudoinverse"],
+        "line": "solid line",
+        "robot": "translucent robot",
+    },
+    "extended": {"dash": DASH["extended"], "line": "dashed line", "robot": "opaque robot"},
+}
+
+#: What each panel shows, and how to read it.
+PANEL_HELP = {
+    "task": "The end effector's path in the task space for both algorithms (paper, Figs. 5 and "
+    "6): × marks the targets of the legs, ○ the start k(x0). Both algorithms follow the same "
+    "task path; they differ in the joints.",
+    "drift": "Repeatability: after each cycle of the closed path, how far the joints are from "
+    "where they started, ‖x − x0‖ (the Euclidean norm of the joint vector, whose coordinates "
+    "can mix units, e.g. m and rad). A repeatable algorithm stays near 0 (log scale). For a "
+    "single target: the task error against θ (or the iteration).",
+    "joints": "Each joint coordinate against θ, the continuation parameter of the algorithm "
+    "(7) (discrete mode: the iteration). Closed joint paths return to their start values at "
+    "the end of each cycle.",
+    "augmenting": "The augmenting map h of the extended Jacobian (eqs. (9)-(11)) over two joint "
+    "coordinates: contours of h, with both runs on top. The extended Jacobian keeps h at h(x0) "
+    "(eq. (12)), so its run follows a contour; the pseudoinverse crosses them. E1 (13) and E2 "
+    "(18) measure how far the extended Jacobian is from the pseudoinverse over the region.",
+    "sensitivity": "The error functionals E1 (13), Roberts-Maciejewski, and E2 (18), the "
+    "manipulability-weighted embedding, of the current map and its alternatives, and how they "
+    "change with the map's parameters: lower is closer to the pseudoinverse.",
+    "cspace": "The joint paths x(θ) of both algorithms in configuration space (three "
+    "coordinates), with the level surface h(x) = h(x0) that the extended Jacobian stays on "
+    "(eq. (12)) and, in green, the self-motion manifolds k(x) = y of the path's corners (curves, "
+    "since p − r = 1). A repeatable run is one closed curve on the surface; the pseudoinverse's "
+    "slides along the green curves from cycle to cycle. Drag to turn the view.",
+    "table": "The joint configuration at the end of each leg. On the paper's experiment "
+    "(Manipulator 2 on the square path), Table 1 of the paper beside jik's numbers.",
+}
+
+
+def page_config() -> dict:
+    """What the page needs before its session: the algorithms' colours, labels and styles,
+    the panels (ids, sizes, help), and when a computation shows its progress."""
+    return {
+        "colors": COLORS,
+        "labels": LABELS,
+        "styles": STYLES,
+        "panels": [{"id": k, "size": v, "help": PANEL_HELP[k]} for k, v in PANEL_SIZES.items()],
+        "progress_after": PROGRESS_AFTER,
+    }

@@ -1,0 +1,152 @@
+"""What the page writes above the plots, computed from the result: for each algorithm whether it
+was repeatable on the closed path and by how much, how much h changed along the extended
+Jacobian's run, and why, in sentences the page shows as they are.
+
+Repeatability (section 2 of the paper): a closed task path driven from x0 gives a closed joint
+path, ``x`` back at ``x0`` after each cycle. The extended Jacobian inverse (11) is repeatable
+because its runs stay on the level set h(x) = h(x0) (eq. (12)); the continuous algorithm (7)
+keeps h exactly, the discrete iteration ``x <- x - gamma J# e`` only to first order per step
+(each step moves along the level set's tangent), and for gamma near 2 the iteration is at the
+edge of convergence (the task error is multiplied by about ``1 - gamma`` per step).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from jik.app.dashboard.messages import h_change
+from jik.app.dashboard.plotting import norm_unit, units
+from jik.app.dashboard.runs import AlgorithmRun, DashboardResult
+from jik.app.dashboard.singular import singular_sentence
+
+#: A run is repeatable when its joints come back to x0 within this after every cycle
+#: (‖x − x0‖ in the joint coordinates' own units).
+REPEATABLE_DRIFT = 1e-3
+#: h counts as conserved when it changed by less than this along a run.
+H_CONSERVED = 1e-6
+#: In discrete mode, a gamma at or above this is "near 2" (the iteration's stability limit).
+GAMMA_NEAR_TWO = 1.5
+
+NAMES = {"pseudoinverse": "pseudoinverse J^P#", "extended": "extended Jacobian J^E#"}
+
+
+@dataclass(frozen=True)
+class Sentence:
+    """One sentence: its ``text``, the algorithm it is about (None: both or neither) and its
+    ``role``: "finding" (what the run did), "why", "note" or "failure"."""
+
+    text: str
+    algorithm: str | None = None
+    role: str = "finding"
+
+    def as_dict(self) -> dict:
+        return {"text": self.text, "algorithm": self.algorithm, "role": self.role}
+
+
+def g(v: float) -> str:
+    """A number in 3 significant digits."""
+    return f"{v:.3g}"
+
+
+def repeatable(run: AlgorithmRun) -> bool | None:
+    """Whether a closed-path run came back to x0 after every cycle (None: no cycle ended)."""
+    if not len(run.drift):
+        return None
+    return bool(np.all(np.asarray(run.drift) < REPEATABLE_DRIFT))
+
+
+def _drift_sentence(algorithm: str, run: AlgorithmRun, unit: str) -> Sentence:
+    d = np.asarray(run.drift)
+    n = len(d)
+    cycles = f"{n} cycle{'s' if n > 1 else ''}"
+    if repeatable(run):
+        text = (
+            f"{NAMES[algorithm]}: repeatable. After each of {cycles} the joints came back "
+            f"to x0 within {g(float(d.max()))} {unit} (‖x − x0‖ below {g(REPEATABLE_DRIFT)})."
+        )
+    else:
+        trend = ""
+        if n > 1:
+            grows = d[-1] > d[0] * 1.05
+            trend = (f", growing from {g(float(d[0]))} after cycle 1" if grows
+                     else f" (after cycle 1: {g(float(d[0]))})")  # fmt: skip
+        text = (f"{NAMES[algorithm]}: not repeatable. After {cycles} the joints end "
+                f"‖x − x0‖ = {g(float(d[-1]))} {unit} away from x0{trend}.")  # fmt: skip
+    return Sentence(text, algorithm)
+
+
+def _extended_why(result: DashboardResult, run: AlgorithmRun) -> list[Sentence]:
+    state = result.state
+    dh = h_change(run.h)
+    if dh is None:
+        return []
+    closed = state.task == "path" and len(run.drift) > 0
+    kept = dh < H_CONSERVED
+    out = []
+    if kept:
+        tail = (" so each task point has one configuration on that level set, and the closed "
+                "task path gave a closed joint path." if closed and repeatable(run)
+                else ".")  # fmt: skip
+        out.append(Sentence(
+            f"Why: J^E# adds the equation h(x) = h(x0) (eq. (12)); h changed by only {g(dh)} "
+            f"along its run,{tail}", "extended", "why"))  # fmt: skip
+    else:
+        lost = (" A closed task path gives a closed joint path only while h stays at h(x0): "
+                "here it did not, so the joints did not come back." if closed and not
+                repeatable(run) else "")  # fmt: skip
+        out.append(Sentence(
+            f"h was not conserved: it changed by {g(dh)} along the extended Jacobian's run."
+            + lost, "extended", "why"))  # fmt: skip
+    if state.mode == "discrete" and not kept:
+        out.append(Sentence(
+            "The discrete algorithm x ← x − γ J^E# e keeps h only approximately: each step "
+            "moves along the tangent of the level set h = h(x0), not on it, so h changes by "
+            "an amount that grows with γ (the continuous algorithm (7) keeps h exactly).",
+            "extended", "note"))  # fmt: skip
+    if state.mode == "discrete" and state.gamma >= GAMMA_NEAR_TWO:
+        out.append(Sentence(
+            f"γ = {g(state.gamma)} is near 2, the limit of the discrete iteration: the task "
+            f"error is multiplied by about 1 − γ = {g(1 - state.gamma)} per step, so the "
+            "iterates overshoot back and forth and h is far from conserved; at γ ≥ 2 the "
+            "iteration diverges.", None, "note"))  # fmt: skip
+    return out
+
+
+def _pseudoinverse_why(run: AlgorithmRun) -> list[Sentence]:
+    if repeatable(run) is False:
+        return [Sentence(
+            "Why: J^P# picks the minimum-norm joint velocity, which has no memory of the start "
+            "(it keeps nothing like h constant), so a closed task path need not close in the "
+            "joints.", "pseudoinverse", "why")]  # fmt: skip
+    if repeatable(run):
+        return [Sentence(
+            "The pseudoinverse happens to come back on this path: its joint flow closes here, "
+            "which it does not in general.", "pseudoinverse", "why")]  # fmt: skip
+    return []
+
+
+def verdict(result: DashboardResult) -> list[dict]:
+    """The sentences the page shows above the plots for ``result`` (:class:`Sentence` dicts):
+    each algorithm's finding, then why; failures with the engine's message."""
+    runs = result.runs
+    out: list[Sentence] = []
+    path = result.state.task == "path"
+    for algorithm in ("pseudoinverse", "extended"):
+        run = runs[algorithm]
+        if path and len(run.drift):
+            out.append(_drift_sentence(algorithm, run, norm_unit(units(result)[0])))
+        elif run.success:
+            out.append(Sentence(f"{NAMES[algorithm]}: {run.message}.", algorithm))
+        if not run.success:
+            done = (f" (after {len(run.drift)} completed cycle{'s' if len(run.drift) > 1 else ''})"
+                    if path and len(run.drift) else "")  # fmt: skip
+            out.append(Sentence(f"{NAMES[algorithm]} stopped{done}: {run.message}", algorithm,
+                                "failure"))  # fmt: skip
+    out += _pseudoinverse_why(runs["pseudoinverse"]) if path else []
+    out += _extended_why(result, runs["extended"])
+    warning = singular_sentence(result.state)
+    if warning:
+        out.append(Sentence(warning, "extended", "warning"))
+    return [s.as_dict() for s in out]

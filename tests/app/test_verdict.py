@@ -1,0 +1,90 @@
+"""What the dashboard writes about a result (app/dashboard/verdict.py), and what it says when a
+generation fails: NaN never reaches JSON, the error names the result still on screen."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+
+from jik.app.dashboard import Dashboard, compute, default_state, updated_state
+from jik.app.dashboard import session as session_module
+from jik.app.dashboard.messages import summary, to_json
+from jik.app.dashboard.verdict import verdict
+from jik.engine.exceptions import JikError
+
+POSE_B = [-5.0, 5.0, math.pi / 2]
+
+
+def texts(result) -> str:
+    return " ".join(s["text"] for s in verdict(result))
+
+
+def test_nan_and_inf_become_null_in_json():
+    """to_json is the one boundary where results become JSON: NaN and inf are null there,
+    in plain floats and in arrays."""
+    data = {"a": float("nan"), "b": [1.0, float("inf")], "c": np.array([0.5, np.nan])}
+    assert json.loads(to_json(data)) == {"a": None, "b": [1.0, None], "c": [0.5, None]}
+
+
+def test_unicycle_from_b_reports_the_engines_message():
+    """Unicycle from q0 = B (discrete): h is undefined after a few iterations; the summary and
+    its JSON carry the engine's message, not a JSON error."""
+    state = updated_state(default_state("unicycle"), {"robot_parameters.q0": POSE_B})
+    result = compute(state)
+    data = json.loads(to_json(summary(result)))
+    assert not data["extended"]["success"]
+    assert "undefined" in data["extended"]["message"]
+    assert "undefined" in texts(result) and "stopped" in texts(result)
+
+
+def test_verdict_says_when_the_extended_jacobian_is_not_repeatable():
+    """Manipulator 2, discrete mode, gamma = 1: the extended Jacobian drifts and h changes; the
+    verdict says both, with the numbers, and why (the discrete step)."""
+    state = updated_state(default_state("manipulator2"), {"mode": "discrete", "gamma": 1.0})
+    result = compute(state)
+    text = texts(result)
+    drift = result.runs["extended"].drift[-1]
+    assert drift > 1e-2
+    assert "extended Jacobian J^E#: not repeatable" in text
+    assert f"{drift:.3g}" in text and "h was not conserved" in text
+    assert "only approximately" in text and "closed joint paths" not in text
+
+
+def test_verdict_names_gamma_near_two():
+    state = updated_state(default_state("manipulator2"), {"mode": "discrete", "gamma": 1.89})
+    assert "γ = 1.89 is near 2" in texts(compute(state))
+
+
+def test_verdict_continuous_is_repeatable():
+    text = texts(compute(default_state("manipulator2")))
+    assert "extended Jacobian J^E#: repeatable" in text
+    assert "pseudoinverse J^P#: not repeatable" in text
+
+
+def test_a_failed_generation_names_the_result_on_screen(monkeypatch):
+    """A generation whose computation raises: the snapshot and a new subscriber get its
+    message and the generation (and state) of the result that stays on screen."""
+    dash = Dashboard()
+    try:
+        assert dash.wait(1, timeout=120)
+        real = session_module.compute
+
+        def failing(state, *args, **kwargs):
+            if state.gamma == 2.5:
+                raise JikError("the start is singular")
+            return real(state, *args, **kwargs)
+
+        monkeypatch.setattr(session_module, "compute", failing)
+        generation, _ = dash.update({"gamma": 2.5})
+        assert dash.wait(generation, timeout=120)
+        snap = dash.snapshot()
+        assert snap["error"]["message"] == "the start is singular"
+        assert snap["error"]["shown"]["generation"] == 1
+        assert snap["computed_generation"] == 1
+        seen = []
+        dash.subscribe(seen.append)()
+        assert [e.kind for e in seen][-1] == "error"
+    finally:
+        dash.stop()

@@ -1,0 +1,91 @@
+"""After a generation fails, the page says what failed where the result would be, which result
+(if any) is still on screen, dims it, and offers no export of it as current; a new viewer of a
+state that fails sees the failure, not "computing…" forever. The server is `jik serve` whose
+computations of gamma = 2.5 raise (tests/browser/failing_serve.py)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from urllib.parse import quote
+
+import pytest
+
+from tests.browser.conftest import ROOT, Tab, Tabs, _free_port, get_json, poll
+from tests.browser.failing_serve import MESSAGE
+
+expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
+pytestmark = pytest.mark.browser
+
+
+@pytest.fixture(scope="module")
+def failing_server(chromium, tmp_path_factory):
+    port = _free_port()
+    log = tmp_path_factory.mktemp("failing") / "serve.log"
+    with open(log, "w") as out:
+        proc = subprocess.Popen(
+            [sys.executable, str(ROOT / "tests" / "browser" / "failing_serve.py"), str(port)],
+            cwd=ROOT, stdout=out, stderr=subprocess.STDOUT,
+        )  # fmt: skip
+    base = f"http://127.0.0.1:{port}"
+
+    def healthy() -> bool:
+        if proc.poll() is not None:
+            pytest.fail(f"failing_serve exited: {log.read_text()[-2000:]}")
+        try:
+            return get_json(f"{base}/health")["status"] == "ok"
+        except OSError:
+            return False
+
+    try:
+        poll(healthy, "the failing server answering")
+        yield base
+    finally:
+        proc.terminate()
+        proc.wait(15)
+
+
+@pytest.fixture
+def failing_tabs(browser, failing_server):
+    tabs = Tabs(browser, failing_server)
+    try:
+        yield tabs
+        tabs.check()
+    finally:
+        tabs.close()
+
+
+def test_a_failure_names_the_result_still_on_screen(failing_tabs):
+    tab = failing_tabs.open()
+    page = tab.page
+    gamma = page.locator("#ctl-gamma-value")
+    gamma.fill("2.5")
+    generation = tab.posting(lambda: gamma.dispatch_event("change")).json()["generation"]
+    failure = page.locator("#failure")
+    expect(failure).to_have_text(f"Generation {generation} failed: {MESSAGE}")
+    expect(page.locator("#still-shown")).to_have_text(
+        "The plots below still show generation 1 (manipulator2, continuous mode, γ = 1.000, "
+        "l = 1.00, closed path, 3 cycles), not the controls' values."
+    )
+    expect(page.locator("#status-text")).to_have_text(f"generation {generation} failed")
+    expect(page.locator("#panels")).to_have_class("panels outdated")
+    export = page.locator("#export-json")
+    expect(export).to_contain_text("off: generation")
+    assert export.get_attribute("href") is None
+    assert tab.snapshot()["error"]["shown"]["generation"] == 1
+    tab.screenshots("failure")
+
+    # A new viewer of that state: its first generation fails, and nothing is on screen.
+    viewer = failing_tabs.new_page(failing_tabs.context())
+    viewer.goto(failing_tabs.base + "/?state=" + quote(json.dumps(tab.url_state())))
+    expect(viewer.locator("#failure")).to_contain_text(f"Generation 1 failed: {MESSAGE}")
+    expect(viewer.locator("#still-shown")).to_have_text("No result is on screen.")
+    assert Tab(viewer, failing_tabs.base).status() == "generation 1 failed"
+
+    # The next good change brings a current result back.
+    gamma.fill("1.5")
+    tab.change(lambda: gamma.dispatch_event("change"))
+    expect(failure).to_have_count(0)
+    expect(page.locator("#panels")).to_have_class("panels")
+    expect(export).to_contain_text(f"(generation {tab.generation})")
