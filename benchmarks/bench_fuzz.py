@@ -9,6 +9,7 @@ cases generated, failures, and whether the server logged a traceback. The CI tes
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import re
 import socket
@@ -98,7 +99,10 @@ def run_fuzz(max_examples: int, seed: int = 26, timeout: float = 1500.0) -> Fuzz
 
 
 def main(quick: bool = False) -> None:
-    examples = 20 if quick else 100
+    if importlib.util.find_spec("schemathesis") is None:
+        print("jik bench fuzz needs schemathesis: pip install 'jik[test]'")
+        return
+    examples = 20 if quick else 600
     run = run_fuzz(examples)
     print(f"schemathesis, all checks, phases {PHASES}, {examples} examples per operation")
     print(f"  cases {run.cases}, failures {run.failures}, {run.seconds:.0f} s "

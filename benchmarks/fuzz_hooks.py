@@ -27,9 +27,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import schemathesis
-from hypothesis import strategies as st
 from pydantic import ValidationError
+
+try:  # (schemathesis loads this module, and brings hypothesis)
+    import schemathesis
+    from hypothesis import strategies as st
+except ImportError as exc:
+    raise ImportError(f"{exc}: jik bench fuzz needs pip install 'jik[test]'") from exc
 
 from jik.app.dashboard.model import StatePatch, default_state, patch_of, updated_state
 from jik.engine.exceptions import InvalidInputError, JikError
