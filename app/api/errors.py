@@ -11,7 +11,8 @@ field; so is a computation stopped at the time limit (the field that sizes the w
 unexpected, is 500 ``{"detail": "internal error: ..."}``, never an HTML page or a dropped
 connection. An atlas job that is not there is 404, too many atlas jobs 429 with Retry-After.
 The dashboard sessions' errors come here too: a refused value (the field it names)
-is 422, a session that is not there 404, a full session store 503 with Retry-After. A body
+is 422, a session that is not there 404, a full session store 503 with Retry-After, an export
+with no result of the current state 409 (its computation failed) or 503 (not yet). A body
 over the size limit is 413 ``{"detail": "request body of ... bytes is larger ..."}``
 (:class:`BodyLimit`).
 """
@@ -32,7 +33,7 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 from jik.app.compute.atlas_jobs import AtlasJobNotFound, AtlasJobsFull
 from jik.app.compute.exceptions import ComputeError, RequestError, ServiceUnavailable
 from jik.app.compute.schemas import AUGMENTATION_MODELS, ROBOT_MODELS, ErrorResponse
-from jik.app.dashboard.sessions import SessionNotFound, SessionsFull
+from jik.app.dashboard.sessions import ExportUnavailable, SessionNotFound, SessionsFull
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS
 
@@ -174,6 +175,10 @@ def session_not_found_response(exc: SessionNotFound) -> JSONResponse:
         "reload the page to start a new one")})  # fmt: skip
 
 
+def export_unavailable_response(exc: ExportUnavailable) -> JSONResponse:
+    return JSONResponse(status_code=exc.status, content={"detail": str(exc)})
+
+
 def sessions_full_response(exc: SessionsFull) -> JSONResponse:
     return JSONResponse(status_code=503, content={"detail": str(exc)},
                         headers={"Retry-After": "30"})  # fmt: skip
@@ -216,6 +221,7 @@ _RESPONSES: dict[type[Exception], Callable[[Any], JSONResponse]] = {
     InvalidInputError: invalid_input_response,
     SessionNotFound: session_not_found_response,
     SessionsFull: sessions_full_response,
+    ExportUnavailable: export_unavailable_response,
     AtlasJobNotFound: atlas_job_not_found_response,
     AtlasJobsFull: atlas_jobs_full_response,
 }

@@ -29,6 +29,15 @@ from jik.app.dashboard.session import Dashboard
 from jik.app.dashboard.slots import FairSlots
 
 
+class ExportUnavailable(Exception):
+    """No result of a session's current state to export: ``status`` 409 when its computation
+    failed, 503 when it is not finished yet."""
+
+    def __init__(self, status: int, detail: str) -> None:
+        super().__init__(detail)
+        self.status = status
+
+
 class SessionNotFound(KeyError):
     """No session with that id (never created, or expired)."""
 

@@ -236,3 +236,30 @@ def test_a_listener_that_never_reads_holds_one_event_of_each_kind(app, client):
     assert held <= 7 and len(set(kinds)) == len(kinds), kinds
     result = next(e for e in events if e.kind == "result")
     assert result.generation == dashboard.generation  # the newest
+
+
+def test_an_export_after_a_failure_is_409_never_the_previous_result(app, client, monkeypatch):
+    """Issue 28, point 6: the export said nothing of a newer generation that failed and returned
+    the previous result as if it were the current state's."""
+    import jik.app.dashboard.session as session
+    from jik.engine.exceptions import JikError
+
+    real = session.compute
+
+    def failing(state, *args, **kwargs):
+        if state.gamma == 2.5:
+            raise JikError("the start configuration is singular (injected by the test)")
+        return real(state, *args, **kwargs)
+
+    monkeypatch.setattr(session, "compute", failing)
+    sid = client.post("/api/sessions", json={}).json()["id"]
+    assert client.get(f"/api/sessions/{sid}/export.json").status_code == 200
+    assert client.post(f"/api/sessions/{sid}/state", json={"gamma": 2.5}).status_code == 200
+    for export in ("export.json", "export.csv"):
+        r = client.get(f"/api/sessions/{sid}/{export}")
+        assert r.status_code == 409, r.text
+        assert "failed: the start configuration is singular" in r.json()["detail"]
+    assert client.post(f"/api/sessions/{sid}/state", json={"gamma": 1.5}).status_code == 200
+    r = client.get(f"/api/sessions/{sid}/export.json")
+    assert r.status_code == 200
+    client.delete(f"/api/sessions/{sid}")

@@ -24,7 +24,7 @@ from jik.app.dashboard import export_csv, export_json
 from jik.app.dashboard.controls import controls_message
 from jik.app.dashboard.messages import LatestEvents
 from jik.app.dashboard.model import StatePatch, patch_of
-from jik.app.dashboard.sessions import Session, SessionNotFound
+from jik.app.dashboard.sessions import ExportUnavailable, Session, SessionNotFound
 from jik.engine.exceptions import InvalidInputError
 
 router = APIRouter(tags=["dashboard sessions"])
@@ -113,6 +113,11 @@ class CSVResponse(PlainTextResponse):
     media_type = "text/csv"
 
 
+#: An export with no result of the current state (:class:`ExportUnavailable`).
+_NO_EXPORT: dict[int | str, dict] = {
+    409: {"description": "the current state's computation failed: nothing current to export"},
+    503: {"description": "the current state's result is not computed yet"},
+}
 #: A session that is not there (expired, deleted, never created).
 _NOT_FOUND: dict[int | str, dict] = {404: {"description": "no such session"}}
 
@@ -168,23 +173,36 @@ async def events(session_id: str, request: Request, store: Store):
 
 
 async def _finished(session: Session):
-    """The session's dashboard, after waiting (up to :data:`EXPORT_WAIT`) for its result."""
+    """The session's dashboard once its current state's result is in (waiting up to
+    :data:`EXPORT_WAIT`); never an older result in its place.
+
+    Raises
+    ------
+    ExportUnavailable
+        409 when the current state's computation failed (the message says which generation and
+        why), 503 when it has not finished in time.
+    """
     dashboard = session.dashboard
-    if dashboard.result is None:
-        await asyncio.to_thread(dashboard.wait, None, EXPORT_WAIT)
+    done = await asyncio.to_thread(dashboard.wait, None, EXPORT_WAIT)
+    snapshot = dashboard.snapshot()
+    if snapshot["error"] is not None:
+        error = snapshot["error"]
+        raise ExportUnavailable(409, (
+            f"generation {error.get('generation')} failed: {error.get('message')}; there is no "
+            "result of the current state to export (change the state, then export)"))  # fmt: skip
+    if not done or dashboard.result is None:
+        raise ExportUnavailable(503, "no result of the current state computed yet; retry")
     return dashboard
 
 
 @router.get(
     "/api/sessions/{session_id}/export.json",
     operation_id="export_json",
-    responses={503: {"description": "no result computed yet"}, **_NOT_FOUND},
+    responses={**_NO_EXPORT, **_NOT_FOUND},
 )
 async def export_result_json(session_id: str, store: Store) -> JSONResponse:
     """The session's result, every trajectory point of both algorithms, as JSON."""
     dashboard = await _finished(store.get(session_id))
-    if dashboard.result is None:
-        return JSONResponse(status_code=503, content={"detail": "no result computed yet"})
     body = export_json(dashboard.result, dashboard.functionals)
     return JSONResponse(
         body, headers={"Content-Disposition": 'attachment; filename="jik-result.json"'}
@@ -197,15 +215,13 @@ async def export_result_json(session_id: str, store: Store) -> JSONResponse:
     response_class=CSVResponse,
     responses={
         200: {"description": "one row per trajectory point"},
-        503: {"description": "no result computed yet"},
+        **_NO_EXPORT,
         **_NOT_FOUND,
     },
 )
 async def export_result_csv(session_id: str, store: Store):
     """The session's result as CSV: one row per trajectory point and algorithm."""
     dashboard = await _finished(store.get(session_id))
-    if dashboard.result is None:
-        return PlainTextResponse("no result computed yet\n", status_code=503)
     return PlainTextResponse(
         export_csv(dashboard.result),
         media_type="text/csv",
