@@ -12,16 +12,14 @@ from __future__ import annotations
 import importlib.util
 import os
 import re
-import socket
 import subprocess
 import sys
 import tempfile
 import time
 from dataclasses import dataclass
 
-import httpx
-
 import jik
+from jik.benchmarks.serving import jik_serve
 
 #: Where ``jik`` is imported from (the source tree, or site-packages): the hooks are found there
 #: from the scratch directory schemathesis runs in.
@@ -44,37 +42,14 @@ class FuzzRun:
         return self.failures == 0 and "Traceback" not in self.server_log and self.cases > 0
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 def run_fuzz(max_examples: int, seed: int = 26, timeout: float = 1500.0) -> FuzzRun:
     """schemathesis with ``max_examples`` per operation and phase against a fresh server."""
-    port = _free_port()
     # A request waits at most JIK_TIMEOUT for a worker and as long again to compute: within
     # schemathesis's request timeout (its "response time" check).
-    env = dict(os.environ, JIK_WORKERS="2", JIK_TIMEOUT="20")
-    server = subprocess.Popen(
-        [sys.executable, "-m", "jik", "serve", f"--port={port}"],
-        env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-    )  # fmt: skip
-    base = f"http://127.0.0.1:{port}"
-    try:
-        deadline = time.monotonic() + 60
-        while True:
-            try:
-                if httpx.get(f"{base}/health", timeout=2).status_code == 200:
-                    break
-            except httpx.TransportError:
-                pass
-            if server.poll() is not None or time.monotonic() > deadline:
-                raise RuntimeError("jik serve did not start")
-            time.sleep(0.2)
+    with jik_serve(JIK_WORKERS="2", JIK_TIMEOUT="20") as server:
         started = time.perf_counter()
         out = subprocess.run(  # (in a scratch directory: schemathesis writes its cache there)
-            [sys.executable, "-m", "schemathesis.cli", "run", f"{base}/openapi.json",
+            [sys.executable, "-m", "schemathesis.cli", "run", f"{server.url}/openapi.json",
              "--checks", "all", "--phases", PHASES, "--max-examples", str(max_examples),
              "--seed", str(seed), "--workers", "1", "--suppress-health-check", "all",
              "--continue-on-failure", "--request-timeout", "60", "--no-color"],
@@ -84,9 +59,7 @@ def run_fuzz(max_examples: int, seed: int = 26, timeout: float = 1500.0) -> Fuzz
             capture_output=True, text=True, timeout=timeout, cwd=tempfile.mkdtemp(),
         )  # fmt: skip
         seconds = time.perf_counter() - started
-    finally:
-        server.terminate()
-        log = server.communicate(timeout=60)[0]
+    log = server.log[0]
     text = out.stdout + out.stderr
     generated = re.search(r"(\d+) generated", text)
     found = re.search(r"found (\d+) unique failures", text)

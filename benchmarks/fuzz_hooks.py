@@ -10,6 +10,8 @@ case in tests/app/test_errors.py, test_synthesize.py and test_sessions.py):
   takes no ``augmentation``;
 - discrete mode (asked for, or the robot's default) needs ``gamma < 2``;
 - the chosen inverse must be defined at ``x0`` (the engine says so: a singular start);
+- an atlas's path must start where the self-motion curve can be traced (the server plans it:
+  the check is the server's own planner);
 - a dashboard change is checked against the session's robot (its parameters' names, its maps,
   its vectors' lengths): one that names no robot depends on a state the generator does not
   know, and one that does is kept only if the dashboard's model takes it on that robot's
@@ -35,13 +37,16 @@ try:  # (schemathesis loads this module, and brings hypothesis)
 except ImportError as exc:
     raise ImportError(f"{exc}: jik bench fuzz needs pip install 'jik[test]'") from exc
 
+from jik.app.compute.atlas_jobs import AtlasLimits, plan_request
+from jik.app.compute.atlas_schemas import AtlasRequest
+from jik.app.compute.exceptions import RequestError
 from jik.app.dashboard.model import StatePatch, default_state, patch_of, updated_state
 from jik.engine.exceptions import InvalidInputError, JikError
 from jik.engine.registry import ROBOTS, make_inverse
 
 #: Caps on the fields that size the work (and on the robot parameters that do: the unicycle's
 #: horizon T sizes its quadrature; T = 19.7 with 300 steps needed 1.7 GB).
-WORK_CAPS = {"cycles": 2, "max_iterations": 300, "degree": 6, "nodes": 4, "grid": 9}
+WORK_CAPS = {"cycles": 2, "max_iterations": 300, "degree": 6, "nodes": 4, "grid": 9, "starts": 16}
 ROBOT_CAPS = {"T": 2 * math.pi}
 MAX_PATH = 4
 
@@ -102,10 +107,11 @@ def _run_ok(body: dict) -> bool:
             kinematics, body["algorithm"], augmentation.get("name"),
             {k: v for k, v in augmentation.items() if k != "name"}, spec.name,
         )  # fmt: skip
-        inverse.matrix(np.asarray(body["x0"], dtype=float))
+        x0 = np.asarray(body["x0"], dtype=float)[None]
+        _, singular = inverse.apply_masked(x0, np.zeros((1, len(spec.task_names))))
     except JikError:
         return False
-    return True
+    return not singular.any()  # (the solver's own test of a singular start)
 
 
 def _change_ok(body: dict) -> bool:
@@ -120,6 +126,14 @@ def _change_ok(body: dict) -> bool:
     return True
 
 
+def _atlas_ok(body: dict) -> bool:
+    try:
+        plan_request(AtlasRequest.model_validate(body), AtlasLimits())
+    except (JikError, RequestError, ValidationError):
+        return False
+    return True
+
+
 def _positive_case_ok(case) -> bool:
     body = case.body
     if not isinstance(body, dict):
@@ -129,6 +143,8 @@ def _positive_case_ok(case) -> bool:
         return _synthesis_ok(body)
     if path in ("/solve", "/repeatability"):
         return _run_ok(body)
+    if path == "/atlas" and case.method == "POST":
+        return _atlas_ok(body)
     if path.startswith("/api/sessions") and case.method == "POST":
         return _change_ok(body)
     return True

@@ -108,18 +108,21 @@ def _validation_detail(errors) -> list[dict]:
     return detail
 
 
+#: Vectors whose length is the robot's p (the others: r); path and shifts hold points.
+_CONFIGURATIONS = ("x0", "reference")
+_TASK_VECTORS = ("target", "path", "shifts")
+
+
 def _length_message(loc, ctx: dict) -> str | None:
     """A vector of the wrong length for the request's robot (its tag is the location's second
     part): how many components it needs and why."""
     parts = [str(p) for p in loc]
     spec = ROBOTS.get(parts[1]) if len(parts) > 2 else None
-    if (
-        spec is None
-        or parts[2] not in ("x0", "target", "path")
-        or (parts[2] == "path" and len(parts) < 4)
-    ):
+    if spec is None or parts[2] not in (*_CONFIGURATIONS, *_TASK_VECTORS):
         return None
-    n, what = (spec.p, "p") if parts[2] == "x0" else (len(spec.task_names), "r")
+    if parts[2] in ("path", "shifts") and len(parts) < 4:
+        return None  # (the list of points itself)
+    n, what = (spec.p, "p") if parts[2] in _CONFIGURATIONS else (len(spec.task_names), "r")
     return f"must have {n} components ({what} of {spec.name}), got {ctx.get('actual_length')}"
 
 

@@ -19,6 +19,7 @@ from jik.app.compute.schemas import (
     MaybeFloat,
     Robot,
     Vector,
+    per_robot,
 )
 from jik.engine.repeatability import MAX_PATH_POINTS
 
@@ -68,6 +69,27 @@ class AtlasRequest(BaseModel):
     )
     cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_CYCLES)] = 3
     leg_ends: bool = Field(False, description="include every leg's end in the result")
+
+
+def _atlas_fields(spec, augmentation) -> dict:
+    r, p = len(spec.task_names), spec.p
+    point = Annotated[list[Coordinate], Field(min_length=r, max_length=r)]
+    return {
+        "augmentation": (augmentation | None, Field(
+            None, description="augmenting map of the extended inverse (default: the robot's)")),
+        "path": (Annotated[list[point], Field(min_length=2, max_length=MAX_PATH_POINTS)], Field(
+            description=f"task points {list(spec.task_names)}, a loop from the first: the "
+            "starts lie on k(x) = path[0]")),
+        "reference": (Annotated[list[Coordinate], Field(min_length=p, max_length=p)] | None,
+                      Field(None, description="s = 0 is where eq. (7) from here meets the "
+                            "curve (default: the robot's x0)")),
+        "shifts": (Annotated[list[point], Field(min_length=1, max_length=MAX_FAMILY)] | None,
+                   Field(None, description="translations of the path (a family of paths)")),
+    }  # fmt: skip
+
+
+#: ``POST /atlas``'s body: an :class:`AtlasRequest` with its robot's lengths and maps.
+AtlasBody = per_robot(AtlasRequest, _atlas_fields)
 
 
 class AtlasResult(BaseModel):

@@ -107,7 +107,8 @@ def test_one_client_may_run_one_job_at_a_time_here(client):
          "legs x algorithms = 8000000 is more than 1200000"),
         ({"starts": 20000, "cycles": 3, "leg_ends": True}, "leg_ends",
          "the ends of 240000 legs are more than the 200000"),
-        ({"path": [[0.0, 1.0], [1.0, 1.0, 2.0]]}, "path", "must have 2 components, got 3"),
+        ({"path": [[0.0, 1.0], [1.0, 1.0, 2.0]]}, "path",
+         "must have 2 components (r of manipulator2), got 3"),
         ({"arc": [1.0, 2.0]}, "arc", "lo <= 0 <= hi"),
         ({"path": [[0.0, 1.0]]}, "path", "at least 2 items"),
     ],
@@ -136,4 +137,4 @@ def test_ended_jobs_are_dropped_after_keep_for():
 
 def test_reference_must_be_a_configuration(client):
     r = client.post("/atlas", json=body(reference=[0.0, math.pi / 2]))
-    assert "reference: must have 3 components, got 2" in messages(r)
+    assert "reference: must have 3 components (p of manipulator2), got 2" in messages(r)

@@ -4,48 +4,23 @@ trickle in, and the server answers other clients meanwhile (issue 26, item 7).""
 
 from __future__ import annotations
 
-import os
 import socket
-import subprocess
-import sys
 import time
 
 import httpx
 import pytest
 
+from jik.benchmarks.serving import jik_serve
+
 READ_SECONDS = 1.0
 HALF_SENT = 150
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 @pytest.fixture(scope="module")
 def server():
-    port = _free_port()
-    env = dict(os.environ, JIK_READ_SECONDS=str(READ_SECONDS), JIK_WORKERS="1")
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "jik", "serve", f"--port={port}"],
-        env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-    )  # fmt: skip
-    base = f"http://127.0.0.1:{port}"
-    deadline = time.monotonic() + 60
-    while True:
-        try:
-            if httpx.get(f"{base}/health", timeout=2).status_code == 200:
-                break
-        except httpx.TransportError:
-            pass
-        assert proc.poll() is None, proc.communicate()[0]
-        assert time.monotonic() < deadline, "server did not start"
-        time.sleep(0.1)
-    yield port, base
-    proc.terminate()
-    log = proc.communicate(timeout=30)[0]
-    assert "Traceback" not in log, log
+    with jik_serve(JIK_READ_SECONDS=str(READ_SECONDS), JIK_WORKERS="1") as served:
+        yield served.port, served.url
+    assert "Traceback" not in served.log[0], served.log[0]
 
 
 def _connect(port: int, data: bytes) -> socket.socket:

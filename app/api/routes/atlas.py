@@ -11,7 +11,7 @@ from fastapi import APIRouter, Depends, Request, Response
 from starlette.concurrency import run_in_threadpool
 
 from jik.app.compute.atlas_jobs import AtlasJobs
-from jik.app.compute.atlas_schemas import AtlasJobResponse, AtlasRequest
+from jik.app.compute.atlas_schemas import AtlasBody, AtlasJobResponse
 from jik.app.compute.schemas import ErrorResponse
 
 router = APIRouter(tags=["atlas"])
@@ -33,7 +33,7 @@ ERRORS: dict[int | str, dict] = {
 
 
 @router.post("/atlas", status_code=202, response_model=AtlasJobResponse, responses=ERRORS)
-async def start_atlas(req: AtlasRequest, request: Request, response: Response, jobs: Jobs):
+async def start_atlas(req: AtlasBody, request: Request, response: Response, jobs: Jobs):
     """Plan the atlas (the self-motion curves are traced here) and start it as a job."""
     client = request.client.host if request.client else "unknown"
     job = await run_in_threadpool(jobs.start, client, req)

@@ -1,0 +1,58 @@
+"""A ``jik serve`` in a subprocess on a free loopback port, for the benchmarks and tests that
+need a real server (its own event loop, protocol and worker processes)."""
+
+from __future__ import annotations
+
+import os
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+
+import httpx
+
+
+def free_port() -> int:
+    """A TCP port free on 127.0.0.1 now."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@dataclass
+class Served:
+    """A running ``jik serve``: its port and base URL; ``log`` is filled when it has stopped."""
+
+    port: int
+    url: str
+    log: list[str] = field(default_factory=list)
+
+
+@contextmanager
+def jik_serve(**env: str) -> Iterator[Served]:
+    """``jik serve`` with the ``JIK_*`` settings ``env``, once /health answers (within 60 s);
+    stopped with SIGTERM on leaving, its output then in ``log[0]``."""
+    port = free_port()
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "jik", "serve", f"--port={port}"],
+        env={**os.environ, **env}, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+    )  # fmt: skip
+    served = Served(port, f"http://127.0.0.1:{port}")
+    try:
+        deadline = time.monotonic() + 60
+        while True:
+            try:
+                if httpx.get(f"{served.url}/health", timeout=2).status_code == 200:
+                    break
+            except httpx.TransportError:
+                pass
+            if proc.poll() is not None or time.monotonic() > deadline:
+                raise RuntimeError("jik serve did not start")
+            time.sleep(0.1)
+        yield served
+    finally:
+        proc.terminate()
+        served.log.append(proc.communicate(timeout=60)[0])
