@@ -15,9 +15,13 @@ import numpy as np
 
 from jik.engine.augmentations import AugmentingMap
 from jik.engine.exceptions import AlgorithmicSingularityError, InvalidInputError
-from jik.engine.inverses import SINGULAR_EXTENDED, Inverse, extended_singularity
+from jik.engine.inverses import (
+    SINGULAR_EXTENDED,
+    Inverse,
+    extended_singularity,
+    solve_extended,
+)
 from jik.engine.kinematics import Kinematics
-from jik.engine.linalg import solve_small
 from jik.engine.validation import FloatArray
 
 
@@ -64,13 +68,7 @@ class VectorExtendedInverse(Inverse):
 
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
         Jbar, undefined = self._extended(x)
-        k = len(self.augmenting_maps)
-        rhs = np.concatenate([e, np.zeros((*e.shape[:-1], k))], axis=-1)  # [e; 0]
-        v, d = solve_small(Jbar, rhs)
-        norms = np.prod(np.linalg.norm(Jbar, axis=-1), axis=-1)
-        bad = undefined | ~(np.abs(d) >= SINGULAR_EXTENDED * norms)
-        bad |= ~np.isfinite(v).all(axis=-1)
-        return (np.where(bad[..., None], 0.0, v) if bad.any() else v), bad
+        return solve_extended(Jbar, e, undefined)
 
     def matrix(self, x: FloatArray) -> FloatArray:
         """J^E#(x): the first r columns of [J; dh]^(-1), shape (..., p, r)."""

@@ -175,6 +175,20 @@ class Pseudoinverse(Inverse):
         )
 
 
+def solve_extended(
+    Jbar: FloatArray, e: FloatArray, undefined: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """v with [J; dh] v = [e; 0] (the extended inverse (11) applied to e, for one map or p - r
+    of them) and where it is undefined: a map undefined there, or |det| below
+    ``SINGULAR_EXTENDED`` times the product of the rows' norms (v is 0 there)."""
+    rhs = np.concatenate([e, np.zeros((*e.shape[:-1], Jbar.shape[-2] - e.shape[-1]))], axis=-1)
+    v, d = solve_small(Jbar, rhs)
+    norms = np.prod(np.linalg.norm(Jbar, axis=-1), axis=-1)
+    bad = undefined | ~(np.abs(d) >= SINGULAR_EXTENDED * norms)
+    bad |= ~np.isfinite(v).all(axis=-1)
+    return (np.where(bad[..., None], 0.0, v) if bad.any() else v), bad
+
+
 class ExtendedInverse(Inverse):
     """The extended Jacobian inverse, eq. (11), of a kinematics augmented by a map h, eq. (9).
 
@@ -195,13 +209,7 @@ class ExtendedInverse(Inverse):
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
         dh, undefined = self.augmenting_map.gradient_masked(x)
         dh = np.where(undefined[..., None], 0.0, dh)  # keeps the solve below free of NaN
-        Jbar = extended_jacobian(self.kinematics.jacobian(x), dh)
-        rhs = np.concatenate([e, np.zeros(e.shape[:-1] + (1,))], axis=-1)  # [e; 0]
-        v, d = solve_small(Jbar, rhs)
-        norms = np.prod(np.linalg.norm(Jbar, axis=-1), axis=-1)
-        bad = undefined | ~(np.abs(d) >= SINGULAR_EXTENDED * norms)
-        bad |= ~np.isfinite(v).all(axis=-1)
-        return (np.where(bad[..., None], 0.0, v) if bad.any() else v), bad
+        return solve_extended(extended_jacobian(self.kinematics.jacobian(x), dh), e, undefined)
 
     def matrix(self, x: FloatArray) -> FloatArray:
         x = self.kinematics.check(x)
