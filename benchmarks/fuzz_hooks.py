@@ -20,7 +20,7 @@ case in tests/app/test_errors.py, test_synthesize.py and test_sessions.py):
   response matches the document.)
 
 Every case also has its work capped (cycles, iterations, path points, grid and node counts, and
-coordinates within +-3, where the unicycle's quadrature stays small), so that the run measures
+coordinates and boxes within +-3, where the unicycle's quadrature stays small), so that the run measures
 the API, not the machine: the time and memory limits have tests of their own.
 """
 
@@ -74,6 +74,9 @@ def _capped(body: dict) -> dict:
     for name in ("x0", "target", "path"):
         if name in body:
             body[name] = _clamped(body[name])
+    for name in ("region", "fixed"):  # (a box of the unicycle's lambdas over +-100 took 20 s)
+        if isinstance(body.get(name), dict):
+            body[name] = {k: _clamped(v) for k, v in body[name].items()}
     robot = body.get("robot")
     if isinstance(robot, dict):
         body["robot"] = {k: min(v, ROBOT_CAPS[k]) if k in ROBOT_CAPS and isinstance(v, float)
