@@ -44,6 +44,9 @@ def create_app(
         store = getattr(app.state, "sessions", None)
         if store is not None:  # (first: its dashboards give up their runs in the pool)
             store.close()
+        jobs = getattr(app.state, "atlas_jobs", None)
+        if jobs is not None:  # (running atlases stop after their chunk)
+            jobs.close()
         pool.close()
 
     # /docs with Swagger UI's files from the fastapi-offline package: the API's documentation
