@@ -16,6 +16,7 @@ from jik.app.api.errors import BodyLimit, add_error_handlers
 from jik.app.api.fastpath import SolveFastPath
 from jik.app.api.routes import dashboard, health, repeatability, robots, sessions, solve, synthesize
 from jik.app.api.routes.atlas import router as atlas_router
+from jik.app.api.routes.session_atlas import router as session_atlas_router
 from jik.app.api.security import SecurityMiddleware, allowed_hosts_from_env
 from jik.app.compute.pool import ComputePool
 from jik.app.compute.settings import Settings, env_flag
@@ -68,6 +69,7 @@ def create_app(
     app.include_router(dashboard.router)
     app.include_router(sessions.router)
     app.include_router(atlas_router)
+    app.include_router(session_atlas_router)
     if fast_solve:
         app.add_middleware(SolveFastPath, pool=pool)
     app.add_middleware(BodyLimit, limit=MAX_BODY_BYTES)  # before any body is read
