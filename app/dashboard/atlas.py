@@ -78,27 +78,33 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
         axis = "" if k == 0 else str(k + 1)
         data.append({
             "type": "heatmap", "x": s, "y": labels, "z": np.log10(np.maximum(z, DRIFT_FLOOR)),
-            "customdata": runs, "coloraxis": "coloraxis", "xaxis": f"x{axis}", "yaxis": f"y{axis}",
+            "customdata": runs.tolist(), "coloraxis": "coloraxis", "xaxis": f"x{axis}",
+            "yaxis": f"y{axis}",
             "hovertemplate": "s = %{x:.3f}<br>%{y}<br>log10 drift = %{z:.2f}"
             f"<extra>{a}</extra>", "hoverongaps": False, "xgap": 0, "ygap": 1,
         })  # fmt: skip
         lo = k * (width + 0.08)
         layout[f"xaxis{axis}"] = {
             **AXIS, "domain": [lo, lo + width], "anchor": f"y{axis}",
-            "title": {"text": f"arc length s of the start on k(x) = k(x0) {unit} (s = 0: x0)"},
+            "title": {"text": f"arc length s of the start {unit}"},
         }  # fmt: skip
+        # s = 0 is x0, the start of the state the atlas was asked for
+        layout.setdefault("shapes", []).append({
+            "type": "line", "xref": f"x{axis}", "yref": f"y{axis} domain", "x0": 0, "x1": 0,
+            "y0": 0, "y1": 1, "line": {"color": "#fff", "width": 1.5, "dash": "dot"},
+        })  # fmt: skip
         layout[f"yaxis{axis}"] = {**AXIS, "anchor": f"x{axis}", "autorange": "reversed",
                                   "showticklabels": k == 0, "type": "category"}  # fmt: skip
-    names = [TITLES.get(a, a) + (f" with h = {request.augmentation.name}" if a == "extended"
+    names = [TITLES.get(a, a) + (f"<br>h = {request.augmentation.name}" if a == "extended"
              and request.augmentation is not None else "") for a in algorithms]  # fmt: skip
     for k, name in enumerate(names):
         lo = k * (width + 0.08)
-        note = f" ({failed[k]} failed: blank)" if failed[k] else ""
+        note = f", {failed[k]} starts failed (blank)" if failed[k] else ""
         layout.setdefault("annotations", []).append({
             "text": name + note, "x": lo + width / 2, "y": 1.0, "xref": "paper", "yref": "paper",
-            "xanchor": "center", "yanchor": "bottom", "showarrow": False, "font": {"size": 12},
+            "xanchor": "center", "yanchor": "bottom", "showarrow": False, "font": {"size": 11},
         })  # fmt: skip
-    title = (f"Repeatability atlas: drift after each cycle, {N} starts on k(x) = k(x0), "
+    title = (f"Drift after each cycle from {N} starts on k(x) = k(x0) (dotted: x0), "
              f"{request.robot.name}, γ = {request.gamma:g}, {request.mode} mode")  # fmt: skip
     logs = np.concatenate([np.ravel(t["z"]) for t in data])
     logs = logs[np.isfinite(logs)]
@@ -114,7 +120,7 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
         title,
         height=height,
         showlegend=False,
-        margin=dict(l=110, r=20, t=70, b=56),
+        margin=dict(l=110, r=20, t=84, b=56),
         **layout,
     )
 
