@@ -68,7 +68,8 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
             rows.append((j, c))
             labels.append(f"×{scales[j]:g}, cycle {c + 1}" if P > 1 else f"cycle {c + 1}")
     runs = np.array([[j * N + i for i in range(N)] for j, _ in rows])
-    data, layout = [], {}
+    data: list[dict] = []
+    layout: dict[str, Any] = {"shapes": [], "annotations": []}
     width = 0.40
     failed = []
     for k, a in enumerate(algorithms):
@@ -89,7 +90,7 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
             "title": {"text": f"arc length s of the start {unit}"},
         }  # fmt: skip
         # s = 0 is x0, the start of the state the atlas was asked for
-        layout.setdefault("shapes", []).append({
+        layout["shapes"].append({
             "type": "line", "xref": f"x{axis}", "yref": f"y{axis} domain", "x0": 0, "x1": 0,
             "y0": 0, "y1": 1, "line": {"color": "#fff", "width": 1.5, "dash": "dot"},
         })  # fmt: skip
@@ -100,7 +101,7 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
     for k, name in enumerate(names):
         lo = k * (width + 0.08)
         note = f", {failed[k]} starts failed (blank)" if failed[k] else ""
-        layout.setdefault("annotations", []).append({
+        layout["annotations"].append({
             "text": name + note, "x": lo + width / 2, "y": 1.0, "xref": "paper", "yref": "paper",
             "xanchor": "center", "yanchor": "bottom", "showarrow": False, "font": {"size": 11},
         })  # fmt: skip
