@@ -154,8 +154,8 @@ def test_a_session_atlas_is_the_atlas_of_its_state(client):
     """POST /api/sessions/{id}/atlas: a job of the same jobs, whose request is the session's
     state (the loop from k(x0) through its path, s = 0 at x0, its gamma and mode); once done,
     GET gives the heatmap (log10 drift, a cell's customdata its run) and the starts."""
-    sid = _session(client, mode="discrete", gamma=0.5, cycles=2)
-    r = client.post(f"/api/sessions/{sid}/atlas", json={"starts": 5, "scales": [1, 0.5]})
+    sid = _session(client, mode="discrete", gamma=0.5, cycles=2)  # (5.0: JSON's integer 5)
+    r = client.post(f"/api/sessions/{sid}/atlas", json={"starts": 5.0, "scales": [1, 0.5]})
     assert r.status_code == 202, r.text
     assert r.headers["location"] == f"/atlas/{r.json()['id']}"
     done = wait_until_ended(client, r.json()["id"])

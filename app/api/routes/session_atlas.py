@@ -20,6 +20,7 @@ from starlette.concurrency import run_in_threadpool
 from jik.app.api.dependencies import Store
 from jik.app.api.routes.atlas import ERRORS, Jobs
 from jik.app.compute.atlas_schemas import MAX_CYCLES, MAX_FAMILY, AtlasJobResponse, Scale
+from jik.app.compute.schemas import INTEGRAL
 from jik.app.dashboard.atlas import atlas_figure, atlas_request
 from jik.app.dashboard.plotting import figure_json
 from jik.engine.exceptions import InvalidInputError
@@ -35,8 +36,8 @@ class SessionAtlas(BaseModel):
 
     model_config = ConfigDict(extra="forbid")
 
-    starts: Annotated[int, Field(strict=True, ge=2, le=MAX_PANEL_STARTS)] = 256
-    cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_CYCLES)] | None = Field(
+    starts: Annotated[int, Field(strict=True, ge=2, le=MAX_PANEL_STARTS), INTEGRAL] = 256
+    cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_CYCLES), INTEGRAL] | None = Field(
         None, description="default: the session's cycles"
     )
     scales: Annotated[list[Scale], Field(min_length=1, max_length=MAX_FAMILY)] | None = Field(
