@@ -97,3 +97,18 @@ def test_the_atlas_computes_cancels_and_moves_the_main_view_to_a_clicked_start(t
     np.testing.assert_allclose(boxes, starts[i], atol=6e-4, rtol=0)  # (3 decimals)
     expect(page.locator("#atlas-outdated")).to_be_hidden()  # (same curve: still this atlas)
     screenshots(page, "atlas-moved")
+
+
+def test_an_atlas_the_state_cannot_have_is_refused_in_words_in_the_panel(tabs):
+    """A single target is no closed path: the panel says so where it is, and shows no
+    progress."""
+    tabs.allow_console("422")  # (chromium logs the refused POST)
+    tab = tabs.open()
+    tab.select("#ctl-task", "target")
+    tab.page.click("#atlas-compute")
+    status = tab.page.locator("#atlas-status")
+    expect(status).to_contain_text(
+        "the atlas was refused: task: the atlas drives a closed path; choose the closed-path task"
+    )
+    expect(status).to_have_class(re.compile("error"))
+    expect(tab.page.locator("#atlas-progress-box")).to_be_hidden()
