@@ -9,7 +9,7 @@ import { PLOT_CONFIG, panelHead } from "./panels.js";
 
 const POLL_MS = 250;
 // token: bumped to stop following a job; job: the one followed; shown: the atlas on screen.
-const atlas = { token: 0, job: null, shown: null, computedFor: null, send: null };
+const atlas = { token: 0, job: null, shown: null, computedFor: null, send: null, polling: null };
 
 const detail = (body) => (Array.isArray(body.detail) ? body.detail.map((d) => d.msg).join("; ") : body.detail);
 // What an atlas depends on in a state (not x0: every start of the curve is in it).
@@ -60,7 +60,8 @@ async function start(state) {
 
 async function follow(id, token) {
   for (;;) {
-    const res = await fetch(api(`/atlas/${id}`));
+    atlas.polling = fetch(api(`/atlas/${id}`));
+    const res = await atlas.polling;
     const body = await res.json();
     if (token !== atlas.token) return;
     if (!res.ok) throw new Error(`the atlas was lost: ${detail(body)}`);
@@ -79,7 +80,9 @@ function cancel() {
   atlas.job = null;
   showProgress(null);
   say(atlas.shown ? "Atlas cancelled; the heatmap below is the previous atlas." : "Atlas cancelled.");
-  if (id) fetch(`/atlas/${id}`, { method: "DELETE" }).catch(() => {});
+  // (after a poll in flight: the job is still there for it, and no 404 is logged)
+  const polled = atlas.polling || Promise.resolve();
+  if (id) polled.catch(() => {}).then(() => fetch(`/atlas/${id}`, { method: "DELETE" })).catch(() => {});
 }
 
 async function draw(body) {
