@@ -10,6 +10,8 @@ arc lengths s on a grid (or sampled), s = 0 where eq. (7) from the robot's defau
 configuration box, or ``--arc``. Writes ``--out`` (JSON: the inputs, the starts, and per
 algorithm the drift after each cycle, success and leg ends), a CSV beside it for large atlases
 (or with ``--csv``), and an HTML figure of the drift map when plotly is installed.
+``--robot`` is a built-in robot's name (``--param`` sets its parameters) or a user's robot file
+(:func:`jik.engine.robot_spec.load_robot`, as for ``jik solve``).
 """
 
 from __future__ import annotations
@@ -36,7 +38,8 @@ def add_atlas_parser(sub) -> None:
         help="repeatability atlas: drift after each cycle over many starts (and paths)",
         description=__doc__.split("\n\n")[2],
     )
-    p.add_argument("--robot", default="manipulator2", help="robot of the catalogue")
+    p.add_argument("--robot", default="manipulator2",
+                   help="a built-in robot, or a robot file (.json, .yaml)")  # fmt: skip
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                    help="a robot parameter (repeat it), e.g. l=1.5")  # fmt: skip
     p.add_argument("--path", required=True, help='task points "y1,y2; y1,y2; ...", a loop')
@@ -132,14 +135,23 @@ def _run(args: argparse.Namespace) -> int:
     from jik.engine.atlas import DEFAULT_CHUNK, plan_atlas
     from jik.engine.atlas_backends import backend_for
     from jik.engine.atlas_run import iter_atlas
+    from jik.engine.exceptions import InvalidInputError
     from jik.engine.registry import make_inverse, robot_spec
+    from jik.engine.robot_spec import load_robot
     from jik.engine.self_motion import MAX_ARC
 
-    spec = robot_spec(args.robot)
-    params = dict(_param(t) for t in args.param)
-    kin = spec.build(**params)
     algorithms = args.algorithm or ["pseudoinverse"]
-    inverses = [make_inverse(kin, a, args.augmentation, None, spec.name) for a in algorithms]
+    if Path(args.robot).is_file():  # a user's robot (jik.engine.robot_spec)
+        if args.param:
+            raise InvalidInputError("--param is for a built-in robot; a robot file holds its "
+                                    "parameters", "param")  # fmt: skip
+        robot = load_robot(args.robot)
+        spec, kin = robot.spec, robot.kinematics
+        inverses = [robot.inverse(a, args.augmentation) for a in algorithms]
+    else:
+        spec = robot_spec(args.robot)
+        kin = spec.build(**dict(_param(t) for t in args.param))
+        inverses = [make_inverse(kin, a, args.augmentation, None, spec.name) for a in algorithms]
     arc = _numbers(args.arc, "--arc") if args.arc else [-MAX_ARC, MAX_ARC]
     reference = _numbers(args.reference, "--reference") if args.reference else spec.default_x0
     backend = backend_option(args)
@@ -147,7 +159,7 @@ def _run(args: argparse.Namespace) -> int:
     plan = plan_atlas(
         inverses, _points(args.path, "--path"), cycles=args.cycles, n_starts=args.starts,
         arc=arc, sampling=args.sampling, seed=args.seed, reference=reference,
-        box=None if args.arc else spec.x_range,
+        box=None if args.arc or not spec.x_range else spec.x_range,
         shifts=[_numbers(s, "--shift") for s in args.shift] or None,
         scales=args.scale or None, chunk=args.chunk or default_chunk(args, DEFAULT_CHUNK),
         gamma=spec.default_gamma, mode=spec.default_mode,
@@ -168,7 +180,8 @@ def _run(args: argparse.Namespace) -> int:
             progress(arrays.done, plan.size)
     elapsed = time.perf_counter() - t0
     inputs = {
-        "robot": spec.name, "robot_parameters": kin.parameters, "path": _points(args.path, "path"),
+        "robot": spec.name, "robot_file": args.robot if Path(args.robot).is_file() else None,
+        "robot_parameters": kin.parameters, "path": _points(args.path, "path"),
         "cycles": C, "algorithms": list(plan.algorithms), "augmentation": args.augmentation,
         "starts": N, "sampling": args.sampling, "seed": args.seed, "arc": arc if args.arc else None,
         "reference": list(reference), "shifts": [_numbers(t, "--shift") for t in args.shift],

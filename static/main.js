@@ -5,6 +5,7 @@ import { change, endOnClose, follow, openSession, session, api } from "./api.js"
 import { showControls, showRefusal } from "./controls.js";
 import { $, el, fmt } from "./dom.js";
 import { algorithmKey, applyFunctionals, drawFigures, layoutPanels, markStale, onAhead, setExportNote } from "./panels.js";
+import { atlasPanel, atlasState } from "./atlas.js";
 
 const page = { config: null, state: null, shown: 0, shownState: null };
 const send = (patch) => { setNotice(""); change(patch, (message) => setStatus(message, true)); };
@@ -37,6 +38,7 @@ function onState(msg, force = false) {
   session.generation = Math.max(session.generation, msg.generation);
   showControls(msg, send, force);
   rememberInUrl(msg.state);
+  atlasState(msg.state);
   if (msg.generation > page.shown) setStatus(`computing generation ${msg.generation}…`);
 }
 
@@ -198,6 +200,7 @@ async function main() {
     (message) => setNotice(`the link's state was refused (${message}); showing the defaults`));
   $("#copy-link").addEventListener("click", copyLink);
   $("#cancel").addEventListener("click", cancel);
+  atlasPanel(() => page.state, send);
   onState(opened);
   showScene(opened.scene);
   let chain = Promise.resolve(); // results and their second phases are drawn in order

@@ -156,9 +156,10 @@ function plan(div, key, fig) {
 
 // A panel's head (once): the key of the algorithms, a "?" that shows what the panel is, and
 // (plots) buttons that save it as PNG or SVG, with its legend and the state it shows.
-function panelHead(div, key, plot = true) {
+// (legend: a key of the panel's own, instead of the algorithms'.)
+export function panelHead(div, key, plot = true, legend = null) {
   if (div.querySelector(":scope > .panel-head")) return;
-  const help = el("p", { className: "panel-help", id: `help-${key}` }, (CONFIG.panels.find((p) => p.id === key) || {}).help || "");
+  const help = el("p", { className: "panel-help", id: `help-${key}` }, ([...CONFIG.panels, ...(CONFIG.tools || [])].find((p) => p.id === key) || {}).help || "");
   help.hidden = true;
   const info = el("button", {
     type: "button", className: "tool info", title: "what this panel shows",
@@ -176,7 +177,7 @@ function panelHead(div, key, plot = true) {
   }, "CSV");
   const tools = el("div", { className: "panel-tools", title: plot ? "drag to zoom, double-click to reset" : "" },
     info, ...(plot ? [save("png"), save("svg")] : [csv]));
-  div.prepend(el("div", { className: "panel-head" }, algorithmKey(), tools), help);
+  div.prepend(el("div", { className: "panel-head" }, legend || algorithmKey(), tools), help);
 }
 const panelTools = (div, key) => panelHead(div, key, true);
 
@@ -203,6 +204,7 @@ function saveTable(div, key) {
 // The panel as an image: the figure on screen with its legend shown and, under it, the
 // result and state it shows (an image saved alone still says what it is).
 function saveImage(div, key, format) {
+  if (!div.layout) return null; // (nothing drawn yet)
   const layout = JSON.parse(JSON.stringify(div.layout));
   const height = (layout.height || div.clientHeight) + 110;
   const margin = { ...(layout.margin || {}), b: ((layout.margin || {}).b || 48) + 110 };

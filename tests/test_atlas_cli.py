@@ -109,3 +109,44 @@ def test_bad_input_exits_2_and_names_it(tmp_path, capsys, extra, text):
 def test_a_path_that_is_not_numbers_is_refused(tmp_path):
     with pytest.raises(SystemExit, match="--path must be comma-separated numbers"):
         main(["atlas", "--path", "1,a; 2,2", "--out", str(tmp_path / "x.json")])
+
+
+ARM = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6],
+       "augmentations": [{"name": "formula", "h": "x1 + x3"}]}  # fmt: skip
+
+
+def test_a_robot_file_runs_as_the_engine_builds_it(tmp_path):
+    """--robot FILE: a user's robot (robot_spec.load_robot); each run is repeatability() of
+    the robot's own inverses from its start (to 1e-10), the starts on k(x) = path[0]."""
+    from jik.engine.robot_spec import load_robot
+
+    (tmp_path / "arm.json").write_text(json.dumps(ARM))
+    path = "1.2,1.2; 1.2,1.6; 0.8,1.6"
+    argv = ["atlas", "--robot", str(tmp_path / "arm.json"), "--path", path, "--reference",
+            "0.3, 1, 1", "--arc=-0.5,0.5", "--starts", "5", "--cycles", "2", "--algorithm",
+            "pseudoinverse", "--algorithm", "extended", "--quiet", "--no-figure", "--out",
+            str(tmp_path / "a.json")]  # fmt: skip
+    assert main(argv) == 0
+    doc = json.loads((tmp_path / "a.json").read_text())
+    assert doc["inputs"]["robot"] == "planar_chain"
+    assert doc["inputs"]["robot_file"] == str(tmp_path / "arm.json")
+    robot = load_robot(tmp_path / "arm.json")
+    starts = np.array(doc["starts"])
+    np.testing.assert_allclose(robot.kinematics.forward(starts), np.full((5, 2), 1.2), atol=1e-9)
+    legs = [(1.2, 1.6), (0.8, 1.6), (1.2, 1.2)]
+    for alg in ("pseudoinverse", "extended"):
+        inverse = robot.inverse(alg)
+        for i in (0, 4):
+            rep = repeatability(inverse, starts[i], legs, cycles=2)
+            np.testing.assert_allclose(doc["results"][alg]["drift"][i], rep.drift, rtol=0,
+                                       atol=1e-10)  # fmt: skip
+    assert max(doc["results"]["extended"]["drift"][0]) < 1e-9
+    assert min(doc["results"]["pseudoinverse"]["drift"][0]) > 1e-4
+
+
+def test_a_robot_file_takes_no_param(tmp_path, capsys):
+    (tmp_path / "arm.json").write_text(json.dumps(ARM))
+    argv = ["atlas", "--robot", str(tmp_path / "arm.json"), "--param", "l=2", "--path",
+            "1.2,1.2; 1.2,1.6", "--quiet", "--out", str(tmp_path / "x.json")]  # fmt: skip
+    assert main(argv) == 2
+    assert "--param is for a built-in robot" in capsys.readouterr().err

@@ -16,6 +16,7 @@ from jik.app.api.errors import BodyLimit, add_error_handlers
 from jik.app.api.fastpath import SolveFastPath
 from jik.app.api.routes import dashboard, health, repeatability, robots, sessions, solve, synthesize
 from jik.app.api.routes.atlas import router as atlas_router
+from jik.app.api.routes.session_atlas import router as session_atlas_router
 from jik.app.api.security import SecurityMiddleware, allowed_hosts_from_env
 from jik.app.compute.pool import ComputePool
 from jik.app.compute.settings import Settings, env_flag
@@ -44,6 +45,9 @@ def create_app(
         store = getattr(app.state, "sessions", None)
         if store is not None:  # (first: its dashboards give up their runs in the pool)
             store.close()
+        jobs = getattr(app.state, "atlas_jobs", None)
+        if jobs is not None:  # (running atlases stop after their chunk)
+            jobs.close()
         pool.close()
 
     # /docs with Swagger UI's files from the fastapi-offline package: the API's documentation
@@ -65,6 +69,7 @@ def create_app(
     app.include_router(dashboard.router)
     app.include_router(sessions.router)
     app.include_router(atlas_router)
+    app.include_router(session_atlas_router)
     if fast_solve:
         app.add_middleware(SolveFastPath, pool=pool)
     app.add_middleware(BodyLimit, limit=MAX_BODY_BYTES)  # before any body is read

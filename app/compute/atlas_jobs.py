@@ -78,6 +78,10 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
     for name, v, size in vectors:
         if len(v) != size:
             raise RequestError(name, f"must have {size} components, got {len(v)}")
+    gamma = spec.default_gamma if req.gamma is None else req.gamma
+    mode = req.mode or spec.default_mode
+    if mode == "discrete" and gamma >= 2:
+        raise RequestError("gamma", f"must be < 2 in discrete mode, got {gamma:g}")
     paths = len(req.shifts or [0]) * len(req.scales or [0])
     closed = np.linalg.norm(np.subtract(req.path[-1], req.path[0])) <= CLOSE_TOL
     legs = req.starts * paths * req.cycles * (len(req.path) - closed) * len(req.algorithms)
@@ -96,7 +100,7 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
         inverses, req.path, cycles=req.cycles, n_starts=req.starts,
         arc=req.arc or (-MAX_ARC, MAX_ARC), sampling=req.sampling, seed=req.seed,
         reference=req.reference or spec.default_x0, box=None if req.arc else spec.x_range,
-        shifts=req.shifts, scales=req.scales, gamma=spec.default_gamma, mode=spec.default_mode,
+        shifts=req.shifts, scales=req.scales, gamma=gamma, mode=mode, tol=req.tolerance,
     )  # fmt: skip
 
 
@@ -131,6 +135,8 @@ class AtlasJob:
     error: str | None = None
     result: dict[str, Any] | None = None
     cancel: threading.Event = field(default_factory=threading.Event)
+    #: The request it was started from (the dashboard draws the result with it).
+    request: AtlasRequest | None = None
 
     def response(self) -> AtlasJobResponse:
         end = self.ended if self.ended is not None else time.monotonic()
@@ -160,7 +166,7 @@ class AtlasJobs:
         with self._lock:
             self._room(client)
         plan = plan_request(req, self.limits)
-        job = AtlasJob(secrets.token_urlsafe(12), client, plan, req.leg_ends)
+        job = AtlasJob(secrets.token_urlsafe(12), client, plan, req.leg_ends, request=req)
         with self._lock:
             self._room(client)
             self._jobs[job.id] = job

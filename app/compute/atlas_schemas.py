@@ -16,8 +16,11 @@ from jik.app.compute.schemas import (
     Algorithm,
     Augmentation,
     Coordinate,
+    Gamma,
     MaybeFloat,
+    Mode,
     Robot,
+    Tolerance,
     Vector,
     per_robot,
 )
@@ -68,6 +71,11 @@ class AtlasRequest(BaseModel):
         None, description="scales of the path about its first point"
     )
     cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_CYCLES)] = 3
+    gamma: Gamma | None = Field(
+        None, description="decay rate of eq. (5) of every leg (discrete: < 2); default: robot's"
+    )
+    mode: Mode | None = Field(None, description="'continuous' or 'discrete'; default: robot's")
+    tolerance: Tolerance = Field(1e-10, description="each leg stops at ||k(x) - target|| < this")
     leg_ends: bool = Field(False, description="include every leg's end in the result")
 
 

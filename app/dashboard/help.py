@@ -50,6 +50,17 @@ PANEL_HELP = {
     "(Manipulator 2 on the square path), Table 1 of the paper beside jik's numbers.",
 }
 
+#: The atlas panel (not a panel of every result: computed on demand, app/dashboard/atlas.py).
+ATLAS_HELP = (
+    "The repeatability atlas of the current state: the closed path driven from many starts on "
+    "the self-motion curve k(x) = k(x0) (p − r = 1), each at its arc length s along the curve "
+    "(s = 0 is x0; the curve is cut where it leaves the robot's joint box). Each cell is the "
+    "drift ‖x − x0‖ after one cycle from one start, as log10 on one colour scale for both: "
+    "the pseudoinverse on the left, the extended Jacobian with the chosen augmenting map on the "
+    "right (repeatable: round-off, about −13). With path scales, one band of rows per scale of "
+    "the path about k(x0). Click a cell to move the main view to that start (and scale)."
+)
+
 
 def page_config() -> dict:
     """What the page needs before its session: the algorithms' colours, labels and styles,
@@ -60,4 +71,5 @@ def page_config() -> dict:
         "styles": STYLES,
         "panels": [{"id": k, "size": v, "help": PANEL_HELP[k]} for k, v in PANEL_SIZES.items()],
         "progress_after": PROGRESS_AFTER,
+        "tools": [{"id": "atlas", "help": ATLAS_HELP}],
     }

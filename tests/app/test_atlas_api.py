@@ -12,7 +12,9 @@ from fastapi.testclient import TestClient
 from jik.app.api.factory import create_app
 from jik.app.compute.atlas_jobs import AtlasJobNotFound, AtlasJobs, AtlasLimits, plan_request
 from jik.app.compute.atlas_schemas import AtlasRequest
+from jik.app.dashboard.sessions import SessionLimits, SessionStore
 from jik.engine.atlas_run import run_atlas
+from jik.engine.registry import robot_spec
 from tests.app.conftest import messages
 
 LOOP = [[0.0, 1.0], [1.0, 1.0], [1.0, 2.0], [0.0, 2.0]]
@@ -33,8 +35,10 @@ LONG = body(starts=20000, cycles=5, arc=None)
 def app():
     app = create_app()
     app.state.atlas_jobs = AtlasJobs(AtlasLimits(max_jobs=3, per_client=1, workers=1))
+    app.state.sessions = SessionStore(SessionLimits(max_sessions=4))
     yield app
     app.state.atlas_jobs.close()
+    app.state.sessions.close()
 
 
 @pytest.fixture
@@ -111,6 +115,7 @@ def test_one_client_may_run_one_job_at_a_time_here(client):
          "must have 2 components (r of manipulator2), got 3"),
         ({"arc": [1.0, 2.0]}, "arc", "lo <= 0 <= hi"),
         ({"path": [[0.0, 1.0]]}, "path", "at least 2 items"),
+        ({"mode": "discrete", "gamma": 2.0}, "gamma", "must be < 2 in discrete mode"),
     ],
 )  # fmt: skip
 def test_bad_or_too_large_requests_are_422_naming_the_field(client, over, field, text):
@@ -138,3 +143,52 @@ def test_ended_jobs_are_dropped_after_keep_for():
 def test_reference_must_be_a_configuration(client):
     r = client.post("/atlas", json=body(reference=[0.0, math.pi / 2]))
     assert "reference: must have 3 components (p of manipulator2), got 2" in messages(r)
+
+
+def _session(client, **state) -> str:
+    r = client.post("/api/sessions", json={"state": state})
+    assert r.status_code == 201, r.text
+    return r.json()["id"]
+
+
+def test_a_session_atlas_is_the_atlas_of_its_state(client):
+    """POST /api/sessions/{id}/atlas: a job of the same jobs, whose request is the session's
+    state (the loop from k(x0) through its path, s = 0 at x0, its gamma and mode); once done,
+    GET gives the heatmap (log10 drift, a cell's customdata its run) and the starts."""
+    sid = _session(client, mode="discrete", gamma=0.5, cycles=2)  # (5.0: JSON's integer 5)
+    r = client.post(f"/api/sessions/{sid}/atlas", json={"starts": 5.0, "scales": [1, 0.5]})
+    assert r.status_code == 202, r.text
+    assert r.headers["location"] == f"/atlas/{r.json()['id']}"
+    done = wait_until_ended(client, r.json()["id"])
+    assert done["status"] == "done", done["error"]
+    body = client.get(f"/api/sessions/{sid}/atlas/{done['id']}").json()
+    req = body["request"]
+    np.testing.assert_allclose(req["path"], [[0.0, 1.0], *LOOP[1:], [0.0, 1.0]], atol=1e-15)
+    assert (req["reference"], req["mode"], req["gamma"], req["cycles"]) == (
+        [0.0, 0.0, math.pi / 2], "discrete", 0.5, 2)  # fmt: skip
+    starts = np.array(body["starts"])  # (P, N, p)
+    assert starts.shape == (2, 5, 3)
+    kin = robot_spec("manipulator2").build(l=1.0)
+    np.testing.assert_allclose(kin.forward(starts), np.broadcast_to([0.0, 1.0], (2, 5, 2)),
+                               atol=1e-9)  # fmt: skip
+    heat = body["figure"]["data"]
+    assert [t["type"] for t in heat] == ["heatmap", "heatmap"]
+    assert heat[0]["y"] == ["×1, cycle 1", "×1, cycle 2", "×0.5, cycle 1", "×0.5, cycle 2"]
+    drift = np.array(done["result"]["drift"]["pseudoinverse"], dtype=float)  # (P, N, C)
+    assert np.min(drift) > 1e-4
+
+
+@pytest.mark.parametrize(
+    ("state", "over", "field", "text"),
+    [
+        ({"task": "target"}, {}, "task", "task: the atlas drives a closed path"),
+        ({}, {"starts": 1}, "starts", "greater than or equal to 2"),
+        ({}, {"scales": [0.0]}, "scales", "greater than 0"),
+    ],
+)  # fmt: skip
+def test_a_session_atlas_it_cannot_make_is_422_naming_the_field(client, state, over, field, text):
+    sid = _session(client, **state)
+    r = client.post(f"/api/sessions/{sid}/atlas", json=over)
+    assert r.status_code == 422, r.text
+    assert any(text in m for m in messages(r)), r.text
+    assert r.json()["detail"][0]["loc"][1] == field

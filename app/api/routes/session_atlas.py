@@ -1,0 +1,81 @@
+"""A dashboard session's repeatability atlas: ``POST /api/sessions/{id}/atlas`` starts the atlas
+of the session's current state, ``GET /api/sessions/{id}/atlas/{job}`` follows it and, once
+done, gives its heatmap; ``DELETE /atlas/{job}`` cancels it.
+
+The atlas is a job of the REST API's :class:`jik.app.compute.atlas_jobs.AtlasJobs`, with its
+request model and limits (jobs per client, one computing at once): the session only says which
+atlas its state asks for (:func:`jik.app.dashboard.atlas.atlas_request`).
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Annotated
+
+from fastapi import APIRouter, Request, Response
+from fastapi.responses import JSONResponse
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from starlette.concurrency import run_in_threadpool
+
+from jik.app.api.dependencies import Store
+from jik.app.api.routes.atlas import ERRORS, Jobs
+from jik.app.compute.atlas_schemas import MAX_CYCLES, MAX_FAMILY, AtlasJobResponse, Scale
+from jik.app.compute.schemas import INTEGRAL
+from jik.app.dashboard.atlas import atlas_figure, atlas_request
+from jik.app.dashboard.plotting import figure_json
+from jik.engine.exceptions import InvalidInputError
+
+router = APIRouter(tags=["dashboard sessions"])
+#: Largest atlas the panel asks for (the API's own limits apply too).
+MAX_PANEL_STARTS = 4096
+_NOT_FOUND: dict[int | str, dict] = {404: {"description": "no such session or atlas job"}}
+
+
+class SessionAtlas(BaseModel):
+    """The atlas of the session's current state: how many starts and cycles, which scales."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    starts: Annotated[int, Field(strict=True, ge=2, le=MAX_PANEL_STARTS), INTEGRAL] = 256
+    cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_CYCLES), INTEGRAL] | None = Field(
+        None, description="default: the session's cycles"
+    )
+    scales: Annotated[list[Scale], Field(min_length=1, max_length=MAX_FAMILY)] | None = Field(
+        None, description="scales of the path about k(x0), a row of the heatmap each"
+    )
+
+
+@router.post("/api/sessions/{session_id}/atlas", status_code=202,
+             response_model=AtlasJobResponse, responses={**ERRORS, **_NOT_FOUND})  # fmt: skip
+async def start_session_atlas(
+    session_id: str, body: SessionAtlas, request: Request, response: Response, store: Store,
+    jobs: Jobs,
+):  # fmt: skip
+    """Start the atlas of the session's current state (422 naming the field it refuses)."""
+    state = store.get(session_id).dashboard.state
+    try:
+        req = atlas_request(state, body.starts, body.cycles, body.scales)
+    except ValidationError as exc:
+        error = exc.errors()[0]
+        name = ".".join(str(p) for p in error["loc"]) or "state"
+        raise InvalidInputError(f"{name}: {error['msg']}", name) from None
+    client = request.client.host if request.client else "unknown"
+    job = await run_in_threadpool(jobs.start, client, req)
+    response.headers["Location"] = f"/atlas/{job.id}"
+    return job.response()
+
+
+@router.get("/api/sessions/{session_id}/atlas/{job_id}", responses={**ERRORS, **_NOT_FOUND})
+async def read_session_atlas(session_id: str, job_id: str, store: Store, jobs: Jobs):
+    """The job's status and progress; once done, its heatmap (a plotly figure), the starts and
+    the paths (a cell's run, path * N + start, picks one of each), and the request."""
+    store.get(session_id)
+    job = jobs.get(job_id)
+    body = job.response().model_dump(mode="json", exclude={"result"})
+    if job.status == "done" and job.result is not None and job.request is not None:
+        figure = await run_in_threadpool(atlas_figure, job.result, job.request)
+        body.update(
+            figure=json.loads(figure_json(figure)), starts=job.result["starts"],
+            paths=job.result["paths"], request=job.request.model_dump(mode="json"),
+        )  # fmt: skip
+    return JSONResponse(body)

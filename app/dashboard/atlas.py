@@ -1,0 +1,129 @@
+"""The dashboard's atlas panel: a repeatability atlas of the session's current state, and its
+heatmap.
+
+The atlas itself is the REST API's (:mod:`jik.app.compute.atlas_jobs`: the same request model,
+the same jobs and limits); :func:`atlas_request` only says which atlas a state asks for: its
+robot, map, gamma, mode and tolerance, both algorithms, and the loop the dashboard drives, from
+k(x0) through the path's points, with the starts on the self-motion curve of k(x0) and s = 0 at
+x0. :func:`atlas_figure` draws a finished atlas: drift per cycle (and per path scale, when
+swept) over the arc length s of the starts, the pseudoinverse beside the extended Jacobian.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from jik.app.compute.atlas_schemas import AtlasRequest
+from jik.app.dashboard.analysis import kinematics_and_map
+from jik.app.dashboard.model import DashboardState
+from jik.app.dashboard.plotting import AXIS, UNITS, figure, norm_unit
+from jik.engine.exceptions import InvalidInputError
+
+#: Drift below this is drawn as this (the extended Jacobian's drift is round-off, ~1e-13).
+DRIFT_FLOOR = 1e-14
+TITLES = {"pseudoinverse": "pseudoinverse J^P# (8)", "extended": "extended Jacobian J^E# (11)"}
+
+
+def atlas_request(
+    state: DashboardState, starts: int, cycles: int | None = None,
+    scales: Sequence[float] | None = None,
+) -> AtlasRequest:  # fmt: skip
+    """The atlas of ``state`` (its closed path, robot, map, gamma, mode and tolerance), with
+    ``starts`` starts and ``cycles`` cycles (default: the state's); InvalidInputError naming
+    the field when the state has no closed path or the request is refused."""
+    if state.task != "path" or not state.path:
+        raise InvalidInputError(
+            "task: the atlas drives a closed path; choose the closed-path task first", "task"
+        )
+    kin, _ = kinematics_and_map(state)
+    home = np.asarray(kin.forward(np.asarray(state.x0, dtype=float)), dtype=float)
+    return AtlasRequest.model_validate({
+        "robot": {"name": state.robot, **state.robot_parameters},
+        "algorithms": ["pseudoinverse", "extended"],
+        "augmentation": {"name": state.augmentation, **state.augmentation_parameters},
+        "path": [home.tolist(), *[list(p) for p in state.path]],
+        "starts": starts, "cycles": cycles or state.cycles, "reference": list(state.x0),
+        "scales": list(scales) if scales else None, "gamma": state.gamma, "mode": state.mode,
+        "tolerance": state.tolerance,
+    })  # fmt: skip
+
+
+def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
+    """The heatmap of a finished atlas (the ``result`` of ``GET /atlas/{id}``): for each
+    algorithm, log10 of the drift ||x after cycle c - x0|| over the starts' arc length s
+    (columns) and the cycles (rows; per path scale when several), one colour scale for both.
+    A cell's ``customdata`` is its run, path * N + start (for a click)."""
+    algorithms = result["algorithms"]
+    s = np.asarray(result["parameter"], dtype=float)  # (N,)
+    scales = request.scales or [1.0]
+    joint = UNITS.get(request.robot.name, ((), ()))[0]
+    unit = norm_unit(joint)
+    rows, labels = [], []
+    P, N = len(result["paths"]), len(s)
+    for j in range(P):
+        for c in range(request.cycles):
+            rows.append((j, c))
+            labels.append(f"×{scales[j]:g}, cycle {c + 1}" if P > 1 else f"cycle {c + 1}")
+    runs = np.array([[j * N + i for i in range(N)] for j, _ in rows])
+    data: list[dict] = []
+    layout: dict[str, Any] = {"shapes": [], "annotations": []}
+    width = 0.40
+    failed = []
+    for k, a in enumerate(algorithms):
+        d = np.array(result["drift"][a], dtype=float)  # (P, N, C), NaN after a failure
+        z = np.array([d[j, :, c] for j, c in rows])  # (rows, N)
+        failed.append(int(np.isnan(d).any(axis=2).sum()))
+        axis = "" if k == 0 else str(k + 1)
+        data.append({
+            "type": "heatmap", "x": s, "y": labels, "z": np.log10(np.maximum(z, DRIFT_FLOOR)),
+            "customdata": runs.tolist(), "coloraxis": "coloraxis", "xaxis": f"x{axis}",
+            "yaxis": f"y{axis}",
+            "hovertemplate": "s = %{x:.3f}<br>%{y}<br>log10 drift = %{z:.2f}"
+            f"<extra>{a}</extra>", "hoverongaps": False, "xgap": 0, "ygap": 1,
+        })  # fmt: skip
+        lo = k * (width + 0.08)
+        layout[f"xaxis{axis}"] = {
+            **AXIS, "domain": [lo, lo + width], "anchor": f"y{axis}",
+            "title": {"text": f"arc length s of the start {unit}"},
+        }  # fmt: skip
+        # s = 0 is x0, the start of the state the atlas was asked for
+        layout["shapes"].append({
+            "type": "line", "xref": f"x{axis}", "yref": f"y{axis} domain", "x0": 0, "x1": 0,
+            "y0": 0, "y1": 1, "line": {"color": "#fff", "width": 1.5, "dash": "dot"},
+        })  # fmt: skip
+        layout[f"yaxis{axis}"] = {**AXIS, "anchor": f"x{axis}", "autorange": "reversed",
+                                  "showticklabels": k == 0, "type": "category"}  # fmt: skip
+    names = [TITLES.get(a, a) + (f"<br>h = {request.augmentation.name}" if a == "extended"
+             and request.augmentation is not None else "") for a in algorithms]  # fmt: skip
+    for k, name in enumerate(names):
+        lo = k * (width + 0.08)
+        note = f", {failed[k]} starts failed (blank)" if failed[k] else ""
+        layout["annotations"].append({
+            "text": name + note, "x": lo + width / 2, "y": 1.0, "xref": "paper", "yref": "paper",
+            "xanchor": "center", "yanchor": "bottom", "showarrow": False, "font": {"size": 11},
+        })  # fmt: skip
+    title = (f"Drift after each cycle from {N} starts on k(x) = k(x0) (dotted: x0), "
+             f"{request.robot.name}, γ = {request.gamma:g}, {request.mode} mode")  # fmt: skip
+    logs = np.concatenate([np.ravel(t["z"]) for t in data])
+    logs = logs[np.isfinite(logs)]
+    cmin, cmax = (np.floor(logs.min()), np.ceil(logs.max())) if logs.size else (-14.0, 0.0)
+    layout["coloraxis"] = {
+        "colorscale": "Viridis", "cmin": float(cmin), "cmax": float(max(cmax, cmin + 1)),
+        "colorbar": {"title": {"text": f"log10 ‖x − x0‖<br>{unit}", "side": "right"},
+                     "x": 2 * width + 0.1, "len": 0.9},
+    }  # fmt: skip
+    height = max(260, 120 + 22 * len(rows))
+    return figure(
+        data,
+        title,
+        height=height,
+        showlegend=False,
+        margin=dict(l=110, r=20, t=84, b=56),
+        **layout,
+    )
+
+
+__all__ = ["atlas_figure", "atlas_request"]

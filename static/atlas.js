@@ -1,0 +1,170 @@
+// The atlas panel: the repeatability atlas of the session's current state (app/dashboard/atlas.py).
+// It is a job of the REST API's atlas jobs (their limits apply): started through the session
+// (POST /api/sessions/{id}/atlas), followed until done (GET .../atlas/{job}: progress, then the
+// heatmap), cancelled by DELETE /atlas/{job}. A cell of the heatmap is a start: a click sets the
+// session's x0 there (and the path's scale), so the main view recomputes from that start.
+import { api } from "./api.js";
+import { $, el, fmt } from "./dom.js";
+import { PLOT_CONFIG, panelHead } from "./panels.js";
+
+const POLL_MS = 250;
+// token: bumped to stop following a job; job: the one followed; shown: the atlas on screen.
+const atlas = { token: 0, job: null, shown: null, computedFor: null, send: null, polling: null };
+
+const detail = (body) => (Array.isArray(body.detail) ? body.detail.map((d) => d.msg).join("; ") : body.detail);
+// What an atlas depends on in a state (not x0: every start of the curve is in it).
+const atlasKey = (s) => JSON.stringify([s.robot, s.robot_parameters, s.augmentation, s.augmentation_parameters, s.gamma, s.mode, s.tolerance, s.task, s.path]);
+
+function say(text, error = false) {
+  const status = $("#atlas-status");
+  status.textContent = text;
+  status.classList.toggle("error", error);
+}
+
+function showProgress(body) {
+  $("#atlas-progress-box").hidden = !body;
+  $("#atlas-compute").disabled = Boolean(body);
+  if (!body) return;
+  const pct = Math.round(100 * body.progress);
+  $("#atlas-bar").style.width = `${pct}%`;
+  $("#atlas-progress-text").textContent = body.status === "queued"
+    ? "waiting: another atlas is computing (one at a time)"
+    : `computing ${pct}% (${body.runs_done} of ${body.runs} starts, ${fmt(body.elapsed_s, 1)} s)`;
+}
+
+async function start(state) {
+  const number = (id) => ($(id).value.trim() === "" ? null : Number($(id).value));
+  const scales = $("#atlas-scales").value.trim();
+  const body = { starts: number("#atlas-starts"), cycles: number("#atlas-cycles") };
+  if (body.starts === null) delete body.starts;
+  if (scales) body.scales = scales.split(/[,;\s]+/).filter(Boolean).map(Number);
+  const token = ++atlas.token;
+  say("starting the atlas…");
+  showProgress({ status: "running", progress: 0, runs_done: 0, runs: body.starts || 0, elapsed_s: 0 });
+  try {
+    const res = await fetch(api("/atlas"), {
+      method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(body),
+    });
+    const job = await res.json();
+    if (token !== atlas.token) return;
+    if (!res.ok) throw new Error(`the atlas was refused: ${detail(job)}`);
+    atlas.job = job.id;
+    atlas.computedFor = atlasKey(state());
+    await follow(job.id, token);
+  } catch (err) {
+    if (token !== atlas.token) return;
+    showProgress(null);
+    say(err.message, true);
+  }
+}
+
+async function follow(id, token) {
+  for (;;) {
+    atlas.polling = fetch(api(`/atlas/${id}`));
+    const res = await atlas.polling;
+    const body = await res.json();
+    if (token !== atlas.token) return;
+    if (!res.ok) throw new Error(`the atlas was lost: ${detail(body)}`);
+    if (body.status === "done") return draw(body);
+    if (body.status === "failed") throw new Error(`the atlas failed: ${body.error}`);
+    if (body.status === "cancelled") throw new Error("the atlas was cancelled on the server");
+    showProgress(body);
+    await new Promise((resolve) => { setTimeout(resolve, POLL_MS); });
+    if (token !== atlas.token) return;
+  }
+}
+
+function cancel() {
+  const id = atlas.job;
+  atlas.token += 1; // (stop following it)
+  atlas.job = null;
+  showProgress(null);
+  say(atlas.shown ? "Atlas cancelled; the heatmap below is the previous atlas." : "Atlas cancelled.");
+  // (after a poll in flight: the job is still there for it, and no 404 is logged)
+  const polled = atlas.polling || Promise.resolve();
+  if (id) polled.catch(() => {}).then(() => fetch(`/atlas/${id}`, { method: "DELETE" })).catch(() => {});
+}
+
+async function draw(body) {
+  atlas.job = null;
+  atlas.shown = body;
+  const div = $("#plot-atlas");
+  div.classList.add("drawn");
+  // Its height is the figure's (rows of cycles and scales); the width follows the window.
+  // (plotly's responsive mode would take the height from the box too.)
+  const layout = { ...body.figure.layout, width: div.clientWidth };
+  await Plotly.react(div, body.figure.data, layout, { ...PLOT_CONFIG, responsive: false });
+  // (plotly puts its plot first: the head and its help go back above it)
+  div.prepend(...div.querySelectorAll(":scope > .panel-head, :scope > .panel-help"));
+  if (!div.dataset.clicks) {
+    div.dataset.clicks = "on";
+    div.on("plotly_click", (ev) => moveTo(ev.points[0]));
+    new ResizeObserver(() => {
+      if (div.layout && Math.abs(div.layout.width - div.clientWidth) > 1) Plotly.relayout(div, { width: div.clientWidth });
+    }).observe(div);
+  }
+  showProgress(null);
+  const n = body.starts[0].length;
+  say(`Atlas done: ${body.runs} runs of ${body.request.cycles} cycles in ${fmt(body.elapsed_s, 1)} s (${n} starts). Click a cell to move the main view to that start.`);
+  div.dataset.runs = body.runs;
+}
+
+// A cell's start (and its path's scale) as the session's state.
+function moveTo(point) {
+  const body = atlas.shown;
+  if (!body || !point) return;
+  const n = body.starts[0].length;
+  const [row, col] = Array.isArray(point.pointNumber) ? point.pointNumber : [null, null];
+  const run = Number.isFinite(point.customdata) ? point.customdata : (Math.floor(row / body.request.cycles) * n + col);
+  const j = Math.floor(run / n);
+  const i = run % n;
+  const x0 = body.starts[j][i];
+  const patch = { x0 };
+  const scale = (body.request.scales || [1])[j];
+  if (scale !== 1) {
+    const path = body.paths[j];
+    const given = body.request.path.slice(1); // (the state's path when computed)
+    const home = path[0];
+    patch.path = given.map((p) => p.map((v, d) => home[d] + scale * (v - home[d])));
+  }
+  atlas.send(patch);
+  const s = body.request.scales ? `, path ×${scale}` : "";
+  say(`Moved the main view to start ${i + 1} of ${n} (s = ${fmt(Number(point.x))}${s}): x0 = (${x0.map((v) => fmt(v)).join(", ")}).`);
+}
+
+// The current state changed: say when the atlas on screen is of another state.
+export function atlasState(state) {
+  const note = $("#atlas-outdated");
+  if (note) note.hidden = !atlas.shown || atlas.computedFor === atlasKey(state);
+}
+
+// Build the panel (index.html's #atlas); ``state()`` is the session's current state, ``send``
+// changes it (as the controls do).
+export function atlasPanel(state, send) {
+  atlas.send = send;
+  const field = (label, input, help) => el("label", { title: help }, el("span", {}, label), input);
+  const starts = el("input", { type: "number", id: "atlas-starts", min: 2, max: 4096, step: 1, value: 256 });
+  const cycles = el("input", { type: "number", id: "atlas-cycles", min: 1, max: 50, step: 1, placeholder: "as above" });
+  const scales = el("input", { type: "text", id: "atlas-scales", placeholder: "1 (e.g. 0.5, 1, 1.5)" });
+  const compute = el("button", { type: "button", id: "atlas-compute", onclick: () => start(state) }, "Compute atlas");
+  const stop = el("button", { type: "button", id: "atlas-cancel", onclick: cancel, title: "stop this atlas" }, "Cancel");
+  const progress = el("span", { id: "atlas-progress-box", className: "progress-box" },
+    el("span", { className: "progress" }, el("span", { id: "atlas-bar", className: "bar" }), el("span", { id: "atlas-progress-text" })), stop);
+  progress.hidden = true;
+  const outdated = el("p", { id: "atlas-outdated", className: "note" }, "This atlas is of an earlier state (robot, map, path, γ or mode): compute again for the current one.");
+  outdated.hidden = true;
+  const plot = el("div", { id: "plot-atlas", className: "panel full atlas-plot" });
+  const key = el("span", { className: "key-list" },
+    el("span", { className: "key" }, "colour: log10 of the drift ‖x − x0‖ after each cycle (its scale on the right)"),
+    el("span", { className: "key" }, "left: pseudoinverse; right: extended Jacobian with the chosen map"));
+  panelHead(plot, "atlas", true, key);
+  $("#atlas").replaceChildren(
+    el("h2", {}, "Repeatability atlas"),
+    el("div", { className: "atlas-bar" },
+      field("starts", starts, "starts on the self-motion curve of k(x0), 2 to 4096"),
+      field("cycles", cycles, "cycles of the path per start (empty: the controls' cycles)"),
+      field("path scales", scales, "scales of the path about k(x0), each a band of rows (empty: the path as it is)"),
+      compute, progress),
+    el("p", { id: "atlas-status", className: "atlas-status", role: "status" }, "Compute the atlas of the current robot, path and map: the drift of both algorithms from every start of the self-motion curve of k(x0)."),
+    outdated, plot);
+}

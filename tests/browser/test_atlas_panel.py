@@ -1,0 +1,124 @@
+"""The atlas panel: the repeatability atlas of the session's state computes with its progress
+shown, can be cancelled, draws its heatmap, and a click on a cell moves the main view there."""
+
+from __future__ import annotations
+
+import re
+import urllib.error
+import urllib.request
+
+import numpy as np
+import pytest
+
+from tests.browser.conftest import ARTIFACTS, SCREEN_SIZES, get_json, poll
+
+expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
+pytestmark = pytest.mark.browser
+
+
+def gone(url: str) -> bool:
+    """Whether ``url`` answers 404."""
+    try:
+        urllib.request.urlopen(url, timeout=30).close()
+    except urllib.error.HTTPError as error:
+        return error.code == 404
+    return False
+
+
+def start_atlas(tab, starts: int, cycles: int) -> str:
+    """Fill in the panel's boxes, press "Compute atlas"; the job's id (from its 202)."""
+    page = tab.page
+    page.fill("#atlas-starts", str(starts))
+    page.fill("#atlas-cycles", str(cycles))
+    with page.expect_response(
+        lambda r: r.request.method == "POST" and r.url.endswith("/atlas")
+    ) as response:
+        page.click("#atlas-compute")
+    assert response.value.status == 202, response.value.text()
+    return response.value.json()["id"]
+
+
+def screenshots(page, name: str) -> None:
+    """The page at each of SCREEN_SIZES with the atlas panel at the top (below the sticky
+    header): tests/artifacts/<name>-<width>.png."""
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    size = page.viewport_size
+    for width, height in SCREEN_SIZES:
+        page.set_viewport_size({"width": width, "height": height})
+        page.evaluate(
+            "() => { document.getElementById('atlas').scrollIntoView({block: 'start'});"
+            " window.scrollBy(0, -document.querySelector('header').offsetHeight - 8); }"
+        )
+        page.wait_for_function("() => document.fonts.status === 'loaded'")
+        page.screenshot(path=str(ARTIFACTS / f"{name}-{width}.png"))
+    if size is not None:
+        page.set_viewport_size(size)
+
+
+def test_the_atlas_computes_cancels_and_moves_the_main_view_to_a_clicked_start(tabs):
+    """Manipulator 2 on the closed path. The first atlas shows its progress and a Cancel
+    button; Cancel hides them, the panel says cancelled and the server forgets the job. The
+    second (64 starts, 2 cycles) runs to its heatmap: two heatmaps (pseudoinverse, extended)
+    with the colour key. A click on a cell of the pseudoinverse's sets x0 to that start (the
+    session's state, the x0 boxes) and the main view recomputes from it."""
+    tab = tabs.open()
+    page = tab.page
+    page.locator("#atlas").scroll_into_view_if_needed()
+    progress = page.locator("#atlas-progress-box")
+    status = page.locator("#atlas-status")
+
+    first = start_atlas(tab, 2048, 2)
+    expect(progress).to_be_visible()
+    expect(page.locator("#atlas-progress-text")).to_contain_text(re.compile("computing|waiting"))
+    expect(page.locator("#atlas-cancel")).to_be_visible()
+    page.click("#atlas-cancel")
+    expect(progress).to_be_hidden()
+    expect(status).to_contain_text("Atlas cancelled")
+    poll(lambda: gone(f"{tab.base}/atlas/{first}"), "the cancelled job forgotten (404)")
+
+    job = start_atlas(tab, 64, 2)
+    expect(progress).to_be_visible()
+    expect(status).to_contain_text("Atlas done", timeout=120_000)
+    expect(progress).to_be_hidden()
+    heatmaps = page.locator("#plot-atlas .heatmaplayer image")
+    expect(heatmaps).to_have_count(2)
+    expect(page.locator("#plot-atlas .colorbar")).to_have_count(1)
+    expect(page.locator("#plot-atlas .panel-head")).to_contain_text("log10 of the drift")
+    screenshots(page, "atlas")
+
+    atlas = get_json(f"{tab.base}/api/sessions/{tab.session_id}/atlas/{job}")
+    starts = np.array(atlas["starts"])[0]  # (N, p): the one path
+    assert starts.shape == (64, 3)
+    before = tab.snapshot()["state"]["x0"]
+    drag = page.locator("#plot-atlas .xy .nsewdrag")
+    drag.scroll_into_view_if_needed()
+    cell = drag.bounding_box()
+    assert cell is not None
+    with page.expect_response(lambda r: r.url.endswith("/state")):
+        page.mouse.click(cell["x"] + 0.3 * cell["width"], cell["y"] + 0.25 * cell["height"])
+    expect(status).to_contain_text("Moved the main view to start")
+    i = int(re.search(r"start (\d+) of 64", status.text_content() or "").group(1)) - 1
+    moved = tab.wait_settled(
+        lambda s: np.allclose(s["state"]["x0"], starts[i], atol=1e-9, rtol=0),
+        "the session's x0 at the clicked start",
+    )
+    assert not np.allclose(moved["state"]["x0"], before, atol=1e-6)
+    boxes = [float(page.input_value(f"#ctl-x0-{k}-value")) for k in range(3)]
+    np.testing.assert_allclose(boxes, starts[i], atol=6e-4, rtol=0)  # (3 decimals)
+    expect(page.locator("#atlas-outdated")).to_be_hidden()  # (same curve: still this atlas)
+    screenshots(page, "atlas-moved")
+
+
+def test_an_atlas_the_state_cannot_have_is_refused_in_words_in_the_panel(tabs):
+    """A single target is no closed path: the panel says so where it is, and shows no
+    progress."""
+    tabs.allow_console("422")  # (chromium logs the refused POST)
+    tab = tabs.open()
+    tab.select("#ctl-task", "target")
+    tab.page.click("#atlas-compute")
+    status = tab.page.locator("#atlas-status")
+    expect(status).to_contain_text(
+        "the atlas was refused: task: the atlas drives a closed path; choose the closed-path task"
+    )
+    expect(status).to_have_class(re.compile("error"))
+    expect(tab.page.locator("#atlas-progress-box")).to_be_hidden()
