@@ -10,6 +10,13 @@ case in tests/app/test_errors.py, test_synthesize.py and test_sessions.py):
   takes no ``augmentation``;
 - discrete mode (asked for, or the robot's default) needs ``gamma < 2``;
 - the chosen inverse must be defined at ``x0`` (the engine says so: a singular start);
+- a user robot (``planar_chain``, ``formula``, ``urdf``) is a definition: its formulas'
+  grammar, its URDF text, lengths one per joint, and what follows from them (p and r, so the
+  lengths of ``x0``, ``target`` and ``path``; the variables of a map's box) no JSON Schema can
+  state. A positive case with one is kept only if the server's own building of the robot
+  (:func:`jik.app.compute.user_robots.user_robot`) and its checks take it; as for the sessions
+  below, what the fuzzing tests there is that whatever the schema takes is served without a
+  5xx and that every response matches the document;
 - a dashboard change is checked against the session's robot (its parameters' names, its maps,
   its vectors' lengths): one that names no robot depends on a state the generator does not
   know, and one that does is kept only if the dashboard's model takes it on that robot's
@@ -35,6 +42,11 @@ try:  # (schemathesis loads this module, and brings hypothesis)
 except ImportError as exc:
     raise ImportError(f"{exc}: jik bench fuzz needs pip install 'jik[test]'") from exc
 
+from jik.app.compute import schemas as S
+from jik.app.compute.exceptions import RequestError
+from jik.app.compute.requests import _setup, check_configuration, check_task_point
+from jik.app.compute.synthesis import synthesis_region
+from jik.app.compute.user_robots import user_robot
 from jik.app.dashboard.model import StatePatch, default_state, patch_of, updated_state
 from jik.engine.exceptions import InvalidInputError, JikError
 from jik.engine.registry import ROBOTS, make_inverse
@@ -69,11 +81,41 @@ def _capped(body: dict) -> dict:
     for name in ("x0", "target", "path"):
         if name in body:
             body[name] = _clamped(body[name])
+    augmentation = body.get("augmentation")
+    if isinstance(augmentation, dict) and isinstance(augmentation.get("degree"), int):
+        body["augmentation"] = {**augmentation, "degree": min(augmentation["degree"],
+                                                              WORK_CAPS["degree"])}  # fmt: skip
     robot = body.get("robot")
     if isinstance(robot, dict):
         body["robot"] = {k: min(v, ROBOT_CAPS[k]) if k in ROBOT_CAPS and isinstance(v, float)
                          else v for k, v in robot.items()}  # fmt: skip
     return body
+
+
+def _user_robot_ok(body: dict, path: str) -> bool:
+    """Whether the server builds the user robot of ``body`` and takes its lengths (see the
+    module's docstring)."""
+    try:
+        if path == "/synthesize":
+            req = S.SynthesizeRequest.model_validate(body)
+            evaluate = req.method == "evaluate"
+            robot, _, _ = user_robot(req.robot, req.augmentation if evaluate else None)
+            spec = robot.spec
+            if spec.p != spec.r + 1 or (evaluate and req.augmentation is None):
+                return False
+            _, region, _ = synthesis_region(spec, req)
+            return len(region) >= 2 or evaluate
+        model = S.SolveRequest if path == "/solve" else S.RepeatabilityRequest
+        run = model.model_validate(body)
+        setup = _setup(run)
+        check_configuration(setup.spec, run.x0)
+        points = run.path if isinstance(run, S.RepeatabilityRequest) else [run.target]
+        for i, point in enumerate(points):
+            check_task_point(setup.spec, point, f"path[{i}]")
+        setup.inverse.matrix(np.asarray(run.x0, dtype=float))
+    except (RequestError, JikError, ValidationError):
+        return False
+    return True
 
 
 def _synthesis_ok(body: dict) -> bool:
@@ -125,6 +167,9 @@ def _positive_case_ok(case) -> bool:
     if not isinstance(body, dict):
         return True
     path = case.operation.path
+    robot = body.get("robot")
+    if isinstance(robot, dict) and robot.get("name") in S.USER_ROBOT_MODELS:
+        return _user_robot_ok(body, path)
     if path == "/synthesize":
         return _synthesis_ok(body)
     if path in ("/solve", "/repeatability"):
