@@ -9,7 +9,8 @@ case in tests/app/test_errors.py, test_synthesize.py and test_sessions.py):
   is left for the box; ``e2_variational`` synthesizes h on a box of 2 or 3 variables, so it
   takes no ``augmentation``;
 - discrete mode (asked for, or the robot's default) needs ``gamma < 2``;
-- the chosen inverse must be defined at ``x0`` (the engine says so: a singular start);
+- the chosen inverse must be defined at ``x0`` (the engine says so: a singular start, by the
+  server's own test);
 - a user robot (``planar_chain``, ``formula``, ``urdf``) is a definition: its formulas'
   grammar, its URDF text, lengths one per joint, and what follows from them (p and r, so the
   lengths of ``x0``, ``target`` and ``path``; the variables of a map's box) no JSON Schema can
@@ -44,7 +45,7 @@ except ImportError as exc:
 
 from jik.app.compute import schemas as S
 from jik.app.compute.exceptions import RequestError
-from jik.app.compute.requests import _setup, check_configuration, check_task_point
+from jik.app.compute.requests import _check_start, _setup, check_configuration, check_task_point
 from jik.app.compute.synthesis import synthesis_region
 from jik.app.compute.user_robots import user_robot
 from jik.app.dashboard.model import StatePatch, default_state, patch_of, updated_state
@@ -112,7 +113,8 @@ def _user_robot_ok(body: dict, path: str) -> bool:
         points = run.path if isinstance(run, S.RepeatabilityRequest) else [run.target]
         for i, point in enumerate(points):
             check_task_point(setup.spec, point, f"path[{i}]")
-        setup.inverse.matrix(np.asarray(run.x0, dtype=float))
+        if _check_start(setup, np.asarray([run.x0], dtype=float))[0]:
+            return False
     except (RequestError, JikError, ValidationError):
         return False
     return True
@@ -145,9 +147,12 @@ def _run_ok(body: dict) -> bool:
             {k: v for k, v in augmentation.items() if k != "name"}, spec.name,
         )  # fmt: skip
         inverse.matrix(np.asarray(body["x0"], dtype=float))
+        # (the server's own test of a singular start, which a nearly singular J J^T fails)
+        _, bad = inverse.apply_masked(np.asarray([body["x0"]], dtype=float),
+                                      np.ones((1, kinematics.r)))  # fmt: skip
     except JikError:
         return False
-    return True
+    return not np.any(bad)
 
 
 def _change_ok(body: dict) -> bool:
