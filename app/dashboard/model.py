@@ -315,6 +315,14 @@ def _user_robot(state: DashboardState) -> tuple[Any, Any, dict, dict]:
         if getattr(state, key):
             raise InvalidInputError(f"{key}: a user robot has none", key)
     robot = user_robot(definition)
+    p, r = robot.spec.p, robot.spec.r
+    if r < 2 or p != r + 1:
+        raise InvalidInputError(
+            "robot_definition: the dashboard's panels (task paths in a plane, the map h, E1, E2) "
+            f"need r >= 2 and one degree of redundancy, p = r + 1; this robot has p = {p}, "
+            f"r = {r} (the REST API and jik solve take it)",
+            "robot_definition",
+        )
     _registered(lambda: robot.spec.augmentation(state.augmentation), "augmentation")
     return robot.spec, robot.kinematics, {}, {}
 
