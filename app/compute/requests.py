@@ -122,11 +122,9 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
         robot, robot_used, aug_used = user_robot(req.robot, req.augmentation if extended else None)
         spec, kin = robot.spec, robot.kinematics
         inverse = user_inverse(robot, req.algorithm)
-        extra = {"robot": robot}
     else:
         spec, kin, robot_used = build_robot(req.robot)
         inverse, aug_used = _catalogue_inverse(spec, kin, req)
-        extra = {}
     mode = req.mode or spec.default_mode
     gamma = spec.default_gamma if req.gamma is None else float(req.gamma)
     if mode == "discrete" and gamma >= 2:
@@ -135,8 +133,9 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
             f"must be < 2 in discrete mode, got {gamma:g} (near the solution the error shrinks "
             "by |1 - gamma| per iteration)",
         )
-    return _Setup(spec, kin, inverse, robot_used, aug_used, mode, gamma, req.tolerance,
-                  req.max_iterations, extra)  # fmt: skip
+    return _Setup(
+        spec, kin, inverse, robot_used, aug_used, mode, gamma, req.tolerance, req.max_iterations
+    )
 
 
 def _catalogue_inverse(spec: RobotSpec, kin, req) -> tuple[Any, S.AugmentationUsed | None]:

@@ -283,23 +283,29 @@ if TYPE_CHECKING:
     # static checker: type them as Any there.
     Robot: TypeAlias = Any
     Augmentation: TypeAlias = Any
+    AnyRobot: TypeAlias = Any
+    AnyAugmentation: TypeAlias = Any
 else:
-    # (the base request models, which the workers validate with, take every robot and map; the
-    # routes take the exact per-robot members of :func:`per_robot`)
-    Robot = _union([*ROBOT_MODELS.values(), *USER_ROBOT_MODELS.values()])
-    Augmentation = _union(list(AUGMENTATION_MODELS.values())) | UserAugmentation
+    #: A catalogue robot and one of its maps (what the atlas takes).
+    Robot = _union(list(ROBOT_MODELS.values()))
+    Augmentation = _union(list(AUGMENTATION_MODELS.values()))
+    #: Any robot and map of a solve, repeatability or synthesis: the base request models, which
+    #: the workers validate with, take them all; the routes take the exact per-robot members
+    #: of :func:`per_robot`.
+    AnyRobot = _union([*ROBOT_MODELS.values(), *USER_ROBOT_MODELS.values()])
+    AnyAugmentation = Augmentation | UserAugmentation
 
 
 class _Request(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
-    robot: Robot = Field(
+    robot: AnyRobot = Field(
         description="the robot and its parameters, e.g. {'name': 'manipulator2', 'l': 1}"
     )
     algorithm: Algorithm = Field(
         description="'pseudoinverse' (eq. (8)) or 'extended' (extended Jacobian inverse, eq. (11))"
     )
-    augmentation: Augmentation | None = Field(
+    augmentation: AnyAugmentation | None = Field(
         None,
         description="augmenting map h of the extended inverse with its parameters; "
         "default: the robot's default augmentation (ignored by the pseudoinverse)",
@@ -586,13 +592,13 @@ class SynthesizeRequest(BaseModel):
 
     model_config = ConfigDict(extra="forbid")
 
-    robot: Robot
+    robot: AnyRobot
     method: SynthesisMethod = Field(
         "evaluate",
         description="'evaluate': a catalogue map (analytic or already synthesized) on the box; "
         "'e2_variational': minimise E2 (eq. (19)) by the Ritz method (engine.variational)",
     )
-    augmentation: Augmentation | None = Field(
+    augmentation: AnyAugmentation | None = Field(
         None, description="for 'evaluate': the map and its parameters (default: the robot's)"
     )
     region: dict[str, tuple[Bound, Bound]] | None = Field(
