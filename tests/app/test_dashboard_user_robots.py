@@ -6,7 +6,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from jik.app.dashboard.model import DashboardState, default_state, updated_state, validate
+from jik.app.dashboard.model import (
+    DashboardState,
+    StatePatch,
+    default_state,
+    patch_of,
+    updated_state,
+    validate,
+)
 from jik.app.dashboard.session import Dashboard
 from jik.engine.exceptions import InvalidInputError
 
@@ -68,3 +75,11 @@ def test_the_session_computes_both_algorithms_for_it():
         assert np.max(runs["extended"].drift) < 1e-9
     finally:
         dashboard.stop()
+
+
+def test_the_pages_link_opens_the_same_robot():
+    """A link holds the whole state (?state=<JSON>): a new session from it has the same robot,
+    definition and changes."""
+    state = updated_state(_arm_state(), {"x0.1": 0.7, "cycles": 2})
+    link = StatePatch.model_validate(state.as_dict())
+    assert updated_state(default_state(), patch_of(link)) == state
