@@ -18,10 +18,6 @@ case in tests/app/test_errors.py, test_synthesize.py and test_sessions.py):
   (:func:`jik.app.compute.user_robots.user_robot`) and its checks take it; as for the sessions
   below, what the fuzzing tests there is that whatever the schema takes is served without a
   5xx and that every response matches the document;
-- an atlas's path has r components per point, r of its robot (the atlas request,
-  :mod:`jik.app.compute.atlas_schemas`, is one model for every robot, not one per robot): a
-  positive case's points are cut or padded with zeros to r (filtering them out instead left
-  too few atlas cases);
 - a dashboard change is checked against the session's robot (its parameters' names, its maps,
   its vectors' lengths): one that names no robot depends on a state the generator does not
   know, and one that does is kept only if the dashboard's model takes it on that robot's
@@ -159,18 +155,6 @@ def _run_ok(body: dict) -> bool:
     return not np.any(bad)
 
 
-def _atlas_fitted(body: dict) -> dict:
-    """An atlas request whose path points have the r components of its robot."""
-    robot = body.get("robot")
-    spec = ROBOTS.get(str(robot.get("name"))) if isinstance(robot, dict) else None
-    points = body.get("path")
-    if spec is None or not isinstance(points, list):
-        return body
-    fitted = [[*p[: spec.r], *[0.0] * (spec.r - len(p))] if isinstance(p, list) else p
-              for p in points]  # fmt: skip
-    return {**body, "path": fitted}
-
-
 def _change_ok(body: dict) -> bool:
     change = body.get("state", body)
     if not isinstance(change, dict) or "robot" not in change:
@@ -205,10 +189,6 @@ def before_generate_case(context, strategy: st.SearchStrategy) -> st.SearchStrat
     def fit(case):
         if isinstance(case.body, dict):
             case.body = _capped(case.body)
-            meta = case.meta
-            positive = meta is None or meta.generation.mode.is_positive
-            if positive and case.operation.path == "/atlas":
-                case.body = _atlas_fitted(case.body)
         return case
 
     def keep(case) -> bool:
