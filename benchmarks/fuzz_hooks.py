@@ -9,7 +9,15 @@ case in tests/app/test_errors.py, test_synthesize.py and test_sessions.py):
   is left for the box; ``e2_variational`` synthesizes h on a box of 2 or 3 variables, so it
   takes no ``augmentation``;
 - discrete mode (asked for, or the robot's default) needs ``gamma < 2``;
-- the chosen inverse must be defined at ``x0`` (the engine says so: a singular start);
+- the chosen inverse must be defined at ``x0`` (the engine says so: a singular start, by the
+  server's own test);
+- a user robot (``planar_chain``, ``formula``, ``urdf``) is a definition: its formulas'
+  grammar, its URDF text, lengths one per joint, and what follows from them (p and r, so the
+  lengths of ``x0``, ``target`` and ``path``; the variables of a map's box) no JSON Schema can
+  state. A positive case with one is kept only if the server's own building of the robot
+  (:func:`jik.app.compute.user_robots.user_robot`) and its checks take it; as for the sessions
+  below, what the fuzzing tests there is that whatever the schema takes is served without a
+  5xx and that every response matches the document;
 - an atlas's path must start where the self-motion curve can be traced (the server plans it:
   the check is the server's own planner);
 - a dashboard change is checked against the session's robot (its parameters' names, its maps,
@@ -37,9 +45,13 @@ try:  # (schemathesis loads this module, and brings hypothesis)
 except ImportError as exc:
     raise ImportError(f"{exc}: jik bench fuzz needs pip install 'jik[test]'") from exc
 
+from jik.app.compute import schemas as S
 from jik.app.compute.atlas_jobs import AtlasLimits, plan_request
 from jik.app.compute.atlas_schemas import AtlasRequest
 from jik.app.compute.exceptions import RequestError
+from jik.app.compute.requests import _check_start, _setup, check_configuration, check_task_point
+from jik.app.compute.synthesis import synthesis_region
+from jik.app.compute.user_robots import user_robot
 from jik.app.dashboard.model import StatePatch, default_state, patch_of, updated_state
 from jik.engine.exceptions import InvalidInputError, JikError
 from jik.engine.registry import ROBOTS, make_inverse
@@ -77,11 +89,42 @@ def _capped(body: dict) -> dict:
     for name in ("region", "fixed"):  # (a box of the unicycle's lambdas over +-100 took 20 s)
         if isinstance(body.get(name), dict):
             body[name] = {k: _clamped(v) for k, v in body[name].items()}
+    augmentation = body.get("augmentation")
+    if isinstance(augmentation, dict) and isinstance(augmentation.get("degree"), int):
+        body["augmentation"] = {**augmentation, "degree": min(augmentation["degree"],
+                                                              WORK_CAPS["degree"])}  # fmt: skip
     robot = body.get("robot")
     if isinstance(robot, dict):
         body["robot"] = {k: min(v, ROBOT_CAPS[k]) if k in ROBOT_CAPS and isinstance(v, float)
                          else v for k, v in robot.items()}  # fmt: skip
     return body
+
+
+def _user_robot_ok(body: dict, path: str) -> bool:
+    """Whether the server builds the user robot of ``body`` and takes its lengths (see the
+    module's docstring)."""
+    try:
+        if path == "/synthesize":
+            req = S.SynthesizeRequest.model_validate(body)
+            evaluate = req.method == "evaluate"
+            robot, _, _ = user_robot(req.robot, req.augmentation if evaluate else None)
+            spec = robot.spec
+            if spec.p != spec.r + 1 or (evaluate and req.augmentation is None):
+                return False
+            _, region, _ = synthesis_region(spec, req)
+            return len(region) >= 2 or evaluate
+        model = S.SolveRequest if path == "/solve" else S.RepeatabilityRequest
+        run = model.model_validate(body)
+        setup = _setup(run)
+        check_configuration(setup.spec, run.x0)
+        points = run.path if isinstance(run, S.RepeatabilityRequest) else [run.target]
+        for i, point in enumerate(points):
+            check_task_point(setup.spec, point, f"path[{i}]")
+        if _check_start(setup, np.asarray([run.x0], dtype=float))[0]:
+            return False
+    except (RequestError, JikError, ValidationError):
+        return False
+    return True
 
 
 def _synthesis_ok(body: dict) -> bool:
@@ -110,11 +153,13 @@ def _run_ok(body: dict) -> bool:
             kinematics, body["algorithm"], augmentation.get("name"),
             {k: v for k, v in augmentation.items() if k != "name"}, spec.name,
         )  # fmt: skip
-        x0 = np.asarray(body["x0"], dtype=float)[None]
-        _, singular = inverse.apply_masked(x0, np.zeros((1, len(spec.task_names))))
+        inverse.matrix(np.asarray(body["x0"], dtype=float))
+        # (the server's own test of a singular start, which a nearly singular J J^T fails)
+        _, bad = inverse.apply_masked(np.asarray([body["x0"]], dtype=float),
+                                      np.ones((1, kinematics.r)))  # fmt: skip
     except JikError:
         return False
-    return not singular.any()  # (the solver's own test of a singular start)
+    return not np.any(bad)
 
 
 def _change_ok(body: dict) -> bool:
@@ -142,6 +187,9 @@ def _positive_case_ok(case) -> bool:
     if not isinstance(body, dict):
         return True
     path = case.operation.path
+    robot = body.get("robot")
+    if isinstance(robot, dict) and robot.get("name") in S.USER_ROBOT_MODELS:
+        return _user_robot_ok(body, path)
     if path == "/synthesize":
         return _synthesis_ok(body)
     if path in ("/solve", "/repeatability"):

@@ -4,10 +4,11 @@
 import { change, endOnClose, follow, openSession, session, api } from "./api.js";
 import { showControls, showRefusal } from "./controls.js";
 import { $, el, fmt } from "./dom.js";
+import { robotEditor } from "./editor.js";
 import { algorithmKey, applyFunctionals, drawFigures, layoutPanels, markStale, onAhead, setExportNote } from "./panels.js";
 import { atlasPanel, atlasState } from "./atlas.js";
 
-const page = { config: null, state: null, shown: 0, shownState: null };
+const page = { config: null, state: null, shown: 0, shownState: null, editor: null };
 const send = (patch) => { setNotice(""); change(patch, (message) => setStatus(message, true)); };
 
 function setStatus(text, error = false) {
@@ -37,6 +38,7 @@ function onState(msg, force = false) {
   page.state = msg.state;
   session.generation = Math.max(session.generation, msg.generation);
   showControls(msg, send, force);
+  page.editor.show(msg.state);
   rememberInUrl(msg.state);
   atlasState(msg.state);
   if (msg.generation > page.shown) setStatus(`computing generation ${msg.generation}…`);
@@ -48,7 +50,7 @@ function onRefused(msg) {
   onState(msg, true);
   const where = msg.source === "scene" ? "in the 3D scene" : "here";
   setStatus(`refused (${where}): ${msg.message}`, true);
-  if (msg.field) showRefusal(msg.field, msg.message);
+  if (msg.field && !page.editor.refused(msg.field, msg.message)) showRefusal(msg.field, msg.message);
 }
 
 async function onResult(msg) {
@@ -192,6 +194,7 @@ async function main() {
   page.config = await fetch("/api/dashboard/config").then((r) => r.json());
   for (const [a, c] of Object.entries(page.config.colors)) document.documentElement.style.setProperty(`--${a}`, c);
   layoutPanels(page.config.panels, page.config);
+  page.editor = robotEditor(page.config.robot_kinds, send);
   // The sticky header's height, for the scene below it (style.css --header-h).
   new ResizeObserver(([entry]) => document.documentElement.style.setProperty("--header-h", `${Math.ceil(entry.target.getBoundingClientRect().height)}px`)).observe($("header"));
   $("#legend").replaceChildren(algorithmKey(true));

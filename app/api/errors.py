@@ -32,13 +32,22 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from jik.app.compute.atlas_jobs import AtlasJobNotFound, AtlasJobsFull
 from jik.app.compute.exceptions import ComputeError, RequestError, ServiceUnavailable
-from jik.app.compute.schemas import AUGMENTATION_MODELS, ROBOT_MODELS, ErrorResponse
+from jik.app.compute.schemas import (
+    AUGMENTATION_MODELS,
+    ROBOT_MODELS,
+    ROBOT_NAMES,
+    USER_AUGMENTATION_MODELS,
+    USER_ROBOT_MODELS,
+    ErrorResponse,
+)
 from jik.app.dashboard.sessions import ExportUnavailable, SessionNotFound, SessionsFull
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS
 
 log = logging.getLogger("jik.api")
-_TAGS = set(ROBOT_MODELS) | set(AUGMENTATION_MODELS)
+_TAGS = {*ROBOT_MODELS, *AUGMENTATION_MODELS, *USER_ROBOT_MODELS, *USER_AUGMENTATION_MODELS}
+#: The tags of a request's variants: the catalogue robots and the kinds of user robots.
+_VARIANTS = set(ROBOT_NAMES)
 _TYPE_LABELS = {"str", "float", "int", "bool", "constrained-float", "constrained-str"}
 
 
@@ -52,7 +61,7 @@ def _field(loc) -> str:
     parts = [
         str(p) for p in loc if p != "body" and str(p) not in _TYPE_LABELS and "[" not in str(p)
     ]
-    if len(parts) > 1 and parts[0] in ROBOTS:
+    if len(parts) > 1 and parts[0] in _VARIANTS:
         del parts[0]
     if len(parts) > 2 and parts[0] in ("robot", "augmentation") and parts[1] in _TAGS:
         del parts[1]
@@ -70,7 +79,7 @@ def _location(loc) -> list:
     request's robot variant (``("body", "manipulator2", "x0")``) and a member labelled by its
     type (``("body", "path", "str")``)."""
     out = [p for p in loc if not (isinstance(p, str) and (p in _TYPE_LABELS or "[" in p))]
-    if len(out) > 2 and out[0] == "body" and out[1] in ROBOTS:
+    if len(out) > 2 and out[0] == "body" and out[1] in _VARIANTS:
         del out[1]
     return out
 
@@ -99,9 +108,9 @@ def _validation_detail(errors) -> list[dict]:
             if isinstance(body, dict) and "robot" not in body:
                 msg = "Field required"
             elif name is None:
-                msg = f"give the robot, with a name among {sorted(ROBOTS)}"
+                msg = f"give the robot, with a name among {ROBOT_NAMES}"
             else:
-                msg = f"unknown name {name!r}; choose one of {sorted(ROBOTS)}"
+                msg = f"unknown name {name!r}; choose one of {ROBOT_NAMES}"
         elif e.get("type") in ("too_short", "too_long"):
             msg = _length_message(e.get("loc", ()), e.get("ctx") or {}) or msg
         detail.append({"loc": loc, "msg": f"{_field(loc)}: {msg}", "type": str(e.get("type"))})

@@ -17,6 +17,8 @@ def precheck(req: S.SolveRequest | S.RepeatabilityRequest | S.SynthesizeRequest)
     once even when every worker is busy. The workers repeat them (the plain service functions
     are complete on their own).
     """
+    if req.robot.name in S.USER_ROBOT_MODELS:
+        return  # (p and r follow from the definition: built and checked in a worker)
     spec = ROBOTS.get(req.robot.name)
     if spec is None:
         raise RequestError(

@@ -20,6 +20,7 @@ import pydantic_core
 from jik.app.compute import schemas as S
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.settings import settings_from_env
+from jik.app.compute.user_robots import is_user_robot, user_inverse, user_robot
 from jik.engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
 from jik.engine.registry import ROBOTS, RobotSpec, make_inverse
 from jik.engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS, repeatability
@@ -115,16 +116,15 @@ def build_augmentation(spec: RobotSpec, kin, req_aug):
 
 
 def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
-    spec, kin, robot_used = build_robot(req.robot)
     aug_used = None
-    if req.algorithm == "extended":
-        aspec, _, aug_used = build_augmentation(spec, kin, req.augmentation)
-        try:
-            inverse = make_inverse(kin, "extended", aspec.name, aug_used.parameters, spec.name)
-        except InvalidInputError as exc:
-            raise RequestError("augmentation", str(exc)) from None
+    if is_user_robot(req.robot):
+        extended = req.algorithm == "extended"
+        robot, robot_used, aug_used = user_robot(req.robot, req.augmentation if extended else None)
+        spec, kin = robot.spec, robot.kinematics
+        inverse = user_inverse(robot, req.algorithm)
     else:
-        inverse = make_inverse(kin, "pseudoinverse")
+        spec, kin, robot_used = build_robot(req.robot)
+        inverse, aug_used = _catalogue_inverse(spec, kin, req)
     mode = req.mode or spec.default_mode
     gamma = spec.default_gamma if req.gamma is None else float(req.gamma)
     if mode == "discrete" and gamma >= 2:
@@ -138,16 +138,41 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
     )
 
 
+def _catalogue_inverse(spec: RobotSpec, kin, req) -> tuple[Any, S.AugmentationUsed | None]:
+    """The inverse a request asks of a catalogue robot, and the map it used."""
+    aug_used = None
+    if req.algorithm == "extended":
+        aspec, _, aug_used = build_augmentation(spec, kin, req.augmentation)
+        try:
+            inverse = make_inverse(kin, "extended", aspec.name, aug_used.parameters, spec.name)
+        except InvalidInputError as exc:
+            raise RequestError("augmentation", str(exc)) from None
+    else:
+        inverse = make_inverse(kin, "pseudoinverse")
+    return inverse, aug_used
+
+
+def _dimensions(spec: RobotSpec, what: str) -> str:
+    """Why a vector has its length: ``p of manipulator2``; a user robot's p and r."""
+    if spec.name in S.USER_ROBOT_MODELS:
+        return f"this {spec.name} robot has p = {spec.p}, r = {spec.r}"
+    return f"{what} of {spec.name}"
+
+
 def check_configuration(spec: RobotSpec, x0) -> None:
     """``x0`` has p components."""
     if len(x0) != spec.p:
-        raise RequestError("x0", f"must have {spec.p} components (p of {spec.name}), got {len(x0)}")
+        raise RequestError(
+            "x0", f"must have {spec.p} components ({_dimensions(spec, 'p')}), got {len(x0)}"
+        )
 
 
 def check_task_point(spec: RobotSpec, y, name: str) -> None:
     """The task point ``y`` (the request's field ``name``) has r components."""
     if len(y) != spec.r:
-        raise RequestError(name, f"must have {spec.r} components (r of {spec.name}), got {len(y)}")
+        raise RequestError(
+            name, f"must have {spec.r} components ({_dimensions(spec, 'r')}), got {len(y)}"
+        )
 
 
 def _check_start(setup: _Setup, x0: np.ndarray) -> np.ndarray:

@@ -127,15 +127,6 @@ AUGMENTATION_MODELS: dict[str, type[BaseModel]] = {
 for _m in (*ROBOT_MODELS.values(), *AUGMENTATION_MODELS.values()):
     globals()[_m.__name__] = _m  # importable by name (pickling, introspection)
 
-if TYPE_CHECKING:
-    # Generated from the catalogue at import time (above), so their fields are invisible to a
-    # static checker: type them as Any there.
-    Robot: TypeAlias = Any
-    Augmentation: TypeAlias = Any
-else:
-    Robot = _union(list(ROBOT_MODELS.values()))
-    Augmentation = _union(list(AUGMENTATION_MODELS.values()))
-
 Algorithm = Literal["pseudoinverse", "extended"]
 Mode = Literal["continuous", "discrete"]
 #: Largest |coordinate| of a configuration or task point (radians, lengths, control amplitudes):
@@ -155,16 +146,166 @@ Gamma = Annotated[float, Field(strict=True, ge=GAMMA_MIN, le=1e6, allow_inf_nan=
 Tolerance = Annotated[float, Field(strict=True, ge=1e-14, le=1.0, allow_inf_nan=False)]
 
 
+# --------------------------------------------------------------------------------------------
+# Robots defined by data (issue 29): the kinds of jik.engine.robot_kinds, checked in full by
+# jik.engine.robot_spec.robot_from_dict. The schema says what JSON Schema can (names, sizes,
+# the joints' letters); the formulas' grammar, the URDF text and what follows from them (p, r,
+# the lengths of x0, target and path) are checked when the robot is built, naming the field.
+
+#: Longest formula text (the engine's bound, :data:`jik.engine.formula.MAX_LENGTH`).
+MAX_FORMULA_CHARS = 2000
+#: Longest URDF text [characters] (the engine's bound is 1 MB of UTF-8).
+MAX_URDF_CHARS = 1_000_000
+#: A variable's, a parameter's or a joint's name.
+Name = Annotated[str, Field(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,31}$")]
+FormulaText = Annotated[str, Field(min_length=1, max_length=MAX_FORMULA_CHARS)]
+Constants = Annotated[dict[Name, FiniteFloat], Field(max_length=32)]
+Title = Annotated[str, Field(min_length=1, max_length=100)]
+_USER = ConfigDict(extra="forbid")
+
+
+class PlanarChainRobot(BaseModel):
+    """A planar serial chain of revolute (R) and prismatic (P) joints: the end point (r = 2),
+    or the end point and its angle (r = 3); p is the number of joints."""
+
+    model_config = ConfigDict(extra="forbid", title="Planar chain")
+    name: Literal["planar_chain"]
+    joints: Annotated[str, Field(pattern=r"^[RP]{1,16}$")] = Field(
+        description="joint types, base first: R revolute, P prismatic (p = its length)"
+    )
+    lengths: Annotated[list[Coordinate], Field(min_length=1, max_length=MAX_DIMENSION)] = Field(
+        description="link lengths, one per joint"
+    )
+    offsets: Annotated[list[Coordinate], Field(min_length=1, max_length=MAX_DIMENSION)] | None = (
+        Field(None, description="joint offsets added to x, one per joint (default 0)")
+    )
+    orientation: Annotated[bool, Field(strict=True)] = Field(
+        False, description="also the end's angle as a task component (r = 3; needs p >= 3)"
+    )
+    title: Title | None = None
+
+
+class FormulaRobot(BaseModel):
+    """Kinematics written as formulas: k(x) = (task[0], task[1], ...) in the variables."""
+
+    model_config = ConfigDict(extra="forbid", title="Formula robot")
+    name: Literal["formula"]
+    variables: Annotated[list[Name], Field(min_length=1, max_length=MAX_DIMENSION)] = Field(
+        description="joint variable names, in order (p = their number)"
+    )
+    task: Annotated[list[FormulaText], Field(min_length=1, max_length=MAX_DIMENSION)] = Field(
+        description="task components (r = their number): formulas in the variables and "
+        "parameters with sin cos tan exp log sqrt atan2 abs, + - * / **, numbers and pi"
+    )
+    parameters: Constants = Field(default_factory=dict, description="named constants")
+    title: Title | None = None
+
+
+class UrdfRobot(BaseModel):
+    """A serial arm from URDF text: the end link's position (task 'xyz' or a subset)."""
+
+    model_config = ConfigDict(extra="forbid", title="URDF arm")
+    name: Literal["urdf"]
+    urdf: Annotated[str, Field(min_length=1, max_length=MAX_URDF_CHARS)] = Field(
+        description="the URDF text (no DOCTYPE; meshes are not loaded)"
+    )
+    end_link: Annotated[str, Field(min_length=1, max_length=200)] = Field(
+        description="the link whose origin is the end point"
+    )
+    active_joints: (
+        Annotated[
+            list[Annotated[str, Field(min_length=1, max_length=200)]],
+            Field(min_length=1, max_length=MAX_DIMENSION),
+        ]
+        | None
+    ) = Field(None, description="the joints that move (default: all from the base to end_link)")
+    task: Literal["xyz", "xy", "xz", "yz", "x", "y", "z"] = Field(
+        "xyz", description="coordinates of the end point"
+    )
+    locked: Annotated[
+        dict[Annotated[str, Field(min_length=1, max_length=200)], FiniteFloat],
+        Field(max_length=64),
+    ] = Field(default_factory=dict, description="values of the chain's other movable joints")
+    title: Title | None = None
+
+
+class FormulaMapAugmentation(BaseModel):
+    """An augmenting map h written as a formula in the robot's variables, eq. (9); for
+    p - r > 1 a list of p - r formulas (the extended inverse of several maps)."""
+
+    model_config = ConfigDict(extra="forbid", title="Formula map")
+    name: Literal["formula"]
+    h: FormulaText | Annotated[list[FormulaText], Field(min_length=1, max_length=15)] = Field(
+        description="h(x), e.g. 'x3'; a list of p - r formulas when p - r > 1"
+    )
+    parameters: Constants | None = Field(None, description="named constants of h")
+
+
+class E2SynthesisAugmentation(BaseModel):
+    """The E2-optimal map on a box, synthesized by the Ritz solve of eq. (20) (p = r + 1)."""
+
+    model_config = ConfigDict(extra="forbid", title="E2-synthesized map")
+    name: Literal["e2_synthesized"]
+    region: Annotated[
+        dict[Name, tuple[Annotated[float, Field(strict=True, ge=-100.0, le=100.0,
+                                                allow_inf_nan=False)],
+                         Annotated[float, Field(strict=True, ge=-100.0, le=100.0,
+                                                allow_inf_nan=False)]]],
+        Field(min_length=2, max_length=3),
+    ] = Field(description="two or three variables to [lo, hi], lo < hi")  # fmt: skip
+    degree: Annotated[int, Field(strict=True, ge=1, le=24), INTEGRAL] = Field(
+        12, description="Legendre degree per variable"
+    )
+    fixed: Annotated[dict[Name, FiniteFloat], Field(max_length=MAX_DIMENSION)] | None = Field(
+        None, description="values of the variables outside the box (default 0)"
+    )
+
+
+#: The robots a user defines, by kind (their ``name``).
+USER_ROBOT_MODELS: dict[str, type[BaseModel]] = {
+    "planar_chain": PlanarChainRobot,
+    "formula": FormulaRobot,
+    "urdf": UrdfRobot,
+}
+#: The augmenting maps a user robot takes, by name.
+USER_AUGMENTATION_MODELS: dict[str, type[BaseModel]] = {
+    "formula": FormulaMapAugmentation,
+    "e2_synthesized": E2SynthesisAugmentation,
+}
+#: Every robot name a request may give: the catalogue's, then the kinds of user robots.
+ROBOT_NAMES = [*ROBOTS, *USER_ROBOT_MODELS]
+UserAugmentation = Annotated[
+    FormulaMapAugmentation | E2SynthesisAugmentation, Field(discriminator="name")
+]
+
+if TYPE_CHECKING:
+    # Generated from the catalogue at import time (above), so their fields are invisible to a
+    # static checker: type them as Any there.
+    Robot: TypeAlias = Any
+    Augmentation: TypeAlias = Any
+    AnyRobot: TypeAlias = Any
+    AnyAugmentation: TypeAlias = Any
+else:
+    #: A catalogue robot and one of its maps (what the atlas takes).
+    Robot = _union(list(ROBOT_MODELS.values()))
+    Augmentation = _union(list(AUGMENTATION_MODELS.values()))
+    #: Any robot and map of a solve, repeatability or synthesis: the base request models, which
+    #: the workers validate with, take them all; the routes take the exact per-robot members
+    #: of :func:`per_robot`.
+    AnyRobot = _union([*ROBOT_MODELS.values(), *USER_ROBOT_MODELS.values()])
+    AnyAugmentation = Augmentation | UserAugmentation
+
+
 class _Request(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
-    robot: Robot = Field(
+    robot: AnyRobot = Field(
         description="the robot and its parameters, e.g. {'name': 'manipulator2', 'l': 1}"
     )
     algorithm: Algorithm = Field(
         description="'pseudoinverse' (eq. (8)) or 'extended' (extended Jacobian inverse, eq. (11))"
     )
-    augmentation: Augmentation | None = Field(
+    augmentation: AnyAugmentation | None = Field(
         None,
         description="augmenting map h of the extended inverse with its parameters; "
         "default: the robot's default augmentation (ignored by the pseudoinverse)",
@@ -203,11 +344,21 @@ class RepeatabilityRequest(_Request):
     )
 
 
+def _absent(value: Any) -> bool:
+    """A response's field that only user robots have is left out for the catalogue's."""
+    return value is None
+
+
 class AugmentationUsed(BaseModel):
     """The augmenting map a run used, with every parameter (defaults filled in)."""
 
     name: str
     parameters: dict[str, float]
+    definition: dict[str, Any] | None = Field(
+        default=None,
+        exclude_if=_absent,
+        description="a user robot's map as given (absent otherwise)",
+    )
 
 
 class RobotUsed(BaseModel):
@@ -215,6 +366,13 @@ class RobotUsed(BaseModel):
 
     name: str
     parameters: dict[str, float | list[float]]
+    definition: dict[str, Any] | None = Field(
+        default=None,
+        exclude_if=_absent,
+        description="a user robot's definition as given (absent for a catalogue robot)",
+    )
+    p: int | None = Field(default=None, exclude_if=_absent, description="a user robot's p")
+    r: int | None = Field(default=None, exclude_if=_absent, description="a user robot's r")
 
 
 class Trajectory(BaseModel):
@@ -295,14 +453,37 @@ def per_robot(base: type[BaseModel], fields: Any) -> Any:
         )
         globals()[model.__name__] = model
         members.append(Annotated[model, Tag(name)])
+    for kind, robot_model in USER_ROBOT_MODELS.items():
+        # p and r follow from the definition: the vectors keep the base's 1 to 16 components,
+        # checked against the built robot (a 422 naming the field and the robot's p, r).
+        model = create_model(
+            f"{base.__name__.removesuffix('Request')}{_camel(kind)}Request",
+            __base__=base,
+            __doc__=f"{(base.__doc__ or '').strip()} ({robot_model.model_config.get('title')})",
+            robot=(robot_model, Field(description=f"{robot_model.__doc__}")),
+            augmentation=(
+                UserAugmentation | None,
+                Field(None, description="augmenting map h of the extended inverse: "
+                      "{'name': 'formula', 'h': ...} or {'name': 'e2_synthesized', 'region': "
+                      "{...}} (p = r + 1)" + USER_AUGMENTATION_NOTE.get(base.__name__, "")),
+            ),
+        )  # fmt: skip
+        globals()[model.__name__] = model
+        members.append(Annotated[model, Tag(kind)])
     return Annotated[
         Union[tuple(members)],  # noqa: UP007
         Discriminator(
             _robot_name,
             custom_error_type="unknown_robot",
-            custom_error_message=f"give a robot whose name is one of {sorted(ROBOTS)}",
+            custom_error_message=f"give a robot whose name is one of {ROBOT_NAMES}",
         ),
     ]
+
+
+#: What the augmentation of a user robot's request is for, by request.
+USER_AUGMENTATION_NOTE = {
+    "SynthesizeRequest": "; 'evaluate' needs one, 'e2_variational' takes none",
+}
 
 
 def _run_fields(spec: RobotSpec, augmentation: Any) -> dict[str, Any]:
@@ -411,13 +592,13 @@ class SynthesizeRequest(BaseModel):
 
     model_config = ConfigDict(extra="forbid")
 
-    robot: Robot
+    robot: AnyRobot
     method: SynthesisMethod = Field(
         "evaluate",
         description="'evaluate': a catalogue map (analytic or already synthesized) on the box; "
         "'e2_variational': minimise E2 (eq. (19)) by the Ritz method (engine.variational)",
     )
-    augmentation: Augmentation | None = Field(
+    augmentation: AnyAugmentation | None = Field(
         None, description="for 'evaluate': the map and its parameters (default: the robot's)"
     )
     region: dict[str, tuple[Bound, Bound]] | None = Field(

@@ -14,6 +14,7 @@ import numpy as np
 from jik.app.compute import schemas as S
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.requests import build_augmentation, build_robot, nullable
+from jik.app.compute.user_robots import is_user_robot, request_field, user_robot
 from jik.engine.exceptions import JikError
 from jik.engine.functionals import error_functional_e1, error_functional_e2
 from jik.engine.registry import RobotSpec
@@ -150,9 +151,44 @@ def _coefficients(amap) -> dict[str, float]:
     return {f"{a}^{i} {b}^{j}": float(c) for (i, j), c in sorted(coef.items())}
 
 
+def _user_map(robot):
+    """The one map a user robot's 'evaluate' request gives."""
+    spec = robot.spec
+    if not spec.augmentations:
+        raise RequestError(
+            "augmentation",
+            "'evaluate' needs the map to evaluate: {'name': "
+            "'formula', 'h': ...} or {'name': 'e2_synthesized', 'region': {...}}",
+        )
+    if spec.p != spec.r + 1:
+        raise RequestError(
+            "augmentation",
+            f"'evaluate' takes one map h and E1, E2 need p = r + 1; this {spec.name} robot has "
+            f"p = {spec.p}, r = {spec.r}",
+        )
+    try:
+        return spec.augmentations[0].build(robot.kinematics)
+    except JikError as exc:
+        raise RequestError(request_field(getattr(exc, "field", None), ()), str(exc)) from None
+
+
 def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
     """Evaluate a catalogue map, or synthesize an E2-optimal one, over a box (section 3)."""
-    spec, kin, robot_used = build_robot(req.robot)
+    user = is_user_robot(req.robot)
+    if user:
+        evaluate = req.method == "evaluate"
+        robot, robot_used, aug_used = user_robot(req.robot, req.augmentation if evaluate else None)
+        spec, kin = robot.spec, robot.kinematics
+        if req.method == "e2_variational" and spec.p != spec.r + 1:
+            raise RequestError(
+                "method",
+                f"'e2_variational' synthesizes one map h, which needs one degree of redundancy "
+                f"(p = r + 1); this {spec.name} robot has p = {spec.p}, r = {spec.r}: give its "
+                f"extended inverse {spec.p - spec.r} formula maps instead ({{'name': 'formula', "
+                "'h': [...]}})",
+            )
+    else:
+        spec, kin, robot_used = build_robot(req.robot)
     names, region, fixed = synthesis_region(spec, req)
     convergence: list[dict[str, float]] = []
     coefficients: dict[str, float] = {}
@@ -178,6 +214,8 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
                 f"{result.polynomial_e2:.6g}"
             )
         region, fixed = dict(result.region) or region, dict(result.fixed) or fixed
+    elif user:
+        amap = _user_map(robot)
     else:
         _, amap, aug_used = build_augmentation(spec, kin, req.augmentation)
         coefficients = _coefficients(amap)

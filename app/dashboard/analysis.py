@@ -10,9 +10,9 @@ from collections.abc import Callable, Mapping
 import numpy as np
 
 from jik.app.dashboard.model import DashboardState, cache_key
+from jik.app.dashboard.robots import state_kinematics, state_spec
 from jik.app.dashboard.runs import AlgorithmRun, Cancelled, DashboardResult
 from jik.engine.exceptions import JikError
-from jik.engine.registry import robot_spec
 
 
 def inert_variables(kin, amap, box: tuple[tuple[float, float], ...], samples: int = 8):
@@ -58,7 +58,7 @@ def state_inert_variables(state: DashboardState) -> frozenset[int]:
     key = json.dumps({k: d[k] for k in keys}, sort_keys=True)
     if key not in _inert_cache:
         kin, amap = kinematics_and_map(state)
-        box = robot_spec(state.robot).x_range or ((-1.0, 1.0),) * kin.p
+        box = state_spec(state).x_range or ((-1.0, 1.0),) * kin.p
         if len(_inert_cache) >= 64:  # (slider values of l, a, b: keep the recent ones)
             del _inert_cache[next(iter(_inert_cache))]
         _inert_cache[key] = inert_variables(kin, amap, box)
@@ -73,7 +73,7 @@ def functionals_key(state: DashboardState) -> str:
     the cycles, gamma and the rest of x0 do not matter. Without a design region the box follows
     the runs: everything they depend on.
     """
-    spec = robot_spec(state.robot)
+    spec = state_spec(state)
     design = spec.functional_region
     if not design:
         return cache_key(state, "extended")
@@ -106,8 +106,8 @@ def augmenting_axes(amap, x: np.ndarray) -> tuple[int, int]:
 def kinematics_and_map(state: DashboardState, kin=None):
     """The state's kinematics (``kin`` when the caller has built it) and its augmenting map h,
     built from the registry."""
-    spec = robot_spec(state.robot)
-    kin = spec.build(**state.robot_parameters) if kin is None else kin
+    spec = state_spec(state)
+    kin = state_kinematics(state) if kin is None else kin
     return kin, spec.augmentation(state.augmentation).build(kin, **state.augmentation_parameters)
 
 
@@ -134,7 +134,7 @@ def augmenting_grid(
     often the same h, and the page moves only the trajectories. Returns None when h cannot be
     evaluated on the grid.
     """
-    spec = robot_spec(state.robot)
+    spec = state_spec(state)
     try:
         _, amap = kinematics_and_map(state, kin)
         xs = np.concatenate([r.x for r in runs.values()])
@@ -192,7 +192,7 @@ def error_functionals(result: DashboardResult, nodes: int = 12) -> dict | None:
         return None
     names = result.variable_names
     i, j = grid["axes"]
-    design = robot_spec(result.state.robot).functional_region
+    design = state_spec(result.state).functional_region
     region = dict(design) or {names[i]: tuple(grid["box"][0]), names[j]: tuple(grid["box"][1])}
     fixed = {n: float(result.state.x0[k]) for k, n in enumerate(names) if n not in region}
     out = {
@@ -251,7 +251,7 @@ def sensitivity(
         parameter_sensitivity,
     )
 
-    spec = robot_spec(state.robot)
+    spec = state_spec(state)
     kin, nodes, fixed = grid["kinematics"], functionals["nodes"], functionals["fixed"]
     region = {k: tuple(v) for k, v in functionals["region"].items()}
     aug = spec.augmentation(state.augmentation)

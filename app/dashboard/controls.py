@@ -21,8 +21,9 @@ from dataclasses import asdict, dataclass
 from typing import Any
 
 from jik.app.dashboard.glossary import SYMBOLS
+from jik.app.dashboard.robots import state_spec
 from jik.engine.exceptions import InvalidInputError
-from jik.engine.registry import ROBOTS, robot_spec
+from jik.engine.registry import ROBOTS
 from jik.engine.solver import MAX_ITERATIONS, MAX_STEPS
 
 #: gamma's range per mode: the decay rate of eq. (5) (continuous), the step of the discrete
@@ -84,12 +85,14 @@ class Control:
 
 def controls(state) -> list[Control]:
     """Every control of ``state`` (a :class:`~jik.app.dashboard.DashboardState`), in order."""
-    spec = robot_spec(state.robot)
+    spec = state_spec(state)
     aug = spec.augmentation(state.augmentation)
     lo, hi = GAMMA_RANGE[state.mode]
     out = [
         Control("robot", "robot", "select", "algorithm", "the robot (section 6 of the paper)",
-                options=tuple((name, ROBOTS[name].title) for name in ROBOTS)),
+                options=tuple((name, ROBOTS[name].title) for name in ROBOTS)
+                + (((state.robot, f"your robot: {spec.title}"),) if state.robot not in ROBOTS
+                   else ())),
         Control("mode", "mode", "select", "algorithm",
                 "continuous: the ODE (7); discrete: the iteration x <- x - gamma J# e",
                 options=tuple((m, m) for m in MODES)),

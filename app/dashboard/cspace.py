@@ -15,9 +15,9 @@ import numpy as np
 from jik.app.dashboard.analysis import expensive_map, kinematics_and_map
 from jik.app.dashboard.model import ALGORITHMS, COLORS, DASH, LABELS
 from jik.app.dashboard.plotting import figure, leg_names, trace
+from jik.app.dashboard.robots import state_spec
 from jik.app.dashboard.runs import DashboardResult
 from jik.engine.exceptions import JikError
-from jik.engine.registry import robot_spec
 
 #: The choices of three coordinates of a four-dimensional configuration (the unicycle's λ).
 AXES_CHOICES = ("012", "013", "023", "123")
@@ -41,7 +41,7 @@ def _box(result: DashboardResult) -> tuple[np.ndarray, np.ndarray]:
     lo, hi = xs.min(axis=0), xs.max(axis=0)
     pad = 0.25 * (hi - lo) + 0.25
     lo, hi = lo - pad, hi + pad
-    spec = robot_spec(result.state.robot)
+    spec = state_spec(result.state)
     if spec.x_range:
         r = np.asarray(spec.x_range, dtype=float)
         lo, hi = np.maximum(lo, r[:, 0]), np.minimum(hi, r[:, 1])

@@ -10,6 +10,7 @@ from __future__ import annotations
 from jik.app.dashboard.controls import PROGRESS_AFTER
 from jik.app.dashboard.model import COLORS, DASH, LABELS
 from jik.app.dashboard.plotting import PANEL_SIZES
+from jik.engine.robot_kinds import robot_kinds
 
 #: How each algorithm is drawn, everywhere: its colour (COLORS), its line style in the plots
 #: (plotly's ``dash``) and its robot in the 3D scene.
@@ -72,4 +73,6 @@ def page_config() -> dict:
         "panels": [{"id": k, "size": v, "help": PANEL_HELP[k]} for k, v in PANEL_SIZES.items()],
         "progress_after": PROGRESS_AFTER,
         "tools": [{"id": "atlas", "help": ATLAS_HELP}],
+        # (the robot editor's fields: one description, the engine's)
+        "robot_kinds": robot_kinds(),
     }

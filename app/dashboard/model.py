@@ -21,6 +21,7 @@ from jik.app.compute.schemas import (
     INTEGRAL,
     MAX_DIMENSION,
     ROBOT_MODELS,
+    USER_AUGMENTATION_MODELS,
     Coordinate,
     Gamma,
     Mode,
@@ -33,6 +34,7 @@ from jik.app.dashboard.controls import (
     expand,
     max_iterations,
 )
+from jik.app.dashboard.robots import USER_KINDS, user_robot
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS, robot_spec
 from jik.engine.repeatability import MAX_PATH_POINTS
@@ -61,6 +63,9 @@ class DashboardState(BaseModel):
 
     robot: str
     robot_parameters: dict[str, Any]
+    #: A robot the user defined (:mod:`jik.app.dashboard.robots`): its definition, whose
+    #: ``name`` is ``robot`` (a kind of :mod:`jik.engine.robot_kinds`); None for the catalogue's.
+    robot_definition: Annotated[dict[str, Any], Field(max_length=32)] | None = None
     augmentation: str
     augmentation_parameters: dict[str, Any]
     gamma: Gamma
@@ -93,8 +98,8 @@ CONTROL_KEYS: dict[str, Any] = {
     r"^augmentation_parameters\.[A-Za-z_][A-Za-z0-9_]*$": Annotated[float, Field(strict=True)],
 }
 _PATCH_TYPES: dict[str, Any] = {
-    "robot": Literal[tuple(ROBOTS)],
-    "augmentation": Literal[tuple(AUGMENTATION_MODELS)],
+    "robot": Literal[(*ROBOTS, *USER_KINDS)],
+    "augmentation": Literal[(*AUGMENTATION_MODELS, *USER_AUGMENTATION_MODELS)],
     "robot_parameters": dict[str, float | Point],
     "augmentation_parameters": dict[str, float],
     "path": Annotated[tuple[Point, ...], Field(max_length=MAX_PATH_POINTS)]
@@ -149,8 +154,12 @@ def patch_of(patch: BaseModel) -> dict[str, Any]:
     return {**patch.model_dump(exclude_unset=True), **controls}
 
 
-def default_state(robot: str = DEFAULT_ROBOT) -> DashboardState:
-    """The registry's defaults for ``robot``."""
+def default_state(
+    robot: str = DEFAULT_ROBOT, definition: Mapping[str, Any] | None = None
+) -> DashboardState:
+    """The registry's defaults for ``robot``; for a user robot, its definition's."""
+    if definition is not None or robot in USER_KINDS:
+        return _user_default_state(robot, definition)
     spec = robot_spec(robot)
     aug = spec.augmentation(None)
     # A platform (the unicycle) starts with the paper's experiment of sec. 6.2: one target.
@@ -172,6 +181,33 @@ def default_state(robot: str = DEFAULT_ROBOT) -> DashboardState:
     )
 
 
+def _user_default_state(robot: str, definition: Mapping[str, Any] | None) -> DashboardState:
+    """The defaults of a user robot: its definition's start, target, path and first map."""
+    if not isinstance(definition, Mapping):
+        raise InvalidInputError(
+            f"robot_definition: a {robot} robot needs its definition (the robot editor's fields)",
+            "robot_definition",
+        )
+    if definition.get("name") != robot:
+        raise InvalidInputError(f"robot_definition.name: must be the robot's kind {robot!r}, got "
+                                f"{definition.get('name')!r}", "robot_definition.name")  # fmt: skip
+    spec = user_robot(definition).spec
+    return DashboardState(
+        robot=robot,
+        robot_parameters={},
+        robot_definition=dict(definition),
+        augmentation=spec.augmentation(None).name,
+        augmentation_parameters={},
+        gamma=float(spec.default_gamma),
+        mode=spec.default_mode,
+        x0=tuple(float(v) for v in spec.default_x0),
+        task="path" if spec.default_path else "target",
+        target=tuple(float(v) for v in spec.default_target),
+        path=tuple(tuple(float(v) for v in p) for p in spec.default_path),
+        cycles=3 if spec.default_path else 1,
+    )
+
+
 def updated_state(state: DashboardState, patch: Mapping[str, object]) -> DashboardState:
     """Apply a partial change and validate the result (:func:`validate`).
 
@@ -189,19 +225,26 @@ def updated_state(state: DashboardState, patch: Mapping[str, object]) -> Dashboa
     patch = expand(state, patch)
     data = state.as_dict()
     robot = patch.get("robot", state.robot)
-    if robot != state.robot:
-        if not isinstance(robot, str) or robot not in ROBOTS:
-            raise InvalidInputError(
-                f"robot: unknown robot {robot!r}; choose one of {sorted(ROBOTS)}", "robot"
-            )
-        data = default_state(robot).as_dict()
+    definition = patch.get("robot_definition", state.robot_definition)
+    if definition is not None and not isinstance(definition, Mapping):
+        raise InvalidInputError("robot_definition: give an object (the robot editor's fields)",
+                                "robot_definition")  # fmt: skip
+    if robot != state.robot or definition != state.robot_definition:
+        if not isinstance(robot, str) or robot not in (*ROBOTS, *USER_KINDS):
+            raise InvalidInputError(f"robot: unknown robot {robot!r}; choose one of "
+                                    f"{sorted(ROBOTS)} or a kind {list(USER_KINDS)}",
+                                    "robot")  # fmt: skip
+        if robot != state.robot and "robot_definition" not in patch:
+            definition = None  # (another robot chosen: the definition was the other's)
+        data = default_state(robot, definition).as_dict()
     if "augmentation" in patch and patch["augmentation"] != data["augmentation"]:
-        aug = _registered(lambda: robot_spec(robot).augmentation(str(patch["augmentation"])),
-                          "augmentation")  # fmt: skip
+        spec = (user_robot(data["robot_definition"]).spec if data.get("robot_definition")
+                else robot_spec(robot))  # fmt: skip
+        aug = _registered(lambda: spec.augmentation(str(patch["augmentation"])), "augmentation")
         data["augmentation"] = aug.name
         data["augmentation_parameters"] = {p.name: p.default for p in aug.parameters}
     for key, value in patch.items():
-        if key in ("robot", "augmentation"):
+        if key in ("robot", "augmentation", "robot_definition"):
             continue
         if key in ("robot_parameters", "augmentation_parameters"):
             if not isinstance(value, Mapping):
@@ -222,14 +265,17 @@ def validate(data: Mapping[str, Any]) -> DashboardState:
         With the first refused field as ``field`` and the message starting with it.
     """
     state = _model(DashboardState, data, ())
-    spec = _registered(lambda: robot_spec(state.robot), "robot")
-    params = _model(ROBOT_MODELS[spec.name], {**state.robot_parameters, "name": spec.name},
-                    ("robot_parameters",)).model_dump(exclude={"name"})  # fmt: skip
-    aug = _registered(lambda: spec.augmentation(state.augmentation), "augmentation")
-    aug_params = _model(AUGMENTATION_MODELS[aug.name],
-                        {**state.augmentation_parameters, "name": aug.name},
-                        ("augmentation_parameters",)).model_dump(exclude={"name"})  # fmt: skip
-    kin = _registered(lambda: spec.build(**params), "robot_parameters")
+    if state.robot_definition is not None or state.robot in USER_KINDS:
+        spec, kin, params, aug_params = _user_robot(state)
+    else:
+        spec = _registered(lambda: robot_spec(state.robot), "robot")
+        params = _model(ROBOT_MODELS[spec.name], {**state.robot_parameters, "name": spec.name},
+                        ("robot_parameters",)).model_dump(exclude={"name"})  # fmt: skip
+        aug = _registered(lambda: spec.augmentation(state.augmentation), "augmentation")
+        aug_params = _model(AUGMENTATION_MODELS[aug.name],
+                            {**state.augmentation_parameters, "name": aug.name},
+                            ("augmentation_parameters",)).model_dump(exclude={"name"})  # fmt: skip
+        kin = _registered(lambda: spec.build(**params), "robot_parameters")
     _registered(lambda: kin.check(state.x0, "x0"), "x0")
     _registered(lambda: kin.check_task(state.target, "target"), "target")
     if state.path:
@@ -250,6 +296,35 @@ def validate(data: Mapping[str, Any]) -> DashboardState:
                              for k, v in params.items()},
         "augmentation_parameters": aug_params,
     })  # fmt: skip
+
+
+def _user_robot(state: DashboardState) -> tuple[Any, Any, dict, dict]:
+    """Spec, kinematics and (empty) parameters of a state's user robot, its map checked."""
+    definition = state.robot_definition
+    if state.robot in ROBOTS or definition is None:
+        raise InvalidInputError(
+            "robot_definition: only a user robot (robot one of "
+            f"{list(USER_KINDS)}) has a definition; {state.robot!r} needs it "
+            + ("removed" if definition is not None else "given"),
+            "robot_definition",
+        )
+    if definition.get("name") != state.robot:
+        raise InvalidInputError(f"robot_definition.name: must be the robot's kind "
+                                f"{state.robot!r}", "robot_definition.name")  # fmt: skip
+    for key in ("robot_parameters", "augmentation_parameters"):
+        if getattr(state, key):
+            raise InvalidInputError(f"{key}: a user robot has none", key)
+    robot = user_robot(definition)
+    p, r = robot.spec.p, robot.spec.r
+    if r < 2 or p != r + 1:
+        raise InvalidInputError(
+            "robot_definition: the dashboard's panels (task paths in a plane, the map h, E1, E2) "
+            f"need r >= 2 and one degree of redundancy, p = r + 1; this robot has p = {p}, "
+            f"r = {r} (the REST API and jik solve take it)",
+            "robot_definition",
+        )
+    _registered(lambda: robot.spec.augmentation(state.augmentation), "augmentation")
+    return robot.spec, robot.kinematics, {}, {}
 
 
 def _model(model: type[BaseModel], data: Mapping[str, Any], prefix: tuple[str, ...]) -> Any:

@@ -20,6 +20,7 @@ from jik.app.dashboard.analysis import augmenting_grid
 from jik.app.dashboard.controls import MAX_DASHBOARD_CYCLES
 from jik.app.dashboard.model import ALGORITHMS, DashboardState, cache_key
 from jik.app.dashboard.offload import OffloadLane
+from jik.app.dashboard.robots import state_kinematics, state_spec
 from jik.app.dashboard.runs import (
     UNICYCLE_TIME_POINTS,
     AlgorithmRun,
@@ -28,7 +29,6 @@ from jik.app.dashboard.runs import (
     first_cycles,
     leg_targets,
 )
-from jik.engine.registry import robot_spec
 from jik.engine.unicycle import Unicycle
 
 
@@ -85,8 +85,8 @@ def compute(
         A singular start configuration raises the engine's typed error.
     """
     t0 = time.perf_counter()
-    spec = robot_spec(state.robot)
-    kin = spec.build(**state.robot_parameters)
+    spec = state_spec(state)
+    kin = state_kinematics(state)
     targets = leg_targets(kin, state)
     cycles = state.cycles if state.task == "path" else 1
     total = 2 * cycles * len(targets)

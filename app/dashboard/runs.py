@@ -13,8 +13,8 @@ import numpy as np
 
 from jik.app.dashboard.controls import max_iterations
 from jik.app.dashboard.model import DashboardState
+from jik.app.dashboard.robots import state_inverse, state_kinematics
 from jik.engine.exceptions import RunCancelled
-from jik.engine.registry import make_inverse, robot_spec
 from jik.engine.repeatability import Leg, Resume, closed_path, repeatability
 from jik.engine.solver import SolveResult, Trajectory
 from jik.engine.unicycle import Unicycle
@@ -223,11 +223,8 @@ def algorithm_run(
     """One algorithm through ``cycles`` cycles of the legs to ``targets`` (see :func:`compute`);
     for the unicycle with the platform paths q(t) of its iterates. ``kin``: the state's
     kinematics when the caller has built it; ``resume``: see :func:`_run_legs`."""
-    spec = robot_spec(state.robot)
-    kin = spec.build(**state.robot_parameters) if kin is None else kin
-    inverse = make_inverse(
-        kin, algorithm, state.augmentation, state.augmentation_parameters, spec.name
-    )
+    kin = state_kinematics(state) if kin is None else kin
+    inverse = state_inverse(state, algorithm, kin)
     run = _run_legs(inverse, state, targets, cycles, progress, cancelled, partial, resume)
     if hasattr(kin, "path"):
         t = np.linspace(0.0, float(cast(Unicycle, kin).T), UNICYCLE_TIME_POINTS)

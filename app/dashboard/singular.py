@@ -12,8 +12,8 @@ import numpy as np
 
 from jik.app.dashboard.analysis import expensive_map, kinematics_and_map
 from jik.app.dashboard.model import DashboardState
+from jik.app.dashboard.robots import state_spec
 from jik.engine.exceptions import JikError
-from jik.engine.registry import robot_spec
 
 #: Grid points per region variable.
 NODES = 25
@@ -61,7 +61,7 @@ def _find(state: DashboardState) -> dict | None:
         when there is no design region, the map is expensive to evaluate, or h is regular
         there.
     """
-    spec = robot_spec(state.robot)
+    spec = state_spec(state)
     region = dict(spec.functional_region)
     if not region:
         return None

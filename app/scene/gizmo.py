@@ -44,6 +44,10 @@ class StartGizmo:
         """Put the gizmo at ``state``'s start point (not while it is dragged)."""
         if self.dragging:
             return
+        if state.robot_definition is not None:  # (a user's robot: its start is set on the page)
+            if self.handle is not None:
+                self.handle.visible = False
+            return
         (X, Y), yaw = gizmo_pose(state.robot, state.x0, state.robot_parameters)
         if self.handle is None or self._robot != state.robot:
             if self.handle is not None:
@@ -57,6 +61,7 @@ class StartGizmo:
             self._scene.add_label("/start/label", "drag: start point", position=(0, 0, 0.15))
             self.handle.on_update(self.on_drag)
         else:
+            self.handle.visible = True
             self.handle.position = (X, Y, 0.3)
             self.handle.wxyz = yaw_quaternion(yaw)
 

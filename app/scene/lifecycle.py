@@ -35,6 +35,7 @@ from jik.app.scene.mechanisms import (
     add_floor_grid,
     extent_of,
     fixtures_of,
+    layout_name,
     polyline,
     rgb,
     trace_tolerance,
@@ -218,7 +219,7 @@ class DashboardScene:
             # client shows the start point and the paths that leave it together, never one
             # without the other.
             self.gizmo.place(state)
-            layout = (state.robot, state.task)
+            layout = (layout_name(state), state.task)
             if timeline.unicycle or layout != self._layout:
                 self._switch_set(None if timeline.unicycle else layout, result, timeline, extent)
             else:
@@ -227,8 +228,8 @@ class DashboardScene:
                 self._update_set(self._sets[layout], result, extent)
             if self._home is not None:
                 self._home.pose(np.asarray(state.x0))
-            if self._framed != state.robot:
-                self._framed = state.robot
+            if self._framed != layout_name(state):
+                self._framed = layout_name(state)
                 self._frame_camera(extent)
             self._timeline = timeline
             # Playing: from the start. Paused: at the end, where the drift of J^P# shows.
@@ -238,8 +239,10 @@ class DashboardScene:
             self.drawn_generation = result.generation
             self._sync_now()
             self.dashboard.scene_status.update(
-                generation=result.generation, robot=state.robot, playing=self.playing
-            )
+                generation=result.generation, robot=state.robot, playing=self.playing,
+                mechanism=type(next(iter(self._mechanisms.values()), None)).__name__,
+                joints=len(getattr(self._mechanisms.get("extended"), "joints", ())),
+            )  # fmt: skip
         self._show_status(result)
 
     def _switch_set(self, layout: tuple | None, result, timeline: Timeline, extent) -> None:
@@ -275,7 +278,7 @@ class DashboardScene:
         """The nodes of ``result``'s manipulator and task under their own frame."""
         scene = self.server.scene
         state = result.state
-        root = f"/robot/{state.robot}-{state.task}"
+        root = f"/robot/{layout_name(state)}-{state.task}"
         entry: dict[str, Any] = {
             "root": root, "frame": scene.add_frame(root, show_axes=False, visible=visible),
             "mechanisms": {}, "home": None, "fixtures": {},
@@ -288,7 +291,7 @@ class DashboardScene:
                 for a in ALGORITHMS
             }
         self._place_fixtures(result, extent, root, entry["fixtures"])
-        self._sets[(state.robot, state.task)] = entry
+        self._sets[(layout_name(state), state.task)] = entry
         return entry
 
     def _update_set(self, entry: dict[str, Any], result, extent) -> None:
@@ -301,7 +304,7 @@ class DashboardScene:
         """Build the hidden node set of a result solved ahead (the other manipulator's
         defaults, see ``Dashboard._prefetch``): switching to it then only moves nodes."""
         state = result.state
-        layout = (state.robot, state.task)
+        layout = (layout_name(state), state.task)
         if state.robot not in MECHANISMS:
             return
         with self._lock, self.server.atomic():

@@ -7,6 +7,8 @@ start x0), the floor grid, and the fixtures of a result (rails or guide, traces,
   x2 on the vertical guide, a lever of slope x3 pivoting on it, and a vertical runner at x1;
   the task point W = (x1, x2 + x1 x3) is where the lever crosses the runner.
 - The unicycle (40): a platform with two wheels and a heading nose at the pose q(t).
+- A user's planar chain or URDF arm (issue 29): links as lines between its joints' points,
+  joints as spheres (:class:`Chain`); a formula robot has no drawing, only its task path.
 
 The pseudoinverse is the translucent red ghost, the extended Jacobian the opaque blue robot (the
 colours of every plot); the grey ghost is the start configuration x0.
@@ -14,11 +16,15 @@ colours of every plot); the grey ghost is the start configuration x0.
 
 from __future__ import annotations
 
+import hashlib
+import json
 import math
+from typing import Any
 
 import numpy as np
 
 from jik.app.dashboard import ALGORITHMS, COLORS
+from jik.app.dashboard.robots import state_kinematics
 from jik.app.scene.pose import yaw_quaternion
 
 #: Height of each algorithm's copy above the task plane, and its opacity (None: solid).
@@ -164,7 +170,51 @@ class Platform(Mechanism):
         self.frame.wxyz = yaw_quaternion(float(q[2]))
 
 
-MECHANISMS = {"manipulator1": NormalForm, "manipulator2": Gantry}
+class Chain(Mechanism):
+    """A user's serial arm (a planar chain, a URDF arm): its links as lines between the points
+    of ``kinematics.points(x)`` (base first, the end last) and its joints as spheres. A planar
+    chain lies in the task plane; a URDF arm stands in its own x, y, z."""
+
+    def build(self) -> None:
+        self.kin = state_kinematics(self.state)
+        n = chain_points(self.kin, np.asarray(self.state.x0, dtype=float), 0.0).shape[0]
+        width = 5.0 if self.opacity is None else 3.5
+        self.links = self.scene.add_line_segments(
+            f"{self.root}/links", np.zeros((n - 1, 2, 3)), self.color, thickness=width,
+            thickness_units="screen",
+        )  # fmt: skip
+        self.joints = [self.ball(f"joint{i}", 0.04 if i < n - 1 else 0.06) for i in range(n)]
+
+    def resize(self, state, extent) -> None:
+        super().resize(state, extent)
+        self.kin = state_kinematics(state)
+
+    def pose(self, x) -> None:
+        pts = chain_points(self.kin, np.asarray(x, dtype=float), self.z + 0.05)
+        self.links.points = np.stack([pts[:-1], pts[1:]], axis=1)
+        for ball, point in zip(self.joints, pts, strict=False):
+            ball.position = tuple(float(v) for v in point)
+
+
+def chain_points(kin: Any, x: np.ndarray, z: float) -> np.ndarray:
+    """The points of a chain (..., n + 1, 3) in the scene: a planar one at height ``z``."""
+    pts = np.asarray(kin.points(x), dtype=float)  # (PlanarChain, UrdfChain)
+    if pts.shape[-1] == 2:
+        return np.concatenate([pts, np.full((*pts.shape[:-1], 1), z)], axis=-1)
+    return pts + np.array([0.0, 0.0, z])
+
+
+MECHANISMS = {"manipulator1": NormalForm, "manipulator2": Gantry, "planar_chain": Chain,
+              "urdf": Chain}  # fmt: skip
+
+
+def layout_name(state) -> str:
+    """The name of a state's set of nodes: its robot, and for a user robot its definition (a
+    chain of other links is another set)."""
+    if state.robot_definition is None:
+        return state.robot
+    text = json.dumps(state.robot_definition, sort_keys=True).encode()
+    return f"{state.robot}-{hashlib.sha256(text).hexdigest()[:12]}"
 
 
 # Every line (traces, grid) is sized in pixels: viser's world-unit lines solve a ray-segment
@@ -266,10 +316,15 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
         out[f"{root}/guide"] = (
             "box", {"dimensions": rail, "position": (0.0, (ylo + yhi) / 2, -0.02)}, grey
         )  # fmt: skip
+    chain = robot in ("planar_chain", "urdf")
+    kin = state_kinematics(result.state) if chain else None
     for a in ALGORITHMS:
         run = result.runs[a]
         line = {"colors": rgb(COLORS[a]), "thickness_units": "screen"}  # pixels, see above
-        task = np.column_stack([run.y[:, 0], run.y[:, 1], np.full(len(run.y), Z[a] + 0.16)])
+        if chain:  # (the end point's path: a URDF arm's task may be some of x, y, z)
+            task = chain_points(kin, run.x, Z[a] + 0.16)[:, -1]
+        else:
+            task = np.column_stack([run.y[:, 0], run.y[:, 1], np.full(len(run.y), Z[a] + 0.16)])
         out[f"{root}/trace/{a}/task"] = (
             "line", {"points": polyline(task, tol)},
             {**line, "thickness": 3.0 if a == "pseudoinverse" else 2.0},
@@ -279,6 +334,8 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
             out[f"{root}/trace/{a}/joints"] = (
                 "line", {"points": polyline(joints, tol)}, {**line, "thickness": 1.2}
             )  # fmt: skip
+    if robot == "urdf" and result.state.robot_definition.get("task", "xyz") != "xyz":
+        return out  # (a target of some of x, y, z is not a point)
     for k, target in enumerate(result.targets):
         out[f"{root}/targets/{k}"] = (
             "ball", {"position": (float(target[0]), float(target[1]), 0.2)},
@@ -294,8 +351,13 @@ def extent_of(result) -> tuple[tuple[float, float], tuple[float, float]]:
         ys = np.vstack([ys, [result.state.target]])
         lo, hi = ys.min(axis=0)[:2] - 1.0, ys.max(axis=0)[:2] + 1.0
         return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
-    ys = np.concatenate([r.y for r in result.runs.values()])
     xs = np.concatenate([r.x for r in result.runs.values()])
+    if result.state.robot in ("planar_chain", "urdf"):  # (the whole arm, not only its end)
+        step = max(1, len(xs) // 200)
+        pts = chain_points(state_kinematics(result.state), xs[::step], 0.0).reshape(-1, 3)
+        lo, hi = pts.min(axis=0)[:2] - 0.3, pts.max(axis=0)[:2] + 0.3
+        return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
+    ys = np.concatenate([r.y for r in result.runs.values()])
     lo = np.minimum(ys.min(axis=0)[:2], 0.0) - 0.6
     hi = np.maximum(ys.max(axis=0)[:2], 1.0) + 0.6
     if result.state.robot == "manipulator2":

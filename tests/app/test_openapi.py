@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import pytest
 
+from jik.app.compute.schemas import USER_ROBOT_MODELS
 from jik.engine.registry import ROBOTS
 
 from .conftest import solve_body
@@ -31,7 +32,10 @@ def _variants(document, path: str) -> dict[str, dict]:
 
 def test_each_robot_has_its_own_vector_lengths(document):
     solve, repeatability = _variants(document, "/solve"), _variants(document, "/repeatability")
-    assert set(solve) == set(repeatability) == set(ROBOTS)
+    assert set(solve) == set(repeatability) == {*ROBOTS, *USER_ROBOT_MODELS}
+    for kind in USER_ROBOT_MODELS:  # (p and r follow from the definition: 1 to 16)
+        x0 = solve[kind]["properties"]["x0"]
+        assert (x0["minItems"], x0["maxItems"]) == (1, 16), kind
     for name, spec in ROBOTS.items():
         r = len(spec.task_names)
         x0 = solve[name]["properties"]["x0"]
@@ -50,8 +54,12 @@ def test_each_robot_offers_only_its_own_maps_and_variables(document):
             m for o in options for m in o.get("oneOf", [])
         ]
         names = {schemas[m["$ref"].rsplit("/", 1)[1]]["properties"]["name"]["const"] for m in refs}
-        assert names == {a.name for a in ROBOTS[name].augmentations}, name
+        expected = {"formula", "e2_synthesized"} if name in USER_ROBOT_MODELS else {
+            a.name for a in ROBOTS[name].augmentations}  # fmt: skip
+        assert names == expected, name
     for name, body in _variants(document, "/synthesize").items():
+        if name in USER_ROBOT_MODELS:
+            continue
         region = body["properties"]["region"]["anyOf"][0]
         assert region["propertyNames"]["enum"] == list(ROBOTS[name].variable_names)
 

@@ -1,0 +1,106 @@
+"""A request's user robot (issue 29): its definition built by the engine, its errors renamed.
+
+A request may give, instead of a catalogue robot, a definition of one of the kinds of
+:mod:`jik.engine.robot_kinds` (``planar_chain``, ``formula``, ``urdf``), and for its extended
+inverse a map ``{"name": "formula", "h": ...}`` or ``{"name": "e2_synthesized", "region":
+{...}}``. :func:`user_robot` builds both with :func:`jik.engine.robot_spec.robot_from_dict`
+(the safe formula parser, the URDF reader) and renames each refusal's field to the request's
+(``lengths.1`` -> ``robot.lengths[1]``, ``augmentations.0.h`` -> ``augmentation.h``). p and r
+follow from the definition: :mod:`jik.app.compute.requests` checks the lengths of ``x0``,
+``target`` and ``path`` against the built robot. Everything runs in the compute workers,
+under their time and memory limits.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+from collections.abc import Sequence
+from typing import Any
+
+from jik.app.compute import schemas as S
+from jik.app.compute.exceptions import RequestError
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.robot_spec import Robot, robot_from_dict
+
+#: The augmentation's label inside the built robot.
+_LABEL = "request"
+
+
+def is_user_robot(req_robot: Any) -> bool:
+    """Whether a request's robot is a definition (not a catalogue robot)."""
+    return getattr(req_robot, "name", None) in S.USER_ROBOT_MODELS
+
+
+def request_field(field: str | None, robot_keys: Sequence[str]) -> str:
+    """The request's field for a field of the engine's definition (see the module docstring)."""
+    parts = (field or "").split(".")
+    if parts[0] == "augmentations":
+        parts = ["augmentation", *parts[2:]]
+    elif parts[0] in robot_keys:
+        parts = ["robot", *parts]
+    elif parts[0] != "augmentation":
+        return "robot"
+    out: list[str] = []
+    for part in parts:  # (indices as the API writes them: robot.task[0])
+        if part.isdigit() and out:
+            out[-1] += f"[{part}]"
+        else:
+            out.append(part)
+    return ".".join(out)
+
+
+@functools.lru_cache(maxsize=16)
+def _built(definition: str) -> Robot:
+    """The robot of a definition (JSON text), kept: a worker serving the same robot again
+    reuses its kinematics and any synthesized map."""
+    return robot_from_dict(json.loads(definition))
+
+
+def user_robot(req_robot: Any, augmentation: Any = None) -> tuple[Robot, S.RobotUsed, Any]:
+    """The robot a request defines, with ``augmentation`` (a request's map model, or None) as
+    its only augmenting map; what it used (``S.RobotUsed``, ``S.AugmentationUsed`` or None).
+
+    Raises
+    ------
+    RequestError
+        The engine refused the definition or the map; the field is the request's.
+    """
+    definition = req_robot.model_dump(exclude_none=True)
+    given = None
+    if augmentation is not None:
+        given = augmentation.model_dump(exclude_none=True)
+        definition["augmentations"] = [{**given, "label": _LABEL}]
+    try:
+        robot = _built(json.dumps(definition, sort_keys=True))
+    except InvalidInputError as exc:
+        raise RequestError(request_field(exc.field, list(definition)), _text(exc)) from None
+    spec = robot.spec
+    used = S.RobotUsed(name=spec.name, parameters={}, definition=req_robot.model_dump(
+        exclude_none=True), p=spec.p, r=spec.r)  # fmt: skip
+    aug_used = None
+    if given is not None:
+        values = {k: float(v) for k, v in (given.get("parameters") or {}).items()}
+        aug_used = S.AugmentationUsed(name=given["name"], parameters=values, definition=given)
+    return robot, used, aug_used
+
+
+def _text(exc: InvalidInputError) -> str:
+    """The engine's message without a leading field name (the RequestError adds the field)."""
+    text = str(exc)
+    head = f"{exc.field}: " if exc.field else ""
+    return text[len(head) :] if head and text.startswith(head) else text
+
+
+def user_inverse(robot: Robot, algorithm: str):
+    """The robot's inverse: the pseudoinverse (8), or the extended inverse (11) of its map."""
+    if algorithm == "extended" and not robot.spec.augmentations:
+        raise RequestError(
+            "augmentation",
+            "the extended inverse of a user robot needs its augmenting map: {'name': "
+            "'formula', 'h': ...} or {'name': 'e2_synthesized', 'region': {...}} (p = r + 1)",
+        )
+    try:
+        return robot.inverse(algorithm, _LABEL if algorithm == "extended" else None)
+    except InvalidInputError as exc:
+        raise RequestError(request_field(exc.field, ()), _text(exc)) from None

@@ -1,0 +1,110 @@
+// The robot editor: a robot of your own (a planar chain, kinematics by formula, a URDF arm).
+// Its fields come from the server's description of each kind (engine/robot_kinds.py, in the
+// page's config as robot_kinds), never written here; applying sends the definition as the
+// session's robot_definition, and a refusal is shown next to the field it names.
+import { $, el } from "./dom.js";
+
+// How a field's text becomes JSON, by the description's type. A value that does not parse is
+// sent as typed: the server says what is wrong with it, next to the field.
+const NUMBER = (t) => (t.trim() !== "" && Number.isFinite(Number(t)) ? Number(t) : t.trim());
+const PARSE = {
+  string: (t) => t.trim(),
+  text: (t) => t,
+  numbers: (t) => t.split(",").map(NUMBER),
+  names: (t) => t.split(",").map((s) => s.trim()).filter((s) => s),
+  formulas: (t) => t.split("\n").map((s) => s.trim()).filter((s) => s),
+  integer: NUMBER,
+  mapping: json, points: json, augmentations: json,
+};
+const SHOW = {
+  numbers: (v) => v.join(", "), names: (v) => v.join(", "), formulas: (v) => v.join("\n"),
+  mapping: JSON.stringify, points: JSON.stringify, augmentations: JSON.stringify,
+};
+const MULTILINE = new Set(["text", "formulas"]);
+// The common fields the editor offers besides the kind's own (the rest keep their defaults).
+const COMMON = ["title", "x0", "augmentations"];
+
+function json(t) {
+  try { return JSON.parse(t); } catch (err) { return t; }
+}
+
+export function robotEditor(kinds, send) {
+  const box = $("#robot-editor");
+  const kind = el("select", { id: "robot-kind" },
+    el("option", { value: "" }, "choose a kind…"),
+    ...Object.keys(kinds.kinds).map((k) => el("option", { value: k }, k.replace("_", " "))));
+  const fields = el("div", { id: "robot-fields", className: "robot-fields" });
+  const apply = el("button", { type: "button", id: "robot-apply", disabled: true }, "apply");
+  const note = el("p", { id: "robot-note", className: "note" });
+  const inputs = new Map(); // field name -> [input, description, error note]
+  let shownKind = "";
+
+  function build(k, values = {}) {
+    shownKind = k;
+    inputs.clear();
+    apply.disabled = !k;
+    if (!k) { fields.replaceChildren(); return; }
+    const common = kinds.common.filter((f) => COMMON.includes(f.name));
+    fields.replaceChildren(...[...kinds.kinds[k], ...common].filter((f) => f.name !== "urdf_file").map((f) => {
+      const id = `robot-field-${f.name}`;
+      const value = f.name in values ? values[f.name] : f.example;
+      const text = value === null || value === undefined ? "" : (SHOW[f.type] || String)(value);
+      let input;
+      if (f.type === "boolean") input = el("input", { type: "checkbox", id, checked: value === true });
+      else if (MULTILINE.has(f.type)) input = el("textarea", { id, rows: f.type === "text" ? 6 : 2, value: text });
+      else input = el("input", { type: "text", id, value: text });
+      const error = el("span", { className: "field-error", id: `${id}-error`, role: "alert", hidden: true });
+      inputs.set(f.name, [input, f, error]);
+      const label = el("label", { title: f.help, htmlFor: id }, `${f.name}${f.required ? " *" : ""}`);
+      return el("div", { className: "robot-field", dataset: { field: f.name } }, label, input,
+        el("small", {}, f.help), error);
+    }));
+  }
+
+  function definition() {
+    const d = { name: shownKind };
+    for (const [name, [input, f]] of inputs) {
+      if (f.type === "boolean") { if (input.checked) d[name] = true; continue; }
+      if (input.value.trim() === "") continue;
+      d[name] = (PARSE[f.type] || String)(input.value);
+    }
+    return d;
+  }
+
+  function clearErrors() {
+    for (const [, [, , error]] of inputs) { error.hidden = true; error.textContent = ""; }
+    note.textContent = "";
+  }
+
+  kind.addEventListener("change", () => { clearErrors(); build(kind.value); });
+  apply.addEventListener("click", () => {
+    clearErrors();
+    note.textContent = "applying…";
+    send({ robot: shownKind, robot_definition: definition() });
+  });
+  box.append(el("div", { className: "robot-kind" }, el("label", { htmlFor: "robot-kind" }, "kind"), kind, apply), fields, note);
+
+  return {
+    // The session's state: a user robot's definition fills the editor (unless it shows the kind
+    // being edited); a refusal then stays where it is.
+    show(state) {
+      if (state.robot_definition && state.robot !== shownKind) {
+        kind.value = state.robot;
+        build(state.robot, state.robot_definition);
+      }
+      if (state.robot_definition && note.textContent === "applying…") note.textContent = `applied: ${state.robot}`;
+    },
+    // A refused field under robot_definition: its message next to it; whether it was shown.
+    refused(field, message) {
+      if (!field.startsWith("robot_definition")) return false;
+      box.open = true;
+      const name = field.split(".")[1];
+      const entry = inputs.get(name);
+      note.textContent = "not applied: see the field marked below";
+      if (!entry) { note.textContent = `not applied: ${message}`; return true; }
+      entry[2].hidden = false;
+      entry[2].textContent = message;
+      return true;
+    },
+  };
+}

@@ -1,0 +1,85 @@
+"""A user's robot in the dashboard's state (issue 29): its definition is state, refusals name
+their field under robot_definition, and the session computes both algorithms for it."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from jik.app.dashboard.model import (
+    DashboardState,
+    StatePatch,
+    default_state,
+    patch_of,
+    updated_state,
+    validate,
+)
+from jik.app.dashboard.session import Dashboard
+from jik.engine.exceptions import InvalidInputError
+
+ARM = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]}
+
+
+def _arm_state() -> DashboardState:
+    return updated_state(default_state(), {"robot": "planar_chain", "robot_definition": ARM})
+
+
+def test_a_definition_is_state_with_its_defaults_and_a_map():
+    """The definition's defaults (x0 = 0.5 each, a closed path) and, as it gives no map, h = x3."""
+    state = _arm_state()
+    assert state.robot == "planar_chain" and state.robot_definition == ARM
+    assert state.x0 == (0.5, 0.5, 0.5) and state.task == "path" and len(state.path) == 3
+    assert state.augmentation == "formula"
+    assert validate(state.as_dict()) == state  # (the page's link: the state as JSON)
+
+
+@pytest.mark.parametrize(
+    ("patch", "field", "text"),
+    [
+        ({"robot_definition": {**ARM, "lengths": [1.0, 0.8]}}, "robot_definition.lengths",
+         "one entry per joint (3), got 2"),
+        ({"robot_definition": {**ARM, "lengths": [1.0, "a", 0.6]}}, "robot_definition.lengths.1",
+         "must be a number"),
+        ({"robot_definition": {**ARM, "name": "formula"}}, "robot_definition.name",
+         "must be the robot's kind"),
+        ({"robot": "formula", "robot_definition": {"name": "formula", "variables": ["x1", "x2"],
+          "task": ["x1 + os"]}}, "robot_definition.task.0", "unknown name 'os'"),
+        ({"robot": "urdf"}, "robot_definition", "needs its definition"),
+        ({"robot_definition": {**ARM, "joints": "RRRRR", "lengths": [0.4] * 5}},
+         "robot_definition", "this robot has p = 5, r = 2 (the REST API and jik solve take it)"),
+    ],
+)  # fmt: skip
+def test_refusals_name_the_definitions_field(patch, field, text):
+    with pytest.raises(InvalidInputError) as err:
+        updated_state(_arm_state(), {"robot": "planar_chain", **patch})
+    assert err.value.field == field
+    assert text in str(err.value)
+
+
+def test_a_catalogue_robot_drops_the_definition():
+    state = updated_state(_arm_state(), {"robot": "manipulator2"})
+    assert state.robot_definition is None and state == default_state("manipulator2")
+    with pytest.raises(InvalidInputError) as err:
+        validate({**default_state().as_dict(), "robot_definition": ARM})
+    assert err.value.field == "robot_definition"
+
+
+def test_the_session_computes_both_algorithms_for_it():
+    """The 3R arm on its default closed path: J^P# drifts, J^E# with h = x3 comes back."""
+    dashboard = Dashboard(_arm_state())
+    dashboard.start()
+    try:
+        assert dashboard.wait(timeout=60)
+        runs = dashboard.result.runs
+        assert runs["pseudoinverse"].drift[-1] > 1e-4
+        assert np.max(runs["extended"].drift) < 1e-9
+    finally:
+        dashboard.stop()
+
+
+def test_the_pages_link_opens_the_same_robot():
+    """A link holds the whole state (?state=<JSON>): a new session from it has the same robot,
+    definition and changes."""
+    state = updated_state(_arm_state(), {"x0.1": 0.7, "cycles": 2})
+    link = StatePatch.model_validate(state.as_dict())
+    assert updated_state(default_state(), patch_of(link)) == state

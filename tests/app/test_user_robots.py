@@ -1,0 +1,185 @@
+"""User robots through REST (issue 29): a planar chain, a formula robot and a URDF arm in
+/solve, /repeatability and /synthesize, and the refusals of bad or hostile definitions."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from jik.engine.kinematics import Manipulator2
+from tests.app.conftest import messages
+from tests.engine.test_planar_chain import _ivp_legs
+
+ARM = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]}
+X0 = [0.3, 1.0, 1.0]
+#: A closed path around k(X0) = (0.770, 1.514), as in tests/engine/test_planar_chain.py.
+PATH = [[1.0, 1.3], [1.0, 1.7], [0.6, 1.7]]
+REGION = {"x2": [0.4, 2.0], "x3": [0.4, 2.0]}
+M2_FORMULA = {
+    "name": "formula",
+    "variables": ["x1", "x2", "x3"],
+    "task": ["x2 + l*cos(x3)", "x1 + l*sin(x3)"],
+    "parameters": {"l": 1.0},
+}
+ARM4 = Path(__file__).resolve().parents[1] / "data" / "arm4.urdf"
+TABLE1_PATH = [[1.0, 1.0], [1.0, 2.0], [0.0, 2.0], [0.0, 1.0]]
+
+
+def _ok(response) -> dict:
+    assert response.status_code == 200, response.text
+    return response.json()
+
+
+def test_planar_3r_solve_reaches_the_target(api):
+    b = _ok(api.post("/solve", json={"robot": ARM, "algorithm": "pseudoinverse", "x0": X0,
+                                     "target": [1.0, 1.3]}))  # fmt: skip
+    assert b["converged"] and b["error"] < 1e-10
+    assert b["robot"]["name"] == "planar_chain" and (b["robot"]["p"], b["robot"]["r"]) == (3, 2)
+    assert b["robot"]["definition"]["lengths"] == [1.0, 0.8, 0.6]
+    x = np.array(b["x"])
+    y = np.array([np.cos(x[0]) + 0.8 * np.cos(x[0] + x[1]) + 0.6 * np.cos(x.sum()),
+                  np.sin(x[0]) + 0.8 * np.sin(x[0] + x[1]) + 0.6 * np.sin(x.sum())])  # fmt: skip
+    np.testing.assert_allclose(y, [1.0, 1.3], atol=1e-9)
+
+
+def test_planar_3r_pseudoinverse_legs_match_an_independent_solve_ivp(api):
+    """Two cycles: the leg ends through REST are scipy's own integration of eq. (7) to 1e-8."""
+    b = _ok(api.post("/repeatability", json={"robot": ARM, "algorithm": "pseudoinverse",
+                                             "x0": X0, "path": PATH, "cycles": 2}))  # fmt: skip
+    from jik.engine.planar_chain import PlanarChain
+
+    arm = PlanarChain("RRR", [1.0, 0.8, 0.6])
+    reference = _ivp_legs(arm, np.array(X0), [*b["targets"], *b["targets"]])
+    np.testing.assert_allclose(np.array(b["legs"]), reference, atol=1e-8, rtol=0)
+    assert b["drift"][0] > 1e-3 and not b["repeatable"]
+
+
+def test_planar_3r_synthesis_then_its_extended_inverse_is_repeatable(api):
+    """e2_variational on the box; E2 below that of h = x3 there; the extended inverse of the
+    synthesized map drives the path 5 times back to x0 (drift < 1e-9)."""
+    synth = _ok(api.post("/synthesize", json={"robot": ARM, "method": "e2_variational",
+                                              "region": REGION, "degree": 12,
+                                              "nodes": 16}))  # fmt: skip
+    x3 = _ok(api.post("/synthesize", json={"robot": ARM, "method": "evaluate", "region": REGION,
+                                           "augmentation": {"name": "formula", "h": "x3"},
+                                           "nodes": 16}))  # fmt: skip
+    e2, e2_x3 = synth["functionals"]["e2"]["value"], x3["functionals"]["e2"]["value"]
+    assert e2 < 0.2 * e2_x3, (e2, e2_x3)
+    assert x3["augmentation"]["definition"] == {"name": "formula", "h": "x3"}
+    rep = _ok(api.post("/repeatability", json={
+        "robot": ARM, "algorithm": "extended", "x0": X0, "path": PATH, "cycles": 5,
+        "augmentation": {"name": "e2_synthesized", "region": REGION, "degree": 12},
+    }))  # fmt: skip
+    assert rep["success"] and rep["repeatable"]
+    assert max(rep["drift"]) < 1e-9
+    assert rep["augmentation"]["name"] == "e2_synthesized"
+
+
+def test_more_than_one_degree_of_redundancy_is_refused_by_e2_variational(api):
+    arm = {"name": "planar_chain", "joints": "RRRR", "lengths": [0.5, 0.5, 0.5, 0.5]}
+    r = api.post("/synthesize", json={"robot": arm, "method": "e2_variational",
+                                      "region": {"x3": [0, 1], "x4": [0, 1]}})  # fmt: skip
+    (msg,) = messages(r)
+    assert msg.startswith("method: 'e2_variational' synthesizes one map h")
+    assert "p = 4, r = 2" in msg
+
+
+def test_formula_manipulator2_equals_the_builtin(api):
+    """Manipulator 2 written as formulas gives the built-in's Table 1 run to 1e-9."""
+    for algorithm, aug in (("pseudoinverse", None), ("extended", "x3 - 0.7501*x2*x3")):
+        results = []
+        for robot, augmentation in ((M2_FORMULA, {"name": "formula", "h": aug}),
+                                    ({"name": "manipulator2", "l": 1.0}, None)):  # fmt: skip
+            body = {"robot": robot, "algorithm": algorithm, "x0": [0.0, 0.0, math.pi / 2],
+                    "path": TABLE1_PATH, "cycles": 2}  # fmt: skip
+            if aug is not None and augmentation is not None:
+                body["augmentation"] = augmentation
+            results.append(_ok(api.post("/repeatability", json=body)))
+        if algorithm == "extended":
+            continue  # (the built-in's default map is the paper's cubic, not this one)
+        np.testing.assert_allclose(results[0]["legs"], results[1]["legs"], atol=1e-9, rtol=0)
+    b = _ok(api.post("/solve", json={"robot": M2_FORMULA, "algorithm": "pseudoinverse",
+                                     "x0": [0.0, 0.0, 1.5], "target": [1.0, 1.0]}))  # fmt: skip
+    ref = _ok(api.post("/solve", json={"robot": {"name": "manipulator2"}, "algorithm":
+                                       "pseudoinverse", "x0": [0.0, 0.0, 1.5],
+                                       "target": [1.0, 1.0]}))  # fmt: skip
+    np.testing.assert_allclose(b["x"], ref["x"], atol=1e-9, rtol=0)
+    np.testing.assert_allclose(Manipulator2().forward(np.array(b["x"])), [1.0, 1.0], atol=1e-9)
+
+
+def test_urdf_arm_solve_and_repeatability(api):
+    pytest.importorskip("yourdfpy")
+    robot = {"name": "urdf", "urdf": ARM4.read_text(), "end_link": "tool"}
+    x0 = [0.3, 0.5, 0.8, 0.6]
+    solved = _ok(api.post("/solve", json={"robot": robot, "algorithm": "pseudoinverse",
+                                          "x0": x0, "target": [0.2, 0.1, 0.8]}))  # fmt: skip
+    assert solved["converged"] and (solved["robot"]["p"], solved["robot"]["r"]) == (4, 3)
+    start = np.array(solved["trajectory"]["y"][0])
+    path = [list(start + [0.05, 0, 0]), list(start + [0.05, 0.05, 0]), list(start + [0, 0.05, 0])]
+    rep = _ok(api.post("/repeatability", json={
+        "robot": robot, "algorithm": "extended", "augmentation": {"name": "formula", "h":
+        "x4 - x3"}, "x0": x0, "path": path, "cycles": 3}))  # fmt: skip
+    assert rep["success"] and max(rep["drift"]) < 1e-9
+
+
+def test_vector_lengths_are_checked_against_the_built_robot(api):
+    body = {"robot": ARM, "algorithm": "pseudoinverse", "x0": [0.3, 1.0], "target": [1.0, 1.3]}
+    assert messages(api.post("/solve", json=body)) == [
+        "x0: must have 3 components (this planar_chain robot has p = 3, r = 2), got 2"
+    ]
+    body = {"robot": ARM, "algorithm": "pseudoinverse", "x0": X0, "path": [[1.0, 1.3, 0.0]]}
+    assert messages(api.post("/repeatability", json=body)) == [
+        "path[0]: must have 2 components (this planar_chain robot has p = 3, r = 2), got 3"
+    ]
+
+
+@pytest.mark.parametrize(
+    ("robot", "field", "text"),
+    [
+        ({**ARM, "lengths": [1.0, 0.8]}, "robot.lengths", "one entry per joint (3), got 2"),
+        ({**ARM, "joints": "RXR"}, "robot.joints", "String should match pattern"),
+        ({**M2_FORMULA, "task": ["x2 +* x3", "x1"]}, "robot.task[0]", "expected a number"),
+        (
+            {"name": "urdf", "urdf": "<robot name='a'><link name='b'/></robot>", "end_link": "c"},
+            "robot.end_link",
+            "'c' is not a link",
+        ),
+        ({"name": "urdf", "urdf": "not xml", "end_link": "c"}, "robot.urdf", "not a valid URDF"),
+    ],
+)
+def test_bad_definitions_are_422_naming_the_field(api, robot, field, text):
+    body = {"robot": robot, "algorithm": "pseudoinverse", "x0": X0, "target": [1.0, 1.3]}
+    r = api.post("/solve", json=body)
+    (msg,) = messages(r)
+    assert msg.startswith(f"{field}: ") and text in msg, msg
+    loc = [str(p) for p in r.json()["detail"][0]["loc"]]
+    assert loc == ["body", *field.replace("[", ".").replace("]", "").split(".")]
+
+
+HOSTILE = [
+    "__import__('os')",
+    "x1.real",
+    "lambda: 1",
+    "[x for x in (1, 2)]",
+    "x1**10**10",
+    "x1 + " * 20_000 + "x1",  # (100 kB)
+    "open + x1",
+    "y + x1",
+]
+
+
+@pytest.mark.parametrize("formula", HOSTILE, ids=lambda f: f[:20])
+def test_hostile_formulas_are_422_in_the_task_and_in_h(api, formula):
+    robot = {**M2_FORMULA, "task": [formula, "x1 + sin(x3)"]}
+    r = api.post("/solve", json={"robot": robot, "algorithm": "pseudoinverse",
+                                 "x0": [0.0, 0.0, 1.5], "target": [1.0, 1.0]})  # fmt: skip
+    (msg,) = messages(r)
+    assert msg.startswith("robot.task[0]: "), msg
+    r = api.post("/solve", json={"robot": M2_FORMULA, "algorithm": "extended",
+                                 "augmentation": {"name": "formula", "h": formula},
+                                 "x0": [0.0, 0.0, 1.5], "target": [1.0, 1.0]})  # fmt: skip
+    # (h is a formula or a list of them: a text too long is refused as both)
+    assert all(m.startswith("augmentation.h: ") for m in messages(r)), r.text

@@ -1,0 +1,52 @@
+"""The robot editor (issue 29): a user defines a planar RRR arm on the page, sees a bad length
+refused next to its field, fixes it, applies, and sees both algorithms' result for the new
+robot, in the verdict and in the 3D scene."""
+
+from __future__ import annotations
+
+import pytest
+
+expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
+pytestmark = pytest.mark.browser
+
+
+def test_a_planar_rrr_arm_from_the_editor(tabs):
+    tabs.allow_console(r"status of 422")  # the page's POST of the refused definition
+    tab = tabs.open()
+    tab.wait_drawn(1)
+    page = tab.page
+    page.click("#robot-editor-open")
+    page.select_option("#robot-kind", "planar_chain")
+    # The fields are the engine's description of the kind (robot_kinds), served to the page.
+    expect(page.locator("#robot-field-joints")).to_be_visible()
+    page.fill("#robot-field-joints", "RRR")
+    page.fill("#robot-field-lengths", "1, 0.8")  # one length short
+    response = tab.posting(lambda: page.click("#robot-apply"))
+    assert response.status == 422
+    error = page.locator("#robot-field-lengths-error")
+    expect(error).to_be_visible()
+    expect(error).to_contain_text("one entry per joint (3), got 2")
+    expect(page.locator("#robot-note")).to_contain_text("not applied")
+    tab.screenshots("robot-editor-refused")
+
+    page.fill("#robot-field-lengths", "1, 0.8, 0.6")
+    generation = tab.change(lambda: page.click("#robot-apply"))
+    expect(error).to_be_hidden()
+    assert tab.robot == "planar_chain"
+    snapshot = tab.wait_settled(lambda s: s["state"]["robot"] == "planar_chain", "the new arm")
+    state = snapshot["state"]
+    assert state["robot_definition"] == {"name": "planar_chain", "joints": "RRR",
+                                         "lengths": [1.0, 0.8, 0.6]}  # fmt: skip
+    assert tab.url_state()["robot_definition"] == state["robot_definition"]  # (the link)
+    summary = snapshot["summary"]
+    assert summary["pseudoinverse"]["success"] and summary["extended"]["success"]
+    assert summary["pseudoinverse"]["drift"][-1] > 1e-4  # the pseudoinverse drifts
+    assert summary["extended"]["drift"][-1] < 1e-9  # h = x3 is kept: repeatable
+    verdict = page.locator("#verdict")
+    expect(verdict).to_contain_text("pseudoinverse")
+    expect(verdict).to_contain_text("extended Jacobian")
+
+    scene = tab.wait_scene_drawn(generation)
+    assert scene["robot"] == "planar_chain"
+    assert scene["mechanism"] == "Chain" and scene["joints"] == 4  # base, 2 elbows, the end
+    tab.screenshots("robot-editor-rrr")
