@@ -1,5 +1,5 @@
 """``jik bench fuzz``: schemathesis against a running ``jik serve``, every check, positive and
-negative data, examples, coverage, fuzzing and stateful phases (issue 26).
+negative data (issue 26).
 
 :func:`run_fuzz` starts the server on a free loopback port, runs the schemathesis command with
 :mod:`jik.benchmarks.fuzz_hooks` (what the OpenAPI document cannot say) and reads its summary:
@@ -25,8 +25,11 @@ from jik.benchmarks.serving import jik_serve
 #: from the scratch directory schemathesis runs in.
 _PACKAGE_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(jik.__file__)))
 
-#: Every check schemathesis has.
-PHASES = "examples,fuzzing,stateful"
+#: The phases run with every check. Not the stateful phase: on this document schemathesis
+#: 4.32.5's grew past 23 GB of memory within 90 s (30 examples; the machine has 24 GB). Not the
+#: coverage phase with positive_data_acceptance: its boundary cases bypass the hooks
+#: (:func:`main` runs it with every other check).
+PHASES = "examples,fuzzing"
 
 
 @dataclass
@@ -91,7 +94,7 @@ def main(quick: bool = False) -> None:
     if importlib.util.find_spec("schemathesis") is None:
         print("jik bench fuzz needs schemathesis: pip install 'jik[test]'")
         return
-    examples = 20 if quick else 600
+    examples = 20 if quick else 850
     _report(f"schemathesis, every check, phases {PHASES}, {examples} examples per operation",
             run_fuzz(examples))  # fmt: skip
     # The coverage phase's boundary cases do not pass through the hooks, so its positive cases

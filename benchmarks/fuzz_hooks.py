@@ -61,6 +61,8 @@ from jik.engine.registry import ROBOTS, make_inverse
 WORK_CAPS = {"cycles": 2, "max_iterations": 300, "degree": 6, "nodes": 4, "grid": 9, "starts": 16}
 ROBOT_CAPS = {"T": 2 * math.pi}
 MAX_PATH = 4
+#: Paths of an atlas's family (shifts, scales) sent.
+MAX_FAMILY = 2
 
 
 #: Largest |coordinate| of a start, target or path point sent (the unicycle's controls of
@@ -81,8 +83,9 @@ def _capped(body: dict) -> dict:
     for name, cap in WORK_CAPS.items():
         if isinstance(body.get(name), int | float) and not isinstance(body[name], bool):
             body[name] = min(body[name], cap)
-    if isinstance(body.get("path"), list):
-        body["path"] = body["path"][:MAX_PATH]
+    for name in ("path", "shifts", "scales"):  # (an atlas: paths x starts x cycles x legs)
+        if isinstance(body.get(name), list):
+            body[name] = body[name][: MAX_PATH if name == "path" else MAX_FAMILY]
     for name in ("x0", "target", "path"):
         if name in body:
             body[name] = _clamped(body[name])
