@@ -1,6 +1,9 @@
 """schemathesis against a running ``jik serve``: every check, positive and negative data, at
-least 2,000 cases: no failure of any kind and no traceback in the server's log (issue 26). The rules the OpenAPI document cannot state are in
-:mod:`jik.benchmarks.fuzz_hooks`; ``jik bench fuzz`` runs the same with 10,000 and more."""
+least 2,000 cases: no failure of any kind and no traceback in the server's log (issue 26).
+
+The rules the OpenAPI document cannot state are in :mod:`jik.benchmarks.fuzz_hooks`;
+``jik bench fuzz`` runs the same with 10,000 and more cases.
+"""
 
 from __future__ import annotations
 
