@@ -32,6 +32,9 @@ from jik.engine.unicycle import Unicycle
 from jik.engine.validation import FloatArray, count
 
 #: Largest number of cycles and of path points accepted.
+#: A run is called repeatable when its joints come back to x0 within this after every cycle
+#: (‖x − x0‖ in the joint coordinates' own units): the API's verdict and the dashboard's.
+REPEATABLE_DRIFT = 1e-6
 MAX_CYCLES = 1000
 MAX_PATH_POINTS = 100
 #: The path is closed by a return leg to k(x0) when its last point is farther than this.

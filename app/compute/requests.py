@@ -23,13 +23,15 @@ from jik.app.compute.settings import settings_from_env
 from jik.app.compute.user_robots import is_user_robot, user_inverse, user_robot
 from jik.engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
 from jik.engine.registry import ROBOTS, RobotSpec, make_inverse
-from jik.engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS, repeatability
+from jik.engine.repeatability import (
+    MAX_CYCLES,
+    MAX_PATH_POINTS,
+    REPEATABLE_DRIFT,
+    repeatability,
+)
 from jik.engine.solver import BatchSolveResult, solve
 
 _R = TypeVar("_R")
-
-#: A run whose largest drift is below this is called repeatable.
-REPEATABLE_DRIFT = 1e-6
 
 
 # --------------------------------------------------------------------------------------------

@@ -20,10 +20,8 @@ from jik.app.dashboard.messages import h_change
 from jik.app.dashboard.plotting import norm_unit, units
 from jik.app.dashboard.runs import AlgorithmRun, DashboardResult
 from jik.app.dashboard.singular import singular_sentence
+from jik.engine.repeatability import REPEATABLE_DRIFT
 
-#: A run is repeatable when its joints come back to x0 within this after every cycle
-#: (‖x − x0‖ in the joint coordinates' own units).
-REPEATABLE_DRIFT = 1e-3
 #: h counts as conserved when it changed by less than this along a run.
 H_CONSERVED = 1e-6
 #: In discrete mode, a gamma at or above this is "near 2" (the iteration's stability limit).

@@ -50,3 +50,22 @@ def test_a_planar_rrr_arm_from_the_editor(tabs):
     assert scene["robot"] == "planar_chain"
     assert scene["mechanism"] == "Chain" and scene["joints"] == 4  # base, 2 elbows, the end
     tab.screenshots("robot-editor-rrr")
+
+
+def test_a_urdf_arm_from_a_link_is_drawn_in_the_scene(tabs):
+    """The 4-joint URDF arm shipped with the tests (issue 29): a link holding its definition
+    opens a session that computes both algorithms and a scene that draws the arm's chain."""
+    import json
+    from pathlib import Path
+    from urllib.parse import quote
+
+    urdf = (Path(__file__).resolve().parents[1] / "data" / "arm4.urdf").read_text()
+    state = {"robot": "urdf",
+             "robot_definition": {"name": "urdf", "urdf": urdf, "end_link": "tool"}}  # fmt: skip
+    tab = tabs.open("/?state=" + quote(json.dumps(state)))
+    snapshot = tab.wait_settled(lambda s: s["state"]["robot"] == "urdf", "the URDF arm")
+    assert snapshot["summary"]["pseudoinverse"]["success"]
+    scene = tab.wait_scene_drawn(snapshot["generation"])
+    assert scene["robot"] == "urdf"
+    assert scene["mechanism"] == "Chain" and scene["joints"] == 6  # base, 4 joints, the tool
+    tab.screenshots("robot-editor-urdf")
