@@ -139,6 +139,29 @@ def _patch_model() -> type[BaseModel]:
 StatePatch = _patch_model()
 
 
+def parse_patch(body: Any) -> dict[str, Any]:
+    """A change's JSON body as a patch (:data:`StatePatch`, then :func:`patch_of`).
+
+    Raises
+    ------
+    InvalidInputError
+        Naming the field: the first the patch's types refuse (a member of a union, labelled by
+        its type in pydantic's location, is left out of the name).
+    """
+    try:
+        return patch_of(StatePatch.model_validate(body))
+    except ValidationError as exc:
+        error = exc.errors()[0]
+        field = (
+            ".".join(
+                str(p) for p in error["loc"] if isinstance(p, str) and "[" not in p and p != "str"
+            )
+            or "body"
+        )
+        message = "unknown field; remove it" if error["type"] == "extra_forbidden" else error["msg"]
+        raise InvalidInputError(f"{field}: {message}", field) from None
+
+
 def patch_of(patch: BaseModel) -> dict[str, Any]:
     """The fields a :data:`StatePatch` was given, and its control keys (checked here: a key of
     no known form, or a value not of its type, is refused naming the key)."""

@@ -20,6 +20,7 @@ import threading
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import replace
+from typing import NoReturn
 
 from jik.app.dashboard.analysis import (
     augmenting_grid,
@@ -146,6 +147,18 @@ class Dashboard:
             self._offload.close()
         self._emit(Event("closed", self._generation, "{}"))
 
+    def refuse(self, refusal: InvalidInputError, source: str = "page") -> NoReturn:
+        """Announce a refused change to every listener as a ``refused`` event (the page and
+        the scene show it beside the field, their controls back to the values in force) and
+        raise it."""
+        with self._cond:
+            generation, state = self._generation, self._state
+        refused = {"type": "refused", "generation": generation, "source": source,
+                   "field": refusal.field, "message": str(refusal),
+                   "state": state.as_dict(), **controls_message(state)}  # fmt: skip
+        self._emit(Event("refused", generation, to_json(refused)))
+        raise refusal
+
     def update(
         self, patch: Mapping[str, object], source: str = "page"
     ) -> tuple[int, DashboardState]:
@@ -173,11 +186,7 @@ class Dashboard:
                     self._offload.newest(generation)
                 self._cond.notify_all()
         if refusal is not None:
-            refused = {"type": "refused", "generation": generation, "source": source,
-                       "field": refusal.field, "message": str(refusal),
-                       "state": state.as_dict(), **controls_message(state)}  # fmt: skip
-            self._emit(Event("refused", generation, to_json(refused)))
-            raise refusal
+            self.refuse(refusal, source)
         self._emit(
             Event("state", generation, to_json(self._state_message(generation, state, source)))
         )

@@ -102,7 +102,7 @@ def test_bad_changes_name_their_field_and_leave_the_state(client):
     assert bad.json()["detail"][0] == {
         "loc": ["body", "gamma"],
         "msg": "gamma: Input should be greater than or equal to 0.000001",
-        "type": "greater_than_equal",
+        "type": "value_error",
     }
     assert client.post(url, content=b"[1]", headers=JSON).status_code == 422
     assert client.get(f"/api/sessions/{session['id']}").json()["state"] == session["state"]

@@ -20,10 +20,11 @@ from pydantic import BaseModel, ConfigDict, Field
 from websockets.typing import Subprotocol
 
 from jik.app.api.dependencies import Store
+from jik.app.api.errors import unparsed_body_response
 from jik.app.dashboard import export_csv, export_json
 from jik.app.dashboard.controls import controls_message
 from jik.app.dashboard.messages import LatestEvents
-from jik.app.dashboard.model import StatePatch, patch_of
+from jik.app.dashboard.model import StatePatch, parse_patch, patch_of
 from jik.app.dashboard.sessions import ExportUnavailable, Session, SessionNotFound
 from jik.engine.exceptions import InvalidInputError
 
@@ -97,15 +98,29 @@ async def delete_session(session_id: str, store: Store):
     return PlainTextResponse(status_code=204, content="")
 
 
-@router.post("/api/sessions/{session_id}/state", operation_id="post_state")
-async def post_state(session_id: str, change: StatePatch, store: Store) -> JSONResponse:  # type: ignore[valid-type]
+@router.post(
+    "/api/sessions/{session_id}/state",
+    operation_id="post_state",
+    openapi_extra={"requestBody": {"required": True, "content": {"application/json": {
+        "schema": {"$ref": "#/components/schemas/StatePatch"}}}}},
+)  # fmt: skip
+async def post_state(session_id: str, request: Request, store: Store) -> JSONResponse:
     """Change some controls: ``{"gamma": 2}``, ``{"x0": [...]}``, ``{"robot": "manipulator1"}``.
 
-    The body is a partial dashboard state; the answer is the new generation and state (422 with
-    the engine's message for a value it refuses, which the session's scene shows too).
+    The body is a :data:`StatePatch`; the answer is the new generation and state. A change
+    refused, by the patch's types or by the engine, is a 422 naming the field, and a ``refused``
+    event for the session's page and scene, which show it beside the field.
     """
     session = store.get(session_id)
-    generation, state = session.dashboard.update(patch_of(change), source="page")
+    try:
+        body = await request.json()
+    except (ValueError, RecursionError) as exc:
+        return unparsed_body_response(exc)
+    try:
+        patch = parse_patch(body)
+    except InvalidInputError as exc:
+        session.dashboard.refuse(exc)
+    generation, state = session.dashboard.update(patch, source="page")
     return JSONResponse({"generation": generation, "state": state.as_dict()})
 
 
