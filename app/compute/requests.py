@@ -1,5 +1,8 @@
 """Requests to engine calls: the robots catalogue, solve and repeatability.
 
+(It stays whole, at about 400 lines: one path from a request model to the engine and back,
+shared by solve, its batches and repeatability; synthesis and user robots have their own.)
+
 Plain synchronous functions (``robots_response``, ``solve_request``, ``solve_batch``,
 ``repeatability_request``) turn a request model into engine calls and the result into a response
 model. They raise :class:`RequestError` naming the offending field. Synthesis requests have
