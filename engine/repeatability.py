@@ -160,7 +160,8 @@ def cycle_guesses(
         chained = chain_guesses(inverse, start, targets, gamma=gamma)
         if chained is not None:
             return list(chained)
-    return list(guides)
+    # A leg that started at its target recorded its start alone: nothing to sweep from.
+    return [g if g is not None and len(g.theta) >= 2 else None for g in guides]
 
 
 def repeatability(

@@ -69,6 +69,20 @@ def test_batch_of_starts_matches_single_runs():
         np.testing.assert_allclose(batch.legs[i], one.legs, atol=1e-9)
 
 
+def test_a_path_that_repeats_a_point_has_a_leg_of_no_length():
+    """A leg from where the path already is: its solve records the start alone, and the next
+    cycle does not take that as a guess (it was refused as "guess[0] must have ... m >= 2",
+    found by schemathesis: the path [(3, -3), (3, -3), (3, 3)] of Manipulator 2)."""
+    kin = Manipulator2()
+    inv = ExtendedInverse(kin, PaperCubic())
+    x0 = np.array([0.3, 0.5, 1.0])
+    twice = [(1, 1), (1, 1), (1, 2)]
+    once = repeatability(inv, x0, [(1, 1), (1, 2)], cycles=2)
+    run = repeatability(inv, x0, twice, cycles=2)
+    np.testing.assert_allclose(run.legs[[0, 2, 3, 5, 6, 7]], once.legs, atol=1e-9)
+    np.testing.assert_array_equal(run.legs[1], run.legs[0])
+
+
 @pytest.mark.parametrize("algorithm", ["pseudoinverse", "extended"])
 def test_one_start_guesses_later_cycles_and_agrees_with_the_batch(algorithm, monkeypatch):
     """A single start guesses its legs (cycle_guesses); a batch does not. The legs agree to
