@@ -11,6 +11,7 @@ import functools
 from typing import Literal, overload
 
 import numpy as np
+import scipy.special
 
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.kinematics import Kinematics
@@ -23,6 +24,14 @@ PANEL_PHASE = 8.0
 #: Nodes of the single Gauss-Legendre rule on [0, T]: ceil(NODES_PER_RAD * phase / 2) + MARGIN.
 NODES_PER_RAD = 1.25
 NODES_MARGIN = 16
+#: Most nodes of that rule, and of a path's composite rule: (|l20| + |l21| + 1) T up to about
+#: 13,000 rad, every start the API takes at T = 2 pi. Beyond it the quadrature's arrays (and the
+#: time to compute the rule) grow with the controls' size, which a diverging solve can make
+#: arbitrarily large: one request drove a process past 20 GB before this bound.
+MAX_NODES = 8192
+#: Largest rule computed by numpy's Golub-Welsch (a dense n x n eigenproblem, O(n^2) memory);
+#: larger ones by scipy's banded solver, O(n) memory (the two agree to 1e-13).
+DENSE_RULE_MAX = 512
 
 
 @functools.lru_cache(maxsize=64)
@@ -46,7 +55,10 @@ def _moment_basis(T: float, nodes: int) -> tuple[FloatArray, FloatArray, FloatAr
     Columns: 1, s, t, C, s t, s C, t^2, t C, C^2, s t^2, s t C, s C^2 with s = sin t,
     C = 1 - cos t (the derivatives of u1 and q3 with respect to lambda).
     """
-    xi, wi = np.polynomial.legendre.leggauss(nodes)
+    if nodes <= DENSE_RULE_MAX:
+        xi, wi = np.polynomial.legendre.leggauss(nodes)
+    else:
+        xi, wi = scipy.special.roots_legendre(nodes)
     t, w = 0.5 * T * (xi + 1.0), 0.5 * T * wi
     s, C = np.sin(t), 1.0 - np.cos(t)
     one = np.ones_like(t)
@@ -76,13 +88,26 @@ def nodes_for(lam: FloatArray, T: float) -> int:
     gave <= 1e-12 against solve_ivp for |l20|, |l21| up to 30 (and the tests check 1e-9). The
     count is the batch maximum, so one rule (cached) serves the whole batch.
     """
-    return int(np.ceil(NODES_PER_RAD * 0.5 * _phase(lam, T))) + NODES_MARGIN
+    return _bounded(np.ceil(NODES_PER_RAD * 0.5 * _phase(lam, T)) + NODES_MARGIN, lam, T)
 
 
 def panels_for(lam: FloatArray, length: float) -> int:
     """Number of composite panels of :data:`PANEL_NODES` nodes over ``length`` (for path()),
     each covering at most :data:`PANEL_PHASE` rad of phase (see :func:`nodes_for`)."""
-    return max(1, int(np.ceil(_phase(lam, length) / PANEL_PHASE)))
+    panels = max(1.0, np.ceil(_phase(lam, length) / PANEL_PHASE))
+    return _bounded(panels * PANEL_NODES, lam, length) // PANEL_NODES
+
+
+def _bounded(nodes: float, lam: FloatArray, length: float) -> int:
+    """``nodes`` if at most :data:`MAX_NODES`; otherwise the controls oscillate too fast."""
+    if nodes <= MAX_NODES:  # (False for NaN)
+        return int(nodes)
+    l20, l21 = np.max(np.abs(np.asarray(lam)[..., 2:4]).reshape(-1, 2), axis=0)
+    raise InvalidInputError(
+        f"the controls oscillate too fast for the quadrature of eq. (42): |lambda20| = "
+        f"{l20:.4g}, |lambda21| = {l21:.4g} over T = {length:.4g} s need {nodes:.0f} nodes, more "
+        f"than {MAX_NODES}; start from smaller lambda20, lambda21 or use a shorter horizon T"
+    )
 
 
 def _derivative_map() -> FloatArray:

@@ -137,3 +137,30 @@ def test_invalid_parameters(kwargs):
 def test_path_rejects_decreasing_times():
     with pytest.raises(InvalidInputError, match="nondecreasing"):
         Unicycle().path([1, 0, 0, 0], [0.0, 2.0, 1.0])
+
+
+def test_a_large_rule_is_banded_and_accurate():
+    """Controls that need more than DENSE_RULE_MAX nodes get scipy's O(n)-memory rule: the
+    end pose still matches an accurate integration of (40)."""
+    from jik.engine import unicycle
+
+    lam = np.array([0.7, -0.4, 90.0, 60.0])
+    assert unicycle.nodes_for(lam, 2 * np.pi) > unicycle.DENSE_RULE_MAX
+    q = Unicycle().forward(lam)
+    np.testing.assert_allclose(q, ode_pose(lam, (0.0, 0.0, 0.0), 2 * np.pi), atol=ODE_TOL)
+
+
+def test_controls_too_fast_for_the_quadrature_are_refused():
+    """The quadrature's size is bounded (MAX_NODES): beyond it forward, the Jacobian and a
+    path are refused with a message naming the controls, not computed with ever larger arrays
+    (a diverging solve asked for a 208 GB rule)."""
+    from jik.engine import unicycle
+
+    kin = Unicycle()
+    fast = np.array([0.0, 0.0, 1100.0, 1000.0])
+    for call in (kin.forward, kin.jacobian, lambda x: kin.path(x, [6.0])):
+        with pytest.raises(InvalidInputError, match=r"\|lambda20\| = 1100.*more than 8192"):
+            call(fast)
+    with pytest.raises(InvalidInputError, match="oscillate too fast"):
+        kin.forward(np.array([0.0, 0.0, np.inf, 0.0]))
+    assert unicycle.nodes_for(np.array([0, 0, 1000.0, 1000.0]), 2 * np.pi) <= unicycle.MAX_NODES
