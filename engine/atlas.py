@@ -283,7 +283,7 @@ def plan_atlas(
             raise InvalidInputError(f"box must be {kin.p} pairs (low, high), low < high", "box")
     if not isinstance(arc, Sequence) or len(arc) != 2:
         raise InvalidInputError("arc must be a pair (lo, hi) with lo <= 0 <= hi", field="arc")
-    manifolds = _manifolds(kin, paths, ref, arc, box)
+    manifolds = _checked(lambda: _manifolds(kin, paths, ref, arc, box), "reference")
     return make(n_starts=n, sampling=(sampling, seed), manifolds=manifolds, explicit=None)
 
 

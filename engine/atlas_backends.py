@@ -63,17 +63,35 @@ class InProcess:
         return map(fn, tasks)
 
 
+def limit_memory(memory_mb: int) -> None:
+    """Limit this process's address space to ``memory_mb`` (0: no limit), so that a chunk too
+    large for it raises MemoryError instead of taking the machine's memory."""
+    if memory_mb <= 0:
+        return
+    try:
+        import resource
+
+        limit = memory_mb * 1024 * 1024
+        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+    except (ImportError, ValueError, OSError):  # (no such limit here: run without)
+        pass
+
+
 class ProcessPool:
     """A local pool of ``workers`` processes (``concurrent.futures``, spawned: safe to start
-    from a threaded program such as the server)."""
+    from a threaded program such as the server), each within ``memory_mb`` (0: no limit)."""
 
-    def __init__(self, workers: int) -> None:
+    def __init__(self, workers: int, memory_mb: int = 0) -> None:
         self.workers = workers
+        self.memory_mb = memory_mb
         self._pool: ProcessPoolExecutor | None = None
 
     def __enter__(self) -> ProcessPool:
         context = multiprocessing.get_context("spawn")
-        self._pool = ProcessPoolExecutor(max_workers=self.workers, mp_context=context)
+        self._pool = ProcessPoolExecutor(
+            max_workers=self.workers, mp_context=context, initializer=limit_memory,
+            initargs=(self.memory_mb,),
+        )  # fmt: skip
         return self
 
     def __exit__(self, *exc: object) -> None:

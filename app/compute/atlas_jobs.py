@@ -1,7 +1,8 @@
 """Atlas jobs of the REST API: started by a request, run in the background, read back later.
 
 An atlas (:mod:`jik.engine.atlas`) takes seconds to minutes, longer than a request may wait, so
-``POST /atlas`` only checks the request and plans the atlas (:func:`plan_request`), then
+``POST /atlas`` only checks the request and plans the atlas (:func:`plan_request`, in a compute
+worker: its time and memory limits hold for the tracing), then
 :class:`AtlasJobs` runs it in a thread of its own that drives worker processes
 (``engine.atlas_run.run_atlas`` with a ``processes:N`` backend: the numbers work outside the
 server's interpreter and its GIL). A job does not belong to a connection: it runs on when its
@@ -27,8 +28,9 @@ from jik.app.compute.atlas_schemas import AtlasJobResponse, AtlasRequest
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.requests import build_augmentation, build_robot, nullable
 from jik.engine.atlas import AtlasPlan, plan_atlas
+from jik.engine.atlas_backends import ProcessPool
 from jik.engine.atlas_run import AtlasResult, run_atlas
-from jik.engine.exceptions import RunCancelled
+from jik.engine.exceptions import InvalidInputError, RunCancelled
 from jik.engine.registry import make_inverse
 from jik.engine.repeatability import CLOSE_TOL
 from jik.engine.self_motion import MAX_ARC
@@ -59,6 +61,8 @@ class AtlasLimits:
     keep_for: float = 600.0
     #: worker processes of a running atlas
     workers: int = 2
+    #: address space of each (MB; 0: no limit): the compute workers' (``JIK_WORKER_MEMORY_MB``)
+    worker_memory: int = 1024
 
 
 def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
@@ -102,6 +106,16 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
         reference=req.reference or spec.default_x0, box=None if req.arc else spec.x_range,
         shifts=req.shifts, scales=req.scales, gamma=gamma, mode=mode, tol=req.tolerance,
     )  # fmt: skip
+
+
+def plan_task(req: str, limits: AtlasLimits):
+    """:func:`plan_request` of a request (JSON) as a compute worker's task (``atlas.plan``),
+    within the workers' time and memory limits (tracing the curves solves eq. (7)): the plan and
+    None, or None and the refusal (message, field), for the server to raise again."""
+    try:
+        return plan_request(AtlasRequest.model_validate_json(req), limits), None
+    except InvalidInputError as exc:
+        return None, (str(exc), exc.field)
 
 
 def result_document(res: AtlasResult, arc, leg_ends: bool) -> dict[str, Any]:
@@ -160,12 +174,18 @@ class AtlasJobs:
         self._lock = threading.Lock()
         self._slots = threading.Semaphore(self.limits.max_running)
 
-    def start(self, client: str, req: AtlasRequest) -> AtlasJob:
-        """Plan the request's atlas and start it as a job (raises before anything is kept)."""
+    def check_room(self, client: str) -> None:
+        """Raise :class:`AtlasJobsFull` if no job of ``client`` can start now."""
         self.sweep()
         with self._lock:
             self._room(client)
-        plan = plan_request(req, self.limits)
+
+    def start(self, client: str, req: AtlasRequest, plan: AtlasPlan | None = None) -> AtlasJob:
+        """Start the request's atlas as a job, planned here unless ``plan`` (its plan) is given
+        (raises before anything is kept)."""
+        self.check_room(client)
+        if plan is None:
+            plan = plan_request(req, self.limits)
         job = AtlasJob(secrets.token_urlsafe(12), client, plan, req.leg_ends, request=req)
         with self._lock:
             self._room(client)
@@ -225,7 +245,8 @@ class AtlasJobs:
                 job.runs_done = done
 
             res = run_atlas(
-                job.plan, f"processes:{self.limits.workers}", on_progress=progress,
+                job.plan, ProcessPool(self.limits.workers, self.limits.worker_memory),
+                on_progress=progress,
                 cancelled=job.cancel.is_set, keep_leg_ends=job.leg_ends,
             )  # fmt: skip
             job.result = result_document(res, job.plan.manifolds[0].arc, job.leg_ends)

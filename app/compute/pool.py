@@ -38,7 +38,7 @@ from jik.app.compute.exceptions import (
 from jik.app.compute.precheck import precheck
 from jik.app.compute.requests import batch_key
 from jik.app.compute.settings import Settings, settings_from_env
-from jik.app.compute.worker import WORK_FIELDS, Worker, frame_header
+from jik.app.compute.worker import Worker, frame_header, work_of
 
 
 def _retrieve(future: asyncio.Future) -> None:
@@ -186,7 +186,7 @@ class ComputePool:
                     "replaced; retry the request"
                 ) from None
             self.stats["exceeded"] += 1
-            field, less = WORK_FIELDS.get(kind, ("request", "less work"))
+            field, less = work_of(kind, payload)
             raise RequestError(
                 field,
                 f"the computation exceeded the time limit of {self.settings.timeout:g} s and "

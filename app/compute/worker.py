@@ -22,6 +22,7 @@ from jik.app.compute import schemas as S
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.requests import engine_error, repeatability_request, solve_batch_json
 from jik.app.compute.synthesis import synthesize_request
+from jik.engine.atlas_backends import limit_memory
 from jik.engine.exceptions import JikError
 
 #: The field that sizes the work of each computation kind, and how to ask for less.
@@ -29,8 +30,19 @@ WORK_FIELDS = {
     "solve": ("max_iterations", "a lower max_iterations or a larger tolerance"),
     "repeatability": ("cycles", "fewer cycles or path points, a lower max_iterations"),
     "synthesize": ("region", "a smaller region, fewer nodes, a smaller grid or a lower degree"),
-    "call": ("cycles", "fewer cycles, a larger gamma or another start"),
+    "dashboard.run": ("cycles", "fewer cycles, a larger gamma or another start"),
+    "atlas.plan": (
+        "reference",
+        "another reference or path (eq. (7) from the reference to the "
+        "path's first point ran out of memory)",
+    ),
 }
+
+
+def work_of(kind: str, payload: Any) -> tuple[str, str]:
+    """The field that sizes a computation's work and how to ask for less (:data:`WORK_FIELDS`;
+    a ``call`` by its task's name)."""
+    return WORK_FIELDS.get(payload[0] if kind == "call" else kind, ("request", "less work"))
 
 
 def _solve_payload(items: list[bytes]) -> list[tuple[str, Any]]:
@@ -46,7 +58,10 @@ def _solve_payload(items: list[bytes]) -> list[tuple[str, Any]]:
 
 #: Work that other parts of the server hand to the same workers (``("call", (task, args))``),
 #: by name: the dashboard's offloaded runs. Only these functions can be called.
-TASKS = {"dashboard.run": "jik.app.dashboard.offload:run_offloaded"}
+TASKS = {
+    "dashboard.run": "jik.app.dashboard.offload:run_offloaded",
+    "atlas.plan": "jik.app.compute.atlas_jobs:plan_task",
+}
 
 
 def _call(payload: tuple[str, tuple]) -> Any:
@@ -89,7 +104,7 @@ def _worker_main(conn) -> None:
             err = engine_error(exc)
             msg = ("request_error", (err.field, err.message))
         except MemoryError:
-            field, less = WORK_FIELDS.get(kind, ("request", "less work"))
+            field, less = work_of(kind, payload)
             msg = ("request_error", (field, f"the computation ran out of memory; ask for {less}"))
         except Exception as exc:  # reported to the client as a 500 with its text
             msg = ("error", f"{type(exc).__name__}: {exc}")
@@ -100,14 +115,7 @@ def _worker_entry(fd: int, memory_mb: int = 0) -> None:
     """Entry point of a worker process started by :class:`Worker` (``python -c``): its address
     space limited to ``memory_mb`` (0: none), so that a computation too large for it raises
     MemoryError (a 422) instead of taking the machine's memory."""
-    if memory_mb > 0:
-        try:
-            import resource
-
-            limit = memory_mb * 1024 * 1024
-            resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
-        except (ImportError, ValueError, OSError):  # (no such limit here: run without)
-            pass
+    limit_memory(memory_mb)
     _worker_main(Connection(fd))
 
 

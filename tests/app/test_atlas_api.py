@@ -192,3 +192,40 @@ def test_a_session_atlas_it_cannot_make_is_422_naming_the_field(client, state, o
     assert r.status_code == 422, r.text
     assert any(text in m for m in messages(r)), r.text
     assert r.json()["detail"][0]["loc"][1] == field
+
+
+def test_the_plan_is_made_in_a_compute_worker(client, monkeypatch):
+    """Tracing the self-motion curves solves eq. (7): the server's process does not (a request
+    once drove it past 20 GB); the compute workers do, within their time and memory limits."""
+
+    def not_here(*_args):
+        raise AssertionError("planned in the server's process")
+
+    monkeypatch.setattr("jik.app.compute.atlas_jobs.plan_request", not_here)
+    r = client.post("/atlas", json=body())
+    assert r.status_code == 202, r.text
+    assert wait_until_ended(client, r.json()["id"])["status"] == "done"
+
+
+def test_a_reference_whose_solve_runs_away_is_refused_by_name(client):
+    """schemathesis's case: the unicycle from a reference with controls of size ~800, whose
+    solve to the path's first point needed an ever larger quadrature. 422 at ``reference``
+    with the engine's words; the worker that refused it serves the next request."""
+    bad = {"robot": {"name": "unicycle"}, "path": [[0.0, -3.0, 0.0], [3.0, 3.0, 0.0],
+           [-3.0, -3.0, 3.0]], "reference": [0.0, -820.6, 738.5, 840.0]}  # fmt: skip
+    r = client.post("/atlas", json=bad)
+    assert r.status_code == 422, r.text
+    (error,) = r.json()["detail"]
+    assert error["loc"] == ["body", "reference"] and "oscillate too fast" in error["msg"]
+    assert client.post("/atlas", json=body()).status_code == 202
+
+
+def test_a_session_reads_a_job_that_left_gamma_and_mode_to_the_robot(client):
+    """A job of POST /atlas without gamma or mode, read through a session's atlas route: its
+    heatmap's title gives the robot's defaults (it was a 500, found by schemathesis)."""
+    sid = _session(client)
+    job = client.post("/atlas", json=body()).json()["id"]
+    assert wait_until_ended(client, job)["status"] == "done"
+    r = client.get(f"/api/sessions/{sid}/atlas/{job}")
+    assert r.status_code == 200, r.text
+    assert "γ = 1, continuous mode" in r.json()["figure"]["layout"]["title"]["text"]

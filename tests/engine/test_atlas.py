@@ -274,3 +274,14 @@ def test_a_bad_backend_is_named(option):
     with pytest.raises(InvalidInputError) as info:
         backend_for(option)
     assert info.value.field == "backend"
+
+
+def test_a_process_pool_holds_its_workers_memory_limit():
+    """ProcessPool(memory_mb=...): a chunk too large for a worker raises MemoryError there
+    (the server's atlas jobs use the compute workers' limit) instead of taking the machine."""
+    from jik.engine.atlas_backends import ProcessPool
+
+    with ProcessPool(1, memory_mb=512) as pool, pytest.raises(MemoryError):
+        list(pool.imap_unordered(np.ones, [300_000_000]))  # (2.4 GB)
+    with ProcessPool(1, memory_mb=512) as pool:
+        assert [a.sum() for a in pool.imap_unordered(np.ones, [1000])] == [1000.0]

@@ -10,19 +10,36 @@ from typing import Annotated
 from fastapi import APIRouter, Depends, Request, Response
 from starlette.concurrency import run_in_threadpool
 
-from jik.app.compute.atlas_jobs import AtlasJobs
+from jik.app.api.dependencies import Pool
+from jik.app.compute.atlas_jobs import AtlasJob, AtlasJobs, AtlasLimits
 from jik.app.compute.atlas_schemas import AtlasBody, AtlasJobResponse
+from jik.app.compute.pool import ComputePool
 from jik.app.compute.schemas import ErrorResponse
+from jik.engine.exceptions import InvalidInputError
 
 router = APIRouter(tags=["atlas"])
 
 
 def jobs_of(request: Request) -> AtlasJobs:
-    """The app's atlas jobs (made on first use)."""
+    """The app's atlas jobs (made on first use; their processes have the compute workers'
+    memory limit)."""
     jobs = getattr(request.app.state, "atlas_jobs", None)
     if jobs is None:
-        jobs = request.app.state.atlas_jobs = AtlasJobs()
+        memory = request.app.state.pool.settings.worker_memory
+        jobs = request.app.state.atlas_jobs = AtlasJobs(AtlasLimits(worker_memory=memory))
     return jobs
+
+
+async def start_job(jobs: AtlasJobs, pool: ComputePool, request: Request, req) -> AtlasJob:
+    """Plan ``req`` in a compute worker (tracing the self-motion curves solves eq. (7): within
+    the workers' time and memory limits, like any computation a request asks for), then start
+    it as a job of the client's."""
+    client = request.client.host if request.client else "unknown"
+    jobs.check_room(client)  # (before the work)
+    plan, refused = await pool.run("call", ("atlas.plan", (req.model_dump_json(), jobs.limits)))
+    if refused is not None:
+        raise InvalidInputError(*refused)
+    return await run_in_threadpool(jobs.start, client, req, plan)
 
 
 Jobs = Annotated[AtlasJobs, Depends(jobs_of)]
@@ -33,10 +50,11 @@ ERRORS: dict[int | str, dict] = {
 
 
 @router.post("/atlas", status_code=202, response_model=AtlasJobResponse, responses=ERRORS)
-async def start_atlas(req: AtlasBody, request: Request, response: Response, jobs: Jobs):
+async def start_atlas(
+    req: AtlasBody, request: Request, response: Response, jobs: Jobs, pool: Pool
+):  # fmt: skip
     """Plan the atlas (the self-motion curves are traced here) and start it as a job."""
-    client = request.client.host if request.client else "unknown"
-    job = await run_in_threadpool(jobs.start, client, req)
+    job = await start_job(jobs, pool, request, req)
     response.headers["Location"] = f"/atlas/{job.id}"
     return job.response()
 

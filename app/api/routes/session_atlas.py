@@ -17,8 +17,8 @@ from fastapi.responses import JSONResponse
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from starlette.concurrency import run_in_threadpool
 
-from jik.app.api.dependencies import Store
-from jik.app.api.routes.atlas import ERRORS, Jobs
+from jik.app.api.dependencies import Pool, Store
+from jik.app.api.routes.atlas import ERRORS, Jobs, start_job
 from jik.app.compute.atlas_schemas import MAX_CYCLES, MAX_FAMILY, AtlasJobResponse, Scale
 from jik.app.compute.schemas import INTEGRAL
 from jik.app.dashboard.atlas import atlas_figure, atlas_request
@@ -49,7 +49,7 @@ class SessionAtlas(BaseModel):
              response_model=AtlasJobResponse, responses={**ERRORS, **_NOT_FOUND})  # fmt: skip
 async def start_session_atlas(
     session_id: str, body: SessionAtlas, request: Request, response: Response, store: Store,
-    jobs: Jobs,
+    jobs: Jobs, pool: Pool,
 ):  # fmt: skip
     """Start the atlas of the session's current state (422 naming the field it refuses)."""
     state = store.get(session_id).dashboard.state
@@ -59,8 +59,7 @@ async def start_session_atlas(
         error = exc.errors()[0]
         name = ".".join(str(p) for p in error["loc"]) or "state"
         raise InvalidInputError(f"{name}: {error['msg']}", name) from None
-    client = request.client.host if request.client else "unknown"
-    job = await run_in_threadpool(jobs.start, client, req)
+    job = await start_job(jobs, pool, request, req)
     response.headers["Location"] = f"/atlas/{job.id}"
     return job.response()
 
