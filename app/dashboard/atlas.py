@@ -21,6 +21,7 @@ from jik.app.dashboard.analysis import kinematics_and_map
 from jik.app.dashboard.model import DashboardState
 from jik.app.dashboard.plotting import AXIS, UNITS, figure, norm_unit
 from jik.engine.exceptions import InvalidInputError
+from jik.engine.registry import ROBOTS
 
 #: Drift below this is drawn as this (the extended Jacobian's drift is round-off, ~1e-13).
 DRIFT_FLOOR = 1e-14
@@ -105,8 +106,11 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
             "text": name + note, "x": lo + width / 2, "y": 1.0, "xref": "paper", "yref": "paper",
             "xanchor": "center", "yanchor": "bottom", "showarrow": False, "font": {"size": 11},
         })  # fmt: skip
+    spec = ROBOTS[request.robot.name]  # (a job of POST /atlas may leave them to the robot)
+    gamma = spec.default_gamma if request.gamma is None else request.gamma
+    mode = request.mode or spec.default_mode
     title = (f"Drift after each cycle from {N} starts on k(x) = k(x0) (dotted: x0), "
-             f"{request.robot.name}, γ = {request.gamma:g}, {request.mode} mode")  # fmt: skip
+             f"{request.robot.name}, γ = {gamma:g}, {mode} mode")  # fmt: skip
     logs = np.concatenate([np.ravel(t["z"]) for t in data])
     logs = logs[np.isfinite(logs)]
     cmin, cmax = (np.floor(logs.min()), np.ceil(logs.max())) if logs.size else (-14.0, 0.0)
