@@ -31,6 +31,11 @@ _PACKAGE_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(jik.__file__)))
 #: (:func:`main` runs it with every other check).
 PHASES = "examples,fuzzing"
 
+#: schemathesis's settings file: a session's event stream (``GET /api/sessions/{id}/events``)
+#: never ends, so its first event is the answer (schemathesis otherwise reads 20 events or until
+#: its request timeout, a minute of heartbeats for an idle session).
+CONFIG = "max-stream-events = 1\n"
+
 
 @dataclass
 class FuzzRun:
@@ -55,18 +60,24 @@ def run_fuzz(
     """schemathesis with ``max_examples`` per operation and phase against a fresh server."""
     # A request waits at most JIK_TIMEOUT for a worker and as long again to compute: within
     # schemathesis's request timeout (its "response time" check).
-    with jik_serve(JIK_WORKERS="2", JIK_TIMEOUT="20") as server:
+    with jik_serve(JIK_WORKERS="2", JIK_TIMEOUT="20", JIK_SESSION_IDLE_SECONDS="30") as server:
+        scratch = tempfile.mkdtemp()  # (schemathesis writes its cache there)
+        config = os.path.join(scratch, "schemathesis.toml")
+        with open(config, "w") as f:
+            f.write(CONFIG)
         started = time.perf_counter()
-        out = subprocess.run(  # (in a scratch directory: schemathesis writes its cache there)
-            [sys.executable, "-m", "schemathesis.cli", "run", f"{server.url}/openapi.json",
+        out = subprocess.run(
+            [sys.executable, "-m", "schemathesis.cli", "--config-file", config, "run",
+             f"{server.url}/openapi.json",
              "--checks", "all", "--phases", phases, "--max-examples", str(max_examples),
              *(["--exclude-checks", exclude_checks] if exclude_checks else []),
              "--seed", str(seed), "--workers", "1", "--suppress-health-check", "all",
              "--continue-on-failure", "--request-timeout", "60", "--no-color"],
             env=dict(os.environ, SCHEMATHESIS_HOOKS="jik.benchmarks.fuzz_hooks",
+                     JIK_FUZZ_SERVER=server.url,
                      PYTHONPATH=os.pathsep.join(filter(None, (_PACKAGE_ROOT,
                                                               os.environ.get("PYTHONPATH"))))),
-            capture_output=True, text=True, timeout=timeout, cwd=tempfile.mkdtemp(),
+            capture_output=True, text=True, timeout=timeout, cwd=scratch,
         )  # fmt: skip
         seconds = time.perf_counter() - started
     log = server.log[0]

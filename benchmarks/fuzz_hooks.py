@@ -27,6 +27,10 @@ case in tests/app/test_errors.py, test_synthesize.py and test_sessions.py):
   there is that whatever the model takes the route serves, without a 5xx, and that every
   response matches the document.)
 
+The sessions' operations get, in their positive cases, the id of a live session (one shared,
+made again when a case has deleted it or it expired; a new one for each ``DELETE``), so that they
+reach the sessions' code instead of answering 404.
+
 Every case also has its work capped (cycles, iterations, path points, grid and node counts, and
 coordinates and boxes within +-3, where the unicycle's quadrature stays small), so that the run
 measures the API, not the machine: the time and memory limits have tests of their own.
@@ -35,7 +39,9 @@ measures the API, not the machine: the time and memory limits have tests of thei
 from __future__ import annotations
 
 import math
+import os
 
+import httpx
 import numpy as np
 from pydantic import ValidationError
 
@@ -86,7 +92,7 @@ def _capped(body: dict) -> dict:
     for name in ("path", "shifts", "scales"):  # (an atlas: paths x starts x cycles x legs)
         if isinstance(body.get(name), list):
             body[name] = body[name][: MAX_PATH if name == "path" else MAX_FAMILY]
-    for name in ("x0", "target", "path"):
+    for name in ("x0", "target", "path", "reference"):
         if name in body:
             body[name] = _clamped(body[name])
     for name in ("region", "fixed"):  # (a box of the unicycle's lambdas over +-100 took 20 s)
@@ -204,6 +210,48 @@ def _positive_case_ok(case) -> bool:
     return True
 
 
+#: The server under test (:func:`jik.benchmarks.bench_fuzz.run_fuzz` names it).
+SERVER = os.environ.get("JIK_FUZZ_SERVER", "")
+
+
+class _Sessions:
+    """Live dashboard sessions of the server under test, for the sessions' operations."""
+
+    def __init__(self) -> None:
+        self._shared: str | None = None
+
+    def _new(self) -> str | None:
+        try:
+            answer = httpx.post(f"{SERVER}/api/sessions", json={}, timeout=30)
+        except httpx.HTTPError:
+            return None
+        return answer.json()["id"] if answer.status_code == 201 else None  # (503: all in use)
+
+    def shared(self) -> str | None:
+        """The shared session, made again if a case deleted it or it expired."""
+        if self._shared is not None:
+            try:
+                gone = httpx.get(f"{SERVER}/api/sessions/{self._shared}", timeout=30)
+            except httpx.HTTPError:
+                return None
+            if gone.status_code == 200:
+                return self._shared
+        self._shared = self._new()
+        return self._shared
+
+    def for_case(self, case) -> None:
+        """Give a positive case of a session's operation a live session's id."""
+        path = case.operation.path
+        if not SERVER or "{session_id}" not in path:
+            return
+        session = self._new() if case.method == "DELETE" else self.shared()
+        if session is not None:
+            case.path_parameters = {**(case.path_parameters or {}), "session_id": session}
+
+
+SESSIONS = _Sessions()
+
+
 @schemathesis.hook
 def before_generate_case(context, strategy: st.SearchStrategy) -> st.SearchStrategy:
     def fit(case):
@@ -212,8 +260,16 @@ def before_generate_case(context, strategy: st.SearchStrategy) -> st.SearchStrat
         return case
 
     def keep(case) -> bool:
-        meta = case.meta
-        positive = meta is None or meta.generation.mode.is_positive
-        return not positive or _positive_case_ok(case)
+        return not _positive(case) or _positive_case_ok(case)
 
-    return strategy.map(fit).filter(keep)
+    def live(case):
+        if _positive(case):
+            SESSIONS.for_case(case)
+        return case
+
+    return strategy.map(fit).filter(keep).map(live)
+
+
+def _positive(case) -> bool:
+    meta = case.meta
+    return meta is None or meta.generation.mode.is_positive

@@ -7,6 +7,7 @@ import os
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -36,9 +37,13 @@ def jik_serve(**env: str) -> Iterator[Served]:
     """``jik serve`` with the ``JIK_*`` settings ``env``, once /health answers (within 60 s);
     stopped with SIGTERM on leaving, its output then in ``log[0]``."""
     port = free_port()
+    # Its output goes to a file, not a pipe: nobody reads a pipe while it runs, and once the
+    # pipe's 64 kB were full the server's threads blocked on their next print (viser prints a
+    # banner for each session's scene).
+    out = tempfile.TemporaryFile("w+")
     proc = subprocess.Popen(
         [sys.executable, "-m", "jik", "serve", f"--port={port}"],
-        env={**os.environ, **env}, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+        env={**os.environ, **env}, stdout=out, stderr=subprocess.STDOUT, text=True,
     )  # fmt: skip
     served = Served(port, f"http://127.0.0.1:{port}")
     try:
@@ -55,4 +60,7 @@ def jik_serve(**env: str) -> Iterator[Served]:
         yield served
     finally:
         proc.terminate()
-        served.log.append(proc.communicate(timeout=60)[0])
+        proc.wait(timeout=60)
+        out.seek(0)
+        served.log.append(out.read())
+        out.close()
