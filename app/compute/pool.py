@@ -166,6 +166,7 @@ class ComputePool:
         loop serves other requests).
         """
         loop = self._bound_loop
+        buf, sent = bytearray(), False
         try:
             if not worker.ready:  # a freshly started worker: importing the engine takes a while
                 await loop.run_in_executor(self._threads, worker.wait_ready)
@@ -173,7 +174,8 @@ class ComputePool:
             cpu = worker.cpu_seconds()
             os.set_blocking(worker.conn.fileno(), True)  # uvloop's add_reader made it non-blocking
             worker.conn.send((kind, payload))
-            msg = await self._reply(worker, deadline)
+            sent = True
+            msg = await self._reply(worker, deadline, buf)
         except TimeoutError:
             used = worker.cpu_seconds() if cpu is not None else None
             self._replace(worker)
@@ -199,26 +201,39 @@ class ComputePool:
                 "was replaced"
             ) from None
         except asyncio.CancelledError:  # the request went away: collect the reply in the back
-            if worker.ready:
-                self._spawn(self._drain(worker, loop.time() + self.settings.timeout))
+            if sent:  # (the reply goes on from what this read of it had)
+                self._spawn(self._drain(worker, loop.time() + self.settings.timeout, buf))
+            elif worker.ready:
+                self._bound_idle.put_nowait(worker)
             else:
                 self._replace(worker)
             raise
         self._bound_idle.put_nowait(worker)
         return msg
 
-    async def _reply(self, worker: Worker, deadline: float):
+    async def _reply(self, worker: Worker, deadline: float, buf: bytearray | None = None):
         """The worker's reply, read in the event loop as it arrives, until ``deadline``.
 
         The reply is framed as by :class:`multiprocessing.connection.Connection` (which the worker
         uses): a 4-byte big-endian length (-1, then 8 bytes, for huge messages), then a pickle.
         Each readiness callback reads once, so it never blocks whether or not the event loop
-        (uvloop does) has made the socket non-blocking.
+        (uvloop does) has made the socket non-blocking. ``buf`` holds what was read: a read cut
+        short (a cancelled request) goes on from it, so the reply's rest is not taken for a new
+        frame. A reply that cannot be read is an EOFError (the worker is replaced).
         """
         loop = self._bound_loop
         fd = worker.conn.fileno()
         done: asyncio.Future = loop.create_future()
-        buf = bytearray()
+        buf = bytearray() if buf is None else buf
+
+        def take() -> None:
+            size, start = frame_header(buf)
+            if size is None or len(buf) < start + size or done.done():
+                return
+            try:
+                done.set_result(pickle.loads(memoryview(buf)[start : start + size]))
+            except Exception as exc:  # (a garbled reply: the worker's end is not trusted)
+                done.set_exception(EOFError(f"the worker's reply could not be read: {exc!r}"))
 
         def readable() -> None:
             try:
@@ -234,20 +249,20 @@ class ComputePool:
                     done.set_exception(EOFError("the worker closed its connection"))
                 return
             buf.extend(chunk)
-            size, start = frame_header(buf)
-            if size is not None and len(buf) >= start + size and not done.done():
-                done.set_result(pickle.loads(memoryview(buf)[start : start + size]))
+            take()
 
+        take()  # (a drained reply may be whole already)
         loop.add_reader(fd, readable)
         try:
             return await asyncio.wait_for(done, max(deadline - loop.time(), 0.0))
         finally:
             loop.remove_reader(fd)
 
-    async def _drain(self, worker: Worker, deadline: float) -> None:
-        """Wait out an abandoned computation, then give the worker back (or replace it)."""
+    async def _drain(self, worker: Worker, deadline: float, buf: bytearray) -> None:
+        """Wait out an abandoned computation (its reply read on from ``buf``), then give the
+        worker back (or replace it)."""
         try:
-            await self._reply(worker, deadline)
+            await self._reply(worker, deadline, buf)
         except (TimeoutError, EOFError, OSError):
             self._replace(worker)
         else:
