@@ -321,10 +321,14 @@ def sensitivity(
         if aug.parameters:
             out: dict = {"kind": "parameters", "parameters": dict(state.augmentation_parameters)}
             for k, key in enumerate(("E1", "E2")):
+
+                def evaluated(done: int, n: int, k: int = k) -> None:
+                    report(k * n + done)
+
                 out[key] = parameter_sensitivity(
                     kin, lambda **p: build(aug, **p), state.augmentation_parameters, region,
                     functional=key.lower(), span=1.0, samples=SENSITIVITY_SAMPLES, nodes=nodes,
-                    fixed=fixed, on_evaluation=lambda done, n, k=k: report(k * n + done),
+                    fixed=fixed, on_evaluation=evaluated,
                 )  # fmt: skip
             return out
         maps = []

@@ -34,7 +34,7 @@ def augmenting_spec(
     grid = result.augmenting
     if grid is None and cancelled:
         return message_figure(augmenting_title(result, None, cancelled),
-                              f"h on a grid not computed: {cancelled}")  # fmt: skip
+                              f"not computed: {cancelled}")  # fmt: skip
     if grid is None:
         return figure([], augmenting_title(result))
     i, j = grid["axes"]

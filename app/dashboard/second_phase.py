@@ -95,7 +95,7 @@ class SecondPhase:
 
         return step
 
-    def run(self) -> tuple[dict | None, dict | None]:
+    def run(self) -> tuple[dict | None, dict]:
         """E1/E2 and their sensitivity (with h on its grid first, when deferred); raises
         :class:`Cancelled` when cancelled, keeping in :attr:`result` the grid if it was done."""
         if self._cancelled():
@@ -143,7 +143,7 @@ def cancelled_message(phase: SecondPhase, generation: int) -> str:
     would have drawn, each saying what was cancelled (never a value of another state), the h
     panel's new title when its figure stays (h on screen, E1, E2 in its title not computed),
     and ``cancelled``: what was being computed, how far, and those panels."""
-    note = f"cancelled at {round(100 * phase.fraction)}% ({phase.what})"
+    note = f"cancelled at {round(100 * phase.fraction)}% (while computing {phase.what})"
     panels = set() if phase.cached else {"sensitivity"}
     if phase.deferred:  # (the h panel was a placeholder: the whole figure, with h if done)
         panels.add("augmenting")

@@ -91,7 +91,8 @@ def test_cancelled_during_the_grid_nothing_is_shown_as_computed():
     percent = round(100 * phase.fraction)
     h = message["figures"]["augmenting"]["layout"]
     assert h["title"]["text"].endswith("(h on a grid: cancelled)")
-    assert f"cancelled at {percent}% (h on a grid)" in h["annotations"][0]["text"]
+    note = f"not computed: cancelled at {percent}% (while computing h on a grid)"
+    assert h["annotations"][0]["text"] == note
     e = message["figures"]["sensitivity"]["layout"]
     assert e["title"]["text"] == "E1, E2 of characteristics: not computed"
     assert "E1 =" not in json.dumps(message) and "E2 =" not in json.dumps(message)
