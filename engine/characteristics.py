@@ -1,6 +1,6 @@
 """Synthesis of an augmenting map by characteristics, one degree of redundancy (section 4).
 
-(It stays whole, at about 560 lines: the one-form, the homotopy and the map class share the
+(It stays whole, at about 610 lines: the one-form, the homotopy and the map class share the
 collocation nodes, the Newton system and its linearisation, from which the exact gradient comes;
 split, the gradient would live apart from the system it differentiates.)
 
@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import functools
 import itertools
+from collections.abc import Callable
 
 import numpy as np
 
@@ -471,6 +472,54 @@ class CharacteristicsMap(AugmentingMap):
         out = (h, dh, failed)
         self._cache = (x.copy(), out, self._where, Z, S)
         return out
+
+    def evaluate_batches(
+        self,
+        x,
+        batch: int = 45,
+        on_batch: Callable[[int, int], None] | None = None,
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """:meth:`evaluate` of a large set of points, ``batch`` members at a time.
+
+        Parameters
+        ----------
+        x : array_like, shape (n, p)
+        batch : int
+            Members per Newton solve (each one cold, from z(s) = z(1): the result never depends
+            on the order of the batches).
+        on_batch : callable, optional
+            ``on_batch(done, total)`` after each batch; what it raises stops the evaluation
+            there (a caller's cancellation).
+
+        Returns
+        -------
+        h : ndarray, shape (n,)
+        dh : ndarray, shape (n, p)
+        failed : ndarray of bool, shape (n,)
+
+        Notes
+        -----
+        Each member's characteristic (28) is its own Newton solve; a batch only shares the
+        iterations, which go on until its slowest member converges. Batches bound that, so that
+        a few slow members do not hold up the rest, and give the caller a place to report
+        progress and to stop.
+        """
+        x = self.kinematics.check(x)
+        xb = x.reshape(-1, self.p)
+        size = count(batch, "batch", 1, 1_000_000)
+        total = -(-len(xb) // size)
+        h, dh = np.empty(len(xb)), np.empty((len(xb), self.p))
+        failed = np.empty(len(xb), dtype=bool)
+        for k in range(total):
+            part = slice(k * size, (k + 1) * size)
+            _, Z, S, bad = self.characteristic(xb[part])
+            h[part] = np.where(bad, np.nan, Z[:, 0])
+            dh[part] = np.where(bad[:, None], np.nan, S[:, 0, :])
+            failed[part] = bad
+            if on_batch is not None:
+                on_batch(k + 1, total)
+        shape = x.shape[:-1]
+        return h.reshape(shape), dh.reshape(*shape, self.p), failed.reshape(shape)
 
     def _raise_if(self, failed) -> None:
         if self.on_undefined == "raise" and np.any(failed):

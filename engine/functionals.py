@@ -284,6 +284,7 @@ def parameter_sensitivity(
     samples: int = 21,
     nodes: int = 16,
     fixed: Mapping[str, float] | None = None,
+    on_evaluation: Callable[[int, int], None] | None = None,
 ) -> dict:
     """The value of E1 or E2 at the given parameters and how it changes as each one moves.
 
@@ -297,6 +298,9 @@ def parameter_sensitivity(
     span, samples : float, int
         Each parameter is swept over [v - span, v + span] with ``samples`` values, the others
         held; parameter values where the map cannot be built are reported as None.
+    on_evaluation : callable, optional
+        ``on_evaluation(done, total)`` after each of the ``1 + len(parameters) (2 + samples)``
+        evaluations of the functional (a caller's progress; what it raises stops the sweep).
 
     Returns
     -------
@@ -310,13 +314,19 @@ def parameter_sensitivity(
     span = finite(span, "span")
     evaluate = error_functional_e1 if functional == "e1" else error_functional_e2
     base = {k: finite(v, k) for k, v in parameters.items()}
+    total, done = 1 + len(base) * (2 + samples), 0
 
     def at(params: dict) -> float | None:
+        nonlocal done
         try:
             amap = factory(**params)
         except InvalidInputError:
-            return None
-        v = evaluate(kinematics, amap, region, nodes=nodes, fixed=fixed).value
+            v = np.nan
+        else:
+            v = evaluate(kinematics, amap, region, nodes=nodes, fixed=fixed).value
+        done += 1
+        if on_evaluation is not None:
+            on_evaluation(done, total)
         return v if np.isfinite(v) else None
 
     out: dict = {"value": at(base), "gradient": {}, "sweeps": {}}

@@ -7,8 +7,10 @@ import { $, el, fmt } from "./dom.js";
 import { robotEditor } from "./editor.js";
 import { algorithmKey, applyFunctionals, drawFigures, layoutPanels, markStale, onAhead, setExportNote } from "./panels.js";
 import { atlasPanel, atlasState } from "./atlas.js";
+import { afterSecond, cancelSecond, clearCancelled, secondWanted } from "./second.js";
 
-const page = { config: null, state: null, shown: 0, shownState: null, editor: null };
+// second: the generation whose second phase runs (its progress came, its functionals not yet).
+const page = { config: null, state: null, shown: 0, shownState: null, editor: null, second: null };
 const send = (patch) => { setNotice(""); change(patch, (message) => setStatus(message, true)); };
 
 function setStatus(text, error = false) {
@@ -24,14 +26,26 @@ function setNotice(text) {
   n.hidden = !text;
 }
 
-// Only computations running longer than the server's progress_after get a progress bar.
-function showProgress(fraction, elapsed) {
-  const busy = elapsed > page.config.progress_after && fraction < 1;
+// Only computations running longer than the server's progress_after get a progress bar, with
+// what they compute: the runs of a new state (the plots meanwhile are the previous result's),
+// or the second phase of the result on screen (E1/E2 and their sensitivity, h on a grid).
+// Cancel stops the one shown (page.phase).
+function showProgress(fraction, elapsed, phase = "runs", what = "") {
+  // (a second phase's bar, once shown, stays until it ends: its timer can show it before an
+  // event sent a little earlier arrives)
+  const shown = phase === "second" && page.phase === "second";
+  const busy = (elapsed > page.config.progress_after || shown) && fraction < 1;
+  const runs = phase === "runs";
   $("#progress-box").hidden = !busy;
-  $("#panels").classList.toggle("pending", busy); // (the plots are the previous result's)
-  $("#cancel").disabled = !page.shownState;
-  $("#progress-bar").style.width = `${Math.round(100 * fraction)}%`;
-  $("#progress-text").textContent = `computing ${Math.round(100 * fraction)}%`;
+  if (runs) $("#panels").classList.toggle("pending", busy);
+  page.phase = busy ? phase : null;
+  const button = $("#cancel");
+  button.disabled = runs && !page.shownState;
+  button.title = runs ? "stop this computation and go back to the values of the result on screen"
+    : `stop computing ${what}: the result on screen stays, without E1, E2 and their sensitivity`;
+  const percent = Math.round(100 * fraction);
+  $("#progress-bar").style.width = `${percent}%`;
+  $("#progress-text").textContent = runs ? `computing ${percent}%` : `computing ${what} ${percent}%`;
 }
 
 function onState(msg, force = false) {
@@ -56,6 +70,7 @@ function onRefused(msg) {
 async function onResult(msg) {
   if (msg.generation < page.shown) return;
   await drawFigures(msg.figures, msg.digests, msg.state.robot);
+  clearCancelled();
   markStale(msg.stale || []);
   page.shown = msg.generation;
   page.shownState = msg.state;
@@ -128,9 +143,16 @@ function exportLinks(generation, why = "") {
   }
 }
 
-// Cancel the computation in progress: the session goes back to the values of the result on
-// screen (a newer generation stops the running one between legs; that result is cached).
+// Cancel the computation in progress. The runs of a new state: the session goes back to the
+// values of the result on screen (a newer generation stops the running one between legs; that
+// result is cached). The second phase of the result on screen: it stops, the result stays.
 function cancel() {
+  if (page.phase === "second") {
+    $("#progress-box").hidden = true;
+    page.phase = null;
+    cancelSecond(page.shown, setStatus);
+    return;
+  }
   const running = session.generation;
   const back = page.shown;
   $("#progress-box").hidden = true;
@@ -138,6 +160,41 @@ function cancel() {
   change(page.shownState, (message) => setStatus(message, true));
   setStatus(`cancelled generation ${running}; back to the values of generation ${back}`, true);
   page.cancelled = { running, back };
+}
+
+// Progress of the current generation's runs, or of the second phase of the result on screen
+// while no newer generation is asked for. One step of a second phase can outlast the wait for
+// the bar (a map synthesized for a new arm length, half a second): its bar shows once the phase
+// has run progress_after, whether or not another step reported by then.
+function onProgress(msg) {
+  if (msg.generation !== session.generation) return;
+  if (msg.phase !== "second") {
+    showProgress(msg.fraction, msg.elapsed);
+    return;
+  }
+  const wanted = () => page.second === msg.generation && page.shown === msg.generation
+    && session.generation === msg.generation && secondWanted(msg.generation);
+  page.second = msg.generation;
+  if (!wanted()) return;
+  showProgress(msg.fraction, msg.elapsed, "second", msg.what);
+  clearTimeout(page.secondTimer);
+  const wait = page.config.progress_after - msg.elapsed;
+  if (wait > 0 && msg.fraction < 1) {
+    page.secondTimer = setTimeout(() => {
+      if (wanted()) showProgress(msg.fraction, page.config.progress_after + 1e-3, "second", msg.what);
+    }, 1000 * wait + 1);
+  }
+}
+
+// The second phase of the result on screen, done or cancelled: its panels, then the header
+// (unless a newer generation is computing: its status stays).
+async function onFunctionals(msg) {
+  if (msg.generation === page.second) page.second = null;
+  clearTimeout(page.secondTimer);
+  if (msg.generation !== page.shown) return;
+  await applyFunctionals(msg);
+  if (page.phase === "second") showProgress(1, 0, "second");
+  afterSecond(msg, msg.generation === session.generation ? setStatus : null);
 }
 
 // ---------------------------------------------------------------- the session and its link
@@ -211,9 +268,9 @@ async function main() {
   follow({
     state: (msg) => onState(msg),
     refused: onRefused,
-    progress: (msg) => { if (msg.generation === session.generation) showProgress(msg.fraction, msg.elapsed); },
+    progress: onProgress,
     result: serial(onResult),
-    functionals: serial((msg) => (msg.generation === page.shown ? applyFunctionals(msg) : null)),
+    functionals: serial(onFunctionals),
     ahead: (msg) => { onAhead(msg, () => page.state && page.state.robot).catch((err) => console.warn("drawing ahead:", err)); },
     error: serial(onError),
   }, lost);

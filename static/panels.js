@@ -304,11 +304,15 @@ function showAhead(div, pre, key, fig) {
 }
 
 
-// Panels that a result's second phase redraws (E1/E2) are dimmed until then, not drawn empty.
-export function markStale(keys) {
+// Panels that a result's second phase redraws (E1/E2) are dimmed until then, not drawn empty,
+// with what they wait for.
+export function markStale(keys, waiting = "computing E1, E2 for the new state…") {
   for (const key of keys) {
     const div = document.getElementById(`plot-${key}`);
-    if (div) div.classList.add("stale");
+    if (div) {
+      div.classList.add("stale");
+      div.dataset.waiting = waiting;
+    }
     drawn[key] = undefined;
   }
 }

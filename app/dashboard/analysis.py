@@ -91,11 +91,16 @@ def functionals_key(state: DashboardState) -> str:
     )  # fmt: skip
 
 
-def augmenting_axes(amap, x: np.ndarray) -> tuple[int, int]:
-    """The two joint variables h depends on most along the configurations ``x`` (n, p)."""
+def augmenting_axes(amap, x: np.ndarray, on_batch=None) -> tuple[int, int]:
+    """The two joint variables h depends on most along the configurations ``x`` (n, p).
+
+    ``on_batch(done, total)``: after each batch of :data:`GRID_BATCH` points of an expensive
+    map (:func:`expensive_map`), whose gradient solves a problem per point.
+    """
     with np.errstate(all="ignore"):
-        if hasattr(amap, "evaluate"):
-            g = np.abs(np.asarray(amap.evaluate(x)[1], dtype=float))
+        if expensive_map(amap):
+            dh = amap.evaluate_batches(x, GRID_BATCH, on_batch)[1]
+            g = np.abs(np.asarray(dh, dtype=float))
         else:
             g = np.abs(np.asarray(amap.gradient(x), dtype=float))
     weight = np.nan_to_num(np.nanmean(g, axis=0)) * (np.ptp(x, axis=0) + 1.0)
@@ -119,11 +124,25 @@ def expensive_map(amap) -> bool:
 
 #: The h panel keeps its box while the trajectories fill at least this fraction of it.
 BOX_FILL = 0.5
+#: Points of an expensive map evaluated at once (each solves a collocation problem): the steps
+#: in which its grid reports progress and can be cancelled (docs/benchmarks.md).
+GRID_BATCH = 45
+#: Grid points per axis of h (fewer for an expensive map).
+GRID_POINTS, EXPENSIVE_GRID_POINTS = 41, 15
+
+
+def grid_batches(runs: Mapping[str, AlgorithmRun], amap) -> int:
+    """The steps of :func:`augmenting_grid` for ``runs``: the batches of the gradient along the
+    runs and of h on the grid (an expensive map), else 1."""
+    if not expensive_map(amap):
+        return 1
+    points = sum(len(r.x) for r in runs.values())
+    return -(-points // GRID_BATCH) + -(-(EXPENSIVE_GRID_POINTS**2) // GRID_BATCH)
 
 
 def augmenting_grid(
-    kin, state: DashboardState, runs: Mapping[str, AlgorithmRun], n: int = 41,
-    before: dict | None = None,
+    kin, state: DashboardState, runs: Mapping[str, AlgorithmRun], n: int = GRID_POINTS,
+    before: dict | None = None, progress: Callable[[int, int], None] | None = None,
 ):  # fmt: skip
     """h on a grid over the two variables it depends on most, other variables at x0.
 
@@ -133,12 +152,20 @@ def augmenting_grid(
     (:func:`jik.app.dashboard.plotting.keep_ranges`): a small change then gives the same grid,
     often the same h, and the page moves only the trajectories. Returns None when h cannot be
     evaluated on the grid.
+
+    ``progress(done, total)``: after each of the :func:`grid_batches` steps; what it raises
+    (:class:`Cancelled`) stops the grid there.
     """
     spec = state_spec(state)
     try:
         _, amap = kinematics_and_map(state, kin)
         xs = np.concatenate([r.x for r in runs.values()])
-        i, j = augmenting_axes(amap, xs)
+        total, along = grid_batches(runs, amap), -(-len(xs) // GRID_BATCH)
+
+        def step(offset: int):
+            return None if progress is None else lambda done, _: progress(offset + done, total)
+
+        i, j = augmenting_axes(amap, xs, step(0))
         box = []
         for k in (i, j):
             lo, hi = float(np.min(xs[:, k])), float(np.max(xs[:, k]))
@@ -148,7 +175,7 @@ def augmenting_grid(
                 lo, hi = max(lo, spec.x_range[k][0]), min(hi, spec.x_range[k][1])
             box.append((lo, hi))
         if expensive_map(amap):
-            n = min(n, 15)  # h solves a collocation problem per point
+            n = min(n, EXPENSIVE_GRID_POINTS)  # h solves a collocation problem per point
         if before is not None and tuple(before["axes"]) == (i, j) and before["n"] == n:
             inside = all(
                 b_lo <= np.min(xs[:, k]) and np.max(xs[:, k]) <= b_hi
@@ -162,10 +189,13 @@ def augmenting_grid(
         X[..., i] = u[None, :]
         X[..., j] = v[:, None]
         with np.errstate(all="ignore"):
-            if hasattr(amap, "evaluate"):  # maps that can be undefined at some points
-                H = np.asarray(amap.evaluate(X.reshape(-1, kin.p))[0], dtype=float)
+            if expensive_map(amap):  # (maps that can be undefined at some points)
+                h = amap.evaluate_batches(X.reshape(-1, kin.p), GRID_BATCH, step(along))[0]
+                H = np.asarray(h, dtype=float)
             else:
                 H = np.asarray(amap.value(X.reshape(-1, kin.p)), dtype=float)
+                if progress is not None:
+                    progress(total, total)
         H = H.reshape(n, n)
     except (JikError, ValueError, ArithmeticError):
         return None
@@ -174,12 +204,15 @@ def augmenting_grid(
             "kinematics": kin}  # fmt: skip
 
 
-def error_functionals(result: DashboardResult, nodes: int = 12) -> dict | None:
+def error_functionals(
+    result: DashboardResult, nodes: int = 12, on_step: Callable[[], None] | None = None
+) -> dict | None:
     """E1 (13) and E2 (18) of the current map, or None if unavailable.
 
     Over the robot's design region from the registry (the boxes of sec. 5, the ones
     ``jik reproduce`` uses) where it has one, so the values do not move with the start point and
     a synthesized map is judged on the box it was built for; else over the heat-map box.
+    ``on_step()`` after each of the two (progress; what it raises stops them).
     """
     grid = result.augmenting
     if grid is None:
@@ -209,6 +242,8 @@ def error_functionals(result: DashboardResult, nodes: int = 12) -> dict | None:
         except (JikError, ValueError, ArithmeticError) as exc:
             out[key] = None
             out[f"{key}_error"] = str(exc)
+        if on_step is not None:
+            on_step()
     return out
 
 
@@ -216,10 +251,24 @@ def error_functionals(result: DashboardResult, nodes: int = 12) -> dict | None:
 SENSITIVITY_SAMPLES = 11
 
 
+def sensitivity_evaluations(state: DashboardState, amap) -> int:
+    """How many values of E1 or E2 :func:`sensitivity` computes for ``state`` and its map
+    ``amap`` (its steps of progress): none for an expensive map; else both functionals at every
+    point of the parameters' sweeps, or of each of the robot's maps."""
+    if expensive_map(amap):
+        return 0
+    spec = state_spec(state)
+    params = spec.augmentation(state.augmentation).parameters
+    if params:
+        return 2 * (1 + len(params) * (2 + SENSITIVITY_SAMPLES))
+    return 2 * len(spec.augmentations)
+
+
 def sensitivity(
     result: DashboardResult,
     functionals: dict | None,
     cancelled: Callable[[], bool] = lambda: False,
+    progress: Callable[[int, int], None] | None = None,
 ) -> dict:
     """How E1 (13) and E2 (18) change with the parameters of the current map (issue 5).
 
@@ -232,7 +281,8 @@ def sensitivity(
       "current"}]}``, the functionals of every map the robot offers, at their defaults;
     * ``{"kind": "unavailable", "reason": ...}`` when they cannot be evaluated here.
 
-    ``cancelled`` is polled before every evaluation of a functional (raises :class:`Cancelled`).
+    ``cancelled`` is polled before every evaluation of a functional (raises :class:`Cancelled`);
+    ``progress(done, total)`` follows each of the :func:`sensitivity_evaluations`.
     """
     grid = result.augmenting
     if grid is None:
@@ -261,20 +311,31 @@ def sensitivity(
             raise Cancelled
         return other.build(kin, **params)
 
+    total = sensitivity_evaluations(state, grid["map"])
+
+    def report(done: int) -> None:
+        if progress is not None:
+            progress(done, total)
+
     try:
         if aug.parameters:
             out: dict = {"kind": "parameters", "parameters": dict(state.augmentation_parameters)}
-            for key in ("E1", "E2"):
+            for k, key in enumerate(("E1", "E2")):
+
+                def evaluated(done: int, n: int, k: int = k) -> None:
+                    report(k * n + done)
+
                 out[key] = parameter_sensitivity(
                     kin, lambda **p: build(aug, **p), state.augmentation_parameters, region,
                     functional=key.lower(), span=1.0, samples=SENSITIVITY_SAMPLES, nodes=nodes,
-                    fixed=fixed,
+                    fixed=fixed, on_evaluation=evaluated,
                 )  # fmt: skip
             return out
         maps = []
-        for other in spec.augmentations:
+        for m, other in enumerate(spec.augmentations):
             amap = build(other, **{p.name: p.default for p in other.parameters})
             if expensive_map(amap):
+                report(2 * m + 2)
                 continue
             row: dict = {"name": other.name, "current": other.name == aug.name}
             for key, fn in (("E1", error_functional_e1), ("E2", error_functional_e2)):
@@ -284,6 +345,7 @@ def sensitivity(
                 except (JikError, ValueError, ArithmeticError):
                     row[key] = None
             maps.append(row)
+            report(2 * m + 2)
         return {"kind": "alternatives", "maps": maps}
     except (JikError, ValueError, ArithmeticError) as exc:
         return {"kind": "unavailable", "reason": str(exc)}

@@ -243,17 +243,20 @@ def figure_specs(
     functionals: dict | None = None,
     only: set[str] | None = None,
     sensitivity: dict | None = None,
+    cancelled: str | None = None,
 ) -> dict[str, dict]:
     """The panels of the dashboard for ``result`` (all, or those in ``only``) as figure dicts,
-    keyed by id: what the dashboard serializes with :func:`figure_json`."""
+    keyed by id: what the dashboard serializes with :func:`figure_json`. ``cancelled``: how the
+    second phase was cancelled (:mod:`jik.app.dashboard.second_phase`), which the h and E1/E2
+    panels then say in place of what it did not compute."""
     builders = {
         "task": _platform if is_unicycle(result) else _task_space,
         "joints": _joints,
         "drift": _drift,
         "table": _table,
         "cspace": cspace_spec,
-        "augmenting": lambda r: augmenting_spec(r, functionals),
-        "sensitivity": lambda r: sensitivity_spec(r, sensitivity),
+        "augmenting": lambda r: augmenting_spec(r, functionals, cancelled),
+        "sensitivity": lambda r: sensitivity_spec(r, sensitivity, cancelled),
     }
     return {k: f(result) for k, f in builders.items() if only is None or k in only}
 

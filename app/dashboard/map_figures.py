@@ -15,7 +15,9 @@ from jik.app.dashboard.plotting import NO_LEGEND, figure, label, trace, units
 from jik.app.dashboard.runs import DashboardResult
 
 
-def augmenting_spec(result: DashboardResult, functionals: dict | None = None) -> dict:
+def augmenting_spec(
+    result: DashboardResult, functionals: dict | None = None, cancelled: str | None = None
+) -> dict:
     """Contours of the augmenting map h over two joint variables with both trajectories on top.
 
     The extended Jacobian keeps h constant (eq. (12)), so its trajectory follows a level curve;
@@ -25,10 +27,14 @@ def augmenting_spec(result: DashboardResult, functionals: dict | None = None) ->
     change that keeps h on its box then moves them by a relayout of the shapes, a few ms in the
     page, and the contours stay (plotly's animation of traces would drop a contour's layer, and
     drawing the panel anew takes ten times as long). Hover gives h; the joint values along
-    the runs are in the joint panel.
+    the runs are in the joint panel. ``cancelled``: the second phase was cancelled (how), so
+    E1, E2 (and h, without its grid) were not computed.
     """
     ju, _ = units(result)
     grid = result.augmenting
+    if grid is None and cancelled:
+        return message_figure(augmenting_title(result, None, cancelled),
+                              f"not computed: {cancelled}")  # fmt: skip
     if grid is None:
         return figure([], augmenting_title(result))
     i, j = grid["axes"]
@@ -65,7 +71,7 @@ def augmenting_spec(result: DashboardResult, functionals: dict | None = None) ->
     )  # fmt: skip
     return figure(
         data,
-        augmenting_title(result, functionals),
+        augmenting_title(result, functionals, cancelled),
         **NO_LEGEND,
         shapes=shapes,
         xaxis=dict(title=label(ni, ju[i])),
@@ -80,15 +86,20 @@ def _svg_path(x: np.ndarray, y: np.ndarray) -> str:
     return "M" + points
 
 
-def augmenting_title(result: DashboardResult, functionals: dict | None = None) -> str:
-    """Title of the h panel: the map, E1 and E2 on the plotted box, the fixed variables."""
+def augmenting_title(
+    result: DashboardResult, functionals: dict | None = None, cancelled: str | None = None
+) -> str:
+    """Title of the h panel: the map, E1 and E2 on the plotted box, the fixed variables; while
+    they are computed, or when that was ``cancelled``, it says so."""
     title = f"Augmenting map h: {result.state.augmentation}"
     grid = result.augmenting
     if grid is None:
-        return title + " (computing h on a grid…)"
+        return title + (" (h on a grid: cancelled)" if cancelled else " (computing h on a grid…)")
     i, j = grid["axes"]
     x0 = result.state.x0
-    sub = [] if functionals else ["E1, E2: computing…"]  # (a line now: the title keeps its height)
+    # (a line now: the title keeps its height)
+    waiting = "E1, E2: not computed (cancelled)" if cancelled else "E1, E2: computing…"
+    sub = [] if functionals else [waiting]
     if functionals:
         values = {k: functionals.get(k) for k in ("E1", "E2")}
         where = "the plotted box"
@@ -154,15 +165,19 @@ def log_ticks(values) -> dict:
     return dict(dtick="D2")
 
 
-def sensitivity_spec(result: DashboardResult, sens: dict | None = None) -> dict:
+def sensitivity_spec(
+    result: DashboardResult, sens: dict | None = None, cancelled: str | None = None
+) -> dict:
     """E1 (13) and E2 (18) of the current map and how they change (issue 5).
 
     With parameters: each functional against each parameter (swept around its current value,
     which is marked), on a log scale. Without: the functionals of the robot's other maps.
     ``sens`` comes from :func:`jik.app.dashboard.analysis.sensitivity` (the dashboard's second
-    phase).
+    phase); ``cancelled`` says how that phase was cancelled, when it was.
     """
     aug = result.state.augmentation
+    if sens is None and cancelled:
+        return message_figure(f"E1, E2 of {aug}: not computed", f"E1, E2 not computed: {cancelled}")
     if sens is None:
         return message_figure(f"E1, E2 of {aug}: computing…", "computing E1 and E2…")
     if sens["kind"] == "unavailable":

@@ -1,8 +1,10 @@
 """One session's live dashboard: its state, a worker thread that computes each change, and the
 listeners (the page's event stream, the scene) it tells.
 
-(It stays whole, at about 500 lines: one class, whose worker phases (result, second phase,
-solving ahead) share its lock, its generation and its caches.)
+(It stays whole, at about 580 lines: one class, whose worker phases (result, second phase,
+solving ahead) share its lock, its generation and its caches; cancelling the second phase and
+running it again go through the same lock and worker. The second phase's steps and its events
+are :mod:`jik.app.dashboard.second_phase`.)
 
 Every change is validated (:mod:`jik.app.dashboard.model`), bumps a generation counter and wakes
 the worker, which solves both algorithms (:func:`jik.app.dashboard.results.compute`), builds the
@@ -19,20 +21,15 @@ import logging
 import threading
 import time
 from collections.abc import Callable, Mapping
-from dataclasses import replace
 from typing import NoReturn
 
 from jik.app.dashboard.analysis import (
-    augmenting_grid,
-    error_functionals,
     expensive_map,
     functionals_key,
     kinematics_and_map,
-    sensitivity,
 )
 from jik.app.dashboard.controls import controls_message
 from jik.app.dashboard.figures import figure_specs, gamma_free_panels
-from jik.app.dashboard.map_figures import augmenting_title
 from jik.app.dashboard.messages import Event, digest, finite, summary, to_json, with_figures
 from jik.app.dashboard.model import (
     ALGORITHMS,
@@ -48,6 +45,7 @@ from jik.app.dashboard.offload import Offload
 from jik.app.dashboard.plotting import PANELS, figure_json, keep_ranges
 from jik.app.dashboard.results import compute
 from jik.app.dashboard.runs import Cancelled, DashboardResult
+from jik.app.dashboard.second_phase import SecondPhase, cancelled_message, finished_message
 from jik.app.dashboard.slots import FairSlots
 from jik.app.dashboard.verdict import verdict
 from jik.engine.exceptions import InvalidInputError, JikError
@@ -112,6 +110,13 @@ class Dashboard:
         }
         self.result: DashboardResult | None = None
         self.functionals: dict | None = None
+        # The second phase (_second_phase): the generation whose phase runs (None when none
+        # does, or it was cancelled), whose phase was cancelled, whose phase to run again, and
+        # the grid on screen when it started (kept for a run again).
+        self._second_running: int | None = None
+        self._second_cancelled: int | None = None
+        self._rerun: int | None = None
+        self._grid_before: dict | None = None
         #: What the 3D scene last drew (set by app.scene), for the page and the tests.
         self.scene_status: dict = {}
         self._thread: threading.Thread | None = None
@@ -257,9 +262,20 @@ class Dashboard:
                     "state": self._state.as_dict(),
                     "summary": None if result is None else summary(result),
                     "functionals": self.functionals,
+                    "second_phase": self._second_status(),
                     "scene": dict(self.scene_status),
                 }
             )
+
+    def _second_status(self) -> str | None:
+        """The second phase of the result on screen: "computing", "cancelled" (E1, E2 and
+        their sensitivity not computed) or "done"; None without a result. (With the lock.)"""
+        if self.result is None:
+            return None
+        g = self.result.generation
+        if self._second_running == g:
+            return "computing"
+        return "cancelled" if self._second_cancelled == g else "done"
 
     # -- worker -----------------------------------------------------------------------------
     def _state_message(self, generation: int, state: DashboardState, source: str) -> dict:
@@ -277,18 +293,26 @@ class Dashboard:
     def _work(self) -> None:
         while True:
             with self._cond:
-                while self._done >= self._generation and not self._stopped:
+                while self._done >= self._generation and self._rerun is None:
+                    if self._stopped:
+                        return
                     self._cond.wait()
                 if self._stopped:
                     return
-                # Debounce: wait until no change arrived for ``debounce`` seconds.
-                while True:
-                    seen = self._generation
-                    self._cond.wait(self._debounce)
-                    if self._generation == seen or self._stopped:
-                        break
+                rerun, self._rerun = self._rerun, None
+                if self._done < self._generation:  # (a change: the rerun is superseded)
+                    rerun = None
+                    # Debounce: wait until no change arrived for ``debounce`` seconds.
+                    while True:
+                        seen = self._generation
+                        self._cond.wait(self._debounce)
+                        if self._generation == seen or self._stopped:
+                            break
                 generation, state = self._generation, self._state
             try:
+                if rerun is not None:
+                    self._second_phase_again(rerun)
+                    continue
                 self._compute(generation, state)
                 self._prefetch(generation)
             except Exception as exc:  # keep the worker alive; the page shows the message
@@ -395,20 +419,28 @@ class Dashboard:
         """This session's turn to compute (:class:`FairSlots`), or at once without slots."""
         return self._slots.slot() if self._slots is not None else contextlib.nullcontext()
 
+    def _reporter(self, generation: int, phase: str) -> Callable[..., None]:
+        """``report(fraction, what="the runs")``: a ``progress`` event of ``phase`` ("runs", or
+        "second": :meth:`_second_phase`) at most every 0.1 s, and at the end of the runs (the
+        page then hides its bar; a second phase ends with its ``functionals`` event)."""
+        t0, last = time.perf_counter(), [0.0]
+
+        def report(fraction: float, what: str = "the runs") -> None:
+            now = time.perf_counter()
+            if now - last[0] > 0.1 or (fraction >= 1 and phase == "runs"):
+                last[0] = now
+                self._emit(Event("progress", generation, to_json({
+                    "type": "progress", "generation": generation, "phase": phase,
+                    "what": what, "fraction": fraction, "elapsed": now - t0,
+                })))  # fmt: skip
+
+        return report
+
     def _compute(self, generation: int, state: DashboardState) -> None:
 
         started = self._changed_at.get(generation, time.perf_counter())
         t0 = time.perf_counter()
-        last = [0.0]
-
-        def progress(fraction: float) -> None:
-            now = time.perf_counter()
-            if now - last[0] > 0.1 or fraction >= 1:
-                last[0] = now
-                self._emit(Event("progress", generation, to_json({
-                    "type": "progress", "generation": generation, "fraction": fraction,
-                    "elapsed": now - t0,
-                })))  # fmt: skip
+        progress = self._reporter(generation, "runs")
 
         # The h panel's box stays while it fits (augmenting_grid), for the same robot and task.
         on_screen = self.result
@@ -460,46 +492,95 @@ class Dashboard:
                 self._robot_since = generation
             self.result, self.functionals = result, functionals
             self._changed_at = {g: t for g, t in self._changed_at.items() if g > generation}
+            self._second_running, self._second_cancelled = generation, None
         self._emit(Event("result", generation, data, result))
         self._finish(generation)
-        # Second phase: h on a grid when it is expensive, then E1 and E2 (quadrature), unless a
-        # newer change came meanwhile. Known functionals went out with
-        # the result: their event only carries the h panel's title (a reused panel can lack it,
-        # and a page that connects now gets this event with the latest result).
-        known = bool(cached) and not deferred
-        if not known:
-            if self._generation != generation:
-                return
-        if deferred:
-            grid = augmenting_grid(kin, state, result.runs, before=grid_before)
-            if self._generation != generation:
-                return
-            result = replace(result, augmenting=grid)
-            with self._cond:
-                self.result = result
-        # E1, E2 and their sensitivity depend on what the grid does (not on gamma in
-        # continuous mode): reused.
-        if cached:
-            functionals, sens = cached
-        else:
-            functionals = error_functionals(result)
-            try:
-                sens = sensitivity(result, functionals, lambda: self._generation != generation)
-            except Cancelled:
-                return
-            self._functionals_cache = {functionals_key(state): (functionals, sens)}
-        if self._generation != generation:
-            return
-        message = {"type": "functionals", "generation": generation, "functionals": functionals,
-                   "sensitivity": sens}  # fmt: skip
+        self._second_phase(generation, kin, amap, result, deferred, cached, grid_before)
+
+    # -- second phase -----------------------------------------------------------------------
+    def _second_phase(
+        self, generation: int, kin, amap, result: DashboardResult, deferred: bool, cached,
+        grid_before: dict | None,
+    ) -> None:  # fmt: skip
+        """h on a grid when it is expensive, then E1 and E2 (quadrature) and their sensitivity
+        (:class:`SecondPhase`), unless a newer change comes meanwhile: ``progress`` events
+        (``"phase": "second"``, what is computed) and a ``functionals`` event at the end, or,
+        when :meth:`cancel_second_phase` stopped it, one that says so (``cancelled``).
+
+        Known functionals went out with the result: their event only carries the h panel's
+        title (a reused panel can lack it, and a page that connects now gets this event with
+        the latest result).
+        """
+        phase = SecondPhase(
+            kin, amap, result, deferred=deferred, cached=cached, grid_before=grid_before,
+            progress=self._reporter(generation, "second"),
+            cancelled=lambda: generation != self._generation or generation != self._second_running,
+        )  # fmt: skip
         with self._cond:
-            self.functionals = functionals
-        panels = set() if known else {"sensitivity"}
-        if deferred:  # the h panel was a placeholder: the whole figure
-            panels.add("augmenting")
-        elif functionals is not None:  # h is on screen: only its title changes (no redraw)
-            message["titles"] = {"augmenting": augmenting_title(result, functionals)}
-        specs = figure_specs(result, functionals, panels, sensitivity=sens)
-        redrawn = {k: figure_json(f) for k, f in specs.items()}
-        message["digests"] = {k: digest(t) for k, t in redrawn.items()}
-        self._emit(Event("functionals", generation, with_figures(message, redrawn)))
+            self._grid_before = grid_before
+        try:
+            functionals, sens = phase.run()
+        except Cancelled:
+            self._second_stopped(generation, phase)
+            return
+        finally:
+            with self._cond:
+                if self._second_running == generation:
+                    self._second_running = None
+        if not phase.cached:
+            self._functionals_cache = {functionals_key(result.state): (functionals, sens)}
+        with self._cond:
+            if self._generation != generation:
+                return
+            self.result, self.functionals = phase.result, functionals
+        data = finished_message(phase, generation, functionals, sens)
+        self._emit(Event("functionals", generation, data))
+
+    def _second_stopped(self, generation: int, phase: SecondPhase) -> None:
+        """A second phase stopped: by a newer change (nothing to say: its result follows), or
+        cancelled (:meth:`cancel_second_phase`): a ``functionals`` event that says so, the grid
+        kept when it was done (:func:`cancelled_message`)."""
+        with self._cond:
+            if self._generation != generation:
+                return
+            self.result = phase.result
+            self._second_cancelled = generation
+        self._emit(Event("functionals", generation, cancelled_message(phase, generation)))
+
+    def cancel_second_phase(self, generation: int) -> bool:
+        """Stop the second phase of ``generation`` (E1, E2, their sensitivity, h on a grid) at
+        its next step; the result stays on screen. False when it is not running (done, or a
+        newer generation is current)."""
+        with self._cond:
+            if self._second_running != generation or self._generation != generation:
+                return False
+            self._second_running = None
+            return True
+
+    def compute_second_phase(self, generation: int) -> bool:
+        """Run again the cancelled second phase of ``generation``, the result on screen. False
+        when it was not cancelled or ``generation`` is not current."""
+        with self._cond:
+            on_screen = self.result
+            if (
+                self._second_cancelled != generation
+                or self._generation != generation
+                or on_screen is None
+                or on_screen.generation != generation
+            ):
+                return False
+            self._second_cancelled, self._rerun = None, generation
+            self._second_running = generation
+            self._cond.notify_all()
+        return True
+
+    def _second_phase_again(self, generation: int) -> None:
+        """The worker's side of :meth:`compute_second_phase`: the phase from where the
+        cancelled one left the result (h on its grid when it was done)."""
+        result = self.result
+        if result is None or result.generation != generation:
+            return
+        kin, amap = kinematics_and_map(result.state)
+        deferred = expensive_map(amap) and result.augmenting is None
+        cached, _ = self._known_functionals(result.state)
+        self._second_phase(generation, kin, amap, result, deferred, cached, self._grid_before)

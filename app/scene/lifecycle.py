@@ -166,7 +166,10 @@ class DashboardScene:
                 self.controls.show(self.dashboard.state)
             elif event.kind == "progress":
                 msg = json.loads(event.data)
-                if event.generation == self.dashboard.generation and msg["elapsed"] > 0.5:
+                # (the runs only: the scene draws no E1, E2, and its status keeps the drawn
+                # result's while the page shows their progress)
+                runs = msg.get("phase") == "runs"
+                if runs and event.generation == self.dashboard.generation and msg["elapsed"] > 0.5:
                     self.progress.visible = msg["fraction"] < 1
                     self.progress.value = min(100.0, 100.0 * msg["fraction"])  # type: ignore[misc]  # viser: settable
                     self.status.content = f"computing… {100 * msg['fraction']:.0f}%"

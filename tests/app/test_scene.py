@@ -255,3 +255,36 @@ def test_the_scenes_integer_sliders_send_integers():
     finally:
         scene.stop()
         dashboard.stop()
+
+
+def test_the_scene_shows_the_runs_progress_not_the_second_phases():
+    """The scene's status keeps the drawn result's line while E1, E2 (which it does not draw)
+    are computed; a new state's runs show their progress there."""
+    import json
+    import socket
+
+    from jik.app.dashboard.messages import Event
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    dashboard = Dashboard(updated_state(default_state("manipulator2"), {"cycles": 1}))
+    scene = DashboardScene(dashboard, port=port)
+    try:
+        assert dashboard.wait(1, timeout=60)
+        scene._show_status(dashboard.result)
+        drawn = scene.status.content
+        assert drawn.startswith("generation 1:")
+
+        def progress(phase: str) -> Event:
+            return Event("progress", 1, json.dumps({
+                "type": "progress", "generation": 1, "phase": phase, "what": "h on a grid",
+                "fraction": 0.4, "elapsed": 0.8}))  # fmt: skip
+
+        scene._on_event(progress("second"))
+        assert scene.status.content == drawn and scene.progress.visible is False
+        scene._on_event(progress("runs"))
+        assert scene.status.content == "computing… 40%" and scene.progress.visible is True
+    finally:
+        scene.stop()
+        dashboard.stop()

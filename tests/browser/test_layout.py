@@ -1,12 +1,15 @@
 """The page at 1280x720: the scene fits below the sticky header, panel titles are not under their
 buttons, tick labels do not overlap, subtitles are not cut off, a panel with nothing to plot
-says why, and the unicycle's animation shows its iteration."""
+says why, and the unicycle's animation shows its iteration; at every size the scene's control
+panel sits beside the 3D view, never over the robot."""
 
 from __future__ import annotations
 
+import base64
+
 import pytest
 
-from tests.browser.conftest import probe
+from tests.browser.conftest import COLORS_RGB, TIMEOUT, probe
 
 expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
 pytestmark = pytest.mark.browser
@@ -48,3 +51,40 @@ def test_layout_at_1280x720(tabs):
     tab.wait_scene_text("iteration ")
     page.evaluate("() => window.scrollTo(0, document.querySelector('main').offsetTop)")
     tab.screenshots("layout-unicycle")
+
+
+def _overlap(a, b) -> float:
+    """The area two boxes [x, y, width, height] share."""
+    w = min(a[0] + a[2], b[0] + b[2]) - max(a[0], b[0])
+    h = min(a[1] + a[3], b[1] + b[3]) - max(a[1], b[1])
+    return max(0.0, w) * max(0.0, h)
+
+
+@pytest.mark.parametrize("size", [(1600, 1000), (1280, 720), (800, 900)])
+def test_the_scenes_panel_never_covers_the_robot(tabs, size):
+    """viser's control panel is docked beside the 3D view (its canvas ends where the panel
+    begins), never laid over it as the sheet viser gives a narrow window; the robots are drawn
+    in that view: the extended Jacobian's blue robot and trace, and the pseudoinverse's red, in
+    the canvas's own pixels, and again after the window is resized to each other size."""
+    width, height = size
+    tab = tabs.open(viewport={"width": width, "height": height})
+    tab.wait_scene_drawn(1)
+    for w, h in [size, *[s for s in ((1600, 1000), (1280, 720), (800, 900)) if s != size]]:
+        tab.page.set_viewport_size({"width": w, "height": h})
+        tab.page.locator("#scene").scroll_into_view_if_needed()
+        seen = tab.scene.wait_for_function(
+            f"() => {{ const s = ({probe('scene_layout')})(); "
+            "return s.canvas && s.panel && s.panel[2] > 200 ? s : null; }",
+            timeout=TIMEOUT,
+        ).json_value()
+        canvas, panel = seen["canvas"], seen["panel"]
+        assert _overlap(canvas, panel) == 0, (w, h, seen)
+        assert canvas[2] >= 250 and canvas[3] >= 300, (w, h, seen)  # (a view, not a sliver)
+        png = base64.b64encode(tab.scene.locator("canvas").first.screenshot()).decode()
+        for algorithm, rgb in COLORS_RGB.items():
+            found = tab.page.evaluate(
+                probe("find_colour"), {"png": png, "rgb": list(rgb), "tolerance": 60}
+            )
+            assert found["n"] > 50, (w, h, algorithm, found)
+    tab.page.set_viewport_size({"width": width, "height": height})
+    tab.screenshots(f"scene-panel-{width}")

@@ -1,11 +1,14 @@
 """Long computations: a progress bar and a cancel button that goes back to the result on
-screen; the cap on iterations that a leg's message names is a control."""
+screen; the second phase of a result (h on a grid, E1, E2) shows its progress and can be
+cancelled, the result staying; the cap on iterations that a leg's message names is a control."""
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
-from tests.browser.conftest import ARTIFACTS
+from tests.browser.conftest import ARTIFACTS, TIMEOUT, probe
 
 expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
 pytestmark = pytest.mark.browser
@@ -51,3 +54,70 @@ def test_the_iteration_cap_is_a_control_the_message_names(tabs):
     cap.fill("20000")
     tab.change(lambda: cap.dispatch_event("change"))
     expect(verdict).to_contain_text("extended Jacobian J^E#: repeatable")
+
+
+def test_the_second_phase_shows_its_progress_and_can_be_cancelled(tabs):
+    """The unicycle from pose B over T = 20 s: after its runs are drawn, h by characteristics on
+    a grid, then E1, E2 take a second or two. The header shows what is computed and how far; cancel
+    stops it: the result stays on screen, the h and E1/E2 panels say what was not computed (no
+    value of E1, E2 anywhere) and a button computes it, with its progress again."""
+    tab = tabs.open()
+    tab.select("#ctl-robot", "unicycle")
+    tab.change(lambda: tab.page.click("#ctl-preset-q0-B"))  # (pose B: the longest of the paper's)
+    box = tab.page.locator("#ctl-T-value")
+    box.fill("20")
+    generation = tab.change(lambda: box.dispatch_event("change"))
+    # (The bar shows for a second or so: its cancel is clicked the moment it shows.)
+    bar = {"box": "#progress-box", "text": "#progress-text", "timeout": TIMEOUT}
+    shown = tab.page.evaluate(probe("when_shown"), {**bar, "click": "#cancel"})
+    assert re.fullmatch(r"computing h on a grid \d+%", shown), shown
+    progress = tab.page.locator("#progress-box")
+    status = tab.page.locator("#status-text")
+    expect(status).to_contain_text(f"generation {generation} shown; not computed: ")
+    expect(progress).to_be_hidden()
+    h, e = tab.page.locator("#plot-augmenting"), tab.page.locator("#plot-sensitivity")
+    expect(e).to_contain_text("E1, E2 of characteristics: not computed")
+    expect(e).to_contain_text(re.compile(r"E1, E2 not computed: cancelled at \d+%"))
+    grid_cancelled = "h on a grid" in status.inner_text()
+    if grid_cancelled:  # (the cancel came while h was computed)
+        expect(h).to_contain_text("(h on a grid: cancelled)")
+        expect(h).to_contain_text(re.compile(r"not computed: cancelled at \d+% \(while comput"))
+        button = h.get_by_role("button", name="compute h and E1, E2")
+    else:  # (h was done: it stays, its title says E1, E2 were not computed)
+        expect(h).to_contain_text("E1, E2: not computed (cancelled)")
+        button = e.get_by_role("button", name="compute E1, E2")
+    for panel in (h, e):
+        expect(panel).to_have_class(re.compile(r"\bcancelled\b"))
+        expect(panel).not_to_have_class(re.compile(r"\bstale\b"))
+        expect(panel).not_to_contain_text(re.compile("E[12] ="))
+    snapshot = tab.snapshot()
+    assert snapshot["second_phase"] == "cancelled" and snapshot["functionals"] is None
+    assert snapshot["computed_generation"] == generation == tab.generation
+    assert snapshot["state"]["robot_parameters"]["T"] == pytest.approx(20.0)
+    expect(box).to_have_value(re.compile(r"^20"))  # (the state stays: only E1, E2 stopped)
+    h.scroll_into_view_if_needed()
+    tab.screenshots("second-phase-cancelled")
+
+    tab.watch_header()
+    button.click()
+    expect(status).to_have_text(f"up to date (generation {generation})")
+    seen = tab.header_seen()
+    assert f"computing E1/E2 of generation {generation} again…" in seen["statuses"], seen
+    assert seen["progress"] or not grid_cancelled, "no progress bar for h on a grid again"
+    expect(h).to_contain_text("E1, E2 undefined")  # (h is undefined on part of this box)
+    for panel in (h, e):
+        expect(panel).not_to_have_class(re.compile(r"\b(cancelled|stale)\b"))
+        expect(panel.locator(".recompute")).to_have_count(0)
+    assert tab.snapshot()["second_phase"] == "done"
+    h.scroll_into_view_if_needed()
+    tab.screenshots("second-phase-again")
+    tab.page.evaluate("() => window.scrollTo(0, 0)")
+
+    box.fill("6.28")  # (and back to T = 20 s: its runs are cached, h on a grid is not)
+    tab.change(lambda: box.dispatch_event("change"))
+    box.fill("20")
+    generation = tab.change(lambda: box.dispatch_event("change"))
+    shown = tab.page.evaluate(probe("when_shown"), bar)
+    tab.page.screenshot(path=str(ARTIFACTS / "second-phase-progress-1600.png"))
+    assert re.fullmatch(r"computing h on a grid \d+%", shown), shown
+    expect(status).to_have_text(f"up to date (generation {generation})")

@@ -227,3 +227,36 @@ def test_printed_rhs_after_28_violates_24(kin, rhs_kind, holds):
     X = np.array([x[0] - 1.0, 0.0, x[2], x[3]])
     residual = abs(one_form(kin, x, 1) @ X - dh @ X / dh[1])
     assert (residual < 1e-6) if holds else (residual > 0.1)  # printed: 0.26
+
+
+def test_evaluation_in_batches_is_the_cold_evaluation_member_by_member(kin):
+    """Batches of 7 (each a cold Newton solve, reported after it) give h, dh and the failures
+    of one batch of all: each member's characteristic is its own solve; a batch only shares
+    the iterations (to Newton's tolerance)."""
+    x = points(30, seed=3, spread=1.5)
+    whole = UnicycleCharacteristics(kin, a=1.0, on_undefined="nan").evaluate(x)
+    seen = []
+    batched = UnicycleCharacteristics(kin, a=1.0, on_undefined="nan").evaluate_batches(
+        x, 7, lambda done, total: seen.append((done, total))
+    )
+    assert seen == [(k, 5) for k in range(1, 6)]
+    assert np.array_equal(whole[2], batched[2])
+    ok = ~whole[2]
+    assert ok.sum() >= 10 and (~ok).sum() >= 5  # (both kinds of members)
+    assert np.max(np.abs(whole[0][ok] - batched[0][ok])) < 1e-10
+    assert np.max(np.abs(whole[1][ok] - batched[1][ok])) < 1e-8
+    assert np.all(np.isnan(batched[0][~ok]))
+
+
+def test_what_the_batch_callback_raises_stops_the_evaluation(hmap):
+    """A caller's cancellation: the error raised after the second batch ends the evaluation."""
+    calls = []
+
+    def stop(done, total):
+        calls.append(done)
+        if done == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        hmap.evaluate_batches(points(20, seed=4), 5, stop)
+    assert calls == [1, 2]

@@ -167,3 +167,22 @@ def test_parameter_sensitivity_matches_closed_form_derivative():
         Manipulator1(), E2Optimal, {"a": 0.0, "b": 0.5}, REGION1, span=0.5, samples=3
     )["sweeps"]["b"]["functional"]
     assert swept_b[0] is None and swept_b[1] is not None
+
+
+def test_parameter_sensitivity_reports_each_evaluation():
+    """1 + 2 (2 + samples) evaluations of E2 for (a, b): each reported, in order, the last at
+    the total; what the callback raises stops the sweep."""
+    seen = []
+    parameter_sensitivity(
+        Manipulator1(), E2Optimal, {"a": 0.0, "b": 1.0}, REGION1, span=0.5, samples=3,
+        on_evaluation=lambda done, total: seen.append((done, total)),
+    )  # fmt: skip
+    assert seen == [(k, 11) for k in range(1, 12)]
+
+    def stop(done, total):
+        if done == 4:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        parameter_sensitivity(Manipulator1(), E2Optimal, {"a": 0.0, "b": 1.0}, REGION1,
+                              samples=3, on_evaluation=stop)  # fmt: skip

@@ -2,7 +2,9 @@
 
 The page creates its session from the state in its URL (``POST /api/sessions``), changes it
 (``POST /api/sessions/{id}/state``), follows it (``GET /api/sessions/{id}/events``, server-sent
-events) and shows its 3D scene, whose websocket goes through
+events), cancels a result's E1/E2 and computes them again
+(``POST /api/sessions/{id}/functionals/cancel``, ``POST /api/sessions/{id}/functionals``) and
+shows its 3D scene, whose websocket goes through
 ``/api/sessions/{id}/scene`` to the session's own viser server on a loopback port. The id is a
 random token: only the tab that created the session knows it.
 """
@@ -58,8 +60,8 @@ class SessionCreate(BaseModel):
 #: What a client does next with a new session (OpenAPI links: the id it answers is the path's).
 _SESSION_LINKS = {
     name: {"operationId": name, "parameters": {"session_id": "$response.body#/id"}}
-    for name in ("get_session", "post_state", "session_events", "export_json", "export_csv",
-                 "delete_session")
+    for name in ("get_session", "post_state", "session_events", "cancel_functionals",
+                 "compute_functionals", "export_json", "export_csv", "delete_session")
 }  # fmt: skip
 
 
@@ -122,6 +124,60 @@ async def post_state(session_id: str, request: Request, store: Store) -> JSONRes
         session.dashboard.refuse(exc)
     generation, state = session.dashboard.update(patch, source="page")
     return JSONResponse({"generation": generation, "state": state.as_dict()})
+
+
+class SecondPhaseRequest(BaseModel):
+    """Which result's second phase (h on a grid when it is expensive, E1, E2 and their
+    sensitivity) a request is about: the generation on screen, never a newer one by accident."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    generation: int = Field(strict=True, ge=1, description="the generation of the result shown")
+
+
+#: A second phase that is not in the state a request needs.
+_SECOND_PHASE_CONFLICT: dict[int | str, dict] = {
+    409: {"description": "that generation's second phase is not running (cancel) or was not "
+          "cancelled (compute), or a newer generation is current"},
+}  # fmt: skip
+
+
+@router.post(
+    "/api/sessions/{session_id}/functionals/cancel",
+    status_code=202,
+    operation_id="cancel_functionals",
+    responses={**_SECOND_PHASE_CONFLICT, 404: {"description": "no such session"}},
+)
+async def cancel_functionals(
+    session_id: str, body: SecondPhaseRequest, store: Store
+) -> JSONResponse:
+    """Stop computing E1, E2, their sensitivity (and h on a grid) of the result on screen: it
+    stays, and a ``functionals`` event with ``cancelled`` says what was not computed."""
+    dashboard = store.get(session_id).dashboard
+    if not dashboard.cancel_second_phase(body.generation):
+        return JSONResponse(status_code=409, content={"detail": (
+            f"nothing to cancel: E1, E2 of generation {body.generation} are not being computed "
+            f"(the session is at generation {dashboard.generation})")})  # fmt: skip
+    return JSONResponse(status_code=202, content={"generation": body.generation})
+
+
+@router.post(
+    "/api/sessions/{session_id}/functionals",
+    status_code=202,
+    operation_id="compute_functionals",
+    responses={**_SECOND_PHASE_CONFLICT, 404: {"description": "no such session"}},
+)
+async def compute_functionals(
+    session_id: str, body: SecondPhaseRequest, store: Store
+) -> JSONResponse:
+    """Compute again the cancelled E1, E2, their sensitivity (and h on a grid) of the result on
+    screen: ``progress`` events, then a ``functionals`` event."""
+    dashboard = store.get(session_id).dashboard
+    if not dashboard.compute_second_phase(body.generation):
+        return JSONResponse(status_code=409, content={"detail": (
+            f"E1, E2 of generation {body.generation} were not cancelled, or it is not the "
+            f"result shown (the session is at generation {dashboard.generation})")})  # fmt: skip
+    return JSONResponse(status_code=202, content={"generation": body.generation})
 
 
 class CSVResponse(PlainTextResponse):

@@ -1,0 +1,162 @@
+"""A result's second phase, after its runs are on screen: h on a grid when each value of h solves
+a problem (the unicycle's characteristics, eqs. (28), (29)), then E1 (13), E2 (18) and their
+sensitivity. It runs in steps of about the same cost (a batch of the grid's points, one value of
+a functional), after each of which it reports its progress and may be cancelled.
+
+A cancelled phase keeps what it finished: h on its grid when the grid was done
+(:attr:`SecondPhase.result`); E1, E2 and their sensitivity are then not computed, and the figures
+of :func:`cancelled_figures` say so instead of showing stale values.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Callable
+from dataclasses import replace
+
+from jik.app.dashboard.analysis import (
+    augmenting_grid,
+    error_functionals,
+    grid_batches,
+    sensitivity,
+    sensitivity_evaluations,
+)
+from jik.app.dashboard.figures import figure_specs
+from jik.app.dashboard.map_figures import augmenting_title
+from jik.app.dashboard.messages import digest, with_figures
+from jik.app.dashboard.plotting import figure_json
+from jik.app.dashboard.runs import Cancelled, DashboardResult
+
+#: What the page says is being computed, step by step.
+GRID = "h on a grid"
+FUNCTIONALS = "E1/E2 and their sensitivity"
+
+
+class SecondPhase:
+    """The second phase of ``result``: run it with :meth:`run`.
+
+    Parameters
+    ----------
+    kin, amap : the state's kinematics and augmenting map h
+    result : DashboardResult
+        Its runs; without h on a grid when ``deferred``.
+    deferred : bool
+        h on a grid is computed here (an expensive map).
+    cached : tuple or None
+        E1/E2 and their sensitivity when already known for this state: not computed again.
+    grid_before : dict or None
+        The grid on screen, whose box the new one keeps while it fits.
+    progress : callable
+        ``progress(fraction, what)`` after each step: the fraction of the whole phase done, and
+        :data:`GRID` or :data:`FUNCTIONALS`.
+    cancelled : callable
+        Polled after each step (and before every map the sensitivity builds); True stops the
+        phase with :class:`Cancelled`.
+    """
+
+    def __init__(
+        self,
+        kin,
+        amap,
+        result: DashboardResult,
+        *,
+        deferred: bool,
+        cached: tuple | None,
+        grid_before: dict | None,
+        progress: Callable[[float, str], None],
+        cancelled: Callable[[], bool],
+    ) -> None:
+        self.kin, self.result, self.deferred, self.cached = kin, result, deferred, cached
+        self.grid_before = grid_before
+        self._progress, self._cancelled = progress, cancelled
+        grid = grid_batches(result.runs, amap) if deferred else 0
+        rest = 0 if cached else 2 + sensitivity_evaluations(result.state, amap)
+        self.steps = {GRID: grid, FUNCTIONALS: rest}
+        self.what = GRID if grid else FUNCTIONALS
+        self.fraction = 0.0
+
+    @property
+    def grid_done(self) -> bool:
+        """Whether h is on its grid (computed here, or before)."""
+        return self.result.augmenting is not None
+
+    def _step(self, what: str, before: int) -> Callable[[int, int], None]:
+        """The progress callback of a stage that starts after ``before`` steps: ``(done, _)``
+        of its own steps. It reports the fraction of the whole phase and raises
+        :class:`Cancelled` when the phase is cancelled."""
+        whole = max(1, sum(self.steps.values()))
+
+        def step(done: int, _total: int) -> None:
+            self.what = what
+            self.fraction = min(1.0, (before + done) / whole)
+            self._progress(self.fraction, what)
+            if self._cancelled():
+                raise Cancelled
+
+        return step
+
+    def run(self) -> tuple[dict | None, dict]:
+        """E1/E2 and their sensitivity (with h on its grid first, when deferred); raises
+        :class:`Cancelled` when cancelled, keeping in :attr:`result` the grid if it was done."""
+        if self._cancelled():
+            raise Cancelled
+        if self.deferred:
+            grid = augmenting_grid(
+                self.kin, self.result.state, self.result.runs, before=self.grid_before,
+                progress=self._step(GRID, 0),
+            )  # fmt: skip
+            self.result = replace(self.result, augmenting=grid)
+        if self.cached:
+            return self.cached
+        grid = self.steps[GRID]
+        one = self._step(FUNCTIONALS, grid)
+        done = itertools.count(1)
+        functionals = error_functionals(self.result, on_step=lambda: one(next(done), 2))
+        sens = sensitivity(
+            self.result, functionals, self._cancelled, progress=self._step(FUNCTIONALS, grid + 2)
+        )
+        return functionals, sens
+
+
+def finished_message(
+    phase: SecondPhase, generation: int, functionals: dict | None, sens: dict | None
+) -> str:
+    """The ``functionals`` event of a phase that finished: E1/E2, their sensitivity and the
+    panels they change. Known functionals went out with the result: the event then only
+    carries the h panel's title (a reused panel can lack it, and a page that connects now gets
+    this event with the latest result)."""
+    message: dict = {"type": "functionals", "generation": generation,
+                     "functionals": functionals, "sensitivity": sens}  # fmt: skip
+    panels = {"sensitivity"} if not phase.cached or phase.deferred else set()
+    if phase.deferred:  # the h panel was a placeholder: the whole figure
+        panels.add("augmenting")
+    elif functionals is not None:  # h is on screen: only its title changes (no redraw)
+        message["titles"] = {"augmenting": augmenting_title(phase.result, functionals)}
+    specs = figure_specs(phase.result, functionals, panels, sensitivity=sens)
+    texts = {k: figure_json(f) for k, f in specs.items()}
+    message["digests"] = {k: digest(t) for k, t in texts.items()}
+    return with_figures(message, texts)
+
+
+def cancelled_message(phase: SecondPhase, generation: int) -> str:
+    """The ``functionals`` event of a cancelled phase: no E1, E2; the figures of the panels it
+    would have drawn, each saying what was cancelled (never a value of another state), the h
+    panel's new title when its figure stays (h on screen, E1, E2 in its title not computed),
+    and ``cancelled``: what was being computed, how far, and those panels."""
+    note = f"cancelled at {round(100 * phase.fraction)}% (while computing {phase.what})"
+    panels = set() if phase.cached else {"sensitivity"}
+    if phase.deferred:  # (the h panel was a placeholder: the whole figure, with h if done)
+        panels.add("augmenting")
+    specs = figure_specs(phase.result, None, panels, cancelled=note)
+    titles = {}
+    if not phase.deferred and not phase.cached:
+        h = figure_specs(phase.result, None, {"augmenting"}, cancelled=note)["augmenting"]
+        titles["augmenting"] = h["layout"]["title"]["text"]
+    texts = {k: figure_json(f) for k, f in specs.items()}
+    message = {
+        "type": "functionals", "generation": generation, "functionals": None,
+        "sensitivity": None, "titles": titles, "digests": {k: digest(t) for k, t in texts.items()},
+        "cancelled": {"what": phase.what, "fraction": phase.fraction,
+                      "panels": sorted(set(texts) | set(titles))},
+    }  # fmt: skip
+    return with_figures(message, texts)
