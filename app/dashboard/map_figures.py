@@ -94,7 +94,9 @@ def augmenting_title(
     title = f"Augmenting map h: {result.state.augmentation}"
     grid = result.augmenting
     if grid is None:
-        return title + (" (h on a grid: cancelled)" if cancelled else " (computing h on a grid…)")
+        # (on a line of its own: the title fits a half-width panel at 1280 px)
+        note = "h on a grid: cancelled" if cancelled else "computing h on a grid…"
+        return f"{title}<br><sup>{note}</sup>"
     i, j = grid["axes"]
     x0 = result.state.x0
     # (a line now: the title keeps its height)

@@ -90,7 +90,7 @@ def test_cancelled_during_the_grid_nothing_is_shown_as_computed():
     assert message["cancelled"]["panels"] == ["augmenting", "sensitivity"]
     percent = round(100 * phase.fraction)
     h = message["figures"]["augmenting"]["layout"]
-    assert h["title"]["text"].endswith("(h on a grid: cancelled)")
+    assert h["title"]["text"].endswith("<br><sup>h on a grid: cancelled</sup>")
     note = f"not computed: cancelled at {percent}% (while computing h on a grid)"
     assert h["annotations"][0]["text"] == note
     e = message["figures"]["sensitivity"]["layout"]
