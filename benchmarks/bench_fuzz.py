@@ -58,8 +58,8 @@ def run_fuzz(
     exclude_checks: str = "",
 ) -> FuzzRun:
     """schemathesis with ``max_examples`` per operation and phase against a fresh server."""
-    # A request waits at most JIK_TIMEOUT for a worker and as long again to compute: within
-    # schemathesis's request timeout (its "response time" check).
+    # A request waits at most JIK_TIMEOUT for a worker and as long again to compute, an export
+    # at most a minute for its session's result: all within schemathesis's request timeout.
     with jik_serve(JIK_WORKERS="2", JIK_TIMEOUT="20", JIK_SESSION_IDLE_SECONDS="30") as server:
         scratch = tempfile.mkdtemp()  # (schemathesis writes its cache there)
         config = os.path.join(scratch, "schemathesis.toml")
@@ -72,7 +72,7 @@ def run_fuzz(
              "--checks", "all", "--phases", phases, "--max-examples", str(max_examples),
              *(["--exclude-checks", exclude_checks] if exclude_checks else []),
              "--seed", str(seed), "--workers", "1", "--suppress-health-check", "all",
-             "--continue-on-failure", "--request-timeout", "60", "--no-color"],
+             "--continue-on-failure", "--request-timeout", "120", "--no-color"],
             env=dict(os.environ, SCHEMATHESIS_HOOKS="jik.benchmarks.fuzz_hooks",
                      JIK_FUZZ_SERVER=server.url,
                      PYTHONPATH=os.pathsep.join(filter(None, (_PACKAGE_ROOT,
