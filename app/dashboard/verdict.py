@@ -78,18 +78,18 @@ def _drift_sentence(algorithm: str, run: AlgorithmRun, unit: str) -> Sentence:
 def _extended_why(result: DashboardResult, run: AlgorithmRun) -> list[Sentence]:
     state = result.state
     dh = h_change(run.h)
-    if dh is None:
+    if dh is None or (not run.success and dh == 0):  # (a run stopped before it moved: no why)
         return []
     closed = state.task == "path" and len(run.drift) > 0
     kept = dh < H_CONSERVED
     out = []
     if kept:
-        tail = (" so each task point has one configuration on that level set, and the closed "
+        tail = (", so each task point has one configuration on that level set, and the closed "
                 "task path gave a closed joint path." if closed and repeatable(run)
                 else ".")  # fmt: skip
         out.append(Sentence(
             f"Why: J^E# adds the equation h(x) = h(x0) (eq. (12)); h changed by only {g(dh)} "
-            f"along its run,{tail}", "extended", "why"))  # fmt: skip
+            f"along its run{tail}", "extended", "why"))  # fmt: skip
     else:
         lost = (" A closed task path gives a closed joint path only while h stays at h(x0): "
                 "here it did not, so the joints did not come back." if closed and not

@@ -3,6 +3,7 @@ generation fails: NaN never reaches JSON, the error names the result still on sc
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 
@@ -37,6 +38,12 @@ def test_unicycle_from_b_reports_the_engines_message():
     assert not data["extended"]["success"]
     assert "undefined" in data["extended"]["message"]
     assert "undefined" in texts(result) and "stopped" in texts(result)
+    # A run stopped where it started has no "why" (it said "h changed by only 0 along its
+    # run,."): its h, constant, says nothing about conservation.
+    run = result.runs["extended"]
+    still = dataclasses.replace(run, h=np.zeros_like(run.error))
+    text = texts(dataclasses.replace(result, runs={**result.runs, "extended": still}))
+    assert "stopped" in text and "Why: J^E#" not in text and ",." not in text
 
 
 def test_verdict_says_when_the_extended_jacobian_is_not_repeatable():
