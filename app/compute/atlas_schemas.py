@@ -76,7 +76,7 @@ class AtlasRequest(BaseModel):
     )
     mode: Mode | None = Field(None, description="'continuous' or 'discrete'; default: robot's")
     tolerance: Tolerance = Field(1e-10, description="each leg stops at ||k(x) - target|| < this")
-    leg_ends: bool = Field(False, description="include every leg's end in the result")
+    leg_ends: bool = Field(False, strict=True, description="include every leg's end in the result")
 
 
 def _atlas_fields(spec, augmentation) -> dict:
@@ -97,7 +97,8 @@ def _atlas_fields(spec, augmentation) -> dict:
 
 
 #: ``POST /atlas``'s body: an :class:`AtlasRequest` with its robot's lengths and maps.
-AtlasBody = per_robot(AtlasRequest, _atlas_fields)
+#: The catalogue's robots only: an atlas of a user robot is `jik atlas --robot FILE`'s.
+AtlasBody = per_robot(AtlasRequest, _atlas_fields, user_robots=False)
 
 
 class AtlasResult(BaseModel):

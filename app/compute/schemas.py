@@ -439,12 +439,14 @@ def _robot_name(body: Any) -> str | None:
     return name if isinstance(name, str) else None
 
 
-def per_robot(base: type[BaseModel], fields: Any) -> Any:
+def per_robot(base: type[BaseModel], fields: Any, user_robots: bool = True) -> Any:
     """``base`` made exact for each robot of the catalogue: one model per robot, chosen by
     ``robot.name``, whose ``robot`` and ``augmentation`` are that robot's and whose vectors have
-    its lengths (``fields(spec)``: the fields that differ from ``base``'s). Their union is what
-    the route takes and what its OpenAPI document shows; each member is still a ``base``."""
+    its lengths (``fields(spec)``: the fields that differ from ``base``'s), and one per kind of
+    user robot unless not ``user_robots``. Their union is what the route takes and what its
+    OpenAPI document shows; each member is still a ``base``."""
     members = []
+    names = ROBOT_NAMES if user_robots else list(ROBOTS)
     for name, spec in ROBOTS.items():
         augmentations = list(dict.fromkeys(a.name for a in spec.augmentations))
         model = create_model(
@@ -456,7 +458,7 @@ def per_robot(base: type[BaseModel], fields: Any) -> Any:
         )
         globals()[model.__name__] = model
         members.append(Annotated[model, Tag(name)])
-    for kind, robot_model in USER_ROBOT_MODELS.items():
+    for kind, robot_model in USER_ROBOT_MODELS.items() if user_robots else ():
         # p and r follow from the definition: the vectors keep the base's 1 to 16 components,
         # checked against the built robot (a 422 naming the field and the robot's p, r).
         model = create_model(
@@ -478,7 +480,8 @@ def per_robot(base: type[BaseModel], fields: Any) -> Any:
         Discriminator(
             _robot_name,
             custom_error_type="unknown_robot",
-            custom_error_message=f"give a robot whose name is one of {ROBOT_NAMES}",
+            custom_error_message=f"give a robot whose name is one of {names}",
+            custom_error_context={"names": names},
         ),
     ]
 
