@@ -14,6 +14,7 @@ than ``package://``).
 from __future__ import annotations
 
 import io
+import logging
 import math
 import re
 from collections.abc import Mapping, Sequence
@@ -38,6 +39,10 @@ def _yourdfpy():
         raise InvalidInputError(
             "URDF robots need the yourdfpy package: pip install 'jik[urdf]'", "urdf"
         ) from None
+    # yourdfpy logs each text it cannot parse as an ERROR ("Using different parsing approach."),
+    # which a server printed for every bad URDF a user sent: parse_urdf reports it, in words
+    # naming the field, to whoever sent it.
+    logging.getLogger("yourdfpy").setLevel(logging.CRITICAL)
     return yourdfpy
 
 

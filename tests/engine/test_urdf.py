@@ -149,3 +149,14 @@ def test_bad_definitions_name_the_field(kwargs, field, text):
         UrdfChain(**{"urdf": TEXT, **kwargs})
     assert err.value.field == field
     assert text in str(err.value)
+
+
+def test_a_bad_urdf_is_reported_once_and_not_logged_as_an_error(caplog, capfd):
+    """The refusal names the field; yourdfpy's own ERROR lines ("Using different parsing
+    approach.") no longer reach a server's log for each bad URDF a user sends."""
+    from jik.engine.urdf import parse_urdf
+
+    with pytest.raises(InvalidInputError, match="urdf: not a valid URDF"):
+        parse_urdf("0")
+    assert not [r for r in caplog.records if r.name.startswith("yourdfpy")]
+    assert "parsing approach" not in capfd.readouterr().err
