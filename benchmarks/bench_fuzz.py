@@ -97,8 +97,9 @@ def _report(title: str, run: FuzzRun) -> None:
     print(f"  cases {run.cases}, failures {run.failures}, {run.seconds:.0f} s "
           f"({1000 * run.seconds / max(run.cases, 1):.1f} ms per case), server tracebacks: "
           f"{run.server_log.count('Traceback')}")  # fmt: skip
-    if not run.clean:
-        print(run.output[-6000:])
+    if not run.clean:  # (schemathesis's failures, each with its curl command)
+        failures = run.output.split("FAILURES")[-1].split("SUMMARY")[0]
+        print(failures[-12000:] if "FAILURES" in run.output else run.output[-6000:])
 
 
 def main(quick: bool = False) -> None:
