@@ -245,8 +245,6 @@ def updated_state(state: DashboardState, patch: Mapping[str, object]) -> Dashboa
         An unknown field, or a value the models, the registry or the engine refuse; its
         ``field`` names the field (a dotted path).
     """
-    patch = expand(state, patch)
-    data = state.as_dict()
     robot = patch.get("robot", state.robot)
     definition = patch.get("robot_definition", state.robot_definition)
     if definition is not None and not isinstance(definition, Mapping):
@@ -259,7 +257,11 @@ def updated_state(state: DashboardState, patch: Mapping[str, object]) -> Dashboa
                                     "robot")  # fmt: skip
         if robot != state.robot and "robot_definition" not in patch:
             definition = None  # (another robot chosen: the definition was the other's)
-        data = default_state(robot, definition).as_dict()
+        state = default_state(robot, definition)
+    # (control keys after a change of robot are the new robot's: {"robot": "unicycle",
+    # "x0.0": 0} changes the unicycle's x0, not the old robot's)
+    patch = expand(state, patch)
+    data = state.as_dict()
     if "augmentation" in patch and patch["augmentation"] != data["augmentation"]:
         spec = (user_robot(data["robot_definition"]).spec if data.get("robot_definition")
                 else robot_spec(robot))  # fmt: skip

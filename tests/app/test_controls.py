@@ -154,3 +154,12 @@ def test_a_dashboard_change_is_refused_as_a_rest_request_is(rest, dashboard, fie
         updated_state(default_state("manipulator2"), dashboard)
     problem = api.value.errors()[0]["msg"]
     assert str(ours.value).endswith(problem) and field in ours.value.field
+
+
+def test_control_keys_beside_a_change_of_robot_are_the_new_robots():
+    """{"robot": "unicycle", "x0.0": 0}: the unicycle's x0 with its first component 0 (the key
+    was expanded against the old robot's three-component x0 and refused; schemathesis, via a
+    session's link state)."""
+    state = updated_state(default_state("manipulator2"), {"x0.0": 0.0, "robot": "unicycle"})
+    assert state.robot == "unicycle"
+    assert state.x0 == (0.0, *default_state("unicycle").x0[1:])
