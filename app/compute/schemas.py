@@ -481,7 +481,7 @@ def per_robot(base: type[BaseModel], fields: Any, user_robots: bool = True) -> A
             _robot_name,
             custom_error_type="unknown_robot",
             custom_error_message=f"give a robot whose name is one of {names}",
-            custom_error_context={"names": names},
+            custom_error_context={"names": str(names)},
         ),
     ]
 
