@@ -27,6 +27,7 @@ import numpy as np
 from jik.app.compute.atlas_schemas import AtlasJobResponse, AtlasRequest
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.requests import build_augmentation, build_robot, nullable
+from jik.app.compute.settings import Settings
 from jik.engine.atlas import AtlasPlan, plan_atlas
 from jik.engine.atlas_backends import ProcessPool
 from jik.engine.atlas_run import AtlasResult, run_atlas
@@ -62,7 +63,7 @@ class AtlasLimits:
     #: worker processes of a running atlas
     workers: int = 2
     #: address space of each (MB; 0: no limit): the compute workers' (``JIK_WORKER_MEMORY_MB``)
-    worker_memory: int = 1024
+    worker_memory: int = Settings.worker_memory
 
 
 def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:

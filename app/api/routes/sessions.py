@@ -154,11 +154,10 @@ async def cancel_functionals(
     """Stop computing E1, E2, their sensitivity (and h on a grid) of the result on screen: it
     stays, and a ``functionals`` event with ``cancelled`` says what was not computed."""
     dashboard = store.get(session_id).dashboard
-    if not dashboard.cancel_second_phase(body.generation):
-        return JSONResponse(status_code=409, content={"detail": (
-            f"nothing to cancel: E1, E2 of generation {body.generation} are not being computed "
-            f"(the session is at generation {dashboard.generation})")})  # fmt: skip
-    return JSONResponse(status_code=202, content={"generation": body.generation})
+    return _second_phase_answer(
+        dashboard.cancel_second_phase(body.generation), dashboard, body.generation,
+        f"nothing to cancel: E1, E2 of generation {body.generation} are not being computed",
+    )  # fmt: skip
 
 
 @router.post(
@@ -173,11 +172,19 @@ async def compute_functionals(
     """Compute again the cancelled E1, E2, their sensitivity (and h on a grid) of the result on
     screen: ``progress`` events, then a ``functionals`` event."""
     dashboard = store.get(session_id).dashboard
-    if not dashboard.compute_second_phase(body.generation):
+    return _second_phase_answer(
+        dashboard.compute_second_phase(body.generation), dashboard, body.generation,
+        f"E1, E2 of generation {body.generation} were not cancelled, or it is not the result "
+        "shown",
+    )  # fmt: skip
+
+
+def _second_phase_answer(done: bool, dashboard, generation: int, refusal: str) -> JSONResponse:
+    """202 with the generation when the second phase did as asked; else 409 saying why."""
+    if not done:
         return JSONResponse(status_code=409, content={"detail": (
-            f"E1, E2 of generation {body.generation} were not cancelled, or it is not the "
-            f"result shown (the session is at generation {dashboard.generation})")})  # fmt: skip
-    return JSONResponse(status_code=202, content={"generation": body.generation})
+            f"{refusal} (the session is at generation {dashboard.generation})")})  # fmt: skip
+    return JSONResponse(status_code=202, content={"generation": generation})
 
 
 class CSVResponse(PlainTextResponse):
