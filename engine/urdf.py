@@ -5,10 +5,11 @@ forward kinematics and the Jacobian are computed here, batched over configuratio
 It is imported when a URDF robot is built, so the rest of the engine works without it
 (``pip install 'jik[urdf]'``).
 
-Safety: the text is bounded in size, a document type declaration (the door to XML entity
-expansion and external entities) is refused before parsing, meshes are never loaded, and a
-mesh file name must stay inside the robot's package (no absolute path, no '..', no URL other
-than ``package://``).
+Safety: the text is bounded in size, must be (or declare) UTF-8 or ASCII, and is parsed by lxml
+with defusedxml's settings (no DTD, no entity expansion, no network; a document type
+declaration, the door to entity expansion and external entities, is refused); meshes are never
+loaded, and a mesh file name must stay inside the robot's package (no absolute path, no '..', no
+URL other than ``package://``).
 """
 
 from __future__ import annotations
@@ -65,14 +66,52 @@ def check_mesh_filename(name: str, field: str = "urdf") -> str:
     return name
 
 
+#: Encodings a URDF may declare: its text reaches the parser as UTF-8 bytes, and any other
+#: declared encoding would make the parser read those bytes as something else (UTF-7 turns
+#: ``+ADw-!DOCTYPE`` into a document type declaration that no text check sees).
+ENCODINGS = ("utf-8", "utf8", "us-ascii", "ascii")
+_DECLARATION = re.compile(rb"""^<\?xml[^>]*?\bencoding\s*=\s*["']([^"']*)["']""")
+
+
+def _hardened_parse(data: bytes, field: str):
+    """The XML tree of ``data`` by lxml with defusedxml's semantics: no DTD (internal or
+    external), no entity expansion, no network; the declared encoding UTF-8 or ASCII."""
+    from lxml import etree  # (yourdfpy's dependency)
+
+    match = _DECLARATION.match(data.removeprefix(b"\xef\xbb\xbf").lstrip())
+    if match and match.group(1).decode("ascii", "replace").lower() not in ENCODINGS:
+        raise InvalidInputError(
+            f"{field}: the URDF declares encoding={match.group(1).decode('ascii', 'replace')!r}; "
+            "only UTF-8 (or ASCII) is accepted",
+            field,
+        )
+    parser = etree.XMLParser(
+        resolve_entities=False, no_network=True, load_dtd=False, dtd_validation=False,
+        huge_tree=False, remove_comments=True, remove_pis=True, remove_blank_text=True,
+    )  # fmt: skip
+    try:
+        tree = etree.fromstring(data, parser=parser).getroottree()
+    except etree.XMLSyntaxError as exc:
+        raise InvalidInputError(f"{field}: not a valid URDF (XML: {exc.msg})", field) from None
+    info = tree.docinfo
+    if info.doctype or info.internalDTD is not None or info.externalDTD is not None:
+        raise InvalidInputError(f"{field}: a URDF with a DOCTYPE (DTD) is refused", field)
+    if any(isinstance(e, etree._Entity) for e in tree.iter()):
+        raise InvalidInputError(f"{field}: a URDF with entity references is refused", field)
+    return tree.getroot()
+
+
 def parse_urdf(text, field: str = "urdf"):
     """Parse URDF text with yourdfpy (no meshes loaded); a ``yourdfpy.URDF``.
+
+    The text is parsed once with hardened settings (:func:`_hardened_parse`); yourdfpy reads the
+    tree serialised back from that parse, which holds no DTD, entity or processing instruction.
 
     Raises
     ------
     InvalidInputError
-        Not a string, over ``MAX_URDF_BYTES``, a DOCTYPE, not a URDF, or a mesh path that
-        escapes (:func:`check_mesh_filename`); the message names ``field``.
+        Not a string, over ``MAX_URDF_BYTES``, a declared encoding other than UTF-8, a DTD or
+        entity, not a URDF; the message names ``field``.
     """
     if not isinstance(text, str) or not text.strip():
         raise InvalidInputError(f"{field} must be the text of a URDF file", field)
@@ -83,10 +122,13 @@ def parse_urdf(text, field: str = "urdf"):
         )
     if re.search(rb"<!\s*(DOCTYPE|ENTITY)", data, re.IGNORECASE):
         raise InvalidInputError(f"{field}: a URDF with a DOCTYPE or ENTITY is refused", field)
+    from lxml import etree
+
+    clean = etree.tostring(_hardened_parse(data, field), encoding="utf-8")
     yourdfpy = _yourdfpy()
     try:
         model = yourdfpy.URDF.load(
-            io.BytesIO(data), build_scene_graph=False, load_meshes=False,
+            io.BytesIO(clean), build_scene_graph=False, load_meshes=False,
             build_collision_scene_graph=False, load_collision_meshes=False,
         )  # fmt: skip
     except Exception as exc:  # yourdfpy raises whatever its XML walk meets
