@@ -7,9 +7,9 @@ It is imported when a URDF robot is built, so the rest of the engine works witho
 
 Safety: the text is bounded in size, must be (or declare) UTF-8 or ASCII, and is parsed by lxml
 with defusedxml's settings (no DTD, no entity expansion, no network; a document type
-declaration, the door to entity expansion and external entities, is refused); meshes are never
-loaded, and a mesh file name must stay inside the robot's package (no absolute path, no '..', no
-URL other than ``package://``).
+declaration, the door to entity expansion and external entities, is refused). Meshes are never
+loaded, nor their paths resolved: a reference of any form is skipped with a note
+(:func:`mesh_note`). A joint naming a link the URDF does not define is refused.
 """
 
 from __future__ import annotations
@@ -20,7 +20,6 @@ import math
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from pathlib import PurePosixPath
 
 import numpy as np
 
@@ -47,23 +46,21 @@ def _yourdfpy():
     return yourdfpy
 
 
-def check_mesh_filename(name: str, field: str = "urdf") -> str:
-    """A mesh file name that stays inside the robot's package: relative or ``package://``."""
-    path = name[len("package://") :] if name.startswith("package://") else name
-    parts = PurePosixPath(path).parts
-    if (
-        not path
-        or "\\" in path
-        or re.match(r"^[A-Za-z][A-Za-z0-9+.-]*:", path)
-        or path.startswith("/")
-        or ".." in parts
-    ):
-        raise InvalidInputError(
-            f"{field}: mesh file {name!r} escapes the robot's folder; use a relative path or "
-            "package://name/relative/path without '..'",
-            field,
-        )
-    return name
+def mesh_note(model, field: str = "urdf") -> str:
+    """A note on the URDF's mesh references, which jik never reads (empty when there are none).
+
+    Meshes only draw a robot; its kinematics is the joints'. No path is resolved or opened,
+    so a reference of any form (relative, ``package://``, ``file:///``, a URL) is skipped.
+    """
+    names = sorted(
+        {str(v.geometry.mesh.filename) for link in model.robot.links
+         for v in (*link.visuals, *link.collisions)
+         if v.geometry is not None and v.geometry.mesh is not None}
+    )  # fmt: skip
+    if not names:
+        return ""
+    return (f"{field}: {len(names)} mesh file reference(s) skipped, never read (jik computes "
+            f"kinematics only), e.g. {names[0][:120]!r}")  # fmt: skip
 
 
 #: Encodings a URDF may declare: its text reaches the parser as UTF-8 bytes, and any other
@@ -135,10 +132,15 @@ def parse_urdf(text, field: str = "urdf"):
         raise InvalidInputError(f"{field}: not a valid URDF ({exc})", field) from None
     if model.robot is None or not model.robot.links:
         raise InvalidInputError(f"{field}: the URDF has no links", field)
-    for link in model.robot.links:
-        for geometry in [v.geometry for v in (*link.visuals, *link.collisions)]:
-            if geometry is not None and geometry.mesh is not None:
-                check_mesh_filename(str(geometry.mesh.filename), field)
+    links = {link.name for link in model.robot.links}
+    for joint in model.robot.joints:
+        for role, link in (("parent", joint.parent), ("child", joint.child)):
+            if link not in links:
+                raise InvalidInputError(
+                    f"{field}: joint {joint.name!r} names {role} link {link!r}, which the URDF "
+                    "does not define",
+                    field,
+                )
     return model
 
 
@@ -276,7 +278,7 @@ class UrdfChain(Kinematics):
                 j.name,
                 {"fixed": "fixed", "prismatic": "prismatic"}.get(j.type, "revolute"),
                 np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=float),
-                _unit(j.axis, j.name),
+                np.array([1.0, 0.0, 0.0]) if j.type == "fixed" else _unit(j.axis, j.name),
                 active.index(j.name) if j.name in active else -1,
                 float(locked.get(j.name, 0.0)),
             )
@@ -285,6 +287,8 @@ class UrdfChain(Kinematics):
         self.limits = tuple(_limits(model.joint_map[name]) for name in active)
         self.locked = {j.name: j.value for j in self.chain if j.type != "fixed" and j.index < 0}
         self.urdf = urdf
+        #: What was skipped while reading the URDF (mesh references), for the run's result.
+        self.notes = tuple(n for n in (mesh_note(model),) if n)
 
     @property
     def parameters(self) -> dict[str, object]:
