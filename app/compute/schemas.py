@@ -372,10 +372,16 @@ class RobotUsed(BaseModel):
     definition: dict[str, Any] | None = Field(
         default=None,
         exclude_if=_absent,
-        description="a user robot's definition as given (absent for a catalogue robot)",
+        description="a user robot's definition as given, a URDF's text replaced by its size and "
+        "SHA-256 (absent for a catalogue robot)",
     )
     p: int | None = Field(default=None, exclude_if=_absent, description="a user robot's p")
     r: int | None = Field(default=None, exclude_if=_absent, description="a user robot's r")
+    notes: list[str] | None = Field(
+        default=None,
+        exclude_if=_absent,
+        description="what was skipped while building the robot (a URDF's mesh references)",
+    )
 
 
 class Trajectory(BaseModel):

@@ -14,6 +14,7 @@ under their time and memory limits.
 from __future__ import annotations
 
 import functools
+import hashlib
 import json
 from collections.abc import Sequence
 from typing import Any
@@ -76,13 +77,24 @@ def user_robot(req_robot: Any, augmentation: Any = None) -> tuple[Robot, S.Robot
     except InvalidInputError as exc:
         raise RequestError(request_field(exc.field, list(definition)), _text(exc)) from None
     spec = robot.spec
-    used = S.RobotUsed(name=spec.name, parameters={}, definition=req_robot.model_dump(
-        exclude_none=True), p=spec.p, r=spec.r)  # fmt: skip
+    used = S.RobotUsed(name=spec.name, parameters={}, definition=echo(req_robot.model_dump(
+        exclude_none=True)), p=spec.p, r=spec.r,
+        notes=list(getattr(robot.kinematics, "notes", ())) or None)  # fmt: skip
     aug_used = None
     if given is not None:
         values = {k: float(v) for k, v in (given.get("parameters") or {}).items()}
         aug_used = S.AugmentationUsed(name=given["name"], parameters=values, definition=given)
     return robot, used, aug_used
+
+
+def echo(definition: dict) -> dict:
+    """A definition as a response repeats it: a URDF's text is left out (it can be 100 kB, and
+    a response is no place to mirror what a client sent), named by its size and SHA-256."""
+    if not isinstance(definition.get("urdf"), str):
+        return definition
+    data = definition["urdf"].encode("utf-8")
+    rest = {k: v for k, v in definition.items() if k != "urdf"}
+    return {**rest, "urdf_bytes": len(data), "urdf_sha256": hashlib.sha256(data).hexdigest()}
 
 
 def _text(exc: InvalidInputError) -> str:

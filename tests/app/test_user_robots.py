@@ -125,6 +125,22 @@ def test_urdf_arm_solve_and_repeatability(api):
     assert rep["success"] and max(rep["drift"]) < 1e-9
 
 
+def test_a_urdf_is_not_echoed_and_skipped_meshes_are_noted(api):
+    pytest.importorskip("yourdfpy")
+    text = ARM4.read_text().replace('<link name="tool"/>', '<link name="tool"><visual><geometry>'
+                                    '<mesh filename="file:///etc/passwd"/></geometry></visual>'
+                                    "</link>")  # fmt: skip
+    robot = {"name": "urdf", "urdf": text, "end_link": "tool"}
+    run = {"robot": robot, "algorithm": "pseudoinverse", "x0": [0.3, 0.5, 0.8, 0.6],
+           "target": [0.2, 0.1, 0.8]}  # fmt: skip
+    response = api.post("/solve", json=run)
+    body = _ok(response)
+    assert "<robot" not in response.text and "link name" not in response.text
+    assert body["robot"]["definition"]["urdf_bytes"] == len(text.encode())
+    assert body["robot"]["definition"]["end_link"] == "tool"
+    assert "1 mesh file reference(s) skipped, never read" in body["robot"]["notes"][0]
+
+
 def test_vector_lengths_are_checked_against_the_built_robot(api):
     body = {"robot": ARM, "algorithm": "pseudoinverse", "x0": [0.3, 1.0], "target": [1.0, 1.3]}
     assert messages(api.post("/solve", json=body)) == [
