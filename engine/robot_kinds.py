@@ -50,10 +50,16 @@ URDF = (
     DefinitionField("end_link", "string", True, "the link whose origin is the end point", "tool"),
     DefinitionField("active_joints", "names", False, "the joints that move, in order (default: "
                     "every movable joint from the base to end_link)"),
-    DefinitionField("task", "string", False, "coordinates of the end point: xyz or a subset "
-                    "such as xz (default xyz)", "xyz"),
+    DefinitionField("task", "string", False, "coordinates of the end link: x y z (position) "
+                    "and rx ry rz (rotation vector of R0^T R), pose for all six, or a subset "
+                    "such as xyz or 'x y z rz' (default xyz)", "xyz"),
     DefinitionField("locked", "mapping", False, "values of the chain's other movable joints "
                     "(default 0)"),
+    DefinitionField("home", "numbers", False, "a reference configuration, one value per "
+                    "active joint (default: zero, clipped into the joint limits)"),
+    DefinitionField("reference", "numbers", False, "R0, the orientation with rotation "
+                    "coordinates 0: a rotation vector (3 numbers), a quaternion x y z w (4) or "
+                    "a matrix (3 rows of 3); default: the end link's orientation at home"),
 )  # fmt: skip
 
 COMMON = (

@@ -121,8 +121,10 @@ def _kinematics(kind: str, d: Mapping, base_dir: Path | None) -> Kinematics:
         text,
         _get(d, "end_link", str, "the name of the end link"),
         d.get("active_joints"),
-        _get(d, "task", str, "'xyz' or a subset such as 'xz'", "xyz"),
+        d.get("task", "xyz"),
         _get(d, "locked", dict, "a mapping of joint names to values", {}),
+        d.get("home"),
+        d.get("reference"),
     )
 
 
@@ -167,12 +169,15 @@ def _x_range(kin: Kinematics, d: Mapping) -> tuple[tuple[float, float], ...]:
 
 
 def _defaults(kin: Kinematics, d: Mapping, box) -> tuple:
-    """x0 (given, or 0.5 in each range), a target and a closed path reachable from it."""
+    """x0 (given, else a URDF arm's home if given, else 0.5 in each range), a target and a
+    closed path reachable from it."""
     lo, hi = np.array(box).T
     if "x0" in d:
         x0 = _points(d["x0"], kin.p, "x0")
         if x0.ndim != 1:
             raise InvalidInputError(f"x0 must be one configuration of {kin.p} numbers", "x0")
+    elif "home" in d:
+        x0 = np.array(kin.parameters["home"], dtype=float)
     else:
         x0 = np.clip(0.5, lo, hi)
     step = 0.15 * np.minimum(1.0, hi - lo)
@@ -333,7 +338,7 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
     task_names = {
         "planar_chain": ("x", "y", "phi")[: kin.r],
         "formula": tuple(f"y{i + 1}" for i in range(kin.r)),
-        "urdf": tuple(getattr(kin, "task", "")),
+        "urdf": tuple(getattr(kin, "task_names", ())),
     }[kind]
     spec = RobotSpec(
         name=kind, title=title, description=f"{title}: a {kind} robot defined by data",

@@ -1,23 +1,14 @@
-"""Serial arms from URDF: the chain from the base to an end link, its end position as the task.
+"""Serial arms from URDF: the chain from the base to an end link, its pose as the task.
 
-yourdfpy (a maintained URDF library; viser's URDF support builds on it) only parses the text;
-forward kinematics and the Jacobian are computed here, batched over configurations with numpy.
-It is imported when a URDF robot is built, so the rest of the engine works without it
-(``pip install 'jik[urdf]'``).
-
-Safety: the text is bounded in size, must be (or declare) UTF-8 or ASCII, and is parsed by lxml
-with defusedxml's settings (no DTD, no entity expansion, no network; a document type
-declaration, the door to entity expansion and external entities, is refused). Meshes are never
-loaded, nor their paths resolved: a reference of any form is skipped with a note
-(:func:`mesh_note`). A joint naming a link the URDF does not define is refused.
+The text is read by :mod:`jik.engine.urdf_parse` (yourdfpy, hardened XML, no meshes); forward
+kinematics and the Jacobian are computed here, batched over configurations with numpy
+(:mod:`jik.engine.serial_chain`), and the task's coordinates, positions and rotation vectors, by
+:mod:`jik.engine.pose_task`.
 """
 
 from __future__ import annotations
 
-import io
-import logging
 import math
-import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -25,123 +16,14 @@ import numpy as np
 
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.kinematics import Kinematics
-from jik.engine.validation import FloatArray, json_number
+from jik.engine.pose_task import PoseTask, parse_task, reference_rotation, task_text
+from jik.engine.serial_chain import ChainStep, CompiledChain
+from jik.engine.urdf_parse import MAX_URDF_BYTES, mesh_note, parse_urdf
+from jik.engine.validation import FloatArray, as_vector, json_number
 
-#: Largest URDF text accepted [bytes].
-MAX_URDF_BYTES = 1_000_000
+__all__ = ["MAX_URDF_BYTES", "ChainJoint", "UrdfChain", "mesh_note", "parse_urdf"]
+
 MOVABLE = ("revolute", "continuous", "prismatic")
-
-
-def _yourdfpy():
-    try:
-        import yourdfpy
-    except ImportError:  # the `urdf` extra is not installed
-        raise InvalidInputError(
-            "URDF robots need the yourdfpy package: pip install 'jik[urdf]'", "urdf"
-        ) from None
-    # yourdfpy logs each text it cannot parse as an ERROR ("Using different parsing approach."),
-    # which a server printed for every bad URDF a user sent: parse_urdf reports it, in words
-    # naming the field, to whoever sent it.
-    logging.getLogger("yourdfpy").setLevel(logging.CRITICAL)
-    return yourdfpy
-
-
-def mesh_note(model, field: str = "urdf") -> str:
-    """A note on the URDF's mesh references, which jik never reads (empty when there are none).
-
-    Meshes only draw a robot; its kinematics is the joints'. No path is resolved or opened,
-    so a reference of any form (relative, ``package://``, ``file:///``, a URL) is skipped.
-    """
-    names = sorted(
-        {str(v.geometry.mesh.filename) for link in model.robot.links
-         for v in (*link.visuals, *link.collisions)
-         if v.geometry is not None and v.geometry.mesh is not None}
-    )  # fmt: skip
-    if not names:
-        return ""
-    return (f"{field}: {len(names)} mesh file reference(s) skipped, never read (jik computes "
-            f"kinematics only), e.g. {names[0][:120]!r}")  # fmt: skip
-
-
-#: Encodings a URDF may declare: its text reaches the parser as UTF-8 bytes, and any other
-#: declared encoding would make the parser read those bytes as something else (UTF-7 turns
-#: ``+ADw-!DOCTYPE`` into a document type declaration that no text check sees).
-ENCODINGS = ("utf-8", "utf8", "us-ascii", "ascii")
-_DECLARATION = re.compile(rb"""^<\?xml[^>]*?\bencoding\s*=\s*["']([^"']*)["']""")
-
-
-def _hardened_parse(data: bytes, field: str):
-    """The XML tree of ``data`` by lxml with defusedxml's semantics: no DTD (internal or
-    external), no entity expansion, no network; the declared encoding UTF-8 or ASCII."""
-    from lxml import etree  # (yourdfpy's dependency)
-
-    match = _DECLARATION.match(data.removeprefix(b"\xef\xbb\xbf").lstrip())
-    if match and match.group(1).decode("ascii", "replace").lower() not in ENCODINGS:
-        raise InvalidInputError(
-            f"{field}: the URDF declares encoding={match.group(1).decode('ascii', 'replace')!r}; "
-            "only UTF-8 (or ASCII) is accepted",
-            field,
-        )
-    parser = etree.XMLParser(
-        resolve_entities=False, no_network=True, load_dtd=False, dtd_validation=False,
-        huge_tree=False, remove_comments=True, remove_pis=True, remove_blank_text=True,
-    )  # fmt: skip
-    try:
-        tree = etree.fromstring(data, parser=parser).getroottree()
-    except etree.XMLSyntaxError as exc:
-        raise InvalidInputError(f"{field}: not a valid URDF (XML: {exc.msg})", field) from None
-    info = tree.docinfo
-    if info.doctype or info.internalDTD is not None or info.externalDTD is not None:
-        raise InvalidInputError(f"{field}: a URDF with a DOCTYPE (DTD) is refused", field)
-    if any(isinstance(e, etree._Entity) for e in tree.iter()):
-        raise InvalidInputError(f"{field}: a URDF with entity references is refused", field)
-    return tree.getroot()
-
-
-def parse_urdf(text, field: str = "urdf"):
-    """Parse URDF text with yourdfpy (no meshes loaded); a ``yourdfpy.URDF``.
-
-    The text is parsed once with hardened settings (:func:`_hardened_parse`); yourdfpy reads the
-    tree serialised back from that parse, which holds no DTD, entity or processing instruction.
-
-    Raises
-    ------
-    InvalidInputError
-        Not a string, over ``MAX_URDF_BYTES``, a declared encoding other than UTF-8, a DTD or
-        entity, not a URDF; the message names ``field``.
-    """
-    if not isinstance(text, str) or not text.strip():
-        raise InvalidInputError(f"{field} must be the text of a URDF file", field)
-    data = text.encode("utf-8")
-    if len(data) > MAX_URDF_BYTES:
-        raise InvalidInputError(
-            f"{field}: URDF too large ({len(data)} bytes; at most {MAX_URDF_BYTES})", field
-        )
-    if re.search(rb"<!\s*(DOCTYPE|ENTITY)", data, re.IGNORECASE):
-        raise InvalidInputError(f"{field}: a URDF with a DOCTYPE or ENTITY is refused", field)
-    from lxml import etree
-
-    clean = etree.tostring(_hardened_parse(data, field), encoding="utf-8")
-    yourdfpy = _yourdfpy()
-    try:
-        model = yourdfpy.URDF.load(
-            io.BytesIO(clean), build_scene_graph=False, load_meshes=False,
-            build_collision_scene_graph=False, load_collision_meshes=False,
-        )  # fmt: skip
-    except Exception as exc:  # yourdfpy raises whatever its XML walk meets
-        raise InvalidInputError(f"{field}: not a valid URDF ({exc})", field) from None
-    if model.robot is None or not model.robot.links:
-        raise InvalidInputError(f"{field}: the URDF has no links", field)
-    links = {link.name for link in model.robot.links}
-    for joint in model.robot.joints:
-        for role, link in (("parent", joint.parent), ("child", joint.child)):
-            if link not in links:
-                raise InvalidInputError(
-                    f"{field}: joint {joint.name!r} names {role} link {link!r}, which the URDF "
-                    "does not define",
-                    field,
-                )
-    return model
 
 
 @dataclass(frozen=True)
@@ -167,7 +49,7 @@ def _rotation(axis: FloatArray, q: FloatArray) -> FloatArray:
 
 
 class UrdfChain(Kinematics):
-    """The position of ``end_link`` (or some of its coordinates) as a kinematics, eq. (4).
+    """The pose of ``end_link`` (or some of its coordinates) as a kinematics, eq. (4).
 
     Parameters
     ----------
@@ -178,17 +60,27 @@ class UrdfChain(Kinematics):
     active_joints : sequence of str, optional
         The joints that are the variables x1..xp, in this order; default: every revolute,
         continuous or prismatic joint on the chain, base first.
-    task : str
-        The end position's coordinates in the base frame, ``"xyz"`` or a subset such as ``"xz"``.
+    task : str or sequence of str
+        The end link's coordinates (:func:`~jik.engine.pose_task.parse_task`): ``x y z`` its
+        position in the base frame, ``rx ry rz`` the rotation vector log(R0^T R) of its
+        orientation; ``"pose"`` for all six, ``"xyz"`` (the default) or any subset.
     locked : mapping str -> float, optional
         Values of the chain's movable joints that are not active (default 0) [rad or m].
+    home : sequence of float, optional
+        A reference configuration (p values): default the zero configuration clipped into the
+        joint limits.
+    reference : optional
+        R0 as a rotation vector, a quaternion (x y z w) or a matrix
+        (:func:`~jik.engine.pose_task.reference_rotation`); default: the end link's orientation
+        at ``home``, so that ``home`` has rotation coordinates 0.
 
     Notes
     -----
     Forward kinematics composes, joint by joint along the chain, the joint's origin and its
-    motion (rotation about, or translation along, its axis). The Jacobian is analytic: column j
-    is z_j x (p - o_j) for a revolute joint and z_j for a prismatic one, with z_j its axis and
-    o_j its origin in the base frame and p the end point.
+    motion (rotation about, or translation along, its axis). The Jacobian is analytic: the
+    geometric Jacobian's column j is (z_j x (p - o_j), z_j) for a revolute joint and (z_j, 0)
+    for a prismatic one, with z_j its axis and o_j its origin in the base frame and p the end
+    point; the rotation rows map it through the SO(3) log's derivative (:mod:`jik.engine.so3`).
     """
 
     name = "urdf"
@@ -198,8 +90,10 @@ class UrdfChain(Kinematics):
         urdf: str,
         end_link: str,
         active_joints: Sequence[str] | None = None,
-        task: str = "xyz",
+        task: str | Sequence[str] = "xyz",
         locked: Mapping[str, float] | None = None,
+        home: Sequence[float] | None = None,
+        reference=None,
     ) -> None:
         model = parse_urdf(urdf)
         self.robot_name = str(model.robot.name)
@@ -253,19 +147,10 @@ class UrdfChain(Kinematics):
                     f"locked.{name}",
                 )
             json_number(value, f"locked.{name}")
-        if (
-            not isinstance(task, str)
-            or not task
-            or set(task) - set("xyz")
-            or len(set(task)) < len(task)
-        ):
-            raise InvalidInputError(
-                f"task must be 'xyz' or a subset of its letters such as 'xz', got {task!r}", "task"
-            )  # fmt: skip
-        self.task = task
-        self.rows = np.array(["xyz".index(c) for c in task])
+        names = parse_task(task)
+        self.task, self.task_names = task_text(names), names
         self.joint_names = tuple(active)
-        self.p, self.r = len(active), len(task)
+        self.p, self.r = len(active), len(names)
         if self.p <= self.r:
             raise InvalidInputError(
                 f"{self.p} active joints for a task of {self.r} coordinates: a redundant robot "
@@ -286,6 +171,22 @@ class UrdfChain(Kinematics):
         )  # fmt: skip
         self.limits = tuple(_limits(model.joint_map[name]) for name in active)
         self.locked = {j.name: j.value for j in self.chain if j.type != "fixed" and j.index < 0}
+        self.compiled = CompiledChain(
+            [ChainStep(j.origin, j.axis, j.type, j.index, j.value) for j in self.chain], self.p
+        )
+        lo, hi = np.array(self.limits).T
+        try:
+            self.home = tuple(
+                np.clip(0.0, lo, hi) if home is None else as_vector(home, self.p, "home")
+            )
+        except InvalidInputError as exc:
+            raise InvalidInputError(str(exc), "home") from None
+        self.reference = (
+            self.compiled.pose(np.array(self.home))[0]
+            if reference is None
+            else reference_rotation(reference)
+        )
+        self.pose_task = PoseTask(names, self.reference)
         self.urdf = urdf
         #: What was skipped while reading the URDF (mesh references), for the run's result.
         self.notes = tuple(n for n in (mesh_note(model),) if n)
@@ -293,7 +194,8 @@ class UrdfChain(Kinematics):
     @property
     def parameters(self) -> dict[str, object]:
         return {"end_link": self.end_link, "active_joints": list(self.joint_names),
-                "task": self.task, "locked": dict(self.locked)}  # fmt: skip
+                "task": self.task, "locked": dict(self.locked), "home": list(self.home),
+                "reference": self.reference.tolist()}  # fmt: skip
 
     def frames(self, x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Joint origins o (..., n, 3), joint axes z (..., n, 3) in the base frame, for the n
@@ -322,23 +224,21 @@ class UrdfChain(Kinematics):
         return np.concatenate([o, T[..., None, :3, 3]], axis=-2)
 
     def forward(self, x: FloatArray) -> FloatArray:
-        """k(x): the end link's origin, the task's coordinates: (..., p) -> (..., r)."""
-        return self.frames(x)[2][..., self.rows, 3]
+        """k(x): the task's coordinates of the end link's pose: (..., p) -> (..., r)."""
+        R, t = self.compiled.pose(x)
+        return self.pose_task.value(R, t)
 
     def jacobian(self, x: FloatArray) -> FloatArray:
         """J(x): (..., p) -> (..., r, p), analytic (see the class notes)."""
-        x = np.asarray(x, dtype=float)
-        o, z, T = self.frames(x)
-        end = T[..., None, :3, 3]
-        cols = np.zeros((*x.shape[:-1], 3, self.p))
-        for k, j in enumerate(self.chain):
-            if j.index < 0:
-                continue
-            if j.type == "revolute":
-                cols[..., :, j.index] = np.cross(z[..., k, :], end[..., 0, :] - o[..., k, :])
-            else:
-                cols[..., :, j.index] = z[..., k, :]
-        return cols[..., self.rows, :]
+        return self.forward_jacobian(x)[1]
+
+    def forward_jacobian(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """k(x) (..., r) and J(x) (..., r, p) from one pass along the chain."""
+        return self.pose_task.value_jacobian(*self.compiled.pose_jacobian(x))
+
+    def end_pose(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """The end link's rotation (..., 3, 3) and position (..., 3) in the base frame."""
+        return self.compiled.pose(x)
 
 
 def _unit(axis, name: str) -> FloatArray:

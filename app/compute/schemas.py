@@ -205,7 +205,7 @@ class FormulaRobot(BaseModel):
 
 
 class UrdfRobot(BaseModel):
-    """A serial arm from URDF text: the end link's position (task 'xyz' or a subset)."""
+    """A serial arm from URDF text: the end link's pose (task 'pose', 'xyz' or a subset)."""
 
     model_config = ConfigDict(extra="forbid", title="URDF arm")
     name: Literal["urdf"]
@@ -222,9 +222,24 @@ class UrdfRobot(BaseModel):
         ]
         | None
     ) = Field(None, description="the joints that move (default: all from the base to end_link)")
-    task: Literal["xyz", "xy", "xz", "yz", "x", "y", "z"] = Field(
-        "xyz", description="coordinates of the end point"
+    task: Annotated[str, Field(min_length=1, max_length=40, pattern=r"^[xyzrpose ,]+$")] = Field(
+        "xyz",
+        description="coordinates of the end link: x y z (position in the base frame) and rx ry "
+        "rz (rotation vector of R0^T R); 'pose' for all six, or a subset such as 'xyz', 'xz' "
+        "or 'x y z rz'",
     )
+    home: Annotated[list[Coordinate], Field(min_length=1, max_length=MAX_DIMENSION)] | None = (
+        Field(None, description="a reference configuration (default: zero, clipped into the "
+              "joint limits); also the default start")
+    )  # fmt: skip
+    reference: (
+        Annotated[list[FiniteFloat], Field(min_length=3, max_length=4)]
+        | Annotated[list[Annotated[list[FiniteFloat], Field(min_length=3, max_length=3)]],
+                    Field(min_length=3, max_length=3)]
+        | None
+    ) = Field(None, description="R0, the orientation whose rotation coordinates are 0: a "
+              "rotation vector, a quaternion x y z w or a 3x3 matrix; default: the orientation "
+              "at home")  # fmt: skip
     locked: Annotated[
         dict[Annotated[str, Field(min_length=1, max_length=200)], FiniteFloat],
         Field(max_length=64),

@@ -77,7 +77,7 @@ def test_an_undeclared_entity_is_refused_not_expanded():
 
 def test_the_parser_itself_refuses_a_dtd_past_the_text_check():
     """The hardened parse stands alone: a DTD that reached it is refused, its entity unread."""
-    from jik.engine.urdf import _hardened_parse
+    from jik.engine.urdf_parse import _hardened_parse
 
     with pytest.raises(InvalidInputError, match="DTD") as err:
         _hardened_parse(f'<!DOCTYPE r [<!ENTITY x "{SECRET}">]><r>&x;</r>'.encode(), "urdf")

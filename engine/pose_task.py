@@ -1,0 +1,127 @@
+"""Pose tasks of an arm: the coordinates ``x y z rx ry rz`` of its end link, or a subset.
+
+``x y z`` are the end link's position in the base frame [m]; ``rx ry rz`` the rotation vector
+phi = log(R0^T R) [rad] of its orientation R relative to a reference orientation R0
+(:mod:`jik.engine.so3`). ``"pose"`` names all six. The Jacobian rows follow from the geometric
+Jacobian (Jv, Jw) of the chain: ``dp/dx = Jv`` and ``dphi/dx = Jl^-1(phi) R0^T Jw``.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+
+import numpy as np
+
+from jik.engine import so3
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.validation import FloatArray
+
+COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
+_TOKEN = re.compile(r"r[xyz]|[xyz]")
+
+
+def parse_task(task, field: str = "task") -> tuple[str, ...]:
+    """The coordinates of a task: ``"pose"`` (all six), a compact string such as ``"xyz"`` or
+    ``"xyzrz"``, pieces separated by spaces or commas (``"x y z rx"``, ``"xz rz"``), or a list
+    of names; in the order given, none repeated."""
+    names: list[str] = []
+    if isinstance(task, str):
+        text = task.strip().lower()
+        if text == "pose":
+            return COORDINATES
+        for piece in re.split(r"[\s,]+", text):  # each piece compact: "xyz", "rz", "xyzrz"
+            tokens = _TOKEN.findall(piece)
+            names += tokens if "".join(tokens) == piece else ["?"]
+    elif isinstance(task, Sequence) and all(isinstance(t, str) for t in task):
+        names = [t.strip().lower() for t in task]
+    if not names or set(names) - set(COORDINATES) or len(set(names)) < len(names):
+        raise InvalidInputError(
+            f"{field} must be 'pose' or coordinates among x y z rx ry rz, none twice (such as "
+            f"'xyz', 'xz' or 'x y z rz'), got {task!r:.80}",
+            field,
+        )
+    return tuple(names)
+
+
+def task_text(names: Sequence[str]) -> str:
+    """The task's canonical text: ``"pose"``, compact positions (``"xz"``), else names."""
+    if tuple(names) == COORDINATES:
+        return "pose"
+    if all(n in "xyz" for n in names):
+        return "".join(names)
+    return " ".join(names)
+
+
+def reference_rotation(value, field: str = "reference") -> FloatArray:
+    """R0 (3, 3) from a rotation vector (3 numbers, [rad]), a unit quaternion (4 numbers,
+    x y z w as ROS and SciPy write it) or a rotation matrix (3 rows of 3)."""
+    from scipy.spatial.transform import Rotation
+
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        a = np.zeros(0)
+    if not np.all(np.isfinite(a)) or a.shape not in ((3,), (4,), (3, 3)):
+        raise InvalidInputError(
+            f"{field} must be a rotation vector (3 numbers), a quaternion x y z w (4 numbers) "
+            "or a rotation matrix (3 rows of 3)",
+            field,
+        )
+    if a.shape == (3,):
+        return so3.exp(a)
+    if a.shape == (4,):
+        if abs(np.linalg.norm(a) - 1.0) > 1e-6:
+            raise InvalidInputError(f"{field}: a quaternion must have norm 1, got "
+                                    f"{np.linalg.norm(a):.6g}", field)  # fmt: skip
+        return Rotation.from_quat(a).as_matrix()
+    if not np.allclose(a.T @ a, np.eye(3), atol=1e-6) or np.linalg.det(a) < 0:
+        raise InvalidInputError(f"{field}: the matrix is not a rotation (R^T R = I, det R = 1 "
+                                "to 1e-6)", field)  # fmt: skip
+    return a
+
+
+class PoseTask:
+    """The rows of a pose task: position and rotation coordinates of (R, t) and their Jacobian.
+
+    Parameters
+    ----------
+    names : sequence of str
+        Coordinates among ``x y z rx ry rz`` (:func:`parse_task`).
+    reference : (3, 3) array
+        R0, the orientation whose rotation coordinates are 0.
+    """
+
+    def __init__(self, names: Sequence[str], reference: FloatArray) -> None:
+        self.names = tuple(names)
+        self.reference = np.asarray(reference, dtype=float)
+        self.position_rows = np.array([COORDINATES.index(n) for n in names if len(n) == 1], int)
+        self.rotation_rows = np.array([COORDINATES.index(n) - 3 for n in names if len(n) == 2],
+                                      int)  # fmt: skip
+        # positions then rotations are computed; ``order`` puts them back in the given order
+        computed = [n for n in names if len(n) == 1] + [n for n in names if len(n) == 2]
+        self.order = np.array([computed.index(n) for n in names])
+        self.rotation = self.rotation_rows.size > 0
+
+    def value(self, R: FloatArray, t: FloatArray) -> FloatArray:
+        """k: (..., 3, 3), (..., 3) -> (..., r)."""
+        parts = [t[..., self.position_rows]]
+        if self.rotation:
+            parts.append(so3.log(self.reference.T @ R)[..., self.rotation_rows])
+        return np.concatenate(parts, axis=-1)[..., self.order]
+
+    def value_jacobian(self, R, t, Jv, Jw) -> tuple[FloatArray, FloatArray]:
+        """k (..., r) and J (..., r, p) from the pose and the geometric Jacobian."""
+        values, rows = [t[..., self.position_rows]], [Jv[..., self.position_rows, :]]
+        if self.rotation:
+            if R.ndim == 2:
+                phi, L = so3.log_and_jacobian(self.reference.T @ R)
+            else:
+                phi = so3.log(self.reference.T @ R)
+                L = so3.left_jacobian_inverse(phi)
+            dphi = (L @ self.reference.T) @ Jw
+            values.append(phi[..., self.rotation_rows])
+            rows.append(dphi[..., self.rotation_rows, :])
+        k = np.concatenate(values, axis=-1)[..., self.order]
+        J = np.concatenate(rows, axis=-2)[..., self.order, :]
+        return k, J

@@ -1,0 +1,135 @@
+"""URDF text to a yourdfpy model, safely: bounded, UTF-8, no DTD or entities, no meshes read.
+
+yourdfpy (a maintained URDF library; viser's URDF support builds on it) parses the robot's
+elements; it is imported when a URDF robot is built, so the rest of the engine works without it
+(``pip install 'jik[urdf]'``).
+
+Safety: the text is bounded in size, must be (or declare) UTF-8 or ASCII, and is parsed by lxml
+with defusedxml's settings (no DTD, no entity expansion, no network; a document type
+declaration, the door to entity expansion and external entities, is refused). Meshes are never
+loaded, nor their paths resolved: a reference of any form is skipped with a note
+(:func:`mesh_note`). A joint naming a link the URDF does not define is refused.
+"""
+
+from __future__ import annotations
+
+import io
+import logging
+import re
+
+from jik.engine.exceptions import InvalidInputError
+
+#: Largest URDF text accepted [bytes].
+MAX_URDF_BYTES = 1_000_000
+
+
+def _yourdfpy():
+    try:
+        import yourdfpy
+    except ImportError:  # the `urdf` extra is not installed
+        raise InvalidInputError(
+            "URDF robots need the yourdfpy package: pip install 'jik[urdf]'", "urdf"
+        ) from None
+    # yourdfpy logs each text it cannot parse as an ERROR ("Using different parsing approach."),
+    # which a server printed for every bad URDF a user sent: parse_urdf reports it, in words
+    # naming the field, to whoever sent it.
+    logging.getLogger("yourdfpy").setLevel(logging.CRITICAL)
+    return yourdfpy
+
+
+def mesh_note(model, field: str = "urdf") -> str:
+    """A note on the URDF's mesh references, which jik never reads (empty when there are none).
+
+    Meshes only draw a robot; its kinematics is the joints'. No path is resolved or opened,
+    so a reference of any form (relative, ``package://``, ``file:///``, a URL) is skipped.
+    """
+    names = sorted(
+        {str(v.geometry.mesh.filename) for link in model.robot.links
+         for v in (*link.visuals, *link.collisions)
+         if v.geometry is not None and v.geometry.mesh is not None}
+    )  # fmt: skip
+    if not names:
+        return ""
+    return (f"{field}: {len(names)} mesh file reference(s) skipped, never read (jik computes "
+            f"kinematics only), e.g. {names[0][:120]!r}")  # fmt: skip
+
+
+#: Encodings a URDF may declare: its text reaches the parser as UTF-8 bytes, and any other
+#: declared encoding would make the parser read those bytes as something else (UTF-7 turns
+#: ``+ADw-!DOCTYPE`` into a document type declaration that no text check sees).
+ENCODINGS = ("utf-8", "utf8", "us-ascii", "ascii")
+_DECLARATION = re.compile(rb"""^<\?xml[^>]*?\bencoding\s*=\s*["']([^"']*)["']""")
+
+
+def _hardened_parse(data: bytes, field: str):
+    """The XML tree of ``data`` by lxml with defusedxml's semantics: no DTD (internal or
+    external), no entity expansion, no network; the declared encoding UTF-8 or ASCII."""
+    from lxml import etree  # (yourdfpy's dependency)
+
+    match = _DECLARATION.match(data.removeprefix(b"\xef\xbb\xbf").lstrip())
+    if match and match.group(1).decode("ascii", "replace").lower() not in ENCODINGS:
+        raise InvalidInputError(
+            f"{field}: the URDF declares encoding={match.group(1).decode('ascii', 'replace')!r}; "
+            "only UTF-8 (or ASCII) is accepted",
+            field,
+        )
+    parser = etree.XMLParser(
+        resolve_entities=False, no_network=True, load_dtd=False, dtd_validation=False,
+        huge_tree=False, remove_comments=True, remove_pis=True, remove_blank_text=True,
+    )  # fmt: skip
+    try:
+        tree = etree.fromstring(data, parser=parser).getroottree()
+    except etree.XMLSyntaxError as exc:
+        raise InvalidInputError(f"{field}: not a valid URDF (XML: {exc.msg})", field) from None
+    info = tree.docinfo
+    if info.doctype or info.internalDTD is not None or info.externalDTD is not None:
+        raise InvalidInputError(f"{field}: a URDF with a DOCTYPE (DTD) is refused", field)
+    if any(isinstance(e, etree._Entity) for e in tree.iter()):
+        raise InvalidInputError(f"{field}: a URDF with entity references is refused", field)
+    return tree.getroot()
+
+
+def parse_urdf(text, field: str = "urdf"):
+    """Parse URDF text with yourdfpy (no meshes loaded); a ``yourdfpy.URDF``.
+
+    The text is parsed once with hardened settings (:func:`_hardened_parse`); yourdfpy reads the
+    tree serialised back from that parse, which holds no DTD, entity or processing instruction.
+
+    Raises
+    ------
+    InvalidInputError
+        Not a string, over ``MAX_URDF_BYTES``, a declared encoding other than UTF-8, a DTD or
+        entity, not a URDF; the message names ``field``.
+    """
+    if not isinstance(text, str) or not text.strip():
+        raise InvalidInputError(f"{field} must be the text of a URDF file", field)
+    data = text.encode("utf-8")
+    if len(data) > MAX_URDF_BYTES:
+        raise InvalidInputError(
+            f"{field}: URDF too large ({len(data)} bytes; at most {MAX_URDF_BYTES})", field
+        )
+    if re.search(rb"<!\s*(DOCTYPE|ENTITY)", data, re.IGNORECASE):
+        raise InvalidInputError(f"{field}: a URDF with a DOCTYPE or ENTITY is refused", field)
+    from lxml import etree
+
+    clean = etree.tostring(_hardened_parse(data, field), encoding="utf-8")
+    yourdfpy = _yourdfpy()
+    try:
+        model = yourdfpy.URDF.load(
+            io.BytesIO(clean), build_scene_graph=False, load_meshes=False,
+            build_collision_scene_graph=False, load_collision_meshes=False,
+        )  # fmt: skip
+    except Exception as exc:  # yourdfpy raises whatever its XML walk meets
+        raise InvalidInputError(f"{field}: not a valid URDF ({exc})", field) from None
+    if model.robot is None or not model.robot.links:
+        raise InvalidInputError(f"{field}: the URDF has no links", field)
+    links = {link.name for link in model.robot.links}
+    for joint in model.robot.joints:
+        for role, link in (("parent", joint.parent), ("child", joint.child)):
+            if link not in links:
+                raise InvalidInputError(
+                    f"{field}: joint {joint.name!r} names {role} link {link!r}, which the URDF "
+                    "does not define",
+                    field,
+                )
+    return model

@@ -1,0 +1,147 @@
+"""Pose tasks of URDF arms: SO(3) log and its derivative, the task's Jacobian against finite
+differences and against Pinocchio's frame Jacobian mapped through the log's derivative."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from jik.engine import so3
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.inverses import Pseudoinverse
+from jik.engine.pose_task import COORDINATES, parse_task, reference_rotation
+from jik.engine.repeatability import repeatability
+from jik.engine.urdf import UrdfChain
+from tests.engine.test_urdf_field import ROBOTS
+from tests.helpers import central_difference
+
+pytest.importorskip("yourdfpy")
+RNG = np.random.default_rng(371)
+ARM4 = (Path(__file__).resolve().parents[1] / "data" / "arm4.urdf").read_text(encoding="utf-8")
+PANDA = ROBOTS / "panda_description" / "urdf" / "panda.urdf" if ROBOTS else None
+PANDA_JOINTS = [f"panda_joint{i}" for i in range(1, 8)]
+
+
+@pytest.mark.parametrize("scale", [1e-7, 1e-3, 0.5, 2.0, 3.0, np.pi - 1e-5])
+def test_log_inverts_exp_and_matches_scipy(scale):
+    w = RNG.normal(size=(20, 3))
+    w *= scale / np.linalg.norm(w, axis=-1, keepdims=True)
+    R = so3.exp(w)
+    np.testing.assert_allclose(R, Rotation.from_rotvec(w).as_matrix(), atol=1e-15)
+    np.testing.assert_allclose(so3.log(R), w, atol=1e-9 if scale > 3 else 1e-14)
+    for Ri in R[:3]:
+        phi, L = so3.log_and_jacobian(Ri)
+        np.testing.assert_allclose(phi, so3.log(Ri), atol=1e-15)
+        np.testing.assert_allclose(L, so3.left_jacobian_inverse(phi), atol=1e-12)
+
+
+@pytest.mark.parametrize("scale", [1e-6, 0.3, 2.5])
+def test_left_jacobian_inverse_is_the_logs_derivative(scale):
+    """d/ds log(exp(s w) R) at s = 0 is Jl^-1(log R) w (the base-frame angular velocity w)."""
+    phi = RNG.normal(size=3)
+    phi *= scale / np.linalg.norm(phi)
+    R = so3.exp(phi)
+    for w in RNG.normal(size=(5, 3)):
+        eps = 1e-6
+        fd = (so3.log(so3.exp(eps * w) @ R) - so3.log(so3.exp(-eps * w) @ R)) / (2 * eps)
+        np.testing.assert_allclose(so3.left_jacobian_inverse(phi) @ w, fd, atol=1e-8)
+
+
+@pytest.mark.parametrize(
+    ("task", "names"),
+    [("pose", COORDINATES), ("xyz", ("x", "y", "z")), ("zx", ("z", "x")),
+     ("xyzrz", ("x", "y", "z", "rz")), ("x y rz", ("x", "y", "rz")), ("rx, z", ("rx", "z")),
+     (["ry", "x"], ("ry", "x"))],
+)  # fmt: skip
+def test_task_names(task, names):
+    assert parse_task(task) == names
+
+
+@pytest.mark.parametrize("task", ["", "xw", "xx", "posee", "x rw", "r", ["x", "x"], 3])
+def test_bad_tasks_name_the_field(task):
+    with pytest.raises(InvalidInputError, match="among x y z rx ry rz") as err:
+        parse_task(task)
+    assert err.value.field == "task"
+
+
+@pytest.mark.parametrize(
+    ("end", "task"),
+    [("tool", "rz ry x"), ("tool", "rx ry rz"), ("tool", "xz"), ("finger", "x rx ry rz"),
+     ("finger", "rz y")],
+)  # fmt: skip
+def test_jacobian_matches_finite_differences(end, task):
+    kin = UrdfChain(ARM4, end, task=task)
+    x = RNG.uniform(-1.5, 1.5, (25, kin.p))
+    J = kin.jacobian(x)
+    np.testing.assert_allclose(J, central_difference(kin.forward, x), atol=1e-8)
+    k = kin.forward(x)
+    for xi, ki, Ji in zip(x[:4], k[:4], J[:4], strict=True):  # one configuration: the scalar path
+        np.testing.assert_allclose(kin.jacobian(xi), Ji, atol=1e-14)
+        np.testing.assert_allclose(kin.forward(xi), ki, atol=1e-15)
+
+
+def test_reference_forms_agree_and_home_has_zero_rotation():
+    R0 = Rotation.from_rotvec([0.3, -0.2, 0.5])
+    forms = [R0.as_rotvec(), R0.as_quat(), R0.as_matrix()]
+    kins = [UrdfChain(ARM4, "tool", task="rx ry rz", reference=f) for f in forms]
+    x = RNG.uniform(-1, 1, (6, 4))
+    for kin in kins[1:]:
+        np.testing.assert_allclose(kin.forward(x), kins[0].forward(x), atol=1e-14)
+    home = [0.2, 0.4, -0.3, 0.1]
+    kin = UrdfChain(ARM4, "tool", task="x rx ry", home=home)
+    np.testing.assert_allclose(kin.forward(np.array(home))[1:], 0.0, atol=1e-15)
+
+
+@pytest.mark.parametrize(
+    ("value", "text"),
+    [([1, 2], "rotation vector"), ([0, 0, 0, 2], "norm 1"), (np.diag([1, 1, -1]), "rotation"),
+     ([[1, 0, 0], [0, 1, 0], [0, 0, float("nan")]], "rotation vector")],
+)  # fmt: skip
+def test_bad_references_name_the_field(value, text):
+    with pytest.raises(InvalidInputError, match=text) as err:
+        reference_rotation(value)
+    assert err.value.field == "reference"
+
+
+@pytest.mark.skipif(PANDA is None, reason="example-robot-data is not installed")
+def test_panda_pose_task_equals_pinocchio_through_jlog3():
+    """k = (p, log3(R0^T R)), J = (Jv, Jlog3(R0^T R) J_local,angular): Pinocchio's frame
+    Jacobian mapped through the SO(3) log's derivative."""
+    pin = pytest.importorskip("pinocchio")
+    text = PANDA.read_text(encoding="utf-8")
+    kin = UrdfChain(text, "panda_link8", PANDA_JOINTS, task="pose")
+    model = pin.buildModelFromXML(text)
+    data, frame = model.createData(), model.getFrameId("panda_link8")
+    x = RNG.uniform(-1.0, 1.0, (20, 7))
+    k, J = kin.forward_jacobian(x)
+    for xi, ki, Ji in zip(x, k, J, strict=True):
+        q = pin.neutral(model)
+        q[:7] = xi
+        pin.computeJointJacobians(model, data, q)
+        pin.updateFramePlacements(model, data)
+        M = data.oMf[frame]
+        Rrel = kin.reference.T @ M.rotation
+        local = pin.getFrameJacobian(model, data, frame, pin.LOCAL)[:, :7]
+        world = pin.getFrameJacobian(model, data, frame, pin.LOCAL_WORLD_ALIGNED)[:, :7]
+        np.testing.assert_allclose(ki, np.r_[M.translation, pin.log3(Rrel)], atol=1e-12)
+        np.testing.assert_allclose(Ji, np.vstack([world[:3], pin.Jlog3(Rrel) @ local[3:]]),
+                                   atol=1e-12)  # fmt: skip
+        np.testing.assert_allclose(kin.jacobian(xi), Ji, atol=1e-12)
+
+
+@pytest.mark.skipif(PANDA is None, reason="example-robot-data is not installed")
+def test_a_pose_loop_of_the_panda_drifts_under_the_pseudoinverse():
+    """A closed loop in position and orientation: every leg reaches its pose target; the
+    pseudoinverse's elbow does not come back (p - r = 1)."""
+    kin = UrdfChain(PANDA.read_text(encoding="utf-8"), "panda_link8", PANDA_JOINTS, task="pose",
+                    home=[0, -0.785, 0, -2.356, 0, 1.571, 0.785])  # fmt: skip
+    x0 = np.array(kin.home)
+    y0 = kin.forward(x0)
+    np.testing.assert_allclose(y0[3:], 0.0, atol=1e-15)
+    moves = np.array(
+        [[0.1, 0, 0, 0, 0, 0.3], [0.1, 0.1, 0, 0.2, 0, 0.3], [0, 0.1, -0.05, 0.2, 0, 0]]
+    )
+    res = repeatability(Pseudoinverse(kin), x0, y0 + moves, cycles=2)
+    assert res.success
+    assert res.drift[-1] > 1e-4
