@@ -62,9 +62,12 @@ URDF = (
                     "a matrix (3 rows of 3); default: the end link's orientation at home"),
 )  # fmt: skip
 
+#: A catalogue arm (:mod:`jik.engine.arms`): its URDF, end link and home are the catalogue's.
+ARM = tuple(f for f in URDF if f.name in ("task", "reference", "home", "locked", "active_joints"))
+
 COMMON = (
-    DefinitionField("name", "string", True, "the kind: planar_chain, formula, urdf, or a "
-                    "built-in robot's name"),
+    DefinitionField("name", "string", True, "the kind: planar_chain, formula, urdf, a "
+                    "catalogue arm (panda, iiwa14, gen3, ur5e) or a built-in robot's name"),
     DefinitionField("title", "string", False, "a name to show"),
     DefinitionField("x_range", "points", False, "one [lo, hi] per variable (default: joint "
                     "limits or [-pi, pi])"),
@@ -105,8 +108,12 @@ KINDS: dict[str, tuple[DefinitionField, ...]] = {
 
 
 def keys(kind: str) -> set[str]:
-    """The keys a definition of ``kind`` may have (its own and the common ones)."""
-    return {f.name for f in (*KINDS.get(kind, ()), *COMMON)}
+    """The keys a definition of ``kind`` may have (its own and the common ones); a catalogue
+    arm's are :data:`ARM`'s."""
+    from jik.engine.arms import ARMS
+
+    own = ARM if kind in ARMS else KINDS.get(kind, ())
+    return {f.name for f in (*own, *COMMON)}
 
 
 def augmentation_keys(name: str) -> set[str]:

@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from jik.engine import robot_kinds
+from jik.engine.arms import ARMS
 from jik.engine.augmentations import AugmentingMap
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.extended_vector import VectorExtendedInverse
@@ -311,11 +312,10 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
     if not isinstance(d, Mapping):
         raise InvalidInputError("a robot must be a mapping with a 'name'", "name")
     kind = d.get("name")
-    if not isinstance(kind, str) or kind not in {*robot_kinds.KINDS, *ROBOTS}:
+    if not isinstance(kind, str) or kind not in {*robot_kinds.KINDS, *ROBOTS, *ARMS}:
         raise InvalidInputError(
-            f"name must be one of {sorted(robot_kinds.KINDS)} or a built-in robot "
-            f"{sorted(ROBOTS)}, "
-            f"got {kind!r}",
+            f"name must be one of {sorted(robot_kinds.KINDS)}, a catalogue arm {sorted(ARMS)} "
+            f"or a built-in robot {sorted(ROBOTS)}, got {kind!r:.80}",
             "name",
         )
     allowed = robot_kinds.keys(kind) | ({"parameters"} if kind in ROBOTS else set())
@@ -330,7 +330,11 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
         extra, _, _ = _augmentations(kin, d.get("augmentations", []))
         spec = replace(base, augmentations=(*base.augmentations, *extra)) if extra else base
         return Robot(spec, kin, dict(d))
-    kin = _kinematics(kind, d, None if base_dir is None else Path(base_dir))
+    if kind in ARMS:  # the catalogue's URDF, end link and home, with the definition's keys
+        d = {**ARMS[kind].definition(), **{k: v for k, v in d.items() if k != "name"}}
+        kin = _kinematics("urdf", d, None)
+    else:
+        kin = _kinematics(kind, d, None if base_dir is None else Path(base_dir))
     box = _x_range(kin, d)
     x0, target, path = _defaults(kin, d, box)
     augmentations, region, vectors = _augmentations(kin, d.get("augmentations", []))
@@ -339,9 +343,10 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
         "planar_chain": ("x", "y", "phi")[: kin.r],
         "formula": tuple(f"y{i + 1}" for i in range(kin.r)),
         "urdf": tuple(getattr(kin, "task_names", ())),
-    }[kind]
+    }.get(kind, tuple(getattr(kin, "task_names", ())))
     spec = RobotSpec(
-        name=kind, title=title, description=f"{title}: a {kind} robot defined by data",
+        name=kind, title=title, description=ARMS[kind].description if kind in ARMS else
+        f"{title}: a {kind} robot defined by data",
         equation="(4)", p=kin.p, r=kin.r, variable_names=tuple(kin.variable_names),
         task_names=tuple(task_names), parameters=(), vector_parameters=(),
         factory=lambda: kin, default_x0=x0, default_target=target, default_path=path,
@@ -356,10 +361,11 @@ def load_robot(source: str | Path) -> Robot:
     """A robot from a JSON or YAML file (``.yaml``/``.yml``, needs PyYAML), or a built-in name."""
     path = Path(source)
     if not path.is_file():
-        if str(source) in ROBOTS:
+        if str(source) in ROBOTS or str(source) in ARMS:
             return robot_from_dict({"name": str(source)})
         raise InvalidInputError(f"robot {str(source)!r} is neither a file nor a built-in robot "
-                                f"({sorted(ROBOTS)})", "robot")  # fmt: skip
+                                f"({sorted(ROBOTS)}) or catalogue arm ({sorted(ARMS)})",
+                                "robot")  # fmt: skip
     if path.stat().st_size > MAX_FILE_BYTES:
         raise InvalidInputError(f"robot file larger than {MAX_FILE_BYTES} bytes", "robot")
     text = path.read_text(encoding="utf-8")

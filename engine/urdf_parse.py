@@ -37,6 +37,17 @@ def _yourdfpy():
     return yourdfpy
 
 
+def _etree():
+    """lxml's etree (yourdfpy's XML library, installed with it)."""
+    try:
+        from lxml import etree
+    except ImportError:  # the `urdf` extra is not installed
+        raise InvalidInputError(
+            "URDF robots need the yourdfpy package: pip install 'jik[urdf]'", "urdf"
+        ) from None
+    return etree
+
+
 def mesh_note(model, field: str = "urdf") -> str:
     """A note on the URDF's mesh references, which jik never reads (empty when there are none).
 
@@ -64,8 +75,7 @@ _DECLARATION = re.compile(rb"""^<\?xml[^>]*?\bencoding\s*=\s*["']([^"']*)["']"""
 def _hardened_parse(data: bytes, field: str):
     """The XML tree of ``data`` by lxml with defusedxml's semantics: no DTD (internal or
     external), no entity expansion, no network; the declared encoding UTF-8 or ASCII."""
-    from lxml import etree  # (yourdfpy's dependency)
-
+    etree = _etree()
     match = _DECLARATION.match(data.removeprefix(b"\xef\xbb\xbf").lstrip())
     if match and match.group(1).decode("ascii", "replace").lower() not in ENCODINGS:
         raise InvalidInputError(
@@ -110,9 +120,7 @@ def parse_urdf(text, field: str = "urdf"):
         )
     if re.search(rb"<!\s*(DOCTYPE|ENTITY)", data, re.IGNORECASE):
         raise InvalidInputError(f"{field}: a URDF with a DOCTYPE or ENTITY is refused", field)
-    from lxml import etree
-
-    clean = etree.tostring(_hardened_parse(data, field), encoding="utf-8")
+    clean = _etree().tostring(_hardened_parse(data, field), encoding="utf-8")
     yourdfpy = _yourdfpy()
     try:
         model = yourdfpy.URDF.load(
