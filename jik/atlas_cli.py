@@ -10,7 +10,8 @@ arc lengths s on a grid (or sampled), s = 0 where eq. (7) from the robot's defau
 configuration box, or ``--arc``. Writes ``--out`` (JSON: the inputs, the starts, and per
 algorithm the drift after each cycle, success and leg ends), a CSV beside it for large atlases
 (or with ``--csv``), and an HTML figure of the drift map when plotly is installed.
-``--robot`` is a built-in robot's name (``--param`` sets its parameters) or a user's robot file
+``--robot`` is a built-in robot's name (``--param`` sets its parameters), a catalogue arm's
+(``panda``, with its default task) or a user's robot file
 (:func:`jik.engine.robot_spec.load_robot`, as for ``jik solve``).
 """
 
@@ -132,6 +133,7 @@ def atlas_command(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace) -> int:
     import numpy as np
 
+    from jik.engine.arms import ARMS
     from jik.engine.atlas import DEFAULT_CHUNK, plan_atlas
     from jik.engine.atlas_backends import backend_for
     from jik.engine.atlas_run import iter_atlas
@@ -141,7 +143,7 @@ def _run(args: argparse.Namespace) -> int:
     from jik.engine.self_motion import MAX_ARC
 
     algorithms = args.algorithm or ["pseudoinverse"]
-    if Path(args.robot).is_file():  # a user's robot (jik.engine.robot_spec)
+    if Path(args.robot).is_file() or args.robot in ARMS:  # a user's robot or a catalogue arm
         if args.param:
             raise InvalidInputError("--param is for a built-in robot; a robot file holds its "
                                     "parameters", "param")  # fmt: skip

@@ -46,7 +46,9 @@ def parse_path(text: str, option: str) -> list[list[float]]:
 
 def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--robot", required=True,
-                   help="a robot file (.json, .yaml) or a built-in robot's name")  # fmt: skip
+                   help="a robot file (.json, .yaml), a built-in robot's name or a catalogue "
+                   "arm's (panda, iiwa14, gen3, ur5e: its default task; for another, a file "
+                   "such as {\"name\": \"panda\", \"task\": \"xyz\"})")  # fmt: skip
     p.add_argument("--x0", help="start configuration, e.g. '0, 0, pi/2' (default: the robot's)")
     p.add_argument("--algorithm", choices=("pseudoinverse", "extended"), default="pseudoinverse")
     p.add_argument("--augmentation", help="augmenting map of the extended inverse (its name)")

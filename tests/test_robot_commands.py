@@ -70,6 +70,17 @@ def test_repeatability_of_a_builtin_robot_reproduces_table1(capsys):
     assert "cycle 2:" in text and "|x - x0| = 4.612e-01" in text
 
 
+def test_a_catalogue_arm_by_name_with_its_pose_task(capsys):
+    """The Panda's default path is a pose loop from home: every leg reaches its pose, and the
+    pseudoinverse does not come back."""
+    pytest.importorskip("yourdfpy")
+    out, _ = run(capsys, "repeatability", "--robot", "panda", "--cycles", "2", "--json")
+    result = json.loads(out)
+    assert result["robot"] == "Franka Panda" and result["success"]
+    assert len(result["x0"]) == 7 and len(result["targets"][0]) == 6
+    assert 1e-5 < result["drift"][-1] < 1e-2
+
+
 def test_urdf_robot_from_a_yaml_file(capsys, tmp_path):
     yaml = pytest.importorskip("yaml")
     pytest.importorskip("yourdfpy")

@@ -13,6 +13,7 @@ processes.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, TypeVar, cast
@@ -24,6 +25,7 @@ from jik.app.compute import schemas as S
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.settings import settings_from_env
 from jik.app.compute.user_robots import is_user_robot, user_inverse, user_robot
+from jik.engine.arms import ARMS
 from jik.engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
 from jik.engine.registry import ROBOTS, RobotSpec, make_inverse
 from jik.engine.repeatability import (
@@ -32,6 +34,7 @@ from jik.engine.repeatability import (
     REPEATABLE_DRIFT,
     repeatability,
 )
+from jik.engine.robot_spec import robot_from_dict
 from jik.engine.solver import BatchSolveResult, solve
 
 _R = TypeVar("_R")
@@ -257,15 +260,22 @@ def _solve_response_json(setup: _Setup, res) -> bytes:
 # Plain service functions
 
 
+@functools.cache
+def _arm_specs() -> tuple[RobotSpec, ...]:
+    """The catalogue arms with their default tasks (each built once: a URDF parse)."""
+    return tuple(robot_from_dict({"name": name}).spec for name in ARMS)
+
+
 def robots_response(timeout: float | None = None) -> S.RobotsResponse:
-    """The catalogue: every robot with p, r, parameters, defaults and augmentations."""
+    """The catalogue: every robot with p, r, parameters, defaults and augmentations, then the
+    catalogue arms (``{"name": "panda"}``; ``task`` and ``reference`` change their r)."""
     robots = [
         S.RobotInfo(
             **spec.as_dict(),
             algorithms=["pseudoinverse", "extended"],
             modes=["continuous", "discrete"],
         )
-        for spec in ROBOTS.values()
+        for spec in (*ROBOTS.values(), *_arm_specs())
     ]
     limits = S.Limits(
         max_cycles=MAX_CYCLES,

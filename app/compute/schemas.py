@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeAlias, Union
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Discriminator, Field, Tag, create_model
 
+from jik.engine.arms import ARMS, Arm
 from jik.engine.registry import ROBOTS, AugmentationSpec, RobotSpec
 from jik.engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
 
@@ -279,12 +280,31 @@ class E2SynthesisAugmentation(BaseModel):
     )
 
 
-#: The robots a user defines, by kind (their ``name``).
+def _arm_model(arm: Arm) -> type[BaseModel]:
+    """A catalogue arm's request model: the URDF robot's fields that choose its task."""
+    fields: dict[str, Any] = {"name": (Literal[arm.name], ...)}
+    for key in ("task", "reference", "home", "title"):
+        info = UrdfRobot.model_fields[key]
+        fields[key] = (info.annotation, Field(arm.task if key == "task" else None,
+                                              description=info.description))  # fmt: skip
+    return create_model(
+        f"{_camel(arm.name)}Arm",
+        __config__=ConfigDict(extra="forbid", title=arm.title),
+        __doc__=f"{arm.title} from jik's catalogue: {arm.description}. Default task "
+        f"{arm.task!r}; R0 defaults to the orientation at home {list(arm.home)}.",
+        **fields,
+    )
+
+
+#: The robots a user defines, by kind (their ``name``); a catalogue arm is one too.
 USER_ROBOT_MODELS: dict[str, type[BaseModel]] = {
     "planar_chain": PlanarChainRobot,
     "formula": FormulaRobot,
     "urdf": UrdfRobot,
+    **{name: _arm_model(arm) for name, arm in ARMS.items()},
 }
+for _m in USER_ROBOT_MODELS.values():
+    globals()[_m.__name__] = _m  # importable by name (pickling, introspection)
 #: The augmenting maps a user robot takes, by name.
 USER_AUGMENTATION_MODELS: dict[str, type[BaseModel]] = {
     "formula": FormulaMapAugmentation,

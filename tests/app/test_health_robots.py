@@ -20,11 +20,14 @@ def test_docs_and_openapi(api):
 
 
 def test_robots_lists_the_whole_registry(api):
-    """Every robot of the registry with p, r, ranges, defaults and augmentations."""
+    """Every robot of the registry with p, r, ranges, defaults and augmentations; then the
+    catalogue arms (tests/app/test_arms_api.py)."""
+    from jik.engine.arms import ARMS
+
     body = api.get("/robots").json()
     names = [r["name"] for r in body["robots"]]
-    assert names == list(ROBOTS)
-    for info in body["robots"]:
+    assert names == [*ROBOTS, *ARMS]
+    for info in body["robots"][: len(ROBOTS)]:
         spec = ROBOTS[info["name"]]
         assert (info["p"], info["r"]) == (spec.p, spec.r)
         assert len(info["default_x0"]) == spec.p
