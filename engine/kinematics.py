@@ -52,6 +52,9 @@ class Kinematics(abc.ABC):
     kernel_orientation: ClassVar[float] = 1.0
     #: Names of the configuration variables, for plots and messages.
     variable_names: tuple[str, ...] = ()
+    #: Joint limits (p, 2), [lower, upper] per variable (+-inf: no bound), or None: the runs
+    #: report whether they stayed within them (:mod:`jik.engine.limits`).
+    joint_limits: FloatArray | None = None
 
     @abc.abstractmethod
     def forward(self, x: FloatArray) -> FloatArray:

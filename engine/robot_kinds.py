@@ -31,6 +31,8 @@ PLANAR_CHAIN = (
                     "extension for P (default 0)"),
     DefinitionField("orientation", "boolean", False, "also the end's angle as a task component "
                     "(r = 3; default false: the end point, r = 2)", False),
+    DefinitionField("limits", "points", False, "joint limits, one [lower, upper] per "
+                    "variable (null: no bound); runs report whether they stayed within them"),
 )  # fmt: skip
 
 FORMULA = (
@@ -41,6 +43,8 @@ FORMULA = (
                     ["x2 + l*cos(x3)", "x1 + l*sin(x3)"]),
     DefinitionField("parameters", "mapping", False, "named constants of the formulas",
                     {"l": 1.0}),
+    DefinitionField("limits", "points", False, "joint limits, one [lower, upper] per "
+                    "variable (null: no bound); runs report whether they stayed within them"),
 )  # fmt: skip
 
 URDF = (

@@ -38,6 +38,7 @@ from jik.engine.formula_kinematics import FormulaKinematics, FormulaMap
 from jik.engine.functionals import check_region
 from jik.engine.inverses import Inverse
 from jik.engine.kinematics import Kinematics
+from jik.engine.limits import check_limits
 from jik.engine.planar_chain import PlanarChain
 from jik.engine.registry import ROBOTS, AugmentationSpec, RobotSpec, make_inverse
 from jik.engine.repeatability import MAX_PATH_POINTS
@@ -335,6 +336,8 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
         kin = _kinematics("urdf", d, None)
     else:
         kin = _kinematics(kind, d, None if base_dir is None else Path(base_dir))
+    if "limits" in d:  # (a planar chain or a formula robot: a URDF's come from its joints)
+        kin.joint_limits = check_limits(d["limits"], kin.p)
     box = _x_range(kin, d)
     x0, target, path = _defaults(kin, d, box)
     augmentations, region, vectors = _augmentations(kin, d.get("augmentations", []))

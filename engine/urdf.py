@@ -171,6 +171,7 @@ class UrdfChain(Kinematics):
         )  # fmt: skip
         self.limits = tuple(_limits(model.joint_map[name]) for name in active)
         self.locked = {j.name: j.value for j in self.chain if j.type != "fixed" and j.index < 0}
+        self.joint_limits = np.array([_bounds(model.joint_map[name]) for name in active])
         self.compiled = CompiledChain(
             [ChainStep(j.origin, j.axis, j.type, j.index, j.value) for j in self.chain], self.p
         )
@@ -247,6 +248,16 @@ def _unit(axis, name: str) -> FloatArray:
     if not n > 0 or not np.all(np.isfinite(a)):
         raise InvalidInputError(f"joint {name!r} has a zero or invalid axis", "urdf")
     return a / n
+
+
+def _bounds(joint) -> tuple[float, float]:
+    """The joint's limits [rad or m]: its URDF limits, unbounded for a continuous joint (or a
+    joint whose limits are missing or empty)."""
+    lim = joint.limit
+    if joint.type == "continuous" or lim is None or lim.lower is None or lim.upper is None:
+        return (-math.inf, math.inf)
+    lo, hi = float(lim.lower), float(lim.upper)
+    return (lo, hi) if lo < hi else (-math.inf, math.inf)
 
 
 def _limits(joint) -> tuple[float, float]:

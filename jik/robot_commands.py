@@ -74,21 +74,32 @@ def _setup(args: argparse.Namespace) -> tuple[Robot, list[float], dict]:
     return robot, x0, settings
 
 
+def _limits(robot: Robot, report):
+    """The run's limits report (``report(limits, names)``), or None for a robot without."""
+    from jik.engine.limits import limit_names, robot_limits
+
+    limits = robot_limits(robot.kinematics)
+    return None if limits is None else report(limits, limit_names(robot.kinematics))
+
+
 def _fmt(v) -> str:
     return "(" + ", ".join(f"{float(t):.10g}" for t in v) + ")"
 
 
 def solve_command(args: argparse.Namespace) -> int:
+    from jik.engine.limits import solve_report
     from jik.engine.solver import solve
 
     robot, x0, settings = _setup(args)
     target = parse_vector(args.target, "--target") if args.target else robot.spec.default_target
     inverse = robot.inverse(args.algorithm, args.augmentation)
-    res = solve(inverse, x0, target, record=False, **settings)
+    res = solve(inverse, x0, target, record=True, **settings)
+    report = _limits(robot, lambda limits, names: solve_report(limits, res, names))
     out = {
         "robot": robot.spec.title, "algorithm": inverse.name, "x0": x0,
         "target": list(target), "x": res.x.tolist(), "y": res.y.tolist(), "error": res.error,
         "success": res.success, "message": res.message, "nit": res.nit,
+        **({} if report is None else {"limits": report.as_dict()}),
     }  # fmt: skip
     if args.json:
         print(json.dumps(out))
@@ -96,21 +107,27 @@ def solve_command(args: argparse.Namespace) -> int:
         print(f"{out['robot']}, {out['algorithm']}: {res.message}")
         print(f"  x0 = {_fmt(x0)}\n  x  = {_fmt(res.x)}\n  k(x) = {_fmt(res.y)}, "
               f"|k(x) - target| = {res.error:.3g}")  # fmt: skip
+        if report is not None:
+            print(f"  joint limits: {report}")
     return 0 if res.success else 1
 
 
 def repeatability_command(args: argparse.Namespace) -> int:
+    from jik.engine.limits import repeatability_report, robot_limits
     from jik.engine.repeatability import repeatability
 
     robot, x0, settings = _setup(args)
     path = parse_path(args.path, "--path") if args.path else robot.spec.default_path
     inverse = robot.inverse(args.algorithm, args.augmentation)
-    rep = repeatability(inverse, x0, path, cycles=args.cycles, **settings)
+    record = robot_limits(robot.kinematics) is not None  # (limits: check whole legs)
+    rep = repeatability(inverse, x0, path, cycles=args.cycles, record=record, **settings)
+    report = _limits(robot, lambda limits, names: repeatability_report(limits, rep, names))
     out = {
         "robot": robot.spec.title, "algorithm": inverse.name, "x0": x0,
         "targets": rep.targets.tolist(), "legs": rep.legs.tolist(),
         "cycle_end": rep.cycle_end.tolist(), "drift": rep.drift.tolist(),
         "success": bool(rep.success), "message": rep.message,
+        **({} if report is None else {"limits": report.as_dict()}),
     }  # fmt: skip
     if args.json:
         print(json.dumps(out))
@@ -119,6 +136,8 @@ def repeatability_command(args: argparse.Namespace) -> int:
         print(f"  x0 = {_fmt(x0)}; {len(rep.targets)} legs a cycle")
         for c, (end, drift) in enumerate(zip(rep.cycle_end, rep.drift, strict=True)):
             print(f"  cycle {c + 1}: x = {_fmt(end)}, |x - x0| = {drift:.3e}")
+        if report is not None:
+            print(f"  joint limits: {report}")
     return 0 if rep.success else 1
 
 

@@ -27,6 +27,7 @@ from jik.app.compute.settings import settings_from_env
 from jik.app.compute.user_robots import is_user_robot, user_inverse, user_robot
 from jik.engine.arms import ARMS
 from jik.engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
+from jik.engine.limits import limit_names, repeatability_report, robot_limits, solve_report
 from jik.engine.registry import ROBOTS, RobotSpec, make_inverse
 from jik.engine.repeatability import (
     MAX_CYCLES,
@@ -242,7 +243,16 @@ def _solve_document(setup: _Setup, res) -> dict[str, Any]:
         "message": str(res.message),
         "iterations": int(res.nit),
         "trajectory": _trajectory_document(res.trajectory),
+        **_limits_document(setup, lambda limits, names: solve_report(limits, res, names)),
     }
+
+
+def _limits_document(setup: _Setup, report) -> dict[str, Any]:
+    """``{"limits": ...}`` of a run (``report(limits, names)``), empty when the robot has none."""
+    limits = robot_limits(setup.kinematics)
+    if limits is None:
+        return {}
+    return {"limits": report(limits, limit_names(setup.kinematics)).as_dict()}
 
 
 def _solve_response(setup: _Setup, res) -> S.SolveResponse:
@@ -390,6 +400,7 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
             mode=setup.mode,
             tol=setup.tolerance,
             max_iterations=setup.max_iterations,
+            record=robot_limits(setup.kinematics) is not None,  # (limits: check whole legs)
         )
     except JikError as exc:
         raise engine_error(exc) from None
@@ -411,4 +422,5 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
         repeatable=bool(res.success) and finite and max_drift < REPEATABLE_DRIFT,
         success=bool(res.success),
         message=cast(str, res.message),  # one start configuration: one message
+        **_limits_document(setup, lambda limits, names: repeatability_report(limits, res, names)),
     )

@@ -186,6 +186,12 @@ class PlanarChainRobot(BaseModel):
     orientation: Annotated[bool, Field(strict=True)] = Field(
         False, description="also the end's angle as a task component (r = 3; needs p >= 3)"
     )
+    limits: (
+        Annotated[list[tuple[FiniteFloat | None, FiniteFloat | None]],
+                  Field(min_length=1, max_length=MAX_DIMENSION)]
+        | None
+    ) = Field(None, description="joint limits, one [lower, upper] per variable (null: no "
+              "bound); runs report whether they stayed within them")  # fmt: skip
     title: Title | None = None
 
 
@@ -202,6 +208,12 @@ class FormulaRobot(BaseModel):
         "parameters with sin cos tan exp log sqrt atan2 abs, + - * / **, numbers and pi"
     )
     parameters: Constants = Field(default_factory=dict, description="named constants")
+    limits: (
+        Annotated[list[tuple[FiniteFloat | None, FiniteFloat | None]],
+                  Field(min_length=1, max_length=MAX_DIMENSION)]
+        | None
+    ) = Field(None, description="joint limits, one [lower, upper] per variable (null: no "
+              "bound); runs report whether they stayed within them")  # fmt: skip
     title: Title | None = None
 
 
@@ -431,6 +443,25 @@ class Trajectory(BaseModel):
     downsampled: bool
 
 
+class LimitViolationInfo(BaseModel):
+    """Where a run first left the joint limits (cycle 0, leg 0: the start x0)."""
+
+    cycle: int = Field(description="from 1; 0 for the start x0")
+    leg: int = Field(description="from 1 within its cycle; 0 for the start x0")
+    joint: int = Field(description="index in x, from 0")
+    name: str = Field(description="the variable's name (and the URDF joint's)")
+    value: float = Field(description="the joint's value there [rad or m]")
+    limit: float = Field(description="the bound it passed")
+    bound: Literal["lower", "upper"]
+
+
+class LimitsInfo(BaseModel):
+    """Whether the run stayed within the robot's joint limits (its whole trajectory)."""
+
+    within: bool
+    violation: LimitViolationInfo | None = Field(description="the first violation, if any")
+
+
 class SolveResponse(BaseModel):
     robot: RobotUsed
     algorithm: Algorithm
@@ -447,6 +478,11 @@ class SolveResponse(BaseModel):
     message: str
     iterations: int = Field(description="integrator steps or iterations taken")
     trajectory: Trajectory
+    limits: LimitsInfo | None = Field(
+        default=None,
+        exclude_if=_absent,
+        description="whether the run stayed within the joint limits (absent: none)",
+    )
 
 
 class RepeatabilityResponse(BaseModel):
@@ -466,6 +502,11 @@ class RepeatabilityResponse(BaseModel):
     repeatable: bool = Field(description="every leg succeeded and max drift < 1e-6")
     success: bool
     message: str
+    limits: LimitsInfo | None = Field(
+        default=None,
+        exclude_if=_absent,
+        description="whether the run stayed within the joint limits (absent: none)",
+    )
 
 
 def _task_point(spec: RobotSpec) -> Any:

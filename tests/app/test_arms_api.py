@@ -74,3 +74,42 @@ def test_bad_arm_definitions_are_422_naming_the_field(api, robot, field, text):
                                  "target": [0.3, 0, 0.6, 0, 0, 0]})  # fmt: skip
     assert r.status_code == 422, r.text
     assert text in r.text and field in r.text, r.text
+
+
+def test_an_x0_outside_the_limits_is_accepted_and_reported(api):
+    x0 = [*HOME[:3], 0.2, *HOME[4:]]  # joint 4's limits: -3.0718, -0.0698
+    body = {"robot": {"name": "panda", "task": "xyz"}, "algorithm": "pseudoinverse", "x0": x0,
+            "path": [[0.45, 0.05, 0.75]], "cycles": 1}  # fmt: skip
+    run = _ok(api.post("/repeatability", json=body))
+    assert run["success"] and run["limits"]["within"] is False
+    assert run["limits"]["violation"] == {"cycle": 0, "leg": 0, "joint": 3,
+                                          "name": "x4 (panda_joint4)", "value": 0.2,
+                                          "limit": -0.0698, "bound": "upper"}  # fmt: skip
+
+
+def test_a_solve_reports_its_first_violation_and_the_paper_robots_none(api):
+    run = _ok(api.post("/solve", json={"robot": {"name": "panda", "task": "xyz"},
+                                       "algorithm": "pseudoinverse", "x0": HOME,
+                                       "target": [-0.3, 0.0, 0.5]}))  # fmt: skip
+    v = run["limits"]["violation"]
+    assert run["converged"] and (v["cycle"], v["leg"], v["joint"], v["bound"]) == (1, 1, 1, "lower")
+    ok = _ok(api.post("/solve", json={"robot": {"name": "panda", "task": "xyz"},
+                                      "algorithm": "pseudoinverse", "x0": HOME,
+                                      "target": [0.35, 0.05, 0.55]}))  # fmt: skip
+    assert ok["limits"] == {"within": True, "violation": None}
+    m2 = _ok(api.post("/solve", json={"robot": {"name": "manipulator2"},
+                                      "algorithm": "pseudoinverse", "x0": [0, 0, 1.5708],
+                                      "target": [0, 2]}))  # fmt: skip
+    assert "limits" not in m2
+
+
+def test_a_planar_chain_with_limits_over_rest(api):
+    robot = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6],
+             "limits": [[-1, 1], [None, 1.2], [-3, 3]]}  # fmt: skip
+    run = _ok(api.post("/solve", json={"robot": robot, "algorithm": "pseudoinverse",
+                                       "x0": [0.3, 1.0, 1.0], "target": [0.2, 1.2]}))  # fmt: skip
+    assert run["limits"]["violation"]["name"] == "x2"
+    bad = api.post("/solve", json={"robot": {**robot, "limits": [[1, 0], [0, 1], [0, 1]]},
+                                   "algorithm": "pseudoinverse", "x0": [0.3, 1.0, 1.0],
+                                   "target": [0.2, 1.2]})  # fmt: skip
+    assert bad.status_code == 422 and "robot.limits" in bad.text and "lower < upper" in bad.text

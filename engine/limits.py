@@ -1,0 +1,163 @@
+"""Joint limits: whether a run stayed within a robot's limits, and its first violation.
+
+A robot's limits are a (p, 2) array of [lower, upper] per joint variable, -inf/+inf where a
+joint has none (a continuous joint). A URDF arm reads them from its file; a planar chain or a
+formula robot takes them from its definition (``"limits"``); the paper's robots have none. A start
+outside the limits is accepted (the run is the paper's algorithm, eq. (7), which knows nothing
+of limits) and reported as the first violation, at cycle 0, leg 0.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.validation import FloatArray
+
+
+def robot_limits(kinematics) -> FloatArray | None:
+    """The kinematics' joint limits (p, 2), or None when it has none."""
+    limits = getattr(kinematics, "joint_limits", None)
+    return None if limits is None else np.asarray(limits, dtype=float)
+
+
+def limit_names(kinematics) -> tuple[str, ...]:
+    """Each variable's name for a report: ``x4 (panda_joint4)`` for a URDF arm."""
+    joints = getattr(kinematics, "joint_names", None)
+    names = tuple(kinematics.variable_names)
+    if joints is None:
+        return names
+    return tuple(f"{v} ({j})" for v, j in zip(names, joints, strict=True))
+
+
+@dataclass(frozen=True)
+class LimitViolation:
+    """Where a run first left the limits.
+
+    ``cycle`` and ``leg`` count from 1 (0, 0: the start x0); ``joint`` indexes x (0-based),
+    ``name`` is its variable's name, ``value`` the joint's value there and ``limit`` the bound
+    it passed (``bound``: ``"lower"`` or ``"upper"``).
+    """
+
+    cycle: int
+    leg: int
+    joint: int
+    name: str
+    value: float
+    limit: float
+    bound: str
+
+    def __str__(self) -> str:
+        where = "the start x0" if self.cycle == 0 else f"cycle {self.cycle}, leg {self.leg}"
+        side = "below its lower" if self.bound == "lower" else "above its upper"
+        return f"{where}: {self.name} = {self.value:.6g}, {side} limit {self.limit:.6g}"
+
+    def as_dict(self) -> dict:
+        return {"cycle": self.cycle, "leg": self.leg, "joint": self.joint, "name": self.name,
+                "value": self.value, "limit": self.limit, "bound": self.bound}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class LimitsReport:
+    """Whether a run stayed within the limits, and if not its first violation."""
+
+    within: bool
+    violation: LimitViolation | None = None
+
+    def __str__(self) -> str:
+        return (
+            "within the joint limits"
+            if self.within
+            else f"left the joint limits at {self.violation}"
+        )
+
+    def as_dict(self) -> dict:
+        first = None if self.violation is None else self.violation.as_dict()
+        return {"within": self.within, "violation": first}
+
+
+def check_limits(limits, p: int, field: str = "limits") -> FloatArray:
+    """Validate limits: p pairs [lower, upper], lower < upper, None (or +-inf) for no bound."""
+    try:
+        raw = [[-np.inf if lo is None else lo, np.inf if hi is None else hi] for lo, hi in limits]
+        box = np.array(raw, dtype=float)
+    except (TypeError, ValueError):
+        box = np.zeros((0, 2))
+    if box.shape != (p, 2) or np.isnan(box).any() or not np.all(box[:, 0] < box[:, 1]):
+        raise InvalidInputError(
+            f"{field} must be {p} pairs [lower, upper] with lower < upper (null: no bound)", field
+        )
+    return box
+
+
+def outside(limits: FloatArray, x: FloatArray) -> FloatArray:
+    """Mask (...,) of the configurations x (..., p) outside the limits (p, 2)."""
+    x = np.asarray(x, dtype=float)
+    return np.any((x < limits[:, 0]) | (x > limits[:, 1]), axis=-1)
+
+
+def _first(limits: FloatArray, X: FloatArray) -> tuple[int, int] | None:
+    """(row, joint) of the first configuration of X (m, p) outside the limits."""
+    low, high = X < limits[:, 0], X > limits[:, 1]
+    rows = np.flatnonzero(np.any(low | high, axis=-1))
+    if rows.size == 0:
+        return None
+    i = int(rows[0])
+    return i, int(np.flatnonzero(low[i] | high[i])[0])
+
+
+def _violation(limits, x, joint, cycle, leg, names) -> LimitViolation:
+    lower = x[joint] < limits[joint, 0]
+    bound = limits[joint, 0 if lower else 1]
+    side = "lower" if lower else "upper"
+    return LimitViolation(cycle, leg, joint, names[joint], float(x[joint]), float(bound), side)
+
+
+def legs_report(
+    limits: FloatArray,
+    x0: FloatArray,
+    legs: Sequence[FloatArray],
+    legs_per_cycle: int,
+    names: Sequence[str],
+) -> LimitsReport:
+    """The first violation of a run: the start x0 (p,), then each leg's configurations in order
+    (a leg's trajectory (m, p), or its end (1, p)), leg k of cycle k // L + 1."""
+    x0 = np.asarray(x0, dtype=float)
+    found = _first(limits, x0[None])
+    if found is not None:
+        return LimitsReport(False, _violation(limits, x0, found[1], 0, 0, names))
+    for k, X in enumerate(legs):
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        found = _first(limits, X)
+        if found is not None:
+            cycle, leg = divmod(k, legs_per_cycle)
+            return LimitsReport(
+                False, _violation(limits, X[found[0]], found[1], cycle + 1, leg + 1, names)
+            )
+    return LimitsReport(True)
+
+
+def solve_report(limits: FloatArray, result, names: Sequence[str]) -> LimitsReport:
+    """A solve (one leg, cycle 1): its recorded trajectory from its start, else its end."""
+    traj = getattr(result, "trajectory", None)
+    X = traj.x if traj is not None else np.atleast_2d(result.x)
+    return legs_report(limits, X[0], [X], 1, names)
+
+
+def repeatability_report(limits: FloatArray, result, names: Sequence[str]) -> LimitsReport:
+    """A single start's repeatability run: every leg's trajectory when recorded, else its end."""
+    L = len(result.targets)
+    if result.leg_results:
+        legs = [r.trajectory.x if r.trajectory is not None else r.x for r in result.leg_results]
+    else:
+        legs = list(np.asarray(result.legs, dtype=float))
+    return legs_report(limits, result.x0, legs, L, names)
+
+
+def starts_outside(limits: FloatArray, x0: FloatArray, legs: FloatArray) -> FloatArray:
+    """Mask (n,) of the runs of an atlas (starts x0 (n, p), leg ends (n, C * L, p)) whose start
+    or some leg end is outside the limits."""
+    return outside(limits, x0) | np.any(outside(limits, legs), axis=-1)

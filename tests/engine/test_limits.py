@@ -1,0 +1,116 @@
+"""Joint limits: a run reports whether it stayed within them and its first violation."""
+
+import numpy as np
+import pytest
+
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.limits import (
+    LimitsReport,
+    check_limits,
+    legs_report,
+    limit_names,
+    repeatability_report,
+    robot_limits,
+    solve_report,
+    starts_outside,
+)
+from jik.engine.repeatability import repeatability
+from jik.engine.robot_spec import robot_from_dict
+from jik.engine.solver import solve
+
+LIMITS = np.array([[-1.0, 1.0], [-np.inf, np.inf], [0.0, 2.0]])
+NAMES = ("x1", "x2", "x3")
+
+
+def test_the_first_violation_is_found_in_order():
+    legs = [np.array([[0, 5, 1], [0.5, -9, 1.5]]), np.array([[0.9, 0, 1], [0.2, 0, 2.5]]),
+            np.array([[1.5, 0, 1]])]  # fmt: skip
+    report = legs_report(LIMITS, [0, 0, 1], legs, 2, NAMES)
+    assert not report.within
+    v = report.violation
+    assert (v.cycle, v.leg, v.joint, v.value, v.limit, v.bound) == (1, 2, 2, 2.5, 2.0, "upper")
+    assert (
+        str(report) == "left the joint limits at cycle 1, leg 2: x3 = 2.5, above its upper limit 2"
+    )
+    assert legs_report(LIMITS, [0, 0, 1], legs[:1], 2, NAMES) == LimitsReport(True)
+
+
+def test_a_start_outside_is_reported_at_cycle_0():
+    report = legs_report(LIMITS, [-1.2, 0, 1], [], 1, NAMES)
+    expected = {"cycle": 0, "leg": 0, "joint": 0, "name": "x1", "value": -1.2, "limit": -1.0,
+                "bound": "lower"}  # fmt: skip
+    assert report.violation.as_dict() == expected
+    assert "the start x0: x1 = -1.2, below its lower limit -1" in str(report)
+
+
+def test_atlas_starts_that_leave_the_limits():
+    x0 = np.array([[0, 0, 1], [0, 0, 1], [3, 0, 1]])
+    legs = np.array([[[0, 0, 1], [0, 0, 1]], [[0, 0, 1], [0, 0, -1]], [[0, 0, 1], [0, 0, 1]]])
+    np.testing.assert_array_equal(starts_outside(LIMITS, x0, legs), [False, True, True])
+
+
+@pytest.mark.parametrize(
+    "limits",
+    [[[0, 1]], [[1, 0], [0, 1], [0, 1]], [[0, 1], [0, "a"], [0, 1]], [[0, 1], [None, None], 3]],
+)
+def test_bad_limits_name_the_field(limits):
+    with pytest.raises(InvalidInputError, match="3 pairs") as err:
+        check_limits(limits, 3)
+    assert err.value.field == "limits"
+
+
+def test_a_planar_chain_takes_optional_limits():
+    arm = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]}
+    assert robot_limits(robot_from_dict(arm).kinematics) is None
+    robot = robot_from_dict({**arm, "limits": [[-1, 1], [None, 1.2], [-3, 3]]})
+    kin = robot.kinematics
+    np.testing.assert_array_equal(robot_limits(kin), [[-1, 1], [-np.inf, 1.2], [-3, 3]])
+    res = solve(robot.inverse(), [0.3, 1.0, 1.0], [0.2, 1.2])
+    report = solve_report(robot_limits(kin), res, limit_names(kin))
+    assert res.success and not report.within
+    assert report.violation.name == "x2" and report.violation.bound == "upper"
+
+
+def test_a_formula_robot_takes_optional_limits():
+    robot = robot_from_dict({"name": "formula", "variables": ["a", "b", "c"],
+                             "task": ["a + b", "b * c"],
+                             "limits": [[0, 1], [0, 1], [0, 1]]})  # fmt: skip
+    assert robot_limits(robot.kinematics).shape == (3, 2)
+
+
+def test_a_panda_run_below_joint_2s_limit_is_reported():
+    """From Franka's ready pose to a point behind the base, the pseudoinverse takes joint 2
+    below -1.7628 rad; the run converges and says where it left the limits."""
+    pytest.importorskip("yourdfpy")
+    robot = robot_from_dict({"name": "panda", "task": "xyz"})
+    kin = robot.kinematics
+    res = solve(robot.inverse(), robot.spec.default_x0, [-0.3, 0.0, 0.5])
+    report = solve_report(robot_limits(kin), res, limit_names(kin))
+    assert res.success and not report.within
+    v = report.violation
+    assert (v.cycle, v.leg, v.joint, v.name, v.bound) == (1, 1, 1, "x2 (panda_joint2)", "lower")
+    assert v.value < v.limit == -1.7628
+
+
+def test_a_panda_start_outside_the_limits_is_accepted_and_reported():
+    """Joint 4 at +0.2 (limits -3.0718, -0.0698): the run goes ahead and reports the start."""
+    pytest.importorskip("yourdfpy")
+    robot = robot_from_dict({"name": "panda", "task": "xyz"})
+    kin = robot.kinematics
+    x0 = np.array(robot.spec.default_x0)
+    x0[3] = 0.2
+    y0 = kin.forward(x0)
+    path = y0 + np.array([[0.05, 0, 0], [0.05, 0.05, 0]])
+    res = repeatability(robot.inverse(), x0, path, cycles=1, record=True)
+    report = repeatability_report(robot_limits(kin), res, limit_names(kin))
+    assert res.success and not report.within
+    assert report.violation.as_dict() == {"cycle": 0, "leg": 0, "joint": 3,
+                                          "name": "x4 (panda_joint4)", "value": 0.2,
+                                          "limit": -0.0698, "bound": "upper"}  # fmt: skip
+
+
+def test_continuous_joints_have_no_limits():
+    pytest.importorskip("yourdfpy")
+    kin = robot_from_dict({"name": "gen3"}).kinematics
+    limits = robot_limits(kin)
+    assert np.all(np.isinf(limits[[0, 2, 4, 6]])) and np.all(np.isfinite(limits[[1, 3, 5]]))
