@@ -19,6 +19,7 @@ from jik.engine.atlas import AtlasPlan
 from jik.engine.atlas_backends import Backend, backend_for
 from jik.engine.exceptions import RunCancelled, SingularConfigurationError
 from jik.engine.inverses import Inverse
+from jik.engine.limits import robot_limits, starts_outside
 from jik.engine.repeatability import repeatability
 from jik.engine.validation import FloatArray
 
@@ -55,6 +56,9 @@ class AtlasChunk:
     success : ndarray of bool, shape (A, n)
     failures : tuple of (a, run, message)
         The runs whose legs did not all converge, and why.
+    outside_limits : ndarray of bool, shape (A, n), or None
+        The runs whose start or some leg end is outside the robot's joint limits (None: the
+        robot has none).
     """
 
     lo: int
@@ -63,6 +67,7 @@ class AtlasChunk:
     leg_ends: FloatArray
     success: FloatArray
     failures: tuple[tuple[int, int, str], ...]
+    outside_limits: FloatArray | None = None
 
 
 def chunk_task(plan: AtlasPlan, lo: int, hi: int) -> ChunkTask:
@@ -91,7 +96,9 @@ def run_chunk(task: ChunkTask) -> AtlasChunk:
             failures.extend(
                 (a, task.lo + int(ids[k]), res.message[k]) for k in np.flatnonzero(~res.success)
             )
-    return AtlasChunk(task.lo, task.hi, drift, legs, success, tuple(failures))
+    limits = robot_limits(task.inverses[0].kinematics)
+    outside = None if limits is None else starts_outside(limits, task.starts, legs)
+    return AtlasChunk(task.lo, task.hi, drift, legs, success, tuple(failures), outside)
 
 
 def _runs(inverse: Inverse, task: ChunkTask, ids: np.ndarray):
@@ -130,6 +137,8 @@ class AtlasResult:
     success : ndarray of bool, shape (A, P, N)
     failures : dict
         (a, j, i) -> why that run failed.
+    outside_limits : ndarray of bool, shape (A, P, N), or None
+        The runs whose start or some leg end left the joint limits (None: the robot has none).
     """
 
     algorithms: tuple[str, ...]
@@ -140,6 +149,7 @@ class AtlasResult:
     leg_ends: FloatArray | None
     success: FloatArray
     failures: dict[tuple[int, int, int], str]
+    outside_limits: FloatArray | None = None
 
 
 def iter_atlas(
@@ -204,6 +214,8 @@ def run_atlas(
     drift = np.empty((A, P * N, plan.cycles))
     legs = np.empty((A, P * N, plan.cycles * plan.legs, p)) if keep_leg_ends else None
     success = np.empty((A, P * N), dtype=bool)
+    limited = robot_limits(plan.inverses[0].kinematics) is not None
+    outside = np.zeros((A, P * N), dtype=bool) if limited else None
     failures: dict[tuple[int, int, int], str] = {}
     done = 0
     for task, chunk in iter_atlas(plan, backend, cancelled):
@@ -211,6 +223,8 @@ def run_atlas(
         starts[sl], drift[:, sl], success[:, sl] = task.starts, chunk.drift, chunk.success
         if legs is not None:
             legs[:, sl] = chunk.leg_ends
+        if outside is not None and chunk.outside_limits is not None:
+            outside[:, sl] = chunk.outside_limits
         for a, run, why in chunk.failures:
             failures[(a, *divmod(run, N))] = why
         done += chunk.hi - chunk.lo
@@ -225,4 +239,5 @@ def run_atlas(
         None if legs is None else legs.reshape(A, P, N, *legs.shape[2:]),
         success.reshape(A, P, N),
         failures,
+        None if outside is None else outside.reshape(A, P, N),
     )

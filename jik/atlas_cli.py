@@ -264,6 +264,7 @@ class _Gathered:
         self.count = np.zeros((A, C))
         self.total = np.zeros((A, C))
         self.worst = np.zeros((A, C))
+        self.outside: Any = None  # (A,) runs that left the joint limits; None: no limits
         if keep:
             self.starts = np.empty((P, N, p))
             self.drift = np.empty((A, P, N, C))
@@ -282,6 +283,10 @@ class _Gathered:
         pick = (self.sampled >= lo) & (self.sampled < hi)
         self.last[:, pick] = chunk.drift[:, self.sampled[pick] - lo, -1]
         self.failures.update({(a, run): why for a, run, why in chunk.failures})
+        if chunk.outside_limits is not None:
+            self.outside = chunk.outside_limits.sum(axis=1) + (
+                0 if self.outside is None else self.outside
+            )
         if self.keep:
             for name, values in (("drift", chunk.drift), ("success", chunk.success),
                                  ("legs", chunk.leg_ends)):  # fmt: skip
@@ -301,6 +306,7 @@ class _Gathered:
                 "failed_runs": sum(1 for (b, _) in self.failures if b == a),
                 "mean_drift": _listed(mean[a]),
                 "max_drift": _listed(self.worst[a]),
+                **({} if self.outside is None else {"outside_limits": int(self.outside[a])}),
             }
             for a, alg in enumerate(self.plan.algorithms)
         }

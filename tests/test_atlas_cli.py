@@ -150,3 +150,21 @@ def test_a_robot_file_takes_no_param(tmp_path, capsys):
             "1.2,1.2; 1.2,1.6", "--quiet", "--out", str(tmp_path / "x.json")]  # fmt: skip
     assert main(argv) == 2
     assert "--param is for a built-in robot" in capsys.readouterr().err
+
+
+def test_a_catalogue_arm_counts_the_starts_that_leave_its_limits(tmp_path):
+    """The Panda's pose loop from its home pose: the runs whose start or a leg end is outside
+    the joint limits are counted, and agree with the leg ends of the JSON."""
+    pytest.importorskip("yourdfpy")
+    from jik.engine.limits import robot_limits, starts_outside
+    from jik.engine.robot_spec import robot_from_dict
+
+    path = "0.3069,0,0.5903,0,0,0; 0.38,0,0.59,0,0,0.2; 0.38,0.08,0.59,0.15,0,0.2"
+    assert main(["atlas", "--robot", "panda", "--path", path, "--starts", "16", "--cycles", "1",
+                 "--out", str(tmp_path / "a.json"), "--no-figure", "--quiet"]) == 0  # fmt: skip
+    doc = json.loads((tmp_path / "a.json").read_text())
+    count = doc["summary"]["pseudoinverse"]["outside_limits"]
+    limits = robot_limits(robot_from_dict({"name": "panda"}).kinematics)
+    legs = np.array(doc["results"]["pseudoinverse"]["leg_ends"], dtype=float)
+    expected = starts_outside(limits, np.array(doc["starts"], dtype=float), legs)
+    assert count == int(expected.sum()) and 0 < count < 16
