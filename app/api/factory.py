@@ -14,7 +14,16 @@ from fastapi_offline import FastAPIOffline
 from jik import __version__
 from jik.app.api.errors import BodyLimit, add_error_handlers
 from jik.app.api.fastpath import SolveFastPath
-from jik.app.api.routes import dashboard, health, repeatability, robots, sessions, solve, synthesize
+from jik.app.api.routes import (
+    dashboard,
+    health,
+    kinematics,
+    repeatability,
+    robots,
+    sessions,
+    solve,
+    synthesize,
+)
 from jik.app.api.routes.atlas import router as atlas_router
 from jik.app.api.routes.session_atlas import router as session_atlas_router
 from jik.app.api.security import SecurityMiddleware, allowed_hosts_from_env
@@ -64,7 +73,7 @@ def create_app(
     app.state.pool = pool
 
     add_error_handlers(app)
-    for module in (health, robots, solve, repeatability, synthesize):
+    for module in (health, robots, solve, repeatability, synthesize, kinematics):
         app.include_router(module.router)
     app.include_router(dashboard.router)
     app.include_router(sessions.router)

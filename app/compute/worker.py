@@ -31,6 +31,7 @@ WORK_FIELDS = {
     "repeatability": ("cycles", "fewer cycles or path points, a lower max_iterations"),
     "synthesize": ("region", "a smaller region, fewer nodes, a smaller grid or a lower degree"),
     "dashboard.run": ("cycles", "fewer cycles, a larger gamma or another start"),
+    "kinematics": ("x", "fewer configurations or a simpler robot"),
     "atlas.plan": (
         "reference",
         "another reference or path (eq. (7) from the reference to the "
@@ -61,6 +62,7 @@ def _solve_payload(items: list[bytes]) -> list[tuple[str, Any]]:
 TASKS = {
     "dashboard.run": "jik.app.dashboard.offload:run_offloaded",
     "atlas.plan": "jik.app.compute.atlas_jobs:plan_task",
+    "kinematics": "jik.app.compute.kinematics:kinematics_task",
 }
 
 

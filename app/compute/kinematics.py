@@ -1,0 +1,85 @@
+"""``POST /kinematics``: k(x) and J(x) of any robot at one configuration or a list of them.
+
+A user checks a model against their own tools before trusting a run: the same robot models as
+``/solve`` (a catalogue robot, a catalogue arm, or a definition), the engine's kinematics, eq. (4),
+and its analytic Jacobian. It runs in the compute workers (a robot's build is bounded there) as
+the task ``"kinematics"`` of :data:`jik.app.compute.worker.TASKS`.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+
+from jik.app.compute import schemas as S
+from jik.app.compute.exceptions import RequestError
+from jik.app.compute.requests import build_robot, nullable
+from jik.app.compute.user_robots import is_user_robot, user_robot
+
+#: Most configurations one request evaluates.
+MAX_CONFIGURATIONS = 1000
+
+Configuration = Annotated[list[S.Coordinate], Field(min_length=1, max_length=S.MAX_DIMENSION)]
+
+
+class KinematicsRequest(BaseModel):
+    """k(x) and J(x) of a robot at x: one configuration, or a list of them."""
+
+    model_config = ConfigDict(
+        extra="forbid",
+        json_schema_extra={"examples": [{"robot": {"name": "panda", "task": "pose"},
+                                         "x": [0, -0.785, 0, -2.356, 0, 1.571, 0.785]}]},
+    )  # fmt: skip
+
+    robot: S.AnyRobot = Field(
+        description="the robot, as for /solve: e.g. {'name': 'panda', 'task': 'pose'}"
+    )
+    x: (
+        Configuration
+        | Annotated[list[Configuration], Field(min_length=1, max_length=MAX_CONFIGURATIONS)]
+    ) = Field(description=f"one configuration (p numbers) or a list of 1 to {MAX_CONFIGURATIONS}")
+
+
+class KinematicsResponse(BaseModel):
+    robot: S.RobotUsed
+    variable_names: list[str] = Field(description="the p configuration variables, in x's order")
+    task_names: list[str] = Field(description="the r task coordinates, in k's order")
+    k: list[float | None] | list[list[float | None]] = Field(
+        description="k(x): r numbers, or one row per configuration (null where not finite)"
+    )
+    J: list[list[float | None]] | list[list[list[float | None]]] = Field(
+        description="J(x) = dk/dx: r rows of p, or one such matrix per configuration"
+    )
+
+
+def kinematics_request(req: KinematicsRequest) -> KinematicsResponse:
+    """The robot of ``req`` built, and its k and J at ``req.x``; raises :class:`RequestError`."""
+    if is_user_robot(req.robot):
+        robot, used, _ = user_robot(req.robot)
+        spec, kin = robot.spec, robot.kinematics
+    else:
+        spec, kin, used = build_robot(req.robot)
+    many = isinstance(req.x[0], list)
+    for i, row in enumerate(req.x if many else [req.x]):
+        if len(row) != spec.p:  # type: ignore[arg-type]
+            raise RequestError(f"x[{i}]" if many else "x", f"must have {spec.p} components "
+                               f"(p of {spec.title}: {list(spec.variable_names)}), got "
+                               f"{len(row)}")  # type: ignore[arg-type]  # fmt: skip
+    x = np.asarray(req.x, dtype=float)
+    forward_jacobian = getattr(kin, "forward_jacobian", None)
+    k, J = forward_jacobian(x) if forward_jacobian else (kin.forward(x), kin.jacobian(x))
+    return KinematicsResponse(
+        robot=used,
+        variable_names=list(spec.variable_names),
+        task_names=list(spec.task_names),
+        k=nullable(k),
+        J=nullable(J),
+    )
+
+
+def kinematics_task(body: bytes) -> bytes:
+    """The worker's task: request JSON in, response JSON out."""
+    response = kinematics_request(KinematicsRequest.model_validate_json(body))
+    return response.model_dump_json().encode()

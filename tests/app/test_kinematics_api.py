@@ -1,0 +1,67 @@
+"""POST /kinematics: k(x) and J(x) of any robot, one configuration or a list."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from jik.engine.arms import ARMS
+from jik.engine.kinematics import Manipulator2
+from jik.engine.robot_spec import robot_from_dict
+
+HOME = list(ARMS["panda"].home)
+
+
+def _ok(response) -> dict:
+    assert response.status_code == 200, response.text
+    return response.json()
+
+
+def test_one_configuration_of_a_paper_robot(api):
+    x = [0.1, 0.2, 1.3]
+    body = _ok(api.post("/kinematics", json={"robot": {"name": "manipulator2", "l": 1.5},
+                                             "x": x}))  # fmt: skip
+    kin = Manipulator2(1.5)
+    np.testing.assert_allclose(body["k"], kin.forward(np.array(x)), atol=1e-15)
+    np.testing.assert_allclose(body["J"], kin.jacobian(np.array(x)), atol=1e-15)
+    assert body["variable_names"] == ["x1", "x2", "x3"] and body["task_names"] == ["y1", "y2"]
+
+
+def test_a_list_of_configurations_of_the_panda_with_its_pose_task(api):
+    pytest.importorskip("yourdfpy")
+    x = np.random.default_rng(7).uniform(-1, 1, (5, 7))
+    x[:, 3] -= 1.5
+    body = _ok(api.post("/kinematics", json={"robot": {"name": "panda", "task": "pose"},
+                                             "x": x.tolist()}))  # fmt: skip
+    kin = robot_from_dict({"name": "panda", "task": "pose"}).kinematics
+    assert np.shape(body["k"]) == (5, 6) and np.shape(body["J"]) == (5, 6, 7)
+    np.testing.assert_allclose(body["k"], kin.forward(x), atol=1e-15)
+    np.testing.assert_allclose(body["J"], kin.jacobian(x), atol=1e-15)
+    assert body["task_names"] == ["x", "y", "z", "rx", "ry", "rz"]
+    home = _ok(api.post("/kinematics", json={"robot": {"name": "panda", "task": "pose"},
+                                             "x": HOME}))  # fmt: skip
+    np.testing.assert_allclose(home["k"], [0.3069, 0, 0.5903, 0, 0, 0], atol=1e-4)
+
+
+def test_a_user_robot(api):
+    robot = {"name": "planar_chain", "joints": "RRP", "lengths": [1.0, 0.5, 0.2]}
+    body = _ok(api.post("/kinematics", json={"robot": robot, "x": [0.0, 0.0, 0.1]}))
+    np.testing.assert_allclose(body["k"], [1.8, 0.0], atol=1e-15)
+
+
+@pytest.mark.parametrize(
+    ("body", "field", "text"),
+    [({"robot": {"name": "manipulator2"}, "x": [0.0, 1.0]}, "x", "must have 3 components"),
+     ({"robot": {"name": "manipulator2"}, "x": [[0, 0, 0], [0, 1]]}, "x[1]",
+      "must have 3 components"),
+     ({"robot": {"name": "manipulator2"}, "x": [0, "a", 1]}, "x", ""),
+     ({"robot": {"name": "nosuch"}, "x": [0, 0, 0]}, "robot", ""),
+     ({"robot": {"name": "manipulator2"}, "x": [[0, 0, 0]] * 1001}, "x", ""),
+     ({"robot": {"name": "panda", "task": "xyzq"}, "x": HOME}, "robot.task", "")],
+)  # fmt: skip
+def test_bad_requests_are_422_naming_the_field(api, body, field, text):
+    r = api.post("/kinematics", json=body)
+    assert r.status_code == 422, r.text
+    assert text in r.text
+    locs = [".".join(map(str, d["loc"][1:])) for d in r.json()["detail"]]
+    assert any(loc.startswith(field.split("[")[0]) for loc in locs), r.text
