@@ -102,24 +102,30 @@ class PoseTask:
         computed = [n for n in names if len(n) == 1] + [n for n in names if len(n) == 2]
         self.order = np.array([computed.index(n) for n in names])
         self.rotation = self.rotation_rows.size > 0
+        #: All six in the order x y z rx ry rz: no row is picked or moved.
+        self.full = self.names == COORDINATES
+        self.reference_T = np.ascontiguousarray(self.reference.T)
 
     def value(self, R: FloatArray, t: FloatArray) -> FloatArray:
         """k: (..., 3, 3), (..., 3) -> (..., r)."""
         parts = [t[..., self.position_rows]]
         if self.rotation:
-            parts.append(so3.log(self.reference.T @ R)[..., self.rotation_rows])
+            parts.append(so3.log(self.reference_T @ R)[..., self.rotation_rows])
         return np.concatenate(parts, axis=-1)[..., self.order]
 
     def value_jacobian(self, R, t, Jv, Jw) -> tuple[FloatArray, FloatArray]:
         """k (..., r) and J (..., r, p) from the pose and the geometric Jacobian."""
+        if self.full and R.ndim == 2:  # one configuration, the whole pose
+            phi, L = so3.log_and_jacobian(self.reference_T @ R)
+            return np.concatenate((t, phi)), np.concatenate((Jv, (L @ self.reference_T) @ Jw))
         values, rows = [t[..., self.position_rows]], [Jv[..., self.position_rows, :]]
         if self.rotation:
             if R.ndim == 2:
-                phi, L = so3.log_and_jacobian(self.reference.T @ R)
+                phi, L = so3.log_and_jacobian(self.reference_T @ R)
             else:
-                phi = so3.log(self.reference.T @ R)
+                phi = so3.log(self.reference_T @ R)
                 L = so3.left_jacobian_inverse(phi)
-            dphi = (L @ self.reference.T) @ Jw
+            dphi = (L @ self.reference_T) @ Jw
             values.append(phi[..., self.rotation_rows])
             rows.append(dphi[..., self.rotation_rows, :])
         k = np.concatenate(values, axis=-1)[..., self.order]

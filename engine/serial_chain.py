@@ -81,6 +81,19 @@ class CompiledChain:
         self.active = np.flatnonzero(self.index >= 0)
         #: Every movable joint active, in chain order: x is the joint vector itself.
         self.direct = bool(np.array_equal(self.index, np.arange(self.m)))
+        self._all_revolute = not self.prismatic.any()
+        # A joint's transform origin @ motion(q) is linear in (1, cos q, sin q, q):
+        # origin @ (M0 + cos q Kc + sin q Ks + q Kq), with Rz(q) or Tz(q) as the motion.
+        rev, pri = self.revolute[:, None, None], self.prismatic[:, None, None]
+        M0, Kc, Ks, Kq = np.zeros((4, self.m, 4, 4))
+        M0[:, 2, 2] = M0[:, 3, 3] = 1.0
+        M0[:, 0, 0] = M0[:, 1, 1] = np.where(self.prismatic, 1.0, 0.0)
+        Kc[:, 0, 0] = Kc[:, 1, 1] = 1.0
+        Ks[:, 1, 0], Ks[:, 0, 1] = 1.0, -1.0
+        Kq[:, 2, 3] = 1.0
+        self._P0 = self.origins @ M0
+        self._Pc, self._Ps = self.origins @ (rev * Kc), self.origins @ (rev * Ks)
+        self._Pq = self.origins @ (pri * Kq)
 
     def joint_values(self, x: FloatArray) -> FloatArray:
         """Every movable joint's value: x where active, the locked value elsewhere (..., m)."""
@@ -93,17 +106,16 @@ class CompiledChain:
     def frames(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
         """Each movable joint's frame after its motion (..., m, 4, 4), its axis the third
         column and (revolute) its origin the fourth, and the end link's pose (..., 4, 4)."""
-        q = self.joint_values(np.asarray(x, dtype=float))
-        M = np.zeros((*q.shape, 4, 4))
-        M[..., 2, 2] = M[..., 3, 3] = 1.0
-        c = np.where(self.revolute, np.cos(q), 1.0)
-        s = np.where(self.revolute, np.sin(q), 0.0)
-        M[..., 0, 0] = M[..., 1, 1] = c
-        M[..., 1, 0] = s
-        M[..., 0, 1] = -s
-        if self.prismatic.any():
-            M[..., 2, 3] = np.where(self.prismatic, q, 0.0)
-        A = self.origins @ M  # (..., m, 4, 4)
+        q = self.joint_values(np.asarray(x, dtype=float))[..., None, None]
+        A = self._P0 + np.cos(q) * self._Pc + np.sin(q) * self._Ps  # (..., m, 4, 4)
+        if not self._all_revolute:
+            A = A + q * self._Pq
+        if A.ndim == 3:  # one configuration: 4x4 products into one array
+            F = np.empty_like(A)
+            F[0] = A[0]
+            for j in range(1, self.m):
+                np.matmul(F[j - 1], A[j], out=F[j])
+            return F, F[-1] @ self.tip
         F = np.empty_like(A)
         F[..., 0, :, :] = A[..., 0, :, :]
         for j in range(1, self.m):
@@ -130,7 +142,7 @@ class CompiledChain:
         d = t[..., None, :] - F[..., :3, 3]
         outer = z[..., :, None] * d[..., None, :]  # (..., m, 3, 3)
         lin = outer.reshape(*outer.shape[:-2], 9) @ _CROSS  # z x d, (..., m, 3)
-        if self.prismatic.any():
+        if not self._all_revolute:
             lin = np.where(self.prismatic[:, None], z, lin)
             z = np.where(self.prismatic[:, None], 0.0, z)
         Jv, Jw = np.swapaxes(lin, -1, -2), np.swapaxes(z, -1, -2)  # (..., 3, m)

@@ -8,15 +8,17 @@ the task ``"kinematics"`` of :data:`jik.app.compute.worker.TASKS`.
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, Any, Union
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, create_model
 
 from jik.app.compute import schemas as S
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.requests import build_robot, nullable
 from jik.app.compute.user_robots import is_user_robot, user_robot
+from jik.engine.arms import ARMS
+from jik.engine.registry import ROBOTS
 
 #: Most configurations one request evaluates.
 MAX_CONFIGURATIONS = 1000
@@ -40,6 +42,50 @@ class KinematicsRequest(BaseModel):
         Configuration
         | Annotated[list[Configuration], Field(min_length=1, max_length=MAX_CONFIGURATIONS)]
     ) = Field(description=f"one configuration (p numbers) or a list of 1 to {MAX_CONFIGURATIONS}")
+
+
+def _points(p: int | None) -> Any:
+    """x: one configuration of p numbers (1 to 16 when p is known only once the robot is
+    built), or a list of them."""
+    one = Annotated[list[S.Coordinate], Field(min_length=p or 1, max_length=p or S.MAX_DIMENSION)]
+    return (
+        one | Annotated[list[one], Field(min_length=1, max_length=MAX_CONFIGURATIONS)],
+        Field(description=f"one configuration ({p or 'p'} numbers) or a list of 1 to "
+              f"{MAX_CONFIGURATIONS}"),
+    )  # fmt: skip
+
+
+def _exact(name: str, robot: Any, p: int | None) -> Any:
+    model = create_model(
+        f"Kinematics{S._camel(name)}Request",
+        __base__=KinematicsRequest,
+        __doc__=f"{KinematicsRequest.__doc__} ({name})",
+        robot=(robot, Field(description=robot.__doc__)),
+        x=_points(p),
+    )
+    globals()[model.__name__] = model  # importable by name (pickling, introspection)
+    return Annotated[model, Tag(name)]
+
+
+def _body() -> Any:
+    """The union of :func:`_exact` over the robots, chosen by ``robot.name``."""
+    members = [_exact(n, S.ROBOT_MODELS[n], spec.p) for n, spec in ROBOTS.items()]
+    members += [_exact(n, m, len(ARMS[n].home) if n in ARMS else None)
+                for n, m in S.USER_ROBOT_MODELS.items()]  # fmt: skip
+    return Annotated[
+        Union[tuple(members)],  # noqa: UP007
+        Discriminator(
+            S._robot_name,
+            custom_error_type="unknown_robot",
+            custom_error_message=f"give a robot whose name is one of {S.ROBOT_NAMES}",
+            custom_error_context={"names": str(S.ROBOT_NAMES)},
+        ),
+    ]
+
+
+#: ``POST /kinematics``'s body: a :class:`KinematicsRequest` whose x has its robot's p where the
+#: robot's name fixes it (the paper's robots, the catalogue arms), chosen by ``robot.name``.
+KinematicsBody = _body()
 
 
 class KinematicsResponse(BaseModel):

@@ -51,9 +51,12 @@ def test_a_user_robot(api):
 
 @pytest.mark.parametrize(
     ("body", "field", "text"),
-    [({"robot": {"name": "manipulator2"}, "x": [0.0, 1.0]}, "x", "must have 3 components"),
-     ({"robot": {"name": "manipulator2"}, "x": [[0, 0, 0], [0, 1]]}, "x[1]",
-      "must have 3 components"),
+    [({"robot": {"name": "manipulator2"}, "x": [0.0, 1.0]}, "x", "3 items"),
+     ({"robot": {"name": "panda"}, "x": [[0] * 7, [0] * 6]}, "x", "7 items"),
+     ({"robot": {"name": "planar_chain", "joints": "RRR", "lengths": [1, 1, 1]},
+       "x": [[0, 0, 0], [0, 1]]}, "x[1]", "must have 3 components"),
+     ({"robot": {"name": "planar_chain", "joints": "RRR", "lengths": [1, 1, 1]},
+       "x": [0, 1]}, "x", "must have 3 components (p of planar chain"),
      ({"robot": {"name": "manipulator2"}, "x": [0, "a", 1]}, "x", ""),
      ({"robot": {"name": "nosuch"}, "x": [0, 0, 0]}, "robot", ""),
      ({"robot": {"name": "manipulator2"}, "x": [[0, 0, 0]] * 1001}, "x", ""),

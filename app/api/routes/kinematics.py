@@ -3,14 +3,14 @@
 from fastapi import APIRouter, Response
 
 from jik.app.api.dependencies import Pool
-from jik.app.compute.kinematics import KinematicsRequest, KinematicsResponse
+from jik.app.compute.kinematics import KinematicsBody, KinematicsResponse
 from jik.app.compute.schemas import BUSY
 
 router = APIRouter(tags=["kinematics"])
 
 
 @router.post("/kinematics", response_model=KinematicsResponse, responses=BUSY)
-async def kinematics(req: KinematicsRequest, pool: Pool) -> Response:
+async def kinematics(req: KinematicsBody, pool: Pool) -> Response:
     """The robot's task coordinates k(x), eq. (4), and its analytic Jacobian J(x) at one
     configuration (``x`` a list of p numbers) or at each of a list of them. The robot is built
     in a compute worker, within its time and memory limits."""
