@@ -82,6 +82,12 @@ def _limits(robot: Robot, report):
     return None if limits is None else report(limits, limit_names(robot.kinematics))
 
 
+def _notes(robot: Robot) -> dict:
+    """``{"notes": [...]}``: what building the robot skipped (a URDF's mesh references)."""
+    notes = list(getattr(robot.kinematics, "notes", ()))
+    return {"notes": notes} if notes else {}
+
+
 def _fmt(v) -> str:
     return "(" + ", ".join(f"{float(t):.10g}" for t in v) + ")"
 
@@ -100,11 +106,14 @@ def solve_command(args: argparse.Namespace) -> int:
         "target": list(target), "x": res.x.tolist(), "y": res.y.tolist(), "error": res.error,
         "success": res.success, "message": res.message, "nit": res.nit,
         **({} if report is None else {"limits": report.as_dict()}),
+        **_notes(robot),
     }  # fmt: skip
     if args.json:
         print(json.dumps(out))
     else:
         print(f"{out['robot']}, {out['algorithm']}: {res.message}")
+        for note in out.get("notes", ()):
+            print(f"  note: {note}")
         print(f"  x0 = {_fmt(x0)}\n  x  = {_fmt(res.x)}\n  k(x) = {_fmt(res.y)}, "
               f"|k(x) - target| = {res.error:.3g}")  # fmt: skip
         if report is not None:
@@ -128,11 +137,14 @@ def repeatability_command(args: argparse.Namespace) -> int:
         "cycle_end": rep.cycle_end.tolist(), "drift": rep.drift.tolist(),
         "success": bool(rep.success), "message": rep.message,
         **({} if report is None else {"limits": report.as_dict()}),
+        **_notes(robot),
     }  # fmt: skip
     if args.json:
         print(json.dumps(out))
     else:
         print(f"{out['robot']}, {out['algorithm']}: {rep.message}")
+        for note in out.get("notes", ()):
+            print(f"  note: {note}")
         print(f"  x0 = {_fmt(x0)}; {len(rep.targets)} legs a cycle")
         for c, (end, drift) in enumerate(zip(rep.cycle_end, rep.drift, strict=True)):
             print(f"  cycle {c + 1}: x = {_fmt(end)}, |x - x0| = {drift:.3e}")
