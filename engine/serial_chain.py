@@ -138,6 +138,10 @@ class CompiledChain:
             column is (z x (t - o), z), a prismatic joint's (z, 0).
         """
         F, T = self.frames(x)
+        if F.ndim == 3 and self.direct and self._all_revolute:  # (plain indexing: faster)
+            z, t = F[:, :3, 2], T[:3, 3]
+            lin = (z[:, :, None] * (t - F[:, :3, 3])[:, None, :]).reshape(self.m, 9) @ _CROSS
+            return T[:3, :3], t, lin.T, z.T
         z, t = F[..., :3, 2], T[..., :3, 3]  # (..., m, 3), (..., 3)
         d = t[..., None, :] - F[..., :3, 3]
         outer = z[..., :, None] * d[..., None, :]  # (..., m, 3, 3)
