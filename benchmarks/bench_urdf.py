@@ -14,7 +14,8 @@ compute the same k(x) (6,) and J(x) (6, 7):
    ``engine.solver.solve`` against ``solve_ivp`` (RK45 and DOP853, rtol = atol = 1e-12, a
    terminal event at the error) on Pinocchio's k and J.
 
-Times are wall-clock medians (``time.perf_counter``); the machine may be shared, so compare the
+Times are wall-clock (``time.perf_counter``): for one configuration the best of 40 rounds in
+which jik and Pinocchio take turns, otherwise medians. The machine may be shared: compare the
 ratios of one run.
 """
 
@@ -47,12 +48,17 @@ def _median(fn, repeat: int) -> float:
     return statistics.median(times)
 
 
-def _per_call(fn, calls: int, repeat: int) -> float:
-    def many():
-        for _ in range(calls):
-            fn()
-
-    return _median(many, repeat) / calls
+def _interleaved(fns: dict, calls: int, repeat: int) -> dict:
+    """Each function's time per call, the best of ``repeat`` rounds of ``calls`` calls, the
+    functions taking turns in every round (a shared machine's load then weighs on all alike)."""
+    best = dict.fromkeys(fns, float("inf"))
+    for _ in range(repeat):
+        for name, fn in fns.items():
+            t = time.perf_counter()
+            for _ in range(calls):
+                fn()
+            best[name] = min(best[name], (time.perf_counter() - t) / calls)
+    return best
 
 
 class PinocchioPose:
@@ -105,12 +111,12 @@ def run(quick: bool = False) -> dict | None:
     k, J = kin.forward_jacobian(x)
     kp, Jp = pose.forward_jacobian(x)
     agree = max(np.abs(k - kp).max(), np.abs(J - Jp).max())
-    reps, calls = (3, 200) if quick else (9, 2000)
-    one = {
-        "jik": _per_call(lambda: kin.forward_jacobian(x), calls, reps),
-        "pinocchio": _per_call(lambda: pose.forward_jacobian(x), calls, reps),
-        "pinocchio_se3": _per_call(lambda: pose.se3(x), calls, reps),
-    }
+    reps, calls = (5, 100) if quick else (40, 200)
+    one = _interleaved(
+        {"jik": lambda: kin.forward_jacobian(x), "pinocchio": lambda: pose.forward_jacobian(x),
+         "pinocchio_se3": lambda: pose.se3(x)}, calls, reps,
+    )  # fmt: skip
+    reps = 3 if quick else 9
     X = np.array(arm.home) + np.random.default_rng(8).uniform(-0.5, 0.5, (4096, 7))
     loop_n = 512 if quick else 4096
     batch = {
