@@ -38,7 +38,14 @@ from jik.engine.formula_kinematics import FormulaKinematics, FormulaMap
 from jik.engine.functionals import check_region
 from jik.engine.inverses import Inverse
 from jik.engine.kinematics import Kinematics
-from jik.engine.limits import check_limits
+from jik.engine.limits import (
+    LimitsReport,
+    check_limits,
+    limit_names,
+    repeatability_report,
+    robot_limits,
+    solve_report,
+)
 from jik.engine.planar_chain import PlanarChain
 from jik.engine.registry import ROBOTS, AugmentationSpec, RobotSpec, make_inverse
 from jik.engine.repeatability import MAX_PATH_POINTS
@@ -67,6 +74,17 @@ class Robot:
     kinematics: Kinematics
     definition: dict
     map_vectors: Mapping[str, tuple[AugmentingMap, ...]] = field(default_factory=dict)
+
+    def limits_report(self, result) -> LimitsReport | None:
+        """Whether a run of this robot (a solve's or a single start's repeatability result)
+        stayed within its joint limits, and its first violation; None for a robot without."""
+        limits = robot_limits(self.kinematics)
+        if limits is None:
+            return None
+        names = limit_names(self.kinematics)
+        if hasattr(result, "leg_results"):
+            return repeatability_report(limits, result, names)
+        return solve_report(limits, result, names)
 
     def inverse(
         self,

@@ -114,3 +114,16 @@ def test_continuous_joints_have_no_limits():
     kin = robot_from_dict({"name": "gen3"}).kinematics
     limits = robot_limits(kin)
     assert np.all(np.isinf(limits[[0, 2, 4, 6]])) and np.all(np.isfinite(limits[[1, 3, 5]]))
+
+
+def test_a_robot_reports_its_runs_limits():
+    """Robot.limits_report: a solve's and a repeatability run's; None without limits."""
+    pytest.importorskip("yourdfpy")
+    panda = robot_from_dict({"name": "panda", "task": "xyz"})
+    res = solve(panda.inverse(), panda.spec.default_x0, [-0.3, 0.0, 0.5])
+    assert panda.limits_report(res).violation.name == "x2 (panda_joint2)"
+    home = np.array(panda.spec.default_x0)
+    run = repeatability(panda.inverse(), home, panda.kinematics.forward(home) + [[0.05, 0, 0]],
+                        record=True)  # fmt: skip
+    assert panda.limits_report(run) == LimitsReport(True)
+    assert robot_from_dict({"name": "manipulator2"}).limits_report(res) is None
