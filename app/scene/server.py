@@ -49,14 +49,18 @@ _installed = threading.Lock()
 
 
 def handshake_refusal(headers: Any) -> str | None:
-    """Why a handshake on a scene's port is refused (see the module's text), or None."""
-    if headers.get("Origin") is not None:
+    """Why a handshake on a scene's port is refused (see the module's text), or None.
+    ``headers``: websockets' ``Headers`` (a name may come more than once)."""
+    if headers.get_all("Origin"):
         return "a scene server takes no browser's request: use /api/sessions/{id}/scene"
-    host = headers.get("Host", "")
+    hosts = headers.get_all("Host")
+    host = hosts[0] if len(hosts) == 1 else ""
     name = host[: host.find("]") + 1] if host.startswith("[") else host.rsplit(":", 1)[0]
     if name.lower() not in _LOOPBACK:
         return "a scene server answers to loopback names only"
-    if not hmac.compare_digest(headers.get("Authorization", "").encode(), _AUTHORIZATION.encode()):
+    keys = headers.get_all("Authorization")
+    key = keys[0] if len(keys) == 1 else ""
+    if not hmac.compare_digest(key.encode(), _AUTHORIZATION.encode()):
         return "a scene server takes the API's relay only"
     return None
 
@@ -101,7 +105,7 @@ def _install_guard() -> None:
     with _installed:
         if websockets.asyncio.server.serve is not _GuardedServe:
             websockets.asyncio.server.serve = _GuardedServe  # type: ignore[misc]
-        rich.reconfigure(file=_ViserLog(), width=100)
+            rich.reconfigure(file=_ViserLog(), width=100)
 
 
 class UnguardedSceneServer(RuntimeError):

@@ -221,3 +221,27 @@ def test_the_openapi_document_gives_the_event_stream_and_the_csv_their_types(cli
     assert list(events["200"]["content"]) == ["text/event-stream"] and "404" in events
     csv = paths["/api/sessions/{session_id}/export.csv"]["get"]["responses"]
     assert list(csv["200"]["content"]) == ["text/csv"] and {"404", "503"} <= set(csv)
+
+
+@pytest.mark.parametrize(
+    ("headers", "refused"),
+    [
+        ([("Host", "127.0.0.1:5"), ("Authorization", "KEY")], None),
+        ([("Host", "[::1]:5"), ("Authorization", "KEY")], None),
+        ([("Host", "127.0.0.1:5")], "relay only"),
+        ([("Host", "127.0.0.1:5"), ("Authorization", "KEY"), ("Authorization", "KEY")],
+         "relay only"),
+        ([("Host", "127.0.0.1:5"), ("Authorization", "KEYx")], "relay only"),
+        ([("Host", "localhost.attacker.example"), ("Authorization", "KEY")], "loopback"),
+        ([("Host", "127.0.0.1:5"), ("Host", "evil"), ("Authorization", "KEY")], "loopback"),
+        ([("Host", "127.0.0.1:5"), ("Authorization", "KEY"), ("Origin", "null")], "browser"),
+    ],
+)  # fmt: skip
+def test_a_scene_handshake_needs_the_key_a_loopback_host_and_no_origin(headers, refused):
+    from websockets.datastructures import Headers
+
+    from jik.app.scene.server import SCENE_KEY, handshake_refusal
+
+    key = f"Bearer {SCENE_KEY}"
+    reason = handshake_refusal(Headers([(k, v.replace("KEY", key)) for k, v in headers]))
+    assert (reason is None) if refused is None else (refused in (reason or "")), reason
