@@ -126,7 +126,10 @@ class SceneServer(viser.ViserServer):
 
     def _probe(self) -> None:
         """Fail closed: a request without the key must be refused."""
-        probe = http.client.HTTPConnection("127.0.0.1", self.get_port(), timeout=10)
+        host = self.get_host()
+        probe = http.client.HTTPConnection(
+            "127.0.0.1" if host in ("0.0.0.0", "") else host, self.get_port(), timeout=10
+        )
         try:
             probe.request("GET", "/")
             status = probe.getresponse().status

@@ -245,3 +245,13 @@ def test_a_scene_handshake_needs_the_key_a_loopback_host_and_no_origin(headers, 
     key = f"Bearer {SCENE_KEY}"
     reason = handshake_refusal(Headers([(k, v.replace("KEY", key)) for k, v in headers]))
     assert (reason is None) if refused is None else (refused in (reason or "")), reason
+
+
+def test_a_scene_server_that_would_serve_unguarded_is_not_started(monkeypatch):
+    """Should viser stop taking the handshake guard, a scene server fails closed: it is
+    stopped and an error says why, instead of serving anyone on its port."""
+    import jik.app.scene.server as scene_server
+
+    monkeypatch.setattr(scene_server, "_guarded", lambda process_request: process_request)
+    with pytest.raises(scene_server.UnguardedSceneServer, match="answered 200"):
+        scene_server.SceneServer()
