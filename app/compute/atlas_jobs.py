@@ -32,6 +32,7 @@ from jik.engine.atlas import AtlasPlan, plan_atlas
 from jik.engine.atlas_backends import ProcessPool
 from jik.engine.atlas_run import AtlasResult, run_atlas
 from jik.engine.exceptions import InvalidInputError, RunCancelled
+from jik.engine.progress import ProgressCallbacks
 from jik.engine.registry import make_inverse
 from jik.engine.repeatability import CLOSE_TOL
 from jik.engine.self_motion import MAX_ARC
@@ -242,13 +243,13 @@ class AtlasJobs:
             job.status = "running"
             job.started = time.monotonic()
 
-            def progress(done: int, _total: int) -> None:
-                job.runs_done = done
+            def progress(done: float, _total: float) -> None:
+                job.runs_done = int(done)
 
             res = run_atlas(
                 job.plan, ProcessPool(self.limits.workers, self.limits.worker_memory),
-                on_progress=progress,
-                cancelled=job.cancel.is_set, keep_leg_ends=job.leg_ends,
+                progress=ProgressCallbacks(on_advance=progress, is_cancelled=job.cancel.is_set),
+                keep_leg_ends=job.leg_ends,
             )  # fmt: skip
             job.result = result_document(res, job.plan.manifolds[0].arc, job.leg_ends)
             self._end(job, "done")

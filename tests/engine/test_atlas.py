@@ -18,6 +18,7 @@ from jik.engine.augmentations import PaperCubic
 from jik.engine.exceptions import InvalidInputError, RunCancelled
 from jik.engine.inverses import ExtendedInverse, Pseudoinverse, extended_singularity
 from jik.engine.kinematics import Manipulator1, Manipulator2
+from jik.engine.progress import ProgressCallbacks
 from jik.engine.repeatability import repeatability
 from jik.engine.self_motion import trace
 from jik.engine.solver import solve
@@ -214,8 +215,13 @@ def test_cancelled_stops_between_chunks():
     plan = small_plan(chunk=4)
     seen = []
     with pytest.raises(RunCancelled, match="after run 8 of 24"):
-        run_atlas(plan, on_progress=lambda done, total: seen.append(done),
-                  cancelled=lambda: len(seen) >= 2)  # fmt: skip
+        run_atlas(
+            plan,
+            progress=ProgressCallbacks(
+                on_advance=lambda done, total: seen.append(done),
+                is_cancelled=lambda: len(seen) >= 2,
+            ),
+        )
     assert seen == [4, 8]
 
 
