@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from functools import partial
+from typing import Any
 
 import numpy as np
 
@@ -27,6 +27,7 @@ from jik.engine.solver import (
     Trajectory,
     chain_guesses,
     solve,
+    solve_batch,
     solve_in_chunks,
 )
 from jik.engine.unicycle import Unicycle
@@ -268,7 +269,9 @@ def repeatability(
     # (cycle_guesses). Batches do without: a guess is per member.
     guided = single and mode == "continuous"
     guides: list[Trajectory | None] = [None] * L
-    step = partial(solve, inverse, gamma=gamma, mode=mode, tol=tol, max_iterations=max_iterations)
+    settings: dict[str, Any] = {
+        "gamma": gamma, "mode": mode, "tol": tol, "max_iterations": max_iterations,
+    }  # fmt: skip
     first = 0
     if resume is not None:
         done, given = _resumed(resume, n, L, kin.p, cycles)
@@ -295,10 +298,11 @@ def repeatability(
                         between=_between(progress, f"in {where}"),
                     )  # fmt: skip
                 elif single:  # (a SolveResult: its trajectory guides the next cycle's leg)
-                    guess = [guesses[j]] if guided else None
-                    res = step(current[0], targets[0, j], record=record or guided, guess=guess)
+                    res = solve(inverse, current[0], targets[0, j], record=record or guided,
+                                guess=guesses[j] if guided else None, **settings)  # fmt: skip
                 else:  # (current[ids] is (k, p): a BatchSolveResult)
-                    res = step(current[ids], targets[ids, j], record=False)
+                    res = solve_batch(inverse, current[ids], targets[ids, j], record=False,
+                                      **settings)  # fmt: skip
             except JikError as exc:
                 if on_undefined == "raise":
                     raise

@@ -36,6 +36,7 @@ from jik.engine.progress import ProgressCallbacks
 from jik.engine.registry import make_inverse
 from jik.engine.repeatability import CLOSE_TOL
 from jik.engine.self_motion import MAX_ARC
+from jik.engine.solver import gamma_problem
 
 
 class AtlasJobNotFound(LookupError):
@@ -86,8 +87,8 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
             raise RequestError(name, f"must have {size} components, got {len(v)}")
     gamma = spec.default_gamma if req.gamma is None else req.gamma
     mode = req.mode or spec.default_mode
-    if mode == "discrete" and gamma >= 2:
-        raise RequestError("gamma", f"must be < 2 in discrete mode, got {gamma:g}")
+    if (why := gamma_problem(gamma, mode)) is not None:
+        raise RequestError("gamma", why)
     paths = len(req.shifts or [0]) * len(req.scales or [0])
     closed = np.linalg.norm(np.subtract(req.path[-1], req.path[0])) <= CLOSE_TOL
     legs = req.starts * paths * req.cycles * (len(req.path) - closed) * len(req.algorithms)
