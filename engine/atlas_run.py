@@ -21,6 +21,7 @@ from jik.engine.exceptions import SingularConfigurationError
 from jik.engine.inverses import Inverse
 from jik.engine.progress import Progress, check_cancelled
 from jik.engine.repeatability import repeatability
+from jik.engine.results import dataframe
 from jik.engine.validation import FloatArray
 
 #: Starts per batched repeatability() call within a chunk: the working set of the Picard sweeps
@@ -141,6 +142,38 @@ class AtlasResult:
     leg_ends: FloatArray | None
     success: FloatArray
     failures: dict[tuple[int, int, int], str]
+
+    def __repr__(self) -> str:
+        _, P, N, cycles = self.drift.shape
+        last = self.drift[..., -1]
+        worst = np.max(np.where(np.isfinite(last), last, -np.inf), axis=(1, 2))
+        drifts = ", ".join(
+            f"{a} {w:.3g}" for a, w in zip(self.algorithms, worst, strict=True) if np.isfinite(w)
+        )  # fmt: skip
+        drifts = f", largest drift after the last cycle: {drifts}" if drifts else ""
+        return (
+            f"AtlasResult({'/'.join(self.algorithms)}, {P} paths x {N} starts x {cycles} cycles, "
+            f"{int(np.count_nonzero(self.success))} of {self.success.size} runs completed"
+            f"{drifts})"
+        )
+
+    def columns(self) -> dict[str, FloatArray]:
+        """One array per column, a row per algorithm, path, start and cycle (long format):
+        ``algorithm``, ``path``, ``start``, ``s`` (arc length, NaN for given starts),
+        ``cycle`` (from 1), ``drift``, ``success`` (the run's), and the start ``x1``..``xp``."""
+        A, P, N, C = self.drift.shape
+        a, j, i, c = (g.ravel() for g in np.indices((A, P, N, C)))
+        s = np.full(N, np.nan) if self.parameter is None else np.asarray(self.parameter)
+        out = {
+            "algorithm": np.asarray(self.algorithms)[a], "path": j, "start": i, "s": s[i],
+            "cycle": c + 1, "drift": self.drift.ravel(), "success": self.success[a, j, i],
+        }  # fmt: skip
+        starts = self.starts[j, i]
+        return out | {f"x{k + 1}": starts[:, k] for k in range(starts.shape[1])}
+
+    def to_dataframe(self):
+        """The atlas as a pandas DataFrame in long format (:meth:`columns`)."""
+        return dataframe(self.columns())
 
 
 def iter_atlas(

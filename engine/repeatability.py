@@ -21,6 +21,7 @@ import numpy as np
 from jik.engine.exceptions import InvalidInputError, JikError
 from jik.engine.inverses import Inverse
 from jik.engine.progress import Progress, check_cancelled
+from jik.engine.results import RepeatabilityResult
 from jik.engine.solver import (
     BatchSolveResult,
     SolveResult,
@@ -45,35 +46,6 @@ CLOSE_TOL = 1e-12
 #: iterations (:func:`jik.engine.solver.solve_in_chunks`: the same iterates), between which a
 #: cancellation is heard and the leg's progress told.
 POLL_ITERATIONS = 80
-
-
-@dataclass(frozen=True)
-class RepeatabilityResult:
-    """Configurations along a closed path driven ``cycles`` times.
-
-    Attributes
-    ----------
-    targets : ndarray, shape (L, r) or (n, L, r)
-        The task point of every leg of one cycle (the given path, closed by k(x0) if needed).
-    legs : ndarray, shape (cycles * L, p) or (n, cycles * L, p)
-        Configuration after each leg.
-    cycle_end : ndarray, shape (cycles, p) or (n, cycles, p)
-    drift : ndarray, shape (cycles,) or (n, cycles)
-        ||cycle_end[c] - x0||.
-    success : bool or ndarray of bool, shape (n,)
-    message : str or tuple of str
-    leg_results : list of SolveResult
-        Every leg with its trajectory (single start with ``record=True`` only).
-    """
-
-    x0: FloatArray
-    targets: FloatArray
-    legs: FloatArray
-    cycle_end: FloatArray
-    drift: FloatArray
-    success: bool | FloatArray
-    message: str | tuple[str, ...]
-    leg_results: list[SolveResult]
 
 
 @dataclass(frozen=True)

@@ -1,8 +1,9 @@
 """The continuation (Wazewski-Davidenko) IK algorithm, eq. (7), batched over start configurations.
 
 (It stays whole, at about 730 lines: the two continuous integrators, the discrete iteration and
-:func:`solve_in_chunks` share one result type, one stopping rule, one check of the start and one
-message; the DOP853 coefficients and the Picard sweeps already live in modules of their own.)
+:func:`solve_in_chunks` share one stopping rule, one check of the start and one message; the
+result types (:mod:`jik.engine.results`), the DOP853 coefficients and the Picard sweeps live in
+modules of their own.)
 
 Continuous mode follows the trajectory of dx/dtheta = -gamma J#(x) (k(x) - y_d) with two
 adaptive high-order methods: Chebyshev-Picard iteration on the equivalent homotopy form (spectral,
@@ -18,8 +19,7 @@ progress and cancellation), the same iterates.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, replace
-from functools import cached_property
+from dataclasses import replace
 
 import numpy as np
 
@@ -27,6 +27,7 @@ from jik.engine import dop853 as _dop
 from jik.engine.exceptions import InvalidInputError, JikError
 from jik.engine.inverses import Inverse
 from jik.engine.picard import Guess, picard_chain, picard_path
+from jik.engine.results import BatchSolveResult, SolveResult, Trajectory
 from jik.engine.validation import FloatArray, count, positive
 
 _NS = _dop.N_STAGES
@@ -62,112 +63,6 @@ GAMMA_MIN, GAMMA_MAX = 1e-6, 1e6
 DISCRETE_GAMMA_BOUND = 2.0
 
 _RUNNING, _CONVERGED, _SINGULAR, _MAX_STEPS, _DIVERGED, _STALLED = range(6)
-
-
-@dataclass(frozen=True)
-class Trajectory:
-    """One run of eq. (7), point by point (accepted steps or iterations).
-
-    Attributes
-    ----------
-    theta : ndarray, shape (m,)
-        Continuation parameter theta (continuous) or iteration number (discrete).
-    x : ndarray, shape (m, p)
-    y : ndarray, shape (m, r)
-        k(x).
-    error : ndarray, shape (m,)
-        ||k(x) - y_d||.
-    h : ndarray, shape (m,) or None
-        h(x) for the extended inverse (constant along the continuous flow, eq. (12)); NaN at a
-        point where h is undefined (a run stopped there).
-    """
-
-    theta: FloatArray
-    x: FloatArray
-    y: FloatArray
-    error: FloatArray
-    h: FloatArray | None
-
-
-@dataclass(frozen=True)
-class SolveResult:
-    """Result of one solve, in SciPy's vocabulary (``x``, ``success``, ``message``, ``nit``)."""
-
-    x: FloatArray
-    y: FloatArray
-    error: float
-    success: bool
-    message: str
-    nit: int
-    trajectory: Trajectory | None
-    mode: str
-    gamma: float
-    algorithm: str
-
-
-@dataclass(frozen=True)
-class BatchSolveResult:
-    """Results of a batch of solves; index it for a :class:`SolveResult` with its trajectory."""
-
-    x: FloatArray  # (n, p)
-    y: FloatArray  # (n, r)
-    error: FloatArray  # (n,)
-    success: FloatArray  # (n,) bool
-    message: tuple[str, ...]
-    nit: FloatArray  # (n,) int
-    mode: str
-    gamma: float
-    algorithm: str
-    _inverse: Inverse = field(repr=False)
-    _y_d: FloatArray = field(repr=False)
-    # Recorded points: member index, theta, x of every accepted step, in order.
-    _rec_member: FloatArray | None = field(repr=False, default=None)
-    _rec_theta: FloatArray | None = field(repr=False, default=None)
-    _rec_x: FloatArray | None = field(repr=False, default=None)
-    # Each member's outcome (_CONVERGED, _SINGULAR, ...): solve_in_chunks words its message.
-    _status: FloatArray | None = field(repr=False, default=None)
-
-    def __len__(self) -> int:
-        return len(self.x)
-
-    def trajectory(self, i: int) -> Trajectory:
-        """The trajectory of member ``i`` (requires ``record=True``)."""
-        # The three recordings are set together (all or none).
-        if self._rec_member is None or self._rec_theta is None or self._rec_x is None:
-            raise InvalidInputError("trajectories were not recorded; solve with record=True")
-        ys, h, err, bounds = self._recorded
-        sel = slice(bounds[i], bounds[i + 1])
-        return Trajectory(
-            theta=self._rec_theta[sel],
-            x=self._rec_x[sel],
-            y=ys[sel],
-            error=err[sel],
-            h=None if h is None else h[sel],
-        )
-
-    @cached_property
-    def _recorded(self):
-        """k(x), h(x), ||k(x) - y_d|| of every recorded point at once, and each member's slice."""
-        assert self._rec_member is not None and self._rec_x is not None
-        ys = self._inverse.kinematics.forward(self._rec_x)
-        h = self._inverse.augmenting_value(self._rec_x)
-        err = np.linalg.norm(ys - self._y_d[self._rec_member], axis=-1)
-        bounds = np.searchsorted(self._rec_member, np.arange(len(self.x) + 1))  # sorted members
-        return ys, None if h is None else np.asarray(h), err, bounds
-
-    def __getitem__(self, i: int) -> SolveResult:
-        return SolveResult(
-            x=self.x[i],
-            y=self.y[i],
-            error=float(self.error[i]),
-            success=bool(self.success[i]),
-            message=self.message[i],
-            nit=int(self.nit[i]),
-            trajectory=self.trajectory(i) if self._rec_member is not None else None,
-            mode=self.mode,
-            gamma=self.gamma,
-            algorithm=self.algorithm,
-        )
 
 
 def gamma_problem(gamma: float, mode: str) -> str | None:

@@ -183,6 +183,10 @@ class SynthesisResult:
     fixed: dict[str, float] = field(default_factory=dict)
     degree: int = 0
 
+    def __repr__(self) -> str:
+        box = ", ".join(f"{k} in [{lo:.4g}, {hi:.4g}]" for k, (lo, hi) in self.region.items())
+        return f"SynthesisResult(E2 = {self.e2:.6g}, degree {self.degree}, {box})"
+
     def polynomial_coefficients(self) -> dict[str, float]:
         """Cubic coefficients keyed like ``"x2^2 x3^1"`` (JSON-friendly)."""
         if self.polynomial is None:
