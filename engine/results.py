@@ -33,6 +33,10 @@ def short_text(text: str, width: int = 60) -> str:
     return repr(text if len(text) <= width else text[: width - 3] + "...")
 
 
+def _plural(n: int, noun: str) -> str:
+    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
+
+
 def dataframe(columns: dict[str, Any]):
     """A pandas DataFrame of ``columns`` (pandas is imported here, and only here)."""
     try:
@@ -270,15 +274,16 @@ class RepeatabilityResult:
         if np.ndim(self.success) == 0:
             last = f"{self.drift[-1]:.3g}" if cycles else "none"
             return (
-                f"RepeatabilityResult(success={self.success}, {cycles} cycles of "
+                f"RepeatabilityResult(success={self.success}, {_plural(cycles, 'cycle')} of "
                 f"{len(self.targets)} legs, x0={short_vector(self.x0)}, drift after the last "
                 f"cycle {last}, message={short_text(str(self.message))})"
             )
         ok = int(np.count_nonzero(self.success))
         worst = float(np.nanmax(self.drift[:, -1])) if np.any(self.success) else float("nan")
         return (
-            f"RepeatabilityResult({len(self.x0)} starts, {ok} completed, {cycles} cycles of "
-            f"{self.targets.shape[1]} legs, largest drift after the last cycle {worst:.3g})"
+            f"RepeatabilityResult({len(self.x0)} starts, {ok} completed, "
+            f"{_plural(cycles, 'cycle')} of {self.targets.shape[1]} legs, largest drift after "
+            f"the last cycle {worst:.3g})"
         )
 
     def columns(self) -> dict[str, Any]:

@@ -1,3 +1,4 @@
+import importlib
 import math
 
 import numpy as np
@@ -186,7 +187,7 @@ def test_cancelled_stops_between_legs(batch):
 
 def _chunks(monkeypatch, iterations: int) -> None:
     """Discrete legs with a progress run as solves of ``iterations`` iterations."""
-    from jik.engine import repeatability as module
+    module = importlib.import_module("jik.engine.repeatability")
 
     monkeypatch.setattr(module, "POLL_ITERATIONS", iterations)
 
@@ -278,7 +279,7 @@ def test_a_leg_that_raises_stops_the_run_with_the_legs_before_it(monkeypatch):
     """on_undefined="stop": a leg whose solve raises (here the second, patched to) ends the run
     there: the legs before it are kept, the stopped leg is its start alone, the message names
     it. By default the error propagates."""
-    from jik.engine import repeatability as module
+    module = importlib.import_module("jik.engine.repeatability")
 
     calls = []
     original = module.solve
