@@ -84,3 +84,14 @@ def test_dask_atlas():
     text = run("05_dask_atlas.py")
     assert "1 paths x 16 starts x 2 cycles, 16 of 16 runs completed" in text
     assert "The same numbers as in this process: True" in text
+
+
+def test_the_readmes_first_python_example_runs_with_one_import():
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    code = re.search(r"```python\n(.*?)```", readme, flags=re.S).group(1)
+    imports = [line for line in code.splitlines() if line.startswith(("import ", "from "))]
+    assert imports == ["import jik.engine as jik  # help(jik) lists the API; examples/ holds "
+                       "runnable scripts"]  # fmt: skip
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.startswith("SolveResult(pseudoinverse, continuous, success=True")
