@@ -164,7 +164,7 @@ class SynthesisResult:
         E2 of that cubic on the region (NaN when there is none).
     grid : dict
         ``{name_1: [...], name_2: [...], "h": [[...]]}``, h on a uniform grid of the first two
-        region variables (h[i][j] at name_1[i], name_2[j]; others at the box centre).
+        region variables (``h[i][j]`` at ``name_1[i]``, ``name_2[j]``; others at the box centre).
     convergence : list of dict
         ``{"degree", "n_unknowns", "e2"}`` for the resolutions computed, the last the result.
     region, fixed : dict
