@@ -78,6 +78,13 @@ class AtlasPlan:
     chunk: int
     settings: dict = field(default_factory=dict)
 
+    def __repr__(self) -> str:
+        return (
+            f"AtlasPlan({'/'.join(self.algorithms)}, {len(self.paths)} paths x {self.n_starts} "
+            f"starts x {self.cycles} cycles of {self.legs} legs, {self.size} runs in chunks of "
+            f"{self.chunk})"
+        )
+
     @property
     def size(self) -> int:
         """Number of runs per inverse: paths x starts."""

@@ -21,11 +21,14 @@ X0 = np.array([0.0, 0.0, math.pi / 2])
 PATH = [(1, 1), (1, 2), (0, 2)]
 
 
-def _atlas() -> AtlasResult:
+def _plan():
     """Two starts on the self-motion curve of k(X0) = (0, 1), Table 1's loop, two cycles."""
-    plan = jik.plan_atlas(jik.Pseudoinverse(jik.Manipulator2()), [(0, 1), *PATH], cycles=2,
+    return jik.plan_atlas(jik.Pseudoinverse(jik.Manipulator2()), [(0, 1), *PATH], cycles=2,
                           n_starts=2, arc=(-0.2, 0.2), reference=X0)  # fmt: skip
-    return jik.run_atlas(plan)
+
+
+def _atlas() -> AtlasResult:
+    return jik.run_atlas(_plan())
 
 
 def _imported_after(code: str) -> set[str]:
@@ -113,6 +116,7 @@ def test_results_print_on_one_line_with_their_numbers():
 
 
 def test_an_atlas_and_a_synthesis_print_on_one_line():
+    _one_line(_plan(), "AtlasPlan(pseudoinverse, 1 paths x 2 starts x 2 cycles of 4 legs, 2 runs")
     atlas = _atlas()
     _one_line(atlas, "AtlasResult(pseudoinverse, 1 paths x 2 starts x 2 cycles, 2 of 2 runs",
               f"pseudoinverse {np.max(atlas.drift[..., -1]):.3g}")  # fmt: skip
