@@ -182,3 +182,25 @@ def test_gamma_rules_are_worded_once():
     assert str(info.value) == f"gamma {why}" and info.value.field == "gamma"
     with pytest.raises(jik.InvalidInputError, match="gamma must be > 0"):
         check_gamma(0.0, "continuous")
+
+
+def test_a_progress_implements_only_what_it_shows():
+    """A Progress subclass with ``leg`` alone runs a discrete repeatability run (its pieces
+    call ``advance`` and ``cancelled``, which do nothing by default) to the numbers of a run
+    without it."""
+
+    class Legs(jik.Progress):
+        def __init__(self):
+            self.seen = []
+
+        def leg(self, leg):
+            self.seen.append((leg.cycle, leg.index))
+
+    inv = jik.ExtendedInverse(jik.Manipulator2(), jik.PaperCubic())
+    progress = Legs()
+    watched = jik.repeatability(inv, X0, PATH, cycles=2, mode="discrete", gamma=0.05,
+                                progress=progress)  # fmt: skip
+    plain = jik.repeatability(inv, X0, PATH, cycles=2, mode="discrete", gamma=0.05)
+    assert progress.seen == [(c, j) for c in range(2) for j in range(4)]
+    np.testing.assert_array_equal(watched.legs, plain.legs)
+    assert watched.message == plain.message and watched.success
