@@ -63,7 +63,7 @@ import types
 from typing import TYPE_CHECKING, Any
 
 # Each public name and the module (under jik.engine) that defines it.
-_EXPORTS: dict[str, str] = {
+_EXPORTS = {
     # robots
     "Kinematics": "kinematics",
     "Manipulator1": "kinematics",
