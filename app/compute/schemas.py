@@ -23,7 +23,7 @@ from pydantic import BaseModel, BeforeValidator, ConfigDict, Discriminator, Fiel
 
 from jik.engine.registry import ROBOTS, AugmentationSpec, RobotSpec
 from jik.engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
-from jik.engine.solver import GAMMA_MAX, GAMMA_MIN, TOL_MIN
+from jik.engine.solver import DISCRETE_GAMMA_BOUND, GAMMA_MAX, GAMMA_MIN, TOL_MIN
 
 #: Largest configuration / task dimension accepted before the registry check.
 MAX_DIMENSION = 16
@@ -314,7 +314,8 @@ class _Request(BaseModel):
     x0: Vector = Field(description="start configuration, length p of the robot")
     gamma: Gamma | None = Field(
         None,
-        description="decay rate > 0 of eq. (5) (discrete: the step, < 2); default: the robot's",
+        description=f"decay rate > 0 of eq. (5) (discrete: the step, < {DISCRETE_GAMMA_BOUND:g}); "
+        "default: the robot's",
     )
     mode: Mode | None = Field(
         None, description="'continuous' (ODE) or 'discrete' (iterations); default: the robot's"
