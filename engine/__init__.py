@@ -241,7 +241,7 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
     from jik.engine.results import BatchSolveResult, RepeatabilityResult, SolveResult, Trajectory
     from jik.engine.robot_spec import Robot, load_robot, robot_from_dict
     from jik.engine.solver import solve, solve_batch
+    from jik.engine.synthesis_nd import TotalDegreeSynthesis, synthesize_e2_nd
     from jik.engine.unicycle import Unicycle
     from jik.engine.urdf import UrdfChain
-    from jik.engine.synthesis_nd import TotalDegreeSynthesis, synthesize_e2_nd
     from jik.engine.variational import SynthesisResult, synthesize_e2
