@@ -21,6 +21,8 @@ Robots (kinematics k: R^p -> R^r, eq. (4))
     UrdfChain                   a serial arm from URDF text (needs yourdfpy)
     robot_from_dict, load_robot a robot and its maps from a dict, a JSON/YAML file or a name
     Robot, Kinematics, ROBOTS   a built robot; the base class; the built-in catalogue
+    ARMS                        real arms (panda, iiwa14, gen3, ur5e): {"name": "panda"}
+    LimitsReport                whether a run stayed within the joint limits (Robot.limits_report)
 Augmenting maps h (eq. (9))
     PaperCubic                  the paper's cubic (38) for Manipulator 2
     E1Optimal, E2Optimal        Manipulator 1's optimal maps, eqs. (32) and (36)
@@ -77,6 +79,8 @@ _EXPORTS = {
     "robot_from_dict": "robot_spec",
     "load_robot": "robot_spec",
     "ROBOTS": "registry",
+    "ARMS": "arms",
+    "LimitsReport": "limits",
     # augmenting maps
     "AugmentingMap": "augmentations",
     "PaperCubic": "augmentations",
@@ -128,6 +132,7 @@ _EXPORTS = {
 }
 
 __all__ = [
+    "ARMS",
     "ROBOTS",
     "AlgorithmicSingularityError",
     "AtlasPlan",
@@ -146,6 +151,7 @@ __all__ = [
     "KinematicSingularityError",
     "Kinematics",
     "Leg",
+    "LimitsReport",
     "Manipulator1",
     "Manipulator2",
     "OneFormUndefinedError",
@@ -216,6 +222,7 @@ sys.modules[__name__].__class__ = _Engine
 
 
 if TYPE_CHECKING:  # what the names are, for type checkers and editors (no import at run time)
+    from jik.engine.arms import ARMS
     from jik.engine.atlas import AtlasPlan, plan_atlas
     from jik.engine.atlas_run import AtlasResult, iter_atlas, run_atlas
     from jik.engine.augmentations import AugmentingMap, E1Optimal, E2Optimal, PaperCubic
@@ -234,6 +241,7 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
     from jik.engine.functionals import error_functional_e1, error_functional_e2
     from jik.engine.inverses import ExtendedInverse, Inverse, Pseudoinverse
     from jik.engine.kinematics import Kinematics, Manipulator1, Manipulator2
+    from jik.engine.limits import LimitsReport
     from jik.engine.planar_chain import PlanarChain
     from jik.engine.progress import Progress, ProgressCallbacks
     from jik.engine.registry import ROBOTS, make_inverse
