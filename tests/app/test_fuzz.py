@@ -4,7 +4,8 @@ failure of any kind and no traceback in the server's log (issue 26).
 150 examples per operation of the examples and fuzzing phases give over 2,000 cases in about
 three minutes here. ``JIK_FUZZ_EXAMPLES`` sets another number (0 skips it: `.ci/run` fuzzes
 the service once, with its first interpreter). The rules the OpenAPI document cannot state are
-in :mod:`jik.benchmarks.fuzz_hooks`; ``jik bench fuzz`` runs the same at length (10,000+ cases).
+in :mod:`jik.benchmarks.harness.fuzz_hooks`; ``jik bench fuzz`` runs the same at length
+(10,000+ cases).
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import os
 
 import pytest
 
-from jik.benchmarks.bench_fuzz import run_fuzz
+from jik.benchmarks.harness.bench_fuzz import run_fuzz
 
 EXAMPLES = int(os.environ.get("JIK_FUZZ_EXAMPLES", "150"))
 #: The acceptance's floor (issue 26).

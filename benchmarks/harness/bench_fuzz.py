@@ -1,9 +1,9 @@
 """``jik bench fuzz``: schemathesis against a running ``jik serve``, every check, positive and
 negative data (issue 26).
 
-:func:`run_fuzz` starts the server on a free loopback port, runs the schemathesis command with
-:mod:`jik.benchmarks.fuzz_hooks` (what the OpenAPI document cannot say) and reads its summary:
-cases generated, failures, and whether the server logged a traceback. The CI test
+:func:`run_fuzz` starts the server on a free loopback port, runs the schemathesis command
+with :mod:`jik.benchmarks.harness.fuzz_hooks` (what the OpenAPI document cannot say) and reads
+its summary: cases generated, failures, and whether the server logged a traceback. The CI test
 (tests/app/test_fuzz.py) runs it with ~2,000 cases; this benchmark with 10,000 and more.
 """
 
@@ -18,12 +18,7 @@ import tempfile
 import time
 from dataclasses import dataclass
 
-import jik
 from jik.benchmarks.serving import jik_serve
-
-#: Where ``jik`` is imported from (the source tree, or site-packages): the hooks are found there
-#: from the scratch directory schemathesis runs in.
-_PACKAGE_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(jik.__file__)))
 
 #: The phases run with every check. Not the stateful phase: on this document schemathesis
 #: 4.32.5's grew past 23 GB of memory within 90 s (30 examples; the machine has 24 GB). Not the
@@ -73,10 +68,8 @@ def run_fuzz(
              *(["--exclude-checks", exclude_checks] if exclude_checks else []),
              "--seed", str(seed), "--workers", "1", "--suppress-health-check", "all",
              "--continue-on-failure", "--request-timeout", "120", "--no-color"],
-            env=dict(os.environ, SCHEMATHESIS_HOOKS="jik.benchmarks.fuzz_hooks",
-                     JIK_FUZZ_SERVER=server.url,
-                     PYTHONPATH=os.pathsep.join(filter(None, (_PACKAGE_ROOT,
-                                                              os.environ.get("PYTHONPATH"))))),
+            env=dict(os.environ, SCHEMATHESIS_HOOKS="jik.benchmarks.harness.fuzz_hooks",
+                     JIK_FUZZ_SERVER=server.url),
             capture_output=True, text=True, timeout=timeout, cwd=scratch,
         )  # fmt: skip
         seconds = time.perf_counter() - started

@@ -210,7 +210,7 @@ def _positive_case_ok(case) -> bool:
     return True
 
 
-#: The server under test (:func:`jik.benchmarks.bench_fuzz.run_fuzz` names it).
+#: The server under test (:func:`jik.benchmarks.harness.bench_fuzz.run_fuzz` names it).
 SERVER = os.environ.get("JIK_FUZZ_SERVER", "")
 
 
