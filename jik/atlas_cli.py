@@ -25,6 +25,8 @@ import time
 from pathlib import Path
 from typing import Any
 
+from jik import install_hint
+
 #: Atlases of more runs than this write their arrays to the CSV only (the JSON keeps a summary).
 JSON_RUNS = 20000
 #: Points per line of the figure (every k-th start beyond this).
@@ -402,7 +404,8 @@ def _figure(arrays: _Gathered, plan, path: Path) -> Path | None:
         np.asarray(s), arrays.last, plan.algorithms, plan.cycles, len(plan.paths), N, label
     )
     if fig is None:
-        sys.stderr.write("jik atlas: plotly is not installed: no figure (pip install 'jik[app]')\n")
+        hint = install_hint("app")
+        sys.stderr.write(f"jik atlas: plotly is not installed: no figure ({hint})\n")
         return None
     fig.write_html(path, include_plotlyjs=True, full_html=True)  # (offline: no CDN)
     return path

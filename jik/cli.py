@@ -1,7 +1,7 @@
 """The ``jik`` command (also ``python -m jik``): ``jik serve``, ``jik reproduce NAME [--json]``,
 ``jik bench [NAME]``.
 
-Only ``serve`` needs the web parts (the ``jik[app]`` extra); the others run on the engine alone,
+Only ``serve`` needs the web parts (the ``app`` extra); the others run on the engine alone,
 so this module imports nothing of :mod:`jik.app` until ``serve`` asks for it.
 """
 
@@ -14,6 +14,7 @@ import signal
 import sys
 from typing import Any
 
+from jik import install_hint
 from jik.robot_commands import add_robot_commands
 
 #: Reproductions: name -> module in jik.engine.reproductions with run() and format_text().
@@ -25,7 +26,7 @@ REPRODUCTIONS = {
 }
 
 
-#: The top-level modules of the ``jik[app]`` extra (a benchmark of the web parts needs them).
+#: The top-level modules of the ``app`` extra (a benchmark of the web parts needs them).
 WEB_PACKAGES = frozenset(
     {"fastapi", "fastapi_offline", "starlette", "uvicorn", "viser", "plotly", "httpx"}
 )
@@ -54,7 +55,7 @@ def reproduce(args: argparse.Namespace) -> int:
 
 
 #: What installs the web parts, for the message of a command that needs them.
-APP_EXTRA_HINT = "pip install 'jik[app]'"
+APP_EXTRA_HINT = install_hint("app")
 
 
 def missing_app_extra(error: ModuleNotFoundError) -> int:

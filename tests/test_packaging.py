@@ -159,3 +159,26 @@ def test_shipped_code_imports_only_its_install_lines_dependencies(folder):
         f"imported by {folder}/ but not installed by `{line}`: {missing}; "
         "declare them in pyproject.toml (or move the import to the web parts)"
     )
+
+
+#: An install command in a message or a document: ``pip install [-e] 'NAME[extra]'`` or
+#: ``".[extra]"``.
+INSTALL_HINT = re.compile(r"""pip install (?:-\w+ )*['"]?([\w.-]+)\[([\w,-]+)\]""")
+
+
+def test_every_install_hint_names_this_distribution_and_its_extras():
+    """A hint that names another distribution installs another project: ``jik`` on the package
+    index is not this one."""
+    project = PYPROJECT["project"]
+    assert project["name"] != "jik", "jik on the package index is another project (0.0.2)"
+    files = [ROOT / "README.md", ROOT / "Dockerfile", *sorted((ROOT / "docs").glob("*.md"))]
+    for folder in EXTRA_OF:
+        files += sorted((ROOT / folder).rglob("*.py"))
+    wrong = []
+    for path in files:
+        for name, extras in INSTALL_HINT.findall(path.read_text(encoding="utf-8")):
+            if name not in (".", project["name"]) or not set(extras.split(",")) <= set(
+                project["optional-dependencies"]
+            ):
+                wrong.append(f"{path.relative_to(ROOT)}: {name}[{extras}]")
+    assert not wrong, wrong

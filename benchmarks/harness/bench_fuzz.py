@@ -97,7 +97,7 @@ def _report(title: str, run: FuzzRun) -> None:
 
 def main(quick: bool = False) -> None:
     if importlib.util.find_spec("schemathesis") is None:
-        print("jik bench fuzz needs schemathesis: pip install 'jik[test]'")
+        print("jik bench fuzz needs schemathesis, of the test extra: pip install -e '.[test]'")
         return
     examples = 20 if quick else 850
     _report(f"schemathesis, every check, phases {PHASES}, {examples} examples per operation",
