@@ -16,6 +16,7 @@ from typing import Any
 
 from jik import install_hint
 from jik.robot_commands import add_robot_commands
+from jik.serve_address import Announcer, listen_problem, port_number
 
 #: Reproductions: name -> module in jik.engine.reproductions with run() and format_text().
 REPRODUCTIONS = {
@@ -77,11 +78,19 @@ def serve(args: argparse.Namespace) -> int:
         from jik.app.api.server import PortInUse, run_server
     except ModuleNotFoundError as error:
         return missing_app_extra(error)
+    problem = listen_problem(args.host, args.port)
+    if problem:
+        sys.stderr.write(f"jik serve: {problem}\n")
+        return 2
+    announcer = Announcer(args.host, args.port)
+    announcer.start()
     try:
         run_server(host=args.host, port=args.port, allowed_hosts=tuple(args.allowed_host))
     except PortInUse as busy:
         sys.stderr.write(f"jik serve: {busy}\n")
         return 2
+    finally:
+        announcer.stop()
     return 0
 
 
@@ -106,7 +115,8 @@ def main(argv: list[str] | None = None) -> int:
 
     p = sub.add_parser("serve", help="start the REST API and the dashboard")
     p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
-    p.add_argument("--port", type=int, default=8000, help="HTTP port of the API, page and scene")
+    p.add_argument("--port", type=port_number, default=8000,
+                   help="HTTP port of the API, page and scene (default 8000)")  # fmt: skip
     p.add_argument(
         "--allowed-host", action="append", default=[], metavar="NAME",
         help="a host name the server answers to besides localhost, 127.0.0.1 and [::1] (repeat it; "
