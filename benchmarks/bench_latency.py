@@ -1,6 +1,6 @@
 """Dashboard latency: a control change to the plots and to the 3D scene, medians and p95.
 
-Issue 27's targets: p95 under 300 ms for a manipulator change and under 2 s for the unicycle,
+The targets: p95 under 300 ms for a manipulator change and under 2 s for the unicycle,
 on a machine without a GPU. A real ``jik serve`` runs on a free loopback port, and the same
 kinds of change are made through it: gamma, the start point x1, the arm length l, the number
 of cycles, the switches from Manipulator 2 to Manipulator 1 and back, then the switch to the
@@ -53,7 +53,7 @@ import numpy as np
 from jik.app.dashboard.controls import element_id
 
 CHROMIUM = "/usr/bin/chromium"
-#: Issue 27: p95 of a change [ms], by family.
+#: The targets: p95 of a change [ms], by family.
 TARGETS_MS = {"manipulator": 300.0, "unicycle": 2000.0}
 #: Seconds a change may take to reach the plots or the scene before the benchmark gives up.
 CHANGE_TIMEOUT = 60.0

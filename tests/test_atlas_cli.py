@@ -1,4 +1,4 @@
-"""`jik atlas` writes what issue 30 promises: inputs, starts, per algorithm drift and leg ends,
+"""`jik atlas` writes its inputs, starts, per algorithm drift and leg ends,
 a CSV for large atlases, a figure, and errors that name the input."""
 
 import csv

@@ -64,6 +64,8 @@ def _scalar_field(p) -> tuple[Any, Any]:
                 le=p.maximum,
                 allow_inf_nan=False,
                 description=f"{p.description}{extra}; default {p.default:g}",
+                # (JSON Schema's way to say nonzero: the engine refuses 0 with a 422)
+                json_schema_extra={"not": {"const": 0}} if p.nonzero else None,
             ),
         ],
         p.default,

@@ -1,5 +1,5 @@
 """``jik bench fuzz``: schemathesis against a running ``jik serve``, every check, positive and
-negative data (issue 26).
+negative data.
 
 :func:`run_fuzz` starts the server on a free loopback port, runs the schemathesis command
 with :mod:`jik.benchmarks.harness.fuzz_hooks` (what the OpenAPI document cannot say) and reads
@@ -51,8 +51,13 @@ def run_fuzz(
     timeout: float = 1500.0,
     phases: str = PHASES,
     exclude_checks: str = "",
+    deterministic: bool = False,
 ) -> FuzzRun:
-    """schemathesis with ``max_examples`` per operation and phase against a fresh server."""
+    """schemathesis with ``max_examples`` per operation and phase against a fresh server.
+
+    ``deterministic``: the same cases on every run (hypothesis derandomized, ``seed`` unused):
+    the test suite's regression check. Otherwise a random search from ``seed``.
+    """
     # A request waits at most JIK_TIMEOUT for a worker and as long again to compute, an export
     # at most a minute for its session's result: all within schemathesis's request timeout.
     with jik_serve(JIK_WORKERS="2", JIK_TIMEOUT="20", JIK_SESSION_IDLE_SECONDS="30") as server:
@@ -66,7 +71,8 @@ def run_fuzz(
              f"{server.url}/openapi.json",
              "--checks", "all", "--phases", phases, "--max-examples", str(max_examples),
              *(["--exclude-checks", exclude_checks] if exclude_checks else []),
-             "--seed", str(seed), "--workers", "1", "--suppress-health-check", "all",
+             *(["--generation-deterministic"] if deterministic else ["--seed", str(seed)]),
+             "--workers", "1", "--suppress-health-check", "all",
              "--continue-on-failure", "--request-timeout", "120", "--no-color"],
             env=dict(os.environ, SCHEMATHESIS_HOOKS="jik.benchmarks.harness.fuzz_hooks",
                      JIK_FUZZ_SERVER=server.url),
