@@ -149,7 +149,7 @@ Tolerance = Annotated[float, Field(strict=True, ge=1e-14, le=1.0, allow_inf_nan=
 
 
 # --------------------------------------------------------------------------------------------
-# Robots defined by data (issue 29): the kinds of jik.engine.robot_kinds, checked in full by
+# Robots defined by data: the kinds of jik.engine.robot_kinds, checked in full by
 # jik.engine.robot_spec.robot_from_dict. The schema says what JSON Schema can (names, sizes,
 # the joints' letters); the formulas' grammar, the URDF text and what follows from them (p, r,
 # the lengths of x0, target and path) are checked when the robot is built, naming the field.

@@ -7,7 +7,7 @@ start x0), the floor grid, and the fixtures of a result (rails or guide, traces,
   x2 on the vertical guide, a lever of slope x3 pivoting on it, and a vertical runner at x1;
   the task point W = (x1, x2 + x1 x3) is where the lever crosses the runner.
 - The unicycle (40): a platform with two wheels and a heading nose at the pose q(t).
-- A user's planar chain or URDF arm (issue 29): links as lines between its joints' points,
+- A user's planar chain or URDF arm: links as lines between its joints' points,
   joints as spheres (:class:`Chain`); a formula robot has no drawing, only its task path.
 
 The pseudoinverse is the translucent red ghost, the extended Jacobian the opaque blue robot (the

@@ -126,7 +126,7 @@ def test_bad_input(kwargs, match):
         repeatability(Pseudoinverse(Manipulator2()), [0, 0, 1.0], args["path"], args["cycles"])
 
 
-# -- hooks of the one engine loop (issue 27): on_leg, cancelled, resume, chunk, on_undefined ----
+# -- hooks of the one engine loop: on_leg, cancelled, resume, chunk, on_undefined ----
 
 TABLE1_X0 = np.array([0, 0, math.pi / 2])
 TABLE1_PATH = [(1, 1), (1, 2), (0, 2), (0, 1)]
