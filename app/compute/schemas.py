@@ -158,8 +158,8 @@ Tolerance = Annotated[float, Field(strict=True, ge=1e-14, le=1.0, allow_inf_nan=
 MAX_FORMULA_CHARS = 2000
 #: Longest URDF text a request carries [characters]: a tenth of the 1 MiB body limit, room for
 #: an arm of dozens of links (the shipped 4-joint arm is 2 kB). A larger file goes through the
-#: CLI (``jik solve --robot arm.json`` with ``urdf_file``; the engine's bound is 1 MB). At 1 MB
-#: here, schemathesis's negative cases (a string one longer) took it past 17 GB of memory.
+#: CLI (``jik solve --robot arm.json`` with ``urdf_file``; the engine's bound is 1 MB). A 1 MB
+#: bound here lets a request's text cost the parser gigabytes of memory.
 MAX_URDF_CHARS = 100_000
 #: A variable's, a parameter's or a joint's name.
 Name = Annotated[str, Field(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,31}$")]

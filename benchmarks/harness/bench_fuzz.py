@@ -20,8 +20,8 @@ from dataclasses import dataclass
 
 from jik.benchmarks.serving import jik_serve
 
-#: The phases run with every check. Not the stateful phase: on this document schemathesis
-#: 4.32.5's grew past 23 GB of memory within 90 s (30 examples; the machine has 24 GB). Not the
+#: The phases run with every check. Not the stateful phase: on this document schemathesis's
+#: grows past the memory of a developer's machine within a minute and a half. Not the
 #: coverage phase with positive_data_acceptance: its boundary cases bypass the hooks
 #: (:func:`main` runs it with every other check).
 PHASES = "examples,fuzzing"
