@@ -65,6 +65,8 @@ def _scalar_field(p) -> tuple[Any, Any]:
                 le=p.maximum,
                 allow_inf_nan=False,
                 description=f"{p.description}{extra}; default {p.default:g}",
+                # (JSON Schema's way to say nonzero: the engine refuses 0 with a 422)
+                json_schema_extra={"not": {"const": 0}} if p.nonzero else None,
             ),
         ],
         p.default,
@@ -145,7 +147,7 @@ Tolerance = Annotated[float, Field(strict=True, ge=TOL_MIN, le=1.0, allow_inf_na
 
 
 # --------------------------------------------------------------------------------------------
-# Robots defined by data (issue 29): the kinds of jik.engine.robot_kinds, checked in full by
+# Robots defined by data: the kinds of jik.engine.robot_kinds, checked in full by
 # jik.engine.robot_spec.robot_from_dict. The schema says what JSON Schema can (names, sizes,
 # the joints' letters); the formulas' grammar, the URDF text and what follows from them (p, r,
 # the lengths of x0, target and path) are checked when the robot is built, naming the field.
@@ -154,8 +156,8 @@ Tolerance = Annotated[float, Field(strict=True, ge=TOL_MIN, le=1.0, allow_inf_na
 MAX_FORMULA_CHARS = 2000
 #: Longest URDF text a request carries [characters]: a tenth of the 1 MiB body limit, room for
 #: an arm of dozens of links (the shipped 4-joint arm is 2 kB). A larger file goes through the
-#: CLI (``jik solve --robot arm.json`` with ``urdf_file``; the engine's bound is 1 MB). At 1 MB
-#: here, schemathesis's negative cases (a string one longer) took it past 17 GB of memory.
+#: CLI (``jik solve --robot arm.json`` with ``urdf_file``; the engine's bound is 1 MB). A 1 MB
+#: bound here lets a request's text cost the parser gigabytes of memory.
 MAX_URDF_CHARS = 100_000
 #: A variable's, a parameter's or a joint's name.
 Name = Annotated[str, Field(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,31}$")]

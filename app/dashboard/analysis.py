@@ -273,7 +273,7 @@ def sensitivity(
     cancelled: Callable[[], bool] = lambda: False,
     progress: Callable[[int, int], None] | None = None,
 ) -> dict:
-    """How E1 (13) and E2 (18) change with the parameters of the current map (issue 5).
+    """How E1 (13) and E2 (18) change with the parameters of the current map.
 
     Over the same box and fixed variables as ``functionals`` (see :func:`error_functionals`):
 

@@ -170,7 +170,7 @@ def log_ticks(values) -> dict:
 def sensitivity_spec(
     result: DashboardResult, sens: dict | None = None, cancelled: str | None = None
 ) -> dict:
-    """E1 (13) and E2 (18) of the current map and how they change (issue 5).
+    """E1 (13) and E2 (18) of the current map and how they change.
 
     With parameters: each functional against each parameter (swept around its current value,
     which is marked), on a log scale. Without: the functionals of the robot's other maps.

@@ -29,7 +29,7 @@ AXIS = dict(
     gridcolor="#e6e6e6", zerolinecolor="#b0b0b0", linecolor="#888", showline=True, mirror=True,
     ticks="outside", automargin=True,
     # plotly's default on linear axes, "hide past div", measures every tick label's box
-    # (a forced layout each) on every redraw: ~10 ms per panel here.
+    # (a forced layout each) on every redraw, milliseconds per panel.
     ticklabeloverflow="allow",
 )  # fmt: skip
 # A small explicit template: the named ones ("plotly_white") cost ~25 ms per figure to apply.

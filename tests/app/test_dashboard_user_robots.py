@@ -1,4 +1,4 @@
-"""A user's robot in the dashboard's state (issue 29): its definition is state, refusals name
+"""A user's robot in the dashboard's state: its definition is state, refusals name
 their field under robot_definition, and the session computes both algorithms for it."""
 
 from __future__ import annotations

@@ -172,7 +172,7 @@ DEEP = b"[" * 50_000 + b"]" * 50_000
 @pytest.mark.parametrize("path", ["/solve", "/repeatability", "/synthesize", "/api/sessions"])
 def test_a_body_nested_too_deep_is_422_not_500(api, path):
     """A JSON nested past Python's recursion limit is the client's bad input (it was a 500
-    with the exception's text, issue 26 item 3)."""
+    with the exception's text)."""
     r = api.post(path, content=DEEP, headers={"content-type": "application/json"})
     assert r.status_code == 422, r.text
     (error,) = r.json()["detail"]
@@ -220,6 +220,6 @@ def test_a_body_that_is_not_json_says_why(api, body, says):
     ],
 )
 def test_a_boolean_or_a_string_is_no_number(api, over, field):
-    """(Booleans were taken as 0 and 1, and numeric strings as numbers, issue 26 item 8.)"""
+    """(Booleans were taken as 0 and 1, and numeric strings as numbers.)"""
     (msg,) = messages(api.post("/solve", json=solve_body(**over)))
     assert msg.startswith(f"{field}: Input should be a valid")

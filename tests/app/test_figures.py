@@ -222,7 +222,7 @@ def test_unicycle_platform_paths_and_controls():
 
 
 def test_sensitivity_sweeps_each_parameter_through_the_current_value():
-    """Issue 5: E1, E2 at the current (a, b) of e2_optimal and how they change as a, b move."""
+    """E1, E2 at the current (a, b) of e2_optimal and how they change as a, b move."""
     result = compute(updated_state(default_state("manipulator1"), {"task": "target"}))
     functionals = error_functionals(result)
     sens = sensitivity(result, functionals)

@@ -91,9 +91,8 @@ def test_no_free_slot_is_busy_503():
 
 def test_a_computation_over_the_worker_memory_limit_is_422_and_the_worker_lives_on():
     """Each worker's address space is limited (Settings.worker_memory, JIK_WORKER_MEMORY_MB):
-    the request of issue 26 item 2 (unicycle, 24 nodes, a 61-point grid over a wide
-    three-variable box; 828 MB in one worker before) ends in a 422 that says what to ask for
-    less of, here under a small limit so that it fails at once."""
+    a heavy request (unicycle, 24 nodes, a 61-point grid over a wide three-variable box) ends in
+    a 422 that says what to ask for less of, here under a small limit so that it fails at once."""
     from fastapi.testclient import TestClient
 
     from jik.app.api.factory import create_app

@@ -1,6 +1,6 @@
 """Slow senders against a real ``jik serve``: a request that does not arrive whole within
 ``JIK_READ_SECONDS`` is cut off (408 when its headers are incomplete), however slowly its bytes
-trickle in, and the server answers other clients meanwhile (issue 26, item 7)."""
+trickle in, and the server answers other clients meanwhile."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The robot editor (issue 29): a user defines a planar RRR arm on the page, sees a bad length
+"""The robot editor: a user defines a planar RRR arm on the page, sees a bad length
 refused next to its field, fixes it, applies, and sees both algorithms' result for the new
 robot, in the verdict and in the 3D scene."""
 
@@ -53,7 +53,7 @@ def test_a_planar_rrr_arm_from_the_editor(tabs):
 
 
 def test_a_urdf_arm_from_a_link_is_drawn_in_the_scene(tabs):
-    """The 4-joint URDF arm shipped with the tests (issue 29): a link holding its definition
+    """The 4-joint URDF arm shipped with the tests: a link holding its definition
     opens a session that computes both algorithms and a scene that draws the arm's chain."""
     import json
     from pathlib import Path
