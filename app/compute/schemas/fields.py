@@ -1,0 +1,55 @@
+"""The field types and size limits every request model shares (JSON, snake_case).
+
+Pydantic checks types, ranges, finiteness (``allow_inf_nan=False``: NaN and inf are rejected) and
+size bounds. The dashboard's state (:mod:`jik.app.dashboard.model`) uses the same types.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Literal
+
+from pydantic import BeforeValidator, Field
+
+#: Largest configuration / task dimension accepted before the registry check.
+MAX_DIMENSION = 16
+#: Largest step / iteration cap a request may ask for.
+MAX_ITERATIONS = 20000
+#: Trajectories longer than this are downsampled (first and last points kept).
+MAX_TRAJECTORY_POINTS = 2000
+
+FiniteFloat = Annotated[float, Field(strict=True, allow_inf_nan=False)]
+
+
+def _integral(value: Any) -> Any:
+    """A float with no fraction is the integer it equals (JSON Schema's "integer": 49.0 is one)."""
+    return int(value) if isinstance(value, float) and value.is_integer() else value
+
+
+#: Makes a strict ``int`` take what JSON Schema calls an integer (49 or 49.0), never a boolean
+#: or a string: ``Annotated[int, Field(strict=True, ...), INTEGRAL]`` (after the
+#: Field, or the schema loses its bounds).
+INTEGRAL = BeforeValidator(_integral)
+
+
+#: A float that is null where the engine produced NaN or inf (a failed or diverged run).
+MaybeFloat = float | None
+
+Algorithm = Literal["pseudoinverse", "extended"]
+Mode = Literal["continuous", "discrete"]
+#: Largest |coordinate| of a configuration or task point (radians, lengths, control amplitudes):
+#: beyond it the kinematics only overflow, and the unicycle's quadrature would need huge grids.
+COORDINATE_BOUND = 1000.0
+Coordinate = Annotated[
+    float, Field(strict=True, ge=-COORDINATE_BOUND, le=COORDINATE_BOUND, allow_inf_nan=False)
+]
+Vector = Annotated[list[Coordinate], Field(min_length=1, max_length=MAX_DIMENSION)]
+#: The decay rate of eq. (5) (discrete mode: the step; below 2 there, checked with the mode).
+#: Continuous runs depend on gamma only through theta = -log(1 - s) / gamma (theta's scale);
+#: below 1e-6 that scale leaves the floating-point range (from about 1e-100 the integrator
+#: failed with NaN).
+GAMMA_MIN = 1e-6
+Gamma = Annotated[float, Field(strict=True, ge=GAMMA_MIN, le=1e6, allow_inf_nan=False)]
+#: The task error at which a solve stops.
+Tolerance = Annotated[float, Field(strict=True, ge=1e-14, le=1.0, allow_inf_nan=False)]
+#: A bound of a synthesis box.
+Bound = Annotated[float, Field(strict=True, ge=-100.0, le=100.0, allow_inf_nan=False)]
