@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+from typing import Annotated
 
 import websockets
 import websockets.asyncio.client
@@ -23,6 +24,7 @@ from websockets.typing import Subprotocol
 
 from jik.app.api.dependencies import Store
 from jik.app.api.errors import unparsed_body_response
+from jik.app.compute.schemas import INTEGRAL
 from jik.app.dashboard import export_csv, export_json
 from jik.app.dashboard.controls import controls_message
 from jik.app.dashboard.messages import LatestEvents
@@ -132,7 +134,9 @@ class SecondPhaseRequest(BaseModel):
 
     model_config = ConfigDict(extra="forbid")
 
-    generation: int = Field(strict=True, ge=1, description="the generation of the result shown")
+    generation: Annotated[int, Field(strict=True, ge=1), INTEGRAL] = Field(
+        description="the generation of the result shown"
+    )
 
 
 #: A second phase that is not in the state a request needs.

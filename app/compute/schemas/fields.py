@@ -25,9 +25,10 @@ def _integral(value: Any) -> Any:
     return int(value) if isinstance(value, float) and value.is_integer() else value
 
 
-#: Makes a strict ``int`` take what JSON Schema calls an integer (49 or 49.0), never a boolean
-#: or a string: ``Annotated[int, Field(strict=True, ...), INTEGRAL]`` (after the
-#: Field, or the schema loses its bounds).
+#: The API's one integer rule, on every route and the session state: what JSON Schema (and so
+#: the OpenAPI document's ``integer``) calls an integer, 49 or 49.0, never 49.5, a boolean or a
+#: string. Written ``Annotated[int, Field(strict=True, ...), INTEGRAL]`` (after the Field, or
+#: the schema loses its bounds); ``tests/app/test_integers.py`` holds every route to it.
 INTEGRAL = BeforeValidator(_integral)
 
 
