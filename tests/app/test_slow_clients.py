@@ -10,6 +10,7 @@ import time
 import httpx
 import pytest
 
+from jik.app.api.protocol import MAX_HEADER_BYTES
 from jik.benchmarks.serving import jik_serve
 
 READ_SECONDS = 1.0
@@ -105,3 +106,30 @@ def test_a_whole_request_on_a_kept_alive_connection_is_not_cut_off(server):
             },
         )
         assert response.status_code == 200, response.text
+
+
+@pytest.mark.parametrize("size", [MAX_HEADER_BYTES + 1, 32 << 20])
+def test_oversized_headers_are_431_at_once_and_others_are_served(server, size):
+    """Headers past the cap are refused as soon as they cross it, not read to the end (a
+    32 MB header was read whole and answered 200, stalling the server meanwhile)."""
+    port, base = server
+    s = _connect(port, b"GET /health HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Big: ")
+    started = time.monotonic()
+    try:
+        try:
+            s.sendall(b"a" * size + b"\r\n\r\n")
+        except OSError:
+            pass  # closed by the server before everything was sent: what this test expects
+        answer = _read_until_closed(s, timeout=5)
+    finally:
+        s.close()
+    assert answer.startswith(b"HTTP/1.1 431 Request Header Fields Too Large"), answer[:100]
+    assert answer.endswith(b"request headers larger than %d bytes\n" % MAX_HEADER_BYTES)
+    assert time.monotonic() - started < 5
+    assert httpx.get(f"{base}/health", timeout=5).status_code == 200
+
+
+def test_headers_under_the_cap_are_served(server):
+    _, base = server
+    r = httpx.get(f"{base}/health", headers={"X-Big": "a" * (MAX_HEADER_BYTES // 2)}, timeout=5)
+    assert r.status_code == 200, r.text
