@@ -153,11 +153,23 @@ class AtlasJob:
     #: The request it was started from (the dashboard draws the result with it).
     request: AtlasRequest | None = None
 
-    def response(self) -> AtlasJobResponse:
+    def response(self, ahead: int | None = None, running: int = 1) -> AtlasJobResponse:
+        """The job's state; ``ahead``: the jobs before it in the queue, of which ``running``
+        are computing (:meth:`AtlasJobs.response` counts them)."""
         end = self.ended if self.ended is not None else time.monotonic()
+        message = {"running": "computing", "done": "done", "failed": "failed",
+                   "cancelled": "cancelled"}.get(self.status, "queued")  # fmt: skip
+        if self.status == "queued" and ahead is not None:
+            message = (
+                f"queued behind {ahead} atlas job{'s' * (ahead != 1)} ({running} computing, "
+                f"the rest waiting); it starts when they end"
+                if ahead
+                else "starting"
+            )
         return AtlasJobResponse(
             id=self.id, status=self.status, runs=self.plan.size, runs_done=self.runs_done,
             progress=self.runs_done / self.plan.size, elapsed_s=end - self.started,
+            queue_position=ahead if self.status == "queued" else None, message=message,
             error=self.error, result=self.result,  # type: ignore[arg-type]  # (validated)
         )  # fmt: skip
 
@@ -204,6 +216,22 @@ class AtlasJobs:
             raise AtlasJobsFull(f"at most {self.limits.per_client} atlas jobs per client run at "
                                 "once; wait for one to end or cancel it")  # fmt: skip
 
+    def response(self, job: AtlasJob) -> AtlasJobResponse:
+        """``job``'s state, with the jobs queued or running before it when it waits."""
+        with self._lock:
+            before = self._before(job)
+        return job.response(len(before), sum(j.status == "running" for j in before))
+
+    def _before(self, job: AtlasJob) -> list[AtlasJob]:
+        """The active jobs ahead of ``job``: the running ones and those queued before it (the
+        queue is served in the order the jobs were started). Under the lock."""
+        ahead, earlier = [], True
+        for other in self._jobs.values():
+            earlier = earlier and other is not job
+            if other is not job and (other.status == "running" or (earlier and other.active)):
+                ahead.append(other)
+        return ahead
+
     def get(self, job_id: str) -> AtlasJob:
         self.sweep()
         with self._lock:
@@ -235,9 +263,15 @@ class AtlasJobs:
             self._jobs.clear()
 
     def _run(self, job: AtlasJob) -> None:
-        while not self._slots.acquire(timeout=0.2):
+        while True:  # first come, first served
             if job.cancel.is_set():
                 return self._end(job, "cancelled")
+            with self._lock:
+                first = not any(j.status == "queued" for j in self._before(job))
+            if first and self._slots.acquire(timeout=0.2):
+                break
+            if not first:
+                job.cancel.wait(0.2)
         try:
             job.status = "running"
             job.started = time.monotonic()

@@ -131,5 +131,11 @@ class AtlasJobResponse(BaseModel):
     runs_done: int
     progress: float = Field(description="runs_done / runs")
     elapsed_s: float
+    queue_position: int | None = Field(
+        None,
+        description="while queued: how many atlas jobs run or wait before it (the server "
+        "computes a few at once, in the order they were started); null once it runs",
+    )
+    message: str = Field("", description="the state in words, e.g. what a queued job waits for")
     error: str | None = None
     result: AtlasResult | None = None
