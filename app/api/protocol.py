@@ -19,6 +19,10 @@ answers a bare 400, and h11 parses slower).
 WebSocket upgrades and responses that take long to compute are not affected: the deadline stops
 when the request has been read.
 
+A client that pipelines requests and goes away: every request it left unanswered sees the
+disconnect (uvicorn tells only the newest one, and the older one being answered wrote to a closed
+transport, logging a traceback).
+
 uvicorn offers neither: ``timeout_keep_alive`` counts only the idle time between requests, and
 ``limit_concurrency`` caps connections (slow ones included) rather than freeing them. The figures
 are in ``docs/benchmarks.md`` ("Slow and oversized requests").
@@ -28,7 +32,7 @@ from __future__ import annotations
 
 import asyncio
 
-from uvicorn.protocols.http.httptools_impl import HttpToolsProtocol
+from uvicorn.protocols.http.httptools_impl import HttpToolsProtocol, RequestResponseCycle
 
 #: Default seconds a client has to send a whole request (``JIK_READ_SECONDS``).
 READ_SECONDS = 10.0
@@ -64,11 +68,20 @@ class ReadDeadlineProtocol(HttpToolsProtocol):
         self._read_timer: asyncio.TimerHandle | None = None
         self._headers_read = False
         self._header_bytes = 0  # of the request being read, up to its blank line
+        self._cycles: list[RequestResponseCycle] = []  # requests read and not yet answered
         super().connection_made(transport)
         self._start_reading()
 
     def connection_lost(self, exc: Exception | None) -> None:
         self._stop_reading()
+        # uvicorn marks only the newest request as disconnected; with pipelined requests the
+        # one being answered is an older one, whose response then went to a closed transport
+        # ("Exception in ASGI application"). Every unanswered request is told here.
+        for cycle in self._cycles:
+            if not cycle.response_complete:
+                cycle.disconnected = True
+                cycle.message_event.set()
+        self._cycles.clear()
         super().connection_lost(exc)
 
     def data_received(self, data: bytes) -> None:
@@ -88,6 +101,8 @@ class ReadDeadlineProtocol(HttpToolsProtocol):
     def on_headers_complete(self) -> None:
         self._headers_read = True
         super().on_headers_complete()
+        if self.cycle is not None and self.cycle not in self._cycles:
+            self._cycles = [c for c in self._cycles if not c.response_complete] + [self.cycle]
 
     def on_message_complete(self) -> None:
         self._stop_reading()

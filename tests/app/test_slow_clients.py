@@ -133,3 +133,22 @@ def test_headers_under_the_cap_are_served(server):
     _, base = server
     r = httpx.get(f"{base}/health", headers={"X-Big": "a" * (MAX_HEADER_BYTES // 2)}, timeout=5)
     assert r.status_code == 200, r.text
+
+
+def test_a_client_that_pipelines_and_leaves_logs_nothing():
+    """Requests sent back to back on one connection, which then closes: the server drops their
+    answers quietly (the one being answered wrote to the closed connection and logged
+    "Exception in ASGI application" with a traceback)."""
+    body = b'{"robot": {"name": "manipulator2"}, "algorithm": "pseudoinverse", "x0": [0, 0, 1.5], '
+    body += b'"target": [1, 1]}'
+    solve = b"POST /solve HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
+    solve += b"Content-Length: %d\r\n\r\n%s" % (len(body), body)
+    health = b"GET /health HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n"
+    with jik_serve(JIK_WORKERS="1") as served:
+        for requests in ([health] * 20, [solve] * 5, [solve, health] * 5):
+            for _ in range(5):
+                _connect(served.port, b"".join(requests)).close()
+            time.sleep(0.5)
+        assert httpx.get(f"{served.url}/health", timeout=5).status_code == 200
+    log = served.log[0]
+    assert "Exception in ASGI application" not in log and "Traceback" not in log, log
