@@ -165,7 +165,18 @@ def _dimensions(spec: RobotSpec, what: str) -> str:
 
 
 def check_configuration(spec: RobotSpec, x0) -> None:
-    """``x0`` has p components."""
+    """The robot has at most the API's p, and ``x0`` has p components."""
+    if spec.p > S.MAX_DIMENSION:
+        joints = (
+            "; name at most that many in active_joints (the others stay at their value in "
+            "locked, default 0)"
+            if spec.name == "urdf"
+            else ""
+        )
+        raise RequestError(
+            "robot", f"this {spec.name} robot has p = {spec.p} moving joints; the API takes at "
+            f"most {S.MAX_DIMENSION} (the cap on x0's components){joints}",
+        )  # fmt: skip
     if len(x0) != spec.p:
         raise RequestError(
             "x0", f"must have {spec.p} components ({_dimensions(spec, 'p')}), got {len(x0)}"

@@ -223,3 +223,29 @@ def test_a_boolean_or_a_string_is_no_number(api, over, field):
     """(Booleans were taken as 0 and 1, and numeric strings as numbers, issue 26 item 8.)"""
     (msg,) = messages(api.post("/solve", json=solve_body(**over)))
     assert msg.startswith(f"{field}: Input should be a valid")
+
+
+def _chain_urdf(joints: int) -> str:
+    links = "".join(f'<link name="l{i}"/>' for i in range(joints + 1))
+    moving = "".join(
+        f'<joint name="j{i}" type="revolute"><parent link="l{i}"/><child link="l{i + 1}"/>'
+        f'<origin xyz="0.1 0 0"/><axis xyz="0 0 1"/>'
+        f'<limit lower="-3" upper="3" effort="1" velocity="1"/></joint>'
+        for i in range(joints)
+    )
+    return f'<robot name="long">{links}{moving}</robot>'
+
+
+@pytest.mark.parametrize("path", ["/solve", "/repeatability"])
+def test_a_robot_past_the_joint_cap_is_refused_by_the_cap(api, path):
+    """A 400-joint URDF chain was answered "x0 must have 400 components", which no x0 can have
+    (x0 takes at most 16): the answer names the cap and how to stay under it."""
+    robot = {"name": "urdf", "urdf": _chain_urdf(400), "end_link": "l400", "task": "xy"}
+    body = {"robot": robot, "algorithm": "pseudoinverse", "x0": [0.1] * 16}
+    body.update({"target": [1.0, 1.0]} if path == "/solve" else {"path": [[1.0, 1.0]]})
+    (msg,) = messages(api.post(path, json=body))
+    assert msg == (
+        "robot: this urdf robot has p = 400 moving joints; the API takes at most 16 (the cap on "
+        "x0's components); name at most that many in active_joints (the others stay at their "
+        "value in locked, default 0)"
+    )
