@@ -198,8 +198,8 @@ def sessions_full_response(exc: SessionsFull) -> JSONResponse:
 
 
 def atlas_job_not_found_response(exc: AtlasJobNotFound) -> JSONResponse:
-    return JSONResponse(status_code=404, content={"detail": (
-        f"no atlas job {exc.args[0]!r} (it was cancelled, or ended and expired)")})  # fmt: skip
+    job_id, why = exc.args
+    return JSONResponse(status_code=404, content={"detail": f"no atlas job {job_id!r}: {why}"})
 
 
 def atlas_jobs_full_response(exc: AtlasJobsFull) -> JSONResponse:

@@ -16,6 +16,7 @@ leg ends in the result.
 
 from __future__ import annotations
 
+import re
 import secrets
 import threading
 import time
@@ -38,7 +39,7 @@ from jik.engine.self_motion import MAX_ARC
 
 
 class AtlasJobNotFound(LookupError):
-    """No job with that id (never made, cancelled, or dropped after ``keep_for``): HTTP 404."""
+    """No job with that id: HTTP 404; ``args``: the id and why it is not there."""
 
 
 class AtlasJobsFull(RuntimeError):
@@ -186,6 +187,9 @@ class AtlasJobs:
         self._jobs: dict[str, AtlasJob] = {}
         self._lock = threading.Lock()
         self._slots = threading.Semaphore(self.limits.max_running)
+        #: The first characters of this server's job ids: an id with others is a job of an
+        #: earlier server process, lost when it stopped (jobs live in memory).
+        self.run = secrets.token_hex(3)
 
     def check_room(self, client: str) -> None:
         """Raise :class:`AtlasJobsFull` if no job of ``client`` can start now."""
@@ -199,7 +203,8 @@ class AtlasJobs:
         self.check_room(client)
         if plan is None:
             plan = plan_request(req, self.limits)
-        job = AtlasJob(secrets.token_urlsafe(12), client, plan, req.leg_ends, request=req)
+        job = AtlasJob(self.run + secrets.token_urlsafe(12), client, plan, req.leg_ends,
+                       request=req)  # fmt: skip
         with self._lock:
             self._room(client)
             self._jobs[job.id] = job
@@ -237,8 +242,18 @@ class AtlasJobs:
         with self._lock:
             job = self._jobs.get(job_id)
         if job is None:
-            raise AtlasJobNotFound(job_id)
+            raise AtlasJobNotFound(job_id, self._missing(job_id))
         return job
+
+    def _missing(self, job_id: str) -> str:
+        """Why no job has the id ``job_id``."""
+        if job_id.startswith(self.run):
+            return (f"it was cancelled, or it ended more than {self.limits.keep_for:g} s ago "
+                    "and was dropped")  # fmt: skip
+        if re.fullmatch(r"[0-9a-f]{6}[A-Za-z0-9_-]{16}", job_id):
+            return ("the server restarted since it was started, and atlas jobs live in the "
+                    "server's memory: start it again")  # fmt: skip
+        return "no job of this server has had this id"
 
     def cancel(self, job_id: str) -> None:
         """Stop the job (after the chunk it is on) and drop it."""

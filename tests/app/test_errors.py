@@ -249,3 +249,26 @@ def test_a_robot_past_the_joint_cap_is_refused_by_the_cap(api, path):
         "x0's components); name at most that many in active_joints (the others stay at their "
         "value in locked, default 0)"
     )
+
+
+def test_a_missing_atlas_job_says_why_it_is_missing(api):
+    """An id of an earlier server process is a job lost in the restart; one of this server's
+    was cancelled or dropped; anything else was never an id (all were answered "it was
+    cancelled, or ended and expired")."""
+    from jik.app.compute.atlas_jobs import AtlasJobs
+
+    assert api.get("/atlas/x").status_code == 404
+    ours = api.app.state.atlas_jobs.run
+    earlier = AtlasJobs().run
+    while earlier == ours:
+        earlier = AtlasJobs().run
+    token = "A" * 16
+    for job_id, why in [
+        (earlier + token, "the server restarted since it was started, and atlas jobs live in "
+         "the server's memory: start it again"),
+        (ours + token, "it was cancelled, or it ended more than 600 s ago and was dropped"),
+        ("nosuchjob", "no job of this server has had this id"),
+    ]:  # fmt: skip
+        r = api.get(f"/atlas/{job_id}")
+        assert r.status_code == 404
+        assert r.json() == {"detail": f"no atlas job {job_id!r}: {why}"}

@@ -44,7 +44,7 @@ async def start_job(jobs: AtlasJobs, pool: ComputePool, request: Request, req) -
 
 Jobs = Annotated[AtlasJobs, Depends(jobs_of)]
 ERRORS: dict[int | str, dict] = {
-    404: {"model": ErrorResponse, "description": "no such job (ended long ago, or cancelled)"},
+    404: {"model": ErrorResponse, "description": "no such job (cancelled, ended long ago, or lost when the server restarted)"},
     429: {"model": ErrorResponse, "description": "too many atlas jobs; retry later"},
 }
 
