@@ -44,7 +44,10 @@ async def start_job(jobs: AtlasJobs, pool: ComputePool, request: Request, req) -
 
 Jobs = Annotated[AtlasJobs, Depends(jobs_of)]
 ERRORS: dict[int | str, dict] = {
-    404: {"model": ErrorResponse, "description": "no such job (cancelled, ended long ago, or lost when the server restarted)"},
+    404: {
+        "model": ErrorResponse,
+        "description": "no such job (cancelled, ended, or lost in a restart)",
+    },
     429: {"model": ErrorResponse, "description": "too many atlas jobs; retry later"},
 }
 
