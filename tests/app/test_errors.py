@@ -272,3 +272,17 @@ def test_a_missing_atlas_job_says_why_it_is_missing(api):
         r = api.get(f"/atlas/{job_id}")
         assert r.status_code == 404
         assert r.json() == {"detail": f"no atlas job {job_id!r}: {why}"}
+
+
+@pytest.mark.parametrize("path", ["/solve", "/repeatability"])
+def test_an_overflow_at_the_start_is_called_an_overflow(api, path):
+    """k(x0) = exp(800) is past the floating-point range: the answer says so (it was "J J^T
+    is singular", and in a session "y_d contains NaN or infinite values")."""
+    robot = {"name": "formula", "variables": ["x1", "x2", "x3"], "task": ["exp(x1) + x3", "x2"]}
+    body = {"robot": robot, "algorithm": "pseudoinverse", "x0": [800.0, 0.5, 0.5]}
+    body.update({"target": [1.0, 1.0]} if path == "/solve" else {"path": [[1.0, 1.0]]})
+    (msg,) = messages(api.post(path, json=body))
+    assert msg == (
+        "x0: the kinematics overflow at the start: k(x0) = (inf, 0.5), its Jacobian not "
+        "finite; choose a start where both are finite (below about 1.8e308)"
+    )
