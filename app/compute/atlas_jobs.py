@@ -16,6 +16,7 @@ leg ends in the result.
 
 from __future__ import annotations
 
+import re
 import secrets
 import threading
 import time
@@ -40,7 +41,7 @@ from jik.engine.solver import gamma_problem
 
 
 class AtlasJobNotFound(LookupError):
-    """No job with that id (never made, cancelled, or dropped after ``keep_for``): HTTP 404."""
+    """No job with that id: HTTP 404; ``args``: the id and why it is not there."""
 
 
 class AtlasJobsFull(RuntimeError):
@@ -155,11 +156,23 @@ class AtlasJob:
     #: The request it was started from (the dashboard draws the result with it).
     request: AtlasRequest | None = None
 
-    def response(self) -> AtlasJobResponse:
+    def response(self, ahead: int | None = None, running: int = 1) -> AtlasJobResponse:
+        """The job's state; ``ahead``: the jobs before it in the queue, of which ``running``
+        are computing (:meth:`AtlasJobs.response` counts them)."""
         end = self.ended if self.ended is not None else time.monotonic()
+        message = {"running": "computing", "done": "done", "failed": "failed",
+                   "cancelled": "cancelled"}.get(self.status, "queued")  # fmt: skip
+        if self.status == "queued" and ahead is not None:
+            message = (
+                f"queued behind {ahead} atlas job{'s' * (ahead != 1)} ({running} computing, "
+                f"the rest waiting); it starts when they end"
+                if ahead
+                else "starting"
+            )
         return AtlasJobResponse(
             id=self.id, status=self.status, runs=self.plan.size, runs_done=self.runs_done,
             progress=self.runs_done / self.plan.size, elapsed_s=end - self.started,
+            queue_position=ahead if self.status == "queued" else None, message=message,
             error=self.error, result=self.result,  # type: ignore[arg-type]  # (validated)
         )  # fmt: skip
 
@@ -176,6 +189,9 @@ class AtlasJobs:
         self._jobs: dict[str, AtlasJob] = {}
         self._lock = threading.Lock()
         self._slots = threading.Semaphore(self.limits.max_running)
+        #: The first characters of this server's job ids: an id with others is a job of an
+        #: earlier server process, lost when it stopped (jobs live in memory).
+        self.run = secrets.token_hex(3)
 
     def check_room(self, client: str) -> None:
         """Raise :class:`AtlasJobsFull` if no job of ``client`` can start now."""
@@ -189,7 +205,8 @@ class AtlasJobs:
         self.check_room(client)
         if plan is None:
             plan = plan_request(req, self.limits)
-        job = AtlasJob(secrets.token_urlsafe(12), client, plan, req.leg_ends, request=req)
+        job = AtlasJob(self.run + secrets.token_urlsafe(12), client, plan, req.leg_ends,
+                       request=req)  # fmt: skip
         with self._lock:
             self._room(client)
             self._jobs[job.id] = job
@@ -206,13 +223,39 @@ class AtlasJobs:
             raise AtlasJobsFull(f"at most {self.limits.per_client} atlas jobs per client run at "
                                 "once; wait for one to end or cancel it")  # fmt: skip
 
+    def response(self, job: AtlasJob) -> AtlasJobResponse:
+        """``job``'s state, with the jobs queued or running before it when it waits."""
+        with self._lock:
+            before = self._before(job)
+        return job.response(len(before), sum(j.status == "running" for j in before))
+
+    def _before(self, job: AtlasJob) -> list[AtlasJob]:
+        """The active jobs ahead of ``job``: the running ones and those queued before it (the
+        queue is served in the order the jobs were started). Under the lock."""
+        ahead, earlier = [], True
+        for other in self._jobs.values():
+            earlier = earlier and other is not job
+            if other is not job and (other.status == "running" or (earlier and other.active)):
+                ahead.append(other)
+        return ahead
+
     def get(self, job_id: str) -> AtlasJob:
         self.sweep()
         with self._lock:
             job = self._jobs.get(job_id)
         if job is None:
-            raise AtlasJobNotFound(job_id)
+            raise AtlasJobNotFound(job_id, self._missing(job_id))
         return job
+
+    def _missing(self, job_id: str) -> str:
+        """Why no job has the id ``job_id``."""
+        if job_id.startswith(self.run):
+            return (f"it was cancelled, or it ended more than {self.limits.keep_for:g} s ago "
+                    "and was dropped")  # fmt: skip
+        if re.fullmatch(r"[0-9a-f]{6}[A-Za-z0-9_-]{16}", job_id):
+            return ("the server restarted since it was started, and atlas jobs live in the "
+                    "server's memory: start it again")  # fmt: skip
+        return "no job of this server has had this id"
 
     def cancel(self, job_id: str) -> None:
         """Stop the job (after the chunk it is on) and drop it."""
@@ -237,9 +280,15 @@ class AtlasJobs:
             self._jobs.clear()
 
     def _run(self, job: AtlasJob) -> None:
-        while not self._slots.acquire(timeout=0.2):
+        while True:  # first come, first served
             if job.cancel.is_set():
                 return self._end(job, "cancelled")
+            with self._lock:
+                first = not any(j.status == "queued" for j in self._before(job))
+            if first and self._slots.acquire(timeout=0.2):
+                break
+            if not first:
+                job.cancel.wait(0.2)
         try:
             job.status = "running"
             job.started = time.monotonic()

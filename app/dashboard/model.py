@@ -82,7 +82,8 @@ class DashboardState(BaseModel):
     #: The three coordinates the configuration-space panel shows (p = 4): "012" is x1, x2, x3.
     cspace_axes: Literal["012", "013", "023", "123"] | None = None
     max_iterations: (
-        Annotated[int, Field(strict=True, ge=MIN_ITERATIONS, le=MAX_ITERATIONS_CAP)] | None
+        Annotated[int, Field(strict=True, ge=MIN_ITERATIONS, le=MAX_ITERATIONS_CAP), INTEGRAL]
+        | None
     ) = None
 
     def as_dict(self) -> dict:

@@ -13,14 +13,17 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+from typing import Annotated
 
 import websockets
 from fastapi import APIRouter, Request, WebSocket
-from fastapi.responses import JSONResponse, PlainTextResponse, StreamingResponse
+from fastapi.responses import JSONResponse, PlainTextResponse
 from pydantic import BaseModel, ConfigDict, Field
+from sse_starlette import EventSourceResponse, ServerSentEvent
 
 from jik.app.api.dependencies import Store
 from jik.app.api.errors import unparsed_body_response
+from jik.app.compute.schemas import INTEGRAL
 from jik.app.dashboard import export_csv, export_json
 from jik.app.dashboard.controls import controls_message
 from jik.app.dashboard.messages import LatestEvents
@@ -130,7 +133,9 @@ class SecondPhaseRequest(BaseModel):
 
     model_config = ConfigDict(extra="forbid")
 
-    generation: int = Field(strict=True, ge=1, description="the generation of the result shown")
+    generation: Annotated[int, Field(strict=True, ge=1), INTEGRAL] = Field(
+        description="the generation of the result shown"
+    )
 
 
 #: A second phase that is not in the state a request needs.
@@ -201,13 +206,13 @@ _NOT_FOUND: dict[int | str, dict] = {404: {"description": "no such session"}}
 @router.get(
     "/api/sessions/{session_id}/events",
     operation_id="session_events",
-    response_class=StreamingResponse,
+    response_class=EventSourceResponse,
     responses={
         200: {"description": "the session's events", "content": {"text/event-stream": {}}},
         **_NOT_FOUND,
     },
 )
-async def events(session_id: str, request: Request, store: Store):
+async def events(session_id: str, store: Store):
     """Server-sent events of one session: ``state``, ``progress``, ``result``, ``functionals``,
     ``error``, ``ahead``, ``refused``.
 
@@ -222,30 +227,21 @@ async def events(session_id: str, request: Request, store: Store):
 
     async def stream():
         try:
-            yield "retry: 1000\n\n"
+            yield ServerSentEvent(retry=1000)  # (the page reconnects after 1 s)
             while True:
-                try:
-                    event = await asyncio.wait_for(queue.get(), HEARTBEAT)
-                except TimeoutError:
-                    if await request.is_disconnected():
-                        return
-                    yield ": keep-alive\n\n"
-                    continue
+                event = await queue.get()
                 if event.kind == "closed":  # (the session ended: the page opens a new one)
                     return
-                if event.kind not in PAGE_EVENTS:
-                    continue
-                yield f"event: {event.kind}\nid: {event.generation}\ndata: {event.data}\n\n"
+                if event.kind in PAGE_EVENTS:
+                    yield ServerSentEvent(event.data, event=event.kind, id=str(event.generation))
         finally:
             unsubscribe()
             session.users -= 1
             session.touch()
 
-    return StreamingResponse(
-        stream(),
-        media_type="text/event-stream",
-        headers={"Cache-Control": "no-cache", "X-Accel-Buffering": "no"},
-    )
+    # sse-starlette frames the events, sends a comment every HEARTBEAT seconds (proxies keep
+    # the connection), and ends the stream when the client leaves or the server stops.
+    return EventSourceResponse(stream(), ping=HEARTBEAT, sep="\n")
 
 
 async def _finished(session: Session):
