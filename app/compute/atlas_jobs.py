@@ -28,6 +28,7 @@ from jik.app.compute.atlas_schemas import AtlasJobResponse, AtlasRequest
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.requests import build_augmentation, build_robot, nullable
 from jik.app.compute.settings import Settings
+from jik.app.compute.worker import task
 from jik.engine.atlas import AtlasPlan, plan_atlas
 from jik.engine.atlas_backends import ProcessPool
 from jik.engine.atlas_run import AtlasResult, run_atlas
@@ -63,7 +64,7 @@ class AtlasLimits:
     #: worker processes of a running atlas
     workers: int = 2
     #: address space of each (MB; 0: no limit): the compute workers' (``JIK_WORKER_MEMORY_MB``)
-    worker_memory: int = Settings.worker_memory
+    worker_memory: int = Settings.model_fields["worker_memory"].default
 
 
 def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
@@ -109,8 +110,13 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
     )  # fmt: skip
 
 
+@task(
+    "reference",
+    "another reference or path (eq. (7) from the reference to the path's first point ran out "
+    "of memory)",
+)
 def plan_task(req: str, limits: AtlasLimits):
-    """:func:`plan_request` of a request (JSON) as a compute worker's task (``atlas.plan``),
+    """:func:`plan_request` of a request (JSON) as a compute worker's task,
     within the workers' time and memory limits (tracing the curves solves eq. (7)): the plan and
     None, or None and the refusal (message, field), for the server to raise again."""
     try:

@@ -8,7 +8,6 @@ socket pair; :class:`jik.app.compute.pool.ComputePool` sends the requests and re
 
 from __future__ import annotations
 
-import importlib
 import os
 import socket
 import struct
@@ -30,19 +29,27 @@ WORK_FIELDS = {
     "solve": ("max_iterations", "a lower max_iterations or a larger tolerance"),
     "repeatability": ("cycles", "fewer cycles or path points, a lower max_iterations"),
     "synthesize": ("region", "a smaller region, fewer nodes, a smaller grid or a lower degree"),
-    "dashboard.run": ("cycles", "fewer cycles, a larger gamma or another start"),
-    "atlas.plan": (
-        "reference",
-        "another reference or path (eq. (7) from the reference to the "
-        "path's first point ran out of memory)",
-    ),
 }
+
+
+def task(field: str, less: str) -> Callable[[Callable], Callable]:
+    """Make a function a task of the compute workers (``pool.run("call", (function, args))``),
+    the request's ``field`` sizing its work and ``less`` saying how to ask for less of it. The
+    function goes to the worker by reference (its module and name, as pickle sends it)."""
+
+    def register(fn: Callable) -> Callable:
+        fn.jik_task = (field, less)  # type: ignore[attr-defined]
+        return fn
+
+    return register
 
 
 def work_of(kind: str, payload: Any) -> tuple[str, str]:
     """The field that sizes a computation's work and how to ask for less (:data:`WORK_FIELDS`;
-    a ``call`` by its task's name)."""
-    return WORK_FIELDS.get(payload[0] if kind == "call" else kind, ("request", "less work"))
+    a ``call`` by its task's :func:`task` registration)."""
+    if kind == "call":
+        return getattr(payload[0], "jik_task", ("request", "less work"))
+    return WORK_FIELDS.get(kind, ("request", "less work"))
 
 
 def _solve_payload(items: list[bytes]) -> list[tuple[str, Any]]:
@@ -56,19 +63,14 @@ def _solve_payload(items: list[bytes]) -> list[tuple[str, Any]]:
     return out
 
 
-#: Work that other parts of the server hand to the same workers (``("call", (task, args))``),
-#: by name: the dashboard's offloaded runs. Only these functions can be called.
-TASKS = {
-    "dashboard.run": "jik.app.dashboard.offload:run_offloaded",
-    "atlas.plan": "jik.app.compute.atlas_jobs:plan_task",
-}
-
-
-def _call(payload: tuple[str, tuple]) -> Any:
-    """Run the task ``payload[0]`` of :data:`TASKS` with the arguments ``payload[1]``."""
-    task, args = payload
-    module, name = TASKS[task].split(":")
-    return getattr(importlib.import_module(module), name)(*args)
+def _call(payload: tuple[Callable, tuple]) -> Any:
+    """Run the function ``payload[0]``, made a task by :func:`task`, on ``payload[1]``: work
+    that other parts of the server hand to the same workers (the dashboards' runs, an atlas's
+    plan). Only such functions are called."""
+    fn, args = payload
+    if not hasattr(fn, "jik_task"):
+        raise TypeError(f"{fn!r} is not a compute task")
+    return fn(*args)
 
 
 # Workers take requests and give responses as JSON bytes: (de)serialization and validation run in

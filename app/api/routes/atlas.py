@@ -11,7 +11,7 @@ from fastapi import APIRouter, Depends, Request, Response
 from starlette.concurrency import run_in_threadpool
 
 from jik.app.api.dependencies import Pool
-from jik.app.compute.atlas_jobs import AtlasJob, AtlasJobs, AtlasLimits
+from jik.app.compute.atlas_jobs import AtlasJob, AtlasJobs, AtlasLimits, plan_task
 from jik.app.compute.atlas_schemas import AtlasBody, AtlasJobResponse
 from jik.app.compute.pool import ComputePool
 from jik.app.compute.schemas import ErrorResponse
@@ -36,7 +36,7 @@ async def start_job(jobs: AtlasJobs, pool: ComputePool, request: Request, req) -
     it as a job of the client's."""
     client = request.client.host if request.client else "unknown"
     jobs.check_room(client)  # (before the work)
-    plan, refused = await pool.run("call", ("atlas.plan", (req.model_dump_json(), jobs.limits)))
+    plan, refused = await pool.run("call", (plan_task, (req.model_dump_json(), jobs.limits)))
     if refused is not None:
         raise InvalidInputError(*refused)
     return await run_in_threadpool(jobs.start, client, req, plan)
