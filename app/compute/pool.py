@@ -83,6 +83,7 @@ class ComputePool:
         self._idle: asyncio.Queue[Worker] | None = None
         self._pending: dict[str, list[_Pending]] = {}
         self._tasks: set[asyncio.Task] = set()
+        self._closed = False
         #: Engine calls made and requests served by them (for tests and the benchmark).
         self.stats = {"solve_calls": 0, "solve_requests": 0, "busy": 0, "exceeded": 0}
 
@@ -90,12 +91,14 @@ class ComputePool:
     def start(self) -> None:
         """Start the worker processes (idempotent, non-blocking)."""
         with self._lock:
+            self._closed = False
             while len(self._workers) < self.settings.workers:
                 self._workers.append(Worker(self.settings.worker_memory))
 
     def close(self) -> None:
-        """Stop every worker process."""
+        """Stop every worker process (none replaces them until :meth:`start`)."""
         with self._lock:
+            self._closed = True
             for w in self._workers:
                 w.kill()
             self._workers.clear()
@@ -149,6 +152,8 @@ class ComputePool:
         )
 
     async def _acquire(self, deadline: float) -> Worker:
+        if self._closed:
+            raise ServiceUnavailable("the server is stopping")
         idle = self._bind()
         remaining = deadline - self._bound_loop.time()
         try:
@@ -201,6 +206,8 @@ class ComputePool:
                 "was replaced"
             ) from None
         except asyncio.CancelledError:  # the request went away: collect the reply in the back
+            if self._closed:  # (the server is stopping: its workers are gone)
+                raise
             if sent:  # (the reply goes on from what this read of it had)
                 self._spawn(self._drain(worker, loop.time() + self.settings.timeout, buf))
             elif worker.ready:
@@ -273,6 +280,8 @@ class ComputePool:
         with self._lock:
             if worker in self._workers:
                 self._workers.remove(worker)
+            if self._closed:  # (the server is stopping)
+                return
             fresh = Worker(self.settings.worker_memory)
             self._workers.append(fresh)
         self._bound_idle.put_nowait(fresh)

@@ -21,12 +21,10 @@ router = APIRouter(tags=["atlas"])
 
 
 def jobs_of(request: Request) -> AtlasJobs:
-    """The app's atlas jobs (made on first use; their processes have the compute workers'
-    memory limit)."""
+    """The app's atlas jobs (made on first use; their chunks run in the compute pool)."""
     jobs = getattr(request.app.state, "atlas_jobs", None)
     if jobs is None:
-        memory = request.app.state.pool.settings.worker_memory
-        jobs = request.app.state.atlas_jobs = AtlasJobs(AtlasLimits(worker_memory=memory))
+        jobs = request.app.state.atlas_jobs = AtlasJobs(AtlasLimits(), request.app.state.pool)
     return jobs
 
 
