@@ -20,6 +20,7 @@ from __future__ import annotations
 import functools
 import itertools
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -328,6 +329,8 @@ class CharacteristicsMap(AugmentingMap):
             raise InvalidInputError(f"on_undefined must be 'raise' or 'nan', got {on_undefined!r}")
         self.on_undefined = on_undefined
         self._cache: tuple | None = None
+        #: Where the last characteristic() failed first: (Phi_s or None, s or None, x), or None.
+        self._where: Any = None
 
     def moments_ignore(self, f: int) -> bool:
         """Whether the kinematics' quadrature moments ignore the leaf coordinate x[f].
@@ -425,17 +428,17 @@ class CharacteristicsMap(AugmentingMap):
         where = None
         for lo in range(0, B, MAX_MEMBERS):
             part = slice(lo, lo + MAX_MEMBERS)
-            Z[part], S[part], failed[part] = self._characteristic(
+            Z[part], S[part], failed[part], first = self._characteristic(
                 xb[part], None if g is None else g[part]
             )
-            where = self._where if where is None else where
+            where = first if where is None else where
         self._where = where
         s0 = collocation(n)[0]
         return s0, Z.reshape(*shape, n), S.reshape(*shape, n, self.p), failed.reshape(shape)
 
-    def _characteristic(self, xb, g) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """:meth:`characteristic` of the points ``xb`` (B, p) in one batched solve; sets
-        ``self._where`` to where the first failure is."""
+    def _characteristic(self, xb, g) -> tuple[FloatArray, FloatArray, FloatArray, Any]:
+        """:meth:`characteristic` of the points ``xb`` (B, p) in one batched solve, and where
+        its first failure is (None if none): (Phi_s or None, s or None, x)."""
         n = self.nodes
         Y = self.homotopy.field(xb)  # (B, p)
         Z, S, bad_nodes, conv, pts, tail = self._collocate(xb, Y, n, g)
@@ -463,8 +466,7 @@ class CharacteristicsMap(AugmentingMap):
             i = np.flatnonzero(failed)[0]
             j = np.flatnonzero(bad_nodes[i])
             where = (pts[i, j[0]], s0[j[0]], xb[i]) if j.size else (None, None, xb[i])
-        self._where = where
-        return Z, S, failed
+        return Z, S, failed, where
 
     def evaluate(self, x) -> tuple[FloatArray, FloatArray, FloatArray]:
         """h(x) (...,), dh/dx (..., p) and the failure mask (...,), without raising.
