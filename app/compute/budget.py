@@ -16,6 +16,16 @@ import threading
 from collections.abc import Iterator
 
 from jik.app.compute.exceptions import RequestError
+from jik.app.compute.settings import settings
+
+#: The build budget of this process [s], set by a compute worker's entry from its pool's
+#: settings (None: the environment's, ``Settings.build_budget``).
+BUILD_SECONDS: float | None = None
+
+
+def build_seconds() -> float:
+    """Seconds a robot's formulas may take to build here (:data:`BUILD_SECONDS`)."""
+    return settings().build_budget if BUILD_SECONDS is None else BUILD_SECONDS
 
 
 class _Expired(BaseException):

@@ -93,7 +93,10 @@ class ComputePool:
         with self._lock:
             self._closed = False
             while len(self._workers) < self.settings.workers:
-                self._workers.append(Worker(self.settings.worker_memory))
+                self._workers.append(self._new_worker())
+
+    def _new_worker(self) -> Worker:
+        return Worker(self.settings.worker_memory, self.settings.build_budget)
 
     def close(self) -> None:
         """Stop every worker process (none replaces them until :meth:`start`)."""
@@ -282,7 +285,7 @@ class ComputePool:
                 self._workers.remove(worker)
             if self._closed:  # (the server is stopping)
                 return
-            fresh = Worker(self.settings.worker_memory)
+            fresh = self._new_worker()
             self._workers.append(fresh)
         self._bound_idle.put_nowait(fresh)
 

@@ -20,9 +20,8 @@ from collections.abc import Sequence
 from typing import Any
 
 from jik.app.compute import schemas as S
-from jik.app.compute.budget import time_budget
+from jik.app.compute.budget import build_seconds, time_budget
 from jik.app.compute.exceptions import RequestError
-from jik.app.compute.settings import settings
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.robot_spec import Robot, robot_from_dict
 
@@ -75,7 +74,7 @@ def user_robot(req_robot: Any, augmentation: Any = None) -> tuple[Robot, S.Robot
         given = augmentation.model_dump(exclude_none=True)
         definition["augmentations"] = [{**given, "label": _LABEL}]
     try:
-        with time_budget(settings().build_budget, "robot", "building the robot's formulas"):
+        with time_budget(build_seconds(), "robot", "building the robot's formulas"):
             robot = _built(json.dumps(definition, sort_keys=True))
     except InvalidInputError as exc:
         raise RequestError(request_field(exc.field, list(definition)), _text(exc)) from None

@@ -17,6 +17,7 @@ from collections.abc import Callable
 from multiprocessing.connection import Connection
 from typing import Any
 
+from jik.app.compute import budget
 from jik.app.compute import schemas as S
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.requests import engine_error, repeatability_request, solve_batch_json
@@ -113,11 +114,14 @@ def _worker_main(conn) -> None:
         conn.send(msg)
 
 
-def _worker_entry(fd: int, memory_mb: int = 0) -> None:
+def _worker_entry(fd: int, memory_mb: int = 0, build_seconds: float = 0.0) -> None:
     """Entry point of a worker process started by :class:`Worker` (``python -c``): its address
     space limited to ``memory_mb`` (0: none), so that a computation too large for it raises
-    MemoryError (a 422) instead of taking the machine's memory."""
+    MemoryError (a 422) instead of taking the machine's memory; robots built within
+    ``build_seconds`` (:func:`jik.app.compute.budget.build_seconds`; 0: the environment's)."""
     limit_memory(memory_mb)
+    if build_seconds > 0:
+        budget.BUILD_SECONDS = build_seconds
     _worker_main(Connection(fd))
 
 
@@ -141,7 +145,7 @@ def frame_header(buf: bytearray) -> tuple[int | None, int]:
 class Worker:
     """A worker process (a fresh interpreter, so nothing of the server's state is inherited)."""
 
-    def __init__(self, memory_mb: int = 0) -> None:
+    def __init__(self, memory_mb: int = 0, build_seconds: float = 0.0) -> None:
         parent, child = socket.socketpair()
         fd = child.fileno()
         env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
@@ -150,7 +154,7 @@ class Worker:
                 sys.executable,
                 "-c",
                 "from jik.app.compute.worker import _worker_entry; "
-                f"_worker_entry({fd}, {int(memory_mb)})",
+                f"_worker_entry({fd}, {int(memory_mb)}, {float(build_seconds)!r})",
             ],
             pass_fds=[fd],
             env=env,

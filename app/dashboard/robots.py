@@ -20,9 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from jik.app.compute.budget import time_budget
+from jik.app.compute.budget import build_seconds, time_budget
 from jik.app.compute.exceptions import RequestError
-from jik.app.compute.settings import settings
 from jik.app.compute.worker import task
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.inverses import Inverse
@@ -72,7 +71,7 @@ def check_definition(definition: Mapping[str, Any]) -> None:
     characteristics of section 4 take, within the build budget (a compute worker's task);
     :class:`RequestError` naming its field if it is refused."""
     what = "building the robot's formulas"
-    with time_budget(settings().build_budget, "robot_definition", what):
+    with time_budget(build_seconds(), "robot_definition", what):
         try:
             kinematics = user_robot(definition).kinematics
         except InvalidInputError as exc:
