@@ -54,9 +54,12 @@ def time_budget(seconds: float, field: str, what: str) -> Iterator[None]:
         yield
         return
     previous = signal.signal(signal.SIGALRM, _expired)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
     try:
-        yield
+        try:
+            signal.setitimer(signal.ITIMER_REAL, seconds)
+            yield
+        finally:  # (a timer that fires in here has fired once: it is caught below)
+            signal.setitimer(signal.ITIMER_REAL, 0)
     except _Expired:
         raise RequestError(
             field,
@@ -64,5 +67,4 @@ def time_budget(seconds: float, field: str, what: str) -> Iterator[None]:
             "or fewer nested functions",
         ) from None
     finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, previous)
