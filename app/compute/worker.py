@@ -17,6 +17,8 @@ from collections.abc import Callable
 from multiprocessing.connection import Connection
 from typing import Any
 
+import psutil
+
 from jik.app.compute import budget
 from jik.app.compute import schemas as S
 from jik.app.compute.exceptions import RequestError
@@ -172,14 +174,12 @@ class Worker:
             self.ready = True
 
     def cpu_seconds(self) -> float | None:
-        """CPU time the worker has used (user and system), from /proc; None where there is no
-        /proc or the process is gone."""
+        """CPU time the worker has used (user and system); None if the process is gone."""
         try:
-            with open(f"/proc/{self.process.pid}/stat") as f:
-                fields = f.read().rsplit(")", 1)[1].split()
-            return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
-        except (OSError, ValueError, IndexError):
+            times = psutil.Process(self.process.pid).cpu_times()
+        except psutil.Error:
             return None
+        return times.user + times.system
 
     def kill(self) -> None:
         self.process.kill()
