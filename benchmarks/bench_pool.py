@@ -71,7 +71,7 @@ async def _pebble(duration: float, clients: int, batching: bool) -> dict:
         return {"throughput_rps": float("nan"), "p50_ms": float("nan"),
                 "p99_ms": float("nan"), "errors": "pebble is not installed"}  # fmt: skip
 
-    from jik.app.compute.worker import _solve_payload
+    from jik.app.compute.worker import solve_batch
     from jik.engine.atlas_backends import limit_memory
 
     pool = pebble.ProcessPool(
@@ -79,7 +79,7 @@ async def _pebble(duration: float, clients: int, batching: bool) -> dict:
         context=multiprocessing.get_context("spawn"),
     )  # fmt: skip
     try:
-        await asyncio.wrap_future(pool.schedule(_solve_payload, args=([],)))  # (workers up)
+        await asyncio.wrap_future(pool.schedule(solve_batch, args=([],)))  # (workers up)
         slots = asyncio.Semaphore(2)
         waiting: list[tuple[bytes, asyncio.Future]] = []
         flushes: set[asyncio.Task] = set()
@@ -92,7 +92,7 @@ async def _pebble(duration: float, clients: int, batching: bool) -> dict:
         async def run(items: list[bytes]) -> list[Any]:
             async with slots:
                 return await asyncio.wrap_future(
-                    pool.schedule(_solve_payload, args=(items,), timeout=20.0)
+                    pool.schedule(solve_batch, args=(items,), timeout=20.0)
                 )
 
         async def flush() -> None:
@@ -104,7 +104,7 @@ async def _pebble(duration: float, clients: int, batching: bool) -> dict:
                 if batch:
                     items = [b for b, _ in batch]
                     results = await asyncio.wrap_future(
-                        pool.schedule(_solve_payload, args=(items,), timeout=20.0)
+                        pool.schedule(solve_batch, args=(items,), timeout=20.0)
                     )
                     for (_, fut), res in zip(batch, results, strict=True):
                         fut.set_result(res)

@@ -148,7 +148,7 @@ class PoolBackend:
         pending: set[Future] = set()
         try:
             for chunk in tasks:
-                pending.add(self.pool.submit("call", (atlas_chunk, (fn, chunk))))
+                pending.add(self.pool.submit(atlas_chunk, fn, chunk))
                 if len(pending) >= IN_FLIGHT * self.workers:
                     finished, pending = wait(pending, return_when=FIRST_COMPLETED)
                     yield from (f.result() for f in finished)

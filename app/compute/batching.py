@@ -13,6 +13,7 @@ idle workers and dispatch.
 from __future__ import annotations
 
 import asyncio
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -22,6 +23,7 @@ from jik.app.compute import schemas as S
 from jik.app.compute.exceptions import ServiceUnavailable
 from jik.app.compute.precheck import precheck
 from jik.app.compute.requests import batch_key
+from jik.app.compute.worker import solve_batch
 
 if TYPE_CHECKING:
     from jik.app.compute.settings import Settings
@@ -60,8 +62,10 @@ class SolveBatching:
         def _busy(self) -> ServiceUnavailable: ...
         def _spawn(self, coro) -> asyncio.Task: ...
         async def _acquire(self, deadline: float) -> Worker: ...
-        async def run(self, kind: str, payload) -> Any: ...
-        async def _dispatch_retried(self, kind: str, payload, worker: Worker | None = None): ...
+        async def run(self, fn: Callable, *args: Any) -> Any: ...
+        async def _dispatch_retried(
+            self, fn: Callable, args: tuple, worker: Worker | None = None
+        ): ...
         @staticmethod
         def _unwrap(msg): ...
 
@@ -73,7 +77,7 @@ class SolveBatching:
         if not self.settings.batching:
             self.stats["solve_calls"] += 1
             self.stats["solve_requests"] += 1
-            (res,) = await self.run("solve", [payload])
+            (res,) = await self.run(solve_batch, [payload])
             return self._unwrap(res)
         loop = self._bound_loop
         entry = _Pending(payload, loop.create_future(), loop.time() + self.settings.timeout)
@@ -137,7 +141,7 @@ class SolveBatching:
     async def _solve_share(self, worker: Worker, items: list[_Pending]) -> None:
         """Solve ``items`` in ONE engine call on ``worker`` and hand each its result."""
         try:
-            msg = await self._dispatch_retried("solve", [p.payload for p in items], worker)
+            msg = await self._dispatch_retried(solve_batch, ([p.payload for p in items],), worker)
             results = self._unwrap(msg)
         except Exception as exc:  # handed to every request of the batch
             for p in items:

@@ -15,7 +15,7 @@ import contextlib
 import os
 import pickle
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Any
 
 from jik.app.compute.batching import SolveBatching, _Pending
@@ -138,7 +138,7 @@ class ComputePool(SolveBatching):
         except TimeoutError:
             raise self._busy() from None
 
-    async def _dispatch(self, worker: Worker, kind: str, payload):
+    async def _dispatch(self, worker: Worker, fn: Callable, args: tuple):
         """Run one computation on ``worker``; it is killed if it overruns the time limit.
 
         The event loop itself waits for the worker's socket to become readable (no thread per
@@ -153,7 +153,7 @@ class ComputePool(SolveBatching):
             deadline = loop.time() + self.settings.timeout
             cpu = worker.cpu_seconds()
             os.set_blocking(worker.conn.fileno(), True)  # uvloop's add_reader made it non-blocking
-            worker.conn.send((kind, payload))
+            worker.conn.send((fn, args))
             sent = True
             msg = await self._reply(worker, deadline, buf)
         except TimeoutError:
@@ -168,7 +168,7 @@ class ComputePool(SolveBatching):
                     "replaced; retry the request"
                 ) from None
             self.stats["exceeded"] += 1
-            field, less = work_of(kind, payload)
+            field, less = work_of(fn)
             raise RequestError(
                 field,
                 f"the computation exceeded the time limit of {self.settings.timeout:g} s and "
@@ -270,15 +270,14 @@ class ComputePool(SolveBatching):
             raise RequestError(*value)
         raise ComputeError(value)
 
-    async def run(self, kind: str, payload) -> Any:
-        """Run handler ``kind`` on ``payload`` in a worker (waits and runs within the limits).
-
-        For the API kinds the payload is the request and the result the response, as JSON bytes.
-        """
+    async def run(self, fn: Callable, *args: Any) -> Any:
+        """``fn(*args)`` in a worker, ``fn`` a :func:`~jik.app.compute.worker.task` (waits and
+        runs within the limits). The API's tasks take the request and give the response as JSON
+        bytes."""
         self._bind()
-        return self._unwrap(await self._dispatch_retried(kind, payload))
+        return self._unwrap(await self._dispatch_retried(fn, args))
 
-    async def _dispatch_retried(self, kind: str, payload, worker: Worker | None = None):
+    async def _dispatch_retried(self, fn: Callable, args: tuple, worker: Worker | None = None):
         """:meth:`_dispatch` on ``worker`` (or the next free one); if that worker had died (it
         died while idle, or with this computation), once more on a fresh one."""
         for attempt in (1, 2):
@@ -286,7 +285,7 @@ class ComputePool(SolveBatching):
                 worker = await self._acquire(self._bound_loop.time() + self.settings.timeout)
             started = self._bound_loop.time()
             try:
-                return await self._dispatch(worker, kind, payload)
+                return await self._dispatch(worker, fn, args)
             except WorkerLost:
                 hung = self._bound_loop.time() - started >= self.settings.timeout
                 if attempt == 2 or hung:  # (a hung worker has used the request's time up)
@@ -294,7 +293,7 @@ class ComputePool(SolveBatching):
                 worker = None
         raise AssertionError("unreachable")
 
-    def submit(self, kind: str, payload) -> concurrent.futures.Future:
+    def submit(self, fn: Callable, *args: Any) -> concurrent.futures.Future:
         """:meth:`run` from another thread (the dashboards' workers): a future of its result,
         queued with the API's requests (first come, first served). Cancelling the future gives
         up the computation (its worker finishes it and is given back).
@@ -307,7 +306,7 @@ class ComputePool(SolveBatching):
         loop = self._loop
         if loop is None or loop.is_closed() or not loop.is_running():
             raise ServiceUnavailable("the compute pool is not running")
-        return asyncio.run_coroutine_threadsafe(self.run(kind, payload), loop)
+        return asyncio.run_coroutine_threadsafe(self.run(fn, *args), loop)
 
 
 @contextlib.contextmanager

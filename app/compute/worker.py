@@ -1,9 +1,10 @@
 """The worker processes: the loop a worker runs, and the server's handle on one.
 
-A worker is a fresh interpreter that imports the engine and then answers ``(kind, payload)``
-messages with ``(status, result)`` over a :class:`~multiprocessing.connection.Connection` on a
-socket pair; :class:`jik.app.compute.pool.ComputePool` sends the requests and reads the replies
-(framed as :func:`frame_header` describes) on its event loop.
+A worker is a fresh interpreter that imports the engine and then answers ``(task, args)``
+messages (a function registered by :func:`task`, sent by reference) with ``(status, result)``
+over a :class:`~multiprocessing.connection.Connection` on a socket pair;
+:class:`jik.app.compute.pool.ComputePool` sends the requests and reads the replies (framed as
+:func:`frame_header` describes) on its event loop.
 """
 
 from __future__ import annotations
@@ -27,18 +28,12 @@ from jik.app.compute.synthesis import synthesize_request
 from jik.engine.atlas_backends import limit_memory
 from jik.engine.exceptions import JikError
 
-#: The field that sizes the work of each computation kind, and how to ask for less.
-WORK_FIELDS = {
-    "solve": ("max_iterations", "a lower max_iterations or a larger tolerance"),
-    "repeatability": ("cycles", "fewer cycles or path points, a lower max_iterations"),
-    "synthesize": ("region", "a smaller region, fewer nodes, a smaller grid or a lower degree"),
-}
-
 
 def task(field: str, less: str) -> Callable[[Callable], Callable]:
-    """Make a function a task of the compute workers (``pool.run("call", (function, args))``),
-    the request's ``field`` sizing its work and ``less`` saying how to ask for less of it. The
-    function goes to the worker by reference (its module and name, as pickle sends it)."""
+    """Make a function a task of the compute workers (``pool.run(function, *args)``), the
+    request's ``field`` sizing its work and ``less`` saying how to ask for less of it. The
+    function goes to the worker by reference (its module and name, as pickle sends it); a worker
+    calls no other function."""
 
     def register(fn: Callable) -> Callable:
         fn.jik_task = (field, less)  # type: ignore[attr-defined]
@@ -47,15 +42,18 @@ def task(field: str, less: str) -> Callable[[Callable], Callable]:
     return register
 
 
-def work_of(kind: str, payload: Any) -> tuple[str, str]:
-    """The field that sizes a computation's work and how to ask for less (:data:`WORK_FIELDS`;
-    a ``call`` by its task's :func:`task` registration)."""
-    if kind == "call":
-        return getattr(payload[0], "jik_task", ("request", "less work"))
-    return WORK_FIELDS.get(kind, ("request", "less work"))
+def work_of(fn: Callable) -> tuple[str, str]:
+    """The field that sizes a task's work and how to ask for less (its :func:`task`)."""
+    return getattr(fn, "jik_task", ("request", "less work"))
 
 
-def _solve_payload(items: list[bytes]) -> list[tuple[str, Any]]:
+# The API's tasks take requests and give responses as JSON bytes: (de)serialization and
+# validation run in the workers, in parallel, and the event loop only passes bytes along.
+
+
+@task("max_iterations", "a lower max_iterations or a larger tolerance")
+def solve_batch(items: list[bytes]) -> list[tuple[str, Any]]:
+    """/solve requests (JSON) solved by one engine call: each one's (status, response)."""
     reqs = [S.SolveRequest.model_validate_json(b) for b in items]
     out: list[tuple[str, Any]] = []
     for res in solve_batch_json(reqs):
@@ -66,50 +64,45 @@ def _solve_payload(items: list[bytes]) -> list[tuple[str, Any]]:
     return out
 
 
-def _call(payload: tuple[Callable, tuple]) -> Any:
-    """Run the function ``payload[0]``, made a task by :func:`task`, on ``payload[1]``: work
-    that other parts of the server hand to the same workers (the dashboards' runs, an atlas's
-    plan). Only such functions are called."""
-    fn, args = payload
-    if not hasattr(fn, "jik_task"):
-        raise TypeError(f"{fn!r} is not a compute task")
-    return fn(*args)
+@task("cycles", "fewer cycles or path points, a lower max_iterations")
+def repeatability_json(body: bytes) -> bytes:
+    """A /repeatability request (JSON) and its response."""
+    req = S.RepeatabilityRequest.model_validate_json(body)
+    return repeatability_request(req).model_dump_json().encode()
 
 
-# Workers take requests and give responses as JSON bytes: (de)serialization and validation run in
-# the workers, in parallel, and the event loop only passes bytes along.
-_HANDLERS: dict[str, Callable[[Any], Any]] = {
-    "ping": lambda payload: "pong",
-    "call": _call,
-    "solve": _solve_payload,
-    "repeatability": lambda b: (
-        repeatability_request(S.RepeatabilityRequest.model_validate_json(b))
-        .model_dump_json()
-        .encode()
-    ),
-    "synthesize": lambda b: (
-        synthesize_request(S.SynthesizeRequest.model_validate_json(b)).model_dump_json().encode()
-    ),
-}
+@task("region", "a smaller region, fewer nodes, a smaller grid or a lower degree")
+def synthesize_json(body: bytes) -> bytes:
+    """A /synthesize request (JSON) and its response."""
+    req = S.SynthesizeRequest.model_validate_json(body)
+    return synthesize_request(req).model_dump_json().encode()
+
+
+@task("request", "less work")
+def ping() -> str:
+    """A worker's answer when it is up."""
+    return "pong"
 
 
 def _worker_main(conn) -> None:
-    """Worker process loop: say "ready", then (kind, payload) in, (status, result) out."""
+    """Worker process loop: say "ready", then (task, args) in, (status, result) out."""
     conn.send(("ready", None))
     while True:
         try:
-            kind, payload = conn.recv()
+            fn, args = conn.recv()
         except (EOFError, OSError):
             return
         try:
-            msg = ("ok", _HANDLERS[kind](payload))
+            if not hasattr(fn, "jik_task"):
+                raise TypeError(f"{fn!r} is not a compute task")
+            msg = ("ok", fn(*args))
         except RequestError as exc:
             msg = ("request_error", (exc.field, exc.message))
         except JikError as exc:
             err = engine_error(exc)
             msg = ("request_error", (err.field, err.message))
         except MemoryError:
-            field, less = work_of(kind, payload)
+            field, less = work_of(fn)
             msg = ("request_error", (field, f"the computation ran out of memory; ask for {less}"))
         except Exception as exc:  # reported to the client as a 500 with its text
             msg = ("error", f"{type(exc).__name__}: {exc}")

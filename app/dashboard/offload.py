@@ -60,9 +60,7 @@ class OffloadLane:
     ) -> concurrent.futures.Future:
         """Run :func:`algorithm_run` in the pool (``resume``: see :func:`algorithm_run`)."""
         try:
-            future = self._pool.submit(
-                "call", (run_offloaded, (state, algorithm, targets, cycles, resume))
-            )
+            future = self._pool.submit(run_offloaded, state, algorithm, targets, cycles, resume)
         except ServiceUnavailable:
             future = concurrent.futures.Future()
             future.set_exception(ServiceUnavailable("the compute pool is not running"))

@@ -101,7 +101,7 @@ async def vet_definition(pool: Any, patch: Mapping[str, Any]) -> None:
     if not isinstance(definition, Mapping) or pool is None:
         return
     try:
-        await pool.run("call", (check_definition, (dict(definition),)))
+        await pool.run(check_definition, dict(definition))
     except RequestError as exc:
         raise InvalidInputError(f"{exc.field}: {exc.message}", exc.field) from None
 

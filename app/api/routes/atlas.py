@@ -34,7 +34,7 @@ async def start_job(jobs: AtlasJobs, pool: ComputePool, request: Request, req) -
     it as a job of the client's."""
     client = request.client.host if request.client else "unknown"
     jobs.check_room(client)  # (before the work)
-    plan, refused = await pool.run("call", (plan_task, (req.model_dump_json(), jobs.limits)))
+    plan, refused = await pool.run(plan_task, req.model_dump_json(), jobs.limits)
     if refused is not None:
         raise InvalidInputError(*refused)
     return await run_in_threadpool(jobs.start, client, req, plan)
