@@ -3,10 +3,11 @@
 An atlas (:mod:`jik.engine.atlas`) takes seconds to minutes, longer than a request may wait, so
 ``POST /atlas`` only checks the request and plans the atlas (:func:`plan_request`, in a compute
 worker: its time and memory limits hold for the tracing), then
-:class:`AtlasJobs` runs it in a thread of its own that drives worker processes
-(``engine.atlas_run.run_atlas`` with a ``processes:N`` backend: the numbers work outside the
-server's interpreter and its GIL). A job does not belong to a connection: it runs on when its
-client goes away, and is dropped ``keep_for`` seconds after it ends (or when cancelled).
+:class:`AtlasJobs` runs it in a thread of its own that hands its chunks to the server's compute
+pool (:class:`PoolBackend`: the same worker processes as the API's requests, with their time
+and memory limits, queued first come first served with them; they stop with the server). A
+job does not belong to a connection: it runs on when its client goes away, and is dropped
+``keep_for`` seconds after it ends (or when cancelled).
 
 Limits: at most ``max_running`` atlases compute at once (the others wait, queued), at most
 ``max_jobs`` are kept in all and ``per_client`` queued or running for one client, and one job's
@@ -20,6 +21,8 @@ import re
 import secrets
 import threading
 import time
+from collections.abc import Callable, Iterable, Iterator
+from concurrent.futures import FIRST_COMPLETED, Future, wait
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -28,9 +31,9 @@ import numpy as np
 from jik.app.compute.atlas_schemas import AtlasJobResponse, AtlasRequest
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.requests import build_augmentation, build_robot, nullable
-from jik.app.compute.settings import Settings
+from jik.app.compute.worker import task
 from jik.engine.atlas import AtlasPlan, plan_atlas
-from jik.engine.atlas_backends import ProcessPool
+from jik.engine.atlas_backends import IN_FLIGHT
 from jik.engine.atlas_run import AtlasResult, run_atlas
 from jik.engine.exceptions import InvalidInputError, RunCancelled
 from jik.engine.progress import ProgressCallbacks
@@ -63,10 +66,6 @@ class AtlasLimits:
     max_leg_ends: int = 200_000
     #: seconds a job is kept after it ends
     keep_for: float = 600.0
-    #: worker processes of a running atlas
-    workers: int = 2
-    #: address space of each (MB; 0: no limit): the compute workers' (``JIK_WORKER_MEMORY_MB``)
-    worker_memory: int = Settings.worker_memory
 
 
 def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
@@ -112,14 +111,56 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
     )  # fmt: skip
 
 
+@task(
+    "reference",
+    "another reference or path (eq. (7) from the reference to the path's first point ran out "
+    "of memory)",
+)
 def plan_task(req: str, limits: AtlasLimits):
-    """:func:`plan_request` of a request (JSON) as a compute worker's task (``atlas.plan``),
+    """:func:`plan_request` of a request (JSON) as a compute worker's task,
     within the workers' time and memory limits (tracing the curves solves eq. (7)): the plan and
     None, or None and the refusal (message, field), for the server to raise again."""
     try:
         return plan_request(AtlasRequest.model_validate_json(req), limits), None
     except InvalidInputError as exc:
         return None, (str(exc), exc.field)
+
+
+@task("starts", "fewer starts or cycles")
+def atlas_chunk(fn: Callable[[Any], Any], chunk: Any) -> Any:
+    """``fn(chunk)``: one chunk of an atlas in a compute worker."""
+    return fn(chunk)
+
+
+class PoolBackend:
+    """An atlas backend (:class:`jik.engine.atlas_backends.Backend`) on the server's compute
+    pool (a :class:`~jik.app.compute.pool.ComputePool`): at most ``IN_FLIGHT`` chunks per worker
+    submitted at once, results in the order they finish; leaving gives up the chunks in flight."""
+
+    def __init__(self, pool: Any) -> None:
+        self.pool = pool
+        self.workers = pool.settings.workers
+
+    def __enter__(self) -> PoolBackend:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        return None
+
+    def imap_unordered(self, fn: Callable[[Any], Any], tasks: Iterable[Any]) -> Iterator[Any]:
+        pending: set[Future] = set()
+        try:
+            for chunk in tasks:
+                pending.add(self.pool.submit(atlas_chunk, fn, chunk))
+                if len(pending) >= IN_FLIGHT * self.workers:
+                    finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+                    yield from (f.result() for f in finished)
+            while pending:
+                finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+                yield from (f.result() for f in finished)
+        finally:
+            for f in pending:
+                f.cancel()
 
 
 def result_document(res: AtlasResult, arc, leg_ends: bool) -> dict[str, Any]:
@@ -184,8 +225,11 @@ class AtlasJob:
 class AtlasJobs:
     """The API's atlas jobs (see the module docstring)."""
 
-    def __init__(self, limits: AtlasLimits | None = None) -> None:
+    def __init__(self, limits: AtlasLimits | None = None, pool: Any = None) -> None:
+        """``pool``: the compute pool whose workers run the chunks (:class:`PoolBackend`;
+        None: each job's own thread runs them)."""
         self.limits = limits or AtlasLimits()
+        self._pool = pool
         self._jobs: dict[str, AtlasJob] = {}
         self._lock = threading.Lock()
         self._slots = threading.Semaphore(self.limits.max_running)
@@ -296,8 +340,9 @@ class AtlasJobs:
             def progress(done: float, _total: float) -> None:
                 job.runs_done = int(done)
 
+            backend = None if self._pool is None else PoolBackend(self._pool)
             res = run_atlas(
-                job.plan, ProcessPool(self.limits.workers, self.limits.worker_memory),
+                job.plan, backend,
                 progress=ProgressCallbacks(on_advance=progress, is_cancelled=job.cancel.is_set),
                 keep_leg_ends=job.leg_ends,
             )  # fmt: skip

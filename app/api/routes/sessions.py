@@ -21,13 +21,14 @@ from fastapi.responses import JSONResponse, PlainTextResponse
 from pydantic import BaseModel, ConfigDict, Field
 from sse_starlette import EventSourceResponse, ServerSentEvent
 
-from jik.app.api.dependencies import Store
+from jik.app.api.dependencies import Pool, Store
 from jik.app.api.errors import unparsed_body_response
 from jik.app.compute.schemas import INTEGRAL
 from jik.app.dashboard import export_csv, export_json
 from jik.app.dashboard.controls import controls_message
 from jik.app.dashboard.messages import LatestEvents
 from jik.app.dashboard.model import StatePatch, parse_patch, patch_of
+from jik.app.dashboard.robots import vet_definition
 from jik.app.dashboard.sessions import ExportUnavailable, Session, SessionNotFound
 from jik.engine.exceptions import InvalidInputError
 
@@ -78,10 +79,12 @@ def _created(session: Session) -> dict:
 
 
 @router.post("/api/sessions", status_code=201, responses={201: {"links": _SESSION_LINKS}})
-async def create_session(body: SessionCreate, store: Store) -> JSONResponse:
+async def create_session(body: SessionCreate, store: Store, pool: Pool) -> JSONResponse:
     """A new session whose state is the defaults changed by ``state`` (a link's state)."""
     try:
-        session = await asyncio.to_thread(store.create, patch_of(body.state), body.low_end)
+        patch = patch_of(body.state)
+        await vet_definition(pool, patch)
+        session = await asyncio.to_thread(store.create, patch, body.low_end)
     except InvalidInputError as exc:  # (the link's state is the body's "state")
         exc.field = f"state.{exc.field}" if exc.field else "state"
         raise
@@ -107,7 +110,7 @@ async def delete_session(session_id: str, store: Store):
     openapi_extra={"requestBody": {"required": True, "content": {"application/json": {
         "schema": {"$ref": "#/components/schemas/StatePatch"}}}}},
 )  # fmt: skip
-async def post_state(session_id: str, request: Request, store: Store) -> JSONResponse:
+async def post_state(session_id: str, request: Request, store: Store, pool: Pool) -> JSONResponse:
     """Change some controls: ``{"gamma": 2}``, ``{"x0": [...]}``, ``{"robot": "manipulator1"}``.
 
     The body is a :data:`StatePatch`; the answer is the new generation and state. A change
@@ -121,9 +124,10 @@ async def post_state(session_id: str, request: Request, store: Store) -> JSONRes
         return unparsed_body_response(exc)
     try:
         patch = parse_patch(body)
+        await vet_definition(pool, patch)  # (a robot's formulas: built off the event loop)
     except InvalidInputError as exc:
         session.dashboard.refuse(exc)
-    generation, state = session.dashboard.update(patch, source="page")
+    generation, state = await asyncio.to_thread(session.dashboard.update, patch, "page")
     return JSONResponse({"generation": generation, "state": state.as_dict()})
 
 
