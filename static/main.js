@@ -52,7 +52,7 @@ function onState(msg, force = false) {
   page.state = msg.state;
   session.generation = Math.max(session.generation, msg.generation);
   showControls(msg, send, force);
-  page.editor.show(msg.state);
+  page.editor.show(msg.state, msg.type === "refused");
   rememberInUrl(msg.state);
   atlasState(msg.state);
   if (msg.generation > page.shown) setStatus(`computing generation ${msg.generation}…`);

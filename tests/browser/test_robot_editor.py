@@ -69,3 +69,55 @@ def test_a_urdf_arm_from_a_link_is_drawn_in_the_scene(tabs):
     assert scene["robot"] == "urdf"
     assert scene["mechanism"] == "Chain" and scene["joints"] == 6  # base, 4 joints, the tool
     tab.screenshots("robot-editor-urdf")
+
+
+def test_a_refused_definition_keeps_what_was_typed(tabs):
+    """A definition the session refuses leaves the editor as the user typed it (another kind
+    than the robot in force included: a formula robot, a pasted URDF), with the error beside
+    the field it names; a zero or negative link length is refused beside ``lengths``."""
+    tabs.allow_console(r"status of 422")
+    tab = tabs.open()
+    page = tab.page
+    page.click("#robot-editor-open")
+    page.select_option("#robot-kind", "planar_chain")
+    page.fill("#robot-field-lengths", "1, -0.8, 0.6")
+    page.fill("#robot-field-title", "my arm")
+    assert tab.posting(lambda: page.click("#robot-apply")).status == 422
+    expect(page.locator("#robot-field-lengths-error")).to_contain_text(
+        "lengths[1] must be positive (a link's length), got -0.8"
+    )
+    expect(page.locator("#robot-field-lengths")).to_have_value("1, -0.8, 0.6")
+    expect(page.locator("#robot-field-title")).to_have_value("my arm")
+
+    page.fill("#robot-field-lengths", "1, 0.8, 0.6")
+    tab.change(lambda: page.click("#robot-apply"))  # a planar chain in force
+    expect(page.locator("#robot-note")).to_contain_text("applied: planar_chain")
+
+    # A formula robot with a bad formula: refused while the planar chain stays in force.
+    page.select_option("#robot-kind", "formula")
+    page.fill("#robot-field-variables", "a, b, c")
+    page.fill("#robot-field-task", "a +* b\nc")
+    page.fill("#robot-field-title", "by formula")
+    assert tab.posting(lambda: page.click("#robot-apply")).status == 422
+    expect(page.locator("#robot-field-task-error")).to_have_text(
+        "task.0: expected a number, a name or '(' at position 3"
+    )
+    expect(page.locator("#robot-field-task-error")).to_be_visible()
+    expect(page.locator("#robot-kind")).to_have_value("formula")
+    expect(page.locator("#robot-field-variables")).to_have_value("a, b, c")
+    expect(page.locator("#robot-field-task")).to_have_value("a +* b\nc")
+    expect(page.locator("#robot-field-title")).to_have_value("by formula")
+    expect(page.locator("#robot-note")).to_contain_text("not applied: see the field task")
+
+    # A pasted URDF whose end link is not in it: the text stays, the error is at end_link.
+    urdf = '<robot name="r"><link name="a"/></robot>'
+    page.select_option("#robot-kind", "urdf")
+    page.fill("#robot-field-urdf", urdf)
+    assert tab.posting(lambda: page.click("#robot-apply")).status == 422
+    expect(page.locator("#robot-field-end_link-error")).to_contain_text("is not a link")
+    expect(page.locator("#robot-field-urdf")).to_have_value(urdf)
+
+    # Back to the formula: what was typed there is still there.
+    page.select_option("#robot-kind", "formula")
+    expect(page.locator("#robot-field-task")).to_have_value("a +* b\nc")
+    assert tab.snapshot()["state"]["robot"] == "planar_chain"
