@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from jik.app.dashboard.analysis import state_inert_variables
+from jik.app.dashboard.analysis import state_inert_variables, vector_note
 from jik.app.dashboard.model import ALGORITHMS, COLORS, DASH, LABELS
 from jik.app.dashboard.plotting import NO_LEGEND, figure, label, trace, units
 from jik.app.dashboard.runs import DashboardResult
@@ -35,6 +35,9 @@ def augmenting_spec(
     if grid is None and cancelled:
         return message_figure(augmenting_title(result, None, cancelled),
                               f"not computed: {cancelled}")  # fmt: skip
+    vector = vector_note(result.state) if grid is None else None
+    if vector:
+        return message_figure(f"Augmenting map h: {result.state.augmentation}", vector)
     if grid is None:
         return figure([], augmenting_title(result))
     i, j = grid["axes"]

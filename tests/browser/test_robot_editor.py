@@ -121,3 +121,35 @@ def test_a_refused_definition_keeps_what_was_typed(tabs):
     page.select_option("#robot-kind", "formula")
     expect(page.locator("#robot-field-task")).to_have_value("a +* b\nc")
     assert tab.snapshot()["state"]["robot"] == "planar_chain"
+
+
+def test_a_planar_4r_chain_runs_with_two_degrees_of_redundancy(tabs):
+    """A planar 4R chain (p - r = 2): both algorithms run (its default map h = (x3, x4), shown
+    on the map's button), the drift and the scene work, and the panels of one scalar h say
+    why they are empty; a single formula h for it is refused beside the augmentations field."""
+    tabs.allow_console(r"status of 422")
+    tab = tabs.open()
+    page = tab.page
+    page.click("#robot-editor-open")
+    page.select_option("#robot-kind", "planar_chain")
+    page.fill("#robot-field-joints", "RRRR")
+    page.fill("#robot-field-lengths", "1, 0.8, 0.6, 0.4")
+    generation = tab.change(lambda: page.click("#robot-apply"))
+    snapshot = tab.wait_settled(lambda s: s["state"]["robot"] == "planar_chain", "the 4R chain")
+    summary = snapshot["summary"]
+    assert summary["pseudoinverse"]["success"] and summary["extended"]["success"]
+    assert summary["pseudoinverse"]["drift"][-1] > 1e-4
+    assert summary["extended"]["drift"][-1] < 1e-9
+    verdict = page.locator("#verdict")
+    expect(verdict).to_contain_text("pseudoinverse J^P#: not repeatable")
+    expect(verdict).to_contain_text("extended Jacobian J^E#: repeatable")
+    expect(page.locator("#ctl-augmentation")).to_contain_text("formula: h = x3, x4")
+    expect(page.locator("#plot-augmenting")).to_contain_text("p − r = 2")
+    scene = tab.wait_scene_drawn(generation)
+    assert scene["robot"] == "planar_chain" and scene["joints"] == 5
+
+    page.fill("#robot-field-augmentations", '[{"name": "formula", "h": "x4"}]')
+    assert tab.posting(lambda: page.click("#robot-apply")).status == 422
+    error = page.locator("#robot-field-augmentations-error")
+    expect(error).to_contain_text("must be a list of 2 formulas (p - r = 2")
+    expect(page.locator("#robot-field-joints")).to_have_value("RRRR")
