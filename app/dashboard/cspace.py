@@ -14,7 +14,7 @@ import numpy as np
 
 from jik.app.dashboard.analysis import expensive_map, kinematics_and_map
 from jik.app.dashboard.model import ALGORITHMS, COLORS, DASH, LABELS
-from jik.app.dashboard.plotting import figure, leg_names, trace
+from jik.app.dashboard.plotting import corner_names, figure, trace
 from jik.app.dashboard.robots import state_spec
 from jik.app.dashboard.runs import DashboardResult
 from jik.engine.exceptions import JikError
@@ -150,7 +150,7 @@ def cspace_spec(result: DashboardResult) -> dict:
     elif len(seeds) == L:
         with np.errstate(all="ignore"):
             curves = self_motion(kin, seeds, np.asarray(result.targets, dtype=float), lo, hi)
-        for k, (curve, name) in enumerate(zip(curves, leg_names(L), strict=True)):
+        for k, (curve, name) in enumerate(zip(curves, corner_names(result), strict=True)):
             data.append(trace("scatter3d", x=curve[:, a], y=curve[:, b], z=curve[:, c],
                               mode="lines", line=dict(color="#2ca02c", width=3),
                               name="self-motion manifolds k(x) = corner", legendgroup="fibres",

@@ -23,6 +23,7 @@ import viser
 
 from jik.app.dashboard import ALGORITHMS, COLORS, Dashboard, Event, runs_key
 from jik.app.dashboard.help import STYLES
+from jik.app.dashboard.plotting import corner_names
 from jik.app.scene.controls import SceneControls
 from jik.app.scene.gizmo import StartGizmo
 from jik.app.scene.mechanisms import (
@@ -362,7 +363,7 @@ class DashboardScene:
                     k = int(name.rsplit("/", 1)[1])
                     scene.add_label(
                         f"{name}/label",
-                        chr(ord("A") + k) if k < 26 else str(k),
+                        corner_names(result)[k],
                         position=(0.05, 0.05, 0.05),
                     )
                 continue
