@@ -22,10 +22,10 @@ from jik.app.dashboard.model import ALGORITHMS, COLORS, DASH, LABELS
 from jik.app.dashboard.plotting import (
     NO_LEGEND,
     SYMBOLS,
+    corner_names,
     figure,
     is_unicycle,
     label,
-    corner_names,
     log_range,
     nice_range,
     norm_unit,
