@@ -75,3 +75,18 @@ def test_the_verdict_follows_the_numbers(tabs):
     assert gamma == pytest.approx(1.89, abs=0.02)
     expect(verdict).to_contain_text(re.compile(r"γ = 1\.\d+ is near 2"))
     expect(verdict).to_contain_text(f"‖x − x0‖ = {_extended_drift(tab):.3g}")
+
+
+def test_an_unreachable_target_is_named_by_the_reach(tabs):
+    """A planar 3R arm (reach 2.4) asked for a target 5 from its base: the verdict says the
+    target is out of reach, with the distance and the reach, not "a singularity or"."""
+    arm = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]}
+    state = {"robot": "planar_chain", "robot_definition": arm, "task": "target",
+             "target": [5.0, 0.0]}  # fmt: skip
+    tab = tabs.open("/?state=" + quote(json.dumps(state)))
+    tab.wait_settled(lambda s: s["state"]["robot"] == "planar_chain", "the arm's result")
+    verdict = tab.page.locator("#verdict")
+    expect(verdict.locator("p.failure.p")).to_contain_text(
+        "the target is out of reach: it is 5 from the base, beyond the arm's reach 2.4"
+    )
+    assert "or the target is unreachable" not in (verdict.text_content() or "")
