@@ -74,7 +74,8 @@ async function onResult(msg) {
   markStale(msg.stale || []);
   page.shown = msg.generation;
   page.shownState = msg.state;
-  setExportNote(`jik · generation ${msg.generation} · ${describe(msg.state)}`);
+  setExportNote(`jik · generation ${msg.generation} · ${describe(msg.state)}`,
+    `${msg.state.augmentation}-${msg.state.mode}-g${msg.generation}`);
   document.body.dataset.generation = msg.generation;
   document.body.dataset.robot = msg.state.robot;
   showProgress(1, 0);
