@@ -152,6 +152,9 @@ class AtlasJob:
     cancel: threading.Event = field(default_factory=threading.Event)
     #: The request it was started from (the dashboard draws the result with it).
     request: AtlasRequest | None = None
+    #: Whether it holds one of the ``max_running`` slots (given back once, at its end or its
+    #: cancel, whichever comes first).
+    holds_slot: bool = False
 
     def response(self) -> AtlasJobResponse:
         end = self.ended if self.ended is not None else time.monotonic()
@@ -213,11 +216,21 @@ class AtlasJobs:
         return job
 
     def cancel(self, job_id: str) -> None:
-        """Stop the job (after the chunk it is on) and drop it."""
+        """Stop the job (after the chunk it is on) and drop it; its slot goes at once to the
+        next queued job (the chunks in flight end in the workers meanwhile, their results
+        dropped), not after those chunks."""
         job = self.get(job_id)
         job.cancel.set()
         with self._lock:
             self._jobs.pop(job_id, None)
+        self._release(job)
+
+    def _release(self, job: AtlasJob) -> None:
+        """Give back ``job``'s slot if it still holds it."""
+        with self._lock:
+            held, job.holds_slot = job.holds_slot, False
+        if held:
+            self._slots.release()
 
     def sweep(self) -> None:
         """Drop the jobs that ended more than ``keep_for`` seconds ago."""
@@ -238,6 +251,7 @@ class AtlasJobs:
         while not self._slots.acquire(timeout=0.2):
             if job.cancel.is_set():
                 return self._end(job, "cancelled")
+        job.holds_slot = True
         try:
             job.status = "running"
             job.started = time.monotonic()
@@ -258,7 +272,7 @@ class AtlasJobs:
             job.error = f"{type(error).__name__}: {error}"
             self._end(job, "failed")
         finally:
-            self._slots.release()
+            self._release(job)
 
     @staticmethod
     def _end(job: AtlasJob, status: Status) -> None:
