@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from jik.engine.exceptions import JikError
 from jik.engine.planar_chain import PlanarChain
 
 #: sigma_min / sigma_max of J below this: the arm is at a kinematic singularity.
@@ -48,13 +49,20 @@ def stall_note(inverse, target, x) -> str:
                     f"arm's inner reach {g(inner)} (2 max l − sum l)")  # fmt: skip
         within = f"the target is within reach ({g(d)} from the base, reach {g(outer)}); "
     x = np.asarray(x, dtype=float)
-    with np.errstate(all="ignore"):
-        s = np.linalg.svd(np.asarray(kin.jacobian(x), dtype=float), compute_uv=False)
-        ratio = float(s[-1] / s[0]) if s[0] > 0 else 0.0
-        if ratio < SINGULAR_RATIO:
-            return (f"{within}the arm stalled at a kinematic singularity: J loses rank there "
-                    f"(σ_min/σ_max = {g(ratio)})")  # fmt: skip
-        grow = float(np.linalg.norm(inverse.matrix(x), 2) * s[-1])
+    try:
+        with np.errstate(all="ignore"):
+            s = np.linalg.svd(np.asarray(kin.jacobian(x), dtype=float), compute_uv=False)
+    except (JikError, ValueError, np.linalg.LinAlgError):
+        return f"{within}the step size collapsed near a singularity"
+    ratio = float(s[-1] / s[0]) if s[0] > 0 else 0.0
+    if ratio < SINGULAR_RATIO:
+        return (f"{within}the arm stalled at a kinematic singularity: J loses rank there "
+                f"(σ_min/σ_max = {g(ratio)})")  # fmt: skip
+    try:  # (an inverse singular there raises: that is the algorithmic singularity)
+        with np.errstate(all="ignore"):
+            grow = float(np.linalg.norm(inverse.matrix(x), 2) * s[-1])
+    except (JikError, ValueError, np.linalg.LinAlgError):
+        grow = float("inf")
     if inverse.name == "extended" and (not np.isfinite(grow) or grow > ALGORITHMIC_RATIO):
         return (f"{within}J is regular there (σ_min/σ_max = {g(ratio)}) but the extended "
                 "Jacobian [J; dh] (10) is near singular (an algorithmic singularity): the level "
