@@ -213,8 +213,8 @@ async function saveImage(div, key, format) {
   const width = div.clientWidth;
   const layout = JSON.parse(JSON.stringify(div.layout));
   const plotHeight = layout.height || div.clientHeight;
-  const lines = wrapText(exportNote, Math.max(20, Math.floor((width - 16) / (0.62 * CAPTION_FONT))));
-  const caption = CAPTION_LINE * lines.length + 10;
+  const chars = Math.max(20, Math.floor((width - 16) / (0.62 * CAPTION_FONT)));
+  let lines = wrapText(exportNote, chars);
   const legend = { orientation: "h", x: 0, xanchor: "left", yref: "container", yanchor: "bottom", font: { size: 10 } };
   const host = el("div", { className: "export-host" });
   host.style.cssText = `position: fixed; left: -20000px; top: 0; width: ${width}px;`;
@@ -224,6 +224,16 @@ async function saveImage(div, key, format) {
     await Plotly.newPlot(host, div.data, probe, { staticPlot: true });
     const box = host.querySelector(".legend");
     const legendHeight = box ? Math.ceil(box.getBBox().height) + 6 : 0;
+    // The algorithms a figure draws without legend entries (runs drawn as shapes): their key
+    // goes into the caption, in their colours.
+    const named = [...host.querySelectorAll(".legendtext")].map((t) => t.textContent);
+    const drawnAs = JSON.stringify([div.data, layout.shapes || []]);
+    const keys = Object.keys(CONFIG.labels).filter((a) => !named.includes(CONFIG.labels[a]) && drawnAs.includes(CONFIG.colors[a]))
+      .map((a) => [`▬ ${CONFIG.labels[a]}`, CONFIG.colors[a]]);
+    const coloured = ([words, colour]) => `<span style="color:${colour}">${words}</span>`;
+    const oneLine = keys.map(([words]) => words).join(" · ").length <= chars;
+    if (keys.length) lines = [...(oneLine ? [keys.map(coloured).join(" · ")] : keys.map(coloured)), ...lines];
+    const caption = CAPTION_LINE * lines.length + 10;
     const extra = legendHeight + caption + 8;
     const height = plotHeight + extra;
     const margin = { ...(layout.margin || {}), b: ((layout.margin || {}).b || 48) + extra };

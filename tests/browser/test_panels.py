@@ -121,18 +121,26 @@ def test_the_table_saves_as_csv_with_its_notes_and_state(tabs):
     expect(tab.page.locator("#export-csv")).to_have_text("export CSV (generation 1)")
 
 
-@pytest.mark.parametrize("panel", ["task", "drift"])
+@pytest.mark.parametrize("panel", ["task", "drift", "augmenting"])
 def test_a_saved_svg_holds_its_legend_and_whole_caption(tabs, panel):
     """A panel saved as SVG holds its legend (the algorithms, the targets) and, under it, the
     caption with the state it shows, whole: both inside the image, in lines that fit its width
-    (the state of a link with a long name makes the caption longer than a line)."""
+    (the state of a link with a long name makes the caption longer than a line). The h panel,
+    whose runs are shapes without legend entries, names the algorithms in their colours in the
+    caption instead."""
     tab = tabs.open()
     with tab.page.expect_download() as saved:
         tab.page.locator(f"#plot-{panel} .panel-tools button", has_text="SVG").click()
     svg = Path(saved.value.path()).read_text()
     fits = tab.page.evaluate(probe("svg_fits"), svg)
     legend, caption = fits["legend"], fits["caption"]
-    assert legend is not None and "pseudoinverse J^P#" in " ".join(fits["legendItems"])
+    if panel == "augmenting":
+        assert caption["lines"][0] == "▬ pseudoinverse J^P# (8) · ▬ extended Jacobian J^E# (11)"
+        assert 'fill:#d62728">▬ pseudoinverse' in svg  # (in the pseudoinverse's red)
+        caption["lines"] = caption["lines"][1:]
+        legend = legend or {"top": 0, "bottom": 0, "right": 0}
+    else:
+        assert legend is not None and "pseudoinverse J^P#" in " ".join(fits["legendItems"])
     assert 0 <= legend["top"] and legend["bottom"] <= fits["height"] + 0.5, fits
     assert legend["right"] <= fits["width"] + 0.5, fits
     assert caption["bottom"] <= fits["height"] + 0.5 and caption["right"] <= fits["width"], fits
