@@ -45,6 +45,9 @@ def test_a_planar_rrr_arm_from_the_editor(tabs):
     verdict = page.locator("#verdict")
     expect(verdict).to_contain_text("pseudoinverse")
     expect(verdict).to_contain_text("extended Jacobian")
+    # Its default map is shown as what it is, h = x3, not as "formula (9)".
+    expect(page.locator("#ctl-augmentation")).to_have_text("formula: h = x3")
+    expect(page.locator("#plot-augmenting .gtitle")).to_contain_text("formula: h = x3")
 
     scene = tab.wait_scene_drawn(generation)
     assert scene["robot"] == "planar_chain"
