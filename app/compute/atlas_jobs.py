@@ -196,6 +196,9 @@ class AtlasJob:
     cancel: threading.Event = field(default_factory=threading.Event)
     #: The request it was started from (the dashboard draws the result with it).
     request: AtlasRequest | None = None
+    #: Whether it holds one of the ``max_running`` slots (given back once, at its end or its
+    #: cancel, whichever comes first).
+    holds_slot: bool = False
 
     def response(self, ahead: int | None = None, running: int = 1) -> AtlasJobResponse:
         """The job's state; ``ahead``: the jobs before it in the queue, of which ``running``
@@ -302,11 +305,21 @@ class AtlasJobs:
         return "no job of this server has had this id"
 
     def cancel(self, job_id: str) -> None:
-        """Stop the job (after the chunk it is on) and drop it."""
+        """Stop the job (after the chunk it is on) and drop it; its slot goes at once to the
+        next queued job (the chunks in flight end in the workers meanwhile, their results
+        dropped), not after those chunks."""
         job = self.get(job_id)
         job.cancel.set()
         with self._lock:
             self._jobs.pop(job_id, None)
+        self._release(job)
+
+    def _release(self, job: AtlasJob) -> None:
+        """Give back ``job``'s slot if it still holds it."""
+        with self._lock:
+            held, job.holds_slot = job.holds_slot, False
+        if held:
+            self._slots.release()
 
     def sweep(self) -> None:
         """Drop the jobs that ended more than ``keep_for`` seconds ago."""
@@ -333,6 +346,7 @@ class AtlasJobs:
                 break
             if not first:
                 job.cancel.wait(0.2)
+        job.holds_slot = True
         try:
             job.status = "running"
             job.started = time.monotonic()
@@ -354,7 +368,7 @@ class AtlasJobs:
             job.error = f"{type(error).__name__}: {error}"
             self._end(job, "failed")
         finally:
-            self._slots.release()
+            self._release(job)
 
     @staticmethod
     def _end(job: AtlasJob, status: Status) -> None:

@@ -24,7 +24,7 @@ from sse_starlette import EventSourceResponse, ServerSentEvent
 from jik.app.api.dependencies import Pool, Store
 from jik.app.api.errors import unparsed_body_response
 from jik.app.compute.schemas import INTEGRAL
-from jik.app.dashboard import export_csv, export_json
+from jik.app.dashboard import export_file
 from jik.app.dashboard.controls import controls_message
 from jik.app.dashboard.messages import LatestEvents
 from jik.app.dashboard.model import StatePatch, parse_patch, patch_of
@@ -279,10 +279,8 @@ async def _finished(session: Session):
 async def export_result_json(session_id: str, store: Store) -> JSONResponse:
     """The session's result, every trajectory point of both algorithms, as JSON."""
     dashboard = await _finished(store.get(session_id))
-    body = export_json(dashboard.result, dashboard.functionals)
-    return JSONResponse(
-        body, headers={"Content-Disposition": 'attachment; filename="jik-result.json"'}
-    )
+    body, name = export_file(dashboard.result, "json", dashboard.functionals)
+    return JSONResponse(body, headers={"Content-Disposition": f'attachment; filename="{name}"'})
 
 
 @router.get(
@@ -298,10 +296,11 @@ async def export_result_json(session_id: str, store: Store) -> JSONResponse:
 async def export_result_csv(session_id: str, store: Store):
     """The session's result as CSV: one row per trajectory point and algorithm."""
     dashboard = await _finished(store.get(session_id))
+    body, name = export_file(dashboard.result, "csv")
     return PlainTextResponse(
-        export_csv(dashboard.result),
+        body,
         media_type="text/csv",
-        headers={"Content-Disposition": 'attachment; filename="jik-result.csv"'},
+        headers={"Content-Disposition": f'attachment; filename="{name}"'},
     )
 
 
