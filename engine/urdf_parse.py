@@ -2,7 +2,7 @@
 
 yourdfpy (a maintained URDF library; viser's URDF support builds on it) parses the robot's
 elements; it is imported when a URDF robot is built, so the rest of the engine works without it
-(``pip install 'jik[urdf]'``).
+(``pip install 'jik-lab[urdf]'``).
 
 Safety: the text is bounded in size, must be (or declare) UTF-8 or ASCII, and is parsed by lxml
 with defusedxml's settings (no DTD, no entity expansion, no network; a document type
@@ -28,7 +28,7 @@ def _yourdfpy():
         import yourdfpy
     except ImportError:  # the `urdf` extra is not installed
         raise InvalidInputError(
-            "URDF robots need the yourdfpy package: pip install 'jik[urdf]'", "urdf"
+            "URDF robots need the yourdfpy package: pip install 'jik-lab[urdf]'", "urdf"
         ) from None
     # yourdfpy logs each text it cannot parse as an ERROR ("Using different parsing approach."),
     # which a server printed for every bad URDF a user sent: parse_urdf reports it, in words
@@ -43,7 +43,7 @@ def _etree():
         from lxml import etree
     except ImportError:  # the `urdf` extra is not installed
         raise InvalidInputError(
-            "URDF robots need the yourdfpy package: pip install 'jik[urdf]'", "urdf"
+            "URDF robots need the yourdfpy package: pip install 'jik-lab[urdf]'", "urdf"
         ) from None
     return etree
 

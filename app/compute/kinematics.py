@@ -3,7 +3,7 @@
 A user checks a model against their own tools before trusting a run: the same robot models as
 ``/solve`` (a catalogue robot, a catalogue arm, or a definition), the engine's kinematics, eq. (4),
 and its analytic Jacobian. It runs in the compute workers (a robot's build is bounded there) as
-the task ``"kinematics"`` of :data:`jik.app.compute.worker.TASKS`.
+the task :func:`kinematics_task`.
 """
 
 from __future__ import annotations
@@ -16,7 +16,10 @@ from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, create_mo
 from jik.app.compute import schemas as S
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.requests import build_robot, nullable
+from jik.app.compute.schemas.robots import _camel
+from jik.app.compute.schemas.variants import _robot_name
 from jik.app.compute.user_robots import is_user_robot, user_robot
+from jik.app.compute.worker import task
 from jik.engine.arms import ARMS
 from jik.engine.registry import ROBOTS
 
@@ -57,7 +60,7 @@ def _points(p: int | None) -> Any:
 
 def _exact(name: str, robot: Any, p: int | None) -> Any:
     model = create_model(
-        f"Kinematics{S._camel(name)}Request",
+        f"Kinematics{_camel(name)}Request",
         __base__=KinematicsRequest,
         __doc__=f"{KinematicsRequest.__doc__} ({name})",
         robot=(robot, Field(description=robot.__doc__)),
@@ -75,7 +78,7 @@ def _body() -> Any:
     return Annotated[
         Union[tuple(members)],  # noqa: UP007
         Discriminator(
-            S._robot_name,
+            _robot_name,
             custom_error_type="unknown_robot",
             custom_error_message=f"give a robot whose name is one of {S.ROBOT_NAMES}",
             custom_error_context={"names": str(S.ROBOT_NAMES)},
@@ -125,6 +128,7 @@ def kinematics_request(req: KinematicsRequest) -> KinematicsResponse:
     )
 
 
+@task("x", "fewer configurations or a simpler robot")
 def kinematics_task(body: bytes) -> bytes:
     """The worker's task: request JSON in, response JSON out."""
     response = kinematics_request(KinematicsRequest.model_validate_json(body))

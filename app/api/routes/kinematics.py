@@ -3,7 +3,7 @@
 from fastapi import APIRouter, Response
 
 from jik.app.api.dependencies import Pool
-from jik.app.compute.kinematics import KinematicsBody, KinematicsResponse
+from jik.app.compute.kinematics import KinematicsBody, KinematicsResponse, kinematics_task
 from jik.app.compute.schemas import BUSY
 
 router = APIRouter(tags=["kinematics"])
@@ -14,5 +14,5 @@ async def kinematics(req: KinematicsBody, pool: Pool) -> Response:
     """The robot's task coordinates k(x), eq. (4), and its analytic Jacobian J(x) at one
     configuration (``x`` a list of p numbers) or at each of a list of them. The robot is built
     in a compute worker, within its time and memory limits."""
-    body = await pool.run("call", ("kinematics", (req.model_dump_json().encode(),)))
+    body = await pool.run(kinematics_task, req.model_dump_json().encode())
     return Response(body, media_type="application/json")
