@@ -17,6 +17,7 @@ leg ends in the result.
 
 from __future__ import annotations
 
+import dataclasses
 import secrets
 import threading
 import time
@@ -33,7 +34,7 @@ from jik.app.compute.requests import build_augmentation, build_robot, nullable
 from jik.app.compute.worker import task
 from jik.engine.atlas import AtlasPlan, plan_atlas
 from jik.engine.atlas_backends import IN_FLIGHT
-from jik.engine.atlas_run import AtlasResult, run_atlas
+from jik.engine.atlas_run import AtlasResult, chunk_task, run_atlas, run_chunk
 from jik.engine.exceptions import InvalidInputError, RunCancelled
 from jik.engine.registry import make_inverse
 from jik.engine.repeatability import CLOSE_TOL
@@ -108,17 +109,38 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
     )  # fmt: skip
 
 
+#: Seconds of work in one chunk of a server's atlas: the compute workers serve the API's requests
+#: between chunks, first come first served, and a chunk stays far within their time limit.
+CHUNK_SECONDS = 1.0
+#: Runs timed together to size an atlas's chunks.
+PROBE = 8
+
+
+def sized_chunks(plan: AtlasPlan, seconds: float = CHUNK_SECONDS) -> AtlasPlan:
+    """``plan`` with chunks of about ``seconds`` of work, from the time of a chunk of its first
+    :data:`PROBE` runs (a unicycle's run costs hundreds of times a Manipulator 2's); at most the
+    plan's own chunk. The atlas's numbers do not depend on its chunks."""
+    run_chunk(chunk_task(plan, 0, 1))  # (untimed: the first run's one-time costs)
+    probe = chunk_task(plan, 0, min(PROBE, plan.size))
+    start = time.perf_counter()
+    run_chunk(probe)
+    per_run = (time.perf_counter() - start) / (probe.hi - probe.lo)
+    chunk = int(min(max(seconds / max(per_run, 1e-9), 1), plan.chunk))
+    return dataclasses.replace(plan, chunk=chunk)
+
+
 @task(
     "reference",
     "another reference or path (eq. (7) from the reference to the path's first point ran out "
     "of memory)",
 )
 def plan_task(req: str, limits: AtlasLimits):
-    """:func:`plan_request` of a request (JSON) as a compute worker's task,
-    within the workers' time and memory limits (tracing the curves solves eq. (7)): the plan and
-    None, or None and the refusal (message, field), for the server to raise again."""
+    """:func:`plan_request` of a request (JSON) as a compute worker's task, within the workers'
+    time and memory limits (tracing the curves solves eq. (7)), its chunks sized for the pool
+    (:func:`sized_chunks`): the plan and None, or None and the refusal (message, field), for the
+    server to raise again."""
     try:
-        return plan_request(AtlasRequest.model_validate_json(req), limits), None
+        return sized_chunks(plan_request(AtlasRequest.model_validate_json(req), limits)), None
     except InvalidInputError as exc:
         return None, (str(exc), exc.field)
 

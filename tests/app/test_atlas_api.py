@@ -264,3 +264,21 @@ def test_an_atlas_in_the_compute_pool_is_the_engines_atlas():
     here = run_atlas(plan)
     np.testing.assert_allclose(pooled.drift, here.drift, rtol=0, atol=1e-12)
     np.testing.assert_allclose(pooled.leg_ends, here.leg_ends, rtol=0, atol=1e-12)
+
+
+def test_a_servers_atlas_is_cut_into_chunks_of_about_a_second():
+    """A unicycle start costs up to about 0.2 s, a Manipulator 2 start about a millisecond: the
+    server's chunks hold tens of unicycle starts (the compute workers serve requests between
+    them, far within their time limit), Manipulator 2's hundreds (here: all in one)."""
+    from jik.app.compute.atlas_jobs import sized_chunks
+
+    unicycle = robot_spec("unicycle")
+    req = AtlasRequest.model_validate({
+        "robot": {"name": "unicycle"}, "starts": 64, "cycles": 1, "algorithms": ["extended"],
+        "path": [list(map(float, p)) for p in unicycle.default_path],
+    })  # fmt: skip
+    plan = plan_request(req, AtlasLimits())
+    assert plan.chunk >= 64
+    assert 1 <= sized_chunks(plan).chunk < 64
+    m2 = plan_request(AtlasRequest.model_validate(body(starts=100)), AtlasLimits())
+    assert sized_chunks(m2).chunk >= m2.size == 100
