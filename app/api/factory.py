@@ -12,7 +12,8 @@ from fastapi import FastAPI
 from fastapi_offline import FastAPIOffline
 
 from jik import __version__
-from jik.app.api.errors import BodyLimit, add_error_handlers
+from jik.app.api.body_limit import BodyLimit
+from jik.app.api.errors import add_error_handlers
 from jik.app.api.fastpath import SolveFastPath
 from jik.app.api.routes import dashboard, health, repeatability, robots, sessions, solve, synthesize
 from jik.app.api.routes.atlas import router as atlas_router

@@ -49,7 +49,10 @@ def _stopped(signum: int, frame: object) -> None:
 
 
 def run_server(
-    host: str = "127.0.0.1", port: int = 8000, allowed_hosts: tuple[str, ...] = ()
+    host: str = "127.0.0.1",
+    port: int = 8000,
+    allowed_hosts: tuple[str, ...] = (),
+    forwarded_allow_ips: str | None = None,
 ) -> None:
     """Serve the API and the dashboard on ``host:port`` until interrupted (SIGINT or SIGTERM).
 
@@ -61,6 +64,11 @@ def run_server(
         HTTP port of the API (OpenAPI docs at /docs), the page and its scenes.
     allowed_hosts : tuple of str
         Host names the server answers to besides the loopback names and ``JIK_ALLOWED_HOSTS``.
+    forwarded_allow_ips : str or None
+        Addresses of the reverse proxies whose ``X-Forwarded-For`` and ``X-Forwarded-Proto``
+        are believed (comma-separated, ``*`` for any; uvicorn's ``forwarded_allow_ips``). None:
+        no proxy; the client is the socket's peer, whatever the headers say (the per-client
+        limits count peers).
 
     Raises
     ------
@@ -90,6 +98,10 @@ def run_server(
             http=with_read_deadline(settings.read_seconds),
             # Beyond max_connections uvicorn answers 503 at once instead of queueing.
             limit_concurrency=settings.max_connections,
+            # uvicorn believes X-Forwarded-For from 127.0.0.1 unless told otherwise: any local
+            # client could then name itself anew with each request.
+            proxy_headers=forwarded_allow_ips is not None,
+            forwarded_allow_ips=forwarded_allow_ips or "",
         )
         uvicorn.Server(config).run(sockets=[sock])
     finally:

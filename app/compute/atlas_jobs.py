@@ -18,6 +18,7 @@ leg ends in the result.
 from __future__ import annotations
 
 import dataclasses
+import re
 import secrets
 import threading
 import time
@@ -36,13 +37,15 @@ from jik.engine.atlas import AtlasPlan, plan_atlas
 from jik.engine.atlas_backends import IN_FLIGHT
 from jik.engine.atlas_run import AtlasResult, chunk_task, run_atlas, run_chunk
 from jik.engine.exceptions import InvalidInputError, RunCancelled
+from jik.engine.progress import ProgressCallbacks
 from jik.engine.registry import make_inverse
 from jik.engine.repeatability import CLOSE_TOL
 from jik.engine.self_motion import MAX_ARC
+from jik.engine.solver import gamma_problem
 
 
 class AtlasJobNotFound(LookupError):
-    """No job with that id (never made, cancelled, or dropped after ``keep_for``): HTTP 404."""
+    """No job with that id: HTTP 404; ``args``: the id and why it is not there."""
 
 
 class AtlasJobsFull(RuntimeError):
@@ -85,8 +88,8 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
             raise RequestError(name, f"must have {size} components, got {len(v)}")
     gamma = spec.default_gamma if req.gamma is None else req.gamma
     mode = req.mode or spec.default_mode
-    if mode == "discrete" and gamma >= 2:
-        raise RequestError("gamma", f"must be < 2 in discrete mode, got {gamma:g}")
+    if (why := gamma_problem(gamma, mode)) is not None:
+        raise RequestError("gamma", why)
     paths = len(req.shifts or [0]) * len(req.scales or [0])
     closed = np.linalg.norm(np.subtract(req.path[-1], req.path[0])) <= CLOSE_TOL
     legs = req.starts * paths * req.cycles * (len(req.path) - closed) * len(req.algorithms)
@@ -215,12 +218,27 @@ class AtlasJob:
     cancel: threading.Event = field(default_factory=threading.Event)
     #: The request it was started from (the dashboard draws the result with it).
     request: AtlasRequest | None = None
+    #: Whether it holds one of the ``max_running`` slots (given back once, at its end or its
+    #: cancel, whichever comes first).
+    holds_slot: bool = False
 
-    def response(self) -> AtlasJobResponse:
+    def response(self, ahead: int | None = None, running: int = 1) -> AtlasJobResponse:
+        """The job's state; ``ahead``: the jobs before it in the queue, of which ``running``
+        are computing (:meth:`AtlasJobs.response` counts them)."""
         end = self.ended if self.ended is not None else time.monotonic()
+        message = {"running": "computing", "done": "done", "failed": "failed",
+                   "cancelled": "cancelled"}.get(self.status, "queued")  # fmt: skip
+        if self.status == "queued" and ahead is not None:
+            message = (
+                f"queued behind {ahead} atlas job{'s' * (ahead != 1)} ({running} computing, "
+                f"the rest waiting); it starts when they end"
+                if ahead
+                else "starting"
+            )
         return AtlasJobResponse(
             id=self.id, status=self.status, runs=self.plan.size, runs_done=self.runs_done,
             progress=self.runs_done / self.plan.size, elapsed_s=end - self.started,
+            queue_position=ahead if self.status == "queued" else None, message=message,
             error=self.error, result=self.result,  # type: ignore[arg-type]  # (validated)
         )  # fmt: skip
 
@@ -240,6 +258,9 @@ class AtlasJobs:
         self._jobs: dict[str, AtlasJob] = {}
         self._lock = threading.Lock()
         self._slots = threading.Semaphore(self.limits.max_running)
+        #: The first characters of this server's job ids: an id with others is a job of an
+        #: earlier server process, lost when it stopped (jobs live in memory).
+        self.run = secrets.token_hex(3)
 
     def check_room(self, client: str) -> None:
         """Raise :class:`AtlasJobsFull` if no job of ``client`` can start now."""
@@ -253,7 +274,8 @@ class AtlasJobs:
         self.check_room(client)
         if plan is None:
             plan = plan_request(req, self.limits)
-        job = AtlasJob(secrets.token_urlsafe(12), client, plan, req.leg_ends, request=req)
+        job = AtlasJob(self.run + secrets.token_urlsafe(12), client, plan, req.leg_ends,
+                       request=req)  # fmt: skip
         with self._lock:
             self._room(client)
             self._jobs[job.id] = job
@@ -270,20 +292,56 @@ class AtlasJobs:
             raise AtlasJobsFull(f"at most {self.limits.per_client} atlas jobs per client run at "
                                 "once; wait for one to end or cancel it")  # fmt: skip
 
+    def response(self, job: AtlasJob) -> AtlasJobResponse:
+        """``job``'s state, with the jobs queued or running before it when it waits."""
+        with self._lock:
+            before = self._before(job)
+        return job.response(len(before), sum(j.status == "running" for j in before))
+
+    def _before(self, job: AtlasJob) -> list[AtlasJob]:
+        """The active jobs ahead of ``job``: the running ones and those queued before it (the
+        queue is served in the order the jobs were started). Under the lock."""
+        ahead, earlier = [], True
+        for other in self._jobs.values():
+            earlier = earlier and other is not job
+            if other is not job and (other.status == "running" or (earlier and other.active)):
+                ahead.append(other)
+        return ahead
+
     def get(self, job_id: str) -> AtlasJob:
         self.sweep()
         with self._lock:
             job = self._jobs.get(job_id)
         if job is None:
-            raise AtlasJobNotFound(job_id)
+            raise AtlasJobNotFound(job_id, self._missing(job_id))
         return job
 
+    def _missing(self, job_id: str) -> str:
+        """Why no job has the id ``job_id``."""
+        if job_id.startswith(self.run):
+            return (f"it was cancelled, or it ended more than {self.limits.keep_for:g} s ago "
+                    "and was dropped")  # fmt: skip
+        if re.fullmatch(r"[0-9a-f]{6}[A-Za-z0-9_-]{16}", job_id):
+            return ("the server restarted since it was started, and atlas jobs live in the "
+                    "server's memory: start it again")  # fmt: skip
+        return "no job of this server has had this id"
+
     def cancel(self, job_id: str) -> None:
-        """Stop the job (after the chunk it is on) and drop it."""
+        """Stop the job (after the chunk it is on) and drop it; its slot goes at once to the
+        next queued job (the chunks in flight end in the workers meanwhile, their results
+        dropped), not after those chunks."""
         job = self.get(job_id)
         job.cancel.set()
         with self._lock:
             self._jobs.pop(job_id, None)
+        self._release(job)
+
+    def _release(self, job: AtlasJob) -> None:
+        """Give back ``job``'s slot if it still holds it."""
+        with self._lock:
+            held, job.holds_slot = job.holds_slot, False
+        if held:
+            self._slots.release()
 
     def sweep(self) -> None:
         """Drop the jobs that ended more than ``keep_for`` seconds ago."""
@@ -301,20 +359,28 @@ class AtlasJobs:
             self._jobs.clear()
 
     def _run(self, job: AtlasJob) -> None:
-        while not self._slots.acquire(timeout=0.2):
+        while True:  # first come, first served
             if job.cancel.is_set():
                 return self._end(job, "cancelled")
+            with self._lock:
+                first = not any(j.status == "queued" for j in self._before(job))
+            if first and self._slots.acquire(timeout=0.2):
+                break
+            if not first:
+                job.cancel.wait(0.2)
+        job.holds_slot = True
         try:
             job.status = "running"
             job.started = time.monotonic()
 
-            def progress(done: int, _total: int) -> None:
-                job.runs_done = done
+            def progress(done: float, _total: float) -> None:
+                job.runs_done = int(done)
 
             backend = None if self._pool is None else PoolBackend(self._pool)
             res = run_atlas(
-                job.plan, backend, on_progress=progress,
-                cancelled=job.cancel.is_set, keep_leg_ends=job.leg_ends,
+                job.plan, backend,
+                progress=ProgressCallbacks(on_advance=progress, is_cancelled=job.cancel.is_set),
+                keep_leg_ends=job.leg_ends,
             )  # fmt: skip
             job.result = result_document(res, job.plan.manifolds[0].arc, job.leg_ends)
             self._end(job, "done")
@@ -324,7 +390,7 @@ class AtlasJobs:
             job.error = f"{type(error).__name__}: {error}"
             self._end(job, "failed")
         finally:
-            self._slots.release()
+            self._release(job)
 
     @staticmethod
     def _end(job: AtlasJob, status: Status) -> None:

@@ -1,4 +1,4 @@
-"""A request's user robot (issue 29): its definition built by the engine, its errors renamed.
+"""A request's user robot: its definition built by the engine, its errors renamed.
 
 A request may give, instead of a catalogue robot, a definition of one of the kinds of
 :mod:`jik.engine.robot_kinds` (``planar_chain``, ``formula``, ``urdf``), and for its extended

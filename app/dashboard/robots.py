@@ -1,4 +1,4 @@
-"""The robot of a dashboard state: one of the catalogue, or one the user defined (issue 29).
+"""The robot of a dashboard state: one of the catalogue, or one the user defined.
 
 A state names a catalogue robot (``robot``, with ``robot_parameters``), or a kind of
 :mod:`jik.engine.robot_kinds` with its definition (``robot_definition``, built by

@@ -176,7 +176,7 @@ def _client(settings):
 
 
 def test_a_worker_that_died_while_idle_costs_no_request_an_error():
-    """The next request is retried once on a fresh worker (it was a 503, issue 26 item 6)."""
+    """The next request is retried once on a fresh worker (it was a 503)."""
     from jik.app.compute.settings import Settings
     from tests.app.conftest import TABLE1_PATH, X0_M2, solve_body
 

@@ -58,7 +58,8 @@ def _imported(name: str, path: Path) -> set[str]:
 
 def _dynamic_import(node: ast.Call) -> str | None:
     """The literal module name of ``importlib.import_module("a.b")``, ``import_module("a.b")``
-    or ``__import__("a.b")``; a name given by a variable is refused (it cannot be checked)."""
+    or ``__import__("a.b")``; the package of ``f"a.b.{name}"`` (its layer is known); a name
+    given otherwise is refused (it cannot be checked)."""
     fn = node.func
     name = fn.attr if isinstance(fn, ast.Attribute) else getattr(fn, "id", None)
     if name not in ("import_module", "__import__"):
@@ -66,6 +67,10 @@ def _dynamic_import(node: ast.Call) -> str | None:
     arg = node.args[0] if node.args else None
     if isinstance(arg, ast.Constant) and isinstance(arg.value, str):
         return arg.value
+    if isinstance(arg, ast.JoinedStr) and arg.values and isinstance(arg.values[0], ast.Constant):
+        head = str(arg.values[0].value)
+        if head.endswith(".") and head.count(".") >= 2:
+            return head[:-1]
     return "<a module named at run time>"
 
 
@@ -180,10 +185,10 @@ def test_dynamic_imports_count_as_imports():
     """``importlib.import_module`` and ``__import__`` with a literal name are imports too; a name
     known only at run time is reported as such (the layers could not be checked)."""
     code = "import importlib\nimportlib.import_module('jik.app.dashboard.offload')\n"
-    code += "__import__('jik.app.api')\nimport_module(name)\n"
+    code += "__import__('jik.app.api')\nimport_module(name)\nimport_module(f'jik.engine.{m}')\n"
     calls = [n for n in ast.walk(ast.parse(code)) if isinstance(n, ast.Call)]
     assert [_dynamic_import(c) for c in calls] == [
-        "jik.app.dashboard.offload", "jik.app.api", "<a module named at run time>"
+        "jik.app.dashboard.offload", "jik.app.api", "<a module named at run time>", "jik.engine"
     ]  # fmt: skip
 
 

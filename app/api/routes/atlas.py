@@ -42,7 +42,10 @@ async def start_job(jobs: AtlasJobs, pool: ComputePool, request: Request, req) -
 
 Jobs = Annotated[AtlasJobs, Depends(jobs_of)]
 ERRORS: dict[int | str, dict] = {
-    404: {"model": ErrorResponse, "description": "no such job (ended long ago, or cancelled)"},
+    404: {
+        "model": ErrorResponse,
+        "description": "no such job (cancelled, ended, or lost in a restart)",
+    },
     429: {"model": ErrorResponse, "description": "too many atlas jobs; retry later"},
 }
 
@@ -54,13 +57,13 @@ async def start_atlas(
     """Plan the atlas (the self-motion curves are traced here) and start it as a job."""
     job = await start_job(jobs, pool, request, req)
     response.headers["Location"] = f"/atlas/{job.id}"
-    return job.response()
+    return jobs.response(job)
 
 
 @router.get("/atlas/{job_id}", response_model=AtlasJobResponse, responses=ERRORS)
 async def read_atlas(job_id: str, jobs: Jobs):
     """The job's status and progress; its result once done."""
-    return jobs.get(job_id).response()
+    return jobs.response(jobs.get(job_id))
 
 
 @router.delete("/atlas/{job_id}", status_code=204, responses=ERRORS)
