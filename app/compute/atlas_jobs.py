@@ -17,25 +17,22 @@ leg ends in the result.
 
 from __future__ import annotations
 
-import dataclasses
 import re
 import secrets
 import threading
 import time
-from collections.abc import Callable, Iterable, Iterator
-from concurrent.futures import FIRST_COMPLETED, Future, wait
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
 
+from jik.app.compute.atlas_pool import PoolBackend, sized_chunks
 from jik.app.compute.atlas_schemas import AtlasJobResponse, AtlasRequest
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.requests import build_augmentation, build_robot, nullable
 from jik.app.compute.worker import task
 from jik.engine.atlas import AtlasPlan, plan_atlas
-from jik.engine.atlas_backends import IN_FLIGHT
-from jik.engine.atlas_run import AtlasResult, chunk_task, run_atlas, run_chunk
+from jik.engine.atlas_run import AtlasResult, run_atlas
 from jik.engine.exceptions import InvalidInputError, RunCancelled
 from jik.engine.progress import ProgressCallbacks
 from jik.engine.registry import make_inverse
@@ -112,26 +109,6 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
     )  # fmt: skip
 
 
-#: Seconds of work in one chunk of a server's atlas: the compute workers serve the API's requests
-#: between chunks, first come first served, and a chunk stays far within their time limit.
-CHUNK_SECONDS = 1.0
-#: Runs timed together to size an atlas's chunks.
-PROBE = 8
-
-
-def sized_chunks(plan: AtlasPlan, seconds: float = CHUNK_SECONDS) -> AtlasPlan:
-    """``plan`` with chunks of about ``seconds`` of work, from the time of a chunk of its first
-    :data:`PROBE` runs (a unicycle's run costs hundreds of times a Manipulator 2's); at most the
-    plan's own chunk. The atlas's numbers do not depend on its chunks."""
-    run_chunk(chunk_task(plan, 0, 1))  # (untimed: the first run's one-time costs)
-    probe = chunk_task(plan, 0, min(PROBE, plan.size))
-    start = time.perf_counter()
-    run_chunk(probe)
-    per_run = (time.perf_counter() - start) / (probe.hi - probe.lo)
-    chunk = int(min(max(seconds / max(per_run, 1e-9), 1), plan.chunk))
-    return dataclasses.replace(plan, chunk=chunk)
-
-
 @task(
     "reference",
     "another reference or path (eq. (7) from the reference to the path's first point ran out "
@@ -146,43 +123,6 @@ def plan_task(req: str, limits: AtlasLimits):
         return sized_chunks(plan_request(AtlasRequest.model_validate_json(req), limits)), None
     except InvalidInputError as exc:
         return None, (str(exc), exc.field)
-
-
-@task("starts", "fewer starts or cycles")
-def atlas_chunk(fn: Callable[[Any], Any], chunk: Any) -> Any:
-    """``fn(chunk)``: one chunk of an atlas in a compute worker."""
-    return fn(chunk)
-
-
-class PoolBackend:
-    """An atlas backend (:class:`jik.engine.atlas_backends.Backend`) on the server's compute
-    pool (a :class:`~jik.app.compute.pool.ComputePool`): at most ``IN_FLIGHT`` chunks per worker
-    submitted at once, results in the order they finish; leaving gives up the chunks in flight."""
-
-    def __init__(self, pool: Any) -> None:
-        self.pool = pool
-        self.workers = pool.settings.workers
-
-    def __enter__(self) -> PoolBackend:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        return None
-
-    def imap_unordered(self, fn: Callable[[Any], Any], tasks: Iterable[Any]) -> Iterator[Any]:
-        pending: set[Future] = set()
-        try:
-            for chunk in tasks:
-                pending.add(self.pool.submit(atlas_chunk, fn, chunk))
-                if len(pending) >= IN_FLIGHT * self.workers:
-                    finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-                    yield from (f.result() for f in finished)
-            while pending:
-                finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-                yield from (f.result() for f in finished)
-        finally:
-            for f in pending:
-                f.cancel()
 
 
 def result_document(res: AtlasResult, arc, leg_ends: bool) -> dict[str, Any]:

@@ -14,9 +14,9 @@ from jik.app.compute.atlas_jobs import (
     AtlasJobNotFound,
     AtlasJobs,
     AtlasLimits,
-    PoolBackend,
     plan_request,
 )
+from jik.app.compute.atlas_pool import PoolBackend
 from jik.app.compute.atlas_schemas import AtlasRequest
 from jik.app.compute.pool import pool_in_thread
 from jik.app.compute.settings import Settings
@@ -266,19 +266,21 @@ def test_an_atlas_in_the_compute_pool_is_the_engines_atlas():
     np.testing.assert_allclose(pooled.leg_ends, here.leg_ends, rtol=0, atol=1e-12)
 
 
-def test_a_servers_atlas_is_cut_into_chunks_of_about_a_second():
-    """A unicycle start costs up to about 0.2 s, a Manipulator 2 start about a millisecond: the
-    server's chunks hold tens of unicycle starts (the compute workers serve requests between
-    them, far within their time limit), Manipulator 2's hundreds (here: all in one)."""
-    from jik.app.compute.atlas_jobs import sized_chunks
+@pytest.mark.parametrize(("seconds_per_run", "chunk"), [(0.2, 5), (0.001, 1000), (1e-5, 2048)])
+def test_a_servers_atlas_is_cut_into_chunks_of_about_a_second(monkeypatch, seconds_per_run, chunk):
+    """The chunk holds about a second of runs, timed on the plan's first runs (a unicycle run
+    costs about 0.2 s, a Manipulator 2 run about a millisecond), at most the plan's own chunk
+    (2048): the compute workers serve requests between chunks, far within their time limit.
+    (The runs' cost is simulated by a clock that each run advances.)"""
+    from jik.app.compute import atlas_pool
 
-    unicycle = robot_spec("unicycle")
-    req = AtlasRequest.model_validate({
-        "robot": {"name": "unicycle"}, "starts": 64, "cycles": 1, "algorithms": ["extended"],
-        "path": [list(map(float, p)) for p in unicycle.default_path],
-    })  # fmt: skip
-    plan = plan_request(req, AtlasLimits())
-    assert plan.chunk >= 64
-    assert 1 <= sized_chunks(plan).chunk < 64
-    m2 = plan_request(AtlasRequest.model_validate(body(starts=100)), AtlasLimits())
-    assert sized_chunks(m2).chunk >= m2.size == 100
+    now = [0.0]
+
+    def run_chunk(task):
+        now[0] += seconds_per_run * (task.hi - task.lo)
+
+    monkeypatch.setattr(atlas_pool, "run_chunk", run_chunk)
+    monkeypatch.setattr(atlas_pool, "perf_counter", lambda: now[0])
+    plan = plan_request(AtlasRequest.model_validate(body(starts=3000)), AtlasLimits())
+    assert plan.chunk == 2048
+    assert atlas_pool.sized_chunks(plan).chunk == chunk
