@@ -365,6 +365,8 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto", guess=N
     with DOP853 on (7) itself from their last point, at tau = -ln(1 - sigma) (or ln(e0 / e)).
     """
     n = len(x0)
+    if not inverse.right_inverse:
+        method = "dop853"  # the homotopy form needs e = e0 exp(-tau), which J J# != I breaks
     e0 = inverse.kinematics.forward(x0) - y_d
     err0 = np.linalg.norm(e0, axis=-1)
     moving = np.flatnonzero(err0 >= tol)
