@@ -12,6 +12,7 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from jik.app.compute.algorithm_schemas import AlgorithmParameters
 from jik.app.compute.schemas import (
     Algorithm,
     Augmentation,
@@ -41,9 +42,15 @@ class AtlasRequest(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
     robot: Robot = Field(description="the robot and its parameters, e.g. {'name': 'manipulator2'}")
-    algorithms: Annotated[list[Algorithm], Field(min_length=1, max_length=2)] = Field(
-        ["pseudoinverse"], description="'pseudoinverse' (8) and/or 'extended' (11)"
+    algorithms: Annotated[list[Algorithm], Field(min_length=1, max_length=5)] = Field(
+        ["pseudoinverse"],
+        description="the algorithms to compare over the same starts, each once: 'pseudoinverse' "
+        "(8), 'extended' (11), 'damped', 'weighted', 'posture'",
     )
+    algorithm_parameters: AlgorithmParameters | None = Field(
+        None, description="parameters of the damped, weighted and posture algorithms (each "
+        "takes its own; default: the engine's)",
+    )  # fmt: skip
     augmentation: Augmentation | None = Field(
         None, description="augmenting map of the extended inverse (default: the robot's)"
     )

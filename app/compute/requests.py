@@ -21,6 +21,7 @@ import numpy as np
 import pydantic_core
 
 from jik.app.compute import schemas as S
+from jik.app.compute.algorithm_schemas import field_of, used
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.settings import settings_from_env
 from jik.app.compute.user_robots import is_user_robot, user_inverse, user_robot
@@ -126,7 +127,7 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
         extended = req.algorithm == "extended"
         robot, robot_used, aug_used = user_robot(req.robot, req.augmentation if extended else None)
         spec, kin = robot.spec, robot.kinematics
-        inverse = user_inverse(robot, req.algorithm)
+        inverse = user_inverse(robot, req.algorithm, used(req.algorithm_parameters))
     else:
         spec, kin, robot_used = build_robot(req.robot)
         inverse, aug_used = _catalogue_inverse(spec, kin, req)
@@ -153,7 +154,12 @@ def _catalogue_inverse(spec: RobotSpec, kin, req) -> tuple[Any, S.AugmentationUs
         except InvalidInputError as exc:
             raise RequestError("augmentation", str(exc)) from None
     else:
-        inverse = make_inverse(kin, "pseudoinverse")
+        try:
+            inverse = make_inverse(
+                kin, req.algorithm, spec=spec, algorithm_parameters=used(req.algorithm_parameters)
+            )
+        except InvalidInputError as exc:
+            raise RequestError(field_of(exc.field, str(exc)), str(exc)) from None
     return inverse, aug_used
 
 
@@ -262,7 +268,7 @@ def robots_response(timeout: float | None = None) -> S.RobotsResponse:
     robots = [
         S.RobotInfo(
             **spec.as_dict(),
-            algorithms=["pseudoinverse", "extended"],
+            algorithms=list(S.Algorithm.__args__),  # type: ignore[attr-defined]
             modes=["continuous", "discrete"],
         )
         for spec in ROBOTS.values()

@@ -21,6 +21,8 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeAlias, Union
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Discriminator, Field, Tag, create_model
 
+from jik.app.compute.algorithm_schemas import Algorithm as Algorithm
+from jik.app.compute.algorithm_schemas import AlgorithmParameters
 from jik.engine.registry import ROBOTS, AugmentationSpec, RobotSpec
 from jik.engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
 
@@ -127,7 +129,6 @@ AUGMENTATION_MODELS: dict[str, type[BaseModel]] = {
 for _m in (*ROBOT_MODELS.values(), *AUGMENTATION_MODELS.values()):
     globals()[_m.__name__] = _m  # importable by name (pickling, introspection)
 
-Algorithm = Literal["pseudoinverse", "extended"]
 Mode = Literal["continuous", "discrete"]
 #: Largest |coordinate| of a configuration or task point (radians, lengths, control amplitudes):
 #: beyond it the kinematics only overflow, and the unicycle's quadrature would need huge grids.
@@ -306,7 +307,14 @@ class _Request(BaseModel):
         description="the robot and its parameters, e.g. {'name': 'manipulator2', 'l': 1}"
     )
     algorithm: Algorithm = Field(
-        description="'pseudoinverse' (eq. (8)) or 'extended' (extended Jacobian inverse, eq. (11))"
+        description="'pseudoinverse' (eq. (8)), 'extended' (extended Jacobian inverse, eq. (11)), "
+        "'damped' (damped least squares), 'weighted' (weighted least-norm inverse for joint "
+        "limits) or 'posture' (pseudoinverse with a null-space pull to a rest posture)"
+    )
+    algorithm_parameters: AlgorithmParameters | None = Field(
+        None,
+        description="parameters of the algorithm (damping, damping_threshold; limits; gain, "
+        "rest); default: the engine's (GET /robots lists them)",
     )
     augmentation: AnyAugmentation | None = Field(
         None,
