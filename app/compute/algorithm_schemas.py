@@ -32,9 +32,7 @@ def _scalar_fields() -> dict[str, Any]:
     return fields
 
 
-_Parameters = create_model(
-    "_Parameters", __config__=ConfigDict(extra="forbid"), **_scalar_fields()
-)
+_Parameters = create_model("_Parameters", __config__=ConfigDict(extra="forbid"), **_scalar_fields())
 
 
 class AlgorithmParameters(_Parameters):  # type: ignore[misc, valid-type]

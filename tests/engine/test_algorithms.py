@@ -43,12 +43,12 @@ def test_catalogue_lists_all_five_with_parameters():
 @pytest.mark.parametrize("mode", ["continuous", "discrete"])
 @pytest.mark.parametrize("name, params", [("damped", {"damping": 0.0}), ("posture", {"gain": 0.0})])
 def test_zero_parameter_is_the_pseudoinverse(name, params, mode):
-    """damping 0 and gain 0 give the pseudoinverse's loop to 1e-14 (the same code runs)."""
+    """damping 0 and gain 0 give the pseudoinverse's loop bit for bit (the same code runs)."""
     kw = {"gamma": 1.0 if mode == "continuous" else 0.5, "mode": mode}
     ref = repeatability(_inverse("pseudoinverse"), X0, TABLE1, cycles=3, **kw)
     got = repeatability(_inverse(name, **params), X0, TABLE1, cycles=3, **kw)
     assert ref.drift[-1] > 0.1
-    np.testing.assert_allclose(got.legs, ref.legs, rtol=0, atol=1e-14)
+    np.testing.assert_array_equal(got.legs, ref.legs)
 
 
 def test_zero_parameter_apply_matches_on_a_batch():
@@ -245,3 +245,21 @@ def test_batched_runs_equal_one_by_one_runs():
 def test_bad_parameters_name_their_field(name, params, field):
     with pytest.raises(InvalidInputError, match=field):
         make_inverse(KIN, name, algorithm_parameters=params)
+
+
+def test_reproduction_table_has_every_algorithm():
+    """`jik reproduce algorithms`, shortened to 2 cycles: one row per algorithm, in order."""
+    from jik.engine.reproductions import algorithms as repro
+
+    result = repro.run(cycles=2)
+    assert [r["name"] for r in result["algorithms"]] == list(ALGORITHMS)
+    drift = {r["name"]: r["drift"]["1"] for r in result["algorithms"]}
+    assert drift["extended"] < 1e-12 < drift["posture"] < 0.2 < drift["pseudoinverse"]
+    text = repro.format_text(result)
+    assert text.count("\n| ") == 6 and "| posture | gain = 1.0, rest = x0 |" in text
+
+
+def test_cli_algorithm_names_are_the_catalogue():
+    from jik.algorithm_options import ALGORITHM_NAMES
+
+    assert list(ALGORITHM_NAMES) == list(ALGORITHMS)
