@@ -149,8 +149,8 @@ def cycle_guesses(
     ``guides`` (those legs' trajectories, None in the first cycle) are its guesses, and a leg
     then takes one or two sweeps. The pseudoinverse (and the other right inverses, weighted and
     posture) drifts, so the cycle before saves almost nothing: its legs are swept together from
-    ``start`` (:func:`jik.engine.solver.chain_guesses`), one or two sweeps a leg instead of about ten, and a cycle's numbers depend only on its
-    start. A chain evaluates J# about three times as often as the legs would, so it pays only
+    ``start`` (:func:`jik.engine.solver.chain_guesses`), one or two sweeps a leg instead of
+    about ten, and a cycle's numbers depend only on its start. A chain evaluates J# about three times as often as the legs would, so it pays only
     where an evaluation costs little beyond numpy's per-call overhead: not for the unicycle.
     """
     if (
