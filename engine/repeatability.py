@@ -150,8 +150,9 @@ def cycle_guesses(
     then takes one or two sweeps. The pseudoinverse (and the other right inverses, weighted and
     posture) drifts, so the cycle before saves almost nothing: its legs are swept together from
     ``start`` (:func:`jik.engine.solver.chain_guesses`), one or two sweeps a leg instead of
-    about ten, and a cycle's numbers depend only on its start. A chain evaluates J# about three times as often as the legs would, so it pays only
-    where an evaluation costs little beyond numpy's per-call overhead: not for the unicycle.
+    about ten, and a cycle's numbers depend only on its start. A chain evaluates J# about three
+    times as often as the legs would, so it pays only where an evaluation costs little beyond
+    numpy's per-call overhead: not for the unicycle.
     """
     if (
         inverse.name != "extended" and inverse.right_inverse and len(targets) > 1
