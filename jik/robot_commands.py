@@ -79,6 +79,12 @@ def _setup(args: argparse.Namespace) -> tuple[Robot, list[float], dict]:
     return robot, x0, settings
 
 
+def _parameters(args: argparse.Namespace, robot: Robot, x0) -> dict:
+    """The algorithm's options; the posture's rest: the robot's home, else the run's x0."""
+    home = getattr(robot.kinematics, "home", None)
+    return algorithm_parameters(args, args.algorithm, x0 if home is None else None)
+
+
 def _fmt(v) -> str:
     return "(" + ", ".join(f"{float(t):.10g}" for t in v) + ")"
 
@@ -90,7 +96,7 @@ def solve_command(args: argparse.Namespace) -> int:
     target = parse_vector(args.target, "--target") if args.target else robot.spec.default_target
     inverse = robot.inverse(
         args.algorithm, args.augmentation,
-        algorithm_parameters=algorithm_parameters(args, args.algorithm),
+        algorithm_parameters=_parameters(args, robot, x0),
     )  # fmt: skip
     res = solve(inverse, x0, target, record=False, **settings)
     out = {
@@ -114,7 +120,7 @@ def repeatability_command(args: argparse.Namespace) -> int:
     path = parse_path(args.path, "--path") if args.path else robot.spec.default_path
     inverse = robot.inverse(
         args.algorithm, args.augmentation,
-        algorithm_parameters=algorithm_parameters(args, args.algorithm),
+        algorithm_parameters=_parameters(args, robot, x0),
     )  # fmt: skip
     rep = repeatability(inverse, x0, path, cycles=args.cycles, **settings)
     out = {

@@ -39,8 +39,8 @@ class AlgorithmParameters(_Parameters):  # type: ignore[misc, valid-type]
     """Parameters of the chosen algorithm; those of another algorithm are refused (422)."""
 
     rest: list[_Coordinate] | None = Field(
-        None, description="posture: the rest posture x_rest, length p (default: the robot's home "
-        "or its default x0)",
+        None, description="posture: the rest posture x_rest, length p (default: the robot's home, "
+        "else the run's x0; in an atlas, else the robot's default x0)",
     )  # fmt: skip
     limits: list[tuple[_Bound, _Bound]] | None = Field(
         None, description="weighted: joint limits [lo, hi] per joint, length p (default: the "
@@ -48,9 +48,14 @@ class AlgorithmParameters(_Parameters):  # type: ignore[misc, valid-type]
     )  # fmt: skip
 
 
-def used(params: BaseModel | None) -> dict[str, Any]:
-    """The parameters given, as the engine's :func:`make_inverse` takes them."""
-    return {} if params is None else params.model_dump(exclude_none=True)
+def used(params: BaseModel | None, algorithm: str = "", kinematics=None, x0=None) -> dict:
+    """The parameters given, as the engine's :func:`make_inverse` takes them. The posture
+    inverse's ``rest`` defaults to the robot's home, else to the run's start ``x0``."""
+    out = {} if params is None else params.model_dump(exclude_none=True)
+    if algorithm == "posture" and "rest" not in out and x0 is not None:
+        if getattr(kinematics, "home", None) is None:
+            out["rest"] = list(x0)
+    return out
 
 
 def field_of(exc_field: str | None, message: str) -> str:

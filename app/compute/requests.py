@@ -127,7 +127,8 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
         extended = req.algorithm == "extended"
         robot, robot_used, aug_used = user_robot(req.robot, req.augmentation if extended else None)
         spec, kin = robot.spec, robot.kinematics
-        inverse = user_inverse(robot, req.algorithm, used(req.algorithm_parameters))
+        params = used(req.algorithm_parameters, req.algorithm, robot.kinematics, req.x0)
+        inverse = user_inverse(robot, req.algorithm, params)
     else:
         spec, kin, robot_used = build_robot(req.robot)
         inverse, aug_used = _catalogue_inverse(spec, kin, req)
@@ -155,9 +156,8 @@ def _catalogue_inverse(spec: RobotSpec, kin, req) -> tuple[Any, S.AugmentationUs
             raise RequestError("augmentation", str(exc)) from None
     else:
         try:
-            inverse = make_inverse(
-                kin, req.algorithm, spec=spec, algorithm_parameters=used(req.algorithm_parameters)
-            )
+            params = used(req.algorithm_parameters, req.algorithm, kin, req.x0)
+            inverse = make_inverse(kin, req.algorithm, spec=spec, algorithm_parameters=params)
         except InvalidInputError as exc:
             raise RequestError(field_of(exc.field, str(exc)), str(exc)) from None
     return inverse, aug_used

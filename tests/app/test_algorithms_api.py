@@ -74,3 +74,20 @@ def test_atlas_compares_algorithms_over_the_same_starts():
     # the same starts, different algorithms: different drift (posture pulls toward its rest)
     assert abs(drift["damped"] - drift["pseudoinverse"]).max() > 1e-6
     assert abs(drift["posture"] - drift["pseudoinverse"]).max() > 1e-3
+
+
+def test_posture_rest_defaults_to_the_runs_start(api):
+    """Without rest, the posture inverse pulls toward the request's x0 (Manipulator 2 has no
+    home): the same loop as with rest = x0 given, and not that of the catalogue's x0."""
+    x0 = [0.2, -0.1, 1.2]
+
+    def legs(params):
+        r = api.post("/repeatability", json={
+            "robot": {"name": "manipulator2"}, "algorithm": "posture", "x0": x0,
+            "path": TABLE1_PATH, "cycles": 2, "algorithm_parameters": params,
+        })  # fmt: skip
+        assert r.status_code == 200, r.text
+        return r.json()["drift"]
+
+    assert legs({"gain": 1.0}) == legs({"gain": 1.0, "rest": x0})
+    assert legs({"gain": 1.0}) != legs({"gain": 1.0, "rest": X0_M2})
