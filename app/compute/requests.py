@@ -26,7 +26,7 @@ from jik.app.compute.exceptions import RequestError
 from jik.app.compute.settings import settings_from_env
 from jik.app.compute.user_robots import is_user_robot, user_inverse, user_robot
 from jik.engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
-from jik.engine.registry import ROBOTS, RobotSpec, make_inverse
+from jik.engine.registry import ALGORITHMS, ROBOTS, RobotSpec, make_inverse
 from jik.engine.repeatability import (
     MAX_CYCLES,
     MAX_PATH_POINTS,
@@ -280,7 +280,8 @@ def robots_response(timeout: float | None = None) -> S.RobotsResponse:
         max_trajectory_points=S.MAX_TRAJECTORY_POINTS,
         request_timeout_s=float(timeout if timeout is not None else settings_from_env().timeout),
     )
-    return S.RobotsResponse(robots=robots, limits=limits)
+    algorithms = [S.AlgorithmInfo(**a.as_dict()) for a in ALGORITHMS.values()]
+    return S.RobotsResponse(robots=robots, limits=limits, algorithms=algorithms)
 
 
 def batch_key(req: S.SolveRequest) -> str:

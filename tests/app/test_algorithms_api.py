@@ -39,8 +39,13 @@ def test_repeatability_posture_drifts_less_than_the_pseudoinverse(api):
 
 
 def test_robots_list_every_algorithm(api):
-    robots = api.get("/robots").json()["robots"]
-    assert robots[0]["algorithms"] == ["pseudoinverse", "extended", "damped", "weighted", "posture"]
+    body = api.get("/robots").json()
+    names = ["pseudoinverse", "extended", "damped", "weighted", "posture"]
+    assert body["robots"][0]["algorithms"] == names
+    assert [a["name"] for a in body["algorithms"]] == names
+    damped = body["algorithms"][2]
+    assert [p["name"] for p in damped["parameters"]] == ["damping", "damping_threshold"]
+    assert damped["parameters"][0]["maximum"] == 10.0 and "Nakamura" in damped["source"]
 
 
 @pytest.mark.parametrize(
