@@ -153,7 +153,9 @@ class WeightedInverse(Inverse):
     joint slows as it nears a limit and stops at it (weight inf). Chan and Dubey switch a
     weight back to 1 while the joint moves away from its limit; that switch depends on the
     motion's history, so it is left out here: the flow (7) stays autonomous and the same in
-    continuous and discrete mode. J J# = I_r, so the task error decays as in eq. (5).
+    continuous and discrete mode. J J# = I_r, so the task error decays as in eq. (5). A
+    configuration at or past a limit is a singular one for this inverse: a start there raises,
+    and a discrete run whose step crosses a limit stops there with a message naming the joint.
     """
 
     name = "weighted"
@@ -171,6 +173,10 @@ class WeightedInverse(Inverse):
             )
         self.limits = lim
 
+    def outside(self, x: FloatArray) -> FloatArray:
+        """Where a joint is at or past one of its limits, shape (...,)."""
+        return ~((x > self.limits[:, 0]) & (x < self.limits[:, 1])).all(axis=-1)
+
     def weights_inverse(self, x: FloatArray) -> FloatArray:
         """diag(W(x))^(-1), shape (..., p): 0 at or past a limit."""
         return 1.0 / (1.0 + np.abs(limit_gradient(x, self.limits)))
@@ -180,7 +186,7 @@ class WeightedInverse(Inverse):
         winv = self.weights_inverse(x)
         Jw = J * np.sqrt(winv)[..., None, :]
         w, d = solve_small(gram(Jw), e)  # (J W^-1 J^T) w = e
-        bad = ~(np.abs(d) >= SINGULAR_MANIPULABILITY**2)
+        bad = ~(np.abs(d) >= SINGULAR_MANIPULABILITY**2) | self.outside(x)
         v = winv * _jt(J, w)
         bad |= ~np.isfinite(v).all(axis=-1)
         return (np.where(bad[..., None], 0.0, v) if bad.any() else v), bad
@@ -196,9 +202,18 @@ class WeightedInverse(Inverse):
         return np.swapaxes(Jw, -1, -2) @ np.linalg.inv(M)
 
     def singular_error(self, x: FloatArray) -> Exception:
-        return _singular(
-            self.kinematics, x, "the weighted inverse (J W^-1 J^T singular, or joints at limits)"
-        )
+        x = np.asarray(x, dtype=float)
+        out = np.flatnonzero(~((x > self.limits[:, 0]) & (x < self.limits[:, 1])))
+        if out.size:
+            i = int(out[0])
+            lo, hi = self.limits[i]
+            return KinematicSingularityError(
+                f"the weighted inverse of {self.kinematics.name} is undefined: joint {i + 1} "
+                f"is at or past its limits [{lo:g}, {hi:g}] (x{i + 1} = {x[i]:.6g}); start "
+                "inside the limits (a discrete step can also cross one: lower gamma)",
+                x,
+            )
+        return _singular(self.kinematics, x, "the weighted inverse (J W^-1 J^T singular)")
 
 
 class PostureInverse(Inverse):

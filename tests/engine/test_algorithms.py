@@ -263,3 +263,11 @@ def test_cli_algorithm_names_are_the_catalogue():
     from jik.algorithm_options import ALGORITHM_NAMES
 
     assert list(ALGORITHM_NAMES) == list(ALGORITHMS)
+
+
+def test_weighted_refuses_a_start_past_a_limit_naming_the_joint():
+    inv = WeightedInverse(KIN, [[-1.0, 1.0], [-1.0, 1.0], [2.0, 3.0]])
+    with pytest.raises(
+        KinematicSingularityError, match=r"joint 3 is at or past its limits \[2, 3\]"
+    ):
+        solve(inv, X0, (1.0, 1.0))
