@@ -175,7 +175,7 @@ class WeightedInverse(Inverse):
 
     def outside(self, x: FloatArray) -> FloatArray:
         """Where a joint is at or past one of its limits, shape (...,)."""
-        return ~((x > self.limits[:, 0]) & (x < self.limits[:, 1])).all(axis=-1)
+        return np.asarray(~((x > self.limits[:, 0]) & (x < self.limits[:, 1])).all(axis=-1))
 
     def weights_inverse(self, x: FloatArray) -> FloatArray:
         """diag(W(x))^(-1), shape (..., p): 0 at or past a limit."""
