@@ -506,7 +506,8 @@ def solve(
     Parameters
     ----------
     inverse : Inverse
-        The pseudoinverse (8) or the extended Jacobian inverse (11).
+        The pseudoinverse (8), the extended Jacobian inverse (11), or one of
+        :mod:`jik.engine.practical_inverses` (damped, weighted, posture).
     x0 : array_like, shape (p,) or (n, p)
         Start configuration(s); a batch is solved in one vectorized run.
     y_d : array_like, shape (r,) or (n, r)
@@ -525,7 +526,9 @@ def solve(
     method : {"auto", "picard", "dop853"}
         Continuous mode only: Chebyshev-Picard with a sweep budget and DOP853 after it
         ("auto"), Picard alone (DOP853 only where it fails), or DOP853 alone. "dop853" suits
-        maps that are expensive per point (the unicycle's characteristics map).
+        maps that are expensive per point (the unicycle's characteristics map). An inverse that
+        is not a right inverse (``inverse.right_inverse`` False: damped least squares) always
+        takes DOP853, since Picard's homotopy form needs J J# = I.
     guess : Trajectory, or a sequence of Trajectory or None (one per start), optional
         Continuous mode: the trajectory of a nearby earlier solve with the same gamma, such as
         the same leg in the previous cycle of a closed path. Picard starts its sweeps from it
