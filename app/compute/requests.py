@@ -123,6 +123,11 @@ def build_augmentation(spec: RobotSpec, kin, req_aug):
 
 def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
     aug_used = None
+    if req.algorithm == "extended" and used(req.algorithm_parameters):
+        raise RequestError(
+            "algorithm_parameters",
+            "the extended inverse takes none (its augmenting map's parameters go in augmentation)",
+        )
     if is_user_robot(req.robot):
         extended = req.algorithm == "extended"
         robot, robot_used, aug_used = user_robot(req.robot, req.augmentation if extended else None)

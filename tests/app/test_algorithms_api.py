@@ -57,6 +57,8 @@ def test_robots_list_every_algorithm(api):
         ("weighted", {"limits": [[1.0, 0.0]] * 3}, ["algorithm_parameters", "limits"], "lo < hi"),
         ("posture", {"speed": 1.0}, ["algorithm_parameters", "speed"], "unknown field"),
         ("newton", None, ["algorithm"], "Input should be"),
+        ("extended", {"gain": 1.0}, ["algorithm_parameters"], "the extended inverse takes none"),
+        ("pseudoinverse", {"damping": 0.1}, ["algorithm_parameters", "damping"], "unknown"),
     ],
 )  # fmt: skip
 def test_bad_parameters_are_422_naming_the_field(api, algorithm, params, loc, text):
