@@ -19,13 +19,13 @@ from __future__ import annotations
 
 import functools
 import itertools
-from collections.abc import Callable
 
 import numpy as np
 
 from jik.engine.augmentations import AugmentingMap
 from jik.engine.exceptions import InvalidInputError, OneFormUndefinedError, format_vector
 from jik.engine.kinematics import SINGULAR_MANIPULABILITY, Kinematics, kernel_cofactors
+from jik.engine.progress import Progress, check_cancelled
 from jik.engine.unicycle import Unicycle
 from jik.engine.validation import FloatArray, as_vector, count, finite
 
@@ -477,7 +477,7 @@ class CharacteristicsMap(AugmentingMap):
         self,
         x,
         batch: int = 45,
-        on_batch: Callable[[int, int], None] | None = None,
+        progress: Progress | None = None,
     ) -> tuple[FloatArray, FloatArray, FloatArray]:
         """:meth:`evaluate` of a large set of points, ``batch`` members at a time.
 
@@ -487,9 +487,10 @@ class CharacteristicsMap(AugmentingMap):
         batch : int
             Members per Newton solve (each one cold, from z(s) = z(1): the result never depends
             on the order of the batches).
-        on_batch : callable, optional
-            ``on_batch(done, total)`` after each batch; what it raises stops the evaluation
-            there (a caller's cancellation).
+        progress : Progress, optional
+            Told ``advance(batches_done, batches_total)`` after each batch, then asked whether to
+            go on (:meth:`Progress.cancelled`: True raises ``RunCancelled``); what it raises
+            stops the evaluation there.
 
         Returns
         -------
@@ -516,8 +517,9 @@ class CharacteristicsMap(AugmentingMap):
             h[part] = np.where(bad, np.nan, Z[:, 0])
             dh[part] = np.where(bad[:, None], np.nan, S[:, 0, :])
             failed[part] = bad
-            if on_batch is not None:
-                on_batch(k + 1, total)
+            if progress is not None:
+                progress.advance(k + 1, total)
+                check_cancelled(progress, f"h evaluation cancelled after batch {k + 1} of {total}")
         shape = x.shape[:-1]
         return h.reshape(shape), dh.reshape(*shape, self.p), failed.reshape(shape)
 

@@ -94,7 +94,7 @@ class SecurityMiddleware:
         if refusal is not None:
             status, message = refusal
             if websocket:
-                await send({"type": "websocket.close", "code": 4000 + status, "reason": message})
+                await _close_websocket(receive, send, 4000 + status, message)
                 return
             await _json(send, status, message)
             return
@@ -146,6 +146,17 @@ def _routed(scope: Scope) -> bool:
     if routes is None:
         return True
     return any(route.matches(scope)[0] == Match.FULL for route in routes)
+
+
+async def _close_websocket(receive: Receive, send: Send, code: int, reason: str) -> None:
+    """Accept, then close with ``code`` (4400, 4403): a refused handshake reaches a browser's
+    script only as 1006, a close code as itself. Nothing the client sends is read."""
+    if (await receive())["type"] != "websocket.connect":
+        return
+    await send({"type": "websocket.accept"})
+    # (a close frame's reason is at most 123 bytes of UTF-8)
+    short = reason.encode()[:123].decode(errors="ignore")
+    await send({"type": "websocket.close", "code": code, "reason": short})
 
 
 async def _json(send: Send, status: int, message: str) -> None:

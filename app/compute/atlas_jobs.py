@@ -33,9 +33,11 @@ from jik.engine.atlas import AtlasPlan, plan_atlas
 from jik.engine.atlas_backends import ProcessPool
 from jik.engine.atlas_run import AtlasResult, run_atlas
 from jik.engine.exceptions import InvalidInputError, RunCancelled
+from jik.engine.progress import ProgressCallbacks
 from jik.engine.registry import ALGORITHMS, make_inverse
 from jik.engine.repeatability import CLOSE_TOL
 from jik.engine.self_motion import MAX_ARC
+from jik.engine.solver import gamma_problem
 
 
 class AtlasJobNotFound(LookupError):
@@ -98,8 +100,8 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
             raise RequestError(name, f"must have {size} components, got {len(v)}")
     gamma = spec.default_gamma if req.gamma is None else req.gamma
     mode = req.mode or spec.default_mode
-    if mode == "discrete" and gamma >= 2:
-        raise RequestError("gamma", f"must be < 2 in discrete mode, got {gamma:g}")
+    if (why := gamma_problem(gamma, mode)) is not None:
+        raise RequestError("gamma", why)
     paths = len(req.shifts or [0]) * len(req.scales or [0])
     closed = np.linalg.norm(np.subtract(req.path[-1], req.path[0])) <= CLOSE_TOL
     legs = req.starts * paths * req.cycles * (len(req.path) - closed) * len(req.algorithms)
@@ -255,13 +257,13 @@ class AtlasJobs:
             job.status = "running"
             job.started = time.monotonic()
 
-            def progress(done: int, _total: int) -> None:
-                job.runs_done = done
+            def progress(done: float, _total: float) -> None:
+                job.runs_done = int(done)
 
             res = run_atlas(
                 job.plan, ProcessPool(self.limits.workers, self.limits.worker_memory),
-                on_progress=progress,
-                cancelled=job.cancel.is_set, keep_leg_ends=job.leg_ends,
+                progress=ProgressCallbacks(on_advance=progress, is_cancelled=job.cancel.is_set),
+                keep_leg_ends=job.leg_ends,
             )  # fmt: skip
             job.result = result_document(res, job.plan.manifolds[0].arc, job.leg_ends)
             self._end(job, "done")

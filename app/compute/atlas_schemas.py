@@ -26,6 +26,7 @@ from jik.app.compute.schemas import (
     per_robot,
 )
 from jik.engine.repeatability import MAX_PATH_POINTS
+from jik.engine.solver import DISCRETE_GAMMA_BOUND
 
 #: Largest starts per path, cycles, and paths of a family (shifts, scales) in one request.
 MAX_STARTS = 20000
@@ -79,7 +80,9 @@ class AtlasRequest(BaseModel):
     )
     cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_CYCLES)] = 3
     gamma: Gamma | None = Field(
-        None, description="decay rate of eq. (5) of every leg (discrete: < 2); default: robot's"
+        None,
+        description=f"decay rate of eq. (5) of every leg (discrete: < {DISCRETE_GAMMA_BOUND:g}); "
+        "default: robot's",
     )
     mode: Mode | None = Field(None, description="'continuous' or 'discrete'; default: robot's")
     tolerance: Tolerance = Field(1e-10, description="each leg stops at ||k(x) - target|| < this")

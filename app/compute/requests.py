@@ -33,7 +33,8 @@ from jik.engine.repeatability import (
     REPEATABLE_DRIFT,
     repeatability,
 )
-from jik.engine.solver import BatchSolveResult, solve
+from jik.engine.solver import gamma_problem
+from jik.engine.solver import solve_batch as engine_solve_batch
 
 _R = TypeVar("_R")
 
@@ -139,12 +140,8 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
         inverse, aug_used = _catalogue_inverse(spec, kin, req)
     mode = req.mode or spec.default_mode
     gamma = spec.default_gamma if req.gamma is None else float(req.gamma)
-    if mode == "discrete" and gamma >= 2:
-        raise RequestError(
-            "gamma",
-            f"must be < 2 in discrete mode, got {gamma:g} (near the solution the error shrinks "
-            "by |1 - gamma| per iteration)",
-        )
+    if (why := gamma_problem(gamma, mode)) is not None:
+        raise RequestError("gamma", why)
     return _Setup(
         spec, kin, inverse, robot_used, aug_used, mode, gamma, req.tolerance, req.max_iterations
     )
@@ -341,19 +338,15 @@ def _solve_batch(
         keep = np.flatnonzero(~bad)
         if keep.size:
             try:
-                # x0[keep] is (k, p), so solve returns a batch.
-                batch = cast(
-                    BatchSolveResult,
-                    solve(
-                        setup.inverse,
-                        x0[keep],
-                        y_d[keep],
-                        gamma=setup.gamma,
-                        mode=setup.mode,
-                        tol=setup.tolerance,
-                        max_iterations=setup.max_iterations,
-                        record=True,
-                    ),
+                batch = engine_solve_batch(
+                    setup.inverse,
+                    x0[keep],
+                    y_d[keep],
+                    gamma=setup.gamma,
+                    mode=setup.mode,
+                    tol=setup.tolerance,
+                    max_iterations=setup.max_iterations,
+                    record=True,
                 )
             except JikError as exc:
                 err = engine_error(exc)

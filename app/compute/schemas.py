@@ -25,6 +25,7 @@ from jik.app.compute.algorithm_schemas import Algorithm as Algorithm
 from jik.app.compute.algorithm_schemas import AlgorithmParameters
 from jik.engine.registry import ROBOTS, AugmentationSpec, RobotSpec
 from jik.engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
+from jik.engine.solver import DISCRETE_GAMMA_BOUND, GAMMA_MAX, GAMMA_MIN, TOL_MIN
 
 #: Largest configuration / task dimension accepted before the registry check.
 MAX_DIMENSION = 16
@@ -137,14 +138,11 @@ Coordinate = Annotated[
     float, Field(strict=True, ge=-COORDINATE_BOUND, le=COORDINATE_BOUND, allow_inf_nan=False)
 ]
 Vector = Annotated[list[Coordinate], Field(min_length=1, max_length=MAX_DIMENSION)]
-#: The decay rate of eq. (5) (discrete mode: the step; below 2 there, checked with the mode).
-#: Continuous runs depend on gamma only through theta = -log(1 - s) / gamma (theta's scale);
-#: below 1e-6 that scale leaves the floating-point range (from about 1e-100 the integrator
-#: failed with NaN).
-GAMMA_MIN = 1e-6
-Gamma = Annotated[float, Field(strict=True, ge=GAMMA_MIN, le=1e6, allow_inf_nan=False)]
+#: The decay rate of eq. (5) (discrete mode: the step; its bound there is checked with the mode,
+#: engine.solver.gamma_problem).
+Gamma = Annotated[float, Field(strict=True, ge=GAMMA_MIN, le=GAMMA_MAX, allow_inf_nan=False)]
 #: The task error at which a solve stops.
-Tolerance = Annotated[float, Field(strict=True, ge=1e-14, le=1.0, allow_inf_nan=False)]
+Tolerance = Annotated[float, Field(strict=True, ge=TOL_MIN, le=1.0, allow_inf_nan=False)]
 
 
 # --------------------------------------------------------------------------------------------
@@ -324,7 +322,8 @@ class _Request(BaseModel):
     x0: Vector = Field(description="start configuration, length p of the robot")
     gamma: Gamma | None = Field(
         None,
-        description="decay rate > 0 of eq. (5) (discrete: the step, < 2); default: the robot's",
+        description=f"decay rate > 0 of eq. (5) (discrete: the step, < {DISCRETE_GAMMA_BOUND:g}); "
+        "default: the robot's",
     )
     mode: Mode | None = Field(
         None, description="'continuous' (ODE) or 'discrete' (iterations); default: the robot's"

@@ -13,6 +13,7 @@ from jik.app.dashboard.model import DashboardState, cache_key
 from jik.app.dashboard.robots import state_kinematics, state_spec
 from jik.app.dashboard.runs import AlgorithmRun, Cancelled, DashboardResult
 from jik.engine.exceptions import JikError
+from jik.engine.progress import ProgressCallbacks
 
 
 def inert_variables(kin, amap, box: tuple[tuple[float, float], ...], samples: int = 8):
@@ -99,7 +100,7 @@ def augmenting_axes(amap, x: np.ndarray, on_batch=None) -> tuple[int, int]:
     """
     with np.errstate(all="ignore"):
         if expensive_map(amap):
-            dh = amap.evaluate_batches(x, GRID_BATCH, on_batch)[1]
+            dh = amap.evaluate_batches(x, GRID_BATCH, ProgressCallbacks(on_advance=on_batch))[1]
             g = np.abs(np.asarray(dh, dtype=float))
         else:
             g = np.abs(np.asarray(amap.gradient(x), dtype=float))
@@ -190,7 +191,9 @@ def augmenting_grid(
         X[..., j] = v[:, None]
         with np.errstate(all="ignore"):
             if expensive_map(amap):  # (maps that can be undefined at some points)
-                h = amap.evaluate_batches(X.reshape(-1, kin.p), GRID_BATCH, step(along))[0]
+                h = amap.evaluate_batches(
+                    X.reshape(-1, kin.p), GRID_BATCH, ProgressCallbacks(on_advance=step(along))
+                )[0]
                 H = np.asarray(h, dtype=float)
             else:
                 H = np.asarray(amap.value(X.reshape(-1, kin.p)), dtype=float)

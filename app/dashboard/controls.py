@@ -24,13 +24,13 @@ from jik.app.dashboard.glossary import SYMBOLS
 from jik.app.dashboard.robots import state_spec
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS
-from jik.engine.solver import MAX_ITERATIONS, MAX_STEPS
+from jik.engine.solver import DISCRETE_GAMMA_BOUND, MAX_ITERATIONS, MAX_STEPS
 
-#: gamma's range per mode: the decay rate of eq. (5) (continuous), the step of the discrete
-#: iteration, which converges only for 0 < gamma < 2.
-GAMMA_RANGE = {"continuous": (0.01, 10.0), "discrete": (0.01, 1.99)}
 #: gamma's resolution: the page's log-scale slider and the scene's slider both land on it.
 GAMMA_STEP = 0.001
+#: gamma's slider range per mode: the decay rate of eq. (5) (continuous), the step of the
+#: discrete iteration, which converges only below the engine's DISCRETE_GAMMA_BOUND.
+GAMMA_RANGE = {"continuous": (0.01, 10.0), "discrete": (0.01, DISCRETE_GAMMA_BOUND - 0.01)}
 #: Switching to discrete mode takes gamma down to this when it is above (the full Newton step).
 DISCRETE_GAMMA_ON_SWITCH = 1.0
 #: Largest number of cycles offered by the dashboard (the engine accepts more).

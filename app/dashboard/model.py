@@ -38,6 +38,7 @@ from jik.app.dashboard.robots import USER_KINDS, user_robot
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS, robot_spec
 from jik.engine.repeatability import MAX_PATH_POINTS
+from jik.engine.solver import gamma_problem
 
 ALGORITHMS = ("pseudoinverse", "extended")
 #: One colour per algorithm, used in the scene and in every plot.
@@ -307,10 +308,8 @@ def validate(data: Mapping[str, Any]) -> DashboardState:
         _registered(lambda: kin.check_task(state.path, "path"), "path")
     elif state.task == "path":
         raise InvalidInputError("path: a closed-path task needs at least one path point", "path")
-    if state.mode == "discrete" and state.gamma >= 2:
-        raise InvalidInputError(
-            f"gamma: must be < 2 in discrete mode, got {state.gamma:g}", "gamma"
-        )
+    if (why := gamma_problem(state.gamma, state.mode)) is not None:
+        raise InvalidInputError(f"gamma: {why}", "gamma")
     # The engine's default cap, set by its value, is the default (None): it follows the mode.
     default_cap = max_iterations(state.model_copy(update={"max_iterations": None}))
     return state.model_copy(update={

@@ -72,7 +72,7 @@ class Session:
 
     id: str
     dashboard: Dashboard
-    scene: Any = None  # a jik.app.scene.DashboardScene (.port, .stop()), or None
+    scene: Any = None  # a jik.app.scene.DashboardScene (.connect(), .stop()), or None
     touched: float = field(default_factory=time.monotonic)
     #: Open event streams and scene connections: a session with any is in use.
     users: int = 0

@@ -15,9 +15,10 @@ from jik.engine.characteristics import (
     one_form,
     one_form_derivative,
 )
-from jik.engine.exceptions import InvalidInputError, OneFormUndefinedError
+from jik.engine.exceptions import InvalidInputError, OneFormUndefinedError, RunCancelled
 from jik.engine.inverses import ExtendedInverse
 from jik.engine.kinematics import Manipulator2, kernel_cofactors
+from jik.engine.progress import ProgressCallbacks
 from jik.engine.unicycle import Unicycle
 
 LAMBDA0 = np.array([0.5, -0.25, 0.3, -0.25])
@@ -237,7 +238,7 @@ def test_evaluation_in_batches_is_the_cold_evaluation_member_by_member(kin):
     whole = UnicycleCharacteristics(kin, a=1.0, on_undefined="nan").evaluate(x)
     seen = []
     batched = UnicycleCharacteristics(kin, a=1.0, on_undefined="nan").evaluate_batches(
-        x, 7, lambda done, total: seen.append((done, total))
+        x, 7, ProgressCallbacks(on_advance=lambda done, total: seen.append((done, total)))
     )
     assert seen == [(k, 5) for k in range(1, 6)]
     assert np.array_equal(whole[2], batched[2])
@@ -249,7 +250,8 @@ def test_evaluation_in_batches_is_the_cold_evaluation_member_by_member(kin):
 
 
 def test_what_the_batch_callback_raises_stops_the_evaluation(hmap):
-    """A caller's cancellation: the error raised after the second batch ends the evaluation."""
+    """A caller's progress: what it raises after the second batch ends the evaluation, and so
+    does its cancellation (RunCancelled)."""
     calls = []
 
     def stop(done, total):
@@ -258,5 +260,12 @@ def test_what_the_batch_callback_raises_stops_the_evaluation(hmap):
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        hmap.evaluate_batches(points(20, seed=4), 5, stop)
+        hmap.evaluate_batches(points(20, seed=4), 5, ProgressCallbacks(on_advance=stop))
     assert calls == [1, 2]
+    calls.clear()
+    cancel = ProgressCallbacks(
+        on_advance=lambda done, total: calls.append(done), is_cancelled=lambda: len(calls) == 3
+    )
+    with pytest.raises(RunCancelled, match="after batch 3 of 4"):
+        hmap.evaluate_batches(points(20, seed=4), 5, cancel)
+    assert calls == [1, 2, 3]

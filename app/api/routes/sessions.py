@@ -15,11 +15,9 @@ import asyncio
 import contextlib
 
 import websockets
-import websockets.asyncio.client
 from fastapi import APIRouter, Request, WebSocket
 from fastapi.responses import JSONResponse, PlainTextResponse, StreamingResponse
 from pydantic import BaseModel, ConfigDict, Field
-from websockets.typing import Subprotocol
 
 from jik.app.api.dependencies import Store
 from jik.app.api.errors import unparsed_body_response
@@ -310,25 +308,21 @@ async def export_result_csv(session_id: str, store: Store):
 @router.websocket("/api/sessions/{session_id}/scene")
 async def scene_socket(websocket: WebSocket, session_id: str) -> None:
     """The session's 3D scene: the viser client's websocket, relayed to the session's viser
-    server (loopback only). Closes with 4404 for no such session (another origin or host never
-    gets here: :mod:`jik.app.api.security`)."""
+    server, which takes no other client (:mod:`jik.app.scene.server`). A socket for no such
+    session is closed with 4404, one whose scene cannot be reached with 1011 (another origin or
+    host never gets here: :mod:`jik.app.api.security` closes it with 4403 or 4400)."""
     store = getattr(websocket.app.state, "sessions", None)
     try:
         session = store.get(session_id) if store is not None else None
     except SessionNotFound:
         session = None
     if session is None or session.scene is None:
-        await websocket.close(code=4404)
+        await _close(websocket, 4404, "no such session (it expired or was deleted)")
         return
-    offered = [Subprotocol(p) for p in websocket.scope.get("subprotocols", [])]
-    port = session.scene.port
     try:
-        upstream = await websockets.asyncio.client.connect(
-            f"ws://127.0.0.1:{port}", subprotocols=offered or None, max_size=None,
-            compression=None, open_timeout=10,
-        )  # fmt: skip
+        upstream = await session.scene.connect(websocket.scope.get("subprotocols", []))
     except (OSError, websockets.exceptions.WebSocketException, TimeoutError):
-        await websocket.close(code=1011)
+        await _close(websocket, 1011, "the session's scene is not reachable")
         return
     await websocket.accept(subprotocol=upstream.subprotocol)
     session.users += 1
@@ -338,6 +332,13 @@ async def scene_socket(websocket: WebSocket, session_id: str) -> None:
         session.users -= 1
         session.touch()
         await upstream.close()
+
+
+async def _close(websocket: WebSocket, code: int, reason: str) -> None:
+    """Accept, then close with ``code``: a refused handshake reaches a browser's script only as
+    1006, a close code as itself."""
+    await websocket.accept()
+    await websocket.close(code=code, reason=reason)
 
 
 async def _relay(websocket: WebSocket, upstream) -> None:
