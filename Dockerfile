@@ -11,7 +11,7 @@ WORKDIR /src
 COPY . .
 RUN python3 -m venv /opt/build \
     && /opt/build/bin/python -m pip wheel --no-cache-dir --no-deps -w /wheels . \
-    && printf 'jik[app] @ file://%s\n' /wheels/jik-*.whl > /wheels/requirements.txt
+    && printf 'jik-lab[app] @ file://%s\n' /wheels/jik_lab-*.whl > /wheels/requirements.txt
 
 # Stage 2: that wheel and the web extra in a venv owned by root; the server runs unprivileged.
 FROM ${BASE}

@@ -1,4 +1,4 @@
-"""Atlas speed and memory (issue 30): 100,000 starts x Table 1's path x 3 cycles, pseudoinverse.
+"""Atlas speed and memory: 100,000 starts x Table 1's path x 3 cycles, pseudoinverse.
 
 1. The atlas (``engine.atlas_run.run_atlas``) in-process, with 2 local processes and with a
    2-worker Dask LocalCluster, against the straightforward code: single-start

@@ -1,7 +1,7 @@
 """Dashboard figures: the JSON of every panel after a control change.
 
 Straightforward: plotly.py's way, a ``go.Figure`` per panel and its ``to_json()`` (what the
-dashboard did until 2026-11-21). jik: the figure dicts serialized directly
+dashboard once did). jik: the figure dicts serialized directly
 (:func:`jik.app.dashboard.figures.figure_specs`, :func:`jik.app.dashboard.figures.figure_json`).
 Both from the same result, checked to decode to the same figures; wall-clock medians.
 """

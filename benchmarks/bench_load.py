@@ -1,12 +1,12 @@
 """REST load: 16 concurrent clients against POST /solve (Manipulator 2, continuous), p50 / p99.
 
-Starts a real ``uvicorn`` server (``app.api.factory:create_app``) on a free 127.0.0.1 port in a
-subprocess, runs 16 concurrent httpx clients for 30 s (``quick``: 3 s), each posting a solve to a
-random reachable target from Table 1's start, and counts every non-200 answer or transport error
-as an error. It does this three times in the same run: with micro-batching and the /solve fast
-path (the defaults), without batching (``JIK_BATCH=0``: one engine call per request), and with
-FastAPI's route alone (``JIK_FAST_SOLVE=0``, see :mod:`jik.app.api.fastpath`), and prints the
-ratios.
+Starts a real ``uvicorn`` server (``jik.app.api.factory:create_app``, from wherever jik is
+installed) on a free 127.0.0.1 port in a subprocess, runs 16 concurrent httpx clients for 30 s
+(``quick``: 3 s), each posting a solve to a random reachable target from Table 1's start, and counts
+every non-200 answer or transport error as an error. It does this three times in the same run: with
+micro-batching and the /solve fast path (the defaults), without batching (``JIK_BATCH=0``: one
+engine call per request), and with FastAPI's route alone (``JIK_FAST_SOLVE=0``, see
+:mod:`jik.app.api.fastpath`), and prints the ratios.
 
 The load generator matters on a 2-core machine: 16 Python (httpx) clients take much of the CPU
 the server needs. When Debian's ``wrk`` (C, one thread, 16 connections) is installed, it is the
@@ -57,7 +57,7 @@ def start_server(
     port = port or _free_port()
     env = {**os.environ, "JIK_BATCH": "1" if batching else "0", "JIK_FAST_SOLVE": str(int(fast))}
     cmd = [
-        sys.executable, "-m", "uvicorn", "app.api.factory:create_app", "--factory",
+        sys.executable, "-m", "uvicorn", "jik.app.api.factory:create_app", "--factory",
         "--host", "127.0.0.1", "--port", str(port), "--log-level", "warning", "--no-access-log",
     ]  # fmt: skip
     proc = subprocess.Popen(cmd, env=env, stdin=subprocess.DEVNULL)
@@ -160,13 +160,11 @@ async def _load(url: str, duration: float, clients: int, path: str = "/solve") -
 
 async def _pool_load(duration: float, clients: int, batching: bool) -> dict:
     """The same load on the compute pool in-process: the computation path without HTTP."""
-    import dataclasses
-
     from jik.app.compute.pool import ComputePool
     from jik.app.compute.schemas import SolveRequest
     from jik.app.compute.settings import settings_from_env
 
-    pool = ComputePool(dataclasses.replace(settings_from_env(), batching=batching))
+    pool = ComputePool(settings_from_env().model_copy(update={"batching": batching}))
     try:
         await pool.warm_up()
         lat: list[float] = []

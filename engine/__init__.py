@@ -47,6 +47,7 @@ Repeatability (sec. 5.2.1, Table 1)
 Functionals and synthesis (secs. 3-4)
     error_functional_e1, error_functional_e2  E1, eq. (14), and E2, eq. (19), on a region
     synthesize_e2               the E2-optimal h by a Ritz method, eq. (20) -> SynthesisResult
+    synthesize_e2_nd            E2-optimal h of all joints, p - r >= 1 -> TotalDegreeSynthesis
 The atlas (drift over many starts and paths)
     plan_atlas, run_atlas       plan and run an atlas (here, in processes or on Dask)
     iter_atlas                  the same, chunk by chunk, in bounded memory
@@ -115,6 +116,8 @@ _EXPORTS = {
     "error_functional_e1": "functionals",
     "error_functional_e2": "functionals",
     "synthesize_e2": "variational",
+    "synthesize_e2_nd": "synthesis_nd",
+    "TotalDegreeSynthesis": "synthesis_nd",
     "SynthesisResult": "variational",
     # the atlas
     "plan_atlas": "atlas",
@@ -169,6 +172,7 @@ __all__ = [
     "SingularConfigurationError",
     "SolveResult",
     "SynthesisResult",
+    "TotalDegreeSynthesis",
     "Trajectory",
     "Unicycle",
     "UnicycleCharacteristics",
@@ -187,6 +191,7 @@ __all__ = [
     "solve",
     "solve_batch",
     "synthesize_e2",
+    "synthesize_e2_nd",
 ]  # (the keys of _EXPORTS, written out for tools that read __all__ without running it)
 
 
@@ -249,6 +254,7 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
     from jik.engine.results import BatchSolveResult, RepeatabilityResult, SolveResult, Trajectory
     from jik.engine.robot_spec import Robot, load_robot, robot_from_dict
     from jik.engine.solver import solve, solve_batch
+    from jik.engine.synthesis_nd import TotalDegreeSynthesis, synthesize_e2_nd
     from jik.engine.unicycle import Unicycle
     from jik.engine.urdf import UrdfChain
     from jik.engine.variational import SynthesisResult, synthesize_e2

@@ -5,7 +5,7 @@ One option picks the backend (:func:`backend_for`): ``None`` or ``"inprocess"``,
 ``dask.distributed`` cluster, whose workers have jik installed) or ``"dask:local:N"`` (a
 ``LocalCluster`` of N single-threaded worker processes, to try it on one machine). Dask is
 imported only when a Dask backend is entered: the engine does not depend on it (``pip install
-'jik[atlas]'`` installs it).
+'jik-lab[atlas]'`` installs it).
 
 Every backend keeps a bounded number of chunks in flight (:data:`IN_FLIGHT` per worker), takes
 the next task from the caller's iterator only when one finishes, and yields results in the order
@@ -135,7 +135,7 @@ class Dask:
             from dask.distributed import Client, LocalCluster, as_completed
         except ImportError as error:
             raise InvalidInputError(
-                f"a Dask backend needs dask.distributed ({error}); pip install 'jik[atlas]'",
+                f"a Dask backend needs dask.distributed ({error}); pip install 'jik-lab[atlas]'",
                 field="backend",
             ) from error
         self._as_completed = as_completed

@@ -25,7 +25,7 @@ from jik.engine.results import dataframe
 from jik.engine.validation import FloatArray
 
 #: Starts per batched repeatability() call within a chunk: the working set of the Picard sweeps
-#: then stays in cache (``jik bench atlas``: 0.033 ms per start and leg at 512, 0.044 at 2048),
+#: then stays in cache (``jik bench atlas``, docs/benchmarks.md: 512 is faster than 2048),
 #: while a chunk, the unit of work a backend hands out, may be larger.
 BATCH = 512
 

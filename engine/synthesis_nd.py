@@ -23,17 +23,18 @@ nodes up to the quadrature error. Natural boundary conditions, as in :mod:`jik.e
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import linalg
 from scipy.stats import qmc
 
-from jik.engine.exceptions import InvalidInputError, KinematicSingularityError, RunCancelled
+from jik.engine.exceptions import InvalidInputError, KinematicSingularityError
 from jik.engine.functionals import Region, check_region
 from jik.engine.inverses import pseudoinverse
 from jik.engine.kinematics import Kinematics
+from jik.engine.progress import Progress, check_cancelled
 from jik.engine.total_degree import (
     TotalDegreeMap,
     basis_gradients,
@@ -196,8 +197,7 @@ def synthesize_e2_nd(
     seed: int = 0,
     frame_axes: Sequence[int] | None = None,
     convergence_degrees: Sequence[int] = (),
-    progress: Callable[[float], None] | None = None,
-    cancelled: Callable[[], bool] | None = None,
+    progress: Progress | None = None,
 ) -> TotalDegreeSynthesis:
     """Minimise E2, eq. (19), over maps h of all the region's variables (see the module).
 
@@ -218,11 +218,9 @@ def synthesize_e2_nd(
         1-based joints whose axes fix the kernel frame for p - r >= 2 (:func:`kernel_frame`).
     convergence_degrees : sequence of int
         Lower total degrees whose Ritz values are reported too.
-    progress : callable, optional
-        Called with a fraction in [0, 1].
-    cancelled : callable, optional
-        Polled between chunks; when it returns True, :class:`~jik.engine.exceptions.RunCancelled`
-        is raised.
+    progress : Progress, optional
+        Told the fraction of the nodes assembled (``advance``); polled between chunks of nodes
+        (``cancelled``: :class:`~jik.engine.exceptions.RunCancelled` stops the synthesis).
 
     Returns
     -------
@@ -271,8 +269,7 @@ def synthesize_e2_nd(
     snapshots: list[tuple[int, FloatArray, FloatArray, float]] = []
     done = 0
     for t, R, f, m in rule.chunks():
-        if cancelled is not None and cancelled():
-            raise RunCancelled("the synthesis was cancelled")
+        check_cancelled(progress, "the E2 synthesis was cancelled")
         _, G = basis_gradients(t, index)  # (n, nb, d)
         H = np.einsum("nbk,nkl->nbl", G, R)
         A += np.tensordot(H, G, axes=([0, 2], [0, 2]))
@@ -284,7 +281,7 @@ def synthesize_e2_nd(
         if done < nodes and done >= 2 * nb and done & (done - 1) == 0:
             snapshots.append((done, A.copy(), B.copy(), c0))
         if progress is not None:
-            progress(0.9 * done / nodes)
+            progress.advance(0.9 * done / nodes, 1.0)
     w = rule.volume / nodes
     A, B, c0 = A * w, B * w, c0 * w
     A = 0.5 * (A + A.T)
@@ -317,7 +314,7 @@ def synthesize_e2_nd(
     e2_check = e2_of_gradients(check, index, C)
     single = _single_joint(rule, diag * w, load * w, c0) if m_red == 1 else {}
     if progress is not None:
-        progress(1.0)
+        progress.advance(1.0, 1.0)
     return TotalDegreeSynthesis(
         maps=maps,
         e2=convergence[-1]["e2"],

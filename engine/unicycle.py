@@ -27,7 +27,7 @@ NODES_MARGIN = 16
 #: Most nodes of that rule, and of a path's composite rule: (|l20| + |l21| + 1) T up to about
 #: 13,000 rad, every start the API takes at T = 2 pi. Beyond it the quadrature's arrays (and the
 #: time to compute the rule) grow with the controls' size, which a diverging solve can make
-#: arbitrarily large: one request drove a process past 20 GB before this bound.
+#: arbitrarily large: without this bound one request can take tens of GB.
 MAX_NODES = 8192
 #: Largest rule computed by numpy's Golub-Welsch (a dense n x n eigenproblem, O(n^2) memory);
 #: larger ones by scipy's banded solver, O(n) memory (the two agree to 1e-13).

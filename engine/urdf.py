@@ -3,7 +3,7 @@
 yourdfpy (a maintained URDF library; viser's URDF support builds on it) only parses the text;
 forward kinematics and the Jacobian are computed here, batched over configurations with numpy.
 It is imported when a URDF robot is built, so the rest of the engine works without it
-(``pip install 'jik[urdf]'``).
+(``pip install 'jik-lab[urdf]'``).
 
 Safety: the text is bounded in size, a document type declaration (the door to XML entity
 expansion and external entities) is refused before parsing, meshes are never loaded, and a
@@ -37,7 +37,7 @@ def _yourdfpy():
         import yourdfpy
     except ImportError:  # the `urdf` extra is not installed
         raise InvalidInputError(
-            "URDF robots need the yourdfpy package: pip install 'jik[urdf]'", "urdf"
+            "URDF robots need the yourdfpy package: pip install 'jik-lab[urdf]'", "urdf"
         ) from None
     # yourdfpy logs each text it cannot parse as an ERROR ("Using different parsing approach."),
     # which a server printed for every bad URDF a user sent: parse_urdf reports it, in words

@@ -20,11 +20,13 @@ import argparse
 import csv
 import json
 import math
+import os
 import sys
 import time
 from pathlib import Path
 from typing import Any
 
+from jik import install_hint
 from jik.algorithm_options import (
     ALGORITHM_NAMES,
     add_algorithm_parameter_options,
@@ -148,6 +150,7 @@ def _run(args: argparse.Namespace) -> int:
     from jik.engine.robot_spec import load_robot
     from jik.engine.self_motion import MAX_ARC
 
+    out = _writable(Path(args.out))
     algorithms = args.algorithm or ["pseudoinverse"]
     if Path(args.robot).is_file():  # a user's robot (jik.engine.robot_spec)
         if args.param:
@@ -176,7 +179,6 @@ def _run(args: argparse.Namespace) -> int:
         scales=args.scale or None, chunk=args.chunk or default_chunk(args, DEFAULT_CHUNK),
         gamma=spec.default_gamma, mode=spec.default_mode,
     )  # fmt: skip
-    out = Path(args.out)
     big = plan.size > JSON_RUNS
     csv_path = out.with_suffix(".csv") if big or args.csv else None
     A, P, N, C = len(inverses), len(plan.paths), plan.n_starts, plan.cycles
@@ -234,6 +236,23 @@ def _run(args: argparse.Namespace) -> int:
         f"jik atlas: {A} x {plan.size} runs x {C} cycles in {elapsed:.1f} s: {written}\n"
     )
     return 0
+
+
+def _writable(out: Path) -> Path:
+    """``out``, once its folder is known to take the files (the JSON, and the CSV and figure
+    beside it): checked before anything is computed."""
+    from jik.engine.exceptions import InvalidInputError
+
+    folder = out.parent
+    if out.is_dir():
+        raise InvalidInputError(
+            f"--out {out} is a folder; give a file name, e.g. {out / 'atlas.json'}", "out"
+        )
+    if not folder.is_dir():
+        raise InvalidInputError(f"--out {out}: there is no folder {folder}", "out")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise InvalidInputError(f"--out {out}: the folder {folder} is not writable", "out")
+    return out
 
 
 def default_chunk(args: argparse.Namespace, largest: int) -> int:
@@ -415,7 +434,8 @@ def _figure(arrays: _Gathered, plan, path: Path) -> Path | None:
         np.asarray(s), arrays.last, plan.algorithms, plan.cycles, len(plan.paths), N, label
     )
     if fig is None:
-        sys.stderr.write("jik atlas: plotly is not installed: no figure (pip install 'jik[app]')\n")
+        hint = install_hint("app")
+        sys.stderr.write(f"jik atlas: plotly is not installed: no figure ({hint})\n")
         return None
     fig.write_html(path, include_plotlyjs=True, full_html=True)  # (offline: no CDN)
     return path

@@ -1,7 +1,7 @@
 """The ``jik`` command (also ``python -m jik``): ``jik serve``, ``jik reproduce NAME [--json]``,
 ``jik bench [NAME]``.
 
-Only ``serve`` needs the web parts (the ``jik[app]`` extra); the others run on the engine alone,
+Only ``serve`` needs the web parts (the ``app`` extra); the others run on the engine alone,
 so this module imports nothing of :mod:`jik.app` until ``serve`` asks for it.
 """
 
@@ -14,7 +14,9 @@ import signal
 import sys
 from typing import Any
 
+from jik import install_hint
 from jik.robot_commands import add_robot_commands
+from jik.serve_address import Announcer, listen_problem, port_number
 
 #: Reproductions: name -> module in jik.engine.reproductions with run() and format_text().
 REPRODUCTIONS = {
@@ -26,7 +28,7 @@ REPRODUCTIONS = {
 }
 
 
-#: The top-level modules of the ``jik[app]`` extra (a benchmark of the web parts needs them).
+#: The top-level modules of the ``app`` extra (a benchmark of the web parts needs them).
 WEB_PACKAGES = frozenset(
     {"fastapi", "fastapi_offline", "starlette", "uvicorn", "viser", "plotly", "httpx"}
 )
@@ -55,7 +57,7 @@ def reproduce(args: argparse.Namespace) -> int:
 
 
 #: What installs the web parts, for the message of a command that needs them.
-APP_EXTRA_HINT = "pip install 'jik[app]'"
+APP_EXTRA_HINT = install_hint("app")
 
 
 def missing_app_extra(error: ModuleNotFoundError) -> int:
@@ -77,11 +79,24 @@ def serve(args: argparse.Namespace) -> int:
         from jik.app.api.server import PortInUse, run_server
     except ModuleNotFoundError as error:
         return missing_app_extra(error)
+    problem = listen_problem(args.host, args.port)
+    if problem:
+        sys.stderr.write(f"jik serve: {problem}\n")
+        return 2
+    announcer = Announcer(args.host, args.port)
+    announcer.start()
     try:
-        run_server(host=args.host, port=args.port, allowed_hosts=tuple(args.allowed_host))
+        run_server(
+            host=args.host,
+            port=args.port,
+            allowed_hosts=tuple(args.allowed_host),
+            forwarded_allow_ips=args.forwarded_allow_ips,
+        )
     except PortInUse as busy:
         sys.stderr.write(f"jik serve: {busy}\n")
         return 2
+    finally:
+        announcer.stop()
     return 0
 
 
@@ -106,11 +121,17 @@ def main(argv: list[str] | None = None) -> int:
 
     p = sub.add_parser("serve", help="start the REST API and the dashboard")
     p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
-    p.add_argument("--port", type=int, default=8000, help="HTTP port of the API, page and scene")
+    p.add_argument("--port", type=port_number, default=8000,
+                   help="HTTP port of the API, page and scene (default 8000)")  # fmt: skip
     p.add_argument(
         "--allowed-host", action="append", default=[], metavar="NAME",
         help="a host name the server answers to besides localhost, 127.0.0.1 and [::1] (repeat it; "
         "also JIK_ALLOWED_HOSTS, comma-separated; '*' for any)",
+    )  # fmt: skip
+    p.add_argument(
+        "--forwarded-allow-ips", default=None, metavar="IPS",
+        help="behind a reverse proxy: its addresses (comma-separated, '*' for any), whose "
+        "X-Forwarded-For names the client; default: none, the client is the connection's peer",
     )  # fmt: skip
     p.set_defaults(func=serve)
 

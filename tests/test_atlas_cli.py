@@ -1,4 +1,4 @@
-"""`jik atlas` writes what issue 30 promises: inputs, starts, per algorithm drift and leg ends,
+"""`jik atlas` writes its inputs, starts, per algorithm drift and leg ends,
 a CSV for large atlases, a figure, and errors that name the input."""
 
 import csv
@@ -104,6 +104,31 @@ def test_bad_input_exits_2_and_names_it(tmp_path, capsys, extra, text):
     assert main(argv) == 2
     assert text in capsys.readouterr().err
     assert not (tmp_path / "x.json").exists()
+
+
+@pytest.mark.parametrize(
+    ("out", "text"),
+    [
+        ("missing/atlas.json", "there is no folder"),
+        (".", "is a folder; give a file name"),
+    ],
+)
+def test_an_out_that_cannot_be_written_is_refused_before_computing(
+    tmp_path, capsys, monkeypatch, out, text
+):
+    """A folder that does not exist (or a folder given as the file) is named at once, in one
+    line, before the curves are traced and the runs computed."""
+    from jik.engine import atlas
+
+    def computed(*args, **kwargs):
+        raise AssertionError("the atlas was planned before --out was checked")
+
+    monkeypatch.setattr(atlas, "plan_atlas", computed)
+    argv = ["atlas", "--path", TABLE1, "--quiet", "--out", str(tmp_path / out)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"jik atlas: --out {tmp_path / out}") and text in err, err
+    assert err.count("\n") == 1 and "Traceback" not in err
 
 
 def test_a_path_that_is_not_numbers_is_refused(tmp_path):

@@ -9,13 +9,16 @@ dashboard that computes), and alone (the engine on numpy, scipy and sympy, no we
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import socket
 import subprocess
 import sys
+import tarfile
 import time
 import venv
+import zipfile
 from pathlib import Path
 
 import httpx
@@ -44,8 +47,15 @@ def wheel(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("wheel")
     run(sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", out, ROOT, cwd=out,
         timeout=PIP_SECONDS)  # fmt: skip
-    (built,) = out.glob("jik-*.whl")
+    (built,) = out.glob("jik_lab-*.whl")
     return built
+
+
+def wheel_files(path: Path) -> dict[str, str]:
+    """A wheel's files, name -> sha256 (its RECORD aside: it lists the same hashes)."""
+    with zipfile.ZipFile(path) as z:
+        return {n: hashlib.sha256(z.read(n)).hexdigest() for n in z.namelist()
+                if not n.endswith("/RECORD")}  # fmt: skip
 
 
 def fresh_env(where: Path) -> tuple[Path, Path]:
@@ -148,4 +158,23 @@ def test_engine_alone_reproduces_table1(wheel, tmp_path):
     serve = subprocess.run([bin_dir / "jik", "serve"], cwd=tmp_path, capture_output=True,
                            text=True, timeout=60)  # fmt: skip
     assert serve.returncode == 2
-    assert "pip install 'jik[app]'" in serve.stderr, serve.stderr
+    assert "pip install 'jik-lab[app]'" in serve.stderr, serve.stderr
+
+
+def test_sdist_builds_the_same_wheel_without_tests_or_docs(wheel, tmp_path):
+    """The sdist holds what builds the wheel, and the wheel pip builds from it is the one built
+    from the tree; the tests, docs, scripts and harnesses stay in the repository."""
+    pytest.importorskip("build", reason="the build package (of the test extra) builds sdists")
+    run(sys.executable, "-m", "build", "--sdist", "-o", tmp_path, ROOT, cwd=tmp_path,
+        timeout=PIP_SECONDS)  # fmt: skip
+    (sdist,) = tmp_path.glob("jik_lab-*.tar.gz")
+    with tarfile.open(sdist) as tar:
+        folders = {Path(*Path(n).parts[1:3]) for n in tar.getnames() if len(Path(n).parts) > 2}
+    left_in = {f for f in folders if f.parts[0] in ("tests", "docs", "scripts", ".ci")}
+    assert not left_in and Path("benchmarks/harness") not in folders, sorted(left_in)
+    assert {Path("engine/reproductions"), Path("app/api")} <= folders, sorted(folders)
+    out = tmp_path / "from-sdist"
+    run(sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", out, sdist, cwd=tmp_path,
+        timeout=PIP_SECONDS)  # fmt: skip
+    (rebuilt,) = out.glob("jik_lab-*.whl")
+    assert wheel_files(rebuilt) == wheel_files(wheel)

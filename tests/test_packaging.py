@@ -1,9 +1,12 @@
-"""What the shipped code imports is installed by its own install line: the engine (and the ``jik``
-command's root package) by ``pip install jik`` alone, the web parts and benchmarks by
-``pip install 'jik[app]'``."""
+"""The package's layout and its install lines: setuptools maps each top-level folder under
+``jik`` with no symlink, lists every subpackage, and what the shipped code imports is installed
+by its own install line: the engine (and the ``jik`` command's root package) by the plain
+install, the web parts and benchmarks by the ``app`` extra, the harnesses (not shipped) by the
+``test`` extra."""
 
 import ast
 import re
+import subprocess
 import sys
 import tomllib
 from importlib import metadata
@@ -13,8 +16,18 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+SETUPTOOLS = PYPROJECT["tool"]["setuptools"]
 #: Source folder -> the extra its imports may come from (None: the plain install).
-EXTRA_OF = {"jik": None, "engine": None, "app": "app", "static": "app", "benchmarks": "app"}
+EXTRA_OF = {
+    "jik": None,
+    "engine": None,
+    "app": "app",
+    "static": "app",
+    "benchmarks": "app",
+    "benchmarks/harness": "test",
+}
+#: Folders of a mapped package that the wheel leaves out (run from a source checkout).
+UNSHIPPED = {"benchmarks/harness"}
 
 
 def _name(requirement: str) -> str:
@@ -23,19 +36,34 @@ def _name(requirement: str) -> str:
     return re.sub(r"[-_.]+", "-", match[0]).lower()
 
 
-def _linked_folders() -> set[str]:
-    """``jik`` and the top-level folders that jik/ links in as its subpackages."""
-    links = {p for p in (ROOT / "jik").iterdir() if p.is_symlink()}
-    for link in links:
-        assert link.resolve() == ROOT / link.name, f"jik/{link.name} must link to ../{link.name}"
-    return {"jik", *(link.name for link in links)}
+def _packages_on_disk() -> set[str]:
+    """Every folder with an __init__.py under the folders that package-dir maps, by the name it
+    installs as, except the unshipped ones."""
+    found = set()
+    for package, folder in SETUPTOOLS["package-dir"].items():
+        for init in (ROOT / folder).rglob("__init__.py"):
+            where = init.parent.relative_to(ROOT)
+            if any(where.is_relative_to(u) for u in UNSHIPPED):
+                continue
+            parts = init.parent.relative_to(ROOT / folder).parts
+            found.add(".".join([package, *parts]))
+    return found
 
 
 def _declared(extra: str | None) -> list[str]:
-    requirements = list(PYPROJECT["project"]["dependencies"])
-    if extra:
-        requirements += PYPROJECT["project"]["optional-dependencies"][extra]
-    return [r for r in requirements if not r.startswith("jik")]
+    """The requirements of the plain install and of ``extra``, the project's own extras (a
+    requirement on itself, ``NAME[app]``) expanded."""
+    project = PYPROJECT["project"]
+    requirements = list(project["dependencies"])
+    extras = [extra] if extra else []
+    while extras:
+        for requirement in project["optional-dependencies"][extras.pop()]:
+            own = re.fullmatch(rf"{re.escape(project['name'])}\[([\w,-]+)\]", requirement)
+            if own:
+                extras += own[1].split(",")
+            else:
+                requirements.append(requirement)
+    return requirements
 
 
 def _runtime_distributions(extra: str | None) -> set[str]:
@@ -71,7 +99,10 @@ def _third_party_imports(folder: str) -> dict[str, str]:
     """Top-level modules imported by the code in ``folder`` -> a file that imports it (not the
     optional ones, see :func:`_optional`)."""
     found: dict[str, str] = {}
+    nested = [ROOT / other for other in EXTRA_OF if other != folder and other.startswith(folder)]
     for path in sorted((ROOT / folder).rglob("*.py")):
+        if any(path.is_relative_to(n) for n in nested):
+            continue  # (counted with its own folder's extra)
         tree = ast.parse(path.read_text(encoding="utf-8"))
         optional = _optional(tree)
         for node in ast.walk(tree):
@@ -90,13 +121,27 @@ def _third_party_imports(folder: str) -> dict[str, str]:
 
 
 def test_every_installed_folder_has_a_declared_extra():
-    assert _linked_folders() == set(EXTRA_OF)
+    assert set(SETUPTOOLS["package-dir"].values()) | UNSHIPPED == set(EXTRA_OF)
 
 
-def test_packages_are_discovered_not_listed():
-    """setuptools finds jik and every subpackage: a new one cannot be left out of the wheel."""
-    setuptools = PYPROJECT["tool"]["setuptools"]
-    assert setuptools["packages"]["find"]["include"] == ["jik", "jik.*"]
+def test_every_package_folder_is_in_the_wheel():
+    """Each folder with an __init__.py under engine/, app/, static/ and benchmarks/ is listed
+    in pyproject.toml's packages: a new subpackage cannot be left out of the wheel."""
+    missing = _packages_on_disk() - set(SETUPTOOLS["packages"])
+    assert not missing, f"add {sorted(missing)} to [tool.setuptools] packages in pyproject.toml"
+    assert set(SETUPTOOLS["packages"]) == _packages_on_disk()
+
+
+def test_the_source_tree_holds_no_symlinks():
+    """A checkout without symlinks (Windows' default, core.symlinks=false) writes a link as a
+    small text file: the package must not depend on one."""
+    try:
+        listed = subprocess.run(["git", "ls-files", "-s"], cwd=ROOT, capture_output=True,
+                                text=True, check=True).stdout  # fmt: skip
+    except (OSError, subprocess.CalledProcessError):
+        pytest.skip("not a git checkout")
+    links = [line.split("\t")[1] for line in listed.splitlines() if line.startswith("120000")]
+    assert not links, f"tracked symlinks: {links}"
 
 
 @pytest.mark.parametrize("folder", sorted(EXTRA_OF))
@@ -109,8 +154,31 @@ def test_shipped_code_imports_only_its_install_lines_dependencies(folder):
         for module, where in _third_party_imports(folder).items()
         if not {_name(d) for d in providers.get(module, [module])} & runtime
     }
-    line = "pip install jik" + (f"[{extra}]" if extra else "")
+    line = f"pip install {PYPROJECT['project']['name']}" + (f"[{extra}]" if extra else "")
     assert not missing, (
         f"imported by {folder}/ but not installed by `{line}`: {missing}; "
         "declare them in pyproject.toml (or move the import to the web parts)"
     )
+
+
+#: An install command in a message or a document: ``pip install [-e] 'NAME[extra]'`` or
+#: ``".[extra]"``.
+INSTALL_HINT = re.compile(r"""pip install (?:-\w+ )*['"]?([\w.-]+)\[([\w,-]+)\]""")
+
+
+def test_every_install_hint_names_this_distribution_and_its_extras():
+    """A hint that names another distribution installs another project: ``jik`` on the package
+    index is not this one."""
+    project = PYPROJECT["project"]
+    assert project["name"] != "jik", "jik on the package index is another project (0.0.2)"
+    files = [ROOT / "README.md", ROOT / "Dockerfile", *sorted((ROOT / "docs").glob("*.md"))]
+    for folder in EXTRA_OF:
+        files += sorted((ROOT / folder).rglob("*.py"))
+    wrong = []
+    for path in files:
+        for name, extras in INSTALL_HINT.findall(path.read_text(encoding="utf-8")):
+            if name not in (".", project["name"]) or not set(extras.split(",")) <= set(
+                project["optional-dependencies"]
+            ):
+                wrong.append(f"{path.relative_to(ROOT)}: {name}[{extras}]")
+    assert not wrong, wrong

@@ -23,12 +23,13 @@ websocket relay (docs/security.md has the threat model):
 from __future__ import annotations
 
 import json
-import os
 from collections.abc import Iterable
 from urllib.parse import urlsplit
 
 from starlette.routing import Match
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+from jik.app.compute.settings import Settings
 
 #: Host names allowed by default: the loopback names.
 LOOPBACK_HOSTS = ("localhost", "127.0.0.1", "[::1]", "::1")
@@ -53,10 +54,12 @@ _SCENE_POLICY = (
 _DOCS_POLICY = _SCENE_POLICY
 
 
-def allowed_hosts_from_env(extra: Iterable[str] = ()) -> tuple[str, ...]:
-    """The loopback names, ``JIK_ALLOWED_HOSTS`` (comma-separated) and ``extra``."""
-    env = [h.strip() for h in os.environ.get("JIK_ALLOWED_HOSTS", "").split(",") if h.strip()]
-    return (*LOOPBACK_HOSTS, *env, *extra)
+def allowed_hosts_from_env(
+    extra: Iterable[str] = (), settings: Settings | None = None
+) -> tuple[str, ...]:
+    """The loopback names, ``settings.allowed_hosts`` (``JIK_ALLOWED_HOSTS``, comma-separated)
+    and ``extra``."""
+    return (*LOOPBACK_HOSTS, *(settings or Settings()).host_names, *extra)
 
 
 def _host_name(host: str) -> str:

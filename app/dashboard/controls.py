@@ -83,6 +83,20 @@ class Control:
         return {k: v for k, v in out.items() if v not in (None, "", (), [], 0, False)}
 
 
+#: A user map's formula is shown on its button up to this many characters.
+MAP_LABEL_CHARS = 48
+
+
+def _map_label(aug) -> str:
+    """A map's button: its name and equation, or for a user's formula map its formula h (a
+    robot's default map is one: "formula: h = x3")."""
+    text = aug.description
+    if not text.startswith("h = "):
+        return f"{aug.name} {aug.equation}"
+    short = text if len(text) <= MAP_LABEL_CHARS else text[: MAP_LABEL_CHARS - 1] + "…"
+    return f"{aug.name}: {short}"
+
+
 def controls(state) -> list[Control]:
     """Every control of ``state`` (a :class:`~jik.app.dashboard.DashboardState`), in order."""
     spec = state_spec(state)
@@ -116,8 +130,8 @@ def controls(state) -> list[Control]:
                                id=f"ctl-preset-{v.name}-{name}"))  # fmt: skip
     out.append(Control("augmentation", "augmenting map h", "select", "algorithm",
                        SYMBOLS["h"] + "; one button per map of the paper for this robot",
-                       options=tuple((a.name, f"{a.name} {a.equation}")
-                                     for a in spec.augmentations), inline=True))  # fmt: skip
+                       options=tuple((a.name, _map_label(a)) for a in spec.augmentations),
+                       inline=True))  # fmt: skip
     for p in aug.parameters:
         out.append(Control(f"augmentation_parameters.{p.name}", p.name, "slider", "algorithm",
                            explained(p.name, p.description), minimum=p.minimum, maximum=p.maximum,

@@ -29,7 +29,7 @@ AXIS = dict(
     gridcolor="#e6e6e6", zerolinecolor="#b0b0b0", linecolor="#888", showline=True, mirror=True,
     ticks="outside", automargin=True,
     # plotly's default on linear axes, "hide past div", measures every tick label's box
-    # (a forced layout each) on every redraw: ~10 ms per panel here.
+    # (a forced layout each) on every redraw, milliseconds per panel.
     ticklabeloverflow="allow",
 )  # fmt: skip
 # A small explicit template: the named ones ("plotly_white") cost ~25 ms per figure to apply.
@@ -81,6 +81,20 @@ def theta_label(result: DashboardResult) -> str:
 
 def leg_names(n: int) -> list[str]:
     return [chr(ord("A") + i) if i < 26 else f"P{i + 1}" for i in range(n)]
+
+
+def corner_names(result: DashboardResult) -> list[str]:
+    """The letters of the task's corners (its targets, in order), as Table 1 names its rows: a
+    closed path that ends where it starts, at k(x0), has its start as A (Manipulator 2: A =
+    k(x0) = (0, 1), then B = (1, 1), C, D, and A again); any other task letters its targets
+    from A."""
+    targets = np.asarray(result.targets, dtype=float)
+    n = len(targets)
+    start = result.runs["pseudoinverse"].y[0]
+    if result.state.task == "path" and n > 1 and np.allclose(targets[-1], start, atol=1e-6):
+        names = leg_names(n)
+        return names[1:] + names[:1]
+    return leg_names(n)
 
 
 def trace(kind: str, **props) -> dict:

@@ -13,6 +13,7 @@ import numpy as np
 
 from jik.app.dashboard.controls import max_iterations
 from jik.app.dashboard.model import DashboardState
+from jik.app.dashboard.reach import stall_note
 from jik.app.dashboard.robots import state_inverse, state_kinematics
 from jik.engine.exceptions import RunCancelled
 from jik.engine.progress import ProgressCallbacks
@@ -127,6 +128,10 @@ def _run_legs(
             failure = f"{where} stopped: {leg.stopped_by}"
         elif not res.success:
             failure = f"{where}: {_leg_message(res, cap)}"
+            if res.message.startswith("stalled") and STALLED in res.message:
+                target = np.asarray(path, dtype=float)[leg.index]
+                note = stall_note(inverse, target, np.asarray(res.x, dtype=float))
+                failure = failure.replace(STALLED, note)
         else:
             last = _leg_message(res, cap)
         progress()
@@ -158,6 +163,10 @@ def _run_legs(
         message=failure or _legs_message(len(ends), drift, last),
         seconds=time.perf_counter() - t0,
     )
+
+
+#: The end of the engine's message for a stalled run, which :func:`stall_note` makes precise.
+STALLED = "the step size collapsed near a singularity or the target is unreachable"
 
 
 def _leg_message(res: SolveResult, cap: int) -> str:

@@ -15,6 +15,7 @@ from typing import Any, cast
 import numpy as np
 
 from jik.app.dashboard import ALGORITHMS, COLORS
+from jik.app.dashboard.plotting import corner_names
 from jik.app.scene.mechanisms import (
     HOME_COLOR,
     MECHANISMS,
@@ -141,7 +142,7 @@ class NodeSets:
                     k = int(name.rsplit("/", 1)[1])
                     scene.add_label(
                         f"{name}/label",
-                        chr(ord("A") + k) if k < 26 else str(k),
+                        corner_names(result)[k],
                         position=(0.05, 0.05, 0.05),
                     )
                 continue

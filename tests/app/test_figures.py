@@ -47,7 +47,7 @@ def test_task_space_paths_use_one_colour_per_algorithm(path_result):
     assert fig.layout.xaxis.title.text == "y1 [m]"
     assert fig.layout.yaxis.title.text == "y2 [m]"
     targets = next(t for t in fig.data if t.name == "targets")
-    assert list(targets.text) == ["A", "B", "C", "D"]
+    assert list(targets.text) == ["B", "C", "D", "A"]  # (Table 1: A = k(x0) = (0, 1))
     np.testing.assert_allclose(targets.x, [1, 1, 0, 0])
     # Both end-effector paths pass through every target (the solver's tol is 1e-10).
     for a, run in path_result.runs.items():
@@ -222,7 +222,7 @@ def test_unicycle_platform_paths_and_controls():
 
 
 def test_sensitivity_sweeps_each_parameter_through_the_current_value():
-    """Issue 5: E1, E2 at the current (a, b) of e2_optimal and how they change as a, b move."""
+    """E1, E2 at the current (a, b) of e2_optimal and how they change as a, b move."""
     result = compute(updated_state(default_state("manipulator1"), {"task": "target"}))
     functionals = error_functionals(result)
     sens = sensitivity(result, functionals)

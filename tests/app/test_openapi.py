@@ -1,4 +1,4 @@
-"""The OpenAPI document says exactly what the server takes and answers (issue 26, item 8): each
+"""The OpenAPI document says exactly what the server takes and answers: each
 robot's vector lengths, maps and variables; every error a check before the routes can answer;
 the methods of a path in a 405's Allow; JSON Schema's integers; a gamma the solver can use."""
 

@@ -1,6 +1,6 @@
 """A result's second phase (h on a grid when it is expensive, E1, E2 and their sensitivity): its
 progress, its cancellation (the result stays, nothing stale is shown as current) and running it
-again, in the dashboard and over HTTP (issue 28, point 5)."""
+again, in the dashboard and over HTTP."""
 
 from __future__ import annotations
 

@@ -215,7 +215,7 @@ def test_a_method_a_route_does_not_take_is_405_with_allow_not_415(client):
 
 
 def test_the_openapi_document_gives_the_event_stream_and_the_csv_their_types(client):
-    """(Both were documented as JSON, issue 26 item 8.)"""
+    """(Both were documented as JSON.)"""
     paths = client.get("/openapi.json").json()["paths"]
     events = paths["/api/sessions/{session_id}/events"]["get"]["responses"]
     assert list(events["200"]["content"]) == ["text/event-stream"] and "404" in events

@@ -1,4 +1,4 @@
-"""Dashboard sessions over HTTP: one per tab, isolated, bounded, expiring (issue 27)."""
+"""Dashboard sessions over HTTP: one per tab, isolated, bounded, expiring."""
 
 from __future__ import annotations
 
@@ -209,7 +209,7 @@ def test_the_scene_socket_refuses_other_origins_and_unknown_sessions(client):
 
 def test_a_listener_that_never_reads_holds_one_event_of_each_kind(app, client):
     """The event stream of a page that stops reading buffers the newest event of each kind, not
-    one per change (issue 26: ~0.45 MB per change, never released)."""
+    one per change (about 0.45 MB per change, never released)."""
     import asyncio
     import concurrent.futures
 
@@ -239,7 +239,7 @@ def test_a_listener_that_never_reads_holds_one_event_of_each_kind(app, client):
 
 
 def test_an_export_after_a_failure_is_409_never_the_previous_result(app, client, monkeypatch):
-    """Issue 28, point 6: the export said nothing of a newer generation that failed and returned
+    """The export said nothing of a newer generation that failed and returned
     the previous result as if it were the current state's."""
     import jik.app.dashboard.session as session
     from jik.engine.exceptions import JikError

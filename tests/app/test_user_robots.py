@@ -1,4 +1,4 @@
-"""User robots through REST (issue 29): a planar chain, a formula robot and a URDF arm in
+"""User robots through REST: a planar chain, a formula robot and a URDF arm in
 /solve, /repeatability and /synthesize, and the refusals of bad or hostile definitions."""
 
 from __future__ import annotations

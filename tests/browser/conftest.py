@@ -129,8 +129,11 @@ def server(chromium, tmp_path_factory):
 
 @pytest.fixture(scope="session")
 def browser(chromium):
-    from playwright.sync_api import sync_playwright
+    from playwright.sync_api import expect, sync_playwright
 
+    # expect()'s assertions have a timeout of their own (5 s), which set_default_timeout does
+    # not change: on a loaded machine they need the pages' TIMEOUT too.
+    expect.set_options(timeout=TIMEOUT)
     with sync_playwright() as p:
         browser = p.chromium.launch(executable_path=chromium, args=ARGS)
         yield browser

@@ -1,4 +1,4 @@
-"""The API's documentation works offline (issue 25): Swagger UI at /docs renders from the
+"""The API's documentation works offline: Swagger UI at /docs renders from the
 server's own files, and no request leaves 127.0.0.1."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Sessions in the browser (issue 27): every tab has its own state, and a copied link opens a new
+"""Sessions in the browser: every tab has its own state, and a copied link opens a new
 session with the same state and the same numbers."""
 
 from __future__ import annotations

@@ -269,3 +269,32 @@ def test_what_the_batch_callback_raises_stops_the_evaluation(hmap):
     with pytest.raises(RunCancelled, match="after batch 3 of 4"):
         hmap.evaluate_batches(points(20, seed=4), 5, cancel)
     assert calls == [1, 2, 3]
+
+
+def test_a_large_batch_is_solved_in_bounded_memory(kin, monkeypatch):
+    """More than MAX_MEMBERS points are solved MAX_MEMBERS at a time: the peak memory of 4x the
+    points is that of one part (the refined collocation systems grow with the batch), and the
+    results are those of one batch of all (each member's Newton solve is its own)."""
+    import tracemalloc
+
+    from jik.engine import characteristics
+
+    monkeypatch.setattr(characteristics, "MAX_MEMBERS", 50)
+    x = points(200, seed=5, spread=1.5)
+
+    def peak(n: int) -> int:
+        tracemalloc.start()
+        UnicycleCharacteristics(kin, a=1.0, on_undefined="nan").evaluate(x[:n])
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        return peak
+
+    assert peak(200) < 1.5 * peak(50)
+    parts = UnicycleCharacteristics(kin, a=1.0, on_undefined="nan").evaluate(x)
+    monkeypatch.setattr(characteristics, "MAX_MEMBERS", 1000)
+    whole = UnicycleCharacteristics(kin, a=1.0, on_undefined="nan").evaluate(x)
+    assert np.array_equal(whole[2], parts[2])
+    ok = ~whole[2]
+    assert ok.sum() >= 50 and (~ok).sum() >= 10
+    assert np.max(np.abs(whole[0][ok] - parts[0][ok])) < 1e-10
+    assert np.max(np.abs(whole[1][ok] - parts[1][ok])) < 1e-8

@@ -9,6 +9,7 @@ from jik.engine.exceptions import InvalidInputError, RunCancelled
 from jik.engine.functionals import error_functional_e2
 from jik.engine.kinematics import Kinematics, Manipulator2
 from jik.engine.planar_chain import PlanarChain
+from jik.engine.progress import ProgressCallbacks
 from jik.engine.synthesis_nd import kernel_frame, synthesize_e2_nd
 from jik.engine.total_degree import basis_size, total_degree_indices
 from jik.engine.variational import MANIPULATOR2_REGION, synthesize_e2
@@ -165,13 +166,11 @@ def test_bad_input_names_its_field():
 
 def test_cancel_stops_between_chunks():
     calls = []
+    progress = ProgressCallbacks(
+        on_advance=lambda done, total: calls.append(done), is_cancelled=lambda: len(calls) >= 2
+    )
     with pytest.raises(RunCancelled):
         synthesize_e2_nd(
-            Manipulator2(1.0),
-            MANIPULATOR2_REGION,
-            degree=6,
-            nodes=2**13,
-            progress=calls.append,
-            cancelled=lambda: len(calls) >= 2,
+            Manipulator2(1.0), MANIPULATOR2_REGION, degree=6, nodes=2**13, progress=progress
         )
     assert len(calls) == 2

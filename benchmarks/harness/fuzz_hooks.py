@@ -49,7 +49,9 @@ try:  # (schemathesis loads this module, and brings hypothesis)
     import schemathesis
     from hypothesis import strategies as st
 except ImportError as exc:
-    raise ImportError(f"{exc}: jik bench fuzz needs pip install 'jik[test]'") from exc
+    raise ImportError(
+        f"{exc}: jik bench fuzz needs the test extra, pip install -e '.[test]'"
+    ) from exc
 
 from jik.app.compute import schemas as S
 from jik.app.compute.atlas_jobs import AtlasLimits, plan_request
@@ -210,7 +212,7 @@ def _positive_case_ok(case) -> bool:
     return True
 
 
-#: The server under test (:func:`jik.benchmarks.bench_fuzz.run_fuzz` names it).
+#: The server under test (:func:`jik.benchmarks.harness.bench_fuzz.run_fuzz` names it).
 SERVER = os.environ.get("JIK_FUZZ_SERVER", "")
 
 

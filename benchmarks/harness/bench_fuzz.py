@@ -1,9 +1,9 @@
 """``jik bench fuzz``: schemathesis against a running ``jik serve``, every check, positive and
-negative data (issue 26).
+negative data.
 
-:func:`run_fuzz` starts the server on a free loopback port, runs the schemathesis command with
-:mod:`jik.benchmarks.fuzz_hooks` (what the OpenAPI document cannot say) and reads its summary:
-cases generated, failures, and whether the server logged a traceback. The CI test
+:func:`run_fuzz` starts the server on a free loopback port, runs the schemathesis command
+with :mod:`jik.benchmarks.harness.fuzz_hooks` (what the OpenAPI document cannot say) and reads
+its summary: cases generated, failures, and whether the server logged a traceback. The CI test
 (tests/app/test_fuzz.py) runs it with ~2,000 cases; this benchmark with 10,000 and more.
 """
 
@@ -18,15 +18,10 @@ import tempfile
 import time
 from dataclasses import dataclass
 
-import jik
 from jik.benchmarks.serving import jik_serve
 
-#: Where ``jik`` is imported from (the source tree, or site-packages): the hooks are found there
-#: from the scratch directory schemathesis runs in.
-_PACKAGE_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(jik.__file__)))
-
-#: The phases run with every check. Not the stateful phase: on this document schemathesis
-#: 4.32.5's grew past 23 GB of memory within 90 s (30 examples; the machine has 24 GB). Not the
+#: The phases run with every check. Not the stateful phase: on this document schemathesis's
+#: grows past the memory of a developer's machine within a minute and a half. Not the
 #: coverage phase with positive_data_acceptance: its boundary cases bypass the hooks
 #: (:func:`main` runs it with every other check).
 PHASES = "examples,fuzzing"
@@ -56,8 +51,13 @@ def run_fuzz(
     timeout: float = 1500.0,
     phases: str = PHASES,
     exclude_checks: str = "",
+    deterministic: bool = False,
 ) -> FuzzRun:
-    """schemathesis with ``max_examples`` per operation and phase against a fresh server."""
+    """schemathesis with ``max_examples`` per operation and phase against a fresh server.
+
+    ``deterministic``: the same cases on every run (hypothesis derandomized, ``seed`` unused):
+    the test suite's regression check. Otherwise a random search from ``seed``.
+    """
     # A request waits at most JIK_TIMEOUT for a worker and as long again to compute, an export
     # at most a minute for its session's result: all within schemathesis's request timeout.
     with jik_serve(JIK_WORKERS="2", JIK_TIMEOUT="20", JIK_SESSION_IDLE_SECONDS="30") as server:
@@ -71,12 +71,11 @@ def run_fuzz(
              f"{server.url}/openapi.json",
              "--checks", "all", "--phases", phases, "--max-examples", str(max_examples),
              *(["--exclude-checks", exclude_checks] if exclude_checks else []),
-             "--seed", str(seed), "--workers", "1", "--suppress-health-check", "all",
+             *(["--generation-deterministic"] if deterministic else ["--seed", str(seed)]),
+             "--workers", "1", "--suppress-health-check", "all",
              "--continue-on-failure", "--request-timeout", "120", "--no-color"],
-            env=dict(os.environ, SCHEMATHESIS_HOOKS="jik.benchmarks.fuzz_hooks",
-                     JIK_FUZZ_SERVER=server.url,
-                     PYTHONPATH=os.pathsep.join(filter(None, (_PACKAGE_ROOT,
-                                                              os.environ.get("PYTHONPATH"))))),
+            env=dict(os.environ, SCHEMATHESIS_HOOKS="jik.benchmarks.harness.fuzz_hooks",
+                     JIK_FUZZ_SERVER=server.url),
             capture_output=True, text=True, timeout=timeout, cwd=scratch,
         )  # fmt: skip
         seconds = time.perf_counter() - started
@@ -104,7 +103,7 @@ def _report(title: str, run: FuzzRun) -> None:
 
 def main(quick: bool = False) -> None:
     if importlib.util.find_spec("schemathesis") is None:
-        print("jik bench fuzz needs schemathesis: pip install 'jik[test]'")
+        print("jik bench fuzz needs schemathesis, of the test extra: pip install -e '.[test]'")
         return
     examples = 20 if quick else 850
     _report(f"schemathesis, every check, phases {PHASES}, {examples} examples per operation",

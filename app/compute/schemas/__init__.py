@@ -1,0 +1,143 @@
+"""Request and response models of the REST API (JSON, snake_case), one module per job.
+
+- :mod:`.fields`: the shared field types and size limits;
+- :mod:`.robots`: the robots and augmenting maps (generated from the engine's catalogue, and the
+  robots a user defines), as requests name them and responses echo them;
+- :mod:`.variants`: a request model made exact for each robot (what a route takes);
+- :mod:`.runs`: ``/solve`` and ``/repeatability``; :mod:`.synthesis`: ``/synthesize``;
+- :mod:`.info`: ``/robots``, ``/health`` and the error body.
+
+Everything is re-exported here: ``from jik.app.compute import schemas as S``.
+"""
+
+from jik.app.compute.schemas.algorithms import AlgorithmParameters
+from jik.app.compute.schemas.fields import (
+    COORDINATE_BOUND,
+    GAMMA_MIN,
+    INTEGRAL,
+    MAX_DIMENSION,
+    MAX_ITERATIONS,
+    MAX_TRAJECTORY_POINTS,
+    Algorithm,
+    Bound,
+    Coordinate,
+    FiniteFloat,
+    Gamma,
+    MaybeFloat,
+    Mode,
+    Tolerance,
+    Vector,
+)
+from jik.app.compute.schemas.info import (
+    BUSY,
+    AlgorithmInfo,
+    AugmentationInfo,
+    ErrorResponse,
+    HealthResponse,
+    Limits,
+    ParameterInfo,
+    RobotInfo,
+    RobotsResponse,
+)
+from jik.app.compute.schemas.robots import (
+    AUGMENTATION_MODELS,
+    MAX_FORMULA_CHARS,
+    MAX_URDF_CHARS,
+    ROBOT_MODELS,
+    ROBOT_NAMES,
+    USER_AUGMENTATION_MODELS,
+    USER_ROBOT_MODELS,
+    AnyAugmentation,
+    AnyRobot,
+    Augmentation,
+    AugmentationUsed,
+    E2SynthesisAugmentation,
+    FormulaMapAugmentation,
+    FormulaRobot,
+    PlanarChainRobot,
+    Robot,
+    RobotUsed,
+    UrdfRobot,
+    UserAugmentation,
+)
+from jik.app.compute.schemas.runs import (
+    RepeatabilityBody,
+    RepeatabilityRequest,
+    RepeatabilityResponse,
+    SolveBody,
+    SolveRequest,
+    SolveResponse,
+    Trajectory,
+)
+from jik.app.compute.schemas.synthesis import (
+    FunctionalInfo,
+    SynthesisGrid,
+    SynthesisMethod,
+    SynthesisMethodsResponse,
+    SynthesizeBody,
+    SynthesizeRequest,
+    SynthesizeResponse,
+)
+from jik.app.compute.schemas.variants import per_robot
+
+__all__ = [
+    "AUGMENTATION_MODELS",
+    "BUSY",
+    "COORDINATE_BOUND",
+    "GAMMA_MIN",
+    "INTEGRAL",
+    "MAX_DIMENSION",
+    "MAX_FORMULA_CHARS",
+    "MAX_ITERATIONS",
+    "MAX_TRAJECTORY_POINTS",
+    "MAX_URDF_CHARS",
+    "ROBOT_MODELS",
+    "ROBOT_NAMES",
+    "USER_AUGMENTATION_MODELS",
+    "USER_ROBOT_MODELS",
+    "Algorithm",
+    "AlgorithmInfo",
+    "AlgorithmParameters",
+    "AnyAugmentation",
+    "AnyRobot",
+    "Augmentation",
+    "AugmentationInfo",
+    "AugmentationUsed",
+    "Bound",
+    "Coordinate",
+    "E2SynthesisAugmentation",
+    "ErrorResponse",
+    "FiniteFloat",
+    "FormulaMapAugmentation",
+    "FormulaRobot",
+    "FunctionalInfo",
+    "Gamma",
+    "HealthResponse",
+    "Limits",
+    "MaybeFloat",
+    "Mode",
+    "ParameterInfo",
+    "PlanarChainRobot",
+    "RepeatabilityBody",
+    "RepeatabilityRequest",
+    "RepeatabilityResponse",
+    "Robot",
+    "RobotInfo",
+    "RobotUsed",
+    "RobotsResponse",
+    "SolveBody",
+    "SolveRequest",
+    "SolveResponse",
+    "SynthesisGrid",
+    "SynthesisMethod",
+    "SynthesisMethodsResponse",
+    "SynthesizeBody",
+    "SynthesizeRequest",
+    "SynthesizeResponse",
+    "Tolerance",
+    "Trajectory",
+    "UrdfRobot",
+    "UserAugmentation",
+    "Vector",
+    "per_robot",
+]
