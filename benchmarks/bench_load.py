@@ -160,13 +160,11 @@ async def _load(url: str, duration: float, clients: int, path: str = "/solve") -
 
 async def _pool_load(duration: float, clients: int, batching: bool) -> dict:
     """The same load on the compute pool in-process: the computation path without HTTP."""
-    import dataclasses
-
     from jik.app.compute.pool import ComputePool
     from jik.app.compute.schemas import SolveRequest
     from jik.app.compute.settings import settings_from_env
 
-    pool = ComputePool(dataclasses.replace(settings_from_env(), batching=batching))
+    pool = ComputePool(settings_from_env().model_copy(update={"batching": batching}))
     try:
         await pool.warm_up()
         lat: list[float] = []

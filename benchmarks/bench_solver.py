@@ -19,7 +19,6 @@ from __future__ import annotations
 import math
 import statistics
 import time
-from typing import cast
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -28,7 +27,7 @@ from jik.engine.augmentations import PaperCubic
 from jik.engine.inverses import ExtendedInverse, Pseudoinverse
 from jik.engine.kinematics import Manipulator2
 from jik.engine.repeatability import closed_path, repeatability
-from jik.engine.solver import ATOL, RTOL, SolveResult, chain_guesses, solve
+from jik.engine.solver import ATOL, RTOL, chain_guesses, solve
 
 X0 = np.array([0.0, 0.0, math.pi / 2])
 PATH = np.array([(1.0, 1.0), (1.0, 2.0), (0.0, 2.0), (0.0, 1.0)])
@@ -70,7 +69,7 @@ def cycles_leg_by_leg(inverse, x0, cycles: int, guessed: bool, chained: bool = F
         chain = chain_guesses(inverse, cur, targets) if chained else None
         for j, y in enumerate(targets):
             guess = chain[j] if chain is not None else guides[j] if guessed else None
-            res = cast(SolveResult, solve(inverse, cur, y, guess=guess))
+            res = solve(inverse, cur, y, guess=guess)
             guides[j], cur = res.trajectory, res.x
             ends.append(cur)
             sweeps += res.nit

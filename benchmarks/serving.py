@@ -25,10 +25,12 @@ def free_port() -> int:
 
 @dataclass
 class Served:
-    """A running ``jik serve``: its port and base URL; ``log`` is filled when it has stopped."""
+    """A running ``jik serve``: its port, base URL and process; ``log`` is filled when it has
+    stopped."""
 
     port: int
     url: str
+    process: subprocess.Popen
     log: list[str] = field(default_factory=list)
 
 
@@ -45,7 +47,7 @@ def jik_serve(**env: str) -> Iterator[Served]:
         [sys.executable, "-m", "jik", "serve", f"--port={port}"],
         env={**os.environ, **env}, stdout=out, stderr=subprocess.STDOUT, text=True,
     )  # fmt: skip
-    served = Served(port, f"http://127.0.0.1:{port}")
+    served = Served(port, f"http://127.0.0.1:{port}", proc)
     try:
         deadline = time.monotonic() + 60
         while True:

@@ -1,0 +1,247 @@
+"""jik's engine: repeatable Jacobian inverse kinematics (Tchoń, Karpińska, Janiak, 2009).
+
+One import gives the whole library; each name is loaded from its module when first used, so
+``import jik.engine`` itself costs nothing (numpy, scipy and sympy come with what needs them,
+yourdfpy only with a URDF robot).
+
+>>> import numpy as np
+>>> import jik.engine as jik
+>>> arm = jik.Manipulator2()
+>>> x0, path = [0, 0, np.pi / 2], [(1, 1), (1, 2), (0, 2)]
+>>> pinv = jik.repeatability(jik.Pseudoinverse(arm), x0, path, cycles=3)
+>>> ext = jik.repeatability(jik.ExtendedInverse(arm, jik.PaperCubic()), x0, path, cycles=3)
+>>> print(pinv.drift.round(3), ext.drift.max() < 1e-9)  # the drift after each cycle
+[0.461 0.88  1.254] True
+
+Robots (kinematics k: R^p -> R^r, eq. (4))
+    Manipulator1, Manipulator2  the paper's manipulators, eqs. (30) and (37)
+    Unicycle                    the unicycle with a Fourier control, eqs. (40)-(42)
+    PlanarChain                 a planar chain of revolute and prismatic joints
+    FormulaKinematics           a robot given by formulas (parsed, never eval'd)
+    UrdfChain                   a serial arm from URDF text (needs yourdfpy)
+    robot_from_dict, load_robot a robot and its maps from a dict, a JSON/YAML file or a name
+    Robot, Kinematics, ROBOTS   a built robot; the base class; the built-in catalogue
+Augmenting maps h (eq. (9))
+    PaperCubic                  the paper's cubic (38) for Manipulator 2
+    E1Optimal, E2Optimal        Manipulator 1's optimal maps, eqs. (32) and (36)
+    FormulaMap                  h given by a formula
+    CharacteristicsMap, UnicycleCharacteristics  h by the method of characteristics (sec. 4)
+    AugmentingMap               the base class
+Inverses (right inverses of the Jacobian)
+    Pseudoinverse               J# = J^T (J J^T)^-1, eq. (8): fast, not repeatable
+    ExtendedInverse             the extended Jacobian inverse, eq. (11): repeatable
+    VectorExtendedInverse       the same for p - r > 1, with p - r maps
+    Inverse, make_inverse       the base class; an inverse by name from the catalogue
+Solving (the continuation algorithm, eq. (7))
+    solve                       one start to one target -> SolveResult
+    solve_batch                 many starts or targets at once -> BatchSolveResult
+    Trajectory                  a run point by point
+Repeatability (sec. 5.2.1, Table 1)
+    repeatability               drive a closed path cycle after cycle -> RepeatabilityResult
+    Resume, Leg                 go on from an earlier run; a leg as a progress sees it
+    Progress, ProgressCallbacks what a long computation reports, and how to cancel it
+Functionals and synthesis (secs. 3-4)
+    error_functional_e1, error_functional_e2  E1, eq. (14), and E2, eq. (19), on a region
+    synthesize_e2               the E2-optimal h by a Ritz method, eq. (20) -> SynthesisResult
+    synthesize_e2_nd            E2-optimal h of all joints, p - r >= 1 -> TotalDegreeSynthesis
+The atlas (drift over many starts and paths)
+    plan_atlas, run_atlas       plan and run an atlas (here, in processes or on Dask)
+    iter_atlas                  the same, chunk by chunk, in bounded memory
+    AtlasPlan, AtlasResult      the plan and the gathered result
+Errors (jik.engine.exceptions)
+    JikError, InvalidInputError, SingularConfigurationError, KinematicSingularityError,
+    AlgorithmicSingularityError, OneFormUndefinedError, RunCancelled
+
+Every numeric function takes a leading batch axis; results print on one line and export their
+numbers (``as_dict()``, ``columns()``, ``to_dataframe()`` with pandas).
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+import types
+from typing import TYPE_CHECKING, Any
+
+# Each public name and the module (under jik.engine) that defines it.
+_EXPORTS = {
+    # robots
+    "Kinematics": "kinematics",
+    "Manipulator1": "kinematics",
+    "Manipulator2": "kinematics",
+    "Unicycle": "unicycle",
+    "PlanarChain": "planar_chain",
+    "FormulaKinematics": "formula_kinematics",
+    "UrdfChain": "urdf",
+    "Robot": "robot_spec",
+    "robot_from_dict": "robot_spec",
+    "load_robot": "robot_spec",
+    "ROBOTS": "registry",
+    # augmenting maps
+    "AugmentingMap": "augmentations",
+    "PaperCubic": "augmentations",
+    "E1Optimal": "augmentations",
+    "E2Optimal": "augmentations",
+    "FormulaMap": "formula_kinematics",
+    "CharacteristicsMap": "characteristics",
+    "UnicycleCharacteristics": "characteristics",
+    # inverses
+    "Inverse": "inverses",
+    "Pseudoinverse": "inverses",
+    "ExtendedInverse": "inverses",
+    "VectorExtendedInverse": "extended_vector",
+    "make_inverse": "registry",
+    # solving
+    "solve": "solver",
+    "solve_batch": "solver",
+    "SolveResult": "results",
+    "BatchSolveResult": "results",
+    "Trajectory": "results",
+    # repeatability
+    "repeatability": "repeatability",
+    "RepeatabilityResult": "results",
+    "Resume": "repeatability",
+    "Leg": "repeatability",
+    "Progress": "progress",
+    "ProgressCallbacks": "progress",
+    # functionals and synthesis
+    "error_functional_e1": "functionals",
+    "error_functional_e2": "functionals",
+    "synthesize_e2": "variational",
+    "synthesize_e2_nd": "synthesis_nd",
+    "TotalDegreeSynthesis": "synthesis_nd",
+    "SynthesisResult": "variational",
+    # the atlas
+    "plan_atlas": "atlas",
+    "AtlasPlan": "atlas",
+    "run_atlas": "atlas_run",
+    "iter_atlas": "atlas_run",
+    "AtlasResult": "atlas_run",
+    # errors
+    "JikError": "exceptions",
+    "InvalidInputError": "exceptions",
+    "SingularConfigurationError": "exceptions",
+    "KinematicSingularityError": "exceptions",
+    "AlgorithmicSingularityError": "exceptions",
+    "OneFormUndefinedError": "exceptions",
+    "RunCancelled": "exceptions",
+}
+
+__all__ = [
+    "ROBOTS",
+    "AlgorithmicSingularityError",
+    "AtlasPlan",
+    "AtlasResult",
+    "AugmentingMap",
+    "BatchSolveResult",
+    "CharacteristicsMap",
+    "E1Optimal",
+    "E2Optimal",
+    "ExtendedInverse",
+    "FormulaKinematics",
+    "FormulaMap",
+    "InvalidInputError",
+    "Inverse",
+    "JikError",
+    "KinematicSingularityError",
+    "Kinematics",
+    "Leg",
+    "Manipulator1",
+    "Manipulator2",
+    "OneFormUndefinedError",
+    "PaperCubic",
+    "PlanarChain",
+    "Progress",
+    "ProgressCallbacks",
+    "Pseudoinverse",
+    "RepeatabilityResult",
+    "Resume",
+    "Robot",
+    "RunCancelled",
+    "SingularConfigurationError",
+    "SolveResult",
+    "SynthesisResult",
+    "TotalDegreeSynthesis",
+    "Trajectory",
+    "Unicycle",
+    "UnicycleCharacteristics",
+    "UrdfChain",
+    "VectorExtendedInverse",
+    "error_functional_e1",
+    "error_functional_e2",
+    "iter_atlas",
+    "load_robot",
+    "make_inverse",
+    "plan_atlas",
+    "repeatability",
+    "robot_from_dict",
+    "run_atlas",
+    "solve",
+    "solve_batch",
+    "synthesize_e2",
+    "synthesize_e2_nd",
+]  # (the keys of _EXPORTS, written out for tools that read __all__ without running it)
+
+
+def __getattr__(name: str) -> Any:
+    """Load a public name from its module on first use (PEP 562), then keep it here."""
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'jik.engine' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"jik.engine.{module}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
+
+
+class _Engine(types.ModuleType):
+    """The package, whose attribute ``repeatability`` stays the function of that name.
+
+    Importing a submodule sets it as an attribute of its package; the submodule
+    ``jik.engine.repeatability`` would then hide the function ``repeatability`` (eagerly
+    imported front doors such as pink's and mink's have the function win by importing it last;
+    here it wins whenever the submodule is first imported, so imports stay lazy).
+    """
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if isinstance(value, types.ModuleType) and _EXPORTS.get(name) == name:
+            value = getattr(value, name)
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Engine
+
+
+if TYPE_CHECKING:  # what the names are, for type checkers and editors (no import at run time)
+    from jik.engine.atlas import AtlasPlan, plan_atlas
+    from jik.engine.atlas_run import AtlasResult, iter_atlas, run_atlas
+    from jik.engine.augmentations import AugmentingMap, E1Optimal, E2Optimal, PaperCubic
+    from jik.engine.characteristics import CharacteristicsMap, UnicycleCharacteristics
+    from jik.engine.exceptions import (
+        AlgorithmicSingularityError,
+        InvalidInputError,
+        JikError,
+        KinematicSingularityError,
+        OneFormUndefinedError,
+        RunCancelled,
+        SingularConfigurationError,
+    )
+    from jik.engine.extended_vector import VectorExtendedInverse
+    from jik.engine.formula_kinematics import FormulaKinematics, FormulaMap
+    from jik.engine.functionals import error_functional_e1, error_functional_e2
+    from jik.engine.inverses import ExtendedInverse, Inverse, Pseudoinverse
+    from jik.engine.kinematics import Kinematics, Manipulator1, Manipulator2
+    from jik.engine.planar_chain import PlanarChain
+    from jik.engine.progress import Progress, ProgressCallbacks
+    from jik.engine.registry import ROBOTS, make_inverse
+    from jik.engine.repeatability import Leg, Resume, repeatability
+    from jik.engine.results import BatchSolveResult, RepeatabilityResult, SolveResult, Trajectory
+    from jik.engine.robot_spec import Robot, load_robot, robot_from_dict
+    from jik.engine.solver import solve, solve_batch
+    from jik.engine.synthesis_nd import TotalDegreeSynthesis, synthesize_e2_nd
+    from jik.engine.unicycle import Unicycle
+    from jik.engine.urdf import UrdfChain
+    from jik.engine.variational import SynthesisResult, synthesize_e2

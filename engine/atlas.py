@@ -28,7 +28,7 @@ from jik.engine.exceptions import InvalidInputError, SingularConfigurationError
 from jik.engine.inverses import Inverse, Pseudoinverse
 from jik.engine.repeatability import CLOSE_TOL, MAX_CYCLES, MAX_PATH_POINTS
 from jik.engine.self_motion import SelfMotionManifold, project, trace
-from jik.engine.solver import BatchSolveResult, solve
+from jik.engine.solver import MAX_ITERATIONS_LIMIT, MODES, check_gamma, solve_batch
 from jik.engine.validation import FloatArray, as_points, count, positive
 
 #: Largest number of starts per path, of paths in a family, and of starts in a chunk.
@@ -77,6 +77,13 @@ class AtlasPlan:
     explicit: FloatArray | None
     chunk: int
     settings: dict = field(default_factory=dict)
+
+    def __repr__(self) -> str:
+        return (
+            f"AtlasPlan({'/'.join(self.algorithms)}, {len(self.paths)} paths x {self.n_starts} "
+            f"starts x {self.cycles} cycles of {self.legs} legs, {self.size} runs in chunks of "
+            f"{self.chunk})"
+        )
 
     @property
     def size(self) -> int:
@@ -223,18 +230,17 @@ def plan_atlas(
         )
     cycles = _checked(lambda: count(cycles, "cycles", 1, MAX_CYCLES), "cycles")
     chunk = _checked(lambda: count(chunk, "chunk", 1, MAX_CHUNK), "chunk")
+    if mode not in MODES:
+        raise InvalidInputError(f"mode must be 'continuous' or 'discrete', got {mode!r}", "mode")
     settings = {
-        "gamma": _checked(lambda: positive(gamma, "gamma"), "gamma"),
+        "gamma": _checked(lambda: check_gamma(gamma, mode), "gamma"),
         "mode": mode,
         "tol": _checked(lambda: positive(tol, "tol"), "tol"),
         "max_iterations": None if max_iterations is None else _checked(
-            lambda: count(max_iterations, "max_iterations", 1, 10**6), "max_iterations"
+            lambda: count(max_iterations, "max_iterations", 1, MAX_ITERATIONS_LIMIT),
+            "max_iterations",
         ),
     }  # fmt: skip
-    if mode not in ("continuous", "discrete"):
-        raise InvalidInputError(f"mode must be 'continuous' or 'discrete', got {mode!r}", "mode")
-    if mode == "discrete" and settings["gamma"] >= 2:
-        raise InvalidInputError("gamma must be < 2 in discrete mode", field="gamma")
     shift = np.zeros((1, kin.r)) if shifts is None else _checked(
         lambda: as_points(shifts, kin.r, "shifts"), "shifts")  # fmt: skip
     scale = np.ones(1) if scales is None else _checked(
@@ -291,13 +297,12 @@ def _manifolds(kin, paths, reference, arc, box) -> tuple[SelfMotionManifold, ...
     """Each path's self-motion curve over one arc: the base path's, cut by ``box``."""
     y0 = paths[:, 0]
     try:
-        res = solve(
+        res = solve_batch(
             Pseudoinverse(kin), np.broadcast_to(reference, (len(y0), kin.p)), y0, tol=1e-12,
             record=False,
         )  # fmt: skip
     except SingularConfigurationError as error:
         raise InvalidInputError(str(error), field="reference") from None
-    assert isinstance(res, BatchSolveResult)
     if not np.all(res.success):
         j = int(np.argmin(res.success))
         raise InvalidInputError(

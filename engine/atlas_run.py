@@ -10,16 +10,18 @@ them into one :class:`AtlasResult`.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
 
 from jik.engine.atlas import AtlasPlan
 from jik.engine.atlas_backends import Backend, backend_for
-from jik.engine.exceptions import RunCancelled, SingularConfigurationError
+from jik.engine.exceptions import SingularConfigurationError
 from jik.engine.inverses import Inverse
+from jik.engine.progress import Progress, check_cancelled
 from jik.engine.repeatability import repeatability
+from jik.engine.results import dataframe
 from jik.engine.validation import FloatArray
 
 #: Starts per batched repeatability() call within a chunk: the working set of the Picard sweeps
@@ -141,11 +143,43 @@ class AtlasResult:
     success: FloatArray
     failures: dict[tuple[int, int, int], str]
 
+    def __repr__(self) -> str:
+        _, P, N, cycles = self.drift.shape
+        last = self.drift[..., -1]
+        worst = np.max(np.where(np.isfinite(last), last, -np.inf), axis=(1, 2))
+        drifts = ", ".join(
+            f"{a} {w:.3g}" for a, w in zip(self.algorithms, worst, strict=True) if np.isfinite(w)
+        )  # fmt: skip
+        drifts = f", largest drift after the last cycle: {drifts}" if drifts else ""
+        return (
+            f"AtlasResult({'/'.join(self.algorithms)}, {P} paths x {N} starts x {cycles} cycles, "
+            f"{int(np.count_nonzero(self.success))} of {self.success.size} runs completed"
+            f"{drifts})"
+        )
+
+    def columns(self) -> dict[str, FloatArray]:
+        """One array per column, a row per algorithm, path, start and cycle (long format):
+        ``algorithm``, ``path``, ``start``, ``s`` (arc length, NaN for given starts),
+        ``cycle`` (from 1), ``drift``, ``success`` (the run's), and the start ``x1``..``xp``."""
+        A, P, N, C = self.drift.shape
+        a, j, i, c = (g.ravel() for g in np.indices((A, P, N, C)))
+        s = np.full(N, np.nan) if self.parameter is None else np.asarray(self.parameter)
+        out = {
+            "algorithm": np.asarray(self.algorithms)[a], "path": j, "start": i, "s": s[i],
+            "cycle": c + 1, "drift": self.drift.ravel(), "success": self.success[a, j, i],
+        }  # fmt: skip
+        starts = self.starts[j, i]
+        return out | {f"x{k + 1}": starts[:, k] for k in range(starts.shape[1])}
+
+    def to_dataframe(self):
+        """The atlas as a pandas DataFrame in long format (:meth:`columns`)."""
+        return dataframe(self.columns())
+
 
 def iter_atlas(
     plan: AtlasPlan,
     backend: str | Backend | None = None,
-    cancelled: Callable[[], bool] | None = None,
+    progress: Progress | None = None,
 ) -> Iterator[tuple[ChunkTask, AtlasChunk]]:
     """The atlas's chunks, each with its task, in the order they finish.
 
@@ -155,7 +189,8 @@ def iter_atlas(
     Raises
     ------
     RunCancelled
-        ``cancelled()`` returned True (polled after every chunk); work not yet done is dropped.
+        ``progress.cancelled()`` returned True (polled after every chunk); work not yet done is
+        dropped.
     """
     tasks = (chunk_task(plan, lo, min(lo + plan.chunk, plan.size))
              for lo in range(0, plan.size, plan.chunk))  # fmt: skip
@@ -169,16 +204,14 @@ def iter_atlas(
     with backend_for(backend) as runner:
         for chunk in runner.imap_unordered(run_chunk, kept(tasks)):
             yield by_lo.pop(chunk.lo), chunk
-            if cancelled is not None and cancelled():
-                raise RunCancelled(f"atlas cancelled after run {chunk.hi} of {plan.size}")
+            check_cancelled(progress, f"atlas cancelled after run {chunk.hi} of {plan.size}")
 
 
 def run_atlas(
     plan: AtlasPlan,
     backend: str | Backend | None = None,
     *,
-    on_progress: Callable[[int, int], None] | None = None,
-    cancelled: Callable[[], bool] | None = None,
+    progress: Progress | None = None,
     keep_leg_ends: bool = True,
 ) -> AtlasResult:
     """Run an atlas and gather it (memory: the result's arrays and a few chunks).
@@ -191,10 +224,9 @@ def run_atlas(
         Where chunks run: None or "inprocess" (here), "processes:N" (a local process pool),
         "dask:ADDRESS" or "dask:local:N" (a Dask cluster); see
         :func:`jik.engine.atlas_backends.backend_for`. The numbers are the same on each.
-    on_progress : callable, optional
-        ``on_progress(runs_done, runs_total)`` after every chunk.
-    cancelled : callable, optional
-        Polled after every chunk; True stops the atlas with :class:`RunCancelled`.
+    progress : Progress, optional
+        Told ``advance(runs_done, runs_total)`` after every chunk, and asked then whether to go
+        on (:meth:`Progress.cancelled`: True stops the atlas with ``RunCancelled``).
     keep_leg_ends : bool
         Keep every leg's end (A P N cycles L p numbers); False keeps the drift alone.
     """
@@ -206,7 +238,7 @@ def run_atlas(
     success = np.empty((A, P * N), dtype=bool)
     failures: dict[tuple[int, int, int], str] = {}
     done = 0
-    for task, chunk in iter_atlas(plan, backend, cancelled):
+    for task, chunk in iter_atlas(plan, backend, progress):
         sl = slice(chunk.lo, chunk.hi)
         starts[sl], drift[:, sl], success[:, sl] = task.starts, chunk.drift, chunk.success
         if legs is not None:
@@ -214,8 +246,8 @@ def run_atlas(
         for a, run, why in chunk.failures:
             failures[(a, *divmod(run, N))] = why
         done += chunk.hi - chunk.lo
-        if on_progress is not None:
-            on_progress(done, plan.size)
+        if progress is not None:
+            progress.advance(done, plan.size)
     return AtlasResult(
         plan.algorithms,
         plan.paths,

@@ -19,13 +19,14 @@ from __future__ import annotations
 
 import functools
 import itertools
-from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
 from jik.engine.augmentations import AugmentingMap
 from jik.engine.exceptions import InvalidInputError, OneFormUndefinedError, format_vector
 from jik.engine.kinematics import SINGULAR_MANIPULABILITY, Kinematics, kernel_cofactors
+from jik.engine.progress import Progress, check_cancelled
 from jik.engine.unicycle import Unicycle
 from jik.engine.validation import FloatArray, as_vector, count, finite
 
@@ -52,6 +53,10 @@ TAIL_FAIL = 1e-6
 REFINE_LEVELS = 1
 #: Warm-start Newton from the previous characteristics when x moved by at most this (max norm).
 WARM_RADIUS = 0.5
+#: Most members solved in one batched Newton solve: its arrays (the collocation systems on the
+#: refined grid, (B, 2n - 1, 2n - 1) each) grow with the batch; larger batches are solved this
+#: many members at a time, which bounds a worker's memory whatever the number of points.
+MAX_MEMBERS = 1024
 
 
 def _levi_civita(p: int) -> FloatArray:
@@ -324,6 +329,8 @@ class CharacteristicsMap(AugmentingMap):
             raise InvalidInputError(f"on_undefined must be 'raise' or 'nan', got {on_undefined!r}")
         self.on_undefined = on_undefined
         self._cache: tuple | None = None
+        #: Where the last characteristic() failed first: (Phi_s or None, s or None, x), or None.
+        self._where: Any = None
 
     def moments_ignore(self, f: int) -> bool:
         """Whether the kinematics' quadrature moments ignore the leaf coordinate x[f].
@@ -410,13 +417,30 @@ class CharacteristicsMap(AugmentingMap):
         Chebyshev coefficients of z(s) exceed TAIL_TOL (a steep characteristic, e.g. one that
         passes near a zero of the normalising kernel component) are solved again on the nested
         Lobatto grid of 2n - 1 nodes (REFINE_LEVELS); results are returned on the n base nodes.
+        Batches of more than MAX_MEMBERS are solved MAX_MEMBERS members at a time.
         """
         x = self.kinematics.check(x)
         shape = x.shape[:-1]
         xb = x.reshape(-1, self.p)
+        n, B = self.nodes, len(xb)
+        g = None if guess is None else np.array(guess, dtype=float).reshape(-1, n)
+        Z, S, failed = np.empty((B, n)), np.empty((B, n, self.p)), np.empty(B, dtype=bool)
+        where = None
+        for lo in range(0, B, MAX_MEMBERS):
+            part = slice(lo, lo + MAX_MEMBERS)
+            Z[part], S[part], failed[part], first = self._characteristic(
+                xb[part], None if g is None else g[part]
+            )
+            where = first if where is None else where
+        self._where = where
+        s0 = collocation(n)[0]
+        return s0, Z.reshape(*shape, n), S.reshape(*shape, n, self.p), failed.reshape(shape)
+
+    def _characteristic(self, xb, g) -> tuple[FloatArray, FloatArray, FloatArray, Any]:
+        """:meth:`characteristic` of the points ``xb`` (B, p) in one batched solve, and where
+        its first failure is (None if none): (Phi_s or None, s or None, x)."""
         n = self.nodes
         Y = self.homotopy.field(xb)  # (B, p)
-        g = None if guess is None else np.array(guess, dtype=float).reshape(-1, n)
         Z, S, bad_nodes, conv, pts, tail = self._collocate(xb, Y, n, g)
         bad = np.any(bad_nodes, axis=-1)
         active, Zc, m_prev = np.arange(len(xb)), Z, n
@@ -442,8 +466,7 @@ class CharacteristicsMap(AugmentingMap):
             i = np.flatnonzero(failed)[0]
             j = np.flatnonzero(bad_nodes[i])
             where = (pts[i, j[0]], s0[j[0]], xb[i]) if j.size else (None, None, xb[i])
-        self._where = where
-        return s0, Z.reshape(*shape, n), S.reshape(*shape, n, self.p), failed.reshape(shape)
+        return Z, S, failed, where
 
     def evaluate(self, x) -> tuple[FloatArray, FloatArray, FloatArray]:
         """h(x) (...,), dh/dx (..., p) and the failure mask (...,), without raising.
@@ -477,7 +500,7 @@ class CharacteristicsMap(AugmentingMap):
         self,
         x,
         batch: int = 45,
-        on_batch: Callable[[int, int], None] | None = None,
+        progress: Progress | None = None,
     ) -> tuple[FloatArray, FloatArray, FloatArray]:
         """:meth:`evaluate` of a large set of points, ``batch`` members at a time.
 
@@ -487,9 +510,10 @@ class CharacteristicsMap(AugmentingMap):
         batch : int
             Members per Newton solve (each one cold, from z(s) = z(1): the result never depends
             on the order of the batches).
-        on_batch : callable, optional
-            ``on_batch(done, total)`` after each batch; what it raises stops the evaluation
-            there (a caller's cancellation).
+        progress : Progress, optional
+            Told ``advance(batches_done, batches_total)`` after each batch, then asked whether to
+            go on (:meth:`Progress.cancelled`: True raises ``RunCancelled``); what it raises
+            stops the evaluation there.
 
         Returns
         -------
@@ -516,8 +540,9 @@ class CharacteristicsMap(AugmentingMap):
             h[part] = np.where(bad, np.nan, Z[:, 0])
             dh[part] = np.where(bad[:, None], np.nan, S[:, 0, :])
             failed[part] = bad
-            if on_batch is not None:
-                on_batch(k + 1, total)
+            if progress is not None:
+                progress.advance(k + 1, total)
+                check_cancelled(progress, f"h evaluation cancelled after batch {k + 1} of {total}")
         shape = x.shape[:-1]
         return h.reshape(shape), dh.reshape(*shape, self.p), failed.reshape(shape)
 

@@ -13,7 +13,8 @@ recursive-descent parser accept exactly
 with numbers such as ``2``, ``0.5``, ``1e-3``, the constant ``pi``, the declared variables and
 parameters, and the functions sin cos tan exp log sqrt atan2 abs; each node becomes a sympy
 object built directly. Bounds keep the work small whatever the text: its length, the number of
-nodes, the nesting depth, the size of exact constants, and constant exponents with
+nodes, the nesting depth (of parentheses and signs, and of function calls, whose derivatives
+grow with each), the size of exact constants, and constant exponents with
 |value| <= ``MAX_EXPONENT`` (also after sympy combines powers, as (x**8)**4 = x**32). Numbers and
 parameter values are exact rationals, so sympy never evaluates a function of a float while the
 expression is built.
@@ -39,6 +40,9 @@ MAX_LENGTH = 2000
 MAX_NODES = 500
 #: Deepest nesting of parentheses, calls and unary signs.
 MAX_DEPTH = 40
+#: Deepest nesting of function calls (``exp(x/exp(x/...))``): each level multiplies the size of
+#: the derivatives by the chain rule.
+MAX_CALLS_NESTED = 8
 #: Largest |exponent| of a power with a constant exponent.
 MAX_EXPONENT = 16
 #: Largest size of an exact constant's numerator or denominator [bits].
@@ -103,6 +107,7 @@ class _Parser:
         self.i = 0
         self.depth = 0
         self.nodes = 0
+        self.calls = 0
 
     def error(self, what: str, token: _Token | None = None) -> FormulaError:
         t = token or self.tokens[self.i]
@@ -208,10 +213,15 @@ class _Parser:
         function, arity = FUNCTIONS[name.text]
         if self.take().text != "(":
             raise self.error(f"{name.text} must be called, as {name.text}(...)", name)
+        self.calls += 1
+        if self.calls > MAX_CALLS_NESTED:
+            raise self.error(f"functions nested too deeply (more than {MAX_CALLS_NESTED} calls "
+                             "inside each other)", name)  # fmt: skip
         args = [self.expression()]
         while self.peek().text == ",":
             self.take()
             args.append(self.expression())
+        self.calls -= 1
         if self.take().text != ")":
             raise self.error("missing ')'", self.tokens[self.i - 1])
         if len(args) != arity:

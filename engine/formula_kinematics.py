@@ -3,7 +3,10 @@
 The Jacobian, the second derivatives (which the characteristics of section 4 need) and the
 gradient of h come from sympy's ``diff`` of the parsed expressions and are evaluated batched by
 numpy functions that sympy's ``lambdify`` generates from them (expressions built by the parser,
-never text).
+never text). Derivatives are bounded in size (:func:`derivatives`): a formula whose derivatives
+grow much larger than itself (nested exponentials, ``exp(x1/exp(x2/exp(...)))``) is refused while
+they are taken, naming its field, before sympy spends seconds or minutes simplifying and
+compiling them.
 """
 
 from __future__ import annotations
@@ -16,10 +19,55 @@ import numpy as np
 import sympy as sp
 
 from jik.engine.augmentations import AugmentingMap
-from jik.engine.exceptions import InvalidInputError
+from jik.engine.exceptions import FormulaError, InvalidInputError
 from jik.engine.formula import MAX_NAMES, check_name, parse_formula
 from jik.engine.kinematics import Kinematics
 from jik.engine.validation import FloatArray, json_number
+
+#: Largest average size (tree nodes) of a formula's first or second derivatives, per entry. The
+#: derivative of an ordinary formula is about as large as the formula (a 16-link chain's
+#: entries: about 200 nodes); of nested exponentials it grows with the nesting depth, and its
+#: second derivatives with its square, as does the time sympy takes to build them.
+MAX_DERIVATIVE_NODES = 1000
+
+
+def _nodes(e: sp.Basic) -> int:
+    return sum(1 for _ in sp.preorder_traversal(e))
+
+
+def derivatives(
+    exprs: Sequence[sp.Expr], symbols: Sequence[sp.Symbol], fields: Sequence[str], order: int = 1
+) -> list[sp.Expr]:
+    """d expr / d symbol (``order`` 1: (len(exprs), p) entries, row-major) or d^2 expr / d s_a
+    d s_b (``order`` 2: (len(exprs), p, p)), within :data:`MAX_DERIVATIVE_NODES` per entry on
+    average over each expression's entries.
+
+    Raises
+    ------
+    FormulaError
+        Naming ``fields[i]`` of the expression whose derivatives exceed the bound, as soon as
+        they do (the entries after it are not computed).
+    """
+    out: list[sp.Expr] = []
+    n = len(symbols) ** order
+    for e, field in zip(exprs, fields, strict=True):
+        used = 0
+        firsts = [sp.diff(e, a) for a in symbols] if order == 2 else [e]
+        for d in firsts:
+            for a in symbols:
+                entry = sp.diff(d, a)
+                used += _nodes(entry)
+                if used > MAX_DERIVATIVE_NODES * n:
+                    which = "first" if order == 1 else "second"
+                    raise FormulaError(
+                        f"{field}: the formula's {which} derivatives are too large to build "
+                        f"(more than {MAX_DERIVATIVE_NODES} terms per entry on average); nest "
+                        "fewer functions",
+                        field,
+                        0,
+                    )
+                out.append(entry)
+    return out
 
 
 def _names(variables, parameters, what: str) -> tuple[list[str], dict[str, float]]:
@@ -118,6 +166,8 @@ class FormulaKinematics(Kinematics):
         self.variable_names = tuple(names)
         self.p, self.r = len(names), len(task)
         self._forward = _Batched(self.expressions, self.symbols, (self.r,))
+        self._fields = [f"task.{i}" for i in range(self.r)]
+        self._first = derivatives(self.expressions, self.symbols, self._fields)
 
     @property
     def parameters(self) -> dict[str, object]:
@@ -126,7 +176,7 @@ class FormulaKinematics(Kinematics):
     @functools.cached_property
     def symbolic_jacobian(self) -> sp.Matrix:
         """dk/dx as a sympy matrix (r, p)."""
-        return sp.Matrix(self.expressions).jacobian(self.symbols)
+        return sp.Matrix(self.r, self.p, self._first)
 
     @functools.cached_property
     def _jacobian(self) -> _Batched:
@@ -134,8 +184,7 @@ class FormulaKinematics(Kinematics):
 
     @functools.cached_property
     def _hessian(self) -> _Batched:
-        exprs = [sp.diff(e, a, b) for e in self.expressions for a in self.symbols
-                 for b in self.symbols]  # fmt: skip
+        exprs = derivatives(self.expressions, self.symbols, self._fields, order=2)
         return _Batched(exprs, self.symbols, (self.r, self.p, self.p))
 
     def forward(self, x: FloatArray) -> FloatArray:
@@ -182,8 +231,8 @@ class FormulaMap(AugmentingMap):
         self.p = len(names)
         self.values = values
         self._value = _Batched([self.expression], symbols, ())
-        self._gradient = _Batched([sp.diff(self.expression, s) for s in symbols], symbols,
-                                  (self.p,))  # fmt: skip
+        gradient = derivatives([self.expression], symbols, [field])
+        self._gradient = _Batched(gradient, symbols, (self.p,))
 
     @property
     def parameters(self) -> dict[str, float]:

@@ -34,7 +34,7 @@ class PlanarChain(Kinematics):
     joints : str
         One letter per joint, base first: ``"R"`` revolute, ``"P"`` prismatic (case-insensitive).
     lengths : sequence of float, shape (p,)
-        Link lengths l_i (for a prismatic joint the link's length at x_i + o_i = 0) [length].
+        Link lengths l_i > 0 (for a prismatic joint the link's length at x_i + o_i = 0) [length].
     offsets : sequence of float, shape (p,), optional
         Joint offsets o_i, added to x_i: an angle [rad] for R, an extension [length] for P.
     orientation : bool
@@ -72,6 +72,13 @@ class PlanarChain(Kinematics):
             raise InvalidInputError(f"at most {MAX_JOINTS} joints, got {len(kinds)}", "joints")
         self.joints = kinds
         self.lengths = _vector(lengths, len(kinds), "lengths")
+        short = np.flatnonzero(self.lengths <= 0)
+        if short.size:
+            i = int(short[0])
+            raise InvalidInputError(
+                f"lengths[{i}] must be positive (a link's length), got {self.lengths[i]:g}",
+                f"lengths.{i}",
+            )
         self.offsets = _vector(
             [0.0] * len(kinds) if offsets is None else offsets, len(kinds), "offsets"
         )

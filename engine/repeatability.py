@@ -4,28 +4,31 @@ An algorithm is repeatable when closed paths in the task space give closed paths
 space. The extended Jacobian inverse (11) is repeatable by design; the pseudoinverse (8) is not.
 
 :func:`repeatability` is the one loop over cycles and legs in jik: a batch runs it for a map of
-starts, and an interactive caller (the dashboard) for one start, with hooks for what it shows
-while the run goes on: every leg as it ends (``on_leg``), cancellation between legs and chunks
-(``cancelled``), progress within a long discrete leg (``chunk``, ``on_chunk``), and more cycles
-from the end of a run it already has (``resume``).
+starts, and an interactive caller (the dashboard) for one start, with a
+:class:`jik.engine.progress.Progress` that sees every leg as it ends, hears a cancellation
+between legs (and between the pieces of a long discrete leg) and the progress within such a leg;
+``resume`` goes on with more cycles from the end of a run it already has.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
-from functools import partial
+from typing import Any
 
 import numpy as np
 
-from jik.engine.exceptions import InvalidInputError, JikError, RunCancelled
+from jik.engine.exceptions import InvalidInputError, JikError
 from jik.engine.inverses import Inverse
+from jik.engine.progress import Progress, check_cancelled
+from jik.engine.results import RepeatabilityResult
 from jik.engine.solver import (
     BatchSolveResult,
     SolveResult,
     Trajectory,
     chain_guesses,
     solve,
+    solve_batch,
     solve_in_chunks,
 )
 from jik.engine.unicycle import Unicycle
@@ -39,35 +42,10 @@ MAX_CYCLES = 1000
 MAX_PATH_POINTS = 100
 #: The path is closed by a return leg to k(x0) when its last point is farther than this.
 CLOSE_TOL = 1e-12
-
-
-@dataclass(frozen=True)
-class RepeatabilityResult:
-    """Configurations along a closed path driven ``cycles`` times.
-
-    Attributes
-    ----------
-    targets : ndarray, shape (L, r) or (n, L, r)
-        The task point of every leg of one cycle (the given path, closed by k(x0) if needed).
-    legs : ndarray, shape (cycles * L, p) or (n, cycles * L, p)
-        Configuration after each leg.
-    cycle_end : ndarray, shape (cycles, p) or (n, cycles, p)
-    drift : ndarray, shape (cycles,) or (n, cycles)
-        ||cycle_end[c] - x0||.
-    success : bool or ndarray of bool, shape (n,)
-    message : str or tuple of str
-    leg_results : list of SolveResult
-        Every leg with its trajectory (single start with ``record=True`` only).
-    """
-
-    x0: FloatArray
-    targets: FloatArray
-    legs: FloatArray
-    cycle_end: FloatArray
-    drift: FloatArray
-    success: bool | FloatArray
-    message: str | tuple[str, ...]
-    leg_results: list[SolveResult]
+#: With a ``progress``, a discrete leg of one start runs as solves of at most this many
+#: iterations (:func:`jik.engine.solver.solve_in_chunks`: the same iterates), between which a
+#: cancellation is heard and the leg's progress told.
+POLL_ITERATIONS = 80
 
 
 @dataclass(frozen=True)
@@ -102,8 +80,8 @@ class Resume:
 
 @dataclass(frozen=True)
 class Leg:
-    """One leg of a run, as :func:`repeatability` hands it to ``on_leg`` when it ends: eq. (7)
-    from where the leg before ended to the cycle's target ``index``.
+    """One leg of a run, as :func:`repeatability` hands it to :meth:`Progress.leg` when it
+    ends: eq. (7) from where the leg before ended to the cycle's target ``index``.
 
     Attributes
     ----------
@@ -177,11 +155,8 @@ def repeatability(
     record: bool = False,
     close: bool = True,
     resume: Resume | None = None,
-    on_leg: Callable[[Leg], None] | None = None,
-    cancelled: Callable[[], bool] | None = None,
-    chunk: int | None = None,
-    on_chunk: Callable[[float], None] | None = None,
     on_undefined: str = "raise",
+    progress: Progress | None = None,
 ) -> RepeatabilityResult:
     """Drive the robot through ``path`` and back to k(x0), ``cycles`` times, each leg by eq. (7).
 
@@ -205,23 +180,16 @@ def repeatability(
     resume : Resume, optional
         Cycles already driven (:class:`Resume`): the run goes on from their end, and the result
         is that of a run from x0 (``leg_results`` holds the new legs only).
-    on_leg : callable, optional
-        ``on_leg(leg)`` with a :class:`Leg`, after every leg (the last one too, whether it
-        converged or not). What it raises propagates.
-    cancelled : callable, optional
-        Polled before every leg, and between the chunks of a leg (``chunk``); when it returns
-        True the run raises :class:`jik.engine.exceptions.RunCancelled` there.
-    chunk : int, optional
-        Discrete mode, one start: run each leg as solves of at most ``chunk`` iterations
-        (:func:`jik.engine.solver.solve_in_chunks`: the same iterates), polling ``cancelled`` and
-        calling ``on_chunk`` between them.
-    on_chunk : callable, optional
-        With ``chunk``: ``on_chunk(fraction)`` after each chunk that leaves a leg unfinished,
-        with how far the leg's task error has come toward ``tol`` on a log scale (eq. (5)).
     on_undefined : {"raise", "stop"}
         What a leg's solve raising a typed error does (a map undefined where the leg starts,
         an algorithmic singularity (11) there): "raise" it; or, one start only, "stop" the run
         there with what it has, as a failed leg whose ``Leg.stopped_by`` is the error.
+    progress : Progress, optional
+        Told every leg as it ends (:meth:`Progress.leg`, with a :class:`Leg`: the last one too,
+        whether it converged or not), asked before every leg whether to go on
+        (:meth:`Progress.cancelled`). In discrete mode with one start, each leg runs as solves of
+        at most :data:`POLL_ITERATIONS` iterations (the same iterates), between which it is
+        asked too and told the leg's progress (:meth:`Progress.advance`, a fraction of 1).
 
     Returns
     -------
@@ -232,12 +200,11 @@ def repeatability(
     Raises
     ------
     InvalidInputError
-        Bad shapes, or a hook that does not apply (``chunk`` or ``on_undefined="stop"`` with a
-        batch, ``chunk`` in continuous mode).
+        Bad shapes, or ``on_undefined="stop"`` with a batch.
     JikError
         A leg's solve raised (a singular start configuration) and ``on_undefined`` is "raise".
     RunCancelled
-        ``cancelled()`` returned True.
+        ``progress.cancelled()`` returned True.
     """
     kin = inverse.kinematics
     x0 = kin.check(x0, "x0")
@@ -259,10 +226,7 @@ def repeatability(
         raise InvalidInputError(f"on_undefined must be 'raise' or 'stop', got {on_undefined!r}")
     if on_undefined == "stop" and not single:
         raise InvalidInputError("on_undefined='stop' needs one start configuration")
-    if chunk is not None:
-        chunk = count(chunk, "chunk", 1, 10**6)
-        if mode != "discrete" or not single:
-            raise InvalidInputError("chunk applies to discrete mode with one start configuration")
+    chunked = progress is not None and mode == "discrete" and single
     if close:
         targets = closed_path(kin, xb, path)  # (n, L, r)
     else:
@@ -277,7 +241,9 @@ def repeatability(
     # (cycle_guesses). Batches do without: a guess is per member.
     guided = single and mode == "continuous"
     guides: list[Trajectory | None] = [None] * L
-    step = partial(solve, inverse, gamma=gamma, mode=mode, tol=tol, max_iterations=max_iterations)
+    settings: dict[str, Any] = {
+        "gamma": gamma, "mode": mode, "tol": tol, "max_iterations": max_iterations,
+    }  # fmt: skip
     first = 0
     if resume is not None:
         done, given = _resumed(resume, n, L, kin.p, cycles)
@@ -293,20 +259,22 @@ def repeatability(
             ids = np.flatnonzero(alive)
             if ids.size == 0:
                 break
-            _poll(cancelled, f"before cycle {c + 1}, leg {j + 1}")
+            where = f"cycle {c + 1}, leg {j + 1}"
+            check_cancelled(progress, f"repeatability run cancelled before {where}")
             stopped = None
             try:
-                if chunk is not None:  # (one start)
+                if chunked:  # (one start, with a progress)
                     res: SolveResult | BatchSolveResult = solve_in_chunks(
-                        inverse, current[0], targets[0, j], chunk=chunk, gamma=gamma, tol=tol,
-                        max_iterations=max_iterations, record=record,
-                        between=_between(cancelled, on_chunk, f"in cycle {c + 1}, leg {j + 1}"),
+                        inverse, current[0], targets[0, j], chunk=POLL_ITERATIONS, gamma=gamma,
+                        tol=tol, max_iterations=max_iterations, record=record,
+                        between=_between(progress, f"in {where}"),
                     )  # fmt: skip
                 elif single:  # (a SolveResult: its trajectory guides the next cycle's leg)
-                    guess = [guesses[j]] if guided else None
-                    res = step(current[0], targets[0, j], record=record or guided, guess=guess)
+                    res = solve(inverse, current[0], targets[0, j], record=record or guided,
+                                guess=guesses[j] if guided else None, **settings)  # fmt: skip
                 else:  # (current[ids] is (k, p): a BatchSolveResult)
-                    res = step(current[ids], targets[ids, j], record=False)
+                    res = solve_batch(inverse, current[ids], targets[ids, j], record=False,
+                                      **settings)  # fmt: skip
             except JikError as exc:
                 if on_undefined == "raise":
                     raise
@@ -329,8 +297,8 @@ def repeatability(
                     f"stopped: {stopped}" if stopped is not None else f"failed: {why[k]}"
                 )
                 legs[ids[k], c * L + j] = np.nan
-            if on_leg is not None:
-                on_leg(Leg(c, j, ids, res, stopped))
+            if progress is not None:
+                progress.leg(Leg(c, j, ids, res, stopped))
     cycle_end = legs[:, L - 1 :: L]
     drift = np.linalg.norm(cycle_end - xb[:, None, :], axis=-1)
     if single:
@@ -366,18 +334,12 @@ def _resumed(resume: Resume, n: int, L: int, p: int, cycles: int):
     return done, guides
 
 
-def _poll(cancelled: Callable[[], bool] | None, where: str) -> None:
-    if cancelled is not None and cancelled():
-        raise RunCancelled(f"repeatability run cancelled {where}")
-
-
-def _between(cancelled, on_chunk, where: str) -> Callable[[float], None]:
+def _between(progress, where: str):
     """What runs between two chunks of a discrete leg: the cancellation poll, then progress."""
 
     def between(fraction: float) -> None:
-        _poll(cancelled, where)
-        if on_chunk is not None:
-            on_chunk(fraction)
+        check_cancelled(progress, f"repeatability run cancelled {where}")
+        progress.advance(fraction, 1.0)
 
     return between
 

@@ -26,7 +26,7 @@ class DefinitionField:
 PLANAR_CHAIN = (
     DefinitionField("joints", "string", True, "joint types in order, base first: R revolute, "
                     "P prismatic", "RRR"),
-    DefinitionField("lengths", "numbers", True, "link lengths, one per joint", [1.0, 0.8, 0.6]),
+    DefinitionField("lengths", "numbers", True, "link lengths > 0, one per joint", [1.0, 0.8, 0.6]),
     DefinitionField("offsets", "numbers", False, "joint offsets added to x: angle [rad] for R, "
                     "extension for P (default 0)"),
     DefinitionField("orientation", "boolean", False, "also the end's angle as a task component "

@@ -1,8 +1,9 @@
 """The continuation (Wazewski-Davidenko) IK algorithm, eq. (7), batched over start configurations.
 
 (It stays whole, at about 730 lines: the two continuous integrators, the discrete iteration and
-:func:`solve_in_chunks` share one result type, one stopping rule, one check of the start and one
-message; the DOP853 coefficients and the Picard sweeps already live in modules of their own.)
+:func:`solve_in_chunks` share one stopping rule, one check of the start and one message; the
+result types (:mod:`jik.engine.results`), the DOP853 coefficients and the Picard sweeps live in
+modules of their own.)
 
 Continuous mode follows the trajectory of dx/dtheta = -gamma J#(x) (k(x) - y_d) with two
 adaptive high-order methods: Chebyshev-Picard iteration on the equivalent homotopy form (spectral,
@@ -18,9 +19,7 @@ progress and cancellation), the same iterates.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, replace
-from functools import cached_property
-from typing import cast
+from dataclasses import replace
 
 import numpy as np
 
@@ -28,6 +27,7 @@ from jik.engine import dop853 as _dop
 from jik.engine.exceptions import InvalidInputError, JikError
 from jik.engine.inverses import Inverse
 from jik.engine.picard import Guess, picard_chain, picard_path
+from jik.engine.results import BatchSolveResult, SolveResult, Trajectory
 from jik.engine.validation import FloatArray, count, positive
 
 _NS = _dop.N_STAGES
@@ -38,124 +38,64 @@ _E5 = _dop.E5
 _SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0
 _EXPONENT = -1.0 / 8.0  # error estimator of order 7
 
+#: The smallest task-error tolerance ``tol`` of a solve (double precision).
+TOL_MIN = 1e-14
 #: Tolerances of the continuous integrator on x (relative and absolute).
 RTOL = 1e-12
 ATOL = 1e-12
 #: Default caps of :func:`solve`: integrator steps (continuous), iterations (discrete).
 MAX_STEPS = 20000
 MAX_ITERATIONS = 2000
+#: The largest cap ``max_iterations`` (and ``chunk``) that a solve accepts.
+MAX_ITERATIONS_LIMIT = 10**6
 #: Picard sweeps per member in method "auto" before DOP853 takes over.
 PICARD_BUDGET = 80
 #: Largest |x| before a run counts as diverged.
 DIVERGED_NORM = 1e8
+#: The modes of eq. (7): its ODE (continuous), or the iteration x <- x - gamma J# e (discrete).
+MODES = ("continuous", "discrete")
+#: The decay rate gamma of eq. (5) that the engine, the API and the dashboard accept. Continuous
+#: runs depend on gamma only through theta = -log(1 - s) / gamma (theta's scale); far below
+#: GAMMA_MIN that scale leaves the floating-point range.
+GAMMA_MIN, GAMMA_MAX = 1e-6, 1e6
+#: Discrete mode converges near a solution only for gamma below this: the task error shrinks
+#: by |1 - gamma| per iteration there.
+DISCRETE_GAMMA_BOUND = 2.0
 
 _RUNNING, _CONVERGED, _SINGULAR, _MAX_STEPS, _DIVERGED, _STALLED = range(6)
 
 
-@dataclass(frozen=True)
-class Trajectory:
-    """One run of eq. (7), point by point (accepted steps or iterations).
+def gamma_problem(gamma: float, mode: str) -> str | None:
+    """What is wrong with a positive ``gamma`` in ``mode``, as a phrase to follow the field's
+    name ("must be < 2 in discrete mode, got 2.5 (...)"), or None: the one wording of gamma's
+    rules, for the engine's errors and the app's."""
+    if not GAMMA_MIN <= gamma <= GAMMA_MAX:
+        return f"must be between {GAMMA_MIN:g} and {GAMMA_MAX:g}, got {gamma:g}"
+    if mode == "discrete" and gamma >= DISCRETE_GAMMA_BOUND:
+        return (
+            f"must be < {DISCRETE_GAMMA_BOUND:g} in discrete mode, got {gamma:g} (near the "
+            "solution the error shrinks by |1 - gamma| per iteration)"
+        )
+    return None
 
-    Attributes
-    ----------
-    theta : ndarray, shape (m,)
-        Continuation parameter theta (continuous) or iteration number (discrete).
-    x : ndarray, shape (m, p)
-    y : ndarray, shape (m, r)
-        k(x).
-    error : ndarray, shape (m,)
-        ||k(x) - y_d||.
-    h : ndarray, shape (m,) or None
-        h(x) for the extended inverse (constant along the continuous flow, eq. (12)); NaN at a
-        point where h is undefined (a run stopped there).
+
+def check_gamma(gamma, mode: str) -> float:
+    """``gamma`` as a float, checked for ``mode`` (:func:`gamma_problem`).
+
+    Raises
+    ------
+    InvalidInputError
+        With ``field="gamma"``: not a number, <= 0, outside [GAMMA_MIN, GAMMA_MAX], or not below
+        :data:`DISCRETE_GAMMA_BOUND` in discrete mode.
     """
-
-    theta: FloatArray
-    x: FloatArray
-    y: FloatArray
-    error: FloatArray
-    h: FloatArray | None
-
-
-@dataclass(frozen=True)
-class SolveResult:
-    """Result of one solve, in SciPy's vocabulary (``x``, ``success``, ``message``, ``nit``)."""
-
-    x: FloatArray
-    y: FloatArray
-    error: float
-    success: bool
-    message: str
-    nit: int
-    trajectory: Trajectory | None
-    mode: str
-    gamma: float
-    algorithm: str
-
-
-@dataclass(frozen=True)
-class BatchSolveResult:
-    """Results of a batch of solves; index it for a :class:`SolveResult` with its trajectory."""
-
-    x: FloatArray  # (n, p)
-    y: FloatArray  # (n, r)
-    error: FloatArray  # (n,)
-    success: FloatArray  # (n,) bool
-    message: tuple[str, ...]
-    nit: FloatArray  # (n,) int
-    mode: str
-    gamma: float
-    algorithm: str
-    _inverse: Inverse = field(repr=False)
-    _y_d: FloatArray = field(repr=False)
-    # Recorded points: member index, theta, x of every accepted step, in order.
-    _rec_member: FloatArray | None = field(repr=False, default=None)
-    _rec_theta: FloatArray | None = field(repr=False, default=None)
-    _rec_x: FloatArray | None = field(repr=False, default=None)
-    # Each member's outcome (_CONVERGED, _SINGULAR, ...): solve_in_chunks words its message.
-    _status: FloatArray | None = field(repr=False, default=None)
-
-    def __len__(self) -> int:
-        return len(self.x)
-
-    def trajectory(self, i: int) -> Trajectory:
-        """The trajectory of member ``i`` (requires ``record=True``)."""
-        # The three recordings are set together (all or none).
-        if self._rec_member is None or self._rec_theta is None or self._rec_x is None:
-            raise InvalidInputError("trajectories were not recorded; solve with record=True")
-        ys, h, err, bounds = self._recorded
-        sel = slice(bounds[i], bounds[i + 1])
-        return Trajectory(
-            theta=self._rec_theta[sel],
-            x=self._rec_x[sel],
-            y=ys[sel],
-            error=err[sel],
-            h=None if h is None else h[sel],
-        )
-
-    @cached_property
-    def _recorded(self):
-        """k(x), h(x), ||k(x) - y_d|| of every recorded point at once, and each member's slice."""
-        assert self._rec_member is not None and self._rec_x is not None
-        ys = self._inverse.kinematics.forward(self._rec_x)
-        h = self._inverse.augmenting_value(self._rec_x)
-        err = np.linalg.norm(ys - self._y_d[self._rec_member], axis=-1)
-        bounds = np.searchsorted(self._rec_member, np.arange(len(self.x) + 1))  # sorted members
-        return ys, None if h is None else np.asarray(h), err, bounds
-
-    def __getitem__(self, i: int) -> SolveResult:
-        return SolveResult(
-            x=self.x[i],
-            y=self.y[i],
-            error=float(self.error[i]),
-            success=bool(self.success[i]),
-            message=self.message[i],
-            nit=int(self.nit[i]),
-            trajectory=self.trajectory(i) if self._rec_member is not None else None,
-            mode=self.mode,
-            gamma=self.gamma,
-            algorithm=self.algorithm,
-        )
+    try:
+        value = positive(gamma, "gamma")
+    except InvalidInputError as exc:
+        raise InvalidInputError(str(exc), field="gamma") from None
+    why = gamma_problem(value, mode)
+    if why is not None:
+        raise InvalidInputError(f"gamma {why}", field="gamma")
+    return value
 
 
 def _rhs(inverse: Inverse, x: FloatArray, y_d: FloatArray):
@@ -335,7 +275,7 @@ def chain_guesses(inverse: Inverse, x0, y_d, *, gamma: float = 1.0) -> list[Traj
     kin = inverse.kinematics
     x0 = kin.check(x0, "x0")
     y_d = kin.check_task(y_d, "y_d")
-    gamma = positive(gamma, "gamma")
+    gamma = check_gamma(gamma, "continuous")
     if x0.ndim != 1 or y_d.ndim != 2 or len(y_d) == 0:
         raise InvalidInputError(
             f"x0 must be one configuration (p,) and y_d the legs' targets (L, r), L >= 1; "
@@ -497,21 +437,22 @@ def solve(
     max_iterations: int | None = None,
     record: bool = True,
     method: str = "auto",
-    guess: Trajectory | Sequence[Trajectory | None] | None = None,
-) -> SolveResult | BatchSolveResult:
-    """Solve k(x) = y_d by the continuation algorithm (7) with the right inverse J#.
+    guess: Trajectory | None = None,
+) -> SolveResult:
+    """Solve k(x) = y_d from one start by the continuation algorithm (7) with the right inverse J#.
 
     Parameters
     ----------
     inverse : Inverse
         The pseudoinverse (8) or the extended Jacobian inverse (11).
-    x0 : array_like, shape (p,) or (n, p)
-        Start configuration(s); a batch is solved in one vectorized run.
-    y_d : array_like, shape (r,) or (n, r)
-        Target task point(s).
+    x0 : array_like, shape (p,)
+        Start configuration (a batch: :func:`solve_batch`).
+    y_d : array_like, shape (r,)
+        Target task point.
     gamma : float
-        Decay rate > 0 of eq. (5). In continuous mode it only rescales theta; in discrete mode
-        it is the step and must be < 2 (near the solution the error shrinks by |1 - gamma|).
+        Decay rate of eq. (5), in [:data:`GAMMA_MIN`, :data:`GAMMA_MAX`]. In continuous mode it
+        only rescales theta; in discrete mode it is the step and must be below
+        :data:`DISCRETE_GAMMA_BOUND` (near the solution the error shrinks by |1 - gamma|).
     mode : {"continuous", "discrete"}
     tol : float
         Stop when ||k(x) - y_d|| < tol.
@@ -524,7 +465,7 @@ def solve(
         Continuous mode only: Chebyshev-Picard with a sweep budget and DOP853 after it
         ("auto"), Picard alone (DOP853 only where it fails), or DOP853 alone. "dop853" suits
         maps that are expensive per point (the unicycle's characteristics map).
-    guess : Trajectory, or a sequence of Trajectory or None (one per start), optional
+    guess : Trajectory, optional
         Continuous mode: the trajectory of a nearby earlier solve with the same gamma, such as
         the same leg in the previous cycle of a closed path. Picard starts its sweeps from it
         where its nodes are those of a segment (:mod:`jik.engine.picard`). The result is the same
@@ -532,20 +473,74 @@ def solve(
 
     Returns
     -------
-    SolveResult for one start, BatchSolveResult for a batch. A run that does not converge
-    (singularity reached, divergence, step cap) has ``success=False`` and a message saying why.
+    SolveResult
+        A run that does not converge (singularity reached, divergence, step cap) has
+        ``success=False`` and a message saying why.
 
     Raises
     ------
     InvalidInputError
-        Wrong shapes, non-finite values, gamma <= 0 (or >= 2 in discrete mode), bad tol.
+        Wrong shapes (a batch of starts or targets), non-finite values, gamma out of range,
+        bad tol.
     KinematicSingularityError, AlgorithmicSingularityError
-        When a start configuration is singular for ``inverse``.
+        When the start configuration is singular for ``inverse``.
     """
     kin = inverse.kinematics
     x0 = kin.check(x0, "x0")
     y_d = kin.check_task(y_d, "target y_d")
-    single = x0.ndim == 1 and y_d.ndim == 1
+    if x0.ndim != 1 or y_d.ndim != 1:
+        raise InvalidInputError(
+            f"solve takes one start x0 (p,) and one target y_d (r,), got shapes {x0.shape} and "
+            f"{y_d.shape}; solve_batch solves a batch"
+        )
+    batch = solve_batch(
+        inverse, x0[None], y_d[None], gamma=gamma, mode=mode, tol=tol,
+        max_iterations=max_iterations, record=record, method=method,
+        guess=None if guess is None else [guess],
+    )  # fmt: skip
+    return batch[0]
+
+
+def solve_batch(
+    inverse: Inverse,
+    x0,
+    y_d,
+    *,
+    gamma: float = 1.0,
+    mode: str = "continuous",
+    tol: float = 1e-10,
+    max_iterations: int | None = None,
+    record: bool = True,
+    method: str = "auto",
+    guess: Sequence[Trajectory | None] | None = None,
+) -> BatchSolveResult:
+    """:func:`solve` for a batch of starts and targets, in one vectorized run.
+
+    Parameters
+    ----------
+    inverse : Inverse
+    x0 : array_like, shape (n, p) or (p,)
+        Start configurations (one is shared by all targets).
+    y_d : array_like, shape (n, r) or (r,)
+        Target task points (one is shared by all starts).
+    gamma, mode, tol, max_iterations, record, method
+        As in :func:`solve`, for every member.
+    guess : sequence of Trajectory or None, one per member, optional
+        As in :func:`solve`.
+
+    Returns
+    -------
+    BatchSolveResult
+        Index it for a member's :class:`SolveResult`.
+
+    Raises
+    ------
+    InvalidInputError, KinematicSingularityError, AlgorithmicSingularityError
+        As :func:`solve` (the first singular start names its configuration).
+    """
+    kin = inverse.kinematics
+    x0 = kin.check(x0, "x0")
+    y_d = kin.check_task(y_d, "target y_d")
     if x0.ndim > 2 or y_d.ndim > 2:
         raise InvalidInputError("x0 and y_d must be one point or a 2-D batch of points")
     xb = np.atleast_2d(x0)
@@ -558,26 +553,20 @@ def solve(
                 f"x0 has {len(xb)} configurations but y_d has {len(np.atleast_2d(y_d))} targets"
             )
     xb, yb = np.array(xb), np.array(yb)
-    gamma = positive(gamma, "gamma")
+    if mode not in MODES:
+        raise InvalidInputError(f"mode must be 'continuous' or 'discrete', got {mode!r}")
+    gamma = check_gamma(gamma, mode)
     tol = positive(tol, "tol")
-    if tol < 1e-14:
-        raise InvalidInputError(f"tol must be >= 1e-14 (double precision), got {tol:g}")
+    if tol < TOL_MIN:
+        raise InvalidInputError(f"tol must be >= {TOL_MIN:g} (double precision), got {tol:g}")
     if method not in ("auto", "picard", "dop853"):
         raise InvalidInputError(f"method must be 'auto', 'picard' or 'dop853', got {method!r}")
-    if mode not in ("continuous", "discrete"):
-        raise InvalidInputError(f"mode must be 'continuous' or 'discrete', got {mode!r}")
     if guess is not None and mode != "continuous":
         raise InvalidInputError("guess applies to continuous mode only")
     guesses = _guesses(guess, len(xb), kin.p, gamma)
-    if mode == "discrete" and gamma >= 2:
-        raise InvalidInputError(
-            f"gamma must be < 2 in discrete mode (got {gamma:g}): the error shrinks by "
-            "|1 - gamma| per iteration near the solution"
-        )
     default_cap = MAX_STEPS if mode == "continuous" else MAX_ITERATIONS
-    cap = count(
-        default_cap if max_iterations is None else max_iterations, "max_iterations", 1, 10**6
-    )
+    cap = default_cap if max_iterations is None else max_iterations
+    cap = count(cap, "max_iterations", 1, MAX_ITERATIONS_LIMIT)
 
     if mode == "continuous":
         x, _, status, nit, rec = _continuous(inverse, xb, yb, tol, cap, record, method, guesses)
@@ -615,7 +604,7 @@ def solve(
         _rec_x=rec_x,
         _status=status,
     )
-    return batch[0] if single else batch
+    return batch
 
 
 def solve_in_chunks(
@@ -683,9 +672,9 @@ def solve_in_chunks(
             f"solve_in_chunks takes one start (p,) and one target (r,); got shapes {x.shape} "
             f"and {y_d.shape}"
         )
-    size = count(chunk, "chunk", 1, 10**6)
+    size = count(chunk, "chunk", 1, MAX_ITERATIONS_LIMIT)
     cap = count(MAX_ITERATIONS if max_iterations is None else max_iterations,
-                "max_iterations", 1, 10**6)  # fmt: skip
+                "max_iterations", 1, MAX_ITERATIONS_LIMIT)  # fmt: skip
     e0 = float(np.linalg.norm(kin.forward(x[None]) - y_d, axis=-1)[0])
     pieces: list[Trajectory] = []
     done, status = 0, _RUNNING
@@ -693,10 +682,10 @@ def solve_in_chunks(
     stopped: JikError | None = None
     while True:
         try:
-            batch = cast(BatchSolveResult, solve(
+            batch = solve_batch(
                 inverse, x[None], y_d[None], gamma=gamma, mode="discrete", tol=tol,
                 max_iterations=min(size, cap - done), record=record,
-            ))  # fmt: skip
+            )  # fmt: skip
             res = batch[0]
         except JikError as exc:
             if size == 1:

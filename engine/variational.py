@@ -43,6 +43,7 @@ from jik.engine.exceptions import InvalidInputError
 from jik.engine.functionals import Region, check_region, error_functional_e2
 from jik.engine.inverses import pseudoinverse
 from jik.engine.kinematics import Kinematics, Manipulator2
+from jik.engine.progress import Progress, check_cancelled
 from jik.engine.validation import FloatArray, count
 
 #: Extra Gauss points per variable beyond the basis degree (R is not polynomial, e.g. cos 2 x3).
@@ -163,7 +164,7 @@ class SynthesisResult:
         E2 of that cubic on the region (NaN when there is none).
     grid : dict
         ``{name_1: [...], name_2: [...], "h": [[...]]}``, h on a uniform grid of the first two
-        region variables (h[i][j] at name_1[i], name_2[j]; others at the box centre).
+        region variables (``h[i][j]`` at ``name_1[i]``, ``name_2[j]``; others at the box centre).
     convergence : list of dict
         ``{"degree", "n_unknowns", "e2"}`` for the resolutions computed, the last the result.
     region, fixed : dict
@@ -181,6 +182,10 @@ class SynthesisResult:
     region: dict[str, tuple[float, float]] = field(default_factory=dict)
     fixed: dict[str, float] = field(default_factory=dict)
     degree: int = 0
+
+    def __repr__(self) -> str:
+        box = ", ".join(f"{k} in [{lo:.4g}, {hi:.4g}]" for k, (lo, hi) in self.region.items())
+        return f"SynthesisResult(E2 = {self.e2:.6g}, degree {self.degree}, {box})"
 
     def polynomial_coefficients(self) -> dict[str, float]:
         """Cubic coefficients keyed like ``"x2^2 x3^1"`` (JSON-friendly)."""
@@ -334,7 +339,7 @@ def synthesize_e2(
     degree: int | Sequence[int] = 16,
     dirichlet: Callable[[FloatArray], FloatArray] | None = None,
     fixed: Mapping[str, float] | None = None,
-    progress: Callable[[float], None] | None = None,
+    progress: Progress | None = None,
     convergence_degrees: Sequence[int] = (),
 ) -> SynthesisResult:
     """Minimise E2, eq. (19), over augmenting maps h of the region's variables (Ritz method).
@@ -352,8 +357,9 @@ def synthesize_e2(
         ``g(x) (n, p) -> (n,)``: boundary values of h. Default: natural boundary conditions
         n . (m P grad h - m K) = 0, with mean(h) = 0 over the box pinning the constant.
     fixed : mapping name -> value, optional
-    progress : callable, optional
-        Called with a fraction in [0, 1] as the work proceeds.
+    progress : Progress, optional
+        Told ``advance(fraction, 1)`` as the work proceeds, and asked between the degrees
+        whether to go on (:meth:`Progress.cancelled`: True raises ``RunCancelled``).
     convergence_degrees : sequence of int
         Lower degrees to solve as well, to show the convergence of E2 with resolution.
 
@@ -378,15 +384,16 @@ def synthesize_e2(
     done = 0.0
     problem = _Problem(kinematics, box, fix, [n + EXTRA_NODES for n in degs])
     if progress is not None:
-        progress(0.05)
+        progress.advance(0.05, 1.0)
     convergence = []
     system = (*problem.system(degs), degs)
     for q, c in zip(plan, cost, strict=True):
+        check_cancelled(progress, f"E2 synthesis cancelled before degree {max(q)}")
         coef, e2 = _solve(problem, system, q, dirichlet, kinematics)
         convergence.append({"degree": max(q), "n_unknowns": int(np.prod(np.add(q, 1))), "e2": e2})
         done += c
         if progress is not None:
-            progress(0.05 + 0.85 * done / cost.sum())
+            progress.advance(0.05 + 0.85 * done / cost.sum(), 1.0)
     amap = SynthesizedMap(coef, box, problem.variables, kinematics.p)
     poly, poly_e2 = None, float("nan")
     if d == 2:
@@ -404,13 +411,11 @@ def synthesize_e2(
         degree=max(degs),
     )
     if progress is not None:
-        progress(1.0)
+        progress.advance(1.0, 1.0)
     return result
 
 
-def synthesize_manipulator2(
-    l: float = 1.0, progress: Callable[[float], None] | None = None
-) -> SynthesisResult:
+def synthesize_manipulator2(l: float = 1.0, progress: Progress | None = None) -> SynthesisResult:
     """E2-optimal h(x2, x3) of Manipulator 2 on x2 in [-1, 1], x3 in [0, pi] (sec. 5.2).
 
     Natural boundary conditions, mean(h) = 0 over the box, x1 = 0 (the integrand does not

@@ -85,7 +85,12 @@ def serve(args: argparse.Namespace) -> int:
     announcer = Announcer(args.host, args.port)
     announcer.start()
     try:
-        run_server(host=args.host, port=args.port, allowed_hosts=tuple(args.allowed_host))
+        run_server(
+            host=args.host,
+            port=args.port,
+            allowed_hosts=tuple(args.allowed_host),
+            forwarded_allow_ips=args.forwarded_allow_ips,
+        )
     except PortInUse as busy:
         sys.stderr.write(f"jik serve: {busy}\n")
         return 2
@@ -121,6 +126,11 @@ def main(argv: list[str] | None = None) -> int:
         "--allowed-host", action="append", default=[], metavar="NAME",
         help="a host name the server answers to besides localhost, 127.0.0.1 and [::1] (repeat it; "
         "also JIK_ALLOWED_HOSTS, comma-separated; '*' for any)",
+    )  # fmt: skip
+    p.add_argument(
+        "--forwarded-allow-ips", default=None, metavar="IPS",
+        help="behind a reverse proxy: its addresses (comma-separated, '*' for any), whose "
+        "X-Forwarded-For names the client; default: none, the client is the connection's peer",
     )  # fmt: skip
     p.set_defaults(func=serve)
 

@@ -37,10 +37,15 @@ export function robotEditor(kinds, send) {
   const apply = el("button", { type: "button", id: "robot-apply", disabled: true }, "apply");
   const note = el("p", { id: "robot-note", className: "note" });
   const inputs = new Map(); // field name -> [input, description, error note]
+  // What the user typed, by kind (kept across a change of kind, a refusal and the session's
+  // state events until a definition is applied), and whether the fields shown hold typing.
+  const typed = new Map();
   let shownKind = "";
+  let edited = false;
 
   function build(k, values = {}) {
     shownKind = k;
+    edited = false;
     inputs.clear();
     apply.disabled = !k;
     if (!k) { fields.replaceChildren(); return; }
@@ -71,15 +76,41 @@ export function robotEditor(kinds, send) {
     return d;
   }
 
+  // The fields' texts as typed (a checkbox: its state), to rebuild them as they were.
+  function texts() {
+    const t = {};
+    for (const [name, [input, f]] of inputs) t[name] = f.type === "boolean" ? input.checked : input.value;
+    return t;
+  }
+
+  function restore(k) {
+    build(k);
+    const t = typed.get(k);
+    if (!t) return;
+    for (const [name, [input, f]] of inputs) {
+      if (!(name in t)) continue;
+      if (f.type === "boolean") input.checked = t[name];
+      else input.value = t[name];
+    }
+    edited = true;
+  }
+
   function clearErrors() {
-    for (const [, [, , error]] of inputs) { error.hidden = true; error.textContent = ""; }
+    for (const [, [input, , error]] of inputs) { error.hidden = true; error.textContent = ""; input.removeAttribute("aria-invalid"); }
     note.textContent = "";
   }
 
-  kind.addEventListener("change", () => { clearErrors(); build(kind.value); });
+  kind.addEventListener("change", () => {
+    if (edited) typed.set(shownKind, texts());
+    clearErrors();
+    restore(kind.value);
+  });
+  fields.addEventListener("input", () => { edited = true; typed.set(shownKind, texts()); });
+  fields.addEventListener("change", () => { edited = true; typed.set(shownKind, texts()); });
   apply.addEventListener("click", () => {
     clearErrors();
     note.textContent = "applying…";
+    typed.set(shownKind, texts());
     send({ robot: shownKind, robot_definition: definition() });
   });
   box.append(el("div", { className: "robot-kind" }, el("label", { htmlFor: "robot-kind" }, "kind"), kind, apply), fields, note);
@@ -87,12 +118,19 @@ export function robotEditor(kinds, send) {
   return {
     // The session's state: a user robot's definition fills the editor (unless it shows the kind
     // being edited); a refusal then stays where it is.
-    show(state) {
-      if (state.robot_definition && state.robot !== shownKind) {
+    // What the user typed and did not apply stays (``refused``: the state in force after a
+    // refusal, which is not what was applied).
+    show(state, refused = false) {
+      const applying = note.textContent === "applying…" && !refused;
+      if (state.robot_definition && applying && state.robot === shownKind) {
+        typed.delete(shownKind);
+        edited = false;
+        note.textContent = `applied: ${state.robot}`;
+      }
+      if (state.robot_definition && state.robot !== shownKind && !edited) {
         kind.value = state.robot;
         build(state.robot, state.robot_definition);
       }
-      if (state.robot_definition && note.textContent === "applying…") note.textContent = `applied: ${state.robot}`;
     },
     // A refused field under robot_definition: its message next to it; whether it was shown.
     refused(field, message) {
@@ -100,10 +138,12 @@ export function robotEditor(kinds, send) {
       box.open = true;
       const name = field.split(".")[1];
       const entry = inputs.get(name);
-      note.textContent = "not applied: see the field marked below";
       if (!entry) { note.textContent = `not applied: ${message}`; return true; }
+      note.textContent = `not applied: see the field ${name}`;
       entry[2].hidden = false;
-      entry[2].textContent = message;
+      entry[2].textContent = message.startsWith(`${field}: `) ? message.slice(field.length + 2) : message;
+      entry[0].setAttribute("aria-invalid", "true");
+      entry[0].scrollIntoView({ block: "nearest" });
       return true;
     },
   };

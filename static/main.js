@@ -52,7 +52,7 @@ function onState(msg, force = false) {
   page.state = msg.state;
   session.generation = Math.max(session.generation, msg.generation);
   showControls(msg, send, force);
-  page.editor.show(msg.state);
+  page.editor.show(msg.state, msg.type === "refused");
   rememberInUrl(msg.state);
   atlasState(msg.state);
   if (msg.generation > page.shown) setStatus(`computing generation ${msg.generation}…`);
@@ -74,7 +74,8 @@ async function onResult(msg) {
   markStale(msg.stale || []);
   page.shown = msg.generation;
   page.shownState = msg.state;
-  setExportNote(`jik · generation ${msg.generation} · ${describe(msg.state)}`);
+  setExportNote(`jik · generation ${msg.generation} · ${describe(msg.state)}`,
+    `${msg.state.augmentation}-${msg.state.mode}-g${msg.generation}`);
   document.body.dataset.generation = msg.generation;
   document.body.dataset.robot = msg.state.robot;
   showProgress(1, 0);

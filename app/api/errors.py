@@ -14,7 +14,8 @@ The dashboard sessions' errors come here too: a refused value (the field it name
 is 422, a session that is not there 404, a full session store 503 with Retry-After, an export
 with no result of the current state 409 (its computation failed) or 503 (not yet). A body
 over the size limit is 413 ``{"detail": "request body of ... bytes is larger ..."}``
-(:class:`BodyLimit`).
+(:class:`jik.app.api.body_limit.BodyLimit`). The messages of validation errors are written
+by :mod:`jik.app.api.validation`.
 """
 
 from __future__ import annotations
@@ -23,121 +24,24 @@ import logging
 from collections.abc import Callable
 from typing import Any
 
-from fastapi import FastAPI, HTTPException, Request
+from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.routing import Match
-from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
+from jik.app.api.validation import validation_detail
 from jik.app.compute.atlas_jobs import AtlasJobNotFound, AtlasJobsFull
 from jik.app.compute.exceptions import ComputeError, RequestError, ServiceUnavailable
-from jik.app.compute.schemas import (
-    AUGMENTATION_MODELS,
-    ROBOT_MODELS,
-    ROBOT_NAMES,
-    USER_AUGMENTATION_MODELS,
-    USER_ROBOT_MODELS,
-    ErrorResponse,
-)
+from jik.app.compute.schemas import ErrorResponse
 from jik.app.dashboard.sessions import ExportUnavailable, SessionNotFound, SessionsFull
 from jik.engine.exceptions import InvalidInputError
-from jik.engine.registry import ROBOTS
 
 log = logging.getLogger("jik.api")
-_TAGS = {*ROBOT_MODELS, *AUGMENTATION_MODELS, *USER_ROBOT_MODELS, *USER_AUGMENTATION_MODELS}
-#: The tags of a request's variants: the catalogue robots and the kinds of user robots.
-_VARIANTS = set(ROBOT_NAMES)
-_TYPE_LABELS = {"str", "float", "int", "bool", "constrained-float", "constrained-str"}
-
-
-def _field(loc) -> str:
-    """Field path of a pydantic location: ``("body", "robot", "manipulator2", "l")`` -> ``robot.l``.
-
-    Indices become ``x0[2]``; the discriminator tag of a union member (a request's robot, a
-    robot's or a map's name) is dropped.
-    """
-    # (a member of a plain union is labelled by its type: "str", "tuple[float, ...]")
-    parts = [
-        str(p) for p in loc if p != "body" and str(p) not in _TYPE_LABELS and "[" not in str(p)
-    ]
-    if len(parts) > 1 and parts[0] in _VARIANTS:
-        del parts[0]
-    if len(parts) > 2 and parts[0] in ("robot", "augmentation") and parts[1] in _TAGS:
-        del parts[1]
-    out: list[str] = []
-    for p in parts:
-        if p.isdigit() and out:
-            out[-1] += f"[{p}]"
-        else:
-            out.append(p)
-    return ".".join(out) or "body"
-
-
-def _location(loc) -> list:
-    """A pydantic location without the labels of union members that are not fields: the
-    request's robot variant (``("body", "manipulator2", "x0")``) and a member labelled by its
-    type (``("body", "path", "str")``)."""
-    out = [p for p in loc if not (isinstance(p, str) and (p in _TYPE_LABELS or "[" in p))]
-    if len(out) > 2 and out[0] == "body" and out[1] in _VARIANTS:
-        del out[1]
-    return out
-
-
-def _validation_detail(errors) -> list[dict]:
-    detail = []
-    for e in errors:
-        loc = _location(e.get("loc", ()))
-        msg = str(e.get("msg", "invalid"))
-        if e.get("type") == "extra_forbidden":
-            msg = "unknown field; remove it"
-        elif e.get("type") == "json_invalid":  # (loc: the body and the character's position)
-            ctx = e.get("ctx") or {}
-            where = f" at character {loc[1]}" if len(loc) > 1 else ""
-            detail.append({"loc": ["body"], "type": "json_invalid", "msg":
-                           f"body: not valid JSON{where}: {ctx.get('error', msg)}"})  # fmt: skip
-            continue
-        elif e.get("type") == "union_tag_invalid":
-            ctx = e.get("ctx") or {}
-            msg = f"unknown name {ctx.get('tag')!r}; choose one of {ctx.get('expected_tags')}"
-        elif e.get("type") == "unknown_robot":  # (the request's variant, chosen by robot.name)
-            loc = [*loc, "robot"]
-            body = e.get("input")
-            robot = body.get("robot") if isinstance(body, dict) else None
-            name = robot.get("name") if isinstance(robot, dict) else None
-            names = (e.get("ctx") or {}).get("names", ROBOT_NAMES)  # (the route's robots)
-            if isinstance(body, dict) and "robot" not in body:
-                msg = "Field required"
-            elif name is None:
-                msg = f"give the robot, with a name among {names}"
-            else:
-                msg = f"unknown name {name!r}; choose one of {names}"
-        elif e.get("type") in ("too_short", "too_long"):
-            msg = _length_message(e.get("loc", ()), e.get("ctx") or {}) or msg
-        detail.append({"loc": loc, "msg": f"{_field(loc)}: {msg}", "type": str(e.get("type"))})
-    return detail
-
-
-#: Vectors whose length is the robot's p (the others: r); path and shifts hold points.
-_CONFIGURATIONS = ("x0", "reference")
-_TASK_VECTORS = ("target", "path", "shifts")
-
-
-def _length_message(loc, ctx: dict) -> str | None:
-    """A vector of the wrong length for the request's robot (its tag is the location's second
-    part): how many components it needs and why."""
-    parts = [str(p) for p in loc]
-    spec = ROBOTS.get(parts[1]) if len(parts) > 2 else None
-    if spec is None or parts[2] not in (*_CONFIGURATIONS, *_TASK_VECTORS):
-        return None
-    if parts[2] in ("path", "shifts") and len(parts) < 4:
-        return None  # (the list of points itself)
-    n, what = (spec.p, "p") if parts[2] in _CONFIGURATIONS else (len(spec.task_names), "r")
-    return f"must have {n} components ({what} of {spec.name}), got {ctx.get('actual_length')}"
 
 
 def validation_error_response(exc: RequestValidationError) -> JSONResponse:
-    return JSONResponse(status_code=422, content={"detail": _validation_detail(exc.errors())})
+    return JSONResponse(status_code=422, content={"detail": validation_detail(exc.errors())})
 
 
 def request_error_response(exc: RequestError) -> JSONResponse:
@@ -198,8 +102,8 @@ def sessions_full_response(exc: SessionsFull) -> JSONResponse:
 
 
 def atlas_job_not_found_response(exc: AtlasJobNotFound) -> JSONResponse:
-    return JSONResponse(status_code=404, content={"detail": (
-        f"no atlas job {exc.args[0]!r} (it was cancelled, or ended and expired)")})  # fmt: skip
+    job_id, why = exc.args
+    return JSONResponse(status_code=404, content={"detail": f"no atlas job {job_id!r}: {why}"})
 
 
 def atlas_jobs_full_response(exc: AtlasJobsFull) -> JSONResponse:
@@ -320,61 +224,3 @@ def add_error_handlers(app: FastAPI) -> None:
         app.add_exception_handler(kind, _handler(respond))
     app.add_exception_handler(Exception, _handler(unexpected_error_response))
     document_errors(app)
-
-
-def _too_large(detail: str) -> JSONResponse:
-    return JSONResponse(status_code=413, content={"detail": detail})
-
-
-class _TooLarge(HTTPException):
-    """Raised while reading an over-long body; an HTTPException so that FastAPI's routes pass it
-    on (to their 413 handler) instead of reporting a body they could not parse."""
-
-
-class BodyLimit:
-    """ASGI middleware: a request body over ``limit`` bytes gets a JSON 413.
-
-    A Content-Length over the limit is answered before the body is read; a body sent without a
-    length is counted as it is read and cut off at the limit.
-    """
-
-    def __init__(self, app: ASGIApp, limit: int) -> None:
-        self.app = app
-        self.limit = limit
-
-    def _message(self, size: str) -> str:
-        return (
-            f"request body of {size} bytes is larger than the limit of {self.limit} bytes; "
-            "send a smaller request"
-        )
-
-    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
-        if scope["type"] != "http":
-            await self.app(scope, receive, send)
-            return
-        for name, value in scope.get("headers", ()):
-            if name == b"content-length" and value.isdigit() and int(value) > self.limit:
-                await _too_large(self._message(str(int(value))))(scope, receive, send)
-                return
-        seen = 0
-        started = False
-
-        async def counted() -> Message:
-            nonlocal seen
-            message = await receive()
-            seen += len(message.get("body", b""))
-            if seen > self.limit:
-                raise _TooLarge(413, self._message(f"more than {self.limit}"))
-            return message
-
-        async def watched(message: Message) -> None:
-            nonlocal started
-            started = started or message["type"] == "http.response.start"
-            await send(message)
-
-        try:
-            await self.app(scope, counted, watched)
-        except _TooLarge as exc:  # from the /solve fast path, which has no handlers
-            if started:
-                raise
-            await _too_large(exc.detail)(scope, receive, send)

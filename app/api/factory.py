@@ -12,14 +12,15 @@ from fastapi import FastAPI
 from fastapi_offline import FastAPIOffline
 
 from jik import __version__
-from jik.app.api.errors import BodyLimit, add_error_handlers
+from jik.app.api.body_limit import BodyLimit
+from jik.app.api.errors import add_error_handlers
 from jik.app.api.fastpath import SolveFastPath
 from jik.app.api.routes import dashboard, health, repeatability, robots, sessions, solve, synthesize
 from jik.app.api.routes.atlas import router as atlas_router
 from jik.app.api.routes.session_atlas import router as session_atlas_router
 from jik.app.api.security import SecurityMiddleware, allowed_hosts_from_env
 from jik.app.compute.pool import ComputePool
-from jik.app.compute.settings import Settings, env_flag
+from jik.app.compute.settings import Settings
 
 #: Largest request body accepted (413 beyond): the largest valid request is a few kilobytes.
 MAX_BODY_BYTES = 1 << 20
@@ -34,8 +35,9 @@ def create_app(
     ``fast_solve`` serves well-formed /solve requests on a short path (:mod:`jik.app.api.fastpath`;
     default on, ``JIK_FAST_SOLVE=0`` turns it off); ``allowed_hosts``: the host names it answers
     to besides the loopback names (default: ``JIK_ALLOWED_HOSTS``, :mod:`jik.app.api.security`)."""
+    settings = settings or Settings()  # (the environment, read here once for the app)
     if fast_solve is None:
-        fast_solve = env_flag("JIK_FAST_SOLVE")
+        fast_solve = settings.fast_solve
     pool = ComputePool(settings)
 
     @asynccontextmanager
@@ -74,6 +76,6 @@ def create_app(
         app.add_middleware(SolveFastPath, pool=pool)
     app.add_middleware(BodyLimit, limit=MAX_BODY_BYTES)  # before any body is read
     # Outermost: hosts, origins and content types are checked before anything else runs.
-    hosts = allowed_hosts_from_env(allowed_hosts or ())
+    hosts = allowed_hosts_from_env(allowed_hosts or (), settings)
     app.add_middleware(SecurityMiddleware, allowed_hosts=hosts)
     return app

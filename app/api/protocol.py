@@ -1,4 +1,5 @@
-"""The HTTP protocol ``jik serve`` runs under uvicorn: uvicorn's own, with a deadline for reading.
+"""The HTTP protocol ``jik serve`` runs under uvicorn: uvicorn's own, with a deadline for reading
+and a cap on the size of a request's headers.
 
 uvicorn times out an idle keep-alive connection but not one that is sending a request: a client
 that opens a connection and sends nothing, or half of its headers, or part of a declared body,
@@ -10,18 +11,33 @@ connection, for the first request), however slowly the bytes trickle in:
 - headers complete, body not: the connection is closed (the application, still waiting for the
   body, sees the client disconnect; no response can be sent through it any more).
 
+Headers longer than :data:`MAX_HEADER_BYTES` are answered ``431 Request Header Fields Too Large``
+at once and the connection is closed (uvicorn's httptools protocol has no such limit: the parser
+kept a 48 MB header in memory and the request was served; h11's ``h11_max_incomplete_event_size``
+answers a bare 400, and h11 parses slower).
+
 WebSocket upgrades and responses that take long to compute are not affected: the deadline stops
 when the request has been read.
+
+A client that pipelines requests and goes away: every request it left unanswered sees the
+disconnect (uvicorn tells only the newest one, and the older one being answered wrote to a closed
+transport, logging a traceback).
+
+uvicorn offers neither: ``timeout_keep_alive`` counts only the idle time between requests, and
+``limit_concurrency`` caps connections (slow ones included) rather than freeing them. The figures
+are in ``docs/benchmarks.md`` ("Slow and oversized requests").
 """
 
 from __future__ import annotations
 
 import asyncio
 
-from uvicorn.protocols.http.httptools_impl import HttpToolsProtocol
+from uvicorn.protocols.http.httptools_impl import HttpToolsProtocol, RequestResponseCycle
 
 #: Default seconds a client has to send a whole request (``JIK_READ_SECONDS``).
 READ_SECONDS = 10.0
+#: Largest request line and headers [bytes]; 431 beyond, as soon as they cross it.
+MAX_HEADER_BYTES = 64 * 1024
 
 _TIMEOUT_RESPONSE = (
     b"HTTP/1.1 408 Request Timeout\r\n"
@@ -30,6 +46,14 @@ _TIMEOUT_RESPONSE = (
     b"connection: close\r\n"
     b"\r\n"
     b"request not received in time; send it at once\n"
+)
+_TOO_LARGE_BODY = b"request headers larger than %d bytes\n" % MAX_HEADER_BYTES
+_TOO_LARGE_RESPONSE = (
+    b"HTTP/1.1 431 Request Header Fields Too Large\r\n"
+    b"content-type: text/plain; charset=utf-8\r\n"
+    b"content-length: %d\r\n"
+    b"connection: close\r\n"
+    b"\r\n%s" % (len(_TOO_LARGE_BODY), _TOO_LARGE_BODY)
 )
 
 
@@ -43,12 +67,32 @@ class ReadDeadlineProtocol(HttpToolsProtocol):
     def connection_made(self, transport: asyncio.Transport) -> None:  # type: ignore[override]
         self._read_timer: asyncio.TimerHandle | None = None
         self._headers_read = False
+        self._header_bytes = 0  # of the request being read, up to its blank line
+        self._cycles: list[RequestResponseCycle] = []  # requests read and not yet answered
         super().connection_made(transport)
         self._start_reading()
 
     def connection_lost(self, exc: Exception | None) -> None:
         self._stop_reading()
+        # uvicorn marks only the newest request as disconnected; with pipelined requests the
+        # one being answered is an older one, whose response then went to a closed transport
+        # ("Exception in ASGI application"). Every unanswered request is told here.
+        for cycle in self._cycles:
+            if not cycle.response_complete:
+                cycle.disconnected = True
+                cycle.message_event.set()
+        self._cycles.clear()
         super().connection_lost(exc)
+
+    def data_received(self, data: bytes) -> None:
+        if not self._headers_read:
+            end = data.find(b"\r\n\r\n")
+            self._header_bytes += len(data) if end < 0 else end
+            if self._header_bytes > MAX_HEADER_BYTES:
+                self._stop_reading()
+                self._refuse(_TOO_LARGE_RESPONSE)
+                return
+        super().data_received(data)
 
     def on_message_begin(self) -> None:
         super().on_message_begin()
@@ -57,9 +101,13 @@ class ReadDeadlineProtocol(HttpToolsProtocol):
     def on_headers_complete(self) -> None:
         self._headers_read = True
         super().on_headers_complete()
+        if self.cycle is not None and self.cycle not in self._cycles:
+            self._cycles = [c for c in self._cycles if not c.response_complete] + [self.cycle]
 
     def on_message_complete(self) -> None:
         self._stop_reading()
+        self._headers_read = False  # the next bytes are the next request's
+        self._header_bytes = 0
         super().on_message_complete()
 
     def handle_websocket_upgrade(self) -> None:
@@ -80,9 +128,14 @@ class ReadDeadlineProtocol(HttpToolsProtocol):
         self._read_timer = None
         if self.transport.is_closing():
             return
+        self._refuse(_TIMEOUT_RESPONSE if not self._headers_read else b"")
+
+    def _refuse(self, response: bytes) -> None:
+        """Close the connection, answering ``response`` first unless a response to an earlier
+        request on it is still being sent (its bytes would be mixed with it)."""
         previous_response_pending = self.cycle is not None and not self.cycle.response_complete
-        if not self._headers_read and not previous_response_pending:
-            self.transport.write(_TIMEOUT_RESPONSE)
+        if response and not previous_response_pending:
+            self.transport.write(response)
         self.transport.close()
 
 

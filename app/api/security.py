@@ -23,12 +23,13 @@ websocket relay (docs/security.md has the threat model):
 from __future__ import annotations
 
 import json
-import os
 from collections.abc import Iterable
 from urllib.parse import urlsplit
 
 from starlette.routing import Match
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+from jik.app.compute.settings import Settings
 
 #: Host names allowed by default: the loopback names.
 LOOPBACK_HOSTS = ("localhost", "127.0.0.1", "[::1]", "::1")
@@ -53,10 +54,12 @@ _SCENE_POLICY = (
 _DOCS_POLICY = _SCENE_POLICY
 
 
-def allowed_hosts_from_env(extra: Iterable[str] = ()) -> tuple[str, ...]:
-    """The loopback names, ``JIK_ALLOWED_HOSTS`` (comma-separated) and ``extra``."""
-    env = [h.strip() for h in os.environ.get("JIK_ALLOWED_HOSTS", "").split(",") if h.strip()]
-    return (*LOOPBACK_HOSTS, *env, *extra)
+def allowed_hosts_from_env(
+    extra: Iterable[str] = (), settings: Settings | None = None
+) -> tuple[str, ...]:
+    """The loopback names, ``settings.allowed_hosts`` (``JIK_ALLOWED_HOSTS``, comma-separated)
+    and ``extra``."""
+    return (*LOOPBACK_HOSTS, *(settings or Settings()).host_names, *extra)
 
 
 def _host_name(host: str) -> str:
@@ -94,7 +97,7 @@ class SecurityMiddleware:
         if refusal is not None:
             status, message = refusal
             if websocket:
-                await send({"type": "websocket.close", "code": 4000 + status, "reason": message})
+                await _close_websocket(receive, send, 4000 + status, message)
                 return
             await _json(send, status, message)
             return
@@ -146,6 +149,17 @@ def _routed(scope: Scope) -> bool:
     if routes is None:
         return True
     return any(route.matches(scope)[0] == Match.FULL for route in routes)
+
+
+async def _close_websocket(receive: Receive, send: Send, code: int, reason: str) -> None:
+    """Accept, then close with ``code`` (4400, 4403): a refused handshake reaches a browser's
+    script only as 1006, a close code as itself. Nothing the client sends is read."""
+    if (await receive())["type"] != "websocket.connect":
+        return
+    await send({"type": "websocket.accept"})
+    # (a close frame's reason is at most 123 bytes of UTF-8)
+    short = reason.encode()[:123].decode(errors="ignore")
+    await send({"type": "websocket.close", "code": code, "reason": short})
 
 
 async def _json(send: Send, status: int, message: str) -> None:

@@ -9,20 +9,16 @@ reached only through the API's proxy (:mod:`jik.app.api.routes.sessions`).
 from __future__ import annotations
 
 import errno
-import os
 import signal
 import socket
 
 import uvicorn
 
 from jik.app.api.factory import create_app
-from jik.app.api.protocol import READ_SECONDS, with_read_deadline
+from jik.app.api.protocol import with_read_deadline
+from jik.app.compute.settings import Settings
 from jik.app.dashboard.sessions import SessionLimits, SessionStore
 from jik.app.scene import start_scene
-
-#: Default cap on open connections and running requests (``JIK_MAX_CONNECTIONS``); beyond it
-#: uvicorn answers 503 at once instead of queueing.
-MAX_CONNECTIONS = 1000
 
 
 class PortInUse(RuntimeError):
@@ -53,7 +49,10 @@ def _stopped(signum: int, frame: object) -> None:
 
 
 def run_server(
-    host: str = "127.0.0.1", port: int = 8000, allowed_hosts: tuple[str, ...] = ()
+    host: str = "127.0.0.1",
+    port: int = 8000,
+    allowed_hosts: tuple[str, ...] = (),
+    forwarded_allow_ips: str | None = None,
 ) -> None:
     """Serve the API and the dashboard on ``host:port`` until interrupted (SIGINT or SIGTERM).
 
@@ -65,6 +64,11 @@ def run_server(
         HTTP port of the API (OpenAPI docs at /docs), the page and its scenes.
     allowed_hosts : tuple of str
         Host names the server answers to besides the loopback names and ``JIK_ALLOWED_HOSTS``.
+    forwarded_allow_ips : str or None
+        Addresses of the reverse proxies whose ``X-Forwarded-For`` and ``X-Forwarded-Proto``
+        are believed (comma-separated, ``*`` for any; uvicorn's ``forwarded_allow_ips``). None:
+        no proxy; the client is the socket's peer, whatever the headers say (the per-client
+        limits count peers).
 
     Raises
     ------
@@ -72,10 +76,11 @@ def run_server(
         If the port is taken, before anything is started.
     """
     sock = bind(host, port, "--port")
-    app = create_app(allowed_hosts=allowed_hosts)
+    settings = Settings()  # (the environment, read once)
+    app = create_app(settings, allowed_hosts=allowed_hosts)
     # The sessions share the app's compute pool (JIK_WORKERS processes) with the API.
     app.state.sessions = SessionStore(
-        SessionLimits.from_env(), scene_factory=start_scene, pool=app.state.pool
+        SessionLimits.from_settings(settings), scene_factory=start_scene, pool=app.state.pool
     )
     # uvicorn shuts down gracefully on SIGINT and SIGTERM (the lifespan stops the sessions and
     # the workers), restores the handlers it found and then raises the signal again. With these
@@ -89,9 +94,14 @@ def run_server(
             port=port,
             log_level="info",
             access_log=False,
-            # A request must arrive whole within JIK_READ_SECONDS (slow senders are cut off).
-            http=with_read_deadline(float(os.environ.get("JIK_READ_SECONDS", READ_SECONDS))),
-            limit_concurrency=int(os.environ.get("JIK_MAX_CONNECTIONS", MAX_CONNECTIONS)),
+            # A request must arrive whole within read_seconds (slow senders are cut off).
+            http=with_read_deadline(settings.read_seconds),
+            # Beyond max_connections uvicorn answers 503 at once instead of queueing.
+            limit_concurrency=settings.max_connections,
+            # uvicorn believes X-Forwarded-For from 127.0.0.1 unless told otherwise: any local
+            # client could then name itself anew with each request.
+            proxy_headers=forwarded_allow_ips is not None,
+            forwarded_allow_ips=forwarded_allow_ips or "",
         )
         uvicorn.Server(config).run(sockets=[sock])
     finally:

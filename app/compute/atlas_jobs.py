@@ -3,10 +3,11 @@
 An atlas (:mod:`jik.engine.atlas`) takes seconds to minutes, longer than a request may wait, so
 ``POST /atlas`` only checks the request and plans the atlas (:func:`plan_request`, in a compute
 worker: its time and memory limits hold for the tracing), then
-:class:`AtlasJobs` runs it in a thread of its own that drives worker processes
-(``engine.atlas_run.run_atlas`` with a ``processes:N`` backend: the numbers work outside the
-server's interpreter and its GIL). A job does not belong to a connection: it runs on when its
-client goes away, and is dropped ``keep_for`` seconds after it ends (or when cancelled).
+:class:`AtlasJobs` runs it in a thread of its own that hands its chunks to the server's compute
+pool (:class:`PoolBackend`: the same worker processes as the API's requests, with their time
+and memory limits, queued first come first served with them; they stop with the server). A
+job does not belong to a connection: it runs on when its client goes away, and is dropped
+``keep_for`` seconds after it ends (or when cancelled).
 
 Limits: at most ``max_running`` atlases compute at once (the others wait, queued), at most
 ``max_jobs`` are kept in all and ``per_client`` queued or running for one client, and one job's
@@ -16,9 +17,12 @@ leg ends in the result.
 
 from __future__ import annotations
 
+import re
 import secrets
 import threading
 import time
+from collections.abc import Callable, Iterable, Iterator
+from concurrent.futures import FIRST_COMPLETED, Future, wait
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -27,18 +31,20 @@ import numpy as np
 from jik.app.compute.atlas_schemas import AtlasJobResponse, AtlasRequest
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.requests import build_augmentation, build_robot, nullable
-from jik.app.compute.settings import Settings
+from jik.app.compute.worker import task
 from jik.engine.atlas import AtlasPlan, plan_atlas
-from jik.engine.atlas_backends import ProcessPool
+from jik.engine.atlas_backends import IN_FLIGHT
 from jik.engine.atlas_run import AtlasResult, run_atlas
 from jik.engine.exceptions import InvalidInputError, RunCancelled
+from jik.engine.progress import ProgressCallbacks
 from jik.engine.registry import make_inverse
 from jik.engine.repeatability import CLOSE_TOL
 from jik.engine.self_motion import MAX_ARC
+from jik.engine.solver import gamma_problem
 
 
 class AtlasJobNotFound(LookupError):
-    """No job with that id (never made, cancelled, or dropped after ``keep_for``): HTTP 404."""
+    """No job with that id: HTTP 404; ``args``: the id and why it is not there."""
 
 
 class AtlasJobsFull(RuntimeError):
@@ -60,10 +66,6 @@ class AtlasLimits:
     max_leg_ends: int = 200_000
     #: seconds a job is kept after it ends
     keep_for: float = 600.0
-    #: worker processes of a running atlas
-    workers: int = 2
-    #: address space of each (MB; 0: no limit): the compute workers' (``JIK_WORKER_MEMORY_MB``)
-    worker_memory: int = Settings.worker_memory
 
 
 def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
@@ -85,8 +87,8 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
             raise RequestError(name, f"must have {size} components, got {len(v)}")
     gamma = spec.default_gamma if req.gamma is None else req.gamma
     mode = req.mode or spec.default_mode
-    if mode == "discrete" and gamma >= 2:
-        raise RequestError("gamma", f"must be < 2 in discrete mode, got {gamma:g}")
+    if (why := gamma_problem(gamma, mode)) is not None:
+        raise RequestError("gamma", why)
     paths = len(req.shifts or [0]) * len(req.scales or [0])
     closed = np.linalg.norm(np.subtract(req.path[-1], req.path[0])) <= CLOSE_TOL
     legs = req.starts * paths * req.cycles * (len(req.path) - closed) * len(req.algorithms)
@@ -109,14 +111,56 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
     )  # fmt: skip
 
 
+@task(
+    "reference",
+    "another reference or path (eq. (7) from the reference to the path's first point ran out "
+    "of memory)",
+)
 def plan_task(req: str, limits: AtlasLimits):
-    """:func:`plan_request` of a request (JSON) as a compute worker's task (``atlas.plan``),
+    """:func:`plan_request` of a request (JSON) as a compute worker's task,
     within the workers' time and memory limits (tracing the curves solves eq. (7)): the plan and
     None, or None and the refusal (message, field), for the server to raise again."""
     try:
         return plan_request(AtlasRequest.model_validate_json(req), limits), None
     except InvalidInputError as exc:
         return None, (str(exc), exc.field)
+
+
+@task("starts", "fewer starts or cycles")
+def atlas_chunk(fn: Callable[[Any], Any], chunk: Any) -> Any:
+    """``fn(chunk)``: one chunk of an atlas in a compute worker."""
+    return fn(chunk)
+
+
+class PoolBackend:
+    """An atlas backend (:class:`jik.engine.atlas_backends.Backend`) on the server's compute
+    pool (a :class:`~jik.app.compute.pool.ComputePool`): at most ``IN_FLIGHT`` chunks per worker
+    submitted at once, results in the order they finish; leaving gives up the chunks in flight."""
+
+    def __init__(self, pool: Any) -> None:
+        self.pool = pool
+        self.workers = pool.settings.workers
+
+    def __enter__(self) -> PoolBackend:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        return None
+
+    def imap_unordered(self, fn: Callable[[Any], Any], tasks: Iterable[Any]) -> Iterator[Any]:
+        pending: set[Future] = set()
+        try:
+            for chunk in tasks:
+                pending.add(self.pool.submit(atlas_chunk, fn, chunk))
+                if len(pending) >= IN_FLIGHT * self.workers:
+                    finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+                    yield from (f.result() for f in finished)
+            while pending:
+                finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+                yield from (f.result() for f in finished)
+        finally:
+            for f in pending:
+                f.cancel()
 
 
 def result_document(res: AtlasResult, arc, leg_ends: bool) -> dict[str, Any]:
@@ -152,12 +196,27 @@ class AtlasJob:
     cancel: threading.Event = field(default_factory=threading.Event)
     #: The request it was started from (the dashboard draws the result with it).
     request: AtlasRequest | None = None
+    #: Whether it holds one of the ``max_running`` slots (given back once, at its end or its
+    #: cancel, whichever comes first).
+    holds_slot: bool = False
 
-    def response(self) -> AtlasJobResponse:
+    def response(self, ahead: int | None = None, running: int = 1) -> AtlasJobResponse:
+        """The job's state; ``ahead``: the jobs before it in the queue, of which ``running``
+        are computing (:meth:`AtlasJobs.response` counts them)."""
         end = self.ended if self.ended is not None else time.monotonic()
+        message = {"running": "computing", "done": "done", "failed": "failed",
+                   "cancelled": "cancelled"}.get(self.status, "queued")  # fmt: skip
+        if self.status == "queued" and ahead is not None:
+            message = (
+                f"queued behind {ahead} atlas job{'s' * (ahead != 1)} ({running} computing, "
+                f"the rest waiting); it starts when they end"
+                if ahead
+                else "starting"
+            )
         return AtlasJobResponse(
             id=self.id, status=self.status, runs=self.plan.size, runs_done=self.runs_done,
             progress=self.runs_done / self.plan.size, elapsed_s=end - self.started,
+            queue_position=ahead if self.status == "queued" else None, message=message,
             error=self.error, result=self.result,  # type: ignore[arg-type]  # (validated)
         )  # fmt: skip
 
@@ -169,11 +228,17 @@ class AtlasJob:
 class AtlasJobs:
     """The API's atlas jobs (see the module docstring)."""
 
-    def __init__(self, limits: AtlasLimits | None = None) -> None:
+    def __init__(self, limits: AtlasLimits | None = None, pool: Any = None) -> None:
+        """``pool``: the compute pool whose workers run the chunks (:class:`PoolBackend`;
+        None: each job's own thread runs them)."""
         self.limits = limits or AtlasLimits()
+        self._pool = pool
         self._jobs: dict[str, AtlasJob] = {}
         self._lock = threading.Lock()
         self._slots = threading.Semaphore(self.limits.max_running)
+        #: The first characters of this server's job ids: an id with others is a job of an
+        #: earlier server process, lost when it stopped (jobs live in memory).
+        self.run = secrets.token_hex(3)
 
     def check_room(self, client: str) -> None:
         """Raise :class:`AtlasJobsFull` if no job of ``client`` can start now."""
@@ -187,7 +252,8 @@ class AtlasJobs:
         self.check_room(client)
         if plan is None:
             plan = plan_request(req, self.limits)
-        job = AtlasJob(secrets.token_urlsafe(12), client, plan, req.leg_ends, request=req)
+        job = AtlasJob(self.run + secrets.token_urlsafe(12), client, plan, req.leg_ends,
+                       request=req)  # fmt: skip
         with self._lock:
             self._room(client)
             self._jobs[job.id] = job
@@ -204,20 +270,56 @@ class AtlasJobs:
             raise AtlasJobsFull(f"at most {self.limits.per_client} atlas jobs per client run at "
                                 "once; wait for one to end or cancel it")  # fmt: skip
 
+    def response(self, job: AtlasJob) -> AtlasJobResponse:
+        """``job``'s state, with the jobs queued or running before it when it waits."""
+        with self._lock:
+            before = self._before(job)
+        return job.response(len(before), sum(j.status == "running" for j in before))
+
+    def _before(self, job: AtlasJob) -> list[AtlasJob]:
+        """The active jobs ahead of ``job``: the running ones and those queued before it (the
+        queue is served in the order the jobs were started). Under the lock."""
+        ahead, earlier = [], True
+        for other in self._jobs.values():
+            earlier = earlier and other is not job
+            if other is not job and (other.status == "running" or (earlier and other.active)):
+                ahead.append(other)
+        return ahead
+
     def get(self, job_id: str) -> AtlasJob:
         self.sweep()
         with self._lock:
             job = self._jobs.get(job_id)
         if job is None:
-            raise AtlasJobNotFound(job_id)
+            raise AtlasJobNotFound(job_id, self._missing(job_id))
         return job
 
+    def _missing(self, job_id: str) -> str:
+        """Why no job has the id ``job_id``."""
+        if job_id.startswith(self.run):
+            return (f"it was cancelled, or it ended more than {self.limits.keep_for:g} s ago "
+                    "and was dropped")  # fmt: skip
+        if re.fullmatch(r"[0-9a-f]{6}[A-Za-z0-9_-]{16}", job_id):
+            return ("the server restarted since it was started, and atlas jobs live in the "
+                    "server's memory: start it again")  # fmt: skip
+        return "no job of this server has had this id"
+
     def cancel(self, job_id: str) -> None:
-        """Stop the job (after the chunk it is on) and drop it."""
+        """Stop the job (after the chunk it is on) and drop it; its slot goes at once to the
+        next queued job (the chunks in flight end in the workers meanwhile, their results
+        dropped), not after those chunks."""
         job = self.get(job_id)
         job.cancel.set()
         with self._lock:
             self._jobs.pop(job_id, None)
+        self._release(job)
+
+    def _release(self, job: AtlasJob) -> None:
+        """Give back ``job``'s slot if it still holds it."""
+        with self._lock:
+            held, job.holds_slot = job.holds_slot, False
+        if held:
+            self._slots.release()
 
     def sweep(self) -> None:
         """Drop the jobs that ended more than ``keep_for`` seconds ago."""
@@ -235,20 +337,28 @@ class AtlasJobs:
             self._jobs.clear()
 
     def _run(self, job: AtlasJob) -> None:
-        while not self._slots.acquire(timeout=0.2):
+        while True:  # first come, first served
             if job.cancel.is_set():
                 return self._end(job, "cancelled")
+            with self._lock:
+                first = not any(j.status == "queued" for j in self._before(job))
+            if first and self._slots.acquire(timeout=0.2):
+                break
+            if not first:
+                job.cancel.wait(0.2)
+        job.holds_slot = True
         try:
             job.status = "running"
             job.started = time.monotonic()
 
-            def progress(done: int, _total: int) -> None:
-                job.runs_done = done
+            def progress(done: float, _total: float) -> None:
+                job.runs_done = int(done)
 
+            backend = None if self._pool is None else PoolBackend(self._pool)
             res = run_atlas(
-                job.plan, ProcessPool(self.limits.workers, self.limits.worker_memory),
-                on_progress=progress,
-                cancelled=job.cancel.is_set, keep_leg_ends=job.leg_ends,
+                job.plan, backend,
+                progress=ProgressCallbacks(on_advance=progress, is_cancelled=job.cancel.is_set),
+                keep_leg_ends=job.leg_ends,
             )  # fmt: skip
             job.result = result_document(res, job.plan.manifolds[0].arc, job.leg_ends)
             self._end(job, "done")
@@ -258,7 +368,7 @@ class AtlasJobs:
             job.error = f"{type(error).__name__}: {error}"
             self._end(job, "failed")
         finally:
-            self._slots.release()
+            self._release(job)
 
     @staticmethod
     def _end(job: AtlasJob, status: Status) -> None:

@@ -13,6 +13,7 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from jik.app.compute.schemas import (
+    INTEGRAL,
     Algorithm,
     Augmentation,
     Coordinate,
@@ -25,6 +26,7 @@ from jik.app.compute.schemas import (
     per_robot,
 )
 from jik.engine.repeatability import MAX_PATH_POINTS
+from jik.engine.solver import DISCRETE_GAMMA_BOUND
 
 #: Largest starts per path, cycles, and paths of a family (shifts, scales) in one request.
 MAX_STARTS = 20000
@@ -50,13 +52,13 @@ class AtlasRequest(BaseModel):
     path: Annotated[list[Vector], Field(min_length=2, max_length=MAX_PATH_POINTS)] = Field(
         description="task points, a loop from the first: the starts lie on k(x) = path[0]"
     )
-    starts: Annotated[int, Field(strict=True, ge=1, le=MAX_STARTS)] = Field(
+    starts: Annotated[int, Field(strict=True, ge=1, le=MAX_STARTS), INTEGRAL] = Field(
         256, description=f"starts per path, 1 to {MAX_STARTS}"
     )
     sampling: Literal["grid", "sample"] = Field(
         "grid", description="arc lengths on a grid (ends included) or sampled uniformly"
     )
-    seed: Annotated[int, Field(strict=True, ge=0, le=2**31 - 1)] = 0
+    seed: Annotated[int, Field(strict=True, ge=0, le=2**31 - 1), INTEGRAL] = 0
     arc: tuple[Coordinate, Coordinate] | None = Field(
         None, description="(lo, hi), lo <= 0 <= hi: arc lengths of the starts; default: the part "
         "of the curve inside the robot's configuration box",
@@ -70,9 +72,11 @@ class AtlasRequest(BaseModel):
     scales: Annotated[list[Scale], Field(min_length=1, max_length=MAX_FAMILY)] | None = Field(
         None, description="scales of the path about its first point"
     )
-    cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_CYCLES)] = 3
+    cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_CYCLES), INTEGRAL] = 3
     gamma: Gamma | None = Field(
-        None, description="decay rate of eq. (5) of every leg (discrete: < 2); default: robot's"
+        None,
+        description=f"decay rate of eq. (5) of every leg (discrete: < {DISCRETE_GAMMA_BOUND:g}); "
+        "default: robot's",
     )
     mode: Mode | None = Field(None, description="'continuous' or 'discrete'; default: robot's")
     tolerance: Tolerance = Field(1e-10, description="each leg stops at ||k(x) - target|| < this")
@@ -130,5 +134,11 @@ class AtlasJobResponse(BaseModel):
     runs_done: int
     progress: float = Field(description="runs_done / runs")
     elapsed_s: float
+    queue_position: int | None = Field(
+        None,
+        description="while queued: how many atlas jobs run or wait before it (the server "
+        "computes a few at once, in the order they were started); null once it runs",
+    )
+    message: str = Field("", description="the state in words, e.g. what a queued job waits for")
     error: str | None = None
     result: AtlasResult | None = None

@@ -1,17 +1,10 @@
 """The compute pool: runs the request functions off the event loop, in worker processes.
 
-(It stays whole, at about 400 lines: the queue of idle workers, their replacement after a death
-or a hang, the micro-batching of /solve and the submissions from other threads share one event
-loop and one idle queue; split, each part would reach into the others'.)
-
-:class:`ComputePool` runs them for the HTTP API in worker *processes*
-(:mod:`jik.app.compute.worker`): numpy-heavy Python loops hold the GIL, and a computation that
-overruns its time limit can only be stopped by ending its process. Concurrent ``/solve``
-requests with the same robot, algorithm, augmentation, mode, gamma, tolerance and iteration cap
-are micro-batched: the first one opens a short window (``JIK_BATCH_WINDOW_MS``, default 2 ms),
-every compatible request arriving until a worker is free joins it, and the batch is solved by
-ONE engine call with x0 of shape (n, p) and targets (n, r) (each member keeps its own adaptive
-step, so its result is the same as alone).
+:class:`ComputePool` runs them for the HTTP API, the dashboards and the API's atlases in worker
+*processes* (:mod:`jik.app.compute.worker`): numpy-heavy Python loops hold the GIL, and a
+computation that overruns its time limit can only be stopped by ending its process. It keeps the
+queue of idle workers, replaces a worker after a death or a hang, and takes submissions from other
+threads; concurrent ``/solve`` requests are micro-batched (:mod:`jik.app.compute.batching`).
 """
 
 from __future__ import annotations
@@ -22,46 +15,25 @@ import contextlib
 import os
 import pickle
 import threading
-from collections.abc import Iterator
-from dataclasses import dataclass
+from collections.abc import Callable, Iterator
 from typing import Any
 
-import numpy as np
-
-from jik.app.compute import schemas as S
+from jik.app.compute.batching import SolveBatching, _Pending
 from jik.app.compute.exceptions import (
     ComputeError,
     RequestError,
     ServiceUnavailable,
     WorkerLost,
 )
-from jik.app.compute.precheck import precheck
-from jik.app.compute.requests import batch_key
 from jik.app.compute.settings import Settings, settings_from_env
 from jik.app.compute.worker import Worker, frame_header, work_of
-
-
-def _retrieve(future: asyncio.Future) -> None:
-    """Mark an abandoned request's exception as seen (no 'never retrieved' warning)."""
-    if not future.cancelled():
-        future.exception()
-
 
 #: A computation that overran its time limit while its worker computed less than this share of
 #: it was not the request's work: the worker hung (the server's fault, 503).
 HUNG = 0.1
 
 
-@dataclass
-class _Pending:
-    payload: bytes
-    future: asyncio.Future
-    deadline: float
-    dispatched: bool = False
-    abandoned: bool = False
-
-
-class ComputePool:
+class ComputePool(SolveBatching):
     """Worker processes with a bound on concurrent computations and a time limit per request.
 
     At most ``settings.workers`` computations run at once. A request that gets no worker within
@@ -83,6 +55,7 @@ class ComputePool:
         self._idle: asyncio.Queue[Worker] | None = None
         self._pending: dict[str, list[_Pending]] = {}
         self._tasks: set[asyncio.Task] = set()
+        self._closed = False
         #: Engine calls made and requests served by them (for tests and the benchmark).
         self.stats = {"solve_calls": 0, "solve_requests": 0, "busy": 0, "exceeded": 0}
 
@@ -90,12 +63,17 @@ class ComputePool:
     def start(self) -> None:
         """Start the worker processes (idempotent, non-blocking)."""
         with self._lock:
+            self._closed = False
             while len(self._workers) < self.settings.workers:
-                self._workers.append(Worker(self.settings.worker_memory))
+                self._workers.append(self._new_worker())
+
+    def _new_worker(self) -> Worker:
+        return Worker(self.settings.worker_memory, self.settings.build_budget)
 
     def close(self) -> None:
-        """Stop every worker process."""
+        """Stop every worker process (none replaces them until :meth:`start`)."""
         with self._lock:
+            self._closed = True
             for w in self._workers:
                 w.kill()
             self._workers.clear()
@@ -149,6 +127,8 @@ class ComputePool:
         )
 
     async def _acquire(self, deadline: float) -> Worker:
+        if self._closed:
+            raise ServiceUnavailable("the server is stopping")
         idle = self._bind()
         remaining = deadline - self._bound_loop.time()
         try:
@@ -158,7 +138,7 @@ class ComputePool:
         except TimeoutError:
             raise self._busy() from None
 
-    async def _dispatch(self, worker: Worker, kind: str, payload):
+    async def _dispatch(self, worker: Worker, fn: Callable, args: tuple):
         """Run one computation on ``worker``; it is killed if it overruns the time limit.
 
         The event loop itself waits for the worker's socket to become readable (no thread per
@@ -173,7 +153,7 @@ class ComputePool:
             deadline = loop.time() + self.settings.timeout
             cpu = worker.cpu_seconds()
             os.set_blocking(worker.conn.fileno(), True)  # uvloop's add_reader made it non-blocking
-            worker.conn.send((kind, payload))
+            worker.conn.send((fn, args))
             sent = True
             msg = await self._reply(worker, deadline, buf)
         except TimeoutError:
@@ -188,7 +168,7 @@ class ComputePool:
                     "replaced; retry the request"
                 ) from None
             self.stats["exceeded"] += 1
-            field, less = work_of(kind, payload)
+            field, less = work_of(fn)
             raise RequestError(
                 field,
                 f"the computation exceeded the time limit of {self.settings.timeout:g} s and "
@@ -201,6 +181,8 @@ class ComputePool:
                 "was replaced"
             ) from None
         except asyncio.CancelledError:  # the request went away: collect the reply in the back
+            if self._closed:  # (the server is stopping: its workers are gone)
+                raise
             if sent:  # (the reply goes on from what this read of it had)
                 self._spawn(self._drain(worker, loop.time() + self.settings.timeout, buf))
             elif worker.ready:
@@ -273,7 +255,9 @@ class ComputePool:
         with self._lock:
             if worker in self._workers:
                 self._workers.remove(worker)
-            fresh = Worker(self.settings.worker_memory)
+            if self._closed:  # (the server is stopping)
+                return
+            fresh = self._new_worker()
             self._workers.append(fresh)
         self._bound_idle.put_nowait(fresh)
 
@@ -286,15 +270,14 @@ class ComputePool:
             raise RequestError(*value)
         raise ComputeError(value)
 
-    async def run(self, kind: str, payload) -> Any:
-        """Run handler ``kind`` on ``payload`` in a worker (waits and runs within the limits).
-
-        For the API kinds the payload is the request and the result the response, as JSON bytes.
-        """
+    async def run(self, fn: Callable, *args: Any) -> Any:
+        """``fn(*args)`` in a worker, ``fn`` a :func:`~jik.app.compute.worker.task` (waits and
+        runs within the limits). The API's tasks take the request and give the response as JSON
+        bytes."""
         self._bind()
-        return self._unwrap(await self._dispatch_retried(kind, payload))
+        return self._unwrap(await self._dispatch_retried(fn, args))
 
-    async def _dispatch_retried(self, kind: str, payload, worker: Worker | None = None):
+    async def _dispatch_retried(self, fn: Callable, args: tuple, worker: Worker | None = None):
         """:meth:`_dispatch` on ``worker`` (or the next free one); if that worker had died (it
         died while idle, or with this computation), once more on a fresh one."""
         for attempt in (1, 2):
@@ -302,7 +285,7 @@ class ComputePool:
                 worker = await self._acquire(self._bound_loop.time() + self.settings.timeout)
             started = self._bound_loop.time()
             try:
-                return await self._dispatch(worker, kind, payload)
+                return await self._dispatch(worker, fn, args)
             except WorkerLost:
                 hung = self._bound_loop.time() - started >= self.settings.timeout
                 if attempt == 2 or hung:  # (a hung worker has used the request's time up)
@@ -310,7 +293,7 @@ class ComputePool:
                 worker = None
         raise AssertionError("unreachable")
 
-    def submit(self, kind: str, payload) -> concurrent.futures.Future:
+    def submit(self, fn: Callable, *args: Any) -> concurrent.futures.Future:
         """:meth:`run` from another thread (the dashboards' workers): a future of its result,
         queued with the API's requests (first come, first served). Cancelling the future gives
         up the computation (its worker finishes it and is given back).
@@ -323,91 +306,7 @@ class ComputePool:
         loop = self._loop
         if loop is None or loop.is_closed() or not loop.is_running():
             raise ServiceUnavailable("the compute pool is not running")
-        return asyncio.run_coroutine_threadsafe(self.run(kind, payload), loop)
-
-    # -- micro-batched solves
-    async def solve(self, req: S.SolveRequest) -> bytes:
-        """One /solve request (JSON response bytes); micro-batched with compatible ones."""
-        precheck(req)
-        self._bind()
-        payload = req.model_dump_json().encode()
-        if not self.settings.batching:
-            self.stats["solve_calls"] += 1
-            self.stats["solve_requests"] += 1
-            (res,) = await self.run("solve", [payload])
-            return self._unwrap(res)
-        loop = self._bound_loop
-        entry = _Pending(payload, loop.create_future(), loop.time() + self.settings.timeout)
-        entry.future.add_done_callback(_retrieve)
-        key = batch_key(req)
-        queue = self._pending.setdefault(key, [])
-        queue.append(entry)
-        if len(queue) == 1:
-            self._spawn(self._flush(key, first=True))
-        try:
-            return self._unwrap(
-                await asyncio.wait_for(asyncio.shield(entry.future), entry.deadline - loop.time())
-            )
-        except TimeoutError:
-            if entry.dispatched:  # computing: bounded by the computation's own time limit
-                return self._unwrap(await entry.future)
-            entry.abandoned = True
-            raise self._busy() from None
-
-    async def _flush(self, key: str, first: bool) -> None:
-        if first and self.settings.batch_window > 0:
-            await asyncio.sleep(self.settings.batch_window)
-        queue = [p for p in self._pending.get(key, []) if not p.abandoned]
-        if not queue:
-            self._pending.pop(key, None)
-            return
-        try:
-            worker = await self._acquire(max(p.deadline for p in queue))
-        except ServiceUnavailable:
-            for p in self._pending.pop(key, []):
-                p.abandoned = True
-                if not p.future.done():
-                    p.future.set_exception(self._busy())
-            return
-        # Everything compatible that arrived while we waited for the worker joins the batch.
-        queue = [p for p in self._pending.pop(key, []) if not p.abandoned]
-        items, rest = queue[: self.settings.max_batch], queue[self.settings.max_batch :]
-        if rest:
-            self._pending[key] = rest
-            self._spawn(self._flush(key, first=False))
-        if not items:
-            self._bound_idle.put_nowait(worker)
-            return
-        # A large batch is shared among the workers that are idle right now: two half batches on
-        # two cores finish sooner than one whole batch on one.
-        workers = [worker]
-        while (
-            len(items) >= (len(workers) + 1) * self.settings.min_share
-            and not self._bound_idle.empty()
-        ):
-            workers.append(self._bound_idle.get_nowait())
-        for p in items:
-            p.dispatched = True
-        self.stats["solve_calls"] += len(workers)
-        self.stats["solve_requests"] += len(items)
-        shares = np.array_split(np.arange(len(items)), len(workers))
-        for w, share in zip(workers[1:], shares[1:], strict=True):
-            self._spawn(self._solve_share(w, [items[i] for i in share]))
-        await self._solve_share(workers[0], [items[i] for i in shares[0]])
-
-    async def _solve_share(self, worker: Worker, items: list[_Pending]) -> None:
-        """Solve ``items`` in ONE engine call on ``worker`` and hand each its result."""
-        try:
-            msg = await self._dispatch_retried("solve", [p.payload for p in items], worker)
-            results = self._unwrap(msg)
-        except Exception as exc:  # handed to every request of the batch
-            for p in items:
-                if not p.future.done():
-                    p.future.set_exception(exc)
-            return
-        for p, res in zip(items, results, strict=True):
-            if not p.future.done():
-                p.future.set_result(res)
+        return asyncio.run_coroutine_threadsafe(self.run(fn, *args), loop)
 
 
 @contextlib.contextmanager

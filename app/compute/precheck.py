@@ -8,6 +8,7 @@ from jik.app.compute.requests import check_configuration, check_task_point
 from jik.app.compute.synthesis import synthesis_region
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS
+from jik.engine.solver import gamma_problem
 
 
 def precheck(req: S.SolveRequest | S.RepeatabilityRequest | S.SynthesizeRequest) -> None:
@@ -39,9 +40,5 @@ def precheck(req: S.SolveRequest | S.RepeatabilityRequest | S.SynthesizeRequest)
         for i, pt in enumerate(req.path):
             check_task_point(spec, pt, f"path[{i}]")
     gamma = spec.default_gamma if req.gamma is None else float(req.gamma)
-    if (req.mode or spec.default_mode) == "discrete" and gamma >= 2:
-        raise RequestError(
-            "gamma",
-            f"must be < 2 in discrete mode, got {gamma:g} (near the solution the error shrinks "
-            "by |1 - gamma| per iteration)",
-        )
+    if (why := gamma_problem(gamma, req.mode or spec.default_mode)) is not None:
+        raise RequestError("gamma", why)

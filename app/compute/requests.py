@@ -32,7 +32,8 @@ from jik.engine.repeatability import (
     REPEATABLE_DRIFT,
     repeatability,
 )
-from jik.engine.solver import BatchSolveResult, solve
+from jik.engine.solver import gamma_problem
+from jik.engine.solver import solve_batch as engine_solve_batch
 
 _R = TypeVar("_R")
 
@@ -132,12 +133,8 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
         inverse, aug_used = _catalogue_inverse(spec, kin, req)
     mode = req.mode or spec.default_mode
     gamma = spec.default_gamma if req.gamma is None else float(req.gamma)
-    if mode == "discrete" and gamma >= 2:
-        raise RequestError(
-            "gamma",
-            f"must be < 2 in discrete mode, got {gamma:g} (near the solution the error shrinks "
-            "by |1 - gamma| per iteration)",
-        )
+    if (why := gamma_problem(gamma, mode)) is not None:
+        raise RequestError("gamma", why)
     return _Setup(
         spec, kin, inverse, robot_used, aug_used, mode, gamma, req.tolerance, req.max_iterations
     )
@@ -165,7 +162,18 @@ def _dimensions(spec: RobotSpec, what: str) -> str:
 
 
 def check_configuration(spec: RobotSpec, x0) -> None:
-    """``x0`` has p components."""
+    """The robot has at most the API's p, and ``x0`` has p components."""
+    if spec.p > S.MAX_DIMENSION:
+        joints = (
+            "; name at most that many in active_joints (the others stay at their value in "
+            "locked, default 0)"
+            if spec.name == "urdf"
+            else ""
+        )
+        raise RequestError(
+            "robot", f"this {spec.name} robot has p = {spec.p} moving joints; the API takes at "
+            f"most {S.MAX_DIMENSION} (the cap on x0's components){joints}",
+        )  # fmt: skip
     if len(x0) != spec.p:
         raise RequestError(
             "x0", f"must have {spec.p} components ({_dimensions(spec, 'p')}), got {len(x0)}"
@@ -187,8 +195,21 @@ def _check_start(setup: _Setup, x0: np.ndarray) -> np.ndarray:
     return np.atleast_1d(bad)
 
 
-def _singular_message(setup: _Setup, x0) -> str:
-    return str(setup.inverse.singular_error(np.asarray(x0, dtype=float)))
+def _start_message(setup: _Setup, x0) -> str:
+    """Why the inverse is undefined at the start ``x0`` (p,): the kinematics overflow there
+    (k(x0) or its Jacobian not finite), or the start is singular."""
+    x = np.asarray(x0, dtype=float)
+    with np.errstate(all="ignore"):
+        y = np.asarray(setup.kinematics.forward(x), dtype=float)
+        jacobian = np.asarray(setup.kinematics.jacobian(x), dtype=float)
+    if not (np.all(np.isfinite(y)) and np.all(np.isfinite(jacobian))):
+        shown = ", ".join(f"{v:.6g}" for v in y)
+        return (
+            f"the kinematics overflow at the start: k(x0) = ({shown}), its Jacobian "
+            f"{'finite' if np.all(np.isfinite(jacobian)) else 'not finite'}; choose a start "
+            "where both are finite (below about 1.8e308)"
+        )
+    return f"{setup.inverse.singular_error(x)}; move the start"
 
 
 _ENGINE_FIELDS = ("x0", "target", "gamma", "tol", "max_iterations", "path", "cycles", "mode")
@@ -325,23 +346,19 @@ def _solve_batch(
         y_d = np.array([reqs[i].target for i in ok], dtype=float)
         bad = _check_start(setup, x0)
         for k in np.flatnonzero(bad):
-            out[ok[k]] = RequestError("x0", _singular_message(setup, x0[k]) + "; move the start")
+            out[ok[k]] = RequestError("x0", _start_message(setup, x0[k]))
         keep = np.flatnonzero(~bad)
         if keep.size:
             try:
-                # x0[keep] is (k, p), so solve returns a batch.
-                batch = cast(
-                    BatchSolveResult,
-                    solve(
-                        setup.inverse,
-                        x0[keep],
-                        y_d[keep],
-                        gamma=setup.gamma,
-                        mode=setup.mode,
-                        tol=setup.tolerance,
-                        max_iterations=setup.max_iterations,
-                        record=True,
-                    ),
+                batch = engine_solve_batch(
+                    setup.inverse,
+                    x0[keep],
+                    y_d[keep],
+                    gamma=setup.gamma,
+                    mode=setup.mode,
+                    tol=setup.tolerance,
+                    max_iterations=setup.max_iterations,
+                    record=True,
                 )
             except JikError as exc:
                 err = engine_error(exc)
@@ -369,7 +386,7 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
         check_task_point(setup.spec, pt, f"path[{i}]")
     x0 = np.array(req.x0, dtype=float)
     if _check_start(setup, x0[None])[0]:
-        raise RequestError("x0", _singular_message(setup, x0) + "; move the start")
+        raise RequestError("x0", _start_message(setup, x0))
     try:
         res = repeatability(
             setup.inverse,

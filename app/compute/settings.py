@@ -1,14 +1,24 @@
-"""How the API runs its computations: :class:`Settings`, from ``JIK_*`` environment variables."""
+"""The server's settings: one :class:`Settings`, from the ``JIK_*`` environment variables.
+
+:func:`settings` reads the environment once (pydantic-settings) and every module asks it; a
+test or a program that wants other values builds ``Settings(workers=1, ...)`` and passes it on.
+"""
 
 from __future__ import annotations
 
+import functools
 import os
-from dataclasses import dataclass
+
+from pydantic import AliasChoices, Field, field_validator
+from pydantic_settings import BaseSettings, SettingsConfigDict
 
 
-@dataclass(frozen=True)
-class Settings:
-    """How the API runs its computations (from the environment by :func:`settings_from_env`).
+def _cores() -> int:
+    return max(1, min(8, os.cpu_count() or 2))
+
+
+class Settings(BaseSettings):
+    """How the server runs, each field from ``JIK_<FIELD>`` (``JIK_WORKERS=4``).
 
     ``timeout`` bounds both phases of a request: waiting for a compute slot (then 503 "server
     busy", retry later) and the computation itself (then 422 naming the field that sizes the
@@ -16,35 +26,69 @@ class Settings:
     and replaced).
     """
 
-    workers: int = 2
-    timeout: float = 20.0
-    batching: bool = True
-    batch_window: float = 0.002
-    max_batch: int = 64
+    model_config = SettingsConfigDict(env_prefix="JIK_", frozen=True, extra="forbid")
+
+    #: Compute worker processes (1..8; default: the CPU count).
+    workers: int = Field(default_factory=_cores)
+    #: Longest wait for a compute slot, and longest computation [s].
+    timeout: float = Field(default=20.0, gt=0)
+    #: Micro-batching of concurrent compatible /solve requests (``JIK_BATCH=0``: off).
+    batching: bool = Field(default=True, validation_alias=AliasChoices("batching", "JIK_BATCH"))
+    #: How long the first /solve of a batch waits for others [ms].
+    batch_window_ms: float = Field(default=2.0, ge=0)
+    max_batch: int = Field(default=64, ge=1)
     #: A batch is split among idle workers only into shares of at least this many requests.
-    min_share: int = 4
+    min_share: int = Field(default=4, ge=1)
     #: Address space a worker may use [MB] (0: no limit). A computation that needs more ends
     #: in a 422 naming what to ask for less of; the worker lives on.
-    worker_memory: int = 1024
+    worker_memory: int = Field(
+        default=1024, ge=0, validation_alias=AliasChoices("worker_memory", "JIK_WORKER_MEMORY_MB")
+    )
+    #: Longest build of a robot's formulas and their derivatives [s] (then 422 naming the
+    #: robot's field); at most half of ``timeout``.
+    build_seconds: float = Field(default=5.0, gt=0)
+    #: /solve's short path (:mod:`jik.app.api.fastpath`).
+    fast_solve: bool = True
+    #: Host names the server answers to besides the loopback names (comma-separated).
+    allowed_hosts: str = ""
+    #: A request must arrive whole within this many seconds (slow senders are cut off).
+    read_seconds: float = Field(default=10.0, gt=0)
+    #: Open connections and running requests; beyond, uvicorn answers 503 at once.
+    max_connections: int = Field(default=1000, ge=1)
+    #: Dashboard sessions kept at once, how long an idle one lives [s], and how many of their
+    #: computations run in their threads at once (default: the CPU count).
+    max_sessions: int = Field(default=32, ge=1)
+    session_idle_seconds: float = Field(default=600.0, ge=1.0)
+    dashboard_computations: int = Field(default_factory=lambda: max(1, os.cpu_count() or 1))
+
+    @field_validator("workers")
+    @classmethod
+    def _clip_workers(cls, value: int) -> int:
+        return max(1, min(8, value))
+
+    @property
+    def batch_window(self) -> float:
+        """``batch_window_ms`` in seconds."""
+        return self.batch_window_ms / 1000.0
+
+    @property
+    def build_budget(self) -> float:
+        """Seconds a robot's formulas may take to build: ``build_seconds``, at most half of
+        ``timeout`` (the rest is the computation's)."""
+        return min(self.build_seconds, self.timeout / 2)
+
+    @property
+    def host_names(self) -> tuple[str, ...]:
+        """``allowed_hosts`` as names."""
+        return tuple(h.strip() for h in self.allowed_hosts.split(",") if h.strip())
 
 
-def env_flag(name: str, default: bool = True) -> bool:
-    """An on/off environment variable: ``0``, ``false``, ``no`` or ``off`` is off."""
-    value = os.environ.get(name)
-    if value is None:
-        return default
-    return value.strip().lower() not in ("0", "false", "no", "off")
+@functools.cache
+def settings() -> Settings:
+    """The settings of the environment, read once."""
+    return Settings()
 
 
 def settings_from_env() -> Settings:
-    """``JIK_WORKERS`` (default: CPU count, 1..8), ``JIK_TIMEOUT`` [s] (default 20),
-    ``JIK_BATCH`` (``0`` disables micro-batching), ``JIK_BATCH_WINDOW_MS`` (default 2),
-    ``JIK_WORKER_MEMORY_MB`` (default 1024; 0 for no limit)."""
-    env = os.environ
-    return Settings(
-        workers=max(1, min(8, int(env.get("JIK_WORKERS", os.cpu_count() or 2)))),
-        timeout=float(env.get("JIK_TIMEOUT", 20.0)),
-        batching=env_flag("JIK_BATCH"),
-        batch_window=float(env.get("JIK_BATCH_WINDOW_MS", 2.0)) / 1000.0,
-        worker_memory=max(0, int(env.get("JIK_WORKER_MEMORY_MB", Settings.worker_memory))),
-    )
+    """:func:`settings` (the environment's, read once)."""
+    return settings()

@@ -8,7 +8,8 @@ inverse a map ``{"name": "formula", "h": ...}`` or ``{"name": "e2_synthesized", 
 (``lengths.1`` -> ``robot.lengths[1]``, ``augmentations.0.h`` -> ``augmentation.h``). p and r
 follow from the definition: :mod:`jik.app.compute.requests` checks the lengths of ``x0``,
 ``target`` and ``path`` against the built robot. Everything runs in the compute workers,
-under their time and memory limits.
+under their time and memory limits; the build itself within ``Settings.build_budget`` (a
+formula too slow to differentiate is refused naming the robot, not the computation's field).
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from jik.app.compute import schemas as S
+from jik.app.compute.budget import build_seconds, time_budget
 from jik.app.compute.exceptions import RequestError
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.robot_spec import Robot, robot_from_dict
@@ -72,7 +74,8 @@ def user_robot(req_robot: Any, augmentation: Any = None) -> tuple[Robot, S.Robot
         given = augmentation.model_dump(exclude_none=True)
         definition["augmentations"] = [{**given, "label": _LABEL}]
     try:
-        robot = _built(json.dumps(definition, sort_keys=True))
+        with time_budget(build_seconds(), "robot", "building the robot's formulas"):
+            robot = _built(json.dumps(definition, sort_keys=True))
     except InvalidInputError as exc:
         raise RequestError(request_field(exc.field, list(definition)), _text(exc)) from None
     spec = robot.spec

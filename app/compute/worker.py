@@ -1,14 +1,14 @@
 """The worker processes: the loop a worker runs, and the server's handle on one.
 
-A worker is a fresh interpreter that imports the engine and then answers ``(kind, payload)``
-messages with ``(status, result)`` over a :class:`~multiprocessing.connection.Connection` on a
-socket pair; :class:`jik.app.compute.pool.ComputePool` sends the requests and reads the replies
-(framed as :func:`frame_header` describes) on its event loop.
+A worker is a fresh interpreter that imports the engine and then answers ``(task, args)``
+messages (a function registered by :func:`task`, sent by reference) with ``(status, result)``
+over a :class:`~multiprocessing.connection.Connection` on a socket pair;
+:class:`jik.app.compute.pool.ComputePool` sends the requests and reads the replies (framed as
+:func:`frame_header` describes) on its event loop.
 """
 
 from __future__ import annotations
 
-import importlib
 import os
 import socket
 import struct
@@ -18,6 +18,9 @@ from collections.abc import Callable
 from multiprocessing.connection import Connection
 from typing import Any
 
+import psutil
+
+from jik.app.compute import budget
 from jik.app.compute import schemas as S
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.requests import engine_error, repeatability_request, solve_batch_json
@@ -25,27 +28,32 @@ from jik.app.compute.synthesis import synthesize_request
 from jik.engine.atlas_backends import limit_memory
 from jik.engine.exceptions import JikError
 
-#: The field that sizes the work of each computation kind, and how to ask for less.
-WORK_FIELDS = {
-    "solve": ("max_iterations", "a lower max_iterations or a larger tolerance"),
-    "repeatability": ("cycles", "fewer cycles or path points, a lower max_iterations"),
-    "synthesize": ("region", "a smaller region, fewer nodes, a smaller grid or a lower degree"),
-    "dashboard.run": ("cycles", "fewer cycles, a larger gamma or another start"),
-    "atlas.plan": (
-        "reference",
-        "another reference or path (eq. (7) from the reference to the "
-        "path's first point ran out of memory)",
-    ),
-}
+
+def task(field: str, less: str) -> Callable[[Callable], Callable]:
+    """Make a function a task of the compute workers (``pool.run(function, *args)``), the
+    request's ``field`` sizing its work and ``less`` saying how to ask for less of it. The
+    function goes to the worker by reference (its module and name, as pickle sends it); a worker
+    calls no other function."""
+
+    def register(fn: Callable) -> Callable:
+        fn.jik_task = (field, less)  # type: ignore[attr-defined]
+        return fn
+
+    return register
 
 
-def work_of(kind: str, payload: Any) -> tuple[str, str]:
-    """The field that sizes a computation's work and how to ask for less (:data:`WORK_FIELDS`;
-    a ``call`` by its task's name)."""
-    return WORK_FIELDS.get(payload[0] if kind == "call" else kind, ("request", "less work"))
+def work_of(fn: Callable) -> tuple[str, str]:
+    """The field that sizes a task's work and how to ask for less (its :func:`task`)."""
+    return getattr(fn, "jik_task", ("request", "less work"))
 
 
-def _solve_payload(items: list[bytes]) -> list[tuple[str, Any]]:
+# The API's tasks take requests and give responses as JSON bytes: (de)serialization and
+# validation run in the workers, in parallel, and the event loop only passes bytes along.
+
+
+@task("max_iterations", "a lower max_iterations or a larger tolerance")
+def solve_batch(items: list[bytes]) -> list[tuple[str, Any]]:
+    """/solve requests (JSON) solved by one engine call: each one's (status, response)."""
     reqs = [S.SolveRequest.model_validate_json(b) for b in items]
     out: list[tuple[str, Any]] = []
     for res in solve_batch_json(reqs):
@@ -56,66 +64,59 @@ def _solve_payload(items: list[bytes]) -> list[tuple[str, Any]]:
     return out
 
 
-#: Work that other parts of the server hand to the same workers (``("call", (task, args))``),
-#: by name: the dashboard's offloaded runs. Only these functions can be called.
-TASKS = {
-    "dashboard.run": "jik.app.dashboard.offload:run_offloaded",
-    "atlas.plan": "jik.app.compute.atlas_jobs:plan_task",
-}
+@task("cycles", "fewer cycles or path points, a lower max_iterations")
+def repeatability_json(body: bytes) -> bytes:
+    """A /repeatability request (JSON) and its response."""
+    req = S.RepeatabilityRequest.model_validate_json(body)
+    return repeatability_request(req).model_dump_json().encode()
 
 
-def _call(payload: tuple[str, tuple]) -> Any:
-    """Run the task ``payload[0]`` of :data:`TASKS` with the arguments ``payload[1]``."""
-    task, args = payload
-    module, name = TASKS[task].split(":")
-    return getattr(importlib.import_module(module), name)(*args)
+@task("region", "a smaller region, fewer nodes, a smaller grid or a lower degree")
+def synthesize_json(body: bytes) -> bytes:
+    """A /synthesize request (JSON) and its response."""
+    req = S.SynthesizeRequest.model_validate_json(body)
+    return synthesize_request(req).model_dump_json().encode()
 
 
-# Workers take requests and give responses as JSON bytes: (de)serialization and validation run in
-# the workers, in parallel, and the event loop only passes bytes along.
-_HANDLERS: dict[str, Callable[[Any], Any]] = {
-    "ping": lambda payload: "pong",
-    "call": _call,
-    "solve": _solve_payload,
-    "repeatability": lambda b: (
-        repeatability_request(S.RepeatabilityRequest.model_validate_json(b))
-        .model_dump_json()
-        .encode()
-    ),
-    "synthesize": lambda b: (
-        synthesize_request(S.SynthesizeRequest.model_validate_json(b)).model_dump_json().encode()
-    ),
-}
+@task("request", "less work")
+def ping() -> str:
+    """A worker's answer when it is up."""
+    return "pong"
 
 
 def _worker_main(conn) -> None:
-    """Worker process loop: say "ready", then (kind, payload) in, (status, result) out."""
+    """Worker process loop: say "ready", then (task, args) in, (status, result) out."""
     conn.send(("ready", None))
     while True:
         try:
-            kind, payload = conn.recv()
+            fn, args = conn.recv()
         except (EOFError, OSError):
             return
         try:
-            msg = ("ok", _HANDLERS[kind](payload))
+            if not hasattr(fn, "jik_task"):
+                raise TypeError(f"{fn!r} is not a compute task")
+            msg = ("ok", fn(*args))
         except RequestError as exc:
             msg = ("request_error", (exc.field, exc.message))
         except JikError as exc:
             err = engine_error(exc)
             msg = ("request_error", (err.field, err.message))
         except MemoryError:
-            field, less = work_of(kind, payload)
+            field, less = work_of(fn)
             msg = ("request_error", (field, f"the computation ran out of memory; ask for {less}"))
         except Exception as exc:  # reported to the client as a 500 with its text
             msg = ("error", f"{type(exc).__name__}: {exc}")
         conn.send(msg)
 
 
-def _worker_entry(fd: int, memory_mb: int = 0) -> None:
+def _worker_entry(fd: int, memory_mb: int = 0, build_seconds: float = 0.0) -> None:
     """Entry point of a worker process started by :class:`Worker` (``python -c``): its address
     space limited to ``memory_mb`` (0: none), so that a computation too large for it raises
-    MemoryError (a 422) instead of taking the machine's memory."""
+    MemoryError (a 422) instead of taking the machine's memory; robots built within
+    ``build_seconds`` (:func:`jik.app.compute.budget.build_seconds`; 0: the environment's)."""
     limit_memory(memory_mb)
+    if build_seconds > 0:
+        budget.BUILD_SECONDS = build_seconds
     _worker_main(Connection(fd))
 
 
@@ -139,7 +140,7 @@ def frame_header(buf: bytearray) -> tuple[int | None, int]:
 class Worker:
     """A worker process (a fresh interpreter, so nothing of the server's state is inherited)."""
 
-    def __init__(self, memory_mb: int = 0) -> None:
+    def __init__(self, memory_mb: int = 0, build_seconds: float = 0.0) -> None:
         parent, child = socket.socketpair()
         fd = child.fileno()
         env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
@@ -148,7 +149,7 @@ class Worker:
                 sys.executable,
                 "-c",
                 "from jik.app.compute.worker import _worker_entry; "
-                f"_worker_entry({fd}, {int(memory_mb)})",
+                f"_worker_entry({fd}, {int(memory_mb)}, {float(build_seconds)!r})",
             ],
             pass_fds=[fd],
             env=env,
@@ -166,14 +167,12 @@ class Worker:
             self.ready = True
 
     def cpu_seconds(self) -> float | None:
-        """CPU time the worker has used (user and system), from /proc; None where there is no
-        /proc or the process is gone."""
+        """CPU time the worker has used (user and system); None if the process is gone."""
         try:
-            with open(f"/proc/{self.process.pid}/stat") as f:
-                fields = f.read().rsplit(")", 1)[1].split()
-            return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
-        except (OSError, ValueError, IndexError):
+            times = psutil.Process(self.process.pid).cpu_times()
+        except psutil.Error:
             return None
+        return times.user + times.system
 
     def kill(self) -> None:
         self.process.kill()

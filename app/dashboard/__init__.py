@@ -7,7 +7,7 @@ processes), :mod:`.analysis` (h on a grid, E1/E2), :mod:`.figures` (plotly panel
 per tab, bounded), :mod:`.export` (JSON and CSV). The names below are the public surface.
 """
 
-from jik.app.dashboard.export import export_csv, export_json
+from jik.app.dashboard.export import export_csv, export_file, export_json
 from jik.app.dashboard.messages import Event
 from jik.app.dashboard.model import (
     ALGORITHMS,
@@ -26,5 +26,5 @@ from jik.app.dashboard.session import Dashboard
 __all__ = [
     "ALGORITHMS", "COLORS", "LABELS", "AlgorithmRun", "Cancelled", "Dashboard",
     "DashboardResult", "DashboardState", "Event", "Offload", "OffloadLane", "compute",
-    "default_state", "export_csv", "export_json", "runs_key", "updated_state",
+    "default_state", "export_csv", "export_file", "export_json", "runs_key", "updated_state",
 ]  # fmt: skip

@@ -13,6 +13,7 @@ from jik.app.dashboard.model import DashboardState, cache_key
 from jik.app.dashboard.robots import state_kinematics, state_spec
 from jik.app.dashboard.runs import AlgorithmRun, Cancelled, DashboardResult
 from jik.engine.exceptions import JikError
+from jik.engine.progress import ProgressCallbacks
 
 
 def inert_variables(kin, amap, box: tuple[tuple[float, float], ...], samples: int = 8):
@@ -22,9 +23,10 @@ def inert_variables(kin, amap, box: tuple[tuple[float, float], ...], samples: in
     bitwise unchanged (NaN where undefined included): an expression without x_k evaluates the
     same, one that merely cancels it would not and counts as dependent. A slice of h at x_k's
     start value then does not depend on that value, nor do E1 (13) and E2 (18), whose integrands
-    are functions of J and dh. Maps that solve a problem per point are not probed (empty set).
+    are functions of J and dh. Maps that solve a problem per point are not probed (empty set),
+    nor is a vector map (None).
     """
-    if expensive_map(amap):
+    if amap is None or expensive_map(amap):
         return frozenset()
     lo, hi = np.array(box, dtype=float).T
     X = np.random.default_rng(0).uniform(lo, hi, (samples, len(lo)))
@@ -99,7 +101,7 @@ def augmenting_axes(amap, x: np.ndarray, on_batch=None) -> tuple[int, int]:
     """
     with np.errstate(all="ignore"):
         if expensive_map(amap):
-            dh = amap.evaluate_batches(x, GRID_BATCH, on_batch)[1]
+            dh = amap.evaluate_batches(x, GRID_BATCH, ProgressCallbacks(on_advance=on_batch))[1]
             g = np.abs(np.asarray(dh, dtype=float))
         else:
             g = np.abs(np.asarray(amap.gradient(x), dtype=float))
@@ -110,10 +112,31 @@ def augmenting_axes(amap, x: np.ndarray, on_batch=None) -> tuple[int, int]:
 
 def kinematics_and_map(state: DashboardState, kin=None):
     """The state's kinematics (``kin`` when the caller has built it) and its augmenting map h,
-    built from the registry."""
+    built from the registry; h is None for a robot with p - r > 1, whose map is a vector of
+    p - r maps (the extended inverse of :mod:`jik.engine.extended_vector` runs with it; the
+    panels of one scalar h, E1 (13) and E2 (18) do not apply)."""
     spec = state_spec(state)
     kin = state_kinematics(state) if kin is None else kin
+    if vector_map(state):
+        return kin, None
     return kin, spec.augmentation(state.augmentation).build(kin, **state.augmentation_parameters)
+
+
+def vector_map(state: DashboardState) -> bool:
+    """Whether the state's robot has p - r > 1 degrees of redundancy (h a vector of maps)."""
+    spec = state_spec(state)
+    return spec.p - spec.r > 1
+
+
+def vector_note(state: DashboardState) -> str | None:
+    """What the panels of one scalar h say for a robot with p - r > 1 (None for p = r + 1)."""
+    if not vector_map(state):
+        return None
+    spec = state_spec(state)
+    h = spec.augmentation(state.augmentation).description
+    return (f"{h}: a vector of p − r = {spec.p - spec.r} maps, each kept constant by the "
+            "extended inverse (eq. (12)); the h panel, E1 (13) and E2 (18) are for one "
+            "degree of redundancy (p = r + 1)")  # fmt: skip
 
 
 def expensive_map(amap) -> bool:
@@ -159,6 +182,8 @@ def augmenting_grid(
     spec = state_spec(state)
     try:
         _, amap = kinematics_and_map(state, kin)
+        if amap is None:
+            return None
         xs = np.concatenate([r.x for r in runs.values()])
         total, along = grid_batches(runs, amap), -(-len(xs) // GRID_BATCH)
 
@@ -190,7 +215,9 @@ def augmenting_grid(
         X[..., j] = v[:, None]
         with np.errstate(all="ignore"):
             if expensive_map(amap):  # (maps that can be undefined at some points)
-                h = amap.evaluate_batches(X.reshape(-1, kin.p), GRID_BATCH, step(along))[0]
+                h = amap.evaluate_batches(
+                    X.reshape(-1, kin.p), GRID_BATCH, ProgressCallbacks(on_advance=step(along))
+                )[0]
                 H = np.asarray(h, dtype=float)
             else:
                 H = np.asarray(amap.value(X.reshape(-1, kin.p)), dtype=float)
@@ -255,7 +282,7 @@ def sensitivity_evaluations(state: DashboardState, amap) -> int:
     """How many values of E1 or E2 :func:`sensitivity` computes for ``state`` and its map
     ``amap`` (its steps of progress): none for an expensive map; else both functionals at every
     point of the parameters' sweeps, or of each of the robot's maps."""
-    if expensive_map(amap):
+    if amap is None or expensive_map(amap):
         return 0
     spec = state_spec(state)
     params = spec.augmentation(state.augmentation).parameters
@@ -286,7 +313,8 @@ def sensitivity(
     """
     grid = result.augmenting
     if grid is None:
-        return {"kind": "unavailable", "reason": "h could not be evaluated on a grid"}
+        note = vector_note(result.state)
+        return {"kind": "unavailable", "reason": note or "h could not be evaluated on a grid"}
     if functionals is None:
         return {"kind": "unavailable", "reason": "E1, E2 could not be evaluated"}
     state = result.state

@@ -24,13 +24,13 @@ from jik.app.dashboard.glossary import SYMBOLS
 from jik.app.dashboard.robots import state_spec
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS
-from jik.engine.solver import MAX_ITERATIONS, MAX_STEPS
+from jik.engine.solver import DISCRETE_GAMMA_BOUND, MAX_ITERATIONS, MAX_STEPS
 
-#: gamma's range per mode: the decay rate of eq. (5) (continuous), the step of the discrete
-#: iteration, which converges only for 0 < gamma < 2.
-GAMMA_RANGE = {"continuous": (0.01, 10.0), "discrete": (0.01, 1.99)}
 #: gamma's resolution: the page's log-scale slider and the scene's slider both land on it.
 GAMMA_STEP = 0.001
+#: gamma's slider range per mode: the decay rate of eq. (5) (continuous), the step of the
+#: discrete iteration, which converges only below the engine's DISCRETE_GAMMA_BOUND.
+GAMMA_RANGE = {"continuous": (0.01, 10.0), "discrete": (0.01, DISCRETE_GAMMA_BOUND - 0.01)}
 #: Switching to discrete mode takes gamma down to this when it is above (the full Newton step).
 DISCRETE_GAMMA_ON_SWITCH = 1.0
 #: Largest number of cycles offered by the dashboard (the engine accepts more).
@@ -83,6 +83,20 @@ class Control:
         return {k: v for k, v in out.items() if v not in (None, "", (), [], 0, False)}
 
 
+#: A user map's formula is shown on its button up to this many characters.
+MAP_LABEL_CHARS = 48
+
+
+def _map_label(aug) -> str:
+    """A map's button: its name and equation, or for a user's formula map its formula h (a
+    robot's default map is one: "formula: h = x3")."""
+    text = aug.description
+    if not text.startswith("h = "):
+        return f"{aug.name} {aug.equation}"
+    short = text if len(text) <= MAP_LABEL_CHARS else text[: MAP_LABEL_CHARS - 1] + "…"
+    return f"{aug.name}: {short}"
+
+
 def controls(state) -> list[Control]:
     """Every control of ``state`` (a :class:`~jik.app.dashboard.DashboardState`), in order."""
     spec = state_spec(state)
@@ -116,8 +130,8 @@ def controls(state) -> list[Control]:
                                id=f"ctl-preset-{v.name}-{name}"))  # fmt: skip
     out.append(Control("augmentation", "augmenting map h", "select", "algorithm",
                        SYMBOLS["h"] + "; one button per map of the paper for this robot",
-                       options=tuple((a.name, f"{a.name} {a.equation}")
-                                     for a in spec.augmentations), inline=True))  # fmt: skip
+                       options=tuple((a.name, _map_label(a)) for a in spec.augmentations),
+                       inline=True))  # fmt: skip
     for p in aug.parameters:
         out.append(Control(f"augmentation_parameters.{p.name}", p.name, "slider", "algorithm",
                            explained(p.name, p.description), minimum=p.minimum, maximum=p.maximum,

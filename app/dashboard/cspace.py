@@ -14,7 +14,7 @@ import numpy as np
 
 from jik.app.dashboard.analysis import expensive_map, kinematics_and_map
 from jik.app.dashboard.model import ALGORITHMS, COLORS, DASH, LABELS
-from jik.app.dashboard.plotting import figure, leg_names, trace
+from jik.app.dashboard.plotting import corner_names, figure, trace
 from jik.app.dashboard.robots import state_spec
 from jik.app.dashboard.runs import DashboardResult
 from jik.engine.exceptions import JikError
@@ -96,7 +96,7 @@ def self_motion(kin, seeds: np.ndarray, targets: np.ndarray, lo, hi) -> np.ndarr
 
 def _level_surface(result: DashboardResult, kin, amap, axes, lo, hi) -> dict | None:
     """h on a grid of the box (p = 3 only, cheap maps only), as an isosurface at h(x0)."""
-    if kin.p != 3 or expensive_map(amap):
+    if kin.p != 3 or amap is None or expensive_map(amap):
         return None
     lines = [np.linspace(lo[k], hi[k], GRID) for k in axes]
     X = np.stack(np.meshgrid(*lines, indexing="ij"), axis=-1).reshape(-1, 3)
@@ -138,15 +138,19 @@ def cspace_spec(result: DashboardResult) -> dict:
         data.append(surface)
     elif kin.p == 3:
         notes.append("level surface not drawn: h is solved point by point for this map")
+    elif amap is None:
+        notes.append(f"h is a vector of p − r = {kin.p - kin.r} maps: its level set not drawn")
     else:
         notes.append(f"the level surface of h lives in {kin.p} dimensions: not drawn")
     ext = result.runs["extended"]
     L = len(result.targets)
     seeds = ext.leg_end[:L] if len(ext.leg_end) >= L else result.runs["pseudoinverse"].leg_end[:L]
-    if len(seeds) == L:
+    if kin.p - kin.r > 1:
+        notes.append(f"self-motion manifolds {kin.p - kin.r}-dimensional: not drawn")
+    elif len(seeds) == L:
         with np.errstate(all="ignore"):
             curves = self_motion(kin, seeds, np.asarray(result.targets, dtype=float), lo, hi)
-        for k, (curve, name) in enumerate(zip(curves, leg_names(L), strict=True)):
+        for k, (curve, name) in enumerate(zip(curves, corner_names(result), strict=True)):
             data.append(trace("scatter3d", x=curve[:, a], y=curve[:, b], z=curve[:, c],
                               mode="lines", line=dict(color="#2ca02c", width=3),
                               name="self-motion manifolds k(x) = corner", legendgroup="fibres",
@@ -169,7 +173,8 @@ def cspace_spec(result: DashboardResult) -> dict:
         notes.append(
             f"{', '.join(fixed)} not shown (the control “configuration-space axes” picks three)"
         )
-    sub = " · ".join(["green: self-motion manifolds of the corners", *notes])
+    fibres = [] if kin.p - kin.r > 1 else ["green: self-motion manifolds of the corners"]
+    sub = " · ".join([*fibres, *notes])
     scene = dict(
         xaxis=dict(title=dict(text=names[a])),
         yaxis=dict(title=dict(text=names[b])),

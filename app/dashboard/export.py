@@ -1,19 +1,75 @@
 """A dashboard result exported: every point of both runs, as JSON or CSV, with the state that
-produced it, what the page says about it (the verdict) and each run's drift and leg ends."""
+produced it, what the page says about it (the verdict), each run's drift and leg ends, the units
+of its columns, the jik version and the time of the export; its file is named after the robot,
+the algorithms' settings (map h, mode), the generation and that time."""
 
 from __future__ import annotations
 
 import json
+import re
+from datetime import UTC, datetime
 
 import numpy as np
 
+from jik import __version__
 from jik.app.dashboard.messages import h_change, to_json
+from jik.app.dashboard.plotting import norm_unit, units
+from jik.app.dashboard.robots import state_kinematics
 from jik.app.dashboard.runs import DashboardResult
 from jik.app.dashboard.verdict import verdict
+from jik.engine.planar_chain import PlanarChain
+from jik.engine.urdf import UrdfChain
+
+#: What a user robot's lengths are measured in when its definition does not say.
+LENGTH = "length unit of the definition"
 
 
-def export_json(result: DashboardResult, functionals: dict | None = None) -> dict:
-    """The current result as plain JSON: the state, and both runs point by point."""
+def export_units(result: DashboardResult) -> dict:
+    """The unit of every column: the joint variables x, the task coordinates y, theta, the task
+    error (a norm of y) and h. The catalogue's robots have theirs; a planar chain's revolute
+    joints are in rad and its lengths in the unit of its link lengths; a URDF arm is in SI
+    units (m, rad); a formula robot's are what its formulas mean."""
+    joint, task = units(result)
+    kin = state_kinematics(result.state)
+    if isinstance(kin, PlanarChain):
+        joint = tuple("rad" if rev else LENGTH for rev in kin.revolute)
+        task = (LENGTH, LENGTH, "rad")[: kin.r]
+    elif isinstance(kin, UrdfChain):
+        kinds = {j.index: j.type for j in kin.chain if j.index >= 0}
+        joint = tuple("m" if kinds[i] == "prismatic" else "rad" for i in range(kin.p))
+        task = ("m",) * kin.r
+
+    def named(names, us) -> dict:
+        spelled = {"": "as the definition's formulas", "1": "dimensionless"}
+        return {n: spelled.get(u, u) for n, u in zip(names, us, strict=True)}
+
+    theta = "iterations" if result.state.mode == "discrete" else "dimensionless"
+    return {"x": named(result.variable_names, joint), "y": named(result.task_names, task),
+            "theta": theta, "error": norm_unit(task).strip("[]") or "as y",
+            "h": "the unit of the map's formula"}  # fmt: skip
+
+
+def provenance(when: datetime | None = None) -> dict:
+    """The jik version and the time (UTC, ISO 8601) of an export."""
+    when = when or datetime.now(UTC)
+    return {"jik_version": __version__, "exported_at": when.isoformat(timespec="seconds")}
+
+
+def export_filename(result: DashboardResult, extension: str, when: datetime) -> str:
+    """``jik-<robot>-<map>-<mode>-g<generation>-<UTC time>.<extension>``: what the file holds
+    and when, so that exports of several states do not overwrite each other."""
+    state = result.state
+    parts = [state.robot, state.augmentation, state.mode, f"g{result.generation}",
+             when.strftime("%Y%m%dT%H%M%SZ")]  # fmt: skip
+    slug = "-".join(re.sub(r"[^A-Za-z0-9_.]+", "_", p) for p in parts)
+    return f"jik-{slug}.{extension}"
+
+
+def export_json(
+    result: DashboardResult, functionals: dict | None = None, when: datetime | None = None
+) -> dict:
+    """The current result as plain JSON: the state, both runs point by point, the columns'
+    units, the jik version and the export's time."""
     runs = {}
     for a, run in result.runs.items():
         runs[a] = {
@@ -32,19 +88,26 @@ def export_json(result: DashboardResult, functionals: dict | None = None) -> dic
         if run.platform is not None:
             runs[a]["platform_final"] = run.platform[-1]
     return json.loads(to_json({
-        "robot": result.title, "state": result.state.as_dict(), "generation": result.generation,
+        **provenance(when), "robot": result.title, "state": result.state.as_dict(),
+        "generation": result.generation, "units": export_units(result),
         "variable_names": result.variable_names, "task_names": result.task_names,
         "targets": result.targets, "runs": runs, "functionals": functionals,
         "verdict": [v["text"] for v in verdict(result)],
     }))  # fmt: skip
 
 
-def csv_context(result: DashboardResult) -> list[str]:
+def csv_context(result: DashboardResult, when: datetime | None = None) -> list[str]:
     """The lines at the top of the CSV, each starting with '#' (``pandas.read_csv(...,
-    comment="#")`` skips them): the generation and state, the verdict, and per algorithm its
-    message, drift after each cycle, h's change and leg ends."""
+    comment="#")`` skips them): the jik version and the export's time, the generation and
+    state, the columns' units, the verdict, and per algorithm its message, drift after each
+    cycle, h's change and leg ends."""
+    made = provenance(when)
+    u = export_units(result)
+    columns = {**u["x"], **u["y"], "theta": u["theta"], "error": u["error"], "h": u["h"]}
     lines = [f"# jik export of generation {result.generation}: {result.title}",
-             f"# state: {to_json(result.state.as_dict())}"]  # fmt: skip
+             f"# jik {made['jik_version']}, exported {made['exported_at']}",
+             f"# state: {to_json(result.state.as_dict())}",
+             "# units: " + "; ".join(f"{k} [{v}]" for k, v in columns.items())]  # fmt: skip
     lines += [f"# verdict: {v['text']}" for v in verdict(result)]
     for a, run in result.runs.items():
         ends = "; ".join(", ".join(f"{v:.6g}" for v in e) for e in run.leg_end)
@@ -56,12 +119,12 @@ def csv_context(result: DashboardResult) -> list[str]:
     return lines
 
 
-def export_csv(result: DashboardResult) -> str:
+def export_csv(result: DashboardResult, when: datetime | None = None) -> str:
     """The context (:func:`csv_context`, '#' lines), then one row per trajectory point:
     algorithm, leg, theta, x..., y..., error, h."""
     names, tasks = result.variable_names, result.task_names
     header = ["algorithm", "leg", "theta", *names, *tasks, "error", "h"]
-    lines = [*csv_context(result), ",".join(header)]
+    lines = [*csv_context(result, when), ",".join(header)]
     for a, run in result.runs.items():
         h = run.h if run.h is not None else np.full(len(run.theta), np.nan)
         for k in range(len(run.theta)):
@@ -70,3 +133,12 @@ def export_csv(result: DashboardResult) -> str:
             vals += [repr(float(run.error[k])), "" if np.isnan(h[k]) else repr(float(h[k]))]
             lines.append(",".join(vals))
     return "\n".join(lines) + "\n"
+
+
+def export_file(
+    result: DashboardResult, kind: str, functionals: dict | None = None
+) -> tuple[dict | str, str]:
+    """The export of ``kind`` ("json": a dict, "csv": text) and its file name, made now."""
+    when = datetime.now(UTC)
+    body = export_json(result, functionals, when) if kind == "json" else export_csv(result, when)
+    return body, export_filename(result, kind, when)

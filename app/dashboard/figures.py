@@ -22,10 +22,10 @@ from jik.app.dashboard.model import ALGORITHMS, COLORS, DASH, LABELS
 from jik.app.dashboard.plotting import (
     NO_LEGEND,
     SYMBOLS,
+    corner_names,
     figure,
     is_unicycle,
     label,
-    leg_names,
     log_range,
     nice_range,
     norm_unit,
@@ -64,7 +64,7 @@ def _task_space(result: DashboardResult) -> dict:
     data.append(
         trace("scatter",
             x=tg[:, 0], y=tg[:, 1], mode="markers+text", name="targets",
-            text=leg_names(len(tg)), textposition="top right",
+            text=corner_names(result), textposition="top right",
             marker=dict(color="black", size=9, symbol="x"),
             hovertemplate=f"%{{text}}: ({n1}, {n2}) = (%{{x:.3f}}, %{{y:.3f}})<extra></extra>",
         )

@@ -9,9 +9,10 @@ from typing import Any
 
 import numpy as np
 
-from jik.app.dashboard.analysis import state_inert_variables
+from jik.app.dashboard.analysis import state_inert_variables, vector_note
 from jik.app.dashboard.model import ALGORITHMS, COLORS, DASH, LABELS
 from jik.app.dashboard.plotting import NO_LEGEND, figure, label, trace, units
+from jik.app.dashboard.robots import state_spec
 from jik.app.dashboard.runs import DashboardResult
 
 
@@ -35,6 +36,9 @@ def augmenting_spec(
     if grid is None and cancelled:
         return message_figure(augmenting_title(result, None, cancelled),
                               f"not computed: {cancelled}")  # fmt: skip
+    vector = vector_note(result.state) if grid is None else None
+    if vector:
+        return message_figure(f"Augmenting map h: {map_name(result)}", vector)
     if grid is None:
         return figure([], augmenting_title(result))
     i, j = grid["axes"]
@@ -86,12 +90,19 @@ def _svg_path(x: np.ndarray, y: np.ndarray) -> str:
     return "M" + points
 
 
+def map_name(result: DashboardResult) -> str:
+    """The map's name, and for a user's formula map its formula ("formula: h = x3")."""
+    name = result.state.augmentation
+    text = state_spec(result.state).augmentation(name).description
+    return f"{name}: {text}" if text.startswith("h = ") else name
+
+
 def augmenting_title(
     result: DashboardResult, functionals: dict | None = None, cancelled: str | None = None
 ) -> str:
     """Title of the h panel: the map, E1 and E2 on the plotted box, the fixed variables; while
     they are computed, or when that was ``cancelled``, it says so."""
-    title = f"Augmenting map h: {result.state.augmentation}"
+    title = f"Augmenting map h: {map_name(result)}"
     grid = result.augmenting
     if grid is None:
         # (on a line of its own: the title fits a half-width panel at 1280 px)

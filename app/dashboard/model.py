@@ -38,6 +38,7 @@ from jik.app.dashboard.robots import USER_KINDS, user_robot
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS, robot_spec
 from jik.engine.repeatability import MAX_PATH_POINTS
+from jik.engine.solver import gamma_problem
 
 ALGORITHMS = ("pseudoinverse", "extended")
 #: One colour per algorithm, used in the scene and in every plot.
@@ -81,7 +82,8 @@ class DashboardState(BaseModel):
     #: The three coordinates the configuration-space panel shows (p = 4): "012" is x1, x2, x3.
     cspace_axes: Literal["012", "013", "023", "123"] | None = None
     max_iterations: (
-        Annotated[int, Field(strict=True, ge=MIN_ITERATIONS, le=MAX_ITERATIONS_CAP)] | None
+        Annotated[int, Field(strict=True, ge=MIN_ITERATIONS, le=MAX_ITERATIONS_CAP), INTEGRAL]
+        | None
     ) = None
 
     def as_dict(self) -> dict:
@@ -214,7 +216,7 @@ def _user_default_state(robot: str, definition: Mapping[str, Any] | None) -> Das
     if definition.get("name") != robot:
         raise InvalidInputError(f"robot_definition.name: must be the robot's kind {robot!r}, got "
                                 f"{definition.get('name')!r}", "robot_definition.name")  # fmt: skip
-    spec = user_robot(definition).spec
+    spec = _redundant_robot(definition).spec
     return DashboardState(
         robot=robot,
         robot_parameters={},
@@ -307,10 +309,8 @@ def validate(data: Mapping[str, Any]) -> DashboardState:
         _registered(lambda: kin.check_task(state.path, "path"), "path")
     elif state.task == "path":
         raise InvalidInputError("path: a closed-path task needs at least one path point", "path")
-    if state.mode == "discrete" and state.gamma >= 2:
-        raise InvalidInputError(
-            f"gamma: must be < 2 in discrete mode, got {state.gamma:g}", "gamma"
-        )
+    if (why := gamma_problem(state.gamma, state.mode)) is not None:
+        raise InvalidInputError(f"gamma: {why}", "gamma")
     # The engine's default cap, set by its value, is the default (None): it follows the mode.
     default_cap = max_iterations(state.model_copy(update={"max_iterations": None}))
     return state.model_copy(update={
@@ -339,17 +339,29 @@ def _user_robot(state: DashboardState) -> tuple[Any, Any, dict, dict]:
     for key in ("robot_parameters", "augmentation_parameters"):
         if getattr(state, key):
             raise InvalidInputError(f"{key}: a user robot has none", key)
-    robot = user_robot(definition)
-    p, r = robot.spec.p, robot.spec.r
-    if r < 2 or p != r + 1:
-        raise InvalidInputError(
-            "robot_definition: the dashboard's panels (task paths in a plane, the map h, E1, E2) "
-            f"need r >= 2 and one degree of redundancy, p = r + 1; this robot has p = {p}, "
-            f"r = {r} (the REST API and jik solve take it)",
-            "robot_definition",
-        )
+    robot = _redundant_robot(definition)
     _registered(lambda: robot.spec.augmentation(state.augmentation), "augmentation")
     return robot.spec, robot.kinematics, {}, {}
+
+
+#: The field of a definition that sets its number of joint variables p, by kind.
+JOINTS_FIELD = {"planar_chain": "joints", "formula": "variables", "urdf": "active_joints"}
+
+
+def _redundant_robot(definition: Mapping[str, Any]):
+    """The user robot of ``definition`` if the dashboard shows it: task paths in a plane or
+    space (r >= 2) and redundancy (p > r; the panels of one scalar h, E1 and E2 need p = r + 1,
+    and say so otherwise). Refused naming the field that sets p."""
+    robot = user_robot(definition)
+    p, r = robot.spec.p, robot.spec.r
+    if r < 2 or p <= r:
+        field = f"robot_definition.{JOINTS_FIELD.get(str(definition.get('name')), 'name')}"
+        raise InvalidInputError(
+            f"{field}: the dashboard needs a redundant robot with r >= 2 task components, "
+            f"p > r; this robot has p = {p}, r = {r} (the REST API and jik solve take it)",
+            field,
+        )
+    return robot
 
 
 def _model(model: type[BaseModel], data: Mapping[str, Any], prefix: tuple[str, ...]) -> Any:

@@ -17,15 +17,15 @@ from collections.abc import Callable
 from typing import Any
 
 from jik.app.compute.exceptions import ServiceUnavailable
+from jik.app.compute.worker import task
 from jik.app.dashboard.runs import AlgorithmRun, Cancelled, algorithm_run
 
 log = logging.getLogger("jik.dashboard")
-#: The task of the compute workers that runs :func:`run_offloaded` (``jik.app.compute.worker``).
-TASK = "dashboard.run"
 
 
+@task("cycles", "fewer cycles, a larger gamma or another start")
 def run_offloaded(state, algorithm, targets, cycles, resume=None) -> AlgorithmRun:
-    """:func:`algorithm_run` in a compute worker (the worker's task :data:`TASK`)."""
+    """:func:`algorithm_run` in a compute worker."""
     return algorithm_run(state, algorithm, targets, cycles, resume=resume)
 
 
@@ -60,7 +60,7 @@ class OffloadLane:
     ) -> concurrent.futures.Future:
         """Run :func:`algorithm_run` in the pool (``resume``: see :func:`algorithm_run`)."""
         try:
-            future = self._pool.submit("call", (TASK, (state, algorithm, targets, cycles, resume)))
+            future = self._pool.submit(run_offloaded, state, algorithm, targets, cycles, resume)
         except ServiceUnavailable:
             future = concurrent.futures.Future()
             future.set_exception(ServiceUnavailable("the compute pool is not running"))

@@ -83,6 +83,20 @@ def leg_names(n: int) -> list[str]:
     return [chr(ord("A") + i) if i < 26 else f"P{i + 1}" for i in range(n)]
 
 
+def corner_names(result: DashboardResult) -> list[str]:
+    """The letters of the task's corners (its targets, in order), as Table 1 names its rows: a
+    closed path that ends where it starts, at k(x0), has its start as A (Manipulator 2: A =
+    k(x0) = (0, 1), then B = (1, 1), C, D, and A again); any other task letters its targets
+    from A."""
+    targets = np.asarray(result.targets, dtype=float)
+    n = len(targets)
+    start = result.runs["pseudoinverse"].y[0]
+    if result.state.task == "path" and n > 1 and np.allclose(targets[-1], start, atol=1e-6):
+        names = leg_names(n)
+        return names[1:] + names[:1]
+    return leg_names(n)
+
+
 def trace(kind: str, **props) -> dict:
     return {"type": kind, **props}
 

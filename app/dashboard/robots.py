@@ -6,7 +6,9 @@ A state names a catalogue robot (``robot``, with ``robot_parameters``), or a kin
 state's :class:`~jik.engine.registry.RobotSpec`, its kinematics and its inverses, so the two
 cases differ in this module only. A definition's refusal names its field under
 ``robot_definition`` (``robot_definition.lengths.1``), which the page's robot editor shows next
-to the field.
+to the field. A definition that a change brings is first built in a compute worker
+(:func:`vet_definition`), within the workers' time and memory limits and the build budget, so
+that a formula too costly to differentiate is refused before the server builds it itself.
 """
 
 from __future__ import annotations
@@ -16,6 +18,11 @@ import json
 from collections.abc import Mapping
 from typing import Any
 
+import numpy as np
+
+from jik.app.compute.budget import build_seconds, time_budget
+from jik.app.compute.exceptions import RequestError
+from jik.app.compute.worker import task
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.inverses import Inverse
 from jik.engine.kinematics import Kinematics
@@ -56,6 +63,47 @@ def user_robot(definition: Mapping[str, Any]) -> Robot:
         text = str(exc)
         raise InvalidInputError(f"{field}: {text}" if not text.startswith(field) else text,
                                 field) from None  # fmt: skip
+
+
+@task("robot_definition", "shorter formulas or fewer nested functions")
+def check_definition(definition: Mapping[str, Any]) -> None:
+    """Build a definition as :func:`user_robot` does, with the second derivatives that the
+    characteristics of section 4 take, within the build budget (a compute worker's task);
+    :class:`RequestError` naming its field if it is refused."""
+    what = "building the robot's formulas"
+    with time_budget(build_seconds(), "robot_definition", what):
+        try:
+            kinematics = user_robot(definition).kinematics
+        except InvalidInputError as exc:
+            field = exc.field or "robot_definition"
+            raise RequestError(field, str(exc).removeprefix(f"{field}: ")) from None
+        try:
+            hessian = getattr(kinematics, "hessian", None)
+            if hessian is not None:
+                hessian(np.zeros((1, kinematics.p)))
+        except InvalidInputError as exc:
+            field = "robot_definition" + (f".{exc.field}" if exc.field else "")
+            raise RequestError(field, str(exc).removeprefix(f"{exc.field}: ")) from None
+
+
+async def vet_definition(pool: Any, patch: Mapping[str, Any]) -> None:
+    """Build the robot definition a change brings (``patch["robot_definition"]``) in ``pool``
+    (a :class:`~jik.app.compute.pool.ComputePool`) first, off the event loop and within its
+    limits; nothing to do for a change without one.
+
+    Raises
+    ------
+    InvalidInputError
+        Naming the field under ``robot_definition`` (the whole definition when its build ran
+        out of time).
+    """
+    definition = patch.get("robot_definition")
+    if not isinstance(definition, Mapping) or pool is None:
+        return
+    try:
+        await pool.run(check_definition, dict(definition))
+    except RequestError as exc:
+        raise InvalidInputError(f"{exc.field}: {exc.message}", exc.field) from None
 
 
 def state_robot(state) -> Robot | None:

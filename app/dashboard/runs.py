@@ -13,8 +13,10 @@ import numpy as np
 
 from jik.app.dashboard.controls import max_iterations
 from jik.app.dashboard.model import DashboardState
+from jik.app.dashboard.reach import stall_note
 from jik.app.dashboard.robots import state_inverse, state_kinematics
 from jik.engine.exceptions import RunCancelled
+from jik.engine.progress import ProgressCallbacks
 from jik.engine.repeatability import Leg, Resume, closed_path, repeatability
 from jik.engine.solver import SolveResult, Trajectory
 from jik.engine.unicycle import Unicycle
@@ -88,21 +90,17 @@ def leg_targets(kin, state: DashboardState) -> np.ndarray:
     return closed_path(kin, np.asarray([state.x0]), np.asarray(state.path))[0]
 
 
-#: Discrete mode runs in chunks of this many iterations, so that a newer change cancels it.
-CHUNK = 80
-
-
 def _run_legs(
     inverse, state, targets, cycles, progress, cancelled, partial, resume=None
 ) -> AlgorithmRun:
     """Drive ``inverse`` through the legs by :func:`jik.engine.repeatability.repeatability`,
-    keeping every point of every leg (its ``on_leg``) with theta cumulative over the legs.
+    keeping every point of every leg (its progress's ``leg``) with theta cumulative over the legs.
 
     ``resume``: a successful run of fewer cycles of the same legs, whose cycles are kept; the
     engine goes on from its end with its last cycle's legs as Picard guides (the numbers of a
-    run from the start). Discrete legs run in chunks of :data:`CHUNK` iterations, between which
-    ``cancelled`` is polled and ``partial`` told the leg's progress. A leg whose solve raises (a
-    map undefined where it starts) stops this algorithm; the other one is still shown.
+    run from the start). Discrete legs run in chunks (the engine's ``POLL_ITERATIONS``), between
+    which ``cancelled`` is polled and ``partial`` told the leg's progress. A leg whose solve
+    raises (a map undefined where it starts) stops this algorithm; the other one is still shown.
     """
     t0 = time.perf_counter()
     x0 = np.asarray(state.x0)
@@ -130,6 +128,10 @@ def _run_legs(
             failure = f"{where} stopped: {leg.stopped_by}"
         elif not res.success:
             failure = f"{where}: {_leg_message(res, cap)}"
+            if res.message.startswith("stalled") and STALLED in res.message:
+                target = np.asarray(path, dtype=float)[leg.index]
+                note = stall_note(inverse, target, np.asarray(res.x, dtype=float))
+                failure = failure.replace(STALLED, note)
         else:
             last = _leg_message(res, cap)
         progress()
@@ -139,9 +141,8 @@ def _run_legs(
         run = repeatability(
             inverse, x0, path, cycles, gamma=1.0 if continuous else state.gamma, mode=state.mode,
             tol=state.tolerance, max_iterations=cap, record=True, close=close,
-            resume=earlier, on_leg=on_leg,
-            cancelled=cancelled, chunk=None if continuous else CHUNK, on_chunk=partial,
-            on_undefined="stop",
+            resume=earlier, on_undefined="stop", progress=ProgressCallbacks(
+                on_leg, lambda done, total: partial(done / total), cancelled),
         )  # fmt: skip
     except RunCancelled:
         raise Cancelled from None
@@ -162,6 +163,10 @@ def _run_legs(
         message=failure or _legs_message(len(ends), drift, last),
         seconds=time.perf_counter() - t0,
     )
+
+
+#: The end of the engine's message for a stalled run, which :func:`stall_note` makes precise.
+STALLED = "the step size collapsed near a singularity or the target is unreachable"
 
 
 def _leg_message(res: SolveResult, cap: int) -> str:

@@ -1,16 +1,13 @@
 """One session's live dashboard: its state, a worker thread that computes each change, and the
 listeners (the page's event stream, the scene) it tells.
 
-(It stays whole, at about 580 lines: one class, whose worker phases (result, second phase,
-solving ahead) share its lock, its generation and its caches; cancelling the second phase and
-running it again go through the same lock and worker. The second phase's steps and its events
-are :mod:`jik.app.dashboard.second_phase`.)
-
 Every change is validated (:mod:`jik.app.dashboard.model`), bumps a generation counter and wakes
 the worker, which solves both algorithms (:func:`jik.app.dashboard.results.compute`), builds the
-figures once and pushes them to every listener; a newer change cancels a stale computation
-between legs. Idle, it solves the other manipulator ahead for a switch.
-
+figures once (:mod:`jik.app.dashboard.panel_texts`) and pushes them to every listener; a newer
+change cancels a stale computation between legs. After each result the worker runs its second
+phase (:mod:`jik.app.dashboard.second_control`); idle, it solves the other manipulator ahead for
+a switch (:mod:`jik.app.dashboard.ahead`). Those parts share this class's lock, generation and
+caches, and live in their modules as the mixins :class:`Dashboard` is made of.
 """
 
 from __future__ import annotations
@@ -23,16 +20,12 @@ import time
 from collections.abc import Callable, Mapping
 from typing import NoReturn
 
-from jik.app.dashboard.analysis import (
-    expensive_map,
-    functionals_key,
-    kinematics_and_map,
-)
+from jik.app.dashboard.ahead import SolvingAhead
+from jik.app.dashboard.analysis import expensive_map, kinematics_and_map
 from jik.app.dashboard.controls import controls_message
-from jik.app.dashboard.figures import figure_specs, gamma_free_panels
+from jik.app.dashboard.figures import gamma_free_panels
 from jik.app.dashboard.messages import Event, digest, finite, summary, to_json, with_figures
 from jik.app.dashboard.model import (
-    ALGORITHMS,
     COLORS,
     LABELS,
     DashboardState,
@@ -42,23 +35,19 @@ from jik.app.dashboard.model import (
     validate,
 )
 from jik.app.dashboard.offload import Offload
-from jik.app.dashboard.plotting import PANELS, figure_json, keep_ranges
+from jik.app.dashboard.panel_texts import PanelTexts
+from jik.app.dashboard.plotting import PANELS
 from jik.app.dashboard.results import compute
 from jik.app.dashboard.runs import Cancelled, DashboardResult
-from jik.app.dashboard.second_phase import SecondPhase, cancelled_message, finished_message
+from jik.app.dashboard.second_control import SecondPhaseControl
 from jik.app.dashboard.slots import FairSlots
 from jik.app.dashboard.verdict import verdict
 from jik.engine.exceptions import InvalidInputError, JikError
 
 log = logging.getLogger("jik.dashboard")
 
-#: Robots whose default state the idle dashboard solves ahead (:meth:`Dashboard._prefetch`).
-#: Not the unicycle: its ~1 s would hold the CPU that a change made meanwhile needs (its
-#: switch shows progress instead).
-PREFETCH_ROBOTS = ("manipulator1", "manipulator2")
 
-
-class Dashboard:
+class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts):
     """One session's live dashboard: one state, a worker thread, and subscribers.
 
     Parameters
@@ -267,16 +256,6 @@ class Dashboard:
                 }
             )
 
-    def _second_status(self) -> str | None:
-        """The second phase of the result on screen: "computing", "cancelled" (E1, E2 and
-        their sensitivity not computed) or "done"; None without a result. (With the lock.)"""
-        if self.result is None:
-            return None
-        g = self.result.generation
-        if self._second_running == g:
-            return "computing"
-        return "cancelled" if self._second_cancelled == g else "done"
-
     # -- worker -----------------------------------------------------------------------------
     def _state_message(self, generation: int, state: DashboardState, source: str) -> dict:
         return {"type": "state", "generation": generation, "state": state.as_dict(),
@@ -318,86 +297,6 @@ class Dashboard:
             except Exception as exc:  # keep the worker alive; the page shows the message
                 log.exception("dashboard computation failed")
                 self._failure(generation, f"internal error: {type(exc).__name__}: {exc}")
-
-    def _prefetch(self, generation: int) -> None:
-        """While no change comes, solve the other robots' default states into the run cache:
-        switching robot starts from those defaults (:func:`updated_state`), so the switch then
-        only draws (Manipulator 1: ~90 ms of computation less in the browser test).
-
-        Each is announced by an ``ahead`` event with the figures the switch will show: the
-        page draws them off screen and shows them on the switch (when they are the same), the
-        3D scene builds the robot's nodes, hidden (from the event's result, given when the
-        runs were solved now). A robot is announced again after every switch of robot (the
-        page has shown what it drew ahead); meanwhile its figures stay the same (no sticky
-        axes or known E1/E2 carry over from another robot) and nothing is done again.
-
-        Only :data:`PREFETCH_ROBOTS`; any change cancels it between legs.
-        """
-
-        for robot in PREFETCH_ROBOTS:
-            state = default_state(robot)
-            if self._generation != generation or self._stopped:
-                return
-            if robot == self._state.robot:
-                continue
-            solved = all(cache_key(state, a) in self._cache for a in ALGORITHMS)
-            if solved and self._ahead_sent.get(robot) == self._robot_since:
-                continue  # (its figures stay the same while the robot on screen stays)
-            try:
-                _, amap = kinematics_and_map(state)
-                with self._turn():
-                    result = compute(
-                        state, generation, cancelled=lambda: self._generation != generation,
-                        cache=self._cache, with_augmenting=not expensive_map(amap),
-                        offload=self._offload,
-                    )  # fmt: skip
-                # The figures as the switch will make them (see _compute; no panel to reuse
-                # from another robot).
-                cached, stale = self._known_functionals(state)
-                functionals, sens = cached or (None, None)
-                texts = self._panel_texts(
-                    result, functionals, sens, set(PANELS) - stale, remember=False
-                )
-            except (Cancelled, JikError, ValueError):
-                return
-            except Exception:  # (work ahead: logged, never shown as the current result's error)
-                log.exception("solving %s ahead failed", robot)
-                return
-            digests = {k: digest(t) for k, t in texts.items()}
-            self._ahead_sent[robot] = self._robot_since
-            head = {"type": "ahead", "generation": generation, "robot": robot,
-                    "digests": digests}  # fmt: skip
-            event = Event(
-                "ahead", generation, with_figures(head, texts), None if solved else result
-            )
-            with self._cond:
-                self._latest_ahead[robot] = event
-            self._emit(event)
-
-    def _known_functionals(self, state: DashboardState) -> tuple[tuple | None, set[str]]:
-        """E1/E2 and their sensitivity for ``state`` when known (same map, same fixed
-        variables), and the panels that wait for the second phase: the E1/E2 panel unless
-        known (the page dims it meanwhile instead of redrawing a placeholder, 20-40 ms of its
-        redraw)."""
-        cached = self._functionals_cache.get(functionals_key(state))
-        return cached, (set() if cached else {"sensitivity"})
-
-    def _panel_texts(
-        self, result: DashboardResult, functionals, sens, todo: set[str], remember: bool
-    ) -> dict[str, str]:
-        """The JSON of the panels in ``todo``, with sticky axes (keep_ranges): against the
-        layout each panel last went out with, for the same robot and task. ``remember``: these
-        panels go out now (a result, not one solved ahead)."""
-
-        layout_key = (result.state.robot, result.state.task)
-        texts = {}
-        for k, f in figure_specs(result, functionals, todo, sensitivity=sens).items():
-            shown = self._layouts.get(k)
-            keep_ranges(f, shown[1] if shown is not None and shown[0] == layout_key else None)
-            if remember:
-                self._layouts[k] = (layout_key, f["layout"])
-            texts[k] = figure_json(f)
-        return texts
 
     def _failure(self, generation: int, message: str) -> None:
         """Announce that ``generation`` failed with ``message``, and which result (if any)
@@ -496,91 +395,3 @@ class Dashboard:
         self._emit(Event("result", generation, data, result))
         self._finish(generation)
         self._second_phase(generation, kin, amap, result, deferred, cached, grid_before)
-
-    # -- second phase -----------------------------------------------------------------------
-    def _second_phase(
-        self, generation: int, kin, amap, result: DashboardResult, deferred: bool, cached,
-        grid_before: dict | None,
-    ) -> None:  # fmt: skip
-        """h on a grid when it is expensive, then E1 and E2 (quadrature) and their sensitivity
-        (:class:`SecondPhase`), unless a newer change comes meanwhile: ``progress`` events
-        (``"phase": "second"``, what is computed) and a ``functionals`` event at the end, or,
-        when :meth:`cancel_second_phase` stopped it, one that says so (``cancelled``).
-
-        Known functionals went out with the result: their event only carries the h panel's
-        title (a reused panel can lack it, and a page that connects now gets this event with
-        the latest result).
-        """
-        phase = SecondPhase(
-            kin, amap, result, deferred=deferred, cached=cached, grid_before=grid_before,
-            progress=self._reporter(generation, "second"),
-            cancelled=lambda: generation != self._generation or generation != self._second_running,
-        )  # fmt: skip
-        with self._cond:
-            self._grid_before = grid_before
-        try:
-            functionals, sens = phase.run()
-        except Cancelled:
-            self._second_stopped(generation, phase)
-            return
-        finally:
-            with self._cond:
-                if self._second_running == generation:
-                    self._second_running = None
-        if not phase.cached:
-            self._functionals_cache = {functionals_key(result.state): (functionals, sens)}
-        with self._cond:
-            if self._generation != generation:
-                return
-            self.result, self.functionals = phase.result, functionals
-        data = finished_message(phase, generation, functionals, sens)
-        self._emit(Event("functionals", generation, data))
-
-    def _second_stopped(self, generation: int, phase: SecondPhase) -> None:
-        """A second phase stopped: by a newer change (nothing to say: its result follows), or
-        cancelled (:meth:`cancel_second_phase`): a ``functionals`` event that says so, the grid
-        kept when it was done (:func:`cancelled_message`)."""
-        with self._cond:
-            if self._generation != generation:
-                return
-            self.result = phase.result
-            self._second_cancelled = generation
-        self._emit(Event("functionals", generation, cancelled_message(phase, generation)))
-
-    def cancel_second_phase(self, generation: int) -> bool:
-        """Stop the second phase of ``generation`` (E1, E2, their sensitivity, h on a grid) at
-        its next step; the result stays on screen. False when it is not running (done, or a
-        newer generation is current)."""
-        with self._cond:
-            if self._second_running != generation or self._generation != generation:
-                return False
-            self._second_running = None
-            return True
-
-    def compute_second_phase(self, generation: int) -> bool:
-        """Run again the cancelled second phase of ``generation``, the result on screen. False
-        when it was not cancelled or ``generation`` is not current."""
-        with self._cond:
-            on_screen = self.result
-            if (
-                self._second_cancelled != generation
-                or self._generation != generation
-                or on_screen is None
-                or on_screen.generation != generation
-            ):
-                return False
-            self._second_cancelled, self._rerun = None, generation
-            self._second_running = generation
-            self._cond.notify_all()
-        return True
-
-    def _second_phase_again(self, generation: int) -> None:
-        """The worker's side of :meth:`compute_second_phase`: the phase from where the
-        cancelled one left the result (h on its grid when it was done)."""
-        result = self.result
-        if result is None or result.generation != generation:
-            return
-        kin, amap = kinematics_and_map(result.state)
-        deferred = expensive_map(amap) and result.augmenting is None
-        cached, _ = self._known_functionals(result.state)
-        self._second_phase(generation, kin, amap, result, deferred, cached, self._grid_before)

@@ -23,6 +23,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from jik.app.compute.settings import Settings
 from jik.app.dashboard.model import default_state, updated_state
 from jik.app.dashboard.offload import Offload
 from jik.app.dashboard.session import Dashboard
@@ -56,14 +57,12 @@ class SessionLimits:
     computations: int = max(1, os.cpu_count() or 1)
 
     @classmethod
-    def from_env(cls) -> SessionLimits:
+    def from_settings(cls, settings: Settings) -> SessionLimits:
         """``JIK_MAX_SESSIONS``, ``JIK_SESSION_IDLE_SECONDS``, ``JIK_DASHBOARD_COMPUTATIONS``."""
-        env = os.environ
         return cls(
-            max_sessions=max(1, int(env.get("JIK_MAX_SESSIONS", cls.max_sessions))),
-            idle_seconds=max(1.0, float(env.get("JIK_SESSION_IDLE_SECONDS", cls.idle_seconds))),
-            computations=max(1, int(env.get("JIK_DASHBOARD_COMPUTATIONS", cls.computations))),
-        )
+            max_sessions=settings.max_sessions, idle_seconds=settings.session_idle_seconds,
+            computations=settings.dashboard_computations,
+        )  # fmt: skip
 
 
 @dataclass
@@ -72,7 +71,7 @@ class Session:
 
     id: str
     dashboard: Dashboard
-    scene: Any = None  # a jik.app.scene.DashboardScene (.port, .stop()), or None
+    scene: Any = None  # a jik.app.scene.DashboardScene (.connect(), .stop()), or None
     touched: float = field(default_factory=time.monotonic)
     #: Open event streams and scene connections: a session with any is in use.
     users: int = 0

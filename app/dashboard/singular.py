@@ -69,7 +69,7 @@ def _find(state: DashboardState) -> dict | None:
         kin, amap = kinematics_and_map(state)
     except (JikError, ValueError):
         return None
-    if expensive_map(amap):
+    if amap is None or expensive_map(amap):
         return None
     names = list(spec.variable_names)
     X, axes = _grid(state, names, region)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from jik.app.dashboard.model import ALGORITHMS
-from jik.app.dashboard.plotting import figure, leg_names, trace
+from jik.app.dashboard.plotting import corner_names, figure, trace
 from jik.app.dashboard.runs import DashboardResult
 from jik.engine.reproductions.table1 import PATH, PRINTED, X0, cell
 
@@ -118,7 +118,7 @@ def leg_ends_spec(result: DashboardResult) -> dict:
     """The configuration after every leg for both algorithms (any robot, path or target)."""
     names = result.variable_names
     L = len(result.targets)
-    legs = leg_names(L)
+    legs = corner_names(result)
     rows = max(len(result.runs[a].leg_end) for a in ALGORITHMS) + 1
     point = ["start x0"] + [
         f"cycle {c // L + 1}, leg to {legs[c % L]} {_point(result.targets[c % L])}"

@@ -20,6 +20,7 @@ from jik.app.dashboard.messages import h_change
 from jik.app.dashboard.plotting import norm_unit, units
 from jik.app.dashboard.runs import AlgorithmRun, DashboardResult
 from jik.app.dashboard.singular import singular_sentence
+from jik.engine.registry import POSE_A, POSE_B
 from jik.engine.repeatability import REPEATABLE_DRIFT
 
 #: h counts as conserved when it changed by less than this along a run.
@@ -112,6 +113,67 @@ def _extended_why(result: DashboardResult, run: AlgorithmRun) -> list[Sentence]:
     return out
 
 
+#: Section 6.2's runs: the start pose, and the figures of its pseudoinverse and extended runs.
+PAPER_RUNS = {"A": (POSE_A, "Figs. 11 (J^P#) and 12 (J^E#)"),
+              "B": (POSE_B, "Figs. 13 (J^P#) and 14 (J^E#)")}  # fmt: skip
+
+
+def _paper_run(result: DashboardResult) -> str | None:
+    """The paper's sec. 6.2 run this unicycle result repeats ("A", "B"), None if none."""
+    state = result.state
+    if state.robot != "unicycle" or state.augmentation != "characteristics":
+        return None
+    q0 = np.asarray(state.robot_parameters.get("q0", ()), dtype=float)
+    for name, (pose, _) in PAPER_RUNS.items():
+        if q0.shape == (3,) and np.allclose(q0, pose, atol=1e-9):
+            return name
+    return None
+
+
+def _undefined_why(result: DashboardResult, run: AlgorithmRun) -> list[Sentence]:
+    """Why the unicycle's map of characteristics (29) became undefined along the extended run:
+    the step that left the foliation's domain (lambda10 of the sign of the reference leaf's a,
+    omega being undefined on lambda10 = 0), the characteristic (28) from there running into a
+    zero of the kernel component that normalises omega, and, for the paper's run B, that this is
+    Figs. 13-14's run and docs/paper-errata.md's finding."""
+    state = result.state
+    if (state.robot != "unicycle" or state.augmentation != "characteristics" or run.success
+            or "is undefined" not in run.message or len(run.x) < 2):  # fmt: skip
+        return []
+    a = float(state.augmentation_parameters.get("a", 1.0))
+    before, after = float(run.x[-2][0]), float(run.x[-1][0])
+    which = f"iteration {len(run.x) - 1}" if state.mode == "discrete" else "the run's last step"
+    step = f"{which} took λ10 from {g(before)} to {g(after)}"
+    if after * a <= 0:
+        left = (f"{step}, across λ10 = 0 and out of the domain of the map's foliation (λ10 of "
+                f"the sign of a = {g(a)}: ω is undefined on λ10 = 0)")  # fmt: skip
+    else:
+        left = step
+    text = (
+        f"Why: h is defined by the characteristic (28) from λ to the reference leaf "
+        f"λ10 = a (eq. (29)); {left}. From there the characteristic runs into a zero of the "
+        "kernel component that normalises ω (J11 J24 − J14 J21 = 0), where ω and dz/ds "
+        "blow up, so h, and with it the extended Jacobian inverse (47), is undefined."
+    )
+    out = [Sentence(text, "extended", "why")]
+    paper = _paper_run(result)
+    if paper is not None:
+        figures = PAPER_RUNS[paper][1]
+        note = (
+            f"This is the paper's run from q0 = {paper} (sec. 6.2, {figures}). Where the "
+            "paper plots the extended run to its end, jik finds that it leaves the domain "
+            'of h: docs/paper-errata.md (Unicycle, "Section 6.2, what jik finds") '
+            "explains it, with a command that shows it."
+        )
+        if state.mode == "discrete":
+            note += (
+                " In mode continuous h is conserved exactly and the extended run from "
+                f"q0 = {paper} converges."
+            )
+        out.append(Sentence(note, "extended", "note"))
+    return out
+
+
 def _pseudoinverse_why(run: AlgorithmRun) -> list[Sentence]:
     if repeatable(run) is False:
         return [Sentence(
@@ -143,7 +205,7 @@ def verdict(result: DashboardResult) -> list[dict]:
             out.append(Sentence(f"{NAMES[algorithm]} stopped{done}: {run.message}", algorithm,
                                 "failure"))  # fmt: skip
     out += _pseudoinverse_why(runs["pseudoinverse"]) if path else []
-    out += _extended_why(result, runs["extended"])
+    out += _undefined_why(result, runs["extended"]) or _extended_why(result, runs["extended"])
     warning = singular_sentence(result.state)
     if warning:
         out.append(Sentence(warning, "extended", "warning"))

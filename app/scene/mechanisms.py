@@ -303,6 +303,9 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
     not for J^P#; the targets of the path's legs."""
     (xlo, xhi), (ylo, yhi) = extent
     tol = trace_tolerance(extent)
+    # Heights and balls at the manipulators' scale, smaller in a smaller scene (a formula
+    # robot's paths may span a few millimetres).
+    scale = min(1.0, max(xhi - xlo, yhi - ylo) / 2.0)
     robot = result.state.robot
     grey: dict = {"color": (90, 90, 90)}
     out: dict[str, tuple[str, dict, dict]] = {}
@@ -322,9 +325,10 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
         run = result.runs[a]
         line = {"colors": rgb(COLORS[a]), "thickness_units": "screen"}  # pixels, see above
         if chain:  # (the end point's path: a URDF arm's task may be some of x, y, z)
-            task = chain_points(kin, run.x, Z[a] + 0.16)[:, -1]
+            task = chain_points(kin, run.x, (Z[a] + 0.16) * scale)[:, -1]
         else:
-            task = np.column_stack([run.y[:, 0], run.y[:, 1], np.full(len(run.y), Z[a] + 0.16)])
+            z = np.full(len(run.y), (Z[a] + 0.16) * scale)
+            task = np.column_stack([run.y[:, 0], run.y[:, 1], z])
         out[f"{root}/trace/{a}/task"] = (
             "line", {"points": polyline(task, tol)},
             {**line, "thickness": 3.0 if a == "pseudoinverse" else 2.0},
@@ -338,8 +342,8 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
         return out  # (a target of some of x, y, z is not a point)
     for k, target in enumerate(result.targets):
         out[f"{root}/targets/{k}"] = (
-            "ball", {"position": (float(target[0]), float(target[1]), 0.2)},
-            {"radius": 0.05, "color": (0, 0, 0)},
+            "ball", {"position": (float(target[0]), float(target[1]), 0.2 * scale)},
+            {"radius": 0.05 * scale, "color": (0, 0, 0)},
         )  # fmt: skip
     return out
 
@@ -358,6 +362,11 @@ def extent_of(result) -> tuple[tuple[float, float], tuple[float, float]]:
         lo, hi = pts.min(axis=0)[:2] - 0.3, pts.max(axis=0)[:2] + 0.3
         return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
     ys = np.concatenate([r.y for r in result.runs.values()])
+    if result.state.robot not in MECHANISMS:  # (a formula robot: its paths, of any size)
+        ys = np.vstack([ys[:, :2], np.asarray(result.targets)[:, :2]])
+        lo, hi = ys.min(axis=0), ys.max(axis=0)
+        pad = max(0.15 * float(np.max(hi - lo)), 1e-3)
+        return (float(lo[0] - pad), float(hi[0] + pad)), (float(lo[1] - pad), float(hi[1] + pad))
     lo = np.minimum(ys.min(axis=0)[:2], 0.0) - 0.6
     hi = np.maximum(ys.max(axis=0)[:2], 1.0) + 0.6
     if result.state.robot == "manipulator2":

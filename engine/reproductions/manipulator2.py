@@ -17,6 +17,7 @@ from jik.engine.augmentations import PaperCubic
 from jik.engine.functionals import error_functional_e2
 from jik.engine.inverses import ExtendedInverse, Pseudoinverse
 from jik.engine.kinematics import Manipulator2
+from jik.engine.progress import ProgressCallbacks
 from jik.engine.reproductions.table1 import cell
 from jik.engine.reproductions.table1 import rows as table1_rows
 from jik.engine.symbolic import findings_summary, manipulator2_findings
@@ -41,7 +42,9 @@ def run(progress: Callable[[float], None] | None = None, symbolic: bool = True) 
     report = progress or (lambda f: None)
     kin = Manipulator2()
     t0 = time.perf_counter()
-    res = synthesize_manipulator2(1.0, progress=lambda f: report(0.3 * f))
+    res = synthesize_manipulator2(
+        1.0, progress=ProgressCallbacks(on_advance=lambda done, total: report(0.3 * done / total))
+    )
     seconds = time.perf_counter() - t0
     reference = synthesize_e2(kin, MANIPULATOR2_REGION, degree=REFERENCE_DEGREE).e2
     report(0.4)

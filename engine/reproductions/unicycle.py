@@ -19,14 +19,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import cast
 
 import numpy as np
 
 from jik.engine.characteristics import UnicycleCharacteristics
 from jik.engine.exceptions import JikError
 from jik.engine.inverses import ExtendedInverse, Pseudoinverse
-from jik.engine.solver import SolveResult, solve
+from jik.engine.solver import solve
 from jik.engine.unicycle import Unicycle
 
 STARTS = {"A": (5.0, 0.0, math.pi / 2), "B": (-5.0, 5.0, math.pi / 2)}
@@ -110,10 +109,10 @@ def _run_one(kin, inverse, strict, mode) -> dict:
         # An undefined h reaches the solver as NaN in [J; dh] (flagged singular there); the
         # 'invalid value' warning of that determinant is expected and diagnosed below.
         with np.errstate(invalid="ignore"):
-            res = cast(SolveResult, solve(  # one start configuration: a single result
+            res = solve(
                 inverse, LAMBDA0, Y_D, gamma=GAMMA, mode=mode, tol=TOL,
                 max_iterations=MAX_ITERATIONS if mode == "discrete" else None, record=True,
-            ))  # fmt: skip
+            )  # fmt: skip
     except JikError as exc:
         out.update(success=False, message=f"could not start: {exc}", lambda_=list(LAMBDA0))
         out["lambda"] = out.pop("lambda_")

@@ -10,8 +10,16 @@ import pytest
 from fastapi.testclient import TestClient
 
 from jik.app.api.factory import create_app
-from jik.app.compute.atlas_jobs import AtlasJobNotFound, AtlasJobs, AtlasLimits, plan_request
+from jik.app.compute.atlas_jobs import (
+    AtlasJobNotFound,
+    AtlasJobs,
+    AtlasLimits,
+    PoolBackend,
+    plan_request,
+)
 from jik.app.compute.atlas_schemas import AtlasRequest
+from jik.app.compute.pool import pool_in_thread
+from jik.app.compute.settings import Settings
 from jik.app.dashboard.sessions import SessionLimits, SessionStore
 from jik.engine.atlas_run import run_atlas
 from jik.engine.registry import robot_spec
@@ -34,7 +42,7 @@ LONG = body(starts=20000, cycles=5, arc=None)
 @pytest.fixture
 def app():
     app = create_app()
-    app.state.atlas_jobs = AtlasJobs(AtlasLimits(max_jobs=3, per_client=1, workers=1))
+    app.state.atlas_jobs = AtlasJobs(AtlasLimits(max_jobs=3, per_client=1))
     app.state.sessions = SessionStore(SessionLimits(max_sessions=4))
     yield app
     app.state.atlas_jobs.close()
@@ -130,7 +138,7 @@ def test_unknown_job_is_404(client):
 
 
 def test_ended_jobs_are_dropped_after_keep_for():
-    jobs = AtlasJobs(AtlasLimits(keep_for=0.0, workers=1))
+    jobs = AtlasJobs(AtlasLimits(keep_for=0.0))
     job = jobs.start("me", AtlasRequest.model_validate(body(starts=2, cycles=1)))
     end = time.monotonic() + 300
     while job.ended is None and time.monotonic() < end:
@@ -245,3 +253,14 @@ def test_an_atlas_takes_the_catalogues_robots_and_says_so(client):
     assert "AtlasUrdfRequest" not in names and "AtlasManipulator2Request" in names
     r = client.post("/atlas", json=body(leg_ends=0))
     assert r.status_code == 422 and r.json()["detail"][0]["loc"] == ["body", "leg_ends"]
+
+
+def test_an_atlas_in_the_compute_pool_is_the_engines_atlas():
+    """The API's atlases run their chunks in the compute pool's workers: the same numbers as
+    in-process, to 1e-12."""
+    plan = plan_request(AtlasRequest.model_validate(body(starts=9)), AtlasLimits())
+    with pool_in_thread(Settings(workers=1, timeout=60.0)) as pool:
+        pooled = run_atlas(plan, PoolBackend(pool))
+    here = run_atlas(plan)
+    np.testing.assert_allclose(pooled.drift, here.drift, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(pooled.leg_ends, here.leg_ends, rtol=0, atol=1e-12)

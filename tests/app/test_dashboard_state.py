@@ -188,7 +188,9 @@ def test_export_has_every_point_of_both_runs():
     result = compute(updated_state(default_state("manipulator1"), {"task": "target"}))
     lines = export_csv(result).strip().split("\n")
     context = [r for r in lines if r.startswith("#")]
-    assert context[0].startswith("# jik export of generation 0") and '"task":"target"' in context[1]
+    assert context[0].startswith("# jik export of generation 0") and '"task":"target"' in context[2]
+    assert context[1].startswith("# jik ") and ", exported " in context[1]
+    assert context[3].startswith("# units: x1 [m]; x2 [m]; x3 [dimensionless]; y1 [m]; y2 [m]")
     assert any(r.startswith("# extended leg ends") for r in context)
     rows = lines[len(context) :]
     assert rows[0] == "algorithm,leg,theta,x1,x2,x3,y1,y2,error,h"

@@ -45,8 +45,11 @@ def test_a_definition_is_state_with_its_defaults_and_a_map():
         ({"robot": "formula", "robot_definition": {"name": "formula", "variables": ["x1", "x2"],
           "task": ["x1 + os"]}}, "robot_definition.task.0", "unknown name 'os'"),
         ({"robot": "urdf"}, "robot_definition", "needs its definition"),
-        ({"robot_definition": {**ARM, "joints": "RRRRR", "lengths": [0.4] * 5}},
-         "robot_definition", "this robot has p = 5, r = 2 (the REST API and jik solve take it)"),
+        ({"robot_definition": {**ARM, "joints": "RR", "lengths": [0.4] * 2}},
+         "robot_definition.joints", "this robot has p = 2, r = 2 (the REST API and jik solve"),
+        ({"robot_definition": {**ARM, "joints": "RRRR", "lengths": [0.4] * 4,
+                               "augmentations": [{"name": "formula", "h": "x4"}]}},
+         "robot_definition.augmentations.0.h", "must be a list of 2 formulas (p - r = 2"),
     ],
 )  # fmt: skip
 def test_refusals_name_the_definitions_field(patch, field, text):

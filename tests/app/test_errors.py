@@ -223,3 +223,66 @@ def test_a_boolean_or_a_string_is_no_number(api, over, field):
     """(Booleans were taken as 0 and 1, and numeric strings as numbers.)"""
     (msg,) = messages(api.post("/solve", json=solve_body(**over)))
     assert msg.startswith(f"{field}: Input should be a valid")
+
+
+def _chain_urdf(joints: int) -> str:
+    links = "".join(f'<link name="l{i}"/>' for i in range(joints + 1))
+    moving = "".join(
+        f'<joint name="j{i}" type="revolute"><parent link="l{i}"/><child link="l{i + 1}"/>'
+        f'<origin xyz="0.1 0 0"/><axis xyz="0 0 1"/>'
+        f'<limit lower="-3" upper="3" effort="1" velocity="1"/></joint>'
+        for i in range(joints)
+    )
+    return f'<robot name="long">{links}{moving}</robot>'
+
+
+@pytest.mark.parametrize("path", ["/solve", "/repeatability"])
+def test_a_robot_past_the_joint_cap_is_refused_by_the_cap(api, path):
+    """A 400-joint URDF chain was answered "x0 must have 400 components", which no x0 can have
+    (x0 takes at most 16): the answer names the cap and how to stay under it."""
+    robot = {"name": "urdf", "urdf": _chain_urdf(400), "end_link": "l400", "task": "xy"}
+    body = {"robot": robot, "algorithm": "pseudoinverse", "x0": [0.1] * 16}
+    body.update({"target": [1.0, 1.0]} if path == "/solve" else {"path": [[1.0, 1.0]]})
+    (msg,) = messages(api.post(path, json=body))
+    assert msg == (
+        "robot: this urdf robot has p = 400 moving joints; the API takes at most 16 (the cap on "
+        "x0's components); name at most that many in active_joints (the others stay at their "
+        "value in locked, default 0)"
+    )
+
+
+def test_a_missing_atlas_job_says_why_it_is_missing(api):
+    """An id of an earlier server process is a job lost in the restart; one of this server's
+    was cancelled or dropped; anything else was never an id (all were answered "it was
+    cancelled, or ended and expired")."""
+    from jik.app.compute.atlas_jobs import AtlasJobs
+
+    assert api.get("/atlas/x").status_code == 404
+    ours = api.app.state.atlas_jobs.run
+    earlier = AtlasJobs().run
+    while earlier == ours:
+        earlier = AtlasJobs().run
+    token = "A" * 16
+    for job_id, why in [
+        (earlier + token, "the server restarted since it was started, and atlas jobs live in "
+         "the server's memory: start it again"),
+        (ours + token, "it was cancelled, or it ended more than 600 s ago and was dropped"),
+        ("nosuchjob", "no job of this server has had this id"),
+    ]:  # fmt: skip
+        r = api.get(f"/atlas/{job_id}")
+        assert r.status_code == 404
+        assert r.json() == {"detail": f"no atlas job {job_id!r}: {why}"}
+
+
+@pytest.mark.parametrize("path", ["/solve", "/repeatability"])
+def test_an_overflow_at_the_start_is_called_an_overflow(api, path):
+    """k(x0) = exp(800) is past the floating-point range: the answer says so (it was "J J^T
+    is singular", and in a session "y_d contains NaN or infinite values")."""
+    robot = {"name": "formula", "variables": ["x1", "x2", "x3"], "task": ["exp(x1) + x3", "x2"]}
+    body = {"robot": robot, "algorithm": "pseudoinverse", "x0": [800.0, 0.5, 0.5]}
+    body.update({"target": [1.0, 1.0]} if path == "/solve" else {"path": [[1.0, 1.0]]})
+    (msg,) = messages(api.post(path, json=body))
+    assert msg == (
+        "x0: the kinematics overflow at the start: k(x0) = (inf, 0.5), its Jacobian not "
+        "finite; choose a start where both are finite (below about 1.8e308)"
+    )

@@ -47,7 +47,7 @@ def test_task_space_paths_use_one_colour_per_algorithm(path_result):
     assert fig.layout.xaxis.title.text == "y1 [m]"
     assert fig.layout.yaxis.title.text == "y2 [m]"
     targets = next(t for t in fig.data if t.name == "targets")
-    assert list(targets.text) == ["A", "B", "C", "D"]
+    assert list(targets.text) == ["B", "C", "D", "A"]  # (Table 1: A = k(x0) = (0, 1))
     np.testing.assert_allclose(targets.x, [1, 1, 0, 0])
     # Both end-effector paths pass through every target (the solver's tol is 1e-10).
     for a, run in path_result.runs.items():

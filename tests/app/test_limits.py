@@ -113,3 +113,65 @@ def test_a_computation_over_the_worker_memory_limit_is_422_and_the_worker_lives_
         assert "a smaller region, fewer nodes, a smaller grid" in error["msg"]
         assert client.app.state.pool._workers[0] is worker  # (not killed)
         assert client.get("/robots").status_code == 200
+
+
+#: An atlas that runs for about a minute of one core (cancelled long before).
+LONG_ATLAS = {"robot": {"name": "manipulator2"}, "path": TABLE1_PATH, "starts": 20000,
+              "cycles": 5}  # fmt: skip
+SHORT_ATLAS = {**LONG_ATLAS, "starts": 4, "cycles": 1, "arc": [-1.0, 1.0]}
+
+
+def test_a_queued_atlas_says_what_it_waits_for():
+    """One atlas computes at a time: the others say how many jobs are before them, and start in
+    the order they came (the queue's wait was invisible in the job's status)."""
+    from fastapi.testclient import TestClient
+
+    from jik.app.compute.atlas_jobs import AtlasJobs, AtlasLimits
+
+    app = create_app(Settings(workers=1, timeout=60.0))
+    app.state.atlas_jobs = AtlasJobs(AtlasLimits(max_jobs=4, per_client=3, workers=1))
+    with TestClient(app) as client:
+        ids = [client.post("/atlas", json=LONG_ATLAS).json()["id"]]
+        ids += [client.post("/atlas", json=SHORT_ATLAS).json()["id"] for _ in range(2)]
+        try:
+            deadline = time.monotonic() + 30
+            while client.get(f"/atlas/{ids[0]}").json()["status"] != "running":
+                assert time.monotonic() < deadline
+                time.sleep(0.1)
+            second, third = (client.get(f"/atlas/{i}").json() for i in ids[1:])
+            assert (second["status"], second["queue_position"]) == ("queued", 1)
+            says = "queued behind 1 atlas job (1 computing, the rest waiting); it starts when"
+            assert second["message"] == f"{says} they end"
+            assert (third["status"], third["queue_position"]) == ("queued", 2)
+            assert "queued behind 2 atlas jobs (1 computing" in third["message"]
+            first = client.get(f"/atlas/{ids[0]}").json()
+            assert first["queue_position"] is None and first["message"] == "computing"
+            client.delete(f"/atlas/{ids[0]}")
+            deadline = time.monotonic() + 60
+            while client.get(f"/atlas/{ids[1]}").json()["status"] == "queued":
+                assert time.monotonic() < deadline
+                assert client.get(f"/atlas/{ids[2]}").json()["status"] == "queued"
+                time.sleep(0.05)
+        finally:
+            for job in ids:
+                client.delete(f"/atlas/{job}")
+
+
+def test_a_forwarded_for_header_does_not_make_a_new_client():
+    """Without --forwarded-allow-ips the client is the connection's peer: X-Forwarded-For
+    cannot lift the per-client atlas limit (2), which a new address per request did."""
+    from jik.benchmarks.serving import jik_serve
+
+    with jik_serve(JIK_WORKERS="1") as served, httpx.Client(base_url=served.url) as c:
+        ids = []
+        try:
+            for k, body in enumerate([LONG_ATLAS, SHORT_ATLAS]):
+                r = c.post("/atlas", json=body, headers={"X-Forwarded-For": f"203.0.113.{k}"})
+                assert r.status_code == 202, r.text
+                ids.append(r.json()["id"])
+            r = c.post("/atlas", json=SHORT_ATLAS, headers={"X-Forwarded-For": "203.0.113.9"})
+            assert r.status_code == 429, r.text
+            assert "at most 2 atlas jobs per client" in r.json()["detail"]
+        finally:
+            for job in ids:
+                c.delete(f"/atlas/{job}")

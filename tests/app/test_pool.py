@@ -16,7 +16,7 @@ import pytest
 
 from jik.app.compute.pool import ComputePool
 from jik.app.compute.settings import Settings
-from jik.app.compute.worker import frame_header
+from jik.app.compute.worker import frame_header, ping, repeatability_json
 
 LOOPS = ["asyncio"] + (["uvloop"] if importlib.util.find_spec("uvloop") else [])
 
@@ -153,12 +153,12 @@ def test_a_cancelled_request_gives_its_worker_back_after_the_reply():
         try:
             await pool.warm_up()
             pid = pool._workers[0].process.pid
-            task = asyncio.create_task(pool.run("repeatability", body))
+            task = asyncio.create_task(pool.run(repeatability_json, body))
             await asyncio.sleep(0.2)
             task.cancel()
             with pytest.raises(asyncio.CancelledError):
                 await task
-            assert await pool.run("ping", None) == "pong"
+            assert await pool.run(ping) == "pong"
             return pid, [w.process.pid for w in pool._workers], dict(pool.stats)
         finally:
             pool.close()

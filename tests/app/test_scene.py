@@ -3,10 +3,13 @@ writing to the session's dashboard, nodes moved in place, traces within their to
 
 from __future__ import annotations
 
+import math
 import threading
+import time
 
 import numpy as np
 import pytest
+import viser
 
 from jik.app.dashboard import Dashboard, compute, default_state, updated_state
 from jik.app.scene import DashboardScene
@@ -106,8 +109,10 @@ def test_viser_gui_and_drag_change_the_one_state():
             assert time.monotonic() < deadline, "the scene did not redraw"
             time.sleep(0.05)
         # A change from elsewhere (the page) moves the scene's GUI at once.
-        dashboard.update({"gamma": 0.5})
+        generation, _ = dashboard.update({"gamma": 0.5})
         assert scene.controls.inputs["gamma"].value == 0.5
+        assert dashboard.wait(generation, timeout=60)
+        _drawn(scene, generation)  # (its status drawn: the refusal's below is not overwritten)
         # A value the dashboard refuses puts the GUI back to the value in force and says so.
         scene.controls.inputs["gamma"].value = -1.0
         assert dashboard.state.gamma == 0.5
@@ -163,53 +168,56 @@ def test_scene_follows_a_new_result_in_place():
         assert dashboard.wait(1, timeout=60)
         second = updated_state(first, {"x0": [0.45, 0.1, 1.4], "robot_parameters": {"l": 1.3}})
         scene._draw(compute(first, 101))
-        fixtures, mechanisms = dict(scene._fixtures), dict(scene._mechanisms)
+        fixtures, mechanisms = dict(scene.nodes.fixtures), dict(scene.nodes.mechanisms)
         scene._draw(compute(second, 102))
-        assert scene._fixtures.keys() == fixtures.keys()
-        assert all(scene._fixtures[k] is v for k, v in fixtures.items())
-        assert all(scene._mechanisms[k] is v for k, v in mechanisms.items())
+        assert scene.nodes.fixtures.keys() == fixtures.keys()
+        assert all(scene.nodes.fixtures[k] is v for k, v in fixtures.items())
+        assert all(scene.nodes.mechanisms[k] is v for k, v in mechanisms.items())
         # The default start maps onto the path's last point: one target fewer, the rest stays.
         scene._draw(compute(default_state("manipulator2"), 105))
-        assert scene._fixtures.keys() == fixtures.keys() - {f"{M2}/targets/4"}
-        assert all(scene._fixtures[k] is v for k, v in fixtures.items() if k in scene._fixtures)
+        assert scene.nodes.fixtures.keys() == fixtures.keys() - {f"{M2}/targets/4"}
+        assert all(
+            scene.nodes.fixtures[k] is v for k, v in fixtures.items() if k in scene.nodes.fixtures
+        )
         scene._draw(compute(second, 106))
-        assert scene._fixtures.keys() == fixtures.keys()
+        assert scene.nodes.fixtures.keys() == fixtures.keys()
         result = compute(second, 103)
         (xlo, xhi), (ylo, yhi) = extent_of(result)
         tol = TRACE_TOLERANCE * max(xhi - xlo, yhi - ylo)
         y = result.runs["extended"].y
         np.testing.assert_allclose(
-            scene._fixtures[f"{M2}/trace/extended/task"].points[:, :, :2],
+            scene.nodes.fixtures[f"{M2}/trace/extended/task"].points[:, :, :2],
             polyline(np.column_stack([y, np.full(len(y), 0.16)]), tol)[:, :, :2],
             rtol=1e-6,  # viser keeps float32
         )
-        assert scene._mechanisms["extended"].arm.dimensions[0] == pytest.approx(1.3)
+        assert scene.nodes.mechanisms["extended"].arm.dimensions[0] == pytest.approx(1.3)
         (X, Y), _ = gizmo_pose("manipulator2", second.x0, second.robot_parameters)
         np.testing.assert_allclose(scene.gizmo.handle.position, (X, Y, 0.3))
         # Another robot: its own nodes; the first robot's are hidden, and shown again (moved,
         # not re-created) when it comes back.
-        fixtures, mechanisms = dict(scene._fixtures), dict(scene._mechanisms)
+        fixtures, mechanisms = dict(scene.nodes.fixtures), dict(scene.nodes.mechanisms)
         scene._draw(compute(default_state("manipulator1"), 104))
-        assert set(scene._fixtures) >= {"/robot/manipulator1-path/guide"}
-        assert not any(k.startswith(M2) for k in scene._fixtures)
-        assert scene._sets[("manipulator2", "path")]["frame"].visible is False
+        assert set(scene.nodes.fixtures) >= {"/robot/manipulator1-path/guide"}
+        assert not any(k.startswith(M2) for k in scene.nodes.fixtures)
+        assert scene.nodes.sets[("manipulator2", "path")]["frame"].visible is False
         scene._draw(compute(second, 107))
-        assert scene._sets[("manipulator2", "path")]["frame"].visible is True
-        assert scene._sets[("manipulator1", "path")]["frame"].visible is False
-        assert all(scene._fixtures[k] is v for k, v in fixtures.items())
-        assert all(scene._mechanisms[k] is v for k, v in mechanisms.items())
+        assert scene.nodes.sets[("manipulator2", "path")]["frame"].visible is True
+        assert scene.nodes.sets[("manipulator1", "path")]["frame"].visible is False
+        assert all(scene.nodes.fixtures[k] is v for k, v in fixtures.items())
+        assert all(scene.nodes.mechanisms[k] is v for k, v in mechanisms.items())
         # A result solved ahead: its nodes are built hidden, and shown by its result.
         other = compute(updated_state(default_state("manipulator1"), {"task": "target"}), 108)
         scene._prebuild(other)
-        ahead = scene._sets[("manipulator1", "target")]
+        ahead = scene.nodes.sets[("manipulator1", "target")]
         assert ahead["frame"].visible is False and ahead["mechanisms"]
         scene._draw(other)
-        assert ahead["frame"].visible is True and scene._mechanisms is ahead["mechanisms"]
+        assert ahead["frame"].visible is True and scene.nodes.mechanisms is ahead["mechanisms"]
         # Paused, a new result is drawn at its end, and the position slider says so.
-        scene.playing = False
+        scene.playback.playing = False
         scene._draw(compute(first, 109))
-        assert scene._timeline is not None and scene._s == scene._timeline.length
-        assert scene.scrub.value == 1.0
+        timeline = scene.playback.timeline
+        assert timeline is not None and scene.playback.position == timeline.length
+        assert scene.playback.scrub.value == 1.0
     finally:
         scene.stop()
         dashboard.stop()
@@ -288,3 +296,93 @@ def test_the_scene_shows_the_runs_progress_not_the_second_phases():
     finally:
         scene.stop()
         dashboard.stop()
+
+
+FORMULA = {"name": "formula", "variables": ["x1", "x2", "x3"], "task": [
+    "0.05*cos(x1) + 0.05*cos(x1 + x2) + 0.03*cos(x1 + x2 + x3)",
+    "0.05*sin(x1) + 0.05*sin(x1 + x2) + 0.03*sin(x1 + x2 + x3)"]}  # fmt: skip
+ARM = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]}
+
+
+def _drawn(scene: DashboardScene, generation: int, timeout: float = 60) -> None:
+    """Wait until the scene has drawn ``generation`` and shows its status."""
+    deadline = time.monotonic() + timeout
+    while scene.drawn_generation < generation or not scene.status.content.startswith(
+        f"generation {scene.drawn_generation}:"
+    ):
+        assert time.monotonic() < deadline, "the scene did not draw"
+        time.sleep(0.05)
+
+
+def test_the_camera_frames_each_robots_reach_for_each_client():
+    """When the robot changes, the camera looks at what it can reach, from a distance at which
+    that fills the view: a formula robot of a few centimetres is not tiny in a corner, an arm's
+    whole reach (the length of its links around its base) is in view; a client reporting a
+    tall, narrow view is framed farther away than the initial (wide) camera."""
+    import asyncio
+
+    import msgspec
+
+    formula = updated_state(default_state(), {"robot": "formula", "robot_definition": FORMULA})
+    dashboard = Dashboard(formula)
+    scene = DashboardScene(dashboard)
+    initial = scene.server.initial_camera
+    try:
+        assert dashboard.wait(1, timeout=60)
+        _drawn(scene, 1)
+        result = dashboard.result
+        points = np.vstack([r.y for r in result.runs.values()] + [result.targets])
+        middle = (points.min(axis=0) + points.max(axis=0)) / 2
+        span = float(np.max(points.max(axis=0) - points.min(axis=0)))
+        np.testing.assert_allclose(initial.look_at[:2], middle, atol=0.2 * span)
+        distance = float(np.linalg.norm(initial.position - initial.look_at))
+        half = initial.fov / 2
+        assert span / 2 < distance * math.tan(half) < 2 * span, (distance, span)
+        # An arm: its base looked at, its reach (2.4) within the view, not much more.
+        generation, _ = dashboard.update({"robot": "planar_chain", "robot_definition": ARM})
+        assert dashboard.wait(generation, timeout=60)
+        _drawn(scene, generation)
+        np.testing.assert_allclose(initial.look_at, (0.0, 0.0, 0.0), atol=1e-9)
+        distance = float(np.linalg.norm(initial.position - initial.look_at))
+        assert 2.4 <= distance * math.sin(half) <= 1.5 * 2.4, distance
+        # A client whose view is three times taller than wide: framed for its narrow width.
+        camera = {"type": "ViewerCameraMessage", "wxyz": (1.0, 0.0, 0.0, 0.0),
+                  "position": (0.0, -5.0, 5.0), "fov": 1.0, "near": 0.01, "far": 100.0,
+                  "image_height": 900, "image_width": 300, "look_at": (0.0, 0.0, 0.0),
+                  "up_direction": (0.0, 0.0, 1.0)}  # fmt: skip
+
+        async def tall_client() -> float:
+            async with scene.connect([f"viser-v{viser.__version__}"]) as ws:
+                await ws.send(msgspec.msgpack.encode(camera))
+                deadline = time.monotonic() + 30
+                while True:
+                    clients = list(scene.server.get_clients().values())
+                    if clients and np.allclose(clients[0].camera.look_at, 0.0, atol=1e-9):
+                        seen = clients[0].camera
+                        if np.linalg.norm(seen.position - (0.0, -5.0, 5.0)) > 1e-6:
+                            return float(np.linalg.norm(seen.position - seen.look_at))
+                    assert time.monotonic() < deadline, "the client was not framed"
+                    await asyncio.sleep(0.05)
+
+        narrow = asyncio.run(tall_client())
+        horizontal = math.atan(math.tan(0.5) / 3)  # (half the width's angle)
+        assert narrow * math.sin(horizontal) == pytest.approx(1.15 * 2.4, rel=1e-6)
+    finally:
+        scene.stop()
+        dashboard.stop()
+
+
+def test_viser_prints_nothing_to_the_servers_output(capsys, caplog):
+    """viser's banners (each server's address, "Server stopped") go to the jik.scene.viser
+    logger at DEBUG, not to ``jik serve``'s output."""
+    import logging
+
+    caplog.set_level(logging.DEBUG, logger="jik.scene.viser")
+    dashboard = Dashboard(default_state("manipulator2"))
+    scene = DashboardScene(dashboard)
+    scene.stop()
+    dashboard.stop()
+    out, err = capsys.readouterr()
+    assert "viser" not in out + err and "Server stopped" not in out + err, out + err
+    logged = [r.getMessage() for r in caplog.records if r.name == "jik.scene.viser"]
+    assert any("Server stopped" in line for line in logged), logged

@@ -2,7 +2,21 @@
 
 from __future__ import annotations
 
+import asyncio
+import contextlib
+import struct
+import threading
+import time
+
+import httpx
+import msgspec
 import pytest
+import uvicorn
+import viser
+import websockets
+import websockets.asyncio.client
+import websockets.typing
+import zstandard
 from fastapi.testclient import TestClient
 from starlette.websockets import WebSocketDisconnect
 
@@ -18,8 +32,8 @@ def test_an_unknown_host_is_refused_on_http_and_websocket(app):
     assert r.status_code == 400 and "attacker.example" in r.json()["detail"]
     assert "JIK_ALLOWED_HOSTS" in r.json()["detail"]
     with pytest.raises(WebSocketDisconnect) as closed:
-        with rebound.websocket_connect("ws://attacker.example:8000/api/sessions/x/scene"):
-            pass
+        with rebound.websocket_connect("ws://attacker.example:8000/api/sessions/x/scene") as ws:
+            ws.receive_text()
     assert closed.value.code == 4400
     for name in ("localhost:8000", "127.0.0.1", "[::1]:8000"):
         assert TestClient(app, base_url=f"http://{name}").get("/health").status_code == 200
@@ -57,9 +71,104 @@ def test_the_scene_socket_refuses_another_origin(client):
     session = client.post("/api/sessions", json={"state": {}}).json()["id"]
     with pytest.raises(WebSocketDisconnect) as closed:
         with client.websocket_connect(f"/api/sessions/{session}/scene",
-                                      headers={"origin": FOREIGN}):  # fmt: skip
-            pass
+                                      headers={"origin": FOREIGN}) as ws:  # fmt: skip
+            ws.receive_text()
     assert closed.value.code == 4403
+
+
+@contextlib.contextmanager
+def _serving(app):
+    """``app`` served by uvicorn on a free loopback port (its port), as ``jik serve`` does."""
+    server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=0, log_level="warning",
+                                           lifespan="off"))  # fmt: skip
+    thread = threading.Thread(target=server.run, daemon=True)
+    thread.start()
+    deadline = time.monotonic() + 30
+    while not server.started:
+        assert time.monotonic() < deadline and thread.is_alive(), "uvicorn did not start"
+        time.sleep(0.02)
+    try:
+        yield server.servers[0].sockets[0].getsockname()[1]
+    finally:
+        server.should_exit = True
+        thread.join(10)
+
+
+async def _close_code(url: str, **headers: str) -> int:
+    """The close code a websocket client gets at ``url`` (an HTTP refusal fails the test)."""
+    async with websockets.asyncio.client.connect(url, additional_headers=headers) as ws:
+        with pytest.raises(websockets.exceptions.ConnectionClosed) as closed:
+            await ws.recv()
+    assert closed.value.rcvd is not None
+    return closed.value.rcvd.code
+
+
+def test_a_real_server_closes_refused_scene_sockets_with_the_documented_codes(app, client):
+    """Under uvicorn (not only the test client) a refused scene socket is accepted and closed
+    with 4403 (another origin), 4400 (another host) or 4404 (no such session), as
+    docs/security.md says: a browser's script sees those codes, never an HTTP refusal's 1006."""
+    session = client.post("/api/sessions", json={"state": {}}).json()["id"]
+    with _serving(app) as port:
+        url = f"ws://127.0.0.1:{port}/api/sessions/{session}/scene"
+        assert asyncio.run(_close_code(url, Origin=FOREIGN)) == 4403
+        assert asyncio.run(_close_code(url, Host="attacker.example")) == 4400
+        unknown = f"ws://127.0.0.1:{port}/api/sessions/nope/scene"
+        assert asyncio.run(_close_code(unknown)) == 4404
+
+
+def _viser_messages(frame: bytes) -> list[dict]:
+    """The messages of one frame viser's server sends (two sizes, zstd-compressed msgpack)."""
+    inner, compressed = struct.unpack_from("<QQ", frame)
+    packed = zstandard.ZstdDecompressor().decompress(frame[16 : 16 + compressed], inner)
+    return msgspec.msgpack.decode(packed)["messages"]
+
+
+def test_a_scene_server_takes_only_the_relay(tmp_path):
+    """A session's viser server listens on a loopback port of its own: a page of another site
+    (its Origin, a rebound Host), a local program without the relay's key and a plain request
+    for viser's page are all refused at the handshake, and the session's state is unchanged;
+    the relay (/api/sessions/{id}/scene) still reaches the scene."""
+    from jik.app.dashboard.sessions import SessionLimits, SessionStore
+    from jik.app.scene import start_scene
+
+    app = create_app()
+    app.state.sessions = SessionStore(SessionLimits(max_sessions=2), scene_factory=start_scene)
+    try:
+        client = TestClient(app)
+        created = client.post("/api/sessions", json={"state": {}}).json()
+        session = app.state.sessions.get(created["id"])
+        raw = f"ws://127.0.0.1:{session.scene.port}"
+        viser_protocol = [websockets.typing.Subprotocol(f"viser-v{viser.__version__}")]
+        gamma = {"type": "GuiUpdateMessage", "uuid": "x", "updates": {"value": 1.9}}
+
+        async def attack(**headers: str) -> int:
+            try:
+                async with websockets.asyncio.client.connect(
+                    raw, additional_headers=headers, subprotocols=viser_protocol
+                ) as ws:
+                    await ws.send(msgspec.msgpack.encode(gamma))
+                    return 101
+            except websockets.exceptions.InvalidStatus as refused:
+                return refused.response.status_code
+
+        assert asyncio.run(attack(Origin=FOREIGN, Host="attacker.example")) == 403
+        assert asyncio.run(attack(Origin=f"http://127.0.0.1:{session.scene.port}")) == 403
+        assert asyncio.run(attack()) == 403  # (a local program without the relay's key)
+        assert asyncio.run(attack(Authorization="Bearer guessed")) == 403
+        page = httpx.get(f"http://127.0.0.1:{session.scene.port}/", timeout=10)
+        assert page.status_code == 403
+        assert session.dashboard.state.gamma == created["state"]["gamma"]
+        # The relay: viser's first messages, its theme without the share button among them.
+        with client.websocket_connect(f"/api/sessions/{created['id']}/scene",
+                                      subprotocols=viser_protocol) as ws:  # fmt: skip
+            themes = []
+            while not themes:
+                themes = [m for m in _viser_messages(ws.receive_bytes())
+                          if m["type"] == "ThemeConfigurationMessage"]  # fmt: skip
+        assert themes[-1]["show_share_button"] is False
+        assert session.scene.server.request_share_url() is None
+    finally:
+        app.state.sessions.close()
 
 
 @pytest.mark.parametrize(
@@ -112,3 +221,37 @@ def test_the_openapi_document_gives_the_event_stream_and_the_csv_their_types(cli
     assert list(events["200"]["content"]) == ["text/event-stream"] and "404" in events
     csv = paths["/api/sessions/{session_id}/export.csv"]["get"]["responses"]
     assert list(csv["200"]["content"]) == ["text/csv"] and {"404", "503"} <= set(csv)
+
+
+@pytest.mark.parametrize(
+    ("headers", "refused"),
+    [
+        ([("Host", "127.0.0.1:5"), ("Authorization", "KEY")], None),
+        ([("Host", "[::1]:5"), ("Authorization", "KEY")], None),
+        ([("Host", "127.0.0.1:5")], "relay only"),
+        ([("Host", "127.0.0.1:5"), ("Authorization", "KEY"), ("Authorization", "KEY")],
+         "relay only"),
+        ([("Host", "127.0.0.1:5"), ("Authorization", "KEYx")], "relay only"),
+        ([("Host", "localhost.attacker.example"), ("Authorization", "KEY")], "loopback"),
+        ([("Host", "127.0.0.1:5"), ("Host", "evil"), ("Authorization", "KEY")], "loopback"),
+        ([("Host", "127.0.0.1:5"), ("Authorization", "KEY"), ("Origin", "null")], "browser"),
+    ],
+)  # fmt: skip
+def test_a_scene_handshake_needs_the_key_a_loopback_host_and_no_origin(headers, refused):
+    from websockets.datastructures import Headers
+
+    from jik.app.scene.server import SCENE_KEY, handshake_refusal
+
+    key = f"Bearer {SCENE_KEY}"
+    reason = handshake_refusal(Headers([(k, v.replace("KEY", key)) for k, v in headers]))
+    assert (reason is None) if refused is None else (refused in (reason or "")), reason
+
+
+def test_a_scene_server_that_would_serve_unguarded_is_not_started(monkeypatch):
+    """Should viser stop taking the handshake guard, a scene server fails closed: it is
+    stopped and an error says why, instead of serving anyone on its port."""
+    import jik.app.scene.server as scene_server
+
+    monkeypatch.setattr(scene_server, "_guarded", lambda process_request: process_request)
+    with pytest.raises(scene_server.UnguardedSceneServer, match="answered 200"):
+        scene_server.SceneServer()

@@ -198,12 +198,12 @@ def test_the_scene_socket_refuses_other_origins_and_unknown_sessions(client):
     session = _open(client)
     url = f"/api/sessions/{session['id']}/scene"
     with pytest.raises(WebSocketDisconnect) as foreign:
-        with client.websocket_connect(url, headers={"origin": "http://evil.example"}):
-            pass
+        with client.websocket_connect(url, headers={"origin": "http://evil.example"}) as ws:
+            ws.receive_text()
     assert foreign.value.code == 4403
     with pytest.raises(WebSocketDisconnect) as unknown:
-        with client.websocket_connect("/api/sessions/nope/scene"):
-            pass
+        with client.websocket_connect("/api/sessions/nope/scene") as ws:
+            ws.receive_text()
     assert unknown.value.code == 4404
 
 

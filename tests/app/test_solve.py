@@ -108,7 +108,7 @@ def test_concurrent_solves_are_batched_and_equal_to_single_solves(api):
     targets = rng.uniform([0.2, 0.8], [1.2, 1.8], size=(16, 2))
     bodies = [solve_body(target=t.tolist()) for t in targets]
     responses, stats = _post_concurrently(
-        Settings(workers=1, timeout=60.0, batch_window=0.005), bodies
+        Settings(workers=1, timeout=60.0, batch_window_ms=5), bodies
     )
     assert [r.status_code for r in responses] == [200] * 16
     assert stats["solve_requests"] == 16
@@ -124,7 +124,7 @@ def test_a_large_batch_is_shared_among_idle_workers(api):
     rng = np.random.default_rng(2)
     bodies = [solve_body(target=t.tolist()) for t in rng.uniform([0.2, 0.8], [1.2, 1.8], (16, 2))]
     responses, stats = _post_concurrently(
-        Settings(workers=2, timeout=60.0, batch_window=0.05), bodies
+        Settings(workers=2, timeout=60.0, batch_window_ms=50), bodies
     )
     assert [r.status_code for r in responses] == [200] * 16
     assert (stats["solve_calls"], stats["solve_requests"]) == (2, 16), stats
@@ -151,7 +151,7 @@ def test_a_bad_member_does_not_spoil_its_batch():
     }
     bad = {**good, "x0": [0.0, 0.5, 1.0]}  # dh K = 0 at x1 = -b/a = 0
     responses, stats = _post_concurrently(
-        Settings(workers=1, timeout=60.0, batch_window=0.01), [good, bad, good]
+        Settings(workers=1, timeout=60.0, batch_window_ms=10), [good, bad, good]
     )
     assert [r.status_code for r in responses] == [200, 422, 200]
     assert stats["solve_calls"] == 1

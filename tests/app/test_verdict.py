@@ -38,6 +38,11 @@ def test_unicycle_from_b_reports_the_engines_message():
     assert not data["extended"]["success"]
     assert "undefined" in data["extended"]["message"]
     assert "undefined" in texts(result) and "stopped" in texts(result)
+    # Why, and that this is the paper's run B with its erratum (none of it where the run stopped
+    # where it started, below).
+    assert "iteration 3 took λ10 from 0.0659 to -0.0777, across λ10 = 0" in texts(result)
+    assert "run from q0 = B (sec. 6.2, Figs. 13 (J^P#) and 14 (J^E#))" in texts(result)
+    assert "docs/paper-errata.md" in texts(result)
     # A run stopped where it started has no "why" (it said "h changed by only 0 along its
     # run,."): its h, constant, says nothing about conservation.
     run = result.runs["extended"]
@@ -95,3 +100,32 @@ def test_a_failed_generation_names_the_result_on_screen(monkeypatch):
         assert [e.kind for e in seen][-1] == "error"
     finally:
         dash.stop()
+
+
+ARM = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]}
+
+
+def _arm_target(target):
+    state = updated_state(
+        default_state(),
+        {"robot": "planar_chain", "robot_definition": ARM, "task": "target", "target": target},
+    )
+    return summary(compute(state))
+
+
+def test_a_stalled_run_says_whether_the_target_is_out_of_reach():
+    """A planar 3R arm of reach 1 + 0.8 + 0.6 = 2.4: a target at distance 5 is out of reach
+    (both algorithms say so); one at 0.05 is within reach, where J^P# converges and J^E#
+    (h = x3) stalls at an algorithmic singularity of [J; dh], J being regular."""
+    far = _arm_target([5.0, 0.0])
+    for algorithm in ("pseudoinverse", "extended"):
+        assert (
+            "the target is out of reach: it is 5 from the base, beyond the arm's reach 2.4"
+            in (far[algorithm]["message"])
+        )
+        assert "near a singularity or the target is unreachable" not in far[algorithm]["message"]
+    near = _arm_target([0.05, 0.0])
+    assert near["pseudoinverse"]["success"]
+    message = near["extended"]["message"]
+    assert "the target is within reach (0.05 from the base, reach 2.4)" in message
+    assert "J is regular there" in message and "algorithmic singularity" in message

@@ -122,3 +122,28 @@ def test_an_atlas_the_state_cannot_have_is_refused_in_words_in_the_panel(tabs):
     )
     expect(status).to_have_class(re.compile("error"))
     expect(tab.page.locator("#atlas-progress-box")).to_be_hidden()
+
+
+def test_an_atlas_after_a_cancel_starts_at_once(tabs):
+    """Cancel an atlas while its workers compute a chunk: the next atlas starts at once (its
+    job running within seconds, the panel never saying it waits for another atlas), not after
+    the cancelled job's chunks in flight end."""
+    tab = tabs.open()
+    page = tab.page
+    page.locator("#atlas").scroll_into_view_if_needed()
+    text = page.locator("#atlas-progress-text")
+    jobs = f"{tab.base}/api/sessions/{tab.session_id}/atlas"
+
+    first = start_atlas(tab, 4096, 20)
+    poll(lambda: get_json(f"{jobs}/{first}")["status"] == "running", "the first atlas running")
+    with page.expect_request(lambda r: r.method == "DELETE"):
+        page.click("#atlas-cancel")
+    poll(lambda: gone(f"{tab.base}/atlas/{first}"), "the cancelled job forgotten (404)")
+
+    second = start_atlas(tab, 4096, 20)
+    poll(lambda: get_json(f"{jobs}/{second}")["status"] == "running",
+         "the next atlas running after a cancel", timeout=5)  # fmt: skip
+    expect(text).to_contain_text("computing")
+    assert "waiting" not in (text.text_content() or "")
+    page.click("#atlas-cancel")
+    poll(lambda: gone(f"{tab.base}/atlas/{second}"), "the second job forgotten (404)")

@@ -9,15 +9,21 @@ from pathlib import Path
 
 import pytest
 
+from tests.browser.conftest import probe
+
 expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
 pytestmark = pytest.mark.browser
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 
+#: An export's file name: robot, panel (images), map, mode, generation, UTC time.
+NAMED = r"jik-manipulator2-{}paper_cubic-continuous-g{}-\d{{8}}T\d{{6}}Z\.{}"
+
+
 def test_every_panel_is_drawn_and_saves_as_png(tabs, config):
     """Each panel that /api/dashboard/config lists is drawn (plotly's SVG, or an HTML table for
-    the table), and a panel's PNG button downloads jik-<panel>.png."""
+    the table), and a panel's PNG button downloads jik-<robot>-<panel>-<map>-...-<time>.png."""
     tab = tabs.open()
     panels = [p["id"] for p in config["panels"]]
     assert "table" in panels and len(panels) > 1
@@ -27,7 +33,7 @@ def test_every_panel_is_drawn_and_saves_as_png(tabs, config):
 
     with tab.page.expect_download() as saved:
         tab.page.locator("#plot-task .panel-tools button", has_text="PNG").click()
-    assert saved.value.suggested_filename == "jik-task.png"
+    assert re.fullmatch(NAMED.format("task-", 1, "png"), saved.value.suggested_filename)
     assert Path(saved.value.path()).read_bytes()[:8] == PNG_SIGNATURE
 
 
@@ -41,10 +47,16 @@ def test_exports_download_the_sessions_data(tabs):
 
     with tab.page.expect_download() as saved:
         tab.page.click("#export-csv")
-    assert saved.value.suggested_filename == "jik-result.csv"
+    generation = snapshot["computed_generation"]
+    assert re.fullmatch(NAMED.format("", generation, "csv"), saved.value.suggested_filename)
     lines = Path(saved.value.path()).read_text().splitlines()
     context = [r for r in lines if r.startswith("#")]
-    assert '"cycles":2' in context[1]  # (the state that produced it)
+    assert re.fullmatch(r"# jik \S+, exported \d{4}-\d\d-\d\dT\d\d:\d\d:\d\d\+00:00", context[1])
+    assert '"cycles":2' in context[2]  # (the state that produced it)
+    assert context[3] == (
+        "# units: x1 [m]; x2 [m]; x3 [rad]; y1 [m]; y2 [m]; theta [dimensionless]; error [m]; "
+        "h [the unit of the map's formula]"
+    )
     assert any(r.startswith("# pseudoinverse drift after each cycle: ") for r in context)
     rows = lines[len(context) :]
     assert rows[0].startswith("algorithm,leg,theta,x1")
@@ -52,8 +64,10 @@ def test_exports_download_the_sessions_data(tabs):
 
     with tab.page.expect_download() as saved:
         tab.page.click("#export-json")
-    assert saved.value.suggested_filename == "jik-result.json"
+    assert re.fullmatch(NAMED.format("", generation, "json"), saved.value.suggested_filename)
     data = json.loads(Path(saved.value.path()).read_text())
+    assert data["jik_version"] and data["exported_at"].endswith("+00:00")
+    assert data["units"]["x"] == {"x1": "m", "x2": "m", "x3": "rad"}
     assert data["state"] == snapshot["state"] and data["state"]["cycles"] == 2
     assert data["generation"] == snapshot["computed_generation"]
     for algorithm, run in summary.items():
@@ -94,7 +108,7 @@ def test_the_table_saves_as_csv_with_its_notes_and_state(tabs):
     tab = tabs.open()
     with tab.page.expect_download() as saved:
         tab.page.locator("#plot-table .panel-tools button", has_text="CSV").click()
-    assert saved.value.suggested_filename == "jik-table.csv"
+    assert re.fullmatch(NAMED.format("table-", 1, "csv"), saved.value.suggested_filename)
     lines = Path(saved.value.path()).read_text().splitlines()
     context = [r for r in lines if r.startswith("#")]
     assert context[0].startswith("# jik · generation 1 · manipulator2, continuous mode")
@@ -105,3 +119,32 @@ def test_the_table_saves_as_csv_with_its_notes_and_state(tabs):
     assert rows[2].startswith("B  x1f,0.1132,0.5379,1.0904,0.1132,0.5379,1.0904")
     expect(tab.page.locator("#export-json")).to_have_text("export JSON (generation 1)")
     expect(tab.page.locator("#export-csv")).to_have_text("export CSV (generation 1)")
+
+
+@pytest.mark.parametrize("panel", ["task", "drift", "augmenting"])
+def test_a_saved_svg_holds_its_legend_and_whole_caption(tabs, panel):
+    """A panel saved as SVG holds its legend (the algorithms, the targets) and, under it, the
+    caption with the state it shows, whole: both inside the image, in lines that fit its width
+    (the state of a link with a long name makes the caption longer than a line). The h panel,
+    whose runs are shapes without legend entries, names the algorithms in their colours in the
+    caption instead."""
+    tab = tabs.open()
+    with tab.page.expect_download() as saved:
+        tab.page.locator(f"#plot-{panel} .panel-tools button", has_text="SVG").click()
+    svg = Path(saved.value.path()).read_text()
+    fits = tab.page.evaluate(probe("svg_fits"), svg)
+    legend, caption = fits["legend"], fits["caption"]
+    if panel == "augmenting":
+        assert caption["lines"][0] == "▬ pseudoinverse J^P# (8) · ▬ extended Jacobian J^E# (11)"
+        assert 'fill:#d62728">▬ pseudoinverse' in svg  # (in the pseudoinverse's red)
+        caption["lines"] = caption["lines"][1:]
+        legend = legend or {"top": 0, "bottom": 0, "right": 0}
+    else:
+        assert legend is not None and "pseudoinverse J^P#" in " ".join(fits["legendItems"])
+    assert 0 <= legend["top"] and legend["bottom"] <= fits["height"] + 0.5, fits
+    assert legend["right"] <= fits["width"] + 0.5, fits
+    assert caption["bottom"] <= fits["height"] + 0.5 and caption["right"] <= fits["width"], fits
+    assert caption["top"] >= legend["bottom"] - 0.5, fits  # (under the legend, not over it)
+    text = " ".join(caption["lines"])
+    assert text.startswith("jik · generation 1 · manipulator2, continuous mode")
+    assert text.endswith("closed path, 3 cycles"), text

@@ -45,6 +45,9 @@ def test_a_planar_rrr_arm_from_the_editor(tabs):
     verdict = page.locator("#verdict")
     expect(verdict).to_contain_text("pseudoinverse")
     expect(verdict).to_contain_text("extended Jacobian")
+    # Its default map is shown as what it is, h = x3, not as "formula (9)".
+    expect(page.locator("#ctl-augmentation")).to_have_text("formula: h = x3")
+    expect(page.locator("#plot-augmenting .gtitle")).to_contain_text("formula: h = x3")
 
     scene = tab.wait_scene_drawn(generation)
     assert scene["robot"] == "planar_chain"
@@ -69,3 +72,87 @@ def test_a_urdf_arm_from_a_link_is_drawn_in_the_scene(tabs):
     assert scene["robot"] == "urdf"
     assert scene["mechanism"] == "Chain" and scene["joints"] == 6  # base, 4 joints, the tool
     tab.screenshots("robot-editor-urdf")
+
+
+def test_a_refused_definition_keeps_what_was_typed(tabs):
+    """A definition the session refuses leaves the editor as the user typed it (another kind
+    than the robot in force included: a formula robot, a pasted URDF), with the error beside
+    the field it names; a zero or negative link length is refused beside ``lengths``."""
+    tabs.allow_console(r"status of 422")
+    tab = tabs.open()
+    page = tab.page
+    page.click("#robot-editor-open")
+    page.select_option("#robot-kind", "planar_chain")
+    page.fill("#robot-field-lengths", "1, -0.8, 0.6")
+    page.fill("#robot-field-title", "my arm")
+    assert tab.posting(lambda: page.click("#robot-apply")).status == 422
+    expect(page.locator("#robot-field-lengths-error")).to_contain_text(
+        "lengths[1] must be positive (a link's length), got -0.8"
+    )
+    expect(page.locator("#robot-field-lengths")).to_have_value("1, -0.8, 0.6")
+    expect(page.locator("#robot-field-title")).to_have_value("my arm")
+
+    page.fill("#robot-field-lengths", "1, 0.8, 0.6")
+    tab.change(lambda: page.click("#robot-apply"))  # a planar chain in force
+    expect(page.locator("#robot-note")).to_contain_text("applied: planar_chain")
+
+    # A formula robot with a bad formula: refused while the planar chain stays in force.
+    page.select_option("#robot-kind", "formula")
+    page.fill("#robot-field-variables", "a, b, c")
+    page.fill("#robot-field-task", "a +* b\nc")
+    page.fill("#robot-field-title", "by formula")
+    assert tab.posting(lambda: page.click("#robot-apply")).status == 422
+    expect(page.locator("#robot-field-task-error")).to_have_text(
+        "task.0: expected a number, a name or '(' at position 3"
+    )
+    expect(page.locator("#robot-field-task-error")).to_be_visible()
+    expect(page.locator("#robot-kind")).to_have_value("formula")
+    expect(page.locator("#robot-field-variables")).to_have_value("a, b, c")
+    expect(page.locator("#robot-field-task")).to_have_value("a +* b\nc")
+    expect(page.locator("#robot-field-title")).to_have_value("by formula")
+    expect(page.locator("#robot-note")).to_contain_text("not applied: see the field task")
+
+    # A pasted URDF whose end link is not in it: the text stays, the error is at end_link.
+    urdf = '<robot name="r"><link name="a"/></robot>'
+    page.select_option("#robot-kind", "urdf")
+    page.fill("#robot-field-urdf", urdf)
+    assert tab.posting(lambda: page.click("#robot-apply")).status == 422
+    expect(page.locator("#robot-field-end_link-error")).to_contain_text("is not a link")
+    expect(page.locator("#robot-field-urdf")).to_have_value(urdf)
+
+    # Back to the formula: what was typed there is still there.
+    page.select_option("#robot-kind", "formula")
+    expect(page.locator("#robot-field-task")).to_have_value("a +* b\nc")
+    assert tab.snapshot()["state"]["robot"] == "planar_chain"
+
+
+def test_a_planar_4r_chain_runs_with_two_degrees_of_redundancy(tabs):
+    """A planar 4R chain (p - r = 2): both algorithms run (its default map h = (x3, x4), shown
+    on the map's button), the drift and the scene work, and the panels of one scalar h say
+    why they are empty; a single formula h for it is refused beside the augmentations field."""
+    tabs.allow_console(r"status of 422")
+    tab = tabs.open()
+    page = tab.page
+    page.click("#robot-editor-open")
+    page.select_option("#robot-kind", "planar_chain")
+    page.fill("#robot-field-joints", "RRRR")
+    page.fill("#robot-field-lengths", "1, 0.8, 0.6, 0.4")
+    generation = tab.change(lambda: page.click("#robot-apply"))
+    snapshot = tab.wait_settled(lambda s: s["state"]["robot"] == "planar_chain", "the 4R chain")
+    summary = snapshot["summary"]
+    assert summary["pseudoinverse"]["success"] and summary["extended"]["success"]
+    assert summary["pseudoinverse"]["drift"][-1] > 1e-4
+    assert summary["extended"]["drift"][-1] < 1e-9
+    verdict = page.locator("#verdict")
+    expect(verdict).to_contain_text("pseudoinverse J^P#: not repeatable")
+    expect(verdict).to_contain_text("extended Jacobian J^E#: repeatable")
+    expect(page.locator("#ctl-augmentation")).to_contain_text("formula: h = x3, x4")
+    expect(page.locator("#plot-augmenting")).to_contain_text("p − r = 2")
+    scene = tab.wait_scene_drawn(generation)
+    assert scene["robot"] == "planar_chain" and scene["joints"] == 5
+
+    page.fill("#robot-field-augmentations", '[{"name": "formula", "h": "x4"}]')
+    assert tab.posting(lambda: page.click("#robot-apply")).status == 422
+    error = page.locator("#robot-field-augmentations-error")
+    expect(error).to_contain_text("must be a list of 2 formulas (p - r = 2")
+    expect(page.locator("#robot-field-joints")).to_have_value("RRRR")

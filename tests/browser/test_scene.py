@@ -40,3 +40,15 @@ def test_pause_and_play_in_the_scene(tabs):
     tab.wait_snapshot(lambda s: s["scene"]["playing"] is True, "the scene playing again")
     expect(scene.get_by_role("button", name="Pause")).to_be_visible()
     tab.scene_control("position", unlike=position)
+
+
+def test_the_scene_offers_no_share_link(tabs):
+    """viser's own share button (a public link to the viser instance, next to the page's "copy
+    link") is not in the scene."""
+    tab = tabs.open()
+    tab.wait_scene_drawn(1)
+    scene = tab.page.frame_locator("#scene")
+    expect(scene.get_by_role("button", name="Pause")).to_be_visible()
+    # (viser's settings button, beside where the share button would be, is there)
+    expect(scene.locator("button:has(svg.tabler-icon-adjustments)")).to_have_count(1)
+    expect(scene.locator("button:has(svg.tabler-icon-share)")).to_have_count(0)

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import pytest
 
+from tests.browser.conftest import probe
+
 expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
 pytestmark = pytest.mark.browser
 
@@ -41,3 +43,20 @@ def test_table1_beside_the_printed_values(tabs):
         "Joint configuration at the end of each leg (not the paper's Table 1)"
     )
     assert "printed" not in " ".join(table.locator("thead th").all_text_contents())
+
+
+def test_the_corner_letters_are_table_1s(tabs):
+    """The task panel letters the closed path's corners as Table 1 labels its rows: A = k(x0)
+    = (0, 1), then B = (1, 1), C = (1, 2), D = (0, 2); the leg-end table of another robot uses
+    the task panel's letters."""
+    tab = tabs.open()
+    targets = tab.page.locator("#plot-task .scatterlayer .textpoint text")
+    expect(targets).to_have_count(4)
+    task = tab.page.evaluate(probe("target_letters"), "plot-task")
+    assert tab.snapshot()["state"]["path"] == [[1, 1], [1, 2], [0, 2], [0, 1]]
+    assert task == ["B", "C", "D", "A"]
+    tab.change(lambda: tab.page.select_option("#ctl-robot", "manipulator1"))
+    task = tab.page.evaluate(probe("target_letters"), "plot-task")
+    rows = tab.page.locator("#plot-table tbody tr td:first-child").all_text_contents()
+    legs = [r.removeprefix("cycle 1, leg to ").split(" ")[0] for r in rows[1 : 1 + len(task)]]
+    assert legs == task

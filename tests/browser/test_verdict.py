@@ -24,6 +24,16 @@ def test_unicycle_from_b_shows_the_engines_message(tabs):
     verdict = tab.page.locator("#verdict")
     expect(verdict).to_contain_text("extended Jacobian J^E# stopped")
     expect(verdict).to_contain_text("is undefined")
+    # Why, and that this is the paper's run (Figs. 13-14) with its erratum.
+    why = verdict.locator("p.why.e")
+    expect(why).to_contain_text("characteristic (28)")
+    expect(why).to_contain_text("iteration 3 took λ10 from 0.0659 to -0.0777, across λ10 = 0")
+    expect(why).to_contain_text("out of the domain of the map's foliation")
+    note = verdict.locator("p.note.e")
+    expect(note).to_contain_text("the paper's run from q0 = B (sec. 6.2, Figs. 13")
+    expect(note).to_contain_text("docs/paper-errata.md")
+    assert "h was not conserved" not in (verdict.text_content() or "")
+    expect(tab.page.locator("#about")).to_contain_text("from B the discrete extended run leaves")
     status = tab.page.locator("#status-text")
     expect(status).to_have_text(f"up to date (generation {generation})")
     assert "internal error" not in (verdict.text_content() or "")
@@ -65,3 +75,18 @@ def test_the_verdict_follows_the_numbers(tabs):
     assert gamma == pytest.approx(1.89, abs=0.02)
     expect(verdict).to_contain_text(re.compile(r"γ = 1\.\d+ is near 2"))
     expect(verdict).to_contain_text(f"‖x − x0‖ = {_extended_drift(tab):.3g}")
+
+
+def test_an_unreachable_target_is_named_by_the_reach(tabs):
+    """A planar 3R arm (reach 2.4) asked for a target 5 from its base: the verdict says the
+    target is out of reach, with the distance and the reach, not "a singularity or"."""
+    arm = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]}
+    state = {"robot": "planar_chain", "robot_definition": arm, "task": "target",
+             "target": [5.0, 0.0]}  # fmt: skip
+    tab = tabs.open("/?state=" + quote(json.dumps(state)))
+    tab.wait_settled(lambda s: s["state"]["robot"] == "planar_chain", "the arm's result")
+    verdict = tab.page.locator("#verdict")
+    expect(verdict.locator("p.failure.p")).to_contain_text(
+        "the target is out of reach: it is 5 from the base, beyond the arm's reach 2.4"
+    )
+    assert "or the target is unreachable" not in (verdict.text_content() or "")

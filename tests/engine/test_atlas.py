@@ -18,9 +18,10 @@ from jik.engine.augmentations import PaperCubic
 from jik.engine.exceptions import InvalidInputError, RunCancelled
 from jik.engine.inverses import ExtendedInverse, Pseudoinverse, extended_singularity
 from jik.engine.kinematics import Manipulator1, Manipulator2
+from jik.engine.progress import ProgressCallbacks
 from jik.engine.repeatability import repeatability
 from jik.engine.self_motion import trace
-from jik.engine.solver import solve
+from jik.engine.solver import solve_batch
 
 X0 = (0.0, 0.0, math.pi / 2)
 #: Table 1's loop from its start's task point (0, 1).
@@ -110,10 +111,10 @@ def test_a_members_dop853_numbers_do_not_depend_on_its_batch():
     curve = trace(inverse.kinematics, X0, (-5.0, 5.0))
     starts = curve.points(np.linspace(-5.0, 5.0, 37))
     target = np.array([1.0, 1.3])
-    whole = solve(inverse, starts, target, method="dop853", record=False)
+    whole = solve_batch(inverse, starts, target, method="dop853", record=False)
     for i in (0, 17, 36):
         for ids in ([i], list(range(i, 37)), list(range(i + 1)), [i, *range(37)]):
-            part = solve(inverse, starts[ids], target, method="dop853", record=False)
+            part = solve_batch(inverse, starts[ids], target, method="dop853", record=False)
             assert np.array_equal(part.x[0 if ids[0] == i else ids.index(i)], whole.x[i])
 
 
@@ -214,8 +215,13 @@ def test_cancelled_stops_between_chunks():
     plan = small_plan(chunk=4)
     seen = []
     with pytest.raises(RunCancelled, match="after run 8 of 24"):
-        run_atlas(plan, on_progress=lambda done, total: seen.append(done),
-                  cancelled=lambda: len(seen) >= 2)  # fmt: skip
+        run_atlas(
+            plan,
+            progress=ProgressCallbacks(
+                on_advance=lambda done, total: seen.append(done),
+                is_cancelled=lambda: len(seen) >= 2,
+            ),
+        )
     assert seen == [4, 8]
 
 

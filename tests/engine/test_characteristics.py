@@ -15,9 +15,10 @@ from jik.engine.characteristics import (
     one_form,
     one_form_derivative,
 )
-from jik.engine.exceptions import InvalidInputError, OneFormUndefinedError
+from jik.engine.exceptions import InvalidInputError, OneFormUndefinedError, RunCancelled
 from jik.engine.inverses import ExtendedInverse
 from jik.engine.kinematics import Manipulator2, kernel_cofactors
+from jik.engine.progress import ProgressCallbacks
 from jik.engine.unicycle import Unicycle
 
 LAMBDA0 = np.array([0.5, -0.25, 0.3, -0.25])
@@ -237,7 +238,7 @@ def test_evaluation_in_batches_is_the_cold_evaluation_member_by_member(kin):
     whole = UnicycleCharacteristics(kin, a=1.0, on_undefined="nan").evaluate(x)
     seen = []
     batched = UnicycleCharacteristics(kin, a=1.0, on_undefined="nan").evaluate_batches(
-        x, 7, lambda done, total: seen.append((done, total))
+        x, 7, ProgressCallbacks(on_advance=lambda done, total: seen.append((done, total)))
     )
     assert seen == [(k, 5) for k in range(1, 6)]
     assert np.array_equal(whole[2], batched[2])
@@ -249,7 +250,8 @@ def test_evaluation_in_batches_is_the_cold_evaluation_member_by_member(kin):
 
 
 def test_what_the_batch_callback_raises_stops_the_evaluation(hmap):
-    """A caller's cancellation: the error raised after the second batch ends the evaluation."""
+    """A caller's progress: what it raises after the second batch ends the evaluation, and so
+    does its cancellation (RunCancelled)."""
     calls = []
 
     def stop(done, total):
@@ -258,5 +260,41 @@ def test_what_the_batch_callback_raises_stops_the_evaluation(hmap):
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        hmap.evaluate_batches(points(20, seed=4), 5, stop)
+        hmap.evaluate_batches(points(20, seed=4), 5, ProgressCallbacks(on_advance=stop))
     assert calls == [1, 2]
+    calls.clear()
+    cancel = ProgressCallbacks(
+        on_advance=lambda done, total: calls.append(done), is_cancelled=lambda: len(calls) == 3
+    )
+    with pytest.raises(RunCancelled, match="after batch 3 of 4"):
+        hmap.evaluate_batches(points(20, seed=4), 5, cancel)
+    assert calls == [1, 2, 3]
+
+
+def test_a_large_batch_is_solved_in_bounded_memory(kin, monkeypatch):
+    """More than MAX_MEMBERS points are solved MAX_MEMBERS at a time: the peak memory of 4x the
+    points is that of one part (the refined collocation systems grow with the batch), and the
+    results are those of one batch of all (each member's Newton solve is its own)."""
+    import tracemalloc
+
+    from jik.engine import characteristics
+
+    monkeypatch.setattr(characteristics, "MAX_MEMBERS", 50)
+    x = points(200, seed=5, spread=1.5)
+
+    def peak(n: int) -> int:
+        tracemalloc.start()
+        UnicycleCharacteristics(kin, a=1.0, on_undefined="nan").evaluate(x[:n])
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        return peak
+
+    assert peak(200) < 1.5 * peak(50)
+    parts = UnicycleCharacteristics(kin, a=1.0, on_undefined="nan").evaluate(x)
+    monkeypatch.setattr(characteristics, "MAX_MEMBERS", 1000)
+    whole = UnicycleCharacteristics(kin, a=1.0, on_undefined="nan").evaluate(x)
+    assert np.array_equal(whole[2], parts[2])
+    ok = ~whole[2]
+    assert ok.sum() >= 50 and (~ok).sum() >= 10
+    assert np.max(np.abs(whole[0][ok] - parts[0][ok])) < 1e-10
+    assert np.max(np.abs(whole[1][ok] - parts[1][ok])) < 1e-8

@@ -8,6 +8,7 @@ import sympy as sp
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from jik.engine import formula_kinematics
 from jik.engine.augmentations import PaperCubic
 from jik.engine.characteristics import CharacteristicsMap
 from jik.engine.exceptions import FormulaError, InvalidInputError
@@ -225,3 +226,36 @@ def test_characteristics_synthesis_runs_on_a_formula_robot(formula_m2):
     np.testing.assert_allclose(h.gradient(x), central_difference(h.value, x, 1e-5), atol=1e-8)
     rep = repeatability(ExtendedInverse(formula_m2, h), X0, PATH, cycles=2)
     assert rep.success and np.max(rep.drift) < 1e-9
+
+
+def _nested_exponentials(depth: int) -> str:
+    """exp(x1/exp(x2/exp(x3/...))): a short formula whose derivatives grow with ``depth``."""
+    inner = "x3"
+    for i in range(depth, 0, -1):
+        inner = f"exp(x{i % 3 + 1}/{inner})"
+    return inner
+
+
+def test_exploding_derivatives_are_refused_naming_the_formula(monkeypatch):
+    """Nested exponentials: the derivatives are refused once they outgrow the bound, naming the
+    task component (not built for minutes: 30 s of sympy for depth 25 without the bounds);
+    deeper nesting is refused by the parser."""
+    with pytest.raises(FormulaError, match=r"task\.1: the formula's second derivatives") as info:
+        robot = FormulaKinematics(["x1", "x2", "x3"], ["x1 + x2", _nested_exponentials(8)])
+        robot.hessian(np.zeros((1, 3)))
+    assert info.value.field == "task.1"
+    with pytest.raises(FormulaError, match=r"task\.0: functions nested too deeply") as info:
+        FormulaKinematics(["x1", "x2", "x3"], [_nested_exponentials(38)])
+    assert info.value.position == 56  # (the ninth exp)
+    monkeypatch.setattr(formula_kinematics, "MAX_DERIVATIVE_NODES", 5)
+    with pytest.raises(FormulaError, match="h: the formula's first derivatives"):
+        FormulaMap("x1 * sin(x2) * exp(x3)", ["x1", "x2", "x3"])
+
+
+def test_ordinary_formulas_keep_their_derivatives_within_the_bound():
+    """An 8-link chain written as a formula builds its Jacobian and Hessian."""
+    names = [f"x{i}" for i in range(1, 9)]
+    xs = [" + ".join(f"cos({'+'.join(names[: i + 1])})" for i in range(8)),
+          " + ".join(f"sin({'+'.join(names[: i + 1])})" for i in range(8))]  # fmt: skip
+    robot = FormulaKinematics([*names, "y"], xs)
+    assert robot.hessian(np.zeros((2, 9))).shape == (2, 2, 9, 9)

@@ -126,6 +126,8 @@ def test_3r_extended_inverse_of_the_synthesized_map_is_repeatable(synthesis):
         ({"joints": "RR", "lengths": [1, 1], "offsets": [0, np.inf]}, "offsets.1", "finite"),
         ({"joints": "RR", "lengths": [1, 1], "orientation": True}, "joints", "at least 3 joints"),
         ({"joints": "RR", "lengths": "11"}, "lengths", "a list of 2 numbers"),
+        ({"joints": "RRR", "lengths": [1, -0.5, 1]}, "lengths.1", "lengths[1] must be positive"),
+        ({"joints": "RP", "lengths": [1, 0]}, "lengths.1", "positive (a link's length), got 0"),
     ],
 )
 def test_bad_definitions_name_the_field(kwargs, field, text):

@@ -1,3 +1,4 @@
+import importlib
 import math
 
 import numpy as np
@@ -7,6 +8,7 @@ from jik.engine.augmentations import E1Optimal, E2Optimal, PaperCubic
 from jik.engine.exceptions import AlgorithmicSingularityError, InvalidInputError, RunCancelled
 from jik.engine.inverses import ExtendedInverse, Pseudoinverse
 from jik.engine.kinematics import Manipulator1, Manipulator2
+from jik.engine.progress import ProgressCallbacks
 from jik.engine.repeatability import Resume, repeatability
 from jik.engine.solver import solve
 from tests.helpers import count_picard_sweeps
@@ -126,7 +128,7 @@ def test_bad_input(kwargs, match):
         repeatability(Pseudoinverse(Manipulator2()), [0, 0, 1.0], args["path"], args["cycles"])
 
 
-# -- hooks of the one engine loop: on_leg, cancelled, resume, chunk, on_undefined ----
+# -- the one engine loop's progress (legs, cancellation, a discrete leg's pieces), resume, stop --
 
 TABLE1_X0 = np.array([0, 0, math.pi / 2])
 TABLE1_PATH = [(1, 1), (1, 2), (0, 2), (0, 1)]
@@ -151,7 +153,7 @@ def test_on_leg_sees_every_leg_in_order():
     each leg's BatchSolveResult and the members that ran it."""
     seen = []
     res = repeatability(_inverse("extended"), TABLE1_X0, TABLE1_PATH, cycles=2, record=True,
-                        on_leg=seen.append)  # fmt: skip
+                        progress=ProgressCallbacks(seen.append))  # fmt: skip
     assert [(leg.cycle, leg.index) for leg in seen] == [(c, j) for c in range(2) for j in range(4)]
     for k, leg in enumerate(seen):
         assert leg.stopped_by is None and leg.members.tolist() == [0]
@@ -160,7 +162,9 @@ def test_on_leg_sees_every_leg_in_order():
         np.testing.assert_array_equal(leg.result.trajectory.x[-1], res.legs[k])
     starts = np.array([TABLE1_X0, TABLE1_X0 + [0.1, 0.0, 0.2], TABLE1_X0 - [0.0, 0.1, 0.1]])
     seen.clear()
-    batch = repeatability(_inverse("pseudoinverse"), starts, TABLE1_PATH, on_leg=seen.append)
+    batch = repeatability(
+        _inverse("pseudoinverse"), starts, TABLE1_PATH, progress=ProgressCallbacks(seen.append)
+    )
     assert len(seen) == batch.legs.shape[1] == 5  # (the last point is not k(x0) for two of them)
     for k, leg in enumerate(seen):
         assert leg.members.tolist() == [0, 1, 2] and len(leg.result) == 3
@@ -169,39 +173,61 @@ def test_on_leg_sees_every_leg_in_order():
 
 @pytest.mark.parametrize("batch", [False, True])
 def test_cancelled_stops_between_legs(batch):
-    """cancelled() is polled before every leg: True before the third raises RunCancelled there,
-    after two legs."""
+    """progress.cancelled() is polled before every leg: True before the third raises
+    RunCancelled there, after two legs."""
     polls, seen = [], []
     x0 = np.array([TABLE1_X0, TABLE1_X0]) if batch else TABLE1_X0
+    progress = ProgressCallbacks(
+        seen.append, is_cancelled=lambda: polls.append(1) or len(polls) == 3
+    )
     with pytest.raises(RunCancelled, match="before cycle 1, leg 3"):
-        repeatability(_inverse("extended"), x0, TABLE1_PATH, cycles=3, on_leg=seen.append,
-                      cancelled=lambda: polls.append(1) or len(polls) == 3)  # fmt: skip
+        repeatability(_inverse("extended"), x0, TABLE1_PATH, cycles=3, progress=progress)
     assert len(polls) == 3 and len(seen) == 2
 
 
-def test_cancelled_stops_between_the_chunks_of_a_discrete_leg():
+def _chunks(monkeypatch, iterations: int) -> None:
+    """Discrete legs with a progress run as solves of ``iterations`` iterations."""
+    module = importlib.import_module("jik.engine.repeatability")
+
+    monkeypatch.setattr(module, "POLL_ITERATIONS", iterations)
+
+
+def test_cancelled_stops_between_the_chunks_of_a_discrete_leg(monkeypatch):
+    _chunks(monkeypatch, 5)
     polls, fractions = [], []
+    progress = ProgressCallbacks(
+        on_advance=lambda done, total: fractions.append(done / total),
+        is_cancelled=lambda: polls.append(1) or len(polls) == 4,
+    )
     with pytest.raises(RunCancelled, match="in cycle 1, leg 1"):
-        repeatability(_inverse("extended"), TABLE1_X0, TABLE1_PATH, gamma=0.3, mode="discrete",
-                      chunk=5, on_chunk=fractions.append,
-                      cancelled=lambda: polls.append(1) or len(polls) == 4)  # fmt: skip
+        repeatability(
+            _inverse("extended"),
+            TABLE1_X0,
+            TABLE1_PATH,
+            gamma=0.3,
+            mode="discrete",
+            progress=progress,
+        )
     assert len(polls) == 4 and len(fractions) == 2  # before the leg, then after chunks 1-3
 
 
 @pytest.mark.parametrize("algorithm", ["pseudoinverse", "extended"])
 @pytest.mark.parametrize(
     "kwargs", [{}, {"mode": "discrete", "gamma": 0.5}, {"mode": "discrete", "gamma": 0.3,
-                                                        "chunk": 7}]
+                                                        "progress": ProgressCallbacks()}]
 )  # fmt: skip
-def test_resume_equals_a_run_from_the_start_bit_for_bit(algorithm, kwargs):
+def test_resume_equals_a_run_from_the_start_bit_for_bit(algorithm, kwargs, monkeypatch):
     """Two cycles, then two more from their end (Resume.of: the legs and, in continuous mode,
-    the last cycle's trajectories as Picard guides): the numbers of four cycles from x0."""
+    the last cycle's trajectories as Picard guides): the numbers of four cycles from x0 (with
+    a progress in discrete mode: legs in pieces of 7 iterations)."""
+    _chunks(monkeypatch, 7)
     inv = _inverse(algorithm)
     cold = repeatability(inv, TABLE1_X0, TABLE1_PATH, cycles=4, record=True, **kwargs)
     part = repeatability(inv, TABLE1_X0, TABLE1_PATH, cycles=2, record=True, **kwargs)
     seen = []
+    kwargs = kwargs | {"progress": ProgressCallbacks(seen.append)}
     rest = repeatability(inv, TABLE1_X0, TABLE1_PATH, cycles=4, record=True, **kwargs,
-                         resume=Resume.of(part), on_leg=seen.append)  # fmt: skip
+                         resume=Resume.of(part))  # fmt: skip
     assert cold.success and rest.success and rest.message == cold.message
     for name in ("legs", "cycle_end", "drift"):
         np.testing.assert_array_equal(getattr(rest, name), getattr(cold, name), name)
@@ -222,15 +248,24 @@ def test_resume_a_batch_equals_a_run_from_the_start():
     np.testing.assert_array_equal(rest.drift, cold.drift)
 
 
-def test_discrete_chunks_equal_an_unchunked_run():
+def test_discrete_chunks_equal_an_unchunked_run(monkeypatch):
     """Legs run as solves of 7 iterations (so that a caller can cancel between them) give the
     iterates, counts and messages of one solve per leg; the progress grows within a leg."""
+    _chunks(monkeypatch, 7)
     inv = _inverse("extended")
     one = repeatability(inv, TABLE1_X0, TABLE1_PATH, cycles=2, gamma=0.3, mode="discrete",
                         record=True)  # fmt: skip
     fractions: list[float] = []
-    chunked = repeatability(inv, TABLE1_X0, TABLE1_PATH, cycles=2, gamma=0.3, mode="discrete",
-                            record=True, chunk=7, on_chunk=fractions.append)  # fmt: skip
+    chunked = repeatability(
+        inv,
+        TABLE1_X0,
+        TABLE1_PATH,
+        cycles=2,
+        gamma=0.3,
+        mode="discrete",
+        record=True,
+        progress=ProgressCallbacks(on_advance=lambda d, t: fractions.append(d)),
+    )
     assert one.success and chunked.message == one.message
     np.testing.assert_array_equal(chunked.legs, one.legs)
     np.testing.assert_array_equal(chunked.drift, one.drift)
@@ -244,7 +279,7 @@ def test_a_leg_that_raises_stops_the_run_with_the_legs_before_it(monkeypatch):
     """on_undefined="stop": a leg whose solve raises (here the second, patched to) ends the run
     there: the legs before it are kept, the stopped leg is its start alone, the message names
     it. By default the error propagates."""
-    from jik.engine import repeatability as module
+    module = importlib.import_module("jik.engine.repeatability")
 
     calls = []
     original = module.solve
@@ -258,8 +293,15 @@ def test_a_leg_that_raises_stops_the_run_with_the_legs_before_it(monkeypatch):
     monkeypatch.setattr(module, "solve", second_raises)
     inv = _inverse("extended")
     seen = []
-    res = repeatability(inv, TABLE1_X0, TABLE1_PATH, cycles=2, record=True, on_leg=seen.append,
-                        on_undefined="stop")  # fmt: skip
+    res = repeatability(
+        inv,
+        TABLE1_X0,
+        TABLE1_PATH,
+        cycles=2,
+        record=True,
+        progress=ProgressCallbacks(seen.append),
+        on_undefined="stop",
+    )
     assert not res.success
     assert res.message.startswith("cycle 1, leg 2 stopped: h is undefined here at x = ")
     assert np.all(np.isfinite(res.legs[0])) and np.all(np.isnan(res.legs[1:]))
@@ -277,7 +319,7 @@ def test_a_leg_that_raises_stops_the_run_with_the_legs_before_it(monkeypatch):
 def test_a_singular_start_stops_the_first_leg():
     """(36) with a = 1, b = 0 is singular on x1 = 0: a run from there stops before it moves."""
     inv = ExtendedInverse(Manipulator1(), E2Optimal(a=1.0, b=0.0))
-    for kwargs in ({}, {"mode": "discrete", "gamma": 0.5, "chunk": 10}):
+    for kwargs in ({}, {"mode": "discrete", "gamma": 0.5, "progress": ProgressCallbacks()}):
         with pytest.raises(AlgorithmicSingularityError):
             repeatability(inv, [0.0, 0.2, 1.0], [(1.0, 1.0)], **kwargs)
         res = repeatability(inv, [0.0, 0.2, 1.0], [(1.0, 1.0)], on_undefined="stop", **kwargs)
@@ -296,9 +338,6 @@ def test_open_legs_are_solves_to_their_targets():
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
-        ({"chunk": 5}, "chunk applies to discrete mode"),
-        ({"chunk": 5, "mode": "discrete", "x0": [TABLE1_X0, TABLE1_X0]}, "chunk applies to"),
-        ({"chunk": 0, "mode": "discrete"}, "chunk must be between"),
         ({"on_undefined": "ignore"}, "on_undefined must be 'raise' or 'stop'"),
         ({"on_undefined": "stop", "x0": [TABLE1_X0, TABLE1_X0]}, "needs one start"),
         ({"resume": "legs", "cycles": 3}, r"whole cycles of 4 legs"),

@@ -9,7 +9,7 @@ from jik.engine.inverses import ExtendedInverse, Pseudoinverse
 from jik.engine.kinematics import Manipulator1, Manipulator2
 from jik.engine.reproductions.table1 import PRINTED
 from jik.engine.reproductions.table1 import run as table1
-from jik.engine.solver import solve
+from jik.engine.solver import solve, solve_batch
 
 X0 = np.array([0.0, 0.0, math.pi / 2])
 
@@ -84,7 +84,7 @@ def test_batch_equals_individual_solves():
     rng = np.random.default_rng(5)
     x0 = rng.uniform(0, 1, (7, 3))
     yd = kin.forward(x0) + rng.uniform(-0.5, 0.5, (7, 2))
-    batch = solve(inv, x0, yd)
+    batch = solve_batch(inv, x0, yd)
     assert np.all(batch.success)
     for i in range(7):
         one = solve(inv, x0[i], yd[i])
@@ -124,7 +124,7 @@ def test_singular_start_raises_typed_error(kwargs):
     at_target = inv.kinematics.forward(np.array([0.0, 0.2, 1.0]))
     for y in ([1.0, 1.0], at_target):
         with pytest.raises(AlgorithmicSingularityError, match=r"x = \(0, 0.2, 1\)"):
-            solve(inv, [[0.5, 0.5, 1.0], [0.0, 0.2, 1.0]], [[1.0, 1.0], y], **kwargs)
+            solve_batch(inv, [[0.5, 0.5, 1.0], [0.0, 0.2, 1.0]], [[1.0, 1.0], y], **kwargs)
 
 
 @pytest.mark.parametrize(
@@ -137,7 +137,10 @@ def test_singular_start_raises_typed_error(kwargs):
         ({"gamma": 0}, "gamma must be > 0"),
         ({"gamma": -1}, "gamma must be > 0"),
         ({"gamma": 2.5, "mode": "discrete"}, "gamma must be < 2"),
+        ({"gamma": 2e6}, "gamma must be between 1e-06 and 1e"),
         ({"mode": "magic"}, "mode must be"),
+        ({"x0": [X0, X0]}, r"solve takes one start x0 \(p,\).*solve_batch"),
+        ({"y_d": [[1, 1]]}, r"shapes \(3,\) and \(1, 2\); solve_batch solves a batch"),
         ({"tol": 0}, "tol must be > 0"),
         ({"max_iterations": 0}, "max_iterations must be between"),
     ],
@@ -235,8 +238,8 @@ def test_guess_with_another_gamma_is_harmless():
 def test_guess_per_member_in_a_batch():
     inv = ExtendedInverse(Manipulator2(), PaperCubic())
     starts = np.array([X0, X0 + 0.05])
-    cold = solve(inv, starts, [1, 2])
-    warm = solve(inv, starts, [1, 2], guess=[cold.trajectory(0), None])
+    cold = solve_batch(inv, starts, [1, 2])
+    warm = solve_batch(inv, starts, [1, 2], guess=[cold.trajectory(0), None])
     assert warm.nit[0] <= 2 and warm.nit[1] == cold.nit[1]
     np.testing.assert_allclose(warm.x, cold.x, atol=1e-12)
 
@@ -269,7 +272,7 @@ def test_bad_guess_is_rejected_with_a_clear_message(guess, kwargs, match):
         else guess
     )
     with pytest.raises(InvalidInputError, match=match):
-        solve(inv, X0, [1, 2], guess=bad, **kwargs)
+        solve_batch(inv, X0, [1, 2], guess=bad, **kwargs)
 
 
 # Table 1's closed path (sec. 5.2) from X0, three cycles: 12 legs, each from the end of the last.

@@ -9,10 +9,11 @@ import pytest
 from scipy import optimize
 
 from jik.engine.augmentations import E2Optimal, PaperCubic, Polynomial2
-from jik.engine.exceptions import InvalidInputError
+from jik.engine.exceptions import InvalidInputError, RunCancelled
 from jik.engine.functionals import error_functional_e2, quadrature
 from jik.engine.inverses import ExtendedInverse, Pseudoinverse, pseudoinverse
 from jik.engine.kinematics import Manipulator1, Manipulator2
+from jik.engine.progress import ProgressCallbacks
 from jik.engine.repeatability import repeatability
 from jik.engine.variational import (
     MANIPULATOR2_REGION,
@@ -127,11 +128,19 @@ def test_repeatable_on_table1_path_with_synthesized_map():
     assert pinv.drift[0] > 0.1  # the pseudoinverse is not repeatable
 
 
-def test_progress_and_bad_input():
+def test_progress_cancel_and_bad_input():
+    """The progress grows to 1; a cancellation stops the synthesis between its degrees."""
     seen = []
+    progress = ProgressCallbacks(on_advance=lambda done, total: seen.append(done / total))
     synthesize_e2(Manipulator2(), MANIPULATOR2_REGION, degree=6, convergence_degrees=(2, 4),
-                  progress=seen.append)  # fmt: skip
+                  progress=progress)  # fmt: skip
     assert seen[-1] == 1.0 and all(b >= a for a, b in itertools.pairwise(seen))
+    seen.clear()
+    cancel = ProgressCallbacks(on_advance=lambda done, total: seen.append(done),
+                               is_cancelled=lambda: len(seen) == 3)  # fmt: skip
+    with pytest.raises(RunCancelled, match="before degree 6"):
+        synthesize_e2(Manipulator2(), MANIPULATOR2_REGION, degree=6, convergence_degrees=(2, 4),
+                      progress=cancel)  # fmt: skip
     with pytest.raises(InvalidInputError, match="two or three variables"):
         synthesize_e2(Manipulator2(), {"x3": (0, 1)})
     with pytest.raises(InvalidInputError, match="degree must be between"):

@@ -11,7 +11,7 @@ from fastapi import APIRouter, Depends, Request, Response
 from starlette.concurrency import run_in_threadpool
 
 from jik.app.api.dependencies import Pool
-from jik.app.compute.atlas_jobs import AtlasJob, AtlasJobs, AtlasLimits
+from jik.app.compute.atlas_jobs import AtlasJob, AtlasJobs, AtlasLimits, plan_task
 from jik.app.compute.atlas_schemas import AtlasBody, AtlasJobResponse
 from jik.app.compute.pool import ComputePool
 from jik.app.compute.schemas import ErrorResponse
@@ -21,12 +21,10 @@ router = APIRouter(tags=["atlas"])
 
 
 def jobs_of(request: Request) -> AtlasJobs:
-    """The app's atlas jobs (made on first use; their processes have the compute workers'
-    memory limit)."""
+    """The app's atlas jobs (made on first use; their chunks run in the compute pool)."""
     jobs = getattr(request.app.state, "atlas_jobs", None)
     if jobs is None:
-        memory = request.app.state.pool.settings.worker_memory
-        jobs = request.app.state.atlas_jobs = AtlasJobs(AtlasLimits(worker_memory=memory))
+        jobs = request.app.state.atlas_jobs = AtlasJobs(AtlasLimits(), request.app.state.pool)
     return jobs
 
 
@@ -36,7 +34,7 @@ async def start_job(jobs: AtlasJobs, pool: ComputePool, request: Request, req) -
     it as a job of the client's."""
     client = request.client.host if request.client else "unknown"
     jobs.check_room(client)  # (before the work)
-    plan, refused = await pool.run("call", ("atlas.plan", (req.model_dump_json(), jobs.limits)))
+    plan, refused = await pool.run(plan_task, req.model_dump_json(), jobs.limits)
     if refused is not None:
         raise InvalidInputError(*refused)
     return await run_in_threadpool(jobs.start, client, req, plan)
@@ -44,7 +42,10 @@ async def start_job(jobs: AtlasJobs, pool: ComputePool, request: Request, req) -
 
 Jobs = Annotated[AtlasJobs, Depends(jobs_of)]
 ERRORS: dict[int | str, dict] = {
-    404: {"model": ErrorResponse, "description": "no such job (ended long ago, or cancelled)"},
+    404: {
+        "model": ErrorResponse,
+        "description": "no such job (cancelled, ended, or lost in a restart)",
+    },
     429: {"model": ErrorResponse, "description": "too many atlas jobs; retry later"},
 }
 
@@ -56,13 +57,13 @@ async def start_atlas(
     """Plan the atlas (the self-motion curves are traced here) and start it as a job."""
     job = await start_job(jobs, pool, request, req)
     response.headers["Location"] = f"/atlas/{job.id}"
-    return job.response()
+    return jobs.response(job)
 
 
 @router.get("/atlas/{job_id}", response_model=AtlasJobResponse, responses=ERRORS)
 async def read_atlas(job_id: str, jobs: Jobs):
     """The job's status and progress; its result once done."""
-    return jobs.get(job_id).response()
+    return jobs.response(jobs.get(job_id))
 
 
 @router.delete("/atlas/{job_id}", status_code=204, responses=ERRORS)

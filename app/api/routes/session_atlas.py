@@ -61,7 +61,7 @@ async def start_session_atlas(
         raise InvalidInputError(f"{name}: {error['msg']}", name) from None
     job = await start_job(jobs, pool, request, req)
     response.headers["Location"] = f"/atlas/{job.id}"
-    return job.response()
+    return jobs.response(job)
 
 
 @router.get("/api/sessions/{session_id}/atlas/{job_id}", responses={**ERRORS, **_NOT_FOUND})
@@ -70,7 +70,7 @@ async def read_session_atlas(session_id: str, job_id: str, store: Store, jobs: J
     the paths (a cell's run, path * N + start, picks one of each), and the request."""
     store.get(session_id)
     job = jobs.get(job_id)
-    body = job.response().model_dump(mode="json", exclude={"result"})
+    body = jobs.response(job).model_dump(mode="json", exclude={"result"})
     if job.status == "done" and job.result is not None and job.request is not None:
         figure = await run_in_threadpool(atlas_figure, job.result, job.request)
         body.update(

@@ -13,20 +13,22 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+from typing import Annotated
 
 import websockets
-import websockets.asyncio.client
 from fastapi import APIRouter, Request, WebSocket
-from fastapi.responses import JSONResponse, PlainTextResponse, StreamingResponse
+from fastapi.responses import JSONResponse, PlainTextResponse
 from pydantic import BaseModel, ConfigDict, Field
-from websockets.typing import Subprotocol
+from sse_starlette import EventSourceResponse, ServerSentEvent
 
-from jik.app.api.dependencies import Store
+from jik.app.api.dependencies import Pool, Store
 from jik.app.api.errors import unparsed_body_response
-from jik.app.dashboard import export_csv, export_json
+from jik.app.compute.schemas import INTEGRAL
+from jik.app.dashboard import export_file
 from jik.app.dashboard.controls import controls_message
 from jik.app.dashboard.messages import LatestEvents
 from jik.app.dashboard.model import StatePatch, parse_patch, patch_of
+from jik.app.dashboard.robots import vet_definition
 from jik.app.dashboard.sessions import ExportUnavailable, Session, SessionNotFound
 from jik.engine.exceptions import InvalidInputError
 
@@ -77,10 +79,12 @@ def _created(session: Session) -> dict:
 
 
 @router.post("/api/sessions", status_code=201, responses={201: {"links": _SESSION_LINKS}})
-async def create_session(body: SessionCreate, store: Store) -> JSONResponse:
+async def create_session(body: SessionCreate, store: Store, pool: Pool) -> JSONResponse:
     """A new session whose state is the defaults changed by ``state`` (a link's state)."""
     try:
-        session = await asyncio.to_thread(store.create, patch_of(body.state), body.low_end)
+        patch = patch_of(body.state)
+        await vet_definition(pool, patch)
+        session = await asyncio.to_thread(store.create, patch, body.low_end)
     except InvalidInputError as exc:  # (the link's state is the body's "state")
         exc.field = f"state.{exc.field}" if exc.field else "state"
         raise
@@ -106,7 +110,7 @@ async def delete_session(session_id: str, store: Store):
     openapi_extra={"requestBody": {"required": True, "content": {"application/json": {
         "schema": {"$ref": "#/components/schemas/StatePatch"}}}}},
 )  # fmt: skip
-async def post_state(session_id: str, request: Request, store: Store) -> JSONResponse:
+async def post_state(session_id: str, request: Request, store: Store, pool: Pool) -> JSONResponse:
     """Change some controls: ``{"gamma": 2}``, ``{"x0": [...]}``, ``{"robot": "manipulator1"}``.
 
     The body is a :data:`StatePatch`; the answer is the new generation and state. A change
@@ -120,9 +124,10 @@ async def post_state(session_id: str, request: Request, store: Store) -> JSONRes
         return unparsed_body_response(exc)
     try:
         patch = parse_patch(body)
+        await vet_definition(pool, patch)  # (a robot's formulas: built off the event loop)
     except InvalidInputError as exc:
         session.dashboard.refuse(exc)
-    generation, state = session.dashboard.update(patch, source="page")
+    generation, state = await asyncio.to_thread(session.dashboard.update, patch, "page")
     return JSONResponse({"generation": generation, "state": state.as_dict()})
 
 
@@ -132,7 +137,9 @@ class SecondPhaseRequest(BaseModel):
 
     model_config = ConfigDict(extra="forbid")
 
-    generation: int = Field(strict=True, ge=1, description="the generation of the result shown")
+    generation: Annotated[int, Field(strict=True, ge=1), INTEGRAL] = Field(
+        description="the generation of the result shown"
+    )
 
 
 #: A second phase that is not in the state a request needs.
@@ -203,13 +210,13 @@ _NOT_FOUND: dict[int | str, dict] = {404: {"description": "no such session"}}
 @router.get(
     "/api/sessions/{session_id}/events",
     operation_id="session_events",
-    response_class=StreamingResponse,
+    response_class=EventSourceResponse,
     responses={
         200: {"description": "the session's events", "content": {"text/event-stream": {}}},
         **_NOT_FOUND,
     },
 )
-async def events(session_id: str, request: Request, store: Store):
+async def events(session_id: str, store: Store):
     """Server-sent events of one session: ``state``, ``progress``, ``result``, ``functionals``,
     ``error``, ``ahead``, ``refused``.
 
@@ -224,30 +231,21 @@ async def events(session_id: str, request: Request, store: Store):
 
     async def stream():
         try:
-            yield "retry: 1000\n\n"
+            yield ServerSentEvent(retry=1000)  # (the page reconnects after 1 s)
             while True:
-                try:
-                    event = await asyncio.wait_for(queue.get(), HEARTBEAT)
-                except TimeoutError:
-                    if await request.is_disconnected():
-                        return
-                    yield ": keep-alive\n\n"
-                    continue
+                event = await queue.get()
                 if event.kind == "closed":  # (the session ended: the page opens a new one)
                     return
-                if event.kind not in PAGE_EVENTS:
-                    continue
-                yield f"event: {event.kind}\nid: {event.generation}\ndata: {event.data}\n\n"
+                if event.kind in PAGE_EVENTS:
+                    yield ServerSentEvent(event.data, event=event.kind, id=str(event.generation))
         finally:
             unsubscribe()
             session.users -= 1
             session.touch()
 
-    return StreamingResponse(
-        stream(),
-        media_type="text/event-stream",
-        headers={"Cache-Control": "no-cache", "X-Accel-Buffering": "no"},
-    )
+    # sse-starlette frames the events, sends a comment every HEARTBEAT seconds (proxies keep
+    # the connection), and ends the stream when the client leaves or the server stops.
+    return EventSourceResponse(stream(), ping=HEARTBEAT, sep="\n")
 
 
 async def _finished(session: Session):
@@ -281,10 +279,8 @@ async def _finished(session: Session):
 async def export_result_json(session_id: str, store: Store) -> JSONResponse:
     """The session's result, every trajectory point of both algorithms, as JSON."""
     dashboard = await _finished(store.get(session_id))
-    body = export_json(dashboard.result, dashboard.functionals)
-    return JSONResponse(
-        body, headers={"Content-Disposition": 'attachment; filename="jik-result.json"'}
-    )
+    body, name = export_file(dashboard.result, "json", dashboard.functionals)
+    return JSONResponse(body, headers={"Content-Disposition": f'attachment; filename="{name}"'})
 
 
 @router.get(
@@ -300,35 +296,32 @@ async def export_result_json(session_id: str, store: Store) -> JSONResponse:
 async def export_result_csv(session_id: str, store: Store):
     """The session's result as CSV: one row per trajectory point and algorithm."""
     dashboard = await _finished(store.get(session_id))
+    body, name = export_file(dashboard.result, "csv")
     return PlainTextResponse(
-        export_csv(dashboard.result),
+        body,
         media_type="text/csv",
-        headers={"Content-Disposition": 'attachment; filename="jik-result.csv"'},
+        headers={"Content-Disposition": f'attachment; filename="{name}"'},
     )
 
 
 @router.websocket("/api/sessions/{session_id}/scene")
 async def scene_socket(websocket: WebSocket, session_id: str) -> None:
     """The session's 3D scene: the viser client's websocket, relayed to the session's viser
-    server (loopback only). Closes with 4404 for no such session (another origin or host never
-    gets here: :mod:`jik.app.api.security`)."""
+    server, which takes no other client (:mod:`jik.app.scene.server`). A socket for no such
+    session is closed with 4404, one whose scene cannot be reached with 1011 (another origin or
+    host never gets here: :mod:`jik.app.api.security` closes it with 4403 or 4400)."""
     store = getattr(websocket.app.state, "sessions", None)
     try:
         session = store.get(session_id) if store is not None else None
     except SessionNotFound:
         session = None
     if session is None or session.scene is None:
-        await websocket.close(code=4404)
+        await _close(websocket, 4404, "no such session (it expired or was deleted)")
         return
-    offered = [Subprotocol(p) for p in websocket.scope.get("subprotocols", [])]
-    port = session.scene.port
     try:
-        upstream = await websockets.asyncio.client.connect(
-            f"ws://127.0.0.1:{port}", subprotocols=offered or None, max_size=None,
-            compression=None, open_timeout=10,
-        )  # fmt: skip
+        upstream = await session.scene.connect(websocket.scope.get("subprotocols", []))
     except (OSError, websockets.exceptions.WebSocketException, TimeoutError):
-        await websocket.close(code=1011)
+        await _close(websocket, 1011, "the session's scene is not reachable")
         return
     await websocket.accept(subprotocol=upstream.subprotocol)
     session.users += 1
@@ -338,6 +331,13 @@ async def scene_socket(websocket: WebSocket, session_id: str) -> None:
         session.users -= 1
         session.touch()
         await upstream.close()
+
+
+async def _close(websocket: WebSocket, code: int, reason: str) -> None:
+    """Accept, then close with ``code``: a refused handshake reaches a browser's script only as
+    1006, a close code as itself."""
+    await websocket.accept()
+    await websocket.close(code=code, reason=reason)
 
 
 async def _relay(websocket: WebSocket, upstream) -> None:

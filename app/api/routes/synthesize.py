@@ -11,6 +11,7 @@ from jik.app.compute.schemas import (
     SynthesizeResponse,
 )
 from jik.app.compute.synthesis import synthesis_methods
+from jik.app.compute.worker import synthesize_json
 
 router = APIRouter(tags=["synthesize"])
 
@@ -29,5 +30,5 @@ async def methods() -> SynthesisMethodsResponse:
 async def synthesize(req: SynthesizeBody, pool: Pool) -> Response:
     """h on a grid of the box, its coefficients and E1, E2 over the box."""
     precheck(req)
-    body = await pool.run("synthesize", req.model_dump_json().encode())
+    body = await pool.run(synthesize_json, req.model_dump_json().encode())
     return Response(body, media_type="application/json")

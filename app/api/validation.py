@@ -1,0 +1,105 @@
+"""Pydantic's validation errors as the API reports them: each names its field (``robot.l``,
+``x0[2]``) at the start of its message, without the labels of union members, and a vector of the
+wrong length says how many components the request's robot needs and why."""
+
+from __future__ import annotations
+
+from jik.app.compute.schemas import (
+    AUGMENTATION_MODELS,
+    ROBOT_MODELS,
+    ROBOT_NAMES,
+    USER_AUGMENTATION_MODELS,
+    USER_ROBOT_MODELS,
+)
+from jik.engine.registry import ROBOTS
+
+_TAGS = {*ROBOT_MODELS, *AUGMENTATION_MODELS, *USER_ROBOT_MODELS, *USER_AUGMENTATION_MODELS}
+#: The tags of a request's variants: the catalogue robots and the kinds of user robots.
+_VARIANTS = set(ROBOT_NAMES)
+_TYPE_LABELS = {"str", "float", "int", "bool", "constrained-float", "constrained-str"}
+
+
+def _field(loc) -> str:
+    """Field path of a pydantic location: ``("body", "robot", "manipulator2", "l")`` -> ``robot.l``.
+
+    Indices become ``x0[2]``; the discriminator tag of a union member (a request's robot, a
+    robot's or a map's name) is dropped.
+    """
+    # (a member of a plain union is labelled by its type: "str", "tuple[float, ...]")
+    parts = [
+        str(p) for p in loc if p != "body" and str(p) not in _TYPE_LABELS and "[" not in str(p)
+    ]
+    if len(parts) > 1 and parts[0] in _VARIANTS:
+        del parts[0]
+    if len(parts) > 2 and parts[0] in ("robot", "augmentation") and parts[1] in _TAGS:
+        del parts[1]
+    out: list[str] = []
+    for p in parts:
+        if p.isdigit() and out:
+            out[-1] += f"[{p}]"
+        else:
+            out.append(p)
+    return ".".join(out) or "body"
+
+
+def _location(loc) -> list:
+    """A pydantic location without the labels of union members that are not fields: the
+    request's robot variant (``("body", "manipulator2", "x0")``) and a member labelled by its
+    type (``("body", "path", "str")``)."""
+    out = [p for p in loc if not (isinstance(p, str) and (p in _TYPE_LABELS or "[" in p))]
+    if len(out) > 2 and out[0] == "body" and out[1] in _VARIANTS:
+        del out[1]
+    return out
+
+
+def validation_detail(errors) -> list[dict]:
+    """FastAPI's list of errors, ``{"loc", "msg", "type"}``, each message naming its field."""
+    detail = []
+    for e in errors:
+        loc = _location(e.get("loc", ()))
+        msg = str(e.get("msg", "invalid"))
+        if e.get("type") == "extra_forbidden":
+            msg = "unknown field; remove it"
+        elif e.get("type") == "json_invalid":  # (loc: the body and the character's position)
+            ctx = e.get("ctx") or {}
+            where = f" at character {loc[1]}" if len(loc) > 1 else ""
+            detail.append({"loc": ["body"], "type": "json_invalid", "msg":
+                           f"body: not valid JSON{where}: {ctx.get('error', msg)}"})  # fmt: skip
+            continue
+        elif e.get("type") == "union_tag_invalid":
+            ctx = e.get("ctx") or {}
+            msg = f"unknown name {ctx.get('tag')!r}; choose one of {ctx.get('expected_tags')}"
+        elif e.get("type") == "unknown_robot":  # (the request's variant, chosen by robot.name)
+            loc = [*loc, "robot"]
+            body = e.get("input")
+            robot = body.get("robot") if isinstance(body, dict) else None
+            name = robot.get("name") if isinstance(robot, dict) else None
+            names = (e.get("ctx") or {}).get("names", ROBOT_NAMES)  # (the route's robots)
+            if isinstance(body, dict) and "robot" not in body:
+                msg = "Field required"
+            elif name is None:
+                msg = f"give the robot, with a name among {names}"
+            else:
+                msg = f"unknown name {name!r}; choose one of {names}"
+        elif e.get("type") in ("too_short", "too_long"):
+            msg = _length_message(e.get("loc", ()), e.get("ctx") or {}) or msg
+        detail.append({"loc": loc, "msg": f"{_field(loc)}: {msg}", "type": str(e.get("type"))})
+    return detail
+
+
+#: Vectors whose length is the robot's p (the others: r); path and shifts hold points.
+_CONFIGURATIONS = ("x0", "reference")
+_TASK_VECTORS = ("target", "path", "shifts")
+
+
+def _length_message(loc, ctx: dict) -> str | None:
+    """A vector of the wrong length for the request's robot (its tag is the location's second
+    part): how many components it needs and why."""
+    parts = [str(p) for p in loc]
+    spec = ROBOTS.get(parts[1]) if len(parts) > 2 else None
+    if spec is None or parts[2] not in (*_CONFIGURATIONS, *_TASK_VECTORS):
+        return None
+    if parts[2] in ("path", "shifts") and len(parts) < 4:
+        return None  # (the list of points itself)
+    n, what = (spec.p, "p") if parts[2] in _CONFIGURATIONS else (len(spec.task_names), "r")
+    return f"must have {n} components ({what} of {spec.name}), got {ctx.get('actual_length')}"

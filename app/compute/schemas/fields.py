@@ -1,0 +1,55 @@
+"""The field types and size limits every request model shares (JSON, snake_case).
+
+Pydantic checks types, ranges, finiteness (``allow_inf_nan=False``: NaN and inf are rejected) and
+size bounds. The dashboard's state (:mod:`jik.app.dashboard.model`) uses the same types.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Literal
+
+from pydantic import BeforeValidator, Field
+
+from jik.engine.solver import GAMMA_MAX, GAMMA_MIN, TOL_MIN
+
+#: Largest configuration / task dimension accepted before the registry check.
+MAX_DIMENSION = 16
+#: Largest step / iteration cap a request may ask for.
+MAX_ITERATIONS = 20000
+#: Trajectories longer than this are downsampled (first and last points kept).
+MAX_TRAJECTORY_POINTS = 2000
+
+FiniteFloat = Annotated[float, Field(strict=True, allow_inf_nan=False)]
+
+
+def _integral(value: Any) -> Any:
+    """A float with no fraction is the integer it equals (JSON Schema's "integer": 49.0 is one)."""
+    return int(value) if isinstance(value, float) and value.is_integer() else value
+
+
+#: The API's one integer rule, on every route and the session state: what JSON Schema (and so
+#: the OpenAPI document's ``integer``) calls an integer, 49 or 49.0, never 49.5, a boolean or a
+#: string. Written ``Annotated[int, Field(strict=True, ...), INTEGRAL]`` (after the Field, or
+#: the schema loses its bounds); ``tests/app/test_integers.py`` holds every route to it.
+INTEGRAL = BeforeValidator(_integral)
+
+
+#: A float that is null where the engine produced NaN or inf (a failed or diverged run).
+MaybeFloat = float | None
+
+Algorithm = Literal["pseudoinverse", "extended"]
+Mode = Literal["continuous", "discrete"]
+#: Largest |coordinate| of a configuration or task point (radians, lengths, control amplitudes):
+#: beyond it the kinematics only overflow, and the unicycle's quadrature would need huge grids.
+COORDINATE_BOUND = 1000.0
+Coordinate = Annotated[
+    float, Field(strict=True, ge=-COORDINATE_BOUND, le=COORDINATE_BOUND, allow_inf_nan=False)
+]
+Vector = Annotated[list[Coordinate], Field(min_length=1, max_length=MAX_DIMENSION)]
+#: The decay rate of eq. (5) (discrete mode: the step; its bound there is checked with the mode,
+#: engine.solver.gamma_problem).
+Gamma = Annotated[float, Field(strict=True, ge=GAMMA_MIN, le=GAMMA_MAX, allow_inf_nan=False)]
+#: The task error at which a solve stops.
+Tolerance = Annotated[float, Field(strict=True, ge=TOL_MIN, le=1.0, allow_inf_nan=False)]
+#: A bound of a synthesis box.
+Bound = Annotated[float, Field(strict=True, ge=-100.0, le=100.0, allow_inf_nan=False)]

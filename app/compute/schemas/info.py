@@ -1,0 +1,80 @@
+"""The catalogue's description (``GET /robots``), health and the error body."""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+from pydantic import BaseModel, Field
+
+from jik.app.compute.schemas.fields import Algorithm, Mode
+
+
+class ParameterInfo(BaseModel):
+    name: str
+    default: float | list[float]
+    minimum: float | list[float]
+    maximum: float | list[float]
+    description: str
+    nonzero: bool = False
+    presets: dict[str, list[float]] | None = None
+
+
+class AugmentationInfo(BaseModel):
+    name: str
+    equation: str
+    description: str
+    parameters: list[ParameterInfo]
+
+
+class RobotInfo(BaseModel):
+    name: str
+    title: str
+    description: str
+    equation: str
+    p: int
+    r: int
+    variable_names: list[str]
+    task_names: list[str]
+    parameters: list[ParameterInfo]
+    default_x0: list[float]
+    default_target: list[float]
+    default_path: list[list[float]]
+    default_mode: Mode
+    default_gamma: float
+    x_range: list[list[float]]
+    augmentations: list[AugmentationInfo]
+    default_augmentation: str
+    functional_region: dict[str, list[float]] = Field(
+        description="the box of the paper's E1/E2 comparisons (sec. 5); empty if none"
+    )
+    algorithms: list[Algorithm]
+    modes: list[Mode]
+
+
+class Limits(BaseModel):
+    max_cycles: int
+    max_path_points: int
+    max_iterations: int
+    max_trajectory_points: int
+    request_timeout_s: float
+
+
+class RobotsResponse(BaseModel):
+    robots: list[RobotInfo]
+    limits: Limits
+
+
+class ErrorResponse(BaseModel):
+    """A request that could not be served now (503) or an unexpected failure (500)."""
+
+    detail: str
+
+
+#: OpenAPI entry of the 503 every computing endpoint may answer.
+BUSY: dict[int | str, dict[str, Any]] = {
+    503: {"model": ErrorResponse, "description": "server busy: no compute slot in time"}
+}
+
+
+class HealthResponse(BaseModel):
+    status: Literal["ok"]

@@ -1,0 +1,286 @@
+"""The robots and augmenting maps a request names, and how a response echoes them.
+
+Catalogue models are generated from the engine's catalogue (:data:`jik.engine.registry.ROBOTS`)
+when this module is imported: one model per robot with its parameters and their ranges,
+discriminated by ``name``, and one per augmenting map. A robot or map the catalogue gains appears
+in the API, its OpenAPI schema and the fuzz test with no change here. The robots a user defines
+(planar chain, formulas, URDF) and their maps are written out below.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeAlias, Union
+
+from pydantic import BaseModel, ConfigDict, Field, create_model
+
+from jik.app.compute.schemas.fields import (
+    INTEGRAL,
+    MAX_DIMENSION,
+    Coordinate,
+    FiniteFloat,
+)
+from jik.engine.registry import ROBOTS, AugmentationSpec, RobotSpec
+
+
+def _camel(name: str) -> str:
+    return "".join(part.capitalize() for part in name.replace("-", "_").split("_"))
+
+
+def _scalar_field(p) -> tuple[Any, Any]:
+    extra = " (nonzero)" if p.nonzero else ""
+    return (
+        Annotated[
+            float,
+            Field(
+                strict=True,
+                ge=p.minimum,
+                le=p.maximum,
+                allow_inf_nan=False,
+                description=f"{p.description}{extra}; default {p.default:g}",
+                # (JSON Schema's way to say nonzero: the engine refuses 0 with a 422)
+                json_schema_extra={"not": {"const": 0}} if p.nonzero else None,
+            ),
+        ],
+        p.default,
+    )
+
+
+def _vector_field(v) -> tuple[Any, Any]:
+    items = tuple(
+        Annotated[float, Field(strict=True, ge=lo, le=hi, allow_inf_nan=False)]
+        for lo, hi in zip(v.minimum, v.maximum, strict=True)
+    )
+    return (
+        # The item types are built at runtime (one per coordinate): a dynamic type by design.
+        Annotated[tuple[items], Field(description=f"{v.description}; default {list(v.default)}")],  # type: ignore[valid-type]
+        tuple(v.default),
+    )
+
+
+def _robot_model(spec: RobotSpec) -> type[BaseModel]:
+    fields: dict[str, Any] = {"name": (Literal[spec.name], ...)}
+    for p in spec.parameters:
+        fields[p.name] = _scalar_field(p)
+    for v in spec.vector_parameters:
+        fields[v.name] = _vector_field(v)
+    return create_model(
+        f"{_camel(spec.name)}Robot",
+        __config__=ConfigDict(extra="forbid", title=spec.title),
+        __doc__=f"{spec.title}: {spec.description}, eq. {spec.equation}.",
+        **fields,
+    )
+
+
+def _augmentation_model(name: str, specs: list[AugmentationSpec]) -> type[BaseModel]:
+    fields: dict[str, Any] = {"name": (Literal[name], ...)}
+    for spec in specs:
+        for p in spec.parameters:
+            fields.setdefault(p.name, _scalar_field(p))
+    first = specs[0]
+    return create_model(
+        f"{_camel(name)}Augmentation",
+        __config__=ConfigDict(extra="forbid"),
+        __doc__=f"Augmenting map {name}, eq. {first.equation}: {first.description}.",
+        **fields,
+    )
+
+
+def _union(models: list[type[BaseModel]]) -> Any:
+    if len(models) == 1:
+        return models[0]
+    return Annotated[Union[tuple(models)], Field(discriminator="name")]  # noqa: UP007
+
+
+ROBOT_MODELS: dict[str, type[BaseModel]] = {name: _robot_model(s) for name, s in ROBOTS.items()}
+_by_name: dict[str, list[AugmentationSpec]] = {}
+for _spec in ROBOTS.values():
+    for _a in _spec.augmentations:
+        _by_name.setdefault(_a.name, []).append(_a)
+AUGMENTATION_MODELS: dict[str, type[BaseModel]] = {
+    name: _augmentation_model(name, specs) for name, specs in _by_name.items()
+}
+for _m in (*ROBOT_MODELS.values(), *AUGMENTATION_MODELS.values()):
+    globals()[_m.__name__] = _m  # importable by name (pickling, introspection)
+
+
+# --------------------------------------------------------------------------------------------
+# Robots defined by data: the kinds of jik.engine.robot_kinds, checked in full by
+# jik.engine.robot_spec.robot_from_dict. The schema says what JSON Schema can (names, sizes,
+# the joints' letters); the formulas' grammar, the URDF text and what follows from them (p, r,
+# the lengths of x0, target and path) are checked when the robot is built, naming the field.
+
+#: Longest formula text (the engine's bound, :data:`jik.engine.formula.MAX_LENGTH`).
+MAX_FORMULA_CHARS = 2000
+#: Longest URDF text a request carries [characters]: a tenth of the 1 MiB body limit, room for
+#: an arm of dozens of links (the shipped 4-joint arm is 2 kB). A larger file goes through the
+#: CLI (``jik solve --robot arm.json`` with ``urdf_file``; the engine's bound is 1 MB). A 1 MB
+#: bound here lets a request's text cost the parser gigabytes of memory.
+MAX_URDF_CHARS = 100_000
+#: A variable's, a parameter's or a joint's name.
+Name = Annotated[str, Field(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,31}$")]
+FormulaText = Annotated[str, Field(min_length=1, max_length=MAX_FORMULA_CHARS)]
+Constants = Annotated[dict[Name, FiniteFloat], Field(max_length=32)]
+Title = Annotated[str, Field(min_length=1, max_length=100)]
+
+
+class PlanarChainRobot(BaseModel):
+    """A planar serial chain of revolute (R) and prismatic (P) joints: the end point (r = 2),
+    or the end point and its angle (r = 3); p is the number of joints."""
+
+    model_config = ConfigDict(extra="forbid", title="Planar chain")
+    name: Literal["planar_chain"]
+    joints: Annotated[str, Field(pattern=r"^[RP]{1,16}$")] = Field(
+        description="joint types, base first: R revolute, P prismatic (p = its length)"
+    )
+    lengths: Annotated[list[Coordinate], Field(min_length=1, max_length=MAX_DIMENSION)] = Field(
+        description="link lengths, one per joint"
+    )
+    offsets: Annotated[list[Coordinate], Field(min_length=1, max_length=MAX_DIMENSION)] | None = (
+        Field(None, description="joint offsets added to x, one per joint (default 0)")
+    )
+    orientation: Annotated[bool, Field(strict=True)] = Field(
+        False, description="also the end's angle as a task component (r = 3; needs p >= 3)"
+    )
+    title: Title | None = None
+
+
+class FormulaRobot(BaseModel):
+    """Kinematics written as formulas: k(x) = (task[0], task[1], ...) in the variables."""
+
+    model_config = ConfigDict(extra="forbid", title="Formula robot")
+    name: Literal["formula"]
+    variables: Annotated[list[Name], Field(min_length=1, max_length=MAX_DIMENSION)] = Field(
+        description="joint variable names, in order (p = their number)"
+    )
+    task: Annotated[list[FormulaText], Field(min_length=1, max_length=MAX_DIMENSION)] = Field(
+        description="task components (r = their number): formulas in the variables and "
+        "parameters with sin cos tan exp log sqrt atan2 abs, + - * / **, numbers and pi"
+    )
+    parameters: Constants = Field(default_factory=dict, description="named constants")
+    title: Title | None = None
+
+
+class UrdfRobot(BaseModel):
+    """A serial arm from URDF text: the end link's position (task 'xyz' or a subset)."""
+
+    model_config = ConfigDict(extra="forbid", title="URDF arm")
+    name: Literal["urdf"]
+    urdf: Annotated[str, Field(min_length=1, max_length=MAX_URDF_CHARS)] = Field(
+        description="the URDF text (no DOCTYPE; meshes are not loaded)"
+    )
+    end_link: Annotated[str, Field(min_length=1, max_length=200)] = Field(
+        description="the link whose origin is the end point"
+    )
+    active_joints: (
+        Annotated[
+            list[Annotated[str, Field(min_length=1, max_length=200)]],
+            Field(min_length=1, max_length=MAX_DIMENSION),
+        ]
+        | None
+    ) = Field(None, description="the joints that move (default: all from the base to end_link)")
+    task: Literal["xyz", "xy", "xz", "yz", "x", "y", "z"] = Field(
+        "xyz", description="coordinates of the end point"
+    )
+    locked: Annotated[
+        dict[Annotated[str, Field(min_length=1, max_length=200)], FiniteFloat],
+        Field(max_length=64),
+    ] = Field(default_factory=dict, description="values of the chain's other movable joints")
+    title: Title | None = None
+
+
+class FormulaMapAugmentation(BaseModel):
+    """An augmenting map h written as a formula in the robot's variables, eq. (9); for
+    p - r > 1 a list of p - r formulas (the extended inverse of several maps)."""
+
+    model_config = ConfigDict(extra="forbid", title="Formula map")
+    name: Literal["formula"]
+    h: FormulaText | Annotated[list[FormulaText], Field(min_length=1, max_length=15)] = Field(
+        description="h(x), e.g. 'x3'; a list of p - r formulas when p - r > 1"
+    )
+    parameters: Constants | None = Field(None, description="named constants of h")
+
+
+class E2SynthesisAugmentation(BaseModel):
+    """The E2-optimal map on a box, synthesized by the Ritz solve of eq. (20) (p = r + 1)."""
+
+    model_config = ConfigDict(extra="forbid", title="E2-synthesized map")
+    name: Literal["e2_synthesized"]
+    region: Annotated[
+        dict[Name, tuple[Annotated[float, Field(strict=True, ge=-100.0, le=100.0,
+                                                allow_inf_nan=False)],
+                         Annotated[float, Field(strict=True, ge=-100.0, le=100.0,
+                                                allow_inf_nan=False)]]],
+        Field(min_length=2, max_length=3),
+    ] = Field(description="two or three variables to [lo, hi], lo < hi")  # fmt: skip
+    degree: Annotated[int, Field(strict=True, ge=1, le=24), INTEGRAL] = Field(
+        12, description="Legendre degree per variable"
+    )
+    fixed: Annotated[dict[Name, FiniteFloat], Field(max_length=MAX_DIMENSION)] | None = Field(
+        None, description="values of the variables outside the box (default 0)"
+    )
+
+
+#: The robots a user defines, by kind (their ``name``).
+USER_ROBOT_MODELS: dict[str, type[BaseModel]] = {
+    "planar_chain": PlanarChainRobot,
+    "formula": FormulaRobot,
+    "urdf": UrdfRobot,
+}
+#: The augmenting maps a user robot takes, by name.
+USER_AUGMENTATION_MODELS: dict[str, type[BaseModel]] = {
+    "formula": FormulaMapAugmentation,
+    "e2_synthesized": E2SynthesisAugmentation,
+}
+#: Every robot name a request may give: the catalogue's, then the kinds of user robots.
+ROBOT_NAMES = [*ROBOTS, *USER_ROBOT_MODELS]
+UserAugmentation = Annotated[
+    FormulaMapAugmentation | E2SynthesisAugmentation, Field(discriminator="name")
+]
+
+if TYPE_CHECKING:
+    # Generated from the catalogue at import time (above), so their fields are invisible to a
+    # static checker: type them as Any there.
+    Robot: TypeAlias = Any
+    Augmentation: TypeAlias = Any
+    AnyRobot: TypeAlias = Any
+    AnyAugmentation: TypeAlias = Any
+else:
+    #: A catalogue robot and one of its maps (what the atlas takes).
+    Robot = _union(list(ROBOT_MODELS.values()))
+    Augmentation = _union(list(AUGMENTATION_MODELS.values()))
+    #: Any robot and map of a solve, repeatability or synthesis: the base request models, which
+    #: the workers validate with, take them all; the routes take the exact per-robot members
+    #: of :func:`per_robot`.
+    AnyRobot = _union([*ROBOT_MODELS.values(), *USER_ROBOT_MODELS.values()])
+    AnyAugmentation = Augmentation | UserAugmentation
+
+
+def _absent(value: Any) -> bool:
+    """A response's field that only user robots have is left out for the catalogue's."""
+    return value is None
+
+
+class AugmentationUsed(BaseModel):
+    """The augmenting map a run used, with every parameter (defaults filled in)."""
+
+    name: str
+    parameters: dict[str, float]
+    definition: dict[str, Any] | None = Field(
+        default=None,
+        exclude_if=_absent,
+        description="a user robot's map as given (absent otherwise)",
+    )
+
+
+class RobotUsed(BaseModel):
+    """The robot a run used, with every parameter (defaults filled in)."""
+
+    name: str
+    parameters: dict[str, float | list[float]]
+    definition: dict[str, Any] | None = Field(
+        default=None,
+        exclude_if=_absent,
+        description="a user robot's definition as given (absent for a catalogue robot)",
+    )
+    p: int | None = Field(default=None, exclude_if=_absent, description="a user robot's p")
+    r: int | None = Field(default=None, exclude_if=_absent, description="a user robot's r")

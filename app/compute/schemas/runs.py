@@ -1,0 +1,173 @@
+"""``POST /solve`` and ``POST /repeatability``: their requests, bodies and responses.
+
+What needs the registry (vector lengths against p and r, an augmentation that belongs to the
+robot, a singular start) is checked by :mod:`jik.app.compute.requests`, which names the field.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from jik.app.compute.schemas.fields import (
+    INTEGRAL,
+    MAX_ITERATIONS,
+    Algorithm,
+    Coordinate,
+    Gamma,
+    MaybeFloat,
+    Mode,
+    Tolerance,
+    Vector,
+)
+from jik.app.compute.schemas.robots import AnyAugmentation, AnyRobot, AugmentationUsed, RobotUsed
+from jik.app.compute.schemas.variants import per_robot
+from jik.engine.registry import RobotSpec
+from jik.engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
+from jik.engine.solver import DISCRETE_GAMMA_BOUND
+
+
+class _Request(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+    robot: AnyRobot = Field(
+        description="the robot and its parameters, e.g. {'name': 'manipulator2', 'l': 1}"
+    )
+    algorithm: Algorithm = Field(
+        description="'pseudoinverse' (eq. (8)) or 'extended' (extended Jacobian inverse, eq. (11))"
+    )
+    augmentation: AnyAugmentation | None = Field(
+        None,
+        description="augmenting map h of the extended inverse with its parameters; "
+        "default: the robot's default augmentation (ignored by the pseudoinverse)",
+    )
+    x0: Vector = Field(description="start configuration, length p of the robot")
+    gamma: Gamma | None = Field(
+        None,
+        description=f"decay rate > 0 of eq. (5) (discrete: the step, < {DISCRETE_GAMMA_BOUND:g}); "
+        "default: the robot's",
+    )
+    mode: Mode | None = Field(
+        None, description="'continuous' (ODE) or 'discrete' (iterations); default: the robot's"
+    )
+    tolerance: Tolerance = Field(1e-10, description="stop when ||k(x) - target|| < tolerance")
+    max_iterations: Annotated[int, Field(strict=True, ge=1, le=MAX_ITERATIONS), INTEGRAL] | None = (
+        Field(
+            None,
+            description="cap on integrator steps (continuous) or iterations (discrete) per solve",
+        )
+    )
+
+
+class SolveRequest(_Request):
+    """One run of the continuation algorithm (7) from x0 to a target task point."""
+
+    target: Vector = Field(description="target task point, length r of the robot")
+
+
+class RepeatabilityRequest(_Request):
+    """Drive the robot ``cycles`` times around a closed task-space path (Table 1)."""
+
+    path: Annotated[list[Vector], Field(min_length=1, max_length=MAX_PATH_POINTS)] = Field(
+        description=f"task points visited in order, 1 to {MAX_PATH_POINTS}; k(x0) closes it"
+    )
+    cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_CYCLES), INTEGRAL] = Field(
+        1, description=f"1 to {MAX_CYCLES}"
+    )
+
+
+class Trajectory(BaseModel):
+    """The run point by point (accepted integrator steps or iterations)."""
+
+    theta: list[MaybeFloat] = Field(description="continuation parameter, or iteration number")
+    x: list[list[MaybeFloat]] = Field(description="configurations, shape (m, p)")
+    y: list[list[MaybeFloat]] = Field(description="k(x), shape (m, r)")
+    error: list[MaybeFloat] = Field(description="||k(x) - target||, shape (m,)")
+    h: list[MaybeFloat] | None = Field(None, description="h(x) for the extended inverse")
+    points: int = Field(description="points of the full trajectory before downsampling")
+    downsampled: bool
+
+
+class SolveResponse(BaseModel):
+    robot: RobotUsed
+    algorithm: Algorithm
+    augmentation: AugmentationUsed | None
+    mode: Mode
+    gamma: float
+    tolerance: float
+    x: list[MaybeFloat] = Field(
+        description="final configuration (null entries if the run diverged)"
+    )
+    y: list[MaybeFloat] = Field(description="k(x)")
+    error: MaybeFloat = Field(description="||k(x) - target||")
+    converged: bool
+    message: str
+    iterations: int = Field(description="integrator steps or iterations taken")
+    trajectory: Trajectory
+
+
+class RepeatabilityResponse(BaseModel):
+    robot: RobotUsed
+    algorithm: Algorithm
+    augmentation: AugmentationUsed | None
+    mode: Mode
+    gamma: float
+    cycles: int
+    targets: list[list[float]] = Field(description="task point of each leg of one cycle (closed)")
+    legs: list[list[MaybeFloat]] = Field(
+        description="configuration after each leg, all cycles (null after a failed leg)"
+    )
+    cycle_end: list[list[MaybeFloat]] = Field(description="configuration at the end of each cycle")
+    drift: list[MaybeFloat] = Field(description="||cycle_end[c] - x0|| per cycle")
+    max_drift: MaybeFloat
+    repeatable: bool = Field(description="every leg succeeded and max drift < 1e-6")
+    success: bool
+    message: str
+
+
+def _task_point(spec: RobotSpec) -> Any:
+    r = len(spec.task_names)
+    return Annotated[list[Coordinate], Field(min_length=r, max_length=r)]
+
+
+def _run_fields(spec: RobotSpec, augmentation: Any) -> dict[str, Any]:
+    return {
+        "augmentation": (
+            augmentation | None,
+            Field(
+                None,
+                description=f"augmenting map h of the extended inverse (one of "
+                f"{sorted({a.name for a in spec.augmentations})}); default: "
+                f"{spec.augmentation(None).name} (ignored by the pseudoinverse)",
+            ),
+        ),
+        "x0": (
+            Annotated[list[Coordinate], Field(min_length=spec.p, max_length=spec.p)],
+            Field(description=f"start configuration {list(spec.variable_names)}"),
+        ),
+    }
+
+
+#: ``POST /solve``'s body: a :class:`SolveRequest` with the lengths of its robot.
+SolveBody = per_robot(
+    SolveRequest,
+    lambda spec, aug: {
+        **_run_fields(spec, aug),
+        "target": (_task_point(spec), Field(description=f"target {list(spec.task_names)}")),
+    },
+)
+#: ``POST /repeatability``'s body: a :class:`RepeatabilityRequest` with its robot's lengths.
+RepeatabilityBody = per_robot(
+    RepeatabilityRequest,
+    lambda spec, aug: {
+        **_run_fields(spec, aug),
+        "path": (
+            Annotated[list[_task_point(spec)], Field(min_length=1, max_length=MAX_PATH_POINTS)],  # type: ignore[misc]
+            Field(
+                description=f"task points {list(spec.task_names)} visited in order, 1 to "
+                f"{MAX_PATH_POINTS}; k(x0) closes it"
+            ),
+        ),
+    },
+)

@@ -1,0 +1,78 @@
+"""One request model per robot: what a route takes and its OpenAPI document shows."""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Union
+
+from pydantic import BaseModel, Discriminator, Field, Tag, create_model
+
+from jik.app.compute.schemas.robots import (
+    AUGMENTATION_MODELS,
+    ROBOT_MODELS,
+    ROBOT_NAMES,
+    USER_ROBOT_MODELS,
+    UserAugmentation,
+    _camel,
+    _union,
+)
+from jik.engine.registry import ROBOTS
+
+
+def _robot_name(body: Any) -> str | None:
+    """The robot's name in a request body (raw JSON data or a model): the variant to check."""
+    robot = body.get("robot") if isinstance(body, dict) else getattr(body, "robot", None)
+    name = robot.get("name") if isinstance(robot, dict) else getattr(robot, "name", None)
+    return name if isinstance(name, str) else None
+
+
+def per_robot(base: type[BaseModel], fields: Any, user_robots: bool = True) -> Any:
+    """``base`` made exact for each robot of the catalogue: one model per robot, chosen by
+    ``robot.name``, whose ``robot`` and ``augmentation`` are that robot's and whose vectors have
+    its lengths (``fields(spec)``: the fields that differ from ``base``'s), and one per kind of
+    user robot unless not ``user_robots``. Their union is what the route takes and what its
+    OpenAPI document shows; each member is still a ``base``."""
+    members = []
+    names = ROBOT_NAMES if user_robots else list(ROBOTS)
+    for name, spec in ROBOTS.items():
+        augmentations = list(dict.fromkeys(a.name for a in spec.augmentations))
+        model = create_model(
+            f"{base.__name__.removesuffix('Request')}{_camel(name)}Request",
+            __base__=base,
+            __doc__=f"{(base.__doc__ or '').strip()} ({spec.title})",
+            robot=(ROBOT_MODELS[name], Field(description=f"{spec.title} and its parameters")),
+            **fields(spec, _union([AUGMENTATION_MODELS[a] for a in augmentations])),
+        )
+        globals()[model.__name__] = model
+        members.append(Annotated[model, Tag(name)])
+    for kind, robot_model in USER_ROBOT_MODELS.items() if user_robots else ():
+        # p and r follow from the definition: the vectors keep the base's 1 to 16 components,
+        # checked against the built robot (a 422 naming the field and the robot's p, r).
+        model = create_model(
+            f"{base.__name__.removesuffix('Request')}{_camel(kind)}Request",
+            __base__=base,
+            __doc__=f"{(base.__doc__ or '').strip()} ({robot_model.model_config.get('title')})",
+            robot=(robot_model, Field(description=f"{robot_model.__doc__}")),
+            augmentation=(
+                UserAugmentation | None,
+                Field(None, description="augmenting map h of the extended inverse: "
+                      "{'name': 'formula', 'h': ...} or {'name': 'e2_synthesized', 'region': "
+                      "{...}} (p = r + 1)" + USER_AUGMENTATION_NOTE.get(base.__name__, "")),
+            ),
+        )  # fmt: skip
+        globals()[model.__name__] = model
+        members.append(Annotated[model, Tag(kind)])
+    return Annotated[
+        Union[tuple(members)],  # noqa: UP007
+        Discriminator(
+            _robot_name,
+            custom_error_type="unknown_robot",
+            custom_error_message=f"give a robot whose name is one of {names}",
+            custom_error_context={"names": str(names)},
+        ),
+    ]
+
+
+#: What the augmentation of a user robot's request is for, by request.
+USER_AUGMENTATION_NOTE = {
+    "SynthesizeRequest": "; 'evaluate' needs one, 'e2_variational' takes none",
+}

@@ -1,0 +1,102 @@
+"""Solving ahead: while no change comes, a :class:`~jik.app.dashboard.session.Dashboard` solves
+the other robots' default states into its run cache and announces their figures (``ahead``
+events), so that a switch of robot only draws."""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import threading
+from collections.abc import Callable
+
+from jik.app.dashboard.analysis import expensive_map, kinematics_and_map
+from jik.app.dashboard.messages import Event, digest, with_figures
+from jik.app.dashboard.model import ALGORITHMS, DashboardState, cache_key, default_state
+from jik.app.dashboard.offload import OffloadLane
+from jik.app.dashboard.plotting import PANELS
+from jik.app.dashboard.results import compute
+from jik.app.dashboard.runs import Cancelled
+from jik.engine.exceptions import JikError
+
+log = logging.getLogger("jik.dashboard")
+
+#: Robots whose default state the idle dashboard solves ahead (:meth:`SolvingAhead._prefetch`).
+#: Not the unicycle: its ~1 s would hold the CPU that a change made meanwhile needs (its
+#: switch shows progress instead).
+PREFETCH_ROBOTS = ("manipulator1", "manipulator2")
+
+
+class SolvingAhead:
+    """The dashboard's work while idle (a part of
+    :class:`~jik.app.dashboard.session.Dashboard`, run by its worker thread)."""
+
+    _cond: threading.Condition
+    _generation: int
+    _stopped: bool
+    _state: DashboardState
+    _cache: dict
+    _offload: OffloadLane | None
+    # When each robot's result solved ahead went to the page (the value of _robot_since then),
+    # the latest by robot, and since when the robot on screen is (its first result's generation).
+    _ahead_sent: dict[str, int]
+    _latest_ahead: dict[str, Event]
+    _robot_since: int
+    _emit: Callable[[Event], None]
+    _turn: Callable[[], contextlib.AbstractContextManager]
+    _known_functionals: Callable[[DashboardState], tuple[tuple | None, set[str]]]
+    _panel_texts: Callable[..., dict[str, str]]
+
+    def _prefetch(self, generation: int) -> None:
+        """While no change comes, solve the other robots' default states into the run cache:
+        switching robot starts from those defaults (:func:`updated_state`), so the switch then
+        only draws (Manipulator 1: ~90 ms of computation less in the browser test).
+
+        Each is announced by an ``ahead`` event with the figures the switch will show: the
+        page draws them off screen and shows them on the switch (when they are the same), the
+        3D scene builds the robot's nodes, hidden (from the event's result, given when the
+        runs were solved now). A robot is announced again after every switch of robot (the
+        page has shown what it drew ahead); meanwhile its figures stay the same (no sticky
+        axes or known E1/E2 carry over from another robot) and nothing is done again.
+
+        Only :data:`PREFETCH_ROBOTS`; any change cancels it between legs.
+        """
+
+        for robot in PREFETCH_ROBOTS:
+            state = default_state(robot)
+            if self._generation != generation or self._stopped:
+                return
+            if robot == self._state.robot:
+                continue
+            solved = all(cache_key(state, a) in self._cache for a in ALGORITHMS)
+            if solved and self._ahead_sent.get(robot) == self._robot_since:
+                continue  # (its figures stay the same while the robot on screen stays)
+            try:
+                _, amap = kinematics_and_map(state)
+                with self._turn():
+                    result = compute(
+                        state, generation, cancelled=lambda: self._generation != generation,
+                        cache=self._cache, with_augmenting=not expensive_map(amap),
+                        offload=self._offload,
+                    )  # fmt: skip
+                # The figures as the switch will make them (see _compute; no panel to reuse
+                # from another robot).
+                cached, stale = self._known_functionals(state)
+                functionals, sens = cached or (None, None)
+                texts = self._panel_texts(
+                    result, functionals, sens, set(PANELS) - stale, remember=False
+                )
+            except (Cancelled, JikError, ValueError):
+                return
+            except Exception:  # (work ahead: logged, never shown as the current result's error)
+                log.exception("solving %s ahead failed", robot)
+                return
+            digests = {k: digest(t) for k, t in texts.items()}
+            self._ahead_sent[robot] = self._robot_since
+            head = {"type": "ahead", "generation": generation, "robot": robot,
+                    "digests": digests}  # fmt: skip
+            event = Event(
+                "ahead", generation, with_figures(head, texts), None if solved else result
+            )
+            with self._cond:
+                self._latest_ahead[robot] = event
+            self._emit(event)

@@ -1,0 +1,94 @@
+"""Where the scene's camera looks: the robot's reach, framed for each client's view.
+
+When the robot changes (another robot, or another definition of a user's robot), the camera
+of every client is set to look at the sphere the robot can reach (:func:`view_of`) from the
+front, tilted, at the distance where the sphere fills the client's narrower field of view
+(viser reports each client's vertical field of view and aspect); a client that connects later
+is framed the same way when it first reports its camera.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from typing import Any
+
+import numpy as np
+
+from jik.app.dashboard.robots import state_kinematics
+from jik.app.scene.mechanisms import chain_points, extent_of
+
+#: Unit vector from the point looked at to the camera: in front of the task plane, tilted.
+VIEW_DIRECTION = np.array([0.0, -0.75, 1.05]) / math.hypot(0.75, 1.05)
+#: Room around the framed sphere, as a factor of its radius.
+MARGIN = 1.15
+
+
+def view_of(result) -> tuple[np.ndarray, float]:
+    """The sphere (center (3,), radius) the camera frames for ``result``'s robot.
+
+    A user's arm (planar chain, URDF): centred on its base, of radius its reach, the length
+    of its links at x0 (at least the farthest point of its drawn configurations). Any other:
+    the task-plane box its mechanisms, paths and targets span (:func:`extent_of`).
+    """
+    state = result.state
+    if state.robot in ("planar_chain", "urdf"):
+        kin = state_kinematics(state)
+        home = chain_points(kin, np.asarray(state.x0, dtype=float), 0.0)  # (n + 1, 3)
+        base = home[0]
+        reach = float(np.linalg.norm(np.diff(home, axis=0), axis=1).sum())
+        xs = np.concatenate([r.x for r in result.runs.values()])
+        drawn = chain_points(kin, xs[:: max(1, len(xs) // 200)], 0.0).reshape(-1, 3)
+        radius = max(reach, float(np.linalg.norm(drawn - base, axis=1).max()))
+        return base, max(radius, 1e-3)
+    (xlo, xhi), (ylo, yhi) = extent_of(result)
+    center = np.array([(xlo + xhi) / 2, (ylo + yhi) / 2, 0.0])
+    return center, max(math.hypot(xhi - xlo, yhi - ylo) / 2, 1e-3)
+
+
+def camera_pose(
+    center: np.ndarray, radius: float, fov: float, aspect: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """(position, look_at) of a camera with vertical field of view ``fov`` [rad] and
+    ``aspect`` (width / height) that shows the whole sphere (``center``, ``radius``)."""
+    half = min(fov / 2, math.atan(math.tan(fov / 2) * aspect))  # the narrower half-angle
+    distance = MARGIN * radius / math.sin(half)
+    return center + distance * VIEW_DIRECTION, np.asarray(center, dtype=float)
+
+
+class CameraFraming:
+    """Frames the cameras of a viser ``server``'s clients on the robot on show."""
+
+    def __init__(self, server: Any) -> None:
+        self.server = server
+        self.view: tuple[np.ndarray, float] | None = None
+        self._lock = threading.Lock()
+        server.on_client_connect(self.frame_client)
+
+    def frame(self, result) -> None:
+        """Frame every client (and the initial camera of clients to come) on ``result``'s
+        robot."""
+        with self._lock:
+            self.view = view_of(result)
+        center, radius = self.view
+        initial = self.server.initial_camera
+        position, look_at = camera_pose(center, radius, initial.fov, 16 / 9)
+        initial.position, initial.look_at = position, look_at
+        initial.near = min(0.01, float(np.linalg.norm(position - look_at)) / 100)
+        for client in self.server.get_clients().values():
+            self.frame_client(client)
+
+    def frame_client(self, client: Any) -> None:
+        """Frame one client on the robot on show, for its field of view and aspect."""
+        with self._lock:
+            view = self.view
+        if view is None:
+            return
+        camera = client.camera
+        aspect = camera.aspect if camera.image_height > 0 else 16 / 9
+        position, look_at = camera_pose(*view, camera.fov, aspect)
+        distance = float(np.linalg.norm(position - look_at))
+        with client.atomic():
+            camera.position = position
+            camera.look_at = look_at
+            camera.near = min(0.01, distance / 100)  # (a tiny robot is not clipped)

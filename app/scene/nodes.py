@@ -1,0 +1,180 @@
+"""The scene's node sets: one per manipulator layout, kept and moved; the unicycle's, redrawn.
+
+A manipulator's set (its mechanisms, the grey copy at x0 and the fixtures of
+:func:`~jik.app.scene.mechanisms.fixtures_of`, under a frame of their own) is built when its
+layout (robot and task) is first shown, or ahead (:meth:`NodeSets.prebuild`), and then kept,
+hidden when another layout is on screen: showing it again moves its nodes, which costs the
+client far less than mounting new ones. The unicycle's paths are drawn anew for each result.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any, cast
+
+import numpy as np
+
+from jik.app.dashboard import ALGORITHMS, COLORS
+from jik.app.dashboard.plotting import corner_names
+from jik.app.scene.mechanisms import (
+    HOME_COLOR,
+    MECHANISMS,
+    OPACITY,
+    Mechanism,
+    Platform,
+    Z,
+    extent_of,
+    fixtures_of,
+    layout_name,
+    polyline,
+    rgb,
+    trace_tolerance,
+)
+from jik.app.scene.pose import Timeline
+
+#: The frame of the unicycle's nodes, drawn anew for each result.
+UNICYCLE_ROOT = "/robot/unicycle"
+
+
+class NodeSets:
+    """The node sets under ``/robot`` of a viser ``scene`` (see the module's text)."""
+
+    def __init__(self, scene: Any) -> None:
+        self.scene = scene
+        scene.add_frame("/robot", show_axes=False)
+        #: The moving copies on screen, by algorithm, and the grey copy at x0.
+        self.mechanisms: dict[str, Mechanism] = {}
+        self.home: Mechanism | None = None
+        self.fixtures: dict[str, Any] = {}  # handles of the nodes of fixtures_of(), by name
+        self._layout: tuple | None = None  # (robot, task) of the set on screen
+        self._unicycle = False  # whether the unicycle's drawing is on screen
+        # (robot, task) -> {"frame", "mechanisms", "home", "fixtures", "root"}
+        self.sets: dict[tuple, dict[str, Any]] = {}
+
+    def show(self, result, timeline: Timeline, extent) -> None:
+        """Show ``result``: its layout's set with the result's values, or the unicycle's."""
+        state = result.state
+        layout = (layout_name(state), state.task)
+        if timeline.unicycle or layout != self._layout:
+            self._switch(None if timeline.unicycle else layout, result, timeline, extent)
+        else:
+            # Same robot and task: the nodes stay and take the new values (re-creating them
+            # costs the client a remount of every node).
+            self._update(self.sets[layout], result, extent)
+        if self.home is not None:
+            self.home.pose(np.asarray(state.x0))
+
+    def prebuild(self, result) -> None:
+        """Build the hidden set of a result solved ahead (another manipulator's defaults):
+        switching to it then only moves nodes."""
+        state = result.state
+        if state.robot not in MECHANISMS or (layout_name(state), state.task) in self.sets:
+            return
+        entry = self._build(result, extent_of(result), visible=False)
+        for a, m in entry["mechanisms"].items():
+            m.pose(result.runs[a].x[-1])
+        entry["home"].pose(np.asarray(state.x0))
+
+    def _switch(self, layout: tuple | None, result, timeline: Timeline, extent) -> None:
+        """Show the set of ``layout``, or the unicycle's when None, and hide the others."""
+        if self._unicycle:
+            self.scene.remove_by_name(UNICYCLE_ROOT)
+        self._layout, self._unicycle = layout, layout is None
+        for key, entry in self.sets.items():
+            if key != layout:
+                entry["frame"].visible = False
+        if layout is None:
+            self.scene.add_frame(UNICYCLE_ROOT, show_axes=False)
+            self.mechanisms, self.fixtures, self.home = {}, {}, None
+            self._draw_unicycle(result, timeline, extent)
+            return
+        if layout not in self.sets:
+            entry = self._build(result, extent, visible=True)
+        else:
+            entry = self.sets[layout]
+            entry["frame"].visible = True
+            self._update(entry, result, extent)
+        self.fixtures, self.mechanisms, self.home = (
+            entry["fixtures"], entry["mechanisms"], entry["home"]
+        )  # fmt: skip
+
+    def _build(self, result, extent, visible: bool) -> dict[str, Any]:
+        """The nodes of ``result``'s manipulator and task under their own frame."""
+        scene = self.scene
+        state = result.state
+        root = f"/robot/{layout_name(state)}-{state.task}"
+        entry: dict[str, Any] = {
+            "root": root, "frame": scene.add_frame(root, show_axes=False, visible=visible),
+            "mechanisms": {}, "home": None, "fixtures": {},
+        }  # fmt: skip
+        cls = MECHANISMS.get(state.robot)
+        if cls is not None:
+            entry["home"] = cls(scene, f"{root}/home", HOME_COLOR, 0.25, -0.03, state, extent)
+            entry["mechanisms"] = {
+                a: cls(scene, f"{root}/{a}", rgb(COLORS[a]), OPACITY[a], Z[a], state, extent)
+                for a in ALGORITHMS
+            }
+        self._place_fixtures(result, extent, root, entry["fixtures"])
+        self.sets[(layout_name(state), state.task)] = entry
+        return entry
+
+    def _update(self, entry: dict[str, Any], result, extent) -> None:
+        for m in (*entry["mechanisms"].values(), entry["home"]):
+            if m is not None:
+                m.resize(result.state, extent)
+        self._place_fixtures(result, extent, entry["root"], entry["fixtures"])
+
+    def _place_fixtures(self, result, extent, root: str, fixtures: dict[str, Any]) -> None:
+        """Give the fixtures under ``root`` (their handles in ``fixtures``) the values of
+        ``result``: existing nodes are moved, missing ones (all, in a new set; a target the
+        path gained) are added, ones it lost are removed."""
+        scene = self.scene
+        add: dict[str, Callable[..., Any]] = {
+            "box": scene.add_box, "line": scene.add_line_segments, "ball": scene.add_icosphere
+        }  # fmt: skip
+        wanted = fixtures_of(result, extent, root)
+        for name in [n for n in fixtures if n not in wanted]:
+            fixtures.pop(name).remove()
+        for name, (kind, values, style) in wanted.items():
+            if name not in fixtures:
+                fixtures[name] = add[kind](name, **style, **values)
+                if name.startswith(f"{root}/targets/"):
+                    k = int(name.rsplit("/", 1)[1])
+                    scene.add_label(
+                        f"{name}/label",
+                        corner_names(result)[k],
+                        position=(0.05, 0.05, 0.05),
+                    )
+                continue
+            for key, value in values.items():
+                setattr(fixtures[name], key, value)
+
+    def _draw_unicycle(self, result, timeline: Timeline, extent) -> None:
+        scene = self.scene
+        state = result.state
+        tol = trace_tolerance(extent)
+        target = Platform(scene, f"{UNICYCLE_ROOT}/target", (0, 0, 0), 0.3, 0.0, state, None)
+        target.pose(state.target)
+        q0 = state.robot_parameters["q0"]
+        home = Platform(scene, f"{UNICYCLE_ROOT}/home", HOME_COLOR, 0.3, 0.0, state, None)
+        home.pose(q0)
+        for a in ALGORITHMS:
+            run = result.runs[a]
+            base = np.asarray(rgb(COLORS[a]), dtype=float)
+            for n, i in enumerate(timeline.shown):
+                i = min(int(i), len(run.platform) - 1)
+                P = run.platform[i]
+                last = n == len(timeline.shown) - 1
+                mix = 1.0 if last else 0.3 + 0.5 * n / len(timeline.shown)
+                color = cast(
+                    "tuple[int, int, int]", tuple(int(v) for v in (255 - mix * (255 - base)))
+                )
+                pts = np.column_stack([P[:, 0], P[:, 1], np.full(len(P), 0.02 + Z[a] * 0.2)])
+                scene.add_line_segments(
+                    f"{UNICYCLE_ROOT}/trace/{a}/{n}", polyline(pts, tol), color,
+                    thickness=3.5 if last else 1.5, thickness_units="screen",
+                )  # fmt: skip
+            self.mechanisms[a] = Platform(
+                scene, f"{UNICYCLE_ROOT}/{a}", rgb(COLORS[a]), OPACITY[a], Z[a] * 0.5, state,
+                None,
+            )  # fmt: skip

@@ -1,0 +1,137 @@
+"""The scene's playback: its GUI folder (play, speed, position, the step on show, the status)
+and the thread that animates the mechanisms along the result's :class:`Timeline`."""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Mapping
+
+import viser
+
+from jik.app.scene.mechanisms import Mechanism
+from jik.app.scene.pose import Timeline
+
+#: Frames per second of the animation (poses sent to the clients).
+FPS = 25.0
+#: Seconds of animation per leg (manipulators) or per shown iteration (unicycle) at speed 1.
+SECONDS_PER_LEG = 1.6
+
+
+class Playback:
+    """The "Playback" folder of a viser ``gui`` and the animation of the mechanisms shown.
+
+    Parameters
+    ----------
+    gui : viser GUI API
+    lock : threading.RLock
+        The scene's lock: the timeline and the mechanisms change under it.
+    status : dict
+        The dashboard's ``scene_status``, whose ``playing`` this keeps.
+    """
+
+    def __init__(self, gui: viser.GuiApi, lock: threading.RLock, status: dict) -> None:
+        self._lock, self._scene_status = lock, status
+        self._local = threading.local()  # see _syncing
+        with gui.add_folder("Playback", order=1):
+            self.play = gui.add_button("Pause", icon=None)
+            self.speed = gui.add_slider("speed", min=0.1, max=5.0, step=0.1, initial_value=1.0)
+            self.scrub = gui.add_slider("position", min=0.0, max=1.0, step=0.001, initial_value=0.0)
+            self.counter = gui.add_markdown("")  # (the iteration or leg on show)
+            self.status = gui.add_markdown("computing…")
+            self.progress = gui.add_progress_bar(0.0, visible=False, animated=True)
+        self.playing = True
+        self.timeline: Timeline | None = None
+        self._mechanisms: Mapping[str, Mechanism] = {}
+        self._s = 0.0
+        self._posed: tuple[Timeline | None, float] = (None, 0.0)  # what the mechanisms show
+        self._stopped = False
+        self.play.on_click(self._toggle)
+        self.scrub.on_update(self._scrubbed)
+        self._thread = threading.Thread(target=self._animate, name="jik-scene", daemon=True)
+        self._thread.start()
+
+    @property
+    def _syncing(self) -> bool:
+        """Whether this thread is moving the position slider (its callback is then not a user's
+        scrub). Per thread: a user's scrub, which viser's thread delivers, is never dropped."""
+        return getattr(self._local, "syncing", False)
+
+    @_syncing.setter
+    def _syncing(self, value: bool) -> None:
+        self._local.syncing = value
+
+    @property
+    def position(self) -> float:
+        """Where the playback is along the timeline (0 to its length)."""
+        return self._s
+
+    def stop(self) -> None:
+        self._stopped = True
+        self._thread.join(timeout=2.0)
+
+    def show(self, timeline: Timeline, mechanisms: Mapping[str, Mechanism]) -> None:
+        """Play ``timeline`` on ``mechanisms`` (call under the scene's lock): from the start
+        when playing; paused, at the end, where the drift of J^P# shows."""
+        self.timeline, self._mechanisms = timeline, mechanisms
+        self._s = 0.0 if self.playing else timeline.length
+        self._pose(self._s)
+        self._show_position(timeline)
+
+    def _toggle(self, _) -> None:
+        self.playing = not self.playing
+        self.play.label = "Pause" if self.playing else "Play"
+        self._scene_status["playing"] = self.playing
+
+    def _scrubbed(self, _) -> None:
+        if self._syncing or self.timeline is None:
+            return
+        self.playing = False
+        self.play.label = "Play"
+        self._scene_status["playing"] = False
+        self._s = float(self.scrub.value) * self.timeline.length
+
+    def _pose(self, s: float) -> None:
+        if self.timeline is None:
+            return
+        self._posed = (self.timeline, s)
+        configs = self.timeline.at(s)
+        for a, m in self._mechanisms.items():
+            m.pose(configs[a])
+
+    def _show_position(self, timeline: Timeline) -> None:
+        """The position slider at the playback position (not a change of it by the user)."""
+        self._syncing = True
+        try:
+            self.scrub.value = round(min(self._s / timeline.length, 1.0), 3)  # type: ignore[misc]  # viser: settable
+            counter = timeline.counter(self._s)
+            if self.counter.content != counter:
+                self.counter.content = counter
+        finally:
+            self._syncing = False
+
+    def _animate(self) -> None:
+        last, last_gui = time.monotonic(), 0.0
+        while not self._stopped:
+            time.sleep(1.0 / FPS)
+            now = time.monotonic()
+            dt, last = now - last, now
+            with self._lock:
+                # (Read under the lock: a timeline read before a drawing swapped it would differ
+                # from the one just posed, and pose the new one again.)
+                timeline = self.timeline
+                if timeline is None:
+                    continue
+                moving = self.playing
+                if moving:
+                    self._s += dt * float(self.speed.value) / SECONDS_PER_LEG
+                    if self._s > timeline.length + 0.5:  # hold the end a moment, then loop
+                        self._s = 0.0
+                # Paused: nothing to send until scrubbed (or drawn, which poses too).
+                if self._posed != (timeline, self._s):
+                    self._pose(self._s)
+            if not moving:
+                continue
+            if now - last_gui > 0.25:
+                last_gui = now
+                self._show_position(timeline)

@@ -1,0 +1,82 @@
+"""How a long engine computation reports its progress and hears that it is no longer wanted.
+
+One small object, a :class:`Progress`, goes into every long computation of the engine
+(:func:`jik.engine.repeatability.repeatability`, :func:`jik.engine.atlas_run.run_atlas`,
+:meth:`jik.engine.characteristics.CharacteristicsMap.evaluate_batches`): the engine calls its
+methods between two pieces of work, and a caller implements only what it shows.
+
+>>> class Printer(Progress):
+...     def leg(self, leg):
+...         print(f"cycle {leg.cycle + 1}, leg {leg.index + 1}")
+>>> # repeatability(inverse, x0, path, cycles=3, progress=Printer())
+
+:class:`ProgressCallbacks` makes one from plain functions.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Protocol
+
+from jik.engine.exceptions import RunCancelled
+
+if TYPE_CHECKING:
+    from jik.engine.repeatability import Leg
+
+
+class Progress(Protocol):
+    """What the engine tells a caller during a long computation, and asks it.
+
+    Subclass it and override what you need (each method does nothing by default), or give any
+    object with these three methods. What a method raises propagates and stops the computation.
+    """
+
+    def leg(self, leg: Leg) -> None:
+        """A leg of a repeatability run ended (:class:`jik.engine.repeatability.Leg`)."""
+
+    def advance(self, done: float, total: float) -> None:
+        """``done`` of ``total`` units of the current piece of work are done: the atlas's runs,
+        the batches of a characteristics map, or a discrete leg's way to its tolerance (a
+        fraction of 1, on a log scale of the task error, eq. (5))."""
+
+    def cancelled(self) -> bool:
+        """Polled between two pieces of work: True stops the computation there with
+        :class:`jik.engine.exceptions.RunCancelled`."""
+        return False
+
+
+@dataclass(frozen=True)
+class ProgressCallbacks(Progress):
+    """A :class:`Progress` made of plain functions, each optional.
+
+    Parameters
+    ----------
+    on_leg : callable, optional
+        ``on_leg(leg)``, called as :meth:`Progress.leg`.
+    on_advance : callable, optional
+        ``on_advance(done, total)``, called as :meth:`Progress.advance`.
+    is_cancelled : callable, optional
+        ``is_cancelled() -> bool``, polled as :meth:`Progress.cancelled`.
+    """
+
+    on_leg: Callable[[Leg], None] | None = None
+    on_advance: Callable[[float, float], None] | None = None
+    is_cancelled: Callable[[], bool] | None = None
+
+    def leg(self, leg: Leg) -> None:
+        if self.on_leg is not None:
+            self.on_leg(leg)
+
+    def advance(self, done: float, total: float) -> None:
+        if self.on_advance is not None:
+            self.on_advance(done, total)
+
+    def cancelled(self) -> bool:
+        return self.is_cancelled is not None and bool(self.is_cancelled())
+
+
+def check_cancelled(progress: Progress | None, what: str) -> None:
+    """Raise :class:`RunCancelled` ("<what>") when ``progress`` says the work is not wanted."""
+    if progress is not None and progress.cancelled():
+        raise RunCancelled(what)
