@@ -31,13 +31,14 @@ import numpy as np
 from jik.app.compute.atlas_schemas import AtlasJobResponse, AtlasRequest
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.requests import build_augmentation, build_robot, nullable
+from jik.app.compute.schemas.algorithms import field_of, used
 from jik.app.compute.worker import task
 from jik.engine.atlas import AtlasPlan, plan_atlas
 from jik.engine.atlas_backends import IN_FLIGHT
 from jik.engine.atlas_run import AtlasResult, run_atlas
 from jik.engine.exceptions import InvalidInputError, RunCancelled
 from jik.engine.progress import ProgressCallbacks
-from jik.engine.registry import make_inverse
+from jik.engine.registry import ALGORITHMS, make_inverse
 from jik.engine.repeatability import CLOSE_TOL
 from jik.engine.self_motion import MAX_ARC
 from jik.engine.solver import gamma_problem
@@ -68,17 +69,29 @@ class AtlasLimits:
     keep_for: float = 600.0
 
 
+def _inverse(kin, spec, algorithm: str, req: AtlasRequest):
+    """The algorithm's inverse with those of ``req.algorithm_parameters`` that are its own."""
+    own = {p.name for p in ALGORITHMS[algorithm].parameters} | set(ALGORITHMS[algorithm].vectors)
+    given = {k: v for k, v in used(req.algorithm_parameters).items() if k in own}
+    try:
+        return make_inverse(kin, algorithm, spec=spec, algorithm_parameters=given)
+    except InvalidInputError as exc:
+        raise RequestError(field_of(exc.field, str(exc)), str(exc)) from None
+
+
 def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
     """The request's atlas, planned (curves traced); RequestError or InvalidInputError, each
     naming the field, when it cannot be."""
     spec, kin, _ = build_robot(req.robot)
+    if len(set(req.algorithms)) != len(req.algorithms):
+        raise RequestError("algorithms", f"name each algorithm once, got {req.algorithms}")
     inverses = []
     for algorithm in req.algorithms:
         if algorithm == "extended":
             aspec, _, used = build_augmentation(spec, kin, req.augmentation)
             inverses.append(make_inverse(kin, "extended", aspec.name, used.parameters, spec.name))
         else:
-            inverses.append(make_inverse(kin, "pseudoinverse"))
+            inverses.append(_inverse(kin, spec, algorithm, req))
     vectors = [(f"path[{i}]", v, spec.r) for i, v in enumerate(req.path)]
     vectors += [(f"shifts[{i}]", v, spec.r) for i, v in enumerate(req.shifts or [])]
     vectors += [("reference", req.reference, spec.p)] if req.reference else []
