@@ -33,7 +33,11 @@ Inverses (right inverses of the Jacobian)
     Pseudoinverse               J# = J^T (J J^T)^-1, eq. (8): fast, not repeatable
     ExtendedInverse             the extended Jacobian inverse, eq. (11): repeatable
     VectorExtendedInverse       the same for p - r > 1, with p - r maps
+    DampedInverse               damped least squares J^T (J J^T + lambda^2 I)^-1 (Wampler 1986)
+    WeightedInverse             weighted least-norm inverse for joint limits (Chan, Dubey 1995)
+    PostureInverse              pseudoinverse plus a null-space pull to a rest posture (Liegeois)
     Inverse, make_inverse       the base class; an inverse by name from the catalogue
+    ALGORITHMS                  the catalogue of the five algorithms and their parameters
 Solving (the continuation algorithm, eq. (7))
     solve                       one start to one target -> SolveResult
     solve_batch                 many starts or targets at once -> BatchSolveResult
@@ -95,6 +99,10 @@ _EXPORTS = {
     "ExtendedInverse": "inverses",
     "VectorExtendedInverse": "extended_vector",
     "make_inverse": "registry",
+    "ALGORITHMS": "registry",
+    "DampedInverse": "practical_inverses",
+    "WeightedInverse": "practical_inverses",
+    "PostureInverse": "practical_inverses",
     # solving
     "solve": "solver",
     "solve_batch": "solver",
@@ -132,6 +140,7 @@ _EXPORTS = {
 }
 
 __all__ = [
+    "ALGORITHMS",
     "ARMS",
     "ROBOTS",
     "AlgorithmicSingularityError",
@@ -140,6 +149,7 @@ __all__ = [
     "AugmentingMap",
     "BatchSolveResult",
     "CharacteristicsMap",
+    "DampedInverse",
     "E1Optimal",
     "E2Optimal",
     "ExtendedInverse",
@@ -157,6 +167,7 @@ __all__ = [
     "OneFormUndefinedError",
     "PaperCubic",
     "PlanarChain",
+    "PostureInverse",
     "Progress",
     "ProgressCallbacks",
     "Pseudoinverse",
@@ -173,6 +184,7 @@ __all__ = [
     "UnicycleCharacteristics",
     "UrdfChain",
     "VectorExtendedInverse",
+    "WeightedInverse",
     "error_functional_e1",
     "error_functional_e2",
     "iter_atlas",
@@ -243,8 +255,9 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
     from jik.engine.kinematics import Kinematics, Manipulator1, Manipulator2
     from jik.engine.limits import LimitsReport
     from jik.engine.planar_chain import PlanarChain
+    from jik.engine.practical_inverses import DampedInverse, PostureInverse, WeightedInverse
     from jik.engine.progress import Progress, ProgressCallbacks
-    from jik.engine.registry import ROBOTS, make_inverse
+    from jik.engine.registry import ALGORITHMS, ROBOTS, make_inverse
     from jik.engine.repeatability import Leg, Resume, repeatability
     from jik.engine.results import BatchSolveResult, RepeatabilityResult, SolveResult, Trajectory
     from jik.engine.robot_spec import Robot, load_robot, robot_from_dict

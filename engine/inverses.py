@@ -105,6 +105,9 @@ class Inverse(abc.ABC):
 
     name: str
     kinematics: Kinematics
+    #: J J# = I_r, so along (7) the task error is e0 exp(-gamma theta), eq. (5), and the
+    #: solver may integrate the homotopy form (:mod:`jik.engine.picard`); False: (7) itself.
+    right_inverse: bool = True
 
     @abc.abstractmethod
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:

@@ -12,57 +12,18 @@ from dataclasses import dataclass, field, replace
 from typing import Literal
 
 from jik.engine import augmentations as aug
+from jik.engine.algorithm_registry import ALGORITHMS as ALGORITHMS
+from jik.engine.algorithm_registry import AlgorithmSpec as AlgorithmSpec
+from jik.engine.algorithm_registry import make_inverse as make_inverse
 from jik.engine.augmentations import AugmentingMap
 from jik.engine.characteristics import UnicycleCharacteristics
 from jik.engine.exceptions import InvalidInputError
-from jik.engine.inverses import ExtendedInverse, Inverse, Pseudoinverse
 from jik.engine.kinematics import Kinematics, Manipulator1, Manipulator2
+from jik.engine.parameters import Parameter as Parameter
+from jik.engine.parameters import check_params as _check_params
 from jik.engine.unicycle import Unicycle
 from jik.engine.validation import finite
 from jik.engine.variational import MANIPULATOR2_REGION, default_manipulator2_synthesis
-
-
-@dataclass(frozen=True)
-class Parameter:
-    """A scalar parameter with its default and closed range [minimum, maximum]."""
-
-    name: str
-    default: float
-    minimum: float
-    maximum: float
-    description: str
-    nonzero: bool = False
-
-    def check(self, value) -> float:
-        """Validate ``value``; the message names the parameter and its range."""
-        v = finite(value, self.name)
-        if not self.minimum <= v <= self.maximum:
-            raise InvalidInputError(
-                f"{self.name} must be in [{self.minimum:g}, {self.maximum:g}], got {v:g}"
-            )
-        if self.nonzero and v == 0:
-            raise InvalidInputError(f"{self.name} must be nonzero ({self.description})")
-        return v
-
-    def as_dict(self) -> dict:
-        return {
-            "name": self.name,
-            "default": self.default,
-            "minimum": self.minimum,
-            "maximum": self.maximum,
-            "description": self.description,
-            "nonzero": self.nonzero,
-        }
-
-
-def _check_params(specs: tuple[Parameter, ...], values: Mapping[str, object], what: str) -> dict:
-    known = {p.name for p in specs}
-    unknown = set(values) - known
-    if unknown:
-        raise InvalidInputError(
-            f"unknown parameter(s) {sorted(unknown)} for {what}; known: {sorted(known) or 'none'}"
-        )
-    return {p.name: p.check(values.get(p.name, p.default)) for p in specs}
 
 
 @dataclass(frozen=True)
@@ -357,27 +318,3 @@ def robot_spec(name: str) -> RobotSpec:
         return ROBOTS[name]
     except KeyError:
         raise InvalidInputError(f"unknown robot {name!r}; choose one of {sorted(ROBOTS)}") from None
-
-
-def make_inverse(
-    kinematics: Kinematics,
-    algorithm: str,
-    augmentation: str | None = None,
-    augmentation_parameters: Mapping[str, object] | None = None,
-    robot: str | None = None,
-    *,
-    spec: RobotSpec | None = None,
-) -> Inverse:
-    """The pseudoinverse (8) or the extended inverse (11) with a named augmenting map.
-
-    The map is looked up in ``spec`` (a robot defined by data, :mod:`jik.engine.robot_spec`),
-    else in the spec of ``robot`` (default: the kinematics' name) in :data:`ROBOTS`.
-    """
-    if algorithm == "pseudoinverse":
-        return Pseudoinverse(kinematics)
-    if algorithm == "extended":
-        aspec = (spec or robot_spec(robot or kinematics.name)).augmentation(augmentation)
-        return ExtendedInverse(
-            kinematics, aspec.build(kinematics, **(augmentation_parameters or {}))
-        )
-    raise InvalidInputError(f"algorithm must be 'pseudoinverse' or 'extended', got {algorithm!r}")

@@ -125,14 +125,15 @@ def cycle_guesses(
 
     The extended inverse is repeatable: a leg repeats the same leg of the cycle before, so
     ``guides`` (those legs' trajectories, None in the first cycle) are its guesses, and a leg
-    then takes one or two sweeps. The pseudoinverse drifts, so the cycle before saves almost
-    nothing: its legs are swept together from ``start`` (:func:`jik.engine.solver.chain_guesses`),
-    one or two sweeps a leg instead of about ten, and a cycle's numbers depend only on its
-    start. A chain evaluates J# about three times as often as the legs would, so it pays only
-    where an evaluation costs little beyond numpy's per-call overhead: not for the unicycle.
+    then takes one or two sweeps. The pseudoinverse (and the other right inverses, weighted and
+    posture) drifts, so the cycle before saves almost nothing: its legs are swept together from
+    ``start`` (:func:`jik.engine.solver.chain_guesses`), one or two sweeps a leg instead of
+    about ten, and a cycle's numbers depend only on its start. A chain evaluates J# about three
+    times as often as the legs would, so it pays only where an evaluation costs little beyond
+    numpy's per-call overhead: not for the unicycle.
     """
     if (
-        inverse.name == "pseudoinverse" and len(targets) > 1
+        inverse.name != "extended" and inverse.right_inverse and len(targets) > 1
         and not isinstance(inverse.kinematics, Unicycle)
     ):  # fmt: skip
         chained = chain_guesses(inverse, start, targets, gamma=gamma)

@@ -91,6 +91,7 @@ class Robot:
         algorithm: str = "pseudoinverse",
         augmentation: str | None = None,
         parameters: Mapping[str, object] | None = None,
+        algorithm_parameters: Mapping[str, object] | None = None,
     ) -> Inverse:
         """The pseudoinverse (8), or the extended inverse (11) with one of its augmenting maps
         (a :class:`~jik.engine.extended_vector.VectorExtendedInverse` for p - r > 1)."""
@@ -104,7 +105,10 @@ class Robot:
             name = augmentation or self.spec.default_augmentation
             if name in self.map_vectors:
                 return VectorExtendedInverse(self.kinematics, self.map_vectors[name])
-        return make_inverse(self.kinematics, algorithm, augmentation, parameters, spec=self.spec)
+        return make_inverse(
+            self.kinematics, algorithm, augmentation, parameters, spec=self.spec,
+            algorithm_parameters=algorithm_parameters,
+        )  # fmt: skip
 
 
 def _get(d: Mapping, key: str, kind: type, what: str, default: Any = None) -> Any:

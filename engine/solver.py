@@ -305,6 +305,8 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto", guess=N
     with DOP853 on (7) itself from their last point, at tau = -ln(1 - sigma) (or ln(e0 / e)).
     """
     n = len(x0)
+    if not inverse.right_inverse:
+        method = "dop853"  # the homotopy form needs e = e0 exp(-tau), which J J# != I breaks
     e0 = inverse.kinematics.forward(x0) - y_d
     err0 = np.linalg.norm(e0, axis=-1)
     moving = np.flatnonzero(err0 >= tol)
@@ -444,7 +446,8 @@ def solve(
     Parameters
     ----------
     inverse : Inverse
-        The pseudoinverse (8) or the extended Jacobian inverse (11).
+        The pseudoinverse (8), the extended Jacobian inverse (11), or one of
+        :mod:`jik.engine.practical_inverses` (damped, weighted, posture).
     x0 : array_like, shape (p,)
         Start configuration (a batch: :func:`solve_batch`).
     y_d : array_like, shape (r,)
@@ -464,7 +467,9 @@ def solve(
     method : {"auto", "picard", "dop853"}
         Continuous mode only: Chebyshev-Picard with a sweep budget and DOP853 after it
         ("auto"), Picard alone (DOP853 only where it fails), or DOP853 alone. "dop853" suits
-        maps that are expensive per point (the unicycle's characteristics map).
+        maps that are expensive per point (the unicycle's characteristics map). An inverse that
+        is not a right inverse (``inverse.right_inverse`` False: damped least squares) always
+        takes DOP853, since Picard's homotopy form needs J J# = I.
     guess : Trajectory, optional
         Continuous mode: the trajectory of a nearby earlier solve with the same gamma, such as
         the same leg in the previous cycle of a closed path. Picard starts its sweeps from it

@@ -28,6 +28,11 @@ from pathlib import Path
 from typing import Any
 
 from jik import install_hint
+from jik.algorithm_options import (
+    ALGORITHM_NAMES,
+    add_algorithm_parameter_options,
+    algorithm_parameters,
+)
 
 #: Atlases of more runs than this write their arrays to the CSV only (the JSON keeps a summary).
 JSON_RUNS = 20000
@@ -55,8 +60,10 @@ def add_atlas_parser(sub) -> None:
     )
     p.add_argument("--reference", help='"x1,x2,...": where s = 0 comes from (robot default)')
     p.add_argument("--cycles", type=int, default=3)
-    p.add_argument("--algorithm", action="append", choices=("pseudoinverse", "extended"),
-                   help="repeat for several (default pseudoinverse)")  # fmt: skip
+    p.add_argument("--algorithm", action="append", choices=ALGORITHM_NAMES,
+                   help="repeat for several, compared over the same starts "
+                   "(default pseudoinverse)")  # fmt: skip
+    add_algorithm_parameter_options(p)
     p.add_argument("--augmentation", help="augmenting map of the extended inverse")
     p.add_argument("--shift", action="append", default=[], metavar='"dy1,dy2"',
                    help="a translation of the path (repeat it; default none)")  # fmt: skip
@@ -153,11 +160,15 @@ def _run(args: argparse.Namespace) -> int:
                                     "parameters", "param")  # fmt: skip
         robot = load_robot(args.robot)
         spec, kin = robot.spec, robot.kinematics
-        inverses = [robot.inverse(a, args.augmentation) for a in algorithms]
+        inverses = [robot.inverse(a, args.augmentation,
+                                  algorithm_parameters=algorithm_parameters(args, a))
+                    for a in algorithms]  # fmt: skip
     else:
         spec = robot_spec(args.robot)
         kin = spec.build(**dict(_param(t) for t in args.param))
-        inverses = [make_inverse(kin, a, args.augmentation, None, spec.name) for a in algorithms]
+        inverses = [make_inverse(kin, a, args.augmentation, None, spec.name,
+                                 algorithm_parameters=algorithm_parameters(args, a))
+                    for a in algorithms]  # fmt: skip
     arc = _numbers(args.arc, "--arc") if args.arc else [-MAX_ARC, MAX_ARC]
     reference = _numbers(args.reference, "--reference") if args.reference else spec.default_x0
     backend = backend_option(args)
@@ -188,6 +199,7 @@ def _run(args: argparse.Namespace) -> int:
         "robot": spec.name, "robot_file": args.robot if Path(args.robot).is_file() else None,
         "robot_parameters": kin.parameters, "path": _points(args.path, "path"),
         "cycles": C, "algorithms": list(plan.algorithms), "augmentation": args.augmentation,
+        "algorithm_parameters": {a: algorithm_parameters(args, a) for a in plan.algorithms},
         "starts": N, "sampling": args.sampling, "seed": args.seed, "arc": arc if args.arc else None,
         "reference": list(reference), "shifts": [_numbers(t, "--shift") for t in args.shift],
         "scales": args.scale or [1.0],

@@ -13,6 +13,12 @@ import json
 import sys
 from typing import TYPE_CHECKING
 
+from jik.algorithm_options import (
+    ALGORITHM_NAMES,
+    add_algorithm_parameter_options,
+    algorithm_parameters,
+)
+
 if TYPE_CHECKING:
     from jik.engine.robot_spec import Robot
 
@@ -50,8 +56,9 @@ def _common(p: argparse.ArgumentParser) -> None:
                    "arm's (panda, iiwa14, gen3, ur5e: its default task; for another, a file "
                    "such as {\"name\": \"panda\", \"task\": \"xyz\"})")  # fmt: skip
     p.add_argument("--x0", help="start configuration, e.g. '0, 0, pi/2' (default: the robot's)")
-    p.add_argument("--algorithm", choices=("pseudoinverse", "extended"), default="pseudoinverse")
+    p.add_argument("--algorithm", choices=ALGORITHM_NAMES, default="pseudoinverse")
     p.add_argument("--augmentation", help="augmenting map of the extended inverse (its name)")
+    add_algorithm_parameter_options(p)
     p.add_argument(
         "--mode",
         choices=("continuous", "discrete"),
@@ -88,6 +95,12 @@ def _notes(robot: Robot) -> dict:
     return {"notes": notes} if notes else {}
 
 
+def _parameters(args: argparse.Namespace, robot: Robot, x0) -> dict:
+    """The algorithm's options; the posture's rest: the robot's home, else the run's x0."""
+    home = getattr(robot.kinematics, "home", None)
+    return algorithm_parameters(args, args.algorithm, x0 if home is None else None)
+
+
 def _fmt(v) -> str:
     return "(" + ", ".join(f"{float(t):.10g}" for t in v) + ")"
 
@@ -98,7 +111,10 @@ def solve_command(args: argparse.Namespace) -> int:
 
     robot, x0, settings = _setup(args)
     target = parse_vector(args.target, "--target") if args.target else robot.spec.default_target
-    inverse = robot.inverse(args.algorithm, args.augmentation)
+    inverse = robot.inverse(
+        args.algorithm, args.augmentation,
+        algorithm_parameters=_parameters(args, robot, x0),
+    )  # fmt: skip
     res = solve(inverse, x0, target, record=True, **settings)
     report = _limits(robot, lambda limits, names: solve_report(limits, res, names))
     out = {
@@ -127,7 +143,10 @@ def repeatability_command(args: argparse.Namespace) -> int:
 
     robot, x0, settings = _setup(args)
     path = parse_path(args.path, "--path") if args.path else robot.spec.default_path
-    inverse = robot.inverse(args.algorithm, args.augmentation)
+    inverse = robot.inverse(
+        args.algorithm, args.augmentation,
+        algorithm_parameters=_parameters(args, robot, x0),
+    )  # fmt: skip
     record = robot_limits(robot.kinematics) is not None  # (limits: check whole legs)
     rep = repeatability(inverse, x0, path, cycles=args.cycles, record=record, **settings)
     report = _limits(robot, lambda limits, names: repeatability_report(limits, rep, names))

@@ -24,6 +24,10 @@ from pathlib import Path
 import httpx
 import pytest
 
+#: Builds and installs into fresh environments (a minute or more): out of the default run,
+#: in CI's slow step.
+pytestmark = pytest.mark.slow
+
 ROOT = Path(__file__).resolve().parents[1]
 #: Packages of the ``app`` extra that the engine alone must not need.
 WEB_MODULES = ("fastapi", "fastapi_offline", "starlette", "uvicorn", "viser", "plotly", "httpx")

@@ -21,23 +21,22 @@ import re
 import secrets
 import threading
 import time
-from collections.abc import Callable, Iterable, Iterator
-from concurrent.futures import FIRST_COMPLETED, Future, wait
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
 
+from jik.app.compute.atlas_pool import PoolBackend, sized_chunks
 from jik.app.compute.atlas_schemas import AtlasJobResponse, AtlasRequest
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.requests import build_augmentation, build_robot, nullable
+from jik.app.compute.schemas.algorithms import field_of, used
 from jik.app.compute.worker import task
 from jik.engine.atlas import AtlasPlan, plan_atlas
-from jik.engine.atlas_backends import IN_FLIGHT
 from jik.engine.atlas_run import AtlasResult, run_atlas
 from jik.engine.exceptions import InvalidInputError, RunCancelled
 from jik.engine.progress import ProgressCallbacks
-from jik.engine.registry import make_inverse
+from jik.engine.registry import ALGORITHMS, make_inverse
 from jik.engine.repeatability import CLOSE_TOL
 from jik.engine.self_motion import MAX_ARC
 from jik.engine.solver import gamma_problem
@@ -68,17 +67,29 @@ class AtlasLimits:
     keep_for: float = 600.0
 
 
+def _inverse(kin, spec, algorithm: str, req: AtlasRequest):
+    """The algorithm's inverse with those of ``req.algorithm_parameters`` that are its own."""
+    own = {p.name for p in ALGORITHMS[algorithm].parameters} | set(ALGORITHMS[algorithm].vectors)
+    given = {k: v for k, v in used(req.algorithm_parameters).items() if k in own}
+    try:
+        return make_inverse(kin, algorithm, spec=spec, algorithm_parameters=given)
+    except InvalidInputError as exc:
+        raise RequestError(field_of(exc.field, str(exc)), str(exc)) from None
+
+
 def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
     """The request's atlas, planned (curves traced); RequestError or InvalidInputError, each
     naming the field, when it cannot be."""
     spec, kin, _ = build_robot(req.robot)
+    if len(set(req.algorithms)) != len(req.algorithms):
+        raise RequestError("algorithms", f"name each algorithm once, got {req.algorithms}")
     inverses = []
     for algorithm in req.algorithms:
         if algorithm == "extended":
             aspec, _, used = build_augmentation(spec, kin, req.augmentation)
             inverses.append(make_inverse(kin, "extended", aspec.name, used.parameters, spec.name))
         else:
-            inverses.append(make_inverse(kin, "pseudoinverse"))
+            inverses.append(_inverse(kin, spec, algorithm, req))
     vectors = [(f"path[{i}]", v, spec.r) for i, v in enumerate(req.path)]
     vectors += [(f"shifts[{i}]", v, spec.r) for i, v in enumerate(req.shifts or [])]
     vectors += [("reference", req.reference, spec.p)] if req.reference else []
@@ -117,50 +128,14 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
     "of memory)",
 )
 def plan_task(req: str, limits: AtlasLimits):
-    """:func:`plan_request` of a request (JSON) as a compute worker's task,
-    within the workers' time and memory limits (tracing the curves solves eq. (7)): the plan and
-    None, or None and the refusal (message, field), for the server to raise again."""
+    """:func:`plan_request` of a request (JSON) as a compute worker's task, within the workers'
+    time and memory limits (tracing the curves solves eq. (7)), its chunks sized for the pool
+    (:func:`sized_chunks`): the plan and None, or None and the refusal (message, field), for the
+    server to raise again."""
     try:
-        return plan_request(AtlasRequest.model_validate_json(req), limits), None
+        return sized_chunks(plan_request(AtlasRequest.model_validate_json(req), limits)), None
     except InvalidInputError as exc:
         return None, (str(exc), exc.field)
-
-
-@task("starts", "fewer starts or cycles")
-def atlas_chunk(fn: Callable[[Any], Any], chunk: Any) -> Any:
-    """``fn(chunk)``: one chunk of an atlas in a compute worker."""
-    return fn(chunk)
-
-
-class PoolBackend:
-    """An atlas backend (:class:`jik.engine.atlas_backends.Backend`) on the server's compute
-    pool (a :class:`~jik.app.compute.pool.ComputePool`): at most ``IN_FLIGHT`` chunks per worker
-    submitted at once, results in the order they finish; leaving gives up the chunks in flight."""
-
-    def __init__(self, pool: Any) -> None:
-        self.pool = pool
-        self.workers = pool.settings.workers
-
-    def __enter__(self) -> PoolBackend:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        return None
-
-    def imap_unordered(self, fn: Callable[[Any], Any], tasks: Iterable[Any]) -> Iterator[Any]:
-        pending: set[Future] = set()
-        try:
-            for chunk in tasks:
-                pending.add(self.pool.submit(atlas_chunk, fn, chunk))
-                if len(pending) >= IN_FLIGHT * self.workers:
-                    finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-                    yield from (f.result() for f in finished)
-            while pending:
-                finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-                yield from (f.result() for f in finished)
-        finally:
-            for f in pending:
-                f.cancel()
 
 
 def result_document(res: AtlasResult, arc, leg_ends: bool) -> dict[str, Any]:

@@ -25,6 +25,7 @@ from jik.app.compute.schemas import (
     Vector,
     per_robot,
 )
+from jik.app.compute.schemas.algorithms import AlgorithmParameters
 from jik.engine.repeatability import MAX_PATH_POINTS
 from jik.engine.solver import DISCRETE_GAMMA_BOUND
 
@@ -43,9 +44,15 @@ class AtlasRequest(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
     robot: Robot = Field(description="the robot and its parameters, e.g. {'name': 'manipulator2'}")
-    algorithms: Annotated[list[Algorithm], Field(min_length=1, max_length=2)] = Field(
-        ["pseudoinverse"], description="'pseudoinverse' (8) and/or 'extended' (11)"
+    algorithms: Annotated[list[Algorithm], Field(min_length=1, max_length=5)] = Field(
+        ["pseudoinverse"],
+        description="the algorithms to compare over the same starts, each once: 'pseudoinverse' "
+        "(8), 'extended' (11), 'damped', 'weighted', 'posture'",
     )
+    algorithm_parameters: AlgorithmParameters | None = Field(
+        None, description="parameters of the damped, weighted and posture algorithms (each "
+        "takes its own; default: the engine's)",
+    )  # fmt: skip
     augmentation: Augmentation | None = Field(
         None, description="augmenting map of the extended inverse (default: the robot's)"
     )

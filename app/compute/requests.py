@@ -23,12 +23,13 @@ import pydantic_core
 
 from jik.app.compute import schemas as S
 from jik.app.compute.exceptions import RequestError
+from jik.app.compute.schemas.algorithms import field_of, used
 from jik.app.compute.settings import settings_from_env
 from jik.app.compute.user_robots import is_user_robot, user_inverse, user_robot
 from jik.engine.arms import ARMS
 from jik.engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
 from jik.engine.limits import limit_names, repeatability_report, robot_limits, solve_report
-from jik.engine.registry import ROBOTS, RobotSpec, make_inverse
+from jik.engine.registry import ALGORITHMS, ROBOTS, RobotSpec, make_inverse
 from jik.engine.repeatability import (
     MAX_CYCLES,
     MAX_PATH_POINTS,
@@ -127,11 +128,17 @@ def build_augmentation(spec: RobotSpec, kin, req_aug):
 
 def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
     aug_used = None
+    if req.algorithm == "extended" and used(req.algorithm_parameters):
+        raise RequestError(
+            "algorithm_parameters",
+            "the extended inverse takes none (its augmenting map's parameters go in augmentation)",
+        )
     if is_user_robot(req.robot):
         extended = req.algorithm == "extended"
         robot, robot_used, aug_used = user_robot(req.robot, req.augmentation if extended else None)
         spec, kin = robot.spec, robot.kinematics
-        inverse = user_inverse(robot, req.algorithm)
+        params = used(req.algorithm_parameters, req.algorithm, robot.kinematics, req.x0)
+        inverse = user_inverse(robot, req.algorithm, params)
     else:
         spec, kin, robot_used = build_robot(req.robot)
         inverse, aug_used = _catalogue_inverse(spec, kin, req)
@@ -154,7 +161,11 @@ def _catalogue_inverse(spec: RobotSpec, kin, req) -> tuple[Any, S.AugmentationUs
         except InvalidInputError as exc:
             raise RequestError("augmentation", str(exc)) from None
     else:
-        inverse = make_inverse(kin, "pseudoinverse")
+        try:
+            params = used(req.algorithm_parameters, req.algorithm, kin, req.x0)
+            inverse = make_inverse(kin, req.algorithm, spec=spec, algorithm_parameters=params)
+        except InvalidInputError as exc:
+            raise RequestError(field_of(exc.field, str(exc)), str(exc)) from None
     return inverse, aug_used
 
 
@@ -303,7 +314,7 @@ def robots_response(timeout: float | None = None) -> S.RobotsResponse:
     robots = [
         S.RobotInfo(
             **spec.as_dict(),
-            algorithms=["pseudoinverse", "extended"],
+            algorithms=list(S.Algorithm.__args__),  # type: ignore[attr-defined]
             modes=["continuous", "discrete"],
         )
         for spec in (*ROBOTS.values(), *_arm_specs())
@@ -315,7 +326,8 @@ def robots_response(timeout: float | None = None) -> S.RobotsResponse:
         max_trajectory_points=S.MAX_TRAJECTORY_POINTS,
         request_timeout_s=float(timeout if timeout is not None else settings_from_env().timeout),
     )
-    return S.RobotsResponse(robots=robots, limits=limits)
+    algorithms = [S.AlgorithmInfo(**a.as_dict()) for a in ALGORITHMS.values()]
+    return S.RobotsResponse(robots=robots, limits=limits, algorithms=algorithms)
 
 
 def batch_key(req: S.SolveRequest) -> str:

@@ -23,6 +23,7 @@ from typing import Any
 from jik.app.compute import schemas as S
 from jik.app.compute.budget import build_seconds, time_budget
 from jik.app.compute.exceptions import RequestError
+from jik.app.compute.schemas.algorithms import field_of
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.robot_spec import Robot, robot_from_dict
 
@@ -107,8 +108,9 @@ def _text(exc: InvalidInputError) -> str:
     return text[len(head) :] if head and text.startswith(head) else text
 
 
-def user_inverse(robot: Robot, algorithm: str):
-    """The robot's inverse: the pseudoinverse (8), or the extended inverse (11) of its map."""
+def user_inverse(robot: Robot, algorithm: str, algorithm_parameters: dict | None = None):
+    """The robot's inverse: the extended inverse (11) of its map, or another algorithm with
+    its parameters (the pseudoinverse (8), damped, weighted, posture)."""
     if algorithm == "extended" and not robot.spec.augmentations:
         raise RequestError(
             "augmentation",
@@ -116,6 +118,10 @@ def user_inverse(robot: Robot, algorithm: str):
             "'formula', 'h': ...} or {'name': 'e2_synthesized', 'region': {...}} (p = r + 1)",
         )
     try:
-        return robot.inverse(algorithm, _LABEL if algorithm == "extended" else None)
+        if algorithm != "extended":
+            return robot.inverse(algorithm, algorithm_parameters=algorithm_parameters)
+        return robot.inverse(algorithm, _LABEL)
     except InvalidInputError as exc:
+        if algorithm != "extended":
+            raise RequestError(field_of(exc.field, str(exc)), _text(exc)) from None
         raise RequestError(request_field(exc.field, ()), _text(exc)) from None

@@ -14,9 +14,9 @@ from jik.app.compute.atlas_jobs import (
     AtlasJobNotFound,
     AtlasJobs,
     AtlasLimits,
-    PoolBackend,
     plan_request,
 )
+from jik.app.compute.atlas_pool import PoolBackend
 from jik.app.compute.atlas_schemas import AtlasRequest
 from jik.app.compute.pool import pool_in_thread
 from jik.app.compute.settings import Settings
@@ -264,3 +264,23 @@ def test_an_atlas_in_the_compute_pool_is_the_engines_atlas():
     here = run_atlas(plan)
     np.testing.assert_allclose(pooled.drift, here.drift, rtol=0, atol=1e-12)
     np.testing.assert_allclose(pooled.leg_ends, here.leg_ends, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize(("seconds_per_run", "chunk"), [(0.2, 5), (0.001, 1000), (1e-5, 2048)])
+def test_a_servers_atlas_is_cut_into_chunks_of_about_a_second(monkeypatch, seconds_per_run, chunk):
+    """The chunk holds about a second of runs, timed on the plan's first runs (a unicycle run
+    costs about 0.2 s, a Manipulator 2 run about a millisecond), at most the plan's own chunk
+    (2048): the compute workers serve requests between chunks, far within their time limit.
+    (The runs' cost is simulated by a clock that each run advances.)"""
+    from jik.app.compute import atlas_pool
+
+    now = [0.0]
+
+    def run_chunk(task):
+        now[0] += seconds_per_run * (task.hi - task.lo)
+
+    monkeypatch.setattr(atlas_pool, "run_chunk", run_chunk)
+    monkeypatch.setattr(atlas_pool, "perf_counter", lambda: now[0])
+    plan = plan_request(AtlasRequest.model_validate(body(starts=3000)), AtlasLimits())
+    assert plan.chunk == 2048
+    assert atlas_pool.sized_chunks(plan).chunk == chunk

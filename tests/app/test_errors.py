@@ -29,7 +29,7 @@ def _rep(**over) -> dict:
         (solve_body(robot={"l": 1.0}), "robot: give the robot, with a name among"),
         (solve_body(robot={"name": "manipulator2", "l": 9}), "robot.l: Input should be less than"),
         (solve_body(robot={"name": "manipulator2", "q": 1}), "robot.q: unknown field"),
-        (solve_body(algorithm="transpose"), "algorithm: Input should be 'pseudoinverse' or"),
+        (solve_body(algorithm="transpose"), "algorithm: Input should be 'pseudoinverse', 'ext"),
         (
             solve_body(algorithm="extended", augmentation={"name": "nope"}),
             "augmentation: unknown name 'nope'",

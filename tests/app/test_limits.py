@@ -129,7 +129,7 @@ def test_a_queued_atlas_says_what_it_waits_for():
     from jik.app.compute.atlas_jobs import AtlasJobs, AtlasLimits
 
     app = create_app(Settings(workers=1, timeout=60.0))
-    app.state.atlas_jobs = AtlasJobs(AtlasLimits(max_jobs=4, per_client=3, workers=1))
+    app.state.atlas_jobs = AtlasJobs(AtlasLimits(max_jobs=4, per_client=3), app.state.pool)
     with TestClient(app) as client:
         ids = [client.post("/atlas", json=LONG_ATLAS).json()["id"]]
         ids += [client.post("/atlas", json=SHORT_ATLAS).json()["id"] for _ in range(2)]
@@ -162,7 +162,7 @@ def test_a_forwarded_for_header_does_not_make_a_new_client():
     cannot lift the per-client atlas limit (2), which a new address per request did."""
     from jik.benchmarks.serving import jik_serve
 
-    with jik_serve(JIK_WORKERS="1") as served, httpx.Client(base_url=served.url) as c:
+    with jik_serve(JIK_WORKERS="1") as served, httpx.Client(base_url=served.url, timeout=120) as c:
         ids = []
         try:
             for k, body in enumerate([LONG_ATLAS, SHORT_ATLAS]):

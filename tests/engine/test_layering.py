@@ -53,12 +53,33 @@ def _imported(name: str, path: Path) -> set[str]:
             found.update(f"{module}.{alias.name}" for alias in node.names)
         elif isinstance(node, ast.Call) and _dynamic_import(node) is not None:
             found.add(_dynamic_import(node))  # type: ignore[arg-type]
+    lazy = _lazy_exports(name, path)
+    if lazy and "<a module named at run time>" in found:
+        found.discard("<a module named at run time>")
+        found.update(lazy)
     return found
+
+
+def _lazy_exports(name: str, path: Path) -> set[str]:
+    """The modules a package's front door loads lazily (PEP 562): the values of its literal
+    ``_EXPORTS = {"Name": "module", ...}``, as submodules of the package. Its dynamic import
+    names only these, so they are what it depends on."""
+    if path.name != "__init__.py":
+        return set()
+    for node in ast.parse(path.read_text(encoding="utf-8")).body:
+        target = node.targets[0] if isinstance(node, ast.Assign) and node.targets else None
+        if isinstance(target, ast.Name) and target.id == "_EXPORTS":
+            value = node.value  # type: ignore[union-attr]
+            if isinstance(value, ast.Dict):
+                return {f"{name}.{v.value}" for v in value.values
+                        if isinstance(v, ast.Constant) and isinstance(v.value, str)}  # fmt: skip
+    return set()
 
 
 def _dynamic_import(node: ast.Call) -> str | None:
     """The literal module name of ``importlib.import_module("a.b")``, ``import_module("a.b")``
-    or ``__import__("a.b")``; a name given by a variable is refused (it cannot be checked)."""
+    or ``__import__("a.b")``; the package of ``f"a.b.{name}"`` (its layer is known); a name
+    given otherwise is refused (it cannot be checked)."""
     fn = node.func
     name = fn.attr if isinstance(fn, ast.Attribute) else getattr(fn, "id", None)
     if name not in ("import_module", "__import__"):
@@ -66,6 +87,10 @@ def _dynamic_import(node: ast.Call) -> str | None:
     arg = node.args[0] if node.args else None
     if isinstance(arg, ast.Constant) and isinstance(arg.value, str):
         return arg.value
+    if isinstance(arg, ast.JoinedStr) and arg.values and isinstance(arg.values[0], ast.Constant):
+        head = str(arg.values[0].value)
+        if head.endswith(".") and head.count(".") >= 2:
+            return head[:-1]
     return "<a module named at run time>"
 
 
@@ -180,12 +205,15 @@ def test_dynamic_imports_count_as_imports():
     """``importlib.import_module`` and ``__import__`` with a literal name are imports too; a name
     known only at run time is reported as such (the layers could not be checked)."""
     code = "import importlib\nimportlib.import_module('jik.app.dashboard.offload')\n"
-    code += "__import__('jik.app.api')\nimport_module(name)\n"
+    code += "__import__('jik.app.api')\nimport_module(name)\nimport_module(f'jik.engine.{m}')\n"
     calls = [n for n in ast.walk(ast.parse(code)) if isinstance(n, ast.Call)]
     assert [_dynamic_import(c) for c in calls] == [
-        "jik.app.dashboard.offload", "jik.app.api", "<a module named at run time>"
+        "jik.app.dashboard.offload", "jik.app.api", "<a module named at run time>", "jik.engine"
     ]  # fmt: skip
 
 
 def test_no_module_is_imported_by_a_name_known_only_at_run_time():
+    """Every dynamic import names its module literally, or (the engine's front door) is one of
+    the modules its literal ``_EXPORTS`` lists, which the scan takes as its imports."""
+    assert {"jik.engine.solver", "jik.engine.repeatability"} <= IMPORTS["jik.engine"]
     assert [m for m, names in IMPORTS.items() if "<a module named at run time>" in names] == []

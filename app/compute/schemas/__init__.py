@@ -10,6 +10,7 @@
 Everything is re-exported here: ``from jik.app.compute import schemas as S``.
 """
 
+from jik.app.compute.schemas.algorithms import AlgorithmParameters
 from jik.app.compute.schemas.fields import (
     COORDINATE_BOUND,
     GAMMA_MIN,
@@ -29,6 +30,7 @@ from jik.app.compute.schemas.fields import (
 )
 from jik.app.compute.schemas.info import (
     BUSY,
+    AlgorithmInfo,
     AugmentationInfo,
     ErrorResponse,
     HealthResponse,
@@ -96,6 +98,8 @@ __all__ = [
     "USER_AUGMENTATION_MODELS",
     "USER_ROBOT_MODELS",
     "Algorithm",
+    "AlgorithmInfo",
+    "AlgorithmParameters",
     "AnyAugmentation",
     "AnyRobot",
     "Augmentation",

@@ -10,6 +10,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BeforeValidator, Field
 
+from jik.app.compute.schemas.algorithms import Algorithm as Algorithm
 from jik.engine.solver import GAMMA_MAX, GAMMA_MIN, TOL_MIN
 
 #: Largest configuration / task dimension accepted before the registry check.
@@ -37,7 +38,6 @@ INTEGRAL = BeforeValidator(_integral)
 #: A float that is null where the engine produced NaN or inf (a failed or diverged run).
 MaybeFloat = float | None
 
-Algorithm = Literal["pseudoinverse", "extended"]
 Mode = Literal["continuous", "discrete"]
 #: Largest |coordinate| of a configuration or task point (radians, lengths, control amplitudes):
 #: beyond it the kinematics only overflow, and the unicycle's quadrature would need huge grids.

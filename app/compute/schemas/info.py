@@ -59,9 +59,24 @@ class Limits(BaseModel):
     request_timeout_s: float
 
 
+class AlgorithmInfo(BaseModel):
+    """An inverse J# of eq. (7): its formula, source and parameters (``algorithm_parameters``)."""
+
+    name: Algorithm
+    equation: str
+    source: str
+    description: str
+    parameters: list[ParameterInfo]
+    vectors: list[str] = Field(description="its vector parameters: rest (p numbers), limits "
+                               "(p pairs [lo, hi])")  # fmt: skip
+
+
 class RobotsResponse(BaseModel):
     robots: list[RobotInfo]
     limits: Limits
+    algorithms: list[AlgorithmInfo] = Field(
+        default_factory=list, description="every algorithm and its parameters"
+    )
 
 
 class ErrorResponse(BaseModel):

@@ -10,6 +10,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from jik.app.compute.schemas.algorithms import AlgorithmParameters
 from jik.app.compute.schemas.fields import (
     INTEGRAL,
     MAX_ITERATIONS,
@@ -41,7 +42,14 @@ class _Request(BaseModel):
         description="the robot and its parameters, e.g. {'name': 'manipulator2', 'l': 1}"
     )
     algorithm: Algorithm = Field(
-        description="'pseudoinverse' (eq. (8)) or 'extended' (extended Jacobian inverse, eq. (11))"
+        description="'pseudoinverse' (eq. (8)), 'extended' (extended Jacobian inverse, eq. (11)), "
+        "'damped' (damped least squares), 'weighted' (weighted least-norm inverse for joint "
+        "limits) or 'posture' (pseudoinverse with a null-space pull to a rest posture)"
+    )
+    algorithm_parameters: AlgorithmParameters | None = Field(
+        None,
+        description="parameters of the algorithm (damping, damping_threshold; limits; gain, "
+        "rest); default: the engine's (GET /robots lists them)",
     )
     augmentation: AnyAugmentation | None = Field(
         None,

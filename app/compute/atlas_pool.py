@@ -1,0 +1,72 @@
+"""A server's atlas in the compute pool: its chunks sized to about a second of work
+(:func:`sized_chunks`) and run by the pool's workers (:class:`PoolBackend`, an atlas backend of
+:mod:`jik.engine.atlas_backends`), first come first served with the API's requests."""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable, Iterable, Iterator
+from concurrent.futures import FIRST_COMPLETED, Future, wait
+from time import perf_counter
+from typing import Any
+
+from jik.app.compute.worker import task
+from jik.engine.atlas import AtlasPlan
+from jik.engine.atlas_backends import IN_FLIGHT
+from jik.engine.atlas_run import chunk_task, run_chunk
+
+#: Seconds of work in one chunk of a server's atlas: the compute workers serve the API's requests
+#: between chunks, first come first served, and a chunk stays far within their time limit.
+CHUNK_SECONDS = 1.0
+#: Runs timed together to size an atlas's chunks.
+PROBE = 8
+
+
+def sized_chunks(plan: AtlasPlan, seconds: float = CHUNK_SECONDS) -> AtlasPlan:
+    """``plan`` with chunks of about ``seconds`` of work, from the time of a chunk of its first
+    :data:`PROBE` runs (a unicycle's run costs hundreds of times a Manipulator 2's); at most the
+    plan's own chunk. The atlas's numbers do not depend on its chunks."""
+    run_chunk(chunk_task(plan, 0, 1))  # (untimed: the first run's one-time costs)
+    probe = chunk_task(plan, 0, min(PROBE, plan.size))
+    start = perf_counter()
+    run_chunk(probe)
+    per_run = (perf_counter() - start) / (probe.hi - probe.lo)
+    chunk = int(min(max(seconds / max(per_run, 1e-9), 1), plan.chunk))
+    return dataclasses.replace(plan, chunk=chunk)
+
+
+@task("starts", "fewer starts or cycles")
+def atlas_chunk(fn: Callable[[Any], Any], chunk: Any) -> Any:
+    """``fn(chunk)``: one chunk of an atlas in a compute worker."""
+    return fn(chunk)
+
+
+class PoolBackend:
+    """An atlas backend (:class:`jik.engine.atlas_backends.Backend`) on the server's compute
+    pool (a :class:`~jik.app.compute.pool.ComputePool`): at most ``IN_FLIGHT`` chunks per worker
+    submitted at once, results in the order they finish; leaving gives up the chunks in flight."""
+
+    def __init__(self, pool: Any) -> None:
+        self.pool = pool
+        self.workers = pool.settings.workers
+
+    def __enter__(self) -> PoolBackend:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        return None
+
+    def imap_unordered(self, fn: Callable[[Any], Any], tasks: Iterable[Any]) -> Iterator[Any]:
+        pending: set[Future] = set()
+        try:
+            for chunk in tasks:
+                pending.add(self.pool.submit(atlas_chunk, fn, chunk))
+                if len(pending) >= IN_FLIGHT * self.workers:
+                    finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+                    yield from (f.result() for f in finished)
+            while pending:
+                finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+                yield from (f.result() for f in finished)
+        finally:
+            for f in pending:
+                f.cancel()

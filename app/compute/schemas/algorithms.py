@@ -1,0 +1,76 @@
+"""The parameters of the inverses J# (damped, weighted, posture), built from the engine's
+catalogue :data:`jik.engine.registry.ALGORITHMS`, so their ranges are written once."""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, create_model
+
+from jik.engine.registry import ALGORITHMS
+
+#: Every algorithm of the engine, as the API names them.
+Algorithm = Literal["pseudoinverse", "extended", "damped", "weighted", "posture"]
+assert set(Algorithm.__args__) == set(ALGORITHMS)  # type: ignore[attr-defined]
+
+_BOUND = 1000.0
+_Coordinate = Annotated[float, Field(strict=True, ge=-_BOUND, le=_BOUND, allow_inf_nan=False)]
+_Bound = Annotated[float, Field(strict=True, allow_inf_nan=True)]
+
+
+def _scalar_fields() -> dict[str, Any]:
+    fields: dict[str, Any] = {}
+    for spec in ALGORITHMS.values():
+        for p in spec.parameters:
+            kind = Annotated[
+                float, Field(strict=True, ge=p.minimum, le=p.maximum, allow_inf_nan=False)
+            ]
+            fields[p.name] = (
+                kind | None,
+                Field(None, description=f"{spec.name}: {p.description} (default {p.default:g})"),
+            )
+    return fields
+
+
+_Parameters = create_model("_Parameters", __config__=ConfigDict(extra="forbid"), **_scalar_fields())
+
+
+class AlgorithmParameters(_Parameters):  # type: ignore[misc, valid-type]
+    """Parameters of the chosen algorithm; those of another algorithm are refused (422)."""
+
+    rest: list[_Coordinate] | None = Field(
+        None, description="posture: the rest posture x_rest, length p (default: the robot's home, "
+        "else the run's x0; in an atlas, else the robot's default x0)",
+    )  # fmt: skip
+    limits: list[tuple[_Bound, _Bound]] | None = Field(
+        None, description="weighted: joint limits [lo, hi] per joint, length p (default: the "
+        "robot's joint limits, else its configuration box x_range)",
+    )  # fmt: skip
+
+
+def used(params: BaseModel | None, algorithm: str = "", kinematics=None, x0=None) -> dict:
+    """The parameters given, as the engine's :func:`make_inverse` takes them. The posture
+    inverse's ``rest`` defaults to the robot's home, else to the run's start ``x0``."""
+    out = {} if params is None else params.model_dump(exclude_none=True)
+    if algorithm == "posture" and "rest" not in out and x0 is not None:
+        if getattr(kinematics, "home", None) is None:
+            out["rest"] = list(x0)
+    return out
+
+
+def field_of(exc_field: str | None, message: str) -> str:
+    """The request's field for an engine error about an algorithm's parameter."""
+    for name in (exc_field, *ALGORITHM_PARAMETER_NAMES):
+        if name and (
+            name == exc_field or message.startswith(f"{name} ") or f"['{name}']" in message
+        ):
+            return f"algorithm_parameters.{name}"
+    return "algorithm_parameters"
+
+
+ALGORITHM_PARAMETER_NAMES = tuple(
+    dict.fromkeys(
+        [p.name for s in ALGORITHMS.values() for p in s.parameters]
+        + [v for s in ALGORITHMS.values() for v in s.vectors]
+    )
+)

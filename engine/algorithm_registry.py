@@ -1,0 +1,154 @@
+"""The catalogue of inverses J# for eq. (7) and :func:`make_inverse`, which builds one by name.
+
+The REST API, the CLI and the dashboard list the algorithms and their parameters from
+:data:`ALGORITHMS` (re-exported by :mod:`jik.engine.registry`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from jik.engine import practical_inverses as pinv
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.inverses import ExtendedInverse, Inverse, Pseudoinverse
+from jik.engine.kinematics import Kinematics
+from jik.engine.parameters import Parameter, check_params
+
+if TYPE_CHECKING:
+    from jik.engine.registry import RobotSpec
+
+
+@dataclass(frozen=True)
+class AlgorithmSpec:
+    """An inverse J# for eq. (7): its equation, source and scalar parameters.
+
+    ``vectors`` names its optional vector parameters (``rest``: p numbers; ``limits``: p pairs),
+    whose length depends on the robot.
+    """
+
+    name: str
+    equation: str
+    source: str
+    description: str
+    parameters: tuple[Parameter, ...] = ()
+    vectors: tuple[str, ...] = ()
+
+    def as_dict(self) -> dict:
+        return {
+            "name": self.name,
+            "equation": self.equation,
+            "source": self.source,
+            "description": self.description,
+            "parameters": [p.as_dict() for p in self.parameters],
+            "vectors": list(self.vectors),
+        }
+
+
+ALGORITHMS: dict[str, AlgorithmSpec] = {
+    a.name: a
+    for a in (
+        AlgorithmSpec("pseudoinverse", "(8)", "the paper, eq. (8)",
+                      "Jacobian pseudoinverse J^T (J J^T)^-1: drifts on closed paths"),
+        AlgorithmSpec("extended", "(11)", "the paper, eqs. (9)-(12)",
+                      "extended Jacobian inverse with an augmenting map h: repeatable"),
+        AlgorithmSpec(
+            "damped", "J^T (J J^T + lambda^2 I)^-1",
+            "Wampler (1986); adaptive damping: Nakamura and Hanafusa (1986)",
+            "damped least squares: bounded joint speed through singularities, at a task error",
+            (
+                Parameter("damping", 0.1, 0.0, pinv.MAX_DAMPING,
+                          "damping lambda (0: the pseudoinverse)"),
+                Parameter("damping_threshold", 0.0, 0.0, pinv.MAX_DAMPING,
+                          "damp only where the smallest singular value of J is below this "
+                          "(0: constant damping)"),
+            ),
+        ),
+        AlgorithmSpec(
+            "weighted", "W^-1 J^T (J W^-1 J^T)^-1", "Chan and Dubey (1995)",
+            "weighted least-norm inverse: joints slow down near their limits",
+            vectors=("limits",),
+        ),
+        AlgorithmSpec(
+            "posture", "J^# dy + (I - J^# J) k (x_rest - x) |dy|", "Liegeois (1977)",
+            "pseudoinverse with a null-space pull toward a rest posture",
+            (Parameter("gain", 1.0, 0.0, pinv.MAX_GAIN,
+                       "null-space gain k per unit of path length (0: the pseudoinverse)"),),
+            vectors=("rest",),
+        ),
+    )
+}  # fmt: skip
+
+
+def _robot_limits(kinematics: Kinematics, spec: RobotSpec | None, robot: str | None):
+    """The robot's joint limits; else the catalogue's box of configurations."""
+    from jik.engine.registry import ROBOTS  # the robots' catalogue imports this module
+
+    limits = getattr(kinematics, "limits", None)
+    if limits is not None:
+        return limits
+    spec = spec or ROBOTS.get(robot or kinematics.name)
+    box = getattr(spec, "x_range", None)
+    if box:
+        return box
+    raise InvalidInputError(
+        f"{kinematics.name} has no joint limits: give limits for the weighted inverse", "limits"
+    )
+
+
+def _robot_rest(kinematics: Kinematics, spec: RobotSpec | None, robot: str | None):
+    """The robot's home configuration; else its default start x0 in the catalogue."""
+    from jik.engine.registry import ROBOTS
+
+    home = getattr(kinematics, "home", None)
+    if home is not None:
+        return home
+    spec = spec or ROBOTS.get(robot or kinematics.name)
+    if spec is not None and getattr(spec, "default_x0", None):
+        return spec.default_x0
+    raise InvalidInputError(f"{kinematics.name} has no home posture: give rest", "rest")
+
+
+def make_inverse(
+    kinematics: Kinematics,
+    algorithm: str,
+    augmentation: str | None = None,
+    augmentation_parameters: Mapping[str, object] | None = None,
+    robot: str | None = None,
+    *,
+    spec: RobotSpec | None = None,
+    algorithm_parameters: Mapping[str, object] | None = None,
+) -> Inverse:
+    """The inverse named ``algorithm`` (:data:`ALGORITHMS`) with its parameters.
+
+    The extended inverse's map is looked up in ``spec`` (a robot defined by data,
+    :mod:`jik.engine.robot_spec`), else in the spec of ``robot`` (default: the kinematics'
+    name) in :data:`ROBOTS`. ``algorithm_parameters`` holds the algorithm's scalars
+    (defaults from :data:`ALGORITHMS`) and vectors: ``limits`` of the weighted inverse (default:
+    the robot's joint limits, else its catalogue box ``x_range``) and ``rest`` of the posture
+    inverse (default: the robot's home, else its default x0).
+    """
+    if algorithm not in ALGORITHMS:
+        raise InvalidInputError(
+            f"algorithm must be one of {list(ALGORITHMS)}, got {algorithm!r}", "algorithm"
+        )
+    aspec_ = ALGORITHMS[algorithm]
+    given = dict(algorithm_parameters or {})
+    vectors = {k: given.pop(k) for k in aspec_.vectors if given.get(k) is not None}
+    given = {k: v for k, v in given.items() if k not in aspec_.vectors}
+    values = check_params(aspec_.parameters, given, f"algorithm {algorithm!r}")
+    if algorithm == "pseudoinverse":
+        return Pseudoinverse(kinematics)
+    if algorithm == "damped":
+        return pinv.DampedInverse(kinematics, values["damping"], values["damping_threshold"])
+    if algorithm == "weighted":
+        limits = vectors.get("limits", _robot_limits(kinematics, spec, robot))
+        return pinv.WeightedInverse(kinematics, limits)
+    if algorithm == "posture":
+        rest = vectors.get("rest", _robot_rest(kinematics, spec, robot))
+        return pinv.PostureInverse(kinematics, rest, values["gain"])
+    from jik.engine.registry import robot_spec
+
+    aspec = (spec or robot_spec(robot or kinematics.name)).augmentation(augmentation)
+    return ExtendedInverse(kinematics, aspec.build(kinematics, **(augmentation_parameters or {})))

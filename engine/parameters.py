@@ -1,0 +1,52 @@
+"""Scalar parameters with defaults and ranges, and their validation (robots, maps, inverses)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.validation import finite
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A scalar parameter with its default and closed range [minimum, maximum]."""
+
+    name: str
+    default: float
+    minimum: float
+    maximum: float
+    description: str
+    nonzero: bool = False
+
+    def check(self, value) -> float:
+        """Validate ``value``; the message names the parameter and its range."""
+        v = finite(value, self.name)
+        if not self.minimum <= v <= self.maximum:
+            raise InvalidInputError(
+                f"{self.name} must be in [{self.minimum:g}, {self.maximum:g}], got {v:g}"
+            )
+        if self.nonzero and v == 0:
+            raise InvalidInputError(f"{self.name} must be nonzero ({self.description})")
+        return v
+
+    def as_dict(self) -> dict:
+        return {
+            "name": self.name,
+            "default": self.default,
+            "minimum": self.minimum,
+            "maximum": self.maximum,
+            "description": self.description,
+            "nonzero": self.nonzero,
+        }
+
+
+def check_params(specs: tuple[Parameter, ...], values: Mapping[str, object], what: str) -> dict:
+    known = {p.name for p in specs}
+    unknown = set(values) - known
+    if unknown:
+        raise InvalidInputError(
+            f"unknown parameter(s) {sorted(unknown)} for {what}; known: {sorted(known) or 'none'}"
+        )
+    return {p.name: p.check(values.get(p.name, p.default)) for p in specs}

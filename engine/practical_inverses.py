@@ -1,0 +1,274 @@
+"""The inverses redundant arms run in practice, beside the paper's (8) and (11).
+
+Each is an :class:`jik.engine.inverses.Inverse`, so the continuation algorithm (7), its discrete
+form and the repeatability test run them unchanged, batched over configurations:
+
+- :class:`DampedInverse`: damped least squares J^T (J J^T + lambda^2 I)^(-1) (Wampler 1986;
+  Nakamura and Hanafusa 1986), with an optional damping that grows only near singularities;
+- :class:`WeightedInverse`: the weighted least-norm inverse W^(-1) J^T (J W^(-1) J^T)^(-1) that
+  slows joints near their limits (Chan and Dubey 1995);
+- :class:`PostureInverse`: the pseudoinverse (8) plus a null-space pull toward a rest posture
+  (gradient projection, Liegeois 1977).
+
+The weighted and posture inverses are right inverses (J J# = I_r), so along (7) the task error
+still decays as e0 exp(-gamma theta), eq. (5). Damped least squares is not (J J# != I_r for
+lambda > 0): it trades tracking for bounded joint speeds, and the solver integrates it on (7)
+itself (:attr:`right_inverse` is False), reporting the task error it leaves.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from jik.engine.exceptions import InvalidInputError, KinematicSingularityError
+from jik.engine.inverses import Inverse, Pseudoinverse
+from jik.engine.kinematics import SINGULAR_MANIPULABILITY, Kinematics
+from jik.engine.linalg import gram, solve_small
+from jik.engine.validation import FloatArray, finite
+
+#: Largest damping lambda and damping threshold accepted.
+MAX_DAMPING = 10.0
+#: Largest null-space gain k of the posture inverse.
+MAX_GAIN = 100.0
+
+
+def _nonnegative(value, name: str, maximum: float) -> float:
+    v = finite(value, name)
+    if not 0.0 <= v <= maximum:
+        raise InvalidInputError(f"{name} must be in [0, {maximum:g}], got {v:g}", name)
+    return v
+
+
+def _singular(kinematics: Kinematics, x: FloatArray, what: str) -> KinematicSingularityError:
+    return KinematicSingularityError(
+        f"{what} of {kinematics.name} is undefined: J J^T is singular; "
+        "start away from the singular set or add damping",
+        x,
+    )
+
+
+def _jt(J: FloatArray, w: FloatArray) -> FloatArray:
+    return np.einsum("...ji,...j->...i", J, w)  # J^T w
+
+
+class DampedInverse(Inverse):
+    """Damped least squares J^T (J J^T + lambda(x)^2 I)^(-1) (Wampler 1986).
+
+    Parameters
+    ----------
+    kinematics : Kinematics
+    damping : float
+        lambda >= 0. With ``damping_threshold`` 0 the damping is constant; lambda = 0 is the
+        pseudoinverse (8), bit for bit (the same code runs).
+    damping_threshold : float
+        epsilon >= 0. When positive, the adaptive damping of Nakamura and Hanafusa (1986):
+        lambda(x)^2 = lambda^2 (1 - s(x) / epsilon)^2 where the smallest singular value s(x) of
+        J(x) is below epsilon, and 0 elsewhere (the pseudoinverse away from singularities).
+
+    Notes
+    -----
+    J# e minimizes ||J v - e||^2 + lambda^2 ||v||^2: the joint speed stays bounded (by
+    ||e|| / (2 lambda)) through a singularity, at the cost of a task error that no longer
+    decays as in eq. (5). Nakamura and Hanafusa write the damping as k0 (1 - w / w0)^2 in the
+    manipulability w; here it is written in the smallest singular value (as Chiaverini 1997
+    does), which measures the distance to the singular set in the same units for any r.
+    """
+
+    name = "damped"
+    right_inverse = False
+
+    def __init__(
+        self, kinematics: Kinematics, damping: float = 0.0, damping_threshold: float = 0.0
+    ) -> None:
+        self.kinematics = kinematics
+        self.damping = _nonnegative(damping, "damping", MAX_DAMPING)
+        self.damping_threshold = _nonnegative(damping_threshold, "damping_threshold", MAX_DAMPING)
+        self._plain = Pseudoinverse(kinematics) if self.damping == 0.0 else None
+        if self._plain is not None:
+            self.right_inverse = True
+
+    def damping_squared(self, J: FloatArray) -> FloatArray:
+        """lambda(x)^2 for Jacobians J (..., r, p): constant, or Nakamura-Hanafusa's."""
+        lam2 = np.full(J.shape[:-2], self.damping**2)
+        if self.damping_threshold > 0.0:
+            s = np.linalg.svd(J, compute_uv=False)[..., -1]
+            near = np.clip(1.0 - s / self.damping_threshold, 0.0, None)
+            lam2 = lam2 * near**2
+        return lam2
+
+    def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
+        if self._plain is not None:
+            return self._plain.apply_masked(x, e)
+        J = self.kinematics.jacobian(x)
+        lam2 = self.damping_squared(J)
+        M = gram(J) + lam2[..., None, None] * np.eye(J.shape[-2])
+        w, d = solve_small(M, e)
+        # Undamped members (adaptive damping far from the singular set) are the pseudoinverse.
+        bad = ~(np.abs(d) >= SINGULAR_MANIPULABILITY**2) & (lam2 == 0.0)
+        v = _jt(J, w)
+        bad |= ~np.isfinite(v).all(axis=-1)
+        return (np.where(bad[..., None], 0.0, v) if bad.any() else v), bad
+
+    def matrix(self, x: FloatArray) -> FloatArray:
+        x = self.kinematics.check(x)
+        r = self.kinematics.r
+        eyes = np.broadcast_to(np.eye(r), (*x.shape[:-1], r, r))
+        cols = [self.apply_masked(x, np.ascontiguousarray(eyes[..., i]))[0] for i in range(r)]
+        out = np.stack(cols, axis=-1)
+        _, bad = self.apply_masked(x, np.zeros((*x.shape[:-1], r)))
+        self._raise_if(x, bad)
+        return out
+
+    def singular_error(self, x: FloatArray) -> Exception:
+        return _singular(self.kinematics, x, "the undamped least-squares inverse")
+
+
+def limit_gradient(x: FloatArray, limits: FloatArray) -> FloatArray:
+    """dH/dx of Chan and Dubey's joint-limit measure H = sum (hi - lo)^2 / (4 (hi - x)(x - lo)).
+
+    dH/dx_i = (hi - lo)^2 (2 x_i - hi - lo) / (4 (hi - x_i)^2 (x_i - lo)^2): zero at mid-range,
+    infinite at a limit. Joints with an infinite range contribute 0; at or past a limit, inf.
+    """
+    lo, hi = limits[:, 0], limits[:, 1]
+    bounded = np.isfinite(lo) & np.isfinite(hi)
+    lo_b, hi_b = np.where(bounded, lo, -1.0), np.where(bounded, hi, 1.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        g = (hi_b - lo_b) ** 2 * (2 * x - hi_b - lo_b) / (4 * (hi_b - x) ** 2 * (x - lo_b) ** 2)
+    inside = (x > lo_b) & (x < hi_b)
+    return np.where(bounded, np.where(inside, g, np.inf), 0.0)
+
+
+class WeightedInverse(Inverse):
+    """Weighted least-norm inverse W^(-1) J^T (J W^(-1) J^T)^(-1) (Chan and Dubey 1995).
+
+    Parameters
+    ----------
+    kinematics : Kinematics
+    limits : array_like, shape (p, 2)
+        [lo, hi] per joint (inf for an unlimited joint).
+
+    Notes
+    -----
+    W(x) = diag(1 + |dH/dx_i|) with H the joint-limit measure of :func:`limit_gradient`, so a
+    joint slows as it nears a limit and stops at it (weight inf). Chan and Dubey switch a
+    weight back to 1 while the joint moves away from its limit; that switch depends on the
+    motion's history, so it is left out here: the flow (7) stays autonomous and the same in
+    continuous and discrete mode. J J# = I_r, so the task error decays as in eq. (5). A
+    configuration at or past a limit is a singular one for this inverse: a start there raises,
+    and a discrete run whose step crosses a limit stops there with a message naming the joint.
+    """
+
+    name = "weighted"
+
+    def __init__(self, kinematics: Kinematics, limits) -> None:
+        self.kinematics = kinematics
+        lim = np.asarray(limits, dtype=float)
+        if (
+            lim.shape != (kinematics.p, 2)
+            or np.isnan(lim).any()
+            or not np.all(lim[:, 0] < lim[:, 1])
+        ):
+            raise InvalidInputError(
+                f"limits must be {kinematics.p} pairs [lo, hi] with lo < hi", "limits"
+            )
+        self.limits = lim
+
+    def outside(self, x: FloatArray) -> FloatArray:
+        """Where a joint is at or past one of its limits, shape (...,)."""
+        return np.asarray(~((x > self.limits[:, 0]) & (x < self.limits[:, 1])).all(axis=-1))
+
+    def weights_inverse(self, x: FloatArray) -> FloatArray:
+        """diag(W(x))^(-1), shape (..., p): 0 at or past a limit."""
+        return 1.0 / (1.0 + np.abs(limit_gradient(x, self.limits)))
+
+    def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
+        J = self.kinematics.jacobian(x)
+        winv = self.weights_inverse(x)
+        Jw = J * np.sqrt(winv)[..., None, :]
+        w, d = solve_small(gram(Jw), e)  # (J W^-1 J^T) w = e
+        bad = ~(np.abs(d) >= SINGULAR_MANIPULABILITY**2) | self.outside(x)
+        v = winv * _jt(J, w)
+        bad |= ~np.isfinite(v).all(axis=-1)
+        return (np.where(bad[..., None], 0.0, v) if bad.any() else v), bad
+
+    def matrix(self, x: FloatArray) -> FloatArray:
+        x = self.kinematics.check(x)
+        J = self.kinematics.jacobian(x)
+        winv = self.weights_inverse(x)
+        Jw = J * winv[..., None, :]
+        M = Jw @ np.swapaxes(J, -1, -2)
+        bad = ~(np.abs(np.linalg.det(M)) >= SINGULAR_MANIPULABILITY**2)
+        self._raise_if(x, bad)
+        return np.swapaxes(Jw, -1, -2) @ np.linalg.inv(M)
+
+    def singular_error(self, x: FloatArray) -> Exception:
+        x = np.asarray(x, dtype=float)
+        out = np.flatnonzero(~((x > self.limits[:, 0]) & (x < self.limits[:, 1])))
+        if out.size:
+            i = int(out[0])
+            lo, hi = self.limits[i]
+            return KinematicSingularityError(
+                f"the weighted inverse of {self.kinematics.name} is undefined: joint {i + 1} "
+                f"is at or past its limits [{lo:g}, {hi:g}] (x{i + 1} = {x[i]:.6g}); start "
+                "inside the limits (a discrete step can also cross one: lower gamma)",
+                x,
+            )
+        return _singular(self.kinematics, x, "the weighted inverse (J W^-1 J^T singular)")
+
+
+class PostureInverse(Inverse):
+    """Pseudoinverse (8) with a null-space pull toward a rest posture (Liegeois 1977).
+
+    Parameters
+    ----------
+    kinematics : Kinematics
+    rest : array_like, shape (p,)
+        The rest posture x_rest.
+    gain : float
+        k >= 0; 0 is the pseudoinverse (8), bit for bit (the same code runs).
+
+    Notes
+    -----
+    Along a leg, dx = J# dy + (I - J# J) k (x_rest - x) ||dy||: per unit of the task path's
+    length the joints move toward x_rest in the kernel of J, by gradient projection of
+    -k ||x - x_rest||^2 / 2. In eq. (7), where dy = -gamma e dtheta,
+
+        dx/dtheta = -gamma (J# e - k ||e|| (I - J# J) (x_rest - x)),
+
+    so J dx/dtheta = -gamma e (eq. (5) holds) and the pull, like the leg, is over in finite
+    length: the drift of a closed path does not depend on gamma or on the solver's tol. The
+    pull makes closed paths contract toward one cycle, so drift per cycle falls but does not
+    vanish in finitely many cycles, unlike the extended inverse (11).
+    """
+
+    name = "posture"
+
+    def __init__(self, kinematics: Kinematics, rest, gain: float = 1.0) -> None:
+        self.kinematics = kinematics
+        self.rest = kinematics.check(rest, "rest")
+        if self.rest.shape != (kinematics.p,):
+            raise InvalidInputError(f"rest must be one configuration of {kinematics.p} numbers",
+                                    "rest")  # fmt: skip
+        self.gain = _nonnegative(gain, "gain", MAX_GAIN)
+        self._plain = Pseudoinverse(kinematics)
+
+    def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
+        if self.gain == 0.0:
+            return self._plain.apply_masked(x, e)
+        J = self.kinematics.jacobian(x)
+        G = gram(J)
+        w, d = solve_small(G, e)  # (J J^T) w = e
+        bad = ~(np.abs(d) >= SINGULAR_MANIPULABILITY**2)
+        z = self.rest - x
+        u, _ = solve_small(G, np.einsum("...ij,...j->...i", J, z))
+        null = z - _jt(J, u)  # (I - J# J) (x_rest - x)
+        v = _jt(J, w) - self.gain * np.linalg.norm(e, axis=-1)[..., None] * null
+        bad |= ~np.isfinite(v).all(axis=-1)
+        return (np.where(bad[..., None], 0.0, v) if bad.any() else v), bad
+
+    def matrix(self, x: FloatArray) -> FloatArray:
+        """J#(x) of the task part (the pseudoinverse); the pull is not linear in e."""
+        return self._plain.matrix(x)
+
+    def singular_error(self, x: FloatArray) -> Exception:
+        return self._plain.singular_error(x)

@@ -1,0 +1,100 @@
+"""The damped, weighted and posture algorithms through /solve, /repeatability and /atlas."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from jik.app.compute.atlas_jobs import AtlasLimits, plan_request
+from jik.app.compute.atlas_schemas import AtlasRequest
+from jik.engine.atlas_run import run_atlas
+from tests.app.conftest import TABLE1_PATH, X0_M2, messages, solve_body
+
+
+@pytest.mark.parametrize(
+    ("algorithm", "params"),
+    [("damped", {"damping": 0.2}), ("weighted", None), ("posture", {"gain": 0.5})],
+)
+def test_solve_runs_each_new_algorithm(api, algorithm, params):
+    r = api.post("/solve", json=solve_body(algorithm=algorithm, algorithm_parameters=params))
+    assert r.status_code == 200, r.text
+    body = r.json()
+    assert body["algorithm"] == algorithm
+    assert body["converged"] and body["error"] < 1e-10
+
+
+def test_repeatability_posture_drifts_less_than_the_pseudoinverse(api):
+    def drift(algorithm, params=None):
+        r = api.post("/repeatability", json={
+            "robot": {"name": "manipulator2"}, "algorithm": algorithm, "x0": X0_M2,
+            "path": TABLE1_PATH, "cycles": 10, "algorithm_parameters": params,
+        })  # fmt: skip
+        assert r.status_code == 200, r.text
+        return r.json()["drift"][-1], r.json()["repeatable"]
+
+    plain, plain_ok = drift("pseudoinverse")
+    posture, posture_ok = drift("posture", {"gain": 1.0})
+    assert posture < 0.1 * plain and posture > 1e-12
+    assert not plain_ok and not posture_ok
+
+
+def test_robots_list_every_algorithm(api):
+    body = api.get("/robots").json()
+    names = ["pseudoinverse", "extended", "damped", "weighted", "posture"]
+    assert body["robots"][0]["algorithms"] == names
+    assert [a["name"] for a in body["algorithms"]] == names
+    damped = body["algorithms"][2]
+    assert [p["name"] for p in damped["parameters"]] == ["damping", "damping_threshold"]
+    assert damped["parameters"][0]["maximum"] == 10.0 and "Nakamura" in damped["source"]
+
+
+@pytest.mark.parametrize(
+    ("algorithm", "params", "loc", "text"),
+    [
+        ("damped", {"damping": -1.0}, ["algorithm_parameters", "damping"], "greater than or equal"),
+        ("damped", {"gain": 1.0}, ["algorithm_parameters", "gain"], "unknown parameter(s)"),
+        ("posture", {"rest": [0.0, 1.0]}, ["algorithm_parameters", "rest"], "rest must have shape"),
+        ("weighted", {"limits": [[1.0, 0.0]] * 3}, ["algorithm_parameters", "limits"], "lo < hi"),
+        ("posture", {"speed": 1.0}, ["algorithm_parameters", "speed"], "unknown field"),
+        ("newton", None, ["algorithm"], "Input should be"),
+        ("extended", {"gain": 1.0}, ["algorithm_parameters"], "the extended inverse takes none"),
+        ("pseudoinverse", {"damping": 0.1}, ["algorithm_parameters", "damping"], "unknown"),
+    ],
+)  # fmt: skip
+def test_bad_parameters_are_422_naming_the_field(api, algorithm, params, loc, text):
+    r = api.post("/solve", json=solve_body(algorithm=algorithm, algorithm_parameters=params))
+    assert any(text in m for m in messages(r)), r.text
+    got = [str(x) for x in r.json()["detail"][0]["loc"][1:]]
+    assert got[: len(loc)] == loc, r.text
+
+
+def test_atlas_compares_algorithms_over_the_same_starts():
+    req = AtlasRequest.model_validate({
+        "robot": {"name": "manipulator2"}, "path": [[0.0, 1.0], *TABLE1_PATH[:3]], "starts": 5,
+        "cycles": 2, "arc": [-1.0, 1.0], "algorithms": ["pseudoinverse", "damped", "posture"],
+        "algorithm_parameters": {"damping": 0.5, "gain": 1.0},
+    })  # fmt: skip
+    res = run_atlas(plan_request(req, AtlasLimits()))
+    assert res.algorithms == ("pseudoinverse", "damped", "posture")
+    drift = {a: res.drift[i] for i, a in enumerate(res.algorithms)}
+    assert all(d.shape == (1, 5, 2) and np.isfinite(d).all() for d in drift.values())
+    # the same starts, different algorithms: different drift (posture pulls toward its rest)
+    assert abs(drift["damped"] - drift["pseudoinverse"]).max() > 1e-6
+    assert abs(drift["posture"] - drift["pseudoinverse"]).max() > 1e-3
+
+
+def test_posture_rest_defaults_to_the_runs_start(api):
+    """Without rest, the posture inverse pulls toward the request's x0 (Manipulator 2 has no
+    home): the same loop as with rest = x0 given, and not that of the catalogue's x0."""
+    x0 = [0.2, -0.1, 1.2]
+
+    def legs(params):
+        r = api.post("/repeatability", json={
+            "robot": {"name": "manipulator2"}, "algorithm": "posture", "x0": x0,
+            "path": TABLE1_PATH, "cycles": 2, "algorithm_parameters": params,
+        })  # fmt: skip
+        assert r.status_code == 200, r.text
+        return r.json()["drift"]
+
+    assert legs({"gain": 1.0}) == legs({"gain": 1.0, "rest": x0})
+    assert legs({"gain": 1.0}) != legs({"gain": 1.0, "rest": X0_M2})

@@ -1,0 +1,273 @@
+"""Damped least squares, the weighted least-norm inverse and the posture inverse, against the
+pseudoinverse (8), the extended inverse (11) and independent integrations of their ODEs."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from jik.engine.exceptions import InvalidInputError, KinematicSingularityError
+from jik.engine.kinematics import Manipulator2
+from jik.engine.planar_chain import PlanarChain
+from jik.engine.practical_inverses import (
+    DampedInverse,
+    PostureInverse,
+    WeightedInverse,
+    limit_gradient,
+)
+from jik.engine.registry import ALGORITHMS, make_inverse
+from jik.engine.repeatability import repeatability
+from jik.engine.solver import solve
+
+X0 = np.array([0.0, 0.0, math.pi / 2])
+#: Table 1's closed path (the return leg to k(x0) = (0, 1) is added by repeatability).
+TABLE1 = [(1.0, 1.0), (1.0, 2.0), (0.0, 2.0)]
+KIN = Manipulator2()
+LIMITS = np.array([[-3.0, 3.0], [-3.0, 3.0], [-math.pi, 2 * math.pi]])
+
+
+def _inverse(name: str, **params):
+    return make_inverse(KIN, name, algorithm_parameters=params)
+
+
+def test_catalogue_lists_all_five_with_parameters():
+    assert list(ALGORITHMS) == ["pseudoinverse", "extended", "damped", "weighted", "posture"]
+    assert [p.name for p in ALGORITHMS["damped"].parameters] == ["damping", "damping_threshold"]
+    assert [p.name for p in ALGORITHMS["posture"].parameters] == ["gain"]
+    assert ALGORITHMS["posture"].vectors == ("rest",)
+
+
+@pytest.mark.parametrize("mode", ["continuous", "discrete"])
+@pytest.mark.parametrize("name, params", [("damped", {"damping": 0.0}), ("posture", {"gain": 0.0})])
+def test_zero_parameter_is_the_pseudoinverse(name, params, mode):
+    """damping 0 and gain 0 give the pseudoinverse's loop bit for bit (the same code runs)."""
+    kw = {"gamma": 1.0 if mode == "continuous" else 0.5, "mode": mode}
+    ref = repeatability(_inverse("pseudoinverse"), X0, TABLE1, cycles=3, **kw)
+    got = repeatability(_inverse(name, **params), X0, TABLE1, cycles=3, **kw)
+    assert ref.drift[-1] > 0.1
+    np.testing.assert_array_equal(got.legs, ref.legs)
+
+
+def test_zero_parameter_apply_matches_on_a_batch():
+    rng = np.random.default_rng(3)
+    x, e = rng.normal(size=(50, 3)), rng.normal(size=(50, 2))
+    v_ref, _ = _inverse("pseudoinverse").apply_masked(x, e)
+    for inv in (_inverse("damped", damping=0.0), _inverse("posture", gain=0.0)):
+        v, bad = inv.apply_masked(x, e)
+        assert not bad.any()
+        np.testing.assert_allclose(v, v_ref, rtol=0, atol=1e-14)
+
+
+def _pinv_ivp(J, e):
+    return np.linalg.pinv(J) @ e
+
+
+def _damped_ivp(lam):
+    def f(J, e):
+        return J.T @ np.linalg.inv(J @ J.T + lam**2 * np.eye(2)) @ e
+
+    return f
+
+
+def _weighted_ivp(x, J, e):
+    lo, hi = LIMITS[:, 0], LIMITS[:, 1]
+    dH = (hi - lo) ** 2 * (2 * x - hi - lo) / (4 * (hi - x) ** 2 * (x - lo) ** 2)
+    Winv = np.diag(1.0 / (1.0 + np.abs(dH)))
+    return Winv @ J.T @ np.linalg.inv(J @ Winv @ J.T) @ e
+
+
+def _posture_ivp(k, rest):
+    def f(x, J, e):
+        Jp = np.linalg.pinv(J)
+        return Jp @ e - k * np.linalg.norm(e) * (np.eye(3) - Jp @ J) @ (rest - x)
+
+    return f
+
+
+def _ivp_loop(velocity, x0, targets, theta=60.0):
+    """Legs of eq. (7), dx/dtheta = -v(x, k(x) - y_d), each integrated by solve_ivp."""
+    x, ends = np.array(x0, dtype=float), []
+    for y_d in np.asarray(targets):
+
+        def rhs(_t, x, y_d=y_d):
+            return -velocity(x, KIN.jacobian(x[None])[0], KIN.forward(x[None])[0] - y_d)
+
+        sol = solve_ivp(rhs, (0.0, theta), x, method="DOP853", rtol=1e-13, atol=1e-13)
+        x = sol.y[:, -1]
+        ends.append(x)
+    return np.array(ends)
+
+
+@pytest.mark.parametrize(
+    "name, params, velocity",
+    [
+        ("damped", {"damping": 1.0}, lambda x, J, e: _damped_ivp(1.0)(J, e)),
+        ("weighted", {}, _weighted_ivp),
+        ("posture", {"gain": 0.5}, _posture_ivp(0.5, X0)),
+    ],
+)
+def test_continuous_loop_agrees_with_solve_ivp(name, params, velocity):
+    """Table 1's loop on Manipulator 2: every leg's end agrees with solve_ivp to 1e-8."""
+    got = repeatability(_inverse(name, **params), X0, TABLE1, cycles=1, tol=1e-12)
+    assert got.success
+    want = _ivp_loop(velocity, X0, got.targets)
+    np.testing.assert_allclose(got.legs, want, rtol=0, atol=1e-8)
+    ref = repeatability(_inverse("pseudoinverse"), X0, TABLE1, cycles=1, tol=1e-12)
+    assert np.max(np.abs(got.legs - ref.legs)) > 1e-3  # not the pseudoinverse's path
+
+
+def test_the_pseudoinverse_reference_integration_is_itself_right():
+    """The independent integration reproduces the pseudoinverse's loop (a check of the check)."""
+    got = repeatability(_inverse("pseudoinverse"), X0, TABLE1, cycles=1, tol=1e-12)
+    want = _ivp_loop(lambda x, J, e: _pinv_ivp(J, e), X0, got.targets)
+    np.testing.assert_allclose(got.legs, want, rtol=0, atol=1e-8)
+
+
+def test_posture_drifts_less_than_the_pseudoinverse_but_is_not_repeatable():
+    """After 10 cycles of Table 1's loop: pseudoinverse > posture > 1e-12 > extended."""
+    drift = {
+        name: repeatability(_inverse(name, **p), X0, TABLE1, cycles=10).drift[-1]
+        for name, p in [("pseudoinverse", {}), ("posture", {"gain": 1.0}), ("extended", {})]
+    }
+    assert drift["posture"] < 0.1 * drift["pseudoinverse"]
+    assert drift["posture"] > 1e-12
+    assert drift["extended"] < 1e-12
+
+
+def test_posture_pull_stays_in_the_kernel():
+    """J v = e for the posture inverse: the pull moves only within the self-motion."""
+    rng = np.random.default_rng(5)
+    x, e = rng.normal(size=(40, 3)), rng.normal(size=(40, 2))
+    inv = PostureInverse(KIN, X0, gain=2.0)
+    v, _ = inv.apply_masked(x, e)
+    np.testing.assert_allclose(np.einsum("nij,nj->ni", KIN.jacobian(x), v), e, atol=1e-12)
+    v0, _ = _inverse("pseudoinverse").apply_masked(x, e)
+    assert np.max(np.abs(v - v0)) > 0.1
+
+
+STRETCHED = np.zeros(3)
+ARM3R = PlanarChain("RRR", [1.0, 1.0, 1.0])
+
+
+def test_damped_leaves_a_singular_start_where_the_pseudoinverse_cannot():
+    """The 3R arm stretched (J of rank 1): damped least squares moves off and converges."""
+    with pytest.raises(KinematicSingularityError):
+        solve(make_inverse(ARM3R, "pseudoinverse"), STRETCHED, (2.0, 1.0))
+    res = solve(DampedInverse(ARM3R, 0.1), STRETCHED, (2.0, 1.0))
+    assert res.success and res.error < 1e-10
+    assert ARM3R.manipulability(res.x[None])[0] > 0.1  # ends away from the singularity
+
+
+@pytest.mark.parametrize("threshold", [0.0, 0.3])
+def test_damped_reaches_the_singularity_and_reports_its_task_error(threshold):
+    """A target beyond reach: the pseudoinverse stalls short of the boundary, damped least
+    squares stretches the arm to the singular configuration toward the target and reports
+    the task error it is left with (0.5 = 3.5 - reach), success False."""
+    x0, target = (0.3, 0.3, 0.3), (3.5, 0.0)
+    plain = solve(make_inverse(ARM3R, "pseudoinverse"), x0, target)
+    assert not plain.success and plain.error > 1.0
+    res = solve(DampedInverse(ARM3R, 0.1, threshold), x0, target)
+    assert not res.success
+    assert res.error == pytest.approx(0.5, abs=1e-9)
+    assert "error 0.5" in res.message
+    np.testing.assert_allclose(res.x, STRETCHED, atol=1e-9)
+    assert res.trajectory is not None and res.trajectory.error[-1] == pytest.approx(0.5)
+
+
+def test_adaptive_damping_is_zero_away_from_singularities():
+    """lambda(x) = 0 where the smallest singular value is above the threshold."""
+    inv = DampedInverse(ARM3R, 0.2, damping_threshold=0.05)
+    x = np.array([[0.3, 0.9, 0.8], [0.0, 0.0, 1e-3]])
+    lam2 = inv.damping_squared(ARM3R.jacobian(x))
+    assert lam2[0] == 0.0 and 0.0 < lam2[1] < 0.04
+    e = np.array([[0.1, -0.2]] * 2)
+    v, _ = inv.apply_masked(x[:1], e[:1])
+    v0, _ = make_inverse(ARM3R, "pseudoinverse").apply_masked(x[:1], e[:1])
+    np.testing.assert_allclose(v, v0, atol=1e-14)
+
+
+def test_limit_gradient_matches_finite_differences():
+    rng = np.random.default_rng(7)
+    lim = np.array([[-1.0, 2.0], [0.5, 1.5], [-np.inf, np.inf]])
+
+    def H(x):
+        lo, hi = lim[:2, 0], lim[:2, 1]
+        return np.sum((hi - lo) ** 2 / (4 * (hi - x[..., :2]) * (x[..., :2] - lo)), axis=-1)
+
+    x = np.column_stack([rng.uniform(-0.8, 1.8, 20), rng.uniform(0.6, 1.4, 20),
+                         rng.normal(size=20)])  # fmt: skip
+    g = limit_gradient(x, lim)
+    h = 1e-6
+    for i in range(3):
+        d = np.zeros(3)
+        d[i] = h
+        np.testing.assert_allclose(g[:, i], (H(x + d) - H(x - d)) / (2 * h), rtol=1e-6, atol=1e-8)
+
+
+def test_weighted_keeps_a_joint_off_its_limit_where_the_pseudoinverse_crosses_it():
+    """A limit on x3 that the pseudoinverse's leg crosses: the weighted inverse stays inside."""
+    target = (1.0, 1.0)
+    plain = solve(_inverse("pseudoinverse"), X0, target)
+    lim = LIMITS.copy()
+    lim[2] = (plain.x[2] + 0.3, 2 * math.pi) if plain.x[2] < X0[2] else (-math.pi, plain.x[2] - 0.3)
+    res = solve(WeightedInverse(KIN, lim), X0, target)
+    assert res.success
+    xs = res.trajectory.x
+    assert np.all((xs > lim[:, 0]) & (xs < lim[:, 1]))
+    assert not np.all((plain.trajectory.x > lim[:, 0]) & (plain.trajectory.x < lim[:, 1]))
+
+
+def test_batched_runs_equal_one_by_one_runs():
+    rng = np.random.default_rng(11)
+    x0 = X0 + rng.normal(scale=0.2, size=(4, 3))
+    for inv in (_inverse("damped", damping=0.2), _inverse("weighted"), _inverse("posture")):
+        batch = repeatability(inv, x0, TABLE1, cycles=2, mode="discrete", gamma=0.5)
+        for i in range(4):
+            one = repeatability(inv, x0[i], TABLE1, cycles=2, mode="discrete", gamma=0.5)
+            np.testing.assert_allclose(batch.legs[i], one.legs, rtol=0, atol=1e-13)
+
+
+@pytest.mark.parametrize(
+    "name, params, field",
+    [
+        ("damped", {"damping": -1.0}, "damping"),
+        ("damped", {"damping_threshold": math.inf}, "damping_threshold"),
+        ("posture", {"gain": -0.1}, "gain"),
+        ("posture", {"rest": [0.0, 1.0]}, "rest"),
+        ("weighted", {"limits": [[1.0, 0.0]] * 3}, "limits"),
+        ("damped", {"gain": 1.0}, "gain"),
+        ("nonsense", {}, "algorithm"),
+    ],
+)
+def test_bad_parameters_name_their_field(name, params, field):
+    with pytest.raises(InvalidInputError, match=field):
+        make_inverse(KIN, name, algorithm_parameters=params)
+
+
+def test_reproduction_table_has_every_algorithm():
+    """`jik reproduce algorithms`, shortened to 2 cycles: one row per algorithm, in order."""
+    from jik.engine.reproductions import algorithms as repro
+
+    result = repro.run(cycles=2)
+    assert [r["name"] for r in result["algorithms"]] == list(ALGORITHMS)
+    drift = {r["name"]: r["drift"]["1"] for r in result["algorithms"]}
+    assert drift["extended"] < 1e-12 < drift["posture"] < 0.2 < drift["pseudoinverse"]
+    text = repro.format_text(result)
+    assert text.count("\n| ") == 6 and "| posture | gain = 1.0, rest = x0 |" in text
+
+
+def test_cli_algorithm_names_are_the_catalogue():
+    from jik.algorithm_options import ALGORITHM_NAMES
+
+    assert list(ALGORITHM_NAMES) == list(ALGORITHMS)
+
+
+def test_weighted_refuses_a_start_past_a_limit_naming_the_joint():
+    inv = WeightedInverse(KIN, [[-1.0, 1.0], [-1.0, 1.0], [2.0, 3.0]])
+    with pytest.raises(
+        KinematicSingularityError, match=r"joint 3 is at or past its limits \[2, 3\]"
+    ):
+        solve(inv, X0, (1.0, 1.0))
