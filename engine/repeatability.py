@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from jik.engine.exceptions import InvalidInputError, JikError
+from jik.engine.exceptions import InvalidInputError, JikError, format_vector
 from jik.engine.inverses import Inverse
 from jik.engine.progress import Progress, check_cancelled
 from jik.engine.results import RepeatabilityResult
@@ -110,7 +110,17 @@ def closed_path(kinematics, x0: FloatArray, path: FloatArray) -> FloatArray:
     ``path`` is (L, r), shared by all starts, or (n, L, r), one path per start.
     Returns shape (n, L, r) for x0 of shape (n, p).
     """
-    home = kinematics.forward(x0)  # (n, r)
+    with np.errstate(all="ignore"):
+        home = np.asarray(kinematics.forward(x0), dtype=float)  # (n, r)
+    bad = ~np.all(np.isfinite(home), axis=-1)
+    if np.any(bad):
+        i = int(np.flatnonzero(bad)[0])
+        shown = ", ".join(f"{v:.6g}" for v in home[i])
+        raise InvalidInputError(
+            f"x0: the kinematics overflow at the start {format_vector(x0[i])}: k(x0) = ({shown}), "
+            "which closes the path; choose a start where k is finite (below about 1.8e308)",
+            "x0",
+        )
     pts = np.broadcast_to(path, (len(x0), *path.shape[-2:]))
     if np.any(np.linalg.norm(pts[:, -1] - home, axis=-1) > CLOSE_TOL):
         pts = np.concatenate([pts, home[:, None, :]], axis=1)

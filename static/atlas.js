@@ -28,7 +28,7 @@ function showProgress(body) {
   const pct = Math.round(100 * body.progress);
   $("#atlas-bar").style.width = `${pct}%`;
   $("#atlas-progress-text").textContent = body.status === "queued"
-    ? "waiting: another atlas is computing (one at a time)"
+    ? `waiting: ${body.message || "another atlas is computing (one at a time)"}`
     : `computing ${pct}% (${body.runs_done} of ${body.runs} starts, ${fmt(body.elapsed_s, 1)} s)`;
 }
 

@@ -217,20 +217,31 @@ def _user_default_state(robot: str, definition: Mapping[str, Any] | None) -> Das
         raise InvalidInputError(f"robot_definition.name: must be the robot's kind {robot!r}, got "
                                 f"{definition.get('name')!r}", "robot_definition.name")  # fmt: skip
     spec = _redundant_robot(definition).spec
-    return DashboardState(
-        robot=robot,
-        robot_parameters={},
-        robot_definition=dict(definition),
-        augmentation=spec.augmentation(None).name,
-        augmentation_parameters={},
-        gamma=float(spec.default_gamma),
-        mode=spec.default_mode,
-        x0=tuple(float(v) for v in spec.default_x0),
-        task="path" if spec.default_path else "target",
-        target=tuple(float(v) for v in spec.default_target),
-        path=tuple(tuple(float(v) for v in p) for p in spec.default_path),
-        cycles=3 if spec.default_path else 1,
-    )
+    try:
+        return DashboardState(
+            robot=robot,
+            robot_parameters={},
+            robot_definition=dict(definition),
+            augmentation=spec.augmentation(None).name,
+            augmentation_parameters={},
+            gamma=float(spec.default_gamma),
+            mode=spec.default_mode,
+            x0=tuple(float(v) for v in spec.default_x0),
+            task="path" if spec.default_path else "target",
+            target=tuple(float(v) for v in spec.default_target),
+            path=tuple(tuple(float(v) for v in p) for p in spec.default_path),
+            cycles=3 if spec.default_path else 1,
+        )
+    except ValidationError as exc:
+        # Defaults the robot computes (its target k(x0), its path) outside the dashboard's
+        # ranges: the definition is what the user can change.
+        first = exc.errors()[0]
+        where = ".".join(str(p) for p in first["loc"])
+        raise InvalidInputError(
+            f"robot_definition: the robot's default {where} is refused by the dashboard "
+            f"({first['msg']}); change the definition (its start x0 or its parameters)",
+            "robot_definition",
+        ) from None
 
 
 def updated_state(state: DashboardState, patch: Mapping[str, object]) -> DashboardState:

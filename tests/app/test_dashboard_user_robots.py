@@ -14,6 +14,7 @@ from jik.app.dashboard.model import (
     updated_state,
     validate,
 )
+from jik.app.dashboard.results import compute
 from jik.app.dashboard.session import Dashboard
 from jik.engine.exceptions import InvalidInputError
 
@@ -50,6 +51,9 @@ def test_a_definition_is_state_with_its_defaults_and_a_map():
         ({"robot_definition": {**ARM, "joints": "RRRR", "lengths": [0.4] * 4,
                                "augmentations": [{"name": "formula", "h": "x4"}]}},
          "robot_definition.augmentations.0.h", "must be a list of 2 formulas (p - r = 2"),
+        ({"robot": "formula", "robot_definition": {"name": "formula", "task": ["x1 * a", "x2"],
+          "variables": ["x1", "x2", "x3"], "parameters": {"a": 1e300}}}, "robot_definition",
+         "the robot's default target.0 is refused by the dashboard"),
     ],
 )  # fmt: skip
 def test_refusals_name_the_definitions_field(patch, field, text):
@@ -86,3 +90,15 @@ def test_the_pages_link_opens_the_same_robot():
     state = updated_state(_arm_state(), {"x0.1": 0.7, "cycles": 2})
     link = StatePatch.model_validate(state.as_dict())
     assert updated_state(default_state(), patch_of(link)) == state
+
+
+def test_an_overflow_at_the_start_is_called_an_overflow():
+    """k(x0) = exp(800) closes the path: the session says the kinematics overflow at x0 (it said
+    "y_d contains NaN or infinite values")."""
+    robot = {"name": "formula", "variables": ["x1", "x2", "x3"], "task": ["exp(x1) + x3", "x2"]}
+    state = updated_state(_arm_state(), {"robot": "formula", "robot_definition": robot})
+    state = updated_state(state, {"x0": [800.0, 0.5, 0.5]})
+    with pytest.raises(InvalidInputError) as err:
+        compute(state)
+    assert err.value.field == "x0"
+    assert "the kinematics overflow at the start" in str(err.value)
