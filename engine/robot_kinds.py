@@ -93,10 +93,12 @@ AUGMENTATIONS: dict[str, tuple[DefinitionField, ...]] = {
                         "formula)"),
     ),
     "e2_synthesized": (
-        DefinitionField("region", "mapping", True, "two or three variables to [lo, hi]: the box "
-                        "of the Ritz synthesis of E2, eq. (20)", {"x2": [0.4, 2], "x3": [0.4, 2]}),
+        DefinitionField("region", "mapping", True, "two or more variables to [lo, hi]: the box "
+                        "of the Ritz synthesis of E2, eq. (20) (over more than three, in a "
+                        "total-degree basis)", {"x2": [0.4, 2], "x3": [0.4, 2]}),
         DefinitionField("degree", "integer", False, "Legendre degree per variable, 1-24 "
-                        "(default 12)", 12),
+                        "(default 12); over more than three variables the total degree, 1-6 "
+                        "(default 4)", 12),
         DefinitionField("fixed", "mapping", False, "values of the variables outside the region "
                         "(default 0)"),
         DefinitionField("label", "string", False, "its name among the robot's maps (default "

@@ -19,7 +19,6 @@ of :mod:`jik.engine.extended_vector`); the E2 synthesis needs p = r + 1 and says
 
 from __future__ import annotations
 
-import functools
 import json
 import math
 from collections.abc import Callable, Mapping
@@ -49,8 +48,8 @@ from jik.engine.limits import (
 from jik.engine.planar_chain import PlanarChain
 from jik.engine.registry import ROBOTS, AugmentationSpec, RobotSpec, make_inverse
 from jik.engine.repeatability import MAX_PATH_POINTS
+from jik.engine.robot_synthesis import TOTAL_DEGREE, arm_augmentations, synthesis
 from jik.engine.validation import as_points, count
-from jik.engine.variational import synthesize_e2
 
 #: Largest robot file read by :func:`load_robot` [bytes].
 MAX_FILE_BYTES = 2_000_000
@@ -219,10 +218,11 @@ def _defaults(kin: Kinematics, d: Mapping, box) -> tuple:
     return tuple(x0.tolist()), tuple(target.tolist()), tuple(map(tuple, path.tolist()))
 
 
-def _augmentations(kin: Kinematics, items):
+def _augmentations(kin: Kinematics, items, key: str | None = None):
     """AugmentationSpecs of ``[{"name": "formula", "h": ...}, {"name": "e2_synthesized", ...}]``,
     the synthesis region of the first e2_synthesized (the robot's functional region), and the
-    vectors of p - r formula maps (p > r + 1: ``"h"`` is a list), by label."""
+    vectors of p - r formula maps (p > r + 1: ``"h"`` is a list), by label. ``key`` names the
+    robot's definition: with it, a synthesized map is computed once per process for it."""
     if not isinstance(items, list):
         raise InvalidInputError("augmentations must be a list of augmenting maps", "augmentations")
     specs: list[AugmentationSpec] = []
@@ -261,9 +261,14 @@ def _augmentations(kin: Kinematics, items):
         else:
             unknown = set(item) - robot_kinds.augmentation_keys("e2_synthesized")
             box, fix = _region(kin, item, where)
-            degree = count(item.get("degree", 12), f"{where}.degree", 1, 24)
-            factory = _synthesis(box, fix, degree)
-            text = f"E2-optimal h on {box} by the Ritz solve of (20), degree {degree}"
+            if len(box) <= 3:
+                degree = count(item.get("degree", 12), f"{where}.degree", 1, 24)
+                text = f"E2-optimal h on {box} by the Ritz solve of (20), degree {degree}"
+            else:
+                degree = count(item.get("degree", TOTAL_DEGREE), f"{where}.degree", 1, 6)
+                text = (f"E2-optimal h of {len(box)} joints on {box}: Ritz solve of (19) in a "
+                        f"total-degree {degree} basis on a Sobol rule")  # fmt: skip
+            factory = synthesis(box, fix, degree, key)
             region = region or box
         if unknown:
             raise InvalidInputError(f"{where}: unknown key(s) {sorted(unknown)}", where)
@@ -302,18 +307,10 @@ def _region(kin: Kinematics, item: Mapping, where: str):
         box, fix = check_region(kin, item.get("region", {}), item.get("fixed"))
     except InvalidInputError as exc:
         raise InvalidInputError(f"{where}.region: {exc}", f"{where}.region") from None
-    if len(box) not in (2, 3):
-        raise InvalidInputError(f"{where}.region must have two or three variables",
+    if len(box) < 2:
+        raise InvalidInputError(f"{where}.region must have at least two variables",
                                 f"{where}.region")  # fmt: skip
     return box, fix
-
-
-def _synthesis(box: dict, fix: dict, degree: int) -> Callable[..., AugmentingMap]:
-    @functools.cache
-    def synthesized(kin: Kinematics) -> AugmentingMap:
-        return synthesize_e2(kin, box, degree=degree, fixed=fix).augmenting_map
-
-    return synthesized
 
 
 def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
@@ -358,11 +355,15 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
         kin = _kinematics("urdf", d, None)
     else:
         kin = _kinematics(kind, d, None if base_dir is None else Path(base_dir))
+    if kind in ARMS or (kind == "urdf" and "home" in d):  # an arm around its home
+        d = {**d, "augmentations": arm_augmentations(kin, d)}
     if "limits" in d:  # (a planar chain or a formula robot: a URDF's come from its joints)
         kin.joint_limits = check_limits(d["limits"], kin.p)
     box = _x_range(kin, d)
     x0, target, path = _defaults(kin, d, box)
-    augmentations, region, vectors = _augmentations(kin, d.get("augmentations", []))
+    key = json.dumps({k: v for k, v in d.items() if k != "augmentations"}, sort_keys=True,
+                     default=str)  # fmt: skip
+    augmentations, region, vectors = _augmentations(kin, d.get("augmentations", []), key)
     title = _get(d, "title", str, "a string", kind.replace("_", " "))
     task_names = {
         "planar_chain": ("x", "y", "phi")[: kin.r],

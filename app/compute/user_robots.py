@@ -115,12 +115,14 @@ def user_inverse(robot: Robot, algorithm: str, algorithm_parameters: dict | None
         raise RequestError(
             "augmentation",
             "the extended inverse of a user robot needs its augmenting map: {'name': "
-            "'formula', 'h': ...} or {'name': 'e2_synthesized', 'region': {...}} (p = r + 1)",
+            "'formula', 'h': ...} or {'name': 'e2_synthesized', 'region': {...}} (p = r + 1); "
+            "an arm given with its home has an E2-optimal one by default",
         )
     try:
         if algorithm != "extended":
             return robot.inverse(algorithm, algorithm_parameters=algorithm_parameters)
-        return robot.inverse(algorithm, _LABEL)
+        given = _LABEL in {a.name for a in robot.spec.augmentations}
+        return robot.inverse(algorithm, _LABEL if given else None)  # (else the robot's default)
     except InvalidInputError as exc:
         if algorithm != "extended":
             raise RequestError(field_of(exc.field, str(exc)), _text(exc)) from None

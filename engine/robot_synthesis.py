@@ -1,0 +1,64 @@
+"""Synthesized augmenting maps of robots defined by data: their computation, cached per robot.
+
+A definition's ``{"name": "e2_synthesized", "region": {...}}`` is the E2-optimal map on its box,
+eq. (19): by the tensor Ritz solve for two or three variables (:mod:`jik.engine.variational`),
+by the total-degree one over more (:mod:`jik.engine.synthesis_nd`). A catalogue arm with one
+degree of redundancy (a 7-joint arm's pose task), or a URDF arm given with its home, gets such a
+map by default, over all its joints.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+from collections.abc import Callable, Mapping
+
+import numpy as np
+
+from jik.engine.augmentations import AugmentingMap
+from jik.engine.kinematics import Kinematics
+from jik.engine.synthesis_nd import synthesize_e2_nd
+from jik.engine.variational import synthesize_e2
+
+
+def synthesis(box: dict, fix: dict, degree: int, key: str | None) -> Callable[..., AugmentingMap]:
+    """The E2-optimal map on ``box``: the tensor Ritz solve for two or three variables
+    (:func:`~jik.engine.variational.synthesize_e2`), the total-degree one for more
+    (:func:`~jik.engine.synthesis_nd.synthesize_e2_nd`)."""
+
+    def synthesized(kin: Kinematics) -> AugmentingMap:
+        cache_key = None if key is None else (key, json.dumps([box, fix, degree], sort_keys=True))
+        if cache_key is not None and cache_key in _SYNTHESIZED:
+            return _SYNTHESIZED[cache_key]
+        if len(box) <= 3:
+            amap: AugmentingMap = synthesize_e2(kin, box, degree=degree, fixed=fix).augmenting_map
+        else:
+            amap = synthesize_e2_nd(kin, box, degree=degree, nodes=TOTAL_NODES, fixed=fix).maps[0]
+        if cache_key is not None:
+            while len(_SYNTHESIZED) >= 16:
+                _SYNTHESIZED.pop(next(iter(_SYNTHESIZED)))
+            _SYNTHESIZED[cache_key] = amap
+        return amap
+
+    return functools.cache(synthesized)
+
+
+#: Synthesized maps by the robot definition they belong to (a process's few most recent).
+_SYNTHESIZED: dict[tuple[str, str], AugmentingMap] = {}
+#: Total degree and nodes of a synthesis over more than three joints (docs/e2-vector.md).
+TOTAL_DEGREE, TOTAL_NODES = 4, 2**13
+#: Half-width [rad] of a catalogue arm's default synthesis box around its home.
+ARM_BOX = 0.3
+
+
+def arm_augmentations(kin: Kinematics, d: Mapping) -> list:
+    """The default map of an arm with a home (a catalogue arm, or a URDF given with ``home``) and
+    one degree of redundancy (a 7-joint arm's pose task): E2-optimal over all its joints,
+    +-ARM_BOX around home within the joint limits. A definition's own maps replace it."""
+    if "augmentations" in d or kin.p - kin.r != 1:
+        return list(d.get("augmentations", []))
+    home = np.asarray(d["home"], dtype=float)
+    lo, hi = np.asarray(kin.joint_limits, dtype=float).T
+    box = {n: [float(max(lo[i], home[i] - ARM_BOX)), float(min(hi[i], home[i] + ARM_BOX))]
+           for i, n in enumerate(kin.variable_names)}  # fmt: skip
+    return [{"name": "e2_synthesized", "region": box}]
