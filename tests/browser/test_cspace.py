@@ -6,7 +6,8 @@ from __future__ import annotations
 import pytest
 
 expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
-pytestmark = pytest.mark.browser
+# A display check: in CI's slow step, to keep the default run under 8 minutes.
+pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
 
 def _legend(tab) -> list[str]:

@@ -16,7 +16,8 @@ from tests.browser.conftest import ROOT, Tab, Tabs, _free_port, get_json, poll
 from tests.browser.failing_serve import MESSAGE
 
 expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
-pytestmark = pytest.mark.browser
+# A display check: in CI's slow step, to keep the default run under 8 minutes.
+pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
 
 @pytest.fixture(scope="module")

@@ -9,7 +9,8 @@ from pathlib import Path
 import pytest
 
 expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
-pytestmark = pytest.mark.browser
+# A display check: in CI's slow step, to keep the default run under 8 minutes.
+pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
 
 def test_one_key_everywhere_and_help_per_panel(tabs, config):

@@ -12,7 +12,8 @@ import pytest
 from tests.browser.conftest import COLORS_RGB, TIMEOUT, probe
 
 expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
-pytestmark = pytest.mark.browser
+# A display check: in CI's slow step, to keep the default run under 8 minutes.
+pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
 
 def _check_panels(tab, panels) -> None:

@@ -9,7 +9,8 @@ import pytest
 from tests.browser.conftest import probe
 
 expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
-pytestmark = pytest.mark.browser
+# A display check: in CI's slow step, to keep the default run under 8 minutes.
+pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
 
 def test_table1_beside_the_printed_values(tabs):
