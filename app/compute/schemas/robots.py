@@ -124,6 +124,17 @@ Constants = Annotated[dict[Name, FiniteFloat], Field(max_length=32)]
 Title = Annotated[str, Field(min_length=1, max_length=100)]
 
 
+#: Optional joint limits of a planar chain or a formula robot (a URDF's come from its joints).
+JointLimits = Annotated[
+    list[tuple[FiniteFloat | None, FiniteFloat | None]],
+    Field(min_length=1, max_length=MAX_DIMENSION),
+]
+LIMITS_DESCRIPTION = (
+    "joint limits, one [lower, upper] per variable (null: no bound); runs report whether they "
+    "stayed within them"
+)
+
+
 class PlanarChainRobot(BaseModel):
     """A planar serial chain of revolute (R) and prismatic (P) joints: the end point (r = 2),
     or the end point and its angle (r = 3); p is the number of joints."""
@@ -142,12 +153,7 @@ class PlanarChainRobot(BaseModel):
     orientation: Annotated[bool, Field(strict=True)] = Field(
         False, description="also the end's angle as a task component (r = 3; needs p >= 3)"
     )
-    limits: (
-        Annotated[list[tuple[FiniteFloat | None, FiniteFloat | None]],
-                  Field(min_length=1, max_length=MAX_DIMENSION)]
-        | None
-    ) = Field(None, description="joint limits, one [lower, upper] per variable (null: no "
-              "bound); runs report whether they stayed within them")  # fmt: skip
+    limits: JointLimits | None = Field(None, description=LIMITS_DESCRIPTION)
     title: Title | None = None
 
 
@@ -164,12 +170,7 @@ class FormulaRobot(BaseModel):
         "parameters with sin cos tan exp log sqrt atan2 abs, + - * / **, numbers and pi"
     )
     parameters: Constants = Field(default_factory=dict, description="named constants")
-    limits: (
-        Annotated[list[tuple[FiniteFloat | None, FiniteFloat | None]],
-                  Field(min_length=1, max_length=MAX_DIMENSION)]
-        | None
-    ) = Field(None, description="joint limits, one [lower, upper] per variable (null: no "
-              "bound); runs report whether they stayed within them")  # fmt: skip
+    limits: JointLimits | None = Field(None, description=LIMITS_DESCRIPTION)
     title: Title | None = None
 
 
