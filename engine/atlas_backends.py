@@ -36,6 +36,25 @@ WORKER_ENVIRONMENT = {
 }
 
 
+def bounded_imap(submit: Callable[[Any], Future], tasks: Iterable[Any], limit: int) -> Iterator:
+    """Results of ``submit(task)`` for each task as they finish, with at most ``limit`` futures
+    in flight (the tasks are generated lazily, so a large atlas's chunks never all exist at once);
+    the futures still pending when the caller stops are cancelled."""
+    pending: set[Future] = set()
+    try:
+        for task in tasks:
+            pending.add(submit(task))
+            if len(pending) >= limit:
+                finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+                yield from (f.result() for f in finished)
+        while pending:
+            finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+            yield from (f.result() for f in finished)
+    finally:
+        for f in pending:
+            f.cancel()
+
+
 class Backend(Protocol):
     """Runs ``fn`` on tasks, a bounded number at a time, yielding results as they finish."""
 
@@ -102,19 +121,7 @@ class ProcessPool:
     def imap_unordered(self, fn, tasks):
         assert self._pool is not None, "enter the backend first"
         pool = self._pool
-        pending: set[Future] = set()
-        try:
-            for task in tasks:
-                pending.add(pool.submit(fn, task))
-                if len(pending) >= IN_FLIGHT * self.workers:
-                    finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-                    yield from (f.result() for f in finished)
-            while pending:
-                finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-                yield from (f.result() for f in finished)
-        finally:
-            for f in pending:
-                f.cancel()
+        yield from bounded_imap(lambda task: pool.submit(fn, task), tasks, IN_FLIGHT * self.workers)
 
 
 class Dask:

@@ -6,13 +6,12 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable, Iterable, Iterator
-from concurrent.futures import FIRST_COMPLETED, Future, wait
 from time import perf_counter
 from typing import Any
 
 from jik.app.compute.worker import task
 from jik.engine.atlas import AtlasPlan
-from jik.engine.atlas_backends import IN_FLIGHT
+from jik.engine.atlas_backends import IN_FLIGHT, bounded_imap
 from jik.engine.atlas_run import chunk_task, run_chunk
 
 #: Seconds of work in one chunk of a server's atlas: the compute workers serve the API's requests
@@ -57,16 +56,5 @@ class PoolBackend:
         return None
 
     def imap_unordered(self, fn: Callable[[Any], Any], tasks: Iterable[Any]) -> Iterator[Any]:
-        pending: set[Future] = set()
-        try:
-            for chunk in tasks:
-                pending.add(self.pool.submit(atlas_chunk, fn, chunk))
-                if len(pending) >= IN_FLIGHT * self.workers:
-                    finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-                    yield from (f.result() for f in finished)
-            while pending:
-                finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-                yield from (f.result() for f in finished)
-        finally:
-            for f in pending:
-                f.cancel()
+        submit = lambda chunk: self.pool.submit(atlas_chunk, fn, chunk)  # noqa: E731
+        yield from bounded_imap(submit, tasks, IN_FLIGHT * self.workers)
