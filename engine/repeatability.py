@@ -20,17 +20,11 @@ import numpy as np
 
 from jik.engine.exceptions import InvalidInputError, JikError, format_vector
 from jik.engine.inverses import Inverse
+from jik.engine.picard_guesses import chain_guesses
 from jik.engine.progress import Progress, check_cancelled
-from jik.engine.results import RepeatabilityResult
-from jik.engine.solver import (
-    BatchSolveResult,
-    SolveResult,
-    Trajectory,
-    chain_guesses,
-    solve,
-    solve_batch,
-    solve_in_chunks,
-)
+from jik.engine.results import BatchSolveResult, RepeatabilityResult, SolveResult, Trajectory
+from jik.engine.solve_chunks import solve_in_chunks
+from jik.engine.solver import solve, solve_batch
 from jik.engine.unicycle import Unicycle
 from jik.engine.validation import FloatArray, count
 
@@ -43,7 +37,7 @@ MAX_PATH_POINTS = 100
 #: The path is closed by a return leg to k(x0) when its last point is farther than this.
 CLOSE_TOL = 1e-12
 #: With a ``progress``, a discrete leg of one start runs as solves of at most this many
-#: iterations (:func:`jik.engine.solver.solve_in_chunks`: the same iterates), between which a
+#: iterations (:func:`jik.engine.solve_chunks.solve_in_chunks`: the same iterates), between which a
 #: cancellation is heard and the leg's progress told.
 POLL_ITERATIONS = 80
 
@@ -137,7 +131,7 @@ def cycle_guesses(
     ``guides`` (those legs' trajectories, None in the first cycle) are its guesses, and a leg
     then takes one or two sweeps. The pseudoinverse (and the other right inverses, weighted and
     posture) drifts, so the cycle before saves almost nothing: its legs are swept together from
-    ``start`` (:func:`jik.engine.solver.chain_guesses`), one or two sweeps a leg instead of
+    ``start`` (:func:`jik.engine.picard_guesses.chain_guesses`), one or two sweeps a leg instead of
     about ten, and a cycle's numbers depend only on its start. A chain evaluates J# about three
     times as often as the legs would, so it pays only where an evaluation costs little beyond
     numpy's per-call overhead: not for the unicycle.

@@ -37,7 +37,7 @@ from jik.engine.repeatability import (
     repeatability,
 )
 from jik.engine.robot_spec import robot_from_dict
-from jik.engine.solver import gamma_problem
+from jik.engine.solve_rules import gamma_problem
 from jik.engine.solver import solve_batch as engine_solve_batch
 
 _R = TypeVar("_R")
