@@ -137,9 +137,11 @@ def cycle_guesses(
     numpy's per-call overhead: not for the unicycle.
     """
     if (
-        inverse.name != "extended" and inverse.right_inverse and len(targets) > 1
+        inverse.name != "extended"
+        and inverse.right_inverse
+        and len(targets) > 1
         and not isinstance(inverse.kinematics, Unicycle)
-    ):  # fmt: skip
+    ):
         chained = chain_guesses(inverse, start, targets, gamma=gamma)
         if chained is not None:
             return list(chained)
@@ -247,8 +249,11 @@ def repeatability(
     guided = single and mode == "continuous"
     guides: list[Trajectory | None] = [None] * L
     settings: dict[str, Any] = {
-        "gamma": gamma, "mode": mode, "tol": tol, "max_iterations": max_iterations,
-    }  # fmt: skip
+        "gamma": gamma,
+        "mode": mode,
+        "tol": tol,
+        "max_iterations": max_iterations,
+    }
     first = 0
     if resume is not None:
         done, given = _resumed(resume, n, L, kin.p, cycles)
@@ -270,16 +275,29 @@ def repeatability(
             try:
                 if chunked:  # (one start, with a progress)
                     res: SolveResult | BatchSolveResult = solve_in_chunks(
-                        inverse, current[0], targets[0, j], chunk=POLL_ITERATIONS, gamma=gamma,
-                        tol=tol, max_iterations=max_iterations, record=record,
+                        inverse,
+                        current[0],
+                        targets[0, j],
+                        chunk=POLL_ITERATIONS,
+                        gamma=gamma,
+                        tol=tol,
+                        max_iterations=max_iterations,
+                        record=record,
                         between=_between(progress, f"in {where}"),
-                    )  # fmt: skip
+                    )
                 elif single:  # (a SolveResult: its trajectory guides the next cycle's leg)
-                    res = solve(inverse, current[0], targets[0, j], record=record or guided,
-                                guess=guesses[j] if guided else None, **settings)  # fmt: skip
+                    res = solve(
+                        inverse,
+                        current[0],
+                        targets[0, j],
+                        record=record or guided,
+                        guess=guesses[j] if guided else None,
+                        **settings,
+                    )
                 else:  # (current[ids] is (k, p): a BatchSolveResult)
-                    res = solve_batch(inverse, current[ids], targets[ids, j], record=False,
-                                      **settings)  # fmt: skip
+                    res = solve_batch(
+                        inverse, current[ids], targets[ids, j], record=False, **settings
+                    )
             except JikError as exc:
                 if on_undefined == "raise":
                     raise
@@ -331,8 +349,9 @@ def _resumed(resume: Resume, n: int, L: int, p: int, cycles: int):
             f"(c * {L}, {p}) for one start or (n, c * {L}, {p}); got shape {done.shape}"
         )
     if not np.all(np.isfinite(done)):
-        raise InvalidInputError("resume.legs contains NaN: go on only from a run whose legs all "
-                                "converged")  # fmt: skip
+        raise InvalidInputError(
+            "resume.legs contains NaN: go on only from a run whose legs all converged"
+        )
     guides = list(resume.guides)
     if guides and len(guides) != L:
         raise InvalidInputError(f"resume.guides must have one trajectory (or None) per leg, {L}")

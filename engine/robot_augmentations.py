@@ -44,8 +44,9 @@ def augmentations_from_dict(kin: Kinematics, items, key: str | None = None):
             )
         label = item.get("label", item["name"])
         if not isinstance(label, str) or label in {s.name for s in specs}:
-            raise InvalidInputError(f"{where}.label must be a new name, got {label!r}",
-                                    f"{where}.label")  # fmt: skip
+            raise InvalidInputError(
+                f"{where}.label must be a new name, got {label!r}", f"{where}.label"
+            )
         factory: Callable[..., AugmentingMap]
         if item["name"] == "formula":
             unknown = set(item) - robot_kinds.augmentation_keys("formula")
@@ -64,8 +65,10 @@ def augmentations_from_dict(kin: Kinematics, items, key: str | None = None):
                 text = f"E2-optimal h on {box} by the Ritz solve of (20), degree {degree}"
             else:
                 degree = count(item.get("degree", TOTAL_DEGREE), f"{where}.degree", 1, 6)
-                text = (f"E2-optimal h of {len(box)} joints on {box}: Ritz solve of (19) in a "
-                        f"total-degree {degree} basis on a Sobol rule")  # fmt: skip
+                text = (
+                    f"E2-optimal h of {len(box)} joints on {box}: Ritz solve of (19) in a "
+                    f"total-degree {degree} basis on a Sobol rule"
+                )
             factory = synthesis(box, fix, degree, key)
             region = region or box
         if unknown:
@@ -80,10 +83,14 @@ def _formula_maps(kin: Kinematics, item: Mapping, where: str) -> tuple[FormulaMa
     texts = [h] if k == 1 else h
     if not isinstance(texts, list) or len(texts) != k:
         raise InvalidInputError(
-            f"{where}.h must be " + ("a formula" if k == 1 else
-            f"a list of {k} formulas (p - r = {k}: one map per degree of redundancy)"),
+            f"{where}.h must be "
+            + (
+                "a formula"
+                if k == 1
+                else f"a list of {k} formulas (p - r = {k}: one map per degree of redundancy)"
+            ),
             f"{where}.h",
-        )  # fmt: skip
+        )
     names, params = kin.variable_names, item.get("parameters")
     fields = [f"{where}.h"] if k == 1 else [f"{where}.h.{j}" for j in range(k)]
     return tuple(FormulaMap(t, names, params, field=f) for t, f in zip(texts, fields, strict=True))
@@ -106,6 +113,7 @@ def _region(kin: Kinematics, item: Mapping, where: str):
     except InvalidInputError as exc:
         raise InvalidInputError(f"{where}.region: {exc}", f"{where}.region") from None
     if len(box) < 2:
-        raise InvalidInputError(f"{where}.region must have at least two variables",
-                                f"{where}.region")  # fmt: skip
+        raise InvalidInputError(
+            f"{where}.region must have at least two variables", f"{where}.region"
+        )
     return box, fix

@@ -105,9 +105,13 @@ class Robot:
             if name in self.map_vectors:
                 return VectorExtendedInverse(self.kinematics, self.map_vectors[name])
         return make_inverse(
-            self.kinematics, algorithm, augmentation, parameters, spec=self.spec,
+            self.kinematics,
+            algorithm,
+            augmentation,
+            parameters,
+            spec=self.spec,
             algorithm_parameters=algorithm_parameters,
-        )  # fmt: skip
+        )
 
 
 def _get(d: Mapping, key: str, kind: type, what: str, default: Any = None) -> Any:
@@ -156,8 +160,9 @@ def _urdf_file(d: Mapping, base_dir: Path | None) -> str:
     from jik.engine.urdf import MAX_URDF_BYTES
 
     if base_dir is None:
-        raise InvalidInputError("urdf_file is read only from a robot file; give urdf (the text)",
-                                "urdf_file")  # fmt: skip
+        raise InvalidInputError(
+            "urdf_file is read only from a robot file; give urdf (the text)", "urdf_file"
+        )
     name = _get(d, "urdf_file", str, "a path relative to the robot file")
     path = (base_dir / name).resolve()
     if not path.is_relative_to(base_dir.resolve()) or not path.is_file():
@@ -179,15 +184,18 @@ def _x_range(kin: Kinematics, d: Mapping) -> tuple[tuple[float, float], ...]:
     if "x_range" in d:
         box = _points(d["x_range"], 2, "x_range")
         if box.shape != (kin.p, 2) or not np.all(box[:, 0] < box[:, 1]):
-            raise InvalidInputError(f"x_range must be {kin.p} pairs [lo, hi] with lo < hi",
-                                    "x_range")  # fmt: skip
+            raise InvalidInputError(
+                f"x_range must be {kin.p} pairs [lo, hi] with lo < hi", "x_range"
+            )
         return tuple((float(a), float(b)) for a, b in box)
     limits = getattr(kin, "limits", None)
     if limits is not None:
         return tuple(limits)
     if isinstance(kin, PlanarChain):
-        return tuple((-math.pi, math.pi) if rev else (-float(length), float(length))
-                     for rev, length in zip(kin.revolute, kin.lengths, strict=True))  # fmt: skip
+        return tuple(
+            (-math.pi, math.pi) if rev else (-float(length), float(length))
+            for rev, length in zip(kin.revolute, kin.lengths, strict=True)
+        )
     return ((-math.pi, math.pi),) * kin.p
 
 
@@ -213,8 +221,9 @@ def _defaults(kin: Kinematics, d: Mapping, box) -> tuple:
     if target.ndim != 1:
         raise InvalidInputError(f"target must be one task point ({kin.r} numbers)", "target")
     if path.ndim != 2 or not 1 <= len(path) <= MAX_PATH_POINTS:
-        raise InvalidInputError(f"path must be a list of 1 to {MAX_PATH_POINTS} task points",
-                                "path")  # fmt: skip
+        raise InvalidInputError(
+            f"path must be a list of 1 to {MAX_PATH_POINTS} task points", "path"
+        )
     return tuple(x0.tolist()), tuple(target.tolist()), tuple(map(tuple, path.tolist()))
 
 
@@ -247,8 +256,9 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
     unknown = set(d) - allowed
     if unknown:
         key = sorted(map(str, unknown))[0]
-        raise InvalidInputError(f"unknown key {key!r} for a {kind} robot; known: {sorted(allowed)}",
-                                key)  # fmt: skip
+        raise InvalidInputError(
+            f"unknown key {key!r} for a {kind} robot; known: {sorted(allowed)}", key
+        )
     if kind in ROBOTS:
         base = ROBOTS[kind]
         kin = base.build(**_get(d, "parameters", dict, "a mapping of parameters", {}))
@@ -266,8 +276,9 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
         kin.joint_limits = check_limits(d["limits"], kin.p)
     box = _x_range(kin, d)
     x0, target, path = _defaults(kin, d, box)
-    key = json.dumps({k: v for k, v in d.items() if k != "augmentations"}, sort_keys=True,
-                     default=str)  # fmt: skip
+    key = json.dumps(
+        {k: v for k, v in d.items() if k != "augmentations"}, sort_keys=True, default=str
+    )
     augmentations, region, vectors = augmentations_from_dict(kin, d.get("augmentations", []), key)
     title = _get(d, "title", str, "a string", kind.replace("_", " "))
     task_names = {
@@ -276,15 +287,27 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
         "urdf": tuple(getattr(kin, "task_names", ())),
     }.get(kind, tuple(getattr(kin, "task_names", ())))
     spec = RobotSpec(
-        name=kind, title=title, description=ARMS[kind].description if kind in ARMS else
-        f"{title}: a {kind} robot defined by data",
-        equation="(4)", p=kin.p, r=kin.r, variable_names=tuple(kin.variable_names),
-        task_names=tuple(task_names), parameters=(), vector_parameters=(),
-        factory=lambda: kin, default_x0=x0, default_target=target, default_path=path,
-        x_range=box, augmentations=augmentations,
+        name=kind,
+        title=title,
+        description=ARMS[kind].description
+        if kind in ARMS
+        else f"{title}: a {kind} robot defined by data",
+        equation="(4)",
+        p=kin.p,
+        r=kin.r,
+        variable_names=tuple(kin.variable_names),
+        task_names=tuple(task_names),
+        parameters=(),
+        vector_parameters=(),
+        factory=lambda: kin,
+        default_x0=x0,
+        default_target=target,
+        default_path=path,
+        x_range=box,
+        augmentations=augmentations,
         default_augmentation=augmentations[0].name if augmentations else "",
         functional_region=region,
-    )  # fmt: skip
+    )
     return Robot(spec, kin, dict(d), vectors)
 
 
@@ -294,9 +317,11 @@ def load_robot(source: str | Path) -> Robot:
     if not path.is_file():
         if str(source) in ROBOTS or str(source) in ARMS:
             return robot_from_dict({"name": str(source)})
-        raise InvalidInputError(f"robot {str(source)!r} is neither a file nor a built-in robot "
-                                f"({sorted(ROBOTS)}) or catalogue arm ({sorted(ARMS)})",
-                                "robot")  # fmt: skip
+        raise InvalidInputError(
+            f"robot {str(source)!r} is neither a file nor a built-in robot "
+            f"({sorted(ROBOTS)}) or catalogue arm ({sorted(ARMS)})",
+            "robot",
+        )
     if path.stat().st_size > MAX_FILE_BYTES:
         raise InvalidInputError(f"robot file larger than {MAX_FILE_BYTES} bytes", "robot")
     text = path.read_text(encoding="utf-8")
@@ -304,8 +329,10 @@ def load_robot(source: str | Path) -> Robot:
         try:
             import yaml
         except ImportError:  # PyYAML is optional
-            raise InvalidInputError("YAML robot files need PyYAML (pip install pyyaml); or "
-                                    "write the robot as JSON", "robot") from None  # fmt: skip
+            raise InvalidInputError(
+                "YAML robot files need PyYAML (pip install pyyaml); or write the robot as JSON",
+                "robot",
+            ) from None
         try:
             data = yaml.safe_load(text)
         except yaml.YAMLError as exc:

@@ -83,8 +83,12 @@ def solve_in_chunks(
             f"and {y_d.shape}"
         )
     size = count(chunk, "chunk", 1, MAX_ITERATIONS_LIMIT)
-    cap = count(MAX_ITERATIONS if max_iterations is None else max_iterations,
-                "max_iterations", 1, MAX_ITERATIONS_LIMIT)  # fmt: skip
+    cap = count(
+        MAX_ITERATIONS if max_iterations is None else max_iterations,
+        "max_iterations",
+        1,
+        MAX_ITERATIONS_LIMIT,
+    )
     e0 = float(np.linalg.norm(kin.forward(x[None]) - y_d, axis=-1)[0])
     pieces: list[Trajectory] = []
     done, status = 0, Status.RUNNING
@@ -93,9 +97,15 @@ def solve_in_chunks(
     while True:
         try:
             batch = solve_batch(
-                inverse, x[None], y_d[None], gamma=gamma, mode="discrete", tol=tol,
-                max_iterations=min(size, cap - done), record=record,
-            )  # fmt: skip
+                inverse,
+                x[None],
+                y_d[None],
+                gamma=gamma,
+                mode="discrete",
+                tol=tol,
+                max_iterations=min(size, cap - done),
+                record=record,
+            )
             res = batch[0]
         except JikError as exc:
             if size == 1:
@@ -133,8 +143,13 @@ def _joined(pieces: list[Trajectory]) -> Trajectory:
     def cat(name: str) -> FloatArray:
         return np.concatenate([getattr(p, name) for p in pieces])
 
-    return Trajectory(theta=cat("theta"), x=cat("x"), y=cat("y"), error=cat("error"),
-                      h=None if pieces[0].h is None else cat("h"))  # fmt: skip
+    return Trajectory(
+        theta=cat("theta"),
+        x=cat("x"),
+        y=cat("y"),
+        error=cat("error"),
+        h=None if pieces[0].h is None else cat("h"),
+    )
 
 
 def _fraction(e0: float, e: float, tol: float) -> float:

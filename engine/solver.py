@@ -76,9 +76,13 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto", guess=N
     # (near a singularity) DOP853 is cheaper, so Picard gets a budget and DOP853 takes over.
     budget = max_steps if method == "picard" else min(max_steps, PICARD_BUDGET)
     x1, done, sigma, sweeps, prec = picard_path(
-        inverse, x0[moving], e0[moving], budget,
-        None if guess is None else [guess[i] for i in moving], check_start=True,
-    )  # fmt: skip
+        inverse,
+        x0[moving],
+        e0[moving],
+        budget,
+        None if guess is None else [guess[i] for i in moving],
+        check_start=True,
+    )
     nit[moving] = sweeps
     if rec is not None:
         for mem, sig, xs in prec:
@@ -220,10 +224,17 @@ def solve(
             f"{y_d.shape}; solve_batch solves a batch"
         )
     batch = solve_batch(
-        inverse, x0[None], y_d[None], gamma=gamma, mode=mode, tol=tol,
-        max_iterations=max_iterations, record=record, method=method,
+        inverse,
+        x0[None],
+        y_d[None],
+        gamma=gamma,
+        mode=mode,
+        tol=tol,
+        max_iterations=max_iterations,
+        record=record,
+        method=method,
         guess=None if guess is None else [guess],
-    )  # fmt: skip
+    )
     return batch[0]
 
 

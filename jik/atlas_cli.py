@@ -46,10 +46,16 @@ def add_atlas_parser(sub) -> None:
         help="repeatability atlas: drift after each cycle over many starts (and paths)",
         description=__doc__.split("\n\n")[2],
     )
-    p.add_argument("--robot", default="manipulator2",
-                   help="a built-in robot, or a robot file (.json, .yaml)")  # fmt: skip
-    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
-                   help="a robot parameter (repeat it), e.g. l=1.5")  # fmt: skip
+    p.add_argument(
+        "--robot", default="manipulator2", help="a built-in robot, or a robot file (.json, .yaml)"
+    )
+    p.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="a robot parameter (repeat it), e.g. l=1.5",
+    )
     p.add_argument("--path", required=True, help='task points "y1,y2; y1,y2; ...", a loop')
     p.add_argument("--starts", type=int, default=256, help="starts per path (default 256)")
     p.add_argument("--sampling", choices=("grid", "sample"), default="grid")
@@ -59,15 +65,28 @@ def add_atlas_parser(sub) -> None:
     )
     p.add_argument("--reference", help='"x1,x2,...": where s = 0 comes from (robot default)')
     p.add_argument("--cycles", type=int, default=3)
-    p.add_argument("--algorithm", action="append", choices=ALGORITHM_NAMES,
-                   help="repeat for several, compared over the same starts "
-                   "(default pseudoinverse)")  # fmt: skip
+    p.add_argument(
+        "--algorithm",
+        action="append",
+        choices=ALGORITHM_NAMES,
+        help="repeat for several, compared over the same starts (default pseudoinverse)",
+    )
     add_algorithm_parameter_options(p)
     p.add_argument("--augmentation", help="augmenting map of the extended inverse")
-    p.add_argument("--shift", action="append", default=[], metavar='"dy1,dy2"',
-                   help="a translation of the path (repeat it; default none)")  # fmt: skip
-    p.add_argument("--scale", action="append", type=float, default=[],
-                   help="a scale of the path about its first point (default 1)")  # fmt: skip
+    p.add_argument(
+        "--shift",
+        action="append",
+        default=[],
+        metavar='"dy1,dy2"',
+        help="a translation of the path (repeat it; default none)",
+    )
+    p.add_argument(
+        "--scale",
+        action="append",
+        type=float,
+        default=[],
+        help="a scale of the path about its first point (default 1)",
+    )
     p.add_argument(
         "--chunk",
         type=int,
@@ -80,8 +99,11 @@ def add_atlas_parser(sub) -> None:
     p.add_argument("--out", default="atlas.json", help="output JSON (default atlas.json)")
     p.add_argument("--csv", action="store_true", help="also write the CSV for a small atlas")
     p.add_argument("--no-figure", action="store_true", help="write no HTML figure")
-    p.add_argument("--no-leg-ends", action="store_true",
-                   help="leave the leg ends out (a large CSV is then far smaller)")  # fmt: skip
+    p.add_argument(
+        "--no-leg-ends",
+        action="store_true",
+        help="leave the leg ends out (a large CSV is then far smaller)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=atlas_command)
 
@@ -155,31 +177,49 @@ def _run(args: argparse.Namespace) -> int:
     algorithms = args.algorithm or ["pseudoinverse"]
     if Path(args.robot).is_file() or args.robot in ARMS:  # a user's robot or a catalogue arm
         if args.param:
-            raise InvalidInputError("--param is for a built-in robot; a robot file holds its "
-                                    "parameters", "param")  # fmt: skip
+            raise InvalidInputError(
+                "--param is for a built-in robot; a robot file holds its parameters", "param"
+            )
         robot = load_robot(args.robot)
         spec, kin = robot.spec, robot.kinematics
-        inverses = [robot.inverse(a, args.augmentation,
-                                  algorithm_parameters=algorithm_parameters(args, a))
-                    for a in algorithms]  # fmt: skip
+        inverses = [
+            robot.inverse(a, args.augmentation, algorithm_parameters=algorithm_parameters(args, a))
+            for a in algorithms
+        ]
     else:
         spec = robot_spec(args.robot)
         kin = spec.build(**dict(_param(t) for t in args.param))
-        inverses = [make_inverse(kin, a, args.augmentation, None, spec.name,
-                                 algorithm_parameters=algorithm_parameters(args, a))
-                    for a in algorithms]  # fmt: skip
+        inverses = [
+            make_inverse(
+                kin,
+                a,
+                args.augmentation,
+                None,
+                spec.name,
+                algorithm_parameters=algorithm_parameters(args, a),
+            )
+            for a in algorithms
+        ]
     arc = _numbers(args.arc, "--arc") if args.arc else [-MAX_ARC, MAX_ARC]
     reference = _numbers(args.reference, "--reference") if args.reference else spec.default_x0
     backend = backend_option(args)
     backend_for(backend)  # (a bad option fails here, before the curves are traced)
     plan = plan_atlas(
-        inverses, _points(args.path, "--path"), cycles=args.cycles, n_starts=args.starts,
-        arc=arc, sampling=args.sampling, seed=args.seed, reference=reference,
+        inverses,
+        _points(args.path, "--path"),
+        cycles=args.cycles,
+        n_starts=args.starts,
+        arc=arc,
+        sampling=args.sampling,
+        seed=args.seed,
+        reference=reference,
         box=None if args.arc or not spec.x_range else spec.x_range,
         shifts=[_numbers(s, "--shift") for s in args.shift] or None,
-        scales=args.scale or None, chunk=args.chunk or default_chunk(args, DEFAULT_CHUNK),
-        gamma=spec.default_gamma, mode=spec.default_mode,
-    )  # fmt: skip
+        scales=args.scale or None,
+        chunk=args.chunk or default_chunk(args, DEFAULT_CHUNK),
+        gamma=spec.default_gamma,
+        mode=spec.default_mode,
+    )
     big = plan.size > JSON_RUNS
     csv_path = out.with_suffix(".csv") if big or args.csv else None
     A, P, N, C = len(inverses), len(plan.paths), plan.n_starts, plan.cycles
@@ -195,16 +235,27 @@ def _run(args: argparse.Namespace) -> int:
             progress(arrays.done, plan.size)
     elapsed = time.perf_counter() - t0
     inputs = {
-        "robot": spec.name, "robot_file": args.robot if Path(args.robot).is_file() else None,
-        "robot_parameters": kin.parameters, "path": _points(args.path, "path"),
-        "cycles": C, "algorithms": list(plan.algorithms), "augmentation": args.augmentation,
+        "robot": spec.name,
+        "robot_file": args.robot if Path(args.robot).is_file() else None,
+        "robot_parameters": kin.parameters,
+        "path": _points(args.path, "path"),
+        "cycles": C,
+        "algorithms": list(plan.algorithms),
+        "augmentation": args.augmentation,
         "algorithm_parameters": {a: algorithm_parameters(args, a) for a in plan.algorithms},
-        "starts": N, "sampling": args.sampling, "seed": args.seed, "arc": arc if args.arc else None,
-        "reference": list(reference), "shifts": [_numbers(t, "--shift") for t in args.shift],
+        "starts": N,
+        "sampling": args.sampling,
+        "seed": args.seed,
+        "arc": arc if args.arc else None,
+        "reference": list(reference),
+        "shifts": [_numbers(t, "--shift") for t in args.shift],
         "scales": args.scale or [1.0],
-        "chunk": plan.chunk, "gamma": plan.settings["gamma"], "mode": plan.settings["mode"],
-        "tol": plan.settings["tol"], "backend": backend,
-    }  # fmt: skip
+        "chunk": plan.chunk,
+        "gamma": plan.settings["gamma"],
+        "mode": plan.settings["mode"],
+        "tol": plan.settings["tol"],
+        "backend": backend,
+    }
     doc: dict[str, Any] = {
         "inputs": inputs,
         "arc": list(plan.manifolds[0].arc),

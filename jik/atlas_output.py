@@ -61,8 +61,11 @@ class Gathered:
                 0 if self.outside is None else self.outside
             )
         if self.keep:
-            for name, values in (("drift", chunk.drift), ("success", chunk.success),
-                                 ("legs", chunk.leg_ends)):  # fmt: skip
+            for name, values in (
+                ("drift", chunk.drift),
+                ("success", chunk.success),
+                ("legs", chunk.leg_ends),
+            ):
                 if getattr(self, name) is not None:
                     flat = getattr(self, name).reshape(len(values), -1, *values.shape[2:])
                     flat[:, lo:hi] = values
@@ -110,8 +113,11 @@ class CsvWriter:
         for alg in self.plan.algorithms:
             cols += [f"{alg}_success"] + [f"{alg}_drift_{c + 1}" for c in range(self.plan.cycles)]
             if self.legs:
-                cols += [f"{alg}_leg{k + 1}_{v}" for k in range(self.plan.cycles * self.plan.legs)
-                         for v in names]  # fmt: skip
+                cols += [
+                    f"{alg}_leg{k + 1}_{v}"
+                    for k in range(self.plan.cycles * self.plan.legs)
+                    for v in names
+                ]
         return cols
 
     def add(self, task, chunk) -> None:
@@ -158,13 +164,16 @@ def atlas_figure(s, drift_last, algorithms, cycles: int, paths: int, n: int, lab
 
     fig = go.Figure()
     for a, alg in enumerate(algorithms):
-        fig.add_trace(go.Scattergl(x=s, y=drift_last[a], mode="markers", name=alg,
-                                   marker={"size": 4}))  # fmt: skip
+        fig.add_trace(
+            go.Scattergl(x=s, y=drift_last[a], mode="markers", name=alg, marker={"size": 4})
+        )
     fig.update_layout(
         title=f"Repeatability atlas: drift after cycle {cycles} ({paths} path(s), {n} starts each)",
-        xaxis_title=label, yaxis_title=f"||x after cycle {cycles} - x0||", yaxis_type="log",
+        xaxis_title=label,
+        yaxis_title=f"||x after cycle {cycles} - x0||",
+        yaxis_type="log",
         template="plotly_white",
-    )  # fmt: skip
+    )
     return fig
 
 
