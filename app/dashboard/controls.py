@@ -25,7 +25,7 @@ from jik.app.dashboard.robots import state_spec
 from jik.engine.arms import ARMS
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS
-from jik.engine.solver import DISCRETE_GAMMA_BOUND, MAX_ITERATIONS, MAX_STEPS
+from jik.engine.solve_rules import DISCRETE_GAMMA_BOUND, MAX_ITERATIONS, MAX_STEPS
 
 #: gamma's resolution: the page's log-scale slider and the scene's slider both land on it.
 GAMMA_STEP = 0.001

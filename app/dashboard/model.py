@@ -38,7 +38,7 @@ from jik.app.dashboard.robots import USER_KINDS, default_definition, user_robot
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS, robot_spec
 from jik.engine.repeatability import MAX_PATH_POINTS
-from jik.engine.solver import gamma_problem
+from jik.engine.solve_rules import gamma_problem
 
 ALGORITHMS = ("pseudoinverse", "extended")
 #: One colour per algorithm, used in the scene and in every plot.
