@@ -13,9 +13,11 @@ import pytest
 from jik.app.dashboard.controls import controls
 from jik.app.dashboard.joint_limits import limits_summary, outside_joints, state_limits
 from jik.app.dashboard.map_figures import augmenting_spec
+from jik.app.dashboard.map_synthesis import built_map
 from jik.app.dashboard.model import default_state, updated_state
 from jik.app.dashboard.results import compute
 from jik.app.dashboard.robots import state_kinematics
+from jik.app.dashboard.runs import Cancelled
 from jik.app.dashboard.verdict import verdict
 from jik.app.scene.arm_marks import end_frame, joint_points, target_pose
 from jik.app.scene.mechanisms import fixtures_of
@@ -111,3 +113,19 @@ def test_vector_maps_run_for_p_minus_r_two():
         assert max(result.runs["extended"].drift) < 1e-9
         panel = json.dumps(augmenting_spec(result), ensure_ascii=False)
         assert "a vector of p − r = 2 maps" in panel and "for one degree of redundancy" in panel
+
+
+def test_the_synthesis_reports_progress_and_a_newer_change_stops_it():
+    """The Panda's map is synthesized on first use with its progress on the way; a cancellation
+    stops it (nothing kept: the next build synthesizes again, to the end)."""
+    title = "a Panda of this test"  # (a definition of its own: no map synthesized before)
+    state = updated_state(
+        default_state(), {"robot": "panda", "robot_definition": {"name": "panda", "title": title}}
+    )
+    seen: list[float] = []
+    with pytest.raises(Cancelled):
+        built_map(state, lambda f, what: seen.append(f), lambda: len(seen) >= 2)
+    assert len(seen) == 2 and seen[-1] < 1
+    seen.clear()
+    _, amap = built_map(state, lambda f, what: seen.append(f), lambda: False)
+    assert seen[0] < 0.5 and seen[-1] == 1.0 and amap is not None
