@@ -41,7 +41,7 @@ from jik.engine.progress import ProgressCallbacks
 from jik.engine.registry import ALGORITHMS, make_inverse
 from jik.engine.repeatability import CLOSE_TOL
 from jik.engine.self_motion import MAX_ARC
-from jik.engine.solver import gamma_problem
+from jik.engine.solve_rules import gamma_problem
 
 
 class AtlasJobNotFound(LookupError):

@@ -8,7 +8,7 @@ from jik.app.compute.robot_requests import check_configuration, check_task_point
 from jik.app.compute.synthesis import synthesis_region
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS
-from jik.engine.solver import gamma_problem
+from jik.engine.solve_rules import gamma_problem
 
 
 def precheck(req: S.SolveRequest | S.RepeatabilityRequest | S.SynthesizeRequest) -> None:

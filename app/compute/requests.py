@@ -36,7 +36,7 @@ from jik.engine.exceptions import InvalidInputError, JikError, SingularConfigura
 from jik.engine.limits import repeatability_report, robot_limits
 from jik.engine.registry import RobotSpec, make_inverse
 from jik.engine.repeatability import REPEATABLE_DRIFT, repeatability
-from jik.engine.solver import gamma_problem
+from jik.engine.solve_rules import gamma_problem
 from jik.engine.solver import solve_batch as engine_solve_batch
 
 _R = TypeVar("_R")
