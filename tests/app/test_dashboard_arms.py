@@ -10,6 +10,7 @@ import json
 import numpy as np
 import pytest
 
+from jik.app.dashboard.atlas import atlas_figure, atlas_request
 from jik.app.dashboard.controls import controls
 from jik.app.dashboard.joint_limits import limits_summary, outside_joints, state_limits
 from jik.app.dashboard.map_figures import augmenting_spec
@@ -129,3 +130,25 @@ def test_the_synthesis_reports_progress_and_a_newer_change_stops_it():
     seen.clear()
     _, amap = built_map(state, lambda f, what: seen.append(f), lambda: False)
     assert seen[0] < 0.5 and seen[-1] == 1.0 and amap is not None
+
+
+def test_the_atlas_of_an_arm_asks_for_its_definition_and_counts_the_limits():
+    """The session's atlas of the Panda is the REST atlas of its definition and its default
+    map; the heatmap says how many runs of each algorithm left the joint limits. A user's map
+    other than the first is sent as its entry of the definition."""
+    req = atlas_request(_panda(), 16, 2)
+    assert req.robot.name == "panda" and req.augmentation is None
+    assert len(req.path[0]) == 6 and req.reference == list(_panda().x0)
+    drift = [[[1e-4, 2e-4]] * 3]  # (P = 1, N = 3, C = 2)
+    result = {"algorithms": ["pseudoinverse", "extended"], "parameter": [-0.1, 0.0, 0.1],
+              "paths": [req.path], "drift": {"pseudoinverse": drift, "extended": drift},
+              "outside_limits": {"pseudoinverse": 2, "extended": 0}}  # fmt: skip
+    notes = [a["text"] for a in atlas_figure(result, req)["layout"]["annotations"]]
+    assert "2 of 3 runs left the joint limits" in notes[0]
+    assert "0 of 3 runs left the joint limits" in notes[1]
+    arm = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6],
+           "augmentations": [{"name": "formula", "h": "x3"},
+                             {"name": "formula", "h": "x2", "label": "second"}]}  # fmt: skip
+    state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": arm})
+    req = atlas_request(updated_state(state, {"augmentation": "second"}), 8)
+    assert req.augmentation.h == "x2" and req.robot.name == "planar_chain"
