@@ -19,9 +19,11 @@ from jik.app.dashboard.model import default_state, updated_state
 from jik.app.dashboard.results import compute
 from jik.app.dashboard.robots import state_kinematics
 from jik.app.dashboard.runs import Cancelled
+from jik.app.dashboard.session import Dashboard
 from jik.app.dashboard.verdict import verdict
-from jik.app.scene.arm_marks import end_frame, joint_points, target_pose
-from jik.app.scene.mechanisms import fixtures_of
+from jik.app.scene import DashboardScene
+from jik.app.scene.arm_marks import OUTSIDE_COLOR, end_frame, joint_points, target_pose
+from jik.app.scene.mechanisms import Chain, fixtures_of
 from jik.engine.arms import ARMS
 from tests.app.test_sessions import _computed, _open
 
@@ -153,3 +155,25 @@ def test_the_atlas_of_an_arm_asks_for_its_definition_and_counts_the_limits():
     state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": arm})
     req = atlas_request(updated_state(state, {"augmentation": "second"}), 8)
     assert req.augmentation.h == "x2" and req.robot.name == "planar_chain"
+
+
+def test_the_scene_colours_a_joint_while_it_is_outside_its_limits():
+    """The Panda's copy in the scene: at x4 = -0.05 the joint of x4 takes OUTSIDE_COLOR, the
+    others keep the copy's colour; back at home, it is the copy's colour again. Its end link
+    carries a frame (the pose task)."""
+    state = updated_state(_panda(), {"x0.3": -0.05, "task": "target"})
+    dashboard = Dashboard(state)
+    scene = DashboardScene(dashboard)
+    try:
+        arm = Chain(scene.server.scene, "/test/arm", (10, 20, 30), None, 0.0, state,
+                    ((-1.0, 1.0), (-1.0, 1.0)))  # fmt: skip
+        arm.pose(state.x0)
+        colours = [tuple(ball.color) for ball in arm.joints]
+        assert colours[joint_points(arm.kin)[3]] == OUTSIDE_COLOR
+        assert colours.count(OUTSIDE_COLOR) == 1
+        arm.pose(_panda().x0)
+        assert all(tuple(ball.color) == (10, 20, 30) for ball in arm.joints)
+        assert arm.end is not None
+    finally:
+        scene.stop()
+        dashboard.stop()
