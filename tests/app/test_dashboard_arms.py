@@ -10,6 +10,7 @@ import json
 import numpy as np
 import pytest
 
+from jik.app.compute.atlas_jobs import AtlasLimits, plan_request
 from jik.app.dashboard.atlas import atlas_figure, atlas_request
 from jik.app.dashboard.controls import controls
 from jik.app.dashboard.joint_limits import limits_summary, outside_joints, state_limits
@@ -25,6 +26,7 @@ from jik.app.scene import DashboardScene
 from jik.app.scene.arm_marks import OUTSIDE_COLOR, end_frame, joint_points, target_pose
 from jik.app.scene.mechanisms import Chain, fixtures_of
 from jik.engine.arms import ARMS
+from jik.engine.atlas_run import run_atlas
 from tests.app.test_sessions import _computed, _open
 
 
@@ -177,3 +179,26 @@ def test_the_scene_colours_a_joint_while_it_is_outside_its_limits():
     finally:
         scene.stop()
         dashboard.stop()
+
+
+def test_the_atlas_of_a_robot_with_two_degrees_of_redundancy():
+    """A planar 4R chain with a position task (p - r = 2): its self-motion manifolds are
+    surfaces, so the session's atlas gives its starts explicitly, x0 first, all on k(x) = k(x0);
+    the pseudoinverse drifts from them, the extended inverse with h = (x3, x4) does not; the
+    heatmap numbers the starts."""
+    arm = {"name": "planar_chain", "joints": "RRRR", "lengths": [1.0, 0.8, 0.6, 0.4],
+           "augmentations": [{"name": "formula", "h": ["x3", "x4"]}]}  # fmt: skip
+    state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": arm})
+    req = atlas_request(state, 12, 2)
+    X = np.asarray(req.start_points)
+    kin = state_kinematics(state)
+    assert X.shape == (12, 4) and np.allclose(X[0], state.x0)
+    np.testing.assert_allclose(kin.forward(X), kin.forward(X[:1]).repeat(12, 0), atol=1e-12)
+    res = run_atlas(plan_request(req, AtlasLimits()))
+    drift = {a: res.drift[k] for k, a in enumerate(res.algorithms)}  # (P, N, C)
+    assert np.nanmax(drift["extended"]) < 1e-9 and np.nanmin(drift["pseudoinverse"]) > 1e-6
+    result = {"algorithms": list(res.algorithms), "parameter": [], "paths": res.paths.tolist(),
+              "drift": {a: d.tolist() for a, d in drift.items()}}  # fmt: skip
+    figure = atlas_figure(result, req)
+    assert list(figure["data"][0]["x"]) == list(range(1, 13))
+    assert figure["layout"]["xaxis"]["title"]["text"].startswith("start")
