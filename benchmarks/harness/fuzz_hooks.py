@@ -60,7 +60,8 @@ from jik.app.compute.exceptions import RequestError
 from jik.app.compute.requests import _check_start, _setup, check_configuration, check_task_point
 from jik.app.compute.synthesis import synthesis_region
 from jik.app.compute.user_robots import user_robot
-from jik.app.dashboard.model import StatePatch, default_state, patch_of, updated_state
+from jik.app.dashboard.model import default_state, updated_state
+from jik.app.dashboard.patch import StatePatch, patch_of
 from jik.engine.exceptions import InvalidInputError, JikError
 from jik.engine.registry import ROBOTS, make_inverse
 

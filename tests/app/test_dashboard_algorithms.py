@@ -1,0 +1,142 @@
+"""The dashboard's choice of algorithms: one to five of the engine's catalogue side by side, their
+parameters as controls with the engine's ranges, one colour each in every panel, their cache
+keys, the verdict's sentences about them, and the session API taking the choice."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from jik.app.dashboard.algorithms import COLORS, DEFAULT_ALGORITHMS, STYLES, cache_key, runs_key
+from jik.app.dashboard.atlas import atlas_request
+from jik.app.dashboard.controls import controls
+from jik.app.dashboard.figures import figure_specs
+from jik.app.dashboard.model import default_state, updated_state
+from jik.app.dashboard.results import compute
+from jik.app.dashboard.verdict import verdict
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.registry import ALGORITHMS
+
+THREE = ["pseudoinverse", "extended", "posture"]
+
+
+def test_the_default_view_runs_the_paper_two():
+    state = default_state()
+    assert state.algorithms == DEFAULT_ALGORITHMS and state.algorithm_parameters == {}
+    assert [c.key for c in controls(state) if c.key.startswith("algorithm_parameters")] == []
+
+
+def test_choosing_algorithms_fills_their_parameters_from_the_engine():
+    state = updated_state(default_state(), {"algorithms": ["posture", "damped", "pseudoinverse"]})
+    assert state.algorithms == ("pseudoinverse", "damped", "posture")  # (the catalogue's order)
+    assert state.algorithm_parameters == {"damping": 0.1, "damping_threshold": 0.0, "gain": 1.0}
+    sliders = {c.key: c for c in controls(state) if c.key.startswith("algorithm_parameters.")}
+    for p in (*ALGORITHMS["damped"].parameters, *ALGORITHMS["posture"].parameters):
+        c = sliders[f"algorithm_parameters.{p.name}"]
+        assert (c.minimum, c.maximum) == (p.minimum, p.maximum)
+    changed = updated_state(state, {"algorithm_parameters.gain": 2.5})
+    assert changed.algorithm_parameters["gain"] == 2.5
+    # (a parameter of an algorithm no longer chosen is dropped)
+    assert updated_state(changed, {"algorithms": ["posture"]}).algorithm_parameters == {"gain": 2.5}
+
+
+@pytest.mark.parametrize(
+    ("patch", "field"),
+    [
+        ({"algorithms": []}, "algorithms"),
+        ({"algorithms": ["nope"]}, "algorithms.0"),
+        ({"algorithms": ["posture", "posture"]}, "algorithms"),
+        ({"algorithms": ["posture"], "algorithm_parameters": {"gain": -1.0}},
+         "algorithm_parameters.gain"),
+        ({"algorithms": ["damped"], "algorithm_parameters.damping": 11.0},
+         "algorithm_parameters.damping"),
+        ({"algorithm_parameters": {"lambda": 1.0}}, "algorithm_parameters.lambda"),
+    ],
+)  # fmt: skip
+def test_a_bad_choice_is_refused_naming_its_field(patch, field):
+    with pytest.raises(InvalidInputError) as refused:
+        updated_state(default_state(), patch)
+    assert refused.value.field == field
+
+
+def test_an_algorithm_the_robot_cannot_run_is_refused_naming_the_choice(monkeypatch):
+    """The chosen inverses are built when the state is validated: the engine's refusal (the
+    weighted inverse of a robot with neither joint limits nor a box) names ``algorithms``."""
+    from jik.app.dashboard import model
+
+    def refuse(state, algorithm, kin=None):
+        raise InvalidInputError("planar_chain has no joint limits: give limits", "limits")
+
+    monkeypatch.setattr(model, "state_inverse", refuse)
+    with pytest.raises(InvalidInputError) as refused:
+        updated_state(default_state(), {"algorithms": ["weighted"]})
+    assert refused.value.field == "algorithms" and "no joint limits" in str(refused.value)
+    assert updated_state(default_state(), {"cycles": 2}).cycles == 2  # (the paper's two: not built)
+
+
+def test_cache_keys_hold_each_algorithms_own_parameters():
+    state = updated_state(default_state(), {"algorithms": ["pseudoinverse", "damped", "posture"]})
+    more = updated_state(state, {"algorithm_parameters.gain": 3.0})
+    assert cache_key(more, "posture") != cache_key(state, "posture")
+    assert cache_key(more, "pseudoinverse") == cache_key(state, "pseudoinverse")
+    assert cache_key(more, "damped") == cache_key(state, "damped")
+    assert len(set(runs_key(state))) == 3
+
+
+@pytest.fixture(scope="module")
+def three():
+    state = updated_state(default_state(), {"algorithms": THREE, "cycles": 10})
+    return compute(state)
+
+
+def test_three_algorithms_one_colour_each_in_every_panel(three):
+    assert list(three.runs) == THREE
+    specs = figure_specs(three)
+    drift = [t for t in specs["drift"]["data"] if t.get("mode") == "lines+markers"]
+    assert [t["line"]["color"] for t in drift] == [COLORS[a] for a in THREE]
+    assert [t["line"]["dash"] for t in drift] == [STYLES[a].dash for a in THREE]
+    task = [t for t in specs["task"]["data"] if t.get("name") in {STYLES[a].label for a in THREE}]
+    assert len(task) == 3
+    assert len({STYLES[a].color for a in STYLES}) == len(STYLES)
+
+
+def test_verdict_says_posture_drifts_less_but_is_not_repeatable(three):
+    """Table 1's loop, gain 1, ten cycles: the sentence gives both comparisons, in numbers."""
+    d = {a: float(r.drift[-1]) for a, r in three.runs.items()}
+    assert d["posture"] < d["pseudoinverse"] and d["extended"] < 1e-12 < d["posture"]
+    posture = [s["text"] for s in verdict(three) if s["algorithm"] == "posture"]
+    said = " ".join(posture)
+    assert f"less than the pseudoinverse's {d['pseudoinverse']:.3g}" in said
+    assert f"does not reach the extended Jacobian's {d['extended']:.3g}" in said
+
+
+def test_verdict_reports_damped_tracking_error_and_weighted_limits():
+    state = updated_state(default_state(), {"algorithms": ["damped", "weighted"], "cycles": 2})
+    result = compute(state)
+    texts = {s["algorithm"]: s["text"] for s in verdict(result) if s["role"] != "finding"}
+    ends = result.runs["damped"].error[np.r_[np.flatnonzero(np.diff(result.runs["damped"].leg)),
+                                             len(result.runs["damped"].leg) - 1]]  # fmt: skip
+    assert f"task error at the end of its legs up to {ends.max():.3g}" in texts["damped"]
+    assert "stayed within its limits" in texts["weighted"]
+    assert "no joint limits: its configuration box x_range" in texts["weighted"]
+
+
+def test_the_atlas_compares_the_chosen_algorithms(three):
+    request = atlas_request(three.state, 8)
+    assert request.algorithms == THREE
+    assert request.algorithm_parameters is not None
+    assert request.algorithm_parameters.gain == 1.0
+
+
+def test_the_session_api_takes_the_choice(client):
+    """POST /api/sessions/{id}/state chooses three algorithms; a bad choice is a 422 naming its
+    field, and the state stays."""
+    session = client.post("/api/sessions", json={"state": {}}).json()
+    url = f"/api/sessions/{session['id']}/state"
+    r = client.post(url, json={"algorithms": THREE, "algorithm_parameters.gain": 2.0})
+    assert r.status_code == 200, r.text
+    assert r.json()["state"]["algorithms"] == THREE
+    assert r.json()["state"]["algorithm_parameters"] == {"gain": 2.0}
+    bad = client.post(url, json={"algorithm_parameters.gain": -2.0})
+    assert bad.status_code == 422 and "algorithm_parameters.gain" in bad.text
+    assert client.get(f"/api/sessions/{session['id']}").json()["state"]["algorithms"] == THREE
