@@ -29,9 +29,10 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from jik.engine.arms import ARMS
+from jik.engine.dop853 import ATOL, RTOL
 from jik.engine.inverses import Pseudoinverse
 from jik.engine.robot_spec import robot_from_dict
-from jik.engine.solver import ATOL, RTOL, solve
+from jik.engine.solver import solve
 from jik.engine.urdf import UrdfChain
 
 TOL = 1e-10

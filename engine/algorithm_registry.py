@@ -49,36 +49,62 @@ class AlgorithmSpec:
 ALGORITHMS: dict[str, AlgorithmSpec] = {
     a.name: a
     for a in (
-        AlgorithmSpec("pseudoinverse", "(8)", "the paper, eq. (8)",
-                      "Jacobian pseudoinverse J^T (J J^T)^-1: drifts on closed paths"),
-        AlgorithmSpec("extended", "(11)", "the paper, eqs. (9)-(12)",
-                      "extended Jacobian inverse with an augmenting map h: repeatable"),
         AlgorithmSpec(
-            "damped", "J^T (J J^T + lambda^2 I)^-1",
+            "pseudoinverse",
+            "(8)",
+            "the paper, eq. (8)",
+            "Jacobian pseudoinverse J^T (J J^T)^-1: drifts on closed paths",
+        ),
+        AlgorithmSpec(
+            "extended",
+            "(11)",
+            "the paper, eqs. (9)-(12)",
+            "extended Jacobian inverse with an augmenting map h: repeatable",
+        ),
+        AlgorithmSpec(
+            "damped",
+            "J^T (J J^T + lambda^2 I)^-1",
             "Wampler (1986); adaptive damping: Nakamura and Hanafusa (1986)",
             "damped least squares: bounded joint speed through singularities, at a task error",
             (
-                Parameter("damping", 0.1, 0.0, pinv.MAX_DAMPING,
-                          "damping lambda (0: the pseudoinverse)"),
-                Parameter("damping_threshold", 0.0, 0.0, pinv.MAX_DAMPING,
-                          "damp only where the smallest singular value of J is below this "
-                          "(0: constant damping)"),
+                Parameter(
+                    "damping", 0.1, 0.0, pinv.MAX_DAMPING, "damping lambda (0: the pseudoinverse)"
+                ),
+                Parameter(
+                    "damping_threshold",
+                    0.0,
+                    0.0,
+                    pinv.MAX_DAMPING,
+                    "damp only where the smallest singular value of J is below this "
+                    "(0: constant damping)",
+                ),
             ),
         ),
         AlgorithmSpec(
-            "weighted", "W^-1 J^T (J W^-1 J^T)^-1", "Chan and Dubey (1995)",
+            "weighted",
+            "W^-1 J^T (J W^-1 J^T)^-1",
+            "Chan and Dubey (1995)",
             "weighted least-norm inverse: joints slow down near their limits",
             vectors=("limits",),
         ),
         AlgorithmSpec(
-            "posture", "J^# dy + (I - J^# J) k (x_rest - x) |dy|", "Liegeois (1977)",
+            "posture",
+            "J^# dy + (I - J^# J) k (x_rest - x) |dy|",
+            "Liegeois (1977)",
             "pseudoinverse with a null-space pull toward a rest posture",
-            (Parameter("gain", 1.0, 0.0, pinv.MAX_GAIN,
-                       "null-space gain k per unit of path length (0: the pseudoinverse)"),),
+            (
+                Parameter(
+                    "gain",
+                    1.0,
+                    0.0,
+                    pinv.MAX_GAIN,
+                    "null-space gain k per unit of path length (0: the pseudoinverse)",
+                ),
+            ),
             vectors=("rest",),
         ),
     )
-}  # fmt: skip
+}
 
 
 def _robot_limits(kinematics: Kinematics, spec: RobotSpec | None, robot: str | None):

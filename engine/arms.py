@@ -36,9 +36,15 @@ class Arm:
 
     def definition(self, **overrides) -> dict:
         """The arm as a ``urdf`` robot definition, with ``overrides`` (task, reference, ...)."""
-        return {"name": "urdf", "urdf": self.urdf, "end_link": self.end_link,
-                "home": list(self.home), "task": self.task, "title": self.title,
-                **overrides}  # fmt: skip
+        return {
+            "name": "urdf",
+            "urdf": self.urdf,
+            "end_link": self.end_link,
+            "home": list(self.home),
+            "task": self.task,
+            "title": self.title,
+            **overrides,
+        }
 
 
 @functools.cache
@@ -50,22 +56,46 @@ _PI = math.pi
 ARMS: dict[str, Arm] = {
     a.name: a
     for a in (
-        Arm("panda", "Franka Panda", "panda.urdf", "panda_link8",
-            (0.0, -_PI / 4, 0.0, -3 * _PI / 4, 0.0, _PI / 2, _PI / 4), "pose",
-            "Franka Emika Panda, 7 revolute joints, to the flange; home: Franka's 'ready' pose"),
-        Arm("iiwa14", "KUKA LBR iiwa 14", "iiwa14.urdf", "iiwa_link_ee",
-            (0.0, _PI / 6, 0.0, -_PI / 2, 0.0, _PI / 3, 0.0), "pose",
-            "KUKA LBR iiwa 14 R820, 7 revolute joints, to the media flange"),
-        Arm("gen3", "Kinova Gen3", "gen3.urdf", "end_effector_link",
-            (0.0, 0.2618, _PI, -2.2689, 0.0, 0.9599, _PI / 2), "pose",
+        Arm(
+            "panda",
+            "Franka Panda",
+            "panda.urdf",
+            "panda_link8",
+            (0.0, -_PI / 4, 0.0, -3 * _PI / 4, 0.0, _PI / 2, _PI / 4),
+            "pose",
+            "Franka Emika Panda, 7 revolute joints, to the flange; home: Franka's 'ready' pose",
+        ),
+        Arm(
+            "iiwa14",
+            "KUKA LBR iiwa 14",
+            "iiwa14.urdf",
+            "iiwa_link_ee",
+            (0.0, _PI / 6, 0.0, -_PI / 2, 0.0, _PI / 3, 0.0),
+            "pose",
+            "KUKA LBR iiwa 14 R820, 7 revolute joints, to the media flange",
+        ),
+        Arm(
+            "gen3",
+            "Kinova Gen3",
+            "gen3.urdf",
+            "end_effector_link",
+            (0.0, 0.2618, _PI, -2.2689, 0.0, 0.9599, _PI / 2),
+            "pose",
             "Kinova Gen3, 7 joints (1, 3, 5, 7 continuous), to the interface module; home: "
-            "Kinova's 'Home' position (0, 15, 180, 230, 0, 55, 90 deg)"),
-        Arm("ur5e", "Universal Robots UR5e", "ur5e.urdf", "tool0",
-            (0.0, -_PI / 2, _PI / 2, -_PI / 2, -_PI / 2, 0.0), "x y z rx ry",
+            "Kinova's 'Home' position (0, 15, 180, 230, 0, 55, 90 deg)",
+        ),
+        Arm(
+            "ur5e",
+            "Universal Robots UR5e",
+            "ur5e.urdf",
+            "tool0",
+            (0.0, -_PI / 2, _PI / 2, -_PI / 2, -_PI / 2, 0.0),
+            "x y z rx ry",
             "Universal Robots UR5e, 6 revolute joints, to the tool flange; 6 joints leave no "
-            "redundancy for a full pose, so its default task leaves out rz"),
+            "redundancy for a full pose, so its default task leaves out rz",
+        ),
     )
-}  # fmt: skip
+}
 
 
 def arm(name: str) -> Arm:

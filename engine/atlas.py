@@ -28,7 +28,8 @@ from jik.engine.exceptions import InvalidInputError, SingularConfigurationError
 from jik.engine.inverses import Inverse, Pseudoinverse
 from jik.engine.repeatability import CLOSE_TOL, MAX_CYCLES, MAX_PATH_POINTS
 from jik.engine.self_motion import SelfMotionManifold, project, trace
-from jik.engine.solver import MAX_ITERATIONS_LIMIT, MODES, check_gamma, solve_batch
+from jik.engine.solve_rules import MAX_ITERATIONS_LIMIT, MODES, check_gamma
+from jik.engine.solver import solve_batch
 from jik.engine.validation import FloatArray, as_points, count, positive
 
 #: Largest number of starts per path, of paths in a family, and of starts in a chunk.
@@ -236,15 +237,23 @@ def plan_atlas(
         "gamma": _checked(lambda: check_gamma(gamma, mode), "gamma"),
         "mode": mode,
         "tol": _checked(lambda: positive(tol, "tol"), "tol"),
-        "max_iterations": None if max_iterations is None else _checked(
+        "max_iterations": None
+        if max_iterations is None
+        else _checked(
             lambda: count(max_iterations, "max_iterations", 1, MAX_ITERATIONS_LIMIT),
             "max_iterations",
         ),
-    }  # fmt: skip
-    shift = np.zeros((1, kin.r)) if shifts is None else _checked(
-        lambda: as_points(shifts, kin.r, "shifts"), "shifts")  # fmt: skip
-    scale = np.ones(1) if scales is None else _checked(
-        lambda: np.asarray(scales, dtype=float), "scales")  # fmt: skip
+    }
+    shift = (
+        np.zeros((1, kin.r))
+        if shifts is None
+        else _checked(lambda: as_points(shifts, kin.r, "shifts"), "shifts")
+    )
+    scale = (
+        np.ones(1)
+        if scales is None
+        else _checked(lambda: np.asarray(scales, dtype=float), "scales")
+    )
     if shift.ndim != 2 or scale.ndim != 1 or not len(shift) or not len(scale):
         raise InvalidInputError("shifts must be (S, r) and scales (Q,), both non-empty", "shifts")
     if not np.all(np.isfinite(scale) & (scale > 0)):
@@ -277,8 +286,9 @@ def plan_atlas(
         )
     n = _checked(lambda: count(n_starts, "n_starts", 1, MAX_STARTS), "n_starts")
     if sampling not in ("grid", "sample"):
-        raise InvalidInputError(f"sampling must be 'grid' or 'sample', got {sampling!r}",
-                                "sampling")  # fmt: skip
+        raise InvalidInputError(
+            f"sampling must be 'grid' or 'sample', got {sampling!r}", "sampling"
+        )
     seed = _checked(lambda: count(seed, "seed", 0, 2**63 - 1), "seed")
     ref = _checked(lambda: kin.check(reference, "reference"), "reference")
     if ref.ndim != 1:
@@ -298,9 +308,12 @@ def _manifolds(kin, paths, reference, arc, box) -> tuple[SelfMotionManifold, ...
     y0 = paths[:, 0]
     try:
         res = solve_batch(
-            Pseudoinverse(kin), np.broadcast_to(reference, (len(y0), kin.p)), y0, tol=1e-12,
+            Pseudoinverse(kin),
+            np.broadcast_to(reference, (len(y0), kin.p)),
+            y0,
+            tol=1e-12,
             record=False,
-        )  # fmt: skip
+        )
     except SingularConfigurationError as error:
         raise InvalidInputError(str(error), field="reference") from None
     if not np.all(res.success):

@@ -108,9 +108,11 @@ class ProcessPool:
     def __enter__(self) -> ProcessPool:
         context = multiprocessing.get_context("spawn")
         self._pool = ProcessPoolExecutor(
-            max_workers=self.workers, mp_context=context, initializer=limit_memory,
+            max_workers=self.workers,
+            mp_context=context,
+            initializer=limit_memory,
             initargs=(self.memory_mb,),
-        )  # fmt: skip
+        )
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -149,9 +151,11 @@ class Dask:
         if self.local:
             with dask.config.set(WORKER_ENVIRONMENT):
                 self._cluster = LocalCluster(
-                    n_workers=self.local, threads_per_worker=1, processes=True,
+                    n_workers=self.local,
+                    threads_per_worker=1,
+                    processes=True,
                     dashboard_address=None,
-                )  # fmt: skip
+                )
             self._client = Client(self._cluster)
         else:
             self._client = Client(self.address)

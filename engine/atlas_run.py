@@ -159,7 +159,7 @@ class AtlasResult:
         worst = np.max(np.where(np.isfinite(last), last, -np.inf), axis=(1, 2))
         drifts = ", ".join(
             f"{a} {w:.3g}" for a, w in zip(self.algorithms, worst, strict=True) if np.isfinite(w)
-        )  # fmt: skip
+        )
         drifts = f", largest drift after the last cycle: {drifts}" if drifts else ""
         return (
             f"AtlasResult({'/'.join(self.algorithms)}, {P} paths x {N} starts x {cycles} cycles, "
@@ -175,9 +175,14 @@ class AtlasResult:
         a, j, i, c = (g.ravel() for g in np.indices((A, P, N, C)))
         s = np.full(N, np.nan) if self.parameter is None else np.asarray(self.parameter)
         out = {
-            "algorithm": np.asarray(self.algorithms)[a], "path": j, "start": i, "s": s[i],
-            "cycle": c + 1, "drift": self.drift.ravel(), "success": self.success[a, j, i],
-        }  # fmt: skip
+            "algorithm": np.asarray(self.algorithms)[a],
+            "path": j,
+            "start": i,
+            "s": s[i],
+            "cycle": c + 1,
+            "drift": self.drift.ravel(),
+            "success": self.success[a, j, i],
+        }
         starts = self.starts[j, i]
         return out | {f"x{k + 1}": starts[:, k] for k in range(starts.shape[1])}
 
@@ -202,8 +207,10 @@ def iter_atlas(
         ``progress.cancelled()`` returned True (polled after every chunk); work not yet done is
         dropped.
     """
-    tasks = (chunk_task(plan, lo, min(lo + plan.chunk, plan.size))
-             for lo in range(0, plan.size, plan.chunk))  # fmt: skip
+    tasks = (
+        chunk_task(plan, lo, min(lo + plan.chunk, plan.size))
+        for lo in range(0, plan.size, plan.chunk)
+    )
     by_lo: dict[int, ChunkTask] = {}
 
     def kept(items):

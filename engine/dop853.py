@@ -1,4 +1,4 @@
-"""The Dormand-Prince 8(5,3) Runge-Kutta pair (DOP853) that :mod:`jik.engine.solver` uses.
+"""The Dormand-Prince 8(5,3) Runge-Kutta pair (DOP853) and the batched integrator of eq. (7) on it.
 
 The coefficients of Hairer, Norsett and Wanner, *Solving Ordinary Differential Equations I*
 (2nd ed., Springer 1993), section II.10, as in Hairer's ``dop853.f`` and SciPy's ``solve_ivp``.
@@ -10,7 +10,15 @@ order conditions either way.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
+
+from jik.engine.solve_rules import DIVERGED_NORM, Record, Status
+from jik.engine.validation import FloatArray
+
+if TYPE_CHECKING:
+    from jik.engine.inverses import Inverse
 
 #: Stages of one step (the 13th evaluation, at the new point, is the next step's first).
 N_STAGES = 12
@@ -155,3 +163,118 @@ E5 = np.array(
         0.0,
     ]
 )
+
+# The integrator :func:`integrate`: its step-size control (as SciPy's ``solve_ivp``).
+_SAFETY, _MIN_FACTOR, _MAX_FACTOR = 0.9, 0.2, 10.0
+_EXPONENT = -1.0 / 8.0  # error estimator of order 7
+#: Tolerances of the continuous integrator on x (relative and absolute).
+RTOL = 1e-12
+ATOL = 1e-12
+
+
+def _rhs(inverse: Inverse, x: FloatArray, y_d: FloatArray):
+    """-J#(x) (k(x) - y_d) per unit tau = gamma theta; also e and the singular mask."""
+    e = inverse.kinematics.forward(x) - y_d
+    v, bad = inverse.apply_masked(x, e)
+    return -v, e, bad
+
+
+def _initial_step(inverse, x, f, y_d, rtol, atol):
+    """Hairer-Norsett-Wanner starting step, per member (as scipy's ``select_initial_step``)."""
+    p = x.shape[-1]
+    scale = atol + np.abs(x) * rtol
+    d0 = np.sqrt(np.sum((x / scale) ** 2, axis=-1) / p)
+    d1 = np.sqrt(np.sum((f / scale) ** 2, axis=-1) / p)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        h0 = np.where((d0 < 1e-5) | (d1 < 1e-5), 1e-6, 0.01 * d0 / d1)
+    f1, _, _ = _rhs(inverse, x + h0[:, None] * f, y_d)
+    d2 = np.sqrt(np.sum(((f1 - f) / scale) ** 2, axis=-1) / p) / h0
+    dm = np.maximum(d1, d2)
+    with np.errstate(divide="ignore"):
+        h1 = np.where(dm <= 1e-15, np.maximum(1e-6, h0 * 1e-3), (0.01 / dm) ** (1.0 / 8.0))
+    return np.minimum(100 * h0, h1)
+
+
+def _combine(weights: FloatArray, K: FloatArray) -> FloatArray:
+    """sum_j weights[j] K[j] over the stages K (s, n, p), term by term in a fixed order.
+
+    ``np.tensordot`` hands this to BLAS, whose kernels round a member's sum differently with
+    the batch's size and the member's place in it; a sum of whole arrays does not, so a member's
+    numbers are the same in any batch (an atlas's do not depend on its chunking).
+    """
+    out = np.zeros(K.shape[1:])
+    for w, k in zip(weights, K, strict=True):
+        if w != 0.0:
+            out += w * k
+    return out
+
+
+def integrate(inverse, x0, y_d, tol, max_steps, record, tau0, rtol=RTOL, atol=ATOL):
+    """Batched DOP853 on dx/dtau = -J# e from tau = tau0 until ||e|| < tol."""
+    n, p = x0.shape
+    x = x0.copy()
+    tau = tau0.copy()
+    f, e, bad = _rhs(inverse, x, y_d)
+    err0 = np.linalg.norm(e, axis=-1)
+    status = np.full(n, Status.RUNNING)
+    status[bad] = Status.SINGULAR
+    status[err0 < tol] = Status.CONVERGED
+    # exp(-tau) decay: tau_needed = ln(err0 / tol); far past that the run has stalled.
+    tau_cap = tau0 + np.log(np.maximum(err0, tol) / tol) + 40.0
+    h = _initial_step(inverse, x, f, y_d, rtol, atol)
+    nsteps = np.zeros(n, dtype=int)
+    last_bad = np.zeros(n, dtype=bool)
+    rec: Record | None = [(np.arange(n), tau.copy(), x.copy())] if record else None
+    K = np.empty((N_STAGES + 1, n, p))
+    while True:
+        idx = np.flatnonzero(status == Status.RUNNING)
+        if idx.size == 0:
+            break
+        m = idx.size
+        xs, hs, yds = x[idx], h[idx], y_d[idx]
+        Ks = K[:, :m]
+        Ks[0] = f[idx]
+        stage_bad = np.zeros(m, dtype=bool)
+        for s in range(1, N_STAGES):
+            dx = _combine(A[s, :s], Ks[:s]) * hs[:, None]
+            Ks[s], _, b = _rhs(inverse, xs + dx, yds)
+            stage_bad |= b
+        x_new = xs + hs[:, None] * _combine(B, Ks[:N_STAGES])
+        f_new, e_new, b = _rhs(inverse, x_new, yds)
+        stage_bad |= b
+        Ks[N_STAGES] = f_new
+        scale = atol + np.maximum(np.abs(xs), np.abs(x_new)) * rtol
+        err5 = np.sum((_combine(E5, Ks) / scale) ** 2, axis=-1)
+        err3 = np.sum((_combine(E3, Ks) / scale) ** 2, axis=-1)
+        denom = err5 + 0.01 * err3
+        with np.errstate(divide="ignore", invalid="ignore"):
+            enorm = np.where(denom > 0, hs * err5 / np.sqrt(denom * p), 0.0)
+            enorm = np.where(np.isfinite(enorm), enorm, np.inf)
+            factor = np.where(
+                enorm == 0,
+                _MAX_FACTOR,
+                np.clip(_SAFETY * enorm**_EXPONENT, _MIN_FACTOR, _MAX_FACTOR),
+            )
+        accept = (enorm < 1.0) & ~stage_bad
+        factor = np.where(accept, factor, np.minimum(factor, 1.0))
+        factor = np.where(stage_bad, _MIN_FACTOR, factor)
+        last_bad[idx] = stage_bad
+        h[idx] = hs * factor
+
+        ai = idx[accept]
+        x[ai] = x_new[accept]
+        f[ai] = f_new[accept]
+        tau[ai] += hs[accept]
+        nsteps[idx] += 1
+        if rec is not None:
+            rec.append((ai, tau[ai].copy(), x[ai].copy()))
+        err = np.linalg.norm(e_new[accept], axis=-1)
+        status[ai[err < tol]] = Status.CONVERGED
+        run = idx[status[idx] == Status.RUNNING]
+        tiny = h[run] < 1e-12 * (1.0 + tau[run])
+        status[run[tiny & last_bad[run]]] = Status.SINGULAR
+        status[run[tiny & ~last_bad[run]]] = Status.STALLED
+        status[run[tau[run] > tau_cap[run]]] = Status.STALLED
+        status[run[np.linalg.norm(x[run], axis=-1) > DIVERGED_NORM]] = Status.DIVERGED
+        status[run[(nsteps[run] >= max_steps) & (status[run] == Status.RUNNING)]] = Status.MAX_STEPS
+    return x, tau, status, nsteps, rec

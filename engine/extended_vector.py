@@ -48,9 +48,11 @@ class VectorExtendedInverse(Inverse):
             )
         for i, m in enumerate(maps):
             if m.p != kinematics.p:
-                raise InvalidInputError(f"augmenting map {i} is defined on R^{m.p}, but "
-                                        f"{kinematics.name} has p = {kinematics.p}",
-                                        "augmentation")  # fmt: skip
+                raise InvalidInputError(
+                    f"augmenting map {i} is defined on R^{m.p}, but "
+                    f"{kinematics.name} has p = {kinematics.p}",
+                    "augmentation",
+                )
         self.kinematics = kinematics
         self.augmenting_maps = maps
 

@@ -189,8 +189,9 @@ class _Parser:
         if t.kind == "number":
             exponent = re.search(r"[eE]([+-]?[0-9]+)$", t.text)
             if exponent and abs(int(exponent[1])) > MAX_DECIMAL_EXPONENT:
-                raise self.error(f"number out of range (|decimal exponent| <= "
-                                 f"{MAX_DECIMAL_EXPONENT})", t)  # fmt: skip
+                raise self.error(
+                    f"number out of range (|decimal exponent| <= {MAX_DECIMAL_EXPONENT})", t
+                )
             return self.constant(_number(t.text), t)
         if t.kind == "name":
             if t.text in FUNCTIONS:
@@ -206,8 +207,9 @@ class _Parser:
             if self.take().text != ")":
                 raise self.error("missing ')'", self.tokens[self.i - 1])
             return e
-        raise self.error("expected a number, a name or '('" if t.kind != "end" else
-                         "formula ends too early", t)  # fmt: skip
+        raise self.error(
+            "expected a number, a name or '('" if t.kind != "end" else "formula ends too early", t
+        )
 
     def call(self, name: _Token) -> sp.Expr:
         function, arity = FUNCTIONS[name.text]
@@ -215,8 +217,11 @@ class _Parser:
             raise self.error(f"{name.text} must be called, as {name.text}(...)", name)
         self.calls += 1
         if self.calls > MAX_CALLS_NESTED:
-            raise self.error(f"functions nested too deeply (more than {MAX_CALLS_NESTED} calls "
-                             "inside each other)", name)  # fmt: skip
+            raise self.error(
+                f"functions nested too deeply (more than {MAX_CALLS_NESTED} calls "
+                "inside each other)",
+                name,
+            )
         args = [self.expression()]
         while self.peek().text == ",":
             self.take()
@@ -279,8 +284,9 @@ def parse_formula(text, names: Mapping[str, sp.Expr], field: str = "formula") ->
         (an InvalidInputError) naming ``field`` and the position of the offending character.
     """
     if not isinstance(text, str):
-        raise FormulaError(f"{field} must be a formula (a string), got {type(text).__name__}",
-                           field)  # fmt: skip
+        raise FormulaError(
+            f"{field} must be a formula (a string), got {type(text).__name__}", field
+        )
     if len(text) > MAX_LENGTH:
         raise FormulaError(
             f"{field}: formula too long ({len(text)} characters; at most {MAX_LENGTH})", field, 0
@@ -291,15 +297,21 @@ def parse_formula(text, names: Mapping[str, sp.Expr], field: str = "formula") ->
     except (ArithmeticError, ValueError, TypeError, RecursionError) as exc:
         if isinstance(exc, FormulaError):
             raise
-        raise FormulaError(f"{field}: cannot build the formula ({type(exc).__name__})", field,
-                           0) from None  # fmt: skip
+        raise FormulaError(
+            f"{field}: cannot build the formula ({type(exc).__name__})", field, 0
+        ) from None
     if e.has(sp.zoo, sp.oo, -sp.oo, sp.nan) or e.has(sp.I):
-        raise FormulaError(f"{field}: the formula has an undefined or complex constant "
-                           f"({e})", field, 0)  # fmt: skip
+        raise FormulaError(
+            f"{field}: the formula has an undefined or complex constant ({e})", field, 0
+        )
     for pw in e.atoms(sp.Pow):
         if pw.exp.is_number and not abs(float(sp.re(pw.exp))) <= MAX_EXPONENT:
-            raise FormulaError(f"{field}: exponent {pw.exp} of {pw} exceeds {MAX_EXPONENT} once "
-                               "powers are combined", field, 0)  # fmt: skip
+            raise FormulaError(
+                f"{field}: exponent {pw.exp} of {pw} exceeds {MAX_EXPONENT} once "
+                "powers are combined",
+                field,
+                0,
+            )
     return e
 
 
@@ -312,6 +324,7 @@ def check_name(name, field: str) -> str:
             field,
         )
     if name in FUNCTIONS or name in CONSTANTS or keyword.iskeyword(name):
-        raise InvalidInputError(f"{field}: {name!r} is reserved (a function, pi or a keyword)",
-                                field)  # fmt: skip
+        raise InvalidInputError(
+            f"{field}: {name!r} is reserved (a function, pi or a keyword)", field
+        )
     return name

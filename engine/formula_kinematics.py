@@ -74,15 +74,17 @@ def _names(variables, parameters, what: str) -> tuple[list[str], dict[str, float
     if isinstance(variables, str) or not isinstance(variables, Sequence):
         raise InvalidInputError(f"variables must be a list of names for {what}", "variables")
     if not 1 <= len(variables) <= MAX_NAMES:
-        raise InvalidInputError(f"variables: give 1 to {MAX_NAMES} names, got {len(variables)}",
-                                "variables")  # fmt: skip
+        raise InvalidInputError(
+            f"variables: give 1 to {MAX_NAMES} names, got {len(variables)}", "variables"
+        )
     names = [check_name(v, f"variables.{i}") for i, v in enumerate(variables)]
     if len(set(names)) != len(names):
         raise InvalidInputError(f"variables must be distinct, got {names}", "variables")
     parameters = {} if parameters is None else parameters
     if not isinstance(parameters, Mapping) or len(parameters) > MAX_NAMES:
-        raise InvalidInputError(f"parameters must be a mapping of at most {MAX_NAMES} names to "
-                                "numbers", "parameters")  # fmt: skip
+        raise InvalidInputError(
+            f"parameters must be a mapping of at most {MAX_NAMES} names to numbers", "parameters"
+        )
     values: dict[str, float] = {}
     for k, v in parameters.items():
         check_name(k, f"parameters.{k}")

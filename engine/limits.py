@@ -56,8 +56,15 @@ class LimitViolation:
         return f"{where}: {self.name} = {self.value:.6g}, {side} limit {self.limit:.6g}"
 
     def as_dict(self) -> dict:
-        return {"cycle": self.cycle, "leg": self.leg, "joint": self.joint, "name": self.name,
-                "value": self.value, "limit": self.limit, "bound": self.bound}  # fmt: skip
+        return {
+            "cycle": self.cycle,
+            "leg": self.leg,
+            "joint": self.joint,
+            "name": self.name,
+            "value": self.value,
+            "limit": self.limit,
+            "bound": self.bound,
+        }
 
 
 @dataclass(frozen=True)

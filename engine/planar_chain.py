@@ -169,6 +169,7 @@ def _vector(values, n: int, name: str) -> FloatArray:
     if isinstance(values, str | bytes) or not isinstance(values, Sequence | np.ndarray):
         raise InvalidInputError(f"{name} must be a list of {n} numbers", name)
     if len(values) != n:
-        raise InvalidInputError(f"{name} must have one entry per joint ({n}), got {len(values)}",
-                                name)  # fmt: skip
+        raise InvalidInputError(
+            f"{name} must have one entry per joint ({n}), got {len(values)}", name
+        )
     return np.array([json_number(v, f"{name}[{i}]", f"{name}.{i}") for i, v in enumerate(values)])

@@ -72,12 +72,14 @@ def reference_rotation(value, field: str = "reference") -> FloatArray:
         return so3.exp(a)
     if a.shape == (4,):
         if abs(np.linalg.norm(a) - 1.0) > 1e-6:
-            raise InvalidInputError(f"{field}: a quaternion must have norm 1, got "
-                                    f"{np.linalg.norm(a):.6g}", field)  # fmt: skip
+            raise InvalidInputError(
+                f"{field}: a quaternion must have norm 1, got {np.linalg.norm(a):.6g}", field
+            )
         return Rotation.from_quat(a).as_matrix()
     if not np.allclose(a.T @ a, np.eye(3), atol=1e-6) or np.linalg.det(a) < 0:
-        raise InvalidInputError(f"{field}: the matrix is not a rotation (R^T R = I, det R = 1 "
-                                "to 1e-6)", field)  # fmt: skip
+        raise InvalidInputError(
+            f"{field}: the matrix is not a rotation (R^T R = I, det R = 1 to 1e-6)", field
+        )
     return a
 
 
@@ -96,8 +98,7 @@ class PoseTask:
         self.names = tuple(names)
         self.reference = np.asarray(reference, dtype=float)
         self.position_rows = np.array([COORDINATES.index(n) for n in names if len(n) == 1], int)
-        self.rotation_rows = np.array([COORDINATES.index(n) - 3 for n in names if len(n) == 2],
-                                      int)  # fmt: skip
+        self.rotation_rows = np.array([COORDINATES.index(n) - 3 for n in names if len(n) == 2], int)
         # positions then rotations are computed; ``order`` puts them back in the given order
         computed = [n for n in names if len(n) == 1] + [n for n in names if len(n) == 2]
         self.order = np.array([computed.index(n) for n in names])

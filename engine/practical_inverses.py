@@ -247,8 +247,9 @@ class PostureInverse(Inverse):
         self.kinematics = kinematics
         self.rest = kinematics.check(rest, "rest")
         if self.rest.shape != (kinematics.p,):
-            raise InvalidInputError(f"rest must be one configuration of {kinematics.p} numbers",
-                                    "rest")  # fmt: skip
+            raise InvalidInputError(
+                f"rest must be one configuration of {kinematics.p} numbers", "rest"
+            )
         self.gain = _nonnegative(gain, "gain", MAX_GAIN)
         self._plain = Pseudoinverse(kinematics)
 

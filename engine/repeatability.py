@@ -20,17 +20,11 @@ import numpy as np
 
 from jik.engine.exceptions import InvalidInputError, JikError, format_vector
 from jik.engine.inverses import Inverse
+from jik.engine.picard_guesses import chain_guesses
 from jik.engine.progress import Progress, check_cancelled
-from jik.engine.results import RepeatabilityResult
-from jik.engine.solver import (
-    BatchSolveResult,
-    SolveResult,
-    Trajectory,
-    chain_guesses,
-    solve,
-    solve_batch,
-    solve_in_chunks,
-)
+from jik.engine.results import BatchSolveResult, RepeatabilityResult, SolveResult, Trajectory
+from jik.engine.solve_chunks import solve_in_chunks
+from jik.engine.solver import solve, solve_batch
 from jik.engine.unicycle import Unicycle
 from jik.engine.validation import FloatArray, count
 
@@ -43,7 +37,7 @@ MAX_PATH_POINTS = 100
 #: The path is closed by a return leg to k(x0) when its last point is farther than this.
 CLOSE_TOL = 1e-12
 #: With a ``progress``, a discrete leg of one start runs as solves of at most this many
-#: iterations (:func:`jik.engine.solver.solve_in_chunks`: the same iterates), between which a
+#: iterations (:func:`jik.engine.solve_chunks.solve_in_chunks`: the same iterates), between which a
 #: cancellation is heard and the leg's progress told.
 POLL_ITERATIONS = 80
 
@@ -137,15 +131,17 @@ def cycle_guesses(
     ``guides`` (those legs' trajectories, None in the first cycle) are its guesses, and a leg
     then takes one or two sweeps. The pseudoinverse (and the other right inverses, weighted and
     posture) drifts, so the cycle before saves almost nothing: its legs are swept together from
-    ``start`` (:func:`jik.engine.solver.chain_guesses`), one or two sweeps a leg instead of
+    ``start`` (:func:`jik.engine.picard_guesses.chain_guesses`), one or two sweeps a leg instead of
     about ten, and a cycle's numbers depend only on its start. A chain evaluates J# about three
     times as often as the legs would, so it pays only where an evaluation costs little beyond
     numpy's per-call overhead: not for the unicycle.
     """
     if (
-        inverse.name != "extended" and inverse.right_inverse and len(targets) > 1
+        inverse.name != "extended"
+        and inverse.right_inverse
+        and len(targets) > 1
         and not isinstance(inverse.kinematics, Unicycle)
-    ):  # fmt: skip
+    ):
         chained = chain_guesses(inverse, start, targets, gamma=gamma)
         if chained is not None:
             return list(chained)
@@ -253,8 +249,11 @@ def repeatability(
     guided = single and mode == "continuous"
     guides: list[Trajectory | None] = [None] * L
     settings: dict[str, Any] = {
-        "gamma": gamma, "mode": mode, "tol": tol, "max_iterations": max_iterations,
-    }  # fmt: skip
+        "gamma": gamma,
+        "mode": mode,
+        "tol": tol,
+        "max_iterations": max_iterations,
+    }
     first = 0
     if resume is not None:
         done, given = _resumed(resume, n, L, kin.p, cycles)
@@ -276,16 +275,29 @@ def repeatability(
             try:
                 if chunked:  # (one start, with a progress)
                     res: SolveResult | BatchSolveResult = solve_in_chunks(
-                        inverse, current[0], targets[0, j], chunk=POLL_ITERATIONS, gamma=gamma,
-                        tol=tol, max_iterations=max_iterations, record=record,
+                        inverse,
+                        current[0],
+                        targets[0, j],
+                        chunk=POLL_ITERATIONS,
+                        gamma=gamma,
+                        tol=tol,
+                        max_iterations=max_iterations,
+                        record=record,
                         between=_between(progress, f"in {where}"),
-                    )  # fmt: skip
+                    )
                 elif single:  # (a SolveResult: its trajectory guides the next cycle's leg)
-                    res = solve(inverse, current[0], targets[0, j], record=record or guided,
-                                guess=guesses[j] if guided else None, **settings)  # fmt: skip
+                    res = solve(
+                        inverse,
+                        current[0],
+                        targets[0, j],
+                        record=record or guided,
+                        guess=guesses[j] if guided else None,
+                        **settings,
+                    )
                 else:  # (current[ids] is (k, p): a BatchSolveResult)
-                    res = solve_batch(inverse, current[ids], targets[ids, j], record=False,
-                                      **settings)  # fmt: skip
+                    res = solve_batch(
+                        inverse, current[ids], targets[ids, j], record=False, **settings
+                    )
             except JikError as exc:
                 if on_undefined == "raise":
                     raise
@@ -337,8 +349,9 @@ def _resumed(resume: Resume, n: int, L: int, p: int, cycles: int):
             f"(c * {L}, {p}) for one start or (n, c * {L}, {p}); got shape {done.shape}"
         )
     if not np.all(np.isfinite(done)):
-        raise InvalidInputError("resume.legs contains NaN: go on only from a run whose legs all "
-                                "converged")  # fmt: skip
+        raise InvalidInputError(
+            "resume.legs contains NaN: go on only from a run whose legs all converged"
+        )
     guides = list(resume.guides)
     if guides and len(guides) != L:
         raise InvalidInputError(f"resume.guides must have one trajectory (or None) per leg, {L}")

@@ -105,10 +105,12 @@ class Trajectory:
     def as_dict(self) -> dict[str, Any]:
         """JSON-friendly: ``theta``, ``x`` (m lists of p), ``y``, ``error``, ``h`` (or None)."""
         return {
-            "theta": np.asarray(self.theta).tolist(), "x": np.asarray(self.x).tolist(),
-            "y": np.asarray(self.y).tolist(), "error": np.asarray(self.error).tolist(),
+            "theta": np.asarray(self.theta).tolist(),
+            "x": np.asarray(self.x).tolist(),
+            "y": np.asarray(self.y).tolist(),
+            "error": np.asarray(self.error).tolist(),
             "h": None if self.h is None else np.asarray(self.h).tolist(),
-        }  # fmt: skip
+        }
 
 
 @dataclass(frozen=True)
@@ -137,10 +139,16 @@ class SolveResult:
     def as_dict(self, trajectory: bool = False) -> dict[str, Any]:
         """JSON-friendly fields; with ``trajectory``, also :meth:`Trajectory.as_dict`."""
         out: dict[str, Any] = {
-            "algorithm": self.algorithm, "mode": self.mode, "gamma": self.gamma,
-            "x": self.x.tolist(), "y": self.y.tolist(), "error": self.error,
-            "success": self.success, "nit": self.nit, "message": self.message,
-        }  # fmt: skip
+            "algorithm": self.algorithm,
+            "mode": self.mode,
+            "gamma": self.gamma,
+            "x": self.x.tolist(),
+            "y": self.y.tolist(),
+            "error": self.error,
+            "success": self.success,
+            "nit": self.nit,
+            "message": self.message,
+        }
         if trajectory:
             out["trajectory"] = None if self.trajectory is None else self.trajectory.as_dict()
         return out
@@ -195,11 +203,16 @@ class BatchSolveResult:
     def as_dict(self) -> dict[str, Any]:
         """JSON-friendly: the settings and, per member, x, y, error, success, nit, message."""
         return {
-            "algorithm": self.algorithm, "mode": self.mode, "gamma": self.gamma,
-            "x": self.x.tolist(), "y": self.y.tolist(), "error": self.error.tolist(),
+            "algorithm": self.algorithm,
+            "mode": self.mode,
+            "gamma": self.gamma,
+            "x": self.x.tolist(),
+            "y": self.y.tolist(),
+            "error": self.error.tolist(),
             "success": np.asarray(self.success, dtype=bool).tolist(),
-            "nit": np.asarray(self.nit, dtype=int).tolist(), "message": list(self.message),
-        }  # fmt: skip
+            "nit": np.asarray(self.nit, dtype=int).tolist(),
+            "message": list(self.message),
+        }
 
     def trajectory(self, i: int) -> Trajectory:
         """The trajectory of member ``i`` (requires ``record=True``)."""
@@ -292,9 +305,9 @@ class RepeatabilityResult:
         drift = np.atleast_2d(self.drift)  # (n, cycles)
         ends = self.cycle_end.reshape(-1, self.cycle_end.shape[-1])
         n, cycles = drift.shape
-        out: dict[str, Any] = {} if np.ndim(self.success) == 0 else {
-            "start": np.repeat(np.arange(n), cycles)
-        }  # fmt: skip
+        out: dict[str, Any] = (
+            {} if np.ndim(self.success) == 0 else {"start": np.repeat(np.arange(n), cycles)}
+        )
         out["cycle"] = np.tile(np.arange(1, cycles + 1), n)
         out["drift"] = drift.ravel()
         return out | coordinate_columns("x", ends)
@@ -306,8 +319,11 @@ class RepeatabilityResult:
     def as_dict(self) -> dict[str, Any]:
         """JSON-friendly: x0, the legs' targets, leg ends, cycle ends, drift, success, message."""
         return {
-            "x0": self.x0.tolist(), "targets": self.targets.tolist(), "legs": self.legs.tolist(),
-            "cycle_end": self.cycle_end.tolist(), "drift": self.drift.tolist(),
+            "x0": self.x0.tolist(),
+            "targets": self.targets.tolist(),
+            "legs": self.legs.tolist(),
+            "cycle_end": self.cycle_end.tolist(),
+            "drift": self.drift.tolist(),
             "success": np.asarray(self.success).tolist(),
             "message": self.message if isinstance(self.message, str) else list(self.message),
-        }  # fmt: skip
+        }

@@ -24,87 +24,168 @@ class DefinitionField:
 
 
 PLANAR_CHAIN = (
-    DefinitionField("joints", "string", True, "joint types in order, base first: R revolute, "
-                    "P prismatic", "RRR"),
+    DefinitionField(
+        "joints", "string", True, "joint types in order, base first: R revolute, P prismatic", "RRR"
+    ),
     DefinitionField("lengths", "numbers", True, "link lengths > 0, one per joint", [1.0, 0.8, 0.6]),
-    DefinitionField("offsets", "numbers", False, "joint offsets added to x: angle [rad] for R, "
-                    "extension for P (default 0)"),
-    DefinitionField("orientation", "boolean", False, "also the end's angle as a task component "
-                    "(r = 3; default false: the end point, r = 2)", False),
-    DefinitionField("limits", "points", False, "joint limits, one [lower, upper] per "
-                    "variable (null: no bound); runs report whether they stayed within them"),
-)  # fmt: skip
+    DefinitionField(
+        "offsets",
+        "numbers",
+        False,
+        "joint offsets added to x: angle [rad] for R, extension for P (default 0)",
+    ),
+    DefinitionField(
+        "orientation",
+        "boolean",
+        False,
+        "also the end's angle as a task component (r = 3; default false: the end point, r = 2)",
+        False,
+    ),
+    DefinitionField(
+        "limits",
+        "points",
+        False,
+        "joint limits, one [lower, upper] per "
+        "variable (null: no bound); runs report whether they stayed within them",
+    ),
+)
 
 FORMULA = (
-    DefinitionField("variables", "names", True, "joint variable names, in order",
-                    ["x1", "x2", "x3"]),
-    DefinitionField("task", "formulas", True, "task components, formulas in the variables and "
-                    "parameters (sin cos tan exp log sqrt atan2 abs, + - * / **, numbers, pi)",
-                    ["x2 + l*cos(x3)", "x1 + l*sin(x3)"]),
-    DefinitionField("parameters", "mapping", False, "named constants of the formulas",
-                    {"l": 1.0}),
-    DefinitionField("limits", "points", False, "joint limits, one [lower, upper] per "
-                    "variable (null: no bound); runs report whether they stayed within them"),
-)  # fmt: skip
+    DefinitionField(
+        "variables", "names", True, "joint variable names, in order", ["x1", "x2", "x3"]
+    ),
+    DefinitionField(
+        "task",
+        "formulas",
+        True,
+        "task components, formulas in the variables and "
+        "parameters (sin cos tan exp log sqrt atan2 abs, + - * / **, numbers, pi)",
+        ["x2 + l*cos(x3)", "x1 + l*sin(x3)"],
+    ),
+    DefinitionField("parameters", "mapping", False, "named constants of the formulas", {"l": 1.0}),
+    DefinitionField(
+        "limits",
+        "points",
+        False,
+        "joint limits, one [lower, upper] per "
+        "variable (null: no bound); runs report whether they stayed within them",
+    ),
+)
 
 URDF = (
     DefinitionField("urdf", "text", True, "the URDF text (at most 1 MB; meshes are not loaded)"),
-    DefinitionField("urdf_file", "string", False, "instead of urdf, in a robot file only: a path "
-                    "relative to the file's folder"),
+    DefinitionField(
+        "urdf_file",
+        "string",
+        False,
+        "instead of urdf, in a robot file only: a path relative to the file's folder",
+    ),
     DefinitionField("end_link", "string", True, "the link whose origin is the end point", "tool"),
-    DefinitionField("active_joints", "names", False, "the joints that move, in order (default: "
-                    "every movable joint from the base to end_link)"),
-    DefinitionField("task", "string", False, "coordinates of the end link: x y z (position) "
-                    "and rx ry rz (rotation vector of R0^T R), pose for all six, or a subset "
-                    "such as xyz or 'x y z rz' (default xyz)", "xyz"),
-    DefinitionField("locked", "mapping", False, "values of the chain's other movable joints "
-                    "(default 0)"),
-    DefinitionField("home", "numbers", False, "a reference configuration, one value per "
-                    "active joint (default: zero, clipped into the joint limits)"),
-    DefinitionField("reference", "numbers", False, "R0, the orientation with rotation "
-                    "coordinates 0: a rotation vector (3 numbers), a quaternion x y z w (4) or "
-                    "a matrix (3 rows of 3); default: the end link's orientation at home"),
-)  # fmt: skip
+    DefinitionField(
+        "active_joints",
+        "names",
+        False,
+        "the joints that move, in order (default: every movable joint from the base to end_link)",
+    ),
+    DefinitionField(
+        "task",
+        "string",
+        False,
+        "coordinates of the end link: x y z (position) "
+        "and rx ry rz (rotation vector of R0^T R), pose for all six, or a subset "
+        "such as xyz or 'x y z rz' (default xyz)",
+        "xyz",
+    ),
+    DefinitionField(
+        "locked", "mapping", False, "values of the chain's other movable joints (default 0)"
+    ),
+    DefinitionField(
+        "home",
+        "numbers",
+        False,
+        "a reference configuration, one value per "
+        "active joint (default: zero, clipped into the joint limits)",
+    ),
+    DefinitionField(
+        "reference",
+        "numbers",
+        False,
+        "R0, the orientation with rotation "
+        "coordinates 0: a rotation vector (3 numbers), a quaternion x y z w (4) or "
+        "a matrix (3 rows of 3); default: the end link's orientation at home",
+    ),
+)
 
 #: A catalogue arm (:mod:`jik.engine.arms`): its URDF, end link and home are the catalogue's.
 ARM = tuple(f for f in URDF if f.name in ("task", "reference", "home", "locked", "active_joints"))
 
 COMMON = (
-    DefinitionField("name", "string", True, "the kind: planar_chain, formula, urdf, a "
-                    "catalogue arm (panda, iiwa14, gen3, ur5e) or a built-in robot's name"),
+    DefinitionField(
+        "name",
+        "string",
+        True,
+        "the kind: planar_chain, formula, urdf, a "
+        "catalogue arm (panda, iiwa14, gen3, ur5e) or a built-in robot's name",
+    ),
     DefinitionField("title", "string", False, "a name to show"),
-    DefinitionField("x_range", "points", False, "one [lo, hi] per variable (default: joint "
-                    "limits or [-pi, pi])"),
+    DefinitionField(
+        "x_range", "points", False, "one [lo, hi] per variable (default: joint limits or [-pi, pi])"
+    ),
     DefinitionField("x0", "numbers", False, "start configuration (default 0.5 in each range)"),
     DefinitionField("target", "numbers", False, "default target of a solve"),
     DefinitionField("path", "points", False, "default closed path (task points)"),
-    DefinitionField("augmentations", "augmentations", False, "augmenting maps of the extended "
-                    "inverse: {name: formula, h: ...} (h a list of p - r formulas when "
-                    "p - r > 1) or {name: e2_synthesized, region: {...}} (p = r + 1)"),
-)  # fmt: skip
+    DefinitionField(
+        "augmentations",
+        "augmentations",
+        False,
+        "augmenting maps of the extended "
+        "inverse: {name: formula, h: ...} (h a list of p - r formulas when "
+        "p - r > 1) or {name: e2_synthesized, region: {...}} (p = r + 1)",
+    ),
+)
 
 #: The entries of an augmentation, by its name.
 AUGMENTATIONS: dict[str, tuple[DefinitionField, ...]] = {
     "formula": (
-        DefinitionField("h", "formulas", True, "h as a formula in the variables (p - r = 1), or "
-                        "a list of p - r formulas", "x3"),
+        DefinitionField(
+            "h",
+            "formulas",
+            True,
+            "h as a formula in the variables (p - r = 1), or a list of p - r formulas",
+            "x3",
+        ),
         DefinitionField("parameters", "mapping", False, "named constants of h"),
-        DefinitionField("label", "string", False, "its name among the robot's maps (default "
-                        "formula)"),
+        DefinitionField(
+            "label", "string", False, "its name among the robot's maps (default formula)"
+        ),
     ),
     "e2_synthesized": (
-        DefinitionField("region", "mapping", True, "two or more variables to [lo, hi]: the box "
-                        "of the Ritz synthesis of E2, eq. (20) (over more than three, in a "
-                        "total-degree basis)", {"x2": [0.4, 2], "x3": [0.4, 2]}),
-        DefinitionField("degree", "integer", False, "Legendre degree per variable, 1-24 "
-                        "(default 12); over more than three variables the total degree, 1-6 "
-                        "(default 4)", 12),
-        DefinitionField("fixed", "mapping", False, "values of the variables outside the region "
-                        "(default 0)"),
-        DefinitionField("label", "string", False, "its name among the robot's maps (default "
-                        "e2_synthesized)"),
+        DefinitionField(
+            "region",
+            "mapping",
+            True,
+            "two or more variables to [lo, hi]: the box "
+            "of the Ritz synthesis of E2, eq. (20) (over more than three, in a "
+            "total-degree basis)",
+            {"x2": [0.4, 2], "x3": [0.4, 2]},
+        ),
+        DefinitionField(
+            "degree",
+            "integer",
+            False,
+            "Legendre degree per variable, 1-24 "
+            "(default 12); over more than three variables the total degree, 1-6 "
+            "(default 4)",
+            12,
+        ),
+        DefinitionField(
+            "fixed", "mapping", False, "values of the variables outside the region (default 0)"
+        ),
+        DefinitionField(
+            "label", "string", False, "its name among the robot's maps (default e2_synthesized)"
+        ),
     ),
-}  # fmt: skip
+}
 
 KINDS: dict[str, tuple[DefinitionField, ...]] = {
     "planar_chain": PLANAR_CHAIN,

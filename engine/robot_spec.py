@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -33,8 +33,7 @@ from jik.engine.arms import ARMS
 from jik.engine.augmentations import AugmentingMap
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.extended_vector import VectorExtendedInverse
-from jik.engine.formula_kinematics import FormulaKinematics, FormulaMap
-from jik.engine.functionals import check_region
+from jik.engine.formula_kinematics import FormulaKinematics
 from jik.engine.inverses import Inverse
 from jik.engine.kinematics import Kinematics
 from jik.engine.limits import (
@@ -46,10 +45,11 @@ from jik.engine.limits import (
     solve_report,
 )
 from jik.engine.planar_chain import PlanarChain
-from jik.engine.registry import ROBOTS, AugmentationSpec, RobotSpec, make_inverse
+from jik.engine.registry import ROBOTS, RobotSpec, make_inverse
 from jik.engine.repeatability import MAX_PATH_POINTS
-from jik.engine.robot_synthesis import TOTAL_DEGREE, arm_augmentations, synthesis
-from jik.engine.validation import as_points, count
+from jik.engine.robot_augmentations import augmentations_from_dict
+from jik.engine.robot_synthesis import arm_augmentations
+from jik.engine.validation import as_points
 
 #: Largest robot file read by :func:`load_robot` [bytes].
 MAX_FILE_BYTES = 2_000_000
@@ -105,9 +105,13 @@ class Robot:
             if name in self.map_vectors:
                 return VectorExtendedInverse(self.kinematics, self.map_vectors[name])
         return make_inverse(
-            self.kinematics, algorithm, augmentation, parameters, spec=self.spec,
+            self.kinematics,
+            algorithm,
+            augmentation,
+            parameters,
+            spec=self.spec,
             algorithm_parameters=algorithm_parameters,
-        )  # fmt: skip
+        )
 
 
 def _get(d: Mapping, key: str, kind: type, what: str, default: Any = None) -> Any:
@@ -156,8 +160,9 @@ def _urdf_file(d: Mapping, base_dir: Path | None) -> str:
     from jik.engine.urdf import MAX_URDF_BYTES
 
     if base_dir is None:
-        raise InvalidInputError("urdf_file is read only from a robot file; give urdf (the text)",
-                                "urdf_file")  # fmt: skip
+        raise InvalidInputError(
+            "urdf_file is read only from a robot file; give urdf (the text)", "urdf_file"
+        )
     name = _get(d, "urdf_file", str, "a path relative to the robot file")
     path = (base_dir / name).resolve()
     if not path.is_relative_to(base_dir.resolve()) or not path.is_file():
@@ -179,15 +184,18 @@ def _x_range(kin: Kinematics, d: Mapping) -> tuple[tuple[float, float], ...]:
     if "x_range" in d:
         box = _points(d["x_range"], 2, "x_range")
         if box.shape != (kin.p, 2) or not np.all(box[:, 0] < box[:, 1]):
-            raise InvalidInputError(f"x_range must be {kin.p} pairs [lo, hi] with lo < hi",
-                                    "x_range")  # fmt: skip
+            raise InvalidInputError(
+                f"x_range must be {kin.p} pairs [lo, hi] with lo < hi", "x_range"
+            )
         return tuple((float(a), float(b)) for a, b in box)
     limits = getattr(kin, "limits", None)
     if limits is not None:
         return tuple(limits)
     if isinstance(kin, PlanarChain):
-        return tuple((-math.pi, math.pi) if rev else (-float(length), float(length))
-                     for rev, length in zip(kin.revolute, kin.lengths, strict=True))  # fmt: skip
+        return tuple(
+            (-math.pi, math.pi) if rev else (-float(length), float(length))
+            for rev, length in zip(kin.revolute, kin.lengths, strict=True)
+        )
     return ((-math.pi, math.pi),) * kin.p
 
 
@@ -213,104 +221,10 @@ def _defaults(kin: Kinematics, d: Mapping, box) -> tuple:
     if target.ndim != 1:
         raise InvalidInputError(f"target must be one task point ({kin.r} numbers)", "target")
     if path.ndim != 2 or not 1 <= len(path) <= MAX_PATH_POINTS:
-        raise InvalidInputError(f"path must be a list of 1 to {MAX_PATH_POINTS} task points",
-                                "path")  # fmt: skip
-    return tuple(x0.tolist()), tuple(target.tolist()), tuple(map(tuple, path.tolist()))
-
-
-def _augmentations(kin: Kinematics, items, key: str | None = None):
-    """AugmentationSpecs of ``[{"name": "formula", "h": ...}, {"name": "e2_synthesized", ...}]``,
-    the synthesis region of the first e2_synthesized (the robot's functional region), and the
-    vectors of p - r formula maps (p > r + 1: ``"h"`` is a list), by label. ``key`` names the
-    robot's definition: with it, a synthesized map is computed once per process for it."""
-    if not isinstance(items, list):
-        raise InvalidInputError("augmentations must be a list of augmenting maps", "augmentations")
-    specs: list[AugmentationSpec] = []
-    region: dict = {}
-    vectors: dict[str, tuple[AugmentingMap, ...]] = {}
-    k = kin.p - kin.r
-    for i, item in enumerate(items):
-        where = f"augmentations.{i}"
-        if not isinstance(item, Mapping) or item.get("name") not in ("formula", "e2_synthesized"):
-            raise InvalidInputError(
-                f"{where} must be {{'name': 'formula', 'h': ...}} or "
-                "{'name': 'e2_synthesized', 'region': {...}}",
-                where,
-            )
-        if k != 1 and item["name"] == "e2_synthesized":
-            raise InvalidInputError(
-                f"{where}: the E2 synthesis needs one degree of redundancy (p = r + 1); this "
-                f"robot has p = {kin.p}, r = {kin.r}: give the extended inverse a list of "
-                f"{k} formula maps, {{'name': 'formula', 'h': [...]}}",
-                where,
-            )
-        label = item.get("label", item["name"])
-        if not isinstance(label, str) or label in {s.name for s in specs}:
-            raise InvalidInputError(f"{where}.label must be a new name, got {label!r}",
-                                    f"{where}.label")  # fmt: skip
-        factory: Callable[..., AugmentingMap]
-        if item["name"] == "formula":
-            unknown = set(item) - robot_kinds.augmentation_keys("formula")
-            maps = _formula_maps(kin, item, where)
-            if k == 1:
-                factory = lambda kin, amap=maps[0]: amap  # noqa: E731
-            else:
-                vectors[label] = maps
-                factory = _vector_only(label)
-            text = "h = " + ", ".join(m.text for m in maps)
-        else:
-            unknown = set(item) - robot_kinds.augmentation_keys("e2_synthesized")
-            box, fix = _region(kin, item, where)
-            if len(box) <= 3:
-                degree = count(item.get("degree", 12), f"{where}.degree", 1, 24)
-                text = f"E2-optimal h on {box} by the Ritz solve of (20), degree {degree}"
-            else:
-                degree = count(item.get("degree", TOTAL_DEGREE), f"{where}.degree", 1, 6)
-                text = (f"E2-optimal h of {len(box)} joints on {box}: Ritz solve of (19) in a "
-                        f"total-degree {degree} basis on a Sobol rule")  # fmt: skip
-            factory = synthesis(box, fix, degree, key)
-            region = region or box
-        if unknown:
-            raise InvalidInputError(f"{where}: unknown key(s) {sorted(unknown)}", where)
-        specs.append(AugmentationSpec(label, "(9)", text, (), factory))
-    return tuple(specs), region, vectors
-
-
-def _formula_maps(kin: Kinematics, item: Mapping, where: str) -> tuple[FormulaMap, ...]:
-    """One map for p = r + 1 (``h`` a formula), p - r of them for more (``h`` a list)."""
-    k, h = kin.p - kin.r, item.get("h", "")
-    texts = [h] if k == 1 else h
-    if not isinstance(texts, list) or len(texts) != k:
         raise InvalidInputError(
-            f"{where}.h must be " + ("a formula" if k == 1 else
-            f"a list of {k} formulas (p - r = {k}: one map per degree of redundancy)"),
-            f"{where}.h",
-        )  # fmt: skip
-    names, params = kin.variable_names, item.get("parameters")
-    fields = [f"{where}.h"] if k == 1 else [f"{where}.h.{j}" for j in range(k)]
-    return tuple(FormulaMap(t, names, params, field=f) for t, f in zip(texts, fields, strict=True))
-
-
-def _vector_only(label: str) -> Callable[..., AugmentingMap]:
-    def refuse(kin: Kinematics) -> AugmentingMap:
-        raise InvalidInputError(
-            f"augmentation {label!r} is a vector of maps (p - r > 1): build its extended "
-            "inverse with Robot.inverse",
-            "augmentation",
+            f"path must be a list of 1 to {MAX_PATH_POINTS} task points", "path"
         )
-
-    return refuse
-
-
-def _region(kin: Kinematics, item: Mapping, where: str):
-    try:
-        box, fix = check_region(kin, item.get("region", {}), item.get("fixed"))
-    except InvalidInputError as exc:
-        raise InvalidInputError(f"{where}.region: {exc}", f"{where}.region") from None
-    if len(box) < 2:
-        raise InvalidInputError(f"{where}.region must have at least two variables",
-                                f"{where}.region")  # fmt: skip
-    return box, fix
+    return tuple(x0.tolist()), tuple(target.tolist()), tuple(map(tuple, path.tolist()))
 
 
 def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
@@ -342,12 +256,13 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
     unknown = set(d) - allowed
     if unknown:
         key = sorted(map(str, unknown))[0]
-        raise InvalidInputError(f"unknown key {key!r} for a {kind} robot; known: {sorted(allowed)}",
-                                key)  # fmt: skip
+        raise InvalidInputError(
+            f"unknown key {key!r} for a {kind} robot; known: {sorted(allowed)}", key
+        )
     if kind in ROBOTS:
         base = ROBOTS[kind]
         kin = base.build(**_get(d, "parameters", dict, "a mapping of parameters", {}))
-        extra, _, _ = _augmentations(kin, d.get("augmentations", []))
+        extra, _, _ = augmentations_from_dict(kin, d.get("augmentations", []))
         spec = replace(base, augmentations=(*base.augmentations, *extra)) if extra else base
         return Robot(spec, kin, dict(d))
     if kind in ARMS:  # the catalogue's URDF, end link and home, with the definition's keys
@@ -361,9 +276,10 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
         kin.joint_limits = check_limits(d["limits"], kin.p)
     box = _x_range(kin, d)
     x0, target, path = _defaults(kin, d, box)
-    key = json.dumps({k: v for k, v in d.items() if k != "augmentations"}, sort_keys=True,
-                     default=str)  # fmt: skip
-    augmentations, region, vectors = _augmentations(kin, d.get("augmentations", []), key)
+    key = json.dumps(
+        {k: v for k, v in d.items() if k != "augmentations"}, sort_keys=True, default=str
+    )
+    augmentations, region, vectors = augmentations_from_dict(kin, d.get("augmentations", []), key)
     title = _get(d, "title", str, "a string", kind.replace("_", " "))
     task_names = {
         "planar_chain": ("x", "y", "phi")[: kin.r],
@@ -371,15 +287,27 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
         "urdf": tuple(getattr(kin, "task_names", ())),
     }.get(kind, tuple(getattr(kin, "task_names", ())))
     spec = RobotSpec(
-        name=kind, title=title, description=ARMS[kind].description if kind in ARMS else
-        f"{title}: a {kind} robot defined by data",
-        equation="(4)", p=kin.p, r=kin.r, variable_names=tuple(kin.variable_names),
-        task_names=tuple(task_names), parameters=(), vector_parameters=(),
-        factory=lambda: kin, default_x0=x0, default_target=target, default_path=path,
-        x_range=box, augmentations=augmentations,
+        name=kind,
+        title=title,
+        description=ARMS[kind].description
+        if kind in ARMS
+        else f"{title}: a {kind} robot defined by data",
+        equation="(4)",
+        p=kin.p,
+        r=kin.r,
+        variable_names=tuple(kin.variable_names),
+        task_names=tuple(task_names),
+        parameters=(),
+        vector_parameters=(),
+        factory=lambda: kin,
+        default_x0=x0,
+        default_target=target,
+        default_path=path,
+        x_range=box,
+        augmentations=augmentations,
         default_augmentation=augmentations[0].name if augmentations else "",
         functional_region=region,
-    )  # fmt: skip
+    )
     return Robot(spec, kin, dict(d), vectors)
 
 
@@ -389,9 +317,11 @@ def load_robot(source: str | Path) -> Robot:
     if not path.is_file():
         if str(source) in ROBOTS or str(source) in ARMS:
             return robot_from_dict({"name": str(source)})
-        raise InvalidInputError(f"robot {str(source)!r} is neither a file nor a built-in robot "
-                                f"({sorted(ROBOTS)}) or catalogue arm ({sorted(ARMS)})",
-                                "robot")  # fmt: skip
+        raise InvalidInputError(
+            f"robot {str(source)!r} is neither a file nor a built-in robot "
+            f"({sorted(ROBOTS)}) or catalogue arm ({sorted(ARMS)})",
+            "robot",
+        )
     if path.stat().st_size > MAX_FILE_BYTES:
         raise InvalidInputError(f"robot file larger than {MAX_FILE_BYTES} bytes", "robot")
     text = path.read_text(encoding="utf-8")
@@ -399,8 +329,10 @@ def load_robot(source: str | Path) -> Robot:
         try:
             import yaml
         except ImportError:  # PyYAML is optional
-            raise InvalidInputError("YAML robot files need PyYAML (pip install pyyaml); or "
-                                    "write the robot as JSON", "robot") from None  # fmt: skip
+            raise InvalidInputError(
+                "YAML robot files need PyYAML (pip install pyyaml); or write the robot as JSON",
+                "robot",
+            ) from None
         try:
             data = yaml.safe_load(text)
         except yaml.YAMLError as exc:

@@ -59,6 +59,8 @@ def arm_augmentations(kin: Kinematics, d: Mapping) -> list:
         return list(d.get("augmentations", []))
     home = np.asarray(d["home"], dtype=float)
     lo, hi = np.asarray(kin.joint_limits, dtype=float).T
-    box = {n: [float(max(lo[i], home[i] - ARM_BOX)), float(min(hi[i], home[i] + ARM_BOX))]
-           for i, n in enumerate(kin.variable_names)}  # fmt: skip
+    box = {
+        n: [float(max(lo[i], home[i] - ARM_BOX)), float(min(hi[i], home[i] + ARM_BOX))]
+        for i, n in enumerate(kin.variable_names)
+    }
     return [{"name": "e2_synthesized", "region": box}]

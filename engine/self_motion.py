@@ -166,9 +166,15 @@ def trace(
             sols.append(None)
             continue
         sol = solve_ivp(
-            kernel, (0.0, end), base, method="DOP853", rtol=TRACE_TOL, atol=TRACE_TOL,
-            dense_output=True, events=events or None,
-        )  # fmt: skip
+            kernel,
+            (0.0, end),
+            base,
+            method="DOP853",
+            rtol=TRACE_TOL,
+            atol=TRACE_TOL,
+            dense_output=True,
+            events=events or None,
+        )
         if not sol.success and sol.status != 1:
             raise InvalidInputError(
                 f"the self-motion curve could not be traced from the base: {sol.message}",

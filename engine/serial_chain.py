@@ -5,7 +5,9 @@ Compiling it merges the fixed joints into the origin of the next movable joint (
 tip transform), and turns each joint's frame so that its axis is z: the motion of a revolute
 joint is then Rz(q), of a prismatic one a translation q along z. The work per configuration is
 one batched product (origins times motions) and one 4x4 product per joint along the chain, the
-same count as a dedicated kinematics library's forward pass, with a few numpy calls in all.
+same count as a dedicated kinematics library's forward pass, with a few numpy calls in all. For
+one configuration of revolute joints numpy's per-call cost dominates, so the chain's prefix
+products are taken in ceil(log2(m + 1)) batched steps instead of m calls.
 """
 
 from __future__ import annotations
@@ -94,6 +96,16 @@ class CompiledChain:
         self._P0 = self.origins @ M0
         self._Pc, self._Ps = self.origins @ (rev * Kc), self.origins @ (rev * Ks)
         self._Pq = self.origins @ (pri * Kq)
+        # One configuration of a chain of revolute joints (x the joint vector): the m joint
+        # transforms and the tip as rows of one product w @ stack, w_j = (1, cos q_j, sin q_j)
+        # (the tip's w = (1, 0, 0)).
+        self._stack = np.concatenate(
+            [np.stack([self._P0, self._Pc, self._Ps], axis=1).reshape(self.m, 3, 16),
+             np.stack([self.tip, 0.0 * self.tip, 0.0 * self.tip]).reshape(1, 3, 16)]
+        )  # fmt: skip
+        self._w = np.zeros((self.m + 1, 1, 3))
+        self._w[:, 0, 0] = 1.0
+        self._one = self.direct and self._all_revolute
 
     def joint_values(self, x: FloatArray) -> FloatArray:
         """Every movable joint's value: x where active, the locked value elsewhere (..., m)."""
@@ -137,11 +149,10 @@ class CompiledChain:
             Linear and angular velocity of the end link per unit joint rate: a revolute joint's
             column is (z x (t - o), z), a prismatic joint's (z, 0).
         """
+        x = np.asarray(x, dtype=float)
+        if x.ndim == 1 and self._one:
+            return self._one_pose_jacobian(x)
         F, T = self.frames(x)
-        if F.ndim == 3 and self.direct and self._all_revolute:  # (plain indexing: faster)
-            z, t = F[:, :3, 2], T[:3, 3]
-            lin = (z[:, :, None] * (t - F[:, :3, 3])[:, None, :]).reshape(self.m, 9) @ _CROSS
-            return T[:3, :3], t, lin.T, z.T
         z, t = F[..., :3, 2], T[..., :3, 3]  # (..., m, 3), (..., 3)
         d = t[..., None, :] - F[..., :3, 3]
         outer = z[..., :, None] * d[..., None, :]  # (..., m, 3, 3)
@@ -156,3 +167,21 @@ class CompiledChain:
             Jv_[..., cols], Jw_[..., cols] = Jv[..., self.active], Jw[..., self.active]
             Jv, Jw = Jv_, Jw_
         return T[..., :3, :3], t, Jv, Jw
+
+    def _one_pose_jacobian(self, q: FloatArray):
+        """:meth:`pose_jacobian` of one configuration q (m,) of a chain of revolute joints, in
+        few numpy calls: the joint transforms and the tip from one product, their prefix
+        products F_j = A_0 ... A_j by ceil(log2(m + 1)) batched products (each step
+        F_j <- F_(j-s) F_j for j >= s, s = 1, 2, 4, ...), the end pose F_m."""
+        m = self.m
+        w = self._w.copy()
+        np.cos(q, out=w[:m, 0, 1])
+        np.sin(q, out=w[:m, 0, 2])
+        F = (w @ self._stack).reshape(m + 1, 4, 4)
+        s = 1
+        while s <= m:
+            F[s:] = F[:-s] @ F[s:]
+            s *= 2
+        z, t = F[:m, :3, 2], F[m, :3, 3]
+        lin = (z[:, :, None] * (t - F[:m, :3, 3])[:, None, :]).reshape(m, 9) @ _CROSS
+        return F[m, :3, :3], t, lin.T, z.T

@@ -205,10 +205,13 @@ class Unicycle(Kinematics):
         l10, l11 = x[..., 0], x[..., 1]
         q3 = self.q0[2] + x[..., 2] * self.T + x[..., 3] * (1.0 - np.cos(self.T))
         return np.stack(
-            [self.q0[0] + l10 * Mc[..., 0] + l11 * Mc[..., 1],
-             self.q0[1] + l10 * Ms[..., 0] + l11 * Ms[..., 1], q3],
+            [
+                self.q0[0] + l10 * Mc[..., 0] + l11 * Mc[..., 1],
+                self.q0[1] + l10 * Ms[..., 0] + l11 * Ms[..., 1],
+                q3,
+            ],
             axis=-1,
-        )  # fmt: skip
+        )
 
     def jacobian(self, x: FloatArray) -> FloatArray:
         """J = dq(T)/dlambda, eq. (43) as derived (see class notes): (..., 4) -> (..., 3, 4)."""

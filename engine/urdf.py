@@ -116,12 +116,17 @@ class UrdfChain(Kinematics):
         movable = [j.name for j in chain if j.type in MOVABLE]
         for j in chain:
             if j.type not in (*MOVABLE, "fixed"):
-                raise InvalidInputError(f"joint {j.name!r} on the chain is {j.type}; only "
-                                        "revolute, continuous, prismatic and fixed joints are "
-                                        "supported", "urdf")  # fmt: skip
+                raise InvalidInputError(
+                    f"joint {j.name!r} on the chain is {j.type}; only "
+                    "revolute, continuous, prismatic and fixed joints are "
+                    "supported",
+                    "urdf",
+                )
             if j.mimic is not None and j.type in MOVABLE:
-                raise InvalidInputError(f"joint {j.name!r} on the chain mimics another; mimic "
-                                        "joints are not supported", "urdf")  # fmt: skip
+                raise InvalidInputError(
+                    f"joint {j.name!r} on the chain mimics another; mimic joints are not supported",
+                    "urdf",
+                )
         if active_joints is not None and (
             isinstance(active_joints, str) or not isinstance(active_joints, Sequence)
         ):
@@ -168,7 +173,7 @@ class UrdfChain(Kinematics):
                 float(locked.get(j.name, 0.0)),
             )
             for j in chain
-        )  # fmt: skip
+        )
         self.limits = tuple(_limits(model.joint_map[name]) for name in active)
         self.locked = {j.name: j.value for j in self.chain if j.type != "fixed" and j.index < 0}
         self.joint_limits = np.array([_bounds(model.joint_map[name]) for name in active])
@@ -194,9 +199,14 @@ class UrdfChain(Kinematics):
 
     @property
     def parameters(self) -> dict[str, object]:
-        return {"end_link": self.end_link, "active_joints": list(self.joint_names),
-                "task": self.task, "locked": dict(self.locked), "home": list(self.home),
-                "reference": self.reference.tolist()}  # fmt: skip
+        return {
+            "end_link": self.end_link,
+            "active_joints": list(self.joint_names),
+            "task": self.task,
+            "locked": dict(self.locked),
+            "home": list(self.home),
+            "reference": self.reference.tolist(),
+        }
 
     def frames(self, x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Joint origins o (..., n, 3), joint axes z (..., n, 3) in the base frame, for the n

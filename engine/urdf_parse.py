@@ -55,14 +55,19 @@ def mesh_note(model, field: str = "urdf") -> str:
     so a reference of any form (relative, ``package://``, ``file:///``, a URL) is skipped.
     """
     names = sorted(
-        {str(v.geometry.mesh.filename) for link in model.robot.links
-         for v in (*link.visuals, *link.collisions)
-         if v.geometry is not None and v.geometry.mesh is not None}
-    )  # fmt: skip
+        {
+            str(v.geometry.mesh.filename)
+            for link in model.robot.links
+            for v in (*link.visuals, *link.collisions)
+            if v.geometry is not None and v.geometry.mesh is not None
+        }
+    )
     if not names:
         return ""
-    return (f"{field}: {len(names)} mesh file reference(s) skipped, never read (jik computes "
-            f"kinematics only), e.g. {names[0][:120]!r}")  # fmt: skip
+    return (
+        f"{field}: {len(names)} mesh file reference(s) skipped, never read (jik computes "
+        f"kinematics only), e.g. {names[0][:120]!r}"
+    )
 
 
 #: Encodings a URDF may declare: its text reaches the parser as UTF-8 bytes, and any other
@@ -84,9 +89,15 @@ def _hardened_parse(data: bytes, field: str):
             field,
         )
     parser = etree.XMLParser(
-        resolve_entities=False, no_network=True, load_dtd=False, dtd_validation=False,
-        huge_tree=False, remove_comments=True, remove_pis=True, remove_blank_text=True,
-    )  # fmt: skip
+        resolve_entities=False,
+        no_network=True,
+        load_dtd=False,
+        dtd_validation=False,
+        huge_tree=False,
+        remove_comments=True,
+        remove_pis=True,
+        remove_blank_text=True,
+    )
     try:
         tree = etree.fromstring(data, parser=parser).getroottree()
     except etree.XMLSyntaxError as exc:
@@ -124,9 +135,12 @@ def parse_urdf(text, field: str = "urdf"):
     yourdfpy = _yourdfpy()
     try:
         model = yourdfpy.URDF.load(
-            io.BytesIO(clean), build_scene_graph=False, load_meshes=False,
-            build_collision_scene_graph=False, load_collision_meshes=False,
-        )  # fmt: skip
+            io.BytesIO(clean),
+            build_scene_graph=False,
+            load_meshes=False,
+            build_collision_scene_graph=False,
+            load_collision_meshes=False,
+        )
     except Exception as exc:  # yourdfpy raises whatever its XML walk meets
         raise InvalidInputError(f"{field}: not a valid URDF ({exc})", field) from None
     if model.robot is None or not model.robot.links:

@@ -1,8 +1,5 @@
 """Synthesis of the E2-optimal augmenting map by a Ritz method, eqs. (19)-(20).
 
-(It stays whole, at about 430 lines: the basis, the quadrature, the linear system and the map
-it yields all work on the same tensor Legendre grids; the derivation below takes most of it.)
-
 For one degree of redundancy, E2(h) = integral of (dh P dh^T - 2 dh K + 1) m dx, eq. (19), is a
 convex quadratic functional of h whose Euler equation is the linear elliptic PDE (20),
 div(m P grad h) = div(m K), with the natural boundary condition n . (m P grad h - m K) = 0 on
@@ -29,7 +26,6 @@ found from the KKT system.
 from __future__ import annotations
 
 import functools
-import string
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import cast
@@ -38,11 +34,12 @@ import numpy as np
 from numpy.polynomial import legendre as L
 from scipy import linalg
 
-from jik.engine.augmentations import AugmentingMap, Polynomial2
+from jik.engine.augmentations import Polynomial2
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.functionals import Region, check_region, error_functional_e2
 from jik.engine.inverses import pseudoinverse
 from jik.engine.kinematics import Kinematics, Manipulator2
+from jik.engine.legendre_map import SynthesizedMap, legendre_vander, lgl_nodes
 from jik.engine.progress import Progress, check_cancelled
 from jik.engine.validation import FloatArray, count
 
@@ -54,97 +51,6 @@ MANIPULATOR2_REGION: dict[str, tuple[float, float]] = {"x2": (-1.0, 1.0), "x3": 
 
 #: Default basis degree (per variable) of the Manipulator 2 synthesis.
 MANIPULATOR2_DEGREE = 16
-
-
-def _derivative_matrix(n: int) -> FloatArray:
-    """D (n+1, n+1) with P_i'(t) = sum_k D[k, i] P_k(t) for Legendre P_0..P_n."""
-    D = np.zeros((n + 1, n + 1))
-    if n:
-        D[:n, :] = L.legder(np.eye(n + 1), axis=0)
-    return D
-
-
-def _vander(t: FloatArray, n: int) -> tuple[FloatArray, FloatArray]:
-    """Legendre values and derivatives, each (..., n + 1), at reference points t."""
-    t = np.asarray(t, dtype=float)
-    V = L.legvander(t, n).reshape(*t.shape, n + 1)
-    return V, V @ _derivative_matrix(n)
-
-
-def _lgl_nodes(n: int) -> FloatArray:
-    """Gauss-Lobatto-Legendre nodes of degree n: -1, roots of P_n', 1."""
-    if n == 1:
-        return np.array([-1.0, 1.0])
-    inner = L.legroots(L.legder(np.eye(n + 1)[n]))
-    return np.concatenate([[-1.0], np.sort(inner.real), [1.0]])
-
-
-class SynthesizedMap(AugmentingMap):
-    """h(x) = sum c_ij.. P_i(t_a) P_j(t_b) .., a tensor Legendre polynomial on a box, eq. (9).
-
-    Parameters
-    ----------
-    coefficients : ndarray, shape (n_1 + 1, ..., n_d + 1)
-        Legendre coefficients; axis k belongs to the k-th variable of ``region``.
-    region : dict name -> (lo, hi)
-        The box; t = (2 x - lo - hi) / (hi - lo) maps it onto [-1, 1]^d.
-    variables : tuple of int
-        0-based indices of the region's variables in x.
-    p : int
-        Configuration-space dimension.
-
-    Notes
-    -----
-    A polynomial, so value and gradient are continuous everywhere (outside the box it is the
-    polynomial continuation). Batched over leading axes of x.
-    """
-
-    name = "e2_synthesized"
-
-    def __init__(
-        self,
-        coefficients: FloatArray,
-        region: Mapping[str, tuple[float, float]],
-        variables: Sequence[int],
-        p: int,
-    ) -> None:
-        self.coefficients = np.asarray(coefficients, dtype=float)
-        self.region = {k: (float(a), float(b)) for k, a, b in ((k, *v) for k, v in region.items())}
-        self.variables = tuple(int(v) for v in variables)
-        self.p = int(p)
-        if self.coefficients.ndim != len(self.variables) or len(self.region) != len(self.variables):
-            raise InvalidInputError("coefficients, region and variables must have one axis each")
-        lo = np.array([v[0] for v in self.region.values()])
-        hi = np.array([v[1] for v in self.region.values()])
-        self._center, self._scale = 0.5 * (lo + hi), 2.0 / (hi - lo)  # t = (x - c) * scale
-        d = len(self.variables)
-        letters = string.ascii_lowercase[:d]
-        self._contract = ",".join(f"...{c}" for c in letters) + f",{letters}->..."
-
-    @property
-    def parameters(self) -> dict[str, float]:
-        shape = self.coefficients.shape
-        return {f"degree_{k}": float(n - 1) for k, n in zip(self.region, shape, strict=True)}
-
-    def _bases(self, x: FloatArray) -> list[tuple[FloatArray, FloatArray]]:
-        x = np.asarray(x, dtype=float)
-        return [
-            _vander((x[..., v] - self._center[k]) * self._scale[k], n - 1)
-            for k, (v, n) in enumerate(zip(self.variables, self.coefficients.shape, strict=True))
-        ]
-
-    def value(self, x: FloatArray) -> FloatArray:
-        bases = self._bases(x)
-        return np.einsum(self._contract, *(V for V, _ in bases), self.coefficients)
-
-    def gradient(self, x: FloatArray) -> FloatArray:
-        x = np.asarray(x, dtype=float)
-        bases = self._bases(x)
-        g = np.zeros(x.shape)
-        for k, v in enumerate(self.variables):
-            mats = [dV if i == k else V for i, (V, dV) in enumerate(bases)]
-            g[..., v] = np.einsum(self._contract, *mats, self.coefficients) * self._scale[k]
-        return g
 
 
 @dataclass(frozen=True)
@@ -230,7 +136,7 @@ class _Problem:
     def system(self, degrees: Sequence[int]) -> tuple[FloatArray, FloatArray]:
         """Stiffness A (nb, nb) and load b (nb,) over the full tensor basis (constant included)."""
         d = len(degrees)
-        bases = [_vander(t, n) for t, n in zip(self.t, degrees, strict=True)]
+        bases = [legendre_vander(t, n) for t, n in zip(self.t, degrees, strict=True)]
         G = []
         for k in range(d):
             mats = [dV if i == k else V for i, (V, dV) in enumerate(bases)]
@@ -272,7 +178,7 @@ def _solve(
         c = np.zeros(A.shape[0])
         c[1:] = linalg.solve(A[1:, 1:], b[1:], assume_a="pos")
     else:
-        nodes = [_lgl_nodes(n) for n in degrees]
+        nodes = [lgl_nodes(n) for n in degrees]
         grid = np.stack(np.meshgrid(*nodes, indexing="ij"), axis=-1).reshape(-1, len(degrees))
         on_boundary = np.any(np.isclose(np.abs(grid), 1.0), axis=1)
         tb = grid[on_boundary]  # (nc, d) reference boundary nodes

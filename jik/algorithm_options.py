@@ -12,14 +12,23 @@ ALGORITHM_NAMES = ("pseudoinverse", "extended", "damped", "weighted", "posture")
 def add_algorithm_parameter_options(p: argparse.ArgumentParser) -> None:
     """--damping, --damping-threshold, --gain, --rest, --limits."""
     p.add_argument("--damping", type=float, help="damped: damping lambda >= 0 (default 0.1)")
-    p.add_argument("--damping-threshold", type=float,
-                   help="damped: damp only where the smallest singular value of J is below "
-                   "this (default 0: constant damping)")  # fmt: skip
+    p.add_argument(
+        "--damping-threshold",
+        type=float,
+        help="damped: damp only where the smallest singular value of J is below "
+        "this (default 0: constant damping)",
+    )
     p.add_argument("--gain", type=float, help="posture: null-space gain k >= 0 (default 1)")
-    p.add_argument("--rest", help="posture: rest posture 'x1, x2, ...' (default: the run's "
-                   "x0; for an atlas the robot's home, else its default x0)")  # fmt: skip
-    p.add_argument("--limits", help="weighted: joint limits 'lo,hi; lo,hi; ...' (default: the "
-                   "robot's limits, else its configuration box)")  # fmt: skip
+    p.add_argument(
+        "--rest",
+        help="posture: rest posture 'x1, x2, ...' (default: the run's "
+        "x0; for an atlas the robot's home, else its default x0)",
+    )
+    p.add_argument(
+        "--limits",
+        help="weighted: joint limits 'lo,hi; lo,hi; ...' (default: the "
+        "robot's limits, else its configuration box)",
+    )
 
 
 def algorithm_parameters(args: argparse.Namespace, algorithm: str, x0=None) -> dict:

@@ -18,7 +18,6 @@ algorithm the drift after each cycle, success and leg ends), a CSV beside it for
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import math
 import os
@@ -27,12 +26,12 @@ import time
 from pathlib import Path
 from typing import Any
 
-from jik import install_hint
 from jik.algorithm_options import (
     ALGORITHM_NAMES,
     add_algorithm_parameter_options,
     algorithm_parameters,
 )
+from jik.atlas_output import CsvWriter, Gathered, listed, write_figure
 
 #: Atlases of more runs than this write their arrays to the CSV only (the JSON keeps a summary).
 JSON_RUNS = 20000
@@ -47,10 +46,16 @@ def add_atlas_parser(sub) -> None:
         help="repeatability atlas: drift after each cycle over many starts (and paths)",
         description=__doc__.split("\n\n")[2],
     )
-    p.add_argument("--robot", default="manipulator2",
-                   help="a built-in robot, or a robot file (.json, .yaml)")  # fmt: skip
-    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
-                   help="a robot parameter (repeat it), e.g. l=1.5")  # fmt: skip
+    p.add_argument(
+        "--robot", default="manipulator2", help="a built-in robot, or a robot file (.json, .yaml)"
+    )
+    p.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="a robot parameter (repeat it), e.g. l=1.5",
+    )
     p.add_argument("--path", required=True, help='task points "y1,y2; y1,y2; ...", a loop')
     p.add_argument("--starts", type=int, default=256, help="starts per path (default 256)")
     p.add_argument("--sampling", choices=("grid", "sample"), default="grid")
@@ -60,15 +65,28 @@ def add_atlas_parser(sub) -> None:
     )
     p.add_argument("--reference", help='"x1,x2,...": where s = 0 comes from (robot default)')
     p.add_argument("--cycles", type=int, default=3)
-    p.add_argument("--algorithm", action="append", choices=ALGORITHM_NAMES,
-                   help="repeat for several, compared over the same starts "
-                   "(default pseudoinverse)")  # fmt: skip
+    p.add_argument(
+        "--algorithm",
+        action="append",
+        choices=ALGORITHM_NAMES,
+        help="repeat for several, compared over the same starts (default pseudoinverse)",
+    )
     add_algorithm_parameter_options(p)
     p.add_argument("--augmentation", help="augmenting map of the extended inverse")
-    p.add_argument("--shift", action="append", default=[], metavar='"dy1,dy2"',
-                   help="a translation of the path (repeat it; default none)")  # fmt: skip
-    p.add_argument("--scale", action="append", type=float, default=[],
-                   help="a scale of the path about its first point (default 1)")  # fmt: skip
+    p.add_argument(
+        "--shift",
+        action="append",
+        default=[],
+        metavar='"dy1,dy2"',
+        help="a translation of the path (repeat it; default none)",
+    )
+    p.add_argument(
+        "--scale",
+        action="append",
+        type=float,
+        default=[],
+        help="a scale of the path about its first point (default 1)",
+    )
     p.add_argument(
         "--chunk",
         type=int,
@@ -81,8 +99,11 @@ def add_atlas_parser(sub) -> None:
     p.add_argument("--out", default="atlas.json", help="output JSON (default atlas.json)")
     p.add_argument("--csv", action="store_true", help="also write the CSV for a small atlas")
     p.add_argument("--no-figure", action="store_true", help="write no HTML figure")
-    p.add_argument("--no-leg-ends", action="store_true",
-                   help="leave the leg ends out (a large CSV is then far smaller)")  # fmt: skip
+    p.add_argument(
+        "--no-leg-ends",
+        action="store_true",
+        help="leave the leg ends out (a large CSV is then far smaller)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=atlas_command)
 
@@ -156,56 +177,85 @@ def _run(args: argparse.Namespace) -> int:
     algorithms = args.algorithm or ["pseudoinverse"]
     if Path(args.robot).is_file() or args.robot in ARMS:  # a user's robot or a catalogue arm
         if args.param:
-            raise InvalidInputError("--param is for a built-in robot; a robot file holds its "
-                                    "parameters", "param")  # fmt: skip
+            raise InvalidInputError(
+                "--param is for a built-in robot; a robot file holds its parameters", "param"
+            )
         robot = load_robot(args.robot)
         spec, kin = robot.spec, robot.kinematics
-        inverses = [robot.inverse(a, args.augmentation,
-                                  algorithm_parameters=algorithm_parameters(args, a))
-                    for a in algorithms]  # fmt: skip
+        inverses = [
+            robot.inverse(a, args.augmentation, algorithm_parameters=algorithm_parameters(args, a))
+            for a in algorithms
+        ]
     else:
         spec = robot_spec(args.robot)
         kin = spec.build(**dict(_param(t) for t in args.param))
-        inverses = [make_inverse(kin, a, args.augmentation, None, spec.name,
-                                 algorithm_parameters=algorithm_parameters(args, a))
-                    for a in algorithms]  # fmt: skip
+        inverses = [
+            make_inverse(
+                kin,
+                a,
+                args.augmentation,
+                None,
+                spec.name,
+                algorithm_parameters=algorithm_parameters(args, a),
+            )
+            for a in algorithms
+        ]
     arc = _numbers(args.arc, "--arc") if args.arc else [-MAX_ARC, MAX_ARC]
     reference = _numbers(args.reference, "--reference") if args.reference else spec.default_x0
     backend = backend_option(args)
     backend_for(backend)  # (a bad option fails here, before the curves are traced)
     plan = plan_atlas(
-        inverses, _points(args.path, "--path"), cycles=args.cycles, n_starts=args.starts,
-        arc=arc, sampling=args.sampling, seed=args.seed, reference=reference,
+        inverses,
+        _points(args.path, "--path"),
+        cycles=args.cycles,
+        n_starts=args.starts,
+        arc=arc,
+        sampling=args.sampling,
+        seed=args.seed,
+        reference=reference,
         box=None if args.arc or not spec.x_range else spec.x_range,
         shifts=[_numbers(s, "--shift") for s in args.shift] or None,
-        scales=args.scale or None, chunk=args.chunk or default_chunk(args, DEFAULT_CHUNK),
-        gamma=spec.default_gamma, mode=spec.default_mode,
-    )  # fmt: skip
+        scales=args.scale or None,
+        chunk=args.chunk or default_chunk(args, DEFAULT_CHUNK),
+        gamma=spec.default_gamma,
+        mode=spec.default_mode,
+    )
     big = plan.size > JSON_RUNS
     csv_path = out.with_suffix(".csv") if big or args.csv else None
     A, P, N, C = len(inverses), len(plan.paths), plan.n_starts, plan.cycles
     keep = not big  # (a small atlas is gathered for the JSON; a large one streams to the CSV)
     every = max(1, plan.size // FIGURE_POINTS)
-    arrays = _Gathered(plan, keep, every, legs=not args.no_leg_ends)
+    arrays = Gathered(plan, keep, every, legs=not args.no_leg_ends)
     progress = Progress(args.quiet)
     t0 = time.perf_counter()
-    with _CsvWriter(csv_path, plan, legs=not args.no_leg_ends) as rows:
+    with CsvWriter(csv_path, plan, legs=not args.no_leg_ends) as rows:
         for task, chunk in iter_atlas(plan, backend):
             arrays.add(task, chunk)
             rows.add(task, chunk)
             progress(arrays.done, plan.size)
     elapsed = time.perf_counter() - t0
     inputs = {
-        "robot": spec.name, "robot_file": args.robot if Path(args.robot).is_file() else None,
-        "robot_parameters": kin.parameters, "path": _points(args.path, "path"),
-        "cycles": C, "algorithms": list(plan.algorithms), "augmentation": args.augmentation,
+        "robot": spec.name,
+        "robot_file": args.robot if Path(args.robot).is_file() else None,
+        "robot_parameters": kin.parameters,
+        "path": _points(args.path, "path"),
+        "cycles": C,
+        "algorithms": list(plan.algorithms),
+        "augmentation": args.augmentation,
         "algorithm_parameters": {a: algorithm_parameters(args, a) for a in plan.algorithms},
-        "starts": N, "sampling": args.sampling, "seed": args.seed, "arc": arc if args.arc else None,
-        "reference": list(reference), "shifts": [_numbers(t, "--shift") for t in args.shift],
+        "starts": N,
+        "sampling": args.sampling,
+        "seed": args.seed,
+        "arc": arc if args.arc else None,
+        "reference": list(reference),
+        "shifts": [_numbers(t, "--shift") for t in args.shift],
         "scales": args.scale or [1.0],
-        "chunk": plan.chunk, "gamma": plan.settings["gamma"], "mode": plan.settings["mode"],
-        "tol": plan.settings["tol"], "backend": backend,
-    }  # fmt: skip
+        "chunk": plan.chunk,
+        "gamma": plan.settings["gamma"],
+        "mode": plan.settings["mode"],
+        "tol": plan.settings["tol"],
+        "backend": backend,
+    }
     doc: dict[str, Any] = {
         "inputs": inputs,
         "arc": list(plan.manifolds[0].arc),
@@ -217,20 +267,20 @@ def _run(args: argparse.Namespace) -> int:
     }
     if keep:
         squeeze = (lambda a: a[0]) if P == 1 else (lambda a: a)
-        doc["parameter"] = _listed(plan.parameter(np.arange(N)))
-        doc["starts"] = _listed(squeeze(arrays.starts))
+        doc["parameter"] = listed(plan.parameter(np.arange(N)))
+        doc["starts"] = listed(squeeze(arrays.starts))
         doc["results"] = {
             alg: {
-                "drift": _listed(squeeze(arrays.drift[a])),
+                "drift": listed(squeeze(arrays.drift[a])),
                 "success": squeeze(arrays.success[a]).tolist(),
-                "leg_ends": None if arrays.legs is None else _listed(squeeze(arrays.legs[a])),
+                "leg_ends": None if arrays.legs is None else listed(squeeze(arrays.legs[a])),
                 "failures": {
                     str(run): why for (b, run), why in sorted(arrays.failures.items()) if b == a
                 },
             }
             for a, alg in enumerate(plan.algorithms)
         }
-    figure = None if args.no_figure else _figure(arrays, plan, out.with_suffix(".html"))
+    figure = None if args.no_figure else write_figure(arrays, plan, out.with_suffix(".html"))
     doc["figure"] = None if figure is None else figure.name
     out.write_text(json.dumps(doc), encoding="utf-8")
     written = ", ".join(str(f) for f in (out, csv_path, figure) if f)
@@ -269,181 +319,3 @@ def _param(text: str) -> tuple[str, float]:
     if not eq:
         raise SystemExit(f"jik atlas: --param must be NAME=VALUE, got {text!r}")
     return name.strip(), _numbers(value, f"--param {name}")[0]
-
-
-def _listed(a) -> Any:
-    """Nested lists with NaN as null (JSON has no NaN)."""
-    import numpy as np
-
-    a = np.asarray(a, dtype=float)
-    listed: Any = np.where(np.isfinite(a), a.astype(object), None)
-    return listed.tolist()
-
-
-class _Gathered:
-    """What the JSON and the figure need: everything for a small atlas; for a large one the
-    last cycle's drift of every ``every``-th run, a summary and the failures."""
-
-    def __init__(self, plan, keep: bool, every: int, legs: bool) -> None:
-        import numpy as np
-
-        A, P, N, C = len(plan.inverses), len(plan.paths), plan.n_starts, plan.cycles
-        p = plan.inverses[0].kinematics.p
-        self.plan, self.keep, self.every, self.done = plan, keep, every, 0
-        self.failures: dict[tuple[int, int], str] = {}
-        self.sampled = np.arange(0, P * N, every)
-        self.last = np.full((A, len(self.sampled)), np.nan)
-        self.count = np.zeros((A, C))
-        self.total = np.zeros((A, C))
-        self.worst = np.zeros((A, C))
-        self.outside: Any = None  # (A,) runs that left the joint limits; None: no limits
-        if keep:
-            self.starts = np.empty((P, N, p))
-            self.drift = np.empty((A, P, N, C))
-            self.success = np.empty((A, P, N), dtype=bool)
-        self.legs = np.empty((A, P, N, C * plan.legs, p)) if keep and legs else None
-
-    def add(self, task, chunk) -> None:
-        import numpy as np
-
-        lo, hi = chunk.lo, chunk.hi
-        self.done += hi - lo
-        finite = np.isfinite(chunk.drift)
-        self.count += finite.sum(axis=1)
-        self.total += np.where(finite, chunk.drift, 0).sum(axis=1)
-        self.worst = np.fmax(self.worst, np.nanmax(np.where(finite, chunk.drift, 0), axis=1))
-        pick = (self.sampled >= lo) & (self.sampled < hi)
-        self.last[:, pick] = chunk.drift[:, self.sampled[pick] - lo, -1]
-        self.failures.update({(a, run): why for a, run, why in chunk.failures})
-        if chunk.outside_limits is not None:
-            self.outside = chunk.outside_limits.sum(axis=1) + (
-                0 if self.outside is None else self.outside
-            )
-        if self.keep:
-            for name, values in (("drift", chunk.drift), ("success", chunk.success),
-                                 ("legs", chunk.leg_ends)):  # fmt: skip
-                if getattr(self, name) is not None:
-                    flat = getattr(self, name).reshape(len(values), -1, *values.shape[2:])
-                    flat[:, lo:hi] = values
-            self.starts.reshape(-1, self.starts.shape[-1])[lo:hi] = task.starts
-
-    def summary(self) -> dict:
-        import numpy as np
-
-        with np.errstate(invalid="ignore", divide="ignore"):
-            mean = self.total / self.count
-        return {
-            alg: {
-                "converged_runs": int(self.count[a, 0]),
-                "failed_runs": sum(1 for (b, _) in self.failures if b == a),
-                "mean_drift": _listed(mean[a]),
-                "max_drift": _listed(self.worst[a]),
-                **({} if self.outside is None else {"outside_limits": int(self.outside[a])}),
-            }
-            for a, alg in enumerate(self.plan.algorithms)
-        }
-
-
-class _CsvWriter:
-    """Rows of the CSV in run order (chunks that finish early wait in a small buffer)."""
-
-    def __init__(self, path: Path | None, plan, legs: bool) -> None:
-        self.path, self.plan, self.next, self.legs = path, plan, 0, legs
-        self.waiting: dict[int, tuple[Any, Any]] = {}
-
-    def __enter__(self) -> _CsvWriter:
-        if self.path is not None:
-            self.file = self.path.open("w", newline="", encoding="utf-8")
-            self.writer = csv.writer(self.file)
-            self.writer.writerow(self._header())
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        if self.path is not None:
-            self.file.close()
-
-    def _header(self) -> list[str]:
-        kin = self.plan.inverses[0].kinematics
-        names = kin.variable_names or tuple(f"x{i + 1}" for i in range(kin.p))
-        cols = ["path", "start", "s", *names]
-        for alg in self.plan.algorithms:
-            cols += [f"{alg}_success"] + [f"{alg}_drift_{c + 1}" for c in range(self.plan.cycles)]
-            if self.legs:
-                cols += [f"{alg}_leg{k + 1}_{v}" for k in range(self.plan.cycles * self.plan.legs)
-                         for v in names]  # fmt: skip
-        return cols
-
-    def add(self, task, chunk) -> None:
-        if self.path is None:
-            return
-        self.waiting[chunk.lo] = (task, chunk)
-        while self.next in self.waiting:
-            task, chunk = self.waiting.pop(self.next)
-            self._write(task, chunk)
-            self.next = chunk.hi
-
-    def _write(self, task, chunk) -> None:
-        import numpy as np
-
-        N = self.plan.n_starts
-        runs = np.arange(chunk.lo, chunk.hi)
-        s = self.plan.parameter(runs % N)
-        s = np.full(len(runs), np.nan) if s is None else s
-        A = chunk.drift.shape[0]
-        parts = [(runs // N)[:, None], (runs % N)[:, None], s[:, None], task.starts]
-        for a in range(A):
-            parts += [chunk.success[a][:, None], chunk.drift[a]]
-            if self.legs:
-                parts.append(chunk.leg_ends[a].reshape(len(runs), -1))
-        table = np.concatenate([np.asarray(p, dtype=float) for p in parts], axis=1)
-        for row in table:
-            self.writer.writerow([_cell(v) for v in row])
-
-
-def _cell(v: float) -> str:
-    if not math.isfinite(v):
-        return ""
-    return str(int(v)) if v == int(v) and abs(v) < 2**53 else repr(float(v))
-
-
-def atlas_figure(s, drift_last, algorithms, cycles: int, paths: int, n: int, label: str):
-    """The drift map, a plotly Figure (None without plotly): drift after the last cycle against
-    the start's arc length s (or run), a marker series per algorithm, log scale.
-    ``drift_last`` is (A, runs) at the sampled runs' ``s``."""
-    try:
-        import plotly.graph_objects as go
-    except ImportError:
-        return None
-
-    fig = go.Figure()
-    for a, alg in enumerate(algorithms):
-        fig.add_trace(go.Scattergl(x=s, y=drift_last[a], mode="markers", name=alg,
-                                   marker={"size": 4}))  # fmt: skip
-    fig.update_layout(
-        title=f"Repeatability atlas: drift after cycle {cycles} ({paths} path(s), {n} starts each)",
-        xaxis_title=label, yaxis_title=f"||x after cycle {cycles} - x0||", yaxis_type="log",
-        template="plotly_white",
-    )  # fmt: skip
-    return fig
-
-
-def _figure(arrays: _Gathered, plan, path: Path) -> Path | None:
-    """Write the HTML figure; None (and a note) when plotly is not installed."""
-    import numpy as np
-
-    N = plan.n_starts
-    s = plan.parameter(arrays.sampled % N)
-    label = "arc length s on the self-motion curve"
-    if s is None:
-        s, label = arrays.sampled % N, "start"
-    if len(plan.paths) > 1:
-        s, label = arrays.sampled.astype(float), "run (path x starts + start)"
-    fig = atlas_figure(
-        np.asarray(s), arrays.last, plan.algorithms, plan.cycles, len(plan.paths), N, label
-    )
-    if fig is None:
-        hint = install_hint("app")
-        sys.stderr.write(f"jik atlas: plotly is not installed: no figure ({hint})\n")
-        return None
-    fig.write_html(path, include_plotlyjs=True, full_html=True)  # (offline: no CDN)
-    return path

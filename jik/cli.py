@@ -121,18 +121,27 @@ def main(argv: list[str] | None = None) -> int:
 
     p = sub.add_parser("serve", help="start the REST API and the dashboard")
     p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
-    p.add_argument("--port", type=port_number, default=8000,
-                   help="HTTP port of the API, page and scene (default 8000)")  # fmt: skip
     p.add_argument(
-        "--allowed-host", action="append", default=[], metavar="NAME",
+        "--port",
+        type=port_number,
+        default=8000,
+        help="HTTP port of the API, page and scene (default 8000)",
+    )
+    p.add_argument(
+        "--allowed-host",
+        action="append",
+        default=[],
+        metavar="NAME",
         help="a host name the server answers to besides localhost, 127.0.0.1 and [::1] (repeat it; "
         "also JIK_ALLOWED_HOSTS, comma-separated; '*' for any)",
-    )  # fmt: skip
+    )
     p.add_argument(
-        "--forwarded-allow-ips", default=None, metavar="IPS",
+        "--forwarded-allow-ips",
+        default=None,
+        metavar="IPS",
         help="behind a reverse proxy: its addresses (comma-separated, '*' for any), whose "
         "X-Forwarded-For names the client; default: none, the client is the connection's peer",
-    )  # fmt: skip
+    )
     p.set_defaults(func=serve)
 
     p = sub.add_parser("reproduce", help="recompute a result of the paper")

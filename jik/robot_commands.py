@@ -51,10 +51,13 @@ def parse_path(text: str, option: str) -> list[list[float]]:
 
 
 def _common(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--robot", required=True,
-                   help="a robot file (.json, .yaml), a built-in robot's name or a catalogue "
-                   "arm's (panda, iiwa14, gen3, ur5e: its default task; for another, a file "
-                   "such as {\"name\": \"panda\", \"task\": \"xyz\"})")  # fmt: skip
+    p.add_argument(
+        "--robot",
+        required=True,
+        help="a robot file (.json, .yaml), a built-in robot's name or a catalogue "
+        "arm's (panda, iiwa14, gen3, ur5e: its default task; for another, a file "
+        'such as {"name": "panda", "task": "xyz"})',
+    )
     p.add_argument("--x0", help="start configuration, e.g. '0, 0, pi/2' (default: the robot's)")
     p.add_argument("--algorithm", choices=ALGORITHM_NAMES, default="pseudoinverse")
     p.add_argument("--augmentation", help="augmenting map of the extended inverse (its name)")
@@ -112,26 +115,36 @@ def solve_command(args: argparse.Namespace) -> int:
     robot, x0, settings = _setup(args)
     target = parse_vector(args.target, "--target") if args.target else robot.spec.default_target
     inverse = robot.inverse(
-        args.algorithm, args.augmentation,
+        args.algorithm,
+        args.augmentation,
         algorithm_parameters=_parameters(args, robot, x0),
-    )  # fmt: skip
+    )
     res = solve(inverse, x0, target, record=True, **settings)
     report = _limits(robot, lambda limits, names: solve_report(limits, res, names))
     out = {
-        "robot": robot.spec.title, "algorithm": inverse.name, "x0": x0,
-        "target": list(target), "x": res.x.tolist(), "y": res.y.tolist(), "error": res.error,
-        "success": res.success, "message": res.message, "nit": res.nit,
+        "robot": robot.spec.title,
+        "algorithm": inverse.name,
+        "x0": x0,
+        "target": list(target),
+        "x": res.x.tolist(),
+        "y": res.y.tolist(),
+        "error": res.error,
+        "success": res.success,
+        "message": res.message,
+        "nit": res.nit,
         **({} if report is None else {"limits": report.as_dict()}),
         **_notes(robot),
-    }  # fmt: skip
+    }
     if args.json:
         print(json.dumps(out))
     else:
         print(f"{out['robot']}, {out['algorithm']}: {res.message}")
         for note in out.get("notes", ()):
             print(f"  note: {note}")
-        print(f"  x0 = {_fmt(x0)}\n  x  = {_fmt(res.x)}\n  k(x) = {_fmt(res.y)}, "
-              f"|k(x) - target| = {res.error:.3g}")  # fmt: skip
+        print(
+            f"  x0 = {_fmt(x0)}\n  x  = {_fmt(res.x)}\n  k(x) = {_fmt(res.y)}, "
+            f"|k(x) - target| = {res.error:.3g}"
+        )
         if report is not None:
             print(f"  joint limits: {report}")
     return 0 if res.success else 1
@@ -144,20 +157,26 @@ def repeatability_command(args: argparse.Namespace) -> int:
     robot, x0, settings = _setup(args)
     path = parse_path(args.path, "--path") if args.path else robot.spec.default_path
     inverse = robot.inverse(
-        args.algorithm, args.augmentation,
+        args.algorithm,
+        args.augmentation,
         algorithm_parameters=_parameters(args, robot, x0),
-    )  # fmt: skip
+    )
     record = robot_limits(robot.kinematics) is not None  # (limits: check whole legs)
     rep = repeatability(inverse, x0, path, cycles=args.cycles, record=record, **settings)
     report = _limits(robot, lambda limits, names: repeatability_report(limits, rep, names))
     out = {
-        "robot": robot.spec.title, "algorithm": inverse.name, "x0": x0,
-        "targets": rep.targets.tolist(), "legs": rep.legs.tolist(),
-        "cycle_end": rep.cycle_end.tolist(), "drift": rep.drift.tolist(),
-        "success": bool(rep.success), "message": rep.message,
+        "robot": robot.spec.title,
+        "algorithm": inverse.name,
+        "x0": x0,
+        "targets": rep.targets.tolist(),
+        "legs": rep.legs.tolist(),
+        "cycle_end": rep.cycle_end.tolist(),
+        "drift": rep.drift.tolist(),
+        "success": bool(rep.success),
+        "message": rep.message,
         **({} if report is None else {"limits": report.as_dict()}),
         **_notes(robot),
-    }  # fmt: skip
+    }
     if args.json:
         print(json.dumps(out))
     else:
@@ -196,7 +215,10 @@ def add_robot_commands(sub) -> None:
 
     p = sub.add_parser("repeatability", help="drive a robot around a closed task path")
     _common(p)
-    p.add_argument("--path", help="task points 'y1,y2; y1,y2; ...' (default: the robot's); "
-                   "the return leg to k(x0) closes it")  # fmt: skip
+    p.add_argument(
+        "--path",
+        help="task points 'y1,y2; y1,y2; ...' (default: the robot's); "
+        "the return leg to k(x0) closes it",
+    )
     p.add_argument("--cycles", type=int, default=1, help="number of cycles (default 1)")
     p.set_defaults(func=_guarded(repeatability_command))

@@ -127,7 +127,9 @@ export function robotEditor(kinds, send) {
         edited = false;
         note.textContent = `applied: ${state.robot}`;
       }
-      if (state.robot_definition && state.robot !== shownKind && !edited) {
+      // (a catalogue arm has a definition too, its name and task: the robot picker's)
+      const editable = state.robot in kinds.kinds;
+      if (editable && state.robot_definition && state.robot !== shownKind && !edited) {
         kind.value = state.robot;
         build(state.robot, state.robot_definition);
       }

@@ -28,8 +28,9 @@ import numpy as np
 
 from jik.app.compute.atlas_pool import PoolBackend, sized_chunks
 from jik.app.compute.atlas_schemas import AtlasJobResponse, AtlasRequest
+from jik.app.compute.documents import nullable
 from jik.app.compute.exceptions import RequestError
-from jik.app.compute.requests import build_augmentation, build_robot, nullable
+from jik.app.compute.robot_requests import build_augmentation, build_robot
 from jik.app.compute.schemas.algorithms import field_of, used
 from jik.app.compute.worker import task
 from jik.engine.atlas import AtlasPlan, plan_atlas
@@ -39,7 +40,7 @@ from jik.engine.progress import ProgressCallbacks
 from jik.engine.registry import ALGORITHMS, make_inverse
 from jik.engine.repeatability import CLOSE_TOL
 from jik.engine.self_motion import MAX_ARC
-from jik.engine.solver import gamma_problem
+from jik.engine.solve_rules import gamma_problem
 
 
 class AtlasJobNotFound(LookupError):

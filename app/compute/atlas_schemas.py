@@ -27,7 +27,7 @@ from jik.app.compute.schemas import (
 )
 from jik.app.compute.schemas.algorithms import AlgorithmParameters
 from jik.engine.repeatability import MAX_PATH_POINTS
-from jik.engine.solver import DISCRETE_GAMMA_BOUND
+from jik.engine.solve_rules import DISCRETE_GAMMA_BOUND
 
 #: Largest starts per path, cycles, and paths of a family (shifts, scales) in one request.
 MAX_STARTS = 20000

@@ -14,8 +14,9 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, create_model
 
 from jik.app.compute import schemas as S
+from jik.app.compute.documents import nullable
 from jik.app.compute.exceptions import RequestError
-from jik.app.compute.requests import build_robot, nullable
+from jik.app.compute.robot_requests import build_robot
 from jik.app.compute.schemas.robots import _camel
 from jik.app.compute.schemas.variants import _robot_name
 from jik.app.compute.user_robots import is_user_robot, user_robot

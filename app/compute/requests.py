@@ -1,69 +1,45 @@
-"""Requests to engine calls: the robots catalogue, solve and repeatability.
+"""Requests to engine calls: solve, its batches, and repeatability.
 
-(It stays whole, at about 400 lines: one path from a request model to the engine and back,
-shared by solve, its batches and repeatability; synthesis and user robots have their own.)
-
-Plain synchronous functions (``robots_response``, ``solve_request``, ``solve_batch``,
-``repeatability_request``) turn a request model into engine calls and the result into a response
-model. They raise :class:`RequestError` naming the offending field. Synthesis requests have
-their own module (:mod:`jik.app.compute.synthesis`), which builds robots and maps with the
-helpers here; :class:`jik.app.compute.pool.ComputePool` runs both for the HTTP API in worker
-processes.
+Plain synchronous functions (``solve_request``, ``solve_batch``, ``repeatability_request``) turn
+a request model into engine calls and the result into a response model. They raise
+:class:`RequestError` naming the offending field. The robot and map a request names are built by
+:mod:`jik.app.compute.robot_requests` (catalogue robots) or :mod:`jik.app.compute.user_robots`
+(definitions, catalogue arms); results become JSON by :mod:`jik.app.compute.documents`.
+:class:`jik.app.compute.pool.ComputePool` runs these for the HTTP API in worker processes.
 """
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, TypeVar, cast
 
 import numpy as np
-import pydantic_core
 
 from jik.app.compute import schemas as S
-from jik.app.compute.exceptions import RequestError
-from jik.app.compute.schemas.algorithms import field_of, used
-from jik.app.compute.settings import settings_from_env
-from jik.app.compute.user_robots import is_user_robot, user_inverse, user_robot
-from jik.engine.arms import ARMS
-from jik.engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
-from jik.engine.limits import limit_names, repeatability_report, robot_limits, solve_report
-from jik.engine.registry import ALGORITHMS, ROBOTS, RobotSpec, make_inverse
-from jik.engine.repeatability import (
-    MAX_CYCLES,
-    MAX_PATH_POINTS,
-    REPEATABLE_DRIFT,
-    repeatability,
+from jik.app.compute.documents import (
+    limits_document,
+    nullable,
+    solve_response,
+    solve_response_json,
 )
-from jik.engine.robot_spec import robot_from_dict
-from jik.engine.solver import gamma_problem
+from jik.app.compute.exceptions import RequestError
+from jik.app.compute.robot_requests import (
+    build_augmentation,
+    build_robot,
+    check_configuration,
+    check_task_point,
+)
+from jik.app.compute.schemas.algorithms import field_of, used
+from jik.app.compute.user_robots import is_user_robot, user_inverse, user_robot
+from jik.engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
+from jik.engine.limits import repeatability_report, robot_limits
+from jik.engine.registry import RobotSpec, make_inverse
+from jik.engine.repeatability import REPEATABLE_DRIFT, repeatability
+from jik.engine.solve_rules import gamma_problem
 from jik.engine.solver import solve_batch as engine_solve_batch
 
 _R = TypeVar("_R")
-
-
-# --------------------------------------------------------------------------------------------
-# Conversions
-
-
-def nullable(a) -> Any:
-    """ndarray -> nested lists with None where not finite (JSON has no NaN)."""
-    a = np.asarray(a, dtype=float)
-    if a.ndim == 0:
-        return float(a) if np.isfinite(a) else None
-    if np.isfinite(a).all():
-        return a.tolist()
-    obj = a.astype(object)
-    obj[~np.isfinite(a)] = None
-    return obj.tolist()
-
-
-def _downsample(m: int, limit: int = S.MAX_TRAJECTORY_POINTS) -> np.ndarray:
-    """Indices of at most ``limit`` of ``m`` points, evenly spread, first and last kept."""
-    if m <= limit:
-        return np.arange(m)
-    return np.unique(np.linspace(0, m - 1, limit).round().astype(int))
 
 
 @dataclass
@@ -80,50 +56,6 @@ class _Setup:
     tolerance: float
     max_iterations: int | None
     extra: dict = field(default_factory=dict)
-
-
-def build_robot(req_robot) -> tuple[RobotSpec, Any, S.RobotUsed]:
-    """The robot named in the request, built with its parameters; what it used, filled in."""
-    try:
-        spec = ROBOTS[req_robot.name]
-    except KeyError:
-        raise RequestError(
-            "robot.name", f"unknown robot {req_robot.name!r}; choose one of {sorted(ROBOTS)}"
-        ) from None
-    params = req_robot.model_dump(exclude={"name"})
-    try:
-        kin = spec.build(**params)
-    except (InvalidInputError, TypeError) as exc:
-        raise RequestError("robot", str(exc)) from None
-    used = {
-        k: [float(t) for t in v] if isinstance(v, tuple | list) else float(v)
-        for k, v in params.items()
-    }
-    return spec, kin, S.RobotUsed(name=spec.name, parameters=used)
-
-
-def build_augmentation(spec: RobotSpec, kin, req_aug):
-    """The augmenting map named in the request (or the robot's default), built and checked."""
-    name = req_aug.name if req_aug is not None else None
-    try:
-        aspec = spec.augmentation(name)
-    except InvalidInputError as exc:
-        raise RequestError("augmentation.name", str(exc)) from None
-    given = req_aug.model_dump(exclude={"name"}, exclude_unset=True) if req_aug is not None else {}
-    known = {p.name for p in aspec.parameters}
-    unknown = sorted(set(given) - known)
-    if unknown:
-        raise RequestError(
-            f"augmentation.{unknown[0]}",
-            f"{aspec.name} of {spec.name} has no parameter {unknown[0]!r}; "
-            f"its parameters: {sorted(known) or 'none'}",
-        )
-    values = {p.name: given.get(p.name, p.default) for p in aspec.parameters}
-    try:
-        amap = aspec.build(kin, **values)
-    except InvalidInputError as exc:
-        raise RequestError("augmentation", str(exc)) from None
-    return aspec, amap, S.AugmentationUsed(name=aspec.name, parameters=values)
 
 
 def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
@@ -169,40 +101,6 @@ def _catalogue_inverse(spec: RobotSpec, kin, req) -> tuple[Any, S.AugmentationUs
     return inverse, aug_used
 
 
-def _dimensions(spec: RobotSpec, what: str) -> str:
-    """Why a vector has its length: ``p of manipulator2``; a user robot's p and r."""
-    if spec.name in S.USER_ROBOT_MODELS:
-        return f"this {spec.name} robot has p = {spec.p}, r = {spec.r}"
-    return f"{what} of {spec.name}"
-
-
-def check_configuration(spec: RobotSpec, x0) -> None:
-    """The robot has at most the API's p, and ``x0`` has p components."""
-    if spec.p > S.MAX_DIMENSION:
-        joints = (
-            "; name at most that many in active_joints (the others stay at their value in "
-            "locked, default 0)"
-            if spec.name == "urdf"
-            else ""
-        )
-        raise RequestError(
-            "robot", f"this {spec.name} robot has p = {spec.p} moving joints; the API takes at "
-            f"most {S.MAX_DIMENSION} (the cap on x0's components){joints}",
-        )  # fmt: skip
-    if len(x0) != spec.p:
-        raise RequestError(
-            "x0", f"must have {spec.p} components ({_dimensions(spec, 'p')}), got {len(x0)}"
-        )
-
-
-def check_task_point(spec: RobotSpec, y, name: str) -> None:
-    """The task point ``y`` (the request's field ``name``) has r components."""
-    if len(y) != spec.r:
-        raise RequestError(
-            name, f"must have {spec.r} components ({_dimensions(spec, 'r')}), got {len(y)}"
-        )
-
-
 def _check_start(setup: _Setup, x0: np.ndarray) -> np.ndarray:
     """Mask (n,) of singular starts for the chosen inverse; x0 of shape (n, p)."""
     kin = setup.kinematics
@@ -242,94 +140,6 @@ def engine_error(exc: JikError) -> RequestError:
     return RequestError(name, text)
 
 
-def _trajectory_document(traj) -> dict[str, Any]:
-    """A run's trajectory as JSON-ready data (the fields of ``S.Trajectory``), downsampled."""
-    m = len(traj.theta)
-    idx = _downsample(m)
-    return {
-        "theta": nullable(traj.theta[idx]),
-        "x": nullable(traj.x[idx]),
-        "y": nullable(traj.y[idx]),
-        "error": nullable(traj.error[idx]),
-        "h": None if traj.h is None else nullable(np.asarray(traj.h)[idx]),
-        "points": m,
-        "downsampled": bool(len(idx) < m),
-    }
-
-
-def _solve_document(setup: _Setup, res) -> dict[str, Any]:
-    """One solve's response as JSON-ready data (the fields of ``S.SolveResponse``)."""
-    return {
-        "robot": setup.robot.model_dump(mode="json"),
-        "algorithm": setup.inverse.name,
-        "augmentation": (
-            None if setup.augmentation is None else setup.augmentation.model_dump(mode="json")
-        ),
-        "mode": setup.mode,
-        "gamma": float(setup.gamma),
-        "tolerance": float(setup.tolerance),
-        "x": nullable(res.x),
-        "y": nullable(res.y),
-        "error": nullable(res.error),
-        "converged": bool(res.success),
-        "message": str(res.message),
-        "iterations": int(res.nit),
-        "trajectory": _trajectory_document(res.trajectory),
-        **_limits_document(setup, lambda limits, names: solve_report(limits, res, names)),
-    }
-
-
-def _limits_document(setup: _Setup, report) -> dict[str, Any]:
-    """``{"limits": ...}`` of a run (``report(limits, names)``), empty when the robot has none."""
-    limits = robot_limits(setup.kinematics)
-    if limits is None:
-        return {}
-    return {"limits": report(limits, limit_names(setup.kinematics)).as_dict()}
-
-
-def _solve_response(setup: _Setup, res) -> S.SolveResponse:
-    return S.SolveResponse.model_validate(_solve_document(setup, res))
-
-
-def _solve_response_json(setup: _Setup, res) -> bytes:
-    """The JSON of :func:`_solve_response` without validating the model (the workers' hot
-    path: validation costs about as much as a small solve). ``tests/app/test_solve.py`` checks
-    that both give the same document."""
-    return pydantic_core.to_json(_solve_document(setup, res))
-
-
-# --------------------------------------------------------------------------------------------
-# Plain service functions
-
-
-@functools.cache
-def _arm_specs() -> tuple[RobotSpec, ...]:
-    """The catalogue arms with their default tasks (each built once: a URDF parse)."""
-    return tuple(robot_from_dict({"name": name}).spec for name in ARMS)
-
-
-def robots_response(timeout: float | None = None) -> S.RobotsResponse:
-    """The catalogue: every robot with p, r, parameters, defaults and augmentations, then the
-    catalogue arms (``{"name": "panda"}``; ``task`` and ``reference`` change their r)."""
-    robots = [
-        S.RobotInfo(
-            **spec.as_dict(),
-            algorithms=list(S.Algorithm.__args__),  # type: ignore[attr-defined]
-            modes=["continuous", "discrete"],
-        )
-        for spec in (*ROBOTS.values(), *_arm_specs())
-    ]
-    limits = S.Limits(
-        max_cycles=MAX_CYCLES,
-        max_path_points=MAX_PATH_POINTS,
-        max_iterations=S.MAX_ITERATIONS,
-        max_trajectory_points=S.MAX_TRAJECTORY_POINTS,
-        request_timeout_s=float(timeout if timeout is not None else settings_from_env().timeout),
-    )
-    algorithms = [S.AlgorithmInfo(**a.as_dict()) for a in ALGORITHMS.values()]
-    return S.RobotsResponse(robots=robots, limits=limits, algorithms=algorithms)
-
-
 def batch_key(req: S.SolveRequest) -> str:
     """Requests with equal keys can share one batched engine call."""
     exclude = {"x0", "target"} | ({"augmentation"} if req.algorithm == "pseudoinverse" else set())
@@ -342,13 +152,13 @@ def solve_batch(reqs: list[S.SolveRequest]) -> list[S.SolveResponse | RequestErr
     Each member is validated on its own (lengths, singular start): a bad member gets its
     :class:`RequestError` in its slot and does not affect the others.
     """
-    return _solve_batch(reqs, _solve_response)
+    return _solve_batch(reqs, solve_response)
 
 
 def solve_batch_json(reqs: list[S.SolveRequest]) -> list[bytes | RequestError]:
     """:func:`solve_batch` with each response as its JSON bytes, built without validating the
-    model (the workers' hot path, see :func:`_solve_response_json`)."""
-    return _solve_batch(reqs, _solve_response_json)
+    model (the workers' hot path, see :func:`solve_response_json`)."""
+    return _solve_batch(reqs, solve_response_json)
 
 
 def _solve_batch(
@@ -451,5 +261,5 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
         repeatable=bool(res.success) and finite and max_drift < REPEATABLE_DRIFT,
         success=bool(res.success),
         message=cast(str, res.message),  # one start configuration: one message
-        **_limits_document(setup, lambda limits, names: repeatability_report(limits, res, names)),
+        **limits_document(setup, lambda limits, names: repeatability_report(limits, res, names)),
     )

@@ -12,8 +12,9 @@ from collections.abc import Collection
 import numpy as np
 
 from jik.app.compute import schemas as S
+from jik.app.compute.documents import nullable
 from jik.app.compute.exceptions import RequestError
-from jik.app.compute.requests import build_augmentation, build_robot, nullable
+from jik.app.compute.robot_requests import build_augmentation, build_robot
 from jik.app.compute.user_robots import is_user_robot, request_field, user_robot
 from jik.engine.exceptions import JikError
 from jik.engine.functionals import error_functional_e1, error_functional_e2

@@ -231,6 +231,10 @@ def augmenting_grid(
             "kinematics": kin}  # fmt: skip
 
 
+#: E1 and E2 are taken by a tensor Gauss rule over at most this many region variables.
+MAX_QUADRATURE_VARIABLES = 3
+
+
 def error_functionals(
     result: DashboardResult, nodes: int = 12, on_step: Callable[[], None] | None = None
 ) -> dict | None:
@@ -261,6 +265,14 @@ def error_functionals(
         "nodes": nodes,
         "design_region": bool(design),
     }
+    if len(region) > MAX_QUADRATURE_VARIABLES:  # (nodes ** 7 points for a 7-joint arm)
+        return {
+            **out,
+            "E1": None,
+            "E2": None,
+            "note": f"E1, E2 not computed: a tensor rule "
+            f"over the {len(region)} variables of the design region is too large",
+        }
     for key, fn in (("E1", error_functional_e1), ("E2", error_functional_e2)):
         try:
             value = fn(grid["kinematics"], grid["map"], region, nodes=nodes, fixed=fixed)

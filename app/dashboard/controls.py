@@ -24,9 +24,10 @@ from typing import Any
 from jik.app.dashboard.algorithms import STYLES, scalar_parameters
 from jik.app.dashboard.glossary import SYMBOLS
 from jik.app.dashboard.robots import state_spec
+from jik.engine.arms import ARMS
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS
-from jik.engine.solver import DISCRETE_GAMMA_BOUND, MAX_ITERATIONS, MAX_STEPS
+from jik.engine.solve_rules import DISCRETE_GAMMA_BOUND, MAX_ITERATIONS, MAX_STEPS
 
 #: gamma's resolution: the page's log-scale slider and the scene's slider both land on it.
 GAMMA_STEP = 0.001
@@ -108,8 +109,9 @@ def controls(state) -> list[Control]:
     out = [
         Control("robot", "robot", "select", "algorithm", "the robot (section 6 of the paper)",
                 options=tuple((name, ROBOTS[name].title) for name in ROBOTS)
-                + (((state.robot, f"your robot: {spec.title}"),) if state.robot not in ROBOTS
-                   else ())),
+                + tuple((name, f"{arm.title} (arm)") for name, arm in ARMS.items())
+                + (((state.robot, f"your robot: {spec.title}"),)
+                   if state.robot not in (*ROBOTS, *ARMS) else ())),
         Control("mode", "mode", "select", "algorithm",
                 "continuous: the ODE (7); discrete: the iteration x <- x - gamma J# e",
                 options=tuple((m, m) for m in MODES)),

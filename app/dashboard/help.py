@@ -7,11 +7,14 @@ and of the paper's symbols that controls and panels use. The page gets them from
 
 from __future__ import annotations
 
+from dataclasses import asdict
+
 from jik.app.dashboard.algorithms import COLORS, LABELS
 from jik.app.dashboard.algorithms import STYLES as DRAWN
 from jik.app.dashboard.controls import PROGRESS_AFTER
 from jik.app.dashboard.plotting import PANEL_SIZES
-from jik.engine.robot_kinds import robot_kinds
+from jik.engine.arms import ARMS
+from jik.engine.robot_kinds import ARM, robot_kinds
 
 #: How each algorithm is drawn, everywhere: its colour (COLORS), its line style in the plots
 #: (plotly's ``dash``) and its robot in the 3D scene (:data:`jik.app.dashboard.algorithms.STYLES`).
@@ -68,6 +71,15 @@ def page_config() -> dict:
         "panels": [{"id": k, "size": v, "help": PANEL_HELP[k]} for k, v in PANEL_SIZES.items()],
         "progress_after": PROGRESS_AFTER,
         "tools": [{"id": "atlas", "help": ATLAS_HELP}],
-        # (the robot editor's fields: one description, the engine's)
-        "robot_kinds": robot_kinds(),
+        # (the robot editor's fields: one description, the engine's; a catalogue arm is a kind
+        # of its own, whose definition changes its task, reference, home or maps)
+        "robot_kinds": editor_kinds(),
     }
+
+
+def editor_kinds() -> dict:
+    """The robot editor's kinds (:func:`jik.engine.robot_kinds.robot_kinds`) and the catalogue's
+    arms, each with the fields of :data:`jik.engine.robot_kinds.ARM`."""
+    kinds = robot_kinds()
+    arm = [asdict(f) for f in ARM]
+    return {**kinds, "kinds": {**kinds["kinds"], **dict.fromkeys(ARMS, arm)}}

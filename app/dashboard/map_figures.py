@@ -119,7 +119,9 @@ def augmenting_title(
         if functionals.get("design_region"):
             where = ", ".join(f"{k} ∈ [{lo:.3g}, {hi:.3g}]" for k, (lo, hi)
                               in functionals["region"].items())  # fmt: skip
-        if all(v is None for v in values.values()):
+        if functionals.get("note"):
+            sub.append(functionals["note"])
+        elif all(v is None for v in values.values()):
             sub.append(f"E1, E2 undefined: h is not defined on all of {where}")
         else:
             sub.append(", ".join(

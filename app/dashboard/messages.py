@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from jik.app.dashboard.joint_limits import limits_summary
 from jik.app.dashboard.runs import DashboardResult
 
 
@@ -131,4 +132,6 @@ def summary(result: DashboardResult) -> dict:
             "seconds": round(run.seconds, 4),
             "cached": bool(result.cached.get(a, False)),
         }
+    for a, report in limits_summary(result).items():
+        out[a]["limits"] = report
     return out

@@ -39,11 +39,11 @@ from jik.app.dashboard.controls import (
     expand,
     max_iterations,
 )
-from jik.app.dashboard.robots import USER_KINDS, state_inverse, user_robot
+from jik.app.dashboard.robots import USER_KINDS, default_definition, state_inverse, user_robot
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS, robot_spec
 from jik.engine.repeatability import MAX_PATH_POINTS
-from jik.engine.solver import gamma_problem
+from jik.engine.solve_rules import gamma_problem
 
 #: The algorithms of a new state (:mod:`jik.app.dashboard.algorithms`: colours, styles, keys).
 ALGORITHMS = DEFAULT_ALGORITHMS
@@ -127,6 +127,7 @@ def default_state(
 
 def _user_default_state(robot: str, definition: Mapping[str, Any] | None) -> DashboardState:
     """The defaults of a user robot: its definition's start, target, path and first map."""
+    definition = default_definition(robot) if definition is None else definition
     if not isinstance(definition, Mapping):
         raise InvalidInputError(
             f"robot_definition: a {robot} robot needs its definition (the robot editor's fields)",

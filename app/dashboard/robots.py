@@ -24,6 +24,7 @@ from jik.app.compute.budget import build_seconds, time_budget
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.worker import task
 from jik.app.dashboard.algorithms import inverse_parameters
+from jik.engine.arms import ARMS
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.inverses import Inverse
 from jik.engine.kinematics import Kinematics
@@ -31,8 +32,15 @@ from jik.engine.registry import RobotSpec, make_inverse, robot_spec
 from jik.engine.robot_kinds import KINDS
 from jik.engine.robot_spec import Robot, robot_from_dict
 
-#: The kinds of robots a user defines (the editor's choices besides the catalogue).
-USER_KINDS = tuple(KINDS)
+#: The robots given by a definition: the kinds a user defines (the editor's choices), and the
+#: catalogue's arms (:mod:`jik.engine.arms`), whose definition is their name and task.
+USER_KINDS = (*KINDS, *ARMS)
+
+
+def default_definition(robot: str) -> dict[str, Any] | None:
+    """The definition a robot starts with when chosen by name: a catalogue arm's
+    ``{"name": arm, "task": its default task}``; None for a kind the user defines."""
+    return {"name": robot, "task": ARMS[robot].task} if robot in ARMS else None
 
 
 @functools.lru_cache(maxsize=32)

@@ -18,7 +18,7 @@ from jik.app.dashboard.robots import state_inverse, state_kinematics
 from jik.engine.exceptions import RunCancelled
 from jik.engine.progress import ProgressCallbacks
 from jik.engine.repeatability import Leg, Resume, closed_path, repeatability
-from jik.engine.solver import SolveResult, Trajectory
+from jik.engine.results import SolveResult, Trajectory
 from jik.engine.unicycle import Unicycle
 
 #: Time grid points of one unicycle platform path q(t).

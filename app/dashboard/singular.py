@@ -17,6 +17,8 @@ from jik.engine.exceptions import JikError
 
 #: Grid points per region variable.
 NODES = 25
+#: Regions of more variables are not searched (a 7-joint arm's box: 25^7 points).
+MAX_GRID_VARIABLES = 3
 #: A point is singular where |dh| exceeds this many times its median over the region, where h
 #: jumps by this many times its median step between neighbours with opposite signs, or where
 #: the extended Jacobian's rows are this close to dependent (|det| / product of row norms).
@@ -38,7 +40,8 @@ def _grid(state: DashboardState, names, region) -> tuple[np.ndarray, list[int]]:
 def singular_points(state: DashboardState) -> dict | None:
     """Where h or the extended Jacobian is singular in the robot's design region (cached by
     what it depends on: the robot, its map and their parameters, and x0)."""
-    key = (state.robot, json.dumps(state.robot_parameters, sort_keys=True), state.augmentation,
+    key = (state.robot, json.dumps(state.robot_parameters, sort_keys=True),
+           json.dumps(state.robot_definition, sort_keys=True), state.augmentation,
            json.dumps(state.augmentation_parameters, sort_keys=True), tuple(state.x0))  # fmt: skip
     if key not in _CACHE:
         if len(_CACHE) > 64:
@@ -63,8 +66,8 @@ def _find(state: DashboardState) -> dict | None:
     """
     spec = state_spec(state)
     region = dict(spec.functional_region)
-    if not region:
-        return None
+    if not region or len(region) > MAX_GRID_VARIABLES:
+        return None  # (none, or a grid of NODES^n points too large to search)
     try:
         kin, amap = kinematics_and_map(state)
     except (JikError, ValueError):

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from jik.app.dashboard.joint_limits import limits_texts
 from jik.app.dashboard.messages import h_change
 from jik.app.dashboard.plotting import norm_unit, units
 from jik.app.dashboard.runs import AlgorithmRun, DashboardResult
@@ -209,6 +210,8 @@ def verdict(result: DashboardResult) -> list[dict]:
         ext = runs["extended"]
         out += _undefined_why(result, ext) or _extended_why(result, ext)
     out += [Sentence(*s) for s in practical_sentences(result, unit)]
+    for text, algorithm, within in limits_texts(result, NAMES):
+        out.append(Sentence(text, algorithm, "note" if within else "warning"))
     warning = singular_sentence(result.state) if "extended" in runs else None
     if warning:
         out.append(Sentence(warning, "extended", "warning"))

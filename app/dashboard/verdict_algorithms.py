@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from jik.app.dashboard.joint_limits import state_limits
 from jik.app.dashboard.robots import state_inverse
 from jik.app.dashboard.runs import AlgorithmRun, DashboardResult
 from jik.engine.repeatability import REPEATABLE_DRIFT
@@ -91,6 +92,10 @@ def _damped(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
 
 
 def _weighted(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
+    """Within the box the weighted inverse took for limits (a robot that declares joint
+    limits has its sentence from :func:`jik.app.dashboard.joint_limits.limits_texts`)."""
+    if state_limits(result.state) is not None:
+        return []
     run = result.runs["weighted"]
     inverse = state_inverse(result.state, "weighted")
     limits = np.asarray(getattr(inverse, "limits", ()), dtype=float)
@@ -100,8 +105,7 @@ def _weighted(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
     below, above = run.x < lo, run.x > hi
     names = result.variable_names
     bounds = "; ".join(f"{names[k]} in [{g(lo[k])}, {g(hi[k])}]" for k in range(len(lo)))
-    if getattr(inverse.kinematics, "limits", None) is None:
-        bounds += "; the robot has no joint limits: its configuration box x_range"
+    bounds += "; the robot has no joint limits: its configuration box x_range"
     if not (below.any() or above.any()):
         margin = np.minimum(run.x - lo, hi - run.x).min(axis=0)
         k = int(np.argmin(margin))

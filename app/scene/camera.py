@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from jik.app.dashboard.robots import state_kinematics
-from jik.app.scene.mechanisms import chain_points, extent_of
+from jik.app.scene.mechanisms import CHAINS, chain_points, extent_of
 
 #: Unit vector from the point looked at to the camera: in front of the task plane, tilted.
 VIEW_DIRECTION = np.array([0.0, -0.75, 1.05]) / math.hypot(0.75, 1.05)
@@ -32,7 +32,7 @@ def view_of(result) -> tuple[np.ndarray, float]:
     the task-plane box its mechanisms, paths and targets span (:func:`extent_of`).
     """
     state = result.state
-    if state.robot in ("planar_chain", "urdf"):
+    if state.robot in CHAINS:
         kin = state_kinematics(state)
         home = chain_points(kin, np.asarray(state.x0, dtype=float), 0.0)  # (n + 1, 3)
         base = home[0]

@@ -25,8 +25,18 @@ from typing import Any
 import numpy as np
 
 from jik.app.dashboard.algorithms import COLORS, STYLES
+from jik.app.dashboard.joint_limits import outside_joints, state_limits
 from jik.app.dashboard.robots import state_kinematics
+from jik.app.scene.arm_marks import (
+    AXES_FRACTION,
+    OUTSIDE_COLOR,
+    end_frame,
+    joint_points,
+    target_fixtures,
+)
 from jik.app.scene.pose import yaw_quaternion
+from jik.app.scene.traces import polyline, trace_tolerance
+from jik.engine.arms import ARMS
 
 #: Height of each algorithm's copy above the task plane, and its opacity (None: solid).
 Z = {a: s.z for a, s in STYLES.items()}
@@ -178,23 +188,44 @@ class Chain(Mechanism):
 
     def build(self) -> None:
         self.kin = state_kinematics(self.state)
-        n = chain_points(self.kin, np.asarray(self.state.x0, dtype=float), 0.0).shape[0]
+        home = chain_points(self.kin, np.asarray(self.state.x0, dtype=float), 0.0)
+        n = home.shape[0]
         width = 5.0 if self.opacity is None else 3.5
         self.links = self.scene.add_line_segments(
             f"{self.root}/links", np.zeros((n - 1, 2, 3)), self.color, thickness=width,
             thickness_units="screen",
         )  # fmt: skip
         self.joints = [self.ball(f"joint{i}", 0.04 if i < n - 1 else 0.06) for i in range(n)]
+        # The end link's frame when the task holds its orientation (a pose task).
+        reach = float(np.linalg.norm(np.diff(home, axis=0), axis=1).sum())
+        self.end = None if end_frame(self.kin, self.state.x0) is None else self.scene.add_frame(
+            f"{self.root}/end", axes_length=AXES_FRACTION * reach,
+            axes_radius=0.06 * AXES_FRACTION * reach,
+        )  # fmt: skip
+        self._marks()
+
+    def _marks(self) -> None:
+        """The joint limits and which drawn joint is each variable's (coloured when outside)."""
+        self.limits, self.at = state_limits(self.state), joint_points(self.kin)
+        self.marked: set[int] = set()
 
     def resize(self, state, extent) -> None:
         super().resize(state, extent)
         self.kin = state_kinematics(state)
+        self._marks()
 
     def pose(self, x) -> None:
         pts = chain_points(self.kin, np.asarray(x, dtype=float), self.z + 0.05)
         self.links.points = np.stack([pts[:-1], pts[1:]], axis=1)
         for ball, point in zip(self.joints, pts, strict=False):
             ball.position = tuple(float(v) for v in point)
+        if self.end is not None and (frame := end_frame(self.kin, x)) is not None:
+            self.end.position = tuple(np.asarray(frame[0]) + np.array([0.0, 0.0, self.z + 0.05]))
+            self.end.wxyz = frame[1]
+        outside = {self.at[int(i)] for i in outside_joints(self.limits, x) if int(i) in self.at}
+        for k in outside ^ self.marked:  # (only the joints whose colour changes)
+            self.joints[k].color = OUTSIDE_COLOR if k in outside else self.color
+        self.marked = outside
 
 
 def chain_points(kin: Any, x: np.ndarray, z: float) -> np.ndarray:
@@ -205,8 +236,10 @@ def chain_points(kin: Any, x: np.ndarray, z: float) -> np.ndarray:
     return pts + np.array([0.0, 0.0, z])
 
 
-MECHANISMS = {"manipulator1": NormalForm, "manipulator2": Gantry, "planar_chain": Chain,
-              "urdf": Chain}  # fmt: skip
+#: The robots drawn as a serial chain of links (:class:`Chain`): a user's and the catalogue's arms.
+CHAINS = ("planar_chain", "urdf", *ARMS)
+MECHANISMS = {"manipulator1": NormalForm, "manipulator2": Gantry,
+              **dict.fromkeys(CHAINS, Chain)}  # fmt: skip
 
 
 def layout_name(state) -> str:
@@ -250,52 +283,6 @@ def add_floor_grid(scene, half: float = 10.0, cell: float = 0.5, section: float 
         )
 
 
-#: Largest distance of a drawn trace from the computed path, as a fraction of the scene's size
-#: (about a third of a pixel at the dashboard's size).
-TRACE_TOLERANCE = 1e-3
-
-
-def simplify(points: np.ndarray, tol: float) -> np.ndarray:
-    """The points of the polyline ``points`` (n, d) that keep it within ``tol`` of every
-    original point (Ramer-Douglas-Peucker; the first and the last are always kept).
-
-    A trace costs the viser client per segment: in software WebGL (no GPU) a thousand segments
-    add about 15 ms to every frame. The continuous task paths are straight between targets, eq.
-    (5), so most of their recorded points lie on a line.
-    """
-    n = len(points)
-    keep = np.zeros(n, dtype=bool)
-    keep[[0, -1]] = True
-    stack = [(0, n - 1)]
-    while stack:
-        i, j = stack.pop()
-        if j <= i + 1:
-            continue
-        a, d = points[i], points[j] - points[i]
-        rel = points[i + 1 : j] - a
-        L2 = float(d @ d)
-        t = np.clip(rel @ d / L2, 0.0, 1.0) if L2 > 0 else np.zeros(len(rel))
-        dist = np.linalg.norm(rel - t[:, None] * d, axis=1)
-        k = int(np.argmax(dist))
-        if dist[k] > tol:
-            m = i + 1 + k
-            keep[m] = True
-            stack += [(i, m), (m, j)]
-    return points[keep]
-
-
-def trace_tolerance(extent) -> float:
-    """:data:`TRACE_TOLERANCE` of the task-plane box ``extent`` (see :func:`_extent`)."""
-    (xlo, xhi), (ylo, yhi) = extent
-    return TRACE_TOLERANCE * max(xhi - xlo, yhi - ylo)
-
-
-def polyline(points: np.ndarray, tol: float = 0.0) -> np.ndarray:
-    """(n, 3) points -> segments (m - 1, 2, 3) of the polyline simplified to within ``tol``."""
-    points = simplify(points, tol) if tol > 0 and len(points) > 2 else points
-    return np.stack([points[:-1], points[1:]], axis=1)
-
-
 def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
     """The parts of a manipulator's scene besides the mechanisms, by node name: (kind, the
     values that follow the result, the fixed style). The rails (Manipulator 2) or the guide
@@ -320,7 +307,7 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
         out[f"{root}/guide"] = (
             "box", {"dimensions": rail, "position": (0.0, (ylo + yhi) / 2, -0.02)}, grey
         )  # fmt: skip
-    chain = robot in ("planar_chain", "urdf")
+    chain = robot in CHAINS
     kin = state_kinematics(result.state) if chain else None
     for a, run in result.runs.items():
         line = {"colors": rgb(COLORS[a]), "thickness_units": "screen"}  # pixels, see above
@@ -338,8 +325,9 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
             out[f"{root}/trace/{a}/joints"] = (
                 "line", {"points": polyline(joints, tol)}, {**line, "thickness": 1.2}
             )  # fmt: skip
-    if robot == "urdf" and result.state.robot_definition.get("task", "xyz") != "xyz":
-        return out  # (a target of some of x, y, z is not a point)
+    if chain and robot != "planar_chain":  # (a frame or a point, see target_fixtures)
+        reach = float(np.linalg.norm(np.ptp(np.reshape(extent, (2, 2)), axis=1)))
+        return {**out, **target_fixtures(result, kin, root, AXES_FRACTION * reach / 2)}
     for k, target in enumerate(result.targets):
         out[f"{root}/targets/{k}"] = (
             "ball", {"position": (float(target[0]), float(target[1]), 0.2 * scale)},
@@ -356,7 +344,7 @@ def extent_of(result) -> tuple[tuple[float, float], tuple[float, float]]:
         lo, hi = ys.min(axis=0)[:2] - 1.0, ys.max(axis=0)[:2] + 1.0
         return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
     xs = np.concatenate([r.x for r in result.runs.values()])
-    if result.state.robot in ("planar_chain", "urdf"):  # (the whole arm, not only its end)
+    if result.state.robot in CHAINS:  # (the whole arm, not only its end)
         step = max(1, len(xs) // 200)
         pts = chain_points(state_kinematics(result.state), xs[::step], 0.0).reshape(-1, 3)
         lo, hi = pts.min(axis=0)[:2] - 0.3, pts.max(axis=0)[:2] + 0.3

@@ -136,7 +136,8 @@ class NodeSets:
         path gained) are added, ones it lost are removed."""
         scene = self.scene
         add: dict[str, Callable[..., Any]] = {
-            "box": scene.add_box, "line": scene.add_line_segments, "ball": scene.add_icosphere
+            "box": scene.add_box, "line": scene.add_line_segments, "ball": scene.add_icosphere,
+            "frame": scene.add_frame,
         }  # fmt: skip
         wanted = fixtures_of(result, extent, root)
         for name in [n for n in fixtures if n not in wanted]:

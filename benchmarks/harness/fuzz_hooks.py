@@ -57,7 +57,8 @@ from jik.app.compute import schemas as S
 from jik.app.compute.atlas_jobs import AtlasLimits, plan_request
 from jik.app.compute.atlas_schemas import AtlasRequest
 from jik.app.compute.exceptions import RequestError
-from jik.app.compute.requests import _check_start, _setup, check_configuration, check_task_point
+from jik.app.compute.requests import _check_start, _setup
+from jik.app.compute.robot_requests import check_configuration, check_task_point
 from jik.app.compute.synthesis import synthesis_region
 from jik.app.compute.user_robots import user_robot
 from jik.app.dashboard.model import default_state, updated_state

@@ -45,11 +45,16 @@ def run(progress: Callable[[float], None] | None = None, cycles: int = CYCLES) -
         drift = np.asarray(rep.drift)
         ends = np.asarray(rep.cycle_end)
         last = float(np.linalg.norm(ends[-1] - ends[-2])) if cycles > 1 else float(drift[0])
-        rows.append({
-            "name": name, "parameters": _parameters(name),
-            "drift": {str(c): float(drift[c - 1]) for c in REPORTED if c <= cycles},
-            "last_cycle": last, "success": bool(rep.success), "message": str(rep.message),
-        })  # fmt: skip
+        rows.append(
+            {
+                "name": name,
+                "parameters": _parameters(name),
+                "drift": {str(c): float(drift[c - 1]) for c in REPORTED if c <= cycles},
+                "last_cycle": last,
+                "success": bool(rep.success),
+                "message": str(rep.message),
+            }
+        )
         if progress is not None:
             progress((i + 1) / len(names))
     return {"algorithms": rows, "cycles": cycles, "x0": list(X0), "path": [list(p) for p in PATH]}

@@ -110,9 +110,15 @@ def _run_one(kin, inverse, strict, mode) -> dict:
         # 'invalid value' warning of that determinant is expected and diagnosed below.
         with np.errstate(invalid="ignore"):
             res = solve(
-                inverse, LAMBDA0, Y_D, gamma=GAMMA, mode=mode, tol=TOL,
-                max_iterations=MAX_ITERATIONS if mode == "discrete" else None, record=True,
-            )  # fmt: skip
+                inverse,
+                LAMBDA0,
+                Y_D,
+                gamma=GAMMA,
+                mode=mode,
+                tol=TOL,
+                max_iterations=MAX_ITERATIONS if mode == "discrete" else None,
+                record=True,
+            )
     except JikError as exc:
         out.update(success=False, message=f"could not start: {exc}", lambda_=list(LAMBDA0))
         out["lambda"] = out.pop("lambda_")

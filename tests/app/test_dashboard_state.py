@@ -91,8 +91,9 @@ def test_closed_path_matches_the_engine_repeatability_test():
 def test_later_cycles_start_from_the_previous_cycle_and_agree_with_a_cold_start(monkeypatch):
     """Each leg after the first cycle is guessed by the same leg of the cycle before (see
     engine.picard): the extended inverse, repeatable, then takes one or two sweeps a leg. The
-    pseudoinverse's legs are guessed by a chain of all its legs (engine.solver.chain_guesses):
-    one or two sweeps a leg too. Both give the numbers of a cold start."""
+    pseudoinverse's legs are guessed by a chain of all its legs
+    (engine.picard_guesses.chain_guesses): one or two sweeps a leg too. Both give the numbers of
+    a cold start."""
     from jik.engine import solver as engine_solver
 
     state = default_state("manipulator2")
@@ -103,7 +104,7 @@ def test_later_cycles_start_from_the_previous_cycle_and_agree_with_a_cold_start(
     first, later = per_run["extended"][:L], per_run["extended"][L:]
     assert sum(first) >= 20 and max(later) <= 2, per_run  # (cold: 13, 2, 13, 2)
     assert max(per_run["pseudoinverse"]) <= 2, per_run  # (cold: 8 to 12 a leg)
-    monkeypatch.setattr(engine_solver, "_guesses", lambda *args: None)
+    monkeypatch.setattr(engine_solver, "picard_guesses", lambda *args: None)
     cold = compute(state)
     for a in ALGORITHMS:
         np.testing.assert_allclose(warm.runs[a].leg_end, cold.runs[a].leg_end, atol=1e-12)

@@ -15,7 +15,7 @@ from jik.app.dashboard import Dashboard, compute, default_state, updated_state
 from jik.app.dashboard.algorithms import DEFAULT_ALGORITHMS
 from jik.app.scene import DashboardScene
 from jik.app.scene.gizmo import DRAG_INTERVAL
-from jik.app.scene.mechanisms import TRACE_TOLERANCE, extent_of, polyline, simplify
+from jik.app.scene.mechanisms import extent_of
 from jik.app.scene.pose import (
     Timeline,
     gizmo_pose,
@@ -23,6 +23,7 @@ from jik.app.scene.pose import (
     start_from_gizmo,
     yaw_quaternion,
 )
+from jik.app.scene.traces import TRACE_TOLERANCE, polyline, simplify
 from jik.engine.registry import ROBOTS
 
 

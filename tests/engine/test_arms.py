@@ -106,7 +106,8 @@ def test_each_arm_equals_its_makers_dh_table(name, table, atol):
 
 @pytest.mark.parametrize("name", sorted(ARMS))
 def test_each_arm_equals_pinocchio_to_1e_12(name):
-    """Pose coordinates and Jacobian at random configurations within the limits."""
+    """Pose coordinates and Jacobian at random configurations within the limits, from the
+    batched call and from the one-configuration path."""
     pin = pytest.importorskip("pinocchio")
     a = ARMS[name]
     kin = _kin(name)
@@ -134,6 +135,9 @@ def test_each_arm_equals_pinocchio_to_1e_12(name):
         rows = [("x", "y", "z", "rx", "ry", "rz").index(n) for n in kin.task_names]
         np.testing.assert_allclose(ki, full_k[rows], atol=1e-12)
         np.testing.assert_allclose(Ji, full_J[rows], atol=1e-12)
+        k1, J1 = kin.forward_jacobian(xi)
+        np.testing.assert_allclose(k1, full_k[rows], atol=1e-12)
+        np.testing.assert_allclose(J1, full_J[rows], atol=1e-12)
 
 
 @pytest.mark.skipif(ROBOTS is None, reason="example-robot-data is not installed")

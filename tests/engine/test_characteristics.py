@@ -6,18 +6,17 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from jik.engine.characteristics import (
-    CharacteristicsMap,
-    LinearHomotopy,
-    UnicycleCharacteristics,
+from jik.engine.characteristics import CharacteristicsMap, UnicycleCharacteristics
+from jik.engine.collocation import LinearHomotopy
+from jik.engine.exceptions import InvalidInputError, OneFormUndefinedError, RunCancelled
+from jik.engine.inverses import ExtendedInverse
+from jik.engine.kinematics import Manipulator2, kernel_cofactors
+from jik.engine.one_form import (
     cofactors,
     kernel_cofactors_derivative,
     one_form,
     one_form_derivative,
 )
-from jik.engine.exceptions import InvalidInputError, OneFormUndefinedError, RunCancelled
-from jik.engine.inverses import ExtendedInverse
-from jik.engine.kinematics import Manipulator2, kernel_cofactors
 from jik.engine.progress import ProgressCallbacks
 from jik.engine.unicycle import Unicycle
 
@@ -277,9 +276,9 @@ def test_a_large_batch_is_solved_in_bounded_memory(kin, monkeypatch):
     results are those of one batch of all (each member's Newton solve is its own)."""
     import tracemalloc
 
-    from jik.engine import characteristics
+    from jik.engine import collocation
 
-    monkeypatch.setattr(characteristics, "MAX_MEMBERS", 50)
+    monkeypatch.setattr(collocation, "MAX_MEMBERS", 50)
     x = points(200, seed=5, spread=1.5)
 
     def peak(n: int) -> int:
@@ -291,7 +290,7 @@ def test_a_large_batch_is_solved_in_bounded_memory(kin, monkeypatch):
 
     assert peak(200) < 1.5 * peak(50)
     parts = UnicycleCharacteristics(kin, a=1.0, on_undefined="nan").evaluate(x)
-    monkeypatch.setattr(characteristics, "MAX_MEMBERS", 1000)
+    monkeypatch.setattr(collocation, "MAX_MEMBERS", 1000)
     whole = UnicycleCharacteristics(kin, a=1.0, on_undefined="nan").evaluate(x)
     assert np.array_equal(whole[2], parts[2])
     ok = ~whole[2]

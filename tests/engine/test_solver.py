@@ -287,7 +287,7 @@ def test_chain_guesses_give_each_leg_in_one_or_two_sweeps_and_the_same_path(
     """chain_guesses sweeps the legs of a closed path together; solved one after another from
     them, each leg takes one or two sweeps (about ten cold for the pseudoinverse) and ends where
     the cold solve ends, to the sweep tolerance; its trajectory is the cold one."""
-    from jik.engine.solver import chain_guesses
+    from jik.engine.picard_guesses import chain_guesses
     from tests.helpers import count_picard_sweeps
 
     kin = Manipulator2()
@@ -317,7 +317,7 @@ def test_chain_guesses_give_each_leg_in_one_or_two_sweeps_and_the_same_path(
 
 
 def test_chain_guesses_refuse_bad_input_and_give_none_at_a_singularity():
-    from jik.engine.solver import chain_guesses
+    from jik.engine.picard_guesses import chain_guesses
 
     inv = Pseudoinverse(Manipulator2())
     for kwargs, match in [
@@ -351,7 +351,7 @@ def test_discrete_chunks_give_the_iterates_of_one_solve(chunk):
     """x <- x - gamma J# e has no memory: solves of `chunk` iterations, each from where the one
     before stopped, give the same iterates, count and message as one solve; between the chunks
     the progress fraction grows toward 1."""
-    from jik.engine.solver import solve_in_chunks
+    from jik.engine.solve_chunks import solve_in_chunks
 
     inv = ExtendedInverse(Manipulator2(), PaperCubic())
     one = solve(inv, X0, [1, 1], gamma=0.3, mode="discrete")
@@ -364,7 +364,7 @@ def test_discrete_chunks_give_the_iterates_of_one_solve(chunk):
 
 
 def test_discrete_chunks_stop_at_the_iteration_cap_as_one_solve():
-    from jik.engine.solver import solve_in_chunks
+    from jik.engine.solve_chunks import solve_in_chunks
 
     inv = Pseudoinverse(Manipulator2())
     one = solve(inv, X0, [1, 1], gamma=0.01, mode="discrete", max_iterations=20)
@@ -402,7 +402,7 @@ class _ThrownNearTarget(Pseudoinverse):
 
 
 def test_a_run_that_diverges_in_a_later_chunk_counts_all_its_iterations():
-    from jik.engine.solver import solve_in_chunks
+    from jik.engine.solve_chunks import solve_in_chunks
 
     inv = _ThrownNearTarget(Manipulator2(), 1e-3)
     one = solve(inv, X0, [1, 1], gamma=0.3, mode="discrete")
@@ -415,7 +415,7 @@ def test_a_run_that_diverges_in_a_later_chunk_counts_all_its_iterations():
 def test_a_typed_error_inside_a_chunk_keeps_every_iterate_before_it():
     """Where one solve raises (the map undefined on the way), the chunks stop with the iterates
     up to the error: the last chunk is redone one iteration at a time."""
-    from jik.engine.solver import solve_in_chunks
+    from jik.engine.solve_chunks import solve_in_chunks
 
     kin = Manipulator2()
     plain = solve(Pseudoinverse(kin), X0, [1, 1], gamma=0.3, mode="discrete")
@@ -430,7 +430,7 @@ def test_a_typed_error_inside_a_chunk_keeps_every_iterate_before_it():
 
 
 def test_discrete_chunks_raise_at_a_singular_start_and_let_between_raise():
-    from jik.engine.solver import solve_in_chunks
+    from jik.engine.solve_chunks import solve_in_chunks
 
     singular = ExtendedInverse(Manipulator1(), E2Optimal(a=1.0, b=0.0))
     with pytest.raises(AlgorithmicSingularityError, match=r"x = \(0, 0.2, 1\)"):

@@ -13,11 +13,11 @@ from jik.engine.exceptions import InvalidInputError, RunCancelled
 from jik.engine.functionals import error_functional_e2, quadrature
 from jik.engine.inverses import ExtendedInverse, Pseudoinverse, pseudoinverse
 from jik.engine.kinematics import Manipulator1, Manipulator2
+from jik.engine.legendre_map import SynthesizedMap
 from jik.engine.progress import ProgressCallbacks
 from jik.engine.repeatability import repeatability
 from jik.engine.variational import (
     MANIPULATOR2_REGION,
-    SynthesizedMap,
     default_manipulator2_synthesis,
     synthesize_e2,
 )

@@ -3,7 +3,7 @@
 from fastapi import APIRouter
 
 from jik.app.api.dependencies import Pool
-from jik.app.compute.requests import robots_response
+from jik.app.compute.catalogue import robots_response
 from jik.app.compute.schemas import RobotsResponse
 
 router = APIRouter(tags=["robots"])

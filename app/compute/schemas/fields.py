@@ -11,7 +11,7 @@ from typing import Annotated, Any, Literal
 from pydantic import BeforeValidator, Field
 
 from jik.app.compute.schemas.algorithms import Algorithm as Algorithm
-from jik.engine.solver import GAMMA_MAX, GAMMA_MIN, TOL_MIN
+from jik.engine.solve_rules import GAMMA_MAX, GAMMA_MIN, TOL_MIN
 
 #: Largest configuration / task dimension accepted before the registry check.
 MAX_DIMENSION = 16
@@ -47,7 +47,7 @@ Coordinate = Annotated[
 ]
 Vector = Annotated[list[Coordinate], Field(min_length=1, max_length=MAX_DIMENSION)]
 #: The decay rate of eq. (5) (discrete mode: the step; its bound there is checked with the mode,
-#: engine.solver.gamma_problem).
+#: engine.solve_rules.gamma_problem).
 Gamma = Annotated[float, Field(strict=True, ge=GAMMA_MIN, le=GAMMA_MAX, allow_inf_nan=False)]
 #: The task error at which a solve stops.
 Tolerance = Annotated[float, Field(strict=True, ge=TOL_MIN, le=1.0, allow_inf_nan=False)]

@@ -32,7 +32,7 @@ from jik.app.compute.schemas.robots import (
 from jik.app.compute.schemas.variants import per_robot
 from jik.engine.registry import RobotSpec
 from jik.engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
-from jik.engine.solver import DISCRETE_GAMMA_BOUND
+from jik.engine.solve_rules import DISCRETE_GAMMA_BOUND
 
 
 class _Request(BaseModel):

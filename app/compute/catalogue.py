@@ -1,0 +1,40 @@
+"""``GET /robots``: the catalogue of robots, catalogue arms and algorithms, and the API's limits."""
+
+from __future__ import annotations
+
+import functools
+
+from jik.app.compute import schemas as S
+from jik.app.compute.settings import settings_from_env
+from jik.engine.arms import ARMS
+from jik.engine.registry import ALGORITHMS, ROBOTS, RobotSpec
+from jik.engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
+from jik.engine.robot_spec import robot_from_dict
+
+
+@functools.cache
+def _arm_specs() -> tuple[RobotSpec, ...]:
+    """The catalogue arms with their default tasks (each built once: a URDF parse)."""
+    return tuple(robot_from_dict({"name": name}).spec for name in ARMS)
+
+
+def robots_response(timeout: float | None = None) -> S.RobotsResponse:
+    """The catalogue: every robot with p, r, parameters, defaults and augmentations, then the
+    catalogue arms (``{"name": "panda"}``; ``task`` and ``reference`` change their r)."""
+    robots = [
+        S.RobotInfo(
+            **spec.as_dict(),
+            algorithms=list(S.Algorithm.__args__),  # type: ignore[attr-defined]
+            modes=["continuous", "discrete"],
+        )
+        for spec in (*ROBOTS.values(), *_arm_specs())
+    ]
+    limits = S.Limits(
+        max_cycles=MAX_CYCLES,
+        max_path_points=MAX_PATH_POINTS,
+        max_iterations=S.MAX_ITERATIONS,
+        max_trajectory_points=S.MAX_TRAJECTORY_POINTS,
+        request_timeout_s=float(timeout if timeout is not None else settings_from_env().timeout),
+    )
+    algorithms = [S.AlgorithmInfo(**a.as_dict()) for a in ALGORITHMS.values()]
+    return S.RobotsResponse(robots=robots, limits=limits, algorithms=algorithms)

@@ -1,0 +1,88 @@
+"""Engine results as JSON-ready documents: arrays to lists (null where not finite), a run's
+trajectory downsampled, one solve's response and its joint-limit report (the fields of
+``S.SolveResponse``), built without validating the model on the workers' hot path."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pydantic_core
+
+from jik.app.compute import schemas as S
+from jik.engine.limits import limit_names, robot_limits, solve_report
+
+
+def nullable(a) -> Any:
+    """ndarray -> nested lists with None where not finite (JSON has no NaN)."""
+    a = np.asarray(a, dtype=float)
+    if a.ndim == 0:
+        return float(a) if np.isfinite(a) else None
+    if np.isfinite(a).all():
+        return a.tolist()
+    obj = a.astype(object)
+    obj[~np.isfinite(a)] = None
+    return obj.tolist()
+
+
+def downsample(m: int, limit: int = S.MAX_TRAJECTORY_POINTS) -> np.ndarray:
+    """Indices of at most ``limit`` of ``m`` points, evenly spread, first and last kept."""
+    if m <= limit:
+        return np.arange(m)
+    return np.unique(np.linspace(0, m - 1, limit).round().astype(int))
+
+
+def trajectory_document(traj) -> dict[str, Any]:
+    """A run's trajectory as JSON-ready data (the fields of ``S.Trajectory``), downsampled."""
+    m = len(traj.theta)
+    idx = downsample(m)
+    return {
+        "theta": nullable(traj.theta[idx]),
+        "x": nullable(traj.x[idx]),
+        "y": nullable(traj.y[idx]),
+        "error": nullable(traj.error[idx]),
+        "h": None if traj.h is None else nullable(np.asarray(traj.h)[idx]),
+        "points": m,
+        "downsampled": bool(len(idx) < m),
+    }
+
+
+def solve_document(setup, res) -> dict[str, Any]:
+    """One solve's response as JSON-ready data (the fields of ``S.SolveResponse``)."""
+    return {
+        "robot": setup.robot.model_dump(mode="json"),
+        "algorithm": setup.inverse.name,
+        "augmentation": (
+            None if setup.augmentation is None else setup.augmentation.model_dump(mode="json")
+        ),
+        "mode": setup.mode,
+        "gamma": float(setup.gamma),
+        "tolerance": float(setup.tolerance),
+        "x": nullable(res.x),
+        "y": nullable(res.y),
+        "error": nullable(res.error),
+        "converged": bool(res.success),
+        "message": str(res.message),
+        "iterations": int(res.nit),
+        "trajectory": trajectory_document(res.trajectory),
+        **limits_document(setup, lambda limits, names: solve_report(limits, res, names)),
+    }
+
+
+def limits_document(setup, report) -> dict[str, Any]:
+    """``{"limits": ...}`` of a run (``report(limits, names)``), empty when the robot has none."""
+    limits = robot_limits(setup.kinematics)
+    if limits is None:
+        return {}
+    return {"limits": report(limits, limit_names(setup.kinematics)).as_dict()}
+
+
+def solve_response(setup, res) -> S.SolveResponse:
+    return S.SolveResponse.model_validate(solve_document(setup, res))
+
+
+def solve_response_json(setup, res) -> bytes:
+    """The JSON of :func:`solve_response` without validating the model (the workers' hot
+    path: validation costs about as much as a small solve). ``tests/app/test_solve.py`` checks
+    that both give the same document."""
+    return pydantic_core.to_json(solve_document(setup, res))

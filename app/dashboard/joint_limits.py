@@ -1,0 +1,85 @@
+"""Whether each run of a dashboard result stayed within its robot's joint limits, and where it
+first left them (:mod:`jik.engine.limits`), for the verdict, the summary and the 3D scene.
+
+The paper's algorithms, eq. (7), know nothing of joint limits: a run is what it is, and the
+dashboard says in words whether it stayed within the limits the robot declares (a URDF arm's, a
+catalogue arm's, a planar chain's or formula robot's ``limits``) and, if not, the first
+violation: the cycle, the leg, the joint, its value and the limit it passed. The scene colours a
+joint while it is outside its limits (:func:`outside_joints`).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from jik.app.dashboard.robots import state_kinematics, state_spec
+from jik.engine.limits import LimitsReport, legs_report, limit_names, robot_limits
+
+
+def state_limits(state) -> np.ndarray | None:
+    """The joint limits (p, 2) of a state's robot; None when it declares none (every bound
+    infinite, or the paper's robots)."""
+    limits = robot_limits(state_kinematics(state))
+    if limits is None or not np.isfinite(limits).any():
+        return None
+    return limits
+
+
+def run_limits(result, algorithm: str) -> LimitsReport | None:
+    """The limits report of ``result``'s run of ``algorithm``: its start x0, then its legs in
+    order (leg k of cycle k // L + 1, L the legs of one cycle); None for a robot without
+    limits."""
+    state = result.state
+    limits = state_limits(state)
+    if limits is None:
+        return None
+    run = result.runs[algorithm]
+    legs = [run.x[run.leg == k] for k in np.unique(run.leg)]
+    names = limit_names(state_kinematics(state))
+    L = max(1, len(result.targets))
+    return legs_report(limits, np.asarray(state.x0, dtype=float), legs, L, names)
+
+
+def limits_summary(result) -> dict[str, Any]:
+    """Per algorithm, ``{"within": bool, "violation": {...} or None}`` (the REST API's
+    ``limits``); empty for a robot without limits."""
+    out = {}
+    for algorithm in result.runs:
+        report = run_limits(result, algorithm)
+        if report is not None:
+            out[algorithm] = report.as_dict()
+    return out
+
+
+def limits_texts(result, names: dict[str, str]) -> list[tuple[str, str, bool]]:
+    """The verdict's sentences on the limits: (text, algorithm, within) per algorithm, in the
+    words of ``names`` (the algorithms' names in the verdict)."""
+    out = []
+    title = state_spec(result.state).title
+    for algorithm in result.runs:
+        report = run_limits(result, algorithm)
+        if report is None:
+            continue
+        name = names.get(algorithm, algorithm)
+        if report.within:
+            text = f"{name}: stayed within the joint limits of the {title} all along its run."
+        else:
+            v = report.violation
+            assert v is not None
+            where = ("its start x0 is already outside them" if v.cycle == 0
+                     else f"first at cycle {v.cycle}, leg {v.leg}")  # fmt: skip
+            side = "below its lower" if v.bound == "lower" else "above its upper"
+            text = (f"{name}: left the joint limits of the {title}: {where}, joint {v.name} = "
+                    f"{v.value:.4g}, {side} limit {v.limit:.4g}.")  # fmt: skip
+        out.append((text, algorithm, report.within))
+    return out
+
+
+def outside_joints(limits: np.ndarray | None, x) -> np.ndarray:
+    """The indices of the joint variables of ``x`` (p,) outside ``limits`` (none without)."""
+    if limits is None:
+        return np.zeros(0, dtype=int)
+    x = np.asarray(x, dtype=float)
+    return np.flatnonzero((x < limits[:, 0]) | (x > limits[:, 1]))

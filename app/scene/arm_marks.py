@@ -1,0 +1,92 @@
+"""What the scene draws of a serial arm beyond its links: the pose frames of its task's targets
+and of its end link (axes triads: x red, y green, z blue), and its joints outside their limits.
+
+A URDF arm's task may hold its end link's orientation, ``rx ry rz`` = log(R0^T R)
+(:mod:`jik.engine.pose_task`): a target with all three is the frame R = R0 exp(phi) at its
+position ``x y z``; a target with the position only is a point; any other (a subset such as
+``x z``) is no place in space and is not drawn.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import viser.transforms as vtf
+
+from jik.engine import so3
+
+#: A joint's colour while its value is outside the robot's limits.
+OUTSIDE_COLOR = (255, 140, 0)
+#: Length of a target's and of the end link's axes, as a fraction of the arm's reach.
+AXES_FRACTION = 0.12
+
+
+def wxyz(R) -> tuple[float, float, float, float]:
+    """The unit quaternion (w, x, y, z) of a rotation matrix (3, 3)."""
+    q = vtf.SO3.from_matrix(np.asarray(R, dtype=float)).wxyz
+    return tuple(float(v) for v in q)  # type: ignore[return-value]
+
+
+def task_names(kin: Any) -> tuple[str, ...]:
+    """The names of a robot's task coordinates (``x y z rx ry rz`` or some of them)."""
+    return tuple(getattr(kin, "task_names", ()))
+
+
+def has_pose(kin: Any) -> bool:
+    """Whether the task gives a whole frame: position and the three rotation coordinates."""
+    return set(task_names(kin)) == {"x", "y", "z", "rx", "ry", "rz"}
+
+
+def target_pose(kin: Any, y) -> tuple[tuple[float, ...], tuple[float, ...] | None] | None:
+    """(position, wxyz or None) of a task point ``y`` of a URDF arm: its frame when the task is
+    the whole pose, its point when it holds x, y and z; None otherwise."""
+    names = task_names(kin)
+    if not {"x", "y", "z"} <= set(names):
+        return None
+    y = np.asarray(y, dtype=float)
+    position = tuple(float(y[names.index(c)]) for c in ("x", "y", "z"))
+    if not has_pose(kin):
+        return position, None
+    phi = np.array([y[names.index(c)] for c in ("rx", "ry", "rz")])
+    R = np.asarray(kin.reference, dtype=float) @ so3.exp(phi)
+    return position, wxyz(R)
+
+
+def target_fixtures(result, kin: Any, root: str, size: float) -> dict[str, tuple[str, dict, dict]]:
+    """The targets of an arm's legs as fixtures (:func:`~jik.app.scene.mechanisms.fixtures_of`):
+    a frame (axes triad) per target of a pose task, a ball per target of a position task."""
+    out: dict[str, tuple[str, dict, dict]] = {}
+    for k, target in enumerate(result.targets):
+        pose = target_pose(kin, target)
+        if pose is None:
+            continue
+        position, q = pose
+        if q is None:
+            out[f"{root}/targets/{k}"] = (
+                "ball", {"position": position}, {"radius": 0.15 * size, "color": (0, 0, 0)}
+            )  # fmt: skip
+        else:
+            out[f"{root}/targets/{k}"] = (
+                "frame", {"position": position, "wxyz": q},
+                {"axes_length": size, "axes_radius": 0.06 * size, "origin_radius": 0.12 * size,
+                 "origin_color": (0, 0, 0)},
+            )  # fmt: skip
+    return out
+
+
+def joint_points(kin: Any) -> dict[int, int]:
+    """Which drawn point (of ``kin.points``) is each joint variable's joint: a URDF chain's
+    joints in chain order (fixed ones included), a planar chain's joint i at point i."""
+    chain = getattr(kin, "chain", None)
+    if chain is None:
+        return {i: i for i in range(kin.p)}
+    return {int(j.index): k for k, j in enumerate(chain) if getattr(j, "index", -1) >= 0}
+
+
+def end_frame(kin: Any, x) -> tuple[tuple[float, ...], tuple[float, ...]] | None:
+    """(position, wxyz) of the end link at ``x`` (p,) when the task holds its orientation."""
+    if not has_pose(kin) or not hasattr(kin, "end_pose"):
+        return None
+    R, t = kin.end_pose(np.asarray(x, dtype=float))
+    return tuple(float(v) for v in t), wxyz(R)

@@ -1,0 +1,100 @@
+"""Picard guesses for the continuous solves of eq. (7): from earlier trajectories, and chained
+over a closed path's legs (:mod:`jik.engine.picard`); :func:`solve` is
+:func:`jik.engine.solver.solve`."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.inverses import Inverse
+from jik.engine.picard import Guess, picard_chain
+from jik.engine.results import Trajectory
+from jik.engine.solve_rules import check_gamma
+
+
+def picard_guesses(guess, n: int, p: int, gamma: float) -> list[Guess | None] | None:
+    """Picard guesses (sigma, x) from earlier trajectories (see :func:`solve`), validated."""
+    if guess is None:
+        return None
+    items = [guess] if isinstance(guess, Trajectory) else list(guess)
+    if len(items) != n:
+        raise InvalidInputError(
+            f"guess has {len(items)} trajectories for {n} start configurations; give one "
+            "Trajectory (or None) per start"
+        )
+    out: list[Guess | None] = []
+    for k, tr in enumerate(items):
+        if tr is None:
+            out.append(None)
+            continue
+        if not isinstance(tr, Trajectory):
+            raise InvalidInputError(
+                f"guess[{k}] must be a Trajectory (a SolveResult's .trajectory) or None"
+            )
+        theta = np.asarray(tr.theta, dtype=float)
+        x = np.asarray(tr.x, dtype=float)
+        if theta.ndim != 1 or x.shape != (len(theta), p) or len(theta) < 2:
+            raise InvalidInputError(
+                f"guess[{k}] must have theta of shape (m,) and x of shape (m, {p}), m >= 2"
+            )
+        if not (np.all(np.isfinite(theta)) and np.all(np.isfinite(x))):
+            raise InvalidInputError(f"guess[{k}] contains NaN or infinite values")
+        if np.any(np.diff(theta) <= 0):
+            raise InvalidInputError(f"guess[{k}].theta must be increasing")
+        # The homotopy parameter of (*) in engine.picard: sigma = 1 - exp(-gamma theta); the
+        # last point of a converged leg is its end, sigma = 1.
+        sigma = -np.expm1(-gamma * (theta - theta[0]))
+        sigma[-1] = 1.0
+        out.append((sigma, x))
+    return out
+
+
+def chain_guesses(inverse: Inverse, x0, y_d, *, gamma: float = 1.0) -> list[Trajectory] | None:
+    """Guesses for solving legs of eq. (7) one after another in continuous mode: leg j from
+    where leg j - 1 ends, to ``y_d[j]`` (a closed path's legs, cycle after cycle).
+
+    Pass ``guesses[j]`` as ``guess`` of the solve of leg j (:func:`solve`): the results are
+    the same to the sweep tolerance; each leg then takes one or two Picard sweeps instead of
+    about ten, and the guesses cost about three legs' worth (:func:`jik.engine.picard.picard_chain`;
+    ``jik bench solver``).
+
+    Parameters
+    ----------
+    inverse : Inverse
+    x0 : array_like, shape (p,)
+        Start of the first leg.
+    y_d : array_like, shape (L, r)
+        The legs' targets.
+    gamma : float
+        The decay rate the legs will be solved with (it only sets their theta).
+
+    Returns
+    -------
+    list of L Trajectory (at the Chebyshev nodes of each leg), or None when the legs
+    cannot all be swept on one segment each (a singular J# on the way, a path that needs finer
+    segments): solve them without guesses then.
+    """
+    kin = inverse.kinematics
+    x0 = kin.check(x0, "x0")
+    y_d = kin.check_task(y_d, "y_d")
+    gamma = check_gamma(gamma, "continuous")
+    if x0.ndim != 1 or y_d.ndim != 2 or len(y_d) == 0:
+        raise InvalidInputError(
+            f"x0 must be one configuration (p,) and y_d the legs' targets (L, r), L >= 1; "
+            f"got shapes {x0.shape} and {y_d.shape}"
+        )
+    chained = picard_chain(inverse, x0, y_d)
+    if chained is None:
+        return None
+    sigma, X = chained
+    # sigma = 1 - exp(-gamma theta) (engine.picard); the last node, sigma = 1, is the leg's end
+    # and stands at any later theta (see picard_guesses).
+    theta = -np.log1p(-sigma[:-1]) / gamma
+    theta = np.append(theta, theta[-1] + 1.0)
+    y = kin.forward(X)  # (L, nodes, r)
+    error = np.linalg.norm(y - y_d[:, None, :], axis=-1)
+    return [
+        Trajectory(theta=theta, x=X[j], y=y[j], error=error[j], h=inverse.augmenting_value(X[j]))
+        for j in range(len(X))
+    ]

@@ -1,0 +1,119 @@
+"""The augmenting maps of a robot defined by data (:func:`jik.engine.robot_spec.robot_from_dict`):
+formula maps, one per degree of redundancy, and E2-optimal syntheses on a region, eq. (9)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+
+from jik.engine import robot_kinds
+from jik.engine.augmentations import AugmentingMap
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.formula_kinematics import FormulaMap
+from jik.engine.functionals import check_region
+from jik.engine.kinematics import Kinematics
+from jik.engine.registry import AugmentationSpec
+from jik.engine.robot_synthesis import TOTAL_DEGREE, synthesis
+from jik.engine.validation import count
+
+
+def augmentations_from_dict(kin: Kinematics, items, key: str | None = None):
+    """AugmentationSpecs of ``[{"name": "formula", "h": ...}, {"name": "e2_synthesized", ...}]``,
+    the synthesis region of the first e2_synthesized (the robot's functional region), and the
+    vectors of p - r formula maps (p > r + 1: ``"h"`` is a list), by label. ``key`` names the
+    robot's definition: with it, a synthesized map is computed once per process for it."""
+    if not isinstance(items, list):
+        raise InvalidInputError("augmentations must be a list of augmenting maps", "augmentations")
+    specs: list[AugmentationSpec] = []
+    region: dict = {}
+    vectors: dict[str, tuple[AugmentingMap, ...]] = {}
+    k = kin.p - kin.r
+    for i, item in enumerate(items):
+        where = f"augmentations.{i}"
+        if not isinstance(item, Mapping) or item.get("name") not in ("formula", "e2_synthesized"):
+            raise InvalidInputError(
+                f"{where} must be {{'name': 'formula', 'h': ...}} or "
+                "{'name': 'e2_synthesized', 'region': {...}}",
+                where,
+            )
+        if k != 1 and item["name"] == "e2_synthesized":
+            raise InvalidInputError(
+                f"{where}: the E2 synthesis needs one degree of redundancy (p = r + 1); this "
+                f"robot has p = {kin.p}, r = {kin.r}: give the extended inverse a list of "
+                f"{k} formula maps, {{'name': 'formula', 'h': [...]}}",
+                where,
+            )
+        label = item.get("label", item["name"])
+        if not isinstance(label, str) or label in {s.name for s in specs}:
+            raise InvalidInputError(
+                f"{where}.label must be a new name, got {label!r}", f"{where}.label"
+            )
+        factory: Callable[..., AugmentingMap]
+        if item["name"] == "formula":
+            unknown = set(item) - robot_kinds.augmentation_keys("formula")
+            maps = _formula_maps(kin, item, where)
+            if k == 1:
+                factory = lambda kin, amap=maps[0]: amap  # noqa: E731
+            else:
+                vectors[label] = maps
+                factory = _vector_only(label)
+            text = "h = " + ", ".join(m.text for m in maps)
+        else:
+            unknown = set(item) - robot_kinds.augmentation_keys("e2_synthesized")
+            box, fix = _region(kin, item, where)
+            if len(box) <= 3:
+                degree = count(item.get("degree", 12), f"{where}.degree", 1, 24)
+                text = f"E2-optimal h on {box} by the Ritz solve of (20), degree {degree}"
+            else:
+                degree = count(item.get("degree", TOTAL_DEGREE), f"{where}.degree", 1, 6)
+                text = (
+                    f"E2-optimal h of {len(box)} joints on {box}: Ritz solve of (19) in a "
+                    f"total-degree {degree} basis on a Sobol rule"
+                )
+            factory = synthesis(box, fix, degree, key)
+            region = region or box
+        if unknown:
+            raise InvalidInputError(f"{where}: unknown key(s) {sorted(unknown)}", where)
+        specs.append(AugmentationSpec(label, "(9)", text, (), factory))
+    return tuple(specs), region, vectors
+
+
+def _formula_maps(kin: Kinematics, item: Mapping, where: str) -> tuple[FormulaMap, ...]:
+    """One map for p = r + 1 (``h`` a formula), p - r of them for more (``h`` a list)."""
+    k, h = kin.p - kin.r, item.get("h", "")
+    texts = [h] if k == 1 else h
+    if not isinstance(texts, list) or len(texts) != k:
+        raise InvalidInputError(
+            f"{where}.h must be "
+            + (
+                "a formula"
+                if k == 1
+                else f"a list of {k} formulas (p - r = {k}: one map per degree of redundancy)"
+            ),
+            f"{where}.h",
+        )
+    names, params = kin.variable_names, item.get("parameters")
+    fields = [f"{where}.h"] if k == 1 else [f"{where}.h.{j}" for j in range(k)]
+    return tuple(FormulaMap(t, names, params, field=f) for t, f in zip(texts, fields, strict=True))
+
+
+def _vector_only(label: str) -> Callable[..., AugmentingMap]:
+    def refuse(kin: Kinematics) -> AugmentingMap:
+        raise InvalidInputError(
+            f"augmentation {label!r} is a vector of maps (p - r > 1): build its extended "
+            "inverse with Robot.inverse",
+            "augmentation",
+        )
+
+    return refuse
+
+
+def _region(kin: Kinematics, item: Mapping, where: str):
+    try:
+        box, fix = check_region(kin, item.get("region", {}), item.get("fixed"))
+    except InvalidInputError as exc:
+        raise InvalidInputError(f"{where}.region: {exc}", f"{where}.region") from None
+    if len(box) < 2:
+        raise InvalidInputError(
+            f"{where}.region must have at least two variables", f"{where}.region"
+        )
+    return box, fix
