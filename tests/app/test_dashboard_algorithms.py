@@ -140,3 +140,29 @@ def test_the_session_api_takes_the_choice(client):
     bad = client.post(url, json={"algorithm_parameters.gain": -2.0})
     assert bad.status_code == 422 and "algorithm_parameters.gain" in bad.text
     assert client.get(f"/api/sessions/{session['id']}").json()["state"]["algorithms"] == THREE
+
+
+def test_the_scene_draws_a_robot_per_chosen_algorithm(three):
+    """A copy of the robot and a trace per algorithm, in its colour; the key names the three;
+    the paper's two alone come back to the default set."""
+    from jik.app.dashboard import Dashboard
+    from jik.app.scene import DashboardScene
+    from jik.app.scene.mechanisms import rgb
+
+    dashboard = Dashboard(default_state())
+    scene = DashboardScene(dashboard)
+    try:
+        assert dashboard.wait(1, timeout=60)
+        scene._draw(three)
+        assert list(scene.nodes.mechanisms) == THREE
+        root = "/robot/manipulator2-path-pseudoinverse-extended-posture"
+        for a in THREE:
+            trace = scene.nodes.fixtures[f"{root}/trace/{a}/task"]
+            assert tuple(np.asarray(trace.colors).reshape(-1, 3)[0]) == rgb(COLORS[a])
+        assert all(STYLES[a].label in scene.legend.content for a in THREE)
+        scene._draw(compute(default_state(), 200))
+        assert list(scene.nodes.mechanisms) == list(DEFAULT_ALGORITHMS)
+        assert STYLES["posture"].label not in scene.legend.content
+    finally:
+        scene.stop()
+        dashboard.stop()
