@@ -86,6 +86,9 @@ def _damped(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
     p = runs.get("pseudoinverse")
     if p is not None and not p.success and run.success:
         text += "; it went through where the pseudoinverse stopped"
+    elif p is not None and not p.success and run.error[-1] < p.error[-1]:
+        text += (f"; where the pseudoinverse stalled at task error {g(float(p.error[-1]))}, "
+                 f"it got to {g(float(run.error[-1]))}")  # fmt: skip
     elif not run.success:
         text += f"; it stopped with task error {g(float(run.error[-1]))}"
     return [(text + ".", "why")]

@@ -166,3 +166,34 @@ def test_the_scene_draws_a_robot_per_chosen_algorithm(three):
     finally:
         scene.stop()
         dashboard.stop()
+
+
+CHAIN = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 1.0, 1.0],
+         "x0": [0.3, 0.3, 0.3]}  # fmt: skip
+
+
+def _damped_beside_pseudoinverse(x0, target):
+    state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": CHAIN})
+    state = updated_state(state, {"task": "target", "target": target, "x0": x0,
+                                  "algorithms": ["pseudoinverse", "damped"]})  # fmt: skip
+    result = compute(state)
+    return result, {(s["algorithm"], s["role"]): s["text"] for s in verdict(result)}
+
+
+def test_damped_goes_through_a_singular_start_where_the_pseudoinverse_stops():
+    """The 3R arm stretched (J of rank 1): the pseudoinverse's run stops, damped least squares
+    converges, and the verdict says so beside its task error."""
+    result, said = _damped_beside_pseudoinverse([0.0, 0.0, 0.0], [2.0, 1.0])
+    assert not result.runs["pseudoinverse"].success and result.runs["damped"].success
+    assert "J J^T is singular" in said[("pseudoinverse", "failure")]
+    assert "it went through where the pseudoinverse stopped" in said[("damped", "why")]
+
+
+def test_damped_reports_its_task_error_at_the_reach_boundary():
+    """A target beyond reach: the pseudoinverse stalls at 1.22, damped least squares stretches
+    the arm to the singular configuration and is left with 0.5; both numbers are said."""
+    result, said = _damped_beside_pseudoinverse([0.3, 0.3, 0.3], [3.5, 0.0])
+    assert result.runs["damped"].error[-1] == pytest.approx(0.5, abs=1e-6)
+    why = said[("damped", "why")]
+    assert "task error at the end of its legs up to 0.5" in why
+    assert "where the pseudoinverse stalled at task error 1.22, it got to 0.5" in why

@@ -259,6 +259,7 @@ def test_reproduction_table_has_every_algorithm():
     assert text.count("\n| ") == 6 and "| posture | gain = 1.0, rest = x0 |" in text
 
 
+@pytest.mark.slow  # (~5 s: the Panda's map is synthesized; the default run has Table 1's)
 def test_reproduction_table_of_the_panda_pose_loop():
     """The Panda's pose loop, one cycle: every algorithm succeeds, the extended inverse (its
     synthesized map) comes back to x0, the pseudoinverse does not."""
