@@ -111,7 +111,16 @@ class _Batched:
         self.size = len(exprs)
         # abs'' and sign' are DiracDelta: the derivative almost everywhere is 0 there.
         exprs = [e.replace(sp.DiracDelta, lambda *a: sp.Integer(0)) for e in exprs]
-        self._f = sp.lambdify(list(symbols), list(exprs), modules="numpy", dummify=True, cse=True)
+        self._exprs, self._symbols = list(exprs), list(symbols)
+        self._f = sp.lambdify(self._symbols, self._exprs, modules="numpy", dummify=True, cse=True)
+
+    def __getstate__(self) -> dict:
+        """Pickled as its expressions (the generated function has no importable name): a
+        process that receives it (an atlas's chunk in a worker) generates the function again."""
+        return {"exprs": self._exprs, "symbols": self._symbols, "shape": self.shape}
+
+    def __setstate__(self, state: dict) -> None:
+        self.__init__(state["exprs"], state["symbols"], state["shape"])  # type: ignore[misc]
 
     def __call__(self, x: FloatArray) -> FloatArray:
         x = np.asarray(x, dtype=float)

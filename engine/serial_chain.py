@@ -100,9 +100,11 @@ class CompiledChain:
         # transforms and the tip as rows of one product w @ stack, w_j = (1, cos q_j, sin q_j)
         # (the tip's w = (1, 0, 0)).
         self._stack = np.concatenate(
-            [np.stack([self._P0, self._Pc, self._Ps], axis=1).reshape(self.m, 3, 16),
-             np.stack([self.tip, 0.0 * self.tip, 0.0 * self.tip]).reshape(1, 3, 16)]
-        )  # fmt: skip
+            [
+                np.stack([self._P0, self._Pc, self._Ps], axis=1).reshape(self.m, 3, 16),
+                np.stack([self.tip, 0.0 * self.tip, 0.0 * self.tip]).reshape(1, 3, 16),
+            ]
+        )
         self._w = np.zeros((self.m + 1, 1, 3))
         self._w[:, 0, 0] = 1.0
         self._one = self.direct and self._all_revolute

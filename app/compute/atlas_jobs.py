@@ -30,8 +30,9 @@ from jik.app.compute.atlas_pool import PoolBackend, sized_chunks
 from jik.app.compute.atlas_schemas import AtlasJobResponse, AtlasRequest
 from jik.app.compute.documents import nullable
 from jik.app.compute.exceptions import RequestError
-from jik.app.compute.robot_requests import build_augmentation, build_robot
+from jik.app.compute.robot_requests import build_augmentation, build_robot, check_task_point
 from jik.app.compute.schemas.algorithms import field_of, used
+from jik.app.compute.user_robots import is_user_robot, user_inverse, user_robot
 from jik.app.compute.worker import task
 from jik.engine.atlas import AtlasPlan, plan_atlas
 from jik.engine.atlas_run import AtlasResult, run_atlas
@@ -68,35 +69,51 @@ class AtlasLimits:
     keep_for: float = 600.0
 
 
-def _inverse(kin, spec, algorithm: str, req: AtlasRequest):
-    """The algorithm's inverse with those of ``req.algorithm_parameters`` that are its own."""
+def _own_parameters(algorithm: str, req: AtlasRequest) -> dict:
+    """Those of ``req.algorithm_parameters`` that are the algorithm's own."""
     own = {p.name for p in ALGORITHMS[algorithm].parameters} | set(ALGORITHMS[algorithm].vectors)
-    given = {k: v for k, v in used(req.algorithm_parameters).items() if k in own}
-    try:
-        return make_inverse(kin, algorithm, spec=spec, algorithm_parameters=given)
-    except InvalidInputError as exc:
-        raise RequestError(field_of(exc.field, str(exc)), str(exc)) from None
+    return {k: v for k, v in used(req.algorithm_parameters).items() if k in own}
+
+
+def _inverses(req: AtlasRequest) -> tuple[Any, list]:
+    """The robot's spec and the inverse of each algorithm: a catalogue robot built by the
+    registry, a definition or catalogue arm by the engine (:func:`user_robot`, the extended
+    inverse with the request's map or the robot's default)."""
+    if len(set(req.algorithms)) != len(req.algorithms):
+        raise RequestError("algorithms", f"name each algorithm once, got {req.algorithms}")
+    if is_user_robot(req.robot):
+        extended = "extended" in req.algorithms
+        robot, _, _ = user_robot(req.robot, req.augmentation if extended else None)
+        inverses = [user_inverse(robot, a, _own_parameters(a, req)) for a in req.algorithms]
+        return robot.spec, inverses
+    spec, kin, _ = build_robot(req.robot)
+    inverses = []
+    for algorithm in req.algorithms:
+        if algorithm == "extended":
+            aspec, _, aug = build_augmentation(spec, kin, req.augmentation)
+            inverses.append(make_inverse(kin, "extended", aspec.name, aug.parameters, spec.name))
+            continue
+        try:
+            inverses.append(
+                make_inverse(
+                    kin, algorithm, spec=spec, algorithm_parameters=_own_parameters(algorithm, req)
+                )
+            )
+        except InvalidInputError as exc:
+            raise RequestError(field_of(exc.field, str(exc)), str(exc)) from None
+    return spec, inverses
 
 
 def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
     """The request's atlas, planned (curves traced); RequestError or InvalidInputError, each
     naming the field, when it cannot be."""
-    spec, kin, _ = build_robot(req.robot)
-    if len(set(req.algorithms)) != len(req.algorithms):
-        raise RequestError("algorithms", f"name each algorithm once, got {req.algorithms}")
-    inverses = []
-    for algorithm in req.algorithms:
-        if algorithm == "extended":
-            aspec, _, used = build_augmentation(spec, kin, req.augmentation)
-            inverses.append(make_inverse(kin, "extended", aspec.name, used.parameters, spec.name))
-        else:
-            inverses.append(_inverse(kin, spec, algorithm, req))
-    vectors = [(f"path[{i}]", v, spec.r) for i, v in enumerate(req.path)]
-    vectors += [(f"shifts[{i}]", v, spec.r) for i, v in enumerate(req.shifts or [])]
-    vectors += [("reference", req.reference, spec.p)] if req.reference else []
-    for name, v, size in vectors:
-        if len(v) != size:
-            raise RequestError(name, f"must have {size} components, got {len(v)}")
+    spec, inverses = _inverses(req)
+    named = [(f"path[{i}]", v) for i, v in enumerate(req.path)]
+    named += [(f"shifts[{i}]", v) for i, v in enumerate(req.shifts or [])]
+    for name, v in named:
+        check_task_point(spec, v, name)
+    if req.reference and len(req.reference) != spec.p:
+        raise RequestError("reference", f"must have {spec.p} components, got {len(req.reference)}")
     gamma = spec.default_gamma if req.gamma is None else req.gamma
     mode = req.mode or spec.default_mode
     if (why := gamma_problem(gamma, mode)) is not None:
@@ -154,6 +171,8 @@ def result_document(res: AtlasResult, arc, leg_ends: bool) -> dict[str, Any]:
         "success": {a: res.success[k].tolist() for k, a in enumerate(algs)},
         "failures": failures,
         "leg_ends": None if legs is None else {a: nullable(legs[k]) for k, a in enumerate(algs)},
+        "outside_limits": None if res.outside_limits is None else
+        {a: int(res.outside_limits[k].sum()) for k, a in enumerate(algs)},
     }  # fmt: skip
 
 

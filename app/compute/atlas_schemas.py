@@ -15,12 +15,12 @@ from pydantic import BaseModel, ConfigDict, Field
 from jik.app.compute.schemas import (
     INTEGRAL,
     Algorithm,
-    Augmentation,
+    AnyAugmentation,
+    AnyRobot,
     Coordinate,
     Gamma,
     MaybeFloat,
     Mode,
-    Robot,
     Tolerance,
     Vector,
     per_robot,
@@ -43,7 +43,11 @@ class AtlasRequest(BaseModel):
 
     model_config = ConfigDict(extra="forbid")
 
-    robot: Robot = Field(description="the robot and its parameters, e.g. {'name': 'manipulator2'}")
+    robot: AnyRobot = Field(
+        description="the robot and its parameters, e.g. {'name': 'manipulator2'}, a catalogue "
+        "arm {'name': 'panda', 'task': 'pose'} or a robot defined in the request (planar_chain, "
+        "formula, urdf)"
+    )
     algorithms: Annotated[list[Algorithm], Field(min_length=1, max_length=5)] = Field(
         ["pseudoinverse"],
         description="the algorithms to compare over the same starts, each once: 'pseudoinverse' "
@@ -53,7 +57,7 @@ class AtlasRequest(BaseModel):
         None, description="parameters of the damped, weighted and posture algorithms (each "
         "takes its own; default: the engine's)",
     )  # fmt: skip
-    augmentation: Augmentation | None = Field(
+    augmentation: AnyAugmentation | None = Field(
         None, description="augmenting map of the extended inverse (default: the robot's)"
     )
     path: Annotated[list[Vector], Field(min_length=2, max_length=MAX_PATH_POINTS)] = Field(
@@ -107,9 +111,10 @@ def _atlas_fields(spec, augmentation) -> dict:
     }  # fmt: skip
 
 
-#: ``POST /atlas``'s body: an :class:`AtlasRequest` with its robot's lengths and maps.
-#: The catalogue's robots only: an atlas of a user robot is `jik atlas --robot FILE`'s.
-AtlasBody = per_robot(AtlasRequest, _atlas_fields, user_robots=False)
+#: ``POST /atlas``'s body: an :class:`AtlasRequest` with its robot's lengths and maps (a
+#: robot defined in the request, or a catalogue arm, keeps the base's vectors, checked against
+#: the built robot).
+AtlasBody = per_robot(AtlasRequest, _atlas_fields)
 
 
 class AtlasResult(BaseModel):
@@ -130,6 +135,10 @@ class AtlasResult(BaseModel):
     leg_ends: dict[str, list[list[list[list[MaybeFloat]]]]] | None = Field(
         None, description="per algorithm (P, N, cycles * L, p), when asked for"
     )
+    outside_limits: dict[str, int] | None = Field(
+        None, description="per algorithm, the runs whose start or some leg end is outside the "
+        "robot's joint limits; null for a robot without limits",
+    )  # fmt: skip
 
 
 class AtlasJobResponse(BaseModel):

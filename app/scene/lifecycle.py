@@ -163,6 +163,8 @@ class DashboardScene:
                 mechanism=type(next(iter(self.nodes.mechanisms.values()), None)).__name__,
                 joints=len(getattr(next(iter(self.nodes.mechanisms.values()), None), "joints",
                                    ())),
+                pose_frames=sum(type(h).__name__ == "FrameHandle"
+                                for h in self.nodes.fixtures.values()),
             )  # fmt: skip
         self._show_status(result)
 

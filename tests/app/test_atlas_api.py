@@ -239,18 +239,20 @@ def test_a_session_reads_a_job_that_left_gamma_and_mode_to_the_robot(client):
     assert "γ = 1, continuous mode" in r.json()["figure"]["layout"]["title"]["text"]
 
 
-def test_an_atlas_takes_the_catalogues_robots_and_says_so(client):
-    """The document offers /atlas the catalogue's robots only (a user robot's atlas is `jik
-    atlas --robot FILE`'s): a URDF robot is a 422 naming those three, not a 500 (schemathesis's
-    coverage phase); leg_ends is a boolean, not 0."""
+def test_an_atlas_takes_every_robot_and_refuses_a_bad_one_naming_the_field(client):
+    """The document offers /atlas the catalogue's robots, its arms and the robots a request
+    defines: a URDF robot without links is a 422 naming the robot, not a 500
+    (schemathesis's coverage phase); an unknown name lists them all; leg_ends is a boolean."""
     urdf = {"name": "urdf", "urdf": "<robot name='r'/>", "end_link": "tool"}
     r = client.post("/atlas", json=body(robot=urdf))
     assert r.status_code == 422, r.text
     (error,) = r.json()["detail"]
-    assert error["loc"] == ["body", "robot"]
-    assert error["msg"].endswith("choose one of ['manipulator1', 'manipulator2', 'unicycle']")
+    assert error["loc"][:2] == ["body", "robot"] and "no links" in error["msg"], error
+    r = client.post("/atlas", json=body(robot={"name": "nao"}))
+    (error,) = r.json()["detail"]
+    assert "'panda'" in error["msg"] and "'urdf'" in error["msg"], error
     names = client.get("/openapi.json").json()["components"]["schemas"]
-    assert "AtlasUrdfRequest" not in names and "AtlasManipulator2Request" in names
+    assert {"AtlasUrdfRequest", "AtlasPandaRequest", "AtlasManipulator2Request"} <= set(names)
     r = client.post("/atlas", json=body(leg_ends=0))
     assert r.status_code == 422 and r.json()["detail"][0]["loc"] == ["body", "leg_ends"]
 
