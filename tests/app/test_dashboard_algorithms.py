@@ -197,3 +197,27 @@ def test_damped_reports_its_task_error_at_the_reach_boundary():
     why = said[("damped", "why")]
     assert "task error at the end of its legs up to 0.5" in why
     assert "where the pseudoinverse stalled at task error 1.22, it got to 0.5" in why
+
+
+def test_the_atlas_figure_has_a_heatmap_per_algorithm_on_one_colour_scale(three):
+    """Three algorithms' drift over the same starts: three heatmaps side by side, one shared
+    colour axis spanning all, each titled in its algorithm's colour (plotly validates it)."""
+    import plotly.graph_objects as go
+
+    from jik.app.dashboard.atlas import atlas_figure
+
+    request = atlas_request(three.state, 4, cycles=2)
+    decades = {"pseudoinverse": -1.0, "extended": -15.0, "posture": -3.0}
+    result = {
+        "algorithms": THREE, "parameter": [-0.2, 0.0, 0.1, 0.3], "paths": [request.path],
+        "drift": {a: np.full((1, 4, 2), 10.0**d).tolist() for a, d in decades.items()},
+    }  # fmt: skip
+    spec = atlas_figure(result, request)
+    maps = [t for t in spec["data"] if t["type"] == "heatmap"]
+    assert [t["coloraxis"] for t in maps] == ["coloraxis"] * 3
+    assert [t["xaxis"] for t in maps] == ["x", "x2", "x3"]
+    axis = spec["layout"]["coloraxis"]
+    assert axis["cmin"] <= -14 and axis["cmax"] >= -1
+    titles = [a["font"]["color"] for a in spec["layout"]["annotations"] if "font" in a]
+    assert [COLORS[a] for a in THREE] == titles[:3]
+    go.Figure(spec)  # (validated)
