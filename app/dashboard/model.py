@@ -2,9 +2,10 @@
 
 A change (:func:`updated_state`) is a patch of state fields or of control keys
 (:func:`jik.app.dashboard.controls.expand`); each refusal names its field
-(:attr:`jik.engine.exceptions.InvalidInputError.field`). :func:`cache_key` and :func:`runs_key`
-say what a run depends on (gamma only rescales theta in continuous mode, see
-:mod:`jik.app.dashboard.results`).
+(:attr:`jik.engine.exceptions.InvalidInputError.field`). The chosen algorithms and their
+parameters are checked by :mod:`jik.app.dashboard.algorithms`, which also says what a run
+depends on (``cache_key``, ``runs_key``); a change's request body is
+:mod:`jik.app.dashboard.patch`.
 """
 
 from __future__ import annotations
