@@ -45,7 +45,9 @@ function showProgress(fraction, elapsed, phase = "runs", what = "") {
     : `stop computing ${what}: the result on screen stays, without E1, E2 and their sensitivity`;
   const percent = Math.round(100 * fraction);
   $("#progress-bar").style.width = `${percent}%`;
-  $("#progress-text").textContent = runs ? `computing ${percent}%` : `computing ${what} ${percent}%`;
+  // (the runs of a new state may first wait for their map's synthesis, which says so)
+  const doing = runs && (!what || what === "the runs") ? "computing" : `computing ${what}`;
+  $("#progress-text").textContent = `${doing} ${percent}%`;
 }
 
 function onState(msg, force = false) {
@@ -176,7 +178,7 @@ function cancel() {
 function onProgress(msg) {
   if (msg.generation !== session.generation) return;
   if (msg.phase !== "second") {
-    showProgress(msg.fraction, msg.elapsed);
+    showProgress(msg.fraction, msg.elapsed, "runs", msg.what);
     return;
   }
   const wanted = () => page.second === msg.generation && page.shown === msg.generation

@@ -26,6 +26,7 @@ from jik.app.dashboard.plotting import AXIS, UNITS, figure, norm_unit
 from jik.app.dashboard.robots import state_spec
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS
+from jik.engine.self_motion import project
 
 #: Drift below this is drawn as this (the extended Jacobian's drift is round-off, ~1e-13).
 DRIFT_FLOOR = 1e-14
@@ -45,6 +46,7 @@ def atlas_request(
     kin, _ = kinematics_and_map(state)
     home = np.asarray(kin.forward(np.asarray(state.x0, dtype=float)), dtype=float)
     params = {k: v for a in state.algorithms for k, v in inverse_parameters(state, a, kin).items()}
+    points = manifold_starts(state, kin, starts) if kin.p - kin.r > 1 else None
     robot, augmentation = request_robot(state)
     return AtlasRequest.model_validate({
         "robot": robot,
@@ -52,9 +54,39 @@ def atlas_request(
         "augmentation": augmentation,
         "path": [home.tolist(), *[list(p) for p in state.path]],
         "starts": starts, "cycles": cycles or state.cycles, "reference": list(state.x0),
+        "start_points": points,
         "scales": list(scales) if scales else None, "gamma": state.gamma, "mode": state.mode,
         "tolerance": state.tolerance,
     })  # fmt: skip
+
+
+#: Explicit starts lie within this fraction of the configuration box's width around x0.
+START_SPREAD = 0.15
+
+
+def manifold_starts(state: DashboardState, kin, n: int) -> list[list[float]]:
+    """``n`` starts on the self-motion manifold k(x) = k(x0) of a robot with p - r > 1 (not a
+    curve: the atlas takes them explicitly), x0 first, then farther and farther: x0 plus a
+    step along a random direction of the null space of J(x0) (seeded: the same starts for the
+    same state), the step growing to START_SPREAD of the box, projected back onto the manifold
+    by Newton steps with the pseudoinverse; those that leave the box or do not reach the
+    manifold are left out."""
+    x0 = np.asarray(state.x0, dtype=float)
+    y0 = kin.forward(x0)
+    J = np.asarray(kin.jacobian(x0), dtype=float)
+    null = np.eye(kin.p) - np.linalg.pinv(J) @ J
+    d = np.random.default_rng(0).standard_normal((n, kin.p)) @ null
+    d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
+    box = np.asarray(state_spec(state).x_range, dtype=float)
+    widths = box[:, 1] - box[:, 0]
+    width = float(np.min(widths[np.isfinite(widths)], initial=2 * np.pi))
+    step = START_SPREAD * width * np.linspace(0.0, 1.0, n)
+    X = project(kin, x0 + step[:, None] * d, y0)
+    X[0] = x0
+    ok = (np.linalg.norm(kin.forward(X) - y0, axis=1) < 1e-10) & np.all(
+        (X >= box[:, 0]) & (X <= box[:, 1]), axis=1
+    )
+    return X[ok].tolist()
 
 
 def request_robot(state: DashboardState) -> tuple[dict, dict | None]:
@@ -85,6 +117,10 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
     scales = request.scales or [1.0]
     joint = UNITS.get(request.robot.name, ((), ()))[0]
     unit = norm_unit(joint)
+    x_title, hover, at_x0 = f"arc length s of the start {unit}", "s = %{x:.3f}", 0.0
+    if request.start_points:  # (p - r > 1: starts by number, the first x0, see manifold_starts)
+        s = np.arange(1.0, len(request.start_points) + 1)
+        x_title, hover, at_x0 = "start, farther from x0 to the right", "start %{x}", 1.0
     rows, labels = [], []
     P, N = len(result["paths"]), len(s)
     for j in range(P):
@@ -106,17 +142,18 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
             "type": "heatmap", "x": s, "y": labels, "z": np.log10(np.maximum(z, DRIFT_FLOOR)),
             "customdata": runs.tolist(), "coloraxis": "coloraxis", "xaxis": f"x{axis}",
             "yaxis": f"y{axis}",
-            "hovertemplate": "s = %{x:.3f}<br>%{y}<br>log10 drift = %{z:.2f}"
+            "hovertemplate": f"{hover}<br>%{{y}}<br>log10 drift = %{{z:.2f}}"
             f"<extra>{a}</extra>", "hoverongaps": False, "xgap": 0, "ygap": 1,
         })  # fmt: skip
         lo = k * (width + gap)
         layout[f"xaxis{axis}"] = {
             **AXIS, "domain": [lo, lo + width], "anchor": f"y{axis}",
-            "title": {"text": f"arc length s of the start {unit}"},
+            "title": {"text": x_title},
         }  # fmt: skip
         # s = 0 is x0, the start of the state the atlas was asked for
         layout["shapes"].append({
-            "type": "line", "xref": f"x{axis}", "yref": f"y{axis} domain", "x0": 0, "x1": 0,
+            "type": "line", "xref": f"x{axis}", "yref": f"y{axis} domain", "x0": at_x0,
+            "x1": at_x0,
             "y0": 0, "y1": 1, "line": {"color": "#fff", "width": 1.5, "dash": "dot"},
         })  # fmt: skip
         layout[f"yaxis{axis}"] = {**AXIS, "anchor": f"x{axis}", "autorange": "reversed",
