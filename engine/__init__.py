@@ -44,7 +44,7 @@ Solving (the continuation algorithm, eq. (7))
     Trajectory                  a run point by point
 Repeatability (sec. 5.2.1, Table 1)
     repeatability               drive a closed path cycle after cycle -> RepeatabilityResult
-    Resume, Leg                 go on from an earlier run; a leg as a progress sees it
+    Resume, Leg                 an earlier run to go on from (as x0); a leg as a progress sees it
     Progress, ProgressCallbacks what a long computation reports, and how to cancel it
 Functionals and synthesis (secs. 3-4)
     error_functional_e1, error_functional_e2  E1, eq. (14), and E2, eq. (19), on a region

@@ -19,7 +19,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Protocol
 
-from jik.engine.exceptions import RunCancelled
+from jik.engine.exceptions import JikError, RunCancelled
 
 if TYPE_CHECKING:
     from jik.engine.repeatability import Leg
@@ -29,7 +29,8 @@ class Progress(Protocol):
     """What the engine tells a caller during a long computation, and asks it.
 
     Subclass it and override what you need (each method does nothing by default), or give any
-    object with these three methods. What a method raises propagates and stops the computation.
+    object with these methods (``stop_at_error`` may be left out: False). What a method raises
+    propagates and stops the computation.
     """
 
     def leg(self, leg: Leg) -> None:
@@ -45,6 +46,12 @@ class Progress(Protocol):
         :class:`jik.engine.exceptions.RunCancelled`."""
         return False
 
+    def stop_at_error(self, error: JikError) -> bool:
+        """A leg of a repeatability run from one start raised ``error`` (a map undefined where
+        the leg starts, an algorithmic singularity of (11) there): True ends the run there with
+        what it has, that leg failed with ``Leg.stopped_by = error``; False lets it propagate."""
+        return False
+
 
 @dataclass(frozen=True)
 class ProgressCallbacks(Progress):
@@ -58,11 +65,14 @@ class ProgressCallbacks(Progress):
         ``on_advance(done, total)``, called as :meth:`Progress.advance`.
     is_cancelled : callable, optional
         ``is_cancelled() -> bool``, polled as :meth:`Progress.cancelled`.
+    stop_at_errors : bool
+        The answer of :meth:`Progress.stop_at_error` (default False: errors propagate).
     """
 
     on_leg: Callable[[Leg], None] | None = None
     on_advance: Callable[[float, float], None] | None = None
     is_cancelled: Callable[[], bool] | None = None
+    stop_at_errors: bool = False
 
     def leg(self, leg: Leg) -> None:
         if self.on_leg is not None:
@@ -74,6 +84,16 @@ class ProgressCallbacks(Progress):
 
     def cancelled(self) -> bool:
         return self.is_cancelled is not None and bool(self.is_cancelled())
+
+    def stop_at_error(self, error: JikError) -> bool:
+        return self.stop_at_errors
+
+
+def stops_at(progress: Progress | None, error: JikError) -> bool:
+    """Whether ``progress`` ends a run at ``error`` (:meth:`Progress.stop_at_error`) rather
+    than let it propagate; False without a progress or without that method."""
+    ask = getattr(progress, "stop_at_error", None)
+    return ask is not None and bool(ask(error))
 
 
 def check_cancelled(progress: Progress | None, what: str) -> None:

@@ -6,8 +6,9 @@ space. The extended Jacobian inverse (11) is repeatable by design; the pseudoinv
 :func:`repeatability` is the one loop over cycles and legs in jik: a batch runs it for a map of
 starts, and an interactive caller (the dashboard) for one start, with a
 :class:`jik.engine.progress.Progress` that sees every leg as it ends, hears a cancellation
-between legs (and between the pieces of a long discrete leg) and the progress within such a leg;
-``resume`` goes on with more cycles from the end of a run it already has.
+between legs (and between the pieces of a long discrete leg) and the progress within such a leg,
+and decides whether a leg that raises ends the run or the error propagates. A :class:`Resume`
+given as the start goes on with more cycles from the end of a run the caller already has.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ import numpy as np
 from jik.engine.exceptions import InvalidInputError, JikError, format_vector
 from jik.engine.inverses import Inverse
 from jik.engine.picard_guesses import chain_guesses
-from jik.engine.progress import Progress, check_cancelled
+from jik.engine.progress import Progress, check_cancelled, stops_at
 from jik.engine.results import BatchSolveResult, RepeatabilityResult, SolveResult, Trajectory
 from jik.engine.solve_chunks import solve_in_chunks
 from jik.engine.solver import solve, solve_batch
@@ -44,7 +45,8 @@ POLL_ITERATIONS = 80
 
 @dataclass(frozen=True)
 class Resume:
-    """Cycles already driven, for :func:`repeatability` to go on from their end.
+    """Cycles already driven from ``x0``, for :func:`repeatability` (given as its ``x0``) to go
+    on from their end.
 
     A leg of eq. (7) depends only on where it starts and on its target, so going on from the
     end of c cycles gives the numbers of a run from x0, bit for bit, when the next cycle's Picard
@@ -52,6 +54,8 @@ class Resume:
 
     Attributes
     ----------
+    x0 : array_like, shape (p,) or (n, p)
+        The start(s) of the run.
     legs : array_like, shape (c * L, p) or (n, c * L, p)
         The configuration after each leg of the first c cycles: ``legs`` of a run of c cycles
         (every leg converged) from the same x0, path and settings.
@@ -61,6 +65,7 @@ class Resume:
         inverse's next cycle starts its sweeps cold: the same legs to the sweep tolerance.
     """
 
+    x0: FloatArray
     legs: FloatArray
     guides: Sequence[Trajectory | None] = ()
 
@@ -69,7 +74,7 @@ class Resume:
         """Go on from ``result`` (the guides come from its ``leg_results``, if recorded)."""
         L = result.targets.shape[-2]
         guides = [r.trajectory for r in result.leg_results[-L:]] if result.leg_results else []
-        return cls(result.legs, guides)
+        return cls(result.x0, result.legs, guides)
 
 
 @dataclass(frozen=True)
@@ -87,8 +92,9 @@ class Leg:
         One start: its SolveResult, with the leg's trajectory (theta from 0) when ``record``.
         A batch: the k members' BatchSolveResult.
     stopped_by : JikError or None
-        With ``on_undefined="stop"``, the error the leg's solve raised; ``result`` is then the
-        leg's start alone (one point, ``success=False``).
+        The error the leg's solve raised, when the progress stopped the run there
+        (:meth:`Progress.stop_at_error`); ``result`` is then the leg's start alone (one point,
+        ``success=False``).
     """
 
     cycle: int
@@ -161,8 +167,6 @@ def repeatability(
     max_iterations: int | None = None,
     record: bool = False,
     close: bool = True,
-    resume: Resume | None = None,
-    on_undefined: str = "raise",
     progress: Progress | None = None,
 ) -> RepeatabilityResult:
     """Drive the robot through ``path`` and back to k(x0), ``cycles`` times, each leg by eq. (7).
@@ -170,8 +174,10 @@ def repeatability(
     Parameters
     ----------
     inverse : Inverse
-    x0 : array_like, shape (p,) or (n, p)
-        Start configuration(s); a batch runs every leg as one vectorized solve.
+    x0 : array_like, shape (p,) or (n, p), or Resume
+        Start configuration(s); a batch runs every leg as one vectorized solve. A
+        :class:`Resume` (cycles already driven from its ``x0``): the run goes on from their end,
+        and the result is that of a run from its x0 (``leg_results`` holds the new legs only).
     path : array_like, shape (L, r) or (n, L, r)
         Task points visited in order (one path for all starts, or one per start); k(x0) is
         appended when the last point differs from it.
@@ -184,19 +190,15 @@ def repeatability(
     close : bool
         False: the legs are the points of ``path`` as given, without the return leg to k(x0)
         (one solve to a target is the run of one such leg).
-    resume : Resume, optional
-        Cycles already driven (:class:`Resume`): the run goes on from their end, and the result
-        is that of a run from x0 (``leg_results`` holds the new legs only).
-    on_undefined : {"raise", "stop"}
-        What a leg's solve raising a typed error does (a map undefined where the leg starts,
-        an algorithmic singularity (11) there): "raise" it; or, one start only, "stop" the run
-        there with what it has, as a failed leg whose ``Leg.stopped_by`` is the error.
     progress : Progress, optional
         Told every leg as it ends (:meth:`Progress.leg`, with a :class:`Leg`: the last one too,
         whether it converged or not), asked before every leg whether to go on
         (:meth:`Progress.cancelled`). In discrete mode with one start, each leg runs as solves of
         at most :data:`POLL_ITERATIONS` iterations (the same iterates), between which it is
         asked too and told the leg's progress (:meth:`Progress.advance`, a fraction of 1).
+        With one start, a leg whose solve raises a typed error (a map undefined where the leg
+        starts, an algorithmic singularity (11) there) asks it whether to end the run there
+        with what it has (:meth:`Progress.stop_at_error`).
 
     Returns
     -------
@@ -207,14 +209,16 @@ def repeatability(
     Raises
     ------
     InvalidInputError
-        Bad shapes, or ``on_undefined="stop"`` with a batch.
+        Bad shapes, or a :class:`Resume` that is not whole cycles of this run.
     JikError
-        A leg's solve raised (a singular start configuration) and ``on_undefined`` is "raise".
+        A leg's solve raised (a singular start configuration) and the progress, if any, did not
+        stop the run there.
     RunCancelled
         ``progress.cancelled()`` returned True.
     """
     kin = inverse.kinematics
-    x0 = kin.check(x0, "x0")
+    resume = x0 if isinstance(x0, Resume) else None
+    x0 = kin.check(x0 if resume is None else resume.x0, "x0")
     path = kin.check_task(path, "path")
     if path.ndim not in (2, 3) or path.shape[-2] < 1:
         raise InvalidInputError("path must be a list of task points, shape (L, r) with L >= 1")
@@ -229,10 +233,6 @@ def repeatability(
         raise InvalidInputError("x0 must be one configuration or a 2-D batch")
     if path.ndim == 3 and len(path) != len(xb):
         raise InvalidInputError(f"{len(path)} paths given for {len(xb)} start configurations")
-    if on_undefined not in ("raise", "stop"):
-        raise InvalidInputError(f"on_undefined must be 'raise' or 'stop', got {on_undefined!r}")
-    if on_undefined == "stop" and not single:
-        raise InvalidInputError("on_undefined='stop' needs one start configuration")
     chunked = progress is not None and mode == "discrete" and single
     if close:
         targets = closed_path(kin, xb, path)  # (n, L, r)
@@ -299,7 +299,7 @@ def repeatability(
                         inverse, current[ids], targets[ids, j], record=False, **settings
                     )
             except JikError as exc:
-                if on_undefined == "raise":
+                if not (single and stops_at(progress, exc)):
                     raise
                 res = _stopped_leg(inverse, current[0], targets[0, j], exc, mode, gamma, record)
                 stopped = exc

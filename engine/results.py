@@ -173,7 +173,7 @@ class BatchSolveResult:
     _rec_member: FloatArray | None = field(repr=False, default=None)
     _rec_theta: FloatArray | None = field(repr=False, default=None)
     _rec_x: FloatArray | None = field(repr=False, default=None)
-    # Each member's outcome (_CONVERGED, _SINGULAR, ...): solve_in_chunks words its message.
+    # Each member's outcome (solve_rules.Status): solve_in_chunks words its message.
     _status: FloatArray | None = field(repr=False, default=None)
 
     def __len__(self) -> int:

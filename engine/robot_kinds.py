@@ -23,6 +23,16 @@ class DefinitionField:
     example: object = None
 
 
+#: Optional joint limits, a field of the planar chains and the formula robots (a URDF's are in
+#: its joints).
+LIMITS = DefinitionField(
+    "limits",
+    "points",
+    False,
+    "joint limits, one [lower, upper] per variable (null: no bound); runs report whether they "
+    "stayed within them",
+)
+
 PLANAR_CHAIN = (
     DefinitionField(
         "joints", "string", True, "joint types in order, base first: R revolute, P prismatic", "RRR"
@@ -41,13 +51,7 @@ PLANAR_CHAIN = (
         "also the end's angle as a task component (r = 3; default false: the end point, r = 2)",
         False,
     ),
-    DefinitionField(
-        "limits",
-        "points",
-        False,
-        "joint limits, one [lower, upper] per "
-        "variable (null: no bound); runs report whether they stayed within them",
-    ),
+    LIMITS,
 )
 
 FORMULA = (
@@ -63,13 +67,7 @@ FORMULA = (
         ["x2 + l*cos(x3)", "x1 + l*sin(x3)"],
     ),
     DefinitionField("parameters", "mapping", False, "named constants of the formulas", {"l": 1.0}),
-    DefinitionField(
-        "limits",
-        "points",
-        False,
-        "joint limits, one [lower, upper] per "
-        "variable (null: no bound); runs report whether they stayed within them",
-    ),
+    LIMITS,
 )
 
 URDF = (

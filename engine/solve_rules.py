@@ -11,7 +11,6 @@ from jik.engine.validation import FloatArray, positive
 
 #: The smallest task-error tolerance ``tol`` of a solve (double precision).
 TOL_MIN = 1e-14
-#: Tolerances of the continuous integrator on x (relative and absolute).
 #: Default caps of :func:`solve`: integrator steps (continuous), iterations (discrete).
 MAX_STEPS = 20000
 MAX_ITERATIONS = 2000

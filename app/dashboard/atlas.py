@@ -20,6 +20,7 @@ from jik.app.compute.atlas_schemas import AtlasRequest
 from jik.app.dashboard.analysis import kinematics_and_map
 from jik.app.dashboard.model import DashboardState
 from jik.app.dashboard.plotting import AXIS, UNITS, figure, norm_unit
+from jik.app.dashboard.robots import state_spec
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS
 
@@ -41,15 +42,34 @@ def atlas_request(
         )
     kin, _ = kinematics_and_map(state)
     home = np.asarray(kin.forward(np.asarray(state.x0, dtype=float)), dtype=float)
+    robot, augmentation = request_robot(state)
     return AtlasRequest.model_validate({
-        "robot": {"name": state.robot, **state.robot_parameters},
+        "robot": robot,
         "algorithms": ["pseudoinverse", "extended"],
-        "augmentation": {"name": state.augmentation, **state.augmentation_parameters},
+        "augmentation": augmentation,
         "path": [home.tolist(), *[list(p) for p in state.path]],
         "starts": starts, "cycles": cycles or state.cycles, "reference": list(state.x0),
         "scales": list(scales) if scales else None, "gamma": state.gamma, "mode": state.mode,
         "tolerance": state.tolerance,
     })  # fmt: skip
+
+
+def request_robot(state: DashboardState) -> tuple[dict, dict | None]:
+    """A state's robot and map as a request gives them: a catalogue robot with its parameters
+    and its map by name; a robot given by a definition (a user's, a catalogue arm) by that
+    definition, with its chosen map as the definition's entry (None: the robot's default map,
+    such as a catalogue arm's synthesized one)."""
+    if state.robot_definition is None:
+        return ({"name": state.robot, **state.robot_parameters},
+                {"name": state.augmentation, **state.augmentation_parameters})  # fmt: skip
+    definition = dict(state.robot_definition)
+    entries = definition.pop("augmentations", None) or []
+    if state.augmentation == state_spec(state).default_augmentation:
+        chosen = entries[0] if entries else None
+    else:
+        chosen = next(e for e in entries if e.get("label", e.get("name")) == state.augmentation)
+    return definition, None if chosen is None else {k: v for k, v in chosen.items()
+                                                    if k != "label"}  # fmt: skip
 
 
 def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
@@ -99,16 +119,19 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
                                   "showticklabels": k == 0, "type": "category"}  # fmt: skip
     names = [TITLES.get(a, a) + (f"<br>h = {request.augmentation.name}" if a == "extended"
              and request.augmentation is not None else "") for a in algorithms]  # fmt: skip
+    outside = outside_counts(result)
     for k, name in enumerate(names):
         lo = k * (width + 0.08)
         note = f", {failed[k]} starts failed (blank)" if failed[k] else ""
+        if algorithms[k] in outside:
+            note += f"<br>{outside[algorithms[k]]} of {P * N} runs left the joint limits"
         layout["annotations"].append({
             "text": name + note, "x": lo + width / 2, "y": 1.0, "xref": "paper", "yref": "paper",
             "xanchor": "center", "yanchor": "bottom", "showarrow": False, "font": {"size": 11},
         })  # fmt: skip
-    spec = ROBOTS[request.robot.name]  # (a job of POST /atlas may leave them to the robot)
-    gamma = spec.default_gamma if request.gamma is None else request.gamma
-    mode = request.mode or spec.default_mode
+    spec = ROBOTS.get(request.robot.name)  # (a job of POST /atlas may leave them to the robot)
+    gamma = request.gamma if spec is None or request.gamma is not None else spec.default_gamma
+    mode = request.mode or (spec.default_mode if spec is not None else "continuous")
     title = (f"Drift after each cycle from {N} starts on k(x) = k(x0) (dotted: x0), "
              f"{request.robot.name}, γ = {gamma:g}, {mode} mode")  # fmt: skip
     logs = np.concatenate([np.ravel(t["z"]) for t in data])
@@ -128,6 +151,14 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
         margin=dict(l=110, r=20, t=84, b=56),
         **layout,
     )
+
+
+def outside_counts(result: dict[str, Any]) -> dict[str, int]:
+    """How many runs of each algorithm left the robot's joint limits (an atlas of a robot with
+    limits reports them as ``outside_limits``: a count, or a flag per run); empty without."""
+    reported = result.get("outside_limits") or {}
+    return {a: int(v) if isinstance(v, int | float) else int(np.count_nonzero(v))
+            for a, v in reported.items() if v is not None}  # fmt: skip
 
 
 __all__ = ["atlas_figure", "atlas_request"]

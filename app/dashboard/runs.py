@@ -115,7 +115,7 @@ def _run_legs(
         offset = float(resume.theta[-1])
         done = (len(resume.drift) - 1) * L  # (the legs before its last cycle)
         guides = [_leg_trajectory(resume, done + j) for j in range(L)] if continuous else []
-        earlier = Resume(resume.leg_end, guides)
+        earlier = Resume(x0, resume.leg_end, guides)
 
     def on_leg(leg: Leg) -> None:
         nonlocal offset, last, failure
@@ -139,10 +139,11 @@ def _run_legs(
     path, close = (state.path, True) if state.task == "path" else (targets, False)
     try:
         run = repeatability(
-            inverse, x0, path, cycles, gamma=1.0 if continuous else state.gamma, mode=state.mode,
+            inverse, x0 if earlier is None else earlier, path, cycles,
+            gamma=1.0 if continuous else state.gamma, mode=state.mode,
             tol=state.tolerance, max_iterations=cap, record=True, close=close,
-            resume=earlier, on_undefined="stop", progress=ProgressCallbacks(
-                on_leg, lambda done, total: partial(done / total), cancelled),
+            progress=ProgressCallbacks(on_leg, lambda done, total: partial(done / total),
+                                       cancelled, stop_at_errors=True),
         )  # fmt: skip
     except RunCancelled:
         raise Cancelled from None

@@ -169,6 +169,8 @@ class DashboardScene:
                 generation=result.generation, robot=state.robot, playing=self.playback.playing,
                 mechanism=type(next(iter(self.nodes.mechanisms.values()), None)).__name__,
                 joints=len(getattr(self.nodes.mechanisms.get("extended"), "joints", ())),
+                pose_frames=sum(type(h).__name__ == "FrameHandle"
+                                for h in self.nodes.fixtures.values()),
             )  # fmt: skip
         self._show_status(result)
 

@@ -204,3 +204,17 @@ def test_a_progress_implements_only_what_it_shows():
     assert progress.seen == [(c, j) for c in range(2) for j in range(4)]
     np.testing.assert_array_equal(watched.legs, plain.legs)
     assert watched.message == plain.message and watched.success
+
+
+def test_repeatability_takes_its_run_and_one_progress_no_other_hooks():
+    """The run's own settings and one Progress: going on from an earlier run is a Resume given
+    as the start, and stopping at a leg's error is the progress's answer."""
+    import inspect
+
+    params = inspect.signature(jik.repeatability).parameters
+    names = "inverse x0 path cycles gamma mode tol max_iterations record close progress"
+    assert list(params) == names.split()
+    inv = jik.Pseudoinverse(jik.Manipulator2())
+    part = jik.repeatability(inv, X0, PATH, cycles=1)
+    rest = jik.repeatability(inv, jik.Resume.of(part), PATH, cycles=2)
+    np.testing.assert_array_equal(rest.legs, jik.repeatability(inv, X0, PATH, cycles=2).legs)

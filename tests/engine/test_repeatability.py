@@ -226,8 +226,7 @@ def test_resume_equals_a_run_from_the_start_bit_for_bit(algorithm, kwargs, monke
     part = repeatability(inv, TABLE1_X0, TABLE1_PATH, cycles=2, record=True, **kwargs)
     seen = []
     kwargs = kwargs | {"progress": ProgressCallbacks(seen.append)}
-    rest = repeatability(inv, TABLE1_X0, TABLE1_PATH, cycles=4, record=True, **kwargs,
-                         resume=Resume.of(part))  # fmt: skip
+    rest = repeatability(inv, Resume.of(part), TABLE1_PATH, cycles=4, record=True, **kwargs)
     assert cold.success and rest.success and rest.message == cold.message
     for name in ("legs", "cycle_end", "drift"):
         np.testing.assert_array_equal(getattr(rest, name), getattr(cold, name), name)
@@ -243,7 +242,7 @@ def test_resume_a_batch_equals_a_run_from_the_start():
     path = np.array([(0.5, 1.0), (0.8, 1.5)])
     cold = repeatability(inv, starts, path, cycles=3)
     part = repeatability(inv, starts, path, cycles=1)
-    rest = repeatability(inv, starts, path, cycles=3, resume=Resume(part.legs))
+    rest = repeatability(inv, Resume(starts, part.legs), path, cycles=3)
     np.testing.assert_array_equal(rest.legs, cold.legs)
     np.testing.assert_array_equal(rest.drift, cold.drift)
 
@@ -276,9 +275,10 @@ def test_discrete_chunks_equal_an_unchunked_run(monkeypatch):
 
 
 def test_a_leg_that_raises_stops_the_run_with_the_legs_before_it(monkeypatch):
-    """on_undefined="stop": a leg whose solve raises (here the second, patched to) ends the run
-    there: the legs before it are kept, the stopped leg is its start alone, the message names
-    it. By default the error propagates."""
+    """A progress that stops at errors: a leg whose solve raises (here the second, patched to)
+    ends the run there: the legs before it are kept, the stopped leg is its start alone, the
+    message names it. By default (no progress, or one that does not stop) the error
+    propagates."""
     module = importlib.import_module("jik.engine.repeatability")
 
     calls = []
@@ -299,8 +299,7 @@ def test_a_leg_that_raises_stops_the_run_with_the_legs_before_it(monkeypatch):
         TABLE1_PATH,
         cycles=2,
         record=True,
-        progress=ProgressCallbacks(seen.append),
-        on_undefined="stop",
+        progress=ProgressCallbacks(seen.append, stop_at_errors=True),
     )
     assert not res.success
     assert res.message.startswith("cycle 1, leg 2 stopped: h is undefined here at x = ")
@@ -311,20 +310,25 @@ def test_a_leg_that_raises_stops_the_run_with_the_legs_before_it(monkeypatch):
     np.testing.assert_array_equal(stop.trajectory.x, res.legs[:1])
     np.testing.assert_array_equal(stop.trajectory.theta, [0.0])
     assert stop.trajectory.h is not None and len(res.leg_results) == 2
-    calls.clear()
-    with pytest.raises(AlgorithmicSingularityError, match="h is undefined here"):
-        repeatability(inv, TABLE1_X0, TABLE1_PATH, cycles=2)
+    for progress in (None, ProgressCallbacks(seen.append)):
+        calls.clear()
+        with pytest.raises(AlgorithmicSingularityError, match="h is undefined here"):
+            repeatability(inv, TABLE1_X0, TABLE1_PATH, cycles=2, progress=progress)
 
 
 def test_a_singular_start_stops_the_first_leg():
     """(36) with a = 1, b = 0 is singular on x1 = 0: a run from there stops before it moves."""
     inv = ExtendedInverse(Manipulator1(), E2Optimal(a=1.0, b=0.0))
-    for kwargs in ({}, {"mode": "discrete", "gamma": 0.5, "progress": ProgressCallbacks()}):
+    stop = ProgressCallbacks(stop_at_errors=True)
+    for kwargs in ({}, {"mode": "discrete", "gamma": 0.5}):
         with pytest.raises(AlgorithmicSingularityError):
             repeatability(inv, [0.0, 0.2, 1.0], [(1.0, 1.0)], **kwargs)
-        res = repeatability(inv, [0.0, 0.2, 1.0], [(1.0, 1.0)], on_undefined="stop", **kwargs)
+        res = repeatability(inv, [0.0, 0.2, 1.0], [(1.0, 1.0)], progress=stop, **kwargs)
         assert not res.success and res.message.startswith("cycle 1, leg 1 stopped: the extended")
         assert np.all(np.isnan(res.legs))
+    # A batch's legs are one solve for all starts: its errors propagate whatever the progress.
+    with pytest.raises(AlgorithmicSingularityError):
+        repeatability(inv, [[0.0, 0.2, 1.0], [0.5, 0.2, 1.0]], [(1.0, 1.0)], progress=stop)
 
 
 def test_open_legs_are_solves_to_their_targets():
@@ -338,23 +342,19 @@ def test_open_legs_are_solves_to_their_targets():
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
-        ({"on_undefined": "ignore"}, "on_undefined must be 'raise' or 'stop'"),
-        ({"on_undefined": "stop", "x0": [TABLE1_X0, TABLE1_X0]}, "needs one start"),
         ({"resume": "legs", "cycles": 3}, r"whole cycles of 4 legs"),
         ({"resume": "legs", "cycles": 1}, r"1 to 1 whole cycles"),
         ({"resume": "nan", "cycles": 3}, "resume.legs contains NaN"),
         ({"resume": "guides", "cycles": 3}, "one trajectory .or None. per leg, 4"),
     ],
 )
-def test_bad_hooks_are_refused(kwargs, match):
+def test_a_bad_resume_is_refused(kwargs, match):
     legs = np.tile(TABLE1_X0, (8, 1))
+    kwargs = dict(kwargs)
     resume = {
-        "legs": Resume(legs[:7]) if kwargs.get("cycles") == 3 else Resume(legs),
-        "nan": Resume(np.where(legs > 1, np.nan, legs)),
-        "guides": Resume(legs, [None]),
-    }
-    args = {"x0": TABLE1_X0} | kwargs
-    if "resume" in args:
-        args["resume"] = resume[args["resume"]]
+        "legs": Resume(TABLE1_X0, legs[:7] if kwargs.get("cycles") == 3 else legs),
+        "nan": Resume(TABLE1_X0, np.where(legs > 1, np.nan, legs)),
+        "guides": Resume(TABLE1_X0, legs, [None]),
+    }[kwargs.pop("resume")]
     with pytest.raises(InvalidInputError, match=match):
-        repeatability(_inverse("pseudoinverse"), args.pop("x0"), TABLE1_PATH, **args)
+        repeatability(_inverse("pseudoinverse"), resume, TABLE1_PATH, **kwargs)

@@ -1,0 +1,113 @@
+"""A catalogue arm in the dashboard, through the session API: picked by name it is a definition
+(its name and task) on the user robots' one path, computed with its synthesized map; the verdict
+says whether each run stayed within the joint limits, and the scene colours a joint outside
+them. Robots with p - r >= 2 run with a list of formula maps."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from jik.app.dashboard.controls import controls
+from jik.app.dashboard.joint_limits import limits_summary, outside_joints, state_limits
+from jik.app.dashboard.map_figures import augmenting_spec
+from jik.app.dashboard.model import default_state, updated_state
+from jik.app.dashboard.results import compute
+from jik.app.dashboard.robots import state_kinematics
+from jik.app.dashboard.verdict import verdict
+from jik.app.scene.arm_marks import end_frame, joint_points, target_pose
+from jik.app.scene.mechanisms import fixtures_of
+from jik.engine.arms import ARMS
+from tests.app.test_sessions import _computed, _open
+
+
+def _panda():
+    return updated_state(default_state(), {"robot": "panda"})
+
+
+def test_the_panda_is_picked_by_name_with_its_pose_task(app, client):
+    """The picker offers the four arms; the Panda's state is its definition, 7 start
+    coordinates within its limits and a closed path of 6-coordinate pose points; both
+    algorithms run: the pseudoinverse drifts, the extended inverse (its E2-synthesized map)
+    comes back, both within the joint limits, and the verdict says so."""
+    options = dict(next(c for c in controls(default_state()) if c.key == "robot").options)
+    assert set(ARMS) <= set(options) and options["panda"] == "Franka Panda (arm)"
+    session = _open(client)
+    r = client.post(f"/api/sessions/{session['id']}/state", json={"robot": "panda"})
+    assert r.status_code == 200, r.text
+    state = r.json()["state"]
+    assert state["robot_definition"] == {"name": "panda", "task": "pose"}
+    assert state["augmentation"] == "e2_synthesized"
+    assert len(state["x0"]) == 7 and all(len(p) == 6 for p in state["path"])
+    _computed(app, session["id"])
+    summary = client.get(f"/api/sessions/{session['id']}").json()["summary"]
+    assert summary["pseudoinverse"]["drift"][-1] > 1e-5
+    assert max(summary["extended"]["drift"]) < 1e-9
+    assert summary["extended"]["limits"] == {"within": True, "violation": None}
+    x0 = [c for c in controls(_panda()) if c.key.startswith("x0.")]
+    assert [(c.minimum, c.maximum) for c in x0][3] == (-3.0718, -0.0698)  # its URDF's limits
+
+
+def test_a_run_outside_the_limits_is_said_in_words_and_marked():
+    """x4 = -0.05 is above the Panda's joint 4 upper limit (-0.0698): the start is accepted,
+    the verdict names the joint, its value and the limit, and the scene's joint of x4 is the
+    one coloured."""
+    state = updated_state(_panda(), {"x0.3": -0.05})
+    result = compute(state)
+    texts = [s["text"] for s in verdict(result) if s["role"] == "warning"]
+    assert any("its start x0 is already outside them, joint x4 (panda_joint4) = -0.05, above "
+               "its upper limit -0.0698" in t for t in texts)  # fmt: skip
+    report = limits_summary(result)["pseudoinverse"]
+    assert report["violation"]["joint"] == 3 and report["violation"]["cycle"] == 0
+    kin = state_kinematics(state)
+    assert list(outside_joints(state_limits(state), state.x0)) == [3]
+    assert joint_points(kin)[3] == 3  # (the Panda's chain has no fixed joint before x4)
+    assert not len(outside_joints(state_limits(_panda()), _panda().x0))
+
+
+def test_a_leg_leaving_the_limits_names_its_cycle_and_leg():
+    """A planar chain with limits on x2: the path takes x2 past its bound on a leg after the
+    start; the violation names that cycle and leg."""
+    arm = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6],
+           "limits": [[None, None], [0.3, 0.55], [None, None]]}  # fmt: skip
+    state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": arm})
+    result = compute(state)
+    violation = limits_summary(result)["pseudoinverse"]["violation"]
+    assert violation is not None and violation["cycle"] >= 1 and violation["leg"] >= 1
+    x = result.runs["pseudoinverse"].x
+    first = int(np.flatnonzero((x[:, 1] < 0.3) | (x[:, 1] > 0.55))[0])
+    assert violation["value"] == pytest.approx(x[first, 1])
+
+
+def test_the_scene_draws_pose_targets_as_frames():
+    """The targets of a pose task are frames R = R0 exp(phi) at their positions; k(x0) is the
+    end link's frame at x0."""
+    state = _panda()
+    result = compute(state)
+    kin = state_kinematics(state)
+    fixtures = fixtures_of(result, ((-1.0, 1.0), (-1.0, 1.0)), "/r")
+    frames = {k: v for k, v in fixtures.items() if v[0] == "frame"}
+    assert len(frames) == len(result.targets) == 4
+    home = kin.forward(np.asarray(state.x0))
+    position, q = target_pose(kin, home)
+    end = end_frame(kin, state.x0)
+    np.testing.assert_allclose(position, end[0], atol=1e-12)
+    assert abs(abs(np.dot(q, end[1])) - 1.0) < 1e-12  # (the same rotation, q or -q)
+
+
+def test_vector_maps_run_for_p_minus_r_two():
+    """A planar 4R chain with a position task (r = 2) and two formula maps of two components:
+    the extended inverse with either is repeatable, the pseudoinverse is not; the h panel says
+    what it shows."""
+    arm = {"name": "planar_chain", "joints": "RRRR", "lengths": [1.0, 0.8, 0.6, 0.4],
+           "augmentations": [{"name": "formula", "h": ["x3", "x4"]},
+                             {"name": "formula", "h": ["x2", "x4"], "label": "other"}]}  # fmt: skip
+    state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": arm})
+    for name in ("formula", "other"):
+        result = compute(updated_state(state, {"augmentation": name}))
+        assert result.runs["pseudoinverse"].drift[-1] > 1e-5
+        assert max(result.runs["extended"].drift) < 1e-9
+        panel = json.dumps(augmenting_spec(result), ensure_ascii=False)
+        assert "a vector of p − r = 2 maps" in panel and "for one degree of redundancy" in panel

@@ -1,0 +1,43 @@
+"""A catalogue arm in the dashboard: the user picks the Franka Panda (7 joints, the pose task
+x y z rx ry rz), sees it in the 3D scene with its targets as pose frames, runs both algorithms
+with its E2-synthesized map, reads in the verdict that the pseudoinverse drifts and the extended
+run comes back and stays within the joint limits, and computes the arm's atlas."""
+
+from __future__ import annotations
+
+import pytest
+
+expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
+pytestmark = [pytest.mark.browser, pytest.mark.slow]
+
+
+def test_the_panda_with_its_pose_task(tabs):
+    tab = tabs.open()
+    page = tab.page
+    generation = tab.select("#ctl-robot", "panda")
+    snapshot = tab.wait_settled(lambda s: s["state"]["robot"] == "panda", "the Panda")
+    state = snapshot["state"]
+    assert state["robot_definition"] == {"name": "panda", "task": "pose"}
+    assert len(state["x0"]) == 7 and all(len(p) == 6 for p in state["path"])
+    assert state["augmentation"] == "e2_synthesized"
+    # Its controls: seven start sliders, the path as 6-coordinate pose points.
+    for k in range(7):
+        expect(page.locator(f"#ctl-x0-{k}")).to_be_attached()
+    path = page.locator("#ctl-path")
+    assert len(path.input_value().split(";")[0].split(",")) == 6
+
+    summary = snapshot["summary"]
+    assert summary["pseudoinverse"]["drift"][-1] > 1e-5  # the pseudoinverse drifts
+    assert max(summary["extended"]["drift"]) < 1e-9  # the synthesized map keeps x0
+    for a in ("pseudoinverse", "extended"):
+        assert summary[a]["limits"] == {"within": True, "violation": None}
+    verdict = page.locator("#verdict")
+    expect(verdict).to_contain_text("pseudoinverse J^P#: not repeatable")
+    expect(verdict).to_contain_text("extended Jacobian J^E#: repeatable")
+    expect(verdict).to_contain_text("stayed within the joint limits of the Franka Panda")
+
+    scene = tab.wait_scene_drawn(generation)
+    assert scene["robot"] == "panda" and scene["mechanism"] == "Chain"
+    assert scene["joints"] == 9  # base, 7 joints, the flange (fixed joints drawn too)
+    assert scene["pose_frames"] == 4  # the path's three pose targets and k(x0)
+    tab.screenshots("arm-panda")
