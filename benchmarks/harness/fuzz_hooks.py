@@ -120,6 +120,9 @@ def _capped(body: dict) -> dict:
     if isinstance(augmentation, dict) and isinstance(augmentation.get("degree"), int):
         body["augmentation"] = {**augmentation, "degree": min(augmentation["degree"],
                                                               WORK_CAPS["degree"])}  # fmt: skip
+    if isinstance(augmentation, dict) and len(augmentation.get("region") or {}) > 3:
+        # a total-degree synthesis' work grows as C(n + d, d)^2: total degree 2 over 4-16 joints
+        body["augmentation"] = {**body["augmentation"], "degree": 2}
     robot = body.get("robot")
     if isinstance(robot, dict):
         body["robot"] = {k: min(v, ROBOT_CAPS[k]) if k in ROBOT_CAPS and isinstance(v, float)

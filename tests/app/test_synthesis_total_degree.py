@@ -104,3 +104,25 @@ def test_two_degrees_of_redundancy_give_two_maps(api):
 def test_bad_total_degree_requests_are_422_naming_the_field(api, body, field, text):
     r = api.post("/synthesize", json={"method": "e2_total_degree", **body})
     assert any(m.startswith(f"{field}: ") and text in m for m in messages(r)), messages(r)
+
+
+def test_a_requested_map_over_all_seven_joints_makes_the_pose_loop_repeatable(api):
+    """``{"name": "e2_synthesized", "region": {7 joints}}`` as a request's map: the total-degree
+    synthesis on that box; its extended inverse returns to x0 after every cycle. A total degree
+    over 6 is a 422 naming augmentation.degree."""
+    from tests.engine.test_synthesis_arms import STEPS
+
+    panda = robot_from_dict(PANDA)
+    home = np.array(panda.spec.default_x0)
+    y0 = panda.kinematics.forward(home)
+    box = {f"x{i + 1}": [home[i] - 0.2, home[i] + 0.2] for i in range(7)}
+    body = {"robot": PANDA, "algorithm": "extended", "x0": home.tolist(), "cycles": 3,
+            "path": [(y0 + np.array(step)).tolist() for step in STEPS],
+            "augmentation": {"name": "e2_synthesized", "region": box, "degree": 2}}  # fmt: skip
+    r = api.post("/repeatability", json=body)
+    assert r.status_code == 200, r.text
+    assert r.json()["success"] and r.json()["max_drift"] < 1e-9
+    body["augmentation"]["degree"] = 9
+    r = api.post("/repeatability", json=body)
+    assert any(m.startswith("augmentation.degree: ") and "between 1 and 6" in m
+               for m in messages(r)), messages(r)  # fmt: skip
