@@ -218,3 +218,28 @@ def test_a_catalogue_arm_takes_a_task(tmp_path, capsys):
             "--quiet", "--out", str(tmp_path / "m.json")]  # fmt: skip
     assert main(argv) == 2
     assert "--task is for a catalogue arm" in capsys.readouterr().err
+
+
+def test_a_urdf_arm_in_a_robot_file_equals_the_catalogue_arm(tmp_path):
+    """The Panda's URDF text given inline in a robot file (with its end link and home) gives the
+    atlas of ``--robot panda``: the same starts, drift and count of runs outside the limits."""
+    pytest.importorskip("yourdfpy")
+    from jik.engine.arms import ARMS
+
+    arm = ARMS["panda"]
+    definition = {"name": "urdf", "urdf": arm.urdf, "end_link": arm.end_link,
+                  "home": list(arm.home), "task": "pose"}  # fmt: skip
+    (tmp_path / "panda.json").write_text(json.dumps(definition))
+    path = "0.3069,0,0.5903,0,0,0; 0.38,0,0.59,0,0,0.2; 0.38,0.08,0.59,0.15,0,0.2"
+    docs = []
+    for robot in ("panda", str(tmp_path / "panda.json")):
+        out = tmp_path / f"{len(docs)}.json"
+        assert main(["atlas", "--robot", robot, "--path", path, "--starts", "6", "--cycles", "1",
+                     "--out", str(out), "--no-figure", "--quiet"]) == 0  # fmt: skip
+        docs.append(json.loads(out.read_text()))
+    by_name, by_file = docs
+    np.testing.assert_allclose(by_name["starts"], by_file["starts"], atol=1e-12)
+    np.testing.assert_allclose(np.array(by_name["results"]["pseudoinverse"]["drift"], float),
+                               np.array(by_file["results"]["pseudoinverse"]["drift"], float),
+                               atol=1e-12)  # fmt: skip
+    assert by_name["summary"] == by_file["summary"]
