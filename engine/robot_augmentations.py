@@ -61,10 +61,12 @@ def augmentations_from_dict(kin: Kinematics, items, key: str | None = None):
             unknown = set(item) - robot_kinds.augmentation_keys("e2_synthesized")
             box, fix = _region(kin, item, where)
             if len(box) <= 3:
-                degree = count(item.get("degree", 12), f"{where}.degree", 1, 24)
+                degree = count(item.get("degree", 12), f"{where}.degree", 1, 24, f"{where}.degree")
                 text = f"E2-optimal h on {box} by the Ritz solve of (20), degree {degree}"
             else:
-                degree = count(item.get("degree", TOTAL_DEGREE), f"{where}.degree", 1, 6)
+                degree = count(
+                    item.get("degree", TOTAL_DEGREE), f"{where}.degree", 1, 6, f"{where}.degree"
+                )
                 text = (
                     f"E2-optimal h of {len(box)} joints on {box}: Ritz solve of (19) in a "
                     f"total-degree {degree} basis on a Sobol rule"

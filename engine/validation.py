@@ -57,17 +57,17 @@ def finite(value, name: str) -> float:
     return v
 
 
-def count(value, name: str, low: int, high: int) -> int:
-    """Check that ``value`` is an integer in [low, high]."""
+def count(value, name: str, low: int, high: int, field: str | None = None) -> int:
+    """Check that ``value`` is an integer in [low, high] (``field``: the error's field)."""
     try:
         integral = not isinstance(value, bool) and int(value) == value
     except (TypeError, ValueError, OverflowError):
         integral = False
     if not integral:
-        raise InvalidInputError(f"{name} must be an integer, got {value!r}")
+        raise InvalidInputError(f"{name} must be an integer, got {value!r}", field)
     v = int(value)
     if not low <= v <= high:
-        raise InvalidInputError(f"{name} must be between {low} and {high}, got {v}")
+        raise InvalidInputError(f"{name} must be between {low} and {high}, got {v}", field)
     return v
 
 

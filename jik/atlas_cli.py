@@ -50,6 +50,11 @@ def add_atlas_parser(sub) -> None:
         "--robot", default="manipulator2", help="a built-in robot, or a robot file (.json, .yaml)"
     )
     p.add_argument(
+        "--task",
+        help="a catalogue arm's task: 'pose', 'xyz' or coordinates among x y z rx ry rz "
+        "(default: the arm's)",
+    )
+    p.add_argument(
         "--param",
         action="append",
         default=[],
@@ -170,17 +175,25 @@ def _run(args: argparse.Namespace) -> int:
     from jik.engine.atlas_run import iter_atlas
     from jik.engine.exceptions import InvalidInputError
     from jik.engine.registry import make_inverse, robot_spec
-    from jik.engine.robot_spec import load_robot
+    from jik.engine.robot_spec import load_robot, robot_from_dict
     from jik.engine.self_motion import MAX_ARC
 
     out = _writable(Path(args.out))
     algorithms = args.algorithm or ["pseudoinverse"]
+    if args.task is not None and args.robot not in ARMS:
+        raise InvalidInputError(
+            f"--task is for a catalogue arm ({sorted(ARMS)}); a robot file holds its task", "task"
+        )
     if Path(args.robot).is_file() or args.robot in ARMS:  # a user's robot or a catalogue arm
         if args.param:
             raise InvalidInputError(
                 "--param is for a built-in robot; a robot file holds its parameters", "param"
             )
-        robot = load_robot(args.robot)
+        robot = (
+            load_robot(args.robot)
+            if args.task is None
+            else robot_from_dict({"name": args.robot, "task": args.task})
+        )
         spec, kin = robot.spec, robot.kinematics
         inverses = [
             robot.inverse(a, args.augmentation, algorithm_parameters=algorithm_parameters(args, a))
@@ -237,6 +250,7 @@ def _run(args: argparse.Namespace) -> int:
     inputs = {
         "robot": spec.name,
         "robot_file": args.robot if Path(args.robot).is_file() else None,
+        "task": list(spec.task_names),
         "robot_parameters": kin.parameters,
         "path": _points(args.path, "path"),
         "cycles": C,

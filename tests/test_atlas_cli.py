@@ -193,3 +193,53 @@ def test_a_catalogue_arm_counts_the_starts_that_leave_its_limits(tmp_path):
     legs = np.array(doc["results"]["pseudoinverse"]["leg_ends"], dtype=float)
     expected = starts_outside(limits, np.array(doc["starts"], dtype=float), legs)
     assert count == int(expected.sum()) and 0 < count < 16
+
+
+def test_a_catalogue_arm_takes_a_task(tmp_path, capsys):
+    """``--task "x y z rx ry"`` on the 6-joint UR5e (p - r = 1): a loop around its home pose in
+    those five coordinates; ``--task`` on a built-in robot names the option."""
+    pytest.importorskip("yourdfpy")
+    from jik.engine.arms import ARMS
+    from jik.engine.robot_spec import robot_from_dict
+
+    kin = robot_from_dict({"name": "ur5e", "task": "x y z rx ry"}).kinematics
+    y0 = kin.forward(np.array(ARMS["ur5e"].home))
+    loop = [y0, y0 + [0.04, 0, 0, 0, 0], y0 + [0.04, 0.04, 0, 0.1, 0]]
+    path = "; ".join(",".join(f"{v:.6f}" for v in y) for y in loop)
+    out = tmp_path / "ur5e.json"
+    argv = ["atlas", "--robot", "ur5e", "--task", "x y z rx ry", "--path", path, "--starts",
+            "4", "--cycles", "1", "--arc=-0.2,0.2", "--out", str(out), "--no-figure",
+            "--quiet"]  # fmt: skip
+    assert main(argv) == 0, capsys.readouterr().err
+    doc = json.loads(out.read_text())
+    assert doc["inputs"]["task"] == ["x", "y", "z", "rx", "ry"] and len(doc["starts"][0]) == 6
+    assert doc["summary"]["pseudoinverse"]["outside_limits"] == 0
+    argv = ["atlas", "--robot", "manipulator2", "--task", "xyz", "--path", "1,1; 1,2",
+            "--quiet", "--out", str(tmp_path / "m.json")]  # fmt: skip
+    assert main(argv) == 2
+    assert "--task is for a catalogue arm" in capsys.readouterr().err
+
+
+def test_a_urdf_arm_in_a_robot_file_equals_the_catalogue_arm(tmp_path):
+    """The Panda's URDF text given inline in a robot file (with its end link and home) gives the
+    atlas of ``--robot panda``: the same starts, drift and count of runs outside the limits."""
+    pytest.importorskip("yourdfpy")
+    from jik.engine.arms import ARMS
+
+    arm = ARMS["panda"]
+    definition = {"name": "urdf", "urdf": arm.urdf, "end_link": arm.end_link,
+                  "home": list(arm.home), "task": "pose"}  # fmt: skip
+    (tmp_path / "panda.json").write_text(json.dumps(definition))
+    path = "0.3069,0,0.5903,0,0,0; 0.38,0,0.59,0,0,0.2; 0.38,0.08,0.59,0.15,0,0.2"
+    docs = []
+    for robot in ("panda", str(tmp_path / "panda.json")):
+        out = tmp_path / f"{len(docs)}.json"
+        assert main(["atlas", "--robot", robot, "--path", path, "--starts", "6", "--cycles", "1",
+                     "--out", str(out), "--no-figure", "--quiet"]) == 0  # fmt: skip
+        docs.append(json.loads(out.read_text()))
+    by_name, by_file = docs
+    np.testing.assert_allclose(by_name["starts"], by_file["starts"], atol=1e-12)
+    np.testing.assert_allclose(np.array(by_name["results"]["pseudoinverse"]["drift"], float),
+                               np.array(by_file["results"]["pseudoinverse"]["drift"], float),
+                               atol=1e-12)  # fmt: skip
+    assert by_name["summary"] == by_file["summary"]

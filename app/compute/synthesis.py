@@ -15,6 +15,7 @@ from jik.app.compute import schemas as S
 from jik.app.compute.documents import nullable
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.robot_requests import build_augmentation, build_robot
+from jik.app.compute.synthesis_total import grid, total_degree_response
 from jik.app.compute.user_robots import is_user_robot, request_field, user_robot
 from jik.engine.exceptions import JikError
 from jik.engine.functionals import error_functional_e1, error_functional_e2
@@ -24,12 +25,16 @@ from jik.engine.variational import synthesize_e2
 
 def synthesis_methods() -> S.SynthesisMethodsResponse:
     return S.SynthesisMethodsResponse(
-        methods=["evaluate", "e2_variational"],
+        methods=["evaluate", "e2_variational", "e2_total_degree"],
         notes={
             "evaluate": "any map of the catalogue (GET /robots): h on a grid of the box, "
             "polynomial coefficients, E1 and E2 on the box",
             "e2_variational": "minimise E2 (eq. (19)) over h of the box variables (Ritz method, "
             "engine.variational.synthesize_e2)",
+            "e2_total_degree": "minimise E2 over h of any number of box variables, and h_1 ... "
+            "h_(p-r) for p - r >= 2, on a total-degree Legendre basis with a scrambled Sobol "
+            "rule (engine.synthesis_nd.synthesize_e2_nd): E2 on the fitting and on an "
+            "independent rule, its convergence with the degree and the nodes",
             "error_functionals": "E1 (13) and E2 (18) by Gauss quadrature (engine.functionals)",
         },
     )
@@ -57,10 +62,17 @@ def default_region(
 def synthesis_region(spec: RobotSpec, req: S.SynthesizeRequest):
     """The variable names, the box and the fixed values of a synthesis request, checked."""
     names = list(spec.variable_names)
+    size = {"e2_variational": 2, "e2_total_degree": spec.p}.get(req.method, 3)
     if req.region is None:
-        region = default_region(spec, 2 if req.method == "e2_variational" else 3, req.fixed or {})
+        region = default_region(spec, size, req.fixed or {})
     else:
         region = {k: (float(lo), float(hi)) for k, (lo, hi) in req.region.items()}
+    if len(region) > 3 and req.method != "e2_total_degree":
+        raise RequestError(
+            "region",
+            f"'{req.method}' takes 1 to 3 variables (2 or 3 for 'e2_variational'), got "
+            f"{len(region)}; 'e2_total_degree' synthesizes h of any number",
+        )
     for k, (lo, hi) in region.items():
         if k not in names:
             raise RequestError(f"region.{k}", f"unknown variable {k!r}; {spec.name} has {names}")
@@ -76,51 +88,6 @@ def synthesis_region(spec: RobotSpec, req: S.SynthesizeRequest):
         if k in region:
             raise RequestError(f"fixed.{k}", "is also a region variable")
     return names, region, fixed
-
-
-def _grid_axes(amap, names, region, base) -> list[str]:
-    """The two region variables along which h varies most (mean |dh/dx_i| on seeded samples)."""
-    if len(region) <= 2:
-        return list(region)
-    rng = np.random.default_rng(0)
-    x = np.broadcast_to(base, (64, len(base))).copy()
-    for k, (lo, hi) in region.items():
-        x[:, names.index(k)] = rng.uniform(lo, hi, 64)
-    with np.errstate(all="ignore"):
-        try:
-            g = np.abs(np.asarray(amap.gradient(x), dtype=float))
-        except JikError:
-            return list(region)[:2]
-    score = {k: float(np.nanmean(g[:, names.index(k)])) for k in region}
-    top = sorted(region, key=lambda k: -(score[k] if np.isfinite(score[k]) else -1.0))[:2]
-    return [k for k in region if k in top]
-
-
-def _grid(amap, names, region, fixed, p: int, n: int) -> S.SynthesisGrid | None:
-    if len(region) < 2:
-        return None
-    base = np.zeros(p)
-    for k, v in fixed.items():
-        base[names.index(k)] = v
-    for k, (lo, hi) in region.items():
-        base[names.index(k)] = 0.5 * (lo + hi)
-    axes = _grid_axes(amap, names, region, base)
-    a, b = (np.linspace(region[k][0], region[k][1], n) for k in axes)
-    x = np.broadcast_to(base, (n, n, p)).copy()
-    x[..., names.index(axes[0])] = a[:, None]
-    x[..., names.index(axes[1])] = b[None, :]
-    with np.errstate(all="ignore"):
-        try:
-            h = np.asarray(amap.value(x), dtype=float)
-        except JikError:  # a map that raises where it is undefined: evaluate point by point
-            h = np.full((n, n), np.nan)
-            for i in range(n):
-                for j in range(n):
-                    try:
-                        h[i, j] = float(amap.value(x[i, j]))
-                    except JikError:
-                        pass
-    return S.SynthesisGrid(axes={axes[0]: a.tolist(), axes[1]: b.tolist()}, h=nullable(h))
 
 
 def _functional_info(fv) -> S.FunctionalInfo:
@@ -191,6 +158,8 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
     else:
         spec, kin, robot_used = build_robot(req.robot)
     names, region, fixed = synthesis_region(spec, req)
+    if req.method == "e2_total_degree":
+        return total_degree_response(req, spec, kin, robot_used, (names, region, fixed))
     convergence: list[dict[str, float]] = []
     coefficients: dict[str, float] = {}
     notes: list[str] = []
@@ -198,7 +167,7 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         if req.augmentation is not None:
             raise RequestError("augmentation", "'e2_variational' synthesizes h; give no map")
         try:
-            result = synthesize_e2(kin, region, degree=req.degree, fixed=fixed)
+            result = synthesize_e2(kin, region, degree=req.degree or 10, fixed=fixed)
         except JikError as exc:
             raise RequestError("region", str(exc)) from None
         amap = result.augmenting_map
@@ -229,9 +198,10 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         augmentation=aug_used,
         region={k: [float(lo), float(hi)] for k, (lo, hi) in region.items()},
         fixed=all_fixed,
-        grid=_grid(amap, names, region, all_fixed, spec.p, req.grid),
+        grid=grid(amap, names, region, all_fixed, spec.p, req.grid),
         coefficients=coefficients,
         functionals=functionals,
         convergence=convergence,
+        total_degree=None,
         message="; ".join(notes) or "ok",
     )

@@ -71,7 +71,7 @@ def repeatability_json(body: bytes) -> bytes:
     return repeatability_request(req).model_dump_json().encode()
 
 
-@task("region", "a smaller region, fewer nodes, a smaller grid or a lower degree")
+@task("region", "a smaller region, fewer nodes or qmc_nodes, a smaller grid or a lower degree")
 def synthesize_json(body: bytes) -> bytes:
     """A /synthesize request (JSON) and its response."""
     req = S.SynthesizeRequest.model_validate_json(body)

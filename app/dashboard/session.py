@@ -32,6 +32,7 @@ from jik.app.dashboard.model import (
     DashboardState,
     cache_key,
     default_state,
+    runs_key,
     updated_state,
     validate,
 )
@@ -367,7 +368,7 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts):
             self._failure(generation, str(exc))
             return
         # Panels that do not depend on gamma are reused from the last result with the same key.
-        key = cache_key(state, "extended")
+        key = "|".join((cache_key(state, "extended"), *runs_key(state)))  # (the map, every run)
         reuse = {k for k in gamma_free_panels(result) if (k, key) in self._figures}
         texts = {k: self._figures[(k, key)] for k in reuse}
         cached, stale = self._known_functionals(state)

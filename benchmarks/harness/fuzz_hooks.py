@@ -8,6 +8,9 @@ case in tests/app/test_errors.py, test_synthesize.py and test_sessions.py):
 - a box's bounds: ``lo < hi``; a variable is in the box or fixed, not both, and some variable
   is left for the box; ``e2_variational`` synthesizes h on a box of 2 or 3 variables, so it
   takes no ``augmentation``;
+- ``e2_total_degree`` takes any number of box variables and no ``augmentation``; its Sobol
+  rule has a power of two of nodes, at least twice the basis' unknowns (at most 4000), and its
+  kernel frame (p - r >= 2) p - r distinct joints;
 - discrete mode (asked for, or the robot's default) needs ``gamma < 2``;
 - the chosen inverse must be defined at ``x0`` (the engine says so: a singular start, by the
   server's own test);
@@ -59,15 +62,28 @@ from jik.app.compute.atlas_schemas import AtlasRequest
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.requests import _check_start, _setup
 from jik.app.compute.robot_requests import check_configuration, check_task_point
+from jik.app.compute.schemas.synthesis import QMC_NODES
 from jik.app.compute.synthesis import synthesis_region
 from jik.app.compute.user_robots import user_robot
-from jik.app.dashboard.model import StatePatch, default_state, patch_of, updated_state
+from jik.app.dashboard.model import default_state, updated_state
+from jik.app.dashboard.patch import StatePatch, patch_of
 from jik.engine.exceptions import InvalidInputError, JikError
 from jik.engine.registry import ROBOTS, make_inverse
+from jik.engine.robot_synthesis import TOTAL_DEGREE
+from jik.engine.synthesis_nd import MAX_UNKNOWNS
+from jik.engine.total_degree import basis_size
 
 #: Caps on the fields that size the work (and on the robot parameters that do: the unicycle's
 #: horizon T sizes its quadrature; T = 19.7 with 300 steps needed 1.7 GB).
-WORK_CAPS = {"cycles": 2, "max_iterations": 300, "degree": 6, "nodes": 4, "grid": 9, "starts": 16}
+WORK_CAPS = {
+    "cycles": 2,
+    "max_iterations": 300,
+    "degree": 6,
+    "nodes": 4,
+    "grid": 9,
+    "starts": 16,
+    "qmc_nodes": 1024,
+}
 ROBOT_CAPS = {"T": 2 * math.pi}
 MAX_PATH = 4
 #: Paths of an atlas's family (shifts, scales) sent.
@@ -105,6 +121,9 @@ def _capped(body: dict) -> dict:
     if isinstance(augmentation, dict) and isinstance(augmentation.get("degree"), int):
         body["augmentation"] = {**augmentation, "degree": min(augmentation["degree"],
                                                               WORK_CAPS["degree"])}  # fmt: skip
+    if isinstance(augmentation, dict) and len(augmentation.get("region") or {}) > 3:
+        # a total-degree synthesis' work grows as C(n + d, d)^2: total degree 2 over 4-16 joints
+        body["augmentation"] = {**body["augmentation"], "degree": 2}
     robot = body.get("robot")
     if isinstance(robot, dict):
         body["robot"] = {k: min(v, ROBOT_CAPS[k]) if k in ROBOT_CAPS and isinstance(v, float)
@@ -116,11 +135,16 @@ def _user_robot_ok(body: dict, path: str) -> bool:
     """Whether the server builds the user robot of ``body`` and takes its lengths (see the
     module's docstring)."""
     try:
+        if path == "/atlas":
+            return _atlas_ok(body)
         if path == "/synthesize":
             req = S.SynthesizeRequest.model_validate(body)
             evaluate = req.method == "evaluate"
             robot, _, _ = user_robot(req.robot, req.augmentation if evaluate else None)
             spec = robot.spec
+            if req.method == "e2_total_degree":
+                _, region, _ = synthesis_region(spec, req)
+                return _total_degree_ok(body, len(region), spec.p, spec.r)
             if spec.p != spec.r + 1 or (evaluate and req.augmentation is None):
                 return False
             _, region, _ = synthesis_region(spec, req)
@@ -139,9 +163,27 @@ def _user_robot_ok(body: dict, path: str) -> bool:
     return True
 
 
+def _total_degree_ok(body: dict, d: int, p: int, r: int) -> bool:
+    """The rules of a total-degree synthesis of ``d`` variables (see the module docstring)."""
+    nodes, degree = body.get("qmc_nodes", QMC_NODES), body.get("degree") or TOTAL_DEGREE
+    axes = body.get("frame_axes")
+    frame_ok = axes is None or p - r < 2 or (len(set(axes)) == p - r and max(axes) <= p)
+    unknowns = basis_size(d, degree)
+    return (
+        d >= 1 and not body.get("augmentation") and frame_ok and not nodes & (nodes - 1)
+        and unknowns <= MAX_UNKNOWNS and nodes >= 2 * unknowns
+    )  # fmt: skip
+
+
 def _synthesis_ok(body: dict) -> bool:
     spec = ROBOTS[body["robot"]["name"]]
     fixed = body.get("fixed") or {}
+    if body.get("method") == "e2_total_degree":
+        try:
+            _, region, _ = synthesis_region(spec, S.SynthesizeRequest.model_validate(body))
+        except (RequestError, ValidationError):
+            return False
+        return _total_degree_ok(body, len(region), spec.p, spec.r)
     synthesis = body.get("method") == "e2_variational"
     if body.get("region") is None:  # (the default box: the last variables not fixed)
         size = min(2 if synthesis else 3, sum(n not in fixed for n in spec.variable_names))

@@ -15,8 +15,9 @@ REGION = {"x2": [-1.0, 1.0], "x3": [0.0, math.pi]}
 
 def test_methods_are_listed_with_notes(api):
     b = api.get("/synthesize").json()
-    assert b["methods"] == ["evaluate", "e2_variational"]
+    assert b["methods"] == ["evaluate", "e2_variational", "e2_total_degree"]
     assert "Ritz" in b["notes"]["e2_variational"]
+    assert "Sobol" in b["notes"]["e2_total_degree"]
 
 
 def test_evaluate_paper_cubic(api):

@@ -79,6 +79,7 @@ from jik.app.compute.schemas.synthesis import (
     SynthesizeBody,
     SynthesizeRequest,
     SynthesizeResponse,
+    TotalDegreeInfo,
 )
 from jik.app.compute.schemas.variants import per_robot
 
@@ -139,6 +140,7 @@ __all__ = [
     "SynthesizeRequest",
     "SynthesizeResponse",
     "Tolerance",
+    "TotalDegreeInfo",
     "Trajectory",
     "UrdfRobot",
     "UserAugmentation",

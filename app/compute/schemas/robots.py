@@ -230,7 +230,8 @@ class FormulaMapAugmentation(BaseModel):
 
 
 class E2SynthesisAugmentation(BaseModel):
-    """The E2-optimal map on a box, synthesized by the Ritz solve of eq. (20) (p = r + 1)."""
+    """The E2-optimal map on a box (p = r + 1): the Ritz solve of eq. (20) on a tensor Legendre
+    basis for two or three variables, on a total-degree basis with a Sobol rule for more."""
 
     model_config = ConfigDict(extra="forbid", title="E2-synthesized map")
     name: Literal["e2_synthesized"]
@@ -239,11 +240,12 @@ class E2SynthesisAugmentation(BaseModel):
                                                 allow_inf_nan=False)],
                          Annotated[float, Field(strict=True, ge=-100.0, le=100.0,
                                                 allow_inf_nan=False)]]],
-        Field(min_length=2, max_length=3),
-    ] = Field(description="two or three variables to [lo, hi], lo < hi")  # fmt: skip
-    degree: Annotated[int, Field(strict=True, ge=1, le=24), INTEGRAL] = Field(
-        12, description="Legendre degree per variable"
-    )
+        Field(min_length=2, max_length=MAX_DIMENSION),
+    ] = Field(description="two or more variables to [lo, hi], lo < hi")  # fmt: skip
+    degree: Annotated[int, Field(strict=True, ge=1, le=24), INTEGRAL] | None = Field(
+        None, description="two or three variables: Legendre degree per variable (default 12); "
+        "more: the total degree, 1 to 6 (default 4)",
+    )  # fmt: skip
     fixed: Annotated[dict[Name, FiniteFloat], Field(max_length=MAX_DIMENSION)] | None = Field(
         None, description="values of the variables outside the box (default 0)"
     )

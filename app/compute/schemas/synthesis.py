@@ -17,7 +17,9 @@ from jik.app.compute.schemas.robots import AnyAugmentation, AnyRobot, Augmentati
 from jik.app.compute.schemas.variants import per_robot
 from jik.engine.registry import RobotSpec
 
-SynthesisMethod = Literal["evaluate", "e2_variational"]
+SynthesisMethod = Literal["evaluate", "e2_variational", "e2_total_degree"]
+#: Sobol nodes of a total-degree synthesis (a power of two): default and bounds.
+QMC_NODES, MIN_QMC_NODES, MAX_QMC_NODES = 2**13, 64, 2**17
 
 
 class SynthesizeRequest(BaseModel):
@@ -29,16 +31,20 @@ class SynthesizeRequest(BaseModel):
     method: SynthesisMethod = Field(
         "evaluate",
         description="'evaluate': a catalogue map (analytic or already synthesized) on the box; "
-        "'e2_variational': minimise E2 (eq. (19)) by the Ritz method (engine.variational)",
+        "'e2_variational': minimise E2 (eq. (19)) by the Ritz method on a tensor Legendre basis "
+        "of 2 or 3 variables (engine.variational); 'e2_total_degree': the same functional over "
+        "any number of variables on a total-degree Legendre basis with a scrambled Sobol rule, "
+        "and for p - r >= 2 the maps h_1 ... h_(p-r) (engine.synthesis_nd)",
     )
     augmentation: AnyAugmentation | None = Field(
         None, description="for 'evaluate': the map and its parameters (default: the robot's)"
     )
     region: dict[str, tuple[Bound, Bound]] | None = Field(
         None,
-        max_length=3,
-        description="box {variable: [lo, hi]} (2 or 3 variables); default: the last 3 (2 for "
-        "'e2_variational') variables, each over a tenth of its x_range either side of the "
+        max_length=MAX_DIMENSION,
+        description="box {variable: [lo, hi]} (1 to 3 variables; any number for "
+        "'e2_total_degree'); default: the last 3 (2 for 'e2_variational', all for "
+        "'e2_total_degree') variables, each over a tenth of its x_range either side of the "
         "robot's default start",
     )
     fixed: dict[str, FiniteFloat] | None = Field(
@@ -49,8 +55,31 @@ class SynthesizeRequest(BaseModel):
     nodes: Annotated[int, Field(strict=True, ge=2, le=24), INTEGRAL] = Field(
         8, description="Gauss-Legendre nodes per variable for E1 and E2"
     )
-    degree: Annotated[int, Field(strict=True, ge=1, le=24), INTEGRAL] = Field(
-        10, description="'e2_variational': Legendre degree per variable"
+    degree: Annotated[int, Field(strict=True, ge=1, le=24), INTEGRAL] | None = Field(
+        None,
+        description="'e2_variational': Legendre degree per variable (default 10); "
+        "'e2_total_degree': total degree of the basis (default 4)",
+    )
+    qmc_nodes: Annotated[int, Field(strict=True, ge=MIN_QMC_NODES, le=MAX_QMC_NODES), INTEGRAL] = (
+        Field(
+            QMC_NODES,
+            description="'e2_total_degree': nodes of the scrambled Sobol rule, a power of two, at "
+            "least twice the basis' unknowns",
+        )
+    )
+    seed: Annotated[int, Field(strict=True, ge=0, le=2**31 - 1), INTEGRAL] = Field(
+        0, description="'e2_total_degree': seed of the Sobol rule's scrambling"
+    )
+    frame_axes: (
+        Annotated[
+            list[Annotated[int, Field(strict=True, ge=1, le=MAX_DIMENSION), INTEGRAL]],
+            Field(min_length=1, max_length=MAX_DIMENSION),
+        ]
+        | None
+    ) = Field(
+        None,
+        description="'e2_total_degree' with p - r >= 2: the p - r joints (1-based) whose axes "
+        "fix the kernel frame (default: the last p - r)",
     )
     grid: Annotated[int, Field(strict=True, ge=3, le=61), INTEGRAL] = Field(
         21, description="grid points per axis for h"
@@ -71,14 +100,17 @@ def _synthesis_fields(spec: RobotSpec, augmentation: Any) -> dict[str, Any]:
             ),
         ),
         "region": (
-            Annotated[dict[variable, tuple[Bound, Bound]], Field(min_length=1, max_length=3)]
+            Annotated[
+                dict[variable, tuple[Bound, Bound]], Field(min_length=1, max_length=len(names))
+            ]
             | None,
             Field(
                 None,
                 description=f"box {{variable: [lo, hi]}}, lo < hi, of 1 to 3 of "
-                f"{list(names)} (2 or 3 draw a grid of h; 'e2_variational' needs 2 or 3), none "
-                "of them fixed; default: the last 3 (2 for 'e2_variational') not fixed, each "
-                "over a tenth of its range either side of the default start",
+                f"{list(names)} (2 or 3 draw a grid of h; 'e2_variational' needs 2 or 3; "
+                "'e2_total_degree' takes any number), none of them fixed; default: the last 3 "
+                "(2 for 'e2_variational', all for 'e2_total_degree') not fixed, each over a "
+                "tenth of its range either side of the default start",
             ),
         ),
         "fixed": (
@@ -107,6 +139,29 @@ class SynthesisGrid(BaseModel):
     h: list[list[MaybeFloat]] = Field(description="h[i][j] at (axis 1 [i], axis 2 [j])")
 
 
+class TotalDegreeInfo(BaseModel):
+    """A total-degree synthesis (engine.synthesis_nd.TotalDegreeSynthesis)."""
+
+    e2: float = Field(description="E2 of the maps on the fitting rule (the Ritz value)")
+    e2_check: float = Field(
+        description="E2 on an independent scrambled Sobol rule of as many nodes: the value to "
+        "trust; its distance to e2 measures the quadrature error"
+    )
+    degree: int
+    nodes: int
+    seed: int
+    unknowns: int = Field(description="basis polynomials per map")
+    single_joint: dict[str, dict[str, float]] = Field(
+        description="p - r = 1: E2 of h = sign * x_j for each region variable, the better sign"
+    )
+    frame_axes: list[int] = Field(description="p - r >= 2: the kernel frame's joints (1-based)")
+    basis: list[list[int]] = Field(
+        description="(unknowns, d): multi-indices a of the basis prod_k sqrt(2 a_k + 1) "
+        "P_(a_k)(t_k), t the region's variables mapped onto [-1, 1]"
+    )
+    coefficients: list[list[float]] = Field(description="(p - r, unknowns): each map's")
+
+
 class SynthesizeResponse(BaseModel):
     robot: RobotUsed
     method: SynthesisMethod
@@ -121,7 +176,12 @@ class SynthesizeResponse(BaseModel):
         description="E1 (13) and E2 (18) of the map on the box; null where undefined (see message)"
     )
     convergence: list[dict[str, float]] = Field(
-        description="'e2_variational': E2 against the Legendre degree"
+        description="'e2_variational': E2 against the Legendre degree; 'e2_total_degree': "
+        "{degree, nodes, unknowns, e2}, the Ritz value with the degree at all the nodes, then "
+        "with the nodes (leading 2^k of the rule) at the final degree"
+    )
+    total_degree: TotalDegreeInfo | None = Field(
+        None, description="'e2_total_degree': the synthesis' numbers and its maps"
     )
     message: str
 

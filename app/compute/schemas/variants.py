@@ -74,5 +74,7 @@ def per_robot(base: type[BaseModel], fields: Any, user_robots: bool = True) -> A
 
 #: What the augmentation of a user robot's request is for, by request.
 USER_AUGMENTATION_NOTE = {
-    "SynthesizeRequest": "; 'evaluate' needs one, 'e2_variational' takes none",
+    "SynthesizeRequest": "; 'evaluate' needs one, 'e2_variational' and 'e2_total_degree' take none",
+    "AtlasRequest": "; default: the robot's (a catalogue arm with one degree of redundancy: "
+    "E2-optimal over all its joints)",
 }
