@@ -17,7 +17,9 @@ from jik.app.dashboard.joint_limits import limits_summary, outside_joints, state
 from jik.app.dashboard.map_figures import augmenting_spec
 from jik.app.dashboard.map_synthesis import built_map
 from jik.app.dashboard.model import default_state, updated_state
+from jik.app.dashboard.plotting import units
 from jik.app.dashboard.results import compute
+from jik.app.dashboard.robot_units import chain_units
 from jik.app.dashboard.robots import state_kinematics
 from jik.app.dashboard.runs import Cancelled
 from jik.app.dashboard.session import Dashboard
@@ -202,3 +204,15 @@ def test_the_atlas_of_a_robot_with_two_degrees_of_redundancy():
     figure = atlas_figure(result, req)
     assert list(figure["data"][0]["x"]) == list(range(1, 13))
     assert figure["layout"]["xaxis"]["title"]["text"].startswith("start")
+
+
+def test_an_arms_units_follow_its_joints_and_task():
+    """The Panda's joints are revolute (rad), its pose task in m and rad; a planar RPR chain's
+    prismatic joint is in m (the panels' axes and the verdict's norms say so)."""
+    result = compute(updated_state(_panda(), {"task": "target"}))
+    assert units(result) == (("rad",) * 7, ("m", "m", "m", "rad", "rad", "rad"))
+    arm = {"name": "planar_chain", "joints": "RPR", "lengths": [1.0, 0.8, 0.6]}
+    kin = state_kinematics(
+        updated_state(default_state(), {"robot": "planar_chain", "robot_definition": arm})
+    )
+    assert chain_units(kin, ("x", "y")) == (("rad", "m", "rad"), ("m", "m"))
