@@ -55,6 +55,10 @@ def test_the_panda_is_picked_by_name_with_its_pose_task(app, client):
     assert summary["pseudoinverse"]["drift"][-1] > 1e-5
     assert max(summary["extended"]["drift"]) < 1e-9
     assert summary["extended"]["limits"] == {"within": True, "violation": None}
+    again = _open(client, state)  # (the page's link holds the definition)
+    assert again["state"] == state
+    export = client.get(f"/api/sessions/{session['id']}/export.json").json()
+    assert len(export["runs"]["extended"]["x"][0]) == 7
     x0 = [c for c in controls(_panda()) if c.key.startswith("x0.")]
     assert [(c.minimum, c.maximum) for c in x0][3] == (-3.0718, -0.0698)  # its URDF's limits
 
