@@ -168,7 +168,7 @@ def test_the_atlas_of_an_arm_asks_for_its_definition_and_counts_the_limits():
 def test_the_scene_colours_a_joint_while_it_is_outside_its_limits():
     """The Panda's copy in the scene: at x4 = -0.05 the joint of x4 takes OUTSIDE_COLOR, the
     others keep the copy's colour; back at home, it is the copy's colour again. Its end link
-    carries a frame (the pose task)."""
+    carries a frame (the pose task), drawn where it is (on the pose targets)."""
     state = updated_state(_panda(), {"x0.3": -0.05, "task": "target"})
     dashboard = Dashboard(state)
     scene = DashboardScene(dashboard)
@@ -181,7 +181,11 @@ def test_the_scene_colours_a_joint_while_it_is_outside_its_limits():
         assert colours.count(OUTSIDE_COLOR) == 1
         arm.pose(_panda().x0)
         assert all(tuple(ball.color) == (10, 20, 30) for ball in arm.joints)
+        # Its end link's frame where the path's pose targets are drawn (k(x0) at home).
+        home = arm.kin.forward(np.asarray(_panda().x0))
         assert arm.end is not None
+        np.testing.assert_allclose(arm.end.position, home[:3], atol=1e-12)
+        np.testing.assert_allclose(arm.joints[-1].position, home[:3], atol=1e-12)
     finally:
         scene.stop()
         dashboard.stop()
