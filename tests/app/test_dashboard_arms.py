@@ -224,3 +224,13 @@ def test_an_arms_units_follow_its_joints_and_task():
         updated_state(default_state(), {"robot": "planar_chain", "robot_definition": arm})
     )
     assert chain_units(kin, ("x", "y")) == (("rad", "m", "rad"), ("m", "m"))
+
+
+@pytest.mark.parametrize("arm", sorted(ARMS))
+def test_every_catalogue_arm_is_a_dashboard_state(arm):
+    """Each arm of the picker gives a state with its definition, its default task's path and a
+    synthesized map (the UR5e's default task x y z rx ry: p - r = 1 too)."""
+    state = updated_state(default_state(), {"robot": arm})
+    assert state.robot_definition == {"name": arm, "task": ARMS[arm].task}
+    assert state.augmentation == "e2_synthesized"
+    assert len(state.x0) == len(ARMS[arm].home) == len(state.path[0]) + 1
