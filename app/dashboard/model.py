@@ -65,8 +65,9 @@ class DashboardState(BaseModel):
 
     robot: str
     robot_parameters: dict[str, Any]
-    #: A robot the user defined (:mod:`jik.app.dashboard.robots`): its definition, whose
-    #: ``name`` is ``robot`` (a kind of :mod:`jik.engine.robot_kinds`); None for the catalogue's.
+    #: A robot given by a definition (:mod:`jik.app.dashboard.robots`), whose ``name`` is
+    #: ``robot``: a kind of :mod:`jik.engine.robot_kinds` or a catalogue arm; None for the
+    #: paper's robots.
     robot_definition: Annotated[dict[str, Any], Field(max_length=32)] | None = None
     augmentation: str
     augmentation_parameters: dict[str, Any]
