@@ -9,14 +9,17 @@ map by default, over all its joints.
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import functools
 import json
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 
 import numpy as np
 
 from jik.engine.augmentations import AugmentingMap
 from jik.engine.kinematics import Kinematics
+from jik.engine.progress import Progress
 from jik.engine.synthesis_nd import synthesize_e2_nd
 from jik.engine.variational import synthesize_e2
 
@@ -30,10 +33,15 @@ def synthesis(box: dict, fix: dict, degree: int, key: str | None) -> Callable[..
         cache_key = None if key is None else (key, json.dumps([box, fix, degree], sort_keys=True))
         if cache_key is not None and cache_key in _SYNTHESIZED:
             return _SYNTHESIZED[cache_key]
+        progress = _PROGRESS.get()  # (a RunCancelled it raises leaves nothing cached)
         if len(box) <= 3:
-            amap: AugmentingMap = synthesize_e2(kin, box, degree=degree, fixed=fix).augmenting_map
+            amap: AugmentingMap = synthesize_e2(
+                kin, box, degree=degree, fixed=fix, progress=progress
+            ).augmenting_map
         else:
-            amap = synthesize_e2_nd(kin, box, degree=degree, nodes=TOTAL_NODES, fixed=fix).maps[0]
+            amap = synthesize_e2_nd(
+                kin, box, degree=degree, nodes=TOTAL_NODES, fixed=fix, progress=progress
+            ).maps[0]
         if cache_key is not None:
             while len(_SYNTHESIZED) >= 16:
                 _SYNTHESIZED.pop(next(iter(_SYNTHESIZED)))
@@ -43,6 +51,22 @@ def synthesis(box: dict, fix: dict, degree: int, key: str | None) -> Callable[..
     return functools.cache(synthesized)
 
 
+@contextlib.contextmanager
+def synthesis_progress(progress: Progress | None) -> Iterator[None]:
+    """Within it, a map synthesized on first use (a robot's ``e2_synthesized``) reports to
+    ``progress`` and stops with :class:`~jik.engine.exceptions.RunCancelled` when it is
+    cancelled (:mod:`jik.engine.progress`); its maps are built on first use, deep inside an
+    inverse's construction, where no argument reaches."""
+    token = _PROGRESS.set(progress)
+    try:
+        yield
+    finally:
+        _PROGRESS.reset(token)
+
+
+_PROGRESS: contextvars.ContextVar[Progress | None] = contextvars.ContextVar(
+    "synthesis_progress", default=None
+)
 #: Synthesized maps by the robot definition they belong to (a process's few most recent).
 _SYNTHESIZED: dict[tuple[str, str], AugmentingMap] = {}
 #: Total degree and nodes of a synthesis over more than three joints (docs/e2-vector.md).

@@ -13,7 +13,7 @@ const atlas = { token: 0, job: null, shown: null, computedFor: null, send: null,
 
 const detail = (body) => (Array.isArray(body.detail) ? body.detail.map((d) => d.msg).join("; ") : body.detail);
 // What an atlas depends on in a state (not x0: every start of the curve is in it).
-const atlasKey = (s) => JSON.stringify([s.robot, s.robot_parameters, s.augmentation, s.augmentation_parameters, s.gamma, s.mode, s.tolerance, s.task, s.path]);
+const atlasKey = (s) => JSON.stringify([s.robot, s.robot_parameters, s.augmentation, s.augmentation_parameters, s.gamma, s.mode, s.tolerance, s.task, s.path, s.algorithms, s.algorithm_parameters]);
 
 function say(text, error = false) {
   const status = $("#atlas-status");
@@ -151,12 +151,12 @@ export function atlasPanel(state, send) {
   const progress = el("span", { id: "atlas-progress-box", className: "progress-box" },
     el("span", { className: "progress" }, el("span", { id: "atlas-bar", className: "bar" }), el("span", { id: "atlas-progress-text" })), stop);
   progress.hidden = true;
-  const outdated = el("p", { id: "atlas-outdated", className: "note" }, "This atlas is of an earlier state (robot, map, path, γ or mode): compute again for the current one.");
+  const outdated = el("p", { id: "atlas-outdated", className: "note" }, "This atlas is of an earlier state (robot, map, path, algorithms, γ or mode): compute again for the current one.");
   outdated.hidden = true;
   const plot = el("div", { id: "plot-atlas", className: "panel full atlas-plot" });
   const key = el("span", { className: "key-list" },
     el("span", { className: "key" }, "colour: log10 of the drift ‖x − x0‖ after each cycle (its scale on the right)"),
-    el("span", { className: "key" }, "left: pseudoinverse; right: extended Jacobian with the chosen map"));
+    el("span", { className: "key" }, "one heatmap per chosen algorithm, named above it in its colour"));
   panelHead(plot, "atlas", true, key);
   $("#atlas").replaceChildren(
     el("h2", {}, "Repeatability atlas"),
@@ -165,6 +165,6 @@ export function atlasPanel(state, send) {
       field("cycles", cycles, "cycles of the path per start (empty: the controls' cycles)"),
       field("path scales", scales, "scales of the path about k(x0), each a band of rows (empty: the path as it is)"),
       compute, progress),
-    el("p", { id: "atlas-status", className: "atlas-status", role: "status" }, "Compute the atlas of the current robot, path and map: the drift of both algorithms from every start of the self-motion curve of k(x0)."),
+    el("p", { id: "atlas-status", className: "atlas-status", role: "status" }, "Compute the atlas of the current robot, path and map: the drift of each chosen algorithm from every start of the self-motion curve of k(x0)."),
     outdated, plot);
 }

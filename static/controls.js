@@ -85,6 +85,28 @@ function choice(c, value, send) {
   return el("div", { className: "ctl", title: c.help }, el("span", {}, c.label), group);
 }
 
+// Any of the options (c.kind "checks": the chosen algorithms), as toggle buttons; the list of
+// those pressed is sent (the server refuses an empty one, naming the control).
+function checks(c, value, send) {
+  const group = el("span", { className: "choice checks", id: c.id, role: "group" });
+  group.setAttribute("aria-label", c.label);
+  let chosen = [...value];
+  const buttons = c.options.map(([v, text]) => {
+    const b = el("button", { type: "button", id: `${c.id}-${v}`, onclick: () => {
+      chosen = chosen.includes(v) ? chosen.filter((k) => k !== v) : [...chosen, v];
+      group.setValue(chosen);
+      send(c.options.map(([k]) => k).filter((k) => chosen.includes(k)));
+    } }, text);
+    b.dataset.value = v;
+    b.style.setProperty("--alg", `var(--${v})`);
+    return b;
+  });
+  group.append(...buttons);
+  group.setValue = (v) => { chosen = [...v]; buttons.forEach((b) => b.setAttribute("aria-pressed", String(chosen.includes(b.dataset.value)))); };
+  group.setValue(value);
+  return el("div", { className: "ctl", title: c.help }, el("span", {}, c.label), group);
+}
+
 function select(c, value, send) {
   if (c.inline) return choice(c, value, send);
   const s = el("select", { id: c.id });
@@ -124,7 +146,7 @@ function preset(c, send) {
   return el("button", { type: "button", id: c.id, title: c.help, onclick: () => send(c.value) }, c.label);
 }
 
-const BUILD = { slider, select, vector, text };
+const BUILD = { slider, select, vector, text, checks };
 
 // Show the controls of a state message ({groups, controls, values}): built anew when the
 // controls differ from those on screen (another robot, map, mode or task), else only their

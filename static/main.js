@@ -5,7 +5,7 @@ import { change, endOnClose, follow, openSession, session, api } from "./api.js"
 import { showControls, showRefusal } from "./controls.js";
 import { $, el, fmt } from "./dom.js";
 import { robotEditor } from "./editor.js";
-import { algorithmKey, applyFunctionals, drawFigures, layoutPanels, markStale, onAhead, setExportNote } from "./panels.js";
+import { algorithmKey, applyFunctionals, drawFigures, layoutPanels, markStale, onAhead, setExportNote, showChosen } from "./panels.js";
 import { atlasPanel, atlasState } from "./atlas.js";
 import { afterSecond, cancelSecond, clearCancelled, secondWanted } from "./second.js";
 
@@ -45,7 +45,9 @@ function showProgress(fraction, elapsed, phase = "runs", what = "") {
     : `stop computing ${what}: the result on screen stays, without E1, E2 and their sensitivity`;
   const percent = Math.round(100 * fraction);
   $("#progress-bar").style.width = `${percent}%`;
-  $("#progress-text").textContent = runs ? `computing ${percent}%` : `computing ${what} ${percent}%`;
+  // (the runs of a new state may first wait for their map's synthesis, which says so)
+  const doing = runs && (!what || what === "the runs") ? "computing" : `computing ${what}`;
+  $("#progress-text").textContent = `${doing} ${percent}%`;
 }
 
 function onState(msg, force = false) {
@@ -69,6 +71,7 @@ function onRefused(msg) {
 
 async function onResult(msg) {
   if (msg.generation < page.shown) return;
+  showChosen(msg.state.algorithms || ["pseudoinverse", "extended"]);
   await drawFigures(msg.figures, msg.digests, msg.state.robot);
   clearCancelled();
   markStale(msg.stale || []);
@@ -95,9 +98,14 @@ async function onResult(msg) {
 function renderVerdict(msg) {
   const box = $("#verdict");
   box.classList.remove("failed");
-  box.replaceChildren(...msg.verdict.map((s) => el("p", {
-    className: [s.role, s.algorithm ? ALGORITHM_CLASS[s.algorithm] : ""].join(" ").trim(),
-  }, s.text)));
+  box.replaceChildren(...msg.verdict.map((s) => {
+    const p = el("p", {
+      className: [s.role, s.algorithm ? ALGORITHM_CLASS[s.algorithm] || "" : ""].join(" ").trim(),
+      dataset: s.algorithm ? { algorithm: s.algorithm } : {},
+    }, s.text);
+    if (s.algorithm) p.style.setProperty("--alg", `var(--${s.algorithm})`);
+    return p;
+  }));
 }
 const ALGORITHM_CLASS = { pseudoinverse: "p", extended: "e" };
 
@@ -170,7 +178,7 @@ function cancel() {
 function onProgress(msg) {
   if (msg.generation !== session.generation) return;
   if (msg.phase !== "second") {
-    showProgress(msg.fraction, msg.elapsed);
+    showProgress(msg.fraction, msg.elapsed, "runs", msg.what);
     return;
   }
   const wanted = () => page.second === msg.generation && page.shown === msg.generation

@@ -17,10 +17,19 @@ export function algorithmKey(withRobot = false) {
   return el("span", { className: "key-list" }, ...Object.keys(CONFIG.labels).map((a) => {
     const style = CONFIG.styles[a] || {};
     const sample = el("i", { className: "line-sample" });
-    sample.style.borderTop = `3px ${style.dash === "solid" ? "solid" : "dashed"} ${CONFIG.colors[a]}`;
+    sample.style.borderTop = `3px ${{ solid: "solid", dot: "dotted" }[style.dash] || "dashed"} ${CONFIG.colors[a]}`;
     const words = withRobot ? `${CONFIG.labels[a]}: ${style.line}; ${style.robot} in the 3D scene` : CONFIG.labels[a];
-    return el("span", { className: "key", dataset: { algorithm: a } }, sample, words);
+    const key = el("span", { className: "key", dataset: { algorithm: a } }, sample, words);
+    key.hidden = !chosen.includes(a);
+    return key;
   }));
+}
+
+// The algorithms of the state on screen (the keys show those only).
+let chosen = ["pseudoinverse", "extended"];
+export function showChosen(algorithms) {
+  chosen = algorithms;
+  for (const key of document.querySelectorAll(".key[data-algorithm]")) key.hidden = !chosen.includes(key.dataset.algorithm);
 }
 
 // The panels' boxes, in the order and sizes the server gives (/api/dashboard/config).
@@ -228,7 +237,7 @@ async function saveImage(div, key, format) {
     // goes into the caption, in their colours.
     const named = [...host.querySelectorAll(".legendtext")].map((t) => t.textContent);
     const drawnAs = JSON.stringify([div.data, layout.shapes || []]);
-    const keys = Object.keys(CONFIG.labels).filter((a) => !named.includes(CONFIG.labels[a]) && drawnAs.includes(CONFIG.colors[a]))
+    const keys = chosen.filter((a) => !named.includes(CONFIG.labels[a]) && drawnAs.includes(CONFIG.colors[a]))
       .map((a) => [`▬ ${CONFIG.labels[a]}`, CONFIG.colors[a]]);
     const coloured = ([words, colour]) => `<span style="color:${colour}">${words}</span>`;
     const oneLine = keys.map(([words]) => words).join(" · ").length <= chars;

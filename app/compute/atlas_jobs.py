@@ -112,6 +112,9 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
     named += [(f"shifts[{i}]", v) for i, v in enumerate(req.shifts or [])]
     for name, v in named:
         check_task_point(spec, v, name)
+    for i, x in enumerate(req.start_points or []):
+        if len(x) != spec.p:
+            raise RequestError(f"start_points[{i}]", f"must have {spec.p} components, got {len(x)}")
     if req.reference and len(req.reference) != spec.p:
         raise RequestError("reference", f"must have {spec.p} components, got {len(req.reference)}")
     gamma = spec.default_gamma if req.gamma is None else req.gamma
@@ -120,7 +123,8 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
         raise RequestError("gamma", why)
     paths = len(req.shifts or [0]) * len(req.scales or [0])
     closed = np.linalg.norm(np.subtract(req.path[-1], req.path[0])) <= CLOSE_TOL
-    legs = req.starts * paths * req.cycles * (len(req.path) - closed) * len(req.algorithms)
+    starts = len(req.start_points) if req.start_points else req.starts
+    legs = starts * paths * req.cycles * (len(req.path) - closed) * len(req.algorithms)
     if legs > limits.max_work:
         raise RequestError(
             "starts", f"starts x paths x cycles x legs x algorithms = {legs} is more than "
@@ -133,7 +137,7 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
             "response carries; ask for the drift alone or a smaller atlas",
         )  # fmt: skip
     return plan_atlas(
-        inverses, req.path, cycles=req.cycles, n_starts=req.starts,
+        inverses, req.path, cycles=req.cycles, n_starts=req.starts, starts=req.start_points,
         arc=req.arc or (-MAX_ARC, MAX_ARC), sampling=req.sampling, seed=req.seed,
         reference=req.reference or spec.default_x0, box=None if req.arc else spec.x_range,
         shifts=req.shifts, scales=req.scales, gamma=gamma, mode=mode, tol=req.tolerance,
@@ -355,7 +359,8 @@ class AtlasJobs:
                 progress=ProgressCallbacks(on_advance=progress, is_cancelled=job.cancel.is_set),
                 keep_leg_ends=job.leg_ends,
             )  # fmt: skip
-            job.result = result_document(res, job.plan.manifolds[0].arc, job.leg_ends)
+            arc = job.plan.manifolds[0].arc if job.plan.manifolds else ()
+            job.result = result_document(res, arc, job.leg_ends)  # (no arc: explicit starts)
             self._end(job, "done")
         except RunCancelled:
             self._end(job, "cancelled")

@@ -33,8 +33,11 @@ from jik.engine.solve_rules import DISCRETE_GAMMA_BOUND
 MAX_STARTS = 20000
 MAX_CYCLES = 50
 MAX_FAMILY = 16
+#: Largest number of explicit starts (their coordinates travel in the request).
+MAX_START_POINTS = 4096
 
 Scale = Annotated[float, Field(strict=True, gt=0, le=100.0, allow_inf_nan=False)]
+StartPoints = Annotated[list[Vector], Field(min_length=1, max_length=MAX_START_POINTS)]
 
 
 class AtlasRequest(BaseModel):
@@ -66,6 +69,11 @@ class AtlasRequest(BaseModel):
     starts: Annotated[int, Field(strict=True, ge=1, le=MAX_STARTS), INTEGRAL] = Field(
         256, description=f"starts per path, 1 to {MAX_STARTS}"
     )
+    start_points: StartPoints | None = Field(
+        None, description="explicit starts (N, p), each on k(x) = path[0] (to 1e-9): a robot "
+        "with p - r > 1, whose self-motion manifolds are not curves, needs them; starts, "
+        "sampling, seed, arc and reference are then not used",
+    )  # fmt: skip
     sampling: Literal["grid", "sample"] = Field(
         "grid", description="arc lengths on a grid (ends included) or sampled uniformly"
     )
@@ -121,7 +129,7 @@ class AtlasResult(BaseModel):
     """The atlas, per algorithm: axes (path, start, cycle), runs = paths x starts."""
 
     algorithms: list[Algorithm]
-    arc: list[float] = Field(description="the arc lengths the starts span")
+    arc: list[float] = Field(description="the arc lengths the starts span (none: explicit starts)")
     paths: list[list[list[float]]] = Field(description="(P, L, r): the family's paths")
     parameter: list[float] = Field(description="(N,): arc length s of each start")
     starts: list[list[list[float]]] = Field(description="(P, N, p)")

@@ -11,12 +11,12 @@ from collections.abc import Callable
 
 from jik.app.dashboard.analysis import expensive_map, kinematics_and_map
 from jik.app.dashboard.messages import Event, digest, with_figures
-from jik.app.dashboard.model import ALGORITHMS, DashboardState, cache_key, default_state
+from jik.app.dashboard.model import DashboardState, cache_key, updated_state
 from jik.app.dashboard.offload import OffloadLane
 from jik.app.dashboard.plotting import PANELS
 from jik.app.dashboard.results import compute
 from jik.app.dashboard.runs import Cancelled
-from jik.engine.exceptions import JikError
+from jik.engine.exceptions import InvalidInputError, JikError
 
 log = logging.getLogger("jik.dashboard")
 
@@ -62,12 +62,15 @@ class SolvingAhead:
         """
 
         for robot in PREFETCH_ROBOTS:
-            state = default_state(robot)
             if self._generation != generation or self._stopped:
                 return
             if robot == self._state.robot:
                 continue
-            solved = all(cache_key(state, a) in self._cache for a in ALGORITHMS)
+            try:  # (the switch keeps the chosen algorithms, which this robot may refuse)
+                state = updated_state(self._state, {"robot": robot})
+            except InvalidInputError:
+                continue
+            solved = all(cache_key(state, a) in self._cache for a in state.algorithms)
             if solved and self._ahead_sent.get(robot) == self._robot_since:
                 continue  # (its figures stay the same while the robot on screen stays)
             try:

@@ -3,10 +3,12 @@ heatmap.
 
 The atlas itself is the REST API's (:mod:`jik.app.compute.atlas_jobs`: the same request model,
 the same jobs and limits); :func:`atlas_request` only says which atlas a state asks for: its
-robot, map, gamma, mode and tolerance, both algorithms, and the loop the dashboard drives, from
-k(x0) through the path's points, with the starts on the self-motion curve of k(x0) and s = 0 at
+robot, map, gamma, mode and tolerance, its chosen algorithms and their parameters, and the
+loop the dashboard drives, from k(x0) through the path's points, with the starts on the
+self-motion curve of k(x0) and s = 0 at
 x0. :func:`atlas_figure` draws a finished atlas: drift per cycle (and per path scale, when
-swept) over the arc length s of the starts, the pseudoinverse beside the extended Jacobian.
+swept) over the arc length s of the starts, one heatmap per algorithm side by side, under one
+colour scale.
 """
 
 from __future__ import annotations
@@ -17,16 +19,17 @@ from typing import Any
 import numpy as np
 
 from jik.app.compute.atlas_schemas import AtlasRequest
+from jik.app.dashboard.algorithms import STYLES, inverse_parameters
 from jik.app.dashboard.analysis import kinematics_and_map
 from jik.app.dashboard.model import DashboardState
 from jik.app.dashboard.plotting import AXIS, UNITS, figure, norm_unit
 from jik.app.dashboard.robots import state_spec
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS
+from jik.engine.self_motion import project
 
 #: Drift below this is drawn as this (the extended Jacobian's drift is round-off, ~1e-13).
 DRIFT_FLOOR = 1e-14
-TITLES = {"pseudoinverse": "pseudoinverse J^P# (8)", "extended": "extended Jacobian J^E# (11)"}
 
 
 def atlas_request(
@@ -42,16 +45,48 @@ def atlas_request(
         )
     kin, _ = kinematics_and_map(state)
     home = np.asarray(kin.forward(np.asarray(state.x0, dtype=float)), dtype=float)
+    params = {k: v for a in state.algorithms for k, v in inverse_parameters(state, a, kin).items()}
+    points = manifold_starts(state, kin, starts) if kin.p - kin.r > 1 else None
     robot, augmentation = request_robot(state)
     return AtlasRequest.model_validate({
         "robot": robot,
-        "algorithms": ["pseudoinverse", "extended"],
+        "algorithms": list(state.algorithms), "algorithm_parameters": params or None,
         "augmentation": augmentation,
         "path": [home.tolist(), *[list(p) for p in state.path]],
         "starts": starts, "cycles": cycles or state.cycles, "reference": list(state.x0),
+        "start_points": points,
         "scales": list(scales) if scales else None, "gamma": state.gamma, "mode": state.mode,
         "tolerance": state.tolerance,
     })  # fmt: skip
+
+
+#: Explicit starts lie within this fraction of the configuration box's width around x0.
+START_SPREAD = 0.15
+
+
+def manifold_starts(state: DashboardState, kin, n: int) -> list[list[float]]:
+    """``n`` starts on the self-motion manifold k(x) = k(x0) of a robot with p - r > 1 (not a
+    curve: the atlas takes them explicitly), x0 first, then farther and farther: x0 plus a
+    step along a random direction of the null space of J(x0) (seeded: the same starts for the
+    same state), the step growing to START_SPREAD of the box, projected back onto the manifold
+    by Newton steps with the pseudoinverse; those that leave the box or do not reach the
+    manifold are left out."""
+    x0 = np.asarray(state.x0, dtype=float)
+    y0 = kin.forward(x0)
+    J = np.asarray(kin.jacobian(x0), dtype=float)
+    null = np.eye(kin.p) - np.linalg.pinv(J) @ J
+    d = np.random.default_rng(0).standard_normal((n, kin.p)) @ null
+    d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
+    box = np.asarray(state_spec(state).x_range, dtype=float)
+    widths = box[:, 1] - box[:, 0]
+    width = float(np.min(widths[np.isfinite(widths)], initial=2 * np.pi))
+    step = START_SPREAD * width * np.linspace(0.0, 1.0, n)
+    X = project(kin, x0 + step[:, None] * d, y0)
+    X[0] = x0
+    ok = (np.linalg.norm(kin.forward(X) - y0, axis=1) < 1e-10) & np.all(
+        (X >= box[:, 0]) & (X <= box[:, 1]), axis=1
+    )
+    return X[ok].tolist()
 
 
 def request_robot(state: DashboardState) -> tuple[dict, dict | None]:
@@ -82,6 +117,10 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
     scales = request.scales or [1.0]
     joint = UNITS.get(request.robot.name, ((), ()))[0]
     unit = norm_unit(joint)
+    x_title, hover, at_x0 = f"arc length s of the start {unit}", "s = %{x:.3f}", 0.0
+    if request.start_points:  # (p - r > 1: starts by number, the first x0, see manifold_starts)
+        s = np.arange(1.0, len(request.start_points) + 1)
+        x_title, hover, at_x0 = "start, farther from x0 to the right", "start %{x}", 1.0
     rows, labels = [], []
     P, N = len(result["paths"]), len(s)
     for j in range(P):
@@ -91,7 +130,8 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
     runs = np.array([[j * N + i for i in range(N)] for j, _ in rows])
     data: list[dict] = []
     layout: dict[str, Any] = {"shapes": [], "annotations": []}
-    width = 0.40
+    gap = 0.06
+    width = (0.92 - gap * (len(algorithms) - 1)) / len(algorithms)
     failed = []
     for k, a in enumerate(algorithms):
         d = np.array(result["drift"][a], dtype=float)  # (P, N, C), NaN after a failure
@@ -102,32 +142,36 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
             "type": "heatmap", "x": s, "y": labels, "z": np.log10(np.maximum(z, DRIFT_FLOOR)),
             "customdata": runs.tolist(), "coloraxis": "coloraxis", "xaxis": f"x{axis}",
             "yaxis": f"y{axis}",
-            "hovertemplate": "s = %{x:.3f}<br>%{y}<br>log10 drift = %{z:.2f}"
+            "hovertemplate": f"{hover}<br>%{{y}}<br>log10 drift = %{{z:.2f}}"
             f"<extra>{a}</extra>", "hoverongaps": False, "xgap": 0, "ygap": 1,
         })  # fmt: skip
-        lo = k * (width + 0.08)
+        lo = k * (width + gap)
         layout[f"xaxis{axis}"] = {
             **AXIS, "domain": [lo, lo + width], "anchor": f"y{axis}",
-            "title": {"text": f"arc length s of the start {unit}"},
+            "title": {"text": x_title},
         }  # fmt: skip
         # s = 0 is x0, the start of the state the atlas was asked for
         layout["shapes"].append({
-            "type": "line", "xref": f"x{axis}", "yref": f"y{axis} domain", "x0": 0, "x1": 0,
+            "type": "line", "xref": f"x{axis}", "yref": f"y{axis} domain", "x0": at_x0,
+            "x1": at_x0,
             "y0": 0, "y1": 1, "line": {"color": "#fff", "width": 1.5, "dash": "dot"},
         })  # fmt: skip
         layout[f"yaxis{axis}"] = {**AXIS, "anchor": f"x{axis}", "autorange": "reversed",
                                   "showticklabels": k == 0, "type": "category"}  # fmt: skip
-    names = [TITLES.get(a, a) + (f"<br>h = {request.augmentation.name}" if a == "extended"
-             and request.augmentation is not None else "") for a in algorithms]  # fmt: skip
+    names = [(STYLES[a].label if a in STYLES else a) + (f"<br>h = {request.augmentation.name}"
+             if a == "extended" and request.augmentation is not None else "")
+             for a in algorithms]  # fmt: skip
     outside = outside_counts(result)
     for k, name in enumerate(names):
-        lo = k * (width + 0.08)
+        lo = k * (width + gap)
         note = f", {failed[k]} starts failed (blank)" if failed[k] else ""
         if algorithms[k] in outside:
             note += f"<br>{outside[algorithms[k]]} of {P * N} runs left the joint limits"
         layout["annotations"].append({
             "text": name + note, "x": lo + width / 2, "y": 1.0, "xref": "paper", "yref": "paper",
-            "xanchor": "center", "yanchor": "bottom", "showarrow": False, "font": {"size": 11},
+            "xanchor": "center", "yanchor": "bottom", "showarrow": False,
+            "font": {"size": 11, "color": STYLES[algorithms[k]].color if algorithms[k] in STYLES
+                     else "#444"},
         })  # fmt: skip
     spec = ROBOTS.get(request.robot.name)  # (a job of POST /atlas may leave them to the robot)
     gamma = request.gamma if spec is None or request.gamma is not None else spec.default_gamma
@@ -140,7 +184,7 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
     layout["coloraxis"] = {
         "colorscale": "Viridis", "cmin": float(cmin), "cmax": float(max(cmax, cmin + 1)),
         "colorbar": {"title": {"text": f"log10 ‖x − x0‖<br>{unit}", "side": "right"},
-                     "x": 2 * width + 0.1, "len": 0.9},
+                     "x": 0.94, "len": 0.9},
     }  # fmt: skip
     height = max(260, 120 + 22 * len(rows))
     return figure(

@@ -10,7 +10,8 @@ format of its own.
 
 A control's ``key`` is a dotted path into the state: ``gamma``, ``x0.1`` (one coordinate of the
 start x0), ``robot_parameters.l``, ``robot_parameters.q0`` (a vector parameter, edited whole),
-``augmentation_parameters.a``, ``path`` (edited as text).
+``augmentation_parameters.a``, ``algorithm_parameters.gain`` (a parameter of a chosen
+algorithm), ``algorithms`` (the chosen ones, a ``checks`` control), ``path`` (edited as text).
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from typing import Any
 
+from jik.app.dashboard.algorithms import STYLES, scalar_parameters
 from jik.app.dashboard.glossary import SYMBOLS
 from jik.app.dashboard.robots import state_spec
 from jik.engine.arms import ARMS
@@ -57,7 +59,8 @@ class Control:
     """One control. ``kind``: ``select`` (``options``), ``slider`` (``minimum``..``maximum`` by
     ``step``, on a ``log`` scale or not, ``integer`` or not), ``vector`` (``size`` numbers, each
     within ``minimum``/``maximum`` lists), ``text`` (``format``), ``preset`` (a button that sets
-    ``key`` to ``value``); ``inline``: a select shown as buttons."""
+    ``key`` to ``value``), ``checks`` (any of ``options``, at least one: a list);
+    ``inline``: a select shown as buttons."""
 
     key: str
     label: str
@@ -134,10 +137,29 @@ def controls(state) -> list[Control]:
                        SYMBOLS["h"] + "; one button per map of the paper for this robot",
                        options=tuple((a.name, _map_label(a)) for a in spec.augmentations),
                        inline=True))  # fmt: skip
-    for p in aug.parameters:
-        out.append(Control(f"augmentation_parameters.{p.name}", p.name, "slider", "algorithm",
-                           explained(p.name, p.description), minimum=p.minimum, maximum=p.maximum,
-                           step=(p.maximum - p.minimum) / SLIDER_STEPS))  # fmt: skip
+    groups = (
+        ("augmentation_parameters", aug.parameters),
+        ("algorithm_parameters", scalar_parameters(state.algorithms)),
+    )
+    for head, parameters in groups:
+        for p in parameters:
+            out.append(
+                Control(
+                    f"{head}.{p.name}",
+                    p.name,
+                    "slider",
+                    "algorithm",
+                    explained(p.name, p.description),
+                    minimum=p.minimum,
+                    maximum=p.maximum,
+                    step=(p.maximum - p.minimum) / SLIDER_STEPS,
+                )
+            )
+        if head == "augmentation_parameters":
+            out.append(Control("algorithms", "algorithms", "checks", "algorithm",
+                               "the inverses J# run side by side, one colour each (at least "
+                               "one)", options=tuple((a, s.label) for a, s in STYLES.items()),
+                               inline=True))  # fmt: skip
     for i, name in enumerate(spec.variable_names):
         lo, hi = spec.x_range[i] if spec.x_range else (-10.0, 10.0)
         out.append(Control(f"x0.{i}", f"x0: {name}", "slider", "start",
@@ -193,7 +215,8 @@ def max_iterations(state) -> int:
 def element_id(key: str) -> str:
     """The page's element id of the control ``key``: ``ctl-gamma``, ``ctl-x0-1``, ``ctl-l``
     (a robot parameter), ``ctl-aug-a`` (a parameter of the map)."""
-    short = key.replace("robot_parameters.", "").replace("augmentation_parameters.", "aug-")
+    short = (key.replace("robot_parameters.", "").replace("augmentation_parameters.", "aug-")
+             .replace("algorithm_parameters.", "alg-"))  # fmt: skip
     return "ctl-" + short.replace(".", "-")
 
 
@@ -235,7 +258,7 @@ def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
             out[key] = (
                 parse_path_text(value, size) if key == "path" and isinstance(value, str) else value
             )
-        elif head in ("robot_parameters", "augmentation_parameters"):
+        elif head in ("robot_parameters", "augmentation_parameters", "algorithm_parameters"):
             out.setdefault(head, {})[rest] = value
         elif head in ("x0", "target") and rest.isdigit():
             vector = out[head] = list(out.get(head, getattr(state, head)))

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from jik.app.dashboard.algorithms import COLORS, DASH, LABELS, STYLES
 from jik.app.dashboard.analysis import expensive_map, kinematics_and_map
-from jik.app.dashboard.model import ALGORITHMS, COLORS, DASH, LABELS
 from jik.app.dashboard.plotting import corner_names, figure, trace
 from jik.app.dashboard.robots import state_spec
 from jik.app.dashboard.runs import DashboardResult
@@ -142,9 +142,10 @@ def cspace_spec(result: DashboardResult) -> dict:
         notes.append(f"h is a vector of p − r = {kin.p - kin.r} maps: its level set not drawn")
     else:
         notes.append(f"the level surface of h lives in {kin.p} dimensions: not drawn")
-    ext = result.runs["extended"]
     L = len(result.targets)
-    seeds = ext.leg_end[:L] if len(ext.leg_end) >= L else result.runs["pseudoinverse"].leg_end[:L]
+    # (the corners' configurations: the extended run's, else any run's that reached them)
+    ends = [r.leg_end[:L] for a, r in sorted(result.runs.items(), key=lambda i: i[0] != "extended")]
+    seeds = next((e for e in ends if len(e) >= L), ends[0])
     if kin.p - kin.r > 1:
         notes.append(f"self-motion manifolds {kin.p - kin.r}-dimensional: not drawn")
     elif len(seeds) == L:
@@ -156,11 +157,11 @@ def cspace_spec(result: DashboardResult) -> dict:
                               name="self-motion manifolds k(x) = corner", legendgroup="fibres",
                               showlegend=k == 0,
                               hovertemplate=f"k(x) = {name}<extra></extra>"))  # fmt: skip
-    for alg in ALGORITHMS:
-        x = _thin(result.runs[alg].x)
+    for alg, run in result.runs.items():
+        x = _thin(run.x)
         data.append(trace("scatter3d", x=x[:, a], y=x[:, b], z=x[:, c], mode="lines",
-                          name=LABELS[alg], line=dict(color=COLORS[alg], width=5 if
-                          alg == "pseudoinverse" else 3, dash=DASH[alg]),
+                          name=LABELS[alg], line=dict(color=COLORS[alg], dash=DASH[alg],
+                                                      width=1 + STYLES[alg].width),
                           hovertemplate=f"{names[a]} = %{{x:.3f}}<br>{names[b]} = %{{y:.3f}}"
                           f"<br>{names[c]} = %{{z:.3f}}<extra>{alg}</extra>"))  # fmt: skip
     x0 = np.asarray(result.state.x0, dtype=float)

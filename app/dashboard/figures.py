@@ -4,8 +4,9 @@ Each figure is built as a plain figure dict first (its "spec"): the dashboard se
 directly (:func:`figure_specs`, :func:`figure_json`), 5x faster than through ``go.Figure``
 and ``to_json``, on every change of a control.
 
-Colours are fixed per algorithm (:data:`jik.app.dashboard.model.COLORS`), the same as in the
-3D scene.
+Colours, line styles and markers are fixed per algorithm
+(:data:`jik.app.dashboard.algorithms.STYLES`), the same as in the 3D scene and the atlas; every
+panel draws the state's chosen algorithms (``result.runs``, in the catalogue's order).
 The figures follow the paper: task-space paths (Figs. 5, 6), joint trajectories against theta
 (Figs. 7-9), the repeatability drift per cycle with the Table 1 numbers, and for the unicycle the
 platform paths in the (q1, q2) plane and the controls against the iteration (Figs. 11-14).
@@ -16,12 +17,11 @@ from __future__ import annotations
 import numpy as np
 import plotly.graph_objects as go
 
+from jik.app.dashboard.algorithms import COLORS, DASH, LABELS, STYLES
 from jik.app.dashboard.cspace import cspace_spec
 from jik.app.dashboard.map_figures import augmenting_spec, sensitivity_spec
-from jik.app.dashboard.model import ALGORITHMS, COLORS, DASH, LABELS
 from jik.app.dashboard.plotting import (
     NO_LEGEND,
-    SYMBOLS,
     corner_names,
     figure,
     is_unicycle,
@@ -38,29 +38,24 @@ from jik.app.dashboard.plotting import (
 from jik.app.dashboard.runs import DashboardResult
 from jik.app.dashboard.table import table_spec
 
-#: Names of the algorithms where a panel has little room (its subplots' titles).
-SHORT_LABELS = {"pseudoinverse": "J^P# (8)", "extended": "J^E# (11)"}
-
 
 def _task_space(result: DashboardResult) -> dict:
-    """End-effector paths of both algorithms in the task plane (paper, Figs. 5 and 6)."""
+    """End-effector paths of the algorithms in the task plane (paper, Figs. 5 and 6)."""
     _, tu = units(result)
     n1, n2 = result.task_names[:2]
     data = []
-    for a in ALGORITHMS:
-        run = result.runs[a]
+    for a, run in result.runs.items():
         data.append(
             trace("scatter",
                 x=run.y[:, 0], y=run.y[:, 1], mode="lines", name=LABELS[a],
-                line=dict(color=COLORS[a], width=4 if a == "pseudoinverse" else 1.8,
-                          dash=DASH[a]),
+                line=dict(color=COLORS[a], width=STYLES[a].width, dash=DASH[a]),
                 customdata=run.leg + 1,  # (theta stays out: this panel does not depend on gamma)
                 hovertemplate=f"{n1} = %{{x:.4f}}<br>{n2} = %{{y:.4f}}"
                 "<br>leg %{customdata}<extra>" + a + "</extra>",
             )
         )  # fmt: skip
     tg = result.targets
-    x0y = result.runs["pseudoinverse"].y[0]
+    x0y = next(iter(result.runs.values())).y[0]
     data.append(
         trace("scatter",
             x=tg[:, 0], y=tg[:, 1], mode="markers+text", name="targets",
@@ -76,11 +71,12 @@ def _task_space(result: DashboardResult) -> dict:
             hovertemplate="start (%{x:.3f}, %{y:.3f})<extra></extra>",
         )
     )  # fmt: skip
-    points = np.vstack([result.runs[a].y[:, :2] for a in ALGORITHMS] + [tg[:, :2]])
+    points = np.vstack([r.y[:, :2] for r in result.runs.values()] + [tg[:, :2]])
     return figure(
         data,
-        "Task-space paths (Figs. 5, 6)<br><sup>solid: J<sup>P#</sup>, dashed: J<sup>E#</sup>"
-        " · × targets of the legs · ○ start k(x0)</sup>",
+        "Task-space paths (Figs. 5, 6)<br><sup>"
+        + ", ".join(f"{STYLES[a].line.split()[0]}: {STYLES[a].short}" for a in result.runs)
+        + " · × targets of the legs · ○ start k(x0)</sup>",
         **NO_LEGEND,
         xaxis=dict(title=label(n1, tu[0]), range=nice_range(points[:, 0])),
         yaxis=dict(title=label(n2, tu[1]), range=nice_range(points[:, 1]), scaleanchor="x",
@@ -89,12 +85,11 @@ def _task_space(result: DashboardResult) -> dict:
 
 
 def _joints(result: DashboardResult) -> dict:
-    """Every joint variable against theta for both algorithms (Figs. 7-9; Figs. 11-14 b, c)."""
+    """Every joint variable against theta for each algorithm (Figs. 7-9; Figs. 11-14 b, c)."""
     ju, _ = units(result)
     names = result.variable_names
     data = []
-    for a in ALGORITHMS:
-        run = result.runs[a]
+    for a, run in result.runs.items():
         for k, name in enumerate(names):
             data.append(
                 trace("scatter",
@@ -106,7 +101,7 @@ def _joints(result: DashboardResult) -> dict:
                 )
             )  # fmt: skip
     axes = stacked_axes(len(names))
-    runs = [result.runs[a] for a in ALGORITHMS]
+    runs = list(result.runs.values())
     for k, name in enumerate(names):
         axis = axes["yaxis" if k == 0 else f"yaxis{k + 1}"]
         axis["title"] = label(name, ju[k])
@@ -128,15 +123,14 @@ def _drift(result: DashboardResult) -> dict:
     """
     data = []
     closed = result.state.task == "path"
-    for a in ALGORITHMS:
-        run = result.runs[a]
+    for a, run in result.runs.items():
         if closed:
             data.append(
                 trace("scatter",
                     x=np.arange(1, len(run.drift) + 1), y=np.maximum(run.drift, 1e-16),
                     mode="lines+markers", name=LABELS[a],
                     line=dict(color=COLORS[a], width=2, dash=DASH[a]),
-                    marker=dict(symbol=SYMBOLS[a], size=9),
+                    marker=dict(symbol=STYLES[a].symbol, size=9),
                     hovertemplate="cycle %{x}: drift %{y:.3e}<extra>" + a + "</extra>",
                 )
             )  # fmt: skip
@@ -150,7 +144,7 @@ def _drift(result: DashboardResult) -> dict:
             )  # fmt: skip
     ys = np.concatenate([np.asarray(t["y"], dtype=float) for t in data])
     if closed:
-        cycles = max(len(result.runs[a].drift) for a in ALGORITHMS)
+        cycles = max(len(r.drift) for r in result.runs.values())
         return figure(
             data,
             "Repeatability: joint drift after each closed cycle",
@@ -160,7 +154,7 @@ def _drift(result: DashboardResult) -> dict:
                        type="log", exponentformat="power",
                        range=log_range(ys)),
         )  # fmt: skip
-    theta = np.concatenate([result.runs[a].theta for a in ALGORITHMS])
+    theta = np.concatenate([r.theta for r in result.runs.values()])
     return figure(
         data,
         "Convergence: task error",
@@ -183,8 +177,10 @@ def _platform(result: DashboardResult, max_paths: int = 12) -> dict:
     _, tu = units(result)
     data = []
     annotations = []
-    for col, a in enumerate(ALGORITHMS, start=1):
-        xa, ya = ("x", "y") if col == 1 else ("x2", "y2")
+    count = len(result.runs)
+    width = (1.0 - 0.04 * (count - 1)) / count
+    for col, a in enumerate(result.runs, start=1):
+        xa, ya = ("x", "y") if col == 1 else (f"x{col}", f"y{col}")
         P = result.runs[a].platform
         assert P is not None  # drawn only for the unicycle, whose runs all carry platform paths
         m = len(P)
@@ -214,16 +210,23 @@ def _platform(result: DashboardResult, max_paths: int = 12) -> dict:
             )
         )  # fmt: skip
         annotations.append(
-            dict(text=SHORT_LABELS[a], xref=f"{xa} domain", yref=f"{ya} domain", x=0.5, y=1.0,
+            dict(text=STYLES[a].short, xref=f"{xa} domain", yref=f"{ya} domain", x=0.5, y=1.0,
                  yanchor="bottom", showarrow=False, font=dict(size=11, color=COLORS[a]))
+        )  # fmt: skip
+    axes: dict = {}
+    for col in range(1, count + 1):
+        k = "" if col == 1 else str(col)
+        lo = (col - 1) * (width + 0.04)
+        axes[f"xaxis{k}"] = dict(domain=[lo, lo + width], title=label("q1", tu[0]),
+                                 **({"matches": "x"} if k else {}))  # fmt: skip
+        axes[f"yaxis{k}"] = (
+            dict(anchor=f"x{k}", matches="y", showticklabels=False) if k
+            else dict(title=label("q2", tu[1]), scaleanchor="x", scaleratio=1)
         )  # fmt: skip
     return figure(
         data,
         "Platform paths q(t) per iteration (Figs. 11-14 a)",
-        xaxis=dict(domain=[0, 0.48], title=label("q1", tu[0])),
-        xaxis2=dict(domain=[0.52, 1], title=label("q1", tu[0]), matches="x"),
-        yaxis=dict(title=label("q2", tu[1]), scaleanchor="x", scaleratio=1),
-        yaxis2=dict(anchor="x2", matches="y", showticklabels=False),
+        **axes,
         annotations=annotations,
         showlegend=False,  # (each plot is named above it)
         margin=dict(l=64, r=20, t=64, b=48),
@@ -275,12 +278,12 @@ def figures_for(
 
 
 def task_space_figure(result: DashboardResult) -> go.Figure:
-    """End-effector paths of both algorithms in the task plane (paper, Figs. 5 and 6)."""
+    """End-effector paths of the algorithms in the task plane (paper, Figs. 5 and 6)."""
     return to_go(_task_space(result))
 
 
 def joint_figure(result: DashboardResult) -> go.Figure:
-    """Every joint variable against theta for both algorithms (Figs. 7-9; Figs. 11-14 b, c)."""
+    """Every joint variable against theta for each algorithm (Figs. 7-9; Figs. 11-14 b, c)."""
     return to_go(_joints(result))
 
 

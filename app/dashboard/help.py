@@ -9,28 +9,22 @@ from __future__ import annotations
 
 from dataclasses import asdict
 
+from jik.app.dashboard.algorithms import COLORS, LABELS
+from jik.app.dashboard.algorithms import STYLES as DRAWN
 from jik.app.dashboard.controls import PROGRESS_AFTER
-from jik.app.dashboard.model import COLORS, DASH, LABELS
 from jik.app.dashboard.plotting import PANEL_SIZES
 from jik.engine.arms import ARMS
 from jik.engine.robot_kinds import ARM, robot_kinds
 
 #: How each algorithm is drawn, everywhere: its colour (COLORS), its line style in the plots
-#: (plotly's ``dash``) and its robot in the 3D scene.
-STYLES = {
-    "pseudoinverse": {
-        "dash": DASH["pseudoinverse"],
-        "line": "solid line",
-        "robot": "translucent robot",
-    },
-    "extended": {"dash": DASH["extended"], "line": "dashed line", "robot": "opaque robot"},
-}
+#: (plotly's ``dash``) and its robot in the 3D scene (:data:`jik.app.dashboard.algorithms.STYLES`).
+STYLES = {a: {"dash": s.dash, "line": s.line, "robot": s.robot} for a, s in DRAWN.items()}
 
 #: What each panel shows, and how to read it.
 PANEL_HELP = {
-    "task": "The end effector's path in the task space for both algorithms (paper, Figs. 5 and "
-    "6): × marks the targets of the legs, ○ the start k(x0). Both algorithms follow the same "
-    "task path; they differ in the joints.",
+    "task": "The end effector's path in the task space for each chosen algorithm (paper, Figs. "
+    "5 and 6): × marks the targets of the legs, ○ the start k(x0). The algorithms follow the "
+    "same task path; they differ in the joints.",
     "drift": "Repeatability: after each cycle of the closed path, how far the joints are from "
     "where they started, ‖x − x0‖ (the Euclidean norm of the joint vector, whose coordinates "
     "can mix units, e.g. m and rad). A repeatable algorithm stays near 0 (log scale). For a "
@@ -45,7 +39,7 @@ PANEL_HELP = {
     "sensitivity": "The error functionals E1 (13), Roberts-Maciejewski, and E2 (18), the "
     "manipulability-weighted embedding, of the current map and its alternatives, and how they "
     "change with the map's parameters: lower is closer to the pseudoinverse.",
-    "cspace": "The joint paths x(θ) of both algorithms in configuration space (three "
+    "cspace": "The joint paths x(θ) of the chosen algorithms in configuration space (three "
     "coordinates), with the level surface h(x) = h(x0) that the extended Jacobian stays on "
     "(eq. (12)) and, in green, the self-motion manifolds k(x) = y of the path's corners (curves, "
     "since p − r = 1). A repeatable run is one closed curve on the surface; the pseudoinverse's "
@@ -59,10 +53,11 @@ ATLAS_HELP = (
     "The repeatability atlas of the current state: the closed path driven from many starts on "
     "the self-motion curve k(x) = k(x0) (p − r = 1), each at its arc length s along the curve "
     "(s = 0 is x0; the curve is cut where it leaves the robot's joint box). Each cell is the "
-    "drift ‖x − x0‖ after one cycle from one start, as log10 on one colour scale for both: "
-    "the pseudoinverse on the left, the extended Jacobian with the chosen augmenting map on the "
-    "right (repeatable: round-off, about −13). With path scales, one band of rows per scale of "
-    "the path about k(x0). Click a cell to move the main view to that start (and scale)."
+    "drift ‖x − x0‖ after one cycle from one start, as log10 on one colour scale for all: one "
+    "heatmap per chosen algorithm, left to right (the extended Jacobian with the chosen "
+    "augmenting map is repeatable: round-off, about −13). With path scales, one band of rows "
+    "per scale of the path about k(x0). Click a cell to move the main view to that start "
+    "(and scale)."
 )
 
 

@@ -9,8 +9,8 @@ from typing import Any
 
 import numpy as np
 
+from jik.app.dashboard.algorithms import COLORS, DASH, LABELS
 from jik.app.dashboard.analysis import state_inert_variables, vector_note
-from jik.app.dashboard.model import ALGORITHMS, COLORS, DASH, LABELS
 from jik.app.dashboard.plotting import NO_LEGEND, figure, label, trace, units
 from jik.app.dashboard.robots import state_spec
 from jik.app.dashboard.runs import DashboardResult
@@ -65,7 +65,7 @@ def augmenting_spec(
     shapes: list[dict[str, Any]] = [
         dict(type="path", path=_svg_path(result.runs[a].x[:, i], result.runs[a].x[:, j]),
              line=dict(color=COLORS[a], width=2.5, dash=DASH[a]), name=LABELS[a])
-        for a in ALGORITHMS
+        for a in result.runs
     ]  # fmt: skip
     x0 = result.state.x0
     shapes.append(  # (a circle of 10 px at x0, whatever the axes' scales)

@@ -2,31 +2,37 @@
 
 A change (:func:`updated_state`) is a patch of state fields or of control keys
 (:func:`jik.app.dashboard.controls.expand`); each refusal names its field
-(:attr:`jik.engine.exceptions.InvalidInputError.field`). :func:`cache_key` and :func:`runs_key`
-say what a run depends on (gamma only rescales theta in continuous mode, see
-:mod:`jik.app.dashboard.results`).
+(:attr:`jik.engine.exceptions.InvalidInputError.field`). The chosen algorithms and their
+parameters are checked by :mod:`jik.app.dashboard.algorithms`, which also says what a run
+depends on (``cache_key``, ``runs_key``); a change's request body is
+:mod:`jik.app.dashboard.patch`.
 """
 
 from __future__ import annotations
 
-import json
-import re
 from collections.abc import Mapping
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, ValidationError, create_model
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from jik.app.compute.schemas import (
     AUGMENTATION_MODELS,
     INTEGRAL,
     MAX_DIMENSION,
     ROBOT_MODELS,
-    USER_AUGMENTATION_MODELS,
     Coordinate,
     Gamma,
     Mode,
     Tolerance,
 )
+from jik.app.compute.schemas.algorithms import Algorithm
+from jik.app.dashboard import algorithms as chosen
+from jik.app.dashboard.algorithms import CHOICES, DEFAULT_ALGORITHMS
+from jik.app.dashboard.algorithms import COLORS as COLORS  # (re-exported: one table, there)
+from jik.app.dashboard.algorithms import DASH as DASH
+from jik.app.dashboard.algorithms import LABELS as LABELS
+from jik.app.dashboard.algorithms import cache_key as cache_key
+from jik.app.dashboard.algorithms import runs_key as runs_key
 from jik.app.dashboard.controls import (
     MAX_DASHBOARD_CYCLES,
     MAX_ITERATIONS_CAP,
@@ -34,18 +40,14 @@ from jik.app.dashboard.controls import (
     expand,
     max_iterations,
 )
-from jik.app.dashboard.robots import USER_KINDS, default_definition, user_robot
+from jik.app.dashboard.robots import USER_KINDS, default_definition, state_inverse, user_robot
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS, robot_spec
 from jik.engine.repeatability import MAX_PATH_POINTS
 from jik.engine.solve_rules import gamma_problem
 
-ALGORITHMS = ("pseudoinverse", "extended")
-#: One colour per algorithm, used in the scene and in every plot.
-COLORS = {"pseudoinverse": "#d62728", "extended": "#1f77b4"}
-#: One line style per algorithm, in every plot (its robot in the 3D scene: translucent, opaque).
-DASH = {"pseudoinverse": "solid", "extended": "dash"}
-LABELS = {"pseudoinverse": "pseudoinverse J^P# (8)", "extended": "extended Jacobian J^E# (11)"}
+#: The algorithms of a new state (:mod:`jik.app.dashboard.algorithms`: colours, styles, keys).
+ALGORITHMS = DEFAULT_ALGORITHMS
 DEFAULT_ROBOT = "manipulator2"
 
 Point = Annotated[tuple[Coordinate, ...], Field(min_length=1, max_length=MAX_DIMENSION)]
@@ -85,98 +87,16 @@ class DashboardState(BaseModel):
         Annotated[int, Field(strict=True, ge=MIN_ITERATIONS, le=MAX_ITERATIONS_CAP), INTEGRAL]
         | None
     ) = None
+    #: The inverses run side by side, and the scalar parameters of those chosen
+    #: (:mod:`jik.app.dashboard.algorithms`).
+    algorithms: Annotated[tuple[Algorithm, ...], Field(min_length=1, max_length=len(CHOICES))] = (
+        DEFAULT_ALGORITHMS
+    )
+    algorithm_parameters: dict[str, Annotated[float, Field(strict=True)]] = {}
 
     def as_dict(self) -> dict:
         """The state as JSON data (tuples as lists)."""
         return self.model_dump(mode="json")
-
-
-#: Control keys a patch may hold besides the state's fields (:func:`.controls.expand`), and
-#: their values: one coordinate of ``x0`` or ``target``, one parameter of the robot (a number
-#: or a vector) or of the map.
-CONTROL_KEYS: dict[str, Any] = {
-    r"^(?:x0|target)\.[0-9]+$": Coordinate,
-    r"^robot_parameters\.[A-Za-z_][A-Za-z0-9_]*$": Annotated[float, Field(strict=True)] | Point,
-    r"^augmentation_parameters\.[A-Za-z_][A-Za-z0-9_]*$": Annotated[float, Field(strict=True)],
-}
-_PATCH_TYPES: dict[str, Any] = {
-    "robot": Literal[(*ROBOTS, *USER_KINDS)],
-    "augmentation": Literal[(*AUGMENTATION_MODELS, *USER_AUGMENTATION_MODELS)],
-    "robot_parameters": dict[str, float | Point],
-    "augmentation_parameters": dict[str, float],
-    "path": Annotated[tuple[Point, ...], Field(max_length=MAX_PATH_POINTS)]
-    | Annotated[str, Field(max_length=10_000)],
-}
-
-
-def _patch_model() -> type[BaseModel]:
-    fields: dict[str, Any] = {}
-    for name, info in DashboardState.model_fields.items():
-        annotation = _PATCH_TYPES.get(name)
-        if annotation is None:
-            annotation = info.annotation
-            for meta in info.metadata:
-                annotation = Annotated[annotation, meta]
-        fields[name] = (annotation, Field(None, description=f"the state's {name}"))
-    return create_model(
-        "StatePatch",
-        __config__=ConfigDict(
-            extra="allow",
-            json_schema_extra={
-                "patternProperties": {
-                    key: TypeAdapter(kind).json_schema() for key, kind in CONTROL_KEYS.items()
-                },
-                "additionalProperties": False,
-            },
-        ),
-        __doc__="A change of the dashboard's state: some of its fields, and control keys "
-        "(``x0.1``, ``robot_parameters.l``: one coordinate or parameter); ``path`` may be text "
-        "('x, y; x, y; ...'). Checked against the session's robot when applied.",
-        **fields,
-    )
-
-
-#: The body of a change (``POST /api/sessions/{id}/state``, a link's state): the state's fields
-#: with their types, all optional; what depends on the robot is checked by :func:`updated_state`.
-StatePatch = _patch_model()
-
-
-def parse_patch(body: Any) -> dict[str, Any]:
-    """A change's JSON body as a patch (:data:`StatePatch`, then :func:`patch_of`).
-
-    Raises
-    ------
-    InvalidInputError
-        Naming the field: the first the patch's types refuse (a member of a union, labelled by
-        its type in pydantic's location, is left out of the name).
-    """
-    try:
-        return patch_of(StatePatch.model_validate(body))
-    except ValidationError as exc:
-        error = exc.errors()[0]
-        field = (
-            ".".join(
-                str(p) for p in error["loc"] if isinstance(p, str) and "[" not in p and p != "str"
-            )
-            or "body"
-        )
-        message = "unknown field; remove it" if error["type"] == "extra_forbidden" else error["msg"]
-        raise InvalidInputError(f"{field}: {message}", field) from None
-
-
-def patch_of(patch: BaseModel) -> dict[str, Any]:
-    """The fields a :data:`StatePatch` was given, and its control keys (checked here: a key of
-    no known form, or a value not of its type, is refused naming the key)."""
-    controls = {}
-    for key, value in (patch.model_extra or {}).items():
-        kind = next((k for p, k in CONTROL_KEYS.items() if re.match(p, key)), None)
-        if kind is None:
-            raise InvalidInputError(f"unknown dashboard control {key!r}", key)
-        try:
-            controls[key] = TypeAdapter(kind).validate_python(value)
-        except ValidationError as exc:
-            raise InvalidInputError(f"{key}: {exc.errors()[0]['msg']}", key) from None
-    return {**patch.model_dump(exclude_unset=True), **controls}
 
 
 def default_state(
@@ -271,7 +191,13 @@ def updated_state(state: DashboardState, patch: Mapping[str, object]) -> Dashboa
                                     "robot")  # fmt: skip
         if robot != state.robot and "robot_definition" not in patch:
             definition = None  # (another robot chosen: the definition was the other's)
-        state = default_state(robot, definition)
+        # (the chosen algorithms stay: the new robot's defaults are for everything else)
+        state = default_state(robot, definition).model_copy(
+            update={
+                "algorithms": state.algorithms,
+                "algorithm_parameters": state.algorithm_parameters,
+            }
+        )
     # (control keys after a change of robot are the new robot's: {"robot": "unicycle",
     # "x0.0": 0} changes the unicycle's x0, not the old robot's)
     patch = expand(state, patch)
@@ -285,7 +211,7 @@ def updated_state(state: DashboardState, patch: Mapping[str, object]) -> Dashboa
     for key, value in patch.items():
         if key in ("robot", "augmentation", "robot_definition"):
             continue
-        if key in ("robot_parameters", "augmentation_parameters"):
+        if key in ("robot_parameters", "augmentation_parameters", "algorithm_parameters"):
             if not isinstance(value, Mapping):
                 raise InvalidInputError(f"{key}: give an object of parameters", key)
             value = {**data[key], **value}
@@ -323,6 +249,8 @@ def validate(data: Mapping[str, Any]) -> DashboardState:
         raise InvalidInputError("path: a closed-path task needs at least one path point", "path")
     if (why := gamma_problem(state.gamma, state.mode)) is not None:
         raise InvalidInputError(f"gamma: {why}", "gamma")
+    state = state.model_copy(update=chosen.checked(state.algorithms, state.algorithm_parameters))
+    chosen.check_inverses(state, lambda a: state_inverse(state, a, kin))
     # The engine's default cap, set by its value, is the default (None): it follows the mode.
     default_cap = max_iterations(state.model_copy(update={"max_iterations": None}))
     return state.model_copy(update={
@@ -396,22 +324,3 @@ def _registered(check, name: str):
     except InvalidInputError as exc:
         raise InvalidInputError(f"{name}: {exc}" if not str(exc).startswith(name) else str(exc),
                                 exc.field or name) from None  # fmt: skip
-
-
-def cache_key(state: DashboardState, algorithm: str) -> str:
-    d = state.as_dict()
-    d.pop("cspace_axes")  # (what a panel shows, not what is solved)
-    if algorithm == "pseudoinverse":
-        d.pop("augmentation"), d.pop("augmentation_parameters")
-    if state.mode == "continuous":
-        d.pop("gamma")
-    return json.dumps(d, sort_keys=True)
-
-
-def runs_key(state: DashboardState) -> tuple[str, ...]:
-    """Everything the runs of both algorithms depend on, up to the scale of theta.
-
-    Two states with the same key have the same configurations along the same legs (in
-    continuous mode gamma only divides theta, see the module's docstring).
-    """
-    return tuple(cache_key(state, a) for a in ALGORITHMS)

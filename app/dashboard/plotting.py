@@ -46,7 +46,6 @@ LAYOUT = dict(
     hovermode="closest",
     uirevision="keep",  # keep the user's zoom across updates of the same robot
 )
-SYMBOLS = {"pseudoinverse": "circle", "extended": "diamond"}
 
 
 def units(result: DashboardResult) -> tuple[tuple[str, ...], tuple[str, ...]]:
@@ -90,7 +89,7 @@ def corner_names(result: DashboardResult) -> list[str]:
     from A."""
     targets = np.asarray(result.targets, dtype=float)
     n = len(targets)
-    start = result.runs["pseudoinverse"].y[0]
+    start = next(iter(result.runs.values())).y[0]
     if result.state.task == "path" and n > 1 and np.allclose(targets[-1], start, atol=1e-6):
         names = leg_names(n)
         return names[1:] + names[:1]

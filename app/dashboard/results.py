@@ -1,4 +1,4 @@
-"""A dashboard state solved: both algorithms through its task (cached runs reused, more cycles
+"""A dashboard state solved: its chosen algorithms through its task (cached runs reused, more cycles
 going on from fewer), with h on a grid for the h panel.
 
 Continuous mode integrates in tau = gamma theta (see :mod:`jik.engine.solver`): x(theta) does not
@@ -18,7 +18,7 @@ import numpy as np
 
 from jik.app.dashboard.analysis import augmenting_grid
 from jik.app.dashboard.controls import MAX_DASHBOARD_CYCLES
-from jik.app.dashboard.model import ALGORITHMS, DashboardState, cache_key
+from jik.app.dashboard.model import DashboardState, cache_key
 from jik.app.dashboard.offload import OffloadLane
 from jik.app.dashboard.robots import state_kinematics, state_spec
 from jik.app.dashboard.runs import (
@@ -59,7 +59,7 @@ def compute(
     offload: OffloadLane | None = None,
     grid_before: dict | None = None,
 ) -> DashboardResult:
-    """Solve the state's task with both algorithms.
+    """Solve the state's task with each of its chosen algorithms (``state.algorithms``).
 
     Parameters
     ----------
@@ -73,8 +73,8 @@ def compute(
     with_augmenting : bool
         Evaluate h on a grid for the h panel now (see :func:`augmenting_grid`).
     offload : OffloadLane, optional
-        A lane of the shared compute processes: the pseudoinverse runs there, concurrently with
-        the extended inverse here (same results).
+        A lane of the shared compute processes: the first algorithm to solve runs there,
+        concurrently with the others here (same results).
     grid_before : dict, optional
         The h grid on screen, whose box the new grid keeps when it fits (see
         :func:`augmenting_grid`).
@@ -89,28 +89,30 @@ def compute(
     kin = state_kinematics(state)
     targets = leg_targets(kin, state)
     cycles = state.cycles if state.task == "path" else 1
-    total = 2 * cycles * len(targets)
+    algorithms = state.algorithms
+    total = len(algorithms) * cycles * len(targets)
     cache = {} if cache is None else cache
-    keys = {a: cache_key(state, a) for a in ALGORITHMS}
-    todo = [a for a in ALGORITHMS if keys[a] not in cache]
+    keys = {a: cache_key(state, a) for a in algorithms}
+    todo = [a for a in algorithms if keys[a] not in cache]
     # Another number of cycles of the same legs: its first cycles are this run's, or this run
     # goes on from its end (cycles slider: only the new legs are solved).
     other = {a: other_cycles(cache, state, a, len(targets)) for a in todo}
     for a in [a for a in todo if other[a] is not None and len(other[a].drift) >= cycles]:
         cache[keys[a]] = first_cycles(other[a], cycles, len(targets))
         todo.remove(a)
-    done = [(len(ALGORITHMS) - len(todo)) * cycles * len(targets)]  # legs, cached runs included
+    done = [
+        float((len(algorithms) - len(todo)) * cycles * len(targets))
+    ]  # legs, cached runs included
     done[0] += sum(len(other[a].leg_end) for a in todo if other[a] is not None)
 
-    # With a lane of the compute pool, the pseudoinverse runs in a worker while this thread runs
-    # the extended inverse (the two are independent); each local leg then stands for two in the
-    # progress.
+    # With a lane of the compute pool, the first algorithm runs in a worker while this thread
+    # runs the others (they are independent); each local leg then stands for n / (n - 1) legs
+    # of the n in the progress.
     remote: Future | None = None
-    if offload is not None and len(todo) == 2:
-        remote = offload.submit(
-            state, "pseudoinverse", targets, cycles, generation, other["pseudoinverse"]
-        )
-    weight = 1 if remote is None else 2
+    away = todo[0] if len(todo) >= 2 else None
+    if offload is not None and away is not None:
+        remote = offload.submit(state, away, targets, cycles, generation, other[away])
+    weight = 1.0 if remote is None else len(todo) / (len(todo) - 1)
 
     def step() -> None:
         done[0] += weight
@@ -122,17 +124,17 @@ def compute(
             progress(min((done[0] + weight * float(fraction)) / total, 1.0))
 
     for algorithm in todo:
-        if remote is None or algorithm != "pseudoinverse":
+        if remote is None or algorithm != away:
             cache[keys[algorithm]] = algorithm_run(
                 state, algorithm, targets, cycles, step, cancelled, partial, kin,
                 resume=other[algorithm],
             )  # fmt: skip
-    if offload is not None and remote is not None:
-        cache[keys["pseudoinverse"]] = offload.result(remote, lambda: algorithm_run(
-            state, "pseudoinverse", targets, cycles, cancelled=cancelled, kin=kin,
-            resume=other["pseudoinverse"]))  # fmt: skip
+    if offload is not None and remote is not None and away is not None:
+        cache[keys[away]] = offload.result(remote, lambda: algorithm_run(
+            state, away, targets, cycles, cancelled=cancelled, kin=kin,
+            resume=other[away]))  # fmt: skip
     runs: dict[str, AlgorithmRun] = {}
-    for algorithm in ALGORITHMS:
+    for algorithm in algorithms:
         run = cache[keys[algorithm]]
         if state.mode == "continuous":
             run = replace(run, theta=run.theta / state.gamma)
@@ -155,5 +157,5 @@ def compute(
         if with_augmenting
         else None,
         seconds=time.perf_counter() - t0,
-        cached={a: a not in todo for a in ALGORITHMS},
+        cached={a: a not in todo for a in algorithms},
     )

@@ -23,6 +23,7 @@ import numpy as np
 from jik.app.compute.budget import build_seconds, time_budget
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.worker import task
+from jik.app.dashboard.algorithms import inverse_parameters
 from jik.engine.arms import ARMS
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.inverses import Inverse
@@ -135,12 +136,15 @@ def state_kinematics(state) -> Kinematics:
 
 
 def state_inverse(state, algorithm: str, kin: Kinematics | None = None) -> Inverse:
-    """The state's inverse for ``algorithm``: its map and the map's parameters."""
+    """The state's inverse for ``algorithm``: its map and the map's parameters, or the
+    algorithm's own (:func:`jik.app.dashboard.algorithms.inverse_parameters`)."""
     robot = state_robot(state)
+    kin = state_kinematics(state) if kin is None else kin
+    params = inverse_parameters(state, algorithm, kin)
     if robot is not None:
-        return robot.inverse(algorithm, state.augmentation)
+        return robot.inverse(algorithm, state.augmentation, algorithm_parameters=params)
     spec = robot_spec(state.robot)
-    kin = spec.build(**state.robot_parameters) if kin is None else kin
     return make_inverse(
-        kin, algorithm, state.augmentation, state.augmentation_parameters, spec.name
-    )
+        kin, algorithm, state.augmentation, state.augmentation_parameters, spec.name,
+        algorithm_parameters=params,
+    )  # fmt: skip

@@ -21,9 +21,10 @@ from collections.abc import Callable, Mapping
 from typing import NoReturn
 
 from jik.app.dashboard.ahead import SolvingAhead
-from jik.app.dashboard.analysis import expensive_map, kinematics_and_map
+from jik.app.dashboard.analysis import expensive_map
 from jik.app.dashboard.controls import controls_message
 from jik.app.dashboard.figures import gamma_free_panels
+from jik.app.dashboard.map_synthesis import built_map
 from jik.app.dashboard.messages import Event, digest, finite, summary, to_json, with_figures
 from jik.app.dashboard.model import (
     COLORS,
@@ -31,6 +32,7 @@ from jik.app.dashboard.model import (
     DashboardState,
     cache_key,
     default_state,
+    runs_key,
     updated_state,
     validate,
 )
@@ -350,7 +352,7 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts):
             else None
         )
         try:
-            kin, amap = kinematics_and_map(state)
+            kin, amap = built_map(state, progress, lambda: self._generation != generation)
             deferred = expensive_map(amap)
             with self._turn():
                 if self._generation != generation:  # (a newer change came while it waited)
@@ -366,7 +368,7 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts):
             self._failure(generation, str(exc))
             return
         # Panels that do not depend on gamma are reused from the last result with the same key.
-        key = cache_key(state, "extended")
+        key = "|".join((cache_key(state, "extended"), *runs_key(state)))  # (the map, every run)
         reuse = {k for k in gamma_free_panels(result) if (k, key) in self._figures}
         texts = {k: self._figures[(k, key)] for k in reuse}
         cached, stale = self._known_functionals(state)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from jik.app.dashboard.model import ALGORITHMS
+from jik.app.dashboard.algorithms import STYLES
 from jik.app.dashboard.plotting import corner_names, figure, trace
 from jik.app.dashboard.runs import DashboardResult
 from jik.engine.reproductions.table1 import PATH, PRINTED, X0, cell
@@ -21,10 +21,20 @@ TABLE1_TITLE = (
     "Table 1 of the paper: Manipulator 2 on the closed path, jik beside the printed values"
 )
 LEG_ENDS_TITLE = "Joint configuration at the end of each leg (not the paper's Table 1)"
-#: Cell colours: the algorithms' columns, the printed ones, and a cell that differs.
-FILLS = {"pseudoinverse": "#fbe3e3", "extended": "#e1ecf7", "printed": "#eeeeee",
+#: The algorithms of the paper's Table 1.
+PAPER = ("pseudoinverse", "extended")
+
+
+def _tint(color: str) -> str:
+    """An algorithm's colour mixed with 85 % white: its columns' fill."""
+    rgb = [int(color[i : i + 2], 16) for i in (1, 3, 5)]
+    return "#" + "".join(f"{round(255 - 0.15 * (255 - v)):02x}" for v in rgb)
+
+
+#: Cell colours: each algorithm's columns, the printed ones, and a cell that differs.
+FILLS = {**{a: _tint(s.color) for a, s in STYLES.items()}, "printed": "#eeeeee",
          "differs": "#ffd966"}  # fmt: skip
-SHORT = {"pseudoinverse": "J^P#", "extended": "J^E#"}
+SHORT = {a: s.short.split(" (")[0] for a, s in STYLES.items()}
 ERRATUM = (
     "Erratum (docs/paper-errata.md, “Table 1 and the cubic (38)”): the printed extended column "
     "is not what the cubic (38) gives. With (38) as printed and its exact gradient, the first leg "
@@ -41,10 +51,12 @@ ROW_LABELS_NOTE = (
 
 
 def is_table1(result: DashboardResult) -> bool:
-    """Whether ``result`` is the paper's Table 1 experiment (any mode, map, gamma, cycles)."""
+    """Whether ``result`` is the paper's Table 1 experiment (any mode, map, gamma, cycles) with
+    the paper's two algorithms among those chosen."""
     s = result.state
     return (
-        s.robot == "manipulator2"
+        set(PAPER) <= set(result.runs)
+        and s.robot == "manipulator2"
         and s.task == "path"
         and abs(float(s.robot_parameters.get("l", 1.0)) - 1.0) < 1e-12
         and np.allclose(s.x0, X0, atol=1e-9)
@@ -62,14 +74,14 @@ def table1_spec(result: DashboardResult) -> dict:
     """Table 1 (paper, sec. 5.2): for each algorithm jik's columns, then the printed ones; the
     printed first cycle compared cell by cell to four decimals, as printed."""
     names = result.variable_names
-    ends = {a: _ends(result, a) for a in ALGORITHMS}
+    ends = {a: _ends(result, a) for a in PAPER}
     rows = max(len(e) for e in ends.values())
     letters = "ABCD"
     labels = ["A  x0"] + [f"{letters[k % 4]}  x{k}f" for k in range(1, rows)]
     header, cols, fills = ["row"], [labels], ["#f4f4f4"]
     differs: list[list] = []
     counts = {}
-    for a in ALGORITHMS:
+    for a in PAPER:
         printed = np.asarray(PRINTED[a], dtype=float)
         n = 0
         for k, name in enumerate(names):
@@ -103,7 +115,7 @@ def table1_spec(result: DashboardResult) -> dict:
                      "compare).")  # fmt: skip
     if state.mode == "discrete":
         gap = max(float(np.max(np.abs(ends[a][: len(PRINTED[a])] - np.asarray(PRINTED[a]))))
-                  for a in ALGORITHMS if len(ends[a]) >= len(PRINTED[a]))  # fmt: skip
+                  for a in PAPER if len(ends[a]) >= len(PRINTED[a]))  # fmt: skip
         notes.append(f"Discrete mode changes the numbers: the paper's Table 1 is the continuous "
                      f"algorithm (7); the iteration with step γ = {state.gamma:.3g} ends its legs "
                      f"elsewhere (up to {gap:.3g} from the printed values). Choose mode = "
@@ -115,17 +127,17 @@ def table1_spec(result: DashboardResult) -> dict:
 
 
 def leg_ends_spec(result: DashboardResult) -> dict:
-    """The configuration after every leg for both algorithms (any robot, path or target)."""
+    """The configuration after every leg for each algorithm (any robot, path or target)."""
     names = result.variable_names
     L = len(result.targets)
     legs = corner_names(result)
-    rows = max(len(result.runs[a].leg_end) for a in ALGORITHMS) + 1
+    rows = max(len(r.leg_end) for r in result.runs.values()) + 1
     point = ["start x0"] + [
         f"cycle {c // L + 1}, leg to {legs[c % L]} {_point(result.targets[c % L])}"
         for c in range(rows - 1)
     ]
     header, cols, fills = ["leg end"], [point], ["#f4f4f4"]
-    for a in ALGORITHMS:
+    for a in result.runs:
         ends = _ends(result, a)
         for k, name in enumerate(names):
             header.append(f"{SHORT[a]} {name}")

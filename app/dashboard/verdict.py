@@ -21,6 +21,7 @@ from jik.app.dashboard.messages import h_change
 from jik.app.dashboard.plotting import norm_unit, units
 from jik.app.dashboard.runs import AlgorithmRun, DashboardResult
 from jik.app.dashboard.singular import singular_sentence
+from jik.app.dashboard.verdict_algorithms import NAMES, practical_sentences
 from jik.engine.registry import POSE_A, POSE_B
 from jik.engine.repeatability import REPEATABLE_DRIFT
 
@@ -28,8 +29,6 @@ from jik.engine.repeatability import REPEATABLE_DRIFT
 H_CONSERVED = 1e-6
 #: In discrete mode, a gamma at or above this is "near 2" (the iteration's stability limit).
 GAMMA_NEAR_TWO = 1.5
-
-NAMES = {"pseudoinverse": "pseudoinverse J^P#", "extended": "extended Jacobian J^E#"}
 
 
 @dataclass(frozen=True)
@@ -190,14 +189,15 @@ def _pseudoinverse_why(run: AlgorithmRun) -> list[Sentence]:
 
 def verdict(result: DashboardResult) -> list[dict]:
     """The sentences the page shows above the plots for ``result`` (:class:`Sentence` dicts):
-    each algorithm's finding, then why; failures with the engine's message."""
+    each chosen algorithm's finding, then why (:mod:`.verdict_algorithms` for the practical
+    inverses); failures with the engine's message."""
     runs = result.runs
     out: list[Sentence] = []
     path = result.state.task == "path"
-    for algorithm in ("pseudoinverse", "extended"):
-        run = runs[algorithm]
+    unit = norm_unit(units(result)[0])
+    for algorithm, run in runs.items():
         if path and len(run.drift):
-            out.append(_drift_sentence(algorithm, run, norm_unit(units(result)[0])))
+            out.append(_drift_sentence(algorithm, run, unit))
         elif run.success:
             out.append(Sentence(f"{NAMES[algorithm]}: {run.message}.", algorithm))
         if not run.success:
@@ -205,11 +205,14 @@ def verdict(result: DashboardResult) -> list[dict]:
                     if path and len(run.drift) else "")  # fmt: skip
             out.append(Sentence(f"{NAMES[algorithm]} stopped{done}: {run.message}", algorithm,
                                 "failure"))  # fmt: skip
-    out += _pseudoinverse_why(runs["pseudoinverse"]) if path else []
-    out += _undefined_why(result, runs["extended"]) or _extended_why(result, runs["extended"])
+    out += _pseudoinverse_why(runs["pseudoinverse"]) if path and "pseudoinverse" in runs else []
+    if "extended" in runs:
+        ext = runs["extended"]
+        out += _undefined_why(result, ext) or _extended_why(result, ext)
+    out += [Sentence(*s) for s in practical_sentences(result, unit)]
     for text, algorithm, within in limits_texts(result, NAMES):
         out.append(Sentence(text, algorithm, "note" if within else "warning"))
-    warning = singular_sentence(result.state)
+    warning = singular_sentence(result.state) if "extended" in runs else None
     if warning:
         out.append(Sentence(warning, "extended", "warning"))
     return [s.as_dict() for s in out]

@@ -27,8 +27,9 @@ MARGIN = 1.15
 def view_of(result) -> tuple[np.ndarray, float]:
     """The sphere (center (3,), radius) the camera frames for ``result``'s robot.
 
-    A user's arm (planar chain, URDF): centred on its base, of radius its reach, the length
-    of its links at x0 (at least the farthest point of its drawn configurations). Any other:
+    A planar chain: centred on its base, of radius its reach, the length of its links at x0
+    (at least the farthest point of its drawn configurations). An arm in space (a URDF or
+    catalogue arm): the sphere around the box of its drawn configurations. Any other:
     the task-plane box its mechanisms, paths and targets span (:func:`extent_of`).
     """
     state = result.state
@@ -40,6 +41,11 @@ def view_of(result) -> tuple[np.ndarray, float]:
         xs = np.concatenate([r.x for r in result.runs.values()])
         drawn = chain_points(kin, xs[:: max(1, len(xs) // 200)], 0.0).reshape(-1, 3)
         radius = max(reach, float(np.linalg.norm(drawn - base, axis=1).max()))
+        if home.shape[-1] == 3 and np.ptp(drawn[:, 2]) > 0:  # (an arm standing in space)
+            # The box of its drawn configurations, not its whole reach around the base.
+            center = (drawn.min(axis=0) + drawn.max(axis=0)) / 2
+            radius = float(np.linalg.norm(drawn - center, axis=1).max())
+            return center, max(radius, 1e-3)
         return base, max(radius, 1e-3)
     (xlo, xhi), (ylo, yhi) = extent_of(result)
     center = np.array([(xlo + xhi) / 2, (ylo + yhi) / 2, 0.0])

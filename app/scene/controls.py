@@ -107,6 +107,8 @@ class SceneControls:
             handle = gui.add_dropdown(control.label, list(by_label), initial_value=labels[value],
                                       hint=control.help)  # fmt: skip
             handle.on_update(lambda e: self._change({key: by_label[e.target.value]}))
+        elif control.kind == "checks":
+            handle = Checks(gui, control, value, lambda v: self._change({key: v}))
         elif control.kind == "slider":
             handle = gui.add_slider(
                 control.label, min=control.minimum, max=control.maximum, step=control.step,
@@ -129,3 +131,24 @@ class SceneControls:
             handle = gui.add_text(control.label, shown, hint=hint)
             handle.on_update(lambda e: self._change({key: e.target.value}))
         self.inputs[key] = handle
+
+
+class Checks:
+    """A ``checks`` control (any of its options) as one viser checkbox per option; ``value``
+    is the list of those checked, in the options' order."""
+
+    def __init__(self, gui, control: Control, value, send: Callable[[list], None]) -> None:
+        self.label = control.label
+        self.boxes = {v: gui.add_checkbox(label, v in value, hint=control.help)
+                      for v, label in control.options}  # fmt: skip
+        for box in self.boxes.values():
+            box.on_update(lambda _: send(self.value))
+
+    @property
+    def value(self) -> list:
+        return [v for v, box in self.boxes.items() if box.value]
+
+    @value.setter
+    def value(self, chosen) -> None:
+        for v, box in self.boxes.items():
+            box.value = v in chosen

@@ -15,7 +15,8 @@ import json
 import threading
 from collections.abc import Sequence
 
-from jik.app.dashboard import COLORS, Dashboard, Event, runs_key
+from jik.app.dashboard import COLORS, LABELS, Dashboard, Event, runs_key
+from jik.app.dashboard.algorithms import DEFAULT_ALGORITHMS
 from jik.app.dashboard.help import STYLES
 from jik.app.scene.camera import CameraFraming
 from jik.app.scene.controls import SceneControls
@@ -86,15 +87,7 @@ class DashboardScene:
         self.server.stop()
 
     def _add_legend(self) -> None:
-        p, e = COLORS["pseudoinverse"], COLORS["extended"]
-        self.server.gui.add_markdown(
-            order=0,
-            content=f"<span style='color:{p}'>■ pseudoinverse J^P# (8)</span>: "
-            f"{STYLES['pseudoinverse']['robot']} · "
-            f"<span style='color:{e}'>■ extended Jacobian J^E# (11)</span>: "
-            f"{STYLES['extended']['robot']} · grey: start x0 (the plots: "
-            f"{STYLES['pseudoinverse']['line']} and {STYLES['extended']['line']})",
-        )
+        self.legend = self.server.gui.add_markdown(order=0, content=legend(DEFAULT_ALGORITHMS))
 
     # -- events ---------------------------------------------------------------------------
     def _on_event(self, event: Event) -> None:
@@ -168,7 +161,8 @@ class DashboardScene:
             self.dashboard.scene_status.update(
                 generation=result.generation, robot=state.robot, playing=self.playback.playing,
                 mechanism=type(next(iter(self.nodes.mechanisms.values()), None)).__name__,
-                joints=len(getattr(self.nodes.mechanisms.get("extended"), "joints", ())),
+                joints=len(getattr(next(iter(self.nodes.mechanisms.values()), None), "joints",
+                                   ())),
                 pose_frames=sum(type(h).__name__ == "FrameHandle"
                                 for h in self.nodes.fixtures.values()),
             )  # fmt: skip
@@ -182,14 +176,25 @@ class DashboardScene:
     def _show_status(self, result) -> None:
         state = result.state
         self.progress.visible = False
-        p, e = result.runs["pseudoinverse"], result.runs["extended"]
-        if state.task == "path" and len(p.drift) and len(e.drift):
+        self.legend.content = legend(state.algorithms)
+        runs = result.runs
+        if state.task == "path" and all(len(r.drift) for r in runs.values()):
+            n = len(next(iter(runs.values())).drift)
+            drifts = ", ".join(f"{a} **{r.drift[-1]:.3g}**" for a, r in runs.items())
             self.status.content = (
-                f"generation {result.generation}: drift after {len(p.drift)} cycles — "
-                f"pseudoinverse **{p.drift[-1]:.3g}**, extended **{e.drift[-1]:.2g}**"
+                f"generation {result.generation}: drift after {n} cycles — {drifts}"
             )
         else:
-            self.status.content = f"generation {result.generation}: {p.message}; {e.message}"
+            messages = "; ".join(r.message for r in runs.values())
+            self.status.content = f"generation {result.generation}: {messages}"
+
+
+def legend(algorithms) -> str:
+    """The scene's key: each chosen algorithm's colour, name and copy, and the grey start."""
+    keys = " · ".join(f"<span style='color:{COLORS[a]}'>■ {LABELS[a]}</span>: "
+                      f"{STYLES[a]['robot']}" for a in algorithms)  # fmt: skip
+    lines = " and ".join(STYLES[a]["line"] for a in algorithms)
+    return f"{keys} · grey: start x0 (the plots: {lines})"
 
 
 def start_scene(dashboard: Dashboard, low_end: bool = False) -> DashboardScene:

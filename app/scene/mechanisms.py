@@ -10,8 +10,9 @@ start x0), the floor grid, and the fixtures of a result (rails or guide, traces,
 - A user's planar chain or URDF arm: links as lines between its joints' points,
   joints as spheres (:class:`Chain`); a formula robot has no drawing, only its task path.
 
-The pseudoinverse is the translucent red ghost, the extended Jacobian the opaque blue robot (the
-colours of every plot); the grey ghost is the start configuration x0.
+One copy per chosen algorithm, in its colour, opacity and height
+(:data:`jik.app.dashboard.algorithms.STYLES`: the pseudoinverse the translucent red ghost, the
+extended Jacobian the opaque blue robot, as in every plot); the grey ghost is the start x0.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from jik.app.dashboard import ALGORITHMS, COLORS
+from jik.app.dashboard.algorithms import COLORS, STYLES
 from jik.app.dashboard.joint_limits import outside_joints, state_limits
 from jik.app.dashboard.robots import state_kinematics
 from jik.app.scene.arm_marks import (
@@ -38,8 +39,8 @@ from jik.app.scene.traces import polyline, trace_tolerance
 from jik.engine.arms import ARMS
 
 #: Height of each algorithm's copy above the task plane, and its opacity (None: solid).
-Z = {"pseudoinverse": 0.10, "extended": 0.0}
-OPACITY = {"pseudoinverse": 0.55, "extended": None}
+Z = {a: s.z for a, s in STYLES.items()}
+OPACITY = {a: s.opacity for a, s in STYLES.items()}
 HOME_COLOR = (150, 150, 150)
 
 
@@ -308,8 +309,7 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
         )  # fmt: skip
     chain = robot in CHAINS
     kin = state_kinematics(result.state) if chain else None
-    for a in ALGORITHMS:
-        run = result.runs[a]
+    for a, run in result.runs.items():
         line = {"colors": rgb(COLORS[a]), "thickness_units": "screen"}  # pixels, see above
         if chain:  # (the end point's path: a URDF arm's task may be some of x, y, z)
             task = chain_points(kin, run.x, (Z[a] + 0.16) * scale)[:, -1]

@@ -14,7 +14,7 @@ from typing import Any, cast
 
 import numpy as np
 
-from jik.app.dashboard import ALGORITHMS, COLORS
+from jik.app.dashboard.algorithms import COLORS, DEFAULT_ALGORITHMS
 from jik.app.dashboard.plotting import corner_names
 from jik.app.scene.mechanisms import (
     HOME_COLOR,
@@ -36,6 +36,11 @@ from jik.app.scene.pose import Timeline
 UNICYCLE_ROOT = "/robot/unicycle"
 
 
+def set_key(state) -> tuple:
+    """A node set's key: the robot's layout, the task and the chosen algorithms (a copy each)."""
+    return layout_name(state), state.task, state.algorithms
+
+
 class NodeSets:
     """The node sets under ``/robot`` of a viser ``scene`` (see the module's text)."""
 
@@ -46,15 +51,15 @@ class NodeSets:
         self.mechanisms: dict[str, Mechanism] = {}
         self.home: Mechanism | None = None
         self.fixtures: dict[str, Any] = {}  # handles of the nodes of fixtures_of(), by name
-        self._layout: tuple | None = None  # (robot, task) of the set on screen
+        self._layout: tuple | None = None  # set_key() of the set on screen
         self._unicycle = False  # whether the unicycle's drawing is on screen
-        # (robot, task) -> {"frame", "mechanisms", "home", "fixtures", "root"}
+        # set_key() -> {"frame", "mechanisms", "home", "fixtures", "root"}
         self.sets: dict[tuple, dict[str, Any]] = {}
 
     def show(self, result, timeline: Timeline, extent) -> None:
         """Show ``result``: its layout's set with the result's values, or the unicycle's."""
         state = result.state
-        layout = (layout_name(state), state.task)
+        layout = set_key(state)
         if timeline.unicycle or layout != self._layout:
             self._switch(None if timeline.unicycle else layout, result, timeline, extent)
         else:
@@ -68,7 +73,7 @@ class NodeSets:
         """Build the hidden set of a result solved ahead (another manipulator's defaults):
         switching to it then only moves nodes."""
         state = result.state
-        if state.robot not in MECHANISMS or (layout_name(state), state.task) in self.sets:
+        if state.robot not in MECHANISMS or set_key(state) in self.sets:
             return
         entry = self._build(result, extent_of(result), visible=False)
         for a, m in entry["mechanisms"].items():
@@ -102,7 +107,8 @@ class NodeSets:
         """The nodes of ``result``'s manipulator and task under their own frame."""
         scene = self.scene
         state = result.state
-        root = f"/robot/{layout_name(state)}-{state.task}"
+        chosen = "" if state.algorithms == DEFAULT_ALGORITHMS else "-" + "-".join(state.algorithms)
+        root = f"/robot/{layout_name(state)}-{state.task}{chosen}"
         entry: dict[str, Any] = {
             "root": root, "frame": scene.add_frame(root, show_axes=False, visible=visible),
             "mechanisms": {}, "home": None, "fixtures": {},
@@ -112,10 +118,10 @@ class NodeSets:
             entry["home"] = cls(scene, f"{root}/home", HOME_COLOR, 0.25, -0.03, state, extent)
             entry["mechanisms"] = {
                 a: cls(scene, f"{root}/{a}", rgb(COLORS[a]), OPACITY[a], Z[a], state, extent)
-                for a in ALGORITHMS
+                for a in result.runs
             }
         self._place_fixtures(result, extent, root, entry["fixtures"])
-        self.sets[(layout_name(state), state.task)] = entry
+        self.sets[set_key(state)] = entry
         return entry
 
     def _update(self, entry: dict[str, Any], result, extent) -> None:
@@ -159,8 +165,7 @@ class NodeSets:
         q0 = state.robot_parameters["q0"]
         home = Platform(scene, f"{UNICYCLE_ROOT}/home", HOME_COLOR, 0.3, 0.0, state, None)
         home.pose(q0)
-        for a in ALGORITHMS:
-            run = result.runs[a]
+        for a, run in result.runs.items():
             base = np.asarray(rgb(COLORS[a]), dtype=float)
             for n, i in enumerate(timeline.shown):
                 i = min(int(i), len(run.platform) - 1)

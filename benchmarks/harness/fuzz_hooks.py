@@ -65,7 +65,8 @@ from jik.app.compute.robot_requests import check_configuration, check_task_point
 from jik.app.compute.schemas.synthesis import QMC_NODES
 from jik.app.compute.synthesis import synthesis_region
 from jik.app.compute.user_robots import user_robot
-from jik.app.dashboard.model import StatePatch, default_state, patch_of, updated_state
+from jik.app.dashboard.model import default_state, updated_state
+from jik.app.dashboard.patch import StatePatch, patch_of
 from jik.engine.exceptions import InvalidInputError, JikError
 from jik.engine.registry import ROBOTS, make_inverse
 from jik.engine.robot_synthesis import TOTAL_DEGREE

@@ -15,6 +15,7 @@ from jik.app.dashboard.controls import (
     parse_path_text,
     path_text,
 )
+from jik.engine.arms import ARMS
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS, robot_spec
 
@@ -51,7 +52,7 @@ def test_ranges_and_labels_come_from_the_registry(robot):
         assert c.help.startswith(p.description)  # (then the paper's symbol explained)
     for i, name in enumerate(spec.variable_names):
         assert by_key[f"x0.{i}"].label == f"x0: {name}"
-    assert [v for v, _ in by_key["robot"].options] == list(ROBOTS)
+    assert [v for v, _ in by_key["robot"].options] == [*ROBOTS, *ARMS]  # (then the arms)
     assert [v for v, _ in by_key["augmentation"].options] == [a.name for a in spec.augmentations]
     aug = spec.augmentation(state.augmentation)
     assert {k for k in by_key if k.startswith("augmentation_parameters.")} == {

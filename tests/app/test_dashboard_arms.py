@@ -10,16 +10,23 @@ import json
 import numpy as np
 import pytest
 
+from jik.app.compute.atlas_jobs import AtlasLimits, plan_request
+from jik.app.dashboard.atlas import atlas_figure, atlas_request
 from jik.app.dashboard.controls import controls
 from jik.app.dashboard.joint_limits import limits_summary, outside_joints, state_limits
 from jik.app.dashboard.map_figures import augmenting_spec
+from jik.app.dashboard.map_synthesis import built_map
 from jik.app.dashboard.model import default_state, updated_state
 from jik.app.dashboard.results import compute
 from jik.app.dashboard.robots import state_kinematics
+from jik.app.dashboard.runs import Cancelled
+from jik.app.dashboard.session import Dashboard
 from jik.app.dashboard.verdict import verdict
-from jik.app.scene.arm_marks import end_frame, joint_points, target_pose
-from jik.app.scene.mechanisms import fixtures_of
+from jik.app.scene import DashboardScene
+from jik.app.scene.arm_marks import OUTSIDE_COLOR, end_frame, joint_points, target_pose
+from jik.app.scene.mechanisms import Chain, fixtures_of
 from jik.engine.arms import ARMS
+from jik.engine.atlas_run import run_atlas
 from tests.app.test_sessions import _computed, _open
 
 
@@ -54,7 +61,7 @@ def test_a_run_outside_the_limits_is_said_in_words_and_marked():
     """x4 = -0.05 is above the Panda's joint 4 upper limit (-0.0698): the start is accepted,
     the verdict names the joint, its value and the limit, and the scene's joint of x4 is the
     one coloured."""
-    state = updated_state(_panda(), {"x0.3": -0.05})
+    state = updated_state(_panda(), {"x0.3": -0.05, "task": "target"})
     result = compute(state)
     texts = [s["text"] for s in verdict(result) if s["role"] == "warning"]
     assert any("its start x0 is already outside them, joint x4 (panda_joint4) = -0.05, above "
@@ -111,3 +118,87 @@ def test_vector_maps_run_for_p_minus_r_two():
         assert max(result.runs["extended"].drift) < 1e-9
         panel = json.dumps(augmenting_spec(result), ensure_ascii=False)
         assert "a vector of p − r = 2 maps" in panel and "for one degree of redundancy" in panel
+
+
+def test_the_synthesis_reports_progress_and_a_newer_change_stops_it():
+    """The Panda's map is synthesized on first use with its progress on the way; a cancellation
+    stops it (nothing kept: the next build synthesizes again from the start)."""
+    title = "a Panda of this test"  # (a definition of its own: no map synthesized before)
+    state = updated_state(
+        default_state(), {"robot": "panda", "robot_definition": {"name": "panda", "title": title}}
+    )
+    seen: list[float] = []
+    with pytest.raises(Cancelled):
+        built_map(state, lambda f, what: seen.append(f), lambda: len(seen) >= 2)
+    assert len(seen) == 2 and seen[-1] < 1
+    seen.clear()  # (it starts over: nothing was kept)
+    with pytest.raises(Cancelled):
+        built_map(state, lambda f, what: seen.append(f), lambda: len(seen) >= 1)
+    assert len(seen) == 1 and seen[0] < 0.5
+
+
+def test_the_atlas_of_an_arm_asks_for_its_definition_and_counts_the_limits():
+    """The session's atlas of the Panda is the REST atlas of its definition and its default
+    map; the heatmap says how many runs of each algorithm left the joint limits. A user's map
+    other than the first is sent as its entry of the definition."""
+    req = atlas_request(_panda(), 16, 2)
+    assert req.robot.name == "panda" and req.augmentation is None
+    assert len(req.path[0]) == 6 and req.reference == list(_panda().x0)
+    drift = [[[1e-4, 2e-4]] * 3]  # (P = 1, N = 3, C = 2)
+    result = {"algorithms": ["pseudoinverse", "extended"], "parameter": [-0.1, 0.0, 0.1],
+              "paths": [req.path], "drift": {"pseudoinverse": drift, "extended": drift},
+              "outside_limits": {"pseudoinverse": 2, "extended": 0}}  # fmt: skip
+    notes = [a["text"] for a in atlas_figure(result, req)["layout"]["annotations"]]
+    assert "2 of 3 runs left the joint limits" in notes[0]
+    assert "0 of 3 runs left the joint limits" in notes[1]
+    arm = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6],
+           "augmentations": [{"name": "formula", "h": "x3"},
+                             {"name": "formula", "h": "x2", "label": "second"}]}  # fmt: skip
+    state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": arm})
+    req = atlas_request(updated_state(state, {"augmentation": "second"}), 8)
+    assert req.augmentation.h == "x2" and req.robot.name == "planar_chain"
+
+
+def test_the_scene_colours_a_joint_while_it_is_outside_its_limits():
+    """The Panda's copy in the scene: at x4 = -0.05 the joint of x4 takes OUTSIDE_COLOR, the
+    others keep the copy's colour; back at home, it is the copy's colour again. Its end link
+    carries a frame (the pose task)."""
+    state = updated_state(_panda(), {"x0.3": -0.05, "task": "target"})
+    dashboard = Dashboard(state)
+    scene = DashboardScene(dashboard)
+    try:
+        arm = Chain(scene.server.scene, "/test/arm", (10, 20, 30), None, 0.0, state,
+                    ((-1.0, 1.0), (-1.0, 1.0)))  # fmt: skip
+        arm.pose(state.x0)
+        colours = [tuple(ball.color) for ball in arm.joints]
+        assert colours[joint_points(arm.kin)[3]] == OUTSIDE_COLOR
+        assert colours.count(OUTSIDE_COLOR) == 1
+        arm.pose(_panda().x0)
+        assert all(tuple(ball.color) == (10, 20, 30) for ball in arm.joints)
+        assert arm.end is not None
+    finally:
+        scene.stop()
+        dashboard.stop()
+
+
+def test_the_atlas_of_a_robot_with_two_degrees_of_redundancy():
+    """A planar 4R chain with a position task (p - r = 2): its self-motion manifolds are
+    surfaces, so the session's atlas gives its starts explicitly, x0 first, all on k(x) = k(x0);
+    the pseudoinverse drifts from them, the extended inverse with h = (x3, x4) does not; the
+    heatmap numbers the starts."""
+    arm = {"name": "planar_chain", "joints": "RRRR", "lengths": [1.0, 0.8, 0.6, 0.4],
+           "augmentations": [{"name": "formula", "h": ["x3", "x4"]}]}  # fmt: skip
+    state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": arm})
+    req = atlas_request(state, 12, 2)
+    X = np.asarray(req.start_points)
+    kin = state_kinematics(state)
+    assert X.shape == (12, 4) and np.allclose(X[0], state.x0)
+    np.testing.assert_allclose(kin.forward(X), kin.forward(X[:1]).repeat(12, 0), atol=1e-12)
+    res = run_atlas(plan_request(req, AtlasLimits()))
+    drift = {a: res.drift[k] for k, a in enumerate(res.algorithms)}  # (P, N, C)
+    assert np.nanmax(drift["extended"]) < 1e-9 and np.nanmin(drift["pseudoinverse"]) > 1e-6
+    result = {"algorithms": list(res.algorithms), "parameter": [], "paths": res.paths.tolist(),
+              "drift": {a: d.tolist() for a, d in drift.items()}}  # fmt: skip
+    figure = atlas_figure(result, req)
+    assert list(figure["data"][0]["x"]) == list(range(1, 13))
+    assert figure["layout"]["xaxis"]["title"]["text"].startswith("start")

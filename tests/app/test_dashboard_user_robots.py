@@ -6,14 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from jik.app.dashboard.model import (
-    DashboardState,
-    StatePatch,
-    default_state,
-    patch_of,
-    updated_state,
-    validate,
-)
+from jik.app.dashboard.model import DashboardState, default_state, updated_state, validate
+from jik.app.dashboard.patch import StatePatch, patch_of
 from jik.app.dashboard.results import compute
 from jik.app.dashboard.session import Dashboard
 from jik.engine.exceptions import InvalidInputError

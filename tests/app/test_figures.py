@@ -43,7 +43,7 @@ def _colors(fig) -> dict[str, str]:
 
 def test_task_space_paths_use_one_colour_per_algorithm(path_result):
     fig = task_space_figure(path_result)
-    assert _colors(fig) == {LABELS[a]: COLORS[a] for a in COLORS}
+    assert _colors(fig) == {LABELS[a]: COLORS[a] for a in path_result.state.algorithms}
     assert fig.layout.xaxis.title.text == "y1 [m]"
     assert fig.layout.yaxis.title.text == "y2 [m]"
     targets = next(t for t in fig.data if t.name == "targets")

@@ -12,6 +12,7 @@ import pytest
 import viser
 
 from jik.app.dashboard import Dashboard, compute, default_state, updated_state
+from jik.app.dashboard.algorithms import DEFAULT_ALGORITHMS
 from jik.app.scene import DashboardScene
 from jik.app.scene.gizmo import DRAG_INTERVAL
 from jik.app.scene.mechanisms import extent_of
@@ -200,16 +201,22 @@ def test_scene_follows_a_new_result_in_place():
         scene._draw(compute(default_state("manipulator1"), 104))
         assert set(scene.nodes.fixtures) >= {"/robot/manipulator1-path/guide"}
         assert not any(k.startswith(M2) for k in scene.nodes.fixtures)
-        assert scene.nodes.sets[("manipulator2", "path")]["frame"].visible is False
+        assert (
+            scene.nodes.sets[("manipulator2", "path", DEFAULT_ALGORITHMS)]["frame"].visible is False
+        )
         scene._draw(compute(second, 107))
-        assert scene.nodes.sets[("manipulator2", "path")]["frame"].visible is True
-        assert scene.nodes.sets[("manipulator1", "path")]["frame"].visible is False
+        assert (
+            scene.nodes.sets[("manipulator2", "path", DEFAULT_ALGORITHMS)]["frame"].visible is True
+        )
+        assert (
+            scene.nodes.sets[("manipulator1", "path", DEFAULT_ALGORITHMS)]["frame"].visible is False
+        )
         assert all(scene.nodes.fixtures[k] is v for k, v in fixtures.items())
         assert all(scene.nodes.mechanisms[k] is v for k, v in mechanisms.items())
         # A result solved ahead: its nodes are built hidden, and shown by its result.
         other = compute(updated_state(default_state("manipulator1"), {"task": "target"}), 108)
         scene._prebuild(other)
-        ahead = scene.nodes.sets[("manipulator1", "target")]
+        ahead = scene.nodes.sets[("manipulator1", "target", DEFAULT_ALGORITHMS)]
         assert ahead["frame"].visible is False and ahead["mechanisms"]
         scene._draw(other)
         assert ahead["frame"].visible is True and scene.nodes.mechanisms is ahead["mechanisms"]

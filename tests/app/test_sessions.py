@@ -11,8 +11,10 @@ from fastapi.testclient import TestClient
 from starlette.websockets import WebSocketDisconnect
 
 from jik.app.api.factory import create_app
+from jik.app.dashboard.algorithms import COLORS
 from jik.app.dashboard.plotting import PANELS
 from jik.app.dashboard.sessions import SessionLimits, SessionNotFound, SessionsFull, SessionStore
+from jik.engine.registry import ALGORITHMS
 
 JSON = {"content-type": "application/json"}
 
@@ -48,7 +50,9 @@ def test_page_static_files_and_config():
     assert client.get("/static/..%2Fpyproject.toml").status_code == 404
     assert client.get("/static/__init__.py").status_code == 404
     config = client.get("/api/dashboard/config").json()
-    assert config["colors"] == {"pseudoinverse": "#d62728", "extended": "#1f77b4"}
+    # (one colour per algorithm of the catalogue; the paper's two keep theirs)
+    assert config["colors"] == COLORS and set(COLORS) == set(ALGORITHMS)
+    assert (COLORS["pseudoinverse"], COLORS["extended"]) == ("#d62728", "#1f77b4")
     assert [p["id"] for p in config["panels"]] == list(PANELS)
     # The viser client for the sessions' scenes, from the viser package.
     scene = client.get("/scene/")

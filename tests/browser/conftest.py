@@ -30,7 +30,7 @@ from urllib.parse import parse_qs, unquote, urlsplit
 
 import pytest
 
-from jik.app.dashboard.model import COLORS
+from jik.app.dashboard.algorithms import COLORS, DEFAULT_ALGORITHMS
 
 ROOT = Path(__file__).resolve().parents[2]
 PROBES = Path(__file__).resolve().parent / "probes"
@@ -51,8 +51,10 @@ SCREEN_SIZES = ((1600, 1000), (1280, 720), (800, 1000))
 ARTIFACTS = ROOT / "tests" / "artifacts"
 #: The colour of the x arrow of the start point's gizmo (drei's PivotControls).
 GIZMO_X_ARROW = (255, 32, 96)
-#: The algorithms' colours as RGB: their lines in the plots, their robots and traces in the scene.
-COLORS_RGB = {a: tuple(int(c[i : i + 2], 16) for i in (1, 3, 5)) for a, c in COLORS.items()}
+#: The colours as RGB of any algorithm, and of the default view's: their lines in the plots,
+#: their robots and traces in the scene.
+ALL_COLORS_RGB = {a: tuple(int(c[i : i + 2], 16) for i in (1, 3, 5)) for a, c in COLORS.items()}
+COLORS_RGB = {a: ALL_COLORS_RGB[a] for a in DEFAULT_ALGORITHMS}
 
 
 @functools.cache

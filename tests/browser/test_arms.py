@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import pytest
 
+from tests.browser.conftest import get_json
+
 expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
@@ -41,3 +43,20 @@ def test_the_panda_with_its_pose_task(tabs):
     assert scene["joints"] == 9  # base, 7 joints, the flange (fixed joints drawn too)
     assert scene["pose_frames"] == 4  # the path's three pose targets and k(x0)
     tab.screenshots("arm-panda")
+
+    # Its atlas: 16 starts on the self-motion curve of k(x0), two cycles, both algorithms.
+    page.locator("#atlas").scroll_into_view_if_needed()
+    page.fill("#atlas-starts", "16")
+    page.fill("#atlas-cycles", "2")
+    with page.expect_response(
+        lambda r: r.request.method == "POST" and r.url.endswith("/atlas")
+    ) as response:
+        page.click("#atlas-compute")
+    assert response.value.status == 202, response.value.text()
+    job = response.value.json()["id"]
+    expect(page.locator("#atlas-status")).to_contain_text("Atlas done", timeout=240_000)
+    expect(page.locator("#plot-atlas .heatmaplayer image")).to_have_count(2)
+    expect(page.locator("#plot-atlas")).to_contain_text("runs left the joint limits")
+    atlas = get_json(f"{tab.base}/api/sessions/{tab.session_id}/atlas/{job}")
+    assert len(atlas["starts"][0]) == 16 and len(atlas["starts"][0][0]) == 7
+    assert atlas["request"]["robot"]["name"] == "panda"

@@ -251,12 +251,28 @@ def test_reproduction_table_has_every_algorithm():
     """`jik reproduce algorithms`, shortened to 2 cycles: one row per algorithm, in order."""
     from jik.engine.reproductions import algorithms as repro
 
-    result = repro.run(cycles=2)
+    result = repro.run(cycles=2, loops=("manipulator2",))
     assert [r["name"] for r in result["algorithms"]] == list(ALGORITHMS)
     drift = {r["name"]: r["drift"]["1"] for r in result["algorithms"]}
     assert drift["extended"] < 1e-12 < drift["posture"] < 0.2 < drift["pseudoinverse"]
     text = repro.format_text(result)
     assert text.count("\n| ") == 6 and "| posture | gain = 1.0, rest = x0 |" in text
+
+
+@pytest.mark.slow  # (~5 s: the Panda's map is synthesized; the default run has Table 1's)
+def test_reproduction_table_of_the_panda_pose_loop():
+    """The Panda's pose loop, one cycle: every algorithm succeeds, the extended inverse (its
+    synthesized map) comes back to x0, the pseudoinverse does not."""
+    from jik.engine.reproductions import algorithms as repro
+
+    result = repro.run(cycles=1, loops=("panda",))
+    rows = {r["name"]: r for r in result["panda"]["algorithms"]}
+    assert list(rows) == list(ALGORITHMS) and all(r["success"] for r in rows.values())
+    assert rows["extended"]["drift"]["1"] < 1e-12 < rows["pseudoinverse"]["drift"]["1"]
+    text = repro.format_text(result)
+    assert (
+        "Panda's pose loop" in text and "| weighted | limits = the Panda's joint limits |" in text
+    )
 
 
 def test_cli_algorithm_names_are_the_catalogue():

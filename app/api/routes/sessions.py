@@ -27,7 +27,7 @@ from jik.app.compute.schemas import INTEGRAL
 from jik.app.dashboard import export_file
 from jik.app.dashboard.controls import controls_message
 from jik.app.dashboard.messages import LatestEvents
-from jik.app.dashboard.model import StatePatch, parse_patch, patch_of
+from jik.app.dashboard.patch import StatePatch, parse_patch, patch_of
 from jik.app.dashboard.robots import vet_definition
 from jik.app.dashboard.sessions import ExportUnavailable, Session, SessionNotFound
 from jik.engine.exceptions import InvalidInputError

@@ -1,0 +1,223 @@
+"""The dashboard's choice of algorithms: one to five of the engine's catalogue side by side, their
+parameters as controls with the engine's ranges, one colour each in every panel, their cache
+keys, the verdict's sentences about them, and the session API taking the choice."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from jik.app.dashboard.algorithms import COLORS, DEFAULT_ALGORITHMS, STYLES, cache_key, runs_key
+from jik.app.dashboard.atlas import atlas_request
+from jik.app.dashboard.controls import controls
+from jik.app.dashboard.figures import figure_specs
+from jik.app.dashboard.model import default_state, updated_state
+from jik.app.dashboard.results import compute
+from jik.app.dashboard.verdict import verdict
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.registry import ALGORITHMS
+
+THREE = ["pseudoinverse", "extended", "posture"]
+
+
+def test_the_default_view_runs_the_paper_two():
+    state = default_state()
+    assert state.algorithms == DEFAULT_ALGORITHMS and state.algorithm_parameters == {}
+    assert [c.key for c in controls(state) if c.key.startswith("algorithm_parameters")] == []
+
+
+def test_choosing_algorithms_fills_their_parameters_from_the_engine():
+    state = updated_state(default_state(), {"algorithms": ["posture", "damped", "pseudoinverse"]})
+    assert state.algorithms == ("pseudoinverse", "damped", "posture")  # (the catalogue's order)
+    assert state.algorithm_parameters == {"damping": 0.1, "damping_threshold": 0.0, "gain": 1.0}
+    sliders = {c.key: c for c in controls(state) if c.key.startswith("algorithm_parameters.")}
+    for p in (*ALGORITHMS["damped"].parameters, *ALGORITHMS["posture"].parameters):
+        c = sliders[f"algorithm_parameters.{p.name}"]
+        assert (c.minimum, c.maximum) == (p.minimum, p.maximum)
+    changed = updated_state(state, {"algorithm_parameters.gain": 2.5})
+    assert changed.algorithm_parameters["gain"] == 2.5
+    # (a parameter of an algorithm no longer chosen is dropped)
+    assert updated_state(changed, {"algorithms": ["posture"]}).algorithm_parameters == {"gain": 2.5}
+
+
+@pytest.mark.parametrize(
+    ("patch", "field"),
+    [
+        ({"algorithms": []}, "algorithms"),
+        ({"algorithms": ["nope"]}, "algorithms.0"),
+        ({"algorithms": ["posture", "posture"]}, "algorithms"),
+        ({"algorithms": ["posture"], "algorithm_parameters": {"gain": -1.0}},
+         "algorithm_parameters.gain"),
+        ({"algorithms": ["damped"], "algorithm_parameters.damping": 11.0},
+         "algorithm_parameters.damping"),
+        ({"algorithm_parameters": {"lambda": 1.0}}, "algorithm_parameters.lambda"),
+    ],
+)  # fmt: skip
+def test_a_bad_choice_is_refused_naming_its_field(patch, field):
+    with pytest.raises(InvalidInputError) as refused:
+        updated_state(default_state(), patch)
+    assert refused.value.field == field
+
+
+def test_an_algorithm_the_robot_cannot_run_is_refused_naming_the_choice(monkeypatch):
+    """The chosen inverses are built when the state is validated: the engine's refusal (the
+    weighted inverse of a robot with neither joint limits nor a box) names ``algorithms``."""
+    from jik.app.dashboard import model
+
+    def refuse(state, algorithm, kin=None):
+        raise InvalidInputError("planar_chain has no joint limits: give limits", "limits")
+
+    monkeypatch.setattr(model, "state_inverse", refuse)
+    with pytest.raises(InvalidInputError) as refused:
+        updated_state(default_state(), {"algorithms": ["weighted"]})
+    assert refused.value.field == "algorithms" and "no joint limits" in str(refused.value)
+    assert updated_state(default_state(), {"cycles": 2}).cycles == 2  # (the paper's two: not built)
+
+
+def test_cache_keys_hold_each_algorithms_own_parameters():
+    state = updated_state(default_state(), {"algorithms": ["pseudoinverse", "damped", "posture"]})
+    more = updated_state(state, {"algorithm_parameters.gain": 3.0})
+    assert cache_key(more, "posture") != cache_key(state, "posture")
+    assert cache_key(more, "pseudoinverse") == cache_key(state, "pseudoinverse")
+    assert cache_key(more, "damped") == cache_key(state, "damped")
+    assert len(set(runs_key(state))) == 3
+
+
+@pytest.fixture(scope="module")
+def three():
+    state = updated_state(default_state(), {"algorithms": THREE, "cycles": 10})
+    return compute(state)
+
+
+def test_three_algorithms_one_colour_each_in_every_panel(three):
+    assert list(three.runs) == THREE
+    specs = figure_specs(three)
+    drift = [t for t in specs["drift"]["data"] if t.get("mode") == "lines+markers"]
+    assert [t["line"]["color"] for t in drift] == [COLORS[a] for a in THREE]
+    assert [t["line"]["dash"] for t in drift] == [STYLES[a].dash for a in THREE]
+    task = [t for t in specs["task"]["data"] if t.get("name") in {STYLES[a].label for a in THREE}]
+    assert len(task) == 3
+    assert len({STYLES[a].color for a in STYLES}) == len(STYLES)
+
+
+def test_verdict_says_posture_drifts_less_but_is_not_repeatable(three):
+    """Table 1's loop, gain 1, ten cycles: the sentence gives both comparisons, in numbers."""
+    d = {a: float(r.drift[-1]) for a, r in three.runs.items()}
+    assert d["posture"] < d["pseudoinverse"] and d["extended"] < 1e-12 < d["posture"]
+    posture = [s["text"] for s in verdict(three) if s["algorithm"] == "posture"]
+    said = " ".join(posture)
+    assert f"less than the pseudoinverse's {d['pseudoinverse']:.3g}" in said
+    assert f"does not reach the extended Jacobian's {d['extended']:.3g}" in said
+
+
+def test_verdict_reports_damped_tracking_error_and_weighted_limits():
+    state = updated_state(default_state(), {"algorithms": ["damped", "weighted"], "cycles": 2})
+    result = compute(state)
+    texts = {s["algorithm"]: s["text"] for s in verdict(result) if s["role"] != "finding"}
+    ends = result.runs["damped"].error[np.r_[np.flatnonzero(np.diff(result.runs["damped"].leg)),
+                                             len(result.runs["damped"].leg) - 1]]  # fmt: skip
+    assert f"task error at the end of its legs up to {ends.max():.3g}" in texts["damped"]
+    assert "stayed within its limits" in texts["weighted"]
+    assert "no joint limits: its configuration box x_range" in texts["weighted"]
+
+
+def test_the_atlas_compares_the_chosen_algorithms(three):
+    request = atlas_request(three.state, 8)
+    assert request.algorithms == THREE
+    assert request.algorithm_parameters is not None
+    assert request.algorithm_parameters.gain == 1.0
+
+
+def test_the_session_api_takes_the_choice(client):
+    """POST /api/sessions/{id}/state chooses three algorithms; a bad choice is a 422 naming its
+    field, and the state stays."""
+    session = client.post("/api/sessions", json={"state": {}}).json()
+    url = f"/api/sessions/{session['id']}/state"
+    r = client.post(url, json={"algorithms": THREE, "algorithm_parameters.gain": 2.0})
+    assert r.status_code == 200, r.text
+    assert r.json()["state"]["algorithms"] == THREE
+    assert r.json()["state"]["algorithm_parameters"] == {"gain": 2.0}
+    bad = client.post(url, json={"algorithm_parameters.gain": -2.0})
+    assert bad.status_code == 422 and "algorithm_parameters.gain" in bad.text
+    assert client.get(f"/api/sessions/{session['id']}").json()["state"]["algorithms"] == THREE
+
+
+def test_the_scene_draws_a_robot_per_chosen_algorithm(three):
+    """A copy of the robot and a trace per algorithm, in its colour; the key names the three;
+    the paper's two alone come back to the default set."""
+    from jik.app.dashboard import Dashboard
+    from jik.app.scene import DashboardScene
+    from jik.app.scene.mechanisms import rgb
+
+    dashboard = Dashboard(default_state())
+    scene = DashboardScene(dashboard)
+    try:
+        assert dashboard.wait(1, timeout=60)
+        scene._draw(three)
+        assert list(scene.nodes.mechanisms) == THREE
+        root = "/robot/manipulator2-path-pseudoinverse-extended-posture"
+        for a in THREE:
+            trace = scene.nodes.fixtures[f"{root}/trace/{a}/task"]
+            assert tuple(np.asarray(trace.colors).reshape(-1, 3)[0]) == rgb(COLORS[a])
+        assert all(STYLES[a].label in scene.legend.content for a in THREE)
+        scene._draw(compute(default_state(), 200))
+        assert list(scene.nodes.mechanisms) == list(DEFAULT_ALGORITHMS)
+        assert STYLES["posture"].label not in scene.legend.content
+    finally:
+        scene.stop()
+        dashboard.stop()
+
+
+CHAIN = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 1.0, 1.0],
+         "x0": [0.3, 0.3, 0.3]}  # fmt: skip
+
+
+def _damped_beside_pseudoinverse(x0, target):
+    state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": CHAIN})
+    state = updated_state(state, {"task": "target", "target": target, "x0": x0,
+                                  "algorithms": ["pseudoinverse", "damped"]})  # fmt: skip
+    result = compute(state)
+    return result, {(s["algorithm"], s["role"]): s["text"] for s in verdict(result)}
+
+
+def test_damped_goes_through_a_singular_start_where_the_pseudoinverse_stops():
+    """The 3R arm stretched (J of rank 1): the pseudoinverse's run stops, damped least squares
+    converges, and the verdict says so beside its task error."""
+    result, said = _damped_beside_pseudoinverse([0.0, 0.0, 0.0], [2.0, 1.0])
+    assert not result.runs["pseudoinverse"].success and result.runs["damped"].success
+    assert "J J^T is singular" in said[("pseudoinverse", "failure")]
+    assert "it went through where the pseudoinverse stopped" in said[("damped", "why")]
+
+
+def test_damped_reports_its_task_error_at_the_reach_boundary():
+    """A target beyond reach: the pseudoinverse stalls at 1.22, damped least squares stretches
+    the arm to the singular configuration and is left with 0.5; both numbers are said."""
+    result, said = _damped_beside_pseudoinverse([0.3, 0.3, 0.3], [3.5, 0.0])
+    assert result.runs["damped"].error[-1] == pytest.approx(0.5, abs=1e-6)
+    why = said[("damped", "why")]
+    assert "task error at the end of its legs up to 0.5" in why
+    assert "where the pseudoinverse stalled at task error 1.22, it got to 0.5" in why
+
+
+def test_the_atlas_figure_has_a_heatmap_per_algorithm_on_one_colour_scale(three):
+    """Three algorithms' drift over the same starts: three heatmaps side by side, one shared
+    colour axis spanning all, each titled in its algorithm's colour (plotly validates it)."""
+    import plotly.graph_objects as go
+
+    from jik.app.dashboard.atlas import atlas_figure
+
+    request = atlas_request(three.state, 4, cycles=2)
+    decades = {"pseudoinverse": -1.0, "extended": -15.0, "posture": -3.0}
+    result = {
+        "algorithms": THREE, "parameter": [-0.2, 0.0, 0.1, 0.3], "paths": [request.path],
+        "drift": {a: np.full((1, 4, 2), 10.0**d).tolist() for a, d in decades.items()},
+    }  # fmt: skip
+    spec = atlas_figure(result, request)
+    maps = [t for t in spec["data"] if t["type"] == "heatmap"]
+    assert [t["coloraxis"] for t in maps] == ["coloraxis"] * 3
+    assert [t["xaxis"] for t in maps] == ["x", "x2", "x3"]
+    axis = spec["layout"]["coloraxis"]
+    assert axis["cmin"] <= -14 and axis["cmax"] >= -1
+    titles = [a["font"]["color"] for a in spec["layout"]["annotations"] if "font" in a]
+    assert [COLORS[a] for a in THREE] == titles[:3]
+    go.Figure(spec)  # (validated)
