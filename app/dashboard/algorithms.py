@@ -15,16 +15,30 @@ algorithm's run depends on (its own parameters included).
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 from jik.app.compute.schemas.algorithms import Algorithm
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ALGORITHMS as REGISTRY
 
-if TYPE_CHECKING:
-    from jik.app.dashboard.model import DashboardState
+
+class ChosenState(Protocol):
+    """What these functions read of a :class:`jik.app.dashboard.model.DashboardState` (which
+    imports this module)."""
+
+    @property
+    def algorithms(self) -> Sequence[str]: ...
+    @property
+    def algorithm_parameters(self) -> Mapping[str, float]: ...
+    @property
+    def x0(self) -> Sequence[float]: ...
+    @property
+    def mode(self) -> str: ...
+
+    def as_dict(self) -> dict: ...
+
 
 #: Every algorithm a state may choose, in the catalogue's order (the order they are drawn in).
 CHOICES = tuple(REGISTRY)
@@ -106,7 +120,7 @@ def checked(algorithms: tuple[str, ...], given: Mapping[str, Any]) -> dict[str, 
     return {"algorithms": ordered, "algorithm_parameters": values}
 
 
-def inverse_parameters(state: DashboardState, algorithm: str, kin) -> dict[str, Any]:
+def inverse_parameters(state: ChosenState, algorithm: str, kin) -> dict[str, Any]:
     """What the engine's ``make_inverse`` takes for ``algorithm``: its scalars, and the posture
     inverse's rest at the state's x0 when the robot has no home."""
     names = {p.name for p in REGISTRY[algorithm].parameters}
@@ -116,7 +130,7 @@ def inverse_parameters(state: DashboardState, algorithm: str, kin) -> dict[str, 
     return out
 
 
-def check_inverses(state: DashboardState, build) -> None:
+def check_inverses(state: ChosenState, build) -> None:
     """Build the chosen algorithms other than the paper's two (``build(algorithm)``, cheap),
     so that a robot without joint limits refuses the weighted inverse here, naming
     ``algorithms``."""
@@ -130,7 +144,7 @@ def check_inverses(state: DashboardState, build) -> None:
                                     "algorithms") from None  # fmt: skip
 
 
-def cache_key(state: DashboardState, algorithm: str) -> str:
+def cache_key(state: ChosenState, algorithm: str) -> str:
     """Everything one algorithm's run depends on: the state without what only a panel shows,
     the other algorithms' parameters, the map (but for the extended inverse) and gamma in
     continuous mode (see :mod:`jik.app.dashboard.results`)."""
@@ -147,7 +161,7 @@ def cache_key(state: DashboardState, algorithm: str) -> str:
     return json.dumps(d, sort_keys=True)
 
 
-def runs_key(state: DashboardState) -> tuple[str, ...]:
+def runs_key(state: ChosenState) -> tuple[str, ...]:
     """Everything the runs of the chosen algorithms depend on, up to the scale of theta.
 
     Two states with the same key have the same configurations along the same legs (in

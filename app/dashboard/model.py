@@ -26,8 +26,7 @@ from jik.app.compute.schemas import (
     Tolerance,
 )
 from jik.app.compute.schemas.algorithms import Algorithm
-from jik.app.dashboard import algorithms as chosen
-from jik.app.dashboard.algorithms import CHOICES, DEFAULT_ALGORITHMS
+from jik.app.dashboard.algorithms import CHOICES, DEFAULT_ALGORITHMS, check_inverses, checked
 from jik.app.dashboard.algorithms import COLORS as COLORS  # (re-exported: one table, there)
 from jik.app.dashboard.algorithms import DASH as DASH
 from jik.app.dashboard.algorithms import LABELS as LABELS
@@ -66,8 +65,9 @@ class DashboardState(BaseModel):
 
     robot: str
     robot_parameters: dict[str, Any]
-    #: A robot the user defined (:mod:`jik.app.dashboard.robots`): its definition, whose
-    #: ``name`` is ``robot`` (a kind of :mod:`jik.engine.robot_kinds`); None for the catalogue's.
+    #: A robot given by a definition (:mod:`jik.app.dashboard.robots`), whose ``name`` is
+    #: ``robot``: a kind of :mod:`jik.engine.robot_kinds` or a catalogue arm; None for the
+    #: paper's robots.
     robot_definition: Annotated[dict[str, Any], Field(max_length=32)] | None = None
     augmentation: str
     augmentation_parameters: dict[str, Any]
@@ -249,8 +249,8 @@ def validate(data: Mapping[str, Any]) -> DashboardState:
         raise InvalidInputError("path: a closed-path task needs at least one path point", "path")
     if (why := gamma_problem(state.gamma, state.mode)) is not None:
         raise InvalidInputError(f"gamma: {why}", "gamma")
-    state = state.model_copy(update=chosen.checked(state.algorithms, state.algorithm_parameters))
-    chosen.check_inverses(state, lambda a: state_inverse(state, a, kin))
+    state = state.model_copy(update=checked(state.algorithms, state.algorithm_parameters))
+    check_inverses(state, lambda a: state_inverse(state, a, kin))
     # The engine's default cap, set by its value, is the default (None): it follows the mode.
     default_cap = max_iterations(state.model_copy(update={"max_iterations": None}))
     return state.model_copy(update={

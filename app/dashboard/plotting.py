@@ -11,6 +11,8 @@ import math
 import numpy as np
 import plotly.graph_objects as go
 
+from jik.app.dashboard.robot_units import chain_units
+from jik.app.dashboard.robots import state_kinematics
 from jik.app.dashboard.runs import DashboardResult
 
 #: Units of the joint and task variables, by robot (the registry does not carry units).
@@ -50,6 +52,9 @@ LAYOUT = dict(
 
 def units(result: DashboardResult) -> tuple[tuple[str, ...], tuple[str, ...]]:
     joint, task = UNITS.get(result.state.robot, ((), ()))
+    if result.state.robot_definition is not None:  # (an arm's: its joints' kinds)
+        kin = state_kinematics(result.state)
+        joint, task = chain_units(kin, result.task_names) or (joint, task)
     p, r = len(result.variable_names), len(result.task_names)
     return (joint or ("",) * p), (task or ("",) * r)
 

@@ -220,8 +220,7 @@ class Chain(Mechanism):
         for ball, point in zip(self.joints, pts, strict=False):
             ball.position = tuple(float(v) for v in point)
         if self.end is not None and (frame := end_frame(self.kin, x)) is not None:
-            self.end.position = tuple(np.asarray(frame[0]) + np.array([0.0, 0.0, self.z + 0.05]))
-            self.end.wxyz = frame[1]
+            self.end.position, self.end.wxyz = frame
         outside = {self.at[int(i)] for i in outside_joints(self.limits, x) if int(i) in self.at}
         for k in outside ^ self.marked:  # (only the joints whose colour changes)
             self.joints[k].color = OUTSIDE_COLOR if k in outside else self.color
@@ -229,11 +228,12 @@ class Chain(Mechanism):
 
 
 def chain_points(kin: Any, x: np.ndarray, z: float) -> np.ndarray:
-    """The points of a chain (..., n + 1, 3) in the scene: a planar one at height ``z``."""
+    """The points of a chain (..., n + 1, 3) in the scene: a planar one at height ``z``; an arm
+    in space where it is (its end on its pose targets: the copies overlap, red translucent)."""
     pts = np.asarray(kin.points(x), dtype=float)  # (PlanarChain, UrdfChain)
     if pts.shape[-1] == 2:
         return np.concatenate([pts, np.full((*pts.shape[:-1], 1), z)], axis=-1)
-    return pts + np.array([0.0, 0.0, z])
+    return pts
 
 
 #: The robots drawn as a serial chain of links (:class:`Chain`): a user's and the catalogue's arms.

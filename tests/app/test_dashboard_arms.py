@@ -17,7 +17,9 @@ from jik.app.dashboard.joint_limits import limits_summary, outside_joints, state
 from jik.app.dashboard.map_figures import augmenting_spec
 from jik.app.dashboard.map_synthesis import built_map
 from jik.app.dashboard.model import default_state, updated_state
+from jik.app.dashboard.plotting import units
 from jik.app.dashboard.results import compute
+from jik.app.dashboard.robot_units import chain_units
 from jik.app.dashboard.robots import state_kinematics
 from jik.app.dashboard.runs import Cancelled
 from jik.app.dashboard.session import Dashboard
@@ -53,6 +55,10 @@ def test_the_panda_is_picked_by_name_with_its_pose_task(app, client):
     assert summary["pseudoinverse"]["drift"][-1] > 1e-5
     assert max(summary["extended"]["drift"]) < 1e-9
     assert summary["extended"]["limits"] == {"within": True, "violation": None}
+    again = _open(client, state)  # (the page's link holds the definition)
+    assert again["state"] == state
+    export = client.get(f"/api/sessions/{session['id']}/export.json").json()
+    assert len(export["runs"]["extended"]["x"][0]) == 7
     x0 = [c for c in controls(_panda()) if c.key.startswith("x0.")]
     assert [(c.minimum, c.maximum) for c in x0][3] == (-3.0718, -0.0698)  # its URDF's limits
 
@@ -162,7 +168,7 @@ def test_the_atlas_of_an_arm_asks_for_its_definition_and_counts_the_limits():
 def test_the_scene_colours_a_joint_while_it_is_outside_its_limits():
     """The Panda's copy in the scene: at x4 = -0.05 the joint of x4 takes OUTSIDE_COLOR, the
     others keep the copy's colour; back at home, it is the copy's colour again. Its end link
-    carries a frame (the pose task)."""
+    carries a frame (the pose task), drawn where it is (on the pose targets)."""
     state = updated_state(_panda(), {"x0.3": -0.05, "task": "target"})
     dashboard = Dashboard(state)
     scene = DashboardScene(dashboard)
@@ -175,7 +181,11 @@ def test_the_scene_colours_a_joint_while_it_is_outside_its_limits():
         assert colours.count(OUTSIDE_COLOR) == 1
         arm.pose(_panda().x0)
         assert all(tuple(ball.color) == (10, 20, 30) for ball in arm.joints)
+        # Its end link's frame where the path's pose targets are drawn (k(x0) at home).
+        home = arm.kin.forward(np.asarray(_panda().x0))
         assert arm.end is not None
+        np.testing.assert_allclose(arm.end.position, home[:3], atol=1e-12)
+        np.testing.assert_allclose(arm.joints[-1].position, home[:3], atol=1e-12)
     finally:
         scene.stop()
         dashboard.stop()
@@ -202,3 +212,25 @@ def test_the_atlas_of_a_robot_with_two_degrees_of_redundancy():
     figure = atlas_figure(result, req)
     assert list(figure["data"][0]["x"]) == list(range(1, 13))
     assert figure["layout"]["xaxis"]["title"]["text"].startswith("start")
+
+
+def test_an_arms_units_follow_its_joints_and_task():
+    """The Panda's joints are revolute (rad), its pose task in m and rad; a planar RPR chain's
+    prismatic joint is in m (the panels' axes and the verdict's norms say so)."""
+    result = compute(updated_state(_panda(), {"task": "target"}))
+    assert units(result) == (("rad",) * 7, ("m", "m", "m", "rad", "rad", "rad"))
+    arm = {"name": "planar_chain", "joints": "RPR", "lengths": [1.0, 0.8, 0.6]}
+    kin = state_kinematics(
+        updated_state(default_state(), {"robot": "planar_chain", "robot_definition": arm})
+    )
+    assert chain_units(kin, ("x", "y")) == (("rad", "m", "rad"), ("m", "m"))
+
+
+@pytest.mark.parametrize("arm", sorted(ARMS))
+def test_every_catalogue_arm_is_a_dashboard_state(arm):
+    """Each arm of the picker gives a state with its definition, its default task's path and a
+    synthesized map (the UR5e's default task x y z rx ry: p - r = 1 too)."""
+    state = updated_state(default_state(), {"robot": arm})
+    assert state.robot_definition == {"name": arm, "task": ARMS[arm].task}
+    assert state.augmentation == "e2_synthesized"
+    assert len(state.x0) == len(ARMS[arm].home) == len(state.path[0]) + 1

@@ -60,3 +60,25 @@ def test_the_panda_with_its_pose_task(tabs):
     atlas = get_json(f"{tab.base}/api/sessions/{tab.session_id}/atlas/{job}")
     assert len(atlas["starts"][0]) == 16 and len(atlas["starts"][0][0]) == 7
     assert atlas["request"]["robot"]["name"] == "panda"
+
+
+def test_the_panda_with_a_position_task_and_four_formula_maps(tabs):
+    """p - r = 4: from the robot editor, the Panda's task "xyz" with h = (x2, x3, x5, x7); a
+    closed path of 3-coordinate points typed in the path box; the extended inverse comes back,
+    the pseudoinverse does not, and the h panel says what it shows for p - r > 1."""
+    tab = tabs.open()
+    page = tab.page
+    tab.select("#ctl-robot", "panda")
+    page.click("#robot-editor-open")
+    expect(page.locator("#robot-kind")).to_have_value("panda")
+    page.fill("#robot-field-task", "xyz")
+    page.fill("#robot-field-augmentations", '[{"name": "formula", "h": ["x2", "x3", "x5", "x7"]}]')
+    tab.change(lambda: page.click("#robot-apply"))
+    page.fill("#ctl-path", "0.35, 0.05, 0.55; 0.3, 0.1, 0.6")
+    tab.change(lambda: page.dispatch_event("#ctl-path", "change"))
+    snapshot = tab.wait_settled(lambda s: len(s["state"]["path"]) == 2, "the typed path")
+    assert snapshot["state"]["robot_definition"]["task"] == "xyz"
+    summary = snapshot["summary"]
+    assert summary["pseudoinverse"]["drift"][-1] > 1e-4
+    assert max(summary["extended"]["drift"]) < 1e-9
+    expect(page.locator("#plot-augmenting")).to_contain_text("a vector of p − r = 4 maps")
