@@ -128,12 +128,17 @@ def limit_gradient(x: FloatArray, limits: FloatArray) -> FloatArray:
 
     dH/dx_i = (hi - lo)^2 (2 x_i - hi - lo) / (4 (hi - x_i)^2 (x_i - lo)^2): zero at mid-range,
     infinite at a limit. Joints with an infinite range contribute 0; at or past a limit, inf.
+    It is evaluated as 2 t / (h (1 - t)^2 (1 + t)^2) with h = (hi - lo) / 2 and
+    t = (x - (lo + hi) / 2) / h, which neither overflows nor underflows to 0/0 for huge ranges:
+    a joint whose range dwarfs x gets a gradient of 0 (weight 1), as an unlimited one.
     """
     lo, hi = limits[:, 0], limits[:, 1]
     bounded = np.isfinite(lo) & np.isfinite(hi)
     lo_b, hi_b = np.where(bounded, lo, -1.0), np.where(bounded, hi, 1.0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        g = (hi_b - lo_b) ** 2 * (2 * x - hi_b - lo_b) / (4 * (hi_b - x) ** 2 * (x - lo_b) ** 2)
+    half = hi_b / 2 - lo_b / 2
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+        t = (x - (lo_b / 2 + hi_b / 2)) / half
+        g = 2 * t / (half * (1 - t) ** 2 * (1 + t) ** 2)
     inside = (x > lo_b) & (x < hi_b)
     return np.where(bounded, np.where(inside, g, np.inf), 0.0)
 
