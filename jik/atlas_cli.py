@@ -4,12 +4,13 @@
         --algorithm pseudoinverse --algorithm extended [--processes 2 | --dask local:2] \\
         --out atlas.json
 
-The path is a loop from its first point: the starts lie on that point's self-motion curve, at
-arc lengths s on a grid (or sampled), s = 0 where eq. (7) from the robot's default start (or
-``--reference``) reaches the point; the arc is where the curve stays in the robot's
-configuration box, or ``--arc``. Writes ``--out`` (JSON: the inputs, the starts, and per
-algorithm the drift after each cycle, success and leg ends), a CSV beside it for large atlases
-(or with ``--csv``), and an HTML figure of the drift map when plotly is installed.
+The path (default: the robot's closed path) is a loop from its first point: the starts lie on
+that point's self-motion curve, at arc lengths s on a grid (or sampled), s = 0 where eq. (7)
+from the robot's default start (or ``--reference``) reaches the point; the arc is where the
+curve stays in the robot's configuration box, or ``--arc``. Writes ``--out`` (JSON: the
+inputs, the starts, and per algorithm the drift after each cycle, success and leg ends), a CSV
+beside it for large atlases (or with ``--csv``), and an HTML figure of the drift map when
+plotly is installed.
 ``--robot`` is a built-in robot's name (``--param`` sets its parameters), a catalogue arm's
 (``panda``, with its default task) or a user's robot file
 (:func:`jik.engine.robot_spec.load_robot`, as for ``jik solve``).
@@ -61,7 +62,9 @@ def add_atlas_parser(sub) -> None:
         metavar="NAME=VALUE",
         help="a robot parameter (repeat it), e.g. l=1.5",
     )
-    p.add_argument("--path", required=True, help='task points "y1,y2; y1,y2; ...", a loop')
+    p.add_argument(
+        "--path", help='task points "y1,y2; y1,y2; ...", a loop (default: the robot\'s closed path)'
+    )
     p.add_argument("--starts", type=int, default=256, help="starts per path (default 256)")
     p.add_argument("--sampling", choices=("grid", "sample"), default="grid")
     p.add_argument("--seed", type=int, default=0, help="seed of --sampling sample")
@@ -213,13 +216,19 @@ def _run(args: argparse.Namespace) -> int:
             )
             for a in algorithms
         ]
+    closed = not hasattr(kin, "path")  # (the unicycle's default path is a curve, not a loop)
+    path = (
+        _points(args.path, "--path") if args.path else closed * [list(t) for t in spec.default_path]
+    )
+    if not path:
+        raise InvalidInputError(f"{spec.name} has no default closed path: give --path", "path")
     arc = _numbers(args.arc, "--arc") if args.arc else [-MAX_ARC, MAX_ARC]
     reference = _numbers(args.reference, "--reference") if args.reference else spec.default_x0
     backend = backend_option(args)
     backend_for(backend)  # (a bad option fails here, before the curves are traced)
     plan = plan_atlas(
         inverses,
-        _points(args.path, "--path"),
+        path,
         cycles=args.cycles,
         n_starts=args.starts,
         arc=arc,
@@ -252,7 +261,7 @@ def _run(args: argparse.Namespace) -> int:
         "robot_file": args.robot if Path(args.robot).is_file() else None,
         "task": list(spec.task_names),
         "robot_parameters": kin.parameters,
-        "path": _points(args.path, "path"),
+        "path": path,
         "cycles": C,
         "algorithms": list(plan.algorithms),
         "augmentation": args.augmentation,
