@@ -199,6 +199,23 @@ def _x_range(kin: Kinematics, d: Mapping) -> tuple[tuple[float, float], ...]:
     return ((-math.pi, math.pi),) * kin.p
 
 
+def _loop_joints(kin: Kinematics, x0: np.ndarray, step: np.ndarray) -> tuple[int, int]:
+    """The two joints whose moves by ``step`` make the default closed path: the first and the
+    last, unless the task moves they make span less than a tenth of the largest parallelogram of any
+    pair (a last joint that only turns the flange about its axis moves no position and, near
+    home, no rx, ry); then that largest pair. Task moves are forward differences, all p at once.
+    """
+    d = kin.forward(x0 + np.diag(step)) - kin.forward(x0)
+    gram = d @ d.T
+    norms = np.diag(gram)
+    area = np.sqrt(np.maximum(np.outer(norms, norms) - gram**2, 0.0))
+    last = kin.p - 1
+    if area[0, last] >= 0.1 * area.max():
+        return 0, last
+    i, j = np.unravel_index(int(np.argmax(area)), area.shape)
+    return int(min(i, j)), int(max(i, j))
+
+
 def _defaults(kin: Kinematics, d: Mapping, box) -> tuple:
     """x0 (given, else a URDF arm's home if given, else 0.5 in each range), a target and a
     closed path reachable from it."""
@@ -212,9 +229,10 @@ def _defaults(kin: Kinematics, d: Mapping, box) -> tuple:
     else:
         x0 = np.clip(0.5, lo, hi)
     step = 0.15 * np.minimum(1.0, hi - lo)
+    i, j = _loop_joints(kin, x0, step)
     moves = np.zeros((3, kin.p))
-    moves[0, 0] = moves[1, 0] = step[0]
-    moves[1, -1] = moves[2, -1] = step[-1]
+    moves[0, i] = moves[1, i] = step[i]
+    moves[1, j] = moves[2, j] = step[j]
     target = d.get("target", kin.forward(x0 + moves[1]))
     path = d.get("path", kin.forward(x0 + moves))
     target, path = _points(target, kin.r, "target"), _points(path, kin.r, "path")

@@ -68,7 +68,7 @@ from jik.app.compute.user_robots import user_robot
 from jik.app.dashboard.model import default_state, updated_state
 from jik.app.dashboard.patch import StatePatch, patch_of
 from jik.engine.exceptions import InvalidInputError, JikError
-from jik.engine.registry import ROBOTS, make_inverse
+from jik.engine.registry import ROBOTS
 from jik.engine.robot_synthesis import TOTAL_DEGREE
 from jik.engine.synthesis_nd import MAX_UNKNOWNS
 from jik.engine.total_degree import basis_size
@@ -149,23 +149,14 @@ def _user_robot_ok(body: dict, path: str) -> bool:
                 return False
             _, region, _ = synthesis_region(spec, req)
             return len(region) >= 2 or evaluate
-        model = S.SolveRequest if path == "/solve" else S.RepeatabilityRequest
-        run = model.model_validate(body)
-        setup = _setup(run)
-        check_configuration(setup.spec, run.x0)
-        points = run.path if isinstance(run, S.RepeatabilityRequest) else [run.target]
-        for i, point in enumerate(points):
-            check_task_point(setup.spec, point, f"path[{i}]")
-        if _check_start(setup, np.asarray([run.x0], dtype=float))[0]:
-            return False
     except (RequestError, JikError, ValidationError):
         return False
-    return True
+    return _run_ok(body, path)
 
 
 def _total_degree_ok(body: dict, d: int, p: int, r: int) -> bool:
     """The rules of a total-degree synthesis of ``d`` variables (see the module docstring)."""
-    nodes, degree = body.get("qmc_nodes", QMC_NODES), body.get("degree") or TOTAL_DEGREE
+    nodes, degree = int(body.get("qmc_nodes", QMC_NODES)), int(body.get("degree") or TOTAL_DEGREE)
     axes = body.get("frame_axes")
     frame_ok = axes is None or p - r < 2 or (len(set(axes)) == p - r and max(axes) <= p)
     unknowns = basis_size(d, degree)
@@ -191,29 +182,29 @@ def _synthesis_ok(body: dict) -> bool:
     region = body["region"]
     if any(not lo < hi for lo, hi in region.values()) or set(region) & set(fixed):
         return False
+    if len(region) > 3:  # (the unicycle's four lambdas: the total-degree synthesis' alone)
+        return False
     return not synthesis or (len(region) >= 2 and not body.get("augmentation"))
 
 
-def _run_ok(body: dict) -> bool:
-    spec = ROBOTS[body["robot"]["name"]]
-    gamma = body.get("gamma") or spec.default_gamma
-    if (body.get("mode") or spec.default_mode) == "discrete" and gamma >= 2:
-        return False
-    robot = {k: v for k, v in body["robot"].items() if k != "name"}
-    augmentation = body.get("augmentation") or {}
+def _run_ok(body: dict, path: str) -> bool:
+    """Whether the server takes the run of ``body`` (a /solve or /repeatability request): its
+    own checks (robot, map, algorithm parameters, gamma's rule, lengths) and start."""
     try:
-        kinematics = spec.build(**robot)
-        inverse = make_inverse(
-            kinematics, body["algorithm"], augmentation.get("name"),
-            {k: v for k, v in augmentation.items() if k != "name"}, spec.name,
-        )  # fmt: skip
-        inverse.matrix(np.asarray(body["x0"], dtype=float))
+        model = S.SolveRequest if path == "/solve" else S.RepeatabilityRequest
+        run = model.model_validate(body)
+        setup = _setup(run)
+        check_configuration(setup.spec, run.x0)
+        points = run.path if isinstance(run, S.RepeatabilityRequest) else [run.target]
+        for i, point in enumerate(points):
+            check_task_point(setup.spec, point, f"path[{i}]")
         # (the server's own test of a singular start, which a nearly singular J J^T fails)
-        _, bad = inverse.apply_masked(np.asarray([body["x0"]], dtype=float),
-                                      np.ones((1, kinematics.r)))  # fmt: skip
-    except JikError:
+        setup.inverse.matrix(np.asarray(run.x0, dtype=float))
+        if _check_start(setup, np.asarray([run.x0], dtype=float))[0]:
+            return False
+    except (RequestError, JikError, ValidationError):
         return False
-    return not np.any(bad)
+    return True
 
 
 def _change_ok(body: dict) -> bool:
@@ -247,7 +238,7 @@ def _positive_case_ok(case) -> bool:
     if path == "/synthesize":
         return _synthesis_ok(body)
     if path in ("/solve", "/repeatability"):
-        return _run_ok(body)
+        return _run_ok(body, path)
     if path == "/atlas" and case.method == "POST":
         return _atlas_ok(body)
     if path.startswith("/api/sessions") and case.method == "POST" and not path.endswith("/atlas"):

@@ -185,3 +185,26 @@ def test_an_arm_equals_its_urdf_definition():
     np.testing.assert_array_equal(by_name.kinematics.forward(x), by_text.kinematics.forward(x))
     assert by_name.spec.default_x0 == by_text.spec.default_x0 == a.home
     assert by_name.spec.default_path == by_text.spec.default_path
+
+
+# (the UR5e's six joints are not redundant for a pose: its build refuses that task)
+@pytest.mark.parametrize(
+    ("name", "task"),
+    [(n, t) for n in sorted(ARMS) for t in (None, "xyz", "pose") if (n, t) != ("ur5e", "pose")],
+)
+def test_the_default_path_is_a_loop_the_pseudoinverse_drifts_on(name, task):
+    """The default closed path goes around: its corners differ and the pseudoinverse does not
+    come back to x0 (a path made by the last joint alone, which turns the flange about its
+    axis, would move no position: a task without rz would stand still)."""
+    from jik.engine.registry import make_inverse
+    from jik.engine.repeatability import repeatability
+
+    robot = robot_from_dict({"name": name, **({"task": task} if task else {})})
+    spec = robot.spec
+    corners = np.array([spec.default_path[0], *spec.default_path])
+    corners[0] = robot.kinematics.forward(np.array(spec.default_x0))
+    gaps = np.linalg.norm(np.diff(corners, axis=0, append=corners[:1]), axis=1)
+    assert gaps.min() > 1e-3
+    inverse = make_inverse(robot.kinematics, "pseudoinverse")
+    run = repeatability(inverse, spec.default_x0, spec.default_path, 1, mode="continuous")
+    assert run.drift[-1] > 1e-6
