@@ -1,5 +1,6 @@
 """How the dashboard shows a catalogue arm (the Panda): the scene's camera frames the whole arm
-and its pose targets left of viser's control panel, its joints sized to the arm."""
+and its pose targets left of viser's control panel, its joints sized to the arm; the task
+panel shows a pose task's position and orientation, its targets' letters apart."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ import math
 
 import numpy as np
 
+from jik.app.dashboard.figures import figure_specs, gamma_free_panels, to_go
 from jik.app.dashboard.model import default_state, updated_state
 from jik.app.dashboard.results import compute
 from jik.app.dashboard.robots import state_kinematics
@@ -73,3 +75,47 @@ def test_the_panda_joints_are_sized_to_the_arm():
     finally:
         scene.stop()
         dashboard.stop()
+
+
+ALL_FIVE = ["pseudoinverse", "extended", "damped", "weighted", "posture"]
+
+
+def _title_lines(spec) -> list[str]:
+    text = spec["layout"]["title"]["text"]
+    return [line.replace("<sup>", "").replace("</sup>", "") for line in text.split("<br>")]
+
+
+def test_a_pose_task_shows_position_and_rotation_against_theta():
+    """The Panda's pose task: one row per coordinate (x y z above rx ry rz) against theta; the
+    default loop's turn of +-0.15 rad about z shows on the rz row; every target is marked at
+    the end of its leg (letters on the top row only, each at its own theta: none overlap).
+    The panel depends on theta, so it is not among the gamma-free panels."""
+    result = compute(_panda())
+    spec = figure_specs(result, only={"task"})["task"]
+    to_go(spec)  # (valid for plotly)
+    layout = spec["layout"]
+    titles = [layout["yaxis" if k == 0 else f"yaxis{k + 1}"]["title"]["text"] for k in range(6)]
+    assert titles == ["x [m]", "y [m]", "z [m]", "rx [rad]", "ry [rad]", "rz [rad]"]
+    rz = [t for t in spec["data"] if t.get("yaxis") == "y6" and t["name"] in (
+        "pseudoinverse J^P# (8)", "extended Jacobian J^E# (11)")]  # fmt: skip
+    assert rz and all(np.ptp(t["y"]) > 0.29 for t in rz)
+    targets = [t for t in spec["data"] if t["name"] == "targets"]
+    assert len(targets) == 6 and targets[0]["mode"] == "markers+text"
+    assert all(t["mode"] == "markers" for t in targets[1:])
+    theta = np.asarray(targets[0]["x"])
+    span = np.ptp(np.concatenate([r.theta for r in result.runs.values()]))
+    assert len(theta) == 12 and np.min(np.diff(theta)) > 0.05 * span
+    assert targets[0]["text"][:4] == ["B", "C", "D", "A"]
+    np.testing.assert_allclose(targets[5]["y"][:4], np.asarray(result.targets)[:, 5])
+    assert "task" not in gamma_free_panels(result)
+
+
+def test_the_task_panels_subtitle_wraps_with_five_algorithms():
+    """With five algorithms the key of the line styles takes two lines (three, then two) and
+    the marks a third: no line of the title is longer than the first's."""
+    for state in (default_state(), _panda()):
+        result = compute(updated_state(state, {"algorithms": ALL_FIVE}))
+        lines = _title_lines(figure_specs(result, only={"task"})["task"])
+        assert len(lines) == 4, lines
+        assert lines[1].count(":") == 3 and lines[2].count(":") == 2, lines
+        assert max(len(line) for line in lines[1:]) <= 70, lines
