@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 from jik.app.dashboard.figures import figure_specs, gamma_free_panels, to_go
 from jik.app.dashboard.model import default_state, updated_state
@@ -119,3 +120,41 @@ def test_the_task_panels_subtitle_wraps_with_five_algorithms():
         assert len(lines) == 4, lines
         assert lines[1].count(":") == 3 and lines[2].count(":") == 2, lines
         assert max(len(line) for line in lines[1:]) <= 70, lines
+
+
+def _second_phase(result, cancelled=lambda: False):
+    from jik.app.dashboard.analysis import kinematics_and_map
+    from jik.app.dashboard.second_phase import SecondPhase
+
+    kin, amap = kinematics_and_map(result.state)
+    deferred = result.augmenting is None
+    return SecondPhase(kin, amap, result, deferred=deferred, cached=None, grid_before=None,
+                       progress=lambda f, w: None, cancelled=cancelled)  # fmt: skip
+
+
+def test_the_e1_e2_panel_shows_e2_of_a_7_joint_map_beside_single_joints():
+    """The Panda's synthesized map (7 joints, p - r = 1): the second phase takes its E2 by the
+    synthesis's Sobol rule (its independent check rule: docs/e2-vector.md), with E2 of
+    h = s x_j for each joint; the E1/E2 panel draws them as bars (the map outlined, first), the
+    h panel's title says E2; a cancelled phase raises Cancelled."""
+    from jik.app.dashboard.runs import Cancelled
+
+    result = compute(_panda())
+    functionals, sens = _second_phase(result).run()
+    assert functionals["E1"] is None and 1.6e-4 < functionals["E2"] < 1.8e-4
+    single = functionals["E2_single_joint"]
+    assert set(single) == {f"x{i}" for i in range(1, 8)}
+    assert single["x1"]["e2"] == pytest.approx(1.78e-3, rel=1e-2)  # (the docs' table)
+    assert min(v["e2"] for v in single.values()) > 5 * functionals["E2"]
+    assert sens["kind"] == "single_joint" and len(sens["maps"]) == 8
+    specs = figure_specs(result, functionals, {"augmenting", "sensitivity"}, sensitivity=sens)
+    bars = specs["sensitivity"]["data"][0]
+    to_go(specs["sensitivity"])
+    assert bars["type"] == "bar" and bars["x"][0] == "h (current)" and bars["x"][1] == "h = +x1"
+    assert (
+        bars["y"][0] == functionals["E2"]
+        and specs["sensitivity"]["layout"]["yaxis"]["type"] == "log"
+    )
+    assert "E2 = 0.000173" in specs["augmenting"]["layout"]["title"]["text"]
+    with pytest.raises(Cancelled):
+        _second_phase(compute(_panda()), cancelled=iter([False] * 3 + [True] * 99).__next__).run()
