@@ -49,8 +49,9 @@ def test_an_atlas_of_a_robot_without_a_closed_path_asks_for_one(client):
 
 
 def test_an_extended_run_names_the_map_it_used_and_a_region_defaults_to_the_arm_s(client):
-    """Without a map: the arm's E2 synthesis over its box around home (total degree 4). An
-    e2_synthesized map without a region takes that box: the same map, the same run."""
+    """Without a map: the arm's E2 synthesis over its box around home (total degree 4), in
+    /solve and in /synthesize's 'evaluate'. An e2_synthesized map without a region takes that
+    box: the same map, the same run."""
     region = {k: list(v) for k, v in robot_from_dict(PANDA).spec.functional_region.items()}
     default = _solve(client, algorithm="extended")
     assert default["augmentation"]["name"] == "e2_synthesized"
@@ -63,6 +64,8 @@ def test_an_extended_run_names_the_map_it_used_and_a_region_defaults_to_the_arm_
                                                                "degree": 3})  # fmt: skip
     assert other["augmentation"]["definition"] == {**default["augmentation"]["definition"],
                                                    "degree": 3}  # fmt: skip
+    r = client.post("/synthesize", json={"robot": PANDA, "method": "evaluate"})
+    assert r.status_code == 200 and r.json()["augmentation"] == default["augmentation"]
 
 
 def test_messages_name_the_catalogue_arm(client):
