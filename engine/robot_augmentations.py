@@ -112,6 +112,12 @@ def _vector_only(label: str) -> Callable[..., AugmentingMap]:
 
 
 def _region(kin: Kinematics, item: Mapping, where: str):
+    if "region" not in item:  # (an arm's maps take its box around home: arm_augmentations)
+        raise InvalidInputError(
+            f"{where}.region is required: only an arm with a home has a default box to "
+            f"synthesize on; give two or more of {list(kin.variable_names)} to [lo, hi]",
+            f"{where}.region",
+        )
     try:
         box, fix = check_region(kin, item.get("region", {}), item.get("fixed"))
     except InvalidInputError as exc:

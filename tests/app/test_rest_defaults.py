@@ -100,3 +100,12 @@ def test_weighted_with_limits_too_wide_to_matter_is_the_pseudoinverse(client, wi
                   algorithm_parameters={"limits": [[-width, width]] * 7})  # fmt: skip
     assert wide["converged"]
     np.testing.assert_allclose(wide["x"], plain["x"], atol=1e-12)
+
+
+def test_an_e2_map_without_region_of_a_robot_without_a_home_asks_for_one(client):
+    chain = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 1.0, 1.0]}
+    body = {"robot": chain, "algorithm": "extended", "x0": [0.1, 0.5, 0.5], "target": [1.5, 1.0],
+            "augmentation": {"name": "e2_synthesized"}}  # fmt: skip
+    r = client.post("/solve", json=body)
+    assert r.json()["detail"][0]["loc"] == ["body", "augmentation", "region"]
+    assert "only an arm with a home has a default box" in messages(r)[0]
