@@ -243,3 +243,13 @@ def test_a_urdf_arm_in_a_robot_file_equals_the_catalogue_arm(tmp_path):
                                np.array(by_file["results"]["pseudoinverse"]["drift"], float),
                                atol=1e-12)  # fmt: skip
     assert by_name["summary"] == by_file["summary"]
+
+
+def test_the_progress_bar_counts_the_runs_of_every_algorithm(tmp_path, capsys):
+    """8 starts, three algorithms: the bar ends at 24 runs, each start run by each algorithm."""
+    argv = ["atlas", "--robot", "manipulator2", "--path", TABLE1, "--starts", "8", "--cycles",
+            "1", "--algorithm", "pseudoinverse", "--algorithm", "posture", "--algorithm",
+            "damped", "--no-figure", "--out", str(tmp_path / "a.json")]  # fmt: skip
+    assert main(argv) == 0
+    err = capsys.readouterr().err
+    assert "24/24 runs (8 starts x 3 algorithms)" in err and "8/8 runs" not in err
