@@ -205,10 +205,12 @@ def _loop_joints(kin: Kinematics, x0: np.ndarray, step: np.ndarray) -> tuple[int
     pair (a last joint that only turns the flange about its axis moves no position and, near
     home, no rx, ry); then that largest pair. Task moves are forward differences, all p at once.
     """
-    d = kin.forward(x0 + np.diag(step)) - kin.forward(x0)
-    gram = d @ d.T
-    norms = np.diag(gram)
-    area = np.sqrt(np.maximum(np.outer(norms, norms) - gram**2, 0.0))
+    with np.errstate(all="ignore"):  # (a task that overflows: the build refuses it after)
+        d = kin.forward(x0 + np.diag(step)) - kin.forward(x0)
+        gram = d @ d.T
+        norms = np.diag(gram)
+        area = np.sqrt(np.maximum(np.outer(norms, norms) - gram**2, 0.0))
+    area = np.where(np.isfinite(area), area, 0.0)
     last = kin.p - 1
     if area[0, last] >= 0.1 * area.max():
         return 0, last

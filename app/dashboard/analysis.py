@@ -9,6 +9,7 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
+from jik.app.dashboard.arm_e2 import qmc_functionals, single_joint_sensitivity
 from jik.app.dashboard.model import DashboardState, cache_key
 from jik.app.dashboard.robots import state_kinematics, state_spec
 from jik.app.dashboard.runs import AlgorithmRun, Cancelled, DashboardResult
@@ -236,14 +237,19 @@ MAX_QUADRATURE_VARIABLES = 3
 
 
 def error_functionals(
-    result: DashboardResult, nodes: int = 12, on_step: Callable[[], None] | None = None
+    result: DashboardResult,
+    nodes: int = 12,
+    on_step: Callable[[], None] | None = None,
+    cancelled: Callable[[], bool] = lambda: False,
 ) -> dict | None:
     """E1 (13) and E2 (18) of the current map, or None if unavailable.
 
     Over the robot's design region from the registry (the boxes of sec. 5, the ones
     ``jik reproduce`` uses) where it has one, so the values do not move with the start point and
     a synthesized map is judged on the box it was built for; else over the heat-map box.
-    ``on_step()`` after each of the two (progress; what it raises stops them).
+    ``on_step()`` after each of the two (progress; what it raises stops them). Over more than
+    three variables, E2 by a Sobol rule (:func:`~jik.app.dashboard.arm_e2.qmc_functionals`,
+    polling ``cancelled``).
     """
     grid = result.augmenting
     if grid is None:
@@ -266,13 +272,7 @@ def error_functionals(
         "design_region": bool(design),
     }
     if len(region) > MAX_QUADRATURE_VARIABLES:  # (nodes ** 7 points for a 7-joint arm)
-        return {
-            **out,
-            "E1": None,
-            "E2": None,
-            "note": f"E1, E2 not computed: a tensor rule "
-            f"over the {len(region)} variables of the design region is too large",
-        }
+        return qmc_functionals(grid, region, fixed, out, cancelled)
     for key, fn in (("E1", error_functional_e1), ("E2", error_functional_e2)):
         try:
             value = fn(grid["kinematics"], grid["map"], region, nodes=nodes, fixed=fixed)
@@ -329,6 +329,8 @@ def sensitivity(
         return {"kind": "unavailable", "reason": note or "h could not be evaluated on a grid"}
     if functionals is None:
         return {"kind": "unavailable", "reason": "E1, E2 could not be evaluated"}
+    if functionals.get("E2_single_joint") is not None:  # (E2 by a Sobol rule, many joints)
+        return single_joint_sensitivity(functionals)
     state = result.state
     if expensive_map(grid["map"]):
         return {"kind": "unavailable", "reason": "each value of E1, E2 of this map solves a "

@@ -35,6 +35,7 @@ from jik.app.dashboard.plotting import (
     trace,
     units,
 )
+from jik.app.dashboard.pose_figures import algorithms_key, is_pose_task, pose_task_spec
 from jik.app.dashboard.runs import DashboardResult
 from jik.app.dashboard.table import table_spec
 
@@ -75,8 +76,9 @@ def _task_space(result: DashboardResult) -> dict:
     return figure(
         data,
         "Task-space paths (Figs. 5, 6)<br><sup>"
-        + ", ".join(f"{STYLES[a].line.split()[0]}: {STYLES[a].short}" for a in result.runs)
-        + " · × targets of the legs · ○ start k(x0)</sup>",
+        + algorithms_key(result)
+        + (" · " if len(result.runs) <= 2 else "</sup><br><sup>")
+        + "× targets of the legs · ○ start k(x0)</sup>",
         **NO_LEGEND,
         xaxis=dict(title=label(n1, tu[0]), range=nice_range(points[:, 0])),
         yaxis=dict(title=label(n2, tu[1]), range=nice_range(points[:, 1]), scaleanchor="x",
@@ -237,7 +239,8 @@ def gamma_free_panels(result: DashboardResult) -> set[str]:
     """Panels that do not change with gamma in continuous mode (theta is not on their axes)."""
     if result.state.mode != "continuous":
         return set()
-    panels = {"table", "augmenting", "cspace"} | ({"task"} if not is_unicycle(result) else set())
+    flat = not is_unicycle(result) and not is_pose_task(result)  # (a plane, theta not on it)
+    panels = {"table", "augmenting", "cspace"} | ({"task"} if flat else set())
     return panels | ({"drift"} if result.state.task == "path" else set())
 
 
@@ -253,7 +256,9 @@ def figure_specs(
     second phase was cancelled (:mod:`jik.app.dashboard.second_phase`), which the h and E1/E2
     panels then say in place of what it did not compute."""
     builders = {
-        "task": _platform if is_unicycle(result) else _task_space,
+        "task": _platform
+        if is_unicycle(result)
+        else (pose_task_spec if is_pose_task(result) else _task_space),
         "joints": _joints,
         "drift": _drift,
         "table": _table,

@@ -198,6 +198,8 @@ def sensitivity_spec(
     if sens["kind"] == "unavailable":
         return message_figure(f"E1, E2 of {aug}", "<br>".join(textwrap.wrap(sens["reason"], 50)))
     log = dict(type="log", exponentformat="power")
+    if sens["kind"] == "single_joint":
+        return single_joint_spec(sens, aug, log)
     if sens["kind"] == "alternatives":
         maps = sens["maps"]
         names = [m["name"] + (" (current)" if m["current"] else "") for m in maps]
@@ -260,3 +262,26 @@ def sensitivity_spec(
     at = ", ".join(f"{p} = {v:.3g}" for p, v in params.items())
     sub = "".join(f"<br><sup>{line}</sup>" for line in wrap([f"at {at} (circles)", *slopes]))
     return figure(data, f"E1 (13), E2 (18) as the parameters of {aug} move{sub}", **layout)
+
+
+def single_joint_spec(sens: dict, aug: str, log: dict) -> dict:
+    """E2 (18) of the map (outlined) beside E2 of h = s x_j for each joint, on a log scale: a
+    map over many joints, its E2 by a Sobol rule (:mod:`jik.app.dashboard.arm_e2`)."""
+    maps = sens["maps"]
+    values = [m["E2"] for m in maps]
+    data = [
+        trace("bar", x=[m["name"] for m in maps], y=values, name="E2",
+              marker=dict(color=E_COLORS["E2"], line=dict(
+                  color=["black" if m["current"] else E_COLORS["E2"] for m in maps], width=2)),
+              hovertemplate="%{x}: E2 = %{y:.4g}<extra></extra>")
+    ]  # fmt: skip
+    best = min((m for m in maps if not m["current"]), key=lambda m: m["E2"])
+    ratio = ""
+    if sens["E2"]:
+        ratio = f": {best['E2'] / sens['E2']:.3g} times E2 of h"
+    title = (
+        f"E2 (18) of {aug} and of a single joint held<br><sup>by a scrambled Sobol rule of "
+        f"{sens['nodes']} nodes on the design box; the best joint, {best['name']}{ratio}</sup>"
+        "<br><sup>E1 (13) not computed (no rule over this many joints)</sup>"
+    )
+    return figure(data, title, yaxis=dict(title="E2 (log)", **log, **log_ticks(values)))

@@ -111,7 +111,9 @@ class SecondPhase:
         grid = self.steps[GRID]
         one = self._step(FUNCTIONALS, grid)
         done = itertools.count(1)
-        functionals = error_functionals(self.result, on_step=lambda: one(next(done), 2))
+        functionals = error_functionals(
+            self.result, on_step=lambda: one(next(done), 2), cancelled=self._cancelled
+        )
         sens = sensitivity(
             self.result, functionals, self._cancelled, progress=self._step(FUNCTIONALS, grid + 2)
         )

@@ -2,8 +2,9 @@
 
 When the robot changes (another robot, or another definition of a user's robot), the camera
 of every client is set to look at the sphere the robot can reach (:func:`view_of`) from the
-front, tilted, at the distance where the sphere fills the client's narrower field of view
-(viser reports each client's vertical field of view and aspect); a client that connects later
+front, tilted, at the distance where the sphere fills the part of the client's view left of
+viser's control panel (viser reports each client's vertical field of view, aspect and width
+in pixels); a client that connects later
 is framed the same way when it first reports its camera.
 """
 
@@ -22,6 +23,9 @@ from jik.app.scene.mechanisms import CHAINS, chain_points, extent_of
 VIEW_DIRECTION = np.array([0.0, -0.75, 1.05]) / math.hypot(0.75, 1.05)
 #: Room around the framed sphere, as a factor of its radius.
 MARGIN = 1.15
+#: Width [px] of the strip at the right of a client's view under viser's floating control panel
+#: (its "small" width and padding); a view narrower than twice this is framed whole.
+PANEL_PX = 320.0
 
 
 def view_of(result) -> tuple[np.ndarray, float]:
@@ -43,6 +47,10 @@ def view_of(result) -> tuple[np.ndarray, float]:
         radius = max(reach, float(np.linalg.norm(drawn - base, axis=1).max()))
         if home.shape[-1] == 3 and np.ptp(drawn[:, 2]) > 0:  # (an arm standing in space)
             # The box of its drawn configurations, not its whole reach around the base.
+            # (and the targets' positions, where its pose frames are drawn).
+            targets = np.asarray(result.targets, dtype=float)
+            if targets.ndim == 2 and targets.shape[1] >= 3:
+                drawn = np.vstack([drawn, targets[:, :3]])
             center = (drawn.min(axis=0) + drawn.max(axis=0)) / 2
             radius = float(np.linalg.norm(drawn - center, axis=1).max())
             return center, max(radius, 1e-3)
@@ -52,14 +60,25 @@ def view_of(result) -> tuple[np.ndarray, float]:
     return center, max(math.hypot(xhi - xlo, yhi - ylo) / 2, 1e-3)
 
 
+def free_fraction(width: float) -> float:
+    """The fraction of a view ``width`` [px] wide left of viser's control panel."""
+    return 1.0 - PANEL_PX / width if width >= 2 * PANEL_PX else 1.0
+
+
 def camera_pose(
-    center: np.ndarray, radius: float, fov: float, aspect: float
+    center: np.ndarray, radius: float, fov: float, aspect: float, free: float = 1.0
 ) -> tuple[np.ndarray, np.ndarray]:
     """(position, look_at) of a camera with vertical field of view ``fov`` [rad] and
-    ``aspect`` (width / height) that shows the whole sphere (``center``, ``radius``)."""
-    half = min(fov / 2, math.atan(math.tan(fov / 2) * aspect))  # the narrower half-angle
+    ``aspect`` (width / height) that shows the whole sphere (``center``, ``radius``) in the
+    left ``free`` fraction of its view (the rest is under the control panel): the camera
+    stands back until the sphere fits that part, then moves right (x, the view's right
+    direction) so the sphere is centred in it."""
+    wide = math.tan(fov / 2) * aspect  # (tangent of half the view's width)
+    half = min(fov / 2, math.atan(wide * free))  # the narrower half-angle of the free part
     distance = MARGIN * radius / math.sin(half)
-    return center + distance * VIEW_DIRECTION, np.asarray(center, dtype=float)
+    shift = np.array([(1.0 - free) * wide * distance, 0.0, 0.0])
+    look_at = np.asarray(center, dtype=float) + shift
+    return look_at + distance * VIEW_DIRECTION, look_at
 
 
 class CameraFraming:
@@ -92,7 +111,8 @@ class CameraFraming:
             return
         camera = client.camera
         aspect = camera.aspect if camera.image_height > 0 else 16 / 9
-        position, look_at = camera_pose(*view, camera.fov, aspect)
+        free = free_fraction(camera.image_width) if camera.image_height > 0 else 1.0
+        position, look_at = camera_pose(*view, camera.fov, aspect, free)
         distance = float(np.linalg.norm(position - look_at))
         with client.atomic():
             camera.position = position

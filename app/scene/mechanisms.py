@@ -195,9 +195,11 @@ class Chain(Mechanism):
             f"{self.root}/links", np.zeros((n - 1, 2, 3)), self.color, thickness=width,
             thickness_units="screen",
         )  # fmt: skip
-        self.joints = [self.ball(f"joint{i}", 0.04 if i < n - 1 else 0.06) for i in range(n)]
-        # The end link's frame when the task holds its orientation (a pose task).
+        # Joints sized to the arm: a sixtieth of its reach (0.04 for an arm of reach 2.4).
         reach = float(np.linalg.norm(np.diff(home, axis=0), axis=1).sum())
+        ball = max(reach, 1e-3) / 60
+        self.joints = [self.ball(f"joint{i}", ball if i < n - 1 else 1.5 * ball) for i in range(n)]
+        # The end link's frame when the task holds its orientation (a pose task).
         self.end = None if end_frame(self.kin, self.state.x0) is None else self.scene.add_frame(
             f"{self.root}/end", axes_length=AXES_FRACTION * reach,
             axes_radius=0.06 * AXES_FRACTION * reach,

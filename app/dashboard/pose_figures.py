@@ -1,0 +1,103 @@
+"""The task-space panel of an arm in space: every task coordinate against the leg's parameter.
+
+An arm's task may hold its end link's position ``x y z`` and orientation ``rx ry rz`` (the
+rotation vector log(R0^T R), :mod:`jik.engine.pose_task`). A plane (x, y) would hide z and the
+orientation (a path that only turns the end link is a point there): instead, one row per task
+coordinate against theta (continuation parameter, or the iteration), positions above
+rotations, like the paper's joint trajectories (Figs. 7-9) for the task space; the legs'
+targets are marked where each leg ends, lettered on the top row.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from jik.app.dashboard.algorithms import COLORS, DASH, LABELS, STYLES
+from jik.app.dashboard.plotting import (
+    NO_LEGEND,
+    corner_names,
+    figure,
+    label,
+    nice_range,
+    stacked_axes,
+    theta_label,
+    trace,
+    units,
+)
+from jik.app.dashboard.runs import DashboardResult
+
+#: The coordinates of an arm's task in space (any of them).
+POSE_NAMES = ("x", "y", "z", "rx", "ry", "rz")
+
+
+def is_pose_task(result: DashboardResult) -> bool:
+    """Whether the task is an arm's in space beyond the plane: some of x y z rx ry rz, with z or
+    an orientation coordinate among them."""
+    names = set(result.task_names)
+    return names <= set(POSE_NAMES) and bool(names & {"z", "rx", "ry", "rz"})
+
+
+def algorithms_key(result: DashboardResult, per_line: int = 3) -> str:
+    """The line style of each algorithm, ``per_line`` to a line (a title fits its panel)."""
+    keys = [f"{STYLES[a].line.split()[0]}: {STYLES[a].short}" for a in result.runs]
+    return "</sup><br><sup>".join(
+        ", ".join(keys[i : i + per_line]) for i in range(0, len(keys), per_line)
+    )
+
+
+def pose_task_spec(result: DashboardResult) -> dict:
+    """Each task coordinate against theta for each algorithm, one row per coordinate; the
+    targets (× at the end of each leg, their letters on the top row) and the start k(x0) (○)."""
+    _, tu = units(result)
+    names = list(result.task_names)
+    order = sorted(range(len(names)), key=lambda k: POSE_NAMES.index(names[k]))
+    runs = list(result.runs.values())
+    first = runs[0]
+    ends = np.flatnonzero(np.diff(first.leg, append=first.leg[-1] + 1))  # (last point of a leg)
+    legs = first.leg[ends]
+    targets = np.asarray(result.targets, dtype=float)
+    letters = np.asarray(corner_names(result), dtype=object)[legs % len(targets)]
+    data = []
+    axes = stacked_axes(len(names))
+    for row, k in enumerate(order):
+        yaxis = "y" if row == 0 else f"y{row + 1}"
+        name = names[k]
+        for a, run in result.runs.items():
+            data.append(
+                trace("scatter",
+                    x=run.theta, y=run.y[:, k], mode="lines", name=LABELS[a],
+                    line=dict(color=COLORS[a], width=1.8, dash=DASH[a]), xaxis="x", yaxis=yaxis,
+                    customdata=run.leg + 1,
+                    hovertemplate=f"{name} = %{{y:.5f}}<br>θ = %{{x:.4g}}<br>leg %{{customdata}}"
+                    f"<extra>{a}</extra>",
+                )
+            )  # fmt: skip
+        data.append(
+            trace("scatter",
+                x=first.theta[ends], y=targets[legs % len(targets), k], name="targets",
+                mode="markers+text" if row == 0 else "markers", xaxis="x", yaxis=yaxis,
+                text=letters.tolist(), textposition="top center",
+                marker=dict(color="black", size=8, symbol="x"),
+                hovertemplate=f"%{{text}}: {name} = %{{y:.4f}}<extra></extra>",
+            )
+        )  # fmt: skip
+        data.append(
+            trace("scatter",
+                x=[first.theta[0]], y=[first.y[0, k]], mode="markers", name="start k(x0)",
+                xaxis="x", yaxis=yaxis,
+                marker=dict(color="#2ca02c", size=10, symbol="circle-open", line=dict(width=2)),
+                hovertemplate=f"start {name} = %{{y:.4f}}<extra></extra>",
+            )
+        )  # fmt: skip
+        values = np.concatenate([r.y[:, k] for r in runs] + [targets[:, k]])
+        axes["yaxis" if row == 0 else f"yaxis{row + 1}"].update(
+            title=label(name, tu[k]), range=nice_range(values)
+        )
+    axes["xaxis"]["title"] = theta_label(result)
+    axes["xaxis"]["range"] = nice_range(np.concatenate([r.theta for r in runs]), from_zero=True)
+    title = (
+        "Task coordinates against θ: position, then rotation vector<br><sup>"
+        + algorithms_key(result)
+        + "</sup><br><sup>× target at the end of each leg · ○ start k(x0)</sup>"
+    )
+    return figure(data, title, height=110 * len(names) + 140, **NO_LEGEND, **axes)

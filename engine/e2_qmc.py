@@ -1,0 +1,116 @@
+"""E2, eq. (18), of a map over many joints by a quasi-Monte Carlo rule, beside single joints.
+
+A tensor Gauss rule over d variables has n^d nodes (12^7 = 3.6e7 for a 7-joint arm): jik's
+:mod:`jik.engine.functionals` stops at three. For one degree of redundancy, E2 is the integral
+over the region of (docs/e2-vector.md, eq. (19) with dh a row)
+
+    m(x) (dh P dh^T - 2 dh K + 1),    P = J^# J^#T + K K^T,
+
+which :func:`e2_qmc` takes as the mean over a scrambled Sobol rule (``scipy.stats.qmc``) of N
+nodes times the region's volume: the rule and the nodes of
+:func:`jik.engine.synthesis_nd.synthesize_e2_nd` (seed 1 is its independent check rule,
+``e2_check``). With it, E2 of the common choice h = s x_j (one joint held, s = +-1 the better
+sign: the one of the integral of m K_j) for each joint of the region, as
+``TotalDegreeSynthesis.single_joint`` gives them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+from scipy.stats import qmc
+
+from jik.engine.augmentations import AugmentingMap
+from jik.engine.exceptions import InvalidInputError, KinematicSingularityError
+from jik.engine.functionals import Region, check_region
+from jik.engine.kinematics import Kinematics
+from jik.engine.progress import Progress, check_cancelled
+from jik.engine.synthesis_nd import CHUNK, MAX_NODES, kernel_frame
+from jik.engine.validation import count
+
+
+def e2_qmc(
+    kinematics: Kinematics,
+    amap: AugmentingMap,
+    region: Region,
+    *,
+    fixed: Mapping[str, float] | None = None,
+    nodes: int = 2**13,
+    seed: int = 1,
+    progress: Progress | None = None,
+) -> dict:
+    """E2 (18) of ``amap`` and of each h = s x_j on ``region`` by a scrambled Sobol rule.
+
+    Parameters
+    ----------
+    kinematics : Kinematics
+        With p - r = 1.
+    amap : AugmentingMap
+        The map h (its gradient, :meth:`~jik.engine.augmentations.AugmentingMap.gradient_masked`).
+    region : mapping name -> (lo, hi)
+        The joint variables integrated over; the others are held at ``fixed``.
+    nodes : int
+        A power of two (a Sobol rule's balance needs it).
+    seed : int
+        Seed of the scrambling (the result is a deterministic function of it).
+    progress : Progress, optional
+        Told the fraction of the nodes done (``advance``); polled between chunks of nodes
+        (``cancelled``: :class:`~jik.engine.exceptions.RunCancelled`).
+
+    Returns
+    -------
+    dict
+        ``{"E2": float or None (h undefined at some node), "undefined_points": int,
+        "single_joint": {name: {"sign", "e2"}}, "nodes", "seed"}``.
+    """
+    if kinematics.p - kinematics.r != 1:
+        raise InvalidInputError(
+            f"{kinematics.name} has p - r = {kinematics.p - kinematics.r}; E2 by this rule "
+            "needs one degree of redundancy",
+            "robot",
+        )
+    box, fix = check_region(kinematics, region, fixed)
+    nodes = count(nodes, "nodes", 64, MAX_NODES)
+    if nodes & (nodes - 1):
+        raise InvalidInputError(f"nodes must be a power of two, got {nodes}", "nodes")
+    names = tuple(kinematics.variable_names) or tuple(f"x{i + 1}" for i in range(kinematics.p))
+    idx = np.array([names.index(n) for n in box])
+    lo, hi = np.array(list(box.values()), dtype=float).T
+    t = 2.0 * qmc.Sobol(len(box), scramble=True, seed=seed).random(nodes) - 1.0
+    base = np.array([fix.get(n, 0.0) for n in names])
+    total, undefined = 0.0, 0
+    c0, diag, load = 0.0, np.zeros(len(idx)), np.zeros(len(idx))
+    for start in range(0, nodes, CHUNK):
+        check_cancelled(progress, "the E2 rule was cancelled")
+        x = np.broadcast_to(base, (len(t[start : start + CHUNK]), base.size)).copy()
+        x[:, idx] = 0.5 * (lo + hi) + 0.5 * (hi - lo) * t[start : start + CHUNK]
+        m = kinematics.manipulability(x)
+        if np.any(m < 1e-9):
+            raise KinematicSingularityError(
+                "the region contains a kinematic singularity", x[int(np.argmin(m))]
+            )
+        K, Jp = kernel_frame(kinematics, x)
+        k = K[..., 0]  # (n, p)
+        P = Jp @ np.swapaxes(Jp, -1, -2) + K @ np.swapaxes(K, -1, -2)
+        dh, bad = amap.gradient_masked(x)
+        dh = np.asarray(dh, dtype=float).reshape(len(x), -1)
+        undefined += int(np.count_nonzero(bad))
+        integrand = m * (np.einsum("nk,nkl,nl->n", dh, P, dh) - 2.0 * np.sum(dh * k, -1) + 1.0)
+        total += float(np.sum(integrand[~np.asarray(bad, dtype=bool).reshape(-1)]))
+        c0 += float(m.sum())
+        diag += np.einsum("n,nk->k", m, P[:, idx, idx])
+        load += np.einsum("n,nk->k", m, k[:, idx])
+        if progress is not None:
+            progress.advance(min(start + CHUNK, nodes) / nodes, 1.0)
+    w = float(np.prod(hi - lo)) / nodes
+    sign = np.where(load >= 0, 1.0, -1.0)
+    single = {
+        name: {"sign": float(sign[j]), "e2": float(w * (c0 + diag[j] - 2.0 * sign[j] * load[j]))}
+        for j, name in enumerate(box)
+    }
+    e2 = None if undefined else float(w * total)
+    return {
+        "E2": e2, "undefined_points": undefined, "single_joint": single, "nodes": nodes,
+        "seed": seed,
+    }  # fmt: skip

@@ -1,0 +1,160 @@
+"""How the dashboard shows a catalogue arm (the Panda): the scene's camera frames the whole arm
+and its pose targets left of viser's control panel, its joints sized to the arm; the task
+panel shows a pose task's position and orientation, its targets' letters apart."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from jik.app.dashboard.figures import figure_specs, gamma_free_panels, to_go
+from jik.app.dashboard.model import default_state, updated_state
+from jik.app.dashboard.results import compute
+from jik.app.dashboard.robots import state_kinematics
+from jik.app.dashboard.session import Dashboard
+from jik.app.scene import DashboardScene
+from jik.app.scene.camera import VIEW_DIRECTION, camera_pose, free_fraction, view_of
+from jik.app.scene.mechanisms import Chain, chain_points
+
+
+def _panda():
+    return updated_state(default_state(), {"robot": "panda"})
+
+
+def _project(points, position, look_at, fov, aspect):
+    """Normalized image coordinates (u, v in [-1, 1] on screen) of ``points`` (m, 3) seen from
+    a camera at ``position`` looking at ``look_at`` with z up."""
+    forward = (look_at - position) / np.linalg.norm(look_at - position)
+    right = np.cross(forward, (0.0, 0.0, 1.0))
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    rel = points - position
+    depth = rel @ forward
+    t = math.tan(fov / 2)
+    return (rel @ right) / depth / (t * aspect), (rel @ up) / depth / t
+
+
+def test_the_camera_frames_the_panda_left_of_the_control_panel():
+    """In the reviewer's 722 x 1017 px scene (viser's panel over its right 320 px), every
+    joint the Panda's runs pass through and every pose target is in view, left of the panel,
+    and the arm fills a good part of that free width (not a few joints close up)."""
+    state = _panda()
+    result = compute(state)
+    center, radius = view_of(result)
+    kin = state_kinematics(state)
+    xs = np.concatenate([r.x for r in result.runs.values()])
+    drawn = chain_points(kin, xs[:: max(1, len(xs) // 200)], 0.0).reshape(-1, 3)
+    points = np.vstack([drawn, np.asarray(result.targets)[:, :3]])
+    fov, width, height = 1.3, 722.0, 1017.0
+    free = free_fraction(width)
+    assert free == 1 - 320 / 722 and free_fraction(500.0) == 1.0
+    position, look_at = camera_pose(center, radius, fov, width / height, free)
+    np.testing.assert_allclose((position - look_at) / np.linalg.norm(position - look_at),
+                               VIEW_DIRECTION, atol=1e-12)  # fmt: skip
+    u, v = _project(points, position, look_at, fov, width / height)
+    edge = -1 + 2 * free  # (the panel's left edge)
+    assert u.min() > -1 and u.max() < edge and abs(v).max() < 1, (u.min(), u.max(), v)
+    assert u.max() - u.min() > 0.4 * (edge + 1), (u.min(), u.max())  # (not tiny either)
+
+
+def test_the_panda_joints_are_sized_to_the_arm():
+    """A joint's sphere is a sixtieth of the arm's reach: under 2 cm for the Panda (reach
+    about 1 m), not 4 cm as for a 2.4 m planar arm."""
+    state = _panda()
+    dashboard = Dashboard(state)
+    scene = DashboardScene(dashboard)
+    try:
+        arm = Chain(scene.server.scene, "/test/arm", (10, 20, 30), None, 0.0, state,
+                    ((-1.0, 1.0), (-1.0, 1.0)))  # fmt: skip
+        home = chain_points(arm.kin, np.asarray(state.x0, dtype=float), 0.0)
+        reach = float(np.linalg.norm(np.diff(home, axis=0), axis=1).sum())
+        assert 0.5 < reach < 1.5
+        assert arm.joints[0].radius == reach / 60 < 0.02
+        assert arm.joints[-1].radius == 1.5 * reach / 60
+    finally:
+        scene.stop()
+        dashboard.stop()
+
+
+ALL_FIVE = ["pseudoinverse", "extended", "damped", "weighted", "posture"]
+
+
+def _title_lines(spec) -> list[str]:
+    text = spec["layout"]["title"]["text"]
+    return [line.replace("<sup>", "").replace("</sup>", "") for line in text.split("<br>")]
+
+
+def test_a_pose_task_shows_position_and_rotation_against_theta():
+    """The Panda's pose task: one row per coordinate (x y z above rx ry rz) against theta; the
+    default loop's turn of +-0.15 rad about z shows on the rz row; every target is marked at
+    the end of its leg (letters on the top row only, each at its own theta: none overlap).
+    The panel depends on theta, so it is not among the gamma-free panels."""
+    result = compute(_panda())
+    spec = figure_specs(result, only={"task"})["task"]
+    to_go(spec)  # (valid for plotly)
+    layout = spec["layout"]
+    titles = [layout["yaxis" if k == 0 else f"yaxis{k + 1}"]["title"]["text"] for k in range(6)]
+    assert titles == ["x [m]", "y [m]", "z [m]", "rx [rad]", "ry [rad]", "rz [rad]"]
+    rz = [t for t in spec["data"] if t.get("yaxis") == "y6" and t["name"] in (
+        "pseudoinverse J^P# (8)", "extended Jacobian J^E# (11)")]  # fmt: skip
+    assert rz and all(np.ptp(t["y"]) > 0.29 for t in rz)
+    targets = [t for t in spec["data"] if t["name"] == "targets"]
+    assert len(targets) == 6 and targets[0]["mode"] == "markers+text"
+    assert all(t["mode"] == "markers" for t in targets[1:])
+    theta = np.asarray(targets[0]["x"])
+    span = np.ptp(np.concatenate([r.theta for r in result.runs.values()]))
+    assert len(theta) == 12 and np.min(np.diff(theta)) > 0.05 * span
+    assert targets[0]["text"][:4] == ["B", "C", "D", "A"]
+    np.testing.assert_allclose(targets[5]["y"][:4], np.asarray(result.targets)[:, 5])
+    assert "task" not in gamma_free_panels(result)
+
+
+def test_the_task_panels_subtitle_wraps_with_five_algorithms():
+    """With five algorithms the key of the line styles takes two lines (three, then two) and
+    the marks a third: no line of the title is longer than the first's."""
+    for state in (default_state(), _panda()):
+        result = compute(updated_state(state, {"algorithms": ALL_FIVE}))
+        lines = _title_lines(figure_specs(result, only={"task"})["task"])
+        assert len(lines) == 4, lines
+        assert lines[1].count(":") == 3 and lines[2].count(":") == 2, lines
+        assert max(len(line) for line in lines[1:]) <= 70, lines
+
+
+def _second_phase(result, cancelled=lambda: False):
+    from jik.app.dashboard.analysis import kinematics_and_map
+    from jik.app.dashboard.second_phase import SecondPhase
+
+    kin, amap = kinematics_and_map(result.state)
+    deferred = result.augmenting is None
+    return SecondPhase(kin, amap, result, deferred=deferred, cached=None, grid_before=None,
+                       progress=lambda f, w: None, cancelled=cancelled)  # fmt: skip
+
+
+def test_the_e1_e2_panel_shows_e2_of_a_7_joint_map_beside_single_joints():
+    """The Panda's synthesized map (7 joints, p - r = 1): the second phase takes its E2 by the
+    synthesis's Sobol rule (its independent check rule: docs/e2-vector.md), with E2 of
+    h = s x_j for each joint; the E1/E2 panel draws them as bars (the map outlined, first), the
+    h panel's title says E2; a cancelled phase raises Cancelled."""
+    from jik.app.dashboard.runs import Cancelled
+
+    result = compute(_panda())
+    functionals, sens = _second_phase(result).run()
+    assert functionals["E1"] is None and 1.6e-4 < functionals["E2"] < 1.8e-4
+    single = functionals["E2_single_joint"]
+    assert set(single) == {f"x{i}" for i in range(1, 8)}
+    assert single["x1"]["e2"] == pytest.approx(1.78e-3, rel=1e-2)  # (the docs' table)
+    assert min(v["e2"] for v in single.values()) > 5 * functionals["E2"]
+    assert sens["kind"] == "single_joint" and len(sens["maps"]) == 8
+    specs = figure_specs(result, functionals, {"augmenting", "sensitivity"}, sensitivity=sens)
+    bars = specs["sensitivity"]["data"][0]
+    to_go(specs["sensitivity"])
+    assert bars["type"] == "bar" and bars["x"][0] == "h (current)" and bars["x"][1] == "h = +x1"
+    assert (
+        bars["y"][0] == functionals["E2"]
+        and specs["sensitivity"]["layout"]["yaxis"]["type"] == "log"
+    )
+    assert "E2 = 0.000173" in specs["augmenting"]["layout"]["title"]["text"]
+    with pytest.raises(Cancelled):
+        _second_phase(compute(_panda()), cancelled=iter([False] * 3 + [True] * 99).__next__).run()
