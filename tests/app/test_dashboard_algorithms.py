@@ -126,6 +126,8 @@ def test_the_atlas_compares_the_chosen_algorithms(three):
     assert request.algorithms == THREE
     assert request.algorithm_parameters is not None
     assert request.algorithm_parameters.gain == 1.0
+    # no rest: the atlas's posture inverse pulls each run toward its own start, not toward x0
+    assert request.algorithm_parameters.rest is None
 
 
 def test_the_session_api_takes_the_choice(client):
