@@ -231,6 +231,10 @@ class PostureInverse(Inverse):
         The rest posture x_rest.
     gain : float
         k >= 0; 0 is the pseudoinverse (8), bit for bit (the same code runs).
+    rest_given : bool
+        False: ``rest`` is a default (:func:`~jik.engine.algorithm_registry.make_inverse`'s, the
+        robot's home), and an atlas pulls each run toward its own start x0 instead
+        (:mod:`jik.engine.posture_at_start`), so that it measures drift, not the pull.
 
     Notes
     -----
@@ -248,8 +252,11 @@ class PostureInverse(Inverse):
 
     name = "posture"
 
-    def __init__(self, kinematics: Kinematics, rest, gain: float = 1.0) -> None:
+    def __init__(
+        self, kinematics: Kinematics, rest, gain: float = 1.0, rest_given: bool = True
+    ) -> None:
         self.kinematics = kinematics
+        self.rest_given = rest_given
         self.rest = kinematics.check(rest, "rest")
         if self.rest.shape != (kinematics.p,):
             raise InvalidInputError(
@@ -259,13 +266,18 @@ class PostureInverse(Inverse):
         self._plain = Pseudoinverse(kinematics)
 
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
+        return self.pull(x, e, self.rest)
+
+    def pull(self, x: FloatArray, e: FloatArray, rest: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """:meth:`apply_masked` with the rest posture ``rest``, shape (p,) or one per member
+        (..., p)."""
         if self.gain == 0.0:
             return self._plain.apply_masked(x, e)
         J = self.kinematics.jacobian(x)
         G = gram(J)
         w, d = solve_small(G, e)  # (J J^T) w = e
         bad = ~(np.abs(d) >= SINGULAR_MANIPULABILITY**2)
-        z = self.rest - x
+        z = rest - x
         u, _ = solve_small(G, np.einsum("...ij,...j->...i", J, z))
         null = z - _jt(J, u)  # (I - J# J) (x_rest - x)
         v = _jt(J, w) - self.gain * np.linalg.norm(e, axis=-1)[..., None] * null

@@ -138,20 +138,25 @@ def backend_option(args: argparse.Namespace) -> str:
 
 
 class Progress:
-    """A progress bar on stderr: runs done, elapsed time and the time left."""
+    """A progress bar on stderr: runs done over every algorithm, elapsed time and the time
+    left."""
 
-    def __init__(self, quiet: bool) -> None:
+    def __init__(self, quiet: bool, algorithms: int = 1) -> None:
         self.quiet = quiet
+        self.algorithms = algorithms
         self.t0 = time.perf_counter()
 
     def __call__(self, done: int, total: int) -> None:
+        """``done`` of ``total`` starts (times paths), each run by every algorithm."""
         if self.quiet:
             return
         t = time.perf_counter() - self.t0
         left = t * (total - done) / done if done else math.nan
         bar = "#" * int(30 * done / total)
+        A = self.algorithms
         sys.stderr.write(
-            f"\r  atlas [{bar:<30}] {done}/{total} runs, {t:.1f} s, {left:.0f} s left "
+            f"\r  atlas [{bar:<30}] {A * done}/{A * total} runs ({total} starts x {A} "
+            f"algorithm{'' if A == 1 else 's'}), {t:.1f} s, {left:.0f} s left "
         )
         if done >= total:
             sys.stderr.write("\n")
@@ -248,7 +253,7 @@ def _run(args: argparse.Namespace) -> int:
     keep = not big  # (a small atlas is gathered for the JSON; a large one streams to the CSV)
     every = max(1, plan.size // FIGURE_POINTS)
     arrays = Gathered(plan, keep, every, legs=not args.no_leg_ends)
-    progress = Progress(args.quiet)
+    progress = Progress(args.quiet, A)
     t0 = time.perf_counter()
     with CsvWriter(csv_path, plan, legs=not args.no_leg_ends) as rows:
         for task, chunk in iter_atlas(plan, backend):

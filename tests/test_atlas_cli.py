@@ -269,3 +269,13 @@ def test_without_path_the_robot_s_closed_path_is_the_loop(tmp_path, capsys):
     argv = ["atlas", "--robot", "unicycle", "--quiet", "--out", str(tmp_path / "u.json")]
     assert main(argv) == 2
     assert "unicycle has no default closed path: give --path" in capsys.readouterr().err
+
+
+def test_the_progress_bar_counts_the_runs_of_every_algorithm(tmp_path, capsys):
+    """8 starts, three algorithms: the bar ends at 24 runs, each start run by each algorithm."""
+    argv = ["atlas", "--robot", "manipulator2", "--path", TABLE1, "--starts", "8", "--cycles",
+            "1", "--algorithm", "pseudoinverse", "--algorithm", "posture", "--algorithm",
+            "damped", "--no-figure", "--out", str(tmp_path / "a.json")]  # fmt: skip
+    assert main(argv) == 0
+    err = capsys.readouterr().err
+    assert "24/24 runs (8 starts x 3 algorithms)" in err and "8/8 runs" not in err

@@ -58,7 +58,8 @@ class AtlasRequest(BaseModel):
     )
     algorithm_parameters: AlgorithmParameters | None = Field(
         None, description="parameters of the damped, weighted and posture algorithms (each "
-        "takes its own; default: the engine's)",
+        "takes its own; default: the engine's; without rest the posture inverse pulls each "
+        "run toward its own start)",
     )  # fmt: skip
     augmentation: AnyAugmentation | None = Field(
         None, description="augmenting map of the extended inverse (default: the robot's)"
