@@ -284,4 +284,8 @@ def single_joint_spec(sens: dict, aug: str, log: dict) -> dict:
         f"{sens['nodes']} nodes on the design box; E1 (13) not computed</sup>"
         f"<br><sup>the best single joint, {best['name']}{ratio}</sup>"
     )
-    return figure(data, title, yaxis=dict(title="E2 (log)", **log, **log_ticks(values)))
+    known = [v for v in values if v is not None and v > 0]
+    # (a decade below the least: the map's bar, often the least, stands out of the axis)
+    lo, hi = (np.log10(min(known)) - 1, np.log10(max(known)) + 0.2) if known else (-3, 0)
+    yaxis = dict(title="E2 (log)", range=[float(lo), float(hi)], **log, **log_ticks(values))
+    return figure(data, title, yaxis=yaxis)

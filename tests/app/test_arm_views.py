@@ -169,6 +169,8 @@ def test_the_e1_e2_panel_shows_e2_of_a_7_joint_map_beside_single_joints():
         bars["y"][0] == functionals["E2"]
         and specs["sensitivity"]["layout"]["yaxis"]["type"] == "log"
     )
+    low = specs["sensitivity"]["layout"]["yaxis"]["range"][0]
+    assert low <= np.log10(functionals["E2"]) - 1  # (the map's bar stands out of the axis)
     assert "E2 = 0.000173" in specs["augmenting"]["layout"]["title"]["text"]
     with pytest.raises(Cancelled):
         _second_phase(compute(_panda()), cancelled=iter([False] * 3 + [True] * 99).__next__).run()
