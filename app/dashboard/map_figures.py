@@ -278,10 +278,14 @@ def single_joint_spec(sens: dict, aug: str, log: dict) -> dict:
     best = min((m for m in maps if not m["current"]), key=lambda m: m["E2"])
     ratio = ""
     if sens["E2"]:
-        ratio = f": {best['E2'] / sens['E2']:.3g} times E2 of h"
+        ratio = f": {best['E2'] / sens['E2']:.3g} × E2 of h"
     title = (
-        f"E2 (18) of {aug} and of a single joint held<br><sup>by a scrambled Sobol rule of "
-        f"{sens['nodes']} nodes on the design box; the best joint, {best['name']}{ratio}</sup>"
-        "<br><sup>E1 (13) not computed (no rule over this many joints)</sup>"
+        f"E2 (18) of {aug} and of a single joint held<br><sup>a scrambled Sobol rule of "
+        f"{sens['nodes']} nodes on the design box; E1 (13) not computed</sup>"
+        f"<br><sup>the best single joint, {best['name']}{ratio}</sup>"
     )
-    return figure(data, title, yaxis=dict(title="E2 (log)", **log, **log_ticks(values)))
+    known = [v for v in values if v is not None and v > 0]
+    # (a decade below the least: the map's bar, often the least, stands out of the axis)
+    lo, hi = (np.log10(min(known)) - 1, np.log10(max(known)) + 0.2) if known else (-3, 0)
+    yaxis = dict(title="E2 (log)", range=[float(lo), float(hi)], **log, **log_ticks(values))
+    return figure(data, title, yaxis=yaxis)

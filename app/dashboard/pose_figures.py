@@ -5,7 +5,7 @@ rotation vector log(R0^T R), :mod:`jik.engine.pose_task`). A plane (x, y) would 
 orientation (a path that only turns the end link is a point there): instead, one row per task
 coordinate against theta (continuation parameter, or the iteration), positions above
 rotations, like the paper's joint trajectories (Figs. 7-9) for the task space; the legs'
-targets are marked where each leg ends, lettered on the top row.
+targets are marked where each leg ends, lettered above the top row.
 """
 
 from __future__ import annotations
@@ -28,6 +28,9 @@ from jik.app.dashboard.runs import DashboardResult
 
 #: The coordinates of an arm's task in space (any of them).
 POSE_NAMES = ("x", "y", "z", "rx", "ry", "rz")
+#: Least half-span of a row's axis [m or rad]: a coordinate the path holds (rx, ry of a turn
+#: about z) shows flat, not its rounding errors of 1e-16 blown up.
+MIN_SPAN = 0.01
 
 
 def is_pose_task(result: DashboardResult) -> bool:
@@ -47,7 +50,7 @@ def algorithms_key(result: DashboardResult, per_line: int = 3) -> str:
 
 def pose_task_spec(result: DashboardResult) -> dict:
     """Each task coordinate against theta for each algorithm, one row per coordinate; the
-    targets (× at the end of each leg, their letters on the top row) and the start k(x0) (○)."""
+    targets (× at the end of each leg, their letters above the top row) and the start k(x0) (○)."""
     _, tu = units(result)
     names = list(result.task_names)
     order = sorted(range(len(names)), key=lambda k: POSE_NAMES.index(names[k]))
@@ -75,8 +78,7 @@ def pose_task_spec(result: DashboardResult) -> dict:
         data.append(
             trace("scatter",
                 x=first.theta[ends], y=targets[legs % len(targets), k], name="targets",
-                mode="markers+text" if row == 0 else "markers", xaxis="x", yaxis=yaxis,
-                text=letters.tolist(), textposition="top center",
+                mode="markers", xaxis="x", yaxis=yaxis, text=letters.tolist(),
                 marker=dict(color="black", size=8, symbol="x"),
                 hovertemplate=f"%{{text}}: {name} = %{{y:.4f}}<extra></extra>",
             )
@@ -90,9 +92,17 @@ def pose_task_spec(result: DashboardResult) -> dict:
             )
         )  # fmt: skip
         values = np.concatenate([r.y[:, k] for r in runs] + [targets[:, k]])
+        mid = float(np.nanmean(values))  # (a coordinate constant up to rounding: +-MIN_SPAN)
+        values = np.append(values, [mid - MIN_SPAN, mid + MIN_SPAN])
         axes["yaxis" if row == 0 else f"yaxis{row + 1}"].update(
             title=label(name, tu[k]), range=nice_range(values)
         )
+    # The targets' letters above the top row, at the end of their legs (never over a line).
+    axes["annotations"] = [
+        dict(text=str(t), x=float(x), xref="x", y=1.0, yref="y domain", yanchor="bottom",
+             showarrow=False, font=dict(size=11))
+        for t, x in zip(letters, first.theta[ends], strict=True)
+    ]  # fmt: skip
     axes["xaxis"]["title"] = theta_label(result)
     axes["xaxis"]["range"] = nice_range(np.concatenate([r.theta for r in runs]), from_zero=True)
     title = (

@@ -2,10 +2,15 @@
 
 When the robot changes (another robot, or another definition of a user's robot), the camera
 of every client is set to look at the sphere the robot can reach (:func:`view_of`) from the
-front, tilted, at the distance where the sphere fills the part of the client's view left of
-viser's control panel (viser reports each client's vertical field of view, aspect and width
-in pixels); a client that connects later
-is framed the same way when it first reports its camera.
+front, tilted, at the distance where the sphere fills the client's narrower field of view
+(viser reports each client's vertical field of view and canvas size); a client that connects
+later is framed the same way when it first reports its camera.
+
+viser's canvas is first as wide as the page's scene frame, then narrower by its control panel
+once that is laid out beside it (the vertical field of view stays): a client reporting a canvas
+wide enough to hold the panel is framed for the width left of it (:func:`settled_aspect`); the
+initial camera, for clients that have reported nothing yet, for a tall narrow canvas
+(:data:`INITIAL_ASPECT`), the scene frame's at the narrowest page.
 """
 
 from __future__ import annotations
@@ -17,15 +22,18 @@ from typing import Any
 import numpy as np
 
 from jik.app.dashboard.robots import state_kinematics
+from jik.app.scene.arm_marks import AXES_FRACTION
 from jik.app.scene.mechanisms import CHAINS, chain_points, extent_of
 
 #: Unit vector from the point looked at to the camera: in front of the task plane, tilted.
 VIEW_DIRECTION = np.array([0.0, -0.75, 1.05]) / math.hypot(0.75, 1.05)
 #: Room around the framed sphere, as a factor of its radius.
 MARGIN = 1.15
-#: Width [px] of the strip at the right of a client's view under viser's floating control panel
-#: (its "small" width and padding); a view narrower than twice this is framed whole.
+#: Width [px] of viser's control panel ("small", 16 em) with its padding, beside the canvas.
 PANEL_PX = 320.0
+#: Aspect (width / height) the initial camera is framed for: the canvas of a 580 px scene frame
+#: beside the panel, in a window about 1000 px high.
+INITIAL_ASPECT = 0.4
 
 
 def view_of(result) -> tuple[np.ndarray, float]:
@@ -53,32 +61,29 @@ def view_of(result) -> tuple[np.ndarray, float]:
                 drawn = np.vstack([drawn, targets[:, :3]])
             center = (drawn.min(axis=0) + drawn.max(axis=0)) / 2
             radius = float(np.linalg.norm(drawn - center, axis=1).max())
-            return center, max(radius, 1e-3)
+            # (and the end link's frame, its axes AXES_FRACTION of the reach long).
+            return center, max(radius + AXES_FRACTION * reach, 1e-3)
         return base, max(radius, 1e-3)
     (xlo, xhi), (ylo, yhi) = extent_of(result)
     center = np.array([(xlo + xhi) / 2, (ylo + yhi) / 2, 0.0])
     return center, max(math.hypot(xhi - xlo, yhi - ylo) / 2, 1e-3)
 
 
-def free_fraction(width: float) -> float:
-    """The fraction of a view ``width`` [px] wide left of viser's control panel."""
-    return 1.0 - PANEL_PX / width if width >= 2 * PANEL_PX else 1.0
+def settled_aspect(width: float, height: float) -> float:
+    """The aspect of a canvas reported ``width`` x ``height`` [px] once viser's control panel
+    is beside it: narrower by the panel when it is wide enough to hold it."""
+    free = width - PANEL_PX if width >= 2 * PANEL_PX else width
+    return free / height
 
 
 def camera_pose(
-    center: np.ndarray, radius: float, fov: float, aspect: float, free: float = 1.0
+    center: np.ndarray, radius: float, fov: float, aspect: float
 ) -> tuple[np.ndarray, np.ndarray]:
     """(position, look_at) of a camera with vertical field of view ``fov`` [rad] and
-    ``aspect`` (width / height) that shows the whole sphere (``center``, ``radius``) in the
-    left ``free`` fraction of its view (the rest is under the control panel): the camera
-    stands back until the sphere fits that part, then moves right (x, the view's right
-    direction) so the sphere is centred in it."""
-    wide = math.tan(fov / 2) * aspect  # (tangent of half the view's width)
-    half = min(fov / 2, math.atan(wide * free))  # the narrower half-angle of the free part
+    ``aspect`` (width / height) that shows the whole sphere (``center``, ``radius``)."""
+    half = min(fov / 2, math.atan(math.tan(fov / 2) * aspect))  # the narrower half-angle
     distance = MARGIN * radius / math.sin(half)
-    shift = np.array([(1.0 - free) * wide * distance, 0.0, 0.0])
-    look_at = np.asarray(center, dtype=float) + shift
-    return look_at + distance * VIEW_DIRECTION, look_at
+    return center + distance * VIEW_DIRECTION, np.asarray(center, dtype=float)
 
 
 class CameraFraming:
@@ -97,7 +102,7 @@ class CameraFraming:
             self.view = view_of(result)
         center, radius = self.view
         initial = self.server.initial_camera
-        position, look_at = camera_pose(center, radius, initial.fov, 16 / 9)
+        position, look_at = camera_pose(center, radius, initial.fov, INITIAL_ASPECT)
         initial.position, initial.look_at = position, look_at
         initial.near = min(0.01, float(np.linalg.norm(position - look_at)) / 100)
         for client in self.server.get_clients().values():
@@ -110,9 +115,11 @@ class CameraFraming:
         if view is None:
             return
         camera = client.camera
-        aspect = camera.aspect if camera.image_height > 0 else 16 / 9
-        free = free_fraction(camera.image_width) if camera.image_height > 0 else 1.0
-        position, look_at = camera_pose(*view, camera.fov, aspect, free)
+        if camera.image_height > 0:
+            aspect = settled_aspect(camera.image_width, camera.image_height)
+        else:
+            aspect = INITIAL_ASPECT
+        position, look_at = camera_pose(*view, camera.fov, aspect)
         distance = float(np.linalg.norm(position - look_at))
         with client.atomic():
             camera.position = position

@@ -1,6 +1,7 @@
 """How the dashboard shows a catalogue arm (the Panda): the scene's camera frames the whole arm
-and its pose targets left of viser's control panel, its joints sized to the arm; the task
-panel shows a pose task's position and orientation, its targets' letters apart."""
+and its pose targets on viser's canvas beside its control panel, its joints sized to the arm;
+the task panel shows a pose task's position and orientation, its targets' letters apart; the
+E1/E2 panel shows E2 of a 7-joint map beside E2 of each single joint."""
 
 from __future__ import annotations
 
@@ -15,7 +16,14 @@ from jik.app.dashboard.results import compute
 from jik.app.dashboard.robots import state_kinematics
 from jik.app.dashboard.session import Dashboard
 from jik.app.scene import DashboardScene
-from jik.app.scene.camera import VIEW_DIRECTION, camera_pose, free_fraction, view_of
+from jik.app.scene.camera import (
+    INITIAL_ASPECT,
+    PANEL_PX,
+    VIEW_DIRECTION,
+    camera_pose,
+    settled_aspect,
+    view_of,
+)
 from jik.app.scene.mechanisms import Chain, chain_points
 
 
@@ -36,10 +44,12 @@ def _project(points, position, look_at, fov, aspect):
     return (rel @ right) / depth / (t * aspect), (rel @ up) / depth / t
 
 
-def test_the_camera_frames_the_panda_left_of_the_control_panel():
-    """In the reviewer's 722 x 1017 px scene (viser's panel over its right 320 px), every
-    joint the Panda's runs pass through and every pose target is in view, left of the panel,
-    and the arm fills a good part of that free width (not a few joints close up)."""
+def test_the_camera_frames_the_whole_panda_on_the_settled_canvas():
+    """The reviewer's page (a 722 x 1014 px scene frame): viser reports its canvas 719 px wide
+    at first, 415 px once its control panel is laid out beside it (the vertical field of view
+    kept). Framed on the first report, every joint the Panda's runs pass through and every pose
+    target is in view on the 415 px canvas, and the arm fills a good part of it (not a few
+    joints close up); so does the initial camera, for a client that reported nothing yet."""
     state = _panda()
     result = compute(state)
     center, radius = view_of(result)
@@ -47,16 +57,16 @@ def test_the_camera_frames_the_panda_left_of_the_control_panel():
     xs = np.concatenate([r.x for r in result.runs.values()])
     drawn = chain_points(kin, xs[:: max(1, len(xs) // 200)], 0.0).reshape(-1, 3)
     points = np.vstack([drawn, np.asarray(result.targets)[:, :3]])
-    fov, width, height = 1.3, 722.0, 1017.0
-    free = free_fraction(width)
-    assert free == 1 - 320 / 722 and free_fraction(500.0) == 1.0
-    position, look_at = camera_pose(center, radius, fov, width / height, free)
-    np.testing.assert_allclose((position - look_at) / np.linalg.norm(position - look_at),
-                               VIEW_DIRECTION, atol=1e-12)  # fmt: skip
-    u, v = _project(points, position, look_at, fov, width / height)
-    edge = -1 + 2 * free  # (the panel's left edge)
-    assert u.min() > -1 and u.max() < edge and abs(v).max() < 1, (u.min(), u.max(), v)
-    assert u.max() - u.min() > 0.4 * (edge + 1), (u.min(), u.max())  # (not tiny either)
+    fov, height = 1.309, 1014.0
+    assert settled_aspect(719.0, height) == (719.0 - PANEL_PX) / height
+    assert settled_aspect(500.0, height) == 500.0 / height  # (too narrow to hold the panel)
+    for aspect in (settled_aspect(719.0, height), INITIAL_ASPECT):
+        position, look_at = camera_pose(center, radius, fov, aspect)
+        direction = (position - look_at) / np.linalg.norm(position - look_at)
+        np.testing.assert_allclose(direction, VIEW_DIRECTION, atol=1e-12)
+        u, v = _project(points, position, look_at, fov, 415.0 / height)
+        assert abs(u).max() < 1 and abs(v).max() < 1, (u, v)
+        assert np.ptp(u) > 0.8, np.ptp(u)  # (not tiny either: most of the canvas's width)
 
 
 def test_the_panda_joints_are_sized_to_the_arm():
@@ -89,7 +99,7 @@ def _title_lines(spec) -> list[str]:
 def test_a_pose_task_shows_position_and_rotation_against_theta():
     """The Panda's pose task: one row per coordinate (x y z above rx ry rz) against theta; the
     default loop's turn of +-0.15 rad about z shows on the rz row; every target is marked at
-    the end of its leg (letters on the top row only, each at its own theta: none overlap).
+    the end of its leg (letters above the top row, each at its own theta: none overlap).
     The panel depends on theta, so it is not among the gamma-free panels."""
     result = compute(_panda())
     spec = figure_specs(result, only={"task"})["task"]
@@ -101,12 +111,16 @@ def test_a_pose_task_shows_position_and_rotation_against_theta():
         "pseudoinverse J^P# (8)", "extended Jacobian J^E# (11)")]  # fmt: skip
     assert rz and all(np.ptp(t["y"]) > 0.29 for t in rz)
     targets = [t for t in spec["data"] if t["name"] == "targets"]
-    assert len(targets) == 6 and targets[0]["mode"] == "markers+text"
-    assert all(t["mode"] == "markers" for t in targets[1:])
-    theta = np.asarray(targets[0]["x"])
+    assert len(targets) == 6 and all(t["mode"] == "markers" for t in targets)
+    letters = layout["annotations"]  # (above the top row, each at its leg's end)
+    assert all(a["yref"] == "y domain" and a["y"] == 1.0 for a in letters)
+    theta = np.asarray([a["x"] for a in letters])
+    np.testing.assert_array_equal(theta, targets[0]["x"])
     span = np.ptp(np.concatenate([r.theta for r in result.runs.values()]))
     assert len(theta) == 12 and np.min(np.diff(theta)) > 0.05 * span
-    assert targets[0]["text"][:4] == ["B", "C", "D", "A"]
+    assert [a["text"] for a in letters[:4]] == ["B", "C", "D", "A"]
+    # rx, ry stay 0 up to rounding: their axes span +-0.01 rad, not the rounding errors.
+    assert all(np.ptp(layout[f"yaxis{k}"]["range"]) >= 0.02 for k in (4, 5))
     np.testing.assert_allclose(targets[5]["y"][:4], np.asarray(result.targets)[:, 5])
     assert "task" not in gamma_free_panels(result)
 
@@ -155,6 +169,8 @@ def test_the_e1_e2_panel_shows_e2_of_a_7_joint_map_beside_single_joints():
         bars["y"][0] == functionals["E2"]
         and specs["sensitivity"]["layout"]["yaxis"]["type"] == "log"
     )
+    low = specs["sensitivity"]["layout"]["yaxis"]["range"][0]
+    assert low <= np.log10(functionals["E2"]) - 1  # (the map's bar stands out of the axis)
     assert "E2 = 0.000173" in specs["augmenting"]["layout"]["title"]["text"]
     with pytest.raises(Cancelled):
         _second_phase(compute(_panda()), cancelled=iter([False] * 3 + [True] * 99).__next__).run()

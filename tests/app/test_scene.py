@@ -326,7 +326,8 @@ def test_the_camera_frames_each_robots_reach_for_each_client():
     """When the robot changes, the camera looks at what it can reach, from a distance at which
     that fills the view: a formula robot of a few centimetres is not tiny in a corner, an arm's
     whole reach (the length of its links around its base) is in view; a client reporting a
-    tall, narrow view is framed farther away than the initial (wide) camera."""
+    tall, narrow view is framed farther away than the initial camera (framed for a canvas
+    0.4 times as wide as high, INITIAL_ASPECT)."""
     import asyncio
 
     import msgspec
@@ -344,7 +345,7 @@ def test_the_camera_frames_each_robots_reach_for_each_client():
         span = float(np.max(points.max(axis=0) - points.min(axis=0)))
         np.testing.assert_allclose(initial.look_at[:2], middle, atol=0.2 * span)
         distance = float(np.linalg.norm(initial.position - initial.look_at))
-        half = initial.fov / 2
+        half = math.atan(math.tan(initial.fov / 2) * 0.4)  # (half the initial width's angle)
         assert span / 2 < distance * math.tan(half) < 2 * span, (distance, span)
         # An arm: its base looked at, its reach (2.4) within the view, not much more.
         generation, _ = dashboard.update({"robot": "planar_chain", "robot_definition": ARM})
