@@ -12,7 +12,12 @@ from jik.engine.formula_kinematics import FormulaMap
 from jik.engine.functionals import check_region
 from jik.engine.kinematics import Kinematics
 from jik.engine.registry import AugmentationSpec
-from jik.engine.robot_synthesis import TENSOR_DEGREE, TOTAL_DEGREE, synthesis
+from jik.engine.robot_synthesis import (
+    TENSOR_DEGREE,
+    TOTAL_DEGREE,
+    synthesis,
+    vector_synthesis,
+)
 from jik.engine.validation import count
 
 
@@ -25,7 +30,7 @@ def augmentations_from_dict(kin: Kinematics, items, key: str | None = None):
         raise InvalidInputError("augmentations must be a list of augmenting maps", "augmentations")
     specs: list[AugmentationSpec] = []
     region: dict = {}
-    vectors: dict[str, tuple[AugmentingMap, ...]] = {}
+    vectors: dict[str, tuple[AugmentingMap, ...] | Callable[[], tuple[AugmentingMap, ...]]] = {}
     k = kin.p - kin.r
     for i, item in enumerate(items):
         where = f"augmentations.{i}"
@@ -33,13 +38,6 @@ def augmentations_from_dict(kin: Kinematics, items, key: str | None = None):
             raise InvalidInputError(
                 f"{where} must be {{'name': 'formula', 'h': ...}} or "
                 "{'name': 'e2_synthesized', 'region': {...}}",
-                where,
-            )
-        if k != 1 and item["name"] == "e2_synthesized":
-            raise InvalidInputError(
-                f"{where}: the E2 synthesis needs one degree of redundancy (p = r + 1); this "
-                f"robot has p = {kin.p}, r = {kin.r}: give the extended inverse a list of "
-                f"{k} formula maps, {{'name': 'formula', 'h': [...]}}",
                 where,
             )
         label = item.get("label", item["name"])
@@ -60,7 +58,7 @@ def augmentations_from_dict(kin: Kinematics, items, key: str | None = None):
         else:
             unknown = set(item) - robot_kinds.augmentation_keys("e2_synthesized")
             box, fix = _region(kin, item, where)
-            if len(box) <= 3:
+            if len(box) <= 3 and k == 1:
                 degree = count(
                     item.get("degree", TENSOR_DEGREE), f"{where}.degree", 1, 24, f"{where}.degree"
                 )
@@ -73,7 +71,13 @@ def augmentations_from_dict(kin: Kinematics, items, key: str | None = None):
                     f"E2-optimal h of {len(box)} joints on {box}: Ritz solve of (19) in a "
                     f"total-degree {degree} basis on a Sobol rule"
                 )
-            factory = synthesis(box, fix, degree, key)
+            if k == 1:
+                factory = synthesis(box, fix, degree, key)
+            else:
+                axes = _frame_axes(kin, item.get("frame_axes"), f"{where}.frame_axes")
+                vectors[label] = vector_synthesis(kin, box, fix, degree, key, axes)
+                factory = _vector_only(label)
+                text = text.replace("E2-optimal h", f"E2-optimal h_1..h_{k}")
             region = region or box
         if unknown:
             raise InvalidInputError(f"{where}: unknown key(s) {sorted(unknown)}", where)
@@ -98,6 +102,19 @@ def _formula_maps(kin: Kinematics, item: Mapping, where: str) -> tuple[FormulaMa
     names, params = kin.variable_names, item.get("parameters")
     fields = [f"{where}.h"] if k == 1 else [f"{where}.h.{j}" for j in range(k)]
     return tuple(FormulaMap(t, names, params, field=f) for t, f in zip(texts, fields, strict=True))
+
+
+def _frame_axes(kin: Kinematics, axes, field: str) -> list[int] | None:
+    """The 1-based joints whose axes fix a vector map's kernel frame (None: the last p - r)."""
+    if axes is None:
+        return None
+    k = kin.p - kin.r
+    if not isinstance(axes, list) or len(axes) != k:
+        raise InvalidInputError(f"{field} must be a list of {k} joints (1 to {kin.p})", field)
+    chosen = [count(a, field, 1, kin.p, field) for a in axes]
+    if len(set(chosen)) != k:
+        raise InvalidInputError(f"{field} must name {k} distinct joints", field)
+    return chosen
 
 
 def _vector_only(label: str) -> Callable[..., AugmentingMap]:

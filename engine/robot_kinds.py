@@ -180,6 +180,13 @@ AUGMENTATIONS: dict[str, tuple[DefinitionField, ...]] = {
             "fixed", "mapping", False, "values of the variables outside the region (default 0)"
         ),
         DefinitionField(
+            "frame_axes",
+            "numbers",
+            False,
+            "p - r > 1: the p - r joints (1-based) whose axes fix the kernel frame of the maps "
+            "h_1..h_(p-r), docs/e2-vector.md (default: the best-conditioned at the box's centre)",
+        ),
+        DefinitionField(
             "label", "string", False, "its name among the robot's maps (default e2_synthesized)"
         ),
     ),

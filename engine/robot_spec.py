@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -65,14 +65,17 @@ class Robot:
     kinematics : Kinematics
     definition : dict
         The definition it was built from (JSON-friendly; :func:`robot_from_dict` rebuilds it).
-    map_vectors : mapping label -> tuple of AugmentingMap
-        For p - r > 1: the augmentations that are vectors of p - r formula maps.
+    map_vectors : mapping label -> tuple of AugmentingMap, or a function giving one
+        For p - r > 1: the augmentations that are vectors of p - r maps (formulas, or an E2
+        synthesis computed on first use).
     """
 
     spec: RobotSpec
     kinematics: Kinematics
     definition: dict
-    map_vectors: Mapping[str, tuple[AugmentingMap, ...]] = field(default_factory=dict)
+    map_vectors: Mapping[
+        str, tuple[AugmentingMap, ...] | Callable[[], tuple[AugmentingMap, ...]]
+    ] = field(default_factory=dict)
 
     def limits_report(self, result) -> LimitsReport | None:
         """Whether a run of this robot (a solve's or a single start's repeatability result)
@@ -103,7 +106,9 @@ class Robot:
         if algorithm == "extended" and self.map_vectors:
             name = augmentation or self.spec.default_augmentation
             if name in self.map_vectors:
-                return VectorExtendedInverse(self.kinematics, self.map_vectors[name])
+                maps = self.map_vectors[name]
+                maps = maps() if callable(maps) else maps  # (a synthesis runs on first use)
+                return VectorExtendedInverse(self.kinematics, maps)
         return make_inverse(
             self.kinematics,
             algorithm,

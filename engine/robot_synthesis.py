@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import functools
+import itertools
 import json
 from collections.abc import Callable, Iterator, Mapping
 
@@ -25,30 +26,68 @@ from jik.engine.variational import synthesize_e2
 
 
 def synthesis(box: dict, fix: dict, degree: int, key: str | None) -> Callable[..., AugmentingMap]:
-    """The E2-optimal map on ``box``: the tensor Ritz solve for two or three variables
-    (:func:`~jik.engine.variational.synthesize_e2`), the total-degree one for more
-    (:func:`~jik.engine.synthesis_nd.synthesize_e2_nd`)."""
+    """The E2-optimal map on ``box`` (one degree of redundancy): the tensor Ritz solve for two
+    or three variables (:func:`~jik.engine.variational.synthesize_e2`), the total-degree one for
+    more (:func:`~jik.engine.synthesis_nd.synthesize_e2_nd`)."""
 
     def synthesized(kin: Kinematics) -> AugmentingMap:
-        cache_key = None if key is None else (key, json.dumps([box, fix, degree], sort_keys=True))
-        if cache_key is not None and cache_key in _SYNTHESIZED:
-            return _SYNTHESIZED[cache_key]
-        progress = _PROGRESS.get()  # (a RunCancelled it raises leaves nothing cached)
-        if len(box) <= 3:
-            amap: AugmentingMap = synthesize_e2(
-                kin, box, degree=degree, fixed=fix, progress=progress
-            ).augmenting_map
-        else:
-            amap = synthesize_e2_nd(
-                kin, box, degree=degree, nodes=TOTAL_NODES, fixed=fix, progress=progress
-            ).maps[0]
-        if cache_key is not None:
-            while len(_SYNTHESIZED) >= 16:
-                _SYNTHESIZED.pop(next(iter(_SYNTHESIZED)))
-            _SYNTHESIZED[cache_key] = amap
-        return amap
+        return _maps(kin, box, fix, degree, key, None)[0]
 
     return functools.cache(synthesized)
+
+
+def vector_synthesis(
+    kin: Kinematics, box: dict, fix: dict, degree: int, key: str | None, axes: list | None
+) -> Callable[[], tuple[AugmentingMap, ...]]:
+    """The E2-optimal maps h_1, ..., h_(p-r) on ``box`` (p - r >= 2; docs/e2-vector.md), by the
+    total-degree synthesis in the kernel frame of the 1-based joints ``axes`` (default: the
+    best-conditioned at the box's centre, :func:`best_frame_axes`), computed on first call."""
+    return functools.cache(lambda: _maps(kin, box, fix, degree, key, axes))
+
+
+def _maps(kin, box, fix, degree, key, axes) -> tuple[AugmentingMap, ...]:
+    """The synthesized maps, cached per robot definition ``key`` (None: not cached)."""
+    cache_key = None if key is None else (key, json.dumps([box, fix, degree, axes], sort_keys=True))
+    if cache_key is not None and cache_key in _SYNTHESIZED:
+        return _SYNTHESIZED[cache_key]
+    progress = _PROGRESS.get()  # (a RunCancelled it raises leaves nothing cached)
+    if axes is None and kin.p - kin.r > 1:
+        axes = best_frame_axes(kin, box, fix)
+    maps: tuple[AugmentingMap, ...]
+    if len(box) <= 3 and kin.p - kin.r == 1:
+        maps = (
+            synthesize_e2(kin, box, degree=degree, fixed=fix, progress=progress).augmenting_map,
+        )
+    else:
+        maps = synthesize_e2_nd(
+            kin,
+            box,
+            degree=degree,
+            nodes=TOTAL_NODES,
+            fixed=fix,
+            frame_axes=axes,
+            progress=progress,
+        ).maps
+    if cache_key is not None:
+        while len(_SYNTHESIZED) >= 16:
+            _SYNTHESIZED.pop(next(iter(_SYNTHESIZED)))
+        _SYNTHESIZED[cache_key] = maps
+    return maps
+
+
+def best_frame_axes(kin: Kinematics, box: Mapping, fix: Mapping) -> list[int]:
+    """The p - r joints (1-based) whose axes give the best-conditioned kernel frame at the box's
+    centre: the largest least eigenvalue of E^T N E (:func:`~jik.engine.synthesis_nd.kernel_frame`;
+    the frame is degenerate where it is 0), over every choice of p - r joints at once."""
+    names = list(kin.variable_names)
+    x = np.array([fix.get(n, 0.0) for n in names], dtype=float)
+    for n, (lo, hi) in box.items():
+        x[names.index(n)] = 0.5 * (lo + hi)
+    J = np.asarray(kin.jacobian(x), dtype=float)
+    N = np.eye(kin.p) - np.linalg.pinv(J) @ J
+    choices = np.array(list(itertools.combinations(range(kin.p), kin.p - kin.r)))
+    least = np.linalg.eigvalsh(N[choices[:, :, None], choices[:, None, :]])[:, 0]
+    return [int(a) + 1 for a in choices[int(np.argmax(least))]]
 
 
 @contextlib.contextmanager
@@ -68,7 +107,7 @@ _PROGRESS: contextvars.ContextVar[Progress | None] = contextvars.ContextVar(
     "synthesis_progress", default=None
 )
 #: Synthesized maps by the robot definition they belong to (a process's few most recent).
-_SYNTHESIZED: dict[tuple[str, str], AugmentingMap] = {}
+_SYNTHESIZED: dict[tuple[str, str], tuple[AugmentingMap, ...]] = {}
 #: Total degree and nodes of a synthesis over more than three joints (docs/e2-vector.md).
 TOTAL_DEGREE, TOTAL_NODES = 4, 2**13
 #: Legendre degree per variable of the tensor synthesis (two or three variables).
@@ -81,9 +120,10 @@ def arm_augmentations(kin: Kinematics, d: Mapping) -> list:
     """The maps of an arm with a home (a catalogue arm, or a URDF given with ``home``): by
     default, with one degree of redundancy (a 7-joint arm's pose task), one E2-optimal over all
     its joints, +-ARM_BOX around home within the joint limits. A definition's own maps replace
-    it; an e2_synthesized one of them without a region takes that box."""
+    it; an e2_synthesized one of them without a region (a scalar or, for p - r >= 2, a vector
+    map) takes that box."""
     given = d.get("augmentations", [])
-    if kin.p - kin.r != 1 or not isinstance(given, list):
+    if not isinstance(given, list):
         return given
     home = np.asarray(d["home"], dtype=float)
     lo, hi = np.asarray(kin.joint_limits, dtype=float).T
@@ -92,7 +132,7 @@ def arm_augmentations(kin: Kinematics, d: Mapping) -> list:
         for i, n in enumerate(kin.variable_names)
     }
     if "augmentations" not in d:
-        return [{"name": "e2_synthesized", "region": box}]
+        return [{"name": "e2_synthesized", "region": box}] if kin.p - kin.r == 1 else given
     return [
         {**item, "region": box}
         if isinstance(item, Mapping)

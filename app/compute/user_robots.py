@@ -98,7 +98,7 @@ def map_used(robot: Robot) -> S.AugmentationUsed | None:
     item = next((a for a in items if a.get("label") == _LABEL), items[0])
     definition = {k: v for k, v in item.items() if k != "label"}
     if definition["name"] == "e2_synthesized" and "degree" not in definition:
-        many = len(definition.get("region") or {}) > 3
+        many = len(definition.get("region") or {}) > 3 or robot.spec.p - robot.spec.r > 1
         definition["degree"] = TOTAL_DEGREE if many else TENSOR_DEGREE
     values = {k: float(v) for k, v in (definition.get("parameters") or {}).items()}
     return S.AugmentationUsed(name=definition["name"], parameters=values, definition=definition)

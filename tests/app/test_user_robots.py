@@ -199,3 +199,35 @@ def test_hostile_formulas_are_422_in_the_task_and_in_h(api, formula):
                                  "x0": [0.0, 0.0, 1.5], "target": [1.0, 1.0]})  # fmt: skip
     # (h is a formula or a list of them: a text too long is refused as both)
     assert all(m.startswith("augmentation.h: ") for m in messages(r)), r.text
+
+
+def test_a_synthesized_vector_map_runs_over_rest(api):
+    """p - r = 2: a planar 4R chain's ``e2_synthesized`` map is the vector (h_1, h_2) of the
+    total-degree synthesis (default degree 4, reported); its extended run is repeatable."""
+    box = {"x1": [0.1, 0.5], "x2": [0.4, 0.8], "x3": [0.4, 0.8], "x4": [0.4, 0.8]}
+    chain = {"name": "planar_chain", "joints": "RRRR", "lengths": [1, 1, 1, 1]}
+    x0 = [0.3, 0.6, 0.6, 0.6]
+    start = np.array(
+        _ok(
+            api.post(
+                "/solve",
+                json={"robot": chain, "algorithm": "pseudoinverse", "x0": x0, "target": [1, 1]},
+            )
+        )["trajectory"]["y"][0]
+    )
+    path = [list(start + [0.1, 0]), list(start + [0.1, 0.1]), list(start + [0, 0.1])]
+    rep = _ok(
+        api.post(
+            "/repeatability",
+            json={
+                "robot": chain,
+                "algorithm": "extended",
+                "x0": x0,
+                "path": path,
+                "cycles": 3,
+                "augmentation": {"name": "e2_synthesized", "region": box},
+            },
+        )
+    )
+    assert rep["success"] and max(rep["drift"]) < 1e-9
+    assert rep["augmentation"]["definition"]["degree"] == 4

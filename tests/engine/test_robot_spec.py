@@ -143,9 +143,8 @@ def test_more_than_one_degree_of_redundancy_takes_a_vector_of_formula_maps():
     with pytest.raises(InvalidInputError, match="vector of maps"):
         robot.spec.augmentation("formula").build(robot.kinematics)
     cases = [
-        ({"name": "e2_synthesized", "region": {"x2": [0, 1], "x3": [0, 1]}}, "augmentations.0",
-         "the E2 synthesis needs one degree of redundancy (p = r + 1); this robot has p = 5, "
-         "r = 2: give the extended inverse a list of 3 formula maps"),
+        ({"name": "e2_synthesized", "region": {"x2": [0, 1], "x3": [0, 1]},
+          "frame_axes": [1, 1, 2]}, "augmentations.0.frame_axes", "3 distinct joints"),
         ({"name": "formula", "h": "x5"}, "augmentations.0.h", "a list of 3 formulas"),
         ({"name": "formula", "h": ["x5", "x4"]}, "augmentations.0.h", "a list of 3 formulas"),
         ({"name": "formula", "h": ["x5", "x4", "x9"]}, "augmentations.0.h.2", "unknown name"),

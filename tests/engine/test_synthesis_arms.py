@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from jik.engine.exceptions import InvalidInputError
 from jik.engine.repeatability import repeatability
 from jik.engine.robot_spec import robot_from_dict
 from jik.engine.synthesis_nd import synthesize_e2_nd
@@ -51,3 +52,49 @@ def test_e2_beats_every_single_joint_map(panda):
     res = synthesize_e2_nd(panda.kinematics, region, degree=3, nodes=2**12)
     assert res.e2 < 0.5 * min(v["e2"] for v in res.single_joint.values())
     assert abs(res.e2_check - res.e2) < 0.01 * res.e2
+
+
+def test_a_definitions_vector_map_is_synthesized_and_repeatable():
+    """p - r = 2 (a planar 4R chain, the end point): an ``e2_synthesized`` map of a definition is
+    the vector h = (h_1, h_2) of the total-degree synthesis, built on first use; its extended
+    inverse comes back to x0 while the pseudoinverse drifts. A frame that is not p - r joints is
+    refused naming the field."""
+
+    box = {"x1": [0.1, 0.5], "x2": [0.4, 0.8], "x3": [0.4, 0.8], "x4": [0.4, 0.8]}
+    d = {
+        "name": "planar_chain",
+        "joints": "RRRR",
+        "lengths": [1, 1, 1, 1],
+        "x0": [0.3, 0.6, 0.6, 0.6],
+        "augmentations": [{"name": "e2_synthesized", "region": box}],
+    }
+    robot = robot_from_dict(d)
+    spec = robot.spec
+    drift = {
+        a: repeatability(robot.inverse(a), spec.default_x0, spec.default_path, 3).drift[-1]
+        for a in ("extended", "pseudoinverse")
+    }
+    assert drift["extended"] < 1e-12 < 1e-4 < drift["pseudoinverse"]
+    bad = {**d, "augmentations": [{"name": "e2_synthesized", "region": box, "frame_axes": [1]}]}
+    with pytest.raises(InvalidInputError) as err:
+        robot_from_dict(bad)
+    assert err.value.field == "augmentations.0.frame_axes"
+
+
+def test_the_default_frame_of_a_vector_synthesis_is_the_best_conditioned():
+    """The Panda with a position task (p - r = 4): the last four joints' frame is degenerate at
+    home (the kernel has no component along them), the default frame is not."""
+    from jik.engine.robot_synthesis import best_frame_axes
+
+    robot = robot_from_dict({"name": "panda", "task": "xyz"})
+    kin, x = robot.kinematics, np.array(robot.spec.default_x0)
+    box = {n: [v - 0.3, v + 0.3] for n, v in zip(kin.variable_names, x, strict=True)}
+    axes = best_frame_axes(kin, box, {})
+    J = kin.jacobian(x)
+    N = np.eye(7) - np.linalg.pinv(J) @ J
+
+    def least(ax):
+        ix = [a - 1 for a in ax]
+        return np.linalg.eigvalsh(N[np.ix_(ix, ix)])[0]
+
+    assert least([4, 5, 6, 7]) < 1e-12 < 0.5 < least(axes)

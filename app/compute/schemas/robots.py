@@ -230,8 +230,9 @@ class FormulaMapAugmentation(BaseModel):
 
 
 class E2SynthesisAugmentation(BaseModel):
-    """The E2-optimal map on a box (p = r + 1): the Ritz solve of eq. (20) on a tensor Legendre
-    basis for two or three variables, on a total-degree basis with a Sobol rule for more."""
+    """The E2-optimal map on a box: for p = r + 1, the Ritz solve of eq. (20) on a tensor
+    Legendre basis for two or three variables, on a total-degree basis with a Sobol rule for
+    more; for p - r > 1, the maps h_1..h_(p-r) on the total-degree basis (docs/e2-vector.md)."""
 
     model_config = ConfigDict(extra="forbid", title="E2-synthesized map")
     name: Literal["e2_synthesized"]
@@ -249,6 +250,17 @@ class E2SynthesisAugmentation(BaseModel):
     )  # fmt: skip
     fixed: Annotated[dict[Name, FiniteFloat], Field(max_length=MAX_DIMENSION)] | None = Field(
         None, description="values of the variables outside the box (default 0)"
+    )
+    frame_axes: (
+        Annotated[
+            list[Annotated[int, Field(ge=1, le=MAX_DIMENSION), INTEGRAL]],
+            Field(min_length=1, max_length=MAX_DIMENSION),
+        ]
+        | None
+    ) = Field(
+        None,
+        description="p - r > 1: the p - r joints (1-based) whose axes fix the kernel "
+        "frame of h_1..h_(p-r) (default: the best-conditioned at the box's centre)",
     )
 
 
