@@ -153,7 +153,8 @@ def make_inverse(
     name) in :data:`ROBOTS`. ``algorithm_parameters`` holds the algorithm's scalars
     (defaults from :data:`ALGORITHMS`) and vectors: ``limits`` of the weighted inverse (default:
     the robot's joint limits, else its catalogue box ``x_range``) and ``rest`` of the posture
-    inverse (default: the robot's home, else its default x0).
+    inverse (default: the robot's home, else its default x0, for one run; in an atlas each
+    run's own start, :mod:`jik.engine.posture_at_start`).
     """
     if algorithm not in ALGORITHMS:
         raise InvalidInputError(
@@ -172,8 +173,10 @@ def make_inverse(
         limits = vectors.get("limits", _robot_limits(kinematics, spec, robot))
         return pinv.WeightedInverse(kinematics, limits)
     if algorithm == "posture":
-        rest = vectors.get("rest", _robot_rest(kinematics, spec, robot))
-        return pinv.PostureInverse(kinematics, rest, values["gain"])
+        if "rest" in vectors:
+            return pinv.PostureInverse(kinematics, vectors["rest"], values["gain"])
+        rest = _robot_rest(kinematics, spec, robot)
+        return pinv.PostureInverse(kinematics, rest, values["gain"], rest_given=False)
     from jik.engine.registry import robot_spec
 
     aspec = (spec or robot_spec(robot or kinematics.name)).augmentation(augmentation)

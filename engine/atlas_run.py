@@ -20,6 +20,8 @@ from jik.engine.atlas_backends import Backend, backend_for
 from jik.engine.exceptions import SingularConfigurationError
 from jik.engine.inverses import Inverse
 from jik.engine.limits import robot_limits, starts_outside
+from jik.engine.posture_at_start import PostureAtStart
+from jik.engine.practical_inverses import PostureInverse
 from jik.engine.progress import Progress, check_cancelled
 from jik.engine.repeatability import repeatability
 from jik.engine.results import dataframe
@@ -94,7 +96,8 @@ def run_chunk(task: ChunkTask) -> AtlasChunk:
             if res is None:
                 failures.extend((a, task.lo + int(i), why) for i in ids)
                 continue
-            drift[a, ids], legs[a, ids], success[a, ids] = res.drift, res.legs, res.success
+            drift[a, ids], success[a, ids] = res.drift, res.success
+            legs[a, ids] = res.legs[..., :p]
             failures.extend(
                 (a, task.lo + int(ids[k]), res.message[k]) for k in np.flatnonzero(~res.success)
             )
@@ -107,10 +110,14 @@ def _runs(inverse: Inverse, task: ChunkTask, ids: np.ndarray):
     """Batched runs of the members ``ids``: (ids, result, "") pairs, or (ids, None, why) for a
     member whose start or leg start is singular for ``inverse`` (a batched solve raises there
     for the whole batch: the batch is halved until that member runs alone; every other member's
-    numbers are those of any batch)."""
+    numbers are those of any batch). A posture inverse whose rest was not given pulls each run
+    toward its own start (:mod:`jik.engine.posture_at_start`)."""
+    starts, run_inverse = task.starts[ids], inverse
+    if isinstance(inverse, PostureInverse) and not inverse.rest_given:
+        starts, run_inverse = PostureAtStart.carry(starts), PostureAtStart(inverse)
     try:
         res = repeatability(
-            inverse, task.starts[ids], task.targets[ids], task.cycles, close=False, **task.settings
+            run_inverse, starts, task.targets[ids], task.cycles, close=False, **task.settings
         )
     except SingularConfigurationError as error:
         if len(ids) == 1:

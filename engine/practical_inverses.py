@@ -128,12 +128,17 @@ def limit_gradient(x: FloatArray, limits: FloatArray) -> FloatArray:
 
     dH/dx_i = (hi - lo)^2 (2 x_i - hi - lo) / (4 (hi - x_i)^2 (x_i - lo)^2): zero at mid-range,
     infinite at a limit. Joints with an infinite range contribute 0; at or past a limit, inf.
+    It is evaluated as 2 t / (h (1 - t)^2 (1 + t)^2) with h = (hi - lo) / 2 and
+    t = (x - (lo + hi) / 2) / h, which neither overflows nor underflows to 0/0 for huge ranges:
+    a joint whose range dwarfs x gets a gradient of 0 (weight 1), as an unlimited one.
     """
     lo, hi = limits[:, 0], limits[:, 1]
     bounded = np.isfinite(lo) & np.isfinite(hi)
     lo_b, hi_b = np.where(bounded, lo, -1.0), np.where(bounded, hi, 1.0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        g = (hi_b - lo_b) ** 2 * (2 * x - hi_b - lo_b) / (4 * (hi_b - x) ** 2 * (x - lo_b) ** 2)
+    half = hi_b / 2 - lo_b / 2
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+        t = (x - (lo_b / 2 + hi_b / 2)) / half
+        g = 2 * t / (half * (1 - t) ** 2 * (1 + t) ** 2)
     inside = (x > lo_b) & (x < hi_b)
     return np.where(bounded, np.where(inside, g, np.inf), 0.0)
 
@@ -226,6 +231,10 @@ class PostureInverse(Inverse):
         The rest posture x_rest.
     gain : float
         k >= 0; 0 is the pseudoinverse (8), bit for bit (the same code runs).
+    rest_given : bool
+        False: ``rest`` is a default (:func:`~jik.engine.algorithm_registry.make_inverse`'s, the
+        robot's home), and an atlas pulls each run toward its own start x0 instead
+        (:mod:`jik.engine.posture_at_start`), so that it measures drift, not the pull.
 
     Notes
     -----
@@ -243,8 +252,11 @@ class PostureInverse(Inverse):
 
     name = "posture"
 
-    def __init__(self, kinematics: Kinematics, rest, gain: float = 1.0) -> None:
+    def __init__(
+        self, kinematics: Kinematics, rest, gain: float = 1.0, rest_given: bool = True
+    ) -> None:
         self.kinematics = kinematics
+        self.rest_given = rest_given
         self.rest = kinematics.check(rest, "rest")
         if self.rest.shape != (kinematics.p,):
             raise InvalidInputError(
@@ -254,13 +266,18 @@ class PostureInverse(Inverse):
         self._plain = Pseudoinverse(kinematics)
 
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
+        return self.pull(x, e, self.rest)
+
+    def pull(self, x: FloatArray, e: FloatArray, rest: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """:meth:`apply_masked` with the rest posture ``rest``, shape (p,) or one per member
+        (..., p)."""
         if self.gain == 0.0:
             return self._plain.apply_masked(x, e)
         J = self.kinematics.jacobian(x)
         G = gram(J)
         w, d = solve_small(G, e)  # (J J^T) w = e
         bad = ~(np.abs(d) >= SINGULAR_MANIPULABILITY**2)
-        z = self.rest - x
+        z = rest - x
         u, _ = solve_small(G, np.einsum("...ij,...j->...i", J, z))
         null = z - _jt(J, u)  # (I - J# J) (x_rest - x)
         v = _jt(J, w) - self.gain * np.linalg.norm(e, axis=-1)[..., None] * null

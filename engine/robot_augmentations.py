@@ -12,7 +12,7 @@ from jik.engine.formula_kinematics import FormulaMap
 from jik.engine.functionals import check_region
 from jik.engine.kinematics import Kinematics
 from jik.engine.registry import AugmentationSpec
-from jik.engine.robot_synthesis import TOTAL_DEGREE, synthesis
+from jik.engine.robot_synthesis import TENSOR_DEGREE, TOTAL_DEGREE, synthesis
 from jik.engine.validation import count
 
 
@@ -61,7 +61,9 @@ def augmentations_from_dict(kin: Kinematics, items, key: str | None = None):
             unknown = set(item) - robot_kinds.augmentation_keys("e2_synthesized")
             box, fix = _region(kin, item, where)
             if len(box) <= 3:
-                degree = count(item.get("degree", 12), f"{where}.degree", 1, 24, f"{where}.degree")
+                degree = count(
+                    item.get("degree", TENSOR_DEGREE), f"{where}.degree", 1, 24, f"{where}.degree"
+                )
                 text = f"E2-optimal h on {box} by the Ritz solve of (20), degree {degree}"
             else:
                 degree = count(
@@ -110,6 +112,12 @@ def _vector_only(label: str) -> Callable[..., AugmentingMap]:
 
 
 def _region(kin: Kinematics, item: Mapping, where: str):
+    if "region" not in item:  # (an arm's maps take its box around home: arm_augmentations)
+        raise InvalidInputError(
+            f"{where}.region is required: only an arm with a home has a default box to "
+            f"synthesize on; give two or more of {list(kin.variable_names)} to [lo, hi]",
+            f"{where}.region",
+        )
     try:
         box, fix = check_region(kin, item.get("region", {}), item.get("fixed"))
     except InvalidInputError as exc:

@@ -288,6 +288,7 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
     if kind in ARMS:  # the catalogue's URDF, end link and home, with the definition's keys
         d = {**ARMS[kind].definition(), **{k: v for k, v in d.items() if k != "name"}}
         kin = _kinematics("urdf", d, None)
+        kin.name = kind  # type: ignore[misc]  # (messages name the arm, not its kinematics' kind)
     else:
         kin = _kinematics(kind, d, None if base_dir is None else Path(base_dir))
     if kind in ARMS or (kind == "urdf" and "home" in d):  # an arm around its home

@@ -71,20 +71,33 @@ _PROGRESS: contextvars.ContextVar[Progress | None] = contextvars.ContextVar(
 _SYNTHESIZED: dict[tuple[str, str], AugmentingMap] = {}
 #: Total degree and nodes of a synthesis over more than three joints (docs/e2-vector.md).
 TOTAL_DEGREE, TOTAL_NODES = 4, 2**13
+#: Legendre degree per variable of the tensor synthesis (two or three variables).
+TENSOR_DEGREE = 12
 #: Half-width [rad] of a catalogue arm's default synthesis box around its home.
 ARM_BOX = 0.3
 
 
 def arm_augmentations(kin: Kinematics, d: Mapping) -> list:
-    """The default map of an arm with a home (a catalogue arm, or a URDF given with ``home``) and
-    one degree of redundancy (a 7-joint arm's pose task): E2-optimal over all its joints,
-    +-ARM_BOX around home within the joint limits. A definition's own maps replace it."""
-    if "augmentations" in d or kin.p - kin.r != 1:
-        return list(d.get("augmentations", []))
+    """The maps of an arm with a home (a catalogue arm, or a URDF given with ``home``): by
+    default, with one degree of redundancy (a 7-joint arm's pose task), one E2-optimal over all
+    its joints, +-ARM_BOX around home within the joint limits. A definition's own maps replace
+    it; an e2_synthesized one of them without a region takes that box."""
+    given = d.get("augmentations", [])
+    if kin.p - kin.r != 1 or not isinstance(given, list):
+        return given
     home = np.asarray(d["home"], dtype=float)
     lo, hi = np.asarray(kin.joint_limits, dtype=float).T
     box = {
         n: [float(max(lo[i], home[i] - ARM_BOX)), float(min(hi[i], home[i] + ARM_BOX))]
         for i, n in enumerate(kin.variable_names)
     }
-    return [{"name": "e2_synthesized", "region": box}]
+    if "augmentations" not in d:
+        return [{"name": "e2_synthesized", "region": box}]
+    return [
+        {**item, "region": box}
+        if isinstance(item, Mapping)
+        and item.get("name") == "e2_synthesized"
+        and "region" not in item
+        else item
+        for item in given
+    ]

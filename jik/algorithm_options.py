@@ -22,7 +22,7 @@ def add_algorithm_parameter_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--rest",
         help="posture: rest posture 'x1, x2, ...' (default: the run's "
-        "x0; for an atlas the robot's home, else its default x0)",
+        "x0; for an atlas each run's own start)",
     )
     p.add_argument(
         "--limits",

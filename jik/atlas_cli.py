@@ -4,12 +4,13 @@
         --algorithm pseudoinverse --algorithm extended [--processes 2 | --dask local:2] \\
         --out atlas.json
 
-The path is a loop from its first point: the starts lie on that point's self-motion curve, at
-arc lengths s on a grid (or sampled), s = 0 where eq. (7) from the robot's default start (or
-``--reference``) reaches the point; the arc is where the curve stays in the robot's
-configuration box, or ``--arc``. Writes ``--out`` (JSON: the inputs, the starts, and per
-algorithm the drift after each cycle, success and leg ends), a CSV beside it for large atlases
-(or with ``--csv``), and an HTML figure of the drift map when plotly is installed.
+The path (default: the robot's closed path) is a loop from its first point: the starts lie on
+that point's self-motion curve, at arc lengths s on a grid (or sampled), s = 0 where eq. (7)
+from the robot's default start (or ``--reference``) reaches the point; the arc is where the
+curve stays in the robot's configuration box, or ``--arc``. Writes ``--out`` (JSON: the
+inputs, the starts, and per algorithm the drift after each cycle, success and leg ends), a CSV
+beside it for large atlases (or with ``--csv``), and an HTML figure of the drift map when
+plotly is installed.
 ``--robot`` is a built-in robot's name (``--param`` sets its parameters), a catalogue arm's
 (``panda``, with its default task) or a user's robot file
 (:func:`jik.engine.robot_spec.load_robot`, as for ``jik solve``).
@@ -61,7 +62,9 @@ def add_atlas_parser(sub) -> None:
         metavar="NAME=VALUE",
         help="a robot parameter (repeat it), e.g. l=1.5",
     )
-    p.add_argument("--path", required=True, help='task points "y1,y2; y1,y2; ...", a loop')
+    p.add_argument(
+        "--path", help='task points "y1,y2; y1,y2; ...", a loop (default: the robot\'s closed path)'
+    )
     p.add_argument("--starts", type=int, default=256, help="starts per path (default 256)")
     p.add_argument("--sampling", choices=("grid", "sample"), default="grid")
     p.add_argument("--seed", type=int, default=0, help="seed of --sampling sample")
@@ -135,20 +138,25 @@ def backend_option(args: argparse.Namespace) -> str:
 
 
 class Progress:
-    """A progress bar on stderr: runs done, elapsed time and the time left."""
+    """A progress bar on stderr: runs done over every algorithm, elapsed time and the time
+    left."""
 
-    def __init__(self, quiet: bool) -> None:
+    def __init__(self, quiet: bool, algorithms: int = 1) -> None:
         self.quiet = quiet
+        self.algorithms = algorithms
         self.t0 = time.perf_counter()
 
     def __call__(self, done: int, total: int) -> None:
+        """``done`` of ``total`` starts (times paths), each run by every algorithm."""
         if self.quiet:
             return
         t = time.perf_counter() - self.t0
         left = t * (total - done) / done if done else math.nan
         bar = "#" * int(30 * done / total)
+        A = self.algorithms
         sys.stderr.write(
-            f"\r  atlas [{bar:<30}] {done}/{total} runs, {t:.1f} s, {left:.0f} s left "
+            f"\r  atlas [{bar:<30}] {A * done}/{A * total} runs ({total} starts x {A} "
+            f"algorithm{'' if A == 1 else 's'}), {t:.1f} s, {left:.0f} s left "
         )
         if done >= total:
             sys.stderr.write("\n")
@@ -213,13 +221,19 @@ def _run(args: argparse.Namespace) -> int:
             )
             for a in algorithms
         ]
+    closed = not hasattr(kin, "path")  # (the unicycle's default path is a curve, not a loop)
+    path = (
+        _points(args.path, "--path") if args.path else closed * [list(t) for t in spec.default_path]
+    )
+    if not path:
+        raise InvalidInputError(f"{spec.name} has no default closed path: give --path", "path")
     arc = _numbers(args.arc, "--arc") if args.arc else [-MAX_ARC, MAX_ARC]
     reference = _numbers(args.reference, "--reference") if args.reference else spec.default_x0
     backend = backend_option(args)
     backend_for(backend)  # (a bad option fails here, before the curves are traced)
     plan = plan_atlas(
         inverses,
-        _points(args.path, "--path"),
+        path,
         cycles=args.cycles,
         n_starts=args.starts,
         arc=arc,
@@ -239,7 +253,7 @@ def _run(args: argparse.Namespace) -> int:
     keep = not big  # (a small atlas is gathered for the JSON; a large one streams to the CSV)
     every = max(1, plan.size // FIGURE_POINTS)
     arrays = Gathered(plan, keep, every, legs=not args.no_leg_ends)
-    progress = Progress(args.quiet)
+    progress = Progress(args.quiet, A)
     t0 = time.perf_counter()
     with CsvWriter(csv_path, plan, legs=not args.no_leg_ends) as rows:
         for task, chunk in iter_atlas(plan, backend):
@@ -252,7 +266,7 @@ def _run(args: argparse.Namespace) -> int:
         "robot_file": args.robot if Path(args.robot).is_file() else None,
         "task": list(spec.task_names),
         "robot_parameters": kin.parameters,
-        "path": _points(args.path, "path"),
+        "path": path,
         "cycles": C,
         "algorithms": list(plan.algorithms),
         "augmentation": args.augmentation,

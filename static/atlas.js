@@ -104,8 +104,10 @@ async function draw(body) {
     }).observe(div);
   }
   showProgress(null);
-  const n = body.starts[0].length;
-  say(`Atlas done: ${body.runs} runs of ${body.request.cycles} cycles in ${fmt(body.elapsed_s, 1)} s (${n} starts). Click a cell to move the main view to that start.`);
+  // body.runs counts the starts (times the paths); every chosen algorithm runs each of them.
+  const k = body.request.algorithms.length;
+  const per = `${body.runs} start${body.runs === 1 ? "" : "s"} x ${k} algorithm${k === 1 ? "" : "s"}`;
+  say(`Atlas done: ${body.runs * k} runs (${per}) of ${body.request.cycles} cycles in ${fmt(body.elapsed_s, 1)} s. Click a cell to move the main view to that start.`);
   div.dataset.runs = body.runs;
 }
 

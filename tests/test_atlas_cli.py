@@ -243,3 +243,39 @@ def test_a_urdf_arm_in_a_robot_file_equals_the_catalogue_arm(tmp_path):
                                np.array(by_file["results"]["pseudoinverse"]["drift"], float),
                                atol=1e-12)  # fmt: skip
     assert by_name["summary"] == by_file["summary"]
+
+
+def test_without_path_the_robot_s_closed_path_is_the_loop(tmp_path, capsys):
+    """``jik atlas --robot panda --task "x y z rx ry rz"`` (the README's command) and a
+    built-in robot without --path run the robot's default closed path; the unicycle, whose
+    default path is not a loop, is told to give --path."""
+    pytest.importorskip("yourdfpy")
+    from jik.engine.registry import ROBOTS
+    from jik.engine.robot_spec import robot_from_dict
+
+    out = tmp_path / "panda.json"
+    argv = ["atlas", "--robot", "panda", "--task", "x y z rx ry rz", "--starts", "2",
+            "--cycles", "1", "--out", str(out), "--no-figure", "--quiet"]  # fmt: skip
+    assert main(argv) == 0, capsys.readouterr().err
+    spec = robot_from_dict({"name": "panda", "task": "pose"}).spec
+    assert json.loads(out.read_text())["inputs"]["path"] == [list(p) for p in spec.default_path]
+    doc = run(tmp_path, out="m2.json")  # (with Table 1's loop, the default path of manipulator2)
+    argv = ["atlas", "--robot", "manipulator2", "--starts", "12", "--cycles", "2", "--quiet",
+            "--out", str(tmp_path / "m2_default.json")]  # fmt: skip
+    assert main(argv) == 0
+    default = json.loads((tmp_path / "m2_default.json").read_text())
+    assert default["inputs"]["path"] == [list(p) for p in ROBOTS["manipulator2"].default_path]
+    assert default["results"]["pseudoinverse"]["drift"] == doc["results"]["pseudoinverse"]["drift"]
+    argv = ["atlas", "--robot", "unicycle", "--quiet", "--out", str(tmp_path / "u.json")]
+    assert main(argv) == 2
+    assert "unicycle has no default closed path: give --path" in capsys.readouterr().err
+
+
+def test_the_progress_bar_counts_the_runs_of_every_algorithm(tmp_path, capsys):
+    """8 starts, three algorithms: the bar ends at 24 runs, each start run by each algorithm."""
+    argv = ["atlas", "--robot", "manipulator2", "--path", TABLE1, "--starts", "8", "--cycles",
+            "1", "--algorithm", "pseudoinverse", "--algorithm", "posture", "--algorithm",
+            "damped", "--no-figure", "--out", str(tmp_path / "a.json")]  # fmt: skip
+    assert main(argv) == 0
+    err = capsys.readouterr().err
+    assert "24/24 runs (8 starts x 3 algorithms)" in err and "8/8 runs" not in err

@@ -108,7 +108,11 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
     """The request's atlas, planned (curves traced); RequestError or InvalidInputError, each
     naming the field, when it cannot be."""
     spec, inverses = _inverses(req)
-    named = [(f"path[{i}]", v) for i, v in enumerate(req.path)]
+    loops = not hasattr(inverses[0].kinematics, "path")  # (the unicycle's path is no loop)
+    path = req.path or loops * [list(t) for t in spec.default_path]
+    if not path:
+        raise RequestError("path", f"{spec.name} has no default closed path: give path")
+    named = [(f"path[{i}]", v) for i, v in enumerate(path)]
     named += [(f"shifts[{i}]", v) for i, v in enumerate(req.shifts or [])]
     for name, v in named:
         check_task_point(spec, v, name)
@@ -122,9 +126,9 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
     if (why := gamma_problem(gamma, mode)) is not None:
         raise RequestError("gamma", why)
     paths = len(req.shifts or [0]) * len(req.scales or [0])
-    closed = np.linalg.norm(np.subtract(req.path[-1], req.path[0])) <= CLOSE_TOL
+    closed = np.linalg.norm(np.subtract(path[-1], path[0])) <= CLOSE_TOL
     starts = len(req.start_points) if req.start_points else req.starts
-    legs = starts * paths * req.cycles * (len(req.path) - closed) * len(req.algorithms)
+    legs = starts * paths * req.cycles * (len(path) - closed) * len(req.algorithms)
     if legs > limits.max_work:
         raise RequestError(
             "starts", f"starts x paths x cycles x legs x algorithms = {legs} is more than "
@@ -136,8 +140,24 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
             "leg_ends", f"the ends of {legs} legs are more than the {limits.max_leg_ends} a "
             "response carries; ask for the drift alone or a smaller atlas",
         )  # fmt: skip
+    try:
+        return _plan(req, spec, inverses, path, gamma, mode)
+    except InvalidInputError as exc:
+        if exc.field != "starts":
+            raise
+        text = str(exc).replace("give the starts explicitly", "give start_points")
+        if not req.start_points:
+            raise RequestError("starts", text) from None
+        # (the engine's starts are the request's start_points: name the entry)
+        entry = re.match(r"starts\[(\d+)\] ", text)
+        if entry is None:
+            raise RequestError("start_points", text) from None
+        raise RequestError(f"start_points[{entry[1]}]", text[entry.end() :]) from None
+
+
+def _plan(req: AtlasRequest, spec, inverses, path, gamma, mode) -> AtlasPlan:
     return plan_atlas(
-        inverses, req.path, cycles=req.cycles, n_starts=req.starts, starts=req.start_points,
+        inverses, path, cycles=req.cycles, n_starts=req.starts, starts=req.start_points,
         arc=req.arc or (-MAX_ARC, MAX_ARC), sampling=req.sampling, seed=req.seed,
         reference=req.reference or spec.default_x0, box=None if req.arc else spec.x_range,
         shifts=req.shifts, scales=req.scales, gamma=gamma, mode=mode, tol=req.tolerance,

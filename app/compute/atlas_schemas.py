@@ -58,14 +58,16 @@ class AtlasRequest(BaseModel):
     )
     algorithm_parameters: AlgorithmParameters | None = Field(
         None, description="parameters of the damped, weighted and posture algorithms (each "
-        "takes its own; default: the engine's)",
+        "takes its own; default: the engine's; without rest the posture inverse pulls each "
+        "run toward its own start)",
     )  # fmt: skip
     augmentation: AnyAugmentation | None = Field(
         None, description="augmenting map of the extended inverse (default: the robot's)"
     )
-    path: Annotated[list[Vector], Field(min_length=2, max_length=MAX_PATH_POINTS)] = Field(
-        description="task points, a loop from the first: the starts lie on k(x) = path[0]"
-    )
+    path: Annotated[list[Vector], Field(min_length=2, max_length=MAX_PATH_POINTS)] | None = Field(
+        None, description="task points, a loop from the first: the starts lie on k(x) = path[0] "
+        "(default: the robot's closed path)",
+    )  # fmt: skip
     starts: Annotated[int, Field(strict=True, ge=1, le=MAX_STARTS), INTEGRAL] = Field(
         256, description=f"starts per path, 1 to {MAX_STARTS}"
     )
@@ -108,9 +110,10 @@ def _atlas_fields(spec, augmentation) -> dict:
     return {
         "augmentation": (augmentation | None, Field(
             None, description="augmenting map of the extended inverse (default: the robot's)")),
-        "path": (Annotated[list[point], Field(min_length=2, max_length=MAX_PATH_POINTS)], Field(
-            description=f"task points {list(spec.task_names)}, a loop from the first: the "
-            "starts lie on k(x) = path[0]")),
+        "path": (Annotated[list[point], Field(min_length=2, max_length=MAX_PATH_POINTS)] | None,
+                 Field(None, description=f"task points {list(spec.task_names)}, a loop from the "
+                       "first: the starts lie on k(x) = path[0] (default: the robot's closed "
+                       "path)")),
         "reference": (Annotated[list[Coordinate], Field(min_length=p, max_length=p)] | None,
                       Field(None, description="s = 0 is where eq. (7) from here meets the "
                             "curve (default: the robot's x0)")),

@@ -31,7 +31,7 @@ from jik.app.compute.robot_requests import (
     check_task_point,
 )
 from jik.app.compute.schemas.algorithms import field_of, used
-from jik.app.compute.user_robots import is_user_robot, user_inverse, user_robot
+from jik.app.compute.user_robots import is_user_robot, map_used, user_inverse, user_robot
 from jik.engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
 from jik.engine.limits import repeatability_report, robot_limits
 from jik.engine.registry import RobotSpec, make_inverse
@@ -71,6 +71,7 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
         spec, kin = robot.spec, robot.kinematics
         params = used(req.algorithm_parameters, req.algorithm, robot.kinematics, req.x0)
         inverse = user_inverse(robot, req.algorithm, params)
+        aug_used = map_used(robot) if extended else None
     else:
         spec, kin, robot_used = build_robot(req.robot)
         inverse, aug_used = _catalogue_inverse(spec, kin, req)

@@ -16,7 +16,7 @@ from jik.app.compute.documents import nullable
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.robot_requests import build_augmentation, build_robot
 from jik.app.compute.synthesis_total import grid, total_degree_response
-from jik.app.compute.user_robots import is_user_robot, request_field, user_robot
+from jik.app.compute.user_robots import is_user_robot, map_used, request_field, user_robot
 from jik.engine.exceptions import JikError
 from jik.engine.functionals import error_functional_e1, error_functional_e2
 from jik.engine.registry import RobotSpec
@@ -186,6 +186,7 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         region, fixed = dict(result.region) or region, dict(result.fixed) or fixed
     elif user:
         amap = _user_map(robot)
+        aug_used = map_used(robot)  # (the request's map, else the robot's default)
     else:
         _, amap, aug_used = build_augmentation(spec, kin, req.augmentation)
         coefficients = _coefficients(amap)

@@ -26,6 +26,7 @@ from jik.app.compute.exceptions import RequestError
 from jik.app.compute.schemas.algorithms import field_of
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.robot_spec import Robot, robot_from_dict
+from jik.engine.robot_synthesis import TENSOR_DEGREE, TOTAL_DEGREE
 
 #: The augmentation's label inside the built robot.
 _LABEL = "request"
@@ -84,11 +85,23 @@ def user_robot(req_robot: Any, augmentation: Any = None) -> tuple[Robot, S.Robot
     used = S.RobotUsed(name=spec.name, parameters={}, definition=echo(req_robot.model_dump(
         exclude_none=True)), p=spec.p, r=spec.r,
         notes=list(getattr(robot.kinematics, "notes", ())) or None)  # fmt: skip
-    aug_used = None
-    if given is not None:
-        values = {k: float(v) for k, v in (given.get("parameters") or {}).items()}
-        aug_used = S.AugmentationUsed(name=given["name"], parameters=values, definition=given)
-    return robot, used, aug_used
+    return robot, used, None if given is None else map_used(robot)
+
+
+def map_used(robot: Robot) -> S.AugmentationUsed | None:
+    """The map the robot's extended inverse uses (the request's, else the robot's default, e.g.
+    a catalogue arm's E2 synthesis), as defined with its defaults filled in (an e2_synthesized
+    map's region and degree); None for a robot without one."""
+    items = [a for a in robot.definition.get("augmentations", []) if isinstance(a, dict)]
+    if not items:
+        return None
+    item = next((a for a in items if a.get("label") == _LABEL), items[0])
+    definition = {k: v for k, v in item.items() if k != "label"}
+    if definition["name"] == "e2_synthesized" and "degree" not in definition:
+        many = len(definition.get("region") or {}) > 3
+        definition["degree"] = TOTAL_DEGREE if many else TENSOR_DEGREE
+    values = {k: float(v) for k, v in (definition.get("parameters") or {}).items()}
+    return S.AugmentationUsed(name=definition["name"], parameters=values, definition=definition)
 
 
 def echo(definition: dict) -> dict:

@@ -45,7 +45,13 @@ def atlas_request(
         )
     kin, _ = kinematics_and_map(state)
     home = np.asarray(kin.forward(np.asarray(state.x0, dtype=float)), dtype=float)
-    params = {k: v for a in state.algorithms for k, v in inverse_parameters(state, a, kin).items()}
+    # The atlas's posture inverse, without rest, pulls each run toward its own start.
+    params = {
+        k: v
+        for a in state.algorithms
+        for k, v in inverse_parameters(state, a, kin).items()
+        if k != "rest"
+    }
     points = manifold_starts(state, kin, starts) if kin.p - kin.r > 1 else None
     robot, augmentation = request_robot(state)
     return AtlasRequest.model_validate({

@@ -1,4 +1,4 @@
-"""The table of leg ends: the configuration after every leg for both algorithms, and on the
+"""The table of leg ends: the configuration after every leg for each chosen algorithm, and on the
 paper's experiment (Manipulator 2, l = 1, from x0 = (0, 0, pi/2) on the path (1, 1), (1, 2),
 (0, 2), (0, 1)) Table 1 of the paper, with the printed columns beside jik's, the cells that differ
 marked, and the errata entry (docs/paper-errata.md) in words.
@@ -71,11 +71,12 @@ def _ends(result: DashboardResult, algorithm: str) -> np.ndarray:
 
 
 def table1_spec(result: DashboardResult) -> dict:
-    """Table 1 (paper, sec. 5.2): for each algorithm jik's columns, then the printed ones; the
-    printed first cycle compared cell by cell to four decimals, as printed."""
+    """Table 1 (paper, sec. 5.2): for each of its two algorithms jik's columns, then the printed
+    ones, the printed first cycle compared cell by cell to four decimals, as printed; then one
+    group of jik's columns per other chosen algorithm, in its colour (:data:`STYLES`)."""
     names = result.variable_names
     ends = {a: _ends(result, a) for a in PAPER}
-    rows = max(len(e) for e in ends.values())
+    rows = max(len(_ends(result, a)) for a in result.runs)
     letters = "ABCD"
     labels = ["A  x0"] + [f"{letters[k % 4]}  x{k}f" for k in range(1, rows)]
     header, cols, fills = ["row"], [labels], ["#f4f4f4"]
@@ -99,6 +100,13 @@ def table1_spec(result: DashboardResult) -> dict:
             cols.append([cell(v, 0) for v in printed[:, k]] + [""] * (rows - len(printed)))
             fills.append(FILLS["printed"])
         counts[a] = n
+    others = [a for a in result.runs if a not in PAPER]
+    for a in others:  # the other chosen algorithms: jik's columns only (the paper has none)
+        ends[a] = _ends(result, a)
+        for k, name in enumerate(names):
+            header.append(f"{SHORT[a]} {name} (jik)")
+            cols.append([cell(v, 0) for v in ends[a][:, k]] + [""] * (rows - len(ends[a])))
+            fills.append(FILLS[a])
     notes = [
         f"Beside each of jik's columns, the paper's printed column (continuous algorithm (7), "
         f"one cycle). Highlighted: jik's cells that differ from the print in the fourth decimal "
@@ -106,6 +114,10 @@ def table1_spec(result: DashboardResult) -> dict:
         f"{counts['extended']} of 15).",
         ROW_LABELS_NOTE,
     ]
+    if others:
+        shown = ", ".join(SHORT[a] for a in others)
+        notes.append(f"Then jik's columns of {shown}: the paper's Table 1 prints the "
+                     "pseudoinverse and the extended Jacobian only.")  # fmt: skip
     state = result.state
     if state.augmentation == "paper_cubic":
         notes.append(ERRATUM)

@@ -286,3 +286,25 @@ def test_a_servers_atlas_is_cut_into_chunks_of_about_a_second(monkeypatch, secon
     plan = plan_request(AtlasRequest.model_validate(body(starts=3000)), AtlasLimits())
     assert plan.chunk == 2048
     assert atlas_pool.sized_chunks(plan).chunk == chunk
+
+
+def test_a_posture_atlas_pulls_each_run_toward_its_own_start(client):
+    """Without rest, the posture inverse of an atlas pulls each run toward its own start, as
+    /repeatability's does toward its x0: each run's drift is that start's /repeatability drift,
+    and below the pseudoinverse's at the same starts (the pull toward one fixed posture would
+    be measured instead, larger than the pseudoinverse's drift)."""
+    req = body(algorithms=["posture", "pseudoinverse"], algorithm_parameters={"gain": 1.0},
+               starts=4)  # fmt: skip
+    done = wait_until_ended(client, client.post("/atlas", json=req).json()["id"])
+    assert done["status"] == "done", done["error"]
+    res = done["result"]
+    posture = np.array(res["drift"]["posture"], dtype=float)[0]  # the one path's (N, cycles)
+    pinv = np.array(res["drift"]["pseudoinverse"], dtype=float)[0]
+    assert np.all(posture[:, -1] < 0.5 * pinv[:, -1])
+    for i, x0 in enumerate(res["starts"][0]):
+        r = client.post("/repeatability", json={
+            "robot": {"name": "manipulator2"}, "algorithm": "posture", "x0": x0,
+            "path": LOOP[1:], "cycles": 2, "algorithm_parameters": {"gain": 1.0},
+        })  # fmt: skip
+        assert r.status_code == 200, r.text
+        np.testing.assert_allclose(posture[i], r.json()["drift"], rtol=1e-8, atol=1e-12)

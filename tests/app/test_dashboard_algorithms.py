@@ -126,6 +126,8 @@ def test_the_atlas_compares_the_chosen_algorithms(three):
     assert request.algorithms == THREE
     assert request.algorithm_parameters is not None
     assert request.algorithm_parameters.gain == 1.0
+    # no rest: the atlas's posture inverse pulls each run toward its own start, not toward x0
+    assert request.algorithm_parameters.rest is None
 
 
 def test_the_session_api_takes_the_choice(client):
@@ -221,3 +223,27 @@ def test_the_atlas_figure_has_a_heatmap_per_algorithm_on_one_colour_scale(three)
     titles = [a["font"]["color"] for a in spec["layout"]["annotations"] if "font" in a]
     assert [COLORS[a] for a in THREE] == titles[:3]
     go.Figure(spec)  # (validated)
+
+
+def test_table1_gives_each_chosen_algorithm_its_column_group(three):
+    """On Table 1's experiment with the posture inverse chosen: the paper's layout for J^P#
+    and J^E# (jik's and the printed columns), then the posture inverse's columns of jik in
+    its colour, its leg ends to four decimals, and a note that the paper prints none."""
+    from jik.app.dashboard.table import FILLS, SHORT, table1_spec
+
+    spec = table1_spec(three)
+    table = spec["data"][0]
+    header, cols = table["header"]["values"], table["cells"]["values"]
+    fills = table["header"]["fill"]["color"]
+    paper = [f"{SHORT[a]} x{k} ({w})" for a in ("pseudoinverse", "extended")
+             for w in ("jik", "printed") for k in (1, 2, 3)]  # fmt: skip
+    assert header[1:13] == paper
+    assert header[13:] == ["posture x1 (jik)", "posture x2 (jik)", "posture x3 (jik)"]
+    assert fills[13:] == [FILLS["posture"]] * 3 and len(set(fills[1:13]) & set(fills[13:])) == 0
+    ends = three.runs["posture"].leg_end
+    for k in range(3):
+        assert float(cols[13 + k][1]) == pytest.approx(ends[0, k], abs=1e-4)
+        assert float(cols[13 + k][len(ends)]) == pytest.approx(ends[-1, k], abs=1e-4)
+    assert any(
+        "posture" in n and "prints the pseudoinverse" in n for n in spec["layout"]["meta"]["notes"]
+    )

@@ -79,6 +79,8 @@ def test_the_atlas_computes_cancels_and_moves_the_main_view_to_a_clicked_start(t
     job = start_atlas(tab, 64, 2)
     expect(progress).to_be_visible()
     expect(status).to_contain_text("Atlas done", timeout=120_000)
+    # every run of both algorithms counts
+    expect(status).to_contain_text("128 runs (64 starts x 2 algorithms) of 2 cycles")
     expect(progress).to_be_hidden()
     heatmaps = page.locator("#plot-atlas .heatmaplayer image")
     expect(heatmaps).to_have_count(2)

@@ -287,3 +287,16 @@ def test_weighted_refuses_a_start_past_a_limit_naming_the_joint():
         KinematicSingularityError, match=r"joint 3 is at or past its limits \[2, 3\]"
     ):
         solve(inv, X0, (1.0, 1.0))
+
+
+@pytest.mark.parametrize("width", [1e308, np.finfo(float).max, np.inf])
+def test_a_joint_whose_limits_are_huge_or_infinite_has_weight_one(width):
+    """Limits [-w, w] with w near the largest float: (hi - lo)^2 would overflow, yet the joint
+    is as unlimited as with w = inf, so W = I and the weighted inverse is the pseudoinverse."""
+    lim = np.array([[-width, width]] * 3)
+    x = X0 + np.random.default_rng(3).normal(scale=0.3, size=(5, 3))
+    np.testing.assert_array_equal(limit_gradient(x, lim), 0.0)
+    plain = solve(_inverse("pseudoinverse"), X0, (1.0, 1.0))
+    res = solve(WeightedInverse(KIN, lim), X0, (1.0, 1.0))
+    assert res.success
+    np.testing.assert_allclose(res.x, plain.x, atol=1e-12)

@@ -291,3 +291,29 @@ def test_a_process_pool_holds_its_workers_memory_limit():
         list(pool.imap_unordered(np.ones, [300_000_000]))  # (2.4 GB)
     with ProcessPool(1, memory_mb=512) as pool:
         assert [a.sum() for a in pool.imap_unordered(np.ones, [1000])] == [1000.0]
+
+
+def test_a_posture_atlas_without_rest_pulls_each_panda_run_toward_its_start():
+    """The Panda has a home; without rest the atlas's posture inverse still pulls each run
+    toward its own start (batched): each run is the run of the posture inverse with rest = that
+    start, and the drift is of the pseudoinverse's order, not the radians of a pull home."""
+    from jik.engine.registry import make_inverse
+    from jik.engine.robot_spec import robot_from_dict
+
+    robot = robot_from_dict({"name": "panda", "task": "pose"})
+    kin, x0 = robot.kinematics, np.asarray(robot.spec.default_x0, dtype=float)
+    path = np.vstack([kin.forward(x0), np.asarray(robot.spec.default_path, dtype=float)])
+    posture = make_inverse(kin, "posture", spec=robot.spec, algorithm_parameters={"gain": 2.0})
+    pinv = make_inverse(kin, "pseudoinverse", spec=robot.spec)
+    plan = plan_atlas([posture, pinv], path, cycles=3, n_starts=6, reference=x0,
+                      arc=(-1.0, 1.0))  # fmt: skip
+    res = run_atlas(plan)
+    drift = np.asarray(res.drift)[:, 0, :, -1]  # (algorithm, start) after the last cycle
+    assert np.max(drift[0]) < 1e-2 and np.mean(drift[0]) < np.mean(drift[1])
+    starts = plan.starts(0, plan.n_starts)
+    for i, s in enumerate(starts):
+        own = make_inverse(kin, "posture", spec=robot.spec,
+                           algorithm_parameters={"gain": 2.0, "rest": list(s)})  # fmt: skip
+        one = repeatability(own, s, plan.targets(i, i + 1, starts[i : i + 1])[0], 3, close=False)
+        np.testing.assert_allclose(np.asarray(res.drift)[0, 0, i], np.asarray(one.drift),
+                                   rtol=1e-8, atol=1e-12)  # fmt: skip

@@ -40,7 +40,7 @@ class AlgorithmParameters(_Parameters):  # type: ignore[misc, valid-type]
 
     rest: list[_Coordinate] | None = Field(
         None, description="posture: the rest posture x_rest, length p (default: the robot's home, "
-        "else the run's x0; in an atlas, else the robot's default x0)",
+        "else the run's x0; in an atlas, each run's own start)",
     )  # fmt: skip
     limits: list[tuple[_Bound, _Bound]] | None = Field(
         None, description="weighted: joint limits [lo, hi] per joint, length p (default: the "

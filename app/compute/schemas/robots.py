@@ -241,7 +241,8 @@ class E2SynthesisAugmentation(BaseModel):
                          Annotated[float, Field(strict=True, ge=-100.0, le=100.0,
                                                 allow_inf_nan=False)]]],
         Field(min_length=2, max_length=MAX_DIMENSION),
-    ] = Field(description="two or more variables to [lo, hi], lo < hi")  # fmt: skip
+    ] | None = Field(None, description="two or more variables to [lo, hi], lo < hi; default: "
+                     "the robot's functional region (an arm's: a box around home)")  # fmt: skip
     degree: Annotated[int, Field(strict=True, ge=1, le=24), INTEGRAL] | None = Field(
         None, description="two or three variables: Legendre degree per variable (default 12); "
         "more: the total degree, 1 to 6 (default 4)",
