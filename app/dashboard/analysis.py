@@ -272,7 +272,7 @@ def error_functionals(
         "design_region": bool(design),
     }
     if len(region) > MAX_QUADRATURE_VARIABLES:  # (nodes ** 7 points for a 7-joint arm)
-        return qmc_functionals(grid, region, fixed, out, cancelled)
+        return qmc_functionals(grid, region, fixed, out, cancelled, on_step)
     for key, fn in (("E1", error_functional_e1), ("E2", error_functional_e2)):
         try:
             value = fn(grid["kinematics"], grid["map"], region, nodes=nodes, fixed=fixed)
@@ -292,11 +292,14 @@ SENSITIVITY_SAMPLES = 11
 
 def sensitivity_evaluations(state: DashboardState, amap) -> int:
     """How many values of E1 or E2 :func:`sensitivity` computes for ``state`` and its map
-    ``amap`` (its steps of progress): none for an expensive map; else both functionals at every
-    point of the parameters' sweeps, or of each of the robot's maps."""
+    ``amap`` (its steps of progress): none for an expensive map or a design region over more
+    variables than a tensor rule takes (E2 from a Sobol rule alone, no sweep); else both
+    functionals at every point of the parameters' sweeps, or of each of the robot's maps."""
     if amap is None or expensive_map(amap):
         return 0
     spec = state_spec(state)
+    if len(spec.functional_region) > MAX_QUADRATURE_VARIABLES:
+        return 0
     params = spec.augmentation(state.augmentation).parameters
     if params:
         return 2 * (1 + len(params) * (2 + SENSITIVITY_SAMPLES))

@@ -21,11 +21,13 @@ QMC_NODES = 2**13
 QMC_SEED = 1
 
 
-def qmc_functionals(grid: dict, region: dict, fixed: dict, out: dict, cancelled) -> dict:
+def qmc_functionals(
+    grid: dict, region: dict, fixed: dict, out: dict, cancelled, on_step=None
+) -> dict:
     """``out`` (the region, fixed variables) with E2 of the grid's map by :data:`QMC_NODES`
     Sobol nodes and ``E2_single_joint`` (name -> {"sign", "e2"}) when p - r = 1; E1 None and a
     ``note`` saying why and how. Raises :class:`~jik.app.dashboard.runs.Cancelled` when
-    ``cancelled()`` turns True."""
+    ``cancelled()`` turns True; ``on_step()`` twice when done (the two functionals' steps)."""
     from jik.app.dashboard.runs import Cancelled
 
     kin = grid["kinematics"]
@@ -40,8 +42,12 @@ def qmc_functionals(grid: dict, region: dict, fixed: dict, out: dict, cancelled)
     except RunCancelled:
         raise Cancelled from None
     except (JikError, ValueError, ArithmeticError) as exc:
-        return {**out, "E1": None, "E2": None, "E2_error": str(exc),
-                "note": f"E1 not computed: {large}; E2 not computed: {exc}"}  # fmt: skip
+        e2 = {"E2": None, "error": str(exc)}
+    for _ in range(2 if on_step is not None else 0):
+        on_step()
+    if "error" in e2:
+        return {**out, "E1": None, "E2": None, "E2_error": e2["error"],
+                "note": f"E1 not computed: {large}; E2 not computed: {e2['error']}"}  # fmt: skip
     value = "undefined (h is not defined on all of it)" if e2["E2"] is None else (
         f"{e2['E2']:.4g}"
     )  # fmt: skip

@@ -105,9 +105,11 @@ def pose_task_spec(result: DashboardResult) -> dict:
     ]  # fmt: skip
     axes["xaxis"]["title"] = theta_label(result)
     axes["xaxis"]["range"] = nice_range(np.concatenate([r.theta for r in runs]), from_zero=True)
+    lead = next(iter(result.runs))  # (the targets are marked at its legs' ends)
     title = (
         "Task coordinates against θ: position, then rotation vector<br><sup>"
         + algorithms_key(result)
-        + "</sup><br><sup>× target at the end of each leg · ○ start k(x0)</sup>"
+        + f"</sup><br><sup>× target at the end of each leg of {STYLES[lead].short}"
+        " · ○ start k(x0)</sup>"
     )
     return figure(data, title, height=110 * len(names) + 140, **NO_LEGEND, **axes)

@@ -152,9 +152,13 @@ def test_the_e1_e2_panel_shows_e2_of_a_7_joint_map_beside_single_joints():
     h = s x_j for each joint; the E1/E2 panel draws them as bars (the map outlined, first), the
     h panel's title says E2; a cancelled phase raises Cancelled."""
     from jik.app.dashboard.runs import Cancelled
+    from jik.app.dashboard.second_phase import FUNCTIONALS, GRID
 
     result = compute(_panda())
-    functionals, sens = _second_phase(result).run()
+    phase = _second_phase(result)
+    assert phase.steps == {GRID: 0, FUNCTIONALS: 2}  # (E2's rule; no sweep over 7 joints)
+    functionals, sens = phase.run()
+    assert phase.fraction == 1.0
     assert functionals["E1"] is None and 1.6e-4 < functionals["E2"] < 1.8e-4
     single = functionals["E2_single_joint"]
     assert set(single) == {f"x{i}" for i in range(1, 8)}

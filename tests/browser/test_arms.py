@@ -1,7 +1,8 @@
 """A catalogue arm in the dashboard: the user picks the Franka Panda (7 joints, the pose task
 x y z rx ry rz), sees it in the 3D scene with its targets as pose frames, runs both algorithms
-with its E2-synthesized map, reads in the verdict that the pseudoinverse drifts and the extended
-run comes back and stays within the joint limits, and computes the arm's atlas."""
+with its E2-synthesized map (its E2 shown beside E2 of each single joint), reads in the verdict
+that the pseudoinverse drifts and the extended run comes back and stays within the joint
+limits, and computes the arm's atlas."""
 
 from __future__ import annotations
 
@@ -43,6 +44,13 @@ def test_the_panda_with_its_pose_task(tabs):
     assert scene["joints"] == 9  # base, 7 joints, the flange (fixed joints drawn too)
     assert scene["pose_frames"] == 4  # the path's three pose targets and k(x0)
     tab.screenshots("arm-panda")
+    # The task panel: position and rotation vector against theta; E2 of the 7-joint map beside
+    # E2 of each single joint (the second phase's Sobol rule).
+    expect(page.locator("#plot-task")).to_contain_text("rz [rad]")
+    sensitivity = page.locator("#plot-sensitivity")
+    expect(sensitivity).to_contain_text("of a single joint held", timeout=120_000)
+    expect(sensitivity).to_contain_text("h = +x1")
+    expect(page.locator("#plot-augmenting")).to_contain_text("E2 = 0.000173")
 
     # Its atlas: 16 starts on the self-motion curve of k(x0), two cycles, both algorithms.
     page.locator("#atlas").scroll_into_view_if_needed()
