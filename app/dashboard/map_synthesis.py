@@ -1,8 +1,8 @@
 """A state's augmenting map built with its progress shown and a newer change able to stop it.
 
-A catalogue arm's default map (and a definition's ``e2_synthesized`` map) is synthesized on first
-use, eq. (19) over all the arm's joints (:mod:`jik.engine.robot_synthesis`): a few seconds before
-the extended run can start. :func:`built_map` builds it with the engine's progress reporting to
+A catalogue arm's default map (and a definition's ``e2_synthesized`` map, scalar or, for
+p - r > 1, a vector) is synthesized on first use, eq. (19) over all the arm's joints
+(:mod:`jik.engine.robot_synthesis`): a few seconds before the extended run can start. :func:`built_map` builds it with the engine's progress reporting to
 the page ("synthesizing h", its fraction done) and polling the session's cancellation between
 the pieces of the synthesis; once built, the map is kept with the robot and costs nothing again.
 """
@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from jik.app.dashboard.analysis import kinematics_and_map
+from jik.app.dashboard.robots import state_robot
 from jik.app.dashboard.runs import Cancelled
 from jik.engine.exceptions import RunCancelled
 from jik.engine.progress import ProgressCallbacks
@@ -31,6 +32,12 @@ def built_map(state, progress: Callable[..., None], cancelled: Callable[[], bool
     )
     try:
         with synthesis_progress(report):
-            return kinematics_and_map(state)
+            kin, amap = kinematics_and_map(state)
+            robot = state_robot(state)
+            if amap is None and robot is not None:  # (p - r > 1: a synthesized vector, built)
+                maps = robot.map_vectors.get(state.augmentation)
+                if callable(maps):
+                    maps()
+            return kin, amap
     except RunCancelled:
         raise Cancelled from None

@@ -143,6 +143,22 @@ def test_the_synthesis_reports_progress_and_a_newer_change_stops_it():
     assert len(seen) == 1 and seen[0] < 0.5
 
 
+def test_a_synthesized_vector_map_is_built_with_progress_and_runs():
+    """p - r = 2 with ``e2_synthesized``: the vector (h_1, h_2) is synthesized when the state's
+    map is built (its progress on the way), and its extended run comes back to x0."""
+    box = {"x1": [0.1, 0.5], "x2": [0.4, 0.8], "x3": [0.4, 0.8], "x4": [0.4, 0.8]}
+    arm = {"name": "planar_chain", "joints": "RRRR", "lengths": [1, 1, 1, 1],
+           "x0": [0.3, 0.6, 0.6, 0.6],
+           "augmentations": [{"name": "e2_synthesized", "region": box}]}  # fmt: skip
+    state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": arm})
+    seen: list[float] = []
+    built_map(state, lambda f, what: seen.append(f), lambda: False)
+    assert seen and seen[-1] == pytest.approx(1.0)
+    result = compute(state)
+    assert result.runs["pseudoinverse"].drift[-1] > 1e-5
+    assert max(result.runs["extended"].drift) < 1e-9
+
+
 def test_the_atlas_of_an_arm_asks_for_its_definition_and_counts_the_limits():
     """The session's atlas of the Panda is the REST atlas of its definition and its default
     map; the heatmap says how many runs of each algorithm left the joint limits. A user's map
