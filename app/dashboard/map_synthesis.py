@@ -2,9 +2,10 @@
 
 A catalogue arm's default map (and a definition's ``e2_synthesized`` map, scalar or, for
 p - r > 1, a vector) is synthesized on first use, eq. (19) over all the arm's joints
-(:mod:`jik.engine.robot_synthesis`): a few seconds before the extended run can start. :func:`built_map` builds it with the engine's progress reporting to
-the page ("synthesizing h", its fraction done) and polling the session's cancellation between
-the pieces of the synthesis; once built, the map is kept with the robot and costs nothing again.
+(:mod:`jik.engine.robot_synthesis`): a few seconds before the extended run can start.
+:func:`built_map` builds it with the engine's progress reporting to the page ("synthesizing h",
+its fraction done) and polling the session's cancellation between the pieces of the synthesis;
+once built, the map is kept with the robot and costs nothing again.
 """
 
 from __future__ import annotations
