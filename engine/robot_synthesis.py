@@ -12,7 +12,6 @@ from __future__ import annotations
 import contextlib
 import contextvars
 import functools
-import itertools
 import json
 from collections.abc import Callable, Iterator, Mapping
 
@@ -41,7 +40,8 @@ def vector_synthesis(
 ) -> Callable[[], tuple[AugmentingMap, ...]]:
     """The E2-optimal maps h_1, ..., h_(p-r) on ``box`` (p - r >= 2; docs/e2-vector.md), by the
     total-degree synthesis in the kernel frame of the 1-based joints ``axes`` (default: the
-    best-conditioned at the box's centre, :func:`best_frame_axes`), computed on first call."""
+    best-conditioned at the box's centre,
+    :func:`~jik.engine.synthesis_nd.best_frame_axes`), computed on first call."""
     return functools.cache(lambda: _maps(kin, box, fix, degree, key, axes))
 
 
@@ -51,8 +51,6 @@ def _maps(kin, box, fix, degree, key, axes) -> tuple[AugmentingMap, ...]:
     if cache_key is not None and cache_key in _SYNTHESIZED:
         return _SYNTHESIZED[cache_key]
     progress = _PROGRESS.get()  # (a RunCancelled it raises leaves nothing cached)
-    if axes is None and kin.p - kin.r > 1:
-        axes = best_frame_axes(kin, box, fix)
     maps: tuple[AugmentingMap, ...]
     if len(box) <= 3 and kin.p - kin.r == 1:
         maps = (
@@ -73,21 +71,6 @@ def _maps(kin, box, fix, degree, key, axes) -> tuple[AugmentingMap, ...]:
             _SYNTHESIZED.pop(next(iter(_SYNTHESIZED)))
         _SYNTHESIZED[cache_key] = maps
     return maps
-
-
-def best_frame_axes(kin: Kinematics, box: Mapping, fix: Mapping) -> list[int]:
-    """The p - r joints (1-based) whose axes give the best-conditioned kernel frame at the box's
-    centre: the largest least eigenvalue of E^T N E (:func:`~jik.engine.synthesis_nd.kernel_frame`;
-    the frame is degenerate where it is 0), over every choice of p - r joints at once."""
-    names = list(kin.variable_names)
-    x = np.array([fix.get(n, 0.0) for n in names], dtype=float)
-    for n, (lo, hi) in box.items():
-        x[names.index(n)] = 0.5 * (lo + hi)
-    J = np.asarray(kin.jacobian(x), dtype=float)
-    N = np.eye(kin.p) - np.linalg.pinv(J) @ J
-    choices = np.array(list(itertools.combinations(range(kin.p), kin.p - kin.r)))
-    least = np.linalg.eigvalsh(N[choices[:, :, None], choices[:, None, :]])[:, 0]
-    return [int(a) + 1 for a in choices[int(np.argmax(least))]]
 
 
 @contextlib.contextmanager

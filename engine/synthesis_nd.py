@@ -23,6 +23,7 @@ nodes up to the quadrature error. Natural boundary conditions, as in :mod:`jik.e
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -79,6 +80,21 @@ def kernel_frame(kinematics: Kinematics, x: FloatArray, axes: Sequence[int] | No
         )
     inv_sqrt = (U / np.sqrt(lam)[..., None, :]) @ np.swapaxes(U, -1, -2)
     return NE @ inv_sqrt, Jp
+
+
+def best_frame_axes(kin: Kinematics, box: Mapping, fix: Mapping) -> list[int]:
+    """The p - r joints (1-based) whose axes give the best-conditioned kernel frame at the box's
+    centre: the largest least eigenvalue of E^T N E (:func:`kernel_frame`;
+    the frame is degenerate where it is 0), over every choice of p - r joints at once."""
+    names = list(kin.variable_names) or [f"x{i + 1}" for i in range(kin.p)]
+    x = np.array([fix.get(n, 0.0) for n in names], dtype=float)
+    for n, (lo, hi) in box.items():
+        x[names.index(n)] = 0.5 * (lo + hi)
+    J = np.asarray(kin.jacobian(x), dtype=float)
+    N = np.eye(kin.p) - np.linalg.pinv(J) @ J
+    choices = np.array(list(itertools.combinations(range(kin.p), kin.p - kin.r)))
+    least = np.linalg.eigvalsh(N[choices[:, :, None], choices[:, None, :]])[:, 0]
+    return [int(a) + 1 for a in choices[int(np.argmax(least))]]
 
 
 @dataclass(frozen=True, repr=False)
@@ -215,7 +231,8 @@ def synthesize_e2_nd(
     seed : int
         Seed of the scrambling (the result is a deterministic function of it).
     frame_axes : sequence of int, optional
-        1-based joints whose axes fix the kernel frame for p - r >= 2 (:func:`kernel_frame`).
+        1-based joints whose axes fix the kernel frame for p - r >= 2 (:func:`kernel_frame`);
+        default: the best conditioned at the box's centre (:func:`best_frame_axes`).
     convergence_degrees : sequence of int
         Lower total degrees whose Ritz values are reported too.
     progress : Progress, optional
@@ -251,7 +268,7 @@ def synthesize_e2_nd(
     axes = None
     if m_red > 1:
         axes = (
-            list(range(kinematics.p - m_red, kinematics.p))
+            [a - 1 for a in best_frame_axes(kinematics, box, fix)]
             if frame_axes is None
             else [count(a, "frame_axes", 1, kinematics.p) - 1 for a in frame_axes]
         )

@@ -148,7 +148,7 @@ def test_a_synthesized_vector_map_is_built_with_progress_and_runs():
     map is built (its progress on the way), and its extended run comes back to x0."""
     box = {"x1": [0.1, 0.5], "x2": [0.4, 0.8], "x3": [0.4, 0.8], "x4": [0.4, 0.8]}
     arm = {"name": "planar_chain", "joints": "RRRR", "lengths": [1, 1, 1, 1],
-           "x0": [0.3, 0.6, 0.6, 0.6],
+           "x0": [0.3, 0.6, 0.6, 0.6], "title": "a chain of this test (no map synthesized before)",
            "augmentations": [{"name": "e2_synthesized", "region": box}]}  # fmt: skip
     state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": arm})
     seen: list[float] = []
