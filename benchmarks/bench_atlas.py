@@ -39,8 +39,14 @@ TURN = math.pi * math.sqrt(2.0)
 
 
 def plan(n: int, cycles: int = 3):
-    return plan_atlas(Pseudoinverse(Manipulator2()), LOOP, cycles=cycles, n_starts=n,
-                      arc=(-TURN, TURN), reference=X0)  # fmt: skip
+    return plan_atlas(
+        Pseudoinverse(Manipulator2()),
+        LOOP,
+        cycles=cycles,
+        n_starts=n,
+        arc=(-TURN, TURN),
+        reference=X0,
+    )
 
 
 def timed(fn):
@@ -54,9 +60,11 @@ def cpu_seconds() -> float:
     LocalCluster's nannies with their workers), which other processes' load does not inflate."""
     return sum(
         u.ru_utime + u.ru_stime
-        for u in (resource.getrusage(resource.RUSAGE_SELF),
-                  resource.getrusage(resource.RUSAGE_CHILDREN))
-    )  # fmt: skip
+        for u in (
+            resource.getrusage(resource.RUSAGE_SELF),
+            resource.getrusage(resource.RUSAGE_CHILDREN),
+        )
+    )
 
 
 def loop_reference(p, sample: int):
@@ -86,11 +94,14 @@ def memory(n: int, backend: str) -> dict:
     tracemalloc.stop()
     kb = 1024  # (ru_maxrss is in kB on Linux)
     return {
-        "starts": n, "runs": runs, "chunk": p.chunk, "seconds": elapsed,
+        "starts": n,
+        "runs": runs,
+        "chunk": p.chunk,
+        "seconds": elapsed,
         "traced_peak_mb": traced / 1e6,
         "parent_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * kb / 1e6,
         "worker_rss_mb": resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss * kb / 1e6,
-    }  # fmt: skip
+    }
 
 
 def memory_in_fresh_process(n: int, backend: str) -> dict:
@@ -114,8 +125,10 @@ def run(quick: bool = False) -> dict:
     idx, times, sample_drift = loop_reference(p, 8 if quick else 40)
     per_start = statistics.median(times)
     loop_total = per_start * n
-    mem = [memory_in_fresh_process(m, "processes:2") for m in ((2000, 20000) if quick
-                                                               else (10**5, 10**6))]  # fmt: skip
+    mem = [
+        memory_in_fresh_process(m, "processes:2")
+        for m in ((2000, 20000) if quick else (10**5, 10**6))
+    ]
     return {
         "starts": n,
         "legs": p.legs * p.cycles,
@@ -141,20 +154,26 @@ def main(quick: bool = False) -> dict:
     n = r["starts"]
     print(f"{n} starts x Table 1's loop x 3 cycles ({r['legs']} legs each), pseudoinverse:")
     for b, t in r["seconds"].items():
-        print(f"  atlas {b:<14} {t:8.1f} s wall, {r['cpu_seconds'][b]:6.1f} s CPU   "
-              f"{1e3 * t / (n * r['legs']):.4f} ms per start and leg   ratio to the loop "
-              f"{r['ratio'][b]:5.0f}x   max |drift - in-process| "
-              f"{r['backend_difference'][b]:.1e}")  # fmt: skip
-    print(f"  repeatability() loop   {r['loop_per_start_ms']:8.2f} ms per start (median of "
-          f"{r['loop_sample']}), {r['loop_extrapolated_s']:.0f} s extrapolated to {n}; "
-          f"max |drift - atlas| {r['sample_difference']:.1e}")  # fmt: skip
+        print(
+            f"  atlas {b:<14} {t:8.1f} s wall, {r['cpu_seconds'][b]:6.1f} s CPU   "
+            f"{1e3 * t / (n * r['legs']):.4f} ms per start and leg   ratio to the loop "
+            f"{r['ratio'][b]:5.0f}x   max |drift - in-process| "
+            f"{r['backend_difference'][b]:.1e}"
+        )
+    print(
+        f"  repeatability() loop   {r['loop_per_start_ms']:8.2f} ms per start (median of "
+        f"{r['loop_sample']}), {r['loop_extrapolated_s']:.0f} s extrapolated to {n}; "
+        f"max |drift - atlas| {r['sample_difference']:.1e}"
+    )
     print(f"  failed runs {r['failed']}; median drift per cycle {r['median_drift']}")
     print(f"  load average during the run (1, 5, 15 min): {r['load_average']}")
     print("Memory, streaming with 2 local processes, one cycle (fresh interpreter each):")
     for m in r["memory"]:
-        print(f"  {m['starts']:>8} starts (chunk {m['chunk']}): {m['seconds']:6.1f} s, traced "
-              f"peak {m['traced_peak_mb']:.2f} MB, parent RSS {m['parent_rss_mb']:.0f} MB, "
-              f"largest worker RSS {m['worker_rss_mb']:.0f} MB")  # fmt: skip
+        print(
+            f"  {m['starts']:>8} starts (chunk {m['chunk']}): {m['seconds']:6.1f} s, traced "
+            f"peak {m['traced_peak_mb']:.2f} MB, parent RSS {m['parent_rss_mb']:.0f} MB, "
+            f"largest worker RSS {m['worker_rss_mb']:.0f} MB"
+        )
     return r
 
 

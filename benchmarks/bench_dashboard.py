@@ -76,8 +76,7 @@ def algorithms_run(offload: OffloadLane | None, repeats: int) -> dict:
         walls["two"].append(_update(TWO, k, offload))
         walls["three"].append(_update(THREE, k, offload))
     two, three = (statistics.median(walls[n]) for n in ("two", "three"))
-    return {"two_ms": 1e3 * two, "three_ms": 1e3 * three, "ratio": three / two,
-            "repeats": repeats}  # fmt: skip
+    return {"two_ms": 1e3 * two, "three_ms": 1e3 * three, "ratio": three / two, "repeats": repeats}
 
 
 def run(quick: bool = False) -> dict:
@@ -89,11 +88,17 @@ def run(quick: bool = False) -> dict:
             repeats = (2 if quick else 5) if robot == "unicycle" else (5 if quick else 21)
             serial = _timed(robot, repeats, None)
             offloaded = _timed(robot, repeats, offload)
-            out[robot] = {"serial_ms": 1e3 * serial, "offloaded_ms": 1e3 * offloaded,
-                          "ratio": serial / offloaded, "repeats": repeats}  # fmt: skip
+            out[robot] = {
+                "serial_ms": 1e3 * serial,
+                "offloaded_ms": 1e3 * offloaded,
+                "ratio": serial / offloaded,
+                "repeats": repeats,
+            }
         repeats = 7 if quick else 21
-        out["algorithms"] = {"one thread": algorithms_run(None, repeats),
-                             "offloaded": algorithms_run(offload, repeats)}  # fmt: skip
+        out["algorithms"] = {
+            "one thread": algorithms_run(None, repeats),
+            "offloaded": algorithms_run(offload, repeats),
+        }
         return out
 
 
@@ -106,12 +111,16 @@ def main(quick: bool = False) -> None:
             f"{robot:16}{v['serial_ms']:10.1f}ms{v['offloaded_ms']:10.1f}ms"
             f"{v['ratio']:8.2f}{v['repeats']:6d}"
         )
-    print("\nManipulator 2, default view's update (runs, panels, verdict): two algorithms vs "
-          "three (+ posture); target ratio <= 1.5")  # fmt: skip
+    print(
+        "\nManipulator 2, default view's update (runs, panels, verdict): two algorithms vs "
+        "three (+ posture); target ratio <= 1.5"
+    )
     print(f"{'':16}{'two':>12}{'three':>12}{'ratio':>8}{'runs':>6}")
     for how, v in chosen.items():
-        print(f"{how:16}{v['two_ms']:10.1f}ms{v['three_ms']:10.1f}ms{v['ratio']:8.2f}"
-              f"{v['repeats']:6d}")  # fmt: skip
+        print(
+            f"{how:16}{v['two_ms']:10.1f}ms{v['three_ms']:10.1f}ms{v['ratio']:8.2f}"
+            f"{v['repeats']:6d}"
+        )
 
 
 if __name__ == "__main__":

@@ -217,8 +217,12 @@ class Machine:
 
     def report(self) -> dict:
         cpu, wall = self._stat(), time.monotonic() - self._t
-        out: dict = {"loadavg_start": self.loadavg, "loadavg_end": self._loadavg(),
-                     "seconds": wall, "cores": os.cpu_count()}  # fmt: skip
+        out: dict = {
+            "loadavg_start": self.loadavg,
+            "loadavg_end": self._loadavg(),
+            "seconds": wall,
+            "cores": os.cpu_count(),
+        }
         if cpu is not None and self._cpu is not None:
             d = [b - a for a, b in zip(self._cpu, cpu, strict=True)]
             busy = (d[0] + d[1] + d[2] + d[5] + d[6]) / _TICK  # user nice system irq softirq
@@ -251,8 +255,10 @@ def served() -> Iterator[tuple[str, subprocess.Popen]]:
     log = tempfile.TemporaryFile("w+")
     proc = subprocess.Popen(
         [sys.executable, "-m", "jik", "serve", "--port", str(port)],
-        env=env, stdout=log, stderr=subprocess.STDOUT,
-    )  # fmt: skip
+        env=env,
+        stdout=log,
+        stderr=subprocess.STDOUT,
+    )
     base = f"http://127.0.0.1:{port}"
     try:
         deadline = time.monotonic() + 60
@@ -371,10 +377,16 @@ def server_only(base: str, pid: int, sessions: list[list[Change]]) -> list[dict]
                     quiet(pid)
                     fresh_id, setup, fresh, _ = _timed_session(client, base, r.json()["state"])
                     client.delete(f"/api/sessions/{fresh_id}")
-                    samples.append({"kind": change.kind, "family": change.family,
-                                    "live_ms": 1e3 * live, "fresh_ms": 1e3 * fresh,
-                                    "setup_ms": 1e3 * setup,
-                                    "compute_ms": 1e3 * result["timing"]["compute"]})  # fmt: skip
+                    samples.append(
+                        {
+                            "kind": change.kind,
+                            "family": change.family,
+                            "live_ms": 1e3 * live,
+                            "fresh_ms": 1e3 * fresh,
+                            "setup_ms": 1e3 * setup,
+                            "compute_ms": 1e3 * result["timing"]["compute"],
+                        }
+                    )
                     quiet(pid)
             finally:
                 stream.close()
@@ -454,8 +466,12 @@ def _ratio(a: float, b: float) -> str:
     return f"{a / b:7.2f}" if not (math.isnan(a) or math.isnan(b)) else f"{'-':>7}"
 
 
-_NONE = {"n": 0, "plots_ms": (math.nan,) * 2, "scene_ms": (math.nan,) * 2,
-         "compute_ms": (math.nan,) * 2}  # fmt: skip
+_NONE = {
+    "n": 0,
+    "plots_ms": (math.nan,) * 2,
+    "scene_ms": (math.nan,) * 2,
+    "compute_ms": (math.nan,) * 2,
+}
 
 
 def main(quick: bool = False) -> None:
@@ -471,8 +487,10 @@ def main(quick: bool = False) -> None:
             else ""
         )
     )
-    print("\nserver only: POST /state -> its result event (live session) vs a fresh session "
-          "of the same state -> its first result; median / p95 [ms]")  # fmt: skip
+    print(
+        "\nserver only: POST /state -> its result event (live session) vs a fresh session "
+        "of the same state -> its first result; median / p95 [ms]"
+    )
     print(f"{'change':34}{'n':>3}{'live':>12}{'fresh':>12}{'ratio':>7}{'setup':>7}{'compute':>9}")
     for (kind, _), v in r["server"].items():
         print(
@@ -484,11 +502,15 @@ def main(quick: bool = False) -> None:
         print(f"\nbrowser: skipped, {r['browser_skipped']}")
         return
     b = r["browser"]
-    print("\nbrowser: control -> plots drawn, -> scene shown; the page's own update (jik) vs the "
-          "page reloaded with the changed state (reload); median / p95 [ms]")  # fmt: skip
+    print(
+        "\nbrowser: control -> plots drawn, -> scene shown; the page's own update (jik) vs the "
+        "page reloaded with the changed state (reload); median / p95 [ms]"
+    )
     print(f"{'':37}{'jik':^33}{'reload':^28}{'ratio':^14}")
-    print(f"{'change':34}{'n':>3}{'plots':>12}{'scene':>12}{'compute':>9}{'n':>4}{'plots':>12}"
-          f"{'scene':>12}{'plots':>7}{'scene':>7}")  # fmt: skip
+    print(
+        f"{'change':34}{'n':>3}{'plots':>12}{'scene':>12}{'compute':>9}{'n':>4}{'plots':>12}"
+        f"{'scene':>12}{'plots':>7}{'scene':>7}"
+    )
     for kind in dict.fromkeys(k for k, _ in b):
         j, s = b.get((kind, "jik"), _NONE), b.get((kind, "reload"), _NONE)
         print(

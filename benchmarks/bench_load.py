@@ -57,9 +57,19 @@ def start_server(
     port = port or _free_port()
     env = {**os.environ, "JIK_BATCH": "1" if batching else "0", "JIK_FAST_SOLVE": str(int(fast))}
     cmd = [
-        sys.executable, "-m", "uvicorn", "jik.app.api.factory:create_app", "--factory",
-        "--host", "127.0.0.1", "--port", str(port), "--log-level", "warning", "--no-access-log",
-    ]  # fmt: skip
+        sys.executable,
+        "-m",
+        "uvicorn",
+        "jik.app.api.factory:create_app",
+        "--factory",
+        "--host",
+        "127.0.0.1",
+        "--port",
+        str(port),
+        "--log-level",
+        "warning",
+        "--no-access-log",
+    ]
     proc = subprocess.Popen(cmd, env=env, stdin=subprocess.DEVNULL)
     url = f"http://127.0.0.1:{port}"
     deadline = time.monotonic() + 120
@@ -238,18 +248,26 @@ def run_wrk(
     proc, url = start_server(batching, fast=fast)
     try:
         with tempfile.NamedTemporaryFile("w", suffix=".lua", delete=False) as f:
-            f.write(WRK_SCRIPT if path == "/solve" else WRK_SCRIPT.split("wrk.method")[0]
-                    + "function response(status, headers, body)\n"
-                    + "  if status ~= 200 then failed = failed + 1 end\nend\n"
-                    + "function done" + WRK_SCRIPT.split("function done")[1])  # fmt: skip
+            f.write(
+                WRK_SCRIPT
+                if path == "/solve"
+                else WRK_SCRIPT.split("wrk.method")[0]
+                + "function response(status, headers, body)\n"
+                + "  if status ~= 200 then failed = failed + 1 end\nend\n"
+                + "function done"
+                + WRK_SCRIPT.split("function done")[1]
+            )
         target = url if path == "/solve" else url + path
         cmd = ["wrk", "-t1", f"-c{clients}", f"-d{duration:g}s", "-s", f.name, target]
         out = subprocess.run(cmd, capture_output=True, text=True, timeout=duration + 60).stdout
     finally:
         stop_server(proc)
         os.unlink(f.name)
-    m = re.search(r"JIK requests=(\d+) failed=(\d+) socket=(\d+) p50=([\d.]+) p99=([\d.]+) "
-                  r"seconds=([\d.]+)", out)  # fmt: skip
+    m = re.search(
+        r"JIK requests=(\d+) failed=(\d+) socket=(\d+) p50=([\d.]+) p99=([\d.]+) "
+        r"seconds=([\d.]+)",
+        out,
+    )
     if m is None:
         raise RuntimeError(f"could not read wrk's output: {out[-500:]}")
     n, failed, sock, p50, p99, secs = (float(g) for g in m.groups())
@@ -281,19 +299,35 @@ def main(quick: bool = False) -> dict:
         flush=True,
     )
     if not wrk:
-        print("  (install wrk, e.g. apt-get install wrk, for a load generator that does not "
-              "compete with the server for the CPU)")  # fmt: skip
+        print(
+            "  (install wrk, e.g. apt-get install wrk, for a load generator that does not "
+            "compete with the server for the CPU)"
+        )
     results = {}
     runner = run_wrk if wrk else run
     tag = "wrk" if wrk else "httpx"
     plan = [
         ("solve_batched", f"POST /solve batched ({tag})", runner, True, True, duration, "/solve"),
-        ("solve_unbatched", f"POST /solve unbatched ({tag})", runner, False, True, duration,
-         "/solve"),
-        ("solve_route", f"POST /solve batched, route only ({tag})", runner, True, False, duration,
-         "/solve"),
+        (
+            "solve_unbatched",
+            f"POST /solve unbatched ({tag})",
+            runner,
+            False,
+            True,
+            duration,
+            "/solve",
+        ),
+        (
+            "solve_route",
+            f"POST /solve batched, route only ({tag})",
+            runner,
+            True,
+            False,
+            duration,
+            "/solve",
+        ),
         ("health", f"GET /health floor ({tag})", runner, True, True, floor, "/health"),
-    ]  # fmt: skip
+    ]
     if wrk:
         plan.append(
             ("httpx_batched", "POST /solve batched (httpx)", run, True, True, floor, "/solve")

@@ -68,16 +68,22 @@ async def _pebble(duration: float, clients: int, batching: bool) -> dict:
     try:
         import pebble
     except ImportError:  # (the comparison's library only: pip install pebble)
-        return {"throughput_rps": float("nan"), "p50_ms": float("nan"),
-                "p99_ms": float("nan"), "errors": "pebble is not installed"}  # fmt: skip
+        return {
+            "throughput_rps": float("nan"),
+            "p50_ms": float("nan"),
+            "p99_ms": float("nan"),
+            "errors": "pebble is not installed",
+        }
 
     from jik.app.compute.worker import solve_batch
     from jik.engine.atlas_backends import limit_memory
 
     pool = pebble.ProcessPool(
-        max_workers=2, initializer=limit_memory, initargs=(1024,),
+        max_workers=2,
+        initializer=limit_memory,
+        initargs=(1024,),
         context=multiprocessing.get_context("spawn"),
-    )  # fmt: skip
+    )
     try:
         await asyncio.wrap_future(pool.schedule(solve_batch, args=([],)))  # (workers up)
         slots = asyncio.Semaphore(2)
@@ -137,12 +143,17 @@ def main(quick: bool = False) -> dict:
     results = {}
     for label, make in runs.items():
         r = results[label] = asyncio.run(make())
-        print(f"{label:24s} {r['throughput_rps']:7.0f} req/s  p50 {r['p50_ms']:6.1f} ms  "
-              f"p99 {r['p99_ms']:6.1f} ms  errors {r['errors']}", flush=True)  # fmt: skip
+        print(
+            f"{label:24s} {r['throughput_rps']:7.0f} req/s  p50 {r['p50_ms']:6.1f} ms  "
+            f"p99 {r['p99_ms']:6.1f} ms  errors {r['errors']}",
+            flush=True,
+        )
     for kind in ("batched", "one per task"):
         j, p = results[f"jik pool, {kind}"], results[f"pebble, {kind}"]
-        print(f"  {kind}: pebble / jik throughput {p['throughput_rps'] / j['throughput_rps']:.2f}, "
-              f"p50 {p['p50_ms'] / j['p50_ms']:.2f}")  # fmt: skip
+        print(
+            f"  {kind}: pebble / jik throughput {p['throughput_rps'] / j['throughput_rps']:.2f}, "
+            f"p50 {p['p50_ms'] / j['p50_ms']:.2f}"
+        )
     return results
 
 

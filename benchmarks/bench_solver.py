@@ -117,11 +117,17 @@ def run(quick: bool = False) -> dict:
     cold_t = median_time(lambda: cycles_leg_by_leg(ext, X0, 3, guessed=False), rep)
     warm_t = median_time(lambda: cycles_leg_by_leg(ext, X0, 3, guessed=True), rep)
     pinv = {
-        how: (cycles_leg_by_leg(inv, X0, 3, guessed=how == "cycle", chained=how == "chain"),
-              median_time(lambda h=how: cycles_leg_by_leg(inv, X0, 3, guessed=h == "cycle",
-                                                          chained=h == "chain"), rep))
+        how: (
+            cycles_leg_by_leg(inv, X0, 3, guessed=how == "cycle", chained=how == "chain"),
+            median_time(
+                lambda h=how: cycles_leg_by_leg(
+                    inv, X0, 3, guessed=h == "cycle", chained=h == "chain"
+                ),
+                rep,
+            ),
+        )
         for how in ("cold", "cycle", "chain")
-    }  # fmt: skip
+    }
     return {
         "pinv_cycles": {
             "legs": len(pinv["cold"][0][0]),

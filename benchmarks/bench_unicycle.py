@@ -108,13 +108,15 @@ def run(quick: bool = False) -> dict:
     n = len(points)
     out: dict = {
         "h_and_gradient": {
-            "jik_ms": 1e3 * fw / n, "jik_cpu_ms": 1e3 * fc / n,
-            "straightforward_ms": 1e3 * sw / n, "straightforward_cpu_ms": 1e3 * sc / n,
+            "jik_ms": 1e3 * fw / n,
+            "jik_cpu_ms": 1e3 * fc / n,
+            "straightforward_ms": 1e3 * sw / n,
+            "straightforward_cpu_ms": 1e3 * sc / n,
             "ratio": sw / fw,
             "max_h_difference": float(np.max(np.abs(np.subtract(fh, sh)))),
             "max_gradient_difference": float(np.max(np.abs(np.subtract(fg, sg)))),
         },
-    }  # fmt: skip
+    }
 
     def fast_run():
         inv = ExtendedInverse(kin, UnicycleCharacteristics(kin, a=repro.A_PARAMETER))
@@ -124,19 +126,26 @@ def run(quick: bool = False) -> dict:
     inv_slow = ExtendedInverse(kin, slow)
     pw, _pc, _ = _timed(
         lambda: solve(
-            inv_slow, lam0, repro.Y_D, gamma=repro.GAMMA, mode="discrete", tol=repro.TOL,
-            max_iterations=PREFIX_ITERATIONS, record=False,
+            inv_slow,
+            lam0,
+            repro.Y_D,
+            gamma=repro.GAMMA,
+            mode="discrete",
+            tol=repro.TOL,
+            max_iterations=PREFIX_ITERATIONS,
+            record=False,
         ),
         1,
-    )  # fmt: skip
+    )
     per_iteration = pw / (PREFIX_ITERATIONS + 1)  # the solver also checks the start point
     out["extended_run_a"] = {
         "iterations": int(res.nit),
-        "jik_s": rw, "jik_cpu_s": rc,
+        "jik_s": rw,
+        "jik_cpu_s": rc,
         "straightforward_s_extrapolated": per_iteration * (res.nit + 1),
         "straightforward_prefix_iterations": PREFIX_ITERATIONS,
         "ratio": per_iteration * (res.nit + 1) / rw,
-    }  # fmt: skip
+    }
     qw, qc, _ = _timed(repro.run, 1)
     out["reproduction"] = {"jik_s": qw, "jik_cpu_s": qc}
     out["targets"] = TARGETS
@@ -152,13 +161,31 @@ def main(quick: bool = False) -> None:
     r = run(quick=quick)
     hg, ra, rp = r["h_and_gradient"], r["extended_run_a"], r["reproduction"]
     rows = [
-        ("h + dh, one point (ms)", hg["jik_ms"], hg["jik_cpu_ms"], hg["straightforward_ms"],
-         hg["ratio"], TARGETS["h_and_gradient_ms"]),
-        (f"extended run from A, {ra['iterations']} it. (s)", ra["jik_s"], ra["jik_cpu_s"],
-         ra["straightforward_s_extrapolated"], ra["ratio"], TARGETS["extended_run_a_s"]),
-        ("whole reproduction (s)", rp["jik_s"], rp["jik_cpu_s"], float("nan"), float("nan"),
-         TARGETS["reproduction_s"]),
-    ]  # fmt: skip
+        (
+            "h + dh, one point (ms)",
+            hg["jik_ms"],
+            hg["jik_cpu_ms"],
+            hg["straightforward_ms"],
+            hg["ratio"],
+            TARGETS["h_and_gradient_ms"],
+        ),
+        (
+            f"extended run from A, {ra['iterations']} it. (s)",
+            ra["jik_s"],
+            ra["jik_cpu_s"],
+            ra["straightforward_s_extrapolated"],
+            ra["ratio"],
+            TARGETS["extended_run_a_s"],
+        ),
+        (
+            "whole reproduction (s)",
+            rp["jik_s"],
+            rp["jik_cpu_s"],
+            float("nan"),
+            float("nan"),
+            TARGETS["reproduction_s"],
+        ),
+    ]
     print(f"{'':36}{'jik':>10}{'jik cpu':>10}{'straightfwd':>13}{'ratio':>9}{'target':>9}")
     for label, a, b, c, d, t in rows:
         print(f"{label:36}{a:10.3g}{b:10.3g}{c:13.3g}{d:9.1f}{t:9.3g}")

@@ -114,9 +114,14 @@ def run(quick: bool = False) -> dict | None:
     agree = max(np.abs(k - kp).max(), np.abs(J - Jp).max())
     reps, calls = (5, 100) if quick else (40, 200)
     one = _interleaved(
-        {"jik": lambda: kin.forward_jacobian(x), "pinocchio": lambda: pose.forward_jacobian(x),
-         "pinocchio_se3": lambda: pose.se3(x)}, calls, reps,
-    )  # fmt: skip
+        {
+            "jik": lambda: kin.forward_jacobian(x),
+            "pinocchio": lambda: pose.forward_jacobian(x),
+            "pinocchio_se3": lambda: pose.se3(x),
+        },
+        calls,
+        reps,
+    )
     reps = 3 if quick else 9
     X = np.array(arm.home) + np.random.default_rng(8).uniform(-0.5, 0.5, (4096, 7))
     loop_n = 512 if quick else 4096
@@ -134,8 +139,14 @@ def run(quick: bool = False) -> dict | None:
     for method in ("RK45", "DOP853"):
         leg[f"solve_ivp_{method}"] = _median(lambda m=method: _pinocchio_leg(pose, x0, y_d, m), 3)
         ends[method], _ = _pinocchio_leg(pose, x0, y_d, method)
-    return {"agree": agree, "one": one, "batch": batch, "leg": leg, "success": res.success,
-            "leg_gap": max(np.abs(ends["jik"] - e).max() for e in ends.values())}  # fmt: skip
+    return {
+        "agree": agree,
+        "one": one,
+        "batch": batch,
+        "leg": leg,
+        "success": res.success,
+        "leg_gap": max(np.abs(ends["jik"] - e).max() for e in ends.values()),
+    }
 
 
 def main(quick: bool = False) -> None:
@@ -146,18 +157,27 @@ def main(quick: bool = False) -> None:
     print(f"Franka Panda, pose task (6 x 7): jik and Pinocchio agree to {r['agree']:.1e}")
     print("one configuration, k and J:")
     print(f"  jik                      {one['jik'] * 1e6:8.1f} us")
-    print(f"  Pinocchio (same k, J)    {one['pinocchio'] * 1e6:8.1f} us   "
-          f"jik / Pinocchio = {one['jik'] / one['pinocchio']:.2f}")  # fmt: skip
-    print(f"  Pinocchio SE(3) only     {one['pinocchio_se3'] * 1e6:8.1f} us   "
-          f"jik / that = {one['jik'] / one['pinocchio_se3']:.2f}")  # fmt: skip
+    print(
+        f"  Pinocchio (same k, J)    {one['pinocchio'] * 1e6:8.1f} us   "
+        f"jik / Pinocchio = {one['jik'] / one['pinocchio']:.2f}"
+    )
+    print(
+        f"  Pinocchio SE(3) only     {one['pinocchio_se3'] * 1e6:8.1f} us   "
+        f"jik / that = {one['jik'] / one['pinocchio_se3']:.2f}"
+    )
     print("4096 configurations, per configuration:")
     print(f"  jik, one batched call    {batch['jik'] * 1e6:8.2f} us")
-    print(f"  Pinocchio, Python loop   {batch['pinocchio_loop'] * 1e6:8.2f} us   "
-          f"loop / jik = {batch['pinocchio_loop'] / batch['jik']:.1f}")  # fmt: skip
-    print(f"one pose leg of (7), pseudoinverse, to error {TOL:g} "
-          f"(ends agree to {r['leg_gap']:.1e}; jik converged: {r['success']}):")  # fmt: skip
+    print(
+        f"  Pinocchio, Python loop   {batch['pinocchio_loop'] * 1e6:8.2f} us   "
+        f"loop / jik = {batch['pinocchio_loop'] / batch['jik']:.1f}"
+    )
+    print(
+        f"one pose leg of (7), pseudoinverse, to error {TOL:g} "
+        f"(ends agree to {r['leg_gap']:.1e}; jik converged: {r['success']}):"
+    )
     print(f"  jik solve                {leg['jik'] * 1e3:8.2f} ms")
     for method in ("RK45", "DOP853"):
         t = leg[f"solve_ivp_{method}"]
-        print(f"  solve_ivp {method:6s} + Pin. {t * 1e3:8.2f} ms   "
-              f"that / jik = {t / leg['jik']:.1f}")  # fmt: skip
+        print(
+            f"  solve_ivp {method:6s} + Pin. {t * 1e3:8.2f} ms   that / jik = {t / leg['jik']:.1f}"
+        )

@@ -45,8 +45,11 @@ def jik_serve(**env: str) -> Iterator[Served]:
     out = tempfile.TemporaryFile("w+")
     proc = subprocess.Popen(
         [sys.executable, "-m", "jik", "serve", f"--port={port}"],
-        env={**os.environ, **env}, stdout=out, stderr=subprocess.STDOUT, text=True,
-    )  # fmt: skip
+        env={**os.environ, **env},
+        stdout=out,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
     served = Served(port, f"http://127.0.0.1:{port}", proc)
     try:
         deadline = time.monotonic() + 60

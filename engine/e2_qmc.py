@@ -111,6 +111,9 @@ def e2_qmc(
     }
     e2 = None if undefined else float(w * total)
     return {
-        "E2": e2, "undefined_points": undefined, "single_joint": single, "nodes": nodes,
+        "E2": e2,
+        "undefined_points": undefined,
+        "single_joint": single,
+        "nodes": nodes,
         "seed": seed,
-    }  # fmt: skip
+    }

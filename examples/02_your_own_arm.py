@@ -25,10 +25,14 @@ print(f"{arm.p} joints, task of {arm.r} coordinates; k(x0) = {arm.forward(x0).ro
 print(jik.solve(jik.Pseudoinverse(arm), x0, [1.0, 1.5]))
 
 # The same arm with an augmenting map h, from a dict (a JSON or YAML robot file holds this).
-robot = jik.robot_from_dict({
-    "name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6],
-    "augmentations": [{"name": "formula", "h": "x3 - x2"}],
-})  # fmt: skip
+robot = jik.robot_from_dict(
+    {
+        "name": "planar_chain",
+        "joints": "RRR",
+        "lengths": [1.0, 0.8, 0.6],
+        "augmentations": [{"name": "formula", "h": "x3 - x2"}],
+    }
+)
 path = [(1.0, 1.3), (1.0, 1.7), (0.6, 1.7)]
 for algorithm in ("pseudoinverse", "extended"):
     run = jik.repeatability(robot.inverse(algorithm), x0, path, cycles=args.cycles)

@@ -23,8 +23,15 @@ args = parser.parse_args()
 arm = jik.Manipulator2()
 inverses = [jik.Pseudoinverse(arm), jik.ExtendedInverse(arm, jik.PaperCubic())]
 loop = [(0, 1), (1, 1), (1, 2), (0, 2)]
-plan = jik.plan_atlas(inverses, loop, cycles=args.cycles, n_starts=args.starts, arc=(-1.0, 1.0),
-                      reference=[0.0, 0.0, np.pi / 2], chunk=16)  # fmt: skip
+plan = jik.plan_atlas(
+    inverses,
+    loop,
+    cycles=args.cycles,
+    n_starts=args.starts,
+    arc=(-1.0, 1.0),
+    reference=[0.0, 0.0, np.pi / 2],
+    chunk=16,
+)
 
 
 class Report(jik.Progress):
@@ -37,11 +44,15 @@ print(atlas)
 for a, name in enumerate(atlas.algorithms):
     ok = atlas.success[a, 0]
     last = atlas.drift[a, 0, ok, -1]
-    print(f"{name:14s} {ok.sum()} of {ok.size} runs completed; drift after cycle {args.cycles}: "
-          f"min {last.min():.2e}, max {last.max():.2e}")  # fmt: skip
+    print(
+        f"{name:14s} {ok.sum()} of {ok.size} runs completed; drift after cycle {args.cycles}: "
+        f"min {last.min():.2e}, max {last.max():.2e}"
+    )
 # A run that stops says why (here: starts where the cubic (38) makes [J; dh] singular).
 for (a, _, start), why in list(atlas.failures.items())[:2]:
     print(f"  {atlas.algorithms[a]} from s = {atlas.parameter[start]:+.3f}: {why}")
 worst = int(np.argmax(atlas.drift[0, 0, :, -1]))
-print(f"The pseudoinverse drifts most from s = {atlas.parameter[worst]:+.3f}, "
-      f"x0 = {atlas.starts[0, worst].round(4)}")  # fmt: skip
+print(
+    f"The pseudoinverse drifts most from s = {atlas.parameter[worst]:+.3f}, "
+    f"x0 = {atlas.starts[0, worst].round(4)}"
+)

@@ -20,8 +20,15 @@ args = parser.parse_args()
 
 arm = jik.Manipulator2()
 loop = [(0, 1), (1, 1), (1, 2), (0, 2)]
-plan = jik.plan_atlas([jik.Pseudoinverse(arm)], loop, cycles=2, n_starts=args.starts,
-                      arc=(-1.0, 1.0), reference=[0.0, 0.0, np.pi / 2], chunk=32)  # fmt: skip
+plan = jik.plan_atlas(
+    [jik.Pseudoinverse(arm)],
+    loop,
+    cycles=2,
+    n_starts=args.starts,
+    arc=(-1.0, 1.0),
+    reference=[0.0, 0.0, np.pi / 2],
+    chunk=32,
+)
 
 if __name__ == "__main__":  # (Dask's local workers are processes that import this file)
     on_dask = jik.run_atlas(plan, backend=f"dask:{args.scheduler}")

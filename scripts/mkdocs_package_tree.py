@@ -21,8 +21,12 @@ def lay_out() -> None:
     pyproject = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
     shutil.rmtree(TREE, ignore_errors=True)
     for package, folder in sorted(pyproject["tool"]["setuptools"]["package-dir"].items()):
-        shutil.copytree(ROOT / folder, TREE.joinpath(*package.split(".")), dirs_exist_ok=True,
-                        ignore=shutil.ignore_patterns("__pycache__"))  # fmt: skip
+        shutil.copytree(
+            ROOT / folder,
+            TREE.joinpath(*package.split(".")),
+            dirs_exist_ok=True,
+            ignore=shutil.ignore_patterns("__pycache__"),
+        )
 
 
 # (at import: mkdocs loads hooks with the configuration, before any plugin reads the paths)

@@ -21,16 +21,31 @@ ROOT = Path(__file__).resolve().parents[1]
 def wheel_of(symlinks: bool, scratch: Path) -> dict[str, str]:
     """The files of the wheel built from a fresh clone of HEAD: name -> sha256."""
     checkout = scratch / f"symlinks-{symlinks}"
-    subprocess.run(["git", "clone", "-q", "--no-hardlinks", "-c",
-                    f"core.symlinks={str(symlinks).lower()}", str(ROOT), str(checkout)],
-                   check=True)  # fmt: skip
+    subprocess.run(
+        [
+            "git",
+            "clone",
+            "-q",
+            "--no-hardlinks",
+            "-c",
+            f"core.symlinks={str(symlinks).lower()}",
+            str(ROOT),
+            str(checkout),
+        ],
+        check=True,
+    )
     out = scratch / f"wheel-{symlinks}"
-    subprocess.run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(out),
-                    str(checkout)], check=True)  # fmt: skip
+    subprocess.run(
+        [sys.executable, "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(out), str(checkout)],
+        check=True,
+    )
     (built,) = out.glob("*.whl")
     with zipfile.ZipFile(built) as z:
-        return {n: hashlib.sha256(z.read(n)).hexdigest() for n in z.namelist()
-                if not n.endswith("/RECORD")}  # fmt: skip
+        return {
+            n: hashlib.sha256(z.read(n)).hexdigest()
+            for n in z.namelist()
+            if not n.endswith("/RECORD")
+        }
 
 
 def main() -> int:
@@ -39,8 +54,10 @@ def main() -> int:
     differ = sorted(n for n in linked.keys() & plain.keys() if linked[n] != plain[n])
     missing, extra = sorted(linked.keys() - plain.keys()), sorted(plain.keys() - linked.keys())
     if differ or missing or extra:
-        print(f"core.symlinks=false builds another wheel: missing {missing}, extra {extra}, "
-              f"different {differ}")  # fmt: skip
+        print(
+            f"core.symlinks=false builds another wheel: missing {missing}, extra {extra}, "
+            f"different {differ}"
+        )
         return 1
     print(f"core.symlinks=false builds the same wheel: {len(linked)} files")
     return 0

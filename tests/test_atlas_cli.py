@@ -19,8 +19,21 @@ TABLE1 = "1,1; 1,2; 0,2; 0,1"
 
 
 def run(tmp_path, *extra, out="atlas.json"):
-    argv = ["atlas", "--robot", "manipulator2", "--path", TABLE1, "--starts", "12", "--cycles",
-            "2", "--quiet", "--out", str(tmp_path / out), *extra]  # fmt: skip
+    argv = [
+        "atlas",
+        "--robot",
+        "manipulator2",
+        "--path",
+        TABLE1,
+        "--starts",
+        "12",
+        "--cycles",
+        "2",
+        "--quiet",
+        "--out",
+        str(tmp_path / out),
+        *extra,
+    ]
     assert main(argv) == 0
     return json.loads((tmp_path / out).read_text())
 
@@ -37,8 +50,10 @@ def test_json_holds_inputs_starts_drift_and_leg_ends(tmp_path):
     kin = Manipulator2()
     np.testing.assert_allclose(kin.forward(starts), np.ones((12, 2)), rtol=0, atol=1e-13)
     path = [(1.0, 2.0), (0.0, 2.0), (0.0, 1.0)]
-    for alg, inverse in (("pseudoinverse", Pseudoinverse(kin)),
-                         ("extended", ExtendedInverse(kin, PaperCubic()))):  # fmt: skip
+    for alg, inverse in (
+        ("pseudoinverse", Pseudoinverse(kin)),
+        ("extended", ExtendedInverse(kin, PaperCubic())),
+    ):
         res = doc["results"][alg]
         assert np.shape(res["drift"]) == (12, 2) and np.shape(res["leg_ends"]) == (12, 8, 3)
         for i in (0, 7):
@@ -59,8 +74,17 @@ def test_json_holds_inputs_starts_drift_and_leg_ends(tmp_path):
 def test_a_large_atlas_streams_to_csv_and_the_json_keeps_a_summary(tmp_path, monkeypatch):
     """Past JSON_RUNS the arrays go to the CSV, in run order, whatever order chunks finish in."""
     monkeypatch.setattr(atlas_cli, "JSON_RUNS", 10)
-    doc = run(tmp_path, "--chunk", "5", "--shift", "0,0", "--shift", "0.2,0", "--no-figure",
-              "--no-leg-ends")  # fmt: skip
+    doc = run(
+        tmp_path,
+        "--chunk",
+        "5",
+        "--shift",
+        "0,0",
+        "--shift",
+        "0.2,0",
+        "--no-figure",
+        "--no-leg-ends",
+    )
     assert "results" not in doc and doc["figure"] is None
     assert doc["summary"]["pseudoinverse"]["converged_runs"] == 24
     assert len(doc["paths"]) == 2
@@ -78,9 +102,11 @@ def test_processes_give_the_in_process_numbers(tmp_path):
     there = run(tmp_path, "--no-figure", "--processes", "2", "--chunk", "4", out="b.json")
     assert there["inputs"]["backend"] == "processes:2"
     np.testing.assert_allclose(
-        there["results"]["pseudoinverse"]["drift"], here["results"]["pseudoinverse"]["drift"],
-        rtol=0, atol=1e-12,
-    )  # fmt: skip
+        there["results"]["pseudoinverse"]["drift"],
+        here["results"]["pseudoinverse"]["drift"],
+        rtol=0,
+        atol=1e-12,
+    )
 
 
 def test_arc_and_sampling_set_the_starts(tmp_path):
@@ -136,8 +162,12 @@ def test_a_path_that_is_not_numbers_is_refused(tmp_path):
         main(["atlas", "--path", "1,a; 2,2", "--out", str(tmp_path / "x.json")])
 
 
-ARM = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6],
-       "augmentations": [{"name": "formula", "h": "x1 + x3"}]}  # fmt: skip
+ARM = {
+    "name": "planar_chain",
+    "joints": "RRR",
+    "lengths": [1.0, 0.8, 0.6],
+    "augmentations": [{"name": "formula", "h": "x1 + x3"}],
+}
 
 
 def test_a_robot_file_runs_as_the_engine_builds_it(tmp_path):
@@ -147,10 +177,28 @@ def test_a_robot_file_runs_as_the_engine_builds_it(tmp_path):
 
     (tmp_path / "arm.json").write_text(json.dumps(ARM))
     path = "1.2,1.2; 1.2,1.6; 0.8,1.6"
-    argv = ["atlas", "--robot", str(tmp_path / "arm.json"), "--path", path, "--reference",
-            "0.3, 1, 1", "--arc=-0.5,0.5", "--starts", "5", "--cycles", "2", "--algorithm",
-            "pseudoinverse", "--algorithm", "extended", "--quiet", "--no-figure", "--out",
-            str(tmp_path / "a.json")]  # fmt: skip
+    argv = [
+        "atlas",
+        "--robot",
+        str(tmp_path / "arm.json"),
+        "--path",
+        path,
+        "--reference",
+        "0.3, 1, 1",
+        "--arc=-0.5,0.5",
+        "--starts",
+        "5",
+        "--cycles",
+        "2",
+        "--algorithm",
+        "pseudoinverse",
+        "--algorithm",
+        "extended",
+        "--quiet",
+        "--no-figure",
+        "--out",
+        str(tmp_path / "a.json"),
+    ]
     assert main(argv) == 0
     doc = json.loads((tmp_path / "a.json").read_text())
     assert doc["inputs"]["robot"] == "planar_chain"
@@ -163,16 +211,27 @@ def test_a_robot_file_runs_as_the_engine_builds_it(tmp_path):
         inverse = robot.inverse(alg)
         for i in (0, 4):
             rep = repeatability(inverse, starts[i], legs, cycles=2)
-            np.testing.assert_allclose(doc["results"][alg]["drift"][i], rep.drift, rtol=0,
-                                       atol=1e-10)  # fmt: skip
+            np.testing.assert_allclose(
+                doc["results"][alg]["drift"][i], rep.drift, rtol=0, atol=1e-10
+            )
     assert max(doc["results"]["extended"]["drift"][0]) < 1e-9
     assert min(doc["results"]["pseudoinverse"]["drift"][0]) > 1e-4
 
 
 def test_a_robot_file_takes_no_param(tmp_path, capsys):
     (tmp_path / "arm.json").write_text(json.dumps(ARM))
-    argv = ["atlas", "--robot", str(tmp_path / "arm.json"), "--param", "l=2", "--path",
-            "1.2,1.2; 1.2,1.6", "--quiet", "--out", str(tmp_path / "x.json")]  # fmt: skip
+    argv = [
+        "atlas",
+        "--robot",
+        str(tmp_path / "arm.json"),
+        "--param",
+        "l=2",
+        "--path",
+        "1.2,1.2; 1.2,1.6",
+        "--quiet",
+        "--out",
+        str(tmp_path / "x.json"),
+    ]
     assert main(argv) == 2
     assert "--param is for a built-in robot" in capsys.readouterr().err
 
@@ -185,8 +244,26 @@ def test_a_catalogue_arm_counts_the_starts_that_leave_its_limits(tmp_path):
     from jik.engine.robot_spec import robot_from_dict
 
     path = "0.3069,0,0.5903,0,0,0; 0.38,0,0.59,0,0,0.2; 0.38,0.08,0.59,0.15,0,0.2"
-    assert main(["atlas", "--robot", "panda", "--path", path, "--starts", "16", "--cycles", "1",
-                 "--out", str(tmp_path / "a.json"), "--no-figure", "--quiet"]) == 0  # fmt: skip
+    assert (
+        main(
+            [
+                "atlas",
+                "--robot",
+                "panda",
+                "--path",
+                path,
+                "--starts",
+                "16",
+                "--cycles",
+                "1",
+                "--out",
+                str(tmp_path / "a.json"),
+                "--no-figure",
+                "--quiet",
+            ]
+        )
+        == 0
+    )
     doc = json.loads((tmp_path / "a.json").read_text())
     count = doc["summary"]["pseudoinverse"]["outside_limits"]
     limits = robot_limits(robot_from_dict({"name": "panda"}).kinematics)
@@ -207,15 +284,40 @@ def test_a_catalogue_arm_takes_a_task(tmp_path, capsys):
     loop = [y0, y0 + [0.04, 0, 0, 0, 0], y0 + [0.04, 0.04, 0, 0.1, 0]]
     path = "; ".join(",".join(f"{v:.6f}" for v in y) for y in loop)
     out = tmp_path / "ur5e.json"
-    argv = ["atlas", "--robot", "ur5e", "--task", "x y z rx ry", "--path", path, "--starts",
-            "4", "--cycles", "1", "--arc=-0.2,0.2", "--out", str(out), "--no-figure",
-            "--quiet"]  # fmt: skip
+    argv = [
+        "atlas",
+        "--robot",
+        "ur5e",
+        "--task",
+        "x y z rx ry",
+        "--path",
+        path,
+        "--starts",
+        "4",
+        "--cycles",
+        "1",
+        "--arc=-0.2,0.2",
+        "--out",
+        str(out),
+        "--no-figure",
+        "--quiet",
+    ]
     assert main(argv) == 0, capsys.readouterr().err
     doc = json.loads(out.read_text())
     assert doc["inputs"]["task"] == ["x", "y", "z", "rx", "ry"] and len(doc["starts"][0]) == 6
     assert doc["summary"]["pseudoinverse"]["outside_limits"] == 0
-    argv = ["atlas", "--robot", "manipulator2", "--task", "xyz", "--path", "1,1; 1,2",
-            "--quiet", "--out", str(tmp_path / "m.json")]  # fmt: skip
+    argv = [
+        "atlas",
+        "--robot",
+        "manipulator2",
+        "--task",
+        "xyz",
+        "--path",
+        "1,1; 1,2",
+        "--quiet",
+        "--out",
+        str(tmp_path / "m.json"),
+    ]
     assert main(argv) == 2
     assert "--task is for a catalogue arm" in capsys.readouterr().err
 
@@ -227,21 +329,46 @@ def test_a_urdf_arm_in_a_robot_file_equals_the_catalogue_arm(tmp_path):
     from jik.engine.arms import ARMS
 
     arm = ARMS["panda"]
-    definition = {"name": "urdf", "urdf": arm.urdf, "end_link": arm.end_link,
-                  "home": list(arm.home), "task": "pose"}  # fmt: skip
+    definition = {
+        "name": "urdf",
+        "urdf": arm.urdf,
+        "end_link": arm.end_link,
+        "home": list(arm.home),
+        "task": "pose",
+    }
     (tmp_path / "panda.json").write_text(json.dumps(definition))
     path = "0.3069,0,0.5903,0,0,0; 0.38,0,0.59,0,0,0.2; 0.38,0.08,0.59,0.15,0,0.2"
     docs = []
     for robot in ("panda", str(tmp_path / "panda.json")):
         out = tmp_path / f"{len(docs)}.json"
-        assert main(["atlas", "--robot", robot, "--path", path, "--starts", "6", "--cycles", "1",
-                     "--out", str(out), "--no-figure", "--quiet"]) == 0  # fmt: skip
+        assert (
+            main(
+                [
+                    "atlas",
+                    "--robot",
+                    robot,
+                    "--path",
+                    path,
+                    "--starts",
+                    "6",
+                    "--cycles",
+                    "1",
+                    "--out",
+                    str(out),
+                    "--no-figure",
+                    "--quiet",
+                ]
+            )
+            == 0
+        )
         docs.append(json.loads(out.read_text()))
     by_name, by_file = docs
     np.testing.assert_allclose(by_name["starts"], by_file["starts"], atol=1e-12)
-    np.testing.assert_allclose(np.array(by_name["results"]["pseudoinverse"]["drift"], float),
-                               np.array(by_file["results"]["pseudoinverse"]["drift"], float),
-                               atol=1e-12)  # fmt: skip
+    np.testing.assert_allclose(
+        np.array(by_name["results"]["pseudoinverse"]["drift"], float),
+        np.array(by_file["results"]["pseudoinverse"]["drift"], float),
+        atol=1e-12,
+    )
     assert by_name["summary"] == by_file["summary"]
 
 
@@ -254,14 +381,37 @@ def test_without_path_the_robot_s_closed_path_is_the_loop(tmp_path, capsys):
     from jik.engine.robot_spec import robot_from_dict
 
     out = tmp_path / "panda.json"
-    argv = ["atlas", "--robot", "panda", "--task", "x y z rx ry rz", "--starts", "2",
-            "--cycles", "1", "--out", str(out), "--no-figure", "--quiet"]  # fmt: skip
+    argv = [
+        "atlas",
+        "--robot",
+        "panda",
+        "--task",
+        "x y z rx ry rz",
+        "--starts",
+        "2",
+        "--cycles",
+        "1",
+        "--out",
+        str(out),
+        "--no-figure",
+        "--quiet",
+    ]
     assert main(argv) == 0, capsys.readouterr().err
     spec = robot_from_dict({"name": "panda", "task": "pose"}).spec
     assert json.loads(out.read_text())["inputs"]["path"] == [list(p) for p in spec.default_path]
     doc = run(tmp_path, out="m2.json")  # (with Table 1's loop, the default path of manipulator2)
-    argv = ["atlas", "--robot", "manipulator2", "--starts", "12", "--cycles", "2", "--quiet",
-            "--out", str(tmp_path / "m2_default.json")]  # fmt: skip
+    argv = [
+        "atlas",
+        "--robot",
+        "manipulator2",
+        "--starts",
+        "12",
+        "--cycles",
+        "2",
+        "--quiet",
+        "--out",
+        str(tmp_path / "m2_default.json"),
+    ]
     assert main(argv) == 0
     default = json.loads((tmp_path / "m2_default.json").read_text())
     assert default["inputs"]["path"] == [list(p) for p in ROBOTS["manipulator2"].default_path]
@@ -273,9 +423,26 @@ def test_without_path_the_robot_s_closed_path_is_the_loop(tmp_path, capsys):
 
 def test_the_progress_bar_counts_the_runs_of_every_algorithm(tmp_path, capsys):
     """8 starts, three algorithms: the bar ends at 24 runs, each start run by each algorithm."""
-    argv = ["atlas", "--robot", "manipulator2", "--path", TABLE1, "--starts", "8", "--cycles",
-            "1", "--algorithm", "pseudoinverse", "--algorithm", "posture", "--algorithm",
-            "damped", "--no-figure", "--out", str(tmp_path / "a.json")]  # fmt: skip
+    argv = [
+        "atlas",
+        "--robot",
+        "manipulator2",
+        "--path",
+        TABLE1,
+        "--starts",
+        "8",
+        "--cycles",
+        "1",
+        "--algorithm",
+        "pseudoinverse",
+        "--algorithm",
+        "posture",
+        "--algorithm",
+        "damped",
+        "--no-figure",
+        "--out",
+        str(tmp_path / "a.json"),
+    ]
     assert main(argv) == 0
     err = capsys.readouterr().err
     assert "24/24 runs (8 starts x 3 algorithms)" in err and "8/8 runs" not in err

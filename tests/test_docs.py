@@ -16,8 +16,11 @@ def test_the_api_reference_builds_strictly_with_local_assets_only(tmp_path):
     site = tmp_path / "site"
     out = subprocess.run(
         [sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(site)],
-        capture_output=True, text=True, cwd=ROOT, timeout=300,
-    )  # fmt: skip
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=300,
+    )
     assert out.returncode == 0, out.stderr
     solving = (site / "api" / "solving" / "index.html").read_text(encoding="utf-8")
     assert "solve_batch" in solving and "BatchSolveResult" in solving

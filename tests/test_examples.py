@@ -23,8 +23,11 @@ FAST = {
 def run(name: str) -> str:
     out = subprocess.run(
         [sys.executable, str(EXAMPLES / name), *FAST[name]],
-        capture_output=True, text=True, timeout=300, cwd=ROOT,
-    )  # fmt: skip
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=ROOT,
+    )
     assert out.returncode == 0, out.stdout + out.stderr
     return out.stdout
 
@@ -90,8 +93,9 @@ def test_the_readmes_first_python_example_runs_with_one_import():
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
     code = re.search(r"```python\n(.*?)```", readme, flags=re.S).group(1)
     imports = [line for line in code.splitlines() if line.startswith(("import ", "from "))]
-    assert imports == ["import jik.engine as jik  # help(jik) lists the API; examples/ holds "
-                       "runnable scripts"]  # fmt: skip
+    assert imports == [
+        "import jik.engine as jik  # help(jik) lists the API; examples/ holds runnable scripts"
+    ]
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT)
     assert out.returncode == 0, out.stderr
     assert out.stdout.startswith("SolveResult(pseudoinverse, continuous, success=True")

@@ -49,8 +49,19 @@ def run(*cmd: str | Path, cwd: Path, timeout: float = 300, env=None) -> str:
 def wheel(tmp_path_factory) -> Path:
     """The project's wheel, built from the source tree as pip builds it."""
     out = tmp_path_factory.mktemp("wheel")
-    run(sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", out, ROOT, cwd=out,
-        timeout=PIP_SECONDS)  # fmt: skip
+    run(
+        sys.executable,
+        "-m",
+        "pip",
+        "wheel",
+        "--no-deps",
+        "-q",
+        "-w",
+        out,
+        ROOT,
+        cwd=out,
+        timeout=PIP_SECONDS,
+    )
     (built,) = out.glob("jik_lab-*.whl")
     return built
 
@@ -58,22 +69,38 @@ def wheel(tmp_path_factory) -> Path:
 def wheel_files(path: Path) -> dict[str, str]:
     """A wheel's files, name -> sha256 (its RECORD aside: it lists the same hashes)."""
     with zipfile.ZipFile(path) as z:
-        return {n: hashlib.sha256(z.read(n)).hexdigest() for n in z.namelist()
-                if not n.endswith("/RECORD")}  # fmt: skip
+        return {
+            n: hashlib.sha256(z.read(n)).hexdigest()
+            for n in z.namelist()
+            if not n.endswith("/RECORD")
+        }
 
 
 def fresh_env(where: Path) -> tuple[Path, Path]:
     """A new virtual environment at ``where`` (no system site-packages): bin/, site-packages."""
     venv.EnvBuilder(with_pip=True, clear=True).create(where)
     bin_dir = where / "bin"
-    site = run(bin_dir / "python", "-c", "import sysconfig; print(sysconfig.get_path('purelib'))",
-               cwd=where).strip()  # fmt: skip
+    site = run(
+        bin_dir / "python",
+        "-c",
+        "import sysconfig; print(sysconfig.get_path('purelib'))",
+        cwd=where,
+    ).strip()
     return bin_dir, Path(site)
 
 
 def pip_install(bin_dir: Path, *args: str | Path) -> None:
-    run(bin_dir / "python", "-m", "pip", "install", "-q", "--disable-pip-version-check", *args,
-        cwd=bin_dir, timeout=PIP_SECONDS)  # fmt: skip
+    run(
+        bin_dir / "python",
+        "-m",
+        "pip",
+        "install",
+        "-q",
+        "--disable-pip-version-check",
+        *args,
+        cwd=bin_dir,
+        timeout=PIP_SECONDS,
+    )
 
 
 def free_port() -> int:
@@ -108,8 +135,12 @@ def test_wheel_installs_one_package_and_serves(wheel, tmp_path):
     env = {**os.environ, "JIK_WORKERS": "1"}
     server = subprocess.Popen(
         [bin_dir / "jik", "serve", "--port", str(port)],
-        cwd=elsewhere, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-    )  # fmt: skip
+        cwd=elsewhere,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
     try:
         snapshot = first_dashboard_result(f"http://127.0.0.1:{port}", server)
         assert snapshot["summary"], snapshot
@@ -159,8 +190,9 @@ def test_engine_alone_reproduces_table1(wheel, tmp_path):
     )
     table = json.loads(run(bin_dir / "python", "-c", script, cwd=tmp_path))
     assert len(table["pseudoinverse"]) == 5, table
-    serve = subprocess.run([bin_dir / "jik", "serve"], cwd=tmp_path, capture_output=True,
-                           text=True, timeout=60)  # fmt: skip
+    serve = subprocess.run(
+        [bin_dir / "jik", "serve"], cwd=tmp_path, capture_output=True, text=True, timeout=60
+    )
     assert serve.returncode == 2
     assert "pip install 'jik-lab[app]'" in serve.stderr, serve.stderr
 
@@ -169,8 +201,17 @@ def test_sdist_builds_the_same_wheel_without_tests_or_docs(wheel, tmp_path):
     """The sdist holds what builds the wheel, and the wheel pip builds from it is the one built
     from the tree; the tests, docs, scripts and harnesses stay in the repository."""
     pytest.importorskip("build", reason="the build package (of the test extra) builds sdists")
-    run(sys.executable, "-m", "build", "--sdist", "-o", tmp_path, ROOT, cwd=tmp_path,
-        timeout=PIP_SECONDS)  # fmt: skip
+    run(
+        sys.executable,
+        "-m",
+        "build",
+        "--sdist",
+        "-o",
+        tmp_path,
+        ROOT,
+        cwd=tmp_path,
+        timeout=PIP_SECONDS,
+    )
     (sdist,) = tmp_path.glob("jik_lab-*.tar.gz")
     with tarfile.open(sdist) as tar:
         folders = {Path(*Path(n).parts[1:3]) for n in tar.getnames() if len(Path(n).parts) > 2}
@@ -178,7 +219,18 @@ def test_sdist_builds_the_same_wheel_without_tests_or_docs(wheel, tmp_path):
     assert not left_in and Path("benchmarks/harness") not in folders, sorted(left_in)
     assert {Path("engine/reproductions"), Path("app/api")} <= folders, sorted(folders)
     out = tmp_path / "from-sdist"
-    run(sys.executable, "-m", "pip", "wheel", "--no-deps", "-q", "-w", out, sdist, cwd=tmp_path,
-        timeout=PIP_SECONDS)  # fmt: skip
+    run(
+        sys.executable,
+        "-m",
+        "pip",
+        "wheel",
+        "--no-deps",
+        "-q",
+        "-w",
+        out,
+        sdist,
+        cwd=tmp_path,
+        timeout=PIP_SECONDS,
+    )
     (rebuilt,) = out.glob("jik_lab-*.whl")
     assert wheel_files(rebuilt) == wheel_files(wheel)

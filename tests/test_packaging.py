@@ -136,8 +136,9 @@ def test_the_source_tree_holds_no_symlinks():
     """A checkout without symlinks (Windows' default, core.symlinks=false) writes a link as a
     small text file: the package must not depend on one."""
     try:
-        listed = subprocess.run(["git", "ls-files", "-s"], cwd=ROOT, capture_output=True,
-                                text=True, check=True).stdout  # fmt: skip
+        listed = subprocess.run(
+            ["git", "ls-files", "-s"], cwd=ROOT, capture_output=True, text=True, check=True
+        ).stdout
     except (OSError, subprocess.CalledProcessError):
         pytest.skip("not a git checkout")
     links = [line.split("\t")[1] for line in listed.splitlines() if line.startswith("120000")]

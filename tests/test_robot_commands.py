@@ -41,8 +41,9 @@ def test_vectors_and_paths_are_constant_formulas():
 
 
 def test_solve_a_planar_arm_from_a_json_file(capsys, arm_file):
-    out, _ = run(capsys, "solve", "--robot", arm_file, "--x0", "0.3, 1, 1", "--target",
-                 "1, 1.5", "--json")  # fmt: skip
+    out, _ = run(
+        capsys, "solve", "--robot", arm_file, "--x0", "0.3, 1, 1", "--target", "1, 1.5", "--json"
+    )
     res = json.loads(out)
     assert res["success"] and res["algorithm"] == "pseudoinverse"
     np.testing.assert_allclose(res["y"], [1.0, 1.5], atol=1e-10)
@@ -52,8 +53,21 @@ def test_solve_a_planar_arm_from_a_json_file(capsys, arm_file):
 
 def test_repeatability_of_the_synthesized_map_from_a_file(capsys, arm_file):
     path = "1,1.3; 1,1.7; 0.6,1.7"
-    out, _ = run(capsys, "repeatability", "--robot", arm_file, "--x0", "0.3, 1, 1", "--path",
-                 path, "--cycles", "3", "--algorithm", "extended", "--json")  # fmt: skip
+    out, _ = run(
+        capsys,
+        "repeatability",
+        "--robot",
+        arm_file,
+        "--x0",
+        "0.3, 1, 1",
+        "--path",
+        path,
+        "--cycles",
+        "3",
+        "--algorithm",
+        "extended",
+        "--json",
+    )
     res = json.loads(out)
     assert res["success"] and res["algorithm"] == "extended"
     assert len(res["drift"]) == 3 and max(res["drift"]) < 1e-9
@@ -61,12 +75,31 @@ def test_repeatability_of_the_synthesized_map_from_a_file(capsys, arm_file):
 
 
 def test_repeatability_of_a_builtin_robot_reproduces_table1(capsys):
-    out, _ = run(capsys, "repeatability", "--robot", "manipulator2", "--x0", "0, 0, pi/2",
-                 "--path", "1,1; 1,2; 0,2; 0,1", "--json")  # fmt: skip
+    out, _ = run(
+        capsys,
+        "repeatability",
+        "--robot",
+        "manipulator2",
+        "--x0",
+        "0, 0, pi/2",
+        "--path",
+        "1,1; 1,2; 0,2; 0,1",
+        "--json",
+    )
     legs = json.loads(out)["legs"]
     np.testing.assert_allclose(legs, PRINTED["pseudoinverse"][1:], atol=5e-5)
-    text, _ = run(capsys, "repeatability", "--robot", "manipulator2", "--x0", "0, 0, pi/2",
-                  "--path", "1,1; 1,2; 0,2; 0,1", "--cycles", "2")  # fmt: skip
+    text, _ = run(
+        capsys,
+        "repeatability",
+        "--robot",
+        "manipulator2",
+        "--x0",
+        "0, 0, pi/2",
+        "--path",
+        "1,1; 1,2; 0,2; 0,1",
+        "--cycles",
+        "2",
+    )
     assert "cycle 2:" in text and "|x - x0| = 4.612e-01" in text
 
 
@@ -88,8 +121,12 @@ def test_urdf_robot_from_a_yaml_file(capsys, tmp_path):
     yaml = pytest.importorskip("yaml")
     pytest.importorskip("yourdfpy")
     shutil.copy(ARM4, tmp_path / "arm4.urdf")
-    robot = {"name": "urdf", "urdf_file": "arm4.urdf", "end_link": "tool",
-             "x0": [0.3, 0.5, 0.8, 0.6]}  # fmt: skip
+    robot = {
+        "name": "urdf",
+        "urdf_file": "arm4.urdf",
+        "end_link": "tool",
+        "x0": [0.3, 0.5, 0.8, 0.6],
+    }
     (tmp_path / "arm.yaml").write_text(yaml.safe_dump(robot))
     out, _ = run(capsys, "solve", "--robot", str(tmp_path / "arm.yaml"), "--json")
     res = json.loads(out)

@@ -84,9 +84,12 @@ def test_serve_prints_the_dashboards_address_once_it_answers(tmp_path):
         port = s.getsockname()[1]
     server = subprocess.Popen(
         [sys.executable, "-m", "jik", "serve", "--port", str(port)],
-        cwd=tmp_path, env={**os.environ, "JIK_WORKERS": "1"},
-        stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
-    )  # fmt: skip
+        cwd=tmp_path,
+        env={**os.environ, "JIK_WORKERS": "1"},
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+    )
     try:
         assert server.stdout is not None
         ready, _, _ = select.select([server.stdout], [], [], 120)

@@ -42,8 +42,9 @@ def sources() -> list[BuildSource]:
 
 
 def main() -> int:
-    _, options = process_options(["--config-file", str(ROOT / "pyproject.toml")],
-                                 require_targets=False)  # fmt: skip
+    _, options = process_options(
+        ["--config-file", str(ROOT / "pyproject.toml")], require_targets=False
+    )
     try:
         messages = build.build(sources(), options).errors
     except CompileError as error:

@@ -65,9 +65,18 @@ def unparsed_body_response(exc: Exception) -> JSONResponse:
         why = "it is not UTF-8 text"
     else:
         why = "it is not valid JSON"
-    return JSONResponse(status_code=422, content={"detail": [{
-        "loc": ["body"], "msg": f"body: the body cannot be read as JSON: {why}",
-        "type": "json_invalid"}]})  # fmt: skip
+    return JSONResponse(
+        status_code=422,
+        content={
+            "detail": [
+                {
+                    "loc": ["body"],
+                    "msg": f"body: the body cannot be read as JSON: {why}",
+                    "type": "json_invalid",
+                }
+            ]
+        },
+    )
 
 
 def http_error_response(exc: StarletteHTTPException) -> JSONResponse:
@@ -75,21 +84,31 @@ def http_error_response(exc: StarletteHTTPException) -> JSONResponse:
     but its unparsed-body 400 as :func:`unparsed_body_response`."""
     if exc.status_code == 400 and exc.detail == _UNPARSED:
         return unparsed_body_response(exc)
-    return JSONResponse(status_code=exc.status_code, content={"detail": exc.detail},
-                        headers=getattr(exc, "headers", None))  # fmt: skip
+    return JSONResponse(
+        status_code=exc.status_code,
+        content={"detail": exc.detail},
+        headers=getattr(exc, "headers", None),
+    )
 
 
 def invalid_input_response(exc: InvalidInputError) -> JSONResponse:
     """422 for a value the dashboard's model or the engine refused, at the field it names."""
     loc = ["body", *exc.field.split(".")] if exc.field else ["body"]
-    return JSONResponse(status_code=422, content={"detail": [
-        {"loc": loc, "msg": str(exc), "type": "value_error"}]})  # fmt: skip
+    return JSONResponse(
+        status_code=422, content={"detail": [{"loc": loc, "msg": str(exc), "type": "value_error"}]}
+    )
 
 
 def session_not_found_response(exc: SessionNotFound) -> JSONResponse:
-    return JSONResponse(status_code=404, content={"detail": (
-        f"no dashboard session {exc.args[0]!r} (it expired or never existed); "
-        "reload the page to start a new one")})  # fmt: skip
+    return JSONResponse(
+        status_code=404,
+        content={
+            "detail": (
+                f"no dashboard session {exc.args[0]!r} (it expired or never existed); "
+                "reload the page to start a new one"
+            )
+        },
+    )
 
 
 def export_unavailable_response(exc: ExportUnavailable) -> JSONResponse:
@@ -97,8 +116,9 @@ def export_unavailable_response(exc: ExportUnavailable) -> JSONResponse:
 
 
 def sessions_full_response(exc: SessionsFull) -> JSONResponse:
-    return JSONResponse(status_code=503, content={"detail": str(exc)},
-                        headers={"Retry-After": "30"})  # fmt: skip
+    return JSONResponse(
+        status_code=503, content={"detail": str(exc)}, headers={"Retry-After": "30"}
+    )
 
 
 def atlas_job_not_found_response(exc: AtlasJobNotFound) -> JSONResponse:
@@ -107,8 +127,9 @@ def atlas_job_not_found_response(exc: AtlasJobNotFound) -> JSONResponse:
 
 
 def atlas_jobs_full_response(exc: AtlasJobsFull) -> JSONResponse:
-    return JSONResponse(status_code=429, content={"detail": str(exc)},
-                        headers={"Retry-After": "10"})  # fmt: skip
+    return JSONResponse(
+        status_code=429, content={"detail": str(exc)}, headers={"Retry-After": "10"}
+    )
 
 
 def busy_response(exc: ServiceUnavailable) -> JSONResponse:
@@ -157,10 +178,12 @@ def _allowed_methods(request: Request) -> str:
     framework's 405 names only the first one's)."""
     routes = request.app.router.routes
     return ", ".join(
-        method for method in ("DELETE", "GET", "HEAD", "OPTIONS", "PATCH", "POST", "PUT")
-        if any(route.matches({**request.scope, "method": method})[0] == Match.FULL
-               for route in routes)
-    )  # fmt: skip
+        method
+        for method in ("DELETE", "GET", "HEAD", "OPTIONS", "PATCH", "POST", "PUT")
+        if any(
+            route.matches({**request.scope, "method": method})[0] == Match.FULL for route in routes
+        )
+    )
 
 
 def _handler(respond: Callable[[Any], JSONResponse]):
@@ -206,8 +229,9 @@ def document_errors(app: FastAPI) -> None:
                     responses = operation.setdefault("responses", {})
                     extra = dict(_ANY_OPERATION)
                     if method in ("post", "put", "patch", "delete"):
-                        extra |= {k: v for k, v in _WITH_BODY.items() if method != "delete"
-                                  or k == "403"}  # fmt: skip
+                        extra |= {
+                            k: v for k, v in _WITH_BODY.items() if method != "delete" or k == "403"
+                        }
                     if "{session_id}" in path:
                         extra |= _IN_SESSION
                     for status, response in extra.items():

@@ -165,15 +165,27 @@ async def _close_websocket(receive: Receive, send: Send, code: int, reason: str)
 async def _json(send: Send, status: int, message: str) -> None:
     body: dict[str, object]
     if status == 415:
-        body = {"detail": [{"loc": ["header", "content-type"], "msg": message,
-                            "type": "unsupported_media_type"}]}  # fmt: skip
+        body = {
+            "detail": [
+                {
+                    "loc": ["header", "content-type"],
+                    "msg": message,
+                    "type": "unsupported_media_type",
+                }
+            ]
+        }
     else:
         body = {"detail": message}
     data = json.dumps(body).encode()
-    await send({
-        "type": "http.response.start", "status": status,
-        "headers": [(b"content-type", b"application/json"),
-                    (b"content-length", str(len(data)).encode()),
-                    (b"x-content-type-options", b"nosniff")],
-    })  # fmt: skip
+    await send(
+        {
+            "type": "http.response.start",
+            "status": status,
+            "headers": [
+                (b"content-type", b"application/json"),
+                (b"content-length", str(len(data)).encode()),
+                (b"x-content-type-options", b"nosniff"),
+            ],
+        }
+    )
     await send({"type": "http.response.body", "body": data})

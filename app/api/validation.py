@@ -63,8 +63,13 @@ def validation_detail(errors) -> list[dict]:
         elif e.get("type") == "json_invalid":  # (loc: the body and the character's position)
             ctx = e.get("ctx") or {}
             where = f" at character {loc[1]}" if len(loc) > 1 else ""
-            detail.append({"loc": ["body"], "type": "json_invalid", "msg":
-                           f"body: not valid JSON{where}: {ctx.get('error', msg)}"})  # fmt: skip
+            detail.append(
+                {
+                    "loc": ["body"],
+                    "type": "json_invalid",
+                    "msg": f"body: not valid JSON{where}: {ctx.get('error', msg)}",
+                }
+            )
             continue
         elif e.get("type") == "union_tag_invalid":
             ctx = e.get("ctx") or {}

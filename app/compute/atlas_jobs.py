@@ -131,15 +131,17 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
     legs = starts * paths * req.cycles * (len(path) - closed) * len(req.algorithms)
     if legs > limits.max_work:
         raise RequestError(
-            "starts", f"starts x paths x cycles x legs x algorithms = {legs} is more than "
+            "starts",
+            f"starts x paths x cycles x legs x algorithms = {legs} is more than "
             f"{limits.max_work}; ask for fewer starts or cycles (or run `jik atlas` for larger "
             "atlases)",
-        )  # fmt: skip
+        )
     if req.leg_ends and legs > limits.max_leg_ends:
         raise RequestError(
-            "leg_ends", f"the ends of {legs} legs are more than the {limits.max_leg_ends} a "
+            "leg_ends",
+            f"the ends of {legs} legs are more than the {limits.max_leg_ends} a "
             "response carries; ask for the drift alone or a smaller atlas",
-        )  # fmt: skip
+        )
     try:
         return _plan(req, spec, inverses, path, gamma, mode)
     except InvalidInputError as exc:
@@ -157,11 +159,22 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
 
 def _plan(req: AtlasRequest, spec, inverses, path, gamma, mode) -> AtlasPlan:
     return plan_atlas(
-        inverses, path, cycles=req.cycles, n_starts=req.starts, starts=req.start_points,
-        arc=req.arc or (-MAX_ARC, MAX_ARC), sampling=req.sampling, seed=req.seed,
-        reference=req.reference or spec.default_x0, box=None if req.arc else spec.x_range,
-        shifts=req.shifts, scales=req.scales, gamma=gamma, mode=mode, tol=req.tolerance,
-    )  # fmt: skip
+        inverses,
+        path,
+        cycles=req.cycles,
+        n_starts=req.starts,
+        starts=req.start_points,
+        arc=req.arc or (-MAX_ARC, MAX_ARC),
+        sampling=req.sampling,
+        seed=req.seed,
+        reference=req.reference or spec.default_x0,
+        box=None if req.arc else spec.x_range,
+        shifts=req.shifts,
+        scales=req.scales,
+        gamma=gamma,
+        mode=mode,
+        tol=req.tolerance,
+    )
 
 
 @task(
@@ -188,16 +201,19 @@ def result_document(res: AtlasResult, arc, leg_ends: bool) -> dict[str, Any]:
         failures[algs[a]][f"{j},{i}"] = why
     legs = res.leg_ends if leg_ends else None
     return {
-        "algorithms": list(algs), "arc": list(arc), "paths": res.paths.tolist(),
+        "algorithms": list(algs),
+        "arc": list(arc),
+        "paths": res.paths.tolist(),
         "parameter": [] if res.parameter is None else res.parameter.tolist(),
         "starts": res.starts.tolist(),
         "drift": {a: nullable(res.drift[k]) for k, a in enumerate(algs)},
         "success": {a: res.success[k].tolist() for k, a in enumerate(algs)},
         "failures": failures,
         "leg_ends": None if legs is None else {a: nullable(legs[k]) for k, a in enumerate(algs)},
-        "outside_limits": None if res.outside_limits is None else
-        {a: int(res.outside_limits[k].sum()) for k, a in enumerate(algs)},
-    }  # fmt: skip
+        "outside_limits": None
+        if res.outside_limits is None
+        else {a: int(res.outside_limits[k].sum()) for k, a in enumerate(algs)},
+    }
 
 
 @dataclass
@@ -223,8 +239,12 @@ class AtlasJob:
         """The job's state; ``ahead``: the jobs before it in the queue, of which ``running``
         are computing (:meth:`AtlasJobs.response` counts them)."""
         end = self.ended if self.ended is not None else time.monotonic()
-        message = {"running": "computing", "done": "done", "failed": "failed",
-                   "cancelled": "cancelled"}.get(self.status, "queued")  # fmt: skip
+        message = {
+            "running": "computing",
+            "done": "done",
+            "failed": "failed",
+            "cancelled": "cancelled",
+        }.get(self.status, "queued")
         if self.status == "queued" and ahead is not None:
             message = (
                 f"queued behind {ahead} atlas job{'s' * (ahead != 1)} ({running} computing, "
@@ -233,11 +253,17 @@ class AtlasJob:
                 else "starting"
             )
         return AtlasJobResponse(
-            id=self.id, status=self.status, runs=self.plan.size, runs_done=self.runs_done,
-            progress=self.runs_done / self.plan.size, elapsed_s=end - self.started,
-            queue_position=ahead if self.status == "queued" else None, message=message,
-            error=self.error, result=self.result,  # type: ignore[arg-type]  # (validated)
-        )  # fmt: skip
+            id=self.id,
+            status=self.status,
+            runs=self.plan.size,
+            runs_done=self.runs_done,
+            progress=self.runs_done / self.plan.size,
+            elapsed_s=end - self.started,
+            queue_position=ahead if self.status == "queued" else None,
+            message=message,
+            error=self.error,
+            result=self.result,  # type: ignore[arg-type]  # (validated)
+        )
 
     @property
     def active(self) -> bool:
@@ -271,23 +297,29 @@ class AtlasJobs:
         self.check_room(client)
         if plan is None:
             plan = plan_request(req, self.limits)
-        job = AtlasJob(self.run + secrets.token_urlsafe(12), client, plan, req.leg_ends,
-                       request=req)  # fmt: skip
+        job = AtlasJob(
+            self.run + secrets.token_urlsafe(12), client, plan, req.leg_ends, request=req
+        )
         with self._lock:
             self._room(client)
             self._jobs[job.id] = job
-        threading.Thread(target=self._run, args=(job,), name=f"jik-atlas-{job.id}",
-                         daemon=True).start()  # fmt: skip
+        threading.Thread(
+            target=self._run, args=(job,), name=f"jik-atlas-{job.id}", daemon=True
+        ).start()
         return job
 
     def _room(self, client: str) -> None:
         jobs = self._jobs.values()
         if len(self._jobs) >= self.limits.max_jobs:
-            raise AtlasJobsFull(f"the server keeps at most {self.limits.max_jobs} atlas jobs; "
-                                "retry when one has ended and expired")  # fmt: skip
+            raise AtlasJobsFull(
+                f"the server keeps at most {self.limits.max_jobs} atlas jobs; "
+                "retry when one has ended and expired"
+            )
         if sum(j.active and j.client == client for j in jobs) >= self.limits.per_client:
-            raise AtlasJobsFull(f"at most {self.limits.per_client} atlas jobs per client run at "
-                                "once; wait for one to end or cancel it")  # fmt: skip
+            raise AtlasJobsFull(
+                f"at most {self.limits.per_client} atlas jobs per client run at "
+                "once; wait for one to end or cancel it"
+            )
 
     def response(self, job: AtlasJob) -> AtlasJobResponse:
         """``job``'s state, with the jobs queued or running before it when it waits."""
@@ -316,11 +348,15 @@ class AtlasJobs:
     def _missing(self, job_id: str) -> str:
         """Why no job has the id ``job_id``."""
         if job_id.startswith(self.run):
-            return (f"it was cancelled, or it ended more than {self.limits.keep_for:g} s ago "
-                    "and was dropped")  # fmt: skip
+            return (
+                f"it was cancelled, or it ended more than {self.limits.keep_for:g} s ago "
+                "and was dropped"
+            )
         if re.fullmatch(r"[0-9a-f]{6}[A-Za-z0-9_-]{16}", job_id):
-            return ("the server restarted since it was started, and atlas jobs live in the "
-                    "server's memory: start it again")  # fmt: skip
+            return (
+                "the server restarted since it was started, and atlas jobs live in the "
+                "server's memory: start it again"
+            )
         return "no job of this server has had this id"
 
     def cancel(self, job_id: str) -> None:
@@ -375,10 +411,11 @@ class AtlasJobs:
 
             backend = None if self._pool is None else PoolBackend(self._pool)
             res = run_atlas(
-                job.plan, backend,
+                job.plan,
+                backend,
                 progress=ProgressCallbacks(on_advance=progress, is_cancelled=job.cancel.is_set),
                 keep_leg_ends=job.leg_ends,
-            )  # fmt: skip
+            )
             arc = job.plan.manifolds[0].arc if job.plan.manifolds else ()
             job.result = result_document(res, arc, job.leg_ends)  # (no arc: explicit starts)
             self._end(job, "done")

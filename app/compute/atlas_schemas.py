@@ -57,33 +57,37 @@ class AtlasRequest(BaseModel):
         "(8), 'extended' (11), 'damped', 'weighted', 'posture'",
     )
     algorithm_parameters: AlgorithmParameters | None = Field(
-        None, description="parameters of the damped, weighted and posture algorithms (each "
+        None,
+        description="parameters of the damped, weighted and posture algorithms (each "
         "takes its own; default: the engine's; without rest the posture inverse pulls each "
         "run toward its own start)",
-    )  # fmt: skip
+    )
     augmentation: AnyAugmentation | None = Field(
         None, description="augmenting map of the extended inverse (default: the robot's)"
     )
     path: Annotated[list[Vector], Field(min_length=2, max_length=MAX_PATH_POINTS)] | None = Field(
-        None, description="task points, a loop from the first: the starts lie on k(x) = path[0] "
+        None,
+        description="task points, a loop from the first: the starts lie on k(x) = path[0] "
         "(default: the robot's closed path)",
-    )  # fmt: skip
+    )
     starts: Annotated[int, Field(strict=True, ge=1, le=MAX_STARTS), INTEGRAL] = Field(
         256, description=f"starts per path, 1 to {MAX_STARTS}"
     )
     start_points: StartPoints | None = Field(
-        None, description="explicit starts (N, p), each on k(x) = path[0] (to 1e-9): a robot "
+        None,
+        description="explicit starts (N, p), each on k(x) = path[0] (to 1e-9): a robot "
         "with p - r > 1, whose self-motion manifolds are not curves, needs them; starts, "
         "sampling, seed, arc and reference are then not used",
-    )  # fmt: skip
+    )
     sampling: Literal["grid", "sample"] = Field(
         "grid", description="arc lengths on a grid (ends included) or sampled uniformly"
     )
     seed: Annotated[int, Field(strict=True, ge=0, le=2**31 - 1), INTEGRAL] = 0
     arc: tuple[Coordinate, Coordinate] | None = Field(
-        None, description="(lo, hi), lo <= 0 <= hi: arc lengths of the starts; default: the part "
+        None,
+        description="(lo, hi), lo <= 0 <= hi: arc lengths of the starts; default: the part "
         "of the curve inside the robot's configuration box",
-    )  # fmt: skip
+    )
     reference: Vector | None = Field(
         None, description="s = 0 is where eq. (7) from here meets the curve (default: robot's x0)"
     )
@@ -108,18 +112,34 @@ def _atlas_fields(spec, augmentation) -> dict:
     r, p = len(spec.task_names), spec.p
     point = Annotated[list[Coordinate], Field(min_length=r, max_length=r)]
     return {
-        "augmentation": (augmentation | None, Field(
-            None, description="augmenting map of the extended inverse (default: the robot's)")),
-        "path": (Annotated[list[point], Field(min_length=2, max_length=MAX_PATH_POINTS)] | None,
-                 Field(None, description=f"task points {list(spec.task_names)}, a loop from the "
-                       "first: the starts lie on k(x) = path[0] (default: the robot's closed "
-                       "path)")),
-        "reference": (Annotated[list[Coordinate], Field(min_length=p, max_length=p)] | None,
-                      Field(None, description="s = 0 is where eq. (7) from here meets the "
-                            "curve (default: the robot's x0)")),
-        "shifts": (Annotated[list[point], Field(min_length=1, max_length=MAX_FAMILY)] | None,
-                   Field(None, description="translations of the path (a family of paths)")),
-    }  # fmt: skip
+        "augmentation": (
+            augmentation | None,
+            Field(
+                None, description="augmenting map of the extended inverse (default: the robot's)"
+            ),
+        ),
+        "path": (
+            Annotated[list[point], Field(min_length=2, max_length=MAX_PATH_POINTS)] | None,
+            Field(
+                None,
+                description=f"task points {list(spec.task_names)}, a loop from the "
+                "first: the starts lie on k(x) = path[0] (default: the robot's closed "
+                "path)",
+            ),
+        ),
+        "reference": (
+            Annotated[list[Coordinate], Field(min_length=p, max_length=p)] | None,
+            Field(
+                None,
+                description="s = 0 is where eq. (7) from here meets the "
+                "curve (default: the robot's x0)",
+            ),
+        ),
+        "shifts": (
+            Annotated[list[point], Field(min_length=1, max_length=MAX_FAMILY)] | None,
+            Field(None, description="translations of the path (a family of paths)"),
+        ),
+    }
 
 
 #: ``POST /atlas``'s body: an :class:`AtlasRequest` with its robot's lengths and maps (a
@@ -147,9 +167,10 @@ class AtlasResult(BaseModel):
         None, description="per algorithm (P, N, cycles * L, p), when asked for"
     )
     outside_limits: dict[str, int] | None = Field(
-        None, description="per algorithm, the runs whose start or some leg end is outside the "
+        None,
+        description="per algorithm, the runs whose start or some leg end is outside the "
         "robot's joint limits; null for a robot without limits",
-    )  # fmt: skip
+    )
 
 
 class AtlasJobResponse(BaseModel):

@@ -35,9 +35,15 @@ class KinematicsRequest(BaseModel):
 
     model_config = ConfigDict(
         extra="forbid",
-        json_schema_extra={"examples": [{"robot": {"name": "panda", "task": "pose"},
-                                         "x": [0, -0.785, 0, -2.356, 0, 1.571, 0.785]}]},
-    )  # fmt: skip
+        json_schema_extra={
+            "examples": [
+                {
+                    "robot": {"name": "panda", "task": "pose"},
+                    "x": [0, -0.785, 0, -2.356, 0, 1.571, 0.785],
+                }
+            ]
+        },
+    )
 
     robot: S.AnyRobot = Field(
         description="the robot, as for /solve: e.g. {'name': 'panda', 'task': 'pose'}"
@@ -54,9 +60,11 @@ def _points(p: int | None) -> Any:
     one = Annotated[list[S.Coordinate], Field(min_length=p or 1, max_length=p or S.MAX_DIMENSION)]
     return (
         one | Annotated[list[one], Field(min_length=1, max_length=MAX_CONFIGURATIONS)],
-        Field(description=f"one configuration ({p or 'p'} numbers) or a list of 1 to "
-              f"{MAX_CONFIGURATIONS}"),
-    )  # fmt: skip
+        Field(
+            description=f"one configuration ({p or 'p'} numbers) or a list of 1 to "
+            f"{MAX_CONFIGURATIONS}"
+        ),
+    )
 
 
 def _exact(name: str, robot: Any, p: int | None) -> Any:
@@ -74,8 +82,10 @@ def _exact(name: str, robot: Any, p: int | None) -> Any:
 def _body() -> Any:
     """The union of :func:`_exact` over the robots, chosen by ``robot.name``."""
     members = [_exact(n, S.ROBOT_MODELS[n], spec.p) for n, spec in ROBOTS.items()]
-    members += [_exact(n, m, len(ARMS[n].home) if n in ARMS else None)
-                for n, m in S.USER_ROBOT_MODELS.items()]  # fmt: skip
+    members += [
+        _exact(n, m, len(ARMS[n].home) if n in ARMS else None)
+        for n, m in S.USER_ROBOT_MODELS.items()
+    ]
     return Annotated[
         Union[tuple(members)],  # noqa: UP007
         Discriminator(
@@ -114,9 +124,12 @@ def kinematics_request(req: KinematicsRequest) -> KinematicsResponse:
     many = isinstance(req.x[0], list)
     for i, row in enumerate(req.x if many else [req.x]):
         if len(row) != spec.p:  # type: ignore[arg-type]
-            raise RequestError(f"x[{i}]" if many else "x", f"must have {spec.p} components "
-                               f"(p of {spec.title}: {list(spec.variable_names)}), got "
-                               f"{len(row)}")  # type: ignore[arg-type]  # fmt: skip
+            raise RequestError(
+                f"x[{i}]" if many else "x",
+                f"must have {spec.p} components "
+                f"(p of {spec.title}: {list(spec.variable_names)}), got "
+                f"{len(row)}",
+            )  # type: ignore[arg-type]
     x = np.asarray(req.x, dtype=float)
     forward_jacobian = getattr(kin, "forward_jacobian", None)
     k, J = forward_jacobian(x) if forward_jacobian else (kin.forward(x), kin.jacobian(x))

@@ -72,9 +72,10 @@ def check_configuration(spec: RobotSpec, x0) -> None:
             else ""
         )
         raise RequestError(
-            "robot", f"this {spec.name} robot has p = {spec.p} moving joints; the API takes at "
+            "robot",
+            f"this {spec.name} robot has p = {spec.p} moving joints; the API takes at "
             f"most {S.MAX_DIMENSION} (the cap on x0's components){joints}",
-        )  # fmt: skip
+        )
     if len(x0) != spec.p:
         raise RequestError(
             "x0", f"must have {spec.p} components ({_dimensions(spec, 'p')}), got {len(x0)}"

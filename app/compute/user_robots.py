@@ -82,9 +82,14 @@ def user_robot(req_robot: Any, augmentation: Any = None) -> tuple[Robot, S.Robot
     except InvalidInputError as exc:
         raise RequestError(request_field(exc.field, list(definition)), _text(exc)) from None
     spec = robot.spec
-    used = S.RobotUsed(name=spec.name, parameters={}, definition=echo(req_robot.model_dump(
-        exclude_none=True)), p=spec.p, r=spec.r,
-        notes=list(getattr(robot.kinematics, "notes", ())) or None)  # fmt: skip
+    used = S.RobotUsed(
+        name=spec.name,
+        parameters={},
+        definition=echo(req_robot.model_dump(exclude_none=True)),
+        p=spec.p,
+        r=spec.r,
+        notes=list(getattr(robot.kinematics, "notes", ())) or None,
+    )
     return robot, used, None if given is None else map_used(robot)
 
 

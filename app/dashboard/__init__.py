@@ -25,7 +25,22 @@ from jik.app.dashboard.runs import AlgorithmRun, Cancelled, DashboardResult
 from jik.app.dashboard.session import Dashboard
 
 __all__ = [
-    "ALGORITHMS", "COLORS", "LABELS", "AlgorithmRun", "Cancelled", "Dashboard",
-    "DashboardResult", "DashboardState", "Event", "Offload", "OffloadLane", "compute",
-    "default_state", "export_csv", "export_file", "export_json", "runs_key", "updated_state",
-]  # fmt: skip
+    "ALGORITHMS",
+    "COLORS",
+    "LABELS",
+    "AlgorithmRun",
+    "Cancelled",
+    "Dashboard",
+    "DashboardResult",
+    "DashboardState",
+    "Event",
+    "Offload",
+    "OffloadLane",
+    "compute",
+    "default_state",
+    "export_csv",
+    "export_file",
+    "export_json",
+    "runs_key",
+    "updated_state",
+]

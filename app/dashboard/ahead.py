@@ -77,10 +77,13 @@ class SolvingAhead:
                 _, amap = kinematics_and_map(state)
                 with self._turn():
                     result = compute(
-                        state, generation, cancelled=lambda: self._generation != generation,
-                        cache=self._cache, with_augmenting=not expensive_map(amap),
+                        state,
+                        generation,
+                        cancelled=lambda: self._generation != generation,
+                        cache=self._cache,
+                        with_augmenting=not expensive_map(amap),
                         offload=self._offload,
-                    )  # fmt: skip
+                    )
                 # The figures as the switch will make them (see _compute; no panel to reuse
                 # from another robot).
                 cached, stale = self._known_functionals(state)
@@ -95,8 +98,7 @@ class SolvingAhead:
                 return
             digests = {k: digest(t) for k, t in texts.items()}
             self._ahead_sent[robot] = self._robot_since
-            head = {"type": "ahead", "generation": generation, "robot": robot,
-                    "digests": digests}  # fmt: skip
+            head = {"type": "ahead", "generation": generation, "robot": robot, "digests": digests}
             event = Event(
                 "ahead", generation, with_figures(head, texts), None if solved else result
             )

@@ -65,17 +65,66 @@ class Style:
 
 
 STYLES: dict[str, Style] = {
-    "pseudoinverse": Style("#d62728", "solid", "circle", "pseudoinverse J^P# (8)", "J^P# (8)",
-                           "solid line", "translucent robot", 0.55, 0.10, 4.0),
-    "extended": Style("#1f77b4", "dash", "diamond", "extended Jacobian J^E# (11)", "J^E# (11)",
-                      "dashed line", "opaque robot", None, 0.0),
-    "damped": Style("#ff7f0e", "dot", "square", "damped least squares J^DLS", "DLS",
-                    "dotted line", "translucent orange robot", 0.6, 0.05, 2.5),
-    "weighted": Style("#8c564b", "dashdot", "triangle-up", "weighted least-norm J^W#", "J^W#",
-                      "dash-dotted line", "translucent brown robot", 0.6, 0.15, 2.5),
-    "posture": Style("#17becf", "longdash", "star", "posture J^P# + null space k(x_rest - x)",
-                     "posture", "long-dashed line", "translucent teal robot", 0.6, 0.20, 2.5),
-}  # fmt: skip
+    "pseudoinverse": Style(
+        "#d62728",
+        "solid",
+        "circle",
+        "pseudoinverse J^P# (8)",
+        "J^P# (8)",
+        "solid line",
+        "translucent robot",
+        0.55,
+        0.10,
+        4.0,
+    ),
+    "extended": Style(
+        "#1f77b4",
+        "dash",
+        "diamond",
+        "extended Jacobian J^E# (11)",
+        "J^E# (11)",
+        "dashed line",
+        "opaque robot",
+        None,
+        0.0,
+    ),
+    "damped": Style(
+        "#ff7f0e",
+        "dot",
+        "square",
+        "damped least squares J^DLS",
+        "DLS",
+        "dotted line",
+        "translucent orange robot",
+        0.6,
+        0.05,
+        2.5,
+    ),
+    "weighted": Style(
+        "#8c564b",
+        "dashdot",
+        "triangle-up",
+        "weighted least-norm J^W#",
+        "J^W#",
+        "dash-dotted line",
+        "translucent brown robot",
+        0.6,
+        0.15,
+        2.5,
+    ),
+    "posture": Style(
+        "#17becf",
+        "longdash",
+        "star",
+        "posture J^P# + null space k(x_rest - x)",
+        "posture",
+        "long-dashed line",
+        "translucent teal robot",
+        0.6,
+        0.20,
+        2.5,
+    ),
+}
 assert set(STYLES) == set(CHOICES)
 COLORS = {a: s.color for a, s in STYLES.items()}
 DASH = {a: s.dash for a, s in STYLES.items()}
@@ -100,15 +149,15 @@ def checked(algorithms: tuple[str, ...], given: Mapping[str, Any]) -> dict[str, 
     """
     twice = sorted({a for a in algorithms if algorithms.count(a) > 1})
     if twice:
-        raise InvalidInputError(f"algorithms: {twice} chosen twice; choose each once",
-                                "algorithms")  # fmt: skip
+        raise InvalidInputError(f"algorithms: {twice} chosen twice; choose each once", "algorithms")
     known = {p.name for p in scalar_parameters(CHOICES)}
     for name in given:
         if name not in known:
             raise InvalidInputError(
                 f"algorithm_parameters.{name}: no algorithm has this parameter; known: "
-                f"{sorted(known)}", f"algorithm_parameters.{name}",
-            )  # fmt: skip
+                f"{sorted(known)}",
+                f"algorithm_parameters.{name}",
+            )
     ordered = tuple(a for a in CHOICES if a in algorithms)
     values = {}
     for p in scalar_parameters(ordered):
@@ -140,8 +189,9 @@ def check_inverses(state: ChosenState, build) -> None:
         try:
             build(a)
         except InvalidInputError as exc:
-            raise InvalidInputError(f"algorithms: {a} cannot run on this robot: {exc}",
-                                    "algorithms") from None  # fmt: skip
+            raise InvalidInputError(
+                f"algorithms: {a} cannot run on this robot: {exc}", "algorithms"
+            ) from None
 
 
 def cache_key(state: ChosenState, algorithm: str) -> str:

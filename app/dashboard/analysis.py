@@ -88,10 +88,10 @@ def functionals_key(state: DashboardState) -> str:
         if n not in design and k not in inert
     }
     return json.dumps(
-        {k: d[k] for k in ("robot", "robot_parameters", "augmentation",
-                           "augmentation_parameters")} | {"fixed": fixed},
+        {k: d[k] for k in ("robot", "robot_parameters", "augmentation", "augmentation_parameters")}
+        | {"fixed": fixed},
         sort_keys=True,
-    )  # fmt: skip
+    )
 
 
 def augmenting_axes(amap, x: np.ndarray, on_batch=None) -> tuple[int, int]:
@@ -135,9 +135,11 @@ def vector_note(state: DashboardState) -> str | None:
         return None
     spec = state_spec(state)
     h = spec.augmentation(state.augmentation).description
-    return (f"{h}: a vector of p − r = {spec.p - spec.r} maps, each kept constant by the "
-            "extended inverse (eq. (12)); the h panel, E1 (13) and E2 (18) are for one "
-            "degree of redundancy (p = r + 1)")  # fmt: skip
+    return (
+        f"{h}: a vector of p − r = {spec.p - spec.r} maps, each kept constant by the "
+        "extended inverse (eq. (12)); the h panel, E1 (13) and E2 (18) are for one "
+        "degree of redundancy (p = r + 1)"
+    )
 
 
 def expensive_map(amap) -> bool:
@@ -165,9 +167,13 @@ def grid_batches(runs: Mapping[str, AlgorithmRun], amap) -> int:
 
 
 def augmenting_grid(
-    kin, state: DashboardState, runs: Mapping[str, AlgorithmRun], n: int = GRID_POINTS,
-    before: dict | None = None, progress: Callable[[int, int], None] | None = None,
-):  # fmt: skip
+    kin,
+    state: DashboardState,
+    runs: Mapping[str, AlgorithmRun],
+    n: int = GRID_POINTS,
+    before: dict | None = None,
+    progress: Callable[[int, int], None] | None = None,
+):
     """h on a grid over the two variables it depends on most, other variables at x0.
 
     The box covers both trajectories with a margin, clipped to the robot's x_range. The box of
@@ -204,10 +210,11 @@ def augmenting_grid(
             n = min(n, EXPENSIVE_GRID_POINTS)  # h solves a collocation problem per point
         if before is not None and tuple(before["axes"]) == (i, j) and before["n"] == n:
             inside = all(
-                b_lo <= np.min(xs[:, k]) and np.max(xs[:, k]) <= b_hi
+                b_lo <= np.min(xs[:, k])
+                and np.max(xs[:, k]) <= b_hi
                 and hi - lo >= BOX_FILL * (b_hi - b_lo)
                 for k, (lo, hi), (b_lo, b_hi) in zip((i, j), box, before["box"], strict=True)
-            )  # fmt: skip
+            )
             if inside:
                 box = [tuple(b) for b in before["box"]]
         u, v = np.linspace(*box[0], n), np.linspace(*box[1], n)
@@ -228,8 +235,16 @@ def augmenting_grid(
     except (JikError, ValueError, ArithmeticError):
         return None
     H = np.where(np.isfinite(H), H, np.nan)
-    return {"axes": (i, j), "u": u, "v": v, "h": H, "box": box, "n": n, "map": amap,
-            "kinematics": kin}  # fmt: skip
+    return {
+        "axes": (i, j),
+        "u": u,
+        "v": v,
+        "h": H,
+        "box": box,
+        "n": n,
+        "map": amap,
+        "kinematics": kin,
+    }
 
 
 #: E1 and E2 are taken by a tensor Gauss rule over at most this many region variables.
@@ -336,8 +351,11 @@ def sensitivity(
         return single_joint_sensitivity(functionals)
     state = result.state
     if expensive_map(grid["map"]):
-        return {"kind": "unavailable", "reason": "each value of E1, E2 of this map solves a "
-                "collocation problem per node: no sweep in the dashboard"}  # fmt: skip
+        return {
+            "kind": "unavailable",
+            "reason": "each value of E1, E2 of this map solves a "
+            "collocation problem per node: no sweep in the dashboard",
+        }
     if functionals.get("E1") is None and functionals.get("E2") is None:
         return {"kind": "unavailable", "reason": "E1, E2 are undefined on this box"}
     from jik.engine.functionals import (
@@ -371,10 +389,17 @@ def sensitivity(
                     report(k * n + done)
 
                 out[key] = parameter_sensitivity(
-                    kin, lambda **p: build(aug, **p), state.augmentation_parameters, region,
-                    functional=key.lower(), span=1.0, samples=SENSITIVITY_SAMPLES, nodes=nodes,
-                    fixed=fixed, on_evaluation=evaluated,
-                )  # fmt: skip
+                    kin,
+                    lambda **p: build(aug, **p),
+                    state.augmentation_parameters,
+                    region,
+                    functional=key.lower(),
+                    span=1.0,
+                    samples=SENSITIVITY_SAMPLES,
+                    nodes=nodes,
+                    fixed=fixed,
+                    on_evaluation=evaluated,
+                )
             return out
         maps = []
         for m, other in enumerate(spec.augmentations):

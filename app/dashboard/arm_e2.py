@@ -46,17 +46,23 @@ def qmc_functionals(
     for _ in range(2 if on_step is not None else 0):
         on_step()
     if "error" in e2:
-        return {**out, "E1": None, "E2": None, "E2_error": e2["error"],
-                "note": f"E1 not computed: {large}; E2 not computed: {e2['error']}"}  # fmt: skip
-    value = "undefined (h is not defined on all of it)" if e2["E2"] is None else (
-        f"{e2['E2']:.4g}"
-    )  # fmt: skip
+        return {
+            **out,
+            "E1": None,
+            "E2": None,
+            "E2_error": e2["error"],
+            "note": f"E1 not computed: {large}; E2 not computed: {e2['error']}",
+        }
+    value = "undefined (h is not defined on all of it)" if e2["E2"] is None else (f"{e2['E2']:.4g}")
     return {
-        **out, "E1": None, "E2": e2["E2"], "E2_single_joint": e2["single_joint"],
+        **out,
+        "E1": None,
+        "E2": e2["E2"],
+        "E2_single_joint": e2["single_joint"],
         "E2_rule": {"kind": "sobol", "nodes": QMC_NODES, "seed": QMC_SEED},
         "note": f"E2 = {value} on the design box (Sobol rule, {QMC_NODES} nodes); "
         f"E1 not computed over {len(region)} joints",
-    }  # fmt: skip
+    }
 
 
 def single_joint_sensitivity(functionals: dict) -> dict:
@@ -67,5 +73,9 @@ def single_joint_sensitivity(functionals: dict) -> dict:
     for name, row in functionals["E2_single_joint"].items():
         sign = "+" if row["sign"] > 0 else "−"
         maps.append({"name": f"h = {sign}{name}", "E2": row["e2"], "current": False})
-    return {"kind": "single_joint", "E2": functionals["E2"], "maps": maps,
-            "nodes": functionals["E2_rule"]["nodes"]}  # fmt: skip
+    return {
+        "kind": "single_joint",
+        "E2": functionals["E2"],
+        "maps": maps,
+        "nodes": functionals["E2_rule"]["nodes"],
+    }

@@ -33,9 +33,11 @@ DRIFT_FLOOR = 1e-14
 
 
 def atlas_request(
-    state: DashboardState, starts: int, cycles: int | None = None,
+    state: DashboardState,
+    starts: int,
+    cycles: int | None = None,
     scales: Sequence[float] | None = None,
-) -> AtlasRequest:  # fmt: skip
+) -> AtlasRequest:
     """The atlas of ``state`` (its closed path, robot, map, gamma, mode and tolerance), with
     ``starts`` starts and ``cycles`` cycles (default: the state's); InvalidInputError naming
     the field when the state has no closed path or the request is refused."""
@@ -54,16 +56,23 @@ def atlas_request(
     }
     points = manifold_starts(state, kin, starts) if kin.p - kin.r > 1 else None
     robot, augmentation = request_robot(state)
-    return AtlasRequest.model_validate({
-        "robot": robot,
-        "algorithms": list(state.algorithms), "algorithm_parameters": params or None,
-        "augmentation": augmentation,
-        "path": [home.tolist(), *[list(p) for p in state.path]],
-        "starts": starts, "cycles": cycles or state.cycles, "reference": list(state.x0),
-        "start_points": points,
-        "scales": list(scales) if scales else None, "gamma": state.gamma, "mode": state.mode,
-        "tolerance": state.tolerance,
-    })  # fmt: skip
+    return AtlasRequest.model_validate(
+        {
+            "robot": robot,
+            "algorithms": list(state.algorithms),
+            "algorithm_parameters": params or None,
+            "augmentation": augmentation,
+            "path": [home.tolist(), *[list(p) for p in state.path]],
+            "starts": starts,
+            "cycles": cycles or state.cycles,
+            "reference": list(state.x0),
+            "start_points": points,
+            "scales": list(scales) if scales else None,
+            "gamma": state.gamma,
+            "mode": state.mode,
+            "tolerance": state.tolerance,
+        }
+    )
 
 
 #: Explicit starts lie within this fraction of the configuration box's width around x0.
@@ -101,16 +110,17 @@ def request_robot(state: DashboardState) -> tuple[dict, dict | None]:
     definition, with its chosen map as the definition's entry (None: the robot's default map,
     such as a catalogue arm's synthesized one)."""
     if state.robot_definition is None:
-        return ({"name": state.robot, **state.robot_parameters},
-                {"name": state.augmentation, **state.augmentation_parameters})  # fmt: skip
+        return (
+            {"name": state.robot, **state.robot_parameters},
+            {"name": state.augmentation, **state.augmentation_parameters},
+        )
     definition = dict(state.robot_definition)
     entries = definition.pop("augmentations", None) or []
     if state.augmentation == state_spec(state).default_augmentation:
         chosen = entries[0] if entries else None
     else:
         chosen = next(e for e in entries if e.get("label", e.get("name")) == state.augmentation)
-    return definition, None if chosen is None else {k: v for k, v in chosen.items()
-                                                    if k != "label"}  # fmt: skip
+    return definition, None if chosen is None else {k: v for k, v in chosen.items() if k != "label"}
 
 
 def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
@@ -144,54 +154,100 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
         z = np.array([d[j, :, c] for j, c in rows])  # (rows, N)
         failed.append(int(np.isnan(d).any(axis=2).sum()))
         axis = "" if k == 0 else str(k + 1)
-        data.append({
-            "type": "heatmap", "x": s, "y": labels, "z": np.log10(np.maximum(z, DRIFT_FLOOR)),
-            "customdata": runs.tolist(), "coloraxis": "coloraxis", "xaxis": f"x{axis}",
-            "yaxis": f"y{axis}",
-            "hovertemplate": f"{hover}<br>%{{y}}<br>log10 drift = %{{z:.2f}}"
-            f"<extra>{a}</extra>", "hoverongaps": False, "xgap": 0, "ygap": 1,
-        })  # fmt: skip
+        data.append(
+            {
+                "type": "heatmap",
+                "x": s,
+                "y": labels,
+                "z": np.log10(np.maximum(z, DRIFT_FLOOR)),
+                "customdata": runs.tolist(),
+                "coloraxis": "coloraxis",
+                "xaxis": f"x{axis}",
+                "yaxis": f"y{axis}",
+                "hovertemplate": f"{hover}<br>%{{y}}<br>log10 drift = %{{z:.2f}}<extra>{a}</extra>",
+                "hoverongaps": False,
+                "xgap": 0,
+                "ygap": 1,
+            }
+        )
         lo = k * (width + gap)
         layout[f"xaxis{axis}"] = {
-            **AXIS, "domain": [lo, lo + width], "anchor": f"y{axis}",
+            **AXIS,
+            "domain": [lo, lo + width],
+            "anchor": f"y{axis}",
             "title": {"text": x_title},
-        }  # fmt: skip
+        }
         # s = 0 is x0, the start of the state the atlas was asked for
-        layout["shapes"].append({
-            "type": "line", "xref": f"x{axis}", "yref": f"y{axis} domain", "x0": at_x0,
-            "x1": at_x0,
-            "y0": 0, "y1": 1, "line": {"color": "#fff", "width": 1.5, "dash": "dot"},
-        })  # fmt: skip
-        layout[f"yaxis{axis}"] = {**AXIS, "anchor": f"x{axis}", "autorange": "reversed",
-                                  "showticklabels": k == 0, "type": "category"}  # fmt: skip
-    names = [(STYLES[a].label if a in STYLES else a) + (f"<br>h = {request.augmentation.name}"
-             if a == "extended" and request.augmentation is not None else "")
-             for a in algorithms]  # fmt: skip
+        layout["shapes"].append(
+            {
+                "type": "line",
+                "xref": f"x{axis}",
+                "yref": f"y{axis} domain",
+                "x0": at_x0,
+                "x1": at_x0,
+                "y0": 0,
+                "y1": 1,
+                "line": {"color": "#fff", "width": 1.5, "dash": "dot"},
+            }
+        )
+        layout[f"yaxis{axis}"] = {
+            **AXIS,
+            "anchor": f"x{axis}",
+            "autorange": "reversed",
+            "showticklabels": k == 0,
+            "type": "category",
+        }
+    names = [
+        (STYLES[a].label if a in STYLES else a)
+        + (
+            f"<br>h = {request.augmentation.name}"
+            if a == "extended" and request.augmentation is not None
+            else ""
+        )
+        for a in algorithms
+    ]
     outside = outside_counts(result)
     for k, name in enumerate(names):
         lo = k * (width + gap)
         note = f", {failed[k]} starts failed (blank)" if failed[k] else ""
         if algorithms[k] in outside:
             note += f"<br>{outside[algorithms[k]]} of {P * N} runs left the joint limits"
-        layout["annotations"].append({
-            "text": name + note, "x": lo + width / 2, "y": 1.0, "xref": "paper", "yref": "paper",
-            "xanchor": "center", "yanchor": "bottom", "showarrow": False,
-            "font": {"size": 11, "color": STYLES[algorithms[k]].color if algorithms[k] in STYLES
-                     else "#444"},
-        })  # fmt: skip
+        layout["annotations"].append(
+            {
+                "text": name + note,
+                "x": lo + width / 2,
+                "y": 1.0,
+                "xref": "paper",
+                "yref": "paper",
+                "xanchor": "center",
+                "yanchor": "bottom",
+                "showarrow": False,
+                "font": {
+                    "size": 11,
+                    "color": STYLES[algorithms[k]].color if algorithms[k] in STYLES else "#444",
+                },
+            }
+        )
     spec = ROBOTS.get(request.robot.name)  # (a job of POST /atlas may leave them to the robot)
     gamma = request.gamma if spec is None or request.gamma is not None else spec.default_gamma
     mode = request.mode or (spec.default_mode if spec is not None else "continuous")
-    title = (f"Drift after each cycle from {N} starts on k(x) = k(x0) (dotted: x0), "
-             f"{request.robot.name}, γ = {gamma:g}, {mode} mode")  # fmt: skip
+    title = (
+        f"Drift after each cycle from {N} starts on k(x) = k(x0) (dotted: x0), "
+        f"{request.robot.name}, γ = {gamma:g}, {mode} mode"
+    )
     logs = np.concatenate([np.ravel(t["z"]) for t in data])
     logs = logs[np.isfinite(logs)]
     cmin, cmax = (np.floor(logs.min()), np.ceil(logs.max())) if logs.size else (-14.0, 0.0)
     layout["coloraxis"] = {
-        "colorscale": "Viridis", "cmin": float(cmin), "cmax": float(max(cmax, cmin + 1)),
-        "colorbar": {"title": {"text": f"log10 ‖x − x0‖<br>{unit}", "side": "right"},
-                     "x": 0.94, "len": 0.9},
-    }  # fmt: skip
+        "colorscale": "Viridis",
+        "cmin": float(cmin),
+        "cmax": float(max(cmax, cmin + 1)),
+        "colorbar": {
+            "title": {"text": f"log10 ‖x − x0‖<br>{unit}", "side": "right"},
+            "x": 0.94,
+            "len": 0.9,
+        },
+    }
     height = max(260, 120 + 22 * len(rows))
     return figure(
         data,
@@ -207,8 +263,11 @@ def outside_counts(result: dict[str, Any]) -> dict[str, int]:
     """How many runs of each algorithm left the robot's joint limits (an atlas of a robot with
     limits reports them as ``outside_limits``: a count, or a flag per run); empty without."""
     reported = result.get("outside_limits") or {}
-    return {a: int(v) if isinstance(v, int | float) else int(np.count_nonzero(v))
-            for a, v in reported.items() if v is not None}  # fmt: skip
+    return {
+        a: int(v) if isinstance(v, int | float) else int(np.count_nonzero(v))
+        for a, v in reported.items()
+        if v is not None
+    }
 
 
 __all__ = ["atlas_figure", "atlas_request"]

@@ -107,36 +107,92 @@ def controls(state) -> list[Control]:
     aug = spec.augmentation(state.augmentation)
     lo, hi = GAMMA_RANGE[state.mode]
     out = [
-        Control("robot", "robot", "select", "algorithm", "the robot (section 6 of the paper)",
-                options=tuple((name, ROBOTS[name].title) for name in ROBOTS)
-                + tuple((name, f"{arm.title} (arm)") for name, arm in ARMS.items())
-                + (((state.robot, f"your robot: {spec.title}"),)
-                   if state.robot not in (*ROBOTS, *ARMS) else ())),
-        Control("mode", "mode", "select", "algorithm",
-                "continuous: the ODE (7); discrete: the iteration x <- x - gamma J# e",
-                options=tuple((m, m) for m in MODES)),
-        Control("gamma", "γ (decay rate)", "slider", "algorithm", SYMBOLS["gamma"],
-                minimum=lo, maximum=hi, step=GAMMA_STEP, log=True),
-    ]  # fmt: skip
+        Control(
+            "robot",
+            "robot",
+            "select",
+            "algorithm",
+            "the robot (section 6 of the paper)",
+            options=tuple((name, ROBOTS[name].title) for name in ROBOTS)
+            + tuple((name, f"{arm.title} (arm)") for name, arm in ARMS.items())
+            + (
+                ((state.robot, f"your robot: {spec.title}"),)
+                if state.robot not in (*ROBOTS, *ARMS)
+                else ()
+            ),
+        ),
+        Control(
+            "mode",
+            "mode",
+            "select",
+            "algorithm",
+            "continuous: the ODE (7); discrete: the iteration x <- x - gamma J# e",
+            options=tuple((m, m) for m in MODES),
+        ),
+        Control(
+            "gamma",
+            "γ (decay rate)",
+            "slider",
+            "algorithm",
+            SYMBOLS["gamma"],
+            minimum=lo,
+            maximum=hi,
+            step=GAMMA_STEP,
+            log=True,
+        ),
+    ]
     out.append(iterations_control(state))
     for p in spec.parameters:
-        out.append(Control(f"robot_parameters.{p.name}", p.name, "slider", "algorithm",
-                           explained(p.name, p.description), minimum=p.minimum, maximum=p.maximum,
-                           step=(p.maximum - p.minimum) / SLIDER_STEPS))  # fmt: skip
+        out.append(
+            Control(
+                f"robot_parameters.{p.name}",
+                p.name,
+                "slider",
+                "algorithm",
+                explained(p.name, p.description),
+                minimum=p.minimum,
+                maximum=p.maximum,
+                step=(p.maximum - p.minimum) / SLIDER_STEPS,
+            )
+        )
     for v in spec.vector_parameters:
-        out.append(Control(f"robot_parameters.{v.name}", v.name, "vector", "algorithm",
-                           explained(v.name, v.description), minimum=list(v.minimum),
-                           maximum=list(v.maximum), step=0.1, size=len(v.default)))  # fmt: skip
+        out.append(
+            Control(
+                f"robot_parameters.{v.name}",
+                v.name,
+                "vector",
+                "algorithm",
+                explained(v.name, v.description),
+                minimum=list(v.minimum),
+                maximum=list(v.maximum),
+                step=0.1,
+                size=len(v.default),
+            )
+        )
         for name, preset in v.presets.items():
             shown = ", ".join(f"{t:.2f}" for t in preset)
-            out.append(Control(f"robot_parameters.{v.name}", f"{v.name} = {name} ({shown})",
-                               "preset", "algorithm", f"set {v.name} to the paper's pose {name}",
-                               value=[float(t) for t in preset],
-                               id=f"ctl-preset-{v.name}-{name}"))  # fmt: skip
-    out.append(Control("augmentation", "augmenting map h", "select", "algorithm",
-                       SYMBOLS["h"] + "; one button per map of the paper for this robot",
-                       options=tuple((a.name, _map_label(a)) for a in spec.augmentations),
-                       inline=True))  # fmt: skip
+            out.append(
+                Control(
+                    f"robot_parameters.{v.name}",
+                    f"{v.name} = {name} ({shown})",
+                    "preset",
+                    "algorithm",
+                    f"set {v.name} to the paper's pose {name}",
+                    value=[float(t) for t in preset],
+                    id=f"ctl-preset-{v.name}-{name}",
+                )
+            )
+    out.append(
+        Control(
+            "augmentation",
+            "augmenting map h",
+            "select",
+            "algorithm",
+            SYMBOLS["h"] + "; one button per map of the paper for this robot",
+            options=tuple((a.name, _map_label(a)) for a in spec.augmentations),
+            inline=True,
+        )
+    )
     groups = (
         ("augmentation_parameters", aug.parameters),
         ("algorithm_parameters", scalar_parameters(state.algorithms)),
@@ -156,36 +212,91 @@ def controls(state) -> list[Control]:
                 )
             )
         if head == "augmentation_parameters":
-            out.append(Control("algorithms", "algorithms", "checks", "algorithm",
-                               "the inverses J# run side by side, one colour each (at least "
-                               "one)", options=tuple((a, s.label) for a, s in STYLES.items()),
-                               inline=True))  # fmt: skip
+            out.append(
+                Control(
+                    "algorithms",
+                    "algorithms",
+                    "checks",
+                    "algorithm",
+                    "the inverses J# run side by side, one colour each (at least one)",
+                    options=tuple((a, s.label) for a, s in STYLES.items()),
+                    inline=True,
+                )
+            )
     for i, name in enumerate(spec.variable_names):
         lo, hi = spec.x_range[i] if spec.x_range else (-10.0, 10.0)
-        out.append(Control(f"x0.{i}", f"x0: {name}", "slider", "start",
-                           f"start configuration, coordinate {name}. {SYMBOLS['x0']}",
-                           minimum=lo, maximum=hi, step=(hi - lo) / X0_STEPS))  # fmt: skip
+        out.append(
+            Control(
+                f"x0.{i}",
+                f"x0: {name}",
+                "slider",
+                "start",
+                f"start configuration, coordinate {name}. {SYMBOLS['x0']}",
+                minimum=lo,
+                maximum=hi,
+                step=(hi - lo) / X0_STEPS,
+            )
+        )
     if len(spec.variable_names) > 3:
         names = spec.variable_names
-        out.append(Control("cspace_axes", "configuration-space axes", "select", "start",
-                           "the three coordinates the configuration-space panel shows",
-                           options=tuple((c, ", ".join(names[int(k)] for k in c))
-                                         for c in ("012", "013", "023", "123"))))  # fmt: skip
+        out.append(
+            Control(
+                "cspace_axes",
+                "configuration-space axes",
+                "select",
+                "start",
+                "the three coordinates the configuration-space panel shows",
+                options=tuple(
+                    (c, ", ".join(names[int(k)] for k in c)) for c in ("012", "013", "023", "123")
+                ),
+            )
+        )
     if spec.default_path:
-        out.append(Control("task", "task", "select", "start",
-                           "drive a closed path cycle after cycle, or solve for one target",
-                           options=TASKS))  # fmt: skip
+        out.append(
+            Control(
+                "task",
+                "task",
+                "select",
+                "start",
+                "drive a closed path cycle after cycle, or solve for one target",
+                options=TASKS,
+            )
+        )
     if state.task == "path":
-        out.append(Control("path", "closed path", "text", "start",
-                           "task points visited in order; the path closes back to k(x0)",
-                           format=PATH_FORMAT))  # fmt: skip
-        cycles = Control("cycles", "cycles", "slider", "start", "times around the path",
-                         minimum=1, maximum=MAX_DASHBOARD_CYCLES, step=1, integer=True)  # fmt: skip
+        out.append(
+            Control(
+                "path",
+                "closed path",
+                "text",
+                "start",
+                "task points visited in order; the path closes back to k(x0)",
+                format=PATH_FORMAT,
+            )
+        )
+        cycles = Control(
+            "cycles",
+            "cycles",
+            "slider",
+            "start",
+            "times around the path",
+            minimum=1,
+            maximum=MAX_DASHBOARD_CYCLES,
+            step=1,
+            integer=True,
+        )
         out.append(cycles)
     else:
-        out.append(Control("target", "target", "vector", "start",
-                           f"target task point ({', '.join(spec.task_names)})",
-                           step=0.1, size=len(spec.task_names)))  # fmt: skip
+        out.append(
+            Control(
+                "target",
+                "target",
+                "vector",
+                "start",
+                f"target task point ({', '.join(spec.task_names)})",
+                step=0.1,
+                size=len(spec.task_names),
+            )
+        )
     return out
 
 
@@ -198,11 +309,19 @@ def iterations_control(state) -> Control:
     """The cap on each leg's iterations (discrete mode) or integrator steps (continuous), which
     a leg that does not converge names in its message."""
     what = "iterations" if state.mode == "discrete" else "integrator steps"
-    return Control("max_iterations", f"max {what} per leg", "slider", "algorithm",
-                   f"a leg that has not reached its target after this many {what} stops and "
-                   "says so (raise it for far targets or small γ; the work grows with it)",
-                   minimum=MIN_ITERATIONS, maximum=MAX_ITERATIONS_CAP, step=1, log=True,
-                   integer=True)  # fmt: skip
+    return Control(
+        "max_iterations",
+        f"max {what} per leg",
+        "slider",
+        "algorithm",
+        f"a leg that has not reached its target after this many {what} stops and "
+        "says so (raise it for far targets or small γ; the work grows with it)",
+        minimum=MIN_ITERATIONS,
+        maximum=MAX_ITERATIONS_CAP,
+        step=1,
+        log=True,
+        integer=True,
+    )
 
 
 def max_iterations(state) -> int:
@@ -215,8 +334,11 @@ def max_iterations(state) -> int:
 def element_id(key: str) -> str:
     """The page's element id of the control ``key``: ``ctl-gamma``, ``ctl-x0-1``, ``ctl-l``
     (a robot parameter), ``ctl-aug-a`` (a parameter of the map)."""
-    short = (key.replace("robot_parameters.", "").replace("augmentation_parameters.", "aug-")
-             .replace("algorithm_parameters.", "alg-"))  # fmt: skip
+    short = (
+        key.replace("robot_parameters.", "")
+        .replace("augmentation_parameters.", "aug-")
+        .replace("algorithm_parameters.", "alg-")
+    )
     return "ctl-" + short.replace(".", "-")
 
 
@@ -301,8 +423,9 @@ def parse_path_text(text: str, size: int | None = None) -> list[list[float]]:
         if size is not None and len(point) != size:
             raise InvalidInputError(
                 f"path: {where} has {len(point)} coordinate{'s' if len(point) > 1 else ''}; "
-                f"each point needs {size} (write '{PATH_FORMAT}')", "path",
-            )  # fmt: skip
+                f"each point needs {size} (write '{PATH_FORMAT}')",
+                "path",
+            )
         points.append(point)
     return points
 

@@ -108,12 +108,23 @@ def _level_surface(result: DashboardResult, kin, amap, axes, lo, hi) -> dict | N
         return None
     value = np.nan_to_num(H, nan=h0 + 1e9).astype(np.float32)  # (undefined h: far from h0)
     X = X.astype(np.float32)
-    return trace("isosurface", x=X[:, 0], y=X[:, 1], z=X[:, 2], value=value, isomin=h0,
-                 isomax=h0, surface=dict(count=1),
-                 caps=dict(x=dict(show=False), y=dict(show=False), z=dict(show=False)),
-                 colorscale=[[0, "#9aa5b1"], [1, "#9aa5b1"]],
-                 showscale=False, opacity=0.3, name=f"level surface h = h(x0) = {h0:.4g}",
-                 hoverinfo="skip", showlegend=True)  # fmt: skip
+    return trace(
+        "isosurface",
+        x=X[:, 0],
+        y=X[:, 1],
+        z=X[:, 2],
+        value=value,
+        isomin=h0,
+        isomax=h0,
+        surface=dict(count=1),
+        caps=dict(x=dict(show=False), y=dict(show=False), z=dict(show=False)),
+        colorscale=[[0, "#9aa5b1"], [1, "#9aa5b1"]],
+        showscale=False,
+        opacity=0.3,
+        name=f"level surface h = h(x0) = {h0:.4g}",
+        hoverinfo="skip",
+        showlegend=True,
+    )
 
 
 def _thin(x: np.ndarray) -> np.ndarray:
@@ -152,22 +163,47 @@ def cspace_spec(result: DashboardResult) -> dict:
         with np.errstate(all="ignore"):
             curves = self_motion(kin, seeds, np.asarray(result.targets, dtype=float), lo, hi)
         for k, (curve, name) in enumerate(zip(curves, corner_names(result), strict=True)):
-            data.append(trace("scatter3d", x=curve[:, a], y=curve[:, b], z=curve[:, c],
-                              mode="lines", line=dict(color="#2ca02c", width=3),
-                              name="self-motion manifolds k(x) = corner", legendgroup="fibres",
-                              showlegend=k == 0,
-                              hovertemplate=f"k(x) = {name}<extra></extra>"))  # fmt: skip
+            data.append(
+                trace(
+                    "scatter3d",
+                    x=curve[:, a],
+                    y=curve[:, b],
+                    z=curve[:, c],
+                    mode="lines",
+                    line=dict(color="#2ca02c", width=3),
+                    name="self-motion manifolds k(x) = corner",
+                    legendgroup="fibres",
+                    showlegend=k == 0,
+                    hovertemplate=f"k(x) = {name}<extra></extra>",
+                )
+            )
     for alg, run in result.runs.items():
         x = _thin(run.x)
-        data.append(trace("scatter3d", x=x[:, a], y=x[:, b], z=x[:, c], mode="lines",
-                          name=LABELS[alg], line=dict(color=COLORS[alg], dash=DASH[alg],
-                                                      width=1 + STYLES[alg].width),
-                          hovertemplate=f"{names[a]} = %{{x:.3f}}<br>{names[b]} = %{{y:.3f}}"
-                          f"<br>{names[c]} = %{{z:.3f}}<extra>{alg}</extra>"))  # fmt: skip
+        data.append(
+            trace(
+                "scatter3d",
+                x=x[:, a],
+                y=x[:, b],
+                z=x[:, c],
+                mode="lines",
+                name=LABELS[alg],
+                line=dict(color=COLORS[alg], dash=DASH[alg], width=1 + STYLES[alg].width),
+                hovertemplate=f"{names[a]} = %{{x:.3f}}<br>{names[b]} = %{{y:.3f}}"
+                f"<br>{names[c]} = %{{z:.3f}}<extra>{alg}</extra>",
+            )
+        )
     x0 = np.asarray(result.state.x0, dtype=float)
-    data.append(trace("scatter3d", x=[x0[a]], y=[x0[b]], z=[x0[c]], mode="markers",
-                      marker=dict(color="white", size=5, line=dict(color="black", width=2)),
-                      name="start x0"))  # fmt: skip
+    data.append(
+        trace(
+            "scatter3d",
+            x=[x0[a]],
+            y=[x0[b]],
+            z=[x0[c]],
+            mode="markers",
+            marker=dict(color="white", size=5, line=dict(color="black", width=2)),
+            name="start x0",
+        )
+    )
     shown = ", ".join(names[k] for k in axes)
     if kin.p > 3:
         fixed = [n for k, n in enumerate(names) if k not in axes]
@@ -186,8 +222,13 @@ def cspace_spec(result: DashboardResult) -> dict:
     # with the id of the page's 3D scene, #scene)
     for t in data:
         t["scene"] = SCENE
-    spec = figure(data, f"Configuration space ({shown})<br><sup>{sub}</sup>", **{SCENE: scene},
-                  height=CSPACE_HEIGHT, showlegend=True,
-                  legend=dict(orientation="h", x=0, y=0, yanchor="top", font=dict(size=10)),
-                  margin=dict(l=0, r=0, t=40, b=40))  # fmt: skip
+    spec = figure(
+        data,
+        f"Configuration space ({shown})<br><sup>{sub}</sup>",
+        **{SCENE: scene},
+        height=CSPACE_HEIGHT,
+        showlegend=True,
+        legend=dict(orientation="h", x=0, y=0, yanchor="top", font=dict(size=10)),
+        margin=dict(l=0, r=0, t=40, b=40),
+    )
     return spec

@@ -44,9 +44,13 @@ def export_units(result: DashboardResult) -> dict:
         return {n: spelled.get(u, u) for n, u in zip(names, us, strict=True)}
 
     theta = "iterations" if result.state.mode == "discrete" else "dimensionless"
-    return {"x": named(result.variable_names, joint), "y": named(result.task_names, task),
-            "theta": theta, "error": norm_unit(task).strip("[]") or "as y",
-            "h": "the unit of the map's formula"}  # fmt: skip
+    return {
+        "x": named(result.variable_names, joint),
+        "y": named(result.task_names, task),
+        "theta": theta,
+        "error": norm_unit(task).strip("[]") or "as y",
+        "h": "the unit of the map's formula",
+    }
 
 
 def provenance(when: datetime | None = None) -> dict:
@@ -59,8 +63,13 @@ def export_filename(result: DashboardResult, extension: str, when: datetime) -> 
     """``jik-<robot>-<map>-<mode>-g<generation>-<UTC time>.<extension>``: what the file holds
     and when, so that exports of several states do not overwrite each other."""
     state = result.state
-    parts = [state.robot, state.augmentation, state.mode, f"g{result.generation}",
-             when.strftime("%Y%m%dT%H%M%SZ")]  # fmt: skip
+    parts = [
+        state.robot,
+        state.augmentation,
+        state.mode,
+        f"g{result.generation}",
+        when.strftime("%Y%m%dT%H%M%SZ"),
+    ]
     slug = "-".join(re.sub(r"[^A-Za-z0-9_.]+", "_", p) for p in parts)
     return f"jik-{slug}.{extension}"
 
@@ -87,13 +96,23 @@ def export_json(
         }
         if run.platform is not None:
             runs[a]["platform_final"] = run.platform[-1]
-    return json.loads(to_json({
-        **provenance(when), "robot": result.title, "state": result.state.as_dict(),
-        "generation": result.generation, "units": export_units(result),
-        "variable_names": result.variable_names, "task_names": result.task_names,
-        "targets": result.targets, "runs": runs, "functionals": functionals,
-        "verdict": [v["text"] for v in verdict(result)],
-    }))  # fmt: skip
+    return json.loads(
+        to_json(
+            {
+                **provenance(when),
+                "robot": result.title,
+                "state": result.state.as_dict(),
+                "generation": result.generation,
+                "units": export_units(result),
+                "variable_names": result.variable_names,
+                "task_names": result.task_names,
+                "targets": result.targets,
+                "runs": runs,
+                "functionals": functionals,
+                "verdict": [v["text"] for v in verdict(result)],
+            }
+        )
+    )
 
 
 def csv_context(result: DashboardResult, when: datetime | None = None) -> list[str]:
@@ -104,10 +123,12 @@ def csv_context(result: DashboardResult, when: datetime | None = None) -> list[s
     made = provenance(when)
     u = export_units(result)
     columns = {**u["x"], **u["y"], "theta": u["theta"], "error": u["error"], "h": u["h"]}
-    lines = [f"# jik export of generation {result.generation}: {result.title}",
-             f"# jik {made['jik_version']}, exported {made['exported_at']}",
-             f"# state: {to_json(result.state.as_dict())}",
-             "# units: " + "; ".join(f"{k} [{v}]" for k, v in columns.items())]  # fmt: skip
+    lines = [
+        f"# jik export of generation {result.generation}: {result.title}",
+        f"# jik {made['jik_version']}, exported {made['exported_at']}",
+        f"# state: {to_json(result.state.as_dict())}",
+        "# units: " + "; ".join(f"{k} [{v}]" for k, v in columns.items()),
+    ]
     lines += [f"# verdict: {v['text']}" for v in verdict(result)]
     for a, run in result.runs.items():
         ends = "; ".join(", ".join(f"{v:.6g}" for v in e) for e in run.leg_end)

@@ -47,31 +47,44 @@ def _task_space(result: DashboardResult) -> dict:
     data = []
     for a, run in result.runs.items():
         data.append(
-            trace("scatter",
-                x=run.y[:, 0], y=run.y[:, 1], mode="lines", name=LABELS[a],
+            trace(
+                "scatter",
+                x=run.y[:, 0],
+                y=run.y[:, 1],
+                mode="lines",
+                name=LABELS[a],
                 line=dict(color=COLORS[a], width=STYLES[a].width, dash=DASH[a]),
                 customdata=run.leg + 1,  # (theta stays out: this panel does not depend on gamma)
                 hovertemplate=f"{n1} = %{{x:.4f}}<br>{n2} = %{{y:.4f}}"
                 "<br>leg %{customdata}<extra>" + a + "</extra>",
             )
-        )  # fmt: skip
+        )
     tg = result.targets
     x0y = next(iter(result.runs.values())).y[0]
     data.append(
-        trace("scatter",
-            x=tg[:, 0], y=tg[:, 1], mode="markers+text", name="targets",
-            text=corner_names(result), textposition="top right",
+        trace(
+            "scatter",
+            x=tg[:, 0],
+            y=tg[:, 1],
+            mode="markers+text",
+            name="targets",
+            text=corner_names(result),
+            textposition="top right",
             marker=dict(color="black", size=9, symbol="x"),
             hovertemplate=f"%{{text}}: ({n1}, {n2}) = (%{{x:.3f}}, %{{y:.3f}})<extra></extra>",
         )
-    )  # fmt: skip
+    )
     data.append(
-        trace("scatter",
-            x=[x0y[0]], y=[x0y[1]], mode="markers", name="start k(x0)",
+        trace(
+            "scatter",
+            x=[x0y[0]],
+            y=[x0y[1]],
+            mode="markers",
+            name="start k(x0)",
             marker=dict(color="#2ca02c", size=12, symbol="circle-open", line=dict(width=2)),
             hovertemplate="start (%{x:.3f}, %{y:.3f})<extra></extra>",
         )
-    )  # fmt: skip
+    )
     points = np.vstack([r.y[:, :2] for r in result.runs.values()] + [tg[:, :2]])
     return figure(
         data,
@@ -81,9 +94,10 @@ def _task_space(result: DashboardResult) -> dict:
         + "× targets of the legs · ○ start k(x0)</sup>",
         **NO_LEGEND,
         xaxis=dict(title=label(n1, tu[0]), range=nice_range(points[:, 0])),
-        yaxis=dict(title=label(n2, tu[1]), range=nice_range(points[:, 1]), scaleanchor="x",
-                   scaleratio=1),
-    )  # fmt: skip
+        yaxis=dict(
+            title=label(n2, tu[1]), range=nice_range(points[:, 1]), scaleanchor="x", scaleratio=1
+        ),
+    )
 
 
 def _joints(result: DashboardResult) -> dict:
@@ -94,14 +108,20 @@ def _joints(result: DashboardResult) -> dict:
     for a, run in result.runs.items():
         for k, name in enumerate(names):
             data.append(
-                trace("scatter",
-                    x=run.theta, y=run.x[:, k], mode="lines", name=LABELS[a],
-                    legendgroup=a, showlegend=k == 0,
+                trace(
+                    "scatter",
+                    x=run.theta,
+                    y=run.x[:, k],
+                    mode="lines",
+                    name=LABELS[a],
+                    legendgroup=a,
+                    showlegend=k == 0,
                     line=dict(color=COLORS[a], width=1.8, dash=DASH[a]),
-                    xaxis="x", yaxis="y" if k == 0 else f"y{k + 1}",
+                    xaxis="x",
+                    yaxis="y" if k == 0 else f"y{k + 1}",
                     hovertemplate=f"{name} = %{{y:.5f}}<br>θ = %{{x:.4g}}<extra>{a}</extra>",
                 )
-            )  # fmt: skip
+            )
     axes = stacked_axes(len(names))
     runs = list(result.runs.values())
     for k, name in enumerate(names):
@@ -128,22 +148,29 @@ def _drift(result: DashboardResult) -> dict:
     for a, run in result.runs.items():
         if closed:
             data.append(
-                trace("scatter",
-                    x=np.arange(1, len(run.drift) + 1), y=np.maximum(run.drift, 1e-16),
-                    mode="lines+markers", name=LABELS[a],
+                trace(
+                    "scatter",
+                    x=np.arange(1, len(run.drift) + 1),
+                    y=np.maximum(run.drift, 1e-16),
+                    mode="lines+markers",
+                    name=LABELS[a],
                     line=dict(color=COLORS[a], width=2, dash=DASH[a]),
                     marker=dict(symbol=STYLES[a].symbol, size=9),
                     hovertemplate="cycle %{x}: drift %{y:.3e}<extra>" + a + "</extra>",
                 )
-            )  # fmt: skip
+            )
         else:
             data.append(
-                trace("scatter",
-                    x=run.theta, y=np.maximum(run.error, 1e-16), mode="lines", name=LABELS[a],
+                trace(
+                    "scatter",
+                    x=run.theta,
+                    y=np.maximum(run.error, 1e-16),
+                    mode="lines",
+                    name=LABELS[a],
                     line=dict(color=COLORS[a], width=2, dash=DASH[a]),
                     hovertemplate="‖k(x) − y_d‖ = %{y:.3e}<br>θ = %{x:.4g}<extra>" + a + "</extra>",
                 )
-            )  # fmt: skip
+            )
     ys = np.concatenate([np.asarray(t["y"], dtype=float) for t in data])
     if closed:
         cycles = max(len(r.drift) for r in result.runs.values())
@@ -152,20 +179,26 @@ def _drift(result: DashboardResult) -> dict:
             "Repeatability: joint drift after each closed cycle",
             **NO_LEGEND,
             xaxis=dict(title="cycle", dtick=1, range=[0.5, cycles + 0.5]),
-            yaxis=dict(title=f"‖x(end of cycle) − x0‖ {norm_unit(units(result)[0])} (log)",
-                       type="log", exponentformat="power",
-                       range=log_range(ys)),
-        )  # fmt: skip
+            yaxis=dict(
+                title=f"‖x(end of cycle) − x0‖ {norm_unit(units(result)[0])} (log)",
+                type="log",
+                exponentformat="power",
+                range=log_range(ys),
+            ),
+        )
     theta = np.concatenate([r.theta for r in result.runs.values()])
     return figure(
         data,
         "Convergence: task error",
         **NO_LEGEND,
         xaxis=dict(title=theta_label(result), range=nice_range(theta, from_zero=True)),
-        yaxis=dict(title=f"‖k(x) − y_d‖ {norm_unit(units(result)[1])} (log)", type="log",
-                   exponentformat="power",
-                   range=log_range(ys)),
-    )  # fmt: skip
+        yaxis=dict(
+            title=f"‖k(x) − y_d‖ {norm_unit(units(result)[1])} (log)",
+            type="log",
+            exponentformat="power",
+            range=log_range(ys),
+        ),
+    )
 
 
 def _table(result: DashboardResult) -> dict:
@@ -190,9 +223,15 @@ def _platform(result: DashboardResult, max_paths: int = 12) -> dict:
         for n, i in enumerate(show):
             last = bool(i == m - 1)
             data.append(
-                trace("scatter",
-                    x=P[i, :, 0], y=P[i, :, 1], mode="lines", xaxis=xa, yaxis=ya,
-                    name=LABELS[a] if last else f"{a} iteration {i}", legendgroup=a,
+                trace(
+                    "scatter",
+                    x=P[i, :, 0],
+                    y=P[i, :, 1],
+                    mode="lines",
+                    xaxis=xa,
+                    yaxis=ya,
+                    name=LABELS[a] if last else f"{a} iteration {i}",
+                    legendgroup=a,
                     showlegend=last,
                     line=dict(color=COLORS[a], width=3 if last else 1, dash=DASH[a]),
                     opacity=1.0 if last else 0.2 + 0.5 * n / max(len(show), 1),
@@ -200,31 +239,48 @@ def _platform(result: DashboardResult, max_paths: int = 12) -> dict:
                     hovertemplate=f"iteration {i}<br>q1 = %{{x:.3f}}<br>q2 = %{{y:.3f}}"
                     "<br>t = %{customdata:.2f}<extra>" + a + "</extra>",
                 )
-            )  # fmt: skip
+            )
         q0 = result.state.robot_parameters.get("q0", P[0, 0])
         target = result.state.target
         data.append(
-            trace("scatter",
-                x=[q0[0], target[0]], y=[q0[1], target[1]], xaxis=xa, yaxis=ya,
-                mode="markers+text", text=["q0", "target"], textposition="top center",
+            trace(
+                "scatter",
+                x=[q0[0], target[0]],
+                y=[q0[1], target[1]],
+                xaxis=xa,
+                yaxis=ya,
+                mode="markers+text",
+                text=["q0", "target"],
+                textposition="top center",
                 marker=dict(color=["#2ca02c", "black"], size=10, symbol=["circle", "x"]),
-                showlegend=False, hovertemplate="%{text}: (%{x:.3f}, %{y:.3f})<extra></extra>",
+                showlegend=False,
+                hovertemplate="%{text}: (%{x:.3f}, %{y:.3f})<extra></extra>",
             )
-        )  # fmt: skip
+        )
         annotations.append(
-            dict(text=STYLES[a].short, xref=f"{xa} domain", yref=f"{ya} domain", x=0.5, y=1.0,
-                 yanchor="bottom", showarrow=False, font=dict(size=11, color=COLORS[a]))
-        )  # fmt: skip
+            dict(
+                text=STYLES[a].short,
+                xref=f"{xa} domain",
+                yref=f"{ya} domain",
+                x=0.5,
+                y=1.0,
+                yanchor="bottom",
+                showarrow=False,
+                font=dict(size=11, color=COLORS[a]),
+            )
+        )
     axes: dict = {}
     for col in range(1, count + 1):
         k = "" if col == 1 else str(col)
         lo = (col - 1) * (width + 0.04)
-        axes[f"xaxis{k}"] = dict(domain=[lo, lo + width], title=label("q1", tu[0]),
-                                 **({"matches": "x"} if k else {}))  # fmt: skip
+        axes[f"xaxis{k}"] = dict(
+            domain=[lo, lo + width], title=label("q1", tu[0]), **({"matches": "x"} if k else {})
+        )
         axes[f"yaxis{k}"] = (
-            dict(anchor=f"x{k}", matches="y", showticklabels=False) if k
+            dict(anchor=f"x{k}", matches="y", showticklabels=False)
+            if k
             else dict(title=label("q2", tu[1]), scaleanchor="x", scaleratio=1)
-        )  # fmt: skip
+        )
     return figure(
         data,
         "Platform paths q(t) per iteration (Figs. 11-14 a)",

@@ -68,11 +68,16 @@ def limits_texts(result, names: dict[str, str]) -> list[tuple[str, str, bool]]:
         else:
             v = report.violation
             assert v is not None
-            where = ("its start x0 is already outside them" if v.cycle == 0
-                     else f"first at cycle {v.cycle}, leg {v.leg}")  # fmt: skip
+            where = (
+                "its start x0 is already outside them"
+                if v.cycle == 0
+                else f"first at cycle {v.cycle}, leg {v.leg}"
+            )
             side = "below its lower" if v.bound == "lower" else "above its upper"
-            text = (f"{name}: left the joint limits of the {title}: {where}, joint {v.name} = "
-                    f"{v.value:.4g}, {side} limit {v.limit:.4g}.")  # fmt: skip
+            text = (
+                f"{name}: left the joint limits of the {title}: {where}, joint {v.name} = "
+                f"{v.value:.4g}, {side} limit {v.limit:.4g}."
+            )
         out.append((text, algorithm, report.within))
     return out
 

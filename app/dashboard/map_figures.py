@@ -34,8 +34,9 @@ def augmenting_spec(
     ju, _ = units(result)
     grid = result.augmenting
     if grid is None and cancelled:
-        return message_figure(augmenting_title(result, None, cancelled),
-                              f"not computed: {cancelled}")  # fmt: skip
+        return message_figure(
+            augmenting_title(result, None, cancelled), f"not computed: {cancelled}"
+        )
     vector = vector_note(result.state) if grid is None else None
     if vector:
         return message_figure(f"Augmenting map h: {map_name(result)}", vector)
@@ -47,32 +48,54 @@ def augmenting_spec(
     finite = H[np.isfinite(H)]
     zmin, zmax = np.percentile(finite, [2, 98]) if finite.size else (0.0, 1.0)
     data = [
-        trace("contour",
-            x=grid["u"], y=grid["v"], z=H, zmin=zmin, zmax=zmax,
+        trace(
+            "contour",
+            x=grid["u"],
+            y=grid["v"],
+            z=H,
+            zmin=zmin,
+            zmax=zmax,
             # A neutral scale, so that the red and blue runs on top stay the algorithms' colours.
             colorscale=[[0.0, "#fdfdfd"], [1.0, "#9a9a9a"]],
             # No labels on the level curves: placing them costs the page 100-250 ms per redraw;
             # the colour bar and the hover give the levels.
-            ncontours=24, contours=dict(showlabels=False),
+            ncontours=24,
+            contours=dict(showlabels=False),
             colorbar=dict(
                 title=dict(text="h", side="right"), thickness=12, ticklabeloverflow="allow"
             ),
             hovertemplate=f"{ni} = %{{x:.3f}}<br>{nj} = %{{y:.3f}}<br>h = %{{z:.4f}}"
             "<extra></extra>",
-            name="h", showlegend=False,
+            name="h",
+            showlegend=False,
         )
-    ]  # fmt: skip
+    ]
     shapes: list[dict[str, Any]] = [
-        dict(type="path", path=_svg_path(result.runs[a].x[:, i], result.runs[a].x[:, j]),
-             line=dict(color=COLORS[a], width=2.5, dash=DASH[a]), name=LABELS[a])
+        dict(
+            type="path",
+            path=_svg_path(result.runs[a].x[:, i], result.runs[a].x[:, j]),
+            line=dict(color=COLORS[a], width=2.5, dash=DASH[a]),
+            name=LABELS[a],
+        )
         for a in result.runs
-    ]  # fmt: skip
+    ]
     x0 = result.state.x0
     shapes.append(  # (a circle of 10 px at x0, whatever the axes' scales)
-        dict(type="circle", xsizemode="pixel", ysizemode="pixel", xanchor=float(x0[i]),
-             yanchor=float(x0[j]), x0=-5, x1=5, y0=-5, y1=5, fillcolor="white",
-             line=dict(color="black", width=2), name="x0")
-    )  # fmt: skip
+        dict(
+            type="circle",
+            xsizemode="pixel",
+            ysizemode="pixel",
+            xanchor=float(x0[i]),
+            yanchor=float(x0[j]),
+            x0=-5,
+            x1=5,
+            y0=-5,
+            y1=5,
+            fillcolor="white",
+            line=dict(color="black", width=2),
+            name="x0",
+        )
+    )
     return figure(
         data,
         augmenting_title(result, functionals, cancelled),
@@ -117,16 +140,21 @@ def augmenting_title(
         values = {k: functionals.get(k) for k in ("E1", "E2")}
         where = "the plotted box"
         if functionals.get("design_region"):
-            where = ", ".join(f"{k} ∈ [{lo:.3g}, {hi:.3g}]" for k, (lo, hi)
-                              in functionals["region"].items())  # fmt: skip
+            where = ", ".join(
+                f"{k} ∈ [{lo:.3g}, {hi:.3g}]" for k, (lo, hi) in functionals["region"].items()
+            )
         if functionals.get("note"):
             sub.append(functionals["note"])
         elif all(v is None for v in values.values()):
             sub.append(f"E1, E2 undefined: h is not defined on all of {where}")
         else:
-            sub.append(", ".join(
-                f"{k} = {v:.4g}" if v is not None else f"{k} undefined" for k, v in values.items()
-            ) + f" on {where}")  # fmt: skip
+            sub.append(
+                ", ".join(
+                    f"{k} = {v:.4g}" if v is not None else f"{k} undefined"
+                    for k, v in values.items()
+                )
+                + f" on {where}"
+            )
     # The slice's other variables, unless neither h nor J depends on them (Manipulator 2's x1
     # for h(x2, x3)): their values would say nothing, and the title would change with them.
     inert = state_inert_variables(result.state)
@@ -161,9 +189,23 @@ def message_figure(title: str, message: str) -> dict:
     """A panel with nothing to plot: its title, and ``message`` where the plot would be (no
     empty axes)."""
     hidden = dict(visible=False)
-    return figure([], title, xaxis=hidden, yaxis=hidden, annotations=[dict(
-        text=message, xref="paper", yref="paper", x=0.5, y=0.5, showarrow=False,
-        font=dict(size=12, color="#555"))])  # fmt: skip
+    return figure(
+        [],
+        title,
+        xaxis=hidden,
+        yaxis=hidden,
+        annotations=[
+            dict(
+                text=message,
+                xref="paper",
+                yref="paper",
+                x=0.5,
+                y=0.5,
+                showarrow=False,
+                font=dict(size=12, color="#555"),
+            )
+        ],
+    )
 
 
 #: Colours of the functionals (the algorithms keep red and blue).
@@ -204,13 +246,21 @@ def sensitivity_spec(
         maps = sens["maps"]
         names = [m["name"] + (" (current)" if m["current"] else "") for m in maps]
         data = [
-            trace("bar", x=names, y=[m[k] for m in maps], name=k,
-                   marker=dict(color=E_COLORS[k],
-                               line=dict(color=["black" if m["current"] else E_COLORS[k]
-                                                for m in maps], width=2)),
-                   hovertemplate="%{x}: " + k + " = %{y:.4g}<extra></extra>")
+            trace(
+                "bar",
+                x=names,
+                y=[m[k] for m in maps],
+                name=k,
+                marker=dict(
+                    color=E_COLORS[k],
+                    line=dict(
+                        color=["black" if m["current"] else E_COLORS[k] for m in maps], width=2
+                    ),
+                ),
+                hovertemplate="%{x}: " + k + " = %{y:.4g}<extra></extra>",
+            )
             for k in ("E1", "E2")
-        ]  # fmt: skip
+        ]
         return figure(
             data,
             f"E1 (13), E2 (18) of the maps of this robot<br><sup>{aug} has no parameters: "
@@ -230,24 +280,44 @@ def sensitivity_spec(
         xa, ya = ("x", "y") if c == 0 else (f"x{c + 1}", f"y{c + 1}")
         for k in ("E1", "E2"):
             sweep = sens[k]["sweeps"][name]
-            data.append(trace("scatter", x=sweep["values"], y=sweep["functional"],
-                               mode="lines", name=k, legendgroup=k, showlegend=c == 0,
-                               line=dict(color=E_COLORS[k], width=2), xaxis=xa, yaxis=ya,
-                               hovertemplate=f"{name} = %{{x:.3g}}<br>{k} = %{{y:.4g}}"
-                               "<extra></extra>"))  # fmt: skip
+            data.append(
+                trace(
+                    "scatter",
+                    x=sweep["values"],
+                    y=sweep["functional"],
+                    mode="lines",
+                    name=k,
+                    legendgroup=k,
+                    showlegend=c == 0,
+                    line=dict(color=E_COLORS[k], width=2),
+                    xaxis=xa,
+                    yaxis=ya,
+                    hovertemplate=f"{name} = %{{x:.3g}}<br>{k} = %{{y:.4g}}<extra></extra>",
+                )
+            )
             if sens[k]["value"] is not None:
-                data.append(trace("scatter", x=[params[name]], y=[sens[k]["value"]],
-                                   mode="markers", name=f"current {k}", showlegend=False,
-                                   marker=dict(color="white", size=9,
-                                               line=dict(color=E_COLORS[k], width=2)),
-                                   xaxis=xa, yaxis=ya,
-                                   hovertemplate=f"current {name} = %{{x:.3g}}<br>{k} = "
-                                   "%{y:.4g}<extra></extra>"))  # fmt: skip
+                data.append(
+                    trace(
+                        "scatter",
+                        x=[params[name]],
+                        y=[sens[k]["value"]],
+                        mode="markers",
+                        name=f"current {k}",
+                        showlegend=False,
+                        marker=dict(color="white", size=9, line=dict(color=E_COLORS[k], width=2)),
+                        xaxis=xa,
+                        yaxis=ya,
+                        hovertemplate=f"current {name} = %{{x:.3g}}<br>{k} = "
+                        "%{y:.4g}<extra></extra>",
+                    )
+                )
         lo = c * (width + gap)
         layout["xaxis" if c == 0 else f"xaxis{c + 1}"] = dict(
-            domain=[round(lo, 6), round(min(1.0, lo + width), 6)], title=name,
-            anchor=ya, nticks=5,
-        )  # fmt: skip
+            domain=[round(lo, 6), round(min(1.0, lo + width), 6)],
+            title=name,
+            anchor=ya,
+            nticks=5,
+        )
         ys = [y for k in ("E1", "E2") for y in sens[k]["sweeps"][name]["functional"]]
         layout["yaxis" if c == 0 else f"yaxis{c + 1}"] = dict(
             anchor=xa, **log, **log_ticks(ys), **({"title": "E (log)"} if c == 0 else {})
@@ -255,10 +325,12 @@ def sensitivity_spec(
     slopes = []
     for k in ("E1", "E2"):
         g = sens[k]["gradient"]
-        slopes.append(", ".join(
-            f"∂{k}/∂{p} = {g[p]:.3g}" if g.get(p) is not None else f"∂{k}/∂{p} undefined"
-            for p in names
-        ))  # fmt: skip
+        slopes.append(
+            ", ".join(
+                f"∂{k}/∂{p} = {g[p]:.3g}" if g.get(p) is not None else f"∂{k}/∂{p} undefined"
+                for p in names
+            )
+        )
     at = ", ".join(f"{p} = {v:.3g}" for p, v in params.items())
     sub = "".join(f"<br><sup>{line}</sup>" for line in wrap([f"at {at} (circles)", *slopes]))
     return figure(data, f"E1 (13), E2 (18) as the parameters of {aug} move{sub}", **layout)
@@ -270,11 +342,20 @@ def single_joint_spec(sens: dict, aug: str, log: dict) -> dict:
     maps = sens["maps"]
     values = [m["E2"] for m in maps]
     data = [
-        trace("bar", x=[m["name"] for m in maps], y=values, name="E2",
-              marker=dict(color=E_COLORS["E2"], line=dict(
-                  color=["black" if m["current"] else E_COLORS["E2"] for m in maps], width=2)),
-              hovertemplate="%{x}: E2 = %{y:.4g}<extra></extra>")
-    ]  # fmt: skip
+        trace(
+            "bar",
+            x=[m["name"] for m in maps],
+            y=values,
+            name="E2",
+            marker=dict(
+                color=E_COLORS["E2"],
+                line=dict(
+                    color=["black" if m["current"] else E_COLORS["E2"] for m in maps], width=2
+                ),
+            ),
+            hovertemplate="%{x}: E2 = %{y:.4g}<extra></extra>",
+        )
+    ]
     best = min((m for m in maps if not m["current"]), key=lambda m: m["E2"])
     ratio = ""
     if sens["E2"]:

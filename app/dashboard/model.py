@@ -135,8 +135,11 @@ def _user_default_state(robot: str, definition: Mapping[str, Any] | None) -> Das
             "robot_definition",
         )
     if definition.get("name") != robot:
-        raise InvalidInputError(f"robot_definition.name: must be the robot's kind {robot!r}, got "
-                                f"{definition.get('name')!r}", "robot_definition.name")  # fmt: skip
+        raise InvalidInputError(
+            f"robot_definition.name: must be the robot's kind {robot!r}, got "
+            f"{definition.get('name')!r}",
+            "robot_definition.name",
+        )
     spec = _redundant_robot(definition).spec
     try:
         return DashboardState(
@@ -182,13 +185,16 @@ def updated_state(state: DashboardState, patch: Mapping[str, object]) -> Dashboa
     robot = patch.get("robot", state.robot)
     definition = patch.get("robot_definition", state.robot_definition)
     if definition is not None and not isinstance(definition, Mapping):
-        raise InvalidInputError("robot_definition: give an object (the robot editor's fields)",
-                                "robot_definition")  # fmt: skip
+        raise InvalidInputError(
+            "robot_definition: give an object (the robot editor's fields)", "robot_definition"
+        )
     if robot != state.robot or definition != state.robot_definition:
         if not isinstance(robot, str) or robot not in (*ROBOTS, *USER_KINDS):
-            raise InvalidInputError(f"robot: unknown robot {robot!r}; choose one of "
-                                    f"{sorted(ROBOTS)} or a kind {list(USER_KINDS)}",
-                                    "robot")  # fmt: skip
+            raise InvalidInputError(
+                f"robot: unknown robot {robot!r}; choose one of "
+                f"{sorted(ROBOTS)} or a kind {list(USER_KINDS)}",
+                "robot",
+            )
         if robot != state.robot and "robot_definition" not in patch:
             definition = None  # (another robot chosen: the definition was the other's)
         # (the chosen algorithms stay: the new robot's defaults are for everything else)
@@ -203,8 +209,11 @@ def updated_state(state: DashboardState, patch: Mapping[str, object]) -> Dashboa
     patch = expand(state, patch)
     data = state.as_dict()
     if "augmentation" in patch and patch["augmentation"] != data["augmentation"]:
-        spec = (user_robot(data["robot_definition"]).spec if data.get("robot_definition")
-                else robot_spec(robot))  # fmt: skip
+        spec = (
+            user_robot(data["robot_definition"]).spec
+            if data.get("robot_definition")
+            else robot_spec(robot)
+        )
         aug = _registered(lambda: spec.augmentation(str(patch["augmentation"])), "augmentation")
         data["augmentation"] = aug.name
         data["augmentation_parameters"] = {p.name: p.default for p in aug.parameters}
@@ -234,12 +243,17 @@ def validate(data: Mapping[str, Any]) -> DashboardState:
         spec, kin, params, aug_params = _user_robot(state)
     else:
         spec = _registered(lambda: robot_spec(state.robot), "robot")
-        params = _model(ROBOT_MODELS[spec.name], {**state.robot_parameters, "name": spec.name},
-                        ("robot_parameters",)).model_dump(exclude={"name"})  # fmt: skip
+        params = _model(
+            ROBOT_MODELS[spec.name],
+            {**state.robot_parameters, "name": spec.name},
+            ("robot_parameters",),
+        ).model_dump(exclude={"name"})
         aug = _registered(lambda: spec.augmentation(state.augmentation), "augmentation")
-        aug_params = _model(AUGMENTATION_MODELS[aug.name],
-                            {**state.augmentation_parameters, "name": aug.name},
-                            ("augmentation_parameters",)).model_dump(exclude={"name"})  # fmt: skip
+        aug_params = _model(
+            AUGMENTATION_MODELS[aug.name],
+            {**state.augmentation_parameters, "name": aug.name},
+            ("augmentation_parameters",),
+        ).model_dump(exclude={"name"})
         kin = _registered(lambda: spec.build(**params), "robot_parameters")
     _registered(lambda: kin.check(state.x0, "x0"), "x0")
     _registered(lambda: kin.check_task(state.target, "target"), "target")
@@ -253,14 +267,17 @@ def validate(data: Mapping[str, Any]) -> DashboardState:
     check_inverses(state, lambda a: state_inverse(state, a, kin))
     # The engine's default cap, set by its value, is the default (None): it follows the mode.
     default_cap = max_iterations(state.model_copy(update={"max_iterations": None}))
-    return state.model_copy(update={
-        "max_iterations": None if state.max_iterations == default_cap else state.max_iterations,
-        # (the first three coordinates are the default, and all there is for p = 3)
-        "cspace_axes": None if state.cspace_axes == "012" or kin.p < 4 else state.cspace_axes,
-        "robot_parameters": {k: tuple(v) if isinstance(v, list | tuple) else v
-                             for k, v in params.items()},
-        "augmentation_parameters": aug_params,
-    })  # fmt: skip
+    return state.model_copy(
+        update={
+            "max_iterations": None if state.max_iterations == default_cap else state.max_iterations,
+            # (the first three coordinates are the default, and all there is for p = 3)
+            "cspace_axes": None if state.cspace_axes == "012" or kin.p < 4 else state.cspace_axes,
+            "robot_parameters": {
+                k: tuple(v) if isinstance(v, list | tuple) else v for k, v in params.items()
+            },
+            "augmentation_parameters": aug_params,
+        }
+    )
 
 
 def _user_robot(state: DashboardState) -> tuple[Any, Any, dict, dict]:
@@ -274,8 +291,10 @@ def _user_robot(state: DashboardState) -> tuple[Any, Any, dict, dict]:
             "robot_definition",
         )
     if definition.get("name") != state.robot:
-        raise InvalidInputError(f"robot_definition.name: must be the robot's kind "
-                                f"{state.robot!r}", "robot_definition.name")  # fmt: skip
+        raise InvalidInputError(
+            f"robot_definition.name: must be the robot's kind {state.robot!r}",
+            "robot_definition.name",
+        )
     for key in ("robot_parameters", "augmentation_parameters"):
         if getattr(state, key):
             raise InvalidInputError(f"{key}: a user robot has none", key)
@@ -322,5 +341,6 @@ def _registered(check, name: str):
     try:
         return check()
     except InvalidInputError as exc:
-        raise InvalidInputError(f"{name}: {exc}" if not str(exc).startswith(name) else str(exc),
-                                exc.field or name) from None  # fmt: skip
+        raise InvalidInputError(
+            f"{name}: {exc}" if not str(exc).startswith(name) else str(exc), exc.field or name
+        ) from None

@@ -24,21 +24,38 @@ UNITS = {
 PANEL_HEIGHT = 380
 #: Panel ids, in the page's order, with their size on the page's grid ("wide": a whole row,
 #: "tall": two rows).
-PANEL_SIZES = {"task": "wide", "drift": "", "joints": "tall", "augmenting": "",
-               "sensitivity": "", "cspace": "full", "table": "wide"}  # fmt: skip
+PANEL_SIZES = {
+    "task": "wide",
+    "drift": "",
+    "joints": "tall",
+    "augmenting": "",
+    "sensitivity": "",
+    "cspace": "full",
+    "table": "wide",
+}
 PANELS = tuple(PANEL_SIZES)
 AXIS = dict(
-    gridcolor="#e6e6e6", zerolinecolor="#b0b0b0", linecolor="#888", showline=True, mirror=True,
-    ticks="outside", automargin=True,
+    gridcolor="#e6e6e6",
+    zerolinecolor="#b0b0b0",
+    linecolor="#888",
+    showline=True,
+    mirror=True,
+    ticks="outside",
+    automargin=True,
     # plotly's default on linear axes, "hide past div", measures every tick label's box
     # (a forced layout each) on every redraw, milliseconds per panel.
     ticklabeloverflow="allow",
-)  # fmt: skip
+)
 # A small explicit template: the named ones ("plotly_white") cost ~25 ms per figure to apply.
 TEMPLATE = dict(
-    layout=dict(paper_bgcolor="white", plot_bgcolor="white", xaxis=AXIS, yaxis=AXIS,
-                colorway=["#d62728", "#1f77b4", "#2ca02c", "#9467bd"])
-)  # fmt: skip
+    layout=dict(
+        paper_bgcolor="white",
+        plot_bgcolor="white",
+        xaxis=AXIS,
+        yaxis=AXIS,
+        colorway=["#d62728", "#1f77b4", "#2ca02c", "#9467bd"],
+    )
+)
 LAYOUT = dict(
     template=TEMPLATE,
     height=PANEL_HEIGHT,
@@ -115,9 +132,19 @@ def figure(data: list, title: str, **layout) -> dict:
     """A figure dict (a spec) with the panels' common layout, not validated by plotly (the
     server builds every panel on each change); tests/app/test_figures.py validates every one."""
     # The title hangs from the top; the top margin has room for each of its lines.
-    base = {**LAYOUT, "title": dict(text=title, font=dict(size=13), x=0.01, xanchor="left",
-                                    yref="container", y=1.0, yanchor="top",
-                                    pad=dict(t=12))}  # fmt: skip
+    base = {
+        **LAYOUT,
+        "title": dict(
+            text=title,
+            font=dict(size=13),
+            x=0.01,
+            xanchor="left",
+            yref="container",
+            y=1.0,
+            yanchor="top",
+            pad=dict(t=12),
+        ),
+    }
     margin = dict(layout.get("margin", LAYOUT["margin"]))
     margin["t"] = max(margin.get("t", 40), 40 + 16 * title.count("<br>"))
     layout["margin"] = margin
@@ -132,8 +159,16 @@ def to_go(spec: dict) -> go.Figure:
 
 
 #: numpy dtypes plotly.js takes as typed arrays (base64), by their plotly.js names.
-TYPED = {"float64": "f8", "float32": "f4", "int32": "i4", "uint32": "u4", "int16": "i2",
-          "uint16": "u2", "int8": "i1", "uint8": "u1"}  # fmt: skip
+TYPED = {
+    "float64": "f8",
+    "float32": "f4",
+    "int32": "i4",
+    "uint32": "u4",
+    "int16": "i2",
+    "uint16": "u2",
+    "int8": "i1",
+    "uint8": "u1",
+}
 
 
 def typed_array(v: np.ndarray):
@@ -197,8 +232,10 @@ def nice_range(values, pad: float = 0.05, from_zero: bool = False) -> list[float
 
     if from_zero:  # (an axis like theta: the data start at its left edge)
         return [0.0, tidy(np.ceil(hi / step) * step)]
-    return [tidy(np.floor((lo - pad * span) / step) * step),
-            tidy(np.ceil((hi + pad * span) / step) * step)]  # fmt: skip
+    return [
+        tidy(np.floor((lo - pad * span) / step) * step),
+        tidy(np.ceil((hi + pad * span) / step) * step),
+    ]
 
 
 def log_range(values) -> list[float] | None:

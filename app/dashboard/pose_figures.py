@@ -67,30 +67,47 @@ def pose_task_spec(result: DashboardResult) -> dict:
         name = names[k]
         for a, run in result.runs.items():
             data.append(
-                trace("scatter",
-                    x=run.theta, y=run.y[:, k], mode="lines", name=LABELS[a],
-                    line=dict(color=COLORS[a], width=1.8, dash=DASH[a]), xaxis="x", yaxis=yaxis,
+                trace(
+                    "scatter",
+                    x=run.theta,
+                    y=run.y[:, k],
+                    mode="lines",
+                    name=LABELS[a],
+                    line=dict(color=COLORS[a], width=1.8, dash=DASH[a]),
+                    xaxis="x",
+                    yaxis=yaxis,
                     customdata=run.leg + 1,
                     hovertemplate=f"{name} = %{{y:.5f}}<br>θ = %{{x:.4g}}<br>leg %{{customdata}}"
                     f"<extra>{a}</extra>",
                 )
-            )  # fmt: skip
+            )
         data.append(
-            trace("scatter",
-                x=first.theta[ends], y=targets[legs % len(targets), k], name="targets",
-                mode="markers", xaxis="x", yaxis=yaxis, text=letters.tolist(),
+            trace(
+                "scatter",
+                x=first.theta[ends],
+                y=targets[legs % len(targets), k],
+                name="targets",
+                mode="markers",
+                xaxis="x",
+                yaxis=yaxis,
+                text=letters.tolist(),
                 marker=dict(color="black", size=8, symbol="x"),
                 hovertemplate=f"%{{text}}: {name} = %{{y:.4f}}<extra></extra>",
             )
-        )  # fmt: skip
+        )
         data.append(
-            trace("scatter",
-                x=[first.theta[0]], y=[first.y[0, k]], mode="markers", name="start k(x0)",
-                xaxis="x", yaxis=yaxis,
+            trace(
+                "scatter",
+                x=[first.theta[0]],
+                y=[first.y[0, k]],
+                mode="markers",
+                name="start k(x0)",
+                xaxis="x",
+                yaxis=yaxis,
                 marker=dict(color="#2ca02c", size=10, symbol="circle-open", line=dict(width=2)),
                 hovertemplate=f"start {name} = %{{y:.4f}}<extra></extra>",
             )
-        )  # fmt: skip
+        )
         values = np.concatenate([r.y[:, k] for r in runs] + [targets[:, k]])
         mid = float(np.nanmean(values))  # (a coordinate constant up to rounding: +-MIN_SPAN)
         values = np.append(values, [mid - MIN_SPAN, mid + MIN_SPAN])
@@ -99,10 +116,18 @@ def pose_task_spec(result: DashboardResult) -> dict:
         )
     # The targets' letters above the top row, at the end of their legs (never over a line).
     axes["annotations"] = [
-        dict(text=str(t), x=float(x), xref="x", y=1.0, yref="y domain", yanchor="bottom",
-             showarrow=False, font=dict(size=11))
+        dict(
+            text=str(t),
+            x=float(x),
+            xref="x",
+            y=1.0,
+            yref="y domain",
+            yanchor="bottom",
+            showarrow=False,
+            font=dict(size=11),
+        )
         for t, x in zip(letters, first.theta[ends], strict=True)
-    ]  # fmt: skip
+    ]
     axes["xaxis"]["title"] = theta_label(result)
     axes["xaxis"]["range"] = nice_range(np.concatenate([r.theta for r in runs]), from_zero=True)
     lead = next(iter(result.runs))  # (the targets are marked at its legs' ends)

@@ -42,11 +42,15 @@ def stall_note(inverse, target, x) -> str:
         d = float(np.linalg.norm(np.asarray(target, dtype=float)[:2]))
         tol = 1e-9 * max(1.0, outer)
         if d > outer + tol:
-            return (f"the target is out of reach: it is {g(d)} from the base, beyond the arm's "
-                    f"reach {g(outer)} (the sum of its link lengths)")  # fmt: skip
+            return (
+                f"the target is out of reach: it is {g(d)} from the base, beyond the arm's "
+                f"reach {g(outer)} (the sum of its link lengths)"
+            )
         if d < inner - tol:
-            return (f"the target is out of reach: it is {g(d)} from the base, inside the "
-                    f"arm's inner reach {g(inner)} (2 max l − sum l)")  # fmt: skip
+            return (
+                f"the target is out of reach: it is {g(d)} from the base, inside the "
+                f"arm's inner reach {g(inner)} (2 max l − sum l)"
+            )
         within = f"the target is within reach ({g(d)} from the base, reach {g(outer)}); "
     x = np.asarray(x, dtype=float)
     try:
@@ -56,16 +60,22 @@ def stall_note(inverse, target, x) -> str:
         return f"{within}the step size collapsed near a singularity"
     ratio = float(s[-1] / s[0]) if s[0] > 0 else 0.0
     if ratio < SINGULAR_RATIO:
-        return (f"{within}the arm stalled at a kinematic singularity: J loses rank there "
-                f"(σ_min/σ_max = {g(ratio)})")  # fmt: skip
+        return (
+            f"{within}the arm stalled at a kinematic singularity: J loses rank there "
+            f"(σ_min/σ_max = {g(ratio)})"
+        )
     try:  # (an inverse singular there raises: that is the algorithmic singularity)
         with np.errstate(all="ignore"):
             grow = float(np.linalg.norm(inverse.matrix(x), 2) * s[-1])
     except (JikError, ValueError, np.linalg.LinAlgError):
         grow = float("inf")
     if inverse.name == "extended" and (not np.isfinite(grow) or grow > ALGORITHMIC_RATIO):
-        return (f"{within}J is regular there (σ_min/σ_max = {g(ratio)}) but the extended "
-                "Jacobian [J; dh] (10) is near singular (an algorithmic singularity): the level "
-                "set h = h(x0) does not lead to the target from this start")  # fmt: skip
-    return (f"{within}J is regular there (σ_min/σ_max = {g(ratio)}): the error stopped at a "
-            "local minimum; move the start or the target")  # fmt: skip
+        return (
+            f"{within}J is regular there (σ_min/σ_max = {g(ratio)}) but the extended "
+            "Jacobian [J; dh] (10) is near singular (an algorithmic singularity): the level "
+            "set h = h(x0) does not lead to the target from this start"
+        )
+    return (
+        f"{within}J is regular there (σ_min/σ_max = {g(ratio)}): the error stopped at a "
+        "local minimum; move the start or the target"
+    )

@@ -126,13 +126,23 @@ def compute(
     for algorithm in todo:
         if remote is None or algorithm != away:
             cache[keys[algorithm]] = algorithm_run(
-                state, algorithm, targets, cycles, step, cancelled, partial, kin,
+                state,
+                algorithm,
+                targets,
+                cycles,
+                step,
+                cancelled,
+                partial,
+                kin,
                 resume=other[algorithm],
-            )  # fmt: skip
+            )
     if offload is not None and remote is not None and away is not None:
-        cache[keys[away]] = offload.result(remote, lambda: algorithm_run(
-            state, away, targets, cycles, cancelled=cancelled, kin=kin,
-            resume=other[away]))  # fmt: skip
+        cache[keys[away]] = offload.result(
+            remote,
+            lambda: algorithm_run(
+                state, away, targets, cycles, cancelled=cancelled, kin=kin, resume=other[away]
+            ),
+        )
     runs: dict[str, AlgorithmRun] = {}
     for algorithm in algorithms:
         run = cache[keys[algorithm]]

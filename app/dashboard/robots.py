@@ -52,8 +52,9 @@ def _built(definition: str) -> Robot:
         return robot
     last = list(spec.variable_names[spec.r :])
     h = last[0] if len(last) == 1 else last
-    return robot_from_dict({**json.loads(definition), "augmentations": [{"name": "formula",
-                                                                         "h": h}]})  # fmt: skip
+    return robot_from_dict(
+        {**json.loads(definition), "augmentations": [{"name": "formula", "h": h}]}
+    )
 
 
 def user_robot(definition: Mapping[str, Any]) -> Robot:
@@ -71,8 +72,9 @@ def user_robot(definition: Mapping[str, Any]) -> Robot:
     except InvalidInputError as exc:
         field = f"robot_definition.{exc.field}" if exc.field else "robot_definition"
         text = str(exc)
-        raise InvalidInputError(f"{field}: {text}" if not text.startswith(field) else text,
-                                field) from None  # fmt: skip
+        raise InvalidInputError(
+            f"{field}: {text}" if not text.startswith(field) else text, field
+        ) from None
 
 
 @task("robot_definition", "shorter formulas or fewer nested functions")
@@ -146,6 +148,10 @@ def state_inverse(state, algorithm: str, kin: Kinematics | None = None) -> Inver
         return robot.inverse(algorithm, state.augmentation, algorithm_parameters=params)
     spec = robot_spec(state.robot)
     return make_inverse(
-        kin, algorithm, state.augmentation, state.augmentation_parameters, spec.name,
+        kin,
+        algorithm,
+        state.augmentation,
+        state.augmentation_parameters,
+        spec.name,
         algorithm_parameters=params,
-    )  # fmt: skip
+    )

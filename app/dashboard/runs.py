@@ -139,12 +139,20 @@ def _run_legs(
     path, close = (state.path, True) if state.task == "path" else (targets, False)
     try:
         run = repeatability(
-            inverse, x0 if earlier is None else earlier, path, cycles,
-            gamma=1.0 if continuous else state.gamma, mode=state.mode,
-            tol=state.tolerance, max_iterations=cap, record=True, close=close,
-            progress=ProgressCallbacks(on_leg, lambda done, total: partial(done / total),
-                                       cancelled, stop_at_errors=True),
-        )  # fmt: skip
+            inverse,
+            x0 if earlier is None else earlier,
+            path,
+            cycles,
+            gamma=1.0 if continuous else state.gamma,
+            mode=state.mode,
+            tol=state.tolerance,
+            max_iterations=cap,
+            record=True,
+            close=close,
+            progress=ProgressCallbacks(
+                on_leg, lambda done, total: partial(done / total), cancelled, stop_at_errors=True
+            ),
+        )
     except RunCancelled:
         raise Cancelled from None
     ends = run.legs[np.isfinite(run.legs).all(axis=1)]
@@ -189,8 +197,13 @@ def _leg_trajectory(run: AlgorithmRun, k: int) -> Trajectory | None:
     at = run.leg == k
     if np.count_nonzero(at) < 2:
         return None
-    return Trajectory(theta=run.theta[at] - run.theta[at][0], x=run.x[at], y=run.y[at],
-                      error=run.error[at], h=None if run.h is None else run.h[at])  # fmt: skip
+    return Trajectory(
+        theta=run.theta[at] - run.theta[at][0],
+        x=run.x[at],
+        y=run.y[at],
+        error=run.error[at],
+        h=None if run.h is None else run.h[at],
+    )
 
 
 def _legs_message(legs: int, drift, last_message: str) -> str:
@@ -208,11 +221,18 @@ def first_cycles(run: AlgorithmRun, cycles: int, legs: int) -> AlgorithmRun:
     keep = run.leg < cycles * legs
     drift = run.drift[:cycles]
     return replace(
-        run, theta=run.theta[keep], x=run.x[keep], y=run.y[keep], error=run.error[keep],
-        h=None if run.h is None else run.h[keep], leg=run.leg[keep],
-        leg_end=run.leg_end[: cycles * legs], drift=drift,
-        message=_legs_message(cycles * legs, drift, run.message), seconds=0.0,
-    )  # fmt: skip
+        run,
+        theta=run.theta[keep],
+        x=run.x[keep],
+        y=run.y[keep],
+        error=run.error[keep],
+        h=None if run.h is None else run.h[keep],
+        leg=run.leg[keep],
+        leg_end=run.leg_end[: cycles * legs],
+        drift=drift,
+        message=_legs_message(cycles * legs, drift, run.message),
+        seconds=0.0,
+    )
 
 
 def algorithm_run(

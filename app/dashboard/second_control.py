@@ -45,9 +45,15 @@ class SecondPhaseControl:
         return "cancelled" if self._second_cancelled == g else "done"
 
     def _second_phase(
-        self, generation: int, kin, amap, result: DashboardResult, deferred: bool, cached,
+        self,
+        generation: int,
+        kin,
+        amap,
+        result: DashboardResult,
+        deferred: bool,
+        cached,
         grid_before: dict | None,
-    ) -> None:  # fmt: skip
+    ) -> None:
         """h on a grid when it is expensive, then E1 and E2 (quadrature) and their sensitivity
         (:class:`SecondPhase`), unless a newer change comes meanwhile: ``progress`` events
         (``"phase": "second"``, what is computed) and a ``functionals`` event at the end, or,
@@ -58,10 +64,15 @@ class SecondPhaseControl:
         the latest result).
         """
         phase = SecondPhase(
-            kin, amap, result, deferred=deferred, cached=cached, grid_before=grid_before,
+            kin,
+            amap,
+            result,
+            deferred=deferred,
+            cached=cached,
+            grid_before=grid_before,
             progress=self._reporter(generation, "second"),
             cancelled=lambda: generation != self._generation or generation != self._second_running,
-        )  # fmt: skip
+        )
         with self._cond:
             self._grid_before = grid_before
         try:

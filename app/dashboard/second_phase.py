@@ -102,9 +102,12 @@ class SecondPhase:
             raise Cancelled
         if self.deferred:
             grid = augmenting_grid(
-                self.kin, self.result.state, self.result.runs, before=self.grid_before,
+                self.kin,
+                self.result.state,
+                self.result.runs,
+                before=self.grid_before,
                 progress=self._step(GRID, 0),
-            )  # fmt: skip
+            )
             self.result = replace(self.result, augmenting=grid)
         if self.cached:
             return self.cached
@@ -127,8 +130,12 @@ def finished_message(
     panels they change. Known functionals went out with the result: the event then only
     carries the h panel's title (a reused panel can lack it, and a page that connects now gets
     this event with the latest result)."""
-    message: dict = {"type": "functionals", "generation": generation,
-                     "functionals": functionals, "sensitivity": sens}  # fmt: skip
+    message: dict = {
+        "type": "functionals",
+        "generation": generation,
+        "functionals": functionals,
+        "sensitivity": sens,
+    }
     panels = {"sensitivity"} if not phase.cached or phase.deferred else set()
     if phase.deferred:  # the h panel was a placeholder: the whole figure
         panels.add("augmenting")
@@ -156,9 +163,16 @@ def cancelled_message(phase: SecondPhase, generation: int) -> str:
         titles["augmenting"] = h["layout"]["title"]["text"]
     texts = {k: figure_json(f) for k, f in specs.items()}
     message = {
-        "type": "functionals", "generation": generation, "functionals": None,
-        "sensitivity": None, "titles": titles, "digests": {k: digest(t) for k, t in texts.items()},
-        "cancelled": {"what": phase.what, "fraction": phase.fraction,
-                      "panels": sorted(set(texts) | set(titles))},
-    }  # fmt: skip
+        "type": "functionals",
+        "generation": generation,
+        "functionals": None,
+        "sensitivity": None,
+        "titles": titles,
+        "digests": {k: digest(t) for k, t in texts.items()},
+        "cancelled": {
+            "what": phase.what,
+            "fraction": phase.fraction,
+            "panels": sorted(set(texts) | set(titles)),
+        },
+    }
     return with_figures(message, texts)

@@ -149,9 +149,15 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts):
         raise it."""
         with self._cond:
             generation, state = self._generation, self._state
-        refused = {"type": "refused", "generation": generation, "source": source,
-                   "field": refusal.field, "message": str(refusal),
-                   "state": state.as_dict(), **controls_message(state)}  # fmt: skip
+        refused = {
+            "type": "refused",
+            "generation": generation,
+            "source": source,
+            "field": refusal.field,
+            "message": str(refusal),
+            "state": state.as_dict(),
+            **controls_message(state),
+        }
         self._emit(Event("refused", generation, to_json(refused)))
         raise refusal
 
@@ -260,8 +266,13 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts):
 
     # -- worker -----------------------------------------------------------------------------
     def _state_message(self, generation: int, state: DashboardState, source: str) -> dict:
-        return {"type": "state", "generation": generation, "state": state.as_dict(),
-                "source": source, **controls_message(state)}  # fmt: skip
+        return {
+            "type": "state",
+            "generation": generation,
+            "state": state.as_dict(),
+            "source": source,
+            **controls_message(state),
+        }
 
     def _emit(self, event: Event) -> None:
         with self._cond:
@@ -304,11 +315,20 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts):
         """Announce that ``generation`` failed with ``message``, and which result (if any)
         stays on screen: its generation and state (``shown``, None when there is none)."""
         on_screen = self.result
-        shown = None if on_screen is None else {
-            "generation": on_screen.generation, "state": on_screen.state.as_dict()}  # fmt: skip
-        self._emit(Event("error", generation, to_json({
-            "type": "error", "generation": generation, "message": message,
-            "shown": shown})))  # fmt: skip
+        shown = (
+            None
+            if on_screen is None
+            else {"generation": on_screen.generation, "state": on_screen.state.as_dict()}
+        )
+        self._emit(
+            Event(
+                "error",
+                generation,
+                to_json(
+                    {"type": "error", "generation": generation, "message": message, "shown": shown}
+                ),
+            )
+        )
         self._finish(generation)
 
     def _finish(self, generation: int) -> None:
@@ -330,10 +350,22 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts):
             now = time.perf_counter()
             if now - last[0] > 0.1 or (fraction >= 1 and phase == "runs"):
                 last[0] = now
-                self._emit(Event("progress", generation, to_json({
-                    "type": "progress", "generation": generation, "phase": phase,
-                    "what": what, "fraction": fraction, "elapsed": now - t0,
-                })))  # fmt: skip
+                self._emit(
+                    Event(
+                        "progress",
+                        generation,
+                        to_json(
+                            {
+                                "type": "progress",
+                                "generation": generation,
+                                "phase": phase,
+                                "what": what,
+                                "fraction": fraction,
+                                "elapsed": now - t0,
+                            }
+                        ),
+                    )
+                )
 
         return report
 
@@ -358,10 +390,15 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts):
                 if self._generation != generation:  # (a newer change came while it waited)
                     raise Cancelled
                 result = compute(
-                    state, generation, progress=progress,
-                    cancelled=lambda: self._generation != generation, cache=self._cache,
-                    with_augmenting=not deferred, offload=self._offload, grid_before=grid_before,
-                )  # fmt: skip
+                    state,
+                    generation,
+                    progress=progress,
+                    cancelled=lambda: self._generation != generation,
+                    cache=self._cache,
+                    with_augmenting=not deferred,
+                    offload=self._offload,
+                    grid_before=grid_before,
+                )
         except Cancelled:
             return
         except (JikError, ValueError) as exc:
@@ -379,12 +416,19 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts):
         self._figures = {(k, key): texts[k] for k in gamma_free_panels(result)}
         ready = time.perf_counter()
         head = {
-            "type": "result", "generation": generation, "state": state.as_dict(),
-            "summary": summary(result), "verdict": verdict(result), "colors": COLORS,
+            "type": "result",
+            "generation": generation,
+            "state": state.as_dict(),
+            "summary": summary(result),
+            "verdict": verdict(result),
+            "colors": COLORS,
             "labels": LABELS,
-            "timing": {"compute": result.seconds, "figures": ready - t0 - result.seconds,
-                       "server_total": ready - started},
-        }  # fmt: skip
+            "timing": {
+                "compute": result.seconds,
+                "figures": ready - t0 - result.seconds,
+                "server_total": ready - started,
+            },
+        }
         head["digests"] = {k: digest(t) for k, t in texts.items()}
         head["stale"] = sorted(stale)
         data = with_figures(head, texts)

@@ -60,9 +60,10 @@ class SessionLimits:
     def from_settings(cls, settings: Settings) -> SessionLimits:
         """``JIK_MAX_SESSIONS``, ``JIK_SESSION_IDLE_SECONDS``, ``JIK_DASHBOARD_COMPUTATIONS``."""
         return cls(
-            max_sessions=settings.max_sessions, idle_seconds=settings.session_idle_seconds,
+            max_sessions=settings.max_sessions,
+            idle_seconds=settings.session_idle_seconds,
             computations=settings.dashboard_computations,
-        )  # fmt: skip
+        )
 
 
 @dataclass

@@ -28,8 +28,9 @@ BLOW_UP, JUMP, DEPENDENT = 30.0, 30.0, 1e-6
 def _grid(state: DashboardState, names, region) -> tuple[np.ndarray, list[int]]:
     """The region's grid, other variables at x0: (NODES, ..., p) and the region's axes."""
     axes = [names.index(n) for n in region]
-    lines = [np.linspace(float(region[names[k]][0]), float(region[names[k]][1]), NODES)
-             for k in axes]  # fmt: skip
+    lines = [
+        np.linspace(float(region[names[k]][0]), float(region[names[k]][1]), NODES) for k in axes
+    ]
     mesh = np.meshgrid(*lines, indexing="ij")
     X = np.broadcast_to(np.asarray(state.x0, dtype=float), (*mesh[0].shape, len(names))).copy()
     for k, m in zip(axes, mesh, strict=True):
@@ -40,9 +41,14 @@ def _grid(state: DashboardState, names, region) -> tuple[np.ndarray, list[int]]:
 def singular_points(state: DashboardState) -> dict | None:
     """Where h or the extended Jacobian is singular in the robot's design region (cached by
     what it depends on: the robot, its map and their parameters, and x0)."""
-    key = (state.robot, json.dumps(state.robot_parameters, sort_keys=True),
-           json.dumps(state.robot_definition, sort_keys=True), state.augmentation,
-           json.dumps(state.augmentation_parameters, sort_keys=True), tuple(state.x0))  # fmt: skip
+    key = (
+        state.robot,
+        json.dumps(state.robot_parameters, sort_keys=True),
+        json.dumps(state.robot_definition, sort_keys=True),
+        state.augmentation,
+        json.dumps(state.augmentation_parameters, sort_keys=True),
+        tuple(state.x0),
+    )
     if key not in _CACHE:
         if len(_CACHE) > 64:
             _CACHE.clear()

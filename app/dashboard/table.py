@@ -32,8 +32,11 @@ def _tint(color: str) -> str:
 
 
 #: Cell colours: each algorithm's columns, the printed ones, and a cell that differs.
-FILLS = {**{a: _tint(s.color) for a, s in STYLES.items()}, "printed": "#eeeeee",
-         "differs": "#ffd966"}  # fmt: skip
+FILLS = {
+    **{a: _tint(s.color) for a, s in STYLES.items()},
+    "printed": "#eeeeee",
+    "differs": "#ffd966",
+}
 SHORT = {a: s.short.split(" (")[0] for a, s in STYLES.items()}
 ERRATUM = (
     "Erratum (docs/paper-errata.md, “Table 1 and the cubic (38)”): the printed extended column "
@@ -116,25 +119,35 @@ def table1_spec(result: DashboardResult) -> dict:
     ]
     if others:
         shown = ", ".join(SHORT[a] for a in others)
-        notes.append(f"Then jik's columns of {shown}: the paper's Table 1 prints the "
-                     "pseudoinverse and the extended Jacobian only.")  # fmt: skip
+        notes.append(
+            f"Then jik's columns of {shown}: the paper's Table 1 prints the "
+            "pseudoinverse and the extended Jacobian only."
+        )
     state = result.state
     if state.augmentation == "paper_cubic":
         notes.append(ERRATUM)
     else:
-        notes.append(f"The extended columns here use the augmenting map {state.augmentation}; "
-                     "the paper's were computed with the cubic (38) (choose paper_cubic to "
-                     "compare).")  # fmt: skip
+        notes.append(
+            f"The extended columns here use the augmenting map {state.augmentation}; "
+            "the paper's were computed with the cubic (38) (choose paper_cubic to "
+            "compare)."
+        )
     if state.mode == "discrete":
-        gap = max(float(np.max(np.abs(ends[a][: len(PRINTED[a])] - np.asarray(PRINTED[a]))))
-                  for a in PAPER if len(ends[a]) >= len(PRINTED[a]))  # fmt: skip
-        notes.append(f"Discrete mode changes the numbers: the paper's Table 1 is the continuous "
-                     f"algorithm (7); the iteration with step γ = {state.gamma:.3g} ends its legs "
-                     f"elsewhere (up to {gap:.3g} from the printed values). Choose mode = "
-                     "continuous to compare with the print.")  # fmt: skip
+        gap = max(
+            float(np.max(np.abs(ends[a][: len(PRINTED[a])] - np.asarray(PRINTED[a]))))
+            for a in PAPER
+            if len(ends[a]) >= len(PRINTED[a])
+        )
+        notes.append(
+            f"Discrete mode changes the numbers: the paper's Table 1 is the continuous "
+            f"algorithm (7); the iteration with step γ = {state.gamma:.3g} ends its legs "
+            f"elsewhere (up to {gap:.3g} from the printed values). Choose mode = "
+            "continuous to compare with the print."
+        )
     else:
-        notes.append("Continuous mode, as in the paper: the columns do not depend on γ "
-                     "(it only rescales θ).")  # fmt: skip
+        notes.append(
+            "Continuous mode, as in the paper: the columns do not depend on γ (it only rescales θ)."
+        )
     return _spec(TABLE1_TITLE, header, cols, fills, rows, notes, differs)
 
 
@@ -157,9 +170,11 @@ def leg_ends_spec(result: DashboardResult) -> dict:
             fills.append(FILLS[a])
     notes = []
     if result.state.robot == "manipulator2":
-        notes.append("Not Table 1: the paper's Table 1 is Manipulator 2 (l = 1) from x0 = "
-                     "(0, 0, π/2) on the closed path (1, 1), (1, 2), (0, 2), (0, 1); set those "
-                     "to compare with the printed values.")  # fmt: skip
+        notes.append(
+            "Not Table 1: the paper's Table 1 is Manipulator 2 (l = 1) from x0 = "
+            "(0, 0, π/2) on the closed path (1, 1), (1, 2), (0, 2), (0, 1); set those "
+            "to compare with the printed values."
+        )
     return _spec(LEG_ENDS_TITLE, header, cols, fills, rows, notes, [])
 
 
@@ -169,16 +184,27 @@ def table_spec(result: DashboardResult) -> dict:
 
 
 def _spec(title, header, cols, fills, rows, notes, differs) -> dict:
-    cell_fills = [[FILLS["differs"] if [c, r] in [d[:2] for d in differs] else
-                   ("white" if r % 2 == 0 else "#f7f7f7") for r in range(rows)]
-                  for c in range(len(cols))]  # fmt: skip
-    table = trace("table",
+    cell_fills = [
+        [
+            FILLS["differs"]
+            if [c, r] in [d[:2] for d in differs]
+            else ("white" if r % 2 == 0 else "#f7f7f7")
+            for r in range(rows)
+        ]
+        for c in range(len(cols))
+    ]
+    table = trace(
+        "table",
         # (fill=dict(color=...): plotly.py's "fill_color" shorthand is expanded only by its
         # validation, which the builders skip; the page reads fill.color)
         header=dict(values=header, fill=dict(color=fills), font=dict(size=11), align="center"),
-        cells=dict(values=cols, font=dict(size=11, family="monospace"), align="right",
-                   fill=dict(color=cell_fills)),
-    )  # fmt: skip
+        cells=dict(
+            values=cols,
+            font=dict(size=11, family="monospace"),
+            align="right",
+            fill=dict(color=cell_fills),
+        ),
+    )
     spec = figure([table], title, margin=dict(l=10, r=10, t=40, b=10))
     spec["layout"]["meta"] = {"notes": notes, "differs": differs}
     return spec

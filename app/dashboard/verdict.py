@@ -69,10 +69,15 @@ def _drift_sentence(algorithm: str, run: AlgorithmRun, unit: str) -> Sentence:
         trend = ""
         if n > 1:
             grows = d[-1] > d[0] * 1.05
-            trend = (f", growing from {g(float(d[0]))} after cycle 1" if grows
-                     else f" (after cycle 1: {g(float(d[0]))})")  # fmt: skip
-        text = (f"{NAMES[algorithm]}: not repeatable. After {cycles} the joints end "
-                f"‖x − x0‖ = {g(float(d[-1]))} {unit} away from x0{trend}.")  # fmt: skip
+            trend = (
+                f", growing from {g(float(d[0]))} after cycle 1"
+                if grows
+                else f" (after cycle 1: {g(float(d[0]))})"
+            )
+        text = (
+            f"{NAMES[algorithm]}: not repeatable. After {cycles} the joints end "
+            f"‖x − x0‖ = {g(float(d[-1]))} {unit} away from x0{trend}."
+        )
     return Sentence(text, algorithm)
 
 
@@ -85,37 +90,64 @@ def _extended_why(result: DashboardResult, run: AlgorithmRun) -> list[Sentence]:
     kept = dh < H_CONSERVED
     out = []
     if kept:
-        tail = (", so each task point has one configuration on that level set, and the closed "
-                "task path gave a closed joint path." if closed and repeatable(run)
-                else ".")  # fmt: skip
-        out.append(Sentence(
-            f"Why: J^E# adds the equation h(x) = h(x0) (eq. (12)); h changed by only {g(dh)} "
-            f"along its run{tail}", "extended", "why"))  # fmt: skip
+        tail = (
+            ", so each task point has one configuration on that level set, and the closed "
+            "task path gave a closed joint path."
+            if closed and repeatable(run)
+            else "."
+        )
+        out.append(
+            Sentence(
+                f"Why: J^E# adds the equation h(x) = h(x0) (eq. (12)); h changed by only {g(dh)} "
+                f"along its run{tail}",
+                "extended",
+                "why",
+            )
+        )
     else:
-        lost = (" A closed task path gives a closed joint path only while h stays at h(x0): "
-                "here it did not, so the joints did not come back." if closed and not
-                repeatable(run) else "")  # fmt: skip
-        out.append(Sentence(
-            f"h was not conserved: it changed by {g(dh)} along the extended Jacobian's run."
-            + lost, "extended", "why"))  # fmt: skip
+        lost = (
+            " A closed task path gives a closed joint path only while h stays at h(x0): "
+            "here it did not, so the joints did not come back."
+            if closed and not repeatable(run)
+            else ""
+        )
+        out.append(
+            Sentence(
+                f"h was not conserved: it changed by {g(dh)} along the extended Jacobian's run."
+                + lost,
+                "extended",
+                "why",
+            )
+        )
     if state.mode == "discrete" and not kept:
-        out.append(Sentence(
-            "The discrete algorithm x ← x − γ J^E# e keeps h only approximately: each step "
-            "moves along the tangent of the level set h = h(x0), not on it, so h changes by "
-            "an amount that grows with γ (the continuous algorithm (7) keeps h exactly).",
-            "extended", "note"))  # fmt: skip
+        out.append(
+            Sentence(
+                "The discrete algorithm x ← x − γ J^E# e keeps h only approximately: each step "
+                "moves along the tangent of the level set h = h(x0), not on it, so h changes by "
+                "an amount that grows with γ (the continuous algorithm (7) keeps h exactly).",
+                "extended",
+                "note",
+            )
+        )
     if state.mode == "discrete" and state.gamma >= GAMMA_NEAR_TWO:
-        out.append(Sentence(
-            f"γ = {g(state.gamma)} is near 2, the limit of the discrete iteration: the task "
-            f"error is multiplied by about 1 − γ = {g(1 - state.gamma)} per step, so the "
-            "iterates overshoot back and forth and h is far from conserved; at γ ≥ 2 the "
-            "iteration diverges.", None, "note"))  # fmt: skip
+        out.append(
+            Sentence(
+                f"γ = {g(state.gamma)} is near 2, the limit of the discrete iteration: the task "
+                f"error is multiplied by about 1 − γ = {g(1 - state.gamma)} per step, so the "
+                "iterates overshoot back and forth and h is far from conserved; at γ ≥ 2 the "
+                "iteration diverges.",
+                None,
+                "note",
+            )
+        )
     return out
 
 
 #: Section 6.2's runs: the start pose, and the figures of its pseudoinverse and extended runs.
-PAPER_RUNS = {"A": (POSE_A, "Figs. 11 (J^P#) and 12 (J^E#)"),
-              "B": (POSE_B, "Figs. 13 (J^P#) and 14 (J^E#)")}  # fmt: skip
+PAPER_RUNS = {
+    "A": (POSE_A, "Figs. 11 (J^P#) and 12 (J^E#)"),
+    "B": (POSE_B, "Figs. 13 (J^P#) and 14 (J^E#)"),
+}
 
 
 def _paper_run(result: DashboardResult) -> str | None:
@@ -137,16 +169,23 @@ def _undefined_why(result: DashboardResult, run: AlgorithmRun) -> list[Sentence]
     zero of the kernel component that normalises omega, and, for the paper's run B, that this is
     Figs. 13-14's run and docs/paper-errata.md's finding."""
     state = result.state
-    if (state.robot != "unicycle" or state.augmentation != "characteristics" or run.success
-            or "is undefined" not in run.message or len(run.x) < 2):  # fmt: skip
+    if (
+        state.robot != "unicycle"
+        or state.augmentation != "characteristics"
+        or run.success
+        or "is undefined" not in run.message
+        or len(run.x) < 2
+    ):
         return []
     a = float(state.augmentation_parameters.get("a", 1.0))
     before, after = float(run.x[-2][0]), float(run.x[-1][0])
     which = f"iteration {len(run.x) - 1}" if state.mode == "discrete" else "the run's last step"
     step = f"{which} took λ10 from {g(before)} to {g(after)}"
     if after * a <= 0:
-        left = (f"{step}, across λ10 = 0 and out of the domain of the map's foliation (λ10 of "
-                f"the sign of a = {g(a)}: ω is undefined on λ10 = 0)")  # fmt: skip
+        left = (
+            f"{step}, across λ10 = 0 and out of the domain of the map's foliation (λ10 of "
+            f"the sign of a = {g(a)}: ω is undefined on λ10 = 0)"
+        )
     else:
         left = step
     text = (
@@ -176,14 +215,24 @@ def _undefined_why(result: DashboardResult, run: AlgorithmRun) -> list[Sentence]
 
 def _pseudoinverse_why(run: AlgorithmRun) -> list[Sentence]:
     if repeatable(run) is False:
-        return [Sentence(
-            "Why: J^P# picks the minimum-norm joint velocity, which has no memory of the start "
-            "(it keeps nothing like h constant), so a closed task path need not close in the "
-            "joints.", "pseudoinverse", "why")]  # fmt: skip
+        return [
+            Sentence(
+                "Why: J^P# picks the minimum-norm joint velocity, which has no memory of the start "
+                "(it keeps nothing like h constant), so a closed task path need not close in the "
+                "joints.",
+                "pseudoinverse",
+                "why",
+            )
+        ]
     if repeatable(run):
-        return [Sentence(
-            "The pseudoinverse happens to come back on this path: its joint flow closes here, "
-            "which it does not in general.", "pseudoinverse", "why")]  # fmt: skip
+        return [
+            Sentence(
+                "The pseudoinverse happens to come back on this path: its joint flow closes here, "
+                "which it does not in general.",
+                "pseudoinverse",
+                "why",
+            )
+        ]
     return []
 
 
@@ -201,10 +250,14 @@ def verdict(result: DashboardResult) -> list[dict]:
         elif run.success:
             out.append(Sentence(f"{NAMES[algorithm]}: {run.message}.", algorithm))
         if not run.success:
-            done = (f" (after {len(run.drift)} completed cycle{'s' if len(run.drift) > 1 else ''})"
-                    if path and len(run.drift) else "")  # fmt: skip
-            out.append(Sentence(f"{NAMES[algorithm]} stopped{done}: {run.message}", algorithm,
-                                "failure"))  # fmt: skip
+            done = (
+                f" (after {len(run.drift)} completed cycle{'s' if len(run.drift) > 1 else ''})"
+                if path and len(run.drift)
+                else ""
+            )
+            out.append(
+                Sentence(f"{NAMES[algorithm]} stopped{done}: {run.message}", algorithm, "failure")
+            )
     out += _pseudoinverse_why(runs["pseudoinverse"]) if path and "pseudoinverse" in runs else []
     if "extended" in runs:
         ext = runs["extended"]

@@ -57,8 +57,11 @@ def _posture(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
         parts.append(f"it drifts {g(d)} {unit}")
     e = runs.get("extended")
     if d >= REPEATABLE_DRIFT:
-        reach = (f"the extended Jacobian's {g(float(e.drift[n - 1]))}"
-                 if e is not None and len(e.drift) >= n else "repeatability")  # fmt: skip
+        reach = (
+            f"the extended Jacobian's {g(float(e.drift[n - 1]))}"
+            if e is not None and len(e.drift) >= n
+            else "repeatability"
+        )
         parts.append(
             f"but does not reach {reach}: the pull toward x_rest moves the joints inside the "
             "self-motion and slows the drift, yet the end of a cycle does not come back to x0"
@@ -87,8 +90,10 @@ def _damped(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
     if p is not None and not p.success and run.success:
         text += "; it went through where the pseudoinverse stopped"
     elif p is not None and not p.success and run.error[-1] < p.error[-1]:
-        text += (f"; where the pseudoinverse stalled at task error {g(float(p.error[-1]))}, "
-                 f"it got to {g(float(run.error[-1]))}")  # fmt: skip
+        text += (
+            f"; where the pseudoinverse stalled at task error {g(float(p.error[-1]))}, "
+            f"it got to {g(float(run.error[-1]))}"
+        )
     elif not run.success:
         text += f"; it stopped with task error {g(float(run.error[-1]))}"
     return [(text + ".", "why")]
@@ -112,8 +117,13 @@ def _weighted(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
     if not (below.any() or above.any()):
         margin = np.minimum(run.x - lo, hi - run.x).min(axis=0)
         k = int(np.argmin(margin))
-        return [(f"{NAMES['weighted']}: every joint stayed within its limits ({bounds}); "
-                 f"closest: {names[k]}, {g(float(margin[k]))} from a limit.", "why")]  # fmt: skip
+        return [
+            (
+                f"{NAMES['weighted']}: every joint stayed within its limits ({bounds}); "
+                f"closest: {names[k]}, {g(float(margin[k]))} from a limit.",
+                "why",
+            )
+        ]
     out = sorted({names[k] for k in np.flatnonzero((below | above).any(axis=0))})
     return [(f"{NAMES['weighted']}: left its limits ({bounds}): {', '.join(out)}.", "failure")]
 
@@ -123,5 +133,9 @@ SENTENCES = {"posture": _posture, "damped": _damped, "weighted": _weighted}
 
 def practical_sentences(result: DashboardResult, unit: str) -> list[tuple[str, str, str]]:
     """(text, algorithm, role) of the chosen practical inverses' sentences."""
-    return [(text, a, role) for a in result.runs if a in SENTENCES
-            for text, role in SENTENCES[a](result, unit)]  # fmt: skip
+    return [
+        (text, a, role)
+        for a in result.runs
+        if a in SENTENCES
+        for text, role in SENTENCES[a](result, unit)
+    ]

@@ -64,14 +64,21 @@ def target_fixtures(result, kin: Any, root: str, size: float) -> dict[str, tuple
         position, q = pose
         if q is None:
             out[f"{root}/targets/{k}"] = (
-                "ball", {"position": position}, {"radius": 0.15 * size, "color": (0, 0, 0)}
-            )  # fmt: skip
+                "ball",
+                {"position": position},
+                {"radius": 0.15 * size, "color": (0, 0, 0)},
+            )
         else:
             out[f"{root}/targets/{k}"] = (
-                "frame", {"position": position, "wxyz": q},
-                {"axes_length": size, "axes_radius": 0.06 * size, "origin_radius": 0.12 * size,
-                 "origin_color": (0, 0, 0)},
-            )  # fmt: skip
+                "frame",
+                {"position": position, "wxyz": q},
+                {
+                    "axes_length": size,
+                    "axes_radius": 0.06 * size,
+                    "origin_radius": 0.12 * size,
+                    "origin_color": (0, 0, 0),
+                },
+            )
     return out
 
 

@@ -104,16 +104,21 @@ class SceneControls:
         if control.kind == "select":
             by_label = {label: v for v, label in control.options}
             labels = self._options[key] = {v: label for v, label in control.options}
-            handle = gui.add_dropdown(control.label, list(by_label), initial_value=labels[value],
-                                      hint=control.help)  # fmt: skip
+            handle = gui.add_dropdown(
+                control.label, list(by_label), initial_value=labels[value], hint=control.help
+            )
             handle.on_update(lambda e: self._change({key: by_label[e.target.value]}))
         elif control.kind == "checks":
             handle = Checks(gui, control, value, lambda v: self._change({key: v}))
         elif control.kind == "slider":
             handle = gui.add_slider(
-                control.label, min=control.minimum, max=control.maximum, step=control.step,
-                initial_value=min(max(value, control.minimum), control.maximum), hint=control.help,
-            )  # fmt: skip
+                control.label,
+                min=control.minimum,
+                max=control.maximum,
+                step=control.step,
+                initial_value=min(max(value, control.minimum), control.maximum),
+                hint=control.help,
+            )
             if control.integer:  # (viser's slider gives a float)
                 handle.on_update(lambda e: self._change({key: round(e.target.value)}))
             else:
@@ -122,8 +127,9 @@ class SceneControls:
             add: Any = gui.add_vector2 if control.size == 2 else gui.add_vector3
             lo = None if control.minimum is None else tuple(control.minimum)
             hi = None if control.maximum is None else tuple(control.maximum)
-            handle = add(control.label, tuple(value), min=lo, max=hi, step=control.step,
-                         hint=control.help)  # fmt: skip
+            handle = add(
+                control.label, tuple(value), min=lo, max=hi, step=control.step, hint=control.help
+            )
             handle.on_update(lambda e: self._change({key: list(e.target.value)}))
         else:  # text (the path), or a vector of another size: as text, parsed by the server
             hint = f"{control.help} ({control.format})" if control.format else control.help
@@ -139,8 +145,10 @@ class Checks:
 
     def __init__(self, gui, control: Control, value, send: Callable[[list], None]) -> None:
         self.label = control.label
-        self.boxes = {v: gui.add_checkbox(label, v in value, hint=control.help)
-                      for v, label in control.options}  # fmt: skip
+        self.boxes = {
+            v: gui.add_checkbox(label, v in value, hint=control.help)
+            for v, label in control.options
+        }
         for box in self.boxes.values():
             box.on_update(lambda _: send(self.value))
 

@@ -53,10 +53,13 @@ class StartGizmo:
             if self.handle is not None:
                 self.handle.remove()
             self.handle = self._scene.add_transform_controls(
-                "/start", scale=1.2 if state.robot == "unicycle" else 0.5,
-                active_axes=(True, True, False), depth_test=False, position=(X, Y, 0.3),
+                "/start",
+                scale=1.2 if state.robot == "unicycle" else 0.5,
+                active_axes=(True, True, False),
+                depth_test=False,
+                position=(X, Y, 0.3),
                 wxyz=yaw_quaternion(yaw),
-            )  # fmt: skip
+            )
             self._robot = state.robot
             self._scene.add_label("/start/label", "drag: start point", position=(0, 0, 0.15))
             self.handle.on_update(self.on_drag)

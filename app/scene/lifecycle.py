@@ -159,13 +159,15 @@ class DashboardScene:
             self.drawn_generation = result.generation
             self._sync_now()
             self.dashboard.scene_status.update(
-                generation=result.generation, robot=state.robot, playing=self.playback.playing,
+                generation=result.generation,
+                robot=state.robot,
+                playing=self.playback.playing,
                 mechanism=type(next(iter(self.nodes.mechanisms.values()), None)).__name__,
-                joints=len(getattr(next(iter(self.nodes.mechanisms.values()), None), "joints",
-                                   ())),
-                pose_frames=sum(type(h).__name__ == "FrameHandle"
-                                for h in self.nodes.fixtures.values()),
-            )  # fmt: skip
+                joints=len(getattr(next(iter(self.nodes.mechanisms.values()), None), "joints", ())),
+                pose_frames=sum(
+                    type(h).__name__ == "FrameHandle" for h in self.nodes.fixtures.values()
+                ),
+            )
         self._show_status(result)
 
     def _prebuild(self, result) -> None:
@@ -191,8 +193,10 @@ class DashboardScene:
 
 def legend(algorithms) -> str:
     """The scene's key: each chosen algorithm's colour, name and copy, and the grey start."""
-    keys = " · ".join(f"<span style='color:{COLORS[a]}'>■ {LABELS[a]}</span>: "
-                      f"{STYLES[a]['robot']}" for a in algorithms)  # fmt: skip
+    keys = " · ".join(
+        f"<span style='color:{COLORS[a]}'>■ {LABELS[a]}</span>: {STYLES[a]['robot']}"
+        for a in algorithms
+    )
     lines = " and ".join(STYLES[a]["line"] for a in algorithms)
     return f"{keys} · grey: start x0 (the plots: {lines})"
 

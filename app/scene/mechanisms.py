@@ -192,18 +192,26 @@ class Chain(Mechanism):
         n = home.shape[0]
         width = 5.0 if self.opacity is None else 3.5
         self.links = self.scene.add_line_segments(
-            f"{self.root}/links", np.zeros((n - 1, 2, 3)), self.color, thickness=width,
+            f"{self.root}/links",
+            np.zeros((n - 1, 2, 3)),
+            self.color,
+            thickness=width,
             thickness_units="screen",
-        )  # fmt: skip
+        )
         # Joints sized to the arm: a sixtieth of its reach (0.04 for an arm of reach 2.4).
         reach = float(np.linalg.norm(np.diff(home, axis=0), axis=1).sum())
         ball = max(reach, 1e-3) / 60
         self.joints = [self.ball(f"joint{i}", ball if i < n - 1 else 1.5 * ball) for i in range(n)]
         # The end link's frame when the task holds its orientation (a pose task).
-        self.end = None if end_frame(self.kin, self.state.x0) is None else self.scene.add_frame(
-            f"{self.root}/end", axes_length=AXES_FRACTION * reach,
-            axes_radius=0.06 * AXES_FRACTION * reach,
-        )  # fmt: skip
+        self.end = (
+            None
+            if end_frame(self.kin, self.state.x0) is None
+            else self.scene.add_frame(
+                f"{self.root}/end",
+                axes_length=AXES_FRACTION * reach,
+                axes_radius=0.06 * AXES_FRACTION * reach,
+            )
+        )
         self._marks()
 
     def _marks(self) -> None:
@@ -240,8 +248,7 @@ def chain_points(kin: Any, x: np.ndarray, z: float) -> np.ndarray:
 
 #: The robots drawn as a serial chain of links (:class:`Chain`): a user's and the catalogue's arms.
 CHAINS = ("planar_chain", "urdf", *ARMS)
-MECHANISMS = {"manipulator1": NormalForm, "manipulator2": Gantry,
-              **dict.fromkeys(CHAINS, Chain)}  # fmt: skip
+MECHANISMS = {"manipulator1": NormalForm, "manipulator2": Gantry, **dict.fromkeys(CHAINS, Chain)}
 
 
 def layout_name(state) -> str:
@@ -303,12 +310,16 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
     if robot == "manipulator2":
         for side, x in (("left", xlo), ("right", xhi)):
             out[f"{root}/rails/{side}"] = (
-                "box", {"dimensions": rail, "position": (x, (ylo + yhi) / 2, -0.02)}, grey
-            )  # fmt: skip
+                "box",
+                {"dimensions": rail, "position": (x, (ylo + yhi) / 2, -0.02)},
+                grey,
+            )
     elif robot == "manipulator1":
         out[f"{root}/guide"] = (
-            "box", {"dimensions": rail, "position": (0.0, (ylo + yhi) / 2, -0.02)}, grey
-        )  # fmt: skip
+            "box",
+            {"dimensions": rail, "position": (0.0, (ylo + yhi) / 2, -0.02)},
+            grey,
+        )
     chain = robot in CHAINS
     kin = state_kinematics(result.state) if chain else None
     for a, run in result.runs.items():
@@ -319,22 +330,26 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
             z = np.full(len(run.y), (Z[a] + 0.16) * scale)
             task = np.column_stack([run.y[:, 0], run.y[:, 1], z])
         out[f"{root}/trace/{a}/task"] = (
-            "line", {"points": polyline(task, tol)},
+            "line",
+            {"points": polyline(task, tol)},
             {**line, "thickness": 3.0 if a == "pseudoinverse" else 2.0},
-        )  # fmt: skip
+        )
         if robot == "manipulator2":
             joints = np.column_stack([run.x[:, 1], run.x[:, 0], np.full(len(run.x), Z[a] + 0.1)])
             out[f"{root}/trace/{a}/joints"] = (
-                "line", {"points": polyline(joints, tol)}, {**line, "thickness": 1.2}
-            )  # fmt: skip
+                "line",
+                {"points": polyline(joints, tol)},
+                {**line, "thickness": 1.2},
+            )
     if chain and robot != "planar_chain":  # (a frame or a point, see target_fixtures)
         reach = float(np.linalg.norm(np.ptp(np.reshape(extent, (2, 2)), axis=1)))
         return {**out, **target_fixtures(result, kin, root, AXES_FRACTION * reach / 2)}
     for k, target in enumerate(result.targets):
         out[f"{root}/targets/{k}"] = (
-            "ball", {"position": (float(target[0]), float(target[1]), 0.2 * scale)},
+            "ball",
+            {"position": (float(target[0]), float(target[1]), 0.2 * scale)},
             {"radius": 0.05 * scale, "color": (0, 0, 0)},
-        )  # fmt: skip
+        )
     return out
 
 

@@ -100,8 +100,10 @@ class NodeSets:
             entry["frame"].visible = True
             self._update(entry, result, extent)
         self.fixtures, self.mechanisms, self.home = (
-            entry["fixtures"], entry["mechanisms"], entry["home"]
-        )  # fmt: skip
+            entry["fixtures"],
+            entry["mechanisms"],
+            entry["home"],
+        )
 
     def _build(self, result, extent, visible: bool) -> dict[str, Any]:
         """The nodes of ``result``'s manipulator and task under their own frame."""
@@ -110,9 +112,12 @@ class NodeSets:
         chosen = "" if state.algorithms == DEFAULT_ALGORITHMS else "-" + "-".join(state.algorithms)
         root = f"/robot/{layout_name(state)}-{state.task}{chosen}"
         entry: dict[str, Any] = {
-            "root": root, "frame": scene.add_frame(root, show_axes=False, visible=visible),
-            "mechanisms": {}, "home": None, "fixtures": {},
-        }  # fmt: skip
+            "root": root,
+            "frame": scene.add_frame(root, show_axes=False, visible=visible),
+            "mechanisms": {},
+            "home": None,
+            "fixtures": {},
+        }
         cls = MECHANISMS.get(state.robot)
         if cls is not None:
             entry["home"] = cls(scene, f"{root}/home", HOME_COLOR, 0.25, -0.03, state, extent)
@@ -136,9 +141,11 @@ class NodeSets:
         path gained) are added, ones it lost are removed."""
         scene = self.scene
         add: dict[str, Callable[..., Any]] = {
-            "box": scene.add_box, "line": scene.add_line_segments, "ball": scene.add_icosphere,
+            "box": scene.add_box,
+            "line": scene.add_line_segments,
+            "ball": scene.add_icosphere,
             "frame": scene.add_frame,
-        }  # fmt: skip
+        }
         wanted = fixtures_of(result, extent, root)
         for name in [n for n in fixtures if n not in wanted]:
             fixtures.pop(name).remove()
@@ -177,10 +184,18 @@ class NodeSets:
                 )
                 pts = np.column_stack([P[:, 0], P[:, 1], np.full(len(P), 0.02 + Z[a] * 0.2)])
                 scene.add_line_segments(
-                    f"{UNICYCLE_ROOT}/trace/{a}/{n}", polyline(pts, tol), color,
-                    thickness=3.5 if last else 1.5, thickness_units="screen",
-                )  # fmt: skip
+                    f"{UNICYCLE_ROOT}/trace/{a}/{n}",
+                    polyline(pts, tol),
+                    color,
+                    thickness=3.5 if last else 1.5,
+                    thickness_units="screen",
+                )
             self.mechanisms[a] = Platform(
-                scene, f"{UNICYCLE_ROOT}/{a}", rgb(COLORS[a]), OPACITY[a], Z[a] * 0.5, state,
+                scene,
+                f"{UNICYCLE_ROOT}/{a}",
+                rgb(COLORS[a]),
+                OPACITY[a],
+                Z[a] * 0.5,
+                state,
                 None,
-            )  # fmt: skip
+            )

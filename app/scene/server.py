@@ -152,5 +152,7 @@ class SceneServer(viser.ViserServer):
             f"ws://127.0.0.1:{self.get_port()}",
             subprotocols=[Subprotocol(p) for p in subprotocols] if subprotocols else None,
             additional_headers={"Authorization": _AUTHORIZATION},
-            max_size=None, compression=None, open_timeout=10,
-        )  # fmt: skip
+            max_size=None,
+            compression=None,
+            open_timeout=10,
+        )

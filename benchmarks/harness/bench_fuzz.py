@@ -67,17 +67,41 @@ def run_fuzz(
             f.write(CONFIG)
         started = time.perf_counter()
         out = subprocess.run(
-            [sys.executable, "-m", "schemathesis.cli", "--config-file", config, "run",
-             f"{server.url}/openapi.json",
-             "--checks", "all", "--phases", phases, "--max-examples", str(max_examples),
-             *(["--exclude-checks", exclude_checks] if exclude_checks else []),
-             *(["--generation-deterministic"] if deterministic else ["--seed", str(seed)]),
-             "--workers", "1", "--suppress-health-check", "all",
-             "--continue-on-failure", "--request-timeout", "120", "--no-color"],
-            env=dict(os.environ, SCHEMATHESIS_HOOKS="jik.benchmarks.harness.fuzz_hooks",
-                     JIK_FUZZ_SERVER=server.url),
-            capture_output=True, text=True, timeout=timeout, cwd=scratch,
-        )  # fmt: skip
+            [
+                sys.executable,
+                "-m",
+                "schemathesis.cli",
+                "--config-file",
+                config,
+                "run",
+                f"{server.url}/openapi.json",
+                "--checks",
+                "all",
+                "--phases",
+                phases,
+                "--max-examples",
+                str(max_examples),
+                *(["--exclude-checks", exclude_checks] if exclude_checks else []),
+                *(["--generation-deterministic"] if deterministic else ["--seed", str(seed)]),
+                "--workers",
+                "1",
+                "--suppress-health-check",
+                "all",
+                "--continue-on-failure",
+                "--request-timeout",
+                "120",
+                "--no-color",
+            ],
+            env=dict(
+                os.environ,
+                SCHEMATHESIS_HOOKS="jik.benchmarks.harness.fuzz_hooks",
+                JIK_FUZZ_SERVER=server.url,
+            ),
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+            cwd=scratch,
+        )
         seconds = time.perf_counter() - started
     log = server.log[0]
     text = out.stdout + out.stderr
@@ -93,9 +117,11 @@ def run_fuzz(
 
 def _report(title: str, run: FuzzRun) -> None:
     print(title)
-    print(f"  cases {run.cases}, failures {run.failures}, {run.seconds:.0f} s "
-          f"({1000 * run.seconds / max(run.cases, 1):.1f} ms per case), server tracebacks: "
-          f"{run.server_log.count('Traceback')}")  # fmt: skip
+    print(
+        f"  cases {run.cases}, failures {run.failures}, {run.seconds:.0f} s "
+        f"({1000 * run.seconds / max(run.cases, 1):.1f} ms per case), server tracebacks: "
+        f"{run.server_log.count('Traceback')}"
+    )
     if not run.clean:  # (schemathesis's failures, each with its curl command)
         failures = run.output.split("FAILURES")[-1].split("SUMMARY")[0]
         print(failures[-12000:] if "FAILURES" in run.output else run.output[-6000:])
@@ -106,8 +132,10 @@ def main(quick: bool = False) -> None:
         print("jik bench fuzz needs schemathesis, of the test extra: pip install -e '.[test]'")
         return
     examples = 20 if quick else 850
-    _report(f"schemathesis, every check, phases {PHASES}, {examples} examples per operation",
-            run_fuzz(examples))  # fmt: skip
+    _report(
+        f"schemathesis, every check, phases {PHASES}, {examples} examples per operation",
+        run_fuzz(examples),
+    )
     # The coverage phase's boundary cases do not pass through the hooks, so its positive cases
     # include what the document cannot rule out (a box [0, 0], 1000 cycles): every other check.
     coverage = run_fuzz(examples, phases="coverage", exclude_checks="positive_data_acceptance")

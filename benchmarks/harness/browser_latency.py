@@ -157,8 +157,11 @@ class Tab:
         arg = {"selector": change.selector, "event": change.event, "position": change.position}
         t0 = self.page.evaluate(_CHANGE, arg)
         plots, scene = self.shown_at(generation)
-        return {"plots_ms": plots - t0, "scene_ms": scene - t0,
-                "compute_ms": self.compute_ms(generation)}  # fmt: skip
+        return {
+            "plots_ms": plots - t0,
+            "scene_ms": scene - t0,
+            "compute_ms": self.compute_ms(generation),
+        }
 
     def reload(self, change: Change) -> dict:
         """The page loaded anew with the changed state in its link: latencies from the
@@ -194,8 +197,9 @@ def browser(base: str, pid: int, sessions: list[list[Change]]) -> list[dict]:
                     k = count[change.kind] = count.get(change.kind, -1) + 1
                     mode = "reload" if k % 2 else "jik"
                     timing = tab.reload(change) if mode == "reload" else tab.change(change)
-                    samples.append({"kind": change.kind, "family": change.family, "mode": mode,
-                                    **timing})  # fmt: skip
+                    samples.append(
+                        {"kind": change.kind, "family": change.family, "mode": mode, **timing}
+                    )
                     tab.settle()
                 tab.page.close()
                 with contextlib.suppress(httpx.HTTPError):

@@ -119,15 +119,19 @@ def _capped(body: dict) -> dict:
             body[name] = {k: _clamped(v) for k, v in body[name].items()}
     augmentation = body.get("augmentation")
     if isinstance(augmentation, dict) and isinstance(augmentation.get("degree"), int):
-        body["augmentation"] = {**augmentation, "degree": min(augmentation["degree"],
-                                                              WORK_CAPS["degree"])}  # fmt: skip
+        body["augmentation"] = {
+            **augmentation,
+            "degree": min(augmentation["degree"], WORK_CAPS["degree"]),
+        }
     if isinstance(augmentation, dict) and len(augmentation.get("region") or {}) > 3:
         # a total-degree synthesis' work grows as C(n + d, d)^2: total degree 2 over 4-16 joints
         body["augmentation"] = {**body["augmentation"], "degree": 2}
     robot = body.get("robot")
     if isinstance(robot, dict):
-        body["robot"] = {k: min(v, ROBOT_CAPS[k]) if k in ROBOT_CAPS and isinstance(v, float)
-                         else v for k, v in robot.items()}  # fmt: skip
+        body["robot"] = {
+            k: min(v, ROBOT_CAPS[k]) if k in ROBOT_CAPS and isinstance(v, float) else v
+            for k, v in robot.items()
+        }
     return body
 
 
@@ -161,9 +165,13 @@ def _total_degree_ok(body: dict, d: int, p: int, r: int) -> bool:
     frame_ok = axes is None or p - r < 2 or (len(set(axes)) == p - r and max(axes) <= p)
     unknowns = basis_size(d, degree)
     return (
-        d >= 1 and not body.get("augmentation") and frame_ok and not nodes & (nodes - 1)
-        and unknowns <= MAX_UNKNOWNS and nodes >= 2 * unknowns
-    )  # fmt: skip
+        d >= 1
+        and not body.get("augmentation")
+        and frame_ok
+        and not nodes & (nodes - 1)
+        and unknowns <= MAX_UNKNOWNS
+        and nodes >= 2 * unknowns
+    )
 
 
 def _synthesis_ok(body: dict) -> bool:

@@ -34,13 +34,17 @@ PANDA = {"name": "panda", "task": "pose"}
 
 #: What the tables print for the parameters the catalogue leaves to the robot, per loop.
 SHOWN = {
-    "manipulator2": {"extended": {"augmentation": "paper_cubic (38)"},
-                     "weighted": {"limits": "x_range of the catalogue: [-3, 3], [-3, 3], "
-                                            "[-pi, 2 pi]"},
-                     "posture": {"rest": "x0"}},
-    "panda": {"extended": {"augmentation": "e2_synthesized (19)"},
-              "weighted": {"limits": "the Panda's joint limits"}, "posture": {"rest": "home"}},
-}  # fmt: skip
+    "manipulator2": {
+        "extended": {"augmentation": "paper_cubic (38)"},
+        "weighted": {"limits": "x_range of the catalogue: [-3, 3], [-3, 3], [-pi, 2 pi]"},
+        "posture": {"rest": "x0"},
+    },
+    "panda": {
+        "extended": {"augmentation": "e2_synthesized (19)"},
+        "weighted": {"limits": "the Panda's joint limits"},
+        "posture": {"rest": "home"},
+    },
+}
 
 
 def _parameters(name: str, loop: str = "manipulator2") -> dict:
@@ -106,8 +110,12 @@ def _part(progress: Callable[[float], None], k: int, n: int) -> Callable[[int, i
 def _table(title: str, rows: list[dict], cycles: int) -> list[str]:
     shown = [c for c in REPORTED if c <= cycles]
     head = " | ".join(f"after {c}" for c in shown)
-    out = [title, "", f"| algorithm | parameters | {head} | cycle {cycles} alone |",
-           "|---|---|" + "---|" * len(shown) + "---|"]  # fmt: skip
+    out = [
+        title,
+        "",
+        f"| algorithm | parameters | {head} | cycle {cycles} alone |",
+        "|---|---|" + "---|" * len(shown) + "---|",
+    ]
     for row in rows:
         params = ", ".join(f"{k} = {v}" for k, v in row["parameters"].items()) or "-"
         cells = " | ".join(f"{row['drift'][str(c)]:.3e}" for c in shown)
@@ -121,10 +129,17 @@ def format_text(result: dict) -> str:
     n = result["cycles"]
     out = []
     if "algorithms" in result:
-        out += _table(f"Drift ||x - x0|| on Table 1's loop of Manipulator 2 (continuous, {n} "
-                      "cycles)", result["algorithms"], n)  # fmt: skip
+        out += _table(
+            f"Drift ||x - x0|| on Table 1's loop of Manipulator 2 (continuous, {n} cycles)",
+            result["algorithms"],
+            n,
+        )
     if "panda" in result:
         out += [""] if out else []
-        out += _table(f"Drift ||x - x0|| [rad] on the Panda's pose loop from its home "
-                      f"(continuous, {n} cycles)", result["panda"]["algorithms"], n)  # fmt: skip
+        out += _table(
+            f"Drift ||x - x0|| [rad] on the Panda's pose loop from its home "
+            f"(continuous, {n} cycles)",
+            result["panda"]["algorithms"],
+            n,
+        )
     return "\n".join(out)

@@ -25,10 +25,17 @@ def test_solve_runs_each_new_algorithm(api, algorithm, params):
 
 def test_repeatability_posture_drifts_less_than_the_pseudoinverse(api):
     def drift(algorithm, params=None):
-        r = api.post("/repeatability", json={
-            "robot": {"name": "manipulator2"}, "algorithm": algorithm, "x0": X0_M2,
-            "path": TABLE1_PATH, "cycles": 10, "algorithm_parameters": params,
-        })  # fmt: skip
+        r = api.post(
+            "/repeatability",
+            json={
+                "robot": {"name": "manipulator2"},
+                "algorithm": algorithm,
+                "x0": X0_M2,
+                "path": TABLE1_PATH,
+                "cycles": 10,
+                "algorithm_parameters": params,
+            },
+        )
         assert r.status_code == 200, r.text
         return r.json()["drift"][-1], r.json()["repeatable"]
 
@@ -60,7 +67,7 @@ def test_robots_list_every_algorithm(api):
         ("extended", {"gain": 1.0}, ["algorithm_parameters"], "the extended inverse takes none"),
         ("pseudoinverse", {"damping": 0.1}, ["algorithm_parameters", "damping"], "unknown"),
     ],
-)  # fmt: skip
+)
 def test_bad_parameters_are_422_naming_the_field(api, algorithm, params, loc, text):
     r = api.post("/solve", json=solve_body(algorithm=algorithm, algorithm_parameters=params))
     assert any(text in m for m in messages(r)), r.text
@@ -69,11 +76,17 @@ def test_bad_parameters_are_422_naming_the_field(api, algorithm, params, loc, te
 
 
 def test_atlas_compares_algorithms_over_the_same_starts():
-    req = AtlasRequest.model_validate({
-        "robot": {"name": "manipulator2"}, "path": [[0.0, 1.0], *TABLE1_PATH[:3]], "starts": 5,
-        "cycles": 2, "arc": [-1.0, 1.0], "algorithms": ["pseudoinverse", "damped", "posture"],
-        "algorithm_parameters": {"damping": 0.5, "gain": 1.0},
-    })  # fmt: skip
+    req = AtlasRequest.model_validate(
+        {
+            "robot": {"name": "manipulator2"},
+            "path": [[0.0, 1.0], *TABLE1_PATH[:3]],
+            "starts": 5,
+            "cycles": 2,
+            "arc": [-1.0, 1.0],
+            "algorithms": ["pseudoinverse", "damped", "posture"],
+            "algorithm_parameters": {"damping": 0.5, "gain": 1.0},
+        }
+    )
     res = run_atlas(plan_request(req, AtlasLimits()))
     assert res.algorithms == ("pseudoinverse", "damped", "posture")
     drift = {a: res.drift[i] for i, a in enumerate(res.algorithms)}
@@ -89,10 +102,17 @@ def test_posture_rest_defaults_to_the_runs_start(api):
     x0 = [0.2, -0.1, 1.2]
 
     def legs(params):
-        r = api.post("/repeatability", json={
-            "robot": {"name": "manipulator2"}, "algorithm": "posture", "x0": x0,
-            "path": TABLE1_PATH, "cycles": 2, "algorithm_parameters": params,
-        })  # fmt: skip
+        r = api.post(
+            "/repeatability",
+            json={
+                "robot": {"name": "manipulator2"},
+                "algorithm": "posture",
+                "x0": x0,
+                "path": TABLE1_PATH,
+                "cycles": 2,
+                "algorithm_parameters": params,
+            },
+        )
         assert r.status_code == 200, r.text
         return r.json()["drift"]
 

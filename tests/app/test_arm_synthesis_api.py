@@ -17,13 +17,23 @@ def test_the_catalogue_name_and_the_urdf_give_the_same_repeatable_run():
     y0 = panda.kinematics.forward(home)
     path = [(y0 + np.array(step)).tolist() for step in STEPS]
     arm = ARMS["panda"]
-    as_urdf = {"name": "urdf", "urdf": arm.urdf, "end_link": arm.end_link, "home": list(arm.home),
-               "task": "pose"}  # fmt: skip
+    as_urdf = {
+        "name": "urdf",
+        "urdf": arm.urdf,
+        "end_link": arm.end_link,
+        "home": list(arm.home),
+        "task": "pose",
+    }
     answers = []
     with TestClient(create_app()) as client:
         for robot in ({"name": "panda", "task": "pose"}, as_urdf):
-            body = {"robot": robot, "algorithm": "extended", "x0": home.tolist(), "path": path,
-                    "cycles": 10}  # fmt: skip
+            body = {
+                "robot": robot,
+                "algorithm": "extended",
+                "x0": home.tolist(),
+                "path": path,
+                "cycles": 10,
+            }
             r = client.post("/repeatability", json=body)
             assert r.status_code == 200, r.text
             answers.append(r.json())

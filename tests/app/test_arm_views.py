@@ -76,8 +76,15 @@ def test_the_panda_joints_are_sized_to_the_arm():
     dashboard = Dashboard(state)
     scene = DashboardScene(dashboard)
     try:
-        arm = Chain(scene.server.scene, "/test/arm", (10, 20, 30), None, 0.0, state,
-                    ((-1.0, 1.0), (-1.0, 1.0)))  # fmt: skip
+        arm = Chain(
+            scene.server.scene,
+            "/test/arm",
+            (10, 20, 30),
+            None,
+            0.0,
+            state,
+            ((-1.0, 1.0), (-1.0, 1.0)),
+        )
         home = chain_points(arm.kin, np.asarray(state.x0, dtype=float), 0.0)
         reach = float(np.linalg.norm(np.diff(home, axis=0), axis=1).sum())
         assert 0.5 < reach < 1.5
@@ -107,8 +114,12 @@ def test_a_pose_task_shows_position_and_rotation_against_theta():
     layout = spec["layout"]
     titles = [layout["yaxis" if k == 0 else f"yaxis{k + 1}"]["title"]["text"] for k in range(6)]
     assert titles == ["x [m]", "y [m]", "z [m]", "rx [rad]", "ry [rad]", "rz [rad]"]
-    rz = [t for t in spec["data"] if t.get("yaxis") == "y6" and t["name"] in (
-        "pseudoinverse J^P# (8)", "extended Jacobian J^E# (11)")]  # fmt: skip
+    rz = [
+        t
+        for t in spec["data"]
+        if t.get("yaxis") == "y6"
+        and t["name"] in ("pseudoinverse J^P# (8)", "extended Jacobian J^E# (11)")
+    ]
     assert rz and all(np.ptp(t["y"]) > 0.29 for t in rz)
     targets = [t for t in spec["data"] if t["name"] == "targets"]
     assert len(targets) == 6 and all(t["mode"] == "markers" for t in targets)
@@ -142,8 +153,16 @@ def _second_phase(result, cancelled=lambda: False):
 
     kin, amap = kinematics_and_map(result.state)
     deferred = result.augmenting is None
-    return SecondPhase(kin, amap, result, deferred=deferred, cached=None, grid_before=None,
-                       progress=lambda f, w: None, cancelled=cancelled)  # fmt: skip
+    return SecondPhase(
+        kin,
+        amap,
+        result,
+        deferred=deferred,
+        cached=None,
+        grid_before=None,
+        progress=lambda f, w: None,
+        cancelled=cancelled,
+    )
 
 
 def test_the_e1_e2_panel_shows_e2_of_a_7_joint_map_beside_single_joints():

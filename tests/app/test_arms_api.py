@@ -21,22 +21,46 @@ def _ok(response) -> dict:
 
 
 def _path(api, robot):
-    y0 = _ok(api.post("/solve", json={"robot": robot, "algorithm": "pseudoinverse", "x0": HOME,
-                                      "target": [0.3, 0.0, 0.6, 0, 0, 0]}))  # fmt: skip
+    y0 = _ok(
+        api.post(
+            "/solve",
+            json={
+                "robot": robot,
+                "algorithm": "pseudoinverse",
+                "x0": HOME,
+                "target": [0.3, 0.0, 0.6, 0, 0, 0],
+            },
+        )
+    )
     home = np.array(y0["trajectory"]["y"][0])
     return (home + np.array(MOVES)).tolist()
 
 
 def test_panda_by_name_equals_panda_by_urdf_text(api):
     by_name = {"name": "panda", "task": "pose"}
-    by_text = {"name": "urdf", "urdf": PANDA.urdf, "end_link": PANDA.end_link, "home": HOME,
-               "task": "pose"}  # fmt: skip
+    by_text = {
+        "name": "urdf",
+        "urdf": PANDA.urdf,
+        "end_link": PANDA.end_link,
+        "home": HOME,
+        "task": "pose",
+    }
     path = _path(api, by_name)
     runs = [
-        _ok(api.post("/repeatability", json={"robot": robot, "algorithm": "pseudoinverse",
-                                             "x0": HOME, "path": path, "cycles": 2}))
+        _ok(
+            api.post(
+                "/repeatability",
+                json={
+                    "robot": robot,
+                    "algorithm": "pseudoinverse",
+                    "x0": HOME,
+                    "path": path,
+                    "cycles": 2,
+                },
+            )
+        )
         for robot in (by_name, by_text)
-    ]  # fmt: skip
+    ]
     assert runs[0]["success"] and runs[0]["legs"] == runs[1]["legs"]
     assert runs[0]["drift"] == runs[1]["drift"] and runs[0]["drift"][-1] > 1e-4
     assert (runs[0]["robot"]["p"], runs[0]["robot"]["r"]) == (7, 6)
@@ -45,9 +69,17 @@ def test_panda_by_name_equals_panda_by_urdf_text(api):
 
 def test_a_pose_target_is_reached(api):
     target = np.array(_path(api, {"name": "panda", "task": "pose"})[1])
-    run = _ok(api.post("/solve", json={"robot": {"name": "panda", "task": "pose"},
-                                       "algorithm": "pseudoinverse", "x0": HOME,
-                                       "target": target.tolist()}))  # fmt: skip
+    run = _ok(
+        api.post(
+            "/solve",
+            json={
+                "robot": {"name": "panda", "task": "pose"},
+                "algorithm": "pseudoinverse",
+                "x0": HOME,
+                "target": target.tolist(),
+            },
+        )
+    )
     assert run["converged"] and run["error"] < 1e-9
     np.testing.assert_allclose(run["y"], target, atol=1e-9)
 
@@ -64,52 +96,115 @@ def test_robots_lists_the_arms(api):
 
 @pytest.mark.parametrize(
     ("robot", "field", "text"),
-    [({"name": "ur5e", "task": "pose"}, "robot", "6 active joints for a task of 6"),
-     ({"name": "panda", "task": "xyzw"}, "robot.task", "coordinates among x y z rx ry rz"),
-     ({"name": "panda", "urdf": "<robot/>"}, "robot.urdf", "unknown field"),
-     ({"name": "panda", "reference": [0, 0, 0, 2]}, "robot.reference", "norm 1")],
-)  # fmt: skip
+    [
+        ({"name": "ur5e", "task": "pose"}, "robot", "6 active joints for a task of 6"),
+        ({"name": "panda", "task": "xyzw"}, "robot.task", "coordinates among x y z rx ry rz"),
+        ({"name": "panda", "urdf": "<robot/>"}, "robot.urdf", "unknown field"),
+        ({"name": "panda", "reference": [0, 0, 0, 2]}, "robot.reference", "norm 1"),
+    ],
+)
 def test_bad_arm_definitions_are_422_naming_the_field(api, robot, field, text):
-    r = api.post("/solve", json={"robot": robot, "algorithm": "pseudoinverse", "x0": HOME,
-                                 "target": [0.3, 0, 0.6, 0, 0, 0]})  # fmt: skip
+    r = api.post(
+        "/solve",
+        json={
+            "robot": robot,
+            "algorithm": "pseudoinverse",
+            "x0": HOME,
+            "target": [0.3, 0, 0.6, 0, 0, 0],
+        },
+    )
     assert r.status_code == 422, r.text
     assert text in r.text and field in r.text, r.text
 
 
 def test_an_x0_outside_the_limits_is_accepted_and_reported(api):
     x0 = [*HOME[:3], 0.2, *HOME[4:]]  # joint 4's limits: -3.0718, -0.0698
-    body = {"robot": {"name": "panda", "task": "xyz"}, "algorithm": "pseudoinverse", "x0": x0,
-            "path": [[0.45, 0.05, 0.75]], "cycles": 1}  # fmt: skip
+    body = {
+        "robot": {"name": "panda", "task": "xyz"},
+        "algorithm": "pseudoinverse",
+        "x0": x0,
+        "path": [[0.45, 0.05, 0.75]],
+        "cycles": 1,
+    }
     run = _ok(api.post("/repeatability", json=body))
     assert run["success"] and run["limits"]["within"] is False
-    assert run["limits"]["violation"] == {"cycle": 0, "leg": 0, "joint": 3,
-                                          "name": "x4 (panda_joint4)", "value": 0.2,
-                                          "limit": -0.0698, "bound": "upper"}  # fmt: skip
+    assert run["limits"]["violation"] == {
+        "cycle": 0,
+        "leg": 0,
+        "joint": 3,
+        "name": "x4 (panda_joint4)",
+        "value": 0.2,
+        "limit": -0.0698,
+        "bound": "upper",
+    }
 
 
 def test_a_solve_reports_its_first_violation_and_the_paper_robots_none(api):
-    run = _ok(api.post("/solve", json={"robot": {"name": "panda", "task": "xyz"},
-                                       "algorithm": "pseudoinverse", "x0": HOME,
-                                       "target": [-0.3, 0.0, 0.5]}))  # fmt: skip
+    run = _ok(
+        api.post(
+            "/solve",
+            json={
+                "robot": {"name": "panda", "task": "xyz"},
+                "algorithm": "pseudoinverse",
+                "x0": HOME,
+                "target": [-0.3, 0.0, 0.5],
+            },
+        )
+    )
     v = run["limits"]["violation"]
     assert run["converged"] and (v["cycle"], v["leg"], v["joint"], v["bound"]) == (1, 1, 1, "lower")
-    ok = _ok(api.post("/solve", json={"robot": {"name": "panda", "task": "xyz"},
-                                      "algorithm": "pseudoinverse", "x0": HOME,
-                                      "target": [0.35, 0.05, 0.55]}))  # fmt: skip
+    ok = _ok(
+        api.post(
+            "/solve",
+            json={
+                "robot": {"name": "panda", "task": "xyz"},
+                "algorithm": "pseudoinverse",
+                "x0": HOME,
+                "target": [0.35, 0.05, 0.55],
+            },
+        )
+    )
     assert ok["limits"] == {"within": True, "violation": None}
-    m2 = _ok(api.post("/solve", json={"robot": {"name": "manipulator2"},
-                                      "algorithm": "pseudoinverse", "x0": [0, 0, 1.5708],
-                                      "target": [0, 2]}))  # fmt: skip
+    m2 = _ok(
+        api.post(
+            "/solve",
+            json={
+                "robot": {"name": "manipulator2"},
+                "algorithm": "pseudoinverse",
+                "x0": [0, 0, 1.5708],
+                "target": [0, 2],
+            },
+        )
+    )
     assert "limits" not in m2
 
 
 def test_a_planar_chain_with_limits_over_rest(api):
-    robot = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6],
-             "limits": [[-1, 1], [None, 1.2], [-3, 3]]}  # fmt: skip
-    run = _ok(api.post("/solve", json={"robot": robot, "algorithm": "pseudoinverse",
-                                       "x0": [0.3, 1.0, 1.0], "target": [0.2, 1.2]}))  # fmt: skip
+    robot = {
+        "name": "planar_chain",
+        "joints": "RRR",
+        "lengths": [1.0, 0.8, 0.6],
+        "limits": [[-1, 1], [None, 1.2], [-3, 3]],
+    }
+    run = _ok(
+        api.post(
+            "/solve",
+            json={
+                "robot": robot,
+                "algorithm": "pseudoinverse",
+                "x0": [0.3, 1.0, 1.0],
+                "target": [0.2, 1.2],
+            },
+        )
+    )
     assert run["limits"]["violation"]["name"] == "x2"
-    bad = api.post("/solve", json={"robot": {**robot, "limits": [[1, 0], [0, 1], [0, 1]]},
-                                   "algorithm": "pseudoinverse", "x0": [0.3, 1.0, 1.0],
-                                   "target": [0.2, 1.2]})  # fmt: skip
+    bad = api.post(
+        "/solve",
+        json={
+            "robot": {**robot, "limits": [[1, 0], [0, 1], [0, 1]]},
+            "algorithm": "pseudoinverse",
+            "x0": [0.3, 1.0, 1.0],
+            "target": [0.2, 1.2],
+        },
+    )
     assert bad.status_code == 422 and "robot.limits" in bad.text and "lower < upper" in bad.text

@@ -29,8 +29,13 @@ LOOP = [[0.0, 1.0], [1.0, 1.0], [1.0, 2.0], [0.0, 2.0]]
 
 
 def body(**over) -> dict:
-    b = {"robot": {"name": "manipulator2"}, "path": LOOP, "starts": 6, "cycles": 2,
-         "arc": [-2.0, 2.0]}  # fmt: skip
+    b = {
+        "robot": {"name": "manipulator2"},
+        "path": LOOP,
+        "starts": 6,
+        "cycles": 2,
+        "arc": [-2.0, 2.0],
+    }
     b.update(over)
     return b
 
@@ -85,8 +90,9 @@ def test_a_job_runs_to_its_result_and_outlives_its_request(app, client):
     for a, alg in enumerate(("pseudoinverse", "extended")):
         drift = np.array(res["drift"][alg], dtype=float)
         np.testing.assert_allclose(drift, expected.drift[a], rtol=0, atol=1e-12)
-        np.testing.assert_allclose(np.array(res["leg_ends"][alg], dtype=float),
-                                   expected.leg_ends[a], rtol=0, atol=1e-12)  # fmt: skip
+        np.testing.assert_allclose(
+            np.array(res["leg_ends"][alg], dtype=float), expected.leg_ends[a], rtol=0, atol=1e-12
+        )
     assert np.min(res["drift"]["pseudoinverse"]) > 1e-3
     assert np.nanmax(np.array(res["drift"]["extended"], dtype=float)) < 1e-8
 
@@ -115,17 +121,26 @@ def test_one_client_may_run_one_job_at_a_time_here(client):
     ("over", "field", "text"),
     [
         ({"starts": 20001}, "starts", "less than or equal to 20000"),
-        ({"starts": 20000, "cycles": 50, "algorithms": ["pseudoinverse", "extended"]}, "starts",
-         "legs x algorithms = 8000000 is more than 1200000"),
-        ({"starts": 20000, "cycles": 3, "leg_ends": True}, "leg_ends",
-         "the ends of 240000 legs are more than the 200000"),
-        ({"path": [[0.0, 1.0], [1.0, 1.0, 2.0]]}, "path",
-         "must have 2 components (r of manipulator2), got 3"),
+        (
+            {"starts": 20000, "cycles": 50, "algorithms": ["pseudoinverse", "extended"]},
+            "starts",
+            "legs x algorithms = 8000000 is more than 1200000",
+        ),
+        (
+            {"starts": 20000, "cycles": 3, "leg_ends": True},
+            "leg_ends",
+            "the ends of 240000 legs are more than the 200000",
+        ),
+        (
+            {"path": [[0.0, 1.0], [1.0, 1.0, 2.0]]},
+            "path",
+            "must have 2 components (r of manipulator2), got 3",
+        ),
         ({"arc": [1.0, 2.0]}, "arc", "lo <= 0 <= hi"),
         ({"path": [[0.0, 1.0]]}, "path", "at least 2 items"),
         ({"mode": "discrete", "gamma": 2.0}, "gamma", "must be < 2 in discrete mode"),
     ],
-)  # fmt: skip
+)
 def test_bad_or_too_large_requests_are_422_naming_the_field(client, over, field, text):
     r = client.post("/atlas", json=body(**over))
     assert any(text in m for m in messages(r)), r.text
@@ -173,12 +188,17 @@ def test_a_session_atlas_is_the_atlas_of_its_state(client):
     req = body["request"]
     np.testing.assert_allclose(req["path"], [[0.0, 1.0], *LOOP[1:], [0.0, 1.0]], atol=1e-15)
     assert (req["reference"], req["mode"], req["gamma"], req["cycles"]) == (
-        [0.0, 0.0, math.pi / 2], "discrete", 0.5, 2)  # fmt: skip
+        [0.0, 0.0, math.pi / 2],
+        "discrete",
+        0.5,
+        2,
+    )
     starts = np.array(body["starts"])  # (P, N, p)
     assert starts.shape == (2, 5, 3)
     kin = robot_spec("manipulator2").build(l=1.0)
-    np.testing.assert_allclose(kin.forward(starts), np.broadcast_to([0.0, 1.0], (2, 5, 2)),
-                               atol=1e-9)  # fmt: skip
+    np.testing.assert_allclose(
+        kin.forward(starts), np.broadcast_to([0.0, 1.0], (2, 5, 2)), atol=1e-9
+    )
     heat = body["figure"]["data"]
     assert [t["type"] for t in heat] == ["heatmap", "heatmap"]
     assert heat[0]["y"] == ["×1, cycle 1", "×1, cycle 2", "×0.5, cycle 1", "×0.5, cycle 2"]
@@ -193,7 +213,7 @@ def test_a_session_atlas_is_the_atlas_of_its_state(client):
         ({}, {"starts": 1}, "starts", "greater than or equal to 2"),
         ({}, {"scales": [0.0]}, "scales", "greater than 0"),
     ],
-)  # fmt: skip
+)
 def test_a_session_atlas_it_cannot_make_is_422_naming_the_field(client, state, over, field, text):
     sid = _session(client, **state)
     r = client.post(f"/api/sessions/{sid}/atlas", json=over)
@@ -219,8 +239,11 @@ def test_a_reference_whose_solve_runs_away_is_refused_by_name(client):
     """schemathesis's case: the unicycle from a reference with controls of size ~800, whose
     solve to the path's first point needed an ever larger quadrature. 422 at ``reference``
     with the engine's words; the worker that refused it serves the next request."""
-    bad = {"robot": {"name": "unicycle"}, "path": [[0.0, -3.0, 0.0], [3.0, 3.0, 0.0],
-           [-3.0, -3.0, 3.0]], "reference": [0.0, -820.6, 738.5, 840.0]}  # fmt: skip
+    bad = {
+        "robot": {"name": "unicycle"},
+        "path": [[0.0, -3.0, 0.0], [3.0, 3.0, 0.0], [-3.0, -3.0, 3.0]],
+        "reference": [0.0, -820.6, 738.5, 840.0],
+    }
     r = client.post("/atlas", json=bad)
     assert r.status_code == 422, r.text
     (error,) = r.json()["detail"]
@@ -293,8 +316,9 @@ def test_a_posture_atlas_pulls_each_run_toward_its_own_start(client):
     /repeatability's does toward its x0: each run's drift is that start's /repeatability drift,
     and below the pseudoinverse's at the same starts (the pull toward one fixed posture would
     be measured instead, larger than the pseudoinverse's drift)."""
-    req = body(algorithms=["posture", "pseudoinverse"], algorithm_parameters={"gain": 1.0},
-               starts=4)  # fmt: skip
+    req = body(
+        algorithms=["posture", "pseudoinverse"], algorithm_parameters={"gain": 1.0}, starts=4
+    )
     done = wait_until_ended(client, client.post("/atlas", json=req).json()["id"])
     assert done["status"] == "done", done["error"]
     res = done["result"]
@@ -302,9 +326,16 @@ def test_a_posture_atlas_pulls_each_run_toward_its_own_start(client):
     pinv = np.array(res["drift"]["pseudoinverse"], dtype=float)[0]
     assert np.all(posture[:, -1] < 0.5 * pinv[:, -1])
     for i, x0 in enumerate(res["starts"][0]):
-        r = client.post("/repeatability", json={
-            "robot": {"name": "manipulator2"}, "algorithm": "posture", "x0": x0,
-            "path": LOOP[1:], "cycles": 2, "algorithm_parameters": {"gain": 1.0},
-        })  # fmt: skip
+        r = client.post(
+            "/repeatability",
+            json={
+                "robot": {"name": "manipulator2"},
+                "algorithm": "posture",
+                "x0": x0,
+                "path": LOOP[1:],
+                "cycles": 2,
+                "algorithm_parameters": {"gain": 1.0},
+            },
+        )
         assert r.status_code == 200, r.text
         np.testing.assert_allclose(posture[i], r.json()["drift"], rtol=1e-8, atol=1e-12)

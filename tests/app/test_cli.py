@@ -98,8 +98,10 @@ def test_serve_on_a_busy_port_says_so_and_names_the_option():
         busy = taken.getsockname()[1]
         out = subprocess.run(
             [sys.executable, "-m", "jik", "serve", f"--port={busy}"],
-            capture_output=True, text=True, timeout=60,
-        )  # fmt: skip
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
     assert out.returncode == 2, out
     assert f"port {busy} on 127.0.0.1 is in use" in out.stderr
     assert "choose another with --port PORT" in out.stderr

@@ -147,8 +147,13 @@ def test_a_dashboard_change_is_refused_as_a_rest_request_is(rest, dashboard, fie
     """The same pydantic field types and per-robot models check both: the same problem."""
     from jik.app.compute.schemas import SolveRequest
 
-    body = {"robot": {"name": "manipulator2"}, "algorithm": "pseudoinverse",
-            "x0": [0.0, 0.0, 1.0], "target": [1.0, 1.0], **rest}  # fmt: skip
+    body = {
+        "robot": {"name": "manipulator2"},
+        "algorithm": "pseudoinverse",
+        "x0": [0.0, 0.0, 1.0],
+        "target": [1.0, 1.0],
+        **rest,
+    }
     with pytest.raises(Exception) as api:
         SolveRequest.model_validate(body)
     with pytest.raises(InvalidInputError) as ours:

@@ -46,13 +46,17 @@ def test_choosing_algorithms_fills_their_parameters_from_the_engine():
         ({"algorithms": []}, "algorithms"),
         ({"algorithms": ["nope"]}, "algorithms.0"),
         ({"algorithms": ["posture", "posture"]}, "algorithms"),
-        ({"algorithms": ["posture"], "algorithm_parameters": {"gain": -1.0}},
-         "algorithm_parameters.gain"),
-        ({"algorithms": ["damped"], "algorithm_parameters.damping": 11.0},
-         "algorithm_parameters.damping"),
+        (
+            {"algorithms": ["posture"], "algorithm_parameters": {"gain": -1.0}},
+            "algorithm_parameters.gain",
+        ),
+        (
+            {"algorithms": ["damped"], "algorithm_parameters.damping": 11.0},
+            "algorithm_parameters.damping",
+        ),
         ({"algorithm_parameters": {"lambda": 1.0}}, "algorithm_parameters.lambda"),
     ],
-)  # fmt: skip
+)
 def test_a_bad_choice_is_refused_naming_its_field(patch, field):
     with pytest.raises(InvalidInputError) as refused:
         updated_state(default_state(), patch)
@@ -114,8 +118,11 @@ def test_verdict_reports_damped_tracking_error_and_weighted_limits():
     state = updated_state(default_state(), {"algorithms": ["damped", "weighted"], "cycles": 2})
     result = compute(state)
     texts = {s["algorithm"]: s["text"] for s in verdict(result) if s["role"] != "finding"}
-    ends = result.runs["damped"].error[np.r_[np.flatnonzero(np.diff(result.runs["damped"].leg)),
-                                             len(result.runs["damped"].leg) - 1]]  # fmt: skip
+    ends = result.runs["damped"].error[
+        np.r_[
+            np.flatnonzero(np.diff(result.runs["damped"].leg)), len(result.runs["damped"].leg) - 1
+        ]
+    ]
     assert f"task error at the end of its legs up to {ends.max():.3g}" in texts["damped"]
     assert "stayed within its limits" in texts["weighted"]
     assert "no joint limits: its configuration box x_range" in texts["weighted"]
@@ -170,14 +177,15 @@ def test_the_scene_draws_a_robot_per_chosen_algorithm(three):
         dashboard.stop()
 
 
-CHAIN = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 1.0, 1.0],
-         "x0": [0.3, 0.3, 0.3]}  # fmt: skip
+CHAIN = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 1.0, 1.0], "x0": [0.3, 0.3, 0.3]}
 
 
 def _damped_beside_pseudoinverse(x0, target):
     state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": CHAIN})
-    state = updated_state(state, {"task": "target", "target": target, "x0": x0,
-                                  "algorithms": ["pseudoinverse", "damped"]})  # fmt: skip
+    state = updated_state(
+        state,
+        {"task": "target", "target": target, "x0": x0, "algorithms": ["pseudoinverse", "damped"]},
+    )
     result = compute(state)
     return result, {(s["algorithm"], s["role"]): s["text"] for s in verdict(result)}
 
@@ -211,9 +219,11 @@ def test_the_atlas_figure_has_a_heatmap_per_algorithm_on_one_colour_scale(three)
     request = atlas_request(three.state, 4, cycles=2)
     decades = {"pseudoinverse": -1.0, "extended": -15.0, "posture": -3.0}
     result = {
-        "algorithms": THREE, "parameter": [-0.2, 0.0, 0.1, 0.3], "paths": [request.path],
+        "algorithms": THREE,
+        "parameter": [-0.2, 0.0, 0.1, 0.3],
+        "paths": [request.path],
         "drift": {a: np.full((1, 4, 2), 10.0**d).tolist() for a, d in decades.items()},
-    }  # fmt: skip
+    }
     spec = atlas_figure(result, request)
     maps = [t for t in spec["data"] if t["type"] == "heatmap"]
     assert [t["coloraxis"] for t in maps] == ["coloraxis"] * 3
@@ -235,8 +245,12 @@ def test_table1_gives_each_chosen_algorithm_its_column_group(three):
     table = spec["data"][0]
     header, cols = table["header"]["values"], table["cells"]["values"]
     fills = table["header"]["fill"]["color"]
-    paper = [f"{SHORT[a]} x{k} ({w})" for a in ("pseudoinverse", "extended")
-             for w in ("jik", "printed") for k in (1, 2, 3)]  # fmt: skip
+    paper = [
+        f"{SHORT[a]} x{k} ({w})"
+        for a in ("pseudoinverse", "extended")
+        for w in ("jik", "printed")
+        for k in (1, 2, 3)
+    ]
     assert header[1:13] == paper
     assert header[13:] == ["posture x1 (jik)", "posture x2 (jik)", "posture x3 (jik)"]
     assert fills[13:] == [FILLS["posture"]] * 3 and len(set(fills[1:13]) & set(fills[13:])) == 0

@@ -70,8 +70,11 @@ def test_a_run_outside_the_limits_is_said_in_words_and_marked():
     state = updated_state(_panda(), {"x0.3": -0.05, "task": "target"})
     result = compute(state)
     texts = [s["text"] for s in verdict(result) if s["role"] == "warning"]
-    assert any("its start x0 is already outside them, joint x4 (panda_joint4) = -0.05, above "
-               "its upper limit -0.0698" in t for t in texts)  # fmt: skip
+    assert any(
+        "its start x0 is already outside them, joint x4 (panda_joint4) = -0.05, above "
+        "its upper limit -0.0698" in t
+        for t in texts
+    )
     report = limits_summary(result)["pseudoinverse"]
     assert report["violation"]["joint"] == 3 and report["violation"]["cycle"] == 0
     kin = state_kinematics(state)
@@ -83,8 +86,12 @@ def test_a_run_outside_the_limits_is_said_in_words_and_marked():
 def test_a_leg_leaving_the_limits_names_its_cycle_and_leg():
     """A planar chain with limits on x2: the path takes x2 past its bound on a leg after the
     start; the violation names that cycle and leg."""
-    arm = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6],
-           "limits": [[None, None], [0.3, 0.55], [None, None]]}  # fmt: skip
+    arm = {
+        "name": "planar_chain",
+        "joints": "RRR",
+        "lengths": [1.0, 0.8, 0.6],
+        "limits": [[None, None], [0.3, 0.55], [None, None]],
+    }
     state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": arm})
     result = compute(state)
     violation = limits_summary(result)["pseudoinverse"]["violation"]
@@ -114,9 +121,15 @@ def test_vector_maps_run_for_p_minus_r_two():
     """A planar 4R chain with a position task (r = 2) and two formula maps of two components:
     the extended inverse with either is repeatable, the pseudoinverse is not; the h panel says
     what it shows."""
-    arm = {"name": "planar_chain", "joints": "RRRR", "lengths": [1.0, 0.8, 0.6, 0.4],
-           "augmentations": [{"name": "formula", "h": ["x3", "x4"]},
-                             {"name": "formula", "h": ["x2", "x4"], "label": "other"}]}  # fmt: skip
+    arm = {
+        "name": "planar_chain",
+        "joints": "RRRR",
+        "lengths": [1.0, 0.8, 0.6, 0.4],
+        "augmentations": [
+            {"name": "formula", "h": ["x3", "x4"]},
+            {"name": "formula", "h": ["x2", "x4"], "label": "other"},
+        ],
+    }
     state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": arm})
     for name in ("formula", "other"):
         result = compute(updated_state(state, {"augmentation": name}))
@@ -147,9 +160,14 @@ def test_a_synthesized_vector_map_is_built_with_progress_and_runs():
     """p - r = 2 with ``e2_synthesized``: the vector (h_1, h_2) is synthesized when the state's
     map is built (its progress on the way), and its extended run comes back to x0."""
     box = {"x1": [0.1, 0.5], "x2": [0.4, 0.8], "x3": [0.4, 0.8], "x4": [0.4, 0.8]}
-    arm = {"name": "planar_chain", "joints": "RRRR", "lengths": [1, 1, 1, 1],
-           "x0": [0.3, 0.6, 0.6, 0.6], "title": "a chain of this test (no map synthesized before)",
-           "augmentations": [{"name": "e2_synthesized", "region": box}]}  # fmt: skip
+    arm = {
+        "name": "planar_chain",
+        "joints": "RRRR",
+        "lengths": [1, 1, 1, 1],
+        "x0": [0.3, 0.6, 0.6, 0.6],
+        "title": "a chain of this test (no map synthesized before)",
+        "augmentations": [{"name": "e2_synthesized", "region": box}],
+    }
     state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": arm})
     seen: list[float] = []
     built_map(state, lambda f, what: seen.append(f), lambda: False)
@@ -167,15 +185,25 @@ def test_the_atlas_of_an_arm_asks_for_its_definition_and_counts_the_limits():
     assert req.robot.name == "panda" and req.augmentation is None
     assert len(req.path[0]) == 6 and req.reference == list(_panda().x0)
     drift = [[[1e-4, 2e-4]] * 3]  # (P = 1, N = 3, C = 2)
-    result = {"algorithms": ["pseudoinverse", "extended"], "parameter": [-0.1, 0.0, 0.1],
-              "paths": [req.path], "drift": {"pseudoinverse": drift, "extended": drift},
-              "outside_limits": {"pseudoinverse": 2, "extended": 0}}  # fmt: skip
+    result = {
+        "algorithms": ["pseudoinverse", "extended"],
+        "parameter": [-0.1, 0.0, 0.1],
+        "paths": [req.path],
+        "drift": {"pseudoinverse": drift, "extended": drift},
+        "outside_limits": {"pseudoinverse": 2, "extended": 0},
+    }
     notes = [a["text"] for a in atlas_figure(result, req)["layout"]["annotations"]]
     assert "2 of 3 runs left the joint limits" in notes[0]
     assert "0 of 3 runs left the joint limits" in notes[1]
-    arm = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6],
-           "augmentations": [{"name": "formula", "h": "x3"},
-                             {"name": "formula", "h": "x2", "label": "second"}]}  # fmt: skip
+    arm = {
+        "name": "planar_chain",
+        "joints": "RRR",
+        "lengths": [1.0, 0.8, 0.6],
+        "augmentations": [
+            {"name": "formula", "h": "x3"},
+            {"name": "formula", "h": "x2", "label": "second"},
+        ],
+    }
     state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": arm})
     req = atlas_request(updated_state(state, {"augmentation": "second"}), 8)
     assert req.augmentation.h == "x2" and req.robot.name == "planar_chain"
@@ -189,8 +217,15 @@ def test_the_scene_colours_a_joint_while_it_is_outside_its_limits():
     dashboard = Dashboard(state)
     scene = DashboardScene(dashboard)
     try:
-        arm = Chain(scene.server.scene, "/test/arm", (10, 20, 30), None, 0.0, state,
-                    ((-1.0, 1.0), (-1.0, 1.0)))  # fmt: skip
+        arm = Chain(
+            scene.server.scene,
+            "/test/arm",
+            (10, 20, 30),
+            None,
+            0.0,
+            state,
+            ((-1.0, 1.0), (-1.0, 1.0)),
+        )
         arm.pose(state.x0)
         colours = [tuple(ball.color) for ball in arm.joints]
         assert colours[joint_points(arm.kin)[3]] == OUTSIDE_COLOR
@@ -212,8 +247,12 @@ def test_the_atlas_of_a_robot_with_two_degrees_of_redundancy():
     surfaces, so the session's atlas gives its starts explicitly, x0 first, all on k(x) = k(x0);
     the pseudoinverse drifts from them, the extended inverse with h = (x3, x4) does not; the
     heatmap numbers the starts."""
-    arm = {"name": "planar_chain", "joints": "RRRR", "lengths": [1.0, 0.8, 0.6, 0.4],
-           "augmentations": [{"name": "formula", "h": ["x3", "x4"]}]}  # fmt: skip
+    arm = {
+        "name": "planar_chain",
+        "joints": "RRRR",
+        "lengths": [1.0, 0.8, 0.6, 0.4],
+        "augmentations": [{"name": "formula", "h": ["x3", "x4"]}],
+    }
     state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": arm})
     req = atlas_request(state, 12, 2)
     X = np.asarray(req.start_points)
@@ -223,8 +262,12 @@ def test_the_atlas_of_a_robot_with_two_degrees_of_redundancy():
     res = run_atlas(plan_request(req, AtlasLimits()))
     drift = {a: res.drift[k] for k, a in enumerate(res.algorithms)}  # (P, N, C)
     assert np.nanmax(drift["extended"]) < 1e-9 and np.nanmin(drift["pseudoinverse"]) > 1e-6
-    result = {"algorithms": list(res.algorithms), "parameter": [], "paths": res.paths.tolist(),
-              "drift": {a: d.tolist() for a, d in drift.items()}}  # fmt: skip
+    result = {
+        "algorithms": list(res.algorithms),
+        "parameter": [],
+        "paths": res.paths.tolist(),
+        "drift": {a: d.tolist() for a, d in drift.items()},
+    }
     figure = atlas_figure(result, req)
     assert list(figure["data"][0]["x"]) == list(range(1, 13))
     assert figure["layout"]["xaxis"]["title"]["text"].startswith("start")

@@ -262,8 +262,13 @@ def test_functionals_are_keyed_by_the_map_and_the_variables_held_fixed():
     the map do not."""
     m2 = default_state("manipulator2")
     key = functionals_key(m2)
-    for patch in ({"x0": [0.0, 0.4, 1.2]}, {"x0": [0.3, 0.0, 1.5]}, {"cycles": 5},
-                  {"gamma": 3.0}, {"path": [[1.0, 1.0], [0.5, 2.0]]}):  # fmt: skip
+    for patch in (
+        {"x0": [0.0, 0.4, 1.2]},
+        {"x0": [0.3, 0.0, 1.5]},
+        {"cycles": 5},
+        {"gamma": 3.0},
+        {"path": [[1.0, 1.0], [0.5, 2.0]]},
+    ):
         assert functionals_key(updated_state(m2, patch)) == key, patch
     for patch in ({"robot_parameters": {"l": 1.5}}, {"augmentation": "e2_synthesized"}):
         assert functionals_key(updated_state(m2, patch)) != key, patch
@@ -415,9 +420,12 @@ def test_compute_workers_leave_with_a_killed_server(tmp_path):
     path.write_text(script)
     root = Path(__file__).resolve().parents[2]
     proc = subprocess.Popen(
-        [sys.executable, str(path)], stdout=subprocess.PIPE, text=True, cwd=root,
+        [sys.executable, str(path)],
+        stdout=subprocess.PIPE,
+        text=True,
+        cwd=root,
         env={**os.environ, "PYTHONPATH": str(root)},
-    )  # fmt: skip
+    )
     try:
         child = int(proc.stdout.readline().split()[0])
         os.kill(child, 0)  # alive
@@ -470,8 +478,11 @@ def test_the_figures_solved_ahead_are_those_of_the_switch():
     dashboard.subscribe(events.append)
 
     def announced(robot: str, since: int) -> list[dict]:
-        return [json.loads(e.data) for e in events[since:]
-                if e.kind == "ahead" and json.loads(e.data)["robot"] == robot]  # fmt: skip
+        return [
+            json.loads(e.data)
+            for e in events[since:]
+            if e.kind == "ahead" and json.loads(e.data)["robot"] == robot
+        ]
 
     def settle(generation: int, robot: str, since: int) -> dict:
         assert dashboard.wait(generation, 60)
@@ -525,9 +536,10 @@ def test_another_number_of_cycles_reuses_the_cycles_already_solved(mode):
     compute(updated_state(state, {"cycles": 3}), cache=cache)
     legs = []
     grown = compute(
-        updated_state(state, {"cycles": 5}), cache=cache,
+        updated_state(state, {"cycles": 5}),
+        cache=cache,
         progress=lambda f: legs.append(f),
-    )  # fmt: skip
+    )
     shrunk = compute(updated_state(state, {"cycles": 2}), cache=cache)
     assert shrunk.cached == {a: True for a in ALGORITHMS}
     L = len(grown.targets)  # 3 of 5 cycles known: the progress starts after them

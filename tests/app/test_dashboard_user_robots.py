@@ -31,25 +31,66 @@ def test_a_definition_is_state_with_its_defaults_and_a_map():
 @pytest.mark.parametrize(
     ("patch", "field", "text"),
     [
-        ({"robot_definition": {**ARM, "lengths": [1.0, 0.8]}}, "robot_definition.lengths",
-         "one entry per joint (3), got 2"),
-        ({"robot_definition": {**ARM, "lengths": [1.0, "a", 0.6]}}, "robot_definition.lengths.1",
-         "must be a number"),
-        ({"robot_definition": {**ARM, "name": "formula"}}, "robot_definition.name",
-         "must be the robot's kind"),
-        ({"robot": "formula", "robot_definition": {"name": "formula", "variables": ["x1", "x2"],
-          "task": ["x1 + os"]}}, "robot_definition.task.0", "unknown name 'os'"),
+        (
+            {"robot_definition": {**ARM, "lengths": [1.0, 0.8]}},
+            "robot_definition.lengths",
+            "one entry per joint (3), got 2",
+        ),
+        (
+            {"robot_definition": {**ARM, "lengths": [1.0, "a", 0.6]}},
+            "robot_definition.lengths.1",
+            "must be a number",
+        ),
+        (
+            {"robot_definition": {**ARM, "name": "formula"}},
+            "robot_definition.name",
+            "must be the robot's kind",
+        ),
+        (
+            {
+                "robot": "formula",
+                "robot_definition": {
+                    "name": "formula",
+                    "variables": ["x1", "x2"],
+                    "task": ["x1 + os"],
+                },
+            },
+            "robot_definition.task.0",
+            "unknown name 'os'",
+        ),
         ({"robot": "urdf"}, "robot_definition", "needs its definition"),
-        ({"robot_definition": {**ARM, "joints": "RR", "lengths": [0.4] * 2}},
-         "robot_definition.joints", "this robot has p = 2, r = 2 (the REST API and jik solve"),
-        ({"robot_definition": {**ARM, "joints": "RRRR", "lengths": [0.4] * 4,
-                               "augmentations": [{"name": "formula", "h": "x4"}]}},
-         "robot_definition.augmentations.0.h", "must be a list of 2 formulas (p - r = 2"),
-        ({"robot": "formula", "robot_definition": {"name": "formula", "task": ["x1 * a", "x2"],
-          "variables": ["x1", "x2", "x3"], "parameters": {"a": 1e300}}}, "robot_definition",
-         "the robot's default target.0 is refused by the dashboard"),
+        (
+            {"robot_definition": {**ARM, "joints": "RR", "lengths": [0.4] * 2}},
+            "robot_definition.joints",
+            "this robot has p = 2, r = 2 (the REST API and jik solve",
+        ),
+        (
+            {
+                "robot_definition": {
+                    **ARM,
+                    "joints": "RRRR",
+                    "lengths": [0.4] * 4,
+                    "augmentations": [{"name": "formula", "h": "x4"}],
+                }
+            },
+            "robot_definition.augmentations.0.h",
+            "must be a list of 2 formulas (p - r = 2",
+        ),
+        (
+            {
+                "robot": "formula",
+                "robot_definition": {
+                    "name": "formula",
+                    "task": ["x1 * a", "x2"],
+                    "variables": ["x1", "x2", "x3"],
+                    "parameters": {"a": 1e300},
+                },
+            },
+            "robot_definition",
+            "the robot's default target.0 is refused by the dashboard",
+        ),
     ],
-)  # fmt: skip
+)
 def test_refusals_name_the_definitions_field(patch, field, text):
     with pytest.raises(InvalidInputError) as err:
         updated_state(_arm_state(), {"robot": "planar_chain", **patch})

@@ -264,11 +264,14 @@ def test_a_missing_atlas_job_says_why_it_is_missing(api):
         earlier = AtlasJobs().run
     token = "A" * 16
     for job_id, why in [
-        (earlier + token, "the server restarted since it was started, and atlas jobs live in "
-         "the server's memory: start it again"),
+        (
+            earlier + token,
+            "the server restarted since it was started, and atlas jobs live in "
+            "the server's memory: start it again",
+        ),
         (ours + token, "it was cancelled, or it ended more than 600 s ago and was dropped"),
         ("nosuchjob", "no job of this server has had this id"),
-    ]:  # fmt: skip
+    ]:
         r = api.get(f"/atlas/{job_id}")
         assert r.status_code == 404
         assert r.json() == {"detail": f"no atlas job {job_id!r}: {why}"}

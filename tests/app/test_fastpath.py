@@ -48,9 +48,12 @@ CASES = {
 }
 #: Cases that pass validation and are answered by the fast path itself.
 SERVED = {
-    "valid", "valid, charset", "extended", "unreachable target",
+    "valid",
+    "valid, charset",
+    "extended",
+    "unreachable target",
     "algorithmic singularity",
-}  # fmt: skip
+}
 
 
 def _fast_path(app) -> SolveFastPath:

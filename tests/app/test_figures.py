@@ -87,7 +87,8 @@ def test_table1_puts_the_printed_columns_beside_jiks(path_result):
     assert list(cells[0][:5]) == ["A  x0", "B  x1f", "C  x2f", "D  x3f", "A  x4f"]
     header = list(fig.data[0].header.values)
     assert header[1:7] == [f"J^P# x{k} (jik)" for k in (1, 2, 3)] + [
-        f"J^P# x{k} (printed)" for k in (1, 2, 3)]  # fmt: skip
+        f"J^P# x{k} (printed)" for k in (1, 2, 3)
+    ]
     for col, (a, k) in enumerate([("pseudoinverse", k) for k in range(3)], start=1):
         assert float(cells[col][1]) == pytest.approx(path_result.runs[a].leg_end[0, k], abs=1e-4)
     differs = {(c, r) for c, r, _ in fig.layout.meta["differs"]}
@@ -138,8 +139,15 @@ def test_single_target_shows_convergence_instead_of_drift(target_result):
 def test_every_panel_serialises_to_plotly_json(path_result, target_result):
     for result in (path_result, target_result):
         figs = figures_for(result)
-        assert set(figs) == {"task", "joints", "drift", "table", "augmenting", "sensitivity",
-                             "cspace"}  # fmt: skip
+        assert set(figs) == {
+            "task",
+            "joints",
+            "drift",
+            "table",
+            "augmenting",
+            "sensitivity",
+            "cspace",
+        }
         for key, fig in figs.items():
             parsed = json.loads(fig.to_json())
             # (the sensitivity panel waits for the second phase: a title, no data yet)
@@ -151,8 +159,16 @@ def test_every_panel_serialises_to_plotly_json(path_result, target_result):
         go.Figure(augmenting_figure(result, error_functionals(result)).to_dict())
 
 
-_DTYPES = {"f8": "<f8", "f4": "<f4", "i4": "<i4", "u4": "<u4", "i2": "<i2", "u2": "<u2",
-           "i1": "i1", "u1": "u1"}  # fmt: skip
+_DTYPES = {
+    "f8": "<f8",
+    "f4": "<f4",
+    "i4": "<i4",
+    "u4": "<u4",
+    "i2": "<i2",
+    "u2": "<u2",
+    "i1": "i1",
+    "u1": "u1",
+}
 
 
 def _decoded(v):
@@ -194,9 +210,17 @@ def test_the_dashboards_json_is_plotlys(path_result, target_result):
             theirs = json.loads(go.Figure(spec).to_json())  # (validated, too)
             _same(_decoded(ours), _decoded(theirs), key)
     # numpy scalars, non-finite numbers (null) and 2-D arrays (with their shape)
-    spec = {"data": [{"type": "heatmap", "z": np.array([[1.0, np.nan], [2.0, 3.0]]),
-                      "x": [np.float64(0.5), float("inf")], "y": np.arange(2)}],
-            "layout": {"title": {"text": "t"}}}  # fmt: skip
+    spec = {
+        "data": [
+            {
+                "type": "heatmap",
+                "z": np.array([[1.0, np.nan], [2.0, 3.0]]),
+                "x": [np.float64(0.5), float("inf")],
+                "y": np.arange(2),
+            }
+        ],
+        "layout": {"title": {"text": "t"}},
+    }
     ours = json.loads(figure_json(spec))
     assert ours["data"][0]["x"] == [0.5, None]
     assert ours["data"][0]["z"]["shape"] == "2, 2" and ours["data"][0]["y"]["dtype"] == "i4"
@@ -369,8 +393,12 @@ def test_axes_keep_their_range_while_the_data_fill_it(path_result):
     assert kept["yaxis"]["range"] == [-17.0, 2.0]  # log axis: in decades
     sens = spec("sensitivity", sensitivity=sensitivity(path_result, error_functionals(path_result)))
     keep_ranges(sens, sens["layout"])  # (the alternatives by name: no error)
-    bars = {"data": [{"type": "bar", "x": ["a", "b"], "y": [1.0, 2.0]}],
-            "layout": {"xaxis": {"range": [-0.5, 1.5]}}}  # fmt: skip
+    bars = {
+        "data": [{"type": "bar", "x": ["a", "b"], "y": [1.0, 2.0]}],
+        "layout": {"xaxis": {"range": [-0.5, 1.5]}},
+    }
     assert keep_ranges(bars, {"xaxis": {"range": [-1, 2]}})["layout"]["xaxis"]["range"] == [
-        -0.5, 1.5]  # fmt: skip
+        -0.5,
+        1.5,
+    ]
     assert keep_ranges(fig, None) is fig

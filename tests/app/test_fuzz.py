@@ -58,8 +58,12 @@ def test_the_document_refuses_what_the_server_refuses_a_zero_reference_leaf():
         jsonschema.validate({"name": "characteristics", "a": 0.5}, schema)
         with pytest.raises(jsonschema.ValidationError, match="should not be valid"):
             jsonschema.validate({"name": "characteristics", "a": 0.0}, schema)
-        answer = client.post("/synthesize", json={
-            "robot": {"name": "unicycle"}, "method": "evaluate",
-            "augmentation": {"name": "characteristics", "a": 0.0},
-        })  # fmt: skip
+        answer = client.post(
+            "/synthesize",
+            json={
+                "robot": {"name": "unicycle"},
+                "method": "evaluate",
+                "augmentation": {"name": "characteristics", "a": 0.0},
+            },
+        )
         assert answer.status_code == 422 and "a must be nonzero" in answer.text, answer.text

@@ -19,8 +19,7 @@ def _ok(response) -> dict:
 
 def test_one_configuration_of_a_paper_robot(api):
     x = [0.1, 0.2, 1.3]
-    body = _ok(api.post("/kinematics", json={"robot": {"name": "manipulator2", "l": 1.5},
-                                             "x": x}))  # fmt: skip
+    body = _ok(api.post("/kinematics", json={"robot": {"name": "manipulator2", "l": 1.5}, "x": x}))
     kin = Manipulator2(1.5)
     np.testing.assert_allclose(body["k"], kin.forward(np.array(x)), atol=1e-15)
     np.testing.assert_allclose(body["J"], kin.jacobian(np.array(x)), atol=1e-15)
@@ -31,15 +30,17 @@ def test_a_list_of_configurations_of_the_panda_with_its_pose_task(api):
     pytest.importorskip("yourdfpy")
     x = np.random.default_rng(7).uniform(-1, 1, (5, 7))
     x[:, 3] -= 1.5
-    body = _ok(api.post("/kinematics", json={"robot": {"name": "panda", "task": "pose"},
-                                             "x": x.tolist()}))  # fmt: skip
+    body = _ok(
+        api.post("/kinematics", json={"robot": {"name": "panda", "task": "pose"}, "x": x.tolist()})
+    )
     kin = robot_from_dict({"name": "panda", "task": "pose"}).kinematics
     assert np.shape(body["k"]) == (5, 6) and np.shape(body["J"]) == (5, 6, 7)
     np.testing.assert_allclose(body["k"], kin.forward(x), atol=1e-15)
     np.testing.assert_allclose(body["J"], kin.jacobian(x), atol=1e-15)
     assert body["task_names"] == ["x", "y", "z", "rx", "ry", "rz"]
-    home = _ok(api.post("/kinematics", json={"robot": {"name": "panda", "task": "pose"},
-                                             "x": HOME}))  # fmt: skip
+    home = _ok(
+        api.post("/kinematics", json={"robot": {"name": "panda", "task": "pose"}, "x": HOME})
+    )
     np.testing.assert_allclose(home["k"], [0.3069, 0, 0.5903, 0, 0, 0], atol=1e-4)
 
 
@@ -51,17 +52,28 @@ def test_a_user_robot(api):
 
 @pytest.mark.parametrize(
     ("body", "field", "text"),
-    [({"robot": {"name": "manipulator2"}, "x": [0.0, 1.0]}, "x", "3 items"),
-     ({"robot": {"name": "panda"}, "x": [[0] * 7, [0] * 6]}, "x", "7 items"),
-     ({"robot": {"name": "planar_chain", "joints": "RRR", "lengths": [1, 1, 1]},
-       "x": [[0, 0, 0], [0, 1]]}, "x[1]", "must have 3 components"),
-     ({"robot": {"name": "planar_chain", "joints": "RRR", "lengths": [1, 1, 1]},
-       "x": [0, 1]}, "x", "must have 3 components (p of planar chain"),
-     ({"robot": {"name": "manipulator2"}, "x": [0, "a", 1]}, "x", ""),
-     ({"robot": {"name": "nosuch"}, "x": [0, 0, 0]}, "robot", ""),
-     ({"robot": {"name": "manipulator2"}, "x": [[0, 0, 0]] * 1001}, "x", ""),
-     ({"robot": {"name": "panda", "task": "xyzq"}, "x": HOME}, "robot.task", "")],
-)  # fmt: skip
+    [
+        ({"robot": {"name": "manipulator2"}, "x": [0.0, 1.0]}, "x", "3 items"),
+        ({"robot": {"name": "panda"}, "x": [[0] * 7, [0] * 6]}, "x", "7 items"),
+        (
+            {
+                "robot": {"name": "planar_chain", "joints": "RRR", "lengths": [1, 1, 1]},
+                "x": [[0, 0, 0], [0, 1]],
+            },
+            "x[1]",
+            "must have 3 components",
+        ),
+        (
+            {"robot": {"name": "planar_chain", "joints": "RRR", "lengths": [1, 1, 1]}, "x": [0, 1]},
+            "x",
+            "must have 3 components (p of planar chain",
+        ),
+        ({"robot": {"name": "manipulator2"}, "x": [0, "a", 1]}, "x", ""),
+        ({"robot": {"name": "nosuch"}, "x": [0, 0, 0]}, "robot", ""),
+        ({"robot": {"name": "manipulator2"}, "x": [[0, 0, 0]] * 1001}, "x", ""),
+        ({"robot": {"name": "panda", "task": "xyzq"}, "x": HOME}, "robot.task", ""),
+    ],
+)
 def test_bad_requests_are_422_naming_the_field(api, body, field, text):
     r = api.post("/kinematics", json=body)
     assert r.status_code == 422, r.text

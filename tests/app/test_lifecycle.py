@@ -51,9 +51,10 @@ def test_an_exploding_formula_is_refused_and_the_server_answers_meanwhile():
     answers within a second or two all along (the machine's load aside, the session's own
     computation shares the event loop's process). A new session with such a robot in its
     link's state is refused the same way."""
-    definitions = [{"name": "formula", "variables": ["x1", "x2", "x3"],
-                    "task": ["x1 + x2", text]}
-                   for text in (_nested_38(), _nested_exponentials(5))]  # fmt: skip
+    definitions = [
+        {"name": "formula", "variables": ["x1", "x2", "x3"], "task": ["x1 + x2", text]}
+        for text in (_nested_38(), _nested_exponentials(5))
+    ]
     definition = definitions[1]
     with jik_serve(JIK_WORKERS="1") as served:
         with httpx.Client(timeout=120) as client:
@@ -82,18 +83,26 @@ def test_an_exploding_formula_is_refused_and_the_server_answers_meanwhile():
     for r in answers:
         assert r.status_code == 422, r.text
         (detail,) = r.json()["detail"]
-        assert detail["loc"] in (["body", "robot_definition", "task", "1"],
-                                 ["body", "robot_definition"]), detail  # fmt: skip
-        assert any(why in detail["msg"] for why in ("derivatives are too large", "took longer",
-                                                     "nested too deeply")), detail  # fmt: skip
+        assert detail["loc"] in (
+            ["body", "robot_definition", "task", "1"],
+            ["body", "robot_definition"],
+        ), detail
+        assert any(
+            why in detail["msg"]
+            for why in ("derivatives are too large", "took longer", "nested too deeply")
+        ), detail
     assert stall < 2.0, f"/health took {stall:.2f} s while the formulas were refused"
 
 
 def test_sigterm_during_an_atlas_job_stops_the_server_within_seconds():
     """An atlas job computing in its worker processes: SIGTERM ends the server (and its
     workers) within 5 s, with no leaked semaphore."""
-    long = {"robot": {"name": "manipulator2"}, "starts": 20000, "cycles": 5,
-            "path": [[0.0, 1.0], [1.0, 1.0], [1.0, 2.0], [0.0, 2.0]]}  # fmt: skip
+    long = {
+        "robot": {"name": "manipulator2"},
+        "starts": 20000,
+        "cycles": 5,
+        "path": [[0.0, 1.0], [1.0, 1.0], [1.0, 2.0], [0.0, 2.0]],
+    }
     with jik_serve(JIK_WORKERS="1") as served:
         with httpx.Client(timeout=60) as client:
             job = client.post(f"{served.url}/atlas", json=long)

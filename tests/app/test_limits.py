@@ -106,8 +106,13 @@ def test_a_computation_over_the_worker_memory_limit_is_422_and_the_worker_lives_
             (line,) = [row for row in f if row.startswith("Max address space")]
         assert line.split()[3] == str(400 * 1024 * 1024)
         wide = {"lambda10": [-3, 3], "lambda11": [-3, 3], "lambda20": [-3, 3]}
-        body = {"robot": {"name": "unicycle"}, "method": "evaluate", "grid": 61, "nodes": 24,
-                "region": wide}  # fmt: skip
+        body = {
+            "robot": {"name": "unicycle"},
+            "method": "evaluate",
+            "grid": 61,
+            "nodes": 24,
+            "region": wide,
+        }
         r = client.post("/synthesize", json=body)
         assert r.status_code == 422, r.text
         (error,) = r.json()["detail"]
@@ -118,8 +123,7 @@ def test_a_computation_over_the_worker_memory_limit_is_422_and_the_worker_lives_
 
 
 #: An atlas that runs for about a minute of one core (cancelled long before).
-LONG_ATLAS = {"robot": {"name": "manipulator2"}, "path": TABLE1_PATH, "starts": 20000,
-              "cycles": 5}  # fmt: skip
+LONG_ATLAS = {"robot": {"name": "manipulator2"}, "path": TABLE1_PATH, "starts": 20000, "cycles": 5}
 SHORT_ATLAS = {**LONG_ATLAS, "starts": 4, "cycles": 1, "arc": [-1.0, 1.0]}
 
 

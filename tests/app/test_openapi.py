@@ -54,8 +54,11 @@ def test_each_robot_offers_only_its_own_maps_and_variables(document):
             m for o in options for m in o.get("oneOf", [])
         ]
         names = {schemas[m["$ref"].rsplit("/", 1)[1]]["properties"]["name"]["const"] for m in refs}
-        expected = {"formula", "e2_synthesized"} if name in USER_ROBOT_MODELS else {
-            a.name for a in ROBOTS[name].augmentations}  # fmt: skip
+        expected = (
+            {"formula", "e2_synthesized"}
+            if name in USER_ROBOT_MODELS
+            else {a.name for a in ROBOTS[name].augmentations}
+        )
         assert names == expected, name
     for name, body in _variants(document, "/synthesize").items():
         if name in USER_ROBOT_MODELS:
@@ -108,8 +111,10 @@ def test_a_gamma_too_small_for_the_solver_is_refused_at_the_boundary(api):
 
 
 def test_the_default_box_leaves_out_the_fixed_variables(api):
-    r = api.post("/synthesize", json={"robot": {"name": "manipulator2"}, "fixed": {"x2": 0.5},
-                                      "grid": 5, "nodes": 3})  # fmt: skip
+    r = api.post(
+        "/synthesize",
+        json={"robot": {"name": "manipulator2"}, "fixed": {"x2": 0.5}, "grid": 5, "nodes": 3},
+    )
     assert r.status_code == 200, r.text
     assert set(r.json()["region"]) == {"x1", "x3"} and r.json()["fixed"] == {"x2": 0.5}
 

@@ -143,10 +143,19 @@ def test_a_cancelled_request_gives_its_worker_back_after_the_reply():
     from jik.app.compute.schemas import RepeatabilityRequest
     from tests.app.conftest import TABLE1_PATH, X0_M2
 
-    body = RepeatabilityRequest.model_validate(
-        {"robot": {"name": "manipulator2"}, "algorithm": "pseudoinverse", "x0": X0_M2,
-         "path": TABLE1_PATH, "cycles": 150}
-    ).model_dump_json().encode()  # fmt: skip
+    body = (
+        RepeatabilityRequest.model_validate(
+            {
+                "robot": {"name": "manipulator2"},
+                "algorithm": "pseudoinverse",
+                "x0": X0_M2,
+                "path": TABLE1_PATH,
+                "cycles": 150,
+            }
+        )
+        .model_dump_json()
+        .encode()
+    )
 
     async def main():
         pool = ComputePool(Settings(workers=1, timeout=60.0))

@@ -56,29 +56,44 @@ def test_an_extended_run_names_the_map_it_used_and_a_region_defaults_to_the_arm_
     default = _solve(client, algorithm="extended")
     assert default["augmentation"]["name"] == "e2_synthesized"
     assert default["augmentation"]["definition"] == {
-        "name": "e2_synthesized", "region": region, "degree": 4}  # fmt: skip
+        "name": "e2_synthesized",
+        "region": region,
+        "degree": 4,
+    }
     given = _solve(client, algorithm="extended", augmentation={"name": "e2_synthesized"})
     assert given["augmentation"] == default["augmentation"] and given["converged"]
     np.testing.assert_allclose(given["x"], default["x"], atol=1e-12)
-    other = _solve(client, algorithm="extended", augmentation={"name": "e2_synthesized",
-                                                               "degree": 3})  # fmt: skip
-    assert other["augmentation"]["definition"] == {**default["augmentation"]["definition"],
-                                                   "degree": 3}  # fmt: skip
+    other = _solve(
+        client, algorithm="extended", augmentation={"name": "e2_synthesized", "degree": 3}
+    )
+    assert other["augmentation"]["definition"] == {
+        **default["augmentation"]["definition"],
+        "degree": 3,
+    }
     r = client.post("/synthesize", json={"robot": PANDA, "method": "evaluate"})
     assert r.status_code == 200 and r.json()["augmentation"] == default["augmentation"]
 
 
 def test_messages_name_the_catalogue_arm(client):
     outside = [[-1.0, 1.0]] * 7  # (joint 4 at home, -2.36, is outside)
-    r = client.post("/solve", json={"robot": PANDA, "x0": HOME, "target": _target(),
-                                    "algorithm": "weighted",
-                                    "algorithm_parameters": {"limits": outside}})  # fmt: skip
+    r = client.post(
+        "/solve",
+        json={
+            "robot": PANDA,
+            "x0": HOME,
+            "target": _target(),
+            "algorithm": "weighted",
+            "algorithm_parameters": {"limits": outside},
+        },
+    )
     assert r.status_code == 422 and "the weighted inverse of panda is undefined" in r.text
     xyz = {"name": "panda", "task": "xyz"}
     y = _target("xyz")
     r = client.post("/atlas", json={"robot": xyz, "path": [y, y], "starts": 2})
-    assert messages(r) == ["starts: a self-motion curve needs one degree of redundancy "
-                           "(p = r + 1); panda has p = 7, r = 3: give start_points"]  # fmt: skip
+    assert messages(r) == [
+        "starts: a self-motion curve needs one degree of redundancy "
+        "(p = r + 1); panda has p = 7, r = 3: give start_points"
+    ]
 
 
 def test_a_start_off_the_path_s_first_point_is_named_by_its_index(client):
@@ -96,16 +111,22 @@ def test_a_start_off_the_path_s_first_point_is_named_by_its_index(client):
 @pytest.mark.parametrize("width", [1e308, 1.7976931348623157e308])
 def test_weighted_with_limits_too_wide_to_matter_is_the_pseudoinverse(client, width):
     plain = _solve(client, algorithm="pseudoinverse")
-    wide = _solve(client, algorithm="weighted",
-                  algorithm_parameters={"limits": [[-width, width]] * 7})  # fmt: skip
+    wide = _solve(
+        client, algorithm="weighted", algorithm_parameters={"limits": [[-width, width]] * 7}
+    )
     assert wide["converged"]
     np.testing.assert_allclose(wide["x"], plain["x"], atol=1e-12)
 
 
 def test_an_e2_map_without_region_of_a_robot_without_a_home_asks_for_one(client):
     chain = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 1.0, 1.0]}
-    body = {"robot": chain, "algorithm": "extended", "x0": [0.1, 0.5, 0.5], "target": [1.5, 1.0],
-            "augmentation": {"name": "e2_synthesized"}}  # fmt: skip
+    body = {
+        "robot": chain,
+        "algorithm": "extended",
+        "x0": [0.1, 0.5, 0.5],
+        "target": [1.5, 1.0],
+        "augmentation": {"name": "e2_synthesized"},
+    }
     r = client.post("/solve", json=body)
     assert r.json()["detail"][0]["loc"] == ["body", "augmentation", "region"]
     assert "only an arm with a home has a default box" in messages(r)[0]

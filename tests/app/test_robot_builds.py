@@ -25,10 +25,15 @@ def test_a_slow_formula_build_is_refused_naming_the_robot():
     longer on any machine), /solve of a slow formula robot is a 422 naming ``robot`` and the
     build (not ``max_iterations``, the field that sizes a solve)."""
     body = {
-        "robot": {"name": "formula", "variables": ["x1", "x2", "x3"],
-                  "task": ["x1 + x2", _slow_formula()]},
-        "algorithm": "pseudoinverse", "x0": [0.1, 0.2, 0.3], "target": [0.3, 1.0],
-    }  # fmt: skip
+        "robot": {
+            "name": "formula",
+            "variables": ["x1", "x2", "x3"],
+            "task": ["x1 + x2", _slow_formula()],
+        },
+        "algorithm": "pseudoinverse",
+        "x0": [0.1, 0.2, 0.3],
+        "target": [0.3, 1.0],
+    }
     with TestClient(create_app(Settings(workers=1, timeout=1.5, build_seconds=0.02))) as client:
         r = client.post("/solve", json=body)
     assert r.status_code == 422, r.text

@@ -236,8 +236,9 @@ def _distance_topolyline(points: np.ndarray, line: np.ndarray) -> np.ndarray:
     a, b = line[:-1], line[1:]
     d = b - a
     rel = points[:, None, :] - a[None]
-    t = np.clip(np.einsum("nmd,md->nm", rel, d) / np.maximum(np.einsum("md,md->m", d, d), 1e-300),
-                0.0, 1.0)  # fmt: skip
+    t = np.clip(
+        np.einsum("nmd,md->nm", rel, d) / np.maximum(np.einsum("md,md->m", d, d), 1e-300), 0.0, 1.0
+    )
     return np.min(np.linalg.norm(rel - t[..., None] * d[None], axis=-1), axis=1)
 
 
@@ -293,9 +294,20 @@ def test_the_scene_shows_the_runs_progress_not_the_second_phases():
         assert drawn.startswith("generation 1:")
 
         def progress(phase: str) -> Event:
-            return Event("progress", 1, json.dumps({
-                "type": "progress", "generation": 1, "phase": phase, "what": "h on a grid",
-                "fraction": 0.4, "elapsed": 0.8}))  # fmt: skip
+            return Event(
+                "progress",
+                1,
+                json.dumps(
+                    {
+                        "type": "progress",
+                        "generation": 1,
+                        "phase": phase,
+                        "what": "h on a grid",
+                        "fraction": 0.4,
+                        "elapsed": 0.8,
+                    }
+                ),
+            )
 
         scene._on_event(progress("second"))
         assert scene.status.content == drawn and scene.progress.visible is False
@@ -306,9 +318,14 @@ def test_the_scene_shows_the_runs_progress_not_the_second_phases():
         dashboard.stop()
 
 
-FORMULA = {"name": "formula", "variables": ["x1", "x2", "x3"], "task": [
-    "0.05*cos(x1) + 0.05*cos(x1 + x2) + 0.03*cos(x1 + x2 + x3)",
-    "0.05*sin(x1) + 0.05*sin(x1 + x2) + 0.03*sin(x1 + x2 + x3)"]}  # fmt: skip
+FORMULA = {
+    "name": "formula",
+    "variables": ["x1", "x2", "x3"],
+    "task": [
+        "0.05*cos(x1) + 0.05*cos(x1 + x2) + 0.03*cos(x1 + x2 + x3)",
+        "0.05*sin(x1) + 0.05*sin(x1 + x2) + 0.03*sin(x1 + x2 + x3)",
+    ],
+}
 ARM = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]}
 
 
@@ -355,10 +372,18 @@ def test_the_camera_frames_each_robots_reach_for_each_client():
         distance = float(np.linalg.norm(initial.position - initial.look_at))
         assert 2.4 <= distance * math.sin(half) <= 1.5 * 2.4, distance
         # A client whose view is three times taller than wide: framed for its narrow width.
-        camera = {"type": "ViewerCameraMessage", "wxyz": (1.0, 0.0, 0.0, 0.0),
-                  "position": (0.0, -5.0, 5.0), "fov": 1.0, "near": 0.01, "far": 100.0,
-                  "image_height": 900, "image_width": 300, "look_at": (0.0, 0.0, 0.0),
-                  "up_direction": (0.0, 0.0, 1.0)}  # fmt: skip
+        camera = {
+            "type": "ViewerCameraMessage",
+            "wxyz": (1.0, 0.0, 0.0, 0.0),
+            "position": (0.0, -5.0, 5.0),
+            "fov": 1.0,
+            "near": 0.01,
+            "far": 100.0,
+            "image_height": 900,
+            "image_width": 300,
+            "look_at": (0.0, 0.0, 0.0),
+            "up_direction": (0.0, 0.0, 1.0),
+        }
 
         async def tall_client() -> float:
             async with scene.connect([f"viser-v{viser.__version__}"]) as ws:

@@ -41,9 +41,15 @@ def _unicycle_result():
 def _phase(kin, amap, result, *, deferred, cancelled=lambda: False):
     seen: list[tuple[float, str]] = []
     phase = SecondPhase(
-        kin, amap, result, deferred=deferred, cached=None, grid_before=None,
-        progress=lambda f, what: seen.append((f, what)), cancelled=cancelled,
-    )  # fmt: skip
+        kin,
+        amap,
+        result,
+        deferred=deferred,
+        cached=None,
+        grid_before=None,
+        progress=lambda f, what: seen.append((f, what)),
+        cancelled=cancelled,
+    )
     return phase, seen
 
 
@@ -80,8 +86,9 @@ def test_cancelled_during_the_grid_nothing_is_shown_as_computed():
     say what was cancelled and how far, with no value of E1 or E2."""
     kin, amap, result = _unicycle_result()
     calls = []
-    phase, _ = _phase(kin, amap, result, deferred=True,
-                      cancelled=lambda: calls.append(1) or len(calls) > 2)  # fmt: skip
+    phase, _ = _phase(
+        kin, amap, result, deferred=True, cancelled=lambda: calls.append(1) or len(calls) > 2
+    )
     with pytest.raises(Cancelled):
         phase.run()
     assert not phase.grid_done and phase.what == GRID
@@ -181,9 +188,15 @@ def test_a_dashboard_reports_its_second_phase_cancels_it_and_computes_it_again()
         assert dashboard.result.augmenting is not None
         kin, amap = kinematics_and_map(dashboard.state)
         plain = SecondPhase(
-            kin, amap, replace(dashboard.result, augmenting=None), deferred=True, cached=None,
-            grid_before=None, progress=lambda f, w: None, cancelled=lambda: False,
-        )  # fmt: skip
+            kin,
+            amap,
+            replace(dashboard.result, augmenting=None),
+            deferred=True,
+            cached=None,
+            grid_before=None,
+            progress=lambda f, w: None,
+            cancelled=lambda: False,
+        )
         functionals, _ = plain.run()
         assert json.dumps(done["functionals"]) == json.dumps(functionals)
         assert set(done["figures"]) == {"augmenting", "sensitivity"}

@@ -52,8 +52,7 @@ def test_a_change_from_another_origin_is_refused(app, client):
     r = client.post("/api/sessions", json={"state": {}}, headers={"origin": FOREIGN})
     assert r.status_code == 403 and FOREIGN in r.json()["detail"]
     assert len(app.state.sessions) == 0
-    ours = client.post("/api/sessions", json={"state": {}},
-                       headers={"origin": "http://testserver"})  # fmt: skip
+    ours = client.post("/api/sessions", json={"state": {}}, headers={"origin": "http://testserver"})
     assert ours.status_code == 201
     session = ours.json()["id"]
     for method, path, body in [
@@ -70,8 +69,9 @@ def test_a_change_from_another_origin_is_refused(app, client):
 def test_the_scene_socket_refuses_another_origin(client):
     session = client.post("/api/sessions", json={"state": {}}).json()["id"]
     with pytest.raises(WebSocketDisconnect) as closed:
-        with client.websocket_connect(f"/api/sessions/{session}/scene",
-                                      headers={"origin": FOREIGN}) as ws:  # fmt: skip
+        with client.websocket_connect(
+            f"/api/sessions/{session}/scene", headers={"origin": FOREIGN}
+        ) as ws:
             ws.receive_text()
     assert closed.value.code == 4403
 
@@ -79,8 +79,9 @@ def test_the_scene_socket_refuses_another_origin(client):
 @contextlib.contextmanager
 def _serving(app):
     """``app`` served by uvicorn on a free loopback port (its port), as ``jik serve`` does."""
-    server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=0, log_level="warning",
-                                           lifespan="off"))  # fmt: skip
+    server = uvicorn.Server(
+        uvicorn.Config(app, host="127.0.0.1", port=0, log_level="warning", lifespan="off")
+    )
     thread = threading.Thread(target=server.run, daemon=True)
     thread.start()
     deadline = time.monotonic() + 30
@@ -159,12 +160,16 @@ def test_a_scene_server_takes_only_the_relay(tmp_path):
         assert page.status_code == 403
         assert session.dashboard.state.gamma == created["state"]["gamma"]
         # The relay: viser's first messages, its theme without the share button among them.
-        with client.websocket_connect(f"/api/sessions/{created['id']}/scene",
-                                      subprotocols=viser_protocol) as ws:  # fmt: skip
+        with client.websocket_connect(
+            f"/api/sessions/{created['id']}/scene", subprotocols=viser_protocol
+        ) as ws:
             themes = []
             while not themes:
-                themes = [m for m in _viser_messages(ws.receive_bytes())
-                          if m["type"] == "ThemeConfigurationMessage"]  # fmt: skip
+                themes = [
+                    m
+                    for m in _viser_messages(ws.receive_bytes())
+                    if m["type"] == "ThemeConfigurationMessage"
+                ]
         assert themes[-1]["show_share_button"] is False
         assert session.scene.server.request_share_url() is None
     finally:
@@ -187,8 +192,11 @@ def test_a_body_that_is_not_json_is_415_and_never_parsed(app, client, content_ty
         assert r.status_code == 415, (path, r.text)
         assert r.json()["detail"][0]["loc"] == ["header", "content-type"]
     assert len(app.state.sessions) == 0
-    ok = client.post("/api/sessions", content=b'{"state": {}}',
-                     headers={"content-type": "application/json; charset=utf-8"})  # fmt: skip
+    ok = client.post(
+        "/api/sessions",
+        content=b'{"state": {}}',
+        headers={"content-type": "application/json; charset=utf-8"},
+    )
     assert ok.status_code == 201
 
 
@@ -229,14 +237,16 @@ def test_the_openapi_document_gives_the_event_stream_and_the_csv_their_types(cli
         ([("Host", "127.0.0.1:5"), ("Authorization", "KEY")], None),
         ([("Host", "[::1]:5"), ("Authorization", "KEY")], None),
         ([("Host", "127.0.0.1:5")], "relay only"),
-        ([("Host", "127.0.0.1:5"), ("Authorization", "KEY"), ("Authorization", "KEY")],
-         "relay only"),
+        (
+            [("Host", "127.0.0.1:5"), ("Authorization", "KEY"), ("Authorization", "KEY")],
+            "relay only",
+        ),
         ([("Host", "127.0.0.1:5"), ("Authorization", "KEYx")], "relay only"),
         ([("Host", "localhost.attacker.example"), ("Authorization", "KEY")], "loopback"),
         ([("Host", "127.0.0.1:5"), ("Host", "evil"), ("Authorization", "KEY")], "loopback"),
         ([("Host", "127.0.0.1:5"), ("Authorization", "KEY"), ("Origin", "null")], "browser"),
     ],
-)  # fmt: skip
+)
 def test_a_scene_handshake_needs_the_key_a_loopback_host_and_no_origin(headers, refused):
     from websockets.datastructures import Headers
 

@@ -64,8 +64,9 @@ def test_each_session_has_its_own_state(app, client):
     one, two = _open(client), _open(client)
     assert one["id"] != two["id"] and one["state"] == two["state"]
     defaults = one["state"]
-    r = client.post(f"/api/sessions/{one['id']}/state",
-                    json={"robot": "manipulator1", "gamma": 2.0})  # fmt: skip
+    r = client.post(
+        f"/api/sessions/{one['id']}/state", json={"robot": "manipulator1", "gamma": 2.0}
+    )
     assert r.status_code == 200 and r.json()["state"]["robot"] == "manipulator1"
     assert client.get(f"/api/sessions/{two['id']}").json()["state"] == defaults
     assert client.get(f"/api/sessions/{one['id']}").json()["state"]["gamma"] == 2.0
@@ -75,8 +76,9 @@ def test_each_session_has_its_own_state(app, client):
 def test_a_link_state_opens_a_session_with_that_state(app, client):
     """The state a page keeps in its URL gives a new session the same state and numbers."""
     first = _open(client)
-    changed = client.post(f"/api/sessions/{first['id']}/state",
-                          json={"x0": [0.2, 0.1, 1.4], "cycles": 2}).json()["state"]  # fmt: skip
+    changed = client.post(
+        f"/api/sessions/{first['id']}/state", json={"x0": [0.2, 0.1, 1.4], "cycles": 2}
+    ).json()["state"]
     again = _open(client, changed)
     assert again["state"] == changed
     _computed(app, first["id"])

@@ -34,10 +34,26 @@ def _engine(robot: dict, b: dict, degree: int, nodes: int, **kw):
 
 def test_manipulator2_agrees_with_the_tensor_ritz_minimum_within_1_percent(api):
     """On the box of the paper's figures, E2 = 1.8152 by the tensor Ritz method (degree 8)."""
-    total = _ok(api, {"robot": {"name": "manipulator2"}, "method": "e2_total_degree",
-                      "region": REGION, "degree": 8, "qmc_nodes": 4096})  # fmt: skip
-    tensor = _ok(api, {"robot": {"name": "manipulator2"}, "method": "e2_variational",
-                       "region": REGION, "degree": 8, "nodes": 12})  # fmt: skip
+    total = _ok(
+        api,
+        {
+            "robot": {"name": "manipulator2"},
+            "method": "e2_total_degree",
+            "region": REGION,
+            "degree": 8,
+            "qmc_nodes": 4096,
+        },
+    )
+    tensor = _ok(
+        api,
+        {
+            "robot": {"name": "manipulator2"},
+            "method": "e2_variational",
+            "region": REGION,
+            "degree": 8,
+            "nodes": 12,
+        },
+    )
     e2, ritz = total["functionals"]["e2"]["value"], tensor["functionals"]["e2"]["value"]
     assert math.isclose(ritz, 1.8152, rel_tol=1e-4) and math.isclose(e2, ritz, rel_tol=0.01)
     assert total["augmentation"]["name"] == "e2_total_degree"
@@ -50,16 +66,19 @@ def test_manipulator2_agrees_with_the_tensor_ritz_minimum_within_1_percent(api):
 
 
 def test_a_7_joint_arm_over_all_its_joints_is_the_engines_synthesis(api):
-    b = _ok(api, {"robot": PANDA, "method": "e2_total_degree", "degree": 2, "qmc_nodes": 1024,
-                  "grid": 5})  # fmt: skip
+    b = _ok(
+        api,
+        {"robot": PANDA, "method": "e2_total_degree", "degree": 2, "qmc_nodes": 1024, "grid": 5},
+    )
     assert len(b["region"]) == 7 and b["fixed"] == {}
     info = b["total_degree"]
     ref = _engine(PANDA, b, 2, 1024, convergence_degrees=[1])
     assert math.isclose(info["e2"], ref.e2, rel_tol=1e-10)
     assert math.isclose(info["e2_check"], ref.e2_check, rel_tol=1e-10)
     assert info["unknowns"] == 35 and np.shape(info["coefficients"]) == (1, 35)
-    np.testing.assert_allclose(info["coefficients"][0], ref.maps[0].coefficients, rtol=1e-8,
-                               atol=1e-10)  # fmt: skip
+    np.testing.assert_allclose(
+        info["coefficients"][0], ref.maps[0].coefficients, rtol=1e-8, atol=1e-10
+    )
     assert set(info["single_joint"]) == set(b["region"])
     assert min(j["e2"] for j in info["single_joint"].values()) > info["e2"]
     # the grid is h of the basis and coefficients reported, on two of the box's axes
@@ -74,16 +93,25 @@ def test_a_7_joint_arm_over_all_its_joints_is_the_engines_synthesis(api):
 def test_two_degrees_of_redundancy_give_two_maps(api):
     """A 4R planar chain with a position task (p - r = 2): h_1 and h_2, the kernel frame on the
     best-conditioned joints at the box's centre by default, as the engine gives them."""
-    b = _ok(api, {"robot": RRRR, "method": "e2_total_degree", "degree": 3, "qmc_nodes": 1024,
-                  "grid": 5})  # fmt: skip
+    b = _ok(
+        api, {"robot": RRRR, "method": "e2_total_degree", "degree": 3, "qmc_nodes": 1024, "grid": 5}
+    )
     info = b["total_degree"]
     ref = _engine(RRRR, b, 3, 1024)
     best = best_frame_axes(robot_from_dict(RRRR).kinematics, ref.region, ref.fixed)
     assert np.shape(info["coefficients"]) == (2, 34) and info["frame_axes"] == best
     assert info["single_joint"] == {} and b["augmentation"]["parameters"]["maps"] == 2
     assert math.isclose(info["e2_check"], ref.e2_check, rel_tol=1e-10)
-    other = _ok(api, {"robot": RRRR, "method": "e2_total_degree", "degree": 3, "qmc_nodes": 1024,
-                      "frame_axes": [3, 4]})  # fmt: skip
+    other = _ok(
+        api,
+        {
+            "robot": RRRR,
+            "method": "e2_total_degree",
+            "degree": 3,
+            "qmc_nodes": 1024,
+            "frame_axes": [3, 4],
+        },
+    )
     assert other["total_degree"]["frame_axes"] == [3, 4] != best
     assert other["total_degree"]["e2"] != info["e2"]
 
@@ -95,13 +123,22 @@ def test_two_degrees_of_redundancy_give_two_maps(api):
         ({"robot": PANDA, "degree": 12}, "degree", "lower the degree"),
         ({"robot": PANDA, "degree": 3, "qmc_nodes": 128}, "qmc_nodes", "at least twice"),
         ({"robot": RRRR, "frame_axes": [4, 4]}, "frame_axes", "2 distinct joints"),
-        ({"robot": {"name": "manipulator2"}, "augmentation": {"name": "paper_cubic"}},
-         "augmentation", "give no map"),
-        ({"robot": PANDA, "method": "e2_variational",
-          "region": {f"x{i}": [-0.1, 0.1] for i in range(1, 5)}},
-         "region", "'e2_total_degree' synthesizes h of any number"),
+        (
+            {"robot": {"name": "manipulator2"}, "augmentation": {"name": "paper_cubic"}},
+            "augmentation",
+            "give no map",
+        ),
+        (
+            {
+                "robot": PANDA,
+                "method": "e2_variational",
+                "region": {f"x{i}": [-0.1, 0.1] for i in range(1, 5)},
+            },
+            "region",
+            "'e2_total_degree' synthesizes h of any number",
+        ),
     ],
-)  # fmt: skip
+)
 def test_bad_total_degree_requests_are_422_naming_the_field(api, body, field, text):
     r = api.post("/synthesize", json={"method": "e2_total_degree", **body})
     assert any(m.startswith(f"{field}: ") and text in m for m in messages(r)), messages(r)
@@ -117,13 +154,19 @@ def test_a_requested_map_over_all_seven_joints_makes_the_pose_loop_repeatable(ap
     home = np.array(panda.spec.default_x0)
     y0 = panda.kinematics.forward(home)
     box = {f"x{i + 1}": [home[i] - 0.2, home[i] + 0.2] for i in range(7)}
-    body = {"robot": PANDA, "algorithm": "extended", "x0": home.tolist(), "cycles": 3,
-            "path": [(y0 + np.array(step)).tolist() for step in STEPS],
-            "augmentation": {"name": "e2_synthesized", "region": box, "degree": 2}}  # fmt: skip
+    body = {
+        "robot": PANDA,
+        "algorithm": "extended",
+        "x0": home.tolist(),
+        "cycles": 3,
+        "path": [(y0 + np.array(step)).tolist() for step in STEPS],
+        "augmentation": {"name": "e2_synthesized", "region": box, "degree": 2},
+    }
     r = api.post("/repeatability", json=body)
     assert r.status_code == 200, r.text
     assert r.json()["success"] and r.json()["max_drift"] < 1e-9
     body["augmentation"]["degree"] = 9
     r = api.post("/repeatability", json=body)
-    assert any(m.startswith("augmentation.degree: ") and "between 1 and 6" in m
-               for m in messages(r)), messages(r)  # fmt: skip
+    assert any(
+        m.startswith("augmentation.degree: ") and "between 1 and 6" in m for m in messages(r)
+    ), messages(r)

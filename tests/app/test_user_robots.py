@@ -34,21 +34,33 @@ def _ok(response) -> dict:
 
 
 def test_planar_3r_solve_reaches_the_target(api):
-    b = _ok(api.post("/solve", json={"robot": ARM, "algorithm": "pseudoinverse", "x0": X0,
-                                     "target": [1.0, 1.3]}))  # fmt: skip
+    b = _ok(
+        api.post(
+            "/solve",
+            json={"robot": ARM, "algorithm": "pseudoinverse", "x0": X0, "target": [1.0, 1.3]},
+        )
+    )
     assert b["converged"] and b["error"] < 1e-10
     assert b["robot"]["name"] == "planar_chain" and (b["robot"]["p"], b["robot"]["r"]) == (3, 2)
     assert b["robot"]["definition"]["lengths"] == [1.0, 0.8, 0.6]
     x = np.array(b["x"])
-    y = np.array([np.cos(x[0]) + 0.8 * np.cos(x[0] + x[1]) + 0.6 * np.cos(x.sum()),
-                  np.sin(x[0]) + 0.8 * np.sin(x[0] + x[1]) + 0.6 * np.sin(x.sum())])  # fmt: skip
+    y = np.array(
+        [
+            np.cos(x[0]) + 0.8 * np.cos(x[0] + x[1]) + 0.6 * np.cos(x.sum()),
+            np.sin(x[0]) + 0.8 * np.sin(x[0] + x[1]) + 0.6 * np.sin(x.sum()),
+        ]
+    )
     np.testing.assert_allclose(y, [1.0, 1.3], atol=1e-9)
 
 
 def test_planar_3r_pseudoinverse_legs_match_an_independent_solve_ivp(api):
     """Two cycles: the leg ends through REST are scipy's own integration of eq. (7) to 1e-8."""
-    b = _ok(api.post("/repeatability", json={"robot": ARM, "algorithm": "pseudoinverse",
-                                             "x0": X0, "path": PATH, "cycles": 2}))  # fmt: skip
+    b = _ok(
+        api.post(
+            "/repeatability",
+            json={"robot": ARM, "algorithm": "pseudoinverse", "x0": X0, "path": PATH, "cycles": 2},
+        )
+    )
     from jik.engine.planar_chain import PlanarChain
 
     arm = PlanarChain("RRR", [1.0, 0.8, 0.6])
@@ -60,19 +72,46 @@ def test_planar_3r_pseudoinverse_legs_match_an_independent_solve_ivp(api):
 def test_planar_3r_synthesis_then_its_extended_inverse_is_repeatable(api):
     """e2_variational on the box; E2 below that of h = x3 there; the extended inverse of the
     synthesized map drives the path 5 times back to x0 (drift < 1e-9)."""
-    synth = _ok(api.post("/synthesize", json={"robot": ARM, "method": "e2_variational",
-                                              "region": REGION, "degree": 12,
-                                              "nodes": 16}))  # fmt: skip
-    x3 = _ok(api.post("/synthesize", json={"robot": ARM, "method": "evaluate", "region": REGION,
-                                           "augmentation": {"name": "formula", "h": "x3"},
-                                           "nodes": 16}))  # fmt: skip
+    synth = _ok(
+        api.post(
+            "/synthesize",
+            json={
+                "robot": ARM,
+                "method": "e2_variational",
+                "region": REGION,
+                "degree": 12,
+                "nodes": 16,
+            },
+        )
+    )
+    x3 = _ok(
+        api.post(
+            "/synthesize",
+            json={
+                "robot": ARM,
+                "method": "evaluate",
+                "region": REGION,
+                "augmentation": {"name": "formula", "h": "x3"},
+                "nodes": 16,
+            },
+        )
+    )
     e2, e2_x3 = synth["functionals"]["e2"]["value"], x3["functionals"]["e2"]["value"]
     assert e2 < 0.2 * e2_x3, (e2, e2_x3)
     assert x3["augmentation"]["definition"] == {"name": "formula", "h": "x3"}
-    rep = _ok(api.post("/repeatability", json={
-        "robot": ARM, "algorithm": "extended", "x0": X0, "path": PATH, "cycles": 5,
-        "augmentation": {"name": "e2_synthesized", "region": REGION, "degree": 12},
-    }))  # fmt: skip
+    rep = _ok(
+        api.post(
+            "/repeatability",
+            json={
+                "robot": ARM,
+                "algorithm": "extended",
+                "x0": X0,
+                "path": PATH,
+                "cycles": 5,
+                "augmentation": {"name": "e2_synthesized", "region": REGION, "degree": 12},
+            },
+        )
+    )
     assert rep["success"] and rep["repeatable"]
     assert max(rep["drift"]) < 1e-9
     assert rep["augmentation"]["name"] == "e2_synthesized"
@@ -80,8 +119,10 @@ def test_planar_3r_synthesis_then_its_extended_inverse_is_repeatable(api):
 
 def test_more_than_one_degree_of_redundancy_is_refused_by_e2_variational(api):
     arm = {"name": "planar_chain", "joints": "RRRR", "lengths": [0.5, 0.5, 0.5, 0.5]}
-    r = api.post("/synthesize", json={"robot": arm, "method": "e2_variational",
-                                      "region": {"x3": [0, 1], "x4": [0, 1]}})  # fmt: skip
+    r = api.post(
+        "/synthesize",
+        json={"robot": arm, "method": "e2_variational", "region": {"x3": [0, 1], "x4": [0, 1]}},
+    )
     (msg,) = messages(r)
     assert msg.startswith("method: 'e2_variational' synthesizes one map h")
     assert "p = 4, r = 2" in msg
@@ -91,21 +132,45 @@ def test_formula_manipulator2_equals_the_builtin(api):
     """Manipulator 2 written as formulas gives the built-in's Table 1 run to 1e-9."""
     for algorithm, aug in (("pseudoinverse", None), ("extended", "x3 - 0.7501*x2*x3")):
         results = []
-        for robot, augmentation in ((M2_FORMULA, {"name": "formula", "h": aug}),
-                                    ({"name": "manipulator2", "l": 1.0}, None)):  # fmt: skip
-            body = {"robot": robot, "algorithm": algorithm, "x0": [0.0, 0.0, math.pi / 2],
-                    "path": TABLE1_PATH, "cycles": 2}  # fmt: skip
+        for robot, augmentation in (
+            (M2_FORMULA, {"name": "formula", "h": aug}),
+            ({"name": "manipulator2", "l": 1.0}, None),
+        ):
+            body = {
+                "robot": robot,
+                "algorithm": algorithm,
+                "x0": [0.0, 0.0, math.pi / 2],
+                "path": TABLE1_PATH,
+                "cycles": 2,
+            }
             if aug is not None and augmentation is not None:
                 body["augmentation"] = augmentation
             results.append(_ok(api.post("/repeatability", json=body)))
         if algorithm == "extended":
             continue  # (the built-in's default map is the paper's cubic, not this one)
         np.testing.assert_allclose(results[0]["legs"], results[1]["legs"], atol=1e-9, rtol=0)
-    b = _ok(api.post("/solve", json={"robot": M2_FORMULA, "algorithm": "pseudoinverse",
-                                     "x0": [0.0, 0.0, 1.5], "target": [1.0, 1.0]}))  # fmt: skip
-    ref = _ok(api.post("/solve", json={"robot": {"name": "manipulator2"}, "algorithm":
-                                       "pseudoinverse", "x0": [0.0, 0.0, 1.5],
-                                       "target": [1.0, 1.0]}))  # fmt: skip
+    b = _ok(
+        api.post(
+            "/solve",
+            json={
+                "robot": M2_FORMULA,
+                "algorithm": "pseudoinverse",
+                "x0": [0.0, 0.0, 1.5],
+                "target": [1.0, 1.0],
+            },
+        )
+    )
+    ref = _ok(
+        api.post(
+            "/solve",
+            json={
+                "robot": {"name": "manipulator2"},
+                "algorithm": "pseudoinverse",
+                "x0": [0.0, 0.0, 1.5],
+                "target": [1.0, 1.0],
+            },
+        )
+    )
     np.testing.assert_allclose(b["x"], ref["x"], atol=1e-9, rtol=0)
     np.testing.assert_allclose(Manipulator2().forward(np.array(b["x"])), [1.0, 1.0], atol=1e-9)
 
@@ -114,25 +179,51 @@ def test_urdf_arm_solve_and_repeatability(api):
     pytest.importorskip("yourdfpy")
     robot = {"name": "urdf", "urdf": ARM4.read_text(), "end_link": "tool"}
     x0 = [0.3, 0.5, 0.8, 0.6]
-    solved = _ok(api.post("/solve", json={"robot": robot, "algorithm": "pseudoinverse",
-                                          "x0": x0, "target": [0.2, 0.1, 0.8]}))  # fmt: skip
+    solved = _ok(
+        api.post(
+            "/solve",
+            json={
+                "robot": robot,
+                "algorithm": "pseudoinverse",
+                "x0": x0,
+                "target": [0.2, 0.1, 0.8],
+            },
+        )
+    )
     assert solved["converged"] and (solved["robot"]["p"], solved["robot"]["r"]) == (4, 3)
     start = np.array(solved["trajectory"]["y"][0])
     path = [list(start + [0.05, 0, 0]), list(start + [0.05, 0.05, 0]), list(start + [0, 0.05, 0])]
-    rep = _ok(api.post("/repeatability", json={
-        "robot": robot, "algorithm": "extended", "augmentation": {"name": "formula", "h":
-        "x4 - x3"}, "x0": x0, "path": path, "cycles": 3}))  # fmt: skip
+    rep = _ok(
+        api.post(
+            "/repeatability",
+            json={
+                "robot": robot,
+                "algorithm": "extended",
+                "augmentation": {"name": "formula", "h": "x4 - x3"},
+                "x0": x0,
+                "path": path,
+                "cycles": 3,
+            },
+        )
+    )
     assert rep["success"] and max(rep["drift"]) < 1e-9
 
 
 def test_a_urdf_is_not_echoed_and_skipped_meshes_are_noted(api):
     pytest.importorskip("yourdfpy")
-    text = ARM4.read_text().replace('<link name="tool"/>', '<link name="tool"><visual><geometry>'
-                                    '<mesh filename="file:///etc/passwd"/></geometry></visual>'
-                                    "</link>")  # fmt: skip
+    text = ARM4.read_text().replace(
+        '<link name="tool"/>',
+        '<link name="tool"><visual><geometry>'
+        '<mesh filename="file:///etc/passwd"/></geometry></visual>'
+        "</link>",
+    )
     robot = {"name": "urdf", "urdf": text, "end_link": "tool"}
-    run = {"robot": robot, "algorithm": "pseudoinverse", "x0": [0.3, 0.5, 0.8, 0.6],
-           "target": [0.2, 0.1, 0.8]}  # fmt: skip
+    run = {
+        "robot": robot,
+        "algorithm": "pseudoinverse",
+        "x0": [0.3, 0.5, 0.8, 0.6],
+        "target": [0.2, 0.1, 0.8],
+    }
     response = api.post("/solve", json=run)
     body = _ok(response)
     assert "<robot" not in response.text and "link name" not in response.text
@@ -190,13 +281,27 @@ HOSTILE = [
 @pytest.mark.parametrize("formula", HOSTILE, ids=lambda f: f[:20])
 def test_hostile_formulas_are_422_in_the_task_and_in_h(api, formula):
     robot = {**M2_FORMULA, "task": [formula, "x1 + sin(x3)"]}
-    r = api.post("/solve", json={"robot": robot, "algorithm": "pseudoinverse",
-                                 "x0": [0.0, 0.0, 1.5], "target": [1.0, 1.0]})  # fmt: skip
+    r = api.post(
+        "/solve",
+        json={
+            "robot": robot,
+            "algorithm": "pseudoinverse",
+            "x0": [0.0, 0.0, 1.5],
+            "target": [1.0, 1.0],
+        },
+    )
     (msg,) = messages(r)
     assert msg.startswith("robot.task[0]: "), msg
-    r = api.post("/solve", json={"robot": M2_FORMULA, "algorithm": "extended",
-                                 "augmentation": {"name": "formula", "h": formula},
-                                 "x0": [0.0, 0.0, 1.5], "target": [1.0, 1.0]})  # fmt: skip
+    r = api.post(
+        "/solve",
+        json={
+            "robot": M2_FORMULA,
+            "algorithm": "extended",
+            "augmentation": {"name": "formula", "h": formula},
+            "x0": [0.0, 0.0, 1.5],
+            "target": [1.0, 1.0],
+        },
+    )
     # (h is a formula or a list of them: a text too long is refused as both)
     assert all(m.startswith("augmentation.h: ") for m in messages(r)), r.text
 

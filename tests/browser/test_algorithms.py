@@ -40,8 +40,9 @@ def test_three_algorithms_chosen_in_the_page(tabs, config):
     expect(said).to_contain_text("does not reach the extended Jacobian's")
 
     # The gain slider's box: a new gain is a new posture run, the others' stay cached.
-    generation = tab.change(lambda: (page.fill("#ctl-alg-gain-value", "3"),
-                                     page.press("#ctl-alg-gain-value", "Enter")))  # fmt: skip
+    generation = tab.change(
+        lambda: (page.fill("#ctl-alg-gain-value", "3"), page.press("#ctl-alg-gain-value", "Enter"))
+    )
     summary = tab.snapshot()["summary"]
     assert generation > 1 and tab.snapshot()["state"]["algorithm_parameters"] == {"gain": 3.0}
     assert summary["pseudoinverse"]["cached"] and not summary["posture"]["cached"]

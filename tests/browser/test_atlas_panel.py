@@ -143,8 +143,11 @@ def test_an_atlas_after_a_cancel_starts_at_once(tabs):
     poll(lambda: gone(f"{tab.base}/atlas/{first}"), "the cancelled job forgotten (404)")
 
     second = start_atlas(tab, 4096, 20)
-    poll(lambda: get_json(f"{jobs}/{second}")["status"] == "running",
-         "the next atlas running after a cancel", timeout=5)  # fmt: skip
+    poll(
+        lambda: get_json(f"{jobs}/{second}")["status"] == "running",
+        "the next atlas running after a cancel",
+        timeout=5,
+    )
     expect(text).to_contain_text("computing")
     assert "waiting" not in (text.text_content() or "")
     page.click("#atlas-cancel")

@@ -35,8 +35,11 @@ def test_a_planar_rrr_arm_from_the_editor(tabs):
     assert tab.robot == "planar_chain"
     snapshot = tab.wait_settled(lambda s: s["state"]["robot"] == "planar_chain", "the new arm")
     state = snapshot["state"]
-    assert state["robot_definition"] == {"name": "planar_chain", "joints": "RRR",
-                                         "lengths": [1.0, 0.8, 0.6]}  # fmt: skip
+    assert state["robot_definition"] == {
+        "name": "planar_chain",
+        "joints": "RRR",
+        "lengths": [1.0, 0.8, 0.6],
+    }
     assert tab.url_state()["robot_definition"] == state["robot_definition"]  # (the link)
     summary = snapshot["summary"]
     assert summary["pseudoinverse"]["success"] and summary["extended"]["success"]
@@ -63,8 +66,10 @@ def test_a_urdf_arm_from_a_link_is_drawn_in_the_scene(tabs):
     from urllib.parse import quote
 
     urdf = (Path(__file__).resolve().parents[1] / "data" / "arm4.urdf").read_text()
-    state = {"robot": "urdf",
-             "robot_definition": {"name": "urdf", "urdf": urdf, "end_link": "tool"}}  # fmt: skip
+    state = {
+        "robot": "urdf",
+        "robot_definition": {"name": "urdf", "urdf": urdf, "end_link": "tool"},
+    }
     tab = tabs.open("/?state=" + quote(json.dumps(state)))
     snapshot = tab.wait_settled(lambda s: s["state"]["robot"] == "urdf", "the URDF arm")
     assert snapshot["summary"]["pseudoinverse"]["success"]

@@ -19,7 +19,8 @@ def test_table1_beside_the_printed_values(tabs):
     expect(table.locator(".table-title")).to_contain_text("Table 1 of the paper")
     headers = table.locator("thead th").all_text_contents()
     assert headers[1:7] == [f"J^P# x{k} (jik)" for k in (1, 2, 3)] + [
-        f"J^P# x{k} (printed)" for k in (1, 2, 3)]  # fmt: skip
+        f"J^P# x{k} (printed)" for k in (1, 2, 3)
+    ]
     labels = table.locator("tbody tr td:first-child").all_text_contents()
     assert labels[:5] == ["A  x0", "B  x1f", "C  x2f", "D  x3f", "A  x4f"]
     # The pseudoinverse is reproduced; the extended column differs in its first two legs.

@@ -81,8 +81,12 @@ def test_an_unreachable_target_is_named_by_the_reach(tabs):
     """A planar 3R arm (reach 2.4) asked for a target 5 from its base: the verdict says the
     target is out of reach, with the distance and the reach, not "a singularity or"."""
     arm = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]}
-    state = {"robot": "planar_chain", "robot_definition": arm, "task": "target",
-             "target": [5.0, 0.0]}  # fmt: skip
+    state = {
+        "robot": "planar_chain",
+        "robot_definition": arm,
+        "task": "target",
+        "target": [5.0, 0.0],
+    }
     tab = tabs.open("/?state=" + quote(json.dumps(state)))
     tab.wait_settled(lambda s: s["state"]["robot"] == "planar_chain", "the arm's result")
     verdict = tab.page.locator("#verdict")

@@ -197,8 +197,9 @@ def test_limit_gradient_matches_finite_differences():
         lo, hi = lim[:2, 0], lim[:2, 1]
         return np.sum((hi - lo) ** 2 / (4 * (hi - x[..., :2]) * (x[..., :2] - lo)), axis=-1)
 
-    x = np.column_stack([rng.uniform(-0.8, 1.8, 20), rng.uniform(0.6, 1.4, 20),
-                         rng.normal(size=20)])  # fmt: skip
+    x = np.column_stack(
+        [rng.uniform(-0.8, 1.8, 20), rng.uniform(0.6, 1.4, 20), rng.normal(size=20)]
+    )
     g = limit_gradient(x, lim)
     h = 1e-6
     for i in range(3):

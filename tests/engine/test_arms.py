@@ -27,8 +27,14 @@ def _standard_dh(rows, q):
     for (d, a, alpha, offset), qi in zip(rows, q, strict=True):
         ct, st = math.cos(qi + offset), math.sin(qi + offset)
         ca, sa = math.cos(alpha), math.sin(alpha)
-        T = T @ np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st],
-                          [0, sa, ca, d], [0, 0, 0, 1]])  # fmt: skip
+        T = T @ np.array(
+            [
+                [ct, -st * ca, st * sa, a * ct],
+                [st, ct * ca, -ct * sa, a * st],
+                [0, sa, ca, d],
+                [0, 0, 0, 1],
+            ]
+        )
     return T
 
 
@@ -40,8 +46,14 @@ def _modified_dh(rows, q):
         qi = q[i] if i < len(q) else 0.0
         ct, st = math.cos(qi), math.sin(qi)
         ca, sa = math.cos(alpha), math.sin(alpha)
-        T = T @ np.array([[ct, -st, 0, a], [st * ca, ct * ca, -sa, -d * sa],
-                          [st * sa, ct * sa, ca, d * ca], [0, 0, 0, 1]])  # fmt: skip
+        T = T @ np.array(
+            [
+                [ct, -st, 0, a],
+                [st * ca, ct * ca, -sa, -d * sa],
+                [st * sa, ct * sa, ca, d * ca],
+                [0, 0, 0, 1],
+            ]
+        )
     return T
 
 
@@ -73,22 +85,32 @@ UR5E_DH = [
     (0.0997, 0, -PI / 2, 0),
     (0.0996, 0, 0, 0),
 ]
-GEN3_DH = [(-(0.1564 + 0.1284), 0, PI / 2, 0), (-(0.0054 + 0.0064), 0, PI / 2, PI),
-           (-(0.2104 + 0.2104), 0, PI / 2, PI), (-(0.0064 + 0.0064), 0, PI / 2, PI),
-           (-(0.2084 + 0.1059), 0, PI / 2, PI), (0, 0, PI / 2, PI),
-           (-(0.1059 + 0.0615), 0, PI, PI)]  # after the base's Rx(pi)  # fmt: skip
+GEN3_DH = [
+    (-(0.1564 + 0.1284), 0, PI / 2, 0),
+    (-(0.0054 + 0.0064), 0, PI / 2, PI),
+    (-(0.2104 + 0.2104), 0, PI / 2, PI),
+    (-(0.0064 + 0.0064), 0, PI / 2, PI),
+    (-(0.2084 + 0.1059), 0, PI / 2, PI),
+    (0, 0, PI / 2, PI),
+    (-(0.1059 + 0.0615), 0, PI, PI),
+]  # after the base's Rx(pi)
 
 
 def _kin(name, task="pose"):
-    return robot_from_dict({"name": name, "task": task if name != "ur5e" else "xyz rx ry"}
-                           ).kinematics  # fmt: skip
+    return robot_from_dict(
+        {"name": name, "task": task if name != "ur5e" else "xyz rx ry"}
+    ).kinematics
 
 
 @pytest.mark.parametrize(
     ("name", "table", "atol"),
-    [("panda", None, 1e-15), ("iiwa14", IIWA_DH, 1e-15), ("ur5e", UR5E_DH, 1e-15),
-     ("gen3", GEN3_DH, 1e-3)],
-)  # fmt: skip
+    [
+        ("panda", None, 1e-15),
+        ("iiwa14", IIWA_DH, 1e-15),
+        ("ur5e", UR5E_DH, 1e-15),
+        ("gen3", GEN3_DH, 1e-3),
+    ],
+)
 def test_each_arm_equals_its_makers_dh_table(name, table, atol):
     """Gen3: the guide's table rounds the kortex frames to 0.1 mm."""
     kin = _kin(name)
@@ -142,8 +164,12 @@ def test_each_arm_equals_pinocchio_to_1e_12(name):
 
 @pytest.mark.skipif(ROBOTS is None, reason="example-robot-data is not installed")
 def test_the_panda_equals_example_robot_datas():
-    theirs = UrdfChain((ROBOTS / "panda_description/urdf/panda.urdf").read_text(),
-                       "panda_link8", [f"panda_joint{i}" for i in range(1, 8)], "pose")  # fmt: skip
+    theirs = UrdfChain(
+        (ROBOTS / "panda_description/urdf/panda.urdf").read_text(),
+        "panda_link8",
+        [f"panda_joint{i}" for i in range(1, 8)],
+        "pose",
+    )
     ours = _kin("panda")
     x = _random_in_limits(ours, 20)
     for a, b in zip(ours.end_pose(x), theirs.end_pose(x), strict=True):
@@ -163,10 +189,12 @@ def test_home_is_within_the_limits_regular_and_has_zero_rotation(name):
 def test_known_home_positions():
     """Franka's 'ready' flange at (0.307, 0, 0.590); Kinova's Home tool at (0.457, 0.001,
     0.434), as their documentation gives them."""
-    np.testing.assert_allclose(_kin("panda", "xyz").forward(ARMS["panda"].home),
-                               [0.3069, 0.0, 0.5903], atol=1e-4)  # fmt: skip
-    np.testing.assert_allclose(_kin("gen3", "xyz").forward(ARMS["gen3"].home),
-                               [0.457, 0.001, 0.434], atol=1e-3)  # fmt: skip
+    np.testing.assert_allclose(
+        _kin("panda", "xyz").forward(ARMS["panda"].home), [0.3069, 0.0, 0.5903], atol=1e-4
+    )
+    np.testing.assert_allclose(
+        _kin("gen3", "xyz").forward(ARMS["gen3"].home), [0.457, 0.001, 0.434], atol=1e-3
+    )
 
 
 def test_the_ur5e_has_no_redundancy_for_a_full_pose():
@@ -179,8 +207,15 @@ def test_the_ur5e_has_no_redundancy_for_a_full_pose():
 def test_an_arm_equals_its_urdf_definition():
     a = ARMS["panda"]
     by_name = robot_from_dict({"name": "panda", "task": "pose"})
-    by_text = robot_from_dict({"name": "urdf", "urdf": a.urdf, "end_link": a.end_link,
-                               "home": list(a.home), "task": "pose"})  # fmt: skip
+    by_text = robot_from_dict(
+        {
+            "name": "urdf",
+            "urdf": a.urdf,
+            "end_link": a.end_link,
+            "home": list(a.home),
+            "task": "pose",
+        }
+    )
     x = _random_in_limits(by_name.kinematics, 5)
     np.testing.assert_array_equal(by_name.kinematics.forward(x), by_text.kinematics.forward(x))
     assert by_name.spec.default_x0 == by_text.spec.default_x0 == a.home

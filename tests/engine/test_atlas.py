@@ -73,8 +73,9 @@ def test_paths_of_the_family_scale_about_the_first_point_and_shift(reference_atl
     np.testing.assert_allclose(plan.paths[1], plan.paths[0] + [0.3, -0.2])
     kin = plan.inverses[0].kinematics
     for j in range(2):
-        np.testing.assert_allclose(kin.forward(res.starts[j]), plan.paths[j, :1].repeat(24, 0),
-                                   rtol=0, atol=1e-13)  # fmt: skip
+        np.testing.assert_allclose(
+            kin.forward(res.starts[j]), plan.paths[j, :1].repeat(24, 0), rtol=0, atol=1e-13
+        )
 
 
 def test_the_same_numbers_whatever_the_chunking(reference_atlas, monkeypatch):
@@ -158,8 +159,12 @@ def test_table1_start_is_the_base_of_its_loop():
 def test_sampled_arc_lengths_depend_only_on_index_and_seed():
     index = np.arange(5000)
     whole = arc_lengths(index, 5000, (-1.0, 2.0), "sample", 3)
-    parts = np.concatenate([arc_lengths(index[a:b], 5000, (-1.0, 2.0), "sample", 3)
-                            for a, b in ((0, 7), (7, 2100), (2100, 5000))])  # fmt: skip
+    parts = np.concatenate(
+        [
+            arc_lengths(index[a:b], 5000, (-1.0, 2.0), "sample", 3)
+            for a, b in ((0, 7), (7, 2100), (2100, 5000))
+        ]
+    )
     np.testing.assert_array_equal(whole, parts)
     assert whole.min() >= -1.0 and whole.max() <= 2.0 and np.ptp(whole) > 2.9
     assert not np.array_equal(whole, arc_lengths(index, 5000, (-1.0, 2.0), "sample", 4))
@@ -193,8 +198,15 @@ def test_a_start_singular_for_one_inverse_fails_alone():
 
 
 def _peak_streaming(n: int) -> int:
-    plan = plan_atlas(Pseudoinverse(Manipulator2()), [(0.0, 1.0), (0.5, 1.2)], cycles=1,
-                      n_starts=n, arc=(-3.0, 3.0), reference=X0, chunk=256)  # fmt: skip
+    plan = plan_atlas(
+        Pseudoinverse(Manipulator2()),
+        [(0.0, 1.0), (0.5, 1.2)],
+        cycles=1,
+        n_starts=n,
+        arc=(-3.0, 3.0),
+        reference=X0,
+        chunk=256,
+    )
     tracemalloc.start()
     for _task, _chunk in iter_atlas(plan):
         pass
@@ -305,15 +317,16 @@ def test_a_posture_atlas_without_rest_pulls_each_panda_run_toward_its_start():
     path = np.vstack([kin.forward(x0), np.asarray(robot.spec.default_path, dtype=float)])
     posture = make_inverse(kin, "posture", spec=robot.spec, algorithm_parameters={"gain": 2.0})
     pinv = make_inverse(kin, "pseudoinverse", spec=robot.spec)
-    plan = plan_atlas([posture, pinv], path, cycles=3, n_starts=6, reference=x0,
-                      arc=(-1.0, 1.0))  # fmt: skip
+    plan = plan_atlas([posture, pinv], path, cycles=3, n_starts=6, reference=x0, arc=(-1.0, 1.0))
     res = run_atlas(plan)
     drift = np.asarray(res.drift)[:, 0, :, -1]  # (algorithm, start) after the last cycle
     assert np.max(drift[0]) < 1e-2 and np.mean(drift[0]) < np.mean(drift[1])
     starts = plan.starts(0, plan.n_starts)
     for i, s in enumerate(starts):
-        own = make_inverse(kin, "posture", spec=robot.spec,
-                           algorithm_parameters={"gain": 2.0, "rest": list(s)})  # fmt: skip
+        own = make_inverse(
+            kin, "posture", spec=robot.spec, algorithm_parameters={"gain": 2.0, "rest": list(s)}
+        )
         one = repeatability(own, s, plan.targets(i, i + 1, starts[i : i + 1])[0], 3, close=False)
-        np.testing.assert_allclose(np.asarray(res.drift)[0, 0, i], np.asarray(one.drift),
-                                   rtol=1e-8, atol=1e-12)  # fmt: skip
+        np.testing.assert_allclose(
+            np.asarray(res.drift)[0, 0, i], np.asarray(one.drift), rtol=1e-8, atol=1e-12
+        )

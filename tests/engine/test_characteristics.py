@@ -83,16 +83,23 @@ def test_cofactor_and_one_form_derivatives_against_fd(kin):
     J, H = kin.derivatives(x)
     eps = 1e-6
     dc_fd = np.stack(
-        [(cofactors(kin.jacobian(x + eps * e)) - cofactors(kin.jacobian(x - eps * e))) / (2 * eps)
-         for e in np.eye(4)], axis=-1,
-    )  # fmt: skip
+        [
+            (cofactors(kin.jacobian(x + eps * e)) - cofactors(kin.jacobian(x - eps * e)))
+            / (2 * eps)
+            for e in np.eye(4)
+        ],
+        axis=-1,
+    )
     dc = kernel_cofactors_derivative(J, H)
     assert np.max(np.abs(dc - dc_fd)) < 1e-6 * max(1.0, np.max(np.abs(dc)))
     _, dw = one_form_derivative(kin, x, 1)
     dw_fd = np.stack(
-        [(one_form(kin, x + eps * e, 1) - one_form(kin, x - eps * e, 1)) / (2 * eps)
-         for e in np.eye(4)], axis=-1,
-    )  # fmt: skip
+        [
+            (one_form(kin, x + eps * e, 1) - one_form(kin, x - eps * e, 1)) / (2 * eps)
+            for e in np.eye(4)
+        ],
+        axis=-1,
+    )
     assert np.max(np.abs(dw - dw_fd)) < 1e-7
 
 
@@ -221,9 +228,11 @@ def test_printed_rhs_after_28_violates_24(kin, rhs_kind, holds):
     x = np.array([1.5, 0.3, -0.4, 0.6])
     eps = 1e-5
     dh = np.array(
-        [(_h_ode(kin, x + eps * e, rhs_kind) - _h_ode(kin, x - eps * e, rhs_kind)) / (2 * eps)
-         for e in np.eye(4)]
-    )  # fmt: skip
+        [
+            (_h_ode(kin, x + eps * e, rhs_kind) - _h_ode(kin, x - eps * e, rhs_kind)) / (2 * eps)
+            for e in np.eye(4)
+        ]
+    )
     X = np.array([x[0] - 1.0, 0.0, x[2], x[3]])
     residual = abs(one_form(kin, x, 1) @ X - dh @ X / dh[1])
     assert (residual < 1e-6) if holds else (residual > 0.1)  # printed: 0.26

@@ -33,8 +33,9 @@ def test_right_inverse_annihilated_by_every_dh():
     inv = VectorExtendedInverse(CHAIN, MAPS)
     x = X0 + RNG.uniform(-0.3, 0.3, (30, 5))
     JE = inv.matrix(x)
-    np.testing.assert_allclose(CHAIN.jacobian(x) @ JE, np.broadcast_to(np.eye(2), (30, 2, 2)),
-                               atol=1e-12)  # fmt: skip
+    np.testing.assert_allclose(
+        CHAIN.jacobian(x) @ JE, np.broadcast_to(np.eye(2), (30, 2, 2)), atol=1e-12
+    )
     dh = np.stack([m.gradient(x) for m in MAPS], axis=-2)
     np.testing.assert_allclose(dh @ JE, 0.0, atol=1e-12)
     assert inv.augmenting_value(x).shape == (30, 3)

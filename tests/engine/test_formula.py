@@ -111,8 +111,34 @@ def test_parser_never_evaluates_text(monkeypatch):
     assert parse_formula("x1*l + sin(x2)", NAMES) == 2 * x1 + sp.sin(x2)
 
 
-PIECES = ["x1", "x2", "l", "pi", "sin", "atan2", "(", ")", ",", "+", "-", "*", "/", "**", " ",
-          "1", "0", ".", "e", "9", "__", "[", "'", "^", "lambda", "abs"]  # fmt: skip
+PIECES = [
+    "x1",
+    "x2",
+    "l",
+    "pi",
+    "sin",
+    "atan2",
+    "(",
+    ")",
+    ",",
+    "+",
+    "-",
+    "*",
+    "/",
+    "**",
+    " ",
+    "1",
+    "0",
+    ".",
+    "e",
+    "9",
+    "__",
+    "[",
+    "'",
+    "^",
+    "lambda",
+    "abs",
+]
 
 
 @settings(max_examples=400, deadline=None)
@@ -131,10 +157,13 @@ def test_fuzz_parser_fails_only_with_invalid_input(text):
 def test_formula_robot_derivatives_match_finite_differences():
     kin = FormulaKinematics(
         ["a", "b", "c", "d"],
-        ["a*cos(b) + exp(-c**2)/(1 + d**2)", "sqrt(1 + a**2) * atan2(c, 2 + sin(d))",
-         "k*log(2 + cos(a*b)) + abs(d) - tan(c/3)"],
+        [
+            "a*cos(b) + exp(-c**2)/(1 + d**2)",
+            "sqrt(1 + a**2) * atan2(c, 2 + sin(d))",
+            "k*log(2 + cos(a*b)) + abs(d) - tan(c/3)",
+        ],
         {"k": 0.7},
-    )  # fmt: skip
+    )
     x = RNG.uniform(-1.5, 1.5, (30, 4))
     x[:, 3] = np.abs(x[:, 3]) + 0.1  # away from the kink of abs
     np.testing.assert_allclose(kin.jacobian(x), central_difference(kin.forward, x), atol=1e-8)
@@ -169,13 +198,19 @@ def test_constant_entries_broadcast_over_the_batch():
         ({"variables": ["x1", "x2"], "task": ["x1", "x2"]}, "task", "r < p"),
         ({"variables": ["x1", "x2"], "task": "x1"}, "task", "non-empty list"),
         ({"variables": ["x1", "x2"], "task": ["x1 + y"]}, "task.0", "unknown name 'y'"),
-        ({"variables": ["x1", "x2"], "task": ["x1", "x2"][:1], "parameters": {"l": "1"}},
-         "parameters.l", "must be a number"),
-        ({"variables": ["x1", "x2"], "task": ["x1"], "parameters": {"x1": 1.0}},
-         "parameters.x1", "also a variable"),
+        (
+            {"variables": ["x1", "x2"], "task": ["x1", "x2"][:1], "parameters": {"l": "1"}},
+            "parameters.l",
+            "must be a number",
+        ),
+        (
+            {"variables": ["x1", "x2"], "task": ["x1"], "parameters": {"x1": 1.0}},
+            "parameters.x1",
+            "also a variable",
+        ),
         ({"variables": "x1 x2", "task": ["x1"]}, "variables", "list of names"),
     ],
-)  # fmt: skip
+)
 def test_bad_formula_robots_name_the_field(kwargs, field, text):
     with pytest.raises(InvalidInputError) as err:
         FormulaKinematics(**kwargs)
@@ -208,9 +243,11 @@ def test_manipulator2_as_formula_gives_table1_legs_and_e2_of_the_builtin(formula
     )
     pairs = [
         (Pseudoinverse(formula_m2), Pseudoinverse(Manipulator2())),
-        (ExtendedInverse(formula_m2, ours.augmenting_map),
-         ExtendedInverse(Manipulator2(), builtin.augmenting_map)),
-    ]  # fmt: skip
+        (
+            ExtendedInverse(formula_m2, ours.augmenting_map),
+            ExtendedInverse(Manipulator2(), builtin.augmenting_map),
+        ),
+    ]
     for a, b in pairs:
         ra, rb = (repeatability(inv, X0, PATH, cycles=3) for inv in (a, b))
         assert ra.success and rb.success
@@ -255,7 +292,9 @@ def test_exploding_derivatives_are_refused_naming_the_formula(monkeypatch):
 def test_ordinary_formulas_keep_their_derivatives_within_the_bound():
     """An 8-link chain written as a formula builds its Jacobian and Hessian."""
     names = [f"x{i}" for i in range(1, 9)]
-    xs = [" + ".join(f"cos({'+'.join(names[: i + 1])})" for i in range(8)),
-          " + ".join(f"sin({'+'.join(names[: i + 1])})" for i in range(8))]  # fmt: skip
+    xs = [
+        " + ".join(f"cos({'+'.join(names[: i + 1])})" for i in range(8)),
+        " + ".join(f"sin({'+'.join(names[: i + 1])})" for i in range(8)),
+    ]
     robot = FormulaKinematics([*names, "y"], xs)
     assert robot.hessian(np.zeros((2, 9))).shape == (2, 2, 9, 9)

@@ -23,8 +23,14 @@ PATH = [(1, 1), (1, 2), (0, 2)]
 
 def _plan():
     """Two starts on the self-motion curve of k(X0) = (0, 1), Table 1's loop, two cycles."""
-    return jik.plan_atlas(jik.Pseudoinverse(jik.Manipulator2()), [(0, 1), *PATH], cycles=2,
-                          n_starts=2, arc=(-0.2, 0.2), reference=X0)  # fmt: skip
+    return jik.plan_atlas(
+        jik.Pseudoinverse(jik.Manipulator2()),
+        [(0, 1), *PATH],
+        cycles=2,
+        n_starts=2,
+        arc=(-0.2, 0.2),
+        reference=X0,
+    )
 
 
 def _atlas() -> AtlasResult:
@@ -101,8 +107,13 @@ def _one_line(obj, *parts: str) -> str:
 def test_results_print_on_one_line_with_their_numbers():
     inv = jik.Pseudoinverse(jik.Manipulator2())
     one = jik.solve(inv, X0, [1, 1])
-    _one_line(one, "SolveResult(pseudoinverse, continuous, success=True", f"nit={one.nit}",
-              f"{len(one.trajectory)} points", "converged")  # fmt: skip
+    _one_line(
+        one,
+        "SolveResult(pseudoinverse, continuous, success=True",
+        f"nit={one.nit}",
+        f"{len(one.trajectory)} points",
+        "converged",
+    )
     _one_line(one.trajectory, f"Trajectory({len(one.trajectory)} points", "x [0, 0, 1.571]")
     starts = np.array([X0, X0 + [0.0, 0.1, 0.0]])
     _one_line(jik.solve_batch(inv, starts, [1, 1]), "2 solves, 2 converged")
@@ -118,8 +129,11 @@ def test_results_print_on_one_line_with_their_numbers():
 def test_an_atlas_and_a_synthesis_print_on_one_line():
     _one_line(_plan(), "AtlasPlan(pseudoinverse, 1 paths x 2 starts x 2 cycles of 4 legs, 2 runs")
     atlas = _atlas()
-    _one_line(atlas, "AtlasResult(pseudoinverse, 1 paths x 2 starts x 2 cycles, 2 of 2 runs",
-              f"pseudoinverse {np.max(atlas.drift[..., -1]):.3g}")  # fmt: skip
+    _one_line(
+        atlas,
+        "AtlasResult(pseudoinverse, 1 paths x 2 starts x 2 cycles, 2 of 2 runs",
+        f"pseudoinverse {np.max(atlas.drift[..., -1]):.3g}",
+    )
     synthesis = jik.synthesize_e2(jik.Manipulator2(), {"x2": (-1, 1), "x3": (0, 3)}, degree=4)
     _one_line(synthesis, f"E2 = {synthesis.e2:.6g}, degree 4, x2 in [-1, 1], x3 in [0, 3]")
 
@@ -198,8 +212,9 @@ def test_a_progress_implements_only_what_it_shows():
 
     inv = jik.ExtendedInverse(jik.Manipulator2(), jik.PaperCubic())
     progress = Legs()
-    watched = jik.repeatability(inv, X0, PATH, cycles=2, mode="discrete", gamma=0.05,
-                                progress=progress)  # fmt: skip
+    watched = jik.repeatability(
+        inv, X0, PATH, cycles=2, mode="discrete", gamma=0.05, progress=progress
+    )
     plain = jik.repeatability(inv, X0, PATH, cycles=2, mode="discrete", gamma=0.05)
     assert progress.seen == [(c, j) for c in range(2) for j in range(4)]
     np.testing.assert_array_equal(watched.legs, plain.legs)

@@ -174,9 +174,14 @@ def test_parameter_sensitivity_reports_each_evaluation():
     the total; what the callback raises stops the sweep."""
     seen = []
     parameter_sensitivity(
-        Manipulator1(), E2Optimal, {"a": 0.0, "b": 1.0}, REGION1, span=0.5, samples=3,
+        Manipulator1(),
+        E2Optimal,
+        {"a": 0.0, "b": 1.0},
+        REGION1,
+        span=0.5,
+        samples=3,
         on_evaluation=lambda done, total: seen.append((done, total)),
-    )  # fmt: skip
+    )
     assert seen == [(k, 11) for k in range(1, 12)]
 
     def stop(done, total):
@@ -184,5 +189,6 @@ def test_parameter_sensitivity_reports_each_evaluation():
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        parameter_sensitivity(Manipulator1(), E2Optimal, {"a": 0.0, "b": 1.0}, REGION1,
-                              samples=3, on_evaluation=stop)  # fmt: skip
+        parameter_sensitivity(
+            Manipulator1(), E2Optimal, {"a": 0.0, "b": 1.0}, REGION1, samples=3, on_evaluation=stop
+        )

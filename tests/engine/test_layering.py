@@ -71,8 +71,11 @@ def _lazy_exports(name: str, path: Path) -> set[str]:
         if isinstance(target, ast.Name) and target.id == "_EXPORTS":
             value = node.value  # type: ignore[union-attr]
             if isinstance(value, ast.Dict):
-                return {f"{name}.{v.value}" for v in value.values
-                        if isinstance(v, ast.Constant) and isinstance(v.value, str)}  # fmt: skip
+                return {
+                    f"{name}.{v.value}"
+                    for v in value.values
+                    if isinstance(v, ast.Constant) and isinstance(v.value, str)
+                }
     return set()
 
 
@@ -208,8 +211,11 @@ def test_dynamic_imports_count_as_imports():
     code += "__import__('jik.app.api')\nimport_module(name)\nimport_module(f'jik.engine.{m}')\n"
     calls = [n for n in ast.walk(ast.parse(code)) if isinstance(n, ast.Call)]
     assert [_dynamic_import(c) for c in calls] == [
-        "jik.app.dashboard.offload", "jik.app.api", "<a module named at run time>", "jik.engine"
-    ]  # fmt: skip
+        "jik.app.dashboard.offload",
+        "jik.app.api",
+        "<a module named at run time>",
+        "jik.engine",
+    ]
 
 
 def test_no_module_is_imported_by_a_name_known_only_at_run_time():

@@ -23,8 +23,11 @@ NAMES = ("x1", "x2", "x3")
 
 
 def test_the_first_violation_is_found_in_order():
-    legs = [np.array([[0, 5, 1], [0.5, -9, 1.5]]), np.array([[0.9, 0, 1], [0.2, 0, 2.5]]),
-            np.array([[1.5, 0, 1]])]  # fmt: skip
+    legs = [
+        np.array([[0, 5, 1], [0.5, -9, 1.5]]),
+        np.array([[0.9, 0, 1], [0.2, 0, 2.5]]),
+        np.array([[1.5, 0, 1]]),
+    ]
     report = legs_report(LIMITS, [0, 0, 1], legs, 2, NAMES)
     assert not report.within
     v = report.violation
@@ -37,8 +40,15 @@ def test_the_first_violation_is_found_in_order():
 
 def test_a_start_outside_is_reported_at_cycle_0():
     report = legs_report(LIMITS, [-1.2, 0, 1], [], 1, NAMES)
-    expected = {"cycle": 0, "leg": 0, "joint": 0, "name": "x1", "value": -1.2, "limit": -1.0,
-                "bound": "lower"}  # fmt: skip
+    expected = {
+        "cycle": 0,
+        "leg": 0,
+        "joint": 0,
+        "name": "x1",
+        "value": -1.2,
+        "limit": -1.0,
+        "bound": "lower",
+    }
     assert report.violation.as_dict() == expected
     assert "the start x0: x1 = -1.2, below its lower limit -1" in str(report)
 
@@ -72,9 +82,14 @@ def test_a_planar_chain_takes_optional_limits():
 
 
 def test_a_formula_robot_takes_optional_limits():
-    robot = robot_from_dict({"name": "formula", "variables": ["a", "b", "c"],
-                             "task": ["a + b", "b * c"],
-                             "limits": [[0, 1], [0, 1], [0, 1]]})  # fmt: skip
+    robot = robot_from_dict(
+        {
+            "name": "formula",
+            "variables": ["a", "b", "c"],
+            "task": ["a + b", "b * c"],
+            "limits": [[0, 1], [0, 1], [0, 1]],
+        }
+    )
     assert robot_limits(robot.kinematics).shape == (3, 2)
 
 
@@ -104,9 +119,15 @@ def test_a_panda_start_outside_the_limits_is_accepted_and_reported():
     res = repeatability(robot.inverse(), x0, path, cycles=1, record=True)
     report = repeatability_report(robot_limits(kin), res, limit_names(kin))
     assert res.success and not report.within
-    assert report.violation.as_dict() == {"cycle": 0, "leg": 0, "joint": 3,
-                                          "name": "x4 (panda_joint4)", "value": 0.2,
-                                          "limit": -0.0698, "bound": "upper"}  # fmt: skip
+    assert report.violation.as_dict() == {
+        "cycle": 0,
+        "leg": 0,
+        "joint": 3,
+        "name": "x4 (panda_joint4)",
+        "value": 0.2,
+        "limit": -0.0698,
+        "bound": "upper",
+    }
 
 
 def test_continuous_joints_have_no_limits():
@@ -123,7 +144,8 @@ def test_a_robot_reports_its_runs_limits():
     res = solve(panda.inverse(), panda.spec.default_x0, [-0.3, 0.0, 0.5])
     assert panda.limits_report(res).violation.name == "x2 (panda_joint2)"
     home = np.array(panda.spec.default_x0)
-    run = repeatability(panda.inverse(), home, panda.kinematics.forward(home) + [[0.05, 0, 0]],
-                        record=True)  # fmt: skip
+    run = repeatability(
+        panda.inverse(), home, panda.kinematics.forward(home) + [[0.05, 0, 0]], record=True
+    )
     assert panda.limits_report(run) == LimitsReport(True)
     assert robot_from_dict({"name": "manipulator2"}).limits_report(res) is None

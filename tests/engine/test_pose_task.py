@@ -50,10 +50,16 @@ def test_left_jacobian_inverse_is_the_logs_derivative(scale):
 
 @pytest.mark.parametrize(
     ("task", "names"),
-    [("pose", COORDINATES), ("xyz", ("x", "y", "z")), ("zx", ("z", "x")),
-     ("xyzrz", ("x", "y", "z", "rz")), ("x y rz", ("x", "y", "rz")), ("rx, z", ("rx", "z")),
-     (["ry", "x"], ("ry", "x"))],
-)  # fmt: skip
+    [
+        ("pose", COORDINATES),
+        ("xyz", ("x", "y", "z")),
+        ("zx", ("z", "x")),
+        ("xyzrz", ("x", "y", "z", "rz")),
+        ("x y rz", ("x", "y", "rz")),
+        ("rx, z", ("rx", "z")),
+        (["ry", "x"], ("ry", "x")),
+    ],
+)
 def test_task_names(task, names):
     assert parse_task(task) == names
 
@@ -67,9 +73,14 @@ def test_bad_tasks_name_the_field(task):
 
 @pytest.mark.parametrize(
     ("end", "task"),
-    [("tool", "rz ry x"), ("tool", "rx ry rz"), ("tool", "xz"), ("finger", "x rx ry rz"),
-     ("finger", "rz y")],
-)  # fmt: skip
+    [
+        ("tool", "rz ry x"),
+        ("tool", "rx ry rz"),
+        ("tool", "xz"),
+        ("finger", "x rx ry rz"),
+        ("finger", "rz y"),
+    ],
+)
 def test_jacobian_matches_finite_differences(end, task):
     kin = UrdfChain(ARM4, end, task=task)
     x = RNG.uniform(-1.5, 1.5, (25, kin.p))
@@ -95,9 +106,13 @@ def test_reference_forms_agree_and_home_has_zero_rotation():
 
 @pytest.mark.parametrize(
     ("value", "text"),
-    [([1, 2], "rotation vector"), ([0, 0, 0, 2], "norm 1"), (np.diag([1, 1, -1]), "rotation"),
-     ([[1, 0, 0], [0, 1, 0], [0, 0, float("nan")]], "rotation vector")],
-)  # fmt: skip
+    [
+        ([1, 2], "rotation vector"),
+        ([0, 0, 0, 2], "norm 1"),
+        (np.diag([1, 1, -1]), "rotation"),
+        ([[1, 0, 0], [0, 1, 0], [0, 0, float("nan")]], "rotation vector"),
+    ],
+)
 def test_bad_references_name_the_field(value, text):
     with pytest.raises(InvalidInputError, match=text) as err:
         reference_rotation(value)
@@ -125,8 +140,9 @@ def test_panda_pose_task_equals_pinocchio_through_jlog3():
         local = pin.getFrameJacobian(model, data, frame, pin.LOCAL)[:, :7]
         world = pin.getFrameJacobian(model, data, frame, pin.LOCAL_WORLD_ALIGNED)[:, :7]
         np.testing.assert_allclose(ki, np.r_[M.translation, pin.log3(Rrel)], atol=1e-12)
-        np.testing.assert_allclose(Ji, np.vstack([world[:3], pin.Jlog3(Rrel) @ local[3:]]),
-                                   atol=1e-12)  # fmt: skip
+        np.testing.assert_allclose(
+            Ji, np.vstack([world[:3], pin.Jlog3(Rrel) @ local[3:]]), atol=1e-12
+        )
         np.testing.assert_allclose(kin.jacobian(xi), Ji, atol=1e-12)
 
 
@@ -134,8 +150,13 @@ def test_panda_pose_task_equals_pinocchio_through_jlog3():
 def test_a_pose_loop_of_the_panda_drifts_under_the_pseudoinverse():
     """A closed loop in position and orientation: every leg reaches its pose target; the
     pseudoinverse's elbow does not come back (p - r = 1)."""
-    kin = UrdfChain(PANDA.read_text(encoding="utf-8"), "panda_link8", PANDA_JOINTS, task="pose",
-                    home=[0, -0.785, 0, -2.356, 0, 1.571, 0.785])  # fmt: skip
+    kin = UrdfChain(
+        PANDA.read_text(encoding="utf-8"),
+        "panda_link8",
+        PANDA_JOINTS,
+        task="pose",
+        home=[0, -0.785, 0, -2.356, 0, 1.571, 0.785],
+    )
     x0 = np.array(kin.home)
     y0 = kin.forward(x0)
     np.testing.assert_allclose(y0[3:], 0.0, atol=1e-15)

@@ -152,8 +152,14 @@ def test_on_leg_sees_every_leg_in_order():
     """One start: every leg's SolveResult with its trajectory, the run's legs in order. A batch:
     each leg's BatchSolveResult and the members that ran it."""
     seen = []
-    res = repeatability(_inverse("extended"), TABLE1_X0, TABLE1_PATH, cycles=2, record=True,
-                        progress=ProgressCallbacks(seen.append))  # fmt: skip
+    res = repeatability(
+        _inverse("extended"),
+        TABLE1_X0,
+        TABLE1_PATH,
+        cycles=2,
+        record=True,
+        progress=ProgressCallbacks(seen.append),
+    )
     assert [(leg.cycle, leg.index) for leg in seen] == [(c, j) for c in range(2) for j in range(4)]
     for k, leg in enumerate(seen):
         assert leg.stopped_by is None and leg.members.tolist() == [0]
@@ -213,9 +219,13 @@ def test_cancelled_stops_between_the_chunks_of_a_discrete_leg(monkeypatch):
 
 @pytest.mark.parametrize("algorithm", ["pseudoinverse", "extended"])
 @pytest.mark.parametrize(
-    "kwargs", [{}, {"mode": "discrete", "gamma": 0.5}, {"mode": "discrete", "gamma": 0.3,
-                                                        "progress": ProgressCallbacks()}]
-)  # fmt: skip
+    "kwargs",
+    [
+        {},
+        {"mode": "discrete", "gamma": 0.5},
+        {"mode": "discrete", "gamma": 0.3, "progress": ProgressCallbacks()},
+    ],
+)
 def test_resume_equals_a_run_from_the_start_bit_for_bit(algorithm, kwargs, monkeypatch):
     """Two cycles, then two more from their end (Resume.of: the legs and, in continuous mode,
     the last cycle's trajectories as Picard guides): the numbers of four cycles from x0 (with
@@ -252,8 +262,9 @@ def test_discrete_chunks_equal_an_unchunked_run(monkeypatch):
     iterates, counts and messages of one solve per leg; the progress grows within a leg."""
     _chunks(monkeypatch, 7)
     inv = _inverse("extended")
-    one = repeatability(inv, TABLE1_X0, TABLE1_PATH, cycles=2, gamma=0.3, mode="discrete",
-                        record=True)  # fmt: skip
+    one = repeatability(
+        inv, TABLE1_X0, TABLE1_PATH, cycles=2, gamma=0.3, mode="discrete", record=True
+    )
     fractions: list[float] = []
     chunked = repeatability(
         inv,

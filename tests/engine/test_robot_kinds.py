@@ -57,5 +57,10 @@ def test_the_description_is_json():
     out = json.loads(json.dumps(robot_kinds()))
     assert set(out["kinds"]) == {"planar_chain", "formula", "urdf"}
     assert {f["name"] for f in out["kinds"]["planar_chain"]} == {
-        "joints", "lengths", "offsets", "orientation", "limits"}  # fmt: skip
+        "joints",
+        "lengths",
+        "offsets",
+        "orientation",
+        "limits",
+    }
     assert set(out["augmentations"]) == {"formula", "e2_synthesized"}

@@ -73,10 +73,17 @@ def test_formula_robot_is_manipulator2():
 def test_urdf_robot_from_a_file_next_to_its_urdf(tmp_path):
     pytest.importorskip("yourdfpy")
     shutil.copy(ARM4, tmp_path / "arm4.urdf")
-    (tmp_path / "arm.json").write_text(json.dumps({
-        "name": "urdf", "urdf_file": "arm4.urdf", "end_link": "tool", "x0": [0.3, 0.5, 0.8, 0.6],
-        "augmentations": [{"name": "formula", "h": "x4 - x3"}],
-    }))  # fmt: skip
+    (tmp_path / "arm.json").write_text(
+        json.dumps(
+            {
+                "name": "urdf",
+                "urdf_file": "arm4.urdf",
+                "end_link": "tool",
+                "x0": [0.3, 0.5, 0.8, 0.6],
+                "augmentations": [{"name": "formula", "h": "x4 - x3"}],
+            }
+        )
+    )
     robot = load_robot(tmp_path / "arm.json")
     assert (robot.spec.p, robot.spec.r, robot.spec.task_names) == (4, 3, ("x", "y", "z"))
     assert robot.spec.x_range[0] == (-3.0, 3.0)  # the URDF's limits
@@ -88,9 +95,16 @@ def test_urdf_robot_from_a_file_next_to_its_urdf(tmp_path):
 
 def test_urdf_text_in_the_definition():
     pytest.importorskip("yourdfpy")
-    robot = robot_from_dict({"name": "urdf", "urdf": ARM4.read_text(), "end_link": "tool",
-                             "active_joints": ["shoulder", "elbow", "wrist_pitch"], "task": "xz",
-                             "x0": [0.5, 0.8, 0.6]})  # fmt: skip
+    robot = robot_from_dict(
+        {
+            "name": "urdf",
+            "urdf": ARM4.read_text(),
+            "end_link": "tool",
+            "active_joints": ["shoulder", "elbow", "wrist_pitch"],
+            "task": "xz",
+            "x0": [0.5, 0.8, 0.6],
+        }
+    )
     assert (robot.spec.p, robot.spec.r) == (3, 2)
     assert _run(robot, "pseudoinverse", cycles=1).success
 
@@ -118,19 +132,30 @@ def test_yaml_robot_file(tmp_path):
 
 def test_builtin_robots_by_name_with_parameters_and_extra_maps():
     assert set(ROBOTS) == {"manipulator1", "manipulator2", "unicycle"}  # the catalogue stays
-    robot = robot_from_dict({"name": "manipulator2", "parameters": {"l": 1.5},
-                             "augmentations": [{"name": "formula", "h": "x3"}]})  # fmt: skip
+    robot = robot_from_dict(
+        {
+            "name": "manipulator2",
+            "parameters": {"l": 1.5},
+            "augmentations": [{"name": "formula", "h": "x3"}],
+        }
+    )
     assert robot.kinematics.parameters == {"l": 1.5}
     assert [a.name for a in robot.spec.augmentations][-1] == "formula"
     assert [a.name for a in ROBOTS["manipulator2"].augmentations] == [
-        "paper_cubic", "e2_synthesized"]  # fmt: skip
+        "paper_cubic",
+        "e2_synthesized",
+    ]
     assert robot.inverse("extended", "paper_cubic").augmenting_map.name == "paper_cubic"
     assert load_robot("manipulator1").spec is ROBOTS["manipulator1"]
 
 
 def test_more_than_one_degree_of_redundancy_takes_a_vector_of_formula_maps():
-    chain = {"name": "planar_chain", "joints": "RRRRR", "lengths": [0.6, 0.5, 0.4, 0.3, 0.2],
-             "x0": [0.2, 0.5, 0.6, 0.4, 0.3]}  # fmt: skip
+    chain = {
+        "name": "planar_chain",
+        "joints": "RRRRR",
+        "lengths": [0.6, 0.5, 0.4, 0.3, 0.2],
+        "x0": [0.2, 0.5, 0.6, 0.4, 0.3],
+    }
     robot = robot_from_dict(chain)
     assert _run(robot, "pseudoinverse", cycles=2).success
     with pytest.raises(InvalidInputError, match="no augmenting map"):
@@ -143,12 +168,19 @@ def test_more_than_one_degree_of_redundancy_takes_a_vector_of_formula_maps():
     with pytest.raises(InvalidInputError, match="vector of maps"):
         robot.spec.augmentation("formula").build(robot.kinematics)
     cases = [
-        ({"name": "e2_synthesized", "region": {"x2": [0, 1], "x3": [0, 1]},
-          "frame_axes": [1, 1, 2]}, "augmentations.0.frame_axes", "3 distinct joints"),
+        (
+            {
+                "name": "e2_synthesized",
+                "region": {"x2": [0, 1], "x3": [0, 1]},
+                "frame_axes": [1, 1, 2],
+            },
+            "augmentations.0.frame_axes",
+            "3 distinct joints",
+        ),
         ({"name": "formula", "h": "x5"}, "augmentations.0.h", "a list of 3 formulas"),
         ({"name": "formula", "h": ["x5", "x4"]}, "augmentations.0.h", "a list of 3 formulas"),
         ({"name": "formula", "h": ["x5", "x4", "x9"]}, "augmentations.0.h.2", "unknown name"),
-    ]  # fmt: skip
+    ]
     for aug, field, text in cases:
         with pytest.raises(InvalidInputError) as err:
             robot_from_dict({**chain, "augmentations": [aug]})
@@ -166,19 +198,31 @@ def test_more_than_one_degree_of_redundancy_takes_a_vector_of_formula_maps():
         ({**ARM3R, "lengths": [1, 1]}, "lengths", "one entry per joint"),
         ({**ARM3R, "x_range": [[0, 1]]}, "x_range", "3 pairs"),
         ({**ARM3R, "x0": [0, 1]}, "x0", "shape (..., 3)"),
-        ({**ARM3R, "augmentations": [{"name": "formula", "h": "x3 + y"}]},
-         "augmentations.0.h", "unknown name 'y'"),
-        ({**ARM3R, "augmentations": [{"name": "formula", "h": "x3", "hh": 1}]},
-         "augmentations.0", "unknown key(s) ['hh']"),
-        ({**ARM3R, "augmentations": [{"name": "e2_synthesized", "region": {"x9": [0, 1]}}]},
-         "augmentations.0.region", "unknown joint variable 'x9'"),
-        ({**ARM3R, "augmentations": [{"name": "formula", "h": "x3"}] * 2},
-         "augmentations.1.label", "must be a new name"),
+        (
+            {**ARM3R, "augmentations": [{"name": "formula", "h": "x3 + y"}]},
+            "augmentations.0.h",
+            "unknown name 'y'",
+        ),
+        (
+            {**ARM3R, "augmentations": [{"name": "formula", "h": "x3", "hh": 1}]},
+            "augmentations.0",
+            "unknown key(s) ['hh']",
+        ),
+        (
+            {**ARM3R, "augmentations": [{"name": "e2_synthesized", "region": {"x9": [0, 1]}}]},
+            "augmentations.0.region",
+            "unknown joint variable 'x9'",
+        ),
+        (
+            {**ARM3R, "augmentations": [{"name": "formula", "h": "x3"}] * 2},
+            "augmentations.1.label",
+            "must be a new name",
+        ),
         ({**ARM3R, "augmentations": [{"name": "cubic"}]}, "augmentations.0", "must be"),
         ({**M2_FORMULA, "task": ["x2 +* x3"]}, "task.0", "expected a number"),
         ({"name": "manipulator2", "parameters": {"l": 99}}, None, "l must be in [0.1, 5]"),
     ],
-)  # fmt: skip
+)
 def test_bad_definitions_name_the_field(definition, field, text):
     with pytest.raises(InvalidInputError) as err:
         robot_from_dict(definition)
@@ -215,11 +259,34 @@ KEYS = {
     "urdf": ["urdf", "end_link", "active_joints", "task", "locked", "urdf_file"],
 }
 COMMON = ["x_range", "x0", "target", "path", "title", "name", "augmentations"]
-HOSTILE = [None, True, 0, 7, -1.5, float("nan"), float("inf"), "", "x", "R" * 300, [], [1],
-           ["a", "b"], [None], [[1, 2], [3]], {}, {"a": 1}, {"x1": [0, 1]}, [{}],
-           [{"name": "formula"}], [{"name": "e2_synthesized", "region": {"x2": [0, 1],
-           "x3": [0, 1]}, "degree": "a"}], [{"name": "formula", "h": ["x1"]}], 10**400,
-           [10**400, 1.0, 1.0], {"l": 10**400}, {"base_yaw": 10**400}]  # fmt: skip
+HOSTILE = [
+    None,
+    True,
+    0,
+    7,
+    -1.5,
+    float("nan"),
+    float("inf"),
+    "",
+    "x",
+    "R" * 300,
+    [],
+    [1],
+    ["a", "b"],
+    [None],
+    [[1, 2], [3]],
+    {},
+    {"a": 1},
+    {"x1": [0, 1]},
+    [{}],
+    [{"name": "formula"}],
+    [{"name": "e2_synthesized", "region": {"x2": [0, 1], "x3": [0, 1]}, "degree": "a"}],
+    [{"name": "formula", "h": ["x1"]}],
+    10**400,
+    [10**400, 1.0, 1.0],
+    {"l": 10**400},
+    {"base_yaw": 10**400},
+]
 
 
 @pytest.mark.parametrize("kind", sorted(GOOD))

@@ -443,8 +443,9 @@ def test_discrete_chunks_raise_at_a_singular_start_and_let_between_raise():
         raise Stop
 
     with pytest.raises(Stop):
-        solve_in_chunks(Pseudoinverse(Manipulator2()), X0, [1, 1], chunk=5, gamma=0.3,
-                        between=between)  # fmt: skip
+        solve_in_chunks(
+            Pseudoinverse(Manipulator2()), X0, [1, 1], chunk=5, gamma=0.3, between=between
+        )
     for kwargs, match in [
         ({"chunk": 0}, "chunk must be between"),
         ({"x0": [X0, X0]}, r"one start \(p,\) and one target"),

@@ -57,9 +57,12 @@ def test_jacobian_against_finite_differences():
     x = random_controls(8, seed=2)
     J = kin.jacobian(x)
     fd = np.stack(
-        [(kin.forward(x + FD_STEP * e) - kin.forward(x - FD_STEP * e)) / (2 * FD_STEP)
-         for e in np.eye(4)], axis=-1,
-    )  # fmt: skip
+        [
+            (kin.forward(x + FD_STEP * e) - kin.forward(x - FD_STEP * e)) / (2 * FD_STEP)
+            for e in np.eye(4)
+        ],
+        axis=-1,
+    )
     assert J.shape == (8, 3, 4)
     assert np.max(np.abs(J - fd)) < FD_TOL
     assert np.allclose(J[..., 2, :], [0.0, 0.0, 2 * np.pi, 0.0], atol=1e-12)
@@ -72,9 +75,12 @@ def test_jacobian_against_ode_finite_differences():
     x = np.array([0.5, -0.25, 0.3, -0.25])
     h = 1e-5
     fd = np.stack(
-        [(ode_pose(x + h * e, q0, kin.T) - ode_pose(x - h * e, q0, kin.T)) / (2 * h)
-         for e in np.eye(4)], axis=-1,
-    )  # fmt: skip
+        [
+            (ode_pose(x + h * e, q0, kin.T) - ode_pose(x - h * e, q0, kin.T)) / (2 * h)
+            for e in np.eye(4)
+        ],
+        axis=-1,
+    )
     assert np.max(np.abs(kin.jacobian(x) - fd)) < 1e-6
 
 
@@ -84,9 +90,12 @@ def test_hessian_against_finite_differences_of_jacobian():
     x = random_controls(6, seed=3).reshape(2, 3, 4)
     H = kin.hessian(x)
     fd = np.stack(
-        [(kin.jacobian(x + FD_STEP * e) - kin.jacobian(x - FD_STEP * e)) / (2 * FD_STEP)
-         for e in np.eye(4)], axis=-1,
-    )  # fmt: skip
+        [
+            (kin.jacobian(x + FD_STEP * e) - kin.jacobian(x - FD_STEP * e)) / (2 * FD_STEP)
+            for e in np.eye(4)
+        ],
+        axis=-1,
+    )
     assert H.shape == (2, 3, 3, 4, 4)
     assert np.max(np.abs(H - fd)) < FD_TOL
     assert np.max(np.abs(H - np.swapaxes(H, -1, -2))) < 1e-13

@@ -57,15 +57,20 @@ def test_locked_joints_and_a_task_subset_match_yourdfpy(reference):
     x = RNG.uniform(-2, 2, (5, 3))
     for xi, yi in zip(x, kin.forward(x), strict=True):
         cfg = {"base_yaw": 0.3, **dict(zip(kin.joint_names, xi, strict=True))}
-        np.testing.assert_allclose(yi, _yourdfpy_position(reference, cfg, "tool")[[0, 2]],
-                                   atol=1e-12)  # fmt: skip
+        np.testing.assert_allclose(
+            yi, _yourdfpy_position(reference, cfg, "tool")[[0, 2]], atol=1e-12
+        )
 
 
 @pytest.mark.parametrize(
     ("end", "active", "task"),
-    [("tool", None, "xyz"), ("tool", ["wrist_pitch", "shoulder", "elbow"], "yz"),
-     ("finger", None, "xyz"), ("finger", ["finger_slide", "elbow", "shoulder"], "zx")],
-)  # fmt: skip
+    [
+        ("tool", None, "xyz"),
+        ("tool", ["wrist_pitch", "shoulder", "elbow"], "yz"),
+        ("finger", None, "xyz"),
+        ("finger", ["finger_slide", "elbow", "shoulder"], "zx"),
+    ],
+)
 def test_jacobian_matches_finite_differences(end, active, task):
     kin = UrdfChain(TEXT, end, active, task)
     x = RNG.uniform(-2, 2, (30, kin.p))
@@ -93,8 +98,9 @@ def test_repeatability_pseudoinverse_drifts_extended_returns(arm):
     home = arm.forward(X0)
     path = home + np.array([[0.1, 0, 0], [0.1, 0.1, 0.05], [0, 0.1, 0.05]])
     pinv = repeatability(Pseudoinverse(arm), X0, path, cycles=3)
-    ext = repeatability(ExtendedInverse(arm, FormulaMap("x4 - x3", arm.variable_names)), X0, path,
-                        cycles=3)  # fmt: skip
+    ext = repeatability(
+        ExtendedInverse(arm, FormulaMap("x4 - x3", arm.variable_names)), X0, path, cycles=3
+    )
     assert pinv.success and ext.success
     assert pinv.drift[-1] > 1e-4
     assert np.max(ext.drift) < 1e-9
@@ -104,23 +110,40 @@ def test_repeatability_pseudoinverse_drifts_extended_returns(arm):
     ("kwargs", "field", "text"),
     [
         ({"end_link": "hand"}, "end_link", "'hand' is not a link"),
-        ({"end_link": "tool", "active_joints": ["shoulder", "finger_slide"]},
-         "active_joints.1", "not a movable joint on the chain"),
-        ({"end_link": "tool", "active_joints": ["shoulder", "shoulder", "elbow"]},
-         "active_joints", "repeats"),
+        (
+            {"end_link": "tool", "active_joints": ["shoulder", "finger_slide"]},
+            "active_joints.1",
+            "not a movable joint on the chain",
+        ),
+        (
+            {"end_link": "tool", "active_joints": ["shoulder", "shoulder", "elbow"]},
+            "active_joints",
+            "repeats",
+        ),
         ({"end_link": "tool", "task": "xw"}, "task", "coordinates among x y z rx ry rz"),
-        ({"end_link": "tool", "active_joints": ["shoulder", "elbow"], "task": "xz"},
-         "active_joints", "more joints than task coordinates"),
+        (
+            {"end_link": "tool", "active_joints": ["shoulder", "elbow"], "task": "xz"},
+            "active_joints",
+            "more joints than task coordinates",
+        ),
         ({"end_link": "tool", "locked": {"nope": 1.0}}, "locked.nope", "not a joint"),
         ({"end_link": "tool", "urdf": "<robot"}, "urdf", "not a valid URDF"),
         ({"end_link": "tool", "urdf": 3}, "urdf", "text of a URDF"),
-        ({"end_link": "tool", "urdf": "<robot>" + " " * MAX_URDF_BYTES + "</robot>"}, "urdf",
-         "too large"),
-        ({"end_link": "tool",
-          "urdf": '<!DOCTYPE r [<!ENTITY x SYSTEM "file:///etc/passwd">]>' + TEXT},
-         "urdf", "DOCTYPE"),
+        (
+            {"end_link": "tool", "urdf": "<robot>" + " " * MAX_URDF_BYTES + "</robot>"},
+            "urdf",
+            "too large",
+        ),
+        (
+            {
+                "end_link": "tool",
+                "urdf": '<!DOCTYPE r [<!ENTITY x SYSTEM "file:///etc/passwd">]>' + TEXT,
+            },
+            "urdf",
+            "DOCTYPE",
+        ),
     ],
-)  # fmt: skip
+)
 def test_bad_definitions_name_the_field(kwargs, field, text):
     with pytest.raises(InvalidInputError) as err:
         UrdfChain(**{"urdf": TEXT, **kwargs})

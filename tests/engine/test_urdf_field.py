@@ -46,8 +46,9 @@ def _serial_chains(text: str) -> list[tuple[str, int]]:
         while link in parent:
             chain.append(parent[link])
             link = chain[-1].find("parent").get("link")
-        if any(j.get("type") in ("floating", "planar") or j.find("mimic") is not None
-               for j in chain):  # fmt: skip
+        if any(
+            j.get("type") in ("floating", "planar") or j.find("mimic") is not None for j in chain
+        ):
             continue
         movable = sum(j.get("type") in MOVABLE for j in chain)
         if movable >= 2:
@@ -100,9 +101,12 @@ def test_the_chains_counted():
 
 def test_a_fixed_joints_axis_is_ignored():
     """The URDF spec: a fixed joint's axis means nothing, so even a zero one is accepted."""
-    text = TEXT.replace("</robot>", '<link name="flange"/><joint name="tool_flange" type="fixed">'
-                        '<parent link="tool"/><child link="flange"/><origin xyz="0 0 0.02"/>'
-                        '<axis xyz="0 0 0"/></joint></robot>')  # fmt: skip
+    text = TEXT.replace(
+        "</robot>",
+        '<link name="flange"/><joint name="tool_flange" type="fixed">'
+        '<parent link="tool"/><child link="flange"/><origin xyz="0 0 0.02"/>'
+        '<axis xyz="0 0 0"/></joint></robot>',
+    )
     kin = UrdfChain(text, "flange")
     np.testing.assert_allclose(
         kin.forward([0.1, 0.2, 0.3, 0.4]) - UrdfChain(TEXT, "tool").forward([0.1, 0.2, 0.3, 0.4]),
@@ -113,13 +117,19 @@ def test_a_fixed_joints_axis_is_ignored():
 
 @pytest.mark.parametrize(
     "name",
-    ["file:///etc/passwd", "package:///meshes/x.stl", "../secret.stl", "https://example.invalid/x",
-     "package://arm4/meshes/tool.dae"],
-)  # fmt: skip
+    [
+        "file:///etc/passwd",
+        "package:///meshes/x.stl",
+        "../secret.stl",
+        "https://example.invalid/x",
+        "package://arm4/meshes/tool.dae",
+    ],
+)
 def test_mesh_references_are_skipped_with_a_note_never_read(name, monkeypatch):
-    text = TEXT.replace('<link name="tool"/>',
-                        f'<link name="tool"><visual><geometry><mesh filename="{name}"/>'
-                        "</geometry></visual></link>")  # fmt: skip
+    text = TEXT.replace(
+        '<link name="tool"/>',
+        f'<link name="tool"><visual><geometry><mesh filename="{name}"/></geometry></visual></link>',
+    )
     import builtins
 
     opened = []
@@ -134,7 +144,9 @@ def test_mesh_references_are_skipped_with_a_note_never_read(name, monkeypatch):
 
 
 def test_a_joint_whose_parent_link_does_not_exist_is_refused():
-    text = TEXT.replace('<parent link="base_link"/><child link="turret"/>',
-                        '<parent link="plinth"/><child link="turret"/>')  # fmt: skip
+    text = TEXT.replace(
+        '<parent link="base_link"/><child link="turret"/>',
+        '<parent link="plinth"/><child link="turret"/>',
+    )
     with pytest.raises(InvalidInputError, match="parent link 'plinth', which the URDF does not"):
         UrdfChain(text, "tool")

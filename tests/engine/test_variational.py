@@ -132,15 +132,22 @@ def test_progress_cancel_and_bad_input():
     """The progress grows to 1; a cancellation stops the synthesis between its degrees."""
     seen = []
     progress = ProgressCallbacks(on_advance=lambda done, total: seen.append(done / total))
-    synthesize_e2(Manipulator2(), MANIPULATOR2_REGION, degree=6, convergence_degrees=(2, 4),
-                  progress=progress)  # fmt: skip
+    synthesize_e2(
+        Manipulator2(), MANIPULATOR2_REGION, degree=6, convergence_degrees=(2, 4), progress=progress
+    )
     assert seen[-1] == 1.0 and all(b >= a for a, b in itertools.pairwise(seen))
     seen.clear()
-    cancel = ProgressCallbacks(on_advance=lambda done, total: seen.append(done),
-                               is_cancelled=lambda: len(seen) == 3)  # fmt: skip
+    cancel = ProgressCallbacks(
+        on_advance=lambda done, total: seen.append(done), is_cancelled=lambda: len(seen) == 3
+    )
     with pytest.raises(RunCancelled, match="before degree 6"):
-        synthesize_e2(Manipulator2(), MANIPULATOR2_REGION, degree=6, convergence_degrees=(2, 4),
-                      progress=cancel)  # fmt: skip
+        synthesize_e2(
+            Manipulator2(),
+            MANIPULATOR2_REGION,
+            degree=6,
+            convergence_degrees=(2, 4),
+            progress=cancel,
+        )
     with pytest.raises(InvalidInputError, match="two or three variables"):
         synthesize_e2(Manipulator2(), {"x3": (0, 1)})
     with pytest.raises(InvalidInputError, match="degree must be between"):

@@ -51,9 +51,7 @@ ERRORS: dict[int | str, dict] = {
 
 
 @router.post("/atlas", status_code=202, response_model=AtlasJobResponse, responses=ERRORS)
-async def start_atlas(
-    req: AtlasBody, request: Request, response: Response, jobs: Jobs, pool: Pool
-):  # fmt: skip
+async def start_atlas(req: AtlasBody, request: Request, response: Response, jobs: Jobs, pool: Pool):
     """Plan the atlas (the self-motion curves are traced here) and start it as a job."""
     job = await start_job(jobs, pool, request, req)
     response.headers["Location"] = f"/atlas/{job.id}"

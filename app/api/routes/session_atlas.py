@@ -45,12 +45,21 @@ class SessionAtlas(BaseModel):
     )
 
 
-@router.post("/api/sessions/{session_id}/atlas", status_code=202,
-             response_model=AtlasJobResponse, responses={**ERRORS, **_NOT_FOUND})  # fmt: skip
+@router.post(
+    "/api/sessions/{session_id}/atlas",
+    status_code=202,
+    response_model=AtlasJobResponse,
+    responses={**ERRORS, **_NOT_FOUND},
+)
 async def start_session_atlas(
-    session_id: str, body: SessionAtlas, request: Request, response: Response, store: Store,
-    jobs: Jobs, pool: Pool,
-):  # fmt: skip
+    session_id: str,
+    body: SessionAtlas,
+    request: Request,
+    response: Response,
+    store: Store,
+    jobs: Jobs,
+    pool: Pool,
+):
     """Start the atlas of the session's current state (422 naming the field it refuses)."""
     state = store.get(session_id).dashboard.state
     try:
@@ -74,7 +83,9 @@ async def read_session_atlas(session_id: str, job_id: str, store: Store, jobs: J
     if job.status == "done" and job.result is not None and job.request is not None:
         figure = await run_in_threadpool(atlas_figure, job.result, job.request)
         body.update(
-            figure=json.loads(figure_json(figure)), starts=job.result["starts"],
-            paths=job.result["paths"], request=job.request.model_dump(mode="json"),
-        )  # fmt: skip
+            figure=json.loads(figure_json(figure)),
+            starts=job.result["starts"],
+            paths=job.result["paths"],
+            request=job.request.model_dump(mode="json"),
+        )
     return JSONResponse(body)

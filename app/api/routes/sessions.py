@@ -62,9 +62,17 @@ class SessionCreate(BaseModel):
 #: What a client does next with a new session (OpenAPI links: the id it answers is the path's).
 _SESSION_LINKS = {
     name: {"operationId": name, "parameters": {"session_id": "$response.body#/id"}}
-    for name in ("get_session", "post_state", "session_events", "cancel_functionals",
-                 "compute_functionals", "export_json", "export_csv", "delete_session")
-}  # fmt: skip
+    for name in (
+        "get_session",
+        "post_state",
+        "session_events",
+        "cancel_functionals",
+        "compute_functionals",
+        "export_json",
+        "export_csv",
+        "delete_session",
+    )
+}
 
 
 def _created(session: Session) -> dict:
@@ -107,9 +115,15 @@ async def delete_session(session_id: str, store: Store):
 @router.post(
     "/api/sessions/{session_id}/state",
     operation_id="post_state",
-    openapi_extra={"requestBody": {"required": True, "content": {"application/json": {
-        "schema": {"$ref": "#/components/schemas/StatePatch"}}}}},
-)  # fmt: skip
+    openapi_extra={
+        "requestBody": {
+            "required": True,
+            "content": {
+                "application/json": {"schema": {"$ref": "#/components/schemas/StatePatch"}}
+            },
+        }
+    },
+)
 async def post_state(session_id: str, request: Request, store: Store, pool: Pool) -> JSONResponse:
     """Change some controls: ``{"gamma": 2}``, ``{"x0": [...]}``, ``{"robot": "manipulator1"}``.
 
@@ -144,9 +158,11 @@ class SecondPhaseRequest(BaseModel):
 
 #: A second phase that is not in the state a request needs.
 _SECOND_PHASE_CONFLICT: dict[int | str, dict] = {
-    409: {"description": "that generation's second phase is not running (cancel) or was not "
-          "cancelled (compute), or a newer generation is current"},
-}  # fmt: skip
+    409: {
+        "description": "that generation's second phase is not running (cancel) or was not "
+        "cancelled (compute), or a newer generation is current"
+    },
+}
 
 
 @router.post(
@@ -162,9 +178,11 @@ async def cancel_functionals(
     stays, and a ``functionals`` event with ``cancelled`` says what was not computed."""
     dashboard = store.get(session_id).dashboard
     return _second_phase_answer(
-        dashboard.cancel_second_phase(body.generation), dashboard, body.generation,
+        dashboard.cancel_second_phase(body.generation),
+        dashboard,
+        body.generation,
         f"nothing to cancel: E1, E2 of generation {body.generation} are not being computed",
-    )  # fmt: skip
+    )
 
 
 @router.post(
@@ -180,17 +198,22 @@ async def compute_functionals(
     screen: ``progress`` events, then a ``functionals`` event."""
     dashboard = store.get(session_id).dashboard
     return _second_phase_answer(
-        dashboard.compute_second_phase(body.generation), dashboard, body.generation,
-        f"E1, E2 of generation {body.generation} were not cancelled, or it is not the result "
-        "shown",
-    )  # fmt: skip
+        dashboard.compute_second_phase(body.generation),
+        dashboard,
+        body.generation,
+        f"E1, E2 of generation {body.generation} were not cancelled, or it is not the result shown",
+    )
 
 
 def _second_phase_answer(done: bool, dashboard, generation: int, refusal: str) -> JSONResponse:
     """202 with the generation when the second phase did as asked; else 409 saying why."""
     if not done:
-        return JSONResponse(status_code=409, content={"detail": (
-            f"{refusal} (the session is at generation {dashboard.generation})")})  # fmt: skip
+        return JSONResponse(
+            status_code=409,
+            content={
+                "detail": (f"{refusal} (the session is at generation {dashboard.generation})")
+            },
+        )
     return JSONResponse(status_code=202, content={"generation": generation})
 
 
@@ -263,9 +286,13 @@ async def _finished(session: Session):
     snapshot = dashboard.snapshot()
     if snapshot["error"] is not None:
         error = snapshot["error"]
-        raise ExportUnavailable(409, (
-            f"generation {error.get('generation')} failed: {error.get('message')}; there is no "
-            "result of the current state to export (change the state, then export)"))  # fmt: skip
+        raise ExportUnavailable(
+            409,
+            (
+                f"generation {error.get('generation')} failed: {error.get('message')}; there is no "
+                "result of the current state to export (change the state, then export)"
+            ),
+        )
     if not done or dashboard.result is None:
         raise ExportUnavailable(503, "no result of the current state computed yet; retry")
     return dashboard

@@ -39,13 +39,15 @@ class AlgorithmParameters(_Parameters):  # type: ignore[misc, valid-type]
     """Parameters of the chosen algorithm; those of another algorithm are refused (422)."""
 
     rest: list[_Coordinate] | None = Field(
-        None, description="posture: the rest posture x_rest, length p (default: the robot's home, "
+        None,
+        description="posture: the rest posture x_rest, length p (default: the robot's home, "
         "else the run's x0; in an atlas, each run's own start)",
-    )  # fmt: skip
+    )
     limits: list[tuple[_Bound, _Bound]] | None = Field(
-        None, description="weighted: joint limits [lo, hi] per joint, length p (default: the "
+        None,
+        description="weighted: joint limits [lo, hi] per joint, length p (default: the "
         "robot's joint limits, else its configuration box x_range)",
-    )  # fmt: skip
+    )
 
 
 def used(params: BaseModel | None, algorithm: str = "", kinematics=None, x0=None) -> dict:

@@ -67,8 +67,9 @@ class AlgorithmInfo(BaseModel):
     source: str
     description: str
     parameters: list[ParameterInfo]
-    vectors: list[str] = Field(description="its vector parameters: rest (p numbers), limits "
-                               "(p pairs [lo, hi])")  # fmt: skip
+    vectors: list[str] = Field(
+        description="its vector parameters: rest (p numbers), limits (p pairs [lo, hi])"
+    )
 
 
 class RobotsResponse(BaseModel):

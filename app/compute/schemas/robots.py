@@ -198,18 +198,24 @@ class UrdfRobot(BaseModel):
         "rz (rotation vector of R0^T R); 'pose' for all six, or a subset such as 'xyz', 'xz' "
         "or 'x y z rz'",
     )
-    home: Annotated[list[Coordinate], Field(min_length=1, max_length=MAX_DIMENSION)] | None = (
-        Field(None, description="a reference configuration (default: zero, clipped into the "
-              "joint limits); also the default start")
-    )  # fmt: skip
+    home: Annotated[list[Coordinate], Field(min_length=1, max_length=MAX_DIMENSION)] | None = Field(
+        None,
+        description="a reference configuration (default: zero, clipped into the "
+        "joint limits); also the default start",
+    )
     reference: (
         Annotated[list[FiniteFloat], Field(min_length=3, max_length=4)]
-        | Annotated[list[Annotated[list[FiniteFloat], Field(min_length=3, max_length=3)]],
-                    Field(min_length=3, max_length=3)]
+        | Annotated[
+            list[Annotated[list[FiniteFloat], Field(min_length=3, max_length=3)]],
+            Field(min_length=3, max_length=3),
+        ]
         | None
-    ) = Field(None, description="R0, the orientation whose rotation coordinates are 0: a "
-              "rotation vector, a quaternion x y z w or a 3x3 matrix; default: the orientation "
-              "at home")  # fmt: skip
+    ) = Field(
+        None,
+        description="R0, the orientation whose rotation coordinates are 0: a "
+        "rotation vector, a quaternion x y z w or a 3x3 matrix; default: the orientation "
+        "at home",
+    )
     locked: Annotated[
         dict[Annotated[str, Field(min_length=1, max_length=200)], FiniteFloat],
         Field(max_length=64),
@@ -236,18 +242,28 @@ class E2SynthesisAugmentation(BaseModel):
 
     model_config = ConfigDict(extra="forbid", title="E2-synthesized map")
     name: Literal["e2_synthesized"]
-    region: Annotated[
-        dict[Name, tuple[Annotated[float, Field(strict=True, ge=-100.0, le=100.0,
-                                                allow_inf_nan=False)],
-                         Annotated[float, Field(strict=True, ge=-100.0, le=100.0,
-                                                allow_inf_nan=False)]]],
-        Field(min_length=2, max_length=MAX_DIMENSION),
-    ] | None = Field(None, description="two or more variables to [lo, hi], lo < hi; default: "
-                     "the robot's functional region (an arm's: a box around home)")  # fmt: skip
+    region: (
+        Annotated[
+            dict[
+                Name,
+                tuple[
+                    Annotated[float, Field(strict=True, ge=-100.0, le=100.0, allow_inf_nan=False)],
+                    Annotated[float, Field(strict=True, ge=-100.0, le=100.0, allow_inf_nan=False)],
+                ],
+            ],
+            Field(min_length=2, max_length=MAX_DIMENSION),
+        ]
+        | None
+    ) = Field(
+        None,
+        description="two or more variables to [lo, hi], lo < hi; default: "
+        "the robot's functional region (an arm's: a box around home)",
+    )
     degree: Annotated[int, Field(strict=True, ge=1, le=24), INTEGRAL] | None = Field(
-        None, description="two or three variables: Legendre degree per variable (default 12); "
+        None,
+        description="two or three variables: Legendre degree per variable (default 12); "
         "more: the total degree, 1 to 6 (default 4)",
-    )  # fmt: skip
+    )
     fixed: Annotated[dict[Name, FiniteFloat], Field(max_length=MAX_DIMENSION)] | None = Field(
         None, description="values of the variables outside the box (default 0)"
     )
@@ -269,8 +285,10 @@ def _arm_model(arm: Arm) -> type[BaseModel]:
     fields: dict[str, Any] = {"name": (Literal[arm.name], ...)}
     for key in ("task", "reference", "home", "title"):
         info = UrdfRobot.model_fields[key]
-        fields[key] = (info.annotation, Field(arm.task if key == "task" else None,
-                                              description=info.description))  # fmt: skip
+        fields[key] = (
+            info.annotation,
+            Field(arm.task if key == "task" else None, description=info.description),
+        )
     return create_model(
         f"{_camel(arm.name)}Arm",
         __config__=ConfigDict(extra="forbid", title=arm.title),

@@ -54,11 +54,14 @@ def per_robot(base: type[BaseModel], fields: Any, user_robots: bool = True) -> A
             robot=(robot_model, Field(description=f"{robot_model.__doc__}")),
             augmentation=(
                 UserAugmentation | None,
-                Field(None, description="augmenting map h of the extended inverse: "
-                      "{'name': 'formula', 'h': ...} or {'name': 'e2_synthesized', 'region': "
-                      "{...}} (p = r + 1)" + USER_AUGMENTATION_NOTE.get(base.__name__, "")),
+                Field(
+                    None,
+                    description="augmenting map h of the extended inverse: "
+                    "{'name': 'formula', 'h': ...} or {'name': 'e2_synthesized', 'region': "
+                    "{...}} (p = r + 1)" + USER_AUGMENTATION_NOTE.get(base.__name__, ""),
+                ),
             ),
-        )  # fmt: skip
+        )
         globals()[model.__name__] = model
         members.append(Annotated[model, Tag(kind)])
     return Annotated[
