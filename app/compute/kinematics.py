@@ -128,8 +128,8 @@ def kinematics_request(req: KinematicsRequest) -> KinematicsResponse:
                 f"x[{i}]" if many else "x",
                 f"must have {spec.p} components "
                 f"(p of {spec.title}: {list(spec.variable_names)}), got "
-                f"{len(row)}",
-            )  # type: ignore[arg-type]
+                f"{len(row)}",  # type: ignore[arg-type]
+            )
     x = np.asarray(req.x, dtype=float)
     forward_jacobian = getattr(kin, "forward_jacobian", None)
     k, J = forward_jacobian(x) if forward_jacobian else (kin.forward(x), kin.jacobian(x))
