@@ -1,11 +1,12 @@
 """The dashboard: one live state per session, solved by its chosen algorithms, drawn as figures.
 
-Modules: :mod:`~jik.app.dashboard.controls` (the controls, described once), :mod:`.model` (the
+Modules: :mod:`~jik.app.dashboard.controls` (the controls, described once),
+:mod:`.control_changes` (a change of controls as a change of the state), :mod:`.model` (the
 state), :mod:`.algorithms` (the chosen algorithms, one style each), :mod:`.runs` and
 :mod:`.results` (a state solved), :mod:`.offload` (the shared compute processes),
-:mod:`.analysis` (h on a grid, E1/E2), :mod:`.figures` (plotly panels), :mod:`.messages`
-(events), :mod:`.session` (the live :class:`Dashboard`), :mod:`.sessions` (one per tab,
-bounded), :mod:`.export` (JSON and CSV). The names below are the public surface.
+:mod:`.analysis` (h on a grid), :mod:`.functionals` (E1/E2), :mod:`.figures` (plotly panels),
+:mod:`.messages` (events), :mod:`.session` (the live :class:`Dashboard`), :mod:`.sessions` (one
+per tab, bounded), :mod:`.export` (JSON and CSV). The names below are the public surface.
 """
 
 from jik.app.dashboard.export import export_csv, export_file, export_json

@@ -1,7 +1,7 @@
 """E2 of a map over more joints than a tensor rule can take (a 7-joint arm's synthesized map).
 
 The dashboard takes E1 (13) and E2 (18) by a tensor Gauss rule over at most three variables
-(:func:`jik.app.dashboard.analysis.error_functionals`). Over more, for one degree of redundancy,
+(:func:`jik.app.dashboard.functionals.error_functionals`). Over more, for one degree of redundancy,
 E2 is taken by the scrambled Sobol rule of the total-degree synthesis
 (:func:`jik.engine.e2_qmc.e2_qmc`, docs/e2-vector.md), with E2 of h = s x_j for each joint
 beside it: the E1/E2 panel compares the map with holding a single joint. E1 has no such rule

@@ -3,10 +3,9 @@
 :func:`controls` lists the controls of a dashboard state (its robot, augmenting map, mode and
 task), generated from the engine's registry: keys, labels, help text, kinds, ranges (gamma's per
 mode), steps and options. :func:`control_values` gives each control's value as shown, and
-:func:`expand` turns a change of controls (a patch keyed by control keys, ``{"x0.1": 0.4}``,
-``{"path": "1, 1; 1, 2"}``) into a patch of the dashboard's state. Neither the page
-(``static/controls.js``) nor the scene (:mod:`jik.app.scene`) knows a range, a label or a text
-format of its own.
+:func:`controls_message` both, for a page. A change of controls becomes a change of the state in
+:mod:`jik.app.dashboard.control_changes`. Neither the page (``static/controls.js``) nor the scene
+(:mod:`jik.app.scene`) knows a range, a label or a text format of its own.
 
 A control's ``key`` is a dotted path into the state: ``gamma``, ``x0.1`` (one coordinate of the
 start x0), ``robot_parameters.l``, ``robot_parameters.q0`` (a vector parameter, edited whole),
@@ -16,16 +15,15 @@ algorithm), ``algorithms`` (the chosen ones, a ``checks`` control), ``path`` (ed
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from typing import Any
 
 from jik.app.dashboard.algorithms import STYLES, scalar_parameters
+from jik.app.dashboard.control_changes import PATH_FORMAT, path_text
 from jik.app.dashboard.glossary import SYMBOLS
 from jik.app.dashboard.robots import state_spec
 from jik.engine.arms import ARMS
-from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS
 from jik.engine.solve_rules import DISCRETE_GAMMA_BOUND, MAX_ITERATIONS, MAX_STEPS
 
@@ -34,16 +32,12 @@ GAMMA_STEP = 0.001
 #: gamma's slider range per mode: the decay rate of eq. (5) (continuous), the step of the
 #: discrete iteration, which converges only below the engine's DISCRETE_GAMMA_BOUND.
 GAMMA_RANGE = {"continuous": (0.01, 10.0), "discrete": (0.01, DISCRETE_GAMMA_BOUND - 0.01)}
-#: Switching to discrete mode takes gamma down to this when it is above (the full Newton step).
-DISCRETE_GAMMA_ON_SWITCH = 1.0
 #: Largest number of cycles offered by the dashboard (the engine accepts more).
 MAX_DASHBOARD_CYCLES = 20
 #: The range of the cap on iterations (or integrator steps) per leg.
 MIN_ITERATIONS, MAX_ITERATIONS_CAP = 10, 200_000
 #: Positions of a slider between its ends (x0's: finer).
 SLIDER_STEPS, X0_STEPS = 200, 400
-#: How a closed path is written in a text box: points separated by ';', coordinates by ','.
-PATH_FORMAT = "y1, y2; y1, y2; ..."
 #: A computation shows its progress once it has run this long [s].
 PROGRESS_AFTER = 0.5
 #: The modes of eq. (7): the ODE, or its Euler iteration with step gamma.
@@ -365,69 +359,6 @@ def lookup(state: Mapping[str, Any], key: str) -> Any:
     for part in key.split("."):
         value = value[int(part)] if isinstance(value, list) else value[part]
     return value
-
-
-def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
-    """A patch of control keys as a patch of the state's fields: ``{"x0.1": v}`` sets one
-    coordinate of x0, ``{"robot_parameters.l": v}`` one parameter, ``{"path": "1, 1; 1, 2"}``
-    the path from its text (:data:`PATH_FORMAT`). Switching to discrete mode without a gamma
-    takes gamma down to :data:`DISCRETE_GAMMA_ON_SWITCH` when it is above."""
-    out: dict[str, Any] = {}
-    for key, value in patch.items():
-        head, _, rest = key.partition(".")
-        if not rest:
-            size = len(state.target) if "robot" not in patch else None
-            out[key] = (
-                parse_path_text(value, size) if key == "path" and isinstance(value, str) else value
-            )
-        elif head in ("robot_parameters", "augmentation_parameters", "algorithm_parameters"):
-            out.setdefault(head, {})[rest] = value
-        elif head in ("x0", "target") and rest.isdigit():
-            vector = out[head] = list(out.get(head, getattr(state, head)))
-            if int(rest) >= len(vector):
-                raise InvalidInputError(f"{key}: {head} has {len(vector)} coordinates", key)
-            vector[int(rest)] = value
-        else:
-            raise InvalidInputError(f"unknown dashboard control {key!r}", key)
-    if out.get("mode") == "discrete" and "gamma" not in out and state.mode != "discrete":
-        out["gamma"] = min(state.gamma, DISCRETE_GAMMA_ON_SWITCH)
-    return out
-
-
-def path_text(path) -> str:
-    """A path as text, :data:`PATH_FORMAT`, each coordinate in the fewest digits that give it
-    back exactly (what is shown is what is in force)."""
-    return "; ".join(", ".join(_number(v) for v in p) for p in path)
-
-
-def _number(v: float) -> str:
-    text = repr(float(v))
-    return text[:-2] if text.endswith(".0") else text
-
-
-def parse_path_text(text: str, size: int | None = None) -> list[list[float]]:
-    """The points of a path written as :data:`PATH_FORMAT`; ``size``: the task's dimension,
-    which every point must have. A refusal quotes the point as the user wrote it."""
-    points = []
-    parts = [p for p in text.split(";") if p.strip()]
-    for k, part in enumerate(parts, start=1):
-        where = f"point {k} of {len(parts)}, '{part.strip()}',"
-        try:
-            point = [float(v) for v in part.split(",")]
-        except ValueError:
-            raise InvalidInputError(
-                f"path: {where} is not numbers separated by ',' (write '{PATH_FORMAT}')", "path"
-            ) from None
-        if not all(math.isfinite(v) for v in point):
-            raise InvalidInputError(f"path: {where} has a coordinate that is not finite", "path")
-        if size is not None and len(point) != size:
-            raise InvalidInputError(
-                f"path: {where} has {len(point)} coordinate{'s' if len(point) > 1 else ''}; "
-                f"each point needs {size} (write '{PATH_FORMAT}')",
-                "path",
-            )
-        points.append(point)
-    return points
 
 
 def controls_message(state) -> dict[str, Any]:

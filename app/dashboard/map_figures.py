@@ -10,7 +10,8 @@ from typing import Any
 import numpy as np
 
 from jik.app.dashboard.algorithms import COLORS, DASH, LABELS
-from jik.app.dashboard.analysis import state_inert_variables, vector_note
+from jik.app.dashboard.analysis import vector_note
+from jik.app.dashboard.functionals import state_inert_variables
 from jik.app.dashboard.plotting import NO_LEGEND, figure, label, trace, units
 from jik.app.dashboard.robots import state_spec
 from jik.app.dashboard.runs import DashboardResult
@@ -229,7 +230,7 @@ def sensitivity_spec(
 
     With parameters: each functional against each parameter (swept around its current value,
     which is marked), on a log scale. Without: the functionals of the robot's other maps.
-    ``sens`` comes from :func:`jik.app.dashboard.analysis.sensitivity` (the dashboard's second
+    ``sens`` comes from :func:`jik.app.dashboard.functionals.sensitivity` (the dashboard's second
     phase); ``cancelled`` says how that phase was cancelled, when it was.
     """
     aug = result.state.augmentation

@@ -1,7 +1,7 @@
 """The dashboard's state: every control, validated against the registry and the engine.
 
 A change (:func:`updated_state`) is a patch of state fields or of control keys
-(:func:`jik.app.dashboard.controls.expand`); each refusal names its field
+(:func:`jik.app.dashboard.control_changes.expand`); each refusal names its field
 (:attr:`jik.engine.exceptions.InvalidInputError.field`). The chosen algorithms and their
 parameters are checked by :mod:`jik.app.dashboard.algorithms`, which also says what a run
 depends on (``cache_key``, ``runs_key``); a change's request body is
@@ -32,11 +32,11 @@ from jik.app.dashboard.algorithms import DASH as DASH
 from jik.app.dashboard.algorithms import LABELS as LABELS
 from jik.app.dashboard.algorithms import cache_key as cache_key
 from jik.app.dashboard.algorithms import runs_key as runs_key
+from jik.app.dashboard.control_changes import expand
 from jik.app.dashboard.controls import (
     MAX_DASHBOARD_CYCLES,
     MAX_ITERATIONS_CAP,
     MIN_ITERATIONS,
-    expand,
     max_iterations,
 )
 from jik.app.dashboard.robots import USER_KINDS, default_definition, state_inverse, user_robot
@@ -171,7 +171,7 @@ def _user_default_state(robot: str, definition: Mapping[str, Any] | None) -> Das
 def updated_state(state: DashboardState, patch: Mapping[str, object]) -> DashboardState:
     """Apply a partial change and validate the result (:func:`validate`).
 
-    ``patch`` is keyed by state fields or by control keys (:func:`.controls.expand`:
+    ``patch`` is keyed by state fields or by control keys (:func:`.control_changes.expand`:
     ``{"x0.1": 0.4}``, ``{"path": "1, 1; 1, 2"}``). Changing ``robot`` starts from that robot's
     defaults; changing ``augmentation`` resets its parameters to their defaults. Nested
     parameter dicts are merged.

@@ -18,7 +18,7 @@ from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS
 from jik.engine.repeatability import MAX_PATH_POINTS
 
-#: Control keys a patch may hold besides the state's fields (:func:`.controls.expand`), and
+#: Control keys a patch may hold besides the state's fields (:func:`.control_changes.expand`), and
 #: their values: one coordinate of ``x0`` or ``target``, one parameter of the robot (a number
 #: or a vector) or of the map.
 CONTROL_KEYS: dict[str, Any] = {

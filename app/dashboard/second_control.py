@@ -7,7 +7,8 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable
 
-from jik.app.dashboard.analysis import expensive_map, functionals_key, kinematics_and_map
+from jik.app.dashboard.analysis import expensive_map, kinematics_and_map
+from jik.app.dashboard.functionals import functionals_key
 from jik.app.dashboard.messages import Event
 from jik.app.dashboard.model import DashboardState
 from jik.app.dashboard.runs import Cancelled, DashboardResult

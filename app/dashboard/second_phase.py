@@ -14,14 +14,13 @@ import itertools
 from collections.abc import Callable
 from dataclasses import replace
 
-from jik.app.dashboard.analysis import (
-    augmenting_grid,
+from jik.app.dashboard.analysis import augmenting_grid, grid_batches
+from jik.app.dashboard.figures import figure_specs
+from jik.app.dashboard.functionals import (
     error_functionals,
-    grid_batches,
     sensitivity,
     sensitivity_evaluations,
 )
-from jik.app.dashboard.figures import figure_specs
 from jik.app.dashboard.map_figures import augmenting_title
 from jik.app.dashboard.messages import digest, with_figures
 from jik.app.dashboard.plotting import figure_json

@@ -1,20 +1,19 @@
-"""One description of the dashboard's controls (jik.app.dashboard.controls): from the
-registry, shown the same in the page and the scene, turned into state changes in one place."""
+"""One description of the dashboard's controls (jik.app.dashboard.controls): from the registry,
+shown the same in the page and the scene, turned into state changes in one place
+(jik.app.dashboard.control_changes)."""
 
 from __future__ import annotations
 
 import pytest
 
 from jik.app.dashboard import default_state, updated_state
-from jik.app.dashboard.controls import (
+from jik.app.dashboard.control_changes import (
     DISCRETE_GAMMA_ON_SWITCH,
-    GAMMA_RANGE,
-    control_values,
-    controls,
     expand,
     parse_path_text,
     path_text,
 )
+from jik.app.dashboard.controls import GAMMA_RANGE, control_values, controls
 from jik.engine.arms import ARMS
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS, robot_spec

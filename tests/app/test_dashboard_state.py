@@ -20,7 +20,7 @@ from jik.app.dashboard import (
     runs_key,
     updated_state,
 )
-from jik.app.dashboard.analysis import functionals_key, inert_variables
+from jik.app.dashboard.functionals import functionals_key, inert_variables
 from jik.app.dashboard.model import cache_key
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS, make_inverse, robot_spec

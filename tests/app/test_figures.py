@@ -10,7 +10,6 @@ import plotly.graph_objects as go
 import pytest
 
 from jik.app.dashboard import COLORS, LABELS, compute, default_state, updated_state
-from jik.app.dashboard.analysis import error_functionals, sensitivity
 from jik.app.dashboard.figures import (
     augmenting_figure,
     drift_figure,
@@ -21,6 +20,7 @@ from jik.app.dashboard.figures import (
     table_figure,
     task_space_figure,
 )
+from jik.app.dashboard.functionals import error_functionals, sensitivity
 from jik.app.dashboard.plotting import figure_json, keep_ranges, nice_range
 from jik.engine.registry import ROBOTS
 

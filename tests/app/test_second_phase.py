@@ -13,10 +13,9 @@ from dataclasses import replace
 import pytest
 
 from jik.app.dashboard import Dashboard, compute, default_state, updated_state
-from jik.app.dashboard.analysis import (
+from jik.app.dashboard.analysis import grid_batches, kinematics_and_map
+from jik.app.dashboard.functionals import (
     error_functionals,
-    grid_batches,
-    kinematics_and_map,
     sensitivity,
     sensitivity_evaluations,
 )

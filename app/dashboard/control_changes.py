@@ -1,0 +1,84 @@
+"""A change of the dashboard's controls as a change of its state.
+
+:func:`expand` turns a patch keyed by control keys (``{"x0.1": 0.4}``,
+``{"robot_parameters.l": 1.2}``, ``{"path": "1, 1; 1, 2"}``) into a patch of the state's fields
+(:func:`jik.app.dashboard.model.updated_state` applies it); :func:`path_text` and
+:func:`parse_path_text` write a closed path as text and read it back (:data:`PATH_FORMAT`), the
+one text format of the path box on the page and in the scene.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+from jik.engine.exceptions import InvalidInputError
+
+#: How a closed path is written in a text box: points separated by ';', coordinates by ','.
+PATH_FORMAT = "y1, y2; y1, y2; ..."
+#: Switching to discrete mode takes gamma down to this when it is above (the full Newton step).
+DISCRETE_GAMMA_ON_SWITCH = 1.0
+
+
+def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
+    """A patch of control keys as a patch of the state's fields: ``{"x0.1": v}`` sets one
+    coordinate of x0, ``{"robot_parameters.l": v}`` one parameter, ``{"path": "1, 1; 1, 2"}``
+    the path from its text (:data:`PATH_FORMAT`). Switching to discrete mode without a gamma
+    takes gamma down to :data:`DISCRETE_GAMMA_ON_SWITCH` when it is above."""
+    out: dict[str, Any] = {}
+    for key, value in patch.items():
+        head, _, rest = key.partition(".")
+        if not rest:
+            size = len(state.target) if "robot" not in patch else None
+            out[key] = (
+                parse_path_text(value, size) if key == "path" and isinstance(value, str) else value
+            )
+        elif head in ("robot_parameters", "augmentation_parameters", "algorithm_parameters"):
+            out.setdefault(head, {})[rest] = value
+        elif head in ("x0", "target") and rest.isdigit():
+            vector = out[head] = list(out.get(head, getattr(state, head)))
+            if int(rest) >= len(vector):
+                raise InvalidInputError(f"{key}: {head} has {len(vector)} coordinates", key)
+            vector[int(rest)] = value
+        else:
+            raise InvalidInputError(f"unknown dashboard control {key!r}", key)
+    if out.get("mode") == "discrete" and "gamma" not in out and state.mode != "discrete":
+        out["gamma"] = min(state.gamma, DISCRETE_GAMMA_ON_SWITCH)
+    return out
+
+
+def path_text(path) -> str:
+    """A path as text, :data:`PATH_FORMAT`, each coordinate in the fewest digits that give it
+    back exactly (what is shown is what is in force)."""
+    return "; ".join(", ".join(_number(v) for v in p) for p in path)
+
+
+def _number(v: float) -> str:
+    text = repr(float(v))
+    return text[:-2] if text.endswith(".0") else text
+
+
+def parse_path_text(text: str, size: int | None = None) -> list[list[float]]:
+    """The points of a path written as :data:`PATH_FORMAT`; ``size``: the task's dimension,
+    which every point must have. A refusal quotes the point as the user wrote it."""
+    points = []
+    parts = [p for p in text.split(";") if p.strip()]
+    for k, part in enumerate(parts, start=1):
+        where = f"point {k} of {len(parts)}, '{part.strip()}',"
+        try:
+            point = [float(v) for v in part.split(",")]
+        except ValueError:
+            raise InvalidInputError(
+                f"path: {where} is not numbers separated by ',' (write '{PATH_FORMAT}')", "path"
+            ) from None
+        if not all(math.isfinite(v) for v in point):
+            raise InvalidInputError(f"path: {where} has a coordinate that is not finite", "path")
+        if size is not None and len(point) != size:
+            raise InvalidInputError(
+                f"path: {where} has {len(point)} coordinate{'s' if len(point) > 1 else ''}; "
+                f"each point needs {size} (write '{PATH_FORMAT}')",
+                "path",
+            )
+        points.append(point)
+    return points

@@ -1,0 +1,270 @@
+"""The E1/E2 panel: the error functionals E1 (13) and E2 (18) of section 5 for the current
+augmenting map h, on the robot's design region (else on the h panel's box,
+:func:`jik.app.dashboard.analysis.augmenting_grid`), their sensitivity to the map's parameters
+(or the other maps the robot offers), the key their cache is kept under, and the joint variables
+that neither J nor h nor dh depends on (which the functionals therefore ignore)."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+
+import numpy as np
+
+from jik.app.dashboard.analysis import expensive_map, kinematics_and_map, vector_note
+from jik.app.dashboard.arm_e2 import qmc_functionals, single_joint_sensitivity
+from jik.app.dashboard.model import DashboardState, cache_key
+from jik.app.dashboard.robots import state_spec
+from jik.app.dashboard.runs import Cancelled, DashboardResult
+from jik.engine.exceptions import JikError
+
+
+def inert_variables(kin, amap, box: tuple[tuple[float, float], ...], samples: int = 8):
+    """Joint variables x_k that neither J nor h nor dh depends on.
+
+    At seeded points of ``box`` (one interval per variable), shifting x_k must leave J, h and dh
+    bitwise unchanged (NaN where undefined included): an expression without x_k evaluates the
+    same, one that merely cancels it would not and counts as dependent. A slice of h at x_k's
+    start value then does not depend on that value, nor do E1 (13) and E2 (18), whose integrands
+    are functions of J and dh. Maps that solve a problem per point are not probed (empty set),
+    nor is a vector map (None).
+    """
+    if amap is None or expensive_map(amap):
+        return frozenset()
+    lo, hi = np.array(box, dtype=float).T
+    X = np.random.default_rng(0).uniform(lo, hi, (samples, len(lo)))
+
+    def probe(x):
+        with np.errstate(all="ignore"):
+            return (kin.jacobian(x), amap.value_masked(x)[0], amap.gradient_masked(x)[0])
+
+    inert = set()
+    try:
+        at = probe(X)
+        for k in range(len(lo)):
+            shifted = X.copy()
+            shifted[:, k] += 0.371 * (hi[k] - lo[k])
+            again = probe(shifted)
+            if all(np.array_equal(a, b, equal_nan=True) for a, b in zip(at, again, strict=True)):
+                inert.add(k)
+    except (JikError, ValueError, ArithmeticError):  # a map that cannot be probed: all matter
+        return frozenset()
+    return frozenset(inert)
+
+
+_inert_cache: dict[str, frozenset[int]] = {}
+
+
+def state_inert_variables(state: DashboardState) -> frozenset[int]:
+    """:func:`inert_variables` of the state's kinematics and map over the robot's x_range
+    (cached per robot, map and parameters)."""
+    d = state.as_dict()
+    keys = ("robot", "robot_parameters", "augmentation", "augmentation_parameters")
+    key = json.dumps({k: d[k] for k in keys}, sort_keys=True)
+    if key not in _inert_cache:
+        kin, amap = kinematics_and_map(state)
+        box = state_spec(state).x_range or ((-1.0, 1.0),) * kin.p
+        if len(_inert_cache) >= 64:  # (slider values of l, a, b: keep the recent ones)
+            del _inert_cache[next(iter(_inert_cache))]
+        _inert_cache[key] = inert_variables(kin, amap, box)
+    return _inert_cache[key]
+
+
+def functionals_key(state: DashboardState) -> str:
+    """Everything E1, E2 and their sensitivity depend on (see :func:`error_functionals`).
+
+    On a robot's design region: the robot, the map and the start values of the variables
+    outside the region (held fixed) that J, h or dh depends on (:func:`inert_variables`); the path,
+    the cycles, gamma and the rest of x0 do not matter. Without a design region the box follows
+    the runs: everything they depend on.
+    """
+    spec = state_spec(state)
+    design = spec.functional_region
+    if not design:
+        return cache_key(state, "extended")
+    d = state.as_dict()
+    inert = state_inert_variables(state)
+    fixed = {
+        n: d["x0"][k]
+        for k, n in enumerate(spec.variable_names)
+        if n not in design and k not in inert
+    }
+    return json.dumps(
+        {k: d[k] for k in ("robot", "robot_parameters", "augmentation", "augmentation_parameters")}
+        | {"fixed": fixed},
+        sort_keys=True,
+    )
+
+
+#: E1 and E2 are taken by a tensor Gauss rule over at most this many region variables.
+MAX_QUADRATURE_VARIABLES = 3
+
+
+def error_functionals(
+    result: DashboardResult,
+    nodes: int = 12,
+    on_step: Callable[[], None] | None = None,
+    cancelled: Callable[[], bool] = lambda: False,
+) -> dict | None:
+    """E1 (13) and E2 (18) of the current map, or None if unavailable.
+
+    Over the robot's design region from the registry (the boxes of sec. 5, the ones
+    ``jik reproduce`` uses) where it has one, so the values do not move with the start point and
+    a synthesized map is judged on the box it was built for; else over the heat-map box.
+    ``on_step()`` after each of the two (progress; what it raises stops them). Over more than
+    three variables, E2 by a Sobol rule (:func:`~jik.app.dashboard.arm_e2.qmc_functionals`,
+    polling ``cancelled``).
+    """
+    grid = result.augmenting
+    if grid is None:
+        return None
+    if expensive_map(grid["map"]):
+        nodes = min(nodes, 6)
+    try:
+        from jik.engine.functionals import error_functional_e1, error_functional_e2
+    except ImportError:
+        return None
+    names = result.variable_names
+    i, j = grid["axes"]
+    design = state_spec(result.state).functional_region
+    region = dict(design) or {names[i]: tuple(grid["box"][0]), names[j]: tuple(grid["box"][1])}
+    fixed = {n: float(result.state.x0[k]) for k, n in enumerate(names) if n not in region}
+    out = {
+        "region": {k: list(v) for k, v in region.items()},
+        "fixed": fixed,
+        "nodes": nodes,
+        "design_region": bool(design),
+    }
+    if len(region) > MAX_QUADRATURE_VARIABLES:  # (nodes ** 7 points for a 7-joint arm)
+        return qmc_functionals(grid, region, fixed, out, cancelled, on_step)
+    for key, fn in (("E1", error_functional_e1), ("E2", error_functional_e2)):
+        try:
+            value = fn(grid["kinematics"], grid["map"], region, nodes=nodes, fixed=fixed)
+            out[key] = value.value if np.isfinite(value.value) else None
+            out[f"{key}_singular_points"] = int(value.singular_points.shape[0])
+        except (JikError, ValueError, ArithmeticError) as exc:
+            out[key] = None
+            out[f"{key}_error"] = str(exc)
+        if on_step is not None:
+            on_step()
+    return out
+
+
+#: Values of each parameter in the E1/E2 sweep of the dashboard (over v - 1 .. v + 1).
+SENSITIVITY_SAMPLES = 11
+
+
+def sensitivity_evaluations(state: DashboardState, amap) -> int:
+    """How many values of E1 or E2 :func:`sensitivity` computes for ``state`` and its map
+    ``amap`` (its steps of progress): none for an expensive map or a design region over more
+    variables than a tensor rule takes (E2 from a Sobol rule alone, no sweep); else both
+    functionals at every point of the parameters' sweeps, or of each of the robot's maps."""
+    if amap is None or expensive_map(amap):
+        return 0
+    spec = state_spec(state)
+    if len(spec.functional_region) > MAX_QUADRATURE_VARIABLES:
+        return 0
+    params = spec.augmentation(state.augmentation).parameters
+    if params:
+        return 2 * (1 + len(params) * (2 + SENSITIVITY_SAMPLES))
+    return 2 * len(spec.augmentations)
+
+
+def sensitivity(
+    result: DashboardResult,
+    functionals: dict | None,
+    cancelled: Callable[[], bool] = lambda: False,
+    progress: Callable[[int, int], None] | None = None,
+) -> dict:
+    """How E1 (13) and E2 (18) change with the parameters of the current map.
+
+    Over the same box and fixed variables as ``functionals`` (see :func:`error_functionals`):
+
+    * a map with parameters (C1, C2 or a, b): ``{"kind": "parameters", "parameters": {...},
+      "E1": ..., "E2": ...}``, each from :func:`jik.engine.functionals.parameter_sensitivity`
+      (the value, the gradient and a sweep of every parameter over v - 1 .. v + 1);
+    * a map without parameters: ``{"kind": "alternatives", "maps": [{"name", "E1", "E2",
+      "current"}]}``, the functionals of every map the robot offers, at their defaults;
+    * ``{"kind": "unavailable", "reason": ...}`` when they cannot be evaluated here.
+
+    ``cancelled`` is polled before every evaluation of a functional (raises :class:`Cancelled`);
+    ``progress(done, total)`` follows each of the :func:`sensitivity_evaluations`.
+    """
+    grid = result.augmenting
+    if grid is None:
+        note = vector_note(result.state)
+        return {"kind": "unavailable", "reason": note or "h could not be evaluated on a grid"}
+    if functionals is None:
+        return {"kind": "unavailable", "reason": "E1, E2 could not be evaluated"}
+    if functionals.get("E2_single_joint") is not None:  # (E2 by a Sobol rule, many joints)
+        return single_joint_sensitivity(functionals)
+    state = result.state
+    if expensive_map(grid["map"]):
+        return {
+            "kind": "unavailable",
+            "reason": "each value of E1, E2 of this map solves a "
+            "collocation problem per node: no sweep in the dashboard",
+        }
+    if functionals.get("E1") is None and functionals.get("E2") is None:
+        return {"kind": "unavailable", "reason": "E1, E2 are undefined on this box"}
+    from jik.engine.functionals import (
+        error_functional_e1,
+        error_functional_e2,
+        parameter_sensitivity,
+    )
+
+    spec = state_spec(state)
+    kin, nodes, fixed = grid["kinematics"], functionals["nodes"], functionals["fixed"]
+    region = {k: tuple(v) for k, v in functionals["region"].items()}
+    aug = spec.augmentation(state.augmentation)
+
+    def build(other, **params):
+        if cancelled():
+            raise Cancelled
+        return other.build(kin, **params)
+
+    total = sensitivity_evaluations(state, grid["map"])
+
+    def report(done: int) -> None:
+        if progress is not None:
+            progress(done, total)
+
+    try:
+        if aug.parameters:
+            out: dict = {"kind": "parameters", "parameters": dict(state.augmentation_parameters)}
+            for k, key in enumerate(("E1", "E2")):
+
+                def evaluated(done: int, n: int, k: int = k) -> None:
+                    report(k * n + done)
+
+                out[key] = parameter_sensitivity(
+                    kin,
+                    lambda **p: build(aug, **p),
+                    state.augmentation_parameters,
+                    region,
+                    functional=key.lower(),
+                    span=1.0,
+                    samples=SENSITIVITY_SAMPLES,
+                    nodes=nodes,
+                    fixed=fixed,
+                    on_evaluation=evaluated,
+                )
+            return out
+        maps = []
+        for m, other in enumerate(spec.augmentations):
+            amap = build(other, **{p.name: p.default for p in other.parameters})
+            if expensive_map(amap):
+                report(2 * m + 2)
+                continue
+            row: dict = {"name": other.name, "current": other.name == aug.name}
+            for key, fn in (("E1", error_functional_e1), ("E2", error_functional_e2)):
+                try:
+                    v = fn(kin, amap, region, nodes=nodes, fixed=fixed).value
+                    row[key] = float(v) if np.isfinite(v) else None
+                except (JikError, ValueError, ArithmeticError):
+                    row[key] = None
+            maps.append(row)
+            report(2 * m + 2)
+        return {"kind": "alternatives", "maps": maps}
+    except (JikError, ValueError, ArithmeticError) as exc:
+        return {"kind": "unavailable", "reason": str(exc)}
