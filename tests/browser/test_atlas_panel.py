@@ -55,6 +55,8 @@ def screenshots(page, name: str) -> None:
         page.set_viewport_size(size)
 
 
+# (CI's slow step: among the longest browser checks; the default run stays under 8 minutes)
+@pytest.mark.slow
 def test_the_atlas_computes_cancels_and_moves_the_main_view_to_a_clicked_start(tabs):
     """Manipulator 2 on the closed path. The first atlas shows its progress and a Cancel
     button; Cancel hides them, the panel says cancelled and the server forgets the job. The

@@ -56,6 +56,8 @@ def test_the_iteration_cap_is_a_control_the_message_names(tabs):
     expect(verdict).to_contain_text("extended Jacobian J^E#: repeatable")
 
 
+# (CI's slow step: among the longest browser checks; the default run stays under 8 minutes)
+@pytest.mark.slow
 def test_the_second_phase_shows_its_progress_and_can_be_cancelled(tabs):
     """The unicycle from pose B over T = 20 s: after its runs are drawn, h by characteristics on
     a grid, then E1, E2 take a second or two. The header shows what is computed and how far; cancel

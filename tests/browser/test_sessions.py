@@ -29,6 +29,8 @@ def seen(tab) -> dict:
     }
 
 
+# (CI's slow step: among the longest browser checks; the default run stays under 8 minutes)
+@pytest.mark.slow
 def test_changes_in_one_tab_leave_another_as_it_was(tabs):
     """A robot switch, a new gamma and a drag of the start point in tab A's scene change nothing
     in tab B (its URL, controls, plots, session); a tab opened afterwards has the defaults."""

@@ -14,6 +14,8 @@ expect = pytest.importorskip("playwright.sync_api", reason="playwright not insta
 pytestmark = pytest.mark.browser
 
 
+# (CI's slow step: among the longest browser checks; the default run stays under 8 minutes)
+@pytest.mark.slow
 def test_unicycle_from_b_shows_the_engines_message(tabs):
     """Unicycle, q0 = B: the extended Jacobian's h is undefined after a few iterations. The
     page shows that message in the verdict, says the result is the current one, and no
