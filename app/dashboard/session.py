@@ -24,6 +24,7 @@ from jik.app.dashboard.ahead import SolvingAhead
 from jik.app.dashboard.analysis import expensive_map
 from jik.app.dashboard.controls import controls_message
 from jik.app.dashboard.figures import gamma_free_panels
+from jik.app.dashboard.listeners import Listeners
 from jik.app.dashboard.map_synthesis import built_map
 from jik.app.dashboard.messages import Event, digest, finite, summary, to_json, with_figures
 from jik.app.dashboard.model import (
@@ -49,7 +50,7 @@ from jik.engine.exceptions import InvalidInputError, JikError
 log = logging.getLogger("jik.dashboard")
 
 
-class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts):
+class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
     """One session's live dashboard: one state, a worker thread, and subscribers.
 
     Parameters
@@ -195,56 +196,6 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts):
         self.start()
         return generation, state
 
-    def subscribe(
-        self, listener: Callable[[Event], None], *, last: bool = False
-    ) -> Callable[[], None]:
-        """Call ``listener(event)`` on every event (from the worker thread); replay the latest.
-
-        ``last``: a slow listener (the 3D scene draws in it) is called after the others, so
-        that it does not hold up the events queued for the page.
-        """
-        with self._cond:
-            if last:
-                self._listeners.append(listener)
-            else:
-                self._listeners.insert(self._fast, listener)
-                self._fast += 1
-            kinds = ["state", "result", "functionals"]
-            if self._failed():  # (a newer generation failed: a new viewer sees why)
-                kinds.append("error")
-            latest = [self._latest[k] for k in kinds if k in self._latest]
-            latest += [e for r, e in self._latest_ahead.items() if r != self._state.robot]
-        for event in latest:
-            listener(event)
-        self.start()
-
-        def unsubscribe() -> None:
-            with self._cond:
-                if listener in self._listeners:
-                    if self._listeners.index(listener) < self._fast:
-                        self._fast -= 1
-                    self._listeners.remove(listener)
-
-        return unsubscribe
-
-    def wait(self, generation: int | None = None, timeout: float = 30.0) -> bool:
-        """Block until the computation of ``generation`` (default: current) has finished."""
-        self.start()
-        deadline = time.monotonic() + timeout
-        with self._cond:
-            target = self._generation if generation is None else generation
-            while self._done < target:
-                left = deadline - time.monotonic()
-                if left <= 0:
-                    return False
-                self._cond.wait(left)
-        return True
-
-    def _failed(self) -> bool:
-        """Whether the latest error is newer than the result on screen (call with the lock)."""
-        error, result = self._latest.get("error"), self._latest.get("result")
-        return error is not None and (result is None or error.generation > result.generation)
-
     def snapshot(self) -> dict:
         """The current state, the summary of the last result, and the error of a newer
         generation that failed (None when the result is the newest computed)."""
@@ -273,14 +224,6 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts):
             "source": source,
             **controls_message(state),
         }
-
-    def _emit(self, event: Event) -> None:
-        with self._cond:
-            if event.kind in ("state", "result", "functionals", "error"):
-                self._latest[event.kind] = event
-            listeners = list(self._listeners)
-        for listener in listeners:
-            listener(event)
 
     def _work(self) -> None:
         while True:
