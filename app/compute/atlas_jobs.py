@@ -24,24 +24,13 @@ import time
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
-import numpy as np
-
-from jik.app.compute.atlas_pool import PoolBackend, sized_chunks
+from jik.app.compute.atlas_plan import AtlasLimits, plan_request, result_document
+from jik.app.compute.atlas_pool import PoolBackend
 from jik.app.compute.atlas_schemas import AtlasJobResponse, AtlasRequest
-from jik.app.compute.documents import nullable
-from jik.app.compute.exceptions import RequestError
-from jik.app.compute.robot_requests import build_augmentation, build_robot, check_task_point
-from jik.app.compute.schemas.algorithms import field_of, used
-from jik.app.compute.user_robots import is_user_robot, user_inverse, user_robot
-from jik.app.compute.worker import task
-from jik.engine.atlas import AtlasPlan, plan_atlas
-from jik.engine.atlas_run import AtlasResult, run_atlas
-from jik.engine.exceptions import InvalidInputError, RunCancelled
+from jik.engine.atlas import AtlasPlan
+from jik.engine.atlas_run import run_atlas
+from jik.engine.exceptions import RunCancelled
 from jik.engine.progress import ProgressCallbacks
-from jik.engine.registry import ALGORITHMS, make_inverse
-from jik.engine.repeatability import CLOSE_TOL
-from jik.engine.self_motion import MAX_ARC
-from jik.engine.solve_rules import gamma_problem
 
 
 class AtlasJobNotFound(LookupError):
@@ -53,167 +42,6 @@ class AtlasJobsFull(RuntimeError):
 
 
 Status = Literal["queued", "running", "done", "failed", "cancelled"]
-
-
-@dataclass(frozen=True)
-class AtlasLimits:
-    max_jobs: int = 16
-    max_running: int = 1
-    per_client: int = 2
-    #: legs of one job, runs x cycles x legs x algorithms (under a minute of one core at 0.04 ms
-    #: a leg, ``jik bench atlas``)
-    max_work: int = 1_200_000
-    #: legs of one job whose ends are sent back (3 numbers each in the JSON: about 12 MB)
-    max_leg_ends: int = 200_000
-    #: seconds a job is kept after it ends
-    keep_for: float = 600.0
-
-
-def _own_parameters(algorithm: str, req: AtlasRequest) -> dict:
-    """Those of ``req.algorithm_parameters`` that are the algorithm's own."""
-    own = {p.name for p in ALGORITHMS[algorithm].parameters} | set(ALGORITHMS[algorithm].vectors)
-    return {k: v for k, v in used(req.algorithm_parameters).items() if k in own}
-
-
-def _inverses(req: AtlasRequest) -> tuple[Any, list]:
-    """The robot's spec and the inverse of each algorithm: a catalogue robot built by the
-    registry, a definition or catalogue arm by the engine (:func:`user_robot`, the extended
-    inverse with the request's map or the robot's default)."""
-    if len(set(req.algorithms)) != len(req.algorithms):
-        raise RequestError("algorithms", f"name each algorithm once, got {req.algorithms}")
-    if is_user_robot(req.robot):
-        extended = "extended" in req.algorithms
-        robot, _, _ = user_robot(req.robot, req.augmentation if extended else None)
-        inverses = [user_inverse(robot, a, _own_parameters(a, req)) for a in req.algorithms]
-        return robot.spec, inverses
-    spec, kin, _ = build_robot(req.robot)
-    inverses = []
-    for algorithm in req.algorithms:
-        if algorithm == "extended":
-            aspec, _, aug = build_augmentation(spec, kin, req.augmentation)
-            inverses.append(make_inverse(kin, "extended", aspec.name, aug.parameters, spec.name))
-            continue
-        try:
-            inverses.append(
-                make_inverse(
-                    kin, algorithm, spec=spec, algorithm_parameters=_own_parameters(algorithm, req)
-                )
-            )
-        except InvalidInputError as exc:
-            raise RequestError(field_of(exc.field, str(exc)), str(exc)) from None
-    return spec, inverses
-
-
-def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
-    """The request's atlas, planned (curves traced); RequestError or InvalidInputError, each
-    naming the field, when it cannot be."""
-    spec, inverses = _inverses(req)
-    loops = not hasattr(inverses[0].kinematics, "path")  # (the unicycle's path is no loop)
-    path = req.path or loops * [list(t) for t in spec.default_path]
-    if not path:
-        raise RequestError("path", f"{spec.name} has no default closed path: give path")
-    named = [(f"path[{i}]", v) for i, v in enumerate(path)]
-    named += [(f"shifts[{i}]", v) for i, v in enumerate(req.shifts or [])]
-    for name, v in named:
-        check_task_point(spec, v, name)
-    for i, x in enumerate(req.start_points or []):
-        if len(x) != spec.p:
-            raise RequestError(f"start_points[{i}]", f"must have {spec.p} components, got {len(x)}")
-    if req.reference and len(req.reference) != spec.p:
-        raise RequestError("reference", f"must have {spec.p} components, got {len(req.reference)}")
-    gamma = spec.default_gamma if req.gamma is None else req.gamma
-    mode = req.mode or spec.default_mode
-    if (why := gamma_problem(gamma, mode)) is not None:
-        raise RequestError("gamma", why)
-    paths = len(req.shifts or [0]) * len(req.scales or [0])
-    closed = np.linalg.norm(np.subtract(path[-1], path[0])) <= CLOSE_TOL
-    starts = len(req.start_points) if req.start_points else req.starts
-    legs = starts * paths * req.cycles * (len(path) - closed) * len(req.algorithms)
-    if legs > limits.max_work:
-        raise RequestError(
-            "starts",
-            f"starts x paths x cycles x legs x algorithms = {legs} is more than "
-            f"{limits.max_work}; ask for fewer starts or cycles (or run `jik atlas` for larger "
-            "atlases)",
-        )
-    if req.leg_ends and legs > limits.max_leg_ends:
-        raise RequestError(
-            "leg_ends",
-            f"the ends of {legs} legs are more than the {limits.max_leg_ends} a "
-            "response carries; ask for the drift alone or a smaller atlas",
-        )
-    try:
-        return _plan(req, spec, inverses, path, gamma, mode)
-    except InvalidInputError as exc:
-        if exc.field != "starts":
-            raise
-        text = str(exc).replace("give the starts explicitly", "give start_points")
-        if not req.start_points:
-            raise RequestError("starts", text) from None
-        # (the engine's starts are the request's start_points: name the entry)
-        entry = re.match(r"starts\[(\d+)\] ", text)
-        if entry is None:
-            raise RequestError("start_points", text) from None
-        raise RequestError(f"start_points[{entry[1]}]", text[entry.end() :]) from None
-
-
-def _plan(req: AtlasRequest, spec, inverses, path, gamma, mode) -> AtlasPlan:
-    return plan_atlas(
-        inverses,
-        path,
-        cycles=req.cycles,
-        n_starts=req.starts,
-        starts=req.start_points,
-        arc=req.arc or (-MAX_ARC, MAX_ARC),
-        sampling=req.sampling,
-        seed=req.seed,
-        reference=req.reference or spec.default_x0,
-        box=None if req.arc else spec.x_range,
-        shifts=req.shifts,
-        scales=req.scales,
-        gamma=gamma,
-        mode=mode,
-        tol=req.tolerance,
-    )
-
-
-@task(
-    "reference",
-    "another reference or path (eq. (7) from the reference to the path's first point ran out "
-    "of memory)",
-)
-def plan_task(req: str, limits: AtlasLimits):
-    """:func:`plan_request` of a request (JSON) as a compute worker's task, within the workers'
-    time and memory limits (tracing the curves solves eq. (7)), its chunks sized for the pool
-    (:func:`sized_chunks`): the plan and None, or None and the refusal (message, field), for the
-    server to raise again."""
-    try:
-        return sized_chunks(plan_request(AtlasRequest.model_validate_json(req), limits)), None
-    except InvalidInputError as exc:
-        return None, (str(exc), exc.field)
-
-
-def result_document(res: AtlasResult, arc, leg_ends: bool) -> dict[str, Any]:
-    """The fields of :class:`jik.app.compute.atlas_schemas.AtlasResult`."""
-    algs = res.algorithms
-    failures: dict[str, dict[str, str]] = {a: {} for a in algs}
-    for (a, j, i), why in res.failures.items():
-        failures[algs[a]][f"{j},{i}"] = why
-    legs = res.leg_ends if leg_ends else None
-    return {
-        "algorithms": list(algs),
-        "arc": list(arc),
-        "paths": res.paths.tolist(),
-        "parameter": [] if res.parameter is None else res.parameter.tolist(),
-        "starts": res.starts.tolist(),
-        "drift": {a: nullable(res.drift[k]) for k, a in enumerate(algs)},
-        "success": {a: res.success[k].tolist() for k, a in enumerate(algs)},
-        "failures": failures,
-        "leg_ends": None if legs is None else {a: nullable(legs[k]) for k, a in enumerate(algs)},
-        "outside_limits": None
-        if res.outside_limits is None
-        else {a: int(res.outside_limits[k].sum()) for k, a in enumerate(algs)},
-    }
 
 
 @dataclass
@@ -433,4 +261,4 @@ class AtlasJobs:
         job.ended = time.monotonic()
 
 
-__all__ = ["AtlasJobNotFound", "AtlasJobs", "AtlasJobsFull", "AtlasLimits"]
+__all__ = ["AtlasJobNotFound", "AtlasJobs", "AtlasJobsFull"]

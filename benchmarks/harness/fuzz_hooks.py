@@ -57,7 +57,7 @@ except ImportError as exc:
     ) from exc
 
 from jik.app.compute import schemas as S
-from jik.app.compute.atlas_jobs import AtlasLimits, plan_request
+from jik.app.compute.atlas_plan import AtlasLimits, plan_request
 from jik.app.compute.atlas_schemas import AtlasRequest
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.requests import _check_start, _setup

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from jik.app.compute.atlas_jobs import AtlasLimits, plan_request
+from jik.app.compute.atlas_plan import AtlasLimits, plan_request
 from jik.app.compute.atlas_schemas import AtlasRequest
 from jik.engine.atlas_run import run_atlas
 from tests.app.conftest import TABLE1_PATH, X0_M2, messages, solve_body

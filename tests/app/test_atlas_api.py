@@ -10,12 +10,8 @@ import pytest
 from fastapi.testclient import TestClient
 
 from jik.app.api.factory import create_app
-from jik.app.compute.atlas_jobs import (
-    AtlasJobNotFound,
-    AtlasJobs,
-    AtlasLimits,
-    plan_request,
-)
+from jik.app.compute.atlas_jobs import AtlasJobNotFound, AtlasJobs
+from jik.app.compute.atlas_plan import AtlasLimits, plan_request
 from jik.app.compute.atlas_pool import PoolBackend
 from jik.app.compute.atlas_schemas import AtlasRequest
 from jik.app.compute.pool import pool_in_thread

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from pydantic import TypeAdapter
 
-from jik.app.compute.atlas_jobs import AtlasLimits, plan_request, result_document
+from jik.app.compute.atlas_plan import AtlasLimits, plan_request, result_document
 from jik.app.compute.atlas_schemas import AtlasBody
 from jik.engine.arms import ARMS
 from jik.engine.atlas_run import run_atlas

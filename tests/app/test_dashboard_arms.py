@@ -10,7 +10,7 @@ import json
 import numpy as np
 import pytest
 
-from jik.app.compute.atlas_jobs import AtlasLimits, plan_request
+from jik.app.compute.atlas_plan import AtlasLimits, plan_request
 from jik.app.dashboard.atlas import atlas_figure, atlas_request
 from jik.app.dashboard.controls import controls
 from jik.app.dashboard.joint_limits import limits_summary, outside_joints, state_limits

@@ -132,7 +132,8 @@ def test_a_queued_atlas_says_what_it_waits_for():
     the order they came (the queue's wait was invisible in the job's status)."""
     from fastapi.testclient import TestClient
 
-    from jik.app.compute.atlas_jobs import AtlasJobs, AtlasLimits
+    from jik.app.compute.atlas_jobs import AtlasJobs
+    from jik.app.compute.atlas_plan import AtlasLimits
 
     app = create_app(Settings(workers=1, timeout=60.0))
     app.state.atlas_jobs = AtlasJobs(AtlasLimits(max_jobs=4, per_client=3), app.state.pool)

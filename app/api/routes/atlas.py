@@ -11,7 +11,8 @@ from fastapi import APIRouter, Depends, Request, Response
 from starlette.concurrency import run_in_threadpool
 
 from jik.app.api.dependencies import Pool
-from jik.app.compute.atlas_jobs import AtlasJob, AtlasJobs, AtlasLimits, plan_task
+from jik.app.compute.atlas_jobs import AtlasJob, AtlasJobs
+from jik.app.compute.atlas_plan import AtlasLimits, plan_task
 from jik.app.compute.atlas_schemas import AtlasBody, AtlasJobResponse
 from jik.app.compute.pool import ComputePool
 from jik.app.compute.schemas import ErrorResponse
