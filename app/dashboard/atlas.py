@@ -23,7 +23,7 @@ from jik.app.dashboard.algorithms import STYLES, inverse_parameters
 from jik.app.dashboard.analysis import kinematics_and_map
 from jik.app.dashboard.model import DashboardState
 from jik.app.dashboard.plotting import AXIS, UNITS, figure, norm_unit
-from jik.app.dashboard.robots import state_spec
+from jik.app.dashboard.robots import state_spec, user_robot
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS
 from jik.engine.self_motion import project
@@ -115,6 +115,10 @@ def request_robot(state: DashboardState) -> tuple[dict, dict | None]:
             {"name": state.augmentation, **state.augmentation_parameters},
         )
     definition = dict(state.robot_definition)
+    if not definition.get("augmentations"):  # (the map the dashboard adds, if it added one)
+        built = user_robot(definition).definition
+        if built.get("name") == definition.get("name") and built.get("augmentations"):
+            definition["augmentations"] = built["augmentations"]
     entries = definition.pop("augmentations", None) or []
     if state.augmentation == state_spec(state).default_augmentation:
         chosen = entries[0] if entries else None

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -335,3 +336,20 @@ def test_a_posture_atlas_pulls_each_run_toward_its_own_start(client):
         )
         assert r.status_code == 200, r.text
         np.testing.assert_allclose(posture[i], r.json()["drift"], rtol=1e-8, atol=1e-12)
+
+
+def test_a_session_atlas_of_a_urdf_robot_does_not_send_its_text_back(client):
+    """The request a session's atlas repeats names a URDF by its size and SHA-256, as every
+    response does: the text is never echoed."""
+    pytest.importorskip("yourdfpy")
+    text = (Path(__file__).parents[1] / "data" / "arm4.urdf").read_text()
+    definition = {"name": "urdf", "urdf": text, "end_link": "tool"}
+    sid = _session(client, robot="urdf", robot_definition=definition)
+    r = client.post(f"/api/sessions/{sid}/atlas", json={"starts": 3, "cycles": 1})
+    assert r.status_code == 202, r.text
+    done = wait_until_ended(client, r.json()["id"])
+    assert done["status"] == "done", done["error"]
+    response = client.get(f"/api/sessions/{sid}/atlas/{done['id']}")
+    assert "<robot" not in response.text and "link name" not in response.text
+    robot = response.json()["request"]["robot"]
+    assert robot["urdf_bytes"] == len(text.encode()) and "urdf" not in robot

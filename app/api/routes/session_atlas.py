@@ -21,6 +21,7 @@ from jik.app.api.dependencies import Pool, Store
 from jik.app.api.routes.atlas import ERRORS, Jobs, start_job
 from jik.app.compute.atlas_schemas import MAX_CYCLES, MAX_FAMILY, AtlasJobResponse, Scale
 from jik.app.compute.schemas import INTEGRAL
+from jik.app.compute.user_robots import echo
 from jik.app.dashboard.atlas import atlas_figure, atlas_request
 from jik.app.dashboard.plotting import figure_json
 from jik.engine.exceptions import InvalidInputError
@@ -86,6 +87,13 @@ async def read_session_atlas(session_id: str, job_id: str, store: Store, jobs: J
             figure=json.loads(figure_json(figure)),
             starts=job.result["starts"],
             paths=job.result["paths"],
-            request=job.request.model_dump(mode="json"),
+            request=_echoed(job.request.model_dump(mode="json")),
         )
     return JSONResponse(body)
+
+
+def _echoed(request: dict) -> dict:
+    """The request as a response repeats it: a URDF robot's text named by its size and SHA-256
+    (:func:`jik.app.compute.user_robots.echo`), never sent back."""
+    robot = request.get("robot")
+    return {**request, "robot": echo(robot)} if isinstance(robot, dict) else request
