@@ -28,8 +28,10 @@ PHASES = "examples,fuzzing"
 
 #: schemathesis's settings file: a session's event stream (``GET /api/sessions/{id}/events``)
 #: never ends, so its first event is the answer (schemathesis otherwise reads 20 events or until
-#: its request timeout, a minute of heartbeats for an idle session).
-CONFIG = "max-stream-events = 1\n"
+#: its request timeout, a minute of heartbeats for an idle session). A response may take the
+#: server's own bound, twice JIK_TIMEOUT (a wait for a worker, then the computation: a catalogue
+#: arm's atlas synthesizes its map while it plans), not schemathesis's default 10 s.
+CONFIG = "max-stream-events = 1\n\n[checks]\nmax_response_time = 40.0\n"
 
 
 @dataclass

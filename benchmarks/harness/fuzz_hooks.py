@@ -34,9 +34,10 @@ The sessions' operations get, in their positive cases, the id of a live session 
 made again when a case has deleted it or it expired; a new one for each ``DELETE``), so that they
 reach the sessions' code instead of answering 404.
 
-Every case also has its work capped (cycles, iterations, path points, grid and node counts, and
-coordinates and boxes within +-3, where the unicycle's quadrature stays small), so that the run
-measures the API, not the machine: the time and memory limits have tests of their own.
+Every case also has its work capped (cycles, iterations, path points, grid and node counts,
+coordinates and boxes within +-3, where the unicycle's quadrature stays small, and the posture
+inverse's gain), so that the run measures the API, not the machine: the time and memory limits
+have tests of their own.
 """
 
 from __future__ import annotations
@@ -93,6 +94,9 @@ MAX_FAMILY = 2
 #: Largest |coordinate| of a start, target or path point sent (the unicycle's controls of
 #: amplitude 10 took over a minute a solve).
 MAX_COORDINATE = 3.0
+#: The posture inverse's gain sent (its pull toward the rest posture, up to the engine's 100 per
+#: unit of path, drives the unicycle's controls far beyond +-3 within one leg).
+MAX_GAIN = 1.0
 
 
 def _clamped(v):
@@ -126,6 +130,9 @@ def _capped(body: dict) -> dict:
     if isinstance(augmentation, dict) and len(augmentation.get("region") or {}) > 3:
         # a total-degree synthesis' work grows as C(n + d, d)^2: total degree 2 over 4-16 joints
         body["augmentation"] = {**body["augmentation"], "degree": 2}
+    params = body.get("algorithm_parameters")
+    if isinstance(params, dict) and isinstance(params.get("gain"), int | float):
+        body["algorithm_parameters"] = {**params, "gain": min(params["gain"], MAX_GAIN)}
     robot = body.get("robot")
     if isinstance(robot, dict):
         body["robot"] = {

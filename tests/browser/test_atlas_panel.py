@@ -128,6 +128,8 @@ def test_an_atlas_the_state_cannot_have_is_refused_in_words_in_the_panel(tabs):
     expect(tab.page.locator("#atlas-progress-box")).to_be_hidden()
 
 
+# (CI's slow step: among the longest browser checks; the default run stays under 8 minutes)
+@pytest.mark.slow
 def test_an_atlas_after_a_cancel_starts_at_once(tabs):
     """Cancel an atlas while its workers compute a chunk: the next atlas starts at once (its
     job running within seconds, the panel never saying it waits for another atlas), not after

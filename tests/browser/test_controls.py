@@ -18,6 +18,8 @@ def refused_path(point: str) -> str:
     )
 
 
+# (CI's slow step: among the longest browser checks; the default run stays under 8 minutes)
+@pytest.mark.slow
 def test_a_refused_value_shows_in_both_with_the_value_in_force(tabs):
     """An unreadable closed path typed on the page, then in the scene, is refused: the page's
     status and the scene's status say so, and the page's box, the scene's box and the server

@@ -11,6 +11,8 @@ expect = pytest.importorskip("playwright.sync_api", reason="playwright not insta
 pytestmark = pytest.mark.browser
 
 
+# (CI's slow step: among the longest browser checks; the default run stays under 8 minutes)
+@pytest.mark.slow
 def test_c1_c2_one_click_away_and_a_singular_map_says_where(tabs):
     """Manipulator 1's default view shows a button per map; one click on e1_optimal (32) shows
     C1 and C2. C2 = -1 makes g(x1) of (32) vanish near x1 = 0.48 inside the design region: the

@@ -66,6 +66,8 @@ def test_changes_in_one_tab_leave_another_as_it_was(tabs):
     assert c.robot == "manipulator2"
 
 
+# (CI's slow step: among the longest browser checks; the default run stays under 8 minutes)
+@pytest.mark.slow
 def test_a_copied_link_opens_the_same_view(tabs):
     """The link that #copy-link puts on the clipboard opens, in a fresh browser, a new session
     with the same state, the same controls and the same numbers."""
@@ -97,6 +99,8 @@ def test_a_copied_link_opens_the_same_view(tabs):
         )
 
 
+# (CI's slow step: among the longest browser checks; the default run stays under 8 minutes)
+@pytest.mark.slow
 def test_a_tab_whose_session_ended_opens_a_new_one_with_its_state(tabs):
     """The server ends a session (expired, or the server restarted): its page notices that the
     session is gone and opens a new one from the state in its link, with the same numbers."""
