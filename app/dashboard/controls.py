@@ -136,19 +136,7 @@ def controls(state) -> list[Control]:
         ),
     ]
     out.append(iterations_control(state))
-    for p in spec.parameters:
-        out.append(
-            Control(
-                f"robot_parameters.{p.name}",
-                p.name,
-                "slider",
-                "algorithm",
-                explained(p.name, p.description),
-                minimum=p.minimum,
-                maximum=p.maximum,
-                step=(p.maximum - p.minimum) / SLIDER_STEPS,
-            )
-        )
+    out += _sliders("robot_parameters", spec.parameters)
     for v in spec.vector_parameters:
         out.append(
             Control(
@@ -192,19 +180,7 @@ def controls(state) -> list[Control]:
         ("algorithm_parameters", scalar_parameters(state.algorithms)),
     )
     for head, parameters in groups:
-        for p in parameters:
-            out.append(
-                Control(
-                    f"{head}.{p.name}",
-                    p.name,
-                    "slider",
-                    "algorithm",
-                    explained(p.name, p.description),
-                    minimum=p.minimum,
-                    maximum=p.maximum,
-                    step=(p.maximum - p.minimum) / SLIDER_STEPS,
-                )
-            )
+        out += _sliders(head, parameters)
         if head == "augmentation_parameters":
             out.append(
                 Control(
@@ -370,3 +346,21 @@ def controls_message(state) -> dict[str, Any]:
         "controls": [c.as_dict() for c in spec],
         "values": control_values(state, spec),
     }
+
+
+def _sliders(head: str, parameters) -> list[Control]:
+    """A slider per scalar parameter (:class:`~jik.engine.parameters.Parameter`: its name,
+    description and range), keyed ``head.name``."""
+    return [
+        Control(
+            f"{head}.{p.name}",
+            p.name,
+            "slider",
+            "algorithm",
+            explained(p.name, p.description),
+            minimum=p.minimum,
+            maximum=p.maximum,
+            step=(p.maximum - p.minimum) / SLIDER_STEPS,
+        )
+        for p in parameters
+    ]
