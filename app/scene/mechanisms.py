@@ -261,15 +261,15 @@ def layout_name(state) -> str:
 
 
 # Every line (traces, grid) is sized in pixels: viser's world-unit lines solve a ray-segment
-# distance per fragment and redraw each line in a second blended pass; the four traces of a
-# manipulator doubled the cost of a frame in software WebGL (no GPU).
+# distance per fragment and redraw each line in a second blended pass, for no visible gain at
+# the dashboard's zoom (frame costs: docs/benchmarks.md, "Dashboard latency").
 
 
 def add_floor_grid(scene, half: float = 10.0, cell: float = 0.5, section: float = 1.0) -> None:
     """A grid on the task plane (z slightly below 0) drawn as two sets of line segments.
 
-    viser's ``add_grid`` shades every pixel of its plane; in software WebGL (no GPU) that is a
-    fifth of each frame, line segments cost next to nothing.
+    viser's ``add_grid`` shades every pixel of its plane; line segments draw the same grid at
+    the cost of its lines only.
     """
     ticks = np.arange(-half, half + cell / 2, cell)
     on_section = np.isclose(np.remainder(ticks + half, section), 0.0) | np.isclose(
