@@ -21,13 +21,13 @@ ratios of one run.
 
 from __future__ import annotations
 
-import statistics
 import time
 from typing import cast
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
+from jik.benchmarks.bench_solver import median_time
 from jik.engine.arms import ARMS
 from jik.engine.dop853 import ATOL, RTOL
 from jik.engine.inverses import Pseudoinverse
@@ -38,15 +38,6 @@ from jik.engine.urdf import UrdfChain
 TOL = 1e-10
 #: The leg: from home, 8 cm along x and 8 cm along y, a turn of 0.2 rad about z and 0.15 about x.
 MOVE = np.array([0.08, 0.08, 0.0, 0.15, 0.0, 0.2])
-
-
-def _median(fn, repeat: int) -> float:
-    times = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times)
 
 
 def _interleaved(fns: dict, calls: int, repeat: int) -> dict:
@@ -126,18 +117,20 @@ def run(quick: bool = False) -> dict | None:
     X = np.array(arm.home) + np.random.default_rng(8).uniform(-0.5, 0.5, (4096, 7))
     loop_n = 512 if quick else 4096
     batch = {
-        "jik": _median(lambda: kin.forward_jacobian(X), reps) / len(X),
-        "pinocchio_loop": _median(lambda: [pose.forward_jacobian(q) for q in X[:loop_n]], 3)
+        "jik": median_time(lambda: kin.forward_jacobian(X), reps) / len(X),
+        "pinocchio_loop": median_time(lambda: [pose.forward_jacobian(q) for q in X[:loop_n]], 3)
         / loop_n,
     }
     x0 = np.array(arm.home)
     y_d = kin.forward(x0) + MOVE
     inverse = Pseudoinverse(kin)
     res = solve(inverse, x0, y_d, tol=TOL, record=False)
-    leg = {"jik": _median(lambda: solve(inverse, x0, y_d, tol=TOL, record=False), reps)}
+    leg = {"jik": median_time(lambda: solve(inverse, x0, y_d, tol=TOL, record=False), reps)}
     ends = {"jik": res.x}
     for method in ("RK45", "DOP853"):
-        leg[f"solve_ivp_{method}"] = _median(lambda m=method: _pinocchio_leg(pose, x0, y_d, m), 3)
+        leg[f"solve_ivp_{method}"] = median_time(
+            lambda m=method: _pinocchio_leg(pose, x0, y_d, m), 3
+        )
         ends[method], _ = _pinocchio_leg(pose, x0, y_d, method)
     return {
         "agree": agree,
