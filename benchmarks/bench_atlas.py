@@ -27,11 +27,11 @@ import time
 
 import numpy as np
 
-from jik.engine.atlas import plan_atlas
-from jik.engine.atlas_run import iter_atlas, run_atlas
-from jik.engine.inverses import Pseudoinverse
-from jik.engine.kinematics import Manipulator2
-from jik.engine.repeatability import repeatability
+from ..engine.atlas import plan_atlas
+from ..engine.atlas_run import iter_atlas, run_atlas
+from ..engine.inverses import Pseudoinverse
+from ..engine.kinematics import Manipulator2
+from ..engine.repeatability import repeatability
 
 X0 = (0.0, 0.0, math.pi / 2)
 LOOP = [(0.0, 1.0), (1.0, 1.0), (1.0, 2.0), (0.0, 2.0)]

@@ -22,13 +22,13 @@ import time
 
 import numpy as np
 
-from jik.app.compute.pool import pool_in_thread
-from jik.app.compute.settings import Settings
-from jik.app.dashboard import Offload, OffloadLane, compute, default_state, updated_state
-from jik.app.dashboard.figures import figure_specs
-from jik.app.dashboard.messages import summary
-from jik.app.dashboard.plotting import figure_json
-from jik.app.dashboard.verdict import verdict
+from ..app.compute.pool import pool_in_thread
+from ..app.compute.settings import Settings
+from ..app.dashboard import Offload, OffloadLane, compute, default_state, updated_state
+from ..app.dashboard.figures import figure_specs
+from ..app.dashboard.messages import summary
+from ..app.dashboard.plotting import figure_json
+from ..app.dashboard.verdict import verdict
 
 ROBOTS = ("manipulator2", "manipulator1", "unicycle")
 

@@ -15,9 +15,9 @@ import time
 
 import numpy as np
 
-from jik.app.dashboard import compute, default_state
-from jik.app.dashboard.figures import figure_specs, figures_for
-from jik.app.dashboard.plotting import PANELS, figure_json
+from ..app.dashboard import compute, default_state
+from ..app.dashboard.figures import figure_specs, figures_for
+from ..app.dashboard.plotting import PANELS, figure_json
 
 ROBOTS = ("manipulator2", "manipulator1", "unicycle")
 

@@ -43,8 +43,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from jik.app.dashboard.controls import element_id
-from jik.benchmarks.latency_server import EventStream, Machine, quiet, served
+from ..app.dashboard.controls import element_id
+from .latency_server import EventStream, Machine, quiet, served
 
 CHROMIUM = "/usr/bin/chromium"
 #: The targets: p95 of a change [ms], by family.
@@ -192,7 +192,7 @@ def server_only(base: str, pid: int, sessions: list[list[Change]]) -> list[dict]
 
 def _browser_missing() -> str:
     """Why the browser's half cannot run here, or ""."""
-    from jik.benchmarks import CHECKOUT_HINT, has_harness
+    from . import CHECKOUT_HINT, has_harness
 
     if not has_harness():
         return CHECKOUT_HINT
@@ -239,7 +239,7 @@ def run(quick: bool = False) -> dict:
         if skipped:
             out["browser_skipped"] = skipped
         else:
-            from jik.benchmarks.harness.browser_latency import browser
+            from .harness.browser_latency import browser
 
             samples = browser(base, proc.pid, sessions)
             out["browser"] = summarize(samples, ("plots_ms", "scene_ms", "compute_ms"), "mode")

@@ -170,9 +170,9 @@ async def _load(url: str, duration: float, clients: int, path: str = "/solve") -
 
 async def _pool_load(duration: float, clients: int, batching: bool) -> dict:
     """The same load on the compute pool in-process: the computation path without HTTP."""
-    from jik.app.compute.pool import ComputePool
-    from jik.app.compute.schemas import SolveRequest
-    from jik.app.compute.settings import settings_from_env
+    from ..app.compute.pool import ComputePool
+    from ..app.compute.schemas import SolveRequest
+    from ..app.compute.settings import settings_from_env
 
     pool = ComputePool(settings_from_env().model_copy(update={"batching": batching}))
     try:

@@ -22,7 +22,7 @@ import multiprocessing
 import time
 from typing import Any
 
-from jik.benchmarks.bench_load import CLIENTS, _bodies, _summary
+from .bench_load import CLIENTS, _bodies, _summary
 
 DURATION = 10.0
 QUICK_DURATION = 3.0
@@ -34,7 +34,7 @@ async def _drive(send, duration: float, clients: int) -> dict:
     errs: list[str] = []
 
     async def client(k: int, stop: float) -> None:
-        from jik.app.compute.schemas import SolveRequest
+        from ..app.compute.schemas import SolveRequest
 
         reqs = [SolveRequest.model_validate(b) for b in _bodies(64, seed=k)]
         i = 0
@@ -53,8 +53,8 @@ async def _drive(send, duration: float, clients: int) -> dict:
 
 
 async def _jik(duration: float, clients: int, batching: bool) -> dict:
-    from jik.app.compute.pool import ComputePool
-    from jik.app.compute.settings import Settings
+    from ..app.compute.pool import ComputePool
+    from ..app.compute.settings import Settings
 
     pool = ComputePool(Settings(workers=2, batching=batching))
     try:
@@ -75,8 +75,8 @@ async def _pebble(duration: float, clients: int, batching: bool) -> dict:
             "errors": "pebble is not installed",
         }
 
-    from jik.app.compute.worker import solve_batch
-    from jik.engine.atlas_backends import limit_memory
+    from ..app.compute.worker import solve_batch
+    from ..engine.atlas_backends import limit_memory
 
     pool = pebble.ProcessPool(
         max_workers=2,

@@ -23,13 +23,13 @@ import time
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from jik.engine.augmentations import PaperCubic
-from jik.engine.dop853 import ATOL, RTOL
-from jik.engine.inverses import ExtendedInverse, Pseudoinverse
-from jik.engine.kinematics import Manipulator2
-from jik.engine.picard_guesses import chain_guesses
-from jik.engine.repeatability import closed_path, repeatability
-from jik.engine.solver import solve
+from ..engine.augmentations import PaperCubic
+from ..engine.dop853 import ATOL, RTOL
+from ..engine.inverses import ExtendedInverse, Pseudoinverse
+from ..engine.kinematics import Manipulator2
+from ..engine.picard_guesses import chain_guesses
+from ..engine.repeatability import closed_path, repeatability
+from ..engine.solver import solve
 
 X0 = np.array([0.0, 0.0, math.pi / 2])
 PATH = np.array([(1.0, 1.0), (1.0, 2.0), (0.0, 2.0), (0.0, 1.0)])

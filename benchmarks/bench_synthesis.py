@@ -18,9 +18,9 @@ from typing import TypeVar, cast
 import numpy as np
 from numpy.polynomial import legendre as L
 
-from jik.engine.inverses import pseudoinverse
-from jik.engine.kinematics import Manipulator2
-from jik.engine.variational import (
+from ..engine.inverses import pseudoinverse
+from ..engine.kinematics import Manipulator2
+from ..engine.variational import (
     EXTRA_NODES,
     MANIPULATOR2_DEGREE,
     MANIPULATOR2_REGION,

@@ -22,13 +22,13 @@ from typing import TypeVar, cast
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from jik.engine.augmentations import AugmentingMap
-from jik.engine.characteristics import UnicycleCharacteristics
-from jik.engine.inverses import ExtendedInverse
-from jik.engine.kinematics import kernel_cofactors
-from jik.engine.reproductions import unicycle as repro
-from jik.engine.solver import solve
-from jik.engine.unicycle import Unicycle
+from ..engine.augmentations import AugmentingMap
+from ..engine.characteristics import UnicycleCharacteristics
+from ..engine.inverses import ExtendedInverse
+from ..engine.kinematics import kernel_cofactors
+from ..engine.reproductions import unicycle as repro
+from ..engine.solver import solve
+from ..engine.unicycle import Unicycle
 
 PREFIX_ITERATIONS = 8
 TARGETS = {"h_and_gradient_ms": 5.0, "extended_run_a_s": 1.0, "reproduction_s": 10.0}

@@ -27,13 +27,13 @@ from typing import cast
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from jik.benchmarks.bench_solver import median_time
-from jik.engine.arms import ARMS
-from jik.engine.dop853 import ATOL, RTOL
-from jik.engine.inverses import Pseudoinverse
-from jik.engine.robot_spec import robot_from_dict
-from jik.engine.solver import solve
-from jik.engine.urdf import UrdfChain
+from ..engine.arms import ARMS
+from ..engine.dop853 import ATOL, RTOL
+from ..engine.inverses import Pseudoinverse
+from ..engine.robot_spec import robot_from_dict
+from ..engine.solver import solve
+from ..engine.urdf import UrdfChain
+from .bench_solver import median_time
 
 TOL = 1e-10
 #: The leg: from home, 8 cm along x and 8 cm along y, a turn of 0.2 rad about z and 0.15 about x.

@@ -234,12 +234,12 @@ sys.modules[__name__].__class__ = _Engine
 
 
 if TYPE_CHECKING:  # what the names are, for type checkers and editors (no import at run time)
-    from jik.engine.arms import ARMS
-    from jik.engine.atlas import AtlasPlan, plan_atlas
-    from jik.engine.atlas_run import AtlasResult, iter_atlas, run_atlas
-    from jik.engine.augmentations import AugmentingMap, E1Optimal, E2Optimal, PaperCubic
-    from jik.engine.characteristics import CharacteristicsMap, UnicycleCharacteristics
-    from jik.engine.exceptions import (
+    from .arms import ARMS
+    from .atlas import AtlasPlan, plan_atlas
+    from .atlas_run import AtlasResult, iter_atlas, run_atlas
+    from .augmentations import AugmentingMap, E1Optimal, E2Optimal, PaperCubic
+    from .characteristics import CharacteristicsMap, UnicycleCharacteristics
+    from .exceptions import (
         AlgorithmicSingularityError,
         InvalidInputError,
         JikError,
@@ -248,21 +248,21 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
         RunCancelled,
         SingularConfigurationError,
     )
-    from jik.engine.extended_vector import VectorExtendedInverse
-    from jik.engine.formula_kinematics import FormulaKinematics, FormulaMap
-    from jik.engine.functionals import error_functional_e1, error_functional_e2
-    from jik.engine.inverses import ExtendedInverse, Inverse, Pseudoinverse
-    from jik.engine.kinematics import Kinematics, Manipulator1, Manipulator2
-    from jik.engine.limits import LimitsReport
-    from jik.engine.planar_chain import PlanarChain
-    from jik.engine.practical_inverses import DampedInverse, PostureInverse, WeightedInverse
-    from jik.engine.progress import Progress, ProgressCallbacks
-    from jik.engine.registry import ALGORITHMS, ROBOTS, make_inverse
-    from jik.engine.repeatability import Leg, Resume, repeatability
-    from jik.engine.results import BatchSolveResult, RepeatabilityResult, SolveResult, Trajectory
-    from jik.engine.robot_spec import Robot, load_robot, robot_from_dict
-    from jik.engine.solver import solve, solve_batch
-    from jik.engine.synthesis_nd import TotalDegreeSynthesis, synthesize_e2_nd
-    from jik.engine.unicycle import Unicycle
-    from jik.engine.urdf import UrdfChain
-    from jik.engine.variational import SynthesisResult, synthesize_e2
+    from .extended_vector import VectorExtendedInverse
+    from .formula_kinematics import FormulaKinematics, FormulaMap
+    from .functionals import error_functional_e1, error_functional_e2
+    from .inverses import ExtendedInverse, Inverse, Pseudoinverse
+    from .kinematics import Kinematics, Manipulator1, Manipulator2
+    from .limits import LimitsReport
+    from .planar_chain import PlanarChain
+    from .practical_inverses import DampedInverse, PostureInverse, WeightedInverse
+    from .progress import Progress, ProgressCallbacks
+    from .registry import ALGORITHMS, ROBOTS, make_inverse
+    from .repeatability import Leg, Resume, repeatability
+    from .results import BatchSolveResult, RepeatabilityResult, SolveResult, Trajectory
+    from .robot_spec import Robot, load_robot, robot_from_dict
+    from .solver import solve, solve_batch
+    from .synthesis_nd import TotalDegreeSynthesis, synthesize_e2_nd
+    from .unicycle import Unicycle
+    from .urdf import UrdfChain
+    from .variational import SynthesisResult, synthesize_e2

@@ -10,14 +10,14 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from jik.engine import practical_inverses as pinv
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.inverses import ExtendedInverse, Inverse, Pseudoinverse
-from jik.engine.kinematics import Kinematics
-from jik.engine.parameters import Parameter, check_params
+from . import practical_inverses as pinv
+from .exceptions import InvalidInputError
+from .inverses import ExtendedInverse, Inverse, Pseudoinverse
+from .kinematics import Kinematics
+from .parameters import Parameter, check_params
 
 if TYPE_CHECKING:
-    from jik.engine.registry import RobotSpec
+    from .registry import RobotSpec
 
 
 @dataclass(frozen=True)
@@ -109,7 +109,7 @@ ALGORITHMS: dict[str, AlgorithmSpec] = {
 
 def _robot_limits(kinematics: Kinematics, spec: RobotSpec | None, robot: str | None):
     """The robot's joint limits; else the catalogue's box of configurations."""
-    from jik.engine.registry import ROBOTS  # the robots' catalogue imports this module
+    from .registry import ROBOTS  # the robots' catalogue imports this module
 
     limits = getattr(kinematics, "limits", None)
     if limits is not None:
@@ -125,7 +125,7 @@ def _robot_limits(kinematics: Kinematics, spec: RobotSpec | None, robot: str | N
 
 def _robot_rest(kinematics: Kinematics, spec: RobotSpec | None, robot: str | None):
     """The robot's home configuration; else its default start x0 in the catalogue."""
-    from jik.engine.registry import ROBOTS
+    from .registry import ROBOTS
 
     home = getattr(kinematics, "home", None)
     if home is not None:
@@ -177,7 +177,7 @@ def make_inverse(
             return pinv.PostureInverse(kinematics, vectors["rest"], values["gain"])
         rest = _robot_rest(kinematics, spec, robot)
         return pinv.PostureInverse(kinematics, rest, values["gain"], rest_given=False)
-    from jik.engine.registry import robot_spec
+    from .registry import robot_spec
 
     aspec = (spec or robot_spec(robot or kinematics.name)).augmentation(augmentation)
     return ExtendedInverse(kinematics, aspec.build(kinematics, **(augmentation_parameters or {})))

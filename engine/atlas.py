@@ -24,13 +24,13 @@ from typing import Any
 
 import numpy as np
 
-from jik.engine.exceptions import InvalidInputError, SingularConfigurationError
-from jik.engine.inverses import Inverse, Pseudoinverse
-from jik.engine.repeatability import CLOSE_TOL, MAX_CYCLES, MAX_PATH_POINTS
-from jik.engine.self_motion import SelfMotionManifold, project, trace
-from jik.engine.solve_rules import MAX_ITERATIONS_LIMIT, MODES, check_gamma
-from jik.engine.solver import solve_batch
-from jik.engine.validation import FloatArray, as_points, count, positive
+from .exceptions import InvalidInputError, SingularConfigurationError
+from .inverses import Inverse, Pseudoinverse
+from .repeatability import CLOSE_TOL, MAX_CYCLES, MAX_PATH_POINTS
+from .self_motion import SelfMotionManifold, project, trace
+from .solve_rules import MAX_ITERATIONS_LIMIT, MODES, check_gamma
+from .solver import solve_batch
+from .validation import FloatArray, as_points, count, positive
 
 #: Largest number of starts per path, of paths in a family, and of starts in a chunk.
 MAX_STARTS = 10**9

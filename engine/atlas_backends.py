@@ -19,7 +19,7 @@ from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from typing import Any, Protocol
 
-from jik.engine.exceptions import InvalidInputError
+from .exceptions import InvalidInputError
 
 #: Chunks in flight per worker: one running, one queued so a worker never waits for the caller.
 IN_FLIGHT = 2

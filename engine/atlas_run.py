@@ -15,17 +15,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from jik.engine.atlas import AtlasPlan
-from jik.engine.atlas_backends import Backend, backend_for
-from jik.engine.exceptions import SingularConfigurationError
-from jik.engine.inverses import Inverse
-from jik.engine.limits import robot_limits, starts_outside
-from jik.engine.posture_at_start import PostureAtStart
-from jik.engine.practical_inverses import PostureInverse
-from jik.engine.progress import Progress, check_cancelled
-from jik.engine.repeatability import repeatability
-from jik.engine.results import dataframe
-from jik.engine.validation import FloatArray
+from .atlas import AtlasPlan
+from .atlas_backends import Backend, backend_for
+from .exceptions import SingularConfigurationError
+from .inverses import Inverse
+from .limits import robot_limits, starts_outside
+from .posture_at_start import PostureAtStart
+from .practical_inverses import PostureInverse
+from .progress import Progress, check_cancelled
+from .repeatability import repeatability
+from .results import dataframe
+from .validation import FloatArray
 
 #: Starts per batched repeatability() call within a chunk: the working set of the Picard sweeps
 #: then stays in cache (``jik bench atlas``, docs/benchmarks.md: 512 is faster than 2048),

@@ -13,8 +13,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.validation import FloatArray, finite
+from .exceptions import InvalidInputError
+from .validation import FloatArray, finite
 
 
 class AugmentingMap(abc.ABC):

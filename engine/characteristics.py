@@ -17,20 +17,20 @@ from typing import Any
 
 import numpy as np
 
-from jik.engine.augmentations import AugmentingMap
-from jik.engine.collocation import (
+from .augmentations import AugmentingMap
+from .collocation import (
     COLLOCATION_NODES,
     LinearHomotopy,
     collocation,
     moments_ignore,
     solve_characteristics,
 )
-from jik.engine.exceptions import InvalidInputError, OneFormUndefinedError, format_vector
-from jik.engine.kinematics import Kinematics
-from jik.engine.one_form import check_index
-from jik.engine.progress import Progress, check_cancelled
-from jik.engine.unicycle import Unicycle
-from jik.engine.validation import FloatArray, as_vector, count, finite
+from .exceptions import InvalidInputError, OneFormUndefinedError, format_vector
+from .kinematics import Kinematics
+from .one_form import check_index
+from .progress import Progress, check_cancelled
+from .unicycle import Unicycle
+from .validation import FloatArray, as_vector, count, finite
 
 #: Warm-start Newton from the previous characteristics when x moved by at most this (max norm).
 WARM_RADIUS = 0.5

@@ -14,10 +14,10 @@ from typing import Any
 
 import numpy as np
 
-from jik.engine.kinematics import Kinematics
-from jik.engine.one_form import derivatives, one_form_parts
-from jik.engine.unicycle import Unicycle
-from jik.engine.validation import FloatArray, as_vector, count
+from .kinematics import Kinematics
+from .one_form import derivatives, one_form_parts
+from .unicycle import Unicycle
+from .validation import FloatArray, as_vector, count
 
 #: Default number of collocation nodes in s (including s = 0 and s = 1).
 COLLOCATION_NODES = 24

@@ -14,11 +14,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from jik.engine.solve_rules import DIVERGED_NORM, Record, Status
-from jik.engine.validation import FloatArray
+from .solve_rules import DIVERGED_NORM, Record, Status
+from .validation import FloatArray
 
 if TYPE_CHECKING:
-    from jik.engine.inverses import Inverse
+    from .inverses import Inverse
 
 #: Stages of one step (the 13th evaluation, at the new point, is the next step's first).
 N_STAGES = 12

@@ -21,13 +21,13 @@ from collections.abc import Mapping
 import numpy as np
 from scipy.stats import qmc
 
-from jik.engine.augmentations import AugmentingMap
-from jik.engine.exceptions import InvalidInputError, KinematicSingularityError
-from jik.engine.functionals import Region, check_region
-from jik.engine.kinematics import Kinematics
-from jik.engine.progress import Progress, check_cancelled
-from jik.engine.synthesis_nd import CHUNK, MAX_NODES, kernel_frame
-from jik.engine.validation import count
+from .augmentations import AugmentingMap
+from .exceptions import InvalidInputError, KinematicSingularityError
+from .functionals import Region, check_region
+from .kinematics import Kinematics
+from .progress import Progress, check_cancelled
+from .synthesis_nd import CHUNK, MAX_NODES, kernel_frame
+from .validation import count
 
 
 def e2_qmc(

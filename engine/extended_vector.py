@@ -13,16 +13,16 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from jik.engine.augmentations import AugmentingMap
-from jik.engine.exceptions import AlgorithmicSingularityError, InvalidInputError
-from jik.engine.inverses import (
+from .augmentations import AugmentingMap
+from .exceptions import AlgorithmicSingularityError, InvalidInputError
+from .inverses import (
     SINGULAR_EXTENDED,
     Inverse,
     extended_singularity,
     solve_extended,
 )
-from jik.engine.kinematics import Kinematics
-from jik.engine.validation import FloatArray
+from .kinematics import Kinematics
+from .validation import FloatArray
 
 
 class VectorExtendedInverse(Inverse):

@@ -32,7 +32,7 @@ from fractions import Fraction
 
 import sympy as sp
 
-from jik.engine.exceptions import FormulaError, InvalidInputError
+from .exceptions import FormulaError, InvalidInputError
 
 #: Longest formula text accepted [characters].
 MAX_LENGTH = 2000

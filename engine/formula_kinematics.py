@@ -18,11 +18,11 @@ from fractions import Fraction
 import numpy as np
 import sympy as sp
 
-from jik.engine.augmentations import AugmentingMap
-from jik.engine.exceptions import FormulaError, InvalidInputError
-from jik.engine.formula import MAX_NAMES, check_name, parse_formula
-from jik.engine.kinematics import Kinematics
-from jik.engine.validation import FloatArray, json_number
+from .augmentations import AugmentingMap
+from .exceptions import FormulaError, InvalidInputError
+from .formula import MAX_NAMES, check_name, parse_formula
+from .kinematics import Kinematics
+from .validation import FloatArray, json_number
 
 #: Largest average size (tree nodes) of a formula's first or second derivatives, per entry. The
 #: derivative of an ordinary formula is about as large as the formula (a 16-link chain's

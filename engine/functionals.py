@@ -18,9 +18,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from jik.engine.augmentations import AugmentingMap
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.inverses import (
+from .augmentations import AugmentingMap
+from .exceptions import InvalidInputError
+from .inverses import (
     SINGULAR_EXTENDED,
     extended_inverse,
     extended_jacobian,
@@ -28,8 +28,8 @@ from jik.engine.inverses import (
     pseudoinverse,
     require_compatible,
 )
-from jik.engine.kinematics import Kinematics
-from jik.engine.validation import FloatArray, count, finite
+from .kinematics import Kinematics
+from .validation import FloatArray, count, finite
 
 # name -> (lo, hi); any two-item sequence (JSON gives lists), validated by check_region.
 Region = Mapping[str, Sequence[float]]

@@ -11,15 +11,15 @@ import abc
 
 import numpy as np
 
-from jik.engine.augmentations import AugmentingMap
-from jik.engine.exceptions import (
+from .augmentations import AugmentingMap
+from .exceptions import (
     AlgorithmicSingularityError,
     InvalidInputError,
     KinematicSingularityError,
 )
-from jik.engine.kinematics import SINGULAR_MANIPULABILITY, Kinematics
-from jik.engine.linalg import gram, solve_small
-from jik.engine.validation import FloatArray
+from .kinematics import SINGULAR_MANIPULABILITY, Kinematics
+from .linalg import gram, solve_small
+from .validation import FloatArray
 
 #: |det [J; dh]| / (product of its row norms) below this counts as an algorithmic singularity.
 SINGULAR_EXTENDED = 1e-10

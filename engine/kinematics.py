@@ -10,8 +10,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from jik.engine.exceptions import InvalidInputError, KinematicSingularityError
-from jik.engine.validation import FloatArray, as_points, positive
+from .exceptions import InvalidInputError, KinematicSingularityError
+from .validation import FloatArray, as_points, positive
 
 #: m(x) below this counts as a kinematic singularity.
 SINGULAR_MANIPULABILITY = 1e-9

@@ -12,9 +12,9 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 from numpy.polynomial import legendre as L
 
-from jik.engine.augmentations import AugmentingMap
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.validation import FloatArray
+from .augmentations import AugmentingMap
+from .exceptions import InvalidInputError
+from .validation import FloatArray
 
 
 def _derivative_matrix(n: int) -> FloatArray:

@@ -14,8 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.validation import FloatArray
+from .exceptions import InvalidInputError
+from .validation import FloatArray
 
 
 def robot_limits(kinematics) -> FloatArray | None:

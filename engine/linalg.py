@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from jik.engine.validation import FloatArray
+from .validation import FloatArray
 
 
 def gram(J: FloatArray) -> FloatArray:

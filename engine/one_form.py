@@ -12,9 +12,9 @@ import itertools
 
 import numpy as np
 
-from jik.engine.exceptions import InvalidInputError, OneFormUndefinedError
-from jik.engine.kinematics import SINGULAR_MANIPULABILITY, Kinematics, kernel_cofactors
-from jik.engine.validation import FloatArray, count
+from .exceptions import InvalidInputError, OneFormUndefinedError
+from .kinematics import SINGULAR_MANIPULABILITY, Kinematics, kernel_cofactors
+from .validation import FloatArray, count
 
 #: |kernel component fixed_index| <= ONE_FORM_TOL |kernel| counts as "omega undefined" (so does a
 #: kinematic singularity, |kernel cofactors| = m(x) < SINGULAR_MANIPULABILITY).

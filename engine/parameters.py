@@ -5,8 +5,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.validation import finite
+from .exceptions import InvalidInputError
+from .validation import finite
 
 
 @dataclass(frozen=True)

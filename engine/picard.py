@@ -31,7 +31,7 @@ from functools import lru_cache
 import numpy as np
 from numpy.polynomial import chebyshev as C
 
-from jik.engine.validation import FloatArray
+from .validation import FloatArray
 
 #: Chebyshev degree per segment.
 DEGREE = 32

@@ -6,11 +6,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.inverses import Inverse
-from jik.engine.picard import Guess, picard_chain
-from jik.engine.results import Trajectory
-from jik.engine.solve_rules import check_gamma
+from .exceptions import InvalidInputError
+from .inverses import Inverse
+from .picard import Guess, picard_chain
+from .results import Trajectory
+from .solve_rules import check_gamma
 
 
 def picard_guesses(guess, n: int, p: int, gamma: float) -> list[Guess | None] | None:

@@ -18,9 +18,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.kinematics import Kinematics
-from jik.engine.validation import FloatArray, json_number
+from .exceptions import InvalidInputError
+from .kinematics import Kinematics
+from .validation import FloatArray, json_number
 
 #: Most joints a chain may have (the REST boundary refuses bigger robots).
 MAX_JOINTS = 32

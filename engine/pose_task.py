@@ -13,9 +13,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from jik.engine import so3
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.validation import FloatArray
+from . import so3
+from .exceptions import InvalidInputError
+from .validation import FloatArray
 
 COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
 _TOKEN = re.compile(r"r[xyz]|[xyz]")

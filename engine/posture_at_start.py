@@ -17,10 +17,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from jik.engine.inverses import Inverse
-from jik.engine.kinematics import Kinematics
-from jik.engine.practical_inverses import PostureInverse
-from jik.engine.validation import FloatArray
+from .inverses import Inverse
+from .kinematics import Kinematics
+from .practical_inverses import PostureInverse
+from .validation import FloatArray
 
 
 class RestCarrying(Kinematics):

@@ -20,11 +20,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from jik.engine.exceptions import InvalidInputError, KinematicSingularityError
-from jik.engine.inverses import Inverse, Pseudoinverse
-from jik.engine.kinematics import SINGULAR_MANIPULABILITY, Kinematics
-from jik.engine.linalg import gram, solve_small
-from jik.engine.validation import FloatArray, finite
+from .exceptions import InvalidInputError, KinematicSingularityError
+from .inverses import Inverse, Pseudoinverse
+from .kinematics import SINGULAR_MANIPULABILITY, Kinematics
+from .linalg import gram, solve_small
+from .validation import FloatArray, finite
 
 #: Largest damping lambda and damping threshold accepted.
 MAX_DAMPING = 10.0

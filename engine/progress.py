@@ -19,10 +19,10 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Protocol
 
-from jik.engine.exceptions import JikError, RunCancelled
+from .exceptions import JikError, RunCancelled
 
 if TYPE_CHECKING:
-    from jik.engine.repeatability import Leg
+    from .repeatability import Leg
 
 
 class Progress(Protocol):

@@ -11,19 +11,19 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Literal
 
-from jik.engine import augmentations as aug
-from jik.engine.algorithm_registry import ALGORITHMS as ALGORITHMS
-from jik.engine.algorithm_registry import AlgorithmSpec as AlgorithmSpec
-from jik.engine.algorithm_registry import make_inverse as make_inverse
-from jik.engine.augmentations import AugmentingMap
-from jik.engine.characteristics import UnicycleCharacteristics
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.kinematics import Kinematics, Manipulator1, Manipulator2
-from jik.engine.parameters import Parameter as Parameter
-from jik.engine.parameters import check_params as _check_params
-from jik.engine.unicycle import Unicycle
-from jik.engine.validation import finite
-from jik.engine.variational import MANIPULATOR2_REGION, default_manipulator2_synthesis
+from . import augmentations as aug
+from .algorithm_registry import ALGORITHMS as ALGORITHMS
+from .algorithm_registry import AlgorithmSpec as AlgorithmSpec
+from .algorithm_registry import make_inverse as make_inverse
+from .augmentations import AugmentingMap
+from .characteristics import UnicycleCharacteristics
+from .exceptions import InvalidInputError
+from .kinematics import Kinematics, Manipulator1, Manipulator2
+from .parameters import Parameter as Parameter
+from .parameters import check_params as _check_params
+from .unicycle import Unicycle
+from .validation import finite
+from .variational import MANIPULATOR2_REGION, default_manipulator2_synthesis
 
 
 @dataclass(frozen=True)

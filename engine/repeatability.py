@@ -19,15 +19,15 @@ from typing import Any
 
 import numpy as np
 
-from jik.engine.exceptions import InvalidInputError, JikError, format_vector
-from jik.engine.inverses import Inverse
-from jik.engine.picard_guesses import chain_guesses
-from jik.engine.progress import Progress, check_cancelled, stops_at
-from jik.engine.results import BatchSolveResult, RepeatabilityResult, SolveResult, Trajectory
-from jik.engine.solve_chunks import solve_in_chunks
-from jik.engine.solver import solve, solve_batch
-from jik.engine.unicycle import Unicycle
-from jik.engine.validation import FloatArray, count
+from .exceptions import InvalidInputError, JikError, format_vector
+from .inverses import Inverse
+from .picard_guesses import chain_guesses
+from .progress import Progress, check_cancelled, stops_at
+from .results import BatchSolveResult, RepeatabilityResult, SolveResult, Trajectory
+from .solve_chunks import solve_in_chunks
+from .solver import solve, solve_batch
+from .unicycle import Unicycle
+from .validation import FloatArray, count
 
 #: Largest number of cycles and of path points accepted.
 #: A run is called repeatable when its joints come back to x0 within this after every cycle

@@ -14,9 +14,9 @@ from typing import Any
 
 import numpy as np
 
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.inverses import Inverse
-from jik.engine.validation import FloatArray
+from .exceptions import InvalidInputError
+from .inverses import Inverse
+from .validation import FloatArray
 
 
 def short_vector(v, digits: int = 4) -> str:

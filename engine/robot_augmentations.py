@@ -5,20 +5,20 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 
-from jik.engine import robot_kinds
-from jik.engine.augmentations import AugmentingMap
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.formula_kinematics import FormulaMap
-from jik.engine.functionals import check_region
-from jik.engine.kinematics import Kinematics
-from jik.engine.registry import AugmentationSpec
-from jik.engine.robot_synthesis import (
+from . import robot_kinds
+from .augmentations import AugmentingMap
+from .exceptions import InvalidInputError
+from .formula_kinematics import FormulaMap
+from .functionals import check_region
+from .kinematics import Kinematics
+from .registry import AugmentationSpec
+from .robot_synthesis import (
     TENSOR_DEGREE,
     TOTAL_DEGREE,
     synthesis,
     vector_synthesis,
 )
-from jik.engine.validation import count
+from .validation import count
 
 
 def augmentations_from_dict(kin: Kinematics, items, key: str | None = None):

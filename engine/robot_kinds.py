@@ -202,7 +202,7 @@ KINDS: dict[str, tuple[DefinitionField, ...]] = {
 def keys(kind: str) -> set[str]:
     """The keys a definition of ``kind`` may have (its own and the common ones); a catalogue
     arm's are :data:`ARM`'s."""
-    from jik.engine.arms import ARMS
+    from .arms import ARMS
 
     own = ARM if kind in ARMS else KINDS.get(kind, ())
     return {f.name for f in (*own, *COMMON)}

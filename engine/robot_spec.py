@@ -28,15 +28,15 @@ from typing import Any
 
 import numpy as np
 
-from jik.engine import robot_kinds
-from jik.engine.arms import ARMS
-from jik.engine.augmentations import AugmentingMap
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.extended_vector import VectorExtendedInverse
-from jik.engine.formula_kinematics import FormulaKinematics
-from jik.engine.inverses import Inverse
-from jik.engine.kinematics import Kinematics
-from jik.engine.limits import (
+from . import robot_kinds
+from .arms import ARMS
+from .augmentations import AugmentingMap
+from .exceptions import InvalidInputError
+from .extended_vector import VectorExtendedInverse
+from .formula_kinematics import FormulaKinematics
+from .inverses import Inverse
+from .kinematics import Kinematics
+from .limits import (
     LimitsReport,
     check_limits,
     limit_names,
@@ -44,12 +44,12 @@ from jik.engine.limits import (
     robot_limits,
     solve_report,
 )
-from jik.engine.planar_chain import PlanarChain
-from jik.engine.registry import ROBOTS, RobotSpec, make_inverse
-from jik.engine.repeatability import MAX_PATH_POINTS
-from jik.engine.robot_augmentations import augmentations_from_dict
-from jik.engine.robot_synthesis import arm_augmentations
-from jik.engine.validation import as_points
+from .planar_chain import PlanarChain
+from .registry import ROBOTS, RobotSpec, make_inverse
+from .repeatability import MAX_PATH_POINTS
+from .robot_augmentations import augmentations_from_dict
+from .robot_synthesis import arm_augmentations
+from .validation import as_points
 
 #: Largest robot file read by :func:`load_robot` [bytes].
 MAX_FILE_BYTES = 2_000_000
@@ -144,7 +144,7 @@ def _kinematics(kind: str, d: Mapping, base_dir: Path | None) -> Kinematics:
             _get(d, "task", list, "a list of formulas, one per task component"),
             _get(d, "parameters", dict, "a mapping of names to numbers", {}),
         )
-    from jik.engine.urdf import UrdfChain  # (imports nothing of yourdfpy until it builds)
+    from .urdf import UrdfChain  # (imports nothing of yourdfpy until it builds)
 
     if "urdf" in d and "urdf_file" in d:
         raise InvalidInputError("give urdf (the text) or urdf_file, not both", "urdf")
@@ -162,7 +162,7 @@ def _kinematics(kind: str, d: Mapping, base_dir: Path | None) -> Kinematics:
 
 def _urdf_file(d: Mapping, base_dir: Path | None) -> str:
     """The text of ``urdf_file``, a path relative to the robot file's folder, inside it."""
-    from jik.engine.urdf import MAX_URDF_BYTES
+    from .urdf import MAX_URDF_BYTES
 
     if base_dir is None:
         raise InvalidInputError(

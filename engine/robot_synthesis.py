@@ -17,11 +17,11 @@ from collections.abc import Callable, Iterator, Mapping
 
 import numpy as np
 
-from jik.engine.augmentations import AugmentingMap
-from jik.engine.kinematics import Kinematics
-from jik.engine.progress import Progress
-from jik.engine.synthesis_nd import synthesize_e2_nd
-from jik.engine.variational import synthesize_e2
+from .augmentations import AugmentingMap
+from .kinematics import Kinematics
+from .progress import Progress
+from .synthesis_nd import synthesize_e2_nd
+from .variational import synthesize_e2
 
 
 def synthesis(box: dict, fix: dict, degree: int, key: str | None) -> Callable[..., AugmentingMap]:

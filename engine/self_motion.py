@@ -22,10 +22,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import OdeSolution, solve_ivp
 
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.inverses import Pseudoinverse
-from jik.engine.kinematics import Kinematics
-from jik.engine.validation import FloatArray, finite
+from .exceptions import InvalidInputError
+from .inverses import Pseudoinverse
+from .kinematics import Kinematics
+from .validation import FloatArray, finite
 
 #: Tolerances of the traced orbit (relative and absolute, on x).
 TRACE_TOL = 1e-12

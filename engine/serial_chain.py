@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from jik.engine.validation import FloatArray
+from .validation import FloatArray
 
 #: E (9, 3) with (z d^T).ravel() @ E = z x d: the cross product as one matrix product.
 _LEVI_CIVITA = np.zeros((3, 3, 3))

@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from jik.engine.validation import FloatArray
+from .validation import FloatArray
 
 #: Below this angle [rad] the series of the log and its derivative replace the closed forms.
 SMALL_ANGLE = 1e-4

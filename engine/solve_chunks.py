@@ -9,12 +9,12 @@ from dataclasses import replace
 
 import numpy as np
 
-from jik.engine.exceptions import InvalidInputError, JikError
-from jik.engine.inverses import Inverse
-from jik.engine.results import SolveResult, Trajectory
-from jik.engine.solve_rules import MAX_ITERATIONS, MAX_ITERATIONS_LIMIT, Status, stop_message
-from jik.engine.solver import solve_batch
-from jik.engine.validation import FloatArray, count
+from .exceptions import InvalidInputError, JikError
+from .inverses import Inverse
+from .results import SolveResult, Trajectory
+from .solve_rules import MAX_ITERATIONS, MAX_ITERATIONS_LIMIT, Status, stop_message
+from .solver import solve_batch
+from .validation import FloatArray, count
 
 
 def solve_in_chunks(

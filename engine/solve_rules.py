@@ -6,8 +6,8 @@ request schemas and dashboard, which word their errors with :func:`gamma_problem
 
 from __future__ import annotations
 
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.validation import FloatArray, positive
+from .exceptions import InvalidInputError
+from .validation import FloatArray, positive
 
 #: The smallest task-error tolerance ``tol`` of a solve (double precision).
 TOL_MIN = 1e-14

@@ -17,13 +17,13 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from jik.engine.dop853 import integrate
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.inverses import Inverse
-from jik.engine.picard import picard_path
-from jik.engine.picard_guesses import picard_guesses
-from jik.engine.results import BatchSolveResult, SolveResult, Trajectory
-from jik.engine.solve_rules import (
+from .dop853 import integrate
+from .exceptions import InvalidInputError
+from .inverses import Inverse
+from .picard import picard_path
+from .picard_guesses import picard_guesses
+from .results import BatchSolveResult, SolveResult, Trajectory
+from .solve_rules import (
     DIVERGED_NORM,
     MAX_ITERATIONS,
     MAX_ITERATIONS_LIMIT,
@@ -35,7 +35,7 @@ from jik.engine.solve_rules import (
     check_gamma,
     stop_message,
 )
-from jik.engine.validation import count, positive
+from .validation import count, positive
 
 #: Picard sweeps per member in method "auto" before DOP853 takes over.
 PICARD_BUDGET = 80

@@ -31,18 +31,18 @@ import numpy as np
 from scipy import linalg
 from scipy.stats import qmc
 
-from jik.engine.exceptions import InvalidInputError, KinematicSingularityError
-from jik.engine.functionals import Region, check_region
-from jik.engine.inverses import pseudoinverse
-from jik.engine.kinematics import Kinematics
-from jik.engine.progress import Progress, check_cancelled
-from jik.engine.total_degree import (
+from .exceptions import InvalidInputError, KinematicSingularityError
+from .functionals import Region, check_region
+from .inverses import pseudoinverse
+from .kinematics import Kinematics
+from .progress import Progress, check_cancelled
+from .total_degree import (
     TotalDegreeMap,
     basis_gradients,
     basis_size,
     total_degree_indices,
 )
-from jik.engine.validation import FloatArray, count
+from .validation import FloatArray, count
 
 #: Largest basis the synthesis assembles (its stiffness matrix is dense, unknowns^2 floats).
 MAX_UNKNOWNS = 4000

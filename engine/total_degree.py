@@ -16,8 +16,8 @@ from itertools import combinations_with_replacement
 import numpy as np
 from numpy.polynomial import legendre as L
 
-from jik.engine.augmentations import AugmentingMap
-from jik.engine.validation import FloatArray
+from .augmentations import AugmentingMap
+from .validation import FloatArray
 
 
 def total_degree_indices(d: int, n: int) -> np.ndarray:

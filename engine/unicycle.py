@@ -13,9 +13,9 @@ from typing import Literal, overload
 import numpy as np
 import scipy.special
 
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.kinematics import Kinematics
-from jik.engine.validation import FloatArray, as_points, as_vector, count, positive
+from .exceptions import InvalidInputError
+from .kinematics import Kinematics
+from .validation import FloatArray, as_points, as_vector, count, positive
 
 #: Gauss-Legendre nodes per quadrature panel (time grids of :meth:`Unicycle.path`).
 PANEL_NODES = 16

@@ -14,12 +14,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.kinematics import Kinematics
-from jik.engine.pose_task import PoseTask, parse_task, reference_rotation, task_text
-from jik.engine.serial_chain import ChainStep, CompiledChain
-from jik.engine.urdf_parse import MAX_URDF_BYTES, mesh_note, parse_urdf
-from jik.engine.validation import FloatArray, as_vector, json_number
+from .exceptions import InvalidInputError
+from .kinematics import Kinematics
+from .pose_task import PoseTask, parse_task, reference_rotation, task_text
+from .serial_chain import ChainStep, CompiledChain
+from .urdf_parse import MAX_URDF_BYTES, mesh_note, parse_urdf
+from .validation import FloatArray, as_vector, json_number
 
 __all__ = ["MAX_URDF_BYTES", "ChainJoint", "UrdfChain", "mesh_note", "parse_urdf"]
 

@@ -17,7 +17,7 @@ import io
 import logging
 import re
 
-from jik.engine.exceptions import InvalidInputError
+from .exceptions import InvalidInputError
 
 #: Largest URDF text accepted [bytes].
 MAX_URDF_BYTES = 1_000_000

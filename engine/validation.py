@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from jik.engine.exceptions import InvalidInputError
+from .exceptions import InvalidInputError
 
 FloatArray = np.ndarray
 

@@ -34,14 +34,14 @@ import numpy as np
 from numpy.polynomial import legendre as L
 from scipy import linalg
 
-from jik.engine.augmentations import Polynomial2
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.functionals import Region, check_region, error_functional_e2
-from jik.engine.inverses import pseudoinverse
-from jik.engine.kinematics import Kinematics, Manipulator2
-from jik.engine.legendre_map import SynthesizedMap, legendre_vander, lgl_nodes
-from jik.engine.progress import Progress, check_cancelled
-from jik.engine.validation import FloatArray, count
+from .augmentations import Polynomial2
+from .exceptions import InvalidInputError
+from .functionals import Region, check_region, error_functional_e2
+from .inverses import pseudoinverse
+from .kinematics import Kinematics, Manipulator2
+from .legendre_map import SynthesizedMap, legendre_vander, lgl_nodes
+from .progress import Progress, check_cancelled
+from .validation import FloatArray, count
 
 #: Extra Gauss points per variable beyond the basis degree (R is not polynomial, e.g. cos 2 x3).
 EXTRA_NODES = 8

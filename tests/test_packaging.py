@@ -149,6 +149,51 @@ def test_the_source_tree_holds_no_symlinks():
     assert not links, f"tracked symlinks: {links}"
 
 
+def _jik_imports(path: Path) -> list[ast.ImportFrom | ast.Import]:
+    """The imports in ``path`` of jik's own modules: relative ones, and absolute ``jik...``."""
+    found: list[ast.ImportFrom | ast.Import] = []
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom) and (
+            node.level or (node.module or "").split(".")[0] == "jik"
+        ):
+            found.append(node)
+        elif isinstance(node, ast.Import) and any(
+            a.name.split(".")[0] == "jik" for a in node.names
+        ):
+            found.append(node)
+    return found
+
+
+@pytest.mark.parametrize("folder", sorted(set(SETUPTOOLS["package-dir"].values()) - {"jik"}))
+def test_imports_between_the_mapped_folders_resolve_in_the_source_tree(folder):
+    """A tool that reads imports from the files (an editor, pyright, jedi) finds every module:
+    the mapped folders import jik's packages relatively (``from ..engine.solver import solve``
+    in app/api/, whose ``..`` is the tree's root, where engine/ sits), and each relative import
+    names a module or package that exists in the tree. Only the root package ``jik`` (its
+    ``__version__``) is imported by its absolute name, which the tree's jik/ folder holds."""
+    problems = []
+    for path in sorted((ROOT / folder).rglob("*.py")):
+        where = f"{path.relative_to(ROOT)}"
+        for node in _jik_imports(path):
+            if isinstance(node, ast.Import) or not node.level:
+                names = [node.module] if isinstance(node, ast.ImportFrom) else []
+                names += [a.name for a in getattr(node, "names", [])]
+                if any(n and n.startswith("jik.") for n in names):
+                    problems.append(f"{where}:{node.lineno} absolute import of a jik subpackage")
+                continue
+            base = path.parent
+            for _ in range(node.level - 1):
+                base = base.parent
+            target = base.joinpath(*(node.module or "").split(".")) if node.module else base
+            # (``from . import name``: a module, or a name the package's __init__ defines)
+            modules = [target] if node.module else [target / a.name for a in node.names]
+            for module in modules:
+                found = module.with_suffix(".py").is_file() or (module / "__init__.py").is_file()
+                if not found and not (node.module is None and (target / "__init__.py").is_file()):
+                    problems.append(f"{where}:{node.lineno} {module} is not in the tree")
+    assert problems == []
+
+
 @pytest.mark.parametrize("folder", sorted(EXTRA_OF))
 def test_shipped_code_imports_only_its_install_lines_dependencies(folder):
     extra = EXTRA_OF[folder]

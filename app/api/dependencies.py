@@ -6,8 +6,8 @@ from typing import Annotated
 
 from fastapi import Depends, Request
 
-from jik.app.compute.pool import ComputePool
-from jik.app.dashboard.sessions import SessionStore
+from ..compute.pool import ComputePool
+from ..dashboard.sessions import SessionStore
 
 
 async def pool_of(request: Request) -> ComputePool:

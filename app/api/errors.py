@@ -30,12 +30,12 @@ from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.routing import Match
 
-from jik.app.api.validation import validation_detail
-from jik.app.compute.atlas_jobs import AtlasJobNotFound, AtlasJobsFull
-from jik.app.compute.exceptions import ComputeError, RequestError, ServiceUnavailable
-from jik.app.compute.schemas import ErrorResponse
-from jik.app.dashboard.sessions import ExportUnavailable, SessionNotFound, SessionsFull
-from jik.engine.exceptions import InvalidInputError
+from ...engine.exceptions import InvalidInputError
+from ..compute.atlas_jobs import AtlasJobNotFound, AtlasJobsFull
+from ..compute.exceptions import ComputeError, RequestError, ServiceUnavailable
+from ..compute.schemas import ErrorResponse
+from ..dashboard.sessions import ExportUnavailable, SessionNotFound, SessionsFull
+from .validation import validation_detail
 
 log = logging.getLogger("jik.api")
 

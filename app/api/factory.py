@@ -12,10 +12,13 @@ from fastapi import FastAPI
 from fastapi_offline import FastAPIOffline
 
 from jik import __version__
-from jik.app.api.body_limit import BodyLimit
-from jik.app.api.errors import add_error_handlers
-from jik.app.api.fastpath import SolveFastPath
-from jik.app.api.routes import (
+
+from ..compute.pool import ComputePool
+from ..compute.settings import Settings
+from .body_limit import BodyLimit
+from .errors import add_error_handlers
+from .fastpath import SolveFastPath
+from .routes import (
     dashboard,
     health,
     kinematics,
@@ -25,11 +28,9 @@ from jik.app.api.routes import (
     solve,
     synthesize,
 )
-from jik.app.api.routes.atlas import router as atlas_router
-from jik.app.api.routes.session_atlas import router as session_atlas_router
-from jik.app.api.security import SecurityMiddleware, allowed_hosts_from_env
-from jik.app.compute.pool import ComputePool
-from jik.app.compute.settings import Settings
+from .routes.atlas import router as atlas_router
+from .routes.session_atlas import router as session_atlas_router
+from .security import SecurityMiddleware, allowed_hosts_from_env
 
 #: Largest request body accepted (413 beyond): the largest valid request is a few kilobytes.
 MAX_BODY_BYTES = 1 << 20

@@ -20,9 +20,9 @@ from pydantic import TypeAdapter, ValidationError
 from starlette.responses import Response
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from jik.app.api.errors import error_response
-from jik.app.compute.pool import ComputePool
-from jik.app.compute.schemas import SolveBody
+from ..compute.pool import ComputePool
+from ..compute.schemas import SolveBody
+from .errors import error_response
 
 #: The route's body type, checked here as the route would.
 _SOLVE_BODY: TypeAdapter[Any] = TypeAdapter(SolveBody)

@@ -29,7 +29,7 @@ from urllib.parse import urlsplit
 from starlette.routing import Match
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from jik.app.compute.settings import Settings
+from ..compute.settings import Settings
 
 #: Host names allowed by default: the loopback names.
 LOOPBACK_HOSTS = ("localhost", "127.0.0.1", "[::1]", "::1")

@@ -14,11 +14,11 @@ import socket
 
 import uvicorn
 
-from jik.app.api.factory import create_app
-from jik.app.api.protocol import with_read_deadline
-from jik.app.compute.settings import Settings
-from jik.app.dashboard.sessions import SessionLimits, SessionStore
-from jik.app.scene import start_scene
+from ..compute.settings import Settings
+from ..dashboard.sessions import SessionLimits, SessionStore
+from ..scene import start_scene
+from .factory import create_app
+from .protocol import with_read_deadline
 
 
 class PortInUse(RuntimeError):

@@ -4,14 +4,14 @@ wrong length says how many components the request's robot needs and why."""
 
 from __future__ import annotations
 
-from jik.app.compute.schemas import (
+from ...engine.registry import ROBOTS
+from ..compute.schemas import (
     AUGMENTATION_MODELS,
     ROBOT_MODELS,
     ROBOT_NAMES,
     USER_AUGMENTATION_MODELS,
     USER_ROBOT_MODELS,
 )
-from jik.engine.registry import ROBOTS
 
 _TAGS = {*ROBOT_MODELS, *AUGMENTATION_MODELS, *USER_ROBOT_MODELS, *USER_AUGMENTATION_MODELS}
 #: The tags of a request's variants: the catalogue robots and the kinds of user robots.

@@ -24,13 +24,13 @@ import time
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
-from jik.app.compute.atlas_plan import AtlasLimits, plan_request, result_document
-from jik.app.compute.atlas_pool import PoolBackend
-from jik.app.compute.atlas_schemas import AtlasJobResponse, AtlasRequest
-from jik.engine.atlas import AtlasPlan
-from jik.engine.atlas_run import run_atlas
-from jik.engine.exceptions import RunCancelled
-from jik.engine.progress import ProgressCallbacks
+from ...engine.atlas import AtlasPlan
+from ...engine.atlas_run import run_atlas
+from ...engine.exceptions import RunCancelled
+from ...engine.progress import ProgressCallbacks
+from .atlas_plan import AtlasLimits, plan_request, result_document
+from .atlas_pool import PoolBackend
+from .atlas_schemas import AtlasJobResponse, AtlasRequest
 
 
 class AtlasJobNotFound(LookupError):

@@ -13,21 +13,21 @@ from typing import Any
 
 import numpy as np
 
-from jik.app.compute.atlas_pool import sized_chunks
-from jik.app.compute.atlas_schemas import AtlasRequest
-from jik.app.compute.documents import nullable
-from jik.app.compute.exceptions import RequestError
-from jik.app.compute.robot_requests import build_augmentation, build_robot, check_task_point
-from jik.app.compute.schemas.algorithms import field_of, used
-from jik.app.compute.user_robots import is_user_robot, user_inverse, user_robot
-from jik.app.compute.worker import task
-from jik.engine.atlas import AtlasPlan, plan_atlas
-from jik.engine.atlas_run import AtlasResult
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.registry import ALGORITHMS, make_inverse
-from jik.engine.repeatability import CLOSE_TOL
-from jik.engine.self_motion import MAX_ARC
-from jik.engine.solve_rules import gamma_problem
+from ...engine.atlas import AtlasPlan, plan_atlas
+from ...engine.atlas_run import AtlasResult
+from ...engine.exceptions import InvalidInputError
+from ...engine.registry import ALGORITHMS, make_inverse
+from ...engine.repeatability import CLOSE_TOL
+from ...engine.self_motion import MAX_ARC
+from ...engine.solve_rules import gamma_problem
+from .atlas_pool import sized_chunks
+from .atlas_schemas import AtlasRequest
+from .documents import nullable
+from .exceptions import RequestError
+from .robot_requests import build_augmentation, build_robot, check_task_point
+from .schemas.algorithms import field_of, used
+from .user_robots import is_user_robot, user_inverse, user_robot
+from .worker import task
 
 
 @dataclass(frozen=True)

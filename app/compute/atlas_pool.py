@@ -9,10 +9,10 @@ from collections.abc import Callable, Iterable, Iterator
 from time import perf_counter
 from typing import Any
 
-from jik.app.compute.worker import task
-from jik.engine.atlas import AtlasPlan
-from jik.engine.atlas_backends import IN_FLIGHT, bounded_imap
-from jik.engine.atlas_run import chunk_task, run_chunk
+from ...engine.atlas import AtlasPlan
+from ...engine.atlas_backends import IN_FLIGHT, bounded_imap
+from ...engine.atlas_run import chunk_task, run_chunk
+from .worker import task
 
 #: Seconds of work in one chunk of a server's atlas: the compute workers serve the API's requests
 #: between chunks, first come first served, and a chunk stays far within their time limit.

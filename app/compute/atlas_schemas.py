@@ -12,7 +12,9 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from jik.app.compute.schemas import (
+from ...engine.repeatability import MAX_PATH_POINTS
+from ...engine.solve_rules import DISCRETE_GAMMA_BOUND
+from .schemas import (
     INTEGRAL,
     Algorithm,
     AnyAugmentation,
@@ -25,9 +27,7 @@ from jik.app.compute.schemas import (
     Vector,
     per_robot,
 )
-from jik.app.compute.schemas.algorithms import AlgorithmParameters
-from jik.engine.repeatability import MAX_PATH_POINTS
-from jik.engine.solve_rules import DISCRETE_GAMMA_BOUND
+from .schemas.algorithms import AlgorithmParameters
 
 #: Largest starts per path, cycles, and paths of a family (shifts, scales) in one request.
 MAX_STARTS = 20000

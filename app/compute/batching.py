@@ -19,15 +19,15 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from jik.app.compute import schemas as S
-from jik.app.compute.exceptions import ServiceUnavailable
-from jik.app.compute.precheck import precheck
-from jik.app.compute.requests import batch_key
-from jik.app.compute.worker import solve_batch
+from . import schemas as S
+from .exceptions import ServiceUnavailable
+from .precheck import precheck
+from .requests import batch_key
+from .worker import solve_batch
 
 if TYPE_CHECKING:
-    from jik.app.compute.settings import Settings
-    from jik.app.compute.worker import Worker
+    from .settings import Settings
+    from .worker import Worker
 
 
 def _retrieve(future: asyncio.Future) -> None:

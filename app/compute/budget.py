@@ -15,8 +15,8 @@ import signal
 import threading
 from collections.abc import Iterator
 
-from jik.app.compute.exceptions import RequestError
-from jik.app.compute.settings import settings
+from .exceptions import RequestError
+from .settings import settings
 
 #: The build budget of this process [s], set by a compute worker's entry from its pool's
 #: settings (None: the environment's, ``Settings.build_budget``).

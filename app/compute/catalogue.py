@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import functools
 
-from jik.app.compute import schemas as S
-from jik.app.compute.settings import settings_from_env
-from jik.engine.arms import ARMS
-from jik.engine.registry import ALGORITHMS, ROBOTS, RobotSpec
-from jik.engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
-from jik.engine.robot_spec import robot_from_dict
+from ...engine.arms import ARMS
+from ...engine.registry import ALGORITHMS, ROBOTS, RobotSpec
+from ...engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
+from ...engine.robot_spec import robot_from_dict
+from . import schemas as S
+from .settings import settings_from_env
 
 
 @functools.cache

@@ -9,8 +9,8 @@ from typing import Any
 import numpy as np
 import pydantic_core
 
-from jik.app.compute import schemas as S
-from jik.engine.limits import limit_names, robot_limits, solve_report
+from ...engine.limits import limit_names, robot_limits, solve_report
+from . import schemas as S
 
 
 def nullable(a) -> Any:

@@ -13,16 +13,16 @@ from typing import Annotated, Any, Union
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, create_model
 
-from jik.app.compute import schemas as S
-from jik.app.compute.documents import nullable
-from jik.app.compute.exceptions import RequestError
-from jik.app.compute.robot_requests import build_robot
-from jik.app.compute.schemas.robots import _camel
-from jik.app.compute.schemas.variants import _robot_name
-from jik.app.compute.user_robots import is_user_robot, user_robot
-from jik.app.compute.worker import task
-from jik.engine.arms import ARMS
-from jik.engine.registry import ROBOTS
+from ...engine.arms import ARMS
+from ...engine.registry import ROBOTS
+from . import schemas as S
+from .documents import nullable
+from .exceptions import RequestError
+from .robot_requests import build_robot
+from .schemas.robots import _camel
+from .schemas.variants import _robot_name
+from .user_robots import is_user_robot, user_robot
+from .worker import task
 
 #: Most configurations one request evaluates.
 MAX_CONFIGURATIONS = 1000

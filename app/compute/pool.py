@@ -18,15 +18,15 @@ import threading
 from collections.abc import Callable, Iterator
 from typing import Any
 
-from jik.app.compute.batching import SolveBatching, _Pending
-from jik.app.compute.exceptions import (
+from .batching import SolveBatching, _Pending
+from .exceptions import (
     ComputeError,
     RequestError,
     ServiceUnavailable,
     WorkerLost,
 )
-from jik.app.compute.settings import Settings, settings_from_env
-from jik.app.compute.worker import Worker, frame_header, work_of
+from .settings import Settings, settings_from_env
+from .worker import Worker, frame_header, work_of
 
 #: A computation that overran its time limit while its worker computed less than this share of
 #: it was not the request's work: the worker hung (the server's fault, 503).

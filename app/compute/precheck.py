@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-from jik.app.compute import schemas as S
-from jik.app.compute.exceptions import RequestError
-from jik.app.compute.robot_requests import check_configuration, check_task_point
-from jik.app.compute.synthesis import synthesis_region
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.registry import ROBOTS
-from jik.engine.solve_rules import gamma_problem
+from ...engine.exceptions import InvalidInputError
+from ...engine.registry import ROBOTS
+from ...engine.solve_rules import gamma_problem
+from . import schemas as S
+from .exceptions import RequestError
+from .robot_requests import check_configuration, check_task_point
+from .synthesis import synthesis_region
 
 
 def precheck(req: S.SolveRequest | S.RepeatabilityRequest | S.SynthesizeRequest) -> None:

@@ -16,28 +16,28 @@ from typing import Any, TypeVar, cast
 
 import numpy as np
 
-from jik.app.compute import schemas as S
-from jik.app.compute.documents import (
+from ...engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
+from ...engine.limits import repeatability_report, robot_limits
+from ...engine.registry import RobotSpec, make_inverse
+from ...engine.repeatability import REPEATABLE_DRIFT, repeatability
+from ...engine.solve_rules import gamma_problem
+from ...engine.solver import solve_batch as engine_solve_batch
+from . import schemas as S
+from .documents import (
     limits_document,
     nullable,
     solve_response,
     solve_response_json,
 )
-from jik.app.compute.exceptions import RequestError
-from jik.app.compute.robot_requests import (
+from .exceptions import RequestError
+from .robot_requests import (
     build_augmentation,
     build_robot,
     check_configuration,
     check_task_point,
 )
-from jik.app.compute.schemas.algorithms import field_of, used
-from jik.app.compute.user_robots import is_user_robot, map_used, user_inverse, user_robot
-from jik.engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
-from jik.engine.limits import repeatability_report, robot_limits
-from jik.engine.registry import RobotSpec, make_inverse
-from jik.engine.repeatability import REPEATABLE_DRIFT, repeatability
-from jik.engine.solve_rules import gamma_problem
-from jik.engine.solver import solve_batch as engine_solve_batch
+from .schemas.algorithms import field_of, used
+from .user_robots import is_user_robot, map_used, user_inverse, user_robot
 
 _R = TypeVar("_R")
 

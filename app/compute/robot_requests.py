@@ -5,10 +5,10 @@ from __future__ import annotations
 
 from typing import Any
 
-from jik.app.compute import schemas as S
-from jik.app.compute.exceptions import RequestError
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.registry import ROBOTS, RobotSpec
+from ...engine.exceptions import InvalidInputError
+from ...engine.registry import ROBOTS, RobotSpec
+from . import schemas as S
+from .exceptions import RequestError
 
 
 def build_robot(req_robot) -> tuple[RobotSpec, Any, S.RobotUsed]:

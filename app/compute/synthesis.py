@@ -11,16 +11,16 @@ from collections.abc import Collection
 
 import numpy as np
 
-from jik.app.compute import schemas as S
-from jik.app.compute.documents import nullable
-from jik.app.compute.exceptions import RequestError
-from jik.app.compute.robot_requests import build_augmentation, build_robot
-from jik.app.compute.synthesis_total import grid, total_degree_response
-from jik.app.compute.user_robots import is_user_robot, map_used, request_field, user_robot
-from jik.engine.exceptions import JikError
-from jik.engine.functionals import error_functional_e1, error_functional_e2
-from jik.engine.registry import RobotSpec
-from jik.engine.variational import synthesize_e2
+from ...engine.exceptions import JikError
+from ...engine.functionals import error_functional_e1, error_functional_e2
+from ...engine.registry import RobotSpec
+from ...engine.variational import synthesize_e2
+from . import schemas as S
+from .documents import nullable
+from .exceptions import RequestError
+from .robot_requests import build_augmentation, build_robot
+from .synthesis_total import grid, total_degree_response
+from .user_robots import is_user_robot, map_used, request_field, user_robot
 
 
 def synthesis_methods() -> S.SynthesisMethodsResponse:

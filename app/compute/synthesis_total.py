@@ -11,12 +11,12 @@ from typing import Any
 
 import numpy as np
 
-from jik.app.compute import schemas as S
-from jik.app.compute.documents import nullable
-from jik.app.compute.exceptions import RequestError
-from jik.engine.exceptions import JikError
-from jik.engine.robot_synthesis import TOTAL_DEGREE
-from jik.engine.synthesis_nd import synthesize_e2_nd
+from ...engine.exceptions import JikError
+from ...engine.robot_synthesis import TOTAL_DEGREE
+from ...engine.synthesis_nd import synthesize_e2_nd
+from . import schemas as S
+from .documents import nullable
+from .exceptions import RequestError
 
 #: The engine's fields of a total-degree synthesis, as the request names them (others: region).
 _FIELDS = {"degree": "degree", "nodes": "qmc_nodes", "frame_axes": "frame_axes"}

@@ -20,13 +20,13 @@ import json
 from collections.abc import Sequence
 from typing import Any
 
-from jik.app.compute import schemas as S
-from jik.app.compute.budget import build_seconds, time_budget
-from jik.app.compute.exceptions import RequestError
-from jik.app.compute.schemas.algorithms import field_of
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.robot_spec import Robot, robot_from_dict
-from jik.engine.robot_synthesis import TENSOR_DEGREE, TOTAL_DEGREE
+from ...engine.exceptions import InvalidInputError
+from ...engine.robot_spec import Robot, robot_from_dict
+from ...engine.robot_synthesis import TENSOR_DEGREE, TOTAL_DEGREE
+from . import schemas as S
+from .budget import build_seconds, time_budget
+from .exceptions import RequestError
+from .schemas.algorithms import field_of
 
 #: The augmentation's label inside the built robot.
 _LABEL = "request"

@@ -20,13 +20,13 @@ from typing import Any
 
 import psutil
 
-from jik.app.compute import budget
-from jik.app.compute import schemas as S
-from jik.app.compute.exceptions import RequestError
-from jik.app.compute.requests import engine_error, repeatability_request, solve_batch_json
-from jik.app.compute.synthesis import synthesize_request
-from jik.engine.atlas_backends import limit_memory
-from jik.engine.exceptions import JikError
+from ...engine.atlas_backends import limit_memory
+from ...engine.exceptions import JikError
+from . import budget
+from . import schemas as S
+from .exceptions import RequestError
+from .requests import engine_error, repeatability_request, solve_batch_json
+from .synthesis import synthesize_request
 
 
 def task(field: str, less: str) -> Callable[[Callable], Callable]:

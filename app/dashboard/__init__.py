@@ -9,9 +9,9 @@ state), :mod:`.algorithms` (the chosen algorithms, one style each), :mod:`.runs`
 per tab, bounded), :mod:`.export` (JSON and CSV). The names below are the public surface.
 """
 
-from jik.app.dashboard.export import export_csv, export_file, export_json
-from jik.app.dashboard.messages import Event
-from jik.app.dashboard.model import (
+from .export import export_csv, export_file, export_json
+from .messages import Event
+from .model import (
     ALGORITHMS,
     COLORS,
     LABELS,
@@ -20,10 +20,10 @@ from jik.app.dashboard.model import (
     runs_key,
     updated_state,
 )
-from jik.app.dashboard.offload import Offload, OffloadLane
-from jik.app.dashboard.results import compute
-from jik.app.dashboard.runs import AlgorithmRun, Cancelled, DashboardResult
-from jik.app.dashboard.session import Dashboard
+from .offload import Offload, OffloadLane
+from .results import compute
+from .runs import AlgorithmRun, Cancelled, DashboardResult
+from .session import Dashboard
 
 __all__ = [
     "ALGORITHMS",

@@ -9,14 +9,14 @@ import logging
 import threading
 from collections.abc import Callable
 
-from jik.app.dashboard.analysis import expensive_map, kinematics_and_map
-from jik.app.dashboard.messages import Event, digest, with_figures
-from jik.app.dashboard.model import DashboardState, cache_key, updated_state
-from jik.app.dashboard.offload import OffloadLane
-from jik.app.dashboard.plotting import PANELS
-from jik.app.dashboard.results import compute
-from jik.app.dashboard.runs import Cancelled
-from jik.engine.exceptions import InvalidInputError, JikError
+from ...engine.exceptions import InvalidInputError, JikError
+from .analysis import expensive_map, kinematics_and_map
+from .messages import Event, digest, with_figures
+from .model import DashboardState, cache_key, updated_state
+from .offload import OffloadLane
+from .plotting import PANELS
+from .results import compute
+from .runs import Cancelled
 
 log = logging.getLogger("jik.dashboard")
 

@@ -19,9 +19,9 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
-from jik.app.compute.schemas.algorithms import Algorithm
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.registry import ALGORITHMS as REGISTRY
+from ...engine.exceptions import InvalidInputError
+from ...engine.registry import ALGORITHMS as REGISTRY
+from ..compute.schemas.algorithms import Algorithm
 
 
 class ChosenState(Protocol):

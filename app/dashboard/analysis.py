@@ -8,11 +8,11 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
-from jik.app.dashboard.model import DashboardState
-from jik.app.dashboard.robots import state_kinematics, state_spec
-from jik.app.dashboard.runs import AlgorithmRun
-from jik.engine.exceptions import JikError
-from jik.engine.progress import ProgressCallbacks
+from ...engine.exceptions import JikError
+from ...engine.progress import ProgressCallbacks
+from .model import DashboardState
+from .robots import state_kinematics, state_spec
+from .runs import AlgorithmRun
 
 
 def augmenting_axes(amap, x: np.ndarray, on_batch=None) -> tuple[int, int]:

@@ -11,9 +11,9 @@ rule's chunks of nodes.
 
 from __future__ import annotations
 
-from jik.engine.e2_qmc import e2_qmc
-from jik.engine.exceptions import JikError, RunCancelled
-from jik.engine.progress import ProgressCallbacks
+from ...engine.e2_qmc import e2_qmc
+from ...engine.exceptions import JikError, RunCancelled
+from ...engine.progress import ProgressCallbacks
 
 #: Nodes of the rule (a power of two): those of a synthesis over more than three joints.
 QMC_NODES = 2**13
@@ -28,7 +28,7 @@ def qmc_functionals(
     Sobol nodes and ``E2_single_joint`` (name -> {"sign", "e2"}) when p - r = 1; E1 None and a
     ``note`` saying why and how. Raises :class:`~jik.app.dashboard.runs.Cancelled` when
     ``cancelled()`` turns True; ``on_step()`` twice when done (the two functionals' steps)."""
-    from jik.app.dashboard.runs import Cancelled
+    from .runs import Cancelled
 
     kin = grid["kinematics"]
     large = f"a tensor rule over the {len(region)} variables of the design region is too large"

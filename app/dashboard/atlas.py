@@ -18,15 +18,15 @@ from typing import Any
 
 import numpy as np
 
-from jik.app.compute.atlas_schemas import AtlasRequest
-from jik.app.dashboard.algorithms import STYLES, inverse_parameters
-from jik.app.dashboard.analysis import kinematics_and_map
-from jik.app.dashboard.model import DashboardState
-from jik.app.dashboard.plotting import AXIS, UNITS, figure, norm_unit
-from jik.app.dashboard.robots import state_spec, user_robot
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.registry import ROBOTS
-from jik.engine.self_motion import project
+from ...engine.exceptions import InvalidInputError
+from ...engine.registry import ROBOTS
+from ...engine.self_motion import project
+from ..compute.atlas_schemas import AtlasRequest
+from .algorithms import STYLES, inverse_parameters
+from .analysis import kinematics_and_map
+from .model import DashboardState
+from .plotting import AXIS, UNITS, figure, norm_unit
+from .robots import state_spec, user_robot
 
 #: Drift below this is drawn as this (the extended Jacobian's drift is round-off, ~1e-13).
 DRIFT_FLOOR = 1e-14

@@ -13,7 +13,7 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from jik.engine.exceptions import InvalidInputError
+from ...engine.exceptions import InvalidInputError
 
 #: How a closed path is written in a text box: points separated by ';', coordinates by ','.
 PATH_FORMAT = "y1, y2; y1, y2; ..."

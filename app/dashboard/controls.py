@@ -19,13 +19,13 @@ from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from typing import Any
 
-from jik.app.dashboard.algorithms import STYLES, scalar_parameters
-from jik.app.dashboard.control_changes import PATH_FORMAT, path_text
-from jik.app.dashboard.glossary import SYMBOLS
-from jik.app.dashboard.robots import state_spec
-from jik.engine.arms import ARMS
-from jik.engine.registry import ROBOTS
-from jik.engine.solve_rules import DISCRETE_GAMMA_BOUND, MAX_ITERATIONS, MAX_STEPS
+from ...engine.arms import ARMS
+from ...engine.registry import ROBOTS
+from ...engine.solve_rules import DISCRETE_GAMMA_BOUND, MAX_ITERATIONS, MAX_STEPS
+from .algorithms import STYLES, scalar_parameters
+from .control_changes import PATH_FORMAT, path_text
+from .glossary import SYMBOLS
+from .robots import state_spec
 
 #: gamma's resolution: the page's log-scale slider and the scene's slider both land on it.
 GAMMA_STEP = 0.001

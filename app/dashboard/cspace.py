@@ -12,12 +12,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from jik.app.dashboard.algorithms import COLORS, DASH, LABELS, STYLES
-from jik.app.dashboard.analysis import expensive_map, kinematics_and_map
-from jik.app.dashboard.plotting import corner_names, figure, trace
-from jik.app.dashboard.robots import state_spec
-from jik.app.dashboard.runs import DashboardResult
-from jik.engine.exceptions import JikError
+from ...engine.exceptions import JikError
+from .algorithms import COLORS, DASH, LABELS, STYLES
+from .analysis import expensive_map, kinematics_and_map
+from .plotting import corner_names, figure, trace
+from .robots import state_spec
+from .runs import DashboardResult
 
 #: The choices of three coordinates of a four-dimensional configuration (the unicycle's λ).
 AXES_CHOICES = ("012", "013", "023", "123")

@@ -12,13 +12,14 @@ from datetime import UTC, datetime
 import numpy as np
 
 from jik import __version__
-from jik.app.dashboard.messages import h_change, to_json
-from jik.app.dashboard.plotting import norm_unit, units
-from jik.app.dashboard.robots import state_kinematics
-from jik.app.dashboard.runs import DashboardResult
-from jik.app.dashboard.verdict import verdict
-from jik.engine.planar_chain import PlanarChain
-from jik.engine.urdf import UrdfChain
+
+from ...engine.planar_chain import PlanarChain
+from ...engine.urdf import UrdfChain
+from .messages import h_change, to_json
+from .plotting import norm_unit, units
+from .robots import state_kinematics
+from .runs import DashboardResult
+from .verdict import verdict
 
 #: What a user robot's lengths are measured in when its definition does not say.
 LENGTH = "length unit of the definition"

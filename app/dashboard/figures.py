@@ -17,10 +17,10 @@ from __future__ import annotations
 import numpy as np
 import plotly.graph_objects as go
 
-from jik.app.dashboard.algorithms import COLORS, DASH, LABELS, STYLES
-from jik.app.dashboard.cspace import cspace_spec
-from jik.app.dashboard.map_figures import augmenting_spec, sensitivity_spec
-from jik.app.dashboard.plotting import (
+from .algorithms import COLORS, DASH, LABELS, STYLES
+from .cspace import cspace_spec
+from .map_figures import augmenting_spec, sensitivity_spec
+from .plotting import (
     NO_LEGEND,
     corner_names,
     figure,
@@ -35,9 +35,9 @@ from jik.app.dashboard.plotting import (
     trace,
     units,
 )
-from jik.app.dashboard.pose_figures import algorithms_key, is_pose_task, pose_task_spec
-from jik.app.dashboard.runs import DashboardResult
-from jik.app.dashboard.table import table_spec
+from .pose_figures import algorithms_key, is_pose_task, pose_task_spec
+from .runs import DashboardResult
+from .table import table_spec
 
 
 def _task_space(result: DashboardResult) -> dict:

@@ -11,12 +11,12 @@ from collections.abc import Callable
 
 import numpy as np
 
-from jik.app.dashboard.analysis import expensive_map, kinematics_and_map, vector_note
-from jik.app.dashboard.arm_e2 import qmc_functionals, single_joint_sensitivity
-from jik.app.dashboard.model import DashboardState, cache_key
-from jik.app.dashboard.robots import state_spec
-from jik.app.dashboard.runs import Cancelled, DashboardResult
-from jik.engine.exceptions import JikError
+from ...engine.exceptions import JikError
+from .analysis import expensive_map, kinematics_and_map, vector_note
+from .arm_e2 import qmc_functionals, single_joint_sensitivity
+from .model import DashboardState, cache_key
+from .robots import state_spec
+from .runs import Cancelled, DashboardResult
 
 
 def inert_variables(kin, amap, box: tuple[tuple[float, float], ...], samples: int = 8):
@@ -121,7 +121,7 @@ def error_functionals(
     if expensive_map(grid["map"]):
         nodes = min(nodes, 6)
     try:
-        from jik.engine.functionals import error_functional_e1, error_functional_e2
+        from ...engine.functionals import error_functional_e1, error_functional_e2
     except ImportError:
         return None
     names = result.variable_names
@@ -207,7 +207,7 @@ def sensitivity(
         }
     if functionals.get("E1") is None and functionals.get("E2") is None:
         return {"kind": "unavailable", "reason": "E1, E2 are undefined on this box"}
-    from jik.engine.functionals import (
+    from ...engine.functionals import (
         error_functional_e1,
         error_functional_e2,
         parameter_sensitivity,

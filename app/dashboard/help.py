@@ -9,12 +9,12 @@ from __future__ import annotations
 
 from dataclasses import asdict
 
-from jik.app.dashboard.algorithms import COLORS, LABELS
-from jik.app.dashboard.algorithms import STYLES as DRAWN
-from jik.app.dashboard.controls import PROGRESS_AFTER
-from jik.app.dashboard.plotting import PANEL_SIZES
-from jik.engine.arms import ARMS
-from jik.engine.robot_kinds import ARM, robot_kinds
+from ...engine.arms import ARMS
+from ...engine.robot_kinds import ARM, robot_kinds
+from .algorithms import COLORS, LABELS
+from .algorithms import STYLES as DRAWN
+from .controls import PROGRESS_AFTER
+from .plotting import PANEL_SIZES
 
 #: How each algorithm is drawn, everywhere: its colour (COLORS), its line style in the plots
 #: (plotly's ``dash``) and its robot in the 3D scene (:data:`jik.app.dashboard.algorithms.STYLES`).

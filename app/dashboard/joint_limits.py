@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from jik.app.dashboard.robots import state_kinematics, state_spec
-from jik.engine.limits import LimitsReport, legs_report, limit_names, robot_limits
+from ...engine.limits import LimitsReport, legs_report, limit_names, robot_limits
+from .robots import state_kinematics, state_spec
 
 
 def state_limits(state) -> np.ndarray | None:

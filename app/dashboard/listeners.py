@@ -8,8 +8,8 @@ import threading
 import time
 from collections.abc import Callable
 
-from jik.app.dashboard.messages import Event
-from jik.app.dashboard.model import DashboardState
+from .messages import Event
+from .model import DashboardState
 
 
 class Listeners:

@@ -9,12 +9,12 @@ from typing import Any
 
 import numpy as np
 
-from jik.app.dashboard.algorithms import COLORS, DASH, LABELS
-from jik.app.dashboard.analysis import vector_note
-from jik.app.dashboard.functionals import state_inert_variables
-from jik.app.dashboard.plotting import NO_LEGEND, figure, label, trace, units
-from jik.app.dashboard.robots import state_spec
-from jik.app.dashboard.runs import DashboardResult
+from .algorithms import COLORS, DASH, LABELS
+from .analysis import vector_note
+from .functionals import state_inert_variables
+from .plotting import NO_LEGEND, figure, label, trace, units
+from .robots import state_spec
+from .runs import DashboardResult
 
 
 def augmenting_spec(

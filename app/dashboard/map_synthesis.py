@@ -12,12 +12,12 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from jik.app.dashboard.analysis import kinematics_and_map
-from jik.app.dashboard.robots import state_robot
-from jik.app.dashboard.runs import Cancelled
-from jik.engine.exceptions import RunCancelled
-from jik.engine.progress import ProgressCallbacks
-from jik.engine.robot_synthesis import synthesis_progress
+from ...engine.exceptions import RunCancelled
+from ...engine.progress import ProgressCallbacks
+from ...engine.robot_synthesis import synthesis_progress
+from .analysis import kinematics_and_map
+from .robots import state_robot
+from .runs import Cancelled
 
 #: What the progress of a synthesis says on the page.
 SYNTHESIZING = "synthesizing h (E2, eq. (19))"

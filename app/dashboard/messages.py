@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from jik.app.dashboard.joint_limits import limits_summary
-from jik.app.dashboard.runs import DashboardResult
+from .joint_limits import limits_summary
+from .runs import DashboardResult
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,11 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from jik.app.compute.schemas import (
+from ...engine.exceptions import InvalidInputError
+from ...engine.registry import ROBOTS, robot_spec
+from ...engine.repeatability import MAX_PATH_POINTS
+from ...engine.solve_rules import gamma_problem
+from ..compute.schemas import (
     AUGMENTATION_MODELS,
     INTEGRAL,
     MAX_DIMENSION,
@@ -25,25 +29,21 @@ from jik.app.compute.schemas import (
     Mode,
     Tolerance,
 )
-from jik.app.compute.schemas.algorithms import Algorithm
-from jik.app.dashboard.algorithms import CHOICES, DEFAULT_ALGORITHMS, check_inverses, checked
-from jik.app.dashboard.algorithms import COLORS as COLORS  # (re-exported: one table, there)
-from jik.app.dashboard.algorithms import DASH as DASH
-from jik.app.dashboard.algorithms import LABELS as LABELS
-from jik.app.dashboard.algorithms import cache_key as cache_key
-from jik.app.dashboard.algorithms import runs_key as runs_key
-from jik.app.dashboard.control_changes import expand
-from jik.app.dashboard.controls import (
+from ..compute.schemas.algorithms import Algorithm
+from .algorithms import CHOICES, DEFAULT_ALGORITHMS, check_inverses, checked
+from .algorithms import COLORS as COLORS  # (re-exported: one table, there)
+from .algorithms import DASH as DASH
+from .algorithms import LABELS as LABELS
+from .algorithms import cache_key as cache_key
+from .algorithms import runs_key as runs_key
+from .control_changes import expand
+from .controls import (
     MAX_DASHBOARD_CYCLES,
     MAX_ITERATIONS_CAP,
     MIN_ITERATIONS,
     max_iterations,
 )
-from jik.app.dashboard.robots import USER_KINDS, default_definition, state_inverse, user_robot
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.registry import ROBOTS, robot_spec
-from jik.engine.repeatability import MAX_PATH_POINTS
-from jik.engine.solve_rules import gamma_problem
+from .robots import USER_KINDS, default_definition, state_inverse, user_robot
 
 #: The algorithms of a new state (:mod:`jik.app.dashboard.algorithms`: colours, styles, keys).
 ALGORITHMS = DEFAULT_ALGORITHMS

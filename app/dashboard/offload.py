@@ -16,9 +16,9 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
-from jik.app.compute.exceptions import ServiceUnavailable
-from jik.app.compute.worker import task
-from jik.app.dashboard.runs import AlgorithmRun, Cancelled, algorithm_run
+from ..compute.exceptions import ServiceUnavailable
+from ..compute.worker import task
+from .runs import AlgorithmRun, Cancelled, algorithm_run
 
 log = logging.getLogger("jik.dashboard")
 

@@ -4,11 +4,11 @@ task), and which panels wait for the second phase (E1/E2 not known yet for the s
 
 from __future__ import annotations
 
-from jik.app.dashboard.figures import figure_specs
-from jik.app.dashboard.functionals import functionals_key
-from jik.app.dashboard.model import DashboardState
-from jik.app.dashboard.plotting import figure_json, keep_ranges
-from jik.app.dashboard.runs import DashboardResult
+from .figures import figure_specs
+from .functionals import functionals_key
+from .model import DashboardState
+from .plotting import figure_json, keep_ranges
+from .runs import DashboardResult
 
 
 class PanelTexts:

@@ -11,12 +11,12 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, ValidationError, create_model
 
-from jik.app.compute.schemas import AUGMENTATION_MODELS, USER_AUGMENTATION_MODELS, Coordinate
-from jik.app.dashboard.model import DashboardState, Point
-from jik.app.dashboard.robots import USER_KINDS
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.registry import ROBOTS
-from jik.engine.repeatability import MAX_PATH_POINTS
+from ...engine.exceptions import InvalidInputError
+from ...engine.registry import ROBOTS
+from ...engine.repeatability import MAX_PATH_POINTS
+from ..compute.schemas import AUGMENTATION_MODELS, USER_AUGMENTATION_MODELS, Coordinate
+from .model import DashboardState, Point
+from .robots import USER_KINDS
 
 #: Control keys a patch may hold besides the state's fields (:func:`.control_changes.expand`), and
 #: their values: one coordinate of ``x0`` or ``target``, one parameter of the robot (a number

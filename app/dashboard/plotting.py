@@ -11,9 +11,9 @@ import math
 import numpy as np
 import plotly.graph_objects as go
 
-from jik.app.dashboard.robot_units import chain_units
-from jik.app.dashboard.robots import state_kinematics
-from jik.app.dashboard.runs import DashboardResult
+from .robot_units import chain_units
+from .robots import state_kinematics
+from .runs import DashboardResult
 
 #: Units of the joint and task variables, by robot (the registry does not carry units).
 UNITS = {

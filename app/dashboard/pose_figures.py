@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from jik.app.dashboard.algorithms import COLORS, DASH, LABELS, STYLES
-from jik.app.dashboard.plotting import (
+from .algorithms import COLORS, DASH, LABELS, STYLES
+from .plotting import (
     NO_LEGEND,
     corner_names,
     figure,
@@ -24,7 +24,7 @@ from jik.app.dashboard.plotting import (
     trace,
     units,
 )
-from jik.app.dashboard.runs import DashboardResult
+from .runs import DashboardResult
 
 #: The coordinates of an arm's task in space (any of them).
 POSE_NAMES = ("x", "y", "z", "rx", "ry", "rz")

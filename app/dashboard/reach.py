@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from jik.engine.exceptions import JikError
-from jik.engine.planar_chain import PlanarChain
+from ...engine.exceptions import JikError
+from ...engine.planar_chain import PlanarChain
 
 #: sigma_min / sigma_max of J below this: the arm is at a kinematic singularity.
 SINGULAR_RATIO = 1e-3

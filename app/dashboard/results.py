@@ -16,12 +16,13 @@ from typing import cast
 
 import numpy as np
 
-from jik.app.dashboard.analysis import augmenting_grid
-from jik.app.dashboard.controls import MAX_DASHBOARD_CYCLES
-from jik.app.dashboard.model import DashboardState, cache_key
-from jik.app.dashboard.offload import OffloadLane
-from jik.app.dashboard.robots import state_kinematics, state_spec
-from jik.app.dashboard.runs import (
+from ...engine.unicycle import Unicycle
+from .analysis import augmenting_grid
+from .controls import MAX_DASHBOARD_CYCLES
+from .model import DashboardState, cache_key
+from .offload import OffloadLane
+from .robots import state_kinematics, state_spec
+from .runs import (
     UNICYCLE_TIME_POINTS,
     AlgorithmRun,
     DashboardResult,
@@ -29,7 +30,6 @@ from jik.app.dashboard.runs import (
     first_cycles,
     leg_targets,
 )
-from jik.engine.unicycle import Unicycle
 
 
 def other_cycles(cache: dict, state: DashboardState, algorithm: str, legs: int):

@@ -21,17 +21,17 @@ from typing import Any
 
 import numpy as np
 
-from jik.app.compute.budget import build_seconds, time_budget
-from jik.app.compute.exceptions import RequestError
-from jik.app.compute.worker import task
-from jik.app.dashboard.algorithms import inverse_parameters
-from jik.engine.arms import ARMS
-from jik.engine.exceptions import InvalidInputError
-from jik.engine.inverses import Inverse
-from jik.engine.kinematics import Kinematics
-from jik.engine.registry import RobotSpec, make_inverse, robot_spec
-from jik.engine.robot_kinds import KINDS
-from jik.engine.robot_spec import Robot, robot_from_dict
+from ...engine.arms import ARMS
+from ...engine.exceptions import InvalidInputError
+from ...engine.inverses import Inverse
+from ...engine.kinematics import Kinematics
+from ...engine.registry import RobotSpec, make_inverse, robot_spec
+from ...engine.robot_kinds import KINDS
+from ...engine.robot_spec import Robot, robot_from_dict
+from ..compute.budget import build_seconds, time_budget
+from ..compute.exceptions import RequestError
+from ..compute.worker import task
+from .algorithms import inverse_parameters
 
 #: The robots given by a definition: the kinds a user defines (the editor's choices), and the
 #: catalogue's arms (:mod:`jik.engine.arms`), whose definition is their name and task.

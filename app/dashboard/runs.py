@@ -11,15 +11,15 @@ from typing import cast
 
 import numpy as np
 
-from jik.app.dashboard.controls import max_iterations
-from jik.app.dashboard.model import DashboardState
-from jik.app.dashboard.reach import stall_note
-from jik.app.dashboard.robots import state_inverse, state_kinematics
-from jik.engine.exceptions import RunCancelled
-from jik.engine.progress import ProgressCallbacks
-from jik.engine.repeatability import Leg, Resume, closed_path, repeatability
-from jik.engine.results import SolveResult, Trajectory
-from jik.engine.unicycle import Unicycle
+from ...engine.exceptions import RunCancelled
+from ...engine.progress import ProgressCallbacks
+from ...engine.repeatability import Leg, Resume, closed_path, repeatability
+from ...engine.results import SolveResult, Trajectory
+from ...engine.unicycle import Unicycle
+from .controls import max_iterations
+from .model import DashboardState
+from .reach import stall_note
+from .robots import state_inverse, state_kinematics
 
 #: Time grid points of one unicycle platform path q(t).
 UNICYCLE_TIME_POINTS = 96

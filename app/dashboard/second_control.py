@@ -7,12 +7,12 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable
 
-from jik.app.dashboard.analysis import expensive_map, kinematics_and_map
-from jik.app.dashboard.functionals import functionals_key
-from jik.app.dashboard.messages import Event
-from jik.app.dashboard.model import DashboardState
-from jik.app.dashboard.runs import Cancelled, DashboardResult
-from jik.app.dashboard.second_phase import SecondPhase, cancelled_message, finished_message
+from .analysis import expensive_map, kinematics_and_map
+from .functionals import functionals_key
+from .messages import Event
+from .model import DashboardState
+from .runs import Cancelled, DashboardResult
+from .second_phase import SecondPhase, cancelled_message, finished_message
 
 
 class SecondPhaseControl:

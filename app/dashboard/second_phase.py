@@ -14,17 +14,17 @@ import itertools
 from collections.abc import Callable
 from dataclasses import replace
 
-from jik.app.dashboard.analysis import augmenting_grid, grid_batches
-from jik.app.dashboard.figures import figure_specs
-from jik.app.dashboard.functionals import (
+from .analysis import augmenting_grid, grid_batches
+from .figures import figure_specs
+from .functionals import (
     error_functionals,
     sensitivity,
     sensitivity_evaluations,
 )
-from jik.app.dashboard.map_figures import augmenting_title
-from jik.app.dashboard.messages import digest, with_figures
-from jik.app.dashboard.plotting import figure_json
-from jik.app.dashboard.runs import Cancelled, DashboardResult
+from .map_figures import augmenting_title
+from .messages import digest, with_figures
+from .plotting import figure_json
+from .runs import Cancelled, DashboardResult
 
 #: What the page says is being computed, step by step.
 GRID = "h on a grid"

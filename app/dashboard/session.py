@@ -20,14 +20,15 @@ import time
 from collections.abc import Callable, Mapping
 from typing import NoReturn
 
-from jik.app.dashboard.ahead import SolvingAhead
-from jik.app.dashboard.analysis import expensive_map
-from jik.app.dashboard.controls import controls_message
-from jik.app.dashboard.figures import gamma_free_panels
-from jik.app.dashboard.listeners import Listeners
-from jik.app.dashboard.map_synthesis import built_map
-from jik.app.dashboard.messages import Event, digest, finite, summary, to_json, with_figures
-from jik.app.dashboard.model import (
+from ...engine.exceptions import InvalidInputError, JikError
+from .ahead import SolvingAhead
+from .analysis import expensive_map
+from .controls import controls_message
+from .figures import gamma_free_panels
+from .listeners import Listeners
+from .map_synthesis import built_map
+from .messages import Event, digest, finite, summary, to_json, with_figures
+from .model import (
     COLORS,
     LABELS,
     DashboardState,
@@ -37,15 +38,14 @@ from jik.app.dashboard.model import (
     updated_state,
     validate,
 )
-from jik.app.dashboard.offload import Offload
-from jik.app.dashboard.panel_texts import PanelTexts
-from jik.app.dashboard.plotting import PANELS
-from jik.app.dashboard.results import compute
-from jik.app.dashboard.runs import Cancelled, DashboardResult
-from jik.app.dashboard.second_control import SecondPhaseControl
-from jik.app.dashboard.slots import FairSlots
-from jik.app.dashboard.verdict import verdict
-from jik.engine.exceptions import InvalidInputError, JikError
+from .offload import Offload
+from .panel_texts import PanelTexts
+from .plotting import PANELS
+from .results import compute
+from .runs import Cancelled, DashboardResult
+from .second_control import SecondPhaseControl
+from .slots import FairSlots
+from .verdict import verdict
 
 log = logging.getLogger("jik.dashboard")
 

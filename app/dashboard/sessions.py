@@ -23,11 +23,11 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from jik.app.compute.settings import Settings
-from jik.app.dashboard.model import default_state, updated_state
-from jik.app.dashboard.offload import Offload
-from jik.app.dashboard.session import Dashboard
-from jik.app.dashboard.slots import FairSlots
+from ..compute.settings import Settings
+from .model import default_state, updated_state
+from .offload import Offload
+from .session import Dashboard
+from .slots import FairSlots
 
 
 class ExportUnavailable(Exception):

@@ -10,10 +10,10 @@ import json
 
 import numpy as np
 
-from jik.app.dashboard.analysis import expensive_map, kinematics_and_map
-from jik.app.dashboard.model import DashboardState
-from jik.app.dashboard.robots import state_spec
-from jik.engine.exceptions import JikError
+from ...engine.exceptions import JikError
+from .analysis import expensive_map, kinematics_and_map
+from .model import DashboardState
+from .robots import state_spec
 
 #: Grid points per region variable.
 NODES = 25

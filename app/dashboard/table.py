@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from jik.app.dashboard.algorithms import STYLES
-from jik.app.dashboard.plotting import corner_names, figure, trace
-from jik.app.dashboard.runs import DashboardResult
-from jik.engine.reproductions.table1 import PATH, PRINTED, X0, cell
+from ...engine.reproductions.table1 import PATH, PRINTED, X0, cell
+from .algorithms import STYLES
+from .plotting import corner_names, figure, trace
+from .runs import DashboardResult
 
 TABLE1_TITLE = (
     "Table 1 of the paper: Manipulator 2 on the closed path, jik beside the printed values"

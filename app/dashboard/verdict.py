@@ -16,14 +16,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from jik.app.dashboard.joint_limits import limits_texts
-from jik.app.dashboard.messages import h_change
-from jik.app.dashboard.plotting import norm_unit, units
-from jik.app.dashboard.runs import AlgorithmRun, DashboardResult
-from jik.app.dashboard.singular import singular_sentence
-from jik.app.dashboard.verdict_algorithms import NAMES, practical_sentences
-from jik.engine.registry import POSE_A, POSE_B
-from jik.engine.repeatability import REPEATABLE_DRIFT
+from ...engine.registry import POSE_A, POSE_B
+from ...engine.repeatability import REPEATABLE_DRIFT
+from .joint_limits import limits_texts
+from .messages import h_change
+from .plotting import norm_unit, units
+from .runs import AlgorithmRun, DashboardResult
+from .singular import singular_sentence
+from .verdict_algorithms import NAMES, practical_sentences
 
 #: h counts as conserved when it changed by less than this along a run.
 H_CONSERVED = 1e-6

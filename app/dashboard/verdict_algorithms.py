@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from jik.app.dashboard.joint_limits import state_limits
-from jik.app.dashboard.robots import state_inverse
-from jik.app.dashboard.runs import AlgorithmRun, DashboardResult
-from jik.engine.repeatability import REPEATABLE_DRIFT
+from ...engine.repeatability import REPEATABLE_DRIFT
+from .joint_limits import state_limits
+from .robots import state_inverse
+from .runs import AlgorithmRun, DashboardResult
 
 #: The algorithms' names in the verdict's sentences.
 NAMES = {

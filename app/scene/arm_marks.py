@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 import viser.transforms as vtf
 
-from jik.engine import so3
+from ...engine import so3
 
 #: A joint's colour while its value is outside the robot's limits.
 OUTSIDE_COLOR = (255, 140, 0)

@@ -10,7 +10,7 @@ from typing import Any
 
 import viser
 
-from jik.app.dashboard.controls import GROUPS, Control, control_values, controls
+from ..dashboard.controls import GROUPS, Control, control_values, controls
 
 
 class SceneControls:

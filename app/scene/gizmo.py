@@ -9,7 +9,7 @@ from collections.abc import Callable
 
 import viser
 
-from jik.app.scene.pose import gizmo_pose, quaternion_yaw, start_from_gizmo, yaw_quaternion
+from .pose import gizmo_pose, quaternion_yaw, start_from_gizmo, yaw_quaternion
 
 #: Seconds between two changes of the start point while its gizmo is dragged (each starts a
 #: computation; the dashboard solves only the newest state, but every change is an event).

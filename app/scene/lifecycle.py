@@ -15,18 +15,18 @@ import json
 import threading
 from collections.abc import Sequence
 
-from jik.app.dashboard import COLORS, LABELS, Dashboard, Event, runs_key
-from jik.app.dashboard.algorithms import DEFAULT_ALGORITHMS
-from jik.app.dashboard.help import STYLES
-from jik.app.scene.camera import CameraFraming
-from jik.app.scene.controls import SceneControls
-from jik.app.scene.gizmo import StartGizmo
-from jik.app.scene.mechanisms import add_floor_grid, extent_of, layout_name
-from jik.app.scene.nodes import NodeSets
-from jik.app.scene.playback import Playback
-from jik.app.scene.pose import Timeline
-from jik.app.scene.server import SceneServer
-from jik.engine.exceptions import InvalidInputError
+from ...engine.exceptions import InvalidInputError
+from ..dashboard import COLORS, LABELS, Dashboard, Event, runs_key
+from ..dashboard.algorithms import DEFAULT_ALGORITHMS
+from ..dashboard.help import STYLES
+from .camera import CameraFraming
+from .controls import SceneControls
+from .gizmo import StartGizmo
+from .mechanisms import add_floor_grid, extent_of, layout_name
+from .nodes import NodeSets
+from .playback import Playback
+from .pose import Timeline
+from .server import SceneServer
 
 
 class DashboardScene:

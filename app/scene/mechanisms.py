@@ -24,19 +24,19 @@ from typing import Any
 
 import numpy as np
 
-from jik.app.dashboard.algorithms import COLORS, STYLES
-from jik.app.dashboard.joint_limits import outside_joints, state_limits
-from jik.app.dashboard.robots import state_kinematics
-from jik.app.scene.arm_marks import (
+from ...engine.arms import ARMS
+from ..dashboard.algorithms import COLORS, STYLES
+from ..dashboard.joint_limits import outside_joints, state_limits
+from ..dashboard.robots import state_kinematics
+from .arm_marks import (
     AXES_FRACTION,
     OUTSIDE_COLOR,
     end_frame,
     joint_points,
     target_fixtures,
 )
-from jik.app.scene.pose import yaw_quaternion
-from jik.app.scene.traces import polyline, trace_tolerance
-from jik.engine.arms import ARMS
+from .pose import yaw_quaternion
+from .traces import polyline, trace_tolerance
 
 #: Height of each algorithm's copy above the task plane, and its opacity (None: solid).
 Z = {a: s.z for a, s in STYLES.items()}

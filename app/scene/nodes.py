@@ -14,9 +14,9 @@ from typing import Any, cast
 
 import numpy as np
 
-from jik.app.dashboard.algorithms import COLORS, DEFAULT_ALGORITHMS
-from jik.app.dashboard.plotting import corner_names
-from jik.app.scene.mechanisms import (
+from ..dashboard.algorithms import COLORS, DEFAULT_ALGORITHMS
+from ..dashboard.plotting import corner_names
+from .mechanisms import (
     HOME_COLOR,
     MECHANISMS,
     OPACITY,
@@ -30,7 +30,7 @@ from jik.app.scene.mechanisms import (
     rgb,
     trace_tolerance,
 )
-from jik.app.scene.pose import Timeline
+from .pose import Timeline
 
 #: The frame of the unicycle's nodes, drawn anew for each result.
 UNICYCLE_ROOT = "/robot/unicycle"

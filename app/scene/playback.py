@@ -9,8 +9,8 @@ from collections.abc import Mapping
 
 import viser
 
-from jik.app.scene.mechanisms import Mechanism
-from jik.app.scene.pose import Timeline
+from .mechanisms import Mechanism
+from .pose import Timeline
 
 #: Frames per second of the animation (poses sent to the clients).
 FPS = 25.0

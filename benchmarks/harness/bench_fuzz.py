@@ -18,7 +18,7 @@ import tempfile
 import time
 from dataclasses import dataclass
 
-from jik.benchmarks.serving import jik_serve
+from ..serving import jik_serve
 
 #: The phases run with every check. Not the stateful phase: on this document schemathesis's
 #: grows past the memory of a developer's machine within a minute and a half. Not the

@@ -13,8 +13,8 @@ import time
 from typing import Any
 from urllib.parse import parse_qs, quote, urlsplit
 
-from jik.benchmarks.bench_latency import CHROMIUM, Change, _progress
-from jik.benchmarks.latency_server import CHANGE_TIMEOUT, quiet
+from ..bench_latency import CHROMIUM, Change, _progress
+from ..latency_server import CHANGE_TIMEOUT, quiet
 
 # In every document, from its start: when each generation first shows. The page sets
 # body[data-generation] once a result's plots are drawn; the viser client's status shows

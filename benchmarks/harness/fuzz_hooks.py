@@ -57,22 +57,22 @@ except ImportError as exc:
         f"{exc}: jik bench fuzz needs the test extra, pip install -e '.[test]'"
     ) from exc
 
-from jik.app.compute import schemas as S
-from jik.app.compute.atlas_plan import AtlasLimits, plan_request
-from jik.app.compute.atlas_schemas import AtlasRequest
-from jik.app.compute.exceptions import RequestError
-from jik.app.compute.requests import _check_start, _setup
-from jik.app.compute.robot_requests import check_configuration, check_task_point
-from jik.app.compute.schemas.synthesis import QMC_NODES
-from jik.app.compute.synthesis import synthesis_region
-from jik.app.compute.user_robots import user_robot
-from jik.app.dashboard.model import default_state, updated_state
-from jik.app.dashboard.patch import StatePatch, patch_of
-from jik.engine.exceptions import InvalidInputError, JikError
-from jik.engine.registry import ROBOTS
-from jik.engine.robot_synthesis import TOTAL_DEGREE
-from jik.engine.synthesis_nd import MAX_UNKNOWNS
-from jik.engine.total_degree import basis_size
+from ...app.compute import schemas as S
+from ...app.compute.atlas_plan import AtlasLimits, plan_request
+from ...app.compute.atlas_schemas import AtlasRequest
+from ...app.compute.exceptions import RequestError
+from ...app.compute.requests import _check_start, _setup
+from ...app.compute.robot_requests import check_configuration, check_task_point
+from ...app.compute.schemas.synthesis import QMC_NODES
+from ...app.compute.synthesis import synthesis_region
+from ...app.compute.user_robots import user_robot
+from ...app.dashboard.model import default_state, updated_state
+from ...app.dashboard.patch import StatePatch, patch_of
+from ...engine.exceptions import InvalidInputError, JikError
+from ...engine.registry import ROBOTS
+from ...engine.robot_synthesis import TOTAL_DEGREE
+from ...engine.synthesis_nd import MAX_UNKNOWNS
+from ...engine.total_degree import basis_size
 
 #: Caps on the fields that size the work (and on the robot parameters that do: the unicycle's
 #: horizon T sizes its quadrature; T = 19.7 with 300 steps needed 1.7 GB).

@@ -19,9 +19,9 @@ from functools import partial
 
 import numpy as np
 
-from jik.engine.kinematics import Manipulator2
-from jik.engine.registry import ALGORITHMS, make_inverse
-from jik.engine.repeatability import repeatability
+from ..kinematics import Manipulator2
+from ..registry import ALGORITHMS, make_inverse
+from ..repeatability import repeatability
 
 X0 = (0.0, 0.0, math.pi / 2)
 PATH = ((1.0, 1.0), (1.0, 2.0), (0.0, 2.0), (0.0, 1.0))
@@ -91,7 +91,7 @@ def run(
             kin = Manipulator2()
             out["algorithms"] = _rows(partial(make_inverse, kin), X0, PATH, cycles, loop, step)
         elif loop == "panda":
-            from jik.engine.robot_spec import robot_from_dict
+            from ..robot_spec import robot_from_dict
 
             robot = robot_from_dict(PANDA)
             x0, path = robot.spec.default_x0, robot.spec.default_path

@@ -15,12 +15,12 @@ from typing import TypedDict
 import numpy as np
 from scipy import optimize
 
-from jik.engine.augmentations import E1Optimal, E1Taylor, E2Optimal
-from jik.engine.functionals import error_functional_e1, error_functional_e2
-from jik.engine.kinematics import Manipulator1
-from jik.engine.registry import MANIPULATOR1_REGION
-from jik.engine.symbolic import findings_summary, manipulator1_findings
-from jik.engine.variational import synthesize_e2
+from ..augmentations import E1Optimal, E1Taylor, E2Optimal
+from ..functionals import error_functional_e1, error_functional_e2
+from ..kinematics import Manipulator1
+from ..registry import MANIPULATOR1_REGION
+from ..symbolic import findings_summary, manipulator1_findings
+from ..variational import synthesize_e2
 
 REGION = MANIPULATOR1_REGION
 NODES = 24

@@ -13,20 +13,20 @@ from collections.abc import Callable
 
 import numpy as np
 
-from jik.engine.augmentations import PaperCubic
-from jik.engine.functionals import error_functional_e2
-from jik.engine.inverses import ExtendedInverse, Pseudoinverse
-from jik.engine.kinematics import Manipulator2
-from jik.engine.progress import ProgressCallbacks
-from jik.engine.reproductions.table1 import cell
-from jik.engine.reproductions.table1 import rows as table1_rows
-from jik.engine.symbolic import findings_summary, manipulator2_findings
-from jik.engine.variational import (
+from ..augmentations import PaperCubic
+from ..functionals import error_functional_e2
+from ..inverses import ExtendedInverse, Pseudoinverse
+from ..kinematics import Manipulator2
+from ..progress import ProgressCallbacks
+from ..symbolic import findings_summary, manipulator2_findings
+from ..variational import (
     MANIPULATOR2_DEGREE,
     MANIPULATOR2_REGION,
     synthesize_e2,
     synthesize_manipulator2,
 )
+from .table1 import cell
+from .table1 import rows as table1_rows
 
 #: Degree of the reference solve that stands for the converged minimum.
 REFERENCE_DEGREE = 40

@@ -11,10 +11,10 @@ import math
 
 import numpy as np
 
-from jik.engine.augmentations import PaperCubic, PaperCubicPrintedGradient
-from jik.engine.inverses import ExtendedInverse, Pseudoinverse
-from jik.engine.kinematics import Manipulator2
-from jik.engine.repeatability import repeatability
+from ..augmentations import PaperCubic, PaperCubicPrintedGradient
+from ..inverses import ExtendedInverse, Pseudoinverse
+from ..kinematics import Manipulator2
+from ..repeatability import repeatability
 
 X0 = (0.0, 0.0, math.pi / 2)
 PATH = ((1.0, 1.0), (1.0, 2.0), (0.0, 2.0), (0.0, 1.0))

@@ -22,11 +22,11 @@ from collections.abc import Callable
 
 import numpy as np
 
-from jik.engine.characteristics import UnicycleCharacteristics
-from jik.engine.exceptions import JikError
-from jik.engine.inverses import ExtendedInverse, Pseudoinverse
-from jik.engine.solver import solve
-from jik.engine.unicycle import Unicycle
+from ..characteristics import UnicycleCharacteristics
+from ..exceptions import JikError
+from ..inverses import ExtendedInverse, Pseudoinverse
+from ..solver import solve
+from ..unicycle import Unicycle
 
 STARTS = {"A": (5.0, 0.0, math.pi / 2), "B": (-5.0, 5.0, math.pi / 2)}
 LAMBDA0 = (0.5, -0.25, 0.3, -0.25)

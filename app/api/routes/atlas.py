@@ -10,13 +10,13 @@ from typing import Annotated
 from fastapi import APIRouter, Depends, Request, Response
 from starlette.concurrency import run_in_threadpool
 
-from jik.app.api.dependencies import Pool
-from jik.app.compute.atlas_jobs import AtlasJob, AtlasJobs
-from jik.app.compute.atlas_plan import AtlasLimits, plan_task
-from jik.app.compute.atlas_schemas import AtlasBody, AtlasJobResponse
-from jik.app.compute.pool import ComputePool
-from jik.app.compute.schemas import ErrorResponse
-from jik.engine.exceptions import InvalidInputError
+from ....engine.exceptions import InvalidInputError
+from ...compute.atlas_jobs import AtlasJob, AtlasJobs
+from ...compute.atlas_plan import AtlasLimits, plan_task
+from ...compute.atlas_schemas import AtlasBody, AtlasJobResponse
+from ...compute.pool import ComputePool
+from ...compute.schemas import ErrorResponse
+from ..dependencies import Pool
 
 router = APIRouter(tags=["atlas"])
 

@@ -14,8 +14,8 @@ import viser
 from fastapi import APIRouter
 from fastapi.responses import FileResponse, JSONResponse, Response
 
-from jik import static
-from jik.app.dashboard.help import page_config
+from .... import static
+from ...dashboard.help import page_config
 
 router = APIRouter(tags=["dashboard"])
 

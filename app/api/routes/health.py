@@ -2,7 +2,7 @@
 
 from fastapi import APIRouter
 
-from jik.app.compute.schemas import HealthResponse
+from ...compute.schemas import HealthResponse
 
 router = APIRouter(tags=["health"])
 

@@ -2,9 +2,9 @@
 
 from fastapi import APIRouter, Response
 
-from jik.app.api.dependencies import Pool
-from jik.app.compute.kinematics import KinematicsBody, KinematicsResponse, kinematics_task
-from jik.app.compute.schemas import BUSY
+from ...compute.kinematics import KinematicsBody, KinematicsResponse, kinematics_task
+from ...compute.schemas import BUSY
+from ..dependencies import Pool
 
 router = APIRouter(tags=["kinematics"])
 

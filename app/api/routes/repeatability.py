@@ -2,10 +2,10 @@
 
 from fastapi import APIRouter, Response
 
-from jik.app.api.dependencies import Pool
-from jik.app.compute.precheck import precheck
-from jik.app.compute.schemas import BUSY, RepeatabilityBody, RepeatabilityResponse
-from jik.app.compute.worker import repeatability_json
+from ...compute.precheck import precheck
+from ...compute.schemas import BUSY, RepeatabilityBody, RepeatabilityResponse
+from ...compute.worker import repeatability_json
+from ..dependencies import Pool
 
 router = APIRouter(tags=["repeatability"])
 

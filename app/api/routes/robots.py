@@ -2,9 +2,9 @@
 
 from fastapi import APIRouter
 
-from jik.app.api.dependencies import Pool
-from jik.app.compute.catalogue import robots_response
-from jik.app.compute.schemas import RobotsResponse
+from ...compute.catalogue import robots_response
+from ...compute.schemas import RobotsResponse
+from ..dependencies import Pool
 
 router = APIRouter(tags=["robots"])
 

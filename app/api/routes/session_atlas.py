@@ -17,14 +17,14 @@ from fastapi.responses import JSONResponse
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from starlette.concurrency import run_in_threadpool
 
-from jik.app.api.dependencies import Pool, Store
-from jik.app.api.routes.atlas import ERRORS, Jobs, start_job
-from jik.app.compute.atlas_schemas import MAX_CYCLES, MAX_FAMILY, AtlasJobResponse, Scale
-from jik.app.compute.schemas import INTEGRAL
-from jik.app.compute.user_robots import echo
-from jik.app.dashboard.atlas import atlas_figure, atlas_request
-from jik.app.dashboard.plotting import figure_json
-from jik.engine.exceptions import InvalidInputError
+from ....engine.exceptions import InvalidInputError
+from ...compute.atlas_schemas import MAX_CYCLES, MAX_FAMILY, AtlasJobResponse, Scale
+from ...compute.schemas import INTEGRAL
+from ...compute.user_robots import echo
+from ...dashboard.atlas import atlas_figure, atlas_request
+from ...dashboard.plotting import figure_json
+from ..dependencies import Pool, Store
+from .atlas import ERRORS, Jobs, start_job
 
 router = APIRouter(tags=["dashboard sessions"])
 #: Largest atlas the panel asks for (the API's own limits apply too).

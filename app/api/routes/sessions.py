@@ -21,16 +21,16 @@ from fastapi.responses import JSONResponse, PlainTextResponse
 from pydantic import BaseModel, ConfigDict, Field
 from sse_starlette import EventSourceResponse, ServerSentEvent
 
-from jik.app.api.dependencies import Pool, Store
-from jik.app.api.errors import unparsed_body_response
-from jik.app.compute.schemas import INTEGRAL
-from jik.app.dashboard import export_file
-from jik.app.dashboard.controls import controls_message
-from jik.app.dashboard.messages import LatestEvents
-from jik.app.dashboard.patch import StatePatch, parse_patch, patch_of
-from jik.app.dashboard.robots import vet_definition
-from jik.app.dashboard.sessions import ExportUnavailable, Session, SessionNotFound
-from jik.engine.exceptions import InvalidInputError
+from ....engine.exceptions import InvalidInputError
+from ...compute.schemas import INTEGRAL
+from ...dashboard import export_file
+from ...dashboard.controls import controls_message
+from ...dashboard.messages import LatestEvents
+from ...dashboard.patch import StatePatch, parse_patch, patch_of
+from ...dashboard.robots import vet_definition
+from ...dashboard.sessions import ExportUnavailable, Session, SessionNotFound
+from ..dependencies import Pool, Store
+from ..errors import unparsed_body_response
 
 router = APIRouter(tags=["dashboard sessions"])
 #: Seconds between keep-alive comments on the event stream.

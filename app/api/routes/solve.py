@@ -2,8 +2,8 @@
 
 from fastapi import APIRouter, Response
 
-from jik.app.api.dependencies import Pool
-from jik.app.compute.schemas import BUSY, SolveBody, SolveResponse
+from ...compute.schemas import BUSY, SolveBody, SolveResponse
+from ..dependencies import Pool
 
 router = APIRouter(tags=["solve"])
 

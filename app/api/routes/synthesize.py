@@ -2,16 +2,16 @@
 
 from fastapi import APIRouter, Response
 
-from jik.app.api.dependencies import Pool
-from jik.app.compute.precheck import precheck
-from jik.app.compute.schemas import (
+from ...compute.precheck import precheck
+from ...compute.schemas import (
     BUSY,
     SynthesisMethodsResponse,
     SynthesizeBody,
     SynthesizeResponse,
 )
-from jik.app.compute.synthesis import synthesis_methods
-from jik.app.compute.worker import synthesize_json
+from ...compute.synthesis import synthesis_methods
+from ...compute.worker import synthesize_json
+from ..dependencies import Pool
 
 router = APIRouter(tags=["synthesize"])
 

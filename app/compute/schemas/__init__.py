@@ -10,8 +10,8 @@
 Everything is re-exported here: ``from jik.app.compute import schemas as S``.
 """
 
-from jik.app.compute.schemas.algorithms import AlgorithmParameters
-from jik.app.compute.schemas.fields import (
+from .algorithms import AlgorithmParameters
+from .fields import (
     COORDINATE_BOUND,
     GAMMA_MIN,
     INTEGRAL,
@@ -28,7 +28,7 @@ from jik.app.compute.schemas.fields import (
     Tolerance,
     Vector,
 )
-from jik.app.compute.schemas.info import (
+from .info import (
     BUSY,
     AlgorithmInfo,
     AugmentationInfo,
@@ -39,7 +39,7 @@ from jik.app.compute.schemas.info import (
     RobotInfo,
     RobotsResponse,
 )
-from jik.app.compute.schemas.robots import (
+from .robots import (
     AUGMENTATION_MODELS,
     MAX_FORMULA_CHARS,
     MAX_URDF_CHARS,
@@ -60,7 +60,7 @@ from jik.app.compute.schemas.robots import (
     UrdfRobot,
     UserAugmentation,
 )
-from jik.app.compute.schemas.runs import (
+from .runs import (
     LimitsInfo,
     LimitViolationInfo,
     RepeatabilityBody,
@@ -71,7 +71,7 @@ from jik.app.compute.schemas.runs import (
     SolveResponse,
     Trajectory,
 )
-from jik.app.compute.schemas.synthesis import (
+from .synthesis import (
     FunctionalInfo,
     SynthesisGrid,
     SynthesisMethod,
@@ -81,7 +81,7 @@ from jik.app.compute.schemas.synthesis import (
     SynthesizeResponse,
     TotalDegreeInfo,
 )
-from jik.app.compute.schemas.variants import per_robot
+from .variants import per_robot
 
 __all__ = [
     "AUGMENTATION_MODELS",

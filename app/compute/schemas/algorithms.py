@@ -7,7 +7,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, create_model
 
-from jik.engine.registry import ALGORITHMS
+from ....engine.registry import ALGORITHMS
 
 #: Every algorithm of the engine, as the API names them.
 Algorithm = Literal["pseudoinverse", "extended", "damped", "weighted", "posture"]

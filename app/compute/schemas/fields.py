@@ -10,8 +10,8 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BeforeValidator, Field
 
-from jik.app.compute.schemas.algorithms import Algorithm as Algorithm
-from jik.engine.solve_rules import GAMMA_MAX, GAMMA_MIN, TOL_MIN
+from ....engine.solve_rules import GAMMA_MAX, GAMMA_MIN, TOL_MIN
+from .algorithms import Algorithm as Algorithm
 
 #: Largest configuration / task dimension accepted before the registry check.
 MAX_DIMENSION = 16

@@ -6,7 +6,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, Field
 
-from jik.app.compute.schemas.fields import Algorithm, Mode
+from .fields import Algorithm, Mode
 
 
 class ParameterInfo(BaseModel):

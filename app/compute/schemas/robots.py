@@ -13,14 +13,14 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeAlias, Union
 
 from pydantic import BaseModel, ConfigDict, Field, create_model
 
-from jik.app.compute.schemas.fields import (
+from ....engine.arms import ARMS, Arm
+from ....engine.registry import ROBOTS, AugmentationSpec, RobotSpec
+from .fields import (
     INTEGRAL,
     MAX_DIMENSION,
     Coordinate,
     FiniteFloat,
 )
-from jik.engine.arms import ARMS, Arm
-from jik.engine.registry import ROBOTS, AugmentationSpec, RobotSpec
 
 
 def _camel(name: str) -> str:

@@ -10,8 +10,11 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from jik.app.compute.schemas.algorithms import AlgorithmParameters
-from jik.app.compute.schemas.fields import (
+from ....engine.registry import RobotSpec
+from ....engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
+from ....engine.solve_rules import DISCRETE_GAMMA_BOUND
+from .algorithms import AlgorithmParameters
+from .fields import (
     INTEGRAL,
     MAX_ITERATIONS,
     Algorithm,
@@ -22,17 +25,14 @@ from jik.app.compute.schemas.fields import (
     Tolerance,
     Vector,
 )
-from jik.app.compute.schemas.robots import (
+from .robots import (
     AnyAugmentation,
     AnyRobot,
     AugmentationUsed,
     RobotUsed,
     _absent,
 )
-from jik.app.compute.schemas.variants import per_robot
-from jik.engine.registry import RobotSpec
-from jik.engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
-from jik.engine.solve_rules import DISCRETE_GAMMA_BOUND
+from .variants import per_robot
 
 
 class _Request(BaseModel):

@@ -6,16 +6,16 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from jik.app.compute.schemas.fields import (
+from ....engine.registry import RobotSpec
+from .fields import (
     INTEGRAL,
     MAX_DIMENSION,
     Bound,
     FiniteFloat,
     MaybeFloat,
 )
-from jik.app.compute.schemas.robots import AnyAugmentation, AnyRobot, AugmentationUsed, RobotUsed
-from jik.app.compute.schemas.variants import per_robot
-from jik.engine.registry import RobotSpec
+from .robots import AnyAugmentation, AnyRobot, AugmentationUsed, RobotUsed
+from .variants import per_robot
 
 SynthesisMethod = Literal["evaluate", "e2_variational", "e2_total_degree"]
 #: Sobol nodes of a total-degree synthesis (a power of two): default and bounds.

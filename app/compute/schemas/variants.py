@@ -6,7 +6,8 @@ from typing import Annotated, Any, Union
 
 from pydantic import BaseModel, Discriminator, Field, Tag, create_model
 
-from jik.app.compute.schemas.robots import (
+from ....engine.registry import ROBOTS
+from .robots import (
     AUGMENTATION_MODELS,
     ROBOT_MODELS,
     ROBOT_NAMES,
@@ -15,7 +16,6 @@ from jik.app.compute.schemas.robots import (
     _camel,
     _union,
 )
-from jik.engine.registry import ROBOTS
 
 
 def _robot_name(body: Any) -> str | None:
