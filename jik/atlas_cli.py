@@ -33,6 +33,7 @@ from jik.algorithm_options import (
     algorithm_parameters,
 )
 from jik.atlas_output import CsvWriter, Gathered, listed, write_figure
+from jik.robot_commands import add_task_option, robot_with_task
 
 #: Atlases of more runs than this write their arrays to the CSV only (the JSON keeps a summary).
 JSON_RUNS = 20000
@@ -50,11 +51,7 @@ def add_atlas_parser(sub) -> None:
     p.add_argument(
         "--robot", default="manipulator2", help="a built-in robot, or a robot file (.json, .yaml)"
     )
-    p.add_argument(
-        "--task",
-        help="a catalogue arm's task: 'pose', 'xyz' or coordinates among x y z rx ry rz "
-        "(default: the arm's)",
-    )
+    add_task_option(p)
     p.add_argument(
         "--param",
         action="append",
@@ -183,25 +180,17 @@ def _run(args: argparse.Namespace) -> int:
     from jik.engine.atlas_run import iter_atlas
     from jik.engine.exceptions import InvalidInputError
     from jik.engine.registry import make_inverse, robot_spec
-    from jik.engine.robot_spec import load_robot, robot_from_dict
     from jik.engine.self_motion import MAX_ARC
 
     out = _writable(Path(args.out))
     algorithms = args.algorithm or ["pseudoinverse"]
-    if args.task is not None and args.robot not in ARMS:
-        raise InvalidInputError(
-            f"--task is for a catalogue arm ({sorted(ARMS)}); a robot file holds its task", "task"
-        )
-    if Path(args.robot).is_file() or args.robot in ARMS:  # a user's robot or a catalogue arm
+    # a user's robot or a catalogue arm (--task given: it must be one)
+    if args.task is not None or Path(args.robot).is_file() or args.robot in ARMS:
+        robot = robot_with_task(args.robot, args.task)
         if args.param:
             raise InvalidInputError(
                 "--param is for a built-in robot; a robot file holds its parameters", "param"
             )
-        robot = (
-            load_robot(args.robot)
-            if args.task is None
-            else robot_from_dict({"name": args.robot, "task": args.task})
-        )
         spec, kin = robot.spec, robot.kinematics
         inverses = [
             robot.inverse(a, args.augmentation, algorithm_parameters=algorithm_parameters(args, a))

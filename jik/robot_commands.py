@@ -50,14 +50,39 @@ def parse_path(text: str, option: str) -> list[list[float]]:
     return [parse_vector(p, f"{option}[{i}]") for i, p in enumerate(_split(text, ";")) if p.strip()]
 
 
+def add_task_option(p: argparse.ArgumentParser) -> None:
+    """--task: a catalogue arm's task (:func:`robot_with_task`)."""
+    p.add_argument(
+        "--task",
+        help="a catalogue arm's task: 'pose', 'xyz' or coordinates among x y z rx ry rz "
+        "(default: the arm's)",
+    )
+
+
+def robot_with_task(source: str, task: str | None) -> Robot:
+    """The robot of ``--robot`` (a file or a name), a catalogue arm with ``--task`` if given."""
+    from jik.engine.arms import ARMS
+    from jik.engine.exceptions import InvalidInputError
+    from jik.engine.robot_spec import load_robot, robot_from_dict
+
+    if task is None:
+        return load_robot(source)
+    if source not in ARMS:
+        raise InvalidInputError(
+            f"--task is for a catalogue arm ({sorted(ARMS)}); a robot file holds its task", "task"
+        )
+    return robot_from_dict({"name": source, "task": task})
+
+
 def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--robot",
         required=True,
         help="a robot file (.json, .yaml), a built-in robot's name or a catalogue "
         "arm's (panda, iiwa14, gen3, ur5e: its default task; for another, a file "
-        'such as {"name": "panda", "task": "xyz"})',
+        "with --task)",
     )
+    add_task_option(p)
     p.add_argument("--x0", help="start configuration, e.g. '0, 0, pi/2' (default: the robot's)")
     p.add_argument("--algorithm", choices=ALGORITHM_NAMES, default="pseudoinverse")
     p.add_argument("--augmentation", help="augmenting map of the extended inverse (its name)")
@@ -73,9 +98,7 @@ def _common(p: argparse.ArgumentParser) -> None:
 
 
 def _setup(args: argparse.Namespace) -> tuple[Robot, list[float], dict]:
-    from jik.engine.robot_spec import load_robot
-
-    robot = load_robot(args.robot)
+    robot = robot_with_task(args.robot, args.task)
     x0 = parse_vector(args.x0, "--x0") if args.x0 else list(robot.spec.default_x0)
     settings = {
         "mode": args.mode or robot.spec.default_mode,

@@ -117,6 +117,21 @@ def test_a_catalogue_arm_by_name_with_its_pose_task(capsys):
     assert "joint limits: left the joint limits at cycle 1, leg 1: x2 (panda_joint2)" in out
 
 
+def test_a_catalogue_arms_task_is_an_option(capsys, tmp_path, arm_file):
+    """``--task xyz`` gives the Panda a position task (r = 3) without a robot file; on a robot
+    file or a built-in robot the option is refused by its name."""
+    pytest.importorskip("yourdfpy")
+    out, _ = run(
+        capsys, "solve", "--robot", "panda", "--task", "xyz", "--target", "0.4, 0.1, 0.5", "--json"
+    )
+    result = json.loads(out)
+    assert result["success"] and len(result["y"]) == 3
+    np.testing.assert_allclose(result["y"], [0.4, 0.1, 0.5], atol=1e-9)
+    for robot in (arm_file, "manipulator2"):
+        _, err = run(capsys, "repeatability", "--robot", robot, "--task", "xyz", code=2)
+        assert "--task is for a catalogue arm" in err
+
+
 def test_urdf_robot_from_a_yaml_file(capsys, tmp_path):
     yaml = pytest.importorskip("yaml")
     pytest.importorskip("yourdfpy")
