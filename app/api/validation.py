@@ -12,6 +12,7 @@ from ..compute.schemas import (
     USER_AUGMENTATION_MODELS,
     USER_ROBOT_MODELS,
 )
+from ..compute.schemas.wording import refusal
 
 _TAGS = {*ROBOT_MODELS, *AUGMENTATION_MODELS, *USER_ROBOT_MODELS, *USER_AUGMENTATION_MODELS}
 #: The tags of a request's variants: the catalogue robots and the kinds of user robots.
@@ -57,10 +58,8 @@ def validation_detail(errors) -> list[dict]:
     detail = []
     for e in errors:
         loc = _location(e.get("loc", ()))
-        msg = str(e.get("msg", "invalid"))
-        if e.get("type") == "extra_forbidden":
-            msg = "unknown field; remove it"
-        elif e.get("type") == "json_invalid":  # (loc: the body and the character's position)
+        msg = refusal(e)
+        if e.get("type") == "json_invalid":  # (loc: the body and the character's position)
             ctx = e.get("ctx") or {}
             where = f" at character {loc[1]}" if len(loc) > 1 else ""
             detail.append(

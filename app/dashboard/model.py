@@ -30,6 +30,7 @@ from ..compute.schemas import (
     Tolerance,
 )
 from ..compute.schemas.algorithms import Algorithm
+from ..compute.schemas.wording import refusal
 from .algorithms import CHOICES, DEFAULT_ALGORITHMS, check_inverses, checked
 from .algorithms import COLORS as COLORS  # (re-exported: one table, there)
 from .algorithms import DASH as DASH
@@ -332,8 +333,7 @@ def _model(model: type[BaseModel], data: Mapping[str, Any], prefix: tuple[str, .
         error = exc.errors()[0]
         loc = (*prefix, *(str(p) for p in error["loc"]))
         name = ".".join(loc) or "state"
-        msg = "unknown field; remove it" if error["type"] == "extra_forbidden" else error["msg"]
-        raise InvalidInputError(f"{name}: {msg}", name) from None
+        raise InvalidInputError(f"{name}: {refusal(error)}", name) from None
 
 
 def _registered(check, name: str):

@@ -15,6 +15,7 @@ from ...engine.exceptions import InvalidInputError
 from ...engine.registry import ROBOTS
 from ...engine.repeatability import MAX_PATH_POINTS
 from ..compute.schemas import AUGMENTATION_MODELS, USER_AUGMENTATION_MODELS, Coordinate
+from ..compute.schemas.wording import refusal
 from .model import DashboardState, Point
 from .robots import USER_KINDS
 
@@ -88,8 +89,7 @@ def parse_patch(body: Any) -> dict[str, Any]:
             )
             or "body"
         )
-        message = "unknown field; remove it" if error["type"] == "extra_forbidden" else error["msg"]
-        raise InvalidInputError(f"{field}: {message}", field) from None
+        raise InvalidInputError(f"{field}: {refusal(error)}", field) from None
 
 
 def patch_of(patch: BaseModel) -> dict[str, Any]:
@@ -103,5 +103,5 @@ def patch_of(patch: BaseModel) -> dict[str, Any]:
         try:
             controls[key] = TypeAdapter(kind).validate_python(value)
         except ValidationError as exc:
-            raise InvalidInputError(f"{key}: {exc.errors()[0]['msg']}", key) from None
+            raise InvalidInputError(f"{key}: {refusal(exc.errors()[0])}", key) from None
     return {**patch.model_dump(exclude_unset=True), **controls}

@@ -148,6 +148,9 @@ def test_the_session_api_takes_the_choice(client):
     assert r.json()["state"]["algorithm_parameters"] == {"gain": 2.0}
     bad = client.post(url, json={"algorithm_parameters.gain": -2.0})
     assert bad.status_code == 422 and "algorithm_parameters.gain" in bad.text
+    none = client.post(url, json={"algorithms": []})
+    assert none.status_code == 422
+    assert [d["msg"] for d in none.json()["detail"]] == ["algorithms: give at least 1 entry, got 0"]
     assert client.get(f"/api/sessions/{session['id']}").json()["state"]["algorithms"] == THREE
 
 

@@ -48,8 +48,8 @@ def _rep(**over) -> dict:
         (solve_body(extra=1), "extra: unknown field; remove it"),
         (_rep(cycles=1001), "cycles: Input should be less than or equal to 1000"),
         (_rep(cycles=0), "cycles: Input should be greater than or equal to 1"),
-        (_rep(path=[[0.0, 1.0]] * 101), "path: List should have at most 100 items"),
-        (_rep(path=[]), "path: List should have at least 1 item"),
+        (_rep(path=[[0.0, 1.0]] * 101), "path: give at most 100 entries, got 101"),
+        (_rep(path=[]), "path: give at least 1 entry, got 0"),
         (_rep(path=[[1.0, 1.0], [1.0, 2.0, 3.0]]), "path[1]: must have 2 components"),
     ],
 )
