@@ -1,4 +1,5 @@
-"""A request's user robot: its definition built by the engine, its errors renamed.
+"""A request's user robot: its definition built by the engine, its errors renamed (the half of
+:func:`jik.app.compute.robot_requests.request_robot` for definitions and catalogue arms).
 
 A request may give, instead of a catalogue robot, a definition of one of the kinds of
 :mod:`jik.engine.robot_kinds` (``planar_chain``, ``formula``, ``urdf``), and for its extended
