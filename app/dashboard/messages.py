@@ -109,13 +109,19 @@ def jsonable(v):
 
 
 def h_change(h) -> float | None:
-    """How much h varied along a run (max - min over its finite values); None without h or
-    without a finite value (h undefined from the start)."""
+    """How much h varied along a run: max - min over the finite values of each component of h
+    (one per point, or p - r per point), the largest of those; None without h or without a finite
+    value (h undefined from the start). Eq. (12) keeps each component constant on its own."""
     if h is None:
         return None
     v = np.asarray(h, dtype=float)
-    v = v[np.isfinite(v)]
-    return float(v.max() - v.min()) if v.size else None
+    columns = v.reshape(len(v), -1) if v.ndim else v.reshape(1, 1)
+    finite = np.isfinite(columns)
+    if not finite.any():
+        return None
+    high = np.where(finite, columns, -np.inf).max(axis=0)
+    low = np.where(finite, columns, np.inf).min(axis=0)
+    return float((high - low)[finite.any(axis=0)].max())
 
 
 def summary(result: DashboardResult) -> dict:
