@@ -16,7 +16,6 @@ import numpy as np
 from ...engine.atlas import AtlasPlan, plan_atlas
 from ...engine.atlas_run import AtlasResult
 from ...engine.exceptions import InvalidInputError
-from ...engine.registry import ALGORITHMS, make_inverse
 from ...engine.repeatability import CLOSE_TOL
 from ...engine.self_motion import MAX_ARC
 from ...engine.solve_rules import gamma_problem
@@ -24,9 +23,7 @@ from .atlas_pool import sized_chunks
 from .atlas_schemas import AtlasRequest
 from .documents import nullable
 from .exceptions import RequestError
-from .robot_requests import build_augmentation, build_robot, check_task_point
-from .schemas.algorithms import field_of, used
-from .user_robots import is_user_robot, user_inverse, user_robot
+from .robot_requests import check_task_point, request_robot
 from .worker import task
 
 
@@ -44,45 +41,15 @@ class AtlasLimits:
     keep_for: float = 600.0
 
 
-def _own_parameters(algorithm: str, req: AtlasRequest) -> dict:
-    """Those of ``req.algorithm_parameters`` that are the algorithm's own."""
-    own = {p.name for p in ALGORITHMS[algorithm].parameters} | set(ALGORITHMS[algorithm].vectors)
-    return {k: v for k, v in used(req.algorithm_parameters).items() if k in own}
-
-
-def _inverses(req: AtlasRequest) -> tuple[Any, list]:
-    """The robot's spec and the inverse of each algorithm: a catalogue robot built by the
-    registry, a definition or catalogue arm by the engine (:func:`user_robot`, the extended
-    inverse with the request's map or the robot's default)."""
-    if len(set(req.algorithms)) != len(req.algorithms):
-        raise RequestError("algorithms", f"name each algorithm once, got {req.algorithms}")
-    if is_user_robot(req.robot):
-        extended = "extended" in req.algorithms
-        robot, _, _ = user_robot(req.robot, req.augmentation if extended else None)
-        inverses = [user_inverse(robot, a, _own_parameters(a, req)) for a in req.algorithms]
-        return robot.spec, inverses
-    spec, kin, _ = build_robot(req.robot)
-    inverses = []
-    for algorithm in req.algorithms:
-        if algorithm == "extended":
-            aspec, _, aug = build_augmentation(spec, kin, req.augmentation)
-            inverses.append(make_inverse(kin, "extended", aspec.name, aug.parameters, spec.name))
-            continue
-        try:
-            inverses.append(
-                make_inverse(
-                    kin, algorithm, spec=spec, algorithm_parameters=_own_parameters(algorithm, req)
-                )
-            )
-        except InvalidInputError as exc:
-            raise RequestError(field_of(exc.field, str(exc)), str(exc)) from None
-    return spec, inverses
-
-
 def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
     """The request's atlas, planned (curves traced); RequestError or InvalidInputError, each
     naming the field, when it cannot be."""
-    spec, inverses = _inverses(req)
+    if len(set(req.algorithms)) != len(req.algorithms):
+        raise RequestError("algorithms", f"name each algorithm once, got {req.algorithms}")
+    robot = request_robot(  # (each algorithm takes its own of the parameters)
+        req.robot, req.augmentation, req.algorithms, req.algorithm_parameters, own=True
+    )
+    spec, inverses = robot.spec, robot.inverses
     loops = not hasattr(inverses[0].kinematics, "path")  # (the unicycle's path is no loop)
     path = req.path or loops * [list(t) for t in spec.default_path]
     if not path:

@@ -18,10 +18,9 @@ from ...engine.registry import ROBOTS
 from . import schemas as S
 from .documents import nullable
 from .exceptions import RequestError
-from .robot_requests import build_robot
+from .robot_requests import request_robot
 from .schemas.robots import _camel
 from .schemas.variants import _robot_name
-from .user_robots import is_user_robot, user_robot
 from .worker import task
 
 #: Most configurations one request evaluates.
@@ -116,11 +115,8 @@ class KinematicsResponse(BaseModel):
 
 def kinematics_request(req: KinematicsRequest) -> KinematicsResponse:
     """The robot of ``req`` built, and its k and J at ``req.x``; raises :class:`RequestError`."""
-    if is_user_robot(req.robot):
-        robot, used, _ = user_robot(req.robot)
-        spec, kin = robot.spec, robot.kinematics
-    else:
-        spec, kin, used = build_robot(req.robot)
+    robot = request_robot(req.robot)
+    spec, kin = robot.spec, robot.kinematics
     many = isinstance(req.x[0], list)
     for i, row in enumerate(req.x if many else [req.x]):
         if len(row) != spec.p:  # type: ignore[arg-type]
@@ -134,7 +130,7 @@ def kinematics_request(req: KinematicsRequest) -> KinematicsResponse:
     forward_jacobian = getattr(kin, "forward_jacobian", None)
     k, J = forward_jacobian(x) if forward_jacobian else (kin.forward(x), kin.jacobian(x))
     return KinematicsResponse(
-        robot=used,
+        robot=robot.robot,
         variable_names=list(spec.variable_names),
         task_names=list(spec.task_names),
         k=nullable(k),

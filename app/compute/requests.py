@@ -2,9 +2,9 @@
 
 Plain synchronous functions (``solve_request``, ``solve_batch``, ``repeatability_request``) turn
 a request model into engine calls and the result into a response model. They raise
-:class:`RequestError` naming the offending field. The robot and map a request names are built by
-:mod:`jik.app.compute.robot_requests` (catalogue robots) or :mod:`jik.app.compute.user_robots`
-(definitions, catalogue arms); results become JSON by :mod:`jik.app.compute.documents`.
+:class:`RequestError` naming the offending field. The robot, map and inverse a request names are
+built by :func:`jik.app.compute.robot_requests.request_robot` (catalogue robots, definitions,
+catalogue arms alike); results become JSON by :mod:`jik.app.compute.documents`.
 :class:`jik.app.compute.pool.ComputePool` runs these for the HTTP API in worker processes.
 """
 
@@ -16,9 +16,9 @@ from typing import Any, TypeVar, cast
 
 import numpy as np
 
-from ...engine.exceptions import InvalidInputError, JikError, SingularConfigurationError
+from ...engine.exceptions import JikError, SingularConfigurationError
 from ...engine.limits import repeatability_report, robot_limits
-from ...engine.registry import RobotSpec, make_inverse
+from ...engine.registry import RobotSpec
 from ...engine.repeatability import REPEATABLE_DRIFT, repeatability
 from ...engine.solve_rules import gamma_problem
 from ...engine.solver import solve_batch as engine_solve_batch
@@ -30,14 +30,8 @@ from .documents import (
     solve_response_json,
 )
 from .exceptions import RequestError
-from .robot_requests import (
-    build_augmentation,
-    build_robot,
-    check_configuration,
-    check_task_point,
-)
-from .schemas.algorithms import field_of, used
-from .user_robots import is_user_robot, map_used, user_inverse, user_robot
+from .robot_requests import check_configuration, check_task_point, request_robot
+from .schemas.algorithms import used
 
 _R = TypeVar("_R")
 
@@ -59,47 +53,23 @@ class _Setup:
 
 
 def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
-    aug_used = None
     if req.algorithm == "extended" and used(req.algorithm_parameters):
         raise RequestError(
             "algorithm_parameters",
             "the extended inverse takes none (its augmenting map's parameters go in augmentation)",
         )
-    if is_user_robot(req.robot):
-        extended = req.algorithm == "extended"
-        robot, robot_used, aug_used = user_robot(req.robot, req.augmentation if extended else None)
-        spec, kin = robot.spec, robot.kinematics
-        params = used(req.algorithm_parameters, req.algorithm, robot.kinematics, req.x0)
-        inverse = user_inverse(robot, req.algorithm, params)
-        aug_used = map_used(robot) if extended else None
-    else:
-        spec, kin, robot_used = build_robot(req.robot)
-        inverse, aug_used = _catalogue_inverse(spec, kin, req)
+    built = request_robot(
+        req.robot, req.augmentation, [req.algorithm], req.algorithm_parameters, req.x0
+    )
+    spec, kin, (inverse,) = built.spec, built.kinematics, built.inverses
     mode = req.mode or spec.default_mode
     gamma = spec.default_gamma if req.gamma is None else float(req.gamma)
     if (why := gamma_problem(gamma, mode)) is not None:
         raise RequestError("gamma", why)
+    robot_used, aug_used = built.robot, built.augmentation
     return _Setup(
         spec, kin, inverse, robot_used, aug_used, mode, gamma, req.tolerance, req.max_iterations
     )
-
-
-def _catalogue_inverse(spec: RobotSpec, kin, req) -> tuple[Any, S.AugmentationUsed | None]:
-    """The inverse a request asks of a catalogue robot, and the map it used."""
-    aug_used = None
-    if req.algorithm == "extended":
-        aspec, _, aug_used = build_augmentation(spec, kin, req.augmentation)
-        try:
-            inverse = make_inverse(kin, "extended", aspec.name, aug_used.parameters, spec.name)
-        except InvalidInputError as exc:
-            raise RequestError("augmentation", str(exc)) from None
-    else:
-        try:
-            params = used(req.algorithm_parameters, req.algorithm, kin, req.x0)
-            inverse = make_inverse(kin, req.algorithm, spec=spec, algorithm_parameters=params)
-        except InvalidInputError as exc:
-            raise RequestError(field_of(exc.field, str(exc)), str(exc)) from None
-    return inverse, aug_used
 
 
 def _check_start(setup: _Setup, x0: np.ndarray) -> np.ndarray:

@@ -1,14 +1,88 @@
-"""A request's catalogue robot and augmenting map, built by the registry; its vectors' lengths
-checked against the robot. Each refusal is a :class:`RequestError` naming the request's field."""
+"""A request's robot built through one path, :func:`request_robot`: a catalogue robot and its
+map by the registry, a definition or catalogue arm by the engine (:mod:`.user_robots`), each with
+the inverses the request asks for; its vectors' lengths checked against the robot. Each refusal
+is a :class:`RequestError` naming the request's field."""
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import Any
 
+from pydantic import BaseModel
+
 from ...engine.exceptions import InvalidInputError
-from ...engine.registry import ROBOTS, RobotSpec
+from ...engine.inverses import ExtendedInverse
+from ...engine.registry import ALGORITHMS, ROBOTS, RobotSpec, make_inverse
 from . import schemas as S
 from .exceptions import RequestError
+from .schemas.algorithms import field_of, used
+from .user_robots import map_used, user_inverse, user_map, user_robot
+
+
+@dataclass(frozen=True)
+class RequestRobot:
+    """A request's robot, built: its spec and kinematics, the inverse of each algorithm asked
+    for, what the response repeats (the robot used; the map the extended inverse used, else
+    None), and a function building the request's map (else the robot's default) and what it
+    used: the map h synthesis' 'evaluate' evaluates."""
+
+    spec: RobotSpec
+    kinematics: Any
+    inverses: tuple[Any, ...]
+    robot: S.RobotUsed
+    augmentation: S.AugmentationUsed | None
+    augmenting_map: Callable[[], tuple[Any, S.AugmentationUsed]]
+
+
+def request_robot(
+    req_robot: Any,
+    augmentation: Any = None,
+    algorithms: Sequence[str] = (),
+    parameters: BaseModel | None = None,
+    x0: Sequence[float] | None = None,
+    *,
+    own: bool = False,
+    with_map: bool = False,
+) -> RequestRobot:
+    """The robot of a request (catalogue robot, definition or catalogue arm) and the inverse of
+    each of ``algorithms``: the extended inverse (11) of ``augmentation`` (a map model; None:
+    the robot's default), the others with ``parameters`` (``algorithm_parameters``; posture's
+    rest defaults to the robot's home, else ``x0``), each with only its own if ``own``. The
+    robot has its map if the extended inverse or ``with_map`` asks for one. Refusals are
+    :class:`RequestError` naming the request's field."""
+
+    def given(algorithm: str, kinematics: Any) -> dict:
+        spec = ALGORITHMS[algorithm]
+        names = {p.name for p in spec.parameters} | set(spec.vectors)
+        values = used(parameters, algorithm, kinematics, x0).items()
+        return {k: v for k, v in values if not own or k in names}
+
+    extended, aug_used = "extended" in algorithms, None
+    if req_robot.name in S.USER_ROBOT_MODELS:
+        robot, robot_used = user_robot(req_robot, augmentation if extended or with_map else None)
+        kin = robot.kinematics
+        inverses = tuple(user_inverse(robot, a, given(a, kin)) for a in algorithms)
+        aug_used = map_used(robot) if extended else None
+        built = robot.spec, kin, inverses, robot_used, aug_used
+        return RequestRobot(*built, lambda: user_map(robot))
+    spec, kin, robot_used = build_robot(req_robot)
+    out: list[Any] = []
+    for algorithm in algorithms:
+        if algorithm == "extended":
+            _, amap, aug_used = build_augmentation(spec, kin, augmentation)
+            try:
+                out.append(ExtendedInverse(kin, amap))
+            except InvalidInputError as exc:
+                raise RequestError("augmentation", str(exc)) from None
+            continue
+        try:
+            params = given(algorithm, kin)
+            out.append(make_inverse(kin, algorithm, spec=spec, algorithm_parameters=params))
+        except InvalidInputError as exc:
+            raise RequestError(field_of(exc.field, str(exc)), str(exc)) from None
+    built = spec, kin, tuple(out), robot_used, aug_used
+    return RequestRobot(*built, lambda: build_augmentation(spec, kin, augmentation)[1:])
 
 
 def build_robot(req_robot) -> tuple[RobotSpec, Any, S.RobotUsed]:

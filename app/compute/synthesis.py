@@ -18,9 +18,8 @@ from ...engine.variational import synthesize_e2
 from . import schemas as S
 from .documents import nullable
 from .exceptions import RequestError
-from .robot_requests import build_augmentation, build_robot
+from .robot_requests import request_robot
 from .synthesis_total import grid, total_degree_response
-from .user_robots import is_user_robot, map_used, request_field, user_robot
 
 
 def synthesis_methods() -> S.SynthesisMethodsResponse:
@@ -119,44 +118,18 @@ def _coefficients(amap) -> dict[str, float]:
     return {f"{a}^{i} {b}^{j}": float(c) for (i, j), c in sorted(coef.items())}
 
 
-def _user_map(robot):
-    """The one map a user robot's 'evaluate' request gives."""
-    spec = robot.spec
-    if not spec.augmentations:
-        raise RequestError(
-            "augmentation",
-            "'evaluate' needs the map to evaluate: {'name': "
-            "'formula', 'h': ...} or {'name': 'e2_synthesized', 'region': {...}}",
-        )
-    if spec.p != spec.r + 1:
-        raise RequestError(
-            "augmentation",
-            f"'evaluate' takes one map h and E1, E2 need p = r + 1; this {spec.name} robot has "
-            f"p = {spec.p}, r = {spec.r}",
-        )
-    try:
-        return spec.augmentations[0].build(robot.kinematics)
-    except JikError as exc:
-        raise RequestError(request_field(getattr(exc, "field", None), ()), str(exc)) from None
-
-
 def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
     """Evaluate a catalogue map, or synthesize an E2-optimal one, over a box (section 3)."""
-    user = is_user_robot(req.robot)
-    if user:
-        evaluate = req.method == "evaluate"
-        robot, robot_used, aug_used = user_robot(req.robot, req.augmentation if evaluate else None)
-        spec, kin = robot.spec, robot.kinematics
-        if req.method == "e2_variational" and spec.p != spec.r + 1:
-            raise RequestError(
-                "method",
-                f"'e2_variational' synthesizes one map h, which needs one degree of redundancy "
-                f"(p = r + 1); this {spec.name} robot has p = {spec.p}, r = {spec.r}: give its "
-                f"extended inverse {spec.p - spec.r} formula maps instead ({{'name': 'formula', "
-                "'h': [...]}})",
-            )
-    else:
-        spec, kin, robot_used = build_robot(req.robot)
+    robot = request_robot(req.robot, req.augmentation, with_map=req.method == "evaluate")
+    spec, kin, robot_used = robot.spec, robot.kinematics, robot.robot
+    if req.method == "e2_variational" and spec.p != spec.r + 1:  # (a user robot's)
+        raise RequestError(
+            "method",
+            f"'e2_variational' synthesizes one map h, which needs one degree of redundancy "
+            f"(p = r + 1); this {spec.name} robot has p = {spec.p}, r = {spec.r}: give its "
+            f"extended inverse {spec.p - spec.r} formula maps instead ({{'name': 'formula', "
+            "'h': [...]}})",
+        )
     names, region, fixed = synthesis_region(spec, req)
     if req.method == "e2_total_degree":
         return total_degree_response(req, spec, kin, robot_used, (names, region, fixed))
@@ -184,11 +157,8 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
                 f"{result.polynomial_e2:.6g}"
             )
         region, fixed = dict(result.region) or region, dict(result.fixed) or fixed
-    elif user:
-        amap = _user_map(robot)
-        aug_used = map_used(robot)  # (the request's map, else the robot's default)
     else:
-        _, amap, aug_used = build_augmentation(spec, kin, req.augmentation)
+        amap, aug_used = robot.augmenting_map()  # (the request's map, else the robot's default)
         coefficients = _coefficients(amap)
     functionals, more = _functionals(kin, amap, region, fixed, req.nodes)
     notes += more

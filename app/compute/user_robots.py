@@ -1,4 +1,5 @@
-"""A request's user robot: its definition built by the engine, its errors renamed.
+"""A request's user robot: its definition built by the engine, its errors renamed (the half of
+:func:`jik.app.compute.robot_requests.request_robot` for definitions and catalogue arms).
 
 A request may give, instead of a catalogue robot, a definition of one of the kinds of
 :mod:`jik.engine.robot_kinds` (``planar_chain``, ``formula``, ``urdf``), and for its extended
@@ -18,9 +19,9 @@ import functools
 import hashlib
 import json
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, cast
 
-from ...engine.exceptions import InvalidInputError
+from ...engine.exceptions import InvalidInputError, JikError
 from ...engine.robot_spec import Robot, robot_from_dict
 from ...engine.robot_synthesis import TENSOR_DEGREE, TOTAL_DEGREE
 from . import schemas as S
@@ -30,11 +31,6 @@ from .schemas.algorithms import field_of
 
 #: The augmentation's label inside the built robot.
 _LABEL = "request"
-
-
-def is_user_robot(req_robot: Any) -> bool:
-    """Whether a request's robot is a definition (not a catalogue robot)."""
-    return getattr(req_robot, "name", None) in S.USER_ROBOT_MODELS
 
 
 def request_field(field: str | None, robot_keys: Sequence[str]) -> str:
@@ -62,9 +58,9 @@ def _built(definition: str) -> Robot:
     return robot_from_dict(json.loads(definition))
 
 
-def user_robot(req_robot: Any, augmentation: Any = None) -> tuple[Robot, S.RobotUsed, Any]:
+def user_robot(req_robot: Any, augmentation: Any = None) -> tuple[Robot, S.RobotUsed]:
     """The robot a request defines, with ``augmentation`` (a request's map model, or None) as
-    its only augmenting map; what it used (``S.RobotUsed``, ``S.AugmentationUsed`` or None).
+    its only augmenting map; what it used.
 
     Raises
     ------
@@ -72,7 +68,6 @@ def user_robot(req_robot: Any, augmentation: Any = None) -> tuple[Robot, S.Robot
         The engine refused the definition or the map; the field is the request's.
     """
     definition = req_robot.model_dump(exclude_none=True)
-    given = None
     if augmentation is not None:
         given = augmentation.model_dump(exclude_none=True)
         definition["augmentations"] = [{**given, "label": _LABEL}]
@@ -90,7 +85,7 @@ def user_robot(req_robot: Any, augmentation: Any = None) -> tuple[Robot, S.Robot
         r=spec.r,
         notes=list(getattr(robot.kinematics, "notes", ())) or None,
     )
-    return robot, used, None if given is None else map_used(robot)
+    return robot, used
 
 
 def map_used(robot: Robot) -> S.AugmentationUsed | None:
@@ -145,3 +140,25 @@ def user_inverse(robot: Robot, algorithm: str, algorithm_parameters: dict | None
         if algorithm != "extended":
             raise RequestError(field_of(exc.field, str(exc)), _text(exc)) from None
         raise RequestError(request_field(exc.field, ()), _text(exc)) from None
+
+
+def user_map(robot: Robot) -> tuple[Any, S.AugmentationUsed]:
+    """The one map h a user robot's 'evaluate' request gives, built; what it used."""
+    spec = robot.spec
+    if not spec.augmentations:
+        raise RequestError(
+            "augmentation",
+            "'evaluate' needs the map to evaluate: {'name': "
+            "'formula', 'h': ...} or {'name': 'e2_synthesized', 'region': {...}}",
+        )
+    if spec.p != spec.r + 1:
+        raise RequestError(
+            "augmentation",
+            f"'evaluate' takes one map h and E1, E2 need p = r + 1; this {spec.name} robot has "
+            f"p = {spec.p}, r = {spec.r}",
+        )
+    try:
+        amap = spec.augmentations[0].build(robot.kinematics)
+    except JikError as exc:
+        raise RequestError(request_field(getattr(exc, "field", None), ()), str(exc)) from None
+    return amap, cast(S.AugmentationUsed, map_used(robot))  # (the robot has a map: above)

@@ -34,9 +34,8 @@ def built_map(state, progress: Callable[..., None], cancelled: Callable[[], bool
     try:
         with synthesis_progress(report):
             kin, amap = kinematics_and_map(state)
-            robot = state_robot(state)
-            if amap is None and robot is not None:  # (p - r > 1: a synthesized vector, built)
-                maps = robot.map_vectors.get(state.augmentation)
+            if amap is None:  # (p - r > 1: a synthesized vector, built)
+                maps = state_robot(state).map_vectors.get(state.augmentation)
                 if callable(maps):
                     maps()
             return kin, amap

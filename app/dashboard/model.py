@@ -44,7 +44,7 @@ from .controls import (
     MIN_ITERATIONS,
     max_iterations,
 )
-from .robots import USER_KINDS, default_definition, state_inverse, user_robot
+from .robots import USER_KINDS, default_definition, state_inverse, state_spec, user_robot
 
 #: The algorithms of a new state (:mod:`jik.app.dashboard.algorithms`: colours, styles, keys).
 ALGORITHMS = DEFAULT_ALGORITHMS
@@ -210,11 +210,7 @@ def updated_state(state: DashboardState, patch: Mapping[str, object]) -> Dashboa
     patch = expand(state, patch)
     data = state.as_dict()
     if "augmentation" in patch and patch["augmentation"] != data["augmentation"]:
-        spec = (
-            user_robot(data["robot_definition"]).spec
-            if data.get("robot_definition")
-            else robot_spec(robot)
-        )
+        spec = state_spec(state)
         aug = _registered(lambda: spec.augmentation(str(patch["augmentation"])), "augmentation")
         data["augmentation"] = aug.name
         data["augmentation_parameters"] = {p.name: p.default for p in aug.parameters}

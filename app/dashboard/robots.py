@@ -25,7 +25,7 @@ from ...engine.arms import ARMS
 from ...engine.exceptions import InvalidInputError
 from ...engine.inverses import Inverse
 from ...engine.kinematics import Kinematics
-from ...engine.registry import RobotSpec, make_inverse, robot_spec
+from ...engine.registry import RobotSpec, robot_spec
 from ...engine.robot_kinds import KINDS
 from ...engine.robot_spec import Robot, robot_from_dict
 from ..compute.budget import build_seconds, time_budget
@@ -118,40 +118,33 @@ async def vet_definition(pool: Any, patch: Mapping[str, Any]) -> None:
         raise InvalidInputError(f"{exc.field}: {exc.message}", exc.field) from None
 
 
-def state_robot(state) -> Robot | None:
-    """The user robot of a state (None for a catalogue robot)."""
+def state_robot(state, kin: Kinematics | None = None) -> Robot:
+    """The robot of a state: its definition's (:func:`user_robot`), or the catalogue robot
+    built with its parameters (its kinematics ``kin`` if given)."""
     definition = getattr(state, "robot_definition", None)
-    return None if definition is None else user_robot(definition)
+    if definition is not None:
+        return user_robot(definition)
+    spec, parameters = robot_spec(state.robot), dict(state.robot_parameters)
+    kin = spec.build(**parameters) if kin is None else kin
+    return Robot(spec, kin, {"name": spec.name, "parameters": parameters})
 
 
 def state_spec(state) -> RobotSpec:
-    """The spec of a state's robot: p, r, names, ranges, defaults and augmenting maps."""
-    robot = state_robot(state)
-    return robot_spec(state.robot) if robot is None else robot.spec
+    """The spec of a state's robot: p, r, names, ranges, defaults and augmenting maps (a
+    catalogue robot's without building its kinematics)."""
+    definition = getattr(state, "robot_definition", None)
+    return robot_spec(state.robot) if definition is None else user_robot(definition).spec
 
 
 def state_kinematics(state) -> Kinematics:
     """The kinematics of a state's robot, with its parameters."""
-    robot = state_robot(state)
-    if robot is None:
-        return robot_spec(state.robot).build(**state.robot_parameters)
-    return robot.kinematics
+    return state_robot(state).kinematics
 
 
 def state_inverse(state, algorithm: str, kin: Kinematics | None = None) -> Inverse:
     """The state's inverse for ``algorithm``: its map and the map's parameters, or the
     algorithm's own (:func:`jik.app.dashboard.algorithms.inverse_parameters`)."""
-    robot = state_robot(state)
-    kin = state_kinematics(state) if kin is None else kin
-    params = inverse_parameters(state, algorithm, kin)
-    if robot is not None:
-        return robot.inverse(algorithm, state.augmentation, algorithm_parameters=params)
-    spec = robot_spec(state.robot)
-    return make_inverse(
-        kin,
-        algorithm,
-        state.augmentation,
-        state.augmentation_parameters,
-        spec.name,
-        algorithm_parameters=params,
-    )
+    robot = state_robot(state, kin)
+    params = inverse_parameters(state, algorithm, robot.kinematics if kin is None else kin)
+    aug = state.augmentation, state.augmentation_parameters
+    return robot.inverse(algorithm, *aug, algorithm_parameters=params)

@@ -18,7 +18,7 @@ case in tests/app/test_errors.py, test_synthesize.py and test_sessions.py):
   grammar, its URDF text, lengths one per joint, and what follows from them (p and r, so the
   lengths of ``x0``, ``target`` and ``path``; the variables of a map's box) no JSON Schema can
   state. A positive case with one is kept only if the server's own building of the robot
-  (:func:`jik.app.compute.user_robots.user_robot`) and its checks take it; as for the sessions
+  (:func:`jik.app.compute.robot_requests.request_robot`) and its checks take it; as for the sessions
   below, what the fuzzing tests there is that whatever the schema takes is served without a
   5xx and that every response matches the document;
 - an atlas's path must start where the self-motion curve can be traced (the server plans it:
@@ -62,10 +62,9 @@ from ...app.compute.atlas_plan import AtlasLimits, plan_request
 from ...app.compute.atlas_schemas import AtlasRequest
 from ...app.compute.exceptions import RequestError
 from ...app.compute.requests import _check_start, _setup
-from ...app.compute.robot_requests import check_configuration, check_task_point
+from ...app.compute.robot_requests import check_configuration, check_task_point, request_robot
 from ...app.compute.schemas.synthesis import QMC_NODES
 from ...app.compute.synthesis import synthesis_region
-from ...app.compute.user_robots import user_robot
 from ...app.dashboard.model import default_state, updated_state
 from ...app.dashboard.patch import StatePatch, patch_of
 from ...engine.exceptions import InvalidInputError, JikError
@@ -151,8 +150,7 @@ def _user_robot_ok(body: dict, path: str) -> bool:
         if path == "/synthesize":
             req = S.SynthesizeRequest.model_validate(body)
             evaluate = req.method == "evaluate"
-            robot, _, _ = user_robot(req.robot, req.augmentation if evaluate else None)
-            spec = robot.spec
+            spec = request_robot(req.robot, req.augmentation, with_map=evaluate).spec
             if req.method == "e2_total_degree":
                 _, region, _ = synthesis_region(spec, req)
                 return _total_degree_ok(body, len(region), spec.p, spec.r)
