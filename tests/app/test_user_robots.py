@@ -336,3 +336,23 @@ def test_a_synthesized_vector_map_runs_over_rest(api):
     )
     assert rep["success"] and max(rep["drift"]) < 1e-9
     assert rep["augmentation"]["definition"]["degree"] == 4
+
+
+def test_a_vector_maps_trajectory_matches_the_published_schema(api):
+    """The extended run of a map of p - r = 2 components gives h as one pair per point, and the
+    response is what SolveResponse (the published schema) describes."""
+    from jik.app.compute.schemas import SolveResponse
+
+    chain = {"name": "planar_chain", "joints": "RRRR", "lengths": [1, 1, 1, 1]}
+    body = {
+        "robot": chain,
+        "algorithm": "extended",
+        "augmentation": {"name": "formula", "h": ["x1", "x2"]},
+        "x0": [0.3, 0.6, 0.6, 0.6],
+        "target": [1.5, 1.5],
+    }
+    out = _ok(api.post("/solve", json=body))
+    h = np.array(out["trajectory"]["h"])
+    assert h.shape == (len(out["trajectory"]["theta"]), 2)
+    np.testing.assert_allclose(h, [[0.3, 0.6]] * len(h), atol=1e-9)
+    SolveResponse.model_validate(out)

@@ -98,7 +98,11 @@ class Trajectory(BaseModel):
     x: list[list[MaybeFloat]] = Field(description="configurations, shape (m, p)")
     y: list[list[MaybeFloat]] = Field(description="k(x), shape (m, r)")
     error: list[MaybeFloat] = Field(description="||k(x) - target||, shape (m,)")
-    h: list[MaybeFloat] | None = Field(None, description="h(x) for the extended inverse")
+    h: list[MaybeFloat] | list[list[MaybeFloat]] | None = Field(
+        None,
+        description="h(x) for the extended inverse: shape (m,), or (m, p - r) for a map of "
+        "p - r > 1 components",
+    )
     points: int = Field(description="points of the full trajectory before downsampling")
     downsampled: bool
 
