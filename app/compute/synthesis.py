@@ -42,12 +42,17 @@ def synthesis_methods() -> S.SynthesisMethodsResponse:
 def default_region(
     spec: RobotSpec, size: int, fixed: Collection[str] = ()
 ) -> dict[str, tuple[float, float]]:
-    """The last ``size`` variables that are not ``fixed``, each over a box around the default
-    start.
+    """The robot's design region (``functional_region``, the box of sec. 5 over which the
+    dashboard and its ``e2_synthesized`` map take E1 (13) and E2 (18)) when it has ``size``
+    variables, none ``fixed``; else the last ``size`` variables that are not ``fixed``, each
+    over a box around the default start.
 
     Half-width: a tenth of the variable's ``x_range``, clipped to it. The other variables are
     held at the default start (where the robot's maps are defined), not at 0.
     """
+    design = dict(spec.functional_region)
+    if len(design) == size and not set(design) & set(fixed):
+        return {n: (float(lo), float(hi)) for n, (lo, hi) in design.items()}
     names = list(spec.variable_names)
     region = {}
     for n in [n for n in names if n not in fixed][-size:]:

@@ -71,6 +71,9 @@ def test_a_7_joint_arm_over_all_its_joints_is_the_engines_synthesis(api):
         {"robot": PANDA, "method": "e2_total_degree", "degree": 2, "qmc_nodes": 1024, "grid": 5},
     )
     assert len(b["region"]) == 7 and b["fixed"] == {}
+    # the default box is the arm's design region, as /robots says and its e2_synthesized uses
+    design = robot_from_dict(PANDA).spec.functional_region
+    assert b["region"] == {n: list(v) for n, v in design.items()}
     info = b["total_degree"]
     ref = _engine(PANDA, b, 2, 1024, convergence_degrees=[1])
     assert math.isclose(info["e2"], ref.e2, rel_tol=1e-10)

@@ -44,8 +44,9 @@ class SynthesizeRequest(BaseModel):
         max_length=MAX_DIMENSION,
         description="box {variable: [lo, hi]} (1 to 3 variables; any number for "
         "'e2_total_degree'); default: the last 3 (2 for 'e2_variational', all for "
-        "'e2_total_degree') variables, each over a tenth of its x_range either side of the "
-        "robot's default start",
+        "'e2_total_degree') variables: the robot's design region (functional_region of "
+        "/robots) when it has that many, else each over a tenth of its x_range either side "
+        "of the robot's default start",
     )
     fixed: dict[str, FiniteFloat] | None = Field(
         None,
@@ -109,8 +110,9 @@ def _synthesis_fields(spec: RobotSpec, augmentation: Any) -> dict[str, Any]:
                 description=f"box {{variable: [lo, hi]}}, lo < hi, of 1 to 3 of "
                 f"{list(names)} (2 or 3 draw a grid of h; 'e2_variational' needs 2 or 3; "
                 "'e2_total_degree' takes any number), none of them fixed; default: the last 3 "
-                "(2 for 'e2_variational', all for 'e2_total_degree') not fixed, each over a "
-                "tenth of its range either side of the default start",
+                "(2 for 'e2_variational', all for 'e2_total_degree') not fixed: the robot's "
+                "design region when it has that many, else each over a tenth of its range "
+                "either side of the default start",
             ),
         ),
         "fixed": (
