@@ -323,7 +323,17 @@ def _manifolds(kin, paths, reference, arc, box) -> tuple[SelfMotionManifold, ...
             field="reference",
         )
     bases = project(kin, res.x, y0)
-    first = trace(kin, bases[0], arc, box)
+    try:
+        first = trace(kin, bases[0], arc, box)
+    except InvalidInputError as error:
+        if error.field != "base":
+            raise
+        where = str(error).partition(": ")[2]
+        raise InvalidInputError(
+            "the reference, moved by eq. (7) to the path's first point, lies outside the "
+            f"configuration box (the robot's x_range, an arm's joint limits): {where}",
+            field="reference",
+        ) from None
     return (first, *(trace(kin, b, first.arc) for b in bases[1:]))
 
 

@@ -144,8 +144,15 @@ def trace(
     y0 = kinematics.forward(base)
     base = project(kinematics, base[None], y0)[0]
     bounds = None if box is None else np.asarray(box, dtype=float)
-    if bounds is not None and not np.all((base >= bounds[:, 0]) & (base <= bounds[:, 1])):
-        raise InvalidInputError("the base configuration lies outside the box", field="starts")
+    if bounds is not None:
+        outside = np.flatnonzero((base < bounds[:, 0]) | (base > bounds[:, 1]))
+        if outside.size:
+            i = int(outside[0])
+            raise InvalidInputError(
+                f"the base configuration lies outside the box: x{i + 1} = {base[i]:.6g} is not "
+                f"in [{bounds[i, 0]:.6g}, {bounds[i, 1]:.6g}]",
+                field="base",
+            )
 
     def kernel(_s, x):
         return kinematics.kernel(x)

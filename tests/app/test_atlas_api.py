@@ -134,7 +134,7 @@ def test_one_client_may_run_one_job_at_a_time_here(client):
             "must have 2 components (r of manipulator2), got 3",
         ),
         ({"arc": [1.0, 2.0]}, "arc", "lo <= 0 <= hi"),
-        ({"path": [[0.0, 1.0]]}, "path", "at least 2 items"),
+        ({"path": [[0.0, 1.0]]}, "path", "give at least 2 entries, got 1"),
         ({"mode": "discrete", "gamma": 2.0}, "gamma", "must be < 2 in discrete mode"),
     ],
 )

@@ -247,6 +247,12 @@ def test_cancelled_stops_between_chunks():
         ({"scales": [1.0, -2.0]}, "scales", "scales must be finite and > 0"),
         ({"shifts": [(0.0, 0.0, 1.0)]}, "shifts", "shape (..., 2)"),
         ({"reference": (0.0, math.nan, 1.0)}, "reference", "NaN"),
+        (
+            {"box": [(-5.0, 5.0), (-5.0, 5.0), (2.0, 3.0)]},
+            "reference",
+            "lies outside the configuration box (the robot's x_range, an arm's joint limits): "
+            "x3 = 1.5708 is not in [2, 3]",
+        ),
         ({"starts": [(0.0, 0.0, 1.0)]}, "starts", "not on the self-motion manifold"),
         ({"gamma": 0}, "gamma", "gamma must be > 0"),
         ({"mode": "discrete", "gamma": 2.5}, "gamma", "< 2 in discrete mode"),
