@@ -115,10 +115,12 @@ def echo(definition: dict) -> dict:
 
 
 def _text(exc: InvalidInputError) -> str:
-    """The engine's message without a leading field name (the RequestError adds the field)."""
+    """The engine's message without a leading field name, ``field: ...`` or ``field must ...``
+    (the RequestError adds the request's name of the field)."""
     text = str(exc)
-    head = f"{exc.field}: " if exc.field else ""
-    return text[len(head) :] if head and text.startswith(head) else text
+    if exc.field and text.startswith(exc.field):
+        return text[len(exc.field) :].lstrip(": ")
+    return text
 
 
 def user_inverse(robot: Robot, algorithm: str, algorithm_parameters: dict | None = None):

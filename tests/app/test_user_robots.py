@@ -356,3 +356,18 @@ def test_a_vector_maps_trajectory_matches_the_published_schema(api):
     assert h.shape == (len(out["trajectory"]["theta"]), 2)
     np.testing.assert_allclose(h, [[0.3, 0.6]] * len(h), atol=1e-9)
     SolveResponse.model_validate(out)
+
+
+def test_a_refused_map_is_named_once_by_the_requests_field(api):
+    """The engine names the definition's field (augmentations.0.h); the answer names the
+    request's (augmentation.h), once, not both."""
+    body = {
+        "robot": {"name": "planar_chain", "joints": "RRR", "lengths": [1, 1, 1]},
+        "algorithm": "extended",
+        "augmentation": {"name": "formula", "h": ["x1", "x2"]},
+        "x0": [0.3, 0.6, 0.6],
+        "target": [1.0, 1.0],
+    }
+    r = api.post("/solve", json=body)
+    assert r.status_code == 422
+    assert messages(r) == ["augmentation.h: must be a formula (a string), got list"]
