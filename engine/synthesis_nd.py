@@ -50,6 +50,16 @@ MAX_UNKNOWNS = 4000
 MAX_NODES = 2**17
 #: Nodes assembled at once: bounds the memory of the basis' gradients to a few tens of MB.
 CHUNK = 1024
+#: Bytes of the basis gradients (nodes, unknowns, variables) held for one chunk of nodes.
+CHUNK_BYTES = 2**24
+
+
+def chunk_for(unknowns: int, variables: int) -> int:
+    """Nodes per chunk: at most :data:`CHUNK`, a power of two (so that the leading 2^k nodes of
+    the convergence table end on a chunk's end), with the chunk's basis gradients within
+    :data:`CHUNK_BYTES` (at least 64 nodes)."""
+    fits = CHUNK_BYTES // (8 * unknowns * variables)
+    return max(64, min(CHUNK, 1 << max(0, int(fits).bit_length() - 1)))
 
 
 def kernel_frame(kinematics: Kinematics, x: FloatArray, axes: Sequence[int] | None = None):
@@ -112,7 +122,8 @@ class TotalDegreeSynthesis:
         trust; its distance to ``e2`` measures the quadrature error.
     convergence : list of dict
         ``{"degree", "nodes", "unknowns", "e2"}``: the Ritz value with the degree at all the nodes,
-        then with the nodes (the leading 2^k nodes of the rule) at the final degree.
+        then with the nodes (the leading 2^k nodes of the rule, 2^k >= 1024 and twice the
+        unknowns) at the final degree.
     single_joint : dict name -> dict
         E2 of the common choice h = s x_j for each joint of the region, with the better sign s
         (one degree of redundancy only; empty otherwise).
@@ -168,8 +179,8 @@ class TotalDegreeSynthesis:
 class _Rule:
     """A scrambled Sobol rule on the box and the integrand's data at its nodes, by chunks."""
 
-    def __init__(self, kinematics, box, fix, nodes, seed, axes):
-        self.kin, self.box, self.axes = kinematics, box, axes
+    def __init__(self, kinematics, box, fix, nodes, seed, axes, chunk=CHUNK):
+        self.kin, self.box, self.axes, self.chunk = kinematics, box, axes, chunk
         names = tuple(kinematics.variable_names) or tuple(f"x{i + 1}" for i in range(kinematics.p))
         self.variables = [names.index(n) for n in box]
         lo = np.array([v[0] for v in box.values()])
@@ -182,8 +193,8 @@ class _Rule:
     def chunks(self):
         """(t, R, f, m) per chunk: R = m P and f = m K restricted to the box's variables."""
         idx = np.array(self.variables)
-        for start in range(0, len(self.t), CHUNK):
-            t = self.t[start : start + CHUNK]
+        for start in range(0, len(self.t), self.chunk):
+            t = self.t[start : start + self.chunk]
             x = np.broadcast_to(self.base, (len(t), self.base.size)).copy()
             x[:, idx] = self.center + self.half * t
             m = self.kin.manipulability(x)
@@ -278,7 +289,8 @@ def synthesize_e2_nd(
     levels = [n for n in levels if n < degree] + [degree]
 
     index = total_degree_indices(d, degree)
-    rule = _Rule(kinematics, box, fix, nodes, seed, axes)
+    chunk = chunk_for(nb, d)
+    rule = _Rule(kinematics, box, fix, nodes, seed, axes, chunk)
     A = np.zeros((nb, nb))
     B = np.zeros((nb, m_red))
     c0 = 0.0
@@ -295,7 +307,7 @@ def synthesize_e2_nd(
         diag += np.einsum("nkk->k", R)
         load += f[:, :, 0].sum(axis=0)
         done += len(t)
-        if done < nodes and done >= 2 * nb and done & (done - 1) == 0:
+        if done < nodes and done >= max(2 * nb, CHUNK) and done & (done - 1) == 0:
             snapshots.append((done, A.copy(), B.copy(), c0))
         if progress is not None:
             progress.advance(0.9 * done / nodes, 1.0)
@@ -327,7 +339,7 @@ def synthesize_e2_nd(
     maps = tuple(
         TotalDegreeMap(index, C[:, i], box, rule.variables, kinematics.p) for i in range(m_red)
     )
-    check = _Rule(kinematics, box, fix, nodes, seed + 1, axes)
+    check = _Rule(kinematics, box, fix, nodes, seed + 1, axes, chunk)
     e2_check = e2_of_gradients(check, index, C)
     single = _single_joint(rule, diag * w, load * w, c0) if m_red == 1 else {}
     if progress is not None:

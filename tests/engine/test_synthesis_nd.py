@@ -5,12 +5,13 @@ import itertools
 import numpy as np
 import pytest
 
+from jik.engine import synthesis_nd
 from jik.engine.exceptions import InvalidInputError, RunCancelled
 from jik.engine.functionals import error_functional_e2
 from jik.engine.kinematics import Kinematics, Manipulator2
 from jik.engine.planar_chain import PlanarChain
 from jik.engine.progress import ProgressCallbacks
-from jik.engine.synthesis_nd import kernel_frame, synthesize_e2_nd
+from jik.engine.synthesis_nd import chunk_for, kernel_frame, synthesize_e2_nd
 from jik.engine.total_degree import basis_size, total_degree_indices
 from jik.engine.variational import MANIPULATOR2_REGION, synthesize_e2
 
@@ -120,6 +121,34 @@ def test_four_joints_beat_every_single_joint_map():
     assert set(res.single_joint) == set(region)
     assert res.e2 < min(v["e2"] for v in res.single_joint.values())
     assert abs(res.e2_check - res.e2) < 1e-2 * res.e2
+
+
+def test_chunks_of_nodes_hold_the_basis_gradients_within_their_bytes():
+    """A degree-6 map of a 7-joint arm (1716 unknowns) is assembled 128 nodes at a time (its
+    gradients in 16 MB a chunk, not 98 MB), a small basis 1024 at a time; powers of two."""
+    assert chunk_for(basis_size(7, 2), 7) == 1024
+    assert chunk_for(basis_size(7, 6), 7) == 128
+    assert chunk_for(10**6, 7) == 64
+    for nb in range(1, 5000, 37):
+        c = chunk_for(nb, 7)
+        assert c & (c - 1) == 0 and 64 <= c <= 1024
+
+
+def test_the_chunk_size_does_not_change_the_map(monkeypatch):
+    """The same synthesis assembled in chunks of 64 nodes (the convergence table's 2^k nodes
+    still end on a chunk) as in chunks of 1024: the same coefficients and E2 to rounding."""
+    kin = PlanarChain("RRRR", [1.0, 0.8, 0.6, 0.4], orientation=True)
+    region = {"x1": (-0.3, 0.3), "x2": (0.5, 1.1), "x3": (0.4, 1.0), "x4": (0.3, 0.9)}
+    whole = synthesize_e2_nd(kin, region, degree=4, nodes=2**11)
+    monkeypatch.setattr(synthesis_nd, "CHUNK_BYTES", 1)
+    small = synthesize_e2_nd(kin, region, degree=4, nodes=2**11)
+    np.testing.assert_allclose(small.maps[0].coefficients, whole.maps[0].coefficients, rtol=1e-9)
+    assert small.e2 == pytest.approx(whole.e2, rel=1e-12)
+    keys = [(row["degree"], row["nodes"], row["unknowns"]) for row in whole.convergence]
+    assert [(row["degree"], row["nodes"], row["unknowns"]) for row in small.convergence] == keys
+    assert [row["e2"] for row in small.convergence] == pytest.approx(
+        [row["e2"] for row in whole.convergence], rel=1e-10
+    )
 
 
 def test_vector_h_of_a_linear_map_is_the_kernel_frame():
