@@ -172,6 +172,8 @@ def augmenting_title(
 
 #: Characters of a subtitle line that fit a half-width panel at 1280 px.
 SUBTITLE_CHARS = 70
+#: Characters of a line of a panel's message (12 px, larger than a subtitle's).
+MESSAGE_CHARS = 50
 
 
 def wrap(parts: list[str], width: int = SUBTITLE_CHARS) -> list[str]:
@@ -188,8 +190,11 @@ def wrap(parts: list[str], width: int = SUBTITLE_CHARS) -> list[str]:
 
 def message_figure(title: str, message: str) -> dict:
     """A panel with nothing to plot: its title, and ``message`` where the plot would be (no
-    empty axes)."""
+    empty axes), in lines of :data:`MESSAGE_CHARS` characters that fit a half-width panel."""
     hidden = dict(visible=False)
+    lines = [
+        line for piece in message.split("<br>") for line in textwrap.wrap(piece, MESSAGE_CHARS)
+    ]
     return figure(
         [],
         title,
@@ -197,7 +202,7 @@ def message_figure(title: str, message: str) -> dict:
         yaxis=hidden,
         annotations=[
             dict(
-                text=message,
+                text="<br>".join(lines),
                 xref="paper",
                 yref="paper",
                 x=0.5,
@@ -239,7 +244,7 @@ def sensitivity_spec(
     if sens is None:
         return message_figure(f"E1, E2 of {aug}: computing…", "computing E1 and E2…")
     if sens["kind"] == "unavailable":
-        return message_figure(f"E1, E2 of {aug}", "<br>".join(textwrap.wrap(sens["reason"], 50)))
+        return message_figure(f"E1, E2 of {aug}", sens["reason"])
     log = dict(type="log", exponentformat="power")
     if sens["kind"] == "single_joint":
         return single_joint_spec(sens, aug, log)

@@ -402,3 +402,20 @@ def test_axes_keep_their_range_while_the_data_fill_it(path_result):
         1.5,
     ]
     assert keep_ranges(fig, None) is fig
+
+
+def test_a_panels_message_is_wrapped_to_fit_the_panel():
+    """A long message (the note of a vector map in the h panel) is cut into lines of at most
+    MESSAGE_CHARS characters, keeping the line breaks it has; nothing is lost."""
+    from jik.app.dashboard.map_figures import MESSAGE_CHARS, message_figure
+
+    note = (
+        "formula: h = x2, x3, x5, x7: a vector of p − r = 4 maps, each kept constant by the "
+        "extended inverse (eq. (12)); the h panel, E1 (13) and E2 (18) are for one degree of "
+        "redundancy (p = r + 1)"
+    )
+    text = message_figure("Augmenting map h", note + "<br>second")["layout"]["annotations"][0]
+    lines = text["text"].split("<br>")
+    assert len(lines) > 3 and lines[-1] == "second"
+    assert max(len(line) for line in lines) <= MESSAGE_CHARS
+    assert " ".join(lines[:-1]) == note
