@@ -89,4 +89,5 @@ def test_the_panda_with_a_position_task_and_four_formula_maps(tabs):
     summary = snapshot["summary"]
     assert summary["pseudoinverse"]["drift"][-1] > 1e-4
     assert max(summary["extended"]["drift"]) < 1e-9
-    expect(page.locator("#plot-augmenting")).to_contain_text("a vector of p − r = 4 maps")
+    assert summary["extended"]["h_change"] < 1e-9  # (each of the four components is conserved)
+    expect(page.locator("#plot-augmenting")).to_contain_text("a vector of p − r = 4")
