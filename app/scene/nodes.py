@@ -147,21 +147,23 @@ class NodeSets:
             "frame": scene.add_frame,
         }
         wanted = fixtures_of(result, extent, root)
-        for name in [n for n in fixtures if n not in wanted]:
-            fixtures.pop(name).remove()
+        labels = target_labels(wanted, corner_names(result), f"{root}/targets/")
+        gone = [n for n in fixtures if n not in wanted and n not in labels]
+        for name in gone:
+            handle = fixtures.pop(name)
+            if name.rpartition("/")[0] not in gone:  # (a removed node takes its children along)
+                handle.remove()
         for name, (kind, values, style) in wanted.items():
             if name not in fixtures:
                 fixtures[name] = add[kind](name, **style, **values)
-                if name.startswith(f"{root}/targets/"):
-                    k = int(name.rsplit("/", 1)[1])
-                    scene.add_label(
-                        f"{name}/label",
-                        corner_names(result)[k],
-                        position=(0.05, 0.05, 0.05),
-                    )
-                continue
-            for key, value in values.items():
-                setattr(fixtures[name], key, value)
+            else:
+                for key, value in values.items():
+                    setattr(fixtures[name], key, value)
+        for name, text in labels.items():
+            if name in fixtures:
+                fixtures[name].text = text
+            else:
+                fixtures[name] = scene.add_label(name, text, position=(0.05, 0.05, 0.05))
 
     def _draw_unicycle(self, result, timeline: Timeline, extent) -> None:
         scene = self.scene
@@ -199,3 +201,19 @@ class NodeSets:
                 state,
                 None,
             )
+
+
+def target_labels(wanted: dict[str, Any], letters: list[str], prefix: str) -> dict[str, str]:
+    """The label of each target node (``prefix`` + its index): its corner's letter, or the
+    letters of every target at its position ("B, C": pose targets that differ in orientation
+    only) on the first of them and nothing on the others, so that no two labels overlap."""
+    first_at: dict[tuple[float, ...], str] = {}
+    texts: dict[str, list[str]] = {}
+    for name, (_, values, _) in wanted.items():
+        if not name.startswith(prefix):
+            continue
+        where = tuple(np.round(np.asarray(values["position"], dtype=float), 9))
+        owner = first_at.setdefault(where, name)
+        texts.setdefault(owner, []).append(letters[int(name[len(prefix) :])])
+        texts.setdefault(name, [])
+    return {f"{name}/label": ", ".join(group) for name, group in texts.items()}
