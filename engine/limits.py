@@ -10,7 +10,7 @@ of limits) and reported as the first violation, at cycle 0, leg 0.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -39,7 +39,8 @@ class LimitViolation:
 
     ``cycle`` and ``leg`` count from 1 (0, 0: the start x0); ``joint`` indexes x (0-based),
     ``name`` is its variable's name, ``value`` the joint's value there and ``limit`` the bound
-    it passed (``bound``: ``"lower"`` or ``"upper"``).
+    it passed (``bound``: ``"lower"`` or ``"upper"``); ``single``: the run was one leg (a solve
+    toward one target), which :attr:`where` says instead of "cycle 1, leg 1".
     """
 
     cycle: int
@@ -49,11 +50,20 @@ class LimitViolation:
     value: float
     limit: float
     bound: str
+    single: bool = False
+
+    @property
+    def where(self) -> str:
+        """ "at the start x0", "on the way to the target" or "at cycle 2, leg 3"."""
+        if self.cycle == 0:
+            return "at the start x0"
+        return (
+            "on the way to the target" if self.single else f"at cycle {self.cycle}, leg {self.leg}"
+        )
 
     def __str__(self) -> str:
-        where = "the start x0" if self.cycle == 0 else f"cycle {self.cycle}, leg {self.leg}"
         side = "below its lower" if self.bound == "lower" else "above its upper"
-        return f"{where}: {self.name} = {self.value:.6g}, {side} limit {self.limit:.6g}"
+        return f"{self.where}: {self.name} = {self.value:.6g}, {side} limit {self.limit:.6g}"
 
     def as_dict(self) -> dict:
         return {
@@ -76,9 +86,7 @@ class LimitsReport:
 
     def __str__(self) -> str:
         return (
-            "within the joint limits"
-            if self.within
-            else f"left the joint limits at {self.violation}"
+            "within the joint limits" if self.within else f"left the joint limits {self.violation}"
         )
 
     def as_dict(self) -> dict:
@@ -141,9 +149,8 @@ def legs_report(
         found = _first(limits, X)
         if found is not None:
             cycle, leg = divmod(k, legs_per_cycle)
-            return LimitsReport(
-                False, _violation(limits, X[found[0]], found[1], cycle + 1, leg + 1, names)
-            )
+            v = _violation(limits, X[found[0]], found[1], cycle + 1, leg + 1, names)
+            return LimitsReport(False, replace(v, single=len(legs) == 1))
     return LimitsReport(True)
 
 

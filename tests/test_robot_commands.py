@@ -114,7 +114,7 @@ def test_a_catalogue_arm_by_name_with_its_pose_task(capsys):
     assert 1e-5 < result["drift"][-1] < 1e-2
     assert result["limits"] == {"within": True, "violation": None}
     out, _ = run(capsys, "solve", "--robot", "panda", "--target", "-0.3, 0, 0.5, 0, 0, 0")
-    assert "joint limits: left the joint limits at cycle 1, leg 1: x2 (panda_joint2)" in out
+    assert "joint limits: left the joint limits on the way to the target: x2 (panda_joint2)" in out
 
 
 def test_a_catalogue_arms_task_is_an_option(capsys, tmp_path, arm_file):

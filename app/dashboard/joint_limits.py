@@ -68,11 +68,7 @@ def limits_texts(result, names: dict[str, str]) -> list[tuple[str, str, bool]]:
         else:
             v = report.violation
             assert v is not None
-            where = (
-                "its start x0 is already outside them"
-                if v.cycle == 0
-                else f"first at cycle {v.cycle}, leg {v.leg}"
-            )
+            where = "its start x0 is already outside them" if v.cycle == 0 else f"first {v.where}"
             side = "below its lower" if v.bound == "lower" else "above its upper"
             text = (
                 f"{name}: left the joint limits of the {title}: {where}, joint {v.name} = "

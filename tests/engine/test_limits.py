@@ -149,3 +149,21 @@ def test_a_robot_reports_its_runs_limits():
     )
     assert panda.limits_report(run) == LimitsReport(True)
     assert robot_from_dict({"name": "manipulator2"}).limits_report(res) is None
+
+
+def test_a_one_leg_run_says_on_the_way_to_the_target():
+    """A solve is one leg: its violation is "on the way to the target", not "cycle 1, leg 1";
+    the start and the legs of a loop keep their words, and as_dict stays the API's."""
+    limits = np.array([[-1.0, 1.0], [-1.0, 1.0]])
+    x0 = np.zeros(2)
+    leg = np.array([[0.0, 0.5], [0.0, 1.5]])
+    one = legs_report(limits, x0, [leg], 1, ["x1", "x2"])
+    assert (
+        str(one)
+        == "left the joint limits on the way to the target: x2 = 1.5, above its upper limit 1"
+    )
+    assert one.violation.as_dict()["cycle"] == 1 and "single" not in one.violation.as_dict()
+    two = legs_report(limits, x0, [leg[:1], leg], 2, ["x1", "x2"])
+    assert str(two).startswith("left the joint limits at cycle 1, leg 2: x2 = 1.5")
+    start = legs_report(limits, np.array([2.0, 0.0]), [leg], 1, ["x1", "x2"])
+    assert str(start).startswith("left the joint limits at the start x0: x1 = 2")
