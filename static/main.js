@@ -37,7 +37,10 @@ function showProgress(fraction, elapsed, phase = "runs", what = "") {
   const busy = (elapsed > page.config.progress_after || shown) && fraction < 1;
   const runs = phase === "runs";
   $("#progress-box").hidden = !busy;
-  if (runs) $("#panels").classList.toggle("pending", busy);
+  if (runs) {
+    $("#panels").classList.toggle("pending", busy);
+    $("#verdict").classList.toggle("pending", busy);
+  }
   page.phase = busy ? phase : null;
   const button = $("#cancel");
   button.disabled = runs && !page.shownState;

@@ -6,6 +6,8 @@ limits, and computes the arm's atlas."""
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
 from tests.browser.conftest import get_json
@@ -38,6 +40,7 @@ def test_the_panda_with_its_pose_task(tabs):
     expect(verdict).to_contain_text("pseudoinverse J^P#: not repeatable")
     expect(verdict).to_contain_text("extended Jacobian J^E#: repeatable")
     expect(verdict).to_contain_text("stayed within the joint limits of the Franka Panda")
+    expect(verdict).not_to_have_class(re.compile(r"\bpending\b"))  # (dimmed while computing)
 
     scene = tab.wait_scene_drawn(generation)
     assert scene["robot"] == "panda" and scene["mechanism"] == "Chain"
