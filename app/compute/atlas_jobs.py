@@ -1,7 +1,7 @@
 """Atlas jobs of the REST API: started by a request, run in the background, read back later.
 
 An atlas (:mod:`jik.engine.atlas`) takes seconds to minutes, longer than a request may wait, so
-``POST /atlas`` only checks the request and plans the atlas (:func:`plan_request`, in a compute
+``POST /atlas`` only checks the request and plans the atlas (:func:`planned`, in a compute
 worker: its time and memory limits hold for the tracing), then
 :class:`AtlasJobs` runs it in a thread of its own that hands its chunks to the server's compute
 pool (:class:`PoolBackend`: the same worker processes as the API's requests, with their time
@@ -28,7 +28,7 @@ from ...engine.atlas import AtlasPlan
 from ...engine.atlas_run import run_atlas
 from ...engine.exceptions import RunCancelled
 from ...engine.progress import ProgressCallbacks
-from .atlas_plan import AtlasLimits, plan_request, result_document
+from .atlas_plan import AtlasLimits, Used, planned, result_document
 from .atlas_pool import PoolBackend
 from .atlas_schemas import AtlasJobResponse, AtlasRequest
 
@@ -59,6 +59,8 @@ class AtlasJob:
     cancel: threading.Event = field(default_factory=threading.Event)
     #: The request it was started from (the dashboard draws the result with it).
     request: AtlasRequest | None = None
+    #: The robot and the map the plan used (:func:`~jik.app.compute.atlas_plan.planned`).
+    used: Used | None = None
     #: Whether it holds one of the ``max_running`` slots (given back once, at its end or its
     #: cancel, whichever comes first).
     holds_slot: bool = False
@@ -89,6 +91,8 @@ class AtlasJob:
             elapsed_s=end - self.started,
             queue_position=ahead if self.status == "queued" else None,
             message=message,
+            robot=self.used[0] if self.used else None,
+            augmentation=self.used[1] if self.used else None,
             error=self.error,
             result=self.result,  # type: ignore[arg-type]  # (validated)
         )
@@ -119,14 +123,21 @@ class AtlasJobs:
         with self._lock:
             self._room(client)
 
-    def start(self, client: str, req: AtlasRequest, plan: AtlasPlan | None = None) -> AtlasJob:
-        """Start the request's atlas as a job, planned here unless ``plan`` (its plan) is given
-        (raises before anything is kept)."""
+    def start(
+        self, client: str, req: AtlasRequest, plan: tuple[AtlasPlan, Used] | None = None
+    ) -> AtlasJob:
+        """Start the request's atlas as a job, planned here unless ``plan`` (its plan and what
+        it used, :func:`~jik.app.compute.atlas_plan.planned`) is given (raises before anything
+        is kept)."""
         self.check_room(client)
-        if plan is None:
-            plan = plan_request(req, self.limits)
+        atlas, used = plan if plan is not None else planned(req, self.limits)
         job = AtlasJob(
-            self.run + secrets.token_urlsafe(12), client, plan, req.leg_ends, request=req
+            self.run + secrets.token_urlsafe(12),
+            client,
+            atlas,
+            req.leg_ends,
+            request=req,
+            used=used,
         )
         with self._lock:
             self._room(client)

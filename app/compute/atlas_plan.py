@@ -19,12 +19,16 @@ from ...engine.exceptions import InvalidInputError
 from ...engine.repeatability import CLOSE_TOL
 from ...engine.self_motion import MAX_ARC
 from ...engine.solve_rules import gamma_problem
+from . import schemas as S
 from .atlas_pool import sized_chunks
 from .atlas_schemas import AtlasRequest
 from .documents import nullable
 from .exceptions import RequestError
 from .robot_requests import check_task_point, request_robot
 from .worker import task
+
+#: What an atlas job's response repeats of its request: the robot used, the map used.
+Used = tuple[S.RobotUsed, S.AugmentationUsed | None]
 
 
 @dataclass(frozen=True)
@@ -44,6 +48,12 @@ class AtlasLimits:
 def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
     """The request's atlas, planned (curves traced); RequestError or InvalidInputError, each
     naming the field, when it cannot be."""
+    return planned(req, limits)[0]
+
+
+def planned(req: AtlasRequest, limits: AtlasLimits) -> tuple[AtlasPlan, Used]:
+    """:func:`plan_request`, and what the job's response repeats: the robot used and the map
+    the extended inverse used (None without it), as every run's response does."""
     if len(set(req.algorithms)) != len(req.algorithms):
         raise RequestError("algorithms", f"name each algorithm once, got {req.algorithms}")
     robot = request_robot(  # (each algorithm takes its own of the parameters)
@@ -85,7 +95,7 @@ def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
             "response carries; ask for the drift alone or a smaller atlas",
         )
     try:
-        return _plan(req, spec, inverses, path, gamma, mode)
+        return _plan(req, spec, inverses, path, gamma, mode), (robot.robot, robot.augmentation)
     except InvalidInputError as exc:
         if exc.field != "starts":
             raise
@@ -127,10 +137,11 @@ def _plan(req: AtlasRequest, spec, inverses, path, gamma, mode) -> AtlasPlan:
 def plan_task(req: str, limits: AtlasLimits):
     """:func:`plan_request` of a request (JSON) as a compute worker's task, within the workers'
     time and memory limits (tracing the curves solves eq. (7)), its chunks sized for the pool
-    (:func:`sized_chunks`): the plan and None, or None and the refusal (message, field), for the
-    server to raise again."""
+    (:func:`sized_chunks`): the plan and what it used (:func:`planned`) and None, or None and
+    the refusal (message, field), for the server to raise again."""
     try:
-        return sized_chunks(plan_request(AtlasRequest.model_validate_json(req), limits)), None
+        plan, used = planned(AtlasRequest.model_validate_json(req), limits)
+        return (sized_chunks(plan), used), None
     except InvalidInputError as exc:
         return None, (str(exc), exc.field)
 

@@ -19,10 +19,12 @@ from .schemas import (
     Algorithm,
     AnyAugmentation,
     AnyRobot,
+    AugmentationUsed,
     Coordinate,
     Gamma,
     MaybeFloat,
     Mode,
+    RobotUsed,
     Tolerance,
     Vector,
     per_robot,
@@ -188,5 +190,11 @@ class AtlasJobResponse(BaseModel):
         "computes a few at once, in the order they were started); null once it runs",
     )
     message: str = Field("", description="the state in words, e.g. what a queued job waits for")
+    robot: RobotUsed | None = Field(
+        None, description="the robot used, as every run's response names it (its notes too)"
+    )
+    augmentation: AugmentationUsed | None = Field(
+        None, description="the map the extended inverse used; null without it"
+    )
     error: str | None = None
     result: AtlasResult | None = None

@@ -77,7 +77,19 @@ def test_a_job_runs_to_its_result_and_outlives_its_request(app, client):
     job = r.json()
     assert r.headers["location"] == f"/atlas/{job['id']}"
     assert job["status"] in ("queued", "running") and job["runs"] == 6
+    # the robot and map used, as a run's response names them
+    run = {
+        "robot": req["robot"],
+        "algorithm": "extended",
+        "path": LOOP,
+        "cycles": 1,
+        "x0": [0.0, 0.0, 1.5],
+    }
+    rep = client.post("/repeatability", json=run).json()
+    assert job["robot"] == rep["robot"] and job["augmentation"] == rep["augmentation"]
+    assert job["robot"]["name"] == "manipulator2" and job["augmentation"]["name"]
     done = wait_until_ended(TestClient(app), job["id"])
+    assert done["robot"] == job["robot"] and done["augmentation"] == job["augmentation"]
     assert done["status"] == "done", done["error"]
     assert done["progress"] == 1.0 and done["runs_done"] == 6
     res = done["result"]
@@ -226,7 +238,7 @@ def test_the_plan_is_made_in_a_compute_worker(client, monkeypatch):
     def not_here(*_args):
         raise AssertionError("planned in the server's process")
 
-    monkeypatch.setattr("jik.app.compute.atlas_jobs.plan_request", not_here)
+    monkeypatch.setattr("jik.app.compute.atlas_jobs.planned", not_here)
     r = client.post("/atlas", json=body())
     assert r.status_code == 202, r.text
     assert wait_until_ended(client, r.json()["id"])["status"] == "done"

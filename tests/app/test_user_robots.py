@@ -230,6 +230,11 @@ def test_a_urdf_is_not_echoed_and_skipped_meshes_are_noted(api):
     assert body["robot"]["definition"]["urdf_bytes"] == len(text.encode())
     assert body["robot"]["definition"]["end_link"] == "tool"
     assert "1 mesh file reference(s) skipped, never read" in body["robot"]["notes"][0]
+    # an atlas job names the same robot, notes included, and not its text either
+    atlas = {"robot": robot, "reference": run["x0"], "starts": 2, "cycles": 1, "arc": [-0.1, 0.1]}
+    job = api.post("/atlas", json=atlas)
+    assert job.status_code == 202, job.text
+    assert job.json()["robot"] == body["robot"] and "<robot" not in job.text
 
 
 def test_vector_lengths_are_checked_against_the_built_robot(api):
