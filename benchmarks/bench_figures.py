@@ -26,7 +26,7 @@ def _values(v):
     """Decoded JSON with typed arrays as float lists, NaN as None (the two sides narrow ints
     differently)."""
     if isinstance(v, dict) and "bdata" in v:
-        dtype = {"f8": "<f8", "i4": "<i4", "i2": "<i2", "i1": "i1", "u1": "u1"}[v["dtype"]]
+        dtype = np.dtype(v["dtype"]).newbyteorder("<")  # (plotly's codes are numpy's: f4, i2, ...)
         a = np.frombuffer(base64.b64decode(v["bdata"]), dtype=dtype).astype(float)
         return [None if np.isnan(x) else x for x in a.tolist()]
     if isinstance(v, dict):
