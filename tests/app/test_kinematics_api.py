@@ -53,8 +53,8 @@ def test_a_user_robot(api):
 @pytest.mark.parametrize(
     ("body", "field", "text"),
     [
-        ({"robot": {"name": "manipulator2"}, "x": [0.0, 1.0]}, "x", "3 items"),
-        ({"robot": {"name": "panda"}, "x": [[0] * 7, [0] * 6]}, "x", "7 items"),
+        ({"robot": {"name": "manipulator2"}, "x": [0.0, 1.0]}, "x", "at least 3 entries"),
+        ({"robot": {"name": "panda"}, "x": [[0] * 7, [0] * 6]}, "x", "at least 7 entries"),
         (
             {
                 "robot": {"name": "planar_chain", "joints": "RRR", "lengths": [1, 1, 1]},
