@@ -126,7 +126,8 @@ def _capped(body: dict) -> dict:
             **augmentation,
             "degree": min(augmentation["degree"], WORK_CAPS["degree"]),
         }
-    if isinstance(augmentation, dict) and len(augmentation.get("region") or {}) > 3:
+    region = augmentation.get("region") if isinstance(augmentation, dict) else None
+    if isinstance(region, dict) and len(region) > 3:  # (a region of any type is generated)
         # a total-degree synthesis' work grows as C(n + d, d)^2: total degree 2 over 4-16 joints
         body["augmentation"] = {**body["augmentation"], "degree": 2}
     params = body.get("algorithm_parameters")
