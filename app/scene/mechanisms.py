@@ -134,7 +134,8 @@ class NormalForm(Mechanism):
         self.bar = self.box("lever/bar", (xhi - xlo, 0.045, 0.03), ((xlo + xhi) / 2, 0.0, 0.05))
         self.ball("lever/pivot", 0.06, (0.0, 0.0, 0.05), color=(40, 40, 40))
         self.point = self.ball("W", 0.08)
-        if self.root.endswith("extended"):
+        chosen = tuple(self.state.algorithms)
+        if self.root.endswith("/" + ("extended" if "extended" in chosen else chosen[0])):
             self.scene.add_label(  # (below the point: clear of the start gizmo's label)
                 f"{self.root}/W/label", "W (task point)", position=(0.1, -0.2, -0.35)
             )
