@@ -55,11 +55,19 @@ The atlas (drift over many starts and paths)
     iter_atlas                  the same, chunk by chunk, in bounded memory
     AtlasPlan, AtlasResult      the plan and the gathered result
 Errors (jik.engine.exceptions)
-    JikError, InvalidInputError, SingularConfigurationError, KinematicSingularityError,
-    AlgorithmicSingularityError, OneFormUndefinedError, RunCancelled
+    JikError                    the base of every error below
+    InvalidInputError, FormulaError  bad input (``error.field`` names it); a formula's syntax
+    SingularConfigurationError, KinematicSingularityError, AlgorithmicSingularityError,
+    OneFormUndefinedError       J# undefined at a configuration (``error.x`` names it)
+    RunCancelled                a Progress said the work is no longer wanted
 
-Every numeric function takes a leading batch axis; results print on one line and export their
-numbers (``as_dict()``, ``columns()``, ``to_dataframe()`` with pandas).
+Every numeric function takes a leading batch axis. Robots, maps and inverses print as what they
+compute (``ExtendedInverse(Manipulator2(p=3, r=2, l=1), map=PaperCubic())``); results print on
+one line and export their numbers: ``as_dict()`` (JSON-friendly; a run's algorithm, inverse,
+mode and gamma included), ``columns()`` (a dict of arrays, a row per item) and ``to_dataframe()``
+(the same columns in pandas: ``pip install 'jik-lab[dataframes]'``). Column names mean one thing
+everywhere: ``x0_1``.. a start, ``x_1``.. the row's configuration (a trajectory's point, a solve's
+or a cycle's end), ``y_1``.. its task point, ``y_d_1``.. a target.
 """
 
 from __future__ import annotations
@@ -112,7 +120,7 @@ _EXPORTS = {
     # repeatability
     "repeatability": "repeatability",
     "RepeatabilityResult": "results",
-    "Resume": "repeatability",
+    "Resume": "run_settings",
     "Leg": "repeatability",
     "Progress": "progress",
     "ProgressCallbacks": "progress",
@@ -132,6 +140,7 @@ _EXPORTS = {
     # errors
     "JikError": "exceptions",
     "InvalidInputError": "exceptions",
+    "FormulaError": "exceptions",
     "SingularConfigurationError": "exceptions",
     "KinematicSingularityError": "exceptions",
     "AlgorithmicSingularityError": "exceptions",
@@ -153,6 +162,7 @@ __all__ = [
     "E1Optimal",
     "E2Optimal",
     "ExtendedInverse",
+    "FormulaError",
     "FormulaKinematics",
     "FormulaMap",
     "InvalidInputError",
@@ -241,6 +251,7 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
     from .characteristics import CharacteristicsMap, UnicycleCharacteristics
     from .exceptions import (
         AlgorithmicSingularityError,
+        FormulaError,
         InvalidInputError,
         JikError,
         KinematicSingularityError,
@@ -258,9 +269,10 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
     from .practical_inverses import DampedInverse, PostureInverse, WeightedInverse
     from .progress import Progress, ProgressCallbacks
     from .registry import ALGORITHMS, ROBOTS, make_inverse
-    from .repeatability import Leg, Resume, repeatability
+    from .repeatability import Leg, repeatability
     from .results import BatchSolveResult, RepeatabilityResult, SolveResult, Trajectory
     from .robot_spec import Robot, load_robot, robot_from_dict
+    from .run_settings import Resume
     from .solver import solve, solve_batch
     from .synthesis_nd import TotalDegreeSynthesis, synthesize_e2_nd
     from .unicycle import Unicycle

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from .exceptions import InvalidInputError, SingularConfigurationError
-from .inverses import Inverse, Pseudoinverse
+from .inverses import Inverse, Pseudoinverse, algorithm_labels
 from .repeatability import CLOSE_TOL, MAX_CYCLES, MAX_PATH_POINTS
 from .self_motion import SelfMotionManifold, project, trace
 from .solve_rules import MAX_ITERATIONS_LIMIT, MODES, check_gamma
@@ -98,7 +98,8 @@ class AtlasPlan:
 
     @property
     def algorithms(self) -> tuple[str, ...]:
-        return tuple(inv.name for inv in self.inverses)
+        """A distinct label per inverse (:func:`jik.engine.inverses.algorithm_labels`)."""
+        return algorithm_labels(self.inverses)
 
     def starts(self, lo: int, hi: int) -> FloatArray:
         """The starts of runs lo to hi - 1 (runs are path-major: run = path * N + start)."""

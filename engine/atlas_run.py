@@ -18,13 +18,13 @@ import numpy as np
 from .atlas import AtlasPlan
 from .atlas_backends import Backend, backend_for
 from .exceptions import SingularConfigurationError
+from .exports import Columns, coordinate_columns
 from .inverses import Inverse
 from .limits import robot_limits, starts_outside
 from .posture_at_start import PostureAtStart
 from .practical_inverses import PostureInverse
 from .progress import Progress, check_cancelled
 from .repeatability import repeatability
-from .results import dataframe
 from .validation import FloatArray
 
 #: Starts per batched repeatability() call within a chunk: the working set of the Picard sweeps
@@ -131,12 +131,15 @@ def _runs(inverse: Inverse, task: ChunkTask, ids: np.ndarray):
 
 
 @dataclass(frozen=True)
-class AtlasResult:
+class AtlasResult(Columns):
     """An atlas: for every inverse a, path j and start i, the drift after each cycle.
 
     Attributes
     ----------
     algorithms : tuple of str, length A
+        A distinct label per inverse: its name, with the parameters that tell it apart from
+        another of the same name (``damped(damping=0.01)``; :func:`jik.engine.inverses.
+        algorithm_labels`).
     paths : ndarray, shape (P, L0, r)
     parameter : ndarray, shape (N,) or None
         Arc length s of each start on its path's self-motion curve (None: explicit starts).
@@ -175,9 +178,10 @@ class AtlasResult:
         )
 
     def columns(self) -> dict[str, FloatArray]:
-        """One array per column, a row per algorithm, path, start and cycle (long format):
-        ``algorithm``, ``path``, ``start``, ``s`` (arc length, NaN for given starts),
-        ``cycle`` (from 1), ``drift``, ``success`` (the run's), and the start ``x1``..``xp``."""
+        """A row per algorithm, path, start and cycle (long format): ``algorithm`` (its label),
+        ``path``, ``start`` (both from 0), ``s`` (arc length, NaN for given starts), ``cycle``
+        (from 1), ``drift``, ``success`` (the run's), the start ``x0_1``..``x0_p`` and, when the
+        leg ends were kept, the configuration at the cycle's end ``x_1``..``x_p``."""
         A, P, N, C = self.drift.shape
         a, j, i, c = (g.ravel() for g in np.indices((A, P, N, C)))
         s = np.full(N, np.nan) if self.parameter is None else np.asarray(self.parameter)
@@ -190,12 +194,34 @@ class AtlasResult:
             "drift": self.drift.ravel(),
             "success": self.success[a, j, i],
         }
-        starts = self.starts[j, i]
-        return out | {f"x{k + 1}": starts[:, k] for k in range(starts.shape[1])}
+        out |= coordinate_columns("x0", self.starts[j, i])
+        if self.leg_ends is not None:
+            L = self.leg_ends.shape[3] // C
+            out |= coordinate_columns("x", self.leg_ends[a, j, i, (c + 1) * L - 1])
+        return out
 
-    def to_dataframe(self):
-        """The atlas as a pandas DataFrame in long format (:meth:`columns`)."""
-        return dataframe(self.columns())
+    def as_dict(self, leg_ends: bool = False) -> dict:
+        """JSON-friendly: the labels, paths, arc lengths, starts, drift, success, the failures
+        (a list of ``{"algorithm", "path", "start", "message"}``), outside_limits and, with
+        ``leg_ends``, every leg's end (A P N cycles L p numbers)."""
+        return {
+            "algorithms": list(self.algorithms),
+            "paths": self.paths.tolist(),
+            "parameter": None if self.parameter is None else self.parameter.tolist(),
+            "starts": self.starts.tolist(),
+            "drift": self.drift.tolist(),
+            "success": self.success.tolist(),
+            "failures": [
+                {"algorithm": self.algorithms[a], "path": j, "start": i, "message": why}
+                for (a, j, i), why in sorted(self.failures.items())
+            ],
+            "outside_limits": None if self.outside_limits is None else self.outside_limits.tolist(),
+            **(
+                {"leg_ends": None if self.leg_ends is None else self.leg_ends.tolist()}
+                if leg_ends
+                else {}
+            ),
+        }
 
 
 def iter_atlas(

@@ -56,6 +56,10 @@ class VectorExtendedInverse(Inverse):
         self.kinematics = kinematics
         self.augmenting_maps = maps
 
+    @property
+    def parameters(self) -> dict[str, object]:
+        return {"maps": self.augmenting_maps}
+
     def augmenting_value(self, x: FloatArray) -> FloatArray:
         """h(x) = (h_1, ..., h_(p-r)), shape (..., p - r); NaN where a map is undefined."""
         return np.stack([m.value_masked(x)[0] for m in self.augmenting_maps], axis=-1)

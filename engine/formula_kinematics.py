@@ -184,6 +184,9 @@ class FormulaKinematics(Kinematics):
     def parameters(self) -> dict[str, object]:
         return dict(self.values)
 
+    def _described(self) -> dict[str, object]:
+        return {"variables": self.variable_names, "task": tuple(self.texts), **self.values}
+
     @functools.cached_property
     def symbolic_jacobian(self) -> sp.Matrix:
         """dk/dx as a sympy matrix (r, p)."""

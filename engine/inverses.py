@@ -8,6 +8,9 @@ Nothing here forms an explicit matrix inverse: every product J# e is a linear so
 from __future__ import annotations
 
 import abc
+from collections import Counter
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -17,6 +20,7 @@ from .exceptions import (
     InvalidInputError,
     KinematicSingularityError,
 )
+from .exports import call_repr, short_value
 from .kinematics import SINGULAR_MANIPULABILITY, Kinematics
 from .linalg import gram, solve_small
 from .validation import FloatArray
@@ -108,6 +112,15 @@ class Inverse(abc.ABC):
     #: J J# = I_r, so along (7) the task error is e0 exp(-gamma theta), eq. (5), and the
     #: solver may integrate the homotopy form (:mod:`jik.engine.picard`); False: (7) itself.
     right_inverse: bool = True
+
+    @property
+    def parameters(self) -> dict[str, Any]:
+        """What the inverse computes with besides its kinematics: its parameters (numbers,
+        vectors) and augmenting map(s); what its repr and its label in an atlas show."""
+        return {}
+
+    def __repr__(self) -> str:
+        return call_repr(type(self).__name__, repr(self.kinematics), **self.parameters)
 
     @abc.abstractmethod
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -205,6 +218,10 @@ class ExtendedInverse(Inverse):
         self.kinematics = kinematics
         self.augmenting_map = augmenting_map
 
+    @property
+    def parameters(self) -> dict[str, Any]:
+        return {"map": self.augmenting_map}
+
     def augmenting_value(self, x: FloatArray) -> FloatArray:
         """h(x), NaN where h is undefined (a run can stop at such a point)."""
         return self.augmenting_map.value_masked(x)[0]
@@ -235,3 +252,30 @@ class ExtendedInverse(Inverse):
             "choose another start or augmentation parameters",
             x,
         )
+
+
+def algorithm_labels(inverses: Sequence[Inverse]) -> tuple[str, ...]:
+    """A distinct label per inverse: its name (``Inverse.name``) where no other inverse has
+    it, else the name and the parameters in which it differs from those that share it,
+    ``damped(damping=0.01)``; inverses alike in every parameter are numbered, ``damped #2``."""
+    names = [inv.name for inv in inverses]
+    labels = []
+    for inv in inverses:
+        group = [other for other in inverses if other.name == inv.name]
+        if len(group) == 1:
+            labels.append(inv.name)
+            continue
+        mine = inv.parameters
+        differ = {
+            k: v
+            for k, v in mine.items()
+            if any(short_value(o.parameters.get(k)) != short_value(v) for o in group)
+        }
+        labels.append(call_repr(inv.name, **differ) if differ else inv.name)
+    counts, seen = Counter(labels), Counter[str]()
+    for i, label in enumerate(labels):
+        if counts[label] > 1:
+            seen[label] += 1
+            labels[i] = f"{label} #{seen[label]}"
+    assert len(set(labels)) == len(names)
+    return tuple(labels)

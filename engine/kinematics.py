@@ -11,6 +11,7 @@ from typing import ClassVar
 import numpy as np
 
 from .exceptions import InvalidInputError, KinematicSingularityError
+from .exports import call_repr
 from .validation import FloatArray, as_points, positive
 
 #: m(x) below this counts as a kinematic singularity.
@@ -68,6 +69,14 @@ class Kinematics(abc.ABC):
     def parameters(self) -> dict[str, object]:
         """The kinematic parameters, as a JSON-friendly dict."""
         return {}
+
+    def __repr__(self) -> str:
+        """One line: the class, p, r and what sets the robot apart (:meth:`_described`)."""
+        return call_repr(type(self).__name__, p=self.p, r=self.r, **self._described())
+
+    def _described(self) -> dict[str, object]:
+        """What the repr shows besides p and r: the parameters by default."""
+        return self.parameters
 
     def check(self, x, name: str = "x") -> FloatArray:
         """Validate configurations: finite, shape (..., p)."""

@@ -84,8 +84,9 @@ class SynthesizedMap(AugmentingMap):
 
     @property
     def parameters(self) -> dict[str, float]:
+        """The basis degree per variable (integers)."""
         shape = self.coefficients.shape
-        return {f"degree_{k}": float(n - 1) for k, n in zip(self.region, shape, strict=True)}
+        return {f"degree_{k}": int(n - 1) for k, n in zip(self.region, shape, strict=True)}
 
     def _bases(self, x: FloatArray) -> list[tuple[FloatArray, FloatArray]]:
         x = np.asarray(x, dtype=float)

@@ -105,6 +105,13 @@ class PlanarChain(Kinematics):
             "orientation": self.orientation,
         }
 
+    def _described(self) -> dict[str, object]:
+        out: dict[str, object] = {"joints": self.joints, "lengths": self.lengths}
+        if np.any(self.offsets != 0):
+            out["offsets"] = self.offsets
+        out["task"] = "x y angle" if self.orientation else "x y"
+        return out
+
     def _angles_lengths(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
         """theta_i (..., p) [rad] and a_i (..., p) [length]."""
         q = np.asarray(x, dtype=float) + self.offsets

@@ -31,6 +31,9 @@ class RestCarrying(Kinematics):
         self.name = inner.name  # type: ignore[misc]
         self.p, self.r = 2 * inner.p, inner.r
 
+    def __repr__(self) -> str:
+        return f"RestCarrying({self.inner!r})"
+
     def forward(self, x: FloatArray) -> FloatArray:
         return self.inner.forward(x[..., : self.inner.p])
 
@@ -47,6 +50,13 @@ class PostureAtStart(Inverse):
         self.posture = posture
         self.name = posture.name
         self.kinematics = RestCarrying(posture.kinematics)
+
+    def __repr__(self) -> str:
+        return f"PostureAtStart({self.posture!r})"
+
+    @property
+    def parameters(self) -> dict[str, object]:
+        return self.posture.parameters
 
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
         p = self.posture.kinematics.p

@@ -87,6 +87,10 @@ class DampedInverse(Inverse):
         if self._plain is not None:
             self.right_inverse = True
 
+    @property
+    def parameters(self) -> dict[str, object]:
+        return {"damping": self.damping, "damping_threshold": self.damping_threshold}
+
     def damping_squared(self, J: FloatArray) -> FloatArray:
         """lambda(x)^2 for Jacobians J (..., r, p): constant, or Nakamura-Hanafusa's."""
         lam2 = np.full(J.shape[:-2], self.damping**2)
@@ -178,6 +182,10 @@ class WeightedInverse(Inverse):
             )
         self.limits = lim
 
+    @property
+    def parameters(self) -> dict[str, object]:
+        return {"limits": self.limits}
+
     def outside(self, x: FloatArray) -> FloatArray:
         """Where a joint is at or past one of its limits, shape (...,)."""
         return np.asarray(~((x > self.limits[:, 0]) & (x < self.limits[:, 1])).all(axis=-1))
@@ -264,6 +272,13 @@ class PostureInverse(Inverse):
             )
         self.gain = _nonnegative(gain, "gain", MAX_GAIN)
         self._plain = Pseudoinverse(kinematics)
+
+    @property
+    def parameters(self) -> dict[str, object]:
+        out: dict[str, object] = {"rest": self.rest, "gain": self.gain}
+        if not self.rest_given:
+            out["rest_given"] = False
+        return out
 
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
         return self.pull(x, e, self.rest)

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING
 
 from .exceptions import JikError, RunCancelled
 
@@ -25,31 +25,44 @@ if TYPE_CHECKING:
     from .repeatability import Leg
 
 
-class Progress(Protocol):
+class Progress:
     """What the engine tells a caller during a long computation, and asks it.
 
-    Subclass it and override what you need (each method does nothing by default), or give any
-    object with these methods (``stop_at_error`` may be left out: False). What a method raises
-    propagates and stops the computation.
+    Subclass it and override what you need: each method does nothing by default, and
+    ``stop_at_error`` is False. :class:`ProgressCallbacks` makes one from plain functions. What
+    a method raises propagates and stops the computation.
+
+    Methods and attribute
+    ---------------------
+    leg(leg)
+        A leg of a repeatability run ended (:class:`jik.engine.repeatability.Leg`).
+    advance(done, total)
+        ``done / total`` of the current piece of work is done: 0 to 1, never decreasing. Where
+        the work comes in equal units they are counted: an atlas's runs
+        (``run_atlas``: ``(runs_done, plan.size)``), a characteristics map's batches. Elsewhere
+        ``total`` is 1.0 and ``done`` the fraction: an E2 synthesis (its stages weighted by
+        their estimated cost) and a discrete repeatability leg (its way to the tolerance, on a
+        log scale of the task error, eq. (5)).
+    cancelled() -> bool
+        Polled between two pieces of work: True stops the computation there with
+        :class:`jik.engine.exceptions.RunCancelled`.
+    stop_at_error : bool
+        A leg of a repeatability run from one start raised a typed error (a map undefined where
+        the leg starts, an algorithmic singularity of (11) there): True ends the run there with
+        what it has, that leg failed with ``Leg.stopped_by`` the error; False (the default) lets
+        the error propagate.
     """
+
+    stop_at_error: bool = False
 
     def leg(self, leg: Leg) -> None:
         """A leg of a repeatability run ended (:class:`jik.engine.repeatability.Leg`)."""
 
     def advance(self, done: float, total: float) -> None:
-        """``done`` of ``total`` units of the current piece of work are done: the atlas's runs,
-        the batches of a characteristics map, or a discrete leg's way to its tolerance (a
-        fraction of 1, on a log scale of the task error, eq. (5))."""
+        """``done / total`` of the current piece of work is done (see the class)."""
 
     def cancelled(self) -> bool:
-        """Polled between two pieces of work: True stops the computation there with
-        :class:`jik.engine.exceptions.RunCancelled`."""
-        return False
-
-    def stop_at_error(self, error: JikError) -> bool:
-        """A leg of a repeatability run from one start raised ``error`` (a map undefined where
-        the leg starts, an algorithmic singularity of (11) there): True ends the run there with
-        what it has, that leg failed with ``Leg.stopped_by = error``; False lets it propagate."""
+        """Polled between two pieces of work: True stops the computation with RunCancelled."""
         return False
 
 
@@ -65,14 +78,14 @@ class ProgressCallbacks(Progress):
         ``on_advance(done, total)``, called as :meth:`Progress.advance`.
     is_cancelled : callable, optional
         ``is_cancelled() -> bool``, polled as :meth:`Progress.cancelled`.
-    stop_at_errors : bool
-        The answer of :meth:`Progress.stop_at_error` (default False: errors propagate).
+    stop_at_error : bool
+        As :attr:`Progress.stop_at_error` (default False: errors propagate).
     """
 
     on_leg: Callable[[Leg], None] | None = None
     on_advance: Callable[[float, float], None] | None = None
     is_cancelled: Callable[[], bool] | None = None
-    stop_at_errors: bool = False
+    stop_at_error: bool = False
 
     def leg(self, leg: Leg) -> None:
         if self.on_leg is not None:
@@ -85,15 +98,11 @@ class ProgressCallbacks(Progress):
     def cancelled(self) -> bool:
         return self.is_cancelled is not None and bool(self.is_cancelled())
 
-    def stop_at_error(self, error: JikError) -> bool:
-        return self.stop_at_errors
-
 
 def stops_at(progress: Progress | None, error: JikError) -> bool:
-    """Whether ``progress`` ends a run at ``error`` (:meth:`Progress.stop_at_error`) rather
-    than let it propagate; False without a progress or without that method."""
-    ask = getattr(progress, "stop_at_error", None)
-    return ask is not None and bool(ask(error))
+    """Whether ``progress`` ends a run at ``error`` (:attr:`Progress.stop_at_error`) rather
+    than let it propagate; False without a progress."""
+    return progress is not None and bool(getattr(progress, "stop_at_error", False))
 
 
 def check_cancelled(progress: Progress | None, what: str) -> None:

@@ -24,6 +24,7 @@ from .inverses import Inverse
 from .picard_guesses import chain_guesses
 from .progress import Progress, check_cancelled, stops_at
 from .results import BatchSolveResult, RepeatabilityResult, SolveResult, Trajectory
+from .run_settings import Resume, RunSettings, inverse_fingerprint, resumed_legs
 from .solve_chunks import solve_in_chunks
 from .solver import solve, solve_batch
 from .unicycle import Unicycle
@@ -44,40 +45,6 @@ POLL_ITERATIONS = 80
 
 
 @dataclass(frozen=True)
-class Resume:
-    """Cycles already driven from ``x0``, for :func:`repeatability` (given as its ``x0``) to go
-    on from their end.
-
-    A leg of eq. (7) depends only on where it starts and on its target, so going on from the
-    end of c cycles gives the numbers of a run from x0, bit for bit, when the next cycle's Picard
-    guesses are those the run from x0 would use (``guides``).
-
-    Attributes
-    ----------
-    x0 : array_like, shape (p,) or (n, p)
-        The start(s) of the run.
-    legs : array_like, shape (c * L, p) or (n, c * L, p)
-        The configuration after each leg of the first c cycles: ``legs`` of a run of c cycles
-        (every leg converged) from the same x0, path and settings.
-    guides : sequence of L Trajectory or None
-        Continuous mode, one start: the trajectories of cycle c's legs, each the Picard guess of
-        the same leg of the next cycle (:func:`cycle_guesses`). Without them the extended
-        inverse's next cycle starts its sweeps cold: the same legs to the sweep tolerance.
-    """
-
-    x0: FloatArray
-    legs: FloatArray
-    guides: Sequence[Trajectory | None] = ()
-
-    @classmethod
-    def of(cls, result: RepeatabilityResult) -> Resume:
-        """Go on from ``result`` (the guides come from its ``leg_results``, if recorded)."""
-        L = result.targets.shape[-2]
-        guides = [r.trajectory for r in result.leg_results[-L:]] if result.leg_results else []
-        return cls(result.x0, result.legs, guides)
-
-
-@dataclass(frozen=True)
 class Leg:
     """One leg of a run, as :func:`repeatability` hands it to :meth:`Progress.leg` when it
     ends: eq. (7) from where the leg before ended to the cycle's target ``index``.
@@ -93,7 +60,7 @@ class Leg:
         A batch: the k members' BatchSolveResult.
     stopped_by : JikError or None
         The error the leg's solve raised, when the progress stopped the run there
-        (:meth:`Progress.stop_at_error`); ``result`` is then the leg's start alone (one point,
+        (:attr:`Progress.stop_at_error`); ``result`` is then the leg's start alone (one point,
         ``success=False``).
     """
 
@@ -197,8 +164,8 @@ def repeatability(
         at most :data:`POLL_ITERATIONS` iterations (the same iterates), between which it is
         asked too and told the leg's progress (:meth:`Progress.advance`, a fraction of 1).
         With one start, a leg whose solve raises a typed error (a map undefined where the leg
-        starts, an algorithmic singularity (11) there) asks it whether to end the run there
-        with what it has (:meth:`Progress.stop_at_error`).
+        starts, an algorithmic singularity (11) there) ends the run there with what it has
+        when ``progress.stop_at_error`` is True; otherwise the error propagates.
 
     Returns
     -------
@@ -209,7 +176,8 @@ def repeatability(
     Raises
     ------
     InvalidInputError
-        Bad shapes, or a :class:`Resume` that is not whole cycles of this run.
+        Bad shapes, or a :class:`Resume` that is not whole cycles of this run (its legs' shape,
+        or its settings: the message names the field that differs).
     JikError
         A leg's solve raised (a singular start configuration) and the progress, if any, did not
         stop the run there.
@@ -254,9 +222,26 @@ def repeatability(
         "tol": tol,
         "max_iterations": max_iterations,
     }
+    run = RunSettings(
+        inverse.name,
+        repr(inverse),
+        inverse_fingerprint(inverse),
+        targets[0].copy() if single else targets.copy(),
+        mode,
+        gamma,
+        tol,
+        max_iterations,
+    )
     first = 0
     if resume is not None:
-        done, given = _resumed(resume, n, L, kin.p, cycles)
+        differs = None if resume.settings is None else resume.settings.difference(run)
+        if differs is not None:
+            raise InvalidInputError(
+                f"x0: the Resume is of another run, {differs}; go on only from a run of the "
+                "same inverse, path and settings",
+                "x0",
+            )
+        done, given = resumed_legs(resume, n, L, kin.p, cycles)
         first = done.shape[1] // L
         legs[:, : first * L] = done
         current = done[:, -1].copy()
@@ -334,28 +319,9 @@ def repeatability(
             bool(alive[0]),
             messages[0],
             leg_results,
+            run,
         )
-    return RepeatabilityResult(xb, targets, legs, cycle_end, drift, alive, tuple(messages), [])
-
-
-def _resumed(resume: Resume, n: int, L: int, p: int, cycles: int):
-    """The legs (n, c * L, p) of ``resume`` and its guides (a list of L, or [])."""
-    done = np.asarray(resume.legs, dtype=float)
-    done = done[None] if done.ndim == 2 and n == 1 else done
-    m = done.shape[1] if done.ndim == 3 else 0
-    if done.shape != (n, m, p) or m == 0 or m % L or m // L > cycles:
-        raise InvalidInputError(
-            f"resume.legs must be the legs of 1 to {cycles} whole cycles of {L} legs, shape "
-            f"(c * {L}, {p}) for one start or (n, c * {L}, {p}); got shape {done.shape}"
-        )
-    if not np.all(np.isfinite(done)):
-        raise InvalidInputError(
-            "resume.legs contains NaN: go on only from a run whose legs all converged"
-        )
-    guides = list(resume.guides)
-    if guides and len(guides) != L:
-        raise InvalidInputError(f"resume.guides must have one trajectory (or None) per leg, {L}")
-    return done, guides
+    return RepeatabilityResult(xb, targets, legs, cycle_end, drift, alive, tuple(messages), [], run)
 
 
 def _between(progress, where: str):
@@ -379,5 +345,17 @@ def _stopped_leg(inverse, x, target, exc, mode, gamma, record) -> SolveResult:
         h = None if h is None else np.asarray(h)
         trajectory = Trajectory(np.zeros(1), x[None, :], y[None, :], np.array([error]), h)
     return SolveResult(
-        x, y, float(error), False, str(exc), 0, trajectory, mode, gamma, inverse.name
+        x,
+        y,
+        float(error),
+        False,
+        str(exc),
+        0,
+        trajectory,
+        mode,
+        gamma,
+        inverse.name,
+        x.copy(),
+        np.asarray(target, dtype=float),
+        repr(inverse),
     )

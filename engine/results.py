@@ -3,7 +3,8 @@
 They borrow SciPy's vocabulary (``x``, ``success``, ``message``, ``nit``), print on one line
 (``print(result)``) and export their numbers: :meth:`as_dict` gives JSON-friendly values, and
 ``to_dataframe()`` a pandas DataFrame (pandas is optional: ``columns()`` gives the same columns
-as plain arrays).
+as plain arrays). Column names follow :mod:`jik.engine.exports`: ``x0_k`` a start, ``x_k`` the
+row's configuration, ``y_k`` its task point, ``y_d_k`` a target.
 """
 
 from __future__ import annotations
@@ -15,48 +16,18 @@ from typing import Any
 import numpy as np
 
 from .exceptions import InvalidInputError
+from .exports import Columns, coordinate_columns, short_text, short_vector
 from .inverses import Inverse
+from .run_settings import RunSettings
 from .validation import FloatArray
-
-
-def short_vector(v, digits: int = 4) -> str:
-    """A vector on one line, ``[0.1235, -1, 1.571]``; a long one elided in the middle."""
-    a = np.asarray(v, dtype=float).ravel()
-    items = [f"{t:.{digits}g}" for t in a]
-    if len(items) > 8:
-        items = [*items[:3], "...", *items[-3:]]
-    return "[" + ", ".join(items) + "]"
-
-
-def short_text(text: str, width: int = 60) -> str:
-    """``text`` cut to ``width`` characters, quoted."""
-    return repr(text if len(text) <= width else text[: width - 3] + "...")
 
 
 def _plural(n: int, noun: str) -> str:
     return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
 
 
-def dataframe(columns: dict[str, Any]):
-    """A pandas DataFrame of ``columns`` (pandas is imported here, and only here)."""
-    try:
-        import pandas as pd
-    except ImportError:
-        raise ImportError(
-            "to_dataframe() needs pandas (pip install pandas); columns() gives the same "
-            "columns as numpy arrays"
-        ) from None
-    return pd.DataFrame(columns)
-
-
-def coordinate_columns(name: str, values: FloatArray) -> dict[str, FloatArray]:
-    """``{name1: values[:, 0], name2: ...}``: one column per coordinate, numbered from 1."""
-    values = np.asarray(values, dtype=float)
-    return {f"{name}{k + 1}": values[:, k] for k in range(values.shape[1])}
-
-
 @dataclass(frozen=True)
-class Trajectory:
+class Trajectory(Columns):
     """One run of eq. (7), point by point (accepted steps or iterations).
 
     Attributes
@@ -90,17 +61,14 @@ class Trajectory:
         )
 
     def columns(self) -> dict[str, FloatArray]:
-        """One array per column: ``theta``, ``x1``..``xp``, ``y1``..``yr``, ``error``, ``h``."""
+        """A row per point: ``theta``, the point ``x_1``..``x_p``, its task point
+        ``y_1``..``y_r``, ``error`` and, for an extended inverse, ``h``."""
         out = {"theta": np.asarray(self.theta, dtype=float)}
         out |= coordinate_columns("x", self.x) | coordinate_columns("y", self.y)
         out["error"] = np.asarray(self.error, dtype=float)
         if self.h is not None:
             out["h"] = np.asarray(self.h, dtype=float)
         return out
-
-    def to_dataframe(self):
-        """The trajectory as a pandas DataFrame, a row per point (:meth:`columns`)."""
-        return dataframe(self.columns())
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-friendly: ``theta``, ``x`` (m lists of p), ``y``, ``error``, ``h`` (or None)."""
@@ -114,8 +82,33 @@ class Trajectory:
 
 
 @dataclass(frozen=True)
-class SolveResult:
-    """Result of one solve, in SciPy's vocabulary (``x``, ``success``, ``message``, ``nit``)."""
+class SolveResult(Columns):
+    """Result of one solve, in SciPy's vocabulary (``x``, ``success``, ``message``, ``nit``).
+
+    Attributes
+    ----------
+    x, y : ndarray, shapes (p,) and (r,)
+        Where the run ended and k(x) there.
+    error : float
+        ||k(x) - y_d||.
+    success : bool
+    message : str
+    nit : int
+        The solver's iterations: in discrete mode the iterations of eq. (7); in continuous mode
+        its work, Chebyshev-Picard sweeps plus DOP853 steps (:mod:`jik.engine.solver`). A
+        sweep integrates the whole leg, so a good initial guess (``solve``'s ``guess``) takes
+        one or two where a cold start takes about ten: a leg of :func:`repeatability` (whose
+        legs are guessed from the cycle before or swept together) reports fewer than the same
+        leg solved alone, at the same x to the sweep tolerance.
+    trajectory : Trajectory or None
+        Every point (``record=True``).
+    mode, gamma, algorithm
+        The settings of eq. (7) and the inverse's name (``Inverse.name``).
+    x0, y_d : ndarray, shapes (p,) and (r,)
+        The start and the target.
+    inverse : str
+        The inverse as printed: its algorithm, parameters, map and robot.
+    """
 
     x: FloatArray
     y: FloatArray
@@ -127,6 +120,9 @@ class SolveResult:
     mode: str
     gamma: float
     algorithm: str
+    x0: FloatArray
+    y_d: FloatArray
+    inverse: str = ""
 
     def __repr__(self) -> str:
         points = "none" if self.trajectory is None else f"{len(self.trajectory)} points"
@@ -136,12 +132,29 @@ class SolveResult:
             f"trajectory={points}, message={short_text(self.message)})"
         )
 
+    def columns(self) -> dict[str, Any]:
+        """One row (a solve; :meth:`Trajectory.columns` has a row per point): the start
+        ``x0_1``..``x0_p``, the target ``y_d_1``..``y_d_r``, the end ``x_1``..``x_p``, its task
+        point ``y_1``..``y_r``, ``error``, ``success``, ``nit``, ``message``."""
+        out: dict[str, Any] = coordinate_columns("x0", np.atleast_2d(self.x0))
+        out |= coordinate_columns("y_d", np.atleast_2d(self.y_d))
+        out |= coordinate_columns("x", np.atleast_2d(self.x))
+        out |= coordinate_columns("y", np.atleast_2d(self.y))
+        out["error"] = np.array([self.error])
+        out["success"] = np.array([self.success])
+        out["nit"] = np.array([self.nit])
+        out["message"] = np.array([self.message])
+        return out
+
     def as_dict(self, trajectory: bool = False) -> dict[str, Any]:
         """JSON-friendly fields; with ``trajectory``, also :meth:`Trajectory.as_dict`."""
         out: dict[str, Any] = {
             "algorithm": self.algorithm,
+            "inverse": self.inverse,
             "mode": self.mode,
             "gamma": self.gamma,
+            "x0": np.asarray(self.x0).tolist(),
+            "y_d": np.asarray(self.y_d).tolist(),
             "x": self.x.tolist(),
             "y": self.y.tolist(),
             "error": self.error,
@@ -155,8 +168,12 @@ class SolveResult:
 
 
 @dataclass(frozen=True)
-class BatchSolveResult:
-    """Results of a batch of solves; index it for a :class:`SolveResult` with its trajectory."""
+class BatchSolveResult(Columns):
+    """Results of a batch of solves; index it for a :class:`SolveResult` with its trajectory.
+
+    ``x0`` (n, p) and ``y_d`` (n, r) are each member's start and target; the other fields are
+    those of :class:`SolveResult`, one per member.
+    """
 
     x: FloatArray  # (n, p)
     y: FloatArray  # (n, r)
@@ -168,7 +185,8 @@ class BatchSolveResult:
     gamma: float
     algorithm: str
     _inverse: Inverse = field(repr=False)
-    _y_d: FloatArray = field(repr=False)
+    y_d: FloatArray = field(repr=False)  # (n, r)
+    x0: FloatArray = field(repr=False)  # (n, p)
     # Recorded points: member index, theta, x of every accepted step, in order.
     _rec_member: FloatArray | None = field(repr=False, default=None)
     _rec_theta: FloatArray | None = field(repr=False, default=None)
@@ -187,25 +205,29 @@ class BatchSolveResult:
         )
 
     def columns(self) -> dict[str, Any]:
-        """One array per column, a row per member: ``x1``..``xp``, ``y1``..``yr``, ``error``,
-        ``success``, ``nit``, ``message``."""
-        out: dict[str, Any] = coordinate_columns("x", self.x) | coordinate_columns("y", self.y)
+        """A row per member: the start ``x0_1``..``x0_p``, the target ``y_d_1``..``y_d_r``, the
+        end ``x_1``..``x_p``, its task point ``y_1``..``y_r``, ``error``, ``success``, ``nit``,
+        ``message``."""
+        out: dict[str, Any] = coordinate_columns("x0", self.x0) | coordinate_columns(
+            "y_d", self.y_d
+        )
+        out |= coordinate_columns("x", self.x) | coordinate_columns("y", self.y)
         out["error"] = np.asarray(self.error)
         out["success"] = np.asarray(self.success, dtype=bool)
         out["nit"] = np.asarray(self.nit, dtype=int)
         out["message"] = np.array(self.message)
         return out
 
-    def to_dataframe(self):
-        """The batch as a pandas DataFrame, a row per member (:meth:`columns`)."""
-        return dataframe(self.columns())
-
     def as_dict(self) -> dict[str, Any]:
-        """JSON-friendly: the settings and, per member, x, y, error, success, nit, message."""
+        """JSON-friendly: the settings and, per member, x0, y_d, x, y, error, success, nit,
+        message."""
         return {
             "algorithm": self.algorithm,
+            "inverse": repr(self._inverse),
             "mode": self.mode,
             "gamma": self.gamma,
+            "x0": np.asarray(self.x0).tolist(),
+            "y_d": np.asarray(self.y_d).tolist(),
             "x": self.x.tolist(),
             "y": self.y.tolist(),
             "error": self.error.tolist(),
@@ -235,7 +257,7 @@ class BatchSolveResult:
         assert self._rec_member is not None and self._rec_x is not None
         ys = self._inverse.kinematics.forward(self._rec_x)
         h = self._inverse.augmenting_value(self._rec_x)
-        err = np.linalg.norm(ys - self._y_d[self._rec_member], axis=-1)
+        err = np.linalg.norm(ys - self.y_d[self._rec_member], axis=-1)
         bounds = np.searchsorted(self._rec_member, np.arange(len(self.x) + 1))  # sorted members
         return ys, None if h is None else np.asarray(h), err, bounds
 
@@ -251,15 +273,19 @@ class BatchSolveResult:
             mode=self.mode,
             gamma=self.gamma,
             algorithm=self.algorithm,
+            x0=self.x0[i],
+            y_d=self.y_d[i],
+            inverse=repr(self._inverse),
         )
 
 
 @dataclass(frozen=True)
-class RepeatabilityResult:
+class RepeatabilityResult(Columns):
     """Configurations along a closed path driven ``cycles`` times.
 
     Attributes
     ----------
+    x0 : ndarray, shape (p,) or (n, p)
     targets : ndarray, shape (L, r) or (n, L, r)
         The task point of every leg of one cycle (the given path, closed by k(x0) if needed).
     legs : ndarray, shape (cycles * L, p) or (n, cycles * L, p)
@@ -271,6 +297,9 @@ class RepeatabilityResult:
     message : str or tuple of str
     leg_results : list of SolveResult
         Every leg with its trajectory (single start with ``record=True`` only).
+    settings : RunSettings
+        The inverse (``settings.algorithm``, ``settings.inverse``), mode, gamma, tol and
+        max_iterations of every leg; also ``algorithm``, ``inverse``, ``mode`` and ``gamma``.
     """
 
     x0: FloatArray
@@ -281,27 +310,47 @@ class RepeatabilityResult:
     success: bool | FloatArray
     message: str | tuple[str, ...]
     leg_results: list[SolveResult]
+    settings: RunSettings
+
+    @property
+    def algorithm(self) -> str:
+        return self.settings.algorithm
+
+    @property
+    def inverse(self) -> str:
+        return self.settings.inverse
+
+    @property
+    def mode(self) -> str:
+        return self.settings.mode
+
+    @property
+    def gamma(self) -> float:
+        return self.settings.gamma
 
     def __repr__(self) -> str:
         cycles = self.drift.shape[-1]
+        how = f"{self.algorithm}, {self.mode}, gamma={self.gamma:g}"
         if np.ndim(self.success) == 0:
             last = f"{self.drift[-1]:.3g}" if cycles else "none"
             return (
-                f"RepeatabilityResult(success={self.success}, {_plural(cycles, 'cycle')} of "
-                f"{len(self.targets)} legs, x0={short_vector(self.x0)}, drift after the last "
-                f"cycle {last}, message={short_text(str(self.message))})"
+                f"RepeatabilityResult({how}, success={self.success}, "
+                f"{_plural(cycles, 'cycle')} of {len(self.targets)} legs, "
+                f"x0={short_vector(self.x0)}, drift after the last cycle {last}, "
+                f"message={short_text(str(self.message))})"
             )
         ok = int(np.count_nonzero(self.success))
         worst = float(np.nanmax(self.drift[:, -1])) if np.any(self.success) else float("nan")
         return (
-            f"RepeatabilityResult({len(self.x0)} starts, {ok} completed, "
+            f"RepeatabilityResult({how}, {len(self.x0)} starts, {ok} completed, "
             f"{_plural(cycles, 'cycle')} of {self.targets.shape[1]} legs, largest drift after "
             f"the last cycle {worst:.3g})"
         )
 
     def columns(self) -> dict[str, Any]:
-        """One array per column, a row per cycle (and start): ``start`` (a batch), ``cycle``
-        (from 1), ``drift``, and the configuration at the cycle's end, ``x1``..``xp``."""
+        """A row per cycle (and start): ``start`` (a batch's member, from 0), ``cycle`` (from
+        1), ``drift``, the start ``x0_1``..``x0_p`` and the configuration at the cycle's end
+        ``x_1``..``x_p``."""
         drift = np.atleast_2d(self.drift)  # (n, cycles)
         ends = self.cycle_end.reshape(-1, self.cycle_end.shape[-1])
         n, cycles = drift.shape
@@ -310,15 +359,20 @@ class RepeatabilityResult:
         )
         out["cycle"] = np.tile(np.arange(1, cycles + 1), n)
         out["drift"] = drift.ravel()
-        return out | coordinate_columns("x", ends)
-
-    def to_dataframe(self):
-        """The drift per cycle as a pandas DataFrame (:meth:`columns`)."""
-        return dataframe(self.columns())
+        starts = np.repeat(np.atleast_2d(self.x0), cycles, axis=0)
+        return out | coordinate_columns("x0", starts) | coordinate_columns("x", ends)
 
     def as_dict(self) -> dict[str, Any]:
-        """JSON-friendly: x0, the legs' targets, leg ends, cycle ends, drift, success, message."""
+        """JSON-friendly: the algorithm, the inverse as printed, mode, gamma, tol,
+        max_iterations, x0, the legs' targets, leg ends, cycle ends, drift, success, message."""
+        s = self.settings
         return {
+            "algorithm": s.algorithm,
+            "inverse": s.inverse,
+            "mode": s.mode,
+            "gamma": s.gamma,
+            "tol": s.tol,
+            "max_iterations": s.max_iterations,
             "x0": self.x0.tolist(),
             "targets": self.targets.tolist(),
             "legs": self.legs.tolist(),

@@ -32,6 +32,7 @@ from . import robot_kinds
 from .arms import ARMS
 from .augmentations import AugmentingMap
 from .exceptions import InvalidInputError
+from .exports import call_repr
 from .extended_vector import VectorExtendedInverse
 from .formula_kinematics import FormulaKinematics
 from .inverses import Inverse
@@ -76,6 +77,19 @@ class Robot:
     map_vectors: Mapping[
         str, tuple[AugmentingMap, ...] | Callable[[], tuple[AugmentingMap, ...]]
     ] = field(default_factory=dict)
+
+    def __repr__(self) -> str:
+        """One line: name, title, p, r, the task's coordinates and the augmenting maps."""
+        spec = self.spec
+        return call_repr(
+            "Robot",
+            repr(spec.name),
+            title=spec.title,
+            p=spec.p,
+            r=spec.r,
+            task=" ".join(spec.task_names),
+            maps=tuple(a.name for a in spec.augmentations) + tuple(self.map_vectors),
+        )
 
     def limits_report(self, result) -> LimitsReport | None:
         """Whether a run of this robot (a solve's or a single start's repeatability result)

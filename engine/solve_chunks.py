@@ -89,6 +89,7 @@ def solve_in_chunks(
         1,
         MAX_ITERATIONS_LIMIT,
     )
+    start = x.copy()  # (x0 may be a view of the caller's array, which moves on)
     e0 = float(np.linalg.norm(kin.forward(x[None]) - y_d, axis=-1)[0])
     pieces: list[Trajectory] = []
     done, status = 0, Status.RUNNING
@@ -134,7 +135,7 @@ def solve_in_chunks(
     else:
         message = stop_message(status, done, last.error, tol, "discrete", last.x, inverse, cap)
     trajectory = _joined(pieces) if pieces else None
-    return replace(last, message=message, nit=done, trajectory=trajectory)
+    return replace(last, message=message, nit=done, trajectory=trajectory, x0=start)
 
 
 def _joined(pieces: list[Trajectory]) -> Trajectory:

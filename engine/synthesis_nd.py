@@ -32,6 +32,7 @@ from scipy import linalg
 from scipy.stats import qmc
 
 from .exceptions import InvalidInputError, KinematicSingularityError
+from .exports import Columns
 from .functionals import Region, check_region
 from .inverses import pseudoinverse
 from .kinematics import Kinematics
@@ -108,7 +109,7 @@ def best_frame_axes(kin: Kinematics, box: Mapping, fix: Mapping) -> list[int]:
 
 
 @dataclass(frozen=True, repr=False)
-class TotalDegreeSynthesis:
+class TotalDegreeSynthesis(Columns):
     """The E2-optimal map(s) on a box and what they achieve.
 
     Attributes
@@ -158,6 +159,14 @@ class TotalDegreeSynthesis:
             f"maps={len(self.maps)}, variables={len(self.region)}, degree={self.degree}, "
             f"unknowns={len(self.maps[0].index)}, nodes={self.nodes})"
         )
+
+    def columns(self) -> dict[str, FloatArray]:
+        """A row per Ritz value computed (:attr:`convergence`), the last the result:
+        ``degree``, ``nodes``, ``unknowns``, ``e2``."""
+        return {
+            key: np.array([row[key] for row in self.convergence])
+            for key in ("degree", "nodes", "unknowns", "e2")
+        }
 
     def as_dict(self) -> dict:
         """JSON-friendly summary (without the coefficients)."""

@@ -208,6 +208,16 @@ class UrdfChain(Kinematics):
             "reference": self.reference.tolist(),
         }
 
+    def _described(self) -> dict[str, object]:
+        out: dict[str, object] = {
+            "robot": self.robot_name,
+            "end_link": self.end_link,
+            "task": self.task,
+        }
+        if self.locked:
+            out["locked"] = len(self.locked)
+        return out
+
     def frames(self, x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Joint origins o (..., n, 3), joint axes z (..., n, 3) in the base frame, for the n
         joints of the chain (fixed ones included), and the end link's pose (..., 4, 4)."""

@@ -36,6 +36,7 @@ from scipy import linalg
 
 from .augmentations import Polynomial2
 from .exceptions import InvalidInputError
+from .exports import Columns
 from .functionals import Region, check_region, error_functional_e2
 from .inverses import pseudoinverse
 from .kinematics import Kinematics, Manipulator2
@@ -54,7 +55,7 @@ MANIPULATOR2_DEGREE = 16
 
 
 @dataclass(frozen=True)
-class SynthesisResult:
+class SynthesisResult(Columns):
     """The E2-optimal augmenting map on a box and what it achieves.
 
     Attributes
@@ -92,6 +93,27 @@ class SynthesisResult:
     def __repr__(self) -> str:
         box = ", ".join(f"{k} in [{lo:.4g}, {hi:.4g}]" for k, (lo, hi) in self.region.items())
         return f"SynthesisResult(E2 = {self.e2:.6g}, degree {self.degree}, {box})"
+
+    def columns(self) -> dict[str, FloatArray]:
+        """A row per resolution computed (:attr:`convergence`), the last the result:
+        ``degree``, ``n_unknowns``, ``e2``."""
+        return {
+            key: np.array([row[key] for row in self.convergence])
+            for key in ("degree", "n_unknowns", "e2")
+        }
+
+    def as_dict(self) -> dict:
+        """JSON-friendly summary: e2, degree, region, fixed, convergence, the cubic fit's E2 and
+        coefficients (no basis coefficients; :attr:`grid` holds h on a grid)."""
+        return {
+            "e2": self.e2,
+            "degree": self.degree,
+            "region": {k: list(v) for k, v in self.region.items()},
+            "fixed": dict(self.fixed),
+            "convergence": list(self.convergence),
+            "polynomial_e2": None if np.isnan(self.polynomial_e2) else self.polynomial_e2,
+            "polynomial_coefficients": self.polynomial_coefficients(),
+        }
 
     def polynomial_coefficients(self) -> dict[str, float]:
         """Cubic coefficients keyed like ``"x2^2 x3^1"`` (JSON-friendly)."""

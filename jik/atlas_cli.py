@@ -259,7 +259,7 @@ def _run(args: argparse.Namespace) -> int:
         "cycles": C,
         "algorithms": list(plan.algorithms),
         "augmentation": args.augmentation,
-        "algorithm_parameters": {a: algorithm_parameters(args, a) for a in plan.algorithms},
+        "algorithm_parameters": {a: algorithm_parameters(args, a) for a in algorithms},
         "starts": N,
         "sampling": args.sampling,
         "seed": args.seed,

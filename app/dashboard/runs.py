@@ -150,7 +150,7 @@ def _run_legs(
             record=True,
             close=close,
             progress=ProgressCallbacks(
-                on_leg, lambda done, total: partial(done / total), cancelled, stop_at_errors=True
+                on_leg, lambda done, total: partial(done / total), cancelled, stop_at_error=True
             ),
         )
     except RunCancelled:

@@ -118,7 +118,11 @@ def test_results_print_on_one_line_with_their_numbers():
     starts = np.array([X0, X0 + [0.0, 0.1, 0.0]])
     _one_line(jik.solve_batch(inv, starts, [1, 1]), "2 solves, 2 converged")
     rep = jik.repeatability(inv, X0, PATH, cycles=3)
-    _one_line(rep, "success=True, 3 cycles of 4 legs", f"{rep.drift[-1]:.3g}")
+    _one_line(
+        rep,
+        "(pseudoinverse, continuous, gamma=1, success=True, 3 cycles of 4 legs",
+        f"{rep.drift[-1]:.3g}",
+    )
     _one_line(jik.repeatability(inv, X0, PATH), "1 cycle of 4 legs")
     reps = jik.repeatability(inv, starts, PATH, cycles=2)
     _one_line(reps, "2 starts, 2 completed, 2 cycles", f"{np.max(reps.drift[:, -1]):.3g}")
@@ -142,22 +146,22 @@ def test_columns_and_dicts_hold_the_results_numbers():
     inv = jik.ExtendedInverse(jik.Manipulator2(), jik.PaperCubic())
     one = jik.solve(inv, X0, [1, 1])
     cols = one.trajectory.columns()
-    assert list(cols) == ["theta", "x1", "x2", "x3", "y1", "y2", "error", "h"]
-    np.testing.assert_array_equal(cols["x2"], one.trajectory.x[:, 1])
+    assert list(cols) == ["theta", "x_1", "x_2", "x_3", "y_1", "y_2", "error", "h"]
+    np.testing.assert_array_equal(cols["x_2"], one.trajectory.x[:, 1])
     np.testing.assert_array_equal(cols["h"], one.trajectory.h)
     d = json.loads(json.dumps(one.as_dict(trajectory=True)))
     assert d["x"] == one.x.tolist() and d["trajectory"]["theta"] == one.trajectory.theta.tolist()
     starts = np.array([X0, X0 + [0.0, 0.1, 0.0]])
     batch = jik.solve_batch(inv, starts, [[1, 1], [1, 2]])
     bc = batch.columns()
-    np.testing.assert_array_equal(bc["y2"], batch.y[:, 1])
+    np.testing.assert_array_equal(bc["y_2"], batch.y[:, 1])
     assert bc["message"].tolist() == list(batch.message)
     assert json.loads(json.dumps(batch.as_dict()))["nit"] == batch.nit.tolist()
     rep = jik.repeatability(inv, starts, PATH, cycles=3)
     rc = rep.columns()
     assert rc["start"].tolist() == [0, 0, 0, 1, 1, 1] and rc["cycle"].tolist() == [1, 2, 3] * 2
     np.testing.assert_array_equal(rc["drift"], rep.drift.ravel())
-    np.testing.assert_array_equal(rc["x3"], rep.cycle_end[..., 2].ravel())
+    np.testing.assert_array_equal(rc["x_3"], rep.cycle_end[..., 2].ravel())
     assert json.loads(json.dumps(rep.as_dict()))["success"] == [True, True]
     single = jik.repeatability(inv, X0, PATH, cycles=2).columns()
     assert "start" not in single and single["cycle"].tolist() == [1, 2]
@@ -170,20 +174,29 @@ def test_an_atlas_in_long_format():
     assert cols["start"].tolist() == [0, 0, 1, 1] and cols["cycle"].tolist() == [1, 2, 1, 2]
     np.testing.assert_array_equal(cols["s"], np.repeat(atlas.parameter, 2))
     np.testing.assert_array_equal(cols["drift"], atlas.drift.ravel())
-    np.testing.assert_array_equal(cols["x3"], np.repeat(atlas.starts[0, :, 2], 2))
+    np.testing.assert_array_equal(cols["x0_3"], np.repeat(atlas.starts[0, :, 2], 2))
 
 
-def test_to_dataframe_with_or_without_pandas():
-    """With pandas: a DataFrame of the columns. Without: an ImportError that says what to do."""
+def test_to_dataframe_with_or_without_pandas(monkeypatch):
+    """With pandas: a DataFrame of the columns. Without: an ImportError that names the extra to
+    install (one pyproject.toml declares, with pandas in it)."""
+    import tomllib
+    from pathlib import Path
+
     tr = jik.solve(jik.Pseudoinverse(jik.Manipulator2()), X0, [1, 1]).trajectory
     try:
         import pandas  # noqa: F401
     except ImportError:
-        with pytest.raises(ImportError, match=r"needs pandas \(pip install pandas\); columns"):
-            tr.to_dataframe()
-        return
-    frame = tr.to_dataframe()
-    assert list(frame.columns) == list(tr.columns()) and len(frame) == len(tr)
+        pass
+    else:
+        frame = tr.to_dataframe()
+        assert list(frame.columns) == list(tr.columns()) and len(frame) == len(tr)
+    monkeypatch.setitem(sys.modules, "pandas", None)  # (import pandas now raises ImportError)
+    with pytest.raises(ImportError, match=r"needs pandas: pip install 'jik-lab\[dataframes\]'"):
+        tr.to_dataframe()
+    root = Path(__file__).resolve().parents[2]
+    extras = tomllib.loads((root / "pyproject.toml").read_text())["project"]
+    assert any(r.startswith("pandas") for r in extras["optional-dependencies"]["dataframes"])
 
 
 def test_gamma_rules_are_worded_once():

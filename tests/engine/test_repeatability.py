@@ -310,7 +310,7 @@ def test_a_leg_that_raises_stops_the_run_with_the_legs_before_it(monkeypatch):
         TABLE1_PATH,
         cycles=2,
         record=True,
-        progress=ProgressCallbacks(seen.append, stop_at_errors=True),
+        progress=ProgressCallbacks(seen.append, stop_at_error=True),
     )
     assert not res.success
     assert res.message.startswith("cycle 1, leg 2 stopped: h is undefined here at x = ")
@@ -330,7 +330,7 @@ def test_a_leg_that_raises_stops_the_run_with_the_legs_before_it(monkeypatch):
 def test_a_singular_start_stops_the_first_leg():
     """(36) with a = 1, b = 0 is singular on x1 = 0: a run from there stops before it moves."""
     inv = ExtendedInverse(Manipulator1(), E2Optimal(a=1.0, b=0.0))
-    stop = ProgressCallbacks(stop_at_errors=True)
+    stop = ProgressCallbacks(stop_at_error=True)
     for kwargs in ({}, {"mode": "discrete", "gamma": 0.5}):
         with pytest.raises(AlgorithmicSingularityError):
             repeatability(inv, [0.0, 0.2, 1.0], [(1.0, 1.0)], **kwargs)

@@ -1,0 +1,108 @@
+"""How the engine's objects print and export: one-line reprs and tables of columns.
+
+Reprs are one line: a vector prints as ``[0.1235, -1, 1.571]`` (elided in the middle when long),
+an integer as an integer, a string cut and quoted. A result that is a table (a row per point,
+member, cycle or run) gives :meth:`Columns.columns` (a dict of equal-length arrays) and, from it,
+:meth:`Columns.to_dataframe` (pandas, optional: the ``dataframes`` extra).
+
+Column names mean one thing everywhere: ``x0_1``..``x0_p`` a start configuration x0,
+``x_1``..``x_p`` the configuration the row is about (a point of a trajectory, a solve's end, a
+cycle's end), ``y_1``..``y_r`` the task point k(x), ``y_d_1``..``y_d_r`` a target.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .validation import FloatArray
+
+#: The install line that brings pandas (pyproject.toml's ``dataframes`` extra).
+PANDAS_HINT = "pip install 'jik-lab[dataframes]' (or pip install pandas)"
+
+
+def number(v: Any, digits: int = 4) -> str:
+    """A number on one line: an integral value as an integer (``12``), else ``{v:.4g}``."""
+    f = float(v)
+    if np.isfinite(f) and f == int(f) and abs(f) < 1e15:
+        return str(int(f))
+    return f"{f:.{digits}g}"
+
+
+def short_vector(v, digits: int = 4) -> str:
+    """A vector on one line, ``[0.1235, -1, 1.571]``; a long one elided in the middle."""
+    a = np.asarray(v, dtype=float).ravel()
+    items = [f"{t:.{digits}g}" for t in a]
+    if len(items) > 8:
+        items = [*items[:3], "...", *items[-3:]]
+    return "[" + ", ".join(items) + "]"
+
+
+def short_text(text: str, width: int = 60) -> str:
+    """``text`` cut to ``width`` characters, quoted."""
+    return repr(text if len(text) <= width else text[: width - 3] + "...")
+
+
+def short_value(v: Any) -> str:
+    """Any parameter's value on one line: numbers, vectors, matrices (rows elided), strings,
+    mappings, and other objects by their own repr."""
+    if isinstance(v, bool) or v is None:
+        return repr(v)
+    if isinstance(v, (int, float, np.integer, np.floating)):
+        return number(v)
+    if isinstance(v, str):
+        return short_text(v, 40)
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{k}: {short_value(x)}" for k, x in v.items()) + "}"
+    if isinstance(v, (list, tuple, np.ndarray)):
+        try:
+            a = np.asarray(v, dtype=float)
+        except (TypeError, ValueError):
+            return "(" + ", ".join(short_value(x) for x in v) + ")"
+        if a.ndim == 2:
+            rows = [short_vector(r) for r in a]
+            if len(rows) > 4:
+                rows = [*rows[:2], "...", rows[-1]]
+            return "[" + ", ".join(rows) + "]"
+        return short_vector(a)
+    return repr(v)
+
+
+def call_repr(name: str, *args: Any, **kwargs: Any) -> str:
+    """``name(arg, ..., key=value, ...)`` with each value by :func:`short_value` (positional
+    arguments that are already text are kept as they are)."""
+    parts = [a if isinstance(a, str) else short_value(a) for a in args]
+    parts += [f"{k}={short_value(v)}" for k, v in kwargs.items()]
+    return f"{name}({', '.join(parts)})"
+
+
+def dataframe(columns: dict[str, Any]):
+    """A pandas DataFrame of ``columns`` (pandas is imported here, and only here)."""
+    try:
+        import pandas as pd
+    except ImportError:
+        raise ImportError(
+            f"to_dataframe() needs pandas: {PANDAS_HINT}; columns() gives the same columns as "
+            "numpy arrays"
+        ) from None
+    return pd.DataFrame(columns)
+
+
+def coordinate_columns(name: str, values: FloatArray) -> dict[str, FloatArray]:
+    """``{name_1: values[:, 0], name_2: ...}``: one column per coordinate, numbered from 1."""
+    values = np.asarray(values, dtype=float)
+    return {f"{name}_{k + 1}": values[:, k] for k in range(values.shape[1])}
+
+
+class Columns:
+    """A result that is a table: :meth:`columns` gives it as arrays, :meth:`to_dataframe` as
+    a pandas DataFrame (the same columns, in the same order)."""
+
+    def columns(self) -> dict[str, Any]:
+        """One array per column, all of one length: a row per item of the result."""
+        raise NotImplementedError
+
+    def to_dataframe(self):
+        """:meth:`columns` as a pandas DataFrame (needs pandas: the ``dataframes`` extra)."""
+        return dataframe(self.columns())
