@@ -59,7 +59,7 @@ def short_value(v: Any) -> str:
         try:
             a = np.asarray(v, dtype=float)
         except (TypeError, ValueError):
-            return "(" + ", ".join(short_value(x) for x in v) + ")"
+            return "[" + ", ".join(short_value(x) for x in v) + "]"
         if a.ndim == 2:
             rows = [short_vector(r) for r in a]
             if len(rows) > 4:

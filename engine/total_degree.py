@@ -104,7 +104,8 @@ class TotalDegreeMap(AugmentingMap):
 
     @property
     def parameters(self) -> dict[str, float]:
-        return {"degree": float(self.index.sum(axis=1).max()), "unknowns": float(len(self.index))}
+        """The total degree and the number of basis polynomials (integers)."""
+        return {"degree": int(self.index.sum(axis=1).max()), "unknowns": len(self.index)}
 
     def _eval(self, x: FloatArray) -> tuple[FloatArray, FloatArray, tuple[int, ...]]:
         x = np.asarray(x, dtype=float)

@@ -132,7 +132,7 @@ def test_robots_and_inverses_print_what_they_compute():
         assert repr(inverse) == text
     kin = jik.FormulaKinematics(["a", "b", "c", "d"], ["a + b", "c + d"])
     vector = jik.VectorExtendedInverse(kin, [jik.FormulaMap("a", kin.variable_names)] * 2)
-    assert "maps=(FormulaMap('a'), FormulaMap('a'))" in repr(vector)
+    assert "maps=[FormulaMap('a'), FormulaMap('a')]" in repr(vector)
 
 
 def test_a_robot_prints_on_one_line():
@@ -147,13 +147,15 @@ def test_a_robot_prints_on_one_line():
         }
     )
     assert repr(robot) == (
-        "Robot('planar_chain', title='planar chain', p=3, r=2, task='x y', maps=('formula'))"
+        "Robot('planar_chain', title='planar chain', p=3, r=2, task='x y', maps=['formula'])"
     )
     panda = jik.robot_from_dict({"name": "panda", "task": "pose"})
     text = repr(panda)
     assert len(text) < 200 and "<?xml" not in text and "\n" not in text, text
     assert text.startswith("Robot('panda'") and "p=7, r=6" in text, text
     assert "robot='panda'" in repr(panda.kinematics) and "task='pose'" in repr(panda.kinematics)
+    extended = repr(panda.inverse("extended"))
+    assert "map=TotalDegreeMap(degree=4, unknowns=329)" in extended, extended
 
 
 def test_runs_export_their_algorithm_settings_start_and_target():
