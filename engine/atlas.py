@@ -146,7 +146,7 @@ def arc_lengths(
     each index's value is fixed by the index and the seed, not by what else is asked for.
 
     On a ``closed`` curve, whose arc is one turn (s = hi is s = lo again), the grid is n even
-    steps from lo, the end hi left out; the samples are in [lo, hi) as on an open arc."""
+    steps from lo, the end hi left out; samples are drawn as on an open arc, over the turn."""
     lo, hi = arc
     if sampling == "grid" and closed:
         u = index / n
