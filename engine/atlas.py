@@ -63,6 +63,9 @@ class AtlasPlan:
         How the arc lengths s of the starts are laid on their curves' common arc: ("grid", 0) or
         ("sample", seed) (:func:`arc_lengths`); None for explicit starts.
     manifolds : tuple of SelfMotionManifold (one per path) or ()
+        The first path's curve sets the arc: one turn when it is closed. Each other path's curve
+        is traced over that arc; when it closes within it, its starts' s are taken modulo its
+        own period (:meth:`SelfMotionManifold.points`).
     explicit : ndarray, shape (N, p) or None
     chunk : int
     settings : dict
@@ -118,7 +121,10 @@ class AtlasPlan:
         starts are explicit. Computed on demand: a plan holds nothing of size N."""
         if self.sampling is None:
             return None
-        return arc_lengths(np.asarray(index), self.n_starts, self.manifolds[0].arc, *self.sampling)
+        curve = self.manifolds[0]
+        return arc_lengths(
+            np.asarray(index), self.n_starts, curve.arc, *self.sampling, closed=curve.closed
+        )
 
     def targets(self, lo: int, hi: int, starts: FloatArray) -> FloatArray:
         """The legs' targets (n, L, r) of runs lo to hi - 1: path[1:] and k(start)."""
@@ -128,13 +134,23 @@ class AtlasPlan:
 
 
 def arc_lengths(
-    index: FloatArray, n: int, arc: tuple[float, float], sampling: str, seed: int
+    index: FloatArray,
+    n: int,
+    arc: tuple[float, float],
+    sampling: str,
+    seed: int,
+    closed: bool = False,
 ) -> FloatArray:
     """Arc lengths of starts ``index`` (ints in [0, n)) of n on [lo, hi]: evenly spaced, ends
     included ("grid"), or uniform random ("sample"): drawn from ``seed`` block by block, so
-    each index's value is fixed by the index and the seed, not by what else is asked for."""
+    each index's value is fixed by the index and the seed, not by what else is asked for.
+
+    On a ``closed`` curve, whose arc is one turn (s = hi is s = lo again), the grid is n even
+    steps from lo, the end hi left out; samples are drawn as on an open arc, over the turn."""
     lo, hi = arc
-    if sampling == "grid":
+    if sampling == "grid" and closed:
+        u = index / n
+    elif sampling == "grid":
         u = index / (n - 1) if n > 1 else np.zeros(len(index))
     else:
         u = np.empty(len(index))
@@ -195,7 +211,9 @@ def plan_atlas(
         uniformly with ``seed``. s = 0 is where eq. (7) with the pseudoinverse from ``reference``
         (a configuration, p) reaches the path's first point; with ``box`` ((low, high) per
         coordinate) the arc is cut where the base path's curve leaves the box, and the same
-        arc is used for every path of the family.
+        arc is used for every path of the family. A base curve that closes on itself within the
+        arc (:func:`jik.engine.self_motion.trace`) gives one turn as the arc, and the starts
+        cover it once: a grid leaves out its end, the start again.
     shifts : array_like, shape (S, r), optional
         Translations of the base path (default: none).
     scales : array_like, shape (Q,), optional
