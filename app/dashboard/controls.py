@@ -262,7 +262,8 @@ def rest_controls(state, spec) -> list[Control]:
     out = joint_sliders(key, "algorithm", spec, text)
     out.append(preset_button(key, "x0", "x0", "set the rest to the start configuration x0"))
     if home is not None:
-        out.append(preset_button(key, "home", home, "set the rest to the robot's home", True))
+        shown = ", ".join(f"{t:.3g}" for t in home)
+        out.append(preset_button(key, "home", home, f"set the rest to the robot's home ({shown})"))
     return out
 
 
@@ -271,7 +272,7 @@ def preset_button(key: str, name: str, value, text: str, numbers: bool = False) 
     ``q0 = A`` (with the numbers if ``numbers``)."""
     short = key.rpartition(".")[2]
     shown = f" ({', '.join(f'{t:.2f}' for t in value)})" if numbers else ""
-    value = [float(t) for t in value] if numbers else value
+    value = value if isinstance(value, str) else [float(t) for t in value]
     label, button = f"{short} = {name}{shown}", f"ctl-preset-{short}-{name}"
     return Control(key, label, "preset", "algorithm", text, value=value, id=button)
 
