@@ -304,6 +304,14 @@ def _run(args: argparse.Namespace) -> int:
     sys.stderr.write(
         f"jik atlas: {A} x {plan.size} runs x {C} cycles in {elapsed:.1f} s: {written}\n"
     )
+    if arrays.outside is not None:  # (a robot with joint limits)
+        counts = ", ".join(
+            f"{alg} {int(arrays.outside[a])}" for a, alg in enumerate(plan.algorithms)
+        )
+        sys.stderr.write(
+            f"jik atlas: runs whose start or a leg end is outside the joint limits, of "
+            f"{plan.size} each: {counts}\n"
+        )
     return 0
 
 

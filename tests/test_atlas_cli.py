@@ -236,9 +236,10 @@ def test_a_robot_file_takes_no_param(tmp_path, capsys):
     assert "--param is for a built-in robot" in capsys.readouterr().err
 
 
-def test_a_catalogue_arm_counts_the_starts_that_leave_its_limits(tmp_path):
+def test_a_catalogue_arm_counts_the_starts_that_leave_its_limits(tmp_path, capsys):
     """The Panda's pose loop from its home pose: the runs whose start or a leg end is outside
-    the joint limits are counted, and agree with the leg ends of the JSON."""
+    the joint limits are counted, agree with the leg ends of the JSON, and are said on the
+    command's output."""
     pytest.importorskip("yourdfpy")
     from jik.engine.limits import robot_limits, starts_outside
     from jik.engine.robot_spec import robot_from_dict
@@ -270,6 +271,8 @@ def test_a_catalogue_arm_counts_the_starts_that_leave_its_limits(tmp_path):
     legs = np.array(doc["results"]["pseudoinverse"]["leg_ends"], dtype=float)
     expected = starts_outside(limits, np.array(doc["starts"], dtype=float), legs)
     assert count == int(expected.sum()) and 0 < count < 16
+    err = capsys.readouterr().err
+    assert f"outside the joint limits, of 16 each: pseudoinverse {count}\n" in err
 
 
 def test_a_catalogue_arm_takes_a_task(tmp_path, capsys):

@@ -49,8 +49,9 @@ def request_robot(
     each of ``algorithms``: the extended inverse (11) of ``augmentation`` (a map model; None:
     the robot's default), the others with ``parameters`` (``algorithm_parameters``; posture's
     rest defaults to the robot's home, else ``x0``), each with only its own if ``own``. The
-    robot has its map if the extended inverse or ``with_map`` asks for one. Refusals are
-    :class:`RequestError` naming the request's field."""
+    robot has its map if the extended inverse or ``with_map`` asks for one; a map given but
+    not used is checked all the same (a catalogue map's parameters, a formula map's formulas),
+    except a map to synthesize. Refusals are :class:`RequestError` naming the request's field."""
 
     def given(algorithm: str, kinematics: Any) -> dict:
         spec = ALGORITHMS[algorithm]
@@ -60,13 +61,18 @@ def request_robot(
 
     extended, aug_used = "extended" in algorithms, None
     if req_robot.name in S.USER_ROBOT_MODELS:
-        robot, robot_used = user_robot(req_robot, augmentation if extended or with_map else None)
+        # A formula map no chosen algorithm uses is built all the same, to be checked (its
+        # formulas' derivatives, within the build budget); a map to synthesize is not.
+        checked = extended or with_map or getattr(augmentation, "name", None) == "formula"
+        robot, robot_used = user_robot(req_robot, augmentation if checked else None)
         kin = robot.kinematics
         inverses = tuple(user_inverse(robot, a, given(a, kin)) for a in algorithms)
         aug_used = map_used(robot) if extended else None
         built = robot.spec, kin, inverses, robot_used, aug_used
         return RequestRobot(*built, lambda: user_map(robot))
     spec, kin, robot_used = build_robot(req_robot)
+    if augmentation is not None and not (extended or with_map):
+        checked_augmentation(spec, augmentation)
     out: list[Any] = []
     for algorithm in algorithms:
         if algorithm == "extended":
@@ -107,6 +113,18 @@ def build_robot(req_robot) -> tuple[RobotSpec, Any, S.RobotUsed]:
 
 def build_augmentation(spec: RobotSpec, kin, req_aug):
     """The augmenting map named in the request (or the robot's default), built and checked."""
+    aspec, values = checked_augmentation(spec, req_aug)
+    try:
+        amap = aspec.build(kin, **values)
+    except InvalidInputError as exc:
+        raise RequestError("augmentation", str(exc)) from None
+    return aspec, amap, S.AugmentationUsed(name=aspec.name, parameters=values)
+
+
+def checked_augmentation(spec: RobotSpec, req_aug) -> tuple[Any, dict]:
+    """The map named in the request (or the robot's default) and its parameters' values, each
+    checked against the map's :class:`~jik.engine.parameters.Parameter` (a map that no chosen
+    algorithm uses is checked too: what the published schema refuses, the server refuses)."""
     name = req_aug.name if req_aug is not None else None
     try:
         aspec = spec.augmentation(name)
@@ -122,11 +140,12 @@ def build_augmentation(spec: RobotSpec, kin, req_aug):
             f"its parameters: {sorted(known) or 'none'}",
         )
     values = {p.name: given.get(p.name, p.default) for p in aspec.parameters}
-    try:
-        amap = aspec.build(kin, **values)
-    except InvalidInputError as exc:
-        raise RequestError("augmentation", str(exc)) from None
-    return aspec, amap, S.AugmentationUsed(name=aspec.name, parameters=values)
+    for p in aspec.parameters:
+        try:
+            p.check(values[p.name])
+        except InvalidInputError as exc:
+            raise RequestError("augmentation", str(exc)) from None
+    return aspec, values
 
 
 def _dimensions(spec: RobotSpec, what: str) -> str:

@@ -158,6 +158,7 @@ class Worker:
         child.close()
         self.conn = Connection(parent.detach())
         self.ready = False
+        self._ps: psutil.Process | None = None
 
     def wait_ready(self) -> None:
         if not self.ready:
@@ -167,9 +168,14 @@ class Worker:
             self.ready = True
 
     def cpu_seconds(self) -> float | None:
-        """CPU time the worker has used (user and system); None if the process is gone."""
+        """CPU time the worker has used (user and system); None if the process is gone.
+
+        The :class:`psutil.Process` handle is made once (making one reads the process's start
+        time, which doubles the cost of the read that every dispatch does)."""
         try:
-            times = psutil.Process(self.process.pid).cpu_times()
+            if self._ps is None:
+                self._ps = psutil.Process(self.process.pid)
+            times = self._ps.cpu_times()
         except psutil.Error:
             return None
         return times.user + times.system

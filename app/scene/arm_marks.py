@@ -82,13 +82,24 @@ def target_fixtures(result, kin: Any, root: str, size: float) -> dict[str, tuple
     return out
 
 
+def base_link(kin: Any) -> bool:
+    """Whether the scene draws a URDF arm's base link: the segment from its base frame's origin to
+    its first joint, where that joint lies away from the origin (the Panda's first joint stands
+    0.333 m above it). The first joint's origin depends on no joint variable."""
+    if getattr(kin, "chain", None) is None:
+        return False
+    return bool(np.linalg.norm(np.asarray(kin.points(np.zeros(kin.p)))[0]) > 1e-9)
+
+
 def joint_points(kin: Any) -> dict[int, int]:
-    """Which drawn point (of ``kin.points``) is each joint variable's joint: a URDF chain's
-    joints in chain order (fixed ones included), a planar chain's joint i at point i."""
+    """Which drawn point (of :func:`~jik.app.scene.mechanisms.chain_points`) is each joint
+    variable's joint: a URDF chain's joints in chain order (fixed ones included) after its base
+    (:func:`base_link`), a planar chain's joint i at point i."""
     chain = getattr(kin, "chain", None)
     if chain is None:
         return {i: i for i in range(kin.p)}
-    return {int(j.index): k for k, j in enumerate(chain) if getattr(j, "index", -1) >= 0}
+    first = int(base_link(kin))
+    return {int(j.index): first + k for k, j in enumerate(chain) if getattr(j, "index", -1) >= 0}
 
 
 def end_frame(kin: Any, x) -> tuple[tuple[float, ...], tuple[float, ...]] | None:

@@ -31,6 +31,7 @@ from ..dashboard.robots import state_kinematics
 from .arm_marks import (
     AXES_FRACTION,
     OUTSIDE_COLOR,
+    base_link,
     end_frame,
     joint_points,
     target_fixtures,
@@ -133,7 +134,8 @@ class NormalForm(Mechanism):
         self.bar = self.box("lever/bar", (xhi - xlo, 0.045, 0.03), ((xlo + xhi) / 2, 0.0, 0.05))
         self.ball("lever/pivot", 0.06, (0.0, 0.0, 0.05), color=(40, 40, 40))
         self.point = self.ball("W", 0.08)
-        if self.root.endswith("extended"):
+        chosen = tuple(self.state.algorithms)
+        if self.root.endswith("/" + ("extended" if "extended" in chosen else chosen[0])):
             self.scene.add_label(  # (below the point: clear of the start gizmo's label)
                 f"{self.root}/W/label", "W (task point)", position=(0.1, -0.2, -0.35)
             )
@@ -198,8 +200,11 @@ class Chain(Mechanism):
             thickness=width,
             thickness_units="screen",
         )
-        # Joints sized to the arm: a sixtieth of its reach (0.04 for an arm of reach 2.4).
-        reach = float(np.linalg.norm(np.diff(home, axis=0), axis=1).sum())
+        # Joints sized to the arm: a sixtieth of its reach from its first joint (0.04 for an arm
+        # of reach 2.4); the base link is not part of the reach.
+        reach = float(
+            np.linalg.norm(np.diff(home[int(base_link(self.kin)) :], axis=0), axis=1).sum()
+        )
         ball = max(reach, 1e-3) / 60
         self.joints = [self.ball(f"joint{i}", ball if i < n - 1 else 1.5 * ball) for i in range(n)]
         # The end link's frame when the task holds its orientation (a pose task).
@@ -238,11 +243,15 @@ class Chain(Mechanism):
 
 
 def chain_points(kin: Any, x: np.ndarray, z: float) -> np.ndarray:
-    """The points of a chain (..., n + 1, 3) in the scene: a planar one at height ``z``; an arm
-    in space where it is (its end on its pose targets: the copies overlap, red translucent)."""
+    """The points of a chain (..., m, 3) in the scene: a planar one at height ``z``; an arm in
+    space where it is, from its base frame's origin when its first joint lies away from it
+    (:func:`~jik.app.scene.arm_marks.base_link`; its end on its pose targets: the copies
+    overlap, red translucent)."""
     pts = np.asarray(kin.points(x), dtype=float)  # (PlanarChain, UrdfChain)
     if pts.shape[-1] == 2:
         return np.concatenate([pts, np.full((*pts.shape[:-1], 1), z)], axis=-1)
+    if base_link(kin):
+        return np.concatenate([np.zeros((*pts.shape[:-2], 1, 3)), pts], axis=-2)
     return pts
 
 

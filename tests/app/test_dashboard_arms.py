@@ -79,7 +79,7 @@ def test_a_run_outside_the_limits_is_said_in_words_and_marked():
     assert report["violation"]["joint"] == 3 and report["violation"]["cycle"] == 0
     kin = state_kinematics(state)
     assert list(outside_joints(state_limits(state), state.x0)) == [3]
-    assert joint_points(kin)[3] == 3  # (the Panda's chain has no fixed joint before x4)
+    assert joint_points(kin)[3] == 4  # (its base link, then x1..x4: no fixed joint before x4)
     assert not len(outside_joints(state_limits(_panda()), _panda().x0))
 
 

@@ -119,6 +119,30 @@ def test_augmentation_parameter_refused_by_the_registry(api):
     assert msg.startswith("augmentation: C1 must be nonzero")
 
 
+@pytest.mark.parametrize("algorithm", ["pseudoinverse", "damped"])
+def test_a_map_no_algorithm_uses_is_checked_all_the_same(api, algorithm):
+    """What the published schema refuses (C1 = 0; a formula that does not parse), the server
+    refuses whether or not the chosen algorithm uses the map."""
+    body = solve_body(
+        robot={"name": "manipulator1"},
+        x0=[0.5, 0.5, 1.0],
+        algorithm=algorithm,
+        augmentation={"name": "e1_optimal", "C1": 0.0},
+    )
+    (msg,) = messages(api.post("/solve", json=body))
+    assert msg.startswith("augmentation: C1 must be nonzero")
+    arm = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]}
+    rep = {
+        "robot": arm,
+        "augmentation": {"name": "formula", "h": "x1 +"},
+        "algorithm": algorithm,
+        "x0": [0.3, 1.0, 1.0],
+        "path": [[1.0, 1.3], [1.0, 1.7]],
+    }
+    (msg,) = messages(api.post("/repeatability", json=rep))
+    assert msg.startswith("augmentation.h: "), msg
+
+
 def test_malformed_json(api):
     r = api.post("/solve", content="{not json", headers={"content-type": "application/json"})
     assert r.status_code == 422

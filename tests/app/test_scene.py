@@ -448,3 +448,22 @@ def test_targets_at_one_position_share_one_label():
         "/r/targets/2/label": "",
         "/r/targets/3/label": "",
     }
+
+
+@pytest.mark.parametrize(
+    "chosen, labelled",
+    [(("pseudoinverse", "extended"), "extended"), (("pseudoinverse", "damped"), "pseudoinverse")],
+)
+def test_manipulator1_names_its_task_point_on_one_chosen_copy(chosen, labelled):
+    """Manipulator 1's task point W is labelled once: on the extended inverse's copy when it is
+    chosen, else on the first chosen algorithm's (it was missing without the extended one)."""
+    from unittest.mock import MagicMock
+
+    from jik.app.scene.mechanisms import NormalForm
+
+    state = updated_state(default_state(), {"robot": "manipulator1", "algorithms": list(chosen)})
+    scene = MagicMock()
+    for a in chosen:
+        NormalForm(scene, f"/robot/m1/{a}", (0, 0, 0), None, 0.0, state, ((-1, 1), (-1, 1)))
+    labels = [c.args[:2] for c in scene.add_label.call_args_list]
+    assert labels == [(f"/robot/m1/{labelled}/W/label", "W (task point)")]

@@ -44,7 +44,7 @@ def test_the_panda_with_its_pose_task(tabs):
 
     scene = tab.wait_scene_drawn(generation)
     assert scene["robot"] == "panda" and scene["mechanism"] == "Chain"
-    assert scene["joints"] == 9  # base, 7 joints, the flange (fixed joints drawn too)
+    assert scene["joints"] == 10  # base link, 7 joints, the flange, the end (fixed ones drawn)
     assert scene["pose_frames"] == 4  # the path's three pose targets and k(x0)
     tab.screenshots("arm-panda")
     # The task panel: position and rotation vector against theta; E2 of the 7-joint map beside

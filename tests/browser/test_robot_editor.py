@@ -75,7 +75,7 @@ def test_a_urdf_arm_from_a_link_is_drawn_in_the_scene(tabs):
     assert snapshot["summary"]["pseudoinverse"]["success"]
     scene = tab.wait_scene_drawn(snapshot["generation"])
     assert scene["robot"] == "urdf"
-    assert scene["mechanism"] == "Chain" and scene["joints"] == 6  # base, 4 joints, the tool
+    assert scene["mechanism"] == "Chain" and scene["joints"] == 7  # base link, 5 joints, the end
     tab.screenshots("robot-editor-urdf")
 
 
