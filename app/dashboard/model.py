@@ -341,22 +341,23 @@ def _model(model: type[BaseModel], data: Mapping[str, Any], prefix: tuple[str, .
         return model.model_validate(data)
     except ValidationError as exc:
         error = exc.errors()[0]
-        name = ".".join((*prefix, *_location(data, error["loc"]))) or "state"
+        name = ".".join((*prefix, *error_location(data, error))) or "state"
         raise InvalidInputError(f"{name}: {refusal(error)}", name) from None
 
 
-def _location(data: Any, loc) -> list[str]:
-    """The field of an error's location ``loc`` in ``data``: its keys and indices, without the
-    label pydantic gives a member of a union (``algorithm_parameters.rest``, not
-    ``algorithm_parameters.rest.float``)."""
+def error_location(data: Any, error: Mapping[str, Any]) -> list[str]:
+    """The field of one of pydantic's errors in ``data``: the keys and indices of its location,
+    without the labels pydantic gives the members of a union (``algorithm_parameters.rest``,
+    not ``algorithm_parameters.rest.float``): a name that is not a key of the value it is
+    under (a missing field's excepted) or is under a value without fields."""
     parts, node = [], data
-    for part in loc:
-        if isinstance(node, Mapping):
-            node = node.get(part)
-        elif isinstance(node, list | tuple) and isinstance(part, int):
+    for part in error["loc"]:
+        if isinstance(node, list | tuple) and isinstance(part, int):
             node = node[part] if part < len(node) else None
-        elif node is not None and isinstance(part, str):
-            continue  # (a union member's label, at a value that has no fields)
+        elif isinstance(node, Mapping) and (part in node or error.get("type") == "missing"):
+            node = node.get(part)
+        elif isinstance(part, str):
+            continue
         parts.append(str(part))
     return parts
 

@@ -21,7 +21,7 @@ from ..compute.schemas import (
     Coordinate,
 )
 from ..compute.schemas.wording import refusal
-from .model import DashboardState, Point
+from .model import DashboardState, Point, error_location
 from .robots import USER_KINDS
 
 #: Control keys a patch may hold besides the state's fields (:func:`.control_changes.expand`), and
@@ -87,18 +87,13 @@ def parse_patch(body: Any) -> dict[str, Any]:
     ------
     InvalidInputError
         Naming the field: the first the patch's types refuse (a member of a union, labelled by
-        its type in pydantic's location, is left out of the name).
+        its type in pydantic's location, is left out of the name: :func:`error_location`).
     """
     try:
         return patch_of(StatePatch.model_validate(body))
     except ValidationError as exc:
         error = exc.errors()[0]
-        field = (
-            ".".join(
-                str(p) for p in error["loc"] if isinstance(p, str) and "[" not in p and p != "str"
-            )
-            or "body"
-        )
+        field = ".".join(error_location(body, error)) or "body"
         raise InvalidInputError(f"{field}: {refusal(error)}", field) from None
 
 

@@ -374,6 +374,8 @@ def test_the_session_api_refuses_a_bad_rest_naming_it(client):
     assert [d["msg"] for d in bad.json()["detail"]] == [
         f"{REST}.2: rest x3 must be in [-3.14159, 6.28319] (the range of x0's sliders), got 9"
     ]
+    junk = client.post(url, json={"algorithm_parameters": {"rest": {}}})  # (not a number list)
+    assert [d["msg"] for d in junk.json()["detail"]] == [f"{REST}: Input should be a valid number"]
     ok = client.post(url, json={f"{REST}.2": 1.0})
     assert ok.status_code == 200 and ok.json()["state"]["algorithm_parameters"]["rest"][2] == 1.0
 
