@@ -420,10 +420,12 @@ def panda():
 def test_an_arm_s_rest_is_within_its_joint_limits_and_defaults_to_its_home(panda):
     """The Panda: the rest sliders span its joint limits, start at its home; 'rest = home'
     sets the default back; a coordinate beyond a limit is refused naming the limits."""
+    from jik.app.compute.schemas.algorithms import used
     from jik.engine.arms import ARMS
     from jik.engine.robot_spec import robot_from_dict
 
     kin = robot_from_dict({"name": "panda", "task": "pose"}).kinematics
+    assert used(None, "posture", kin, [0.1] * 7)["rest"] == list(ARMS["panda"].home)  # (API)
     spec = controls(panda)
     sliders = [c for c in spec if c.key.startswith(f"{REST}.")]
     assert [(c.minimum, c.maximum) for c in sliders] == [tuple(b) for b in kin.limits]
