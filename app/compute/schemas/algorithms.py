@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, create_model
 
 from ....engine.registry import ALGORITHMS
@@ -68,6 +69,20 @@ def used(params: BaseModel | None, algorithm: str = "", kinematics=None, x0=None
     out = {} if params is None else params.model_dump(exclude_none=True)
     if algorithm == "posture" and "rest" not in out and x0 is not None:
         out["rest"] = default_rest(kinematics, x0)[0]
+    return out
+
+
+def parameters_of(inverse) -> dict[str, Any]:
+    """The parameters an engine inverse holds, by the catalogue's names, defaults filled in
+    (posture's rest, weighted's limits, with None for an unbounded end): what a response says
+    the run used."""
+    spec = ALGORITHMS[inverse.name]
+    out: dict[str, Any] = {p.name: float(getattr(inverse, p.name)) for p in spec.parameters}
+    for name in spec.vectors:
+        values = np.asarray(getattr(inverse, name), dtype=float)
+        shown = values.astype(object)
+        shown[~np.isfinite(values)] = None
+        out[name] = shown.tolist()
     return out
 
 
