@@ -19,7 +19,7 @@ wherever the chunks run (:mod:`jik.engine.atlas_backends`).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -36,9 +36,21 @@ from .validation import FloatArray, as_points, count, positive
 MAX_STARTS = 10**9
 MAX_PATHS = 10**4
 MAX_CHUNK = 65536
-#: Default number of starts in a chunk, the unit of work handed to a backend: about a second of
-#: work (a progress bar moves, a cancellation is heard), few tasks for a scheduler.
+#: Largest number of starts in a chunk by default, the unit of work handed to a backend: about a
+#: second of work for the paper's robots, few tasks for a scheduler.
 DEFAULT_CHUNK = 2048
+#: A default chunking cuts an atlas into at least this many chunks (of at least MIN_AUTO_CHUNK
+#: starts): progress moves and a cancellation is heard within a small atlas of a slow robot.
+AUTO_CHUNKS, MIN_AUTO_CHUNK = 16, 16
+
+
+def auto_chunk(size: int) -> int:
+    """The default starts per chunk of an atlas of ``size`` runs per inverse: at most
+    :data:`DEFAULT_CHUNK`, at least :data:`AUTO_CHUNKS` chunks of :data:`MIN_AUTO_CHUNK` or
+    more (an atlas's numbers do not depend on its chunking)."""
+    return max(MIN_AUTO_CHUNK, min(DEFAULT_CHUNK, -(-size // AUTO_CHUNKS)))
+
+
 #: Sampled arc lengths are drawn in blocks of this many indices, each from its own seeded stream,
 #: so the s of a start depends only on its index and the seed.
 SAMPLE_BLOCK = 1024
@@ -186,7 +198,7 @@ def plan_atlas(
     box=None,
     shifts=None,
     scales=None,
-    chunk: int = DEFAULT_CHUNK,
+    chunk: int | None = None,
     gamma: float = 1.0,
     mode: str = "continuous",
     tol: float = 1e-10,
@@ -219,8 +231,10 @@ def plan_atlas(
     scales : array_like, shape (Q,), optional
         Scales of the base path about its first point, > 0 (default 1). The family is every
         shift with every scale, P = S Q paths.
-    chunk : int
-        Starts per chunk: the batch size and the unit of work, 1 to 65536.
+    chunk : int, optional
+        Starts per chunk: the batch size and the unit of work, 1 to 65536; by default
+        :func:`auto_chunk` of the atlas's size (progress is told, and cancellation asked,
+        after every chunk).
     gamma, mode, tol, max_iterations
         Of every leg, as in :func:`jik.engine.solver.solve`.
 
@@ -248,7 +262,9 @@ def plan_atlas(
             field="path",
         )
     cycles = _checked(lambda: count(cycles, "cycles", 1, MAX_CYCLES), "cycles")
-    chunk = _checked(lambda: count(chunk, "chunk", 1, MAX_CHUNK), "chunk")
+    chunk = (
+        None if chunk is None else _checked(lambda: count(chunk, "chunk", 1, MAX_CHUNK), "chunk")
+    )
     if mode not in MODES:
         raise InvalidInputError(f"mode must be 'continuous' or 'discrete', got {mode!r}", "mode")
     settings = {
@@ -281,9 +297,10 @@ def plan_atlas(
     paths = family(base_path, shift, scale)
 
     def make(**starts_: Any) -> AtlasPlan:
-        return AtlasPlan(
-            inverses=invs, paths=paths, cycles=cycles, chunk=chunk, settings=settings, **starts_
+        plan = AtlasPlan(
+            inverses=invs, paths=paths, cycles=cycles, chunk=1, settings=settings, **starts_
         )
+        return replace(plan, chunk=auto_chunk(plan.size) if chunk is None else chunk)
 
     if starts is not None:
         x = _checked(lambda: as_points(starts, kin.p, "starts"), "starts")

@@ -96,7 +96,7 @@ def add_atlas_parser(sub) -> None:
         "--chunk",
         type=int,
         default=None,
-        help="starts per chunk (default: 2048, fewer for small atlases)",
+        help="starts per chunk (default: at most 2048, and 16 chunks or more when there are 256 runs or more)",
     )
     where = p.add_mutually_exclusive_group()
     where.add_argument("--processes", type=int, help="run chunks in N local processes")
@@ -175,7 +175,7 @@ def _run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from jik.engine.arms import ARMS
-    from jik.engine.atlas import DEFAULT_CHUNK, plan_atlas
+    from jik.engine.atlas import plan_atlas
     from jik.engine.atlas_backends import backend_for
     from jik.engine.atlas_run import iter_atlas
     from jik.engine.exceptions import InvalidInputError
@@ -232,7 +232,7 @@ def _run(args: argparse.Namespace) -> int:
         box=None if args.arc or not spec.x_range else spec.x_range,
         shifts=[_numbers(s, "--shift") for s in args.shift] or None,
         scales=args.scale or None,
-        chunk=args.chunk or default_chunk(args, DEFAULT_CHUNK),
+        chunk=args.chunk or None,
         gamma=spec.default_gamma,
         mode=spec.default_mode,
     )
@@ -330,13 +330,6 @@ def _writable(out: Path) -> Path:
     if not os.access(folder, os.W_OK | os.X_OK):
         raise InvalidInputError(f"--out {out}: the folder {folder} is not writable", "out")
     return out
-
-
-def default_chunk(args: argparse.Namespace, largest: int) -> int:
-    """Chunks of ``largest`` starts, but at least 16 chunks (of 128 or more) in all: the bar
-    moves and the workers share the last chunks."""
-    runs = args.starts * max(1, len(args.shift)) * max(1, len(args.scale))
-    return max(128, min(largest, -(-runs // 16)))
 
 
 def _param(text: str) -> tuple[str, float]:
