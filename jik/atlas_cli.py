@@ -96,7 +96,7 @@ def add_atlas_parser(sub) -> None:
         "--chunk",
         type=int,
         default=None,
-        help="starts per chunk (default: at most 2048, and 16 chunks or more when there are 256 runs or more)",
+        help="starts per chunk (default: at most 2048, and 16 chunks or more from 256 runs)",
     )
     where = p.add_mutually_exclusive_group()
     where.add_argument("--processes", type=int, help="run chunks in N local processes")
@@ -276,6 +276,7 @@ def _run(args: argparse.Namespace) -> int:
     doc: dict[str, Any] = {
         "inputs": inputs,
         "arc": list(plan.manifolds[0].arc),
+        "period": plan.manifolds[0].period,
         "paths": plan.paths.tolist(),
         "legs_per_cycle": plan.legs,
         "elapsed_s": elapsed,
@@ -304,6 +305,11 @@ def _run(args: argparse.Namespace) -> int:
     sys.stderr.write(
         f"jik atlas: {A} x {plan.size} runs x {C} cycles in {elapsed:.1f} s: {written}\n"
     )
+    if plan.manifolds[0].period is not None:
+        sys.stderr.write(
+            "jik atlas: the self-motion curve closes on itself: the starts cover one turn, of "
+            f"arc length {plan.manifolds[0].period:.6g}\n"
+        )
     if arrays.outside is not None:  # (a robot with joint limits)
         counts = ", ".join(
             f"{alg} {int(arrays.outside[a])}" for a, alg in enumerate(plan.algorithms)

@@ -139,6 +139,8 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
     joint = UNITS.get(request.robot.name, ((), ()))[0]
     unit = norm_unit(joint)
     x_title, hover, at_x0 = f"arc length s of the start {unit}", "s = %{x:.3f}", 0.0
+    if result.get("period") is not None:  # (a closed curve: the starts cover one turn)
+        x_title = f"arc length s of the start {unit}, one turn of {result['period']:.4g}"
     if request.start_points:  # (p - r > 1: starts by number, the first x0, see manifold_starts)
         s = np.arange(1.0, len(request.start_points) + 1)
         x_title, hover, at_x0 = "start, farther from x0 to the right", "start %{x}", 1.0

@@ -368,3 +368,9 @@ def test_a_session_atlas_of_a_urdf_robot_does_not_send_its_text_back(client):
     assert "<robot" not in response.text and "link name" not in response.text
     robot = response.json()["request"]["robot"]
     assert robot["urdf_bytes"] == len(text.encode()) and "urdf" not in robot
+    # Its continuous wrist closes the self-motion curve: the starts cover one turn, once.
+    result = done["result"]
+    period = result["period"]
+    assert period is not None and 6.0 < period < 7.0
+    assert result["arc"][1] - result["arc"][0] == pytest.approx(period)
+    assert all(0 <= s < period for s in result["parameter"]) and len(result["parameter"]) == 3
