@@ -19,7 +19,7 @@ wherever the chunks run (:mod:`jik.engine.atlas_backends`).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -36,9 +36,21 @@ from .validation import FloatArray, as_points, count, positive
 MAX_STARTS = 10**9
 MAX_PATHS = 10**4
 MAX_CHUNK = 65536
-#: Default number of starts in a chunk, the unit of work handed to a backend: about a second of
-#: work (a progress bar moves, a cancellation is heard), few tasks for a scheduler.
+#: Largest number of starts in a chunk by default, the unit of work handed to a backend: about a
+#: second of work for the paper's robots, few tasks for a scheduler.
 DEFAULT_CHUNK = 2048
+#: A default chunking cuts an atlas into at least this many chunks (of at least MIN_AUTO_CHUNK
+#: starts): progress moves and a cancellation is heard within a small atlas of a slow robot.
+AUTO_CHUNKS, MIN_AUTO_CHUNK = 16, 16
+
+
+def auto_chunk(size: int) -> int:
+    """The default starts per chunk of an atlas of ``size`` runs per inverse: at most
+    :data:`DEFAULT_CHUNK`, at least :data:`AUTO_CHUNKS` chunks of :data:`MIN_AUTO_CHUNK` or
+    more (an atlas's numbers do not depend on its chunking)."""
+    return max(MIN_AUTO_CHUNK, min(DEFAULT_CHUNK, -(-size // AUTO_CHUNKS)))
+
+
 #: Sampled arc lengths are drawn in blocks of this many indices, each from its own seeded stream,
 #: so the s of a start depends only on its index and the seed.
 SAMPLE_BLOCK = 1024
@@ -63,6 +75,9 @@ class AtlasPlan:
         How the arc lengths s of the starts are laid on their curves' common arc: ("grid", 0) or
         ("sample", seed) (:func:`arc_lengths`); None for explicit starts.
     manifolds : tuple of SelfMotionManifold (one per path) or ()
+        The first path's curve sets the arc: one turn when it is closed. Each other path's curve
+        is traced over that arc; when it closes within it, its starts' s are taken modulo its
+        own period (:meth:`SelfMotionManifold.points`).
     explicit : ndarray, shape (N, p) or None
     chunk : int
     settings : dict
@@ -119,7 +134,10 @@ class AtlasPlan:
         starts are explicit. Computed on demand: a plan holds nothing of size N."""
         if self.sampling is None:
             return None
-        return arc_lengths(np.asarray(index), self.n_starts, self.manifolds[0].arc, *self.sampling)
+        curve = self.manifolds[0]
+        return arc_lengths(
+            np.asarray(index), self.n_starts, curve.arc, *self.sampling, closed=curve.closed
+        )
 
     def targets(self, lo: int, hi: int, starts: FloatArray) -> FloatArray:
         """The legs' targets (n, L, r) of runs lo to hi - 1: path[1:] and k(start)."""
@@ -129,13 +147,23 @@ class AtlasPlan:
 
 
 def arc_lengths(
-    index: FloatArray, n: int, arc: tuple[float, float], sampling: str, seed: int
+    index: FloatArray,
+    n: int,
+    arc: tuple[float, float],
+    sampling: str,
+    seed: int,
+    closed: bool = False,
 ) -> FloatArray:
     """Arc lengths of starts ``index`` (ints in [0, n)) of n on [lo, hi]: evenly spaced, ends
     included ("grid"), or uniform random ("sample"): drawn from ``seed`` block by block, so
-    each index's value is fixed by the index and the seed, not by what else is asked for."""
+    each index's value is fixed by the index and the seed, not by what else is asked for.
+
+    On a ``closed`` curve, whose arc is one turn (s = hi is s = lo again), the grid is n even
+    steps from lo, the end hi left out; samples are drawn as on an open arc, over the turn."""
     lo, hi = arc
-    if sampling == "grid":
+    if sampling == "grid" and closed:
+        u = index / n
+    elif sampling == "grid":
         u = index / (n - 1) if n > 1 else np.zeros(len(index))
     else:
         u = np.empty(len(index))
@@ -171,7 +199,7 @@ def plan_atlas(
     box=None,
     shifts=None,
     scales=None,
-    chunk: int = DEFAULT_CHUNK,
+    chunk: int | None = None,
     gamma: float = 1.0,
     mode: str = "continuous",
     tol: float = 1e-10,
@@ -196,14 +224,18 @@ def plan_atlas(
         uniformly with ``seed``. s = 0 is where eq. (7) with the pseudoinverse from ``reference``
         (a configuration, p) reaches the path's first point; with ``box`` ((low, high) per
         coordinate) the arc is cut where the base path's curve leaves the box, and the same
-        arc is used for every path of the family.
+        arc is used for every path of the family. A base curve that closes on itself within the
+        arc (:func:`jik.engine.self_motion.trace`) gives one turn as the arc, and the starts
+        cover it once: a grid leaves out its end, the start again.
     shifts : array_like, shape (S, r), optional
         Translations of the base path (default: none).
     scales : array_like, shape (Q,), optional
         Scales of the base path about its first point, > 0 (default 1). The family is every
         shift with every scale, P = S Q paths.
-    chunk : int
-        Starts per chunk: the batch size and the unit of work, 1 to 65536.
+    chunk : int, optional
+        Starts per chunk: the batch size and the unit of work, 1 to 65536; by default
+        :func:`auto_chunk` of the atlas's size (progress is told, and cancellation asked,
+        after every chunk).
     gamma, mode, tol, max_iterations
         Of every leg, as in :func:`jik.engine.solver.solve`.
 
@@ -231,7 +263,9 @@ def plan_atlas(
             field="path",
         )
     cycles = _checked(lambda: count(cycles, "cycles", 1, MAX_CYCLES), "cycles")
-    chunk = _checked(lambda: count(chunk, "chunk", 1, MAX_CHUNK), "chunk")
+    chunk = (
+        None if chunk is None else _checked(lambda: count(chunk, "chunk", 1, MAX_CHUNK), "chunk")
+    )
     if mode not in MODES:
         raise InvalidInputError(f"mode must be 'continuous' or 'discrete', got {mode!r}", "mode")
     settings = {
@@ -264,9 +298,10 @@ def plan_atlas(
     paths = family(base_path, shift, scale)
 
     def make(**starts_: Any) -> AtlasPlan:
-        return AtlasPlan(
-            inverses=invs, paths=paths, cycles=cycles, chunk=chunk, settings=settings, **starts_
+        plan = AtlasPlan(
+            inverses=invs, paths=paths, cycles=cycles, chunk=1, settings=settings, **starts_
         )
+        return replace(plan, chunk=auto_chunk(plan.size) if chunk is None else chunk)
 
     if starts is not None:
         x = _checked(lambda: as_points(starts, kin.p, "starts"), "starts")
