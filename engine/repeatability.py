@@ -57,7 +57,10 @@ class Leg:
         The starts that ran it (those still running), as indices into the batch; [0] for one.
     result : SolveResult or BatchSolveResult
         One start: its SolveResult, with the leg's trajectory (theta from 0) when ``record``.
-        A batch: the k members' BatchSolveResult.
+        A batch: the k members' BatchSolveResult. In continuous mode its ``nit`` counts the
+        solver's sweeps and steps, which the leg's guess lowers (one or two where a cold
+        :func:`jik.engine.solver.solve` of the same leg takes about ten; see
+        :class:`SolveResult`): the same leg, the same x to the sweep tolerance.
     stopped_by : JikError or None
         The error the leg's solve raised, when the progress stopped the run there
         (:attr:`Progress.stop_at_error`); ``result`` is then the leg's start alone (one point,
