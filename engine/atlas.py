@@ -24,15 +24,18 @@ from typing import Any
 
 import numpy as np
 
+from . import validation
 from .exceptions import InvalidInputError, SingularConfigurationError
 from .inverses import Inverse, Pseudoinverse
 from .repeatability import CLOSE_TOL, MAX_CYCLES, MAX_PATH_POINTS
 from .self_motion import SelfMotionManifold, project, trace
-from .solve_rules import MAX_ITERATIONS_LIMIT, MODES, check_gamma
+from .solve_rules import MAX_ITERATIONS_LIMIT, MAX_STEPS, MODES, check_gamma, run_bytes
 from .solver import solve_batch
-from .validation import FloatArray, as_points, count, positive
+from .validation import FloatArray, as_points, check_memory, count, positive
 
-#: Largest number of starts per path, of paths in a family, and of starts in a chunk.
+#: Largest number of starts per path, of paths in a family, and of starts in a chunk. A chunk
+#: must also fit in :data:`jik.engine.validation.MEMORY_LIMIT` (:func:`chunk_bytes`); the
+#: starts need not, when the atlas is streamed (``iter_atlas``).
 MAX_STARTS = 10**9
 MAX_PATHS = 10**4
 MAX_CHUNK = 65536
@@ -210,7 +213,9 @@ def plan_atlas(
     ------
     InvalidInputError
         Naming the field (``error.field``): path, cycles, starts, n_starts, arc, sampling, seed,
-        reference, box, shifts, scales, chunk, gamma, mode, tol, max_iterations, inverses.
+        reference, box, shifts, scales, chunk, gamma, mode, tol, max_iterations, inverses; a
+        chunk whose runs would exceed :data:`jik.engine.validation.MEMORY_LIMIT`
+        (:func:`chunk_bytes`) names ``chunk`` (or ``cycles``, when one run is too large).
     """
     invs = (inverses,) if isinstance(inverses, Inverse) else tuple(inverses)
     if not invs or not all(isinstance(i, Inverse) for i in invs):
@@ -262,6 +267,15 @@ def plan_atlas(
         raise InvalidInputError(f"at most {MAX_PATHS} paths (shifts x scales)", field="shifts")
     paths = family(base_path, shift, scale)
 
+    each = chunk_bytes(
+        kin, len(invs), cycles, paths.shape[1], mode, settings["gamma"], settings["tol"]
+    )
+    if each > validation.MEMORY_LIMIT:
+        check_memory(cycles, each / cycles, "cycles", "cycles of one run", "ask for fewer cycles")
+    check_memory(
+        chunk, each, "chunk", "runs of a chunk", "give a smaller chunk, or ask for fewer cycles"
+    )
+
     def make(**starts_: Any) -> AtlasPlan:
         return AtlasPlan(
             inverses=invs, paths=paths, cycles=cycles, chunk=chunk, settings=settings, **starts_
@@ -280,9 +294,20 @@ def plan_atlas(
                 field="starts",
             )
         return make(n_starts=len(x), sampling=None, manifolds=(), explicit=x)
-    if n_starts is None or arc is None or reference is None:
+    if n_starts is None:
         raise InvalidInputError(
-            "give explicit starts, or n_starts, arc and a reference configuration", "starts"
+            "give explicit starts, or n_starts with arc and reference (starts on the "
+            "self-motion curve of the path's first point)",
+            "starts",
+        )
+    missing = [name for name, value in (("arc", arc), ("reference", reference)) if value is None]
+    if missing:
+        raise InvalidInputError(
+            f"n_starts needs {' and '.join(missing)}: arc = (lo, hi), the arc lengths s of the "
+            "starts on the self-motion curve (lo <= 0 <= hi; one turn of Manipulator 2's curve "
+            f"is 2 pi sqrt(1 + l^2)), and reference, a configuration ({kin.p} numbers, such as "
+            "the robot's home) that eq. (7) moves onto the path's first point, where s = 0",
+            missing[0],
         )
     n = _checked(lambda: count(n_starts, "n_starts", 1, MAX_STARTS), "n_starts")
     if sampling not in ("grid", "sample"):
@@ -301,6 +326,16 @@ def plan_atlas(
         raise InvalidInputError("arc must be a pair (lo, hi) with lo <= 0 <= hi", field="arc")
     manifolds = _checked(lambda: _manifolds(kin, paths, ref, arc, box), "reference")
     return make(n_starts=n, sampling=(sampling, seed), manifolds=manifolds, explicit=None)
+
+
+def chunk_bytes(kin, algorithms: int, cycles: int, legs: int, mode, gamma, tol) -> float:
+    """Estimated peak memory, in bytes, per run of a chunk (:func:`jik.engine.atlas_run.run_chunk`):
+    its starts, targets, drift and leg ends for each of the ``algorithms`` (with the masks of
+    the joint limits' check), and the per-start share of one batched repeatability run
+    (:func:`jik.engine.solve_rules.run_bytes`)."""
+    p, r = kin.p, kin.r
+    kept = algorithms * (1.25 * cycles * legs * p + cycles + 2) + p + legs * r
+    return 8.0 * kept + run_bytes(kin, cycles, legs, mode, False, gamma, float(tol), MAX_STEPS)
 
 
 def _manifolds(kin, paths, reference, arc, box) -> tuple[SelfMotionManifold, ...]:

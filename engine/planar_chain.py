@@ -105,6 +105,12 @@ class PlanarChain(Kinematics):
             "orientation": self.orientation,
         }
 
+    @property
+    def scratch(self) -> int:
+        """Float64 numbers per configuration of an evaluation of J: angles, link vectors and
+        joint positions, a few (p + 1, 2) arrays."""
+        return 12 * (self.p + 1)
+
     def _angles_lengths(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
         """theta_i (..., p) [rad] and a_i (..., p) [length]."""
         q = np.asarray(x, dtype=float) + self.offsets
