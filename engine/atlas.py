@@ -19,29 +19,40 @@ wherever the chunks run (:mod:`jik.engine.atlas_backends`).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
-from . import validation
 from .exceptions import InvalidInputError, SingularConfigurationError
 from .inverses import Inverse, Pseudoinverse
 from .repeatability import CLOSE_TOL, MAX_CYCLES, MAX_PATH_POINTS
 from .self_motion import SelfMotionManifold, project, trace
-from .solve_rules import MAX_ITERATIONS_LIMIT, MAX_STEPS, MODES, check_gamma, run_bytes
+from .solve_rules import MAX_ITERATIONS_LIMIT, MODES, check_gamma, chunk_limit
 from .solver import solve_batch
-from .validation import FloatArray, as_points, check_memory, count, positive
+from .validation import FloatArray, as_points, count, positive
 
 #: Largest number of starts per path, of paths in a family, and of starts in a chunk. A chunk
-#: must also fit in :data:`jik.engine.validation.MEMORY_LIMIT` (:func:`chunk_bytes`); the
-#: starts need not, when the atlas is streamed (``iter_atlas``).
+#: must also fit in the memory bound (:func:`~jik.engine.solve_rules.chunk_limit`); the starts
+#: need not, when the atlas is streamed (``iter_atlas``).
 MAX_STARTS = 10**9
 MAX_PATHS = 10**4
 MAX_CHUNK = 65536
-#: Default number of starts in a chunk, the unit of work handed to a backend: about a second of
-#: work (a progress bar moves, a cancellation is heard), few tasks for a scheduler.
+#: Largest number of starts in a chunk by default, the unit of work handed to a backend: about a
+#: second of work for the paper's robots, few tasks for a scheduler.
 DEFAULT_CHUNK = 2048
+#: A default chunking cuts an atlas into at least this many chunks (of at least MIN_AUTO_CHUNK
+#: starts): progress moves and a cancellation is heard within a small atlas of a slow robot.
+AUTO_CHUNKS, MIN_AUTO_CHUNK = 16, 16
+
+
+def auto_chunk(size: int) -> int:
+    """The default starts per chunk of an atlas of ``size`` runs per inverse: at most
+    :data:`DEFAULT_CHUNK`, at least :data:`AUTO_CHUNKS` chunks of :data:`MIN_AUTO_CHUNK` or
+    more (an atlas's numbers do not depend on its chunking)."""
+    return max(MIN_AUTO_CHUNK, min(DEFAULT_CHUNK, -(-size // AUTO_CHUNKS)))
+
+
 #: Sampled arc lengths are drawn in blocks of this many indices, each from its own seeded stream,
 #: so the s of a start depends only on its index and the seed.
 SAMPLE_BLOCK = 1024
@@ -66,6 +77,9 @@ class AtlasPlan:
         How the arc lengths s of the starts are laid on their curves' common arc: ("grid", 0) or
         ("sample", seed) (:func:`arc_lengths`); None for explicit starts.
     manifolds : tuple of SelfMotionManifold (one per path) or ()
+        The first path's curve sets the arc: one turn when it is closed. Each other path's curve
+        is traced over that arc; when it closes within it, its starts' s are taken modulo its
+        own period (:meth:`SelfMotionManifold.points`).
     explicit : ndarray, shape (N, p) or None
     chunk : int
     settings : dict
@@ -121,7 +135,10 @@ class AtlasPlan:
         starts are explicit. Computed on demand: a plan holds nothing of size N."""
         if self.sampling is None:
             return None
-        return arc_lengths(np.asarray(index), self.n_starts, self.manifolds[0].arc, *self.sampling)
+        curve = self.manifolds[0]
+        return arc_lengths(
+            np.asarray(index), self.n_starts, curve.arc, *self.sampling, closed=curve.closed
+        )
 
     def targets(self, lo: int, hi: int, starts: FloatArray) -> FloatArray:
         """The legs' targets (n, L, r) of runs lo to hi - 1: path[1:] and k(start)."""
@@ -131,13 +148,23 @@ class AtlasPlan:
 
 
 def arc_lengths(
-    index: FloatArray, n: int, arc: tuple[float, float], sampling: str, seed: int
+    index: FloatArray,
+    n: int,
+    arc: tuple[float, float],
+    sampling: str,
+    seed: int,
+    closed: bool = False,
 ) -> FloatArray:
     """Arc lengths of starts ``index`` (ints in [0, n)) of n on [lo, hi]: evenly spaced, ends
     included ("grid"), or uniform random ("sample"): drawn from ``seed`` block by block, so
-    each index's value is fixed by the index and the seed, not by what else is asked for."""
+    each index's value is fixed by the index and the seed, not by what else is asked for.
+
+    On a ``closed`` curve, whose arc is one turn (s = hi is s = lo again), the grid is n even
+    steps from lo, the end hi left out; samples are drawn as on an open arc, over the turn."""
     lo, hi = arc
-    if sampling == "grid":
+    if sampling == "grid" and closed:
+        u = index / n
+    elif sampling == "grid":
         u = index / (n - 1) if n > 1 else np.zeros(len(index))
     else:
         u = np.empty(len(index))
@@ -173,7 +200,7 @@ def plan_atlas(
     box=None,
     shifts=None,
     scales=None,
-    chunk: int = DEFAULT_CHUNK,
+    chunk: int | None = None,
     gamma: float = 1.0,
     mode: str = "continuous",
     tol: float = 1e-10,
@@ -198,14 +225,19 @@ def plan_atlas(
         uniformly with ``seed``. s = 0 is where eq. (7) with the pseudoinverse from ``reference``
         (a configuration, p) reaches the path's first point; with ``box`` ((low, high) per
         coordinate) the arc is cut where the base path's curve leaves the box, and the same
-        arc is used for every path of the family.
+        arc is used for every path of the family. A base curve that closes on itself within the
+        arc (:func:`jik.engine.self_motion.trace`) gives one turn as the arc, and the starts
+        cover it once: a grid leaves out its end, the start again.
     shifts : array_like, shape (S, r), optional
         Translations of the base path (default: none).
     scales : array_like, shape (Q,), optional
         Scales of the base path about its first point, > 0 (default 1). The family is every
         shift with every scale, P = S Q paths.
-    chunk : int
-        Starts per chunk: the batch size and the unit of work, 1 to 65536.
+    chunk : int, optional
+        Starts per chunk: the batch size and the unit of work, 1 to 65536; by default
+        :func:`auto_chunk` of the atlas's size (progress is told, and cancellation asked,
+        after every chunk), lowered to what fits in :data:`jik.engine.validation.MEMORY_LIMIT`
+        (:func:`~jik.engine.solve_rules.chunk_limit`).
     gamma, mode, tol, max_iterations
         Of every leg, as in :func:`jik.engine.solver.solve`.
 
@@ -214,8 +246,8 @@ def plan_atlas(
     InvalidInputError
         Naming the field (``error.field``): path, cycles, starts, n_starts, arc, sampling, seed,
         reference, box, shifts, scales, chunk, gamma, mode, tol, max_iterations, inverses; a
-        chunk whose runs would exceed :data:`jik.engine.validation.MEMORY_LIMIT`
-        (:func:`chunk_bytes`) names ``chunk`` (or ``cycles``, when one run is too large).
+        chunk whose runs would exceed :data:`jik.engine.validation.MEMORY_LIMIT` names
+        ``chunk`` (``cycles``, when one run is too large).
     """
     invs = (inverses,) if isinstance(inverses, Inverse) else tuple(inverses)
     if not invs or not all(isinstance(i, Inverse) for i in invs):
@@ -235,7 +267,9 @@ def plan_atlas(
             field="path",
         )
     cycles = _checked(lambda: count(cycles, "cycles", 1, MAX_CYCLES), "cycles")
-    chunk = _checked(lambda: count(chunk, "chunk", 1, MAX_CHUNK), "chunk")
+    chunk = (
+        None if chunk is None else _checked(lambda: count(chunk, "chunk", 1, MAX_CHUNK), "chunk")
+    )
     if mode not in MODES:
         raise InvalidInputError(f"mode must be 'continuous' or 'discrete', got {mode!r}", "mode")
     settings = {
@@ -267,19 +301,13 @@ def plan_atlas(
         raise InvalidInputError(f"at most {MAX_PATHS} paths (shifts x scales)", field="shifts")
     paths = family(base_path, shift, scale)
 
-    each = chunk_bytes(
-        kin, len(invs), cycles, paths.shape[1], mode, settings["gamma"], settings["tol"]
-    )
-    if each > validation.MEMORY_LIMIT:
-        check_memory(cycles, each / cycles, "cycles", "cycles of one run", "ask for fewer cycles")
-    check_memory(
-        chunk, each, "chunk", "runs of a chunk", "give a smaller chunk, or ask for fewer cycles"
-    )
+    fits = chunk_limit(kin, len(invs), cycles, paths.shape[1], settings, chunk)
 
     def make(**starts_: Any) -> AtlasPlan:
-        return AtlasPlan(
-            inverses=invs, paths=paths, cycles=cycles, chunk=chunk, settings=settings, **starts_
+        plan = AtlasPlan(
+            inverses=invs, paths=paths, cycles=cycles, chunk=1, settings=settings, **starts_
         )
+        return replace(plan, chunk=min(auto_chunk(plan.size), fits) if chunk is None else chunk)
 
     if starts is not None:
         x = _checked(lambda: as_points(starts, kin.p, "starts"), "starts")
@@ -304,9 +332,9 @@ def plan_atlas(
     if missing:
         raise InvalidInputError(
             f"n_starts needs {' and '.join(missing)}: arc = (lo, hi), the arc lengths s of the "
-            "starts on the self-motion curve (lo <= 0 <= hi; one turn of Manipulator 2's curve "
-            f"is 2 pi sqrt(1 + l^2)), and reference, a configuration ({kin.p} numbers, such as "
-            "the robot's home) that eq. (7) moves onto the path's first point, where s = 0",
+            "starts on the self-motion curve (lo <= 0 <= hi), and reference, a configuration "
+            f"({kin.p} numbers, such as the robot's home) that eq. (7) moves onto the path's "
+            "first point, where s = 0",
             missing[0],
         )
     n = _checked(lambda: count(n_starts, "n_starts", 1, MAX_STARTS), "n_starts")
@@ -326,16 +354,6 @@ def plan_atlas(
         raise InvalidInputError("arc must be a pair (lo, hi) with lo <= 0 <= hi", field="arc")
     manifolds = _checked(lambda: _manifolds(kin, paths, ref, arc, box), "reference")
     return make(n_starts=n, sampling=(sampling, seed), manifolds=manifolds, explicit=None)
-
-
-def chunk_bytes(kin, algorithms: int, cycles: int, legs: int, mode, gamma, tol) -> float:
-    """Estimated peak memory, in bytes, per run of a chunk (:func:`jik.engine.atlas_run.run_chunk`):
-    its starts, targets, drift and leg ends for each of the ``algorithms`` (with the masks of
-    the joint limits' check), and the per-start share of one batched repeatability run
-    (:func:`jik.engine.solve_rules.run_bytes`)."""
-    p, r = kin.p, kin.r
-    kept = algorithms * (1.25 * cycles * legs * p + cycles + 2) + p + legs * r
-    return 8.0 * kept + run_bytes(kin, cycles, legs, mode, False, gamma, float(tol), MAX_STEPS)
 
 
 def _manifolds(kin, paths, reference, arc, box) -> tuple[SelfMotionManifold, ...]:

@@ -44,6 +44,7 @@ class FunctionalValue:
     value : float
         The integral; for E1, quadrature points where [J; dh] is singular are excluded (the
         integrand is infinite there), for E2 they are included (the integrand (19) is finite).
+        E1 is ``inf`` when it diverges (``divergent``).
     region : dict
         ``{"x2": (lo, hi), ...}``: the integrated variables.
     n_points : int
@@ -55,6 +56,11 @@ class FunctionalValue:
     min_abs_dh_k : float
         min |dh K| over the quadrature points: E1 is singular where dh K = 0 (eq. (14)), and a
         sign change of dh K inside the region makes E1 infinite.
+    divergent : bool
+        For E1: dh K vanishes inside the region, so the integral (14) diverges and ``value`` is
+        ``inf``. Found by the sign of det [J; dh] = +-(dh K) sqrt(det J J^T) (continuous on the
+        box, unlike dh K, whose sign follows K's orientation): zero, or of both signs, over the
+        quadrature points and the box's faces. Always False for E2, finite everywhere.
     """
 
     value: float
@@ -63,6 +69,7 @@ class FunctionalValue:
     singular_points: np.ndarray
     fixed: dict[str, float] = field(default_factory=dict)
     min_abs_dh_k: float = float("nan")
+    divergent: bool = False
 
     def as_dict(self) -> dict:
         """JSON-friendly form."""
@@ -74,6 +81,7 @@ class FunctionalValue:
             "n_singular": int(self.singular_points.shape[0]),
             "singular_points": self.singular_points.tolist(),
             "min_abs_dh_k": self.min_abs_dh_k,
+            "divergent": self.divergent,
         }
 
 
@@ -99,11 +107,8 @@ def check_region(
                 f"unknown joint variable {name!r}; use one of {names}",
                 "region" if name in region else "fixed",
             )
-    both = set(region) & set(fixed)
-    if both:
-        raise InvalidInputError(
-            f"variables {sorted(both)} are both integrated over and fixed", "fixed"
-        )
+    if both := sorted(set(region) & set(fixed)):
+        raise InvalidInputError(f"variables {both} are both integrated over and fixed", "fixed")
     box: dict[str, tuple[float, float]] = {}
     for name in names:
         if name not in region:
@@ -174,6 +179,41 @@ def _singular_mask(J: FloatArray, dh: FloatArray) -> FloatArray:
     return ~ok | (extended_singularity(extended_jacobian(J, dh_safe)) < SINGULAR_EXTENDED)
 
 
+def _e1_diverges(
+    kinematics: Kinematics,
+    augmenting_map: AugmentingMap,
+    x: FloatArray,
+    J: FloatArray,
+    dh: FloatArray,
+    box: dict[str, tuple[float, float]],
+) -> bool:
+    """Whether dh K vanishes on the box, so that E1 (14) diverges: [J; dh] is singular (as
+    :data:`~jik.engine.inverses.SINGULAR_EXTENDED` says) at, or det [J; dh] (continuous,
+    +-(dh K) sqrt(det J J^T)) is of both signs over, the quadrature points ``x`` and the same
+    points moved onto each face of the box (a zero on a face is outside the
+    Gauss-Legendre points but makes the integral diverge all the same). Points where dh is
+    not defined, and face points where J loses rank, do not count."""
+    names = list(kinematics.variable_names) or [f"x{i + 1}" for i in range(kinematics.p)]
+    faces = []
+    for name, ends in box.items():
+        for end in ends:
+            face = x.copy()
+            face[:, names.index(name)] = end
+            faces.append(np.unique(face, axis=0))
+    xf = np.concatenate(faces)
+    xf = xf[~np.atleast_1d(kinematics.is_singular(xf))]
+    with np.errstate(all="ignore"):
+        dhf = np.asarray(augmenting_map.gradient(xf), dtype=float).reshape(len(xf), -1)
+    Jall = np.concatenate([J, kinematics.jacobian(xf)])
+    dhall = np.concatenate([dh, dhf])
+    defined = np.all(np.isfinite(dhall), axis=-1)
+    Jbar = extended_jacobian(Jall[defined], dhall[defined])
+    det = np.linalg.det(Jbar)
+    if np.any(extended_singularity(Jbar) < SINGULAR_EXTENDED):  # (dh K = 0 at a point)
+        return True
+    return bool(det.size) and bool(np.min(det) < 0.0 < np.max(det))
+
+
 def e1_integrand(J: FloatArray, dh: FloatArray) -> FloatArray:
     """||J^P# - J^E#||_F^2 of eq. (13), shape (...,); NaN where [J; dh] is singular."""
     D = pseudoinverse(J) - extended_inverse(J, dh)
@@ -210,12 +250,15 @@ def _evaluate(
     dh_safe = np.where(bad[:, None], 0.0, dh)
     K = kinematics.kernel(x)
     dhk = np.einsum("np,np->n", dh_safe, K)
+    divergent = False
     if which == "e1":
         f = np.where(bad, 0.0, e1_integrand(J, np.where(bad[:, None], K, dh_safe)))
+        divergent = _e1_diverges(kinematics, augmenting_map, x, J, dh, box)
     else:
         f = e2_integrand(J, K, kinematics.manipulability(x), dh_safe)
     return FunctionalValue(
-        value=float(np.dot(w, f)),
+        value=float("inf") if divergent else float(np.dot(w, f)),
+        divergent=divergent,
         region=box,
         n_points=int(w.size),
         singular_points=x[bad],
@@ -251,7 +294,8 @@ def error_functional_e1(
     -------
     FunctionalValue
         Quadrature points where [J; dh] is singular are excluded from the value and listed in
-        ``singular_points``.
+        ``singular_points``; where dh K vanishes inside the region, the value is ``inf`` and
+        ``divergent`` is set.
 
     Notes
     -----

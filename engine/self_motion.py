@@ -12,19 +12,34 @@ the dense output there, projected back onto k(x) = y0 by Newton steps with the p
 which move it normal to K and so keep s its arc length to first order. Points depend only on s,
 not on which other points are asked for at the same time: an atlas computes its starts chunk by
 chunk and gets the same numbers.
+
+A curve that is a closed loop (a component of the fibre that is a circle inside the box: the
+fibres of a revolute arm often are) is traced once round, not round and round until the arc is
+used up. Going ahead from x_b, the tracer watches a Poincare section, the hyperplane through x_b
+normal to the curve there: when the curve crosses it again in the same direction (coming from
+behind it) at a point within :data:`CLOSE_TOL` of x_b, with the same tangent, the loop has
+closed; the crossing is located on the dense output (Brent's method, as ``solve_ivp`` locates
+events) and its arc length is the loop's period T. Going behind, it watches the section
+through the end of the arc traced ahead, the first point of that arc it can come round to.
+The angle of a joint that turns
+freely (a URDF's continuous joint, :func:`periodic_joints`) is compared modulo 2 pi, so a loop
+that closes after that joint has turned a whole turn is found too.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
-from scipy.integrate import OdeSolution, solve_ivp
+from scipy.integrate import DOP853, OdeSolution
+from scipy.optimize import brentq
 
 from .exceptions import InvalidInputError
 from .inverses import Pseudoinverse
 from .kinematics import Kinematics
+from .urdf import UrdfChain
 from .validation import FloatArray, finite
 
 #: Tolerances of the traced orbit (relative and absolute, on x).
@@ -34,6 +49,10 @@ PROJECT_TOL = 1e-14
 PROJECT_STEPS = 6
 #: Longest arc traced either way from the base configuration.
 MAX_ARC = 1e3
+#: A curve has closed when it crosses its start's section again this close to the start.
+CLOSE_TOL = 1e-6
+#: Brent's tolerance on s where an event is located (``solve_ivp``'s).
+EVENT_TOL = 4 * np.finfo(float).eps
 
 
 @dataclass(frozen=True)
@@ -48,7 +67,13 @@ class SelfMotionManifold:
     base : ndarray, shape (p,)
         The configuration at s = 0 (k(base) = y0 to :data:`PROJECT_TOL`).
     arc : (float, float)
-        The traced range of the arc length s, lo <= 0 <= hi.
+        The traced range of the arc length s, lo <= 0 <= hi: one turn, hi - lo = period, when
+        the curve is closed.
+    period : float or None
+        The length T of a closed curve (x(s + T) = x(s)), None for an open one (cut by the box
+        or by the asked arc).
+    steps : int
+        Integrator steps taken, both ways.
     """
 
     kinematics: Kinematics
@@ -57,17 +82,29 @@ class SelfMotionManifold:
     arc: tuple[float, float]
     _ahead: OdeSolution | None
     _behind: OdeSolution | None
+    period: float | None = None
+    steps: int = 0
+
+    @property
+    def closed(self) -> bool:
+        """Whether the curve closes on itself within the traced arc (one turn is traced)."""
+        return self.period is not None
 
     def points(self, s) -> FloatArray:
         """Configurations at arc lengths ``s`` (shape (n,)), shape (n, p), each on k(x) = y0.
 
+        On a closed curve any s is a point: an s outside the traced turn is taken modulo the
+        period (the point's freely turning joints are then those of the traced turn).
+
         Raises
         ------
         InvalidInputError
-            An s outside the traced arc.
+            An s outside the traced arc of an open curve.
         """
         s = np.asarray(s, dtype=float)
         lo, hi = self.arc
+        if self.period is not None and s.ndim == 1 and np.all(np.isfinite(s)):
+            s = np.where((s >= lo) & (s <= hi), s, lo + np.mod(s - lo, self.period))
         if s.ndim != 1 or not np.all((s >= lo) & (s <= hi)):
             raise InvalidInputError(
                 f"arc lengths must be a 1-D array within the traced arc [{lo:g}, {hi:g}]",
@@ -98,6 +135,20 @@ def project(kinematics: Kinematics, x: FloatArray, y0: FloatArray) -> FloatArray
     return x
 
 
+def periodic_joints(kinematics: Kinematics) -> FloatArray:
+    """Which variables (bool, shape (p,)) are angles of joints that turn freely, so that x and
+    x + 2 pi e_i are one posture: a URDF's continuous joints and its revolute joints without
+    limits. Every other variable (the paper's robots', a planar chain's) is a coordinate of R^p,
+    as in the paper's drift ||x - x0||."""
+    periodic = np.zeros(kinematics.p, dtype=bool)
+    if isinstance(kinematics, UrdfChain):
+        free = ~np.isfinite(np.asarray(kinematics.joint_limits, dtype=float)).all(axis=1)
+        for joint in kinematics.chain:
+            if joint.index >= 0 and joint.type == "revolute":
+                periodic[joint.index] = free[joint.index]
+    return periodic
+
+
 def trace(
     kinematics: Kinematics,
     base,
@@ -121,6 +172,9 @@ def trace(
     Returns
     -------
     SelfMotionManifold
+        Open, over ``arc`` or the part of it within ``box``; or closed, when the curve comes
+        back to where it began within ``arc`` (the module's notes): then over one turn, (0, T)
+        when it closes ahead (hi >= T), else (hi - T, hi), with ``period`` T.
 
     Raises
     ------
@@ -154,41 +208,107 @@ def trace(
                 field="base",
             )
 
-    def kernel(_s, x):
-        return kinematics.kernel(x)
-
-    events = []
+    leaves = None
     if bounds is not None:
         # (a margin inside the box: the curve may run along a face of it)
         def leaves(_s, x):
             return float(np.min(np.minimum(x - bounds[:, 0], bounds[:, 1] - x)))
 
-        leaves.terminal = True  # type: ignore[attr-defined]  # solve_ivp reads it off the function
-        events.append(leaves)
-    ends: list[float] = []
-    sols: list[OdeSolution | None] = []
-    for end in (hi, lo):
-        if end == 0:
-            ends.append(0.0)
-            sols.append(None)
-            continue
-        sol = solve_ivp(
-            kernel,
-            (0.0, end),
-            base,
-            method="DOP853",
-            rtol=TRACE_TOL,
-            atol=TRACE_TOL,
-            dense_output=True,
-            events=events or None,
+    periodic = periodic_joints(kinematics)
+    ahead = _leg(kinematics, base, hi, leaves, (base, kinematics.kernel(base)), periodic)
+    if ahead.closed:
+        return SelfMotionManifold(
+            kinematics, y0, base, (0.0, ahead.end), ahead.sol, None, ahead.end, ahead.steps
         )
-        if not sol.success and sol.status != 1:
+    # Behind, the curve closes where it comes round to the end of the arc traced ahead (unless
+    # the box cut that end: a curve that leaves the box is no loop within it).
+    watch = None
+    if not ahead.cut:
+        end = base if ahead.sol is None else ahead.sol(ahead.end)
+        watch = (end, -kinematics.kernel(end))
+    behind = _leg(kinematics, base, lo, leaves, watch, periodic)
+    return SelfMotionManifold(
+        kinematics,
+        y0,
+        base,
+        (behind.end, ahead.end),
+        _ahead=ahead.sol,
+        _behind=behind.sol,
+        period=ahead.end - behind.end if behind.closed else None,
+        steps=ahead.steps + behind.steps,
+    )
+
+
+class _Leg(NamedTuple):
+    """One way of a traced curve: where it ended, its dense output (None: no arc), its steps,
+    and whether the box cut it or it closed."""
+
+    end: float
+    sol: OdeSolution | None
+    steps: int
+    cut: bool
+    closed: bool
+
+
+def _leg(kinematics, base, end, leaves, watch, periodic) -> _Leg:
+    """Integrate dx/ds = K(x), x(0) = ``base``, from s = 0 toward ``end`` (DOP853 with dense
+    output, stepped as ``solve_ivp`` steps it), stopping at the first of: ``end``; a zero of
+    ``leaves(s, x)`` (the box, located as ``solve_ivp`` locates a terminal event); the return to
+    ``watch`` = (w, v), w a point of the curve and v the unit tangent the curve has there in the
+    direction of integration: a crossing of the section v . (x - w) = 0 from behind it (v . d < 0
+    at the step's start, >= 0 at its end, so the start's own crossing at s = 0 is none), at
+    which x is within :data:`CLOSE_TOL` of w with its tangent near v (angles of
+    ``periodic`` joints compared modulo 2 pi)."""
+    if end == 0:
+        return _Leg(0.0, None, 0, False, False)
+
+    def wrapped(x):
+        d = x - watch[0]
+        d[periodic] = np.mod(d[periodic] + np.pi, 2 * np.pi) - np.pi
+        return d
+
+    def section(x):
+        return float(watch[1] @ wrapped(x))
+
+    def returned(x) -> bool:
+        along = np.sign(end) * kinematics.kernel(x) @ watch[1]
+        return bool(np.linalg.norm(wrapped(x)) <= CLOSE_TOL and along > 0.5)
+
+    solver = DOP853(
+        lambda _s, x: kinematics.kernel(x), 0.0, base, float(end), rtol=TRACE_TOL, atol=TRACE_TOL
+    )
+    ts, interpolants = [0.0], []
+    g = 0.0 if leaves is None else leaves(0.0, base)
+    stop, cut, closed, steps = None, False, False, 0
+    while solver.status == "running" and stop is None:
+        message = solver.step()
+        steps += 1
+        if solver.status == "failed":
             raise InvalidInputError(
-                f"the self-motion curve could not be traced from the base: {sol.message}",
+                f"the self-motion curve could not be traced from the base: {message}",
                 field="starts",
             )
-        ends.append(float(sol.t[-1]))
-        sols.append(sol.sol if sol.t[-1] != 0 else None)
-    return SelfMotionManifold(
-        kinematics, y0, base, (ends[1], ends[0]), _ahead=sols[0], _behind=sols[1]
-    )
+        t_old, t, sol = solver.t_old, solver.t, solver.dense_output()
+        interpolants.append(sol)
+        if leaves is not None:
+            g_new = leaves(t, solver.y)
+            if g <= 0 <= g_new or g >= 0 >= g_new:
+                stop = brentq(
+                    lambda u, sol=sol: leaves(u, sol(u)), t_old, t, xtol=EVENT_TOL, rtol=EVENT_TOL
+                )
+                cut = True
+            g = g_new
+        if watch is not None and section(sol(t_old)) < 0 <= section(sol(t)):
+            root = brentq(
+                lambda u, sol=sol: section(sol(u)), t_old, t, xtol=EVENT_TOL, rtol=EVENT_TOL
+            )
+            if returned(sol(root)) and (stop is None or abs(root) < abs(stop)):
+                stop, cut, closed = root, False, True
+        t = t if stop is None else stop
+        if len(ts) > 1 and ts[-1] == t:  # (an event where the step began: no new segment)
+            interpolants.pop()
+        else:
+            ts.append(t)
+    if ts[-1] == 0:
+        return _Leg(0.0, None, steps, cut, False)
+    return _Leg(float(ts[-1]), OdeSolution(np.array(ts), interpolants), steps, cut, closed)

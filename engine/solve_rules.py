@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import math
 
+from . import validation
 from .exceptions import InvalidInputError
 from .inverses import Inverse
 from .kinematics import Kinematics
 from .picard import DEGREE
-from .validation import FloatArray, count, positive
+from .validation import FloatArray, check_memory, count, positive
 
 #: The smallest task-error tolerance ``tol`` of a solve (double precision).
 TOL_MIN = 1e-14
@@ -199,3 +200,30 @@ def run_bytes(
     held = 8.0 * (2 * cycles * legs * p + legs * r + cycles * (p + 1) + 3 * p)
     each_leg = solve_bytes(kinematics, 1, mode, record, gamma, tol, cap)
     return held + (cycles * legs * each_leg if record else each_leg)
+
+
+def chunk_limit(kinematics, algorithms: int, cycles: int, legs: int, settings, chunk) -> int:
+    """How many runs of an atlas fit in a chunk within :data:`MEMORY_LIMIT
+    <jik.engine.validation.MEMORY_LIMIT>` (:func:`jik.engine.atlas.plan_atlas`).
+
+    A run of a chunk (:func:`jik.engine.atlas_run.run_chunk`) holds its start, targets, drift
+    and leg ends for each of the ``algorithms`` (with the masks of the joint limits' check), and
+    its share of one batched repeatability run (:func:`run_bytes`).
+
+    Raises
+    ------
+    InvalidInputError
+        Naming ``cycles`` when one run does not fit, ``chunk`` when ``chunk`` (if given)
+        runs do not.
+    """
+    p, r = kinematics.p, kinematics.r
+    kept = 8.0 * (algorithms * (1.25 * cycles * legs * p + cycles + 2) + p + legs * r)
+    mode, gamma, tol = settings["mode"], settings["gamma"], settings["tol"]
+    each = kept + run_bytes(kinematics, cycles, legs, mode, False, gamma, tol, MAX_STEPS)
+    if each > validation.MEMORY_LIMIT:
+        check_memory(cycles, each / cycles, "cycles", "cycles of one run", "ask for fewer cycles")
+    if chunk is not None:
+        check_memory(
+            chunk, each, "chunk", "runs of a chunk", "give a smaller chunk or fewer cycles"
+        )
+    return int(validation.MEMORY_LIMIT // each)

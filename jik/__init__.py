@@ -7,7 +7,19 @@ web service and dashboard (:mod:`jik.app`, with the ``app`` extra), the page's f
 on the package index belongs to another project): ``pip install 'jik-lab[app]'``.
 """
 
+import os as _os
+
 __version__ = "0.1.0"
+
+# In a source checkout, jik's subpackages are the top-level folders engine/, app/, static/ and
+# benchmarks/ (pyproject.toml's package-dir). Where this jik/ is imported from such a checkout
+# without an editable install (a notebook started at its root, where the folder comes first on
+# sys.path), the checkout's root is searched for them too; an installed jik holds them inside.
+_HERE = _os.path.dirname(_os.path.abspath(__file__))
+if not _os.path.isdir(_os.path.join(_HERE, "engine")) and _os.path.isfile(
+    _os.path.join(_os.path.dirname(_HERE), "engine", "__init__.py")
+):
+    __path__.append(_os.path.dirname(_HERE))
 
 #: The distribution's name on the package index; the import package and the command are ``jik``.
 DISTRIBUTION = "jik-lab"

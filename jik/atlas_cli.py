@@ -96,7 +96,7 @@ def add_atlas_parser(sub) -> None:
         "--chunk",
         type=int,
         default=None,
-        help="starts per chunk (default: 2048, fewer for small atlases)",
+        help="starts per chunk (default: at most 2048, and 16 chunks or more from 256 runs)",
     )
     where = p.add_mutually_exclusive_group()
     where.add_argument("--processes", type=int, help="run chunks in N local processes")
@@ -175,7 +175,7 @@ def _run(args: argparse.Namespace) -> int:
     import numpy as np
 
     from jik.engine.arms import ARMS
-    from jik.engine.atlas import DEFAULT_CHUNK, plan_atlas
+    from jik.engine.atlas import plan_atlas
     from jik.engine.atlas_backends import backend_for
     from jik.engine.atlas_run import iter_atlas
     from jik.engine.exceptions import InvalidInputError
@@ -232,7 +232,7 @@ def _run(args: argparse.Namespace) -> int:
         box=None if args.arc or not spec.x_range else spec.x_range,
         shifts=[_numbers(s, "--shift") for s in args.shift] or None,
         scales=args.scale or None,
-        chunk=args.chunk or default_chunk(args, DEFAULT_CHUNK),
+        chunk=args.chunk or None,
         gamma=spec.default_gamma,
         mode=spec.default_mode,
     )
@@ -276,6 +276,7 @@ def _run(args: argparse.Namespace) -> int:
     doc: dict[str, Any] = {
         "inputs": inputs,
         "arc": list(plan.manifolds[0].arc),
+        "period": plan.manifolds[0].period,
         "paths": plan.paths.tolist(),
         "legs_per_cycle": plan.legs,
         "elapsed_s": elapsed,
@@ -304,6 +305,11 @@ def _run(args: argparse.Namespace) -> int:
     sys.stderr.write(
         f"jik atlas: {A} x {plan.size} runs x {C} cycles in {elapsed:.1f} s: {written}\n"
     )
+    if plan.manifolds[0].period is not None:
+        sys.stderr.write(
+            "jik atlas: the self-motion curve closes on itself: the starts cover one turn, of "
+            f"arc length {plan.manifolds[0].period:.6g}\n"
+        )
     if arrays.outside is not None:  # (a robot with joint limits)
         counts = ", ".join(
             f"{alg} {int(arrays.outside[a])}" for a, alg in enumerate(plan.algorithms)
@@ -330,13 +336,6 @@ def _writable(out: Path) -> Path:
     if not os.access(folder, os.W_OK | os.X_OK):
         raise InvalidInputError(f"--out {out}: the folder {folder} is not writable", "out")
     return out
-
-
-def default_chunk(args: argparse.Namespace, largest: int) -> int:
-    """Chunks of ``largest`` starts, but at least 16 chunks (of 128 or more) in all: the bar
-    moves and the workers share the last chunks."""
-    runs = args.starts * max(1, len(args.shift)) * max(1, len(args.scale))
-    return max(128, min(largest, -(-runs // 16)))
 
 
 def _param(text: str) -> tuple[str, float]:

@@ -13,7 +13,11 @@ const atlas = { token: 0, job: null, shown: null, computedFor: null, send: null,
 
 const detail = (body) => (Array.isArray(body.detail) ? body.detail.map((d) => d.msg).join("; ") : body.detail);
 // What an atlas depends on in a state (not x0: every start of the curve is in it).
-const atlasKey = (s) => JSON.stringify([s.robot, s.robot_parameters, s.augmentation, s.augmentation_parameters, s.gamma, s.mode, s.tolerance, s.task, s.path, s.algorithms, s.algorithm_parameters]);
+// (posture's rest is left out: an atlas pulls each run toward its own start)
+const atlasKey = (s) => {
+  const { rest, ...parameters } = s.algorithm_parameters || {};
+  return JSON.stringify([s.robot, s.robot_parameters, s.augmentation, s.augmentation_parameters, s.gamma, s.mode, s.tolerance, s.task, s.path, s.algorithms, parameters]);
+};
 
 function say(text, error = false) {
   const status = $("#atlas-status");

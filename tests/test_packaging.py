@@ -136,6 +136,21 @@ def test_every_package_folder_is_in_the_wheel():
     assert "jik.engine.arm_data" in setup_py.packages()
 
 
+def test_a_checkout_imports_from_its_root_without_an_install():
+    """A notebook started at the checkout's root (this jik/ first on sys.path, no editable
+    install's finder): jik.engine and jik.app are the checkout's engine/ and app/."""
+    code = (
+        "import sys; sys.meta_path[:] = [f for f in sys.meta_path if 'editable' not in "
+        "getattr(f, '__module__', '') + getattr(f, '__name__', '')]; "
+        "import jik.engine, jik.app.compute.schemas; print(jik.engine.__file__)"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=120
+    )
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert Path(out.stdout.strip()) == ROOT / "engine" / "__init__.py"
+
+
 def test_the_source_tree_holds_no_symlinks():
     """A checkout without symlinks (Windows' default, core.symlinks=false) writes a link as a
     small text file: the package must not depend on one."""

@@ -255,8 +255,9 @@ class AtlasJobs:
                 progress=ProgressCallbacks(on_advance=progress, is_cancelled=job.cancel.is_set),
                 keep_leg_ends=job.leg_ends,
             )
-            arc = job.plan.manifolds[0].arc if job.plan.manifolds else ()
-            job.result = result_document(res, arc, job.leg_ends)  # (no arc: explicit starts)
+            curve = job.plan.manifolds[0] if job.plan.manifolds else None  # (explicit starts)
+            arc, period = ((), None) if curve is None else (curve.arc, curve.period)
+            job.result = result_document(res, arc, job.leg_ends, period)
             self._end(job, "done")
         except RunCancelled:
             self._end(job, "cancelled")

@@ -146,8 +146,11 @@ def plan_task(req: str, limits: AtlasLimits):
         return None, (str(exc), exc.field)
 
 
-def result_document(res: AtlasResult, arc, leg_ends: bool) -> dict[str, Any]:
-    """The fields of :class:`jik.app.compute.atlas_schemas.AtlasResult`."""
+def result_document(
+    res: AtlasResult, arc, leg_ends: bool, period: float | None = None
+) -> dict[str, Any]:
+    """The fields of :class:`jik.app.compute.atlas_schemas.AtlasResult` (``period``: of the
+    starts' closed self-motion curve, else None)."""
     algs = res.algorithms
     failures: dict[str, dict[str, str]] = {a: {} for a in algs}
     for (a, j, i), why in res.failures.items():
@@ -158,6 +161,7 @@ def result_document(res: AtlasResult, arc, leg_ends: bool) -> dict[str, Any]:
         "arc": list(arc),
         "paths": res.paths.tolist(),
         "parameter": [] if res.parameter is None else res.parameter.tolist(),
+        "period": None if period is None else float(period),
         "starts": res.starts.tolist(),
         "drift": {a: nullable(res.drift[k]) for k, a in enumerate(algs)},
         "success": {a: res.success[k].tolist() for k, a in enumerate(algs)},

@@ -157,6 +157,12 @@ class AtlasResult(BaseModel):
     arc: list[float] = Field(description="the arc lengths the starts span (none: explicit starts)")
     paths: list[list[list[float]]] = Field(description="(P, L, r): the family's paths")
     parameter: list[float] = Field(description="(N,): arc length s of each start")
+    period: float | None = Field(
+        None,
+        description="the length of one turn of the starts' self-motion curve when it closes on "
+        "itself (the arc is then one turn and the starts cover it once); null for an open curve "
+        "or explicit starts",
+    )
     starts: list[list[list[float]]] = Field(description="(P, N, p)")
     drift: dict[str, list[list[list[MaybeFloat]]]] = Field(
         description="per algorithm (P, N, cycles): ||x after cycle c - x0||; null after a failure"

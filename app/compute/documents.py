@@ -52,6 +52,7 @@ def solve_document(setup, res) -> dict[str, Any]:
     return {
         "robot": setup.robot.model_dump(mode="json"),
         "algorithm": setup.inverse.name,
+        "algorithm_parameters": setup.parameters,
         "augmentation": (
             None if setup.augmentation is None else setup.augmentation.model_dump(mode="json")
         ),

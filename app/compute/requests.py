@@ -31,7 +31,7 @@ from .documents import (
 )
 from .exceptions import RequestError
 from .robot_requests import check_configuration, check_task_point, request_robot
-from .schemas.algorithms import used
+from .schemas.algorithms import parameters_of, used
 
 _R = TypeVar("_R")
 
@@ -50,6 +50,8 @@ class _Setup:
     tolerance: float
     max_iterations: int | None
     extra: dict = field(default_factory=dict)
+    #: The inverse's parameters, defaults filled in (:func:`parameters_of`).
+    parameters: dict = field(default_factory=dict)
 
 
 def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
@@ -68,7 +70,16 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
         raise RequestError("gamma", why)
     robot_used, aug_used = built.robot, built.augmentation
     return _Setup(
-        spec, kin, inverse, robot_used, aug_used, mode, gamma, req.tolerance, req.max_iterations
+        spec,
+        kin,
+        inverse,
+        robot_used,
+        aug_used,
+        mode,
+        gamma,
+        req.tolerance,
+        req.max_iterations,
+        parameters=parameters_of(inverse),
     )
 
 
@@ -112,8 +123,15 @@ def engine_error(exc: JikError) -> RequestError:
 
 
 def batch_key(req: S.SolveRequest) -> str:
-    """Requests with equal keys can share one batched engine call."""
-    exclude = {"x0", "target"} | ({"augmentation"} if req.algorithm == "pseudoinverse" else set())
+    """Requests with equal keys can share one batched engine call: their x0 apart, except
+    for a posture inverse without a rest, whose rest may be the run's start."""
+    rest = req.algorithm_parameters is not None and req.algorithm_parameters.rest is not None
+    own_start = req.algorithm == "posture" and not rest
+    exclude = (
+        {"target"}
+        | (set() if own_start else {"x0"})
+        | ({"augmentation"} if req.algorithm == "pseudoinverse" else set())
+    )
     return req.model_dump_json(exclude=exclude)
 
 
@@ -220,6 +238,7 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
     return S.RepeatabilityResponse(
         robot=setup.robot,
         algorithm=setup.inverse.name,
+        algorithm_parameters=parameters_of(setup.inverse),
         augmentation=setup.augmentation,
         mode=setup.mode,
         gamma=setup.gamma,

@@ -100,6 +100,7 @@ def _functional_info(fv) -> S.FunctionalInfo:
         n_points=int(fv.n_points),
         n_singular=int(np.asarray(fv.singular_points).shape[0]),
         min_abs_dh_k=nullable(getattr(fv, "min_abs_dh_k", float("nan"))),
+        divergent=bool(getattr(fv, "divergent", False)),
     )
 
 
@@ -108,7 +109,10 @@ def _functionals(kin, amap, region, fixed, nodes) -> tuple[dict, list[str]]:
     out: dict[str, S.FunctionalInfo | None] = {}
     for label, fn in (("e1", error_functional_e1), ("e2", error_functional_e2)):
         try:
-            out[label] = _functional_info(fn(kin, amap, region, nodes=nodes, fixed=fixed))
+            value = fn(kin, amap, region, nodes=nodes, fixed=fixed)
+            out[label] = _functional_info(value)
+            if value.divergent:
+                notes.append(f"{label.upper()} diverges: dh K vanishes inside the region")
         except JikError as exc:
             out[label] = None
             notes.append(f"{label.upper()} not evaluated: {exc}")

@@ -4,24 +4,27 @@
 A state chooses one to five algorithms (``algorithms``, default the paper's two, eqs. (8) and
 (11)) and holds the scalar parameters of the chosen ones (``algorithm_parameters``: ``damping``
 and ``damping_threshold`` of damped least squares, ``gain`` of the posture inverse), with their
-ranges from the engine's :class:`~jik.engine.parameters.Parameter`. The posture inverse's rest
-is the robot's home, else the state's start x0; the weighted inverse takes the robot's joint
-limits (else its configuration box), and is refused naming ``algorithms`` for a robot with
-neither. :data:`STYLES` gives each algorithm one colour, line style, marker, label and 3D copy,
-used by the scene, every plot, the drift panel and the atlas. :func:`cache_key` says what one
+ranges from the engine's :class:`~jik.engine.parameters.Parameter`, and the posture inverse's
+rest x_rest (``rest``, p numbers within the robot's :func:`configuration_box`; without it, the
+REST API's default, :func:`~jik.app.compute.schemas.algorithms.default_rest`: the robot's home,
+else the state's start x0). The weighted inverse takes the robot's joint limits (else its
+configuration box), and is refused naming ``algorithms`` for a robot with neither.
+:data:`STYLES` gives each algorithm one colour, line style, marker, label and 3D copy, used by
+the scene, every plot, the drift panel and the atlas. :func:`cache_key` says what one
 algorithm's run depends on (its own parameters included).
 """
 
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
 from ...engine.exceptions import InvalidInputError
 from ...engine.registry import ALGORITHMS as REGISTRY
-from ..compute.schemas.algorithms import Algorithm
+from ..compute.schemas.algorithms import Algorithm, default_rest
 
 
 class ChosenState(Protocol):
@@ -31,7 +34,7 @@ class ChosenState(Protocol):
     @property
     def algorithms(self) -> Sequence[str]: ...
     @property
-    def algorithm_parameters(self) -> Mapping[str, float]: ...
+    def algorithm_parameters(self) -> Mapping[str, Any]: ...
     @property
     def x0(self) -> Sequence[float]: ...
     @property
@@ -44,6 +47,11 @@ class ChosenState(Protocol):
 CHOICES = tuple(REGISTRY)
 #: The algorithms of a new state: the paper's pseudoinverse (8) and extended Jacobian (11).
 DEFAULT_ALGORITHMS: tuple[Algorithm, ...] = ("pseudoinverse", "extended")
+#: The vector parameters a state sets, by the algorithm that takes them (the weighted inverse's
+#: limits are the robot's).
+VECTORS = {"rest": "posture"}
+#: The range of each joint variable of a robot without a configuration box (x0's sliders).
+DEFAULT_BOX = (-10.0, 10.0)
 
 
 @dataclass(frozen=True)
@@ -139,7 +147,8 @@ def scalar_parameters(algorithms) -> tuple:
 def checked(algorithms: tuple[str, ...], given: Mapping[str, Any]) -> dict[str, Any]:
     """The chosen algorithms in the catalogue's order and their scalar parameters (the given
     ones checked against the engine's ranges, the others at their defaults; parameters of
-    algorithms not chosen are dropped).
+    algorithms not chosen are dropped). A vector parameter (:data:`VECTORS`) is kept as given
+    when its algorithm is chosen: its check needs the robot (:func:`checked_rest`).
 
     Raises
     ------
@@ -150,7 +159,7 @@ def checked(algorithms: tuple[str, ...], given: Mapping[str, Any]) -> dict[str, 
     twice = sorted({a for a in algorithms if algorithms.count(a) > 1})
     if twice:
         raise InvalidInputError(f"algorithms: {twice} chosen twice; choose each once", "algorithms")
-    known = {p.name for p in scalar_parameters(CHOICES)}
+    known = {p.name for p in scalar_parameters(CHOICES)} | set(VECTORS)
     for name in given:
         if name not in known:
             raise InvalidInputError(
@@ -166,16 +175,99 @@ def checked(algorithms: tuple[str, ...], given: Mapping[str, Any]) -> dict[str, 
         except InvalidInputError as exc:
             field = f"algorithm_parameters.{p.name}"
             raise InvalidInputError(f"{field}: {exc}", field) from None
+    values.update({k: given[k] for k, a in VECTORS.items() if a in ordered and k in given})
     return {"algorithms": ordered, "algorithm_parameters": values}
+
+
+def scalar(state: ChosenState, name: str) -> float:
+    """The scalar parameter ``name`` of a chosen algorithm (0 when none is chosen that has it)."""
+    value = state.algorithm_parameters.get(name, 0.0)
+    if not isinstance(value, int | float):
+        raise TypeError(f"algorithm_parameters.{name} is not a number: {value!r}")
+    return float(value)
+
+
+def configuration_box(spec) -> tuple[tuple[float, float], ...]:
+    """The range of each joint variable on the sliders of x0 and of the posture inverse's rest:
+    the robot's ``x_range`` (an arm's joint limits), else :data:`DEFAULT_BOX`."""
+    if spec.x_range:
+        return tuple((float(lo), float(hi)) for lo, hi in spec.x_range)
+    return (DEFAULT_BOX,) * len(spec.variable_names)
+
+
+def checked_rest(value, spec, kin, x0) -> tuple[float, ...] | None:
+    """The posture inverse's rest x_rest as set (``algorithm_parameters.rest``), checked: p
+    finite numbers within the robot's :func:`configuration_box`; None when it is the default in
+    force (:func:`~jik.app.compute.schemas.algorithms.default_rest`: the robot's home, else the
+    start ``x0``), which the state then follows, as it does without a rest.
+
+    Raises
+    ------
+    InvalidInputError
+        ``algorithm_parameters.rest`` for a wrong length, ``algorithm_parameters.rest.<i>``
+        for a coordinate not finite or outside the box.
+    """
+    field, names = "algorithm_parameters.rest", spec.variable_names
+    if not isinstance(value, tuple | list):
+        raise InvalidInputError(
+            f"{field}: give {len(names)} numbers, one per joint variable ({', '.join(names)})",
+            field,
+        )
+    if len(value) != len(names):
+        raise InvalidInputError(
+            f"{field}: give {len(names)} entries, one per joint variable "
+            f"({', '.join(names)}), got {len(value)}",
+            field,
+        )
+    box = configuration_box(spec)
+    limits = getattr(kin, "limits", None)
+    where = (
+        f"the joint limits of the {spec.title}"
+        if limits is not None and tuple(map(tuple, limits)) == box
+        else "the range of x0's sliders"
+    )
+    for i, v in enumerate(value):
+        if not math.isfinite(v):
+            raise InvalidInputError(f"{field}.{i}: Input should be a finite number", f"{field}.{i}")
+        lo, hi = box[i]
+        if not lo <= v <= hi:
+            raise InvalidInputError(
+                f"{field}.{i}: rest {names[i]} must be in [{lo:g}, {hi:g}] ({where}), got {v:g}",
+                f"{field}.{i}",
+            )
+    rest = tuple(float(v) for v in value)
+    return None if list(rest) == default_rest(kin, x0)[0] else rest
+
+
+def posture_rest(state: ChosenState, kin) -> tuple[list[float], str]:
+    """The posture inverse's rest in force and what it is: "set" (the state's), else the
+    default's "home" or "x0" (:func:`~jik.app.compute.schemas.algorithms.default_rest`)."""
+    given = state.algorithm_parameters.get("rest")
+    if given is not None:
+        return [float(v) for v in given], "set"
+    return default_rest(kin, state.x0)
+
+
+def rest_words(state: ChosenState, kin) -> str:
+    """The rest in force in words, for the verdict and the exports: ``x_rest = the robot's
+    home (0, -0.785, ...)``, ``x_rest = x0 (...)`` (set so, or the default), or the numbers
+    set."""
+    rest, source = posture_rest(state, kin)
+    shown = "(" + ", ".join(f"{v:.4g}" for v in rest) + ")"
+    if source == "home":
+        return f"x_rest = the robot's home {shown}"
+    if source == "x0" or rest == [float(v) for v in state.x0]:
+        return f"x_rest = x0 {shown}"
+    return f"x_rest = {shown} (set)"
 
 
 def inverse_parameters(state: ChosenState, algorithm: str, kin) -> dict[str, Any]:
     """What the engine's ``make_inverse`` takes for ``algorithm``: its scalars, and the posture
-    inverse's rest at the state's x0 when the robot has no home."""
+    inverse's rest in force (:func:`posture_rest`)."""
     names = {p.name for p in REGISTRY[algorithm].parameters}
     out: dict[str, Any] = {k: v for k, v in state.algorithm_parameters.items() if k in names}
-    if algorithm == "posture" and getattr(kin, "home", None) is None:
-        out["rest"] = list(state.x0)
+    if algorithm == "posture":
+        out["rest"] = posture_rest(state, kin)[0]
     return out
 
 
@@ -202,6 +294,7 @@ def cache_key(state: ChosenState, algorithm: str) -> str:
     d.pop("cspace_axes")  # (what a panel shows, not what is solved)
     d.pop("algorithms")
     names = {p.name for p in REGISTRY[algorithm].parameters}
+    names |= {k for k, a in VECTORS.items() if a == algorithm}
     d["algorithm_parameters"] = {k: v for k, v in d["algorithm_parameters"].items() if k in names}
     d["algorithm"] = algorithm
     if algorithm != "extended":

@@ -47,7 +47,8 @@ def atlas_request(
         )
     kin, _ = kinematics_and_map(state)
     home = np.asarray(kin.forward(np.asarray(state.x0, dtype=float)), dtype=float)
-    # The atlas's posture inverse, without rest, pulls each run toward its own start.
+    # The atlas's posture inverse, without rest, pulls each run toward its own start (the
+    # state's rest is for the runs from x0; the heatmap's title says so).
     params = {
         k: v
         for a in state.algorithms
@@ -138,6 +139,8 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
     joint = UNITS.get(request.robot.name, ((), ()))[0]
     unit = norm_unit(joint)
     x_title, hover, at_x0 = f"arc length s of the start {unit}", "s = %{x:.3f}", 0.0
+    if result.get("period") is not None:  # (a closed curve: the starts cover one turn)
+        x_title = f"arc length s of the start {unit}, one turn of {result['period']:.4g}"
     if request.start_points:  # (p - r > 1: starts by number, the first x0, see manifold_starts)
         s = np.arange(1.0, len(request.start_points) + 1)
         x_title, hover, at_x0 = "start, farther from x0 to the right", "start %{x}", 1.0
@@ -208,6 +211,7 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
             if a == "extended" and request.augmentation is not None
             else ""
         )
+        + (f"<br>{_rest_used(request)}" if a == "posture" else "")
         for a in algorithms
     ]
     outside = outside_counts(result)
@@ -261,6 +265,14 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
         margin=dict(l=110, r=20, t=84, b=56),
         **layout,
     )
+
+
+def _rest_used(request: AtlasRequest) -> str:
+    """The posture inverse's rest in an atlas: the request's, else each run's own start."""
+    rest = request.algorithm_parameters.rest if request.algorithm_parameters else None
+    if rest is None:
+        return "x_rest = each run's start"
+    return "x_rest = (" + ", ".join(f"{v:.4g}" for v in rest) + ")"
 
 
 def outside_counts(result: dict[str, Any]) -> dict[str, int]:

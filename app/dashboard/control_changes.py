@@ -2,7 +2,9 @@
 
 :func:`expand` turns a patch keyed by control keys (``{"x0.1": 0.4}``,
 ``{"robot_parameters.l": 1.2}``, ``{"path": "1, 1; 1, 2"}``) into a patch of the state's fields
-(:func:`jik.app.dashboard.model.updated_state` applies it); :func:`path_text` and
+(:func:`jik.app.dashboard.model.updated_state` applies it), one coordinate of the posture
+inverse's rest (``{"algorithm_parameters.rest.1": 0.4}``) or the rest set to the start
+(``{"algorithm_parameters.rest": "x0"}``) included; :func:`path_text` and
 :func:`parse_path_text` write a closed path as text and read it back (:data:`PATH_FORMAT`), the
 one text format of the path box on the page and in the scene.
 """
@@ -14,6 +16,8 @@ from collections.abc import Mapping
 from typing import Any
 
 from ...engine.exceptions import InvalidInputError
+from .algorithms import posture_rest
+from .robots import state_kinematics
 
 #: How a closed path is written in a text box: points separated by ';', coordinates by ','.
 PATH_FORMAT = "y1, y2; y1, y2; ..."
@@ -24,12 +28,24 @@ DISCRETE_GAMMA_ON_SWITCH = 1.0
 def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
     """A patch of control keys as a patch of the state's fields: ``{"x0.1": v}`` sets one
     coordinate of x0, ``{"robot_parameters.l": v}`` one parameter, ``{"path": "1, 1; 1, 2"}``
-    the path from its text (:data:`PATH_FORMAT`). Switching to discrete mode without a gamma
-    takes gamma down to :data:`DISCRETE_GAMMA_ON_SWITCH` when it is above."""
+    the path from its text (:data:`PATH_FORMAT`), ``{"algorithm_parameters.rest.1": v}`` one
+    coordinate of the posture inverse's rest in force, ``{"algorithm_parameters.rest": "x0"}``
+    the rest at the start x0 (the patch's, else the state's). Switching to discrete mode
+    without a gamma takes gamma down to :data:`DISCRETE_GAMMA_ON_SWITCH` when it is above."""
     out: dict[str, Any] = {}
     for key, value in patch.items():
         head, _, rest = key.partition(".")
-        if not rest:
+        if head == "algorithm_parameters" and rest.startswith("rest."):
+            params = out.setdefault(head, {})
+            if not isinstance(params.get("rest"), list | tuple):
+                params["rest"] = posture_rest(state, state_kinematics(state))[0]
+            params["rest"] = list(params["rest"])
+            index = rest.removeprefix("rest.")
+            if not index.isdigit() or int(index) >= len(params["rest"]):
+                n = len(params["rest"])
+                raise InvalidInputError(f"{key}: rest has {n} coordinates", key)
+            params["rest"][int(index)] = value
+        elif not rest:
             size = len(state.target) if "robot" not in patch else None
             out[key] = (
                 parse_path_text(value, size) if key == "path" and isinstance(value, str) else value
@@ -43,6 +59,8 @@ def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
             vector[int(rest)] = value
         else:
             raise InvalidInputError(f"unknown dashboard control {key!r}", key)
+    if out.get("algorithm_parameters", {}).get("rest") == "x0":
+        out["algorithm_parameters"]["rest"] = list(out.get("x0", state.x0))
     if out.get("mode") == "discrete" and "gamma" not in out and state.mode != "discrete":
         out["gamma"] = min(state.gamma, DISCRETE_GAMMA_ON_SWITCH)
     return out

@@ -10,7 +10,9 @@ mode), steps and options. :func:`control_values` gives each control's value as s
 A control's ``key`` is a dotted path into the state: ``gamma``, ``x0.1`` (one coordinate of the
 start x0), ``robot_parameters.l``, ``robot_parameters.q0`` (a vector parameter, edited whole),
 ``augmentation_parameters.a``, ``algorithm_parameters.gain`` (a parameter of a chosen
-algorithm), ``algorithms`` (the chosen ones, a ``checks`` control), ``path`` (edited as text).
+algorithm), ``algorithm_parameters.rest.1`` (one coordinate of the posture inverse's rest, shown
+while it is chosen), ``algorithms`` (the chosen ones, a ``checks`` control), ``path`` (edited as
+text).
 """
 
 from __future__ import annotations
@@ -22,10 +24,10 @@ from typing import Any
 from ...engine.arms import ARMS
 from ...engine.registry import ROBOTS
 from ...engine.solve_rules import DISCRETE_GAMMA_BOUND, MAX_ITERATIONS, MAX_STEPS
-from .algorithms import STYLES, scalar_parameters
+from .algorithms import STYLES, configuration_box, posture_rest, scalar_parameters
 from .control_changes import PATH_FORMAT, path_text
 from .glossary import SYMBOLS
-from .robots import state_spec
+from .robots import state_kinematics, state_spec
 
 #: gamma's resolution: the page's log-scale slider and the scene's slider both land on it.
 GAMMA_STEP = 0.001
@@ -152,18 +154,8 @@ def controls(state) -> list[Control]:
             )
         )
         for name, preset in v.presets.items():
-            shown = ", ".join(f"{t:.2f}" for t in preset)
-            out.append(
-                Control(
-                    f"robot_parameters.{v.name}",
-                    f"{v.name} = {name} ({shown})",
-                    "preset",
-                    "algorithm",
-                    f"set {v.name} to the paper's pose {name}",
-                    value=[float(t) for t in preset],
-                    id=f"ctl-preset-{v.name}-{name}",
-                )
-            )
+            text = f"set {v.name} to the paper's pose {name}"
+            out.append(preset_button(f"robot_parameters.{v.name}", name, preset, text, True))
     out.append(
         Control(
             "augmentation",
@@ -181,6 +173,8 @@ def controls(state) -> list[Control]:
     )
     for head, parameters in groups:
         out += _sliders(head, parameters)
+        if head == "algorithm_parameters" and "posture" in state.algorithms:
+            out += rest_controls(state, spec)
         if head == "augmentation_parameters":
             out.append(
                 Control(
@@ -193,20 +187,9 @@ def controls(state) -> list[Control]:
                     inline=True,
                 )
             )
-    for i, name in enumerate(spec.variable_names):
-        lo, hi = spec.x_range[i] if spec.x_range else (-10.0, 10.0)
-        out.append(
-            Control(
-                f"x0.{i}",
-                f"x0: {name}",
-                "slider",
-                "start",
-                f"start configuration, coordinate {name}. {SYMBOLS['x0']}",
-                minimum=lo,
-                maximum=hi,
-                step=(hi - lo) / X0_STEPS,
-            )
-        )
+    out += joint_sliders(
+        "x0", "start", spec, "start configuration, coordinate {}. " + SYMBOLS["x0"]
+    )
     if len(spec.variable_names) > 3:
         names = spec.variable_names
         out.append(
@@ -270,6 +253,51 @@ def controls(state) -> list[Control]:
     return out
 
 
+def rest_controls(state, spec) -> list[Control]:
+    """The posture inverse's rest x_rest: a slider per joint variable (as x0's), and buttons
+    setting it to the start x0 and, for a robot with one, to its home (the default)."""
+    home, key = getattr(state_kinematics(state), "home", None), "algorithm_parameters.rest"
+    default = "the robot's home" if home is not None else "the start x0"
+    text = f"rest configuration, coordinate {{}} (default: {default}). {SYMBOLS['rest']}"
+    out = joint_sliders(key, "algorithm", spec, text)
+    out.append(preset_button(key, "x0", "x0", "set the rest to the start configuration x0"))
+    if home is not None:
+        shown = ", ".join(f"{t:.3g}" for t in home)
+        out.append(preset_button(key, "home", home, f"set the rest to the robot's home ({shown})"))
+    return out
+
+
+def preset_button(key: str, name: str, value, text: str, numbers: bool = False) -> Control:
+    """A button setting the control ``key`` (``robot_parameters.q0``) to ``value``, labelled
+    ``q0 = A`` (with the numbers if ``numbers``)."""
+    short = key.rpartition(".")[2]
+    shown = f" ({', '.join(f'{t:.2f}' for t in value)})" if numbers else ""
+    value = value if isinstance(value, str) else [float(t) for t in value]
+    label, button = f"{short} = {name}{shown}", f"ctl-preset-{short}-{name}"
+    return Control(key, label, "preset", "algorithm", text, value=value, id=button)
+
+
+def joint_sliders(key: str, group: str, spec, text: str) -> list[Control]:
+    """A slider per joint variable over its range in the robot's configuration box (an arm's
+    joint limits), keyed ``key.<i>`` and labelled ``x0: x1``, ``rest: x1``; ``text``: the help,
+    with ``{}`` for the variable's name."""
+    box = configuration_box(spec)
+    short = key.rpartition(".")[2]
+    return [
+        Control(
+            f"{key}.{i}",
+            f"{short}: {name}",
+            "slider",
+            group,
+            text.format(name),
+            minimum=lo,
+            maximum=hi,
+            step=(hi - lo) / X0_STEPS,
+        )
+        for i, (name, (lo, hi)) in enumerate(zip(spec.variable_names, box, strict=True))
+    ]
+
+
 def explained(name: str, description: str) -> str:
     """A parameter's description from the registry, with the paper's symbol explained."""
     return f"{description}. {SYMBOLS[name]}" if name in SYMBOLS else description
@@ -317,10 +345,14 @@ def control_values(state, spec: list[Control] | None = None) -> dict[str, Any]:
     :func:`controls` when the caller has them."""
     d = state.as_dict()
     values: dict[str, Any] = {}
+    rest: list[float] = []
     for c in controls(state) if spec is None else spec:
         if c.kind == "preset":
             continue
-        if c.key == "max_iterations":
+        if c.key.startswith("algorithm_parameters.rest."):
+            rest = rest or posture_rest(state, state_kinematics(state))[0]
+            values[c.key] = rest[int(c.key.rpartition(".")[2])]
+        elif c.key == "max_iterations":
             values[c.key] = max_iterations(state)
         elif c.key == "cspace_axes":
             values[c.key] = state.cspace_axes or "012"

@@ -1,5 +1,6 @@
 """A dashboard result exported: every point of both runs, as JSON or CSV, with the state that
-produced it, what the page says about it (the verdict), each run's drift and leg ends, the units
+produced it, what the page says about it (the verdict), each run's drift and leg ends (and the
+posture inverse's rest x_rest in force, with what it is: set, the home or x0), the units
 of its columns, the jik version and the time of the export; its file is named after the robot,
 the algorithms' settings (map h, mode), the generation and that time."""
 
@@ -15,6 +16,7 @@ from jik import __version__
 
 from ...engine.planar_chain import PlanarChain
 from ...engine.urdf import UrdfChain
+from .algorithms import posture_rest
 from .messages import h_change, to_json
 from .plotting import norm_unit, units
 from .robots import state_kinematics
@@ -97,6 +99,9 @@ def export_json(
         }
         if run.platform is not None:
             runs[a]["platform_final"] = run.platform[-1]
+        if a == "posture":
+            rest, source = posture_rest(result.state, state_kinematics(result.state))
+            runs[a].update(rest=rest, rest_from=source)
     return json.loads(
         to_json(
             {
@@ -120,7 +125,7 @@ def csv_context(result: DashboardResult, when: datetime | None = None) -> list[s
     """The lines at the top of the CSV, each starting with '#' (``pandas.read_csv(...,
     comment="#")`` skips them): the jik version and the export's time, the generation and
     state, the columns' units, the verdict, and per algorithm its message, drift after each
-    cycle, h's change and leg ends."""
+    cycle, h's change and leg ends (the posture inverse's rest x_rest in force too)."""
     made = provenance(when)
     u = export_units(result)
     columns = {**u["x"], **u["y"], "theta": u["theta"], "error": u["error"], "h": u["h"]}
@@ -131,6 +136,7 @@ def csv_context(result: DashboardResult, when: datetime | None = None) -> list[s
         "# units: " + "; ".join(f"{k} [{v}]" for k, v in columns.items()),
     ]
     lines += [f"# verdict: {v['text']}" for v in verdict(result)]
+    kin = state_kinematics(result.state)
     for a, run in result.runs.items():
         ends = "; ".join(", ".join(f"{v:.6g}" for v in e) for e in run.leg_end)
         lines.append(f"# {a}: success {str(run.success).lower()}; {run.message}")
@@ -138,6 +144,9 @@ def csv_context(result: DashboardResult, when: datetime | None = None) -> list[s
         dh = h_change(run.h)
         lines.append(f"# {a} h changed by: {'' if dh is None else f'{dh:.6g}'}")
         lines.append(f"# {a} leg ends (x after each leg): {ends}")
+        if a == "posture":
+            rest, source = posture_rest(result.state, kin)
+            lines.append(f"# {a} rest x_rest ({source}): {', '.join(repr(v) for v in rest)}")
     return lines
 
 

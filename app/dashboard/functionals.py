@@ -142,6 +142,8 @@ def error_functionals(
             value = fn(grid["kinematics"], grid["map"], region, nodes=nodes, fixed=fixed)
             out[key] = value.value if np.isfinite(value.value) else None
             out[f"{key}_singular_points"] = int(value.singular_points.shape[0])
+            if value.divergent:
+                out[f"{key}_divergent"] = True
         except (JikError, ValueError, ArithmeticError) as exc:
             out[key] = None
             out[f"{key}_error"] = str(exc)

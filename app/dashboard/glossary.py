@@ -19,6 +19,9 @@ SYMBOLS = {
     "l": "l: the arm length of Manipulator 2 [m]",
     "T": "T: the control horizon of the unicycle [s]",
     "q0": "q0: the unicycle's initial pose (q1, q2 [m], q3 [rad]); A and B are the paper's",
+    "rest": "x_rest: the rest configuration of the posture inverse J^P# dy + (I − J^P# J) "
+    "k (x_rest − x) ‖dy‖ (Liégeois 1977): inside the self-motion the joints are pulled toward it "
+    "at gain k",
     "x0": "x0: the start configuration (for the unicycle, the control parameters λ10, λ11, "
     "λ20, λ21 of eq. (41): u1 = λ10 + λ11 sin t, u2 = λ20 + λ21 sin t)",
 }

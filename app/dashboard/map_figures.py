@@ -151,7 +151,11 @@ def augmenting_title(
         else:
             sub.append(
                 ", ".join(
-                    f"{k} = {v:.4g}" if v is not None else f"{k} undefined"
+                    f"{k} = {v:.4g}"
+                    if v is not None
+                    else f"{k} = ∞ (dh K = 0 inside)"
+                    if functionals.get(f"{k}_divergent")
+                    else f"{k} undefined"
                     for k, v in values.items()
                 )
                 + f" on {where}"

@@ -31,7 +31,7 @@ from ..compute.schemas import (
 )
 from ..compute.schemas.algorithms import Algorithm
 from ..compute.schemas.wording import refusal
-from .algorithms import CHOICES, DEFAULT_ALGORITHMS, check_inverses, checked
+from .algorithms import CHOICES, DEFAULT_ALGORITHMS, check_inverses, checked, checked_rest
 from .algorithms import COLORS as COLORS  # (re-exported: one table, there)
 from .algorithms import DASH as DASH
 from .algorithms import LABELS as LABELS
@@ -51,6 +51,12 @@ ALGORITHMS = DEFAULT_ALGORITHMS
 DEFAULT_ROBOT = "manipulator2"
 
 Point = Annotated[tuple[Coordinate, ...], Field(min_length=1, max_length=MAX_DIMENSION)]
+#: An algorithm's parameter: a number, or a vector (the posture inverse's rest, checked with the
+#: robot: :func:`jik.app.dashboard.algorithms.checked_rest`).
+AlgorithmValue = (
+    Annotated[float, Field(strict=True)]
+    | Annotated[tuple[Annotated[float, Field(strict=True)], ...], Field(max_length=MAX_DIMENSION)]
+)
 
 
 class DashboardState(BaseModel):
@@ -88,12 +94,12 @@ class DashboardState(BaseModel):
         Annotated[int, Field(strict=True, ge=MIN_ITERATIONS, le=MAX_ITERATIONS_CAP), INTEGRAL]
         | None
     ) = None
-    #: The inverses run side by side, and the scalar parameters of those chosen
-    #: (:mod:`jik.app.dashboard.algorithms`).
+    #: The inverses run side by side, and the parameters of those chosen
+    #: (:mod:`jik.app.dashboard.algorithms`): numbers, and the posture inverse's ``rest``.
     algorithms: Annotated[tuple[Algorithm, ...], Field(min_length=1, max_length=len(CHOICES))] = (
         DEFAULT_ALGORITHMS
     )
-    algorithm_parameters: dict[str, Annotated[float, Field(strict=True)]] = {}
+    algorithm_parameters: dict[str, AlgorithmValue] = {}
 
     def as_dict(self) -> dict:
         """The state as JSON data (tuples as lists)."""
@@ -198,11 +204,14 @@ def updated_state(state: DashboardState, patch: Mapping[str, object]) -> Dashboa
             )
         if robot != state.robot and "robot_definition" not in patch:
             definition = None  # (another robot chosen: the definition was the other's)
-        # (the chosen algorithms stay: the new robot's defaults are for everything else)
+        # (the chosen algorithms and their numbers stay: the new robot's defaults are for
+        # everything else, the posture inverse's rest included)
         state = default_state(robot, definition).model_copy(
             update={
                 "algorithms": state.algorithms,
-                "algorithm_parameters": state.algorithm_parameters,
+                "algorithm_parameters": {
+                    k: v for k, v in state.algorithm_parameters.items() if k != "rest"
+                },
             }
         )
     # (control keys after a change of robot are the new robot's: {"robot": "unicycle",
@@ -261,6 +270,11 @@ def validate(data: Mapping[str, Any]) -> DashboardState:
     if (why := gamma_problem(state.gamma, state.mode)) is not None:
         raise InvalidInputError(f"gamma: {why}", "gamma")
     state = state.model_copy(update=checked(state.algorithms, state.algorithm_parameters))
+    if "rest" in state.algorithm_parameters:
+        chosen = dict(state.algorithm_parameters)
+        if (rest := checked_rest(chosen.pop("rest"), spec, kin, state.x0)) is not None:
+            chosen["rest"] = rest
+        state = state.model_copy(update={"algorithm_parameters": chosen})
     check_inverses(state, lambda a: state_inverse(state, a, kin))
     # The engine's default cap, set by its value, is the default (None): it follows the mode.
     default_cap = max_iterations(state.model_copy(update={"max_iterations": None}))
@@ -327,9 +341,25 @@ def _model(model: type[BaseModel], data: Mapping[str, Any], prefix: tuple[str, .
         return model.model_validate(data)
     except ValidationError as exc:
         error = exc.errors()[0]
-        loc = (*prefix, *(str(p) for p in error["loc"]))
-        name = ".".join(loc) or "state"
+        name = ".".join((*prefix, *error_location(data, error))) or "state"
         raise InvalidInputError(f"{name}: {refusal(error)}", name) from None
+
+
+def error_location(data: Any, error: Mapping[str, Any]) -> list[str]:
+    """The field of one of pydantic's errors in ``data``: the keys and indices of its location,
+    without the labels pydantic gives the members of a union (``algorithm_parameters.rest``,
+    not ``algorithm_parameters.rest.float``): a name that is not a key of the value it is
+    under (a missing field's excepted) or is under a value without fields."""
+    parts, node = [], data
+    for part in error["loc"]:
+        if isinstance(node, list | tuple) and isinstance(part, int):
+            node = node[part] if part < len(node) else None
+        elif isinstance(node, Mapping) and (part in node or error.get("type") == "missing"):
+            node = node.get(part)
+        elif isinstance(part, str):
+            continue
+        parts.append(str(part))
+    return parts
 
 
 def _registered(check, name: str):

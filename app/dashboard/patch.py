@@ -14,16 +14,26 @@ from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, ValidationError,
 from ...engine.exceptions import InvalidInputError
 from ...engine.registry import ROBOTS
 from ...engine.repeatability import MAX_PATH_POINTS
-from ..compute.schemas import AUGMENTATION_MODELS, USER_AUGMENTATION_MODELS, Coordinate
+from ..compute.schemas import (
+    AUGMENTATION_MODELS,
+    MAX_DIMENSION,
+    USER_AUGMENTATION_MODELS,
+    Coordinate,
+)
 from ..compute.schemas.wording import refusal
-from .model import DashboardState, Point
+from .model import DashboardState, Point, error_location
 from .robots import USER_KINDS
 
 #: Control keys a patch may hold besides the state's fields (:func:`.control_changes.expand`), and
-#: their values: one coordinate of ``x0`` or ``target``, one parameter of the robot (a number
-#: or a vector) or of the map.
+#: their values: one coordinate of ``x0``, ``target`` or the posture inverse's rest, one
+#: parameter of the robot (a number or a vector), of the map or of an algorithm, the rest whole
+#: or at the start ("x0"). (The first pattern a key matches gives its type.)
 CONTROL_KEYS: dict[str, Any] = {
-    r"^(?:x0|target)\.[0-9]+$": Coordinate,
+    r"^(?:x0|target|algorithm_parameters\.rest)\.[0-9]+$": Coordinate,
+    r"^algorithm_parameters\.rest$": Annotated[
+        tuple[Annotated[float, Field(strict=True)], ...], Field(max_length=MAX_DIMENSION)
+    ]
+    | Literal["x0"],
     r"^robot_parameters\.[A-Za-z_][A-Za-z0-9_]*$": Annotated[float, Field(strict=True)] | Point,
     r"^augmentation_parameters\.[A-Za-z_][A-Za-z0-9_]*$": Annotated[float, Field(strict=True)],
     r"^algorithm_parameters\.[A-Za-z_][A-Za-z0-9_]*$": Annotated[float, Field(strict=True)],
@@ -77,18 +87,13 @@ def parse_patch(body: Any) -> dict[str, Any]:
     ------
     InvalidInputError
         Naming the field: the first the patch's types refuse (a member of a union, labelled by
-        its type in pydantic's location, is left out of the name).
+        its type in pydantic's location, is left out of the name: :func:`error_location`).
     """
     try:
         return patch_of(StatePatch.model_validate(body))
     except ValidationError as exc:
         error = exc.errors()[0]
-        field = (
-            ".".join(
-                str(p) for p in error["loc"] if isinstance(p, str) and "[" not in p and p != "str"
-            )
-            or "body"
-        )
+        field = ".".join(error_location(body, error)) or "body"
         raise InvalidInputError(f"{field}: {refusal(error)}", field) from None
 
 

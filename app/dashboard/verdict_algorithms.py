@@ -1,5 +1,6 @@
 """The verdict's sentences about the practical inverses beside the paper's two: how far the
-posture inverse's null-space pull (Liegeois 1977) brings the drift of the pseudoinverse (8) down,
+posture inverse's null-space pull (Liegeois 1977) toward its rest x_rest (named with its
+numbers) brings the drift of the pseudoinverse (8) down,
 and that it does not reach the extended Jacobian's repeatability (11); the task error damped
 least squares is left with where it damps (it is not a right inverse, J J# != I); whether the
 weighted least-norm inverse (Chan and Dubey 1995) kept every joint within its limits.
@@ -10,8 +11,9 @@ from __future__ import annotations
 import numpy as np
 
 from ...engine.repeatability import REPEATABLE_DRIFT
+from .algorithms import rest_words, scalar
 from .joint_limits import state_limits
-from .robots import state_inverse
+from .robots import state_inverse, state_kinematics
 from .runs import AlgorithmRun, DashboardResult
 
 #: The algorithms' names in the verdict's sentences.
@@ -40,11 +42,12 @@ def leg_end_errors(run: AlgorithmRun) -> np.ndarray:
 def _posture(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
     runs, state = result.runs, result.state
     run = runs["posture"]
-    gain = float(state.algorithm_parameters.get("gain", 0.0))
+    gain = scalar(state, "gain")
     if state.task != "path" or not len(run.drift):
         return []
     n, d = len(run.drift), float(run.drift[-1])
-    head = f"{NAMES['posture']}, gain k = {g(gain)}: after {n} cycle{'s' if n > 1 else ''}"
+    rest = rest_words(state, state_kinematics(state))
+    head = f"{NAMES['posture']}, gain k = {g(gain)}, {rest}: after {n} cycle{'s' if n > 1 else ''}"
     if gain == 0:
         return [(f"{head} it is the pseudoinverse (k = 0), drift {g(d)} {unit}.", "why")]
     parts = []
@@ -74,8 +77,8 @@ def _posture(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
 def _damped(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
     runs, state = result.runs, result.state
     run = runs["damped"]
-    lam = float(state.algorithm_parameters.get("damping", 0.0))
-    eps = float(state.algorithm_parameters.get("damping_threshold", 0.0))
+    lam = scalar(state, "damping")
+    eps = scalar(state, "damping_threshold")
     ends = leg_end_errors(run)
     if not len(ends):
         return []

@@ -14,7 +14,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ..augmentations import PaperCubic
-from ..functionals import error_functional_e2
+from ..functionals import error_functional_e1, error_functional_e2
 from ..inverses import ExtendedInverse, Pseudoinverse
 from ..kinematics import Manipulator2
 from ..progress import ProgressCallbacks
@@ -50,6 +50,10 @@ def run(progress: Callable[[float], None] | None = None, symbolic: bool = True) 
     report(0.4)
     cubic = error_functional_e2(kin, PaperCubic(), MANIPULATOR2_REGION, nodes=NODES)
     ours = error_functional_e2(kin, res.augmenting_map, MANIPULATOR2_REGION, nodes=NODES)
+    e1 = {
+        name: error_functional_e1(kin, h, MANIPULATOR2_REGION, nodes=NODES)
+        for name, h in (("paper_cubic", PaperCubic()), ("e2_synthesized", res.augmenting_map))
+    }
     table = {
         "pseudoinverse": np.array(table1_rows(Pseudoinverse(kin))),
         "paper_cubic": np.array(table1_rows(ExtendedInverse(kin, PaperCubic()))),
@@ -62,6 +66,9 @@ def run(progress: Callable[[float], None] | None = None, symbolic: bool = True) 
     return {
         "region": {k: list(v) for k, v in MANIPULATOR2_REGION.items()},
         "E2": {"paper_cubic": cubic.value, "e2_synthesized": ours.value},
+        # E1 (13): null where it diverges (dh K = 0 inside the region, eq. (14))
+        "E1": {k: None if v.divergent else v.value for k, v in e1.items()},
+        "E1_divergent": {k: v.divergent for k, v in e1.items()},
         "polynomial": res.polynomial_coefficients(),
         "table1_extended": table["e2_synthesized"].tolist(),
         "polynomial_e2": res.polynomial_e2,
@@ -83,6 +90,12 @@ def run(progress: Callable[[float], None] | None = None, symbolic: bool = True) 
     }
 
 
+def _e1(result: dict, name: str) -> str:
+    """E1 of a map in the table's column: its value, or inf where it diverges."""
+    value = result["E1"][name]
+    return f"{'inf':>14}" if value is None else f"{value:>14.8f}"
+
+
 def format_text(result: dict) -> str:
     """Readable tables of :func:`run`'s result."""
     reg = ", ".join(f"{k} in [{a:g}, {b:.6g}]" for k, (a, b) in result["region"].items())
@@ -91,11 +104,12 @@ def format_text(result: dict) -> str:
         f"Manipulator 2 (l = 1), region {reg}, h = h(x2, x3); "
         f"synthesis {result['synthesis_seconds']:.3f} s",
         "",
-        f"{'augmenting map':<28} {'E2 (18)':>14}",
-        f"{'paper_cubic (38)':<28} {e2['paper_cubic']:>14.8f}",
-        f"{'e2_synthesized':<28} {e2['e2_synthesized']:>14.8f}",
+        f"{'augmenting map':<28} {'E2 (18)':>14} {'E1 (13)':>14}",
+        f"{'paper_cubic (38)':<28} {e2['paper_cubic']:>14.8f} {_e1(result, 'paper_cubic')}",
+        f"{'e2_synthesized':<28} {e2['e2_synthesized']:>14.8f} {_e1(result, 'e2_synthesized')}",
         f"{'cubic fit of e2_synthesized':<28} {result['polynomial_e2']:>14.8f}",
         f"{'h = const (dh = 0)':<28} {result['e2_zero_map']:>14.8f}",
+        "(E1 = inf: dh K vanishes inside the region, so the extended Jacobian is singular there)",
         "",
         f"convergence (reference degree {result['reference']['degree']}: "
         f"E2 = {result['reference']['e2']:.12f})",

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -118,3 +120,46 @@ def test_posture_rest_defaults_to_the_runs_start(api):
 
     assert legs({"gain": 1.0}) == legs({"gain": 1.0, "rest": x0})
     assert legs({"gain": 1.0}) != legs({"gain": 1.0, "rest": X0_M2})
+
+
+def test_batched_posture_runs_each_pull_toward_their_own_start():
+    """Micro-batched /solve requests share one inverse: posture requests without a rest (whose
+    rest is each one's x0 on Manipulator 2) batch only with equal starts, so each gets what it
+    gets alone (a batch of two gave the second the first's rest)."""
+    from jik.app.compute import schemas as S
+    from jik.app.compute.requests import batch_key, solve_batch
+
+    def req(x0, **params):
+        body = {"robot": {"name": "manipulator2"}, "algorithm": "posture", "x0": x0}
+        body |= {"target": [1.0, 1.5], "algorithm_parameters": params or None}
+        return S.SolveRequest.model_validate(body)
+
+    a, b = req([0.0, 0.0, 1.5707963]), req([0.3, 0.2, 1.2])
+    assert batch_key(a) != batch_key(b)
+    assert batch_key(req([0.0, 0.0, 1.5], rest=[0, 0, 1])) == batch_key(
+        req([0.3, 0.2, 1.2], rest=[0, 0, 1])
+    )
+    (alone,) = solve_batch([b])
+    assert alone.algorithm_parameters == {"gain": 1.0, "rest": [0.3, 0.2, 1.2]}
+
+
+@pytest.mark.parametrize(
+    ("algorithm", "params", "used"),
+    [
+        ("damped", {"damping": 0.2}, {"damping": 0.2, "damping_threshold": 0.0}),
+        ("posture", {"gain": 0.5}, {"gain": 0.5, "rest": X0_M2}),
+        ("weighted", None, {"limits": [[-3.0, 3.0], [-3.0, 3.0], [-math.pi, 2 * math.pi]]}),
+        ("pseudoinverse", None, {}),
+    ],
+)
+def test_a_response_says_which_parameters_the_inverse_used(api, algorithm, params, used):
+    """Defaults filled in: posture's rest (Manipulator 2 has no home: the run's x0), weighted's
+    limits (its configuration box), damped's threshold."""
+    body = solve_body(algorithm=algorithm, algorithm_parameters=params)
+    r = api.post("/solve", json=body)
+    assert r.status_code == 200, r.text
+    assert r.json()["algorithm_parameters"] == pytest.approx(used)
+    rep = {k: v for k, v in body.items() if k != "target"} | {"path": TABLE1_PATH, "cycles": 1}
+    r = api.post("/repeatability", json=rep)
+    assert r.status_code == 200, r.text
+    assert r.json()["algorithm_parameters"] == pytest.approx(used)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from pathlib import Path
@@ -304,7 +305,8 @@ def test_an_atlas_in_the_compute_pool_is_the_engines_atlas():
 def test_a_servers_atlas_is_cut_into_chunks_of_about_a_second(monkeypatch, seconds_per_run, chunk):
     """The chunk holds about a second of runs, timed on the plan's first runs (a unicycle run
     costs about 0.2 s, a Manipulator 2 run about a millisecond), at most the plan's own chunk
-    (2048): the compute workers serve requests between chunks, far within their time limit.
+    (by default a sixteenth of the atlas, at most 2048): the compute workers serve requests
+    between chunks, far within their time limit.
     (The runs' cost is simulated by a clock that each run advances.)"""
     from jik.app.compute import atlas_pool
 
@@ -316,8 +318,9 @@ def test_a_servers_atlas_is_cut_into_chunks_of_about_a_second(monkeypatch, secon
     monkeypatch.setattr(atlas_pool, "run_chunk", run_chunk)
     monkeypatch.setattr(atlas_pool, "perf_counter", lambda: now[0])
     plan = plan_request(AtlasRequest.model_validate(body(starts=3000)), AtlasLimits())
-    assert plan.chunk == 2048
-    assert atlas_pool.sized_chunks(plan).chunk == chunk
+    assert plan.chunk == 188  # (the default: 16 chunks, so that progress moves)
+    assert atlas_pool.sized_chunks(plan).chunk == min(chunk, 188)
+    assert atlas_pool.sized_chunks(dataclasses.replace(plan, chunk=2048)).chunk == chunk
 
 
 def test_a_posture_atlas_pulls_each_run_toward_its_own_start(client):
@@ -365,3 +368,9 @@ def test_a_session_atlas_of_a_urdf_robot_does_not_send_its_text_back(client):
     assert "<robot" not in response.text and "link name" not in response.text
     robot = response.json()["request"]["robot"]
     assert robot["urdf_bytes"] == len(text.encode()) and "urdf" not in robot
+    # Its continuous wrist closes the self-motion curve: the starts cover one turn, once.
+    result = done["result"]
+    period = result["period"]
+    assert period is not None and 6.0 < period < 7.0
+    assert result["arc"][1] - result["arc"][0] == pytest.approx(period)
+    assert all(0 <= s < period for s in result["parameter"]) and len(result["parameter"]) == 3

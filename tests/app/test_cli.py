@@ -48,6 +48,9 @@ def test_manipulator2_json_contract(capsys):
     out = json.loads(run_cli(capsys, "reproduce", "manipulator2", "--json"))
     assert out["region"] == {"x2": [-1, 1], "x3": [0, math.pi]}
     assert out["E2"]["e2_synthesized"] < 0.1 * out["E2"]["paper_cubic"]
+    # (38)'s dh K changes sign inside the region: its E1 diverges; the E2-optimal map's does not.
+    assert out["E1"]["paper_cubic"] is None and out["E1_divergent"]["paper_cubic"] is True
+    assert 1.0 < out["E1"]["e2_synthesized"] < 3.0 and not out["E1_divergent"]["e2_synthesized"]
     assert len(out["polynomial"]) >= 10
     rows = np.array(out["table1_extended"])
     assert rows.shape == (5, 3)

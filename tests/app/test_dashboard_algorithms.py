@@ -9,15 +9,17 @@ import pytest
 
 from jik.app.dashboard.algorithms import COLORS, DEFAULT_ALGORITHMS, STYLES, cache_key, runs_key
 from jik.app.dashboard.atlas import atlas_request
-from jik.app.dashboard.controls import controls
+from jik.app.dashboard.controls import control_values, controls
 from jik.app.dashboard.figures import figure_specs
 from jik.app.dashboard.model import default_state, updated_state
 from jik.app.dashboard.results import compute
+from jik.app.dashboard.robots import state_inverse
 from jik.app.dashboard.verdict import verdict
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ALGORITHMS
 
 THREE = ["pseudoinverse", "extended", "posture"]
+REST = "algorithm_parameters.rest"
 
 
 def test_the_default_view_runs_the_paper_two():
@@ -175,6 +177,11 @@ def test_the_scene_draws_a_robot_per_chosen_algorithm(three):
         scene._draw(compute(default_state(), 200))
         assert list(scene.nodes.mechanisms) == list(DEFAULT_ALGORITHMS)
         assert STYLES["posture"].label not in scene.legend.content
+        # (the scene's panel builds the rest's sliders from the same description as the page)
+        scene.controls.show(three.state)
+        rest = {k: h for k, h in scene.controls.inputs.items() if k.startswith(REST)}
+        assert [h.label for h in rest.values()] == ["rest: x1", "rest: x2", "rest: x3"]
+        assert [h.value for h in rest.values()] == list(three.state.x0)
     finally:
         scene.stop()
         dashboard.stop()
@@ -235,6 +242,8 @@ def test_the_atlas_figure_has_a_heatmap_per_algorithm_on_one_colour_scale(three)
     assert axis["cmin"] <= -14 and axis["cmax"] >= -1
     titles = [a["font"]["color"] for a in spec["layout"]["annotations"] if "font" in a]
     assert [COLORS[a] for a in THREE] == titles[:3]
+    posture = [a["text"] for a in spec["layout"]["annotations"] if "posture" in a["text"]]
+    assert len(posture) == 1 and posture[0].endswith("<br>x_rest = each run's start")
     go.Figure(spec)  # (validated)
 
 
@@ -264,3 +273,171 @@ def test_table1_gives_each_chosen_algorithm_its_column_group(three):
     assert any(
         "posture" in n and "prints the pseudoinverse" in n for n in spec["layout"]["meta"]["notes"]
     )
+
+
+# -- the posture inverse's rest x_rest -------------------------------------------------------------
+
+
+def _posture(robot: str = "manipulator2", **patch):
+    return updated_state(default_state(robot), {"algorithms": THREE, **patch})
+
+
+def test_the_rest_shows_only_with_the_posture_inverse_over_x0_s_ranges():
+    """One slider per joint variable, over the same range as x0's sliders, at the default in
+    force (x0 here: Manipulator 2 has no home), and a button 'rest = x0'; none without posture."""
+    assert not [c for c in controls(default_state()) if c.key.startswith(REST)]
+    state = _posture()
+    spec = controls(state)
+    sliders = [c for c in spec if c.key.startswith(f"{REST}.")]
+    x0 = {c.key.removeprefix("x0."): c for c in spec if c.key.startswith("x0.")}
+    assert [c.key for c in sliders] == [f"{REST}.{i}" for i in range(3)]
+    for c in sliders:
+        twin = x0[c.key.rpartition(".")[2]]
+        assert (c.minimum, c.maximum, c.step, c.kind) == (
+            twin.minimum,
+            twin.maximum,
+            twin.step,
+            "slider",
+        )
+    assert [(c.label, c.value) for c in spec if c.kind == "preset"] == [("rest = x0", "x0")]
+    values = control_values(state)
+    assert [values[c.key] for c in sliders] == list(state.x0)
+    assert "rest" not in state.algorithm_parameters  # (the default: it follows x0)
+    moved = updated_state(state, {"x0.0": 0.25})
+    assert control_values(moved)[f"{REST}.0"] == 0.25
+
+
+def test_setting_the_rest_changes_the_posture_run_and_only_it():
+    """A rest coordinate moved: the posture inverse's run changes, the others are the same bit
+    for bit (solved again without a cache), and the posture run is the engine's with that
+    rest; the verdict names the rest."""
+    state = _posture(cycles=2)
+    before = compute(state)
+    moved = updated_state(state, {f"{REST}.1": 0.5})
+    assert moved.algorithm_parameters == {"gain": 1.0, "rest": (0.0, 0.5, state.x0[2])}
+    assert cache_key(moved, "posture") != cache_key(state, "posture")
+    assert [cache_key(moved, a) for a in THREE[:2]] == [cache_key(state, a) for a in THREE[:2]]
+    after = compute(moved)
+    for a in ("pseudoinverse", "extended"):
+        for field in ("theta", "x", "y", "error", "drift"):
+            assert np.array_equal(getattr(after.runs[a], field), getattr(before.runs[a], field))
+    shift = np.abs(after.runs["posture"].x[-1] - before.runs["posture"].x[-1]).max()
+    assert shift > 0.1
+    np.testing.assert_array_equal(state_inverse(moved, "posture").rest, [0.0, 0.5, state.x0[2]])
+    said = " ".join(s["text"] for s in verdict(after) if s["algorithm"] == "posture")
+    assert f"x_rest = (0, 0.5, {state.x0[2]:.4g}) (set)" in said
+    said = " ".join(s["text"] for s in verdict(before) if s["algorithm"] == "posture")
+    assert f"x_rest = x0 (0, 0, {state.x0[2]:.4g})" in said
+
+
+def test_a_rest_equal_to_the_default_is_the_default():
+    """'rest = x0' (and a rest sent back as shown) on a robot without home is the default,
+    which follows x0; a rest set elsewhere stays when x0 moves."""
+    state = _posture()
+    moved = updated_state(state, {f"{REST}.1": 0.5})
+    assert updated_state(moved, {REST: "x0"}) == state
+    assert updated_state(moved, {"x0.2": 1.0}).algorithm_parameters["rest"][2] == state.x0[2]
+    values = control_values(state)
+    assert updated_state(state, {k: v for k, v in values.items() if k.startswith(REST)}) == state
+
+
+@pytest.mark.parametrize(
+    ("patch", "field", "words"),
+    [
+        ({REST: [0.0, 0.0]}, REST, "give 3 entries, one per joint variable (x1, x2, x3), got 2"),
+        ({"algorithm_parameters": {"rest": [0.0, 0.0, 0.5, 1.0]}}, REST, "got 4"),
+        ({REST: [0.0, 0.0, float("nan")]}, f"{REST}.2", "Input should be a finite number"),
+        ({f"{REST}.0": float("inf")}, f"{REST}.0", "Input should be a finite number"),
+        ({f"{REST}.2": 7.0}, f"{REST}.2", "rest x3 must be in [-3.14159, 6.28319]"),
+        ({REST: [0.0, -3.5, 0.0]}, f"{REST}.1", "(the range of x0's sliders), got -3.5"),
+        ({f"{REST}.3": 0.0}, f"{REST}.3", "rest has 3 coordinates"),
+        ({"algorithm_parameters": {"rest": ["a"]}}, REST, "Input should be a valid number"),
+    ],
+)
+def test_a_bad_rest_is_refused_naming_its_field(patch, field, words):
+    from jik.app.dashboard.patch import parse_patch
+
+    state = _posture()
+    with pytest.raises(InvalidInputError) as refused:
+        updated_state(state, parse_patch(patch) if "." in next(iter(patch)) else patch)
+    assert refused.value.field == field
+    assert str(refused.value).startswith(f"{field}: ") and words in str(refused.value)
+
+
+def test_the_session_api_refuses_a_bad_rest_naming_it(client):
+    """A session's change with a rest outside the box: 422 naming the coordinate, the state
+    stays."""
+    session = client.post("/api/sessions", json={"state": {"algorithms": THREE}}).json()
+    url = f"/api/sessions/{session['id']}/state"
+    bad = client.post(url, json={f"{REST}.2": 9.0})
+    assert bad.status_code == 422
+    assert [d["msg"] for d in bad.json()["detail"]] == [
+        f"{REST}.2: rest x3 must be in [-3.14159, 6.28319] (the range of x0's sliders), got 9"
+    ]
+    junk = client.post(url, json={"algorithm_parameters": {"rest": {}}})  # (not a number list)
+    assert [d["msg"] for d in junk.json()["detail"]] == [f"{REST}: Input should be a valid number"]
+    ok = client.post(url, json={f"{REST}.2": 1.0})
+    assert ok.status_code == 200 and ok.json()["state"]["algorithm_parameters"]["rest"][2] == 1.0
+
+
+def test_the_rest_is_dropped_with_the_posture_inverse_and_with_the_robot():
+    moved = updated_state(_posture(), {f"{REST}.1": 0.5})
+    assert updated_state(moved, {"algorithms": ["pseudoinverse"]}).algorithm_parameters == {}
+    other = updated_state(moved, {"robot": "manipulator1"})
+    assert other.algorithm_parameters == {"gain": 1.0} and other.algorithms == moved.algorithms
+
+
+def test_the_api_and_the_dashboard_take_the_same_default_rest():
+    """One rule, default_rest: the robot's home, else the run's start x0."""
+    from jik.app.compute.schemas.algorithms import default_rest, used
+    from jik.app.dashboard.algorithms import posture_rest
+    from jik.app.dashboard.robots import state_kinematics
+
+    state = updated_state(_posture(), {"x0.0": 0.25})
+    kin = state_kinematics(state)
+    assert posture_rest(state, kin) == default_rest(kin, state.x0) == (list(state.x0), "x0")
+    assert used(None, "posture", kin, state.x0)["rest"] == list(state.x0)
+    np.testing.assert_array_equal(state_inverse(state, "posture").rest, state.x0)
+
+
+def test_export_carries_the_rest_used():
+    from jik.app.dashboard.export import export_csv, export_json
+
+    result = compute(updated_state(_posture(cycles=1), {f"{REST}.1": 0.5}))
+    run = export_json(result)["runs"]["posture"]
+    assert run["rest"] == [0.0, 0.5, result.state.x0[2]] and run["rest_from"] == "set"
+    assert "rest" not in export_json(result)["runs"]["pseudoinverse"]
+    line = f"# posture rest x_rest (set): 0.0, 0.5, {result.state.x0[2]!r}"
+    assert line in export_csv(result).splitlines()
+
+
+@pytest.fixture(scope="module")
+def panda():
+    pytest.importorskip("yourdfpy")
+    return updated_state(default_state("panda"), {"algorithms": ["pseudoinverse", "posture"]})
+
+
+def test_an_arm_s_rest_is_within_its_joint_limits_and_defaults_to_its_home(panda):
+    """The Panda: the rest sliders span its joint limits, start at its home; 'rest = home'
+    sets the default back; a coordinate beyond a limit is refused naming the limits."""
+    from jik.app.compute.schemas.algorithms import used
+    from jik.engine.arms import ARMS
+    from jik.engine.robot_spec import robot_from_dict
+
+    kin = robot_from_dict({"name": "panda", "task": "pose"}).kinematics
+    assert used(None, "posture", kin, [0.1] * 7)["rest"] == list(ARMS["panda"].home)  # (API)
+    spec = controls(panda)
+    sliders = [c for c in spec if c.key.startswith(f"{REST}.")]
+    assert [(c.minimum, c.maximum) for c in sliders] == [tuple(b) for b in kin.limits]
+    values = control_values(panda, spec)
+    assert [values[c.key] for c in sliders] == list(ARMS["panda"].home)
+    home = next(c for c in spec if c.id == "ctl-preset-rest-home")
+    assert home.value == list(ARMS["panda"].home) and home.label == "rest = home"
+    moved = updated_state(panda, {f"{REST}.0": 0.5})
+    assert updated_state(moved, {REST: home.value}) == panda
+    shown = {c.key: values[c.key] for c in sliders}
+    assert updated_state(moved, shown) == panda  # (what the sliders show, sent back)
+    with pytest.raises(InvalidInputError) as refused:
+        updated_state(panda, {f"{REST}.3": 0.0})
+    assert refused.value.field == f"{REST}.3"
+    assert "must be in [-3.0718, -0.0698] (the joint limits of the" in str(refused.value)

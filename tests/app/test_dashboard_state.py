@@ -351,7 +351,7 @@ def test_known_functionals_are_drawn_with_the_first_result():
     assert (
         after["titles"]["augmenting"] == result["figures"]["augmenting"]["layout"]["title"]["text"]
     )
-    assert dashboard.functionals is not None and dashboard.functionals["E1"] is not None
+    assert dashboard.functionals is not None and dashboard.functionals["E2"] is not None
 
 
 def test_offloaded_computation_is_the_same_and_can_be_cancelled():

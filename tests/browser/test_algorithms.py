@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import pytest
 
-from tests.browser.conftest import ALL_COLORS_RGB, TIMEOUT, probe
+from tests.browser.conftest import ALL_COLORS_RGB, TIMEOUT, Tab, probe
 
 expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
 # ~15 s: in CI's slow step, to keep the default run under 8 minutes (the default run checks the
@@ -46,3 +46,88 @@ def test_three_algorithms_chosen_in_the_page(tabs, config):
     summary = tab.snapshot()["summary"]
     assert generation > 1 and tab.snapshot()["state"]["algorithm_parameters"] == {"gain": 3.0}
     assert summary["pseudoinverse"]["cached"] and not summary["posture"]["cached"]
+
+
+def _curves(tab, config) -> dict[str, list[float]]:
+    """Each chosen algorithm's drift line as the page holds it, by algorithm."""
+    return {
+        a: tab.page.evaluate(probe("trace_y"), {"plot": "plot-drift", "name": config["labels"][a]})
+        for a in THREE
+    }
+
+
+def test_the_posture_rest_in_the_page(tabs, config):
+    """Choosing the posture inverse shows its rest, one slider per joint at the start x0 (the
+    default of a robot without home) and a 'rest = x0' button; moving a rest coordinate gives a
+    new posture line in the drift panel, the others' stay (cached), and the verdict names the
+    rest. A second tab of the same browser has its own session: its rest is the default, and
+    its change does not reach the first."""
+    tab = tabs.open()
+    page = tab.page
+    expect(page.locator("#ctl-alg-rest-0")).to_have_count(0)
+    tab.change(lambda: page.locator("#ctl-algorithms-posture").click())
+    x0 = tab.snapshot()["state"]["x0"]
+    for i in range(3):
+        expect(page.locator(f"#ctl-alg-rest-{i}")).to_be_visible()
+        expect(page.locator(f"#ctl-alg-rest-{i}-value")).to_have_value(f"{x0[i]:.3f}")
+    expect(page.locator("#ctl-preset-rest-x0")).to_be_visible()
+    expect(page.locator("#ctl-preset-rest-home")).to_have_count(0)  # (Manipulator 2: no home)
+    before = _curves(tab, config)
+    assert all(len(before[a]) == 3 for a in THREE)  # (three cycles each)
+
+    generation = tab.set_slider("#ctl-alg-rest-1", 0.5)
+    snapshot = tab.snapshot()
+    rest = snapshot["state"]["algorithm_parameters"]["rest"]
+    assert rest[0] == x0[0] and rest[1] == pytest.approx(0.495) and rest[2] == x0[2]
+    assert tab.url_state()["algorithm_parameters"]["rest"] == rest  # (a link keeps it)
+    summary = snapshot["summary"]
+    assert not summary["posture"]["cached"]
+    assert summary["pseudoinverse"]["cached"] and summary["extended"]["cached"]
+    after = _curves(tab, config)
+    assert tab.generation == generation
+    assert after["pseudoinverse"] == before["pseudoinverse"]
+    assert after["extended"] == before["extended"]
+    assert max(abs(a - b) for a, b in zip(after["posture"], before["posture"], strict=True)) > 0.05
+    said = page.locator('#verdict p[data-algorithm="posture"].why')
+    expect(said).to_contain_text(f"x_rest = (0, 0.495, {x0[2]:.4g}) (set)")
+
+    # A second tab of the same browser: its own session, its own rest.
+    other = tabs.new_page(page.context)
+    other.goto(tabs.base + "/")
+    second = Tab(other, tabs.base)
+    second.wait_drawn(1)
+    assert second.session_id != tab.session_id
+    second.change(lambda: other.locator("#ctl-algorithms-posture").click())
+    expect(other.locator("#ctl-alg-rest-1-value")).to_have_value(f"{x0[1]:.3f}")
+    assert "rest" not in second.snapshot()["state"]["algorithm_parameters"]
+    second.set_slider("#ctl-alg-rest-0", -0.99)  # (on the step, 0.015)
+    assert second.snapshot()["state"]["algorithm_parameters"]["rest"][0] == pytest.approx(-0.99)
+    assert tab.snapshot()["state"]["algorithm_parameters"]["rest"] == rest
+    expect(page.locator("#ctl-alg-rest-0-value")).to_have_value(f"{x0[0]:.3f}")
+
+    # Back to the start: 'rest = x0' is the default again, which the state then leaves out.
+    tab.change(lambda: page.locator("#ctl-preset-rest-x0").click())
+    assert "rest" not in tab.snapshot()["state"]["algorithm_parameters"]
+    expect(page.locator("#ctl-alg-rest-1-value")).to_have_value(f"{x0[1]:.3f}")
+    assert _curves(tab, config)["posture"] == before["posture"]
+
+
+def test_a_rest_outside_the_box_is_refused_beside_its_slider(tabs):
+    """A rest coordinate typed beyond its range: the page says why beside that slider, in the
+    server's words naming the field, and the state keeps its rest."""
+    tabs.allow_console("422")
+    tab = tabs.open()
+    page = tab.page
+    tab.change(lambda: page.locator("#ctl-algorithms-posture").click())
+    response = tab.posting(
+        lambda: (
+            page.fill("#ctl-alg-rest-2-value", "9"),
+            page.press("#ctl-alg-rest-2-value", "Enter"),
+        )
+    )
+    assert response.status == 422
+    note = page.locator("#controls .field-error")
+    expect(note).to_contain_text(
+        "algorithm_parameters.rest.2: rest x3 must be in [-3.14159, 6.28319]"
+    )
+    assert "rest" not in tab.snapshot()["state"]["algorithm_parameters"]

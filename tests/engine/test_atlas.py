@@ -78,6 +78,21 @@ def test_paths_of_the_family_scale_about_the_first_point_and_shift(reference_atl
         )
 
 
+@pytest.mark.parametrize(("n_starts", "chunk"), [(8, 16), (64, 16), (600, 38), (10**5, 2048)])
+def test_a_default_chunking_reports_progress_within_a_small_atlas(n_starts, chunk):
+    """By default a chunk holds at most 2048 starts, and an atlas of 256 runs or more has 16
+    chunks or more: a 64-start atlas tells its progress 4 times, not once at the end."""
+    from jik.engine.atlas import auto_chunk
+
+    assert auto_chunk(n_starts) == chunk
+    if n_starts == 64:
+        plan = small_plan(n_starts=64, cycles=1)
+        assert plan.chunk == 16
+        told: list[tuple[int, int]] = []
+        run_atlas(plan, progress=ProgressCallbacks(on_advance=lambda d, t: told.append((d, t))))
+        assert told == [(16, 64), (32, 64), (48, 64), (64, 64)]
+
+
 def test_the_same_numbers_whatever_the_chunking(reference_atlas, monkeypatch):
     """Chunks of 5 (reference), 1 and all 48 runs at once, the last in batches of 7, give the
     same numbers (to 1e-12; they are in fact equal: each member's arithmetic in a batch is its

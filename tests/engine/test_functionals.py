@@ -8,6 +8,7 @@ from scipy import integrate
 
 from jik.engine.augmentations import AugmentingMap, E1Optimal, E2Optimal, PaperCubic, Polynomial2
 from jik.engine.exceptions import InvalidInputError
+from jik.engine.formula_kinematics import FormulaMap
 from jik.engine.functionals import (
     e1_integrand,
     e2_integrand,
@@ -98,7 +99,8 @@ def test_integrands_equal_paper_forms_14_and_19():
 
 
 def test_singular_points_are_reported_not_dropped_silently():
-    """dh K = 0 on a line x3 = c through Gauss nodes: the points are listed, E1 excludes them."""
+    """dh K = 0 on a line x3 = c through Gauss nodes: the points are listed; E1 diverges there
+    (its integrand grows like (dh K)^(-2), eq. (14)), E2 stays finite."""
     nodes = 8
     x, _, _, _ = quadrature(Manipulator2(), REGION2, nodes)
     c = float(np.unique(x[:, 2])[3])
@@ -108,8 +110,27 @@ def test_singular_points_are_reported_not_dropped_silently():
     e2 = error_functional_e2(k, h, REGION2, nodes=nodes)
     assert e1.singular_points.shape == (nodes, 3)
     np.testing.assert_allclose(e1.singular_points[:, 2], c, atol=1e-15)
-    assert np.isfinite(e1.value) and e1.min_abs_dh_k == pytest.approx(0.0, abs=1e-15)
+    assert e1.value == np.inf and e1.divergent
+    assert e1.min_abs_dh_k == pytest.approx(0.0, abs=1e-15)
     assert e2.singular_points.shape == (nodes, 3) and np.isfinite(e2.value)
+    assert not e2.divergent
+
+
+@pytest.mark.parametrize(
+    ("top", "divergent"), [(1.6, True), (np.pi / 2, True), (1.5, False), (1.55, False)]
+)
+def test_e1_diverges_where_dh_k_changes_sign_between_the_nodes(top, divergent):
+    """Manipulator 2 with h = x1: dh K vanishes on x3 = pi/2 and nowhere else. A box across it
+    (no Gauss node on it) or up to it (on a face) has E1 = inf; a box short of it a finite E1,
+    growing as the box nears the line."""
+    k = Manipulator2()
+    h = FormulaMap("x1", k.variable_names)
+    e1 = error_functional_e1(k, h, {"x2": (0.0, 1.0), "x3": (1.0, top)})
+    assert e1.divergent is divergent and bool(np.isinf(e1.value)) is divergent
+    assert e1.singular_points.shape[0] == 0  # (no node is singular: found by det's sign)
+    if not divergent:
+        assert 10 < e1.value < 1e3
+        assert e1.as_dict()["divergent"] is False
 
 
 def test_e2_depends_on_the_orientation_of_k():

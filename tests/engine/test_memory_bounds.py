@@ -147,17 +147,17 @@ def test_explicit_starts_name_starts(monkeypatch):
 
 
 def test_a_chunk_too_large_for_the_bound_is_refused_by_plan_atlas(monkeypatch):
-    """1000 cycles of a 100-point loop: the default chunk of 2048 runs would hold about
-    10 GiB; plan_atlas names chunk and how many runs fit. Below the bound even one run does
-    not fit: it names cycles."""
+    """1000 cycles of a 100-point loop: a chunk of 2048 runs would hold about 10 GiB;
+    plan_atlas names chunk and how many runs fit, and the default chunking takes no more.
+    Below the bound even one run does not fit: it names cycles."""
     loop = [(np.cos(t), np.sin(t)) for t in np.linspace(0, 2 * np.pi, 100, endpoint=False)]
 
     def plan(**kw):
-        return jik.plan_atlas(P, loop, starts=[(0.0, 0.0, 0.0)], cycles=1000, **kw)
+        return jik.plan_atlas(P, loop, starts=np.zeros((40000, 3)), cycles=1000, **kw)
 
-    text = _refused(plan, "chunk", "2048 runs of a chunk", "a smaller chunk")
+    text = _refused(lambda: plan(chunk=2048), "chunk", "2048 runs of a chunk", "a smaller chunk")
     fit = int(text.split("at most ")[1].split()[0])
     assert 100 < fit < 2048
-    assert plan(chunk=fit).chunk == fit
+    assert plan(chunk=fit).chunk == fit and plan().chunk == fit
     monkeypatch.setattr(validation, "MEMORY_LIMIT", 2**20)
     _refused(lambda: plan(chunk=1), "cycles", "1000 cycles of one run", "fewer cycles")

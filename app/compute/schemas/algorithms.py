@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, create_model
 
 from ....engine.registry import ALGORITHMS
@@ -50,13 +51,38 @@ class AlgorithmParameters(_Parameters):  # type: ignore[misc, valid-type]
     )
 
 
+def default_rest(kinematics, x0) -> tuple[list[float], str]:
+    """The posture inverse's rest x_rest when none is given, and what it is ("home" or
+    "x0"): the robot's home configuration, else the run's start ``x0``. The one rule of the
+    REST API's runs and the dashboard's (an atlas without rest pulls each run toward its own
+    start instead: :mod:`jik.engine.posture_at_start`)."""
+    home = getattr(kinematics, "home", None)
+    if home is not None:
+        return [float(v) for v in home], "home"
+    return [float(v) for v in x0], "x0"
+
+
 def used(params: BaseModel | None, algorithm: str = "", kinematics=None, x0=None) -> dict:
     """The parameters given, as the engine's :func:`make_inverse` takes them. The posture
-    inverse's ``rest`` defaults to the robot's home, else to the run's start ``x0``."""
+    inverse's ``rest`` defaults to :func:`default_rest` (the robot's home, else the run's
+    start ``x0``) when the run has a start."""
     out = {} if params is None else params.model_dump(exclude_none=True)
     if algorithm == "posture" and "rest" not in out and x0 is not None:
-        if getattr(kinematics, "home", None) is None:
-            out["rest"] = list(x0)
+        out["rest"] = default_rest(kinematics, x0)[0]
+    return out
+
+
+def parameters_of(inverse) -> dict[str, Any]:
+    """The parameters an engine inverse holds, by the catalogue's names, defaults filled in
+    (posture's rest, weighted's limits, with None for an unbounded end): what a response says
+    the run used."""
+    spec = ALGORITHMS[inverse.name]
+    out: dict[str, Any] = {p.name: float(getattr(inverse, p.name)) for p in spec.parameters}
+    for name in spec.vectors:
+        values = np.asarray(getattr(inverse, name), dtype=float)
+        shown = values.astype(object)
+        shown[~np.isfinite(values)] = None
+        out[name] = shown.tolist()
     return out
 
 

@@ -129,6 +129,11 @@ class LimitsInfo(BaseModel):
 class SolveResponse(BaseModel):
     robot: RobotUsed
     algorithm: Algorithm
+    algorithm_parameters: dict[str, float | list[float | None] | list[list[float | None]]] = Field(
+        default_factory=dict,
+        description="the parameters the inverse used, defaults filled in (damped: damping, "
+        "damping_threshold; weighted: limits, null for an unbounded end; posture: gain, rest)",
+    )
     augmentation: AugmentationUsed | None
     mode: Mode
     gamma: float
@@ -152,6 +157,11 @@ class SolveResponse(BaseModel):
 class RepeatabilityResponse(BaseModel):
     robot: RobotUsed
     algorithm: Algorithm
+    algorithm_parameters: dict[str, float | list[float | None] | list[list[float | None]]] = Field(
+        default_factory=dict,
+        description="the parameters the inverse used, defaults filled in (damped: damping, "
+        "damping_threshold; weighted: limits, null for an unbounded end; posture: gain, rest)",
+    )
     augmentation: AugmentationUsed | None
     mode: Mode
     gamma: float

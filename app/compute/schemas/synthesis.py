@@ -130,10 +130,14 @@ SynthesizeBody = per_robot(SynthesizeRequest, _synthesis_fields)
 
 
 class FunctionalInfo(BaseModel):
-    value: MaybeFloat
+    value: MaybeFloat = Field(description="the integral; null where it is not finite")
     n_points: int
     n_singular: int
     min_abs_dh_k: MaybeFloat
+    divergent: bool = Field(
+        default=False,
+        description="E1 diverges: dh K vanishes inside the region (eq. (14)); value is null",
+    )
 
 
 class SynthesisGrid(BaseModel):
