@@ -210,7 +210,10 @@ def repeatability(
     Raises
     ------
     InvalidInputError
-        Bad shapes, or a :class:`Resume` that is not whole cycles of this run.
+        Bad shapes or settings (``error.field`` names the argument), a :class:`Resume` that is
+        not whole cycles of this run, or, before any work, starts whose estimated memory
+        (:func:`jik.engine.solve_rules.run_bytes`) exceeds
+        :data:`jik.engine.validation.MEMORY_LIMIT` (field ``x0``).
     JikError
         A leg's solve raised (a singular start configuration) and the progress, if any, did not
         stop the run there.

@@ -208,7 +208,7 @@ def solve(
     ------
     InvalidInputError
         Wrong shapes (a batch of starts or targets), non-finite values, gamma out of range,
-        bad tol.
+        bad tol, mode, method or max_iterations; ``error.field`` names the argument.
     KinematicSingularityError, AlgorithmicSingularityError
         When the start configuration is singular for ``inverse``.
     """
@@ -271,7 +271,10 @@ def solve_batch(
     Raises
     ------
     InvalidInputError, KinematicSingularityError, AlgorithmicSingularityError
-        As :func:`solve` (the first singular start names its configuration).
+        As :func:`solve` (the first singular start names its configuration); also, before any
+        work, a batch whose estimated memory (:func:`jik.engine.solve_rules.solve_bytes`)
+        exceeds :data:`jik.engine.validation.MEMORY_LIMIT`, naming ``x0`` (``y_d`` for a batch
+        of targets from one start) and how many starts fit.
     """
     kin = check_inverse(inverse)
     x0 = kin.check(x0, "x0")
