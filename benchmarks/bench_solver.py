@@ -37,14 +37,16 @@ TOL = 1e-10
 
 
 def straightforward_leg(kin, x0, y_d, method="RK45"):
-    """The textbook implementation: solve_ivp on (7) until ||e|| < TOL, gamma = 1."""
+    """The textbook implementation: solve_ivp on (7) until ||e|| < TOL, gamma = 1. It calls
+    the robot's unchecked k and J, as jik's solver does: the ratio is of the integration, not
+    of the public methods' input checks."""
 
     def f(_t, x):
-        J = kin.jacobian(x)
-        return -J.T @ np.linalg.solve(J @ J.T, kin.forward(x) - y_d)
+        J = kin.jacobian_unchecked(x)
+        return -J.T @ np.linalg.solve(J @ J.T, kin.forward_unchecked(x) - y_d)
 
     def reached(_t, x):
-        return np.linalg.norm(kin.forward(x) - y_d) - TOL
+        return np.linalg.norm(kin.forward_unchecked(x) - y_d) - TOL
 
     reached.terminal = True  # type: ignore[attr-defined]  # solve_ivp reads event attributes off the function
     sol = solve_ivp(f, (0, 200), x0, method=method, rtol=RTOL, atol=ATOL, events=reached)

@@ -28,11 +28,13 @@ from .exceptions import InvalidInputError, SingularConfigurationError
 from .inverses import Inverse, Pseudoinverse, algorithm_labels
 from .repeatability import CLOSE_TOL, MAX_CYCLES, MAX_PATH_POINTS
 from .self_motion import SelfMotionManifold, project, trace
-from .solve_rules import MAX_ITERATIONS_LIMIT, MODES, check_gamma
+from .solve_rules import MAX_ITERATIONS_LIMIT, MODES, check_gamma, chunk_limit
 from .solver import solve_batch
 from .validation import FloatArray, as_points, count, positive
 
-#: Largest number of starts per path, of paths in a family, and of starts in a chunk.
+#: Largest number of starts per path, of paths in a family, and of starts in a chunk. A chunk
+#: must also fit in the memory bound (:func:`~jik.engine.solve_rules.chunk_limit`); the starts
+#: need not, when the atlas is streamed (``iter_atlas``).
 MAX_STARTS = 10**9
 MAX_PATHS = 10**4
 MAX_CHUNK = 65536
@@ -113,7 +115,6 @@ class AtlasPlan:
 
     @property
     def algorithms(self) -> tuple[str, ...]:
-        """A distinct label per inverse (:func:`jik.engine.inverses.algorithm_labels`)."""
         return algorithm_labels(self.inverses)
 
     def starts(self, lo: int, hi: int) -> FloatArray:
@@ -235,7 +236,8 @@ def plan_atlas(
     chunk : int, optional
         Starts per chunk: the batch size and the unit of work, 1 to 65536; by default
         :func:`auto_chunk` of the atlas's size (progress is told, and cancellation asked,
-        after every chunk).
+        after every chunk), lowered to what fits in :data:`jik.engine.validation.MEMORY_LIMIT`
+        (:func:`~jik.engine.solve_rules.chunk_limit`).
     gamma, mode, tol, max_iterations
         Of every leg, as in :func:`jik.engine.solver.solve`.
 
@@ -243,7 +245,9 @@ def plan_atlas(
     ------
     InvalidInputError
         Naming the field (``error.field``): path, cycles, starts, n_starts, arc, sampling, seed,
-        reference, box, shifts, scales, chunk, gamma, mode, tol, max_iterations, inverses.
+        reference, box, shifts, scales, chunk, gamma, mode, tol, max_iterations, inverses; a
+        chunk whose runs would exceed :data:`jik.engine.validation.MEMORY_LIMIT` names
+        ``chunk`` (``cycles``, when one run is too large).
     """
     invs = (inverses,) if isinstance(inverses, Inverse) else tuple(inverses)
     if not invs or not all(isinstance(i, Inverse) for i in invs):
@@ -297,11 +301,13 @@ def plan_atlas(
         raise InvalidInputError(f"at most {MAX_PATHS} paths (shifts x scales)", field="shifts")
     paths = family(base_path, shift, scale)
 
+    fits = chunk_limit(kin, len(invs), cycles, paths.shape[1], settings, chunk)
+
     def make(**starts_: Any) -> AtlasPlan:
         plan = AtlasPlan(
             inverses=invs, paths=paths, cycles=cycles, chunk=1, settings=settings, **starts_
         )
-        return replace(plan, chunk=auto_chunk(plan.size) if chunk is None else chunk)
+        return replace(plan, chunk=min(auto_chunk(plan.size), fits) if chunk is None else chunk)
 
     if starts is not None:
         x = _checked(lambda: as_points(starts, kin.p, "starts"), "starts")
@@ -316,9 +322,20 @@ def plan_atlas(
                 field="starts",
             )
         return make(n_starts=len(x), sampling=None, manifolds=(), explicit=x)
-    if n_starts is None or arc is None or reference is None:
+    if n_starts is None:
         raise InvalidInputError(
-            "give explicit starts, or n_starts, arc and a reference configuration", "starts"
+            "give explicit starts, or n_starts with arc and reference (starts on the "
+            "self-motion curve of the path's first point)",
+            "starts",
+        )
+    missing = [name for name, value in (("arc", arc), ("reference", reference)) if value is None]
+    if missing:
+        raise InvalidInputError(
+            f"n_starts needs {' and '.join(missing)}: arc = (lo, hi), the arc lengths s of the "
+            "starts on the self-motion curve (lo <= 0 <= hi), and reference, a configuration "
+            f"({kin.p} numbers, such as the robot's home) that eq. (7) moves onto the path's "
+            "first point, where s = 0",
+            missing[0],
         )
     n = _checked(lambda: count(n_starts, "n_starts", 1, MAX_STARTS), "n_starts")
     if sampling not in ("grid", "sample"):

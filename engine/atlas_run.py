@@ -25,7 +25,7 @@ from .posture_at_start import PostureAtStart
 from .practical_inverses import PostureInverse
 from .progress import Progress, check_cancelled
 from .repeatability import repeatability
-from .validation import FloatArray
+from .validation import FloatArray, check_memory
 
 #: Starts per batched repeatability() call within a chunk: the working set of the Picard sweeps
 #: then stays in cache (``jik bench atlas``, docs/benchmarks.md: 512 is faster than 2048),
@@ -279,9 +279,26 @@ def run_atlas(
         on (:meth:`Progress.cancelled`: True stops the atlas with ``RunCancelled``).
     keep_leg_ends : bool
         Keep every leg's end (A P N cycles L p numbers); False keeps the drift alone.
+
+    Raises
+    ------
+    InvalidInputError
+        Before any work, with field ``n_starts`` (``starts`` for explicit starts), when the
+        gathered arrays would exceed :data:`jik.engine.validation.MEMORY_LIMIT`: stream such an
+        atlas with :func:`iter_atlas`, or keep the drift alone.
     """
     A, P, N = len(plan.inverses), len(plan.paths), plan.n_starts
     p = plan.inverses[0].kinematics.p
+    leg_ends = A * plan.cycles * plan.legs * p if keep_leg_ends else 0
+    check_memory(
+        P * N,
+        8.0 * (p + A * plan.cycles + leg_ends + 1) + 2 * A,
+        "n_starts" if plan.explicit is None else "starts",
+        f"runs of a gathered atlas ({P} paths x {N} starts)",
+        "stream it chunk by chunk with iter_atlas"
+        + (", keep the drift alone (keep_leg_ends=False)" if keep_leg_ends else "")
+        + ", or ask for fewer starts, paths or cycles",
+    )
     starts = np.empty((P * N, p))
     drift = np.empty((A, P * N, plan.cycles))
     legs = np.empty((A, P * N, plan.cycles * plan.legs, p)) if keep_leg_ends else None

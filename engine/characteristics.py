@@ -77,7 +77,7 @@ class CharacteristicsMap(AugmentingMap):
         self.p = kinematics.p
         self.fixed_index = check_index(kinematics, fixed_index)
         self.homotopy = LinearHomotopy(as_vector(reference, self.p, "reference"), fixed_index)
-        self.nodes = count(nodes, "collocation nodes", 4, 200)
+        self.nodes = count(nodes, "collocation nodes", 4, 200, "nodes")
         if on_undefined not in ("raise", "nan"):
             raise InvalidInputError(f"on_undefined must be 'raise' or 'nan', got {on_undefined!r}")
         self.on_undefined = on_undefined

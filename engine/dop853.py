@@ -174,7 +174,7 @@ ATOL = 1e-12
 
 def _rhs(inverse: Inverse, x: FloatArray, y_d: FloatArray):
     """-J#(x) (k(x) - y_d) per unit tau = gamma theta; also e and the singular mask."""
-    e = inverse.kinematics.forward(x) - y_d
+    e = inverse.kinematics.forward_unchecked(x) - y_d
     v, bad = inverse.apply_masked(x, e)
     return -v, e, bad
 

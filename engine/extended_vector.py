@@ -19,6 +19,8 @@ from .inverses import (
     SINGULAR_EXTENDED,
     Inverse,
     extended_singularity,
+    require_kinematics,
+    require_map,
     solve_extended,
 )
 from .kinematics import Kinematics
@@ -39,7 +41,19 @@ class VectorExtendedInverse(Inverse):
     name = "extended"
 
     def __init__(self, kinematics: Kinematics, augmenting_maps: Sequence[AugmentingMap]) -> None:
-        maps = tuple(augmenting_maps)
+        kinematics = require_kinematics(kinematics)
+        if isinstance(augmenting_maps, AugmentingMap | str):
+            augmenting_maps = [augmenting_maps]  # (one map: refused below unless p - r = 1)
+        if not isinstance(augmenting_maps, Sequence):
+            raise InvalidInputError(
+                f"augmenting_maps must be a list of p - r augmenting maps, got "
+                f"{type(augmenting_maps).__name__}",
+                "augmenting_maps",
+            )
+        maps = tuple(
+            require_map(m, kinematics, f"augmenting_maps.{i}")
+            for i, m in enumerate(augmenting_maps)
+        )
         if len(maps) != kinematics.p - kinematics.r:
             raise InvalidInputError(
                 f"the extended inverse of {kinematics.name} needs p - r = "
@@ -70,7 +84,7 @@ class VectorExtendedInverse(Inverse):
         dh = np.stack([g for g, _ in grads], axis=-2)  # (..., p - r, p)
         undefined = np.any(np.stack([u for _, u in grads], axis=-1), axis=-1)
         dh = np.where(undefined[..., None, None], 0.0, dh)
-        return np.concatenate([self.kinematics.jacobian(x), dh], axis=-2), undefined
+        return np.concatenate([self.kinematics.jacobian_unchecked(x), dh], axis=-2), undefined
 
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
         Jbar, undefined = self._extended(x)

@@ -97,14 +97,18 @@ def check_region(
     """
     names = tuple(kinematics.variable_names) or tuple(f"x{i + 1}" for i in range(kinematics.p))
     if not isinstance(region, Mapping) or not region:
-        raise InvalidInputError(f"region must be a non-empty mapping of {names} to (lo, hi)")
+        raise InvalidInputError(
+            f"region must be a non-empty mapping of {names} to (lo, hi)", "region"
+        )
     fixed = dict(fixed or {})
     for name in (*region, *fixed):
         if name not in names:
-            raise InvalidInputError(f"unknown joint variable {name!r}; use one of {names}")
-    both = set(region) & set(fixed)
-    if both:
-        raise InvalidInputError(f"variables {sorted(both)} are both integrated over and fixed")
+            raise InvalidInputError(
+                f"unknown joint variable {name!r}; use one of {names}",
+                "region" if name in region else "fixed",
+            )
+    if both := sorted(set(region) & set(fixed)):
+        raise InvalidInputError(f"variables {both} are both integrated over and fixed", "fixed")
     box: dict[str, tuple[float, float]] = {}
     for name in names:
         if name not in region:
@@ -112,12 +116,17 @@ def check_region(
         try:
             lo, hi = region[name]
         except (TypeError, ValueError) as exc:
-            raise InvalidInputError(f"region[{name!r}] must be a pair (lo, hi)") from exc
-        lo, hi = finite(lo, f"lower bound of {name}"), finite(hi, f"upper bound of {name}")
+            raise InvalidInputError(
+                f"region[{name!r}] must be a pair (lo, hi)", f"region.{name}"
+            ) from exc
+        lo = finite(lo, f"lower bound of {name}", f"region.{name}")
+        hi = finite(hi, f"upper bound of {name}", f"region.{name}")
         if not lo < hi:
-            raise InvalidInputError(f"region[{name!r}] must have lo < hi, got ({lo}, {hi})")
+            raise InvalidInputError(
+                f"region[{name!r}] must have lo < hi, got ({lo}, {hi})", f"region.{name}"
+            )
         box[name] = (lo, hi)
-    fix = {n: finite(fixed.get(n, 0.0), f"fixed {n}") for n in names if n not in box}
+    fix = {n: finite(fixed.get(n, 0.0), f"fixed {n}", f"fixed.{n}") for n in names if n not in box}
     return box, fix
 
 

@@ -93,14 +93,55 @@ def extended_inverse(J: FloatArray, dh: FloatArray) -> FloatArray:
     return np.where(bad[..., None, None], np.nan, out)
 
 
+def require_kinematics(kinematics) -> Kinematics:
+    """``kinematics`` if it is a :class:`Kinematics`, else an InvalidInputError (field
+    ``"kinematics"``) that says how to make one."""
+    if isinstance(kinematics, Kinematics):
+        return kinematics
+    hint = (
+        f"; for a robot by name use robot_from_dict({{'name': {kinematics!r}}}).kinematics"
+        if isinstance(kinematics, str)
+        else ""
+    )
+    raise InvalidInputError(
+        "kinematics must be a Kinematics (Manipulator2(), PlanarChain(...), "
+        f"FormulaKinematics(...), UrdfChain(...)), got {type(kinematics).__name__} "
+        f"{kinematics!r:.60}{hint}",
+        "kinematics",
+    )
+
+
+def require_map(augmenting_map, kinematics: Kinematics, field: str = "augmenting_map"):
+    """``augmenting_map`` if it is an :class:`AugmentingMap`, else an InvalidInputError naming
+    ``field`` that says how to make one."""
+    if isinstance(augmenting_map, AugmentingMap):
+        return augmenting_map
+    hint = (
+        f"; for a formula use FormulaMap({augmenting_map!r}, {list(kinematics.variable_names)})"
+        if isinstance(augmenting_map, str)
+        else ""
+    )
+    raise InvalidInputError(
+        "the augmenting map must be an AugmentingMap (PaperCubic(), E2Optimal(...), "
+        f"FormulaMap(...), synthesize_e2(...)), got {type(augmenting_map).__name__} "
+        f"{augmenting_map!r:.60}{hint}",
+        field,
+    )
+
+
 def require_compatible(kinematics: Kinematics, augmenting_map: AugmentingMap, what: str) -> None:
     """Check one degree of redundancy (p - r = 1) and that h is defined on R^p."""
     if kinematics.p - kinematics.r != 1:
-        raise InvalidInputError(f"{what} here needs one degree of redundancy (p - r = 1)")
+        raise InvalidInputError(
+            f"{what} here needs one degree of redundancy (p - r = 1); {kinematics.name} has "
+            f"p - r = {kinematics.p - kinematics.r} (VectorExtendedInverse takes p - r maps)",
+            "kinematics",
+        )
     if augmenting_map.p != kinematics.p:
         raise InvalidInputError(
             f"augmenting map {augmenting_map.name!r} is defined on R^{augmenting_map.p}, "
-            f"but {kinematics.name} has p = {kinematics.p}"
+            f"but {kinematics.name} has p = {kinematics.p}",
+            "augmenting_map",
         )
 
 
@@ -168,10 +209,10 @@ class Pseudoinverse(Inverse):
     name = "pseudoinverse"
 
     def __init__(self, kinematics: Kinematics) -> None:
-        self.kinematics = kinematics
+        self.kinematics = require_kinematics(kinematics)
 
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
-        J = self.kinematics.jacobian(x)
+        J = self.kinematics.jacobian_unchecked(x)
         w, d = solve_small(gram(J), e)  # (J J^T) w = e
         bad = ~(np.abs(d) >= SINGULAR_MANIPULABILITY**2)  # m = sqrt(det); also catches NaN
         v = np.einsum("...ji,...j->...i", J, w)  # J^T w
@@ -179,7 +220,7 @@ class Pseudoinverse(Inverse):
 
     def matrix(self, x: FloatArray) -> FloatArray:
         x = self.kinematics.check(x)
-        out = pseudoinverse(self.kinematics.jacobian(x))
+        out = pseudoinverse(self.kinematics.jacobian_unchecked(x))
         self._raise_if(x, np.isnan(out[..., 0, 0]))
         return out
 
@@ -214,6 +255,8 @@ class ExtendedInverse(Inverse):
     name = "extended"
 
     def __init__(self, kinematics: Kinematics, augmenting_map: AugmentingMap) -> None:
+        kinematics = require_kinematics(kinematics)
+        augmenting_map = require_map(augmenting_map, kinematics)
         require_compatible(kinematics, augmenting_map, "the extended inverse")
         self.kinematics = kinematics
         self.augmenting_map = augmenting_map
@@ -229,11 +272,13 @@ class ExtendedInverse(Inverse):
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
         dh, undefined = self.augmenting_map.gradient_masked(x)
         dh = np.where(undefined[..., None], 0.0, dh)  # keeps the solve below free of NaN
-        return solve_extended(extended_jacobian(self.kinematics.jacobian(x), dh), e, undefined)
+        J = self.kinematics.jacobian_unchecked(x)
+        return solve_extended(extended_jacobian(J, dh), e, undefined)
 
     def matrix(self, x: FloatArray) -> FloatArray:
         x = self.kinematics.check(x)
-        out = extended_inverse(self.kinematics.jacobian(x), self.augmenting_map.gradient(x))
+        J = self.kinematics.jacobian_unchecked(x)
+        out = extended_inverse(J, self.augmenting_map.gradient(x))
         self._raise_if(x, ~np.isfinite(out[..., 0, 0]))
         return out
 

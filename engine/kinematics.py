@@ -1,12 +1,17 @@
 """Kinematics k: R^p -> R^r with analytic Jacobians (paper, eqs. (4), (30), (37)).
 
 Every method is batched over leading axes: ``x`` of shape (..., p) gives (..., r) and (..., r, p).
+The public evaluations (:data:`CHECKED`) check their ``x`` once, at the boundary; the solvers,
+which check their inputs at their own entry, call the unchecked cores (``forward_unchecked``).
 """
 
 from __future__ import annotations
 
 import abc
-from typing import ClassVar
+import functools
+import math
+from collections.abc import Callable
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -16,6 +21,8 @@ from .validation import FloatArray, as_points, positive
 
 #: m(x) below this counts as a kinematic singularity.
 SINGULAR_MANIPULABILITY = 1e-9
+#: The evaluations that a subclass of :class:`Kinematics` implements and that check ``x``.
+CHECKED = ("forward", "jacobian", "forward_jacobian")
 
 
 def kernel_cofactors(J: FloatArray) -> FloatArray:
@@ -39,12 +46,50 @@ def kernel_cofactors(J: FloatArray) -> FloatArray:
     return minors * signs
 
 
+def _checked(core: Callable[..., Any]) -> Callable[..., Any]:
+    """``core(self, x)`` behind the check of ``x`` (:meth:`Kinematics.check`).
+
+    The common case costs about a microsecond: a float array of the right width whose sum is
+    finite is finite; anything else (a sum that overflows, a list, a wrong shape, NaN) takes
+    the full check, which raises or returns the array.
+    """
+
+    @functools.wraps(core)
+    def evaluation(self, x, *args, **kwargs):
+        if not (
+            type(x) is np.ndarray
+            and x.dtype == np.float64
+            and x.ndim
+            and x.shape[-1] == self.p
+            and math.isfinite(np.add.reduce(x, axis=None))
+        ):
+            x = self.check(x, "x")
+        return core(self, x, *args, **kwargs)
+
+    return evaluation
+
+
 class Kinematics(abc.ABC):
     """k: R^p -> R^r with p - r degrees of redundancy (paper, eq. (4)).
 
-    Subclasses implement only :meth:`forward` and :meth:`jacobian`; the kernel, the
-    manipulability and singularity checks follow from the Jacobian.
+    Subclasses implement only :meth:`forward` and :meth:`jacobian` (and may implement
+    ``forward_jacobian``, both from one pass); the kernel, the manipulability and singularity
+    checks follow from the Jacobian. Each of those a subclass defines is wrapped, when the class
+    is made, by the check of ``x`` (finite, shape (..., p): :class:`InvalidInputError` with
+    field ``"x"`` otherwise); the subclass's own code stays reachable, unchecked, as
+    ``forward_unchecked``, ``jacobian_unchecked`` (and ``forward_jacobian_unchecked``), for
+    callers that checked their configurations once (the solvers, whose iterates may also leave
+    the finite range when a run diverges).
     """
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        for name in CHECKED:
+            core = cls.__dict__.get(name)
+            if core is None or getattr(core, "__isabstractmethod__", False):
+                continue
+            setattr(cls, f"{name}_unchecked", core)
+            setattr(cls, name, _checked(core))
 
     name: ClassVar[str]
     p: int  # configuration-space dimension
@@ -65,6 +110,14 @@ class Kinematics(abc.ABC):
     def jacobian(self, x: FloatArray) -> FloatArray:
         """J(x) = dk/dx: (..., p) -> (..., r, p)."""
 
+    def forward_unchecked(self, x: FloatArray) -> FloatArray:
+        """:meth:`forward` without the check of ``x`` (a float array (..., p))."""
+        return self.forward(x)  # (replaced by each subclass's own forward)
+
+    def jacobian_unchecked(self, x: FloatArray) -> FloatArray:
+        """:meth:`jacobian` without the check of ``x`` (a float array (..., p))."""
+        return self.jacobian(x)  # (replaced by each subclass's own jacobian)
+
     @property
     def parameters(self) -> dict[str, object]:
         """The kinematic parameters, as a JSON-friendly dict."""
@@ -78,13 +131,22 @@ class Kinematics(abc.ABC):
         """What the repr shows besides p and r: the parameters by default."""
         return self.parameters
 
-    def check(self, x, name: str = "x") -> FloatArray:
-        """Validate configurations: finite, shape (..., p)."""
-        return as_points(x, self.p, name)
+    @property
+    def scratch(self) -> int:
+        """About how many float64 numbers an evaluation of J(x) holds per configuration,
+        its result included: the memory estimates of batched calls
+        (:func:`jik.engine.solve_rules.solve_bytes`) use it. A kinematics whose evaluation
+        builds larger intermediates (a chain's transforms) says so."""
+        return 3 * self.r * self.p
 
-    def check_task(self, y, name: str = "y") -> FloatArray:
+    def check(self, x, name: str = "x", field: str | None = None) -> FloatArray:
+        """Validate configurations: finite, shape (..., p); errors name ``field`` (default
+        ``name``, :func:`jik.engine.validation.field_for`)."""
+        return as_points(x, self.p, name, field)
+
+    def check_task(self, y, name: str = "y", field: str | None = None) -> FloatArray:
         """Validate task-space points: finite, shape (..., r)."""
-        return as_points(y, self.r, name)
+        return as_points(y, self.r, name, field)
 
     def kernel(self, x: FloatArray) -> FloatArray:
         """Unit kernel vector K(x) of J(x), shape (..., p) (one degree of redundancy).
@@ -173,7 +235,7 @@ class Manipulator2(Kinematics):
     variable_names = ("x1", "x2", "x3")
 
     def __init__(self, l: float = 1.0) -> None:
-        self.l = positive(l, "arm length l")
+        self.l = positive(l, "arm length l", "l")
 
     @property
     def parameters(self) -> dict[str, object]:

@@ -92,7 +92,7 @@ def chain_guesses(inverse: Inverse, x0, y_d, *, gamma: float = 1.0) -> list[Traj
     # and stands at any later theta (see picard_guesses).
     theta = -np.log1p(-sigma[:-1]) / gamma
     theta = np.append(theta, theta[-1] + 1.0)
-    y = kin.forward(X)  # (L, nodes, r)
+    y = kin.forward_unchecked(X)  # (L, nodes, r)
     error = np.linalg.norm(y - y_d[:, None, :], axis=-1)
     return [
         Trajectory(theta=theta, x=X[j], y=y[j], error=error[j], h=inverse.augmenting_value(X[j]))

@@ -112,6 +112,12 @@ class PlanarChain(Kinematics):
         out["task"] = "x y angle" if self.orientation else "x y"
         return out
 
+    @property
+    def scratch(self) -> int:
+        """Float64 numbers per configuration of an evaluation of J: angles, link vectors and
+        joint positions, a few (p + 1, 2) arrays."""
+        return 12 * (self.p + 1)
+
     def _angles_lengths(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
         """theta_i (..., p) [rad] and a_i (..., p) [length]."""
         q = np.asarray(x, dtype=float) + self.offsets

@@ -35,10 +35,10 @@ class RestCarrying(Kinematics):
         return f"RestCarrying({self.inner!r})"
 
     def forward(self, x: FloatArray) -> FloatArray:
-        return self.inner.forward(x[..., : self.inner.p])
+        return self.inner.forward_unchecked(x[..., : self.inner.p])
 
     def jacobian(self, x: FloatArray) -> FloatArray:
-        J = self.inner.jacobian(x[..., : self.inner.p])
+        J = self.inner.jacobian_unchecked(x[..., : self.inner.p])
         return np.concatenate([J, np.zeros_like(J)], axis=-1)
 
 

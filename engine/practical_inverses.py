@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from .exceptions import InvalidInputError, KinematicSingularityError
-from .inverses import Inverse, Pseudoinverse
+from .inverses import Inverse, Pseudoinverse, require_kinematics
 from .kinematics import SINGULAR_MANIPULABILITY, Kinematics
 from .linalg import gram, solve_small
 from .validation import FloatArray, finite
@@ -80,7 +80,7 @@ class DampedInverse(Inverse):
     def __init__(
         self, kinematics: Kinematics, damping: float = 0.0, damping_threshold: float = 0.0
     ) -> None:
-        self.kinematics = kinematics
+        self.kinematics = require_kinematics(kinematics)
         self.damping = _nonnegative(damping, "damping", MAX_DAMPING)
         self.damping_threshold = _nonnegative(damping_threshold, "damping_threshold", MAX_DAMPING)
         self._plain = Pseudoinverse(kinematics) if self.damping == 0.0 else None
@@ -103,7 +103,7 @@ class DampedInverse(Inverse):
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
         if self._plain is not None:
             return self._plain.apply_masked(x, e)
-        J = self.kinematics.jacobian(x)
+        J = self.kinematics.jacobian_unchecked(x)
         lam2 = self.damping_squared(J)
         M = gram(J) + lam2[..., None, None] * np.eye(J.shape[-2])
         w, d = solve_small(M, e)
@@ -170,7 +170,7 @@ class WeightedInverse(Inverse):
     name = "weighted"
 
     def __init__(self, kinematics: Kinematics, limits) -> None:
-        self.kinematics = kinematics
+        self.kinematics = kinematics = require_kinematics(kinematics)
         lim = np.asarray(limits, dtype=float)
         if (
             lim.shape != (kinematics.p, 2)
@@ -195,7 +195,7 @@ class WeightedInverse(Inverse):
         return 1.0 / (1.0 + np.abs(limit_gradient(x, self.limits)))
 
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
-        J = self.kinematics.jacobian(x)
+        J = self.kinematics.jacobian_unchecked(x)
         winv = self.weights_inverse(x)
         Jw = J * np.sqrt(winv)[..., None, :]
         w, d = solve_small(gram(Jw), e)  # (J W^-1 J^T) w = e
@@ -206,7 +206,7 @@ class WeightedInverse(Inverse):
 
     def matrix(self, x: FloatArray) -> FloatArray:
         x = self.kinematics.check(x)
-        J = self.kinematics.jacobian(x)
+        J = self.kinematics.jacobian_unchecked(x)
         winv = self.weights_inverse(x)
         Jw = J * winv[..., None, :]
         M = Jw @ np.swapaxes(J, -1, -2)
@@ -263,7 +263,7 @@ class PostureInverse(Inverse):
     def __init__(
         self, kinematics: Kinematics, rest, gain: float = 1.0, rest_given: bool = True
     ) -> None:
-        self.kinematics = kinematics
+        self.kinematics = kinematics = require_kinematics(kinematics)
         self.rest_given = rest_given
         self.rest = kinematics.check(rest, "rest")
         if self.rest.shape != (kinematics.p,):
@@ -288,7 +288,7 @@ class PostureInverse(Inverse):
         (..., p)."""
         if self.gain == 0.0:
             return self._plain.apply_masked(x, e)
-        J = self.kinematics.jacobian(x)
+        J = self.kinematics.jacobian_unchecked(x)
         G = gram(J)
         w, d = solve_small(G, e)  # (J J^T) w = e
         bad = ~(np.abs(d) >= SINGULAR_MANIPULABILITY**2)

@@ -26,9 +26,10 @@ from .progress import Progress, check_cancelled, stops_at
 from .results import BatchSolveResult, RepeatabilityResult, SolveResult, Trajectory
 from .run_settings import Resume, RunSettings, inverse_fingerprint, resumed_legs
 from .solve_chunks import solve_in_chunks
+from .solve_rules import check_inverse, check_settings, run_bytes
 from .solver import solve, solve_batch
 from .unicycle import Unicycle
-from .validation import FloatArray, count
+from .validation import FloatArray, check_memory, count
 
 #: Largest number of cycles and of path points accepted.
 #: A run is called repeatable when its joints come back to x0 within this after every cycle
@@ -179,31 +180,47 @@ def repeatability(
     Raises
     ------
     InvalidInputError
-        Bad shapes, or a :class:`Resume` that is not whole cycles of this run (its legs' shape,
-        or its settings: the message names the field that differs).
+        Bad shapes or settings (``error.field`` names the argument), a :class:`Resume` that is
+        not whole cycles of this run or is of another run (its settings: the message names the
+        field that differs), or, before any work, starts whose estimated memory
+        (:func:`jik.engine.solve_rules.run_bytes`) exceeds
+        :data:`jik.engine.validation.MEMORY_LIMIT` (field ``x0``).
     JikError
         A leg's solve raised (a singular start configuration) and the progress, if any, did not
         stop the run there.
     RunCancelled
         ``progress.cancelled()`` returned True.
     """
-    kin = inverse.kinematics
+    kin = check_inverse(inverse)
     resume = x0 if isinstance(x0, Resume) else None
     x0 = kin.check(x0 if resume is None else resume.x0, "x0")
     path = kin.check_task(path, "path")
     if path.ndim not in (2, 3) or path.shape[-2] < 1:
-        raise InvalidInputError("path must be a list of task points, shape (L, r) with L >= 1")
+        raise InvalidInputError(
+            "path must be a list of task points, shape (L, r) with L >= 1", "path"
+        )
     if path.shape[-2] > MAX_PATH_POINTS:
         raise InvalidInputError(
-            f"path has {path.shape[-2]} points; at most {MAX_PATH_POINTS} allowed"
+            f"path has {path.shape[-2]} points; at most {MAX_PATH_POINTS} allowed", "path"
         )
     cycles = count(cycles, "cycles", 1, MAX_CYCLES)
     single = x0.ndim == 1
     xb = np.atleast_2d(x0)
     if xb.ndim != 2:
-        raise InvalidInputError("x0 must be one configuration or a 2-D batch")
+        raise InvalidInputError("x0 must be one configuration or a 2-D batch", "x0")
     if path.ndim == 3 and len(path) != len(xb):
-        raise InvalidInputError(f"{len(path)} paths given for {len(xb)} start configurations")
+        raise InvalidInputError(
+            f"{len(path)} paths given for {len(xb)} start configurations", "path"
+        )
+    mode, gamma, tol, cap = check_settings(mode, gamma, tol, max_iterations)
+    L = path.shape[-2] + int(close)  # (at most: the return leg to k(x0) is added when needed)
+    check_memory(
+        len(xb),
+        run_bytes(kin, cycles, L, mode, record and single, gamma, tol, cap),
+        "x0",
+        f"starts of a repeatability run ({cycles} cycles x {L} legs)",
+        "run them in smaller batches, with fewer cycles, or as an atlas streamed by iter_atlas",
+    )
     chunked = progress is not None and mode == "discrete" and single
     if close:
         targets = closed_path(kin, xb, path)  # (n, L, r)

@@ -255,7 +255,7 @@ class BatchSolveResult(Columns):
     def _recorded(self):
         """k(x), h(x), ||k(x) - y_d|| of every recorded point at once, and each member's slice."""
         assert self._rec_member is not None and self._rec_x is not None
-        ys = self._inverse.kinematics.forward(self._rec_x)
+        ys = self._inverse.kinematics.forward_unchecked(self._rec_x)
         h = self._inverse.augmenting_value(self._rec_x)
         err = np.linalg.norm(ys - self.y_d[self._rec_member], axis=-1)
         bounds = np.searchsorted(self._rec_member, np.arange(len(self.x) + 1))  # sorted members

@@ -76,11 +76,12 @@ def solve_in_chunks(
     """
     kin = inverse.kinematics
     x = kin.check(x0, "x0")
-    y_d = kin.check_task(y_d, "target y_d")
+    y_d = kin.check_task(y_d, "target y_d", "y_d")
     if x.ndim != 1 or y_d.ndim != 1:
         raise InvalidInputError(
             f"solve_in_chunks takes one start (p,) and one target (r,); got shapes {x.shape} "
-            f"and {y_d.shape}"
+            f"and {y_d.shape}",
+            "x0" if x.ndim != 1 else "y_d",
         )
     size = count(chunk, "chunk", 1, MAX_ITERATIONS_LIMIT)
     cap = count(

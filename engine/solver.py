@@ -25,17 +25,14 @@ from .picard_guesses import picard_guesses
 from .results import BatchSolveResult, SolveResult, Trajectory
 from .solve_rules import (
     DIVERGED_NORM,
-    MAX_ITERATIONS,
-    MAX_ITERATIONS_LIMIT,
-    MAX_STEPS,
-    MODES,
-    TOL_MIN,
     Record,
     Status,
-    check_gamma,
+    check_inverse,
+    check_settings,
+    solve_bytes,
     stop_message,
 )
-from .validation import count, positive
+from .validation import check_memory
 
 #: Picard sweeps per member in method "auto" before DOP853 takes over.
 PICARD_BUDGET = 80
@@ -51,7 +48,7 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto", guess=N
     n = len(x0)
     if not inverse.right_inverse:
         method = "dop853"  # the homotopy form needs e = e0 exp(-tau), which J J# != I breaks
-    e0 = inverse.kinematics.forward(x0) - y_d
+    e0 = inverse.kinematics.forward_unchecked(x0) - y_d
     err0 = np.linalg.norm(e0, axis=-1)
     moving = np.flatnonzero(err0 >= tol)
     # A singular start raises. Picard's first sweep evaluates J# at every moving start: only
@@ -89,7 +86,7 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto", guess=N
             keep = sig > 0
             rec.append((moving[mem[keep]], -np.log1p(-sig[keep]), xs[keep]))
     x[moving] = x1
-    err1 = np.linalg.norm(inverse.kinematics.forward(x1) - y_d[moving], axis=-1)
+    err1 = np.linalg.norm(inverse.kinematics.forward_unchecked(x1) - y_d[moving], axis=-1)
     with np.errstate(divide="ignore"):
         tau_end = np.where(
             done,
@@ -125,7 +122,7 @@ def _discrete(inverse, x0, y_d, gamma, tol, max_iterations, record):
     """x <- x - gamma J#(x) (k(x) - y_d) (section 6.2) until ||e|| < tol."""
     n = x0.shape[0]
     x = x0.copy()
-    e = inverse.kinematics.forward(x) - y_d
+    e = inverse.kinematics.forward_unchecked(x) - y_d
     _check_start(inverse, x, e, slice(None))
     err = np.linalg.norm(e, axis=-1)
     err0 = err.copy()
@@ -142,7 +139,7 @@ def _discrete(inverse, x0, y_d, gamma, tol, max_iterations, record):
         ok = idx[~bad]
         x[ok] -= gamma * v[~bad]
         nit[ok] = k
-        e[ok] = inverse.kinematics.forward(x[ok]) - y_d[ok]
+        e[ok] = inverse.kinematics.forward_unchecked(x[ok]) - y_d[ok]
         err[ok] = np.linalg.norm(e[ok], axis=-1)
         if rec is not None:
             rec.append((ok, np.full(ok.size, float(k)), x[ok].copy()))
@@ -211,17 +208,18 @@ def solve(
     ------
     InvalidInputError
         Wrong shapes (a batch of starts or targets), non-finite values, gamma out of range,
-        bad tol.
+        bad tol, mode, method or max_iterations; ``error.field`` names the argument.
     KinematicSingularityError, AlgorithmicSingularityError
         When the start configuration is singular for ``inverse``.
     """
-    kin = inverse.kinematics
+    kin = check_inverse(inverse)
     x0 = kin.check(x0, "x0")
-    y_d = kin.check_task(y_d, "target y_d")
+    y_d = kin.check_task(y_d, "target y_d", "y_d")
     if x0.ndim != 1 or y_d.ndim != 1:
         raise InvalidInputError(
             f"solve takes one start x0 (p,) and one target y_d (r,), got shapes {x0.shape} and "
-            f"{y_d.shape}; solve_batch solves a batch"
+            f"{y_d.shape}; solve_batch solves a batch",
+            "x0" if x0.ndim != 1 else "y_d",
         )
     batch = solve_batch(
         inverse,
@@ -273,13 +271,18 @@ def solve_batch(
     Raises
     ------
     InvalidInputError, KinematicSingularityError, AlgorithmicSingularityError
-        As :func:`solve` (the first singular start names its configuration).
+        As :func:`solve` (the first singular start names its configuration); also, before any
+        work, a batch whose estimated memory (:func:`jik.engine.solve_rules.solve_bytes`)
+        exceeds :data:`jik.engine.validation.MEMORY_LIMIT`, naming ``x0`` (``y_d`` for a batch
+        of targets from one start) and how many starts fit.
     """
-    kin = inverse.kinematics
+    kin = check_inverse(inverse)
     x0 = kin.check(x0, "x0")
-    y_d = kin.check_task(y_d, "target y_d")
+    y_d = kin.check_task(y_d, "target y_d", "y_d")
     if x0.ndim > 2 or y_d.ndim > 2:
-        raise InvalidInputError("x0 and y_d must be one point or a 2-D batch of points")
+        raise InvalidInputError(
+            "x0 and y_d must be one point or a 2-D batch of points", "x0" if x0.ndim > 2 else "y_d"
+        )
     xb = np.atleast_2d(x0)
     yb = np.broadcast_to(np.atleast_2d(y_d), (max(len(xb), len(np.atleast_2d(y_d))), kin.r))
     if len(xb) != len(yb):
@@ -287,23 +290,21 @@ def solve_batch(
             xb = np.broadcast_to(xb, (len(yb), kin.p))
         else:
             raise InvalidInputError(
-                f"x0 has {len(xb)} configurations but y_d has {len(np.atleast_2d(y_d))} targets"
+                f"x0 has {len(xb)} configurations but y_d has {len(np.atleast_2d(y_d))} targets",
+                "y_d",
             )
-    xb, yb = np.array(xb), np.array(yb)
-    if mode not in MODES:
-        raise InvalidInputError(f"mode must be 'continuous' or 'discrete', got {mode!r}")
-    gamma = check_gamma(gamma, mode)
-    tol = positive(tol, "tol")
-    if tol < TOL_MIN:
-        raise InvalidInputError(f"tol must be >= {TOL_MIN:g} (double precision), got {tol:g}")
-    if method not in ("auto", "picard", "dop853"):
-        raise InvalidInputError(f"method must be 'auto', 'picard' or 'dop853', got {method!r}")
+    mode, gamma, tol, cap = check_settings(mode, gamma, tol, max_iterations, method)
     if guess is not None and mode != "continuous":
-        raise InvalidInputError("guess applies to continuous mode only")
+        raise InvalidInputError("guess applies to continuous mode only", "guess")
+    check_memory(
+        len(xb),
+        solve_bytes(kin, 1, mode, record, gamma, tol, cap),
+        "x0" if x0.ndim == 2 or y_d.ndim == 1 else "y_d",
+        "starts of a batched solve" + (" with record=True" if record else ""),
+        "solve them in smaller batches" + (", or with record=False" if record else ""),
+    )
+    xb, yb = np.array(xb), np.array(yb)
     guesses = picard_guesses(guess, len(xb), kin.p, gamma)
-    default_cap = MAX_STEPS if mode == "continuous" else MAX_ITERATIONS
-    cap = default_cap if max_iterations is None else max_iterations
-    cap = count(cap, "max_iterations", 1, MAX_ITERATIONS_LIMIT)
 
     if mode == "continuous":
         x, _, status, nit, rec = _continuous(inverse, xb, yb, tol, cap, record, method, guesses)
@@ -311,7 +312,7 @@ def solve_batch(
     else:
         x, _, status, nit, rec = _discrete(inverse, xb, yb, gamma, tol, cap, record)
         theta_scale = 1.0
-    y = kin.forward(x)
+    y = kin.forward_unchecked(x)
     err = np.linalg.norm(y - yb, axis=-1)
     messages = tuple(
         stop_message(s, int(k), float(er), tol, mode, xi, inverse, cap)

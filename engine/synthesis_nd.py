@@ -294,7 +294,12 @@ def synthesize_e2_nd(
         )
         if len(set(axes)) != m_red:
             raise InvalidInputError(f"frame_axes needs {m_red} distinct joints", "frame_axes")
-    levels = sorted({count(n, "convergence degree", 1, degree) for n in convergence_degrees})
+    levels = sorted(
+        {
+            count(n, "convergence degree", 1, degree, "convergence_degrees")
+            for n in convergence_degrees
+        }
+    )
     levels = [n for n in levels if n < degree] + [degree]
 
     index = total_degree_indices(d, degree)

@@ -185,8 +185,8 @@ class Unicycle(Kinematics):
     variable_names = ("lambda10", "lambda11", "lambda20", "lambda21")
 
     def __init__(self, q0=(0.0, 0.0, 0.0), T: float = 2.0 * np.pi) -> None:
-        self.q0 = as_vector(q0, 3, "initial pose q0")
-        self.T = positive(T, "horizon T")
+        self.q0 = as_vector(q0, 3, "initial pose q0", "q0")
+        self.T = positive(T, "horizon T", "T")
 
     @property
     def parameters(self) -> dict[str, object]:
@@ -292,7 +292,7 @@ class Unicycle(Kinematics):
         Gauss-Legendre and the increments are summed cumulatively, so every point is as accurate
         as :meth:`forward`.
         """
-        lam = as_points(lam, 4, "control vector lambda")
+        lam = as_points(lam, 4, "control vector lambda", "lam")
         t = np.asarray(t, dtype=float)
         if t.ndim != 1 or t.size == 0 or np.any(~np.isfinite(t)) or np.any(t < 0):
             raise InvalidInputError("t must be a nonempty 1-D array of finite times >= 0")

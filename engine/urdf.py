@@ -251,11 +251,17 @@ class UrdfChain(Kinematics):
 
     def jacobian(self, x: FloatArray) -> FloatArray:
         """J(x): (..., p) -> (..., r, p), analytic (see the class notes)."""
-        return self.forward_jacobian(x)[1]
+        return self.pose_task.value_jacobian(*self.compiled.pose_jacobian(x))[1]
 
     def forward_jacobian(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
         """k(x) (..., r) and J(x) (..., r, p) from one pass along the chain."""
         return self.pose_task.value_jacobian(*self.compiled.pose_jacobian(x))
+
+    @property
+    def scratch(self) -> int:
+        """Float64 numbers per configuration of an evaluation of J: the m movable joints'
+        4 x 4 transforms and the geometric Jacobian, a few times over."""
+        return 48 * (self.compiled.m + 1)
 
     def end_pose(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
         """The end link's rotation (..., 3, 3) and position (..., 3) in the base frame."""

@@ -1,6 +1,13 @@
-"""Input validation shared by every public engine function."""
+"""Input validation shared by every public engine function, and the bound on a call's memory.
+
+Each check raises :class:`InvalidInputError` whose ``field`` names the argument: the ``field``
+given, else ``name`` when it is an argument's name or a dotted path (``"x0"``, ``"region.x2"``);
+a descriptive ``name`` ("target y_d") gives no field unless ``field`` is passed.
+"""
 
 from __future__ import annotations
+
+import re
 
 import numpy as np
 
@@ -8,67 +15,138 @@ from .exceptions import InvalidInputError
 
 FloatArray = np.ndarray
 
+#: The most memory, in bytes, that one call of the engine may plan to hold (a batched solve, a
+#: repeatability run, a gathered atlas, an atlas's chunk): a call whose estimate
+#: (:func:`check_memory`) is larger is refused before it allocates anything. Read at each call,
+#: so a caller with more memory may raise it: ``jik.engine.validation.MEMORY_LIMIT = 16 * 2**30``.
+MEMORY_LIMIT = 4 * 2**30
 
-def as_points(x, size: int, name: str) -> FloatArray:
+_FIELD = re.compile(r"[A-Za-z_]\w*(\.\w+)*")
+
+
+def field_for(name: str, field: str | None = None) -> str | None:
+    """The error's field for a check of ``name``: ``field``, else ``name`` if it is an
+    argument's name or a dotted path, else None."""
+    if field is not None:
+        return field
+    return name if _FIELD.fullmatch(name) else None
+
+
+def as_points(x, size: int, name: str, field: str | None = None) -> FloatArray:
     """Check that ``x`` is a finite float array of shape (..., size) and return it.
 
     Raises
     ------
     InvalidInputError
-        On a wrong trailing dimension or a NaN/inf entry, naming ``name``.
+        On a wrong trailing dimension or a NaN/inf entry, naming ``name`` (field:
+        :func:`field_for`).
     """
     try:
         a = np.asarray(x, dtype=float)
     except (TypeError, ValueError, OverflowError) as exc:
-        raise InvalidInputError(f"{name} must be numeric, got {x!r}") from exc
+        raise InvalidInputError(
+            f"{name} must be numeric, got {x!r:.80}", field_for(name, field)
+        ) from exc
     if a.ndim == 0 or a.shape[-1] != size:
         raise InvalidInputError(
-            f"{name} must have shape (..., {size}) (a vector of length {size}), got shape {a.shape}"
+            f"{name} must have shape (..., {size}) (a vector of length {size}), got shape "
+            f"{a.shape}",
+            field_for(name, field),
         )
-    if not np.all(np.isfinite(a)):
-        raise InvalidInputError(f"{name} contains NaN or infinite values; give finite numbers")
+    if not np.isfinite(a).all():
+        raise InvalidInputError(
+            f"{name} contains NaN or infinite values; give finite numbers", field_for(name, field)
+        )
     return a
 
 
-def as_vector(x, size: int, name: str) -> FloatArray:
+def as_vector(x, size: int, name: str, field: str | None = None) -> FloatArray:
     """Check that ``x`` is one finite vector of length ``size``."""
-    a = as_points(x, size, name)
+    a = as_points(x, size, name, field)
     if a.ndim != 1:
-        raise InvalidInputError(f"{name} must be a single vector of length {size}, got {a.shape}")
+        raise InvalidInputError(
+            f"{name} must be a single vector of length {size}, got {a.shape}",
+            field_for(name, field),
+        )
     return a
 
 
-def positive(value, name: str) -> float:
+def positive(value, name: str, field: str | None = None) -> float:
     """Check that ``value`` is a finite number > 0."""
-    v = finite(value, name)
+    v = finite(value, name, field)
     if v <= 0:
-        raise InvalidInputError(f"{name} must be > 0, got {v}")
+        raise InvalidInputError(f"{name} must be > 0, got {v}", field_for(name, field))
     return v
 
 
-def finite(value, name: str) -> float:
+def finite(value, name: str, field: str | None = None) -> float:
     """Check that ``value`` is a finite real number."""
     try:
         v = float(value)
     except (TypeError, ValueError, OverflowError) as exc:
-        raise InvalidInputError(f"{name} must be a number, got {value!r:.80}") from exc
+        raise InvalidInputError(
+            f"{name} must be a number, got {value!r:.80}", field_for(name, field)
+        ) from exc
     if not np.isfinite(v):
-        raise InvalidInputError(f"{name} must be finite, got {v}")
+        raise InvalidInputError(f"{name} must be finite, got {v}", field_for(name, field))
     return v
 
 
 def count(value, name: str, low: int, high: int, field: str | None = None) -> int:
-    """Check that ``value`` is an integer in [low, high] (``field``: the error's field)."""
+    """Check that ``value`` is an integer in [low, high]."""
     try:
         integral = not isinstance(value, bool) and int(value) == value
     except (TypeError, ValueError, OverflowError):
         integral = False
     if not integral:
-        raise InvalidInputError(f"{name} must be an integer, got {value!r}", field)
+        raise InvalidInputError(f"{name} must be an integer, got {value!r}", field_for(name, field))
     v = int(value)
     if not low <= v <= high:
-        raise InvalidInputError(f"{name} must be between {low} and {high}, got {v}", field)
+        raise InvalidInputError(
+            f"{name} must be between {low} and {high}, got {v}", field_for(name, field)
+        )
     return v
+
+
+def check_memory(n: int, each: float, field: str, what: str, instead: str) -> None:
+    """Refuse a call of ``n`` items of ``each`` bytes (its estimated peak memory) when they
+    exceed :data:`MEMORY_LIMIT`.
+
+    Parameters
+    ----------
+    n : int
+        The number of items the call holds at once (starts, runs).
+    each : float
+        The estimated bytes per item.
+    field : str
+        The argument that gives ``n`` (``"x0"``, ``"n_starts"``).
+    what : str
+        What the items are, for the message: "starts of a batched solve".
+    instead : str
+        What to do instead: "solve them in smaller batches".
+
+    Raises
+    ------
+    InvalidInputError
+        With ``field``: "x0: 1000000 starts of a batched solve would hold about 10.1 GiB, more
+        than ... ; at most 425000 fit: solve them in smaller batches".
+    """
+    limit = MEMORY_LIMIT
+    if n * each > limit:
+        raise InvalidInputError(
+            f"{field}: {n} {what} would hold about {_size(n * each)}, more than the engine's "
+            f"bound of {_size(limit)} (jik.engine.validation.MEMORY_LIMIT); at most "
+            f"{int(limit // each)} fit: {instead}",
+            field,
+        )
+
+
+def _size(n: float) -> str:
+    """Bytes in readable units: '1.5 GiB'."""
+    for unit, scale in (("TiB", 2**40), ("GiB", 2**30), ("MiB", 2**20)):
+        if n >= scale:
+            return f"{n / scale:.3g} {unit}"
+    return f"{n / 2**10:.3g} KiB"
 
 
 def json_number(value, name: str, field: str | None = None) -> float:

@@ -296,16 +296,27 @@ def synthesize_e2(
     SynthesisResult
     """
     if kinematics.p - kinematics.r != 1:
-        raise InvalidInputError("synthesize_e2 needs one degree of redundancy (p - r = 1)")
+        raise InvalidInputError(
+            "synthesize_e2 needs one degree of redundancy (p - r = 1)", "kinematics"
+        )
     box, fix = check_region(kinematics, region, fixed)
     d = len(box)
     if d not in (2, 3):
-        raise InvalidInputError(f"the region must have two or three variables, got {list(box)}")
+        raise InvalidInputError(
+            f"the region must have two or three variables, got {list(box)}", "region"
+        )
     degs = [degree] * d if np.ndim(degree) == 0 else list(cast(Sequence[int], degree))
     if len(degs) != d:
-        raise InvalidInputError(f"degree needs one value per region variable ({d}), got {degree}")
+        raise InvalidInputError(
+            f"degree needs one value per region variable ({d}), got {degree}", "degree"
+        )
     degs = [count(n, "degree", 1, 64 if d == 2 else 16) for n in degs]
-    levels = sorted({count(n, "convergence degree", 1, max(degs)) for n in convergence_degrees})
+    levels = sorted(
+        {
+            count(n, "convergence degree", 1, max(degs), "convergence_degrees")
+            for n in convergence_degrees
+        }
+    )
     levels = [n for n in levels if n < min(degs)]
     plan = [[n] * d for n in levels] + [degs]
     cost = np.array([float(np.prod(np.add(q, 1))) ** 2 for q in plan])

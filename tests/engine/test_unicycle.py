@@ -170,6 +170,9 @@ def test_controls_too_fast_for_the_quadrature_are_refused():
     for call in (kin.forward, kin.jacobian, lambda x: kin.path(x, [6.0])):
         with pytest.raises(InvalidInputError, match=r"\|lambda20\| = 1100.*more than 8192"):
             call(fast)
+    # (a diverging solve's iterate reaches the unchecked core; the public forward refuses it)
     with pytest.raises(InvalidInputError, match="oscillate too fast"):
+        kin.forward_unchecked(np.array([0.0, 0.0, np.inf, 0.0]))
+    with pytest.raises(InvalidInputError, match="x contains NaN or infinite"):
         kin.forward(np.array([0.0, 0.0, np.inf, 0.0]))
     assert unicycle.nodes_for(np.array([0, 0, 1000.0, 1000.0]), 2 * np.pi) <= unicycle.MAX_NODES

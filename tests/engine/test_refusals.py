@@ -1,0 +1,225 @@
+"""The front door's refusals: every public function that refuses an argument raises
+InvalidInputError whose ``field`` names it; the kinematics check ``x`` at their public methods,
+and the inverses check what they are built from."""
+
+import math
+
+import numpy as np
+import pytest
+
+import jik.engine as jik
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.kinematics import Kinematics
+
+X0 = [0.0, 0.0, math.pi / 2]
+PATH = [(1, 1), (1, 2), (0, 2)]
+LOOP = [(0, 1), *PATH]
+BOX = {"x2": (0, 1), "x3": (1, 2)}
+ARM = jik.Manipulator2()
+P = jik.Pseudoinverse(ARM)
+
+#: (call, expected field): each call refuses one argument.
+REFUSALS = {
+    "solve x0 wrong length": (lambda: jik.solve(P, [0, 0], [1, 1]), "x0"),
+    "solve x0 NaN": (lambda: jik.solve(P, [0, np.nan, 1], [1, 1]), "x0"),
+    "solve x0 text": (lambda: jik.solve(P, "abc", [1, 1]), "x0"),
+    "solve x0 a batch": (lambda: jik.solve(P, [X0, X0], [1, 1]), "x0"),
+    "solve y_d wrong length": (lambda: jik.solve(P, X0, [1, 1, 1]), "y_d"),
+    "solve y_d infinite": (lambda: jik.solve(P, X0, [np.inf, 1]), "y_d"),
+    "solve y_d a batch": (lambda: jik.solve(P, X0, [[1, 1], [1, 2]]), "y_d"),
+    "solve gamma": (lambda: jik.solve(P, X0, [1, 1], gamma=-1), "gamma"),
+    "solve mode": (lambda: jik.solve(P, X0, [1, 1], mode="euler"), "mode"),
+    "solve method": (lambda: jik.solve(P, X0, [1, 1], method="rk4"), "method"),
+    "solve tol 0": (lambda: jik.solve(P, X0, [1, 1], tol=0), "tol"),
+    "solve tol tiny": (lambda: jik.solve(P, X0, [1, 1], tol=1e-20), "tol"),
+    "solve max_iterations": (lambda: jik.solve(P, X0, [1, 1], max_iterations=-5), "max_iterations"),
+    "solve guess in discrete mode": (
+        lambda: jik.solve(
+            P, X0, [1, 1], mode="discrete", gamma=0.5, guess=jik.solve(P, X0, [1, 1]).trajectory
+        ),
+        "guess",
+    ),
+    "solve not an inverse": (lambda: jik.solve("pseudoinverse", X0, [1, 1]), "inverse"),
+    "solve_batch x0 3-D": (lambda: jik.solve_batch(P, np.zeros((2, 2, 3)), [1, 1]), "x0"),
+    "solve_batch counts differ": (lambda: jik.solve_batch(P, [X0, X0], [[1, 1]] * 3), "y_d"),
+    "repeatability cycles -1": (lambda: jik.repeatability(P, X0, PATH, cycles=-1), "cycles"),
+    "repeatability cycles 1e9": (lambda: jik.repeatability(P, X0, PATH, cycles=10**9), "cycles"),
+    "repeatability cycles 2.5": (lambda: jik.repeatability(P, X0, PATH, cycles=2.5), "cycles"),
+    "repeatability path 3-D points": (lambda: jik.repeatability(P, X0, [(1, 1, 1)]), "path"),
+    "repeatability path empty": (lambda: jik.repeatability(P, X0, []), "path"),
+    "repeatability path no points": (lambda: jik.repeatability(P, X0, np.zeros((0, 2))), "path"),
+    "repeatability path NaN": (lambda: jik.repeatability(P, X0, [(1, np.nan)]), "path"),
+    "repeatability path too long": (lambda: jik.repeatability(P, X0, [(1, 1)] * 101), "path"),
+    "repeatability paths per start": (
+        lambda: jik.repeatability(P, [X0, X0], [PATH] * 3),
+        "path",
+    ),
+    "repeatability x0 wrong width": (lambda: jik.repeatability(P, np.zeros((2, 5)), PATH), "x0"),
+    "repeatability x0 3-D": (lambda: jik.repeatability(P, np.zeros((2, 2, 3)), PATH), "x0"),
+    "repeatability mode": (lambda: jik.repeatability(P, X0, PATH, mode="euler"), "mode"),
+    "repeatability tol": (lambda: jik.repeatability(P, X0, PATH, tol=-1), "tol"),
+    "repeatability max_iterations": (
+        lambda: jik.repeatability(P, X0, PATH, max_iterations=0),
+        "max_iterations",
+    ),
+    "Manipulator2 l": (lambda: jik.Manipulator2(l=-1), "l"),
+    "forward wrong width": (lambda: ARM.forward(np.zeros(5)), "x"),
+    "jacobian NaN": (lambda: ARM.jacobian(np.array([np.nan, 0, 0])), "x"),
+    "Pseudoinverse of a name": (lambda: jik.Pseudoinverse("manipulator2"), "kinematics"),
+    "DampedInverse of a name": (lambda: jik.DampedInverse("manipulator2", 0.1), "kinematics"),
+    "WeightedInverse of None": (lambda: jik.WeightedInverse(None, [[0, 1]] * 3), "kinematics"),
+    "PostureInverse rest": (lambda: jik.PostureInverse(ARM, rest=[0, 0]), "rest"),
+    "ExtendedInverse of a formula text": (
+        lambda: jik.ExtendedInverse(ARM, "x3"),
+        "augmenting_map",
+    ),
+    "ExtendedInverse with two degrees of redundancy": (
+        lambda: jik.ExtendedInverse(
+            jik.PlanarChain("RRRR", [1, 1, 1, 1]), jik.FormulaMap("x1", ["x1", "x2", "x3", "x4"])
+        ),
+        "kinematics",
+    ),
+    "ExtendedInverse map on another space": (
+        lambda: jik.ExtendedInverse(ARM, jik.FormulaMap("a", ["a", "b"])),
+        "augmenting_map",
+    ),
+    "VectorExtendedInverse of texts": (
+        lambda: jik.VectorExtendedInverse(jik.PlanarChain("RRRR", [1] * 4), ["x1", "x2"]),
+        "augmenting_maps.0",
+    ),
+    "synthesize_e2 unknown variable": (
+        lambda: jik.synthesize_e2(ARM, {"x7": (0, 1), "x3": (1, 2)}),
+        "region",
+    ),
+    "synthesize_e2 reversed box": (
+        lambda: jik.synthesize_e2(ARM, {"x2": (1, 0), "x3": (1, 2)}),
+        "region.x2",
+    ),
+    "synthesize_e2 bound not a number": (
+        lambda: jik.synthesize_e2(ARM, {"x2": (0, "a"), "x3": (1, 2)}),
+        "region.x2",
+    ),
+    "synthesize_e2 one variable": (lambda: jik.synthesize_e2(ARM, {"x2": (0, 1)}), "region"),
+    "synthesize_e2 degree": (lambda: jik.synthesize_e2(ARM, BOX, degree=10000), "degree"),
+    "synthesize_e2 degrees per variable": (
+        lambda: jik.synthesize_e2(ARM, BOX, degree=[4, 4, 4]),
+        "degree",
+    ),
+    "synthesize_e2 redundancy": (
+        lambda: jik.synthesize_e2(jik.PlanarChain("RRRR", [1] * 4), {"x1": (0, 1), "x2": (0, 1)}),
+        "kinematics",
+    ),
+    "error_functional_e2 nodes 0": (
+        lambda: jik.error_functional_e2(ARM, jik.PaperCubic(), BOX, nodes=0),
+        "nodes",
+    ),
+    "error_functional_e2 nodes huge": (
+        lambda: jik.error_functional_e2(ARM, jik.PaperCubic(), BOX, nodes=100000),
+        "nodes",
+    ),
+    "plan_atlas n_starts without arc": (
+        lambda: jik.plan_atlas(P, LOOP, n_starts=64, reference=X0),
+        "arc",
+    ),
+    "plan_atlas n_starts without reference": (
+        lambda: jik.plan_atlas(P, LOOP, n_starts=64, arc=(-1, 1)),
+        "reference",
+    ),
+    "plan_atlas no starts at all": (lambda: jik.plan_atlas(P, LOOP), "starts"),
+    "plan_atlas n_starts negative": (
+        lambda: jik.plan_atlas(P, LOOP, n_starts=-4, arc=(-1, 1), reference=X0),
+        "n_starts",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", REFUSALS, ids=str)
+def test_a_refused_argument_is_the_errors_field(case):
+    call, field = REFUSALS[case]
+    with pytest.raises(InvalidInputError) as info:
+        call()
+    assert info.value.field == field, str(info.value)
+
+
+def test_plan_atlas_names_both_missing_arguments():
+    """n_starts alone: the message names arc and reference, and what each is."""
+    with pytest.raises(InvalidInputError) as info:
+        jik.plan_atlas(P, LOOP, n_starts=64)
+    assert info.value.field == "arc"
+    assert str(info.value).startswith("n_starts needs arc and reference: arc = (lo, hi)")
+    assert "reference, a configuration (3 numbers" in str(info.value)
+
+
+def test_texts_for_objects_say_how_to_make_them():
+    """A robot's or a formula's name where an object belongs: the message shows the call."""
+    with pytest.raises(InvalidInputError, match=r"robot_from_dict\(\{'name': 'manipulator2'\}\)"):
+        jik.Pseudoinverse("manipulator2")
+    with pytest.raises(InvalidInputError, match=r"FormulaMap\('x3', \['x1', 'x2', 'x3'\]\)"):
+        jik.ExtendedInverse(ARM, "x3")
+
+
+def _ur5e():
+    return jik.robot_from_dict({"name": "ur5e"}).kinematics
+
+
+def _robots():
+    """One kinematics of each kind, built-in, user-defined and URDF."""
+    return [
+        jik.Manipulator1(),
+        jik.Manipulator2(),
+        jik.PlanarChain("RRR", [1, 1, 1]),
+        jik.PlanarChain("RPR", [1, 1, 1], orientation=True),
+        jik.FormulaKinematics(["a", "b", "c"], ["a + cos(c)", "b + sin(c)"]),
+        _ur5e(),
+        jik.Unicycle(),
+    ]
+
+
+def _methods(kin):
+    names = ["forward", "jacobian"] + ["forward_jacobian"] * hasattr(kin, "forward_jacobian")
+    return [getattr(kin, n) for n in names]
+
+
+@pytest.mark.parametrize("kin", _robots(), ids=lambda k: f"{k.name}-p{k.p}-r{k.r}")
+def test_every_kinematics_checks_x_at_its_public_methods(kin):
+    """Wrong width (short, long, a matrix's rows), a scalar, NaN, inf and text: InvalidInputError
+    with field "x", for forward, jacobian and forward_jacobian alike."""
+    p = kin.p
+    bad = [np.zeros(p - 1), np.zeros(p + 2), np.zeros((4, p + 1)), 0.5, [np.nan] * p, "x1"]
+    bad.append(np.r_[np.full(p - 1, 0.1), np.inf])
+    for method in _methods(kin):
+        for x in bad:
+            with pytest.raises(InvalidInputError) as info:
+                method(x)
+            assert info.value.field == "x", (method.__name__, x)
+
+
+@pytest.mark.parametrize("kin", _robots(), ids=lambda k: f"{k.name}-p{k.p}-r{k.r}")
+def test_the_checked_methods_give_the_cores_numbers(kin):
+    """A batch of good configurations (a list, or a float array with huge finite entries whose
+    sum overflows): the checked method and the unchecked core agree, bit for bit."""
+    x = np.random.default_rng(3).uniform(0.1, 0.6, (5, kin.p))
+    np.testing.assert_array_equal(kin.forward(x.tolist()), kin.forward_unchecked(x))
+    np.testing.assert_array_equal(kin.jacobian(x), kin.jacobian_unchecked(x))
+    if not isinstance(kin, jik.Unicycle):  # (its quadrature refuses such controls)
+        huge = np.full((2, kin.p), 1e308)
+        with np.errstate(all="ignore"):
+            np.testing.assert_array_equal(kin.forward(huge), kin.forward_unchecked(huge))
+
+
+def test_a_users_kinematics_gets_the_check():
+    """A subclass written as STYLE.md shows it (forward and jacobian only) is checked too."""
+
+    class Line(Kinematics):
+        name, p, r = "line", 2, 1
+
+        def forward(self, x):
+            return x[..., :1] + x[..., 1:]
+
+        def jacobian(self, x):
+            return np.ones((*x.shape[:-1], 1, 2))
+
+    with pytest.raises(InvalidInputError, match=r"x must have shape \(\.\.\., 2\)") as info:
+        Line().forward(np.zeros(3))
+    assert info.value.field == "x"
+    np.testing.assert_array_equal(Line().forward([1.0, 2.0]), [3.0])
