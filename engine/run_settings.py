@@ -34,43 +34,44 @@ def inverse_fingerprint(inverse) -> str:
     names start with ``_``). Equal for two inverses built alike, different when a parameter, a
     map's coefficient or a link length differs."""
     digest = hashlib.sha256()
-
-    def feed(obj, depth: int) -> None:
-        digest.update(type(obj).__qualname__.encode())
-        items = (
-            {f.name: getattr(obj, f.name) for f in dataclasses.fields(obj)}
-            if dataclasses.is_dataclass(obj)
-            else vars(obj)
-            if hasattr(obj, "__dict__")
-            else {}
-        )
-        for key in sorted(items):
-            if not key.startswith("_"):
-                digest.update(key.encode())
-                value(items[key], depth)
-
-    def value(v, depth: int) -> None:
-        if isinstance(v, _SIMPLE):
-            digest.update(repr(v).encode())
-        elif isinstance(v, np.ndarray):
-            digest.update(str(v.dtype).encode() + str(v.shape).encode())
-            digest.update(np.ascontiguousarray(v).tobytes())
-        elif isinstance(v, (list, tuple)):
-            for item in v:
-                value(item, depth)
-        elif isinstance(v, dict):
-            for k in sorted(v, key=str):
-                digest.update(str(k).encode())
-                value(v[k], depth)
-        elif (
-            depth < 4
-            and not callable(v)
-            and (hasattr(v, "__dict__") or dataclasses.is_dataclass(v))
-        ):
-            feed(v, depth + 1)
-
-    feed(inverse, 0)
+    _feed(digest, inverse, 0)
     return digest.hexdigest()[:16]
+
+
+def _feed(digest, obj, depth: int) -> None:
+    """Digest an object's class and public attributes (module-level, not a closure: a
+    recursive closure is a reference cycle that lives until the garbage collector runs)."""
+    digest.update(type(obj).__qualname__.encode())
+    items = (
+        {f.name: getattr(obj, f.name) for f in dataclasses.fields(obj)}
+        if dataclasses.is_dataclass(obj)
+        else vars(obj)
+        if hasattr(obj, "__dict__")
+        else {}
+    )
+    for key in sorted(items):
+        if not key.startswith("_"):
+            digest.update(key.encode())
+            _value(digest, items[key], depth)
+
+
+def _value(digest, v, depth: int) -> None:
+    """Digest one attribute's value: simple values by repr, arrays by their bytes, containers
+    item by item, objects (to depth 4) by :func:`_feed`."""
+    if isinstance(v, _SIMPLE):
+        digest.update(repr(v).encode())
+    elif isinstance(v, np.ndarray):
+        digest.update(str(v.dtype).encode() + str(v.shape).encode())
+        digest.update(np.ascontiguousarray(v).tobytes())
+    elif isinstance(v, (list, tuple)):
+        for item in v:
+            _value(digest, item, depth)
+    elif isinstance(v, dict):
+        for k in sorted(v, key=str):
+            digest.update(str(k).encode())
+            _value(digest, v[k], depth)
+    elif depth < 4 and not callable(v) and (hasattr(v, "__dict__") or dataclasses.is_dataclass(v)):
+        _feed(digest, v, depth + 1)
 
 
 @dataclass(frozen=True)
