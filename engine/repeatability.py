@@ -377,5 +377,5 @@ def _stopped_leg(inverse, x, target, exc, mode, gamma, record) -> SolveResult:
         inverse.name,
         x.copy(),
         np.asarray(target, dtype=float),
-        repr(inverse),
+        inverse,
     )

@@ -122,7 +122,12 @@ class SolveResult(Columns):
     algorithm: str
     x0: FloatArray
     y_d: FloatArray
-    inverse: str = ""
+    _inverse: Inverse | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def inverse(self) -> str:
+        """The inverse as printed (made when asked: the API's workers never ask)."""
+        return "" if self._inverse is None else repr(self._inverse)
 
     def __repr__(self) -> str:
         points = "none" if self.trajectory is None else f"{len(self.trajectory)} points"
@@ -275,7 +280,7 @@ class BatchSolveResult(Columns):
             algorithm=self.algorithm,
             x0=self.x0[i],
             y_d=self.y_d[i],
-            inverse=repr(self._inverse),
+            _inverse=self._inverse,
         )
 
 
