@@ -130,7 +130,7 @@ def check_settings(
 
 def stop_message(status, nit, err, tol, mode, x, inverse, max_iterations) -> str:
     """What a member that stopped with ``status`` after ``nit`` steps at task error ``err`` says."""
-    steps = "steps" if mode == "continuous" else "iterations"
+    steps = ("step" if mode == "continuous" else "iteration") + ("" if nit == 1 else "s")
     if status == Status.CONVERGED:
         if nit == 0:
             return f"already at the target (error {err:.3g} < {tol:g}): no motion"
@@ -146,8 +146,9 @@ def stop_message(status, nit, err, tol, mode, x, inverse, max_iterations) -> str
             f"stalled after {nit} {steps} at error {err:.3g}: the step size collapsed near a "
             "singularity or the target is unreachable"
         )
+    cap = ("step" if mode == "continuous" else "iteration") + ("" if max_iterations == 1 else "s")
     return (
-        f"did not converge within {max_iterations} {steps} (error {err:.3g} >= {tol:g}); "
+        f"did not converge within {max_iterations} {cap} (error {err:.3g} >= {tol:g}); "
         "raise max_iterations or gamma"
     )
 
