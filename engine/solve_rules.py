@@ -128,27 +128,32 @@ def check_settings(
     return mode, gamma, tol, cap
 
 
+def counted(n: int, mode: str) -> str:
+    """``n`` steps of ``mode``: integrator steps (continuous) or iterations (discrete), the
+    singular for one ("1 step", "20 iterations")."""
+    return f"{n} {'step' if mode == 'continuous' else 'iteration'}{'' if n == 1 else 's'}"
+
+
 def stop_message(status, nit, err, tol, mode, x, inverse, max_iterations) -> str:
     """What a member that stopped with ``status`` after ``nit`` steps at task error ``err`` says."""
-    steps = ("step" if mode == "continuous" else "iteration") + ("" if nit == 1 else "s")
+    steps = counted(nit, mode)
     if status == Status.CONVERGED:
         if nit == 0:
             return f"already at the target (error {err:.3g} < {tol:g}): no motion"
-        return f"converged: task error {err:.3g} < {tol:g} after {nit} {steps}"
+        return f"converged: task error {err:.3g} < {tol:g} after {steps}"
     if status == Status.SINGULAR:
         return str(inverse.singular_error(x)) + "; the run stopped there"
     if status == Status.DIVERGED:
-        return f"diverged after {nit} {steps} (error {err:.3g}); " + (
+        return f"diverged after {steps} (error {err:.3g}); " + (
             "lower gamma" if mode == "discrete" else "the target may be unreachable"
         )
     if status == Status.STALLED:
         return (
-            f"stalled after {nit} {steps} at error {err:.3g}: the step size collapsed near a "
+            f"stalled after {steps} at error {err:.3g}: the step size collapsed near a "
             "singularity or the target is unreachable"
         )
-    cap = ("step" if mode == "continuous" else "iteration") + ("" if max_iterations == 1 else "s")
     return (
-        f"did not converge within {max_iterations} {cap} (error {err:.3g} >= {tol:g}); "
+        f"did not converge within {counted(max_iterations, mode)} (error {err:.3g} >= {tol:g}); "
         "raise max_iterations or gamma"
     )
 

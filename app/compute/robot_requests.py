@@ -13,6 +13,7 @@ from pydantic import BaseModel
 
 from ...engine.exceptions import InvalidInputError
 from ...engine.inverses import ExtendedInverse
+from ...engine.parameters import check_params
 from ...engine.registry import ALGORITHMS, ROBOTS, RobotSpec, make_inverse
 from . import schemas as S
 from .exceptions import RequestError
@@ -140,11 +141,10 @@ def checked_augmentation(spec: RobotSpec, req_aug) -> tuple[Any, dict]:
             f"its parameters: {sorted(known) or 'none'}",
         )
     values = {p.name: given.get(p.name, p.default) for p in aspec.parameters}
-    for p in aspec.parameters:
-        try:
-            p.check(values[p.name])
-        except InvalidInputError as exc:
-            raise RequestError("augmentation", str(exc)) from None
+    try:
+        check_params(aspec.parameters, values, f"{aspec.name} of {spec.name}")
+    except InvalidInputError as exc:
+        raise RequestError("augmentation", str(exc)) from None
     return aspec, values
 
 

@@ -15,6 +15,7 @@ from ...engine.exceptions import RunCancelled
 from ...engine.progress import ProgressCallbacks
 from ...engine.repeatability import Leg, Resume, closed_path, repeatability
 from ...engine.results import SolveResult, Trajectory
+from ...engine.solve_rules import counted
 from ...engine.unicycle import Unicycle
 from .controls import max_iterations
 from .model import DashboardState
@@ -189,7 +190,7 @@ def _leg_message(res: SolveResult, cap: int) -> str:
         )
     if res.mode == "continuous" or not res.success:
         return res.message
-    return f"converged: task error {res.error:.3g} after {res.nit} iterations"
+    return f"converged: task error {res.error:.3g} after {counted(res.nit, res.mode)}"
 
 
 def _leg_trajectory(run: AlgorithmRun, k: int) -> Trajectory | None:
