@@ -123,17 +123,28 @@ def _robot_limits(kinematics: Kinematics, spec: RobotSpec | None, robot: str | N
     )
 
 
-def _robot_rest(kinematics: Kinematics, spec: RobotSpec | None, robot: str | None):
-    """The robot's home configuration; else its default start x0 in the catalogue."""
+def default_rest(
+    kinematics: Kinematics,
+    x0=None,
+    spec: RobotSpec | None = None,
+    robot: str | None = None,
+) -> tuple[list[float], str]:
+    """The posture inverse's rest x_rest when none is given, and what it is ("home" or "x0"):
+    the robot's home configuration, else the run's start ``x0``, else (no start given) the
+    robot's default start in ``spec`` (or the catalogue's spec of ``robot``). The one rule of
+    single runs, for the REST API and the dashboard alike; an atlas without rest pulls each run
+    toward its own start instead (:mod:`jik.engine.posture_at_start`)."""
     from .registry import ROBOTS
 
     home = getattr(kinematics, "home", None)
     if home is not None:
-        return home
-    spec = spec or ROBOTS.get(robot or kinematics.name)
-    if spec is not None and getattr(spec, "default_x0", None):
-        return spec.default_x0
-    raise InvalidInputError(f"{kinematics.name} has no home posture: give rest", "rest")
+        return [float(v) for v in home], "home"
+    if x0 is None:
+        spec = spec or ROBOTS.get(robot or kinematics.name)
+        x0 = getattr(spec, "default_x0", None) or None
+    if x0 is None:
+        raise InvalidInputError(f"{kinematics.name} has no home posture: give rest", "rest")
+    return [float(v) for v in x0], "x0"
 
 
 def make_inverse(
@@ -145,6 +156,7 @@ def make_inverse(
     *,
     spec: RobotSpec | None = None,
     algorithm_parameters: Mapping[str, object] | None = None,
+    x0=None,
 ) -> Inverse:
     """The inverse named ``algorithm`` (:data:`ALGORITHMS`) with its parameters.
 
@@ -153,8 +165,10 @@ def make_inverse(
     name) in :data:`ROBOTS`. ``algorithm_parameters`` holds the algorithm's scalars
     (defaults from :data:`ALGORITHMS`) and vectors: ``limits`` of the weighted inverse (default:
     the robot's joint limits, else its catalogue box ``x_range``) and ``rest`` of the posture
-    inverse (default: the robot's home, else its default x0, for one run; in an atlas each
-    run's own start, :mod:`jik.engine.posture_at_start`).
+    inverse (given: within the robot's joint limits if it has some,
+    :func:`~jik.engine.practical_inverses.check_rest`; default :func:`default_rest`, the
+    robot's home, else the run's start ``x0``, else its default start, not checked against
+    the limits; in an atlas each run's own start, :mod:`jik.engine.posture_at_start`).
     """
     if algorithm not in ALGORITHMS:
         raise InvalidInputError(
@@ -175,7 +189,7 @@ def make_inverse(
     if algorithm == "posture":
         if "rest" in vectors:
             return pinv.PostureInverse(kinematics, vectors["rest"], values["gain"])
-        rest = _robot_rest(kinematics, spec, robot)
+        rest, _ = default_rest(kinematics, x0, spec, robot)
         return pinv.PostureInverse(kinematics, rest, values["gain"], rest_given=False)
     from .registry import robot_spec
 

@@ -23,8 +23,9 @@ import numpy as np
 from .exceptions import InvalidInputError, KinematicSingularityError
 from .inverses import Inverse, Pseudoinverse, require_kinematics
 from .kinematics import SINGULAR_MANIPULABILITY, Kinematics
+from .limits import limit_names, robot_limits
 from .linalg import gram, solve_small
-from .validation import FloatArray, finite
+from .validation import FloatArray, finite, within
 
 #: Largest damping lambda and damping threshold accepted.
 MAX_DAMPING = 10.0
@@ -37,6 +38,28 @@ def _nonnegative(value, name: str, maximum: float) -> float:
     if not 0.0 <= v <= maximum:
         raise InvalidInputError(f"{name} must be in [0, {maximum:g}], got {v:g}", name)
     return v
+
+
+def check_rest(kinematics: Kinematics, rest, limited: bool = True) -> FloatArray:
+    """A rest posture x_rest (p,) of the posture inverse, checked: p finite numbers and, if
+    ``limited`` (a rest given, not a default), within the robot's joint limits when it declares
+    some (:func:`~jik.engine.limits.robot_limits`: a URDF arm's, a planar chain's or a formula
+    robot's ``limits``); a robot without limits takes any finite rest.
+
+    Raises
+    ------
+    InvalidInputError
+        ``rest`` for a wrong shape or a value not finite; ``rest.<i>`` for coordinate i outside
+        its joint's limits, naming the joint, its value and the limit.
+    """
+    x = kinematics.check(rest, "rest")
+    if x.shape != (kinematics.p,):
+        raise InvalidInputError(f"rest must be one configuration of {kinematics.p} numbers", "rest")
+    limits = robot_limits(kinematics) if limited else None
+    if limits is not None:
+        names = limit_names(kinematics)
+        within(x, limits, "rest", names, f"the joint limits of the {kinematics.name}")
+    return x
 
 
 def _singular(kinematics: Kinematics, x: FloatArray, what: str) -> KinematicSingularityError:
@@ -236,13 +259,17 @@ class PostureInverse(Inverse):
     ----------
     kinematics : Kinematics
     rest : array_like, shape (p,)
-        The rest posture x_rest.
+        The rest posture x_rest; given (``rest_given``), it must lie within the robot's joint
+        limits if it has some (:func:`check_rest`).
     gain : float
         k >= 0; 0 is the pseudoinverse (8), bit for bit (the same code runs).
     rest_given : bool
-        False: ``rest`` is a default (:func:`~jik.engine.algorithm_registry.make_inverse`'s, the
-        robot's home), and an atlas pulls each run toward its own start x0 instead
-        (:mod:`jik.engine.posture_at_start`), so that it measures drift, not the pull.
+        False: ``rest`` is a default (:func:`~jik.engine.algorithm_registry.default_rest`: the
+        robot's home, else the run's start), not checked against the limits (a start outside
+        them is allowed and reported as leaving them; so is a home outside them, which a URDF
+        given its ``home`` may have, though no catalogue arm does); an atlas pulls each run
+        toward its own start x0 instead (:mod:`jik.engine.posture_at_start`), so that it
+        measures drift, not the pull.
 
     Notes
     -----
@@ -265,11 +292,7 @@ class PostureInverse(Inverse):
     ) -> None:
         self.kinematics = kinematics = require_kinematics(kinematics)
         self.rest_given = rest_given
-        self.rest = kinematics.check(rest, "rest")
-        if self.rest.shape != (kinematics.p,):
-            raise InvalidInputError(
-                f"rest must be one configuration of {kinematics.p} numbers", "rest"
-            )
+        self.rest = check_rest(kinematics, rest, limited=rest_given)
         self.gain = _nonnegative(gain, "gain", MAX_GAIN)
         self._plain = Pseudoinverse(kinematics)
 

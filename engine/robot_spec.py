@@ -108,9 +108,12 @@ class Robot:
         augmentation: str | None = None,
         parameters: Mapping[str, object] | None = None,
         algorithm_parameters: Mapping[str, object] | None = None,
+        x0=None,
     ) -> Inverse:
-        """The pseudoinverse (8), or the extended inverse (11) with one of its augmenting maps
-        (a :class:`~jik.engine.extended_vector.VectorExtendedInverse` for p - r > 1)."""
+        """The inverse named ``algorithm`` (:func:`~jik.engine.registry.make_inverse`, with
+        ``x0`` the run's start: the posture inverse's default rest for a robot without home),
+        or the extended inverse (11) with one of its augmenting maps (a
+        :class:`~jik.engine.extended_vector.VectorExtendedInverse` for p - r > 1)."""
         if algorithm == "extended" and not self.spec.augmentations:
             raise InvalidInputError(
                 f"robot {self.spec.title!r} has no augmenting map for the extended inverse; add "
@@ -130,6 +133,7 @@ class Robot:
             parameters,
             spec=self.spec,
             algorithm_parameters=algorithm_parameters,
+            x0=x0,
         )
 
 

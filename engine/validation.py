@@ -71,6 +71,29 @@ def as_vector(x, size: int, name: str, field: str | None = None) -> FloatArray:
     return a
 
 
+def within(x, bounds, name: str, names, where: str, field: str | None = None) -> None:
+    """Check that each coordinate of the vector ``x`` (p,) lies in its [lo, hi] of ``bounds``
+    (p, 2; +-inf: no bound on that side).
+
+    Raises
+    ------
+    InvalidInputError
+        At the first coordinate i outside, with field ``{field}.{i}`` (``field`` default
+        ``name``): "rest x4 (panda_joint4) must be in [-3.0718, -0.0698] (the joint limits of
+        the panda), got 0", ``names[i]`` naming the coordinate and ``where`` what the bounds
+        are.
+    """
+    x, box = np.asarray(x, dtype=float), np.asarray(bounds, dtype=float)
+    out = np.flatnonzero((x < box[:, 0]) | (x > box[:, 1]))
+    if out.size:
+        i = int(out[0])
+        lo, hi = box[i]
+        raise InvalidInputError(
+            f"{name} {names[i]} must be in [{lo:g}, {hi:g}] ({where}), got {x[i]:g}",
+            f"{field or name}.{i}",
+        )
+
+
 def positive(value, name: str, field: str | None = None) -> float:
     """Check that ``value`` is a finite number > 0."""
     v = finite(value, name, field)

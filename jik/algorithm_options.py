@@ -21,8 +21,8 @@ def add_algorithm_parameter_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--gain", type=float, help="posture: null-space gain k >= 0 (default 1)")
     p.add_argument(
         "--rest",
-        help="posture: rest posture 'x1, x2, ...' (default: the run's "
-        "x0; for an atlas each run's own start)",
+        help="posture: rest posture 'x1, x2, ...', within the robot's joint limits if it has "
+        "some (default: the robot's home, else the run's x0; for an atlas each run's own start)",
     )
     p.add_argument(
         "--limits",
@@ -31,9 +31,10 @@ def add_algorithm_parameter_options(p: argparse.ArgumentParser) -> None:
     )
 
 
-def algorithm_parameters(args: argparse.Namespace, algorithm: str, x0=None) -> dict:
-    """The options given that belong to ``algorithm`` (the others are ignored for it); the
-    posture inverse's rest defaults to ``x0`` when given (a run's start)."""
+def algorithm_parameters(args: argparse.Namespace, algorithm: str) -> dict:
+    """The options given that belong to ``algorithm`` (the others are ignored for it); without
+    ``--rest``, the posture inverse's rest is the engine's default (``Robot.inverse``'s
+    ``x0``)."""
     from jik.engine.registry import ALGORITHMS
     from jik.robot_commands import parse_path, parse_vector
 
@@ -45,8 +46,6 @@ def algorithm_parameters(args: argparse.Namespace, algorithm: str, x0=None) -> d
             out[p.name] = value
     if "rest" in spec.vectors and args.rest:
         out["rest"] = parse_vector(args.rest, "--rest")
-    elif "rest" in spec.vectors and x0 is not None:
-        out["rest"] = list(x0)
     if "limits" in spec.vectors and args.limits:
         out["limits"] = parse_path(args.limits, "--limits")
     return out

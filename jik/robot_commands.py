@@ -121,12 +121,6 @@ def _notes(robot: Robot) -> dict:
     return {"notes": notes} if notes else {}
 
 
-def _parameters(args: argparse.Namespace, robot: Robot, x0) -> dict:
-    """The algorithm's options; the posture's rest: the robot's home, else the run's x0."""
-    home = getattr(robot.kinematics, "home", None)
-    return algorithm_parameters(args, args.algorithm, x0 if home is None else None)
-
-
 def _fmt(v) -> str:
     return "(" + ", ".join(f"{float(t):.10g}" for t in v) + ")"
 
@@ -140,7 +134,8 @@ def solve_command(args: argparse.Namespace) -> int:
     inverse = robot.inverse(
         args.algorithm,
         args.augmentation,
-        algorithm_parameters=_parameters(args, robot, x0),
+        algorithm_parameters=algorithm_parameters(args, args.algorithm),
+        x0=x0,  # (the posture's default rest: the robot's home, else x0)
     )
     res = solve(inverse, x0, target, record=True, **settings)
     report = _limits(robot, lambda limits, names: solve_report(limits, res, names))
@@ -182,7 +177,8 @@ def repeatability_command(args: argparse.Namespace) -> int:
     inverse = robot.inverse(
         args.algorithm,
         args.augmentation,
-        algorithm_parameters=_parameters(args, robot, x0),
+        algorithm_parameters=algorithm_parameters(args, args.algorithm),
+        x0=x0,  # (the posture's default rest: the robot's home, else x0)
     )
     record = robot_limits(robot.kinematics) is not None  # (limits: check whole legs)
     rep = repeatability(inverse, x0, path, cycles=args.cycles, record=record, **settings)

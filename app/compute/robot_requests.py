@@ -54,11 +54,10 @@ def request_robot(
     not used is checked all the same (a catalogue map's parameters, a formula map's formulas),
     except a map to synthesize. Refusals are :class:`RequestError` naming the request's field."""
 
-    def given(algorithm: str, kinematics: Any) -> dict:
+    def given(algorithm: str) -> dict:
         spec = ALGORITHMS[algorithm]
         names = {p.name for p in spec.parameters} | set(spec.vectors)
-        values = used(parameters, algorithm, kinematics, x0).items()
-        return {k: v for k, v in values if not own or k in names}
+        return {k: v for k, v in used(parameters).items() if not own or k in names}
 
     extended, aug_used = "extended" in algorithms, None
     if req_robot.name in S.USER_ROBOT_MODELS:
@@ -67,7 +66,7 @@ def request_robot(
         checked = extended or with_map or getattr(augmentation, "name", None) == "formula"
         robot, robot_used = user_robot(req_robot, augmentation if checked else None)
         kin = robot.kinematics
-        inverses = tuple(user_inverse(robot, a, given(a, kin)) for a in algorithms)
+        inverses = tuple(user_inverse(robot, a, given(a), x0) for a in algorithms)
         aug_used = map_used(robot) if extended else None
         built = robot.spec, kin, inverses, robot_used, aug_used
         return RequestRobot(*built, lambda: user_map(robot))
@@ -84,8 +83,8 @@ def request_robot(
                 raise RequestError("augmentation", str(exc)) from None
             continue
         try:
-            params = given(algorithm, kin)
-            out.append(make_inverse(kin, algorithm, spec=spec, algorithm_parameters=params))
+            params = given(algorithm)
+            out.append(make_inverse(kin, algorithm, spec=spec, algorithm_parameters=params, x0=x0))
         except InvalidInputError as exc:
             raise RequestError(field_of(exc.field, str(exc)), str(exc)) from None
     built = spec, kin, tuple(out), robot_used, aug_used

@@ -123,9 +123,10 @@ def _text(exc: InvalidInputError) -> str:
     return text
 
 
-def user_inverse(robot: Robot, algorithm: str, algorithm_parameters: dict | None = None):
+def user_inverse(robot: Robot, algorithm: str, algorithm_parameters: dict | None = None, x0=None):
     """The robot's inverse: the extended inverse (11) of its map, or another algorithm with
-    its parameters (the pseudoinverse (8), damped, weighted, posture)."""
+    its parameters (the pseudoinverse (8), damped, weighted, posture; ``x0`` the run's start,
+    posture's default rest for a robot without home)."""
     if algorithm == "extended" and not robot.spec.augmentations:
         raise RequestError(
             "augmentation",
@@ -135,7 +136,7 @@ def user_inverse(robot: Robot, algorithm: str, algorithm_parameters: dict | None
         )
     try:
         if algorithm != "extended":
-            return robot.inverse(algorithm, algorithm_parameters=algorithm_parameters)
+            return robot.inverse(algorithm, algorithm_parameters=algorithm_parameters, x0=x0)
         given = _LABEL in {a.name for a in robot.spec.augmentations}
         return robot.inverse(algorithm, _LABEL if given else None)  # (else the robot's default)
     except InvalidInputError as exc:

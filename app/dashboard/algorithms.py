@@ -5,9 +5,10 @@ A state chooses one to five algorithms (``algorithms``, default the paper's two,
 (11)) and holds the scalar parameters of the chosen ones (``algorithm_parameters``: ``damping``
 and ``damping_threshold`` of damped least squares, ``gain`` of the posture inverse), with their
 ranges from the engine's :class:`~jik.engine.parameters.Parameter`, and the posture inverse's
-rest x_rest (``rest``, p numbers within the robot's :func:`configuration_box`; without it, the
-REST API's default, :func:`~jik.app.compute.schemas.algorithms.default_rest`: the robot's home,
-else the state's start x0). The weighted inverse takes the robot's joint limits (else its
+rest x_rest (``rest``, p numbers within the robot's joint limits, the engine's rule, and
+within its sliders' range, :func:`configuration_box`; without it, the engine's default,
+:func:`~jik.engine.algorithm_registry.default_rest`: the robot's home, else the state's start
+x0). The weighted inverse takes the robot's joint limits (else its
 configuration box), and is refused naming ``algorithms`` for a robot with neither.
 :data:`STYLES` gives each algorithm one colour, line style, marker, label and 3D copy, used by
 the scene, every plot, the drift panel and the atlas. :func:`cache_key` says what one
@@ -22,9 +23,12 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+from ...engine.algorithm_registry import default_rest
 from ...engine.exceptions import InvalidInputError
+from ...engine.practical_inverses import check_rest
 from ...engine.registry import ALGORITHMS as REGISTRY
-from ..compute.schemas.algorithms import Algorithm, default_rest
+from ...engine.validation import within
+from ..compute.schemas.algorithms import Algorithm
 
 
 class ChosenState(Protocol):
@@ -197,15 +201,19 @@ def configuration_box(spec) -> tuple[tuple[float, float], ...]:
 
 def checked_rest(value, spec, kin, x0) -> tuple[float, ...] | None:
     """The posture inverse's rest x_rest as set (``algorithm_parameters.rest``), checked: p
-    finite numbers within the robot's :func:`configuration_box`; None when it is the default in
-    force (:func:`~jik.app.compute.schemas.algorithms.default_rest`: the robot's home, else the
-    start ``x0``), which the state then follows, as it does without a rest.
+    finite numbers, within the robot's joint limits if it has some (the engine's
+    :func:`~jik.engine.practical_inverses.check_rest`, in its words) and within the range of
+    its sliders (:func:`configuration_box`; the only bound of a robot without limits, whose
+    REST API runs take any finite rest); None when it is the default in force
+    (:func:`~jik.engine.algorithm_registry.default_rest`: the robot's home, else the start
+    ``x0``, taken as it is, like the engine's default), which the state then follows, as it
+    does without a rest.
 
     Raises
     ------
     InvalidInputError
         ``algorithm_parameters.rest`` for a wrong length, ``algorithm_parameters.rest.<i>``
-        for a coordinate not finite or outside the box.
+        for a coordinate not finite, outside its joint's limits or outside its slider.
     """
     field, names = "algorithm_parameters.rest", spec.variable_names
     if not isinstance(value, tuple | list):
@@ -219,24 +227,19 @@ def checked_rest(value, spec, kin, x0) -> tuple[float, ...] | None:
             f"({', '.join(names)}), got {len(value)}",
             field,
         )
-    box = configuration_box(spec)
-    limits = getattr(kin, "limits", None)
-    where = (
-        f"the joint limits of the {spec.title}"
-        if limits is not None and tuple(map(tuple, limits)) == box
-        else "the range of x0's sliders"
-    )
     for i, v in enumerate(value):
         if not math.isfinite(v):
             raise InvalidInputError(f"{field}.{i}: Input should be a finite number", f"{field}.{i}")
-        lo, hi = box[i]
-        if not lo <= v <= hi:
-            raise InvalidInputError(
-                f"{field}.{i}: rest {names[i]} must be in [{lo:g}, {hi:g}] ({where}), got {v:g}",
-                f"{field}.{i}",
-            )
     rest = tuple(float(v) for v in value)
-    return None if list(rest) == default_rest(kin, x0)[0] else rest
+    if list(rest) == default_rest(kin, x0)[0]:
+        return None
+    try:
+        check_rest(kin, rest)
+        within(rest, configuration_box(spec), "rest", names, "the range of x0's sliders")
+    except InvalidInputError as exc:
+        where = f"algorithm_parameters.{exc.field}"
+        raise InvalidInputError(f"{where}: {exc}", where) from None
+    return rest
 
 
 def posture_rest(state: ChosenState, kin) -> tuple[list[float], str]:
@@ -261,14 +264,13 @@ def rest_words(state: ChosenState, kin) -> str:
     return f"x_rest = {shown} (set)"
 
 
-def inverse_parameters(state: ChosenState, algorithm: str, kin) -> dict[str, Any]:
+def inverse_parameters(state: ChosenState, algorithm: str) -> dict[str, Any]:
     """What the engine's ``make_inverse`` takes for ``algorithm``: its scalars, and the posture
-    inverse's rest in force (:func:`posture_rest`)."""
-    names = {p.name for p in REGISTRY[algorithm].parameters}
-    out: dict[str, Any] = {k: v for k, v in state.algorithm_parameters.items() if k in names}
-    if algorithm == "posture":
-        out["rest"] = posture_rest(state, kin)[0]
-    return out
+    inverse's rest when the state sets one (else the engine's default at the state's start:
+    :func:`~jik.app.dashboard.robots.state_inverse` passes it)."""
+    spec = REGISTRY[algorithm]
+    names = {p.name for p in spec.parameters} | set(spec.vectors)
+    return {k: v for k, v in state.algorithm_parameters.items() if k in names}
 
 
 def check_inverses(state: ChosenState, build) -> None:

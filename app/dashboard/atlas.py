@@ -52,7 +52,7 @@ def atlas_request(
     params = {
         k: v
         for a in state.algorithms
-        for k, v in inverse_parameters(state, a, kin).items()
+        for k, v in inverse_parameters(state, a).items()
         if k != "rest"
     }
     points = manifold_starts(state, kin, starts) if kin.p - kin.r > 1 else None

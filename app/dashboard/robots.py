@@ -143,8 +143,9 @@ def state_kinematics(state) -> Kinematics:
 
 def state_inverse(state, algorithm: str, kin: Kinematics | None = None) -> Inverse:
     """The state's inverse for ``algorithm``: its map and the map's parameters, or the
-    algorithm's own (:func:`jik.app.dashboard.algorithms.inverse_parameters`)."""
+    algorithm's own (:func:`jik.app.dashboard.algorithms.inverse_parameters`; the posture
+    inverse's default rest at the state's start x0)."""
     robot = state_robot(state, kin)
-    params = inverse_parameters(state, algorithm, robot.kinematics if kin is None else kin)
+    params = inverse_parameters(state, algorithm)
     aug = state.augmentation, state.augmentation_parameters
-    return robot.inverse(algorithm, *aug, algorithm_parameters=params)
+    return robot.inverse(algorithm, *aug, algorithm_parameters=params, x0=state.x0)

@@ -163,3 +163,65 @@ def test_a_response_says_which_parameters_the_inverse_used(api, algorithm, param
     r = api.post("/repeatability", json=rep)
     assert r.status_code == 200, r.text
     assert r.json()["algorithm_parameters"] == pytest.approx(used)
+
+
+#: A planar RRR chain with joint limits and no home.
+LIMITED = {"name": "planar_chain", "joints": "RRR", "lengths": [1, 0.8, 0.6]}
+LIMITED["limits"] = [[-1, 1], [None, 1.2], [-3, 3]]
+RRR_PATH = [[1.2, 1.0], [1.0, 1.2]]
+
+
+@pytest.mark.parametrize(
+    ("route", "body"),
+    [
+        ("/solve", {"x0": [0.3, 0.2, 0.3], "target": [1.2, 1.0]}),
+        ("/repeatability", {"x0": [0.3, 0.2, 0.3], "path": RRR_PATH, "cycles": 1}),
+        ("/atlas", {"path": RRR_PATH, "starts": 4, "cycles": 1}),
+    ],
+)
+def test_a_rest_outside_the_joint_limits_is_refused_naming_its_coordinate(api, route, body):
+    """The engine's rule, one for every run: a robot with joint limits takes a rest within them
+    (422 at algorithm_parameters.rest.<i>, in the engine's words); a robot without limits
+    takes any finite rest."""
+    key = "algorithms" if route == "/atlas" else "algorithm"
+    posture = {key: ["posture"] if route == "/atlas" else "posture"}
+    bad = {**body, **posture, "robot": LIMITED, "algorithm_parameters": {"rest": [0, 2.5, 0]}}
+    r = api.post(route, json=bad)
+    assert messages(r) == [
+        "algorithm_parameters.rest.1: rest x2 must be in [-inf, 1.2] (the joint limits of the "
+        "planar_chain), got 2.5"
+    ]
+    assert r.json()["detail"][0]["loc"] == ["body", "algorithm_parameters", "rest", "1"]
+    free = {k: v for k, v in LIMITED.items() if k != "limits"}
+    ok = api.post(route, json={**bad, "robot": free})
+    assert ok.status_code in (200, 202), ok.text
+    if route == "/atlas":
+        api.delete(f"/atlas/{ok.json()['id']}")
+
+
+def test_the_default_rest_at_a_start_outside_the_limits_runs(api):
+    """No rest given: the default (the start, the chain has no home) is not refused when the
+    start is outside the limits; the run reports leaving them at the start. The same numbers
+    given as the rest are refused."""
+    x0 = [1.5, 0.2, 0.3]
+    body = {"robot": LIMITED, "algorithm": "posture", "x0": x0, "path": RRR_PATH, "cycles": 1}
+    r = api.post("/repeatability", json=body)
+    assert r.status_code == 200, r.text
+    assert r.json()["algorithm_parameters"]["rest"] == x0
+    assert r.json()["limits"]["violation"]["cycle"] == 0
+    given = api.post("/repeatability", json={**body, "algorithm_parameters": {"rest": x0}})
+    assert messages(given)[0].startswith("algorithm_parameters.rest.0: rest x1 must be in")
+
+
+def test_a_panda_rest_outside_its_limits_is_refused_by_solve(api):
+    pytest.importorskip("yourdfpy")
+    from jik.engine.arms import ARMS
+
+    home = list(ARMS["panda"].home)
+    rest = [*home[:3], 0.0, *home[4:]]
+    body = {"robot": {"name": "panda"}, "algorithm": "posture", "x0": home}
+    body |= {"target": [0.3, 0.0, 0.5, 0.0, 0.0, 0.0], "algorithm_parameters": {"rest": rest}}
+    assert messages(api.post("/solve", json=body)) == [
+        "algorithm_parameters.rest.3: rest x4 (panda_joint4) must be in [-3.0718, -0.0698] "
+        "(the joint limits of the panda), got 0"
+    ]

@@ -388,15 +388,19 @@ def test_the_rest_is_dropped_with_the_posture_inverse_and_with_the_robot():
 
 
 def test_the_api_and_the_dashboard_take_the_same_default_rest():
-    """One rule, default_rest: the robot's home, else the run's start x0."""
-    from jik.app.compute.schemas.algorithms import default_rest, used
+    """One rule, the engine's default_rest: the robot's home, else the run's start x0."""
+    from jik.app.compute.requests import solve_batch
+    from jik.app.compute.schemas import SolveRequest
     from jik.app.dashboard.algorithms import posture_rest
     from jik.app.dashboard.robots import state_kinematics
+    from jik.engine.algorithm_registry import default_rest
 
     state = updated_state(_posture(), {"x0.0": 0.25})
     kin = state_kinematics(state)
     assert posture_rest(state, kin) == default_rest(kin, state.x0) == (list(state.x0), "x0")
-    assert used(None, "posture", kin, state.x0)["rest"] == list(state.x0)
+    body = {"robot": {"name": "manipulator2"}, "algorithm": "posture", "x0": list(state.x0)}
+    (api,) = solve_batch([SolveRequest.model_validate({**body, "target": [1.0, 1.5]})])
+    assert api.algorithm_parameters["rest"] == list(state.x0)
     np.testing.assert_array_equal(state_inverse(state, "posture").rest, state.x0)
 
 
@@ -420,12 +424,12 @@ def panda():
 def test_an_arm_s_rest_is_within_its_joint_limits_and_defaults_to_its_home(panda):
     """The Panda: the rest sliders span its joint limits, start at its home; 'rest = home'
     sets the default back; a coordinate beyond a limit is refused naming the limits."""
-    from jik.app.compute.schemas.algorithms import used
     from jik.engine.arms import ARMS
+    from jik.engine.registry import make_inverse
     from jik.engine.robot_spec import robot_from_dict
 
     kin = robot_from_dict({"name": "panda", "task": "pose"}).kinematics
-    assert used(None, "posture", kin, [0.1] * 7)["rest"] == list(ARMS["panda"].home)  # (API)
+    assert list(make_inverse(kin, "posture", x0=[0.1] * 7).rest) == list(ARMS["panda"].home)
     spec = controls(panda)
     sliders = [c for c in spec if c.key.startswith(f"{REST}.")]
     assert [(c.minimum, c.maximum) for c in sliders] == [tuple(b) for b in kin.limits]
@@ -441,3 +445,23 @@ def test_an_arm_s_rest_is_within_its_joint_limits_and_defaults_to_its_home(panda
         updated_state(panda, {f"{REST}.3": 0.0})
     assert refused.value.field == f"{REST}.3"
     assert "must be in [-3.0718, -0.0698] (the joint limits of the" in str(refused.value)
+
+
+def test_a_rest_outside_a_chain_s_joint_limits_is_refused_in_the_engine_s_words():
+    """A planar chain with limits (its sliders span (-pi, pi)): a rest outside the limits is
+    refused at its coordinate with the words the engine (and so the REST API) uses; the
+    default rest at a start outside the limits (the start) is not."""
+    from jik.engine.robot_spec import robot_from_dict
+
+    chain = {**CHAIN, "limits": [[-1, 1], [None, 1.2], [-3, 3]]}
+    state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": chain})
+    state = updated_state(state, {"algorithms": ["pseudoinverse", "posture"]})
+    with pytest.raises(InvalidInputError) as engine:
+        robot_from_dict(chain).inverse("posture", algorithm_parameters={"rest": [0, 2, 0]})
+    with pytest.raises(InvalidInputError) as refused:
+        updated_state(state, {f"{REST}.1": 2.0})
+    assert refused.value.field == f"{REST}.1" and engine.value.field == "rest.1"
+    assert str(refused.value) == f"{REST}.1: {engine.value}"
+    assert "[-inf, 1.2] (the joint limits of the planar_chain), got 2" in str(refused.value)
+    outside = updated_state(state, {"x0": [1.5, 0.2, 0.3]})
+    assert list(state_inverse(outside, "posture").rest) == [1.5, 0.2, 0.3]

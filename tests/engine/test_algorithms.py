@@ -27,6 +27,8 @@ X0 = np.array([0.0, 0.0, math.pi / 2])
 TABLE1 = [(1.0, 1.0), (1.0, 2.0), (0.0, 2.0)]
 KIN = Manipulator2()
 LIMITS = np.array([[-3.0, 3.0], [-3.0, 3.0], [-math.pi, 2 * math.pi]])
+#: A planar RRR chain's limits: x2 has no lower bound.
+LIMITS_RRR = [[-1.0, 1.0], [None, 1.2], [-3.0, 3.0]]
 
 
 def _inverse(name: str, **params):
@@ -301,3 +303,70 @@ def test_a_joint_whose_limits_are_huge_or_infinite_has_weight_one(width):
     res = solve(WeightedInverse(KIN, lim), X0, (1.0, 1.0))
     assert res.success
     np.testing.assert_allclose(res.x, plain.x, atol=1e-12)
+
+
+@pytest.fixture(scope="module")
+def panda():
+    pytest.importorskip("yourdfpy")
+    from jik.engine.robot_spec import robot_from_dict
+
+    return robot_from_dict({"name": "panda", "task": "pose"})
+
+
+def test_a_rest_outside_an_arm_s_joint_limits_is_refused_naming_the_joint(panda):
+    """The Panda's joint 4 lies in [-3.0718, -0.0698]: a rest with x4 = 0 is refused at rest.3,
+    naming the joint, its value and the limit; its home is accepted, given or by default."""
+    kin, home = panda.kinematics, list(panda.kinematics.home)
+    bad = [*home[:3], 0.0, *home[4:]]
+    for build in (
+        lambda: PostureInverse(kin, bad),
+        lambda: make_inverse(kin, "posture", algorithm_parameters={"rest": bad}),
+        lambda: panda.inverse("posture", algorithm_parameters={"rest": bad}),
+    ):
+        with pytest.raises(InvalidInputError) as refused:
+            build()
+        assert refused.value.field == "rest.3"
+        assert str(refused.value) == (
+            "rest x4 (panda_joint4) must be in [-3.0718, -0.0698] (the joint limits of the "
+            "panda), got 0"
+        )
+    np.testing.assert_array_equal(PostureInverse(kin, home).rest, home)
+    default = make_inverse(kin, "posture", x0=bad)
+    assert not default.rest_given and list(default.rest) == home
+
+
+def test_a_default_rest_at_a_start_outside_the_limits_is_accepted():
+    """A planar chain with limits and no home: a start outside its limits is allowed (the run
+    reports leaving them), and so is the default rest there (the start); the same numbers given
+    as the rest are refused."""
+    from jik.engine.robot_spec import robot_from_dict
+
+    robot = robot_from_dict(
+        {"name": "planar_chain", "joints": "RRR", "lengths": [1, 0.8, 0.6], "limits": LIMITS_RRR}
+    )
+    x0 = [1.5, 0.2, 0.3]  # (x1 above its upper limit 1)
+    inv = make_inverse(robot.kinematics, "posture", x0=x0)
+    assert not inv.rest_given and list(inv.rest) == x0
+    assert list(robot.inverse("posture", x0=x0).rest) == x0
+    res = repeatability(inv, np.array(x0), [(1.2, 1.0), (1.0, 1.2)], cycles=1)
+    assert np.isfinite(res.drift).all()
+    with pytest.raises(InvalidInputError, match=r"rest x1 must be in \[-1, 1\]") as refused:
+        make_inverse(robot.kinematics, "posture", algorithm_parameters={"rest": x0})
+    assert refused.value.field == "rest.0"
+    # A joint without a lower bound: only its upper one refuses.
+    PostureInverse(robot.kinematics, [0.0, -50.0, 0.0])
+    with pytest.raises(InvalidInputError, match=r"must be in \[-inf, 1.2\] .*, got 2"):
+        PostureInverse(robot.kinematics, [0.0, 2.0, 0.0])
+
+
+def test_a_home_outside_the_limits_is_the_default_rest_but_not_a_given_one(panda):
+    """A URDF arm given a home outside its limits (its start by default, allowed and reported
+    as leaving them): the posture inverse's default rest is that home; given, it is refused."""
+    from jik.engine.robot_spec import robot_from_dict
+
+    home = [*panda.kinematics.home[:3], 0.0, *panda.kinematics.home[4:]]
+    robot = robot_from_dict({"name": "panda", "task": "pose", "home": home})
+    assert list(robot.inverse("posture").rest) == home
+    with pytest.raises(InvalidInputError) as refused:
+        robot.inverse("posture", algorithm_parameters={"rest": home})
+    assert refused.value.field == "rest.3"

@@ -41,8 +41,9 @@ class AlgorithmParameters(_Parameters):  # type: ignore[misc, valid-type]
 
     rest: list[_Coordinate] | None = Field(
         None,
-        description="posture: the rest posture x_rest, length p (default: the robot's home, "
-        "else the run's x0; in an atlas, each run's own start)",
+        description="posture: the rest posture x_rest, length p, within the robot's joint "
+        "limits if it has some (default: the robot's home, else the run's x0; in an atlas, "
+        "each run's own start)",
     )
     limits: list[tuple[_Bound, _Bound]] | None = Field(
         None,
@@ -51,25 +52,11 @@ class AlgorithmParameters(_Parameters):  # type: ignore[misc, valid-type]
     )
 
 
-def default_rest(kinematics, x0) -> tuple[list[float], str]:
-    """The posture inverse's rest x_rest when none is given, and what it is ("home" or
-    "x0"): the robot's home configuration, else the run's start ``x0``. The one rule of the
-    REST API's runs and the dashboard's (an atlas without rest pulls each run toward its own
-    start instead: :mod:`jik.engine.posture_at_start`)."""
-    home = getattr(kinematics, "home", None)
-    if home is not None:
-        return [float(v) for v in home], "home"
-    return [float(v) for v in x0], "x0"
-
-
-def used(params: BaseModel | None, algorithm: str = "", kinematics=None, x0=None) -> dict:
-    """The parameters given, as the engine's :func:`make_inverse` takes them. The posture
-    inverse's ``rest`` defaults to :func:`default_rest` (the robot's home, else the run's
-    start ``x0``) when the run has a start."""
-    out = {} if params is None else params.model_dump(exclude_none=True)
-    if algorithm == "posture" and "rest" not in out and x0 is not None:
-        out["rest"] = default_rest(kinematics, x0)[0]
-    return out
+def used(params: BaseModel | None) -> dict:
+    """The parameters given, as the engine's :func:`make_inverse` takes them (the posture
+    inverse's ``rest``, when not given, is the engine's
+    :func:`~jik.engine.algorithm_registry.default_rest` at the run's start)."""
+    return {} if params is None else params.model_dump(exclude_none=True)
 
 
 def parameters_of(inverse) -> dict[str, Any]:
