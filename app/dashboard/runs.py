@@ -19,7 +19,6 @@ from ...engine.solve_rules import counted
 from ...engine.unicycle import Unicycle
 from .controls import max_iterations
 from .model import DashboardState
-from .reach import stall_note
 from .robots import state_inverse, state_kinematics
 
 #: Time grid points of one unicycle platform path q(t).
@@ -129,10 +128,6 @@ def _run_legs(
             failure = f"{where} stopped: {leg.stopped_by}"
         elif not res.success:
             failure = f"{where}: {_leg_message(res, cap)}"
-            if res.message.startswith("stalled") and STALLED in res.message:
-                target = np.asarray(path, dtype=float)[leg.index]
-                note = stall_note(inverse, target, np.asarray(res.x, dtype=float))
-                failure = failure.replace(STALLED, note)
         else:
             last = _leg_message(res, cap)
         progress()
@@ -173,10 +168,6 @@ def _run_legs(
         message=failure or _legs_message(len(ends), drift, last),
         seconds=time.perf_counter() - t0,
     )
-
-
-#: The end of the engine's message for a stalled run, which :func:`stall_note` makes precise.
-STALLED = "the step size collapsed near a singularity or the target is unreachable"
 
 
 def _leg_message(res: SolveResult, cap: int) -> str:
