@@ -35,8 +35,8 @@ def algorithm_parameters(args: argparse.Namespace, algorithm: str) -> dict:
     """The options given that belong to ``algorithm`` (the others are ignored for it); without
     ``--rest``, the posture inverse's rest is the engine's default (``Robot.inverse``'s
     ``x0``)."""
-    from jik.engine.registry import ALGORITHMS
-    from jik.robot_commands import parse_path, parse_vector
+    from ..engine.registry import ALGORITHMS
+    from .robot_commands import parse_path, parse_vector
 
     spec = ALGORITHMS[algorithm]
     out: dict = {}
