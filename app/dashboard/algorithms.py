@@ -244,7 +244,7 @@ def checked_rest(value, spec, kin, x0) -> tuple[float, ...] | None:
 
 def posture_rest(state: ChosenState, kin) -> tuple[list[float], str]:
     """The posture inverse's rest in force and what it is: "set" (the state's), else the
-    default's "home" or "x0" (:func:`~jik.app.compute.schemas.algorithms.default_rest`)."""
+    default's "home" or "x0" (:func:`~jik.engine.algorithm_registry.default_rest`)."""
     given = state.algorithm_parameters.get("rest")
     if given is not None:
         return [float(v) for v in given], "set"
