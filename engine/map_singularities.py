@@ -1,10 +1,5 @@
 """Where an augmenting map h is singular in a box of the joint space (the design region of
-sec. 5, over which E1 (13) and E2 (18) are taken).
-
-On a uniform grid of the box, ends included, evaluated in one batch: h or dh not finite, |dh|
-blowing up, h jumping through infinity between grid neighbours (a pole between them), or the
-extended Jacobian [J; dh] of eq. (10) losing rank (at a point, or between neighbours where
-det [J; dh] changes sign), where the extended Jacobian inverse (11) is undefined.
+sec. 5, over which E1 (13) and E2 (18) are taken), found on one batch of a uniform grid.
 """
 
 from __future__ import annotations
@@ -18,7 +13,7 @@ from .augmentations import AugmentingMap
 from .exceptions import InvalidInputError
 from .exports import number
 from .functionals import Region, check_region
-from .inverses import extended_determinant, require_compatible, require_kinematics
+from .inverses import extended_determinant, require_compatible, require_kinematics, require_map
 from .kinematics import Kinematics
 from .validation import count
 
@@ -62,6 +57,23 @@ class MapSingularities:
         return (
             f"MapSingularities({self.fraction:.2%} of a {self.nodes}^{len(self.region)} grid, "
             f"{at}: {'; '.join(self.reasons)})"
+        )
+
+    def __str__(self) -> str:
+        """What and where, in words: ``the gradient of h blows up at x1 ∈ [0.458, 0.5], any
+        x2, any x3 (8% of the region's grid)``."""
+        spans = []
+        for name, (lo, hi) in self.where.items():
+            r_lo, r_hi = self.region[name]
+            if lo <= r_lo and hi >= r_hi:
+                spans.append(f"any {name}")
+            elif hi - lo < 1e-12:
+                spans.append(f"{name} ≈ {lo:.3g}")
+            else:
+                spans.append(f"{name} ∈ [{lo:.3g}, {hi:.3g}]")
+        return (
+            f"{'; '.join(self.reasons)} at {', '.join(spans)} "
+            f"({100 * self.fraction:.2g}% of the region's grid)"
         )
 
     def as_dict(self) -> dict:
@@ -138,14 +150,12 @@ def map_singularities(
     (:func:`~jik.engine.inverses.extended_determinant`, the test E1's quadrature uses), and
     both neighbours of a grid step count where h changes sign by more than JUMP times its
     median step (a pole, which a grid point rarely hits) or, elsewhere, where det [J; dh] =
-    +-(dh K) sqrt(det J J^T) changes sign (dh K = 0 between them: E1 diverges there).
+    +-(dh K) sqrt(det J J^T) changes sign: dh K = 0 between them, where E1 diverges (or dh K
+    passes through infinity: a pole of h whose jump is not JUMP times the median step, as on
+    a coarse grid, is reported there as a rank loss).
     """
     kinematics = require_kinematics(kinematics)
-    if not isinstance(augmenting_map, AugmentingMap):
-        raise InvalidInputError(
-            f"augmenting_map must be an AugmentingMap, got {type(augmenting_map).__name__}",
-            "augmenting_map",
-        )
+    augmenting_map = require_map(augmenting_map, kinematics)
     require_compatible(kinematics, augmenting_map, "map_singularities")
     box, fix = check_region(kinematics, region, fixed)
     nodes = count(nodes, "nodes", 2, MAX_GRID_POINTS)

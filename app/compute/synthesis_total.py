@@ -82,9 +82,7 @@ def singularities(
     if found is None:
         return None, []
     info = S.MapSingularitiesInfo.model_validate(found.as_dict())
-    return info, [
-        f"h is singular on {found.fraction:.2%} of the box's grid: {', '.join(found.reasons)}"
-    ]
+    return info, [f"h is singular in the box: {found}"]
 
 
 def total_degree_response(

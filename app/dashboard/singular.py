@@ -60,22 +60,11 @@ def singular_sentence(state: DashboardState) -> str | None:
     found = singular_points(state)
     if found is None:
         return None
-    spans = []
-    for name, (lo, hi) in found.where.items():
-        r_lo, r_hi = found.region[name]
-        if lo <= r_lo and hi >= r_hi:
-            spans.append(f"any {name}")
-        elif hi - lo < 1e-12:
-            spans.append(f"{name} ≈ {lo:.3g}")
-        else:
-            spans.append(f"{name} ∈ [{lo:.3g}, {hi:.3g}]")
     box = ", ".join(f"{k} ∈ [{lo:.3g}, {hi:.3g}]" for k, (lo, hi) in found.region.items())
     params = ", ".join(f"{k} = {v:.3g}" for k, v in state.augmentation_parameters.items())
     return (
         f"Warning: the augmenting map {state.augmentation}"
         + (f" ({params})" if params else "")
-        + f" is singular in the design region {box}: {'; '.join(found.reasons)} at "
-        + ", ".join(spans)
-        + f" ({100 * found.fraction:.2g}% of the region's grid). E1 and E2 there are not a "
+        + f" is singular in the design region {box}: {found}. E1 and E2 there are not a "
         "measure of fit, and the extended Jacobian is undefined where a run crosses it."
     )

@@ -124,7 +124,10 @@ def test_a_map_singular_in_its_box_says_where(api):
     assert found["where"]["x2"] == [0.0, 1.0] and found["where"]["x3"] == [0.5, 1.5]
     assert found["fraction"] == pytest.approx(2 / 12) and found["nodes"] == 12
     assert "h jumps through infinity" in found["reasons"]
-    assert "h is singular on 16.67% of the box's grid" in r.json()["message"]
+    assert (
+        f"h is singular in the box: {'; '.join(found['reasons'])} at x1 ∈ [0.455, 0.545], any "
+        "x2, any x3 (17% of the region's grid)" in r.json()["message"]
+    )
     regular = api.post(
         "/synthesize", json={**body, "augmentation": {"name": "e2_optimal", "a": 0.5, "b": 1.0}}
     ).json()

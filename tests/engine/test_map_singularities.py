@@ -112,11 +112,18 @@ def test_the_grid_is_evaluated_in_one_batch():
         assert sorted(set(x[:, 0])) == pytest.approx(np.linspace(0.0, 1.0, 9))
 
 
-def test_result_prints_on_one_line_and_exports_json():
+def test_result_prints_on_one_line_says_where_in_words_and_exports_json():
     found = jik.map_singularities(jik.Manipulator1(), jik.E1Optimal(1.0, -1.0), MANIPULATOR1_REGION)
     text = repr(found)
     assert "\n" not in text and len(text) < 260
     assert text.startswith("MapSingularities(8.00% of a 25^3 grid, x1 in [0.4583, 0.5], x2 in [0")
+    assert str(found) == (
+        "the gradient of h blows up; h jumps through infinity at x1 ∈ [0.458, 0.5], any x2, "
+        "any x3 (8% of the region's grid)"
+    )
+    assert str(map_singularities(Manipulator1(), E1Optimal(1.0, 0.0), MANIPULATOR1_REGION)) == (
+        "h or its gradient is not finite at x1 ≈ 0, any x2, any x3 (4% of the region's grid)"
+    )
     d = json.loads(json.dumps(found.as_dict()))
     assert d["where"]["x1"] == pytest.approx([11 / 24, 0.5]) and d["fraction"] == 0.08
     assert d["reasons"] == list(found.reasons) and d["nodes"] == 25
