@@ -1,4 +1,4 @@
-"""What ``jik atlas`` writes (:mod:`jik.atlas_cli`): the chunks gathered for the JSON, the CSV
+"""What ``jik atlas`` writes (:mod:`jik.cli.atlas`): the chunks gathered for the JSON, the CSV
 rows in run order, and the HTML figure of the drift map."""
 
 from __future__ import annotations
