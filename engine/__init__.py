@@ -50,6 +50,7 @@ Functionals and synthesis (secs. 3-4)
     error_functional_e1, error_functional_e2  E1, eq. (14), and E2, eq. (19), on a region
     synthesize_e2               the E2-optimal h by a Ritz method, eq. (20) -> SynthesisResult
     synthesize_e2_nd            E2-optimal h of all joints, p - r >= 1 -> TotalDegreeSynthesis
+    map_singularities           where h or [J; dh] (10) is singular in a box -> MapSingularities
 The atlas (drift over many starts and paths)
     plan_atlas, run_atlas       plan and run an atlas (here, in processes or on Dask)
     iter_atlas                  the same, chunk by chunk, in bounded memory
@@ -131,6 +132,8 @@ _EXPORTS = {
     "synthesize_e2_nd": "synthesis_nd",
     "TotalDegreeSynthesis": "synthesis_nd",
     "SynthesisResult": "variational",
+    "map_singularities": "map_singularities",
+    "MapSingularities": "map_singularities",
     # the atlas
     "plan_atlas": "atlas",
     "AtlasPlan": "atlas",
@@ -174,6 +177,7 @@ __all__ = [
     "LimitsReport",
     "Manipulator1",
     "Manipulator2",
+    "MapSingularities",
     "OneFormUndefinedError",
     "PaperCubic",
     "PlanarChain",
@@ -200,6 +204,7 @@ __all__ = [
     "iter_atlas",
     "load_robot",
     "make_inverse",
+    "map_singularities",
     "plan_atlas",
     "repeatability",
     "robot_from_dict",
@@ -265,6 +270,7 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
     from .inverses import ExtendedInverse, Inverse, Pseudoinverse
     from .kinematics import Kinematics, Manipulator1, Manipulator2
     from .limits import LimitsReport
+    from .map_singularities import MapSingularities, map_singularities
     from .planar_chain import PlanarChain
     from .practical_inverses import DampedInverse, PostureInverse, WeightedInverse
     from .progress import Progress, ProgressCallbacks

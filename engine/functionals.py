@@ -21,10 +21,9 @@ import numpy as np
 from .augmentations import AugmentingMap
 from .exceptions import InvalidInputError
 from .inverses import (
-    SINGULAR_EXTENDED,
+    extended_determinant,
     extended_inverse,
     extended_jacobian,
-    extended_singularity,
     pseudoinverse,
     require_compatible,
 )
@@ -172,13 +171,6 @@ def quadrature(
     return x, w.ravel(), box, fix
 
 
-def _singular_mask(J: FloatArray, dh: FloatArray) -> FloatArray:
-    """Where [J; dh] is singular or dh is not finite, shape (n,)."""
-    ok = np.all(np.isfinite(dh), axis=-1)
-    dh_safe = np.where(ok[:, None], dh, 0.0)
-    return ~ok | (extended_singularity(extended_jacobian(J, dh_safe)) < SINGULAR_EXTENDED)
-
-
 def _e1_diverges(
     kinematics: Kinematics,
     augmenting_map: AugmentingMap,
@@ -188,7 +180,7 @@ def _e1_diverges(
     box: dict[str, tuple[float, float]],
 ) -> bool:
     """Whether dh K vanishes on the box, so that E1 (14) diverges: [J; dh] is singular (as
-    :data:`~jik.engine.inverses.SINGULAR_EXTENDED` says) at, or det [J; dh] (continuous,
+    :func:`~jik.engine.inverses.extended_determinant` says) at, or det [J; dh] (continuous,
     +-(dh K) sqrt(det J J^T)) is of both signs over, the quadrature points ``x`` and the same
     points moved onto each face of the box (a zero on a face is outside the
     Gauss-Legendre points but makes the integral diverge all the same). Points where dh is
@@ -204,13 +196,13 @@ def _e1_diverges(
     xf = xf[~np.atleast_1d(kinematics.is_singular(xf))]
     with np.errstate(all="ignore"):
         dhf = np.asarray(augmenting_map.gradient(xf), dtype=float).reshape(len(xf), -1)
-    Jall = np.concatenate([J, kinematics.jacobian(xf)])
-    dhall = np.concatenate([dh, dhf])
-    defined = np.all(np.isfinite(dhall), axis=-1)
-    Jbar = extended_jacobian(Jall[defined], dhall[defined])
-    det = np.linalg.det(Jbar)
-    if np.any(extended_singularity(Jbar) < SINGULAR_EXTENDED):  # (dh K = 0 at a point)
+    det, singular = extended_determinant(
+        np.concatenate([J, kinematics.jacobian(xf)]), np.concatenate([dh, dhf])
+    )
+    defined = np.isfinite(det)
+    if np.any(singular & defined):  # (dh K = 0 at a point)
         return True
+    det = det[defined]
     return bool(det.size) and bool(np.min(det) < 0.0 < np.max(det))
 
 
@@ -246,7 +238,7 @@ def _evaluate(
     J = kinematics.jacobian(x)
     with np.errstate(all="ignore"):
         dh = np.asarray(augmenting_map.gradient(x), dtype=float)
-    bad = _singular_mask(J, dh)
+    bad = extended_determinant(J, dh)[1]
     dh_safe = np.where(bad[:, None], 0.0, dh)
     K = kinematics.kernel(x)
     dhk = np.einsum("np,np->n", dh_safe, K)

@@ -64,11 +64,32 @@ def extended_jacobian(J: FloatArray, dh: FloatArray) -> FloatArray:
     return np.concatenate([J, dh[..., None, :]], axis=-2)
 
 
-def extended_singularity(Jbar: FloatArray) -> FloatArray:
-    """Hadamard ratio |det Jbar| / prod(row norms) in [0, 1]: 0 means singular."""
+def extended_singularity(Jbar: FloatArray, det: FloatArray | None = None) -> FloatArray:
+    """Hadamard ratio |det Jbar| / prod(row norms) in [0, 1]: 0 means singular (``det``:
+    Jbar's determinant, when the caller has it)."""
     norms = np.prod(np.linalg.norm(Jbar, axis=-1), axis=-1)
+    det = np.linalg.det(Jbar) if det is None else det
     with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(norms > 0, np.abs(np.linalg.det(Jbar)) / norms, 0.0)
+        return np.where(norms > 0, np.abs(det) / norms, 0.0)
+
+
+def extended_determinant(J: FloatArray, dh: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """det [J; dh] of eq. (10), and where [J; dh] is singular.
+
+    Returns
+    -------
+    det : ndarray, shape (...,)
+        NaN where dh is not finite. det [J; dh] = +-(dh K) sqrt(det J J^T) is continuous
+        where J and dh are, so a sign change between two points is a rank loss between them.
+    singular : ndarray of bool, shape (...,)
+        dh not finite, or the Hadamard ratio (:func:`extended_singularity`) below
+        :data:`SINGULAR_EXTENDED`: eq. (11) is undefined there.
+    """
+    defined = np.all(np.isfinite(dh), axis=-1)
+    Jbar = extended_jacobian(J, np.where(defined[..., None], dh, 0.0))
+    det = np.linalg.det(Jbar)
+    singular = ~defined | ~(extended_singularity(Jbar, det) >= SINGULAR_EXTENDED)
+    return np.where(defined, det, np.nan), singular
 
 
 def extended_inverse(J: FloatArray, dh: FloatArray) -> FloatArray:

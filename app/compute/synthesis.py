@@ -19,7 +19,7 @@ from . import schemas as S
 from .documents import nullable
 from .exceptions import RequestError
 from .robot_requests import request_robot
-from .synthesis_total import grid, total_degree_response
+from .synthesis_total import grid, singularities, total_degree_response
 
 
 def synthesis_methods() -> S.SynthesisMethodsResponse:
@@ -170,8 +170,9 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         amap, aug_used = robot.augmenting_map()  # (the request's map, else the robot's default)
         coefficients = _coefficients(amap)
     functionals, more = _functionals(kin, amap, region, fixed, req.nodes)
-    notes += more
     all_fixed = {n: float(fixed.get(n, 0.0)) for n in names if n not in region}
+    found, said = singularities(kin, amap, region, all_fixed, req.nodes)
+    notes += more + said
     return S.SynthesizeResponse(
         robot=robot_used,
         method=req.method,
@@ -182,6 +183,7 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         coefficients=coefficients,
         functionals=functionals,
         convergence=convergence,
+        singularities=found,
         total_degree=None,
         message="; ".join(notes) or "ok",
     )

@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from ...engine.exceptions import JikError
+from ...engine.map_singularities import map_singularities
 from ...engine.robot_synthesis import TOTAL_DEGREE
 from ...engine.synthesis_nd import synthesize_e2_nd
 from . import schemas as S
@@ -67,6 +68,23 @@ def grid(amap, names, region, fixed, p: int, n: int) -> S.SynthesisGrid | None:
     return S.SynthesisGrid(axes={axes[0]: a.tolist(), axes[1]: b.tolist()}, h=nullable(h))
 
 
+def singularities(
+    kin, amap, region, fixed, nodes: int
+) -> tuple[S.MapSingularitiesInfo | None, list[str]]:
+    """Where h is singular in the box (:func:`jik.engine.map_singularities.map_singularities`
+    on a grid of ``nodes`` points per variable, as many as E1's and E2's Gauss rule: h costs
+    as much there, whether it is a formula or solves a problem per point) and what the
+    response's message says of it."""
+    try:
+        found = map_singularities(kin, amap, region, fixed=fixed, nodes=nodes)
+    except JikError as exc:
+        return None, [f"singularities of h not searched: {exc}"]
+    if found is None:
+        return None, []
+    info = S.MapSingularitiesInfo.model_validate(found.as_dict())
+    return info, [f"h is singular in the box: {found}"]
+
+
 def total_degree_response(
     req: S.SynthesizeRequest, spec, kin, robot_used: S.RobotUsed, box: tuple[list[str], dict, dict]
 ) -> S.SynthesizeResponse:
@@ -111,6 +129,7 @@ def total_degree_response(
     if len(res.maps) > 1:
         notes.append(f"{len(res.maps)} maps h_1 ... h_{len(res.maps)}; the grid shows h_1")
     notes.append("E1 is not evaluated (its Gauss rule grows as nodes^d)")
+    found, more = singularities(kin, res.maps[0], res.region, all_fixed, req.nodes)
     return S.SynthesizeResponse(
         robot=robot_used,
         method=req.method,
@@ -133,6 +152,7 @@ def total_degree_response(
             ),
         },
         convergence=[{k: float(v) for k, v in row.items()} for row in res.convergence],
+        singularities=found,
         total_degree=S.TotalDegreeInfo(**info),
-        message="; ".join(notes),
+        message="; ".join(notes + more),
     )

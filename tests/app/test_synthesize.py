@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
+from scipy.optimize import brentq
 
 from jik.engine.augmentations import E2Optimal, PaperCubic
 from jik.engine.functionals import error_functional_e2
@@ -96,3 +98,62 @@ def test_synthesize_bad_input(api):
     )
     assert msg({"robot": m2, "grid": 1000}).startswith("grid: Input should be less than")
     assert msg({"robot": m2, "method": "magic"}).startswith("method: Input should be")
+
+
+M1_REGION = {"x1": [0.0, 1.0], "x2": [0.0, 1.0], "x3": [0.5, 1.5]}
+
+
+def test_a_map_singular_in_its_box_says_where(api):
+    """(32) with C2 = -1: g(x1) vanishes at x1* = 0.479 (h through a pole, for any x2, x3);
+    the response's ``singularities`` say where on a grid of ``nodes`` points per variable, why,
+    and the message too.
+    (36) on the same box is regular: null."""
+    x1 = brentq(lambda t: t * np.sqrt(1 + t * t) + np.arcsinh(t) - 1.0, 0.0, 1.0)
+    body = {
+        "robot": {"name": "manipulator1"},
+        "augmentation": {"name": "e1_optimal", "C1": 1.0, "C2": -1.0},
+        "region": M1_REGION,
+        "nodes": 12,
+        "grid": 5,
+    }
+    r = api.post("/synthesize", json=body)
+    assert r.status_code == 200, r.text
+    found = r.json()["singularities"]
+    lo, hi = found["where"]["x1"]
+    assert lo < x1 < hi and hi - lo == pytest.approx(1 / 11)
+    assert found["where"]["x2"] == [0.0, 1.0] and found["where"]["x3"] == [0.5, 1.5]
+    assert found["fraction"] == pytest.approx(2 / 12) and found["nodes"] == 12
+    assert "h jumps through infinity" in found["reasons"]
+    assert (
+        f"h is singular in the box: {'; '.join(found['reasons'])} at x1 ∈ [0.455, 0.545], any "
+        "x2, any x3 (17% of the region's grid)" in r.json()["message"]
+    )
+    regular = api.post(
+        "/synthesize", json={**body, "augmentation": {"name": "e2_optimal", "a": 0.5, "b": 1.0}}
+    ).json()
+    assert "singularities" in regular and regular["singularities"] is None
+    assert regular["message"] == "ok"
+
+
+def test_a_synthesized_map_is_searched_and_a_vector_of_maps_is_said_not_to_be(api):
+    """The Ritz minimiser of E2 on Manipulator 2's design region is regular there; a 4R chain's
+    pair of maps (p - r = 2) is not one h: null, and the message says why."""
+    body = {"robot": {"name": "manipulator2"}, "method": "e2_variational", "region": REGION}
+    b = api.post("/synthesize", json={**body, "degree": 6, "nodes": 8}).json()
+    assert b["singularities"] is None and "singularities" not in b["message"]
+    chain = {"name": "planar_chain", "joints": "RRRR", "lengths": [1.0] * 4}
+    body = {"robot": chain, "method": "e2_total_degree", "degree": 2, "qmc_nodes": 256}
+    b = api.post("/synthesize", json=body).json()
+    assert b["singularities"] is None
+    assert (
+        "singularities of h not searched: map_singularities here needs one degree" in (b["message"])
+    )
+
+
+def test_the_singularities_field_is_documented(api):
+    schemas = api.get("/openapi.json").json()["components"]["schemas"]
+    field = schemas["SynthesizeResponse"]["properties"]["singularities"]
+    assert "null when h is regular" in field["description"]
+    assert "singularities" in schemas["SynthesizeResponse"]["required"]
+    info = schemas["MapSingularitiesInfo"]["properties"]
+    assert set(info) == {"where", "fraction", "reasons", "nodes"}

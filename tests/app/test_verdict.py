@@ -145,3 +145,36 @@ def test_a_stalled_run_says_whether_the_target_is_out_of_reach():
     message = near["extended"]["message"]
     assert "the target is within reach (0.05 from the base, reach 2.4)" in message
     assert "J is regular there" in message and "algorithmic singularity" in message
+
+
+def _warnings(state) -> list[str]:
+    return [s["text"] for s in verdict(compute(state)) if s["role"] == "warning"]
+
+
+def test_a_map_singular_in_its_design_region_is_said_where():
+    """(32) with C2 = -1: g(x1) vanishes near x1 = 0.48 for any x2, x3, found by the engine's
+    map_singularities on the design region; C2 = 1 is regular: no warning."""
+    state = updated_state(default_state("manipulator1"), {"augmentation": "e1_optimal"})
+    state = updated_state(state, {"augmentation_parameters": {"C1": 1.0, "C2": -1.0}})
+    assert _warnings(state) == [
+        "Warning: the augmenting map e1_optimal (C1 = 1, C2 = -1) is singular in the design "
+        "region x1 ∈ [0, 1], x2 ∈ [0, 1], x3 ∈ [0.5, 1.5]: the gradient of h blows up; h jumps "
+        "through infinity at x1 ∈ [0.458, 0.5], any x2, any x3 (8% of the region's grid). E1 "
+        "and E2 there are not a measure of fit, and the extended Jacobian is undefined where a "
+        "run crosses it."
+    ]
+    regular = updated_state(state, {"augmentation_parameters": {"C1": 1.0, "C2": 1.0}})
+    assert _warnings(regular) == []
+
+
+def test_the_paper_cubic_loses_rank_inside_its_design_region():
+    """(38) on Manipulator 2's design region: det [J; dh] changes sign between grid points
+    (dh K = 0 there, where E1 diverges), which a test of the grid points alone missed."""
+    warnings = _warnings(default_state("manipulator2"))
+    assert len(warnings) == 1
+    assert (
+        "paper_cubic is singular in the design region x2 ∈ [-1, 1], x3 ∈ [0, 3.14]" in (warnings[0])
+    )
+    assert (
+        "the extended Jacobian (10) loses rank at x2 ∈ [-1, 0.25], x3 ∈ [0, 0.916]" in (warnings[0])
+    )

@@ -73,6 +73,7 @@ from .runs import (
 )
 from .synthesis import (
     FunctionalInfo,
+    MapSingularitiesInfo,
     SynthesisGrid,
     SynthesisMethod,
     SynthesisMethodsResponse,
@@ -119,6 +120,7 @@ __all__ = [
     "LimitViolationInfo",
     "Limits",
     "LimitsInfo",
+    "MapSingularitiesInfo",
     "MaybeFloat",
     "Mode",
     "ParameterInfo",

@@ -54,7 +54,9 @@ class SynthesizeRequest(BaseModel):
         description="values of the variables not in the box (default: the default start)",
     )
     nodes: Annotated[int, Field(strict=True, ge=2, le=24), INTEGRAL] = Field(
-        8, description="Gauss-Legendre nodes per variable for E1 and E2"
+        8,
+        description="Gauss-Legendre nodes per variable for E1 and E2, and grid points per "
+        "variable of the search for h's singularities (singularities)",
     )
     degree: Annotated[int, Field(strict=True, ge=1, le=24), INTEGRAL] | None = Field(
         None,
@@ -140,6 +142,22 @@ class FunctionalInfo(BaseModel):
     )
 
 
+class MapSingularitiesInfo(BaseModel):
+    """Where h is singular on a grid of the box (engine.map_singularities.MapSingularities)."""
+
+    where: dict[str, list[float]] = Field(
+        description="per box variable, [lo, hi] of the grid points where h is singular"
+    )
+    fraction: float = Field(description="the fraction of the grid's points where h is singular")
+    reasons: list[str] = Field(
+        description="what is singular there: 'h or its gradient is not finite', 'the gradient "
+        "of h blows up', 'the extended Jacobian (10) loses rank' (at a point, or det [J; dh] "
+        "changes sign between neighbours: dh K = 0, where E1 diverges), 'h jumps through "
+        "infinity'"
+    )
+    nodes: int = Field(description="grid points per box variable, ends included")
+
+
 class SynthesisGrid(BaseModel):
     axes: dict[str, list[float]] = Field(description="the two grid variables and their values")
     h: list[list[MaybeFloat]] = Field(description="h[i][j] at (axis 1 [i], axis 2 [j])")
@@ -185,6 +203,11 @@ class SynthesizeResponse(BaseModel):
         description="'e2_variational': E2 against the Legendre degree; 'e2_total_degree': "
         "{degree, nodes, unknowns, e2}, the Ritz value with the degree at all the nodes, then "
         "with the nodes (leading 2^k of the rule) at the final degree"
+    )
+    singularities: MapSingularitiesInfo | None = Field(
+        description="where h, or the extended Jacobian [J; dh] (10), is singular in the box "
+        "(the fixed variables held), on a uniform grid: null when h is regular there, or when "
+        "the search does not apply (a vector of maps, too large a grid: see message)"
     )
     total_degree: TotalDegreeInfo | None = Field(
         None, description="'e2_total_degree': the synthesis' numbers and its maps"
