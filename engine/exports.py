@@ -12,6 +12,7 @@ cycle's end), ``y_1``..``y_r`` the task point k(x), ``y_d_1``..``y_d_r`` a targe
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -89,10 +90,30 @@ def dataframe(columns: dict[str, Any]):
     return pd.DataFrame(columns)
 
 
+def coordinate_names(name: str, n: int) -> list[str]:
+    """``[name_1, ..., name_n]``: the columns of a vector's n coordinates, numbered from 1."""
+    return [f"{name}_{k + 1}" for k in range(n)]
+
+
 def coordinate_columns(name: str, values: FloatArray) -> dict[str, FloatArray]:
     """``{name_1: values[:, 0], name_2: ...}``: one column per coordinate, numbered from 1."""
     values = np.asarray(values, dtype=float)
-    return {f"{name}_{k + 1}": values[:, k] for k in range(values.shape[1])}
+    names = coordinate_names(name, values.shape[1])
+    return {n: values[:, k] for k, n in enumerate(names)}
+
+
+def csv_rows(columns: dict[str, Any]) -> Iterator[tuple[str, ...]]:
+    """The rows of a table's :meth:`Columns.columns` as text cells for :func:`csv.writer`
+    (the header is ``list(columns)``): a number as Python prints it (``repr``, which reads back
+    exactly), NaN as an empty cell, a boolean as ``True``/``False`` (as pandas writes them)."""
+
+    def cells(column) -> list[str]:
+        column = np.asarray(column)
+        if column.dtype.kind == "f":
+            return ["" if v != v else repr(v) for v in column.tolist()]  # (v != v: NaN)
+        return [str(v) for v in column.tolist()]
+
+    return zip(*(cells(c) for c in columns.values()), strict=True)
 
 
 class Columns:

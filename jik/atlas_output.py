@@ -119,6 +119,7 @@ class CsvWriter:
         import numpy as np
 
         from jik.engine.atlas_table import atlas_columns
+        from jik.engine.exports import csv_rows
 
         path, start = np.divmod(np.arange(chunk.lo, chunk.hi), self.plan.n_starts)
         table = atlas_columns(
@@ -134,14 +135,7 @@ class CsvWriter:
         )
         if chunk.lo == 0:  # (the first rows: the header, the table's column names)
             self.writer.writerow(list(table))
-        self.writer.writerows(zip(*(_cells(v) for v in table.values()), strict=True))
-
-
-def _cells(column) -> list[str]:
-    """A column's cells as text: numbers as Python prints them, NaN as an empty cell."""
-    if column.dtype.kind == "f":
-        return ["" if v != v else repr(v) for v in column.tolist()]  # (v != v: NaN)
-    return [str(v) for v in column.tolist()]
+        self.writer.writerows(csv_rows(table))
 
 
 def atlas_figure(s, drift_last, algorithms, cycles: int, paths: int, n: int, label: str):
