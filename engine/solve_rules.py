@@ -15,6 +15,7 @@ from .exceptions import InvalidInputError
 from .inverses import Inverse
 from .kinematics import Kinematics
 from .picard import DEGREE
+from .stall import stall_reason
 from .validation import FloatArray, check_memory, count, positive
 
 #: The smallest task-error tolerance ``tol`` of a solve (double precision).
@@ -134,8 +135,10 @@ def counted(n: int, mode: str) -> str:
     return f"{n} {'step' if mode == 'continuous' else 'iteration'}{'' if n == 1 else 's'}"
 
 
-def stop_message(status, nit, err, tol, mode, x, inverse, max_iterations) -> str:
-    """What a member that stopped with ``status`` after ``nit`` steps at task error ``err`` says."""
+def stop_message(status, nit, err, tol, mode, x, inverse, max_iterations, target) -> str:
+    """What a member that stopped with ``status`` after ``nit`` steps at task error ``err``, at
+    ``x`` on its way to ``target``, says (a stall says why:
+    :func:`jik.engine.stall.stall_reason`)."""
     steps = counted(nit, mode)
     if status == Status.CONVERGED:
         if nit == 0:
@@ -148,10 +151,7 @@ def stop_message(status, nit, err, tol, mode, x, inverse, max_iterations) -> str
             "lower gamma" if mode == "discrete" else "the target may be unreachable"
         )
     if status == Status.STALLED:
-        return (
-            f"stalled after {steps} at error {err:.3g}: the step size collapsed near a "
-            "singularity or the target is unreachable"
-        )
+        return f"stalled after {steps} at error {err:.3g}: {stall_reason(inverse, target, x)}"
     return (
         f"did not converge within {counted(max_iterations, mode)} (error {err:.3g} >= {tol:g}); "
         "raise max_iterations or gamma"

@@ -315,8 +315,8 @@ def solve_batch(
     y = kin.forward_unchecked(x)
     err = np.linalg.norm(y - yb, axis=-1)
     messages = tuple(
-        stop_message(s, int(k), float(er), tol, mode, xi, inverse, cap)
-        for s, k, er, xi in zip(status, nit, err, x, strict=True)
+        stop_message(s, int(k), float(er), tol, mode, xi, inverse, cap, yi)
+        for s, k, er, xi, yi in zip(status, nit, err, x, yb, strict=True)
     )
     rec_m = rec_t = rec_x = None
     if record:

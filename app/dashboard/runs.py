@@ -15,11 +15,11 @@ from ...engine.exceptions import RunCancelled
 from ...engine.progress import ProgressCallbacks
 from ...engine.repeatability import Leg, Resume, closed_path, repeatability
 from ...engine.results import SolveResult, Trajectory
+from ...engine.run_settings import RunSettings
 from ...engine.solve_rules import counted
 from ...engine.unicycle import Unicycle
 from .controls import max_iterations
 from .model import DashboardState
-from .reach import stall_note
 from .robots import state_inverse, state_kinematics
 
 #: Time grid points of one unicycle platform path q(t).
@@ -51,6 +51,10 @@ class AlgorithmRun:
         ||x at the end of cycle c - x0|| (closed-path task only, else empty).
     platform : ndarray, shape (m, T, 3) or None
         Unicycle only: the platform path q(t) for the controls of every iteration.
+    settings : RunSettings or None
+        The engine's record of the inverse, targets and settings of the legs
+        (:attr:`jik.engine.results.RepeatabilityResult.settings`): a run going on from this
+        one must have the same.
     """
 
     algorithm: str
@@ -66,6 +70,7 @@ class AlgorithmRun:
     message: str
     seconds: float
     platform: np.ndarray | None = None
+    settings: RunSettings | None = None
 
 
 @dataclass(frozen=True)
@@ -116,7 +121,7 @@ def _run_legs(
         offset = float(resume.theta[-1])
         done = (len(resume.drift) - 1) * L  # (the legs before its last cycle)
         guides = [_leg_trajectory(resume, done + j) for j in range(L)] if continuous else []
-        earlier = Resume(x0, resume.leg_end, guides)
+        earlier = Resume(x0, resume.leg_end, guides, resume.settings)
 
     def on_leg(leg: Leg) -> None:
         nonlocal offset, last, failure
@@ -129,10 +134,6 @@ def _run_legs(
             failure = f"{where} stopped: {leg.stopped_by}"
         elif not res.success:
             failure = f"{where}: {_leg_message(res, cap)}"
-            if res.message.startswith("stalled") and STALLED in res.message:
-                target = np.asarray(path, dtype=float)[leg.index]
-                note = stall_note(inverse, target, np.asarray(res.x, dtype=float))
-                failure = failure.replace(STALLED, note)
         else:
             last = _leg_message(res, cap)
         progress()
@@ -172,11 +173,8 @@ def _run_legs(
         success=bool(run.success),
         message=failure or _legs_message(len(ends), drift, last),
         seconds=time.perf_counter() - t0,
+        settings=run.settings,
     )
-
-
-#: The end of the engine's message for a stalled run, which :func:`stall_note` makes precise.
-STALLED = "the step size collapsed near a singularity or the target is unreachable"
 
 
 def _leg_message(res: SolveResult, cap: int) -> str:

@@ -580,3 +580,5 @@ def test_another_number_of_cycles_reuses_the_cycles_already_solved(mode):
             if want.h is not None:
                 np.testing.assert_array_equal(got.h, want.h)
             assert (got.success, got.message) == (want.success, want.message)
+            assert got.settings is not None and want.settings is not None
+            assert got.settings.difference(want.settings) is None  # (the engine checked it)

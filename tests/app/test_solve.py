@@ -79,6 +79,19 @@ def test_solve_not_converged_is_200_with_reason(api):
     assert "did not converge within 3 steps" in b["message"]
 
 
+def test_a_stalled_solve_says_why(api):
+    """A planar 3R arm of reach 2.4 asked for a target at 5: the response's message says the
+    target is out of reach (the engine's diagnosis, the same words as the dashboard's)."""
+    arm = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]}
+    body = solve_body(robot=arm, x0=[0.3, 0.4, 0.5], target=[5.0, 0.0])
+    b = api.post("/solve", json=body).json()
+    assert b["converged"] is False and b["message"].startswith("stalled after ")
+    assert (
+        "the target is out of reach: it is 5 from the base, beyond the arm's reach 2.4"
+        in (b["message"])
+    )
+
+
 def test_gamma_only_rescales_theta(api):
     """Continuous mode: x(theta) does not depend on gamma, theta scales as 1/gamma (NOTES.md)."""
     a = api.post("/solve", json=solve_body(gamma=1.0)).json()
