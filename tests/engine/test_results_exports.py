@@ -206,6 +206,9 @@ def test_every_result_exports_a_table_with_one_meaning_per_column_name():
         ARM, {"x2": (0, 1), "x3": (1, 1.6)}, degree=4, convergence_degrees=(2,)
     )
     assert synthesis.columns()["degree"].tolist() == [2, 4]
+    # (the number of unknowns was n_unknowns here and unknowns in a total-degree synthesis)
+    assert list(synthesis.columns()) == ["degree", "unknowns", "e2"]
+    assert synthesis.columns()["unknowns"].tolist() == [9, 25]
     sd = json.loads(json.dumps(synthesis.as_dict()))
     assert sd["e2"] == synthesis.e2 and sd["degree"] == 4
     assert repr(synthesis.augmenting_map) == "SynthesizedMap(degree_x2=4, degree_x3=4)"
