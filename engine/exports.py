@@ -7,7 +7,10 @@ member, cycle or run) gives :meth:`Columns.columns` (a dict of equal-length arra
 
 Column names mean one thing everywhere: ``x0_1``..``x0_p`` a start configuration x0,
 ``x_1``..``x_p`` the configuration the row is about (a point of a trajectory, a solve's end, a
-cycle's end), ``y_1``..``y_r`` the task point k(x), ``y_d_1``..``y_d_r`` a target.
+cycle's or a leg's end), ``y_1``..``y_r`` the task point k(x), ``y_d_1``..``y_d_r`` a target;
+``cycle`` counts from 1, ``leg`` from 1 within its cycle, ``start`` and ``path`` from 0. The
+product's other tables (``jik atlas``'s CSV, the dashboard's export) take these names from here
+(:func:`coordinate_names`, the results' ``columns()``) and write them with :func:`csv_rows`.
 """
 
 from __future__ import annotations
