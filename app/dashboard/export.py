@@ -129,7 +129,7 @@ def export_json(
             "h": run.h,
             "cycle": table["cycle"],
             "leg": table["leg"],
-            "leg_end": run.leg_end,
+            "legs": run.leg_end,  # (x after each leg, as RepeatabilityResult.as_dict names it)
             "drift": run.drift,
             "h_change": h_change(run.h),
         }

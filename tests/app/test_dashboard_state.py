@@ -210,12 +210,14 @@ def test_export_has_every_point_of_both_runs():
 def test_an_export_names_its_columns_as_the_engine_does():
     """The CSV named its columns by the robot's joint and task names (``x1``, ``panda_joint1``)
     and numbered legs across cycles from 1 where the JSON counted from 0: its point columns are
-    now the engine's trajectory columns, its units keyed by them, cycle and leg from 1 in both."""
+    now the engine's trajectory columns, its units keyed by them, cycle and leg from 1 in both,
+    and the JSON's leg ends are "legs" as in the engine's results."""
     state = updated_state(default_state("manipulator2"), {"cycles": 2})
     result = compute(state)
     header, *rows = [r for r in export_csv(result).splitlines() if not r.startswith("#")]
     inverse = make_inverse(state_kinematics(state), "extended", state.augmentation)
-    engine = solve(inverse, state.x0, result.targets[0], record=True).trajectory.columns()
+    trajectory = solve(inverse, state.x0, result.targets[0], record=True).trajectory
+    engine = trajectory.columns()
     assert header.split(",") == ["algorithm", "cycle", "leg", *engine]
     body = export_json(result)
     assert list(body["units"]) == list(engine)
@@ -228,6 +230,9 @@ def test_an_export_names_its_columns_as_the_engine_does():
     first = [r.split(",") for r in rows if r.startswith("pseudoinverse,")]
     assert [int(r[1]) for r in first] == run["cycle"]
     assert [int(r[2]) for r in first] == run["leg"]
+    rep = repeatability(inverse, state.x0, result.targets, cycles=1)
+    assert set(trajectory.as_dict()) <= set(run)  # (theta, x, y, error, h)
+    assert {"legs", "drift"} <= set(rep.as_dict()) & set(run) and "leg_end" not in run
 
 
 def test_a_gamma_change_redraws_only_the_panels_with_theta_on_an_axis():
