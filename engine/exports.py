@@ -105,18 +105,21 @@ def coordinate_columns(name: str, values: FloatArray) -> dict[str, FloatArray]:
     return {n: values[:, k] for k, n in enumerate(names)}
 
 
-def csv_rows(columns: dict[str, Any]) -> Iterator[tuple[str, ...]]:
+def csv_rows(columns: dict[str, Any], block: int = 1024) -> Iterator[tuple[str, ...]]:
     """The rows of a table's :meth:`Columns.columns` as text cells for :func:`csv.writer`
     (the header is ``list(columns)``): a number as Python prints it (``repr``, which reads back
-    exactly), NaN as an empty cell, a boolean as ``True``/``False`` (as pandas writes them)."""
+    exactly), NaN as an empty cell, a boolean as ``True``/``False`` (as pandas writes them).
+    Cells are made ``block`` rows at a time, so a large table's text is never held whole."""
 
     def cells(column) -> list[str]:
-        column = np.asarray(column)
         if column.dtype.kind == "f":
             return ["" if v != v else repr(v) for v in column.tolist()]  # (v != v: NaN)
         return [str(v) for v in column.tolist()]
 
-    return zip(*(cells(c) for c in columns.values()), strict=True)
+    arrays = [np.asarray(c) for c in columns.values()]
+    rows = len(arrays[0]) if arrays else 0
+    for lo in range(0, rows, block):
+        yield from zip(*(cells(a[lo : lo + block]) for a in arrays), strict=True)
 
 
 class Columns:
