@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from jik import atlas_cli
+from jik.cli import atlas as atlas_cli
 from jik.cli import main
 from jik.engine.augmentations import PaperCubic
 from jik.engine.inverses import ExtendedInverse, Pseudoinverse

@@ -21,6 +21,7 @@ SETUPTOOLS = PYPROJECT["tool"]["setuptools"]
 #: Source folder -> the extra its imports may come from (None: the plain install).
 EXTRA_OF = {
     "jik": None,
+    "cli": None,
     "engine": None,
     "app": "app",
     "static": "app",
@@ -207,6 +208,24 @@ def test_imports_between_the_mapped_folders_resolve_in_the_source_tree(folder):
                 if not found and not (node.module is None and (target / "__init__.py").is_file()):
                     problems.append(f"{where}:{node.lineno} {module} is not in the tree")
     assert problems == []
+
+
+def test_the_root_package_imports_none_of_its_mapped_subpackages():
+    """jik/ holds the root package only (its version, the install hint): a static tool looks
+    for ``jik.engine`` in jik/ and would not find it, so no module there imports one; the
+    ``jik`` command's code is cli/ (``jik.cli``), which imports the others relatively. The one
+    exception is ``python -m jik``, whose jik/__main__.py must name ``jik.cli``."""
+    found = [
+        f"{path.name}:{node.lineno}"
+        for path in sorted((ROOT / "jik").glob("*.py"))
+        for node in _jik_imports(path)
+        if node.level
+        or any(
+            n.startswith("jik.")
+            for n in [getattr(node, "module", None) or "", *(a.name for a in node.names)]
+        )
+    ]
+    assert found == ["__main__.py:3"]
 
 
 @pytest.mark.parametrize("folder", sorted(EXTRA_OF))

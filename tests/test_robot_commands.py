@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from jik.cli import main
+from jik.cli.robot_commands import parse_path, parse_vector
 from jik.engine.reproductions.table1 import PRINTED
-from jik.robot_commands import parse_path, parse_vector
 
 ARM4 = Path(__file__).resolve().parent / "data" / "arm4.urdf"
 ARM3R = {

@@ -13,7 +13,7 @@ import urllib.request
 import pytest
 
 from jik.cli import main
-from jik.serve_address import dashboard_url
+from jik.cli.serve_address import dashboard_url
 
 pytest.importorskip("uvicorn", reason="jik serve needs the app extra")
 

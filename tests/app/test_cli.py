@@ -69,7 +69,7 @@ def test_only_the_printing_commands_die_quietly_on_a_closed_pipe(monkeypatch):
     caller's handling as it found it."""
     import signal
 
-    from jik import cli
+    from jik.cli import command as cli
 
     seen = {}
     monkeypatch.setattr(

@@ -277,7 +277,7 @@ def test_reproduction_table_of_the_panda_pose_loop():
 
 
 def test_cli_algorithm_names_are_the_catalogue():
-    from jik.algorithm_options import ALGORITHM_NAMES
+    from jik.cli.algorithm_options import ALGORITHM_NAMES
 
     assert list(ALGORITHM_NAMES) == list(ALGORITHMS)
 

@@ -1,4 +1,4 @@
-"""What ``jik atlas`` writes (:mod:`jik.atlas_cli`): the chunks gathered for the JSON, the CSV
+"""What ``jik atlas`` writes (:mod:`jik.cli.atlas`): the chunks gathered for the JSON, the CSV
 (the engine's atlas table, streamed in run order) and the HTML figure of the drift map."""
 
 from __future__ import annotations
@@ -118,8 +118,8 @@ class CsvWriter:
     def _write(self, task, chunk) -> None:
         import numpy as np
 
-        from jik.engine.atlas_table import atlas_columns
-        from jik.engine.exports import csv_rows
+        from ..engine.atlas_table import atlas_columns
+        from ..engine.exports import csv_rows
 
         path, start = np.divmod(np.arange(chunk.lo, chunk.hi), self.plan.n_starts)
         table = atlas_columns(

@@ -30,13 +30,13 @@ import time
 from pathlib import Path
 from typing import Any
 
-from jik.algorithm_options import (
+from .algorithm_options import (
     ALGORITHM_NAMES,
     add_algorithm_parameter_options,
     algorithm_parameters,
 )
-from jik.atlas_output import CsvWriter, Gathered, listed, write_figure
-from jik.robot_commands import add_task_option, robot_with_task
+from .atlas_output import CsvWriter, Gathered, listed, write_figure
+from .robot_commands import add_task_option, robot_with_task
 
 #: Atlases of more runs than this write their arrays to the CSV only (the JSON keeps a summary).
 JSON_RUNS = 20000
@@ -164,7 +164,7 @@ class Progress:
 
 
 def atlas_command(args: argparse.Namespace) -> int:
-    from jik.engine.exceptions import InvalidInputError
+    from ..engine.exceptions import InvalidInputError
 
     try:
         return _run(args)
@@ -177,13 +177,13 @@ def atlas_command(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from jik.engine.arms import ARMS
-    from jik.engine.atlas import plan_atlas
-    from jik.engine.atlas_backends import backend_for
-    from jik.engine.atlas_run import iter_atlas
-    from jik.engine.exceptions import InvalidInputError
-    from jik.engine.registry import make_inverse, robot_spec
-    from jik.engine.self_motion import MAX_ARC
+    from ..engine.arms import ARMS
+    from ..engine.atlas import plan_atlas
+    from ..engine.atlas_backends import backend_for
+    from ..engine.atlas_run import iter_atlas
+    from ..engine.exceptions import InvalidInputError
+    from ..engine.registry import make_inverse, robot_spec
+    from ..engine.self_motion import MAX_ARC
 
     out = _writable(Path(args.out))
     algorithms = args.algorithm or ["pseudoinverse"]
@@ -328,7 +328,7 @@ def _run(args: argparse.Namespace) -> int:
 def _writable(out: Path) -> Path:
     """``out``, once its folder is known to take the files (the JSON, and the CSV and figure
     beside it): checked before anything is computed."""
-    from jik.engine.exceptions import InvalidInputError
+    from ..engine.exceptions import InvalidInputError
 
     folder = out.parent
     if out.is_dir():

@@ -15,14 +15,14 @@ import json
 import sys
 from typing import TYPE_CHECKING
 
-from jik.algorithm_options import (
+from .algorithm_options import (
     ALGORITHM_NAMES,
     add_algorithm_parameter_options,
     algorithm_parameters,
 )
 
 if TYPE_CHECKING:
-    from jik.engine.robot_spec import Robot
+    from ..engine.robot_spec import Robot
 
 
 def _split(text: str, sep: str) -> list[str]:
@@ -38,7 +38,7 @@ def _split(text: str, sep: str) -> list[str]:
 
 def parse_vector(text: str, option: str) -> list[float]:
     """``"0, 0, pi/2"`` -> [0.0, 0.0, 1.5707963267948966]; each entry a constant formula."""
-    from jik.engine.formula import parse_formula
+    from ..engine.formula import parse_formula
 
     out = []
     for i, part in enumerate(_split(text, ",")):
@@ -63,9 +63,9 @@ def add_task_option(p: argparse.ArgumentParser) -> None:
 
 def robot_with_task(source: str, task: str | None) -> Robot:
     """The robot of ``--robot`` (a file or a name), a catalogue arm with ``--task`` if given."""
-    from jik.engine.arms import ARMS
-    from jik.engine.exceptions import InvalidInputError
-    from jik.engine.robot_spec import load_robot, robot_from_dict
+    from ..engine.arms import ARMS
+    from ..engine.exceptions import InvalidInputError
+    from ..engine.robot_spec import load_robot, robot_from_dict
 
     if task is None:
         return load_robot(source)
@@ -111,7 +111,7 @@ def _setup(args: argparse.Namespace) -> tuple[Robot, list[float], dict]:
 
 def _limits(robot: Robot, report):
     """The run's limits report (``report(limits, names)``), or None for a robot without."""
-    from jik.engine.limits import limit_names, robot_limits
+    from ..engine.limits import limit_names, robot_limits
 
     limits = robot_limits(robot.kinematics)
     return None if limits is None else report(limits, limit_names(robot.kinematics))
@@ -134,8 +134,8 @@ def _fmt(v) -> str:
 
 
 def solve_command(args: argparse.Namespace) -> int:
-    from jik.engine.limits import solve_report
-    from jik.engine.solver import solve
+    from ..engine.limits import solve_report
+    from ..engine.solver import solve
 
     robot, x0, settings = _setup(args)
     target = parse_vector(args.target, "--target") if args.target else robot.spec.default_target
@@ -168,8 +168,8 @@ def solve_command(args: argparse.Namespace) -> int:
 
 
 def repeatability_command(args: argparse.Namespace) -> int:
-    from jik.engine.limits import repeatability_report, robot_limits
-    from jik.engine.repeatability import repeatability
+    from ..engine.limits import repeatability_report, robot_limits
+    from ..engine.repeatability import repeatability
 
     robot, x0, settings = _setup(args)
     path = parse_path(args.path, "--path") if args.path else robot.spec.default_path
@@ -203,7 +203,7 @@ def repeatability_command(args: argparse.Namespace) -> int:
 
 def _guarded(command):
     def run(args: argparse.Namespace) -> int:
-        from jik.engine.exceptions import InvalidInputError, JikError
+        from ..engine.exceptions import InvalidInputError, JikError
 
         try:
             return command(args)

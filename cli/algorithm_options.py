@@ -34,8 +34,8 @@ def add_algorithm_parameter_options(p: argparse.ArgumentParser) -> None:
 def algorithm_parameters(args: argparse.Namespace, algorithm: str, x0=None) -> dict:
     """The options given that belong to ``algorithm`` (the others are ignored for it); the
     posture inverse's rest defaults to ``x0`` when given (a run's start)."""
-    from jik.engine.registry import ALGORITHMS
-    from jik.robot_commands import parse_path, parse_vector
+    from ..engine.registry import ALGORITHMS
+    from .robot_commands import parse_path, parse_vector
 
     spec = ALGORITHMS[algorithm]
     out: dict = {}

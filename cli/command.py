@@ -15,8 +15,9 @@ import sys
 from typing import Any
 
 from jik import install_hint
-from jik.robot_commands import add_robot_commands
-from jik.serve_address import Announcer, listen_problem, port_number
+
+from .robot_commands import add_robot_commands
+from .serve_address import Announcer, listen_problem, port_number
 
 #: Reproductions: name -> module in jik.engine.reproductions with run() and format_text().
 REPRODUCTIONS = {
@@ -42,7 +43,7 @@ def _progress(fraction: float) -> None:
 
 
 def reproduce(args: argparse.Namespace) -> int:
-    module = importlib.import_module(f"jik.engine.reproductions.{args.name}")
+    module = importlib.import_module(f"..engine.reproductions.{args.name}", __package__)
     kwargs: dict[str, Any] = {}
     if args.name == "table1" and args.printed_gradient:
         kwargs["printed_gradient"] = True
@@ -76,7 +77,7 @@ def missing_app_extra(error: ModuleNotFoundError) -> int:
 
 def serve(args: argparse.Namespace) -> int:
     try:
-        from jik.app.api.server import PortInUse, run_server
+        from ..app.api.server import PortInUse, run_server
     except ModuleNotFoundError as error:
         return missing_app_extra(error)
     problem = listen_problem(args.host, args.port)
@@ -101,7 +102,7 @@ def serve(args: argparse.Namespace) -> int:
 
 
 def bench(args: argparse.Namespace) -> int:
-    from jik.benchmarks import run_benchmarks
+    from ..benchmarks import run_benchmarks
 
     try:
         return run_benchmarks(args.names, quick=args.quick)
@@ -111,7 +112,8 @@ def bench(args: argparse.Namespace) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     from jik import __version__
-    from jik.atlas_cli import add_atlas_parser
+
+    from .atlas import add_atlas_parser
 
     parser = argparse.ArgumentParser(
         prog="jik", description="jik: a lab for repeatable Jacobian inverse kinematics"
