@@ -10,7 +10,10 @@ from the robot's default start (or ``--reference``) reaches the point; the arc i
 curve stays in the robot's configuration box, or ``--arc``. Writes ``--out`` (JSON: the
 inputs, the starts, and per algorithm the drift after each cycle, success and leg ends), a CSV
 beside it for large atlases (or with ``--csv``), and an HTML figure of the drift map when
-plotly is installed.
+plotly is installed. The CSV is the engine's atlas table (``AtlasResult.columns``), written
+chunk by chunk: a row per run, algorithm, cycle and leg (per cycle with ``--no-leg-ends``),
+columns ``algorithm, path, start, s, cycle, leg, drift, success, x0_1..x0_p, x_1..x_p`` (x0 the
+start, x the leg's end); the JSON's ``variable_names`` name the coordinates k.
 ``--robot`` is a built-in robot's name (``--param`` sets its parameters), a catalogue arm's
 (``panda``, with its default task) or a user's robot file
 (:func:`jik.engine.robot_spec.load_robot`, as for ``jik solve``).
@@ -107,7 +110,7 @@ def add_atlas_parser(sub) -> None:
     p.add_argument(
         "--no-leg-ends",
         action="store_true",
-        help="leave the leg ends out (a large CSV is then far smaller)",
+        help="leave the leg ends out (the CSV: a row per cycle, no x_k; far smaller)",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=atlas_command)
@@ -279,6 +282,7 @@ def _run(args: argparse.Namespace) -> int:
         "period": plan.manifolds[0].period,
         "paths": plan.paths.tolist(),
         "legs_per_cycle": plan.legs,
+        "variable_names": list(kin.variable_names or (f"x{k + 1}" for k in range(kin.p))),
         "elapsed_s": elapsed,
         "csv": None if csv_path is None else csv_path.name,
         "summary": arrays.summary(),

@@ -1,10 +1,9 @@
 """What ``jik atlas`` writes (:mod:`jik.cli.atlas`): the chunks gathered for the JSON, the CSV
-rows in run order, and the HTML figure of the drift map."""
+(the engine's atlas table, streamed in run order) and the HTML figure of the drift map."""
 
 from __future__ import annotations
 
 import csv
-import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -89,7 +88,9 @@ class Gathered:
 
 
 class CsvWriter:
-    """Rows of the CSV in run order (chunks that finish early wait in a small buffer)."""
+    """The CSV: the atlas's long table (:func:`jik.engine.atlas_table.atlas_columns`, the
+    columns of ``AtlasResult.columns(every_leg=legs)``, named there), a chunk's rows at a time in
+    run order (chunks that finish early wait in a small buffer)."""
 
     def __init__(self, path: Path | None, plan, legs: bool) -> None:
         self.path, self.plan, self.next, self.legs = path, plan, 0, legs
@@ -99,26 +100,11 @@ class CsvWriter:
         if self.path is not None:
             self.file = self.path.open("w", newline="", encoding="utf-8")
             self.writer = csv.writer(self.file)
-            self.writer.writerow(self._header())
         return self
 
     def __exit__(self, *exc: object) -> None:
         if self.path is not None:
             self.file.close()
-
-    def _header(self) -> list[str]:
-        kin = self.plan.inverses[0].kinematics
-        names = kin.variable_names or tuple(f"x{i + 1}" for i in range(kin.p))
-        cols = ["path", "start", "s", *names]
-        for alg in self.plan.algorithms:
-            cols += [f"{alg}_success"] + [f"{alg}_drift_{c + 1}" for c in range(self.plan.cycles)]
-            if self.legs:
-                cols += [
-                    f"{alg}_leg{k + 1}_{v}"
-                    for k in range(self.plan.cycles * self.plan.legs)
-                    for v in names
-                ]
-        return cols
 
     def add(self, task, chunk) -> None:
         if self.path is None:
@@ -132,25 +118,24 @@ class CsvWriter:
     def _write(self, task, chunk) -> None:
         import numpy as np
 
-        N = self.plan.n_starts
-        runs = np.arange(chunk.lo, chunk.hi)
-        s = self.plan.parameter(runs % N)
-        s = np.full(len(runs), np.nan) if s is None else s
-        A = chunk.drift.shape[0]
-        parts = [(runs // N)[:, None], (runs % N)[:, None], s[:, None], task.starts]
-        for a in range(A):
-            parts += [chunk.success[a][:, None], chunk.drift[a]]
-            if self.legs:
-                parts.append(chunk.leg_ends[a].reshape(len(runs), -1))
-        table = np.concatenate([np.asarray(p, dtype=float) for p in parts], axis=1)
-        for row in table:
-            self.writer.writerow([_cell(v) for v in row])
+        from ..engine.atlas_table import atlas_columns
+        from ..engine.exports import csv_rows
 
-
-def _cell(v: float) -> str:
-    if not math.isfinite(v):
-        return ""
-    return str(int(v)) if v == int(v) and abs(v) < 2**53 else repr(float(v))
+        path, start = np.divmod(np.arange(chunk.lo, chunk.hi), self.plan.n_starts)
+        table = atlas_columns(
+            self.plan.algorithms,
+            path,
+            start,
+            self.plan.parameter(start),
+            task.starts,
+            chunk.drift,
+            chunk.success,
+            chunk.leg_ends if self.legs else None,
+            self.legs,
+        )
+        if chunk.lo == 0:  # (the first rows: the header, the table's column names)
+            self.writer.writerow(list(table))
+        self.writer.writerows(csv_rows(table))
 
 
 def atlas_figure(s, drift_last, algorithms, cycles: int, paths: int, n: int, label: str):

@@ -4,6 +4,8 @@
 a built-in robot. Vectors are comma-separated numbers or constant formulas (``0, 0, pi/2``),
 paths are points separated by ``;`` (``1,1; 1,2; 0,2``). Engine alone: no web package, and the
 engine itself is imported only when a command runs (``jik --help`` and ``jik serve`` stay light).
+``--json`` prints the engine result's ``as_dict()`` (its names: ``y_d`` the target, ``nit``, ...)
+with the robot's title, its notes and its joint-limit report.
 """
 
 from __future__ import annotations
@@ -141,15 +143,7 @@ def solve_command(args: argparse.Namespace) -> int:
     report = _limits(robot, lambda limits, names: solve_report(limits, res, names))
     out = {
         "robot": robot.spec.title,
-        "algorithm": inverse.name,
-        "x0": x0,
-        "target": list(target),
-        "x": res.x.tolist(),
-        "y": res.y.tolist(),
-        "error": res.error,
-        "success": res.success,
-        "message": res.message,
-        "nit": res.nit,
+        **res.as_dict(),  # (the engine's names: x0, y_d, x, y, error, success, nit, ...)
         **({} if report is None else {"limits": report.as_dict()}),
         **_notes(robot),
     }
@@ -185,14 +179,7 @@ def repeatability_command(args: argparse.Namespace) -> int:
     report = _limits(robot, lambda limits, names: repeatability_report(limits, rep, names))
     out = {
         "robot": robot.spec.title,
-        "algorithm": inverse.name,
-        "x0": x0,
-        "targets": rep.targets.tolist(),
-        "legs": rep.legs.tolist(),
-        "cycle_end": rep.cycle_end.tolist(),
-        "drift": rep.drift.tolist(),
-        "success": bool(rep.success),
-        "message": rep.message,
+        **rep.as_dict(),  # (the engine's names: x0, targets, legs, cycle_end, drift, ...)
         **({} if report is None else {"limits": report.as_dict()}),
         **_notes(robot),
     }

@@ -67,8 +67,9 @@ compute (``ExtendedInverse(Manipulator2(p=3, r=2, l=1), map=PaperCubic())``); re
 one line and export their numbers: ``as_dict()`` (JSON-friendly; a run's algorithm, inverse,
 mode and gamma included), ``columns()`` (a dict of arrays, a row per item) and ``to_dataframe()``
 (the same columns in pandas: ``pip install 'jik-lab[dataframes]'``). Column names mean one thing
-everywhere: ``x0_1``.. a start, ``x_1``.. the row's configuration (a trajectory's point, a solve's
-or a cycle's end), ``y_1``.. its task point, ``y_d_1``.. a target.
+everywhere: ``x0_1``.. a start, ``x_1``.. the row's configuration (a trajectory's point, a solve's,
+a cycle's or a leg's end), ``y_1``.. its task point, ``y_d_1``.. a target; ``jik atlas``'s CSV and
+the dashboard's export use the same names.
 """
 
 from __future__ import annotations

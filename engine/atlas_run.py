@@ -17,8 +17,9 @@ import numpy as np
 
 from .atlas import AtlasPlan
 from .atlas_backends import Backend, backend_for
+from .atlas_table import atlas_columns
 from .exceptions import SingularConfigurationError
-from .exports import Columns, coordinate_columns
+from .exports import Columns, dataframe
 from .inverses import Inverse
 from .limits import robot_limits, starts_outside
 from .posture_at_start import PostureAtStart
@@ -177,28 +178,32 @@ class AtlasResult(Columns):
             f"{drifts})"
         )
 
-    def columns(self) -> dict[str, FloatArray]:
-        """A row per algorithm, path, start and cycle (long format): ``algorithm`` (its label),
-        ``path``, ``start`` (both from 0), ``s`` (arc length, NaN for given starts), ``cycle``
-        (from 1), ``drift``, ``success`` (the run's), the start ``x0_1``..``x0_p`` and, when the
-        leg ends were kept, the configuration at the cycle's end ``x_1``..``x_p``."""
+    def columns(self, every_leg: bool = False) -> dict[str, FloatArray]:
+        """A row per path, start, algorithm and cycle (long format, run order:
+        :func:`jik.engine.atlas_table.atlas_columns`, the table ``jik atlas`` streams to its
+        CSV): ``algorithm`` (its label), ``path``, ``start`` (both from 0), ``s`` (arc length, NaN
+        for given starts), ``cycle`` (from 1), ``drift``, ``success`` (the run's), the start
+        ``x0_1``..``x0_p`` and, when the leg ends were kept, the configuration at the cycle's end
+        ``x_1``..``x_p``. ``every_leg``: a row per leg instead, with ``leg`` (from 1 within its
+        cycle) and ``x_k`` the leg's end."""
         A, P, N, C = self.drift.shape
-        a, j, i, c = (g.ravel() for g in np.indices((A, P, N, C)))
-        s = np.full(N, np.nan) if self.parameter is None else np.asarray(self.parameter)
-        out = {
-            "algorithm": np.asarray(self.algorithms)[a],
-            "path": j,
-            "start": i,
-            "s": s[i],
-            "cycle": c + 1,
-            "drift": self.drift.ravel(),
-            "success": self.success[a, j, i],
-        }
-        out |= coordinate_columns("x0", self.starts[j, i])
-        if self.leg_ends is not None:
-            L = self.leg_ends.shape[3] // C
-            out |= coordinate_columns("x", self.leg_ends[a, j, i, (c + 1) * L - 1])
-        return out
+        path, start = np.divmod(np.arange(P * N), N)
+        legs = self.leg_ends
+        return atlas_columns(
+            self.algorithms,
+            path,
+            start,
+            None if self.parameter is None else np.asarray(self.parameter)[start],
+            self.starts.reshape(P * N, -1),
+            self.drift.reshape(A, P * N, C),
+            self.success.reshape(A, P * N),
+            None if legs is None else legs.reshape(A, P * N, *legs.shape[3:]),
+            every_leg,
+        )
+
+    def to_dataframe(self, every_leg: bool = False):
+        """:meth:`columns` as a pandas DataFrame (needs pandas: the ``dataframes`` extra)."""
+        return dataframe(self.columns(every_leg))
 
     def as_dict(self, leg_ends: bool = False) -> dict:
         """JSON-friendly: the labels, paths, arc lengths, starts, drift, success, the failures

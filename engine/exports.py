@@ -7,11 +7,15 @@ member, cycle or run) gives :meth:`Columns.columns` (a dict of equal-length arra
 
 Column names mean one thing everywhere: ``x0_1``..``x0_p`` a start configuration x0,
 ``x_1``..``x_p`` the configuration the row is about (a point of a trajectory, a solve's end, a
-cycle's end), ``y_1``..``y_r`` the task point k(x), ``y_d_1``..``y_d_r`` a target.
+cycle's or a leg's end), ``y_1``..``y_r`` the task point k(x), ``y_d_1``..``y_d_r`` a target;
+``cycle`` counts from 1, ``leg`` from 1 within its cycle, ``start`` and ``path`` from 0. The
+product's other tables (``jik atlas``'s CSV, the dashboard's export) take these names from here
+(:func:`coordinate_names`, the results' ``columns()``) and write them with :func:`csv_rows`.
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -89,10 +93,33 @@ def dataframe(columns: dict[str, Any]):
     return pd.DataFrame(columns)
 
 
+def coordinate_names(name: str, n: int) -> list[str]:
+    """``[name_1, ..., name_n]``: the columns of a vector's n coordinates, numbered from 1."""
+    return [f"{name}_{k + 1}" for k in range(n)]
+
+
 def coordinate_columns(name: str, values: FloatArray) -> dict[str, FloatArray]:
     """``{name_1: values[:, 0], name_2: ...}``: one column per coordinate, numbered from 1."""
     values = np.asarray(values, dtype=float)
-    return {f"{name}_{k + 1}": values[:, k] for k in range(values.shape[1])}
+    names = coordinate_names(name, values.shape[1])
+    return {n: values[:, k] for k, n in enumerate(names)}
+
+
+def csv_rows(columns: dict[str, Any], block: int = 1024) -> Iterator[tuple[str, ...]]:
+    """The rows of a table's :meth:`Columns.columns` as text cells for :func:`csv.writer`
+    (the header is ``list(columns)``): a number as Python prints it (``repr``, which reads back
+    exactly), NaN as an empty cell, a boolean as ``True``/``False`` (as pandas writes them).
+    Cells are made ``block`` rows at a time, so a large table's text is never held whole."""
+
+    def cells(column) -> list[str]:
+        if column.dtype.kind == "f":
+            return ["" if v != v else repr(v) for v in column.tolist()]  # (v != v: NaN)
+        return [str(v) for v in column.tolist()]
+
+    arrays = [np.asarray(c) for c in columns.values()]
+    rows = len(arrays[0]) if arrays else 0
+    for lo in range(0, rows, block):
+        yield from zip(*(cells(a[lo : lo + block]) for a in arrays), strict=True)
 
 
 class Columns:

@@ -73,7 +73,7 @@ class SynthesisResult(Columns):
         ``{name_1: [...], name_2: [...], "h": [[...]]}``, h on a uniform grid of the first two
         region variables (``h[i][j]`` at ``name_1[i]``, ``name_2[j]``; others at the box centre).
     convergence : list of dict
-        ``{"degree", "n_unknowns", "e2"}`` for the resolutions computed, the last the result.
+        ``{"degree", "unknowns", "e2"}`` for the resolutions computed, the last the result.
     region, fixed : dict
         The box and the values of the variables not integrated over.
     degree : int
@@ -96,10 +96,10 @@ class SynthesisResult(Columns):
 
     def columns(self) -> dict[str, FloatArray]:
         """A row per resolution computed (:attr:`convergence`), the last the result:
-        ``degree``, ``n_unknowns``, ``e2``."""
+        ``degree``, ``unknowns``, ``e2``."""
         return {
             key: np.array([row[key] for row in self.convergence])
-            for key in ("degree", "n_unknowns", "e2")
+            for key in ("degree", "unknowns", "e2")
         }
 
     def as_dict(self) -> dict:
@@ -329,7 +329,7 @@ def synthesize_e2(
     for q, c in zip(plan, cost, strict=True):
         check_cancelled(progress, f"E2 synthesis cancelled before degree {max(q)}")
         coef, e2 = _solve(problem, system, q, dirichlet, kinematics)
-        convergence.append({"degree": max(q), "n_unknowns": int(np.prod(np.add(q, 1))), "e2": e2})
+        convergence.append({"degree": max(q), "unknowns": int(np.prod(np.add(q, 1))), "e2": e2})
         done += c
         if progress is not None:
             progress.advance(0.05 + 0.85 * done / cost.sum(), 1.0)

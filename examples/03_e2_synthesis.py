@@ -24,7 +24,7 @@ low = sorted({2, 4, max(2, args.degree // 2)} - {args.degree})
 result = jik.synthesize_e2(arm, region, degree=args.degree, convergence_degrees=low)
 print(result)
 for step in result.convergence:
-    print(f"  degree {step['degree']:2d}: {step['n_unknowns']:4d} unknowns, E2 = {step['e2']:.6f}")
+    print(f"  degree {step['degree']:2d}: {step['unknowns']:4d} unknowns, E2 = {step['e2']:.6f}")
 
 cubic = jik.error_functional_e2(arm, jik.PaperCubic(), region)
 print(f"The paper's cubic (38) on the same box: E2 = {cubic.value:.6f}")

@@ -63,11 +63,18 @@ def test_json_holds_inputs_starts_drift_and_leg_ends(tmp_path):
                 np.testing.assert_allclose(res["drift"][i], one.drift, rtol=0, atol=1e-10)
                 np.testing.assert_allclose(res["leg_ends"][i], one.legs, rtol=0, atol=1e-10)
     rows = list(csv.DictReader((tmp_path / doc["csv"]).open()))
-    assert len(rows) == 12
-    assert float(rows[7]["pseudoinverse_drift_2"]) == pytest.approx(
-        doc["results"]["pseudoinverse"]["drift"][7][1], abs=1e-15
+    assert len(rows) == 12 * 2 * 2 * 4  # (starts, algorithms, cycles, legs)
+    row = rows[7 * 16 + 7]  # (start 7, pseudoinverse, cycle 2, leg 4)
+    assert (row["start"], row["algorithm"], row["cycle"], row["leg"]) == (
+        "7",
+        "pseudoinverse",
+        "2",
+        "4",
     )
-    assert float(rows[7]["x3"]) == pytest.approx(starts[7, 2], abs=1e-15)
+    assert float(row["drift"]) == doc["results"]["pseudoinverse"]["drift"][7][1]
+    assert float(row["x0_3"]) == starts[7, 2]
+    assert float(row["x_1"]) == doc["results"]["pseudoinverse"]["leg_ends"][7][7][0]
+    assert doc["variable_names"] == ["x1", "x2", "x3"]  # (x0_k and x_k: the variable k)
     assert (tmp_path / doc["figure"]).read_text().count("Repeatability atlas") >= 1
 
 
@@ -89,12 +96,52 @@ def test_a_large_atlas_streams_to_csv_and_the_json_keeps_a_summary(tmp_path, mon
     assert doc["summary"]["pseudoinverse"]["converged_runs"] == 24
     assert len(doc["paths"]) == 2
     rows = list(csv.DictReader((tmp_path / doc["csv"]).open()))
-    assert not any("leg" in name for name in rows[0])
-    assert [(int(r["path"]), int(r["start"])) for r in rows] == [
+    assert "leg" not in rows[0] and "x_1" not in rows[0]
+    assert [(int(r["path"]), int(r["start"])) for r in rows[::2]] == [
         (j, i) for j in range(2) for i in range(12)
-    ]
-    drift = np.array([[float(r[f"pseudoinverse_drift_{c}"]) for c in (1, 2)] for r in rows])
+    ]  # (run order; a run's rows: its 2 cycles)
+    drift = [float(r["drift"] or "nan") for r in rows if r["algorithm"] == "pseudoinverse"]
     assert np.nanmax(drift) == pytest.approx(max(doc["summary"]["pseudoinverse"]["max_drift"]))
+
+
+@pytest.mark.parametrize("extra", [(), ("--no-leg-ends", "--chunk", "5")])
+def test_the_csv_is_the_engine_atlas_table(tmp_path, monkeypatch, extra):
+    """The CSV named its columns by joint names and ``{alg}_leg{k}_{v}``, a row per run; it is
+    now the engine's table of the same atlas, ``AtlasResult.columns()`` (a row per leg with the
+    leg ends, per cycle without), written chunk by chunk."""
+    from jik.engine import atlas_run
+
+    plans = []
+
+    def recorded(plan, *args, **kwargs):
+        plans.append(plan)
+        return iter_atlas(plan, *args, **kwargs)
+
+    iter_atlas = atlas_run.iter_atlas
+    monkeypatch.setattr(atlas_run, "iter_atlas", recorded)
+    doc = run(
+        tmp_path,
+        "--algorithm",
+        "pseudoinverse",
+        "--algorithm",
+        "extended",
+        "--csv",
+        "--no-figure",
+        *extra,
+    )
+    legs = "--no-leg-ends" not in extra
+    table = atlas_run.run_atlas(plans[0], keep_leg_ends=legs).columns(every_leg=legs)
+    with (tmp_path / doc["csv"]).open() as f:
+        header, *rows = list(csv.reader(f))
+    assert header == list(table)
+    assert len(rows) == len(table["drift"])
+    for k, name in enumerate(header):
+        column = table[name]
+        if column.dtype.kind == "f":
+            cells = np.array([float(r[k] or "nan") for r in rows])
+            np.testing.assert_array_equal(cells, column)
+        else:
+            assert [r[k] for r in rows] == [str(v) for v in column.tolist()]
 
 
 def test_processes_give_the_in_process_numbers(tmp_path):

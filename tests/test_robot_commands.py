@@ -51,6 +51,29 @@ def test_solve_a_planar_arm_from_a_json_file(capsys, arm_file):
     assert "planar chain, pseudoinverse: converged" in text and "k(x) = (1, 1.5)" in text
 
 
+def test_json_outputs_are_the_engine_results_dicts(capsys):
+    """``jik solve --json`` called the target ``target`` where the engine's results (and their
+    ``y_d_k`` columns) say ``y_d``: both commands now print the engine's ``as_dict()`` (with the
+    robot, and its notes and limits)."""
+    from jik.engine.inverses import Pseudoinverse
+    from jik.engine.kinematics import Manipulator2
+    from jik.engine.repeatability import repeatability
+    from jik.engine.solver import solve
+
+    x0, inverse = [0.0, 0.0, np.pi / 2], Pseudoinverse(Manipulator2())
+    out, _ = run(capsys, "solve", "--robot", "manipulator2", "--target", "1, 1", "--json")
+    engine = json.loads(json.dumps(solve(inverse, x0, [1, 1]).as_dict()))
+    printed = json.loads(out)
+    assert "target" not in printed and printed["robot"] == "Manipulator 2"
+    assert {k: printed[k] for k in engine} == pytest.approx(engine, abs=1e-12)
+    out, _ = run(capsys, "repeatability", "--robot", "manipulator2", "--cycles", "2", "--json")
+    path = [(1, 1), (1, 2), (0, 2), (0, 1)]
+    engine = json.loads(json.dumps(repeatability(inverse, x0, path, cycles=2).as_dict()))
+    printed = json.loads(out)
+    assert list(printed)[1 : len(engine) + 1] == list(engine)
+    np.testing.assert_allclose(printed["cycle_end"], engine["cycle_end"], rtol=0, atol=1e-12)
+
+
 def test_repeatability_of_the_synthesized_map_from_a_file(capsys, arm_file):
     path = "1,1.3; 1,1.7; 0.6,1.7"
     out, _ = run(
@@ -146,7 +169,7 @@ def test_urdf_robot_from_a_yaml_file(capsys, tmp_path):
     out, _ = run(capsys, "solve", "--robot", str(tmp_path / "arm.yaml"), "--json")
     res = json.loads(out)
     assert res["success"]
-    np.testing.assert_allclose(res["y"], res["target"], atol=1e-9)
+    np.testing.assert_allclose(res["y"], res["y_d"], atol=1e-9)
 
 
 @pytest.mark.parametrize(

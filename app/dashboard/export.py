@@ -6,6 +6,8 @@ the algorithms' settings (map h, mode), the generation and that time."""
 
 from __future__ import annotations
 
+import csv
+import io
 import json
 import re
 from datetime import UTC, datetime
@@ -14,7 +16,9 @@ import numpy as np
 
 from jik import __version__
 
+from ...engine.exports import coordinate_names, csv_rows
 from ...engine.planar_chain import PlanarChain
+from ...engine.results import Trajectory
 from ...engine.urdf import UrdfChain
 from .algorithms import posture_rest
 from .messages import h_change, to_json
@@ -28,10 +32,11 @@ LENGTH = "length unit of the definition"
 
 
 def export_units(result: DashboardResult) -> dict:
-    """The unit of every column: the joint variables x, the task coordinates y, theta, the task
-    error (a norm of y) and h. The catalogue's robots have theirs; a planar chain's revolute
-    joints are in rad and its lengths in the unit of its link lengths; a URDF arm is in SI
-    units (m, rad); a formula robot's are what its formulas mean."""
+    """The unit of every column, keyed by its name (:func:`run_columns`): theta, the joint
+    variables x_k, the task coordinates y_k, the task error (a norm of y) and h. The
+    catalogue's robots have theirs; a planar chain's revolute joints are in rad and its lengths
+    in the unit of its link lengths; a URDF arm is in SI units (m, rad); a formula robot's are
+    what its formulas mean."""
     joint, task = units(result)
     kin = state_kinematics(result.state)
     if isinstance(kin, PlanarChain):
@@ -42,17 +47,45 @@ def export_units(result: DashboardResult) -> dict:
         joint = tuple("m" if kinds[i] == "prismatic" else "rad" for i in range(kin.p))
         task = ("m",) * kin.r
 
-    def named(names, us) -> dict:
+    def named(name, us) -> dict:
         spelled = {"": "as the definition's formulas", "1": "dimensionless"}
-        return {n: spelled.get(u, u) for n, u in zip(names, us, strict=True)}
+        return dict(
+            zip(coordinate_names(name, len(us)), [spelled.get(u, u) for u in us], strict=True)
+        )
 
-    theta = "iterations" if result.state.mode == "discrete" else "dimensionless"
     return {
-        "x": named(result.variable_names, joint),
-        "y": named(result.task_names, task),
-        "theta": theta,
+        "theta": "iterations" if result.state.mode == "discrete" else "dimensionless",
+        **named("x", joint),
+        **named("y", task),
         "error": norm_unit(task).strip("[]") or "as y",
         "h": "the unit of the map's formula",
+    }
+
+
+def coordinates(result: DashboardResult) -> dict[str, str]:
+    """What each coordinate column is: ``{"x_1": <the first joint's name>, ..., "y_1": <the
+    first task coordinate's>, ...}``."""
+    x, y = result.variable_names, result.task_names
+    return {
+        **dict(zip(coordinate_names("x", len(x)), x, strict=True)),
+        **dict(zip(coordinate_names("y", len(y)), y, strict=True)),
+    }
+
+
+def run_columns(result: DashboardResult, algorithm: str) -> dict[str, np.ndarray]:
+    """A run's table, a row per point: ``algorithm``, ``cycle`` and ``leg`` (both from 1, the
+    leg within its cycle), then the engine's trajectory columns
+    (:meth:`jik.engine.results.Trajectory.columns`: ``theta``, ``x_k``, ``y_k``, ``error``, ``h``;
+    ``h`` NaN for an inverse without a map)."""
+    run = result.runs[algorithm]
+    m, legs = len(run.theta), max(1, len(result.targets))
+    h = run.h if run.h is not None else np.full(m, np.nan)
+    cycle, leg = np.divmod(np.asarray(run.leg, dtype=int), legs)
+    return {
+        "algorithm": np.full(m, algorithm),
+        "cycle": cycle + 1,
+        "leg": leg + 1,
+        **Trajectory(run.theta, run.x, run.y, run.error, h).columns(),
     }
 
 
@@ -80,10 +113,12 @@ def export_filename(result: DashboardResult, extension: str, when: datetime) -> 
 def export_json(
     result: DashboardResult, functionals: dict | None = None, when: datetime | None = None
 ) -> dict:
-    """The current result as plain JSON: the state, both runs point by point, the columns'
-    units, the jik version and the export's time."""
+    """The current result as plain JSON: the state, both runs point by point (``x``, ``y`` the
+    vectors whose coordinates the CSV's ``x_k``, ``y_k`` are; ``cycle``, ``leg`` from 1), the
+    columns' units and what each coordinate is, the jik version and the export's time."""
     runs = {}
     for a, run in result.runs.items():
+        table = run_columns(result, a)
         runs[a] = {
             "success": run.success,
             "message": run.message,
@@ -92,8 +127,9 @@ def export_json(
             "y": run.y,
             "error": run.error,
             "h": run.h,
-            "leg": run.leg,
-            "leg_end": run.leg_end,
+            "cycle": table["cycle"],
+            "leg": table["leg"],
+            "legs": run.leg_end,  # (x after each leg, as RepeatabilityResult.as_dict names it)
             "drift": run.drift,
             "h_change": h_change(run.h),
         }
@@ -110,6 +146,7 @@ def export_json(
                 "state": result.state.as_dict(),
                 "generation": result.generation,
                 "units": export_units(result),
+                "coordinates": coordinates(result),
                 "variable_names": result.variable_names,
                 "task_names": result.task_names,
                 "targets": result.targets,
@@ -124,16 +161,16 @@ def export_json(
 def csv_context(result: DashboardResult, when: datetime | None = None) -> list[str]:
     """The lines at the top of the CSV, each starting with '#' (``pandas.read_csv(...,
     comment="#")`` skips them): the jik version and the export's time, the generation and
-    state, the columns' units, the verdict, and per algorithm its message, drift after each
-    cycle, h's change and leg ends (the posture inverse's rest x_rest in force too)."""
+    state, the columns' units, what each coordinate column is (``x_1 x1``: a joint's name), the
+    verdict, and per algorithm its message, drift after each cycle, h's change and leg ends (the
+    posture inverse's rest x_rest in force too)."""
     made = provenance(when)
-    u = export_units(result)
-    columns = {**u["x"], **u["y"], "theta": u["theta"], "error": u["error"], "h": u["h"]}
     lines = [
         f"# jik export of generation {result.generation}: {result.title}",
         f"# jik {made['jik_version']}, exported {made['exported_at']}",
         f"# state: {to_json(result.state.as_dict())}",
-        "# units: " + "; ".join(f"{k} [{v}]" for k, v in columns.items()),
+        "# units: " + "; ".join(f"{k} [{v}]" for k, v in export_units(result).items()),
+        "# coordinates: " + "; ".join(f"{k} {v}" for k, v in coordinates(result).items()),
     ]
     lines += [f"# verdict: {v['text']}" for v in verdict(result)]
     kin = state_kinematics(result.state)
@@ -151,19 +188,18 @@ def csv_context(result: DashboardResult, when: datetime | None = None) -> list[s
 
 
 def export_csv(result: DashboardResult, when: datetime | None = None) -> str:
-    """The context (:func:`csv_context`, '#' lines), then one row per trajectory point:
-    algorithm, leg, theta, x..., y..., error, h."""
-    names, tasks = result.variable_names, result.task_names
-    header = ["algorithm", "leg", "theta", *names, *tasks, "error", "h"]
-    lines = [*csv_context(result, when), ",".join(header)]
-    for a, run in result.runs.items():
-        h = run.h if run.h is not None else np.full(len(run.theta), np.nan)
-        for k in range(len(run.theta)):
-            vals = [a, str(int(run.leg[k]) + 1), repr(float(run.theta[k]))]
-            vals += [repr(float(v)) for v in run.x[k]] + [repr(float(v)) for v in run.y[k]]
-            vals += [repr(float(run.error[k])), "" if np.isnan(h[k]) else repr(float(h[k]))]
-            lines.append(",".join(vals))
-    return "\n".join(lines) + "\n"
+    """The context (:func:`csv_context`, '#' lines), then one row per trajectory point of each
+    run: the columns of :func:`run_columns` (``algorithm, cycle, leg, theta, x_1.., y_1..,
+    error, h``)."""
+    out = io.StringIO()
+    out.write("\n".join(csv_context(result, when)) + "\n")
+    writer = csv.writer(out, lineterminator="\n")
+    for i, a in enumerate(result.runs):
+        table = run_columns(result, a)
+        if i == 0:
+            writer.writerow(list(table))
+        writer.writerows(csv_rows(table))
+    return out.getvalue()
 
 
 def export_file(

@@ -118,7 +118,7 @@ def format_text(result: dict) -> str:
     ref = result["reference"]["e2"]
     for c in result["convergence"]:
         gap = (c["e2"] - ref) / ref
-        out.append(f"{c['degree']:>6} {c['n_unknowns']:>9} {c['e2']:>18.12f} {gap:>13.2e}")
+        out.append(f"{c['degree']:>6} {c['unknowns']:>9} {c['e2']:>18.12f} {gap:>13.2e}")
     out += ["", "cubic fit (like (38)), h = sum c x2^i x3^j:"]
     out += [f"  {k:<12} {v:>+12.6f}" for k, v in result["polynomial"].items()]
     out += ["", "Table 1 path, configuration after each leg (|x - x_pinv| in brackets):"]

@@ -22,6 +22,7 @@ from jik.app.dashboard import (
 )
 from jik.app.dashboard.functionals import functionals_key, inert_variables
 from jik.app.dashboard.model import cache_key
+from jik.app.dashboard.robots import state_kinematics
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS, make_inverse, robot_spec
 from jik.engine.repeatability import repeatability
@@ -191,16 +192,47 @@ def test_export_has_every_point_of_both_runs():
     context = [r for r in lines if r.startswith("#")]
     assert context[0].startswith("# jik export of generation 0") and '"task":"target"' in context[2]
     assert context[1].startswith("# jik ") and ", exported " in context[1]
-    assert context[3].startswith("# units: x1 [m]; x2 [m]; x3 [dimensionless]; y1 [m]; y2 [m]")
+    assert context[3].startswith(
+        "# units: theta [dimensionless]; x_1 [m]; x_2 [m]; x_3 [dimensionless]; y_1 [m]; y_2 [m]"
+    )
+    assert context[4] == "# coordinates: x_1 x1; x_2 x2; x_3 x3; y_1 y1; y_2 y2"
     assert any(r.startswith("# extended leg ends") for r in context)
     rows = lines[len(context) :]
-    assert rows[0] == "algorithm,leg,theta,x1,x2,x3,y1,y2,error,h"
+    assert rows[0] == "algorithm,cycle,leg,theta,x_1,x_2,x_3,y_1,y_2,error,h"
     n = sum(len(r.theta) for r in result.runs.values())
     assert len(rows) == 1 + n
     body = export_json(result)
     assert len(body["runs"]["extended"]["x"]) == len(result.runs["extended"].x)
     last = rows[-1].split(",")
-    assert last[0] == "extended" and float(last[8]) < 1e-9
+    assert last[0] == "extended" and float(last[9]) < 1e-9
+
+
+def test_an_export_names_its_columns_as_the_engine_does():
+    """The CSV named its columns by the robot's joint and task names (``x1``, ``panda_joint1``)
+    and numbered legs across cycles from 1 where the JSON counted from 0: its point columns are
+    now the engine's trajectory columns, its units keyed by them, cycle and leg from 1 in both,
+    and the JSON's leg ends are "legs" as in the engine's results."""
+    state = updated_state(default_state("manipulator2"), {"cycles": 2})
+    result = compute(state)
+    header, *rows = [r for r in export_csv(result).splitlines() if not r.startswith("#")]
+    inverse = make_inverse(state_kinematics(state), "extended", state.augmentation)
+    trajectory = solve(inverse, state.x0, result.targets[0], record=True).trajectory
+    engine = trajectory.columns()
+    assert header.split(",") == ["algorithm", "cycle", "leg", *engine]
+    body = export_json(result)
+    assert list(body["units"]) == list(engine)
+    assert body["coordinates"] == {
+        f"{v}_{k}": f"{v}{k}" for v, n in (("x", 3), ("y", 2)) for k in range(1, n + 1)
+    }
+    run, legs = body["runs"]["pseudoinverse"], len(result.targets)
+    assert sorted(set(run["cycle"])) == [1, 2]
+    assert sorted(set(run["leg"])) == list(range(1, legs + 1))
+    first = [r.split(",") for r in rows if r.startswith("pseudoinverse,")]
+    assert [int(r[1]) for r in first] == run["cycle"]
+    assert [int(r[2]) for r in first] == run["leg"]
+    rep = repeatability(inverse, state.x0, result.targets, cycles=1)
+    assert set(trajectory.as_dict()) <= set(run)  # (theta, x, y, error, h)
+    assert {"legs", "drift"} <= set(rep.as_dict()) & set(run) and "leg_end" not in run
 
 
 def test_a_gamma_change_redraws_only_the_panels_with_theta_on_an_axis():

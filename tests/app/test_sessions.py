@@ -120,7 +120,7 @@ def test_export_is_per_session(app, client):
     _computed(app, one["id"])
     csv = client.get(f"/api/sessions/{one['id']}/export.csv")
     assert csv.status_code == 200 and csv.text.startswith("# jik export of generation")
-    assert "\nalgorithm,leg,theta,x1" in csv.text
+    assert "\nalgorithm,cycle,leg,theta,x_1" in csv.text
     body = client.get(f"/api/sessions/{one['id']}/export.json").json()
     assert body["state"]["x0"] == [0.2, 0.1, 1.4]
     assert len(body["runs"]["pseudoinverse"]["x"][0]) == 3

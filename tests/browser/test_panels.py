@@ -54,12 +54,13 @@ def test_exports_download_the_sessions_data(tabs):
     assert re.fullmatch(r"# jik \S+, exported \d{4}-\d\d-\d\dT\d\d:\d\d:\d\d\+00:00", context[1])
     assert '"cycles":2' in context[2]  # (the state that produced it)
     assert context[3] == (
-        "# units: x1 [m]; x2 [m]; x3 [rad]; y1 [m]; y2 [m]; theta [dimensionless]; error [m]; "
-        "h [the unit of the map's formula]"
+        "# units: theta [dimensionless]; x_1 [m]; x_2 [m]; x_3 [rad]; y_1 [m]; y_2 [m]; "
+        "error [m]; h [the unit of the map's formula]"
     )
+    assert context[4] == "# coordinates: x_1 x1; x_2 x2; x_3 x3; y_1 y1; y_2 y2"
     assert any(r.startswith("# pseudoinverse drift after each cycle: ") for r in context)
     rows = lines[len(context) :]
-    assert rows[0].startswith("algorithm,leg,theta,x1")
+    assert rows[0].startswith("algorithm,cycle,leg,theta,x_1")
     assert len(rows) - 1 == sum(run["points"] for run in summary.values())
 
     with tab.page.expect_download() as saved:
@@ -67,7 +68,7 @@ def test_exports_download_the_sessions_data(tabs):
     assert re.fullmatch(NAMED.format("", generation, "json"), saved.value.suggested_filename)
     data = json.loads(Path(saved.value.path()).read_text())
     assert data["jik_version"] and data["exported_at"].endswith("+00:00")
-    assert data["units"]["x"] == {"x1": "m", "x2": "m", "x3": "rad"}
+    assert [data["units"][f"x_{k}"] for k in (1, 2, 3)] == ["m", "m", "rad"]
     assert data["state"] == snapshot["state"] and data["state"]["cycles"] == 2
     assert data["generation"] == snapshot["computed_generation"]
     for algorithm, run in summary.items():

@@ -206,6 +206,9 @@ def test_every_result_exports_a_table_with_one_meaning_per_column_name():
         ARM, {"x2": (0, 1), "x3": (1, 1.6)}, degree=4, convergence_degrees=(2,)
     )
     assert synthesis.columns()["degree"].tolist() == [2, 4]
+    # (the number of unknowns was n_unknowns here and unknowns in a total-degree synthesis)
+    assert list(synthesis.columns()) == ["degree", "unknowns", "e2"]
+    assert synthesis.columns()["unknowns"].tolist() == [9, 25]
     sd = json.loads(json.dumps(synthesis.as_dict()))
     assert sd["e2"] == synthesis.e2 and sd["degree"] == 4
     assert repr(synthesis.augmenting_map) == "SynthesizedMap(degree_x2=4, degree_x3=4)"
@@ -228,3 +231,41 @@ def test_help_on_progress_shows_its_methods_not_typing_internals():
     for method in ("leg(", "advance(", "cancelled(", "stop_at_error"):
         assert method in text
     assert "an atlas's runs" in jik.Progress.__doc__ and "total`` is 1.0" in jik.Progress.__doc__
+
+
+def test_an_atlas_table_runs_in_run_order_and_can_hold_every_leg():
+    """Rows were algorithm by algorithm, which a CSV streamed chunk by chunk cannot write; they
+    are run by run (then algorithm, cycle), and ``every_leg`` gives each leg's end its row."""
+    plan, atlas = _damped_atlas(0.01, 0.5)
+    A, _, N, C = atlas.drift.shape
+    L = plan.legs
+    cols = atlas.columns()
+    assert cols["start"].tolist() == [0, 0, 1, 1] and cols["algorithm"].tolist() == [
+        *atlas.algorithms,
+        *atlas.algorithms,
+    ]
+    np.testing.assert_array_equal(cols["drift"], atlas.drift[:, 0].T.ravel())
+    legs = atlas.columns(every_leg=True)
+    assert list(legs) == [
+        "algorithm",
+        "path",
+        "start",
+        "s",
+        "cycle",
+        "leg",
+        "drift",
+        "success",
+        "x0_1",
+        "x0_2",
+        "x0_3",
+        "x_1",
+        "x_2",
+        "x_3",
+    ]
+    assert len(legs["drift"]) == N * A * C * L and legs["leg"].tolist()[:L] == [1, 2, 3, 4]
+    np.testing.assert_array_equal(legs["x_2"][L : 2 * L], atlas.leg_ends[1, 0, 0, :, 1])
+    np.testing.assert_array_equal(legs["drift"][:L], [atlas.drift[0, 0, 0, 0]] * L)
+    drift_only = jik.run_atlas(plan, keep_leg_ends=False)
+    assert "x_1" not in drift_only.columns()
+    with pytest.raises(jik.InvalidInputError, match="a row per leg needs the leg ends"):
+        drift_only.columns(every_leg=True)

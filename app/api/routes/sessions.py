@@ -304,7 +304,7 @@ async def _finished(session: Session):
     responses={**_NO_EXPORT, **_NOT_FOUND},
 )
 async def export_result_json(session_id: str, store: Store) -> JSONResponse:
-    """The session's result, every trajectory point of both algorithms, as JSON."""
+    """The session's result as JSON: every point of each run; units keyed by column names."""
     dashboard = await _finished(store.get(session_id))
     body, name = export_file(dashboard.result, "json", dashboard.functionals)
     return JSONResponse(body, headers={"Content-Disposition": f'attachment; filename="{name}"'})
@@ -321,7 +321,8 @@ async def export_result_json(session_id: str, store: Store) -> JSONResponse:
     },
 )
 async def export_result_csv(session_id: str, store: Store):
-    """The session's result as CSV: one row per trajectory point and algorithm."""
+    """The session's result as CSV: '#' lines (units per column, the coordinates' names), then
+    a row per point of each run: algorithm, cycle, leg, theta, x_1.., y_1.., error, h."""
     dashboard = await _finished(store.get(session_id))
     body, name = export_file(dashboard.result, "csv")
     return PlainTextResponse(

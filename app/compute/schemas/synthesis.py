@@ -200,9 +200,9 @@ class SynthesizeResponse(BaseModel):
         description="E1 (13) and E2 (18) of the map on the box; null where undefined (see message)"
     )
     convergence: list[dict[str, float]] = Field(
-        description="'e2_variational': E2 against the Legendre degree; 'e2_total_degree': "
-        "{degree, nodes, unknowns, e2}, the Ritz value with the degree at all the nodes, then "
-        "with the nodes (leading 2^k of the rule) at the final degree"
+        description="'e2_variational': {degree, unknowns, e2}, E2 against the Legendre degree; "
+        "'e2_total_degree': {degree, nodes, unknowns, e2}, the Ritz value with the degree at all "
+        "the nodes, then with the nodes (leading 2^k of the rule) at the final degree"
     )
     singularities: MapSingularitiesInfo | None = Field(
         description="where h, or the extended Jacobian [J; dh] (10), is singular in the box "
