@@ -14,7 +14,7 @@ import numpy as np
 from ...engine.exceptions import JikError
 from .analysis import expensive_map, kinematics_and_map, vector_note
 from .arm_e2 import qmc_functionals, single_joint_sensitivity
-from .model import DashboardState, cache_key
+from .model import DashboardState, cache_key, robot_and_map
 from .robots import state_spec
 from .runs import Cancelled, DashboardResult
 
@@ -58,9 +58,7 @@ _inert_cache: dict[str, frozenset[int]] = {}
 def state_inert_variables(state: DashboardState) -> frozenset[int]:
     """:func:`inert_variables` of the state's kinematics and map over the robot's x_range
     (cached per robot, map and parameters)."""
-    d = state.as_dict()
-    keys = ("robot", "robot_parameters", "augmentation", "augmentation_parameters")
-    key = json.dumps({k: d[k] for k in keys}, sort_keys=True)
+    key = json.dumps(robot_and_map(state), sort_keys=True)
     if key not in _inert_cache:
         kin, amap = kinematics_and_map(state)
         box = state_spec(state).x_range or ((-1.0, 1.0),) * kin.p
@@ -82,18 +80,13 @@ def functionals_key(state: DashboardState) -> str:
     design = spec.functional_region
     if not design:
         return cache_key(state, "extended")
-    d = state.as_dict()
     inert = state_inert_variables(state)
     fixed = {
-        n: d["x0"][k]
+        n: state.x0[k]
         for k, n in enumerate(spec.variable_names)
         if n not in design and k not in inert
     }
-    return json.dumps(
-        {k: d[k] for k in ("robot", "robot_parameters", "augmentation", "augmentation_parameters")}
-        | {"fixed": fixed},
-        sort_keys=True,
-    )
+    return json.dumps(robot_and_map(state) | {"fixed": fixed}, sort_keys=True)
 
 
 #: E1 and E2 are taken by a tensor Gauss rule over at most this many region variables.

@@ -106,6 +106,22 @@ class DashboardState(BaseModel):
         return self.model_dump(mode="json")
 
 
+#: The fields of a state that say which robot and map it has (a user's robot by its definition).
+ROBOT_AND_MAP = (
+    "robot",
+    "robot_parameters",
+    "robot_definition",
+    "augmentation",
+    "augmentation_parameters",
+)
+
+
+def robot_and_map(state: DashboardState) -> dict:
+    """The state's :data:`ROBOT_AND_MAP` fields, as JSON data."""
+    d = state.as_dict()
+    return {k: d[k] for k in ROBOT_AND_MAP}
+
+
 def default_state(
     robot: str = DEFAULT_ROBOT, definition: Mapping[str, Any] | None = None
 ) -> DashboardState:

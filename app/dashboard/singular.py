@@ -11,7 +11,7 @@ import json
 from ...engine.exceptions import JikError
 from ...engine.map_singularities import MapSingularities, map_singularities
 from .analysis import expensive_map, kinematics_and_map
-from .model import DashboardState
+from .model import DashboardState, robot_and_map
 from .robots import state_spec
 
 
@@ -20,14 +20,7 @@ def singular_points(state: DashboardState) -> MapSingularities | None:
     when it has none, the map is expensive to evaluate (it solves a problem per point), the
     region's grid is too large (a 7-joint arm's) or h is regular there. Cached by what it
     depends on: the robot, its map and their parameters, and x0."""
-    key = (
-        state.robot,
-        json.dumps(state.robot_parameters, sort_keys=True),
-        json.dumps(state.robot_definition, sort_keys=True),
-        state.augmentation,
-        json.dumps(state.augmentation_parameters, sort_keys=True),
-        tuple(state.x0),
-    )
+    key = (json.dumps(robot_and_map(state), sort_keys=True), tuple(state.x0))
     if key not in _CACHE:
         if len(_CACHE) > 64:
             _CACHE.clear()
@@ -35,7 +28,7 @@ def singular_points(state: DashboardState) -> MapSingularities | None:
     return _CACHE[key]
 
 
-_CACHE: dict[tuple, MapSingularities | None] = {}
+_CACHE: dict[tuple[str, tuple[float, ...]], MapSingularities | None] = {}
 
 
 def _find(state: DashboardState) -> MapSingularities | None:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from jik.app.dashboard.functionals import functionals_key, state_inert_variables
 from jik.app.dashboard.model import DashboardState, default_state, updated_state, validate
 from jik.app.dashboard.patch import StatePatch, patch_of
 from jik.app.dashboard.results import compute
@@ -137,3 +138,26 @@ def test_an_overflow_at_the_start_is_called_an_overflow():
         compute(state)
     assert err.value.field == "x0"
     assert "the kinematics overflow at the start" in str(err.value)
+
+
+def _formula_robot(task: list[str]) -> DashboardState:
+    definition = {
+        "name": "formula",
+        "variables": ["x1", "x2", "x3"],
+        "task": task,
+        "augmentations": [{"name": "e2_synthesized", "region": {"x2": [0.4, 1], "x3": [0.4, 1]}}],
+    }
+    return updated_state(default_state(), {"robot": "formula", "robot_definition": definition})
+
+
+def test_two_robots_of_one_kind_and_map_do_not_share_e1_e2():
+    """Two formula robots with the same map and design region: J of the first ignores x1,
+    the second's depends on it. Their E1/E2 (cached by what they depend on, shared by every
+    session of the server) are not each other's: x1 is inert for the first only, held at x0's
+    value for the second."""
+    first = _formula_robot(["x2 + cos(x3)", "x1 + sin(x3)"])
+    second = _formula_robot(["x2 + x1*cos(x3)", "x1 + sin(x3)"])
+    assert state_inert_variables(first) == {0}
+    assert state_inert_variables(second) == frozenset()
+    assert functionals_key(first) != functionals_key(second)
+    assert '"fixed": {"x1": 0.5}' in functionals_key(second)
