@@ -70,6 +70,15 @@ class FunctionalValue:
     min_abs_dh_k: float = float("nan")
     divergent: bool = False
 
+    def __repr__(self) -> str:
+        box = ", ".join(f"{k} in [{lo:.4g}, {hi:.4g}]" for k, (lo, hi) in self.region.items())
+        held = ", ".join(f"{k}={v:.4g}" for k, v in self.fixed.items())
+        return (
+            f"FunctionalValue({self.value:.10g}{' (divergent)' if self.divergent else ''}, "
+            f"{box}{f', held {held}' if held else ''}, {self.n_points} points, "
+            f"{int(self.singular_points.shape[0])} singular)"
+        )
+
     def as_dict(self) -> dict:
         """JSON-friendly form."""
         return {

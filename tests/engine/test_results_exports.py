@@ -269,3 +269,14 @@ def test_an_atlas_table_runs_in_run_order_and_can_hold_every_leg():
     assert "x_1" not in drift_only.columns()
     with pytest.raises(jik.InvalidInputError, match="a row per leg needs the leg ends"):
         drift_only.columns(every_leg=True)
+
+
+def test_a_functional_value_prints_in_one_line():
+    """E1 (13) and E2 (18) of the cubic (38) on its region: the value, the box, what is held,
+    the points, and E1's divergence (docs/paper-errata.md), not the array of singular points."""
+    region = {"x2": (-1.0, 1.0), "x3": (0.0, 3.0)}
+    e2 = repr(jik.error_functional_e2(ARM, jik.PaperCubic(), region))
+    assert e2.startswith("FunctionalValue(") and "\n" not in e2 and len(e2) < 200, e2
+    assert "x2 in [-1, 1], x3 in [0, 3], held x1=0, 256 points, 0 singular" in e2
+    e1 = repr(jik.error_functional_e1(ARM, jik.PaperCubic(), region))
+    assert e1.startswith("FunctionalValue(inf (divergent), "), e1
