@@ -10,10 +10,13 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from . import practical_inverses as pinv
 from .exceptions import InvalidInputError
 from .inverses import ExtendedInverse, Inverse, Pseudoinverse
 from .kinematics import Kinematics
+from .limits import limited_box, robot_limits
 from .parameters import Parameter, check_params
 
 if TYPE_CHECKING:
@@ -108,16 +111,21 @@ ALGORITHMS: dict[str, AlgorithmSpec] = {
 
 
 def _robot_limits(kinematics: Kinematics, spec: RobotSpec | None, robot: str | None):
-    """The robot's joint limits; else the catalogue's box of configurations."""
+    """The weighted inverse's default limits, finite: the robot's configuration box (a URDF
+    arm's joint ranges, else the catalogue's ``x_range``) narrowed to its declared joint limits
+    (:func:`~jik.engine.limits.robot_limits`, a planar chain's or formula robot's ``limits``) by
+    :func:`~jik.engine.limits.limited_box`; limits finite on every side without a box."""
     from .registry import ROBOTS  # the robots' catalogue imports this module
 
-    limits = getattr(kinematics, "limits", None)
-    if limits is not None:
-        return limits
-    spec = spec or ROBOTS.get(robot or kinematics.name)
-    box = getattr(spec, "x_range", None)
-    if box:
-        return box
+    declared = robot_limits(kinematics)
+    box = getattr(kinematics, "limits", None)
+    if box is None:
+        spec = spec or ROBOTS.get(robot or kinematics.name)
+        box = getattr(spec, "x_range", None) or None
+    if box is not None:
+        return limited_box(box, declared)
+    if declared is not None and np.isfinite(declared).all():
+        return declared
     raise InvalidInputError(
         f"{kinematics.name} has no joint limits: give limits for the weighted inverse", "limits"
     )
@@ -164,8 +172,9 @@ def make_inverse(
     :mod:`jik.engine.robot_spec`), else in the spec of ``robot`` (default: the kinematics'
     name) in :data:`ROBOTS`. ``algorithm_parameters`` holds the algorithm's scalars
     (defaults from :data:`ALGORITHMS`) and vectors: ``limits`` of the weighted inverse (default:
-    the robot's joint limits, else its catalogue box ``x_range``) and ``rest`` of the posture
-    inverse (given: within the robot's joint limits if it has some,
+    the robot's configuration box, a URDF arm's joint ranges else its catalogue box
+    ``x_range``, narrowed to its declared joint limits, :func:`_robot_limits`) and ``rest`` of
+    the posture inverse (given: within the robot's joint limits if it has some,
     :func:`~jik.engine.practical_inverses.check_rest`; default :func:`default_rest`, the
     robot's home, else the run's start ``x0``, else its default start, not checked against
     the limits; in an atlas each run's own start, :mod:`jik.engine.posture_at_start`).
@@ -178,7 +187,7 @@ def make_inverse(
     given = dict(algorithm_parameters or {})
     vectors = {k: given.pop(k) for k in aspec_.vectors if given.get(k) is not None}
     given = {k: v for k, v in given.items() if k not in aspec_.vectors}
-    values = check_params(aspec_.parameters, given, f"algorithm {algorithm!r}")
+    values = check_params(aspec_.parameters, given, f"algorithm {algorithm!r}", aspec_.vectors)
     if algorithm == "pseudoinverse":
         return Pseudoinverse(kinematics)
     if algorithm == "damped":

@@ -24,6 +24,24 @@ def robot_limits(kinematics) -> FloatArray | None:
     return None if limits is None else np.asarray(limits, dtype=float)
 
 
+def limited_box(box, limits) -> FloatArray:
+    """A finite box (p, 2) of configurations within the robot's limits (p, 2), or the box itself
+    when ``limits`` is None: each finite limit replaces its side of the box, a side without one
+    (+-inf) keeps the box's; where the box lies wholly beyond a finite limit, the free side
+    keeps the box's width from that limit. The weighted inverse's default limits and the range
+    of the posture rest's sliders."""
+    box = np.asarray(box, dtype=float)
+    if limits is None:
+        return box.copy()
+    limits = np.asarray(limits, dtype=float)
+    free = ~np.isfinite(limits)
+    lo, hi = np.where(free, box, limits).T
+    empty, width = lo >= hi, box[:, 1] - box[:, 0]
+    lo = np.where(empty & free[:, 0], hi - width, lo)
+    hi = np.where(empty & free[:, 1], lo + width, hi)
+    return np.stack([lo, hi], axis=-1)
+
+
 def limit_names(kinematics) -> tuple[str, ...]:
     """Each variable's name for a report: ``x4 (panda_joint4)`` for a URDF arm."""
     joints = getattr(kinematics, "joint_names", None)

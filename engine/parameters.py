@@ -42,8 +42,16 @@ class Parameter:
         }
 
 
-def check_params(specs: tuple[Parameter, ...], values: Mapping[str, object], what: str) -> dict:
-    known = {p.name for p in specs}
+def check_params(
+    specs: tuple[Parameter, ...],
+    values: Mapping[str, object],
+    what: str,
+    vectors: tuple[str, ...] = (),
+) -> dict:
+    """Each parameter's value checked (its default where not given); an unknown name is
+    refused naming every known one, the scalars ``specs`` and the ``vectors`` (checked by
+    their owner)."""
+    known = {p.name for p in specs} | set(vectors)
     unknown = set(values) - known
     if unknown:
         raise InvalidInputError(

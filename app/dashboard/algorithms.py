@@ -28,7 +28,7 @@ import numpy as np
 
 from ...engine.algorithm_registry import default_rest
 from ...engine.exceptions import InvalidInputError
-from ...engine.limits import robot_limits
+from ...engine.limits import limited_box, robot_limits
 from ...engine.practical_inverses import check_rest
 from ...engine.registry import ALGORITHMS as REGISTRY
 from ...engine.validation import within
@@ -211,16 +211,9 @@ def rest_box(spec, kin) -> tuple[tuple[float, float], ...]:
     accepts: the robot's joint limits (:func:`~jik.engine.limits.robot_limits`), x0's slider
     range (:func:`configuration_box`) on a side without a limit (a continuous joint; the
     whole box for a robot without limits), or that range's width beyond a finite limit the box
-    lies on the other side of."""
-    box, limits = np.array(configuration_box(spec)), robot_limits(kin)
-    if limits is None:
-        return configuration_box(spec)
-    free = ~np.isfinite(limits)
-    lo, hi = np.where(free, box, limits).T
-    empty, width = lo >= hi, box[:, 1] - box[:, 0]
-    lo = np.where(empty & free[:, 0], hi - width, lo)
-    hi = np.where(empty & free[:, 1], lo + width, hi)
-    return tuple((float(a), float(b)) for a, b in zip(lo, hi, strict=True))
+    lies on the other side of (:func:`~jik.engine.limits.limited_box`)."""
+    box = limited_box(configuration_box(spec), robot_limits(kin))
+    return tuple((float(a), float(b)) for a, b in box)
 
 
 def checked_rest(value, spec, kin, x0) -> tuple[float, ...] | None:

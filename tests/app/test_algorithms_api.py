@@ -199,6 +199,36 @@ def test_a_rest_outside_the_joint_limits_is_refused_naming_its_coordinate(api, r
         api.delete(f"/atlas/{ok.json()['id']}")
 
 
+@pytest.mark.parametrize(
+    ("limits", "used"),
+    [
+        ([[0.2, 1], [0, 2], [0, 2]], [[0.2, 1], [0, 2], [0, 2]]),
+        (LIMITED["limits"], [[-1, 1], [-math.pi, 1.2], [-3, 3]]),
+    ],
+)
+def test_the_weighted_inverse_defaults_to_a_chain_s_own_limits(api, limits, used):
+    """A planar chain's ``limits`` are the weighted inverse's default (a side without a limit
+    takes the chain's box x_range, [-pi, pi]), which keeps the run within them."""
+    robot = {**LIMITED, "limits": limits}
+    body = {"robot": robot, "algorithm": "weighted", "x0": [0.3, 1, 1], "cycles": 2}
+    r = api.post("/repeatability", json=body | {"path": [[1, 1.3], [1, 1.7], [0.6, 1.7]]})
+    assert r.status_code == 200, r.text
+    np.testing.assert_allclose(r.json()["algorithm_parameters"]["limits"], used)
+    if limits[0][0] == 0.2:
+        assert r.json()["limits"] == {"within": True, "violation": None}
+
+
+@pytest.mark.parametrize(
+    ("algorithm", "params", "known"),
+    [("posture", {"damping": 0.1}, "['gain', 'rest']"), ("weighted", {"gain": 1}, "['limits']")],
+)
+def test_a_refused_parameter_names_every_parameter_the_algorithm_takes(
+    api, algorithm, params, known
+):
+    r = api.post("/solve", json=solve_body(algorithm=algorithm, algorithm_parameters=params))
+    assert messages(r)[0].endswith(f"known: {known}"), r.text
+
+
 def test_the_default_rest_at_a_start_outside_the_limits_runs(api):
     """No rest given: the default (the start, the chain has no home) is not refused when the
     start is outside the limits; the run reports leaving them at the start. The same numbers

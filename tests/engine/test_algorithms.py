@@ -370,3 +370,15 @@ def test_a_home_outside_the_limits_is_the_default_rest_but_not_a_given_one(panda
     with pytest.raises(InvalidInputError) as refused:
         robot.inverse("posture", algorithm_parameters={"rest": home})
     assert refused.value.field == "rest.3"
+
+
+def test_limited_box_narrows_a_box_to_the_limits_keeping_its_width_beyond_one():
+    """Finite limits replace their side of the box; a side without a limit keeps the box's, or,
+    where the box lies wholly beyond the other side's limit, the box's width from that limit."""
+    from jik.engine.limits import limited_box
+
+    box = [[-3.0, 3.0], [-3.0, 3.0], [5.0, 7.0], [-3.0, 3.0]]
+    limits = [[-1.0, 1.0], [-np.inf, 1.2], [-np.inf, 4.0], [-np.inf, np.inf]]
+    want = [[-1.0, 1.0], [-3.0, 1.2], [2.0, 4.0], [-3.0, 3.0]]
+    np.testing.assert_array_equal(limited_box(box, limits), want)
+    np.testing.assert_array_equal(limited_box(box, None), box)

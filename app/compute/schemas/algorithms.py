@@ -48,7 +48,8 @@ class AlgorithmParameters(_Parameters):  # type: ignore[misc, valid-type]
     limits: list[tuple[_Bound, _Bound]] | None = Field(
         None,
         description="weighted: joint limits [lo, hi] per joint, length p (default: the "
-        "robot's joint limits, else its configuration box x_range)",
+        "robot's joint limits, a side without one taking its configuration box x_range's; no "
+        "limits: the box x_range)",
     )
 
 
