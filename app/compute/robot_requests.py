@@ -49,7 +49,8 @@ def request_robot(
     """The robot of a request (catalogue robot, definition or catalogue arm) and the inverse of
     each of ``algorithms``: the extended inverse (11) of ``augmentation`` (a map model; None:
     the robot's default), the others with ``parameters`` (``algorithm_parameters``; posture's
-    rest defaults to the robot's home, else ``x0``), each with only its own if ``own``. The
+    rest defaults to the robot's home, else ``x0``), each with only its own if ``own`` (then a
+    parameter of none of them is refused, :func:`_belong`). The
     robot has its map if the extended inverse or ``with_map`` asks for one; a map given but
     not used is checked all the same (a catalogue map's parameters, a formula map's formulas),
     except a map to synthesize. Refusals are :class:`RequestError` naming the request's field."""
@@ -59,6 +60,8 @@ def request_robot(
         names = {p.name for p in spec.parameters} | set(spec.vectors)
         return {k: v for k, v in used(parameters).items() if not own or k in names}
 
+    if own:
+        _belong(used(parameters), algorithms)
     extended, aug_used = "extended" in algorithms, None
     if req_robot.name in S.USER_ROBOT_MODELS:
         # A formula map no chosen algorithm uses is built all the same, to be checked (its
@@ -89,6 +92,24 @@ def request_robot(
             raise RequestError(field_of(exc.field, str(exc)), str(exc)) from None
     built = spec, kin, tuple(out), robot_used, aug_used
     return RequestRobot(*built, lambda: build_augmentation(spec, kin, augmentation)[1:])
+
+
+def _belong(given: dict, algorithms: Sequence[str]) -> None:
+    """Each parameter given belongs to at least one of the chosen ``algorithms`` (a run of
+    several takes each its own, :func:`request_robot`'s ``own``), as a run of one refuses
+    another's; each then goes to its algorithms, which check its value."""
+    known = {
+        name
+        for a in algorithms
+        for name in (*(p.name for p in ALGORITHMS[a].parameters), *ALGORITHMS[a].vectors)
+    }
+    for name in given:
+        if name not in known:
+            raise RequestError(
+                f"algorithm_parameters.{name}",
+                f"unknown parameter {name!r} for the algorithms {list(algorithms)}; "
+                f"known: {sorted(known) or 'none'}",
+            )
 
 
 def build_robot(req_robot) -> tuple[RobotSpec, Any, S.RobotUsed]:

@@ -157,6 +157,29 @@ def test_bad_or_too_large_requests_are_422_naming_the_field(client, over, field,
     assert r.json()["detail"][0]["loc"][1] == field
 
 
+@pytest.mark.parametrize(
+    ("over", "loc", "text"),
+    [
+        ({"algorithms": ["weighted"], "algorithm_parameters": {"gain": 2}}, "gain", "unknown"),
+        (
+            {"algorithms": ["pseudoinverse"], "algorithm_parameters": {"rest": [0, 1, 0]}},
+            "rest",
+            "unknown parameter 'rest' for the algorithms ['pseudoinverse']; known: none",
+        ),
+        (
+            {"algorithms": ["damped", "posture"], "algorithm_parameters": {"rest": [0, 1]}},
+            "rest",
+            "rest must have shape",
+        ),
+    ],
+)
+def test_an_atlas_refuses_parameters_as_a_solve_does(client, over, loc, text):
+    """A parameter belongs to at least one chosen algorithm, whose check its value passes."""
+    r = client.post("/atlas", json=body(**over))
+    assert any(text in m for m in messages(r)), r.text
+    assert r.json()["detail"][0]["loc"][1:] == ["algorithm_parameters", loc]
+
+
 def test_unknown_job_is_404(client):
     assert client.get("/atlas/nope").status_code == 404
     assert client.delete("/atlas/nope").status_code == 404
