@@ -100,6 +100,22 @@ def test_synthesize_bad_input(api):
     assert msg({"robot": m2, "method": "magic"}).startswith("method: Input should be")
 
 
+def test_fixed_values_and_a_formula_robot_s_constants_are_coordinates_within_1000(api):
+    """A value the kinematics only overflow on is refused naming its field, as x0's is."""
+    body = {"robot": {"name": "manipulator1"}, "augmentation": {"name": "e2_optimal", "a": 1}}
+    body |= {"region": {"x2": [-1, 1], "x3": [-1, 1]}, "fixed": {"x1": 1e300}}
+    r = api.post("/synthesize", json=body)
+    assert r.status_code == 422, r.text
+    assert r.json()["detail"][0]["loc"][1:] == ["fixed", "x1"]
+    assert "less than or equal to 1000" in r.json()["detail"][0]["msg"]
+    formula = {"name": "formula", "variables": ["x1", "x2", "x3"], "parameters": {"l": 1e300}}
+    formula["task"] = ["x2 + l*cos(x3)", "x1 + l*sin(x3)"]
+    solve = {"robot": formula, "x0": [0.1, 0.2, 0.3], "target": [1.0, 1.0]}
+    r = api.post("/solve", json=solve)
+    assert r.status_code == 422, r.text
+    assert r.json()["detail"][0]["loc"][1:] == ["robot", "parameters", "l"]
+
+
 M1_REGION = {"x1": [0.0, 1.0], "x2": [0.0, 1.0], "x3": [0.5, 1.5]}
 
 

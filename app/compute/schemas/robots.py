@@ -120,7 +120,9 @@ MAX_URDF_CHARS = 100_000
 #: A variable's, a parameter's or a joint's name.
 Name = Annotated[str, Field(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,31}$")]
 FormulaText = Annotated[str, Field(min_length=1, max_length=MAX_FORMULA_CHARS)]
-Constants = Annotated[dict[Name, FiniteFloat], Field(max_length=32)]
+#: Named constants of a formula robot or map (lengths, offsets): numbers within +-1000, as
+#: coordinates are (beyond that the kinematics only overflow).
+Constants = Annotated[dict[Name, Coordinate], Field(max_length=32)]
 Title = Annotated[str, Field(min_length=1, max_length=100)]
 
 

@@ -11,7 +11,7 @@ from .fields import (
     INTEGRAL,
     MAX_DIMENSION,
     Bound,
-    FiniteFloat,
+    Coordinate,
     MaybeFloat,
 )
 from .robots import AnyAugmentation, AnyRobot, AugmentationUsed, RobotUsed
@@ -48,7 +48,7 @@ class SynthesizeRequest(BaseModel):
         "/robots) when it has that many, else each over a tenth of its x_range either side "
         "of the robot's default start",
     )
-    fixed: dict[str, FiniteFloat] | None = Field(
+    fixed: dict[str, Coordinate] | None = Field(
         None,
         max_length=MAX_DIMENSION,
         description="values of the variables not in the box (default: the default start)",
@@ -118,7 +118,7 @@ def _synthesis_fields(spec: RobotSpec, augmentation: Any) -> dict[str, Any]:
             ),
         ),
         "fixed": (
-            dict[variable, FiniteFloat] | None,
+            dict[variable, Coordinate] | None,
             Field(
                 None,
                 description="values of the variables not in the box (default: the default start)",
