@@ -50,8 +50,14 @@ EXTRA_NODES = 8
 #: Default region of Manipulator 2 (sec. 5.2).
 MANIPULATOR2_REGION: dict[str, tuple[float, float]] = {"x2": (-1.0, 1.0), "x3": (0.0, np.pi)}
 
-#: Default basis degree (per variable) of the Manipulator 2 synthesis.
-MANIPULATOR2_DEGREE = 16
+#: Default Legendre degree per variable of :func:`synthesize_e2`, by the region's number of
+#: variables: 16 over two (Manipulator 2's E2 4.9e-9 above its degree-40 minimum,
+#: docs/paper-errata.md), 10 over three (17^3 unknowns at 16 would take Ritz matrices of about
+#: 2 GB on (16 + 8)^3 quadrature points; 11^3 take 0.2 GB).
+DEFAULT_DEGREE = {2: 16, 3: 10}
+
+#: Basis degree (per variable) of the Manipulator 2 synthesis: the default over two variables.
+MANIPULATOR2_DEGREE = DEFAULT_DEGREE[2]
 
 
 @dataclass(frozen=True)
@@ -78,6 +84,14 @@ class SynthesisResult(Columns):
         The box and the values of the variables not integrated over.
     degree : int
         Basis degree per variable.
+    nodes : int
+        Gauss-Legendre nodes per variable of the rule E2 was minimised on, ``degree +``
+        :data:`EXTRA_NODES`: enough for the map's degree (n nodes integrate a polynomial of
+        degree 2 n - 1 exactly; dh P dh^T m, eq. (19), is of degree up to 2 ``degree`` per
+        variable in dh times the smooth m P), so E2 evaluated on it,
+        :func:`~jik.engine.functionals.error_functional_e2` with ``nodes``, is :attr:`e2` (to
+        rounding); 8 nodes, the REST API's default, leave Manipulator 2's degree-16 map's
+        E2 3e-5 off.
     """
 
     augmenting_map: SynthesizedMap
@@ -89,6 +103,10 @@ class SynthesisResult(Columns):
     region: dict[str, tuple[float, float]] = field(default_factory=dict)
     fixed: dict[str, float] = field(default_factory=dict)
     degree: int = 0
+
+    @property
+    def nodes(self) -> int:
+        return self.degree + EXTRA_NODES
 
     def __repr__(self) -> str:
         box = ", ".join(f"{k} in [{lo:.4g}, {hi:.4g}]" for k, (lo, hi) in self.region.items())
@@ -264,7 +282,7 @@ def synthesize_e2(
     kinematics: Kinematics,
     region: Region,
     *,
-    degree: int | Sequence[int] = 16,
+    degree: int | Sequence[int] | None = None,
     dirichlet: Callable[[FloatArray], FloatArray] | None = None,
     fixed: Mapping[str, float] | None = None,
     progress: Progress | None = None,
@@ -279,8 +297,9 @@ def synthesize_e2(
     region : mapping name -> (lo, hi)
         Two or three integrated joint variables (h depends on these only); the others are held
         at ``fixed`` (default 0), as in the paper's reduction h = h(x2, x3) for Manipulator 2.
-    degree : int or sequence of int
-        Legendre degree per variable (the error decays exponentially with it for smooth data).
+    degree : int or sequence of int, optional
+        Legendre degree per variable (the error decays exponentially with it for smooth data);
+        default :data:`DEFAULT_DEGREE` of the region's number of variables.
     dirichlet : callable, optional
         ``g(x) (n, p) -> (n,)``: boundary values of h. Default: natural boundary conditions
         n . (m P grad h - m K) = 0, with mean(h) = 0 over the box pinning the constant.
@@ -305,6 +324,7 @@ def synthesize_e2(
         raise InvalidInputError(
             f"the region must have two or three variables, got {list(box)}", "region"
         )
+    degree = DEFAULT_DEGREE[d] if degree is None else degree
     degs = [degree] * d if np.ndim(degree) == 0 else list(cast(Sequence[int], degree))
     if len(degs) != d:
         raise InvalidInputError(

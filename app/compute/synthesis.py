@@ -149,7 +149,7 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         if req.augmentation is not None:
             raise RequestError("augmentation", "'e2_variational' synthesizes h; give no map")
         try:
-            result = synthesize_e2(kin, region, degree=req.degree or 10, fixed=fixed)
+            result = synthesize_e2(kin, region, degree=req.degree, fixed=fixed)
         except JikError as exc:
             raise RequestError("region", str(exc)) from None
         amap = result.augmenting_map
@@ -166,10 +166,12 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
                 f"{result.polynomial_e2:.6g}"
             )
         region, fixed = dict(result.region) or region, dict(result.fixed) or fixed
+        nodes = max(req.nodes, result.nodes)  # (the rule it was minimised on, or a finer one)
     else:
         amap, aug_used = robot.augmenting_map()  # (the request's map, else the robot's default)
         coefficients = _coefficients(amap)
-    functionals, more = _functionals(kin, amap, region, fixed, req.nodes)
+        nodes = req.nodes
+    functionals, more = _functionals(kin, amap, region, fixed, nodes)
     all_fixed = {n: float(fixed.get(n, 0.0)) for n in names if n not in region}
     found, said = singularities(kin, amap, region, all_fixed, req.nodes)
     notes += more + said

@@ -80,6 +80,22 @@ def test_e2_variational_beats_the_printed_cubic(api):
     assert b["functionals"]["e2"]["value"] < cubic["functionals"]["e2"]["value"]
 
 
+def test_e2_variational_defaults_to_the_engine_s_degree_and_reports_its_own_e2(api):
+    """No degree: the engine's default over two variables (16), and the headline E2 is the
+    value minimised (the convergence's last), on the synthesis's own rule, not on the 8 nodes
+    that leave it 3e-5 off."""
+    from jik.engine.variational import MANIPULATOR2_REGION, synthesize_e2
+
+    body = {"robot": {"name": "manipulator2"}, "method": "e2_variational"}
+    r = api.post("/synthesize", json=body | {"region": REGION})
+    assert r.status_code == 200, r.text
+    b = r.json()
+    assert b["convergence"][-1]["degree"] == 16
+    e2 = synthesize_e2(Manipulator2(1.0), MANIPULATOR2_REGION).e2
+    assert b["convergence"][-1]["e2"] == pytest.approx(e2, abs=1e-12)
+    assert b["functionals"]["e2"]["value"] == pytest.approx(e2, abs=1e-12)
+
+
 def test_synthesize_bad_input(api):
     def msg(body):
         r = api.post("/synthesize", json=body)

@@ -7,6 +7,7 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from ....engine.registry import RobotSpec
+from ....engine.variational import DEFAULT_DEGREE
 from .fields import (
     INTEGRAL,
     MAX_DIMENSION,
@@ -55,12 +56,16 @@ class SynthesizeRequest(BaseModel):
     )
     nodes: Annotated[int, Field(strict=True, ge=2, le=24), INTEGRAL] = Field(
         8,
-        description="Gauss-Legendre nodes per variable for E1 and E2, and grid points per "
-        "variable of the search for h's singularities (singularities)",
+        description="Gauss-Legendre nodes per variable for E1 and E2 (of a map 'e2_variational' "
+        "synthesizes, at least its degree + 8: the rule it was synthesized on, on which its E2 "
+        "is the convergence's last), and grid points per variable of the search for h's "
+        "singularities (singularities)",
     )
     degree: Annotated[int, Field(strict=True, ge=1, le=24), INTEGRAL] | None = Field(
         None,
-        description="'e2_variational': Legendre degree per variable (default 10); "
+        description="'e2_variational': Legendre degree per variable (default: "
+        f"{DEFAULT_DEGREE[2]} over two variables, {DEFAULT_DEGREE[3]} over three, "
+        "engine.variational.DEFAULT_DEGREE); "
         "'e2_total_degree': total degree of the basis (default 4)",
     )
     qmc_nodes: Annotated[int, Field(strict=True, ge=MIN_QMC_NODES, le=MAX_QMC_NODES), INTEGRAL] = (
