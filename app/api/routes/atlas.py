@@ -7,6 +7,7 @@ cancelled by DELETE (204). The jobs live in the app's
 id is a random token: whoever has it reads the job, and no one else.
 """
 
+import re
 from typing import Annotated
 
 from fastapi import APIRouter, Depends, Query, Request, Response
@@ -87,7 +88,8 @@ def table_response(jobs: AtlasJobs, job: AtlasJob, every_leg: bool) -> Response:
     except InvalidInputError as exc:
         error = {"loc": ("query", "every_leg"), "msg": str(exc), "type": "value_error"}
         raise RequestValidationError([error]) from None
-    name = f"jik-atlas-{job.id}{'-legs' * every_leg}.csv"
+    robot = re.sub(r"[^A-Za-z0-9_.-]", "_", job.used[0].name) if job.used else "robot"
+    name = f"jik-{robot}-atlas-{job.id}{'-legs' * every_leg}.csv"
     return StreamingResponse(
         text,
         media_type="text/csv",
