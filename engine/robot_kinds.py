@@ -127,7 +127,12 @@ COMMON = (
     ),
     DefinitionField("title", "string", False, "a name to show"),
     DefinitionField(
-        "x_range", "points", False, "one [lo, hi] per variable (default: joint limits or [-pi, pi])"
+        "x_range",
+        "points",
+        False,
+        "one [lo, hi] per variable, the range of x0's sliders (default: a URDF's joint limits, "
+        "[-pi, pi] for a continuous or revolute joint, +-length for a prismatic one; a planar "
+        "chain's or formula robot's limits do not narrow it: a start outside them is reported)",
     ),
     DefinitionField("x0", "numbers", False, "start configuration (default 0.5 in each range)"),
     DefinitionField("target", "numbers", False, "default target of a solve"),

@@ -6,10 +6,11 @@ A state chooses one to five algorithms (``algorithms``, default the paper's two,
 and ``damping_threshold`` of damped least squares, ``gain`` of the posture inverse), with their
 ranges from the engine's :class:`~jik.engine.parameters.Parameter`, and the posture inverse's
 rest x_rest (``rest``, p numbers within the robot's joint limits, the engine's rule, and
-within its sliders' range, :func:`configuration_box`; without it, the engine's default,
+within its sliders' range, :func:`rest_box`; without it, the engine's default,
 :func:`~jik.engine.algorithm_registry.default_rest`: the robot's home, else the state's start
-x0). The weighted inverse takes the robot's joint limits (else its
-configuration box), and is refused naming ``algorithms`` for a robot with neither.
+x0, which a rest slider moved first brings into that range, :func:`editable_rest`). The
+weighted inverse takes the robot's joint limits (else its configuration box), and is refused
+naming ``algorithms`` for a robot with neither.
 :data:`STYLES` gives each algorithm one colour, line style, marker, label and 3D copy, used by
 the scene, every plot, the drift panel and the atlas. :func:`cache_key` says what one
 algorithm's run depends on (its own parameters included).
@@ -23,8 +24,11 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+import numpy as np
+
 from ...engine.algorithm_registry import default_rest
 from ...engine.exceptions import InvalidInputError
+from ...engine.limits import robot_limits
 from ...engine.practical_inverses import check_rest
 from ...engine.registry import ALGORITHMS as REGISTRY
 from ...engine.validation import within
@@ -192,19 +196,39 @@ def scalar(state: ChosenState, name: str) -> float:
 
 
 def configuration_box(spec) -> tuple[tuple[float, float], ...]:
-    """The range of each joint variable on the sliders of x0 and of the posture inverse's rest:
-    the robot's ``x_range`` (an arm's joint limits), else :data:`DEFAULT_BOX`."""
+    """The range of each joint variable on the sliders of x0: the robot's ``x_range`` (an arm's
+    joint limits), else :data:`DEFAULT_BOX`. It may be wider than the joint limits (a planar
+    chain or a formula robot given ``limits`` but no ``x_range``): a start outside the limits is
+    accepted and reported as leaving them at cycle 0 (:mod:`jik.engine.limits`), so x0's
+    sliders reach it; the rest's, which the limits bound, span :func:`rest_box`."""
     if spec.x_range:
         return tuple((float(lo), float(hi)) for lo, hi in spec.x_range)
     return (DEFAULT_BOX,) * len(spec.variable_names)
+
+
+def rest_box(spec, kin) -> tuple[tuple[float, float], ...]:
+    """The range of each slider of the posture inverse's rest, what :func:`checked_rest`
+    accepts: the robot's joint limits (:func:`~jik.engine.limits.robot_limits`), x0's slider
+    range (:func:`configuration_box`) on a side without a limit (a continuous joint; the
+    whole box for a robot without limits), or that range's width beyond a finite limit the box
+    lies on the other side of."""
+    box, limits = np.array(configuration_box(spec)), robot_limits(kin)
+    if limits is None:
+        return configuration_box(spec)
+    free = ~np.isfinite(limits)
+    lo, hi = np.where(free, box, limits).T
+    empty, width = lo >= hi, box[:, 1] - box[:, 0]
+    lo = np.where(empty & free[:, 0], hi - width, lo)
+    hi = np.where(empty & free[:, 1], lo + width, hi)
+    return tuple((float(a), float(b)) for a, b in zip(lo, hi, strict=True))
 
 
 def checked_rest(value, spec, kin, x0) -> tuple[float, ...] | None:
     """The posture inverse's rest x_rest as set (``algorithm_parameters.rest``), checked: p
     finite numbers, within the robot's joint limits if it has some (the engine's
     :func:`~jik.engine.practical_inverses.check_rest`, in its words) and within the range of
-    its sliders (:func:`configuration_box`; the only bound of a robot without limits, whose
-    REST API runs take any finite rest); None when it is the default in force
+    its sliders (:func:`rest_box`; the only bound of a robot without limits, whose REST API
+    runs take any finite rest); None when it is the default in force
     (:func:`~jik.engine.algorithm_registry.default_rest`: the robot's home, else the start
     ``x0``, taken as it is, like the engine's default), which the state then follows, as it
     does without a rest.
@@ -235,7 +259,7 @@ def checked_rest(value, spec, kin, x0) -> tuple[float, ...] | None:
         return None
     try:
         check_rest(kin, rest)
-        within(rest, configuration_box(spec), "rest", names, "the range of x0's sliders")
+        within(rest, rest_box(spec, kin), "rest", names, "the range of the rest's sliders")
     except InvalidInputError as exc:
         where = f"algorithm_parameters.{exc.field}"
         raise InvalidInputError(f"{where}: {exc}", where) from None
@@ -251,17 +275,40 @@ def posture_rest(state: ChosenState, kin) -> tuple[list[float], str]:
     return default_rest(kin, state.x0)
 
 
-def rest_words(state: ChosenState, kin) -> str:
-    """The rest in force in words, for the verdict and the exports: ``x_rest = the robot's
-    home (0, -0.785, ...)``, ``x_rest = x0 (...)`` (set so, or the default), or the numbers
-    set."""
+def editable_rest(state: ChosenState, spec, kin) -> list[float]:
+    """The rest that one rest slider moved changes: the state's, else the default in force
+    brought into the sliders' range (:func:`rest_box`), as the sliders show it. A default
+    outside the joint limits (a start outside them) is accepted as it is, but a rest set is
+    checked: the coordinates the user did not touch take the nearest value accepted."""
+    rest, source = posture_rest(state, kin)
+    if source == "set":
+        return rest
+    lo, hi = np.array(rest_box(spec, kin)).T
+    return [float(v) for v in np.clip(rest, lo, hi)]
+
+
+def rest_words(state: ChosenState, spec, kin) -> str:
+    """The rest in force in words, for the verdict: ``x_rest = the robot's home (0, -0.785,
+    ...)``, ``x_rest = x0 (...)`` (set so, or the default), or the numbers set; a default
+    outside the rest's sliders (:func:`rest_box`: the joint limits) says what moving one of
+    them makes of it (:func:`editable_rest`)."""
     rest, source = posture_rest(state, kin)
     shown = "(" + ", ".join(f"{v:.4g}" for v in rest) + ")"
-    if source == "home":
-        return f"x_rest = the robot's home {shown}"
-    if source == "x0" or rest == [float(v) for v in state.x0]:
-        return f"x_rest = x0 {shown}"
-    return f"x_rest = {shown} (set)"
+    if source == "set":
+        return f"x_rest = x0 {shown}" if rest == list(state.x0) else f"x_rest = {shown} (set)"
+    named = "the robot's home" if source == "home" else "x0"
+    words = f"x_rest = {named} {shown}"
+    near = editable_rest(state, spec, kin)
+    moved = [
+        f"{n} = {b:.4g}" for n, r, b in zip(spec.variable_names, rest, near, strict=True) if r != b
+    ]
+    if not moved:
+        return words
+    where = "the joint limits" if robot_limits(kin) is not None else "the rest's sliders"
+    return (
+        f"{words}, the default, outside {where}: moving a rest slider sets the rest with "
+        f"{', '.join(moved)}, the nearest values within them"
+    )
 
 
 def inverse_parameters(state: ChosenState, algorithm: str) -> dict[str, Any]:

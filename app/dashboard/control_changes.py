@@ -16,8 +16,8 @@ from collections.abc import Mapping
 from typing import Any
 
 from ...engine.exceptions import InvalidInputError
-from .algorithms import posture_rest
-from .robots import state_kinematics
+from .algorithms import editable_rest
+from .robots import state_kinematics, state_spec
 
 #: How a closed path is written in a text box: points separated by ';', coordinates by ','.
 PATH_FORMAT = "y1, y2; y1, y2; ..."
@@ -29,16 +29,18 @@ def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
     """A patch of control keys as a patch of the state's fields: ``{"x0.1": v}`` sets one
     coordinate of x0, ``{"robot_parameters.l": v}`` one parameter, ``{"path": "1, 1; 1, 2"}``
     the path from its text (:data:`PATH_FORMAT`), ``{"algorithm_parameters.rest.1": v}`` one
-    coordinate of the posture inverse's rest in force, ``{"algorithm_parameters.rest": "x0"}``
-    the rest at the start x0 (the patch's, else the state's). Switching to discrete mode
-    without a gamma takes gamma down to :data:`DISCRETE_GAMMA_ON_SWITCH` when it is above."""
+    coordinate of the posture inverse's rest in force (a default outside the joint limits
+    brought into them first, :func:`~jik.app.dashboard.algorithms.editable_rest`),
+    ``{"algorithm_parameters.rest": "x0"}`` the rest at the start x0 (the patch's, else the
+    state's). Switching to discrete mode without a gamma takes gamma down to
+    :data:`DISCRETE_GAMMA_ON_SWITCH` when it is above."""
     out: dict[str, Any] = {}
     for key, value in patch.items():
         head, _, rest = key.partition(".")
         if head == "algorithm_parameters" and rest.startswith("rest."):
             params = out.setdefault(head, {})
             if not isinstance(params.get("rest"), list | tuple):
-                params["rest"] = posture_rest(state, state_kinematics(state))[0]
+                params["rest"] = editable_rest(state, state_spec(state), state_kinematics(state))
             params["rest"] = list(params["rest"])
             index = rest.removeprefix("rest.")
             if not index.isdigit() or int(index) >= len(params["rest"]):

@@ -13,7 +13,7 @@ import numpy as np
 from ...engine.repeatability import REPEATABLE_DRIFT
 from .algorithms import rest_words, scalar
 from .joint_limits import state_limits
-from .robots import state_inverse, state_kinematics
+from .robots import state_inverse, state_kinematics, state_spec
 from .runs import AlgorithmRun, DashboardResult
 
 #: The algorithms' names in the verdict's sentences.
@@ -46,7 +46,7 @@ def _posture(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
     if state.task != "path" or not len(run.drift):
         return []
     n, d = len(run.drift), float(run.drift[-1])
-    rest = rest_words(state, state_kinematics(state))
+    rest = rest_words(state, state_spec(state), state_kinematics(state))
     head = f"{NAMES['posture']}, gain k = {g(gain)}, {rest}: after {n} cycle{'s' if n > 1 else ''}"
     if gain == 0:
         return [(f"{head} it is the pseudoinverse (k = 0), drift {g(d)} {unit}.", "why")]

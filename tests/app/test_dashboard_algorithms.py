@@ -283,8 +283,9 @@ def _posture(robot: str = "manipulator2", **patch):
 
 
 def test_the_rest_shows_only_with_the_posture_inverse_over_x0_s_ranges():
-    """One slider per joint variable, over the same range as x0's sliders, at the default in
-    force (x0 here: Manipulator 2 has no home), and a button 'rest = x0'; none without posture."""
+    """One slider per joint variable, over the same range as x0's sliders (Manipulator 2 has
+    no joint limits), at the default in force (x0 here: it has no home), and a button
+    'rest = x0'; none without posture."""
     assert not [c for c in controls(default_state()) if c.key.startswith(REST)]
     state = _posture()
     spec = controls(state)
@@ -349,7 +350,7 @@ def test_a_rest_equal_to_the_default_is_the_default():
         ({REST: [0.0, 0.0, float("nan")]}, f"{REST}.2", "Input should be a finite number"),
         ({f"{REST}.0": float("inf")}, f"{REST}.0", "Input should be a finite number"),
         ({f"{REST}.2": 7.0}, f"{REST}.2", "rest x3 must be in [-3.14159, 6.28319]"),
-        ({REST: [0.0, -3.5, 0.0]}, f"{REST}.1", "(the range of x0's sliders), got -3.5"),
+        ({REST: [0.0, -3.5, 0.0]}, f"{REST}.1", "(the range of the rest's sliders), got -3.5"),
         ({f"{REST}.3": 0.0}, f"{REST}.3", "rest has 3 coordinates"),
         ({"algorithm_parameters": {"rest": ["a"]}}, REST, "Input should be a valid number"),
     ],
@@ -372,7 +373,7 @@ def test_the_session_api_refuses_a_bad_rest_naming_it(client):
     bad = client.post(url, json={f"{REST}.2": 9.0})
     assert bad.status_code == 422
     assert [d["msg"] for d in bad.json()["detail"]] == [
-        f"{REST}.2: rest x3 must be in [-3.14159, 6.28319] (the range of x0's sliders), got 9"
+        f"{REST}.2: rest x3 must be in [-3.14159, 6.28319] (the range of the rest's sliders), got 9"
     ]
     junk = client.post(url, json={"algorithm_parameters": {"rest": {}}})  # (not a number list)
     assert [d["msg"] for d in junk.json()["detail"]] == [f"{REST}: Input should be a valid number"]
@@ -448,9 +449,9 @@ def test_an_arm_s_rest_is_within_its_joint_limits_and_defaults_to_its_home(panda
 
 
 def test_a_rest_outside_a_chain_s_joint_limits_is_refused_in_the_engine_s_words():
-    """A planar chain with limits (its sliders span (-pi, pi)): a rest outside the limits is
-    refused at its coordinate with the words the engine (and so the REST API) uses; the
-    default rest at a start outside the limits (the start) is not."""
+    """A planar chain with limits: a rest outside the limits is refused at its coordinate with
+    the words the engine (and so the REST API) uses; the default rest at a start outside the
+    limits (the start) is not."""
     from jik.engine.robot_spec import robot_from_dict
 
     chain = {**CHAIN, "limits": [[-1, 1], [None, 1.2], [-3, 3]]}

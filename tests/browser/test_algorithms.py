@@ -4,6 +4,8 @@ keys, its gain as a slider, and the verdict's sentence comparing it with the pap
 
 from __future__ import annotations
 
+import math
+
 import pytest
 
 from tests.browser.conftest import ALL_COLORS_RGB, TIMEOUT, Tab, probe
@@ -131,3 +133,38 @@ def test_a_rest_outside_the_box_is_refused_beside_its_slider(tabs):
         "algorithm_parameters.rest.2: rest x3 must be in [-3.14159, 6.28319]"
     )
     assert "rest" not in tab.snapshot()["state"]["algorithm_parameters"]
+
+
+def test_the_rest_sliders_of_a_chain_with_limits(tabs):
+    """A planar chain with joint limits, started outside them (a link): the rest's sliders span
+    the limits, x0's the robot's range (-pi, pi); the verdict says what a rest slider moved
+    makes of the default rest outside the limits, and moving one is accepted, the untouched
+    coordinates at their nearest limit in their boxes."""
+    import json
+    from urllib.parse import quote
+
+    chain = {
+        "name": "planar_chain",
+        "joints": "RRR",
+        "lengths": [1.0, 1.0, 1.0],
+        "limits": [[-1.0, 1.0], [None, 1.2], [-4.0, 4.0]],
+        "x0": [1.5, 0.3, 0.3],
+    }
+    state = {"robot": "planar_chain", "robot_definition": chain, "algorithms": THREE}
+    tab = tabs.open("/?state=" + quote(json.dumps(state)))
+    page = tab.page
+    rest = [page.locator(f"#ctl-alg-rest-{i}") for i in range(3)]
+    spans = [(r.get_attribute("min"), r.get_attribute("max")) for r in rest]
+    assert [(float(a), float(b)) for a, b in spans] == [(-1, 1), (-math.pi, 1.2), (-4, 4)]
+    x0 = page.locator("#ctl-x0-0")
+    assert (float(x0.get_attribute("min")), float(x0.get_attribute("max"))) == (-math.pi, math.pi)
+    expect(page.locator("#ctl-alg-rest-0-value")).to_have_value("1.500")  # (the default: x0)
+    said = page.locator('#verdict p[data-algorithm="posture"].why')
+    expect(said).to_contain_text(
+        "x_rest = x0 (1.5, 0.3, 0.3), the default, outside the joint limits: moving a rest "
+        "slider sets the rest with x1 = 1, the nearest values within them"
+    )
+    tab.set_slider("#ctl-alg-rest-2", 0.5)
+    assert tab.snapshot()["state"]["algorithm_parameters"]["rest"] == [1.0, 0.3, 0.5]
+    expect(page.locator("#ctl-alg-rest-0-value")).to_have_value("1.000")
+    expect(said).to_contain_text("x_rest = (1, 0.3, 0.5) (set)")
