@@ -18,6 +18,7 @@ from .inverses import ExtendedInverse, Inverse, Pseudoinverse
 from .kinematics import Kinematics
 from .limits import limited_box, robot_limits
 from .parameters import Parameter, check_params
+from .validation import as_vector
 
 if TYPE_CHECKING:
     from .registry import RobotSpec
@@ -152,7 +153,7 @@ def default_rest(
         x0 = getattr(spec, "default_x0", None) or None
     if x0 is None:
         raise InvalidInputError(f"{kinematics.name} has no home posture: give rest", "rest")
-    return [float(v) for v in x0], "x0"
+    return [float(v) for v in as_vector(x0, kinematics.p, "x0")], "x0"
 
 
 def make_inverse(

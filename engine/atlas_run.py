@@ -18,8 +18,8 @@ import numpy as np
 from .atlas import AtlasPlan
 from .atlas_backends import Backend, backend_for
 from .atlas_table import atlas_columns
-from .exceptions import SingularConfigurationError
-from .exports import Columns, dataframe
+from .exceptions import InvalidInputError, SingularConfigurationError
+from .exports import Columns, csv_text, dataframe
 from .inverses import Inverse
 from .limits import robot_limits, starts_outside
 from .posture_at_start import PostureAtStart
@@ -178,27 +178,52 @@ class AtlasResult(Columns):
             f"{drifts})"
         )
 
-    def columns(self, every_leg: bool = False) -> dict[str, FloatArray]:
+    def columns(self, every_leg: bool = False, runs: slice | None = None) -> dict[str, FloatArray]:
         """A row per path, start, algorithm and cycle (long format, run order:
         :func:`jik.engine.atlas_table.atlas_columns`, the table ``jik atlas`` streams to its
         CSV): ``algorithm`` (its label), ``path``, ``start`` (both from 0), ``s`` (arc length, NaN
         for given starts), ``cycle`` (from 1), ``drift``, ``success`` (the run's), the start
         ``x0_1``..``x0_p`` and, when the leg ends were kept, the configuration at the cycle's end
         ``x_1``..``x_p``. ``every_leg``: a row per leg instead, with ``leg`` (from 1 within its
-        cycle) and ``x_k`` the leg's end."""
+        cycle) and ``x_k`` the leg's end. ``runs``: the rows of those runs alone (run = path *
+        N + start), a block of the table."""
         A, P, N, C = self.drift.shape
-        path, start = np.divmod(np.arange(P * N), N)
+        runs = slice(None) if runs is None else runs
+        path, start = np.divmod(np.arange(P * N)[runs], N)
         legs = self.leg_ends
         return atlas_columns(
             self.algorithms,
             path,
             start,
             None if self.parameter is None else np.asarray(self.parameter)[start],
-            self.starts.reshape(P * N, -1),
-            self.drift.reshape(A, P * N, C),
-            self.success.reshape(A, P * N),
-            None if legs is None else legs.reshape(A, P * N, *legs.shape[3:]),
+            self.starts.reshape(P * N, -1)[runs],
+            self.drift.reshape(A, P * N, C)[:, runs],
+            self.success.reshape(A, P * N)[:, runs],
+            None if legs is None else legs.reshape(A, P * N, *legs.shape[3:])[:, runs],
             every_leg,
+        )
+
+    def csv_text(self, every_leg: bool = False, rows: int = 8192) -> Iterator[str]:
+        """:meth:`columns` as CSV text (:func:`jik.engine.exports.csv_text`: the header, then
+        the rows), made a block of about ``rows`` rows (whole runs) at a time: the memory a
+        download takes is a block's, never the whole table's text.
+
+        Raises
+        ------
+        InvalidInputError
+            At the call, with field ``every_leg``, when a row per leg is asked for and the leg
+            ends were not kept.
+        """
+        A, P, N, C = self.drift.shape
+        if every_leg and self.leg_ends is None:
+            raise InvalidInputError(
+                "a row per leg needs the leg ends, and this atlas did not keep them",
+                "every_leg",
+            )
+        legs = self.leg_ends.shape[3] // C if every_leg and self.leg_ends is not None else 1
+        block = max(1, rows // (A * C * legs))
+        return csv_text(
+            self.columns(every_leg, slice(lo, lo + block)) for lo in range(0, P * N, block)
         )
 
     def to_dataframe(self, every_leg: bool = False):

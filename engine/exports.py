@@ -15,7 +15,9 @@ product's other tables (``jik atlas``'s CSV, the dashboard's export) take these 
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+import csv
+import io
+from collections.abc import Iterable, Iterator
 from typing import Any
 
 import numpy as np
@@ -120,6 +122,22 @@ def csv_rows(columns: dict[str, Any], block: int = 1024) -> Iterator[tuple[str, 
     rows = len(arrays[0]) if arrays else 0
     for lo in range(0, rows, block):
         yield from zip(*(cells(a[lo : lo + block]) for a in arrays), strict=True)
+
+
+def csv_text(blocks: Iterable[dict[str, Any]]) -> Iterator[str]:
+    """The CSV text of a table given as blocks of its rows (each a :meth:`Columns.columns`
+    dict, all with the same columns): the header (the column names) and the first block's rows,
+    then each further block's rows, one block's text at a time (cells by :func:`csv_rows`,
+    lines ended by ``\\r\\n`` as :func:`csv.writer` ends them)."""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer)
+    for k, block in enumerate(blocks):
+        if k == 0:
+            writer.writerow(list(block))
+        writer.writerows(csv_rows(block))
+        yield buffer.getvalue()
+        buffer.seek(0)
+        buffer.truncate()
 
 
 class Columns:

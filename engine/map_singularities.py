@@ -33,7 +33,8 @@ class MapSingularities:
     where : dict name -> (lo, hi)
         Per region variable, the bounds of the singular grid points.
     fraction : float
-        The fraction of the grid's points that are singular.
+        The fraction of the grid's points that are singular (of the grid, not of the box:
+        :func:`map_singularities`' notes).
     reasons : tuple of str
         What is singular there, each once: "h or its gradient is not finite", "the gradient
         of h blows up", "the extended Jacobian (10) loses rank", "h jumps through infinity".
@@ -61,7 +62,7 @@ class MapSingularities:
 
     def __str__(self) -> str:
         """What and where, in words: ``the gradient of h blows up at x1 ∈ [0.458, 0.5], any
-        x2, any x3 (8% of the region's grid)``."""
+        x2, any x3 (1250 of the 25^3 grid points)``."""
         spans = []
         for name, (lo, hi) in self.where.items():
             r_lo, r_hi = self.region[name]
@@ -73,7 +74,8 @@ class MapSingularities:
                 spans.append(f"{name} ∈ [{lo:.3g}, {hi:.3g}]")
         return (
             f"{'; '.join(self.reasons)} at {', '.join(spans)} "
-            f"({100 * self.fraction:.2g}% of the region's grid)"
+            f"({round(self.fraction * self.nodes ** len(self.region))} of the "
+            f"{self.nodes}^{len(self.region)} grid points)"
         )
 
     def as_dict(self) -> dict:
@@ -95,18 +97,26 @@ def _neighbours(a: np.ndarray, axis: int) -> tuple[np.ndarray, np.ndarray]:
     return a[tuple(lo)], a[tuple(hi)]
 
 
-def _between(h: np.ndarray, det: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Grid points (h's shape) beside a step where h jumps through infinity (a change of sign
-    by more than JUMP times the median step along that axis), and beside a step where, without
-    such a jump, det [J; dh] changes sign (a rank loss between the two points)."""
+def _between(
+    h: np.ndarray, det: np.ndarray, slopes: list[np.ndarray]
+) -> tuple[np.ndarray, np.ndarray]:
+    """Grid points (h's shape) beside a step where h jumps through infinity, and beside a step
+    where, without such a jump, det [J; dh] changes sign (a rank loss between the two points).
+
+    h jumps through infinity between two neighbours where it changes sign against its slope:
+    the step h1 - h0 has the opposite sign of dh/dx along that axis at both ends (``slopes``,
+    one array per axis), as across a pole and never across a smooth zero; or, where the slopes
+    do not say so, by more than JUMP times the median step."""
     pole, flip = np.zeros(h.shape, dtype=bool), np.zeros(h.shape, dtype=bool)
     with np.errstate(all="ignore"):
         for axis in range(h.ndim):
             (h0, h1), (d0, d1) = _neighbours(h, axis), _neighbours(det, axis)
-            step = np.abs(h1 - h0)
-            steps = step[np.isfinite(step)]
+            g0, g1 = _neighbours(slopes[axis], axis)
+            step = h1 - h0
+            steps = np.abs(step[np.isfinite(step)])
             median = float(np.median(steps)) if steps.size else 0.0
-            jump = (h0 * h1 < 0) & (step > JUMP * max(median, 1e-12))
+            against = (step * g0 < 0) & (step * g1 < 0)
+            jump = (h0 * h1 < 0) & (against | (np.abs(step) > JUMP * max(median, 1e-12)))
             for mask, pair in ((pole, jump), (flip, (d0 * d1 < 0) & ~jump)):
                 for side in _neighbours(mask, axis):
                     side |= pair  # (views of mask: both ends of each step)
@@ -148,11 +158,12 @@ def map_singularities(
     (13) blows up and E2 (18) does not measure fit. A point counts where h or dh is not
     finite, where |dh| > BLOW_UP times its median, where [J; dh] is singular
     (:func:`~jik.engine.inverses.extended_determinant`, the test E1's quadrature uses), and
-    both neighbours of a grid step count where h changes sign by more than JUMP times its
-    median step (a pole, which a grid point rarely hits) or, elsewhere, where det [J; dh] =
-    +-(dh K) sqrt(det J J^T) changes sign: dh K = 0 between them, where E1 diverges (or dh K
-    passes through infinity: a pole of h whose jump is not JUMP times the median step, as on
-    a coarse grid, is reported there as a rank loss).
+    both neighbours of a grid step count where h changes sign against its slope (a pole,
+    which a grid point rarely hits: :func:`_between`) or, elsewhere, where det [J; dh] =
+    +-(dh K) sqrt(det J J^T) changes sign: dh K = 0 between them, where E1 diverges.
+    ``fraction`` is that of the grid's points, not of the box: a rank loss or a pole is a
+    set of lower dimension, found at the points beside it, whose share falls as the grid is
+    refined; ``where`` is what a finer grid keeps.
     """
     kinematics = require_kinematics(kinematics)
     augmenting_map = require_map(augmenting_map, kinematics)
@@ -186,7 +197,8 @@ def map_singularities(
     scale = np.median(g[~undefined]) if np.any(~undefined) else 0.0
     found["the gradient of h blows up"] = ~undefined & (g > BLOW_UP * scale) & (scale > 0)
     found["the extended Jacobian (10) loses rank"] = singular & ~undefined
-    pole, flip = _between(h.reshape(shape), det.reshape(shape))
+    slopes = [dh[:, k].reshape(shape) for k in axes]
+    pole, flip = _between(h.reshape(shape), det.reshape(shape), slopes)
     found["the extended Jacobian (10) loses rank"] |= flip.reshape(-1)
     found["h jumps through infinity"] = pole.reshape(-1)
     bad = np.logical_or.reduce(list(found.values()))

@@ -134,7 +134,9 @@ def solve_in_chunks(
     elif status == Status.SINGULAR:
         message = last.message  # (names the configuration, not the count)
     else:
-        message = stop_message(status, done, last.error, tol, "discrete", last.x, inverse, cap, y_d)
+        message = stop_message(
+            status, done, last.error, tol, "discrete", gamma, last.x, inverse, cap, y_d
+        )
     trajectory = _joined(pieces) if pieces else None
     return replace(last, message=message, nit=done, trajectory=trajectory, x0=start)
 

@@ -15,7 +15,7 @@ from .exceptions import InvalidInputError
 from .inverses import Inverse
 from .kinematics import Kinematics
 from .picard import DEGREE
-from .stall import stall_reason
+from .stall import reach_note, stall_reason
 from .validation import FloatArray, check_memory, count, positive
 
 #: The smallest task-error tolerance ``tol`` of a solve (double precision).
@@ -135,10 +135,14 @@ def counted(n: int, mode: str) -> str:
     return f"{n} {'step' if mode == 'continuous' else 'iteration'}{'' if n == 1 else 's'}"
 
 
-def stop_message(status, nit, err, tol, mode, x, inverse, max_iterations, target) -> str:
+def stop_message(status, nit, err, tol, mode, gamma, x, inverse, max_iterations, target) -> str:
     """What a member that stopped with ``status`` after ``nit`` steps at task error ``err``, at
-    ``x`` on its way to ``target``, says (a stall says why:
-    :func:`jik.engine.stall.stall_reason`)."""
+    ``x`` on its way to ``target``, says: a stall says why
+    (:func:`jik.engine.stall.stall_reason`); a run that diverged or ran out of steps says
+    whether the target is out of reach (:func:`jik.engine.stall.reach_note`), else what to
+    change: a discrete run that diverged a lower gamma (shorter steps), one out of iterations
+    gamma nearer 1 (near a solution the error shrinks by |1 - gamma| per iteration, eq. (5));
+    in continuous mode gamma only rescales theta, so more steps, not another gamma."""
     steps = counted(nit, mode)
     if status == Status.CONVERGED:
         if nit == 0:
@@ -146,15 +150,17 @@ def stop_message(status, nit, err, tol, mode, x, inverse, max_iterations, target
         return f"converged: task error {err:.3g} < {tol:g} after {steps}"
     if status == Status.SINGULAR:
         return str(inverse.singular_error(x)) + "; the run stopped there"
-    if status == Status.DIVERGED:
-        return f"diverged after {steps} (error {err:.3g}); " + (
-            "lower gamma" if mode == "discrete" else "the target may be unreachable"
-        )
     if status == Status.STALLED:
         return f"stalled after {steps} at error {err:.3g}: {stall_reason(inverse, target, x)}"
+    out, _ = reach_note(inverse.kinematics, target)
+    nearer = mode == "discrete" and gamma != 1.0
+    if status == Status.DIVERGED:
+        advice = out or ("lower gamma" if mode == "discrete" else "the target may be unreachable")
+        return f"diverged after {steps} (error {err:.3g}); {advice}"
+    advice = out or "raise max_iterations" + (", or take gamma nearer 1" if nearer else "")
     return (
         f"did not converge within {counted(max_iterations, mode)} (error {err:.3g} >= {tol:g}); "
-        "raise max_iterations or gamma"
+        + advice
     )
 
 

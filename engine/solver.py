@@ -315,7 +315,7 @@ def solve_batch(
     y = kin.forward_unchecked(x)
     err = np.linalg.norm(y - yb, axis=-1)
     messages = tuple(
-        stop_message(s, int(k), float(er), tol, mode, xi, inverse, cap, yi)
+        stop_message(s, int(k), float(er), tol, mode, gamma, xi, inverse, cap, yi)
         for s, k, er, xi, yi in zip(status, nit, err, x, yb, strict=True)
     )
     rec_m = rec_t = rec_x = None

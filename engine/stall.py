@@ -1,6 +1,7 @@
 """Why a continuous run of eq. (7) stalled: the target beyond the robot's reach, a kinematic
 singularity (J loses rank), an algorithmic one of the extended Jacobian (10) (J regular,
-[J; dh] singular), or a local minimum of the task error.
+[J; dh] singular), or a local minimum of the task error; and whether a target is out of reach,
+which a run that diverged or ran out of steps says too.
 
 The integrator only sees its step size collapse; the robot's workspace and the Jacobians where
 the run stopped tell which. A planar chain of revolute joints reaches the annulus between
@@ -25,8 +26,13 @@ ALGORITHMIC_RATIO = 1e2
 def reach(kinematics) -> tuple[float, float] | None:
     """(inner, outer) distances from the base that a planar chain of revolute joints reaches
     with its end point; None for other robots (prismatic joints, formulas, URDF arms, the
-    paper's)."""
-    if not isinstance(kinematics, PlanarChain) or not bool(np.all(kinematics.revolute)):
+    paper's) and for a chain whose task includes the end's orientation (r = 3: whether a
+    target is reached then depends on its angle too)."""
+    if (
+        not isinstance(kinematics, PlanarChain)
+        or not bool(np.all(kinematics.revolute))
+        or kinematics.r != 2
+    ):
         return None
     lengths = np.abs(kinematics.lengths)
     outer = float(lengths.sum())
@@ -37,8 +43,9 @@ def _g(v: float) -> str:
     return f"{v:.3g}"
 
 
-def _reach_note(kinematics, target) -> tuple[str | None, str]:
-    """(why the target is out of reach, or None; a clause saying it is within reach, or "")."""
+def reach_note(kinematics, target) -> tuple[str | None, str]:
+    """(why ``target`` is out of the robot's reach, or None; a clause saying it is within
+    reach, or "" when the reach is not known)."""
     bounds = reach(kinematics)
     if bounds is None:
         return None, ""
@@ -70,7 +77,7 @@ def stall_reason(inverse: Inverse, target, x) -> str:
     equality for the pseudoinverse (8)) or J^E# is undefined there; else a local minimum of
     the task error.
     """
-    out, within = _reach_note(inverse.kinematics, target)
+    out, within = reach_note(inverse.kinematics, target)
     if out is not None:
         return out
     x = np.asarray(x, dtype=float)

@@ -2,7 +2,9 @@
 // It is a job of the REST API's atlas jobs (their limits apply): started through the session
 // (POST /api/sessions/{id}/atlas), followed until done (GET .../atlas/{job}: progress, then the
 // heatmap), cancelled by DELETE /atlas/{job}. A cell of the heatmap is a start: a click sets the
-// session's x0 there (and the path's scale), so the main view recomputes from that start.
+// session's x0 there (and the path's scale), so the main view recomputes from that start. Its
+// CSV button downloads the table of the atlas shown (GET .../atlas/{job}/table.csv: the engine's
+// AtlasResult.columns(), a row per start, algorithm and cycle).
 import { api } from "./api.js";
 import { $, el, fmt } from "./dom.js";
 import { PLOT_CONFIG, panelHead } from "./panels.js";
@@ -108,11 +110,31 @@ async function draw(body) {
     }).observe(div);
   }
   showProgress(null);
+  $("#atlas-csv").disabled = false;
   // body.runs counts the starts (times the paths); every chosen algorithm runs each of them.
   const k = body.request.algorithms.length;
   const per = `${body.runs} start${body.runs === 1 ? "" : "s"} x ${k} algorithm${k === 1 ? "" : "s"}`;
   say(`Atlas done: ${body.runs * k} runs (${per}) of ${body.request.cycles} cycles in ${fmt(body.elapsed_s, 1)} s. Click a cell to move the main view to that start.`);
   div.dataset.runs = body.runs;
+}
+
+// The table of the atlas on screen, as the server writes it (its name from the server): asked
+// for first, so that a job the server no longer keeps is said in the panel, then saved by a link
+// (the browser streams it to disk).
+async function saveTable() {
+  if (!atlas.shown) return;
+  const url = api(`/atlas/${atlas.shown.id}/table.csv`);
+  const res = await fetch(url);
+  if (!res.ok) {
+    const body = await res.json().catch(() => ({}));
+    say(`The table of this atlas is gone: ${detail(body) || res.status}. Compute the atlas again.`, true);
+    return;
+  }
+  await res.body.cancel();
+  const link = el("a", { href: url, download: "" });
+  document.body.append(link);
+  link.click();
+  link.remove();
 }
 
 // A cell's start (and its path's scale) as the session's state.
@@ -164,6 +186,10 @@ export function atlasPanel(state, send) {
     el("span", { className: "key" }, "colour: log10 of the drift ‖x − x0‖ after each cycle (its scale on the right)"),
     el("span", { className: "key" }, "one heatmap per chosen algorithm, named above it in its colour"));
   panelHead(plot, "atlas", true, key);
+  plot.querySelector(".panel-tools").append(el("button", {
+    type: "button", className: "tool", id: "atlas-csv", disabled: true, onclick: saveTable,
+    title: "save the table of this atlas as CSV: a row per start, algorithm and cycle, with its drift",
+  }, "CSV"));
   $("#atlas").replaceChildren(
     el("h2", {}, "Repeatability atlas"),
     el("div", { className: "atlas-bar" },

@@ -12,7 +12,9 @@ job does not belong to a connection: it runs on when its client goes away, and i
 Limits: at most ``max_running`` atlases compute at once (the others wait, queued), at most
 ``max_jobs`` are kept in all and ``per_client`` queued or running for one client, and one job's
 work (legs: runs x cycles x legs x algorithms) is at most ``max_work``, ``max_leg_ends`` with the
-leg ends in the result.
+leg ends in the result. A done job keeps its result document and the engine's atlas it was made
+from (its table's source, :meth:`~jik.engine.atlas_run.AtlasResult.csv_text`): drift and success
+of at most ``max_work`` runs x cycles x algorithms, the starts, and the leg ends only when asked.
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 from ...engine.atlas import AtlasPlan
-from ...engine.atlas_run import run_atlas
+from ...engine.atlas_run import AtlasResult, run_atlas
 from ...engine.exceptions import RunCancelled
 from ...engine.progress import ProgressCallbacks
 from .atlas_plan import AtlasLimits, Used, planned, result_document
@@ -57,6 +59,11 @@ class AtlasJob:
     error: str | None = None
     result: dict[str, Any] | None = None
     cancel: threading.Event = field(default_factory=threading.Event)
+    #: The engine's atlas once done: its table (``GET /atlas/{id}/table.csv``) is made from it.
+    atlas: AtlasResult | None = None
+    #: The dashboard session that started it (None: a REST client): only that session's
+    #: routes give its table.
+    session: str | None = None
     #: The request it was started from (the dashboard draws the result with it).
     request: AtlasRequest | None = None
     #: The robot and the map the plan used (:func:`~jik.app.compute.atlas_plan.planned`).
@@ -124,11 +131,15 @@ class AtlasJobs:
             self._room(client)
 
     def start(
-        self, client: str, req: AtlasRequest, plan: tuple[AtlasPlan, Used] | None = None
+        self,
+        client: str,
+        req: AtlasRequest,
+        plan: tuple[AtlasPlan, Used] | None = None,
+        session: str | None = None,
     ) -> AtlasJob:
         """Start the request's atlas as a job, planned here unless ``plan`` (its plan and what
         it used, :func:`~jik.app.compute.atlas_plan.planned`) is given (raises before anything
-        is kept)."""
+        is kept); ``session``: the dashboard session that asks for it."""
         self.check_room(client)
         atlas, used = plan if plan is not None else planned(req, self.limits)
         job = AtlasJob(
@@ -136,6 +147,7 @@ class AtlasJobs:
             client,
             atlas,
             req.leg_ends,
+            session=session,
             request=req,
             used=used,
         )
@@ -257,7 +269,7 @@ class AtlasJobs:
             )
             curve = job.plan.manifolds[0] if job.plan.manifolds else None  # (explicit starts)
             arc, period = ((), None) if curve is None else (curve.arc, curve.period)
-            job.result = result_document(res, arc, job.leg_ends, period)
+            job.atlas, job.result = res, result_document(res, arc, job.leg_ends, period)
             self._end(job, "done")
         except RunCancelled:
             self._end(job, "cancelled")

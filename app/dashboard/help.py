@@ -57,7 +57,8 @@ ATLAS_HELP = (
     "heatmap per chosen algorithm, left to right (the extended Jacobian with the chosen "
     "augmenting map is repeatable: round-off, about −13). With path scales, one band of rows "
     "per scale of the path about k(x0). Click a cell to move the main view to that start "
-    "(and scale)."
+    "(and scale). CSV saves the atlas's table: a row per start, algorithm and cycle (its "
+    "columns: the engine's AtlasResult.columns())."
 )
 
 

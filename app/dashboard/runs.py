@@ -182,10 +182,15 @@ def _leg_message(res: SolveResult, cap: int) -> str:
     leg stopped by the cap (``cap``) naming the control that sets it."""
     if not res.success and "did not converge within" in res.message:
         what = "iterations" if res.mode == "discrete" else "integrator steps"
-        return (
-            f"did not converge within {cap} {what} (error {res.error:.3g}); raise "
-            f"“max {what} per leg” (a control above) or γ, or move the start"
-        )
+        if "out of reach" in res.message:  # (the engine's words: what to change is the target)
+            advice = res.message.split("; ", 1)[1]
+        else:
+            nearer = res.mode == "discrete" and res.gamma != 1.0
+            advice = f"raise “max {what} per leg” (a control above)" + (
+                ", take γ nearer 1" if nearer else ""
+            )
+            advice += " or move the start"
+        return f"did not converge within {cap} {what} (error {res.error:.3g}); {advice}"
     if res.mode == "continuous" or not res.success:
         return res.message
     return f"converged: task error {res.error:.3g} after {counted(res.nit, res.mode)}"

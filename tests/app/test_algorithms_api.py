@@ -255,3 +255,15 @@ def test_a_panda_rest_outside_its_limits_is_refused_by_solve(api):
         "algorithm_parameters.rest.3: rest x4 (panda_joint4) must be in [-3.0718, -0.0698] "
         "(the joint limits of the panda), got 0"
     ]
+
+
+@pytest.mark.parametrize("route", ["/solve", "/repeatability"])
+def test_a_wrong_start_for_posture_is_refused_at_x0(api, route):
+    """The posture inverse's default rest is the start: a start of the wrong length is the
+    start's fault (422 at x0, as for the pseudoinverse), not the rest's, which was not given."""
+    chain = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]}
+    body = {"robot": chain, "algorithm": "posture", "x0": [0.3, 0.2]}
+    body |= {"target": [1.2, 1.0]} if route == "/solve" else {"path": [[1.2, 1.0], [1.0, 1.2]]}
+    r = api.post(route, json=body)
+    assert r.status_code == 422, r.text
+    assert [e["loc"] for e in r.json()["detail"]] == [["body", "x0"]]

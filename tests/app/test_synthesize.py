@@ -158,7 +158,7 @@ def test_a_map_singular_in_its_box_says_where(api):
     assert "h jumps through infinity" in found["reasons"]
     assert (
         f"h is singular in the box: {'; '.join(found['reasons'])} at x1 ∈ [0.455, 0.545], any "
-        "x2, any x3 (17% of the region's grid)" in r.json()["message"]
+        "x2, any x3 (288 of the 12^3 grid points)" in r.json()["message"]
     )
     regular = api.post(
         "/synthesize", json={**body, "augmentation": {"name": "e2_optimal", "a": 0.5, "b": 1.0}}

@@ -159,7 +159,7 @@ def test_a_map_singular_in_its_design_region_is_said_where():
     assert _warnings(state) == [
         "Warning: the augmenting map e1_optimal (C1 = 1, C2 = -1) is singular in the design "
         "region x1 ∈ [0, 1], x2 ∈ [0, 1], x3 ∈ [0.5, 1.5]: the gradient of h blows up; h jumps "
-        "through infinity at x1 ∈ [0.458, 0.5], any x2, any x3 (8% of the region's grid). E1 "
+        "through infinity at x1 ∈ [0.458, 0.5], any x2, any x3 (1250 of the 25^3 grid points). E1 "
         "and E2 there are not a measure of fit, and the extended Jacobian is undefined where a "
         "run crosses it."
     ]
@@ -178,3 +178,28 @@ def test_the_paper_cubic_loses_rank_inside_its_design_region():
     assert (
         "the extended Jacobian (10) loses rank at x2 ∈ [-1, 0.25], x3 ∈ [0, 0.916]" in (warnings[0])
     )
+
+
+def test_a_leg_out_of_iterations_names_the_control_and_gamma_only_when_it_helps():
+    """Discrete mode at gamma 1.9 with few iterations per leg: the leg's message names the
+    control and says to take gamma nearer 1; a target out of reach says so instead."""
+    state = updated_state(default_state(), {"mode": "discrete", "gamma": 1.9, "max_iterations": 10})
+    message = summary(compute(state))["pseudoinverse"]["message"]
+    assert "did not converge within 10 iterations" in message
+    assert "raise “max iterations per leg” (a control above), take γ nearer 1" in message
+    far = updated_state(
+        default_state(),
+        {
+            "robot": "planar_chain",
+            "robot_definition": ARM,
+            "task": "target",
+            "target": [3.0, 1.0],
+            "mode": "discrete",
+            "gamma": 1.0,
+            "max_iterations": 10,
+        },
+    )
+    message = summary(compute(far))["pseudoinverse"]["message"]
+    assert "did not converge within 10 iterations" in message
+    assert "the target is out of reach: it is 3.16 from the base" in message
+    assert "γ" not in message

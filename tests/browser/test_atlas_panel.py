@@ -3,13 +3,19 @@ shown, can be cancelled, draws its heatmap, and a click on a cell moves the main
 
 from __future__ import annotations
 
+import csv
+import io
 import re
 import urllib.error
 import urllib.request
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+from jik.app.compute.atlas_plan import AtlasLimits, plan_request
+from jik.app.compute.atlas_schemas import AtlasRequest
+from jik.engine.atlas_run import run_atlas
 from tests.browser.conftest import ARTIFACTS, SCREEN_SIZES, get_json, poll
 
 expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
@@ -156,3 +162,28 @@ def test_an_atlas_after_a_cancel_starts_at_once(tabs):
     assert "waiting" not in (text.text_content() or "")
     page.click("#atlas-cancel")
     poll(lambda: gone(f"{tab.base}/atlas/{second}"), "the second job forgotten (404)")
+
+
+def test_the_atlas_panels_csv_downloads_the_table_of_the_atlas_shown(tabs):
+    """Its CSV button, off until an atlas is drawn, downloads that atlas's table: the header
+    the engine's AtlasResult.columns() of the same request, a row per start, algorithm and
+    cycle, the same file as the REST API's table of the job."""
+    tab = tabs.open()
+    page = tab.page
+    page.locator("#atlas").scroll_into_view_if_needed()
+    button = page.locator("#atlas-csv")
+    expect(button).to_be_disabled()
+    job = start_atlas(tab, 8, 1)
+    expect(page.locator("#atlas-status")).to_contain_text("Atlas done", timeout=120_000)
+    expect(button).to_be_enabled()
+    with page.expect_download() as saved:
+        button.click()
+    assert re.fullmatch(rf"jik-manipulator2-atlas-{job}\.csv", saved.value.suggested_filename)
+    text = Path(saved.value.path()).read_bytes().decode()
+    rows = list(csv.reader(io.StringIO(text)))
+    request = get_json(f"{tab.base}/api/sessions/{tab.session_id}/atlas/{job}")["request"]
+    plan = plan_request(AtlasRequest.model_validate(request), AtlasLimits())
+    assert rows[0] == list(run_atlas(plan, keep_leg_ends=request["leg_ends"]).columns())
+    assert len(rows) - 1 == 8 * len(request["algorithms"])
+    with urllib.request.urlopen(f"{tab.base}/atlas/{job}/table.csv", timeout=30) as rest:
+        assert rest.read().decode() == text

@@ -119,13 +119,15 @@ def test_result_prints_on_one_line_says_where_in_words_and_exports_json():
     assert text.startswith("MapSingularities(8.00% of a 25^3 grid, x1 in [0.4583, 0.5], x2 in [0")
     assert str(found) == (
         "the gradient of h blows up; h jumps through infinity at x1 ∈ [0.458, 0.5], any x2, "
-        "any x3 (8% of the region's grid)"
+        "any x3 (1250 of the 25^3 grid points)"
     )
     assert str(map_singularities(Manipulator1(), E1Optimal(1.0, 0.0), MANIPULATOR1_REGION)) == (
-        "h or its gradient is not finite at x1 ≈ 0, any x2, any x3 (4% of the region's grid)"
+        "h or its gradient is not finite at x1 ≈ 0, any x2, any x3 (625 of the 25^3 grid points)"
     )
     d = json.loads(json.dumps(found.as_dict()))
-    assert d["where"]["x1"] == pytest.approx([11 / 24, 0.5]) and d["fraction"] == 0.08
+    assert d["where"]["x1"] == pytest.approx([11 / 24, 0.5]) and d["fraction"] == pytest.approx(
+        0.08
+    )
     assert d["reasons"] == list(found.reasons) and d["nodes"] == 25
     assert d["region"]["x3"] == [0.5, 1.5] and d["fixed"] == {}
 
@@ -153,3 +155,21 @@ def test_bad_input_is_refused_naming_its_field(call, field, words):
     with pytest.raises(InvalidInputError) as err:
         call()
     assert err.value.field == field and words in str(err.value)
+
+
+@pytest.mark.parametrize("nodes", [8, 12, 24])
+def test_a_pole_between_grid_points_is_found_on_a_coarse_grid_too(nodes):
+    """h = 1 / (x2 - 0.5) never sits on a grid point here: between the two points beside
+    x2 = 0.5 it changes sign against its slope (dh/dx2 < 0 at both), which a smooth zero never
+    does; the step there is only about 14 times the median at 8 nodes."""
+    chain = jik.PlanarChain("RRR", [1.0, 0.8, 0.6])
+    found = map_singularities(
+        chain,
+        jik.FormulaMap("1/(x2 - 0.5)", ["x1", "x2", "x3"]),
+        {"x1": (0, 1), "x2": (0.2, 1)},
+        nodes=nodes,
+    )
+    assert found is not None and "h jumps through infinity" in found.reasons
+    lo, hi = found.where["x2"]
+    assert lo < 0.5 < hi and hi - lo <= 0.8 / (nodes - 1) + 1e-12
+    assert found.where["x1"] == (0.0, 1.0)

@@ -1,6 +1,8 @@
 """What the front door's objects say about themselves: a Resume refuses another run, atlas
 labels stay apart, reprs and exports name what was computed, and names mean one thing."""
 
+import csv
+import io
 import json
 import math
 import pydoc
@@ -9,6 +11,7 @@ import numpy as np
 import pytest
 
 import jik.engine as jik
+import jik.engine.exports as jik_exports
 from jik.engine.legendre_map import SynthesizedMap
 
 ARM = jik.Manipulator2()
@@ -269,6 +272,24 @@ def test_an_atlas_table_runs_in_run_order_and_can_hold_every_leg():
     assert "x_1" not in drift_only.columns()
     with pytest.raises(jik.InvalidInputError, match="a row per leg needs the leg ends"):
         drift_only.columns(every_leg=True)
+
+
+@pytest.mark.parametrize("every_leg", [False, True])
+def test_an_atlas_csv_made_in_blocks_is_its_whole_table(every_leg):
+    """The CSV text a download streams, made a few rows at a time (here a run per block), is
+    the header and the rows of the whole table by csv_rows; a row per leg without the leg
+    ends is refused at the call, naming every_leg."""
+    plan, atlas = _damped_atlas(0.01, 0.5)
+    table = atlas.columns(every_leg)
+    blocks = list(atlas.csv_text(every_leg, rows=1))
+    assert len(blocks) == atlas.starts.shape[1] > 1
+    rows = list(csv.reader(io.StringIO("".join(blocks))))
+    assert rows[0] == list(table)
+    assert rows[1:] == [list(r) for r in jik_exports.csv_rows(table)]
+    drift_only = jik.run_atlas(plan, keep_leg_ends=False)
+    with pytest.raises(jik.InvalidInputError, match="needs the leg ends") as refused:
+        drift_only.csv_text(every_leg=True)
+    assert refused.value.field == "every_leg"
 
 
 def test_a_functional_value_prints_in_one_line():

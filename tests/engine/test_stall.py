@@ -58,3 +58,35 @@ def test_other_robots_are_judged_by_their_jacobians_only():
     assert reach(e.Manipulator2()) is None
     message = stall_reason(e.Pseudoinverse(e.Manipulator2()), [1.0, 1.0], [0.1, 0.2, 0.3])
     assert "reach" not in message and "local minimum" in message
+
+
+def test_a_discrete_run_out_of_reach_says_so_not_raise_gamma():
+    """Discrete mode toward a target beyond the reach runs out of iterations: the message says
+    why (the target's distance and the reach), not "raise max_iterations or gamma"."""
+    result = e.solve(e.Pseudoinverse(ARM), X0, [3.0, 1.0], mode="discrete", max_iterations=50)
+    assert not result.success and "did not converge within 50 iterations" in result.message
+    assert "the target is out of reach: it is 3.16 from the base" in result.message
+    assert "gamma" not in result.message
+
+
+def test_out_of_iterations_advice_follows_the_mode_and_gamma():
+    """Discrete: near a solution the error shrinks by |1 - gamma| per iteration (eq. (5)), so
+    gamma nearer 1 helps and a larger gamma (refused at 2) does not; at gamma = 1 only more
+    iterations. Continuous: gamma only rescales theta, so it is never the advice."""
+    inverse = e.Pseudoinverse(e.Manipulator2())
+    x0, target = [0.0, 0.0, 1.5707963267948966], [1.0, 1.0]
+    slow = e.solve(inverse, x0, target, mode="discrete", gamma=1.99, max_iterations=5)
+    assert slow.message.endswith("; raise max_iterations, or take gamma nearer 1"), slow.message
+    plain = e.solve(inverse, x0, target, mode="discrete", gamma=1.0, max_iterations=1)
+    assert plain.message.endswith("; raise max_iterations"), plain.message
+    continuous = e.solve(inverse, x0, target, max_iterations=2)
+    assert continuous.message.endswith("; raise max_iterations"), continuous.message
+
+
+def test_a_chain_with_an_orientation_task_claims_no_reach():
+    """Links 1, 1, 1 with the end's angle as a task (r = 3): (2.9, 0) at angle pi puts the
+    wrist at (3.9, 0), beyond the first two links; the end point's annulus says nothing."""
+    chain = e.PlanarChain("RRR", [1.0, 1.0, 1.0], orientation=True)
+    assert reach(chain) is None
+    message = stall_reason(e.Pseudoinverse(chain), [2.9, 0.0, np.pi], [0.3, 0.2, 0.1])
+    assert "within reach" not in message and "out of reach" not in message

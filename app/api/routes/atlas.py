@@ -1,13 +1,18 @@
 """POST /atlas, GET /atlas/{id}, DELETE /atlas/{id}: repeatability atlases as background jobs.
 
 A job is planned and started by POST (202 with its id; 422 for bad input, 429 past the limits),
-read by GET (progress, then the result), and cancelled by DELETE (204). The jobs live in the
-app's :class:`jik.app.compute.atlas_jobs.AtlasJobs` and outlive the requests that made them.
+read by GET (progress, then the result; ``/table.csv``: the result as the engine's table), and
+cancelled by DELETE (204). The jobs live in the app's
+:class:`jik.app.compute.atlas_jobs.AtlasJobs` and outlive the requests that made them. A job's
+id is a random token: whoever has it reads the job, and no one else.
 """
 
+import re
 from typing import Annotated
 
-from fastapi import APIRouter, Depends, Request, Response
+from fastapi import APIRouter, Depends, Query, Request, Response
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import JSONResponse, StreamingResponse
 from starlette.concurrency import run_in_threadpool
 
 from ....engine.exceptions import InvalidInputError
@@ -29,16 +34,18 @@ def jobs_of(request: Request) -> AtlasJobs:
     return jobs
 
 
-async def start_job(jobs: AtlasJobs, pool: ComputePool, request: Request, req) -> AtlasJob:
+async def start_job(
+    jobs: AtlasJobs, pool: ComputePool, request: Request, req, session: str | None = None
+) -> AtlasJob:
     """Plan ``req`` in a compute worker (tracing the self-motion curves solves eq. (7): within
     the workers' time and memory limits, like any computation a request asks for), then start
-    it as a job of the client's."""
+    it as a job of the client's (``session``: of that dashboard session's)."""
     client = request.client.host if request.client else "unknown"
     jobs.check_room(client)  # (before the work)
     plan, refused = await pool.run(plan_task, req.model_dump_json(), jobs.limits)
     if refused is not None:
         raise InvalidInputError(*refused)
-    return await run_in_threadpool(jobs.start, client, req, plan)
+    return await run_in_threadpool(jobs.start, client, req, plan, session)
 
 
 Jobs = Annotated[AtlasJobs, Depends(jobs_of)]
@@ -49,6 +56,45 @@ ERRORS: dict[int | str, dict] = {
     },
     429: {"model": ErrorResponse, "description": "too many atlas jobs; retry later"},
 }
+EveryLeg = Annotated[
+    bool,
+    Query(
+        description="a row per leg's end instead of per cycle (needs a job with leg_ends); "
+        "422 when the job did not keep them"
+    ),
+]
+#: The table's answers: the CSV once the job is done, else the job's state.
+TABLE: dict[int | str, dict] = {
+    200: {
+        "description": "the atlas's table, a row per run, algorithm and cycle (or leg), "
+        "columns named as the engine's AtlasResult.columns() names them; while the job is not "
+        "done (queued, running, failed), its state as GET /atlas/{job_id} gives it, as JSON",
+        "content": {
+            "text/csv": {"schema": {"type": "string"}},
+            "application/json": {"schema": {"$ref": "#/components/schemas/AtlasJobResponse"}},
+        },
+    },
+}
+
+
+def table_response(jobs: AtlasJobs, job: AtlasJob, every_leg: bool) -> Response:
+    """The done job's table as CSV (:meth:`jik.engine.atlas_run.AtlasResult.csv_text`,
+    streamed a block of rows at a time from the atlas the job keeps); before that, the job's
+    state (JSON, as ``GET /atlas/{job_id}`` answers it)."""
+    if job.status != "done" or job.atlas is None:
+        return JSONResponse(jobs.response(job).model_dump(mode="json"))
+    try:
+        text = job.atlas.csv_text(every_leg)
+    except InvalidInputError as exc:
+        error = {"loc": ("query", "every_leg"), "msg": str(exc), "type": "value_error"}
+        raise RequestValidationError([error]) from None
+    robot = re.sub(r"[^A-Za-z0-9_.-]", "_", job.used[0].name) if job.used else "robot"
+    name = f"jik-{robot}-atlas-{job.id}{'-legs' * every_leg}.csv"
+    return StreamingResponse(
+        text,
+        media_type="text/csv",
+        headers={"Content-Disposition": f'attachment; filename="{name}"'},
+    )
 
 
 @router.post("/atlas", status_code=202, response_model=AtlasJobResponse, responses=ERRORS)
@@ -63,6 +109,17 @@ async def start_atlas(req: AtlasBody, request: Request, response: Response, jobs
 async def read_atlas(job_id: str, jobs: Jobs):
     """The job's status and progress; its result once done."""
     return jobs.response(jobs.get(job_id))
+
+
+@router.get(
+    "/atlas/{job_id}/table.csv",
+    response_class=StreamingResponse,
+    responses={**ERRORS, **TABLE},
+)
+async def read_atlas_table(job_id: str, jobs: Jobs, every_leg: EveryLeg = False) -> Response:
+    """The done job's atlas as one long table (CSV): the engine's ``AtlasResult.columns()``,
+    whose docstring names the columns, with cells as ``jik atlas --csv`` writes them."""
+    return table_response(jobs, jobs.get(job_id), every_leg)
 
 
 @router.delete("/atlas/{job_id}", status_code=204, responses=ERRORS)

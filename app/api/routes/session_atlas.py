@@ -1,6 +1,7 @@
 """A dashboard session's repeatability atlas: ``POST /api/sessions/{id}/atlas`` starts the atlas
 of the session's current state, ``GET /api/sessions/{id}/atlas/{job}`` follows it and, once
-done, gives its heatmap; ``DELETE /atlas/{job}`` cancels it.
+done, gives its heatmap, ``GET .../atlas/{job}/table.csv`` its table (of the session's own jobs
+alone: another tab's atlas is not there for it); ``DELETE /atlas/{job}`` cancels it.
 
 The atlas is a job of the REST API's :class:`jik.app.compute.atlas_jobs.AtlasJobs`, with its
 request model and limits (jobs per client, one computing at once): the session only says which
@@ -13,18 +14,19 @@ import json
 from typing import Annotated
 
 from fastapi import APIRouter, Request, Response
-from fastapi.responses import JSONResponse
+from fastapi.responses import JSONResponse, StreamingResponse
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from starlette.concurrency import run_in_threadpool
 
 from ....engine.exceptions import InvalidInputError
+from ...compute.atlas_jobs import AtlasJobNotFound
 from ...compute.atlas_schemas import MAX_CYCLES, MAX_FAMILY, AtlasJobResponse, Scale
 from ...compute.schemas import INTEGRAL
 from ...compute.user_robots import echo
 from ...dashboard.atlas import atlas_figure, atlas_request
 from ...dashboard.plotting import figure_json
 from ..dependencies import Pool, Store
-from .atlas import ERRORS, Jobs, start_job
+from .atlas import ERRORS, TABLE, EveryLeg, Jobs, start_job, table_response
 
 router = APIRouter(tags=["dashboard sessions"])
 #: Largest atlas the panel asks for (the API's own limits apply too).
@@ -69,7 +71,7 @@ async def start_session_atlas(
         error = exc.errors()[0]
         name = ".".join(str(p) for p in error["loc"]) or "state"
         raise InvalidInputError(f"{name}: {error['msg']}", name) from None
-    job = await start_job(jobs, pool, request, req)
+    job = await start_job(jobs, pool, request, req, session_id)
     response.headers["Location"] = f"/atlas/{job.id}"
     return jobs.response(job)
 
@@ -90,6 +92,23 @@ async def read_session_atlas(session_id: str, job_id: str, store: Store, jobs: J
             request=_echoed(job.request.model_dump(mode="json")),
         )
     return JSONResponse(body)
+
+
+@router.get(
+    "/api/sessions/{session_id}/atlas/{job_id}/table.csv",
+    response_class=StreamingResponse,
+    responses={**ERRORS, **_NOT_FOUND, **TABLE},
+)
+async def read_session_atlas_table(
+    session_id: str, job_id: str, store: Store, jobs: Jobs, every_leg: EveryLeg = False
+) -> Response:
+    """The table of an atlas this session started (the panel's CSV): the same CSV as
+    ``GET /atlas/{job_id}/table.csv``; 404 for a job of another session or of the REST API."""
+    store.get(session_id)
+    job = jobs.get(job_id)
+    if job.session != session_id:
+        raise AtlasJobNotFound(job_id, "this session did not start it")
+    return table_response(jobs, job, every_leg)
 
 
 def _echoed(request: dict) -> dict:

@@ -75,7 +75,10 @@ def parameters_of(inverse) -> dict[str, Any]:
 
 
 def field_of(exc_field: str | None, message: str) -> str:
-    """The request's field for an engine error about an algorithm's parameter."""
+    """The request's field for an engine error about an algorithm's parameter; the start
+    ``x0``, which the posture inverse's default rest is, keeps its own name."""
+    if exc_field is not None and exc_field.split(".")[0] == "x0":
+        return exc_field
     for name in (exc_field, *ALGORITHM_PARAMETER_NAMES):
         if name and (
             name == exc_field or message.startswith(f"{name} ") or f"['{name}']" in message
