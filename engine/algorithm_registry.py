@@ -39,6 +39,11 @@ class AlgorithmSpec:
     parameters: tuple[Parameter, ...] = ()
     vectors: tuple[str, ...] = ()
 
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Every parameter it takes: its scalars', then its vectors' names."""
+        return (*(p.name for p in self.parameters), *self.vectors)
+
     def as_dict(self) -> dict:
         return {
             "name": self.name,

@@ -56,8 +56,7 @@ def request_robot(
     except a map to synthesize. Refusals are :class:`RequestError` naming the request's field."""
 
     def given(algorithm: str) -> dict:
-        spec = ALGORITHMS[algorithm]
-        names = {p.name for p in spec.parameters} | set(spec.vectors)
+        names = ALGORITHMS[algorithm].names
         return {k: v for k, v in used(parameters).items() if not own or k in names}
 
     if own:
@@ -98,11 +97,7 @@ def _belong(given: dict, algorithms: Sequence[str]) -> None:
     """Each parameter given belongs to at least one of the chosen ``algorithms`` (a run of
     several takes each its own, :func:`request_robot`'s ``own``), as a run of one refuses
     another's; each then goes to its algorithms, which check its value."""
-    known = {
-        name
-        for a in algorithms
-        for name in (*(p.name for p in ALGORITHMS[a].parameters), *ALGORITHMS[a].vectors)
-    }
+    known = {name for a in algorithms for name in ALGORITHMS[a].names}
     for name in given:
         if name not in known:
             raise RequestError(
