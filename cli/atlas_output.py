@@ -87,6 +87,10 @@ class Gathered:
         }
 
 
+#: Rows of the CSV's table made at a time (the atlas result's csv_text makes its blocks alike).
+ROWS = 8192
+
+
 class CsvWriter:
     """The CSV: the atlas's long table (:func:`jik.engine.atlas_table.atlas_columns`, the
     columns of ``AtlasResult.columns(every_leg=legs)``, named there), a chunk's rows at a time in
@@ -116,26 +120,33 @@ class CsvWriter:
             self.next = chunk.hi
 
     def _write(self, task, chunk) -> None:
+        """The chunk's rows, a block of about ROWS rows (whole runs) at a time: a chunk's long
+        table is several times its arrays, and only a block of it is held."""
         import numpy as np
 
         from ..engine.atlas_table import atlas_columns
         from ..engine.exports import csv_rows
 
-        path, start = np.divmod(np.arange(chunk.lo, chunk.hi), self.plan.n_starts)
-        table = atlas_columns(
-            self.plan.algorithms,
-            path,
-            start,
-            self.plan.parameter(start),
-            task.starts,
-            chunk.drift,
-            chunk.success,
-            chunk.leg_ends if self.legs else None,
-            self.legs,
-        )
-        if chunk.lo == 0:  # (the first rows: the header, the table's column names)
-            self.writer.writerow(list(table))
-        self.writer.writerows(csv_rows(table))
+        A, n, C = np.shape(chunk.drift)
+        L = np.shape(chunk.leg_ends)[2] // C if self.legs else 1
+        block = max(1, ROWS // (A * C * L))
+        for lo in range(0, n, block):
+            runs = slice(lo, lo + block)
+            path, start = np.divmod(np.arange(chunk.lo, chunk.hi)[runs], self.plan.n_starts)
+            table = atlas_columns(
+                self.plan.algorithms,
+                path,
+                start,
+                self.plan.parameter(start),
+                task.starts[runs],
+                chunk.drift[:, runs],
+                chunk.success[:, runs],
+                chunk.leg_ends[:, runs] if self.legs else None,
+                self.legs,
+            )
+            if chunk.lo == 0 and lo == 0:  # (the first rows: the header, the column names)
+                self.writer.writerow(list(table))
+            self.writer.writerows(csv_rows(table))
 
 
 def atlas_figure(s, drift_last, algorithms, cycles: int, paths: int, n: int, label: str):

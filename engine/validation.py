@@ -88,9 +88,15 @@ def within(x, bounds, name: str, names, where: str, field: str | None = None) ->
     if out.size:
         i = int(out[0])
         lo, hi = box[i]
+        bound = (
+            f"be in [{lo:g}, {hi:g}]"
+            if np.isfinite(lo) and np.isfinite(hi)
+            else f"be at most {hi:g}"
+            if np.isfinite(hi)
+            else f"be at least {lo:g}"
+        )
         raise InvalidInputError(
-            f"{name} {names[i]} must be in [{lo:g}, {hi:g}] ({where}), got {x[i]:g}",
-            f"{field or name}.{i}",
+            f"{name} {names[i]} must {bound} ({where}), got {x[i]:g}", f"{field or name}.{i}"
         )
 
 

@@ -104,12 +104,17 @@ def test_a_large_atlas_streams_to_csv_and_the_json_keeps_a_summary(tmp_path, mon
     assert np.nanmax(drift) == pytest.approx(max(doc["summary"]["pseudoinverse"]["max_drift"]))
 
 
-@pytest.mark.parametrize("extra", [(), ("--no-leg-ends", "--chunk", "5")])
-def test_the_csv_is_the_engine_atlas_table(tmp_path, monkeypatch, extra):
-    """The CSV named its columns by joint names and ``{alg}_leg{k}_{v}``, a row per run; it is
-    now the engine's table of the same atlas, ``AtlasResult.columns()`` (a row per leg with the
-    leg ends, per cycle without), written chunk by chunk."""
+@pytest.mark.parametrize(
+    ("extra", "rows"), [((), 8192), (("--no-leg-ends", "--chunk", "5"), 8192), ((), 5)]
+)
+def test_the_csv_is_the_engine_atlas_table(tmp_path, monkeypatch, extra, rows):
+    """The CSV is the engine's table of the same atlas, ``AtlasResult.columns()`` (a row per
+    leg with the leg ends, per cycle without), written chunk by chunk and, within a chunk, a
+    block of about ``ROWS`` rows at a time (5: a block of one run)."""
+    from jik.cli import atlas_output
     from jik.engine import atlas_run
+
+    monkeypatch.setattr(atlas_output, "ROWS", rows)
 
     plans = []
 

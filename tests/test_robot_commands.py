@@ -52,9 +52,9 @@ def test_solve_a_planar_arm_from_a_json_file(capsys, arm_file):
 
 
 def test_json_outputs_are_the_engine_results_dicts(capsys):
-    """``jik solve --json`` called the target ``target`` where the engine's results (and their
-    ``y_d_k`` columns) say ``y_d``: both commands now print the engine's ``as_dict()`` (with the
-    robot, and its notes and limits)."""
+    """``jik solve --json`` and ``jik repeatability --json`` print the engine result's
+    ``as_dict()`` (the target is ``y_d``, as in its ``y_d_k`` columns), with the robot, and its
+    notes and limits."""
     from jik.engine.inverses import Pseudoinverse
     from jik.engine.kinematics import Manipulator2
     from jik.engine.repeatability import repeatability

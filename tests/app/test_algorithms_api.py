@@ -188,7 +188,7 @@ def test_a_rest_outside_the_joint_limits_is_refused_naming_its_coordinate(api, r
     bad = {**body, **posture, "robot": LIMITED, "algorithm_parameters": {"rest": [0, 2.5, 0]}}
     r = api.post(route, json=bad)
     assert messages(r) == [
-        "algorithm_parameters.rest.1: rest x2 must be in [-inf, 1.2] (the joint limits of the "
+        "algorithm_parameters.rest.1: rest x2 must be at most 1.2 (the joint limits of the "
         "planar_chain), got 2.5"
     ]
     assert r.json()["detail"][0]["loc"] == ["body", "algorithm_parameters", "rest", "1"]

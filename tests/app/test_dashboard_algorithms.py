@@ -463,6 +463,6 @@ def test_a_rest_outside_a_chain_s_joint_limits_is_refused_in_the_engine_s_words(
         updated_state(state, {f"{REST}.1": 2.0})
     assert refused.value.field == f"{REST}.1" and engine.value.field == "rest.1"
     assert str(refused.value) == f"{REST}.1: {engine.value}"
-    assert "[-inf, 1.2] (the joint limits of the planar_chain), got 2" in str(refused.value)
+    assert "at most 1.2 (the joint limits of the planar_chain), got 2" in str(refused.value)
     outside = updated_state(state, {"x0": [1.5, 0.2, 0.3]})
     assert list(state_inverse(outside, "posture").rest) == [1.5, 0.2, 0.3]

@@ -208,10 +208,9 @@ def test_export_has_every_point_of_both_runs():
 
 
 def test_an_export_names_its_columns_as_the_engine_does():
-    """The CSV named its columns by the robot's joint and task names (``x1``, ``panda_joint1``)
-    and numbered legs across cycles from 1 where the JSON counted from 0: its point columns are
-    now the engine's trajectory columns, its units keyed by them, cycle and leg from 1 in both,
-    and the JSON's leg ends are "legs" as in the engine's results."""
+    """The export's point columns are the engine's trajectory columns (``x_k``, ``y_k``, not
+    the robot's joint and task names), its units keyed by them, cycle and leg from 1 in the CSV
+    and the JSON, and the JSON's leg ends are "legs" as in the engine's results."""
     state = updated_state(default_state("manipulator2"), {"cycles": 2})
     result = compute(state)
     header, *rows = [r for r in export_csv(result).splitlines() if not r.startswith("#")]

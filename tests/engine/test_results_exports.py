@@ -209,7 +209,7 @@ def test_every_result_exports_a_table_with_one_meaning_per_column_name():
         ARM, {"x2": (0, 1), "x3": (1, 1.6)}, degree=4, convergence_degrees=(2,)
     )
     assert synthesis.columns()["degree"].tolist() == [2, 4]
-    # (the number of unknowns was n_unknowns here and unknowns in a total-degree synthesis)
+    # (one name for the number of unknowns in both syntheses)
     assert list(synthesis.columns()) == ["degree", "unknowns", "e2"]
     assert synthesis.columns()["unknowns"].tolist() == [9, 25]
     sd = json.loads(json.dumps(synthesis.as_dict()))
@@ -237,8 +237,8 @@ def test_help_on_progress_shows_its_methods_not_typing_internals():
 
 
 def test_an_atlas_table_runs_in_run_order_and_can_hold_every_leg():
-    """Rows were algorithm by algorithm, which a CSV streamed chunk by chunk cannot write; they
-    are run by run (then algorithm, cycle), and ``every_leg`` gives each leg's end its row."""
+    """Rows run by run (then algorithm, cycle), so that a CSV streamed chunk by chunk writes
+    a block of the table at a time; ``every_leg`` gives each leg's end its row."""
     plan, atlas = _damped_atlas(0.01, 0.5)
     A, _, N, C = atlas.drift.shape
     L = plan.legs
