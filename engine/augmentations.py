@@ -22,6 +22,10 @@ class AugmentingMap(abc.ABC):
 
     name: ClassVar[str]
     p: int
+    #: Whether each value of h solves a problem of its own (a characteristic's collocation,
+    #: eq. (28)), so that a grid of h costs seconds: analyses over a box skip such a map or
+    #: take it on a coarser grid.
+    solves_per_point: ClassVar[bool] = False
 
     @abc.abstractmethod
     def value(self, x: FloatArray) -> FloatArray:

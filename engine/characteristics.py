@@ -64,6 +64,7 @@ class CharacteristicsMap(AugmentingMap):
     """
 
     name = "characteristics"
+    solves_per_point = True
 
     def __init__(
         self,

@@ -173,7 +173,7 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         nodes = req.nodes
     functionals, more = _functionals(kin, amap, region, fixed, nodes)
     all_fixed = {n: float(fixed.get(n, 0.0)) for n in names if n not in region}
-    found, said = singularities(kin, amap, region, all_fixed, req.nodes)
+    found, said, searched = singularities(kin, amap, region, all_fixed, req.nodes)
     notes += more + said
     return S.SynthesizeResponse(
         robot=robot_used,
@@ -186,6 +186,7 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         functionals=functionals,
         convergence=convergence,
         singularities=found,
+        singularities_searched=searched,
         total_degree=None,
         message="; ".join(notes) or "ok",
     )

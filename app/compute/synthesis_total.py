@@ -70,19 +70,23 @@ def grid(amap, names, region, fixed, p: int, n: int) -> S.SynthesisGrid | None:
 
 def singularities(
     kin, amap, region, fixed, nodes: int
-) -> tuple[S.MapSingularitiesInfo | None, list[str]]:
+) -> tuple[S.MapSingularitiesInfo | None, list[str], bool]:
     """Where h is singular in the box (:func:`jik.engine.map_singularities.map_singularities`
-    on a grid of ``nodes`` points per variable, as many as E1's and E2's Gauss rule: h costs
-    as much there, whether it is a formula or solves a problem per point) and what the
-    response's message says of it."""
+    on a grid of ``nodes`` points per variable, as many as E1's and E2's Gauss rule: a
+    polynomial map costs as much there), what the response's message says of it, and whether
+    it was searched: not for a map that solves a problem per point (a characteristic's, eq.
+    (28): seconds for a grid), as the dashboard does not either, nor where the search does
+    not apply (a vector of maps, too large a grid)."""
+    if amap.solves_per_point:
+        return None, ["singularities of h not searched: each value of h solves a problem"], False
     try:
         found = map_singularities(kin, amap, region, fixed=fixed, nodes=nodes)
     except JikError as exc:
-        return None, [f"singularities of h not searched: {exc}"]
+        return None, [f"singularities of h not searched: {exc}"], False
     if found is None:
-        return None, []
+        return None, [], True
     info = S.MapSingularitiesInfo.model_validate(found.as_dict())
-    return info, [f"h is singular in the box: {found}"]
+    return info, [f"h is singular in the box: {found}"], True
 
 
 def total_degree_response(
@@ -129,7 +133,7 @@ def total_degree_response(
     if len(res.maps) > 1:
         notes.append(f"{len(res.maps)} maps h_1 ... h_{len(res.maps)}; the grid shows h_1")
     notes.append("E1 is not evaluated (its Gauss rule grows as nodes^d)")
-    found, more = singularities(kin, res.maps[0], res.region, all_fixed, req.nodes)
+    found, more, searched = singularities(kin, res.maps[0], res.region, all_fixed, req.nodes)
     return S.SynthesizeResponse(
         robot=robot_used,
         method=req.method,
@@ -153,6 +157,7 @@ def total_degree_response(
         },
         convergence=[{k: float(v) for k, v in row.items()} for row in res.convergence],
         singularities=found,
+        singularities_searched=searched,
         total_degree=S.TotalDegreeInfo(**info),
         message="; ".join(notes + more),
     )

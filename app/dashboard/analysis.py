@@ -64,9 +64,10 @@ def vector_note(state: DashboardState) -> str | None:
 
 
 def expensive_map(amap) -> bool:
-    """Maps evaluated by solving a problem per point (characteristics): h is computed after
-    the runs have been shown, on a coarser grid."""
-    return hasattr(amap, "evaluate")
+    """Maps evaluated by solving a problem per point (the engine's
+    :attr:`~jik.engine.augmentations.AugmentingMap.solves_per_point`): h is computed after the
+    runs have been shown, on a coarser grid."""
+    return bool(getattr(amap, "solves_per_point", False))
 
 
 #: The h panel keeps its box while the trajectories fill at least this fraction of it.

@@ -173,13 +173,23 @@ def test_a_synthesized_map_is_searched_and_a_vector_of_maps_is_said_not_to_be(ap
     body = {"robot": {"name": "manipulator2"}, "method": "e2_variational", "region": REGION}
     b = api.post("/synthesize", json={**body, "degree": 6, "nodes": 8}).json()
     assert b["singularities"] is None and "singularities" not in b["message"]
+    assert b["singularities_searched"] is True
     chain = {"name": "planar_chain", "joints": "RRRR", "lengths": [1.0] * 4}
     body = {"robot": chain, "method": "e2_total_degree", "degree": 2, "qmc_nodes": 256}
     b = api.post("/synthesize", json=body).json()
-    assert b["singularities"] is None
+    assert b["singularities"] is None and b["singularities_searched"] is False
     assert (
         "singularities of h not searched: map_singularities here needs one degree" in (b["message"])
     )
+
+
+def test_a_map_that_solves_a_problem_per_point_is_not_searched(api):
+    """The unicycle's characteristics map solves a collocation problem (28) for each value:
+    the search on a grid would cost seconds more than E1 and E2, so it is skipped and said."""
+    b = api.post("/synthesize", json={"robot": {"name": "unicycle"}, "nodes": 2, "grid": 3}).json()
+    assert b["augmentation"]["name"] == "characteristics"
+    assert b["singularities"] is None and b["singularities_searched"] is False
+    assert "singularities of h not searched: each value of h solves a problem" in b["message"]
 
 
 def test_the_singularities_field_is_documented(api):

@@ -153,7 +153,11 @@ class MapSingularitiesInfo(BaseModel):
     where: dict[str, list[float]] = Field(
         description="per box variable, [lo, hi] of the grid points where h is singular"
     )
-    fraction: float = Field(description="the fraction of the grid's points where h is singular")
+    fraction: float = Field(
+        description="the fraction of the grid's points where h is singular (of the grid, not "
+        "of the box: a rank loss or a pole is found at the points beside it, fewer of them on "
+        "a finer grid)"
+    )
     reasons: list[str] = Field(
         description="what is singular there: 'h or its gradient is not finite', 'the gradient "
         "of h blows up', 'the extended Jacobian (10) loses rank' (at a point, or det [J; dh] "
@@ -212,7 +216,12 @@ class SynthesizeResponse(BaseModel):
     singularities: MapSingularitiesInfo | None = Field(
         description="where h, or the extended Jacobian [J; dh] (10), is singular in the box "
         "(the fixed variables held), on a uniform grid: null when h is regular there, or when "
-        "the search does not apply (a vector of maps, too large a grid: see message)"
+        "it was not searched (singularities_searched)"
+    )
+    singularities_searched: bool = Field(
+        description="whether h was searched for singularities: not for a map that solves a "
+        "problem per point (the characteristics'), a vector of maps, or too large a grid "
+        "(message says which)"
     )
     total_degree: TotalDegreeInfo | None = Field(
         None, description="'e2_total_degree': the synthesis' numbers and its maps"
