@@ -127,32 +127,44 @@ def _fmt(v) -> str:
     return "(" + ", ".join(f"{float(t):.10g}" for t in v) + ")"
 
 
+def _inverse(robot, args: argparse.Namespace, x0):
+    """The inverse the command line asks for (the posture's default rest: the robot's home,
+    else x0)."""
+    return robot.inverse(
+        args.algorithm,
+        args.augmentation,
+        algorithm_parameters=algorithm_parameters(args, args.algorithm),
+        x0=x0,
+    )
+
+
+def _document(robot, result, report, as_json: bool) -> None:
+    """The result in the engine's names (``as_dict()``: x0, y_d or targets, x, legs, ...) with
+    the robot, its limits' report and notes; printed as JSON, or its first lines as text."""
+    out = {
+        "robot": robot.spec.title,
+        **result.as_dict(),
+        **({} if report is None else {"limits": report.as_dict()}),
+        **_notes(robot),
+    }
+    if as_json:
+        print(json.dumps(out))
+    else:
+        print(f"{out['robot']}, {out['algorithm']}: {result.message}")
+        for note in out.get("notes", ()):
+            print(f"  note: {note}")
+
+
 def solve_command(args: argparse.Namespace) -> int:
     from ..engine.limits import solve_report
     from ..engine.solver import solve
 
     robot, x0, settings = _setup(args)
     target = parse_vector(args.target, "--target") if args.target else robot.spec.default_target
-    inverse = robot.inverse(
-        args.algorithm,
-        args.augmentation,
-        algorithm_parameters=algorithm_parameters(args, args.algorithm),
-        x0=x0,  # (the posture's default rest: the robot's home, else x0)
-    )
-    res = solve(inverse, x0, target, record=True, **settings)
+    res = solve(_inverse(robot, args, x0), x0, target, record=True, **settings)
     report = _limits(robot, lambda limits, names: solve_report(limits, res, names))
-    out = {
-        "robot": robot.spec.title,
-        **res.as_dict(),  # (the engine's names: x0, y_d, x, y, error, success, nit, ...)
-        **({} if report is None else {"limits": report.as_dict()}),
-        **_notes(robot),
-    }
-    if args.json:
-        print(json.dumps(out))
-    else:
-        print(f"{out['robot']}, {out['algorithm']}: {res.message}")
-        for note in out.get("notes", ()):
-            print(f"  note: {note}")
+    _document(robot, res, report, args.json)
+    if not args.json:
         print(
             f"  x0 = {_fmt(x0)}\n  x  = {_fmt(res.x)}\n  k(x) = {_fmt(res.y)}, "
             f"|k(x) - target| = {res.error:.3g}"
@@ -168,27 +180,12 @@ def repeatability_command(args: argparse.Namespace) -> int:
 
     robot, x0, settings = _setup(args)
     path = parse_path(args.path, "--path") if args.path else robot.spec.default_path
-    inverse = robot.inverse(
-        args.algorithm,
-        args.augmentation,
-        algorithm_parameters=algorithm_parameters(args, args.algorithm),
-        x0=x0,  # (the posture's default rest: the robot's home, else x0)
-    )
+    inverse = _inverse(robot, args, x0)
     record = robot_limits(robot.kinematics) is not None  # (limits: check whole legs)
     rep = repeatability(inverse, x0, path, cycles=args.cycles, record=record, **settings)
     report = _limits(robot, lambda limits, names: repeatability_report(limits, rep, names))
-    out = {
-        "robot": robot.spec.title,
-        **rep.as_dict(),  # (the engine's names: x0, targets, legs, cycle_end, drift, ...)
-        **({} if report is None else {"limits": report.as_dict()}),
-        **_notes(robot),
-    }
-    if args.json:
-        print(json.dumps(out))
-    else:
-        print(f"{out['robot']}, {out['algorithm']}: {rep.message}")
-        for note in out.get("notes", ()):
-            print(f"  note: {note}")
+    _document(robot, rep, report, args.json)
+    if not args.json:
         print(f"  x0 = {_fmt(x0)}; {len(rep.targets)} legs a cycle")
         for c, (end, drift) in enumerate(zip(rep.cycle_end, rep.drift, strict=True)):
             print(f"  cycle {c + 1}: x = {_fmt(end)}, |x - x0| = {drift:.3e}")
