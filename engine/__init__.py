@@ -55,6 +55,7 @@ The atlas (drift over many starts and paths)
     plan_atlas, run_atlas       plan and run an atlas (here, in processes or on Dask)
     iter_atlas                  the same, chunk by chunk, in bounded memory
     AtlasPlan, AtlasResult      the plan and the gathered result
+    manifold_starts             starts on a self-motion manifold of p - r > 1 (no curve)
 Errors (jik.engine.exceptions)
     JikError                    the base of every error below
     InvalidInputError, FormulaError  bad input (``error.field`` names it); a formula's syntax
@@ -140,6 +141,7 @@ _EXPORTS = {
     "AtlasPlan": "atlas",
     "run_atlas": "atlas_run",
     "iter_atlas": "atlas_run",
+    "manifold_starts": "self_motion",
     "AtlasResult": "atlas_run",
     # errors
     "JikError": "exceptions",
@@ -205,6 +207,7 @@ __all__ = [
     "iter_atlas",
     "load_robot",
     "make_inverse",
+    "manifold_starts",
     "map_singularities",
     "plan_atlas",
     "repeatability",

@@ -20,7 +20,7 @@ import numpy as np
 
 from ...engine.exceptions import InvalidInputError
 from ...engine.registry import ROBOTS
-from ...engine.self_motion import project
+from ...engine.self_motion import manifold_starts
 from ..compute.atlas_schemas import AtlasRequest
 from .algorithms import STYLES, inverse_parameters
 from .analysis import kinematics_and_map
@@ -55,7 +55,10 @@ def atlas_request(
         for k, v in inverse_parameters(state, a).items()
         if k != "rest"
     }
-    points = manifold_starts(state, kin, starts) if kin.p - kin.r > 1 else None
+    points = None
+    if kin.p - kin.r > 1:  # (its self-motion manifolds are not curves: starts given)
+        box = state_spec(state).x_range
+        points = manifold_starts(kin, state.x0, starts, box).tolist()
     robot, augmentation = request_robot(state)
     return AtlasRequest.model_validate(
         {
@@ -74,35 +77,6 @@ def atlas_request(
             "tolerance": state.tolerance,
         }
     )
-
-
-#: Explicit starts lie within this fraction of the configuration box's width around x0.
-START_SPREAD = 0.15
-
-
-def manifold_starts(state: DashboardState, kin, n: int) -> list[list[float]]:
-    """``n`` starts on the self-motion manifold k(x) = k(x0) of a robot with p - r > 1 (not a
-    curve: the atlas takes them explicitly), x0 first, then farther and farther: x0 plus a
-    step along a random direction of the null space of J(x0) (seeded: the same starts for the
-    same state), the step growing to START_SPREAD of the box, projected back onto the manifold
-    by Newton steps with the pseudoinverse; those that leave the box or do not reach the
-    manifold are left out."""
-    x0 = np.asarray(state.x0, dtype=float)
-    y0 = kin.forward(x0)
-    J = np.asarray(kin.jacobian(x0), dtype=float)
-    null = np.eye(kin.p) - np.linalg.pinv(J) @ J
-    d = np.random.default_rng(0).standard_normal((n, kin.p)) @ null
-    d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
-    box = np.asarray(state_spec(state).x_range, dtype=float)
-    widths = box[:, 1] - box[:, 0]
-    width = float(np.min(widths[np.isfinite(widths)], initial=2 * np.pi))
-    step = START_SPREAD * width * np.linspace(0.0, 1.0, n)
-    X = project(kin, x0 + step[:, None] * d, y0)
-    X[0] = x0
-    ok = (np.linalg.norm(kin.forward(X) - y0, axis=1) < 1e-10) & np.all(
-        (X >= box[:, 0]) & (X <= box[:, 1]), axis=1
-    )
-    return X[ok].tolist()
 
 
 def request_robot(state: DashboardState) -> tuple[dict, dict | None]:
@@ -141,7 +115,9 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
     x_title, hover, at_x0 = f"arc length s of the start {unit}", "s = %{x:.3f}", 0.0
     if result.get("period") is not None:  # (a closed curve: the starts cover one turn)
         x_title = f"arc length s of the start {unit}, one turn of {result['period']:.4g}"
-    if request.start_points:  # (p - r > 1: starts by number, the first x0, see manifold_starts)
+    if (
+        request.start_points
+    ):  # (p - r > 1: starts by number, the first x0, see the engine's manifold_starts)
         s = np.arange(1.0, len(request.start_points) + 1)
         x_title, hover, at_x0 = "start, farther from x0 to the right", "start %{x}", 1.0
     rows, labels = [], []

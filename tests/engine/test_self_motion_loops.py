@@ -262,3 +262,25 @@ def test_a_family_of_loops_takes_each_loops_s_modulo_its_own_period():
     np.testing.assert_allclose(kin.forward(starts[8:]), 0.25, rtol=0, atol=1e-13)
     np.testing.assert_allclose(starts[8:], second.points(np.mod(s, math.pi)), rtol=0, atol=1e-9)
     np.testing.assert_allclose(starts[12], starts[8], rtol=0, atol=1e-9)  # (s = pi: once round)
+
+
+def test_starts_on_a_manifold_of_two_dimensions_stay_on_it_and_in_the_box():
+    """A planar 4R chain with a position task (p - r = 2): the starts are x0, then points of
+    k(x) = k(x0) farther and farther from it, within the box, the same for the same seed."""
+    import jik.engine as jik
+
+    chain = jik.PlanarChain("RRRR", [1.0, 0.8, 0.6, 0.4])
+    x0 = np.array([0.3, 0.5, 0.7, 0.9])
+    box = [(-np.pi, np.pi)] * 4
+    X = jik.manifold_starts(chain, x0, 12, box)
+    assert 8 <= len(X) <= 12 and np.array_equal(X[0], x0)
+    np.testing.assert_allclose(
+        chain.forward(X), chain.forward(x0)[None].repeat(len(X), 0), atol=1e-10
+    )
+    assert np.all(np.abs(X) <= np.pi)
+    distance = np.linalg.norm(X - x0, axis=1)
+    assert distance[-1] > 0.5 and np.all(np.diff(distance[:4]) > 0)
+    np.testing.assert_array_equal(X, jik.manifold_starts(chain, x0, 12, box))
+    with pytest.raises(jik.InvalidInputError) as refused:
+        jik.manifold_starts(chain, x0, 0, box)
+    assert refused.value.field == "n"
