@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from .exceptions import InvalidInputError, SingularConfigurationError
+from .exceptions import InvalidInputError, SingularConfigurationError, format_vector
 from .inverses import Inverse, Pseudoinverse, algorithm_labels
 from .repeatability import CLOSE_TOL, MAX_CYCLES, MAX_PATH_POINTS
 from .self_motion import SelfMotionManifold, project, trace
@@ -369,11 +369,11 @@ def _manifolds(kin, paths, reference, arc, box) -> tuple[SelfMotionManifold, ...
         )
     except SingularConfigurationError as error:
         raise InvalidInputError(str(error), field="reference") from None
-    if not np.all(res.success):
+    if not np.all(res.success):  # (the path's point is at fault, not the reference: a default)
         j = int(np.argmin(res.success))
         raise InvalidInputError(
-            f"eq. (7) from the reference does not reach path {j}'s first point: {res.message[j]}",
-            field="reference",
+            f"path {j}'s first point {format_vector(y0[j])} is out of reach: {res.message[j]}",
+            field="path",
         )
     bases = project(kin, res.x, y0)
     try:
@@ -383,9 +383,9 @@ def _manifolds(kin, paths, reference, arc, box) -> tuple[SelfMotionManifold, ...
             raise
         where = str(error).partition(": ")[2]
         raise InvalidInputError(
-            "the reference, moved by eq. (7) to the path's first point, lies outside the "
-            f"configuration box (the robot's x_range, an arm's joint limits): {where}",
-            field="reference",
+            f"the path's first point {format_vector(y0[0])} is out of reach in the box (x_range, "
+            f"joint limits): eq. (7) from the reference reaches it only where {where}",
+            field="path",
         ) from None
     return (first, *(trace(kin, b, first.arc) for b in bases[1:]))
 

@@ -25,10 +25,11 @@ class Parameter:
         v = finite(value, self.name)
         if not self.minimum <= v <= self.maximum:
             raise InvalidInputError(
-                f"{self.name} must be in [{self.minimum:g}, {self.maximum:g}], got {v:g}"
+                f"{self.name} must be in [{self.minimum:g}, {self.maximum:g}], got {v:g}",
+                self.name,
             )
         if self.nonzero and v == 0:
-            raise InvalidInputError(f"{self.name} must be nonzero ({self.description})")
+            raise InvalidInputError(f"{self.name} must be nonzero ({self.description})", self.name)
         return v
 
     def as_dict(self) -> dict:
@@ -50,11 +51,12 @@ def check_params(
 ) -> dict:
     """Each parameter's value checked (its default where not given); an unknown name is
     refused naming every known one, the scalars ``specs`` and the ``vectors`` (checked by
-    their owner)."""
+    their owner); the error's field is the parameter's name (the first unknown one)."""
     known = {p.name for p in specs} | set(vectors)
-    unknown = set(values) - known
+    unknown = sorted(set(values) - known, key=str)
     if unknown:
         raise InvalidInputError(
-            f"unknown parameter(s) {sorted(unknown)} for {what}; known: {sorted(known) or 'none'}"
+            f"unknown parameter(s) {unknown} for {what}; known: {sorted(known) or 'none'}",
+            str(unknown[0]),
         )
     return {p.name: p.check(values.get(p.name, p.default)) for p in specs}

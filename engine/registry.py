@@ -64,15 +64,17 @@ class VectorSpec:
             v = tuple(finite(t, self.name) for t in value)
         except TypeError as exc:
             raise InvalidInputError(
-                f"{self.name} must be a list of {len(self.default)} numbers"
+                f"{self.name} must be a list of {len(self.default)} numbers", self.name
             ) from exc
         if len(v) != len(self.default):
             raise InvalidInputError(
-                f"{self.name} must have {len(self.default)} components, got {len(v)}"
+                f"{self.name} must have {len(self.default)} components, got {len(v)}", self.name
             )
         for i, (t, lo, hi) in enumerate(zip(v, self.minimum, self.maximum, strict=True)):
             if not lo <= t <= hi:
-                raise InvalidInputError(f"{self.name}[{i}] must be in [{lo:g}, {hi:g}], got {t:g}")
+                raise InvalidInputError(
+                    f"{self.name}[{i}] must be in [{lo:g}, {hi:g}], got {t:g}", f"{self.name}.{i}"
+                )
         return v
 
     def as_dict(self) -> dict:

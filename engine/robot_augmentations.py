@@ -143,4 +143,13 @@ def _region(kin: Kinematics, item: Mapping, where: str):
         raise InvalidInputError(
             f"{where}.region must have at least two variables", f"{where}.region"
         )
+    k = kin.p - kin.r
+    if len(box) < k:  # (h_1..h_k of fewer variables: rank dh < k, [J; dh] singular everywhere)
+        raise InvalidInputError(
+            f"{where}.region must vary at least p - r = {k} of the joints "
+            f"{list(kin.variable_names)}, got {sorted(box)}: maps h_1..h_{k} of fewer have a "
+            "derivative dh of rank below p - r, so the extended Jacobian [J; dh] of eq. (11) is "
+            "singular everywhere",
+            f"{where}.region",
+        )
     return box, fix

@@ -4,18 +4,19 @@ for the FastAPI handlers (:func:`add_error_handlers`) and the /solve fast path
 
 Errors have one shape. Bad input (pydantic validation, or the engine refusing it,
 :class:`RequestError`) is HTTP 422 in FastAPI's list format, ``{"detail": [{"loc": ["body",
-<field>...], "msg": "<field>: <problem>", "type": ...}]}``, the message always starting with the
-field; so is a computation stopped at the time limit (the field that sizes the work, e.g.
-``cycles``). A request that finds no free compute slot within the time limit is 503
-``{"detail": "server busy: ..."}`` with Retry-After; a failure inside a worker, and anything
-unexpected, is 500 ``{"detail": "internal error: ..."}``, never an HTML page or a dropped
-connection. An atlas job that is not there is 404, too many atlas jobs 429 with Retry-After.
-The dashboard sessions' errors come here too: a refused value (the field it names)
-is 422, a session that is not there 404, a full session store 503 with Retry-After, an export
-with no result of the current state 409 (its computation failed) or 503 (not yet). A body
-over the size limit is 413 ``{"detail": "request body of ... bytes is larger ..."}``
-(:class:`jik.app.api.body_limit.BodyLimit`). The messages of validation errors are written
-by :mod:`jik.app.api.validation`.
+<field>...], "msg": "<field>: <problem>", "type": ...}]}``, the message always starting with
+the field as :func:`~jik.app.compute.schemas.wording.field_text` writes it
+(``algorithm_parameters.rest[3]``; ``loc`` as FastAPI's, ``[..., "rest", 3]``); so is a
+computation stopped at the time limit (the field that sizes the work, e.g. ``cycles``). A
+request that finds no free compute slot within the time limit is 503 ``{"detail": "server busy:
+..."}`` with Retry-After; a failure inside a worker, and anything unexpected, is 500
+``{"detail": "internal error: ..."}``, never an HTML page or a dropped connection. An atlas job
+that is not there is 404, too many atlas jobs 429 with Retry-After. The dashboard sessions'
+errors come here too: a refused value (the field it names) is 422, a session that is not there
+404, a full session store 503 with Retry-After, an export with no result of the current state
+409 (its computation failed) or 503 (not yet). A body over the size limit is 413 ``{"detail":
+"request body of ... bytes is larger ..."}`` (:class:`jik.app.api.body_limit.BodyLimit`). The
+messages of validation errors are written by :mod:`jik.app.api.validation`.
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ from ...engine.exceptions import InvalidInputError
 from ..compute.atlas_jobs import AtlasJobNotFound, AtlasJobsFull
 from ..compute.exceptions import ComputeError, RequestError, ServiceUnavailable
 from ..compute.schemas import ErrorResponse
+from ..compute.schemas.wording import field_loc
 from ..dashboard.sessions import ExportUnavailable, SessionNotFound, SessionsFull
 from .validation import validation_detail
 
@@ -45,7 +47,7 @@ def validation_error_response(exc: RequestValidationError) -> JSONResponse:
 
 
 def request_error_response(exc: RequestError) -> JSONResponse:
-    loc = ["body", *exc.field.replace("[", ".").replace("]", "").split(".")]
+    loc = field_loc(exc.field)
     return JSONResponse(
         status_code=422, content={"detail": [{"loc": loc, "msg": str(exc), "type": "value_error"}]}
     )
@@ -93,7 +95,7 @@ def http_error_response(exc: StarletteHTTPException) -> JSONResponse:
 
 def invalid_input_response(exc: InvalidInputError) -> JSONResponse:
     """422 for a value the dashboard's model or the engine refused, at the field it names."""
-    loc = ["body", *exc.field.split(".")] if exc.field else ["body"]
+    loc = field_loc(exc.field or "")
     return JSONResponse(
         status_code=422, content={"detail": [{"loc": loc, "msg": str(exc), "type": "value_error"}]}
     )

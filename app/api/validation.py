@@ -12,7 +12,7 @@ from ..compute.schemas import (
     USER_AUGMENTATION_MODELS,
     USER_ROBOT_MODELS,
 )
-from ..compute.schemas.wording import refusal
+from ..compute.schemas.wording import field_text, refusal
 
 _TAGS = {*ROBOT_MODELS, *AUGMENTATION_MODELS, *USER_ROBOT_MODELS, *USER_AUGMENTATION_MODELS}
 #: The tags of a request's variants: the catalogue robots and the kinds of user robots.
@@ -34,13 +34,7 @@ def _field(loc) -> str:
         del parts[0]
     if len(parts) > 2 and parts[0] in ("robot", "augmentation") and parts[1] in _TAGS:
         del parts[1]
-    out: list[str] = []
-    for p in parts:
-        if p.isdigit() and out:
-            out[-1] += f"[{p}]"
-        else:
-            out.append(p)
-    return ".".join(out) or "body"
+    return field_text(".".join(parts)) or "body"
 
 
 def _location(loc) -> list:

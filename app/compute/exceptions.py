@@ -1,13 +1,16 @@
 """The compute layer's typed errors; the API's error mapping gives each its HTTP response."""
 
+from .schemas.wording import field_text
+
 
 class RequestError(ValueError):
-    """A request the engine cannot serve: HTTP 422 with a message that names ``field``."""
+    """A request the engine cannot serve: HTTP 422 with a message that names ``field`` (its
+    path in either notation, ``x0[1]`` or ``x0.1``; the message writes it as ``x0[1]``)."""
 
     def __init__(self, field: str, message: str) -> None:
         self.field = field
         self.message = message
-        super().__init__(f"{field}: {message}")
+        super().__init__(f"{field_text(field)}: {message}")
 
 
 class ServiceUnavailable(RuntimeError):

@@ -20,7 +20,7 @@ from .documents import nullable
 from .exceptions import RequestError
 from .robot_requests import request_robot
 from .schemas.robots import _camel
-from .schemas.variants import _robot_name
+from .schemas.variants import OBJECT_BODY, _robot_name
 from .worker import task
 
 #: Most configurations one request evaluates.
@@ -93,6 +93,7 @@ def _body() -> Any:
             custom_error_message=f"give a robot whose name is one of {S.ROBOT_NAMES}",
             custom_error_context={"names": str(S.ROBOT_NAMES)},
         ),
+        OBJECT_BODY,
     ]
 
 

@@ -18,6 +18,7 @@ from ...engine.registry import ALGORITHMS, ROBOTS, RobotSpec, make_inverse
 from . import schemas as S
 from .exceptions import RequestError
 from .schemas.algorithms import field_of, used
+from .schemas.wording import without_field
 from .user_robots import map_used, user_inverse, user_map, user_robot
 
 
@@ -88,7 +89,7 @@ def request_robot(
             params = given(algorithm)
             out.append(make_inverse(kin, algorithm, spec=spec, algorithm_parameters=params, x0=x0))
         except InvalidInputError as exc:
-            raise RequestError(field_of(exc.field, str(exc)), str(exc)) from None
+            raise RequestError(field_of(exc.field), without_field(str(exc), exc.field)) from None
     built = spec, kin, tuple(out), robot_used, aug_used
     return RequestRobot(*built, lambda: build_augmentation(spec, kin, augmentation)[1:])
 

@@ -23,11 +23,12 @@ from typing import Any, cast
 
 from ...engine.exceptions import InvalidInputError, JikError
 from ...engine.robot_spec import Robot, robot_from_dict
-from ...engine.robot_synthesis import TENSOR_DEGREE, TOTAL_DEGREE
+from ...engine.robot_synthesis import ARM_BOX, TENSOR_DEGREE, TOTAL_DEGREE
 from . import schemas as S
 from .budget import build_seconds, time_budget
 from .exceptions import RequestError
 from .schemas.algorithms import field_of
+from .schemas.wording import field_text, without_field
 
 #: The augmentation's label inside the built robot.
 _LABEL = "request"
@@ -42,13 +43,7 @@ def request_field(field: str | None, robot_keys: Sequence[str]) -> str:
         parts = ["robot", *parts]
     elif parts[0] != "augmentation":
         return "robot"
-    out: list[str] = []
-    for part in parts:  # (indices as the API writes them: robot.task[0])
-        if part.isdigit() and out:
-            out[-1] += f"[{part}]"
-        else:
-            out.append(part)
-    return ".".join(out)
+    return field_text(".".join(parts))  # (indices as the API writes them: robot.task[0])
 
 
 @functools.lru_cache(maxsize=16)
@@ -117,10 +112,7 @@ def echo(definition: dict) -> dict:
 def _text(exc: InvalidInputError) -> str:
     """The engine's message without a leading field name, ``field: ...`` or ``field must ...``
     (the RequestError adds the request's name of the field)."""
-    text = str(exc)
-    if exc.field and text.startswith(exc.field):
-        return text[len(exc.field) :].lstrip(": ")
-    return text
+    return without_field(str(exc), exc.field)
 
 
 def user_inverse(robot: Robot, algorithm: str, algorithm_parameters: dict | None = None, x0=None):
@@ -128,12 +120,7 @@ def user_inverse(robot: Robot, algorithm: str, algorithm_parameters: dict | None
     its parameters (the pseudoinverse (8), damped, weighted, posture; ``x0`` the run's start,
     posture's default rest for a robot without home)."""
     if algorithm == "extended" and not robot.spec.augmentations:
-        raise RequestError(
-            "augmentation",
-            "the extended inverse of a user robot needs its augmenting map: {'name': "
-            "'formula', 'h': ...} or {'name': 'e2_synthesized', 'region': {...}} (p = r + 1); "
-            "an arm given with its home has an E2-optimal one by default",
-        )
+        raise RequestError("augmentation", _needs_map(robot))
     try:
         if algorithm != "extended":
             return robot.inverse(algorithm, algorithm_parameters=algorithm_parameters, x0=x0)
@@ -141,8 +128,33 @@ def user_inverse(robot: Robot, algorithm: str, algorithm_parameters: dict | None
         return robot.inverse(algorithm, _LABEL if given else None)  # (else the robot's default)
     except InvalidInputError as exc:
         if algorithm != "extended":
-            raise RequestError(field_of(exc.field, str(exc)), _text(exc)) from None
+            raise RequestError(field_of(exc.field), _text(exc)) from None
         raise RequestError(request_field(exc.field, ()), _text(exc)) from None
+
+
+def _needs_map(robot: Robot) -> str:
+    """What a robot without a map gives its extended inverse: p - r maps h (eq. (11)); an arm
+    with a home has one by default only for p = r + 1 (:func:`arm_augmentations`)."""
+    spec = robot.spec
+    k = spec.p - spec.r
+    if k == 1:
+        return (
+            "the extended inverse needs an augmenting map: {'name': 'formula', 'h': ...} or "
+            "{'name': 'e2_synthesized', 'region': {...}}; an arm given with its home has an "
+            "E2-optimal one by default"
+        )
+    formulas = f"{{'name': 'formula', 'h': [...]}} ({k} formulas, one per degree of redundancy)"
+    if "home" in robot.definition:
+        return (
+            f"the extended inverse needs p - r = {k} augmenting maps, and this {spec.name} "
+            f"(p = {spec.p}, r = {spec.r}) has a default map only when p = r + 1: give "
+            f"{{'name': 'e2_synthesized'}} (E2-optimal over all its joints, +-{ARM_BOX:g} "
+            f"around its home) or {formulas}"
+        )
+    return (
+        f"the extended inverse needs p - r = {k} augmenting maps: give {formulas} or "
+        f"{{'name': 'e2_synthesized', 'region': {{...}}}} over at least {k} of the joints"
+    )
 
 
 def user_map(robot: Robot) -> tuple[Any, S.AugmentationUsed]:

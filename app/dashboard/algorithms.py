@@ -33,6 +33,7 @@ from ...engine.practical_inverses import check_rest
 from ...engine.registry import ALGORITHMS as REGISTRY
 from ...engine.validation import within
 from ..compute.schemas.algorithms import Algorithm
+from ..compute.schemas.wording import refused, without_field
 
 
 class ChosenState(Protocol):
@@ -182,7 +183,7 @@ def checked(algorithms: tuple[str, ...], given: Mapping[str, Any]) -> dict[str, 
             values[p.name] = p.check(given.get(p.name, p.default))
         except InvalidInputError as exc:
             field = f"algorithm_parameters.{p.name}"
-            raise InvalidInputError(f"{field}: {exc}", field) from None
+            raise refused(field, without_field(str(exc), exc.field)) from None
     values.update({k: given[k] for k, a in VECTORS.items() if a in ordered and k in given})
     return {"algorithms": ordered, "algorithm_parameters": values}
 
@@ -246,7 +247,7 @@ def checked_rest(value, spec, kin, x0) -> tuple[float, ...] | None:
         )
     for i, v in enumerate(value):
         if not math.isfinite(v):
-            raise InvalidInputError(f"{field}.{i}: Input should be a finite number", f"{field}.{i}")
+            raise refused(f"{field}.{i}", "Input should be a finite number")
     rest = tuple(float(v) for v in value)
     if list(rest) == default_rest(kin, x0)[0]:
         return None
@@ -255,7 +256,7 @@ def checked_rest(value, spec, kin, x0) -> tuple[float, ...] | None:
         within(rest, rest_box(spec, kin), "rest", names, "the range of the rest's sliders")
     except InvalidInputError as exc:
         where = f"algorithm_parameters.{exc.field}"
-        raise InvalidInputError(f"{where}: {exc}", where) from None
+        raise refused(where, without_field(str(exc), exc.field)) from None
     return rest
 
 

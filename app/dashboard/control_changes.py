@@ -16,6 +16,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from ...engine.exceptions import InvalidInputError
+from ..compute.schemas.wording import refused
 from .algorithms import editable_rest
 from .robots import state_kinematics, state_spec
 
@@ -45,7 +46,7 @@ def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
             index = rest.removeprefix("rest.")
             if not index.isdigit() or int(index) >= len(params["rest"]):
                 n = len(params["rest"])
-                raise InvalidInputError(f"{key}: rest has {n} coordinates", key)
+                raise refused(key, f"rest has {n} coordinates")
             params["rest"][int(index)] = value
         elif not rest:
             size = len(state.target) if "robot" not in patch else None
@@ -57,7 +58,7 @@ def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
         elif head in ("x0", "target") and rest.isdigit():
             vector = out[head] = list(out.get(head, getattr(state, head)))
             if int(rest) >= len(vector):
-                raise InvalidInputError(f"{key}: {head} has {len(vector)} coordinates", key)
+                raise refused(key, f"{head} has {len(vector)} coordinates")
             vector[int(rest)] = value
         else:
             raise InvalidInputError(f"unknown dashboard control {key!r}", key)

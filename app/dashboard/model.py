@@ -30,7 +30,7 @@ from ..compute.schemas import (
     Tolerance,
 )
 from ..compute.schemas.algorithms import Algorithm
-from ..compute.schemas.wording import refusal
+from ..compute.schemas.wording import refusal, refused, without_field
 from .algorithms import CHOICES, DEFAULT_ALGORITHMS, check_inverses, checked, checked_rest
 from .algorithms import COLORS as COLORS  # (re-exported: one table, there)
 from .algorithms import DASH as DASH
@@ -244,7 +244,7 @@ def updated_state(state: DashboardState, patch: Mapping[str, object]) -> Dashboa
             continue
         if key in ("robot_parameters", "augmentation_parameters", "algorithm_parameters"):
             if not isinstance(value, Mapping):
-                raise InvalidInputError(f"{key}: give an object of parameters", key)
+                raise refused(key, "give an object of parameters")
             value = {**data[key], **value}
         data[key] = value
     return validate(data)
@@ -324,7 +324,7 @@ def _user_robot(state: DashboardState) -> tuple[Any, Any, dict, dict]:
         )
     for key in ("robot_parameters", "augmentation_parameters"):
         if getattr(state, key):
-            raise InvalidInputError(f"{key}: a user robot has none", key)
+            raise refused(key, "a user robot has none")
     robot = _redundant_robot(definition)
     _registered(lambda: robot.spec.augmentation(state.augmentation), "augmentation")
     return robot.spec, robot.kinematics, {}, {}
@@ -358,7 +358,7 @@ def _model(model: type[BaseModel], data: Mapping[str, Any], prefix: tuple[str, .
     except ValidationError as exc:
         error = exc.errors()[0]
         name = ".".join((*prefix, *error_location(data, error))) or "state"
-        raise InvalidInputError(f"{name}: {refusal(error)}", name) from None
+        raise refused(name, refusal(error)) from None
 
 
 def error_location(data: Any, error: Mapping[str, Any]) -> list[str]:
@@ -379,10 +379,12 @@ def error_location(data: Any, error: Mapping[str, Any]) -> list[str]:
 
 
 def _registered(check, name: str):
-    """``check()``; an engine's or the registry's refusal as a refusal of field ``name``."""
+    """``check()``; an engine's or the registry's refusal as a refusal of field ``name`` (of
+    ``robot_parameters.l`` for the parameter ``l`` the registry names)."""
     try:
         return check()
     except InvalidInputError as exc:
-        raise InvalidInputError(
-            f"{name}: {exc}" if not str(exc).startswith(name) else str(exc), exc.field or name
-        ) from None
+        field = exc.field or name
+        if name.endswith("_parameters") and exc.field:
+            field = f"{name}.{exc.field}"
+        raise refused(field, without_field(str(exc), exc.field or name)) from None

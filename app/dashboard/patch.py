@@ -20,7 +20,7 @@ from ..compute.schemas import (
     USER_AUGMENTATION_MODELS,
     Coordinate,
 )
-from ..compute.schemas.wording import refusal
+from ..compute.schemas.wording import refusal, refused
 from .model import DashboardState, Point, error_location
 from .robots import USER_KINDS
 
@@ -94,7 +94,7 @@ def parse_patch(body: Any) -> dict[str, Any]:
     except ValidationError as exc:
         error = exc.errors()[0]
         field = ".".join(error_location(body, error)) or "body"
-        raise InvalidInputError(f"{field}: {refusal(error)}", field) from None
+        raise refused(field, refusal(error)) from None
 
 
 def patch_of(patch: BaseModel) -> dict[str, Any]:
@@ -108,5 +108,5 @@ def patch_of(patch: BaseModel) -> dict[str, Any]:
         try:
             controls[key] = TypeAdapter(kind).validate_python(value)
         except ValidationError as exc:
-            raise InvalidInputError(f"{key}: {refusal(exc.errors()[0])}", key) from None
+            raise refused(key, refusal(exc.errors()[0])) from None
     return {**patch.model_dump(exclude_unset=True), **controls}

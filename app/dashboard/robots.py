@@ -30,6 +30,7 @@ from ...engine.robot_kinds import KINDS
 from ...engine.robot_spec import Robot, robot_from_dict
 from ..compute.budget import build_seconds, time_budget
 from ..compute.exceptions import RequestError
+from ..compute.schemas.wording import refused
 from ..compute.worker import task
 from .algorithms import inverse_parameters
 
@@ -115,7 +116,7 @@ async def vet_definition(pool: Any, patch: Mapping[str, Any]) -> None:
     try:
         await pool.run(check_definition, dict(definition))
     except RequestError as exc:
-        raise InvalidInputError(f"{exc.field}: {exc.message}", exc.field) from None
+        raise refused(exc.field, exc.message) from None
 
 
 def state_robot(state, kin: Kinematics | None = None) -> Robot:

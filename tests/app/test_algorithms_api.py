@@ -62,7 +62,12 @@ def test_robots_list_every_algorithm(api):
     [
         ("damped", {"damping": -1.0}, ["algorithm_parameters", "damping"], "greater than or equal"),
         ("damped", {"gain": 1.0}, ["algorithm_parameters", "gain"], "unknown parameter(s)"),
-        ("posture", {"rest": [0.0, 1.0]}, ["algorithm_parameters", "rest"], "rest must have shape"),
+        (
+            "posture",
+            {"rest": [0.0, 1.0]},
+            ["algorithm_parameters", "rest"],
+            "rest: must have shape",
+        ),
         ("weighted", {"limits": [[1.0, 0.0]] * 3}, ["algorithm_parameters", "limits"], "lo < hi"),
         ("posture", {"speed": 1.0}, ["algorithm_parameters", "speed"], "unknown field"),
         ("newton", None, ["algorithm"], "Input should be"),
@@ -181,17 +186,17 @@ RRR_PATH = [[1.2, 1.0], [1.0, 1.2]]
 )
 def test_a_rest_outside_the_joint_limits_is_refused_naming_its_coordinate(api, route, body):
     """The engine's rule, one for every run: a robot with joint limits takes a rest within them
-    (422 at algorithm_parameters.rest.<i>, in the engine's words); a robot without limits
+    (422 at algorithm_parameters.rest[i], in the engine's words); a robot without limits
     takes any finite rest."""
     key = "algorithms" if route == "/atlas" else "algorithm"
     posture = {key: ["posture"] if route == "/atlas" else "posture"}
     bad = {**body, **posture, "robot": LIMITED, "algorithm_parameters": {"rest": [0, 2.5, 0]}}
     r = api.post(route, json=bad)
     assert messages(r) == [
-        "algorithm_parameters.rest.1: rest x2 must be at most 1.2 (the joint limits of the "
+        "algorithm_parameters.rest[1]: rest x2 must be at most 1.2 (the joint limits of the "
         "planar_chain), got 2.5"
     ]
-    assert r.json()["detail"][0]["loc"] == ["body", "algorithm_parameters", "rest", "1"]
+    assert r.json()["detail"][0]["loc"] == ["body", "algorithm_parameters", "rest", 1]
     free = {k: v for k, v in LIMITED.items() if k != "limits"}
     ok = api.post(route, json={**bad, "robot": free})
     assert ok.status_code in (200, 202), ok.text
@@ -240,7 +245,7 @@ def test_the_default_rest_at_a_start_outside_the_limits_runs(api):
     assert r.json()["algorithm_parameters"]["rest"] == x0
     assert r.json()["limits"]["violation"]["cycle"] == 0
     given = api.post("/repeatability", json={**body, "algorithm_parameters": {"rest": x0}})
-    assert messages(given)[0].startswith("algorithm_parameters.rest.0: rest x1 must be in")
+    assert messages(given)[0].startswith("algorithm_parameters.rest[0]: rest x1 must be in")
 
 
 def test_a_panda_rest_outside_its_limits_is_refused_by_solve(api):
@@ -252,7 +257,7 @@ def test_a_panda_rest_outside_its_limits_is_refused_by_solve(api):
     body = {"robot": {"name": "panda"}, "algorithm": "posture", "x0": home}
     body |= {"target": [0.3, 0.0, 0.5, 0.0, 0.0, 0.0], "algorithm_parameters": {"rest": rest}}
     assert messages(api.post("/solve", json=body)) == [
-        "algorithm_parameters.rest.3: rest x4 (panda_joint4) must be in [-3.0718, -0.0698] "
+        "algorithm_parameters.rest[3]: rest x4 (panda_joint4) must be in [-3.0718, -0.0698] "
         "(the joint limits of the panda), got 0"
     ]
 

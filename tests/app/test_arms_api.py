@@ -208,3 +208,38 @@ def test_a_planar_chain_with_limits_over_rest(api):
         },
     )
     assert bad.status_code == 422 and "robot.limits" in bad.text and "lower < upper" in bad.text
+
+
+XYZ = {"robot": {"name": "panda", "task": "xyz"}, "algorithm": "extended", "x0": HOME}
+XYZ["target"] = [0.3, 0.1, 0.5]
+
+
+def test_a_region_of_fewer_joints_than_p_minus_r_is_refused_at_the_region(api):
+    """The Panda's position task has p - r = 4: maps h_1..h_4 of x1 and x2 alone make [J; dh]
+    singular everywhere, which the region causes, not the start."""
+    region = {"x1": [-0.5, 0.5], "x2": [-0.5, 0.5]}
+    body = XYZ | {"augmentation": {"name": "e2_synthesized", "region": region}}
+    r = api.post("/solve", json=body)
+    (error,) = r.json()["detail"]
+    assert r.status_code == 422 and error["loc"] == ["body", "augmentation", "region"], r.text
+    assert error["msg"].startswith(
+        "augmentation.region: must vary at least p - r = 4 of the joints"
+    )
+
+
+def test_an_arm_without_a_map_for_its_task_is_told_the_map_that_works(api):
+    """The Panda (a catalogue arm, with its home) has a default map only for p = r + 1; for the
+    position task (p - r = 4) the message gives a map that works, and it does."""
+    r = api.post("/solve", json=XYZ)
+    (msg,) = [e["msg"] for e in r.json()["detail"]]
+    assert msg == (
+        "augmentation: the extended inverse needs p - r = 4 augmenting maps, and this panda "
+        "(p = 7, r = 3) has a default map only when p = r + 1: give {'name': 'e2_synthesized'} "
+        "(E2-optimal over all its joints, +-0.3 around its home) or {'name': 'formula', 'h': "
+        "[...]} (4 formulas, one per degree of redundancy)"
+    )
+    ok = api.post("/solve", json=XYZ | {"augmentation": {"name": "e2_synthesized"}})
+    assert ok.status_code == 200, ok.text
+    assert ok.json()["augmentation"]["definition"]["region"].keys() == {
+        f"x{i}" for i in range(1, 8)
+    }

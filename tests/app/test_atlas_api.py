@@ -169,7 +169,7 @@ def test_bad_or_too_large_requests_are_422_naming_the_field(client, over, field,
         (
             {"algorithms": ["damped", "posture"], "algorithm_parameters": {"rest": [0, 1]}},
             "rest",
-            "rest must have shape",
+            "rest: must have shape",
         ),
     ],
 )
@@ -397,3 +397,16 @@ def test_a_session_atlas_of_a_urdf_robot_does_not_send_its_text_back(client):
     assert period is not None and 6.0 < period < 7.0
     assert result["arc"][1] - result["arc"][0] == pytest.approx(period)
     assert all(0 <= s < period for s in result["parameter"]) and len(result["parameter"]) == 3
+
+
+def test_a_first_point_out_of_reach_is_refused_at_path(client):
+    """No reference given: a path whose first point Manipulator 2 reaches only outside its box
+    (x1 = 4.35 > 3) is refused at ``path``, in words, not at the default reference the user
+    never sent."""
+    r = client.post("/atlas", json={"robot": {"name": "manipulator2"}, "path": [[5, 5], [1, 1]]})
+    (error,) = r.json()["detail"]
+    assert r.status_code == 422 and error["loc"] == ["body", "path"], r.text
+    assert error["msg"] == (
+        "path: the path's first point (5, 5) is out of reach in the box (x_range, joint limits): "
+        "eq. (7) from the reference reaches it only where x1 = 4.34525 is not in [-3, 3]"
+    )

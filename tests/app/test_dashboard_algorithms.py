@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from jik.app.compute.schemas.wording import field_text
 from jik.app.dashboard.algorithms import COLORS, DEFAULT_ALGORITHMS, STYLES, cache_key, runs_key
 from jik.app.dashboard.atlas import atlas_request
 from jik.app.dashboard.controls import control_values, controls
@@ -362,7 +363,8 @@ def test_a_bad_rest_is_refused_naming_its_field(patch, field, words):
     with pytest.raises(InvalidInputError) as refused:
         updated_state(state, parse_patch(patch) if "." in next(iter(patch)) else patch)
     assert refused.value.field == field
-    assert str(refused.value).startswith(f"{field}: ") and words in str(refused.value)
+    # (the message writes the field as every message does: algorithm_parameters.rest[2])
+    assert str(refused.value).startswith(f"{field_text(field)}: ") and words in str(refused.value)
 
 
 def test_the_session_api_refuses_a_bad_rest_naming_it(client):
@@ -373,7 +375,8 @@ def test_the_session_api_refuses_a_bad_rest_naming_it(client):
     bad = client.post(url, json={f"{REST}.2": 9.0})
     assert bad.status_code == 422
     assert [d["msg"] for d in bad.json()["detail"]] == [
-        f"{REST}.2: rest x3 must be in [-3.14159, 6.28319] (the range of the rest's sliders), got 9"
+        f"{REST}[2]: rest x3 must be in [-3.14159, 6.28319] (the range of the rest's sliders), "
+        "got 9"
     ]
     junk = client.post(url, json={"algorithm_parameters": {"rest": {}}})  # (not a number list)
     assert [d["msg"] for d in junk.json()["detail"]] == [f"{REST}: Input should be a valid number"]
@@ -462,7 +465,7 @@ def test_a_rest_outside_a_chain_s_joint_limits_is_refused_in_the_engine_s_words(
     with pytest.raises(InvalidInputError) as refused:
         updated_state(state, {f"{REST}.1": 2.0})
     assert refused.value.field == f"{REST}.1" and engine.value.field == "rest.1"
-    assert str(refused.value) == f"{REST}.1: {engine.value}"
+    assert str(refused.value) == f"{REST}[1]: {engine.value}"
     assert "at most 1.2 (the joint limits of the planar_chain), got 2" in str(refused.value)
     outside = updated_state(state, {"x0": [1.5, 0.2, 0.3]})
     assert list(state_inverse(outside, "posture").rest) == [1.5, 0.2, 0.3]

@@ -60,7 +60,7 @@ def test_parameters_merge_and_augmentation_resets_its_parameters():
     [
         ({"gamma": 0}, "gamma: Input should be greater than or equal to 0.000001"),
         ({"mode": "discrete", "gamma": 2.5}, "gamma: must be < 2 in discrete mode"),
-        ({"x0": [1, 2]}, "x0 must have shape"),
+        ({"x0": [1, 2]}, "x0: must have shape"),
         ({"cycles": 0}, "cycles"),
         ({"robot_parameters": {"l": 99}}, "robot_parameters.l: Input should be less than or"),
         ({"augmentation": "nope"}, "unknown augmentation 'nope'"),

@@ -313,3 +313,38 @@ def test_an_overflow_at_the_start_is_called_an_overflow(api, path):
         "x0: the kinematics overflow at the start: k(x0) = (inf, 0.5), its Jacobian not "
         "finite; choose a start where both are finite (below about 1.8e308)"
     )
+
+
+@pytest.mark.parametrize("path", ["/solve", "/repeatability", "/atlas", "/kinematics"])
+@pytest.mark.parametrize("raw", [b"[1, 2, 3]", b"3", b'"robot"', b"true"])
+def test_a_body_that_is_no_json_object_says_so(api, path, raw):
+    """An array or a scalar has no robot to choose by: the body is named, not the robot."""
+    r = api.post(path, content=raw, headers={"content-type": "application/json"})
+    assert r.status_code == 422, r.text
+    assert r.json()["detail"] == [
+        {"loc": ["body"], "msg": "body: the body must be a JSON object", "type": "model_type"}
+    ]
+
+
+def test_a_refusal_names_its_field_once_and_as_every_message_does(api):
+    """The engine's ``lengths[1] must be positive`` and ``rest must have shape`` under the
+    request's field: the field is the message's prefix, not repeated after it; indices in
+    brackets (``algorithm_parameters.rest[1]``), ``loc`` as FastAPI's (an index a number)."""
+    chain = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, -0.8, 0.6]}
+    r = api.post(
+        "/solve",
+        json={"robot": chain, "algorithm": "pseudoinverse", "x0": X0_M2, "target": [1, 1]},
+    )
+    assert messages(r) == ["robot.lengths[1]: must be positive (a link's length), got -0.8"]
+    assert r.json()["detail"][0]["loc"] == ["body", "robot", "lengths", 1]
+    rest = {"rest": [0.0, 1.0]}
+    r = api.post("/solve", json=solve_body(algorithm="posture", algorithm_parameters=rest))
+    assert messages(r) == [
+        "algorithm_parameters.rest: must have shape (..., 3) (a vector of length 3), got shape (2,)"
+    ]
+    chain = {"name": "planar_chain", "joints": "RRR", "lengths": [1, 1, 1], "limits": [[-1, 1]] * 3}
+    rest = {"rest": [0.0, 2.0, 0.0]}
+    body = {"robot": chain, "algorithm": "posture", "x0": [0.1, 0.2, 0.3], "target": [1, 1]}
+    r = api.post("/solve", json={**body, "algorithm_parameters": rest})
+    assert messages(r)[0].startswith("algorithm_parameters.rest[1]: rest x2 must be")
+    assert r.json()["detail"][0]["loc"] == ["body", "algorithm_parameters", "rest", 1]

@@ -103,8 +103,8 @@ def test_a_start_off_the_path_s_first_point_is_named_by_its_index(client):
     r = client.post("/atlas", json=body)
     body["start_points"] = [off, HOME]
     r0 = client.post("/atlas", json=body)
-    assert r.json()["detail"][0]["loc"] == ["body", "start_points", "1"]
-    assert r0.json()["detail"][0]["loc"] == ["body", "start_points", "0"]
+    assert r.json()["detail"][0]["loc"] == ["body", "start_points", 1]
+    assert r0.json()["detail"][0]["loc"] == ["body", "start_points", 0]
     assert messages(r)[0].startswith("start_points[1]: is not on the self-motion manifold")
 
 

@@ -130,7 +130,7 @@ def test_a_rest_outside_the_box_is_refused_beside_its_slider(tabs):
     assert response.status == 422
     note = page.locator("#controls .field-error")
     expect(note).to_contain_text(
-        "algorithm_parameters.rest.2: rest x3 must be in [-3.14159, 6.28319]"
+        "algorithm_parameters.rest[2]: rest x3 must be in [-3.14159, 6.28319]"
     )
     assert "rest" not in tab.snapshot()["state"]["algorithm_parameters"]
 

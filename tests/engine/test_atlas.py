@@ -264,9 +264,9 @@ def test_cancelled_stops_between_chunks():
         ({"reference": (0.0, math.nan, 1.0)}, "reference", "NaN"),
         (
             {"box": [(-5.0, 5.0), (-5.0, 5.0), (2.0, 3.0)]},
-            "reference",
-            "lies outside the configuration box (the robot's x_range, an arm's joint limits): "
-            "x3 = 1.5708 is not in [2, 3]",
+            "path",
+            "the path's first point (0, 1) is out of reach in the box (x_range, joint limits): "
+            "eq. (7) from the reference reaches it only where x3 = 1.5708 is not in [2, 3]",
         ),
         ({"starts": [(0.0, 0.0, 1.0)]}, "starts", "not on the self-motion manifold"),
         ({"gamma": 0}, "gamma", "gamma must be > 0"),

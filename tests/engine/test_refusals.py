@@ -126,6 +126,20 @@ REFUSALS = {
         "reference",
     ),
     "plan_atlas no starts at all": (lambda: jik.plan_atlas(P, LOOP), "starts"),
+    "plan_atlas first point out of reach": (
+        lambda: jik.plan_atlas(
+            P, [(5, 5), (1, 1)], n_starts=4, arc=(-1, 1), reference=X0, box=[(-3, 3)] * 3
+        ),
+        "path",
+    ),
+    "make_inverse unknown parameter": (
+        lambda: jik.make_inverse(ARM, "damped", algorithm_parameters={"gain": 1, "zeta": 2}),
+        "gain",
+    ),
+    "make_inverse parameter out of range": (
+        lambda: jik.make_inverse(ARM, "damped", algorithm_parameters={"damping": -1}),
+        "damping",
+    ),
     "plan_atlas n_starts negative": (
         lambda: jik.plan_atlas(P, LOOP, n_starts=-4, arc=(-1, 1), reference=X0),
         "n_starts",

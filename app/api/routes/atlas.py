@@ -19,8 +19,10 @@ from ....engine.exceptions import InvalidInputError
 from ...compute.atlas_jobs import AtlasJob, AtlasJobs
 from ...compute.atlas_plan import AtlasLimits, plan_task
 from ...compute.atlas_schemas import AtlasBody, AtlasJobResponse
+from ...compute.exceptions import RequestError
 from ...compute.pool import ComputePool
 from ...compute.schemas import ErrorResponse
+from ...compute.schemas.wording import without_field
 from ..dependencies import Pool
 
 router = APIRouter(tags=["atlas"])
@@ -43,8 +45,11 @@ async def start_job(
     client = request.client.host if request.client else "unknown"
     jobs.check_room(client)  # (before the work)
     plan, refused = await pool.run(plan_task, req.model_dump_json(), jobs.limits)
-    if refused is not None:
-        raise InvalidInputError(*refused)
+    if refused is not None:  # (the engine's message and field)
+        message, field = refused
+        if field is None:
+            raise InvalidInputError(message)
+        raise RequestError(field, without_field(message, field))
     return await run_in_threadpool(jobs.start, client, req, plan, session)
 
 

@@ -18,10 +18,10 @@ from fastapi.responses import JSONResponse, StreamingResponse
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from starlette.concurrency import run_in_threadpool
 
-from ....engine.exceptions import InvalidInputError
 from ...compute.atlas_jobs import AtlasJobNotFound
 from ...compute.atlas_schemas import MAX_CYCLES, MAX_FAMILY, AtlasJobResponse, Scale
 from ...compute.schemas import INTEGRAL
+from ...compute.schemas.wording import refused
 from ...compute.user_robots import echo
 from ...dashboard.atlas import atlas_figure, atlas_request
 from ...dashboard.plotting import figure_json
@@ -70,7 +70,7 @@ async def start_session_atlas(
     except ValidationError as exc:
         error = exc.errors()[0]
         name = ".".join(str(p) for p in error["loc"]) or "state"
-        raise InvalidInputError(f"{name}: {error['msg']}", name) from None
+        raise refused(name, error["msg"]) from None
     job = await start_job(jobs, pool, request, req, session_id)
     response.headers["Location"] = f"/atlas/{job.id}"
     return jobs.response(job)

@@ -74,22 +74,13 @@ def parameters_of(inverse) -> dict[str, Any]:
     return out
 
 
-def field_of(exc_field: str | None, message: str) -> str:
-    """The request's field for an engine error about an algorithm's parameter; the start
-    ``x0``, which the posture inverse's default rest is, keeps its own name."""
-    if exc_field is not None and exc_field.split(".")[0] == "x0":
+def field_of(exc_field: str | None) -> str:
+    """The request's field for the field of an engine error about an algorithm's parameter
+    (:attr:`InvalidInputError.field <jik.engine.exceptions.InvalidInputError>`: ``gamma``,
+    ``rest.3``); the start ``x0``, which the posture inverse's default rest is, keeps its own
+    name."""
+    if exc_field is None:
+        return "algorithm_parameters"
+    if exc_field.split(".")[0] == "x0":
         return exc_field
-    for name in (exc_field, *ALGORITHM_PARAMETER_NAMES):
-        if name and (
-            name == exc_field or message.startswith(f"{name} ") or f"['{name}']" in message
-        ):
-            return f"algorithm_parameters.{name}"
-    return "algorithm_parameters"
-
-
-ALGORITHM_PARAMETER_NAMES = tuple(
-    dict.fromkeys(
-        [p.name for s in ALGORITHMS.values() for p in s.parameters]
-        + [v for s in ALGORITHMS.values() for v in s.vectors]
-    )
-)
+    return f"algorithm_parameters.{exc_field}"

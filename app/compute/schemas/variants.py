@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Union
 
-from pydantic import BaseModel, Discriminator, Field, Tag, create_model
+from pydantic import BaseModel, BeforeValidator, Discriminator, Field, Tag, create_model
+from pydantic_core import PydanticCustomError
 
 from ....engine.registry import ROBOTS
 from .robots import (
@@ -23,6 +24,18 @@ def _robot_name(body: Any) -> str | None:
     robot = body.get("robot") if isinstance(body, dict) else getattr(body, "robot", None)
     name = robot.get("name") if isinstance(robot, dict) else getattr(robot, "name", None)
     return name if isinstance(name, str) else None
+
+
+def _object(body: Any) -> Any:
+    """A body that is a JSON object (or a model), else the error that says so: an array or a
+    scalar has no robot to choose the variant by."""
+    if not isinstance(body, dict | BaseModel):
+        raise PydanticCustomError("model_type", "the body must be a JSON object")
+    return body
+
+
+#: Checks a body before its robot's variant is chosen (:func:`_object`).
+OBJECT_BODY = BeforeValidator(_object)
 
 
 def per_robot(base: type[BaseModel], fields: Any, user_robots: bool = True) -> Any:
@@ -72,6 +85,7 @@ def per_robot(base: type[BaseModel], fields: Any, user_robots: bool = True) -> A
             custom_error_message=f"give a robot whose name is one of {names}",
             custom_error_context={"names": str(names)},
         ),
+        OBJECT_BODY,
     ]
 
 

@@ -6,6 +6,8 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+from ....engine.exceptions import InvalidInputError
+
 
 def refusal(error: Mapping[str, Any]) -> str:
     """The message of one of pydantic's errors (``{"type", "msg", "ctx"}``), without its field."""
@@ -19,3 +21,41 @@ def refusal(error: Mapping[str, Any]) -> str:
         most = "at least" if kind == "too_short" else "at most"
         return f"give {most} {bound} {entries}, got {ctx.get('actual_length')}"
     return str(error.get("msg", "invalid"))
+
+
+def _parts(field: str) -> list[str]:
+    """The names and indices of a field's path, in either notation (``rest.3``, ``x0[1]``)."""
+    return [p for p in field.replace("[", ".").replace("]", "").split(".") if p]
+
+
+def field_text(field: str) -> str:
+    """A field's path as every message writes it: names joined by dots, indices in brackets
+    (``algorithm_parameters.rest.3`` -> ``algorithm_parameters.rest[3]``)."""
+    out: list[str] = []
+    for part in _parts(field):
+        if part.isdigit() and out:
+            out[-1] += f"[{part}]"
+        else:
+            out.append(part)
+    return ".".join(out)
+
+
+def field_loc(field: str) -> list[str | int]:
+    """A field's path as FastAPI's ``loc`` of a body field: ``["body", "rest", 3]``."""
+    return ["body", *(int(p) if p.isdigit() else p for p in _parts(field))]
+
+
+def without_field(text: str, field: str | None) -> str:
+    """An engine message without its leading mention of ``field`` (``lengths[1] must be ...``
+    -> ``must be ...``): the error's prefix names the field, in the request's words."""
+    if field:
+        for name in dict.fromkeys((field, field_text(field))):
+            if text.startswith(name) and text[len(name) : len(name) + 1] in (":", " "):
+                return text[len(name) :].lstrip(":").lstrip()
+    return text
+
+
+def refused(field: str, problem: str) -> InvalidInputError:
+    """The error of a value refused at ``field`` (its path as data, dotted: ``x0.1``), its
+    message ``<field>: <problem>`` naming it as every message does (:func:`field_text`)."""
+    return InvalidInputError(f"{field_text(field)}: {problem}", field)
