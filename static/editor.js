@@ -143,7 +143,9 @@ export function robotEditor(kinds, send) {
       if (!entry) { note.textContent = `not applied: ${message}`; return true; }
       note.textContent = `not applied: see the field ${name}`;
       entry[2].hidden = false;
-      entry[2].textContent = message.startsWith(`${field}: `) ? message.slice(field.length + 2) : message;
+      // (the message names the field under the definition: "robot_definition.lengths[1]: ...")
+      const own = message.startsWith("robot_definition.");
+      entry[2].textContent = own ? message.slice("robot_definition.".length) : message;
       entry[0].setAttribute("aria-invalid", "true");
       entry[0].scrollIntoView({ block: "nearest" });
       return true;

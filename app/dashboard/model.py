@@ -30,7 +30,7 @@ from ..compute.schemas import (
     Tolerance,
 )
 from ..compute.schemas.algorithms import Algorithm
-from ..compute.schemas.wording import refusal, refused, without_field
+from ..compute.schemas.wording import field_text, refusal, refused, without_field
 from .algorithms import CHOICES, DEFAULT_ALGORITHMS, check_inverses, checked, checked_rest
 from .algorithms import COLORS as COLORS  # (re-exported: one table, there)
 from .algorithms import DASH as DASH
@@ -183,7 +183,7 @@ def _user_default_state(robot: str, definition: Mapping[str, Any] | None) -> Das
         # Defaults the robot computes (its target k(x0), its path) outside the dashboard's
         # ranges: the definition is what the user can change.
         first = exc.errors()[0]
-        where = ".".join(str(p) for p in first["loc"])
+        where = field_text(".".join(str(p) for p in first["loc"]))
         raise InvalidInputError(
             f"robot_definition: the robot's default {where} is refused by the dashboard "
             f"({first['msg']}); change the definition (its start x0 or its parameters)",

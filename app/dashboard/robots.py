@@ -30,7 +30,7 @@ from ...engine.robot_kinds import KINDS
 from ...engine.robot_spec import Robot, robot_from_dict
 from ..compute.budget import build_seconds, time_budget
 from ..compute.exceptions import RequestError
-from ..compute.schemas.wording import refused
+from ..compute.schemas.wording import refused, without_field
 from ..compute.worker import task
 from .algorithms import inverse_parameters
 
@@ -72,10 +72,7 @@ def user_robot(definition: Mapping[str, Any]) -> Robot:
         return _built(json.dumps(dict(definition), sort_keys=True))
     except InvalidInputError as exc:
         field = f"robot_definition.{exc.field}" if exc.field else "robot_definition"
-        text = str(exc)
-        raise InvalidInputError(
-            f"{field}: {text}" if not text.startswith(field) else text, field
-        ) from None
+        raise refused(field, without_field(str(exc), exc.field)) from None
 
 
 @task("robot_definition", "shorter formulas or fewer nested functions")
@@ -89,14 +86,14 @@ def check_definition(definition: Mapping[str, Any]) -> None:
             kinematics = user_robot(definition).kinematics
         except InvalidInputError as exc:
             field = exc.field or "robot_definition"
-            raise RequestError(field, str(exc).removeprefix(f"{field}: ")) from None
+            raise RequestError(field, without_field(str(exc), field)) from None
         try:
             hessian = getattr(kinematics, "hessian", None)
             if hessian is not None:
                 hessian(np.zeros((1, kinematics.p)))
         except InvalidInputError as exc:
             field = "robot_definition" + (f".{exc.field}" if exc.field else "")
-            raise RequestError(field, str(exc).removeprefix(f"{exc.field}: ")) from None
+            raise RequestError(field, without_field(str(exc), exc.field)) from None
 
 
 async def vet_definition(pool: Any, patch: Mapping[str, Any]) -> None:

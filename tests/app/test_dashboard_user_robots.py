@@ -88,7 +88,7 @@ def test_a_definition_is_state_with_its_defaults_and_a_map():
                 },
             },
             "robot_definition",
-            "the robot's default target.0 is refused by the dashboard",
+            "the robot's default target[0] is refused by the dashboard",
         ),
     ],
 )

@@ -92,7 +92,7 @@ def test_a_refused_definition_keeps_what_was_typed(tabs):
     page.fill("#robot-field-title", "my arm")
     assert tab.posting(lambda: page.click("#robot-apply")).status == 422
     expect(page.locator("#robot-field-lengths-error")).to_contain_text(
-        "lengths[1] must be positive (a link's length), got -0.8"
+        "lengths[1]: must be positive (a link's length), got -0.8"
     )
     expect(page.locator("#robot-field-lengths")).to_have_value("1, -0.8, 0.6")
     expect(page.locator("#robot-field-title")).to_have_value("my arm")
@@ -108,7 +108,7 @@ def test_a_refused_definition_keeps_what_was_typed(tabs):
     page.fill("#robot-field-title", "by formula")
     assert tab.posting(lambda: page.click("#robot-apply")).status == 422
     expect(page.locator("#robot-field-task-error")).to_have_text(
-        "task.0: expected a number, a name or '(' at position 3"
+        "task[0]: expected a number, a name or '(' at position 3"
     )
     expect(page.locator("#robot-field-task-error")).to_be_visible()
     expect(page.locator("#robot-kind")).to_have_value("formula")
