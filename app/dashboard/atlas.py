@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from ...engine.exceptions import InvalidInputError
-from ...engine.registry import ROBOTS
+from ...engine.registry import ROBOTS, RobotSpec
 from ...engine.self_motion import manifold_starts
 from ..compute.atlas_schemas import AtlasRequest
 from .algorithms import STYLES, inverse_parameters
@@ -212,9 +212,11 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
                 },
             }
         )
-    spec = ROBOTS.get(request.robot.name)  # (a job of POST /atlas may leave them to the robot)
-    gamma = request.gamma if spec is None or request.gamma is not None else spec.default_gamma
-    mode = request.mode or (spec.default_mode if spec is not None else "continuous")
+    # (a job of POST /atlas may leave them to the robot: a robot the request defines has
+    # RobotSpec's defaults, as its build gives them)
+    spec = ROBOTS.get(request.robot.name)
+    gamma = request.gamma if request.gamma is not None else (spec or RobotSpec).default_gamma
+    mode = request.mode or (spec or RobotSpec).default_mode
     title = (
         f"Drift after each cycle from {N} starts on k(x) = k(x0) (dotted: x0), "
         f"{request.robot.name}, γ = {gamma:g}, {mode} mode"

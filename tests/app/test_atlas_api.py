@@ -295,6 +295,18 @@ def test_a_session_reads_a_job_that_left_gamma_and_mode_to_the_robot(client):
     assert "γ = 1, continuous mode" in r.json()["figure"]["layout"]["title"]["text"]
 
 
+def test_a_session_reads_a_job_of_a_user_robot_that_left_gamma_to_it(client):
+    """The same for a robot the request defines: its build's defaults (a 500 before, found by
+    schemathesis posting the document's example of a planar chain's atlas)."""
+    sid = _session(client)
+    robot = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]}
+    job = client.post("/atlas", json={"robot": robot, "starts": 4, "cycles": 1}).json()["id"]
+    assert wait_until_ended(client, job)["status"] == "done"
+    r = client.get(f"/api/sessions/{sid}/atlas/{job}")
+    assert r.status_code == 200, r.text
+    assert "γ = 1, continuous mode" in r.json()["figure"]["layout"]["title"]["text"]
+
+
 def test_an_atlas_takes_every_robot_and_refuses_a_bad_one_naming_the_field(client):
     """The document offers /atlas the catalogue's robots, its arms and the robots a request
     defines: a URDF robot without links is a 422 naming the robot, not a 500

@@ -37,7 +37,9 @@ _NOT_FOUND: dict[int | str, dict] = {404: {"description": "no such session or at
 class SessionAtlas(BaseModel):
     """The atlas of the session's current state: how many starts and cycles, which scales."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(
+        extra="forbid", json_schema_extra={"examples": [{"starts": 16, "scales": [1.0, 0.5]}]}
+    )
 
     starts: Annotated[int, Field(strict=True, ge=2, le=MAX_PANEL_STARTS), INTEGRAL] = 256
     cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_CYCLES), INTEGRAL] | None = Field(
