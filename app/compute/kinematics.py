@@ -31,6 +31,10 @@ MAX_CONFIGURATIONS = 1000
 Configuration = Annotated[list[S.Coordinate], Field(min_length=1, max_length=S.MAX_DIMENSION)]
 
 
+def _many(one: Any) -> Any:
+    return Annotated[list[one], Field(min_length=1, max_length=MAX_CONFIGURATIONS)]
+
+
 class KinematicsRequest(BaseModel):
     """k(x) and J(x) of a robot at x: one configuration, or a list of them."""
 
@@ -39,7 +43,7 @@ class KinematicsRequest(BaseModel):
     robot: S.AnyRobot = Field(
         description="the robot, as for /solve: e.g. {'name': 'panda', 'task': 'pose'}"
     )
-    x: one_or_many(Configuration, MAX_CONFIGURATIONS) = Field(  # type: ignore[valid-type]
+    x: one_or_many(Configuration, _many(Configuration)) = Field(  # type: ignore[valid-type]
         description=f"one configuration (p numbers) or a list of 1 to {MAX_CONFIGURATIONS}"
     )
 
@@ -49,7 +53,7 @@ def _points(p: int | None) -> Any:
     built), or a list of them."""
     one = Annotated[list[S.Coordinate], Field(min_length=p or 1, max_length=p or S.MAX_DIMENSION)]
     return (
-        one_or_many(one, MAX_CONFIGURATIONS),
+        one_or_many(one, _many(one)),
         Field(
             description=f"one configuration ({p or 'p'} numbers) or a list of 1 to "
             f"{MAX_CONFIGURATIONS}"

@@ -101,3 +101,21 @@ def test_one_or_many_configurations_is_refused_once_for_the_shape_given(api, rob
     (error,) = r.json()["detail"]
     assert error["msg"].startswith(message), error
     assert error["loc"] == (["body", "x", 1] if message.startswith("x[1]") else ["body", "x"])
+
+
+@pytest.mark.parametrize(
+    ("reference", "message"),
+    [
+        ([1.0, 2.0], "robot.reference: give at least 3 entries, got 2"),
+        ([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], "robot.reference: give at least 3 entries, got 2"),
+        ([[1.0, 0.0, 0.0], [0.0, 1.0]] + [[0.0] * 3], "robot.reference[1]: give at least 3"),
+        ([0.0] * 5, "robot.reference: give at most 4 entries, got 5"),
+    ],
+)
+def test_an_arms_reference_is_refused_once_for_the_shape_given(api, reference, message):
+    """R0 is a rotation vector or quaternion (numbers) or a matrix (rows): one refusal."""
+    robot = {"name": "panda", "reference": reference}
+    r = api.post("/kinematics", json={"robot": robot, "x": HOME})
+    assert r.status_code == 422, r.text
+    (error,) = r.json()["detail"]
+    assert error["msg"].startswith(message), error

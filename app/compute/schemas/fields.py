@@ -66,11 +66,10 @@ def _shape(value: Any) -> str:
     return MANY if isinstance(value, list) and value and isinstance(value[0], list) else ONE
 
 
-def one_or_many(one: Any, most: int) -> Any:
-    """``one`` (a list of numbers) or a list of 1 to ``most`` of them, told apart by the value's
+def one_or_many(one: Any, many: Any) -> Any:
+    """``one`` (a list of numbers) or ``many`` (a list of such lists), told apart by the value's
     shape before either is checked: a refusal is the one of the shape the request gave, once
     per field (a plain union reports both members' refusals)."""
-    many = Annotated[list[one], Field(min_length=1, max_length=most)]
     return Annotated[
         Union[Annotated[one, Tag(ONE)], Annotated[many, Tag(MANY)]],  # noqa: UP007
         Discriminator(_shape),
