@@ -32,9 +32,9 @@ ALGORITHMS_ROBOT = "manipulator2"
 
 
 @functools.cache
-def _robot(name: str) -> tuple[dict[str, Any], RobotSpec]:
+def _robot(name: str) -> tuple[dict[str, Any], RobotSpec, Any]:
     """The robot ``name`` (a catalogue robot, arm or kind of user robot) as a request gives it,
-    and its spec (a user robot's as its build makes it)."""
+    its spec (a user robot's as its build makes it) and its kinematics."""
     from ....engine import robot_kinds
     from ....engine.robot_spec import robot_from_dict
 
@@ -43,7 +43,7 @@ def _robot(name: str) -> tuple[dict[str, Any], RobotSpec]:
         robot: dict[str, Any] = {"name": name}
         robot |= {p.name: p.default for p in spec.parameters}
         robot |= {v.name: list(v.default) for v in spec.vector_parameters}
-        return robot, spec
+        return robot, spec, spec.build(**{k: v for k, v in robot.items() if k != "name"})
     if name in ARMS:
         robot = {"name": name, "task": ARMS[name].task}
     elif name == "urdf":
@@ -51,7 +51,8 @@ def _robot(name: str) -> tuple[dict[str, Any], RobotSpec]:
     else:
         fields = robot_kinds.KINDS[name]
         robot = {"name": name, **{f.name: f.example for f in fields if f.example is not None}}
-    return robot, robot_from_dict(robot).spec
+    built = robot_from_dict(robot)
+    return robot, built.spec, built.kinematics
 
 
 def _map(name: str, spec: RobotSpec) -> dict[str, Any]:
@@ -62,13 +63,10 @@ def _map(name: str, spec: RobotSpec) -> dict[str, Any]:
     return {"name": "formula", "h": spec.variable_names[-1]}
 
 
-def _loop(robot: dict[str, Any], spec: RobotSpec) -> list[list[float]]:
+def _loop(name: str) -> list[list[float]]:
     """An atlas's loop as the dashboard drives it: from k(x0) through the robot's closed path
     (its starts then lie on the self-motion curve through x0, the default reference)."""
-    from ....engine.robot_spec import robot_from_dict
-
-    name, values = robot["name"], {k: v for k, v in robot.items() if k != "name"}
-    kin = spec.build(**values) if name in ROBOTS else robot_from_dict(robot).kinematics
+    _, spec, kin = _robot(name)
     home = kin.forward(np.asarray(spec.default_x0, dtype=float))
     path = [list(point) for point in spec.default_path]
     return path if np.allclose(home, path[0]) else [home.tolist(), *path]
@@ -78,7 +76,7 @@ def _loop(robot: dict[str, Any], spec: RobotSpec) -> list[list[float]]:
 def example(route: str, name: str) -> dict[str, Any]:
     """A body of ``route`` (one of :data:`ROUTES`) for the robot ``name`` that the server
     accepts: the robot's defaults, the route's other fields left at theirs."""
-    robot, spec = _robot(name)
+    robot, spec, _ = _robot(name)
     x0 = list(spec.default_x0)
     path = [list(point) for point in spec.default_path]
     if route == "solve":
@@ -91,7 +89,7 @@ def example(route: str, name: str) -> dict[str, Any]:
     if route == "kinematics":
         return {"robot": robot, "x": x0}
     if route == "atlas":
-        return {"robot": robot, "path": _loop(robot, spec), "starts": ATLAS_STARTS}
+        return {"robot": robot, "path": _loop(name), "starts": ATLAS_STARTS}
     raise ValueError(f"no example for route {route!r}; one of {ROUTES}")
 
 
