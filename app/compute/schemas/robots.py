@@ -15,6 +15,7 @@ from pydantic import BaseModel, ConfigDict, Field, create_model
 
 from ....engine.arms import ARMS, Arm
 from ....engine.registry import ROBOTS, AugmentationSpec, RobotSpec
+from ....engine.units import RobotUnits
 from .fields import (
     INTEGRAL,
     MAX_DIMENSION,
@@ -355,6 +356,22 @@ class AugmentationUsed(BaseModel):
     )
 
 
+class UnitsInfo(BaseModel):
+    """The units of the response's configurations x and task points y (k(x), targets)."""
+
+    x: list[str] = Field(
+        description="each joint variable's unit, in x's order: rad, m, 1 (dimensionless), "
+        "m/s, rad/s; '' where the robot states none (a formula robot)"
+    )
+    y: list[str] = Field(description="each task coordinate's unit, in k(x)'s order")
+    lengths: str = Field(description="what the robot's length unit m stands for")
+
+    @classmethod
+    def of(cls, units: RobotUnits) -> UnitsInfo:
+        """The engine's description of a robot's units, as a response says them."""
+        return cls(x=list(units.x), y=list(units.y), lengths=units.lengths)
+
+
 class RobotUsed(BaseModel):
     """The robot a run used, with every parameter (defaults filled in)."""
 
@@ -373,3 +390,4 @@ class RobotUsed(BaseModel):
         exclude_if=_absent,
         description="what was skipped while building the robot (a URDF's mesh references)",
     )
+    units: UnitsInfo = Field(description="the units of x and y")
