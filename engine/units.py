@@ -119,6 +119,11 @@ class RobotUnits:
         """The unit of each task coordinate, (r,)."""
         return tuple(c.unit for c in self.task)
 
+    def summary(self) -> dict:
+        """``{"x": units of x, "y": units of y, "lengths": ...}``, JSON-friendly: what a run's
+        document says of its configurations x and task points y."""
+        return {"x": list(self.x), "y": list(self.y), "lengths": self.lengths}
+
     def as_dict(self) -> dict:
         """``{"variables": [...], "task": [...], "lengths": ...}``, JSON-friendly."""
         return {

@@ -125,7 +125,7 @@ def build_robot(req_robot) -> tuple[RobotSpec, Any, S.RobotUsed]:
         k: [float(t) for t in v] if isinstance(v, tuple | list) else float(v)
         for k, v in params.items()
     }
-    units = S.UnitsInfo.of(robot_units(kin, spec.task_names))
+    units = S.UnitsInfo(**robot_units(kin, spec.task_names).summary())
     return spec, kin, S.RobotUsed(name=spec.name, parameters=used, units=units)
 
 

@@ -113,3 +113,9 @@ def test_robot_units_of_bare_kinematics_name_the_task_itself():
     assert [c.name for c in units.task] == ["y1", "y2"] and units.y == ("m", "m")
     chain = robot_units(jik.PlanarChain("PRR", [1.0, 1.0, 1.0]))
     assert chain.x == ("m", "rad", "rad") and chain.y == ("m", "m")
+
+
+def test_a_runs_summary_says_the_units_of_x_and_y():
+    summary = jik.robot_from_dict({"name": "manipulator1"}).units.summary()
+    assert summary["x"] == ["m", "m", "1"] and summary["y"] == ["m", "m"]
+    assert summary["lengths"].startswith("the paper states no unit")

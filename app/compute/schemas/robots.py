@@ -15,7 +15,6 @@ from pydantic import BaseModel, ConfigDict, Field, create_model
 
 from ....engine.arms import ARMS, Arm
 from ....engine.registry import ROBOTS, AugmentationSpec, RobotSpec
-from ....engine.units import RobotUnits
 from .fields import (
     INTEGRAL,
     MAX_DIMENSION,
@@ -357,7 +356,8 @@ class AugmentationUsed(BaseModel):
 
 
 class UnitsInfo(BaseModel):
-    """The units of the response's configurations x and task points y (k(x), targets)."""
+    """The units of the response's configurations x and task points y (k(x), targets):
+    :meth:`jik.engine.units.RobotUnits.summary`."""
 
     x: list[str] = Field(
         description="each joint variable's unit, in x's order: rad, m, 1 (dimensionless), "
@@ -365,11 +365,6 @@ class UnitsInfo(BaseModel):
     )
     y: list[str] = Field(description="each task coordinate's unit, in k(x)'s order")
     lengths: str = Field(description="what the robot's length unit m stands for")
-
-    @classmethod
-    def of(cls, units: RobotUnits) -> UnitsInfo:
-        """The engine's description of a robot's units, as a response says them."""
-        return cls(x=list(units.x), y=list(units.y), lengths=units.lengths)
 
 
 class RobotUsed(BaseModel):
