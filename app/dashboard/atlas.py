@@ -25,7 +25,7 @@ from ..compute.atlas_schemas import AtlasRequest
 from .algorithms import STYLES, inverse_parameters
 from .analysis import kinematics_and_map
 from .model import DashboardState
-from .plotting import AXIS, UNITS, figure, norm_unit
+from .plotting import AXIS, figure, norm_unit
 from .robots import state_spec, user_robot
 
 #: Drift below this is drawn as this (the extended Jacobian's drift is round-off, ~1e-13).
@@ -102,16 +102,18 @@ def request_robot(state: DashboardState) -> tuple[dict, dict | None]:
     return definition, None if chosen is None else {k: v for k, v in chosen.items() if k != "label"}
 
 
-def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
+def atlas_figure(
+    result: dict[str, Any], request: AtlasRequest, x_units: Sequence[str] = ()
+) -> dict:
     """The heatmap of a finished atlas (the ``result`` of ``GET /atlas/{id}``): for each
     algorithm, log10 of the drift ||x after cycle c - x0|| over the starts' arc length s
     (columns) and the cycles (rows; per path scale when several), one colour scale for both.
-    A cell's ``customdata`` is its run, path * N + start (for a click)."""
+    A cell's ``customdata`` is its run, path * N + start (for a click); ``x_units``, the
+    units of x (the job's ``robot.units.x``), give the arc length's."""
     algorithms = result["algorithms"]
     s = np.asarray(result["parameter"], dtype=float)  # (N,)
     scales = request.scales or [1.0]
-    joint = UNITS.get(request.robot.name, ((), ()))[0]
-    unit = norm_unit(joint)
+    unit = norm_unit(x_units)
     x_title, hover, at_x0 = f"arc length s of the start {unit}", "s = %{x:.3f}", 0.0
     if result.get("period") is not None:  # (a closed curve: the starts cover one turn)
         x_title = f"arc length s of the start {unit}, one turn of {result['period']:.4g}"

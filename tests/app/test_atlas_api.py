@@ -232,6 +232,8 @@ def test_a_session_atlas_is_the_atlas_of_its_state(client):
     np.testing.assert_allclose(
         kin.forward(starts), np.broadcast_to([0.0, 1.0], (2, 5, 2)), atol=1e-9
     )
+    x_title = body["figure"]["layout"]["xaxis"]["title"]["text"]
+    assert x_title.startswith("arc length s of the start [m and rad mixed]")  # (the job's units)
     heat = body["figure"]["data"]
     assert [t["type"] for t in heat] == ["heatmap", "heatmap"]
     assert heat[0]["y"] == ["×1, cycle 1", "×1, cycle 2", "×0.5, cycle 1", "×0.5, cycle 2"]

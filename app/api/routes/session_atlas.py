@@ -86,7 +86,8 @@ async def read_session_atlas(session_id: str, job_id: str, store: Store, jobs: J
     job = jobs.get(job_id)
     body = jobs.response(job).model_dump(mode="json", exclude={"result"})
     if job.status == "done" and job.result is not None and job.request is not None:
-        figure = await run_in_threadpool(atlas_figure, job.result, job.request)
+        x_units = job.used[0].units.x if job.used else ()
+        figure = await run_in_threadpool(atlas_figure, job.result, job.request, x_units)
         body.update(
             figure=json.loads(figure_json(figure)),
             starts=job.result["starts"],

@@ -358,6 +358,18 @@ class AugmentationUsed(BaseModel):
     )
 
 
+class UnitsInfo(BaseModel):
+    """The units of the response's configurations x and task points y (k(x), targets):
+    :meth:`jik.engine.units.RobotUnits.summary`."""
+
+    x: list[str] = Field(
+        description="each joint variable's unit, in x's order: rad, m, 1 (dimensionless), "
+        "m/s, rad/s; '' where the robot states none (a formula robot)"
+    )
+    y: list[str] = Field(description="each task coordinate's unit, in k(x)'s order")
+    lengths: str = Field(description="what the robot's length unit m stands for")
+
+
 class RobotUsed(BaseModel):
     """The robot a run used, with every parameter (defaults filled in)."""
 
@@ -376,3 +388,4 @@ class RobotUsed(BaseModel):
         exclude_if=_absent,
         description="what was skipped while building the robot (a URDF's mesh references)",
     )
+    units: UnitsInfo = Field(description="the units of x and y")
