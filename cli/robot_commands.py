@@ -140,12 +140,14 @@ def _inverse(robot, args: argparse.Namespace, x0):
 
 def _document(robot, result, report, as_json: bool) -> None:
     """The result in the engine's names (``as_dict()``: x0, y_d or targets, x, legs, ...) with
-    the robot, its limits' report and notes; printed as JSON, or its first lines as text."""
+    the robot, its limits' report, notes and the units of x and y; printed as JSON, or its
+    first lines as text."""
     out = {
         "robot": robot.spec.title,
         **result.as_dict(),
         **({} if report is None else {"limits": report.as_dict()}),
         **_notes(robot),
+        "units": robot.units.summary(),
     }
     if as_json:
         print(json.dumps(out))

@@ -23,6 +23,7 @@ Robots (kinematics k: R^p -> R^r, eq. (4))
     Robot, Kinematics, ROBOTS   a built robot; the base class; the built-in catalogue
     ARMS                        real arms (panda, iiwa14, gen3, ur5e): {"name": "panda"}
     LimitsReport                whether a run stayed within the joint limits (Robot.limits_report)
+    RobotUnits, robot_units     the units of x and y, joint names, limits, home (Robot.units)
 Augmenting maps h (eq. (9))
     PaperCubic                  the paper's cubic (38) for Manipulator 2
     E1Optimal, E2Optimal        Manipulator 1's optimal maps, eqs. (32) and (36)
@@ -96,6 +97,8 @@ _EXPORTS = {
     "ROBOTS": "registry",
     "ARMS": "arms",
     "LimitsReport": "limits",
+    "RobotUnits": "units",
+    "robot_units": "units",
     # augmenting maps
     "AugmentingMap": "augmentations",
     "PaperCubic": "augmentations",
@@ -191,6 +194,7 @@ __all__ = [
     "RepeatabilityResult",
     "Resume",
     "Robot",
+    "RobotUnits",
     "RunCancelled",
     "SingularConfigurationError",
     "SolveResult",
@@ -212,6 +216,7 @@ __all__ = [
     "plan_atlas",
     "repeatability",
     "robot_from_dict",
+    "robot_units",
     "run_atlas",
     "solve",
     "solve_batch",
@@ -286,5 +291,6 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
     from .solver import solve, solve_batch
     from .synthesis_nd import TotalDegreeSynthesis, synthesize_e2_nd
     from .unicycle import Unicycle
+    from .units import RobotUnits, robot_units
     from .urdf import UrdfChain
     from .variational import SynthesisResult, synthesize_e2

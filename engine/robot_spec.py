@@ -50,6 +50,7 @@ from .registry import ROBOTS, RobotSpec, make_inverse
 from .repeatability import MAX_PATH_POINTS
 from .robot_augmentations import augmentations_from_dict
 from .robot_synthesis import arm_augmentations
+from .units import RobotUnits, robot_units
 from .validation import as_points
 
 #: Largest robot file read by :func:`load_robot` [bytes].
@@ -90,6 +91,12 @@ class Robot:
             task=" ".join(spec.task_names),
             maps=tuple(a.name for a in spec.augmentations) + tuple(self.map_vectors),
         )
+
+    @property
+    def units(self) -> RobotUnits:
+        """Its joint variables and task coordinates with their units (:mod:`jik.engine.units`),
+        a URDF arm's joint names and home, and the joint limits where it has them."""
+        return robot_units(self.kinematics, self.spec.task_names)
 
     def limits_report(self, result) -> LimitsReport | None:
         """Whether a run of this robot (a solve's or a single start's repeatability result)

@@ -65,6 +65,7 @@ def test_json_outputs_are_the_engine_results_dicts(capsys):
     engine = json.loads(json.dumps(solve(inverse, x0, [1, 1]).as_dict()))
     printed = json.loads(out)
     assert "target" not in printed and printed["robot"] == "Manipulator 2"
+    assert printed["units"]["x"] == ["m", "m", "rad"] and printed["units"]["y"] == ["m", "m"]
     assert {k: printed[k] for k in engine} == pytest.approx(engine, abs=1e-12)
     out, _ = run(capsys, "repeatability", "--robot", "manipulator2", "--cycles", "2", "--json")
     path = [(1, 1), (1, 2), (0, 2), (0, 1)]
@@ -150,6 +151,7 @@ def test_a_catalogue_arms_task_is_an_option(capsys, tmp_path, arm_file):
     result = json.loads(out)
     assert result["success"] and len(result["y"]) == 3
     np.testing.assert_allclose(result["y"], [0.4, 0.1, 0.5], atol=1e-9)
+    assert (result["units"]["x"], result["units"]["y"]) == (["rad"] * 7, ["m", "m", "m"])
     for robot in (arm_file, "manipulator2"):
         _, err = run(capsys, "repeatability", "--robot", robot, "--task", "xyz", code=2)
         assert "--task is for a catalogue arm" in err

@@ -5,29 +5,32 @@ from __future__ import annotations
 import functools
 
 from ...engine.arms import ARMS
-from ...engine.registry import ALGORITHMS, ROBOTS, RobotSpec
+from ...engine.registry import ALGORITHMS, ROBOTS
 from ...engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
-from ...engine.robot_spec import robot_from_dict
+from ...engine.robot_spec import Robot, robot_from_dict
 from . import schemas as S
 from .settings import settings_from_env
 
 
 @functools.cache
-def _arm_specs() -> tuple[RobotSpec, ...]:
-    """The catalogue arms with their default tasks (each built once: a URDF parse)."""
-    return tuple(robot_from_dict({"name": name}).spec for name in ARMS)
+def _robots() -> tuple[Robot, ...]:
+    """The paper's robots with their default parameters, then the catalogue arms with their
+    default tasks (each built once: a URDF parse)."""
+    return tuple(robot_from_dict({"name": name}) for name in (*ROBOTS, *ARMS))
 
 
 def robots_response(timeout: float | None = None) -> S.RobotsResponse:
-    """The catalogue: every robot with p, r, parameters, defaults and augmentations, then the
-    catalogue arms (``{"name": "panda"}``; ``task`` and ``reference`` change their r)."""
+    """The catalogue: every robot with p, r, parameters, defaults, augmentations, its variables
+    and task coordinates with their units (:mod:`jik.engine.units`), then the catalogue arms
+    (``{"name": "panda"}``; ``task`` and ``reference`` change their r)."""
     robots = [
         S.RobotInfo(
-            **spec.as_dict(),
+            **robot.spec.as_dict(),
+            **robot.units.as_dict(),
             algorithms=list(S.Algorithm.__args__),  # type: ignore[attr-defined]
             modes=["continuous", "discrete"],
         )
-        for spec in (*ROBOTS.values(), *_arm_specs())
+        for robot in _robots()
     ]
     limits = S.Limits(
         max_cycles=MAX_CYCLES,

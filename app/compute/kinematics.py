@@ -19,6 +19,8 @@ from . import schemas as S
 from .documents import nullable
 from .exceptions import RequestError
 from .robot_requests import request_robot
+from .schemas.examples import schema_examples
+from .schemas.fields import one_or_many
 from .schemas.robots import _camel
 from .schemas.variants import OBJECT_BODY, _robot_name
 from .worker import task
@@ -29,28 +31,21 @@ MAX_CONFIGURATIONS = 1000
 Configuration = Annotated[list[S.Coordinate], Field(min_length=1, max_length=S.MAX_DIMENSION)]
 
 
+def _many(one: Any) -> Any:
+    return Annotated[list[one], Field(min_length=1, max_length=MAX_CONFIGURATIONS)]
+
+
 class KinematicsRequest(BaseModel):
     """k(x) and J(x) of a robot at x: one configuration, or a list of them."""
 
-    model_config = ConfigDict(
-        extra="forbid",
-        json_schema_extra={
-            "examples": [
-                {
-                    "robot": {"name": "panda", "task": "pose"},
-                    "x": [0, -0.785, 0, -2.356, 0, 1.571, 0.785],
-                }
-            ]
-        },
-    )
+    model_config = ConfigDict(extra="forbid")
 
     robot: S.AnyRobot = Field(
         description="the robot, as for /solve: e.g. {'name': 'panda', 'task': 'pose'}"
     )
-    x: (
-        Configuration
-        | Annotated[list[Configuration], Field(min_length=1, max_length=MAX_CONFIGURATIONS)]
-    ) = Field(description=f"one configuration (p numbers) or a list of 1 to {MAX_CONFIGURATIONS}")
+    x: one_or_many(Configuration, _many(Configuration)) = Field(  # type: ignore[valid-type]
+        description=f"one configuration (p numbers) or a list of 1 to {MAX_CONFIGURATIONS}"
+    )
 
 
 def _points(p: int | None) -> Any:
@@ -58,7 +53,7 @@ def _points(p: int | None) -> Any:
     built), or a list of them."""
     one = Annotated[list[S.Coordinate], Field(min_length=p or 1, max_length=p or S.MAX_DIMENSION)]
     return (
-        one | Annotated[list[one], Field(min_length=1, max_length=MAX_CONFIGURATIONS)],
+        one_or_many(one, _many(one)),
         Field(
             description=f"one configuration ({p or 'p'} numbers) or a list of 1 to "
             f"{MAX_CONFIGURATIONS}"
@@ -71,6 +66,7 @@ def _exact(name: str, robot: Any, p: int | None) -> Any:
         f"Kinematics{_camel(name)}Request",
         __base__=KinematicsRequest,
         __doc__=f"{KinematicsRequest.__doc__} ({name})",
+        __cls_kwargs__={"json_schema_extra": schema_examples("kinematics", name)},
         robot=(robot, Field(description=robot.__doc__)),
         x=_points(p),
     )
@@ -120,12 +116,12 @@ def kinematics_request(req: KinematicsRequest) -> KinematicsResponse:
     spec, kin = robot.spec, robot.kinematics
     many = isinstance(req.x[0], list)
     for i, row in enumerate(req.x if many else [req.x]):
-        if len(row) != spec.p:  # type: ignore[arg-type]
+        if len(row) != spec.p:
             raise RequestError(
                 f"x[{i}]" if many else "x",
                 f"must have {spec.p} components "
                 f"(p of {spec.title}: {list(spec.variable_names)}), got "
-                f"{len(row)}",  # type: ignore[arg-type]
+                f"{len(row)}",
             )
     x = np.asarray(req.x, dtype=float)
     forward_jacobian = getattr(kin, "forward_jacobian", None)

@@ -15,6 +15,7 @@ from ...engine.exceptions import InvalidInputError
 from ...engine.inverses import ExtendedInverse
 from ...engine.parameters import check_params
 from ...engine.registry import ALGORITHMS, ROBOTS, RobotSpec, make_inverse
+from ...engine.units import robot_units
 from . import schemas as S
 from .exceptions import RequestError
 from .schemas.algorithms import field_of, used
@@ -125,7 +126,8 @@ def build_robot(req_robot) -> tuple[RobotSpec, Any, S.RobotUsed]:
         k: [float(t) for t in v] if isinstance(v, tuple | list) else float(v)
         for k, v in params.items()
     }
-    return spec, kin, S.RobotUsed(name=spec.name, parameters=used)
+    units = S.UnitsInfo(**robot_units(kin, spec.task_names).summary())
+    return spec, kin, S.RobotUsed(name=spec.name, parameters=used, units=units)
 
 
 def build_augmentation(spec: RobotSpec, kin, req_aug):

@@ -79,6 +79,7 @@ def user_robot(req_robot: Any, augmentation: Any = None) -> tuple[Robot, S.Robot
         p=spec.p,
         r=spec.r,
         notes=list(getattr(robot.kinematics, "notes", ())) or None,
+        units=S.UnitsInfo(**robot.units.summary()),
     )
     return robot, used
 

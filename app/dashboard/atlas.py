@@ -19,13 +19,13 @@ from typing import Any
 import numpy as np
 
 from ...engine.exceptions import InvalidInputError
-from ...engine.registry import ROBOTS
+from ...engine.registry import ROBOTS, RobotSpec
 from ...engine.self_motion import manifold_starts
 from ..compute.atlas_schemas import AtlasRequest
 from .algorithms import STYLES, inverse_parameters
 from .analysis import kinematics_and_map
 from .model import DashboardState
-from .plotting import AXIS, UNITS, figure, norm_unit
+from .plotting import AXIS, figure, norm_unit
 from .robots import state_spec, user_robot
 
 #: Drift below this is drawn as this (the extended Jacobian's drift is round-off, ~1e-13).
@@ -102,16 +102,18 @@ def request_robot(state: DashboardState) -> tuple[dict, dict | None]:
     return definition, None if chosen is None else {k: v for k, v in chosen.items() if k != "label"}
 
 
-def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
+def atlas_figure(
+    result: dict[str, Any], request: AtlasRequest, x_units: Sequence[str] = ()
+) -> dict:
     """The heatmap of a finished atlas (the ``result`` of ``GET /atlas/{id}``): for each
     algorithm, log10 of the drift ||x after cycle c - x0|| over the starts' arc length s
     (columns) and the cycles (rows; per path scale when several), one colour scale for both.
-    A cell's ``customdata`` is its run, path * N + start (for a click)."""
+    A cell's ``customdata`` is its run, path * N + start (for a click); ``x_units``, the
+    units of x (the job's ``robot.units.x``), give the arc length's."""
     algorithms = result["algorithms"]
     s = np.asarray(result["parameter"], dtype=float)  # (N,)
     scales = request.scales or [1.0]
-    joint = UNITS.get(request.robot.name, ((), ()))[0]
-    unit = norm_unit(joint)
+    unit = norm_unit(x_units)
     x_title, hover, at_x0 = f"arc length s of the start {unit}", "s = %{x:.3f}", 0.0
     if result.get("period") is not None:  # (a closed curve: the starts cover one turn)
         x_title = f"arc length s of the start {unit}, one turn of {result['period']:.4g}"
@@ -212,9 +214,11 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest) -> dict:
                 },
             }
         )
-    spec = ROBOTS.get(request.robot.name)  # (a job of POST /atlas may leave them to the robot)
-    gamma = request.gamma if spec is None or request.gamma is not None else spec.default_gamma
-    mode = request.mode or (spec.default_mode if spec is not None else "continuous")
+    # (a job of POST /atlas may leave them to the robot: a robot the request defines has
+    # RobotSpec's defaults, as its build gives them)
+    spec = ROBOTS.get(request.robot.name)
+    gamma = request.gamma if request.gamma is not None else (spec or RobotSpec).default_gamma
+    mode = request.mode or (spec or RobotSpec).default_mode
     title = (
         f"Drift after each cycle from {N} starts on k(x) = k(x0) (dotted: x0), "
         f"{request.robot.name}, γ = {gamma:g}, {mode} mode"

@@ -17,9 +17,8 @@ import numpy as np
 from jik import __version__
 
 from ...engine.exports import coordinate_names, csv_rows
-from ...engine.planar_chain import PlanarChain
 from ...engine.results import Trajectory
-from ...engine.urdf import UrdfChain
+from ...engine.units import robot_units
 from .algorithms import posture_rest
 from .messages import h_change, to_json
 from .plotting import norm_unit, units
@@ -27,25 +26,13 @@ from .robots import state_kinematics
 from .runs import DashboardResult
 from .verdict import verdict
 
-#: What a user robot's lengths are measured in when its definition does not say.
-LENGTH = "length unit of the definition"
-
 
 def export_units(result: DashboardResult) -> dict:
     """The unit of every column, keyed by its name (:func:`run_columns`): theta, the joint
-    variables x_k, the task coordinates y_k, the task error (a norm of y) and h. The
-    catalogue's robots have theirs; a planar chain's revolute joints are in rad and its lengths
-    in the unit of its link lengths; a URDF arm is in SI units (m, rad); a formula robot's are
-    what its formulas mean."""
+    variables x_k, the task coordinates y_k (the engine's, :func:`jik.engine.units.robot_units`;
+    what a robot's length unit m stands for is :func:`length_unit`), the task error (a norm of
+    y) and h."""
     joint, task = units(result)
-    kin = state_kinematics(result.state)
-    if isinstance(kin, PlanarChain):
-        joint = tuple("rad" if rev else LENGTH for rev in kin.revolute)
-        task = (LENGTH, LENGTH, "rad")[: kin.r]
-    elif isinstance(kin, UrdfChain):
-        kinds = {j.index: j.type for j in kin.chain if j.index >= 0}
-        joint = tuple("m" if kinds[i] == "prismatic" else "rad" for i in range(kin.p))
-        task = ("m",) * kin.r
 
     def named(name, us) -> dict:
         spelled = {"": "as the definition's formulas", "1": "dimensionless"}
@@ -60,6 +47,11 @@ def export_units(result: DashboardResult) -> dict:
         "error": norm_unit(task).strip("[]") or "as y",
         "h": "the unit of the map's formula",
     }
+
+
+def length_unit(result: DashboardResult) -> str:
+    """What the robot's length unit m stands for (the paper states none)."""
+    return robot_units(state_kinematics(result.state), result.task_names).lengths
 
 
 def coordinates(result: DashboardResult) -> dict[str, str]:
@@ -146,6 +138,7 @@ def export_json(
                 "state": result.state.as_dict(),
                 "generation": result.generation,
                 "units": export_units(result),
+                "length_unit": length_unit(result),
                 "coordinates": coordinates(result),
                 "variable_names": result.variable_names,
                 "task_names": result.task_names,
@@ -171,6 +164,7 @@ def csv_context(result: DashboardResult, when: datetime | None = None) -> list[s
         f"# state: {to_json(result.state.as_dict())}",
         "# units: " + "; ".join(f"{k} [{v}]" for k, v in export_units(result).items()),
         "# coordinates: " + "; ".join(f"{k} {v}" for k, v in coordinates(result).items()),
+        f"# lengths: {length_unit(result)}",
     ]
     lines += [f"# verdict: {v['text']}" for v in verdict(result)]
     kin = state_kinematics(result.state)

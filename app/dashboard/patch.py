@@ -66,6 +66,7 @@ def _patch_model() -> type[BaseModel]:
                     key: TypeAdapter(kind).json_schema() for key, kind in CONTROL_KEYS.items()
                 },
                 "additionalProperties": False,
+                "examples": [{"robot": "manipulator1"}, {"gamma": 2.0, "x0.1": 0.5}],
             },
         ),
         __doc__="A change of the dashboard's state: some of its fields, and control keys "

@@ -11,16 +11,10 @@ import math
 import numpy as np
 import plotly.graph_objects as go
 
-from .robot_units import chain_units
+from ...engine.units import robot_units
 from .robots import state_kinematics
 from .runs import DashboardResult
 
-#: Units of the joint and task variables, by robot (the registry does not carry units).
-UNITS = {
-    "manipulator1": (("m", "m", "1"), ("m", "m")),
-    "manipulator2": (("m", "m", "rad"), ("m", "m")),
-    "unicycle": (("m/s", "m/s", "rad/s", "rad/s"), ("m", "m", "rad")),
-}
 PANEL_HEIGHT = 380
 #: Panel ids, in the page's order, with their size on the page's grid ("wide": a whole row,
 #: "tall": two rows).
@@ -68,12 +62,9 @@ LAYOUT = dict(
 
 
 def units(result: DashboardResult) -> tuple[tuple[str, ...], tuple[str, ...]]:
-    joint, task = UNITS.get(result.state.robot, ((), ()))
-    if result.state.robot_definition is not None:  # (an arm's: its joints' kinds)
-        kin = state_kinematics(result.state)
-        joint, task = chain_units(kin, result.task_names) or (joint, task)
-    p, r = len(result.variable_names), len(result.task_names)
-    return (joint or ("",) * p), (task or ("",) * r)
+    """The units of x and of y (:func:`jik.engine.units.robot_units`; "": not stated)."""
+    described = robot_units(state_kinematics(result.state), result.task_names)
+    return described.x, described.y
 
 
 def label(name: str, unit: str) -> str:

@@ -232,6 +232,8 @@ def test_a_session_atlas_is_the_atlas_of_its_state(client):
     np.testing.assert_allclose(
         kin.forward(starts), np.broadcast_to([0.0, 1.0], (2, 5, 2)), atol=1e-9
     )
+    x_title = body["figure"]["layout"]["xaxis"]["title"]["text"]
+    assert x_title.startswith("arc length s of the start [m and rad mixed]")  # (the job's units)
     heat = body["figure"]["data"]
     assert [t["type"] for t in heat] == ["heatmap", "heatmap"]
     assert heat[0]["y"] == ["×1, cycle 1", "×1, cycle 2", "×0.5, cycle 1", "×0.5, cycle 2"]
@@ -289,6 +291,18 @@ def test_a_session_reads_a_job_that_left_gamma_and_mode_to_the_robot(client):
     heatmap's title gives the robot's defaults (it was a 500, found by schemathesis)."""
     sid = _session(client)
     job = client.post("/atlas", json=body()).json()["id"]
+    assert wait_until_ended(client, job)["status"] == "done"
+    r = client.get(f"/api/sessions/{sid}/atlas/{job}")
+    assert r.status_code == 200, r.text
+    assert "γ = 1, continuous mode" in r.json()["figure"]["layout"]["title"]["text"]
+
+
+def test_a_session_reads_a_job_of_a_user_robot_that_left_gamma_to_it(client):
+    """The same for a robot the request defines: its build's defaults (a 500 before, found by
+    schemathesis posting the document's example of a planar chain's atlas)."""
+    sid = _session(client)
+    robot = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]}
+    job = client.post("/atlas", json={"robot": robot, "starts": 4, "cycles": 1}).json()["id"]
     assert wait_until_ended(client, job)["status"] == "done"
     r = client.get(f"/api/sessions/{sid}/atlas/{job}")
     assert r.status_code == 200, r.text

@@ -13,13 +13,13 @@ import pytest
 from jik.app.compute.atlas_plan import AtlasLimits, plan_request
 from jik.app.dashboard.atlas import atlas_figure, atlas_request
 from jik.app.dashboard.controls import controls
+from jik.app.dashboard.export import export_csv, export_units
 from jik.app.dashboard.joint_limits import limits_summary, outside_joints, state_limits
 from jik.app.dashboard.map_figures import augmenting_spec
 from jik.app.dashboard.map_synthesis import built_map
 from jik.app.dashboard.model import default_state, updated_state
 from jik.app.dashboard.plotting import units
 from jik.app.dashboard.results import compute
-from jik.app.dashboard.robot_units import chain_units
 from jik.app.dashboard.robots import state_kinematics
 from jik.app.dashboard.runs import Cancelled
 from jik.app.dashboard.session import Dashboard
@@ -29,6 +29,7 @@ from jik.app.scene.arm_marks import OUTSIDE_COLOR, end_frame, joint_points, targ
 from jik.app.scene.mechanisms import Chain, fixtures_of
 from jik.engine.arms import ARMS
 from jik.engine.atlas_run import run_atlas
+from jik.engine.units import robot_units
 from tests.app.test_sessions import _computed, _open
 
 
@@ -282,7 +283,17 @@ def test_an_arms_units_follow_its_joints_and_task():
     kin = state_kinematics(
         updated_state(default_state(), {"robot": "planar_chain", "robot_definition": arm})
     )
-    assert chain_units(kin, ("x", "y")) == (("rad", "m", "rad"), ("m", "m"))
+    described = robot_units(kin, ("x", "y"))
+    assert (described.x, described.y) == (("rad", "m", "rad"), ("m", "m"))
+
+
+def test_an_arms_export_has_its_rotation_coordinates_in_rad():
+    """The export's units are the axes': the Panda's rx ry rz in rad, its x y z in m, and a line
+    saying what its lengths are in (a URDF's SI units)."""
+    result = compute(updated_state(_panda(), {"task": "target"}))
+    units = export_units(result)
+    assert [units[f"y_{k}"] for k in range(1, 7)] == ["m", "m", "m", "rad", "rad", "rad"]
+    assert "# lengths: m: SI units, as in a URDF" in export_csv(result).splitlines()
 
 
 @pytest.mark.parametrize("arm", sorted(ARMS))

@@ -80,3 +80,42 @@ def test_bad_requests_are_422_naming_the_field(api, body, field, text):
     assert text in r.text
     locs = [".".join(map(str, d["loc"][1:])) for d in r.json()["detail"]]
     assert any(loc.startswith(field.split("[")[0]) for loc in locs), r.text
+
+
+@pytest.mark.parametrize(
+    ("robot", "x", "message"),
+    [
+        ({"name": "manipulator2"}, [0.0] * 1001, "x: give at most 3 entries, got 1001"),
+        ({"name": "manipulator2"}, [], "x: give at least 3 entries, got 0"),
+        ({"name": "manipulator2"}, [[0.0] * 3] * 1001, "x: give at most 1000 entries, got 1001"),
+        ({"name": "manipulator2"}, [[0.0] * 3, [0.0] * 2], "x[1]: give at least 3 entries, got 2"),
+        ({"name": "panda"}, [0.0] * 8, "x: give at most 7 entries, got 8"),
+        ({"name": "formula", "variables": ["a"], "task": ["a"]}, [], "x: give at least 1 entry"),
+    ],
+)
+def test_one_or_many_configurations_is_refused_once_for_the_shape_given(api, robot, x, message):
+    """x is one configuration or a list of them: a list of numbers is refused as one
+    configuration, a list of lists as many, never as both."""
+    r = api.post("/kinematics", json={"robot": robot, "x": x})
+    assert r.status_code == 422, r.text
+    (error,) = r.json()["detail"]
+    assert error["msg"].startswith(message), error
+    assert error["loc"] == (["body", "x", 1] if message.startswith("x[1]") else ["body", "x"])
+
+
+@pytest.mark.parametrize(
+    ("reference", "message"),
+    [
+        ([1.0, 2.0], "robot.reference: give at least 3 entries, got 2"),
+        ([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], "robot.reference: give at least 3 entries, got 2"),
+        ([[1.0, 0.0, 0.0], [0.0, 1.0]] + [[0.0] * 3], "robot.reference[1]: give at least 3"),
+        ([0.0] * 5, "robot.reference: give at most 4 entries, got 5"),
+    ],
+)
+def test_an_arms_reference_is_refused_once_for_the_shape_given(api, reference, message):
+    """R0 is a rotation vector or quaternion (numbers) or a matrix (rows): one refusal."""
+    robot = {"name": "panda", "reference": reference}
+    r = api.post("/kinematics", json={"robot": robot, "x": HOME})
+    assert r.status_code == 422, r.text
+    (error,) = r.json()["detail"]
+    assert error["msg"].startswith(message), error

@@ -10,7 +10,7 @@ id is a random token: whoever has it reads the job, and no one else.
 import re
 from typing import Annotated
 
-from fastapi import APIRouter, Depends, Query, Request, Response
+from fastapi import APIRouter, Body, Depends, Query, Request, Response
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse, StreamingResponse
 from starlette.concurrency import run_in_threadpool
@@ -22,10 +22,13 @@ from ...compute.atlas_schemas import AtlasBody, AtlasJobResponse
 from ...compute.exceptions import RequestError
 from ...compute.pool import ComputePool
 from ...compute.schemas import ErrorResponse
+from ...compute.schemas.examples import openapi_examples
 from ...compute.schemas.wording import without_field
 from ..dependencies import Pool
 
 router = APIRouter(tags=["atlas"])
+#: The body, with every robot's example in the document (Swagger UI starts from the first).
+AtlasExamples = Annotated[AtlasBody, Body(openapi_examples=openapi_examples("atlas"))]
 
 
 def jobs_of(request: Request) -> AtlasJobs:
@@ -103,7 +106,9 @@ def table_response(jobs: AtlasJobs, job: AtlasJob, every_leg: bool) -> Response:
 
 
 @router.post("/atlas", status_code=202, response_model=AtlasJobResponse, responses=ERRORS)
-async def start_atlas(req: AtlasBody, request: Request, response: Response, jobs: Jobs, pool: Pool):
+async def start_atlas(
+    req: AtlasExamples, request: Request, response: Response, jobs: Jobs, pool: Pool
+):
     """Plan the atlas (the self-motion curves are traced here) and start it as a job."""
     job = await start_job(jobs, pool, request, req)
     response.headers["Location"] = f"/atlas/{job.id}"

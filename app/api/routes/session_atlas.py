@@ -37,7 +37,9 @@ _NOT_FOUND: dict[int | str, dict] = {404: {"description": "no such session or at
 class SessionAtlas(BaseModel):
     """The atlas of the session's current state: how many starts and cycles, which scales."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(
+        extra="forbid", json_schema_extra={"examples": [{"starts": 16, "scales": [1.0, 0.5]}]}
+    )
 
     starts: Annotated[int, Field(strict=True, ge=2, le=MAX_PANEL_STARTS), INTEGRAL] = 256
     cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_CYCLES), INTEGRAL] | None = Field(
@@ -84,7 +86,8 @@ async def read_session_atlas(session_id: str, job_id: str, store: Store, jobs: J
     job = jobs.get(job_id)
     body = jobs.response(job).model_dump(mode="json", exclude={"result"})
     if job.status == "done" and job.result is not None and job.request is not None:
-        figure = await run_in_threadpool(atlas_figure, job.result, job.request)
+        x_units = job.used[0].units.x if job.used else ()
+        figure = await run_in_threadpool(atlas_figure, job.result, job.request, x_units)
         body.update(
             figure=json.loads(figure_json(figure)),
             starts=job.result["starts"],

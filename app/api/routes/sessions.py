@@ -44,7 +44,9 @@ EXPORT_WAIT = 60.0
 class SessionCreate(BaseModel):
     """``POST /api/sessions``: a new dashboard session (one per browser tab)."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(
+        extra="forbid", json_schema_extra={"examples": [{"state": {"robot": "manipulator1"}}]}
+    )
 
     state: StatePatch = Field(  # type: ignore[valid-type]
         default_factory=StatePatch,
@@ -149,7 +151,7 @@ class SecondPhaseRequest(BaseModel):
     """Which result's second phase (h on a grid when it is expensive, E1, E2 and their
     sensitivity) a request is about: the generation on screen, never a newer one by accident."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", json_schema_extra={"examples": [{"generation": 1}]})
 
     generation: Annotated[int, Field(strict=True, ge=1), INTEGRAL] = Field(
         description="the generation of the result shown"
@@ -210,9 +212,7 @@ def _second_phase_answer(done: bool, dashboard, generation: int, refusal: str) -
     if not done:
         return JSONResponse(
             status_code=409,
-            content={
-                "detail": (f"{refusal} (the session is at generation {dashboard.generation})")
-            },
+            content={"detail": f"{refusal} (the session is at generation {dashboard.generation})"},
         )
     return JSONResponse(status_code=202, content={"generation": generation})
 

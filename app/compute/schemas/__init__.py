@@ -57,6 +57,7 @@ from .robots import (
     PlanarChainRobot,
     Robot,
     RobotUsed,
+    UnitsInfo,
     UrdfRobot,
     UserAugmentation,
 )
@@ -144,6 +145,7 @@ __all__ = [
     "Tolerance",
     "TotalDegreeInfo",
     "Trajectory",
+    "UnitsInfo",
     "UrdfRobot",
     "UserAugmentation",
     "Vector",

@@ -6,9 +6,9 @@ size bounds. The dashboard's state (:mod:`jik.app.dashboard.model`) uses the sam
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, Union
 
-from pydantic import BeforeValidator, Field
+from pydantic import BeforeValidator, Discriminator, Field, Tag
 
 from ....engine.solve_rules import GAMMA_MAX, GAMMA_MIN, TOL_MIN
 from .algorithms import Algorithm as Algorithm
@@ -53,3 +53,24 @@ Gamma = Annotated[float, Field(strict=True, ge=GAMMA_MIN, le=GAMMA_MAX, allow_in
 Tolerance = Annotated[float, Field(strict=True, ge=TOL_MIN, le=1.0, allow_inf_nan=False)]
 #: A bound of a synthesis box.
 Bound = Annotated[float, Field(strict=True, ge=-100.0, le=100.0, allow_inf_nan=False)]
+
+
+#: The labels of a one-or-many union's members in pydantic's error locations: written as type
+#: labels (they hold "["), which the API's field names leave out, as they do a plain union's.
+ONE, MANY = "list[number]", "list[list[number]]"
+
+
+def _shape(value: Any) -> str:
+    """Which member of :func:`one_or_many` a value evidently means: a list whose first entry is a
+    list is many, anything else one."""
+    return MANY if isinstance(value, list) and value and isinstance(value[0], list) else ONE
+
+
+def one_or_many(one: Any, many: Any) -> Any:
+    """``one`` (a list of numbers) or ``many`` (a list of such lists), told apart by the value's
+    shape before either is checked: a refusal is the one of the shape the request gave, once
+    per field (a plain union reports both members' refusals)."""
+    return Annotated[
+        Union[Annotated[one, Tag(ONE)], Annotated[many, Tag(MANY)]],  # noqa: UP007
+        Discriminator(_shape),
+    ]

@@ -26,6 +26,21 @@ class AugmentationInfo(BaseModel):
     parameters: list[ParameterInfo]
 
 
+class CoordinateInfo(BaseModel):
+    """A joint variable or task coordinate and its unit (:mod:`jik.engine.units`)."""
+
+    name: str
+    unit: str = Field(
+        description="rad, m, 1 (dimensionless), m/s, rad/s; '' where the robot states none "
+        "(a formula robot)"
+    )
+    joint: str | None = Field(None, description="a URDF arm's joint of this variable")
+    limits: list[float | None] | None = Field(
+        None, description="the joint's [lower, upper] (null: no bound on that side)"
+    )
+    home: float | None = Field(None, description="its value at the arm's home")
+
+
 class RobotInfo(BaseModel):
     name: str
     title: str
@@ -49,6 +64,12 @@ class RobotInfo(BaseModel):
     )
     algorithms: list[Algorithm]
     modes: list[Mode]
+    variables: list[CoordinateInfo] = Field(
+        description="the p joint variables, in x's order: units, a URDF arm's joint names, the "
+        "joint limits and home where the robot has them"
+    )
+    task: list[CoordinateInfo] = Field(description="the r task coordinates, in k's order")
+    lengths: str = Field(description="what the robot's length unit m stands for")
 
 
 class Limits(BaseModel):

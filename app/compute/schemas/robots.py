@@ -20,6 +20,7 @@ from .fields import (
     MAX_DIMENSION,
     Coordinate,
     FiniteFloat,
+    one_or_many,
 )
 
 
@@ -136,6 +137,15 @@ LIMITS_DESCRIPTION = (
     "stayed within them"
 )
 
+#: An orientation R0: a rotation vector or a quaternion x y z w (numbers), or a 3x3 matrix.
+Orientation = one_or_many(
+    Annotated[list[FiniteFloat], Field(min_length=3, max_length=4)],
+    Annotated[
+        list[Annotated[list[FiniteFloat], Field(min_length=3, max_length=3)]],
+        Field(min_length=3, max_length=3),
+    ],
+)
+
 
 class PlanarChainRobot(BaseModel):
     """A planar serial chain of revolute (R) and prismatic (P) joints: the end point (r = 2),
@@ -205,14 +215,7 @@ class UrdfRobot(BaseModel):
         description="a reference configuration (default: zero, clipped into the "
         "joint limits); also the default start",
     )
-    reference: (
-        Annotated[list[FiniteFloat], Field(min_length=3, max_length=4)]
-        | Annotated[
-            list[Annotated[list[FiniteFloat], Field(min_length=3, max_length=3)]],
-            Field(min_length=3, max_length=3),
-        ]
-        | None
-    ) = Field(
+    reference: Orientation | None = Field(  # type: ignore[valid-type]
         None,
         description="R0, the orientation whose rotation coordinates are 0: a "
         "rotation vector, a quaternion x y z w or a 3x3 matrix; default: the orientation "
@@ -355,6 +358,18 @@ class AugmentationUsed(BaseModel):
     )
 
 
+class UnitsInfo(BaseModel):
+    """The units of the response's configurations x and task points y (k(x), targets):
+    :meth:`jik.engine.units.RobotUnits.summary`."""
+
+    x: list[str] = Field(
+        description="each joint variable's unit, in x's order: rad, m, 1 (dimensionless), "
+        "m/s, rad/s; '' where the robot states none (a formula robot)"
+    )
+    y: list[str] = Field(description="each task coordinate's unit, in k(x)'s order")
+    lengths: str = Field(description="what the robot's length unit m stands for")
+
+
 class RobotUsed(BaseModel):
     """The robot a run used, with every parameter (defaults filled in)."""
 
@@ -373,3 +388,4 @@ class RobotUsed(BaseModel):
         exclude_if=_absent,
         description="what was skipped while building the robot (a URDF's mesh references)",
     )
+    units: UnitsInfo = Field(description="the units of x and y")

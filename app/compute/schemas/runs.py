@@ -114,7 +114,7 @@ class LimitViolationInfo(BaseModel):
     leg: int = Field(description="from 1 within its cycle; 0 for the start x0")
     joint: int = Field(description="index in x, from 0")
     name: str = Field(description="the variable's name (and the URDF joint's)")
-    value: float = Field(description="the joint's value there [rad or m]")
+    value: float = Field(description="the joint's value there (in its unit, robot.units.x)")
     limit: float = Field(description="the bound it passed")
     bound: Literal["lower", "upper"]
 

@@ -8,6 +8,7 @@ from pydantic import BaseModel, BeforeValidator, Discriminator, Field, Tag, crea
 from pydantic_core import PydanticCustomError
 
 from ....engine.registry import ROBOTS
+from .examples import schema_examples
 from .robots import (
     AUGMENTATION_MODELS,
     ROBOT_MODELS,
@@ -43,15 +44,18 @@ def per_robot(base: type[BaseModel], fields: Any, user_robots: bool = True) -> A
     ``robot.name``, whose ``robot`` and ``augmentation`` are that robot's and whose vectors have
     its lengths (``fields(spec)``: the fields that differ from ``base``'s), and one per kind of
     user robot unless not ``user_robots``. Their union is what the route takes and what its
-    OpenAPI document shows; each member is still a ``base``."""
+    OpenAPI document shows, each member with its robot's example (:mod:`.examples`); each
+    member is still a ``base``."""
     members = []
     names = ROBOT_NAMES if user_robots else list(ROBOTS)
+    route = base.__name__.removesuffix("Request").lower()
     for name, spec in ROBOTS.items():
         augmentations = list(dict.fromkeys(a.name for a in spec.augmentations))
         model = create_model(
             f"{base.__name__.removesuffix('Request')}{_camel(name)}Request",
             __base__=base,
             __doc__=f"{(base.__doc__ or '').strip()} ({spec.title})",
+            __cls_kwargs__={"json_schema_extra": schema_examples(route, name)},
             robot=(ROBOT_MODELS[name], Field(description=f"{spec.title} and its parameters")),
             **fields(spec, _union([AUGMENTATION_MODELS[a] for a in augmentations])),
         )
@@ -64,6 +68,7 @@ def per_robot(base: type[BaseModel], fields: Any, user_robots: bool = True) -> A
             f"{base.__name__.removesuffix('Request')}{_camel(kind)}Request",
             __base__=base,
             __doc__=f"{(base.__doc__ or '').strip()} ({robot_model.model_config.get('title')})",
+            __cls_kwargs__={"json_schema_extra": schema_examples(route, kind)},
             robot=(robot_model, Field(description=f"{robot_model.__doc__}")),
             augmentation=(
                 UserAugmentation | None,
