@@ -32,6 +32,7 @@ from .documents import (
 from .exceptions import RequestError
 from .robot_requests import check_configuration, check_task_point, request_robot
 from .schemas.algorithms import parameters_of, used
+from .schemas.wording import without_field
 
 _R = TypeVar("_R")
 
@@ -107,19 +108,24 @@ def _start_message(setup: _Setup, x0) -> str:
     return f"{setup.inverse.singular_error(x)}; move the start"
 
 
-_ENGINE_FIELDS = ("x0", "target", "gamma", "tol", "max_iterations", "path", "cycles", "mode")
+#: A run's arguments in the engine that are a request's fields, by the request's names.
+_ENGINE_FIELDS = ("x0", "target", "gamma", "tolerance", "max_iterations", "path", "cycles", "mode")
+_REQUEST_NAMES = {"tol": "tolerance", "y_d": "target"}
 
 
 def engine_error(exc: JikError) -> RequestError:
-    """An engine error as a RequestError; the field is read off the engine's message."""
+    """An engine error as a RequestError at the request's name of the field the engine's error
+    carries (:attr:`InvalidInputError.field <jik.engine.exceptions.InvalidInputError>`:
+    ``tol`` is ``tolerance``, ``path.1`` ``path[1]``); a singular configuration at ``x0``;
+    an error about no field of the request at ``request``, in the engine's words."""
     if isinstance(exc, SingularConfigurationError):
         return RequestError("x0", str(exc))
-    text = str(exc)
-    first = text.split(" ", 1)[0]
-    name = {"tol": "tolerance", "y_d": "target"}.get(first, first)
-    if first not in _ENGINE_FIELDS and name not in _ENGINE_FIELDS:
-        name = "request"
-    return RequestError(name, text)
+    field = getattr(exc, "field", None) or ""
+    head, dot, tail = field.partition(".")
+    name = _REQUEST_NAMES.get(head, head)
+    if name not in _ENGINE_FIELDS:
+        return RequestError("request", str(exc))
+    return RequestError(name + dot + tail, without_field(str(exc), field))
 
 
 def batch_key(req: S.SolveRequest) -> str:

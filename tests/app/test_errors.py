@@ -348,3 +348,20 @@ def test_a_refusal_names_its_field_once_and_as_every_message_does(api):
     r = api.post("/solve", json={**body, "algorithm_parameters": rest})
     assert messages(r)[0].startswith("algorithm_parameters.rest[1]: rest x2 must be")
     assert r.json()["detail"][0]["loc"] == ["body", "algorithm_parameters", "rest", 1]
+
+
+def test_an_engine_error_is_named_by_its_field_not_its_words():
+    """The request's field of an engine error is the error's field (the engine's name made the
+    request's: tol -> tolerance), whatever its message starts with."""
+    from jik.app.compute.requests import engine_error
+    from jik.engine.exceptions import InvalidInputError
+
+    err = engine_error(InvalidInputError("the tolerance tol must be > 0, got -1", "tol"))
+    assert (err.field, str(err)) == (
+        "tolerance",
+        "tolerance: the tolerance tol must be > 0, got -1",
+    )
+    err = engine_error(InvalidInputError("y_d contains NaN or infinite values", "y_d"))
+    assert str(err) == "target: contains NaN or infinite values"
+    err = engine_error(InvalidInputError("x0 is fine; gamma is not", "chunk"))
+    assert err.field == "request"
