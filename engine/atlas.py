@@ -319,7 +319,7 @@ def plan_atlas(
             raise InvalidInputError(
                 f"starts[{i}] is not on the self-motion manifold of every path's first point: "
                 f"|k(x) - path[0]| = {off[i]:.3g} > {ON_MANIFOLD_TOL:g}",
-                field="starts",
+                field=f"starts.{i}",
             )
         return make(n_starts=len(x), sampling=None, manifolds=(), explicit=x)
     if n_starts is None:

@@ -7,7 +7,6 @@ of the atlas jobs (:class:`AtlasLimits`), and the fields of a finished atlas
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from typing import Any
 
@@ -25,6 +24,7 @@ from .atlas_schemas import AtlasRequest
 from .documents import nullable
 from .exceptions import RequestError
 from .robot_requests import check_task_point, request_robot
+from .schemas.wording import without_field
 from .worker import task
 
 #: What an atlas job's response repeats of its request: the robot used, the map used.
@@ -97,16 +97,14 @@ def planned(req: AtlasRequest, limits: AtlasLimits) -> tuple[AtlasPlan, Used]:
     try:
         return _plan(req, spec, inverses, path, gamma, mode), (robot.robot, robot.augmentation)
     except InvalidInputError as exc:
-        if exc.field != "starts":
+        head, dot, index = (exc.field or "").partition(".")
+        if head != "starts":
             raise
         text = str(exc).replace("give the starts explicitly", "give start_points")
         if not req.start_points:
             raise RequestError("starts", text) from None
-        # (the engine's starts are the request's start_points: name the entry)
-        entry = re.match(r"starts\[(\d+)\] ", text)
-        if entry is None:
-            raise RequestError("start_points", text) from None
-        raise RequestError(f"start_points[{entry[1]}]", text[entry.end() :]) from None
+        # (the engine's starts are the request's start_points: its field names the entry)
+        raise RequestError("start_points" + dot + index, without_field(text, exc.field)) from None
 
 
 def _plan(req: AtlasRequest, spec, inverses, path, gamma, mode) -> AtlasPlan:

@@ -268,7 +268,7 @@ def test_cancelled_stops_between_chunks():
             "the path's first point (0, 1) is out of reach in the box (x_range, joint limits): "
             "eq. (7) from the reference reaches it only where x3 = 1.5708 is not in [2, 3]",
         ),
-        ({"starts": [(0.0, 0.0, 1.0)]}, "starts", "not on the self-motion manifold"),
+        ({"starts": [(0.0, 0.0, 1.0)]}, "starts.0", "not on the self-motion manifold"),
         ({"gamma": 0}, "gamma", "gamma must be > 0"),
         ({"mode": "discrete", "gamma": 2.5}, "gamma", "< 2 in discrete mode"),
     ],
