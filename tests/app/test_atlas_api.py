@@ -411,3 +411,21 @@ def test_a_session_atlas_of_a_urdf_robot_does_not_send_its_text_back(client):
     assert period is not None and 6.0 < period < 7.0
     assert result["arc"][1] - result["arc"][0] == pytest.approx(period)
     assert all(0 <= s < period for s in result["parameter"]) and len(result["parameter"]) == 3
+
+
+def test_every_catalogue_arm_has_a_default_atlas_and_the_unicycle_says_why_not(client):
+    """A catalogue arm's atlas with nothing but its name runs (the Gen3's continuous joints
+    turn past the box's pi: a window on one turn, not a limit); the unicycle's default path is
+    its experiment's targets, which /robots says (default_path_loops) and /atlas names."""
+    for arm in ("panda", "iiwa14", "gen3", "ur5e"):
+        r = client.post("/atlas", json={"robot": {"name": arm}, "starts": 3, "cycles": 1})
+        assert r.status_code == 202, (arm, r.text)
+        assert wait_until_ended(client, r.json()["id"])["status"] == "done", arm
+        assert client.delete(f"/atlas/{r.json()['id']}").status_code == 204
+    r = client.post("/atlas", json={"robot": {"name": "unicycle"}, "starts": 3, "cycles": 1})
+    (error,) = r.json()["detail"]
+    assert error["loc"] == ["body", "path"]
+    assert "is the targets of the paper's experiment, reached once, not a loop" in error["msg"]
+    robots = {r["name"]: r for r in client.get("/robots").json()["robots"]}
+    assert robots["unicycle"]["default_path_loops"] is False
+    assert robots["manipulator2"]["default_path_loops"] is True
