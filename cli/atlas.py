@@ -36,7 +36,7 @@ from .algorithm_options import (
     algorithm_parameters,
 )
 from .atlas_output import CsvWriter, Gathered, listed, write_figure
-from .robot_commands import add_task_option, robot_with_task
+from .robot_commands import add_task_option, refused, robot_with_task
 
 #: Atlases of more runs than this write their arrays to the CSV only (the JSON keeps a summary).
 JSON_RUNS = 20000
@@ -169,9 +169,7 @@ def atlas_command(args: argparse.Namespace) -> int:
     try:
         return _run(args)
     except InvalidInputError as error:
-        where = f" ({error.field})" if error.field else ""
-        sys.stderr.write(f"jik atlas: {error}{where}\n")
-        return 2
+        return refused("atlas", error)
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -213,12 +211,7 @@ def _run(args: argparse.Namespace) -> int:
             )
             for a in algorithms
         ]
-    closed = not hasattr(kin, "path")  # (the unicycle's default path is a curve, not a loop)
-    path = (
-        _points(args.path, "--path") if args.path else closed * [list(t) for t in spec.default_path]
-    )
-    if not path:
-        raise InvalidInputError(f"{spec.name} has no default closed path: give --path", "path")
+    path = _points(args.path, "--path") if args.path else spec.default_loop("--path")
     arc = _numbers(args.arc, "--arc") if args.arc else [-MAX_ARC, MAX_ARC]
     reference = _numbers(args.reference, "--reference") if args.reference else spec.default_x0
     backend = backend_option(args)

@@ -181,7 +181,7 @@ def repeatability_command(args: argparse.Namespace) -> int:
     from ..engine.repeatability import repeatability
 
     robot, x0, settings = _setup(args)
-    path = parse_path(args.path, "--path") if args.path else robot.spec.default_path
+    path = parse_path(args.path, "--path") if args.path else robot.spec.default_loop("--path")
     inverse = _inverse(robot, args, x0)
     record = robot_limits(robot.kinematics) is not None  # (limits: check whole legs)
     rep = repeatability(inverse, x0, path, cycles=args.cycles, record=record, **settings)
@@ -196,17 +196,22 @@ def repeatability_command(args: argparse.Namespace) -> int:
     return 0 if rep.success else 1
 
 
+def refused(command: str, error: Exception) -> int:
+    """Say on stderr why ``jik command`` refused its input, and the field; the exit status 2."""
+    field = getattr(error, "field", None)
+    where = f" (field {field})" if field else ""
+    sys.stderr.write(f"jik {command}: {error}{where}\n")
+    return 2
+
+
 def _guarded(command):
     def run(args: argparse.Namespace) -> int:
-        from ..engine.exceptions import InvalidInputError, JikError
+        from ..engine.exceptions import JikError
 
         try:
             return command(args)
         except JikError as exc:
-            field = getattr(exc, "field", None)
-            where = f" (field {field})" if isinstance(exc, InvalidInputError) and field else ""
-            sys.stderr.write(f"jik {args.command}: {exc}{where}\n")
-            return 2
+            return refused(args.command, exc)
 
     return run
 

@@ -106,6 +106,9 @@ class RobotSpec:
     default_x0: tuple[float, ...] = ()
     default_target: tuple[float, ...] = ()
     default_path: tuple[tuple[float, ...], ...] = ()
+    #: Whether ``default_path`` is a closed task path to drive cycle after cycle (False: the
+    #: targets of an experiment, the unicycle's of sec. 6.2, which a platform reaches once).
+    default_path_loops: bool = True
     default_mode: Literal["continuous", "discrete"] = "continuous"
     default_gamma: float = 1.0
     x_range: tuple[tuple[float, float], ...] = ()
@@ -122,6 +125,25 @@ class RobotSpec:
         for vp in self.vector_parameters:
             args[vp.name] = vp.check(values.get(vp.name, vp.default))
         return self.factory(**args)
+
+    def default_loop(self, field: str = "path") -> list[list[float]]:
+        """The default closed path of a repeatability run or an atlas, as lists.
+
+        Raises
+        ------
+        InvalidInputError
+            Naming ``field`` when the robot has none (its default path, if any, is an
+            experiment's targets: :attr:`default_path_loops`).
+        """
+        if self.default_path and self.default_path_loops:
+            return [list(t) for t in self.default_path]
+        why = (
+            f": its default path {[list(t) for t in self.default_path]} is the targets of the "
+            "paper's experiment, reached once, not a loop"
+            if self.default_path
+            else ""
+        )
+        raise InvalidInputError(f"{self.name} has no default closed path{why}: give {field}", field)
 
     def augmentation(self, name: str | None) -> AugmentationSpec:
         name = name or self.default_augmentation
@@ -148,6 +170,7 @@ class RobotSpec:
             "default_x0": list(self.default_x0),
             "default_target": list(self.default_target),
             "default_path": [list(t) for t in self.default_path],
+            "default_path_loops": self.default_path_loops,
             "default_mode": self.default_mode,
             "default_gamma": self.default_gamma,
             "x_range": [list(t) for t in self.x_range],
@@ -287,6 +310,7 @@ UNICYCLE = RobotSpec(
     default_x0=(0.5, -0.25, 0.3, -0.25),
     default_target=(1.0, 0.0, -math.pi / 2),
     default_path=((1.0, 0.0, -math.pi / 2), (3.0, 2.0, 0.0)),
+    default_path_loops=False,
     default_mode="discrete",
     default_gamma=0.1,
     x_range=((-3.0, 3.0), (-3.0, 3.0), (-3.0, 3.0), (-3.0, 3.0)),

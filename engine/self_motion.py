@@ -167,7 +167,9 @@ def trace(
         lo <= 0 <= hi, |lo|, |hi| <= :data:`MAX_ARC`.
     box : sequence of p (low, high), optional
         Stop the curve where it leaves this box of configurations (the robot's ``x_range``):
-        the traced ``arc`` is then shorter than asked.
+        the traced ``arc`` is then shorter than asked. A joint that turns freely
+        (:func:`periodic_joints`) is not bounded by it: its angle's range in the box is a
+        window on one turn, not a limit.
 
     Returns
     -------
@@ -197,8 +199,9 @@ def trace(
         )
     y0 = kinematics.forward(base)
     base = project(kinematics, base[None], y0)[0]
-    bounds = None if box is None else np.asarray(box, dtype=float)
+    bounds = None if box is None else np.array(box, dtype=float)
     if bounds is not None:
+        bounds[periodic_joints(kinematics)] = (-np.inf, np.inf)  # (x and x + 2 pi: one posture)
         outside = np.flatnonzero((base < bounds[:, 0]) | (base > bounds[:, 1]))
         if outside.size:
             i = int(outside[0])

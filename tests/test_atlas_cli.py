@@ -173,7 +173,7 @@ def test_arc_and_sampling_set_the_starts(tmp_path):
     ("extra", "text"),
     [
         (["--dask", "local:0"], "local Dask cluster is 'local:N'"),
-        (["--cycles", "0"], "cycles must be between 1 and 1000, got 0 (cycles)"),
+        (["--cycles", "0"], "cycles must be between 1 and 1000, got 0 (field cycles)"),
         (["--arc", "1,2"], "lo <= 0 <= hi"),
     ],
 )
@@ -473,7 +473,9 @@ def test_without_path_the_robot_s_closed_path_is_the_loop(tmp_path, capsys):
     assert default["results"]["pseudoinverse"]["drift"] == doc["results"]["pseudoinverse"]["drift"]
     argv = ["atlas", "--robot", "unicycle", "--quiet", "--out", str(tmp_path / "u.json")]
     assert main(argv) == 2
-    assert "unicycle has no default closed path: give --path" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "unicycle has no default closed path: its default path" in err
+    assert "not a loop: give --path (field --path)" in err
 
 
 def test_the_progress_bar_counts_the_runs_of_every_algorithm(tmp_path, capsys):

@@ -60,10 +60,10 @@ def planned(req: AtlasRequest, limits: AtlasLimits) -> tuple[AtlasPlan, Used]:
         req.robot, req.augmentation, req.algorithms, req.algorithm_parameters, own=True
     )
     spec, inverses = robot.spec, robot.inverses
-    loops = not hasattr(inverses[0].kinematics, "path")  # (the unicycle's path is no loop)
-    path = req.path or loops * [list(t) for t in spec.default_path]
-    if not path:
-        raise RequestError("path", f"{spec.name} has no default closed path: give path")
+    try:
+        path = req.path or spec.default_loop()
+    except InvalidInputError as exc:
+        raise RequestError("path", str(exc)) from None
     named = [(f"path[{i}]", v) for i, v in enumerate(path)]
     named += [(f"shifts[{i}]", v) for i, v in enumerate(req.shifts or [])]
     for name, v in named:

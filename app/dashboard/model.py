@@ -131,7 +131,7 @@ def default_state(
     spec = robot_spec(robot)
     aug = spec.augmentation(None)
     # A platform (the unicycle) starts with the paper's experiment of sec. 6.2: one target.
-    closed = bool(spec.default_path) and not hasattr(spec.build(), "path")
+    closed = bool(spec.default_path) and spec.default_path_loops
     params: dict[str, object] = {p.name: p.default for p in spec.parameters}
     params.update({v.name: tuple(v.default) for v in spec.vector_parameters})
     return DashboardState(

@@ -424,3 +424,21 @@ def test_a_first_point_out_of_reach_is_refused_at_path(client):
         "path: the path's first point (5, 5) is out of reach in the box (x_range, joint limits): "
         "eq. (7) from the reference reaches it only where x1 = 4.34525 is not in [-3, 3]"
     )
+
+
+def test_every_catalogue_arm_has_a_default_atlas_and_the_unicycle_says_why_not(client):
+    """A catalogue arm's atlas with nothing but its name runs (the Gen3's continuous joints
+    turn past the box's pi: a window on one turn, not a limit); the unicycle's default path is
+    its experiment's targets, which /robots says (default_path_loops) and /atlas names."""
+    for arm in ("panda", "iiwa14", "gen3", "ur5e"):
+        r = client.post("/atlas", json={"robot": {"name": arm}, "starts": 3, "cycles": 1})
+        assert r.status_code == 202, (arm, r.text)
+        assert wait_until_ended(client, r.json()["id"])["status"] == "done", arm
+        assert client.delete(f"/atlas/{r.json()['id']}").status_code == 204
+    r = client.post("/atlas", json={"robot": {"name": "unicycle"}, "starts": 3, "cycles": 1})
+    (error,) = r.json()["detail"]
+    assert error["loc"] == ["body", "path"]
+    assert "is the targets of the paper's experiment, reached once, not a loop" in error["msg"]
+    robots = {r["name"]: r for r in client.get("/robots").json()["robots"]}
+    assert robots["unicycle"]["default_path_loops"] is False
+    assert robots["manipulator2"]["default_path_loops"] is True

@@ -54,6 +54,10 @@ class RobotInfo(BaseModel):
     default_x0: list[float]
     default_target: list[float]
     default_path: list[list[float]]
+    default_path_loops: bool = Field(
+        description="whether default_path is a closed task path that /repeatability and "
+        "/atlas drive by default (false: an experiment's targets, the unicycle's, reached once)"
+    )
     default_mode: Mode
     default_gamma: float
     x_range: list[list[float]]
