@@ -1,5 +1,8 @@
-"""The words of a field's refusal by its type (pydantic's error), the same for a REST request and
-a dashboard change: an unknown field, too few or too many entries, else pydantic's own."""
+"""How every refusal is worded, the same for a REST request and a dashboard change: a field's
+path written one way (:func:`field_text`: ``x0[1]``, ``algorithm_parameters.rest[3]``; its
+``loc`` as FastAPI's, :func:`field_loc`), once, as the message's prefix (:func:`refused`,
+:func:`without_field`); the words of pydantic's errors (:func:`refusal`): an unknown field, too
+few or too many entries, else pydantic's own."""
 
 from __future__ import annotations
 
