@@ -22,11 +22,20 @@ PROBE = 8
 
 
 def sized_chunks(plan: AtlasPlan, seconds: float = CHUNK_SECONDS) -> AtlasPlan:
-    """``plan`` with chunks of about ``seconds`` of work, from the time of a chunk of its first
-    :data:`PROBE` runs (a unicycle's run costs hundreds of times a Manipulator 2's); at most the
-    plan's own chunk. The atlas's numbers do not depend on its chunks."""
-    run_chunk(chunk_task(plan, 0, 1))  # (untimed: the first run's one-time costs)
-    probe = chunk_task(plan, 0, min(PROBE, plan.size))
+    """``plan`` with chunks of about ``seconds`` of work, from the time of its first runs (a
+    unicycle's run costs hundreds of times a Manipulator 2's); at most the plan's own chunk.
+    The first run (with its one-time costs) is timed alone: when it takes ``seconds`` or more,
+    a chunk is one run and nothing more is probed (an arm's runs far out of reach take seconds
+    each, and the probe is part of the request); else up to :data:`PROBE` runs, as many as fit
+    in ``seconds`` at the first one's pace, are timed together. The atlas's numbers do not
+    depend on its chunks."""
+    start = perf_counter()
+    run_chunk(chunk_task(plan, 0, 1))
+    first = perf_counter() - start
+    if first >= seconds:
+        return dataclasses.replace(plan, chunk=1)
+    n = int(min(PROBE, plan.size, max(1.0, seconds / max(first, 1e-9))))
+    probe = chunk_task(plan, 0, n)
     start = perf_counter()
     run_chunk(probe)
     per_run = (perf_counter() - start) / (probe.hi - probe.lo)
