@@ -303,15 +303,19 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
             "name",
         )
     allowed = robot_kinds.keys(kind) | ({"parameters"} if kind in ROBOTS else set())
-    unknown = set(d) - allowed
-    if unknown:
+    if unknown := set(d) - allowed:
         key = sorted(map(str, unknown))[0]
         raise InvalidInputError(
             f"unknown key {key!r} for a {kind} robot; known: {sorted(allowed)}", key
         )
     if kind in ROBOTS:
         base = ROBOTS[kind]
-        kin = base.build(**_get(d, "parameters", dict, "a mapping of parameters", {}))
+        try:
+            kin = base.build(**_get(d, "parameters", dict, "a mapping of parameters", {}))
+        except InvalidInputError as exc:  # (a parameter's field, within the definition)
+            if exc.field and not exc.field.startswith("parameters"):
+                exc.field = f"parameters.{exc.field}"
+            raise
         extra, _, _ = augmentations_from_dict(kin, d.get("augmentations", []))
         spec = replace(base, augmentations=(*base.augmentations, *extra)) if extra else base
         return Robot(spec, kin, dict(d))

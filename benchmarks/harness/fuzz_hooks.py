@@ -93,6 +93,9 @@ MAX_FAMILY = 2
 #: Largest |coordinate| of a start, target or path point sent (the unicycle's controls of
 #: amplitude 10 took over a minute a solve).
 MAX_COORDINATE = 3.0
+#: Largest path scale of an atlas sent (a Gen3's default path scaled 54 times lies far out of
+#: reach: runs of seconds each, whose atlas job took the workers from the cases after it).
+MAX_SCALE = 3.0
 #: The posture inverse's gain sent (its pull toward the rest posture, up to the engine's 100 per
 #: unit of path, drives the unicycle's controls far beyond +-3 within one leg).
 MAX_GAIN = 1.0
@@ -117,6 +120,11 @@ def _capped(body: dict) -> dict:
     for name in ("x0", "target", "path", "reference"):
         if name in body:
             body[name] = _clamped(body[name])
+    if isinstance(body.get("scales"), list):
+        body["scales"] = [
+            min(v, MAX_SCALE) if isinstance(v, float | int) and not isinstance(v, bool) else v
+            for v in body["scales"]
+        ]
     for name in ("region", "fixed"):  # (a box of the unicycle's lambdas over +-100 took 20 s)
         if isinstance(body.get(name), dict):
             body[name] = {k: _clamped(v) for k, v in body[name].items()}

@@ -164,6 +164,7 @@ def test_an_atlas_after_a_cancel_starts_at_once(tabs):
     poll(lambda: gone(f"{tab.base}/atlas/{second}"), "the second job forgotten (404)")
 
 
+@pytest.mark.slow
 def test_the_atlas_panels_csv_downloads_the_table_of_the_atlas_shown(tabs):
     """Its CSV button, off until an atlas is drawn, downloads that atlas's table: the header
     the engine's AtlasResult.columns() of the same request, a row per start, algorithm and

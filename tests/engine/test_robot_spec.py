@@ -171,7 +171,7 @@ def test_more_than_one_degree_of_redundancy_takes_a_vector_of_formula_maps():
         (
             {
                 "name": "e2_synthesized",
-                "region": {"x2": [0, 1], "x3": [0, 1]},
+                "region": {"x2": [0, 1], "x3": [0, 1], "x4": [0, 1]},
                 "frame_axes": [1, 1, 2],
             },
             "augmentations.0.frame_axes",
@@ -220,7 +220,11 @@ def test_more_than_one_degree_of_redundancy_takes_a_vector_of_formula_maps():
         ),
         ({**ARM3R, "augmentations": [{"name": "cubic"}]}, "augmentations.0", "must be"),
         ({**M2_FORMULA, "task": ["x2 +* x3"]}, "task.0", "expected a number"),
-        ({"name": "manipulator2", "parameters": {"l": 99}}, None, "l must be in [0.1, 5]"),
+        (
+            {"name": "manipulator2", "parameters": {"l": 99}},
+            "parameters.l",
+            "l must be in [0.1, 5]",
+        ),
     ],
 )
 def test_bad_definitions_name_the_field(definition, field, text):
