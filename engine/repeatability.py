@@ -378,4 +378,5 @@ def _stopped_leg(inverse, x, target, exc, mode, gamma, record) -> SolveResult:
         x.copy(),
         np.asarray(target, dtype=float),
         inverse,
+        "raised",
     )

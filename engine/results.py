@@ -19,6 +19,7 @@ from .exceptions import InvalidInputError
 from .exports import Columns, coordinate_columns, short_text, short_vector
 from .inverses import Inverse
 from .run_settings import RunSettings
+from .solve_rules import Status
 from .validation import FloatArray
 
 
@@ -108,6 +109,12 @@ class SolveResult(Columns):
         The start and the target.
     inverse : str
         The inverse as printed: its algorithm, parameters, map and robot.
+    status : str
+        Why the run stopped, for a caller that words its own message: "converged",
+        "max_steps" (out of iterations or integrator steps), "diverged", "stalled", "singular"
+        (the inverse singular where it stopped) or "raised" (a typed error stopped it where it
+        is: :func:`jik.engine.solve_chunks.solve_in_chunks`, a leg of
+        :func:`jik.engine.repeatability.repeatability` whose progress stops at errors).
     """
 
     x: FloatArray
@@ -123,6 +130,7 @@ class SolveResult(Columns):
     x0: FloatArray
     y_d: FloatArray
     _inverse: Inverse | None = field(default=None, repr=False, compare=False)
+    status: str = field(default="", repr=False)
 
     @property
     def inverse(self) -> str:
@@ -196,7 +204,7 @@ class BatchSolveResult(Columns):
     _rec_member: FloatArray | None = field(repr=False, default=None)
     _rec_theta: FloatArray | None = field(repr=False, default=None)
     _rec_x: FloatArray | None = field(repr=False, default=None)
-    # Each member's outcome (solve_rules.Status): solve_in_chunks words its message.
+    # Each member's outcome (solve_rules.Status), named by its SolveResult's ``status``.
     _status: FloatArray | None = field(repr=False, default=None)
 
     def __len__(self) -> int:
@@ -281,6 +289,7 @@ class BatchSolveResult(Columns):
             x0=self.x0[i],
             y_d=self.y_d[i],
             _inverse=self._inverse,
+            status=Status.NAMES[int(self._status[i])] if self._status is not None else "",
         )
 
 

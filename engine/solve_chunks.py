@@ -120,8 +120,7 @@ def solve_in_chunks(
             k = 1 if pieces else 0  # (a chunk starts where the one before ended)
             h = None if tr.h is None else tr.h[k:]
             pieces.append(Trajectory(tr.theta[k:] + done, tr.x[k:], tr.y[k:], tr.error[k:], h))
-        assert batch._status is not None  # (solve sets it)
-        done, x, last, status = done + res.nit, res.x, res, int(batch._status[0])
+        done, x, last, status = done + res.nit, res.x, res, Status.NAMES.index(res.status)
         if res.success or res.nit < size or done >= cap:
             break
         if between is not None:
@@ -138,7 +137,14 @@ def solve_in_chunks(
             status, done, last.error, tol, "discrete", gamma, last.x, inverse, cap, y_d
         )
     trajectory = _joined(pieces) if pieces else None
-    return replace(last, message=message, nit=done, trajectory=trajectory, x0=start)
+    return replace(
+        last,
+        message=message,
+        nit=done,
+        trajectory=trajectory,
+        x0=start,
+        status="raised" if stopped is not None else last.status,
+    )
 
 
 def _joined(pieces: list[Trajectory]) -> Trajectory:

@@ -50,6 +50,8 @@ class Status:
     """A member's outcome: running, or why it stopped (kept as ints in arrays of statuses)."""
 
     RUNNING, CONVERGED, SINGULAR, MAX_STEPS, DIVERGED, STALLED = range(6)
+    #: Each outcome's name, as :attr:`jik.engine.results.SolveResult.status` gives it.
+    NAMES = ("running", "converged", "singular", "max_steps", "diverged", "stalled")
 
 
 def gamma_problem(gamma: float, mode: str) -> str | None:

@@ -17,6 +17,7 @@ from ...engine.repeatability import Leg, Resume, closed_path, repeatability
 from ...engine.results import SolveResult, Trajectory
 from ...engine.run_settings import RunSettings
 from ...engine.solve_rules import counted
+from ...engine.stall import reach_note
 from ...engine.unicycle import Unicycle
 from .controls import max_iterations
 from .model import DashboardState
@@ -133,9 +134,9 @@ def _run_legs(
         if leg.stopped_by is not None:
             failure = f"{where} stopped: {leg.stopped_by}"
         elif not res.success:
-            failure = f"{where}: {_leg_message(res, cap)}"
+            failure = f"{where}: {_leg_message(res, cap, inverse.kinematics)}"
         else:
-            last = _leg_message(res, cap)
+            last = _leg_message(res, cap, inverse.kinematics)
         progress()
 
     path, close = (state.path, True) if state.task == "path" else (targets, False)
@@ -158,8 +159,8 @@ def _run_legs(
     except RunCancelled:
         raise Cancelled from None
     ends = run.legs[np.isfinite(run.legs).all(axis=1)]
-    cycle_ends = ends[L - 1 :: L] if state.task == "path" else ends[:0]
-    drift = [float(np.linalg.norm(e - x0)) for e in cycle_ends]
+    # (the cycles that ended: a failed leg leaves NaN from there on)
+    drift = run.drift[np.isfinite(run.drift)] if state.task == "path" else run.drift[:0]
     return AlgorithmRun(
         algorithm=inverse.name,
         theta=np.concatenate([p[0] for p in parts]),
@@ -169,7 +170,7 @@ def _run_legs(
         h=None if parts[0][4] is None else np.concatenate([p[4] for p in parts]),
         leg=np.concatenate([np.broadcast_to(p[5], len(p[0])) for p in parts]),
         leg_end=ends,
-        drift=np.asarray(drift),
+        drift=drift,
         success=bool(run.success),
         message=failure or _legs_message(len(ends), drift, last),
         seconds=time.perf_counter() - t0,
@@ -177,14 +178,15 @@ def _run_legs(
     )
 
 
-def _leg_message(res: SolveResult, cap: int) -> str:
+def _leg_message(res: SolveResult, cap: int, kinematics) -> str:
     """A leg's message in the dashboard's words: a discrete leg in iterations (not tol), and a
-    leg stopped by the cap (``cap``) naming the control that sets it."""
-    if not res.success and "did not converge within" in res.message:
+    leg stopped by the cap (``cap``, :attr:`~jik.engine.results.SolveResult.status`
+    "max_steps") naming the control that sets it, or the target out of reach
+    (:func:`jik.engine.stall.reach_note`)."""
+    if res.status == "max_steps":
         what = "iterations" if res.mode == "discrete" else "integrator steps"
-        if "out of reach" in res.message:  # (the engine's words: what to change is the target)
-            advice = res.message.split("; ", 1)[1]
-        else:
+        advice, _ = reach_note(kinematics, res.y_d)
+        if advice is None:
             nearer = res.mode == "discrete" and res.gamma != 1.0
             advice = f"raise “max {what} per leg” (a control above)" + (
                 ", take γ nearer 1" if nearer else ""

@@ -318,6 +318,7 @@ def test_a_leg_that_raises_stops_the_run_with_the_legs_before_it(monkeypatch):
     assert len(seen) == 2 and seen[1].stopped_by is not None
     stop = seen[1].result
     assert not stop.success and stop.nit == 0 and stop.message == str(seen[1].stopped_by)
+    assert stop.status == "raised" and seen[0].result.status == "converged"
     np.testing.assert_array_equal(stop.trajectory.x, res.legs[:1])
     np.testing.assert_array_equal(stop.trajectory.theta, [0.0])
     assert stop.trajectory.h is not None and len(res.leg_results) == 2

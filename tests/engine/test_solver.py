@@ -98,15 +98,16 @@ def test_iteration_cap_gives_failure_with_message():
     res = solve(
         Pseudoinverse(Manipulator2()), X0, [1, 1], gamma=0.01, mode="discrete", max_iterations=3
     )
-    assert not res.success
+    assert not res.success and res.status == "max_steps"
     assert "did not converge within 3 iterations" in res.message
+    assert solve(Pseudoinverse(Manipulator2()), X0, [1, 1]).status == "converged"
 
 
 def test_unreachable_pass_through_algorithmic_singularity_stops_with_message():
     """(36) with a = 1, b = 0 is singular on x1 = 0: driving x1 across 0 must stop, not hang."""
     inv = ExtendedInverse(Manipulator1(), E2Optimal(a=1.0, b=0.0))
     res = solve(inv, [0.5, 0.2, 1.0], [-0.5, 0.2])
-    assert not res.success
+    assert not res.success and res.status in ("singular", "stalled")
     assert "singular" in res.message or "stalled" in res.message
 
 
@@ -340,7 +341,7 @@ def test_chain_guesses_refuse_bad_input_and_give_none_at_a_singularity():
 
 def _same_run(a, b) -> None:
     """Two results of eq. (7) with the same numbers, bit for bit."""
-    assert (a.success, a.nit, a.message) == (b.success, b.nit, b.message)
+    assert (a.success, a.nit, a.message, a.status) == (b.success, b.nit, b.message, b.status)
     np.testing.assert_array_equal(a.x, b.x)
     for name in ("theta", "x", "y", "error", "h"):
         np.testing.assert_array_equal(getattr(a.trajectory, name), getattr(b.trajectory, name))
@@ -407,6 +408,7 @@ def test_a_run_that_diverges_in_a_later_chunk_counts_all_its_iterations():
     inv = _ThrownNearTarget(Manipulator2(), 1e-3)
     one = solve(inv, X0, [1, 1], gamma=0.3, mode="discrete")
     assert not one.success and one.message.startswith(f"diverged after {one.nit} iterations")
+    assert one.status == "diverged"
     chunk = 5 if one.nit % 5 else 6  # (not at a chunk's end: see solve_in_chunks' Notes)
     assert one.nit > chunk
     _same_run(solve_in_chunks(inv, X0, [1, 1], chunk=chunk, gamma=0.3), one)
@@ -423,7 +425,7 @@ def test_a_typed_error_inside_a_chunk_keeps_every_iterate_before_it():
     with pytest.raises(AlgorithmicSingularityError):
         solve(_UndefinedNearTarget(kin, 1e-3), X0, [1, 1], gamma=0.3, mode="discrete")
     res = solve_in_chunks(_UndefinedNearTarget(kin, 1e-3), X0, [1, 1], chunk=7, gamma=0.3)
-    assert not res.success and res.nit == m
+    assert not res.success and res.nit == m and res.status == "raised"
     assert res.message.startswith(f"stopped after {m} iterations: undefined near the target")
     np.testing.assert_array_equal(res.trajectory.x, plain.trajectory.x[: m + 1])
     np.testing.assert_array_equal(res.x, plain.trajectory.x[m])
