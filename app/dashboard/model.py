@@ -125,32 +125,51 @@ def robot_and_map(state: DashboardState) -> dict:
 def default_state(
     robot: str = DEFAULT_ROBOT, definition: Mapping[str, Any] | None = None
 ) -> DashboardState:
-    """The registry's defaults for ``robot``; for a user robot, its definition's."""
-    if definition is not None or robot in USER_KINDS:
-        return _user_default_state(robot, definition)
-    spec = robot_spec(robot)
+    """The registry's defaults for ``robot``; for a user robot, its definition's start, target,
+    path and first map. A platform (the unicycle) starts with the paper's experiment of
+    sec. 6.2: one target."""
+    user = definition is not None or robot in USER_KINDS
+    if user:
+        definition = _user_definition(robot, definition)
+        spec = _redundant_robot(definition).spec
+    else:
+        spec = robot_spec(robot)
     aug = spec.augmentation(None)
-    # A platform (the unicycle) starts with the paper's experiment of sec. 6.2: one target.
     closed = bool(spec.default_path) and spec.default_path_loops
     params: dict[str, object] = {p.name: p.default for p in spec.parameters}
     params.update({v.name: tuple(v.default) for v in spec.vector_parameters})
-    return DashboardState(
-        robot=spec.name,
-        robot_parameters=params,
-        augmentation=aug.name,
-        augmentation_parameters={p.name: p.default for p in aug.parameters},
-        gamma=float(spec.default_gamma),
-        mode=spec.default_mode,
-        x0=tuple(float(v) for v in spec.default_x0),
-        task="path" if closed else "target",
-        target=tuple(float(v) for v in spec.default_target),
-        path=tuple(tuple(float(v) for v in p) for p in spec.default_path),
-        cycles=3 if closed else 1,
-    )
+    try:
+        return DashboardState(
+            robot=spec.name,
+            robot_parameters=params,
+            robot_definition=dict(definition) if definition is not None else None,
+            augmentation=aug.name,
+            augmentation_parameters={p.name: p.default for p in aug.parameters},
+            gamma=float(spec.default_gamma),
+            mode=spec.default_mode,
+            x0=tuple(float(v) for v in spec.default_x0),
+            task="path" if closed else "target",
+            target=tuple(float(v) for v in spec.default_target),
+            path=tuple(tuple(float(v) for v in p) for p in spec.default_path),
+            cycles=3 if closed else 1,
+        )
+    except ValidationError as exc:
+        if not user:
+            raise
+        # Defaults the robot computes (its target k(x0), its path) outside the dashboard's
+        # ranges: the definition is what the user can change.
+        first = exc.errors()[0]
+        where = field_text(".".join(str(p) for p in first["loc"]))
+        raise InvalidInputError(
+            f"robot_definition: the robot's default {where} is refused by the dashboard "
+            f"({first['msg']}); change the definition (its start x0 or its parameters)",
+            "robot_definition",
+        ) from None
 
 
-def _user_default_state(robot: str, definition: Mapping[str, Any] | None) -> DashboardState:
-    """The defaults of a user robot: its definition's start, target, path and first map."""
+def _user_definition(robot: str, definition: Mapping[str, Any] | None) -> Mapping[str, Any]:
+    """The definition of a user robot of kind ``robot``: the one given, else a catalogue arm's
+    own (:func:`~jik.app.dashboard.robots.default_definition`); refused naming its field."""
     definition = default_definition(robot) if definition is None else definition
     if not isinstance(definition, Mapping):
         raise InvalidInputError(
@@ -163,32 +182,7 @@ def _user_default_state(robot: str, definition: Mapping[str, Any] | None) -> Das
             f"{definition.get('name')!r}",
             "robot_definition.name",
         )
-    spec = _redundant_robot(definition).spec
-    try:
-        return DashboardState(
-            robot=robot,
-            robot_parameters={},
-            robot_definition=dict(definition),
-            augmentation=spec.augmentation(None).name,
-            augmentation_parameters={},
-            gamma=float(spec.default_gamma),
-            mode=spec.default_mode,
-            x0=tuple(float(v) for v in spec.default_x0),
-            task="path" if spec.default_path else "target",
-            target=tuple(float(v) for v in spec.default_target),
-            path=tuple(tuple(float(v) for v in p) for p in spec.default_path),
-            cycles=3 if spec.default_path else 1,
-        )
-    except ValidationError as exc:
-        # Defaults the robot computes (its target k(x0), its path) outside the dashboard's
-        # ranges: the definition is what the user can change.
-        first = exc.errors()[0]
-        where = field_text(".".join(str(p) for p in first["loc"]))
-        raise InvalidInputError(
-            f"robot_definition: the robot's default {where} is refused by the dashboard "
-            f"({first['msg']}); change the definition (its start x0 or its parameters)",
-            "robot_definition",
-        ) from None
+    return definition
 
 
 def updated_state(state: DashboardState, patch: Mapping[str, object]) -> DashboardState:
@@ -317,15 +311,10 @@ def _user_robot(state: DashboardState) -> tuple[Any, Any, dict, dict]:
             + ("removed" if definition is not None else "given"),
             "robot_definition",
         )
-    if definition.get("name") != state.robot:
-        raise InvalidInputError(
-            f"robot_definition.name: must be the robot's kind {state.robot!r}",
-            "robot_definition.name",
-        )
     for key in ("robot_parameters", "augmentation_parameters"):
         if getattr(state, key):
             raise refused(key, "a user robot has none")
-    robot = _redundant_robot(definition)
+    robot = _redundant_robot(_user_definition(state.robot, definition))
     _registered(lambda: robot.spec.augmentation(state.augmentation), "augmentation")
     return robot.spec, robot.kinematics, {}, {}
 
