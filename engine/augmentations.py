@@ -16,6 +16,32 @@ import numpy as np
 from .exceptions import InvalidInputError
 from .validation import FloatArray, finite
 
+#: h counts as conserved along a run when it changed by less than this (:func:`h_change`).
+H_CONSERVED = 1e-6
+
+
+def h_change(h) -> float | None:
+    """How much h varied along a run: max - min over the finite values of each component of h
+    (``h`` of shape (m,) or (m, p - r), one row per point), the largest of those; None without
+    h or without a finite value (h undefined from the start).
+
+    Notes
+    -----
+    The continuous extended Jacobian run (7) with (11) keeps each component of h constant on
+    its own, eq. (12): components at different constant values have changed by 0, not by
+    their spread.
+    """
+    if h is None:
+        return None
+    v = np.asarray(h, dtype=float)
+    columns = v.reshape(len(v), -1) if v.ndim else v.reshape(1, 1)
+    known = np.isfinite(columns)
+    if not known.any():
+        return None
+    high = np.where(known, columns, -np.inf).max(axis=0)
+    low = np.where(known, columns, np.inf).min(axis=0)
+    return float((high - low)[known.any(axis=0)].max())
+
 
 class AugmentingMap(abc.ABC):
     """h: R^p -> R^(p-r) with p - r = 1, eq. (9); dh/dx is its exact gradient."""

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...engine.augmentations import h_change
 from .joint_limits import limits_summary
 from .runs import DashboardResult
 
@@ -106,22 +107,6 @@ def jsonable(v):
     if isinstance(v, np.generic):
         return v.item()
     raise TypeError(f"not JSON serialisable: {type(v).__name__}")
-
-
-def h_change(h) -> float | None:
-    """How much h varied along a run: max - min over the finite values of each component of h
-    (one per point, or p - r per point), the largest of those; None without h or without a finite
-    value (h undefined from the start). Eq. (12) keeps each component constant on its own."""
-    if h is None:
-        return None
-    v = np.asarray(h, dtype=float)
-    columns = v.reshape(len(v), -1) if v.ndim else v.reshape(1, 1)
-    finite = np.isfinite(columns)
-    if not finite.any():
-        return None
-    high = np.where(finite, columns, -np.inf).max(axis=0)
-    low = np.where(finite, columns, np.inf).min(axis=0)
-    return float((high - low)[finite.any(axis=0)].max())
 
 
 def summary(result: DashboardResult) -> dict:

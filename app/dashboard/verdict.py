@@ -16,17 +16,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...engine.augmentations import H_CONSERVED, h_change
 from ...engine.registry import POSE_A, POSE_B
 from ...engine.repeatability import REPEATABLE_DRIFT
 from .joint_limits import limits_texts
-from .messages import h_change
 from .plotting import norm_unit, units
 from .runs import AlgorithmRun, DashboardResult
 from .singular import singular_sentence
-from .verdict_algorithms import NAMES, practical_sentences
+from .verdict_algorithms import NAMES, g, practical_sentences
 
-#: h counts as conserved when it changed by less than this along a run.
-H_CONSERVED = 1e-6
 #: In discrete mode, a gamma at or above this is "near 2" (the iteration's stability limit).
 GAMMA_NEAR_TWO = 1.5
 
@@ -42,11 +40,6 @@ class Sentence:
 
     def as_dict(self) -> dict:
         return {"text": self.text, "algorithm": self.algorithm, "role": self.role}
-
-
-def g(v: float) -> str:
-    """A number in 3 significant digits."""
-    return f"{v:.3g}"
 
 
 def repeatable(run: AlgorithmRun) -> bool | None:

@@ -8,11 +8,10 @@ import json
 import math
 
 import numpy as np
-import pytest
 
 from jik.app.dashboard import Dashboard, compute, default_state, updated_state
 from jik.app.dashboard import session as session_module
-from jik.app.dashboard.messages import h_change, summary, to_json
+from jik.app.dashboard.messages import summary, to_json
 from jik.app.dashboard.verdict import verdict
 from jik.engine.exceptions import JikError
 
@@ -21,21 +20,6 @@ POSE_B = [-5.0, 5.0, math.pi / 2]
 
 def texts(result) -> str:
     return " ".join(s["text"] for s in verdict(result))
-
-
-def test_h_change_is_each_components_own_range():
-    """A vector h (p - r components) is conserved when each component is: components that sit
-    at different constant values have changed by 0, not by their spread; the largest range of
-    one component is the change; undefined points are skipped."""
-    constant = np.tile([0.785, -0.785, 0.1, 2.0], (5, 1))
-    assert h_change(constant) == 0.0
-    drifting = constant.copy()
-    drifting[:, 2] += np.linspace(0.0, 0.25, 5)
-    drifting[1, 0] = np.nan
-    assert h_change(drifting) == pytest.approx(0.25, abs=1e-15)
-    assert h_change(np.array([0.3, np.nan, 0.5])) == pytest.approx(0.2, abs=1e-15)
-    assert h_change(np.full((3, 2), np.nan)) is None
-    assert h_change(None) is None
 
 
 def test_nan_and_inf_become_null_in_json():

@@ -67,3 +67,18 @@ def test_printed_j32_j33_are_not_the_gradient_of_38():
 def test_bad_parameters(make, match):
     with pytest.raises(InvalidInputError, match=match):
         make()
+
+
+def test_h_change_is_each_components_own_range():
+    """A vector h (p - r components) is conserved when each component is: components that sit
+    at different constant values have changed by 0, not by their spread; the largest range of
+    one component is the change; undefined points are skipped."""
+    constant = np.tile([0.785, -0.785, 0.1, 2.0], (5, 1))
+    assert aug.h_change(constant) == 0.0
+    drifting = constant.copy()
+    drifting[:, 2] += np.linspace(0.0, 0.25, 5)
+    drifting[1, 0] = np.nan
+    assert aug.h_change(drifting) == pytest.approx(0.25, abs=1e-15)
+    assert aug.h_change(np.array([0.3, np.nan, 0.5])) == pytest.approx(0.2, abs=1e-15)
+    assert aug.h_change(np.full((3, 2), np.nan)) is None
+    assert aug.h_change(None) is None
