@@ -66,14 +66,16 @@ DEFAULT_BOX = (-10.0, 10.0)
 @dataclass(frozen=True)
 class Style:
     """How one algorithm is drawn: ``color`` everywhere, ``dash`` (plotly's) and ``symbol``
-    (a marker) in the plots, ``label``/``short`` its names, ``line``/``robot`` the key's words,
-    and its copy in the 3D scene: ``opacity`` (None: solid) at height ``z``."""
+    (a marker) in the plots, ``label``/``short`` its names, ``named`` its name in the
+    verdict's sentences, ``line``/``robot`` the key's words, and its copy in the 3D scene:
+    ``opacity`` (None: solid) at height ``z``."""
 
     color: str
     dash: str
     symbol: str
     label: str
     short: str
+    named: str
     line: str
     robot: str
     opacity: float | None
@@ -88,6 +90,7 @@ STYLES: dict[str, Style] = {
         "circle",
         "pseudoinverse J^P# (8)",
         "J^P# (8)",
+        "pseudoinverse J^P#",
         "solid line",
         "translucent robot",
         0.55,
@@ -100,6 +103,7 @@ STYLES: dict[str, Style] = {
         "diamond",
         "extended Jacobian J^E# (11)",
         "J^E# (11)",
+        "extended Jacobian J^E#",
         "dashed line",
         "opaque robot",
         None,
@@ -111,6 +115,7 @@ STYLES: dict[str, Style] = {
         "square",
         "damped least squares J^DLS",
         "DLS",
+        "damped least squares J^DLS",
         "dotted line",
         "translucent orange robot",
         0.6,
@@ -123,6 +128,7 @@ STYLES: dict[str, Style] = {
         "triangle-up",
         "weighted least-norm J^W#",
         "J^W#",
+        "weighted least-norm J^W#",
         "dash-dotted line",
         "translucent brown robot",
         0.6,
@@ -135,6 +141,7 @@ STYLES: dict[str, Style] = {
         "star",
         "posture J^P# + null space k(x_rest - x)",
         "posture",
+        "posture inverse (J^P# with a null-space pull)",
         "long-dashed line",
         "translucent teal robot",
         0.6,

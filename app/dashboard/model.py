@@ -33,7 +33,6 @@ from ..compute.schemas.algorithms import Algorithm
 from ..compute.schemas.wording import field_text, refusal, refused, without_field
 from .algorithms import CHOICES, DEFAULT_ALGORITHMS, check_inverses, checked, checked_rest
 from .algorithms import COLORS as COLORS  # (re-exported: one table, there)
-from .algorithms import DASH as DASH
 from .algorithms import LABELS as LABELS
 from .algorithms import cache_key as cache_key
 from .algorithms import runs_key as runs_key

@@ -11,19 +11,13 @@ from __future__ import annotations
 import numpy as np
 
 from ...engine.repeatability import REPEATABLE_DRIFT
-from .algorithms import rest_words, scalar
+from .algorithms import STYLES, rest_words, scalar
 from .joint_limits import state_limits
 from .robots import state_inverse, state_kinematics, state_spec
 from .runs import AlgorithmRun, DashboardResult
 
 #: The algorithms' names in the verdict's sentences.
-NAMES = {
-    "pseudoinverse": "pseudoinverse J^P#",
-    "extended": "extended Jacobian J^E#",
-    "damped": "damped least squares J^DLS",
-    "weighted": "weighted least-norm J^W#",
-    "posture": "posture inverse (J^P# with a null-space pull)",
-}
+NAMES = {a: s.named for a, s in STYLES.items()}
 
 
 def g(v: float) -> str:
