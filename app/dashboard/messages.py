@@ -28,6 +28,11 @@ class Event:
     data: str
     result: DashboardResult | None = None
 
+    @classmethod
+    def of(cls, kind: str, generation: int, **data) -> Event:
+        """The event whose JSON is ``{"type": kind, "generation": generation, **data}``."""
+        return cls(kind, generation, to_json({"type": kind, "generation": generation, **data}))
+
 
 class LatestEvents:
     """The events a listener has not taken yet, at most one of each kind (the newest; of

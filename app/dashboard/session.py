@@ -27,7 +27,7 @@ from .controls import controls_message
 from .figures import gamma_free_panels
 from .listeners import Listeners
 from .map_synthesis import built_map
-from .messages import Event, digest, finite, summary, to_json, with_figures
+from .messages import Event, digest, finite, summary, with_figures
 from .model import (
     COLORS,
     LABELS,
@@ -97,9 +97,7 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
         self._robot_since = 0
         # key -> (E1/E2 functionals or None, their sensitivity)
         self._functionals_cache: dict[str, tuple[dict | None, dict]] = {}
-        self._latest: dict[str, Event] = {
-            "state": Event("state", 1, to_json(self._state_message(1, self._state, "initial")))
-        }
+        self._latest: dict[str, Event] = {"state": self._state_event(1, self._state, "initial")}
         self.result: DashboardResult | None = None
         self.functionals: dict | None = None
         # The second phase (_second_phase): the generation whose phase runs (None when none
@@ -150,16 +148,17 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
         raise it."""
         with self._cond:
             generation, state = self._generation, self._state
-        refused = {
-            "type": "refused",
-            "generation": generation,
-            "source": source,
-            "field": refusal.field,
-            "message": str(refusal),
-            "state": state.as_dict(),
-            **controls_message(state),
-        }
-        self._emit(Event("refused", generation, to_json(refused)))
+        self._emit(
+            Event.of(
+                "refused",
+                generation,
+                source=source,
+                field=refusal.field,
+                message=str(refusal),
+                state=state.as_dict(),
+                **controls_message(state),
+            )
+        )
         raise refusal
 
     def update(
@@ -190,9 +189,7 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
                 self._cond.notify_all()
         if refusal is not None:
             self.refuse(refusal, source)
-        self._emit(
-            Event("state", generation, to_json(self._state_message(generation, state, source)))
-        )
+        self._emit(self._state_event(generation, state, source))
         self.start()
         return generation, state
 
@@ -216,14 +213,10 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
             )
 
     # -- worker -----------------------------------------------------------------------------
-    def _state_message(self, generation: int, state: DashboardState, source: str) -> dict:
-        return {
-            "type": "state",
-            "generation": generation,
-            "state": state.as_dict(),
-            "source": source,
-            **controls_message(state),
-        }
+    def _state_event(self, generation: int, state: DashboardState, source: str) -> Event:
+        return Event.of(
+            "state", generation, state=state.as_dict(), source=source, **controls_message(state)
+        )
 
     def _work(self) -> None:
         while True:
@@ -263,15 +256,7 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
             if on_screen is None
             else {"generation": on_screen.generation, "state": on_screen.state.as_dict()}
         )
-        self._emit(
-            Event(
-                "error",
-                generation,
-                to_json(
-                    {"type": "error", "generation": generation, "message": message, "shown": shown}
-                ),
-            )
-        )
+        self._emit(Event.of("error", generation, message=message, shown=shown))
         self._finish(generation)
 
     def _finish(self, generation: int) -> None:
@@ -294,19 +279,13 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
             if now - last[0] > 0.1 or (fraction >= 1 and phase == "runs"):
                 last[0] = now
                 self._emit(
-                    Event(
+                    Event.of(
                         "progress",
                         generation,
-                        to_json(
-                            {
-                                "type": "progress",
-                                "generation": generation,
-                                "phase": phase,
-                                "what": what,
-                                "fraction": fraction,
-                                "elapsed": now - t0,
-                            }
-                        ),
+                        phase=phase,
+                        what=what,
+                        fraction=fraction,
+                        elapsed=now - t0,
                     )
                 )
 
