@@ -5,7 +5,6 @@ from __future__ import annotations
 import asyncio
 import hashlib
 import json
-import math
 from collections import OrderedDict
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -13,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...engine.augmentations import h_change
+from ..compute.documents import nullable
 from .joint_limits import limits_summary
 from .runs import DashboardResult
 
@@ -89,14 +89,8 @@ def finite(v):
         return {k: finite(x) for k, x in v.items()}
     if isinstance(v, list | tuple):
         return [finite(x) for x in v]
-    if isinstance(v, float | np.floating):
-        return float(v) if math.isfinite(v) else None
-    if isinstance(v, np.ndarray) and v.dtype.kind in "fc":
-        if np.isfinite(v).all():
-            return v.tolist()
-        out = v.astype(object)
-        out[~np.isfinite(v)] = None
-        return out.tolist()
+    if isinstance(v, float | np.floating) or (isinstance(v, np.ndarray) and v.dtype.kind == "f"):
+        return nullable(v)
     return v
 
 

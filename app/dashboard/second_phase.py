@@ -74,11 +74,6 @@ class SecondPhase:
         self.what = GRID if grid else FUNCTIONALS
         self.fraction = 0.0
 
-    @property
-    def grid_done(self) -> bool:
-        """Whether h is on its grid (computed here, or before)."""
-        return self.result.augmenting is not None
-
     def _step(self, what: str, before: int) -> Callable[[int, int], None]:
         """The progress callback of a stage that starts after ``before`` steps: ``(done, _)``
         of its own steps. It reports the fraction of the whole phase and raises

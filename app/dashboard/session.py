@@ -48,6 +48,9 @@ from .slots import FairSlots
 from .verdict import verdict
 
 log = logging.getLogger("jik.dashboard")
+#: Seconds the worker waits after a change for a newer one (short: the page already coalesces a
+#: slider drag into one request in flight at a time).
+DEBOUNCE = 0.002
 
 
 class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
@@ -57,9 +60,6 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
     ----------
     state : DashboardState, optional
         Initial state (registry defaults of :data:`DEFAULT_ROBOT`).
-    debounce : float
-        Seconds the worker waits after a change for a newer one (short: the page already
-        coalesces a slider drag into one request in flight at a time).
     offload : Offload, optional
         The server's compute pool (shared with the API and the other dashboards): one algorithm
         runs there, in this dashboard's own lane (:meth:`Offload.lane`); ``jik serve`` gives it.
@@ -72,7 +72,6 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
         self,
         state: DashboardState | None = None,
         *,
-        debounce: float = 0.002,
         offload: Offload | None = None,
         slots: FairSlots | None = None,
     ) -> None:
@@ -82,7 +81,6 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
         self._state = validate((state or default_state()).as_dict())
         self._generation = 1
         self._done = 0  # last generation whose computation finished (or failed)
-        self._debounce = debounce
         self._changed_at = {1: time.perf_counter()}
         self._listeners: list[Callable[[Event], None]] = []
         self._fast = 0  # the first ``_fast`` listeners are the quick ones
@@ -230,10 +228,10 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
                 rerun, self._rerun = self._rerun, None
                 if self._done < self._generation:  # (a change: the rerun is superseded)
                     rerun = None
-                    # Debounce: wait until no change arrived for ``debounce`` seconds.
+                    # Debounce: wait until no change arrived for DEBOUNCE seconds.
                     while True:
                         seen = self._generation
-                        self._cond.wait(self._debounce)
+                        self._cond.wait(DEBOUNCE)
                         if self._generation == seen or self._stopped:
                             break
                 generation, state = self._generation, self._state

@@ -63,7 +63,7 @@ def test_progress_counts_the_steps_of_the_grid_then_of_e1_e2():
     assert [w for _, w in seen] == [GRID] * steps + [FUNCTIONALS] * 2
     fractions = [f for f, _ in seen]
     assert fractions == sorted(set(fractions)) and fractions[-1] == pytest.approx(1.0)
-    assert phase.grid_done and sens["kind"] == "unavailable"
+    assert phase.result.augmenting is not None and sens["kind"] == "unavailable"
     again = error_functionals(phase.result)
     assert json.dumps(functionals) == json.dumps(again)
 
@@ -90,7 +90,7 @@ def test_cancelled_during_the_grid_nothing_is_shown_as_computed():
     )
     with pytest.raises(Cancelled):
         phase.run()
-    assert not phase.grid_done and phase.what == GRID
+    assert phase.result.augmenting is None and phase.what == GRID
     message = json.loads(cancelled_message(phase, 7))
     assert message["functionals"] is None and message["sensitivity"] is None
     assert message["cancelled"]["panels"] == ["augmenting", "sensitivity"]
@@ -116,7 +116,7 @@ def test_cancelled_after_the_grid_keeps_h_and_says_e1_e2_were_not_computed():
     phase, _ = _phase(kin, amap, result, deferred=True, cancelled=cancelled)
     with pytest.raises(Cancelled):
         phase.run()
-    assert phase.grid_done
+    assert phase.result.augmenting is not None
     message = json.loads(cancelled_message(phase, 7))
     h = message["figures"]["augmenting"]
     assert h["data"][0]["type"] == "contour"
