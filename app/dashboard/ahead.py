@@ -11,7 +11,7 @@ from collections.abc import Callable
 
 from ...engine.exceptions import InvalidInputError, JikError
 from .analysis import expensive_map, kinematics_and_map
-from .messages import Event, digest, with_figures
+from .messages import Event, with_figures
 from .model import DashboardState, cache_key, updated_state
 from .offload import OffloadLane
 from .plotting import PANELS
@@ -96,9 +96,8 @@ class SolvingAhead:
             except Exception:  # (work ahead: logged, never shown as the current result's error)
                 log.exception("solving %s ahead failed", robot)
                 return
-            digests = {k: digest(t) for k, t in texts.items()}
             self._ahead_sent[robot] = self._robot_since
-            head = {"type": "ahead", "generation": generation, "robot": robot, "digests": digests}
+            head = {"type": "ahead", "generation": generation, "robot": robot}
             event = Event(
                 "ahead", generation, with_figures(head, texts), None if solved else result
             )

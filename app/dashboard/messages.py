@@ -95,7 +95,9 @@ def finite(v):
 
 
 def with_figures(message: dict, figures: Mapping[str, str]) -> str:
-    """The JSON of ``message`` with a "figures" object of already serialized figures."""
+    """The JSON of ``message`` with the "digests" of already serialized figures (the page
+    redraws a panel only when its digest changed) and a "figures" object of them."""
+    message = {**message, "digests": {k: digest(t) for k, t in figures.items()}}
     body = ",".join(f'"{k}":{t}' for k, t in figures.items())
     return to_json(message)[:-1] + ',"figures":{' + body + "}}"
 

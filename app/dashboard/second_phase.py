@@ -22,7 +22,7 @@ from .functionals import (
     sensitivity_evaluations,
 )
 from .map_figures import augmenting_title
-from .messages import digest, with_figures
+from .messages import with_figures
 from .plotting import figure_json
 from .runs import Cancelled, DashboardResult
 
@@ -137,7 +137,6 @@ def finished_message(
         message["titles"] = {"augmenting": augmenting_title(phase.result, functionals)}
     specs = figure_specs(phase.result, functionals, panels, sensitivity=sens)
     texts = {k: figure_json(f) for k, f in specs.items()}
-    message["digests"] = {k: digest(t) for k, t in texts.items()}
     return with_figures(message, texts)
 
 
@@ -162,7 +161,6 @@ def cancelled_message(phase: SecondPhase, generation: int) -> str:
         "functionals": None,
         "sensitivity": None,
         "titles": titles,
-        "digests": {k: digest(t) for k, t in texts.items()},
         "cancelled": {
             "what": phase.what,
             "fraction": phase.fraction,

@@ -27,7 +27,7 @@ from .controls import controls_message
 from .figures import gamma_free_panels
 from .listeners import Listeners
 from .map_synthesis import built_map
-from .messages import Event, digest, finite, summary, with_figures
+from .messages import Event, finite, summary, with_figures
 from .model import (
     COLORS,
     LABELS,
@@ -349,7 +349,6 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
                 "server_total": ready - started,
             },
         }
-        head["digests"] = {k: digest(t) for k, t in texts.items()}
         head["stale"] = sorted(stale)
         data = with_figures(head, texts)
         with self._cond:
