@@ -24,9 +24,7 @@ class Listeners:
     _state: DashboardState
     _generation: int
     _done: int
-
-    def start(self) -> None:
-        raise NotImplementedError
+    start: Callable[[], None]  # (the dashboard's: start its worker)
 
     def subscribe(
         self, listener: Callable[[Event], None], *, last: bool = False
