@@ -12,23 +12,19 @@ import time
 from collections.abc import Callable
 from concurrent.futures import Future
 from dataclasses import replace
-from typing import cast
 
-import numpy as np
-
-from ...engine.unicycle import Unicycle
 from .analysis import augmenting_grid
 from .controls import MAX_DASHBOARD_CYCLES
 from .model import DashboardState, cache_key
 from .offload import OffloadLane
 from .robots import state_kinematics, state_spec
 from .runs import (
-    UNICYCLE_TIME_POINTS,
     AlgorithmRun,
     DashboardResult,
     algorithm_run,
     first_cycles,
     leg_targets,
+    platform_time,
 )
 
 
@@ -160,9 +156,7 @@ def compute(
         task_names=tuple(spec.task_names),
         targets=targets,
         runs=runs,
-        time=np.linspace(0.0, float(cast(Unicycle, kin).T), UNICYCLE_TIME_POINTS)
-        if hasattr(kin, "path")
-        else None,
+        time=platform_time(kin),
         augmenting=augmenting_grid(kin, state, runs, before=grid_before)
         if with_augmenting
         else None,

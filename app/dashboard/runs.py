@@ -258,7 +258,12 @@ def algorithm_run(
     kin = state_kinematics(state) if kin is None else kin
     inverse = state_inverse(state, algorithm, kin)
     run = _run_legs(inverse, state, targets, cycles, progress, cancelled, partial, resume)
-    if hasattr(kin, "path"):
-        t = np.linspace(0.0, float(cast(Unicycle, kin).T), UNICYCLE_TIME_POINTS)
-        run = replace(run, platform=kin.path(run.x, t))
-    return run
+    t = platform_time(kin)
+    return run if t is None else replace(run, platform=kin.path(run.x, t))
+
+
+def platform_time(kin) -> np.ndarray | None:
+    """The time grid [s] of a platform's (the unicycle's) paths q(t); None for an arm."""
+    if not hasattr(kin, "path"):
+        return None
+    return np.linspace(0.0, float(cast(Unicycle, kin).T), UNICYCLE_TIME_POINTS)
