@@ -117,9 +117,8 @@ def atlas_figure(
     x_title, hover, at_x0 = f"arc length s of the start {unit}", "s = %{x:.3f}", 0.0
     if result.get("period") is not None:  # (a closed curve: the starts cover one turn)
         x_title = f"arc length s of the start {unit}, one turn of {result['period']:.4g}"
-    if (
-        request.start_points
-    ):  # (p - r > 1: starts by number, the first x0, see the engine's manifold_starts)
+    # (p - r > 1: starts by number, the first x0, see the engine's manifold_starts)
+    if request.start_points:
         s = np.arange(1.0, len(request.start_points) + 1)
         x_title, hover, at_x0 = "start, farther from x0 to the right", "start %{x}", 1.0
     rows, labels = [], []
@@ -183,7 +182,7 @@ def atlas_figure(
             "type": "category",
         }
     names = [
-        (STYLES[a].label if a in STYLES else a)
+        STYLES[a].label
         + (
             f"<br>h = {request.augmentation.name}"
             if a == "extended" and request.augmentation is not None
@@ -208,10 +207,7 @@ def atlas_figure(
                 "xanchor": "center",
                 "yanchor": "bottom",
                 "showarrow": False,
-                "font": {
-                    "size": 11,
-                    "color": STYLES[algorithms[k]].color if algorithms[k] in STYLES else "#444",
-                },
+                "font": {"size": 11, "color": STYLES[algorithms[k]].color},
             }
         )
     # (a job of POST /atlas may leave them to the robot: a robot the request defines has
