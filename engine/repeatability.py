@@ -31,10 +31,10 @@ from .solver import solve, solve_batch
 from .unicycle import Unicycle
 from .validation import FloatArray, check_memory, count
 
-#: Largest number of cycles and of path points accepted.
 #: A run is called repeatable when its joints come back to x0 within this after every cycle
 #: (‖x − x0‖ in the joint coordinates' own units): the API's verdict and the dashboard's.
 REPEATABLE_DRIFT = 1e-6
+#: Largest number of cycles and of path points accepted.
 MAX_CYCLES = 1000
 MAX_PATH_POINTS = 100
 #: The path is closed by a return leg to k(x0) when its last point is farther than this.
@@ -73,6 +73,16 @@ class Leg:
     members: np.ndarray
     result: SolveResult | BatchSolveResult
     stopped_by: JikError | None = None
+
+
+def repeatable(drift) -> bool | None:
+    """Whether the joints came back to x0 after every cycle that ended: each finite drift
+    ||x - x0|| (a :class:`RepeatabilityResult`'s ``drift``, NaN from a failed leg on) below
+    :data:`REPEATABLE_DRIFT`; None when no cycle ended (sec. 5.2.1: closed task paths give
+    closed joint paths)."""
+    d = np.asarray(drift, dtype=float)
+    d = d[np.isfinite(d)]
+    return bool(np.all(d < REPEATABLE_DRIFT)) if d.size else None
 
 
 def closed_path(kinematics, x0: FloatArray, path: FloatArray) -> FloatArray:

@@ -18,7 +18,7 @@ import numpy as np
 
 from ...engine.augmentations import H_CONSERVED, h_change
 from ...engine.registry import POSE_A, POSE_B
-from ...engine.repeatability import REPEATABLE_DRIFT
+from ...engine.repeatability import REPEATABLE_DRIFT, repeatable
 from .joint_limits import limits_texts
 from .plotting import norm_unit, units
 from .runs import AlgorithmRun, DashboardResult
@@ -42,18 +42,11 @@ class Sentence:
         return {"text": self.text, "algorithm": self.algorithm, "role": self.role}
 
 
-def repeatable(run: AlgorithmRun) -> bool | None:
-    """Whether a closed-path run came back to x0 after every cycle (None: no cycle ended)."""
-    if not len(run.drift):
-        return None
-    return bool(np.all(np.asarray(run.drift) < REPEATABLE_DRIFT))
-
-
 def _drift_sentence(algorithm: str, run: AlgorithmRun, unit: str) -> Sentence:
     d = np.asarray(run.drift)
     n = len(d)
     cycles = f"{n} cycle{'s' if n > 1 else ''}"
-    if repeatable(run):
+    if repeatable(run.drift):
         text = (
             f"{NAMES[algorithm]}: repeatable. After each of {cycles} the joints came back "
             f"to x0 within {g(float(d.max()))} {unit} (‖x − x0‖ below {g(REPEATABLE_DRIFT)})."
@@ -86,7 +79,7 @@ def _extended_why(result: DashboardResult, run: AlgorithmRun) -> list[Sentence]:
         tail = (
             ", so each task point has one configuration on that level set, and the closed "
             "task path gave a closed joint path."
-            if closed and repeatable(run)
+            if closed and repeatable(run.drift)
             else "."
         )
         out.append(
@@ -101,7 +94,7 @@ def _extended_why(result: DashboardResult, run: AlgorithmRun) -> list[Sentence]:
         lost = (
             " A closed task path gives a closed joint path only while h stays at h(x0): "
             "here it did not, so the joints did not come back."
-            if closed and not repeatable(run)
+            if closed and not repeatable(run.drift)
             else ""
         )
         out.append(
@@ -207,7 +200,7 @@ def _undefined_why(result: DashboardResult, run: AlgorithmRun) -> list[Sentence]
 
 
 def _pseudoinverse_why(run: AlgorithmRun) -> list[Sentence]:
-    if repeatable(run) is False:
+    if repeatable(run.drift) is False:
         return [
             Sentence(
                 "Why: J^P# picks the minimum-norm joint velocity, which has no memory of the start "
@@ -217,7 +210,7 @@ def _pseudoinverse_why(run: AlgorithmRun) -> list[Sentence]:
                 "why",
             )
         ]
-    if repeatable(run):
+    if repeatable(run.drift):
         return [
             Sentence(
                 "The pseudoinverse happens to come back on this path: its joint flow closes here, "

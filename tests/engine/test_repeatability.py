@@ -370,3 +370,17 @@ def test_a_bad_resume_is_refused(kwargs, match):
     }[kwargs.pop("resume")]
     with pytest.raises(InvalidInputError, match=match):
         repeatability(_inverse("pseudoinverse"), resume, TABLE1_PATH, **kwargs)
+
+
+def test_repeatable_judges_the_cycles_that_ended():
+    """Every finite drift below REPEATABLE_DRIFT: repeatable; one above: not; the NaN of the
+    cycles after a failed leg are not judged; no cycle ended: no verdict (None)."""
+    from jik.engine.repeatability import REPEATABLE_DRIFT, repeatable
+
+    assert repeatable([1e-13, 2e-12]) is True
+    assert repeatable([1e-13, 10 * REPEATABLE_DRIFT]) is False
+    assert repeatable([1e-13, np.nan, np.nan]) is True
+    assert repeatable([np.nan]) is None and repeatable([]) is None
+    ext = repeatability(_inverse("extended"), TABLE1_X0, TABLE1_PATH, cycles=2)
+    pinv = repeatability(_inverse("pseudoinverse"), TABLE1_X0, TABLE1_PATH, cycles=2)
+    assert repeatable(ext.drift) is True and repeatable(pinv.drift) is False
