@@ -45,6 +45,7 @@ Solving (the continuation algorithm, eq. (7))
     Trajectory                  a run point by point
 Repeatability (sec. 5.2.1, Table 1)
     repeatability               drive a closed path cycle after cycle -> RepeatabilityResult
+    repeatable, h_change        whether every cycle came back to x0; how much h changed, eq. (12)
     Resume, Leg                 an earlier run to go on from (as x0); a leg as a progress sees it
     Progress, ProgressCallbacks what a long computation reports, and how to cancel it
 Functionals and synthesis (secs. 3-4)
@@ -128,6 +129,8 @@ _EXPORTS = {
     "RepeatabilityResult": "results",
     "Resume": "run_settings",
     "Leg": "repeatability",
+    "repeatable": "repeatability",
+    "h_change": "augmentations",
     "Progress": "progress",
     "ProgressCallbacks": "progress",
     # functionals and synthesis
@@ -208,6 +211,7 @@ __all__ = [
     "WeightedInverse",
     "error_functional_e1",
     "error_functional_e2",
+    "h_change",
     "iter_atlas",
     "load_robot",
     "make_inverse",
@@ -215,6 +219,7 @@ __all__ = [
     "map_singularities",
     "plan_atlas",
     "repeatability",
+    "repeatable",
     "robot_from_dict",
     "robot_units",
     "run_atlas",
@@ -261,7 +266,7 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
     from .arms import ARMS
     from .atlas import AtlasPlan, plan_atlas
     from .atlas_run import AtlasResult, iter_atlas, run_atlas
-    from .augmentations import AugmentingMap, E1Optimal, E2Optimal, PaperCubic
+    from .augmentations import AugmentingMap, E1Optimal, E2Optimal, PaperCubic, h_change
     from .characteristics import CharacteristicsMap, UnicycleCharacteristics
     from .exceptions import (
         AlgorithmicSingularityError,
@@ -284,7 +289,7 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
     from .practical_inverses import DampedInverse, PostureInverse, WeightedInverse
     from .progress import Progress, ProgressCallbacks
     from .registry import ALGORITHMS, ROBOTS, make_inverse
-    from .repeatability import Leg, repeatability
+    from .repeatability import Leg, repeatability, repeatable
     from .results import BatchSolveResult, RepeatabilityResult, SolveResult, Trajectory
     from .robot_spec import Robot, load_robot, robot_from_dict
     from .run_settings import Resume
