@@ -83,11 +83,7 @@ def check_definition(definition: Mapping[str, Any]) -> None:
     what = "building the robot's formulas"
     with time_budget(build_seconds(), "robot_definition", what):
         try:
-            kinematics = user_robot(definition).kinematics
-        except InvalidInputError as exc:
-            field = exc.field or "robot_definition"
-            raise RequestError(field, without_field(str(exc), field)) from None
-        try:
+            kinematics = _built(json.dumps(dict(definition), sort_keys=True)).kinematics
             hessian = getattr(kinematics, "hessian", None)
             if hessian is not None:
                 hessian(np.zeros((1, kinematics.p)))
