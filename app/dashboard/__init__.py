@@ -12,6 +12,7 @@ per tab, bounded), :mod:`.export` (JSON and CSV). The names below are the public
 from .export import export_csv, export_file, export_json
 from .messages import Event
 from .model import (
+    ALGORITHMS,
     COLORS,
     LABELS,
     DashboardState,
@@ -25,6 +26,7 @@ from .runs import AlgorithmRun, Cancelled, DashboardResult
 from .session import Dashboard
 
 __all__ = [
+    "ALGORITHMS",
     "COLORS",
     "LABELS",
     "AlgorithmRun",

@@ -45,6 +45,8 @@ from .controls import (
 )
 from .robots import USER_KINDS, default_definition, state_inverse, state_spec, user_robot
 
+#: The algorithms of a new state (:mod:`jik.app.dashboard.algorithms`: colours, styles, keys).
+ALGORITHMS = DEFAULT_ALGORITHMS
 DEFAULT_ROBOT = "manipulator2"
 
 Point = Annotated[tuple[Coordinate, ...], Field(min_length=1, max_length=MAX_DIMENSION)]
