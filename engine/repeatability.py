@@ -388,5 +388,5 @@ def _stopped_leg(inverse, x, target, exc, mode, gamma, record) -> SolveResult:
         x.copy(),
         np.asarray(target, dtype=float),
         inverse,
-        "raised",
+        status="raised",
     )
