@@ -421,3 +421,27 @@ def test_a_panels_message_is_wrapped_to_fit_the_panel():
     assert len(lines) > 3 and lines[-1] == "second"
     assert max(len(line) for line in lines) <= MESSAGE_CHARS
     assert " ".join(lines[:-1]) == note
+
+
+def test_cspace_draws_each_corners_self_motion_manifold_through_its_leg_end(path_result):
+    """The green curves are the engine's traced fibres k(x) = corner (one per corner, through
+    the extended run's leg end there), a point every SPACING box diagonals, inside the box
+    widened by half (up to the drawing's tolerance: the ends are where the curve leaves it)."""
+    from jik.app.dashboard.cspace import SPACING, _box, cspace_spec
+    from jik.app.dashboard.robots import state_kinematics
+
+    kin = state_kinematics(path_result.state)
+    curves = [t for t in cspace_spec(path_result)["data"] if t.get("legendgroup") == "fibres"]
+    assert len(curves) == len(path_result.targets)
+    lo, hi = _box(path_result)
+    diagonal = float(np.linalg.norm(hi - lo))
+    seeds = path_result.runs["extended"].leg_end
+    for curve, target, seed in zip(curves, path_result.targets, seeds, strict=False):
+        x = np.stack([curve["x"], curve["y"], curve["z"]], axis=1)  # (axes 0, 1, 2 of p = 3)
+        assert len(x) > 20 and np.isfinite(x).all()
+        np.testing.assert_allclose(kin.forward(x), np.broadcast_to(target, (len(x), 2)), atol=1e-9)
+        assert np.min(np.linalg.norm(x - seed, axis=1)) < SPACING * diagonal
+        gaps = np.linalg.norm(np.diff(x, axis=0), axis=1)
+        assert np.all(gaps <= SPACING * diagonal * (1 + 1e-3))
+        outside = np.maximum(lo - 0.5 * (hi - lo) - x, x - hi - 0.5 * (hi - lo))
+        assert np.max(outside) < 1e-5
