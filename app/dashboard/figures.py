@@ -201,13 +201,11 @@ def _drift(result: DashboardResult) -> dict:
     )
 
 
-def _table(result: DashboardResult) -> dict:
-    """Table 1 of the paper beside jik's numbers, or the table of leg ends
-    (:mod:`jik.app.dashboard.table`)."""
-    return table_spec(result)
+#: Iterations of the unicycle's platform path drawn per algorithm (first and last included).
+PLATFORM_PATHS = 12
 
 
-def _platform(result: DashboardResult, max_paths: int = 12) -> dict:
+def _platform(result: DashboardResult) -> dict:
     """Unicycle platform paths q(t) in the (q1, q2) plane, per iteration (Figs. 11-14 a)."""
     _, tu = units(result)
     data = []
@@ -219,7 +217,7 @@ def _platform(result: DashboardResult, max_paths: int = 12) -> dict:
         P = result.runs[a].platform
         assert P is not None  # drawn only for the unicycle, whose runs all carry platform paths
         m = len(P)
-        show = sorted(set(np.geomspace(1, m, num=max_paths).astype(int) - 1) | {0, m - 1})
+        show = sorted(set(np.geomspace(1, m, num=PLATFORM_PATHS).astype(int) - 1) | {0, m - 1})
         for n, i in enumerate(show):
             last = bool(i == m - 1)
             data.append(
@@ -317,7 +315,7 @@ def figure_specs(
         else (pose_task_spec if is_pose_task(result) else _task_space),
         "joints": _joints,
         "drift": _drift,
-        "table": _table,
+        "table": table_spec,
         "cspace": cspace_spec,
         "augmenting": lambda r: augmenting_spec(r, functionals, cancelled),
         "sensitivity": lambda r: sensitivity_spec(r, sensitivity, cancelled),
@@ -333,49 +331,3 @@ def figures_for(
 ) -> dict[str, go.Figure]:
     """The panels of the dashboard for ``result`` (all, or those in ``only``), keyed by id."""
     return {k: to_go(v) for k, v in figure_specs(result, functionals, only, sensitivity).items()}
-
-
-# The figures as plotly objects, for notebooks and tests.
-
-
-def task_space_figure(result: DashboardResult) -> go.Figure:
-    """End-effector paths of the algorithms in the task plane (paper, Figs. 5 and 6)."""
-    return to_go(_task_space(result))
-
-
-def joint_figure(result: DashboardResult) -> go.Figure:
-    """Every joint variable against theta for each algorithm (Figs. 7-9; Figs. 11-14 b, c)."""
-    return to_go(_joints(result))
-
-
-def drift_figure(result: DashboardResult) -> go.Figure:
-    """Repeatability drift per closed cycle, log scale (Table 1), or the task error against
-    theta for a single target."""
-    return to_go(_drift(result))
-
-
-def table_figure(result: DashboardResult) -> go.Figure:
-    """The configuration after every leg for both algorithms, as in Table 1 of the paper."""
-    return to_go(_table(result))
-
-
-def platform_figure(result: DashboardResult, max_paths: int = 12) -> go.Figure:
-    """Unicycle platform paths q(t) in the (q1, q2) plane, per iteration (Figs. 11-14 a)."""
-    return to_go(_platform(result, max_paths))
-
-
-def augmenting_figure(result: DashboardResult, functionals: dict | None = None) -> go.Figure:
-    """Contours of h over two joint variables with both trajectories on top; E1 (13) and
-    E2 (18) in the title."""
-    return to_go(augmenting_spec(result, functionals))
-
-
-def sensitivity_figure(result: DashboardResult, sens: dict | None = None) -> go.Figure:
-    """E1 (13) and E2 (18) of the current map and how they change with its parameters."""
-    return to_go(sensitivity_spec(result, sens))
-
-
-def cspace_figure(result: DashboardResult) -> go.Figure:
-    """Both joint paths in configuration space with the level surface h = h(x0) and the
-    self-motion manifolds of the corners."""
-    return to_go(cspace_spec(result))
