@@ -11,6 +11,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ...engine.dependence import inert_variables
 from ...engine.exceptions import JikError
 from .analysis import expensive_map, kinematics_and_map, vector_note
 from .arm_e2 import qmc_functionals, single_joint_sensitivity
@@ -18,46 +19,13 @@ from .model import DashboardState, cache_key, robot_and_map
 from .robots import state_spec
 from .runs import Cancelled, DashboardResult
 
-
-def inert_variables(kin, amap, box: tuple[tuple[float, float], ...], samples: int = 8):
-    """Joint variables x_k that neither J nor h nor dh depends on.
-
-    At seeded points of ``box`` (one interval per variable), shifting x_k must leave J, h and dh
-    bitwise unchanged (NaN where undefined included): an expression without x_k evaluates the
-    same, one that merely cancels it would not and counts as dependent. A slice of h at x_k's
-    start value then does not depend on that value, nor do E1 (13) and E2 (18), whose integrands
-    are functions of J and dh. Maps that solve a problem per point are not probed (empty set),
-    nor is a vector map (None).
-    """
-    if amap is None or expensive_map(amap):
-        return frozenset()
-    lo, hi = np.array(box, dtype=float).T
-    X = np.random.default_rng(0).uniform(lo, hi, (samples, len(lo)))
-
-    def probe(x):
-        with np.errstate(all="ignore"):
-            return (kin.jacobian(x), amap.value_masked(x)[0], amap.gradient_masked(x)[0])
-
-    inert = set()
-    try:
-        at = probe(X)
-        for k in range(len(lo)):
-            shifted = X.copy()
-            shifted[:, k] += 0.371 * (hi[k] - lo[k])
-            again = probe(shifted)
-            if all(np.array_equal(a, b, equal_nan=True) for a, b in zip(at, again, strict=True)):
-                inert.add(k)
-    except (JikError, ValueError, ArithmeticError):  # a map that cannot be probed: all matter
-        return frozenset()
-    return frozenset(inert)
-
-
 _inert_cache: dict[str, frozenset[int]] = {}
 
 
 def state_inert_variables(state: DashboardState) -> frozenset[int]:
-    """:func:`inert_variables` of the state's kinematics and map over the robot's x_range
-    (cached per robot, map and parameters)."""
+    """The joint variables that neither J nor h nor dh depends on
+    (:func:`jik.engine.dependence.inert_variables`) over the robot's x_range, cached per robot,
+    map and parameters."""
     key = json.dumps(robot_and_map(state), sort_keys=True)
     if key not in _inert_cache:
         kin, amap = kinematics_and_map(state)
@@ -72,9 +40,9 @@ def functionals_key(state: DashboardState) -> str:
     """Everything E1, E2 and their sensitivity depend on (see :func:`error_functionals`).
 
     On a robot's design region: the robot, the map and the start values of the variables
-    outside the region (held fixed) that J, h or dh depends on (:func:`inert_variables`); the path,
-    the cycles, gamma and the rest of x0 do not matter. Without a design region the box follows
-    the runs: everything they depend on.
+    outside the region (held fixed) that J, h or dh depends on
+    (:func:`state_inert_variables`); the path, the cycles, gamma and the rest of x0 do not
+    matter. Without a design region the box follows the runs: everything they depend on.
     """
     spec = state_spec(state)
     design = spec.functional_region
