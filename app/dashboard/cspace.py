@@ -16,9 +16,8 @@ from ...engine.exceptions import JikError
 from ...engine.self_motion import MAX_ARC, periodic_joints
 from ...engine.self_motion import trace as trace_curve
 from .algorithms import COLORS, DASH, LABELS, STYLES
-from .analysis import expensive_map, kinematics_and_map
+from .analysis import expensive_map, kinematics_and_map, runs_box
 from .plotting import corner_names, figure, trace
-from .robots import state_spec
 from .runs import DashboardResult
 
 #: The choices of three coordinates of a four-dimensional configuration (the unicycle's λ).
@@ -37,20 +36,6 @@ def axes_of(result: DashboardResult) -> tuple[int, int, int]:
     """The three coordinates shown: all three for p = 3, else the state's choice."""
     choice = result.state.cspace_axes or AXES_CHOICES[0]
     return tuple(int(c) for c in choice)  # type: ignore[return-value]
-
-
-def _box(result: DashboardResult) -> tuple[np.ndarray, np.ndarray]:
-    """Lower and upper corners around both runs, with a margin, within the robot's x_range."""
-    xs = np.concatenate([r.x for r in result.runs.values()])
-    xs = xs[np.isfinite(xs).all(axis=1)]
-    lo, hi = xs.min(axis=0), xs.max(axis=0)
-    pad = 0.25 * (hi - lo) + 0.25
-    lo, hi = lo - pad, hi + pad
-    spec = state_spec(result.state)
-    if spec.x_range:
-        r = np.asarray(spec.x_range, dtype=float)
-        lo, hi = np.maximum(lo, r[:, 0]), np.minimum(hi, r[:, 1])
-    return lo, hi
 
 
 def self_motion(kin, seeds: np.ndarray, lo, hi) -> list[np.ndarray]:
@@ -137,7 +122,7 @@ def cspace_spec(result: DashboardResult) -> dict:
         kin, amap = kinematics_and_map(result.state)
     except (JikError, ValueError) as exc:
         return figure([], f"Configuration space: {exc}")
-    lo, hi = _box(result)
+    lo, hi = runs_box(result.state, result.runs)
     surface = _level_surface(result, kin, amap, axes, lo, hi)
     if surface is not None:
         data.append(surface)

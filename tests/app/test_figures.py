@@ -423,13 +423,14 @@ def test_cspace_draws_each_corners_self_motion_manifold_through_its_leg_end(path
     """The green curves are the engine's traced fibres k(x) = corner (one per corner, through
     the extended run's leg end there), a point every SPACING box diagonals, inside the box
     widened by half (up to the drawing's tolerance: the ends are where the curve leaves it)."""
-    from jik.app.dashboard.cspace import SPACING, _box, cspace_spec
+    from jik.app.dashboard.analysis import runs_box
+    from jik.app.dashboard.cspace import SPACING, cspace_spec
     from jik.app.dashboard.robots import state_kinematics
 
     kin = state_kinematics(path_result.state)
     curves = [t for t in cspace_spec(path_result)["data"] if t.get("legendgroup") == "fibres"]
     assert len(curves) == len(path_result.targets)
-    lo, hi = _box(path_result)
+    lo, hi = runs_box(path_result.state, path_result.runs)
     diagonal = float(np.linalg.norm(hi - lo))
     seeds = path_result.runs["extended"].leg_end
     for curve, target, seed in zip(curves, path_result.targets, seeds, strict=False):
