@@ -13,6 +13,7 @@ import numpy as np
 
 from ...engine.dependence import inert_variables
 from ...engine.exceptions import JikError
+from ...engine.functionals import error_functional_e1, error_functional_e2, parameter_sensitivity
 from .analysis import expensive_map, kinematics_and_map, vector_note
 from .arm_e2 import qmc_functionals, single_joint_sensitivity
 from .model import DashboardState, cache_key, robot_and_map
@@ -81,10 +82,6 @@ def error_functionals(
         return None
     if expensive_map(grid["map"]):
         nodes = min(nodes, 6)
-    try:
-        from ...engine.functionals import error_functional_e1, error_functional_e2
-    except ImportError:
-        return None
     names = result.variable_names
     i, j = grid["axes"]
     design = state_spec(result.state).functional_region
@@ -98,19 +95,26 @@ def error_functionals(
     }
     if len(region) > MAX_QUADRATURE_VARIABLES:  # (nodes ** 7 points for a 7-joint arm)
         return qmc_functionals(grid, region, fixed, out, cancelled, on_step)
-    for key, fn in (("E1", error_functional_e1), ("E2", error_functional_e2)):
-        try:
-            value = fn(grid["kinematics"], grid["map"], region, nodes=nodes, fixed=fixed)
-            out[key] = value.value if np.isfinite(value.value) else None
-            out[f"{key}_singular_points"] = int(value.singular_points.shape[0])
-            if value.divergent:
-                out[f"{key}_divergent"] = True
-        except (JikError, ValueError, ArithmeticError) as exc:
-            out[key] = None
-            out[f"{key}_error"] = str(exc)
+    for key in ("E1", "E2"):
+        out |= _functional(key, grid["kinematics"], grid["map"], region, nodes, fixed)
         if on_step is not None:
             on_step()
     return out
+
+
+def _functional(key: str, kin, amap, region: dict, nodes: int, fixed: dict) -> dict:
+    """``{key: E1 (13) or E2 (18), or None where undefined}`` with its singular points, and
+    ``key_divergent`` (E1 = inf) or ``key_error`` (why it could not be evaluated) if so."""
+    fn = error_functional_e1 if key == "E1" else error_functional_e2
+    try:
+        value = fn(kin, amap, region, nodes=nodes, fixed=fixed)
+    except (JikError, ValueError, ArithmeticError) as exc:
+        return {key: None, f"{key}_error": str(exc)}
+    out = {
+        key: float(value.value) if np.isfinite(value.value) else None,
+        f"{key}_singular_points": int(value.singular_points.shape[0]),
+    }
+    return out | ({f"{key}_divergent": True} if value.divergent else {})
 
 
 #: Values of each parameter in the E1/E2 sweep of the dashboard (over v - 1 .. v + 1).
@@ -170,12 +174,6 @@ def sensitivity(
         }
     if functionals.get("E1") is None and functionals.get("E2") is None:
         return {"kind": "unavailable", "reason": "E1, E2 are undefined on this box"}
-    from ...engine.functionals import (
-        error_functional_e1,
-        error_functional_e2,
-        parameter_sensitivity,
-    )
-
     spec = state_spec(state)
     kin, nodes, fixed = grid["kinematics"], functionals["nodes"], functionals["fixed"]
     region = {k: tuple(v) for k, v in functionals["region"].items()}
@@ -220,12 +218,8 @@ def sensitivity(
                 report(2 * m + 2)
                 continue
             row: dict = {"name": other.name, "current": other.name == aug.name}
-            for key, fn in (("E1", error_functional_e1), ("E2", error_functional_e2)):
-                try:
-                    v = fn(kin, amap, region, nodes=nodes, fixed=fixed).value
-                    row[key] = float(v) if np.isfinite(v) else None
-                except (JikError, ValueError, ArithmeticError):
-                    row[key] = None
+            for key in ("E1", "E2"):
+                row[key] = _functional(key, kin, amap, region, nodes, fixed)[key]
             maps.append(row)
             report(2 * m + 2)
         return {"kind": "alternatives", "maps": maps}
