@@ -143,62 +143,36 @@ def _drift(result: DashboardResult) -> dict:
 
     For a single-target task (and the unicycle) the task error against theta is shown instead.
     """
-    data = []
     closed = result.state.task == "path"
+    data = []
     for a, run in result.runs.items():
-        if closed:
-            data.append(
-                trace(
-                    "scatter",
-                    x=np.arange(1, len(run.drift) + 1),
-                    y=np.maximum(run.drift, 1e-16),
-                    mode="lines+markers",
-                    name=LABELS[a],
-                    line=dict(color=COLORS[a], width=2, dash=DASH[a]),
-                    marker=dict(symbol=STYLES[a].symbol, size=9),
-                    hovertemplate="cycle %{x}: drift %{y:.3e}<extra>" + a + "</extra>",
-                )
-            )
-        else:
-            data.append(
-                trace(
-                    "scatter",
-                    x=run.theta,
-                    y=np.maximum(run.error, 1e-16),
-                    mode="lines",
-                    name=LABELS[a],
-                    line=dict(color=COLORS[a], width=2, dash=DASH[a]),
-                    hovertemplate="‖k(x) − y_d‖ = %{y:.3e}<br>θ = %{x:.4g}<extra>" + a + "</extra>",
-                )
-            )
+        cycle = dict(
+            x=np.arange(1, len(run.drift) + 1),
+            y=np.maximum(run.drift, 1e-16),
+            mode="lines+markers",
+            marker=dict(symbol=STYLES[a].symbol, size=9),
+            hovertemplate="cycle %{x}: drift %{y:.3e}<extra>" + a + "</extra>",
+        )
+        point = dict(
+            x=run.theta,
+            y=np.maximum(run.error, 1e-16),
+            mode="lines",
+            hovertemplate="‖k(x) − y_d‖ = %{y:.3e}<br>θ = %{x:.4g}<extra>" + a + "</extra>",
+        )
+        line = dict(color=COLORS[a], width=2, dash=DASH[a])
+        data.append(trace("scatter", name=LABELS[a], line=line, **(cycle if closed else point)))
     ys = np.concatenate([np.asarray(t["y"], dtype=float) for t in data])
     if closed:
         cycles = max(len(r.drift) for r in result.runs.values())
-        return figure(
-            data,
-            "Repeatability: joint drift after each closed cycle",
-            **NO_LEGEND,
-            xaxis=dict(title="cycle", dtick=1, range=[0.5, cycles + 0.5]),
-            yaxis=dict(
-                title=f"‖x(end of cycle) − x0‖ {norm_unit(units(result)[0])} (log)",
-                type="log",
-                exponentformat="power",
-                range=log_range(ys),
-            ),
-        )
-    theta = np.concatenate([r.theta for r in result.runs.values()])
-    return figure(
-        data,
-        "Convergence: task error",
-        **NO_LEGEND,
-        xaxis=dict(title=theta_label(result), range=nice_range(theta, from_zero=True)),
-        yaxis=dict(
-            title=f"‖k(x) − y_d‖ {norm_unit(units(result)[1])} (log)",
-            type="log",
-            exponentformat="power",
-            range=log_range(ys),
-        ),
-    )
+        title, norm = "Repeatability: joint drift after each closed cycle", "‖x(end of cycle) − x0‖"
+        xaxis = dict(title="cycle", dtick=1, range=[0.5, cycles + 0.5])
+    else:
+        theta = np.concatenate([r.theta for r in result.runs.values()])
+        title, norm = "Convergence: task error", "‖k(x) − y_d‖"
+        xaxis = dict(title=theta_label(result), range=nice_range(theta, from_zero=True))
+    unit = norm_unit(units(result)[0 if closed else 1])
+    yaxis = dict(title=f"{norm} {unit} (log)", type="log", exponentformat="power")
+    return figure(data, title, **NO_LEGEND, xaxis=xaxis, yaxis=yaxis | {"range": log_range(ys)})
 
 
 #: Iterations of the unicycle's platform path drawn per algorithm (first and last included).
