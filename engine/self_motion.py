@@ -167,6 +167,7 @@ def trace(
     arc: Sequence[float],
     box: Sequence[Sequence[float]] | None = None,
     tol: float = TRACE_TOL,
+    bound_free_joints: bool = False,
 ) -> SelfMotionManifold:
     """Trace the self-motion curve through ``base`` over the arc lengths ``arc`` = (lo, hi).
 
@@ -182,11 +183,14 @@ def trace(
         Stop the curve where it leaves this box of configurations (the robot's ``x_range``):
         the traced ``arc`` is then shorter than asked. A joint that turns freely
         (:func:`periodic_joints`) is not bounded by it: its angle's range in the box is a
-        window on one turn, not a limit.
+        window on one turn, not a limit (unless ``bound_free_joints``).
     tol : float
         The integrator's relative and absolute tolerance on x, :data:`TRACE_TOL` to
         :data:`LOOSEST_TOL`: the points of :meth:`SelfMotionManifold.points` lie on k(x) = y0
         whatever it is, their arc lengths are within about ``tol`` of s.
+    bound_free_joints : bool
+        Stop the curve where a freely turning joint's angle leaves ``box`` too, as any other
+        variable's (a curve drawn in the box's view).
 
     Returns
     -------
@@ -221,9 +225,11 @@ def trace(
         )
     y0 = kinematics.forward(base)
     base = project(kinematics, base[None], y0)[0]
-    bounds = None if box is None else np.array(box, dtype=float)
+    periodic = periodic_joints(kinematics)
+    bounds, leaves = None if box is None else np.array(box, dtype=float), None
     if bounds is not None:
-        bounds[periodic_joints(kinematics)] = (-np.inf, np.inf)  # (x and x + 2 pi: one posture)
+        if not bound_free_joints:
+            bounds[periodic] = (-np.inf, np.inf)  # (x and x + 2 pi: one posture)
         outside = np.flatnonzero((base < bounds[:, 0]) | (base > bounds[:, 1]))
         if outside.size:
             i = int(outside[0])
@@ -233,13 +239,10 @@ def trace(
                 field="base",
             )
 
-    leaves = None
-    if bounds is not None:
         # (a margin inside the box: the curve may run along a face of it)
         def leaves(_s, x):
             return float(np.min(np.minimum(x - bounds[:, 0], bounds[:, 1] - x)))
 
-    periodic = periodic_joints(kinematics)
     ahead = _leg(kinematics, base, hi, leaves, (base, kinematics.kernel(base)), periodic, tol)
     if ahead.closed:
         return SelfMotionManifold(
@@ -252,15 +255,10 @@ def trace(
         end = base if ahead.sol is None else ahead.sol(ahead.end)
         watch = (end, -kinematics.kernel(end))
     behind = _leg(kinematics, base, lo, leaves, watch, periodic, tol)
+    period = ahead.end - behind.end if behind.closed else None
+    arc_traced, steps = (behind.end, ahead.end), ahead.steps + behind.steps
     return SelfMotionManifold(
-        kinematics,
-        y0,
-        base,
-        (behind.end, ahead.end),
-        _ahead=ahead.sol,
-        _behind=behind.sol,
-        period=ahead.end - behind.end if behind.closed else None,
-        steps=ahead.steps + behind.steps,
+        kinematics, y0, base, arc_traced, ahead.sol, behind.sol, period, steps
     )
 
 

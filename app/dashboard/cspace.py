@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...engine.exceptions import JikError
-from ...engine.self_motion import MAX_ARC, periodic_joints
+from ...engine.self_motion import MAX_ARC
 from ...engine.self_motion import trace as trace_curve
 from .algorithms import COLORS, DASH, LABELS, STYLES
 from .analysis import expensive_map, kinematics_and_map, runs_box
@@ -47,29 +47,26 @@ def self_motion(kin, seeds: np.ndarray, lo, hi) -> list[np.ndarray]:
     -----
     Each curve is the engine's (:func:`jik.engine.self_motion.trace`, to a drawing's tolerance
     :data:`DRAW_TOL`): the orbit of the unit kernel K(x) both ways from its seed over an arc of
-    :data:`ARC_SPANS` box diagonals, stopped by the widened box or after one turn of a closed
-    curve, its points projected onto k(x) = y by the pseudoinverse (8). A freely turning
-    joint's angle is not stopped by the box: its points outside are NaN.
+    :data:`ARC_SPANS` box diagonals, stopped where any variable (a freely turning joint's angle
+    too) leaves the widened box or after one turn of a closed curve, its points projected onto
+    k(x) = y by the pseudoinverse (8).
     """
     span = hi - lo
     finite = seeds[np.isfinite(seeds).all(axis=1)]  # (a seed beyond x_range widens the box)
     low = np.minimum(lo - 0.5 * span, np.min(finite, axis=0, initial=np.inf))
     high = np.maximum(hi + 0.5 * span, np.max(finite, axis=0, initial=-np.inf))
     diagonal = float(np.linalg.norm(span))
-    free = periodic_joints(kin)
     arc = min(ARC_SPANS * diagonal, MAX_ARC)
     box = list(zip(low.tolist(), high.tolist(), strict=True))
     curves = []
     for seed in seeds:
         try:
-            curve = trace_curve(kin, seed, (-arc, arc), box, tol=DRAW_TOL)
+            curve = trace_curve(kin, seed, (-arc, arc), box, DRAW_TOL, bound_free_joints=True)
         except JikError:  # (a singular seed: no kernel to follow)
             curves.append(np.empty((0, kin.p)))
             continue
         n = int(np.ceil((curve.arc[1] - curve.arc[0]) / (SPACING * diagonal or 1.0))) + 1
-        x = curve.sample(max(n, 2))
-        inside = np.all((x >= low) & (x <= high) | ~free, axis=1)
-        curves.append(np.where(inside[:, None], x, np.nan))
+        curves.append(curve.sample(max(n, 2)))
     return curves
 
 

@@ -215,6 +215,15 @@ def test_a_continuous_joint_closes_a_loop_modulo_two_pi():
     open_ = trace(planar, base, (-3 * length, 3 * length))
     assert not open_.closed and open_.arc == (-3 * length, 3 * length)
     assert not trace(limited, base, (-3 * length, 3 * length)).closed
+    # A box of +-1 rad about the base: a window on the continuous joints' turn (the loop is
+    # still found) unless they are bounded by it too, when the curve stops where an angle
+    # leaves it, on the box's face.
+    box = [(v - 1.0, v + 1.0) for v in base]
+    assert trace(urdf, base, (-MAX_ARC, MAX_ARC), box).closed
+    cut = trace(urdf, base, (-MAX_ARC, MAX_ARC), box, bound_free_joints=True)
+    assert not cut.closed and cut.arc[1] - cut.arc[0] < length
+    ends = cut.points(np.array(cut.arc))
+    assert np.all(np.isclose(np.abs(ends - base), 1.0, atol=1e-9).any(axis=1))
 
 
 def arm4_plan(n: int, **kw):
