@@ -4,7 +4,7 @@ What a control change costs the server before the page and the scene can redraw:
 :func:`jik.app.dashboard.compute` of the registry's default state (both algorithms through the
 closed path, h on a grid), with a fresh cache each time (a new start point). Straightforward:
 the two algorithms one after the other in the calling thread. jik serve: the pseudoinverse in a
-worker of the server's compute pool (:class:`jik.app.dashboard.Offload`, the pool the REST API
+worker of the server's compute pool (:class:`jik.app.dashboard.OffloadLane`, the pool the REST API
 uses, here with one worker) while the thread runs the extended inverse.
 Wall-clock medians; each offloaded run is checked to give the same configurations.
 
@@ -24,7 +24,7 @@ import numpy as np
 
 from ..app.compute.pool import pool_in_thread
 from ..app.compute.settings import Settings
-from ..app.dashboard import Offload, OffloadLane, compute, default_state, updated_state
+from ..app.dashboard import OffloadLane, compute, default_state, updated_state
 from ..app.dashboard.figures import figure_specs
 from ..app.dashboard.messages import summary
 from ..app.dashboard.plotting import figure_json
@@ -81,7 +81,7 @@ def algorithms_run(offload: OffloadLane | None, repeats: int) -> dict:
 
 def run(quick: bool = False) -> dict:
     with pool_in_thread(Settings(workers=1, timeout=120.0)) as pool:
-        offload = Offload(pool).lane()
+        offload = OffloadLane(pool)
         compute(default_state("manipulator2"), offload=offload)  # the worker has run one
         out: dict = {}
         for robot in ROBOTS:

@@ -20,7 +20,7 @@ from .model import (
     runs_key,
     updated_state,
 )
-from .offload import Offload, OffloadLane
+from .offload import OffloadLane
 from .results import compute
 from .runs import AlgorithmRun, Cancelled, DashboardResult
 from .session import Dashboard
@@ -35,7 +35,6 @@ __all__ = [
     "DashboardResult",
     "DashboardState",
     "Event",
-    "Offload",
     "OffloadLane",
     "compute",
     "default_state",

@@ -29,17 +29,6 @@ def run_offloaded(state, algorithm, targets, cycles, resume=None) -> AlgorithmRu
     return algorithm_run(state, algorithm, targets, cycles, resume=resume)
 
 
-class Offload:
-    """The dashboards' way into ``pool`` (a :class:`~jik.app.compute.pool.ComputePool`)."""
-
-    def __init__(self, pool: Any) -> None:
-        self.pool = pool
-
-    def lane(self) -> OffloadLane:
-        """A lane for one dashboard."""
-        return OffloadLane(self.pool)
-
-
 class OffloadLane:
     """One dashboard's runs in the pool, and their cancellation by a newer generation."""
 

@@ -18,7 +18,7 @@ import logging
 import threading
 import time
 from collections.abc import Callable, Mapping
-from typing import NoReturn
+from typing import Any, NoReturn
 
 from ...engine.exceptions import InvalidInputError, JikError
 from .ahead import SolvingAhead
@@ -38,7 +38,7 @@ from .model import (
     updated_state,
     validate,
 )
-from .offload import Offload
+from .offload import OffloadLane
 from .panel_texts import PanelTexts
 from .plotting import PANELS
 from .results import compute
@@ -60,9 +60,10 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
     ----------
     state : DashboardState, optional
         Initial state (registry defaults of :data:`DEFAULT_ROBOT`).
-    offload : Offload, optional
-        The server's compute pool (shared with the API and the other dashboards): one algorithm
-        runs there, in this dashboard's own lane (:meth:`Offload.lane`); ``jik serve`` gives it.
+    pool : ComputePool, optional
+        The server's compute pool (:class:`jik.app.compute.pool.ComputePool`, shared with the API
+        and the other dashboards): one algorithm runs there, in this dashboard's own lane
+        (:class:`~jik.app.dashboard.offload.OffloadLane`); ``jik serve`` gives it.
     slots : FairSlots, optional
         Turns for the computations in the sessions' threads (first come, first served), shared
         by the dashboards of a server.
@@ -72,12 +73,12 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
         self,
         state: DashboardState | None = None,
         *,
-        offload: Offload | None = None,
+        pool: Any = None,
         slots: FairSlots | None = None,
     ) -> None:
         self._cond = threading.Condition()
         self._slots = slots
-        self._offload = offload.lane() if offload is not None else None
+        self._offload = OffloadLane(pool) if pool is not None else None
         self._state = validate((state or default_state()).as_dict())
         self._generation = 1
         self._done = 0  # last generation whose computation finished (or failed)

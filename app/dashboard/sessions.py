@@ -8,9 +8,10 @@ stopped. When the store is full, the session idle the longest makes room; if eve
 use the new one is refused (the route answers 503).
 
 The sessions' computations share the server's one compute pool with the REST API: one
-algorithm of each run goes to its worker processes (:class:`~jik.app.dashboard.offload.Offload`,
-first come first served), and the other is computed in the session's own thread, in turns of
-:class:`~jik.app.dashboard.slots.FairSlots` (at most ``computations`` at once, in the order asked).
+algorithm of each run goes to its worker processes (each dashboard's
+:class:`~jik.app.dashboard.offload.OffloadLane`, first come first served), and the other is
+computed in the session's own thread, in turns of :class:`~jik.app.dashboard.slots.FairSlots`
+(at most ``computations`` at once, in the order asked).
 """
 
 from __future__ import annotations
@@ -25,7 +26,6 @@ from typing import Any
 
 from ..compute.settings import Settings
 from .model import default_state, updated_state
-from .offload import Offload
 from .session import Dashboard
 from .slots import FairSlots
 
@@ -111,7 +111,7 @@ class SessionStore:
         self._scene_factory = scene_factory
         self._sessions: dict[str, Session] = {}
         self._lock = threading.Lock()
-        self._offload = Offload(pool) if pool is not None else None
+        self._pool = pool
         self._slots = FairSlots(self.limits.computations)
         self._closed = threading.Event()
         self._reaper: threading.Thread | None = None
@@ -138,7 +138,7 @@ class SessionStore:
             if len(self._sessions) >= self.limits.max_sessions:
                 self._evict_idlest()
             session_id = secrets.token_urlsafe(16)
-            dashboard = Dashboard(state, offload=self._offload, slots=self._slots)
+            dashboard = Dashboard(state, pool=self._pool, slots=self._slots)
             session = Session(session_id, dashboard)
             self._sessions[session_id] = session
         if self._scene_factory is not None:

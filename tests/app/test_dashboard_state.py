@@ -369,10 +369,10 @@ def test_offloaded_computation_is_the_same_and_can_be_cancelled():
     redone here and a new worker serves the next."""
     from jik.app.compute.pool import pool_in_thread
     from jik.app.compute.settings import Settings
-    from jik.app.dashboard import Offload
+    from jik.app.dashboard import OffloadLane
 
     with pool_in_thread(Settings(workers=1, timeout=120.0)) as pool:
-        offload = Offload(pool).lane()
+        offload = OffloadLane(pool)
         for robot in ("manipulator1", "manipulator2"):
             state = default_state(robot)
             here, there = compute(state), compute(state, 7, offload=offload)
@@ -419,9 +419,9 @@ def test_compute_workers_leave_with_a_killed_server(tmp_path):
         "import time\n"
         "from jik.app.compute.pool import pool_in_thread\n"
         "from jik.app.compute.settings import Settings\n"
-        "from jik.app.dashboard import Offload, compute, default_state\n"
+        "from jik.app.dashboard import OffloadLane, compute, default_state\n"
         "with pool_in_thread(Settings(workers=1)) as pool:\n"
-        "    compute(default_state('manipulator2'), offload=Offload(pool).lane())\n"
+        "    compute(default_state('manipulator2'), offload=OffloadLane(pool))\n"
         "    print(*(w.process.pid for w in pool._workers), flush=True)\n"
         "    time.sleep(60)\n"
     )
