@@ -1,6 +1,6 @@
 """Requests to engine calls: solve, its batches, and repeatability.
 
-Plain synchronous functions (``solve_request``, ``solve_batch``, ``repeatability_request``) turn
+Plain synchronous functions (``solve_batch``, ``repeatability_request``) turn
 a request model into engine calls and the result into a response model. They raise
 :class:`RequestError` naming the offending field. The robot, map and inverse a request names are
 built by :func:`jik.app.compute.robot_requests.request_robot` (catalogue robots, definitions,
@@ -205,14 +205,6 @@ def _solve_batch(
                 for j, k in enumerate(keep):
                     out[ok[k]] = respond(setup, batch[j])
     return cast(list[_R | RequestError], out)  # every slot was filled above
-
-
-def solve_request(req: S.SolveRequest) -> S.SolveResponse:
-    """One run of eq. (7) from ``req.x0`` to ``req.target``; raises :class:`RequestError`."""
-    (res,) = solve_batch([req])
-    if isinstance(res, RequestError):
-        raise res
-    return res
 
 
 def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityResponse:
