@@ -52,6 +52,7 @@ Functionals and synthesis (secs. 3-4)
     synthesize_e2               the E2-optimal h by a Ritz method, eq. (20) -> SynthesisResult
     synthesize_e2_nd            E2-optimal h of all joints, p - r >= 1 -> TotalDegreeSynthesis
     map_singularities           where h or [J; dh] (10) is singular in a box -> MapSingularities
+    map_grid                    h on the plane of a box where it varies most -> MapGrid
 The atlas (drift over many starts and paths)
     plan_atlas, run_atlas       plan and run an atlas (here, in processes or on Dask)
     iter_atlas                  the same, chunk by chunk, in bounded memory
@@ -139,6 +140,8 @@ _EXPORTS = {
     "SynthesisResult": "variational",
     "map_singularities": "map_singularities",
     "MapSingularities": "map_singularities",
+    "map_grid": "map_grid",
+    "MapGrid": "map_grid",
     # the atlas
     "plan_atlas": "atlas",
     "AtlasPlan": "atlas",
@@ -183,6 +186,7 @@ __all__ = [
     "LimitsReport",
     "Manipulator1",
     "Manipulator2",
+    "MapGrid",
     "MapSingularities",
     "OneFormUndefinedError",
     "PaperCubic",
@@ -212,6 +216,7 @@ __all__ = [
     "load_robot",
     "make_inverse",
     "manifold_starts",
+    "map_grid",
     "map_singularities",
     "plan_atlas",
     "repeatability",
@@ -279,6 +284,7 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
     from .inverses import ExtendedInverse, Inverse, Pseudoinverse
     from .kinematics import Kinematics, Manipulator1, Manipulator2
     from .limits import LimitsReport
+    from .map_grid import MapGrid, map_grid
     from .map_singularities import MapSingularities, map_singularities
     from .planar_chain import PlanarChain
     from .practical_inverses import DampedInverse, PostureInverse, WeightedInverse

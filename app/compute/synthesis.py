@@ -141,7 +141,7 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         )
     names, region, fixed = synthesis_region(spec, req)
     if req.method == "e2_total_degree":
-        return total_degree_response(req, spec, kin, robot_used, (names, region, fixed))
+        return total_degree_response(req, kin, robot_used, (names, region, fixed))
     convergence: list[dict[str, float]] = []
     coefficients: dict[str, float] = {}
     notes: list[str] = []
@@ -181,7 +181,7 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         augmentation=aug_used,
         region={k: [float(lo), float(hi)] for k, (lo, hi) in region.items()},
         fixed=all_fixed,
-        grid=grid(amap, names, region, all_fixed, spec.p, req.grid),
+        grid=grid(amap, names, region, all_fixed, req.grid),
         coefficients=coefficients,
         functionals=functionals,
         convergence=convergence,
