@@ -20,7 +20,7 @@ from ...engine.exceptions import JikError, SingularConfigurationError
 from ...engine.limits import repeatability_report, robot_limits
 from ...engine.registry import RobotSpec
 from ...engine.repeatability import REPEATABLE_DRIFT, repeatability
-from ...engine.solve_rules import gamma_problem
+from ...engine.solve_rules import gamma_problem, refused_starts
 from ...engine.solver import solve_batch as engine_solve_batch
 from . import schemas as S
 from .documents import (
@@ -82,30 +82,6 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
         req.max_iterations,
         parameters=parameters_of(inverse),
     )
-
-
-def _check_start(setup: _Setup, x0: np.ndarray) -> np.ndarray:
-    """Mask (n,) of singular starts for the chosen inverse; x0 of shape (n, p)."""
-    kin = setup.kinematics
-    _, bad = setup.inverse.apply_masked(x0, np.zeros((len(x0), kin.r)) + 1.0)
-    return np.atleast_1d(bad)
-
-
-def _start_message(setup: _Setup, x0) -> str:
-    """Why the inverse is undefined at the start ``x0`` (p,): the kinematics overflow there
-    (k(x0) or its Jacobian not finite), or the start is singular."""
-    x = np.asarray(x0, dtype=float)
-    with np.errstate(all="ignore"):
-        y = np.asarray(setup.kinematics.forward(x), dtype=float)
-        jacobian = np.asarray(setup.kinematics.jacobian(x), dtype=float)
-    if not (np.all(np.isfinite(y)) and np.all(np.isfinite(jacobian))):
-        shown = ", ".join(f"{v:.6g}" for v in y)
-        return (
-            f"the kinematics overflow at the start: k(x0) = ({shown}), its Jacobian "
-            f"{'finite' if np.all(np.isfinite(jacobian)) else 'not finite'}; choose a start "
-            "where both are finite (below about 1.8e308)"
-        )
-    return f"{setup.inverse.singular_error(x)}; move the start"
 
 
 #: A run's arguments in the engine that are a request's fields, by the request's names.
@@ -181,10 +157,10 @@ def _solve_batch(
     if ok:
         x0 = np.array([reqs[i].x0 for i in ok], dtype=float)
         y_d = np.array([reqs[i].target for i in ok], dtype=float)
-        bad = _check_start(setup, x0)
-        for k in np.flatnonzero(bad):
-            out[ok[k]] = RequestError("x0", _start_message(setup, x0[k]))
-        keep = np.flatnonzero(~bad)
+        refused = refused_starts(setup.inverse, x0)
+        for k, why in refused.items():
+            out[ok[k]] = RequestError("x0", why)
+        keep = np.array([k for k in range(len(ok)) if k not in refused], dtype=int)
         if keep.size:
             try:
                 batch = engine_solve_batch(
@@ -214,8 +190,8 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
     for i, pt in enumerate(req.path):
         check_task_point(setup.spec, pt, f"path[{i}]")
     x0 = np.array(req.x0, dtype=float)
-    if _check_start(setup, x0[None])[0]:
-        raise RequestError("x0", _start_message(setup, x0))
+    if refused := refused_starts(setup.inverse, x0[None]):
+        raise RequestError("x0", refused[0])
     try:
         res = repeatability(
             setup.inverse,
