@@ -82,6 +82,13 @@ def per_robot(base: type[BaseModel], fields: Any, user_robots: bool = True) -> A
         )
         globals()[model.__name__] = model
         members.append(Annotated[model, Tag(kind)])
+    return robot_union(members, names)
+
+
+def robot_union(members: list[Any], names: list[str] = ROBOT_NAMES) -> Any:
+    """A body that is one of ``members`` (each tagged by its robot's name), chosen by
+    ``robot.name``; a JSON object (:data:`OBJECT_BODY`), and an unknown name refused naming
+    ``names``."""
     return Annotated[
         Union[tuple(members)],  # noqa: UP007
         Discriminator(
