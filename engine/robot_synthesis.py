@@ -99,6 +99,13 @@ TENSOR_DEGREE = 12
 ARM_BOX = 0.3
 
 
+def default_degree(variables: int, k: int) -> int:
+    """The degree of an E2 synthesis given none: :data:`TENSOR_DEGREE` per variable for one
+    map (p - r = ``k`` = 1) of two or three ``variables`` (the tensor Ritz solve of eq. (20)),
+    else the total degree :data:`TOTAL_DEGREE` (eq. (19) on a Sobol rule)."""
+    return TENSOR_DEGREE if variables <= 3 and k == 1 else TOTAL_DEGREE
+
+
 def arm_augmentations(kin: Kinematics, d: Mapping) -> list:
     """The maps of an arm with a home (a catalogue arm, or a URDF given with ``home``): by
     default, with one degree of redundancy (a 7-joint arm's pose task), one E2-optimal over all

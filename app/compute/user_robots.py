@@ -23,7 +23,7 @@ from typing import Any, cast
 
 from ...engine.exceptions import InvalidInputError, JikError
 from ...engine.robot_spec import Robot, robot_from_dict
-from ...engine.robot_synthesis import TENSOR_DEGREE, TOTAL_DEGREE
+from ...engine.robot_synthesis import default_degree
 from . import schemas as S
 from .budget import build_seconds, time_budget
 from .exceptions import RequestError
@@ -94,8 +94,8 @@ def map_used(robot: Robot) -> S.AugmentationUsed | None:
     item = next((a for a in items if a.get("label") == _LABEL), items[0])
     definition = {k: v for k, v in item.items() if k != "label"}
     if definition["name"] == "e2_synthesized" and "degree" not in definition:
-        many = len(definition.get("region") or {}) > 3 or robot.spec.p - robot.spec.r > 1
-        definition["degree"] = TOTAL_DEGREE if many else TENSOR_DEGREE
+        variables, k = len(definition.get("region") or {}), robot.spec.p - robot.spec.r
+        definition["degree"] = default_degree(variables, k)
     values = {k: float(v) for k, v in (definition.get("parameters") or {}).items()}
     return S.AugmentationUsed(name=definition["name"], parameters=values, definition=definition)
 
