@@ -37,14 +37,7 @@ from .extended_vector import VectorExtendedInverse
 from .formula_kinematics import FormulaKinematics
 from .inverses import Inverse
 from .kinematics import Kinematics
-from .limits import (
-    LimitsReport,
-    check_limits,
-    limit_names,
-    repeatability_report,
-    robot_limits,
-    solve_report,
-)
+from .limits import LimitsReport, check_limits, run_report
 from .planar_chain import PlanarChain
 from .registry import ROBOTS, RobotSpec, make_inverse
 from .repeatability import MAX_PATH_POINTS
@@ -101,13 +94,7 @@ class Robot:
     def limits_report(self, result) -> LimitsReport | None:
         """Whether a run of this robot (a solve's or a single start's repeatability result)
         stayed within its joint limits, and its first violation; None for a robot without."""
-        limits = robot_limits(self.kinematics)
-        if limits is None:
-            return None
-        names = limit_names(self.kinematics)
-        if hasattr(result, "leg_results"):
-            return repeatability_report(limits, result, names)
-        return solve_report(limits, result, names)
+        return run_report(self.kinematics, result)
 
     def inverse(
         self,

@@ -17,7 +17,7 @@ from typing import Any, TypeVar, cast
 import numpy as np
 
 from ...engine.exceptions import JikError, SingularConfigurationError
-from ...engine.limits import repeatability_report, robot_limits
+from ...engine.limits import robot_limits
 from ...engine.registry import RobotSpec
 from ...engine.repeatability import REPEATABLE_DRIFT, repeatability
 from ...engine.solve_rules import gamma_problem, refused_starts
@@ -225,5 +225,5 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
         repeatable=bool(res.success) and finite and max_drift < REPEATABLE_DRIFT,
         success=bool(res.success),
         message=cast(str, res.message),  # one start configuration: one message
-        **limits_document(setup, lambda limits, names: repeatability_report(limits, res, names)),
+        **limits_document(setup.kinematics, res),
     )
