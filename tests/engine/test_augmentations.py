@@ -67,3 +67,12 @@ def test_printed_j32_j33_are_not_the_gradient_of_38():
 def test_bad_parameters(make, match):
     with pytest.raises(InvalidInputError, match=match):
         make()
+
+
+def test_a_polynomial_map_names_its_coefficients_by_their_monomials():
+    """The paper's cubic (38) in x2, x3: each c_ij keyed "x2^i x3^j"."""
+    cubic = aug.PaperCubic()
+    named = cubic.monomials()
+    assert len(named) == len(cubic.coefficients)
+    for (i, j), c in cubic.coefficients.items():
+        assert named[f"x2^{i} x3^{j}"] == c
