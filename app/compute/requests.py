@@ -11,7 +11,7 @@ catalogue arms alike); results become JSON by :mod:`jik.app.compute.documents`.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, TypeVar, cast
 
 import numpy as np
@@ -50,9 +50,8 @@ class _Setup:
     gamma: float
     tolerance: float
     max_iterations: int | None
-    extra: dict = field(default_factory=dict)
     #: The inverse's parameters, defaults filled in (:func:`parameters_of`).
-    parameters: dict = field(default_factory=dict)
+    parameters: dict
 
 
 def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
@@ -69,18 +68,9 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
     gamma = spec.default_gamma if req.gamma is None else float(req.gamma)
     if (why := gamma_problem(gamma, mode)) is not None:
         raise RequestError("gamma", why)
-    robot_used, aug_used = built.robot, built.augmentation
     return _Setup(
-        spec,
-        kin,
-        inverse,
-        robot_used,
-        aug_used,
-        mode,
-        gamma,
-        req.tolerance,
-        req.max_iterations,
-        parameters=parameters_of(inverse),
+        *(spec, kin, inverse, built.robot, built.augmentation, mode, gamma),
+        *(req.tolerance, req.max_iterations, parameters_of(inverse)),
     )
 
 
@@ -212,7 +202,7 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
     return S.RepeatabilityResponse(
         robot=setup.robot,
         algorithm=setup.inverse.name,
-        algorithm_parameters=parameters_of(setup.inverse),
+        algorithm_parameters=setup.parameters,
         augmentation=setup.augmentation,
         mode=setup.mode,
         gamma=setup.gamma,
