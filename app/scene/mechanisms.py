@@ -57,6 +57,7 @@ class Mechanism:
         self.scene, self.root, self.color, self.opacity, self.z = scene, root, color, opacity, z
         self.state, self.extent = state, extent
         self.build()
+        self.resize(state, extent)
 
     def box(self, name, dims, position=(0.0, 0.0, 0.0), wxyz=(1.0, 0.0, 0.0, 0.0), color=None):
         return self.scene.add_box(
@@ -80,7 +81,8 @@ class Mechanism:
             subdivisions=2,
         )
 
-    def build(self) -> None: ...
+    def build(self) -> None:
+        """Create the nodes (those sized by the state or the task-plane box: by :meth:`resize`)."""
 
     def resize(self, state, extent) -> None:
         """Follow a new arm length or task-plane box in place (no node is re-created)."""
@@ -93,20 +95,16 @@ class Gantry(Mechanism):
     """Manipulator 2: XY gantry (prismatic x1 vertical, x2 horizontal) with a revolute arm."""
 
     def build(self) -> None:
-        (lo, hi), _ = self.extent
-        self.span = (lo, hi)
-        l = float(self.state.robot_parameters["l"])
-        self.beam = self.box("beam", (hi - lo, 0.07, 0.05))
+        self.beam = self.box("beam", (1.0, 0.07, 0.05))
         self.carriage = self.scene.add_frame(f"{self.root}/carriage", show_axes=False)
         self.box("carriage/body", (0.2, 0.2, 0.09))
         self.ball("carriage/joint", 0.06, (0.0, 0.0, 0.07), color=(40, 40, 40))
-        self.arm = self.box("carriage/arm", (l, 0.06, 0.04), (l / 2, 0.0, 0.07))
-        self.effector = self.ball("carriage/effector", 0.07, (l, 0.0, 0.07))
+        self.arm = self.box("carriage/arm", (1.0, 0.06, 0.04))
+        self.effector = self.ball("carriage/effector", 0.07)
 
     def resize(self, state, extent) -> None:
         super().resize(state, extent)
         (lo, hi), _ = extent
-        self.span = (lo, hi)
         l = float(state.robot_parameters["l"])
         self.beam.dimensions = (hi - lo, 0.07, 0.05)
         self.arm.dimensions = (l, 0.06, 0.04)
@@ -114,7 +112,7 @@ class Gantry(Mechanism):
         self.effector.position = (l, 0.0, 0.07)
 
     def pose(self, x) -> None:
-        lo, hi = self.span
+        (lo, hi), _ = self.extent
         self.beam.position = ((lo + hi) / 2, float(x[0]), self.z)
         self.carriage.position = (float(x[1]), float(x[0]), self.z + 0.05)
         self.carriage.wxyz = yaw_quaternion(float(x[2]))
@@ -124,14 +122,10 @@ class NormalForm(Mechanism):
     """Manipulator 1 (30): slider x2 on the vertical guide, lever of slope x3, runner at x1."""
 
     def build(self) -> None:
-        (xlo, xhi), (lo, hi) = self.extent
-        self.runner = self.box("runner", (0.05, hi - lo, 0.04))
-        self.runner_span = (lo, hi)
+        self.runner = self.box("runner", (0.05, 1.0, 0.04))
         self.slider = self.box("slider", (0.18, 0.14, 0.08))
         self.lever = self.scene.add_frame(f"{self.root}/lever", show_axes=False)
-        # Along the lever from x = xlo to x = xhi of the task-plane box when level: shorter in x
-        # when it tilts, so it stays in the framed view.
-        self.bar = self.box("lever/bar", (xhi - xlo, 0.045, 0.03), ((xlo + xhi) / 2, 0.0, 0.05))
+        self.bar = self.box("lever/bar", (1.0, 0.045, 0.03))
         self.ball("lever/pivot", 0.06, (0.0, 0.0, 0.05), color=(40, 40, 40))
         self.point = self.ball("W", 0.08)
         chosen = tuple(self.state.algorithms)
@@ -144,13 +138,14 @@ class NormalForm(Mechanism):
         super().resize(state, extent)
         (xlo, xhi), (lo, hi) = extent
         self.runner.dimensions = (0.05, hi - lo, 0.04)
-        self.runner_span = (lo, hi)
+        # Along the lever from x = xlo to x = xhi of the task-plane box when level: shorter in x
+        # when it tilts, so it stays in the framed view.
         self.bar.dimensions = (xhi - xlo, 0.045, 0.03)
         self.bar.position = ((xlo + xhi) / 2, 0.0, 0.05)
 
     def pose(self, x) -> None:
         x1, x2, x3 = (float(v) for v in x)
-        lo, hi = self.runner_span
+        _, (lo, hi) = self.extent
         self.runner.position = (x1, (lo + hi) / 2, self.z)
         self.slider.position = (0.0, x2, self.z)
         self.lever.position = (0.0, x2, self.z)
@@ -217,17 +212,14 @@ class Chain(Mechanism):
                 axes_radius=0.06 * AXES_FRACTION * reach,
             )
         )
-        self._marks()
-
-    def _marks(self) -> None:
-        """The joint limits and which drawn joint is each variable's (coloured when outside)."""
-        self.limits, self.at = state_limits(self.state), joint_points(self.kin)
-        self.marked: set[int] = set()
 
     def resize(self, state, extent) -> None:
+        """Follow a new state: its kinematics, its joint limits and which drawn joint is each
+        variable's (coloured when outside)."""
         super().resize(state, extent)
         self.kin = state_kinematics(state)
-        self._marks()
+        self.limits, self.at = state_limits(state), joint_points(self.kin)
+        self.marked: set[int] = set()
 
     def pose(self, x) -> None:
         pts = chain_points(self.kin, np.asarray(x, dtype=float), self.z + 0.05)
