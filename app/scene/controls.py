@@ -13,6 +13,25 @@ import viser
 from ..dashboard.controls import GROUPS, Control, control_values, controls
 
 
+class Syncing:
+    """Whether this thread is setting a GUI's inputs to the values in force (``with syncing:``
+    while it does, ``if syncing:`` in the inputs' callbacks): the callbacks viser calls from
+    within an assignment are then not a user's change. Per thread: a user's change, which
+    viser's thread delivers, is never dropped while another thread syncs."""
+
+    def __init__(self) -> None:
+        self._local = threading.local()
+
+    def __bool__(self) -> bool:
+        return getattr(self._local, "depth", 0) > 0
+
+    def __enter__(self) -> None:
+        self._local.depth = getattr(self._local, "depth", 0) + 1
+
+    def __exit__(self, *_) -> None:
+        self._local.depth -= 1
+
+
 class SceneControls:
     """The inputs of one scene's GUI, one folder per group of the specification.
 
@@ -30,19 +49,8 @@ class SceneControls:
         self.folders: list = []
         self._options: dict[str, dict[str, str]] = {}  # a select's value -> its label
         self._shape: list[dict] | None = None  # the specification on screen
-        self._local = threading.local()
+        self.syncing = Syncing()
         self._lock = threading.RLock()
-
-    @property
-    def syncing(self) -> bool:
-        """Whether this thread is setting the inputs to the state's values: the callbacks viser
-        calls from within the assignment are then not a user's change. Per thread: a user's
-        change, which viser's thread delivers, is never dropped while another thread syncs."""
-        return getattr(self._local, "syncing", False)
-
-    @syncing.setter
-    def syncing(self, value: bool) -> None:
-        self._local.syncing = value
 
     def show(self, state) -> None:
         """Show ``state``: the inputs are built anew when its controls differ from those on
@@ -59,8 +67,7 @@ class SceneControls:
     def sync(self, state) -> None:
         """Set every input to the value in force (a user's own change included)."""
         values = control_values(state)
-        self.syncing = True
-        try:
+        with self.syncing:
             for key, handle in self.inputs.items():
                 value = values.get(key)
                 if key in self._options and isinstance(value, str):
@@ -71,23 +78,18 @@ class SceneControls:
                     handle.value = value
                 except (ValueError, AssertionError):
                     pass
-        finally:
-            self.syncing = False
 
     def _build(self, spec: list[Control], values: dict[str, Any]) -> None:
         for folder in self.folders:
             folder.remove()
         self.folders, self.inputs, self._options = [], {}, {}
-        self.syncing = True
-        try:
+        with self.syncing:
             for order, (group, title) in enumerate(GROUPS, start=2):
                 with self._gui.add_folder(title, order=order) as folder:
                     self.folders.append(folder)
                     for control in spec:
                         if control.group == group:
                             self._add(control, values.get(control.key))
-        finally:
-            self.syncing = False
 
     def _change(self, patch: dict) -> None:
         if not self.syncing:

@@ -35,17 +35,13 @@ class DashboardScene:
     Parameters
     ----------
     dashboard : Dashboard
-    host, port : str, int
-        Where viser listens (a loopback address; the page reaches it through the relay).
     low_end : bool
         Draw for a software renderer: no shadows, no environment map.
     """
 
-    def __init__(
-        self, dashboard: Dashboard, host: str = "127.0.0.1", port: int = 0, low_end: bool = False
-    ) -> None:
+    def __init__(self, dashboard: Dashboard, low_end: bool = False) -> None:
         self.dashboard = dashboard
-        self.server = SceneServer(host=host, port=port)
+        self.server = SceneServer()  # (on a free loopback port: the page reaches it by the relay)
         self.server.scene.set_up_direction("+z")
         if low_end:
             # Without shadows and the environment map a frame costs a software renderer far

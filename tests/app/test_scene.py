@@ -66,15 +66,11 @@ def test_animation_timeline_ends_at_the_last_configuration():
 
 def test_viser_gui_and_drag_change_the_one_state():
     """The scene's GUI and its start-point gizmo write to the same Dashboard as the page."""
-    import socket
     import time
     from types import SimpleNamespace
 
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
     dashboard = Dashboard(updated_state(default_state("manipulator2"), {"task": "target"}))
-    scene = DashboardScene(dashboard, port=port)
+    scene = DashboardScene(dashboard)
     try:
         assert dashboard.wait(1, timeout=60)
         deadline = time.monotonic() + 30
@@ -127,10 +123,9 @@ def test_viser_gui_and_drag_change_the_one_state():
         syncing, release = threading.Event(), threading.Event()
 
         def sync_elsewhere() -> None:
-            scene.controls.syncing = True
-            syncing.set()
-            release.wait(10)
-            scene.controls.syncing = False
+            with scene.controls.syncing:
+                syncing.set()
+                release.wait(10)
 
         other = threading.Thread(target=sync_elsewhere)
         other.start()
@@ -158,15 +153,10 @@ def test_scene_follows_a_new_result_in_place():
     """A change that keeps the robot and the task moves the scene's nodes instead of
     re-creating them (a target the closed path gains or loses is added or removed); the
     start-point gizmo moves with the drawing."""
-    import socket
-
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
     # (k(x0) off the path's points for both: the closed path has the same number of legs)
     first = updated_state(default_state("manipulator2"), {"x0": [0.4, 0.0, 1.5]})
     dashboard = Dashboard(first)
-    scene = DashboardScene(dashboard, port=port)
+    scene = DashboardScene(dashboard)
     M2 = "/robot/manipulator2-path"
     try:
         assert dashboard.wait(1, timeout=60)
@@ -283,15 +273,11 @@ def test_the_scene_shows_the_runs_progress_not_the_second_phases():
     """The scene's status keeps the drawn result's line while E1, E2 (which it does not draw)
     are computed; a new state's runs show their progress there."""
     import json
-    import socket
 
     from jik.app.dashboard.messages import Event
 
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
     dashboard = Dashboard(updated_state(default_state("manipulator2"), {"cycles": 1}))
-    scene = DashboardScene(dashboard, port=port)
+    scene = DashboardScene(dashboard)
     try:
         assert dashboard.wait(1, timeout=60)
         scene._show_status(dashboard.result)
