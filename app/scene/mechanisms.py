@@ -36,7 +36,7 @@ from .arm_marks import (
     joint_points,
     target_fixtures,
 )
-from .pose import yaw_quaternion
+from .pose import NORMAL_FORM, yaw_quaternion
 from .traces import polyline, trace_tolerance
 
 #: Height of each algorithm's copy above the task plane, and its opacity (None: solid).
@@ -150,7 +150,8 @@ class NormalForm(Mechanism):
         self.slider.position = (0.0, x2, self.z)
         self.lever.position = (0.0, x2, self.z)
         self.lever.wxyz = yaw_quaternion(math.atan(x3))
-        self.point.position = (x1, x2 + x1 * x3, self.z + 0.08)
+        W = NORMAL_FORM.forward(np.asarray(x, dtype=float))
+        self.point.position = (float(W[0]), float(W[1]), self.z + 0.08)
 
 
 class Platform(Mechanism):
@@ -245,6 +246,13 @@ def chain_points(kin: Any, x: np.ndarray, z: float) -> np.ndarray:
     if base_link(kin):
         return np.concatenate([np.zeros((*pts.shape[:-2], 1, 3)), pts], axis=-2)
     return pts
+
+
+def drawn_points(result, kin: Any) -> np.ndarray:
+    """The points (n, 3) of a chain in the configurations of ``result``'s runs (about 200 of
+    them, evenly spaced), at height 0: what the scene's box and camera must hold."""
+    xs = np.concatenate([r.x for r in result.runs.values()])
+    return chain_points(kin, xs[:: max(1, len(xs) // 200)], 0.0).reshape(-1, 3)
 
 
 #: The robots drawn as a serial chain of links (:class:`Chain`): a user's and the catalogue's arms.
@@ -363,8 +371,7 @@ def extent_of(result) -> tuple[tuple[float, float], tuple[float, float]]:
         return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
     xs = np.concatenate([r.x for r in result.runs.values()])
     if result.state.robot in CHAINS:  # (the whole arm, not only its end)
-        step = max(1, len(xs) // 200)
-        pts = chain_points(state_kinematics(result.state), xs[::step], 0.0).reshape(-1, 3)
+        pts = drawn_points(result, state_kinematics(result.state))
         lo, hi = pts.min(axis=0)[:2] - 0.3, pts.max(axis=0)[:2] + 0.3
         return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
     ys = np.concatenate([r.y for r in result.runs.values()])

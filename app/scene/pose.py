@@ -7,6 +7,10 @@ import math
 
 import numpy as np
 
+from ...engine.kinematics import Manipulator1
+
+#: Manipulator 1's kinematics k(x) = (x1, x2 + x1 x3), eq. (30): where its task point W is.
+NORMAL_FORM = Manipulator1()
 #: Unicycle iterations shown in the animation (geometrically spaced, the last always).
 UNICYCLE_SHOWN = 10
 
@@ -31,7 +35,8 @@ def gizmo_pose(robot: str, x0, robot_parameters: dict) -> tuple[tuple[float, flo
     if robot == "manipulator2":
         return (x0[1], x0[0]), x0[2]
     if robot == "manipulator1":
-        return (x0[0], x0[1] + x0[0] * x0[2]), math.atan(x0[2])
+        X, Y = (float(v) for v in NORMAL_FORM.forward(np.asarray(x0, dtype=float)))
+        return (X, Y), math.atan(x0[2])
     q0 = robot_parameters["q0"]
     return (q0[0], q0[1]), q0[2]
 
