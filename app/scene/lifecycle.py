@@ -56,10 +56,9 @@ class DashboardScene:
         self.server.gui.main_panel.dock_right()
         self.server.gui.main_panel.set_width(300)
         self._lock = threading.RLock()
-        self.drawn_generation = 0
         self._drawn_runs: tuple[str, ...] | None = None  # runs_key of what the scene shows
         self._framed: str | None = None  # layout_name of the robot the camera frames
-        self._add_legend()
+        self.legend = self.server.gui.add_markdown(order=0, content=legend(DEFAULT_ALGORITHMS))
         self.playback = Playback(self.server.gui, self._lock, dashboard.scene_status)
         self.status, self.progress = self.playback.status, self.playback.progress
         self.controls = SceneControls(self.server.gui, self._send)
@@ -69,10 +68,6 @@ class DashboardScene:
         self.nodes = NodeSets(self.server.scene)
         self._unsubscribe = dashboard.subscribe(self._on_event, last=True)
 
-    @property
-    def port(self) -> int:
-        return self.server.get_port()
-
     def connect(self, subprotocols: Sequence[str] | None):
         """The relay's websocket to this scene (await it; see :class:`SceneServer`)."""
         return self.server.connect(subprotocols)
@@ -81,9 +76,6 @@ class DashboardScene:
         self._unsubscribe()
         self.playback.stop()
         self.server.stop()
-
-    def _add_legend(self) -> None:
-        self.legend = self.server.gui.add_markdown(order=0, content=legend(DEFAULT_ALGORITHMS))
 
     # -- events ---------------------------------------------------------------------------
     def _on_event(self, event: Event) -> None:
@@ -102,12 +94,12 @@ class DashboardScene:
             elif event.kind == "result" and event.result is not None:
                 self._draw(event.result)
             elif event.kind == "refused":
-                self._sync_now()
+                self.controls.sync(self.dashboard.state)
                 self.status.content = f"**refused:** {json.loads(event.data)['message']}"
             elif event.kind == "ahead" and event.result is not None:
                 self._prebuild(event.result)
             elif event.kind == "error":
-                self._sync_now()
+                self.controls.sync(self.dashboard.state)
                 self.progress.visible = False
                 self.status.content = f"**error:** {json.loads(event.data)['message']}"
         except Exception as exc:  # never let a drawing error kill the worker thread
@@ -123,10 +115,6 @@ class DashboardScene:
             return
 
     # -- drawing --------------------------------------------------------------------------
-    def _sync_now(self) -> None:
-        """Show the values in force in the GUI (after a drawing, an error or a refusal)."""
-        self.controls.sync(self.dashboard.state)
-
     def _draw(self, result) -> None:
         state = result.state
         drawn = runs_key(state)
@@ -135,8 +123,7 @@ class DashboardScene:
             # animation runs per leg): nothing in the scene changes but its status, so nothing
             # is sent but the status (a redraw would make every client render anew).
             with self._lock:  # (the timeline on screen plays the same legs)
-                self.drawn_generation = result.generation
-                self._sync_now()
+                self.controls.sync(self.dashboard.state)
                 self.dashboard.scene_status.update(generation=result.generation)
             self._show_status(result)
             return
@@ -152,8 +139,7 @@ class DashboardScene:
                 self._framed = layout_name(state)
                 self.camera.frame(result)
             self.playback.show(timeline, self.nodes.mechanisms)
-            self.drawn_generation = result.generation
-            self._sync_now()
+            self.controls.sync(self.dashboard.state)
             self.dashboard.scene_status.update(
                 generation=result.generation,
                 robot=state.robot,

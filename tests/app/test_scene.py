@@ -323,8 +323,8 @@ ARM = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]}
 def _drawn(scene: DashboardScene, generation: int, timeout: float = 60) -> None:
     """Wait until the scene has drawn ``generation`` and shows its status."""
     deadline = time.monotonic() + timeout
-    while scene.drawn_generation < generation or not scene.status.content.startswith(
-        f"generation {scene.drawn_generation}:"
+    while (drawn := scene.dashboard.scene_status.get("generation", 0)) < generation or not (
+        scene.status.content.startswith(f"generation {drawn}:")
     ):
         assert time.monotonic() < deadline, "the scene did not draw"
         time.sleep(0.05)
