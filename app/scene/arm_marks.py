@@ -94,9 +94,7 @@ def joint_points(kin: Any) -> dict[int, int]:
     return {int(j.index): first + k for k, j in enumerate(chain) if getattr(j, "index", -1) >= 0}
 
 
-def end_frame(kin: Any, x) -> tuple[tuple[float, ...], tuple[float, ...]] | None:
-    """(position, wxyz) of the end link at ``x`` (p,) when the task holds its orientation."""
-    if not has_pose(kin) or not hasattr(kin, "end_pose"):
-        return None
+def end_frame(kin: Any, x) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """(position, wxyz) of a URDF arm's end link at ``x`` (p,)."""
     R, t = kin.end_pose(np.asarray(x, dtype=float))
     return tuple(float(v) for v in t), wxyz(R)

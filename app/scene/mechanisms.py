@@ -33,6 +33,7 @@ from .arm_marks import (
     OUTSIDE_COLOR,
     base_link,
     end_frame,
+    has_pose,
     joint_points,
     target_fixtures,
 )
@@ -204,15 +205,12 @@ class Chain(Mechanism):
         ball = max(reach, 1e-3) / 60
         self.joints = [self.ball(f"joint{i}", ball if i < n - 1 else 1.5 * ball) for i in range(n)]
         # The end link's frame when the task holds its orientation (a pose task).
-        self.end = (
-            None
-            if end_frame(self.kin, self.state.x0) is None
-            else self.scene.add_frame(
-                f"{self.root}/end",
-                axes_length=AXES_FRACTION * reach,
-                axes_radius=0.06 * AXES_FRACTION * reach,
+        self.end = None
+        if has_pose(self.kin):
+            size = AXES_FRACTION * reach
+            self.end = self.scene.add_frame(
+                f"{self.root}/end", axes_length=size, axes_radius=0.06 * size
             )
-        )
 
     def resize(self, state, extent) -> None:
         """Follow a new state: its kinematics, its joint limits and which drawn joint is each
@@ -227,8 +225,8 @@ class Chain(Mechanism):
         self.links.points = np.stack([pts[:-1], pts[1:]], axis=1)
         for ball, point in zip(self.joints, pts, strict=False):
             ball.position = tuple(float(v) for v in point)
-        if self.end is not None and (frame := end_frame(self.kin, x)) is not None:
-            self.end.position, self.end.wxyz = frame
+        if self.end is not None:
+            self.end.position, self.end.wxyz = end_frame(self.kin, x)
         outside = {self.at[int(i)] for i in outside_joints(self.limits, x) if int(i) in self.at}
         for k in outside ^ self.marked:  # (only the joints whose colour changes)
             self.joints[k].color = OUTSIDE_COLOR if k in outside else self.color
