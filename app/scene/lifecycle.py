@@ -134,7 +134,7 @@ class DashboardScene:
             # client shows the start point and the paths that leave it together, never one
             # without the other.
             self.gizmo.place(state)
-            self.nodes.show(result, timeline, extent_of(result))
+            self.nodes.show(result, extent_of(result))
             if self._framed != layout_name(state):  # another robot: frame its reach
                 self._framed = layout_name(state)
                 self.camera.frame(result)

@@ -38,17 +38,12 @@ from .arm_marks import (
     target_fixtures,
 )
 from .pose import NORMAL_FORM, yaw_quaternion
-from .traces import polyline, trace_tolerance
+from .traces import polyline, rgb, trace_tolerance, unicycle_traces
 
 #: Height of each algorithm's copy above the task plane, and its opacity (None: solid).
 Z = {a: s.z for a, s in STYLES.items()}
 OPACITY = {a: s.opacity for a, s in STYLES.items()}
 HOME_COLOR = (150, 150, 150)
-
-
-def rgb(hex_color: str) -> tuple[int, int, int]:
-    h = hex_color.lstrip("#")
-    return int(h[0:2], 16), int(h[2:4], 16), int(h[4:6], 16)
 
 
 class Mechanism:
@@ -156,7 +151,8 @@ class NormalForm(Mechanism):
 
 
 class Platform(Mechanism):
-    """The unicycle: a wheeled platform at pose (q1, q2, q3), nose pointing along the heading."""
+    """The unicycle: a wheeled platform at pose (q1, q2, q3), nose pointing along the heading,
+    at half a manipulator's copy's height."""
 
     def build(self) -> None:
         self.frame = self.scene.add_frame(f"{self.root}/platform", show_axes=False)
@@ -176,7 +172,7 @@ class Platform(Mechanism):
             )
 
     def pose(self, q) -> None:
-        self.frame.position = (float(q[0]), float(q[1]), self.z)
+        self.frame.position = (float(q[0]), float(q[1]), 0.5 * self.z)
         self.frame.wxyz = yaw_quaternion(float(q[2]))
 
 
@@ -255,7 +251,8 @@ def drawn_points(result, kin: Any) -> np.ndarray:
 
 #: The robots drawn as a serial chain of links (:class:`Chain`): a user's and the catalogue's arms.
 CHAINS = ("planar_chain", "urdf", *ARMS)
-MECHANISMS = {"manipulator1": NormalForm, "manipulator2": Gantry, **dict.fromkeys(CHAINS, Chain)}
+MECHANISMS: dict[str, type[Mechanism]] = dict.fromkeys(CHAINS, Chain)
+MECHANISMS.update(manipulator1=NormalForm, manipulator2=Gantry, unicycle=Platform)
 
 
 def layout_name(state) -> str:
@@ -307,6 +304,8 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
     not for J^P#; the targets of the path's legs."""
     (xlo, xhi), (ylo, yhi) = extent
     tol = trace_tolerance(extent)
+    if result.state.robot == "unicycle":
+        return unicycle_traces(result, root, tol)
     # Heights and balls at the manipulators' scale, smaller in a smaller scene (a formula
     # robot's paths may span a few millimetres).
     scale = min(1.0, max(xhi - xlo, yhi - ylo) / 2.0)

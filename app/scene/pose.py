@@ -71,6 +71,14 @@ def start_from_gizmo(robot: str, xy, yaw: float, state) -> dict:
     return {"robot_parameters": {"q0": _snapped([X, Y, q3], q0)}}
 
 
+def shown_iterations(result) -> np.ndarray:
+    """The unicycle's iterations that the animation and the traces show: :data:`UNICYCLE_SHOWN`
+    geometrically spaced ones, the first and the last always."""
+    m = max(len(r.platform) for r in result.runs.values())
+    shown = np.unique(np.geomspace(1, m, num=UNICYCLE_SHOWN).astype(int) - 1)
+    return np.union1d(shown, [0, m - 1]).astype(int)
+
+
 class Timeline:
     """Configurations of both algorithms as functions of one playback position s in [0, length]."""
 
@@ -78,9 +86,7 @@ class Timeline:
         self.result = result
         self.unicycle = any(r.platform is not None for r in result.runs.values())
         if self.unicycle:
-            m = max(len(r.platform) for r in result.runs.values())
-            shown = np.unique(np.geomspace(1, m, num=UNICYCLE_SHOWN).astype(int) - 1)
-            self.shown = np.union1d(shown, [0, m - 1]).astype(int)
+            self.shown = shown_iterations(result)
             self.length = float(len(self.shown))
         else:
             self.theta_end = max(float(r.theta[-1]) for r in result.runs.values())

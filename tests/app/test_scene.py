@@ -453,3 +453,36 @@ def test_manipulator1_names_its_task_point_on_one_chosen_copy(chosen, labelled):
         NormalForm(scene, f"/robot/m1/{a}", (0, 0, 0), None, 0.0, state, ((-1, 1), (-1, 1)))
     labels = [c.args[:2] for c in scene.add_label.call_args_list]
     assert labels == [(f"/robot/m1/{labelled}/W/label", "W (task point)")]
+
+
+def test_the_unicycles_nodes_are_kept_and_moved():
+    """The unicycle's set is kept like a manipulator's: a new result moves its platforms and its
+    traces (one per algorithm and shown iteration, the last thicker) instead of drawing them
+    anew; the grey platform stands at the start q0, the black one at the target."""
+    from jik.app.scene.nodes import set_key
+    from jik.app.scene.pose import shown_iterations
+
+    state = default_state("unicycle")
+    dashboard = Dashboard(default_state("manipulator2"))
+    scene = DashboardScene(dashboard)
+    try:
+        assert dashboard.wait(1, timeout=60)
+        first = compute(state, 101)
+        scene._draw(first)
+        fixtures, mechanisms = dict(scene.nodes.fixtures), dict(scene.nodes.mechanisms)
+        n = len(shown_iterations(first))
+        root = f"/robot/unicycle-{state.task}"
+        assert fixtures.keys() == {f"{root}/trace/{a}/{k}" for a in first.runs for k in range(n)}
+        assert [fixtures[f"{root}/trace/extended/{k}"].thickness for k in (0, n - 1)] == [1.5, 3.5]
+        second = updated_state(state, {"robot_parameters": {"q0": [0.2, -0.1, 0.3]}})
+        scene._draw(compute(second, 102))
+        assert all(
+            scene.nodes.fixtures[k] is v for k, v in fixtures.items() if k in scene.nodes.fixtures
+        )
+        assert all(scene.nodes.mechanisms[k] is v for k, v in mechanisms.items())
+        still = scene.nodes.sets[set_key(second)]["still"]
+        np.testing.assert_allclose(still["home"].frame.position, (0.2, -0.1, 0.0))
+        np.testing.assert_allclose(still["target"].frame.position[:2], second.target[:2])
+    finally:
+        scene.stop()
+        dashboard.stop()
