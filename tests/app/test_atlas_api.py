@@ -286,27 +286,20 @@ def test_a_reference_whose_solve_runs_away_is_refused_by_name(client):
     assert client.post("/atlas", json=body()).status_code == 202
 
 
-def test_a_session_reads_a_job_that_left_gamma_and_mode_to_the_robot(client):
-    """A job of POST /atlas without gamma or mode, read through a session's atlas route: its
-    heatmap's title gives the robot's defaults (it was a 500, found by schemathesis)."""
-    sid = _session(client)
-    job = client.post("/atlas", json=body()).json()["id"]
-    assert wait_until_ended(client, job)["status"] == "done"
-    r = client.get(f"/api/sessions/{sid}/atlas/{job}")
-    assert r.status_code == 200, r.text
-    assert "γ = 1, continuous mode" in r.json()["figure"]["layout"]["title"]["text"]
-
-
-def test_a_session_reads_a_job_of_a_user_robot_that_left_gamma_to_it(client):
-    """The same for a robot the request defines: its build's defaults (a 500 before, found by
-    schemathesis posting the document's example of a planar chain's atlas)."""
-    sid = _session(client)
-    robot = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]}
-    job = client.post("/atlas", json={"robot": robot, "starts": 4, "cycles": 1}).json()["id"]
-    assert wait_until_ended(client, job)["status"] == "done"
-    r = client.get(f"/api/sessions/{sid}/atlas/{job}")
-    assert r.status_code == 200, r.text
-    assert "γ = 1, continuous mode" in r.json()["figure"]["layout"]["title"]["text"]
+def test_a_session_reads_only_the_atlases_it_started(client):
+    """A tab's atlas route gives its own jobs: a job of the REST API or of another session is
+    a 404, as for a job that is not there (the session's id alone no longer reads any job)."""
+    sid, other = _session(client), _session(client)
+    rest = client.post("/atlas", json=body()).json()["id"]
+    assert wait_until_ended(client, rest)["status"] == "done"
+    r = client.post(f"/api/sessions/{other}/atlas", json={"starts": 4})
+    assert r.status_code == 202, r.text
+    theirs = r.json()["id"]
+    assert wait_until_ended(client, theirs)["status"] == "done"
+    for job in (rest, theirs):
+        r = client.get(f"/api/sessions/{sid}/atlas/{job}")
+        assert r.status_code == 404 and "this session did not start it" in r.text
+    assert client.get(f"/api/sessions/{other}/atlas/{theirs}").status_code == 200
 
 
 def test_an_atlas_takes_every_robot_and_refuses_a_bad_one_naming_the_field(client):

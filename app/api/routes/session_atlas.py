@@ -18,7 +18,7 @@ from fastapi.responses import JSONResponse, StreamingResponse
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from starlette.concurrency import run_in_threadpool
 
-from ...compute.atlas_jobs import AtlasJobNotFound
+from ...compute.atlas_jobs import AtlasJob, AtlasJobNotFound
 from ...compute.atlas_schemas import MAX_CYCLES, MAX_FAMILY, AtlasJobResponse, Scale
 from ...compute.schemas import INTEGRAL
 from ...compute.schemas.wording import refused
@@ -81,9 +81,9 @@ async def start_session_atlas(
 @router.get("/api/sessions/{session_id}/atlas/{job_id}", responses={**ERRORS, **_NOT_FOUND})
 async def read_session_atlas(session_id: str, job_id: str, store: Store, jobs: Jobs):
     """The job's status and progress; once done, its heatmap (a plotly figure), the starts and
-    the paths (a cell's run, path * N + start, picks one of each), and the request."""
-    store.get(session_id)
-    job = jobs.get(job_id)
+    the paths (a cell's run, path * N + start, picks one of each), and the request; 404 for a
+    job of another session or of the REST API."""
+    job = _own_job(store, jobs, session_id, job_id)
     body = jobs.response(job).model_dump(mode="json", exclude={"result"})
     if job.status == "done" and job.result is not None and job.request is not None:
         x_units = job.used[0].units.x if job.used else ()
@@ -107,11 +107,17 @@ async def read_session_atlas_table(
 ) -> Response:
     """The table of an atlas this session started (the panel's CSV): the same CSV as
     ``GET /atlas/{job_id}/table.csv``; 404 for a job of another session or of the REST API."""
+    return table_response(jobs, _own_job(store, jobs, session_id, job_id), every_leg)
+
+
+def _own_job(store: Store, jobs: Jobs, session_id: str, job_id: str) -> AtlasJob:
+    """The job ``job_id`` if the session ``session_id`` started it: a tab reads only its own
+    atlases (404, as for a job that is not there, otherwise)."""
     store.get(session_id)
     job = jobs.get(job_id)
     if job.session != session_id:
         raise AtlasJobNotFound(job_id, "this session did not start it")
-    return table_response(jobs, job, every_leg)
+    return job
 
 
 def _echoed(request: dict) -> dict:
