@@ -10,6 +10,7 @@ from typing import Any
 
 import viser
 
+from ..dashboard.control_changes import path_text
 from ..dashboard.controls import GROUPS, Control, control_values, controls
 
 
@@ -47,7 +48,8 @@ class SceneControls:
         self._send = send
         self.inputs: dict[str, Any] = {}  # control key -> viser input handle
         self.folders: list = []
-        self._options: dict[str, dict[str, str]] = {}  # a select's value -> its label
+        # control key -> its value as its input takes it (a select's label, a vector's tuple)
+        self._shown: dict[str, Callable[[Any], Any]] = {}
         self._shape: list[dict] | None = None  # the specification on screen
         self.syncing = Syncing()
         self._lock = threading.RLock()
@@ -69,20 +71,16 @@ class SceneControls:
         values = control_values(state)
         with self.syncing:
             for key, handle in self.inputs.items():
-                value = values.get(key)
-                if key in self._options and isinstance(value, str):
-                    value = self._options[key].get(value, value)
-                elif isinstance(value, list):
-                    value = tuple(value)
+                shown = self._shown.get(key)
                 try:
-                    handle.value = value
+                    handle.value = values.get(key) if shown is None else shown(values.get(key))
                 except (ValueError, AssertionError):
                     pass
 
     def _build(self, spec: list[Control], values: dict[str, Any]) -> None:
         for folder in self.folders:
             folder.remove()
-        self.folders, self.inputs, self._options = [], {}, {}
+        self.folders, self.inputs, self._shown = [], {}, {}
         with self.syncing:
             for order, (group, title) in enumerate(GROUPS, start=2):
                 with self._gui.add_folder(title, order=order) as folder:
@@ -105,7 +103,8 @@ class SceneControls:
             return
         if control.kind == "select":
             by_label = {label: v for v, label in control.options}
-            labels = self._options[key] = {v: label for v, label in control.options}
+            labels = {v: label for v, label in control.options}
+            self._shown[key] = lambda v: labels.get(v, v)
             handle = gui.add_dropdown(
                 control.label, list(by_label), initial_value=labels[value], hint=control.help
             )
@@ -129,16 +128,23 @@ class SceneControls:
             add: Any = gui.add_vector2 if control.size == 2 else gui.add_vector3
             lo = None if control.minimum is None else tuple(control.minimum)
             hi = None if control.maximum is None else tuple(control.maximum)
+            self._shown[key] = tuple
             handle = add(
                 control.label, tuple(value), min=lo, max=hi, step=control.step, hint=control.help
             )
             handle.on_update(lambda e: self._change({key: list(e.target.value)}))
         else:  # text (the path), or a vector of another size: as text, parsed by the server
             hint = f"{control.help} ({control.format})" if control.format else control.help
-            shown = value if isinstance(value, str) else ", ".join(f"{v:g}" for v in value)
-            handle = gui.add_text(control.label, shown, hint=hint)
+            self._shown[key] = as_text
+            handle = gui.add_text(control.label, as_text(value), hint=hint)
             handle.on_update(lambda e: self._change({key: e.target.value}))
         self.inputs[key] = handle
+
+
+def as_text(value) -> str:
+    """A text input's value: the path's text, or a vector's numbers as the path writes a point
+    (each in the fewest digits that give it back exactly: what is shown is what is in force)."""
+    return value if isinstance(value, str) else path_text([value])
 
 
 class Checks:

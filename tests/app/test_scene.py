@@ -486,3 +486,26 @@ def test_the_unicycles_nodes_are_kept_and_moved():
     finally:
         scene.stop()
         dashboard.stop()
+
+
+def test_a_vector_shown_as_text_stays_text_in_force():
+    """A vector of more than three numbers (a pose task's target) is a text input: it shows the
+    numbers in force, exactly, after every change (not a Python tuple), and its text sent back
+    is no change."""
+    from jik.app.dashboard.control_changes import path_text
+
+    dashboard = Dashboard(updated_state(default_state("panda"), {"task": "target"}))
+    scene = DashboardScene(dashboard)
+    try:
+        text = scene.controls.inputs["target"]
+        assert text.value == path_text([dashboard.state.target])
+        target = list(dashboard.state.target)
+        target[0] += 0.05
+        dashboard.update({"target": target})
+        assert text.value == path_text([target])
+        before = dashboard.state
+        text.value = text.value  # (a user's Enter in it, delivered as viser's thread does)
+        assert dashboard.state == before
+    finally:
+        scene.stop()
+        dashboard.stop()
