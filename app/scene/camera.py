@@ -52,7 +52,7 @@ def view_of(result) -> tuple[np.ndarray, float]:
         reach = float(np.linalg.norm(np.diff(home, axis=0), axis=1).sum())
         drawn = drawn_points(result, kin)
         radius = max(reach, float(np.linalg.norm(drawn - base, axis=1).max()))
-        if home.shape[-1] == 3 and np.ptp(drawn[:, 2]) > 0:  # (an arm standing in space)
+        if np.ptp(drawn[:, 2]) > 0:  # (an arm standing in space)
             # The box of its drawn configurations, not its whole reach around the base.
             # (and the targets' positions, where its pose frames are drawn).
             targets = np.asarray(result.targets, dtype=float)

@@ -15,6 +15,8 @@ import json
 import threading
 from collections.abc import Sequence
 
+from viser import FrameHandle
+
 from ...engine.exceptions import InvalidInputError
 from ..dashboard import COLORS, LABELS, Dashboard, Event, runs_key
 from ..dashboard.algorithms import DEFAULT_ALGORITHMS
@@ -140,15 +142,14 @@ class DashboardScene:
                 self.camera.frame(result)
             self.playback.show(timeline, self.nodes.mechanisms)
             self.controls.sync(self.dashboard.state)
+            first = next(iter(self.nodes.mechanisms.values()), None)
             self.dashboard.scene_status.update(
                 generation=result.generation,
                 robot=state.robot,
                 playing=self.playback.playing,
-                mechanism=type(next(iter(self.nodes.mechanisms.values()), None)).__name__,
-                joints=len(getattr(next(iter(self.nodes.mechanisms.values()), None), "joints", ())),
-                pose_frames=sum(
-                    type(h).__name__ == "FrameHandle" for h in self.nodes.fixtures.values()
-                ),
+                mechanism=type(first).__name__,
+                joints=len(getattr(first, "joints", ())),
+                pose_frames=sum(isinstance(h, FrameHandle) for h in self.nodes.fixtures.values()),
             )
         self._show_status(result)
 
