@@ -55,14 +55,13 @@ class Mechanism:
         self.build()
         self.resize(state, extent)
 
-    def box(self, name, dims, position=(0.0, 0.0, 0.0), wxyz=(1.0, 0.0, 0.0, 0.0), color=None):
+    def box(self, name, dims, position=(0.0, 0.0, 0.0)):
         return self.scene.add_box(
             f"{self.root}/{name}",
-            color=color or self.color,
+            color=self.color,
             dimensions=dims,
             opacity=self.opacity,
             position=position,
-            wxyz=wxyz,
             cast_shadow=False,
         )
 
