@@ -89,9 +89,9 @@ class Timeline:
             self.shown = shown_iterations(result)
             self.length = float(len(self.shown))
         else:
-            self.theta_end = max(float(r.theta[-1]) for r in result.runs.values())
+            theta_end = max(float(r.theta[-1]) for r in result.runs.values())
             legs = int(max(r.leg.max() for r in result.runs.values())) + 1
-            self.leg_theta = self.theta_end / legs
+            self.leg_theta = theta_end / legs
             self.length = float(legs)
 
     def at(self, s: float) -> dict[str, np.ndarray]:
@@ -114,16 +114,11 @@ class Timeline:
             )
         return out
 
-    def iteration(self, s: float) -> int | None:
-        if not self.unicycle:
-            return None
-        return int(self.shown[min(int(s), len(self.shown) - 1)])
-
     def counter(self, s: float) -> str:
         """What the animation shows at ``s``: the unicycle's iteration (of the discrete
         algorithm), or the leg of the closed path (its cycle)."""
-        k = self.iteration(s)
-        if k is not None:
+        if self.unicycle:
+            k = int(self.shown[min(int(s), len(self.shown) - 1)])
             last = max(len(r.platform) for r in self.result.runs.values()) - 1
             return f"**iteration {k}** of {last}"
         legs = max(round(self.length), 1)
