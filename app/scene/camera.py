@@ -99,11 +99,7 @@ class CameraFraming:
         robot."""
         with self._lock:
             self.view = view_of(result)
-        center, radius = self.view
-        initial = self.server.initial_camera
-        position, look_at = camera_pose(center, radius, initial.fov, INITIAL_ASPECT)
-        initial.position, initial.look_at = position, look_at
-        initial.near = min(0.01, float(np.linalg.norm(position - look_at)) / 100)
+        aim(self.server.initial_camera, self.view, INITIAL_ASPECT)
         for client in self.server.get_clients().values():
             self.frame_client(client)
 
@@ -118,9 +114,13 @@ class CameraFraming:
             aspect = settled_aspect(camera.image_width, camera.image_height)
         else:
             aspect = INITIAL_ASPECT
-        position, look_at = camera_pose(*view, camera.fov, aspect)
-        distance = float(np.linalg.norm(position - look_at))
         with client.atomic():
-            camera.position = position
-            camera.look_at = look_at
-            camera.near = min(0.01, distance / 100)  # (a tiny robot is not clipped)
+            aim(camera, view, aspect)
+
+
+def aim(camera: Any, view: tuple[np.ndarray, float], aspect: float) -> None:
+    """Point a viser camera (a client's, or the initial one) at ``view`` (center, radius) for
+    its field of view and ``aspect`` (:func:`camera_pose`)."""
+    position, look_at = camera_pose(*view, camera.fov, aspect)
+    camera.position, camera.look_at = position, look_at
+    camera.near = min(0.01, float(np.linalg.norm(position - look_at)) / 100)  # (a tiny robot)
