@@ -94,24 +94,27 @@ class SceneControls:
             self._send(patch)
 
     def _add(self, control: Control, value: Any) -> None:
-        """One viser input for ``control``."""
+        """One viser input for ``control``: what it shows of a value (``self._shown``) and
+        what it sends of its own (``sent``)."""
         gui, key = self._gui, control.key
         handle: Any
+        sent: Callable[[Any], Any]
         if control.kind == "preset":
             button = gui.add_button(control.label, hint=control.help)
             button.on_click(lambda _: self._change({key: control.value}))
             return
+        if control.kind == "checks":
+            self.inputs[key] = Checks(gui, control, value, lambda v: self._change({key: v}))
+            return
         if control.kind == "select":
-            by_label = {label: v for v, label in control.options}
+            sent = {label: v for v, label in control.options}.__getitem__
             labels = {v: label for v, label in control.options}
             self._shown[key] = lambda v: labels.get(v, v)
             handle = gui.add_dropdown(
-                control.label, list(by_label), initial_value=labels[value], hint=control.help
+                control.label, list(labels.values()), initial_value=labels[value], hint=control.help
             )
-            handle.on_update(lambda e: self._change({key: by_label[e.target.value]}))
-        elif control.kind == "checks":
-            handle = Checks(gui, control, value, lambda v: self._change({key: v}))
         elif control.kind == "slider":
+            sent = round if control.integer else float  # (viser's slider gives a float)
             handle = gui.add_slider(
                 control.label,
                 min=control.minimum,
@@ -120,24 +123,19 @@ class SceneControls:
                 initial_value=min(max(value, control.minimum), control.maximum),
                 hint=control.help,
             )
-            if control.integer:  # (viser's slider gives a float)
-                handle.on_update(lambda e: self._change({key: round(e.target.value)}))
-            else:
-                handle.on_update(lambda e: self._change({key: e.target.value}))
         elif control.kind == "vector" and control.size in (2, 3):
             add: Any = gui.add_vector2 if control.size == 2 else gui.add_vector3
             lo = None if control.minimum is None else tuple(control.minimum)
             hi = None if control.maximum is None else tuple(control.maximum)
-            self._shown[key] = tuple
+            sent, self._shown[key] = list, tuple
             handle = add(
                 control.label, tuple(value), min=lo, max=hi, step=control.step, hint=control.help
             )
-            handle.on_update(lambda e: self._change({key: list(e.target.value)}))
         else:  # text (the path), or a vector of another size: as text, parsed by the server
             hint = f"{control.help} ({control.format})" if control.format else control.help
-            self._shown[key] = as_text
+            sent, self._shown[key] = str, as_text
             handle = gui.add_text(control.label, as_text(value), hint=hint)
-            handle.on_update(lambda e: self._change({key: e.target.value}))
+        handle.on_update(lambda e: self._change({key: sent(e.target.value)}))
         self.inputs[key] = handle
 
 
