@@ -309,22 +309,14 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
     # robot's paths may span a few millimetres).
     scale = min(1.0, max(xhi - xlo, yhi - ylo) / 2.0)
     robot = result.state.robot
-    grey: dict = {"color": (90, 90, 90)}
     out: dict[str, tuple[str, dict, dict]] = {}
-    rail = (0.06, yhi - ylo, 0.05)
-    if robot == "manipulator2":
-        for side, x in (("left", xlo), ("right", xhi)):
-            out[f"{root}/rails/{side}"] = (
-                "box",
-                {"dimensions": rail, "position": (x, (ylo + yhi) / 2, -0.02)},
-                grey,
-            )
-    elif robot == "manipulator1":
-        out[f"{root}/guide"] = (
-            "box",
-            {"dimensions": rail, "position": (0.0, (ylo + yhi) / 2, -0.02)},
-            grey,
-        )
+    rails = {
+        "manipulator2": {"rails/left": xlo, "rails/right": xhi},
+        "manipulator1": {"guide": 0.0},
+    }
+    for name, x in rails.get(robot, {}).items():  # (grey boxes along y, at x)
+        rail = {"dimensions": (0.06, yhi - ylo, 0.05), "position": (x, (ylo + yhi) / 2, -0.02)}
+        out[f"{root}/{name}"] = ("box", rail, {"color": (90, 90, 90)})
     chain = robot in CHAINS
     kin = state_kinematics(result.state) if chain else None
     for a, run in result.runs.items():
