@@ -296,11 +296,12 @@ def add_floor_grid(scene, half: float = 10.0, cell: float = 0.5, section: float 
 
 
 def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
-    """The parts of a manipulator's scene besides the mechanisms, by node name: (kind, the
-    values that follow the result, the fixed style). The rails (Manipulator 2) or the guide
+    """The parts of a robot's scene besides the mechanisms, by node name: (kind, the values
+    that follow the result, the fixed style). The rails (Manipulator 2) or the guide
     (Manipulator 1) span the task-plane box; the task paths of both algorithms, and for
     Manipulator 2 the carriage paths (x2, x1), which are the joint paths: closed for J^E#,
-    not for J^P#; the targets of the path's legs."""
+    not for J^P#; the targets of the path's legs. The unicycle's: its paths
+    (:func:`~jik.app.scene.traces.unicycle_traces`)."""
     (xlo, xhi), (ylo, yhi) = extent
     tol = trace_tolerance(extent)
     if result.state.robot == "unicycle":
@@ -352,25 +353,22 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
 
 def extent_of(result) -> tuple[tuple[float, float], tuple[float, float]]:
     """Box of the task plane used by the mechanisms (rails, runner), covering both runs."""
-    if any(r.platform is not None for r in result.runs.values()):
-        ys = np.concatenate([r.platform.reshape(-1, 3) for r in result.runs.values()])
-        ys = np.vstack([ys, [result.state.target]])
+    runs, robot = result.runs.values(), result.state.robot
+    if any(r.platform is not None for r in runs):
+        ys = np.vstack([*(r.platform.reshape(-1, 3) for r in runs), [result.state.target]])
         lo, hi = ys.min(axis=0)[:2] - 1.0, ys.max(axis=0)[:2] + 1.0
-        return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
-    xs = np.concatenate([r.x for r in result.runs.values()])
-    if result.state.robot in CHAINS:  # (the whole arm, not only its end)
+    elif robot in CHAINS:  # (the whole arm, not only its end)
         pts = drawn_points(result, state_kinematics(result.state))
         lo, hi = pts.min(axis=0)[:2] - 0.3, pts.max(axis=0)[:2] + 0.3
-        return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
-    ys = np.concatenate([r.y for r in result.runs.values()])
-    if result.state.robot not in MECHANISMS:  # (a formula robot: its paths, of any size)
-        ys = np.vstack([ys[:, :2], np.asarray(result.targets)[:, :2]])
-        lo, hi = ys.min(axis=0), ys.max(axis=0)
-        pad = max(0.15 * float(np.max(hi - lo)), 1e-3)
-        return (float(lo[0] - pad), float(hi[0] + pad)), (float(lo[1] - pad), float(hi[1] + pad))
-    lo = np.minimum(ys.min(axis=0)[:2], 0.0) - 0.6
-    hi = np.maximum(ys.max(axis=0)[:2], 1.0) + 0.6
-    if result.state.robot == "manipulator2":
-        lo[0] = min(lo[0], xs[:, 1].min() - 0.4)
-        hi[0] = max(hi[0], xs[:, 1].max() + 0.4)
+    elif robot not in MECHANISMS:  # (a formula robot: its paths, of any size)
+        ys = np.vstack([*(r.y[:, :2] for r in runs), np.asarray(result.targets)[:, :2]])
+        pad = max(0.15 * float(np.max(np.ptp(ys, axis=0))), 1e-3)
+        lo, hi = ys.min(axis=0) - pad, ys.max(axis=0) + pad
+    else:
+        ys = np.concatenate([r.y for r in runs])
+        lo = np.minimum(ys.min(axis=0)[:2], 0.0) - 0.6
+        hi = np.maximum(ys.max(axis=0)[:2], 1.0) + 0.6
+        if robot == "manipulator2":  # (and the carriage's x2)
+            x2 = np.concatenate([r.x[:, 1] for r in runs])
+            lo[0], hi[0] = min(lo[0], x2.min() - 0.4), max(hi[0], x2.max() + 0.4)
     return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
