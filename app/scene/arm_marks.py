@@ -56,7 +56,7 @@ def target_fixtures(result, kin: Any, root: str, size: float) -> dict[str, tuple
         position, q = pose
         if q is None:
             out[f"{root}/targets/{k}"] = (
-                "ball",
+                "icosphere",
                 {"position": position},
                 {"radius": 0.15 * size, "color": (0, 0, 0)},
             )

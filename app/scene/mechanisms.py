@@ -297,7 +297,7 @@ def add_floor_grid(scene, half: float = 10.0, cell: float = 0.5, section: float 
 
 def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
     """The parts of a robot's scene besides the mechanisms, by node name: (kind, the values
-    that follow the result, the fixed style). The rails (Manipulator 2) or the guide
+    that follow the result, the fixed style), made by viser's ``add_<kind>``. The rails (Manipulator 2) or the guide
     (Manipulator 1) span the task-plane box; the task paths of both algorithms, and for
     Manipulator 2 the carriage paths (x2, x1), which are the joint paths: closed for J^E#,
     not for J^P#; the targets of the path's legs. The unicycle's: its paths
@@ -328,14 +328,14 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
             z = np.full(len(run.y), (Z[a] + 0.16) * scale)
             task = np.column_stack([run.y[:, 0], run.y[:, 1], z])
         out[f"{root}/trace/{a}/task"] = (
-            "line",
+            "line_segments",
             {"points": polyline(task, tol)},
             {**line, "thickness": 3.0 if a == "pseudoinverse" else 2.0},
         )
         if robot == "manipulator2":
             joints = np.column_stack([run.x[:, 1], run.x[:, 0], np.full(len(run.x), Z[a] + 0.1)])
             out[f"{root}/trace/{a}/joints"] = (
-                "line",
+                "line_segments",
                 {"points": polyline(joints, tol)},
                 {**line, "thickness": 1.2},
             )
@@ -344,7 +344,7 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
         return {**out, **target_fixtures(result, kin, root, AXES_FRACTION * reach / 2)}
     for k, target in enumerate(result.targets):
         out[f"{root}/targets/{k}"] = (
-            "ball",
+            "icosphere",
             {"position": (float(target[0]), float(target[1]), 0.2 * scale)},
             {"radius": 0.05 * scale, "color": (0, 0, 0)},
         )

@@ -9,7 +9,6 @@ client far less than mounting new ones.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -135,12 +134,6 @@ class NodeSets:
         ``result``: existing nodes are moved, missing ones (all, in a new set; a target the
         path gained) are added, ones it lost are removed."""
         scene = self.scene
-        add: dict[str, Callable[..., Any]] = {
-            "box": scene.add_box,
-            "line": scene.add_line_segments,
-            "ball": scene.add_icosphere,
-            "frame": scene.add_frame,
-        }
         wanted = fixtures_of(result, extent, root)
         labels = target_labels(wanted, corner_names(result), f"{root}/targets/")
         gone = [n for n in fixtures if n not in wanted and n not in labels]
@@ -150,7 +143,7 @@ class NodeSets:
                 handle.remove()
         for name, (kind, values, style) in wanted.items():
             if name not in fixtures:
-                fixtures[name] = add[kind](name, **style, **values)
+                fixtures[name] = getattr(scene, f"add_{kind}")(name, **style, **values)
             else:
                 for key, value in values.items():
                     setattr(fixtures[name], key, value)

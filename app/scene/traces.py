@@ -78,5 +78,5 @@ def unicycle_traces(result, root: str, tol: float) -> dict[str, tuple[str, dict,
                 "colors": (255 - mix * (255 - base)).astype(np.uint8),
                 "thickness": 3.5 if last else 1.5,
             }
-            out[f"{root}/trace/{a}/{n}"] = ("line", values, {"thickness_units": "screen"})
+            out[f"{root}/trace/{a}/{n}"] = ("line_segments", values, {"thickness_units": "screen"})
     return out

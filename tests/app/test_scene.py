@@ -426,7 +426,7 @@ def test_targets_at_one_position_share_one_label():
         "/r/targets/1": frame((0.3, 0.1, 0.5)),
         "/r/targets/2": frame((0.3, 0.1, 0.5 + 1e-12)),
         "/r/targets/3": frame((0.3, 0.0, 0.5)),
-        "/r/path": ("line", {"points": None}, {}),
+        "/r/path": ("line_segments", {"points": None}, {}),
     }
     assert target_labels(wanted, ["B", "C", "D", "A"], "/r/targets/") == {
         "/r/targets/0/label": "B, A",
