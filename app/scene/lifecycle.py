@@ -20,6 +20,7 @@ from viser import FrameHandle
 from ...engine.exceptions import InvalidInputError
 from ..dashboard import COLORS, LABELS, Dashboard, Event, runs_key
 from ..dashboard.algorithms import DEFAULT_ALGORITHMS
+from ..dashboard.controls import PROGRESS_AFTER
 from ..dashboard.help import STYLES
 from .camera import CameraFraming
 from .controls import SceneControls
@@ -89,7 +90,8 @@ class DashboardScene:
                 # (the runs only: the scene draws no E1, E2, and its status keeps the drawn
                 # result's while the page shows their progress)
                 runs = msg.get("phase") == "runs"
-                if runs and event.generation == self.dashboard.generation and msg["elapsed"] > 0.5:
+                now = event.generation == self.dashboard.generation
+                if runs and now and msg["elapsed"] > PROGRESS_AFTER:
                     self.progress.visible = msg["fraction"] < 1
                     self.progress.value = min(100.0, 100.0 * msg["fraction"])  # type: ignore[misc]  # viser: settable
                     self.status.content = f"computing… {100 * msg['fraction']:.0f}%"

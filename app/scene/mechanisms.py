@@ -297,10 +297,10 @@ def add_floor_grid(scene, half: float = 10.0, cell: float = 0.5, section: float 
 
 def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
     """The parts of a robot's scene besides the mechanisms, by node name: (kind, the values
-    that follow the result, the fixed style), made by viser's ``add_<kind>``. The rails (Manipulator 2) or the guide
-    (Manipulator 1) span the task-plane box; the task paths of both algorithms, and for
-    Manipulator 2 the carriage paths (x2, x1), which are the joint paths: closed for J^E#,
-    not for J^P#; the targets of the path's legs. The unicycle's: its paths
+    that follow the result, the fixed style), made by viser's ``add_<kind>``. The rails
+    (Manipulator 2) or the guide (Manipulator 1) span the task-plane box; the task paths of both
+    algorithms, and for Manipulator 2 the carriage paths (x2, x1), which are the joint paths:
+    closed for J^E#, not for J^P#; the targets of the path's legs. The unicycle's: its paths
     (:func:`~jik.app.scene.traces.unicycle_traces`)."""
     (xlo, xhi), (ylo, yhi) = extent
     tol = trace_tolerance(extent)
