@@ -49,7 +49,8 @@ def simplify(points: np.ndarray, tol: float) -> np.ndarray:
 
 
 def trace_tolerance(extent) -> float:
-    """:data:`TRACE_TOLERANCE` of the task-plane box ``extent`` (see :func:`_extent`)."""
+    """:data:`TRACE_TOLERANCE` of the task-plane box ``extent``
+    (:func:`~jik.app.scene.mechanisms.extent_of`)."""
     (xlo, xhi), (ylo, yhi) = extent
     return TRACE_TOLERANCE * max(xhi - xlo, yhi - ylo)
 
