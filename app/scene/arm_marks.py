@@ -77,10 +77,9 @@ def target_fixtures(result, kin: Any, root: str, size: float) -> dict[str, tuple
 def base_link(kin: Any) -> bool:
     """Whether the scene draws a URDF arm's base link: the segment from its base frame's origin to
     its first joint, where that joint lies away from the origin (the Panda's first joint stands
-    0.333 m above it). The first joint's origin depends on no joint variable."""
-    if getattr(kin, "chain", None) is None:
-        return False
-    return bool(np.linalg.norm(np.asarray(kin.points(np.zeros(kin.p)))[0]) > 1e-9)
+    0.333 m above it): its origin's fixed offset from the base frame (no joint moves it)."""
+    chain = getattr(kin, "chain", None)
+    return chain is not None and bool(np.linalg.norm(chain[0].origin[:3, 3]) > 1e-9)
 
 
 def joint_points(kin: Any) -> dict[int, int]:
