@@ -268,29 +268,22 @@ def layout_name(state) -> str:
 # the dashboard's zoom (frame costs: docs/benchmarks.md, "Dashboard latency").
 
 
-def add_floor_grid(scene, half: float = 10.0, cell: float = 0.5, section: float = 1.0) -> None:
-    """A grid on the task plane (z slightly below 0) drawn as two sets of line segments.
+def add_floor_grid(scene) -> None:
+    """A grid on the task plane (z slightly below 0), 20 x 20 with cells of 0.5 and section
+    lines every 1, drawn as two sets of line segments.
 
     viser's ``add_grid`` shades every pixel of its plane; line segments draw the same grid at
     the cost of its lines only.
     """
-    ticks = np.arange(-half, half + cell / 2, cell)
-    on_section = np.isclose(np.remainder(ticks + half, section), 0.0) | np.isclose(
-        np.remainder(ticks + half, section), section
-    )
-    z = -0.06
+    ticks = 0.5 * np.arange(-20, 21)  # (every other one a section line, from -10 to 10)
     for name, where, color in (
-        ("cells", ticks[~on_section], (200, 200, 200)),
-        ("sections", ticks[on_section], (140, 140, 140)),
+        ("cells", ticks[1::2], (200, 200, 200)),
+        ("sections", ticks[::2], (140, 140, 140)),
     ):
-        n = len(where)
-        lines = np.zeros((2 * n, 2, 3))
-        lines[:n, :, 0] = where[:, None]  # along y
-        lines[:n, 0, 1], lines[:n, 1, 1] = -half, half
-        lines[n:, :, 1] = where[:, None]  # along x
-        lines[n:, 0, 0], lines[n:, 1, 0] = -half, half
-        lines[..., 2] = z
-        scene.add_line_segments(
+        at, span = np.broadcast_arrays(where[:, None], [-10.0, 10.0])  # (n, 2)
+        z = np.full(at.shape, -0.06)
+        lines = np.concatenate([np.stack([at, span, z], -1), np.stack([span, at, z], -1)])
+        scene.add_line_segments(  # (along y at x = where, then along x at y = where)
             f"/grid/{name}", lines, color, thickness=1.0, thickness_units="screen"
         )
 
