@@ -52,6 +52,7 @@ Functionals and synthesis (secs. 3-4)
     synthesize_e2               the E2-optimal h by a Ritz method, eq. (20) -> SynthesisResult
     synthesize_e2_nd            E2-optimal h of all joints, p - r >= 1 -> TotalDegreeSynthesis
     map_singularities           where h or [J; dh] (10) is singular in a box -> MapSingularities
+    inert_variables             the joint variables that J, h and dh do not depend on
 The atlas (drift over many starts and paths)
     plan_atlas, run_atlas       plan and run an atlas (here, in processes or on Dask)
     iter_atlas                  the same, chunk by chunk, in bounded memory
@@ -138,6 +139,7 @@ _EXPORTS = {
     "TotalDegreeSynthesis": "synthesis_nd",
     "SynthesisResult": "variational",
     "map_singularities": "map_singularities",
+    "inert_variables": "dependence",
     "MapSingularities": "map_singularities",
     # the atlas
     "plan_atlas": "atlas",
@@ -208,6 +210,7 @@ __all__ = [
     "WeightedInverse",
     "error_functional_e1",
     "error_functional_e2",
+    "inert_variables",
     "iter_atlas",
     "load_robot",
     "make_inverse",
@@ -263,6 +266,7 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
     from .atlas_run import AtlasResult, iter_atlas, run_atlas
     from .augmentations import AugmentingMap, E1Optimal, E2Optimal, PaperCubic
     from .characteristics import CharacteristicsMap, UnicycleCharacteristics
+    from .dependence import inert_variables
     from .exceptions import (
         AlgorithmicSingularityError,
         FormulaError,

@@ -41,7 +41,10 @@ def kernel_cofactors(J: FloatArray) -> FloatArray:
     r, p = J.shape[-2:]
     if p != r + 1:
         raise InvalidInputError(f"kernel_cofactors needs p = r + 1, got r = {r}, p = {p}")
-    minors = np.stack([np.linalg.det(np.delete(J, i, axis=-1)) for i in range(p)], axis=-1)
+    others = np.array([[j for j in range(p) if j != i] for i in range(p)])  # (p, r)
+    # (one det call over the p minors J without column i, (..., p, r, r): a batch of one
+    # point, as an ODE's right-hand side asks for, costs one call, not p)
+    minors = np.linalg.det(np.swapaxes(J[..., :, others], -3, -2))
     signs = np.array([(-1.0) ** (r + 1 + i) for i in range(1, p + 1)])
     return minors * signs
 

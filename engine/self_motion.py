@@ -17,7 +17,8 @@ A curve that is a closed loop (a component of the fibre that is a circle inside 
 fibres of a revolute arm often are) is traced once round, not round and round until the arc is
 used up. Going ahead from x_b, the tracer watches a Poincare section, the hyperplane through x_b
 normal to the curve there: when the curve crosses it again in the same direction (coming from
-behind it) at a point within :data:`CLOSE_TOL` of x_b, with the same tangent, the loop has
+behind it) at a point within :data:`CLOSE_TOL` of x_b (:data:`CLOSE_PER_TOL` times the
+integrator's tolerance, if that is more), with the same tangent, the loop has
 closed; the crossing is located on the dense output (Brent's method, as ``solve_ivp`` locates
 events) and its arc length is the loop's period T. Going behind, it watches the section
 through the end of the arc traced ahead, the first point of that arc it can come round to.
@@ -40,10 +41,13 @@ from .exceptions import InvalidInputError
 from .inverses import Pseudoinverse
 from .kinematics import Kinematics
 from .urdf import UrdfChain
-from .validation import FloatArray, finite
+from .validation import FloatArray, count, finite
 
 #: Tolerances of the traced orbit (relative and absolute, on x).
 TRACE_TOL = 1e-12
+#: The loosest tolerance :func:`trace` takes (a curve traced to be drawn: its points are projected
+#: onto k(x) = y0 either way, so the tolerance moves them along the curve only).
+LOOSEST_TOL = 1e-6
 #: Newton steps onto k(x) = y0 stop below this task error.
 PROJECT_TOL = 1e-14
 PROJECT_STEPS = 6
@@ -51,6 +55,8 @@ PROJECT_STEPS = 6
 MAX_ARC = 1e3
 #: A curve has closed when it crosses its start's section again this close to the start.
 CLOSE_TOL = 1e-6
+#: ... or this many times the integrator's tolerance (an orbit traced loosely drifts off k = y0).
+CLOSE_PER_TOL = 1e3
 #: Brent's tolerance on s where an event is located (``solve_ivp``'s).
 EVENT_TOL = 4 * np.finfo(float).eps
 
@@ -116,6 +122,12 @@ class SelfMotionManifold:
                 x[part] = self.base if sol is None else sol(s[part]).T
         return project(self.kinematics, x, self.y0)
 
+    def sample(self, n: int) -> FloatArray:
+        """``n`` points (2 to 10^5) evenly spaced in arc length over the traced arc, ends
+        included, shape (n, p): the curve as a polyline (one turn of a closed one, which ends
+        where it began)."""
+        return self.points(np.linspace(*self.arc, count(n, "n", 2, 10**5)))
+
 
 def project(kinematics: Kinematics, x: FloatArray, y0: FloatArray) -> FloatArray:
     """Newton steps x <- x - J#(x) (k(x) - y0) with the pseudoinverse (8), batched over x.
@@ -154,6 +166,8 @@ def trace(
     base,
     arc: Sequence[float],
     box: Sequence[Sequence[float]] | None = None,
+    tol: float = TRACE_TOL,
+    bound_free_joints: bool = False,
 ) -> SelfMotionManifold:
     """Trace the self-motion curve through ``base`` over the arc lengths ``arc`` = (lo, hi).
 
@@ -169,7 +183,14 @@ def trace(
         Stop the curve where it leaves this box of configurations (the robot's ``x_range``):
         the traced ``arc`` is then shorter than asked. A joint that turns freely
         (:func:`periodic_joints`) is not bounded by it: its angle's range in the box is a
-        window on one turn, not a limit.
+        window on one turn, not a limit (unless ``bound_free_joints``).
+    tol : float
+        The integrator's relative and absolute tolerance on x, :data:`TRACE_TOL` to
+        :data:`LOOSEST_TOL`: the points of :meth:`SelfMotionManifold.points` lie on k(x) = y0
+        whatever it is, their arc lengths are within about ``tol`` of s.
+    bound_free_joints : bool
+        Stop the curve where a freely turning joint's angle leaves ``box`` too, as any other
+        variable's (a curve drawn in the box's view).
 
     Returns
     -------
@@ -181,7 +202,7 @@ def trace(
     Raises
     ------
     InvalidInputError
-        Not one degree of redundancy, a bad ``arc``, or ``base`` outside ``box``.
+        Not one degree of redundancy, a bad ``arc`` or ``tol``, or ``base`` outside ``box``.
     """
     if kinematics.p - kinematics.r != 1:
         raise InvalidInputError(
@@ -190,6 +211,11 @@ def trace(
             field="starts",
         )
     base = kinematics.check(base, "base")
+    tol = finite(tol, "tol")
+    if not TRACE_TOL <= tol <= LOOSEST_TOL:
+        raise InvalidInputError(
+            f"tol must be from {TRACE_TOL:g} to {LOOSEST_TOL:g}, got {tol:g}", field="tol"
+        )
     lo, hi = (finite(a, "arc") for a in arc)
     if not (-MAX_ARC <= lo <= 0 <= hi <= MAX_ARC):
         raise InvalidInputError(
@@ -199,9 +225,11 @@ def trace(
         )
     y0 = kinematics.forward(base)
     base = project(kinematics, base[None], y0)[0]
-    bounds = None if box is None else np.array(box, dtype=float)
+    periodic = periodic_joints(kinematics)
+    bounds, leaves = None if box is None else np.array(box, dtype=float), None
     if bounds is not None:
-        bounds[periodic_joints(kinematics)] = (-np.inf, np.inf)  # (x and x + 2 pi: one posture)
+        if not bound_free_joints:
+            bounds[periodic] = (-np.inf, np.inf)  # (x and x + 2 pi: one posture)
         outside = np.flatnonzero((base < bounds[:, 0]) | (base > bounds[:, 1]))
         if outside.size:
             i = int(outside[0])
@@ -211,14 +239,11 @@ def trace(
                 field="base",
             )
 
-    leaves = None
-    if bounds is not None:
         # (a margin inside the box: the curve may run along a face of it)
         def leaves(_s, x):
             return float(np.min(np.minimum(x - bounds[:, 0], bounds[:, 1] - x)))
 
-    periodic = periodic_joints(kinematics)
-    ahead = _leg(kinematics, base, hi, leaves, (base, kinematics.kernel(base)), periodic)
+    ahead = _leg(kinematics, base, hi, leaves, (base, kinematics.kernel(base)), periodic, tol)
     if ahead.closed:
         return SelfMotionManifold(
             kinematics, y0, base, (0.0, ahead.end), ahead.sol, None, ahead.end, ahead.steps
@@ -229,16 +254,11 @@ def trace(
     if not ahead.cut:
         end = base if ahead.sol is None else ahead.sol(ahead.end)
         watch = (end, -kinematics.kernel(end))
-    behind = _leg(kinematics, base, lo, leaves, watch, periodic)
+    behind = _leg(kinematics, base, lo, leaves, watch, periodic, tol)
+    period = ahead.end - behind.end if behind.closed else None
+    arc_traced, steps = (behind.end, ahead.end), ahead.steps + behind.steps
     return SelfMotionManifold(
-        kinematics,
-        y0,
-        base,
-        (behind.end, ahead.end),
-        _ahead=ahead.sol,
-        _behind=behind.sol,
-        period=ahead.end - behind.end if behind.closed else None,
-        steps=ahead.steps + behind.steps,
+        kinematics, y0, base, arc_traced, ahead.sol, behind.sol, period, steps
     )
 
 
@@ -253,15 +273,15 @@ class _Leg(NamedTuple):
     closed: bool
 
 
-def _leg(kinematics, base, end, leaves, watch, periodic) -> _Leg:
+def _leg(kinematics, base, end, leaves, watch, periodic, tol) -> _Leg:
     """Integrate dx/ds = K(x), x(0) = ``base``, from s = 0 toward ``end`` (DOP853 with dense
-    output, stepped as ``solve_ivp`` steps it), stopping at the first of: ``end``; a zero of
-    ``leaves(s, x)`` (the box, located as ``solve_ivp`` locates a terminal event); the return to
-    ``watch`` = (w, v), w a point of the curve and v the unit tangent the curve has there in the
-    direction of integration: a crossing of the section v . (x - w) = 0 from behind it (v . d < 0
-    at the step's start, >= 0 at its end, so the start's own crossing at s = 0 is none), at
-    which x is within :data:`CLOSE_TOL` of w with its tangent near v (angles of
-    ``periodic`` joints compared modulo 2 pi)."""
+    output to ``tol``, stepped as ``solve_ivp`` steps it), stopping at the first of: ``end``; a
+    zero of ``leaves(s, x)`` (the box, located as ``solve_ivp`` locates a terminal event); the
+    return to ``watch`` = (w, v), w a point of the curve and v the unit tangent the curve has
+    there in the direction of integration: a crossing of the section v . (x - w) = 0 from behind
+    it (v . d < 0 at the step's start, >= 0 at its end, so the start's own crossing at s = 0 is
+    none), at which x is within :data:`CLOSE_TOL` (or :data:`CLOSE_PER_TOL` ``tol``) of w with
+    its tangent near v (angles of ``periodic`` joints compared modulo 2 pi)."""
     if end == 0:
         return _Leg(0.0, None, 0, False, False)
 
@@ -275,11 +295,10 @@ def _leg(kinematics, base, end, leaves, watch, periodic) -> _Leg:
 
     def returned(x) -> bool:
         along = np.sign(end) * kinematics.kernel(x) @ watch[1]
-        return bool(np.linalg.norm(wrapped(x)) <= CLOSE_TOL and along > 0.5)
+        near = np.linalg.norm(wrapped(x)) <= max(CLOSE_TOL, CLOSE_PER_TOL * tol)
+        return bool(near and along > 0.5)
 
-    solver = DOP853(
-        lambda _s, x: kinematics.kernel(x), 0.0, base, float(end), rtol=TRACE_TOL, atol=TRACE_TOL
-    )
+    solver = DOP853(lambda _s, x: kinematics.kernel(x), 0.0, base, float(end), rtol=tol, atol=tol)
     ts, interpolants = [0.0], []
     g = 0.0 if leaves is None else leaves(0.0, base)
     stop, cut, closed, steps = None, False, False, 0

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .exports import coordinate_names
 from .limits import robot_limits
 from .planar_chain import PlanarChain
 from .urdf import UrdfChain
@@ -118,6 +119,15 @@ class RobotUnits:
     def y(self) -> tuple[str, ...]:
         """The unit of each task coordinate, (r,)."""
         return tuple(c.unit for c in self.task)
+
+    def columns(self) -> dict[str, Coordinate]:
+        """The coordinates under the names of their columns in the engine's tables
+        (:func:`jik.engine.exports.coordinate_names`): ``x_1``..``x_p`` the joint variables,
+        then ``y_1``..``y_r`` the task coordinates."""
+        return {
+            **dict(zip(coordinate_names("x", len(self.variables)), self.variables, strict=True)),
+            **dict(zip(coordinate_names("y", len(self.task)), self.task, strict=True)),
+        }
 
     def summary(self) -> dict:
         """``{"x": units of x, "y": units of y, "lengths": ...}``, JSON-friendly: what a run's

@@ -88,6 +88,22 @@ def grid_batches(runs: Mapping[str, AlgorithmRun], amap) -> int:
     return -(-points // GRID_BATCH) + -(-(EXPENSIVE_GRID_POINTS**2) // GRID_BATCH)
 
 
+def runs_box(state: DashboardState, runs: Mapping[str, AlgorithmRun]):
+    """Lower and upper corners (p,) around the runs' configurations, with a margin of a quarter
+    of their span plus 0.25, within the robot's x_range: the box the h panel's grid and the
+    configuration-space panel's curves are drawn in."""
+    xs = np.concatenate([r.x for r in runs.values()])
+    xs = xs[np.isfinite(xs).all(axis=1)]
+    lo, hi = xs.min(axis=0), xs.max(axis=0)
+    pad = 0.25 * (hi - lo) + 0.25
+    lo, hi = lo - pad, hi + pad
+    x_range = state_spec(state).x_range
+    if x_range:
+        r = np.asarray(x_range, dtype=float)
+        lo, hi = np.maximum(lo, r[:, 0]), np.minimum(hi, r[:, 1])
+    return lo, hi
+
+
 def augmenting_grid(
     kin,
     state: DashboardState,
@@ -108,7 +124,6 @@ def augmenting_grid(
     ``progress(done, total)``: after each of the :func:`grid_batches` steps; what it raises
     (:class:`~jik.app.dashboard.runs.Cancelled`) stops the grid there.
     """
-    spec = state_spec(state)
     try:
         _, amap = kinematics_and_map(state, kin)
         if amap is None:
@@ -120,14 +135,8 @@ def augmenting_grid(
             return None if progress is None else lambda done, _: progress(offset + done, total)
 
         i, j = augmenting_axes(amap, xs, step(0))
-        box = []
-        for k in (i, j):
-            lo, hi = float(np.min(xs[:, k])), float(np.max(xs[:, k]))
-            pad = 0.25 * (hi - lo) + 0.25
-            lo, hi = lo - pad, hi + pad
-            if spec.x_range:
-                lo, hi = max(lo, spec.x_range[k][0]), min(hi, spec.x_range[k][1])
-            box.append((lo, hi))
+        low, high = runs_box(state, runs)
+        box = [(float(low[k]), float(high[k])) for k in (i, j)]
         if expensive_map(amap):
             n = min(n, EXPENSIVE_GRID_POINTS)  # h solves a collocation problem per point
         if before is not None and tuple(before["axes"]) == (i, j) and before["n"] == n:

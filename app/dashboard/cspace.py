@@ -13,16 +13,20 @@ from __future__ import annotations
 import numpy as np
 
 from ...engine.exceptions import JikError
+from ...engine.self_motion import MAX_ARC
+from ...engine.self_motion import trace as trace_curve
 from .algorithms import COLORS, DASH, LABELS, STYLES
-from .analysis import expensive_map, kinematics_and_map
+from .analysis import expensive_map, kinematics_and_map, runs_box
 from .plotting import corner_names, figure, trace
-from .robots import state_spec
 from .runs import DashboardResult
 
 #: The choices of three coordinates of a four-dimensional configuration (the unicycle's λ).
 AXES_CHOICES = ("012", "013", "023", "123")
-#: Points per run drawn; steps each way along a self-motion manifold; level-surface grid.
-MAX_POINTS, MANIFOLD_STEPS, GRID = 1500, 160, 16
+#: Points per run drawn; level-surface grid.
+MAX_POINTS, GRID = 1500, 16
+#: A self-motion manifold is traced this many box diagonals each way (to a drawing's tolerance)
+#: and drawn with a point every SPACING of them.
+ARC_SPANS, SPACING, DRAW_TOL = 3.2, 0.02, 1e-6
 CSPACE_HEIGHT = 520
 #: The layout key of the panel's 3D axes (not "scene": see :func:`cspace_spec`).
 SCENE = "scene2"
@@ -34,64 +38,36 @@ def axes_of(result: DashboardResult) -> tuple[int, int, int]:
     return tuple(int(c) for c in choice)  # type: ignore[return-value]
 
 
-def _box(result: DashboardResult) -> tuple[np.ndarray, np.ndarray]:
-    """Lower and upper corners around both runs, with a margin, within the robot's x_range."""
-    xs = np.concatenate([r.x for r in result.runs.values()])
-    xs = xs[np.isfinite(xs).all(axis=1)]
-    lo, hi = xs.min(axis=0), xs.max(axis=0)
-    pad = 0.25 * (hi - lo) + 0.25
-    lo, hi = lo - pad, hi + pad
-    spec = state_spec(result.state)
-    if spec.x_range:
-        r = np.asarray(spec.x_range, dtype=float)
-        lo, hi = np.maximum(lo, r[:, 0]), np.minimum(hi, r[:, 1])
-    return lo, hi
-
-
-def _step(kin, x: np.ndarray, targets: np.ndarray, ds: float) -> np.ndarray:
-    """One step of length ``ds`` along the kernel K(x) (midpoint), then two Newton steps back
-    onto k(x) = targets with the pseudoinverse (8); NaN where J J^T is singular."""
-    k1 = kin.kernel(x)
-    k2 = kin.kernel(x + 0.5 * ds * k1)
-    k2 *= np.sign(np.sum(k1 * k2, axis=-1, keepdims=True))  # (the same way along the curve)
-    x = x + ds * k2
-    for _ in range(2):
-        J = kin.jacobian(x)  # (n, r, p)
-        M = J @ np.swapaxes(J, 1, 2)  # (n, r, r)
-        ok = np.isfinite(M).all(axis=(1, 2)) & (np.abs(np.linalg.det(np.nan_to_num(M))) > 1e-12)
-        e = kin.forward(x) - targets  # (n, r)
-        lam = np.full_like(e, np.nan)
-        lam[ok] = np.linalg.solve(M[ok], e[ok][..., None])[..., 0]
-        x = x - np.einsum("nrp,nr->np", J, lam)
-    return x
-
-
-def self_motion(kin, seeds: np.ndarray, targets: np.ndarray, lo, hi) -> np.ndarray:
-    """Points of the self-motion manifolds k(x) = targets through ``seeds``, (n, 2 S + 1, p).
+def self_motion(kin, seeds: np.ndarray, lo, hi) -> list[np.ndarray]:
+    """Points of the self-motion manifolds k(x) = k(seed) through ``seeds``, (m, p) each: a
+    polyline with a point every :data:`SPACING` box diagonals, within the box widened by half
+    its width each way (none for a seed where the curve cannot be traced).
 
     Notes
     -----
-    Each manifold is traced both ways from its seed along the unit kernel vector K(x) of J(x)
-    (a midpoint step), each step corrected back onto k(x) = y by two Newton steps with the
-    pseudoinverse (8); points outside the box (widened by half) are NaN, and so is the rest of
-    that branch.
+    Each curve is the engine's (:func:`jik.engine.self_motion.trace`, to a drawing's tolerance
+    :data:`DRAW_TOL`): the orbit of the unit kernel K(x) both ways from its seed over an arc of
+    :data:`ARC_SPANS` box diagonals, stopped where any variable (a freely turning joint's angle
+    too) leaves the widened box or after one turn of a closed curve, its points projected onto
+    k(x) = y by the pseudoinverse (8).
     """
     span = hi - lo
-    ds = 0.02 * float(np.linalg.norm(span))
-    branches = []
-    for sign in (1.0, -1.0):
-        x = seeds.astype(float).copy()
-        alive = np.ones(len(x), dtype=bool)
-        pts = []
-        with np.errstate(all="ignore"):
-            for _ in range(MANIFOLD_STEPS):
-                if alive.any():
-                    x[alive] = _step(kin, x[alive], targets[alive], sign * ds)
-                inside = np.all((x >= lo - 0.5 * span) & (x <= hi + 0.5 * span), axis=1)
-                alive &= inside & np.isfinite(x).all(axis=1)
-                pts.append(np.where(alive[:, None], x, np.nan))
-        branches.append(np.stack(pts, axis=1))
-    return np.concatenate([branches[1][:, ::-1], seeds[:, None, :], branches[0]], axis=1)
+    finite = seeds[np.isfinite(seeds).all(axis=1)]  # (a seed beyond x_range widens the box)
+    low = np.minimum(lo - 0.5 * span, np.min(finite, axis=0, initial=np.inf))
+    high = np.maximum(hi + 0.5 * span, np.max(finite, axis=0, initial=-np.inf))
+    diagonal = float(np.linalg.norm(span))
+    arc = min(ARC_SPANS * diagonal, MAX_ARC)
+    box = list(zip(low.tolist(), high.tolist(), strict=True))
+    curves = []
+    for seed in seeds:
+        try:
+            curve = trace_curve(kin, seed, (-arc, arc), box, DRAW_TOL, bound_free_joints=True)
+        except JikError:  # (a singular seed: no kernel to follow)
+            curves.append(np.empty((0, kin.p)))
+            continue
+        n = int(np.ceil((curve.arc[1] - curve.arc[0]) / (SPACING * diagonal or 1.0))) + 1
+        curves.append(curve.sample(max(n, 2)))
+    return curves
 
 
 def _level_surface(result: DashboardResult, kin, amap, axes, lo, hi) -> dict | None:
@@ -143,7 +119,7 @@ def cspace_spec(result: DashboardResult) -> dict:
         kin, amap = kinematics_and_map(result.state)
     except (JikError, ValueError) as exc:
         return figure([], f"Configuration space: {exc}")
-    lo, hi = _box(result)
+    lo, hi = runs_box(result.state, result.runs)
     surface = _level_surface(result, kin, amap, axes, lo, hi)
     if surface is not None:
         data.append(surface)
@@ -161,7 +137,7 @@ def cspace_spec(result: DashboardResult) -> dict:
         notes.append(f"self-motion manifolds {kin.p - kin.r}-dimensional: not drawn")
     elif len(seeds) == L:
         with np.errstate(all="ignore"):
-            curves = self_motion(kin, seeds, np.asarray(result.targets, dtype=float), lo, hi)
+            curves = self_motion(kin, seeds, lo, hi)
         for k, (curve, name) in enumerate(zip(curves, corner_names(result), strict=True)):
             data.append(
                 trace(

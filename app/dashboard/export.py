@@ -16,52 +16,46 @@ import numpy as np
 
 from jik import __version__
 
-from ...engine.exports import coordinate_names, csv_rows
+from ...engine.exports import csv_rows
 from ...engine.results import Trajectory
-from ...engine.units import robot_units
+from ...engine.units import RobotUnits, robot_units
 from .algorithms import posture_rest
 from .messages import h_change, to_json
-from .plotting import norm_unit, units
+from .plotting import norm_unit
 from .robots import state_kinematics
 from .runs import DashboardResult
 from .verdict import verdict
 
 
+def described(result: DashboardResult) -> RobotUnits:
+    """The robot's coordinates with their names and units (:func:`jik.engine.units.robot_units`)."""
+    return robot_units(state_kinematics(result.state), result.task_names)
+
+
 def export_units(result: DashboardResult) -> dict:
     """The unit of every column, keyed by its name (:func:`run_columns`): theta, the joint
-    variables x_k, the task coordinates y_k (the engine's, :func:`jik.engine.units.robot_units`;
-    what a robot's length unit m stands for is :func:`length_unit`), the task error (a norm of
-    y) and h."""
-    joint, task = units(result)
-
-    def named(name, us) -> dict:
-        spelled = {"": "as the definition's formulas", "1": "dimensionless"}
-        return dict(
-            zip(coordinate_names(name, len(us)), [spelled.get(u, u) for u in us], strict=True)
-        )
-
+    variables x_k and the task coordinates y_k (the engine's,
+    :meth:`jik.engine.units.RobotUnits.columns`; what a robot's length unit m stands for is
+    :func:`length_unit`), the task error (a norm of y) and h."""
+    spelled = {"": "as the definition's formulas", "1": "dimensionless"}
+    units = described(result)
     return {
         "theta": "iterations" if result.state.mode == "discrete" else "dimensionless",
-        **named("x", joint),
-        **named("y", task),
-        "error": norm_unit(task).strip("[]") or "as y",
+        **{k: spelled.get(c.unit, c.unit) for k, c in units.columns().items()},
+        "error": norm_unit(units.y).strip("[]") or "as y",
         "h": "the unit of the map's formula",
     }
 
 
 def length_unit(result: DashboardResult) -> str:
     """What the robot's length unit m stands for (the paper states none)."""
-    return robot_units(state_kinematics(result.state), result.task_names).lengths
+    return described(result).lengths
 
 
 def coordinates(result: DashboardResult) -> dict[str, str]:
     """What each coordinate column is: ``{"x_1": <the first joint's name>, ..., "y_1": <the
     first task coordinate's>, ...}``."""
-    x, y = result.variable_names, result.task_names
-    return {
-        **dict(zip(coordinate_names("x", len(x)), x, strict=True)),
-        **dict(zip(coordinate_names("y", len(y)), y, strict=True)),
-    }
+    return {k: c.name for k, c in described(result).columns().items()}
 
 
 def run_columns(result: DashboardResult, algorithm: str) -> dict[str, np.ndarray]:

@@ -143,71 +143,43 @@ def _drift(result: DashboardResult) -> dict:
 
     For a single-target task (and the unicycle) the task error against theta is shown instead.
     """
-    data = []
     closed = result.state.task == "path"
+    data = []
     for a, run in result.runs.items():
-        if closed:
-            data.append(
-                trace(
-                    "scatter",
-                    x=np.arange(1, len(run.drift) + 1),
-                    y=np.maximum(run.drift, 1e-16),
-                    mode="lines+markers",
-                    name=LABELS[a],
-                    line=dict(color=COLORS[a], width=2, dash=DASH[a]),
-                    marker=dict(symbol=STYLES[a].symbol, size=9),
-                    hovertemplate="cycle %{x}: drift %{y:.3e}<extra>" + a + "</extra>",
-                )
-            )
-        else:
-            data.append(
-                trace(
-                    "scatter",
-                    x=run.theta,
-                    y=np.maximum(run.error, 1e-16),
-                    mode="lines",
-                    name=LABELS[a],
-                    line=dict(color=COLORS[a], width=2, dash=DASH[a]),
-                    hovertemplate="‖k(x) − y_d‖ = %{y:.3e}<br>θ = %{x:.4g}<extra>" + a + "</extra>",
-                )
-            )
+        cycle = dict(
+            x=np.arange(1, len(run.drift) + 1),
+            y=np.maximum(run.drift, 1e-16),
+            mode="lines+markers",
+            marker=dict(symbol=STYLES[a].symbol, size=9),
+            hovertemplate="cycle %{x}: drift %{y:.3e}<extra>" + a + "</extra>",
+        )
+        point = dict(
+            x=run.theta,
+            y=np.maximum(run.error, 1e-16),
+            mode="lines",
+            hovertemplate="‖k(x) − y_d‖ = %{y:.3e}<br>θ = %{x:.4g}<extra>" + a + "</extra>",
+        )
+        line = dict(color=COLORS[a], width=2, dash=DASH[a])
+        data.append(trace("scatter", name=LABELS[a], line=line, **(cycle if closed else point)))
     ys = np.concatenate([np.asarray(t["y"], dtype=float) for t in data])
     if closed:
         cycles = max(len(r.drift) for r in result.runs.values())
-        return figure(
-            data,
-            "Repeatability: joint drift after each closed cycle",
-            **NO_LEGEND,
-            xaxis=dict(title="cycle", dtick=1, range=[0.5, cycles + 0.5]),
-            yaxis=dict(
-                title=f"‖x(end of cycle) − x0‖ {norm_unit(units(result)[0])} (log)",
-                type="log",
-                exponentformat="power",
-                range=log_range(ys),
-            ),
-        )
-    theta = np.concatenate([r.theta for r in result.runs.values()])
-    return figure(
-        data,
-        "Convergence: task error",
-        **NO_LEGEND,
-        xaxis=dict(title=theta_label(result), range=nice_range(theta, from_zero=True)),
-        yaxis=dict(
-            title=f"‖k(x) − y_d‖ {norm_unit(units(result)[1])} (log)",
-            type="log",
-            exponentformat="power",
-            range=log_range(ys),
-        ),
-    )
+        title, norm = "Repeatability: joint drift after each closed cycle", "‖x(end of cycle) − x0‖"
+        xaxis = dict(title="cycle", dtick=1, range=[0.5, cycles + 0.5])
+    else:
+        theta = np.concatenate([r.theta for r in result.runs.values()])
+        title, norm = "Convergence: task error", "‖k(x) − y_d‖"
+        xaxis = dict(title=theta_label(result), range=nice_range(theta, from_zero=True))
+    unit = norm_unit(units(result)[0 if closed else 1])
+    yaxis = dict(title=f"{norm} {unit} (log)", type="log", exponentformat="power")
+    return figure(data, title, **NO_LEGEND, xaxis=xaxis, yaxis=yaxis | {"range": log_range(ys)})
 
 
-def _table(result: DashboardResult) -> dict:
-    """Table 1 of the paper beside jik's numbers, or the table of leg ends
-    (:mod:`jik.app.dashboard.table`)."""
-    return table_spec(result)
+#: Iterations of the unicycle's platform path drawn per algorithm (first and last included).
+PLATFORM_PATHS = 12
 
 
-def _platform(result: DashboardResult, max_paths: int = 12) -> dict:
+def _platform(result: DashboardResult) -> dict:
     """Unicycle platform paths q(t) in the (q1, q2) plane, per iteration (Figs. 11-14 a)."""
     _, tu = units(result)
     data = []
@@ -219,7 +191,7 @@ def _platform(result: DashboardResult, max_paths: int = 12) -> dict:
         P = result.runs[a].platform
         assert P is not None  # drawn only for the unicycle, whose runs all carry platform paths
         m = len(P)
-        show = sorted(set(np.geomspace(1, m, num=max_paths).astype(int) - 1) | {0, m - 1})
+        show = sorted(set(np.geomspace(1, m, num=PLATFORM_PATHS).astype(int) - 1) | {0, m - 1})
         for n, i in enumerate(show):
             last = bool(i == m - 1)
             data.append(
@@ -317,7 +289,7 @@ def figure_specs(
         else (pose_task_spec if is_pose_task(result) else _task_space),
         "joints": _joints,
         "drift": _drift,
-        "table": _table,
+        "table": table_spec,
         "cspace": cspace_spec,
         "augmenting": lambda r: augmenting_spec(r, functionals, cancelled),
         "sensitivity": lambda r: sensitivity_spec(r, sensitivity, cancelled),
@@ -333,49 +305,3 @@ def figures_for(
 ) -> dict[str, go.Figure]:
     """The panels of the dashboard for ``result`` (all, or those in ``only``), keyed by id."""
     return {k: to_go(v) for k, v in figure_specs(result, functionals, only, sensitivity).items()}
-
-
-# The figures as plotly objects, for notebooks and tests.
-
-
-def task_space_figure(result: DashboardResult) -> go.Figure:
-    """End-effector paths of the algorithms in the task plane (paper, Figs. 5 and 6)."""
-    return to_go(_task_space(result))
-
-
-def joint_figure(result: DashboardResult) -> go.Figure:
-    """Every joint variable against theta for each algorithm (Figs. 7-9; Figs. 11-14 b, c)."""
-    return to_go(_joints(result))
-
-
-def drift_figure(result: DashboardResult) -> go.Figure:
-    """Repeatability drift per closed cycle, log scale (Table 1), or the task error against
-    theta for a single target."""
-    return to_go(_drift(result))
-
-
-def table_figure(result: DashboardResult) -> go.Figure:
-    """The configuration after every leg for both algorithms, as in Table 1 of the paper."""
-    return to_go(_table(result))
-
-
-def platform_figure(result: DashboardResult, max_paths: int = 12) -> go.Figure:
-    """Unicycle platform paths q(t) in the (q1, q2) plane, per iteration (Figs. 11-14 a)."""
-    return to_go(_platform(result, max_paths))
-
-
-def augmenting_figure(result: DashboardResult, functionals: dict | None = None) -> go.Figure:
-    """Contours of h over two joint variables with both trajectories on top; E1 (13) and
-    E2 (18) in the title."""
-    return to_go(augmenting_spec(result, functionals))
-
-
-def sensitivity_figure(result: DashboardResult, sens: dict | None = None) -> go.Figure:
-    """E1 (13) and E2 (18) of the current map and how they change with its parameters."""
-    return to_go(sensitivity_spec(result, sens))
-
-
-def cspace_figure(result: DashboardResult) -> go.Figure:
-    """Both joint paths in configuration space with the level surface h = h(x0) and the
-    self-motion manifolds of the corners."""
-    return to_go(cspace_spec(result))

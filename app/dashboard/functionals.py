@@ -11,53 +11,22 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ...engine.dependence import inert_variables
 from ...engine.exceptions import JikError
+from ...engine.functionals import error_functional_e1, error_functional_e2, parameter_sensitivity
 from .analysis import expensive_map, kinematics_and_map, vector_note
 from .arm_e2 import qmc_functionals, single_joint_sensitivity
 from .model import DashboardState, cache_key, robot_and_map
 from .robots import state_spec
 from .runs import Cancelled, DashboardResult
 
-
-def inert_variables(kin, amap, box: tuple[tuple[float, float], ...], samples: int = 8):
-    """Joint variables x_k that neither J nor h nor dh depends on.
-
-    At seeded points of ``box`` (one interval per variable), shifting x_k must leave J, h and dh
-    bitwise unchanged (NaN where undefined included): an expression without x_k evaluates the
-    same, one that merely cancels it would not and counts as dependent. A slice of h at x_k's
-    start value then does not depend on that value, nor do E1 (13) and E2 (18), whose integrands
-    are functions of J and dh. Maps that solve a problem per point are not probed (empty set),
-    nor is a vector map (None).
-    """
-    if amap is None or expensive_map(amap):
-        return frozenset()
-    lo, hi = np.array(box, dtype=float).T
-    X = np.random.default_rng(0).uniform(lo, hi, (samples, len(lo)))
-
-    def probe(x):
-        with np.errstate(all="ignore"):
-            return (kin.jacobian(x), amap.value_masked(x)[0], amap.gradient_masked(x)[0])
-
-    inert = set()
-    try:
-        at = probe(X)
-        for k in range(len(lo)):
-            shifted = X.copy()
-            shifted[:, k] += 0.371 * (hi[k] - lo[k])
-            again = probe(shifted)
-            if all(np.array_equal(a, b, equal_nan=True) for a, b in zip(at, again, strict=True)):
-                inert.add(k)
-    except (JikError, ValueError, ArithmeticError):  # a map that cannot be probed: all matter
-        return frozenset()
-    return frozenset(inert)
-
-
 _inert_cache: dict[str, frozenset[int]] = {}
 
 
 def state_inert_variables(state: DashboardState) -> frozenset[int]:
-    """:func:`inert_variables` of the state's kinematics and map over the robot's x_range
-    (cached per robot, map and parameters)."""
+    """The joint variables that neither J nor h nor dh depends on
+    (:func:`jik.engine.dependence.inert_variables`) over the robot's x_range, cached per robot,
+    map and parameters."""
     key = json.dumps(robot_and_map(state), sort_keys=True)
     if key not in _inert_cache:
         kin, amap = kinematics_and_map(state)
@@ -72,9 +41,9 @@ def functionals_key(state: DashboardState) -> str:
     """Everything E1, E2 and their sensitivity depend on (see :func:`error_functionals`).
 
     On a robot's design region: the robot, the map and the start values of the variables
-    outside the region (held fixed) that J, h or dh depends on (:func:`inert_variables`); the path,
-    the cycles, gamma and the rest of x0 do not matter. Without a design region the box follows
-    the runs: everything they depend on.
+    outside the region (held fixed) that J, h or dh depends on
+    (:func:`state_inert_variables`); the path, the cycles, gamma and the rest of x0 do not
+    matter. Without a design region the box follows the runs: everything they depend on.
     """
     spec = state_spec(state)
     design = spec.functional_region
@@ -113,10 +82,6 @@ def error_functionals(
         return None
     if expensive_map(grid["map"]):
         nodes = min(nodes, 6)
-    try:
-        from ...engine.functionals import error_functional_e1, error_functional_e2
-    except ImportError:
-        return None
     names = result.variable_names
     i, j = grid["axes"]
     design = state_spec(result.state).functional_region
@@ -130,19 +95,26 @@ def error_functionals(
     }
     if len(region) > MAX_QUADRATURE_VARIABLES:  # (nodes ** 7 points for a 7-joint arm)
         return qmc_functionals(grid, region, fixed, out, cancelled, on_step)
-    for key, fn in (("E1", error_functional_e1), ("E2", error_functional_e2)):
-        try:
-            value = fn(grid["kinematics"], grid["map"], region, nodes=nodes, fixed=fixed)
-            out[key] = value.value if np.isfinite(value.value) else None
-            out[f"{key}_singular_points"] = int(value.singular_points.shape[0])
-            if value.divergent:
-                out[f"{key}_divergent"] = True
-        except (JikError, ValueError, ArithmeticError) as exc:
-            out[key] = None
-            out[f"{key}_error"] = str(exc)
+    for key in ("E1", "E2"):
+        out |= _functional(key, grid["kinematics"], grid["map"], region, nodes, fixed)
         if on_step is not None:
             on_step()
     return out
+
+
+def _functional(key: str, kin, amap, region: dict, nodes: int, fixed: dict) -> dict:
+    """``{key: E1 (13) or E2 (18), or None where undefined}`` with its singular points, and
+    ``key_divergent`` (E1 = inf) or ``key_error`` (why it could not be evaluated) if so."""
+    fn = error_functional_e1 if key == "E1" else error_functional_e2
+    try:
+        value = fn(kin, amap, region, nodes=nodes, fixed=fixed)
+    except (JikError, ValueError, ArithmeticError) as exc:
+        return {key: None, f"{key}_error": str(exc)}
+    out = {
+        key: float(value.value) if np.isfinite(value.value) else None,
+        f"{key}_singular_points": int(value.singular_points.shape[0]),
+    }
+    return out | ({f"{key}_divergent": True} if value.divergent else {})
 
 
 #: Values of each parameter in the E1/E2 sweep of the dashboard (over v - 1 .. v + 1).
@@ -202,12 +174,6 @@ def sensitivity(
         }
     if functionals.get("E1") is None and functionals.get("E2") is None:
         return {"kind": "unavailable", "reason": "E1, E2 are undefined on this box"}
-    from ...engine.functionals import (
-        error_functional_e1,
-        error_functional_e2,
-        parameter_sensitivity,
-    )
-
     spec = state_spec(state)
     kin, nodes, fixed = grid["kinematics"], functionals["nodes"], functionals["fixed"]
     region = {k: tuple(v) for k, v in functionals["region"].items()}
@@ -252,12 +218,8 @@ def sensitivity(
                 report(2 * m + 2)
                 continue
             row: dict = {"name": other.name, "current": other.name == aug.name}
-            for key, fn in (("E1", error_functional_e1), ("E2", error_functional_e2)):
-                try:
-                    v = fn(kin, amap, region, nodes=nodes, fixed=fixed).value
-                    row[key] = float(v) if np.isfinite(v) else None
-                except (JikError, ValueError, ArithmeticError):
-                    row[key] = None
+            for key in ("E1", "E2"):
+                row[key] = _functional(key, kin, amap, region, nodes, fixed)[key]
             maps.append(row)
             report(2 * m + 2)
         return {"kind": "alternatives", "maps": maps}

@@ -255,22 +255,7 @@ def sensitivity_spec(
     if sens["kind"] == "alternatives":
         maps = sens["maps"]
         names = [m["name"] + (" (current)" if m["current"] else "") for m in maps]
-        data = [
-            trace(
-                "bar",
-                x=names,
-                y=[m[k] for m in maps],
-                name=k,
-                marker=dict(
-                    color=E_COLORS[k],
-                    line=dict(
-                        color=["black" if m["current"] else E_COLORS[k] for m in maps], width=2
-                    ),
-                ),
-                hovertemplate="%{x}: " + k + " = %{y:.4g}<extra></extra>",
-            )
-            for k in ("E1", "E2")
-        ]
+        data = [_bars(maps, k, names) for k in ("E1", "E2")]
         return figure(
             data,
             f"E1 (13), E2 (18) of the maps of this robot<br><sup>{aug} has no parameters: "
@@ -346,26 +331,25 @@ def sensitivity_spec(
     return figure(data, f"E1 (13), E2 (18) as the parameters of {aug} move{sub}", **layout)
 
 
+def _bars(maps: list[dict], key: str, names: list[str]) -> dict:
+    """The bars of E1 or E2 (``key``) of ``maps`` named ``names``, the current map's outlined."""
+    edges = ["black" if m["current"] else E_COLORS[key] for m in maps]
+    return trace(
+        "bar",
+        x=names,
+        y=[m[key] for m in maps],
+        name=key,
+        marker=dict(color=E_COLORS[key], line=dict(color=edges, width=2)),
+        hovertemplate="%{x}: " + key + " = %{y:.4g}<extra></extra>",
+    )
+
+
 def single_joint_spec(sens: dict, aug: str, log: dict) -> dict:
     """E2 (18) of the map (outlined) beside E2 of h = s x_j for each joint, on a log scale: a
     map over many joints, its E2 by a Sobol rule (:mod:`jik.app.dashboard.arm_e2`)."""
     maps = sens["maps"]
     values = [m["E2"] for m in maps]
-    data = [
-        trace(
-            "bar",
-            x=[m["name"] for m in maps],
-            y=values,
-            name="E2",
-            marker=dict(
-                color=E_COLORS["E2"],
-                line=dict(
-                    color=["black" if m["current"] else E_COLORS["E2"] for m in maps], width=2
-                ),
-            ),
-            hovertemplate="%{x}: E2 = %{y:.4g}<extra></extra>",
-        )
-    ]
+    data = [_bars(maps, "E2", [m["name"] for m in maps])]
     best = min((m for m in maps if not m["current"]), key=lambda m: m["E2"])
     ratio = ""
     if sens["E2"]:

@@ -40,12 +40,10 @@ def is_pose_task(result: DashboardResult) -> bool:
     return names <= set(POSE_NAMES) and bool(names & {"z", "rx", "ry", "rz"})
 
 
-def algorithms_key(result: DashboardResult, per_line: int = 3) -> str:
-    """The line style of each algorithm, ``per_line`` to a line (a title fits its panel)."""
+def algorithms_key(result: DashboardResult) -> str:
+    """The line style of each algorithm, three to a line (a title fits its panel)."""
     keys = [f"{STYLES[a].line.split()[0]}: {STYLES[a].short}" for a in result.runs]
-    return "</sup><br><sup>".join(
-        ", ".join(keys[i : i + per_line]) for i in range(0, len(keys), per_line)
-    )
+    return "</sup><br><sup>".join(", ".join(keys[i : i + 3]) for i in range(0, len(keys), 3))
 
 
 def pose_task_spec(result: DashboardResult) -> dict:

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...engine.reproductions.table1 import PATH, PRINTED, X0, cell
+from ...engine.reproductions.table1 import PATH, PRINTED, X0, cell, differing
 from .algorithms import STYLES
 from .plotting import corner_names, figure, trace
 from .runs import DashboardResult
@@ -73,43 +73,47 @@ def _ends(result: DashboardResult, algorithm: str) -> np.ndarray:
     return np.vstack([np.asarray(result.state.x0)[None, :], result.runs[algorithm].leg_end])
 
 
+class _Table:
+    """A table's columns as they are added: header texts, cell texts, header fills."""
+
+    def __init__(self, first: str, labels: list[str]) -> None:
+        self.rows = len(labels)
+        self.header, self.cols, self.fills = [first], [labels], ["#f4f4f4"]
+
+    def add(self, names, values: np.ndarray, fill: str, label: str) -> None:
+        """One column per variable of ``values`` (rows, p), headed ``label.format(name)``,
+        to four decimals (:func:`~jik.engine.reproductions.table1.cell`), blank below them."""
+        for k, name in enumerate(names):
+            self.header.append(label.format(name))
+            self.cols.append([cell(v, 0) for v in values[:, k]] + [""] * (self.rows - len(values)))
+            self.fills.append(fill)
+
+
 def table1_spec(result: DashboardResult) -> dict:
     """Table 1 (paper, sec. 5.2): for each of its two algorithms jik's columns, then the printed
-    ones, the printed first cycle compared cell by cell to four decimals, as printed; then one
-    group of jik's columns per other chosen algorithm, in its colour (:data:`STYLES`)."""
+    ones, the printed first cycle compared cell by cell to four decimals, as printed
+    (:func:`~jik.engine.reproductions.table1.differing`); then one group of jik's columns per
+    other chosen algorithm, in its colour (:data:`STYLES`)."""
     names = result.variable_names
-    ends = {a: _ends(result, a) for a in PAPER}
-    rows = max(len(_ends(result, a)) for a in result.runs)
+    ends = {a: _ends(result, a) for a in result.runs}
+    rows = max(len(e) for e in ends.values())
     letters = "ABCD"
-    labels = ["A  x0"] + [f"{letters[k % 4]}  x{k}f" for k in range(1, rows)]
-    header, cols, fills = ["row"], [labels], ["#f4f4f4"]
+    table = _Table("row", ["A  x0"] + [f"{letters[k % 4]}  x{k}f" for k in range(1, rows)])
     differs: list[list] = []
     counts = {}
     for a in PAPER:
         printed = np.asarray(PRINTED[a], dtype=float)
-        n = 0
-        for k, name in enumerate(names):
-            col = len(cols)
-            ours = [cell(v, 0) for v in ends[a][:, k]] + [""] * (rows - len(ends[a]))
-            for r in range(min(len(printed), len(ends[a]))):
-                if ours[r] != cell(printed[r, k], 0):
-                    differs.append([col, r, cell(printed[r, k], 0)])
-                    n += 1
-            header.append(f"{SHORT[a]} {name} (jik)")
-            cols.append(ours)
-            fills.append(FILLS[a])
-        for k, name in enumerate(names):
-            header.append(f"{SHORT[a]} {name} (printed)")
-            cols.append([cell(v, 0) for v in printed[:, k]] + [""] * (rows - len(printed)))
-            fills.append(FILLS["printed"])
-        counts[a] = n
+        mask = differing(a, ends[a])
+        first = len(table.cols)
+        differs += [
+            [first + int(k), int(r), cell(printed[r, k], 0)] for k, r in np.argwhere(mask.T)
+        ]
+        counts[a] = int(mask.sum())
+        table.add(names, ends[a], FILLS[a], f"{SHORT[a]} {{}} (jik)")
+        table.add(names, printed, FILLS["printed"], f"{SHORT[a]} {{}} (printed)")
     others = [a for a in result.runs if a not in PAPER]
     for a in others:  # the other chosen algorithms: jik's columns only (the paper has none)
-        ends[a] = _ends(result, a)
-        for k, name in enumerate(names):
-            header.append(f"{SHORT[a]} {name} (jik)")
-            cols.append([cell(v, 0) for v in ends[a][:, k]] + [""] * (rows - len(ends[a])))
-            fills.append(FILLS[a])
+        table.add(names, ends[a], FILLS[a], f"{SHORT[a]} {{}} (jik)")
     notes = [
         f"Beside each of jik's columns, the paper's printed column (continuous algorithm (7), "
         f"one cycle). Highlighted: jik's cells that differ from the print in the fourth decimal "
@@ -148,12 +152,11 @@ def table1_spec(result: DashboardResult) -> dict:
         notes.append(
             "Continuous mode, as in the paper: the columns do not depend on γ (it only rescales θ)."
         )
-    return _spec(TABLE1_TITLE, header, cols, fills, rows, notes, differs)
+    return _spec(TABLE1_TITLE, table, notes, differs)
 
 
 def leg_ends_spec(result: DashboardResult) -> dict:
     """The configuration after every leg for each algorithm (any robot, path or target)."""
-    names = result.variable_names
     L = len(result.targets)
     legs = corner_names(result)
     rows = max(len(r.leg_end) for r in result.runs.values()) + 1
@@ -161,13 +164,9 @@ def leg_ends_spec(result: DashboardResult) -> dict:
         f"cycle {c // L + 1}, leg to {legs[c % L]} {_point(result.targets[c % L])}"
         for c in range(rows - 1)
     ]
-    header, cols, fills = ["leg end"], [point], ["#f4f4f4"]
+    table = _Table("leg end", point)
     for a in result.runs:
-        ends = _ends(result, a)
-        for k, name in enumerate(names):
-            header.append(f"{SHORT[a]} {name}")
-            cols.append([cell(v, 0) for v in ends[:, k]] + [""] * (rows - len(ends)))
-            fills.append(FILLS[a])
+        table.add(result.variable_names, _ends(result, a), FILLS[a], f"{SHORT[a]} {{}}")
     notes = []
     if result.state.robot == "manipulator2":
         notes.append(
@@ -175,7 +174,7 @@ def leg_ends_spec(result: DashboardResult) -> dict:
             "(0, 0, π/2) on the closed path (1, 1), (1, 2), (0, 2), (0, 1); set those "
             "to compare with the printed values."
         )
-    return _spec(LEG_ENDS_TITLE, header, cols, fills, rows, notes, [])
+    return _spec(LEG_ENDS_TITLE, table, notes, [])
 
 
 def table_spec(result: DashboardResult) -> dict:
@@ -183,29 +182,30 @@ def table_spec(result: DashboardResult) -> dict:
     return table1_spec(result) if is_table1(result) else leg_ends_spec(result)
 
 
-def _spec(title, header, cols, fills, rows, notes, differs) -> dict:
+def _spec(title: str, table: _Table, notes: list[str], differs: list[list]) -> dict:
+    marked = {(c, r) for c, r, _ in differs}
     cell_fills = [
         [
-            FILLS["differs"]
-            if [c, r] in [d[:2] for d in differs]
-            else ("white" if r % 2 == 0 else "#f7f7f7")
-            for r in range(rows)
+            FILLS["differs"] if (c, r) in marked else ("white" if r % 2 == 0 else "#f7f7f7")
+            for r in range(table.rows)
         ]
-        for c in range(len(cols))
+        for c in range(len(table.cols))
     ]
-    table = trace(
+    data = trace(
         "table",
         # (fill=dict(color=...): plotly.py's "fill_color" shorthand is expanded only by its
         # validation, which the builders skip; the page reads fill.color)
-        header=dict(values=header, fill=dict(color=fills), font=dict(size=11), align="center"),
+        header=dict(
+            values=table.header, fill=dict(color=table.fills), font=dict(size=11), align="center"
+        ),
         cells=dict(
-            values=cols,
+            values=table.cols,
             font=dict(size=11, family="monospace"),
             align="right",
             fill=dict(color=cell_fills),
         ),
     )
-    spec = figure([table], title, margin=dict(l=10, r=10, t=40, b=10))
+    spec = figure([data], title, margin=dict(l=10, r=10, t=40, b=10))
     spec["layout"]["meta"] = {"notes": notes, "differs": differs}
     return spec
 

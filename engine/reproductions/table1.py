@@ -12,9 +12,11 @@ import math
 import numpy as np
 
 from ..augmentations import PaperCubic, PaperCubicPrintedGradient
+from ..exceptions import InvalidInputError
 from ..inverses import ExtendedInverse, Pseudoinverse
 from ..kinematics import Manipulator2
 from ..repeatability import repeatability
+from ..validation import as_points
 
 X0 = (0.0, 0.0, math.pi / 2)
 PATH = ((1.0, 1.0), (1.0, 2.0), (0.0, 2.0), (0.0, 1.0))
@@ -58,6 +60,31 @@ def cell(value: float, width: int = 9) -> str:
     """``value`` to four decimals in ``width`` columns (0: as wide as it takes), as Table 1
     prints it: a round-off zero such as -1e-16 prints 0.0000, not -0.0000."""
     return f"{round(float(value), 4) + 0.0:{width}.4f}"
+
+
+def differing(algorithm: str, rows) -> np.ndarray:
+    """Which cells of ``rows`` differ from Table 1's printed column of ``algorithm`` when both
+    are printed to four decimals (:func:`cell`), as the paper prints them.
+
+    Parameters
+    ----------
+    algorithm : {"pseudoinverse", "extended"}
+    rows : array_like, shape (n, 3)
+        x0 and the configurations after the legs (:func:`rows`), of one cycle or more.
+
+    Returns
+    -------
+    ndarray of bool, shape (min(n, 5), 3)
+        True where the printed digits differ, for the rows the paper prints.
+    """
+    if algorithm not in PRINTED:
+        raise InvalidInputError(
+            f"algorithm must be one of {', '.join(PRINTED)}, got {algorithm!r}", "algorithm"
+        )
+    ours = as_points(rows, 3, "rows")[: len(PRINTED[algorithm])]
+    printed = np.asarray(PRINTED[algorithm], dtype=float)[: len(ours)]
+    text = np.vectorize(lambda v: cell(v, 0))
+    return text(ours) != text(printed)
 
 
 def format_text(result: dict) -> str:

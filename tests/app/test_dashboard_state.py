@@ -20,7 +20,7 @@ from jik.app.dashboard import (
     runs_key,
     updated_state,
 )
-from jik.app.dashboard.functionals import functionals_key, inert_variables
+from jik.app.dashboard.functionals import functionals_key
 from jik.app.dashboard.model import cache_key
 from jik.app.dashboard.robots import state_kinematics
 from jik.engine.exceptions import InvalidInputError
@@ -309,28 +309,6 @@ def test_functionals_are_keyed_by_the_map_and_the_variables_held_fixed():
     assert functionals_key(
         updated_state(m1, {"augmentation_parameters": {"a": 0.5}})
     ) != functionals_key(m1)
-
-
-def test_inert_variables_are_those_j_h_and_dh_ignore():
-    """Shifting x_k must leave J, h and dh unchanged; a map with a constant dh/dx_k still
-    depends on x_k through its value."""
-    from jik.engine.augmentations import E2Optimal, PaperCubic, Polynomial2
-    from jik.engine.kinematics import Manipulator1, Manipulator2
-
-    box = ((-2.0, 2.0), (-2.0, 2.0), (0.0, 3.0))
-    m2 = Manipulator2()
-    assert inert_variables(m2, PaperCubic(), box) == {0}  # J(x3), h(x2, x3)
-    assert inert_variables(Manipulator1(), E2Optimal(0.5, 1.0), box) == {1}  # J(x1, x3), h(x1, x3)
-    assert inert_variables(m2, Polynomial2({(1, 0): 1.0}, variables=(1, 2), p=3), box) == {0}
-    # h = x1 + x2: dh = (1, 1, 0) does not change with x1 or x2, h does; J depends on x3
-    h = Polynomial2({(1, 0): 1.0, (0, 1): 1.0}, variables=(0, 1), p=3)
-    assert inert_variables(m2, h, box) == frozenset()
-
-    class Unprobeable(PaperCubic):  # a map that raises where it is probed: every variable counts
-        def value_masked(self, x):
-            raise ValueError("cannot evaluate here")
-
-    assert inert_variables(m2, Unprobeable(), box) == frozenset()
 
 
 def test_the_h_panel_names_only_the_fixed_variables_h_depends_on():

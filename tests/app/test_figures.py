@@ -10,19 +10,15 @@ import plotly.graph_objects as go
 import pytest
 
 from jik.app.dashboard import COLORS, LABELS, compute, default_state, updated_state
-from jik.app.dashboard.figures import (
-    augmenting_figure,
-    drift_figure,
-    figure_specs,
-    figures_for,
-    joint_figure,
-    sensitivity_figure,
-    table_figure,
-    task_space_figure,
-)
+from jik.app.dashboard.figures import figure_specs, figures_for
 from jik.app.dashboard.functionals import error_functionals, sensitivity
 from jik.app.dashboard.plotting import figure_json, keep_ranges, nice_range
 from jik.engine.registry import ROBOTS
+
+
+def panel(result, key, functionals=None, sensitivity=None) -> go.Figure:
+    """One panel of ``result`` as a plotly figure (:func:`figures_for`)."""
+    return figures_for(result, functionals, {key}, sensitivity)[key]
 
 
 @pytest.fixture(scope="module")
@@ -42,7 +38,7 @@ def _colors(fig) -> dict[str, str]:
 
 
 def test_task_space_paths_use_one_colour_per_algorithm(path_result):
-    fig = task_space_figure(path_result)
+    fig = panel(path_result, "task")
     assert _colors(fig) == {LABELS[a]: COLORS[a] for a in path_result.state.algorithms}
     assert fig.layout.xaxis.title.text == "y1 [m]"
     assert fig.layout.yaxis.title.text == "y2 [m]"
@@ -56,7 +52,7 @@ def test_task_space_paths_use_one_colour_per_algorithm(path_result):
 
 
 def test_joint_figure_has_one_axis_per_joint_with_units(path_result):
-    fig = joint_figure(path_result)
+    fig = panel(path_result, "joints")
     titles = [fig.layout[f"yaxis{'' if k == 0 else k + 1}"].title.text for k in range(3)]
     assert titles == ["x1 [m]", "x2 [m]", "x3 [rad]"]
     assert fig.layout.xaxis.title.text.startswith("θ")
@@ -67,7 +63,7 @@ def test_joint_figure_has_one_axis_per_joint_with_units(path_result):
 
 
 def test_drift_is_log_scale_and_separates_the_algorithms(path_result):
-    fig = drift_figure(path_result)
+    fig = panel(path_result, "drift")
     assert fig.layout.yaxis.type == "log"
     drift = {t.name: np.asarray(t.y) for t in fig.data}
     assert drift[LABELS["pseudoinverse"]].shape == (2,)
@@ -81,7 +77,7 @@ def test_table1_puts_the_printed_columns_beside_jiks(path_result):
     """On the paper's experiment the table is Table 1: the paper's row labels, jik's columns
     each followed by the printed one, and the extended cells that differ from the print marked
     (the errata's first two legs), with the erratum in words."""
-    fig = table_figure(path_result)
+    fig = panel(path_result, "table")
     cells = fig.data[0].cells.values
     assert fig.layout.title.text.startswith("Table 1 of the paper")
     assert list(cells[0][:5]) == ["A  x0", "B  x1f", "C  x2f", "D  x3f", "A  x4f"]
@@ -101,14 +97,14 @@ def test_table1_puts_the_printed_columns_beside_jiks(path_result):
 
 def test_off_the_papers_path_the_table_is_plainly_named():
     result = compute(updated_state(default_state("manipulator2"), {"x0.0": 0.3, "cycles": 1}))
-    fig = table_figure(result)
+    fig = panel(result, "table")
     assert "not the paper's Table 1" in fig.layout.title.text
     assert fig.data[0].cells.values[0][0] == "start x0"
 
 
 def test_augmenting_map_contours_with_the_extended_run_on_a_level_set(path_result):
     functionals = error_functionals(path_result)
-    fig = augmenting_figure(path_result, functionals)
+    fig = panel(path_result, "augmenting", functionals)
     contour = fig.data[0]
     assert contour.type == "contour"
     assert np.asarray(contour.z).shape == (len(contour.y), len(contour.x))
@@ -132,7 +128,7 @@ def test_augmenting_map_contours_with_the_extended_run_on_a_level_set(path_resul
 
 
 def test_single_target_shows_convergence_instead_of_drift(target_result):
-    fig = drift_figure(target_result)
+    fig = panel(target_result, "drift")
     assert fig.layout.title.text.startswith("Convergence")
     for t in fig.data:
         assert t.y[-1] < 1e-9 and t.y[0] > 0.1
@@ -158,7 +154,7 @@ def test_every_panel_serialises_to_plotly_json(path_result, target_result):
             # The builders skip plotly's validation for speed: every property must still be
             # valid (go.Figure validates a plain dict and raises on an unknown property).
             go.Figure(parsed)
-        go.Figure(augmenting_figure(result, error_functionals(result)).to_dict())
+        go.Figure(panel(result, "augmenting", error_functionals(result)).to_dict())
 
 
 _DTYPES = {
@@ -260,7 +256,7 @@ def test_sensitivity_sweeps_each_parameter_through_the_current_value():
             assert sweep["values"][0] == pytest.approx(v - 1) and len(sweep["values"]) > 5
             mid = len(sweep["values"]) // 2  # the sweep passes through the current value
             assert sweep["functional"][mid] == pytest.approx(sens[key]["value"], rel=1e-9)
-    fig = sensitivity_figure(result, sens)
+    fig = panel(result, "sensitivity", sensitivity=sens)
     go.Figure(fig.to_dict())
     assert "as the parameters of e2_optimal move" in fig.layout.title.text
     assert fig.layout.xaxis.title.text == "a" and fig.layout.xaxis2.title.text == "b"
@@ -279,11 +275,11 @@ def test_sensitivity_without_parameters_compares_the_alternatives(path_result):
     current = next(m for m in sens["maps"] if m["current"])
     assert current["name"] == "paper_cubic"
     assert current["E2"] == pytest.approx(error_functionals(path_result)["E2"], rel=1e-9)
-    fig = sensitivity_figure(path_result, sens)
+    fig = panel(path_result, "sensitivity", sensitivity=sens)
     go.Figure(fig.to_dict())
     assert "no parameters" in fig.layout.title.text
     assert [t.name for t in fig.data] == ["E1", "E2"]
-    assert "computing" in sensitivity_figure(path_result, None).layout.title.text
+    assert "computing" in panel(path_result, "sensitivity", sensitivity=None).layout.title.text
 
 
 def test_functionals_use_the_design_region_and_rank_the_synthesized_map_first(path_result):
@@ -299,7 +295,7 @@ def test_functionals_use_the_design_region_and_rank_the_synthesized_map_first(pa
     assert functionals["region"] == {k: list(v) for k, v in region.items()}
     assert (
         "x2 ∈ [-1, 1], x3 ∈ [0, 3.14]"
-        in augmenting_figure(path_result, functionals).layout.title.text
+        in panel(path_result, "augmenting", functionals).layout.title.text
     )
     spec = robot_spec("manipulator2")
     kin = spec.build()
@@ -356,9 +352,9 @@ def test_axis_ranges_hold_the_data_and_stay_put_for_a_small_change(path_result):
         compute(updated_state(path_result.state, {"x0": [x1, 0.0, np.pi / 2]}))
         for x1 in (0.45, 0.46)
     )  # (the browser test's step)
-    for build in (task_space_figure, joint_figure, drift_figure):
-        fig, fig2 = build(here), build(nearby)
-        assert fig.layout.to_plotly_json() == fig2.layout.to_plotly_json(), build.__name__
+    for key in ("task", "joints", "drift"):
+        fig, fig2 = panel(here, key), panel(nearby, key)
+        assert fig.layout.to_plotly_json() == fig2.layout.to_plotly_json(), key
         for t in fig.data:
             for axis, values in (("x", t.x), ("y", t.y)):
                 name = f"{axis}axis" + (getattr(t, f"{axis}axis") or axis)[1:]
@@ -367,7 +363,7 @@ def test_axis_ranges_hold_the_data_and_stay_put_for_a_small_change(path_result):
                 v = np.asarray(values, dtype=float)
                 if layout_axis.type == "log":
                     v = np.log10(v)
-                assert lo <= v.min() and v.max() <= hi, (build.__name__, name)
+                assert lo <= v.min() and v.max() <= hi, (key, name)
 
 
 def test_axes_keep_their_range_while_the_data_fill_it(path_result):
@@ -421,3 +417,28 @@ def test_a_panels_message_is_wrapped_to_fit_the_panel():
     assert len(lines) > 3 and lines[-1] == "second"
     assert max(len(line) for line in lines) <= MESSAGE_CHARS
     assert " ".join(lines[:-1]) == note
+
+
+def test_cspace_draws_each_corners_self_motion_manifold_through_its_leg_end(path_result):
+    """The green curves are the engine's traced fibres k(x) = corner (one per corner, through
+    the extended run's leg end there), a point every SPACING box diagonals, inside the box
+    widened by half (up to the drawing's tolerance: the ends are where the curve leaves it)."""
+    from jik.app.dashboard.analysis import runs_box
+    from jik.app.dashboard.cspace import SPACING, cspace_spec
+    from jik.app.dashboard.robots import state_kinematics
+
+    kin = state_kinematics(path_result.state)
+    curves = [t for t in cspace_spec(path_result)["data"] if t.get("legendgroup") == "fibres"]
+    assert len(curves) == len(path_result.targets)
+    lo, hi = runs_box(path_result.state, path_result.runs)
+    diagonal = float(np.linalg.norm(hi - lo))
+    seeds = path_result.runs["extended"].leg_end
+    for curve, target, seed in zip(curves, path_result.targets, seeds, strict=False):
+        x = np.stack([curve["x"], curve["y"], curve["z"]], axis=1)  # (axes 0, 1, 2 of p = 3)
+        assert len(x) > 20 and np.isfinite(x).all()
+        np.testing.assert_allclose(kin.forward(x), np.broadcast_to(target, (len(x), 2)), atol=1e-9)
+        assert np.min(np.linalg.norm(x - seed, axis=1)) < SPACING * diagonal
+        gaps = np.linalg.norm(np.diff(x, axis=0), axis=1)
+        assert np.all(gaps <= SPACING * diagonal * (1 + 1e-3))
+        outside = np.maximum(lo - 0.5 * (hi - lo) - x, x - hi - 0.5 * (hi - lo))
+        assert np.max(outside) < 1e-5

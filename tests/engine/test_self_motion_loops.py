@@ -10,6 +10,7 @@ from scipy.integrate import quad, solve_ivp
 from scipy.optimize import brentq
 
 from jik.engine.atlas import plan_atlas
+from jik.engine.exceptions import InvalidInputError
 from jik.engine.inverses import Pseudoinverse
 from jik.engine.kinematics import Kinematics
 from jik.engine.planar_chain import PlanarChain
@@ -108,6 +109,41 @@ def test_a_loop_closing_behind_is_one_turn_ending_at_the_arc_asked_ahead():
     assert not short.closed and short.period is None and short.arc == (-3.0, 3.0)
 
 
+@pytest.mark.parametrize("tol", [1e-8, 1e-6])
+def test_a_loosely_traced_curve_still_closes_and_its_samples_lie_on_the_fibre(tol):
+    """Traced to a drawing's tolerance: the circle and the planar 3R's loop are still found
+    closed after one turn (the return is judged within CLOSE_PER_TOL tol), with the period
+    to about 1e3 tol, in fewer steps; sample(n) gives n points evenly spaced in s over the turn,
+    each on k(x) = y0 to 1e-12 and within 1e3 tol of the accurate curve's point at that s."""
+    for kin, base in ((Circles(), np.array([0.9, -1.2])), (PlanarChain("RRR", LENGTHS), LOOP_BASE)):
+        exact = trace(kin, base, (-50.0, 50.0))
+        loose = trace(kin, base, (-50.0, 50.0), tol=tol)
+        assert loose.closed and loose.steps < exact.steps
+        assert loose.period == pytest.approx(exact.period, rel=0, abs=1e3 * tol)
+        x = loose.sample(101)
+        assert x.shape == (101, kin.p)
+        y0 = np.broadcast_to(kin.forward(np.asarray(base, dtype=float)), (101, kin.r))
+        np.testing.assert_allclose(kin.forward(x), y0, rtol=0, atol=1e-12)
+        s = np.linspace(*loose.arc, 101)
+        np.testing.assert_allclose(x, exact.points(s), rtol=0, atol=1e3 * tol)
+        np.testing.assert_allclose(x[-1], x[0], rtol=0, atol=1e3 * tol)
+
+
+@pytest.mark.parametrize(
+    ("call", "field", "text"),
+    [
+        (lambda c: trace(Circles(), (1.0, 0.0), (-1.0, 1.0), tol=1e-3), "tol", "from 1e-12"),
+        (lambda c: trace(Circles(), (1.0, 0.0), (-1.0, 1.0), tol="x"), "tol", "a number"),
+        (lambda c: c.sample(1), "n", "between 2 and 100000"),
+    ],
+)
+def test_a_bad_tolerance_or_sample_count_is_named(call, field, text):
+    curve = trace(Circles(), (1.0, 0.0), (-1.0, 1.0))
+    with pytest.raises(InvalidInputError, match=text) as info:
+        call(curve)
+    assert info.value.field == field
+
+
 def test_a_planar_3r_loop_has_the_length_of_its_closed_form_fibre():
     """The 3R arm's fibre through LOOP_BASE: phi sweeps [a, b] (where the wrist's distance
     reaches l1 + l2) on both elbow branches; its length by quadrature of the closed-form
@@ -179,6 +215,15 @@ def test_a_continuous_joint_closes_a_loop_modulo_two_pi():
     open_ = trace(planar, base, (-3 * length, 3 * length))
     assert not open_.closed and open_.arc == (-3 * length, 3 * length)
     assert not trace(limited, base, (-3 * length, 3 * length)).closed
+    # A box of +-1 rad about the base: a window on the continuous joints' turn (the loop is
+    # still found) unless they are bounded by it too, when the curve stops where an angle
+    # leaves it, on the box's face.
+    box = [(v - 1.0, v + 1.0) for v in base]
+    assert trace(urdf, base, (-MAX_ARC, MAX_ARC), box).closed
+    cut = trace(urdf, base, (-MAX_ARC, MAX_ARC), box, bound_free_joints=True)
+    assert not cut.closed and cut.arc[1] - cut.arc[0] < length
+    ends = cut.points(np.array(cut.arc))
+    assert np.all(np.isclose(np.abs(ends - base), 1.0, atol=1e-9).any(axis=1))
 
 
 def arm4_plan(n: int, **kw):

@@ -7,7 +7,7 @@ from jik.engine.augmentations import E2Optimal, PaperCubic
 from jik.engine.exceptions import AlgorithmicSingularityError, InvalidInputError
 from jik.engine.inverses import ExtendedInverse, Pseudoinverse
 from jik.engine.kinematics import Manipulator1, Manipulator2
-from jik.engine.reproductions.table1 import PRINTED
+from jik.engine.reproductions.table1 import PRINTED, differing
 from jik.engine.reproductions.table1 import run as table1
 from jik.engine.solver import solve, solve_batch
 
@@ -23,6 +23,22 @@ def test_table1_pseudoinverse_column_to_four_decimals():
 def test_table1_extended_column_closes_the_path():
     rows = np.array(table1()["extended"])
     np.testing.assert_allclose(rows[-1], X0, atol=1e-9)
+
+
+def test_table1_cells_that_differ_from_the_print_in_the_fourth_decimal():
+    """The pseudoinverse's twelve numbers print as the paper's; the cubic (38)'s first two
+    leg ends differ in every coordinate (docs/paper-errata.md), x0 and the last two do not;
+    a second cycle's rows are not compared, and a cell off by 1e-4 is."""
+    result = table1()
+    assert not differing("pseudoinverse", result["pseudoinverse"]).any()
+    mask = differing("extended", result["extended"] + result["extended"][1:])
+    np.testing.assert_array_equal(mask, [[r in (1, 2)] * 3 for r in range(5)])
+    off = np.array(PRINTED["pseudoinverse"][:2])
+    off[1, 2] += 1e-4
+    np.testing.assert_array_equal(differing("pseudoinverse", off), [[0, 0, 0], [0, 0, 1]])
+    with pytest.raises(InvalidInputError, match="algorithm must be one of") as info:
+        differing("posture", result["pseudoinverse"])
+    assert info.value.field == "algorithm"
 
 
 @pytest.mark.parametrize("gamma", [0.05, 1.0, 30.0])

@@ -119,3 +119,20 @@ def test_a_runs_summary_says_the_units_of_x_and_y():
     summary = jik.robot_from_dict({"name": "manipulator1"}).units.summary()
     assert summary["x"] == ["m", "m", "1"] and summary["y"] == ["m", "m"]
     assert summary["lengths"].startswith("the paper states no unit")
+
+
+def test_the_columns_name_each_coordinate_as_the_engines_tables_do():
+    """x_1..x_p, then y_1..y_r, in order, keyed to the coordinates with their names and units:
+    the columns of a trajectory's table (Trajectory.columns) between theta and error."""
+    m1 = jik.robot_from_dict({"name": "manipulator1"})
+    columns = m1.units.columns()
+    assert {k: (c.name, c.unit) for k, c in columns.items()} == {
+        "x_1": ("x1", "m"),
+        "x_2": ("x2", "m"),
+        "x_3": ("x3", "1"),
+        "y_1": ("y1", "m"),
+        "y_2": ("y2", "m"),
+    }
+    inverse = m1.inverse("pseudoinverse")
+    trajectory = jik.solve(inverse, (0.5, 0.25, 1.0), (0.5, 0.5), record=True).trajectory
+    assert list(trajectory.columns())[1:-1] == list(columns)
