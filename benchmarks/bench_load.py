@@ -172,9 +172,9 @@ async def _pool_load(duration: float, clients: int, batching: bool) -> dict:
     """The same load on the compute pool in-process: the computation path without HTTP."""
     from ..app.compute.pool import ComputePool
     from ..app.compute.schemas import SolveRequest
-    from ..app.compute.settings import settings_from_env
+    from ..app.compute.settings import settings
 
-    pool = ComputePool(settings_from_env().model_copy(update={"batching": batching}))
+    pool = ComputePool(settings().model_copy(update={"batching": batching}))
     try:
         await pool.warm_up()
         lat: list[float] = []

@@ -54,6 +54,7 @@ Functionals and synthesis (secs. 3-4)
     synthesize_e2_nd            E2-optimal h of all joints, p - r >= 1 -> TotalDegreeSynthesis
     map_singularities           where h or [J; dh] (10) is singular in a box -> MapSingularities
     inert_variables             the joint variables that J, h and dh do not depend on
+    map_grid                    h on the plane of a box where it varies most -> MapGrid
 The atlas (drift over many starts and paths)
     plan_atlas, run_atlas       plan and run an atlas (here, in processes or on Dask)
     iter_atlas                  the same, chunk by chunk, in bounded memory
@@ -144,6 +145,8 @@ _EXPORTS = {
     "map_singularities": "map_singularities",
     "inert_variables": "dependence",
     "MapSingularities": "map_singularities",
+    "map_grid": "map_grid",
+    "MapGrid": "map_grid",
     # the atlas
     "plan_atlas": "atlas",
     "AtlasPlan": "atlas",
@@ -188,6 +191,7 @@ __all__ = [
     "LimitsReport",
     "Manipulator1",
     "Manipulator2",
+    "MapGrid",
     "MapSingularities",
     "OneFormUndefinedError",
     "PaperCubic",
@@ -219,6 +223,7 @@ __all__ = [
     "load_robot",
     "make_inverse",
     "manifold_starts",
+    "map_grid",
     "map_singularities",
     "plan_atlas",
     "repeatability",
@@ -288,6 +293,7 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
     from .inverses import ExtendedInverse, Inverse, Pseudoinverse
     from .kinematics import Kinematics, Manipulator1, Manipulator2
     from .limits import LimitsReport
+    from .map_grid import MapGrid, map_grid
     from .map_singularities import MapSingularities, map_singularities
     from .planar_chain import PlanarChain
     from .practical_inverses import DampedInverse, PostureInverse, WeightedInverse

@@ -10,8 +10,10 @@ them into one :class:`AtlasResult`.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterator
 from dataclasses import dataclass
+from time import perf_counter
 
 import numpy as np
 
@@ -105,6 +107,31 @@ def run_chunk(task: ChunkTask) -> AtlasChunk:
     limits = robot_limits(task.inverses[0].kinematics)
     outside = None if limits is None else starts_outside(limits, task.starts, legs)
     return AtlasChunk(task.lo, task.hi, drift, legs, success, tuple(failures), outside)
+
+
+#: Runs timed together by :func:`sized_chunks`.
+PROBE = 8
+
+
+def sized_chunks(plan: AtlasPlan, seconds: float = 1.0) -> AtlasPlan:
+    """``plan`` with chunks of about ``seconds`` of work, from the time of its first runs (a
+    unicycle's run costs hundreds of times a Manipulator 2's); at most the plan's own chunk.
+    The first run (with its one-time costs) is timed alone: when it takes ``seconds`` or more,
+    a chunk is one run and nothing more is probed (an arm's runs far out of reach take seconds
+    each); else up to :data:`PROBE` runs, as many as fit in ``seconds`` at the first one's
+    pace, are timed together. The atlas's numbers do not depend on its chunks."""
+    start = perf_counter()
+    run_chunk(chunk_task(plan, 0, 1))
+    first = perf_counter() - start
+    if first >= seconds:
+        return dataclasses.replace(plan, chunk=1)
+    n = int(min(PROBE, plan.size, max(1.0, seconds / max(first, 1e-9))))
+    probe = chunk_task(plan, 0, n)
+    start = perf_counter()
+    run_chunk(probe)
+    per_run = (perf_counter() - start) / (probe.hi - probe.lo)
+    chunk = int(min(max(seconds / max(per_run, 1e-9), 1), plan.chunk))
+    return dataclasses.replace(plan, chunk=chunk)
 
 
 def _runs(inverse: Inverse, task: ChunkTask, ids: np.ndarray):

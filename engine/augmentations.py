@@ -217,6 +217,12 @@ class Polynomial2(AugmentingMap):
     def parameters(self) -> dict[str, float]:
         return {f"c{i}{j}": c for (i, j), c in sorted(self.coefficients.items())}
 
+    def monomials(self) -> dict[str, float]:
+        """The coefficients keyed by their monomials in the 1-based variable names,
+        ``"x2^2 x3^1"`` (JSON-friendly)."""
+        a, b = (f"x{v + 1}" for v in self.variables)
+        return {f"{a}^{i} {b}^{j}": float(c) for (i, j), c in sorted(self.coefficients.items())}
+
     def _powers(self, x: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
         """U = (1, u, u^2, ...), V likewise (..., degree + 1), and their derivatives dU, dV.
 

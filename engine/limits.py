@@ -189,6 +189,19 @@ def repeatability_report(limits: FloatArray, result, names: Sequence[str]) -> Li
     return legs_report(limits, result.x0, legs, L, names)
 
 
+def run_report(kinematics, result) -> LimitsReport | None:
+    """Whether a run of ``kinematics`` (a solve's result, or a single start's repeatability
+    result) stayed within its joint limits, and its first violation; None for a robot
+    without limits."""
+    limits = robot_limits(kinematics)
+    if limits is None:
+        return None
+    names = limit_names(kinematics)
+    if hasattr(result, "leg_results"):
+        return repeatability_report(limits, result, names)
+    return solve_report(limits, result, names)
+
+
 def starts_outside(limits: FloatArray, x0: FloatArray, legs: FloatArray) -> FloatArray:
     """Mask (n,) of the runs of an atlas (starts x0 (n, p), leg ends (n, C * L, p)) whose start
     or some leg end is outside the limits."""

@@ -114,6 +114,19 @@ class PoseTask:
             parts.append(so3.log(self.reference_T @ R)[..., self.rotation_rows])
         return np.concatenate(parts, axis=-1)[..., self.order]
 
+    def pose_of(self, y: FloatArray) -> tuple[FloatArray | None, FloatArray | None]:
+        """Where task coordinates y (..., r) put the end link, the inverse of :meth:`value` on
+        what the task holds: its position t (..., 3) when the task holds x, y and z, its
+        orientation R = R0 exp(phi) (..., 3, 3) when it holds rx, ry and rz; None for what the
+        task leaves free (a target of eq. (4) then fixes no point or no frame in space)."""
+        y = np.asarray(y, dtype=float)
+        at = dict(zip(self.names, np.moveaxis(y, -1, 0), strict=True))
+        t, phi = (
+            np.stack([at[c] for c in part], axis=-1) if set(part) <= at.keys() else None
+            for part in (COORDINATES[:3], COORDINATES[3:])
+        )
+        return t, None if phi is None else self.reference @ so3.exp(phi)
+
     def value_jacobian(self, R, t, Jv, Jw) -> tuple[FloatArray, FloatArray]:
         """k (..., r) and J (..., r, p) from the pose and the geometric Jacobian."""
         if self.full and R.ndim == 2:  # one configuration, the whole pose

@@ -12,12 +12,7 @@ from .formula_kinematics import FormulaMap
 from .functionals import check_region
 from .kinematics import Kinematics
 from .registry import AugmentationSpec
-from .robot_synthesis import (
-    TENSOR_DEGREE,
-    TOTAL_DEGREE,
-    synthesis,
-    vector_synthesis,
-)
+from .robot_synthesis import default_degree, synthesis, vector_synthesis
 from .validation import count
 
 
@@ -58,15 +53,13 @@ def augmentations_from_dict(kin: Kinematics, items, key: str | None = None):
         else:
             unknown = set(item) - robot_kinds.augmentation_keys("e2_synthesized")
             box, fix = _region(kin, item, where)
-            if len(box) <= 3 and k == 1:
-                degree = count(
-                    item.get("degree", TENSOR_DEGREE), f"{where}.degree", 1, 24, f"{where}.degree"
-                )
+            tensor = len(box) <= 3 and k == 1  # (else a total-degree basis, at most 6)
+            given = item.get("degree", default_degree(len(box), k))
+            field = f"{where}.degree"
+            degree = count(given, field, 1, 24 if tensor else 6, field)
+            if tensor:
                 text = f"E2-optimal h on {box} by the Ritz solve of (20), degree {degree}"
             else:
-                degree = count(
-                    item.get("degree", TOTAL_DEGREE), f"{where}.degree", 1, 6, f"{where}.degree"
-                )
                 text = (
                     f"E2-optimal h of {len(box)} joints on {box}: Ritz solve of (19) in a "
                     f"total-degree {degree} basis on a Sobol rule"

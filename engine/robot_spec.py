@@ -37,19 +37,12 @@ from .extended_vector import VectorExtendedInverse
 from .formula_kinematics import FormulaKinematics
 from .inverses import Inverse
 from .kinematics import Kinematics
-from .limits import (
-    LimitsReport,
-    check_limits,
-    limit_names,
-    repeatability_report,
-    robot_limits,
-    solve_report,
-)
+from .limits import LimitsReport, check_limits, run_report
 from .planar_chain import PlanarChain
 from .registry import ROBOTS, RobotSpec, make_inverse
 from .repeatability import MAX_PATH_POINTS
 from .robot_augmentations import augmentations_from_dict
-from .robot_synthesis import arm_augmentations
+from .robot_synthesis import arm_augmentations, missing_map
 from .units import RobotUnits, robot_units
 from .validation import as_points
 
@@ -101,13 +94,7 @@ class Robot:
     def limits_report(self, result) -> LimitsReport | None:
         """Whether a run of this robot (a solve's or a single start's repeatability result)
         stayed within its joint limits, and its first violation; None for a robot without."""
-        limits = robot_limits(self.kinematics)
-        if limits is None:
-            return None
-        names = limit_names(self.kinematics)
-        if hasattr(result, "leg_results"):
-            return repeatability_report(limits, result, names)
-        return solve_report(limits, result, names)
+        return run_report(self.kinematics, result)
 
     def inverse(
         self,
@@ -121,12 +108,10 @@ class Robot:
         ``x0`` the run's start: the posture inverse's default rest for a robot without home),
         or the extended inverse (11) with one of its augmenting maps (a
         :class:`~jik.engine.extended_vector.VectorExtendedInverse` for p - r > 1)."""
-        if algorithm == "extended" and not self.spec.augmentations:
-            raise InvalidInputError(
-                f"robot {self.spec.title!r} has no augmenting map for the extended inverse; add "
-                "one under 'augmentations' ({'name': 'formula', 'h': ...} or 'e2_synthesized')",
-                "augmentation",
-            )
+        spec = self.spec
+        if algorithm == "extended" and not spec.augmentations:
+            arm = "home" in self.definition
+            raise InvalidInputError(missing_map(spec.name, spec.p, spec.r, arm), "augmentation")
         if algorithm == "extended" and self.map_vectors:
             name = augmentation or self.spec.default_augmentation
             if name in self.map_vectors:

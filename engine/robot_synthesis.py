@@ -99,6 +99,13 @@ TENSOR_DEGREE = 12
 ARM_BOX = 0.3
 
 
+def default_degree(variables: int, k: int) -> int:
+    """The degree of an E2 synthesis given none: :data:`TENSOR_DEGREE` per variable for one
+    map (p - r = ``k`` = 1) of two or three ``variables`` (the tensor Ritz solve of eq. (20)),
+    else the total degree :data:`TOTAL_DEGREE` (eq. (19) on a Sobol rule)."""
+    return TENSOR_DEGREE if variables <= 3 and k == 1 else TOTAL_DEGREE
+
+
 def arm_augmentations(kin: Kinematics, d: Mapping) -> list:
     """The maps of an arm with a home (a catalogue arm, or a URDF given with ``home``): by
     default, with one degree of redundancy (a 7-joint arm's pose task), one E2-optimal over all
@@ -124,3 +131,28 @@ def arm_augmentations(kin: Kinematics, d: Mapping) -> list:
         else item
         for item in given
     ]
+
+
+def missing_map(name: str, p: int, r: int, arm: bool) -> str:
+    """What the extended inverse (11) of a robot without an augmenting map needs: p - r maps h
+    (eq. (9)), a formula or an E2 synthesis; an arm with a home (``arm``) has one by default
+    only for p = r + 1 (:func:`arm_augmentations`). ``name``: the robot's kind or name."""
+    k = p - r
+    if k == 1:
+        return (
+            "the extended inverse needs an augmenting map: {'name': 'formula', 'h': ...} or "
+            "{'name': 'e2_synthesized', 'region': {...}}; an arm given with its home has an "
+            "E2-optimal one by default"
+        )
+    formulas = f"{{'name': 'formula', 'h': [...]}} ({k} formulas, one per degree of redundancy)"
+    if arm:
+        return (
+            f"the extended inverse needs p - r = {k} augmenting maps, and this {name} "
+            f"(p = {p}, r = {r}) has a default map only when p = r + 1: give "
+            f"{{'name': 'e2_synthesized'}} (E2-optimal over all its joints, +-{ARM_BOX:g} "
+            f"around its home) or {formulas}"
+        )
+    return (
+        f"the extended inverse needs p - r = {k} augmenting maps: give {formulas} or "
+        f"{{'name': 'e2_synthesized', 'region': {{...}}}} over at least {k} of the joints"
+    )

@@ -1,6 +1,6 @@
 """The rules of a solve of eq. (7): its modes, its limits, gamma's range, the check of its
-settings, the memory a batch of it holds (for :func:`jik.engine.validation.check_memory`), and
-why a run stopped.
+settings and of its starts, the memory a batch of it holds (for
+:func:`jik.engine.validation.check_memory`), and why a run stopped.
 
 One definition of each, used by the solver (:mod:`jik.engine.solver`), the atlas, and the app's
 request schemas and dashboard, which word their errors with :func:`gamma_problem`.
@@ -9,6 +9,8 @@ request schemas and dashboard, which word their errors with :func:`gamma_problem
 from __future__ import annotations
 
 import math
+
+import numpy as np
 
 from . import validation
 from .exceptions import InvalidInputError
@@ -96,6 +98,41 @@ def check_inverse(inverse) -> Kinematics:
             "inverse",
         )
     return inverse.kinematics
+
+
+def refused_starts(inverse: Inverse, x0: FloatArray) -> dict[int, str]:
+    """The starts of a batch from which eq. (7) cannot run with ``inverse``, each with why.
+
+    Parameters
+    ----------
+    inverse : Inverse
+    x0 : array_like, shape (n, p)
+
+    Returns
+    -------
+    dict int -> str
+        Index in ``x0`` -> why: the kinematics overflow there (k(x0) or its Jacobian not
+        finite), or J#(x0) is undefined (the inverse's singular error). Empty when every start
+        can run; :func:`jik.engine.solver.solve_batch` raises at the first refused one.
+    """
+    x0 = np.asarray(x0, dtype=float)
+    _, bad = inverse.apply_masked(x0, np.ones((len(x0), inverse.kinematics.r)))
+    return {int(i): _start_problem(inverse, x0[i]) for i in np.flatnonzero(np.atleast_1d(bad))}
+
+
+def _start_problem(inverse: Inverse, x: FloatArray) -> str:
+    """Why J#(x) is undefined at the start ``x`` (p,): overflow, else a singularity."""
+    with np.errstate(all="ignore"):
+        y = np.asarray(inverse.kinematics.forward(x), dtype=float)
+        jacobian = np.asarray(inverse.kinematics.jacobian(x), dtype=float)
+    if not (np.all(np.isfinite(y)) and np.all(np.isfinite(jacobian))):
+        shown = ", ".join(f"{v:.6g}" for v in y)
+        return (
+            f"the kinematics overflow at the start: k(x0) = ({shown}), its Jacobian "
+            f"{'finite' if np.all(np.isfinite(jacobian)) else 'not finite'}; choose a start "
+            "where both are finite (below about 1.8e308)"
+        )
+    return f"{inverse.singular_error(x)}; move the start"
 
 
 def check_settings(

@@ -135,10 +135,7 @@ class SynthesisResult(Columns):
 
     def polynomial_coefficients(self) -> dict[str, float]:
         """Cubic coefficients keyed like ``"x2^2 x3^1"`` (JSON-friendly)."""
-        if self.polynomial is None:
-            return {}
-        a, b = (f"x{v + 1}" for v in self.polynomial.variables)
-        return {f"{a}^{i} {b}^{j}": c for (i, j), c in sorted(self.polynomial.coefficients.items())}
+        return {} if self.polynomial is None else self.polynomial.monomials()
 
 
 class _Problem:

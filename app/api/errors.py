@@ -42,15 +42,23 @@ from .validation import validation_detail
 log = logging.getLogger("jik.api")
 
 
-def validation_error_response(exc: RequestValidationError) -> JSONResponse:
-    return JSONResponse(status_code=422, content={"detail": validation_detail(exc.errors())})
+def _detail(status: int, detail: str, retry_after: str | None = None) -> JSONResponse:
+    """``{"detail": detail}`` with ``status`` (and Retry-After, in seconds, when given)."""
+    headers = None if retry_after is None else {"Retry-After": retry_after}
+    return JSONResponse(status_code=status, content={"detail": detail}, headers=headers)
 
 
-def request_error_response(exc: RequestError) -> JSONResponse:
-    loc = field_loc(exc.field)
+def _refused(loc: list[str | int], msg: str, kind: str = "value_error") -> JSONResponse:
+    """422 in FastAPI's list format, one error at ``loc``."""
     return JSONResponse(
-        status_code=422, content={"detail": [{"loc": loc, "msg": str(exc), "type": "value_error"}]}
+        status_code=422, content={"detail": [{"loc": loc, "msg": msg, "type": kind}]}
     )
+
+
+def field_error_response(exc: RequestError | InvalidInputError) -> JSONResponse:
+    """422 for a value the request's checks, the dashboard's model or the engine refused, at
+    the field it names."""
+    return _refused(field_loc(exc.field or ""), str(exc))
 
 
 #: What FastAPI says of a body it could not parse (a JSON nested too deep, bytes that are not
@@ -67,18 +75,7 @@ def unparsed_body_response(exc: Exception) -> JSONResponse:
         why = "it is not UTF-8 text"
     else:
         why = "it is not valid JSON"
-    return JSONResponse(
-        status_code=422,
-        content={
-            "detail": [
-                {
-                    "loc": ["body"],
-                    "msg": f"body: the body cannot be read as JSON: {why}",
-                    "type": "json_invalid",
-                }
-            ]
-        },
-    )
+    return _refused(["body"], f"body: the body cannot be read as JSON: {why}", "json_invalid")
 
 
 def http_error_response(exc: StarletteHTTPException) -> JSONResponse:
@@ -93,77 +90,36 @@ def http_error_response(exc: StarletteHTTPException) -> JSONResponse:
     )
 
 
-def invalid_input_response(exc: InvalidInputError) -> JSONResponse:
-    """422 for a value the dashboard's model or the engine refused, at the field it names."""
-    loc = field_loc(exc.field or "")
-    return JSONResponse(
-        status_code=422, content={"detail": [{"loc": loc, "msg": str(exc), "type": "value_error"}]}
-    )
-
-
-def session_not_found_response(exc: SessionNotFound) -> JSONResponse:
-    return JSONResponse(
-        status_code=404,
-        content={
-            "detail": (
-                f"no dashboard session {exc.args[0]!r} (it expired or never existed); "
-                "reload the page to start a new one"
-            )
-        },
-    )
-
-
-def export_unavailable_response(exc: ExportUnavailable) -> JSONResponse:
-    return JSONResponse(status_code=exc.status, content={"detail": str(exc)})
-
-
-def sessions_full_response(exc: SessionsFull) -> JSONResponse:
-    return JSONResponse(
-        status_code=503, content={"detail": str(exc)}, headers={"Retry-After": "30"}
-    )
-
-
-def atlas_job_not_found_response(exc: AtlasJobNotFound) -> JSONResponse:
-    job_id, why = exc.args
-    return JSONResponse(status_code=404, content={"detail": f"no atlas job {job_id!r}: {why}"})
-
-
-def atlas_jobs_full_response(exc: AtlasJobsFull) -> JSONResponse:
-    return JSONResponse(
-        status_code=429, content={"detail": str(exc)}, headers={"Retry-After": "10"}
-    )
-
-
-def busy_response(exc: ServiceUnavailable) -> JSONResponse:
-    return JSONResponse(status_code=503, content={"detail": str(exc)}, headers={"Retry-After": "1"})
-
-
 def compute_error_response(exc: ComputeError) -> JSONResponse:
     log.error("computation failed: %s", exc)
-    return JSONResponse(status_code=500, content={"detail": f"internal error: {exc}"})
+    return _detail(500, f"internal error: {exc}")
 
 
 def unexpected_error_response(exc: Exception) -> JSONResponse:
     """500 for an error nothing expected; logged with its traceback (called while handling it)."""
     log.exception("unexpected error")
-    return JSONResponse(
-        status_code=500, content={"detail": f"internal error: {type(exc).__name__}: {exc}"}
-    )
+    return _detail(500, f"internal error: {type(exc).__name__}: {exc}")
 
 
 #: Every expected error and its response; anything else is :func:`unexpected_error_response`.
 _RESPONSES: dict[type[Exception], Callable[[Any], JSONResponse]] = {
-    RequestValidationError: validation_error_response,
-    RequestError: request_error_response,
-    ServiceUnavailable: busy_response,
+    RequestValidationError: lambda exc: JSONResponse(
+        status_code=422, content={"detail": validation_detail(exc.errors())}
+    ),
+    RequestError: field_error_response,
+    ServiceUnavailable: lambda exc: _detail(503, str(exc), retry_after="1"),
     ComputeError: compute_error_response,
     StarletteHTTPException: http_error_response,
-    InvalidInputError: invalid_input_response,
-    SessionNotFound: session_not_found_response,
-    SessionsFull: sessions_full_response,
-    ExportUnavailable: export_unavailable_response,
-    AtlasJobNotFound: atlas_job_not_found_response,
-    AtlasJobsFull: atlas_jobs_full_response,
+    InvalidInputError: field_error_response,
+    SessionNotFound: lambda exc: _detail(
+        404,
+        f"no dashboard session {exc.args[0]!r} (it expired or never existed); "
+        "reload the page to start a new one",
+    ),
+    SessionsFull: lambda exc: _detail(503, str(exc), retry_after="30"),
+    ExportUnavailable: lambda exc: _detail(exc.status, str(exc)),
+    AtlasJobNotFound: lambda exc: _detail(404, f"no atlas job {exc.args[0]!r}: {exc.args[1]}"),
+    AtlasJobsFull: lambda exc: _detail(429, str(exc), retry_after="10"),
 }
 
 

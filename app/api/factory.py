@@ -19,17 +19,17 @@ from .body_limit import BodyLimit
 from .errors import add_error_handlers
 from .fastpath import SolveFastPath
 from .routes import (
+    atlas,
     dashboard,
     health,
     kinematics,
     repeatability,
     robots,
+    session_atlas,
     sessions,
     solve,
     synthesize,
 )
-from .routes.atlas import router as atlas_router
-from .routes.session_atlas import router as session_atlas_router
 from .security import SecurityMiddleware, allowed_hosts_from_env
 
 #: Largest request body accepted (413 beyond): the largest valid request is a few kilobytes.
@@ -76,12 +76,9 @@ def create_app(
     app.state.pool = pool
 
     add_error_handlers(app)
-    for module in (health, robots, solve, repeatability, synthesize, kinematics):
+    routes = (health, robots, solve, repeatability, synthesize, kinematics, dashboard, sessions)
+    for module in (*routes, atlas, session_atlas):
         app.include_router(module.router)
-    app.include_router(dashboard.router)
-    app.include_router(sessions.router)
-    app.include_router(atlas_router)
-    app.include_router(session_atlas_router)
     if fast_solve:
         app.add_middleware(SolveFastPath, pool=pool)
     app.add_middleware(BodyLimit, limit=MAX_BODY_BYTES)  # before any body is read

@@ -22,10 +22,10 @@ websocket relay (docs/security.md has the threat model):
 
 from __future__ import annotations
 
-import json
 from collections.abc import Iterable
 from urllib.parse import urlsplit
 
+from starlette.responses import JSONResponse
 from starlette.routing import Match
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
@@ -99,7 +99,7 @@ class SecurityMiddleware:
             if websocket:
                 await _close_websocket(receive, send, 4000 + status, message)
                 return
-            await _json(send, status, message)
+            await _refused(status, message)(scope, receive, send)
             return
         if websocket:
             await self.app(scope, receive, send)
@@ -162,30 +162,10 @@ async def _close_websocket(receive: Receive, send: Send, code: int, reason: str)
     await send({"type": "websocket.close", "code": code, "reason": short})
 
 
-async def _json(send: Send, status: int, message: str) -> None:
-    body: dict[str, object]
+def _refused(status: int, message: str) -> JSONResponse:
+    """The JSON answer to a refused request: a 415 in FastAPI's list format, on the header."""
+    detail: object = message
     if status == 415:
-        body = {
-            "detail": [
-                {
-                    "loc": ["header", "content-type"],
-                    "msg": message,
-                    "type": "unsupported_media_type",
-                }
-            ]
-        }
-    else:
-        body = {"detail": message}
-    data = json.dumps(body).encode()
-    await send(
-        {
-            "type": "http.response.start",
-            "status": status,
-            "headers": [
-                (b"content-type", b"application/json"),
-                (b"content-length", str(len(data)).encode()),
-                (b"x-content-type-options", b"nosniff"),
-            ],
-        }
-    )
-    await send({"type": "http.response.body", "body": data})
+        loc = ["header", "content-type"]
+        detail = [{"loc": loc, "msg": message, "type": "unsupported_media_type"}]
+    return JSONResponse({"detail": detail}, status, headers={"X-Content-Type-Options": "nosniff"})

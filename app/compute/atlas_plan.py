@@ -13,13 +13,13 @@ from typing import Any
 import numpy as np
 
 from ...engine.atlas import AtlasPlan, plan_atlas
-from ...engine.atlas_run import AtlasResult
+from ...engine.atlas_run import AtlasResult, sized_chunks
 from ...engine.exceptions import InvalidInputError
 from ...engine.repeatability import CLOSE_TOL
 from ...engine.self_motion import MAX_ARC
 from ...engine.solve_rules import gamma_problem
 from . import schemas as S
-from .atlas_pool import sized_chunks
+from .atlas_pool import CHUNK_SECONDS
 from .atlas_schemas import AtlasRequest
 from .documents import nullable
 from .exceptions import RequestError
@@ -135,11 +135,11 @@ def _plan(req: AtlasRequest, spec, inverses, path, gamma, mode) -> AtlasPlan:
 def plan_task(req: str, limits: AtlasLimits):
     """:func:`plan_request` of a request (JSON) as a compute worker's task, within the workers'
     time and memory limits (tracing the curves solves eq. (7)), its chunks sized for the pool
-    (:func:`sized_chunks`): the plan and what it used (:func:`planned`) and None, or None and
-    the refusal (message, field), for the server to raise again."""
+    (:func:`~jik.engine.atlas_run.sized_chunks`): the plan and what it used (:func:`planned`)
+    and None, or None and the refusal (message, field), for the server to raise again."""
     try:
         plan, used = planned(AtlasRequest.model_validate_json(req), limits)
-        return (sized_chunks(plan), used), None
+        return (sized_chunks(plan, CHUNK_SECONDS), used), None
     except InvalidInputError as exc:
         return None, (str(exc), exc.field)
 

@@ -30,6 +30,7 @@ from .schemas import (
     per_robot,
 )
 from .schemas.algorithms import AlgorithmParameters
+from .schemas.variants import narrowed
 
 #: Largest starts per path, cycles, and paths of a family (shifts, scales) in one request.
 MAX_STARTS = 20000
@@ -91,7 +92,8 @@ class AtlasRequest(BaseModel):
         "of the curve inside the robot's configuration box",
     )
     reference: Vector | None = Field(
-        None, description="s = 0 is where eq. (7) from here meets the curve (default: robot's x0)"
+        None,
+        description="s = 0 is where eq. (7) from here meets the curve (default: the robot's x0)",
     )
     shifts: Annotated[list[Vector], Field(min_length=1, max_length=MAX_FAMILY)] | None = Field(
         None, description="translations of the path (a family of paths)"
@@ -114,12 +116,7 @@ def _atlas_fields(spec, augmentation) -> dict:
     r, p = len(spec.task_names), spec.p
     point = Annotated[list[Coordinate], Field(min_length=r, max_length=r)]
     return {
-        "augmentation": (
-            augmentation | None,
-            Field(
-                None, description="augmenting map of the extended inverse (default: the robot's)"
-            ),
-        ),
+        "augmentation": narrowed(AtlasRequest, "augmentation", augmentation | None),
         "path": (
             Annotated[list[point], Field(min_length=2, max_length=MAX_PATH_POINTS)] | None,
             Field(
@@ -129,17 +126,15 @@ def _atlas_fields(spec, augmentation) -> dict:
                 "path)",
             ),
         ),
-        "reference": (
+        "reference": narrowed(
+            AtlasRequest,
+            "reference",
             Annotated[list[Coordinate], Field(min_length=p, max_length=p)] | None,
-            Field(
-                None,
-                description="s = 0 is where eq. (7) from here meets the "
-                "curve (default: the robot's x0)",
-            ),
         ),
-        "shifts": (
+        "shifts": narrowed(
+            AtlasRequest,
+            "shifts",
             Annotated[list[point], Field(min_length=1, max_length=MAX_FAMILY)] | None,
-            Field(None, description="translations of the path (a family of paths)"),
         ),
     }
 

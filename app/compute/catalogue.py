@@ -9,7 +9,7 @@ from ...engine.registry import ALGORITHMS, ROBOTS
 from ...engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
 from ...engine.robot_spec import Robot, robot_from_dict
 from . import schemas as S
-from .settings import settings_from_env
+from .settings import settings
 
 
 @functools.cache
@@ -37,7 +37,7 @@ def robots_response(timeout: float | None = None) -> S.RobotsResponse:
         max_path_points=MAX_PATH_POINTS,
         max_iterations=S.MAX_ITERATIONS,
         max_trajectory_points=S.MAX_TRAJECTORY_POINTS,
-        request_timeout_s=float(timeout if timeout is not None else settings_from_env().timeout),
+        request_timeout_s=float(timeout if timeout is not None else settings().timeout),
     )
     algorithms = [S.AlgorithmInfo(**a.as_dict()) for a in ALGORITHMS.values()]
     return S.RobotsResponse(robots=robots, limits=limits, algorithms=algorithms)

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 import pydantic_core
 
-from ...engine.limits import limit_names, robot_limits, solve_report
+from ...engine.limits import run_report
 from . import schemas as S
 
 
@@ -66,16 +66,15 @@ def solve_document(setup, res) -> dict[str, Any]:
         "message": str(res.message),
         "iterations": int(res.nit),
         "trajectory": trajectory_document(res.trajectory),
-        **limits_document(setup, lambda limits, names: solve_report(limits, res, names)),
+        **limits_document(setup.kinematics, res),
     }
 
 
-def limits_document(setup, report) -> dict[str, Any]:
-    """``{"limits": ...}`` of a run (``report(limits, names)``), empty when the robot has none."""
-    limits = robot_limits(setup.kinematics)
-    if limits is None:
-        return {}
-    return {"limits": report(limits, limit_names(setup.kinematics)).as_dict()}
+def limits_document(kinematics, result) -> dict[str, Any]:
+    """``{"limits": ...}`` of a run (:func:`jik.engine.limits.run_report`), empty when the
+    robot has none."""
+    report = run_report(kinematics, result)
+    return {} if report is None else {"limits": report.as_dict()}
 
 
 def solve_response(setup, res) -> S.SolveResponse:

@@ -8,10 +8,10 @@ the task :func:`kinematics_task`.
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Union
+from typing import Annotated, Any
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, create_model
+from pydantic import BaseModel, ConfigDict, Field, Tag, create_model
 
 from ...engine.arms import ARMS
 from ...engine.registry import ROBOTS
@@ -22,7 +22,7 @@ from .robot_requests import request_robot
 from .schemas.examples import schema_examples
 from .schemas.fields import one_or_many
 from .schemas.robots import _camel
-from .schemas.variants import OBJECT_BODY, _robot_name
+from .schemas.variants import robot_union
 from .worker import task
 
 #: Most configurations one request evaluates.
@@ -81,16 +81,7 @@ def _body() -> Any:
         _exact(n, m, len(ARMS[n].home) if n in ARMS else None)
         for n, m in S.USER_ROBOT_MODELS.items()
     ]
-    return Annotated[
-        Union[tuple(members)],  # noqa: UP007
-        Discriminator(
-            _robot_name,
-            custom_error_type="unknown_robot",
-            custom_error_message=f"give a robot whose name is one of {S.ROBOT_NAMES}",
-            custom_error_context={"names": str(S.ROBOT_NAMES)},
-        ),
-        OBJECT_BODY,
-    ]
+    return robot_union(members)
 
 
 #: ``POST /kinematics``'s body: a :class:`KinematicsRequest` whose x has its robot's p where the

@@ -25,7 +25,8 @@ from .exceptions import (
     ServiceUnavailable,
     WorkerLost,
 )
-from .settings import Settings, settings_from_env
+from .settings import Settings
+from .settings import settings as environment_settings
 from .worker import Worker, frame_header, work_of
 
 #: A computation that overran its time limit while its worker computed less than this share of
@@ -45,7 +46,7 @@ class ComputePool(SolveBatching):
     """
 
     def __init__(self, settings: Settings | None = None) -> None:
-        self.settings = settings or settings_from_env()
+        self.settings = settings or environment_settings()
         self._workers: list[Worker] = []
         self._lock = threading.Lock()
         self._threads = concurrent.futures.ThreadPoolExecutor(

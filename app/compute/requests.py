@@ -1,6 +1,6 @@
 """Requests to engine calls: solve, its batches, and repeatability.
 
-Plain synchronous functions (``solve_request``, ``solve_batch``, ``repeatability_request``) turn
+Plain synchronous functions (``solve_batch``, ``repeatability_request``) turn
 a request model into engine calls and the result into a response model. They raise
 :class:`RequestError` naming the offending field. The robot, map and inverse a request names are
 built by :func:`jik.app.compute.robot_requests.request_robot` (catalogue robots, definitions,
@@ -11,16 +11,16 @@ catalogue arms alike); results become JSON by :mod:`jik.app.compute.documents`.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, TypeVar, cast
 
 import numpy as np
 
 from ...engine.exceptions import JikError, SingularConfigurationError
-from ...engine.limits import repeatability_report, robot_limits
+from ...engine.limits import robot_limits
 from ...engine.registry import RobotSpec
 from ...engine.repeatability import REPEATABLE_DRIFT, repeatability
-from ...engine.solve_rules import gamma_problem
+from ...engine.solve_rules import gamma_problem, refused_starts
 from ...engine.solver import solve_batch as engine_solve_batch
 from . import schemas as S
 from .documents import (
@@ -50,9 +50,8 @@ class _Setup:
     gamma: float
     tolerance: float
     max_iterations: int | None
-    extra: dict = field(default_factory=dict)
     #: The inverse's parameters, defaults filled in (:func:`parameters_of`).
-    parameters: dict = field(default_factory=dict)
+    parameters: dict
 
 
 def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
@@ -69,43 +68,10 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
     gamma = spec.default_gamma if req.gamma is None else float(req.gamma)
     if (why := gamma_problem(gamma, mode)) is not None:
         raise RequestError("gamma", why)
-    robot_used, aug_used = built.robot, built.augmentation
     return _Setup(
-        spec,
-        kin,
-        inverse,
-        robot_used,
-        aug_used,
-        mode,
-        gamma,
-        req.tolerance,
-        req.max_iterations,
-        parameters=parameters_of(inverse),
+        *(spec, kin, inverse, built.robot, built.augmentation, mode, gamma),
+        *(req.tolerance, req.max_iterations, parameters_of(inverse)),
     )
-
-
-def _check_start(setup: _Setup, x0: np.ndarray) -> np.ndarray:
-    """Mask (n,) of singular starts for the chosen inverse; x0 of shape (n, p)."""
-    kin = setup.kinematics
-    _, bad = setup.inverse.apply_masked(x0, np.zeros((len(x0), kin.r)) + 1.0)
-    return np.atleast_1d(bad)
-
-
-def _start_message(setup: _Setup, x0) -> str:
-    """Why the inverse is undefined at the start ``x0`` (p,): the kinematics overflow there
-    (k(x0) or its Jacobian not finite), or the start is singular."""
-    x = np.asarray(x0, dtype=float)
-    with np.errstate(all="ignore"):
-        y = np.asarray(setup.kinematics.forward(x), dtype=float)
-        jacobian = np.asarray(setup.kinematics.jacobian(x), dtype=float)
-    if not (np.all(np.isfinite(y)) and np.all(np.isfinite(jacobian))):
-        shown = ", ".join(f"{v:.6g}" for v in y)
-        return (
-            f"the kinematics overflow at the start: k(x0) = ({shown}), its Jacobian "
-            f"{'finite' if np.all(np.isfinite(jacobian)) else 'not finite'}; choose a start "
-            "where both are finite (below about 1.8e308)"
-        )
-    return f"{setup.inverse.singular_error(x)}; move the start"
 
 
 #: A run's arguments in the engine that are a request's fields, by the request's names.
@@ -181,10 +147,10 @@ def _solve_batch(
     if ok:
         x0 = np.array([reqs[i].x0 for i in ok], dtype=float)
         y_d = np.array([reqs[i].target for i in ok], dtype=float)
-        bad = _check_start(setup, x0)
-        for k in np.flatnonzero(bad):
-            out[ok[k]] = RequestError("x0", _start_message(setup, x0[k]))
-        keep = np.flatnonzero(~bad)
+        refused = refused_starts(setup.inverse, x0)
+        for k, why in refused.items():
+            out[ok[k]] = RequestError("x0", why)
+        keep = np.array([k for k in range(len(ok)) if k not in refused], dtype=int)
         if keep.size:
             try:
                 batch = engine_solve_batch(
@@ -207,14 +173,6 @@ def _solve_batch(
     return cast(list[_R | RequestError], out)  # every slot was filled above
 
 
-def solve_request(req: S.SolveRequest) -> S.SolveResponse:
-    """One run of eq. (7) from ``req.x0`` to ``req.target``; raises :class:`RequestError`."""
-    (res,) = solve_batch([req])
-    if isinstance(res, RequestError):
-        raise res
-    return res
-
-
 def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityResponse:
     """The closed path of ``req`` driven ``req.cycles`` times (Table 1); drift per cycle."""
     setup = _setup(req)
@@ -222,8 +180,8 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
     for i, pt in enumerate(req.path):
         check_task_point(setup.spec, pt, f"path[{i}]")
     x0 = np.array(req.x0, dtype=float)
-    if _check_start(setup, x0[None])[0]:
-        raise RequestError("x0", _start_message(setup, x0))
+    if refused := refused_starts(setup.inverse, x0[None]):
+        raise RequestError("x0", refused[0])
     try:
         res = repeatability(
             setup.inverse,
@@ -244,7 +202,7 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
     return S.RepeatabilityResponse(
         robot=setup.robot,
         algorithm=setup.inverse.name,
-        algorithm_parameters=parameters_of(setup.inverse),
+        algorithm_parameters=setup.parameters,
         augmentation=setup.augmentation,
         mode=setup.mode,
         gamma=setup.gamma,
@@ -257,5 +215,5 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
         repeatable=bool(res.success) and finite and max_drift < REPEATABLE_DRIFT,
         success=bool(res.success),
         message=cast(str, res.message),  # one start configuration: one message
-        **limits_document(setup, lambda limits, names: repeatability_report(limits, res, names)),
+        **limits_document(setup.kinematics, res),
     )

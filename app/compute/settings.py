@@ -87,8 +87,3 @@ class Settings(BaseSettings):
 def settings() -> Settings:
     """The settings of the environment, read once."""
     return Settings()
-
-
-def settings_from_env() -> Settings:
-    """:func:`settings` (the environment's, read once)."""
-    return settings()

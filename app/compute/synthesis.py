@@ -11,6 +11,7 @@ from collections.abc import Collection
 
 import numpy as np
 
+from ...engine.augmentations import Polynomial2
 from ...engine.exceptions import JikError
 from ...engine.functionals import error_functional_e1, error_functional_e2
 from ...engine.registry import RobotSpec
@@ -119,14 +120,6 @@ def _functionals(kin, amap, region, fixed, nodes) -> tuple[dict, list[str]]:
     return out, notes
 
 
-def _coefficients(amap) -> dict[str, float]:
-    coef = getattr(amap, "coefficients", None)
-    if not isinstance(coef, dict):
-        return {}
-    a, b = (f"x{v + 1}" for v in getattr(amap, "variables", (0, 1)))
-    return {f"{a}^{i} {b}^{j}": float(c) for (i, j), c in sorted(coef.items())}
-
-
 def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
     """Evaluate a catalogue map, or synthesize an E2-optimal one, over a box (section 3)."""
     robot = request_robot(req.robot, req.augmentation, with_map=req.method == "evaluate")
@@ -141,7 +134,7 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         )
     names, region, fixed = synthesis_region(spec, req)
     if req.method == "e2_total_degree":
-        return total_degree_response(req, spec, kin, robot_used, (names, region, fixed))
+        return total_degree_response(req, kin, robot_used, (names, region, fixed))
     convergence: list[dict[str, float]] = []
     coefficients: dict[str, float] = {}
     notes: list[str] = []
@@ -158,9 +151,8 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
             {k: float(v) for k, v in row.items() if isinstance(v, int | float)}
             for row in result.convergence
         ]
-        poly = getattr(result, "polynomial", None)
-        if poly is not None:
-            coefficients = _coefficients(poly)
+        if result.polynomial is not None:
+            coefficients = result.polynomial_coefficients()
             notes.append(
                 f"E2 of the synthesized map {result.e2:.6g}; of its cubic fit "
                 f"{result.polynomial_e2:.6g}"
@@ -169,7 +161,7 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         nodes = max(req.nodes, result.nodes)  # (the rule it was minimised on, or a finer one)
     else:
         amap, aug_used = robot.augmenting_map()  # (the request's map, else the robot's default)
-        coefficients = _coefficients(amap)
+        coefficients = amap.monomials() if isinstance(amap, Polynomial2) else {}
         nodes = req.nodes
     functionals, more = _functionals(kin, amap, region, fixed, nodes)
     all_fixed = {n: float(fixed.get(n, 0.0)) for n in names if n not in region}
@@ -181,7 +173,7 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         augmentation=aug_used,
         region={k: [float(lo), float(hi)] for k, (lo, hi) in region.items()},
         fixed=all_fixed,
-        grid=grid(amap, names, region, all_fixed, spec.p, req.grid),
+        grid=grid(amap, names, region, all_fixed, req.grid),
         coefficients=coefficients,
         functionals=functionals,
         convergence=convergence,

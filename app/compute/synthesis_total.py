@@ -9,9 +9,8 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
-
 from ...engine.exceptions import JikError
+from ...engine.map_grid import map_grid
 from ...engine.map_singularities import map_singularities
 from ...engine.robot_synthesis import TOTAL_DEGREE
 from ...engine.synthesis_nd import synthesize_e2_nd
@@ -23,49 +22,12 @@ from .exceptions import RequestError
 _FIELDS = {"degree": "degree", "nodes": "qmc_nodes", "frame_axes": "frame_axes"}
 
 
-def _grid_axes(amap, names, region, base) -> list[str]:
-    """The two region variables along which h varies most (mean |dh/dx_i| on seeded samples)."""
-    if len(region) <= 2:
-        return list(region)
-    rng = np.random.default_rng(0)
-    x = np.broadcast_to(base, (64, len(base))).copy()
-    for k, (lo, hi) in region.items():
-        x[:, names.index(k)] = rng.uniform(lo, hi, 64)
-    with np.errstate(all="ignore"):
-        try:
-            g = np.abs(np.asarray(amap.gradient(x), dtype=float))
-        except JikError:
-            return list(region)[:2]
-    score = {k: float(np.nanmean(g[:, names.index(k)])) for k in region}
-    top = sorted(region, key=lambda k: -(score[k] if np.isfinite(score[k]) else -1.0))[:2]
-    return [k for k in region if k in top]
-
-
-def grid(amap, names, region, fixed, p: int, n: int) -> S.SynthesisGrid | None:
-    if len(region) < 2:
+def grid(amap, names, region, fixed, n: int) -> S.SynthesisGrid | None:
+    """h on the response's grid (:func:`jik.engine.map_grid.map_grid`); None for one variable."""
+    found = map_grid(amap, names, region, fixed, n)
+    if found is None:
         return None
-    base = np.zeros(p)
-    for k, v in fixed.items():
-        base[names.index(k)] = v
-    for k, (lo, hi) in region.items():
-        base[names.index(k)] = 0.5 * (lo + hi)
-    axes = _grid_axes(amap, names, region, base)
-    a, b = (np.linspace(region[k][0], region[k][1], n) for k in axes)
-    x = np.broadcast_to(base, (n, n, p)).copy()
-    x[..., names.index(axes[0])] = a[:, None]
-    x[..., names.index(axes[1])] = b[None, :]
-    with np.errstate(all="ignore"):
-        try:
-            h = np.asarray(amap.value(x), dtype=float)
-        except JikError:  # a map that raises where it is undefined: evaluate point by point
-            h = np.full((n, n), np.nan)
-            for i in range(n):
-                for j in range(n):
-                    try:
-                        h[i, j] = float(amap.value(x[i, j]))
-                    except JikError:
-                        pass
-    return S.SynthesisGrid(axes={axes[0]: a.tolist(), axes[1]: b.tolist()}, h=nullable(h))
+    return S.SynthesisGrid(axes={k: v.tolist() for k, v in found.axes.items()}, h=nullable(found.h))
 
 
 def singularities(
@@ -90,7 +52,7 @@ def singularities(
 
 
 def total_degree_response(
-    req: S.SynthesizeRequest, spec, kin, robot_used: S.RobotUsed, box: tuple[list[str], dict, dict]
+    req: S.SynthesizeRequest, kin, robot_used: S.RobotUsed, box: tuple[list[str], dict, dict]
 ) -> S.SynthesizeResponse:
     """The E2-optimal map(s) of ``req`` on its box (names, region, fixed values): E2 on the
     fitting rule and on an independent one, its convergence with the degree and the nodes,
@@ -147,7 +109,7 @@ def total_degree_response(
         ),
         region={k: [float(lo), float(hi)] for k, (lo, hi) in res.region.items()},
         fixed=all_fixed,
-        grid=grid(res.maps[0], names, res.region, all_fixed, spec.p, req.grid),
+        grid=grid(res.maps[0], names, res.region, all_fixed, req.grid),
         coefficients={},
         functionals={
             "e1": None,

@@ -23,7 +23,7 @@ from typing import Any, cast
 
 from ...engine.exceptions import InvalidInputError, JikError
 from ...engine.robot_spec import Robot, robot_from_dict
-from ...engine.robot_synthesis import ARM_BOX, TENSOR_DEGREE, TOTAL_DEGREE
+from ...engine.robot_synthesis import default_degree
 from . import schemas as S
 from .budget import build_seconds, time_budget
 from .exceptions import RequestError
@@ -94,8 +94,8 @@ def map_used(robot: Robot) -> S.AugmentationUsed | None:
     item = next((a for a in items if a.get("label") == _LABEL), items[0])
     definition = {k: v for k, v in item.items() if k != "label"}
     if definition["name"] == "e2_synthesized" and "degree" not in definition:
-        many = len(definition.get("region") or {}) > 3 or robot.spec.p - robot.spec.r > 1
-        definition["degree"] = TOTAL_DEGREE if many else TENSOR_DEGREE
+        variables, k = len(definition.get("region") or {}), robot.spec.p - robot.spec.r
+        definition["degree"] = default_degree(variables, k)
     values = {k: float(v) for k, v in (definition.get("parameters") or {}).items()}
     return S.AugmentationUsed(name=definition["name"], parameters=values, definition=definition)
 
@@ -120,8 +120,6 @@ def user_inverse(robot: Robot, algorithm: str, algorithm_parameters: dict | None
     """The robot's inverse: the extended inverse (11) of its map, or another algorithm with
     its parameters (the pseudoinverse (8), damped, weighted, posture; ``x0`` the run's start,
     posture's default rest for a robot without home)."""
-    if algorithm == "extended" and not robot.spec.augmentations:
-        raise RequestError("augmentation", _needs_map(robot))
     try:
         if algorithm != "extended":
             return robot.inverse(algorithm, algorithm_parameters=algorithm_parameters, x0=x0)
@@ -131,31 +129,6 @@ def user_inverse(robot: Robot, algorithm: str, algorithm_parameters: dict | None
         if algorithm != "extended":
             raise RequestError(field_of(exc.field), _text(exc)) from None
         raise RequestError(request_field(exc.field, ()), _text(exc)) from None
-
-
-def _needs_map(robot: Robot) -> str:
-    """What a robot without a map gives its extended inverse: p - r maps h (eq. (11)); an arm
-    with a home has one by default only for p = r + 1 (:func:`arm_augmentations`)."""
-    spec = robot.spec
-    k = spec.p - spec.r
-    if k == 1:
-        return (
-            "the extended inverse needs an augmenting map: {'name': 'formula', 'h': ...} or "
-            "{'name': 'e2_synthesized', 'region': {...}}; an arm given with its home has an "
-            "E2-optimal one by default"
-        )
-    formulas = f"{{'name': 'formula', 'h': [...]}} ({k} formulas, one per degree of redundancy)"
-    if "home" in robot.definition:
-        return (
-            f"the extended inverse needs p - r = {k} augmenting maps, and this {spec.name} "
-            f"(p = {spec.p}, r = {spec.r}) has a default map only when p = r + 1: give "
-            f"{{'name': 'e2_synthesized'}} (E2-optimal over all its joints, +-{ARM_BOX:g} "
-            f"around its home) or {formulas}"
-        )
-    return (
-        f"the extended inverse needs p - r = {k} augmenting maps: give {formulas} or "
-        f"{{'name': 'e2_synthesized', 'region': {{...}}}} over at least {k} of the joints"
-    )
 
 
 def user_map(robot: Robot) -> tuple[Any, S.AugmentationUsed]:

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 import viser.transforms as vtf
 
-from ...engine import so3
+from ...engine.pose_task import COORDINATES
 
 #: A joint's colour while its value is outside the robot's limits.
 OUTSIDE_COLOR = (255, 140, 0)
@@ -28,29 +28,21 @@ def wxyz(R) -> tuple[float, float, float, float]:
     return tuple(float(v) for v in q)  # type: ignore[return-value]
 
 
-def task_names(kin: Any) -> tuple[str, ...]:
-    """The names of a robot's task coordinates (``x y z rx ry rz`` or some of them)."""
-    return tuple(getattr(kin, "task_names", ()))
-
-
 def has_pose(kin: Any) -> bool:
     """Whether the task gives a whole frame: position and the three rotation coordinates."""
-    return set(task_names(kin)) == {"x", "y", "z", "rx", "ry", "rz"}
+    return set(getattr(kin, "task_names", ())) == set(COORDINATES)
 
 
 def target_pose(kin: Any, y) -> tuple[tuple[float, ...], tuple[float, ...] | None] | None:
     """(position, wxyz or None) of a task point ``y`` of a URDF arm: its frame when the task is
-    the whole pose, its point when it holds x, y and z; None otherwise."""
-    names = task_names(kin)
-    if not {"x", "y", "z"} <= set(names):
+    the whole pose, its point when it holds x, y and z
+    (:meth:`~jik.engine.pose_task.PoseTask.pose_of`); None otherwise."""
+    if getattr(kin, "pose_task", None) is None:
         return None
-    y = np.asarray(y, dtype=float)
-    position = tuple(float(y[names.index(c)]) for c in ("x", "y", "z"))
-    if not has_pose(kin):
-        return position, None
-    phi = np.array([y[names.index(c)] for c in ("rx", "ry", "rz")])
-    R = np.asarray(kin.reference, dtype=float) @ so3.exp(phi)
-    return position, wxyz(R)
+    t, R = kin.pose_task.pose_of(y)
+    if t is None:
+        return None
+    return tuple(float(v) for v in t), None if R is None else wxyz(R)
 
 
 def target_fixtures(result, kin: Any, root: str, size: float) -> dict[str, tuple[str, dict, dict]]:
@@ -64,7 +56,7 @@ def target_fixtures(result, kin: Any, root: str, size: float) -> dict[str, tuple
         position, q = pose
         if q is None:
             out[f"{root}/targets/{k}"] = (
-                "ball",
+                "icosphere",
                 {"position": position},
                 {"radius": 0.15 * size, "color": (0, 0, 0)},
             )
@@ -85,10 +77,9 @@ def target_fixtures(result, kin: Any, root: str, size: float) -> dict[str, tuple
 def base_link(kin: Any) -> bool:
     """Whether the scene draws a URDF arm's base link: the segment from its base frame's origin to
     its first joint, where that joint lies away from the origin (the Panda's first joint stands
-    0.333 m above it). The first joint's origin depends on no joint variable."""
-    if getattr(kin, "chain", None) is None:
-        return False
-    return bool(np.linalg.norm(np.asarray(kin.points(np.zeros(kin.p)))[0]) > 1e-9)
+    0.333 m above it): its origin's fixed offset from the base frame (no joint moves it)."""
+    chain = getattr(kin, "chain", None)
+    return chain is not None and bool(np.linalg.norm(chain[0].origin[:3, 3]) > 1e-9)
 
 
 def joint_points(kin: Any) -> dict[int, int]:
@@ -102,9 +93,7 @@ def joint_points(kin: Any) -> dict[int, int]:
     return {int(j.index): first + k for k, j in enumerate(chain) if getattr(j, "index", -1) >= 0}
 
 
-def end_frame(kin: Any, x) -> tuple[tuple[float, ...], tuple[float, ...]] | None:
-    """(position, wxyz) of the end link at ``x`` (p,) when the task holds its orientation."""
-    if not has_pose(kin) or not hasattr(kin, "end_pose"):
-        return None
+def end_frame(kin: Any, x) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """(position, wxyz) of a URDF arm's end link at ``x`` (p,)."""
     R, t = kin.end_pose(np.asarray(x, dtype=float))
     return tuple(float(v) for v in t), wxyz(R)

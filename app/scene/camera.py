@@ -23,7 +23,7 @@ import numpy as np
 
 from ..dashboard.robots import state_kinematics
 from .arm_marks import AXES_FRACTION
-from .mechanisms import CHAINS, chain_points, extent_of
+from .mechanisms import CHAINS, chain_points, drawn_points, extent_of
 
 #: Unit vector from the point looked at to the camera: in front of the task plane, tilted.
 VIEW_DIRECTION = np.array([0.0, -0.75, 1.05]) / math.hypot(0.75, 1.05)
@@ -50,10 +50,9 @@ def view_of(result) -> tuple[np.ndarray, float]:
         home = chain_points(kin, np.asarray(state.x0, dtype=float), 0.0)  # (n + 1, 3)
         base = home[0]
         reach = float(np.linalg.norm(np.diff(home, axis=0), axis=1).sum())
-        xs = np.concatenate([r.x for r in result.runs.values()])
-        drawn = chain_points(kin, xs[:: max(1, len(xs) // 200)], 0.0).reshape(-1, 3)
+        drawn = drawn_points(result, kin)
         radius = max(reach, float(np.linalg.norm(drawn - base, axis=1).max()))
-        if home.shape[-1] == 3 and np.ptp(drawn[:, 2]) > 0:  # (an arm standing in space)
+        if np.ptp(drawn[:, 2]) > 0:  # (an arm standing in space)
             # The box of its drawn configurations, not its whole reach around the base.
             # (and the targets' positions, where its pose frames are drawn).
             targets = np.asarray(result.targets, dtype=float)
@@ -100,11 +99,7 @@ class CameraFraming:
         robot."""
         with self._lock:
             self.view = view_of(result)
-        center, radius = self.view
-        initial = self.server.initial_camera
-        position, look_at = camera_pose(center, radius, initial.fov, INITIAL_ASPECT)
-        initial.position, initial.look_at = position, look_at
-        initial.near = min(0.01, float(np.linalg.norm(position - look_at)) / 100)
+        aim(self.server.initial_camera, self.view, INITIAL_ASPECT)
         for client in self.server.get_clients().values():
             self.frame_client(client)
 
@@ -119,9 +114,13 @@ class CameraFraming:
             aspect = settled_aspect(camera.image_width, camera.image_height)
         else:
             aspect = INITIAL_ASPECT
-        position, look_at = camera_pose(*view, camera.fov, aspect)
-        distance = float(np.linalg.norm(position - look_at))
         with client.atomic():
-            camera.position = position
-            camera.look_at = look_at
-            camera.near = min(0.01, distance / 100)  # (a tiny robot is not clipped)
+            aim(camera, view, aspect)
+
+
+def aim(camera: Any, view: tuple[np.ndarray, float], aspect: float) -> None:
+    """Point a viser camera (a client's, or the initial one) at ``view`` (center, radius) for
+    its field of view and ``aspect`` (:func:`camera_pose`)."""
+    position, look_at = camera_pose(*view, camera.fov, aspect)
+    camera.position, camera.look_at = position, look_at
+    camera.near = min(0.01, float(np.linalg.norm(position - look_at)) / 100)  # (a tiny robot)

@@ -10,7 +10,27 @@ from typing import Any
 
 import viser
 
+from ..dashboard.control_changes import path_text
 from ..dashboard.controls import GROUPS, Control, control_values, controls
+
+
+class Syncing:
+    """Whether this thread is setting a GUI's inputs to the values in force (``with syncing:``
+    while it does, ``if syncing:`` in the inputs' callbacks): the callbacks viser calls from
+    within an assignment are then not a user's change. Per thread: a user's change, which
+    viser's thread delivers, is never dropped while another thread syncs."""
+
+    def __init__(self) -> None:
+        self._local = threading.local()
+
+    def __bool__(self) -> bool:
+        return getattr(self._local, "depth", 0) > 0
+
+    def __enter__(self) -> None:
+        self._local.depth = getattr(self._local, "depth", 0) + 1
+
+    def __exit__(self, *_) -> None:
+        self._local.depth -= 1
 
 
 class SceneControls:
@@ -28,21 +48,11 @@ class SceneControls:
         self._send = send
         self.inputs: dict[str, Any] = {}  # control key -> viser input handle
         self.folders: list = []
-        self._options: dict[str, dict[str, str]] = {}  # a select's value -> its label
+        # control key -> its value as its input takes it (a select's label, a vector's tuple)
+        self._shown: dict[str, Callable[[Any], Any]] = {}
         self._shape: list[dict] | None = None  # the specification on screen
-        self._local = threading.local()
+        self.syncing = Syncing()
         self._lock = threading.RLock()
-
-    @property
-    def syncing(self) -> bool:
-        """Whether this thread is setting the inputs to the state's values: the callbacks viser
-        calls from within the assignment are then not a user's change. Per thread: a user's
-        change, which viser's thread delivers, is never dropped while another thread syncs."""
-        return getattr(self._local, "syncing", False)
-
-    @syncing.setter
-    def syncing(self, value: bool) -> None:
-        self._local.syncing = value
 
     def show(self, state) -> None:
         """Show ``state``: the inputs are built anew when its controls differ from those on
@@ -59,58 +69,52 @@ class SceneControls:
     def sync(self, state) -> None:
         """Set every input to the value in force (a user's own change included)."""
         values = control_values(state)
-        self.syncing = True
-        try:
+        with self.syncing:
             for key, handle in self.inputs.items():
-                value = values.get(key)
-                if key in self._options and isinstance(value, str):
-                    value = self._options[key].get(value, value)
-                elif isinstance(value, list):
-                    value = tuple(value)
+                shown = self._shown.get(key)
                 try:
-                    handle.value = value
+                    handle.value = values.get(key) if shown is None else shown(values.get(key))
                 except (ValueError, AssertionError):
                     pass
-        finally:
-            self.syncing = False
 
     def _build(self, spec: list[Control], values: dict[str, Any]) -> None:
         for folder in self.folders:
             folder.remove()
-        self.folders, self.inputs, self._options = [], {}, {}
-        self.syncing = True
-        try:
+        self.folders, self.inputs, self._shown = [], {}, {}
+        with self.syncing:
             for order, (group, title) in enumerate(GROUPS, start=2):
                 with self._gui.add_folder(title, order=order) as folder:
                     self.folders.append(folder)
                     for control in spec:
                         if control.group == group:
                             self._add(control, values.get(control.key))
-        finally:
-            self.syncing = False
 
     def _change(self, patch: dict) -> None:
         if not self.syncing:
             self._send(patch)
 
     def _add(self, control: Control, value: Any) -> None:
-        """One viser input for ``control``."""
+        """One viser input for ``control``: what it shows of a value (``self._shown``) and
+        what it sends of its own (``sent``)."""
         gui, key = self._gui, control.key
         handle: Any
+        sent: Callable[[Any], Any]
         if control.kind == "preset":
             button = gui.add_button(control.label, hint=control.help)
             button.on_click(lambda _: self._change({key: control.value}))
             return
+        if control.kind == "checks":
+            self.inputs[key] = Checks(gui, control, value, lambda v: self._change({key: v}))
+            return
         if control.kind == "select":
-            by_label = {label: v for v, label in control.options}
-            labels = self._options[key] = {v: label for v, label in control.options}
+            sent = {label: v for v, label in control.options}.__getitem__
+            labels = {v: label for v, label in control.options}
+            self._shown[key] = lambda v: labels.get(v, v)
             handle = gui.add_dropdown(
-                control.label, list(by_label), initial_value=labels[value], hint=control.help
+                control.label, list(labels.values()), initial_value=labels[value], hint=control.help
             )
-            handle.on_update(lambda e: self._change({key: by_label[e.target.value]}))
-        elif control.kind == "checks":
-            handle = Checks(gui, control, value, lambda v: self._change({key: v}))
         elif control.kind == "slider":
+            sent = round if control.integer else float  # (viser's slider gives a float)
             handle = gui.add_slider(
                 control.label,
                 min=control.minimum,
@@ -119,24 +123,26 @@ class SceneControls:
                 initial_value=min(max(value, control.minimum), control.maximum),
                 hint=control.help,
             )
-            if control.integer:  # (viser's slider gives a float)
-                handle.on_update(lambda e: self._change({key: round(e.target.value)}))
-            else:
-                handle.on_update(lambda e: self._change({key: e.target.value}))
         elif control.kind == "vector" and control.size in (2, 3):
             add: Any = gui.add_vector2 if control.size == 2 else gui.add_vector3
             lo = None if control.minimum is None else tuple(control.minimum)
             hi = None if control.maximum is None else tuple(control.maximum)
+            sent, self._shown[key] = list, tuple
             handle = add(
                 control.label, tuple(value), min=lo, max=hi, step=control.step, hint=control.help
             )
-            handle.on_update(lambda e: self._change({key: list(e.target.value)}))
         else:  # text (the path), or a vector of another size: as text, parsed by the server
             hint = f"{control.help} ({control.format})" if control.format else control.help
-            shown = value if isinstance(value, str) else ", ".join(f"{v:g}" for v in value)
-            handle = gui.add_text(control.label, shown, hint=hint)
-            handle.on_update(lambda e: self._change({key: e.target.value}))
+            sent, self._shown[key] = str, as_text
+            handle = gui.add_text(control.label, as_text(value), hint=hint)
+        handle.on_update(lambda e: self._change({key: sent(e.target.value)}))
         self.inputs[key] = handle
+
+
+def as_text(value) -> str:
+    """A text input's value: the path's text, or a vector's numbers as the path writes a point
+    (each in the fewest digits that give it back exactly: what is shown is what is in force)."""
+    return value if isinstance(value, str) else path_text([value])
 
 
 class Checks:

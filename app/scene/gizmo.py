@@ -57,16 +57,13 @@ class StartGizmo:
                 scale=1.2 if state.robot == "unicycle" else 0.5,
                 active_axes=(True, True, False),
                 depth_test=False,
-                position=(X, Y, 0.3),
-                wxyz=yaw_quaternion(yaw),
             )
             self._robot = state.robot
             self._scene.add_label("/start/label", "drag: start point", position=(0, 0, 0.15))
             self.handle.on_update(self.on_drag)
-        else:
-            self.handle.visible = True
-            self.handle.position = (X, Y, 0.3)
-            self.handle.wxyz = yaw_quaternion(yaw)
+        self.handle.visible = True
+        self.handle.position = (X, Y, 0.3)
+        self.handle.wxyz = yaw_quaternion(yaw)
 
     def on_drag(self, event) -> None:
         """The gizmo pressed, moved or released: the start point follows.

@@ -15,9 +15,12 @@ import json
 import threading
 from collections.abc import Sequence
 
+from viser import FrameHandle
+
 from ...engine.exceptions import InvalidInputError
 from ..dashboard import COLORS, LABELS, Dashboard, Event, runs_key
 from ..dashboard.algorithms import DEFAULT_ALGORITHMS
+from ..dashboard.controls import PROGRESS_AFTER
 from ..dashboard.help import STYLES
 from .camera import CameraFraming
 from .controls import SceneControls
@@ -35,17 +38,13 @@ class DashboardScene:
     Parameters
     ----------
     dashboard : Dashboard
-    host, port : str, int
-        Where viser listens (a loopback address; the page reaches it through the relay).
     low_end : bool
         Draw for a software renderer: no shadows, no environment map.
     """
 
-    def __init__(
-        self, dashboard: Dashboard, host: str = "127.0.0.1", port: int = 0, low_end: bool = False
-    ) -> None:
+    def __init__(self, dashboard: Dashboard, low_end: bool = False) -> None:
         self.dashboard = dashboard
-        self.server = SceneServer(host=host, port=port)
+        self.server = SceneServer()  # (on a free loopback port: the page reaches it by the relay)
         self.server.scene.set_up_direction("+z")
         if low_end:
             # Without shadows and the environment map a frame costs a software renderer far
@@ -60,10 +59,9 @@ class DashboardScene:
         self.server.gui.main_panel.dock_right()
         self.server.gui.main_panel.set_width(300)
         self._lock = threading.RLock()
-        self.drawn_generation = 0
         self._drawn_runs: tuple[str, ...] | None = None  # runs_key of what the scene shows
         self._framed: str | None = None  # layout_name of the robot the camera frames
-        self._add_legend()
+        self.legend = self.server.gui.add_markdown(order=0, content=legend(DEFAULT_ALGORITHMS))
         self.playback = Playback(self.server.gui, self._lock, dashboard.scene_status)
         self.status, self.progress = self.playback.status, self.playback.progress
         self.controls = SceneControls(self.server.gui, self._send)
@@ -73,10 +71,6 @@ class DashboardScene:
         self.nodes = NodeSets(self.server.scene)
         self._unsubscribe = dashboard.subscribe(self._on_event, last=True)
 
-    @property
-    def port(self) -> int:
-        return self.server.get_port()
-
     def connect(self, subprotocols: Sequence[str] | None):
         """The relay's websocket to this scene (await it; see :class:`SceneServer`)."""
         return self.server.connect(subprotocols)
@@ -85,9 +79,6 @@ class DashboardScene:
         self._unsubscribe()
         self.playback.stop()
         self.server.stop()
-
-    def _add_legend(self) -> None:
-        self.legend = self.server.gui.add_markdown(order=0, content=legend(DEFAULT_ALGORITHMS))
 
     # -- events ---------------------------------------------------------------------------
     def _on_event(self, event: Event) -> None:
@@ -99,19 +90,20 @@ class DashboardScene:
                 # (the runs only: the scene draws no E1, E2, and its status keeps the drawn
                 # result's while the page shows their progress)
                 runs = msg.get("phase") == "runs"
-                if runs and event.generation == self.dashboard.generation and msg["elapsed"] > 0.5:
+                now = event.generation == self.dashboard.generation
+                if runs and now and msg["elapsed"] > PROGRESS_AFTER:
                     self.progress.visible = msg["fraction"] < 1
                     self.progress.value = min(100.0, 100.0 * msg["fraction"])  # type: ignore[misc]  # viser: settable
                     self.status.content = f"computing… {100 * msg['fraction']:.0f}%"
             elif event.kind == "result" and event.result is not None:
                 self._draw(event.result)
             elif event.kind == "refused":
-                self._sync_now()
+                self.controls.sync(self.dashboard.state)
                 self.status.content = f"**refused:** {json.loads(event.data)['message']}"
             elif event.kind == "ahead" and event.result is not None:
                 self._prebuild(event.result)
             elif event.kind == "error":
-                self._sync_now()
+                self.controls.sync(self.dashboard.state)
                 self.progress.visible = False
                 self.status.content = f"**error:** {json.loads(event.data)['message']}"
         except Exception as exc:  # never let a drawing error kill the worker thread
@@ -127,10 +119,6 @@ class DashboardScene:
             return
 
     # -- drawing --------------------------------------------------------------------------
-    def _sync_now(self) -> None:
-        """Show the values in force in the GUI (after a drawing, an error or a refusal)."""
-        self.controls.sync(self.dashboard.state)
-
     def _draw(self, result) -> None:
         state = result.state
         drawn = runs_key(state)
@@ -139,8 +127,7 @@ class DashboardScene:
             # animation runs per leg): nothing in the scene changes but its status, so nothing
             # is sent but the status (a redraw would make every client render anew).
             with self._lock:  # (the timeline on screen plays the same legs)
-                self.drawn_generation = result.generation
-                self._sync_now()
+                self.controls.sync(self.dashboard.state)
                 self.dashboard.scene_status.update(generation=result.generation)
             self._show_status(result)
             return
@@ -151,22 +138,20 @@ class DashboardScene:
             # client shows the start point and the paths that leave it together, never one
             # without the other.
             self.gizmo.place(state)
-            self.nodes.show(result, timeline, extent_of(result))
+            self.nodes.show(result, extent_of(result))
             if self._framed != layout_name(state):  # another robot: frame its reach
                 self._framed = layout_name(state)
                 self.camera.frame(result)
             self.playback.show(timeline, self.nodes.mechanisms)
-            self.drawn_generation = result.generation
-            self._sync_now()
+            self.controls.sync(self.dashboard.state)
+            first = next(iter(self.nodes.mechanisms.values()), None)
             self.dashboard.scene_status.update(
                 generation=result.generation,
                 robot=state.robot,
                 playing=self.playback.playing,
-                mechanism=type(next(iter(self.nodes.mechanisms.values()), None)).__name__,
-                joints=len(getattr(next(iter(self.nodes.mechanisms.values()), None), "joints", ())),
-                pose_frames=sum(
-                    type(h).__name__ == "FrameHandle" for h in self.nodes.fixtures.values()
-                ),
+                mechanism=type(first).__name__,
+                joints=len(getattr(first, "joints", ())),
+                pose_frames=sum(isinstance(h, FrameHandle) for h in self.nodes.fixtures.values()),
             )
         self._show_status(result)
 

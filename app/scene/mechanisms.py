@@ -33,21 +33,17 @@ from .arm_marks import (
     OUTSIDE_COLOR,
     base_link,
     end_frame,
+    has_pose,
     joint_points,
     target_fixtures,
 )
-from .pose import yaw_quaternion
-from .traces import polyline, trace_tolerance
+from .pose import NORMAL_FORM, yaw_quaternion
+from .traces import polyline, rgb, trace_tolerance, unicycle_traces
 
 #: Height of each algorithm's copy above the task plane, and its opacity (None: solid).
 Z = {a: s.z for a, s in STYLES.items()}
 OPACITY = {a: s.opacity for a, s in STYLES.items()}
 HOME_COLOR = (150, 150, 150)
-
-
-def rgb(hex_color: str) -> tuple[int, int, int]:
-    h = hex_color.lstrip("#")
-    return int(h[0:2], 16), int(h[2:4], 16), int(h[4:6], 16)
 
 
 class Mechanism:
@@ -57,15 +53,15 @@ class Mechanism:
         self.scene, self.root, self.color, self.opacity, self.z = scene, root, color, opacity, z
         self.state, self.extent = state, extent
         self.build()
+        self.resize(state, extent)
 
-    def box(self, name, dims, position=(0.0, 0.0, 0.0), wxyz=(1.0, 0.0, 0.0, 0.0), color=None):
+    def box(self, name, dims, position=(0.0, 0.0, 0.0)):
         return self.scene.add_box(
             f"{self.root}/{name}",
-            color=color or self.color,
+            color=self.color,
             dimensions=dims,
             opacity=self.opacity,
             position=position,
-            wxyz=wxyz,
             cast_shadow=False,
         )
 
@@ -80,7 +76,8 @@ class Mechanism:
             subdivisions=2,
         )
 
-    def build(self) -> None: ...
+    def build(self) -> None:
+        """Create the nodes (those sized by the state or the task-plane box: by :meth:`resize`)."""
 
     def resize(self, state, extent) -> None:
         """Follow a new arm length or task-plane box in place (no node is re-created)."""
@@ -93,20 +90,16 @@ class Gantry(Mechanism):
     """Manipulator 2: XY gantry (prismatic x1 vertical, x2 horizontal) with a revolute arm."""
 
     def build(self) -> None:
-        (lo, hi), _ = self.extent
-        self.span = (lo, hi)
-        l = float(self.state.robot_parameters["l"])
-        self.beam = self.box("beam", (hi - lo, 0.07, 0.05))
+        self.beam = self.box("beam", (1.0, 0.07, 0.05))
         self.carriage = self.scene.add_frame(f"{self.root}/carriage", show_axes=False)
         self.box("carriage/body", (0.2, 0.2, 0.09))
         self.ball("carriage/joint", 0.06, (0.0, 0.0, 0.07), color=(40, 40, 40))
-        self.arm = self.box("carriage/arm", (l, 0.06, 0.04), (l / 2, 0.0, 0.07))
-        self.effector = self.ball("carriage/effector", 0.07, (l, 0.0, 0.07))
+        self.arm = self.box("carriage/arm", (1.0, 0.06, 0.04))
+        self.effector = self.ball("carriage/effector", 0.07)
 
     def resize(self, state, extent) -> None:
         super().resize(state, extent)
         (lo, hi), _ = extent
-        self.span = (lo, hi)
         l = float(state.robot_parameters["l"])
         self.beam.dimensions = (hi - lo, 0.07, 0.05)
         self.arm.dimensions = (l, 0.06, 0.04)
@@ -114,7 +107,7 @@ class Gantry(Mechanism):
         self.effector.position = (l, 0.0, 0.07)
 
     def pose(self, x) -> None:
-        lo, hi = self.span
+        (lo, hi), _ = self.extent
         self.beam.position = ((lo + hi) / 2, float(x[0]), self.z)
         self.carriage.position = (float(x[1]), float(x[0]), self.z + 0.05)
         self.carriage.wxyz = yaw_quaternion(float(x[2]))
@@ -124,14 +117,10 @@ class NormalForm(Mechanism):
     """Manipulator 1 (30): slider x2 on the vertical guide, lever of slope x3, runner at x1."""
 
     def build(self) -> None:
-        (xlo, xhi), (lo, hi) = self.extent
-        self.runner = self.box("runner", (0.05, hi - lo, 0.04))
-        self.runner_span = (lo, hi)
+        self.runner = self.box("runner", (0.05, 1.0, 0.04))
         self.slider = self.box("slider", (0.18, 0.14, 0.08))
         self.lever = self.scene.add_frame(f"{self.root}/lever", show_axes=False)
-        # Along the lever from x = xlo to x = xhi of the task-plane box when level: shorter in x
-        # when it tilts, so it stays in the framed view.
-        self.bar = self.box("lever/bar", (xhi - xlo, 0.045, 0.03), ((xlo + xhi) / 2, 0.0, 0.05))
+        self.bar = self.box("lever/bar", (1.0, 0.045, 0.03))
         self.ball("lever/pivot", 0.06, (0.0, 0.0, 0.05), color=(40, 40, 40))
         self.point = self.ball("W", 0.08)
         chosen = tuple(self.state.algorithms)
@@ -144,22 +133,25 @@ class NormalForm(Mechanism):
         super().resize(state, extent)
         (xlo, xhi), (lo, hi) = extent
         self.runner.dimensions = (0.05, hi - lo, 0.04)
-        self.runner_span = (lo, hi)
+        # Along the lever from x = xlo to x = xhi of the task-plane box when level: shorter in x
+        # when it tilts, so it stays in the framed view.
         self.bar.dimensions = (xhi - xlo, 0.045, 0.03)
         self.bar.position = ((xlo + xhi) / 2, 0.0, 0.05)
 
     def pose(self, x) -> None:
         x1, x2, x3 = (float(v) for v in x)
-        lo, hi = self.runner_span
+        _, (lo, hi) = self.extent
         self.runner.position = (x1, (lo + hi) / 2, self.z)
         self.slider.position = (0.0, x2, self.z)
         self.lever.position = (0.0, x2, self.z)
         self.lever.wxyz = yaw_quaternion(math.atan(x3))
-        self.point.position = (x1, x2 + x1 * x3, self.z + 0.08)
+        W = NORMAL_FORM.forward(np.asarray(x, dtype=float))
+        self.point.position = (float(W[0]), float(W[1]), self.z + 0.08)
 
 
 class Platform(Mechanism):
-    """The unicycle: a wheeled platform at pose (q1, q2, q3), nose pointing along the heading."""
+    """The unicycle: a wheeled platform at pose (q1, q2, q3), nose pointing along the heading,
+    at half a manipulator's copy's height."""
 
     def build(self) -> None:
         self.frame = self.scene.add_frame(f"{self.root}/platform", show_axes=False)
@@ -179,7 +171,7 @@ class Platform(Mechanism):
             )
 
     def pose(self, q) -> None:
-        self.frame.position = (float(q[0]), float(q[1]), self.z)
+        self.frame.position = (float(q[0]), float(q[1]), 0.5 * self.z)
         self.frame.wxyz = yaw_quaternion(float(q[2]))
 
 
@@ -208,34 +200,28 @@ class Chain(Mechanism):
         ball = max(reach, 1e-3) / 60
         self.joints = [self.ball(f"joint{i}", ball if i < n - 1 else 1.5 * ball) for i in range(n)]
         # The end link's frame when the task holds its orientation (a pose task).
-        self.end = (
-            None
-            if end_frame(self.kin, self.state.x0) is None
-            else self.scene.add_frame(
-                f"{self.root}/end",
-                axes_length=AXES_FRACTION * reach,
-                axes_radius=0.06 * AXES_FRACTION * reach,
+        self.end = None
+        if has_pose(self.kin):
+            size = AXES_FRACTION * reach
+            self.end = self.scene.add_frame(
+                f"{self.root}/end", axes_length=size, axes_radius=0.06 * size
             )
-        )
-        self._marks()
-
-    def _marks(self) -> None:
-        """The joint limits and which drawn joint is each variable's (coloured when outside)."""
-        self.limits, self.at = state_limits(self.state), joint_points(self.kin)
-        self.marked: set[int] = set()
 
     def resize(self, state, extent) -> None:
+        """Follow a new state: its kinematics, its joint limits and which drawn joint is each
+        variable's (coloured when outside)."""
         super().resize(state, extent)
         self.kin = state_kinematics(state)
-        self._marks()
+        self.limits, self.at = state_limits(state), joint_points(self.kin)
+        self.marked: set[int] = set()
 
     def pose(self, x) -> None:
         pts = chain_points(self.kin, np.asarray(x, dtype=float), self.z + 0.05)
         self.links.points = np.stack([pts[:-1], pts[1:]], axis=1)
         for ball, point in zip(self.joints, pts, strict=False):
             ball.position = tuple(float(v) for v in point)
-        if self.end is not None and (frame := end_frame(self.kin, x)) is not None:
-            self.end.position, self.end.wxyz = frame
+        if self.end is not None:
+            self.end.position, self.end.wxyz = end_frame(self.kin, x)
         outside = {self.at[int(i)] for i in outside_joints(self.limits, x) if int(i) in self.at}
         for k in outside ^ self.marked:  # (only the joints whose colour changes)
             self.joints[k].color = OUTSIDE_COLOR if k in outside else self.color
@@ -255,9 +241,17 @@ def chain_points(kin: Any, x: np.ndarray, z: float) -> np.ndarray:
     return pts
 
 
+def drawn_points(result, kin: Any) -> np.ndarray:
+    """The points (n, 3) of a chain in the configurations of ``result``'s runs (about 200 of
+    them, evenly spaced), at height 0: what the scene's box and camera must hold."""
+    xs = np.concatenate([r.x for r in result.runs.values()])
+    return chain_points(kin, xs[:: max(1, len(xs) // 200)], 0.0).reshape(-1, 3)
+
+
 #: The robots drawn as a serial chain of links (:class:`Chain`): a user's and the catalogue's arms.
 CHAINS = ("planar_chain", "urdf", *ARMS)
-MECHANISMS = {"manipulator1": NormalForm, "manipulator2": Gantry, **dict.fromkeys(CHAINS, Chain)}
+MECHANISMS: dict[str, type[Mechanism]] = dict.fromkeys(CHAINS, Chain)
+MECHANISMS.update(manipulator1=NormalForm, manipulator2=Gantry, unicycle=Platform)
 
 
 def layout_name(state) -> str:
@@ -274,61 +268,49 @@ def layout_name(state) -> str:
 # the dashboard's zoom (frame costs: docs/benchmarks.md, "Dashboard latency").
 
 
-def add_floor_grid(scene, half: float = 10.0, cell: float = 0.5, section: float = 1.0) -> None:
-    """A grid on the task plane (z slightly below 0) drawn as two sets of line segments.
+def add_floor_grid(scene) -> None:
+    """A grid on the task plane (z slightly below 0), 20 x 20 with cells of 0.5 and section
+    lines every 1, drawn as two sets of line segments.
 
     viser's ``add_grid`` shades every pixel of its plane; line segments draw the same grid at
     the cost of its lines only.
     """
-    ticks = np.arange(-half, half + cell / 2, cell)
-    on_section = np.isclose(np.remainder(ticks + half, section), 0.0) | np.isclose(
-        np.remainder(ticks + half, section), section
-    )
-    z = -0.06
+    ticks = 0.5 * np.arange(-20, 21)  # (every other one a section line, from -10 to 10)
     for name, where, color in (
-        ("cells", ticks[~on_section], (200, 200, 200)),
-        ("sections", ticks[on_section], (140, 140, 140)),
+        ("cells", ticks[1::2], (200, 200, 200)),
+        ("sections", ticks[::2], (140, 140, 140)),
     ):
-        n = len(where)
-        lines = np.zeros((2 * n, 2, 3))
-        lines[:n, :, 0] = where[:, None]  # along y
-        lines[:n, 0, 1], lines[:n, 1, 1] = -half, half
-        lines[n:, :, 1] = where[:, None]  # along x
-        lines[n:, 0, 0], lines[n:, 1, 0] = -half, half
-        lines[..., 2] = z
-        scene.add_line_segments(
+        at, span = np.broadcast_arrays(where[:, None], [-10.0, 10.0])  # (n, 2)
+        z = np.full(at.shape, -0.06)
+        lines = np.concatenate([np.stack([at, span, z], -1), np.stack([span, at, z], -1)])
+        scene.add_line_segments(  # (along y at x = where, then along x at y = where)
             f"/grid/{name}", lines, color, thickness=1.0, thickness_units="screen"
         )
 
 
 def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
-    """The parts of a manipulator's scene besides the mechanisms, by node name: (kind, the
-    values that follow the result, the fixed style). The rails (Manipulator 2) or the guide
-    (Manipulator 1) span the task-plane box; the task paths of both algorithms, and for
-    Manipulator 2 the carriage paths (x2, x1), which are the joint paths: closed for J^E#,
-    not for J^P#; the targets of the path's legs."""
+    """The parts of a robot's scene besides the mechanisms, by node name: (kind, the values
+    that follow the result, the fixed style), made by viser's ``add_<kind>``. The rails
+    (Manipulator 2) or the guide (Manipulator 1) span the task-plane box; the task paths of both
+    algorithms, and for Manipulator 2 the carriage paths (x2, x1), which are the joint paths:
+    closed for J^E#, not for J^P#; the targets of the path's legs. The unicycle's: its paths
+    (:func:`~jik.app.scene.traces.unicycle_traces`)."""
     (xlo, xhi), (ylo, yhi) = extent
     tol = trace_tolerance(extent)
+    if result.state.robot == "unicycle":
+        return unicycle_traces(result, root, tol)
     # Heights and balls at the manipulators' scale, smaller in a smaller scene (a formula
     # robot's paths may span a few millimetres).
     scale = min(1.0, max(xhi - xlo, yhi - ylo) / 2.0)
     robot = result.state.robot
-    grey: dict = {"color": (90, 90, 90)}
     out: dict[str, tuple[str, dict, dict]] = {}
-    rail = (0.06, yhi - ylo, 0.05)
-    if robot == "manipulator2":
-        for side, x in (("left", xlo), ("right", xhi)):
-            out[f"{root}/rails/{side}"] = (
-                "box",
-                {"dimensions": rail, "position": (x, (ylo + yhi) / 2, -0.02)},
-                grey,
-            )
-    elif robot == "manipulator1":
-        out[f"{root}/guide"] = (
-            "box",
-            {"dimensions": rail, "position": (0.0, (ylo + yhi) / 2, -0.02)},
-            grey,
-        )
+    rails = {
+        "manipulator2": {"rails/left": xlo, "rails/right": xhi},
+        "manipulator1": {"guide": 0.0},
+    }
+    for name, x in rails.get(robot, {}).items():  # (grey boxes along y, at x)
+        rail = {"dimensions": (0.06, yhi - ylo, 0.05), "position": (x, (ylo + yhi) / 2, -0.02)}
+        out[f"{root}/{name}"] = ("box", rail, {"color": (90, 90, 90)})
     chain = robot in CHAINS
     kin = state_kinematics(result.state) if chain else None
     for a, run in result.runs.items():
@@ -339,14 +321,14 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
             z = np.full(len(run.y), (Z[a] + 0.16) * scale)
             task = np.column_stack([run.y[:, 0], run.y[:, 1], z])
         out[f"{root}/trace/{a}/task"] = (
-            "line",
+            "line_segments",
             {"points": polyline(task, tol)},
             {**line, "thickness": 3.0 if a == "pseudoinverse" else 2.0},
         )
         if robot == "manipulator2":
             joints = np.column_stack([run.x[:, 1], run.x[:, 0], np.full(len(run.x), Z[a] + 0.1)])
             out[f"{root}/trace/{a}/joints"] = (
-                "line",
+                "line_segments",
                 {"points": polyline(joints, tol)},
                 {**line, "thickness": 1.2},
             )
@@ -355,7 +337,7 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
         return {**out, **target_fixtures(result, kin, root, AXES_FRACTION * reach / 2)}
     for k, target in enumerate(result.targets):
         out[f"{root}/targets/{k}"] = (
-            "ball",
+            "icosphere",
             {"position": (float(target[0]), float(target[1]), 0.2 * scale)},
             {"radius": 0.05 * scale, "color": (0, 0, 0)},
         )
@@ -364,26 +346,22 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
 
 def extent_of(result) -> tuple[tuple[float, float], tuple[float, float]]:
     """Box of the task plane used by the mechanisms (rails, runner), covering both runs."""
-    if any(r.platform is not None for r in result.runs.values()):
-        ys = np.concatenate([r.platform.reshape(-1, 3) for r in result.runs.values()])
-        ys = np.vstack([ys, [result.state.target]])
+    runs, robot = result.runs.values(), result.state.robot
+    if any(r.platform is not None for r in runs):
+        ys = np.vstack([*(r.platform.reshape(-1, 3) for r in runs), [result.state.target]])
         lo, hi = ys.min(axis=0)[:2] - 1.0, ys.max(axis=0)[:2] + 1.0
-        return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
-    xs = np.concatenate([r.x for r in result.runs.values()])
-    if result.state.robot in CHAINS:  # (the whole arm, not only its end)
-        step = max(1, len(xs) // 200)
-        pts = chain_points(state_kinematics(result.state), xs[::step], 0.0).reshape(-1, 3)
+    elif robot in CHAINS:  # (the whole arm, not only its end)
+        pts = drawn_points(result, state_kinematics(result.state))
         lo, hi = pts.min(axis=0)[:2] - 0.3, pts.max(axis=0)[:2] + 0.3
-        return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
-    ys = np.concatenate([r.y for r in result.runs.values()])
-    if result.state.robot not in MECHANISMS:  # (a formula robot: its paths, of any size)
-        ys = np.vstack([ys[:, :2], np.asarray(result.targets)[:, :2]])
-        lo, hi = ys.min(axis=0), ys.max(axis=0)
-        pad = max(0.15 * float(np.max(hi - lo)), 1e-3)
-        return (float(lo[0] - pad), float(hi[0] + pad)), (float(lo[1] - pad), float(hi[1] + pad))
-    lo = np.minimum(ys.min(axis=0)[:2], 0.0) - 0.6
-    hi = np.maximum(ys.max(axis=0)[:2], 1.0) + 0.6
-    if result.state.robot == "manipulator2":
-        lo[0] = min(lo[0], xs[:, 1].min() - 0.4)
-        hi[0] = max(hi[0], xs[:, 1].max() + 0.4)
+    elif robot not in MECHANISMS:  # (a formula robot: its paths, of any size)
+        ys = np.vstack([*(r.y[:, :2] for r in runs), np.asarray(result.targets)[:, :2]])
+        pad = max(0.15 * float(np.max(np.ptp(ys, axis=0))), 1e-3)
+        lo, hi = ys.min(axis=0) - pad, ys.max(axis=0) + pad
+    else:
+        ys = np.concatenate([r.y for r in runs])
+        lo = np.minimum(ys.min(axis=0)[:2], 0.0) - 0.6
+        hi = np.maximum(ys.max(axis=0)[:2], 1.0) + 0.6
+        if robot == "manipulator2":  # (and the carriage's x2)
+            x2 = np.concatenate([r.x[:, 1] for r in runs])
+            lo[0], hi[0] = min(lo[0], x2.min() - 0.4), max(hi[0], x2.max() + 0.4)
     return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))

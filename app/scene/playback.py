@@ -9,6 +9,7 @@ from collections.abc import Mapping
 
 import viser
 
+from .controls import Syncing
 from .mechanisms import Mechanism
 from .pose import Timeline
 
@@ -32,7 +33,7 @@ class Playback:
 
     def __init__(self, gui: viser.GuiApi, lock: threading.RLock, status: dict) -> None:
         self._lock, self._scene_status = lock, status
-        self._local = threading.local()  # see _syncing
+        self._syncing = Syncing()  # (moving the position slider: not a user's scrub)
         with gui.add_folder("Playback", order=1):
             self.play = gui.add_button("Pause", icon=None)
             self.speed = gui.add_slider("speed", min=0.1, max=5.0, step=0.1, initial_value=1.0)
@@ -50,16 +51,6 @@ class Playback:
         self.scrub.on_update(self._scrubbed)
         self._thread = threading.Thread(target=self._animate, name="jik-scene", daemon=True)
         self._thread.start()
-
-    @property
-    def _syncing(self) -> bool:
-        """Whether this thread is moving the position slider (its callback is then not a user's
-        scrub). Per thread: a user's scrub, which viser's thread delivers, is never dropped."""
-        return getattr(self._local, "syncing", False)
-
-    @_syncing.setter
-    def _syncing(self, value: bool) -> None:
-        self._local.syncing = value
 
     @property
     def position(self) -> float:
@@ -101,14 +92,11 @@ class Playback:
 
     def _show_position(self, timeline: Timeline) -> None:
         """The position slider at the playback position (not a change of it by the user)."""
-        self._syncing = True
-        try:
+        with self._syncing:
             self.scrub.value = round(min(self._s / timeline.length, 1.0), 3)  # type: ignore[misc]  # viser: settable
             counter = timeline.counter(self._s)
             if self.counter.content != counter:
                 self.counter.content = counter
-        finally:
-            self._syncing = False
 
     def _animate(self) -> None:
         last, last_gui = time.monotonic(), 0.0

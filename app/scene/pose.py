@@ -7,6 +7,10 @@ import math
 
 import numpy as np
 
+from ...engine.kinematics import Manipulator1
+
+#: Manipulator 1's kinematics k(x) = (x1, x2 + x1 x3), eq. (30): where its task point W is.
+NORMAL_FORM = Manipulator1()
 #: Unicycle iterations shown in the animation (geometrically spaced, the last always).
 UNICYCLE_SHOWN = 10
 
@@ -31,7 +35,8 @@ def gizmo_pose(robot: str, x0, robot_parameters: dict) -> tuple[tuple[float, flo
     if robot == "manipulator2":
         return (x0[1], x0[0]), x0[2]
     if robot == "manipulator1":
-        return (x0[0], x0[1] + x0[0] * x0[2]), math.atan(x0[2])
+        X, Y = (float(v) for v in NORMAL_FORM.forward(np.asarray(x0, dtype=float)))
+        return (X, Y), math.atan(x0[2])
     q0 = robot_parameters["q0"]
     return (q0[0], q0[1]), q0[2]
 
@@ -66,6 +71,14 @@ def start_from_gizmo(robot: str, xy, yaw: float, state) -> dict:
     return {"robot_parameters": {"q0": _snapped([X, Y, q3], q0)}}
 
 
+def shown_iterations(result) -> np.ndarray:
+    """The unicycle's iterations that the animation and the traces show: :data:`UNICYCLE_SHOWN`
+    geometrically spaced ones, the first and the last always."""
+    m = max(len(r.platform) for r in result.runs.values())
+    shown = np.unique(np.geomspace(1, m, num=UNICYCLE_SHOWN).astype(int) - 1)
+    return np.union1d(shown, [0, m - 1]).astype(int)
+
+
 class Timeline:
     """Configurations of both algorithms as functions of one playback position s in [0, length]."""
 
@@ -73,14 +86,12 @@ class Timeline:
         self.result = result
         self.unicycle = any(r.platform is not None for r in result.runs.values())
         if self.unicycle:
-            m = max(len(r.platform) for r in result.runs.values())
-            shown = np.unique(np.geomspace(1, m, num=UNICYCLE_SHOWN).astype(int) - 1)
-            self.shown = np.union1d(shown, [0, m - 1]).astype(int)
+            self.shown = shown_iterations(result)
             self.length = float(len(self.shown))
         else:
-            self.theta_end = max(float(r.theta[-1]) for r in result.runs.values())
+            theta_end = max(float(r.theta[-1]) for r in result.runs.values())
             legs = int(max(r.leg.max() for r in result.runs.values())) + 1
-            self.leg_theta = self.theta_end / legs
+            self.leg_theta = theta_end / legs
             self.length = float(legs)
 
     def at(self, s: float) -> dict[str, np.ndarray]:
@@ -103,16 +114,11 @@ class Timeline:
             )
         return out
 
-    def iteration(self, s: float) -> int | None:
-        if not self.unicycle:
-            return None
-        return int(self.shown[min(int(s), len(self.shown) - 1)])
-
     def counter(self, s: float) -> str:
         """What the animation shows at ``s``: the unicycle's iteration (of the discrete
         algorithm), or the leg of the closed path (its cycle)."""
-        k = self.iteration(s)
-        if k is not None:
+        if self.unicycle:
+            k = int(self.shown[min(int(s), len(self.shown) - 1)])
             last = max(len(r.platform) for r in self.result.runs.values()) - 1
             return f"**iteration {k}** of {last}"
         legs = max(round(self.length), 1)

@@ -115,9 +115,9 @@ class UnguardedSceneServer(RuntimeError):
 class SceneServer(viser.ViserServer):
     """A viser server on a loopback port that only the relay reaches (see the module's text)."""
 
-    def __init__(self, host: str = "127.0.0.1", port: int = 0, label: str = "jik scene") -> None:
+    def __init__(self) -> None:
         _install_guard()
-        super().__init__(host=host, port=port, label=label, verbose=False)
+        super().__init__(host="127.0.0.1", port=0, label="jik scene", verbose=False)
         try:
             self._probe()
         except BaseException:
@@ -126,10 +126,7 @@ class SceneServer(viser.ViserServer):
 
     def _probe(self) -> None:
         """Fail closed: a request without the key must be refused."""
-        host = self.get_host()
-        probe = http.client.HTTPConnection(
-            "127.0.0.1" if host in ("0.0.0.0", "") else host, self.get_port(), timeout=10
-        )
+        probe = http.client.HTTPConnection("127.0.0.1", self.get_port(), timeout=10)
         try:
             probe.request("GET", "/")
             status = probe.getresponse().status

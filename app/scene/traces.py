@@ -1,12 +1,22 @@
-"""The scene's traces: polylines of the computed paths, simplified to what a pixel shows."""
+"""The scene's traces: polylines of the computed paths, simplified to what a pixel shows, in
+their algorithm's colour."""
 
 from __future__ import annotations
 
 import numpy as np
 
+from ..dashboard.algorithms import COLORS, STYLES
+from .pose import shown_iterations
+
 #: Largest distance of a drawn trace from the computed path, as a fraction of the scene's size
 #: (about a third of a pixel at the dashboard's size).
 TRACE_TOLERANCE = 1e-3
+
+
+def rgb(hex_color: str) -> tuple[int, int, int]:
+    """The (r, g, b) of a colour ``#rrggbb``, as viser takes it."""
+    h = hex_color.lstrip("#")
+    return int(h[0:2], 16), int(h[2:4], 16), int(h[4:6], 16)
 
 
 def simplify(points: np.ndarray, tol: float) -> np.ndarray:
@@ -39,7 +49,8 @@ def simplify(points: np.ndarray, tol: float) -> np.ndarray:
 
 
 def trace_tolerance(extent) -> float:
-    """:data:`TRACE_TOLERANCE` of the task-plane box ``extent`` (see :func:`_extent`)."""
+    """:data:`TRACE_TOLERANCE` of the task-plane box ``extent``
+    (:func:`~jik.app.scene.mechanisms.extent_of`)."""
     (xlo, xhi), (ylo, yhi) = extent
     return TRACE_TOLERANCE * max(xhi - xlo, yhi - ylo)
 
@@ -48,3 +59,25 @@ def polyline(points: np.ndarray, tol: float = 0.0) -> np.ndarray:
     """(n, 3) points -> segments (m - 1, 2, 3) of the polyline simplified to within ``tol``."""
     points = simplify(points, tol) if tol > 0 and len(points) > 2 else points
     return np.stack([points[:-1], points[1:]], axis=1)
+
+
+def unicycle_traces(result, root: str, tol: float) -> dict[str, tuple[str, dict, dict]]:
+    """The unicycle's paths at its shown iterations (:func:`~jik.app.scene.pose.shown_iterations`)
+    as fixtures (:func:`~jik.app.scene.mechanisms.fixtures_of`): each algorithm's the paler the
+    earlier, the last in its colour and thicker."""
+    shown = shown_iterations(result)
+    out: dict[str, tuple[str, dict, dict]] = {}
+    for a, run in result.runs.items():
+        base = np.asarray(rgb(COLORS[a]), dtype=float)
+        for n, i in enumerate(shown):
+            P = run.platform[min(int(i), len(run.platform) - 1)]
+            last = n == len(shown) - 1
+            mix = 1.0 if last else 0.3 + 0.5 * n / len(shown)
+            pts = np.column_stack([P[:, 0], P[:, 1], np.full(len(P), 0.02 + STYLES[a].z * 0.2)])
+            values = {
+                "points": polyline(pts, tol),
+                "colors": (255 - mix * (255 - base)).astype(np.uint8),
+                "thickness": 3.5 if last else 1.5,
+            }
+            out[f"{root}/trace/{a}/{n}"] = ("line_segments", values, {"thickness_units": "screen"})
+    return out

@@ -61,7 +61,7 @@ from ...app.compute import schemas as S
 from ...app.compute.atlas_plan import AtlasLimits, plan_request
 from ...app.compute.atlas_schemas import AtlasRequest
 from ...app.compute.exceptions import RequestError
-from ...app.compute.requests import _check_start, _setup
+from ...app.compute.requests import _setup
 from ...app.compute.robot_requests import check_configuration, check_task_point, request_robot
 from ...app.compute.schemas.synthesis import QMC_NODES
 from ...app.compute.synthesis import synthesis_region
@@ -70,6 +70,7 @@ from ...app.dashboard.patch import StatePatch, patch_of
 from ...engine.exceptions import InvalidInputError, JikError
 from ...engine.registry import ROBOTS
 from ...engine.robot_synthesis import TOTAL_DEGREE
+from ...engine.solve_rules import refused_starts
 from ...engine.synthesis_nd import MAX_UNKNOWNS
 from ...engine.total_degree import basis_size
 
@@ -222,7 +223,7 @@ def _run_ok(body: dict, path: str) -> bool:
             check_task_point(setup.spec, point, f"path[{i}]")
         # (the server's own test of a singular start, which a nearly singular J J^T fails)
         setup.inverse.matrix(np.asarray(run.x0, dtype=float))
-        if _check_start(setup, np.asarray([run.x0], dtype=float))[0]:
+        if refused_starts(setup.inverse, np.asarray([run.x0], dtype=float)):
             return False
     except (RequestError, JikError, ValidationError):
         return False

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 from pathlib import Path
@@ -329,36 +328,6 @@ def test_an_atlas_in_the_compute_pool_is_the_engines_atlas():
     here = run_atlas(plan)
     np.testing.assert_allclose(pooled.drift, here.drift, rtol=0, atol=1e-12)
     np.testing.assert_allclose(pooled.leg_ends, here.leg_ends, rtol=0, atol=1e-12)
-
-
-@pytest.mark.parametrize(
-    ("seconds_per_run", "chunk", "probed"),
-    [(0.2, 5, 1 + 5), (0.001, 1000, 1 + 8), (1e-5, 2048, 1 + 8), (4.0, 1, 1)],
-)
-def test_a_servers_atlas_is_cut_into_chunks_of_about_a_second(
-    monkeypatch, seconds_per_run, chunk, probed
-):
-    """The chunk holds about a second of runs, timed on the plan's first runs (a unicycle run
-    costs about 0.2 s, a Manipulator 2 run about a millisecond), at most the plan's own chunk
-    (by default a sixteenth of the atlas, at most 2048): the compute workers serve requests
-    between chunks, far within their time limit. The probe runs about a second too: a run of
-    4 s (a Gen3 far out of reach) is a chunk alone, with no more runs probed.
-    (The runs' cost is simulated by a clock that each run advances.)"""
-    from jik.app.compute import atlas_pool
-
-    now, runs = [0.0], []
-
-    def run_chunk(task):
-        now[0] += seconds_per_run * (task.hi - task.lo)
-        runs.append(task.hi - task.lo)
-
-    monkeypatch.setattr(atlas_pool, "run_chunk", run_chunk)
-    monkeypatch.setattr(atlas_pool, "perf_counter", lambda: now[0])
-    plan = plan_request(AtlasRequest.model_validate(body(starts=3000)), AtlasLimits())
-    assert plan.chunk == 188  # (the default: 16 chunks, so that progress moves)
-    assert atlas_pool.sized_chunks(plan).chunk == min(chunk, 188)
-    assert sum(runs) == probed
-    assert atlas_pool.sized_chunks(dataclasses.replace(plan, chunk=2048)).chunk == chunk
 
 
 def test_a_posture_atlas_pulls_each_run_toward_its_own_start(client):

@@ -66,15 +66,11 @@ def test_animation_timeline_ends_at_the_last_configuration():
 
 def test_viser_gui_and_drag_change_the_one_state():
     """The scene's GUI and its start-point gizmo write to the same Dashboard as the page."""
-    import socket
     import time
     from types import SimpleNamespace
 
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
     dashboard = Dashboard(updated_state(default_state("manipulator2"), {"task": "target"}))
-    scene = DashboardScene(dashboard, port=port)
+    scene = DashboardScene(dashboard)
     try:
         assert dashboard.wait(1, timeout=60)
         deadline = time.monotonic() + 30
@@ -127,10 +123,9 @@ def test_viser_gui_and_drag_change_the_one_state():
         syncing, release = threading.Event(), threading.Event()
 
         def sync_elsewhere() -> None:
-            scene.controls.syncing = True
-            syncing.set()
-            release.wait(10)
-            scene.controls.syncing = False
+            with scene.controls.syncing:
+                syncing.set()
+                release.wait(10)
 
         other = threading.Thread(target=sync_elsewhere)
         other.start()
@@ -158,15 +153,10 @@ def test_scene_follows_a_new_result_in_place():
     """A change that keeps the robot and the task moves the scene's nodes instead of
     re-creating them (a target the closed path gains or loses is added or removed); the
     start-point gizmo moves with the drawing."""
-    import socket
-
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
     # (k(x0) off the path's points for both: the closed path has the same number of legs)
     first = updated_state(default_state("manipulator2"), {"x0": [0.4, 0.0, 1.5]})
     dashboard = Dashboard(first)
-    scene = DashboardScene(dashboard, port=port)
+    scene = DashboardScene(dashboard)
     M2 = "/robot/manipulator2-path"
     try:
         assert dashboard.wait(1, timeout=60)
@@ -283,15 +273,11 @@ def test_the_scene_shows_the_runs_progress_not_the_second_phases():
     """The scene's status keeps the drawn result's line while E1, E2 (which it does not draw)
     are computed; a new state's runs show their progress there."""
     import json
-    import socket
 
     from jik.app.dashboard.messages import Event
 
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
     dashboard = Dashboard(updated_state(default_state("manipulator2"), {"cycles": 1}))
-    scene = DashboardScene(dashboard, port=port)
+    scene = DashboardScene(dashboard)
     try:
         assert dashboard.wait(1, timeout=60)
         scene._show_status(dashboard.result)
@@ -337,8 +323,8 @@ ARM = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]}
 def _drawn(scene: DashboardScene, generation: int, timeout: float = 60) -> None:
     """Wait until the scene has drawn ``generation`` and shows its status."""
     deadline = time.monotonic() + timeout
-    while scene.drawn_generation < generation or not scene.status.content.startswith(
-        f"generation {scene.drawn_generation}:"
+    while (drawn := scene.dashboard.scene_status.get("generation", 0)) < generation or not (
+        scene.status.content.startswith(f"generation {drawn}:")
     ):
         assert time.monotonic() < deadline, "the scene did not draw"
         time.sleep(0.05)
@@ -440,7 +426,7 @@ def test_targets_at_one_position_share_one_label():
         "/r/targets/1": frame((0.3, 0.1, 0.5)),
         "/r/targets/2": frame((0.3, 0.1, 0.5 + 1e-12)),
         "/r/targets/3": frame((0.3, 0.0, 0.5)),
-        "/r/path": ("line", {"points": None}, {}),
+        "/r/path": ("line_segments", {"points": None}, {}),
     }
     assert target_labels(wanted, ["B", "C", "D", "A"], "/r/targets/") == {
         "/r/targets/0/label": "B, A",
@@ -467,3 +453,59 @@ def test_manipulator1_names_its_task_point_on_one_chosen_copy(chosen, labelled):
         NormalForm(scene, f"/robot/m1/{a}", (0, 0, 0), None, 0.0, state, ((-1, 1), (-1, 1)))
     labels = [c.args[:2] for c in scene.add_label.call_args_list]
     assert labels == [(f"/robot/m1/{labelled}/W/label", "W (task point)")]
+
+
+def test_the_unicycles_nodes_are_kept_and_moved():
+    """The unicycle's set is kept like a manipulator's: a new result moves its platforms and its
+    traces (one per algorithm and shown iteration, the last thicker) instead of drawing them
+    anew; the grey platform stands at the start q0, the black one at the target."""
+    from jik.app.scene.nodes import set_key
+    from jik.app.scene.pose import shown_iterations
+
+    state = default_state("unicycle")
+    dashboard = Dashboard(default_state("manipulator2"))
+    scene = DashboardScene(dashboard)
+    try:
+        assert dashboard.wait(1, timeout=60)
+        first = compute(state, 101)
+        scene._draw(first)
+        fixtures, mechanisms = dict(scene.nodes.fixtures), dict(scene.nodes.mechanisms)
+        n = len(shown_iterations(first))
+        root = f"/robot/unicycle-{state.task}"
+        assert fixtures.keys() == {f"{root}/trace/{a}/{k}" for a in first.runs for k in range(n)}
+        assert [fixtures[f"{root}/trace/extended/{k}"].thickness for k in (0, n - 1)] == [1.5, 3.5]
+        second = updated_state(state, {"robot_parameters": {"q0": [0.2, -0.1, 0.3]}})
+        scene._draw(compute(second, 102))
+        assert all(
+            scene.nodes.fixtures[k] is v for k, v in fixtures.items() if k in scene.nodes.fixtures
+        )
+        assert all(scene.nodes.mechanisms[k] is v for k, v in mechanisms.items())
+        still = scene.nodes.sets[set_key(second)]["still"]
+        np.testing.assert_allclose(still["home"].frame.position, (0.2, -0.1, 0.0))
+        np.testing.assert_allclose(still["target"].frame.position[:2], second.target[:2])
+    finally:
+        scene.stop()
+        dashboard.stop()
+
+
+def test_a_vector_shown_as_text_stays_text_in_force():
+    """A vector of more than three numbers (a pose task's target) is a text input: it shows the
+    numbers in force, exactly, after every change (not a Python tuple), and its text sent back
+    is no change."""
+    from jik.app.dashboard.control_changes import path_text
+
+    dashboard = Dashboard(updated_state(default_state("panda"), {"task": "target"}))
+    scene = DashboardScene(dashboard)
+    try:
+        text = scene.controls.inputs["target"]
+        assert text.value == path_text([dashboard.state.target])
+        target = list(dashboard.state.target)
+        target[0] += 0.05
+        dashboard.update({"target": target})
+        assert text.value == path_text([target])
+        before = dashboard.state
+        text.value = text.value  # (a user's Enter in it, delivered as viser's thread does)
+        assert dashboard.state == before
+    finally:
+        scene.stop()
+        dashboard.stop()

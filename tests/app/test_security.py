@@ -138,7 +138,7 @@ def test_a_scene_server_takes_only_the_relay(tmp_path):
         client = TestClient(app)
         created = client.post("/api/sessions", json={"state": {}}).json()
         session = app.state.sessions.get(created["id"])
-        raw = f"ws://127.0.0.1:{session.scene.port}"
+        raw = f"ws://127.0.0.1:{session.scene.server.get_port()}"
         viser_protocol = [websockets.typing.Subprotocol(f"viser-v{viser.__version__}")]
         gamma = {"type": "GuiUpdateMessage", "uuid": "x", "updates": {"value": 1.9}}
 
@@ -153,10 +153,12 @@ def test_a_scene_server_takes_only_the_relay(tmp_path):
                 return refused.response.status_code
 
         assert asyncio.run(attack(Origin=FOREIGN, Host="attacker.example")) == 403
-        assert asyncio.run(attack(Origin=f"http://127.0.0.1:{session.scene.port}")) == 403
+        assert (
+            asyncio.run(attack(Origin=f"http://127.0.0.1:{session.scene.server.get_port()}")) == 403
+        )
         assert asyncio.run(attack()) == 403  # (a local program without the relay's key)
         assert asyncio.run(attack(Authorization="Bearer guessed")) == 403
-        page = httpx.get(f"http://127.0.0.1:{session.scene.port}/", timeout=10)
+        page = httpx.get(f"http://127.0.0.1:{session.scene.server.get_port()}/", timeout=10)
         assert page.status_code == 403
         assert session.dashboard.state.gamma == created["state"]["gamma"]
         # The relay: viser's first messages, its theme without the share button among them.

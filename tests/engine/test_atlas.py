@@ -1,5 +1,6 @@
 """The repeatability atlas: engine.atlas, atlas_run, atlas_backends and self_motion."""
 
+import dataclasses
 import math
 import re
 import subprocess
@@ -351,3 +352,31 @@ def test_a_posture_atlas_without_rest_pulls_each_panda_run_toward_its_start():
         np.testing.assert_allclose(
             np.asarray(res.drift)[0, 0, i], np.asarray(one.drift), rtol=1e-8, atol=1e-12
         )
+
+
+@pytest.mark.parametrize(
+    ("seconds_per_run", "chunk", "probed"),
+    [(0.2, 5, 1 + 5), (0.001, 1000, 1 + 8), (1e-5, 2048, 1 + 8), (4.0, 1, 1)],
+)
+def test_sized_chunks_hold_about_a_second_of_runs(monkeypatch, seconds_per_run, chunk, probed):
+    """The chunk holds about a second of runs, timed on the plan's first runs (a unicycle run
+    costs about 0.2 s, a Manipulator 2 run about a millisecond), at most the plan's own chunk
+    (by default a sixteenth of the atlas, at most 2048): a server's compute workers serve
+    requests between chunks, far within their time limit. The probe runs about a second too: a
+    run of 4 s (a Gen3 far out of reach) is a chunk alone, with no more runs probed.
+    (The runs' cost is simulated by a clock that each run advances.)"""
+    now, runs = [0.0], []
+
+    def run_chunk(task):
+        now[0] += seconds_per_run * (task.hi - task.lo)
+        runs.append(task.hi - task.lo)
+
+    monkeypatch.setattr(atlas_run, "run_chunk", run_chunk)
+    monkeypatch.setattr(atlas_run, "perf_counter", lambda: now[0])
+    plan = plan_atlas(
+        Pseudoinverse(Manipulator2()), LOOP, n_starts=3000, arc=(-1.0, 1.0), reference=X0
+    )
+    assert plan.chunk == 188  # (the default: 16 chunks, so that progress moves)
+    assert atlas_run.sized_chunks(plan).chunk == min(chunk, 188)
+    assert sum(runs) == probed
+    assert atlas_run.sized_chunks(dataclasses.replace(plan, chunk=2048)).chunk == chunk

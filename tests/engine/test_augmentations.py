@@ -82,3 +82,12 @@ def test_h_change_is_each_components_own_range():
     assert aug.h_change(np.array([0.3, np.nan, 0.5])) == pytest.approx(0.2, abs=1e-15)
     assert aug.h_change(np.full((3, 2), np.nan)) is None
     assert aug.h_change(None) is None
+
+
+def test_a_polynomial_map_names_its_coefficients_by_their_monomials():
+    """The paper's cubic (38) in x2, x3: each c_ij keyed "x2^i x3^j"."""
+    cubic = aug.PaperCubic()
+    named = cubic.monomials()
+    assert len(named) == len(cubic.coefficients)
+    for (i, j), c in cubic.coefficients.items():
+        assert named[f"x2^{i} x3^{j}"] == c

@@ -11,6 +11,7 @@ from jik.engine.limits import (
     limit_names,
     repeatability_report,
     robot_limits,
+    run_report,
     solve_report,
     starts_outside,
 )
@@ -149,6 +150,8 @@ def test_a_robot_reports_its_runs_limits():
     )
     assert panda.limits_report(run) == LimitsReport(True)
     assert robot_from_dict({"name": "manipulator2"}).limits_report(res) is None
+    assert run_report(panda.kinematics, run) == LimitsReport(True)
+    assert run_report(panda.kinematics, res) == panda.limits_report(res)
 
 
 def test_a_one_leg_run_says_on_the_way_to_the_target():

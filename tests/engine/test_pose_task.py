@@ -8,6 +8,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from jik.engine import so3
+from jik.engine.arms import ARMS
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.inverses import Pseudoinverse
 from jik.engine.pose_task import COORDINATES, parse_task, reference_rotation
@@ -166,3 +167,29 @@ def test_a_pose_loop_of_the_panda_drifts_under_the_pseudoinverse():
     res = repeatability(Pseudoinverse(kin), x0, y0 + moves, cycles=2)
     assert res.success
     assert res.drift[-1] > 1e-4
+
+
+@pytest.mark.parametrize(
+    ("task", "has_t", "has_R"),
+    [
+        ("pose", True, True),
+        ("rz x ry y rx z", True, True),
+        ("xyz", True, False),
+        ("rx ry rz", False, True),
+        ("x z rx", False, False),
+    ],
+)
+def test_pose_of_inverts_the_task_coordinates(task, has_t, has_R):
+    """pose_of(k(x)) is the end link's pose at x where the task fixes it, for a batch and for one
+    configuration; what the task leaves free is None."""
+    panda = ARMS["panda"]
+    kin = UrdfChain(panda.urdf, panda.end_link, task=task, reference=[0.3, -0.2, 0.5])
+    x = RNG.uniform(-1.0, 1.0, size=(6, kin.p))
+    R, t = kin.end_pose(x)
+    for batch in (slice(None), 0):
+        pos, rot = kin.pose_task.pose_of(kin.forward(x[batch]))
+        assert (pos is not None, rot is not None) == (has_t, has_R)
+        if has_t:
+            np.testing.assert_allclose(pos, t[batch], atol=1e-12)
+        if has_R:
+            np.testing.assert_allclose(rot, R[batch], atol=1e-9)

@@ -237,3 +237,20 @@ def test_a_users_kinematics_gets_the_check():
         Line().forward(np.zeros(3))
     assert info.value.field == "x"
     np.testing.assert_array_equal(Line().forward([1.0, 2.0]), [3.0])
+
+
+def test_refused_starts_say_why_each_start_of_a_batch_cannot_run():
+    """Of three starts, the overflowing one (k(x0) = exp(800)) and the singular one (x2 = 0: the
+    row of x2^2 in J vanishes) are refused, each with its reason; the good one is not."""
+    from jik.engine.solve_rules import refused_starts
+
+    arm = jik.FormulaKinematics(["x1", "x2", "x3"], ["exp(x1) + x3", "x2**2"])
+    refused = refused_starts(
+        jik.Pseudoinverse(arm), [[0.1, 0.5, 0.5], [800.0, 0.5, 0.5], [0.1, 0.0, 0.5]]
+    )
+    assert sorted(refused) == [1, 2]
+    assert refused[1] == (
+        "the kinematics overflow at the start: k(x0) = (inf, 0.25), its Jacobian not finite; "
+        "choose a start where both are finite (below about 1.8e308)"
+    )
+    assert "J J^T is singular" in refused[2] and refused[2].endswith("; move the start")

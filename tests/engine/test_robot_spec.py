@@ -158,8 +158,9 @@ def test_more_than_one_degree_of_redundancy_takes_a_vector_of_formula_maps():
     }
     robot = robot_from_dict(chain)
     assert _run(robot, "pseudoinverse", cycles=2).success
-    with pytest.raises(InvalidInputError, match="no augmenting map"):
+    with pytest.raises(InvalidInputError, match=r"needs p - r = 3 augmenting maps: give") as err:
         robot.inverse("extended")
+    assert err.value.field == "augmentation"
     vector = {"name": "formula", "h": ["x3 - x2", "x4 - x3", "x5 - x4"]}
     robot = robot_from_dict({**chain, "augmentations": [vector]})
     assert isinstance(robot.inverse("extended"), VectorExtendedInverse)

@@ -98,3 +98,16 @@ def test_the_default_frame_of_a_vector_synthesis_is_the_best_conditioned():
         return np.linalg.eigvalsh(N[np.ix_(ix, ix)])[0]
 
     assert least([4, 5, 6, 7]) < 1e-12 < 0.5 < least(axes)
+
+
+def test_a_synthesis_without_a_degree_takes_the_basis_its_box_and_redundancy_call_for():
+    """A tensor basis of degree 12 for one map of two or three variables, eq. (20); a total
+    degree of 4 for more variables or p - r > 1; a definition's map says which in its text."""
+    from jik.engine.robot_synthesis import default_degree
+
+    assert [default_degree(2, 1), default_degree(3, 1)] == [12, 12]
+    assert [default_degree(4, 1), default_degree(2, 2), default_degree(7, 1)] == [4, 4, 4]
+    chain = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]}
+    box = {"x2": [0.4, 2.0], "x3": [0.4, 2.0]}
+    robot = robot_from_dict({**chain, "augmentations": [{"name": "e2_synthesized", "region": box}]})
+    assert robot.spec.augmentations[0].description.endswith("degree 12")

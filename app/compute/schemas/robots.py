@@ -15,9 +15,11 @@ from pydantic import BaseModel, ConfigDict, Field, create_model
 
 from ....engine.arms import ARMS, Arm
 from ....engine.registry import ROBOTS, AugmentationSpec, RobotSpec
+from ....engine.robot_kinds import LIMITS
 from .fields import (
     INTEGRAL,
     MAX_DIMENSION,
+    Bound,
     Coordinate,
     FiniteFloat,
     one_or_many,
@@ -132,10 +134,6 @@ JointLimits = Annotated[
     list[tuple[FiniteFloat | None, FiniteFloat | None]],
     Field(min_length=1, max_length=MAX_DIMENSION),
 ]
-LIMITS_DESCRIPTION = (
-    "joint limits, one [lower, upper] per variable (null: no bound); runs report whether they "
-    "stayed within them"
-)
 
 #: An orientation R0: a rotation vector or a quaternion x y z w (numbers), or a 3x3 matrix.
 Orientation = one_or_many(
@@ -165,7 +163,7 @@ class PlanarChainRobot(BaseModel):
     orientation: Annotated[bool, Field(strict=True)] = Field(
         False, description="also the end's angle as a task component (r = 3; needs p >= 3)"
     )
-    limits: JointLimits | None = Field(None, description=LIMITS_DESCRIPTION)
+    limits: JointLimits | None = Field(None, description=LIMITS.help)
     title: Title | None = None
 
 
@@ -182,7 +180,7 @@ class FormulaRobot(BaseModel):
         "parameters with sin cos tan exp log sqrt atan2 abs, + - * / **, numbers and pi"
     )
     parameters: Constants = Field(default_factory=dict, description="named constants")
-    limits: JointLimits | None = Field(None, description=LIMITS_DESCRIPTION)
+    limits: JointLimits | None = Field(None, description=LIMITS.help)
     title: Title | None = None
 
 
@@ -251,10 +249,7 @@ class E2SynthesisAugmentation(BaseModel):
         Annotated[
             dict[
                 Name,
-                tuple[
-                    Annotated[float, Field(strict=True, ge=-100.0, le=100.0, allow_inf_nan=False)],
-                    Annotated[float, Field(strict=True, ge=-100.0, le=100.0, allow_inf_nan=False)],
-                ],
+                tuple[Bound, Bound],
             ],
             Field(min_length=2, max_length=MAX_DIMENSION),
         ]

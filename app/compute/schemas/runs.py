@@ -126,7 +126,7 @@ class LimitsInfo(BaseModel):
     violation: LimitViolationInfo | None = Field(description="the first violation, if any")
 
 
-class SolveResponse(BaseModel):
+class _RunResponse(BaseModel):
     robot: RobotUsed
     algorithm: Algorithm
     algorithm_parameters: dict[str, float | list[float | None] | list[list[float | None]]] = Field(
@@ -137,6 +137,19 @@ class SolveResponse(BaseModel):
     augmentation: AugmentationUsed | None
     mode: Mode
     gamma: float
+
+
+#: A run's joint-limit report, the last field of its response.
+RunLimits = Annotated[
+    LimitsInfo | None,
+    Field(
+        exclude_if=_absent,
+        description="whether the run stayed within the joint limits (absent: none)",
+    ),
+]
+
+
+class SolveResponse(_RunResponse):
     tolerance: float
     x: list[MaybeFloat] = Field(
         description="final configuration (null entries if the run diverged)"
@@ -147,24 +160,10 @@ class SolveResponse(BaseModel):
     message: str
     iterations: int = Field(description="integrator steps or iterations taken")
     trajectory: Trajectory
-    limits: LimitsInfo | None = Field(
-        default=None,
-        exclude_if=_absent,
-        description="whether the run stayed within the joint limits (absent: none)",
-    )
+    limits: RunLimits = None
 
 
-class RepeatabilityResponse(BaseModel):
-    robot: RobotUsed
-    algorithm: Algorithm
-    algorithm_parameters: dict[str, float | list[float | None] | list[list[float | None]]] = Field(
-        default_factory=dict,
-        description="the parameters the inverse used, defaults filled in (damped: damping, "
-        "damping_threshold; weighted: limits, null for an unbounded end; posture: gain, rest)",
-    )
-    augmentation: AugmentationUsed | None
-    mode: Mode
-    gamma: float
+class RepeatabilityResponse(_RunResponse):
     cycles: int
     targets: list[list[float]] = Field(description="task point of each leg of one cycle (closed)")
     legs: list[list[MaybeFloat]] = Field(
@@ -176,11 +175,7 @@ class RepeatabilityResponse(BaseModel):
     repeatable: bool = Field(description="every leg succeeded and max drift < 1e-6")
     success: bool
     message: str
-    limits: LimitsInfo | None = Field(
-        default=None,
-        exclude_if=_absent,
-        description="whether the run stayed within the joint limits (absent: none)",
-    )
+    limits: RunLimits = None
 
 
 def _task_point(spec: RobotSpec) -> Any:

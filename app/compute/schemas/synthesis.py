@@ -16,7 +16,7 @@ from .fields import (
     MaybeFloat,
 )
 from .robots import AnyAugmentation, AnyRobot, AugmentationUsed, RobotUsed
-from .variants import per_robot
+from .variants import narrowed, per_robot
 
 SynthesisMethod = Literal["evaluate", "e2_variational", "e2_total_degree"]
 #: Sobol nodes of a total-degree synthesis (a power of two): default and bounds.
@@ -122,13 +122,7 @@ def _synthesis_fields(spec: RobotSpec, augmentation: Any) -> dict[str, Any]:
                 "either side of the default start",
             ),
         ),
-        "fixed": (
-            dict[variable, Coordinate] | None,
-            Field(
-                None,
-                description="values of the variables not in the box (default: the default start)",
-            ),
-        ),
+        "fixed": narrowed(SynthesizeRequest, "fixed", dict[variable, Coordinate] | None),
     }
 
 

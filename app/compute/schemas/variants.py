@@ -39,6 +39,14 @@ def _object(body: Any) -> Any:
 OBJECT_BODY = BeforeValidator(_object)
 
 
+def narrowed(base: type[BaseModel], name: str, annotation: Any) -> tuple[Any, Any]:
+    """The field ``name`` of ``base`` with another type (a robot's lengths, its maps), its
+    default and description kept, its constraints the new type's: a field of
+    :func:`per_robot`'s ``fields``."""
+    info = base.model_fields[name]
+    return annotation, Field(info.default, description=info.description)
+
+
 def per_robot(base: type[BaseModel], fields: Any, user_robots: bool = True) -> Any:
     """``base`` made exact for each robot of the catalogue: one model per robot, chosen by
     ``robot.name``, whose ``robot`` and ``augmentation`` are that robot's and whose vectors have
@@ -82,6 +90,13 @@ def per_robot(base: type[BaseModel], fields: Any, user_robots: bool = True) -> A
         )
         globals()[model.__name__] = model
         members.append(Annotated[model, Tag(kind)])
+    return robot_union(members, names)
+
+
+def robot_union(members: list[Any], names: list[str] = ROBOT_NAMES) -> Any:
+    """A body that is one of ``members`` (each tagged by its robot's name), chosen by
+    ``robot.name``; a JSON object (:data:`OBJECT_BODY`), and an unknown name refused naming
+    ``names``."""
     return Annotated[
         Union[tuple(members)],  # noqa: UP007
         Discriminator(

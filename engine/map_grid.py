@@ -1,0 +1,117 @@
+"""An augmenting map h on a plane of a box of the joint space: the slice that shows h over the
+design region of sec. 5 (where E1 (13) and E2 (18) are taken), along the two variables of the
+box that h varies most with, the others held at the box's centre or at given values.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from .augmentations import AugmentingMap
+from .exceptions import JikError
+from .validation import FloatArray
+
+#: Seeded samples of the box on which :func:`grid_axes` compares h's partial derivatives.
+AXIS_SAMPLES = 64
+
+
+@dataclass(frozen=True)
+class MapGrid:
+    """h on an n x n grid of two variables (:func:`map_grid`).
+
+    Attributes
+    ----------
+    axes : dict name -> ndarray, shape (n,)
+        The two variables, in the robot's order, and their grid values.
+    h : ndarray, shape (n, n)
+        h at (first axis value i, second axis value j); NaN where h is undefined.
+    """
+
+    axes: dict[str, FloatArray]
+    h: FloatArray
+
+
+def grid_axes(
+    amap: AugmentingMap,
+    variable_names: Sequence[str],
+    region: Mapping[str, tuple[float, float]],
+    base: FloatArray,
+) -> list[str]:
+    """The two variables of ``region`` along which h varies most: the largest mean |dh/dx_i|
+    (the gradient of eq. (9)'s map) on :data:`AXIS_SAMPLES` seeded uniform samples of the box,
+    the other variables at ``base`` (p,). All of them for a box of at most two variables, the
+    first two when the gradient cannot be evaluated. Returned in the box's order."""
+    if len(region) <= 2:
+        return list(region)
+    names = list(variable_names)
+    rng = np.random.default_rng(0)
+    x = np.broadcast_to(base, (AXIS_SAMPLES, len(base))).copy()
+    for k, (lo, hi) in region.items():
+        x[:, names.index(k)] = rng.uniform(lo, hi, AXIS_SAMPLES)
+    with np.errstate(all="ignore"):
+        try:
+            g = np.abs(np.asarray(amap.gradient(x), dtype=float))
+        except JikError:
+            return list(region)[:2]
+    score = {k: float(np.nanmean(g[:, names.index(k)])) for k in region}
+    top = sorted(region, key=lambda k: -(score[k] if np.isfinite(score[k]) else -1.0))[:2]
+    return [k for k in region if k in top]
+
+
+def map_grid(
+    amap: AugmentingMap,
+    variable_names: Sequence[str],
+    region: Mapping[str, tuple[float, float]],
+    fixed: Mapping[str, float] | None = None,
+    n: int = 21,
+) -> MapGrid | None:
+    """h on an ``n`` x ``n`` grid over the two variables of ``region`` it varies most with
+    (:func:`grid_axes`), ends included.
+
+    Parameters
+    ----------
+    amap : AugmentingMap
+        The map h of eq. (9), of the configurations x (..., p).
+    variable_names : sequence of str, length p
+        The robot's variable names, in x's order.
+    region : dict name -> (lo, hi)
+        The box; its variables other than the two axes are held at their centre.
+    fixed : dict name -> value, optional
+        The values of variables outside the box (default 0).
+    n : int
+        Grid points per axis.
+
+    Returns
+    -------
+    MapGrid or None
+        None for a box of fewer than two variables. A map that raises where it is undefined
+        is evaluated point by point, NaN at the points where it raises.
+    """
+    if len(region) < 2:
+        return None
+    names = list(variable_names)
+    p = len(names)
+    base = np.zeros(p)
+    for k, v in (fixed or {}).items():
+        base[names.index(k)] = v
+    for k, (lo, hi) in region.items():
+        base[names.index(k)] = 0.5 * (lo + hi)
+    axes = grid_axes(amap, names, region, base)
+    a, b = (np.linspace(region[k][0], region[k][1], n) for k in axes)
+    x = np.broadcast_to(base, (n, n, p)).copy()
+    x[..., names.index(axes[0])] = a[:, None]
+    x[..., names.index(axes[1])] = b[None, :]
+    with np.errstate(all="ignore"):
+        try:
+            h = np.asarray(amap.value(x), dtype=float)
+        except JikError:
+            h = np.full((n, n), np.nan)
+            for i, j in np.ndindex(n, n):
+                try:
+                    h[i, j] = float(amap.value(x[i, j]))
+                except JikError:
+                    pass
+    return MapGrid({axes[0]: a, axes[1]: b}, h)

@@ -1,0 +1,63 @@
+"""h on a plane of a box (engine.map_grid): the two variables h varies most with, h's values
+at the grid's points, NaN where a map raises."""
+
+import numpy as np
+import pytest
+
+from jik.engine.augmentations import PaperCubic
+from jik.engine.exceptions import JikError
+from jik.engine.map_grid import grid_axes, map_grid
+
+NAMES = ("x1", "x2", "x3")
+BOX = {"x1": (-1.0, 1.0), "x2": (0.4, 2.0), "x3": (0.4, 2.0)}
+
+
+def test_the_grid_spans_the_two_variables_h_depends_on():
+    """The paper's cubic (38) is h(x2, x3): x1, on which it does not depend, is no axis."""
+    amap = PaperCubic()
+    grid = map_grid(amap, NAMES, BOX, n=5)
+    assert grid is not None and list(grid.axes) == ["x2", "x3"]
+    np.testing.assert_allclose(grid.axes["x2"], np.linspace(0.4, 2.0, 5), atol=0)
+    assert grid.h.shape == (5, 5)
+
+
+def test_the_grid_holds_h_at_its_points_the_others_at_the_box_centre_or_fixed():
+    amap = PaperCubic()
+    box = {"x2": BOX["x2"], "x3": BOX["x3"]}
+    grid = map_grid(amap, NAMES, box, fixed={"x1": 0.7}, n=4)
+    assert grid is not None
+    for i, a in enumerate(grid.axes["x2"]):
+        for j, b in enumerate(grid.axes["x3"]):
+            assert grid.h[i, j] == pytest.approx(
+                float(amap.value(np.array([0.7, a, b]))), abs=1e-14
+            )
+
+
+def test_axes_of_a_box_of_three_follow_the_largest_partial_derivatives():
+    """A gradient largest along x1, then x3, zero along x2: the axes are x1 and x3."""
+
+    class OfX1(PaperCubic):
+        def gradient(self, x):
+            g = np.zeros(np.shape(x))
+            g[..., 0] = 1.0
+            g[..., 2] = 0.5
+            return g
+
+    assert grid_axes(OfX1(), NAMES, BOX, np.zeros(3)) == ["x1", "x3"]
+
+
+def test_a_map_that_raises_somewhere_is_nan_there_and_evaluated_elsewhere():
+    class Partial(PaperCubic):
+        def value(self, x):
+            x = np.asarray(x, dtype=float)
+            if x.ndim > 1 or x[1] > 1.0:
+                raise JikError("undefined here")
+            return super().value(x)
+
+    grid = map_grid(Partial(), NAMES, {"x2": (0.5, 1.5), "x3": (0.5, 1.5)}, n=3)
+    assert grid is not None
+    assert np.isnan(grid.h[2]).all() and np.isfinite(grid.h[:2]).all()
+
+
+def test_a_box_of_one_variable_has_no_grid():
+    assert map_grid(PaperCubic(), NAMES, {"x2": (0.4, 2.0)}) is None
