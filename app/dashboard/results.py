@@ -48,7 +48,7 @@ def compute(
     state: DashboardState,
     generation: int = 0,
     *,
-    progress: Callable[[float], None] | None = None,
+    progress: Callable[[float], None] = lambda fraction: None,
     cancelled: Callable[[], bool] = lambda: False,
     cache: dict | None = None,
     with_augmenting: bool = True,
@@ -112,12 +112,10 @@ def compute(
 
     def step() -> None:
         done[0] += weight
-        if progress is not None:
-            progress(min(done[0] / total, 1.0))
+        progress(min(done[0] / total, 1.0))
 
     def partial(fraction: float) -> None:
-        if progress is not None:
-            progress(min((done[0] + weight * float(fraction)) / total, 1.0))
+        progress(min((done[0] + weight * float(fraction)) / total, 1.0))
 
     for algorithm in todo:
         if remote is None or algorithm != away:
