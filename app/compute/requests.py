@@ -19,7 +19,7 @@ import numpy as np
 from ...engine.exceptions import JikError, SingularConfigurationError
 from ...engine.limits import robot_limits
 from ...engine.registry import RobotSpec
-from ...engine.repeatability import REPEATABLE_DRIFT, repeatability
+from ...engine.repeatability import repeatability, repeatable
 from ...engine.solve_rules import gamma_problem, refused_starts
 from ...engine.solver import solve_batch as engine_solve_batch
 from . import schemas as S
@@ -197,8 +197,7 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
     except JikError as exc:
         raise engine_error(exc) from None
     drift = np.asarray(res.drift, dtype=float)
-    finite = bool(np.all(np.isfinite(drift)))
-    max_drift = float(np.max(drift)) if finite else float("nan")
+    max_drift = float(np.max(drift)) if np.all(np.isfinite(drift)) else float("nan")
     return S.RepeatabilityResponse(
         robot=setup.robot,
         algorithm=setup.inverse.name,
@@ -212,7 +211,7 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
         cycle_end=nullable(res.cycle_end),
         drift=nullable(drift),
         max_drift=nullable(max_drift),
-        repeatable=bool(res.success) and finite and max_drift < REPEATABLE_DRIFT,
+        repeatable=bool(res.success) and repeatable(drift) is True,
         success=bool(res.success),
         message=cast(str, res.message),  # one start configuration: one message
         **limits_document(setup.kinematics, res),

@@ -18,7 +18,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any, cast
 
 from ...engine.exceptions import InvalidInputError, JikError
@@ -46,10 +46,20 @@ def request_field(field: str | None, robot_keys: Sequence[str]) -> str:
     return field_text(".".join(parts))  # (indices as the API writes them: robot.task[0])
 
 
-@functools.lru_cache(maxsize=16)
+def built(definition: Mapping[str, Any]) -> Robot:
+    """The robot of a definition, kept (keyed by its JSON text): a worker serving the same
+    robot again, a dashboard's scene and figures, reuse its kinematics and any synthesized map.
+
+    Raises
+    ------
+    InvalidInputError
+        The engine's, naming the definition's field.
+    """
+    return _built(json.dumps(dict(definition), sort_keys=True))
+
+
+@functools.lru_cache(maxsize=32)
 def _built(definition: str) -> Robot:
-    """The robot of a definition (JSON text), kept: a worker serving the same robot again
-    reuses its kinematics and any synthesized map."""
     return robot_from_dict(json.loads(definition))
 
 
@@ -68,7 +78,7 @@ def user_robot(req_robot: Any, augmentation: Any = None) -> tuple[Robot, S.Robot
         definition["augmentations"] = [{**given, "label": _LABEL}]
     try:
         with time_budget(build_seconds(), "robot", "building the robot's formulas"):
-            robot = _built(json.dumps(definition, sort_keys=True))
+            robot = built(definition)
     except InvalidInputError as exc:
         raise RequestError(request_field(exc.field, list(definition)), _text(exc)) from None
     spec = robot.spec

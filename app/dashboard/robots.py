@@ -14,8 +14,6 @@ that a formula too costly to differentiate is refused before the server builds i
 
 from __future__ import annotations
 
-import functools
-import json
 from collections.abc import Mapping
 from typing import Any
 
@@ -27,10 +25,11 @@ from ...engine.inverses import Inverse
 from ...engine.kinematics import Kinematics
 from ...engine.registry import RobotSpec, robot_spec
 from ...engine.robot_kinds import KINDS
-from ...engine.robot_spec import Robot, robot_from_dict
+from ...engine.robot_spec import Robot
 from ..compute.budget import build_seconds, time_budget
 from ..compute.exceptions import RequestError
 from ..compute.schemas.wording import refused, without_field
+from ..compute.user_robots import built
 from ..compute.worker import task
 from .algorithms import inverse_parameters
 
@@ -45,17 +44,14 @@ def default_definition(robot: str) -> dict[str, Any] | None:
     return {"name": robot, "task": ARMS[robot].task} if robot in ARMS else None
 
 
-@functools.lru_cache(maxsize=32)
-def _built(definition: str) -> Robot:
-    robot = robot_from_dict(json.loads(definition))
+def _built(definition: Mapping[str, Any]) -> Robot:
+    robot = built(definition)
     spec = robot.spec
     if spec.augmentations or spec.p <= spec.r:
         return robot
     last = list(spec.variable_names[spec.r :])
     h = last[0] if len(last) == 1 else last
-    return robot_from_dict(
-        {**json.loads(definition), "augmentations": [{"name": "formula", "h": h}]}
-    )
+    return built({**definition, "augmentations": [{"name": "formula", "h": h}]})
 
 
 def user_robot(definition: Mapping[str, Any]) -> Robot:
@@ -69,7 +65,7 @@ def user_robot(definition: Mapping[str, Any]) -> Robot:
         With ``field`` under ``robot_definition``.
     """
     try:
-        return _built(json.dumps(dict(definition), sort_keys=True))
+        return _built(definition)
     except InvalidInputError as exc:
         field = f"robot_definition.{exc.field}" if exc.field else "robot_definition"
         raise refused(field, without_field(str(exc), exc.field)) from None
@@ -83,7 +79,7 @@ def check_definition(definition: Mapping[str, Any]) -> None:
     what = "building the robot's formulas"
     with time_budget(build_seconds(), "robot_definition", what):
         try:
-            kinematics = _built(json.dumps(dict(definition), sort_keys=True)).kinematics
+            kinematics = _built(definition).kinematics
             hessian = getattr(kinematics, "hessian", None)
             if hessian is not None:
                 hessian(np.zeros((1, kinematics.p)))
