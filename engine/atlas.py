@@ -26,7 +26,7 @@ import numpy as np
 
 from .exceptions import InvalidInputError, SingularConfigurationError, format_vector
 from .inverses import Inverse, Pseudoinverse, algorithm_labels
-from .repeatability import CLOSE_TOL, MAX_CYCLES, MAX_PATH_POINTS
+from .repeatability import MAX_CYCLES, MAX_PATH_POINTS, open_loop
 from .self_motion import SelfMotionManifold, project, trace
 from .solve_rules import MAX_ITERATIONS_LIMIT, MODES, check_gamma, chunk_limit
 from .solver import solve_batch
@@ -258,8 +258,7 @@ def plan_atlas(
     base_path = _checked(lambda: as_points(path, kin.r, "path"), "path")
     if base_path.ndim != 2:
         raise InvalidInputError(f"path must be a list of task points (L, {kin.r})", field="path")
-    if len(base_path) > 2 and np.linalg.norm(base_path[-1] - base_path[0]) <= CLOSE_TOL:
-        base_path = base_path[:-1]
+    base_path = open_loop(base_path)
     if not 2 <= len(base_path) <= MAX_PATH_POINTS:
         raise InvalidInputError(
             f"path must have 2 to {MAX_PATH_POINTS} points (a loop from the first), got "

@@ -108,6 +108,13 @@ def closed_path(kinematics, x0: FloatArray, path: FloatArray) -> FloatArray:
     return pts
 
 
+def open_loop(path: FloatArray) -> FloatArray:
+    """An atlas's loop (L, r) as the points its cycle's legs go to from path[1] before the leg
+    back to k(x): without a last point repeating the first, when more than two remain."""
+    closes = len(path) > 2 and np.linalg.norm(path[-1] - path[0]) <= CLOSE_TOL
+    return path[:-1] if closes else path
+
+
 def cycle_guesses(
     inverse: Inverse, start, targets, guides: list[Trajectory | None], gamma: float = 1.0
 ) -> list[Trajectory | None]:

@@ -1,8 +1,9 @@
 """Atlas jobs of the REST API: started by a request, run in the background, read back later.
 
 An atlas (:mod:`jik.engine.atlas`) takes seconds to minutes, longer than a request may wait, so
-``POST /atlas`` only checks the request and plans the atlas (:func:`planned`, in a compute
-worker: its time and memory limits hold for the tracing), then
+``POST /atlas`` only checks the request and plans the atlas
+(:func:`~jik.app.compute.atlas_plan.planned`, in a compute worker: its time and memory limits
+hold for the tracing), then
 :class:`AtlasJobs` runs it in a thread of its own that hands its chunks to the server's compute
 pool (:class:`PoolBackend`: the same worker processes as the API's requests, with their time
 and memory limits, queued first come first served with them; they stop with the server). A
@@ -30,7 +31,7 @@ from ...engine.atlas import AtlasPlan
 from ...engine.atlas_run import AtlasResult, run_atlas
 from ...engine.exceptions import RunCancelled
 from ...engine.progress import ProgressCallbacks
-from .atlas_plan import AtlasLimits, Used, planned, result_document
+from .atlas_plan import AtlasLimits, Used, result_document
 from .atlas_pool import PoolBackend
 from .atlas_schemas import AtlasJobResponse, AtlasRequest
 
@@ -134,14 +135,14 @@ class AtlasJobs:
         self,
         client: str,
         req: AtlasRequest,
-        plan: tuple[AtlasPlan, Used] | None = None,
+        plan: tuple[AtlasPlan, Used],
         session: str | None = None,
     ) -> AtlasJob:
-        """Start the request's atlas as a job, planned here unless ``plan`` (its plan and what
-        it used, :func:`~jik.app.compute.atlas_plan.planned`) is given (raises before anything
-        is kept); ``session``: the dashboard session that asks for it."""
+        """Start the request's atlas as a job: ``plan`` is its plan and what it used
+        (:func:`~jik.app.compute.atlas_plan.planned`); raises before anything is kept when
+        there is no room; ``session``: the dashboard session that asks for it."""
         self.check_room(client)
-        atlas, used = plan if plan is not None else planned(req, self.limits)
+        atlas, used = plan
         job = AtlasJob(
             self.run + secrets.token_urlsafe(12),
             client,

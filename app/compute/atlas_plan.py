@@ -1,5 +1,5 @@
 """The plan of a REST atlas and its result document: a request's robot, inverses and paths
-checked and traced into an :class:`~jik.engine.atlas.AtlasPlan` (:func:`plan_request`, run in a
+checked and traced into an :class:`~jik.engine.atlas.AtlasPlan` (:func:`planned`, run in a
 compute worker by :func:`plan_task`: tracing the self-motion curves solves eq. (7)), the limits
 of the atlas jobs (:class:`AtlasLimits`), and the fields of a finished atlas
 (:func:`result_document`). The jobs that run the plans are :mod:`jik.app.compute.atlas_jobs`'.
@@ -15,7 +15,7 @@ import numpy as np
 from ...engine.atlas import AtlasPlan, plan_atlas
 from ...engine.atlas_run import AtlasResult, sized_chunks
 from ...engine.exceptions import InvalidInputError
-from ...engine.repeatability import CLOSE_TOL
+from ...engine.repeatability import open_loop
 from ...engine.self_motion import MAX_ARC
 from ...engine.solve_rules import gamma_problem
 from . import schemas as S
@@ -45,15 +45,10 @@ class AtlasLimits:
     keep_for: float = 600.0
 
 
-def plan_request(req: AtlasRequest, limits: AtlasLimits) -> AtlasPlan:
-    """The request's atlas, planned (curves traced); RequestError or InvalidInputError, each
-    naming the field, when it cannot be."""
-    return planned(req, limits)[0]
-
-
 def planned(req: AtlasRequest, limits: AtlasLimits) -> tuple[AtlasPlan, Used]:
-    """:func:`plan_request`, and what the job's response repeats: the robot used and the map
-    the extended inverse used (None without it), as every run's response does."""
+    """The request's atlas, planned (curves traced), and what the job's response repeats: the
+    robot used and the map the extended inverse used (None without it), as every run's
+    response does; RequestError or InvalidInputError, each naming the field, when it cannot be."""
     if len(set(req.algorithms)) != len(req.algorithms):
         raise RequestError("algorithms", f"name each algorithm once, got {req.algorithms}")
     robot = request_robot(  # (each algorithm takes its own of the parameters)
@@ -78,9 +73,9 @@ def planned(req: AtlasRequest, limits: AtlasLimits) -> tuple[AtlasPlan, Used]:
     if (why := gamma_problem(gamma, mode)) is not None:
         raise RequestError("gamma", why)
     paths = len(req.shifts or [0]) * len(req.scales or [0])
-    closed = np.linalg.norm(np.subtract(path[-1], path[0])) <= CLOSE_TOL
     starts = len(req.start_points) if req.start_points else req.starts
-    legs = starts * paths * req.cycles * (len(path) - closed) * len(req.algorithms)
+    cycle = len(open_loop(np.asarray(path, dtype=float)))  # (the engine's legs of a cycle)
+    legs = starts * paths * req.cycles * cycle * len(req.algorithms)
     if legs > limits.max_work:
         raise RequestError(
             "starts",
@@ -133,7 +128,7 @@ def _plan(req: AtlasRequest, spec, inverses, path, gamma, mode) -> AtlasPlan:
     "of memory)",
 )
 def plan_task(req: str, limits: AtlasLimits):
-    """:func:`plan_request` of a request (JSON) as a compute worker's task, within the workers'
+    """:func:`planned` of a request (JSON) as a compute worker's task, within the workers'
     time and memory limits (tracing the curves solves eq. (7)), its chunks sized for the pool
     (:func:`~jik.engine.atlas_run.sized_chunks`): the plan and what it used (:func:`planned`)
     and None, or None and the refusal (message, field), for the server to raise again."""

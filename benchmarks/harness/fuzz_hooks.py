@@ -58,7 +58,7 @@ except ImportError as exc:
     ) from exc
 
 from ...app.compute import schemas as S
-from ...app.compute.atlas_plan import AtlasLimits, plan_request
+from ...app.compute.atlas_plan import AtlasLimits, planned
 from ...app.compute.atlas_schemas import AtlasRequest
 from ...app.compute.exceptions import RequestError
 from ...app.compute.requests import _setup
@@ -244,7 +244,7 @@ def _change_ok(body: dict) -> bool:
 
 def _atlas_ok(body: dict) -> bool:
     try:
-        plan_request(AtlasRequest.model_validate(body), AtlasLimits())
+        planned(AtlasRequest.model_validate(body), AtlasLimits())
     except (JikError, RequestError, ValidationError):
         return False
     return True

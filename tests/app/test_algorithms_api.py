@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from jik.app.compute.atlas_plan import AtlasLimits, plan_request
+from jik.app.compute.atlas_plan import AtlasLimits, planned
 from jik.app.compute.atlas_schemas import AtlasRequest
 from jik.engine.atlas_run import run_atlas
 from tests.app.conftest import TABLE1_PATH, X0_M2, messages, solve_body
@@ -94,7 +94,7 @@ def test_atlas_compares_algorithms_over_the_same_starts():
             "algorithm_parameters": {"damping": 0.5, "gain": 1.0},
         }
     )
-    res = run_atlas(plan_request(req, AtlasLimits()))
+    res = run_atlas(planned(req, AtlasLimits())[0])
     assert res.algorithms == ("pseudoinverse", "damped", "posture")
     drift = {a: res.drift[i] for i, a in enumerate(res.algorithms)}
     assert all(d.shape == (1, 5, 2) and np.isfinite(d).all() for d in drift.values())

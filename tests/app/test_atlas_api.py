@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 import time
 from pathlib import Path
 
@@ -12,9 +13,10 @@ from fastapi.testclient import TestClient
 
 from jik.app.api.factory import create_app
 from jik.app.compute.atlas_jobs import AtlasJobNotFound, AtlasJobs
-from jik.app.compute.atlas_plan import AtlasLimits, plan_request
+from jik.app.compute.atlas_plan import AtlasLimits, planned
 from jik.app.compute.atlas_pool import PoolBackend
 from jik.app.compute.atlas_schemas import AtlasRequest
+from jik.app.compute.exceptions import RequestError
 from jik.app.compute.pool import pool_in_thread
 from jik.app.compute.settings import Settings
 from jik.app.dashboard.sessions import SessionLimits, SessionStore
@@ -93,7 +95,7 @@ def test_a_job_runs_to_its_result_and_outlives_its_request(app, client):
     assert done["status"] == "done", done["error"]
     assert done["progress"] == 1.0 and done["runs_done"] == 6
     res = done["result"]
-    expected = run_atlas(plan_request(AtlasRequest.model_validate(req), AtlasLimits()))
+    expected = run_atlas(planned(AtlasRequest.model_validate(req), AtlasLimits())[0])
     np.testing.assert_allclose(res["starts"], expected.starts, rtol=0, atol=1e-12)
     np.testing.assert_allclose(res["parameter"], np.linspace(-2, 2, 6), rtol=0, atol=1e-15)
     for a, alg in enumerate(("pseudoinverse", "extended")):
@@ -179,6 +181,13 @@ def test_an_atlas_refuses_parameters_as_a_solve_does(client, over, loc, text):
     assert r.json()["detail"][0]["loc"][1:] == ["algorithm_parameters", loc]
 
 
+def test_the_work_of_a_two_point_closed_path_is_counted_as_the_engine_runs_it():
+    """A two-point path whose ends meet keeps both points: two legs a cycle, not one."""
+    two = body(path=[[0.0, 1.0], [0.0, 1.0]], starts=5, algorithms=["extended"])
+    with pytest.raises(RequestError, match=re.escape("= 20 is more than 15")):
+        planned(AtlasRequest.model_validate(two), AtlasLimits(max_work=15))[0]
+
+
 def test_unknown_job_is_404(client):
     assert client.get("/atlas/nope").status_code == 404
     assert client.delete("/atlas/nope").status_code == 404
@@ -186,7 +195,8 @@ def test_unknown_job_is_404(client):
 
 def test_ended_jobs_are_dropped_after_keep_for():
     jobs = AtlasJobs(AtlasLimits(keep_for=0.0))
-    job = jobs.start("me", AtlasRequest.model_validate(body(starts=2, cycles=1)))
+    req = AtlasRequest.model_validate(body(starts=2, cycles=1))
+    job = jobs.start("me", req, planned(req, jobs.limits))
     end = time.monotonic() + 300
     while job.ended is None and time.monotonic() < end:
         time.sleep(0.1)
@@ -263,7 +273,7 @@ def test_the_plan_is_made_in_a_compute_worker(client, monkeypatch):
     def not_here(*_args):
         raise AssertionError("planned in the server's process")
 
-    monkeypatch.setattr("jik.app.compute.atlas_jobs.planned", not_here)
+    monkeypatch.setattr("jik.app.compute.atlas_plan.planned", not_here)
     r = client.post("/atlas", json=body())
     assert r.status_code == 202, r.text
     assert wait_until_ended(client, r.json()["id"])["status"] == "done"
@@ -322,7 +332,7 @@ def test_an_atlas_takes_every_robot_and_refuses_a_bad_one_naming_the_field(clien
 def test_an_atlas_in_the_compute_pool_is_the_engines_atlas():
     """The API's atlases run their chunks in the compute pool's workers: the same numbers as
     in-process, to 1e-12."""
-    plan = plan_request(AtlasRequest.model_validate(body(starts=9)), AtlasLimits())
+    plan = planned(AtlasRequest.model_validate(body(starts=9)), AtlasLimits())[0]
     with pool_in_thread(Settings(workers=1, timeout=60.0)) as pool:
         pooled = run_atlas(plan, PoolBackend(pool))
     here = run_atlas(plan)

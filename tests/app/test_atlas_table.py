@@ -13,7 +13,7 @@ from fastapi.testclient import TestClient
 
 from jik.app.api.factory import create_app
 from jik.app.compute.atlas_jobs import AtlasJobs
-from jik.app.compute.atlas_plan import AtlasLimits, plan_request
+from jik.app.compute.atlas_plan import AtlasLimits, planned
 from jik.app.compute.atlas_schemas import AtlasRequest
 from jik.app.dashboard.sessions import SessionLimits, SessionStore
 from jik.engine.atlas_run import run_atlas
@@ -67,7 +67,7 @@ def test_a_done_jobs_table_is_the_engines_table_of_its_atlas(client):
     req = body(algorithms=["pseudoinverse", "extended"], leg_ends=True)
     job = client.post("/atlas", json=req).json()["id"]
     assert wait_until_ended(client, job)["status"] == "done"
-    expected = run_atlas(plan_request(AtlasRequest.model_validate(req), AtlasLimits()))
+    expected = run_atlas(planned(AtlasRequest.model_validate(req), AtlasLimits())[0])
     rows = table(client.get(f"/atlas/{job}/table.csv"))
     assert_same_table(rows, expected.columns())
     assert len(rows) - 1 == 2 * 6 * 2  # (algorithms x starts x cycles)
@@ -79,7 +79,7 @@ def test_a_table_without_leg_ends_has_no_x_columns_and_no_row_per_leg(client):
     job = client.post("/atlas", json=body()).json()["id"]
     assert wait_until_ended(client, job)["status"] == "done"
     expected = run_atlas(
-        plan_request(AtlasRequest.model_validate(body()), AtlasLimits()), keep_leg_ends=False
+        planned(AtlasRequest.model_validate(body()), AtlasLimits())[0], keep_leg_ends=False
     )
     rows = table(client.get(f"/atlas/{job}/table.csv"))
     assert "x_1" not in rows[0]

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from pydantic import TypeAdapter
 
-from jik.app.compute.atlas_plan import AtlasLimits, plan_request, result_document
+from jik.app.compute.atlas_plan import AtlasLimits, planned, result_document
 from jik.app.compute.atlas_schemas import AtlasBody
 from jik.engine.arms import ARMS
 from jik.engine.atlas_run import run_atlas
@@ -49,7 +49,7 @@ def _atlas(api, body: dict) -> dict:
 def _here(body: dict) -> dict:
     """The engine's atlas of the same request, in this process."""
     req = TypeAdapter(AtlasBody).validate_python(body)
-    plan = plan_request(req, AtlasLimits())
+    plan = planned(req, AtlasLimits())[0]
     res = run_atlas(plan, keep_leg_ends=bool(body.get("leg_ends")))
     return result_document(res, plan.manifolds[0].arc, bool(body.get("leg_ends")))
 

@@ -10,7 +10,7 @@ import json
 import numpy as np
 import pytest
 
-from jik.app.compute.atlas_plan import AtlasLimits, plan_request
+from jik.app.compute.atlas_plan import AtlasLimits, planned
 from jik.app.dashboard.atlas import atlas_figure, atlas_request
 from jik.app.dashboard.controls import controls
 from jik.app.dashboard.export import export_csv, export_units
@@ -260,7 +260,7 @@ def test_the_atlas_of_a_robot_with_two_degrees_of_redundancy():
     kin = state_kinematics(state)
     assert X.shape == (12, 4) and np.allclose(X[0], state.x0)
     np.testing.assert_allclose(kin.forward(X), kin.forward(X[:1]).repeat(12, 0), atol=1e-12)
-    res = run_atlas(plan_request(req, AtlasLimits()))
+    res = run_atlas(planned(req, AtlasLimits())[0])
     drift = {a: res.drift[k] for k, a in enumerate(res.algorithms)}  # (P, N, C)
     assert np.nanmax(drift["extended"]) < 1e-9 and np.nanmin(drift["pseudoinverse"]) > 1e-6
     result = {

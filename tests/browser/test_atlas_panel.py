@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from jik.app.compute.atlas_plan import AtlasLimits, plan_request
+from jik.app.compute.atlas_plan import AtlasLimits, planned
 from jik.app.compute.atlas_schemas import AtlasRequest
 from jik.engine.atlas_run import run_atlas
 from tests.browser.conftest import ARTIFACTS, SCREEN_SIZES, get_json, poll
@@ -183,7 +183,7 @@ def test_the_atlas_panels_csv_downloads_the_table_of_the_atlas_shown(tabs):
     text = Path(saved.value.path()).read_bytes().decode()
     rows = list(csv.reader(io.StringIO(text)))
     request = get_json(f"{tab.base}/api/sessions/{tab.session_id}/atlas/{job}")["request"]
-    plan = plan_request(AtlasRequest.model_validate(request), AtlasLimits())
+    plan = planned(AtlasRequest.model_validate(request), AtlasLimits())[0]
     assert rows[0] == list(run_atlas(plan, keep_leg_ends=request["leg_ends"]).columns())
     assert len(rows) - 1 == 8 * len(request["algorithms"])
     with urllib.request.urlopen(f"{tab.base}/atlas/{job}/table.csv", timeout=30) as rest:

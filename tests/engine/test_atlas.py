@@ -20,7 +20,7 @@ from jik.engine.exceptions import InvalidInputError, RunCancelled
 from jik.engine.inverses import ExtendedInverse, Pseudoinverse, extended_singularity
 from jik.engine.kinematics import Manipulator1, Manipulator2
 from jik.engine.progress import ProgressCallbacks
-from jik.engine.repeatability import repeatability
+from jik.engine.repeatability import open_loop, repeatability
 from jik.engine.self_motion import trace
 from jik.engine.solver import solve_batch
 
@@ -287,6 +287,21 @@ def test_a_bad_path_is_named(path, text):
     with pytest.raises(InvalidInputError, match=re.escape(text)) as info:
         plan_atlas(manipulator2_inverses(), path, n_starts=2, arc=(0, 1), reference=X0)
     assert info.value.field == "path"
+
+
+@pytest.mark.parametrize(
+    ("path", "legs"),
+    [
+        (LOOP, 4),  # path[1:] and back to k(x)
+        ([*LOOP, LOOP[0]], 4),  # a last point repeating the first is the return leg
+        ([(0.0, 1.0), (1.0, 1.0)], 2),
+        ([(0.0, 1.0), (0.0, 1.0)], 2),  # two points stay two, closed or not
+    ],
+)
+def test_a_cycle_has_the_legs_of_its_open_loop(path, legs):
+    """A plan's legs of a cycle are open_loop's points, the rule an API counts work by."""
+    plan = plan_atlas(manipulator2_inverses(), path, n_starts=2, arc=(0, 1), reference=X0)
+    assert plan.legs == len(open_loop(np.asarray(path, dtype=float))) == legs
 
 
 def test_the_engine_does_not_import_dask():

@@ -40,11 +40,17 @@ def jobs_of(request: Request) -> AtlasJobs:
 
 
 async def start_job(
-    jobs: AtlasJobs, pool: ComputePool, request: Request, req, session: str | None = None
-) -> AtlasJob:
+    jobs: AtlasJobs,
+    pool: ComputePool,
+    request: Request,
+    response: Response,
+    req,
+    session: str | None = None,
+) -> AtlasJobResponse:
     """Plan ``req`` in a compute worker (tracing the self-motion curves solves eq. (7): within
     the workers' time and memory limits, like any computation a request asks for), then start
-    it as a job of the client's (``session``: of that dashboard session's)."""
+    it as a job of the client's (``session``: of that dashboard session's); the 202's body,
+    its ``Location`` the job's ``/atlas/{job_id}``."""
     client = request.client.host if request.client else "unknown"
     jobs.check_room(client)  # (before the work)
     plan, refused = await pool.run(plan_task, req.model_dump_json(), jobs.limits)
@@ -53,7 +59,9 @@ async def start_job(
         if field is None:
             raise InvalidInputError(message)
         raise RequestError(field, without_field(message, field))
-    return await run_in_threadpool(jobs.start, client, req, plan, session)
+    job = await run_in_threadpool(jobs.start, client, req, plan, session)
+    response.headers["Location"] = f"/atlas/{job.id}"
+    return jobs.response(job)
 
 
 Jobs = Annotated[AtlasJobs, Depends(jobs_of)]
@@ -110,9 +118,7 @@ async def start_atlas(
     req: AtlasExamples, request: Request, response: Response, jobs: Jobs, pool: Pool
 ):
     """Plan the atlas (the self-motion curves are traced here) and start it as a job."""
-    job = await start_job(jobs, pool, request, req)
-    response.headers["Location"] = f"/atlas/{job.id}"
-    return jobs.response(job)
+    return await start_job(jobs, pool, request, response, req)
 
 
 @router.get("/atlas/{job_id}", response_model=AtlasJobResponse, responses=ERRORS)

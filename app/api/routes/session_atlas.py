@@ -73,9 +73,7 @@ async def start_session_atlas(
         error = exc.errors()[0]
         name = ".".join(str(p) for p in error["loc"]) or "state"
         raise refused(name, error["msg"]) from None
-    job = await start_job(jobs, pool, request, req, session_id)
-    response.headers["Location"] = f"/atlas/{job.id}"
-    return jobs.response(job)
+    return await start_job(jobs, pool, request, response, req, session_id)
 
 
 @router.get("/api/sessions/{session_id}/atlas/{job_id}", responses={**ERRORS, **_NOT_FOUND})
