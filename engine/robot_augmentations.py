@@ -12,7 +12,13 @@ from .formula_kinematics import FormulaMap
 from .functionals import check_region
 from .kinematics import Kinematics
 from .registry import AugmentationSpec
-from .robot_synthesis import default_degree, synthesis, vector_synthesis
+from .robot_synthesis import (
+    MAX_TENSOR_DEGREE,
+    MAX_TOTAL_DEGREE,
+    default_degree,
+    synthesis,
+    vector_synthesis,
+)
 from .validation import count
 
 
@@ -56,7 +62,8 @@ def augmentations_from_dict(kin: Kinematics, items, key: str | None = None):
             tensor = len(box) <= 3 and k == 1  # (else a total-degree basis, at most 6)
             given = item.get("degree", default_degree(len(box), k))
             field = f"{where}.degree"
-            degree = count(given, field, 1, 24 if tensor else 6, field)
+            top = MAX_TENSOR_DEGREE if tensor else MAX_TOTAL_DEGREE
+            degree = count(given, field, 1, top, field)
             if tensor:
                 text = f"E2-optimal h on {box} by the Ritz solve of (20), degree {degree}"
             else:

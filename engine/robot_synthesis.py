@@ -95,6 +95,8 @@ _SYNTHESIZED: dict[tuple[str, str], tuple[AugmentingMap, ...]] = {}
 TOTAL_DEGREE, TOTAL_NODES = 4, 2**13
 #: Legendre degree per variable of the tensor synthesis (two or three variables).
 TENSOR_DEGREE = 12
+#: Largest degree a definition's E2 synthesis takes: per variable (tensor), and total.
+MAX_TENSOR_DEGREE, MAX_TOTAL_DEGREE = 24, 6
 #: Half-width [rad] of a catalogue arm's default synthesis box around its home.
 ARM_BOX = 0.3
 

@@ -10,7 +10,7 @@
 Everything is re-exported here: ``from jik.app.compute import schemas as S``.
 """
 
-from .algorithms import AlgorithmParameters
+from .algorithms import Algorithm, AlgorithmParameters
 from .fields import (
     COORDINATE_BOUND,
     GAMMA_MIN,
@@ -18,7 +18,6 @@ from .fields import (
     MAX_DIMENSION,
     MAX_ITERATIONS,
     MAX_TRAJECTORY_POINTS,
-    Algorithm,
     Bound,
     Coordinate,
     FiniteFloat,

@@ -9,13 +9,12 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, create_model
 
 from ....engine.registry import ALGORITHMS
+from .fields import Coordinate
 
 #: Every algorithm of the engine, as the API names them.
 Algorithm = Literal["pseudoinverse", "extended", "damped", "weighted", "posture"]
 assert set(Algorithm.__args__) == set(ALGORITHMS)  # type: ignore[attr-defined]
 
-_BOUND = 1000.0
-_Coordinate = Annotated[float, Field(strict=True, ge=-_BOUND, le=_BOUND, allow_inf_nan=False)]
 _Bound = Annotated[float, Field(strict=True, allow_inf_nan=True)]
 
 
@@ -39,7 +38,7 @@ _Parameters = create_model("_Parameters", __config__=ConfigDict(extra="forbid"),
 class AlgorithmParameters(_Parameters):  # type: ignore[misc, valid-type]
     """Parameters of the chosen algorithm; those of another algorithm are refused (422)."""
 
-    rest: list[_Coordinate] | None = Field(
+    rest: list[Coordinate] | None = Field(
         None,
         description="posture: the rest posture x_rest, length p, within the robot's joint "
         "limits if it has some (default: the robot's home, else the run's x0; in an atlas, "

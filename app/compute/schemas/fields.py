@@ -11,7 +11,6 @@ from typing import Annotated, Any, Literal, Union
 from pydantic import BeforeValidator, Discriminator, Field, Tag
 
 from ....engine.solve_rules import GAMMA_MAX, GAMMA_MIN, TOL_MIN
-from .algorithms import Algorithm as Algorithm
 
 #: Largest configuration / task dimension accepted before the registry check.
 MAX_DIMENSION = 16

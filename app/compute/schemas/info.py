@@ -6,7 +6,8 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, Field
 
-from .fields import Algorithm, Mode
+from .algorithms import Algorithm
+from .fields import Mode
 
 
 class ParameterInfo(BaseModel):

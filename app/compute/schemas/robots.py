@@ -13,7 +13,9 @@ from typing import TYPE_CHECKING, Annotated, Any, Literal, TypeAlias, Union
 
 from pydantic import BaseModel, ConfigDict, Field, create_model
 
+from ....engine import robot_synthesis as synthesis
 from ....engine.arms import ARMS, Arm
+from ....engine.formula import MAX_LENGTH as MAX_FORMULA_CHARS  # (the engine's bound)
 from ....engine.registry import ROBOTS, AugmentationSpec, RobotSpec
 from ....engine.robot_kinds import LIMITS
 from .fields import (
@@ -113,8 +115,6 @@ for _m in (*ROBOT_MODELS.values(), *AUGMENTATION_MODELS.values()):
 # the joints' letters); the formulas' grammar, the URDF text and what follows from them (p, r,
 # the lengths of x0, target and path) are checked when the robot is built, naming the field.
 
-#: Longest formula text (the engine's bound, :data:`jik.engine.formula.MAX_LENGTH`).
-MAX_FORMULA_CHARS = 2000
 #: Longest URDF text a request carries [characters]: a tenth of the 1 MiB body limit, room for
 #: an arm of dozens of links (the shipped 4-joint arm is 2 kB). A larger file goes through the
 #: CLI (``jik solve --robot arm.json`` with ``urdf_file``; the engine's bound is 1 MB). A 1 MB
@@ -259,10 +259,13 @@ class E2SynthesisAugmentation(BaseModel):
         description="two or more variables to [lo, hi], lo < hi; default: "
         "the robot's functional region (an arm's: a box around home)",
     )
-    degree: Annotated[int, Field(strict=True, ge=1, le=24), INTEGRAL] | None = Field(
+    degree: (
+        Annotated[int, Field(strict=True, ge=1, le=synthesis.MAX_TENSOR_DEGREE), INTEGRAL] | None
+    ) = Field(
         None,
-        description="two or three variables: Legendre degree per variable (default 12); "
-        "more: the total degree, 1 to 6 (default 4)",
+        description="two or three variables: Legendre degree per variable (default "
+        f"{synthesis.TENSOR_DEGREE}); more: the total degree, 1 to "
+        f"{synthesis.MAX_TOTAL_DEGREE} (default {synthesis.TOTAL_DEGREE})",
     )
     fixed: Annotated[dict[Name, FiniteFloat], Field(max_length=MAX_DIMENSION)] | None = Field(
         None, description="values of the variables outside the box (default 0)"

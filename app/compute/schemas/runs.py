@@ -11,13 +11,12 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from ....engine.registry import RobotSpec
-from ....engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
+from ....engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS, REPEATABLE_DRIFT
 from ....engine.solve_rules import DISCRETE_GAMMA_BOUND
-from .algorithms import AlgorithmParameters
+from .algorithms import Algorithm, AlgorithmParameters
 from .fields import (
     INTEGRAL,
     MAX_ITERATIONS,
-    Algorithm,
     Coordinate,
     Gamma,
     MaybeFloat,
@@ -172,7 +171,9 @@ class RepeatabilityResponse(_RunResponse):
     cycle_end: list[list[MaybeFloat]] = Field(description="configuration at the end of each cycle")
     drift: list[MaybeFloat] = Field(description="||cycle_end[c] - x0|| per cycle")
     max_drift: MaybeFloat
-    repeatable: bool = Field(description="every leg succeeded and max drift < 1e-6")
+    repeatable: bool = Field(
+        description=f"every leg succeeded and max drift < {REPEATABLE_DRIFT:g}"
+    )
     success: bool
     message: str
     limits: RunLimits = None

@@ -7,6 +7,7 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from ....engine.registry import RobotSpec
+from ....engine.robot_synthesis import TOTAL_DEGREE
 from ....engine.variational import DEFAULT_DEGREE
 from .fields import (
     INTEGRAL,
@@ -66,7 +67,7 @@ class SynthesizeRequest(BaseModel):
         description="'e2_variational': Legendre degree per variable (default: "
         f"{DEFAULT_DEGREE[2]} over two variables, {DEFAULT_DEGREE[3]} over three, "
         "engine.variational.DEFAULT_DEGREE); "
-        "'e2_total_degree': total degree of the basis (default 4)",
+        f"'e2_total_degree': total degree of the basis (default {TOTAL_DEGREE})",
     )
     qmc_nodes: Annotated[int, Field(strict=True, ge=MIN_QMC_NODES, le=MAX_QMC_NODES), INTEGRAL] = (
         Field(
