@@ -17,13 +17,12 @@ from ...engine.atlas_run import AtlasResult, sized_chunks
 from ...engine.exceptions import InvalidInputError
 from ...engine.repeatability import open_loop
 from ...engine.self_motion import MAX_ARC
-from ...engine.solve_rules import gamma_problem
 from . import schemas as S
 from .atlas_pool import CHUNK_SECONDS
 from .atlas_schemas import AtlasRequest
 from .documents import nullable
 from .exceptions import RequestError
-from .robot_requests import check_task_point, request_robot
+from .robot_requests import check_task_point, gamma_and_mode, request_robot
 from .schemas.wording import without_field
 from .worker import task
 
@@ -68,10 +67,7 @@ def planned(req: AtlasRequest, limits: AtlasLimits) -> tuple[AtlasPlan, Used]:
             raise RequestError(f"start_points[{i}]", f"must have {spec.p} components, got {len(x)}")
     if req.reference and len(req.reference) != spec.p:
         raise RequestError("reference", f"must have {spec.p} components, got {len(req.reference)}")
-    gamma = spec.default_gamma if req.gamma is None else req.gamma
-    mode = req.mode or spec.default_mode
-    if (why := gamma_problem(gamma, mode)) is not None:
-        raise RequestError("gamma", why)
+    gamma, mode = gamma_and_mode(spec, req)
     paths = len(req.shifts or [0]) * len(req.scales or [0])
     starts = len(req.start_points) if req.start_points else req.starts
     cycle = len(open_loop(np.asarray(path, dtype=float)))  # (the engine's legs of a cycle)

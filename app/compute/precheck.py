@@ -4,10 +4,9 @@ from __future__ import annotations
 
 from ...engine.exceptions import InvalidInputError
 from ...engine.registry import ROBOTS
-from ...engine.solve_rules import gamma_problem
 from . import schemas as S
 from .exceptions import RequestError
-from .robot_requests import check_configuration, check_task_point
+from .robot_requests import check_configuration, check_task_point, gamma_and_mode
 from .synthesis import synthesis_region
 
 
@@ -39,6 +38,4 @@ def precheck(req: S.SolveRequest | S.RepeatabilityRequest | S.SynthesizeRequest)
     else:
         for i, pt in enumerate(req.path):
             check_task_point(spec, pt, f"path[{i}]")
-    gamma = spec.default_gamma if req.gamma is None else float(req.gamma)
-    if (why := gamma_problem(gamma, req.mode or spec.default_mode)) is not None:
-        raise RequestError("gamma", why)
+    gamma_and_mode(spec, req)

@@ -20,7 +20,7 @@ from ...engine.exceptions import JikError, SingularConfigurationError
 from ...engine.limits import robot_limits
 from ...engine.registry import RobotSpec
 from ...engine.repeatability import repeatability, repeatable
-from ...engine.solve_rules import gamma_problem, refused_starts
+from ...engine.solve_rules import refused_starts
 from ...engine.solver import solve_batch as engine_solve_batch
 from . import schemas as S
 from .documents import (
@@ -30,7 +30,7 @@ from .documents import (
     solve_response_json,
 )
 from .exceptions import RequestError
-from .robot_requests import check_configuration, check_task_point, request_robot
+from .robot_requests import check_configuration, check_task_point, gamma_and_mode, request_robot
 from .schemas.algorithms import parameters_of, used
 from .schemas.wording import without_field
 
@@ -64,10 +64,7 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
         req.robot, req.augmentation, [req.algorithm], req.algorithm_parameters, req.x0
     )
     spec, kin, (inverse,) = built.spec, built.kinematics, built.inverses
-    mode = req.mode or spec.default_mode
-    gamma = spec.default_gamma if req.gamma is None else float(req.gamma)
-    if (why := gamma_problem(gamma, mode)) is not None:
-        raise RequestError("gamma", why)
+    gamma, mode = gamma_and_mode(spec, req)
     return _Setup(
         *(spec, kin, inverse, built.robot, built.augmentation, mode, gamma),
         *(req.tolerance, req.max_iterations, parameters_of(inverse)),

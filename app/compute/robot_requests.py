@@ -15,6 +15,7 @@ from ...engine.exceptions import InvalidInputError
 from ...engine.inverses import ExtendedInverse
 from ...engine.parameters import check_params
 from ...engine.registry import ALGORITHMS, ROBOTS, RobotSpec, make_inverse
+from ...engine.solve_rules import gamma_problem
 from ...engine.units import robot_units
 from . import schemas as S
 from .exceptions import RequestError
@@ -191,6 +192,16 @@ def check_configuration(spec: RobotSpec, x0) -> None:
         raise RequestError(
             "x0", f"must have {spec.p} components ({_dimensions(spec, 'p')}), got {len(x0)}"
         )
+
+
+def gamma_and_mode(spec: RobotSpec, req) -> tuple[float, S.Mode]:
+    """The request's gamma of eq. (5) and mode, the robot's where not given; RequestError at
+    ``gamma`` when it does not suit the mode (:func:`~jik.engine.solve_rules.gamma_problem`)."""
+    mode = req.mode or spec.default_mode
+    gamma = spec.default_gamma if req.gamma is None else float(req.gamma)
+    if (why := gamma_problem(gamma, mode)) is not None:
+        raise RequestError("gamma", why)
+    return gamma, mode
 
 
 def check_task_point(spec: RobotSpec, y, name: str) -> None:
