@@ -48,13 +48,8 @@ def request_field(field: str | None, robot_keys: Sequence[str]) -> str:
 
 def built(definition: Mapping[str, Any]) -> Robot:
     """The robot of a definition, kept (keyed by its JSON text): a worker serving the same
-    robot again, a dashboard's scene and figures, reuse its kinematics and any synthesized map.
-
-    Raises
-    ------
-    InvalidInputError
-        The engine's, naming the definition's field.
-    """
+    robot again, a dashboard's scene and figures, reuse its kinematics and any synthesized map
+    (the engine's InvalidInputError, naming the definition's field, when it is refused)."""
     return _built(json.dumps(dict(definition), sort_keys=True))
 
 

@@ -24,7 +24,6 @@ from ...compute.pool import ComputePool
 from ...compute.schemas import ErrorResponse
 from ...compute.schemas.examples import openapi_examples
 from ...compute.schemas.wording import without_field
-from ..dependencies import Pool
 
 router = APIRouter(tags=["atlas"])
 #: The body, with every robot's example in the document (Swagger UI starts from the first).
@@ -40,19 +39,15 @@ def jobs_of(request: Request) -> AtlasJobs:
 
 
 async def start_job(
-    jobs: AtlasJobs,
-    pool: ComputePool,
-    request: Request,
-    response: Response,
-    req,
-    session: str | None = None,
+    jobs: AtlasJobs, request: Request, response: Response, req, session: str | None = None
 ) -> AtlasJobResponse:
-    """Plan ``req`` in a compute worker (tracing the self-motion curves solves eq. (7): within
-    the workers' time and memory limits, like any computation a request asks for), then start
-    it as a job of the client's (``session``: of that dashboard session's); the 202's body,
-    its ``Location`` the job's ``/atlas/{job_id}``."""
+    """Plan ``req`` in a worker of the app's compute pool (tracing the self-motion curves solves
+    eq. (7): within the workers' time and memory limits, like any computation a request asks
+    for), then start it as a job of the client's (``session``: of that dashboard session's);
+    the 202's body, its ``Location`` the job's ``/atlas/{job_id}``."""
     client = request.client.host if request.client else "unknown"
     jobs.check_room(client)  # (before the work)
+    pool: ComputePool = request.app.state.pool
     plan, refused = await pool.run(plan_task, req.model_dump_json(), jobs.limits)
     if refused is not None:  # (the engine's message and field)
         message, field = refused
@@ -114,11 +109,9 @@ def table_response(jobs: AtlasJobs, job: AtlasJob, every_leg: bool) -> Response:
 
 
 @router.post("/atlas", status_code=202, response_model=AtlasJobResponse, responses=ERRORS)
-async def start_atlas(
-    req: AtlasExamples, request: Request, response: Response, jobs: Jobs, pool: Pool
-):
+async def start_atlas(req: AtlasExamples, request: Request, response: Response, jobs: Jobs):
     """Plan the atlas (the self-motion curves are traced here) and start it as a job."""
-    return await start_job(jobs, pool, request, response, req)
+    return await start_job(jobs, request, response, req)
 
 
 @router.get("/atlas/{job_id}", response_model=AtlasJobResponse, responses=ERRORS)

@@ -25,7 +25,7 @@ from ...compute.schemas.wording import refused
 from ...compute.user_robots import echo
 from ...dashboard.atlas import atlas_figure, atlas_request
 from ...dashboard.plotting import figure_json
-from ..dependencies import Pool, Store
+from ..dependencies import Store
 from .atlas import ERRORS, TABLE, EveryLeg, Jobs, start_job, table_response
 
 router = APIRouter(tags=["dashboard sessions"])
@@ -63,7 +63,6 @@ async def start_session_atlas(
     response: Response,
     store: Store,
     jobs: Jobs,
-    pool: Pool,
 ):
     """Start the atlas of the session's current state (422 naming the field it refuses)."""
     state = store.get(session_id).dashboard.state
@@ -73,7 +72,7 @@ async def start_session_atlas(
         error = exc.errors()[0]
         name = ".".join(str(p) for p in error["loc"]) or "state"
         raise refused(name, error["msg"]) from None
-    return await start_job(jobs, pool, request, response, req, session_id)
+    return await start_job(jobs, request, response, req, session_id)
 
 
 @router.get("/api/sessions/{session_id}/atlas/{job_id}", responses={**ERRORS, **_NOT_FOUND})
