@@ -77,12 +77,7 @@ class AtlasJob:
         """The job's state; ``ahead``: the jobs before it in the queue, of which ``running``
         are computing (:meth:`AtlasJobs.response` counts them)."""
         end = self.ended if self.ended is not None else time.monotonic()
-        message = {
-            "running": "computing",
-            "done": "done",
-            "failed": "failed",
-            "cancelled": "cancelled",
-        }.get(self.status, "queued")
+        message: str = "computing" if self.status == "running" else self.status
         if self.status == "queued" and ahead is not None:
             message = (
                 f"queued behind {ahead} atlas job{'s' * (ahead != 1)} ({running} computing, "
