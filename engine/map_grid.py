@@ -12,10 +12,13 @@ import numpy as np
 
 from .augmentations import AugmentingMap
 from .exceptions import JikError
-from .validation import FloatArray
+from .validation import FloatArray, check_box_region, count
 
 #: Seeded samples of the box on which :func:`grid_axes` compares h's partial derivatives.
 AXIS_SAMPLES = 64
+#: The most grid points per axis (a map that raises where it is undefined is evaluated point
+#: by point).
+MAX_N = 201
 
 
 @dataclass(frozen=True)
@@ -82,20 +85,28 @@ def map_grid(
     fixed : dict name -> value, optional
         The values of variables outside the box (default 0).
     n : int
-        Grid points per axis.
+        Grid points per axis, 2 to :data:`MAX_N`.
 
     Returns
     -------
     MapGrid or None
         None for a box of fewer than two variables. A map that raises where it is undefined
         is evaluated point by point, NaN at the points where it raises.
+
+    Raises
+    ------
+    InvalidInputError
+        A region or fixed value that is not one of ``variable_names``' (field ``region.<name>``,
+        ``fixed``), an empty or reversed interval, or ``n`` out of range.
     """
+    names = list(variable_names)
+    region, held = check_box_region(names, region, fixed)
+    n = count(n, "n", 2, MAX_N)
     if len(region) < 2:
         return None
-    names = list(variable_names)
     p = len(names)
     base = np.zeros(p)
-    for k, v in (fixed or {}).items():
+    for k, v in held.items():
         base[names.index(k)] = v
     for k, (lo, hi) in region.items():
         base[names.index(k)] = 0.5 * (lo + hi)

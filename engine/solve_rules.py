@@ -106,7 +106,8 @@ def refused_starts(inverse: Inverse, x0: FloatArray) -> dict[int, str]:
     Parameters
     ----------
     inverse : Inverse
-    x0 : array_like, shape (n, p)
+    x0 : array_like, shape (n, p) or (p,)
+        Finite starts (a NaN is refused here, naming ``x0``, as :func:`solve_batch` does).
 
     Returns
     -------
@@ -115,7 +116,7 @@ def refused_starts(inverse: Inverse, x0: FloatArray) -> dict[int, str]:
         finite), or J#(x0) is undefined (the inverse's singular error). Empty when every start
         can run; :func:`jik.engine.solver.solve_batch` raises at the first refused one.
     """
-    x0 = np.asarray(x0, dtype=float)
+    x0 = np.atleast_2d(validation.as_points(x0, check_inverse(inverse).p, "x0"))
     _, bad = inverse.apply_masked(x0, np.ones((len(x0), inverse.kinematics.r)))
     return {int(i): _start_problem(inverse, x0[i]) for i in np.flatnonzero(np.atleast_1d(bad))}
 
