@@ -274,3 +274,10 @@ def platform_time(kin) -> np.ndarray | None:
     if not hasattr(kin, "path"):
         return None
     return np.linspace(0.0, float(cast(Unicycle, kin).T), UNICYCLE_TIME_POINTS)
+
+
+def spaced_iterations(m: int, count: int) -> np.ndarray:
+    """About ``count`` geometrically spaced iterations of ``m`` (ascending, each once), the first
+    and the last always: the unicycle's platform paths q(t) that the task panel and the scene
+    draw, dense at the start where they change most."""
+    return np.union1d(np.geomspace(1, m, num=count).astype(int) - 1, [0, m - 1]).astype(int)
