@@ -49,11 +49,13 @@ Record = list[tuple[FloatArray, FloatArray, FloatArray]]
 
 
 class Status:
-    """A member's outcome: running, or why it stopped (kept as ints in arrays of statuses)."""
+    """A member's outcome: running, or why it stopped (kept as ints in arrays of statuses).
+    UNDEFINED is a SINGULAR stop where J# is undefined because its augmenting map h is
+    (:meth:`jik.engine.inverses.Inverse.map_undefined`), not [J; dh] singular (eq. (11))."""
 
-    RUNNING, CONVERGED, SINGULAR, MAX_STEPS, DIVERGED, STALLED = range(6)
+    RUNNING, CONVERGED, SINGULAR, MAX_STEPS, DIVERGED, STALLED, UNDEFINED = range(7)
     #: Each outcome's name, as :attr:`jik.engine.results.SolveResult.status` gives it.
-    NAMES = ("running", "converged", "singular", "max_steps", "diverged", "stalled")
+    NAMES = ("running", "converged", "singular", "max_steps", "diverged", "stalled", "undefined")
 
 
 def gamma_problem(gamma: float, mode: str) -> str | None:
@@ -188,7 +190,7 @@ def stop_message(status, nit, err, tol, mode, gamma, x, inverse, max_iterations,
         if nit == 0:
             return f"already at the target (error {err:.3g} < {tol:g}): no motion"
         return f"converged: task error {err:.3g} < {tol:g} after {steps}"
-    if status == Status.SINGULAR:
+    if status in (Status.SINGULAR, Status.UNDEFINED):
         return str(inverse.singular_error(x)) + "; the run stopped there"
     if status == Status.STALLED:
         return f"stalled after {steps} at error {err:.3g}: {stall_reason(inverse, target, x)}"
