@@ -14,7 +14,7 @@ from typing import ClassVar
 import numpy as np
 
 from .exceptions import InvalidInputError
-from .validation import FloatArray, finite
+from .validation import FloatArray, as_numbers, finite
 
 #: h counts as conserved along a run when it changed by less than this (:func:`h_change`).
 H_CONSERVED = 1e-6
@@ -33,7 +33,9 @@ def h_change(h) -> float | None:
     """
     if h is None:
         return None
-    v = np.asarray(h, dtype=float)
+    v = as_numbers(h, "h")
+    if not v.size:
+        return None
     columns = v.reshape(len(v), -1) if v.ndim else v.reshape(1, 1)
     known = np.isfinite(columns)
     if not known.any():

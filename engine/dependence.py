@@ -12,8 +12,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .exceptions import InvalidInputError, JikError
+from .exceptions import JikError
 from .kinematics import Kinematics
+from .validation import as_box
 
 #: Seeded points of the box probed, and the shift of each variable (a fraction of its width).
 SAMPLES, SHIFT = 8, 0.371
@@ -45,7 +46,7 @@ def inert_variables(kinematics: Kinematics, amap, box: Sequence[Sequence[float]]
     InvalidInputError
         ``box`` is not p finite pairs (low, high).
     """
-    lo, hi = _box(box, kinematics.p).T
+    lo, hi = as_box(box, kinematics.p).T
     if amap is None or getattr(amap, "solves_per_point", False):
         return frozenset()
     X = np.random.default_rng(0).uniform(lo, hi, (SAMPLES, len(lo)))
@@ -66,13 +67,3 @@ def inert_variables(kinematics: Kinematics, amap, box: Sequence[Sequence[float]]
     except (JikError, ValueError, ArithmeticError):  # a map that cannot be probed: all matter
         return frozenset()
     return frozenset(inert)
-
-
-def _box(box, p: int) -> np.ndarray:
-    try:
-        b = np.asarray(box, dtype=float)
-    except (TypeError, ValueError):
-        b = np.empty(0)
-    if b.shape != (p, 2) or not np.isfinite(b).all():
-        raise InvalidInputError(f"box must be {p} finite pairs (low, high)", field="box")
-    return b

@@ -86,6 +86,9 @@ class VectorExtendedInverse(Inverse):
         dh = np.where(undefined[..., None, None], 0.0, dh)
         return np.concatenate([self.kinematics.jacobian_unchecked(x), dh], axis=-2), undefined
 
+    def map_undefined(self, x: FloatArray) -> FloatArray:
+        return self._extended(x)[1]
+
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
         Jbar, undefined = self._extended(x)
         return solve_extended(Jbar, e, undefined)

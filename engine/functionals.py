@@ -28,7 +28,7 @@ from .inverses import (
     require_compatible,
 )
 from .kinematics import Kinematics
-from .validation import FloatArray, count, finite
+from .validation import FloatArray, check_box_region, count, finite
 
 # name -> (lo, hi); any two-item sequence (JSON gives lists), validated by check_region.
 Region = Mapping[str, Sequence[float]]
@@ -96,7 +96,8 @@ class FunctionalValue:
 def check_region(
     kinematics: Kinematics, region: Region, fixed: Mapping[str, float] | None = None
 ) -> tuple[dict[str, tuple[float, float]], dict[str, float]]:
-    """Validate a box region and the fixed values of the other variables.
+    """Validate a box region of the kinematics' variables and the fixed values of the others
+    (:func:`jik.engine.validation.check_box_region`).
 
     Returns
     -------
@@ -104,38 +105,7 @@ def check_region(
     fixed : dict name -> value for every variable not in ``region`` (default 0)
     """
     names = tuple(kinematics.variable_names) or tuple(f"x{i + 1}" for i in range(kinematics.p))
-    if not isinstance(region, Mapping) or not region:
-        raise InvalidInputError(
-            f"region must be a non-empty mapping of {names} to (lo, hi)", "region"
-        )
-    fixed = dict(fixed or {})
-    for name in (*region, *fixed):
-        if name not in names:
-            raise InvalidInputError(
-                f"unknown joint variable {name!r}; use one of {names}",
-                "region" if name in region else "fixed",
-            )
-    if both := sorted(set(region) & set(fixed)):
-        raise InvalidInputError(f"variables {both} are both integrated over and fixed", "fixed")
-    box: dict[str, tuple[float, float]] = {}
-    for name in names:
-        if name not in region:
-            continue
-        try:
-            lo, hi = region[name]
-        except (TypeError, ValueError) as exc:
-            raise InvalidInputError(
-                f"region[{name!r}] must be a pair (lo, hi)", f"region.{name}"
-            ) from exc
-        lo = finite(lo, f"lower bound of {name}", f"region.{name}")
-        hi = finite(hi, f"upper bound of {name}", f"region.{name}")
-        if not lo < hi:
-            raise InvalidInputError(
-                f"region[{name!r}] must have lo < hi, got ({lo}, {hi})", f"region.{name}"
-            )
-        box[name] = (lo, hi)
-    fix = {n: finite(fixed.get(n, 0.0), f"fixed {n}", f"fixed.{n}") for n in names if n not in box}
-    return box, fix
+    return check_box_region(names, region, fixed)
 
 
 def quadrature(

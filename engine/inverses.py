@@ -208,6 +208,12 @@ class Inverse(abc.ABC):
         """h(x) for the extended inverse, None for the pseudoinverse."""
         return None
 
+    def map_undefined(self, x: FloatArray) -> FloatArray:
+        """Where J#(x) is undefined because an augmenting map h of eq. (9) is (its gradient
+        cannot be evaluated there), not because [J; dh] is singular: bool (...,), all False
+        for an inverse without a map."""
+        return np.zeros(np.shape(x)[:-1], dtype=bool)
+
     def apply(self, x: FloatArray, e: FloatArray) -> FloatArray:
         """J#(x) e, shape (..., p); raises at a singular configuration."""
         x = self.kinematics.check(x)
@@ -290,6 +296,9 @@ class ExtendedInverse(Inverse):
         """h(x), NaN where h is undefined (a run can stop at such a point)."""
         return self.augmenting_map.value_masked(x)[0]
 
+    def map_undefined(self, x: FloatArray) -> FloatArray:
+        return self.augmenting_map.gradient_masked(x)[1]
+
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
         dh, undefined = self.augmenting_map.gradient_masked(x)
         dh = np.where(undefined[..., None], 0.0, dh)  # keeps the solve below free of NaN
@@ -304,8 +313,7 @@ class ExtendedInverse(Inverse):
         return out
 
     def singular_error(self, x: FloatArray) -> Exception:
-        _, undefined = self.augmenting_map.gradient_masked(np.asarray(x, dtype=float)[None])
-        if undefined[0]:
+        if self.map_undefined(np.asarray(x, dtype=float)[None])[0]:
             return AlgorithmicSingularityError(
                 f"the augmenting map {self.augmenting_map.name!r} is undefined (its gradient "
                 "cannot be evaluated), so the extended Jacobian inverse (11) is undefined; "

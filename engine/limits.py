@@ -193,6 +193,14 @@ def run_report(kinematics, result) -> LimitsReport | None:
     """Whether a run of ``kinematics`` (a solve's result, or a single start's repeatability
     result) stayed within its joint limits, and its first violation; None for a robot
     without limits."""
+    if not hasattr(result, "leg_results") and not isinstance(
+        getattr(result, "x", None), np.ndarray
+    ):
+        raise InvalidInputError(
+            "result must be a SolveResult or a single start's RepeatabilityResult, got "
+            f"{type(result).__name__}",
+            "result",
+        )
     limits = robot_limits(kinematics)
     if limits is None:
         return None

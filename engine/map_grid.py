@@ -12,10 +12,13 @@ import numpy as np
 
 from .augmentations import AugmentingMap
 from .exceptions import JikError
-from .validation import FloatArray
+from .validation import FloatArray, check_box_region, count
 
 #: Seeded samples of the box on which :func:`grid_axes` compares h's partial derivatives.
 AXIS_SAMPLES = 64
+#: The most grid points per axis (a map that raises where it is undefined is evaluated point
+#: by point).
+MAX_N = 201
 
 
 @dataclass(frozen=True)
@@ -34,16 +37,33 @@ class MapGrid:
     h: FloatArray
 
 
+def varying_most(dh: FloatArray, spread: FloatArray | None = None) -> tuple[int, int]:
+    """The two variables h varies most with at some configurations: the largest mean |dh/dx_i|
+    (the gradient of eq. (9)'s map) over the rows of ``dh`` (n, k), rows where h is undefined
+    (NaN) left out, each times ``spread_i + 1`` when ``spread`` (k,) is given (how far the
+    configurations extend along x_i, e.g. a run's: a variable they move along counts more). A
+    variable whose gradient is never defined comes last. Ascending indices; ties keep the
+    variables' order."""
+    g = np.abs(np.asarray(dh, dtype=float))
+    defined = np.isfinite(g)
+    count = defined.sum(axis=0)
+    score = np.where(count > 0, np.where(defined, g, 0.0).sum(axis=0) / np.maximum(count, 1), -1.0)
+    if spread is not None:
+        score = score * (np.asarray(spread, dtype=float) + 1.0)
+    i, j = sorted(np.argsort(-score, kind="stable")[:2])
+    return int(i), int(j)
+
+
 def grid_axes(
     amap: AugmentingMap,
     variable_names: Sequence[str],
     region: Mapping[str, tuple[float, float]],
     base: FloatArray,
 ) -> list[str]:
-    """The two variables of ``region`` along which h varies most: the largest mean |dh/dx_i|
-    (the gradient of eq. (9)'s map) on :data:`AXIS_SAMPLES` seeded uniform samples of the box,
-    the other variables at ``base`` (p,). All of them for a box of at most two variables, the
-    first two when the gradient cannot be evaluated. Returned in the box's order."""
+    """The two variables of ``region`` along which h varies most (:func:`varying_most`) on
+    :data:`AXIS_SAMPLES` seeded uniform samples of the box, the other variables at ``base``
+    (p,). All of them for a box of at most two variables, the first two when the gradient
+    cannot be evaluated. Returned in the box's order."""
     if len(region) <= 2:
         return list(region)
     names = list(variable_names)
@@ -53,12 +73,12 @@ def grid_axes(
         x[:, names.index(k)] = rng.uniform(lo, hi, AXIS_SAMPLES)
     with np.errstate(all="ignore"):
         try:
-            g = np.abs(np.asarray(amap.gradient(x), dtype=float))
+            g = np.asarray(amap.gradient(x), dtype=float)
         except JikError:
             return list(region)[:2]
-    score = {k: float(np.nanmean(g[:, names.index(k)])) for k in region}
-    top = sorted(region, key=lambda k: -(score[k] if np.isfinite(score[k]) else -1.0))[:2]
-    return [k for k in region if k in top]
+    keys = list(region)
+    i, j = varying_most(g[:, [names.index(k) for k in keys]])
+    return [keys[i], keys[j]]
 
 
 def map_grid(
@@ -82,20 +102,28 @@ def map_grid(
     fixed : dict name -> value, optional
         The values of variables outside the box (default 0).
     n : int
-        Grid points per axis.
+        Grid points per axis, 2 to :data:`MAX_N`.
 
     Returns
     -------
     MapGrid or None
         None for a box of fewer than two variables. A map that raises where it is undefined
         is evaluated point by point, NaN at the points where it raises.
+
+    Raises
+    ------
+    InvalidInputError
+        A region or fixed value that is not one of ``variable_names``' (field ``region.<name>``,
+        ``fixed``), an empty or reversed interval, or ``n`` out of range.
     """
+    names = list(variable_names)
+    region, held = check_box_region(names, region, fixed)
+    n = count(n, "n", 2, MAX_N)
     if len(region) < 2:
         return None
-    names = list(variable_names)
     p = len(names)
     base = np.zeros(p)
-    for k, v in (fixed or {}).items():
+    for k, v in held.items():
         base[names.index(k)] = v
     for k, (lo, hi) in region.items():
         base[names.index(k)] = 0.5 * (lo + hi)

@@ -15,7 +15,7 @@ import numpy as np
 
 from . import so3
 from .exceptions import InvalidInputError
-from .validation import FloatArray
+from .validation import FloatArray, as_points
 
 COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
 _TOKEN = re.compile(r"r[xyz]|[xyz]")
@@ -119,7 +119,7 @@ class PoseTask:
         what the task holds: its position t (..., 3) when the task holds x, y and z, its
         orientation R = R0 exp(phi) (..., 3, 3) when it holds rx, ry and rz; None for what the
         task leaves free (a target of eq. (4) then fixes no point or no frame in space)."""
-        y = np.asarray(y, dtype=float)
+        y = as_points(y, len(self.names), "y")
         at = dict(zip(self.names, np.moveaxis(y, -1, 0), strict=True))
         t, phi = (
             np.stack([at[c] for c in part], axis=-1) if set(part) <= at.keys() else None

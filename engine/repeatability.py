@@ -29,7 +29,7 @@ from .solve_chunks import solve_in_chunks
 from .solve_rules import check_inverse, check_settings, run_bytes
 from .solver import solve, solve_batch
 from .unicycle import Unicycle
-from .validation import FloatArray, check_memory, count
+from .validation import FloatArray, as_numbers, check_memory, count
 
 #: A run is called repeatable when its joints come back to x0 within this after every cycle
 #: (‖x − x0‖ in the joint coordinates' own units): the API's verdict and the dashboard's.
@@ -80,7 +80,7 @@ def repeatable(drift) -> bool | None:
     ||x - x0|| (a :class:`RepeatabilityResult`'s ``drift``, NaN from a failed leg on) below
     :data:`REPEATABLE_DRIFT`; None when no cycle ended (sec. 5.2.1: closed task paths give
     closed joint paths)."""
-    d = np.asarray(drift, dtype=float)
+    d = as_numbers(drift, "drift")
     d = d[np.isfinite(d)]
     return bool(np.all(d < REPEATABLE_DRIFT)) if d.size else None
 

@@ -112,8 +112,9 @@ class SolveResult(Columns):
     status : str
         Why the run stopped, for a caller that words its own message: "converged",
         "max_steps" (out of iterations or integrator steps), "diverged", "stalled", "singular"
-        (the inverse singular where it stopped) or "raised" (a typed error stopped it where it
-        is: :func:`jik.engine.solve_chunks.solve_in_chunks`, a leg of
+        (the inverse singular where it stopped), "undefined" (the inverse undefined there
+        because its augmenting map h is, not [J; dh] singular) or "raised" (a typed error
+        stopped it where it is: :func:`jik.engine.solve_chunks.solve_in_chunks`, a leg of
         :func:`jik.engine.repeatability.repeatability` whose progress stops at errors).
     """
 

@@ -41,7 +41,7 @@ from .exceptions import InvalidInputError
 from .inverses import Pseudoinverse
 from .kinematics import Kinematics
 from .urdf import UrdfChain
-from .validation import FloatArray, count, finite
+from .validation import FloatArray, as_box, count, finite
 
 #: Tolerances of the traced orbit (relative and absolute, on x).
 TRACE_TOL = 1e-12
@@ -226,7 +226,9 @@ def trace(
     y0 = kinematics.forward(base)
     base = project(kinematics, base[None], y0)[0]
     periodic = periodic_joints(kinematics)
-    bounds, leaves = None if box is None else np.array(box, dtype=float), None
+    if not isinstance(bound_free_joints, bool):
+        raise InvalidInputError("bound_free_joints must be True or False", "bound_free_joints")
+    bounds, leaves = None if box is None else as_box(box, kinematics.p, finite=False), None
     if bounds is not None:
         if not bound_free_joints:
             bounds[periodic] = (-np.inf, np.inf)  # (x and x + 2 pi: one posture)
@@ -378,9 +380,7 @@ def manifold_starts(
         raise InvalidInputError(f"x0 must be one configuration of {kinematics.p} numbers", "x0")
     if isinstance(n, bool) or not isinstance(n, int | np.integer) or not 1 <= n <= 10**5:
         raise InvalidInputError(f"n must be an integer from 1 to 100000, got {n!r}", "n")
-    lim = np.asarray(box, dtype=float)
-    if lim.shape != (kinematics.p, 2):
-        raise InvalidInputError(f"box must be {kinematics.p} pairs (low, high)", "box")
+    lim = as_box(box, kinematics.p, finite=False)
     y0 = kinematics.forward(x0)
     J = np.asarray(kinematics.jacobian(x0), dtype=float)
     null = np.eye(kinematics.p) - np.linalg.pinv(J) @ J

@@ -130,7 +130,7 @@ def solve_in_chunks(
         raise stopped
     if stopped is not None:
         message = f"stopped after {done} iterations: {stopped}"
-    elif status == Status.SINGULAR:
+    elif status in (Status.SINGULAR, Status.UNDEFINED):
         message = last.message  # (names the configuration, not the count)
     else:
         message = stop_message(

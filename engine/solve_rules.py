@@ -49,11 +49,13 @@ Record = list[tuple[FloatArray, FloatArray, FloatArray]]
 
 
 class Status:
-    """A member's outcome: running, or why it stopped (kept as ints in arrays of statuses)."""
+    """A member's outcome: running, or why it stopped (kept as ints in arrays of statuses).
+    UNDEFINED is a SINGULAR stop where J# is undefined because its augmenting map h is
+    (:meth:`jik.engine.inverses.Inverse.map_undefined`), not [J; dh] singular (eq. (11))."""
 
-    RUNNING, CONVERGED, SINGULAR, MAX_STEPS, DIVERGED, STALLED = range(6)
+    RUNNING, CONVERGED, SINGULAR, MAX_STEPS, DIVERGED, STALLED, UNDEFINED = range(7)
     #: Each outcome's name, as :attr:`jik.engine.results.SolveResult.status` gives it.
-    NAMES = ("running", "converged", "singular", "max_steps", "diverged", "stalled")
+    NAMES = ("running", "converged", "singular", "max_steps", "diverged", "stalled", "undefined")
 
 
 def gamma_problem(gamma: float, mode: str) -> str | None:
@@ -106,7 +108,8 @@ def refused_starts(inverse: Inverse, x0: FloatArray) -> dict[int, str]:
     Parameters
     ----------
     inverse : Inverse
-    x0 : array_like, shape (n, p)
+    x0 : array_like, shape (n, p) or (p,)
+        Finite starts (a NaN is refused here, naming ``x0``, as :func:`solve_batch` does).
 
     Returns
     -------
@@ -115,7 +118,7 @@ def refused_starts(inverse: Inverse, x0: FloatArray) -> dict[int, str]:
         finite), or J#(x0) is undefined (the inverse's singular error). Empty when every start
         can run; :func:`jik.engine.solver.solve_batch` raises at the first refused one.
     """
-    x0 = np.asarray(x0, dtype=float)
+    x0 = np.atleast_2d(validation.as_points(x0, check_inverse(inverse).p, "x0"))
     _, bad = inverse.apply_masked(x0, np.ones((len(x0), inverse.kinematics.r)))
     return {int(i): _start_problem(inverse, x0[i]) for i in np.flatnonzero(np.atleast_1d(bad))}
 
@@ -187,7 +190,7 @@ def stop_message(status, nit, err, tol, mode, gamma, x, inverse, max_iterations,
         if nit == 0:
             return f"already at the target (error {err:.3g} < {tol:g}): no motion"
         return f"converged: task error {err:.3g} < {tol:g} after {steps}"
-    if status == Status.SINGULAR:
+    if status in (Status.SINGULAR, Status.UNDEFINED):
         return str(inverse.singular_error(x)) + "; the run stopped there"
     if status == Status.STALLED:
         return f"stalled after {steps} at error {err:.3g}: {stall_reason(inverse, target, x)}"

@@ -312,6 +312,9 @@ def solve_batch(
     else:
         x, _, status, nit, rec = _discrete(inverse, xb, yb, gamma, tol, cap, record)
         theta_scale = 1.0
+    singular = np.flatnonzero(status == Status.SINGULAR)
+    if singular.size:  # (the inverse undefined there because its map h is)
+        status[singular[inverse.map_undefined(x[singular])]] = Status.UNDEFINED
     y = kin.forward_unchecked(x)
     err = np.linalg.norm(y - yb, axis=-1)
     messages = tuple(

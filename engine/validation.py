@@ -8,6 +8,7 @@ a descriptive ``name`` ("target y_d") gives no field unless ``field`` is passed.
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
@@ -30,6 +31,16 @@ def field_for(name: str, field: str | None = None) -> str | None:
     if field is not None:
         return field
     return name if _FIELD.fullmatch(name) else None
+
+
+def as_numbers(x, name: str, field: str | None = None) -> FloatArray:
+    """``x`` as a float array (NaN and inf allowed), or an error naming ``name``."""
+    try:
+        return np.asarray(x, dtype=float)
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise InvalidInputError(
+            f"{name} must be numeric, got {x!r:.80}", field_for(name, field)
+        ) from exc
 
 
 def as_points(x, size: int, name: str, field: str | None = None) -> FloatArray:
@@ -69,6 +80,23 @@ def as_vector(x, size: int, name: str, field: str | None = None) -> FloatArray:
             field_for(name, field),
         )
     return a
+
+
+def as_box(box, p: int, name: str = "box", *, finite: bool = True) -> FloatArray:
+    """Check that ``box`` is ``p`` pairs (low, high) with low < high, no NaN, and finite unless
+    ``finite`` is False (then an infinite end leaves its variable unbounded); return it (p, 2)."""
+    try:
+        b = np.array(box, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        b = np.empty(0)
+    bad = b.shape != (p, 2) or np.isnan(b).any() or (finite and not np.isfinite(b).all())
+    if bad or np.any(b[..., 0] >= b[..., 1]):
+        kind = "finite pairs" if finite else "pairs"
+        raise InvalidInputError(
+            f"{name} must be {p} {kind} (low, high) with low < high, got {box!r:.80}",
+            field_for(name),
+        )
+    return b
 
 
 def within(x, bounds, name: str, names, where: str, field: str | None = None) -> None:
@@ -189,3 +217,50 @@ def json_number(value, name: str, field: str | None = None) -> float:
         return finite(value, name)
     except InvalidInputError as exc:
         raise InvalidInputError(str(exc), field or name) from None
+
+
+def check_box_region(
+    names: Sequence[str], region, fixed: Mapping[str, float] | None = None
+) -> tuple[dict[str, tuple[float, float]], dict[str, float]]:
+    """Validate a box region over some of the variables ``names`` (name -> (lo, hi), lo < hi,
+    finite) and the fixed values of the others (name -> value, default 0): the design region
+    of sec. 5, where E1 (13) and E2 (18) are taken.
+
+    Returns
+    -------
+    region : dict name -> (lo, hi), in the order of ``names``
+    fixed : dict name -> value for every variable not in ``region``
+    """
+    names = tuple(names)
+    if not isinstance(region, Mapping) or not region:
+        raise InvalidInputError(
+            f"region must be a non-empty mapping of {names} to (lo, hi)", "region"
+        )
+    fixed = dict(fixed or {})
+    for name in (*region, *fixed):
+        if name not in names:
+            raise InvalidInputError(
+                f"unknown joint variable {name!r}; use one of {names}",
+                "region" if name in region else "fixed",
+            )
+    if both := sorted(set(region) & set(fixed)):
+        raise InvalidInputError(f"variables {both} are both integrated over and fixed", "fixed")
+    box: dict[str, tuple[float, float]] = {}
+    for name in names:
+        if name not in region:
+            continue
+        try:
+            lo, hi = region[name]
+        except (TypeError, ValueError) as exc:
+            raise InvalidInputError(
+                f"region[{name!r}] must be a pair (lo, hi)", f"region.{name}"
+            ) from exc
+        lo = finite(lo, f"lower bound of {name}", f"region.{name}")
+        hi = finite(hi, f"upper bound of {name}", f"region.{name}")
+        if not lo < hi:
+            raise InvalidInputError(
+                f"region[{name!r}] must have lo < hi, got ({lo}, {hi})", f"region.{name}"
+            )
+        box[name] = (lo, hi)
+    fix = {n: finite(fixed.get(n, 0.0), f"fixed {n}", f"fixed.{n}") for n in names if n not in box}
+    return box, fix

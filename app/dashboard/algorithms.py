@@ -6,7 +6,7 @@ A state chooses one to five algorithms (``algorithms``, default the paper's two,
 and ``damping_threshold`` of damped least squares, ``gain`` of the posture inverse), with their
 ranges from the engine's :class:`~jik.engine.parameters.Parameter`, and the posture inverse's
 rest x_rest (``rest``, p numbers within the robot's joint limits, the engine's rule, and
-within its sliders' range, :func:`rest_box`; without it, the engine's default,
+within its sliders' range, :func:`joint_box`; without it, the engine's default,
 :func:`~jik.engine.algorithm_registry.default_rest`: the robot's home, else the state's start
 x0, which a rest slider moved first brings into that range, :func:`editable_rest`). The
 weighted inverse takes the robot's joint limits (else its configuration box), and is refused
@@ -203,24 +203,17 @@ def scalar(state: ChosenState, name: str) -> float:
     return float(value)
 
 
-def configuration_box(spec) -> tuple[tuple[float, float], ...]:
-    """The range of each joint variable on the sliders of x0: the robot's ``x_range`` (an arm's
-    joint limits), else :data:`DEFAULT_BOX`. It may be wider than the joint limits (a planar
-    chain or a formula robot given ``limits`` but no ``x_range``): a start outside the limits is
-    accepted and reported as leaving them at cycle 0 (:mod:`jik.engine.limits`), so x0's
-    sliders reach it; the rest's, which the limits bound, span :func:`rest_box`."""
-    if spec.x_range:
-        return tuple((float(lo), float(hi)) for lo, hi in spec.x_range)
-    return (DEFAULT_BOX,) * len(spec.variable_names)
-
-
-def rest_box(spec, kin) -> tuple[tuple[float, float], ...]:
-    """The range of each slider of the posture inverse's rest, what :func:`checked_rest`
-    accepts: the robot's joint limits (:func:`~jik.engine.limits.robot_limits`), x0's slider
-    range (:func:`configuration_box`) on a side without a limit (a continuous joint; the
-    whole box for a robot without limits), or that range's width beyond a finite limit the box
-    lies on the other side of (:func:`~jik.engine.limits.limited_box`)."""
-    box = limited_box(configuration_box(spec), robot_limits(kin))
+def joint_box(spec, kin) -> tuple[tuple[float, float], ...]:
+    """The range of each slider of a joint configuration, x0's and the posture rest's (what
+    :func:`checked_rest` accepts): the robot's joint limits
+    (:func:`~jik.engine.limits.robot_limits`), its ``x_range`` (an arm's joint limits) else
+    :data:`DEFAULT_BOX` on a side without a limit (a continuous joint; the whole range for a
+    robot without limits), or that range's width beyond a finite limit it lies on the other
+    side of (:func:`~jik.engine.limits.limited_box`). A start outside the limits, which the
+    engine accepts and reports as leaving them at cycle 0 (:mod:`jik.engine.limits`), is typed
+    in x0's exact-value boxes."""
+    x_range = spec.x_range or (DEFAULT_BOX,) * len(spec.variable_names)
+    box = limited_box(x_range, robot_limits(kin))
     return tuple((float(a), float(b)) for a, b in box)
 
 
@@ -228,7 +221,7 @@ def checked_rest(value, spec, kin, x0) -> tuple[float, ...] | None:
     """The posture inverse's rest x_rest as set (``algorithm_parameters.rest``), checked: p
     finite numbers, within the robot's joint limits if it has some (the engine's
     :func:`~jik.engine.practical_inverses.check_rest`, in its words) and within the range of
-    its sliders (:func:`rest_box`; the only bound of a robot without limits, whose REST API
+    its sliders (:func:`joint_box`; the only bound of a robot without limits, whose REST API
     runs take any finite rest); None when it is the default in force
     (:func:`~jik.engine.algorithm_registry.default_rest`: the robot's home, else the start
     ``x0``, taken as it is, like the engine's default), which the state then follows, as it
@@ -260,7 +253,7 @@ def checked_rest(value, spec, kin, x0) -> tuple[float, ...] | None:
         return None
     try:
         check_rest(kin, rest)
-        within(rest, rest_box(spec, kin), "rest", names, "the range of the rest's sliders")
+        within(rest, joint_box(spec, kin), "rest", names, "the range of the rest's sliders")
     except InvalidInputError as exc:
         where = f"algorithm_parameters.{exc.field}"
         raise refused(where, without_field(str(exc), exc.field)) from None
@@ -278,20 +271,20 @@ def posture_rest(state: ChosenState, kin) -> tuple[list[float], str]:
 
 def editable_rest(state: ChosenState, spec, kin) -> list[float]:
     """The rest that one rest slider moved changes: the state's, else the default in force
-    brought into the sliders' range (:func:`rest_box`), as the sliders show it. A default
+    brought into the sliders' range (:func:`joint_box`), as the sliders show it. A default
     outside the joint limits (a start outside them) is accepted as it is, but a rest set is
     checked: the coordinates the user did not touch take the nearest value accepted."""
     rest, source = posture_rest(state, kin)
     if source == "set":
         return rest
-    lo, hi = np.array(rest_box(spec, kin)).T
+    lo, hi = np.array(joint_box(spec, kin)).T
     return [float(v) for v in np.clip(rest, lo, hi)]
 
 
 def rest_words(state: ChosenState, spec, kin) -> str:
     """The rest in force in words, for the verdict: ``x_rest = the robot's home (0, -0.785,
     ...)``, ``x_rest = x0 (...)`` (set so, or the default), or the numbers set; a default
-    outside the rest's sliders (:func:`rest_box`: the joint limits) says what moving one of
+    outside the rest's sliders (:func:`joint_box`: the joint limits) says what moving one of
     them makes of it (:func:`editable_rest`)."""
     rest, source = posture_rest(state, kin)
     shown = "(" + ", ".join(f"{v:.4g}" for v in rest) + ")"

@@ -9,6 +9,7 @@ from collections.abc import Callable, Mapping
 import numpy as np
 
 from ...engine.exceptions import JikError
+from ...engine.map_grid import varying_most
 from ...engine.progress import ProgressCallbacks
 from .model import DashboardState
 from .robots import state_kinematics, state_spec
@@ -16,7 +17,8 @@ from .runs import AlgorithmRun
 
 
 def augmenting_axes(amap, x: np.ndarray, on_batch=None) -> tuple[int, int]:
-    """The two joint variables h depends on most along the configurations ``x`` (n, p).
+    """The two joint variables h depends on most along the configurations ``x`` (n, p), their
+    spread counted (:func:`jik.engine.map_grid.varying_most`).
 
     ``on_batch(done, total)``: after each batch of :data:`GRID_BATCH` points of an expensive
     map (:func:`expensive_map`), whose gradient solves a problem per point.
@@ -24,12 +26,9 @@ def augmenting_axes(amap, x: np.ndarray, on_batch=None) -> tuple[int, int]:
     with np.errstate(all="ignore"):
         if expensive_map(amap):
             dh = amap.evaluate_batches(x, GRID_BATCH, ProgressCallbacks(on_advance=on_batch))[1]
-            g = np.abs(np.asarray(dh, dtype=float))
         else:
-            g = np.abs(np.asarray(amap.gradient(x), dtype=float))
-    weight = np.nan_to_num(np.nanmean(g, axis=0)) * (np.ptp(x, axis=0) + 1.0)
-    i, j = sorted(np.argsort(-weight, kind="stable")[:2])
-    return int(i), int(j)
+            dh = amap.gradient(x)
+    return varying_most(dh, np.ptp(x, axis=0))
 
 
 def kinematics_and_map(state: DashboardState, kin=None):

@@ -19,7 +19,6 @@ from typing import Any
 import numpy as np
 
 from ...engine.exceptions import InvalidInputError
-from ...engine.registry import ROBOTS, RobotSpec
 from ...engine.self_motion import manifold_starts
 from ..compute.atlas_schemas import AtlasRequest
 from .algorithms import STYLES, inverse_parameters
@@ -105,9 +104,10 @@ def request_robot(state: DashboardState) -> tuple[dict, dict | None]:
 def atlas_figure(
     result: dict[str, Any], request: AtlasRequest, x_units: Sequence[str] = ()
 ) -> dict:
-    """The heatmap of a finished atlas (the ``result`` of ``GET /atlas/{id}``): for each
-    algorithm, log10 of the drift ||x after cycle c - x0|| over the starts' arc length s
-    (columns) and the cycles (rows; per path scale when several), one colour scale for both.
+    """The heatmap of a finished atlas of :func:`atlas_request`'s ``request`` (the ``result``
+    of ``GET /atlas/{id}``): for each algorithm, log10 of the drift ||x after cycle c - x0||
+    over the starts' arc length s (columns) and the cycles (rows; per path scale when
+    several), one colour scale for both.
     A cell's ``customdata`` is its run, path * N + start (for a click); ``x_units``, the
     units of x (the job's ``robot.units.x``), give the arc length's."""
     algorithms = result["algorithms"]
@@ -210,14 +210,11 @@ def atlas_figure(
                 "font": {"size": 11, "color": STYLES[algorithms[k]].color},
             }
         )
-    # (a job of POST /atlas may leave them to the robot: a robot the request defines has
-    # RobotSpec's defaults, as its build gives them)
-    spec = ROBOTS.get(request.robot.name)
-    gamma = request.gamma if request.gamma is not None else (spec or RobotSpec).default_gamma
-    mode = request.mode or (spec or RobotSpec).default_mode
+    # (a session's atlas, whose request atlas_request made: gamma and mode the state's)
+    assert request.gamma is not None and request.mode is not None
     title = (
         f"Drift after each cycle from {N} starts on k(x) = k(x0) (dotted: x0), "
-        f"{request.robot.name}, γ = {gamma:g}, {mode} mode"
+        f"{request.robot.name}, γ = {request.gamma:g}, {request.mode} mode"
     )
     logs = np.concatenate([np.ravel(t["z"]) for t in data])
     logs = logs[np.isfinite(logs)]

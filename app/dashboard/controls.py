@@ -24,7 +24,7 @@ from typing import Any
 from ...engine.arms import ARMS
 from ...engine.registry import ROBOTS
 from ...engine.solve_rules import DISCRETE_GAMMA_BOUND, MAX_ITERATIONS, MAX_STEPS
-from .algorithms import STYLES, configuration_box, posture_rest, rest_box, scalar_parameters
+from .algorithms import STYLES, joint_box, posture_rest, scalar_parameters
 from .control_changes import PATH_FORMAT, path_text
 from .glossary import SYMBOLS
 from .robots import state_kinematics, state_spec
@@ -188,7 +188,7 @@ def controls(state) -> list[Control]:
                 )
             )
     text = "start configuration, coordinate {}. " + SYMBOLS["x0"]
-    out += joint_sliders("x0", "start", spec, text, configuration_box(spec))
+    out += joint_sliders("x0", "start", spec, text, joint_box(spec, state_kinematics(state)))
     if len(spec.variable_names) > 3:
         names = spec.variable_names
         out.append(
@@ -254,14 +254,14 @@ def controls(state) -> list[Control]:
 
 def rest_controls(state, spec) -> list[Control]:
     """The posture inverse's rest x_rest: a slider per joint variable over what it accepts
-    (:func:`~jik.app.dashboard.algorithms.rest_box`), and buttons setting it to the start x0
+    (:func:`~jik.app.dashboard.algorithms.joint_box`), and buttons setting it to the start x0
     and, for a robot with one, to its home (the default)."""
     kin, key = state_kinematics(state), "algorithm_parameters.rest"
     home = getattr(kin, "home", None)
     default = "the robot's home" if home is not None else "the start x0"
     text = f"rest configuration, coordinate {{}} (default: {default}; moving one sets the "
     text += f"rest, the others at their nearest value a slider takes). {SYMBOLS['rest']}"
-    out = joint_sliders(key, "algorithm", spec, text, rest_box(spec, kin))
+    out = joint_sliders(key, "algorithm", spec, text, joint_box(spec, kin))
     out.append(preset_button(key, "x0", "x0", "set the rest to the start configuration x0"))
     if home is not None:
         shown = ", ".join(f"{t:.3g}" for t in home)

@@ -36,7 +36,7 @@ from .plotting import (
     units,
 )
 from .pose_figures import algorithms_key, is_pose_task, pose_task_spec
-from .runs import DashboardResult
+from .runs import DashboardResult, spaced_iterations
 from .table import table_spec
 
 
@@ -191,7 +191,7 @@ def _platform(result: DashboardResult) -> dict:
         P = result.runs[a].platform
         assert P is not None  # drawn only for the unicycle, whose runs all carry platform paths
         m = len(P)
-        show = sorted(set(np.geomspace(1, m, num=PLATFORM_PATHS).astype(int) - 1) | {0, m - 1})
+        show = spaced_iterations(m, PLATFORM_PATHS)
         for n, i in enumerate(show):
             last = bool(i == m - 1)
             data.append(

@@ -11,14 +11,9 @@ from dataclasses import asdict
 
 from ...engine.arms import ARMS
 from ...engine.robot_kinds import ARM, robot_kinds
-from .algorithms import COLORS, LABELS
-from .algorithms import STYLES as DRAWN
+from .algorithms import COLORS, LABELS, STYLES
 from .controls import PROGRESS_AFTER
 from .plotting import PANEL_SIZES
-
-#: How each algorithm is drawn, everywhere: its colour (COLORS), its line style in the plots
-#: (plotly's ``dash``) and its robot in the 3D scene (:data:`jik.app.dashboard.algorithms.STYLES`).
-STYLES = {a: {"dash": s.dash, "line": s.line, "robot": s.robot} for a, s in DRAWN.items()}
 
 #: What each panel shows, and how to read it.
 PANEL_HELP = {
@@ -68,7 +63,11 @@ def page_config() -> dict:
     return {
         "colors": COLORS,
         "labels": LABELS,
-        "styles": STYLES,
+        # (how each algorithm is drawn, everywhere: its line style in the plots, plotly's
+        # ``dash``, and its robot in the 3D scene, :data:`jik.app.dashboard.algorithms.STYLES`)
+        "styles": {
+            a: {"dash": s.dash, "line": s.line, "robot": s.robot} for a, s in STYLES.items()
+        },
         "panels": [{"id": k, "size": v, "help": PANEL_HELP[k]} for k, v in PANEL_SIZES.items()],
         "progress_after": PROGRESS_AFTER,
         "tools": [{"id": "atlas", "help": ATLAS_HELP}],

@@ -52,6 +52,9 @@ class AlgorithmRun:
         ||x at the end of cycle c - x0|| (closed-path task only, else empty).
     platform : ndarray, shape (m, T, 3) or None
         Unicycle only: the platform path q(t) for the controls of every iteration.
+    status : str
+        Why its last leg stopped, the engine's :attr:`~jik.engine.results.SolveResult.status`
+        ("converged"; "undefined": its augmenting map h undefined there; ...).
     settings : RunSettings or None
         The engine's record of the inverse, targets and settings of the legs
         (:attr:`jik.engine.results.RepeatabilityResult.settings`): a run going on from this
@@ -70,6 +73,7 @@ class AlgorithmRun:
     success: bool
     message: str
     seconds: float
+    status: str = "converged"
     platform: np.ndarray | None = None
     settings: RunSettings | None = None
 
@@ -116,6 +120,7 @@ def _run_legs(
     L = len(targets)
     parts = []  # (theta, x, y, error, h, leg index) of every leg
     offset, last, failure = 0.0, "", ""  # (the last leg's message; what stopped the run)
+    status = "converged"  # (the last leg's)
     earlier = None
     if resume is not None:
         parts.append((resume.theta, resume.x, resume.y, resume.error, resume.h, resume.leg))
@@ -125,8 +130,9 @@ def _run_legs(
         earlier = Resume(x0, resume.leg_end, guides, resume.settings)
 
     def on_leg(leg: Leg) -> None:
-        nonlocal offset, last, failure
+        nonlocal offset, last, failure, status
         res = cast(SolveResult, leg.result)  # (one start, recorded)
+        status = res.status
         tr = cast(Trajectory, res.trajectory)
         parts.append((tr.theta + offset, tr.x, tr.y, tr.error, tr.h, leg.cycle * L + leg.index))
         offset += float(tr.theta[-1])
@@ -174,6 +180,7 @@ def _run_legs(
         success=bool(run.success),
         message=failure or _legs_message(len(ends), drift, last),
         seconds=time.perf_counter() - t0,
+        status=status,
         settings=run.settings,
     )
 
@@ -267,3 +274,10 @@ def platform_time(kin) -> np.ndarray | None:
     if not hasattr(kin, "path"):
         return None
     return np.linspace(0.0, float(cast(Unicycle, kin).T), UNICYCLE_TIME_POINTS)
+
+
+def spaced_iterations(m: int, count: int) -> np.ndarray:
+    """About ``count`` geometrically spaced iterations of ``m`` (ascending, each once), the first
+    and the last always: the unicycle's platform paths q(t) that the task panel and the scene
+    draw, dense at the start where they change most."""
+    return np.union1d(np.geomspace(1, m, num=count).astype(int) - 1, [0, m - 1]).astype(int)

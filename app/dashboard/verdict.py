@@ -158,8 +158,7 @@ def _undefined_why(result: DashboardResult, run: AlgorithmRun) -> list[Sentence]
     if (
         state.robot != "unicycle"
         or state.augmentation != "characteristics"
-        or run.success
-        or "is undefined" not in run.message
+        or run.status != "undefined"
         or len(run.x) < 2
     ):
         return []

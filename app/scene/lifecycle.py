@@ -19,9 +19,8 @@ from viser import FrameHandle
 
 from ...engine.exceptions import InvalidInputError
 from ..dashboard import COLORS, LABELS, Dashboard, Event, runs_key
-from ..dashboard.algorithms import DEFAULT_ALGORITHMS
+from ..dashboard.algorithms import DEFAULT_ALGORITHMS, STYLES
 from ..dashboard.controls import PROGRESS_AFTER
-from ..dashboard.help import STYLES
 from .camera import CameraFraming
 from .controls import SceneControls
 from .gizmo import StartGizmo
@@ -179,10 +178,10 @@ class DashboardScene:
 def legend(algorithms) -> str:
     """The scene's key: each chosen algorithm's colour, name and copy, and the grey start."""
     keys = " · ".join(
-        f"<span style='color:{COLORS[a]}'>■ {LABELS[a]}</span>: {STYLES[a]['robot']}"
+        f"<span style='color:{COLORS[a]}'>■ {LABELS[a]}</span>: {STYLES[a].robot}"
         for a in algorithms
     )
-    lines = " and ".join(STYLES[a]["line"] for a in algorithms)
+    lines = " and ".join(STYLES[a].line for a in algorithms)
     return f"{keys} · grey: start x0 (the plots: {lines})"
 
 

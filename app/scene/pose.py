@@ -8,6 +8,7 @@ import math
 import numpy as np
 
 from ...engine.kinematics import Manipulator1
+from ..dashboard.runs import spaced_iterations
 
 #: Manipulator 1's kinematics k(x) = (x1, x2 + x1 x3), eq. (30): where its task point W is.
 NORMAL_FORM = Manipulator1()
@@ -74,9 +75,7 @@ def start_from_gizmo(robot: str, xy, yaw: float, state) -> dict:
 def shown_iterations(result) -> np.ndarray:
     """The unicycle's iterations that the animation and the traces show: :data:`UNICYCLE_SHOWN`
     geometrically spaced ones, the first and the last always."""
-    m = max(len(r.platform) for r in result.runs.values())
-    shown = np.unique(np.geomspace(1, m, num=UNICYCLE_SHOWN).astype(int) - 1)
-    return np.union1d(shown, [0, m - 1]).astype(int)
+    return spaced_iterations(max(len(r.platform) for r in result.runs.values()), UNICYCLE_SHOWN)
 
 
 class Timeline:

@@ -297,7 +297,7 @@ def test_a_reference_whose_solve_runs_away_is_refused_by_name(client):
 
 def test_a_session_reads_only_the_atlases_it_started(client):
     """A tab's atlas route gives its own jobs: a job of the REST API or of another session is
-    a 404, as for a job that is not there (the session's id alone no longer reads any job)."""
+    a 404, as for a job that is not there."""
     sid, other = _session(client), _session(client)
     rest = client.post("/atlas", json=body()).json()["id"]
     assert wait_until_ended(client, rest)["status"] == "done"

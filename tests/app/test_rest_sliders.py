@@ -1,6 +1,7 @@
 """The posture inverse's rest sliders on a robot with joint limits but no ``x_range``: they span
-what the dashboard accepts (the joint limits, x0's slider range on a side without one), x0's
-sliders stay wider (a start outside the limits is accepted and reported), and a rest slider
+what the dashboard accepts (the joint limits, the robot's range on a side without one), x0's
+sliders the same (a start outside the limits, accepted and reported, is typed in x0's exact
+boxes), and a rest slider
 moved while the default rest (the start) is outside the limits brings the coordinates the user
 did not touch into them, as the verdict said beforehand."""
 
@@ -39,13 +40,14 @@ def _sliders(state, key: str) -> list[tuple[float, float]]:
     ]
 
 
-def test_the_rest_sliders_span_the_joint_limits_and_x0_s_stay_wider():
+def test_the_rest_and_x0_sliders_span_the_joint_limits():
     """Each end of a rest slider is accepted, a step beyond it is refused naming its
-    coordinate; x0's sliders keep the robot's range (-pi, pi), which reaches past the first
-    joint's limits: x0 there is accepted and reported as leaving them."""
+    coordinate; x0's sliders span the same ranges (the joint limits, not the robot's range
+    (-pi, pi) past them), and an x0 beyond the first joint's limits, as an exact box sends it,
+    is accepted (the runs report it as leaving them)."""
     state = _state([0.3, 0.3, 0.3, 3.6])
     assert _sliders(state, REST) == SPAN
-    assert _sliders(state, "x0") == [(-PI, PI)] * 4
+    assert _sliders(state, "x0") == SPAN
     for i, (lo, hi) in enumerate(SPAN):
         for end, beyond in ((lo, lo - 0.01), (hi, hi + 0.01)):
             assert updated_state(state, {f"{REST}.{i}": end}).algorithm_parameters["rest"][i] == end

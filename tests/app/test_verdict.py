@@ -43,9 +43,15 @@ def test_unicycle_from_b_reports_the_engines_message():
     assert "iteration 3 took λ10 from 0.0659 to -0.0777, across λ10 = 0" in texts(result)
     assert "run from q0 = B (sec. 6.2, Figs. 13 (J^P#) and 14 (J^E#))" in texts(result)
     assert "docs/paper-errata.md" in texts(result)
+    # The why follows the engine's status of the run ("undefined": h undefined where it stopped),
+    # not its words: a run stopped where [J; dh] is singular gets none of it.
+    run = result.runs["extended"]
+    assert run.status == "undefined"
+    singular = dataclasses.replace(run, status="singular")
+    text = texts(dataclasses.replace(result, runs={**result.runs, "extended": singular}))
+    assert "characteristic (28)" not in text and "docs/paper-errata.md" not in text
     # A run stopped where it started has no "why" (it said "h changed by only 0 along its
     # run,."): its h, constant, says nothing about conservation.
-    run = result.runs["extended"]
     still = dataclasses.replace(run, h=np.zeros_like(run.error))
     text = texts(dataclasses.replace(result, runs={**result.runs, "extended": still}))
     assert "stopped" in text and "Why: J^E#" not in text and ",." not in text

@@ -136,10 +136,11 @@ def test_a_rest_outside_the_box_is_refused_beside_its_slider(tabs):
 
 
 def test_the_rest_sliders_of_a_chain_with_limits(tabs):
-    """A planar chain with joint limits, started outside them (a link): the rest's sliders span
-    the limits, x0's the robot's range (-pi, pi); the verdict says what a rest slider moved
-    makes of the default rest outside the limits, and moving one is accepted, the untouched
-    coordinates at their nearest limit in their boxes."""
+    """A planar chain with joint limits, started outside them (a link): the rest's sliders and
+    x0's span the limits (the start outside them shows in x0's exact box, where another is
+    typed); the verdict says what a rest slider moved makes of the default rest outside the
+    limits, and moving one is accepted, the untouched coordinates at their nearest limit in
+    their boxes."""
     import json
     from urllib.parse import quote
 
@@ -156,8 +157,13 @@ def test_the_rest_sliders_of_a_chain_with_limits(tabs):
     rest = [page.locator(f"#ctl-alg-rest-{i}") for i in range(3)]
     spans = [(r.get_attribute("min"), r.get_attribute("max")) for r in rest]
     assert [(float(a), float(b)) for a, b in spans] == [(-1, 1), (-math.pi, 1.2), (-4, 4)]
-    x0 = page.locator("#ctl-x0-0")
-    assert (float(x0.get_attribute("min")), float(x0.get_attribute("max"))) == (-math.pi, math.pi)
+    x0 = [page.locator(f"#ctl-x0-{i}") for i in range(3)]
+    assert [(float(r.get_attribute("min")), float(r.get_attribute("max"))) for r in x0] == [
+        (-1, 1),
+        (-math.pi, 1.2),
+        (-4, 4),
+    ]
+    expect(page.locator("#ctl-x0-0-value")).to_have_value("1.500")
     expect(page.locator("#ctl-alg-rest-0-value")).to_have_value("1.500")  # (the default: x0)
     said = page.locator('#verdict p[data-algorithm="posture"].why')
     expect(said).to_contain_text(
@@ -168,3 +174,8 @@ def test_the_rest_sliders_of_a_chain_with_limits(tabs):
     assert tab.snapshot()["state"]["algorithm_parameters"]["rest"] == [1.0, 0.3, 0.5]
     expect(page.locator("#ctl-alg-rest-0-value")).to_have_value("1.000")
     expect(said).to_contain_text("x_rest = (1, 0.3, 0.5) (set)")
+    # A start beyond the limits, past x0's slider, is typed in its exact box and accepted.
+    tab.change(
+        lambda: (page.fill("#ctl-x0-1-value", "1.8"), page.press("#ctl-x0-1-value", "Enter"))
+    )
+    assert tab.snapshot()["state"]["x0"] == [1.5, 1.8, 0.3]

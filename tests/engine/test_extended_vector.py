@@ -61,3 +61,17 @@ def test_wrong_number_of_maps_and_singular_start():
     same = [FormulaMap("x3", NAMES), FormulaMap("2*x3", NAMES), FormulaMap("x4", NAMES)]
     with pytest.raises(AlgorithmicSingularityError, match="singular"):
         VectorExtendedInverse(CHAIN, same).matrix(X0)
+
+
+def test_map_undefined_tells_an_undefined_map_from_a_singular_extended_jacobian():
+    """Where a map h_i is undefined (sqrt(x1) for x1 < 0) J^E# is undefined because h is:
+    ``map_undefined`` says so (the solver's status "undefined"), for several maps and for one;
+    the pseudoinverse has no map: never."""
+    x = np.array([X0, [-0.2, *X0[1:]]])
+    inv = VectorExtendedInverse(CHAIN, [FormulaMap("sqrt(x1)", NAMES), *MAPS[1:]])
+    assert inv.map_undefined(x).tolist() == [False, True]
+    assert Pseudoinverse(CHAIN).map_undefined(x).tolist() == [False, False]
+    kin = Manipulator2()
+    one = ExtendedInverse(kin, FormulaMap("sqrt(x1)", kin.variable_names))
+    assert one.map_undefined(x[:, :3]).tolist() == [False, True]
+    assert not ExtendedInverse(kin, PaperCubic()).map_undefined(x[:, :3]).any()

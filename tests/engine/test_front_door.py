@@ -6,8 +6,10 @@ import importlib
 import json
 import math
 import pydoc
+import re
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -70,6 +72,24 @@ def test_every_exported_name_is_its_modules_object_with_a_docstring():
     assert set(jik.__all__) <= set(dir(jik))
     with pytest.raises(AttributeError, match="no attribute 'solve_ik'"):
         _ = jik.solve_ik
+
+
+ROOT = Path(__file__).resolve().parents[2]
+#: Exported data tables, shown in the reference by the functions that read them.
+TABLES = {"ROBOTS", "ARMS", "ALGORITHMS"}
+
+
+def test_the_reference_documents_every_exported_name():
+    """docs/api holds each name of ``jik.engine.__all__``: by its own directive
+    (``::: jik.engine.<module>.<name>``) or by its whole module's."""
+    pages = "".join(p.read_text() for p in (ROOT / "docs" / "api").glob("*.md"))
+    directives = set(re.findall(r"^::: jik\.engine\.([\w.]+)$", pages, re.M))
+    missing = [
+        name
+        for name, module in _EXPORTS.items()
+        if name not in TABLES and f"{module}.{name}" not in directives and module not in directives
+    ]
+    assert not missing, f"not in docs/api: {missing}"
 
 
 def test_help_lists_the_api():

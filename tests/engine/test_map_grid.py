@@ -6,7 +6,7 @@ import pytest
 
 from jik.engine.augmentations import PaperCubic
 from jik.engine.exceptions import JikError
-from jik.engine.map_grid import grid_axes, map_grid
+from jik.engine.map_grid import grid_axes, map_grid, varying_most
 
 NAMES = ("x1", "x2", "x3")
 BOX = {"x1": (-1.0, 1.0), "x2": (0.4, 2.0), "x3": (0.4, 2.0)}
@@ -44,6 +44,21 @@ def test_axes_of_a_box_of_three_follow_the_largest_partial_derivatives():
             return g
 
     assert grid_axes(OfX1(), NAMES, BOX, np.zeros(3)) == ["x1", "x3"]
+
+
+def test_varying_most_weighs_by_the_spread_and_leaves_out_where_h_is_undefined():
+    """Mean |dh/dx_i| over the defined rows (a NaN row left out, a never-defined variable
+    last); with a spread, each times spread_i + 1: a variable the configurations move along
+    overtakes a steeper one they do not."""
+    dh = np.array([[1.0, 0.0, 0.5, np.nan], [1.0, 0.0, 0.5, np.nan], [np.nan] * 4])
+    assert varying_most(dh) == (0, 2)
+    assert varying_most(dh, np.array([0.0, 0.0, 2.0, 9.0])) == (0, 2)
+    assert varying_most(dh, np.array([0.0, 5.0, 2.0, 9.0])) == (0, 2)
+    assert varying_most(dh[:, [1, 3, 2]], np.array([0.0, 9.0, 0.0])) == (0, 2)
+    steep = np.array([[0.3, -1.0, 0.6]])
+    assert varying_most(steep) == (1, 2)
+    assert varying_most(steep, np.array([3.0, 0.0, 0.0])) == (0, 1)
+    assert varying_most(np.full((2, 3), np.nan)) == (0, 1)
 
 
 def test_a_map_that_raises_somewhere_is_nan_there_and_evaluated_elsewhere():

@@ -10,6 +10,9 @@ import pytest
 import jik.engine as jik
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.kinematics import Kinematics
+from jik.engine.limits import run_report
+from jik.engine.self_motion import trace
+from jik.engine.solve_rules import refused_starts
 
 X0 = [0.0, 0.0, math.pi / 2]
 PATH = [(1, 1), (1, 2), (0, 2)]
@@ -17,6 +20,8 @@ LOOP = [(0, 1), *PATH]
 BOX = {"x2": (0, 1), "x3": (1, 2)}
 ARM = jik.Manipulator2()
 P = jik.Pseudoinverse(ARM)
+NAMES = ARM.variable_names
+PANDA_TASK = jik.load_robot("panda").kinematics.pose_task
 
 #: (call, expected field): each call refuses one argument.
 REFUSALS = {
@@ -144,6 +149,33 @@ REFUSALS = {
         lambda: jik.plan_atlas(P, LOOP, n_starts=-4, arc=(-1, 1), reference=X0),
         "n_starts",
     ),
+    "map_grid unknown variable": (
+        lambda: jik.map_grid(jik.PaperCubic(), NAMES, {"x9": (0, 1), "x2": (0, 1)}),
+        "region",
+    ),
+    "map_grid NaN bound": (
+        lambda: jik.map_grid(jik.PaperCubic(), NAMES, {"x2": (np.nan, 1), "x3": (0, 1)}),
+        "region.x2",
+    ),
+    "map_grid n huge": (lambda: jik.map_grid(jik.PaperCubic(), NAMES, BOX, n=10**5), "n"),
+    "map_grid n text": (lambda: jik.map_grid(jik.PaperCubic(), NAMES, BOX, n="a"), "n"),
+    "inert_variables reversed box": (
+        lambda: jik.inert_variables(ARM, jik.PaperCubic(), [(0, 1), (1, 0), (0, 1)]),
+        "box",
+    ),
+    "trace box wrong shape": (lambda: trace(ARM, X0, (-1, 1), box=[(0, 1)]), "box"),
+    "trace box NaN": (lambda: trace(ARM, X0, (-1, 1), box=[(-9, np.nan)] * 3), "box"),
+    "trace bound_free_joints": (
+        lambda: trace(ARM, X0, (-1, 1), bound_free_joints="no"),
+        "bound_free_joints",
+    ),
+    "manifold_starts box": (lambda: jik.manifold_starts(ARM, X0, 4, box=[(0, 1)]), "box"),
+    "refused_starts x0 NaN": (lambda: refused_starts(P, [[0, np.nan, 1]]), "x0"),
+    "refused_starts x0 wrong length": (lambda: refused_starts(P, [[0, 1]]), "x0"),
+    "pose_of y wrong length": (lambda: PANDA_TASK.pose_of(np.zeros(5)), "y"),
+    "run_report not a result": (lambda: run_report(ARM, "abc"), "result"),
+    "repeatable drift text": (lambda: jik.repeatable("abc"), "drift"),
+    "h_change h text": (lambda: jik.h_change("abc"), "h"),
 }
 
 

@@ -120,11 +120,15 @@ def test_iteration_cap_gives_failure_with_message():
 
 
 def test_unreachable_pass_through_algorithmic_singularity_stops_with_message():
-    """(36) with a = 1, b = 0 is singular on x1 = 0: driving x1 across 0 must stop, not hang."""
+    """(36) with a = 1, b = 0 is singular on x1 = 0: driving x1 across 0 must stop, not hang;
+    where it stops, h is defined and [J; dh] singular: status "singular", not "undefined"."""
     inv = ExtendedInverse(Manipulator1(), E2Optimal(a=1.0, b=0.0))
     res = solve(inv, [0.5, 0.2, 1.0], [-0.5, 0.2])
     assert not res.success and res.status in ("singular", "stalled")
     assert "singular" in res.message or "stalled" in res.message
+    assert solve(inv, [0.5, 0.2, 1.0], [-0.5, 0.2], mode="discrete", gamma=0.5).status == (
+        "singular"
+    )
 
 
 @pytest.mark.parametrize(
@@ -199,14 +203,18 @@ def test_undefined_h_at_a_trial_point_does_not_abort_the_run():
 
 
 def test_run_into_undefined_h_stops_with_message_and_nan():
-    """From pose B the discrete extended run leaves the domain of h: stop, say why, NaN h."""
+    """From pose B the discrete extended run leaves the domain of h: stop, say why, NaN h; its
+    status "undefined" (J^E# undefined because h is, not [J; dh] singular), alone or in
+    chunks."""
     from jik.engine.registry import make_inverse, robot_spec
+    from jik.engine.solve_chunks import solve_in_chunks
 
     kin = robot_spec("unicycle").build(q0=[-5.0, 5.0, math.pi / 2])
-    res = solve(
-        make_inverse(kin, "extended"), UNICYCLE_START, UNICYCLE_TARGET, gamma=0.1, mode="discrete"
-    )
-    assert not res.success
+    inverse = make_inverse(kin, "extended")
+    res = solve(inverse, UNICYCLE_START, UNICYCLE_TARGET, gamma=0.1, mode="discrete")
+    assert not res.success and res.status == "undefined"
+    chunks = solve_in_chunks(inverse, UNICYCLE_START, UNICYCLE_TARGET, chunk=5, gamma=0.1)
+    assert chunks.status == "undefined"
     assert "'characteristics' is undefined" in res.message and "stopped" in res.message
     assert np.isnan(res.trajectory.h[-1]) and np.all(np.isfinite(res.trajectory.h[:-1]))
 
