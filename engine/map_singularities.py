@@ -15,13 +15,15 @@ from .exports import number
 from .functionals import Region, check_region
 from .inverses import extended_determinant, require_compatible, require_kinematics, require_map
 from .kinematics import Kinematics
-from .validation import count
+from .validation import FloatArray, count
 
 #: A point is singular where |dh| exceeds this many times its median over the grid, or where h
 #: changes sign by this many times its median step between grid neighbours (a pole).
 BLOW_UP, JUMP = 30.0, 30.0
 #: Grid points at most (nodes ** number of region variables).
 MAX_GRID_POINTS = 2**17
+#: Grid points evaluated at once (:func:`_evaluated`).
+BLOCK = 2048
 
 
 @dataclass(frozen=True)
@@ -123,6 +125,27 @@ def _between(
     return pole, flip & ~pole
 
 
+def _evaluated(kinematics, augmenting_map, x: FloatArray) -> tuple[FloatArray, ...]:
+    """h (n,), dh (n, p), det [J; dh] (n,), where it is singular and where h or dh is
+    undefined (n,) at the points x (n, p), :data:`BLOCK` points at a time: a map's gradient
+    may hold far more per point than its value (a total-degree basis of seven variables, 64
+    kB), and the grid's memory stays that of one block."""
+    n = len(x)
+    h, det = np.empty(n), np.empty(n)
+    dh = np.empty((n, kinematics.p))
+    singular, undefined = np.empty(n, dtype=bool), np.empty(n, dtype=bool)
+    with np.errstate(all="ignore"):
+        for at in range(0, n, BLOCK):
+            part = slice(at, at + BLOCK)
+            value, value_undefined = augmenting_map.value_masked(x[part])
+            slope, slope_undefined = augmenting_map.gradient_masked(x[part])
+            h[part] = np.asarray(value, dtype=float).reshape(-1)
+            dh[part] = np.asarray(slope, dtype=float)
+            det[part], singular[part] = extended_determinant(kinematics.jacobian(x[part]), dh[part])
+            undefined[part] = np.asarray(value_undefined | slope_undefined).reshape(-1)
+    return h, dh, det, singular, undefined
+
+
 def map_singularities(
     kinematics: Kinematics,
     augmenting_map: AugmentingMap,
@@ -185,13 +208,8 @@ def map_singularities(
         x[:, names.index(name)] = value
     for k, m in zip(axes, mesh, strict=True):
         x[:, k] = m.ravel()
-    with np.errstate(all="ignore"):
-        h, h_undefined = augmenting_map.value_masked(x)
-        dh, dh_undefined = augmenting_map.gradient_masked(x)
-        h, dh = np.asarray(h, dtype=float).reshape(-1), np.asarray(dh, dtype=float)
-        det, singular = extended_determinant(kinematics.jacobian(x), dh)
-        g = np.linalg.norm(dh, axis=-1)
-    undefined = np.asarray(h_undefined | dh_undefined).reshape(-1)
+    h, dh, det, singular, undefined = _evaluated(kinematics, augmenting_map, x)
+    g = np.linalg.norm(dh, axis=-1)
     undefined |= ~np.isfinite(h) | ~np.isfinite(g)
     found = {"h or its gradient is not finite": undefined}
     scale = np.median(g[~undefined]) if np.any(~undefined) else 0.0

@@ -161,3 +161,23 @@ def test_a_chunk_too_large_for_the_bound_is_refused_by_plan_atlas(monkeypatch):
     assert plan(chunk=fit).chunk == fit and plan().chunk == fit
     monkeypatch.setattr(validation, "MEMORY_LIMIT", 2**20)
     _refused(lambda: plan(chunk=1), "cycles", "1000 cycles of one run", "fewer cycles")
+
+
+def test_a_map_singularity_search_holds_a_block_of_its_grid():
+    """A seven-variable total-degree map (the Gen3's E2 synthesis) holds 64 kB per point in its
+    gradient: the search of a 4^7 grid held 1 GB at once (a server's worker ran out of memory);
+    it is evaluated a block at a time, the same points found."""
+    from jik.engine.map_singularities import BLOCK, map_singularities
+    from jik.engine.synthesis_nd import synthesize_e2_nd
+
+    gen3 = jik.load_robot("gen3").kinematics
+    x0 = jik.load_robot("gen3").spec.default_x0
+    region = {n: (c - 0.3, c + 0.3) for n, c in zip(gen3.variable_names, x0, strict=True)}
+    found = synthesize_e2_nd(gen3, region, nodes=1024)
+    tracemalloc.start()
+    try:
+        map_singularities(gen3, found.maps[0], found.region, fixed=found.fixed, nodes=4)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert 4**7 > 4 * BLOCK and peak < 300e6, peak
