@@ -46,8 +46,8 @@ def varying_most(dh: FloatArray, spread: FloatArray | None = None) -> tuple[int,
     variables' order."""
     g = np.abs(np.asarray(dh, dtype=float))
     defined = np.isfinite(g)
-    count = defined.sum(axis=0)
-    score = np.where(count > 0, np.where(defined, g, 0.0).sum(axis=0) / np.maximum(count, 1), -1.0)
+    rows = defined.sum(axis=0)  # (the rows where each partial derivative is defined)
+    score = np.where(rows > 0, np.where(defined, g, 0.0).sum(axis=0) / np.maximum(rows, 1), -1.0)
     if spread is not None:
         score = score * (np.asarray(spread, dtype=float) + 1.0)
     i, j = sorted(np.argsort(-score, kind="stable")[:2])
