@@ -1,4 +1,4 @@
-"""Plotly figures of a dashboard result: pure functions ``DashboardResult -> go.Figure``.
+"""Plotly figures of a dashboard result: pure functions ``DashboardResult -> figure dict``.
 
 Each figure is built as a plain figure dict first (its "spec"): the dashboard serializes those
 directly (:func:`figure_specs`, :func:`figure_json`), 5x faster than through ``go.Figure``
@@ -15,7 +15,6 @@ platform paths in the (q1, q2) plane and the controls against the iteration (Fig
 from __future__ import annotations
 
 import numpy as np
-import plotly.graph_objects as go
 
 from .algorithms import COLORS, DASH, LABELS, STYLES
 from .cspace import cspace_spec
@@ -31,7 +30,6 @@ from .plotting import (
     norm_unit,
     stacked_axes,
     theta_label,
-    to_go,
     trace,
     units,
 )
@@ -295,13 +293,3 @@ def figure_specs(
         "sensitivity": lambda r: sensitivity_spec(r, sensitivity, cancelled),
     }
     return {k: f(result) for k, f in builders.items() if only is None or k in only}
-
-
-def figures_for(
-    result: DashboardResult,
-    functionals: dict | None = None,
-    only: set[str] | None = None,
-    sensitivity: dict | None = None,
-) -> dict[str, go.Figure]:
-    """The panels of the dashboard for ``result`` (all, or those in ``only``), keyed by id."""
-    return {k: to_go(v) for k, v in figure_specs(result, functionals, only, sensitivity).items()}

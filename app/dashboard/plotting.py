@@ -9,7 +9,6 @@ import json
 import math
 
 import numpy as np
-import plotly.graph_objects as go
 
 from ...engine.units import robot_units
 from .robots import state_kinematics
@@ -143,10 +142,6 @@ def figure(data: list, title: str, **layout) -> dict:
         if key.startswith(("xaxis", "yaxis")) and isinstance(axis.get("title"), str):
             layout[key] = {**axis, "title": {"text": axis["title"]}}
     return {"data": data, "layout": {**base, **layout}}
-
-
-def to_go(spec: dict) -> go.Figure:
-    return go.Figure(data=spec["data"], layout=spec["layout"], _validate=False)
 
 
 #: numpy dtypes plotly.js takes as typed arrays (base64), by their plotly.js names.

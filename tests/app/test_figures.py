@@ -10,14 +10,22 @@ import plotly.graph_objects as go
 import pytest
 
 from jik.app.dashboard import COLORS, LABELS, compute, default_state, updated_state
-from jik.app.dashboard.figures import figure_specs, figures_for
+from jik.app.dashboard.figures import figure_specs
 from jik.app.dashboard.functionals import error_functionals, sensitivity
 from jik.app.dashboard.plotting import figure_json, keep_ranges, nice_range
 from jik.engine.registry import ROBOTS
 
 
+def figures_for(result, functionals=None, only=None, sensitivity=None) -> dict[str, go.Figure]:
+    """The panels of ``result`` (:func:`figure_specs`) as plotly figures, validated by plotly
+    (the builders skip its validation: an unknown property raises here)."""
+    return {
+        k: go.Figure(v) for k, v in figure_specs(result, functionals, only, sensitivity).items()
+    }
+
+
 def panel(result, key, functionals=None, sensitivity=None) -> go.Figure:
-    """One panel of ``result`` as a plotly figure (:func:`figures_for`)."""
+    """One panel of ``result`` as a validated plotly figure (:func:`figures_for`)."""
     return figures_for(result, functionals, {key}, sensitivity)[key]
 
 
