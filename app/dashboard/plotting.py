@@ -144,17 +144,8 @@ def figure(data: list, title: str, **layout) -> dict:
     return {"data": data, "layout": {**base, **layout}}
 
 
-#: numpy dtypes plotly.js takes as typed arrays (base64), by their plotly.js names.
-TYPED = {
-    "float64": "f8",
-    "float32": "f4",
-    "int32": "i4",
-    "uint32": "u4",
-    "int16": "i2",
-    "uint16": "u2",
-    "int8": "i1",
-    "uint8": "u1",
-}
+#: The typed arrays plotly.js takes (base64), by their names, which are numpy's type codes.
+TYPED = {"f8", "f4", "i4", "u4", "i2", "u2", "i1", "u1"}
 
 
 def typed_array(v: np.ndarray):
@@ -163,8 +154,8 @@ def typed_array(v: np.ndarray):
     if v.dtype.kind in "iu" and v.size and v.dtype.itemsize == 8:
         if np.iinfo(np.int32).min <= v.min() and v.max() <= np.iinfo(np.int32).max:
             v = v.astype(np.int32)
-    name = TYPED.get(str(v.dtype))
-    if name is None or not v.size:
+    name = v.dtype.str[1:]  # ("<f8": native little-endian float64 -> "f8")
+    if name not in TYPED or v.dtype.byteorder == ">" or not v.size:
         return plain(v.tolist())
     out = {"dtype": name, "bdata": base64.b64encode(v.tobytes()).decode("ascii")}
     if v.ndim > 1:

@@ -450,3 +450,13 @@ def test_cspace_draws_each_corners_self_motion_manifold_through_its_leg_end(path
         assert np.all(gaps <= SPACING * diagonal * (1 + 1e-3))
         outside = np.maximum(lo - 0.5 * (hi - lo) - x, x - hi - 0.5 * (hi - lo))
         assert np.max(outside) < 1e-5
+
+
+def test_a_big_endian_array_keeps_its_values():
+    """A typed array is the array's bytes, which plotly.js reads little-endian: an array of
+    the other byte order goes as a list of its values, not as bytes read backwards."""
+    values = np.array([0.5, 2.0], dtype=">f8")
+    assert json.loads(figure_json({"data": [{"x": values}], "layout": {}}))["data"][0]["x"] == [
+        0.5,
+        2.0,
+    ]
