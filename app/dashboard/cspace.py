@@ -20,8 +20,6 @@ from .analysis import expensive_map, kinematics_and_map, runs_box
 from .plotting import corner_names, figure, trace
 from .runs import DashboardResult
 
-#: The choices of three coordinates of a four-dimensional configuration (the unicycle's λ).
-AXES_CHOICES = ("012", "013", "023", "123")
 #: Points per run drawn; level-surface grid.
 MAX_POINTS, GRID = 1500, 16
 #: A self-motion manifold is traced this many box diagonals each way (to a drawing's tolerance)
@@ -33,8 +31,9 @@ SCENE = "scene2"
 
 
 def axes_of(result: DashboardResult) -> tuple[int, int, int]:
-    """The three coordinates shown: all three for p = 3, else the state's choice."""
-    choice = result.state.cspace_axes or AXES_CHOICES[0]
+    """The three coordinates shown: all three for p = 3, else the state's choice (of its
+    ``cspace_axes``: "012", "013", "023" or "123"; none: the first three)."""
+    choice = result.state.cspace_axes or "012"
     return tuple(int(c) for c in choice)  # type: ignore[return-value]
 
 

@@ -29,7 +29,7 @@ from .plotting import (
     nice_range,
     norm_unit,
     stacked_axes,
-    theta_label,
+    theta_axis,
     trace,
     units,
 )
@@ -126,8 +126,7 @@ def _joints(result: DashboardResult) -> dict:
         axis = axes["yaxis" if k == 0 else f"yaxis{k + 1}"]
         axis["title"] = label(name, ju[k])
         axis["range"] = nice_range(np.concatenate([r.x[:, k] for r in runs]))
-    axes["xaxis"]["title"] = theta_label(result)
-    axes["xaxis"]["range"] = nice_range(np.concatenate([r.theta for r in runs]), from_zero=True)
+    axes["xaxis"].update(theta_axis(result))
     title = (
         "Controls λ against the iteration (Figs. 11-14 b, c)"
         if is_unicycle(result)
@@ -165,9 +164,7 @@ def _drift(result: DashboardResult) -> dict:
         title, norm = "Repeatability: joint drift after each closed cycle", "‖x(end of cycle) − x0‖"
         xaxis = dict(title="cycle", dtick=1, range=[0.5, cycles + 0.5])
     else:
-        theta = np.concatenate([r.theta for r in result.runs.values()])
-        title, norm = "Convergence: task error", "‖k(x) − y_d‖"
-        xaxis = dict(title=theta_label(result), range=nice_range(theta, from_zero=True))
+        title, norm, xaxis = "Convergence: task error", "‖k(x) − y_d‖", theta_axis(result)
     unit = norm_unit(units(result)[0 if closed else 1])
     yaxis = dict(title=f"{norm} {unit} (log)", type="log", exponentformat="power")
     return figure(data, title, **NO_LEGEND, xaxis=xaxis, yaxis=yaxis | {"range": log_range(ys)})

@@ -84,10 +84,12 @@ def is_unicycle(result: DashboardResult) -> bool:
     return any(r.platform is not None for r in result.runs.values())
 
 
-def theta_label(result: DashboardResult) -> str:
-    if result.state.mode == "discrete":
-        return "iteration"
-    return f"θ (continuation parameter, γ = {result.state.gamma:g})"
+def theta_axis(result: DashboardResult) -> dict:
+    """The axis of theta (the iteration in discrete mode), from 0 over every run."""
+    theta = np.concatenate([r.theta for r in result.runs.values()])
+    gamma = f"θ (continuation parameter, γ = {result.state.gamma:g})"
+    title = "iteration" if result.state.mode == "discrete" else gamma
+    return dict(title=title, range=nice_range(theta, from_zero=True))
 
 
 def leg_names(n: int) -> list[str]:

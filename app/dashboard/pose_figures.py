@@ -20,7 +20,7 @@ from .plotting import (
     label,
     nice_range,
     stacked_axes,
-    theta_label,
+    theta_axis,
     trace,
     units,
 )
@@ -126,8 +126,7 @@ def pose_task_spec(result: DashboardResult) -> dict:
         )
         for t, x in zip(letters, first.theta[ends], strict=True)
     ]
-    axes["xaxis"]["title"] = theta_label(result)
-    axes["xaxis"]["range"] = nice_range(np.concatenate([r.theta for r in runs]), from_zero=True)
+    axes["xaxis"].update(theta_axis(result))
     lead = next(iter(result.runs))  # (the targets are marked at its legs' ends)
     title = (
         "Task coordinates against θ: position, then rotation vector<br><sup>"
