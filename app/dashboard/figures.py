@@ -28,6 +28,7 @@ from .plotting import (
     log_range,
     nice_range,
     norm_unit,
+    side_by_side,
     stacked_axes,
     theta_axis,
     trace,
@@ -177,12 +178,19 @@ PLATFORM_PATHS = 12
 def _platform(result: DashboardResult) -> dict:
     """Unicycle platform paths q(t) in the (q1, q2) plane, per iteration (Figs. 11-14 a)."""
     _, tu = units(result)
-    data = []
-    annotations = []
-    count = len(result.runs)
-    width = (1.0 - 0.04 * (count - 1)) / count
-    for col, a in enumerate(result.runs, start=1):
-        xa, ya = ("x", "y") if col == 1 else (f"x{col}", f"y{col}")
+    data, annotations, axes = [], [], {}
+    domains = side_by_side(len(result.runs), 0.04)
+    for col, (a, domain) in enumerate(zip(result.runs, domains, strict=True)):
+        k = str(col + 1) if col else ""
+        xa, ya = f"x{k}", f"y{k}"
+        axes[f"xaxis{k}"] = dict(
+            domain=domain, title=label("q1", tu[0]), **({"matches": "x"} if k else {})
+        )
+        axes[f"yaxis{k}"] = (
+            dict(anchor=xa, matches="y", showticklabels=False)
+            if k
+            else dict(title=label("q2", tu[1]), scaleanchor="x", scaleratio=1)
+        )
         P = result.runs[a].platform
         assert P is not None  # drawn only for the unicycle, whose runs all carry platform paths
         m = len(P)
@@ -235,18 +243,6 @@ def _platform(result: DashboardResult) -> dict:
                 showarrow=False,
                 font=dict(size=11, color=COLORS[a]),
             )
-        )
-    axes: dict = {}
-    for col in range(1, count + 1):
-        k = "" if col == 1 else str(col)
-        lo = (col - 1) * (width + 0.04)
-        axes[f"xaxis{k}"] = dict(
-            domain=[lo, lo + width], title=label("q1", tu[0]), **({"matches": "x"} if k else {})
-        )
-        axes[f"yaxis{k}"] = (
-            dict(anchor=f"x{k}", matches="y", showticklabels=False)
-            if k
-            else dict(title=label("q2", tu[1]), scaleanchor="x", scaleratio=1)
         )
     return figure(
         data,

@@ -270,6 +270,13 @@ def keep_ranges(spec: dict, before: dict | None) -> dict:
     return spec
 
 
+def side_by_side(n: int, gap: float) -> list[list[float]]:
+    """The x domains of n plots side by side, ``gap`` (of the width) between them."""
+    width = (1.0 - gap * (n - 1)) / n
+    lows = [c * (width + gap) for c in range(n)]
+    return [[round(lo, 6), round(min(1.0, lo + width), 6)] for lo in lows]
+
+
 def stacked_axes(n: int) -> dict:
     """Layout of n y-axes stacked over one shared x-axis (instead of make_subplots), 0.04 of
     the height between them."""
