@@ -107,7 +107,6 @@ def augmenting_grid(
     kin,
     state: DashboardState,
     runs: Mapping[str, AlgorithmRun],
-    n: int = GRID_POINTS,
     before: dict | None = None,
     progress: Callable[[int, int], None] | None = None,
 ):
@@ -136,8 +135,8 @@ def augmenting_grid(
         i, j = augmenting_axes(amap, xs, step(0))
         low, high = runs_box(state, runs)
         box = [(float(low[k]), float(high[k])) for k in (i, j)]
-        if expensive_map(amap):
-            n = min(n, EXPENSIVE_GRID_POINTS)  # h solves a collocation problem per point
+        # (fewer for a map that solves a collocation problem per point)
+        n = EXPENSIVE_GRID_POINTS if expensive_map(amap) else GRID_POINTS
         if before is not None and tuple(before["axes"]) == (i, j) and before["n"] == n:
             inside = all(
                 b_lo <= np.min(xs[:, k])

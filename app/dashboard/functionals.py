@@ -58,13 +58,13 @@ def functionals_key(state: DashboardState) -> str:
     return json.dumps(robot_and_map(state) | {"fixed": fixed}, sort_keys=True)
 
 
-#: E1 and E2 are taken by a tensor Gauss rule over at most this many region variables.
-MAX_QUADRATURE_VARIABLES = 3
+#: E1 and E2 are taken by a tensor Gauss rule over at most this many region variables, of this
+#: many nodes per variable (fewer for a map that solves a problem per point).
+MAX_QUADRATURE_VARIABLES, NODES, EXPENSIVE_NODES = 3, 12, 6
 
 
 def error_functionals(
     result: DashboardResult,
-    nodes: int = 12,
     on_step: Callable[[], None] | None = None,
     cancelled: Callable[[], bool] = lambda: False,
 ) -> dict | None:
@@ -80,8 +80,7 @@ def error_functionals(
     grid = result.augmenting
     if grid is None:
         return None
-    if expensive_map(grid["map"]):
-        nodes = min(nodes, 6)
+    nodes = EXPENSIVE_NODES if expensive_map(grid["map"]) else NODES
     names = result.variable_names
     i, j = grid["axes"]
     design = state_spec(result.state).functional_region

@@ -180,12 +180,12 @@ SUBTITLE_CHARS = 70
 MESSAGE_CHARS = 50
 
 
-def wrap(parts: list[str], width: int = SUBTITLE_CHARS) -> list[str]:
-    """The subtitle's parts joined by " · " into lines of about ``width`` characters (a long
-    part on its own line), so that no panel cuts its subtitle off."""
+def wrap(parts: list[str]) -> list[str]:
+    """The subtitle's parts joined by " · " into lines of about :data:`SUBTITLE_CHARS`
+    characters (a long part on its own line), so that no panel cuts its subtitle off."""
     lines: list[str] = []
     for part in parts:
-        if lines and len(lines[-1]) + 3 + len(part) <= width:
+        if lines and len(lines[-1]) + 3 + len(part) <= SUBTITLE_CHARS:
             lines[-1] += " · " + part
         else:
             lines.append(part)
