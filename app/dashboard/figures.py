@@ -178,7 +178,8 @@ PLATFORM_PATHS = 12
 def _platform(result: DashboardResult) -> dict:
     """Unicycle platform paths q(t) in the (q1, q2) plane, per iteration (Figs. 11-14 a)."""
     _, tu = units(result)
-    data, annotations, axes = [], [], {}
+    data, annotations = [], []
+    axes: dict[str, dict] = {}
     domains = side_by_side(len(result.runs), 0.04)
     for col, (a, domain) in enumerate(zip(result.runs, domains, strict=True)):
         k = str(col + 1) if col else ""
