@@ -140,7 +140,7 @@ def sensitivity(
     result: DashboardResult,
     functionals: dict | None,
     cancelled: Callable[[], bool] = lambda: False,
-    progress: Callable[[int, int], None] | None = None,
+    progress: Callable[[int, int], None] = lambda done, total: None,
 ) -> dict:
     """How E1 (13) and E2 (18) change with the parameters of the current map.
 
@@ -184,18 +184,13 @@ def sensitivity(
         return other.build(kin, **params)
 
     total = sensitivity_evaluations(state, grid["map"])
-
-    def report(done: int) -> None:
-        if progress is not None:
-            progress(done, total)
-
     try:
         if aug.parameters:
             out: dict = {"kind": "parameters", "parameters": dict(state.augmentation_parameters)}
             for k, key in enumerate(("E1", "E2")):
 
                 def evaluated(done: int, n: int, k: int = k) -> None:
-                    report(k * n + done)
+                    progress(k * n + done, total)
 
                 out[key] = parameter_sensitivity(
                     kin,
@@ -203,7 +198,6 @@ def sensitivity(
                     state.augmentation_parameters,
                     region,
                     functional=key.lower(),
-                    span=1.0,
                     samples=SENSITIVITY_SAMPLES,
                     nodes=nodes,
                     fixed=fixed,
@@ -213,14 +207,12 @@ def sensitivity(
         maps = []
         for m, other in enumerate(spec.augmentations):
             amap = build(other, **{p.name: p.default for p in other.parameters})
-            if expensive_map(amap):
-                report(2 * m + 2)
-                continue
-            row: dict = {"name": other.name, "current": other.name == aug.name}
-            for key in ("E1", "E2"):
-                row[key] = _functional(key, kin, amap, region, nodes, fixed)[key]
-            maps.append(row)
-            report(2 * m + 2)
+            if not expensive_map(amap):  # (no value of a map that solves per point)
+                row: dict = {"name": other.name, "current": other.name == aug.name}
+                for key in ("E1", "E2"):
+                    row[key] = _functional(key, kin, amap, region, nodes, fixed)[key]
+                maps.append(row)
+            progress(2 * m + 2, total)
         return {"kind": "alternatives", "maps": maps}
     except (JikError, ValueError, ArithmeticError) as exc:
         return {"kind": "unavailable", "reason": str(exc)}
