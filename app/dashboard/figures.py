@@ -34,7 +34,7 @@ from .plotting import (
     trace,
     units,
 )
-from .pose_figures import algorithms_key, is_pose_task, pose_task_spec
+from .pose_figures import algorithms_key, is_pose_task, pose_task_spec, theta_line
 from .runs import DashboardResult, spaced_iterations
 from .table import table_spec
 
@@ -106,21 +106,7 @@ def _joints(result: DashboardResult) -> dict:
     data = []
     for a, run in result.runs.items():
         for k, name in enumerate(names):
-            data.append(
-                trace(
-                    "scatter",
-                    x=run.theta,
-                    y=run.x[:, k],
-                    mode="lines",
-                    name=LABELS[a],
-                    legendgroup=a,
-                    showlegend=k == 0,
-                    line=dict(color=COLORS[a], width=1.8, dash=DASH[a]),
-                    xaxis="x",
-                    yaxis="y" if k == 0 else f"y{k + 1}",
-                    hovertemplate=f"{name} = %{{y:.5f}}<br>θ = %{{x:.4g}}<extra>{a}</extra>",
-                )
-            )
+            data.append(theta_line(a, run, run.x[:, k], name, k, legendgroup=a, showlegend=k == 0))
     axes = stacked_axes(len(names))
     runs = list(result.runs.values())
     for k, name in enumerate(names):
