@@ -460,3 +460,18 @@ def test_a_big_endian_array_keeps_its_values():
         0.5,
         2.0,
     ]
+
+
+def test_the_configuration_space_says_why_it_draws_no_level_surface():
+    """A map undefined at x0 (a user's h = log(x3) from x3 < 0) has no level h = h(x0): the
+    panel says so, not that h is solved point by point (it is not)."""
+    definition = {
+        "name": "formula",
+        "variables": ["x1", "x2", "x3"],
+        "task": ["x2 + cos(x3)", "x1 + sin(x3)"],
+        "augmentations": [{"name": "formula", "h": "log(x3)"}],
+    }
+    state = updated_state(default_state("formula", definition), {"x0.2": -0.5})
+    title = figure_specs(compute(state), only={"cspace"})["cspace"]["layout"]["title"]["text"]
+    assert "level surface not drawn: h is undefined at x0" in title
+    assert "point by point" not in title
