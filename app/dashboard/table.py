@@ -129,15 +129,22 @@ def table1_spec(result: DashboardResult) -> dict:
         )
     if state.mode == "discrete":
         gap = max(
-            float(np.max(np.abs(ends[a][: len(PRINTED[a])] - np.asarray(PRINTED[a]))))
-            for a in PAPER
-            if len(ends[a]) >= len(PRINTED[a])
+            (
+                float(np.max(np.abs(ends[a][: len(PRINTED[a])] - np.asarray(PRINTED[a]))))
+                for a in PAPER
+                if len(ends[a]) >= len(PRINTED[a])
+            ),
+            default=None,
+        )
+        where = (
+            "stopped before the end of the first cycle"
+            if gap is None
+            else f"ends its legs elsewhere (up to {gap:.3g} from the printed values)"
         )
         notes.append(
             f"Discrete mode changes the numbers: the paper's Table 1 is the continuous "
-            f"algorithm (7); the iteration with step γ = {state.gamma:.3g} ends its legs "
-            f"elsewhere (up to {gap:.3g} from the printed values). Choose mode = "
-            "continuous to compare with the print."
+            f"algorithm (7); the iteration with step γ = {state.gamma:.3g} {where}. Choose "
+            "mode = continuous to compare with the print."
         )
     else:
         notes.append(

@@ -475,3 +475,14 @@ def test_the_configuration_space_says_why_it_draws_no_level_surface():
     title = figure_specs(compute(state), only={"cspace"})["cspace"]["layout"]["title"]["text"]
     assert "level surface not drawn: h is undefined at x0" in title
     assert "point by point" not in title
+
+
+def test_table1_of_discrete_runs_that_stop_in_the_first_cycle():
+    """The paper's experiment in discrete mode with a step (gamma = 1.99) at which neither run
+    finishes its first leg: the table still shows (x0 and the printed columns) and says the
+    iteration stopped before the end of the first cycle."""
+    state = updated_state(default_state("manipulator2"), {"mode": "discrete", "gamma": 1.99})
+    result = compute(state)
+    assert not any(run.success for run in result.runs.values())
+    notes = figure_specs(result, only={"table"})["table"]["layout"]["meta"]["notes"]
+    assert "γ = 1.99 stopped before the end of the first cycle" in notes[-1]
