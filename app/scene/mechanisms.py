@@ -53,13 +53,12 @@ class Mechanism:
         self.scene, self.root, self.color, self.opacity, self.z = scene, root, color, opacity, z
         self.state, self.extent = state, extent
         self.build()
-        self.resize(state, extent)
 
-    def box(self, name, dims, position=(0.0, 0.0, 0.0)):
+    def box(self, name, dimensions, position=(0.0, 0.0, 0.0)):
         return self.scene.add_box(
             f"{self.root}/{name}",
             color=self.color,
-            dimensions=dims,
+            dimensions=dimensions,
             opacity=self.opacity,
             position=position,
             cast_shadow=False,
@@ -77,11 +76,21 @@ class Mechanism:
         )
 
     def build(self) -> None:
-        """Create the nodes (those sized by the state or the task-plane box: by :meth:`resize`)."""
+        """Create the nodes, those sized by the state or the task-plane box with the values of
+        :meth:`fitted`."""
+
+    def fitted(self) -> dict[str, dict[str, Any]]:
+        """The values of the nodes that follow the state (an arm length) or the task-plane box,
+        by the attribute holding each node: what :meth:`build` creates them with and
+        :meth:`resize` sets."""
+        return {}
 
     def resize(self, state, extent) -> None:
         """Follow a new arm length or task-plane box in place (no node is re-created)."""
         self.state, self.extent = state, extent
+        for attr, values in self.fitted().items():
+            for key, value in values.items():
+                setattr(getattr(self, attr), key, value)
 
     def pose(self, x) -> None: ...
 
@@ -90,21 +99,23 @@ class Gantry(Mechanism):
     """Manipulator 2: XY gantry (prismatic x1 vertical, x2 horizontal) with a revolute arm."""
 
     def build(self) -> None:
-        self.beam = self.box("beam", (1.0, 0.07, 0.05))
+        fit = self.fitted()
+        self.beam = self.box("beam", **fit["beam"])
         self.carriage = self.scene.add_frame(f"{self.root}/carriage", show_axes=False)
         self.box("carriage/body", (0.2, 0.2, 0.09))
         self.ball("carriage/joint", 0.06, (0.0, 0.0, 0.07), color=(40, 40, 40))
-        self.arm = self.box("carriage/arm", (1.0, 0.06, 0.04))
-        self.effector = self.ball("carriage/effector", 0.07)
+        self.arm = self.box("carriage/arm", **fit["arm"])
+        self.effector = self.ball("carriage/effector", 0.07, **fit["effector"])
 
-    def resize(self, state, extent) -> None:
-        super().resize(state, extent)
-        (lo, hi), _ = extent
-        l = float(state.robot_parameters["l"])
-        self.beam.dimensions = (hi - lo, 0.07, 0.05)
-        self.arm.dimensions = (l, 0.06, 0.04)
-        self.arm.position = (l / 2, 0.0, 0.07)
-        self.effector.position = (l, 0.0, 0.07)
+    def fitted(self) -> dict[str, dict[str, Any]]:
+        """The beam spans the task-plane box in x; the arm is l long."""
+        (lo, hi), _ = self.extent
+        l = float(self.state.robot_parameters["l"])
+        return {
+            "beam": {"dimensions": (hi - lo, 0.07, 0.05)},
+            "arm": {"dimensions": (l, 0.06, 0.04), "position": (l / 2, 0.0, 0.07)},
+            "effector": {"position": (l, 0.0, 0.07)},
+        }
 
     def pose(self, x) -> None:
         (lo, hi), _ = self.extent
@@ -117,10 +128,11 @@ class NormalForm(Mechanism):
     """Manipulator 1 (30): slider x2 on the vertical guide, lever of slope x3, runner at x1."""
 
     def build(self) -> None:
-        self.runner = self.box("runner", (0.05, 1.0, 0.04))
+        fit = self.fitted()
+        self.runner = self.box("runner", **fit["runner"])
         self.slider = self.box("slider", (0.18, 0.14, 0.08))
         self.lever = self.scene.add_frame(f"{self.root}/lever", show_axes=False)
-        self.bar = self.box("lever/bar", (1.0, 0.045, 0.03))
+        self.bar = self.box("lever/bar", **fit["bar"])
         self.ball("lever/pivot", 0.06, (0.0, 0.0, 0.05), color=(40, 40, 40))
         self.point = self.ball("W", 0.08)
         chosen = tuple(self.state.algorithms)
@@ -129,14 +141,17 @@ class NormalForm(Mechanism):
                 f"{self.root}/W/label", "W (task point)", position=(0.1, -0.2, -0.35)
             )
 
-    def resize(self, state, extent) -> None:
-        super().resize(state, extent)
-        (xlo, xhi), (lo, hi) = extent
-        self.runner.dimensions = (0.05, hi - lo, 0.04)
-        # Along the lever from x = xlo to x = xhi of the task-plane box when level: shorter in x
-        # when it tilts, so it stays in the framed view.
-        self.bar.dimensions = (xhi - xlo, 0.045, 0.03)
-        self.bar.position = ((xlo + xhi) / 2, 0.0, 0.05)
+    def fitted(self) -> dict[str, dict[str, Any]]:
+        """The runner spans the task-plane box in y; the lever, from x = xlo to x = xhi of the
+        box when level (shorter in x when it tilts, so it stays in the framed view)."""
+        (xlo, xhi), (lo, hi) = self.extent
+        return {
+            "runner": {"dimensions": (0.05, hi - lo, 0.04)},
+            "bar": {
+                "dimensions": (xhi - xlo, 0.045, 0.03),
+                "position": ((xlo + xhi) / 2, 0.0, 0.05),
+            },
+        }
 
     def pose(self, x) -> None:
         x1, x2, x3 = (float(v) for v in x)
@@ -181,7 +196,7 @@ class Chain(Mechanism):
     chain lies in the task plane; a URDF arm stands in its own x, y, z."""
 
     def build(self) -> None:
-        self.kin = state_kinematics(self.state)
+        self.resize(self.state, self.extent)  # (its kinematics and limits; no node is sized)
         home = chain_points(self.kin, np.asarray(self.state.x0, dtype=float), 0.0)
         n = home.shape[0]
         width = 5.0 if self.opacity is None else 3.5
