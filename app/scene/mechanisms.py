@@ -40,9 +40,6 @@ from .arm_marks import (
 from .pose import NORMAL_FORM, yaw_quaternion
 from .traces import polyline, rgb, trace_tolerance, unicycle_traces
 
-#: Height of each algorithm's copy above the task plane, and its opacity (None: solid).
-Z = {a: s.z for a, s in STYLES.items()}
-OPACITY = {a: s.opacity for a, s in STYLES.items()}
 HOME_COLOR = (150, 150, 150)
 
 
@@ -331,9 +328,9 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
     for a, run in result.runs.items():
         line = {"colors": rgb(COLORS[a]), "thickness_units": "screen"}  # pixels, see above
         if chain:  # (the end point's path: a URDF arm's task may be some of x, y, z)
-            task = chain_points(kin, run.x, (Z[a] + 0.16) * scale)[:, -1]
+            task = chain_points(kin, run.x, (STYLES[a].z + 0.16) * scale)[:, -1]
         else:
-            z = np.full(len(run.y), (Z[a] + 0.16) * scale)
+            z = np.full(len(run.y), (STYLES[a].z + 0.16) * scale)
             task = np.column_stack([run.y[:, 0], run.y[:, 1], z])
         out[f"{root}/trace/{a}/task"] = (
             "line_segments",
@@ -341,7 +338,9 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
             {**line, "thickness": 3.0 if a == "pseudoinverse" else 2.0},
         )
         if robot == "manipulator2":
-            joints = np.column_stack([run.x[:, 1], run.x[:, 0], np.full(len(run.x), Z[a] + 0.1)])
+            joints = np.column_stack(
+                [run.x[:, 1], run.x[:, 0], np.full(len(run.x), STYLES[a].z + 0.1)]
+            )
             out[f"{root}/trace/{a}/joints"] = (
                 "line_segments",
                 {"points": polyline(joints, tol)},
