@@ -36,6 +36,7 @@ from .arm_marks import (
     has_pose,
     joint_points,
     target_fixtures,
+    target_pose,
 )
 from .pose import NORMAL_FORM, yaw_quaternion
 from .traces import polyline, rgb, trace_tolerance, unicycle_traces
@@ -346,16 +347,14 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
                 {"points": polyline(joints, tol)},
                 {**line, "thickness": 1.2},
             )
-    if chain and robot != "planar_chain":  # (a frame or a point, see target_fixtures)
-        reach = float(np.linalg.norm(np.ptp(np.reshape(extent, (2, 2)), axis=1)))
-        return {**out, **target_fixtures(result, kin, root, AXES_FRACTION * reach / 2)}
-    for k, target in enumerate(result.targets):
-        out[f"{root}/targets/{k}"] = (
-            "icosphere",
-            {"position": (float(target[0]), float(target[1]), 0.2 * scale)},
-            {"radius": 0.05 * scale, "color": (0, 0, 0)},
-        )
-    return out
+    size = 0.0  # (of a target's axes)
+    if chain and robot != "planar_chain":  # (a frame or a point, see target_pose)
+        size = AXES_FRACTION * float(np.linalg.norm(np.ptp(np.reshape(extent, (2, 2)), axis=1))) / 2
+        poses, radius = [target_pose(kin, t) for t in result.targets], 0.15 * size
+    else:
+        poses = [((float(t[0]), float(t[1]), 0.2 * scale), None) for t in result.targets]
+        radius = 0.05 * scale
+    return {**out, **target_fixtures(poses, root, radius, size)}
 
 
 def extent_of(result) -> tuple[tuple[float, float], tuple[float, float]]:
