@@ -52,26 +52,20 @@ class Mechanism:
         self.state, self.extent = state, extent
         self.build()
 
-    def box(self, name, dimensions, position=(0.0, 0.0, 0.0)):
-        return self.scene.add_box(
-            f"{self.root}/{name}",
-            color=self.color,
-            dimensions=dimensions,
-            opacity=self.opacity,
-            position=position,
-            cast_shadow=False,
+    def node(self, kind: str, name: str, color=None, **values):
+        """A node of this copy, made by viser's ``add_<kind>``, in its colour (or ``color``) and
+        opacity, casting no shadow."""
+        add = getattr(self.scene, f"add_{kind}")
+        color = color or self.color
+        return add(
+            f"{self.root}/{name}", color=color, opacity=self.opacity, cast_shadow=False, **values
         )
 
+    def box(self, name, dimensions, position=(0.0, 0.0, 0.0)):
+        return self.node("box", name, dimensions=dimensions, position=position)
+
     def ball(self, name, radius, position=(0.0, 0.0, 0.0), color=None):
-        return self.scene.add_icosphere(
-            f"{self.root}/{name}",
-            radius=radius,
-            color=color or self.color,
-            opacity=self.opacity,
-            position=position,
-            cast_shadow=False,
-            subdivisions=2,
-        )
+        return self.node("icosphere", name, color, radius=radius, position=position, subdivisions=2)
 
     def build(self) -> None:
         """Create the nodes, those sized by the state or the task-plane box with the values of
@@ -172,16 +166,8 @@ class Platform(Mechanism):
         self.box("platform/nose", (0.3, 0.12, 0.08), (0.45, 0.0, 0.2))
         axle = (math.cos(math.pi / 4), math.sin(math.pi / 4), 0.0, 0.0)  # cylinder axis -> y
         for side in (-1, 1):
-            self.scene.add_cylinder(
-                f"{self.root}/platform/wheel{side}",
-                radius=0.16,
-                height=0.08,
-                color=(50, 50, 50),
-                opacity=self.opacity,
-                position=(0.0, side * 0.28, 0.16),
-                wxyz=axle,
-                cast_shadow=False,
-            )
+            wheel = {"radius": 0.16, "height": 0.08, "position": (0.0, side * 0.28, 0.16)}
+            self.node("cylinder", f"platform/wheel{side}", (50, 50, 50), **wheel, wxyz=axle)
 
     def pose(self, q) -> None:
         self.frame.position = (float(q[0]), float(q[1]), 0.5 * self.z)
