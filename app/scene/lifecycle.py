@@ -24,7 +24,7 @@ from ..dashboard.controls import PROGRESS_AFTER
 from .camera import CameraFraming
 from .controls import SceneControls
 from .gizmo import StartGizmo
-from .mechanisms import add_floor_grid, extent_of, layout_name
+from .mechanisms import add_floor_grid, layout_name
 from .nodes import NodeSets
 from .playback import Playback
 from .pose import Timeline
@@ -137,7 +137,7 @@ class DashboardScene:
             # client shows the start point and the paths that leave it together, never one
             # without the other.
             self.gizmo.place(state)
-            self.nodes.show(result, extent_of(result))
+            self.nodes.show(result)
             if self._framed != layout_name(state):  # another robot: frame its reach
                 self._framed = layout_name(state)
                 self.camera.frame(result)

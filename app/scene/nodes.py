@@ -44,11 +44,11 @@ class NodeSets:
         # set_key() -> {"frame", "mechanisms", "still", "fixtures", "root"}
         self.sets: dict[tuple, dict[str, Any]] = {}
 
-    def show(self, result, extent) -> None:
+    def show(self, result) -> None:
         """Show ``result``: its layout's set with the result's values, the other sets hidden. A
         kept set's nodes stay and take the new values (re-creating them costs the client a
         remount of every node)."""
-        layout = set_key(result.state)
+        layout, extent = set_key(result.state), extent_of(result)
         for key, entry in self.sets.items():
             entry["frame"].visible = key == layout  # (viser sends only a change)
         if layout in self.sets:
@@ -95,26 +95,16 @@ class NodeSets:
         }
         cls = MECHANISMS.get(state.robot)
         if cls is not None:
-            # (colour, opacity, height) of the still copies
+            # (colour, opacity, height) of each copy: the still ones, one per algorithm
             still = {"home": (HOME_COLOR, 0.25, -0.03)}
             if state.robot == "unicycle":  # (its target is a pose: a black platform)
                 still = {"home": (HOME_COLOR, 0.3, 0.0), "target": ((0, 0, 0), 0.3, 0.0)}
-            entry["still"] = {
-                name: cls(scene, f"{root}/{name}", *style, state, extent)
-                for name, style in still.items()
-            }
-            entry["mechanisms"] = {
-                a: cls(
-                    scene,
-                    f"{root}/{a}",
-                    rgb(COLORS[a]),
-                    STYLES[a].opacity,
-                    STYLES[a].z,
-                    state,
-                    extent,
-                )
-                for a in result.runs
-            }
+            copies = {a: (rgb(COLORS[a]), STYLES[a].opacity, STYLES[a].z) for a in result.runs}
+            for part, styles in (("still", still), ("mechanisms", copies)):
+                entry[part] = {
+                    name: cls(scene, f"{root}/{name}", *style, state, extent)
+                    for name, style in styles.items()
+                }
         self._place_fixtures(result, extent, root, entry["fixtures"])
         self.sets[set_key(state)] = entry
         return entry
