@@ -96,15 +96,13 @@ class DashboardScene:
                     self.status.content = f"computing… {100 * msg['fraction']:.0f}%"
             elif event.kind == "result" and event.result is not None:
                 self._draw(event.result)
-            elif event.kind == "refused":
-                self.controls.sync(self.dashboard.state)
-                self.status.content = f"**refused:** {json.loads(event.data)['message']}"
             elif event.kind == "ahead" and event.result is not None:
                 self._prebuild(event.result)
-            elif event.kind == "error":
+            elif event.kind in ("refused", "error"):
                 self.controls.sync(self.dashboard.state)
-                self.progress.visible = False
-                self.status.content = f"**error:** {json.loads(event.data)['message']}"
+                # (a refusal stops no computation: its progress bar stays)
+                self.progress.visible &= event.kind == "refused"
+                self.status.content = f"**{event.kind}:** {json.loads(event.data)['message']}"
         except Exception as exc:  # never let a drawing error kill the worker thread
             self.status.content = f"**scene error:** {type(exc).__name__}: {exc}"
 
