@@ -271,7 +271,7 @@ def test_the_scenes_integer_sliders_send_integers():
 
 def test_the_scene_shows_the_runs_progress_not_the_second_phases():
     """The scene's status keeps the drawn result's line while E1, E2 (which it does not draw)
-    are computed; a new state's runs show their progress there."""
+    are computed; a new state's runs show their progress there, until a failure."""
     import json
 
     from jik.app.dashboard.messages import Event
@@ -304,6 +304,13 @@ def test_the_scene_shows_the_runs_progress_not_the_second_phases():
         assert scene.status.content == drawn and scene.progress.visible is False
         scene._on_event(progress("runs"))
         assert scene.status.content == "computing… 40%" and scene.progress.visible is True
+        # A refused change leaves the computation's bar; a failed one ends it.
+        scene._on_event(Event("refused", 1, json.dumps({"message": "gamma: too large"})))
+        assert scene.status.content == "**refused:** gamma: too large"
+        assert scene.progress.visible is True
+        scene._on_event(Event("error", 1, json.dumps({"message": "the solver failed"})))
+        assert scene.status.content == "**error:** the solver failed"
+        assert scene.progress.visible is False
     finally:
         scene.stop()
         dashboard.stop()
