@@ -58,15 +58,16 @@ ERRATUM = (
 def row_labels(n: int) -> list[str]:
     """The labels of ``n`` rows, x0 then the leg ends, as Table 1 prints them (``"A  x0"``,
     ``"B  x1f"``, ..., ``"A  x4f"``) and on over more cycles (``"B  x5f"``, ...)."""
-    return ["A  x0"] + [f"{'ABCD'[k % 4]}  x{k}f" for k in range(1, n)]
+    return [f"{'ABCD'[k % 4]}  x{k}f" if k else "A  x0" for k in range(n)]
 
 
 def is_experiment(length: float, x0, path) -> bool:
     """Whether Manipulator 2 with arm length l = ``length`` from ``x0`` on ``path`` is Table 1's
     run: l = 1, x0 = :data:`X0`, the closed path :data:`PATH`."""
-    path = np.asarray(path, dtype=float)
+    x0, path = np.asarray(x0, dtype=float), np.asarray(path, dtype=float)
     return (
         abs(float(length) - 1.0) < 1e-12
+        and x0.shape == np.shape(X0)
         and np.allclose(x0, X0, atol=1e-9)
         and path.shape == np.shape(PATH)
         and np.allclose(path, PATH, atol=1e-12)

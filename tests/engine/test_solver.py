@@ -56,6 +56,7 @@ def test_table1_erratum_states_what_the_cubic_38_gives():
         assert "(" + ", ".join(f"{v:.4f}" for v in leg) + ")" in ERRATUM
     assert row_labels(5) == ["A  x0", "B  x1f", "C  x2f", "D  x3f", "A  x4f"]
     assert row_labels(7)[5:] == ["B  x5f", "C  x6f"]
+    assert row_labels(0) == []
 
 
 def test_table1_experiment_is_its_arm_start_and_path():
@@ -65,6 +66,7 @@ def test_table1_experiment_is_its_arm_start_and_path():
     assert not is_experiment(1.0, X0 + [0.1, 0, 0], PATH)
     assert not is_experiment(1.0, X0, PATH[:3])
     assert not is_experiment(1.0, X0, np.add(PATH, 0.01))
+    assert not is_experiment(1.0, X0[:2], PATH)  # (another robot's start: not an error)
 
 
 @pytest.mark.parametrize("gamma", [0.05, 1.0, 30.0])
