@@ -108,7 +108,7 @@ def augmenting_grid(
     state: DashboardState,
     runs: Mapping[str, AlgorithmRun],
     before: dict | None = None,
-    progress: Callable[[int, int], None] | None = None,
+    progress: Callable[[int, int], None] = lambda done, total: None,
 ):
     """h on a grid over the two variables it depends on most, other variables at x0.
 
@@ -130,7 +130,7 @@ def augmenting_grid(
         total, along = grid_batches(runs, amap), -(-len(xs) // GRID_BATCH)
 
         def step(offset: int):
-            return None if progress is None else lambda done, _: progress(offset + done, total)
+            return lambda done, _: progress(offset + done, total)
 
         i, j = augmenting_axes(amap, xs, step(0))
         low, high = runs_box(state, runs)
@@ -152,15 +152,12 @@ def augmenting_grid(
         X[..., j] = v[:, None]
         with np.errstate(all="ignore"):
             if expensive_map(amap):  # (maps that can be undefined at some points)
-                h = amap.evaluate_batches(
-                    X.reshape(-1, kin.p), GRID_BATCH, ProgressCallbacks(on_advance=step(along))
-                )[0]
-                H = np.asarray(h, dtype=float)
+                on = ProgressCallbacks(on_advance=step(along))
+                H = amap.evaluate_batches(X.reshape(-1, kin.p), GRID_BATCH, on)[0]
             else:
-                H = np.asarray(amap.value(X.reshape(-1, kin.p)), dtype=float)
-                if progress is not None:
-                    progress(total, total)
-        H = H.reshape(n, n)
+                H = amap.value(X.reshape(-1, kin.p))
+                progress(total, total)
+        H = np.asarray(H, dtype=float).reshape(n, n)
     except (JikError, ValueError, ArithmeticError):
         return None
     H = np.where(np.isfinite(H), H, np.nan)
