@@ -65,7 +65,7 @@ MAX_QUADRATURE_VARIABLES, NODES, EXPENSIVE_NODES = 3, 12, 6
 
 def error_functionals(
     result: DashboardResult,
-    on_step: Callable[[], None] | None = None,
+    on_step: Callable[[], None] = lambda: None,
     cancelled: Callable[[], bool] = lambda: False,
 ) -> dict | None:
     """E1 (13) and E2 (18) of the current map, or None if unavailable.
@@ -96,8 +96,7 @@ def error_functionals(
         return qmc_functionals(grid, region, fixed, out, cancelled, on_step)
     for key in ("E1", "E2"):
         out |= _functional(key, grid["kinematics"], grid["map"], region, nodes, fixed)
-        if on_step is not None:
-            on_step()
+        on_step()
     return out
 
 
