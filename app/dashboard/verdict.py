@@ -12,7 +12,7 @@ edge of convergence (the task error is multiplied by about ``1 - gamma`` per ste
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 
 import numpy as np
 
@@ -37,9 +37,6 @@ class Sentence:
     text: str
     algorithm: str | None = None
     role: str = "finding"
-
-    def as_dict(self) -> dict:
-        return {"text": self.text, "algorithm": self.algorithm, "role": self.role}
 
 
 def _drift_sentence(algorithm: str, run: AlgorithmRun, unit: str) -> Sentence:
@@ -253,4 +250,4 @@ def verdict(result: DashboardResult) -> list[dict]:
     warning = singular_sentence(result.state) if "extended" in runs else None
     if warning:
         out.append(Sentence(warning, "extended", "warning"))
-    return [s.as_dict() for s in out]
+    return [asdict(s) for s in out]
