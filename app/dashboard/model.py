@@ -50,12 +50,12 @@ ALGORITHMS = DEFAULT_ALGORITHMS
 DEFAULT_ROBOT = "manipulator2"
 
 Point = Annotated[tuple[Coordinate, ...], Field(min_length=1, max_length=MAX_DIMENSION)]
+#: A number given as one (not as text), and up to MAX_DIMENSION of them.
+Number = Annotated[float, Field(strict=True)]
+Numbers = Annotated[tuple[Number, ...], Field(max_length=MAX_DIMENSION)]
 #: An algorithm's parameter: a number, or a vector (the posture inverse's rest, checked with the
 #: robot: :func:`jik.app.dashboard.algorithms.checked_rest`).
-AlgorithmValue = (
-    Annotated[float, Field(strict=True)]
-    | Annotated[tuple[Annotated[float, Field(strict=True)], ...], Field(max_length=MAX_DIMENSION)]
-)
+AlgorithmValue = Number | Numbers
 
 
 class DashboardState(BaseModel):
