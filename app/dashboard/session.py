@@ -175,7 +175,6 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
                 state = updated_state(self._state, patch)
             except InvalidInputError as exc:
                 refusal = exc
-                generation, state = self._generation, self._state
             else:
                 if state == self._state:
                     return self._generation, state
