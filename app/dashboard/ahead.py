@@ -10,9 +10,10 @@ import threading
 from collections.abc import Callable
 
 from ...engine.exceptions import InvalidInputError, JikError
+from .algorithms import cache_key
 from .analysis import expensive_map, kinematics_and_map
 from .messages import Event, with_figures
-from .model import DashboardState, cache_key, updated_state
+from .model import DashboardState, updated_state
 from .offload import OffloadLane
 from .plotting import PANELS
 from .results import compute

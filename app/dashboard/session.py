@@ -22,22 +22,14 @@ from typing import Any, NoReturn
 
 from ...engine.exceptions import InvalidInputError, JikError
 from .ahead import SolvingAhead
+from .algorithms import COLORS, LABELS, cache_key, runs_key
 from .analysis import expensive_map
 from .controls import controls_message
 from .figures import gamma_free_panels
 from .listeners import Listeners
 from .map_synthesis import built_map
 from .messages import Event, finite, summary, with_figures
-from .model import (
-    COLORS,
-    LABELS,
-    DashboardState,
-    cache_key,
-    default_state,
-    runs_key,
-    updated_state,
-    validate,
-)
+from .model import DashboardState, default_state, updated_state, validate
 from .offload import OffloadLane
 from .panel_texts import PanelTexts
 from .plotting import PANELS
