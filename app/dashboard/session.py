@@ -34,7 +34,7 @@ from .offload import OffloadLane
 from .panel_texts import PanelTexts
 from .plotting import PANELS
 from .results import compute
-from .runs import Cancelled, DashboardResult
+from .runs import Cancelled
 from .second_control import SecondPhaseControl
 from .slots import FairSlots
 from .verdict import verdict
@@ -75,29 +75,15 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
         self._generation = 1
         self._done = 0  # last generation whose computation finished (or failed)
         self._changed_at = {1: time.perf_counter()}
-        self._listeners: list[Callable[[Event], None]] = []
-        self._fast = 0  # the first ``_fast`` listeners are the quick ones
         self._cache: dict = {}
         self._figures: dict[tuple[str, str], str] = {}  # (panel, key) -> figure JSON
-        self._layouts: dict[str, tuple[tuple, dict]] = {}  # panel -> (robot, task), last layout
-        # Results solved ahead (_prefetch): when each robot's went to the page (the value of
-        # _robot_since then), the latest by robot, and since when the robot on screen is
-        # (the generation of its first result).
-        self._ahead_sent: dict[str, int] = {}
-        self._latest_ahead: dict[str, Event] = {}
-        self._robot_since = 0
-        # key -> (E1/E2 functionals or None, their sensitivity)
-        self._functionals_cache: dict[str, tuple[dict | None, dict]] = {}
-        self._latest: dict[str, Event] = {"state": self._state_event(1, self._state, "initial")}
-        self.result: DashboardResult | None = None
-        self.functionals: dict | None = None
-        # The second phase (_second_phase): the generation whose phase runs (None when none
-        # does, or it was cancelled), whose phase was cancelled, whose phase to run again, and
-        # the grid on screen when it started (kept for a run again).
-        self._second_running: int | None = None
-        self._second_cancelled: int | None = None
-        self._rerun: int | None = None
-        self._grid_before: dict | None = None
+        # (what the parts share, each typed and described where its part declares it)
+        self._listeners, self._fast = [], 0  # (Listeners)
+        self._latest = {"state": self._state_event(1, self._state, "initial")}
+        self._layouts, self._functionals_cache = {}, {}  # (PanelTexts)
+        self._ahead_sent, self._latest_ahead, self._robot_since = {}, {}, 0  # (SolvingAhead)
+        self.result, self.functionals, self._grid_before = None, None, None  # (SecondPhaseControl)
+        self._second_running = self._second_cancelled = self._rerun = None
         #: What the 3D scene last drew (set by app.scene), for the page and the tests.
         self.scene_status: dict = {}
         self._thread: threading.Thread | None = None
