@@ -34,7 +34,7 @@ from .offload import OffloadLane
 from .panel_texts import PanelTexts
 from .plotting import PANELS
 from .results import compute
-from .runs import Cancelled
+from .runs import Cancelled, DashboardResult
 from .second_control import SecondPhaseControl
 from .slots import FairSlots
 from .verdict import verdict
@@ -240,9 +240,21 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
             self._done = max(self._done, generation)
             self._cond.notify_all()
 
-    def _turn(self):
-        """This session's turn to compute (:class:`FairSlots`), or at once without slots."""
-        return self._slots.slot() if self._slots is not None else contextlib.nullcontext()
+    def _solved(self, state: DashboardState, generation: int, **more) -> DashboardResult:
+        """:func:`compute` of ``state`` (``more``: its options) in this session's turn
+        (:class:`FairSlots`; at once without slots), with its run cache and lane of the pool;
+        :class:`Cancelled` when a newer change comes, also while it waits for its turn."""
+        with self._slots.slot() if self._slots is not None else contextlib.nullcontext():
+            if self._generation != generation:
+                raise Cancelled
+            return compute(
+                state,
+                generation,
+                cancelled=lambda: self._generation != generation,
+                cache=self._cache,
+                offload=self._offload,
+                **more,
+            )
 
     def _reporter(self, generation: int, phase: str) -> Callable[..., None]:
         """``report(fraction, what="the runs")``: a ``progress`` event of ``phase`` ("runs", or
@@ -284,19 +296,13 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
         try:
             kin, amap = built_map(state, progress, lambda: self._generation != generation)
             deferred = expensive_map(amap)
-            with self._turn():
-                if self._generation != generation:  # (a newer change came while it waited)
-                    raise Cancelled
-                result = compute(
-                    state,
-                    generation,
-                    progress=progress,
-                    cancelled=lambda: self._generation != generation,
-                    cache=self._cache,
-                    with_augmenting=not deferred,
-                    offload=self._offload,
-                    grid_before=grid_before,
-                )
+            result = self._solved(
+                state,
+                generation,
+                progress=progress,
+                with_augmenting=not deferred,
+                grid_before=grid_before,
+            )
         except Cancelled:
             return
         except (JikError, ValueError) as exc:
