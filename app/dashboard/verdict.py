@@ -247,7 +247,6 @@ def verdict(result: DashboardResult) -> list[dict]:
     out += [Sentence(*s) for s in practical_sentences(result, unit)]
     for text, algorithm, within in limits_texts(result, NAMES):
         out.append(Sentence(text, algorithm, "note" if within else "warning"))
-    warning = singular_sentence(result.state) if "extended" in runs else None
-    if warning:
+    if "extended" in runs and (warning := singular_sentence(result.state)):
         out.append(Sentence(warning, "extended", "warning"))
     return [asdict(s) for s in out]
