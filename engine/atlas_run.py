@@ -26,7 +26,7 @@ from .inverses import Inverse
 from .limits import robot_limits, starts_outside
 from .posture_at_start import PostureAtStart
 from .practical_inverses import PostureInverse
-from .progress import Progress, check_cancelled
+from .progress import Progress, check_cancelled, check_progress
 from .repeatability import repeatability
 from .validation import FloatArray, check_memory
 
@@ -297,6 +297,7 @@ def iter_atlas(
         ``progress.cancelled()`` returned True (polled after every chunk); work not yet done is
         dropped.
     """
+    progress = check_progress(progress)
     tasks = (
         chunk_task(plan, lo, min(lo + plan.chunk, plan.size))
         for lo in range(0, plan.size, plan.chunk)
@@ -344,6 +345,7 @@ def run_atlas(
         gathered arrays would exceed :data:`jik.engine.validation.MEMORY_LIMIT`: stream such an
         atlas with :func:`iter_atlas`, or keep the drift alone.
     """
+    progress = check_progress(progress)
     A, P, N = len(plan.inverses), len(plan.paths), plan.n_starts
     p = plan.inverses[0].kinematics.p
     leg_ends = A * plan.cycles * plan.legs * p if keep_leg_ends else 0

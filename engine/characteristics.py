@@ -28,7 +28,7 @@ from .collocation import (
 from .exceptions import InvalidInputError, OneFormUndefinedError, format_vector
 from .kinematics import Kinematics
 from .one_form import check_index
-from .progress import Progress, check_cancelled
+from .progress import Progress, check_cancelled, check_progress
 from .unicycle import Unicycle
 from .validation import FloatArray, as_vector, count, finite
 
@@ -198,6 +198,7 @@ class CharacteristicsMap(AugmentingMap):
         progress and to stop.
         """
         x = self.kinematics.check(x)
+        progress = check_progress(progress)
         xb = x.reshape(-1, self.p)
         size = count(batch, "batch", 1, 1_000_000)
         total = -(-len(xb) // size)

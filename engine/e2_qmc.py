@@ -25,7 +25,7 @@ from .augmentations import AugmentingMap
 from .exceptions import InvalidInputError, KinematicSingularityError
 from .functionals import Region, check_region
 from .kinematics import Kinematics
-from .progress import Progress, check_cancelled
+from .progress import Progress, check_cancelled, check_progress
 from .synthesis_nd import CHUNK, MAX_NODES, kernel_frame
 from .validation import count
 
@@ -71,6 +71,7 @@ def e2_qmc(
             "robot",
         )
     box, fix = check_region(kinematics, region, fixed)
+    progress = check_progress(progress)
     nodes = count(nodes, "nodes", 64, MAX_NODES)
     if nodes & (nodes - 1):
         raise InvalidInputError(f"nodes must be a power of two, got {nodes}", "nodes")

@@ -19,7 +19,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from .exceptions import JikError, RunCancelled
+from .exceptions import InvalidInputError, JikError, RunCancelled
 
 if TYPE_CHECKING:
     from .repeatability import Leg
@@ -109,3 +109,17 @@ def check_cancelled(progress: Progress | None, what: str) -> None:
     """Raise :class:`RunCancelled` ("<what>") when ``progress`` says the work is not wanted."""
     if progress is not None and progress.cancelled():
         raise RunCancelled(what)
+
+
+def check_progress(progress: object, field: str = "progress") -> Progress | None:
+    """``progress`` itself when it is None or a :class:`Progress`; otherwise an
+    :class:`~jik.engine.exceptions.InvalidInputError` naming ``field`` (a plain function is
+    wrapped by :class:`ProgressCallbacks`, which says which of its slots it fills)."""
+    if progress is None or isinstance(progress, Progress):
+        return progress
+    raise InvalidInputError(
+        f"{field} must be a Progress (subclass it and override leg, advance or cancelled) or "
+        "ProgressCallbacks(on_leg=..., on_advance=..., is_cancelled=...) made of functions, "
+        f"got {type(progress).__name__} {progress!r:.60}",
+        field,
+    )

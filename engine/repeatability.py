@@ -22,7 +22,7 @@ import numpy as np
 from .exceptions import InvalidInputError, JikError, format_vector
 from .inverses import Inverse
 from .picard_guesses import chain_guesses
-from .progress import Progress, check_cancelled, stops_at
+from .progress import Progress, check_cancelled, check_progress, stops_at
 from .repeatability_result import RepeatabilityResult
 from .results import BatchSolveResult, SolveResult, Trajectory
 from .run_settings import Resume, RunSettings, inverse_fingerprint, resumed_legs
@@ -209,7 +209,7 @@ def repeatability(
     RunCancelled
         ``progress.cancelled()`` returned True.
     """
-    kin = check_inverse(inverse)
+    kin, progress = check_inverse(inverse), check_progress(progress)
     resume = x0 if isinstance(x0, Resume) else None
     x0 = kin.check(x0 if resume is None else resume.x0, "x0")
     path = kin.check_task(path, "path")

@@ -36,7 +36,7 @@ from .exports import Columns
 from .functionals import Region, check_region
 from .inverses import pseudoinverse
 from .kinematics import Kinematics
-from .progress import Progress, check_cancelled
+from .progress import Progress, check_cancelled, check_progress
 from .total_degree import (
     TotalDegreeMap,
     basis_gradients,
@@ -267,6 +267,7 @@ def synthesize_e2_nd(
     if m_red < 1:
         raise InvalidInputError(f"{kinematics.name} has no redundancy (p = r)", "robot")
     box, fix = check_region(kinematics, region, fixed)
+    progress = check_progress(progress)
     d = len(box)
     degree = count(degree, "degree", 1, 32)
     nodes = count(nodes, "nodes", 64, MAX_NODES)

@@ -41,7 +41,7 @@ from .functionals import Region, check_region, error_functional_e2
 from .inverses import pseudoinverse
 from .kinematics import Kinematics, Manipulator2
 from .legendre_map import SynthesizedMap, legendre_vander, lgl_nodes
-from .progress import Progress, check_cancelled
+from .progress import Progress, check_cancelled, check_progress
 from .validation import FloatArray, count
 
 #: Extra Gauss points per variable beyond the basis degree (R is not polynomial, e.g. cos 2 x3).
@@ -316,6 +316,7 @@ def synthesize_e2(
             "synthesize_e2 needs one degree of redundancy (p - r = 1)", "kinematics"
         )
     box, fix = check_region(kinematics, region, fixed)
+    progress = check_progress(progress)
     d = len(box)
     if d not in (2, 3):
         raise InvalidInputError(

@@ -175,6 +175,26 @@ REFUSALS = {
     "pose_of y wrong length": (lambda: PANDA_TASK.pose_of(np.zeros(5)), "y"),
     "run_report not a result": (lambda: run_report(ARM, "abc"), "result"),
     "repeatable drift text": (lambda: jik.repeatable("abc"), "drift"),
+    "repeatability progress a function": (
+        lambda: jik.repeatability(P, X0, PATH, progress=lambda leg: None),
+        "progress",
+    ),
+    "run_atlas progress a function": (
+        lambda: jik.run_atlas(jik.plan_atlas(P, LOOP, starts=[X0]), progress=print),
+        "progress",
+    ),
+    "iter_atlas progress a function": (
+        lambda: next(jik.iter_atlas(jik.plan_atlas(P, LOOP, starts=[X0]), progress=print)),
+        "progress",
+    ),
+    "synthesize_e2 progress a function": (
+        lambda: jik.synthesize_e2(ARM, BOX, degree=2, progress=print),
+        "progress",
+    ),
+    "synthesize_e2_nd progress a function": (
+        lambda: jik.synthesize_e2_nd(ARM, BOX, degree=2, nodes=64, progress=print),
+        "progress",
+    ),
     "h_change h text": (lambda: jik.h_change("abc"), "h"),
 }
 
