@@ -209,20 +209,39 @@ def repeatability_report(limits: FloatArray, result, names: Sequence[str]) -> Li
 def run_report(kinematics, result) -> LimitsReport | None:
     """Whether a run of ``kinematics`` (a solve's result, or a single start's repeatability
     result) stayed within its joint limits, and its first violation; None for a robot
-    without limits."""
-    if not hasattr(result, "leg_results") and not isinstance(
-        getattr(result, "x", None), np.ndarray
-    ):
+    without limits. A batch is refused (a :class:`~jik.engine.results.BatchSolveResult`'s
+    member ``result[i]`` is a solve's result), and so is a run of a robot with another p."""
+    from .repeatability_result import RepeatabilityResult
+    from .results import BatchSolveResult, SolveResult
+
+    if isinstance(result, BatchSolveResult):
+        raise InvalidInputError(
+            f"result is a batch of {len(result)} solves; report each member, result[i]", "result"
+        )
+    if not isinstance(result, SolveResult | RepeatabilityResult):
         raise InvalidInputError(
             "result must be a SolveResult or a single start's RepeatabilityResult, got "
             f"{type(result).__name__}",
+            "result",
+        )
+    x0 = np.asarray(result.x0)
+    if x0.ndim != 1:
+        raise InvalidInputError(
+            f"result is a repeatability run of {len(x0)} starts; the report is of one start's "
+            "run (an atlas counts the runs of many that leave the limits)",
+            "result",
+        )
+    if x0.shape[-1] != kinematics.p:
+        raise InvalidInputError(
+            f"result is a run of a robot with {x0.shape[-1]} joint variables; this robot has "
+            f"p = {kinematics.p}",
             "result",
         )
     limits = robot_limits(kinematics)
     if limits is None:
         return None
     names = limit_names(kinematics)
-    if hasattr(result, "leg_results"):
+    if isinstance(result, RepeatabilityResult):
         return repeatability_report(limits, result, names)
     return solve_report(limits, result, names)
 

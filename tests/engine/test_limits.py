@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+import jik.engine as jik
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.limits import (
     LimitsReport,
@@ -17,7 +18,7 @@ from jik.engine.limits import (
 )
 from jik.engine.repeatability import repeatability
 from jik.engine.robot_spec import robot_from_dict
-from jik.engine.solver import solve
+from jik.engine.solver import solve, solve_batch
 
 LIMITS = np.array([[-1.0, 1.0], [-np.inf, np.inf], [0.0, 2.0]])
 NAMES = ("x1", "x2", "x3")
@@ -149,9 +150,37 @@ def test_a_robot_reports_its_runs_limits():
         panda.inverse(), home, panda.kinematics.forward(home) + [[0.05, 0, 0]], record=True
     )
     assert panda.limits_report(run) == LimitsReport(True)
-    assert robot_from_dict({"name": "manipulator2"}).limits_report(res) is None
+    m2 = robot_from_dict({"name": "manipulator2"})
+    assert m2.limits_report(solve(m2.inverse(), [0, 0, 1.5708], [1, 1])) is None
     assert run_report(panda.kinematics, run) == LimitsReport(True)
     assert run_report(panda.kinematics, res) == panda.limits_report(res)
+
+
+CHAIN = {"name": "planar_chain", "joints": "RRR", "lengths": [1, 0.8, 0.6]}
+
+
+def test_a_report_is_of_one_run_of_this_robot():
+    """A batch of solves, a repeatability run of several starts and another robot's run are
+    refused (field ``result``), not misread as one run: the second start of a batch that
+    begins outside the limits is no violation of the first's run."""
+    chain = robot_from_dict({**CHAIN, "limits": [[-1, 1], [None, 1.2], [-2, 2]]})
+    inside, outside = [0.3, 1.0, 1.0], [0.3, 1.5, 1.0]
+    loop = [(1, 1.3), (1, 1.7), (0.6, 1.7)]
+    calls = {
+        "a batch of solves": lambda: solve_batch(chain.inverse(), [inside, outside], [0.2, 1.6]),
+        "a run of two starts": lambda: repeatability(chain.inverse(), [inside, outside], loop),
+        "a run of the other order": lambda: repeatability(chain.inverse(), [outside, inside], loop),
+        "a run of another robot": lambda: solve(
+            jik.Pseudoinverse(jik.PlanarChain("RRRR", [1] * 4)), [0.1, 0.2, 0.3, 0.4], [1, 1]
+        ),
+    }
+    for what, run in calls.items():
+        with pytest.raises(InvalidInputError, match="result is a") as info:
+            chain.limits_report(run())
+        assert info.value.field == "result", what
+    batch = solve_batch(chain.inverse(), [inside, outside], [0.2, 1.6])
+    assert chain.limits_report(batch[0]).within
+    assert chain.limits_report(batch[1]).violation.where == "at the start x0"
 
 
 def test_a_one_leg_run_says_on_the_way_to_the_target():
