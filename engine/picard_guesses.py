@@ -4,6 +4,8 @@ over a closed path's legs (:mod:`jik.engine.picard`); :func:`solve` is
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from .exceptions import InvalidInputError
@@ -13,35 +15,54 @@ from .results import Trajectory
 from .solve_rules import check_gamma
 
 
-def picard_guesses(guess, n: int, p: int, gamma: float) -> list[Guess | None] | None:
-    """Picard guesses (sigma, x) from earlier trajectories (see :func:`solve`), validated."""
+def picard_guesses(
+    guess, n: int, p: int, gamma: float, single: bool = False
+) -> list[Guess | None] | None:
+    """Picard guesses (sigma, x) from earlier trajectories (see :func:`solve`), validated.
+
+    ``guess`` is one Trajectory per start (a sequence of n, each a Trajectory or None), or with
+    ``single`` the one start's Trajectory; a refusal's field is ``guess`` (``guess.k`` for the
+    k-th of a sequence)."""
     if guess is None:
         return None
-    items = [guess] if isinstance(guess, Trajectory) else list(guess)
+    if single or isinstance(guess, Trajectory):
+        items = [guess]
+    elif isinstance(guess, Sequence) and not isinstance(guess, str):
+        items = list(guess)
+    else:
+        raise InvalidInputError(
+            "guess must be a list of Trajectory (a SolveResult's .trajectory) or None, one per "
+            f"start, got {type(guess).__name__}",
+            "guess",
+        )
     if len(items) != n:
         raise InvalidInputError(
             f"guess has {len(items)} trajectories for {n} start configurations; give one "
-            "Trajectory (or None) per start"
+            "Trajectory (or None) per start",
+            "guess",
         )
     out: list[Guess | None] = []
     for k, tr in enumerate(items):
+        name, field = ("guess", "guess") if single else (f"guess[{k}]", f"guess.{k}")
         if tr is None:
             out.append(None)
             continue
         if not isinstance(tr, Trajectory):
             raise InvalidInputError(
-                f"guess[{k}] must be a Trajectory (a SolveResult's .trajectory) or None"
+                f"{name} must be a Trajectory (a SolveResult's .trajectory) or None, got "
+                f"{type(tr).__name__}",
+                field,
             )
         theta = np.asarray(tr.theta, dtype=float)
         x = np.asarray(tr.x, dtype=float)
         if theta.ndim != 1 or x.shape != (len(theta), p) or len(theta) < 2:
             raise InvalidInputError(
-                f"guess[{k}] must have theta of shape (m,) and x of shape (m, {p}), m >= 2"
+                f"{name} must have theta of shape (m,) and x of shape (m, {p}), m >= 2", field
             )
         if not (np.all(np.isfinite(theta)) and np.all(np.isfinite(x))):
-            raise InvalidInputError(f"guess[{k}] contains NaN or infinite values")
+            raise InvalidInputError(f"{name} contains NaN or infinite values", field)
         if np.any(np.diff(theta) <= 0):
-            raise InvalidInputError(f"guess[{k}].theta must be increasing")
+            raise InvalidInputError(f"{name}.theta must be increasing", field)
         # The homotopy parameter of (*) in engine.picard: sigma = 1 - exp(-gamma theta); the
         # last point of a converged leg is its end, sigma = 1.
         sigma = -np.expm1(-gamma * (theta - theta[0]))

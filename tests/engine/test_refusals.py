@@ -44,6 +44,24 @@ REFUSALS = {
         ),
         "guess",
     ),
+    "solve guess a result": (
+        lambda: jik.solve(P, X0, [1, 1], guess=jik.solve(P, X0, [1, 1])),
+        "guess",
+    ),
+    "solve guess a list": (
+        lambda: jik.solve(P, X0, [1, 1], guess=[jik.solve(P, X0, [1, 1]).trajectory]),
+        "guess",
+    ),
+    "solve_batch guess a number": (lambda: jik.solve_batch(P, [X0], [1, 1], guess=5), "guess"),
+    "solve_batch guess text": (lambda: jik.solve_batch(P, [X0], [1, 1], guess="abc"), "guess"),
+    "solve_batch guess count": (
+        lambda: jik.solve_batch(P, [X0], [1, 1], guess=[None] * 2),
+        "guess",
+    ),
+    "solve_batch guess member": (
+        lambda: jik.solve_batch(P, [X0, X0], [1, 1], guess=[None, 5]),
+        "guess.1",
+    ),
     "solve not an inverse": (lambda: jik.solve("pseudoinverse", X0, [1, 1]), "inverse"),
     "solve_batch x0 3-D": (lambda: jik.solve_batch(P, np.zeros((2, 2, 3)), [1, 1]), "x0"),
     "solve_batch counts differ": (lambda: jik.solve_batch(P, [X0, X0], [[1, 1]] * 3), "y_d"),
