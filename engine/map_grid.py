@@ -36,6 +36,16 @@ class MapGrid:
     axes: dict[str, FloatArray]
     h: FloatArray
 
+    def __repr__(self) -> str:
+        box = " x ".join(f"{k} in [{v[0]:.4g}, {v[-1]:.4g}]" for k, v in self.axes.items())
+        defined = self.h[np.isfinite(self.h)]
+        span = f"h in [{defined.min():.4g}, {defined.max():.4g}]" if defined.size else "h undefined"
+        undefined = self.h.size - defined.size
+        return (
+            f"MapGrid({box}, {' x '.join(str(n) for n in self.h.shape)} points, {span}"
+            f"{f', undefined at {undefined}' if undefined and defined.size else ''})"
+        )
+
 
 def varying_most(dh: FloatArray, spread: FloatArray | None = None) -> tuple[int, int]:
     """The two variables h varies most with at some configurations: the largest mean |dh/dx_i|

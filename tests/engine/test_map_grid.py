@@ -72,6 +72,15 @@ def test_a_map_that_raises_somewhere_is_nan_there_and_evaluated_elsewhere():
     grid = map_grid(Partial(), NAMES, {"x2": (0.5, 1.5), "x3": (0.5, 1.5)}, n=3)
     assert grid is not None
     assert np.isnan(grid.h[2]).all() and np.isfinite(grid.h[:2]).all()
+    assert repr(grid).endswith("3 x 3 points, h in [-1.139, -0.1031], undefined at 3)")
+
+
+def test_a_grid_prints_on_one_line_as_what_it_holds():
+    """As the other results: its box, its size and h's range, not its arrays."""
+    grid = map_grid(PaperCubic(), NAMES, BOX, n=101)
+    assert repr(grid) == (
+        "MapGrid(x2 in [0.4, 2] x x3 in [0.4, 2], 101 x 101 points, h in [-2.292, 0.001372])"
+    )
 
 
 def test_a_box_of_one_variable_has_no_grid():
