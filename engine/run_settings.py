@@ -166,20 +166,28 @@ class Resume:
 
 
 def resumed_legs(resume: Resume, n: int, L: int, p: int, cycles: int):
-    """The legs (n, c * L, p) of ``resume`` and its guides (a list of L, or [])."""
-    done = np.asarray(resume.legs, dtype=float)
-    done = done[None] if done.ndim == 2 and n == 1 else done
+    """The legs (n, c * L, p) of ``resume`` and its guides (a list of L, or []); a refusal's
+    field is ``x0``, where the Resume was given."""
+    try:
+        given = np.asarray(resume.legs, dtype=float)
+    except (TypeError, ValueError):
+        given = np.zeros(0)
+    done = given[None] if given.ndim == 2 and n == 1 else given
     m = done.shape[1] if done.ndim == 3 else 0
     if done.shape != (n, m, p) or m == 0 or m % L or m // L > cycles:
         raise InvalidInputError(
             f"resume.legs must be the legs of 1 to {cycles} whole cycles of {L} legs, shape "
-            f"(c * {L}, {p}) for one start or (n, c * {L}, {p}); got shape {done.shape}"
+            f"(c * {L}, {p}) for one start or (n, c * {L}, {p}) for n starts; got "
+            + (f"shape {given.shape}" if given.size else f"{resume.legs!r:.60}"),
+            "x0",
         )
     if not np.all(np.isfinite(done)):
         raise InvalidInputError(
-            "resume.legs contains NaN: go on only from a run whose legs all converged"
+            "resume.legs contains NaN: go on only from a run whose legs all converged", "x0"
         )
     guides = list(resume.guides)
     if guides and len(guides) != L:
-        raise InvalidInputError(f"resume.guides must have one trajectory (or None) per leg, {L}")
+        raise InvalidInputError(
+            f"resume.guides must have one trajectory (or None) per leg, {L}", "x0"
+        )
     return done, guides

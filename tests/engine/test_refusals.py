@@ -85,6 +85,18 @@ REFUSALS = {
         lambda: jik.repeatability(P, X0, PATH, max_iterations=0),
         "max_iterations",
     ),
+    "repeatability Resume legs text": (
+        lambda: jik.repeatability(P, jik.Resume(np.array(X0), "abc"), PATH, cycles=2),
+        "x0",
+    ),
+    "repeatability Resume legs not whole cycles": (
+        lambda: jik.repeatability(P, jik.Resume(np.array(X0), np.zeros((5, 3))), PATH, cycles=2),
+        "x0",
+    ),
+    "repeatability Resume legs NaN": (
+        lambda: jik.repeatability(P, jik.Resume(np.array(X0), np.full((4, 3), np.nan)), PATH),
+        "x0",
+    ),
     "Manipulator2 l": (lambda: jik.Manipulator2(l=-1), "l"),
     "forward wrong width": (lambda: ARM.forward(np.zeros(5)), "x"),
     "jacobian NaN": (lambda: ARM.jacobian(np.array([np.nan, 0, 0])), "x"),
