@@ -1,6 +1,6 @@
 """Requests to engine calls: solve, its batches, and repeatability.
 
-Plain synchronous functions (``solve_batch``, ``repeatability_request``) turn
+Plain synchronous functions (``solve_batch_json``, ``repeatability_request``) turn
 a request model into engine calls and the result into a response model. They raise
 :class:`RequestError` naming the offending field. The robot, map and inverse a request names are
 built by :func:`jik.app.compute.robot_requests.request_robot` (catalogue robots, definitions,
@@ -10,9 +10,8 @@ catalogue arms alike); results become JSON by :mod:`jik.app.compute.documents`.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, TypeVar, cast
+from typing import Any, cast
 
 import numpy as np
 
@@ -23,18 +22,11 @@ from ...engine.repeatability import repeatability, repeatable
 from ...engine.solve_rules import refused_starts
 from ...engine.solver import solve_batch as engine_solve_batch
 from . import schemas as S
-from .documents import (
-    limits_document,
-    nullable,
-    solve_response,
-    solve_response_json,
-)
+from .documents import limits_document, nullable, solve_response_json
 from .exceptions import RequestError
 from .robot_requests import check_configuration, check_task_point, gamma_and_mode, request_robot
 from .schemas.algorithms import parameters_of, used
 from .schemas.wording import without_field
-
-_R = TypeVar("_R")
 
 
 @dataclass
@@ -104,35 +96,22 @@ def batch_key(req: S.SolveRequest) -> str:
     return req.model_dump_json(exclude=exclude)
 
 
-def solve_batch(reqs: list[S.SolveRequest]) -> list[S.SolveResponse | RequestError]:
-    """Solve requests sharing one :func:`batch_key` in ONE batched engine call.
+def solve_batch_json(reqs: list[S.SolveRequest]) -> list[bytes | RequestError]:
+    """Solve requests sharing one :func:`batch_key` in ONE batched engine call, each response
+    as its JSON bytes (:func:`solve_response_json`).
 
     Each member is validated on its own (lengths, singular start): a bad member gets its
     :class:`RequestError` in its slot and does not affect the others.
     """
-    return _solve_batch(reqs, solve_response)
-
-
-def solve_batch_json(reqs: list[S.SolveRequest]) -> list[bytes | RequestError]:
-    """:func:`solve_batch` with each response as its JSON bytes, built without validating the
-    model (the workers' hot path, see :func:`solve_response_json`)."""
-    return _solve_batch(reqs, solve_response_json)
-
-
-def _solve_batch(
-    reqs: list[S.SolveRequest], respond: Callable[[_Setup, Any], _R]
-) -> list[_R | RequestError]:
-    """:func:`solve_batch` with ``respond`` turning a member's result into its response (the
-    model, or JSON bytes in the workers)."""
     if not reqs:
         return []
     if len({batch_key(r) for r in reqs}) != 1:
-        raise ValueError("solve_batch needs requests with equal batch keys")
+        raise ValueError("solve_batch_json needs requests with equal batch keys")
     try:
         setup = _setup(reqs[0])
     except RequestError as exc:
         return [exc] * len(reqs)
-    out: list[_R | RequestError | None] = [None] * len(reqs)
+    out: list[bytes | RequestError | None] = [None] * len(reqs)
     ok: list[int] = []
     for i, r in enumerate(reqs):
         try:
@@ -166,8 +145,8 @@ def _solve_batch(
                     out[ok[k]] = err
             else:
                 for j, k in enumerate(keep):
-                    out[ok[k]] = respond(setup, batch[j])
-    return cast(list[_R | RequestError], out)  # every slot was filled above
+                    out[ok[k]] = solve_response_json(setup, batch[j])
+    return cast(list[bytes | RequestError], out)  # every slot was filled above
 
 
 def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityResponse:

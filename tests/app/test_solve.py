@@ -194,10 +194,10 @@ def test_every_registered_robot_solves_with_its_defaults(api):
 
 
 def test_service_batch_isolates_a_bad_first_member():
-    """The plain service function (used by the dashboard): a wrong-length first member gets its
-    own error, the others are solved."""
+    """The plain service function (the workers'): a wrong-length first member gets its own
+    error, the others are solved."""
     from jik.app.compute.exceptions import RequestError
-    from jik.app.compute.requests import solve_batch
+    from jik.app.compute.requests import solve_batch_json
     from jik.app.compute.schemas import SolveRequest
 
     reqs = [
@@ -205,10 +205,10 @@ def test_service_batch_isolates_a_bad_first_member():
         SolveRequest.model_validate(solve_body()),
         SolveRequest.model_validate(solve_body(target=[0.5, 1.5])),
     ]
-    out = solve_batch(reqs)
+    out = solve_batch_json(reqs)
     assert isinstance(out[0], RequestError) and out[0].field == "x0"
-    np.testing.assert_allclose(out[1].x, X1F, atol=6e-5)
-    np.testing.assert_allclose(out[2].y, [0.5, 1.5], atol=1e-9)
+    np.testing.assert_allclose(json.loads(out[1])["x"], X1F, atol=6e-5)
+    np.testing.assert_allclose(json.loads(out[2])["y"], [0.5, 1.5], atol=1e-9)
 
 
 @pytest.mark.parametrize(
@@ -226,12 +226,11 @@ def test_service_batch_isolates_a_bad_first_member():
 def test_worker_json_is_the_validated_response(over):
     """The workers' JSON (built without pydantic) is the validated model's document: the same
     keys and the same float values (only the spelling of exponents differs)."""
-    from jik.app.compute.requests import solve_batch, solve_batch_json
+    from jik.app.compute.requests import solve_batch_json
     from jik.app.compute.schemas import SolveRequest, SolveResponse
 
     req = SolveRequest.model_validate(solve_body(**over))
-    (model,) = solve_batch([req])
     (raw,) = solve_batch_json([req])
-    assert isinstance(model, SolveResponse) and isinstance(raw, bytes)
+    assert isinstance(raw, bytes)
+    model = SolveResponse.model_validate_json(raw)
     assert json.loads(raw) == json.loads(model.model_dump_json())
-    SolveResponse.model_validate_json(raw)
