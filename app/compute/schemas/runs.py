@@ -17,12 +17,13 @@ from .algorithms import Algorithm, AlgorithmParameters
 from .fields import (
     INTEGRAL,
     MAX_ITERATIONS,
-    Coordinate,
     Gamma,
     MaybeFloat,
     Mode,
     Tolerance,
     Vector,
+    coordinates,
+    points,
 )
 from .robots import (
     AnyAugmentation,
@@ -179,11 +180,6 @@ class RepeatabilityResponse(_RunResponse):
     limits: RunLimits = None
 
 
-def _task_point(spec: RobotSpec) -> Any:
-    r = len(spec.task_names)
-    return Annotated[list[Coordinate], Field(min_length=r, max_length=r)]
-
-
 def _run_fields(spec: RobotSpec, augmentation: Any) -> dict[str, Any]:
     return {
         "augmentation": (
@@ -196,7 +192,7 @@ def _run_fields(spec: RobotSpec, augmentation: Any) -> dict[str, Any]:
             ),
         ),
         "x0": (
-            Annotated[list[Coordinate], Field(min_length=spec.p, max_length=spec.p)],
+            coordinates(spec.p),
             Field(description=f"start configuration {list(spec.variable_names)}"),
         ),
     }
@@ -207,7 +203,7 @@ SolveBody = per_robot(
     SolveRequest,
     lambda spec, aug: {
         **_run_fields(spec, aug),
-        "target": (_task_point(spec), Field(description=f"target {list(spec.task_names)}")),
+        "target": (coordinates(spec.r), Field(description=f"target {list(spec.task_names)}")),
     },
 )
 #: ``POST /repeatability``'s body: a :class:`RepeatabilityRequest` with its robot's lengths.
@@ -216,7 +212,7 @@ RepeatabilityBody = per_robot(
     lambda spec, aug: {
         **_run_fields(spec, aug),
         "path": (
-            Annotated[list[_task_point(spec)], Field(min_length=1, max_length=MAX_PATH_POINTS)],  # type: ignore[misc]
+            points(spec.r, 1, MAX_PATH_POINTS),
             Field(
                 description=f"task points {list(spec.task_names)} visited in order, 1 to "
                 f"{MAX_PATH_POINTS}; k(x0) closes it"

@@ -9,13 +9,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from ....engine.registry import RobotSpec
 from ....engine.robot_synthesis import TOTAL_DEGREE
 from ....engine.variational import DEFAULT_DEGREE
-from .fields import (
-    INTEGRAL,
-    MAX_DIMENSION,
-    Bound,
-    Coordinate,
-    MaybeFloat,
-)
+from .fields import INTEGRAL, MAX_DIMENSION, Bound, Coordinate, FrameAxes, MaybeFloat, Seed
 from .robots import AnyAugmentation, AnyRobot, AugmentationUsed, RobotUsed
 from .variants import narrowed, per_robot
 
@@ -76,16 +70,8 @@ class SynthesizeRequest(BaseModel):
             "least twice the basis' unknowns",
         )
     )
-    seed: Annotated[int, Field(strict=True, ge=0, le=2**31 - 1), INTEGRAL] = Field(
-        0, description="'e2_total_degree': seed of the Sobol rule's scrambling"
-    )
-    frame_axes: (
-        Annotated[
-            list[Annotated[int, Field(strict=True, ge=1, le=MAX_DIMENSION), INTEGRAL]],
-            Field(min_length=1, max_length=MAX_DIMENSION),
-        ]
-        | None
-    ) = Field(
+    seed: Seed = Field(0, description="'e2_total_degree': seed of the Sobol rule's scrambling")
+    frame_axes: FrameAxes | None = Field(
         None,
         description="'e2_total_degree' with p - r >= 2: the p - r joints (1-based) whose axes "
         "fix the kernel frame (default: the last p - r)",
