@@ -111,13 +111,9 @@ def _belong(given: dict, algorithms: Sequence[str]) -> None:
 
 
 def build_robot(req_robot) -> tuple[RobotSpec, Any, S.RobotUsed]:
-    """The robot named in the request, built with its parameters; what it used, filled in."""
-    try:
-        spec = ROBOTS[req_robot.name]
-    except KeyError:
-        raise RequestError(
-            "robot.name", f"unknown robot {req_robot.name!r}; choose one of {sorted(ROBOTS)}"
-        ) from None
+    """The catalogue robot of the request (its model names one), built with its parameters;
+    what it used, filled in."""
+    spec = ROBOTS[req_robot.name]
     params = req_robot.model_dump(exclude={"name"})
     try:
         kin = spec.build(**params)

@@ -9,15 +9,12 @@ from __future__ import annotations
 
 from collections.abc import Collection
 
-import numpy as np
-
 from ...engine.augmentations import Polynomial2
 from ...engine.exceptions import JikError
 from ...engine.functionals import error_functional_e1, error_functional_e2
 from ...engine.registry import RobotSpec
 from ...engine.variational import synthesize_e2
 from . import schemas as S
-from .documents import nullable
 from .exceptions import RequestError
 from .robot_requests import request_robot
 from .synthesis_total import grid, singularities, total_degree_response
@@ -95,23 +92,13 @@ def synthesis_region(spec: RobotSpec, req: S.SynthesizeRequest):
     return names, region, fixed
 
 
-def _functional_info(fv) -> S.FunctionalInfo:
-    return S.FunctionalInfo(
-        value=nullable(fv.value),
-        n_points=int(fv.n_points),
-        n_singular=int(np.asarray(fv.singular_points).shape[0]),
-        min_abs_dh_k=nullable(getattr(fv, "min_abs_dh_k", float("nan"))),
-        divergent=bool(getattr(fv, "divergent", False)),
-    )
-
-
 def _functionals(kin, amap, region, fixed, nodes) -> tuple[dict, list[str]]:
     notes: list[str] = []
     out: dict[str, S.FunctionalInfo | None] = {}
     for label, fn in (("e1", error_functional_e1), ("e2", error_functional_e2)):
         try:
             value = fn(kin, amap, region, nodes=nodes, fixed=fixed)
-            out[label] = _functional_info(value)
+            out[label] = S.FunctionalInfo.model_validate(value.as_dict())
             if value.divergent:
                 notes.append(f"{label.upper()} diverges: dh K vanishes inside the region")
         except JikError as exc:
