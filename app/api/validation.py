@@ -21,17 +21,11 @@ _TYPE_LABELS = {"str", "float", "int", "bool", "constrained-float", "constrained
 
 
 def _field(loc) -> str:
-    """Field path of a pydantic location: ``("body", "robot", "manipulator2", "l")`` -> ``robot.l``.
+    """Field path of a location (:func:`_location`'s): ``["body", "robot", "l"]`` -> ``robot.l``.
 
-    Indices become ``x0[2]``; the discriminator tag of a union member (a request's robot, a
-    robot's or a map's name) is dropped.
+    Indices become ``x0[2]``; the discriminator tag of a robot's or a map's name is dropped.
     """
-    # (a member of a plain union is labelled by its type: "str", "tuple[float, ...]")
-    parts = [
-        str(p) for p in loc if p != "body" and str(p) not in _TYPE_LABELS and "[" not in str(p)
-    ]
-    if len(parts) > 1 and parts[0] in _VARIANTS:
-        del parts[0]
+    parts = [str(p) for p in loc if p != "body"]
     if len(parts) > 2 and parts[0] in ("robot", "augmentation") and parts[1] in _TAGS:
         del parts[1]
     return field_text(".".join(parts)) or "body"
