@@ -5,6 +5,7 @@ wrong length says how many components the request's robot needs and why."""
 from __future__ import annotations
 
 from ...engine.registry import ROBOTS
+from ..compute.robot_requests import length_problem
 from ..compute.schemas import (
     AUGMENTATION_MODELS,
     ROBOT_MODELS,
@@ -93,5 +94,5 @@ def _length_message(loc, ctx: dict) -> str | None:
         return None
     if parts[2] in ("path", "shifts") and len(parts) < 4:
         return None  # (the list of points itself)
-    n, what = (spec.p, "p") if parts[2] in _CONFIGURATIONS else (len(spec.task_names), "r")
-    return f"must have {n} components ({what} of {spec.name}), got {ctx.get('actual_length')}"
+    what = "p" if parts[2] in _CONFIGURATIONS else "r"
+    return length_problem(spec, what, ctx.get("actual_length", -1))

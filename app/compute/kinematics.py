@@ -17,8 +17,7 @@ from ...engine.arms import ARMS
 from ...engine.registry import ROBOTS
 from . import schemas as S
 from .documents import nullable
-from .exceptions import RequestError
-from .robot_requests import request_robot
+from .robot_requests import check_length, request_robot
 from .schemas.examples import schema_examples
 from .schemas.fields import coordinates, one_or_many
 from .schemas.robots import _camel
@@ -105,13 +104,7 @@ def kinematics_request(req: KinematicsRequest) -> KinematicsResponse:
     spec, kin = robot.spec, robot.kinematics
     many = isinstance(req.x[0], list)
     for i, row in enumerate(req.x if many else [req.x]):
-        if len(row) != spec.p:
-            raise RequestError(
-                f"x[{i}]" if many else "x",
-                f"must have {spec.p} components "
-                f"(p of {spec.title}: {list(spec.variable_names)}), got "
-                f"{len(row)}",
-            )
+        check_length(spec, row, f"x[{i}]" if many else "x", "p")
     x = np.asarray(req.x, dtype=float)
     forward_jacobian = getattr(kin, "forward_jacobian", None)
     k, J = forward_jacobian(x) if forward_jacobian else (kin.forward(x), kin.jacobian(x))

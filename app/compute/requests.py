@@ -24,7 +24,7 @@ from ...engine.solver import solve_batch as engine_solve_batch
 from . import schemas as S
 from .documents import limits_document, nullable, solve_response_json
 from .exceptions import RequestError
-from .robot_requests import check_configuration, check_task_point, gamma_and_mode, request_robot
+from .robot_requests import check_configuration, check_length, gamma_and_mode, request_robot
 from .schemas.algorithms import parameters_of, used
 from .schemas.wording import without_field
 
@@ -116,7 +116,7 @@ def solve_batch_json(reqs: list[S.SolveRequest]) -> list[bytes | RequestError]:
     for i, r in enumerate(reqs):
         try:
             check_configuration(setup.spec, r.x0)
-            check_task_point(setup.spec, r.target, "target")
+            check_length(setup.spec, r.target, "target")
             ok.append(i)
         except RequestError as exc:
             out[i] = exc
@@ -154,7 +154,7 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
     setup = _setup(req)
     check_configuration(setup.spec, req.x0)
     for i, pt in enumerate(req.path):
-        check_task_point(setup.spec, pt, f"path[{i}]")
+        check_length(setup.spec, pt, f"path[{i}]")
     x0 = np.array(req.x0, dtype=float)
     if refused := refused_starts(setup.inverse, x0[None]):
         raise RequestError("x0", refused[0])

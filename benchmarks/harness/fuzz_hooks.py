@@ -62,7 +62,7 @@ from ...app.compute.atlas_plan import AtlasLimits, planned
 from ...app.compute.atlas_schemas import AtlasRequest
 from ...app.compute.exceptions import RequestError
 from ...app.compute.requests import _setup
-from ...app.compute.robot_requests import check_configuration, check_task_point, request_robot
+from ...app.compute.robot_requests import check_configuration, check_length, request_robot
 from ...app.compute.schemas.synthesis import QMC_NODES
 from ...app.compute.synthesis import synthesis_region
 from ...app.dashboard.model import default_state, updated_state
@@ -220,7 +220,7 @@ def _run_ok(body: dict, path: str) -> bool:
         check_configuration(setup.spec, run.x0)
         points = run.path if isinstance(run, S.RepeatabilityRequest) else [run.target]
         for i, point in enumerate(points):
-            check_task_point(setup.spec, point, f"path[{i}]")
+            check_length(setup.spec, point, f"path[{i}]")
         # (the server's own test of a singular start, which a nearly singular J J^T fails)
         setup.inverse.matrix(np.asarray(run.x0, dtype=float))
         if refused_starts(setup.inverse, np.asarray([run.x0], dtype=float)):
