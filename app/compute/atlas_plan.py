@@ -63,8 +63,8 @@ def planned(req: AtlasRequest, limits: AtlasLimits) -> tuple[AtlasPlan, Used]:
     for name, v in named:
         check_length(spec, v, name)
     named = [(f"start_points[{i}]", v) for i, v in enumerate(req.start_points or [])]
-    for name, v in [*named, ("reference", req.reference or spec.default_x0)]:  # (its default)
-        check_length(spec, v, name, "p")
+    for name, x in [*named, ("reference", req.reference or spec.default_x0)]:  # (its default)
+        check_length(spec, x, name, "p")
     gamma, mode = gamma_and_mode(spec, req)
     paths = len(req.shifts or [0]) * len(req.scales or [0])
     starts = len(req.start_points) if req.start_points else req.starts
