@@ -17,7 +17,7 @@ from ...engine.variational import synthesize_e2
 from . import schemas as S
 from .exceptions import RequestError
 from .robot_requests import request_robot
-from .synthesis_total import grid, singularities, total_degree_response
+from .synthesis_total import map_response, total_degree_response
 
 
 def synthesis_methods() -> S.SynthesisMethodsResponse:
@@ -151,21 +151,16 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         coefficients = amap.monomials() if isinstance(amap, Polynomial2) else {}
         nodes = req.nodes
     functionals, more = _functionals(kin, amap, region, fixed, nodes)
-    all_fixed = {n: float(fixed.get(n, 0.0)) for n in names if n not in region}
-    found, said, searched = singularities(kin, amap, region, all_fixed, req.nodes)
-    notes += more + said
-    return S.SynthesizeResponse(
-        robot=robot_used,
-        method=req.method,
+    return map_response(
+        req,
+        robot_used,
+        kin,
+        amap,
+        (names, region, fixed),
+        notes + more,
         augmentation=aug_used,
-        region={k: [float(lo), float(hi)] for k, (lo, hi) in region.items()},
-        fixed=all_fixed,
-        grid=grid(amap, names, region, all_fixed, req.grid),
         coefficients=coefficients,
         functionals=functionals,
         convergence=convergence,
-        singularities=found,
-        singularities_searched=searched,
         total_degree=None,
-        message="; ".join(notes) or "ok",
     )
