@@ -53,15 +53,8 @@ def solve_response_json(setup, res) -> bytes:
     ``tests/app/test_solve.py`` checks that the model reads it back as the same document."""
     return pydantic_core.to_json(
         {
-            "robot": setup.robot.model_dump(mode="json"),
-            "algorithm": setup.inverse.name,
-            "algorithm_parameters": setup.parameters,
-            "augmentation": (
-                None if setup.augmentation is None else setup.augmentation.model_dump(mode="json")
-            ),
-            "mode": setup.mode,
-            "gamma": float(setup.gamma),
-            "tolerance": float(setup.tolerance),
+            **setup.head,
+            "tolerance": float(setup.run["tol"]),
             "x": nullable(res.x),
             "y": nullable(res.y),
             "error": nullable(res.error),

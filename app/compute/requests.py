@@ -31,19 +31,16 @@ from .schemas.wording import without_field
 
 @dataclass
 class _Setup:
-    """Everything a run needs, validated against the registry."""
+    """Everything a run needs, validated against the registry: the robot, its inverse of the
+    request's algorithm, the engine's keywords of the run (``gamma``, ``mode``, ``tol``,
+    ``max_iterations``) and the fields every run's response starts with (the robot, algorithm,
+    parameters the inverse used, map, mode and gamma)."""
 
     spec: RobotSpec
     kinematics: Any
     inverse: Any
-    robot: S.RobotUsed
-    augmentation: S.AugmentationUsed | None
-    mode: S.Mode
-    gamma: float
-    tolerance: float
-    max_iterations: int | None
-    #: The inverse's parameters, defaults filled in (:func:`parameters_of`).
-    parameters: dict
+    run: dict[str, Any]
+    head: dict[str, Any]
 
 
 def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
@@ -55,12 +52,19 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
     built = request_robot(
         req.robot, req.augmentation, [req.algorithm], req.algorithm_parameters, req.x0
     )
-    spec, kin, (inverse,) = built.spec, built.kinematics, built.inverses
-    gamma, mode = gamma_and_mode(spec, req)
-    return _Setup(
-        *(spec, kin, inverse, built.robot, built.augmentation, mode, gamma),
-        *(req.tolerance, req.max_iterations, parameters_of(inverse)),
-    )
+    (inverse,) = built.inverses
+    gamma, mode = gamma_and_mode(built.spec, req)
+    aug = built.augmentation
+    head = {
+        "robot": built.robot.model_dump(mode="json"),
+        "algorithm": inverse.name,
+        "algorithm_parameters": parameters_of(inverse),
+        "augmentation": None if aug is None else aug.model_dump(mode="json"),
+        "mode": mode,
+        "gamma": float(gamma),
+    }
+    run = {"gamma": gamma, "mode": mode, "tol": req.tolerance, "max_iterations": req.max_iterations}
+    return _Setup(built.spec, built.kinematics, inverse, run, head)
 
 
 #: A run's arguments in the engine that are a request's fields, by the request's names.
@@ -130,14 +134,7 @@ def solve_batch_json(reqs: list[S.SolveRequest]) -> list[bytes | RequestError]:
         if keep.size:
             try:
                 batch = engine_solve_batch(
-                    setup.inverse,
-                    x0[keep],
-                    y_d[keep],
-                    gamma=setup.gamma,
-                    mode=setup.mode,
-                    tol=setup.tolerance,
-                    max_iterations=setup.max_iterations,
-                    record=True,
+                    setup.inverse, x0[keep], y_d[keep], **setup.run, record=True
                 )
             except JikError as exc:
                 err = engine_error(exc)
@@ -164,29 +161,20 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
             x0,
             np.array(req.path, dtype=float),
             cycles=req.cycles,
-            gamma=setup.gamma,
-            mode=setup.mode,
-            tol=setup.tolerance,
-            max_iterations=setup.max_iterations,
+            **setup.run,
             record=robot_limits(setup.kinematics) is not None,  # (limits: check whole legs)
         )
     except JikError as exc:
         raise engine_error(exc) from None
     drift = np.asarray(res.drift, dtype=float)
-    max_drift = float(np.max(drift)) if np.all(np.isfinite(drift)) else float("nan")
     return S.RepeatabilityResponse(
-        robot=setup.robot,
-        algorithm=setup.inverse.name,
-        algorithm_parameters=setup.parameters,
-        augmentation=setup.augmentation,
-        mode=setup.mode,
-        gamma=setup.gamma,
+        **setup.head,
         cycles=req.cycles,
         targets=np.asarray(res.targets, dtype=float).tolist(),
         legs=nullable(res.legs),
         cycle_end=nullable(res.cycle_end),
         drift=nullable(drift),
-        max_drift=nullable(max_drift),
+        max_drift=nullable(np.max(drift)),  # (null when a cycle's drift is not finite)
         repeatable=bool(res.success) and repeatable(drift) is True,
         success=bool(res.success),
         message=cast(str, res.message),  # one start configuration: one message
