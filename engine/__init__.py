@@ -128,7 +128,7 @@ _EXPORTS = {
     "Trajectory": "results",
     # repeatability
     "repeatability": "repeatability",
-    "RepeatabilityResult": "results",
+    "RepeatabilityResult": "repeatability_result",
     "Resume": "run_settings",
     "Leg": "repeatability",
     "repeatable": "repeatability",
@@ -300,7 +300,8 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
     from .progress import Progress, ProgressCallbacks
     from .registry import ALGORITHMS, ROBOTS, make_inverse
     from .repeatability import Leg, repeatability, repeatable
-    from .results import BatchSolveResult, RepeatabilityResult, SolveResult, Trajectory
+    from .repeatability_result import RepeatabilityResult
+    from .results import BatchSolveResult, SolveResult, Trajectory
     from .robot_spec import Robot, load_robot, robot_from_dict
     from .run_settings import Resume
     from .solver import solve, solve_batch

@@ -105,9 +105,23 @@ class VectorExtendedInverse(Inverse):
         return np.linalg.solve(Jbar, rhs)
 
     def singular_error(self, x: FloatArray) -> Exception:
+        at = np.asarray(x, dtype=float)[None]
+        undefined = [
+            f"h_{i + 1} = {m!r}"
+            for i, m in enumerate(self.augmenting_maps)
+            if m.gradient_masked(at)[1][0]
+        ]
+        if undefined:
+            maps = ", ".join(undefined)
+            which = f"map {maps} is" if len(undefined) == 1 else f"maps {maps} are"
+            return AlgorithmicSingularityError(
+                f"the augmenting {which} undefined (the gradient cannot be evaluated), so the "
+                "extended Jacobian inverse (11) is undefined; choose another start or other maps",
+                x,
+            )
         return AlgorithmicSingularityError(
             f"the extended Jacobian [J; dh_1; ...; dh_{len(self.augmenting_maps)}] of "
-            f"{self.kinematics.name} is singular or a map is undefined (algorithmic singularity, "
-            "eq. (11)); choose another start or other maps",
+            f"{self.kinematics.name} is singular (algorithmic singularity, eq. (11)); choose "
+            "another start or other maps",
             x,
         )

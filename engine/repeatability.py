@@ -23,7 +23,8 @@ from .exceptions import InvalidInputError, JikError, format_vector
 from .inverses import Inverse
 from .picard_guesses import chain_guesses
 from .progress import Progress, check_cancelled, stops_at
-from .results import BatchSolveResult, RepeatabilityResult, SolveResult, Trajectory
+from .repeatability_result import RepeatabilityResult
+from .results import BatchSolveResult, SolveResult, Trajectory
 from .run_settings import Resume, RunSettings, inverse_fingerprint, resumed_legs
 from .solve_chunks import solve_in_chunks
 from .solve_rules import check_inverse, check_settings, run_bytes

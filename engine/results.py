@@ -1,10 +1,11 @@
-"""Results of the continuation algorithm (7): a solve, a batch, a trajectory, a repeatability run.
+"""Results of the continuation algorithm (7): a solve, a batch of solves, a trajectory.
 
 They borrow SciPy's vocabulary (``x``, ``success``, ``message``, ``nit``), print on one line
 (``print(result)``) and export their numbers: :meth:`as_dict` gives JSON-friendly values, and
 ``to_dataframe()`` a pandas DataFrame (pandas is optional: ``columns()`` gives the same columns
 as plain arrays). Column names follow :mod:`jik.engine.exports`: ``x0_k`` a start, ``x_k`` the
-row's configuration, ``y_k`` its task point, ``y_d_k`` a target.
+row's configuration, ``y_k`` its task point, ``y_d_k`` a target. A repeatability run's result
+is :class:`jik.engine.repeatability_result.RepeatabilityResult`.
 """
 
 from __future__ import annotations
@@ -18,13 +19,8 @@ import numpy as np
 from .exceptions import InvalidInputError
 from .exports import Columns, coordinate_columns, short_text, short_vector
 from .inverses import Inverse
-from .run_settings import RunSettings
 from .solve_rules import Status
 from .validation import FloatArray
-
-
-def _plural(n: int, noun: str) -> str:
-    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
 
 
 @dataclass(frozen=True)
@@ -149,7 +145,7 @@ class SolveResult(Columns):
     def columns(self) -> dict[str, Any]:
         """One row (a solve; :meth:`Trajectory.columns` has a row per point): the start
         ``x0_1``..``x0_p``, the target ``y_d_1``..``y_d_r``, the end ``x_1``..``x_p``, its task
-        point ``y_1``..``y_r``, ``error``, ``success``, ``nit``, ``message``."""
+        point ``y_1``..``y_r``, ``error``, ``success``, ``nit``, ``message``, ``status``."""
         out: dict[str, Any] = coordinate_columns("x0", np.atleast_2d(self.x0))
         out |= coordinate_columns("y_d", np.atleast_2d(self.y_d))
         out |= coordinate_columns("x", np.atleast_2d(self.x))
@@ -158,6 +154,7 @@ class SolveResult(Columns):
         out["success"] = np.array([self.success])
         out["nit"] = np.array([self.nit])
         out["message"] = np.array([self.message])
+        out["status"] = np.array([self.status])
         return out
 
     def as_dict(self, trajectory: bool = False) -> dict[str, Any]:
@@ -175,6 +172,7 @@ class SolveResult(Columns):
             "success": self.success,
             "nit": self.nit,
             "message": self.message,
+            "status": self.status,
         }
         if trajectory:
             out["trajectory"] = None if self.trajectory is None else self.trajectory.as_dict()
@@ -201,12 +199,12 @@ class BatchSolveResult(Columns):
     _inverse: Inverse = field(repr=False)
     y_d: FloatArray = field(repr=False)  # (n, r)
     x0: FloatArray = field(repr=False)  # (n, p)
+    # Each member's outcome (solve_rules.Status), named by its SolveResult's ``status``.
+    _status: FloatArray = field(repr=False)
     # Recorded points: member index, theta, x of every accepted step, in order.
     _rec_member: FloatArray | None = field(repr=False, default=None)
     _rec_theta: FloatArray | None = field(repr=False, default=None)
     _rec_x: FloatArray | None = field(repr=False, default=None)
-    # Each member's outcome (solve_rules.Status), named by its SolveResult's ``status``.
-    _status: FloatArray | None = field(repr=False, default=None)
 
     def __len__(self) -> int:
         return len(self.x)
@@ -221,7 +219,7 @@ class BatchSolveResult(Columns):
     def columns(self) -> dict[str, Any]:
         """A row per member: the start ``x0_1``..``x0_p``, the target ``y_d_1``..``y_d_r``, the
         end ``x_1``..``x_p``, its task point ``y_1``..``y_r``, ``error``, ``success``, ``nit``,
-        ``message``."""
+        ``message``, ``status``."""
         out: dict[str, Any] = coordinate_columns("x0", self.x0) | coordinate_columns(
             "y_d", self.y_d
         )
@@ -230,11 +228,12 @@ class BatchSolveResult(Columns):
         out["success"] = np.asarray(self.success, dtype=bool)
         out["nit"] = np.asarray(self.nit, dtype=int)
         out["message"] = np.array(self.message)
+        out["status"] = np.array(self.status)
         return out
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-friendly: the settings and, per member, x0, y_d, x, y, error, success, nit,
-        message."""
+        message, status."""
         return {
             "algorithm": self.algorithm,
             "inverse": repr(self._inverse),
@@ -248,7 +247,13 @@ class BatchSolveResult(Columns):
             "success": np.asarray(self.success, dtype=bool).tolist(),
             "nit": np.asarray(self.nit, dtype=int).tolist(),
             "message": list(self.message),
+            "status": list(self.status),
         }
+
+    @property
+    def status(self) -> tuple[str, ...]:
+        """Each member's :attr:`SolveResult.status`."""
+        return tuple(Status.NAMES[int(c)] for c in self._status)
 
     def trajectory(self, i: int) -> Trajectory:
         """The trajectory of member ``i`` (requires ``record=True``)."""
@@ -290,109 +295,5 @@ class BatchSolveResult(Columns):
             x0=self.x0[i],
             y_d=self.y_d[i],
             _inverse=self._inverse,
-            status=Status.NAMES[int(self._status[i])] if self._status is not None else "",
+            status=Status.NAMES[int(self._status[i])],
         )
-
-
-@dataclass(frozen=True)
-class RepeatabilityResult(Columns):
-    """Configurations along a closed path driven ``cycles`` times.
-
-    Attributes
-    ----------
-    x0 : ndarray, shape (p,) or (n, p)
-    targets : ndarray, shape (L, r) or (n, L, r)
-        The task point of every leg of one cycle (the given path, closed by k(x0) if needed).
-    legs : ndarray, shape (cycles * L, p) or (n, cycles * L, p)
-        Configuration after each leg.
-    cycle_end : ndarray, shape (cycles, p) or (n, cycles, p)
-    drift : ndarray, shape (cycles,) or (n, cycles)
-        ||cycle_end[c] - x0||.
-    success : bool or ndarray of bool, shape (n,)
-    message : str or tuple of str
-    leg_results : list of SolveResult
-        Every leg with its trajectory (single start with ``record=True`` only).
-    settings : RunSettings
-        The inverse (``settings.algorithm``, ``settings.inverse``), mode, gamma, tol and
-        max_iterations of every leg; also ``algorithm``, ``inverse``, ``mode`` and ``gamma``.
-    """
-
-    x0: FloatArray
-    targets: FloatArray
-    legs: FloatArray
-    cycle_end: FloatArray
-    drift: FloatArray
-    success: bool | FloatArray
-    message: str | tuple[str, ...]
-    leg_results: list[SolveResult]
-    settings: RunSettings
-
-    @property
-    def algorithm(self) -> str:
-        return self.settings.algorithm
-
-    @property
-    def inverse(self) -> str:
-        return self.settings.inverse
-
-    @property
-    def mode(self) -> str:
-        return self.settings.mode
-
-    @property
-    def gamma(self) -> float:
-        return self.settings.gamma
-
-    def __repr__(self) -> str:
-        cycles = self.drift.shape[-1]
-        how = f"{self.algorithm}, {self.mode}, gamma={self.gamma:g}"
-        if np.ndim(self.success) == 0:
-            last = f"{self.drift[-1]:.3g}" if cycles else "none"
-            return (
-                f"RepeatabilityResult({how}, success={self.success}, "
-                f"{_plural(cycles, 'cycle')} of {len(self.targets)} legs, "
-                f"x0={short_vector(self.x0)}, drift after the last cycle {last}, "
-                f"message={short_text(str(self.message))})"
-            )
-        ok = int(np.count_nonzero(self.success))
-        worst = float(np.nanmax(self.drift[:, -1])) if np.any(self.success) else float("nan")
-        return (
-            f"RepeatabilityResult({how}, {len(self.x0)} starts, {ok} completed, "
-            f"{_plural(cycles, 'cycle')} of {self.targets.shape[1]} legs, largest drift after "
-            f"the last cycle {worst:.3g})"
-        )
-
-    def columns(self) -> dict[str, Any]:
-        """A row per cycle (and start): ``start`` (a batch's member, from 0), ``cycle`` (from
-        1), ``drift``, the start ``x0_1``..``x0_p`` and the configuration at the cycle's end
-        ``x_1``..``x_p``."""
-        drift = np.atleast_2d(self.drift)  # (n, cycles)
-        ends = self.cycle_end.reshape(-1, self.cycle_end.shape[-1])
-        n, cycles = drift.shape
-        out: dict[str, Any] = (
-            {} if np.ndim(self.success) == 0 else {"start": np.repeat(np.arange(n), cycles)}
-        )
-        out["cycle"] = np.tile(np.arange(1, cycles + 1), n)
-        out["drift"] = drift.ravel()
-        starts = np.repeat(np.atleast_2d(self.x0), cycles, axis=0)
-        return out | coordinate_columns("x0", starts) | coordinate_columns("x", ends)
-
-    def as_dict(self) -> dict[str, Any]:
-        """JSON-friendly: the algorithm, the inverse as printed, mode, gamma, tol,
-        max_iterations, x0, the legs' targets, leg ends, cycle ends, drift, success, message."""
-        s = self.settings
-        return {
-            "algorithm": s.algorithm,
-            "inverse": s.inverse,
-            "mode": s.mode,
-            "gamma": s.gamma,
-            "tol": s.tol,
-            "max_iterations": s.max_iterations,
-            "x0": self.x0.tolist(),
-            "targets": self.targets.tolist(),
-            "legs": self.legs.tolist(),
-            "cycle_end": self.cycle_end.tolist(),
-            "drift": self.drift.tolist(),
-            "success": np.asarray(self.success).tolist(),
-            "message": self.message if isinstance(self.message, str) else list(self.message),
-        }

@@ -22,7 +22,8 @@ from .exports import short_vector
 from .validation import FloatArray
 
 if TYPE_CHECKING:
-    from .results import RepeatabilityResult, Trajectory
+    from .repeatability_result import RepeatabilityResult
+    from .results import Trajectory
 
 #: Simple values digested as their repr.
 _SIMPLE = (bool, int, float, str, type(None), np.integer, np.floating)

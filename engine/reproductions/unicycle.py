@@ -56,7 +56,7 @@ def _floats(a) -> list:
 
 def _inverses(q0):
     kin = Unicycle(q0=q0, T=T)
-    # "nan": the solver sees an undefined h as a singular [J; dh] and stops cleanly; the precise
+    # "nan": the solver stops cleanly where h is undefined (status "undefined"); the precise
     # reason is recovered below with the raising twin.
     masked = UnicycleCharacteristics(kin, a=A_PARAMETER, on_undefined="nan")
     strict = UnicycleCharacteristics(kin, a=A_PARAMETER)
@@ -106,8 +106,8 @@ def _run_one(kin, inverse, strict, mode) -> dict:
     extended = inverse.name == "extended"
     out: dict = {"algorithm": inverse.name, "mode": mode}
     try:
-        # An undefined h reaches the solver as NaN in [J; dh] (flagged singular there); the
-        # 'invalid value' warning of that determinant is expected and diagnosed below.
+        # An undefined h reaches the solver as NaN in [J; dh]; the 'invalid value' warning of
+        # that determinant is expected and diagnosed below.
         with np.errstate(invalid="ignore"):
             res = solve(
                 inverse,
@@ -127,7 +127,7 @@ def _run_one(kin, inverse, strict, mode) -> dict:
     assert tr is not None  # record=True
     lam, err = tr.x, tr.error
     h = None if tr.h is None else np.asarray(tr.h, dtype=float)
-    stop, notes = _diagnose(lam, h, strict, not res.success and "singular" in res.message)
+    stop, notes = _diagnose(lam, h, strict, res.status in ("singular", "undefined"))
     n = len(lam) if stop is None else stop + 1
     success = bool(res.success) and stop is None
     message = res.message if stop is None else "stopped: " + " | ".join(notes)

@@ -75,3 +75,17 @@ def test_map_undefined_tells_an_undefined_map_from_a_singular_extended_jacobian(
     one = ExtendedInverse(kin, FormulaMap("sqrt(x1)", kin.variable_names))
     assert one.map_undefined(x[:, :3]).tolist() == [False, True]
     assert not ExtendedInverse(kin, PaperCubic()).map_undefined(x[:, :3]).any()
+
+
+def test_the_error_names_the_undefined_map_or_says_singular():
+    """The error said "singular or a map is undefined" either way; it names the map h_i
+    undefined there, and says "singular" only where [J; dh] is."""
+    inv = VectorExtendedInverse(CHAIN, [FormulaMap("sqrt(x1)", NAMES), *MAPS[1:]])
+    with pytest.raises(
+        AlgorithmicSingularityError, match=r"map h_1 = FormulaMap\('sqrt\(x1\)'\) is undef"
+    ):
+        inv.matrix([-0.2, *X0[1:]])
+    same = [FormulaMap("x3", NAMES), FormulaMap("2*x3", NAMES), FormulaMap("x4", NAMES)]
+    with pytest.raises(AlgorithmicSingularityError, match=r"\] of .* is singular \(") as info:
+        VectorExtendedInverse(CHAIN, same).matrix(X0)
+    assert "undefined" not in str(info.value)

@@ -189,6 +189,26 @@ def test_runs_export_their_algorithm_settings_start_and_target():
     np.testing.assert_array_equal(chunked.leg_results[1].x0, chunked.legs[0])
 
 
+def test_a_solve_exports_why_it_stopped():
+    """as_dict() and columns() dropped SolveResult.status: a notebook's export or
+    `jik solve --json` could not tell why a run stopped without parsing the message."""
+    one = jik.solve(jik.Pseudoinverse(ARM), X0, [1, 1])
+    assert one.as_dict()["status"] == "converged" and one.columns()["status"].tolist() == [
+        "converged"
+    ]
+    batch = jik.solve_batch(
+        jik.Pseudoinverse(ARM),
+        [X0, X0],
+        [[1, 1], [50, -40]],
+        mode="discrete",
+        gamma=0.5,
+        max_iterations=40,
+    )
+    assert batch.status == (batch[0].status, batch[1].status) == ("converged", "max_steps")
+    assert json.loads(json.dumps(batch.as_dict()))["status"] == ["converged", "max_steps"]
+    assert batch.columns()["status"].tolist() == ["converged", "max_steps"]
+
+
 def test_every_result_exports_a_table_with_one_meaning_per_column_name():
     """x1..xp were cycle ends in a repeatability table but starts in an atlas's."""
     rep = jik.repeatability(jik.Pseudoinverse(ARM), X0, PATH, cycles=2)

@@ -58,6 +58,10 @@ def test_start_b_extended_discrete_stops_with_a_message(result):
     assert "lambda10 crossed 0" in r["message"]
     reasons = ("diverged", "undefined", "could not be resolved", "singular")
     assert any(reason in r["message"] for reason in reasons)
+    # A run stopped where h is undefined notes the map's own reason (the raising twin's), not
+    # only the inverse's "undefined".
+    assert r["solver_message"].startswith("the augmenting map 'characteristics' is undefined")
+    assert "its characteristic (28) could not be resolved" in r["notes"][-1]
     assert all(v is None or np.isfinite(v) for v in r["lambda"])
     assert result["B"]["pseudoinverse"]["success"]
 
