@@ -7,12 +7,11 @@
 
 from __future__ import annotations
 
-from collections.abc import Collection
-
 from ...engine.augmentations import Polynomial2
 from ...engine.exceptions import JikError
 from ...engine.functionals import error_functional_e1, error_functional_e2
 from ...engine.registry import RobotSpec
+from ...engine.robot_synthesis import default_box
 from ...engine.variational import synthesize_e2
 from . import schemas as S
 from .exceptions import RequestError
@@ -37,36 +36,12 @@ def synthesis_methods() -> S.SynthesisMethodsResponse:
     )
 
 
-def default_region(
-    spec: RobotSpec, size: int, fixed: Collection[str] = ()
-) -> dict[str, tuple[float, float]]:
-    """The robot's design region (``functional_region``, the box of sec. 5 over which the
-    dashboard and its ``e2_synthesized`` map take E1 (13) and E2 (18)) when it has ``size``
-    variables, none ``fixed``; else the last ``size`` variables that are not ``fixed``, each
-    over a box around the default start.
-
-    Half-width: a tenth of the variable's ``x_range``, clipped to it. The other variables are
-    held at the default start (where the robot's maps are defined), not at 0.
-    """
-    design = dict(spec.functional_region)
-    if len(design) == size and not set(design) & set(fixed):
-        return {n: (float(lo), float(hi)) for n, (lo, hi) in design.items()}
-    names = list(spec.variable_names)
-    region = {}
-    for n in [n for n in names if n not in fixed][-size:]:
-        i = names.index(n)
-        lo, hi = spec.x_range[i]
-        c, w = spec.default_x0[i], 0.1 * (hi - lo)
-        region[n] = (max(lo, c - w), min(hi, c + w))
-    return region
-
-
 def synthesis_region(spec: RobotSpec, req: S.SynthesizeRequest):
     """The variable names, the box and the fixed values of a synthesis request, checked."""
     names = list(spec.variable_names)
     size = {"e2_variational": 2, "e2_total_degree": spec.p}.get(req.method, 3)
     if req.region is None:
-        region = default_region(spec, size, req.fixed or {})
+        region = default_box(spec, size, req.fixed or {})
     else:
         region = {k: (float(lo), float(hi)) for k, (lo, hi) in req.region.items()}
     if len(region) > 3 and req.method != "e2_total_degree":
