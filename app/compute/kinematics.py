@@ -106,8 +106,7 @@ def kinematics_request(req: KinematicsRequest) -> KinematicsResponse:
     for i, row in enumerate(req.x if many else [req.x]):
         check_length(spec, row, f"x[{i}]" if many else "x", "p")
     x = np.asarray(req.x, dtype=float)
-    forward_jacobian = getattr(kin, "forward_jacobian", None)
-    k, J = forward_jacobian(x) if forward_jacobian else (kin.forward(x), kin.jacobian(x))
+    k, J = kin.forward_jacobian(x)
     return KinematicsResponse(
         robot=robot.robot,
         variable_names=list(spec.variable_names),
