@@ -9,17 +9,11 @@ state), :mod:`.algorithms` (the chosen algorithms, one style each), :mod:`.runs`
 per tab, bounded), :mod:`.export` (JSON and CSV). The names below are the public surface.
 """
 
+from .algorithms import COLORS, LABELS, runs_key
+from .algorithms import DEFAULT_ALGORITHMS as ALGORITHMS  # (the algorithms of a new state)
 from .export import export_csv, export_file, export_json
 from .messages import Event
-from .model import (
-    ALGORITHMS,
-    COLORS,
-    LABELS,
-    DashboardState,
-    default_state,
-    runs_key,
-    updated_state,
-)
+from .model import DashboardState, default_state, updated_state
 from .offload import OffloadLane
 from .results import compute
 from .runs import AlgorithmRun, Cancelled, DashboardResult

@@ -4,19 +4,17 @@ events), so that a switch of robot only draws."""
 
 from __future__ import annotations
 
-import contextlib
 import logging
 import threading
 from collections.abc import Callable
 
 from ...engine.exceptions import InvalidInputError, JikError
+from .algorithms import cache_key
 from .analysis import expensive_map, kinematics_and_map
 from .messages import Event, with_figures
-from .model import DashboardState, cache_key, updated_state
-from .offload import OffloadLane
+from .model import DashboardState, updated_state
 from .plotting import PANELS
-from .results import compute
-from .runs import Cancelled
+from .runs import Cancelled, DashboardResult
 
 log = logging.getLogger("jik.dashboard")
 
@@ -35,14 +33,13 @@ class SolvingAhead:
     _stopped: bool
     _state: DashboardState
     _cache: dict
-    _offload: OffloadLane | None
     # When each robot's result solved ahead went to the page (the value of _robot_since then),
     # the latest by robot, and since when the robot on screen is (its first result's generation).
     _ahead_sent: dict[str, int]
     _latest_ahead: dict[str, Event]
     _robot_since: int
     _emit: Callable[[Event], None]
-    _turn: Callable[[], contextlib.AbstractContextManager]
+    _solved: Callable[..., DashboardResult]
     _known_functionals: Callable[[DashboardState], tuple[tuple | None, set[str]]]
     _panel_texts: Callable[..., dict[str, str]]
 
@@ -75,15 +72,7 @@ class SolvingAhead:
                 continue  # (its figures stay the same while the robot on screen stays)
             try:
                 _, amap = kinematics_and_map(state)
-                with self._turn():
-                    result = compute(
-                        state,
-                        generation,
-                        cancelled=lambda: self._generation != generation,
-                        cache=self._cache,
-                        with_augmenting=not expensive_map(amap),
-                        offload=self._offload,
-                    )
+                result = self._solved(state, generation, with_augmenting=not expensive_map(amap))
                 # The figures as the switch will make them (see _compute; no panel to reuse
                 # from another robot).
                 cached, stale = self._known_functionals(state)

@@ -309,8 +309,7 @@ def inverse_parameters(state: ChosenState, algorithm: str) -> dict[str, Any]:
     """What the engine's ``make_inverse`` takes for ``algorithm``: its scalars, and the posture
     inverse's rest when the state sets one (else the engine's default at the state's start:
     :func:`~jik.app.dashboard.robots.state_inverse` passes it)."""
-    spec = REGISTRY[algorithm]
-    names = {p.name for p in spec.parameters} | set(spec.vectors)
+    names = REGISTRY[algorithm].names
     return {k: v for k, v in state.algorithm_parameters.items() if k in names}
 
 
@@ -336,9 +335,7 @@ def cache_key(state: ChosenState, algorithm: str) -> str:
     d = state.as_dict()
     d.pop("cspace_axes")  # (what a panel shows, not what is solved)
     d.pop("algorithms")
-    names = {p.name for p in REGISTRY[algorithm].parameters}
-    names |= {k for k, a in VECTORS.items() if a == algorithm}
-    d["algorithm_parameters"] = {k: v for k, v in d["algorithm_parameters"].items() if k in names}
+    d["algorithm_parameters"] = inverse_parameters(state, algorithm)
     d["algorithm"] = algorithm
     if algorithm != "extended":
         d.pop("augmentation"), d.pop("augmentation_parameters")

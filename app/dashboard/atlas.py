@@ -132,11 +132,11 @@ def atlas_figure(
     layout: dict[str, Any] = {"shapes": [], "annotations": []}
     gap = 0.06
     width = (0.92 - gap * (len(algorithms) - 1)) / len(algorithms)
-    failed = []
+    outside = outside_counts(result)
     for k, a in enumerate(algorithms):
         d = np.array(result["drift"][a], dtype=float)  # (P, N, C), NaN after a failure
         z = np.array([d[j, :, c] for j, c in rows])  # (rows, N)
-        failed.append(int(np.isnan(d).any(axis=2).sum()))
+        failed = int(np.isnan(d).any(axis=2).sum())
         axis = "" if k == 0 else str(k + 1)
         data.append(
             {
@@ -181,25 +181,16 @@ def atlas_figure(
             "showticklabels": k == 0,
             "type": "category",
         }
-    names = [
-        STYLES[a].label
-        + (
-            f"<br>h = {request.augmentation.name}"
-            if a == "extended" and request.augmentation is not None
-            else ""
-        )
-        + (f"<br>{_rest_used(request)}" if a == "posture" else "")
-        for a in algorithms
-    ]
-    outside = outside_counts(result)
-    for k, name in enumerate(names):
-        lo = k * (width + gap)
-        note = f", {failed[k]} starts failed (blank)" if failed[k] else ""
-        if algorithms[k] in outside:
-            note += f"<br>{outside[algorithms[k]]} of {P * N} runs left the joint limits"
+        name = STYLES[a].label
+        if a == "extended" and request.augmentation is not None:
+            name += f"<br>h = {request.augmentation.name}"
+        name += f"<br>{_rest_used(request)}" if a == "posture" else ""
+        name += f", {failed} starts failed (blank)" if failed else ""
+        if a in outside:
+            name += f"<br>{outside[a]} of {P * N} runs left the joint limits"
         layout["annotations"].append(
             {
-                "text": name + note,
+                "text": name,
                 "x": lo + width / 2,
                 "y": 1.0,
                 "xref": "paper",
@@ -207,7 +198,7 @@ def atlas_figure(
                 "xanchor": "center",
                 "yanchor": "bottom",
                 "showarrow": False,
-                "font": {"size": 11, "color": STYLES[algorithms[k]].color},
+                "font": {"size": 11, "color": STYLES[a].color},
             }
         )
     # (a session's atlas, whose request atlas_request made: gamma and mode the state's)

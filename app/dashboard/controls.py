@@ -167,26 +167,21 @@ def controls(state) -> list[Control]:
             inline=True,
         )
     )
-    groups = (
-        ("augmentation_parameters", aug.parameters),
-        ("algorithm_parameters", scalar_parameters(state.algorithms)),
+    out += _sliders("augmentation_parameters", aug.parameters)
+    out.append(
+        Control(
+            "algorithms",
+            "algorithms",
+            "checks",
+            "algorithm",
+            "the inverses J# run side by side, one colour each (at least one)",
+            options=tuple((a, s.label) for a, s in STYLES.items()),
+            inline=True,
+        )
     )
-    for head, parameters in groups:
-        out += _sliders(head, parameters)
-        if head == "algorithm_parameters" and "posture" in state.algorithms:
-            out += rest_controls(state, spec)
-        if head == "augmentation_parameters":
-            out.append(
-                Control(
-                    "algorithms",
-                    "algorithms",
-                    "checks",
-                    "algorithm",
-                    "the inverses J# run side by side, one colour each (at least one)",
-                    options=tuple((a, s.label) for a, s in STYLES.items()),
-                    inline=True,
-                )
-            )
+    out += _sliders("algorithm_parameters", scalar_parameters(state.algorithms))
+    if "posture" in state.algorithms:
+        out += rest_controls(state, spec)
     text = "start configuration, coordinate {}. " + SYMBOLS["x0"]
     out += joint_sliders("x0", "start", spec, text, joint_box(spec, state_kinematics(state)))
     if len(spec.variable_names) > 3:

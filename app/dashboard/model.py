@@ -32,10 +32,7 @@ from ..compute.schemas import (
 from ..compute.schemas.algorithms import Algorithm
 from ..compute.schemas.wording import field_text, refusal, refused, without_field
 from .algorithms import CHOICES, DEFAULT_ALGORITHMS, check_inverses, checked, checked_rest
-from .algorithms import COLORS as COLORS  # (re-exported: one table, there)
-from .algorithms import LABELS as LABELS
-from .algorithms import cache_key as cache_key
-from .algorithms import runs_key as runs_key
+from .algorithms import cache_key as cache_key  # (re-exported: the figures' caches import it)
 from .control_changes import expand
 from .controls import (
     MAX_DASHBOARD_CYCLES,
@@ -45,17 +42,15 @@ from .controls import (
 )
 from .robots import USER_KINDS, default_definition, state_inverse, state_spec, user_robot
 
-#: The algorithms of a new state (:mod:`jik.app.dashboard.algorithms`: colours, styles, keys).
-ALGORITHMS = DEFAULT_ALGORITHMS
 DEFAULT_ROBOT = "manipulator2"
 
 Point = Annotated[tuple[Coordinate, ...], Field(min_length=1, max_length=MAX_DIMENSION)]
+#: A number given as one (not as text), and up to MAX_DIMENSION of them.
+Number = Annotated[float, Field(strict=True)]
+Numbers = Annotated[tuple[Number, ...], Field(max_length=MAX_DIMENSION)]
 #: An algorithm's parameter: a number, or a vector (the posture inverse's rest, checked with the
 #: robot: :func:`jik.app.dashboard.algorithms.checked_rest`).
-AlgorithmValue = (
-    Annotated[float, Field(strict=True)]
-    | Annotated[tuple[Annotated[float, Field(strict=True)], ...], Field(max_length=MAX_DIMENSION)]
-)
+AlgorithmValue = Number | Numbers
 
 
 class DashboardState(BaseModel):

@@ -16,12 +16,11 @@ from ...engine.registry import ROBOTS
 from ...engine.repeatability import MAX_PATH_POINTS
 from ..compute.schemas import (
     AUGMENTATION_MODELS,
-    MAX_DIMENSION,
     USER_AUGMENTATION_MODELS,
     Coordinate,
 )
 from ..compute.schemas.wording import refusal, refused
-from .model import DashboardState, Point, error_location
+from .model import DashboardState, Number, Numbers, Point, error_location
 from .robots import USER_KINDS
 
 #: Control keys a patch may hold besides the state's fields (:func:`.control_changes.expand`), and
@@ -30,13 +29,10 @@ from .robots import USER_KINDS
 #: or at the start ("x0"). (The first pattern a key matches gives its type.)
 CONTROL_KEYS: dict[str, Any] = {
     r"^(?:x0|target|algorithm_parameters\.rest)\.[0-9]+$": Coordinate,
-    r"^algorithm_parameters\.rest$": Annotated[
-        tuple[Annotated[float, Field(strict=True)], ...], Field(max_length=MAX_DIMENSION)
-    ]
-    | Literal["x0"],
-    r"^robot_parameters\.[A-Za-z_][A-Za-z0-9_]*$": Annotated[float, Field(strict=True)] | Point,
-    r"^augmentation_parameters\.[A-Za-z_][A-Za-z0-9_]*$": Annotated[float, Field(strict=True)],
-    r"^algorithm_parameters\.[A-Za-z_][A-Za-z0-9_]*$": Annotated[float, Field(strict=True)],
+    r"^algorithm_parameters\.rest$": Numbers | Literal["x0"],
+    r"^robot_parameters\.[A-Za-z_][A-Za-z0-9_]*$": Number | Point,
+    r"^augmentation_parameters\.[A-Za-z_][A-Za-z0-9_]*$": Number,
+    r"^algorithm_parameters\.[A-Za-z_][A-Za-z0-9_]*$": Number,
 }
 _PATCH_TYPES: dict[str, Any] = {
     "robot": Literal[(*ROBOTS, *USER_KINDS)],

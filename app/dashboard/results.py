@@ -13,9 +13,10 @@ from collections.abc import Callable
 from concurrent.futures import Future
 from dataclasses import replace
 
+from .algorithms import cache_key
 from .analysis import augmenting_grid
 from .controls import MAX_DASHBOARD_CYCLES
-from .model import DashboardState, cache_key
+from .model import DashboardState
 from .offload import OffloadLane
 from .robots import state_kinematics, state_spec
 from .runs import (
@@ -96,9 +97,8 @@ def compute(
     for a in [a for a in todo if other[a] is not None and len(other[a].drift) >= cycles]:
         cache[keys[a]] = first_cycles(other[a], cycles, len(targets))
         todo.remove(a)
-    done = [
-        float((len(algorithms) - len(todo)) * cycles * len(targets))
-    ]  # legs, cached runs included
+    # (legs done: those of the cached runs and of the runs the others go on from)
+    done = [float((len(algorithms) - len(todo)) * cycles * len(targets))]
     done[0] += sum(len(other[a].leg_end) for a in todo if other[a] is not None)
 
     # With a lane of the compute pool, the first algorithm runs in a worker while this thread

@@ -7,7 +7,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import cast
+from typing import Any, cast
 
 import numpy as np
 
@@ -207,16 +207,16 @@ def _leg_message(res: SolveResult, cap: int, kinematics) -> str:
 
 def _leg_trajectory(run: AlgorithmRun, k: int) -> Trajectory | None:
     """Leg ``k`` of a run as a trajectory (theta from the leg's start), None if not there."""
-    at = run.leg == k
-    if np.count_nonzero(at) < 2:
+    at = _points(run, run.leg == k)
+    if len(at["theta"]) < 2:
         return None
-    return Trajectory(
-        theta=run.theta[at] - run.theta[at][0],
-        x=run.x[at],
-        y=run.y[at],
-        error=run.error[at],
-        h=None if run.h is None else run.h[at],
-    )
+    return Trajectory(**{**at, "theta": at["theta"] - at["theta"][0]})
+
+
+def _points(run: AlgorithmRun, keep: np.ndarray) -> dict[str, Any]:
+    """The points ``keep`` (a mask) of a run: its theta, x, y, error and h (None stays None)."""
+    arrays = {k: getattr(run, k) for k in ("theta", "x", "y", "error", "h")}
+    return {k: None if v is None else v[keep] for k, v in arrays.items()}
 
 
 def _legs_message(legs: int, drift, last_message: str) -> str:
@@ -235,11 +235,7 @@ def first_cycles(run: AlgorithmRun, cycles: int, legs: int) -> AlgorithmRun:
     drift = run.drift[:cycles]
     return replace(
         run,
-        theta=run.theta[keep],
-        x=run.x[keep],
-        y=run.y[keep],
-        error=run.error[keep],
-        h=None if run.h is None else run.h[keep],
+        **_points(run, keep),
         leg=run.leg[keep],
         leg_end=run.leg_end[: cycles * legs],
         drift=drift,

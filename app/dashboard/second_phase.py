@@ -13,6 +13,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Callable
 from dataclasses import replace
+from typing import Any
 
 from .analysis import augmenting_grid, grid_batches
 from .figures import figure_specs
@@ -124,20 +125,14 @@ def finished_message(
     panels they change. Known functionals went out with the result: the event then only
     carries the h panel's title (a reused panel can lack it, and a page that connects now gets
     this event with the latest result)."""
-    message: dict = {
-        "type": "functionals",
-        "generation": generation,
-        "functionals": functionals,
-        "sensitivity": sens,
-    }
     panels = {"sensitivity"} if not phase.cached or phase.deferred else set()
+    titles = {}
     if phase.deferred:  # the h panel was a placeholder: the whole figure
         panels.add("augmenting")
     elif functionals is not None:  # h is on screen: only its title changes (no redraw)
-        message["titles"] = {"augmenting": augmenting_title(phase.result, functionals)}
+        titles["augmenting"] = augmenting_title(phase.result, functionals)
     specs = figure_specs(phase.result, functionals, panels, sensitivity=sens)
-    texts = {k: figure_json(f) for k, f in specs.items()}
-    return with_figures(message, texts)
+    return _message(generation, functionals, sens, specs, titles=titles or None)
 
 
 def cancelled_message(phase: SecondPhase, generation: int) -> str:
@@ -152,19 +147,16 @@ def cancelled_message(phase: SecondPhase, generation: int) -> str:
     specs = figure_specs(phase.result, None, panels, cancelled=note)
     titles = {}
     if not phase.deferred and not phase.cached:
-        h = figure_specs(phase.result, None, {"augmenting"}, cancelled=note)["augmenting"]
-        titles["augmenting"] = h["layout"]["title"]["text"]
-    texts = {k: figure_json(f) for k, f in specs.items()}
-    message = {
-        "type": "functionals",
-        "generation": generation,
-        "functionals": None,
-        "sensitivity": None,
-        "titles": titles,
-        "cancelled": {
-            "what": phase.what,
-            "fraction": phase.fraction,
-            "panels": sorted(set(texts) | set(titles)),
-        },
-    }
-    return with_figures(message, texts)
+        titles["augmenting"] = augmenting_title(phase.result, None, note)
+    shown = sorted(set(specs) | set(titles))
+    cancelled = {"what": phase.what, "fraction": phase.fraction, "panels": shown}
+    return _message(generation, None, None, specs, titles=titles, cancelled=cancelled)
+
+
+def _message(generation: int, functionals, sens, specs: dict[str, dict], **more) -> str:
+    """A ``functionals`` event: E1/E2, their sensitivity, the figures ``specs`` and ``more``
+    fields (those given as None left out)."""
+    message: dict[str, Any] = {"type": "functionals", "generation": generation}
+    message |= {"functionals": functionals, "sensitivity": sens}
+    message |= {k: v for k, v in more.items() if v is not None}
+    return with_figures(message, {k: figure_json(f) for k, f in specs.items()})

@@ -22,22 +22,14 @@ from typing import Any, NoReturn
 
 from ...engine.exceptions import InvalidInputError, JikError
 from .ahead import SolvingAhead
+from .algorithms import COLORS, LABELS, cache_key, runs_key
 from .analysis import expensive_map
 from .controls import controls_message
 from .figures import gamma_free_panels
 from .listeners import Listeners
 from .map_synthesis import built_map
 from .messages import Event, finite, summary, with_figures
-from .model import (
-    COLORS,
-    LABELS,
-    DashboardState,
-    cache_key,
-    default_state,
-    runs_key,
-    updated_state,
-    validate,
-)
+from .model import DashboardState, default_state, updated_state, validate
 from .offload import OffloadLane
 from .panel_texts import PanelTexts
 from .plotting import PANELS
@@ -83,29 +75,15 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
         self._generation = 1
         self._done = 0  # last generation whose computation finished (or failed)
         self._changed_at = {1: time.perf_counter()}
-        self._listeners: list[Callable[[Event], None]] = []
-        self._fast = 0  # the first ``_fast`` listeners are the quick ones
         self._cache: dict = {}
         self._figures: dict[tuple[str, str], str] = {}  # (panel, key) -> figure JSON
-        self._layouts: dict[str, tuple[tuple, dict]] = {}  # panel -> (robot, task), last layout
-        # Results solved ahead (_prefetch): when each robot's went to the page (the value of
-        # _robot_since then), the latest by robot, and since when the robot on screen is
-        # (the generation of its first result).
-        self._ahead_sent: dict[str, int] = {}
-        self._latest_ahead: dict[str, Event] = {}
-        self._robot_since = 0
-        # key -> (E1/E2 functionals or None, their sensitivity)
-        self._functionals_cache: dict[str, tuple[dict | None, dict]] = {}
-        self._latest: dict[str, Event] = {"state": self._state_event(1, self._state, "initial")}
-        self.result: DashboardResult | None = None
-        self.functionals: dict | None = None
-        # The second phase (_second_phase): the generation whose phase runs (None when none
-        # does, or it was cancelled), whose phase was cancelled, whose phase to run again, and
-        # the grid on screen when it started (kept for a run again).
-        self._second_running: int | None = None
-        self._second_cancelled: int | None = None
-        self._rerun: int | None = None
-        self._grid_before: dict | None = None
+        # (what the parts share, each typed and described where its part declares it)
+        self._listeners, self._fast = [], 0  # (Listeners)
+        self._latest = {"state": self._state_event(1, self._state, "initial")}
+        self._layouts, self._functionals_cache = {}, {}  # (PanelTexts)
+        self._ahead_sent, self._latest_ahead, self._robot_since = {}, {}, 0  # (SolvingAhead)
+        self.result, self.functionals, self._grid_before = None, None, None  # (SecondPhaseControl)
+        self._second_running = self._second_cancelled = self._rerun = None
         #: What the 3D scene last drew (set by app.scene), for the page and the tests.
         self.scene_status: dict = {}
         self._thread: threading.Thread | None = None
@@ -175,7 +153,6 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
                 state = updated_state(self._state, patch)
             except InvalidInputError as exc:
                 refusal = exc
-                generation, state = self._generation, self._state
             else:
                 if state == self._state:
                     return self._generation, state
@@ -263,9 +240,21 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
             self._done = max(self._done, generation)
             self._cond.notify_all()
 
-    def _turn(self):
-        """This session's turn to compute (:class:`FairSlots`), or at once without slots."""
-        return self._slots.slot() if self._slots is not None else contextlib.nullcontext()
+    def _solved(self, state: DashboardState, generation: int, **more) -> DashboardResult:
+        """:func:`compute` of ``state`` (``more``: its options) in this session's turn
+        (:class:`FairSlots`; at once without slots), with its run cache and lane of the pool;
+        :class:`Cancelled` when a newer change comes, also while it waits for its turn."""
+        with self._slots.slot() if self._slots is not None else contextlib.nullcontext():
+            if self._generation != generation:
+                raise Cancelled
+            return compute(
+                state,
+                generation,
+                cancelled=lambda: self._generation != generation,
+                cache=self._cache,
+                offload=self._offload,
+                **more,
+            )
 
     def _reporter(self, generation: int, phase: str) -> Callable[..., None]:
         """``report(fraction, what="the runs")``: a ``progress`` event of ``phase`` ("runs", or
@@ -307,19 +296,13 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
         try:
             kin, amap = built_map(state, progress, lambda: self._generation != generation)
             deferred = expensive_map(amap)
-            with self._turn():
-                if self._generation != generation:  # (a newer change came while it waited)
-                    raise Cancelled
-                result = compute(
-                    state,
-                    generation,
-                    progress=progress,
-                    cancelled=lambda: self._generation != generation,
-                    cache=self._cache,
-                    with_augmenting=not deferred,
-                    offload=self._offload,
-                    grid_before=grid_before,
-                )
+            result = self._solved(
+                state,
+                generation,
+                progress=progress,
+                with_augmenting=not deferred,
+                grid_before=grid_before,
+            )
         except Cancelled:
             return
         except (JikError, ValueError) as exc:

@@ -12,7 +12,7 @@ edge of convergence (the task error is multiplied by about ``1 - gamma`` per ste
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 
 import numpy as np
 
@@ -37,9 +37,6 @@ class Sentence:
     text: str
     algorithm: str | None = None
     role: str = "finding"
-
-    def as_dict(self) -> dict:
-        return {"text": self.text, "algorithm": self.algorithm, "role": self.role}
 
 
 def _drift_sentence(algorithm: str, run: AlgorithmRun, unit: str) -> Sentence:
@@ -250,7 +247,6 @@ def verdict(result: DashboardResult) -> list[dict]:
     out += [Sentence(*s) for s in practical_sentences(result, unit)]
     for text, algorithm, within in limits_texts(result, NAMES):
         out.append(Sentence(text, algorithm, "note" if within else "warning"))
-    warning = singular_sentence(result.state) if "extended" in runs else None
-    if warning:
+    if "extended" in runs and (warning := singular_sentence(result.state)):
         out.append(Sentence(warning, "extended", "warning"))
-    return [s.as_dict() for s in out]
+    return [asdict(s) for s in out]

@@ -45,12 +45,15 @@ def target_pose(kin: Any, y) -> tuple[tuple[float, ...], tuple[float, ...] | Non
     return tuple(float(v) for v in t), None if R is None else wxyz(R)
 
 
-def target_fixtures(result, kin: Any, root: str, size: float) -> dict[str, tuple[str, dict, dict]]:
-    """The targets of an arm's legs as fixtures (:func:`~jik.app.scene.mechanisms.fixtures_of`):
-    a frame (axes triad) per target of a pose task, a ball per target of a position task."""
+def target_fixtures(
+    poses, root: str, radius: float, size: float
+) -> dict[str, tuple[str, dict, dict]]:
+    """The targets of a path's legs as fixtures (:func:`~jik.app.scene.mechanisms.fixtures_of`),
+    one per pose (position, wxyz or None) of ``poses`` (None: not drawn, see
+    :func:`target_pose`): a frame (axes triad ``size`` long) where it has an orientation, else
+    a ball of ``radius``."""
     out: dict[str, tuple[str, dict, dict]] = {}
-    for k, target in enumerate(result.targets):
-        pose = target_pose(kin, target)
+    for k, pose in enumerate(poses):
         if pose is None:
             continue
         position, q = pose
@@ -58,7 +61,7 @@ def target_fixtures(result, kin: Any, root: str, size: float) -> dict[str, tuple
             out[f"{root}/targets/{k}"] = (
                 "icosphere",
                 {"position": position},
-                {"radius": 0.15 * size, "color": (0, 0, 0)},
+                {"radius": radius, "color": (0, 0, 0)},
             )
         else:
             out[f"{root}/targets/{k}"] = (

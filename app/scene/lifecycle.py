@@ -24,7 +24,7 @@ from ..dashboard.controls import PROGRESS_AFTER
 from .camera import CameraFraming
 from .controls import SceneControls
 from .gizmo import StartGizmo
-from .mechanisms import add_floor_grid, extent_of, layout_name
+from .mechanisms import add_floor_grid, layout_name
 from .nodes import NodeSets
 from .playback import Playback
 from .pose import Timeline
@@ -96,15 +96,13 @@ class DashboardScene:
                     self.status.content = f"computing… {100 * msg['fraction']:.0f}%"
             elif event.kind == "result" and event.result is not None:
                 self._draw(event.result)
-            elif event.kind == "refused":
-                self.controls.sync(self.dashboard.state)
-                self.status.content = f"**refused:** {json.loads(event.data)['message']}"
             elif event.kind == "ahead" and event.result is not None:
                 self._prebuild(event.result)
-            elif event.kind == "error":
+            elif event.kind in ("refused", "error"):
                 self.controls.sync(self.dashboard.state)
-                self.progress.visible = False
-                self.status.content = f"**error:** {json.loads(event.data)['message']}"
+                # (a refusal stops no computation: its progress bar stays)
+                self.progress.visible &= event.kind == "refused"
+                self.status.content = f"**{event.kind}:** {json.loads(event.data)['message']}"
         except Exception as exc:  # never let a drawing error kill the worker thread
             self.status.content = f"**scene error:** {type(exc).__name__}: {exc}"
 
@@ -137,7 +135,7 @@ class DashboardScene:
             # client shows the start point and the paths that leave it together, never one
             # without the other.
             self.gizmo.place(state)
-            self.nodes.show(result, extent_of(result))
+            self.nodes.show(result)
             if self._framed != layout_name(state):  # another robot: frame its reach
                 self._framed = layout_name(state)
                 self.camera.frame(result)

@@ -36,13 +36,11 @@ from .arm_marks import (
     has_pose,
     joint_points,
     target_fixtures,
+    target_pose,
 )
 from .pose import NORMAL_FORM, yaw_quaternion
 from .traces import polyline, rgb, trace_tolerance, unicycle_traces
 
-#: Height of each algorithm's copy above the task plane, and its opacity (None: solid).
-Z = {a: s.z for a, s in STYLES.items()}
-OPACITY = {a: s.opacity for a, s in STYLES.items()}
 HOME_COLOR = (150, 150, 150)
 
 
@@ -53,35 +51,38 @@ class Mechanism:
         self.scene, self.root, self.color, self.opacity, self.z = scene, root, color, opacity, z
         self.state, self.extent = state, extent
         self.build()
-        self.resize(state, extent)
 
-    def box(self, name, dims, position=(0.0, 0.0, 0.0)):
-        return self.scene.add_box(
-            f"{self.root}/{name}",
-            color=self.color,
-            dimensions=dims,
-            opacity=self.opacity,
-            position=position,
-            cast_shadow=False,
+    def node(self, kind: str, name: str, color=None, **values):
+        """A node of this copy, made by viser's ``add_<kind>``, in its colour (or ``color``) and
+        opacity, casting no shadow."""
+        add = getattr(self.scene, f"add_{kind}")
+        color = color or self.color
+        return add(
+            f"{self.root}/{name}", color=color, opacity=self.opacity, cast_shadow=False, **values
         )
+
+    def box(self, name, dimensions, position=(0.0, 0.0, 0.0)):
+        return self.node("box", name, dimensions=dimensions, position=position)
 
     def ball(self, name, radius, position=(0.0, 0.0, 0.0), color=None):
-        return self.scene.add_icosphere(
-            f"{self.root}/{name}",
-            radius=radius,
-            color=color or self.color,
-            opacity=self.opacity,
-            position=position,
-            cast_shadow=False,
-            subdivisions=2,
-        )
+        return self.node("icosphere", name, color, radius=radius, position=position, subdivisions=2)
 
     def build(self) -> None:
-        """Create the nodes (those sized by the state or the task-plane box: by :meth:`resize`)."""
+        """Create the nodes, those sized by the state or the task-plane box with the values of
+        :meth:`fitted`."""
+
+    def fitted(self) -> dict[str, dict[str, Any]]:
+        """The values of the nodes that follow the state (an arm length) or the task-plane box,
+        by the attribute holding each node: what :meth:`build` creates them with and
+        :meth:`resize` sets."""
+        return {}
 
     def resize(self, state, extent) -> None:
         """Follow a new arm length or task-plane box in place (no node is re-created)."""
         self.state, self.extent = state, extent
+        for attr, values in self.fitted().items():
+            for key, value in values.items():
+                setattr(getattr(self, attr), key, value)
 
     def pose(self, x) -> None: ...
 
@@ -90,21 +91,23 @@ class Gantry(Mechanism):
     """Manipulator 2: XY gantry (prismatic x1 vertical, x2 horizontal) with a revolute arm."""
 
     def build(self) -> None:
-        self.beam = self.box("beam", (1.0, 0.07, 0.05))
+        fit = self.fitted()
+        self.beam = self.box("beam", **fit["beam"])
         self.carriage = self.scene.add_frame(f"{self.root}/carriage", show_axes=False)
         self.box("carriage/body", (0.2, 0.2, 0.09))
         self.ball("carriage/joint", 0.06, (0.0, 0.0, 0.07), color=(40, 40, 40))
-        self.arm = self.box("carriage/arm", (1.0, 0.06, 0.04))
-        self.effector = self.ball("carriage/effector", 0.07)
+        self.arm = self.box("carriage/arm", **fit["arm"])
+        self.effector = self.ball("carriage/effector", 0.07, **fit["effector"])
 
-    def resize(self, state, extent) -> None:
-        super().resize(state, extent)
-        (lo, hi), _ = extent
-        l = float(state.robot_parameters["l"])
-        self.beam.dimensions = (hi - lo, 0.07, 0.05)
-        self.arm.dimensions = (l, 0.06, 0.04)
-        self.arm.position = (l / 2, 0.0, 0.07)
-        self.effector.position = (l, 0.0, 0.07)
+    def fitted(self) -> dict[str, dict[str, Any]]:
+        """The beam spans the task-plane box in x; the arm is l long."""
+        (lo, hi), _ = self.extent
+        l = float(self.state.robot_parameters["l"])
+        return {
+            "beam": {"dimensions": (hi - lo, 0.07, 0.05)},
+            "arm": {"dimensions": (l, 0.06, 0.04), "position": (l / 2, 0.0, 0.07)},
+            "effector": {"position": (l, 0.0, 0.07)},
+        }
 
     def pose(self, x) -> None:
         (lo, hi), _ = self.extent
@@ -117,10 +120,11 @@ class NormalForm(Mechanism):
     """Manipulator 1 (30): slider x2 on the vertical guide, lever of slope x3, runner at x1."""
 
     def build(self) -> None:
-        self.runner = self.box("runner", (0.05, 1.0, 0.04))
+        fit = self.fitted()
+        self.runner = self.box("runner", **fit["runner"])
         self.slider = self.box("slider", (0.18, 0.14, 0.08))
         self.lever = self.scene.add_frame(f"{self.root}/lever", show_axes=False)
-        self.bar = self.box("lever/bar", (1.0, 0.045, 0.03))
+        self.bar = self.box("lever/bar", **fit["bar"])
         self.ball("lever/pivot", 0.06, (0.0, 0.0, 0.05), color=(40, 40, 40))
         self.point = self.ball("W", 0.08)
         chosen = tuple(self.state.algorithms)
@@ -129,14 +133,17 @@ class NormalForm(Mechanism):
                 f"{self.root}/W/label", "W (task point)", position=(0.1, -0.2, -0.35)
             )
 
-    def resize(self, state, extent) -> None:
-        super().resize(state, extent)
-        (xlo, xhi), (lo, hi) = extent
-        self.runner.dimensions = (0.05, hi - lo, 0.04)
-        # Along the lever from x = xlo to x = xhi of the task-plane box when level: shorter in x
-        # when it tilts, so it stays in the framed view.
-        self.bar.dimensions = (xhi - xlo, 0.045, 0.03)
-        self.bar.position = ((xlo + xhi) / 2, 0.0, 0.05)
+    def fitted(self) -> dict[str, dict[str, Any]]:
+        """The runner spans the task-plane box in y; the lever, from x = xlo to x = xhi of the
+        box when level (shorter in x when it tilts, so it stays in the framed view)."""
+        (xlo, xhi), (lo, hi) = self.extent
+        return {
+            "runner": {"dimensions": (0.05, hi - lo, 0.04)},
+            "bar": {
+                "dimensions": (xhi - xlo, 0.045, 0.03),
+                "position": ((xlo + xhi) / 2, 0.0, 0.05),
+            },
+        }
 
     def pose(self, x) -> None:
         x1, x2, x3 = (float(v) for v in x)
@@ -159,16 +166,8 @@ class Platform(Mechanism):
         self.box("platform/nose", (0.3, 0.12, 0.08), (0.45, 0.0, 0.2))
         axle = (math.cos(math.pi / 4), math.sin(math.pi / 4), 0.0, 0.0)  # cylinder axis -> y
         for side in (-1, 1):
-            self.scene.add_cylinder(
-                f"{self.root}/platform/wheel{side}",
-                radius=0.16,
-                height=0.08,
-                color=(50, 50, 50),
-                opacity=self.opacity,
-                position=(0.0, side * 0.28, 0.16),
-                wxyz=axle,
-                cast_shadow=False,
-            )
+            wheel = {"radius": 0.16, "height": 0.08, "position": (0.0, side * 0.28, 0.16)}
+            self.node("cylinder", f"platform/wheel{side}", (50, 50, 50), **wheel, wxyz=axle)
 
     def pose(self, q) -> None:
         self.frame.position = (float(q[0]), float(q[1]), 0.5 * self.z)
@@ -181,7 +180,7 @@ class Chain(Mechanism):
     chain lies in the task plane; a URDF arm stands in its own x, y, z."""
 
     def build(self) -> None:
-        self.kin = state_kinematics(self.state)
+        self.resize(self.state, self.extent)  # (its kinematics and limits; no node is sized)
         home = chain_points(self.kin, np.asarray(self.state.x0, dtype=float), 0.0)
         n = home.shape[0]
         width = 5.0 if self.opacity is None else 3.5
@@ -316,9 +315,9 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
     for a, run in result.runs.items():
         line = {"colors": rgb(COLORS[a]), "thickness_units": "screen"}  # pixels, see above
         if chain:  # (the end point's path: a URDF arm's task may be some of x, y, z)
-            task = chain_points(kin, run.x, (Z[a] + 0.16) * scale)[:, -1]
+            task = chain_points(kin, run.x, (STYLES[a].z + 0.16) * scale)[:, -1]
         else:
-            z = np.full(len(run.y), (Z[a] + 0.16) * scale)
+            z = np.full(len(run.y), (STYLES[a].z + 0.16) * scale)
             task = np.column_stack([run.y[:, 0], run.y[:, 1], z])
         out[f"{root}/trace/{a}/task"] = (
             "line_segments",
@@ -326,22 +325,22 @@ def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
             {**line, "thickness": 3.0 if a == "pseudoinverse" else 2.0},
         )
         if robot == "manipulator2":
-            joints = np.column_stack([run.x[:, 1], run.x[:, 0], np.full(len(run.x), Z[a] + 0.1)])
+            joints = np.column_stack(
+                [run.x[:, 1], run.x[:, 0], np.full(len(run.x), STYLES[a].z + 0.1)]
+            )
             out[f"{root}/trace/{a}/joints"] = (
                 "line_segments",
                 {"points": polyline(joints, tol)},
                 {**line, "thickness": 1.2},
             )
-    if chain and robot != "planar_chain":  # (a frame or a point, see target_fixtures)
-        reach = float(np.linalg.norm(np.ptp(np.reshape(extent, (2, 2)), axis=1)))
-        return {**out, **target_fixtures(result, kin, root, AXES_FRACTION * reach / 2)}
-    for k, target in enumerate(result.targets):
-        out[f"{root}/targets/{k}"] = (
-            "icosphere",
-            {"position": (float(target[0]), float(target[1]), 0.2 * scale)},
-            {"radius": 0.05 * scale, "color": (0, 0, 0)},
-        )
-    return out
+    size = 0.0  # (of a target's axes)
+    if chain and robot != "planar_chain":  # (a frame or a point, see target_pose)
+        size = AXES_FRACTION * float(np.linalg.norm(np.ptp(np.reshape(extent, (2, 2)), axis=1))) / 2
+        poses, radius = [target_pose(kin, t) for t in result.targets], 0.15 * size
+    else:
+        poses = [((float(t[0]), float(t[1]), 0.2 * scale), None) for t in result.targets]
+        radius = 0.05 * scale
+    return {**out, **target_fixtures(poses, root, radius, size)}
 
 
 def extent_of(result) -> tuple[tuple[float, float], tuple[float, float]]:

@@ -13,14 +13,12 @@ from typing import Any
 
 import numpy as np
 
-from ..dashboard.algorithms import COLORS, DEFAULT_ALGORITHMS
+from ..dashboard.algorithms import COLORS, DEFAULT_ALGORITHMS, STYLES
 from ..dashboard.plotting import corner_names
 from .mechanisms import (
     HOME_COLOR,
     MECHANISMS,
-    OPACITY,
     Mechanism,
-    Z,
     extent_of,
     fixtures_of,
     layout_name,
@@ -43,20 +41,23 @@ class NodeSets:
         #: The moving copies on screen, by algorithm.
         self.mechanisms: dict[str, Mechanism] = {}
         self.fixtures: dict[str, Any] = {}  # handles of the nodes of fixtures_of(), by name
-        self._layout: tuple | None = None  # set_key() of the set on screen
         # set_key() -> {"frame", "mechanisms", "still", "fixtures", "root"}
         self.sets: dict[tuple, dict[str, Any]] = {}
 
-    def show(self, result, extent) -> None:
-        """Show ``result``: its layout's set with the result's values."""
-        layout = set_key(result.state)
-        if layout != self._layout:
-            self._switch(layout, result, extent)
+    def show(self, result) -> None:
+        """Show ``result``: its layout's set with the result's values, the other sets hidden. A
+        kept set's nodes stay and take the new values (re-creating them costs the client a
+        remount of every node)."""
+        layout, extent = set_key(result.state), extent_of(result)
+        for key, entry in self.sets.items():
+            entry["frame"].visible = key == layout  # (viser sends only a change)
+        if layout in self.sets:
+            entry = self.sets[layout]
+            self._update(entry, result, extent)
         else:
-            # Same robot and task: the nodes stay and take the new values (re-creating them
-            # costs the client a remount of every node).
-            self._update(self.sets[layout], result, extent)
-        self._pose_still(self.sets[layout], result.state)
+            entry = self._build(result, extent, visible=True)
+        self.fixtures, self.mechanisms = entry["fixtures"], entry["mechanisms"]
+        self._pose_still(entry, result.state)
 
     def prebuild(self, result) -> None:
         """Build the hidden set of a result solved ahead (another manipulator's defaults):
@@ -69,20 +70,6 @@ class NodeSets:
         for a, x in timeline.at(timeline.length).items():
             entry["mechanisms"][a].pose(x)
         self._pose_still(entry, state)
-
-    def _switch(self, layout: tuple, result, extent) -> None:
-        """Show the set of ``layout`` and hide the others."""
-        self._layout = layout
-        for key, entry in self.sets.items():
-            if key != layout:
-                entry["frame"].visible = False
-        if layout not in self.sets:
-            entry = self._build(result, extent, visible=True)
-        else:
-            entry = self.sets[layout]
-            entry["frame"].visible = True
-            self._update(entry, result, extent)
-        self.fixtures, self.mechanisms = entry["fixtures"], entry["mechanisms"]
 
     @staticmethod
     def _pose_still(entry: dict[str, Any], state) -> None:
@@ -108,18 +95,16 @@ class NodeSets:
         }
         cls = MECHANISMS.get(state.robot)
         if cls is not None:
-            # (colour, opacity, height) of the still copies
+            # (colour, opacity, height) of each copy: the still ones, one per algorithm
             still = {"home": (HOME_COLOR, 0.25, -0.03)}
             if state.robot == "unicycle":  # (its target is a pose: a black platform)
                 still = {"home": (HOME_COLOR, 0.3, 0.0), "target": ((0, 0, 0), 0.3, 0.0)}
-            entry["still"] = {
-                name: cls(scene, f"{root}/{name}", *style, state, extent)
-                for name, style in still.items()
-            }
-            entry["mechanisms"] = {
-                a: cls(scene, f"{root}/{a}", rgb(COLORS[a]), OPACITY[a], Z[a], state, extent)
-                for a in result.runs
-            }
+            copies = {a: (rgb(COLORS[a]), STYLES[a].opacity, STYLES[a].z) for a in result.runs}
+            for part, styles in (("still", still), ("mechanisms", copies)):
+                entry[part] = {
+                    name: cls(scene, f"{root}/{name}", *style, state, extent)
+                    for name, style in styles.items()
+                }
         self._place_fixtures(result, extent, root, entry["fixtures"])
         self.sets[set_key(state)] = entry
         return entry

@@ -25,10 +25,11 @@ import numpy as np
 from ..characteristics import UnicycleCharacteristics
 from ..exceptions import JikError
 from ..inverses import ExtendedInverse, Pseudoinverse
+from ..registry import POSE_A, POSE_B
 from ..solver import solve
 from ..unicycle import Unicycle
 
-STARTS = {"A": (5.0, 0.0, math.pi / 2), "B": (-5.0, 5.0, math.pi / 2)}
+STARTS = {"A": POSE_A, "B": POSE_B}
 LAMBDA0 = (0.5, -0.25, 0.3, -0.25)
 Y_D = (1.0, 0.0, -math.pi / 2)
 GAMMA = 0.1

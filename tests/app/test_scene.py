@@ -271,7 +271,7 @@ def test_the_scenes_integer_sliders_send_integers():
 
 def test_the_scene_shows_the_runs_progress_not_the_second_phases():
     """The scene's status keeps the drawn result's line while E1, E2 (which it does not draw)
-    are computed; a new state's runs show their progress there."""
+    are computed; a new state's runs show their progress there, until a failure."""
     import json
 
     from jik.app.dashboard.messages import Event
@@ -304,6 +304,13 @@ def test_the_scene_shows_the_runs_progress_not_the_second_phases():
         assert scene.status.content == drawn and scene.progress.visible is False
         scene._on_event(progress("runs"))
         assert scene.status.content == "computing… 40%" and scene.progress.visible is True
+        # A refused change leaves the computation's bar; a failed one ends it.
+        scene._on_event(Event("refused", 1, json.dumps({"message": "gamma: too large"})))
+        assert scene.status.content == "**refused:** gamma: too large"
+        assert scene.progress.visible is True
+        scene._on_event(Event("error", 1, json.dumps({"message": "the solver failed"})))
+        assert scene.status.content == "**error:** the solver failed"
+        assert scene.progress.visible is False
     finally:
         scene.stop()
         dashboard.stop()
@@ -509,3 +516,57 @@ def test_a_vector_shown_as_text_stays_text_in_force():
     finally:
         scene.stop()
         dashboard.stop()
+
+
+class _RecordingScene:
+    """A stand-in for viser's scene API: ``add_<kind>(name, ...)`` makes a node whose later
+    assignments (node updates, each a message to every client) are recorded."""
+
+    def __init__(self) -> None:
+        self.updates: list[tuple[str, str]] = []
+        self.nodes: dict[str, dict] = {}
+
+    def __getattr__(self, attr: str):
+        if not attr.startswith("add_"):
+            raise AttributeError(attr)
+
+        def add(name: str, *args, **values):
+            self.nodes[name] = values
+            return _RecordedNode(self, name)
+
+        return add
+
+
+class _RecordedNode:
+    def __init__(self, scene: _RecordingScene, name: str) -> None:
+        object.__setattr__(self, "_at", (scene, name))
+
+    def __setattr__(self, key: str, value) -> None:
+        scene, name = self._at
+        scene.updates.append((name, key))
+        scene.nodes[name][key] = value
+
+
+@pytest.mark.parametrize("robot", ["manipulator1", "manipulator2"])
+def test_sized_boxes_are_created_at_their_size(robot):
+    """Manipulator 1's lever and runner and Manipulator 2's beam and arm are created at the size
+    the task-plane box and the arm length give them: building a copy updates none of its nodes,
+    and following the same state again leaves every value as built."""
+    from jik.app.scene.mechanisms import MECHANISMS
+
+    state = updated_state(
+        default_state(robot), {"robot_parameters": {"l": 1.3}} if robot == "manipulator2" else {}
+    )
+    extent = ((-0.9, 2.1), (-0.7, 2.4))
+    scene = _RecordingScene()
+    copy = MECHANISMS[robot](scene, "/r/extended", (0, 0, 255), None, 0.0, state, extent)
+    assert scene.updates == []
+    built = {name: dict(values) for name, values in scene.nodes.items()}
+    copy.resize(state, extent)
+    assert scene.nodes == built
+    sized = {  # (axis, length) of each sized box
+        "manipulator1": {"runner": (1, 3.1), "lever/bar": (0, 3.0)},
+        "manipulator2": {"beam": (0, 3.0), "carriage/arm": (0, 1.3)},
+    }
+    for name, (axis, length) in sized[robot].items():
+        assert built[f"/r/extended/{name}"]["dimensions"][axis] == pytest.approx(length)
