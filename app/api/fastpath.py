@@ -48,15 +48,14 @@ class SolveFastPath:
     ``served`` counts the requests it answered (the rest went to the app).
     """
 
-    def __init__(self, app: ASGIApp, pool: ComputePool, path: str = "/solve") -> None:
+    def __init__(self, app: ASGIApp, pool: ComputePool) -> None:
         self.app = app
         self.pool = pool
-        self.path = path
         self.served = 0
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         # (a body that is not JSON never gets here: the security middleware, outside, answers 415)
-        solve = scope["type"] == "http" and scope["path"] == self.path
+        solve = scope["type"] == "http" and scope["path"] == "/solve"
         if not (solve and scope["method"] == "POST"):
             await self.app(scope, receive, send)
             return
