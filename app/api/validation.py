@@ -67,13 +67,12 @@ def validation_detail(errors) -> list[dict]:
             body = e.get("input")
             robot = body.get("robot") if isinstance(body, dict) else None
             name = robot.get("name") if isinstance(robot, dict) else None
-            names = (e.get("ctx") or {}).get("names", ROBOT_NAMES)  # (the route's robots)
             if isinstance(body, dict) and "robot" not in body:
                 msg = "Field required"
             elif name is None:
-                msg = f"give the robot, with a name among {names}"
+                msg = f"give the robot, with a name among {ROBOT_NAMES}"
             else:
-                msg = f"unknown name {name!r}; choose one of {names}"
+                msg = f"unknown name {name!r}; choose one of {ROBOT_NAMES}"
         elif e.get("type") in ("too_short", "too_long"):
             msg = _length_message(e.get("loc", ()), e.get("ctx") or {}) or msg
         detail.append({"loc": loc, "msg": f"{_field(loc)}: {msg}", "type": str(e.get("type"))})
