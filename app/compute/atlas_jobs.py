@@ -72,12 +72,12 @@ class AtlasJob:
     #: cancel, whichever comes first).
     holds_slot: bool = False
 
-    def response(self, ahead: int | None = None, running: int = 1) -> AtlasJobResponse:
+    def response(self, ahead: int, running: int) -> AtlasJobResponse:
         """The job's state; ``ahead``: the jobs before it in the queue, of which ``running``
         are computing (:meth:`AtlasJobs.response` counts them)."""
         end = self.ended if self.ended is not None else time.monotonic()
         message: str = "computing" if self.status == "running" else self.status
-        if self.status == "queued" and ahead is not None:
+        if self.status == "queued":
             message = (
                 f"queued behind {ahead} atlas job{'s' * (ahead != 1)} ({running} computing, "
                 f"the rest waiting); it starts when they end"
