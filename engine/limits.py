@@ -79,9 +79,13 @@ class LimitViolation:
             "on the way to the target" if self.single else f"at cycle {self.cycle}, leg {self.leg}"
         )
 
+    @property
+    def side(self) -> str:
+        """ "below its lower" or "above its upper": the limit it passed, in words."""
+        return "below its lower" if self.bound == "lower" else "above its upper"
+
     def __str__(self) -> str:
-        side = "below its lower" if self.bound == "lower" else "above its upper"
-        return f"{self.where}: {self.name} = {self.value:.6g}, {side} limit {self.limit:.6g}"
+        return f"{self.where}: {self.name} = {self.value:.6g}, {self.side} limit {self.limit:.6g}"
 
     def as_dict(self) -> dict:
         return {
@@ -105,6 +109,19 @@ class LimitsReport:
     def __str__(self) -> str:
         return (
             "within the joint limits" if self.within else f"left the joint limits {self.violation}"
+        )
+
+    def sentence(self, run: str, robot: str) -> str:
+        """The report as a sentence on the run named ``run`` of ``robot`` (values to four
+        digits): it "stayed within the joint limits of the <robot> all along its run", or "left
+        the joint limits of the <robot>" and where first (its start, or a cycle and leg)."""
+        v = self.violation
+        if v is None:
+            return f"{run}: stayed within the joint limits of the {robot} all along its run."
+        where = "its start x0 is already outside them" if v.cycle == 0 else f"first {v.where}"
+        return (
+            f"{run}: left the joint limits of the {robot}: {where}, joint {v.name} = "
+            f"{v.value:.4g}, {v.side} limit {v.limit:.4g}."
         )
 
     def as_dict(self) -> dict:

@@ -107,9 +107,8 @@ def augmenting_grid(
     kin,
     state: DashboardState,
     runs: Mapping[str, AlgorithmRun],
-    n: int = GRID_POINTS,
     before: dict | None = None,
-    progress: Callable[[int, int], None] | None = None,
+    progress: Callable[[int, int], None] = lambda done, total: None,
 ):
     """h on a grid over the two variables it depends on most, other variables at x0.
 
@@ -131,13 +130,13 @@ def augmenting_grid(
         total, along = grid_batches(runs, amap), -(-len(xs) // GRID_BATCH)
 
         def step(offset: int):
-            return None if progress is None else lambda done, _: progress(offset + done, total)
+            return lambda done, _: progress(offset + done, total)
 
         i, j = augmenting_axes(amap, xs, step(0))
         low, high = runs_box(state, runs)
         box = [(float(low[k]), float(high[k])) for k in (i, j)]
-        if expensive_map(amap):
-            n = min(n, EXPENSIVE_GRID_POINTS)  # h solves a collocation problem per point
+        # (fewer for a map that solves a collocation problem per point)
+        n = EXPENSIVE_GRID_POINTS if expensive_map(amap) else GRID_POINTS
         if before is not None and tuple(before["axes"]) == (i, j) and before["n"] == n:
             inside = all(
                 b_lo <= np.min(xs[:, k])
@@ -153,15 +152,12 @@ def augmenting_grid(
         X[..., j] = v[:, None]
         with np.errstate(all="ignore"):
             if expensive_map(amap):  # (maps that can be undefined at some points)
-                h = amap.evaluate_batches(
-                    X.reshape(-1, kin.p), GRID_BATCH, ProgressCallbacks(on_advance=step(along))
-                )[0]
-                H = np.asarray(h, dtype=float)
+                on = ProgressCallbacks(on_advance=step(along))
+                H = amap.evaluate_batches(X.reshape(-1, kin.p), GRID_BATCH, on)[0]
             else:
-                H = np.asarray(amap.value(X.reshape(-1, kin.p)), dtype=float)
-                if progress is not None:
-                    progress(total, total)
-        H = H.reshape(n, n)
+                H = amap.value(X.reshape(-1, kin.p))
+                progress(total, total)
+        H = np.asarray(H, dtype=float).reshape(n, n)
     except (JikError, ValueError, ArithmeticError):
         return None
     H = np.where(np.isfinite(H), H, np.nan)

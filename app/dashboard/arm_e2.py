@@ -11,6 +11,8 @@ rule's chunks of nodes.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from ...engine.e2_qmc import e2_qmc
 from ...engine.exceptions import JikError, RunCancelled
 from ...engine.progress import ProgressCallbacks
@@ -22,7 +24,7 @@ QMC_SEED = 1
 
 
 def qmc_functionals(
-    grid: dict, region: dict, fixed: dict, out: dict, cancelled, on_step=None
+    grid: dict, region: dict, fixed: dict, out: dict, cancelled, on_step: Callable[[], None]
 ) -> dict:
     """``out`` (the region, fixed variables) with E2 of the grid's map by :data:`QMC_NODES`
     Sobol nodes and ``E2_single_joint`` (name -> {"sign", "e2"}) when p - r = 1; E1 None and a
@@ -43,8 +45,8 @@ def qmc_functionals(
         raise Cancelled from None
     except (JikError, ValueError, ArithmeticError) as exc:
         e2 = {"E2": None, "error": str(exc)}
-    for _ in range(2 if on_step is not None else 0):
-        on_step()
+    on_step()
+    on_step()
     if "error" in e2:
         return {
             **out,

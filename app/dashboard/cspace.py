@@ -20,8 +20,6 @@ from .analysis import expensive_map, kinematics_and_map, runs_box
 from .plotting import corner_names, figure, trace
 from .runs import DashboardResult
 
-#: The choices of three coordinates of a four-dimensional configuration (the unicycle's λ).
-AXES_CHOICES = ("012", "013", "023", "123")
 #: Points per run drawn; level-surface grid.
 MAX_POINTS, GRID = 1500, 16
 #: A self-motion manifold is traced this many box diagonals each way (to a drawing's tolerance)
@@ -33,8 +31,9 @@ SCENE = "scene2"
 
 
 def axes_of(result: DashboardResult) -> tuple[int, int, int]:
-    """The three coordinates shown: all three for p = 3, else the state's choice."""
-    choice = result.state.cspace_axes or AXES_CHOICES[0]
+    """The three coordinates shown: all three for p = 3, else the state's choice (of its
+    ``cspace_axes``: "012", "013", "023" or "123"; none: the first three)."""
+    choice = result.state.cspace_axes or "012"
     return tuple(int(c) for c in choice)  # type: ignore[return-value]
 
 
@@ -70,10 +69,9 @@ def self_motion(kin, seeds: np.ndarray, lo, hi) -> list[np.ndarray]:
     return curves
 
 
-def _level_surface(result: DashboardResult, kin, amap, axes, lo, hi) -> dict | None:
-    """h on a grid of the box (p = 3 only, cheap maps only), as an isosurface at h(x0)."""
-    if kin.p != 3 or amap is None or expensive_map(amap):
-        return None
+def _level_surface(result: DashboardResult, amap, axes, lo, hi) -> dict | str:
+    """h (of p = 3 variables, a cheap map) on a grid of the box, as an isosurface at h(x0); or
+    why there is none."""
     lines = [np.linspace(lo[k], hi[k], GRID) for k in axes]
     X = np.stack(np.meshgrid(*lines, indexing="ij"), axis=-1).reshape(-1, 3)
     # (float32 on the way: half the bytes of a panel sent on every change of its runs)
@@ -81,7 +79,7 @@ def _level_surface(result: DashboardResult, kin, amap, axes, lo, hi) -> dict | N
         H = np.asarray(amap.value(X), dtype=float)
         h0 = float(np.asarray(amap.value(np.asarray(result.state.x0, dtype=float)[None]))[0])
     if not np.isfinite(h0) or not np.isfinite(H).any():
-        return None
+        return "h is undefined at x0" if not np.isfinite(h0) else "h is undefined on the box"
     value = np.nan_to_num(H, nan=h0 + 1e9).astype(np.float32)  # (undefined h: far from h0)
     X = X.astype(np.float32)
     return trace(
@@ -120,15 +118,16 @@ def cspace_spec(result: DashboardResult) -> dict:
     except (JikError, ValueError) as exc:
         return figure([], f"Configuration space: {exc}")
     lo, hi = runs_box(result.state, result.runs)
-    surface = _level_surface(result, kin, amap, axes, lo, hi)
-    if surface is not None:
-        data.append(surface)
-    elif kin.p == 3:
-        notes.append("level surface not drawn: h is solved point by point for this map")
-    elif amap is None:
+    if amap is None:
         notes.append(f"h is a vector of p − r = {kin.p - kin.r} maps: its level set not drawn")
-    else:
+    elif kin.p != 3:
         notes.append(f"the level surface of h lives in {kin.p} dimensions: not drawn")
+    elif expensive_map(amap):
+        notes.append("level surface not drawn: h is solved point by point for this map")
+    elif isinstance(surface := _level_surface(result, amap, axes, lo, hi), str):
+        notes.append(f"level surface not drawn: {surface}")
+    else:
+        data.append(surface)
     L = len(result.targets)
     # (the corners' configurations: the extended run's, else any run's that reached them)
     ends = [r.leg_end[:L] for a, r in sorted(result.runs.items(), key=lambda i: i[0] != "extended")]

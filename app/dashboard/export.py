@@ -18,7 +18,7 @@ from jik import __version__
 
 from ...engine.exports import csv_rows
 from ...engine.results import Trajectory
-from ...engine.units import RobotUnits, robot_units
+from ...engine.units import robot_units
 from .algorithms import posture_rest
 from .messages import h_change, to_json
 from .plotting import norm_unit
@@ -27,35 +27,26 @@ from .runs import DashboardResult
 from .verdict import verdict
 
 
-def described(result: DashboardResult) -> RobotUnits:
-    """The robot's coordinates with their names and units (:func:`jik.engine.units.robot_units`)."""
-    return robot_units(state_kinematics(result.state), result.task_names)
-
-
-def export_units(result: DashboardResult) -> dict:
-    """The unit of every column, keyed by its name (:func:`run_columns`): theta, the joint
-    variables x_k and the task coordinates y_k (the engine's,
-    :meth:`jik.engine.units.RobotUnits.columns`; what a robot's length unit m stands for is
-    :func:`length_unit`), the task error (a norm of y) and h."""
+def described(result: DashboardResult) -> dict:
+    """What an export says of its columns (:func:`run_columns`): ``units``, the unit of every
+    column by its name (theta, the joint variables x_k and the task coordinates y_k as the
+    engine's :meth:`jik.engine.units.RobotUnits.columns` give them, the task error (a norm of
+    y) and h); ``length_unit``, what the robot's length unit m stands for (the paper states
+    none); ``coordinates``, what each coordinate column is (``{"x_1": <the first joint's
+    name>, ..., "y_1": <the first task coordinate's>, ...}``)."""
     spelled = {"": "as the definition's formulas", "1": "dimensionless"}
-    units = described(result)
+    units = robot_units(state_kinematics(result.state), result.task_names)
+    columns = units.columns()
     return {
-        "theta": "iterations" if result.state.mode == "discrete" else "dimensionless",
-        **{k: spelled.get(c.unit, c.unit) for k, c in units.columns().items()},
-        "error": norm_unit(units.y).strip("[]") or "as y",
-        "h": "the unit of the map's formula",
+        "units": {
+            "theta": "iterations" if result.state.mode == "discrete" else "dimensionless",
+            **{k: spelled.get(c.unit, c.unit) for k, c in columns.items()},
+            "error": norm_unit(units.y).strip("[]") or "as y",
+            "h": "the unit of the map's formula",
+        },
+        "length_unit": units.lengths,
+        "coordinates": {k: c.name for k, c in columns.items()},
     }
-
-
-def length_unit(result: DashboardResult) -> str:
-    """What the robot's length unit m stands for (the paper states none)."""
-    return described(result).lengths
-
-
-def coordinates(result: DashboardResult) -> dict[str, str]:
-    """What each coordinate column is: ``{"x_1": <the first joint's name>, ..., "y_1": <the
-    first task coordinate's>, ...}``."""
-    return {k: c.name for k, c in described(result).columns().items()}
 
 
 def run_columns(result: DashboardResult, algorithm: str) -> dict[str, np.ndarray]:
@@ -131,9 +122,7 @@ def export_json(
                 "robot": result.title,
                 "state": result.state.as_dict(),
                 "generation": result.generation,
-                "units": export_units(result),
-                "length_unit": length_unit(result),
-                "coordinates": coordinates(result),
+                **described(result),
                 "variable_names": result.variable_names,
                 "task_names": result.task_names,
                 "targets": result.targets,
@@ -151,14 +140,14 @@ def csv_context(result: DashboardResult, when: datetime | None = None) -> list[s
     state, the columns' units, what each coordinate column is (``x_1 x1``: a joint's name), the
     verdict, and per algorithm its message, drift after each cycle, h's change and leg ends (the
     posture inverse's rest x_rest in force too)."""
-    made = provenance(when)
+    made, columns = provenance(when), described(result)
     lines = [
         f"# jik export of generation {result.generation}: {result.title}",
         f"# jik {made['jik_version']}, exported {made['exported_at']}",
         f"# state: {to_json(result.state.as_dict())}",
-        "# units: " + "; ".join(f"{k} [{v}]" for k, v in export_units(result).items()),
-        "# coordinates: " + "; ".join(f"{k} {v}" for k, v in coordinates(result).items()),
-        f"# lengths: {length_unit(result)}",
+        "# units: " + "; ".join(f"{k} [{v}]" for k, v in columns["units"].items()),
+        "# coordinates: " + "; ".join(f"{k} {v}" for k, v in columns["coordinates"].items()),
+        f"# lengths: {columns['length_unit']}",
     ]
     lines += [f"# verdict: {v['text']}" for v in verdict(result)]
     kin = state_kinematics(result.state)

@@ -1,4 +1,4 @@
-"""Plotly figures of a dashboard result: pure functions ``DashboardResult -> go.Figure``.
+"""Plotly figures of a dashboard result: pure functions ``DashboardResult -> figure dict``.
 
 Each figure is built as a plain figure dict first (its "spec"): the dashboard serializes those
 directly (:func:`figure_specs`, :func:`figure_json`), 5x faster than through ``go.Figure``
@@ -15,7 +15,6 @@ platform paths in the (q1, q2) plane and the controls against the iteration (Fig
 from __future__ import annotations
 
 import numpy as np
-import plotly.graph_objects as go
 
 from .algorithms import COLORS, DASH, LABELS, STYLES
 from .cspace import cspace_spec
@@ -29,13 +28,13 @@ from .plotting import (
     log_range,
     nice_range,
     norm_unit,
+    side_by_side,
     stacked_axes,
-    theta_label,
-    to_go,
+    theta_axis,
     trace,
     units,
 )
-from .pose_figures import algorithms_key, is_pose_task, pose_task_spec
+from .pose_figures import algorithms_key, is_pose_task, pose_task_spec, theta_line
 from .runs import DashboardResult, spaced_iterations
 from .table import table_spec
 
@@ -107,29 +106,14 @@ def _joints(result: DashboardResult) -> dict:
     data = []
     for a, run in result.runs.items():
         for k, name in enumerate(names):
-            data.append(
-                trace(
-                    "scatter",
-                    x=run.theta,
-                    y=run.x[:, k],
-                    mode="lines",
-                    name=LABELS[a],
-                    legendgroup=a,
-                    showlegend=k == 0,
-                    line=dict(color=COLORS[a], width=1.8, dash=DASH[a]),
-                    xaxis="x",
-                    yaxis="y" if k == 0 else f"y{k + 1}",
-                    hovertemplate=f"{name} = %{{y:.5f}}<br>θ = %{{x:.4g}}<extra>{a}</extra>",
-                )
-            )
+            data.append(theta_line(a, run, run.x[:, k], name, k, legendgroup=a, showlegend=k == 0))
     axes = stacked_axes(len(names))
     runs = list(result.runs.values())
     for k, name in enumerate(names):
         axis = axes["yaxis" if k == 0 else f"yaxis{k + 1}"]
         axis["title"] = label(name, ju[k])
         axis["range"] = nice_range(np.concatenate([r.x[:, k] for r in runs]))
-    axes["xaxis"]["title"] = theta_label(result)
-    axes["xaxis"]["range"] = nice_range(np.concatenate([r.theta for r in runs]), from_zero=True)
+    axes["xaxis"].update(theta_axis(result))
     title = (
         "Controls λ against the iteration (Figs. 11-14 b, c)"
         if is_unicycle(result)
@@ -167,9 +151,7 @@ def _drift(result: DashboardResult) -> dict:
         title, norm = "Repeatability: joint drift after each closed cycle", "‖x(end of cycle) − x0‖"
         xaxis = dict(title="cycle", dtick=1, range=[0.5, cycles + 0.5])
     else:
-        theta = np.concatenate([r.theta for r in result.runs.values()])
-        title, norm = "Convergence: task error", "‖k(x) − y_d‖"
-        xaxis = dict(title=theta_label(result), range=nice_range(theta, from_zero=True))
+        title, norm, xaxis = "Convergence: task error", "‖k(x) − y_d‖", theta_axis(result)
     unit = norm_unit(units(result)[0 if closed else 1])
     yaxis = dict(title=f"{norm} {unit} (log)", type="log", exponentformat="power")
     return figure(data, title, **NO_LEGEND, xaxis=xaxis, yaxis=yaxis | {"range": log_range(ys)})
@@ -182,12 +164,20 @@ PLATFORM_PATHS = 12
 def _platform(result: DashboardResult) -> dict:
     """Unicycle platform paths q(t) in the (q1, q2) plane, per iteration (Figs. 11-14 a)."""
     _, tu = units(result)
-    data = []
-    annotations = []
-    count = len(result.runs)
-    width = (1.0 - 0.04 * (count - 1)) / count
-    for col, a in enumerate(result.runs, start=1):
-        xa, ya = ("x", "y") if col == 1 else (f"x{col}", f"y{col}")
+    data, annotations = [], []
+    axes: dict[str, dict] = {}
+    domains = side_by_side(len(result.runs), 0.04)
+    for col, (a, domain) in enumerate(zip(result.runs, domains, strict=True)):
+        k = str(col + 1) if col else ""
+        xa, ya = f"x{k}", f"y{k}"
+        axes[f"xaxis{k}"] = dict(
+            domain=domain, title=label("q1", tu[0]), **({"matches": "x"} if k else {})
+        )
+        axes[f"yaxis{k}"] = (
+            dict(anchor=xa, matches="y", showticklabels=False)
+            if k
+            else dict(title=label("q2", tu[1]), scaleanchor="x", scaleratio=1)
+        )
         P = result.runs[a].platform
         assert P is not None  # drawn only for the unicycle, whose runs all carry platform paths
         m = len(P)
@@ -241,18 +231,6 @@ def _platform(result: DashboardResult) -> dict:
                 font=dict(size=11, color=COLORS[a]),
             )
         )
-    axes: dict = {}
-    for col in range(1, count + 1):
-        k = "" if col == 1 else str(col)
-        lo = (col - 1) * (width + 0.04)
-        axes[f"xaxis{k}"] = dict(
-            domain=[lo, lo + width], title=label("q1", tu[0]), **({"matches": "x"} if k else {})
-        )
-        axes[f"yaxis{k}"] = (
-            dict(anchor=f"x{k}", matches="y", showticklabels=False)
-            if k
-            else dict(title=label("q2", tu[1]), scaleanchor="x", scaleratio=1)
-        )
     return figure(
         data,
         "Platform paths q(t) per iteration (Figs. 11-14 a)",
@@ -295,13 +273,3 @@ def figure_specs(
         "sensitivity": lambda r: sensitivity_spec(r, sensitivity, cancelled),
     }
     return {k: f(result) for k, f in builders.items() if only is None or k in only}
-
-
-def figures_for(
-    result: DashboardResult,
-    functionals: dict | None = None,
-    only: set[str] | None = None,
-    sensitivity: dict | None = None,
-) -> dict[str, go.Figure]:
-    """The panels of the dashboard for ``result`` (all, or those in ``only``), keyed by id."""
-    return {k: to_go(v) for k, v in figure_specs(result, functionals, only, sensitivity).items()}

@@ -58,14 +58,14 @@ def functionals_key(state: DashboardState) -> str:
     return json.dumps(robot_and_map(state) | {"fixed": fixed}, sort_keys=True)
 
 
-#: E1 and E2 are taken by a tensor Gauss rule over at most this many region variables.
-MAX_QUADRATURE_VARIABLES = 3
+#: E1 and E2 are taken by a tensor Gauss rule over at most this many region variables, of this
+#: many nodes per variable (fewer for a map that solves a problem per point).
+MAX_QUADRATURE_VARIABLES, NODES, EXPENSIVE_NODES = 3, 12, 6
 
 
 def error_functionals(
     result: DashboardResult,
-    nodes: int = 12,
-    on_step: Callable[[], None] | None = None,
+    on_step: Callable[[], None] = lambda: None,
     cancelled: Callable[[], bool] = lambda: False,
 ) -> dict | None:
     """E1 (13) and E2 (18) of the current map, or None if unavailable.
@@ -80,8 +80,7 @@ def error_functionals(
     grid = result.augmenting
     if grid is None:
         return None
-    if expensive_map(grid["map"]):
-        nodes = min(nodes, 6)
+    nodes = EXPENSIVE_NODES if expensive_map(grid["map"]) else NODES
     names = result.variable_names
     i, j = grid["axes"]
     design = state_spec(result.state).functional_region
@@ -97,8 +96,7 @@ def error_functionals(
         return qmc_functionals(grid, region, fixed, out, cancelled, on_step)
     for key in ("E1", "E2"):
         out |= _functional(key, grid["kinematics"], grid["map"], region, nodes, fixed)
-        if on_step is not None:
-            on_step()
+        on_step()
     return out
 
 
@@ -141,7 +139,7 @@ def sensitivity(
     result: DashboardResult,
     functionals: dict | None,
     cancelled: Callable[[], bool] = lambda: False,
-    progress: Callable[[int, int], None] | None = None,
+    progress: Callable[[int, int], None] = lambda done, total: None,
 ) -> dict:
     """How E1 (13) and E2 (18) change with the parameters of the current map.
 
@@ -185,18 +183,13 @@ def sensitivity(
         return other.build(kin, **params)
 
     total = sensitivity_evaluations(state, grid["map"])
-
-    def report(done: int) -> None:
-        if progress is not None:
-            progress(done, total)
-
     try:
         if aug.parameters:
             out: dict = {"kind": "parameters", "parameters": dict(state.augmentation_parameters)}
             for k, key in enumerate(("E1", "E2")):
 
                 def evaluated(done: int, n: int, k: int = k) -> None:
-                    report(k * n + done)
+                    progress(k * n + done, total)
 
                 out[key] = parameter_sensitivity(
                     kin,
@@ -204,7 +197,6 @@ def sensitivity(
                     state.augmentation_parameters,
                     region,
                     functional=key.lower(),
-                    span=1.0,
                     samples=SENSITIVITY_SAMPLES,
                     nodes=nodes,
                     fixed=fixed,
@@ -214,14 +206,12 @@ def sensitivity(
         maps = []
         for m, other in enumerate(spec.augmentations):
             amap = build(other, **{p.name: p.default for p in other.parameters})
-            if expensive_map(amap):
-                report(2 * m + 2)
-                continue
-            row: dict = {"name": other.name, "current": other.name == aug.name}
-            for key in ("E1", "E2"):
-                row[key] = _functional(key, kin, amap, region, nodes, fixed)[key]
-            maps.append(row)
-            report(2 * m + 2)
+            if not expensive_map(amap):  # (no value of a map that solves per point)
+                row: dict = {"name": other.name, "current": other.name == aug.name}
+                for key in ("E1", "E2"):
+                    row[key] = _functional(key, kin, amap, region, nodes, fixed)[key]
+                maps.append(row)
+            progress(2 * m + 2, total)
         return {"kind": "alternatives", "maps": maps}
     except (JikError, ValueError, ArithmeticError) as exc:
         return {"kind": "unavailable", "reason": str(exc)}

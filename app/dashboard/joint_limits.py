@@ -54,27 +54,15 @@ def limits_summary(result) -> dict[str, Any]:
 
 
 def limits_texts(result, names: dict[str, str]) -> list[tuple[str, str, bool]]:
-    """The verdict's sentences on the limits: (text, algorithm, within) per algorithm, in the
-    words of ``names`` (the algorithms' names in the verdict)."""
-    out = []
+    """The verdict's sentences on the limits (:meth:`jik.engine.limits.LimitsReport.sentence`):
+    (text, algorithm, within) per algorithm, named by ``names`` (the verdict's names)."""
     title = state_spec(result.state).title
+    out = []
     for algorithm in result.runs:
         report = run_limits(result, algorithm)
-        if report is None:
-            continue
-        name = names.get(algorithm, algorithm)
-        if report.within:
-            text = f"{name}: stayed within the joint limits of the {title} all along its run."
-        else:
-            v = report.violation
-            assert v is not None
-            where = "its start x0 is already outside them" if v.cycle == 0 else f"first {v.where}"
-            side = "below its lower" if v.bound == "lower" else "above its upper"
-            text = (
-                f"{name}: left the joint limits of the {title}: {where}, joint {v.name} = "
-                f"{v.value:.4g}, {side} limit {v.limit:.4g}."
-            )
-        out.append((text, algorithm, report.within))
+        if report is not None:
+            text = report.sentence(names.get(algorithm, algorithm), title)
+            out.append((text, algorithm, report.within))
     return out
 
 

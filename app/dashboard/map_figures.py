@@ -12,7 +12,7 @@ import numpy as np
 from .algorithms import COLORS, DASH, LABELS
 from .analysis import vector_note
 from .functionals import state_inert_variables
-from .plotting import NO_LEGEND, figure, label, trace, units
+from .plotting import NO_LEGEND, figure, label, side_by_side, trace, units
 from .robots import state_spec
 from .runs import DashboardResult
 
@@ -180,12 +180,12 @@ SUBTITLE_CHARS = 70
 MESSAGE_CHARS = 50
 
 
-def wrap(parts: list[str], width: int = SUBTITLE_CHARS) -> list[str]:
-    """The subtitle's parts joined by " · " into lines of about ``width`` characters (a long
-    part on its own line), so that no panel cuts its subtitle off."""
+def wrap(parts: list[str]) -> list[str]:
+    """The subtitle's parts joined by " · " into lines of about :data:`SUBTITLE_CHARS`
+    characters (a long part on its own line), so that no panel cuts its subtitle off."""
     lines: list[str] = []
     for part in parts:
-        if lines and len(lines[-1]) + 3 + len(part) <= width:
+        if lines and len(lines[-1]) + 3 + len(part) <= SUBTITLE_CHARS:
             lines[-1] += " · " + part
         else:
             lines.append(part)
@@ -269,9 +269,8 @@ def sensitivity_spec(
     names = list(params)
     n = len(names)
     data, layout = [], {}
-    gap = 0.2  # (room for the next subplot's y tick labels)
-    width = (1.0 - gap * (n - 1)) / n
-    for c, name in enumerate(names):
+    # (0.2 of the width between the plots: room for the next one's y tick labels)
+    for c, (name, domain) in enumerate(zip(names, side_by_side(n, 0.2), strict=True)):
         xa, ya = ("x", "y") if c == 0 else (f"x{c + 1}", f"y{c + 1}")
         for k in ("E1", "E2"):
             sweep = sens[k]["sweeps"][name]
@@ -306,12 +305,8 @@ def sensitivity_spec(
                         "%{y:.4g}<extra></extra>",
                     )
                 )
-        lo = c * (width + gap)
         layout["xaxis" if c == 0 else f"xaxis{c + 1}"] = dict(
-            domain=[round(lo, 6), round(min(1.0, lo + width), 6)],
-            title=name,
-            anchor=ya,
-            nticks=5,
+            domain=domain, title=name, anchor=ya, nticks=5
         )
         ys = [y for k in ("E1", "E2") for y in sens[k]["sweeps"][name]["functional"]]
         layout["yaxis" if c == 0 else f"yaxis{c + 1}"] = dict(

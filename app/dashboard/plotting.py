@@ -9,7 +9,6 @@ import json
 import math
 
 import numpy as np
-import plotly.graph_objects as go
 
 from ...engine.units import robot_units
 from .robots import state_kinematics
@@ -85,10 +84,12 @@ def is_unicycle(result: DashboardResult) -> bool:
     return any(r.platform is not None for r in result.runs.values())
 
 
-def theta_label(result: DashboardResult) -> str:
-    if result.state.mode == "discrete":
-        return "iteration"
-    return f"θ (continuation parameter, γ = {result.state.gamma:g})"
+def theta_axis(result: DashboardResult) -> dict:
+    """The axis of theta (the iteration in discrete mode), from 0 over every run."""
+    theta = np.concatenate([r.theta for r in result.runs.values()])
+    gamma = f"θ (continuation parameter, γ = {result.state.gamma:g})"
+    title = "iteration" if result.state.mode == "discrete" else gamma
+    return dict(title=title, range=nice_range(theta, from_zero=True))
 
 
 def leg_names(n: int) -> list[str]:
@@ -145,21 +146,8 @@ def figure(data: list, title: str, **layout) -> dict:
     return {"data": data, "layout": {**base, **layout}}
 
 
-def to_go(spec: dict) -> go.Figure:
-    return go.Figure(data=spec["data"], layout=spec["layout"], _validate=False)
-
-
-#: numpy dtypes plotly.js takes as typed arrays (base64), by their plotly.js names.
-TYPED = {
-    "float64": "f8",
-    "float32": "f4",
-    "int32": "i4",
-    "uint32": "u4",
-    "int16": "i2",
-    "uint16": "u2",
-    "int8": "i1",
-    "uint8": "u1",
-}
+#: The typed arrays plotly.js takes (base64), by their names, which are numpy's type codes.
+TYPED = {"f8", "f4", "i4", "u4", "i2", "u2", "i1", "u1"}
 
 
 def typed_array(v: np.ndarray):
@@ -168,8 +156,8 @@ def typed_array(v: np.ndarray):
     if v.dtype.kind in "iu" and v.size and v.dtype.itemsize == 8:
         if np.iinfo(np.int32).min <= v.min() and v.max() <= np.iinfo(np.int32).max:
             v = v.astype(np.int32)
-    name = TYPED.get(str(v.dtype))
-    if name is None or not v.size:
+    name = v.dtype.str[1:]  # ("<f8": native little-endian float64 -> "f8")
+    if name not in TYPED or v.dtype.byteorder == ">" or not v.size:
         return plain(v.tolist())
     out = {"dtype": name, "bdata": base64.b64encode(v.tobytes()).decode("ascii")}
     if v.ndim > 1:
@@ -280,6 +268,13 @@ def keep_ranges(spec: dict, before: dict | None) -> dict:
         if v.size and lo <= v.min() and v.max() <= hi and np.ptp(v) >= KEEP_FILL * (hi - lo):
             layout[name] = {**axis, "range": [lo, hi]}
     return spec
+
+
+def side_by_side(n: int, gap: float) -> list[list[float]]:
+    """The x domains of n plots side by side, ``gap`` (of the width) between them."""
+    width = (1.0 - gap * (n - 1)) / n
+    lows = [c * (width + gap) for c in range(n)]
+    return [[round(lo, 6), round(min(1.0, lo + width), 6)] for lo in lows]
 
 
 def stacked_axes(n: int) -> dict:

@@ -20,11 +20,11 @@ from .plotting import (
     label,
     nice_range,
     stacked_axes,
-    theta_label,
+    theta_axis,
     trace,
     units,
 )
-from .runs import DashboardResult
+from .runs import AlgorithmRun, DashboardResult
 
 #: The coordinates of an arm's task in space (any of them).
 POSE_NAMES = ("x", "y", "z", "rx", "ry", "rz")
@@ -46,6 +46,26 @@ def algorithms_key(result: DashboardResult) -> str:
     return "</sup><br><sup>".join(", ".join(keys[i : i + 3]) for i in range(0, len(keys), 3))
 
 
+def theta_line(a: str, run: AlgorithmRun, values, name: str, row: int, legs=False, **props):
+    """Algorithm ``a``'s ``run``: the ``values`` of coordinate ``name`` against theta on the row
+    ``row`` (from the top, 0) of stacked axes; ``legs``: its leg in the hover too."""
+    if legs:
+        props["customdata"] = run.leg + 1
+    leg = "<br>leg %{customdata}" if legs else ""
+    return trace(
+        "scatter",
+        x=run.theta,
+        y=values,
+        mode="lines",
+        name=LABELS[a],
+        line=dict(color=COLORS[a], width=1.8, dash=DASH[a]),
+        xaxis="x",
+        yaxis="y" if row == 0 else f"y{row + 1}",
+        hovertemplate=f"{name} = %{{y:.5f}}<br>θ = %{{x:.4g}}{leg}<extra>{a}</extra>",
+        **props,
+    )
+
+
 def pose_task_spec(result: DashboardResult) -> dict:
     """Each task coordinate against theta for each algorithm, one row per coordinate; the
     targets (× at the end of each leg, their letters above the top row) and the start k(x0) (○)."""
@@ -63,22 +83,7 @@ def pose_task_spec(result: DashboardResult) -> dict:
     for row, k in enumerate(order):
         yaxis = "y" if row == 0 else f"y{row + 1}"
         name = names[k]
-        for a, run in result.runs.items():
-            data.append(
-                trace(
-                    "scatter",
-                    x=run.theta,
-                    y=run.y[:, k],
-                    mode="lines",
-                    name=LABELS[a],
-                    line=dict(color=COLORS[a], width=1.8, dash=DASH[a]),
-                    xaxis="x",
-                    yaxis=yaxis,
-                    customdata=run.leg + 1,
-                    hovertemplate=f"{name} = %{{y:.5f}}<br>θ = %{{x:.4g}}<br>leg %{{customdata}}"
-                    f"<extra>{a}</extra>",
-                )
-            )
+        data += [theta_line(a, r, r.y[:, k], name, row, legs=True) for a, r in result.runs.items()]
         data.append(
             trace(
                 "scatter",
@@ -126,8 +131,7 @@ def pose_task_spec(result: DashboardResult) -> dict:
         )
         for t, x in zip(letters, first.theta[ends], strict=True)
     ]
-    axes["xaxis"]["title"] = theta_label(result)
-    axes["xaxis"]["range"] = nice_range(np.concatenate([r.theta for r in runs]), from_zero=True)
+    axes["xaxis"].update(theta_axis(result))
     lead = next(iter(result.runs))  # (the targets are marked at its legs' ends)
     title = (
         "Task coordinates against θ: position, then rotation vector<br><sup>"

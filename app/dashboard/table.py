@@ -12,7 +12,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...engine.reproductions.table1 import PATH, PRINTED, X0, cell, differing
+from ...engine.reproductions.table1 import (
+    ERRATUM,
+    PRINTED,
+    ROWS_NOTE,
+    cell,
+    differing,
+    is_experiment,
+    row_labels,
+)
 from .algorithms import STYLES
 from .plotting import corner_names, figure, trace
 from .runs import DashboardResult
@@ -22,7 +30,7 @@ TABLE1_TITLE = (
 )
 LEG_ENDS_TITLE = "Joint configuration at the end of each leg (not the paper's Table 1)"
 #: The algorithms of the paper's Table 1.
-PAPER = ("pseudoinverse", "extended")
+PAPER = tuple(PRINTED)
 
 
 def _tint(color: str) -> str:
@@ -38,19 +46,6 @@ FILLS = {
     "differs": "#ffd966",
 }
 SHORT = {a: s.short.split(" (")[0] for a, s in STYLES.items()}
-ERRATUM = (
-    "Erratum (docs/paper-errata.md, “Table 1 and the cubic (38)”): the printed extended column "
-    "is not what the cubic (38) gives. With (38) as printed and its exact gradient, the first leg "
-    "ends at (0.0637, 0.6487, 1.2119), where the paper prints (0.1208, 0.5235, 1.0741); the "
-    "printed j32, j33 of (39) are not the gradient of (38), and with them the leg ends at "
-    "(0.1787, 0.4295, 0.9637), not the printed row either. Both return to x0: the path closes. "
-    "jik shows what (38) gives; nothing is tuned to match the print."
-)
-ROW_LABELS_NOTE = (
-    "Row labels as printed: A, B, C, D, A. The rows are x0 (whose task point k(x0) is (0, 1)) "
-    "and the configurations after the legs to (1, 1), (1, 2), (0, 2), (0, 1): the paper's "
-    "letters name the legs' order, not the square's corners."
-)
 
 
 def is_table1(result: DashboardResult) -> bool:
@@ -61,10 +56,7 @@ def is_table1(result: DashboardResult) -> bool:
         set(PAPER) <= set(result.runs)
         and s.robot == "manipulator2"
         and s.task == "path"
-        and abs(float(s.robot_parameters.get("l", 1.0)) - 1.0) < 1e-12
-        and np.allclose(s.x0, X0, atol=1e-9)
-        and len(s.path) == len(PATH)
-        and np.allclose(s.path, PATH, atol=1e-12)
+        and is_experiment(s.robot_parameters.get("l", 1.0), s.x0, s.path)
     )
 
 
@@ -97,8 +89,7 @@ def table1_spec(result: DashboardResult) -> dict:
     names = result.variable_names
     ends = {a: _ends(result, a) for a in result.runs}
     rows = max(len(e) for e in ends.values())
-    letters = "ABCD"
-    table = _Table("row", ["A  x0"] + [f"{letters[k % 4]}  x{k}f" for k in range(1, rows)])
+    table = _Table("row", row_labels(rows))
     differs: list[list] = []
     counts = {}
     for a in PAPER:
@@ -119,7 +110,7 @@ def table1_spec(result: DashboardResult) -> dict:
         f"one cycle). Highlighted: jik's cells that differ from the print in the fourth decimal "
         f"(pseudoinverse: {counts['pseudoinverse']} of 15, extended Jacobian: "
         f"{counts['extended']} of 15).",
-        ROW_LABELS_NOTE,
+        ROWS_NOTE,
     ]
     if others:
         shown = ", ".join(SHORT[a] for a in others)
@@ -138,15 +129,22 @@ def table1_spec(result: DashboardResult) -> dict:
         )
     if state.mode == "discrete":
         gap = max(
-            float(np.max(np.abs(ends[a][: len(PRINTED[a])] - np.asarray(PRINTED[a]))))
-            for a in PAPER
-            if len(ends[a]) >= len(PRINTED[a])
+            (
+                float(np.max(np.abs(ends[a][: len(PRINTED[a])] - np.asarray(PRINTED[a]))))
+                for a in PAPER
+                if len(ends[a]) >= len(PRINTED[a])
+            ),
+            default=None,
+        )
+        where = (
+            "stopped before the end of the first cycle"
+            if gap is None
+            else f"ends its legs elsewhere (up to {gap:.3g} from the printed values)"
         )
         notes.append(
             f"Discrete mode changes the numbers: the paper's Table 1 is the continuous "
-            f"algorithm (7); the iteration with step γ = {state.gamma:.3g} ends its legs "
-            f"elsewhere (up to {gap:.3g} from the printed values). Choose mode = "
-            "continuous to compare with the print."
+            f"algorithm (7); the iteration with step γ = {state.gamma:.3g} {where}. Choose "
+            "mode = continuous to compare with the print."
         )
     else:
         notes.append(

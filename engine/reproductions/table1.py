@@ -38,6 +38,41 @@ PRINTED = {
     ],
 }
 
+#: What the printed row labels A, B, C, D, A name.
+ROWS_NOTE = (
+    "Row labels as printed: A, B, C, D, A. The rows are x0 (whose task point k(x0) is (0, 1)) "
+    "and the configurations after the legs to (1, 1), (1, 2), (0, 2), (0, 1): the paper's "
+    "letters name the legs' order, not the square's corners."
+)
+#: The erratum of the extended column (docs/paper-errata.md), with what :func:`run` gives.
+ERRATUM = (
+    "Erratum (docs/paper-errata.md, “Table 1 and the cubic (38)”): the printed extended column "
+    "is not what the cubic (38) gives. With (38) as printed and its exact gradient, the first leg "
+    "ends at (0.0637, 0.6487, 1.2119), where the paper prints (0.1208, 0.5235, 1.0741); the "
+    "printed j32, j33 of (39) are not the gradient of (38), and with them the leg ends at "
+    "(0.1787, 0.4295, 0.9637), not the printed row either. Both return to x0: the path closes. "
+    "jik shows what (38) gives; nothing is tuned to match the print."
+)
+
+
+def row_labels(n: int) -> list[str]:
+    """The labels of ``n`` rows, x0 then the leg ends, as Table 1 prints them (``"A  x0"``,
+    ``"B  x1f"``, ..., ``"A  x4f"``) and on over more cycles (``"B  x5f"``, ...)."""
+    return [f"{'ABCD'[k % 4]}  x{k}f" if k else "A  x0" for k in range(n)]
+
+
+def is_experiment(length: float, x0, path) -> bool:
+    """Whether Manipulator 2 with arm length l = ``length`` from ``x0`` on ``path`` is Table 1's
+    run: l = 1, x0 = :data:`X0`, the closed path :data:`PATH`."""
+    x0, path = np.asarray(x0, dtype=float), np.asarray(path, dtype=float)
+    return (
+        abs(float(length) - 1.0) < 1e-12
+        and x0.shape == np.shape(X0)
+        and np.allclose(x0, X0, atol=1e-9)
+        and path.shape == np.shape(PATH)
+        and np.allclose(path, PATH, atol=1e-12)
+    )
+
 
 def rows(inverse) -> list[list[float]]:
     """x0 and the configuration after each leg of Table 1's path (continuous algorithm (7))."""
@@ -89,7 +124,7 @@ def differing(algorithm: str, rows) -> np.ndarray:
 
 def format_text(result: dict) -> str:
     """Table 1 laid out as in the paper, with the printed values beside ours."""
-    labels = ["A  x0 ", "B  x1f", "C  x2f", "D  x3f", "A  x4f"]
+    labels = row_labels(5)
     out = []
     for alg, title in (
         ("extended", "Extended Jacobian"),

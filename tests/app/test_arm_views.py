@@ -9,9 +9,10 @@ import math
 from pathlib import Path
 
 import numpy as np
+import plotly.graph_objects as go
 import pytest
 
-from jik.app.dashboard.figures import figure_specs, gamma_free_panels, to_go
+from jik.app.dashboard.figures import figure_specs, gamma_free_panels
 from jik.app.dashboard.model import default_state, updated_state
 from jik.app.dashboard.results import compute
 from jik.app.dashboard.robots import state_kinematics
@@ -129,7 +130,7 @@ def test_a_pose_task_shows_position_and_rotation_against_theta():
     The panel depends on theta, so it is not among the gamma-free panels."""
     result = compute(_panda())
     spec = figure_specs(result, only={"task"})["task"]
-    to_go(spec)  # (valid for plotly)
+    go.Figure(spec)  # (valid for plotly: go.Figure validates a dict)
     layout = spec["layout"]
     titles = [layout["yaxis" if k == 0 else f"yaxis{k + 1}"]["title"]["text"] for k in range(6)]
     assert titles == ["x [m]", "y [m]", "z [m]", "rx [rad]", "ry [rad]", "rz [rad]"]
@@ -205,7 +206,7 @@ def test_the_e1_e2_panel_shows_e2_of_a_7_joint_map_beside_single_joints():
     assert sens["kind"] == "single_joint" and len(sens["maps"]) == 8
     specs = figure_specs(result, functionals, {"augmenting", "sensitivity"}, sensitivity=sens)
     bars = specs["sensitivity"]["data"][0]
-    to_go(specs["sensitivity"])
+    go.Figure(specs["sensitivity"])  # (validated)
     assert bars["type"] == "bar" and bars["x"][0] == "h (current)" and bars["x"][1] == "h = +x1"
     assert (
         bars["y"][0] == functionals["E2"]

@@ -13,7 +13,7 @@ import pytest
 from jik.app.compute.atlas_plan import AtlasLimits, planned
 from jik.app.dashboard.atlas import atlas_figure, atlas_request
 from jik.app.dashboard.controls import controls
-from jik.app.dashboard.export import export_csv, export_units
+from jik.app.dashboard.export import described, export_csv
 from jik.app.dashboard.joint_limits import limits_summary, outside_joints, state_limits
 from jik.app.dashboard.map_figures import augmenting_spec
 from jik.app.dashboard.map_synthesis import built_map
@@ -291,7 +291,7 @@ def test_an_arms_export_has_its_rotation_coordinates_in_rad():
     """The export's units are the axes': the Panda's rx ry rz in rad, its x y z in m, and a line
     saying what its lengths are in (a URDF's SI units)."""
     result = compute(updated_state(_panda(), {"task": "target"}))
-    units = export_units(result)
+    units = described(result)["units"]
     assert [units[f"y_{k}"] for k in range(1, 7)] == ["m", "m", "m", "rad", "rad", "rad"]
     assert "# lengths: m: SI units, as in a URDF" in export_csv(result).splitlines()
 

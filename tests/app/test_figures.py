@@ -10,14 +10,22 @@ import plotly.graph_objects as go
 import pytest
 
 from jik.app.dashboard import COLORS, LABELS, compute, default_state, updated_state
-from jik.app.dashboard.figures import figure_specs, figures_for
+from jik.app.dashboard.figures import figure_specs
 from jik.app.dashboard.functionals import error_functionals, sensitivity
 from jik.app.dashboard.plotting import figure_json, keep_ranges, nice_range
 from jik.engine.registry import ROBOTS
 
 
+def figures_for(result, functionals=None, only=None, sensitivity=None) -> dict[str, go.Figure]:
+    """The panels of ``result`` (:func:`figure_specs`) as plotly figures, validated by plotly
+    (the builders skip its validation: an unknown property raises here)."""
+    return {
+        k: go.Figure(v) for k, v in figure_specs(result, functionals, only, sensitivity).items()
+    }
+
+
 def panel(result, key, functionals=None, sensitivity=None) -> go.Figure:
-    """One panel of ``result`` as a plotly figure (:func:`figures_for`)."""
+    """One panel of ``result`` as a validated plotly figure (:func:`figures_for`)."""
     return figures_for(result, functionals, {key}, sensitivity)[key]
 
 
@@ -442,3 +450,39 @@ def test_cspace_draws_each_corners_self_motion_manifold_through_its_leg_end(path
         assert np.all(gaps <= SPACING * diagonal * (1 + 1e-3))
         outside = np.maximum(lo - 0.5 * (hi - lo) - x, x - hi - 0.5 * (hi - lo))
         assert np.max(outside) < 1e-5
+
+
+def test_a_big_endian_array_keeps_its_values():
+    """A typed array is the array's bytes, which plotly.js reads little-endian: an array of
+    the other byte order goes as a list of its values, not as bytes read backwards."""
+    values = np.array([0.5, 2.0], dtype=">f8")
+    assert json.loads(figure_json({"data": [{"x": values}], "layout": {}}))["data"][0]["x"] == [
+        0.5,
+        2.0,
+    ]
+
+
+def test_the_configuration_space_says_why_it_draws_no_level_surface():
+    """A map undefined at x0 (a user's h = log(x3) from x3 < 0) has no level h = h(x0): the
+    panel says so, not that h is solved point by point (it is not)."""
+    definition = {
+        "name": "formula",
+        "variables": ["x1", "x2", "x3"],
+        "task": ["x2 + cos(x3)", "x1 + sin(x3)"],
+        "augmentations": [{"name": "formula", "h": "log(x3)"}],
+    }
+    state = updated_state(default_state("formula", definition), {"x0.2": -0.5})
+    title = figure_specs(compute(state), only={"cspace"})["cspace"]["layout"]["title"]["text"]
+    assert "level surface not drawn: h is undefined at x0" in title
+    assert "point by point" not in title
+
+
+def test_table1_of_discrete_runs_that_stop_in_the_first_cycle():
+    """The paper's experiment in discrete mode with a step (gamma = 1.99) at which neither run
+    finishes its first leg: the table still shows (x0 and the printed columns) and says the
+    iteration stopped before the end of the first cycle."""
+    state = updated_state(default_state("manipulator2"), {"mode": "discrete", "gamma": 1.99})
+    result = compute(state)
+    assert not any(run.success for run in result.runs.values())
+    notes = figure_specs(result, only={"table"})["table"]["layout"]["meta"]["notes"]
+    assert "γ = 1.99 stopped before the end of the first cycle" in notes[-1]

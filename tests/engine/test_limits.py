@@ -170,3 +170,21 @@ def test_a_one_leg_run_says_on_the_way_to_the_target():
     assert str(two).startswith("left the joint limits at cycle 1, leg 2: x2 = 1.5")
     start = legs_report(limits, np.array([2.0, 0.0]), [leg], 1, ["x1", "x2"])
     assert str(start).startswith("left the joint limits at the start x0: x1 = 2")
+
+
+def test_a_report_says_in_a_sentence_where_its_run_left_the_limits():
+    """The verdict's sentence: within all along, else where first (a leg, or the start already
+    outside), the joint, its value and the limit it passed, to four digits."""
+    legs = [np.array([[0.0, 0, 1]]), np.array([[0.2, 0, 2.123456]])]
+    out = legs_report(LIMITS, [0, 0, 1], legs, 2, NAMES).sentence("J^P#", "planar chain")
+    assert out == (
+        "J^P#: left the joint limits of the planar chain: first at cycle 1, leg 2, joint x3 = "
+        "2.123, above its upper limit 2."
+    )
+    start = legs_report(LIMITS, [-1.2, 0, 1], [], 1, NAMES).sentence("J^E#", "arm")
+    assert start == (
+        "J^E#: left the joint limits of the arm: its start x0 is already outside them, joint "
+        "x1 = -1.2, below its lower limit -1."
+    )
+    within = legs_report(LIMITS, [0, 0, 1], legs[:1], 2, NAMES).sentence("J^P#", "arm")
+    assert within == "J^P#: stayed within the joint limits of the arm all along its run."

@@ -7,7 +7,14 @@ from jik.engine.augmentations import E2Optimal, PaperCubic
 from jik.engine.exceptions import AlgorithmicSingularityError, InvalidInputError
 from jik.engine.inverses import ExtendedInverse, Pseudoinverse
 from jik.engine.kinematics import Manipulator1, Manipulator2
-from jik.engine.reproductions.table1 import PRINTED, differing
+from jik.engine.reproductions.table1 import (
+    ERRATUM,
+    PATH,
+    PRINTED,
+    differing,
+    is_experiment,
+    row_labels,
+)
 from jik.engine.reproductions.table1 import run as table1
 from jik.engine.solver import solve, solve_batch
 
@@ -39,6 +46,27 @@ def test_table1_cells_that_differ_from_the_print_in_the_fourth_decimal():
     with pytest.raises(InvalidInputError, match="algorithm must be one of") as info:
         differing("posture", result["pseudoinverse"])
     assert info.value.field == "algorithm"
+
+
+def test_table1_erratum_states_what_the_cubic_38_gives():
+    """The erratum's first leg ends are run()'s, with (38)'s exact gradient and with the printed
+    j32, j33 of (39), to the four decimals it prints; the rows' labels are the paper's."""
+    for printed_gradient in (False, True):
+        leg = table1(printed_gradient)["extended"][1]
+        assert "(" + ", ".join(f"{v:.4f}" for v in leg) + ")" in ERRATUM
+    assert row_labels(5) == ["A  x0", "B  x1f", "C  x2f", "D  x3f", "A  x4f"]
+    assert row_labels(7)[5:] == ["B  x5f", "C  x6f"]
+    assert row_labels(0) == []
+
+
+def test_table1_experiment_is_its_arm_start_and_path():
+    """Table 1's run: l = 1, x0 = (0, 0, pi/2), the closed path; not another of these."""
+    assert is_experiment(1.0, X0, PATH)
+    assert not is_experiment(1.5, X0, PATH)
+    assert not is_experiment(1.0, X0 + [0.1, 0, 0], PATH)
+    assert not is_experiment(1.0, X0, PATH[:3])
+    assert not is_experiment(1.0, X0, np.add(PATH, 0.01))
+    assert not is_experiment(1.0, X0[:2], PATH)  # (another robot's start: not an error)
 
 
 @pytest.mark.parametrize("gamma", [0.05, 1.0, 30.0])
