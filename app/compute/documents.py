@@ -60,6 +60,7 @@ def solve_response_json(setup, res) -> bytes:
             "error": nullable(res.error),
             "converged": bool(res.success),
             "message": str(res.message),
+            "status": res.status,
             "iterations": int(res.nit),
             "trajectory": trajectory_document(res.trajectory),
             **limits_document(setup.kinematics, res),

@@ -22,7 +22,7 @@ def test_solve_pseudoinverse_manipulator2(api):
     r = api.post("/solve", json=solve_body())
     assert r.status_code == 200, r.text
     b = r.json()
-    assert b["converged"] is True
+    assert b["converged"] is True and b["status"] == "converged"
     assert b["message"].startswith("converged")
     np.testing.assert_allclose(b["x"], X1F, atol=6e-5)
     np.testing.assert_allclose(b["y"], [1.0, 1.0], atol=1e-9)
@@ -75,7 +75,7 @@ def test_solve_manipulator1_with_parameters_and_discrete_mode(api):
 def test_solve_not_converged_is_200_with_reason(api):
     """A run that hits max_iterations is a result (converged false), not an error."""
     b = api.post("/solve", json=solve_body(max_iterations=3)).json()
-    assert b["converged"] is False
+    assert b["converged"] is False and b["status"] == "max_steps"
     assert "did not converge within 3 steps" in b["message"]
 
 
@@ -86,6 +86,7 @@ def test_a_stalled_solve_says_why(api):
     body = solve_body(robot=arm, x0=[0.3, 0.4, 0.5], target=[5.0, 0.0])
     b = api.post("/solve", json=body).json()
     assert b["converged"] is False and b["message"].startswith("stalled after ")
+    assert b["status"] == "stalled"  # (the engine's SolveResult.status, for a client's branch)
     assert (
         "the target is out of reach: it is 5 from the base, beyond the arm's reach 2.4"
         in (b["message"])

@@ -12,7 +12,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from ....engine.registry import RobotSpec
 from ....engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS, REPEATABLE_DRIFT
-from ....engine.solve_rules import DISCRETE_GAMMA_BOUND
+from ....engine.solve_rules import DISCRETE_GAMMA_BOUND, Status
 from .algorithms import Algorithm, AlgorithmParameters
 from .fields import (
     INTEGRAL,
@@ -149,6 +149,11 @@ RunLimits = Annotated[
 ]
 
 
+#: Why a solve stopped: the engine's SolveResult.status of one run.
+RunStatus = Literal["converged", "max_steps", "diverged", "stalled", "singular", "undefined"]
+assert set(RunStatus.__args__) == set(Status.NAMES) - {"running"}  # type: ignore[attr-defined]
+
+
 class SolveResponse(_RunResponse):
     tolerance: float
     x: list[MaybeFloat] = Field(
@@ -158,6 +163,11 @@ class SolveResponse(_RunResponse):
     error: MaybeFloat = Field(description="||k(x) - target||")
     converged: bool
     message: str
+    status: RunStatus = Field(
+        description="why the run stopped: converged, max_steps (out of iterations or "
+        "integrator steps), diverged, stalled, singular (the inverse singular there) or "
+        "undefined (the augmenting map h undefined there)"
+    )
     iterations: int = Field(description="integrator steps or iterations taken")
     trajectory: Trajectory
     limits: RunLimits = None
