@@ -26,6 +26,7 @@ from .collocation import (
     solve_characteristics,
 )
 from .exceptions import InvalidInputError, OneFormUndefinedError, format_vector
+from .inverses import require_kinematics
 from .kinematics import Kinematics
 from .one_form import check_index
 from .progress import Progress, check_cancelled, check_progress
@@ -74,7 +75,7 @@ class CharacteristicsMap(AugmentingMap):
         nodes: int = COLLOCATION_NODES,
         on_undefined: str = "raise",
     ) -> None:
-        self.kinematics = kinematics
+        self.kinematics = kinematics = require_kinematics(kinematics)
         self.p = kinematics.p
         self.fixed_index = check_index(kinematics, fixed_index)
         self.homotopy = LinearHomotopy(as_vector(reference, self.p, "reference"), fixed_index)

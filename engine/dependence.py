@@ -13,6 +13,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from .exceptions import JikError
+from .inverses import require_kinematics, require_map
 from .kinematics import Kinematics
 from .validation import as_box
 
@@ -46,6 +47,8 @@ def inert_variables(kinematics: Kinematics, amap, box: Sequence[Sequence[float]]
     InvalidInputError
         ``box`` is not p finite pairs (low, high).
     """
+    kinematics = require_kinematics(kinematics)
+    amap = None if amap is None else require_map(amap, kinematics, "amap")
     lo, hi = as_box(box, kinematics.p).T
     if amap is None or getattr(amap, "solves_per_point", False):
         return frozenset()

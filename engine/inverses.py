@@ -132,13 +132,17 @@ def require_kinematics(kinematics) -> Kinematics:
     )
 
 
-def require_map(augmenting_map, kinematics: Kinematics, field: str = "augmenting_map"):
+def require_map(
+    augmenting_map, kinematics: Kinematics | Sequence[str], field: str = "augmenting_map"
+):
     """``augmenting_map`` if it is an :class:`AugmentingMap`, else an InvalidInputError naming
-    ``field`` that says how to make one."""
+    ``field`` that says how to make one (of the variables of ``kinematics``, or of the names
+    given instead)."""
     if isinstance(augmenting_map, AugmentingMap):
         return augmenting_map
+    names = kinematics.variable_names if isinstance(kinematics, Kinematics) else kinematics
     hint = (
-        f"; for a formula use FormulaMap({augmenting_map!r}, {list(kinematics.variable_names)})"
+        f"; for a formula use FormulaMap({augmenting_map!r}, {list(names)})"
         if isinstance(augmenting_map, str)
         else ""
     )
@@ -151,7 +155,10 @@ def require_map(augmenting_map, kinematics: Kinematics, field: str = "augmenting
 
 
 def require_compatible(kinematics: Kinematics, augmenting_map: AugmentingMap, what: str) -> None:
-    """Check one degree of redundancy (p - r = 1) and that h is defined on R^p."""
+    """Check that they are a Kinematics and an AugmentingMap, one degree of redundancy
+    (p - r = 1) and that h is defined on R^p."""
+    kinematics = require_kinematics(kinematics)
+    augmenting_map = require_map(augmenting_map, kinematics)
     if kinematics.p - kinematics.r != 1:
         raise InvalidInputError(
             f"{what} here needs one degree of redundancy (p - r = 1); {kinematics.name} has "

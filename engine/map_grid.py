@@ -12,6 +12,7 @@ import numpy as np
 
 from .augmentations import AugmentingMap
 from .exceptions import JikError
+from .inverses import require_map
 from .validation import FloatArray, check_box_region, count
 
 #: Seeded samples of the box on which :func:`grid_axes` compares h's partial derivatives.
@@ -127,6 +128,7 @@ def map_grid(
         ``fixed``), an empty or reversed interval, or ``n`` out of range.
     """
     names = list(variable_names)
+    amap = require_map(amap, names, "amap")
     region, held = check_box_region(names, region, fixed)
     n = count(n, "n", 2, MAX_N)
     if len(region) < 2:

@@ -38,7 +38,7 @@ from scipy.integrate import DOP853, OdeSolution
 from scipy.optimize import brentq
 
 from .exceptions import InvalidInputError
-from .inverses import Pseudoinverse
+from .inverses import Pseudoinverse, require_kinematics
 from .kinematics import Kinematics
 from .urdf import UrdfChain
 from .validation import FloatArray, as_box, count, finite
@@ -375,6 +375,7 @@ def manifold_starts(
         the pseudoinverse (8) (:func:`project`); those that leave the box or do not reach the
         manifold (task error 1e-10) are left out.
     """
+    kinematics = require_kinematics(kinematics)
     x0 = kinematics.check(x0, "x0")
     if x0.shape != (kinematics.p,):
         raise InvalidInputError(f"x0 must be one configuration of {kinematics.p} numbers", "x0")

@@ -34,7 +34,7 @@ from scipy.stats import qmc
 from .exceptions import InvalidInputError, KinematicSingularityError
 from .exports import Columns
 from .functionals import Region, check_region
-from .inverses import pseudoinverse
+from .inverses import pseudoinverse, require_kinematics
 from .kinematics import Kinematics
 from .progress import Progress, check_cancelled, check_progress
 from .total_degree import (
@@ -263,11 +263,11 @@ def synthesize_e2_nd(
     -------
     TotalDegreeSynthesis
     """
+    kinematics = require_kinematics(kinematics)
     m_red = kinematics.p - kinematics.r
     if m_red < 1:
         raise InvalidInputError(f"{kinematics.name} has no redundancy (p = r)", "robot")
-    box, fix = check_region(kinematics, region, fixed)
-    progress = check_progress(progress)
+    (box, fix), progress = check_region(kinematics, region, fixed), check_progress(progress)
     d = len(box)
     degree = count(degree, "degree", 1, 32)
     nodes = count(nodes, "nodes", 64, MAX_NODES)

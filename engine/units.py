@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .exports import coordinate_names
+from .inverses import require_kinematics
 from .limits import robot_limits
 from .planar_chain import PlanarChain
 from .urdf import UrdfChain
@@ -170,6 +171,7 @@ def robot_units(kinematics, task_names: Sequence[str] | None = None) -> RobotUni
         The task coordinates' names (a spec's ``task_names``); default: the kinematics' own
         (a URDF arm's), else ``y1 .. yr``.
     """
+    kinematics = require_kinematics(kinematics)
     if task_names is None:
         default = tuple(f"y{i + 1}" for i in range(kinematics.r))
         task_names = getattr(kinematics, "task_names", None) or default

@@ -38,7 +38,7 @@ from .augmentations import Polynomial2
 from .exceptions import InvalidInputError
 from .exports import Columns
 from .functionals import Region, check_region, error_functional_e2
-from .inverses import pseudoinverse
+from .inverses import pseudoinverse, require_kinematics
 from .kinematics import Kinematics, Manipulator2
 from .legendre_map import SynthesizedMap, legendre_vander, lgl_nodes
 from .progress import Progress, check_cancelled, check_progress
@@ -311,6 +311,12 @@ def synthesize_e2(
     -------
     SynthesisResult
     """
+    kinematics = require_kinematics(kinematics)
+    if dirichlet is not None and not callable(dirichlet):
+        raise InvalidInputError(
+            f"dirichlet must be a function g(x) (n, p) -> (n,), got {type(dirichlet).__name__}",
+            "dirichlet",
+        )
     if kinematics.p - kinematics.r != 1:
         raise InvalidInputError(
             "synthesize_e2 needs one degree of redundancy (p - r = 1)", "kinematics"

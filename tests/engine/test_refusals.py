@@ -204,6 +204,38 @@ REFUSALS = {
     "refused_starts x0 wrong length": (lambda: refused_starts(P, [[0, 1]]), "x0"),
     "pose_of y wrong length": (lambda: PANDA_TASK.pose_of(np.zeros(5)), "y"),
     "run_report not a result": (lambda: run_report(ARM, "abc"), "result"),
+    "error_functional_e1 robot by name": (
+        lambda: jik.error_functional_e1("manipulator2", jik.PaperCubic(), BOX),
+        "kinematics",
+    ),
+    "error_functional_e2 map as text": (
+        lambda: jik.error_functional_e2(ARM, "x3 - x2", BOX),
+        "augmenting_map",
+    ),
+    "synthesize_e2 robot by name": (lambda: jik.synthesize_e2("manipulator2", BOX), "kinematics"),
+    "synthesize_e2 dirichlet text": (
+        lambda: jik.synthesize_e2(ARM, BOX, degree=2, dirichlet="x2"),
+        "dirichlet",
+    ),
+    "synthesize_e2_nd robot None": (lambda: jik.synthesize_e2_nd(None, BOX), "kinematics"),
+    "inert_variables robot by name": (
+        lambda: jik.inert_variables("manipulator2", None, [(0, 1)] * 3),
+        "kinematics",
+    ),
+    "inert_variables map as text": (
+        lambda: jik.inert_variables(ARM, "x1", [(0, 1)] * 3),
+        "amap",
+    ),
+    "manifold_starts robot by name": (
+        lambda: jik.manifold_starts("manipulator2", X0, 4, [(0, 1)] * 3),
+        "kinematics",
+    ),
+    "map_grid map as text": (lambda: jik.map_grid("x2 * x3", NAMES, BOX), "amap"),
+    "CharacteristicsMap robot by name": (
+        lambda: jik.CharacteristicsMap("unicycle", [0, 0, 0, 0], 0),
+        "kinematics",
+    ),
+    "robot_units robot by name": (lambda: jik.robot_units("panda"), "kinematics"),
     "repeatable drift text": (lambda: jik.repeatable("abc"), "drift"),
     "repeatability progress a function": (
         lambda: jik.repeatability(P, X0, PATH, progress=lambda leg: None),
