@@ -28,7 +28,7 @@ from .inverses import (
     require_compatible,
 )
 from .kinematics import Kinematics
-from .validation import FloatArray, check_box_region, count, finite
+from .validation import FloatArray, check_box_region, check_memory, count, finite
 
 # name -> (lo, hi); any two-item sequence (JSON gives lists), validated by check_region.
 Region = Mapping[str, Sequence[float]]
@@ -108,6 +108,14 @@ def check_region(
     return check_box_region(names, region, fixed)
 
 
+def point_bytes(kinematics: Kinematics) -> float:
+    """Estimated peak memory, in bytes, of E1 or E2 per quadrature point: the point, J (with
+    ``kinematics.scratch`` numbers to evaluate it), dh, K, and the integrand's J J^T, J^#
+    and P. Measured peaks (tracemalloc, Manipulator 2 to a Panda) are 0.4 to 0.5 times this."""
+    p, r = kinematics.p, kinematics.r
+    return 8.0 * (kinematics.scratch + 4 * p * p + 4 * r * p + 2 * r * r + 8 * p + 8)
+
+
 def quadrature(
     kinematics: Kinematics,
     region: Region,
@@ -127,6 +135,14 @@ def quadrature(
     """
     nodes = count(nodes, "nodes", 1, 400)
     box, fix = check_region(kinematics, region, fixed)
+    check_memory(
+        nodes ** len(box),
+        point_bytes(kinematics),
+        "nodes",
+        f"quadrature points ({nodes}^{len(box)}) of E1 or E2",
+        "use fewer nodes or region variables (synthesize_e2_nd integrates E2 over many "
+        "variables by a Sobol rule)",
+    )
     names = tuple(kinematics.variable_names) or tuple(f"x{i + 1}" for i in range(kinematics.p))
     t, tw = np.polynomial.legendre.leggauss(nodes)
     axes, weights = [], []

@@ -148,6 +148,10 @@ REFUSALS = {
         lambda: jik.error_functional_e2(ARM, jik.PaperCubic(), BOX, nodes=0),
         "nodes",
     ),
+    "error_functional_e1 too many points": (
+        lambda: jik.error_functional_e1(ARM, jik.PaperCubic(), {"x1": (0, 1), **BOX}, nodes=400),
+        "nodes",
+    ),
     "error_functional_e2 nodes huge": (
         lambda: jik.error_functional_e2(ARM, jik.PaperCubic(), BOX, nodes=100000),
         "nodes",
