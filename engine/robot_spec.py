@@ -176,7 +176,10 @@ def _urdf_file(d: Mapping, base_dir: Path | None) -> str:
 
     if base_dir is None:
         raise InvalidInputError(
-            "urdf_file is read only from a robot file; give urdf (the text)", "urdf_file"
+            "urdf_file is a path relative to a robot file's folder, which robot_from_dict takes "
+            "as base_dir (load_robot passes it); or give urdf, the text "
+            "(pathlib.Path(file).read_text())",
+            "urdf_file",
         )
     name = _get(d, "urdf_file", str, "a path relative to the robot file")
     path = (base_dir / name).resolve()

@@ -3,6 +3,7 @@ InvalidInputError whose ``field`` names it; the kinematics check ``x`` at their 
 and the inverses check what they are built from."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,6 +15,7 @@ from jik.engine.limits import run_report
 from jik.engine.self_motion import trace
 from jik.engine.solve_rules import refused_starts
 
+ROOT = Path(__file__).resolve().parents[2]
 X0 = [0.0, 0.0, math.pi / 2]
 PATH = [(1, 1), (1, 2), (0, 2)]
 LOOP = [(0, 1), *PATH]
@@ -288,6 +290,16 @@ def test_texts_for_objects_say_how_to_make_them():
         jik.Pseudoinverse("manipulator2")
     with pytest.raises(InvalidInputError, match=r"FormulaMap\('x3', \['x1', 'x2', 'x3'\]\)"):
         jik.ExtendedInverse(ARM, "x3")
+
+
+def test_a_urdf_file_without_its_folder_says_how_to_give_one(tmp_path):
+    """urdf_file is relative to a folder: from Python, robot_from_dict's base_dir names it."""
+    (tmp_path / "arm4.urdf").write_text((ROOT / "tests/data/arm4.urdf").read_text())
+    arm = {"name": "urdf", "urdf_file": "arm4.urdf", "end_link": "tool"}
+    with pytest.raises(InvalidInputError, match="which robot_from_dict takes as base_dir") as info:
+        jik.robot_from_dict(arm)
+    assert info.value.field == "urdf_file"
+    assert jik.robot_from_dict(arm, base_dir=tmp_path).kinematics.p == 4
 
 
 def _ur5e():

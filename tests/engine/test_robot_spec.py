@@ -119,7 +119,10 @@ def test_urdf_file_must_stay_in_the_robot_files_folder(tmp_path):
     with pytest.raises(InvalidInputError, match="not a file inside") as err:
         load_robot(tmp_path / "sub" / "arm.json")
     assert err.value.field == "urdf_file"
-    with pytest.raises(InvalidInputError, match="only from a robot file"):
+    with pytest.raises(
+        InvalidInputError,
+        match="which robot_from_dict takes as base_dir",
+    ):
         robot_from_dict({"name": "urdf", "urdf_file": "arm4.urdf", "end_link": "tool"})
 
 
