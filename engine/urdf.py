@@ -72,7 +72,11 @@ class UrdfChain(Kinematics):
     reference : optional
         R0 as a rotation vector, a quaternion (x y z w) or a matrix
         (:func:`~jik.engine.pose_task.reference_rotation`); default: the end link's orientation
-        at ``home``, so that ``home`` has rotation coordinates 0.
+        at ``home``, so that ``home`` has rotation coordinates 0. The rotation coordinates are
+        those of the principal log, |phi| <= pi, not differentiable at a half turn from R0
+        (:mod:`jik.engine.so3`): keep the task's orientations well within a half turn of R0.
+        The base frame (``[0, 0, 0]``) is a half turn from a Panda's home, whose flange points
+        down: there k jumps and the solves stall.
 
     Notes
     -----

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import jik.engine as e
-from jik.engine.stall import reach, stall_reason
+from jik.engine.stall import reach, reach_note, stall_reason
 
 ARM = e.PlanarChain("RRR", [1.0, 0.8, 0.6])
 X0 = np.array([0.3, 0.4, 0.5])
@@ -90,3 +90,21 @@ def test_a_chain_with_an_orientation_task_claims_no_reach():
     assert reach(chain) is None
     message = stall_reason(e.Pseudoinverse(chain), [2.9, 0.0, np.pi], [0.3, 0.2, 0.1])
     assert "within reach" not in message and "out of reach" not in message
+
+
+def test_a_rotation_vector_longer_than_a_half_turn_is_out_of_reach():
+    """A pose task's rotation coordinates are the principal log (|r| <= pi): a target whose
+    rotation vector is longer is never reached, and the message gives the same orientation
+    within a half turn; one within it gets no such note."""
+    pytest.importorskip("yourdfpy")
+    panda = e.robot_from_dict({"name": "panda", "task": "pose"})
+    home = np.array(panda.spec.default_x0)
+    target = panda.kinematics.forward(home) + [0, 0, 0, 3.0, 0, 1.0]  # |r| = sqrt(10)
+    res = e.solve(panda.inverse(), home, target, mode="discrete", gamma=0.5, max_iterations=50)
+    assert not res.success
+    assert (
+        "the target is out of reach: its rotation vector (rx, ry, rz) has length 3.16228 > pi"
+        in res.message
+    )
+    assert res.message.endswith("the same orientation is (-2.96, 0, -0.987)")
+    assert reach_note(panda.kinematics, target - [0, 0, 0, 0.1, 0, 0.1]) == (None, "")
