@@ -10,6 +10,7 @@ is :class:`jik.engine.repeatability_result.RepeatabilityResult`.
 
 from __future__ import annotations
 
+import operator
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
@@ -255,8 +256,17 @@ class BatchSolveResult(Columns):
         """Each member's :attr:`SolveResult.status`."""
         return tuple(Status.NAMES[int(c)] for c in self._status)
 
+    def _member(self, i) -> int:
+        """``i`` as a member's index from 0 (a negative one counts from the end)."""
+        n = len(self.x)
+        k = operator.index(i)
+        if not -n <= k < n:
+            raise IndexError(f"member {k} of a batch of {n} solves")
+        return k % n
+
     def trajectory(self, i: int) -> Trajectory:
         """The trajectory of member ``i`` (requires ``record=True``)."""
+        i = self._member(i)
         # The three recordings are set together (all or none).
         if self._rec_member is None or self._rec_theta is None or self._rec_x is None:
             raise InvalidInputError("trajectories were not recorded; solve with record=True")
@@ -281,6 +291,7 @@ class BatchSolveResult(Columns):
         return ys, None if h is None else np.asarray(h), err, bounds
 
     def __getitem__(self, i: int) -> SolveResult:
+        i = self._member(i)
         return SolveResult(
             x=self.x[i],
             y=self.y[i],

@@ -138,6 +138,22 @@ def test_batch_equals_individual_solves():
         assert tr.theta[0] == 0 and np.all(np.diff(tr.theta) > 0)
 
 
+def test_a_batch_member_counted_from_the_end_is_that_member_with_its_trajectory():
+    """batch[-1] is batch[n - 1], trajectory and all, as for a list; past the end, IndexError."""
+    kin = Manipulator2()
+    x0 = np.array([X0, [0.1, 0.2, 1.4], [0.3, 0.1, 1.2]])
+    batch = solve_batch(Pseudoinverse(kin), x0, [1, 1])
+    last, first = batch[-1], batch[-3]
+    np.testing.assert_array_equal(last.trajectory.x, batch[2].trajectory.x)
+    np.testing.assert_array_equal(batch.trajectory(-2).x, batch.trajectory(1).x)
+    np.testing.assert_array_equal(first.x0, x0[0])
+    assert len(last.trajectory.x) > 2 and [r.x0[0] for r in batch] == [0.0, 0.1, 0.3]
+    with pytest.raises(IndexError, match="member 3 of a batch of 3 solves"):
+        batch[3]
+    with pytest.raises(IndexError):
+        batch.trajectory(-4)
+
+
 def test_iteration_cap_gives_failure_with_message():
     res = solve(
         Pseudoinverse(Manipulator2()), X0, [1, 1], gamma=0.01, mode="discrete", max_iterations=3
