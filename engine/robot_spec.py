@@ -236,25 +236,30 @@ def _loop_joints(kin: Kinematics, x0: np.ndarray, step: np.ndarray) -> tuple[int
     return int(min(i, j)), int(max(i, j))
 
 
-def _defaults(kin: Kinematics, d: Mapping, box) -> tuple:
+def _defaults(kin: Kinematics, d: Mapping, box, base: RobotSpec | None = None) -> tuple:
     """x0 (given, else a URDF arm's home if given, else 0.5 in each range), a target and a
-    closed path reachable from it."""
+    closed path reachable from it; a built-in robot's (``base``) where its definition has none."""
     lo, hi = np.array(box).T
     if "x0" in d:
         x0 = _points(d["x0"], kin.p, "x0")
         if x0.ndim != 1:
             raise InvalidInputError(f"x0 must be one configuration of {kin.p} numbers", "x0")
+    elif base is not None:
+        x0 = np.array(base.default_x0, dtype=float)
     elif "home" in d:
         x0 = np.array(kin.parameters["home"], dtype=float)
     else:
         x0 = np.clip(0.5, lo, hi)
-    step = 0.15 * np.minimum(1.0, hi - lo)
-    i, j = _loop_joints(kin, x0, step)
-    moves = np.zeros((3, kin.p))
-    moves[0, i] = moves[1, i] = step[i]
-    moves[1, j] = moves[2, j] = step[j]
-    target = d.get("target", kin.forward(x0 + moves[1]))
-    path = d.get("path", kin.forward(x0 + moves))
+    if base is not None:
+        target, path = d.get("target", base.default_target), d.get("path", base.default_path)
+    else:
+        step = 0.15 * np.minimum(1.0, hi - lo)
+        i, j = _loop_joints(kin, x0, step)
+        moves = np.zeros((3, kin.p))
+        moves[0, i] = moves[1, i] = step[i]
+        moves[1, j] = moves[2, j] = step[j]
+        target = d.get("target", kin.forward(x0 + moves[1]))
+        path = d.get("path", kin.forward(x0 + moves))
     target, path = _points(target, kin.r, "target"), _points(path, kin.r, "path")
     if target.ndim != 1:
         raise InvalidInputError(f"target must be one task point ({kin.r} numbers)", "target")
@@ -272,7 +277,8 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
     ----------
     d : mapping
         ``{"name": kind, ...}`` with kind ``"planar_chain"``, ``"formula"``, ``"urdf"``, or a
-        built-in robot (``registry.ROBOTS``; its parameters under ``"parameters"``).
+        built-in robot (``registry.ROBOTS``; its parameters under ``"parameters"``; ``title``,
+        ``x_range``, ``x0``, ``target`` and ``path``, given, replace its defaults).
     base_dir : path, optional
         The folder of the robot file: only then may a URDF be given as ``urdf_file``.
 
@@ -306,6 +312,12 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
             raise
         extra, _, _ = augmentations_from_dict(kin, d.get("augmentations", []))
         spec = replace(base, augmentations=(*base.augmentations, *extra)) if extra else base
+        if {"title", "x_range", "x0", "target", "path"} & set(d):  # (else the built-in itself)
+            box = _x_range(kin, d) if "x_range" in d else base.x_range
+            x0, target, path = _defaults(kin, d, box, base)
+            title = _get(d, "title", str, "a string", base.title)
+            spec = replace(spec, title=title, x_range=box, default_x0=x0, default_target=target)
+            spec = replace(spec, default_path=path)
         return Robot(spec, kin, dict(d))
     if kind in ARMS:  # the catalogue's URDF, end link and home, with the definition's keys
         d = {**ARMS[kind].definition(), **{k: v for k, v in d.items() if k != "name"}}

@@ -152,6 +152,25 @@ def test_builtin_robots_by_name_with_parameters_and_extra_maps():
     assert load_robot("manipulator1").spec is ROBOTS["manipulator1"]
 
 
+def test_a_builtin_robots_defaults_given_in_its_definition_are_used_and_checked():
+    """x0, target, path, x_range and title of a built-in robot's definition replace the
+    built-in's (what `jik repeatability --robot file` runs without --x0 or --path); a bad one
+    is refused naming its field, not silently dropped; what is not given stays the built-in's."""
+    mine = {"x0": [0.1, 0.0, 1.5], "path": [[1, 1], [1, 1.5]], "title": "M2", "target": [1, 1]}
+    spec = robot_from_dict({"name": "manipulator2", **mine}).spec
+    assert (spec.default_x0, spec.default_path) == ((0.1, 0.0, 1.5), ((1.0, 1.0), (1.0, 1.5)))
+    assert (spec.title, spec.default_target) == ("M2", (1.0, 1.0))
+    assert spec.x_range == ROBOTS["manipulator2"].x_range
+    unicycle = robot_from_dict({"name": "unicycle", "x_range": [[-1, 1]] * 4}).spec
+    assert unicycle.x_range == ((-1.0, 1.0),) * 4
+    assert unicycle.default_x0 == ROBOTS["unicycle"].default_x0
+    assert unicycle.default_path == ROBOTS["unicycle"].default_path
+    for key, value in {"x0": [0, 0], "path": [[1, 1, 1]], "target": "abc", "title": 3}.items():
+        with pytest.raises(InvalidInputError) as err:
+            robot_from_dict({"name": "manipulator2", key: value})
+        assert err.value.field == key
+
+
 def test_more_than_one_degree_of_redundancy_takes_a_vector_of_formula_maps():
     chain = {
         "name": "planar_chain",
