@@ -28,7 +28,7 @@ from .posture_at_start import PostureAtStart
 from .practical_inverses import PostureInverse
 from .progress import Progress, check_cancelled, check_progress
 from .repeatability import repeatability
-from .validation import FloatArray, check_memory
+from .validation import FloatArray, check_memory, flag
 
 #: Starts per batched repeatability() call within a chunk: the working set of the Picard sweeps
 #: then stays in cache (``jik bench atlas``, docs/benchmarks.md: 512 is faster than 2048),
@@ -345,7 +345,7 @@ def run_atlas(
         gathered arrays would exceed :data:`jik.engine.validation.MEMORY_LIMIT`: stream such an
         atlas with :func:`iter_atlas`, or keep the drift alone.
     """
-    progress = check_progress(progress)
+    progress, keep_leg_ends = check_progress(progress), flag(keep_leg_ends, "keep_leg_ends")
     A, P, N = len(plan.inverses), len(plan.paths), plan.n_starts
     p = plan.inverses[0].kinematics.p
     leg_ends = A * plan.cycles * plan.legs * p if keep_leg_ends else 0

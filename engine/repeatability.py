@@ -30,7 +30,7 @@ from .solve_chunks import solve_in_chunks
 from .solve_rules import check_inverse, check_settings, run_bytes
 from .solver import solve, solve_batch
 from .unicycle import Unicycle
-from .validation import FloatArray, as_numbers, check_memory, count
+from .validation import FloatArray, as_numbers, check_memory, count, flag
 
 #: A run is called repeatable when its joints come back to x0 within this after every cycle
 #: (‖x − x0‖ in the joint coordinates' own units): the API's verdict and the dashboard's.
@@ -221,7 +221,7 @@ def repeatability(
         raise InvalidInputError(
             f"path has {path.shape[-2]} points; at most {MAX_PATH_POINTS} allowed", "path"
         )
-    cycles = count(cycles, "cycles", 1, MAX_CYCLES)
+    cycles, record = count(cycles, "cycles", 1, MAX_CYCLES), flag(record, "record")
     single = x0.ndim == 1
     xb = np.atleast_2d(x0)
     if xb.ndim != 2:
@@ -231,7 +231,7 @@ def repeatability(
             f"{len(path)} paths given for {len(xb)} start configurations", "path"
         )
     mode, gamma, tol, cap = check_settings(mode, gamma, tol, max_iterations)
-    L = path.shape[-2] + int(close)  # (at most: the return leg to k(x0) is added when needed)
+    L = path.shape[-2] + int(flag(close, "close"))  # (at most: k(x0) is added when needed)
     check_memory(
         len(xb),
         run_bytes(kin, cycles, L, mode, record and single, gamma, tol, cap),

@@ -32,7 +32,7 @@ from .solve_rules import (
     solve_bytes,
     stop_message,
 )
-from .validation import check_memory
+from .validation import check_memory, flag
 
 #: Picard sweeps per member in method "auto" before DOP853 takes over.
 PICARD_BUDGET = 80
@@ -295,6 +295,7 @@ def solve_batch(
                 "y_d",
             )
     mode, gamma, tol, cap = check_settings(mode, gamma, tol, max_iterations, method)
+    record = flag(record, "record")
     if guess is not None and mode != "continuous":
         raise InvalidInputError("guess applies to continuous mode only", "guess")
     check_memory(

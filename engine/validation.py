@@ -165,6 +165,14 @@ def count(value, name: str, low: int, high: int, field: str | None = None) -> in
     return v
 
 
+def flag(value, name: str) -> bool:
+    """``value``, True or False (numpy's too), as a bool; else an InvalidInputError naming
+    ``name`` (a text such as "no" is not read as True)."""
+    if isinstance(value, bool | np.bool_):
+        return bool(value)
+    raise InvalidInputError(f"{name} must be True or False, got {value!r:.40}", name)
+
+
 def check_memory(n: int, each: float, field: str, what: str, instead: str) -> None:
     """Refuse a call of ``n`` items of ``each`` bytes (its estimated peak memory) when they
     exceed :data:`MEMORY_LIMIT`.

@@ -99,6 +99,13 @@ REFUSALS = {
         lambda: jik.repeatability(P, jik.Resume(np.array(X0), np.full((4, 3), np.nan)), PATH),
         "x0",
     ),
+    "repeatability close a text": (lambda: jik.repeatability(P, X0, PATH, close="no"), "close"),
+    "repeatability record a text": (lambda: jik.repeatability(P, X0, PATH, record="no"), "record"),
+    "solve record a text": (lambda: jik.solve(P, X0, [1, 1], record="no"), "record"),
+    "run_atlas keep_leg_ends a text": (
+        lambda: jik.run_atlas(jik.plan_atlas(P, LOOP, starts=[X0]), keep_leg_ends="no"),
+        "keep_leg_ends",
+    ),
     "Manipulator2 l": (lambda: jik.Manipulator2(l=-1), "l"),
     "forward wrong width": (lambda: ARM.forward(np.zeros(5)), "x"),
     "jacobian NaN": (lambda: ARM.jacobian(np.array([np.nan, 0, 0])), "x"),
