@@ -83,15 +83,12 @@ class SynthesisResult(Columns):
     region, fixed : dict
         The box and the values of the variables not integrated over.
     degree : int
-        Basis degree per variable.
+        The basis degree (the largest; each variable's: the map's ``parameters``).
     nodes : int
         Gauss-Legendre nodes per variable of the rule E2 was minimised on, ``degree +``
-        :data:`EXTRA_NODES`: enough for the map's degree (n nodes integrate a polynomial of
-        degree 2 n - 1 exactly; dh P dh^T m, eq. (19), is of degree up to 2 ``degree`` per
-        variable in dh times the smooth m P), so E2 evaluated on it,
-        :func:`~jik.engine.functionals.error_functional_e2` with ``nodes``, is :attr:`e2` (to
-        rounding); 8 nodes, the REST API's default, leave Manipulator 2's degree-16 map's
-        E2 3e-5 off.
+        :data:`EXTRA_NODES` (n nodes integrate degree 2 n - 1 exactly; dh P dh^T m, eq. (19), is
+        of degree 2 ``degree`` in dh times the smooth m P): E2 on it (``error_functional_e2``
+        with ``nodes``) is :attr:`e2`; 8 nodes leave Manipulator 2's degree-16 map's 3e-5 off.
     """
 
     augmenting_map: SynthesizedMap
@@ -110,7 +107,10 @@ class SynthesisResult(Columns):
 
     def __repr__(self) -> str:
         box = ", ".join(f"{k} in [{lo:.4g}, {hi:.4g}]" for k, (lo, hi) in self.region.items())
-        return f"SynthesisResult(E2 = {self.e2:.6g}, degree {self.degree}, {box})"
+        own = {k[len("degree_") :]: n for k, n in self.augmenting_map.parameters.items()}
+        each = ", ".join(f"{k} {n}" for k, n in own.items())
+        degree = f"degree {self.degree}" if len(set(own.values())) < 2 else f"degrees {each}"
+        return f"SynthesisResult(E2 = {self.e2:.6g}, {degree}, {box})"
 
     def columns(self) -> dict[str, FloatArray]:
         """A row per resolution computed (:attr:`convergence`), the last the result:

@@ -156,3 +156,14 @@ def test_progress_cancel_and_bad_input():
         synthesize_e2(Manipulator1(), M1_BOX, degree=4, dirichlet=lambda x: np.zeros(3))
     with pytest.raises(InvalidInputError, match="one axis each"):
         SynthesizedMap(np.zeros((3, 3)), {"x2": (0, 1)}, (1,), 3)
+
+
+def test_a_map_of_two_degrees_prints_each():
+    """degree=[4, 8]: the result says each variable's degree, as its map does, not 8 alone."""
+    box = {"x2": (-1.0, 1.0), "x3": (0.5, 2.0)}
+    mixed = synthesize_e2(Manipulator2(), box, degree=[4, 8])
+    assert repr(mixed).startswith("SynthesisResult(E2 = 0.443072, degrees x2 4, x3 8, x2 in [-1")
+    assert mixed.augmenting_map.parameters == {"degree_x2": 4, "degree_x3": 8}
+    assert repr(synthesize_e2(Manipulator2(), box, degree=4)).startswith(
+        "SynthesisResult(E2 = 0.443087, degree 4, x2 in [-1, 1]"
+    )
