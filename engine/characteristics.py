@@ -76,12 +76,21 @@ class CharacteristicsMap(AugmentingMap):
         on_undefined: str = "raise",
     ) -> None:
         self.kinematics = kinematics = require_kinematics(kinematics)
+        if not (hasattr(kinematics, "derivatives") or hasattr(kinematics, "hessian")):
+            raise InvalidInputError(
+                f"{kinematics.name} has no second derivatives (hessian()), which the one-form's "
+                "d omega needs: a planar chain, a formula robot (the paper's manipulators as "
+                "formulas too) and the unicycle have them",
+                "kinematics",
+            )
         self.p = kinematics.p
         self.fixed_index = check_index(kinematics, fixed_index)
         self.homotopy = LinearHomotopy(as_vector(reference, self.p, "reference"), fixed_index)
         self.nodes = count(nodes, "collocation nodes", 4, 200, "nodes")
         if on_undefined not in ("raise", "nan"):
-            raise InvalidInputError(f"on_undefined must be 'raise' or 'nan', got {on_undefined!r}")
+            raise InvalidInputError(
+                f"on_undefined must be 'raise' or 'nan', got {on_undefined!r}", "on_undefined"
+            )
         self.on_undefined = on_undefined
         self._cache: tuple | None = None
         #: Where the last characteristic() failed first: (Phi_s or None, s or None, x), or None.
@@ -290,7 +299,8 @@ class UnicycleCharacteristics(CharacteristicsMap):
         if self.a == 0:
             raise InvalidInputError(
                 "a must be nonzero: omega is undefined on lambda10 = 0, so the reference "
-                "leaf E_{a,0} = a e1 + R e2 needs a != 0"
+                "leaf E_{a,0} = a e1 + R e2 needs a != 0",
+                "a",
             )
         kinematics = Unicycle() if kinematics is None else kinematics
         super().__init__(kinematics, (self.a, 0.0, 0.0, 0.0), 1, nodes, on_undefined)

@@ -248,6 +248,15 @@ REFUSALS = {
         lambda: jik.CharacteristicsMap("unicycle", [0, 0, 0, 0], 0),
         "kinematics",
     ),
+    "CharacteristicsMap without second derivatives": (
+        lambda: jik.CharacteristicsMap(ARM, X0, 0),
+        "kinematics",
+    ),
+    "UnicycleCharacteristics a 0": (lambda: jik.UnicycleCharacteristics(a=0), "a"),
+    "UnicycleCharacteristics on_undefined": (
+        lambda: jik.UnicycleCharacteristics(on_undefined="skip"),
+        "on_undefined",
+    ),
     "robot_units robot by name": (lambda: jik.robot_units("panda"), "kinematics"),
     "repeatable drift text": (lambda: jik.repeatable("abc"), "drift"),
     "repeatability progress a function": (
