@@ -107,7 +107,9 @@ class E1Optimal(AugmentingMap):
         self.C1 = finite(C1, "C1")
         self.C2 = finite(C2, "C2")
         if self.C1 == 0:
-            raise InvalidInputError("C1 must be nonzero: with C1 = 0, h = 0 and dh = 0 everywhere")
+            raise InvalidInputError(
+                "C1 must be nonzero: with C1 = 0, h = 0 and dh = 0 everywhere", "C1"
+            )
 
     @property
     def parameters(self) -> dict[str, float]:
@@ -143,7 +145,7 @@ class E2Optimal(AugmentingMap):
         self.a = finite(a, "a")
         self.b = finite(b, "b")
         if self.a == 0 and self.b == 0:
-            raise InvalidInputError("a and b must not both be 0: h would vanish identically")
+            raise InvalidInputError("a and b must not both be 0: h would vanish identically", "a")
 
     @property
     def parameters(self) -> dict[str, float]:

@@ -352,7 +352,9 @@ def parameter_sensitivity(
         "sweeps": {name: {"values": [...], "functional": [...]}}}``.
     """
     if functional not in ("e1", "e2"):
-        raise InvalidInputError(f"functional must be 'e1' or 'e2', got {functional!r}")
+        raise InvalidInputError(
+            f"functional must be 'e1' or 'e2', got {functional!r}", "functional"
+        )
     samples = count(samples, "samples", 2, 201)
     span = finite(span, "span")
     evaluate = error_functional_e1 if functional == "e1" else error_functional_e2

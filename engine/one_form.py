@@ -115,7 +115,11 @@ def one_form_parts(J, H, fixed_index):
 def check_index(kinematics: Kinematics, fixed_index) -> int:
     """``fixed_index`` checked for ``kinematics``, which must have one degree of redundancy."""
     if kinematics.p - kinematics.r != 1:
-        raise InvalidInputError("characteristics synthesis here needs one degree of redundancy")
+        raise InvalidInputError(
+            "characteristics synthesis here needs one degree of redundancy (p - r = 1); "
+            f"{kinematics.name} has p - r = {kinematics.p - kinematics.r}",
+            "kinematics",
+        )
     return count(fixed_index, "fixed_index", 0, kinematics.p - 1)
 
 

@@ -152,7 +152,8 @@ class RobotSpec:
                 return a
         raise InvalidInputError(
             f"unknown augmentation {name!r} for {self.name}; "
-            f"choose one of {[a.name for a in self.augmentations]}"
+            f"choose one of {[a.name for a in self.augmentations]}",
+            "augmentation",
         )
 
     def as_dict(self) -> dict:
@@ -343,4 +344,6 @@ def robot_spec(name: str) -> RobotSpec:
     try:
         return ROBOTS[name]
     except KeyError:
-        raise InvalidInputError(f"unknown robot {name!r}; choose one of {sorted(ROBOTS)}") from None
+        raise InvalidInputError(
+            f"unknown robot {name!r}; choose one of {sorted(ROBOTS)}", "robot"
+        ) from None

@@ -233,7 +233,7 @@ def _solve(
             x[:, v] = 0.5 * (lo[k] + hi[k]) + tb[:, k] / problem.scale[k]
         g = np.asarray(dirichlet(x), dtype=float).reshape(-1)
         if g.shape[0] != x.shape[0] or not np.all(np.isfinite(g)):
-            raise InvalidInputError("dirichlet(x) must return one finite value per point of x")
+            raise InvalidInputError("dirichlet must give one finite value per point", "dirichlet")
         nc = C.shape[0]
         KKT = np.block([[A, C.T], [C, np.zeros((nc, nc))]])
         c = linalg.solve(KKT, np.concatenate([b, g]), assume_a="sym")[: A.shape[0]]

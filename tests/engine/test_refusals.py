@@ -257,6 +257,20 @@ REFUSALS = {
         lambda: jik.UnicycleCharacteristics(on_undefined="skip"),
         "on_undefined",
     ),
+    "Robot.inverse unknown augmentation": (
+        lambda: jik.load_robot("manipulator2").inverse("extended", "nope"),
+        "augmentation",
+    ),
+    "E1Optimal C1 0": (lambda: jik.E1Optimal(C1=0), "C1"),
+    "E2Optimal a and b 0": (lambda: jik.E2Optimal(0, 0), "a"),
+    "CharacteristicsMap two degrees of redundancy": (
+        lambda: jik.CharacteristicsMap(jik.PlanarChain("RRRR", [1] * 4), [0] * 4, 0),
+        "kinematics",
+    ),
+    "synthesize_e2 dirichlet of wrong length": (
+        lambda: jik.synthesize_e2(ARM, BOX, degree=2, dirichlet=lambda x: np.zeros(2)),
+        "dirichlet",
+    ),
     "robot_units robot by name": (lambda: jik.robot_units("panda"), "kinematics"),
     "repeatable drift text": (lambda: jik.repeatable("abc"), "drift"),
     "repeatability progress a function": (
