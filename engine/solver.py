@@ -221,7 +221,7 @@ def solve(
             f"{y_d.shape}; solve_batch solves a batch",
             "x0" if x0.ndim != 1 else "y_d",
         )
-    picard_guesses(guess, 1, kin.p, 1.0, single=True)  # (its refusals name "guess")
+    picard_guesses(guess, 1, kin.p, 1.0, True)  # (single: its refusals name "guess")
     batch = solve_batch(
         inverse,
         x0[None],
