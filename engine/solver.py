@@ -50,7 +50,7 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto", guess=N
         method = "dop853"  # the homotopy form needs e = e0 exp(-tau), which J J# != I breaks
     e0 = inverse.kinematics.forward_unchecked(x0) - y_d
     err0 = np.linalg.norm(e0, axis=-1)
-    moving = np.flatnonzero(err0 >= tol)
+    moving = np.flatnonzero(~(err0 < tol))  # (a NaN error, k undefined at x0, is not arrived)
     # A singular start raises. Picard's first sweep evaluates J# at every moving start: only
     # the members already at their target (and every start for DOP853 alone) are checked here.
     _check_start(inverse, x0, e0, slice(None) if method == "dop853" else err0 < tol)

@@ -524,3 +524,17 @@ def test_discrete_chunks_raise_at_a_singular_start_and_let_between_raise():
         args = {"x0": X0, "chunk": 5} | kwargs
         with pytest.raises(InvalidInputError, match=match):
             solve_in_chunks(Pseudoinverse(Manipulator2()), args.pop("x0"), [1, 1], **args)
+
+
+def test_a_start_where_k_is_undefined_is_refused_not_already_at_the_target():
+    """sqrt(a) at a = -1 is NaN: the task error is NaN, which is not below tol, so the start
+    is refused as the discrete mode refuses it, not reported converged with no motion."""
+    from jik.engine.exceptions import KinematicSingularityError
+    from jik.engine.formula_kinematics import FormulaKinematics
+
+    kin = FormulaKinematics(["a", "b", "c"], ["sqrt(a) + b", "c"])
+    for mode in ("continuous", "discrete"):
+        with pytest.raises(KinematicSingularityError, match=r"at x = \(-1, 0.5, 1\)"):
+            solve(Pseudoinverse(kin), [-1.0, 0.5, 1.0], [2.0, 1.0], mode=mode, gamma=0.5)
+    with pytest.raises(KinematicSingularityError):
+        solve_batch(Pseudoinverse(kin), [[0.5, 0.5, 0.5], [-1.0, 0.5, 1.0]], [2.0, 1.0])
