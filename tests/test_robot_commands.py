@@ -75,6 +75,20 @@ def test_json_outputs_are_the_engine_results_dicts(capsys):
     np.testing.assert_allclose(printed["cycle_end"], engine["cycle_end"], rtol=0, atol=1e-12)
 
 
+def test_a_failed_runs_json_is_json_with_null_for_its_missing_numbers(capsys):
+    """A leg that fails leaves NaN in the engine's legs and drift; the printed JSON has null
+    there (JSON has no NaN: a strict parser, as jq or a browser's, refuses it), as jik atlas's."""
+
+    def refuse(constant):
+        raise ValueError(f"not JSON: {constant}")
+
+    argv = ["--robot", "manipulator2", "--x0", "0.2398, -0.6496, 0.8637", "--algorithm"]
+    out, _ = run(capsys, "repeatability", *argv, "extended", "--json", code=1)
+    printed = json.loads(out, parse_constant=refuse)
+    assert printed["success"] is False and printed["drift"] == [None]
+    assert printed["legs"][0] == [None, None, None] and printed["x0"][0] == 0.2398
+
+
 def test_repeatability_of_the_synthesized_map_from_a_file(capsys, arm_file):
     path = "1,1.3; 1,1.7; 0.6,1.7"
     out, _ = run(
