@@ -113,6 +113,11 @@ class Kinematics(abc.ABC):
     def jacobian(self, x: FloatArray) -> FloatArray:
         """J(x) = dk/dx: (..., p) -> (..., r, p)."""
 
+    def forward_jacobian(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """k(x) and J(x) of eq. (4) together; a subclass that has both from one pass (a serial
+        chain's) implements its own."""
+        return self.forward(x), self.jacobian(x)
+
     def forward_unchecked(self, x: FloatArray) -> FloatArray:
         """:meth:`forward` without the check of ``x`` (a float array (..., p))."""
         return self.forward(x)  # (replaced by each subclass's own forward)

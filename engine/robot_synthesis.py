@@ -13,7 +13,8 @@ import contextlib
 import contextvars
 import functools
 import json
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Collection, Iterator, Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -22,6 +23,9 @@ from .kinematics import Kinematics
 from .progress import Progress
 from .synthesis_nd import synthesize_e2_nd
 from .variational import synthesize_e2
+
+if TYPE_CHECKING:
+    from .registry import RobotSpec
 
 
 def synthesis(box: dict, fix: dict, degree: int, key: str | None) -> Callable[..., AugmentingMap]:
@@ -99,6 +103,30 @@ TENSOR_DEGREE = 12
 MAX_TENSOR_DEGREE, MAX_TOTAL_DEGREE = 24, 6
 #: Half-width [rad] of a catalogue arm's default synthesis box around its home.
 ARM_BOX = 0.3
+
+
+def default_box(
+    spec: RobotSpec, size: int, fixed: Collection[str] = ()
+) -> dict[str, tuple[float, float]]:
+    """The box of a synthesis given none: the robot's design region (``functional_region``,
+    the box of sec. 5 over which E1, eq. (13), and E2, eq. (18), are compared) when it has
+    ``size`` variables, none of them ``fixed``; else the last ``size`` variables not ``fixed``,
+    each over a tenth of its ``x_range`` either side of the default start, within the range.
+
+    The variables outside the box are meant to be held at the default start, where the robot's
+    maps are defined (not at 0).
+    """
+    design = dict(spec.functional_region)
+    if len(design) == size and not set(design) & set(fixed):
+        return {n: (float(lo), float(hi)) for n, (lo, hi) in design.items()}
+    names = list(spec.variable_names)
+    box = {}
+    for n in [n for n in names if n not in fixed][-size:]:
+        i = names.index(n)
+        lo, hi = spec.x_range[i]
+        c, w = spec.default_x0[i], 0.1 * (hi - lo)
+        box[n] = (max(lo, c - w), min(hi, c + w))
+    return box
 
 
 def default_degree(variables: int, k: int) -> int:

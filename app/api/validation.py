@@ -5,6 +5,7 @@ wrong length says how many components the request's robot needs and why."""
 from __future__ import annotations
 
 from ...engine.registry import ROBOTS
+from ..compute.robot_requests import length_problem
 from ..compute.schemas import (
     AUGMENTATION_MODELS,
     ROBOT_MODELS,
@@ -21,17 +22,11 @@ _TYPE_LABELS = {"str", "float", "int", "bool", "constrained-float", "constrained
 
 
 def _field(loc) -> str:
-    """Field path of a pydantic location: ``("body", "robot", "manipulator2", "l")`` -> ``robot.l``.
+    """Field path of a location (:func:`_location`'s): ``["body", "robot", "l"]`` -> ``robot.l``.
 
-    Indices become ``x0[2]``; the discriminator tag of a union member (a request's robot, a
-    robot's or a map's name) is dropped.
+    Indices become ``x0[2]``; the discriminator tag of a robot's or a map's name is dropped.
     """
-    # (a member of a plain union is labelled by its type: "str", "tuple[float, ...]")
-    parts = [
-        str(p) for p in loc if p != "body" and str(p) not in _TYPE_LABELS and "[" not in str(p)
-    ]
-    if len(parts) > 1 and parts[0] in _VARIANTS:
-        del parts[0]
+    parts = [str(p) for p in loc if p != "body"]
     if len(parts) > 2 and parts[0] in ("robot", "augmentation") and parts[1] in _TAGS:
         del parts[1]
     return field_text(".".join(parts)) or "body"
@@ -72,13 +67,12 @@ def validation_detail(errors) -> list[dict]:
             body = e.get("input")
             robot = body.get("robot") if isinstance(body, dict) else None
             name = robot.get("name") if isinstance(robot, dict) else None
-            names = (e.get("ctx") or {}).get("names", ROBOT_NAMES)  # (the route's robots)
             if isinstance(body, dict) and "robot" not in body:
                 msg = "Field required"
             elif name is None:
-                msg = f"give the robot, with a name among {names}"
+                msg = f"give the robot, with a name among {ROBOT_NAMES}"
             else:
-                msg = f"unknown name {name!r}; choose one of {names}"
+                msg = f"unknown name {name!r}; choose one of {ROBOT_NAMES}"
         elif e.get("type") in ("too_short", "too_long"):
             msg = _length_message(e.get("loc", ()), e.get("ctx") or {}) or msg
         detail.append({"loc": loc, "msg": f"{_field(loc)}: {msg}", "type": str(e.get("type"))})
@@ -99,5 +93,5 @@ def _length_message(loc, ctx: dict) -> str | None:
         return None
     if parts[2] in ("path", "shifts") and len(parts) < 4:
         return None  # (the list of points itself)
-    n, what = (spec.p, "p") if parts[2] in _CONFIGURATIONS else (len(spec.task_names), "r")
-    return f"must have {n} components ({what} of {spec.name}), got {ctx.get('actual_length')}"
+    what = "p" if parts[2] in _CONFIGURATIONS else "r"
+    return length_problem(spec, what, ctx.get("actual_length", -1))

@@ -51,8 +51,11 @@ Status = Literal["queued", "running", "done", "failed", "cancelled"]
 class AtlasJob:
     id: str
     client: str
+    #: The request it was started from (the dashboard draws the result with it).
+    request: AtlasRequest
     plan: AtlasPlan
-    leg_ends: bool
+    #: The robot and the map the plan used (:func:`~jik.app.compute.atlas_plan.planned`).
+    used: Used
     status: Status = "queued"
     runs_done: int = 0
     started: float = field(default_factory=time.monotonic)
@@ -65,20 +68,16 @@ class AtlasJob:
     #: The dashboard session that started it (None: a REST client): only that session's
     #: routes give its table.
     session: str | None = None
-    #: The request it was started from (the dashboard draws the result with it).
-    request: AtlasRequest | None = None
-    #: The robot and the map the plan used (:func:`~jik.app.compute.atlas_plan.planned`).
-    used: Used | None = None
     #: Whether it holds one of the ``max_running`` slots (given back once, at its end or its
     #: cancel, whichever comes first).
     holds_slot: bool = False
 
-    def response(self, ahead: int | None = None, running: int = 1) -> AtlasJobResponse:
+    def response(self, ahead: int, running: int) -> AtlasJobResponse:
         """The job's state; ``ahead``: the jobs before it in the queue, of which ``running``
         are computing (:meth:`AtlasJobs.response` counts them)."""
         end = self.ended if self.ended is not None else time.monotonic()
         message: str = "computing" if self.status == "running" else self.status
-        if self.status == "queued" and ahead is not None:
+        if self.status == "queued":
             message = (
                 f"queued behind {ahead} atlas job{'s' * (ahead != 1)} ({running} computing, "
                 f"the rest waiting); it starts when they end"
@@ -94,8 +93,8 @@ class AtlasJob:
             elapsed_s=end - self.started,
             queue_position=ahead if self.status == "queued" else None,
             message=message,
-            robot=self.used[0] if self.used else None,
-            augmentation=self.used[1] if self.used else None,
+            robot=self.used[0],
+            augmentation=self.used[1],
             error=self.error,
             result=self.result,  # type: ignore[arg-type]  # (validated)
         )
@@ -137,16 +136,7 @@ class AtlasJobs:
         (:func:`~jik.app.compute.atlas_plan.planned`); raises before anything is kept when
         there is no room; ``session``: the dashboard session that asks for it."""
         self.check_room(client)
-        atlas, used = plan
-        job = AtlasJob(
-            self.run + secrets.token_urlsafe(12),
-            client,
-            atlas,
-            req.leg_ends,
-            session=session,
-            request=req,
-            used=used,
-        )
+        job = AtlasJob(self.run + secrets.token_urlsafe(12), client, req, *plan, session=session)
         with self._lock:
             self._room(client)
             self._jobs[job.id] = job
@@ -261,11 +251,11 @@ class AtlasJobs:
                 job.plan,
                 backend,
                 progress=ProgressCallbacks(on_advance=progress, is_cancelled=job.cancel.is_set),
-                keep_leg_ends=job.leg_ends,
+                keep_leg_ends=job.request.leg_ends,
             )
             curve = job.plan.manifolds[0] if job.plan.manifolds else None  # (explicit starts)
             arc, period = ((), None) if curve is None else (curve.arc, curve.period)
-            job.atlas, job.result = res, result_document(res, arc, job.leg_ends, period)
+            job.atlas, job.result = res, result_document(res, arc, job.request.leg_ends, period)
             self._end(job, "done")
         except RunCancelled:
             self._end(job, "cancelled")

@@ -22,7 +22,7 @@ from .atlas_pool import CHUNK_SECONDS
 from .atlas_schemas import AtlasRequest
 from .documents import nullable
 from .exceptions import RequestError
-from .robot_requests import check_task_point, gamma_and_mode, request_robot
+from .robot_requests import check_length, gamma_and_mode, request_robot
 from .schemas.wording import without_field
 from .worker import task
 
@@ -61,12 +61,10 @@ def planned(req: AtlasRequest, limits: AtlasLimits) -> tuple[AtlasPlan, Used]:
     named = [(f"path[{i}]", v) for i, v in enumerate(path)]
     named += [(f"shifts[{i}]", v) for i, v in enumerate(req.shifts or [])]
     for name, v in named:
-        check_task_point(spec, v, name)
-    for i, x in enumerate(req.start_points or []):
-        if len(x) != spec.p:
-            raise RequestError(f"start_points[{i}]", f"must have {spec.p} components, got {len(x)}")
-    if req.reference and len(req.reference) != spec.p:
-        raise RequestError("reference", f"must have {spec.p} components, got {len(req.reference)}")
+        check_length(spec, v, name)
+    named = [(f"start_points[{i}]", v) for i, v in enumerate(req.start_points or [])]
+    for name, x in [*named, ("reference", req.reference or spec.default_x0)]:  # (its default)
+        check_length(spec, x, name, "p")
     gamma, mode = gamma_and_mode(spec, req)
     paths = len(req.shifts or [0]) * len(req.scales or [0])
     starts = len(req.start_points) if req.start_points else req.starts

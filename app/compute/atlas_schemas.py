@@ -30,6 +30,7 @@ from .schemas import (
     per_robot,
 )
 from .schemas.algorithms import AlgorithmParameters
+from .schemas.fields import Seed, coordinates, points
 from .schemas.variants import narrowed
 
 #: Largest starts per path, cycles, and paths of a family (shifts, scales) in one request.
@@ -85,7 +86,7 @@ class AtlasRequest(BaseModel):
     sampling: Literal["grid", "sample"] = Field(
         "grid", description="arc lengths on a grid (ends included) or sampled uniformly"
     )
-    seed: Annotated[int, Field(strict=True, ge=0, le=2**31 - 1), INTEGRAL] = 0
+    seed: Seed = 0
     arc: tuple[Coordinate, Coordinate] | None = Field(
         None,
         description="(lo, hi), lo <= 0 <= hi: arc lengths of the starts; default: the part "
@@ -113,12 +114,10 @@ class AtlasRequest(BaseModel):
 
 
 def _atlas_fields(spec, augmentation) -> dict:
-    r, p = len(spec.task_names), spec.p
-    point = Annotated[list[Coordinate], Field(min_length=r, max_length=r)]
     return {
         "augmentation": narrowed(AtlasRequest, "augmentation", augmentation | None),
         "path": (
-            Annotated[list[point], Field(min_length=2, max_length=MAX_PATH_POINTS)] | None,
+            points(spec.r, 2, MAX_PATH_POINTS) | None,
             Field(
                 None,
                 description=f"task points {list(spec.task_names)}, a loop from the "
@@ -126,16 +125,8 @@ def _atlas_fields(spec, augmentation) -> dict:
                 "path)",
             ),
         ),
-        "reference": narrowed(
-            AtlasRequest,
-            "reference",
-            Annotated[list[Coordinate], Field(min_length=p, max_length=p)] | None,
-        ),
-        "shifts": narrowed(
-            AtlasRequest,
-            "shifts",
-            Annotated[list[point], Field(min_length=1, max_length=MAX_FAMILY)] | None,
-        ),
+        "reference": narrowed(AtlasRequest, "reference", coordinates(spec.p) | None),
+        "shifts": narrowed(AtlasRequest, "shifts", points(spec.r, 1, MAX_FAMILY) | None),
     }
 
 

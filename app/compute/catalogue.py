@@ -9,7 +9,6 @@ from ...engine.registry import ALGORITHMS, ROBOTS
 from ...engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
 from ...engine.robot_spec import Robot, robot_from_dict
 from . import schemas as S
-from .settings import settings
 
 
 @functools.cache
@@ -19,10 +18,11 @@ def _robots() -> tuple[Robot, ...]:
     return tuple(robot_from_dict({"name": name}) for name in (*ROBOTS, *ARMS))
 
 
-def robots_response(timeout: float | None = None) -> S.RobotsResponse:
+def robots_response(timeout: float) -> S.RobotsResponse:
     """The catalogue: every robot with p, r, parameters, defaults, augmentations, its variables
     and task coordinates with their units (:mod:`jik.engine.units`), then the catalogue arms
-    (``{"name": "panda"}``; ``task`` and ``reference`` change their r)."""
+    (``{"name": "panda"}``; ``task`` and ``reference`` change their r); ``timeout``: the
+    server's time limit of a request [s]."""
     robots = [
         S.RobotInfo(
             **robot.spec.as_dict(),
@@ -37,7 +37,7 @@ def robots_response(timeout: float | None = None) -> S.RobotsResponse:
         max_path_points=MAX_PATH_POINTS,
         max_iterations=S.MAX_ITERATIONS,
         max_trajectory_points=S.MAX_TRAJECTORY_POINTS,
-        request_timeout_s=float(timeout if timeout is not None else settings().timeout),
+        request_timeout_s=float(timeout),
     )
     algorithms = [S.AlgorithmInfo(**a.as_dict()) for a in ALGORITHMS.values()]
     return S.RobotsResponse(robots=robots, limits=limits, algorithms=algorithms)

@@ -47,27 +47,25 @@ def trajectory_document(traj) -> dict[str, Any]:
     }
 
 
-def solve_document(setup, res) -> dict[str, Any]:
-    """One solve's response as JSON-ready data (the fields of ``S.SolveResponse``)."""
-    return {
-        "robot": setup.robot.model_dump(mode="json"),
-        "algorithm": setup.inverse.name,
-        "algorithm_parameters": setup.parameters,
-        "augmentation": (
-            None if setup.augmentation is None else setup.augmentation.model_dump(mode="json")
-        ),
-        "mode": setup.mode,
-        "gamma": float(setup.gamma),
-        "tolerance": float(setup.tolerance),
-        "x": nullable(res.x),
-        "y": nullable(res.y),
-        "error": nullable(res.error),
-        "converged": bool(res.success),
-        "message": str(res.message),
-        "iterations": int(res.nit),
-        "trajectory": trajectory_document(res.trajectory),
-        **limits_document(setup.kinematics, res),
-    }
+def solve_response_json(setup, res) -> bytes:
+    """One solve's response (``S.SolveResponse``) as JSON, built without validating the model
+    (the workers' hot path: validation costs about as much as a small solve).
+    ``tests/app/test_solve.py`` checks that the model reads it back as the same document."""
+    return pydantic_core.to_json(
+        {
+            **setup.head,
+            "tolerance": float(setup.run["tol"]),
+            "x": nullable(res.x),
+            "y": nullable(res.y),
+            "error": nullable(res.error),
+            "converged": bool(res.success),
+            "message": str(res.message),
+            "status": res.status,
+            "iterations": int(res.nit),
+            "trajectory": trajectory_document(res.trajectory),
+            **limits_document(setup.kinematics, res),
+        }
+    )
 
 
 def limits_document(kinematics, result) -> dict[str, Any]:
@@ -75,14 +73,3 @@ def limits_document(kinematics, result) -> dict[str, Any]:
     robot has none."""
     report = run_report(kinematics, result)
     return {} if report is None else {"limits": report.as_dict()}
-
-
-def solve_response(setup, res) -> S.SolveResponse:
-    return S.SolveResponse.model_validate(solve_document(setup, res))
-
-
-def solve_response_json(setup, res) -> bytes:
-    """The JSON of :func:`solve_response` without validating the model (the workers' hot
-    path: validation costs about as much as a small solve). ``tests/app/test_solve.py`` checks
-    that both give the same document."""
-    return pydantic_core.to_json(solve_document(setup, res))

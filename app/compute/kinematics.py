@@ -17,18 +17,15 @@ from ...engine.arms import ARMS
 from ...engine.registry import ROBOTS
 from . import schemas as S
 from .documents import nullable
-from .exceptions import RequestError
-from .robot_requests import request_robot
+from .robot_requests import check_length, request_robot
 from .schemas.examples import schema_examples
-from .schemas.fields import one_or_many
+from .schemas.fields import coordinates, one_or_many
 from .schemas.robots import _camel
 from .schemas.variants import robot_union
 from .worker import task
 
 #: Most configurations one request evaluates.
 MAX_CONFIGURATIONS = 1000
-
-Configuration = Annotated[list[S.Coordinate], Field(min_length=1, max_length=S.MAX_DIMENSION)]
 
 
 def _many(one: Any) -> Any:
@@ -43,7 +40,7 @@ class KinematicsRequest(BaseModel):
     robot: S.AnyRobot = Field(
         description="the robot, as for /solve: e.g. {'name': 'panda', 'task': 'pose'}"
     )
-    x: one_or_many(Configuration, _many(Configuration)) = Field(  # type: ignore[valid-type]
+    x: one_or_many(S.Vector, _many(S.Vector)) = Field(  # type: ignore[valid-type]
         description=f"one configuration (p numbers) or a list of 1 to {MAX_CONFIGURATIONS}"
     )
 
@@ -51,7 +48,7 @@ class KinematicsRequest(BaseModel):
 def _points(p: int | None) -> Any:
     """x: one configuration of p numbers (1 to 16 when p is known only once the robot is
     built), or a list of them."""
-    one = Annotated[list[S.Coordinate], Field(min_length=p or 1, max_length=p or S.MAX_DIMENSION)]
+    one = coordinates(p) if p else S.Vector
     return (
         one_or_many(one, _many(one)),
         Field(
@@ -107,16 +104,9 @@ def kinematics_request(req: KinematicsRequest) -> KinematicsResponse:
     spec, kin = robot.spec, robot.kinematics
     many = isinstance(req.x[0], list)
     for i, row in enumerate(req.x if many else [req.x]):
-        if len(row) != spec.p:
-            raise RequestError(
-                f"x[{i}]" if many else "x",
-                f"must have {spec.p} components "
-                f"(p of {spec.title}: {list(spec.variable_names)}), got "
-                f"{len(row)}",
-            )
+        check_length(spec, row, f"x[{i}]" if many else "x", "p")
     x = np.asarray(req.x, dtype=float)
-    forward_jacobian = getattr(kin, "forward_jacobian", None)
-    k, J = forward_jacobian(x) if forward_jacobian else (kin.forward(x), kin.jacobian(x))
+    k, J = kin.forward_jacobian(x)
     return KinematicsResponse(
         robot=robot.robot,
         variable_names=list(spec.variable_names),

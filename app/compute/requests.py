@@ -1,6 +1,6 @@
 """Requests to engine calls: solve, its batches, and repeatability.
 
-Plain synchronous functions (``solve_batch``, ``repeatability_request``) turn
+Plain synchronous functions (``solve_batch_json``, ``repeatability_request``) turn
 a request model into engine calls and the result into a response model. They raise
 :class:`RequestError` naming the offending field. The robot, map and inverse a request names are
 built by :func:`jik.app.compute.robot_requests.request_robot` (catalogue robots, definitions,
@@ -10,9 +10,8 @@ catalogue arms alike); results become JSON by :mod:`jik.app.compute.documents`.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, TypeVar, cast
+from typing import Any, cast
 
 import numpy as np
 
@@ -23,35 +22,25 @@ from ...engine.repeatability import repeatability, repeatable
 from ...engine.solve_rules import refused_starts
 from ...engine.solver import solve_batch as engine_solve_batch
 from . import schemas as S
-from .documents import (
-    limits_document,
-    nullable,
-    solve_response,
-    solve_response_json,
-)
+from .documents import limits_document, nullable, solve_response_json
 from .exceptions import RequestError
-from .robot_requests import check_configuration, check_task_point, gamma_and_mode, request_robot
+from .robot_requests import check_configuration, check_length, gamma_and_mode, request_robot
 from .schemas.algorithms import parameters_of, used
 from .schemas.wording import without_field
-
-_R = TypeVar("_R")
 
 
 @dataclass
 class _Setup:
-    """Everything a run needs, validated against the registry."""
+    """Everything a run needs, validated against the registry: the robot, its inverse of the
+    request's algorithm, the engine's keywords of the run (``gamma``, ``mode``, ``tol``,
+    ``max_iterations``) and the fields every run's response starts with (the robot, algorithm,
+    parameters the inverse used, map, mode and gamma)."""
 
     spec: RobotSpec
     kinematics: Any
     inverse: Any
-    robot: S.RobotUsed
-    augmentation: S.AugmentationUsed | None
-    mode: S.Mode
-    gamma: float
-    tolerance: float
-    max_iterations: int | None
-    #: The inverse's parameters, defaults filled in (:func:`parameters_of`).
-    parameters: dict
+    run: dict[str, Any]
+    head: dict[str, Any]
 
 
 def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
@@ -63,12 +52,19 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
     built = request_robot(
         req.robot, req.augmentation, [req.algorithm], req.algorithm_parameters, req.x0
     )
-    spec, kin, (inverse,) = built.spec, built.kinematics, built.inverses
-    gamma, mode = gamma_and_mode(spec, req)
-    return _Setup(
-        *(spec, kin, inverse, built.robot, built.augmentation, mode, gamma),
-        *(req.tolerance, req.max_iterations, parameters_of(inverse)),
-    )
+    (inverse,) = built.inverses
+    gamma, mode = gamma_and_mode(built.spec, req)
+    aug = built.augmentation
+    head = {
+        "robot": built.robot.model_dump(mode="json"),
+        "algorithm": inverse.name,
+        "algorithm_parameters": parameters_of(inverse),
+        "augmentation": None if aug is None else aug.model_dump(mode="json"),
+        "mode": mode,
+        "gamma": float(gamma),
+    }
+    run = {"gamma": gamma, "mode": mode, "tol": req.tolerance, "max_iterations": req.max_iterations}
+    return _Setup(built.spec, built.kinematics, inverse, run, head)
 
 
 #: A run's arguments in the engine that are a request's fields, by the request's names.
@@ -104,40 +100,27 @@ def batch_key(req: S.SolveRequest) -> str:
     return req.model_dump_json(exclude=exclude)
 
 
-def solve_batch(reqs: list[S.SolveRequest]) -> list[S.SolveResponse | RequestError]:
-    """Solve requests sharing one :func:`batch_key` in ONE batched engine call.
+def solve_batch_json(reqs: list[S.SolveRequest]) -> list[bytes | RequestError]:
+    """Solve requests sharing one :func:`batch_key` in ONE batched engine call, each response
+    as its JSON bytes (:func:`solve_response_json`).
 
     Each member is validated on its own (lengths, singular start): a bad member gets its
     :class:`RequestError` in its slot and does not affect the others.
     """
-    return _solve_batch(reqs, solve_response)
-
-
-def solve_batch_json(reqs: list[S.SolveRequest]) -> list[bytes | RequestError]:
-    """:func:`solve_batch` with each response as its JSON bytes, built without validating the
-    model (the workers' hot path, see :func:`solve_response_json`)."""
-    return _solve_batch(reqs, solve_response_json)
-
-
-def _solve_batch(
-    reqs: list[S.SolveRequest], respond: Callable[[_Setup, Any], _R]
-) -> list[_R | RequestError]:
-    """:func:`solve_batch` with ``respond`` turning a member's result into its response (the
-    model, or JSON bytes in the workers)."""
     if not reqs:
         return []
     if len({batch_key(r) for r in reqs}) != 1:
-        raise ValueError("solve_batch needs requests with equal batch keys")
+        raise ValueError("solve_batch_json needs requests with equal batch keys")
     try:
         setup = _setup(reqs[0])
     except RequestError as exc:
         return [exc] * len(reqs)
-    out: list[_R | RequestError | None] = [None] * len(reqs)
+    out: list[bytes | RequestError | None] = [None] * len(reqs)
     ok: list[int] = []
     for i, r in enumerate(reqs):
         try:
             check_configuration(setup.spec, r.x0)
-            check_task_point(setup.spec, r.target, "target")
+            check_length(setup.spec, r.target, "target")
             ok.append(i)
         except RequestError as exc:
             out[i] = exc
@@ -151,14 +134,7 @@ def _solve_batch(
         if keep.size:
             try:
                 batch = engine_solve_batch(
-                    setup.inverse,
-                    x0[keep],
-                    y_d[keep],
-                    gamma=setup.gamma,
-                    mode=setup.mode,
-                    tol=setup.tolerance,
-                    max_iterations=setup.max_iterations,
-                    record=True,
+                    setup.inverse, x0[keep], y_d[keep], **setup.run, record=True
                 )
             except JikError as exc:
                 err = engine_error(exc)
@@ -166,8 +142,8 @@ def _solve_batch(
                     out[ok[k]] = err
             else:
                 for j, k in enumerate(keep):
-                    out[ok[k]] = respond(setup, batch[j])
-    return cast(list[_R | RequestError], out)  # every slot was filled above
+                    out[ok[k]] = solve_response_json(setup, batch[j])
+    return cast(list[bytes | RequestError], out)  # every slot was filled above
 
 
 def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityResponse:
@@ -175,7 +151,7 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
     setup = _setup(req)
     check_configuration(setup.spec, req.x0)
     for i, pt in enumerate(req.path):
-        check_task_point(setup.spec, pt, f"path[{i}]")
+        check_length(setup.spec, pt, f"path[{i}]")
     x0 = np.array(req.x0, dtype=float)
     if refused := refused_starts(setup.inverse, x0[None]):
         raise RequestError("x0", refused[0])
@@ -185,29 +161,20 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
             x0,
             np.array(req.path, dtype=float),
             cycles=req.cycles,
-            gamma=setup.gamma,
-            mode=setup.mode,
-            tol=setup.tolerance,
-            max_iterations=setup.max_iterations,
+            **setup.run,
             record=robot_limits(setup.kinematics) is not None,  # (limits: check whole legs)
         )
     except JikError as exc:
         raise engine_error(exc) from None
     drift = np.asarray(res.drift, dtype=float)
-    max_drift = float(np.max(drift)) if np.all(np.isfinite(drift)) else float("nan")
     return S.RepeatabilityResponse(
-        robot=setup.robot,
-        algorithm=setup.inverse.name,
-        algorithm_parameters=setup.parameters,
-        augmentation=setup.augmentation,
-        mode=setup.mode,
-        gamma=setup.gamma,
+        **setup.head,
         cycles=req.cycles,
         targets=np.asarray(res.targets, dtype=float).tolist(),
         legs=nullable(res.legs),
         cycle_end=nullable(res.cycle_end),
         drift=nullable(drift),
-        max_drift=nullable(max_drift),
+        max_drift=nullable(np.max(drift)),  # (null when a cycle's drift is not finite)
         repeatable=bool(res.success) and repeatable(drift) is True,
         success=bool(res.success),
         message=cast(str, res.message),  # one start configuration: one message

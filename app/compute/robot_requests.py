@@ -111,13 +111,9 @@ def _belong(given: dict, algorithms: Sequence[str]) -> None:
 
 
 def build_robot(req_robot) -> tuple[RobotSpec, Any, S.RobotUsed]:
-    """The robot named in the request, built with its parameters; what it used, filled in."""
-    try:
-        spec = ROBOTS[req_robot.name]
-    except KeyError:
-        raise RequestError(
-            "robot.name", f"unknown robot {req_robot.name!r}; choose one of {sorted(ROBOTS)}"
-        ) from None
+    """The catalogue robot of the request (its model names one), built with its parameters;
+    what it used, filled in."""
+    spec = ROBOTS[req_robot.name]
     params = req_robot.model_dump(exclude={"name"})
     try:
         kin = spec.build(**params)
@@ -167,11 +163,22 @@ def checked_augmentation(spec: RobotSpec, req_aug) -> tuple[Any, dict]:
     return aspec, values
 
 
-def _dimensions(spec: RobotSpec, what: str) -> str:
-    """Why a vector has its length: ``p of manipulator2``; a user robot's p and r."""
+def length_problem(spec: RobotSpec, what: str, got: int) -> str | None:
+    """Why a vector of ``got`` components is not one of the robot's p (``what`` "p") or r
+    components (``p of manipulator2``; a user robot's p and r), or None if it is."""
+    n = spec.p if what == "p" else spec.r
+    if got == n:
+        return None
+    why = f"{what} of {spec.name}"
     if spec.name in S.USER_ROBOT_MODELS:
-        return f"this {spec.name} robot has p = {spec.p}, r = {spec.r}"
-    return f"{what} of {spec.name}"
+        why = f"this {spec.name} robot has p = {spec.p}, r = {spec.r}"
+    return f"must have {n} components ({why}), got {got}"
+
+
+def check_length(spec: RobotSpec, vector, field: str, what: str = "r") -> None:
+    """The request's vector at ``field`` has the robot's r (``what`` "p": p) components."""
+    if (problem := length_problem(spec, what, len(vector))) is not None:
+        raise RequestError(field, problem)
 
 
 def check_configuration(spec: RobotSpec, x0) -> None:
@@ -188,10 +195,7 @@ def check_configuration(spec: RobotSpec, x0) -> None:
             f"this {spec.name} robot has p = {spec.p} moving joints; the API takes at "
             f"most {S.MAX_DIMENSION} (the cap on x0's components){joints}",
         )
-    if len(x0) != spec.p:
-        raise RequestError(
-            "x0", f"must have {spec.p} components ({_dimensions(spec, 'p')}), got {len(x0)}"
-        )
+    check_length(spec, x0, "x0", "p")
 
 
 def gamma_and_mode(spec: RobotSpec, req) -> tuple[float, S.Mode]:
@@ -202,11 +206,3 @@ def gamma_and_mode(spec: RobotSpec, req) -> tuple[float, S.Mode]:
     if (why := gamma_problem(gamma, mode)) is not None:
         raise RequestError("gamma", why)
     return gamma, mode
-
-
-def check_task_point(spec: RobotSpec, y, name: str) -> None:
-    """The task point ``y`` (the request's field ``name``) has r components."""
-    if len(y) != spec.r:
-        raise RequestError(
-            name, f"must have {spec.r} components ({_dimensions(spec, 'r')}), got {len(y)}"
-        )

@@ -17,6 +17,11 @@ def _cores() -> int:
     return max(1, min(8, os.cpu_count() or 2))
 
 
+def cpu_count() -> int:
+    """The machine's CPU count (at least 1): the default of ``dashboard_computations``."""
+    return max(1, os.cpu_count() or 1)
+
+
 class Settings(BaseSettings):
     """How the server runs, each field from ``JIK_<FIELD>`` (``JIK_WORKERS=4``).
 
@@ -59,7 +64,7 @@ class Settings(BaseSettings):
     #: computations run in their threads at once (default: the CPU count).
     max_sessions: int = Field(default=32, ge=1)
     session_idle_seconds: float = Field(default=600.0, ge=1.0)
-    dashboard_computations: int = Field(default_factory=lambda: max(1, os.cpu_count() or 1))
+    dashboard_computations: int = Field(default_factory=cpu_count)
 
     @field_validator("workers")
     @classmethod

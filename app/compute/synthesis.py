@@ -7,20 +7,16 @@
 
 from __future__ import annotations
 
-from collections.abc import Collection
-
-import numpy as np
-
 from ...engine.augmentations import Polynomial2
 from ...engine.exceptions import JikError
 from ...engine.functionals import error_functional_e1, error_functional_e2
 from ...engine.registry import RobotSpec
+from ...engine.robot_synthesis import default_box
 from ...engine.variational import synthesize_e2
 from . import schemas as S
-from .documents import nullable
 from .exceptions import RequestError
 from .robot_requests import request_robot
-from .synthesis_total import grid, singularities, total_degree_response
+from .synthesis_total import map_response, total_degree_response
 
 
 def synthesis_methods() -> S.SynthesisMethodsResponse:
@@ -40,36 +36,12 @@ def synthesis_methods() -> S.SynthesisMethodsResponse:
     )
 
 
-def default_region(
-    spec: RobotSpec, size: int, fixed: Collection[str] = ()
-) -> dict[str, tuple[float, float]]:
-    """The robot's design region (``functional_region``, the box of sec. 5 over which the
-    dashboard and its ``e2_synthesized`` map take E1 (13) and E2 (18)) when it has ``size``
-    variables, none ``fixed``; else the last ``size`` variables that are not ``fixed``, each
-    over a box around the default start.
-
-    Half-width: a tenth of the variable's ``x_range``, clipped to it. The other variables are
-    held at the default start (where the robot's maps are defined), not at 0.
-    """
-    design = dict(spec.functional_region)
-    if len(design) == size and not set(design) & set(fixed):
-        return {n: (float(lo), float(hi)) for n, (lo, hi) in design.items()}
-    names = list(spec.variable_names)
-    region = {}
-    for n in [n for n in names if n not in fixed][-size:]:
-        i = names.index(n)
-        lo, hi = spec.x_range[i]
-        c, w = spec.default_x0[i], 0.1 * (hi - lo)
-        region[n] = (max(lo, c - w), min(hi, c + w))
-    return region
-
-
 def synthesis_region(spec: RobotSpec, req: S.SynthesizeRequest):
     """The variable names, the box and the fixed values of a synthesis request, checked."""
     names = list(spec.variable_names)
     size = {"e2_variational": 2, "e2_total_degree": spec.p}.get(req.method, 3)
     if req.region is None:
-        region = default_region(spec, size, req.fixed or {})
+        region = default_box(spec, size, req.fixed or {})
     else:
         region = {k: (float(lo), float(hi)) for k, (lo, hi) in req.region.items()}
     if len(region) > 3 and req.method != "e2_total_degree":
@@ -95,23 +67,13 @@ def synthesis_region(spec: RobotSpec, req: S.SynthesizeRequest):
     return names, region, fixed
 
 
-def _functional_info(fv) -> S.FunctionalInfo:
-    return S.FunctionalInfo(
-        value=nullable(fv.value),
-        n_points=int(fv.n_points),
-        n_singular=int(np.asarray(fv.singular_points).shape[0]),
-        min_abs_dh_k=nullable(getattr(fv, "min_abs_dh_k", float("nan"))),
-        divergent=bool(getattr(fv, "divergent", False)),
-    )
-
-
 def _functionals(kin, amap, region, fixed, nodes) -> tuple[dict, list[str]]:
     notes: list[str] = []
     out: dict[str, S.FunctionalInfo | None] = {}
     for label, fn in (("e1", error_functional_e1), ("e2", error_functional_e2)):
         try:
             value = fn(kin, amap, region, nodes=nodes, fixed=fixed)
-            out[label] = _functional_info(value)
+            out[label] = S.FunctionalInfo.model_validate(value.as_dict())
             if value.divergent:
                 notes.append(f"{label.upper()} diverges: dh K vanishes inside the region")
         except JikError as exc:
@@ -164,21 +126,16 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         coefficients = amap.monomials() if isinstance(amap, Polynomial2) else {}
         nodes = req.nodes
     functionals, more = _functionals(kin, amap, region, fixed, nodes)
-    all_fixed = {n: float(fixed.get(n, 0.0)) for n in names if n not in region}
-    found, said, searched = singularities(kin, amap, region, all_fixed, req.nodes)
-    notes += more + said
-    return S.SynthesizeResponse(
-        robot=robot_used,
-        method=req.method,
+    return map_response(
+        req,
+        robot_used,
+        kin,
+        amap,
+        (names, region, fixed),
+        notes + more,
         augmentation=aug_used,
-        region={k: [float(lo), float(hi)] for k, (lo, hi) in region.items()},
-        fixed=all_fixed,
-        grid=grid(amap, names, region, all_fixed, req.grid),
         coefficients=coefficients,
         functionals=functionals,
         convergence=convergence,
-        singularities=found,
-        singularities_searched=searched,
         total_degree=None,
-        message="; ".join(notes) or "ok",
     )

@@ -1,8 +1,8 @@
 """``POST /synthesize`` with ``'e2_total_degree'``: E2-optimal maps over any number of joint
 variables (:func:`jik.engine.synthesis_nd.synthesize_e2_nd`, eq. (19) on a total-degree Legendre
 basis with a scrambled Sobol rule; for p - r >= 2 the maps h_1 ... h_(p-r) of the functional
-generalised in ``docs/e2-vector.md``), and the grid of a map on two axes of its box that every
-method's response draws.
+generalised in ``docs/e2-vector.md``), and the response every method gives of its map: h on a
+grid of two axes of its box, where it is singular (:func:`map_response`).
 """
 
 from __future__ import annotations
@@ -51,6 +51,28 @@ def singularities(
     return info, [f"h is singular in the box: {found}"], True
 
 
+def map_response(
+    req, robot_used, kin, amap, box, notes: list[str], **fields
+) -> S.SynthesizeResponse:
+    """The response of a synthesis whose map h is ``amap`` on ``box`` (the variables' names,
+    the region, the values of the others, default 0): h on the grid and where it is singular,
+    the message ``notes`` and what the search says, with the method's own ``fields``."""
+    names, region, fixed = box
+    all_fixed = {n: float(fixed.get(n, 0.0)) for n in names if n not in region}
+    found, said, searched = singularities(kin, amap, region, all_fixed, req.nodes)
+    return S.SynthesizeResponse(
+        robot=robot_used,
+        method=req.method,
+        region={k: [float(lo), float(hi)] for k, (lo, hi) in region.items()},
+        fixed=all_fixed,
+        grid=grid(amap, names, region, all_fixed, req.grid),
+        singularities=found,
+        singularities_searched=searched,
+        message="; ".join(notes + said) or "ok",
+        **fields,
+    )
+
+
 def total_degree_response(
     req: S.SynthesizeRequest, kin, robot_used: S.RobotUsed, box: tuple[list[str], dict, dict]
 ) -> S.SynthesizeResponse:
@@ -81,7 +103,6 @@ def total_degree_response(
     }
     info["basis"] = res.maps[0].index.tolist()
     info["coefficients"] = [m.coefficients.tolist() for m in res.maps]
-    all_fixed = {n: float(res.fixed.get(n, fixed.get(n, 0.0))) for n in names if n not in region}
     notes = [
         f"E2 {res.e2:.6g} on the fitting rule, {res.e2_check:.6g} on an independent rule "
         f"of {res.nodes} nodes ({len(info['coefficients'][0])} unknowns per map)"
@@ -95,10 +116,13 @@ def total_degree_response(
     if len(res.maps) > 1:
         notes.append(f"{len(res.maps)} maps h_1 ... h_{len(res.maps)}; the grid shows h_1")
     notes.append("E1 is not evaluated (its Gauss rule grows as nodes^d)")
-    found, more, searched = singularities(kin, res.maps[0], res.region, all_fixed, req.nodes)
-    return S.SynthesizeResponse(
-        robot=robot_used,
-        method=req.method,
+    return map_response(
+        req,
+        robot_used,
+        kin,
+        res.maps[0],
+        (names, res.region, {**fixed, **res.fixed}),
+        notes,
         augmentation=S.AugmentationUsed(
             name=res.maps[0].name,
             parameters={
@@ -107,9 +131,6 @@ def total_degree_response(
                 "maps": float(len(res.maps)),
             },
         ),
-        region={k: [float(lo), float(hi)] for k, (lo, hi) in res.region.items()},
-        fixed=all_fixed,
-        grid=grid(res.maps[0], names, res.region, all_fixed, req.grid),
         coefficients={},
         functionals={
             "e1": None,
@@ -118,8 +139,5 @@ def total_degree_response(
             ),
         },
         convergence=[{k: float(v) for k, v in row.items()} for row in res.convergence],
-        singularities=found,
-        singularities_searched=searched,
         total_degree=S.TotalDegreeInfo(**info),
-        message="; ".join(notes + more),
     )

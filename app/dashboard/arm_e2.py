@@ -16,18 +16,18 @@ from collections.abc import Callable
 from ...engine.e2_qmc import e2_qmc
 from ...engine.exceptions import JikError, RunCancelled
 from ...engine.progress import ProgressCallbacks
+from ...engine.robot_synthesis import TOTAL_NODES as QMC_NODES
 
-#: Nodes of the rule (a power of two): those of a synthesis over more than three joints.
-QMC_NODES = 2**13
-#: Seed of its scrambling: the synthesis's independent check rule (its ``e2_check``).
+#: Seed of the rule's scrambling: the synthesis's independent check rule (its ``e2_check``).
 QMC_SEED = 1
 
 
 def qmc_functionals(
     grid: dict, region: dict, fixed: dict, out: dict, cancelled, on_step: Callable[[], None]
 ) -> dict:
-    """``out`` (the region, fixed variables) with E2 of the grid's map by :data:`QMC_NODES`
-    Sobol nodes and ``E2_single_joint`` (name -> {"sign", "e2"}) when p - r = 1; E1 None and a
+    """``out`` (the region, fixed variables) with E2 of the grid's map by the Sobol rule of a
+    synthesis over more than three joints (:data:`~jik.engine.robot_synthesis.TOTAL_NODES`
+    nodes) and ``E2_single_joint`` (name -> {"sign", "e2"}) when p - r = 1; E1 None and a
     ``note`` saying why and how. Raises :class:`~jik.app.dashboard.runs.Cancelled` when
     ``cancelled()`` turns True; ``on_step()`` twice when done (the two functionals' steps)."""
     from .runs import Cancelled

@@ -16,7 +16,6 @@ computed in the session's own thread, in turns of :class:`~jik.app.dashboard.slo
 
 from __future__ import annotations
 
-import os
 import secrets
 import threading
 import time
@@ -24,7 +23,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..compute.settings import Settings
+from ..compute.settings import Settings, cpu_count
 from .model import default_state, updated_state
 from .session import Dashboard
 from .slots import FairSlots
@@ -47,14 +46,18 @@ class SessionsFull(RuntimeError):
     """Every session slot is in use; the message says how many and what to do."""
 
 
+_DEFAULTS = Settings.model_fields
+
+
 @dataclass(frozen=True)
 class SessionLimits:
     """How many sessions, how long an idle one lives, how many of their computations run in
-    their threads at once (the other algorithm's runs are the compute pool's, JIK_WORKERS)."""
+    their threads at once (the other algorithm's runs are the compute pool's, JIK_WORKERS);
+    by default the server's :class:`~jik.app.compute.settings.Settings` defaults."""
 
-    max_sessions: int = 32
-    idle_seconds: float = 600.0
-    computations: int = max(1, os.cpu_count() or 1)
+    max_sessions: int = _DEFAULTS["max_sessions"].default
+    idle_seconds: float = _DEFAULTS["session_idle_seconds"].default
+    computations: int = field(default_factory=cpu_count)
 
     @classmethod
     def from_settings(cls, settings: Settings) -> SessionLimits:

@@ -62,14 +62,13 @@ from ...app.compute.atlas_plan import AtlasLimits, planned
 from ...app.compute.atlas_schemas import AtlasRequest
 from ...app.compute.exceptions import RequestError
 from ...app.compute.requests import _setup
-from ...app.compute.robot_requests import check_configuration, check_task_point, request_robot
-from ...app.compute.schemas.synthesis import QMC_NODES
+from ...app.compute.robot_requests import check_configuration, check_length, request_robot
 from ...app.compute.synthesis import synthesis_region
 from ...app.dashboard.model import default_state, updated_state
 from ...app.dashboard.patch import StatePatch, patch_of
 from ...engine.exceptions import InvalidInputError, JikError
 from ...engine.registry import ROBOTS
-from ...engine.robot_synthesis import TOTAL_DEGREE
+from ...engine.robot_synthesis import TOTAL_DEGREE, TOTAL_NODES
 from ...engine.solve_rules import refused_starts
 from ...engine.synthesis_nd import MAX_UNKNOWNS
 from ...engine.total_degree import basis_size
@@ -175,7 +174,7 @@ def _user_robot_ok(body: dict, path: str) -> bool:
 
 def _total_degree_ok(body: dict, d: int, p: int, r: int) -> bool:
     """The rules of a total-degree synthesis of ``d`` variables (see the module docstring)."""
-    nodes, degree = int(body.get("qmc_nodes", QMC_NODES)), int(body.get("degree") or TOTAL_DEGREE)
+    nodes, degree = int(body.get("qmc_nodes", TOTAL_NODES)), int(body.get("degree") or TOTAL_DEGREE)
     axes = body.get("frame_axes")
     frame_ok = axes is None or p - r < 2 or (len(set(axes)) == p - r and max(axes) <= p)
     unknowns = basis_size(d, degree)
@@ -220,7 +219,7 @@ def _run_ok(body: dict, path: str) -> bool:
         check_configuration(setup.spec, run.x0)
         points = run.path if isinstance(run, S.RepeatabilityRequest) else [run.target]
         for i, point in enumerate(points):
-            check_task_point(setup.spec, point, f"path[{i}]")
+            check_length(setup.spec, point, f"path[{i}]")
         # (the server's own test of a singular start, which a nearly singular J J^T fails)
         setup.inverse.matrix(np.asarray(run.x0, dtype=float))
         if refused_starts(setup.inverse, np.asarray([run.x0], dtype=float)):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
@@ -132,7 +133,7 @@ def test_batched_posture_runs_each_pull_toward_their_own_start():
     rest is each one's x0 on Manipulator 2) batch only with equal starts, so each gets what it
     gets alone (a batch of two gave the second the first's rest)."""
     from jik.app.compute import schemas as S
-    from jik.app.compute.requests import batch_key, solve_batch
+    from jik.app.compute.requests import batch_key, solve_batch_json
 
     def req(x0, **params):
         body = {"robot": {"name": "manipulator2"}, "algorithm": "posture", "x0": x0}
@@ -144,8 +145,8 @@ def test_batched_posture_runs_each_pull_toward_their_own_start():
     assert batch_key(req([0.0, 0.0, 1.5], rest=[0, 0, 1])) == batch_key(
         req([0.3, 0.2, 1.2], rest=[0, 0, 1])
     )
-    (alone,) = solve_batch([b])
-    assert alone.algorithm_parameters == {"gain": 1.0, "rest": [0.3, 0.2, 1.2]}
+    (alone,) = solve_batch_json([b])
+    assert json.loads(alone)["algorithm_parameters"] == {"gain": 1.0, "rest": [0.3, 0.2, 1.2]}
 
 
 @pytest.mark.parametrize(

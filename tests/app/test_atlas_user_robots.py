@@ -145,7 +145,11 @@ def test_a_formula_robot_atlas_runs_in_the_workers(api):
             "path[0]",
             "must have 6 components (this panda robot has p = 7, r = 6), got 3",
         ),
-        ({"reference": [0.0, 0.1]}, "reference", "must have 7 components, got 2"),
+        (
+            {"reference": [0.0, 0.1]},
+            "reference",
+            "must have 7 components (this panda robot has p = 7, r = 6), got 2",
+        ),
         ({"robot": {"name": "panda", "task": "pose", "end_link": "x"}}, "robot", "end_link"),
     ],
 )

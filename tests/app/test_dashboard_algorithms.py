@@ -4,6 +4,8 @@ keys, the verdict's sentences about them, and the session API taking the choice.
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -393,7 +395,7 @@ def test_the_rest_is_dropped_with_the_posture_inverse_and_with_the_robot():
 
 def test_the_api_and_the_dashboard_take_the_same_default_rest():
     """One rule, the engine's default_rest: the robot's home, else the run's start x0."""
-    from jik.app.compute.requests import solve_batch
+    from jik.app.compute.requests import solve_batch_json
     from jik.app.compute.schemas import SolveRequest
     from jik.app.dashboard.algorithms import posture_rest
     from jik.app.dashboard.robots import state_kinematics
@@ -403,8 +405,8 @@ def test_the_api_and_the_dashboard_take_the_same_default_rest():
     kin = state_kinematics(state)
     assert posture_rest(state, kin) == default_rest(kin, state.x0) == (list(state.x0), "x0")
     body = {"robot": {"name": "manipulator2"}, "algorithm": "posture", "x0": list(state.x0)}
-    (api,) = solve_batch([SolveRequest.model_validate({**body, "target": [1.0, 1.5]})])
-    assert api.algorithm_parameters["rest"] == list(state.x0)
+    (api,) = solve_batch_json([SolveRequest.model_validate({**body, "target": [1.0, 1.5]})])
+    assert json.loads(api)["algorithm_parameters"]["rest"] == list(state.x0)
     np.testing.assert_array_equal(state_inverse(state, "posture").rest, state.x0)
 
 

@@ -84,3 +84,20 @@ def test_the_second_phase_takes_the_same_integers(api, session, route):
     for value in (2.5, True, "2"):
         r = api.post(url, json={"generation": value})
         assert r.status_code == 422 and r.json()["detail"][0]["loc"] == ["body", "generation"]
+
+
+#: A planar chain with p - r = 2, whose E2-synthesized maps take the joints of their frame.
+_CHAIN = {"name": "planar_chain", "joints": "RRRR", "lengths": [1.0, 1.0, 1.0, 1.0]}
+
+
+@pytest.mark.parametrize("value", [2.5, True, "2"])
+def test_a_maps_frame_axes_follow_the_same_rule(api, value):
+    """A map's ``frame_axes`` (in a robot's request, as in /synthesize's own) are integers by
+    the one rule: a boolean or a string is refused, as 2.5 is."""
+    body = solve_body(robot=_CHAIN, algorithm="extended", x0=[0.1, 0.2, 0.3, 0.4])
+    body["augmentation"] = {"name": "e2_synthesized", "frame_axes": [value]}
+    r = api.post("/solve", json=body)
+    assert r.status_code == 422, r.text
+    (error,) = r.json()["detail"]
+    assert error["loc"][-2:] == ["frame_axes", 0], r.text
+    assert error["msg"].startswith("augmentation.frame_axes[0]: Input should be a valid integer")

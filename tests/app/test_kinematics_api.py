@@ -66,7 +66,7 @@ def test_a_user_robot(api):
         (
             {"robot": {"name": "planar_chain", "joints": "RRR", "lengths": [1, 1, 1]}, "x": [0, 1]},
             "x",
-            "must have 3 components (p of planar chain",
+            "must have 3 components (this planar_chain robot has p = 3, r = 2)",
         ),
         ({"robot": {"name": "manipulator2"}, "x": [0, "a", 1]}, "x", ""),
         ({"robot": {"name": "nosuch"}, "x": [0, 0, 0]}, "robot", ""),

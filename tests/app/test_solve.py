@@ -22,7 +22,7 @@ def test_solve_pseudoinverse_manipulator2(api):
     r = api.post("/solve", json=solve_body())
     assert r.status_code == 200, r.text
     b = r.json()
-    assert b["converged"] is True
+    assert b["converged"] is True and b["status"] == "converged"
     assert b["message"].startswith("converged")
     np.testing.assert_allclose(b["x"], X1F, atol=6e-5)
     np.testing.assert_allclose(b["y"], [1.0, 1.0], atol=1e-9)
@@ -75,7 +75,7 @@ def test_solve_manipulator1_with_parameters_and_discrete_mode(api):
 def test_solve_not_converged_is_200_with_reason(api):
     """A run that hits max_iterations is a result (converged false), not an error."""
     b = api.post("/solve", json=solve_body(max_iterations=3)).json()
-    assert b["converged"] is False
+    assert b["converged"] is False and b["status"] == "max_steps"
     assert "did not converge within 3 steps" in b["message"]
 
 
@@ -86,6 +86,7 @@ def test_a_stalled_solve_says_why(api):
     body = solve_body(robot=arm, x0=[0.3, 0.4, 0.5], target=[5.0, 0.0])
     b = api.post("/solve", json=body).json()
     assert b["converged"] is False and b["message"].startswith("stalled after ")
+    assert b["status"] == "stalled"  # (the engine's SolveResult.status, for a client's branch)
     assert (
         "the target is out of reach: it is 5 from the base, beyond the arm's reach 2.4"
         in (b["message"])
@@ -194,10 +195,10 @@ def test_every_registered_robot_solves_with_its_defaults(api):
 
 
 def test_service_batch_isolates_a_bad_first_member():
-    """The plain service function (used by the dashboard): a wrong-length first member gets its
-    own error, the others are solved."""
+    """The plain service function (the workers'): a wrong-length first member gets its own
+    error, the others are solved."""
     from jik.app.compute.exceptions import RequestError
-    from jik.app.compute.requests import solve_batch
+    from jik.app.compute.requests import solve_batch_json
     from jik.app.compute.schemas import SolveRequest
 
     reqs = [
@@ -205,10 +206,10 @@ def test_service_batch_isolates_a_bad_first_member():
         SolveRequest.model_validate(solve_body()),
         SolveRequest.model_validate(solve_body(target=[0.5, 1.5])),
     ]
-    out = solve_batch(reqs)
+    out = solve_batch_json(reqs)
     assert isinstance(out[0], RequestError) and out[0].field == "x0"
-    np.testing.assert_allclose(out[1].x, X1F, atol=6e-5)
-    np.testing.assert_allclose(out[2].y, [0.5, 1.5], atol=1e-9)
+    np.testing.assert_allclose(json.loads(out[1])["x"], X1F, atol=6e-5)
+    np.testing.assert_allclose(json.loads(out[2])["y"], [0.5, 1.5], atol=1e-9)
 
 
 @pytest.mark.parametrize(
@@ -226,12 +227,11 @@ def test_service_batch_isolates_a_bad_first_member():
 def test_worker_json_is_the_validated_response(over):
     """The workers' JSON (built without pydantic) is the validated model's document: the same
     keys and the same float values (only the spelling of exponents differs)."""
-    from jik.app.compute.requests import solve_batch, solve_batch_json
+    from jik.app.compute.requests import solve_batch_json
     from jik.app.compute.schemas import SolveRequest, SolveResponse
 
     req = SolveRequest.model_validate(solve_body(**over))
-    (model,) = solve_batch([req])
     (raw,) = solve_batch_json([req])
-    assert isinstance(model, SolveResponse) and isinstance(raw, bytes)
+    assert isinstance(raw, bytes)
+    model = SolveResponse.model_validate_json(raw)
     assert json.loads(raw) == json.loads(model.model_dump_json())
-    SolveResponse.model_validate_json(raw)

@@ -89,3 +89,15 @@ def test_singular_jacobian_is_reported_with_configuration():
     assert kin.is_singular(np.array([0.0, 1.0, 2.0]))
     with pytest.raises(KinematicSingularityError, match=r"x = \(0, 1, 2\)"):
         kin.require_regular(np.array([[1.0, 1.0, 2.0], [0.0, 1.0, 2.0]]))
+
+
+@pytest.mark.parametrize("kin", ROBOTS, ids=lambda k: f"{k.name}{k.parameters}")
+def test_every_robot_gives_k_and_j_together(kin):
+    """``forward_jacobian`` of a robot without its own one-pass evaluation is k(x) and J(x),
+    with the check of x."""
+    x = RNG.uniform(-2, 2, (5, 3))
+    k, J = kin.forward_jacobian(x)
+    np.testing.assert_array_equal(k, kin.forward(x))
+    np.testing.assert_array_equal(J, kin.jacobian(x))
+    with pytest.raises(InvalidInputError):
+        kin.forward_jacobian(np.full(3, np.nan))

@@ -99,7 +99,7 @@ def table_response(jobs: AtlasJobs, job: AtlasJob, every_leg: bool) -> Response:
     except InvalidInputError as exc:
         error = {"loc": ("query", "every_leg"), "msg": str(exc), "type": "value_error"}
         raise RequestValidationError([error]) from None
-    robot = re.sub(r"[^A-Za-z0-9_.-]", "_", job.used[0].name) if job.used else "robot"
+    robot = re.sub(r"[^A-Za-z0-9_.-]", "_", job.used[0].name)
     name = f"jik-{robot}-atlas-{job.id}{'-legs' * every_leg}.csv"
     return StreamingResponse(
         text,

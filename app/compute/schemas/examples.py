@@ -103,13 +103,13 @@ def schema_examples(route: str, name: str) -> Callable[[dict[str, Any]], None]:
     return extra
 
 
-def openapi_examples(route: str, names: tuple[str, ...] = ()) -> dict[str, dict[str, Any]]:
-    """``Body(openapi_examples=...)`` of ``route``: the example of every robot (of ``names``,
-    default all a request may name), by its name."""
+def openapi_examples(route: str) -> dict[str, dict[str, Any]]:
+    """``Body(openapi_examples=...)`` of ``route``: the example of every robot a request may
+    name, by its name."""
     from .robots import ROBOT_NAMES
 
     out = {}
-    for name in names or ROBOT_NAMES:
+    for name in ROBOT_NAMES:
         out[name] = {"summary": _robot(name)[1].title, "value": copy.deepcopy(example(route, name))}
     if route in ("solve", "repeatability") and ALGORITHMS_ROBOT in out:
         out |= _algorithm_examples(route)

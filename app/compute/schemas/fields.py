@@ -45,6 +45,26 @@ Coordinate = Annotated[
     float, Field(strict=True, ge=-COORDINATE_BOUND, le=COORDINATE_BOUND, allow_inf_nan=False)
 ]
 Vector = Annotated[list[Coordinate], Field(min_length=1, max_length=MAX_DIMENSION)]
+
+
+def coordinates(n: int) -> Any:
+    """A vector of exactly ``n`` coordinates: a configuration (n = p) or a task point (n = r)
+    of a robot whose request model knows them."""
+    return Annotated[list[Coordinate], Field(min_length=n, max_length=n)]
+
+
+def points(n: int, least: int, most: int) -> Any:
+    """A list of ``least`` to ``most`` vectors of ``n`` coordinates (a path's task points)."""
+    return Annotated[list[coordinates(n)], Field(min_length=least, max_length=most)]  # type: ignore[misc]
+
+
+#: The seed of a random rule (a Sobol rule's scrambling, an atlas's sampled starts).
+Seed = Annotated[int, Field(strict=True, ge=0, le=2**31 - 1), INTEGRAL]
+#: The p - r joints (1-based) whose axes fix the kernel frame of maps h_1..h_(p-r).
+FrameAxes = Annotated[
+    list[Annotated[int, Field(strict=True, ge=1, le=MAX_DIMENSION), INTEGRAL]],
+    Field(min_length=1, max_length=MAX_DIMENSION),
+]
 #: The decay rate of eq. (5) (discrete mode: the step; its bound there is checked with the mode,
 #: engine.solve_rules.gamma_problem).
 Gamma = Annotated[float, Field(strict=True, ge=GAMMA_MIN, le=GAMMA_MAX, allow_inf_nan=False)]

@@ -24,6 +24,8 @@ from .fields import (
     Bound,
     Coordinate,
     FiniteFloat,
+    FrameAxes,
+    Vector,
     one_or_many,
 )
 
@@ -154,11 +156,9 @@ class PlanarChainRobot(BaseModel):
     joints: Annotated[str, Field(pattern=r"^[RP]{1,16}$")] = Field(
         description="joint types, base first: R revolute, P prismatic (p = its length)"
     )
-    lengths: Annotated[list[Coordinate], Field(min_length=1, max_length=MAX_DIMENSION)] = Field(
-        description="link lengths, one per joint"
-    )
-    offsets: Annotated[list[Coordinate], Field(min_length=1, max_length=MAX_DIMENSION)] | None = (
-        Field(None, description="joint offsets added to x, one per joint (default 0)")
+    lengths: Vector = Field(description="link lengths, one per joint")
+    offsets: Vector | None = Field(
+        None, description="joint offsets added to x, one per joint (default 0)"
     )
     orientation: Annotated[bool, Field(strict=True)] = Field(
         False, description="also the end's angle as a task component (r = 3; needs p >= 3)"
@@ -208,7 +208,7 @@ class UrdfRobot(BaseModel):
         "rz (rotation vector of R0^T R); 'pose' for all six, or a subset such as 'xyz', 'xz' "
         "or 'x y z rz'",
     )
-    home: Annotated[list[Coordinate], Field(min_length=1, max_length=MAX_DIMENSION)] | None = Field(
+    home: Vector | None = Field(
         None,
         description="a reference configuration (default: zero, clipped into the "
         "joint limits); also the default start",
@@ -270,13 +270,7 @@ class E2SynthesisAugmentation(BaseModel):
     fixed: Annotated[dict[Name, FiniteFloat], Field(max_length=MAX_DIMENSION)] | None = Field(
         None, description="values of the variables outside the box (default 0)"
     )
-    frame_axes: (
-        Annotated[
-            list[Annotated[int, Field(ge=1, le=MAX_DIMENSION), INTEGRAL]],
-            Field(min_length=1, max_length=MAX_DIMENSION),
-        ]
-        | None
-    ) = Field(
+    frame_axes: FrameAxes | None = Field(
         None,
         description="p - r > 1: the p - r joints (1-based) whose axes fix the kernel "
         "frame of h_1..h_(p-r) (default: the best-conditioned at the box's centre)",

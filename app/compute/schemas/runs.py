@@ -12,17 +12,18 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from ....engine.registry import RobotSpec
 from ....engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS, REPEATABLE_DRIFT
-from ....engine.solve_rules import DISCRETE_GAMMA_BOUND
+from ....engine.solve_rules import DISCRETE_GAMMA_BOUND, Status
 from .algorithms import Algorithm, AlgorithmParameters
 from .fields import (
     INTEGRAL,
     MAX_ITERATIONS,
-    Coordinate,
     Gamma,
     MaybeFloat,
     Mode,
     Tolerance,
     Vector,
+    coordinates,
+    points,
 )
 from .robots import (
     AnyAugmentation,
@@ -148,6 +149,11 @@ RunLimits = Annotated[
 ]
 
 
+#: Why a solve stopped: the engine's SolveResult.status of one run.
+RunStatus = Literal["converged", "max_steps", "diverged", "stalled", "singular", "undefined"]
+assert set(RunStatus.__args__) == set(Status.NAMES) - {"running"}  # type: ignore[attr-defined]
+
+
 class SolveResponse(_RunResponse):
     tolerance: float
     x: list[MaybeFloat] = Field(
@@ -157,6 +163,11 @@ class SolveResponse(_RunResponse):
     error: MaybeFloat = Field(description="||k(x) - target||")
     converged: bool
     message: str
+    status: RunStatus = Field(
+        description="why the run stopped: converged, max_steps (out of iterations or "
+        "integrator steps), diverged, stalled, singular (the inverse singular there) or "
+        "undefined (the augmenting map h undefined there)"
+    )
     iterations: int = Field(description="integrator steps or iterations taken")
     trajectory: Trajectory
     limits: RunLimits = None
@@ -179,11 +190,6 @@ class RepeatabilityResponse(_RunResponse):
     limits: RunLimits = None
 
 
-def _task_point(spec: RobotSpec) -> Any:
-    r = len(spec.task_names)
-    return Annotated[list[Coordinate], Field(min_length=r, max_length=r)]
-
-
 def _run_fields(spec: RobotSpec, augmentation: Any) -> dict[str, Any]:
     return {
         "augmentation": (
@@ -196,7 +202,7 @@ def _run_fields(spec: RobotSpec, augmentation: Any) -> dict[str, Any]:
             ),
         ),
         "x0": (
-            Annotated[list[Coordinate], Field(min_length=spec.p, max_length=spec.p)],
+            coordinates(spec.p),
             Field(description=f"start configuration {list(spec.variable_names)}"),
         ),
     }
@@ -207,7 +213,7 @@ SolveBody = per_robot(
     SolveRequest,
     lambda spec, aug: {
         **_run_fields(spec, aug),
-        "target": (_task_point(spec), Field(description=f"target {list(spec.task_names)}")),
+        "target": (coordinates(spec.r), Field(description=f"target {list(spec.task_names)}")),
     },
 )
 #: ``POST /repeatability``'s body: a :class:`RepeatabilityRequest` with its robot's lengths.
@@ -216,7 +222,7 @@ RepeatabilityBody = per_robot(
     lambda spec, aug: {
         **_run_fields(spec, aug),
         "path": (
-            Annotated[list[_task_point(spec)], Field(min_length=1, max_length=MAX_PATH_POINTS)],  # type: ignore[misc]
+            points(spec.r, 1, MAX_PATH_POINTS),
             Field(
                 description=f"task points {list(spec.task_names)} visited in order, 1 to "
                 f"{MAX_PATH_POINTS}; k(x0) closes it"

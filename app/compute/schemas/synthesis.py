@@ -7,21 +7,15 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from ....engine.registry import RobotSpec
-from ....engine.robot_synthesis import TOTAL_DEGREE
+from ....engine.robot_synthesis import TOTAL_DEGREE, TOTAL_NODES
 from ....engine.variational import DEFAULT_DEGREE
-from .fields import (
-    INTEGRAL,
-    MAX_DIMENSION,
-    Bound,
-    Coordinate,
-    MaybeFloat,
-)
+from .fields import INTEGRAL, MAX_DIMENSION, Bound, Coordinate, FrameAxes, MaybeFloat, Seed
 from .robots import AnyAugmentation, AnyRobot, AugmentationUsed, RobotUsed
 from .variants import narrowed, per_robot
 
 SynthesisMethod = Literal["evaluate", "e2_variational", "e2_total_degree"]
-#: Sobol nodes of a total-degree synthesis (a power of two): default and bounds.
-QMC_NODES, MIN_QMC_NODES, MAX_QMC_NODES = 2**13, 64, 2**17
+#: Sobol nodes of a total-degree synthesis (a power of two): bounds (default: the engine's).
+MIN_QMC_NODES, MAX_QMC_NODES = 64, 2**17
 
 
 class SynthesizeRequest(BaseModel):
@@ -71,21 +65,13 @@ class SynthesizeRequest(BaseModel):
     )
     qmc_nodes: Annotated[int, Field(strict=True, ge=MIN_QMC_NODES, le=MAX_QMC_NODES), INTEGRAL] = (
         Field(
-            QMC_NODES,
+            TOTAL_NODES,
             description="'e2_total_degree': nodes of the scrambled Sobol rule, a power of two, at "
             "least twice the basis' unknowns",
         )
     )
-    seed: Annotated[int, Field(strict=True, ge=0, le=2**31 - 1), INTEGRAL] = Field(
-        0, description="'e2_total_degree': seed of the Sobol rule's scrambling"
-    )
-    frame_axes: (
-        Annotated[
-            list[Annotated[int, Field(strict=True, ge=1, le=MAX_DIMENSION), INTEGRAL]],
-            Field(min_length=1, max_length=MAX_DIMENSION),
-        ]
-        | None
-    ) = Field(
+    seed: Seed = Field(0, description="'e2_total_degree': seed of the Sobol rule's scrambling")
+    frame_axes: FrameAxes | None = Field(
         None,
         description="'e2_total_degree' with p - r >= 2: the p - r joints (1-based) whose axes "
         "fix the kernel frame (default: the last p - r)",

@@ -47,15 +47,14 @@ def narrowed(base: type[BaseModel], name: str, annotation: Any) -> tuple[Any, An
     return annotation, Field(info.default, description=info.description)
 
 
-def per_robot(base: type[BaseModel], fields: Any, user_robots: bool = True) -> Any:
+def per_robot(base: type[BaseModel], fields: Any) -> Any:
     """``base`` made exact for each robot of the catalogue: one model per robot, chosen by
     ``robot.name``, whose ``robot`` and ``augmentation`` are that robot's and whose vectors have
     its lengths (``fields(spec)``: the fields that differ from ``base``'s), and one per kind of
-    user robot unless not ``user_robots``. Their union is what the route takes and what its
+    user robot. Their union is what the route takes and what its
     OpenAPI document shows, each member with its robot's example (:mod:`.examples`); each
     member is still a ``base``."""
     members = []
-    names = ROBOT_NAMES if user_robots else list(ROBOTS)
     route = base.__name__.removesuffix("Request").lower()
     for name, spec in ROBOTS.items():
         augmentations = list(dict.fromkeys(a.name for a in spec.augmentations))
@@ -69,7 +68,7 @@ def per_robot(base: type[BaseModel], fields: Any, user_robots: bool = True) -> A
         )
         globals()[model.__name__] = model
         members.append(Annotated[model, Tag(name)])
-    for kind, robot_model in USER_ROBOT_MODELS.items() if user_robots else ():
+    for kind, robot_model in USER_ROBOT_MODELS.items():
         # p and r follow from the definition: the vectors keep the base's 1 to 16 components,
         # checked against the built robot (a 422 naming the field and the robot's p, r).
         model = create_model(
@@ -90,20 +89,19 @@ def per_robot(base: type[BaseModel], fields: Any, user_robots: bool = True) -> A
         )
         globals()[model.__name__] = model
         members.append(Annotated[model, Tag(kind)])
-    return robot_union(members, names)
+    return robot_union(members)
 
 
-def robot_union(members: list[Any], names: list[str] = ROBOT_NAMES) -> Any:
+def robot_union(members: list[Any]) -> Any:
     """A body that is one of ``members`` (each tagged by its robot's name), chosen by
     ``robot.name``; a JSON object (:data:`OBJECT_BODY`), and an unknown name refused naming
-    ``names``."""
+    every robot a request may give."""
     return Annotated[
         Union[tuple(members)],  # noqa: UP007
         Discriminator(
             _robot_name,
             custom_error_type="unknown_robot",
-            custom_error_message=f"give a robot whose name is one of {names}",
-            custom_error_context={"names": str(names)},
+            custom_error_message=f"give a robot whose name is one of {ROBOT_NAMES}",
         ),
         OBJECT_BODY,
     ]
