@@ -110,6 +110,18 @@ def test_off_the_papers_path_the_table_is_plainly_named():
     assert fig.data[0].cells.values[0][0] == "start x0"
 
 
+def test_on_the_papers_path_without_both_its_algorithms_the_table_says_to_choose_them():
+    """Manipulator 2 on the paper's experiment with J^E# (11) unchosen is not Table 1, and its
+    note names what is missing (the paper's two algorithms), not the robot, x0 and path that
+    are already the paper's."""
+    state = updated_state(default_state("manipulator2"), {"algorithms": ["pseudoinverse"]})
+    notes = panel(compute(state), "table").layout.meta["notes"]
+    assert notes == [
+        "Not Table 1: the paper's Table 1 compares J^P# (8) and J^E# (11) on this experiment; "
+        "choose both to compare with the printed values."
+    ]
+
+
 def test_augmenting_map_contours_with_the_extended_run_on_a_level_set(path_result):
     functionals = error_functionals(path_result)
     fig = panel(path_result, "augmenting", functionals)
