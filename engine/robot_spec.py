@@ -245,6 +245,15 @@ def _defaults(kin: Kinematics, d: Mapping, box) -> tuple:
         x0 = np.array(kin.parameters["home"], dtype=float)
     else:
         x0 = np.clip(0.5, lo, hi)
+    with np.errstate(all="ignore"):
+        y0 = kin.forward(x0)
+    if not np.isfinite(y0).all() and not ("target" in d and "path" in d):
+        k = int(np.flatnonzero(~np.isfinite(y0))[0])
+        raise InvalidInputError(
+            f"the task k(x0) is undefined at x0 = ({', '.join(f'{v:g}' for v in x0)}) "
+            f"(k{k + 1} = {y0[k]:g}): give an x0 where it is defined",
+            "x0",
+        )
     step = 0.15 * np.minimum(1.0, hi - lo)
     i, j = _loop_joints(kin, x0, step)
     moves = np.zeros((3, kin.p))
