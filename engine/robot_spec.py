@@ -40,11 +40,10 @@ from .kinematics import Kinematics
 from .limits import LimitsReport, check_limits, run_report
 from .planar_chain import PlanarChain
 from .registry import ROBOTS, RobotSpec, make_inverse
-from .repeatability import MAX_PATH_POINTS
 from .robot_augmentations import augmentations_from_dict
+from .robot_defaults import defaults, points
 from .robot_synthesis import arm_augmentations, missing_map
 from .units import RobotUnits, robot_units
-from .validation import as_points
 
 #: Largest robot file read by :func:`load_robot` [bytes].
 MAX_FILE_BYTES = 2_000_000
@@ -190,17 +189,9 @@ def _urdf_file(d: Mapping, base_dir: Path | None) -> str:
     return path.read_text(encoding="utf-8")
 
 
-def _points(value, size: int, name: str):
-    """``as_points`` with the error's field set to ``name``."""
-    try:
-        return as_points(value, size, name)
-    except InvalidInputError as exc:
-        raise InvalidInputError(str(exc), name) from None
-
-
 def _x_range(kin: Kinematics, d: Mapping) -> tuple[tuple[float, float], ...]:
     if "x_range" in d:
-        box = _points(d["x_range"], 2, "x_range")
+        box = points(d["x_range"], 2, "x_range")
         if box.shape != (kin.p, 2) or not np.all(box[:, 0] < box[:, 1]):
             raise InvalidInputError(
                 f"x_range must be {kin.p} pairs [lo, hi] with lo < hi", "x_range"
@@ -215,59 +206,6 @@ def _x_range(kin: Kinematics, d: Mapping) -> tuple[tuple[float, float], ...]:
             for rev, length in zip(kin.revolute, kin.lengths, strict=True)
         )
     return ((-math.pi, math.pi),) * kin.p
-
-
-def _loop_joints(kin: Kinematics, x0: np.ndarray, step: np.ndarray) -> tuple[int, int]:
-    """The two joints whose moves by ``step`` make the default closed path: the first and the
-    last, unless the task moves they make span less than a tenth of the largest parallelogram of any
-    pair (a last joint that only turns the flange about its axis moves no position and, near
-    home, no rx, ry); then that largest pair. Task moves are forward differences, all p at once.
-    """
-    with np.errstate(all="ignore"):  # (a task that overflows: the build refuses it after)
-        d = kin.forward(x0 + np.diag(step)) - kin.forward(x0)
-        gram = d @ d.T
-        norms = np.diag(gram)
-        area = np.sqrt(np.maximum(np.outer(norms, norms) - gram**2, 0.0))
-    area = np.where(np.isfinite(area), area, 0.0)
-    last = kin.p - 1
-    if area[0, last] >= 0.1 * area.max():
-        return 0, last
-    i, j = np.unravel_index(int(np.argmax(area)), area.shape)
-    return int(min(i, j)), int(max(i, j))
-
-
-def _defaults(kin: Kinematics, d: Mapping, box, base: RobotSpec | None = None) -> tuple:
-    """x0 (given, else a URDF arm's home if given, else 0.5 in each range), a target and a
-    closed path reachable from it; a built-in robot's (``base``) where its definition has none."""
-    lo, hi = np.array(box).T
-    if "x0" in d:
-        x0 = _points(d["x0"], kin.p, "x0")
-        if x0.ndim != 1:
-            raise InvalidInputError(f"x0 must be one configuration of {kin.p} numbers", "x0")
-    elif base is not None:
-        x0 = np.array(base.default_x0, dtype=float)
-    elif "home" in d:
-        x0 = np.array(kin.parameters["home"], dtype=float)
-    else:
-        x0 = np.clip(0.5, lo, hi)
-    if base is not None:
-        target, path = d.get("target", base.default_target), d.get("path", base.default_path)
-    else:
-        step = 0.15 * np.minimum(1.0, hi - lo)
-        i, j = _loop_joints(kin, x0, step)
-        moves = np.zeros((3, kin.p))
-        moves[0, i] = moves[1, i] = step[i]
-        moves[1, j] = moves[2, j] = step[j]
-        target = d.get("target", kin.forward(x0 + moves[1]))
-        path = d.get("path", kin.forward(x0 + moves))
-    target, path = _points(target, kin.r, "target"), _points(path, kin.r, "path")
-    if target.ndim != 1:
-        raise InvalidInputError(f"target must be one task point ({kin.r} numbers)", "target")
-    if path.ndim != 2 or not 1 <= len(path) <= MAX_PATH_POINTS:
-        raise InvalidInputError(
-            f"path must be a list of 1 to {MAX_PATH_POINTS} task points", "path"
-        )
-    return tuple(x0.tolist()), tuple(target.tolist()), tuple(map(tuple, path.tolist()))
 
 
 def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
@@ -314,7 +252,7 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
         spec = replace(base, augmentations=(*base.augmentations, *extra)) if extra else base
         if {"title", "x_range", "x0", "target", "path"} & set(d):  # (else the built-in itself)
             box = _x_range(kin, d) if "x_range" in d else base.x_range
-            x0, target, path = _defaults(kin, d, box, base)
+            x0, target, path = defaults(kin, d, box, base)
             title = _get(d, "title", str, "a string", base.title)
             spec = replace(spec, title=title, x_range=box, default_x0=x0, default_target=target)
             spec = replace(spec, default_path=path)
@@ -330,7 +268,7 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
     if "limits" in d:  # (a planar chain or a formula robot: a URDF's come from its joints)
         kin.joint_limits = check_limits(d["limits"], kin.p)
     box = _x_range(kin, d)
-    x0, target, path = _defaults(kin, d, box)
+    x0, target, path = defaults(kin, d, box)
     key = json.dumps(
         {k: v for k, v in d.items() if k != "augmentations"}, sort_keys=True, default=str
     )

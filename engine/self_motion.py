@@ -13,18 +13,17 @@ which move it normal to K and so keep s its arc length to first order. Points de
 not on which other points are asked for at the same time: an atlas computes its starts chunk by
 chunk and gets the same numbers.
 
-A curve that is a closed loop (a component of the fibre that is a circle inside the box: the
-fibres of a revolute arm often are) is traced once round, not round and round until the arc is
-used up. Going ahead from x_b, the tracer watches a Poincare section, the hyperplane through x_b
-normal to the curve there: when the curve crosses it again in the same direction (coming from
-behind it) at a point within :data:`CLOSE_TOL` of x_b (:data:`CLOSE_PER_TOL` times the
-integrator's tolerance, if that is more), with the same tangent, the loop has
-closed; the crossing is located on the dense output (Brent's method, as ``solve_ivp`` locates
-events) and its arc length is the loop's period T. Going behind, it watches the section
-through the end of the arc traced ahead, the first point of that arc it can come round to.
-The angle of a joint that turns
-freely (a URDF's continuous joint, :func:`periodic_joints`) is compared modulo 2 pi, so a loop
-that closes after that joint has turned a whole turn is found too.
+A curve that is a closed loop (a component of the fibre that is a circle inside the box: the fibres
+of a revolute arm often are) is traced once round, not round and round until the arc is used up.
+Going ahead from x_b, the tracer watches a Poincare section, the hyperplane through x_b normal to
+the curve there: when the curve crosses it again in the same direction (coming from behind it) at a
+point within :data:`CLOSE_TOL` of x_b (:data:`CLOSE_PER_TOL` times the integrator's tolerance, if
+that is more), with the same tangent, the loop has closed; the crossing is located on the dense
+output (Brent's method, as ``solve_ivp`` locates events) and its arc length is the loop's period T.
+Going behind, it watches the section through the end of the arc traced ahead, the first point of
+that arc it can come round to. The angle of a joint that turns freely (a URDF's continuous joint,
+:func:`periodic_joints`) is compared modulo 2 pi, so a loop that closes after that joint has turned
+a whole turn is found too.
 """
 
 from __future__ import annotations
@@ -168,6 +167,7 @@ def trace(
     box: Sequence[Sequence[float]] | None = None,
     tol: float = TRACE_TOL,
     bound_free_joints: bool = False,
+    max_steps: int = 2**31,
 ) -> SelfMotionManifold:
     """Trace the self-motion curve through ``base`` over the arc lengths ``arc`` = (lo, hi).
 
@@ -191,6 +191,8 @@ def trace(
     bound_free_joints : bool
         Stop the curve where a freely turning joint's angle leaves ``box`` too, as any other
         variable's (a curve drawn in the box's view).
+    max_steps : int
+        Integrator steps each way at most, ``arc`` then shorter (K flips where k is undefined).
 
     Returns
     -------
@@ -223,6 +225,7 @@ def trace(
             f"got ({lo:g}, {hi:g})",
             field="arc",
         )
+    max_steps = count(max_steps, "max_steps", 1, 2**31)
     y0 = kinematics.forward(base)
     base = project(kinematics, base[None], y0)[0]
     periodic = periodic_joints(kinematics)
@@ -245,7 +248,8 @@ def trace(
         def leaves(_s, x):
             return float(np.min(np.minimum(x - bounds[:, 0], bounds[:, 1] - x)))
 
-    ahead = _leg(kinematics, base, hi, leaves, (base, kinematics.kernel(base)), periodic, tol)
+    start = (base, kinematics.kernel(base))
+    ahead = _leg(kinematics, base, hi, leaves, start, periodic, tol, max_steps)
     if ahead.closed:
         return SelfMotionManifold(
             kinematics, y0, base, (0.0, ahead.end), ahead.sol, None, ahead.end, ahead.steps
@@ -256,12 +260,10 @@ def trace(
     if not ahead.cut:
         end = base if ahead.sol is None else ahead.sol(ahead.end)
         watch = (end, -kinematics.kernel(end))
-    behind = _leg(kinematics, base, lo, leaves, watch, periodic, tol)
+    behind = _leg(kinematics, base, lo, leaves, watch, periodic, tol, max_steps)
     period = ahead.end - behind.end if behind.closed else None
-    arc_traced, steps = (behind.end, ahead.end), ahead.steps + behind.steps
-    return SelfMotionManifold(
-        kinematics, y0, base, arc_traced, ahead.sol, behind.sol, period, steps
-    )
+    arc, steps = (behind.end, ahead.end), ahead.steps + behind.steps
+    return SelfMotionManifold(kinematics, y0, base, arc, ahead.sol, behind.sol, period, steps)
 
 
 class _Leg(NamedTuple):
@@ -275,7 +277,7 @@ class _Leg(NamedTuple):
     closed: bool
 
 
-def _leg(kinematics, base, end, leaves, watch, periodic, tol) -> _Leg:
+def _leg(kinematics, base, end, leaves, watch, periodic, tol, max_steps) -> _Leg:
     """Integrate dx/ds = K(x), x(0) = ``base``, from s = 0 toward ``end`` (DOP853 with dense
     output to ``tol``, stepped as ``solve_ivp`` steps it), stopping at the first of: ``end``; a
     zero of ``leaves(s, x)`` (the box, located as ``solve_ivp`` locates a terminal event); the
@@ -283,7 +285,7 @@ def _leg(kinematics, base, end, leaves, watch, periodic, tol) -> _Leg:
     there in the direction of integration: a crossing of the section v . (x - w) = 0 from behind
     it (v . d < 0 at the step's start, >= 0 at its end, so the start's own crossing at s = 0 is
     none), at which x is within :data:`CLOSE_TOL` (or :data:`CLOSE_PER_TOL` ``tol``) of w with
-    its tangent near v (angles of ``periodic`` joints compared modulo 2 pi)."""
+    its tangent near v (angles of ``periodic`` joints compared modulo 2 pi); or ``max_steps``."""
     if end == 0:
         return _Leg(0.0, None, 0, False, False)
 
@@ -304,7 +306,7 @@ def _leg(kinematics, base, end, leaves, watch, periodic, tol) -> _Leg:
     ts, interpolants = [0.0], []
     g = 0.0 if leaves is None else leaves(0.0, base)
     stop, cut, closed, steps = None, False, False, 0
-    while solver.status == "running" and stop is None:
+    while solver.status == "running" and stop is None and steps < max_steps:
         message = solver.step()
         steps += 1
         if solver.status == "failed":
@@ -333,6 +335,7 @@ def _leg(kinematics, base, end, leaves, watch, periodic, tol) -> _Leg:
             interpolants.pop()
         else:
             ts.append(t)
+    cut = cut or (stop is None and solver.status == "running")  # (max_steps: as by the box)
     if ts[-1] == 0:
         return _Leg(0.0, None, steps, cut, False)
     return _Leg(float(ts[-1]), OdeSolution(np.array(ts), interpolants), steps, cut, closed)
@@ -375,8 +378,7 @@ def manifold_starts(
         the pseudoinverse (8) (:func:`project`); those that leave the box or do not reach the
         manifold (task error 1e-10) are left out.
     """
-    kinematics = require_kinematics(kinematics)
-    x0 = kinematics.check(x0, "x0")
+    x0 = require_kinematics(kinematics).check(x0, "x0")
     if x0.shape != (kinematics.p,):
         raise InvalidInputError(f"x0 must be one configuration of {kinematics.p} numbers", "x0")
     if isinstance(n, bool) or not isinstance(n, int | np.integer) or not 1 <= n <= 10**5:

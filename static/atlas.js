@@ -10,8 +10,10 @@ import { $, el, fmt } from "./dom.js";
 import { PLOT_CONFIG, panelHead } from "./panels.js";
 
 const POLL_MS = 250;
-// token: bumped to stop following a job; job: the one followed; shown: the atlas on screen.
-const atlas = { token: 0, job: null, shown: null, computedFor: null, send: null, polling: null };
+// token: bumped to stop following a job; job: the one followed; shown: the atlas on screen;
+// covers: the atlasKey of each state it is the atlas of (the state it was computed for, and a
+// scaled path's state that a click on a cell of that band set).
+const atlas = { token: 0, job: null, shown: null, covers: new Set(), state: null, send: null, polling: null };
 
 const detail = (body) => (Array.isArray(body.detail) ? body.detail.map((d) => d.msg).join("; ") : body.detail);
 // What an atlas depends on in a state (not x0: every start of the curve is in it).
@@ -55,8 +57,7 @@ async function start(state) {
     if (token !== atlas.token) return;
     if (!res.ok) throw new Error(`the atlas was refused: ${detail(job)}`);
     atlas.job = job.id;
-    atlas.computedFor = atlasKey(state());
-    await follow(job.id, token);
+    await follow(job.id, token, atlasKey(state()));
   } catch (err) {
     if (token !== atlas.token) return;
     showProgress(null);
@@ -64,14 +65,14 @@ async function start(state) {
   }
 }
 
-async function follow(id, token) {
+async function follow(id, token, key) {
   for (;;) {
     atlas.polling = fetch(api(`/atlas/${id}`));
     const res = await atlas.polling;
     const body = await res.json();
     if (token !== atlas.token) return;
     if (!res.ok) throw new Error(`the atlas was lost: ${detail(body)}`);
-    if (body.status === "done") return draw(body);
+    if (body.status === "done") return draw(body, key);
     if (body.status === "failed") throw new Error(`the atlas failed: ${body.error}`);
     if (body.status === "cancelled") throw new Error("the atlas was cancelled on the server");
     showProgress(body);
@@ -91,9 +92,11 @@ function cancel() {
   if (id) polled.catch(() => {}).then(() => fetch(`/atlas/${id}`, { method: "DELETE" })).catch(() => {});
 }
 
-async function draw(body) {
+async function draw(body, key) {
   atlas.job = null;
   atlas.shown = body;
+  atlas.covers = new Set([key]);
+  atlasState(atlas.state());
   const div = $("#plot-atlas");
   div.classList.add("drawn");
   // Its height is the figure's (rows of cycles and scales); the width follows the window.
@@ -155,6 +158,7 @@ function moveTo(point) {
     const home = path[0];
     patch.path = given.map((p) => p.map((v, d) => home[d] + scale * (v - home[d])));
   }
+  atlas.covers.add(atlasKey({ ...atlas.state(), ...patch })); // (still this atlas: its band)
   atlas.send(patch);
   const s = body.request.scales ? `, path ×${scale}` : "";
   say(`Moved the main view to start ${i + 1} of ${n} (s = ${fmt(Number(point.x))}${s}): x0 = (${x0.map((v) => fmt(v)).join(", ")}).`);
@@ -163,13 +167,14 @@ function moveTo(point) {
 // The current state changed: say when the atlas on screen is of another state.
 export function atlasState(state) {
   const note = $("#atlas-outdated");
-  if (note) note.hidden = !atlas.shown || atlas.computedFor === atlasKey(state);
+  if (note) note.hidden = !atlas.shown || atlas.covers.has(atlasKey(state));
 }
 
 // Build the panel (index.html's #atlas); ``state()`` is the session's current state, ``send``
 // changes it (as the controls do).
 export function atlasPanel(state, send) {
   atlas.send = send;
+  atlas.state = state;
   const field = (label, input, help) => el("label", { title: help }, el("span", {}, label), input);
   const starts = el("input", { type: "number", id: "atlas-starts", min: 2, max: 4096, step: 1, value: 256 });
   const cycles = el("input", { type: "number", id: "atlas-cycles", min: 1, max: 50, step: 1, placeholder: "as above" });

@@ -5,6 +5,7 @@ import { el, fmt } from "./dom.js";
 
 let shape = null; // JSON of the controls on screen: rebuilt only when it changes
 const inputs = new Map(); // control key -> element with setValue()
+const inForce = new Map(); // control key -> JSON of its value in the last state shown
 
 // A number as the user wrote it, or null when it is not one ("abc", "", "1,5").
 export function parseNumber(text) {
@@ -62,6 +63,13 @@ export function showRefusal(field, message) {
   if (!key) return false;
   const typed = typedText.get(key);
   return fieldError(key, typed, typed === undefined ? message : `was refused: ${message}`);
+}
+
+// A control's error, once its value changed (in the 3D scene, another client): what it
+// quoted is no longer what the control holds.
+function clearFieldError(key) {
+  const note = rows.has(key) && rows.get(key).querySelector(":scope > .field-error");
+  if (note) note.remove();
 }
 
 export function clearFieldErrors() {
@@ -153,10 +161,18 @@ const BUILD = { slider, select, vector, text, checks };
 // values set: not the one being edited, unless ``force`` (a refusal: the values in force).
 export function showControls(msg, change, force = false) {
   const next = JSON.stringify(msg.controls);
+  const changed = (key) => {
+    const value = JSON.stringify(msg.values[key]);
+    const was = inForce.get(key);
+    inForce.set(key, value);
+    return was !== undefined && was !== value;
+  };
   if (next !== shape) {
     shape = next;
     inputs.clear();
     rows.clear();
+    inForce.clear();
+    Object.keys(msg.values).forEach(changed);
     const form = document.getElementById("controls");
     form.replaceChildren(...msg.groups.map(([group, title]) => {
       const set = el("fieldset", { dataset: { group } }, el("legend", {}, title));
@@ -177,7 +193,9 @@ export function showControls(msg, change, force = false) {
     return;
   }
   for (const [key, input] of inputs) {
+    if (!(key in msg.values)) continue;
+    if (changed(key)) clearFieldError(key);
     if (!force && input.contains(document.activeElement)) continue;
-    if (key in msg.values) input.setValue(msg.values[key]);
+    input.setValue(msg.values[key]);
   }
 }

@@ -223,7 +223,9 @@ function stateFromUrl() {
   if (!text) return {};
   try {
     const state = JSON.parse(text);
-    return state && typeof state === "object" && !Array.isArray(state) ? state : {};
+    if (state && typeof state === "object" && !Array.isArray(state)) return state;
+    setNotice(`the link's state is not an object of the state's fields (${text}); showing the defaults`);
+    return {};
   } catch (err) {
     setNotice(`the link's state is not valid JSON (${err.message}); showing the defaults`);
     return {};

@@ -26,7 +26,7 @@ from ...engine.registry import ROBOTS
 from ...engine.solve_rules import DISCRETE_GAMMA_BOUND, MAX_ITERATIONS, MAX_STEPS
 from .algorithms import STYLES, joint_box, posture_rest, scalar_parameters
 from .control_changes import PATH_FORMAT, path_text
-from .glossary import SYMBOLS
+from .glossary import PARAMETER_LABELS, SYMBOLS
 from .robots import state_kinematics, state_spec
 
 #: gamma's resolution: the page's log-scale slider and the scene's slider both land on it.
@@ -381,7 +381,7 @@ def _sliders(head: str, parameters) -> list[Control]:
     return [
         Control(
             f"{head}.{p.name}",
-            p.name,
+            PARAMETER_LABELS.get(p.name, p.name),
             "slider",
             "algorithm",
             explained(p.name, p.description),

@@ -25,6 +25,9 @@ MAX_POINTS, GRID = 1500, 16
 #: A self-motion manifold is traced this many box diagonals each way (to a drawing's tolerance)
 #: and drawn with a point every SPACING of them.
 ARC_SPANS, SPACING, DRAW_TOL = 3.2, 0.02, 1e-6
+#: Integrator steps each way of a traced manifold: a smooth one takes under ten; one that runs
+#: into a configuration where k is undefined creeps there and is drawn up to it.
+MAX_TRACE_STEPS = 1000
 CSPACE_HEIGHT = 520
 #: The layout key of the panel's 3D axes (not "scene": see :func:`cspace_spec`).
 SCENE = "scene2"
@@ -47,8 +50,8 @@ def self_motion(kin, seeds: np.ndarray, lo, hi) -> list[np.ndarray]:
     Each curve is the engine's (:func:`jik.engine.self_motion.trace`, to a drawing's tolerance
     :data:`DRAW_TOL`): the orbit of the unit kernel K(x) both ways from its seed over an arc of
     :data:`ARC_SPANS` box diagonals, stopped where any variable (a freely turning joint's angle
-    too) leaves the widened box or after one turn of a closed curve, its points projected onto
-    k(x) = y by the pseudoinverse (8).
+    too) leaves the widened box, after one turn of a closed curve or after
+    :data:`MAX_TRACE_STEPS` steps, its points projected onto k(x) = y by the pseudoinverse (8).
     """
     span = hi - lo
     finite = seeds[np.isfinite(seeds).all(axis=1)]  # (a seed beyond x_range widens the box)
@@ -60,7 +63,9 @@ def self_motion(kin, seeds: np.ndarray, lo, hi) -> list[np.ndarray]:
     curves = []
     for seed in seeds:
         try:
-            curve = trace_curve(kin, seed, (-arc, arc), box, DRAW_TOL, bound_free_joints=True)
+            curve = trace_curve(
+                kin, seed, (-arc, arc), box, DRAW_TOL, True, max_steps=MAX_TRACE_STEPS
+            )
         except JikError:  # (a singular seed: no kernel to follow)
             curves.append(np.empty((0, kin.p)))
             continue

@@ -3,6 +3,14 @@
 
 from __future__ import annotations
 
+#: The labels of the algorithms' parameters' controls, in the verdict's symbols (the registry's
+#: names are keys: "damping_threshold"). The paper's parameters are labelled by their names.
+PARAMETER_LABELS = {
+    "damping": "λ (damping)",
+    "damping_threshold": "damping threshold (σ_min)",
+    "gain": "k (null-space gain)",
+}
+
 #: The paper's symbols, as the controls and panels use them.
 SYMBOLS = {
     "gamma": "γ: the decay rate of the task error, e(θ) = e(0) exp(−γθ), eq. (5); in discrete "

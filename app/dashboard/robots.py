@@ -14,6 +14,7 @@ that a formula too costly to differentiate is refused before the server builds i
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Mapping
 from typing import Any
 
@@ -33,6 +34,10 @@ from ..compute.user_robots import built
 from ..compute.worker import task
 from .algorithms import inverse_parameters
 
+#: sigma_min / sigma_max of J's columns of the joints h leaves free, at x0, above which the
+#: default map keeps the last p - r variables.
+REGULAR = 1e-6
+
 #: The robots given by a definition: the kinds a user defines (the editor's choices), and the
 #: catalogue's arms (:mod:`jik.engine.arms`), whose definition is their name and task.
 USER_KINDS = (*KINDS, *ARMS)
@@ -49,9 +54,25 @@ def _built(definition: Mapping[str, Any]) -> Robot:
     spec = robot.spec
     if spec.augmentations or spec.p <= spec.r:
         return robot
-    last = list(spec.variable_names[spec.r :])
-    h = last[0] if len(last) == 1 else last
+    kept = [spec.variable_names[i] for i in _kept_variables(robot)]
+    h = kept[0] if len(kept) == 1 else kept
     return built({**definition, "augmentations": [{"name": "formula", "h": h}]})
+
+
+def _kept_variables(robot: Robot) -> list[int]:
+    """The p - r variables a default map h keeps: the last ones, unless the columns of J(x0)
+    of the others are singular at the default x0 (then [J; dh] (10) is, as for a Panda's xyz
+    task at home, whose joints 1 and 3 move the point alike); then those whose others' columns
+    are best conditioned (largest sigma_min / sigma_max)."""
+    p, r = robot.spec.p, robot.spec.r
+    with np.errstate(all="ignore"):
+        J = np.asarray(robot.kinematics.jacobian(np.asarray(robot.spec.default_x0)), float)
+    driven = np.array(list(itertools.combinations(range(p), r)))  # (n, r): joints J drives
+    s = np.linalg.svd(np.nan_to_num(J[:, driven].transpose(1, 0, 2)), compute_uv=False)
+    ratio = s[:, -1] / np.maximum(s[:, 0], 1e-300)  # (n,)
+    first = int(np.flatnonzero((driven == np.arange(r)).all(axis=1))[0])
+    best = first if ratio[first] > REGULAR else int(np.argmax(ratio))
+    return [i for i in range(p) if i not in driven[best]]
 
 
 def user_robot(definition: Mapping[str, Any]) -> Robot:

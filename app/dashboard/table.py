@@ -51,13 +51,14 @@ SHORT = {a: s.short.split(" (")[0] for a, s in STYLES.items()}
 def is_table1(result: DashboardResult) -> bool:
     """Whether ``result`` is the paper's Table 1 experiment (any mode, map, gamma, cycles) with
     the paper's two algorithms among those chosen."""
-    s = result.state
-    return (
-        set(PAPER) <= set(result.runs)
-        and s.robot == "manipulator2"
-        and s.task == "path"
-        and is_experiment(s.robot_parameters.get("l", 1.0), s.x0, s.path)
-    )
+    return set(PAPER) <= set(result.runs) and _on_experiment(result.state)
+
+
+def _on_experiment(s) -> bool:
+    """Whether the state ``s`` is Manipulator 2 (l = 1) from the paper's x0 on its closed path,
+    whatever its algorithms."""
+    l = s.robot_parameters.get("l", 1.0)
+    return s.robot == "manipulator2" and s.task == "path" and is_experiment(l, s.x0, s.path)
 
 
 def _ends(result: DashboardResult, algorithm: str) -> np.ndarray:
@@ -166,7 +167,13 @@ def leg_ends_spec(result: DashboardResult) -> dict:
     for a in result.runs:
         table.add(result.variable_names, _ends(result, a), FILLS[a], f"{SHORT[a]} {{}}")
     notes = []
-    if result.state.robot == "manipulator2":
+    paper = " and ".join(STYLES[a].short for a in PAPER)
+    if _on_experiment(result.state):
+        notes.append(
+            f"Not Table 1: the paper's Table 1 compares {paper} on this experiment; choose both "
+            "to compare with the printed values."
+        )
+    elif result.state.robot == "manipulator2":
         notes.append(
             "Not Table 1: the paper's Table 1 is Manipulator 2 (l = 1) from x0 = "
             "(0, 0, π/2) on the closed path (1, 1), (1, 2), (0, 2), (0, 1); set those "

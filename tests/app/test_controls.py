@@ -168,3 +168,13 @@ def test_control_keys_beside_a_change_of_robot_are_the_new_robots():
     state = updated_state(default_state("manipulator2"), {"x0.0": 0.0, "robot": "unicycle"})
     assert state.robot == "unicycle"
     assert state.x0 == (0.0, *default_state("unicycle").x0[1:])
+
+
+def test_the_algorithms_parameters_are_labelled_with_the_verdicts_symbols():
+    """The sliders of damped least squares and the posture inverse read as the verdict writes
+    them (λ, σ_min, gain k), not as the registry's keys ("damping_threshold")."""
+    state = updated_state(default_state(), {"algorithms": ["pseudoinverse", "damped", "posture"]})
+    labels = {c.key: c.label for c in controls(state) if c.key.startswith("algorithm_parameters.")}
+    assert labels["algorithm_parameters.damping"] == "λ (damping)"
+    assert labels["algorithm_parameters.damping_threshold"] == "damping threshold (σ_min)"
+    assert labels["algorithm_parameters.gain"] == "k (null-space gain)"

@@ -304,3 +304,16 @@ def test_every_catalogue_arm_is_a_dashboard_state(arm):
     assert state.robot_definition == {"name": arm, "task": ARMS[arm].task}
     assert state.augmentation == "e2_synthesized"
     assert len(state.x0) == len(ARMS[arm].home) == len(state.path[0]) + 1
+
+
+def test_an_arms_position_task_gets_a_map_whose_extended_jacobian_is_regular_at_home():
+    """The Panda's xyz task from its home: the last four joints as h would leave joints 1-3 to
+    drive x, y, z, and at home joints 1 and 3 move the point the same way ([J; dh] (10)
+    singular at x0). The default map keeps four other joints, and the extended Jacobian's run
+    goes round the closed path and back to x0."""
+    state = updated_state(
+        default_state(), {"robot": "panda", "robot_definition": {"name": "panda", "task": "xyz"}}
+    )
+    result = compute(state)
+    assert result.runs["extended"].success, result.runs["extended"].message
+    assert np.max(result.runs["extended"].drift) < 1e-8

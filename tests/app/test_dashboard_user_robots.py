@@ -90,6 +90,18 @@ def test_a_definition_is_state_with_its_defaults_and_a_map():
             "robot_definition",
             "the robot's default target[0] is refused by the dashboard",
         ),
+        (
+            {
+                "robot": "formula",
+                "robot_definition": {
+                    "name": "formula",
+                    "task": ["sqrt(x1 - 1)", "x2 + x3"],
+                    "variables": ["x1", "x2", "x3"],
+                },
+            },
+            "robot_definition.x0",
+            "the task k(x0) is undefined at x0 = (0.5, 0.5, 0.5) (k1 = nan)",
+        ),
     ],
 )
 def test_refusals_name_the_definitions_field(patch, field, text):

@@ -110,6 +110,18 @@ def test_off_the_papers_path_the_table_is_plainly_named():
     assert fig.data[0].cells.values[0][0] == "start x0"
 
 
+def test_on_the_papers_path_without_both_its_algorithms_the_table_says_to_choose_them():
+    """Manipulator 2 on the paper's experiment with J^E# (11) unchosen is not Table 1, and its
+    note names what is missing (the paper's two algorithms), not the robot, x0 and path that
+    are already the paper's."""
+    state = updated_state(default_state("manipulator2"), {"algorithms": ["pseudoinverse"]})
+    notes = panel(compute(state), "table").layout.meta["notes"]
+    assert notes == [
+        "Not Table 1: the paper's Table 1 compares J^P# (8) and J^E# (11) on this experiment; "
+        "choose both to compare with the printed values."
+    ]
+
+
 def test_augmenting_map_contours_with_the_extended_run_on_a_level_set(path_result):
     functionals = error_functionals(path_result)
     fig = panel(path_result, "augmenting", functionals)
@@ -486,3 +498,35 @@ def test_table1_of_discrete_runs_that_stop_in_the_first_cycle():
     assert not any(run.success for run in result.runs.values())
     notes = figure_specs(result, only={"table"})["table"]["layout"]["meta"]["notes"]
     assert "γ = 1.99 stopped before the end of the first cycle" in notes[-1]
+
+
+def test_the_configuration_space_of_a_robot_undefined_on_its_fibres_is_drawn(monkeypatch):
+    """A user's k = (x1^2 + x2, x3 / x1): the corners' fibres reach x1 = 0, where k is
+    undefined and the integrator creeps (steps of about 1e-5 over an arc of units). The panel
+    is drawn with the curves traced up to there, not after hours with the session's result
+    waiting on it (a counting integrator stands guard: far beyond the dashboard's bound, it
+    stops the test instead of the clock)."""
+    from scipy.integrate import DOP853
+
+    import jik.engine.self_motion as self_motion
+    from jik.app.dashboard.cspace import MAX_TRACE_STEPS
+
+    class Guard(DOP853):
+        steps = 0
+
+        def step(self):
+            Guard.steps += 1
+            assert Guard.steps <= 100 * MAX_TRACE_STEPS, "the self-motion curves creep on"
+            return super().step()
+
+    monkeypatch.setattr(self_motion, "DOP853", Guard)
+    definition = {
+        "name": "formula",
+        "variables": ["x1", "x2", "x3"],
+        "task": ["x1**2 + x2", "x3/x1"],
+    }
+    result = compute(default_state("formula", definition))
+    spec = figure_specs(result, only={"cspace"})["cspace"]
+    curves = [t for t in spec["data"] if t.get("legendgroup") == "fibres"]
+    assert len(curves) == len(result.targets) and all(len(c["x"]) >= 2 for c in curves)
+    assert Guard.steps <= 2 * len(result.targets) * MAX_TRACE_STEPS

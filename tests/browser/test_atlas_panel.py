@@ -188,3 +188,24 @@ def test_the_atlas_panels_csv_downloads_the_table_of_the_atlas_shown(tabs):
     assert len(rows) - 1 == 8 * len(request["algorithms"])
     with urllib.request.urlopen(f"{tab.base}/atlas/{job}/table.csv", timeout=30) as rest:
         assert rest.read().decode() == text
+
+
+@pytest.mark.slow
+def test_a_click_in_a_scaled_band_keeps_the_atlas_current(tabs):
+    """An atlas of two path scales (0.5, 1): a click on a cell of the 0.5 band moves the main
+    view to that start with the path scaled by 0.5, a state the atlas holds, so the panel does
+    not call it an atlas of an earlier state."""
+    tab = tabs.open()
+    page = tab.page
+    page.fill("#atlas-scales", "0.5, 1")
+    start_atlas(tab, 8, 1)
+    status = page.locator("#atlas-status")
+    expect(status).to_contain_text("Atlas done", timeout=120_000)
+    drag = page.locator("#plot-atlas .xy .nsewdrag")
+    drag.scroll_into_view_if_needed()
+    cell = drag.bounding_box()
+    assert cell is not None
+    page.mouse.click(cell["x"] + 0.5 * cell["width"], cell["y"] + 0.1 * cell["height"])
+    expect(status).to_contain_text("path ×0.5")
+    tab.wait_settled(lambda s: s["state"]["path"][0] == [0.5, 1.0], "the path scaled by 0.5")
+    expect(page.locator("#atlas-outdated")).to_be_hidden()

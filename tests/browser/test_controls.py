@@ -3,7 +3,9 @@ either shows in both, and a refused value leaves both showing the value in force
 
 from __future__ import annotations
 
+import json
 import re
+import urllib.request
 
 import pytest
 
@@ -134,3 +136,26 @@ def test_errors_show_beside_their_control_in_the_users_text(tabs):
     )
     expect(cycles).to_have_value("3")  # (the value in force)
     tab.screenshots("field-errors")
+
+
+def test_a_refusal_beside_a_control_goes_when_its_value_changes_elsewhere(tabs):
+    """γ = -1 typed on the page is refused beside its box; γ then set elsewhere (the 3D scene,
+    or any client of the session) to 2: the box shows 2, and the refusal of "-1" is gone."""
+    tabs.allow_console(r"status of 422")
+    tab = tabs.open()
+    page = tab.page
+    box = page.locator("#ctl-gamma-value")
+    box.fill("-1")
+    assert tab.posting(lambda: box.press("Enter")).status == 422
+    error = page.locator("label", has=box).locator(".field-error")
+    expect(error).to_contain_text("“-1” was refused")
+    box.blur()  # (the user moves on: a box being edited keeps what is typed in it)
+    request = urllib.request.Request(
+        f"{tab.base}/api/sessions/{tab.session_id}/state",
+        data=json.dumps({"gamma": 2.0}).encode(),
+        headers={"Content-Type": "application/json"},
+    )
+    generation = json.loads(urllib.request.urlopen(request, timeout=30).read())["generation"]
+    tab.wait_drawn(generation)
+    expect(box).to_have_value("2.000")
+    expect(error).to_have_count(0)

@@ -120,3 +120,14 @@ def test_a_tab_whose_session_ended_opens_a_new_one_with_its_state(tabs):
     tab.wait_drawn(1)
     assert tab.session_id != old and tab.robot == "manipulator1"
     assert tab.url_state() == before and tab.snapshot()["state"] == before
+
+
+@pytest.mark.parametrize("text", ["[1, 2]", "null"])
+def test_a_link_whose_state_is_not_an_object_says_so(tabs, text):
+    """A link's ?state= that is JSON but not an object of the state's fields opens the
+    defaults and says why beside the status, as a link that is not JSON does."""
+    tab = tabs.open(f"/?state={text}")
+    expect(tab.page.locator("#notice")).to_have_text(
+        f"the link's state is not an object of the state's fields ({text}); showing the defaults"
+    )
+    assert tab.snapshot()["state"]["robot"] == "manipulator2"

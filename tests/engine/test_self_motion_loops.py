@@ -329,3 +329,44 @@ def test_starts_on_a_manifold_of_two_dimensions_stay_on_it_and_in_the_box():
     with pytest.raises(jik.InvalidInputError) as refused:
         jik.manifold_starts(chain, x0, 0, box)
     assert refused.value.field == "n"
+
+
+class Ratio(Kinematics):
+    """k(x) = (x1^2 + x2, x3 / x1): undefined at x1 = 0, which the fibre of k(0.5, 0.5, 0.5)
+    reaches (x3 = x1, x2 = 0.75 - x1^2); there the field K flips and an integrator creeps."""
+
+    name = "ratio"
+    p, r = 3, 2
+
+    def forward(self, x):
+        x = np.asarray(x, dtype=float)
+        return np.stack([x[..., 0] ** 2 + x[..., 1], x[..., 2] / x[..., 0]], axis=-1)
+
+    def jacobian(self, x):
+        x1, _, x3 = np.moveaxis(np.asarray(x, dtype=float), -1, 0)
+        zero = np.zeros_like(x1)
+        return np.stack(
+            [
+                np.stack([2 * x1, np.ones_like(x1), zero], axis=-1),
+                np.stack([-x3 / x1**2, zero, 1 / x1], axis=-1),
+            ],
+            axis=-2,
+        )
+
+
+def test_a_curve_that_creeps_stops_after_max_steps_each_way():
+    """Toward x1 = 0 the curve creeps (steps of about 1e-5); max_steps stops each way there,
+    with a shorter arc than asked, every point still on k(x) = y0."""
+    kin = Ratio()
+    base = np.array([0.5, 0.5, 0.5])
+    curve = trace(kin, base, (-30.0, 30.0), None, 1e-6, max_steps=300)
+    assert curve.steps <= 600
+    assert not curve.closed and curve.arc[0] > -30.0
+    points = curve.sample(50)
+    assert np.allclose(kin.forward(points), kin.forward(base), atol=1e-9)
+
+
+@pytest.mark.parametrize("max_steps", [0, -1, 2.5, True])
+def test_max_steps_must_be_a_positive_integer(max_steps):
+    with pytest.raises(InvalidInputError, match="max_steps"):
+        trace(Circles(), [1.0, 0.0], (-1.0, 1.0), max_steps=max_steps)
