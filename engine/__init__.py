@@ -152,7 +152,7 @@ _EXPORTS = {
     "AtlasPlan": "atlas",
     "run_atlas": "atlas_run",
     "iter_atlas": "atlas_run",
-    "manifold_starts": "self_motion",
+    "manifold_starts": "redundant_starts",
     "AtlasResult": "atlas_run",
     # errors
     "JikError": "exceptions",

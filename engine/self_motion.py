@@ -37,7 +37,7 @@ from scipy.integrate import DOP853, OdeSolution
 from scipy.optimize import brentq
 
 from .exceptions import InvalidInputError
-from .inverses import Pseudoinverse, require_kinematics
+from .inverses import Pseudoinverse
 from .kinematics import Kinematics
 from .urdf import UrdfChain
 from .validation import FloatArray, as_box, count, finite
@@ -52,6 +52,9 @@ PROJECT_TOL = 1e-14
 PROJECT_STEPS = 6
 #: Longest arc traced either way from the base configuration.
 MAX_ARC = 1e3
+#: Integrator steps either way by default: a smooth curve takes about 2.5 per unit of arc at
+#: TRACE_TOL (2,500 over MAX_ARC); one running into a point where k is undefined creeps.
+MAX_STEPS = 10_000
 #: A curve has closed when it crosses its start's section again this close to the start.
 CLOSE_TOL = 1e-6
 #: ... or this many times the integrator's tolerance (an orbit traced loosely drifts off k = y0).
@@ -167,7 +170,7 @@ def trace(
     box: Sequence[Sequence[float]] | None = None,
     tol: float = TRACE_TOL,
     bound_free_joints: bool = False,
-    max_steps: int = 2**31,
+    max_steps: int = MAX_STEPS,
 ) -> SelfMotionManifold:
     """Trace the self-motion curve through ``base`` over the arc lengths ``arc`` = (lo, hi).
 
@@ -192,7 +195,8 @@ def trace(
         Stop the curve where a freely turning joint's angle leaves ``box`` too, as any other
         variable's (a curve drawn in the box's view).
     max_steps : int
-        Integrator steps each way at most, ``arc`` then shorter (K flips where k is undefined).
+        Integrator steps each way at most (:data:`MAX_STEPS`), ``arc`` then shorter (K flips
+        where k is undefined).
 
     Returns
     -------
@@ -339,62 +343,3 @@ def _leg(kinematics, base, end, leaves, watch, periodic, tol, max_steps) -> _Leg
     if ts[-1] == 0:
         return _Leg(0.0, None, steps, cut, False)
     return _Leg(float(ts[-1]), OdeSolution(np.array(ts), interpolants), steps, cut, closed)
-
-
-#: Starts on a self-motion manifold lie within this fraction of the box's width around x0.
-START_SPREAD = 0.15
-
-
-def manifold_starts(
-    kinematics: Kinematics,
-    x0,
-    n: int,
-    box: Sequence[Sequence[float]],
-    spread: float = START_SPREAD,
-    seed: int = 0,
-) -> FloatArray:
-    """Starts for an atlas on the self-motion manifold k(x) = k(x0) of a robot with p - r > 1,
-    where it is not a curve (:func:`jik.engine.atlas.plan_atlas` then takes explicit
-    ``starts``): x0 first, then farther and farther.
-
-    Parameters
-    ----------
-    kinematics : Kinematics
-    x0 : array_like, shape (p,)
-    n : int
-        Starts asked for (1 to 10^5), x0 among them.
-    box : sequence of p (low, high)
-        The configurations allowed (the robot's ``x_range``); starts outside are left out.
-    spread : float
-        The farthest step, as a fraction of the box's narrowest finite width.
-    seed : int
-        The random directions' seed: the same starts for the same arguments.
-
-    Returns
-    -------
-    ndarray, shape (m, p), m <= n
-        x0 plus a step along a random direction of the null space of J(x0), the step growing
-        from 0 to ``spread`` of the box, projected back onto k(x) = k(x0) by Newton steps with
-        the pseudoinverse (8) (:func:`project`); those that leave the box or do not reach the
-        manifold (task error 1e-10) are left out.
-    """
-    x0 = require_kinematics(kinematics).check(x0, "x0")
-    if x0.shape != (kinematics.p,):
-        raise InvalidInputError(f"x0 must be one configuration of {kinematics.p} numbers", "x0")
-    if isinstance(n, bool) or not isinstance(n, int | np.integer) or not 1 <= n <= 10**5:
-        raise InvalidInputError(f"n must be an integer from 1 to 100000, got {n!r}", "n")
-    lim = as_box(box, kinematics.p, finite=False)
-    y0 = kinematics.forward(x0)
-    J = np.asarray(kinematics.jacobian(x0), dtype=float)
-    null = np.eye(kinematics.p) - np.linalg.pinv(J) @ J
-    d = np.random.default_rng(seed).standard_normal((n, kinematics.p)) @ null
-    d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
-    widths = lim[:, 1] - lim[:, 0]
-    width = float(np.min(widths[np.isfinite(widths)], initial=2 * np.pi))
-    step = finite(spread, "spread") * width * np.linspace(0.0, 1.0, n)
-    X = project(kinematics, x0 + step[:, None] * d, y0)
-    X[0] = x0
-    ok = (np.linalg.norm(kinematics.forward(X) - y0, axis=1) < 1e-10) & np.all(
-        (X >= lim[:, 0]) & (X <= lim[:, 1]), axis=1
-    )
-    return X[ok]

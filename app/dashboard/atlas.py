@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from ...engine.exceptions import InvalidInputError
-from ...engine.self_motion import manifold_starts
+from ...engine.redundant_starts import manifold_starts
 from ..compute.atlas_schemas import AtlasRequest
 from .algorithms import STYLES, inverse_parameters
 from .analysis import kinematics_and_map

@@ -1,6 +1,7 @@
 """Closed self-motion curves: engine.self_motion traces one turn and reports its period, and the
 atlas lays its starts over that turn once (engine.atlas)."""
 
+import inspect
 import math
 from pathlib import Path
 
@@ -12,9 +13,9 @@ from scipy.optimize import brentq
 from jik.engine.atlas import plan_atlas
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.inverses import Pseudoinverse
-from jik.engine.kinematics import Kinematics
+from jik.engine.kinematics import Kinematics, Manipulator2
 from jik.engine.planar_chain import PlanarChain
-from jik.engine.self_motion import MAX_ARC, periodic_joints, trace
+from jik.engine.self_motion import MAX_ARC, MAX_STEPS, periodic_joints, trace
 
 ARM4 = Path(__file__).parents[1] / "data" / "arm4.urdf"
 #: A planar 3R arm's link lengths, and a base configuration whose fibre of the end point is a
@@ -364,6 +365,15 @@ def test_a_curve_that_creeps_stops_after_max_steps_each_way():
     assert not curve.closed and curve.arc[0] > -30.0
     points = curve.sample(50)
     assert np.allclose(kin.forward(points), kin.forward(base), atol=1e-9)
+
+
+def test_trace_is_bounded_by_default_and_the_bound_holds_a_smooth_curve_of_the_longest_arc():
+    """trace's steps were unbounded unless asked (2**31): a notebook's curve into a point where
+    k is undefined crept for ever, as the dashboard's and an atlas's did. By default it stops
+    after MAX_STEPS each way, which Manipulator 2's curve over MAX_ARC each way stays within."""
+    assert inspect.signature(trace).parameters["max_steps"].default == MAX_STEPS
+    curve = trace(Manipulator2(), [0.0, 0.0, math.pi / 2], (-MAX_ARC, MAX_ARC))
+    assert curve.arc == (-MAX_ARC, MAX_ARC) and curve.steps < MAX_STEPS
 
 
 @pytest.mark.parametrize("max_steps", [0, -1, 2.5, True])
