@@ -221,20 +221,10 @@ def solve(
             f"{y_d.shape}; solve_batch solves a batch",
             "x0" if x0.ndim != 1 else "y_d",
         )
-    picard_guesses(guess, 1, kin.p, 1.0, True)  # (single: its refusals name "guess")
-    batch = solve_batch(
-        inverse,
-        x0[None],
-        y_d[None],
-        gamma=gamma,
-        mode=mode,
-        tol=tol,
-        max_iterations=max_iterations,
-        record=record,
-        method=method,
-        guess=None if guess is None else [guess],
-    )
-    return batch[0]
+    # (one guess, not a list of one: its refusals name "guess")
+    return _batch(
+        inverse, x0[None], y_d[None], gamma, mode, tol, max_iterations, record, method, guess, True
+    )[0]
 
 
 def solve_batch(
@@ -277,6 +267,11 @@ def solve_batch(
         exceeds :data:`jik.engine.validation.MEMORY_LIMIT`, naming ``x0`` (``y_d`` for a batch
         of targets from one start) and how many starts fit.
     """
+    return _batch(inverse, x0, y_d, gamma, mode, tol, max_iterations, record, method, guess, False)
+
+
+def _batch(inverse, x0, y_d, gamma, mode, tol, max_iterations, record, method, guess, single):
+    """:func:`solve_batch`; with ``single``, ``guess`` is one start's Trajectory (or None)."""
     kin = check_inverse(inverse)
     x0 = kin.check(x0, "x0")
     y_d = kin.check_task(y_d, "target y_d", "y_d")
@@ -306,7 +301,7 @@ def solve_batch(
         "solve them in smaller batches" + (", or with record=False" if record else ""),
     )
     xb, yb = np.array(xb), np.array(yb)
-    guesses = picard_guesses(guess, len(xb), kin.p, gamma)
+    guesses = picard_guesses(guess, len(xb), kin.p, gamma, single)
 
     if mode == "continuous":
         x, _, status, nit, rec = _continuous(inverse, xb, yb, tol, cap, record, method, guesses)
