@@ -138,6 +138,7 @@ def test_errors_show_beside_their_control_in_the_users_text(tabs):
     tab.screenshots("field-errors")
 
 
+@pytest.mark.slow
 def test_a_refusal_beside_a_control_goes_when_its_value_changes_elsewhere(tabs):
     """γ = -1 typed on the page is refused beside its box; γ then set elsewhere (the 3D scene,
     or any client of the session) to 2: the box shows 2, and the refusal of "-1" is gone."""

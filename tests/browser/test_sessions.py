@@ -122,6 +122,7 @@ def test_a_tab_whose_session_ended_opens_a_new_one_with_its_state(tabs):
     assert tab.url_state() == before and tab.snapshot()["state"] == before
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("text", ["[1, 2]", "null"])
 def test_a_link_whose_state_is_not_an_object_says_so(tabs, text):
     """A link's ?state= that is JSON but not an object of the state's fields opens the
