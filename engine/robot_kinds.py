@@ -35,7 +35,11 @@ LIMITS = DefinitionField(
 
 PLANAR_CHAIN = (
     DefinitionField(
-        "joints", "string", True, "joint types in order, base first: R revolute, P prismatic", "RRR"
+        "joints",
+        "string",
+        True,
+        "joint types in order, base first: R revolute, P prismatic (p = their number)",
+        "RRR",
     ),
     DefinitionField("lengths", "numbers", True, "link lengths > 0, one per joint", [1.0, 0.8, 0.6]),
     DefinitionField(
@@ -48,7 +52,8 @@ PLANAR_CHAIN = (
         "orientation",
         "boolean",
         False,
-        "also the end's angle as a task component (r = 3; default false: the end point, r = 2)",
+        "also the end's angle as a task component (r = 3, needs p >= 3; default false: the end "
+        "point, r = 2)",
         False,
     ),
     LIMITS,
@@ -56,13 +61,17 @@ PLANAR_CHAIN = (
 
 FORMULA = (
     DefinitionField(
-        "variables", "names", True, "joint variable names, in order", ["x1", "x2", "x3"]
+        "variables",
+        "names",
+        True,
+        "joint variable names, in order (p = their number)",
+        ["x1", "x2", "x3"],
     ),
     DefinitionField(
         "task",
         "formulas",
         True,
-        "task components, formulas in the variables and "
+        "task components (r = their number), formulas in the variables and "
         "parameters (sin cos tan exp log sqrt atan2 abs, + - * / **, numbers, pi)",
         ["x2 + l*cos(x3)", "x1 + l*sin(x3)"],
     ),
@@ -71,7 +80,9 @@ FORMULA = (
 )
 
 URDF = (
-    DefinitionField("urdf", "text", True, "the URDF text (at most 1 MB; meshes are not loaded)"),
+    DefinitionField(
+        "urdf", "text", True, "the URDF text (no DOCTYPE; at most 1 MB; meshes are not loaded)"
+    ),
     DefinitionField(
         "urdf_file",
         "string",
@@ -89,7 +100,7 @@ URDF = (
         "task",
         "string",
         False,
-        "coordinates of the end link: x y z (position) "
+        "coordinates of the end link: x y z (position in the base frame) "
         "and rx ry rz (rotation vector of R0^T R), pose for all six, or a subset "
         "such as xyz or 'x y z rz' (default xyz)",
         "xyz",
@@ -102,7 +113,7 @@ URDF = (
         "numbers",
         False,
         "a reference configuration, one value per "
-        "active joint (default: zero, clipped into the joint limits)",
+        "active joint (default: zero, clipped into the joint limits); also the default start",
     ),
     DefinitionField(
         "reference",
@@ -167,9 +178,9 @@ AUGMENTATIONS: dict[str, tuple[DefinitionField, ...]] = {
             "region",
             "mapping",
             True,
-            "two or more variables to [lo, hi]: the box "
+            "two or more variables to [lo, hi], lo < hi: the box "
             "of the Ritz synthesis of E2, eq. (20) (over more than three, in a "
-            "total-degree basis)",
+            "total-degree basis); an arm's maps default to a box around its home",
             {"x2": [0.4, 2], "x3": [0.4, 2]},
         ),
         DefinitionField(

@@ -17,7 +17,7 @@ from ....engine import robot_synthesis as synthesis
 from ....engine.arms import ARMS, Arm
 from ....engine.formula import MAX_LENGTH as MAX_FORMULA_CHARS  # (the engine's bound)
 from ....engine.registry import ROBOTS, AugmentationSpec, RobotSpec
-from ....engine.robot_kinds import LIMITS
+from ....engine.robot_kinds import AUGMENTATIONS, COMMON, KINDS
 from .fields import (
     INTEGRAL,
     MAX_DIMENSION,
@@ -147,134 +147,117 @@ Orientation = one_or_many(
 )
 
 
-class PlanarChainRobot(BaseModel):
-    """A planar serial chain of revolute (R) and prismatic (P) joints: the end point (r = 2),
-    or the end point and its angle (r = 3); p is the number of joints."""
-
-    model_config = ConfigDict(extra="forbid", title="Planar chain")
-    name: Literal["planar_chain"]
-    joints: Annotated[str, Field(pattern=r"^[RP]{1,16}$")] = Field(
-        description="joint types, base first: R revolute, P prismatic (p = its length)"
-    )
-    lengths: Vector = Field(description="link lengths, one per joint")
-    offsets: Vector | None = Field(
-        None, description="joint offsets added to x, one per joint (default 0)"
-    )
-    orientation: Annotated[bool, Field(strict=True)] = Field(
-        False, description="also the end's angle as a task component (r = 3; needs p >= 3)"
-    )
-    limits: JointLimits | None = Field(None, description=LIMITS.help)
-    title: Title | None = None
-
-
-class FormulaRobot(BaseModel):
-    """Kinematics written as formulas: k(x) = (task[0], task[1], ...) in the variables."""
-
-    model_config = ConfigDict(extra="forbid", title="Formula robot")
-    name: Literal["formula"]
-    variables: Annotated[list[Name], Field(min_length=1, max_length=MAX_DIMENSION)] = Field(
-        description="joint variable names, in order (p = their number)"
-    )
-    task: Annotated[list[FormulaText], Field(min_length=1, max_length=MAX_DIMENSION)] = Field(
-        description="task components (r = their number): formulas in the variables and "
-        "parameters with sin cos tan exp log sqrt atan2 abs, + - * / **, numbers and pi"
-    )
-    parameters: Constants = Field(default_factory=dict, description="named constants")
-    limits: JointLimits | None = Field(None, description=LIMITS.help)
-    title: Title | None = None
-
-
-class UrdfRobot(BaseModel):
-    """A serial arm from URDF text: the end link's pose (task 'pose', 'xyz' or a subset)."""
-
-    model_config = ConfigDict(extra="forbid", title="URDF arm")
-    name: Literal["urdf"]
-    urdf: Annotated[str, Field(min_length=1, max_length=MAX_URDF_CHARS)] = Field(
-        description="the URDF text (no DOCTYPE; meshes are not loaded)"
-    )
-    end_link: Annotated[str, Field(min_length=1, max_length=200)] = Field(
-        description="the link whose origin is the end point"
-    )
-    active_joints: (
-        Annotated[
-            list[Annotated[str, Field(min_length=1, max_length=200)]],
-            Field(min_length=1, max_length=MAX_DIMENSION),
-        ]
-        | None
-    ) = Field(None, description="the joints that move (default: all from the base to end_link)")
-    task: Annotated[str, Field(min_length=1, max_length=40, pattern=r"^[xyzrpose ,]+$")] = Field(
-        "xyz",
-        description="coordinates of the end link: x y z (position in the base frame) and rx ry "
-        "rz (rotation vector of R0^T R); 'pose' for all six, or a subset such as 'xyz', 'xz' "
-        "or 'x y z rz'",
-    )
-    home: Vector | None = Field(
-        None,
-        description="a reference configuration (default: zero, clipped into the "
-        "joint limits); also the default start",
-    )
-    reference: Orientation | None = Field(  # type: ignore[valid-type]
-        None,
-        description="R0, the orientation whose rotation coordinates are 0: a "
-        "rotation vector, a quaternion x y z w or a 3x3 matrix; default: the orientation "
-        "at home",
-    )
-    locked: Annotated[
-        dict[Annotated[str, Field(min_length=1, max_length=200)], FiniteFloat],
-        Field(max_length=64),
-    ] = Field(default_factory=dict, description="values of the chain's other movable joints")
-    title: Title | None = None
+#: A URDF's joint or link name (any characters: URDF does not restrict them).
+LinkName = Annotated[str, Field(min_length=1, max_length=200)]
+#: Each kind's definition entries the API takes, as ``(type, default)`` (``...``: required;
+#: ``dict``: an empty mapping): what JSON Schema can say of them. Their descriptions are the
+#: engine's (:data:`jik.engine.robot_kinds.KINDS`, ``AUGMENTATIONS``), the one text the
+#: dashboard's robot editor shows too; a robot file's ``urdf_file`` and a map's ``label`` are
+#: not a request's.
+_ENTRIES: dict[str, dict[str, tuple[Any, Any]]] = {
+    "planar_chain": {
+        "joints": (Annotated[str, Field(pattern=r"^[RP]{1,16}$")], ...),
+        "lengths": (Vector, ...),
+        "offsets": (Vector | None, None),
+        "orientation": (Annotated[bool, Field(strict=True)], False),
+        "limits": (JointLimits | None, None),
+    },
+    "formula": {
+        "variables": (Annotated[list[Name], Field(min_length=1, max_length=MAX_DIMENSION)], ...),
+        "task": (Annotated[list[FormulaText], Field(min_length=1, max_length=MAX_DIMENSION)], ...),
+        "parameters": (Constants, dict),
+        "limits": (JointLimits | None, None),
+    },
+    "urdf": {
+        "urdf": (Annotated[str, Field(min_length=1, max_length=MAX_URDF_CHARS)], ...),
+        "end_link": (LinkName, ...),
+        "active_joints": (
+            Annotated[list[LinkName], Field(min_length=1, max_length=MAX_DIMENSION)] | None,
+            None,
+        ),
+        "task": (
+            Annotated[str, Field(min_length=1, max_length=40, pattern=r"^[xyzrpose ,]+$")],
+            "xyz",
+        ),
+        "home": (Vector | None, None),
+        "reference": (Orientation | None, None),
+        "locked": (Annotated[dict[LinkName, FiniteFloat], Field(max_length=64)], dict),
+    },
+    "formula map": {
+        "h": (FormulaText | Annotated[list[FormulaText], Field(min_length=1, max_length=15)], ...),
+        "parameters": (Constants | None, None),
+    },
+    "e2_synthesized": {
+        "region": (
+            Annotated[
+                dict[Name, tuple[Bound, Bound]], Field(min_length=2, max_length=MAX_DIMENSION)
+            ]
+            | None,
+            None,
+        ),
+        "degree": (
+            Annotated[int, Field(strict=True, ge=1, le=synthesis.MAX_TENSOR_DEGREE), INTEGRAL]
+            | None,
+            None,
+        ),
+        "fixed": (Annotated[dict[Name, FiniteFloat], Field(max_length=MAX_DIMENSION)] | None, None),
+        "frame_axes": (FrameAxes | None, None),
+    },
+}
 
 
-class FormulaMapAugmentation(BaseModel):
-    """An augmenting map h written as a formula in the robot's variables, eq. (9); for
-    p - r > 1 a list of p - r formulas (the extended inverse of several maps)."""
+def _definition_model(cls: str, entries: str, title: str, doc: str) -> type[BaseModel]:
+    """The request model ``cls`` of a definition: its ``name``, the entries of
+    :data:`_ENTRIES` ``[entries]`` described by the engine, and a robot's ``title``."""
+    robot = entries in KINDS
+    kind = entries.replace("formula map", "formula")
+    said = {f.name: f.help for f in (*(KINDS[kind] if robot else AUGMENTATIONS[kind]), *COMMON)}
+    fields: dict[str, Any] = {"name": (Literal[kind], ...)}
+    for key, (kind_of, default) in _ENTRIES[entries].items():
+        made = {"default_factory": dict} if default is dict else {"default": default}
+        made = Field(**made, description=said[key])
+        fields[key] = (kind_of, made)
+    if robot:
+        fields["title"] = (Title | None, Field(None, description=said["title"]))
+    return create_model(
+        cls, __config__=ConfigDict(extra="forbid", title=title), __doc__=doc, **fields
+    )
 
-    model_config = ConfigDict(extra="forbid", title="Formula map")
-    name: Literal["formula"]
-    h: FormulaText | Annotated[list[FormulaText], Field(min_length=1, max_length=15)] = Field(
-        description="h(x), e.g. 'x3'; a list of p - r formulas when p - r > 1"
-    )
-    parameters: Constants | None = Field(None, description="named constants of h")
 
-
-class E2SynthesisAugmentation(BaseModel):
-    """The E2-optimal map on a box: for p = r + 1, the Ritz solve of eq. (20) on a tensor
-    Legendre basis for two or three variables, on a total-degree basis with a Sobol rule for
-    more; for p - r > 1, the maps h_1..h_(p-r) on the total-degree basis (docs/e2-vector.md)."""
-
-    model_config = ConfigDict(extra="forbid", title="E2-synthesized map")
-    name: Literal["e2_synthesized"]
-    region: (
-        Annotated[
-            dict[
-                Name,
-                tuple[Bound, Bound],
-            ],
-            Field(min_length=2, max_length=MAX_DIMENSION),
-        ]
-        | None
-    ) = Field(
-        None,
-        description="two or more variables to [lo, hi], lo < hi; default: "
-        "the robot's functional region (an arm's: a box around home)",
-    )
-    degree: (
-        Annotated[int, Field(strict=True, ge=1, le=synthesis.MAX_TENSOR_DEGREE), INTEGRAL] | None
-    ) = Field(
-        None,
-        description="two or three variables: Legendre degree per variable (default "
-        f"{synthesis.TENSOR_DEGREE}); more: the total degree, 1 to "
-        f"{synthesis.MAX_TOTAL_DEGREE} (default {synthesis.TOTAL_DEGREE})",
-    )
-    fixed: Annotated[dict[Name, FiniteFloat], Field(max_length=MAX_DIMENSION)] | None = Field(
-        None, description="values of the variables outside the box (default 0)"
-    )
-    frame_axes: FrameAxes | None = Field(
-        None,
-        description="p - r > 1: the p - r joints (1-based) whose axes fix the kernel "
-        "frame of h_1..h_(p-r) (default: the best-conditioned at the box's centre)",
-    )
+PlanarChainRobot = _definition_model(
+    "PlanarChainRobot",
+    "planar_chain",
+    "Planar chain",
+    "A planar serial chain of revolute (R) and prismatic (P) joints: the end point (r = 2), or "
+    "the end point and its angle (r = 3); p is the number of joints.",
+)
+FormulaRobot = _definition_model(
+    "FormulaRobot",
+    "formula",
+    "Formula robot",
+    "Kinematics written as formulas: k(x) = (task[0], task[1], ...) in the variables.",
+)
+UrdfRobot = _definition_model(
+    "UrdfRobot",
+    "urdf",
+    "URDF arm",
+    "A serial arm from URDF text: the end link's pose (task 'pose', 'xyz' or a subset).",
+)
+FormulaMapAugmentation = _definition_model(
+    "FormulaMapAugmentation",
+    "formula map",
+    "Formula map",
+    "An augmenting map h written as a formula in the robot's variables, eq. (9); for p - r > 1 "
+    "a list of p - r formulas (the extended inverse of several maps).",
+)
+E2SynthesisAugmentation = _definition_model(
+    "E2SynthesisAugmentation",
+    "e2_synthesized",
+    "E2-synthesized map",
+    "The E2-optimal map on a box: for p = r + 1, the Ritz solve of eq. (20) on a tensor Legendre "
+    "basis for two or three variables, on a total-degree basis with a Sobol rule for more; for "
+    "p - r > 1, the maps h_1..h_(p-r) on the total-degree basis (docs/e2-vector.md).",
+)
 
 
 def _arm_model(arm: Arm) -> type[BaseModel]:
@@ -311,17 +294,15 @@ USER_AUGMENTATION_MODELS: dict[str, type[BaseModel]] = {
 }
 #: Every robot name a request may give: the catalogue's, then the kinds of user robots.
 ROBOT_NAMES = [*ROBOTS, *USER_ROBOT_MODELS]
-UserAugmentation = Annotated[
-    FormulaMapAugmentation | E2SynthesisAugmentation, Field(discriminator="name")
-]
 
 if TYPE_CHECKING:
-    # Generated from the catalogue at import time (above), so their fields are invisible to a
+    # Generated from the catalogue and robot_kinds at import time (above), so their fields are invisible to a
     # static checker: type them as Any there.
     Robot: TypeAlias = Any
     Augmentation: TypeAlias = Any
     AnyRobot: TypeAlias = Any
     AnyAugmentation: TypeAlias = Any
+    UserAugmentation: TypeAlias = Any
 else:
     #: A catalogue robot and one of its maps (what the atlas takes).
     Robot = _union(list(ROBOT_MODELS.values()))
@@ -330,6 +311,7 @@ else:
     #: the workers validate with, take them all; the routes take the exact per-robot members
     #: of :func:`per_robot`.
     AnyRobot = _union([*ROBOT_MODELS.values(), *USER_ROBOT_MODELS.values()])
+    UserAugmentation = _union(list(USER_AUGMENTATION_MODELS.values()))
     AnyAugmentation = Augmentation | UserAugmentation
 
 
