@@ -11,17 +11,14 @@ from __future__ import annotations
 from typing import Annotated, Any
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, Tag, create_model
+from pydantic import BaseModel, ConfigDict, Field
 
 from ...engine.arms import ARMS
-from ...engine.registry import ROBOTS
 from . import schemas as S
 from .documents import nullable
 from .robot_requests import check_length, request_robot
-from .schemas.examples import schema_examples
 from .schemas.fields import coordinates, one_or_many
-from .schemas.robots import _camel
-from .schemas.variants import robot_union
+from .schemas.variants import per_robot
 from .worker import task
 
 #: Most configurations one request evaluates.
@@ -58,32 +55,13 @@ def _points(p: int | None) -> Any:
     )
 
 
-def _exact(name: str, robot: Any, p: int | None) -> Any:
-    model = create_model(
-        f"Kinematics{_camel(name)}Request",
-        __base__=KinematicsRequest,
-        __doc__=f"{KinematicsRequest.__doc__} ({name})",
-        __cls_kwargs__={"json_schema_extra": schema_examples("kinematics", name)},
-        robot=(robot, Field(description=robot.__doc__)),
-        x=_points(p),
-    )
-    globals()[model.__name__] = model  # importable by name (pickling, introspection)
-    return Annotated[model, Tag(name)]
-
-
-def _body() -> Any:
-    """The union of :func:`_exact` over the robots, chosen by ``robot.name``."""
-    members = [_exact(n, S.ROBOT_MODELS[n], spec.p) for n, spec in ROBOTS.items()]
-    members += [
-        _exact(n, m, len(ARMS[n].home) if n in ARMS else None)
-        for n, m in S.USER_ROBOT_MODELS.items()
-    ]
-    return robot_union(members)
-
-
 #: ``POST /kinematics``'s body: a :class:`KinematicsRequest` whose x has its robot's p where the
 #: robot's name fixes it (the paper's robots, the catalogue arms), chosen by ``robot.name``.
-KinematicsBody = _body()
+KinematicsBody = per_robot(
+    KinematicsRequest,
+    lambda spec, maps: {"x": _points(spec.p)},
+    lambda kind: {"x": _points(len(ARMS[kind].home) if kind in ARMS else None)},
+)
 
 
 class KinematicsResponse(BaseModel):

@@ -296,8 +296,8 @@ USER_AUGMENTATION_MODELS: dict[str, type[BaseModel]] = {
 ROBOT_NAMES = [*ROBOTS, *USER_ROBOT_MODELS]
 
 if TYPE_CHECKING:
-    # Generated from the catalogue and robot_kinds at import time (above), so their fields are invisible to a
-    # static checker: type them as Any there.
+    # Generated from the catalogue and robot_kinds at import time (above), so their fields are
+    # invisible to a static checker: type them as Any there.
     Robot: TypeAlias = Any
     Augmentation: TypeAlias = Any
     AnyRobot: TypeAlias = Any

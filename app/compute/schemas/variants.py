@@ -47,49 +47,55 @@ def narrowed(base: type[BaseModel], name: str, annotation: Any) -> tuple[Any, An
     return annotation, Field(info.default, description=info.description)
 
 
-def per_robot(base: type[BaseModel], fields: Any) -> Any:
+def per_robot(base: type[BaseModel], fields: Any, user_fields: Any = None) -> Any:
     """``base`` made exact for each robot of the catalogue: one model per robot, chosen by
     ``robot.name``, whose ``robot`` and ``augmentation`` are that robot's and whose vectors have
-    its lengths (``fields(spec)``: the fields that differ from ``base``'s), and one per kind of
-    user robot. Their union is what the route takes and what its
+    its lengths (``fields(spec, maps)``: the fields that differ from ``base``'s, ``maps`` the
+    robot's augmenting maps), and one per kind of user robot (``user_fields(kind)``; default:
+    its maps, :func:`user_maps`). Their union is what the route takes and what its
     OpenAPI document shows, each member with its robot's example (:mod:`.examples`); each
     member is still a ``base``."""
-    members = []
-    route = base.__name__.removesuffix("Request").lower()
-    for name, spec in ROBOTS.items():
-        augmentations = list(dict.fromkeys(a.name for a in spec.augmentations))
+    route = base.__name__.removesuffix("Request")
+
+    def member(name: str, robot: Any, title: Any, about: Any, more: dict[str, Any]) -> Any:
         model = create_model(
-            f"{base.__name__.removesuffix('Request')}{_camel(name)}Request",
+            f"{route}{_camel(name)}Request",
             __base__=base,
-            __doc__=f"{(base.__doc__ or '').strip()} ({spec.title})",
-            __cls_kwargs__={"json_schema_extra": schema_examples(route, name)},
-            robot=(ROBOT_MODELS[name], Field(description=f"{spec.title} and its parameters")),
-            **fields(spec, _union([AUGMENTATION_MODELS[a] for a in augmentations])),
+            __doc__=f"{(base.__doc__ or '').strip()} ({title})",
+            __cls_kwargs__={"json_schema_extra": schema_examples(route.lower(), name)},
+            robot=(robot, Field(description=about)),
+            **more,
         )
-        globals()[model.__name__] = model
-        members.append(Annotated[model, Tag(name)])
-    for kind, robot_model in USER_ROBOT_MODELS.items():
+        globals()[model.__name__] = model  # importable by name (pickling, introspection)
+        return Annotated[model, Tag(name)]
+
+    members = []
+    for name, spec in ROBOTS.items():
+        names = dict.fromkeys(a.name for a in spec.augmentations)
+        maps = _union([AUGMENTATION_MODELS[a] for a in names])
+        about = f"{spec.title} and its parameters"
+        members.append(member(name, ROBOT_MODELS[name], spec.title, about, fields(spec, maps)))
+    for kind, model in USER_ROBOT_MODELS.items():
         # p and r follow from the definition: the vectors keep the base's 1 to 16 components,
         # checked against the built robot (a 422 naming the field and the robot's p, r).
-        model = create_model(
-            f"{base.__name__.removesuffix('Request')}{_camel(kind)}Request",
-            __base__=base,
-            __doc__=f"{(base.__doc__ or '').strip()} ({robot_model.model_config.get('title')})",
-            __cls_kwargs__={"json_schema_extra": schema_examples(route, kind)},
-            robot=(robot_model, Field(description=f"{robot_model.__doc__}")),
-            augmentation=(
-                UserAugmentation | None,
-                Field(
-                    None,
-                    description="augmenting map h of the extended inverse: "
-                    "{'name': 'formula', 'h': ...} or {'name': 'e2_synthesized', 'region': "
-                    "{...}} (p = r + 1)" + USER_AUGMENTATION_NOTE.get(base.__name__, ""),
-                ),
+        more = (user_fields or (lambda kind: user_maps(base)))(kind)
+        members.append(member(kind, model, model.model_config.get("title"), model.__doc__, more))
+    return robot_union(members)
+
+
+def user_maps(base: type[BaseModel]) -> dict[str, Any]:
+    """The ``augmentation`` field of ``base`` made for a user robot: a map it defines."""
+    return {
+        "augmentation": (
+            UserAugmentation | None,
+            Field(
+                None,
+                description="augmenting map h of the extended inverse: "
+                "{'name': 'formula', 'h': ...} or {'name': 'e2_synthesized', 'region': "
+                "{...}} (p = r + 1)" + USER_AUGMENTATION_NOTE.get(base.__name__, ""),
             ),
         )
-        globals()[model.__name__] = model
-        members.append(Annotated[model, Tag(kind)])
-    return robot_union(members)
+    }
 
 
 def robot_union(members: list[Any]) -> Any:
