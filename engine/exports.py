@@ -95,6 +95,19 @@ def dataframe(columns: dict[str, Any]):
     return pd.DataFrame(columns)
 
 
+def nullable(a) -> Any:
+    """An array (or a number) as JSON-ready data: nested lists of floats, None where not finite
+    (JSON has no NaN: a failed run's, a diverged map's values)."""
+    a = np.asarray(a, dtype=float)
+    if a.ndim == 0:
+        return float(a) if np.isfinite(a) else None
+    if np.isfinite(a).all():
+        return a.tolist()
+    obj = a.astype(object)
+    obj[~np.isfinite(a)] = None
+    return obj.tolist()
+
+
 def coordinate_names(name: str, n: int) -> list[str]:
     """``[name_1, ..., name_n]``: the columns of a vector's n coordinates, numbered from 1."""
     return [f"{name}_{k + 1}" for k in range(n)]

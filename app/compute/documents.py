@@ -1,4 +1,4 @@
-"""Engine results as JSON-ready documents: arrays to lists (null where not finite), a run's
+"""Engine results as JSON-ready documents (arrays by :func:`jik.engine.exports.nullable`): a run's
 trajectory downsampled, one solve's response and its joint-limit report (the fields of
 ``S.SolveResponse``), built without validating the model on the workers' hot path."""
 
@@ -9,20 +9,9 @@ from typing import Any
 import numpy as np
 import pydantic_core
 
+from ...engine.exports import nullable
 from ...engine.limits import run_report
 from . import schemas as S
-
-
-def nullable(a) -> Any:
-    """ndarray -> nested lists with None where not finite (JSON has no NaN)."""
-    a = np.asarray(a, dtype=float)
-    if a.ndim == 0:
-        return float(a) if np.isfinite(a) else None
-    if np.isfinite(a).all():
-        return a.tolist()
-    obj = a.astype(object)
-    obj[~np.isfinite(a)] = None
-    return obj.tolist()
 
 
 def downsample(m: int, limit: int = S.MAX_TRAJECTORY_POINTS) -> np.ndarray:

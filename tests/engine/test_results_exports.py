@@ -321,3 +321,13 @@ def test_a_functional_value_prints_in_one_line():
     assert "x2 in [-1, 1], x3 in [0, 3], held x1=0, 256 points, 0 singular" in e2
     e1 = repr(jik.error_functional_e1(ARM, jik.PaperCubic(), region))
     assert e1.startswith("FunctionalValue(inf (divergent), "), e1
+
+
+def test_nullable_writes_not_finite_values_as_none():
+    """JSON has no NaN: a value that is not finite becomes None, the rest plain floats."""
+    a = np.array([[1.0, np.nan], [-np.inf, 2.5]])
+    assert jik_exports.nullable(a) == [[1.0, None], [None, 2.5]]
+    assert json.dumps(jik_exports.nullable(a)) == "[[1.0, null], [null, 2.5]]"
+    assert jik_exports.nullable(np.float64(np.inf)) is None
+    assert jik_exports.nullable(3) == 3.0
+    assert jik_exports.nullable([0.5, 1.0]) == [0.5, 1.0]

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
-import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, create_model
 
+from ....engine.exports import nullable
 from ....engine.registry import ALGORITHMS
 from .fields import Coordinate
 
@@ -60,17 +60,11 @@ def used(params: BaseModel | None) -> dict:
 
 
 def parameters_of(inverse) -> dict[str, Any]:
-    """The parameters an engine inverse holds, by the catalogue's names, defaults filled in
-    (posture's rest, weighted's limits, with None for an unbounded end): what a response says
-    the run used."""
-    spec = ALGORITHMS[inverse.name]
-    out: dict[str, Any] = {p.name: float(getattr(inverse, p.name)) for p in spec.parameters}
-    for name in spec.vectors:
-        values = np.asarray(getattr(inverse, name), dtype=float)
-        shown = values.astype(object)
-        shown[~np.isfinite(values)] = None
-        out[name] = shown.tolist()
-    return out
+    """The parameters an engine inverse holds (its ``parameters``), by the catalogue's names,
+    defaults filled in (posture's rest, weighted's limits, with None for an unbounded end): what
+    a response says the run used."""
+    values = inverse.parameters
+    return {name: nullable(values[name]) for name in ALGORITHMS[inverse.name].names}
 
 
 def field_of(exc_field: str | None) -> str:
