@@ -10,27 +10,23 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, Field
 
 from ...engine.repeatability import MAX_PATH_POINTS
-from ...engine.solve_rules import DISCRETE_GAMMA_BOUND
 from .schemas import (
     INTEGRAL,
     Algorithm,
     AnyAugmentation,
-    AnyRobot,
     AugmentationUsed,
     Coordinate,
-    Gamma,
     MaybeFloat,
-    Mode,
     RobotUsed,
-    Tolerance,
     Vector,
     per_robot,
 )
 from .schemas.algorithms import AlgorithmParameters
 from .schemas.fields import Seed, coordinates, points
+from .schemas.runs import RunSettings
 from .schemas.variants import narrowed
 
 #: Largest starts per path, cycles, and paths of a family (shifts, scales) in one request.
@@ -44,17 +40,10 @@ Scale = Annotated[float, Field(strict=True, gt=0, le=100.0, allow_inf_nan=False)
 StartPoints = Annotated[list[Vector], Field(min_length=1, max_length=MAX_START_POINTS)]
 
 
-class AtlasRequest(BaseModel):
+class AtlasRequest(RunSettings):
     """A repeatability atlas: the drift after each cycle of a closed path, for many starts on the
     self-motion curve of the path's first point (engine.atlas)."""
 
-    model_config = ConfigDict(extra="forbid")
-
-    robot: AnyRobot = Field(
-        description="the robot and its parameters, e.g. {'name': 'manipulator2'}, a catalogue "
-        "arm {'name': 'panda', 'task': 'pose'} or a robot defined in the request (planar_chain, "
-        "formula, urdf)"
-    )
     algorithms: Annotated[list[Algorithm], Field(min_length=1, max_length=5)] = Field(
         ["pseudoinverse"],
         description="the algorithms to compare over the same starts, each once: 'pseudoinverse' "
@@ -103,13 +92,6 @@ class AtlasRequest(BaseModel):
         None, description="scales of the path about its first point"
     )
     cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_CYCLES), INTEGRAL] = 3
-    gamma: Gamma | None = Field(
-        None,
-        description=f"decay rate of eq. (5) of every leg (discrete: < {DISCRETE_GAMMA_BOUND:g}); "
-        "default: robot's",
-    )
-    mode: Mode | None = Field(None, description="'continuous' or 'discrete'; default: robot's")
-    tolerance: Tolerance = Field(1e-10, description="each leg stops at ||k(x) - target|| < this")
     leg_ends: bool = Field(False, strict=True, description="include every leg's end in the result")
 
 

@@ -35,12 +35,28 @@ from .robots import (
 from .variants import per_robot
 
 
-class _Request(BaseModel):
+class RunSettings(BaseModel):
+    """What every run of a request shares (a solve's, a repeatability's, an atlas's legs)."""
+
     model_config = ConfigDict(extra="forbid")
 
     robot: AnyRobot = Field(
-        description="the robot and its parameters, e.g. {'name': 'manipulator2', 'l': 1}"
+        description="the robot and its parameters, e.g. {'name': 'manipulator2'}, a catalogue "
+        "arm {'name': 'panda', 'task': 'pose'} or a robot defined in the request (planar_chain, "
+        "formula, urdf)"
     )
+    gamma: Gamma | None = Field(
+        None,
+        description=f"decay rate > 0 of eq. (5) (discrete: the step, < {DISCRETE_GAMMA_BOUND:g}); "
+        "default: the robot's",
+    )
+    mode: Mode | None = Field(
+        None, description="'continuous' (ODE) or 'discrete' (iterations); default: the robot's"
+    )
+    tolerance: Tolerance = Field(1e-10, description="stop when ||k(x) - target|| < tolerance")
+
+
+class _Request(RunSettings):
     algorithm: Algorithm = Field(
         description="'pseudoinverse' (eq. (8)), 'extended' (extended Jacobian inverse, eq. (11)), "
         "'damped' (damped least squares), 'weighted' (weighted least-norm inverse for joint "
@@ -57,15 +73,6 @@ class _Request(BaseModel):
         "default: the robot's default augmentation (ignored by the pseudoinverse)",
     )
     x0: Vector = Field(description="start configuration, length p of the robot")
-    gamma: Gamma | None = Field(
-        None,
-        description=f"decay rate > 0 of eq. (5) (discrete: the step, < {DISCRETE_GAMMA_BOUND:g}); "
-        "default: the robot's",
-    )
-    mode: Mode | None = Field(
-        None, description="'continuous' (ODE) or 'discrete' (iterations); default: the robot's"
-    )
-    tolerance: Tolerance = Field(1e-10, description="stop when ||k(x) - target|| < tolerance")
     max_iterations: Annotated[int, Field(strict=True, ge=1, le=MAX_ITERATIONS), INTEGRAL] | None = (
         Field(
             None,
