@@ -7,7 +7,8 @@
 - :mod:`.runs`: ``/solve`` and ``/repeatability``; :mod:`.synthesis`: ``/synthesize``;
 - :mod:`.info`: ``/robots``, ``/health`` and the error body.
 
-Everything is re-exported here: ``from jik.app.compute import schemas as S``.
+Everything is re-exported here, by the imports below: ``from jik.app.compute import schemas as
+S`` (their names are this package's API; ``pyproject.toml`` lets ruff keep them unused here).
 """
 
 from .algorithms import Algorithm, AlgorithmParameters
@@ -83,70 +84,3 @@ from .synthesis import (
     TotalDegreeInfo,
 )
 from .variants import per_robot
-
-__all__ = [
-    "AUGMENTATION_MODELS",
-    "BUSY",
-    "COORDINATE_BOUND",
-    "GAMMA_MIN",
-    "INTEGRAL",
-    "MAX_DIMENSION",
-    "MAX_FORMULA_CHARS",
-    "MAX_ITERATIONS",
-    "MAX_TRAJECTORY_POINTS",
-    "MAX_URDF_CHARS",
-    "ROBOT_MODELS",
-    "ROBOT_NAMES",
-    "USER_AUGMENTATION_MODELS",
-    "USER_ROBOT_MODELS",
-    "Algorithm",
-    "AlgorithmInfo",
-    "AlgorithmParameters",
-    "AnyAugmentation",
-    "AnyRobot",
-    "Augmentation",
-    "AugmentationInfo",
-    "AugmentationUsed",
-    "Bound",
-    "Coordinate",
-    "E2SynthesisAugmentation",
-    "ErrorResponse",
-    "FiniteFloat",
-    "FormulaMapAugmentation",
-    "FormulaRobot",
-    "FunctionalInfo",
-    "Gamma",
-    "HealthResponse",
-    "LimitViolationInfo",
-    "Limits",
-    "LimitsInfo",
-    "MapSingularitiesInfo",
-    "MaybeFloat",
-    "Mode",
-    "ParameterInfo",
-    "PlanarChainRobot",
-    "RepeatabilityBody",
-    "RepeatabilityRequest",
-    "RepeatabilityResponse",
-    "Robot",
-    "RobotInfo",
-    "RobotUsed",
-    "RobotsResponse",
-    "SolveBody",
-    "SolveRequest",
-    "SolveResponse",
-    "SynthesisGrid",
-    "SynthesisMethod",
-    "SynthesisMethodsResponse",
-    "SynthesizeBody",
-    "SynthesizeRequest",
-    "SynthesizeResponse",
-    "Tolerance",
-    "TotalDegreeInfo",
-    "Trajectory",
-    "UnitsInfo",
-    "UrdfRobot",
-    "UserAugmentation",
-    "Vector",
-    "per_robot",
-]
