@@ -13,10 +13,6 @@ from pydantic import AliasChoices, Field, field_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
 
-def _cores() -> int:
-    return max(1, min(8, os.cpu_count() or 2))
-
-
 def cpu_count() -> int:
     """The machine's CPU count (at least 1): the default of ``dashboard_computations``."""
     return max(1, os.cpu_count() or 1)
@@ -34,7 +30,7 @@ class Settings(BaseSettings):
     model_config = SettingsConfigDict(env_prefix="JIK_", frozen=True, extra="forbid")
 
     #: Compute worker processes (1..8; default: the CPU count).
-    workers: int = Field(default_factory=_cores)
+    workers: int = Field(default_factory=cpu_count, validate_default=True)
     #: Longest wait for a compute slot, and longest computation [s].
     timeout: float = Field(default=20.0, gt=0)
     #: Micro-batching of concurrent compatible /solve requests (``JIK_BATCH=0``: off).

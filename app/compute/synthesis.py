@@ -7,6 +7,8 @@
 
 from __future__ import annotations
 
+from typing import get_args
+
 from ...engine.augmentations import Polynomial2
 from ...engine.exceptions import JikError
 from ...engine.functionals import error_functional_e1, error_functional_e2
@@ -21,7 +23,7 @@ from .synthesis_total import map_response, total_degree_response
 
 def synthesis_methods() -> S.SynthesisMethodsResponse:
     return S.SynthesisMethodsResponse(
-        methods=["evaluate", "e2_variational", "e2_total_degree"],
+        methods=list(get_args(S.SynthesisMethod)),
         notes={
             "evaluate": "any map of the catalogue (GET /robots): h on a grid of the box, "
             "polynomial coefficients, E1 and E2 on the box",
