@@ -95,9 +95,8 @@ class AtlasRequest(RunSettings):
     leg_ends: bool = Field(False, strict=True, description="include every leg's end in the result")
 
 
-def _atlas_fields(spec, augmentation) -> dict:
+def _atlas_fields(spec) -> dict:
     return {
-        "augmentation": narrowed(AtlasRequest, "augmentation", augmentation | None),
         "path": (
             points(spec.r, 2, MAX_PATH_POINTS) | None,
             Field(

@@ -59,7 +59,7 @@ def _points(p: int | None) -> Any:
 #: robot's name fixes it (the paper's robots, the catalogue arms), chosen by ``robot.name``.
 KinematicsBody = per_robot(
     KinematicsRequest,
-    lambda spec, maps: {"x": _points(spec.p)},
+    lambda spec: {"x": _points(spec.p)},
     lambda kind: {"x": _points(len(ARMS[kind].home) if kind in ARMS else None)},
 )
 

@@ -197,17 +197,8 @@ class RepeatabilityResponse(_RunResponse):
     limits: RunLimits = None
 
 
-def _run_fields(spec: RobotSpec, augmentation: Any) -> dict[str, Any]:
+def _run_fields(spec: RobotSpec) -> dict[str, Any]:
     return {
-        "augmentation": (
-            augmentation | None,
-            Field(
-                None,
-                description=f"augmenting map h of the extended inverse (one of "
-                f"{sorted({a.name for a in spec.augmentations})}); default: "
-                f"{spec.augmentation(None).name} (ignored by the pseudoinverse)",
-            ),
-        ),
         "x0": (
             coordinates(spec.p),
             Field(description=f"start configuration {list(spec.variable_names)}"),
@@ -218,16 +209,16 @@ def _run_fields(spec: RobotSpec, augmentation: Any) -> dict[str, Any]:
 #: ``POST /solve``'s body: a :class:`SolveRequest` with the lengths of its robot.
 SolveBody = per_robot(
     SolveRequest,
-    lambda spec, aug: {
-        **_run_fields(spec, aug),
+    lambda spec: {
+        **_run_fields(spec),
         "target": (coordinates(spec.r), Field(description=f"target {list(spec.task_names)}")),
     },
 )
 #: ``POST /repeatability``'s body: a :class:`RepeatabilityRequest` with its robot's lengths.
 RepeatabilityBody = per_robot(
     RepeatabilityRequest,
-    lambda spec, aug: {
-        **_run_fields(spec, aug),
+    lambda spec: {
+        **_run_fields(spec),
         "path": (
             points(spec.r, 1, MAX_PATH_POINTS),
             Field(

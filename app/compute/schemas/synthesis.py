@@ -81,19 +81,10 @@ class SynthesizeRequest(BaseModel):
     )
 
 
-def _synthesis_fields(spec: RobotSpec, augmentation: Any) -> dict[str, Any]:
+def _synthesis_fields(spec: RobotSpec) -> dict[str, Any]:
     names = tuple(spec.variable_names)
     variable = Literal[names]  # type: ignore[valid-type]
     return {
-        "augmentation": (
-            augmentation | None,
-            Field(
-                None,
-                description="for 'evaluate': the map and its parameters (one of "
-                f"{sorted({a.name for a in spec.augmentations})}; default: "
-                f"{spec.augmentation(None).name})",
-            ),
-        ),
         "region": (
             Annotated[
                 dict[variable, tuple[Bound, Bound]], Field(min_length=1, max_length=len(names))

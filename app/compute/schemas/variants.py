@@ -49,12 +49,12 @@ def narrowed(base: type[BaseModel], name: str, annotation: Any) -> tuple[Any, An
 
 def per_robot(base: type[BaseModel], fields: Any, user_fields: Any = None) -> Any:
     """``base`` made exact for each robot of the catalogue: one model per robot, chosen by
-    ``robot.name``, whose ``robot`` and ``augmentation`` are that robot's and whose vectors have
-    its lengths (``fields(spec, maps)``: the fields that differ from ``base``'s, ``maps`` the
-    robot's augmenting maps), and one per kind of user robot (``user_fields(kind)``; default:
-    its maps, :func:`user_maps`). Their union is what the route takes and what its
-    OpenAPI document shows, each member with its robot's example (:mod:`.examples`); each
-    member is still a ``base``."""
+    ``robot.name``, whose ``robot`` and ``augmentation`` (if ``base`` has one: the robot's maps,
+    named with its default) are that robot's and whose vectors have its lengths
+    (``fields(spec)``: the other fields that differ from ``base``'s), and one per kind of user
+    robot (``user_fields(kind)``; default: its maps, :func:`user_maps`). Their union is what the
+    route takes and what its OpenAPI document shows, each member with its robot's example
+    (:mod:`.examples`); each member is still a ``base``."""
     route = base.__name__.removesuffix("Request")
 
     def member(name: str, robot: Any, title: Any, about: Any, more: dict[str, Any]) -> Any:
@@ -71,10 +71,16 @@ def per_robot(base: type[BaseModel], fields: Any, user_fields: Any = None) -> An
 
     members = []
     for name, spec in ROBOTS.items():
-        names = dict.fromkeys(a.name for a in spec.augmentations)
-        maps = _union([AUGMENTATION_MODELS[a] for a in names])
+        more = fields(spec)
+        if "augmentation" in base.model_fields:
+            names = list(dict.fromkeys(a.name for a in spec.augmentations))
+            maps = _union([AUGMENTATION_MODELS[a] for a in names])
+            info = base.model_fields["augmentation"]
+            default = spec.augmentation(None).name
+            said = f"{info.description}; {spec.title}'s: one of {sorted(names)}, default {default}"
+            more["augmentation"] = (maps | None, Field(None, description=said))
         about = f"{spec.title} and its parameters"
-        members.append(member(name, ROBOT_MODELS[name], spec.title, about, fields(spec, maps)))
+        members.append(member(name, ROBOT_MODELS[name], spec.title, about, more))
     for kind, model in USER_ROBOT_MODELS.items():
         # p and r follow from the definition: the vectors keep the base's 1 to 16 components,
         # checked against the built robot (a 422 naming the field and the robot's p, r).
