@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from .exceptions import InvalidInputError
-from .exports import Columns, coordinate_columns, short_text, short_vector
+from .exports import Columns, coordinate_columns, json_values, short_text, short_vector
 from .inverses import Inverse
 from .solve_rules import Status
 from .validation import FloatArray
@@ -69,14 +69,18 @@ class Trajectory(Columns):
         return out
 
     def as_dict(self) -> dict[str, Any]:
-        """JSON-friendly: ``theta``, ``x`` (m lists of p), ``y``, ``error``, ``h`` (or None)."""
-        return {
-            "theta": np.asarray(self.theta).tolist(),
-            "x": np.asarray(self.x).tolist(),
-            "y": np.asarray(self.y).tolist(),
-            "error": np.asarray(self.error).tolist(),
-            "h": None if self.h is None else np.asarray(self.h).tolist(),
-        }
+        """JSON-friendly (:func:`~jik.engine.exports.json_values`: NaN as None): ``theta``,
+        ``x`` (m lists of p), ``y``, ``error``, ``h`` (None without a map, or where h is
+        undefined)."""
+        return json_values(
+            {
+                "theta": np.asarray(self.theta),
+                "x": np.asarray(self.x),
+                "y": np.asarray(self.y),
+                "error": np.asarray(self.error),
+                "h": None if self.h is None else np.asarray(self.h),
+            }
+        )
 
 
 @dataclass(frozen=True)
@@ -159,7 +163,8 @@ class SolveResult(Columns):
         return out
 
     def as_dict(self, trajectory: bool = False) -> dict[str, Any]:
-        """JSON-friendly fields; with ``trajectory``, also :meth:`Trajectory.as_dict`."""
+        """JSON-friendly fields (:func:`~jik.engine.exports.json_values`: NaN as None); with
+        ``trajectory``, also :meth:`Trajectory.as_dict`."""
         out: dict[str, Any] = {
             "algorithm": self.algorithm,
             "inverse": self.inverse,
@@ -177,7 +182,7 @@ class SolveResult(Columns):
         }
         if trajectory:
             out["trajectory"] = None if self.trajectory is None else self.trajectory.as_dict()
-        return out
+        return json_values(out)
 
 
 @dataclass(frozen=True)
@@ -233,23 +238,25 @@ class BatchSolveResult(Columns):
         return out
 
     def as_dict(self) -> dict[str, Any]:
-        """JSON-friendly: the settings and, per member, x0, y_d, x, y, error, success, nit,
-        message, status."""
-        return {
-            "algorithm": self.algorithm,
-            "inverse": repr(self._inverse),
-            "mode": self.mode,
-            "gamma": self.gamma,
-            "x0": np.asarray(self.x0).tolist(),
-            "y_d": np.asarray(self.y_d).tolist(),
-            "x": self.x.tolist(),
-            "y": self.y.tolist(),
-            "error": self.error.tolist(),
-            "success": np.asarray(self.success, dtype=bool).tolist(),
-            "nit": np.asarray(self.nit, dtype=int).tolist(),
-            "message": list(self.message),
-            "status": list(self.status),
-        }
+        """JSON-friendly (:func:`~jik.engine.exports.json_values`: NaN as None): the settings
+        and, per member, x0, y_d, x, y, error, success, nit, message, status."""
+        return json_values(
+            {
+                "algorithm": self.algorithm,
+                "inverse": repr(self._inverse),
+                "mode": self.mode,
+                "gamma": self.gamma,
+                "x0": np.asarray(self.x0).tolist(),
+                "y_d": np.asarray(self.y_d).tolist(),
+                "x": self.x.tolist(),
+                "y": self.y.tolist(),
+                "error": self.error.tolist(),
+                "success": np.asarray(self.success, dtype=bool).tolist(),
+                "nit": np.asarray(self.nit, dtype=int).tolist(),
+                "message": list(self.message),
+                "status": list(self.status),
+            }
+        )
 
     @property
     def status(self) -> tuple[str, ...]:
