@@ -85,6 +85,8 @@ def json_values(v: Any) -> Any:
     if isinstance(v, list | tuple):
         return [json_values(x) for x in v]
     if isinstance(v, np.ndarray) and v.dtype.kind == "f":
+        if np.isfinite(v).all():
+            return v.tolist()
         out = v.astype(object)
         out[~np.isfinite(v)] = None
         return out.tolist()
