@@ -20,6 +20,7 @@ import numpy as np
 
 from .augmentations import AugmentingMap
 from .exceptions import InvalidInputError
+from .exports import json_values
 from .inverses import (
     extended_determinant,
     extended_inverse,
@@ -80,17 +81,20 @@ class FunctionalValue:
         )
 
     def as_dict(self) -> dict:
-        """JSON-friendly form."""
-        return {
-            "value": self.value,
-            "region": {k: list(v) for k, v in self.region.items()},
-            "fixed": dict(self.fixed),
-            "n_points": self.n_points,
-            "n_singular": int(self.singular_points.shape[0]),
-            "singular_points": self.singular_points.tolist(),
-            "min_abs_dh_k": self.min_abs_dh_k,
-            "divergent": self.divergent,
-        }
+        """JSON-friendly form (:func:`~jik.engine.exports.json_values`: a divergent E1's value
+        None)."""
+        return json_values(
+            {
+                "value": self.value,
+                "region": {k: list(v) for k, v in self.region.items()},
+                "fixed": dict(self.fixed),
+                "n_points": self.n_points,
+                "n_singular": int(self.singular_points.shape[0]),
+                "singular_points": self.singular_points.tolist(),
+                "min_abs_dh_k": self.min_abs_dh_k,
+                "divergent": self.divergent,
+            }
+        )
 
 
 def check_region(
