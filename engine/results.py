@@ -1,11 +1,12 @@
 """Results of the continuation algorithm (7): a solve, a batch of solves, a trajectory.
 
 They borrow SciPy's vocabulary (``x``, ``success``, ``message``, ``nit``), print on one line
-(``print(result)``) and export their numbers: :meth:`as_dict` gives JSON-friendly values, and
-``to_dataframe()`` a pandas DataFrame (pandas is optional: ``columns()`` gives the same columns
-as plain arrays). Column names follow :mod:`jik.engine.exports`: ``x0_k`` a start, ``x_k`` the
-row's configuration, ``y_k`` its task point, ``y_d_k`` a target. A repeatability run's result
-is :class:`jik.engine.repeatability_result.RepeatabilityResult`.
+(``print(result)``) and export their numbers: :meth:`as_dict` gives JSON-friendly values (None
+where a number is missing, NaN in the arrays), and ``to_dataframe()`` a pandas DataFrame, with
+NaN there (pandas is optional: ``columns()`` gives the same columns as plain arrays). Column
+names follow :mod:`jik.engine.exports`: ``x0_k`` a start, ``x_k`` the row's configuration,
+``y_k`` its task point, ``y_d_k`` a target. A repeatability run's result is
+:class:`jik.engine.repeatability_result.RepeatabilityResult`.
 """
 
 from __future__ import annotations
