@@ -36,8 +36,3 @@ class FairSlots:
             with self._cond:
                 self._busy -= 1
                 self._cond.notify_all()
-
-    @property
-    def busy(self) -> int:
-        """Slots held now."""
-        return self._busy
