@@ -35,7 +35,7 @@ from ..compute.schemas.wording import refused, without_field
 
 class ChosenState(Protocol):
     """What these functions read of a :class:`jik.app.dashboard.model.DashboardState` (which
-    imports this module)."""
+    imports this module: importing it here, even for the type checker, is a cycle)."""
 
     @property
     def algorithms(self) -> Sequence[str]: ...
