@@ -9,7 +9,8 @@ from pathlib import Path
 from typing import Any
 
 from jik import install_hint
-from jik.engine.exports import json_values
+
+from ..engine.exports import json_values
 
 
 class Gathered:
