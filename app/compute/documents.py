@@ -1,4 +1,4 @@
-"""Engine results as JSON-ready documents (arrays by :func:`jik.engine.exports.nullable`): a run's
+"""Engine results as JSON-ready documents: arrays to lists (null where not finite), a run's
 trajectory downsampled, one solve's response and its joint-limit report (the fields of
 ``S.SolveResponse``), built without validating the model on the workers' hot path."""
 
@@ -9,9 +9,14 @@ from typing import Any
 import numpy as np
 import pydantic_core
 
-from ...engine.exports import nullable
+from ...engine.exports import json_values
 from ...engine.limits import run_report
 from . import schemas as S
+
+
+def nullable(a) -> Any:
+    """Numbers -> nested lists with None where not finite (:func:`json_values`)."""
+    return json_values(np.asarray(a, dtype=float))
 
 
 def downsample(m: int, limit: int = S.MAX_TRAJECTORY_POINTS) -> np.ndarray:

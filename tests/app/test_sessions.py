@@ -11,9 +11,10 @@ from fastapi.testclient import TestClient
 from starlette.websockets import WebSocketDisconnect
 
 from jik.app.api.factory import create_app
+from jik.app.compute.settings import Settings
 from jik.app.dashboard.algorithms import COLORS
 from jik.app.dashboard.plotting import PANELS
-from jik.app.dashboard.sessions import SessionLimits, SessionNotFound, SessionsFull, SessionStore
+from jik.app.dashboard.sessions import SessionNotFound, SessionsFull, SessionStore
 from jik.engine.registry import ALGORITHMS
 
 JSON = {"content-type": "application/json"}
@@ -139,7 +140,7 @@ def test_unknown_and_deleted_sessions_are_404(client):
 
 
 def test_a_full_store_evicts_the_idlest_unused_session_or_refuses():
-    store = SessionStore(SessionLimits(max_sessions=2))
+    store = SessionStore(Settings(max_sessions=2))
     try:
         a = store.create()
         b = store.create()
@@ -157,7 +158,7 @@ def test_a_full_store_evicts_the_idlest_unused_session_or_refuses():
 
 def test_a_full_store_answers_503(app, client):
     app.state.sessions.close()
-    app.state.sessions = store = SessionStore(SessionLimits(max_sessions=1))
+    app.state.sessions = store = SessionStore(Settings(max_sessions=1))
     session = _open(client)
     store.get(session["id"]).users = 1
     r = client.post("/api/sessions", json={"state": {}})
@@ -166,7 +167,7 @@ def test_a_full_store_answers_503(app, client):
 
 
 def test_idle_sessions_expire_by_themselves():
-    store = SessionStore(SessionLimits(idle_seconds=1.0))
+    store = SessionStore(Settings(session_idle_seconds=1.0))
     try:
         kept, idle = store.create(), store.create()
         kept.users = 1
@@ -269,3 +270,44 @@ def test_an_export_after_a_failure_is_409_never_the_previous_result(app, client,
     r = client.get(f"/api/sessions/{sid}/export.json")
     assert r.status_code == 200
     client.delete(f"/api/sessions/{sid}")
+
+
+def test_an_export_of_a_named_generation_is_that_one_while_a_newer_computes(
+    app, client, monkeypatch
+):
+    """The page's export link names the generation on screen: while a newer state computes,
+    its file is the one it names, at once (not, after a wait, the newer one), and once that is
+    replaced the link's generation is refused, 409, naming the one on screen."""
+    import threading
+
+    import jik.app.dashboard.session as session
+
+    real, release = session.compute, threading.Event()
+
+    def slow(state, *args, **kwargs):
+        if state.gamma == 1.5:
+            release.wait(60)
+        return real(state, *args, **kwargs)
+
+    monkeypatch.setattr(session, "compute", slow)
+    sid = client.post("/api/sessions", json={}).json()["id"]
+    try:
+        first = client.get(f"/api/sessions/{sid}/export.json").json()["generation"]
+        assert client.post(f"/api/sessions/{sid}/state", json={"gamma": 1.5}).status_code == 200
+        named = {"generation": first}
+        body = client.get(f"/api/sessions/{sid}/export.json", params=named).json()
+        assert body["generation"] == first and body["state"]["gamma"] == 1.0
+        csv = client.get(f"/api/sessions/{sid}/export.csv", params=named)
+        assert csv.text.startswith(f"# jik export of generation {first}")
+        release.set()
+        newer = client.get(f"/api/sessions/{sid}/export.json").json()  # (the current state's)
+        assert newer["generation"] > first and newer["state"]["gamma"] == 1.5
+        r = client.get(f"/api/sessions/{sid}/export.json", params=named)
+        assert r.status_code == 409, r.text
+        assert r.json()["detail"] == (
+            f"generation {first} is not the result on screen (generation "
+            f"{newer['generation']}); export again"
+        )
+    finally:
+        release.set()
+        client.delete(f"/api/sessions/{sid}")

@@ -5,9 +5,10 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, create_model
 
-from ....engine.exports import nullable
+from ....engine.exports import json_values
 from ....engine.registry import ALGORITHMS
 from .fields import Coordinate
 
@@ -64,7 +65,8 @@ def parameters_of(inverse) -> dict[str, Any]:
     defaults filled in (posture's rest, weighted's limits, with None for an unbounded end): what
     a response says the run used."""
     values = inverse.parameters
-    return {name: nullable(values[name]) for name in ALGORITHMS[inverse.name].names}
+    names = ALGORITHMS[inverse.name].names
+    return {name: json_values(np.asarray(values[name], dtype=float)) for name in names}
 
 
 def field_of(exc_field: str | None) -> str:
