@@ -46,6 +46,7 @@ Solving (the continuation algorithm, eq. (7))
 Repeatability (sec. 5.2.1, Table 1)
     repeatability               drive a closed path cycle after cycle -> RepeatabilityResult
     repeatable, h_change        whether every cycle came back to x0; how much h changed, eq. (12)
+    run_findings, extended_why  what a run found, and why (h kept, eq. (12)), in sentences
     Resume, Leg                 an earlier run to go on from (as x0); a leg as a progress sees it
     Progress, ProgressCallbacks what a long computation reports, and how to cancel it
 Functionals and synthesis (secs. 3-4)
@@ -133,6 +134,8 @@ _EXPORTS = {
     "Leg": "repeatability",
     "repeatable": "repeatability",
     "h_change": "augmentations",
+    "run_findings": "findings",
+    "extended_why": "findings",
     "Progress": "progress",
     "ProgressCallbacks": "progress",
     # functionals and synthesis
@@ -217,6 +220,7 @@ __all__ = [
     "WeightedInverse",
     "error_functional_e1",
     "error_functional_e2",
+    "extended_why",
     "h_change",
     "inert_variables",
     "iter_atlas",
@@ -231,6 +235,7 @@ __all__ = [
     "robot_from_dict",
     "robot_units",
     "run_atlas",
+    "run_findings",
     "solve",
     "solve_batch",
     "synthesize_e2",
@@ -288,6 +293,7 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
         SingularConfigurationError,
     )
     from .extended_vector import VectorExtendedInverse
+    from .findings import extended_why, run_findings
     from .formula_kinematics import FormulaKinematics, FormulaMap
     from .functionals import error_functional_e1, error_functional_e2
     from .inverses import ExtendedInverse, Inverse, Pseudoinverse

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...engine.findings import g
 from ...engine.repeatability import REPEATABLE_DRIFT
 from .algorithms import STYLES, rest_words, scalar
 from .joint_limits import state_limits
@@ -18,11 +19,6 @@ from .runs import AlgorithmRun, DashboardResult
 
 #: The algorithms' names in the verdict's sentences.
 NAMES = {a: s.named for a, s in STYLES.items()}
-
-
-def g(v: float) -> str:
-    """A number in 3 significant digits."""
-    return f"{v:.3g}"
 
 
 def leg_end_errors(run: AlgorithmRun) -> np.ndarray:

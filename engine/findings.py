@@ -1,0 +1,151 @@
+"""What a run of the repeatability test found, and why, in sentences a reader can take as they
+are (the dashboard's verdict, a notebook's summary).
+
+Repeatability (section 2 of the paper): a closed task path driven from x0 gives a closed joint
+path, ``x`` back at ``x0`` after each cycle. The extended Jacobian inverse (11) is repeatable
+because its runs stay on the level set h(x) = h(x0) (eq. (12)); the continuous algorithm (7)
+keeps h exactly, the discrete iteration ``x <- x - gamma J# e`` only to first order per step
+(each step moves along the level set's tangent), and for gamma near 2 the iteration is at the
+edge of convergence (the task error is multiplied by about ``1 - gamma`` per step).
+
+Each function returns ``(text, role)`` pairs, ``role`` one of "finding" (what the run did),
+"why", "note" or "failure".
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .augmentations import H_CONSERVED, h_change
+from .repeatability import REPEATABLE_DRIFT, repeatable
+
+#: In discrete mode, a gamma at or above this is "near 2" (the iteration's stability limit).
+GAMMA_NEAR_TWO = 1.5
+
+
+def g(v: float) -> str:
+    """A number in 3 significant digits."""
+    return f"{v:.3g}"
+
+
+def _cycles(n: int) -> str:
+    return f"{n} cycle{'s' if n > 1 else ''}"
+
+
+def drift_sentence(name: str, drift, unit: str) -> str:
+    """Whether the run named ``name`` was repeatable, from its ``drift`` ||x - x0|| after each
+    cycle (cycles,) in ``unit``: the largest drift if so (below
+    :data:`~jik.engine.repeatability.REPEATABLE_DRIFT`), else the last and how it grew."""
+    d = np.asarray(drift, dtype=float)
+    n = len(d)
+    if repeatable(d):
+        return (
+            f"{name}: repeatable. After each of {_cycles(n)} the joints came back "
+            f"to x0 within {g(float(d.max()))} {unit} (‖x − x0‖ below {g(REPEATABLE_DRIFT)})."
+        )
+    trend = ""
+    if n > 1:
+        grows = d[-1] > d[0] * 1.05
+        trend = (
+            f", growing from {g(float(d[0]))} after cycle 1"
+            if grows
+            else f" (after cycle 1: {g(float(d[0]))})"
+        )
+    return (
+        f"{name}: not repeatable. After {_cycles(n)} the joints end "
+        f"‖x − x0‖ = {g(float(d[-1]))} {unit} away from x0{trend}."
+    )
+
+
+def run_findings(
+    name: str, drift, success: bool, message: str, closed: bool, unit: str
+) -> list[tuple[str, str]]:
+    """What the run named ``name`` did: on a closed path (``closed``) with completed cycles
+    (``drift`` (cycles,)) its :func:`drift_sentence`, else the solver's ``message`` when it
+    succeeded; and, when it did not, where it stopped ("failure")."""
+    n = len(drift)
+    out = []
+    if closed and n:
+        out.append((drift_sentence(name, drift, unit), "finding"))
+    elif success:
+        out.append((f"{name}: {message}.", "finding"))
+    if not success:
+        done = f" (after {n} completed cycle{'s' if n > 1 else ''})" if closed and n else ""
+        out.append((f"{name} stopped{done}: {message}", "failure"))
+    return out
+
+
+def pseudoinverse_why(drift) -> str | None:
+    """Why the pseudoinverse (8) drifted, or that it happened to come back, from its ``drift``
+    after each cycle; None without a completed cycle."""
+    if repeatable(drift) is False:
+        return (
+            "Why: J^P# picks the minimum-norm joint velocity, which has no memory of the start "
+            "(it keeps nothing like h constant), so a closed task path need not close in the "
+            "joints."
+        )
+    if repeatable(drift):
+        return (
+            "The pseudoinverse happens to come back on this path: its joint flow closes here, "
+            "which it does not in general."
+        )
+    return None
+
+
+def extended_why(
+    h, drift, success: bool, closed: bool, mode: str, gamma: float
+) -> list[tuple[str, str]]:
+    """Why the extended Jacobian inverse (11) was repeatable or not, from h along its run
+    (:func:`~jik.engine.augmentations.h_change` against
+    :data:`~jik.engine.augmentations.H_CONSERVED`, eq. (12)) and its ``drift`` on a ``closed``
+    path; in discrete ``mode`` that the iteration keeps h only approximately. None for a run
+    without h, or stopped before it moved."""
+    dh = h_change(h)
+    if dh is None or (not success and dh == 0):
+        return []
+    closed = closed and len(drift) > 0
+    kept = dh < H_CONSERVED
+    if kept:
+        tail = (
+            ", so each task point has one configuration on that level set, and the closed "
+            "task path gave a closed joint path."
+            if closed and repeatable(drift)
+            else "."
+        )
+        text = (
+            f"Why: J^E# adds the equation h(x) = h(x0) (eq. (12)); h changed by only {g(dh)} "
+            f"along its run{tail}"
+        )
+    else:
+        lost = (
+            " A closed task path gives a closed joint path only while h stays at h(x0): "
+            "here it did not, so the joints did not come back."
+            if closed and not repeatable(drift)
+            else ""
+        )
+        text = f"h was not conserved: it changed by {g(dh)} along the extended Jacobian's run."
+        text += lost
+    out = [(text, "why")]
+    if mode == "discrete" and not kept:
+        out.append(
+            (
+                "The discrete algorithm x ← x − γ J^E# e keeps h only approximately: each step "
+                "moves along the tangent of the level set h = h(x0), not on it, so h changes by "
+                "an amount that grows with γ (the continuous algorithm (7) keeps h exactly).",
+                "note",
+            )
+        )
+    return out
+
+
+def gamma_note(mode: str, gamma: float) -> str | None:
+    """In discrete mode, that a ``gamma`` of at least :data:`GAMMA_NEAR_TWO` is near the
+    iteration's limit 2 (the task error is multiplied by about 1 - gamma per step)."""
+    if mode != "discrete" or gamma < GAMMA_NEAR_TWO:
+        return None
+    return (
+        f"γ = {g(gamma)} is near 2, the limit of the discrete iteration: the task "
+        f"error is multiplied by about 1 − γ = {g(1 - gamma)} per step, so the "
+        "iterates overshoot back and forth and h is far from conserved; at γ ≥ 2 the "
+        "iteration diverges."
+    )
