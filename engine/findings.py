@@ -8,6 +8,12 @@ keeps h exactly, the discrete iteration ``x <- x - gamma J# e`` only to first or
 (each step moves along the level set's tangent), and for gamma near 2 the iteration is at the
 edge of convergence (the task error is multiplied by about ``1 - gamma`` per step).
 
+Beside the paper's two inverses: how far the posture inverse's null-space pull (Liegeois 1977)
+toward its rest x_rest (named with its numbers) brings the drift of the pseudoinverse (8) down,
+and that it does not reach the extended Jacobian's repeatability (11); the task error damped
+least squares is left with where it damps (it is not a right inverse, J J# != I); whether the
+weighted least-norm inverse (Chan and Dubey 1995) kept every joint within its limits.
+
 Each function returns ``(text, role)`` pairs, ``role`` one of "finding" (what the run did),
 "why", "note" or "failure".
 """
@@ -149,3 +155,100 @@ def gamma_note(mode: str, gamma: float) -> str | None:
         "iterates overshoot back and forth and h is far from conserved; at γ ≥ 2 the "
         "iteration diverges."
     )
+
+
+def leg_end_errors(error, leg) -> np.ndarray:
+    """The task error at the last point of each leg of a run: ``error`` (m,) and ``leg`` (m,)
+    the leg of every point."""
+    leg = np.asarray(leg)
+    if not len(leg):
+        return np.zeros(0)
+    last = np.r_[np.flatnonzero(np.diff(leg)), len(leg) - 1]
+    return np.asarray(error, dtype=float)[last]
+
+
+def posture_findings(
+    name: str, gain: float, rest: str, drift, unit: str, pinv_drift=None, ext_drift=None
+) -> list[tuple[str, str]]:
+    """How far the posture inverse's null-space pull (Liegeois 1977) toward its rest (``rest``:
+    x_rest in words) at gain ``gain`` brought its ``drift`` after each cycle down against the
+    pseudoinverse's (8) ``pinv_drift``, and that it does not reach the extended Jacobian's
+    (11) repeatability (``ext_drift``); none without a completed cycle."""
+    n = len(drift)
+    if not n:
+        return []
+    d = float(drift[-1])
+    head = f"{name}, gain k = {g(gain)}, {rest}: after {_cycles(n)}"
+    if gain == 0:
+        return [(f"{head} it is the pseudoinverse (k = 0), drift {g(d)} {unit}.", "why")]
+    parts = []
+    if pinv_drift is not None and len(pinv_drift) >= n:
+        dp = float(pinv_drift[n - 1])
+        than = "less than" if d < dp else "not less than"
+        parts.append(f"it drifts {g(d)} {unit}, {than} the pseudoinverse's {g(dp)}")
+    else:
+        parts.append(f"it drifts {g(d)} {unit}")
+    if d >= REPEATABLE_DRIFT:
+        reach = (
+            f"the extended Jacobian's {g(float(ext_drift[n - 1]))}"
+            if ext_drift is not None and len(ext_drift) >= n
+            else "repeatability"
+        )
+        parts.append(
+            f"but does not reach {reach}: the pull toward x_rest moves the joints inside the "
+            "self-motion and slows the drift, yet the end of a cycle does not come back to x0"
+        )
+    else:
+        parts.append("and came back to x0 within round-off on this path")
+    return [(f"{head} " + ", ".join(parts) + ".", "why")]
+
+
+def damped_findings(
+    name: str, damping: float, threshold: float, tol: float, run, pinv=None
+) -> list[tuple[str, str]]:
+    """The task error damped least squares (damping ``damping``, adaptive where sigma_min(J)
+    < ``threshold`` if positive) is left with at the end of its legs, since it is not a right
+    inverse (J J# != I), and how it fared where the pseudoinverse (8) stopped. ``run`` and
+    ``pinv`` carry ``error``, ``leg`` and ``success`` (a run point by point)."""
+    ends = leg_end_errors(run.error, run.leg)
+    if not len(ends):
+        return []
+    worst = int(np.argmax(ends))
+    where = "adaptive, where σ_min(J) < " + g(threshold) if threshold > 0 else "constant"
+    text = (
+        f"{name} (λ = {g(damping)}, {where}): task error at the end of its legs up to "
+        f"{g(float(ends[worst]))} (leg {worst + 1}; tolerance {g(tol)}). Damping "
+        "bounds the joint speed near singularities at the price of tracking (J J# ≠ I)"
+    )
+    if pinv is not None and not pinv.success and run.success:
+        text += "; it went through where the pseudoinverse stopped"
+    elif pinv is not None and not pinv.success and run.error[-1] < pinv.error[-1]:
+        text += (
+            f"; where the pseudoinverse stalled at task error {g(float(pinv.error[-1]))}, "
+            f"it got to {g(float(run.error[-1]))}"
+        )
+    elif not run.success:
+        text += f"; it stopped with task error {g(float(run.error[-1]))}"
+    return [(text + ".", "why")]
+
+
+def weighted_findings(name: str, x, limits, names) -> list[tuple[str, str]]:
+    """Whether the weighted least-norm inverse (Chan and Dubey 1995) kept every joint of its
+    run ``x`` (m, p) within the box ``limits`` (p, 2) it took for limits (a robot without
+    joint limits: its configuration box x_range), and its closest approach, or which left."""
+    lo, hi = limits[:, 0], limits[:, 1]
+    below, above = x < lo, x > hi
+    bounds = "; ".join(f"{names[k]} in [{g(lo[k])}, {g(hi[k])}]" for k in range(len(lo)))
+    bounds += "; the robot has no joint limits: its configuration box x_range"
+    if not (below.any() or above.any()):
+        margin = np.minimum(x - lo, hi - x).min(axis=0)
+        k = int(np.argmin(margin))
+        return [
+            (
+                f"{name}: every joint stayed within its limits ({bounds}); "
+                f"closest: {names[k]}, {g(float(margin[k]))} from a limit.",
+                "why",
+            )
+        ]
+    out = sorted({names[k] for k in np.flatnonzero((below | above).any(axis=0))})
+    return [(f"{name}: left its limits ({bounds}): {', '.join(out)}.", "failure")]

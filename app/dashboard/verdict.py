@@ -2,20 +2,35 @@
 was repeatable on the closed path and by how much, how much h changed along the extended
 Jacobian's run, and why, in sentences the page shows as they are (the engine's
 :mod:`jik.engine.findings`, which says what repeatability is and why the extended Jacobian has
-it; the unicycle's undefined map: :func:`jik.engine.reproductions.unicycle.undefined_why`).
+it, and what the practical inverses beside the paper's two did; the unicycle's undefined map:
+:func:`jik.engine.reproductions.unicycle.undefined_why`).
 """
 
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
-from ...engine.findings import extended_why, gamma_note, pseudoinverse_why, run_findings
+import numpy as np
+
+from ...engine.findings import (
+    damped_findings,
+    extended_why,
+    gamma_note,
+    posture_findings,
+    pseudoinverse_why,
+    run_findings,
+    weighted_findings,
+)
 from ...engine.reproductions.unicycle import undefined_why
-from .joint_limits import limits_texts
+from .algorithms import STYLES, rest_words, scalar
+from .joint_limits import limits_texts, state_limits
 from .plotting import norm_unit, units
+from .robots import state_inverse, state_kinematics, state_spec
 from .runs import AlgorithmRun, DashboardResult
 from .singular import singular_sentence
-from .verdict_algorithms import NAMES, practical_sentences
+
+#: The algorithms' names in the verdict's sentences.
+NAMES = {a: s.named for a, s in STYLES.items()}
 
 
 @dataclass(frozen=True)
@@ -48,10 +63,46 @@ def _undefined_why(result: DashboardResult, run: AlgorithmRun) -> list[Sentence]
     return [Sentence(t, "extended", r) for t, r in zip(texts, ("why", "note"), strict=False)]
 
 
+def _posture(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
+    runs, state = result.runs, result.state
+    if state.task != "path":
+        return []
+    rest = rest_words(state, state_spec(state), state_kinematics(state))
+    p, e = runs.get("pseudoinverse"), runs.get("extended")
+    return posture_findings(
+        NAMES["posture"],
+        scalar(state, "gain"),
+        rest,
+        runs["posture"].drift,
+        unit,
+        None if p is None else p.drift,
+        None if e is None else e.drift,
+    )
+
+
+def _damped(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
+    state = result.state
+    lam, eps = scalar(state, "damping"), scalar(state, "damping_threshold")
+    run, p = result.runs["damped"], result.runs.get("pseudoinverse")
+    return damped_findings(NAMES["damped"], lam, eps, state.tolerance, run, p)
+
+
+def _weighted(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
+    """Within the box the weighted inverse took for limits (a robot that declares joint
+    limits has its sentence from :func:`jik.app.dashboard.joint_limits.limits_texts`)."""
+    if state_limits(result.state) is not None:
+        return []
+    run = result.runs["weighted"]
+    inverse = state_inverse(result.state, "weighted")
+    limits = np.asarray(getattr(inverse, "limits", ()), dtype=float)
+    if limits.shape != (run.x.shape[1], 2):
+        return []
+    return weighted_findings(NAMES["weighted"], run.x, limits, result.variable_names)
+
+
 def verdict(result: DashboardResult) -> list[dict]:
     """The sentences the page shows above the plots for ``result`` (:class:`Sentence` dicts):
-    each chosen algorithm's finding, then why (:mod:`.verdict_algorithms` for the practical
-    inverses); failures with the engine's message."""
+    each chosen algorithm's finding, then why; failures with the engine's message."""
     runs = result.runs
     out: list[Sentence] = []
     path = result.state.task == "path"
@@ -68,7 +119,9 @@ def verdict(result: DashboardResult) -> list[dict]:
         out += undefined or [Sentence(text, "extended", role) for text, role in found]
         if not undefined and found and (note := gamma_note(state.mode, state.gamma)):
             out.append(Sentence(note, None, "note"))
-    out += [Sentence(*s) for s in practical_sentences(result, unit)]
+    practical = {"posture": _posture, "damped": _damped, "weighted": _weighted}
+    for a in (a for a in runs if a in practical):
+        out += [Sentence(text, a, role) for text, role in practical[a](result, unit)]
     for text, algorithm, within in limits_texts(result, NAMES):
         out.append(Sentence(text, algorithm, "note" if within else "warning"))
     if "extended" in runs and (warning := singular_sentence(result.state)):

@@ -3,10 +3,20 @@ characteristics became undefined (jik.engine.reproductions.unicycle.undefined_wh
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 
 import jik.engine as jik
-from jik.engine.findings import drift_sentence, gamma_note, pseudoinverse_why
+from jik.engine.findings import (
+    damped_findings,
+    drift_sentence,
+    gamma_note,
+    leg_end_errors,
+    posture_findings,
+    pseudoinverse_why,
+    weighted_findings,
+)
 from jik.engine.registry import POSE_A, POSE_B
 from jik.engine.reproductions.unicycle import paper_start, undefined_why
 
@@ -81,3 +91,47 @@ def test_the_unicycle_runs_of_the_paper_are_named_and_their_undefined_map_explai
     assert note.endswith("the extended run from q0 = B converges.")
     (alone,) = undefined_why((1.0, 2.0, 0.0), 1.0, (0.5, 0.4), "the run's last step", False)
     assert "the run's last step took λ10 from 0.5 to 0.4. From there" in alone
+
+
+def test_the_posture_inverse_drifts_less_than_the_pseudoinverse_but_is_not_repeatable():
+    """Its sentence compares its drift after the last cycle with the pseudoinverse's and the
+    extended Jacobian's after as many cycles; gain 0 is the pseudoinverse."""
+    arm, pinv, ext = _runs()
+    x0, path = [0, 0, np.pi / 2], [(1, 1), (1, 2), (0, 2)]
+    post = jik.repeatability(jik.PostureInverse(arm, rest=x0, gain=1.0), x0, path, cycles=2)
+    ((text, role),) = posture_findings(
+        "J^N#", 1.0, "x_rest = x0", post.drift, "[m]", pinv.drift, ext.drift
+    )
+    assert role == "why" and text.startswith("J^N#, gain k = 1, x_rest = x0: after 2 cycles")
+    assert f"less than the pseudoinverse's {pinv.drift[1]:.3g}" in text
+    assert f"but does not reach the extended Jacobian's {ext.drift[1]:.3g}" in text
+    ((zero, _),) = posture_findings("J^N#", 0.0, "x_rest = x0", [0.5], "[m]")
+    assert zero == (
+        "J^N#, gain k = 0, x_rest = x0: after 1 cycle it is the pseudoinverse (k = 0), "
+        "drift 0.5 [m]."
+    )
+    assert posture_findings("J^N#", 1.0, "x_rest = x0", [], "[m]") == []
+
+
+def test_damped_least_squares_says_its_worst_leg_end_and_where_the_pseudoinverse_stalled():
+    run = SimpleNamespace(error=np.array([1.0, 0.2, 0.8, 0.5]), leg=np.array([0, 0, 1, 1]))
+    run.success = False
+    stalled = SimpleNamespace(error=np.array([1.0, 1.22]), success=False)
+    np.testing.assert_allclose(leg_end_errors(run.error, run.leg), [0.2, 0.5])
+    ((text, _),) = damped_findings("DLS", 0.1, 0.05, 1e-10, run, stalled)
+    assert text.startswith("DLS (λ = 0.1, adaptive, where σ_min(J) < 0.05): task error at")
+    assert "up to 0.5 (leg 2; tolerance 1e-10)" in text
+    assert text.endswith("where the pseudoinverse stalled at task error 1.22, it got to 0.5.")
+    run.success = True
+    assert damped_findings("DLS", 0.1, 0.0, 1e-10, run, stalled)[0][0].endswith(
+        "; it went through where the pseudoinverse stopped."
+    )
+
+
+def test_the_weighted_inverse_says_whether_its_joints_stayed_within_the_box():
+    limits = np.array([[-1.0, 1.0], [0.0, 2.0]])
+    inside = np.array([[0.0, 1.0], [0.9, 0.5]])
+    ((text, role),) = weighted_findings("W", inside, limits, ("a", "b"))
+    assert role == "why" and "closest: a, 0.1 from a limit." in text
+    ((text, role),) = weighted_findings("W", inside - 0.6, limits, ("a", "b"))
+    assert role == "failure" and text.endswith(": b.")
