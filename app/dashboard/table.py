@@ -12,15 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...engine.reproductions.table1 import (
-    ERRATUM,
-    PRINTED,
-    ROWS_NOTE,
-    cell,
-    differing,
-    is_experiment,
-    row_labels,
-)
+from ...engine.reproductions.table1 import PRINTED, cell, differing, is_experiment, row_labels
+from ...engine.reproductions.table1 import notes as table1_notes
 from .algorithms import STYLES
 from .plotting import corner_names, figure, trace
 from .runs import DashboardResult
@@ -92,7 +85,6 @@ def table1_spec(result: DashboardResult) -> dict:
     rows = max(len(e) for e in ends.values())
     table = _Table("row", row_labels(rows))
     differs: list[list] = []
-    counts = {}
     for a in PAPER:
         printed = np.asarray(PRINTED[a], dtype=float)
         mask = differing(a, ends[a])
@@ -100,57 +92,14 @@ def table1_spec(result: DashboardResult) -> dict:
         differs += [
             [first + int(k), int(r), cell(printed[r, k], 0)] for k, r in np.argwhere(mask.T)
         ]
-        counts[a] = int(mask.sum())
         table.add(names, ends[a], FILLS[a], f"{SHORT[a]} {{}} (jik)")
         table.add(names, printed, FILLS["printed"], f"{SHORT[a]} {{}} (printed)")
     others = [a for a in result.runs if a not in PAPER]
     for a in others:  # the other chosen algorithms: jik's columns only (the paper has none)
         table.add(names, ends[a], FILLS[a], f"{SHORT[a]} {{}} (jik)")
-    notes = [
-        f"Beside each of jik's columns, the paper's printed column (continuous algorithm (7), "
-        f"one cycle). Highlighted: jik's cells that differ from the print in the fourth decimal "
-        f"(pseudoinverse: {counts['pseudoinverse']} of 15, extended Jacobian: "
-        f"{counts['extended']} of 15).",
-        ROWS_NOTE,
-    ]
-    if others:
-        shown = ", ".join(SHORT[a] for a in others)
-        notes.append(
-            f"Then jik's columns of {shown}: the paper's Table 1 prints the "
-            "pseudoinverse and the extended Jacobian only."
-        )
+    shown = ", ".join(SHORT[a] for a in others)
     state = result.state
-    if state.augmentation == "paper_cubic":
-        notes.append(ERRATUM)
-    else:
-        notes.append(
-            f"The extended columns here use the augmenting map {state.augmentation}; "
-            "the paper's were computed with the cubic (38) (choose paper_cubic to "
-            "compare)."
-        )
-    if state.mode == "discrete":
-        gap = max(
-            (
-                float(np.max(np.abs(ends[a][: len(PRINTED[a])] - np.asarray(PRINTED[a]))))
-                for a in PAPER
-                if len(ends[a]) >= len(PRINTED[a])
-            ),
-            default=None,
-        )
-        where = (
-            "stopped before the end of the first cycle"
-            if gap is None
-            else f"ends its legs elsewhere (up to {gap:.3g} from the printed values)"
-        )
-        notes.append(
-            f"Discrete mode changes the numbers: the paper's Table 1 is the continuous "
-            f"algorithm (7); the iteration with step γ = {state.gamma:.3g} {where}. Choose "
-            "mode = continuous to compare with the print."
-        )
-    else:
-        notes.append(
-            "Continuous mode, as in the paper: the columns do not depend on γ (it only rescales θ)."
-        )
+    notes = table1_notes(ends, state.augmentation, state.mode, state.gamma, shown)
     return _spec(TABLE1_TITLE, table, notes, differs)
 
 

@@ -11,8 +11,10 @@ from jik.engine.reproductions.table1 import (
     ERRATUM,
     PATH,
     PRINTED,
+    ROWS_NOTE,
     differing,
     is_experiment,
+    notes,
     row_labels,
 )
 from jik.engine.reproductions.table1 import run as table1
@@ -46,6 +48,25 @@ def test_table1_cells_that_differ_from_the_print_in_the_fourth_decimal():
     with pytest.raises(InvalidInputError, match="algorithm must be one of") as info:
         differing("posture", result["pseudoinverse"])
     assert info.value.field == "algorithm"
+
+
+def test_table1_notes_count_the_differing_cells_and_say_what_the_settings_change():
+    """Under jik's columns beside the print: the count of differing cells (the cubic (38)'s
+    six), the labels, the other algorithms' columns, the erratum or the map used instead, and
+    how far a discrete run (or one that stopped before a cycle) ends from the print."""
+    result = table1()
+    said = notes(result, "paper_cubic", "continuous", 1.0, others="DLS")
+    assert "(pseudoinverse: 0 of 15, extended Jacobian: 6 of 15)" in said[0]
+    assert said[1:4] == [ROWS_NOTE, said[2], ERRATUM] and said[2].startswith(
+        "Then jik's columns of DLS"
+    )
+    assert said[-1].startswith("Continuous mode, as in the paper")
+    off = {a: np.asarray(PRINTED[a]) + 0.01 for a in PRINTED}
+    said = notes(off, "e2_synthesized", "discrete", 0.5)
+    assert "augmenting map e2_synthesized;" in said[2]
+    assert "step γ = 0.5 ends its legs elsewhere (up to 0.01 from the printed values)" in said[-1]
+    short = {a: np.asarray(PRINTED[a])[:2] for a in PRINTED}
+    assert "stopped before the end of the first cycle" in notes(short, "h", "discrete", 1.0)[-1]
 
 
 def test_table1_erratum_states_what_the_cubic_38_gives():
