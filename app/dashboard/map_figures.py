@@ -341,7 +341,8 @@ def _bars(maps: list[dict], key: str, names: list[str]) -> dict:
 
 def single_joint_spec(sens: dict, aug: str, log: dict) -> dict:
     """E2 (18) of the map (outlined) beside E2 of h = s x_j for each joint, on a log scale: a
-    map over many joints, its E2 by a Sobol rule (:mod:`jik.app.dashboard.arm_e2`)."""
+    map over many joints, its E2 by a Sobol rule
+    (:func:`jik.engine.functional_report.functionals_report`)."""
     maps = sens["maps"]
     values = [m["E2"] for m in maps]
     data = [_bars(maps, "E2", [m["name"] for m in maps])]
