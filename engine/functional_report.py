@@ -95,3 +95,29 @@ def functionals_report(
         "note": f"E2 = {value} on the design box (Sobol rule, {QMC_NODES} nodes); "
         f"E1 not computed over {len(region)} joints",
     }
+
+
+def region_words(region: Mapping) -> str:
+    """A box (name -> (lo, hi)) in words: ``x2 ∈ [-1, 1], x3 ∈ [0, 3.14]``."""
+    return ", ".join(f"{k} ∈ [{lo:.3g}, {hi:.3g}]" for k, (lo, hi) in region.items())
+
+
+def report_words(report: Mapping, where: str) -> str:
+    """A :func:`functionals_report` in words, on ``where`` (the box, in words): its note if it
+    has one, else each functional's value, ∞ where E1 diverges (dh K = 0 inside) or undefined."""
+    if report.get("note"):
+        return report["note"]
+    values = {k: report.get(k) for k in ("E1", "E2")}
+    if all(v is None for v in values.values()):
+        return f"E1, E2 undefined: h is not defined on all of {where}"
+    return (
+        ", ".join(
+            f"{k} = {v:.4g}"
+            if v is not None
+            else f"{k} = ∞ (dh K = 0 inside)"
+            if report.get(f"{k}_divergent")
+            else f"{k} undefined"
+            for k, v in values.items()
+        )
+        + f" on {where}"
+    )

@@ -7,7 +7,13 @@ import pytest
 from jik.engine.augmentations import PaperCubic
 from jik.engine.e2_qmc import e2_qmc
 from jik.engine.exceptions import RunCancelled
-from jik.engine.functional_report import QMC_NODES, QMC_SEED, functionals_report
+from jik.engine.functional_report import (
+    QMC_NODES,
+    QMC_SEED,
+    functionals_report,
+    region_words,
+    report_words,
+)
 from jik.engine.functionals import error_functional_e1, error_functional_e2
 from jik.engine.kinematics import Manipulator2
 from jik.engine.progress import ProgressCallbacks
@@ -43,3 +49,15 @@ def test_a_region_of_four_joints_gets_e2_by_the_sobol_rule_and_no_e1():
             CHAIN, h, REGION, {}, 12, progress=ProgressCallbacks(is_cancelled=lambda: True)
         )
     assert np.isfinite(out["E2"])
+
+
+def test_a_report_in_words_gives_its_note_or_each_value_on_the_box():
+    box = region_words({"x2": (-1.0, 1.0), "x3": (0.0, 3.14159)})
+    assert box == "x2 ∈ [-1, 1], x3 ∈ [0, 3.14]"
+    assert report_words({"E1": 0.5, "E2": 0.25}, box) == f"E1 = 0.5, E2 = 0.25 on {box}"
+    diverges = {"E1": None, "E1_divergent": True, "E2": None}
+    assert report_words(diverges, "B") == "E1, E2 undefined: h is not defined on all of B"
+    diverges["E2"] = 1.0
+    assert report_words(diverges, "B") == "E1 = ∞ (dh K = 0 inside), E2 = 1 on B"
+    assert report_words({"E1": None, "E2": 1.0}, "B") == "E1 undefined, E2 = 1 on B"
+    assert report_words({"E2": 1.0, "note": "by a Sobol rule"}, "B") == "by a Sobol rule"
