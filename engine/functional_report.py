@@ -17,7 +17,7 @@ import numpy as np
 
 from .e2_qmc import e2_qmc
 from .exceptions import JikError
-from .functionals import error_functional_e1, error_functional_e2
+from .functionals import error_functional_e1, error_functional_e2, parameter_sensitivity
 from .progress import Progress
 from .robot_synthesis import TOTAL_NODES as QMC_NODES
 
@@ -121,3 +121,63 @@ def report_words(report: Mapping, where: str) -> str:
         )
         + f" on {where}"
     )
+
+
+def parameters_report(
+    kinematics,
+    factory,
+    parameters: Mapping,
+    region: Mapping,
+    nodes: int,
+    fixed,
+    samples: int,
+    on_evaluation: Callable[[int, int], None] = lambda done, total: None,
+) -> dict:
+    """How E1 (13) and E2 (18) of the map ``factory(**parameters)`` change with its parameters:
+    ``{"kind": "parameters", "parameters", "E1", "E2"}``, each functional's
+    :func:`~jik.engine.functionals.parameter_sensitivity` (its value, gradient and a sweep of
+    ``samples`` values of every parameter over v - 1 .. v + 1) by a tensor rule of ``nodes``;
+    ``on_evaluation(done, total)`` after each evaluation of either functional."""
+    out: dict = {"kind": "parameters", "parameters": dict(parameters)}
+    for k, key in enumerate(("E1", "E2")):
+
+        def evaluated(done: int, n: int, k: int = k) -> None:
+            on_evaluation(k * n + done, 2 * n)
+
+        out[key] = parameter_sensitivity(
+            kinematics,
+            factory,
+            parameters,
+            region,
+            functional=key.lower(),
+            samples=samples,
+            nodes=nodes,
+            fixed=fixed,
+            on_evaluation=evaluated,
+        )
+    return out
+
+
+def maps_report(
+    kinematics,
+    maps,
+    current: str,
+    region: Mapping,
+    nodes: int,
+    fixed,
+    on_map: Callable[[int, int], None] = lambda done, total: None,
+) -> dict:
+    """E1 (13) and E2 (18) of each of ``maps`` ((name, build) pairs, ``build()`` the map):
+    ``{"kind": "alternatives", "maps": [{"name", "current", "E1", "E2"}]}`` (``current``: the
+    map named so), by :func:`functional_value`, none of a map that solves a problem per point;
+    ``on_map(done, total)`` after each map, two evaluations a map."""
+    rows = []
+    for m, (name, build) in enumerate(maps):
+        amap = build()
+        if not amap.solves_per_point:
+            row: dict = {"name": name, "current": name == current}
+            for key in ("E1", "E2"):
+                row[key] = functional_value(key, kinematics, amap, region, nodes, fixed)[key]
+            rows.append(row)
+        on_map(2 * m + 2, 2 * len(maps))
+    return {"kind": "alternatives", "maps": rows}

@@ -13,10 +13,10 @@ from ...engine.dependence import inert_variables
 from ...engine.exceptions import JikError, RunCancelled
 from ...engine.functional_report import (
     MAX_TENSOR_VARIABLES,
-    functional_value,
     functionals_report,
+    maps_report,
+    parameters_report,
 )
-from ...engine.functionals import parameter_sensitivity
 from ...engine.progress import ProgressCallbacks
 from .analysis import expensive_map, kinematics_and_map, vector_note
 from .model import DashboardState, cache_key, robot_and_map
@@ -171,37 +171,16 @@ def sensitivity(
             raise Cancelled
         return other.build(kin, **params)
 
-    total = sensitivity_evaluations(state, grid["map"])
     try:
         if aug.parameters:
-            out: dict = {"kind": "parameters", "parameters": dict(state.augmentation_parameters)}
-            for k, key in enumerate(("E1", "E2")):
-
-                def evaluated(done: int, n: int, k: int = k) -> None:
-                    progress(k * n + done, total)
-
-                out[key] = parameter_sensitivity(
-                    kin,
-                    lambda **p: build(aug, **p),
-                    state.augmentation_parameters,
-                    region,
-                    functional=key.lower(),
-                    samples=SENSITIVITY_SAMPLES,
-                    nodes=nodes,
-                    fixed=fixed,
-                    on_evaluation=evaluated,
-                )
-            return out
-        maps = []
-        for m, other in enumerate(spec.augmentations):
-            amap = build(other, **{p.name: p.default for p in other.parameters})
-            if not expensive_map(amap):  # (no value of a map that solves per point)
-                row: dict = {"name": other.name, "current": other.name == aug.name}
-                for key in ("E1", "E2"):
-                    row[key] = functional_value(key, kin, amap, region, nodes, fixed)[key]
-                maps.append(row)
-            progress(2 * m + 2, total)
-        return {"kind": "alternatives", "maps": maps}
+            factory, samples = (lambda **p: build(aug, **p)), SENSITIVITY_SAMPLES
+            params = state.augmentation_parameters
+            return parameters_report(kin, factory, params, region, nodes, fixed, samples, progress)
+        maps = [
+            (m.name, lambda m=m: build(m, **{p.name: p.default for p in m.parameters}))
+            for m in spec.augmentations
+        ]
+        return maps_report(kin, maps, aug.name, region, nodes, fixed, progress)
     except (JikError, ValueError, ArithmeticError) as exc:
         return {"kind": "unavailable", "reason": str(exc)}
 

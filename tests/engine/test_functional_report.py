@@ -4,18 +4,24 @@ else E2 by the Sobol rule beside single joints (jik.engine.functional_report).""
 import numpy as np
 import pytest
 
-from jik.engine.augmentations import PaperCubic
+from jik.engine.augmentations import E2Optimal, PaperCubic
 from jik.engine.e2_qmc import e2_qmc
 from jik.engine.exceptions import RunCancelled
 from jik.engine.functional_report import (
     QMC_NODES,
     QMC_SEED,
     functionals_report,
+    maps_report,
+    parameters_report,
     region_words,
     report_words,
 )
-from jik.engine.functionals import error_functional_e1, error_functional_e2
-from jik.engine.kinematics import Manipulator2
+from jik.engine.functionals import (
+    error_functional_e1,
+    error_functional_e2,
+    parameter_sensitivity,
+)
+from jik.engine.kinematics import Manipulator1, Manipulator2
 from jik.engine.progress import ProgressCallbacks
 from jik.engine.synthesis_nd import synthesize_e2_nd
 from tests.engine.test_e2_qmc import CHAIN, REGION
@@ -61,3 +67,29 @@ def test_a_report_in_words_gives_its_note_or_each_value_on_the_box():
     assert report_words(diverges, "B") == "E1 = ∞ (dh K = 0 inside), E2 = 1 on B"
     assert report_words({"E1": None, "E2": 1.0}, "B") == "E1 undefined, E2 = 1 on B"
     assert report_words({"E2": 1.0, "note": "by a Sobol rule"}, "B") == "by a Sobol rule"
+
+
+def test_the_parameters_report_sweeps_both_functionals_and_counts_every_evaluation():
+    """E2-optimal maps (36) of Manipulator 1 over (a, b): each functional's sweep is the
+    engine's parameter_sensitivity; the progress runs over both functionals' evaluations."""
+    kin, region, params = Manipulator1(), {"x1": (0.0, 1.0), "x2": (0.0, 1.0)}, {"a": 1.0, "b": 0.5}
+    told = []
+    out = parameters_report(
+        kin, E2Optimal, params, region, 6, {"x3": 1.0}, 3, lambda *d: told.append(d)
+    )
+    e1 = parameter_sensitivity(
+        kin, E2Optimal, params, region, functional="e1", samples=3, nodes=6, fixed={"x3": 1.0}
+    )
+    assert out["kind"] == "parameters" and out["parameters"] == params and out["E1"] == e1
+    n = 1 + 2 * (2 + 3)
+    assert told[-1] == (2 * n, 2 * n) and len(told) == 2 * n
+
+
+def test_the_maps_report_gives_each_map_its_functionals_and_marks_the_current_one():
+    kin, region = Manipulator2(), {"x2": (-0.5, 0.5), "x3": (1.0, 2.0)}
+    told = []
+    maps = [("cubic", PaperCubic), ("again", PaperCubic)]
+    out = maps_report(kin, maps, "again", region, 6, {"x1": 0.0}, lambda *d: told.append(d))
+    e2 = error_functional_e2(kin, PaperCubic(), region, nodes=6, fixed={"x1": 0.0}).value
+    assert [(m["name"], m["current"]) for m in out["maps"]] == [("cubic", False), ("again", True)]
+    assert out["maps"][0]["E2"] == pytest.approx(e2) and told == [(2, 4), (4, 4)]
