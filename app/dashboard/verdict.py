@@ -23,7 +23,7 @@ from ...engine.findings import (
 )
 from ...engine.reproductions.unicycle import undefined_why
 from .algorithms import STYLES, rest_words, scalar
-from .joint_limits import limits_texts, state_limits
+from .joint_limits import limits_reports, state_limits
 from .plotting import norm_unit, units
 from .robots import state_inverse, state_kinematics, state_spec
 from .runs import AlgorithmRun, DashboardResult
@@ -89,7 +89,7 @@ def _damped(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
 
 def _weighted(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
     """Within the box the weighted inverse took for limits (a robot that declares joint
-    limits has its sentence from :func:`jik.app.dashboard.joint_limits.limits_texts`)."""
+    limits has its sentence from :func:`jik.app.dashboard.joint_limits.limits_reports`)."""
     if state_limits(result.state) is not None:
         return []
     run = result.runs["weighted"]
@@ -122,8 +122,10 @@ def verdict(result: DashboardResult) -> list[dict]:
     practical = {"posture": _posture, "damped": _damped, "weighted": _weighted}
     for a in (a for a in runs if a in practical):
         out += [Sentence(text, a, role) for text, role in practical[a](result, unit)]
-    for text, algorithm, within in limits_texts(result, NAMES):
-        out.append(Sentence(text, algorithm, "note" if within else "warning"))
+    robot = state_spec(result.state).title
+    for a, report in limits_reports(result).items():
+        role = "note" if report.within else "warning"
+        out.append(Sentence(report.sentence(NAMES[a], robot), a, role))
     if "extended" in runs and (warning := singular_sentence(result.state)):
         out.append(Sentence(warning, "extended", "warning"))
     return [asdict(s) for s in out]
