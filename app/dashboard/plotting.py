@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 
+from ...engine.units import norm_unit as norm_unit  # (the panels' and the atlas's)
 from ...engine.units import robot_units
 from .robots import state_kinematics
 from .runs import DashboardResult
@@ -68,15 +69,6 @@ def units(result: DashboardResult) -> tuple[tuple[str, ...], tuple[str, ...]]:
 
 def label(name: str, unit: str) -> str:
     return f"{name} [{unit}]" if unit else name
-
-
-def norm_unit(unit_names) -> str:
-    """The unit of a Euclidean norm of coordinates in ``unit_names``: one unit, or the units
-    it mixes said so ("1": dimensionless)."""
-    names = [("dimensionless" if u == "1" else u) for u in dict.fromkeys(unit_names) if u]
-    if len(names) <= 1:
-        return f"[{names[0]}]" if names else ""
-    return f"[{' and '.join(names)} mixed]"
 
 
 def is_unicycle(result: DashboardResult) -> bool:
