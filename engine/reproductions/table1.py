@@ -61,6 +61,19 @@ def row_labels(n: int) -> list[str]:
     return [f"{'ABCD'[k % 4]}  x{k}f" if k else "A  x0" for k in range(n)]
 
 
+def corner_letters(targets, start, closed: bool) -> list[str]:
+    """The letters of a task's corners (its ``targets`` (L, r), in order), as Table 1 names its
+    rows: a ``closed`` path that ends where it starts, at k(x0) = ``start`` (r,), has its start
+    as A (Manipulator 2: A = k(x0) = (0, 1), then B = (1, 1), C, D, and A again); any other
+    task letters its targets from A (past Z: P27, P28, ...)."""
+    targets = np.asarray(targets, dtype=float)
+    n = len(targets)
+    names = [chr(ord("A") + i) if i < 26 else f"P{i + 1}" for i in range(n)]
+    if closed and n > 1 and np.allclose(targets[-1], start, atol=1e-6):
+        return names[1:] + names[:1]
+    return names
+
+
 def is_experiment(length: float, x0, path) -> bool:
     """Whether Manipulator 2 with arm length l = ``length`` from ``x0`` on ``path`` is Table 1's
     run: l = 1, x0 = :data:`X0`, the closed path :data:`PATH`."""

@@ -12,6 +12,7 @@ from jik.engine.reproductions.table1 import (
     PATH,
     PRINTED,
     ROWS_NOTE,
+    corner_letters,
     differing,
     is_experiment,
     notes,
@@ -67,6 +68,15 @@ def test_table1_notes_count_the_differing_cells_and_say_what_the_settings_change
     assert "step γ = 0.5 ends its legs elsewhere (up to 0.01 from the printed values)" in said[-1]
     short = {a: np.asarray(PRINTED[a])[:2] for a in PRINTED}
     assert "stopped before the end of the first cycle" in notes(short, "h", "discrete", 1.0)[-1]
+
+
+def test_corner_letters_start_at_k_x0_on_a_closed_path_as_table1_does():
+    """Table 1's path (1, 1), (1, 2), (0, 2), (0, 1) from k(x0) = (0, 1): A is the start, so
+    the corners are B, C, D, A; a path that does not close there, or one target, from A."""
+    assert corner_letters(PATH, (0.0, 1.0), closed=True) == ["B", "C", "D", "A"]
+    assert corner_letters(PATH, (0.0, 1.0), closed=False) == ["A", "B", "C", "D"]
+    assert corner_letters(PATH[:3], (0.0, 1.0), closed=True) == ["A", "B", "C"]
+    assert corner_letters(np.zeros((28, 2)), (5.0, 5.0), True)[25:] == ["Z", "P27", "P28"]
 
 
 def test_table1_erratum_states_what_the_cubic_38_gives():
