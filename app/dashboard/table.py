@@ -12,7 +12,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...engine.reproductions.table1 import PRINTED, cell, differing, is_experiment, row_labels
+from ...engine.reproductions.table1 import (
+    PRINTED,
+    cell,
+    differing,
+    is_experiment,
+    not_table1,
+    row_labels,
+)
 from ...engine.reproductions.table1 import notes as table1_notes
 from .algorithms import STYLES
 from .plotting import corner_names, figure, trace
@@ -116,18 +123,9 @@ def leg_ends_spec(result: DashboardResult) -> dict:
     for a in result.runs:
         table.add(result.variable_names, _ends(result, a), FILLS[a], f"{SHORT[a]} {{}}")
     notes = []
-    paper = " and ".join(STYLES[a].short for a in PAPER)
-    if _on_experiment(result.state):
-        notes.append(
-            f"Not Table 1: the paper's Table 1 compares {paper} on this experiment; choose both "
-            "to compare with the printed values."
-        )
-    elif result.state.robot == "manipulator2":
-        notes.append(
-            "Not Table 1: the paper's Table 1 is Manipulator 2 (l = 1) from x0 = "
-            "(0, 0, π/2) on the closed path (1, 1), (1, 2), (0, 2), (0, 1); set those "
-            "to compare with the printed values."
-        )
+    on = _on_experiment(result.state)
+    if on or result.state.robot == "manipulator2":
+        notes.append(not_table1(on, " and ".join(STYLES[a].short for a in PAPER)))
     return _spec(LEG_ENDS_TITLE, table, notes, [])
 
 

@@ -157,6 +157,21 @@ def format_text(result: dict) -> str:
     return "\n".join(out)
 
 
+def not_table1(on_experiment: bool, algorithms: str) -> str:
+    """Why a table of Manipulator 2's leg ends is not Table 1: on its experiment
+    (``on_experiment``) without both of its algorithms (named ``algorithms``), else not on it."""
+    if on_experiment:
+        return (
+            f"Not Table 1: the paper's Table 1 compares {algorithms} on this experiment; choose "
+            "both to compare with the printed values."
+        )
+    return (
+        "Not Table 1: the paper's Table 1 is Manipulator 2 (l = 1) from x0 = "
+        "(0, 0, π/2) on the closed path (1, 1), (1, 2), (0, 2), (0, 1); set those "
+        "to compare with the printed values."
+    )
+
+
 def notes(rows: dict, augmentation: str, mode: str, gamma: float, others: str = "") -> list[str]:
     """What a table of jik's leg ends beside the printed Table 1 needs said under it: how many
     cells differ from the print in the fourth decimal (:func:`differing`) of the ``rows`` of

@@ -15,6 +15,7 @@ from jik.engine.reproductions.table1 import (
     corner_letters,
     differing,
     is_experiment,
+    not_table1,
     notes,
     row_labels,
 )
@@ -68,6 +69,14 @@ def test_table1_notes_count_the_differing_cells_and_say_what_the_settings_change
     assert "step γ = 0.5 ends its legs elsewhere (up to 0.01 from the printed values)" in said[-1]
     short = {a: np.asarray(PRINTED[a])[:2] for a in PRINTED}
     assert "stopped before the end of the first cycle" in notes(short, "h", "discrete", 1.0)[-1]
+
+
+def test_a_table_of_leg_ends_says_why_it_is_not_table1():
+    assert not_table1(True, "J^P# and J^E#") == (
+        "Not Table 1: the paper's Table 1 compares J^P# and J^E# on this experiment; choose "
+        "both to compare with the printed values."
+    )
+    assert "from x0 = (0, 0, π/2) on the closed path (1, 1), (1, 2)" in not_table1(False, "")
 
 
 def test_corner_letters_start_at_k_x0_on_a_closed_path_as_table1_does():
