@@ -295,15 +295,15 @@ def undefined_why(q0, a: float, lam10: tuple[float, float], step: str, discrete:
     this is its Figs. 11-14's run and docs/paper-errata.md's finding (``discrete``: that the
     continuous run from there converges)."""
     before, after = lam10
-    moved = f"{step} took λ10 from {before:.3g} to {after:.3g}"
+    moved = f"{step} took lambda10 from {before:.3g} to {after:.3g}"
     if after * a <= 0:
         moved += (
-            f", across λ10 = 0 and out of the domain of the map's foliation (λ10 of "
-            f"the sign of a = {a:.3g}: ω is undefined on λ10 = 0)"
+            f", across lambda10 = 0 and out of the domain of the map's foliation "
+            f"(lambda10 of the sign of a = {a:.3g}: ω is undefined on lambda10 = 0)"
         )
     out = [
-        f"Why: h is defined by the characteristic (28) from λ to the reference leaf "
-        f"λ10 = a (eq. (29)); {moved}. From there the characteristic runs into a zero of the "
+        f"Why: h is defined by the characteristic (28) from x to the reference leaf "
+        f"lambda10 = a (eq. (29)); {moved}. From there the characteristic runs into a zero of the "
         "kernel component that normalises ω (J11 J24 − J14 J21 = 0), where ω and dz/ds "
         "blow up, so h, and with it the extended Jacobian inverse (47), is undefined."
     ]

@@ -86,11 +86,11 @@ def test_the_unicycle_runs_of_the_paper_are_named_and_their_undefined_map_explai
     assert paper_start(POSE_A) == "A" and paper_start(POSE_B) == "B"
     assert paper_start((0.0, 0.0, 0.0)) is None and paper_start(()) is None
     why, note = undefined_why(POSE_B, 1.0, (0.0659, -0.0777), "iteration 3", discrete=True)
-    assert "iteration 3 took λ10 from 0.0659 to -0.0777, across λ10 = 0" in why
+    assert "iteration 3 took lambda10 from 0.0659 to -0.0777, across lambda10 = 0" in why
     assert "(sec. 6.2, Figs. 13 (J^P#) and 14 (J^E#))" in note
     assert note.endswith("the extended run from q0 = B converges.")
     (alone,) = undefined_why((1.0, 2.0, 0.0), 1.0, (0.5, 0.4), "the run's last step", False)
-    assert "the run's last step took λ10 from 0.5 to 0.4. From there" in alone
+    assert "the run's last step took lambda10 from 0.5 to 0.4. From there" in alone
 
 
 def test_the_posture_inverse_drifts_less_than_the_pseudoinverse_but_is_not_repeatable():
