@@ -107,6 +107,9 @@ class Kinematics(abc.ABC):
     #: The robot's home configuration (p,), within its joint limits, or None: where syntheses
     #: hold the variables outside their region (:func:`held_values`).
     home: tuple[float, ...] | None = None
+    #: The default start (p,) of a robot without a home (a catalogue manipulator's, a robot
+    #: definition's ``x0``), or None: where syntheses hold them then (:func:`held_values`).
+    start: tuple[float, ...] | None = None
 
     @abc.abstractmethod
     def forward(self, x: FloatArray) -> FloatArray:
@@ -201,10 +204,13 @@ class Kinematics(abc.ABC):
 
 def held_values(kinematics: Kinematics) -> FloatArray:
     """Where E1, E2 and their syntheses hold the variables outside their region by default,
-    shape (p,): the kinematics' home (a catalogue arm's or a URDF's, within its joint limits;
-    the dashboard's default start), else 0 moved into the joint limits."""
-    if kinematics.home is not None:
-        return np.asarray(kinematics.home, dtype=float)
+    shape (p,): the robot's default start, where its maps are defined (the dashboard's, and
+    ``POST /synthesize``'s): the kinematics' home (a catalogue arm's or a URDF's, within its
+    joint limits), else its ``start`` (Manipulator 2's paper cubic is singular at
+    x3 = 0), else 0 moved into the joint limits."""
+    for given in (kinematics.home, kinematics.start):
+        if given is not None:
+            return np.asarray(given, dtype=float)
     zero = np.zeros(kinematics.p)
     if kinematics.joint_limits is None:
         return zero
@@ -222,6 +228,7 @@ class Manipulator1(Kinematics):
     name = "manipulator1"
     p = 3
     r = 2
+    start = (0.5, 0.5, 1.0)
     kernel_orientation = 1.0
     variable_names = ("x1", "x2", "x3")
 
@@ -259,6 +266,7 @@ class Manipulator2(Kinematics):
     name = "manipulator2"
     p = 3
     r = 2
+    start = (0.0, 0.0, math.pi / 2)
     kernel_orientation = -1.0
     variable_names = ("x1", "x2", "x3")
 

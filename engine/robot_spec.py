@@ -248,14 +248,16 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
             if exc.field and not exc.field.startswith("parameters"):
                 exc.field = f"parameters.{exc.field}"
             raise
-        extra, _, _ = augmentations_from_dict(kin, d.get("augmentations", []))
-        spec = replace(base, augmentations=(*base.augmentations, *extra)) if extra else base
+        spec = base
         if {"title", "x_range", "x0", "target", "path"} & set(d):  # (else the built-in itself)
             box = _x_range(kin, d) if "x_range" in d else base.x_range
             x0, target, path = defaults(kin, d, box, base)
+            kin.start = tuple(x0)  # (where its syntheses hold the joints outside their box)
             title = _get(d, "title", str, "a string", base.title)
             spec = replace(spec, title=title, x_range=box, default_x0=x0, default_target=target)
             spec = replace(spec, default_path=path)
+        extra, _, _ = augmentations_from_dict(kin, d.get("augmentations", []))
+        spec = replace(spec, augmentations=(*base.augmentations, *extra)) if extra else spec
         return Robot(spec, kin, dict(d))
     if kind in ARMS:  # the catalogue's URDF, end link and home, with the definition's keys
         d = {**ARMS[kind].definition(), **{k: v for k, v in d.items() if k != "name"}}
@@ -269,6 +271,7 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
         kin.joint_limits = check_limits(d["limits"], kin.p)
     box = _x_range(kin, d)
     x0, target, path = defaults(kin, d, box)
+    kin.start = tuple(x0)  # (where its syntheses hold the joints outside their box, homeless)
     key = json.dumps(
         {k: v for k, v in d.items() if k != "augmentations"}, sort_keys=True, default=str
     )

@@ -113,8 +113,8 @@ def default_box(
     ``size`` variables, none of them ``fixed``; else the last ``size`` variables not ``fixed``,
     each over a tenth of its ``x_range`` either side of the default start, within the range.
 
-    The variables outside the box are meant to be held at the default start, where the robot's
-    maps are defined (not at 0).
+    The variables outside the box are held at the default start, where the robot's maps are
+    defined (not at 0): :func:`~jik.engine.kinematics.held_values`.
     """
     design = dict(spec.functional_region)
     if len(design) == size and not set(design) & set(fixed):

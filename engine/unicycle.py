@@ -181,6 +181,7 @@ class Unicycle(Kinematics):
     name = "unicycle"
     p = 4
     r = 3
+    start = (0.5, -0.25, 0.3, -0.25)
     kernel_orientation = 1.0
     variable_names = ("lambda10", "lambda11", "lambda20", "lambda21")
 

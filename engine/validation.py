@@ -264,10 +264,12 @@ def check_box_region(
         if name not in names:
             raise InvalidInputError(
                 f"unknown joint variable {name!r}; use one of {names}",
-                "region" if name in region else "fixed",
+                f"{'region' if name in region else 'fixed'}.{name}",
             )
     if both := sorted(set(region) & set(fixed)):
-        raise InvalidInputError(f"variables {both} are both integrated over and fixed", "fixed")
+        raise InvalidInputError(
+            f"variables {both} are both integrated over and fixed", f"fixed.{both[0]}"
+        )
     box: dict[str, tuple[float, float]] = {}
     for name in names:
         if name not in region:

@@ -21,6 +21,6 @@ def precheck(req: S.SolveRequest | S.RepeatabilityRequest | S.SynthesizeRequest)
         return  # (p and r follow from the definition: built and checked in a worker)
     spec = ROBOTS[req.robot.name]
     if isinstance(req, S.SynthesizeRequest):
-        synthesis_region(spec, req)
+        synthesis_region(spec, spec.build(), req)
     else:
         gamma_and_mode(spec, req)

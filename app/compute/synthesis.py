@@ -11,7 +11,8 @@ from typing import get_args
 
 from ...engine.augmentations import Polynomial2
 from ...engine.exceptions import JikError
-from ...engine.functionals import error_functional_e1, error_functional_e2
+from ...engine.functionals import check_region, error_functional_e1, error_functional_e2
+from ...engine.kinematics import Kinematics
 from ...engine.registry import RobotSpec
 from ...engine.robot_synthesis import default_box
 from ...engine.variational import synthesize_e2
@@ -38,9 +39,10 @@ def synthesis_methods() -> S.SynthesisMethodsResponse:
     )
 
 
-def synthesis_region(spec: RobotSpec, req: S.SynthesizeRequest):
-    """The variable names, the box and the fixed values of a synthesis request, checked."""
-    names = list(spec.variable_names)
+def synthesis_region(spec: RobotSpec, kin: Kinematics, req: S.SynthesizeRequest):
+    """The variable names, the box and the fixed values of a synthesis request, checked by the
+    engine (:func:`jik.engine.functionals.check_region`: the variables outside the box held
+    at the robot's default start, :func:`jik.engine.kinematics.held_values`)."""
     size = {"e2_variational": 2, "e2_total_degree": spec.p}.get(req.method, 3)
     if req.region is None:
         region = default_box(spec, size, req.fixed or {})
@@ -52,21 +54,8 @@ def synthesis_region(spec: RobotSpec, req: S.SynthesizeRequest):
             f"'{req.method}' takes 1 to 3 variables (2 or 3 for 'e2_variational'), got "
             f"{len(region)}; 'e2_total_degree' synthesizes h of any number",
         )
-    for k, (lo, hi) in region.items():
-        if k not in names:
-            raise RequestError(f"region.{k}", f"unknown variable {k!r}; {spec.name} has {names}")
-        if not lo < hi:
-            raise RequestError(f"region.{k}", f"needs lo < hi, got [{lo:g}, {hi:g}]")
-    if not region:
-        raise RequestError("region", f"give at least one variable of {names}")
-    fixed = {n: float(v) for n, v in zip(names, spec.default_x0, strict=False) if n not in region}
-    fixed.update(req.fixed or {})
-    for k in req.fixed or {}:
-        if k not in names:
-            raise RequestError(f"fixed.{k}", f"unknown variable {k!r}; {spec.name} has {names}")
-        if k in region:
-            raise RequestError(f"fixed.{k}", "is also a region variable")
-    return names, region, fixed
+    region, fixed = check_region(kin, region, req.fixed)
+    return list(spec.variable_names), region, fixed
 
 
 def _functionals(kin, amap, region, fixed, nodes) -> tuple[dict, list[str]]:
@@ -96,7 +85,7 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
             f"extended inverse {spec.p - spec.r} formula maps instead ({{'name': 'formula', "
             "'h': [...]}})",
         )
-    names, region, fixed = synthesis_region(spec, req)
+    names, region, fixed = synthesis_region(spec, kin, req)
     if req.method == "e2_total_degree":
         return total_degree_response(req, kin, robot_used, (names, region, fixed))
     convergence: list[dict[str, float]] = []

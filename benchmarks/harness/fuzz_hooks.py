@@ -159,13 +159,14 @@ def _user_robot_ok(body: dict, path: str) -> bool:
         if path == "/synthesize":
             req = S.SynthesizeRequest.model_validate(body)
             evaluate = req.method == "evaluate"
-            spec = request_robot(req.robot, req.augmentation, with_map=evaluate).spec
+            robot = request_robot(req.robot, req.augmentation, with_map=evaluate)
+            spec = robot.spec
             if req.method == "e2_total_degree":
-                _, region, _ = synthesis_region(spec, req)
+                _, region, _ = synthesis_region(spec, robot.kinematics, req)
                 return _total_degree_ok(body, len(region), spec.p, spec.r)
             if spec.p != spec.r + 1 or (evaluate and req.augmentation is None):
                 return False
-            _, region, _ = synthesis_region(spec, req)
+            _, region, _ = synthesis_region(spec, robot.kinematics, req)
             return len(region) >= 2 or evaluate
     except (RequestError, JikError, ValidationError):
         return False
@@ -193,8 +194,9 @@ def _synthesis_ok(body: dict) -> bool:
     fixed = body.get("fixed") or {}
     if body.get("method") == "e2_total_degree":
         try:
-            _, region, _ = synthesis_region(spec, S.SynthesizeRequest.model_validate(body))
-        except (RequestError, ValidationError):
+            req = S.SynthesizeRequest.model_validate(body)
+            _, region, _ = synthesis_region(spec, spec.build(), req)
+        except (RequestError, JikError, ValidationError):
             return False
         return _total_degree_ok(body, len(region), spec.p, spec.r)
     synthesis = body.get("method") == "e2_variational"

@@ -100,20 +100,21 @@ def test_synthesize_bad_input(api):
     def msg(body):
         r = api.post("/synthesize", json=body)
         assert r.status_code == 422, r.text
-        return r.json()["detail"][0]["msg"]
+        detail = r.json()["detail"][0]
+        return f"{'.'.join(map(str, detail['loc'][1:]))} | {detail['msg']}"
 
     m2 = {"name": "manipulator2"}
     assert msg({"robot": m2, "region": {"x7": [0, 1], "x2": [0, 1]}}).startswith(
-        "region.x7: Input should be 'x1', 'x2' or 'x3'"
+        "region.x7 | region.x7: Input should be 'x1', 'x2' or 'x3'"
     )
     assert msg({"robot": m2, "region": {"x2": [1, 0], "x3": [0, 1]}}).startswith(
-        "region.x2: needs lo < hi"
+        "region.x2 | region['x2'] must have lo < hi, got (1.0, 0.0)"
     )
     assert msg({"robot": m2, "region": REGION, "fixed": {"x2": 0.0}}).startswith(
-        "fixed.x2: is also a region variable"
+        "fixed.x2 | variables ['x2'] are both integrated over and fixed"
     )
-    assert msg({"robot": m2, "grid": 1000}).startswith("grid: Input should be less than")
-    assert msg({"robot": m2, "method": "magic"}).startswith("method: Input should be")
+    assert msg({"robot": m2, "grid": 1000}).startswith("grid | grid: Input should be less than")
+    assert msg({"robot": m2, "method": "magic"}).startswith("method | method: Input should be")
 
 
 def test_fixed_values_and_a_formula_robot_s_constants_are_coordinates_within_1000(api):

@@ -146,7 +146,7 @@ def test_result_prints_on_one_line_says_where_in_words_and_exports_json():
 @pytest.mark.parametrize(
     ("call", "field", "words"),
     [
-        (lambda: map_singularities(Manipulator1(), E2Optimal(), {"y": (0, 1)}), "region", "y"),
+        (lambda: map_singularities(Manipulator1(), E2Optimal(), {"y": (0, 1)}), "region.y", "y"),
         (
             lambda: map_singularities(Manipulator1(), E2Optimal(), MANIPULATOR1_REGION, nodes=60),
             "nodes",

@@ -143,7 +143,7 @@ REFUSALS = {
     ),
     "synthesize_e2 unknown variable": (
         lambda: jik.synthesize_e2(ARM, {"x7": (0, 1), "x3": (1, 2)}),
-        "region",
+        "region.x7",
     ),
     "synthesize_e2 reversed box": (
         lambda: jik.synthesize_e2(ARM, {"x2": (1, 0), "x3": (1, 2)}),
@@ -204,7 +204,7 @@ REFUSALS = {
     ),
     "map_grid unknown variable": (
         lambda: jik.map_grid(jik.PaperCubic(), NAMES, {"x9": (0, 1), "x2": (0, 1)}),
-        "region",
+        "region.x9",
     ),
     "map_grid NaN bound": (
         lambda: jik.map_grid(jik.PaperCubic(), NAMES, {"x2": (np.nan, 1), "x3": (0, 1)}),

@@ -224,4 +224,23 @@ def test_the_joints_outside_the_region_are_held_at_home_within_the_joint_limits(
     bounded = PlanarChain("RRR", [1, 1, 1])
     bounded.joint_limits = np.array([[0.5, 1.0], [-1.0, 1.0], [-2.0, -1.0]])
     assert check_region(bounded, {"x2": (-1, 1)})[1] == {"x1": 0.5, "x3": -1.0}
-    assert check_region(Manipulator2(), {"x2": (-1, 1)})[1] == {"x1": 0.0, "x3": 0.0}
+    assert check_region(Manipulator2(), {"x2": (-1, 1)})[1] == {"x1": 0.0, "x3": np.pi / 2}
+
+
+def test_a_robot_without_a_home_holds_the_other_joints_at_its_default_start():
+    """Manipulator 2's paper cubic is singular at x3 = 0: held at its default start (the
+    dashboard's and /synthesize's), E1 is finite; a definition's x0 is its start."""
+    from jik.engine.augmentations import PaperCubic
+    from jik.engine.functionals import check_region, error_functional_e1
+    from jik.engine.registry import ROBOTS
+    from jik.engine.robot_spec import robot_from_dict
+
+    for name, spec in ROBOTS.items():
+        held = check_region(spec.build(), {spec.variable_names[0]: (0, 1)})[1]
+        assert list(held.values()) == list(spec.default_x0[1:]), name
+    e1 = error_functional_e1(Manipulator2(), PaperCubic(), {"x1": (-1, 1), "x2": (-1, 1)})
+    assert not e1.divergent and np.isfinite(e1.value)
+    chain = robot_from_dict({"name": "planar_chain", "joints": "RRR", "lengths": [1, 1, 1]})
+    assert check_region(chain.kinematics, {"x1": (0, 1)})[1] == {"x2": 0.5, "x3": 0.5}
+    moved = robot_from_dict({"name": "manipulator2", "x0": [0.1, 0.2, 1.0]})
+    assert check_region(moved.kinematics, {"x1": (0, 1)})[1] == {"x2": 0.2, "x3": 1.0}
