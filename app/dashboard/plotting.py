@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import base64
 import json
-import math
 
 import numpy as np
 
+from ...engine.exports import json_values
 from ...engine.reproductions.table1 import corner_letters
 from ...engine.units import norm_unit as norm_unit  # (the panels' and the atlas's)
 from ...engine.units import robot_units
@@ -140,7 +140,7 @@ def typed_array(v: np.ndarray):
             v = v.astype(np.int32)
     name = v.dtype.str[1:]  # ("<f8": native little-endian float64 -> "f8")
     if name not in TYPED or v.dtype.byteorder == ">" or not v.size:
-        return plain(v.tolist())
+        return json_values(v)
     out = {"dtype": name, "bdata": base64.b64encode(v.tobytes()).decode("ascii")}
     if v.ndim > 1:
         out["shape"] = ", ".join(str(n) for n in v.shape)
@@ -148,18 +148,13 @@ def typed_array(v: np.ndarray):
 
 
 def plain(v):
-    """``v`` with numpy values made JSON's (arrays typed) and non-finite numbers null."""
+    """``v`` as JSON values by the engine's rule (:func:`jik.engine.exports.json_values`:
+    non-finite numbers null), its arrays typed."""
     if isinstance(v, dict):
         return {k: plain(x) for k, x in v.items()}
     if isinstance(v, list | tuple):
         return [plain(x) for x in v]
-    if isinstance(v, np.ndarray):
-        return typed_array(v)
-    if isinstance(v, float | np.floating):
-        return float(v) if math.isfinite(v) else None
-    if isinstance(v, np.integer | np.bool_):
-        return v.item()
-    return v
+    return typed_array(v) if isinstance(v, np.ndarray) else json_values(v)
 
 
 def figure_json(spec: dict) -> str:
