@@ -42,17 +42,11 @@ def run_limits(result, algorithm: str) -> LimitsReport | None:
     return legs_report(limits, np.asarray(state.x0, dtype=float), legs, L, names)
 
 
-def limits_reports(result) -> dict[str, LimitsReport]:
-    """Per algorithm, the limits report of its run (:func:`run_limits`: the verdict says its
-    :meth:`~jik.engine.limits.LimitsReport.sentence`); empty for a robot without limits."""
-    reports = {algorithm: run_limits(result, algorithm) for algorithm in result.runs}
-    return {a: report for a, report in reports.items() if report is not None}
-
-
 def limits_summary(result) -> dict[str, Any]:
     """Per algorithm, ``{"within": bool, "violation": {...} or None}`` (the REST API's
-    ``limits``); empty for a robot without limits."""
-    return {a: report.as_dict() for a, report in limits_reports(result).items()}
+    ``limits``, of the reports ``result.limits`` the verdict says too); empty for a robot
+    without limits."""
+    return {a: report.as_dict() for a, report in result.limits.items()}
 
 
 def outside_joints(limits: np.ndarray | None, x) -> np.ndarray:

@@ -4,6 +4,7 @@ algorithms for one state (:class:`DashboardResult`)."""
 
 from __future__ import annotations
 
+import functools
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
@@ -12,6 +13,7 @@ from typing import Any, cast
 import numpy as np
 
 from ...engine.exceptions import RunCancelled
+from ...engine.limits import LimitsReport
 from ...engine.progress import ProgressCallbacks
 from ...engine.repeatability import Leg, Resume, closed_path, repeatability
 from ...engine.results import SolveResult, Trajectory
@@ -20,6 +22,7 @@ from ...engine.solve_rules import counted
 from ...engine.stall import reach_note
 from ...engine.unicycle import Unicycle
 from .controls import max_iterations
+from .joint_limits import run_limits
 from .model import DashboardState
 from .robots import state_inverse, state_kinematics
 
@@ -93,6 +96,14 @@ class DashboardResult:
     augmenting: dict | None = None  # h on a grid, see augmenting_grid()
     seconds: float = 0.0
     cached: dict = field(default_factory=dict)
+
+    @functools.cached_property
+    def limits(self) -> dict[str, LimitsReport]:
+        """Per algorithm, the limits report of its run (:func:`~.joint_limits.run_limits`),
+        built once for the verdict's sentence and the summary; empty for a robot without
+        limits."""
+        reports = {algorithm: run_limits(self, algorithm) for algorithm in self.runs}
+        return {a: report for a, report in reports.items() if report is not None}
 
 
 def leg_targets(kin, state: DashboardState) -> np.ndarray:

@@ -23,7 +23,7 @@ from ...engine.findings import (
 )
 from ...engine.reproductions.unicycle import undefined_why
 from .algorithms import STYLES, rest_words, scalar
-from .joint_limits import limits_reports, state_limits
+from .joint_limits import state_limits
 from .plotting import norm_unit, units
 from .robots import state_inverse, state_kinematics, state_spec
 from .runs import AlgorithmRun, DashboardResult
@@ -89,7 +89,7 @@ def _damped(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
 
 def _weighted(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
     """Within the box the weighted inverse took for limits (a robot that declares joint
-    limits has its sentence from :func:`jik.app.dashboard.joint_limits.limits_reports`)."""
+    limits has its sentence from :attr:`~jik.app.dashboard.runs.DashboardResult.limits`)."""
     if state_limits(result.state) is not None:
         return []
     run = result.runs["weighted"]
@@ -123,7 +123,7 @@ def verdict(result: DashboardResult) -> list[dict]:
     for a in (a for a in runs if a in practical):
         out += [Sentence(text, a, role) for text, role in practical[a](result, unit)]
     robot = state_spec(result.state).title
-    for a, report in limits_reports(result).items():
+    for a, report in result.limits.items():
         role = "note" if report.within else "warning"
         out.append(Sentence(report.sentence(NAMES[a], robot), a, role))
     if "extended" in runs and (warning := singular_sentence(result.state)):
