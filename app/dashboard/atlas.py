@@ -22,10 +22,9 @@ from ...engine.exceptions import InvalidInputError
 from ...engine.redundant_starts import manifold_starts
 from ..compute.atlas_schemas import AtlasRequest
 from .algorithms import STYLES, inverse_parameters
-from .analysis import kinematics_and_map
 from .model import DashboardState
 from .plotting import AXIS, figure, norm_unit
-from .robots import state_spec, user_robot
+from .robots import state_kinematics, state_spec, user_robot
 
 #: Drift below this is drawn as this (the extended Jacobian's drift is round-off, ~1e-13).
 DRIFT_FLOOR = 1e-14
@@ -44,7 +43,7 @@ def atlas_request(
         raise InvalidInputError(
             "task: the atlas drives a closed path; choose the closed-path task first", "task"
         )
-    kin, _ = kinematics_and_map(state)
+    kin = state_kinematics(state)  # (its map is the atlas workers' to build, not this)
     home = np.asarray(kin.forward(np.asarray(state.x0, dtype=float)), dtype=float)
     # The atlas's posture inverse, without rest, pulls each run toward its own start (the
     # state's rest is for the runs from x0; the heatmap's title says so).
