@@ -15,7 +15,6 @@ from jik import __version__
 
 from ..compute.pool import ComputePool
 from ..compute.settings import Settings
-from .body_limit import BodyLimit
 from .errors import add_error_handlers
 from .fastpath import SolveFastPath
 from .routes import (
@@ -31,9 +30,6 @@ from .routes import (
     synthesize,
 )
 from .security import SecurityMiddleware, allowed_hosts_from_env
-
-#: Largest request body accepted (413 beyond): the largest valid request is a few kilobytes.
-MAX_BODY_BYTES = 1 << 20
 
 
 def create_app(
@@ -81,8 +77,7 @@ def create_app(
         app.include_router(module.router)
     if fast_solve:
         app.add_middleware(SolveFastPath, pool=pool)
-    app.add_middleware(BodyLimit, limit=MAX_BODY_BYTES)  # before any body is read
-    # Outermost: hosts, origins and content types are checked before anything else runs.
+    # Outermost: hosts, origins, content types and sizes are checked before anything else runs.
     hosts = allowed_hosts_from_env(allowed_hosts or (), settings)
     app.add_middleware(SecurityMiddleware, allowed_hosts=hosts)
     return app
