@@ -23,6 +23,7 @@ import math
 from typing import Any
 
 import numpy as np
+from viser.transforms import SO3
 
 from ...engine.arms import ARMS
 from ..dashboard.algorithms import COLORS, STYLES
@@ -38,7 +39,7 @@ from .arm_marks import (
     target_fixtures,
     target_pose,
 )
-from .pose import NORMAL_FORM, yaw_quaternion
+from .pose import NORMAL_FORM
 from .traces import polyline, rgb, trace_tolerance, unicycle_traces
 
 HOME_COLOR = (150, 150, 150)
@@ -113,7 +114,7 @@ class Gantry(Mechanism):
         (lo, hi), _ = self.extent
         self.beam.position = ((lo + hi) / 2, float(x[0]), self.z)
         self.carriage.position = (float(x[1]), float(x[0]), self.z + 0.05)
-        self.carriage.wxyz = yaw_quaternion(float(x[2]))
+        self.carriage.wxyz = SO3.from_z_radians(float(x[2])).wxyz
 
 
 class NormalForm(Mechanism):
@@ -151,7 +152,7 @@ class NormalForm(Mechanism):
         self.runner.position = (x1, (lo + hi) / 2, self.z)
         self.slider.position = (0.0, x2, self.z)
         self.lever.position = (0.0, x2, self.z)
-        self.lever.wxyz = yaw_quaternion(math.atan(x3))
+        self.lever.wxyz = SO3.from_z_radians(math.atan(x3)).wxyz
         W = NORMAL_FORM.forward(np.asarray(x, dtype=float))
         self.point.position = (float(W[0]), float(W[1]), self.z + 0.08)
 
@@ -171,7 +172,7 @@ class Platform(Mechanism):
 
     def pose(self, q) -> None:
         self.frame.position = (float(q[0]), float(q[1]), 0.5 * self.z)
-        self.frame.wxyz = yaw_quaternion(float(q[2]))
+        self.frame.wxyz = SO3.from_z_radians(float(q[2])).wxyz
 
 
 class Chain(Mechanism):
