@@ -20,7 +20,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from viser.transforms import SO3
@@ -32,10 +32,8 @@ from ..dashboard.robots import state_kinematics
 from .arm_marks import (
     AXES_FRACTION,
     OUTSIDE_COLOR,
-    base_link,
     end_frame,
     has_pose,
-    joint_points,
     target_fixtures,
     target_pose,
 )
@@ -194,9 +192,8 @@ class Chain(Mechanism):
         )
         # Joints sized to the arm: a sixtieth of its reach from its first joint (0.04 for an arm
         # of reach 2.4); the base link is not part of the reach.
-        reach = float(
-            np.linalg.norm(np.diff(home[int(base_link(self.kin)) :], axis=0), axis=1).sum()
-        )
+        links = np.diff(self.kin.points(np.asarray(self.state.x0, dtype=float)), axis=0)
+        reach = float(np.linalg.norm(links, axis=1).sum())
         ball = max(reach, 1e-3) / 60
         self.joints = [self.ball(f"joint{i}", ball if i < n - 1 else 1.5 * ball) for i in range(n)]
         # The end link's frame when the task holds its orientation (a pose task).
@@ -211,8 +208,8 @@ class Chain(Mechanism):
         """Follow a new state: its kinematics, its joint limits and which drawn joint is each
         variable's (coloured when outside)."""
         super().resize(state, extent)
-        self.kin = state_kinematics(state)
-        self.limits, self.at = state_limits(state), joint_points(self.kin)
+        self.kin = cast(Any, state_kinematics(state))  # (a PlanarChain or a UrdfChain)
+        self.limits, self.at = state_limits(state), self.kin.joint_points
         self.marked: set[int] = set()
 
     def pose(self, x) -> None:
@@ -229,15 +226,12 @@ class Chain(Mechanism):
 
 
 def chain_points(kin: Any, x: np.ndarray, z: float) -> np.ndarray:
-    """The points of a chain (..., m, 3) in the scene: a planar one at height ``z``; an arm in
-    space where it is, from its base frame's origin when its first joint lies away from it
-    (:func:`~jik.app.scene.arm_marks.base_link`; its end on its pose targets: the copies
-    overlap, red translucent)."""
-    pts = np.asarray(kin.points(x), dtype=float)  # (PlanarChain, UrdfChain)
+    """The points of a chain (..., m, 3) in the scene, its ``drawn_points`` (PlanarChain,
+    UrdfChain): a planar one at height ``z``; an arm in space where it is (its end on its pose
+    targets: the copies overlap, red translucent)."""
+    pts = np.asarray(kin.drawn_points(x), dtype=float)
     if pts.shape[-1] == 2:
         return np.concatenate([pts, np.full((*pts.shape[:-1], 1), z)], axis=-1)
-    if base_link(kin):
-        return np.concatenate([np.zeros((*pts.shape[:-2], 1, 3)), pts], axis=-2)
     return pts
 
 
