@@ -325,11 +325,7 @@ async def export_result_csv(session_id: str, store: Store):
     a row per point of each run: algorithm, cycle, leg, theta, x_1.., y_1.., error, h."""
     dashboard = await _finished(store.get(session_id))
     body, name = export_file(dashboard.result, "csv")
-    return PlainTextResponse(
-        body,
-        media_type="text/csv",
-        headers={"Content-Disposition": f'attachment; filename="{name}"'},
-    )
+    return CSVResponse(body, headers={"Content-Disposition": f'attachment; filename="{name}"'})
 
 
 @router.websocket("/api/sessions/{session_id}/scene")
