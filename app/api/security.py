@@ -140,7 +140,7 @@ class SecurityMiddleware:
             if length.isdigit() and int(length) > MAX_BODY_BYTES:
                 raise _TooLarge(413, _too_large(str(int(length))))
             await self.app(scope, counted, secured)
-        except _TooLarge as exc:  # (from the /solve fast path, which has no handlers)
+        except _TooLarge as exc:  # (its length, or its body read past the limit by the fast path)
             if started:
                 raise
             await JSONResponse({"detail": exc.detail}, 413)(scope, receive, secured)
