@@ -103,7 +103,7 @@ class SecurityMiddleware:
         if refusal is not None:
             status, message = refusal
             if websocket:
-                await _close_websocket(receive, send, 4000 + status, message)
+                await close_websocket(receive, send, 4000 + status, message)
                 return
             await _refused(status, message)(scope, receive, send)
             return
@@ -189,9 +189,10 @@ def _routed(scope: Scope) -> bool:
     return any(route.matches(scope)[0] == Match.FULL for route in routes)
 
 
-async def _close_websocket(receive: Receive, send: Send, code: int, reason: str) -> None:
-    """Accept, then close with ``code`` (4400, 4403): a refused handshake reaches a browser's
-    script only as 1006, a close code as itself. Nothing the client sends is read."""
+async def close_websocket(receive: Receive, send: Send, code: int, reason: str) -> None:
+    """Accept, then close with ``code`` (4400, 4403; the scene's relay: 4404, 1011): a refused
+    handshake reaches a browser's script only as 1006, a close code as itself. Nothing the
+    client sends is read."""
     if (await receive())["type"] != "websocket.connect":
         return
     await send({"type": "websocket.accept"})

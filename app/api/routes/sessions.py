@@ -31,6 +31,7 @@ from ...dashboard.robots import vet_definition
 from ...dashboard.sessions import ExportUnavailable, Session, SessionNotFound
 from ..dependencies import Pool, Store
 from ..errors import unparsed_body_response
+from ..security import close_websocket
 
 router = APIRouter(tags=["dashboard sessions"])
 #: Seconds between keep-alive comments on the event stream.
@@ -340,12 +341,16 @@ async def scene_socket(websocket: WebSocket, session_id: str) -> None:
     except SessionNotFound:
         session = None
     if session is None or session.scene is None:
-        await _close(websocket, 4404, "no such session (it expired or was deleted)")
+        await close_websocket(
+            websocket.receive, websocket.send, 4404, "no such session (it expired or was deleted)"
+        )
         return
     try:
         upstream = await session.scene.connect(websocket.scope.get("subprotocols", []))
     except (OSError, websockets.exceptions.WebSocketException, TimeoutError):
-        await _close(websocket, 1011, "the session's scene is not reachable")
+        await close_websocket(
+            websocket.receive, websocket.send, 1011, "the session's scene is not reachable"
+        )
         return
     await websocket.accept(subprotocol=upstream.subprotocol)
     session.users += 1
@@ -355,13 +360,6 @@ async def scene_socket(websocket: WebSocket, session_id: str) -> None:
         session.users -= 1
         session.touch()
         await upstream.close()
-
-
-async def _close(websocket: WebSocket, code: int, reason: str) -> None:
-    """Accept, then close with ``code``: a refused handshake reaches a browser's script only as
-    1006, a close code as itself."""
-    await websocket.accept()
-    await websocket.close(code=code, reason=reason)
 
 
 async def _relay(websocket: WebSocket, upstream) -> None:
