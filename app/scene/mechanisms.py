@@ -235,7 +235,7 @@ def chain_points(kin: Any, x: np.ndarray, z: float) -> np.ndarray:
     return pts
 
 
-def drawn_points(result, kin: Any) -> np.ndarray:
+def runs_points(result, kin: Any) -> np.ndarray:
     """The points (n, 3) of a chain in the configurations of ``result``'s runs (about 200 of
     them, evenly spaced), at height 0: what the scene's box and camera must hold."""
     xs = np.concatenate([r.x for r in result.runs.values()])
@@ -345,7 +345,7 @@ def extent_of(result) -> tuple[tuple[float, float], tuple[float, float]]:
         ys = np.vstack([*(r.platform.reshape(-1, 3) for r in runs), [result.state.target]])
         lo, hi = ys.min(axis=0)[:2] - 1.0, ys.max(axis=0)[:2] + 1.0
     elif robot in CHAINS:  # (the whole arm, not only its end)
-        pts = drawn_points(result, state_kinematics(result.state))
+        pts = runs_points(result, state_kinematics(result.state))
         lo, hi = pts.min(axis=0)[:2] - 0.3, pts.max(axis=0)[:2] + 0.3
     elif robot not in MECHANISMS:  # (a formula robot: its paths, of any size)
         ys = np.vstack([*(r.y[:, :2] for r in runs), np.asarray(result.targets)[:, :2]])
