@@ -33,8 +33,6 @@ from starlette.responses import JSONResponse
 from starlette.routing import Match
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from ..compute.settings import Settings
-
 #: Largest request body accepted (413 beyond): the largest valid request is a few kilobytes.
 MAX_BODY_BYTES = 1 << 20
 #: Host names allowed by default: the loopback names.
@@ -58,14 +56,6 @@ _SCENE_POLICY = (
 )
 # The API's documentation pages (Swagger UI, ReDoc): their bootstrap is an inline script.
 _DOCS_POLICY = _SCENE_POLICY
-
-
-def allowed_hosts_from_env(
-    extra: Iterable[str] = (), settings: Settings | None = None
-) -> tuple[str, ...]:
-    """The loopback names, ``settings.allowed_hosts`` (``JIK_ALLOWED_HOSTS``, comma-separated)
-    and ``extra``."""
-    return (*LOOPBACK_HOSTS, *(settings or Settings()).host_names, *extra)
 
 
 def _host_name(host: str) -> str:
