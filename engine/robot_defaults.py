@@ -1,9 +1,12 @@
 """The defaults of a robot defined by data (:func:`jik.engine.robot_spec.robot_from_dict`):
-its start x0, a target, and a closed path the pseudoinverse drifts on, each checked when given.
+its start x0, a target, and a closed path the pseudoinverse drifts on, each checked when given;
+and, for a robot without an augmenting map, the variables a default map h keeps
+(:func:`kept_variables`).
 """
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Mapping
 
 import numpy as np
@@ -83,3 +86,37 @@ def defaults(kin: Kinematics, d: Mapping, box, base: RobotSpec | None = None) ->
             f"path must be a list of 1 to {MAX_PATH_POINTS} task points", "path"
         )
     return tuple(x0.tolist()), tuple(target.tolist()), tuple(map(tuple, path.tolist()))
+
+
+#: sigma_min / sigma_max of J's columns of the joints h leaves free, at x0, above which the
+#: default map keeps the last p - r variables.
+REGULAR = 1e-6
+
+
+def kept_variables(kin: Kinematics, x0) -> list[int]:
+    """The p - r variables a default augmenting map h = (x_i, ...) keeps, for a robot defined
+    without a map: the last ones, unless the columns of J(x0) of the others are singular at
+    ``x0`` (then the extended Jacobian [J; dh] of eq. (10) is, as for a Panda's xyz task at
+    home, whose joints 1 and 3 move the point alike); then those whose others' columns are best
+    conditioned (largest sigma_min / sigma_max).
+
+    Parameters
+    ----------
+    kin : Kinematics
+    x0 : array_like, shape (p,)
+        The robot's default start.
+
+    Returns
+    -------
+    list of int
+        p - r indices of variables, ascending.
+    """
+    p, r = kin.p, kin.r
+    with np.errstate(all="ignore"):
+        J = np.asarray(kin.jacobian(np.asarray(x0, dtype=float)), float)  # (r, p)
+    driven = np.array(list(itertools.combinations(range(p), r)))  # (n, r): joints J drives
+    s = np.linalg.svd(np.nan_to_num(J[:, driven].transpose(1, 0, 2)), compute_uv=False)
+    ratio = s[:, -1] / np.maximum(s[:, 0], 1e-300)  # (n,)
+    first = int(np.flatnonzero((driven == np.arange(r)).all(axis=1))[0])
+    best = first if ratio[first] > REGULAR else int(np.argmax(ratio))
+    return [i for i in range(p) if i not in driven[best]]

@@ -15,7 +15,7 @@ import socket
 import uvicorn
 
 from ..compute.settings import Settings
-from ..dashboard.sessions import SessionLimits, SessionStore
+from ..dashboard.sessions import SessionStore
 from ..scene import start_scene
 from .factory import create_app
 from .protocol import with_read_deadline
@@ -79,9 +79,7 @@ def run_server(
     settings = Settings()  # (the environment, read once)
     app = create_app(settings, allowed_hosts=allowed_hosts)
     # The sessions share the app's compute pool (JIK_WORKERS processes) with the API.
-    app.state.sessions = SessionStore(
-        SessionLimits.from_settings(settings), scene_factory=start_scene, pool=app.state.pool
-    )
+    app.state.sessions = SessionStore(settings, scene_factory=start_scene, pool=app.state.pool)
     # uvicorn shuts down gracefully on SIGINT and SIGTERM (the lifespan stops the sessions and
     # the workers), restores the handlers it found and then raises the signal again. With these
     # handlers that second signal only ends the wait, and the command exits 0, as a server asked

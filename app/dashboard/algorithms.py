@@ -4,13 +4,10 @@
 A state chooses one to five algorithms (``algorithms``, default the paper's two, eqs. (8) and
 (11)) and holds the scalar parameters of the chosen ones (``algorithm_parameters``: ``damping``
 and ``damping_threshold`` of damped least squares, ``gain`` of the posture inverse), with their
-ranges from the engine's :class:`~jik.engine.parameters.Parameter`, and the posture inverse's
-rest x_rest (``rest``, p numbers within the robot's joint limits, the engine's rule, and
-within its sliders' range, :func:`joint_box`; without it, the engine's default,
-:func:`~jik.engine.algorithm_registry.default_rest`: the robot's home, else the state's start
-x0, which a rest slider moved first brings into that range, :func:`editable_rest`). The
-weighted inverse takes the robot's joint limits (else its configuration box), and is refused
-naming ``algorithms`` for a robot with neither.
+ranges from the engine's :class:`~jik.engine.parameters.Parameter` (:func:`checked`), and the
+posture inverse's rest x_rest (``rest``: :func:`checked_rest`, :func:`editable_rest`); an
+algorithm the robot cannot run (the weighted inverse without joint limits) is refused by
+:func:`check_inverses`.
 :data:`STYLES` gives each algorithm one colour, line style, marker, label and 3D copy, used by
 the scene, every plot, the drift panel and the atlas. :func:`cache_key` says what one
 algorithm's run depends on (its own parameters included).
@@ -38,7 +35,7 @@ from ..compute.schemas.wording import refused, without_field
 
 class ChosenState(Protocol):
     """What these functions read of a :class:`jik.app.dashboard.model.DashboardState` (which
-    imports this module)."""
+    imports this module: importing it here, even for the type checker, is a cycle)."""
 
     @property
     def algorithms(self) -> Sequence[str]: ...

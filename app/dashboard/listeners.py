@@ -5,7 +5,6 @@ and waiting for a generation's computation. A part of the dashboard, sharing its
 from __future__ import annotations
 
 import threading
-import time
 from collections.abc import Callable
 
 from .messages import Event
@@ -61,15 +60,9 @@ class Listeners:
     def wait(self, generation: int | None = None, timeout: float = 30.0) -> bool:
         """Block until the computation of ``generation`` (default: current) has finished."""
         self.start()
-        deadline = time.monotonic() + timeout
         with self._cond:
             target = self._generation if generation is None else generation
-            while self._done < target:
-                left = deadline - time.monotonic()
-                if left <= 0:
-                    return False
-                self._cond.wait(left)
-        return True
+            return self._cond.wait_for(lambda: self._done >= target, timeout)
 
     def _failed(self) -> bool:
         """Whether the latest error is newer than the result on screen (call with the lock)."""

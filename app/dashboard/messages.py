@@ -79,19 +79,20 @@ def to_json(obj) -> str:
     """``obj`` as JSON, NaN and infinities as null (:func:`finite`): the one place where a
     dashboard's results become JSON (events, exports), so that an undefined h or a diverged
     iterate never reaches an encoder that refuses it."""
-    return json.dumps(finite(obj), separators=(",", ":"), allow_nan=False, default=jsonable)
+    return json.dumps(finite(obj), separators=(",", ":"), allow_nan=False)
 
 
 def finite(v):
-    """``v`` with every non-finite float (NaN, inf) made None, through dicts, lists, tuples
-    and numpy arrays (a float array becomes a list with None where it is not finite)."""
+    """``v`` as JSON data: every non-finite float (NaN, inf) made None, through dicts, lists,
+    tuples and numpy arrays (a float array becomes a list with None where it is not finite;
+    other arrays and numpy scalars, lists and Python numbers)."""
     if isinstance(v, dict):
         return {k: finite(x) for k, x in v.items()}
     if isinstance(v, list | tuple):
         return [finite(x) for x in v]
     if isinstance(v, float | np.floating) or (isinstance(v, np.ndarray) and v.dtype.kind == "f"):
         return nullable(v)
-    return v
+    return v.tolist() if isinstance(v, np.ndarray | np.generic) else v
 
 
 def with_figures(message: dict, figures: Mapping[str, str]) -> str:
@@ -100,14 +101,6 @@ def with_figures(message: dict, figures: Mapping[str, str]) -> str:
     message = {**message, "digests": {k: digest(t) for k, t in figures.items()}}
     body = ",".join(f'"{k}":{t}' for k, t in figures.items())
     return to_json(message)[:-1] + ',"figures":{' + body + "}}"
-
-
-def jsonable(v):
-    if isinstance(v, np.ndarray):
-        return v.tolist()
-    if isinstance(v, np.generic):
-        return v.item()
-    raise TypeError(f"not JSON serialisable: {type(v).__name__}")
 
 
 def summary(result: DashboardResult) -> dict:

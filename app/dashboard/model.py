@@ -80,10 +80,10 @@ class DashboardState(BaseModel):
     path: Annotated[tuple[Point, ...], Field(max_length=MAX_PATH_POINTS)]
     cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_DASHBOARD_CYCLES), INTEGRAL]
     tolerance: Tolerance = 1e-10
-    #: Cap on each leg's iterations (discrete) or integrator steps (continuous); None: the
-    #: engine's default (:func:`jik.engine.solver.solve`).
     #: The three coordinates the configuration-space panel shows (p = 4): "012" is x1, x2, x3.
     cspace_axes: Literal["012", "013", "023", "123"] | None = None
+    #: Cap on each leg's iterations (discrete) or integrator steps (continuous); None: the
+    #: engine's default (:func:`jik.engine.solver.solve`).
     max_iterations: (
         Annotated[int, Field(strict=True, ge=MIN_ITERATIONS, le=MAX_ITERATIONS_CAP), INTEGRAL]
         | None

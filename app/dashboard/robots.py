@@ -14,7 +14,6 @@ that a formula too costly to differentiate is refused before the server builds i
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Mapping
 from typing import Any
 
@@ -25,6 +24,7 @@ from ...engine.exceptions import InvalidInputError
 from ...engine.inverses import Inverse
 from ...engine.kinematics import Kinematics
 from ...engine.registry import RobotSpec, robot_spec
+from ...engine.robot_defaults import kept_variables
 from ...engine.robot_kinds import KINDS
 from ...engine.robot_spec import Robot
 from ..compute.budget import build_seconds, time_budget
@@ -33,10 +33,6 @@ from ..compute.schemas.wording import refused, without_field
 from ..compute.user_robots import built
 from ..compute.worker import task
 from .algorithms import inverse_parameters
-
-#: sigma_min / sigma_max of J's columns of the joints h leaves free, at x0, above which the
-#: default map keeps the last p - r variables.
-REGULAR = 1e-6
 
 #: The robots given by a definition: the kinds a user defines (the editor's choices), and the
 #: catalogue's arms (:mod:`jik.engine.arms`), whose definition is their name and task.
@@ -54,25 +50,9 @@ def _built(definition: Mapping[str, Any]) -> Robot:
     spec = robot.spec
     if spec.augmentations or spec.p <= spec.r:
         return robot
-    kept = [spec.variable_names[i] for i in _kept_variables(robot)]
+    kept = [spec.variable_names[i] for i in kept_variables(robot.kinematics, spec.default_x0)]
     h = kept[0] if len(kept) == 1 else kept
     return built({**definition, "augmentations": [{"name": "formula", "h": h}]})
-
-
-def _kept_variables(robot: Robot) -> list[int]:
-    """The p - r variables a default map h keeps: the last ones, unless the columns of J(x0)
-    of the others are singular at the default x0 (then [J; dh] (10) is, as for a Panda's xyz
-    task at home, whose joints 1 and 3 move the point alike); then those whose others' columns
-    are best conditioned (largest sigma_min / sigma_max)."""
-    p, r = robot.spec.p, robot.spec.r
-    with np.errstate(all="ignore"):
-        J = np.asarray(robot.kinematics.jacobian(np.asarray(robot.spec.default_x0)), float)
-    driven = np.array(list(itertools.combinations(range(p), r)))  # (n, r): joints J drives
-    s = np.linalg.svd(np.nan_to_num(J[:, driven].transpose(1, 0, 2)), compute_uv=False)
-    ratio = s[:, -1] / np.maximum(s[:, 0], 1e-300)  # (n,)
-    first = int(np.flatnonzero((driven == np.arange(r)).all(axis=1))[0])
-    best = first if ratio[first] > REGULAR else int(np.argmax(ratio))
-    return [i for i in range(p) if i not in driven[best]]
 
 
 def user_robot(definition: Mapping[str, Any]) -> Robot:

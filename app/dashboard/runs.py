@@ -101,11 +101,21 @@ def leg_targets(kin, state: DashboardState) -> np.ndarray:
     return closed_path(kin, np.asarray([state.x0]), np.asarray(state.path))[0]
 
 
-def _run_legs(
-    inverse, state, targets, cycles, progress, cancelled, partial, resume=None
+def algorithm_run(
+    state: DashboardState,
+    algorithm: str,
+    targets: np.ndarray,
+    cycles: int,
+    progress: Callable[[], None] = lambda: None,
+    cancelled: Callable[[], bool] = lambda: False,
+    partial: Callable[[float], None] = lambda f: None,
+    kin=None,
+    resume: AlgorithmRun | None = None,
 ) -> AlgorithmRun:
-    """Drive ``inverse`` through the legs by :func:`jik.engine.repeatability.repeatability`,
-    keeping every point of every leg (its progress's ``leg``) with theta cumulative over the legs.
+    """One algorithm through ``cycles`` cycles of the legs to ``targets`` (see :func:`compute`)
+    by :func:`jik.engine.repeatability.repeatability`, keeping every point of every leg (its
+    progress's ``leg``) with theta cumulative over the legs; for the unicycle with the platform
+    paths q(t) of its iterates. ``kin``: the state's kinematics when the caller has built it.
 
     ``resume``: a successful run of fewer cycles of the same legs, whose cycles are kept; the
     engine goes on from its end with its last cycle's legs as Picard guides (the numbers of a
@@ -114,11 +124,13 @@ def _run_legs(
     raises (a map undefined where it starts) stops this algorithm; the other one is still shown.
     """
     t0 = time.perf_counter()
+    kin = state_kinematics(state) if kin is None else kin
+    inverse = state_inverse(state, algorithm, kin)
     x0 = np.asarray(state.x0)
     continuous = state.mode == "continuous"
     cap = max_iterations(state)
     L = len(targets)
-    parts = []  # (theta, x, y, error, h, leg index) of every leg
+    parts: list[tuple] = []  # (theta, x, y, error, h, leg index) of every leg
     offset, last, failure = 0.0, "", ""  # (the last leg's message; what stopped the run)
     status = "converged"  # (the last leg's)
     earlier = None
@@ -167,7 +179,7 @@ def _run_legs(
     ends = run.legs[np.isfinite(run.legs).all(axis=1)]
     # (the cycles that ended: a failed leg leaves NaN from there on)
     drift = run.drift[np.isfinite(run.drift)] if state.task == "path" else run.drift[:0]
-    return AlgorithmRun(
+    out = AlgorithmRun(
         algorithm=inverse.name,
         theta=np.concatenate([p[0] for p in parts]),
         x=np.concatenate([p[1] for p in parts]),
@@ -183,6 +195,8 @@ def _run_legs(
         status=status,
         settings=run.settings,
     )
+    t = platform_time(kin)
+    return out if t is None else replace(out, platform=kin.path(out.x, t))
 
 
 def _leg_message(res: SolveResult, cap: int, kinematics) -> str:
@@ -230,7 +244,7 @@ def _legs_message(legs: int, drift, last_message: str) -> str:
 
 def first_cycles(run: AlgorithmRun, cycles: int, legs: int) -> AlgorithmRun:
     """The first ``cycles`` cycles of a successful closed-path run of ``legs`` legs a cycle:
-    what a run of that many cycles gives (see :func:`_run_legs`)."""
+    what a run of that many cycles gives (see :func:`algorithm_run`)."""
     keep = run.leg < cycles * legs
     drift = run.drift[:cycles]
     return replace(
@@ -242,27 +256,6 @@ def first_cycles(run: AlgorithmRun, cycles: int, legs: int) -> AlgorithmRun:
         message=_legs_message(cycles * legs, drift, run.message),
         seconds=0.0,
     )
-
-
-def algorithm_run(
-    state: DashboardState,
-    algorithm: str,
-    targets: np.ndarray,
-    cycles: int,
-    progress: Callable[[], None] = lambda: None,
-    cancelled: Callable[[], bool] = lambda: False,
-    partial: Callable[[float], None] = lambda f: None,
-    kin=None,
-    resume: AlgorithmRun | None = None,
-) -> AlgorithmRun:
-    """One algorithm through ``cycles`` cycles of the legs to ``targets`` (see :func:`compute`);
-    for the unicycle with the platform paths q(t) of its iterates. ``kin``: the state's
-    kinematics when the caller has built it; ``resume``: see :func:`_run_legs`."""
-    kin = state_kinematics(state) if kin is None else kin
-    inverse = state_inverse(state, algorithm, kin)
-    run = _run_legs(inverse, state, targets, cycles, progress, cancelled, partial, resume)
-    t = platform_time(kin)
-    return run if t is None else replace(run, platform=kin.path(run.x, t))
 
 
 def platform_time(kin) -> np.ndarray | None:

@@ -58,11 +58,8 @@ class SecondPhaseControl:
         """h on a grid when it is expensive, then E1 and E2 (quadrature) and their sensitivity
         (:class:`SecondPhase`), unless a newer change comes meanwhile: ``progress`` events
         (``"phase": "second"``, what is computed) and a ``functionals`` event at the end, or,
-        when :meth:`cancel_second_phase` stopped it, one that says so (``cancelled``).
-
-        Known functionals went out with the result: their event only carries the h panel's
-        title (a reused panel can lack it, and a page that connects now gets this event with
-        the latest result).
+        when :meth:`cancel_second_phase` stopped it, one that says so (``cancelled``); see
+        :func:`~jik.app.dashboard.second_phase.finished_message` for known functionals.
         """
         phase = SecondPhase(
             kin,

@@ -142,11 +142,7 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
         self, patch: Mapping[str, object], source: str = "page"
     ) -> tuple[int, DashboardState]:
         """Validate and apply a change; the worker recomputes. Returns (generation, state).
-
-        A change the registry refuses raises :class:`InvalidInputError` and is announced to
-        every listener as a ``refused`` event (the page and the scene both show it, and their
-        controls go back to the values in force).
-        """
+        A change the registry refuses is announced and raised by :meth:`refuse`."""
         refusal: InvalidInputError | None = None
         with self._cond:
             try:

@@ -2,16 +2,16 @@
 
 Every browser tab creates its own session from the state in its URL; the session's id is a
 random token that only that tab holds, so nobody else sees or changes its state. Sessions are
-bounded in number (:attr:`SessionLimits.max_sessions`) and expire when idle: a session with no
-page listening (event stream) and no scene connected, untouched for ``idle_seconds``, is
-stopped. When the store is full, the session idle the longest makes room; if every session is in
-use the new one is refused (the route answers 503).
+bounded in number (``max_sessions`` of :class:`~jik.app.compute.settings.Settings`) and expire
+when idle: a session with no page listening (event stream) and no scene connected, untouched
+for ``session_idle_seconds``, is stopped. When the store is full, the session idle the longest
+makes room; if every session is in use the new one is refused (the route answers 503).
 
 The sessions' computations share the server's one compute pool with the REST API: one
 algorithm of each run goes to its worker processes (each dashboard's
 :class:`~jik.app.dashboard.offload.OffloadLane`, first come first served), and the other is
 computed in the session's own thread, in turns of :class:`~jik.app.dashboard.slots.FairSlots`
-(at most ``computations`` at once, in the order asked).
+(at most ``dashboard_computations`` at once, in the order asked).
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..compute.settings import Settings, cpu_count
+from ..compute.settings import Settings
 from .model import default_state, updated_state
 from .session import Dashboard
 from .slots import FairSlots
@@ -44,29 +44,6 @@ class SessionNotFound(KeyError):
 
 class SessionsFull(RuntimeError):
     """Every session slot is in use; the message says how many and what to do."""
-
-
-_DEFAULTS = Settings.model_fields
-
-
-@dataclass(frozen=True)
-class SessionLimits:
-    """How many sessions, how long an idle one lives, how many of their computations run in
-    their threads at once (the other algorithm's runs are the compute pool's, JIK_WORKERS);
-    by default the server's :class:`~jik.app.compute.settings.Settings` defaults."""
-
-    max_sessions: int = _DEFAULTS["max_sessions"].default
-    idle_seconds: float = _DEFAULTS["session_idle_seconds"].default
-    computations: int = field(default_factory=cpu_count)
-
-    @classmethod
-    def from_settings(cls, settings: Settings) -> SessionLimits:
-        """``JIK_MAX_SESSIONS``, ``JIK_SESSION_IDLE_SECONDS``, ``JIK_DASHBOARD_COMPUTATIONS``."""
-        return cls(
-            max_sessions=settings.max_sessions,
-            idle_seconds=settings.session_idle_seconds,
-            computations=settings.dashboard_computations,
-        )
 
 
 @dataclass
@@ -94,7 +71,10 @@ class SessionStore:
 
     Parameters
     ----------
-    limits : SessionLimits
+    settings : Settings, optional
+        The server's: ``max_sessions``, ``session_idle_seconds`` and ``dashboard_computations``
+        (how many of the sessions' computations run in their threads at once; the other
+        algorithm's runs are the compute pool's); default: the environment's.
     scene_factory : callable, optional
         ``scene_factory(dashboard, low_end)`` starts the 3D scene of a new session (``jik
         serve`` gives :func:`jik.app.scene.start_scene`: a viser server on a loopback port);
@@ -106,16 +86,16 @@ class SessionStore:
 
     def __init__(
         self,
-        limits: SessionLimits | None = None,
+        settings: Settings | None = None,
         scene_factory: Callable[[Dashboard, bool], Any] | None = None,
         pool: Any = None,
     ) -> None:
-        self.limits = limits or SessionLimits()
+        self.settings = settings or Settings()
         self._scene_factory = scene_factory
         self._sessions: dict[str, Session] = {}
         self._lock = threading.Lock()
         self._pool = pool
-        self._slots = FairSlots(self.limits.computations)
+        self._slots = FairSlots(self.settings.dashboard_computations)
         self._closed = threading.Event()
         self._reaper: threading.Thread | None = None
 
@@ -138,7 +118,7 @@ class SessionStore:
             state = updated_state(state, patch)
         self.expire()
         with self._lock:
-            if len(self._sessions) >= self.limits.max_sessions:
+            if len(self._sessions) >= self.settings.max_sessions:
                 self._evict_idlest()
             session_id = secrets.token_urlsafe(16)
             dashboard = Dashboard(state, pool=self._pool, slots=self._slots)
@@ -156,7 +136,7 @@ class SessionStore:
         with self._lock:
             if self._reaper is not None:
                 return
-            period = min(30.0, self.limits.idle_seconds / 4)
+            period = min(30.0, self.settings.session_idle_seconds / 4)
 
             def reap() -> None:
                 while not self._closed.wait(period):
@@ -183,7 +163,7 @@ class SessionStore:
 
     def expire(self) -> int:
         """Stop the sessions idle for longer than the limit; how many were stopped."""
-        deadline = time.monotonic() - self.limits.idle_seconds
+        deadline = time.monotonic() - self.settings.session_idle_seconds
         with self._lock:
             old = [s for s in self._sessions.values() if s.users == 0 and s.touched < deadline]
             for session in old:

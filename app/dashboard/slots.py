@@ -26,8 +26,7 @@ class FairSlots:
         me = object()
         with self._cond:
             self._queue.append(me)
-            while self._queue[0] is not me or self._busy >= self.n:
-                self._cond.wait()
+            self._cond.wait_for(lambda: self._queue[0] is me and self._busy < self.n)
             self._queue.popleft()
             self._busy += 1
             self._cond.notify_all()
@@ -37,8 +36,3 @@ class FairSlots:
             with self._cond:
                 self._busy -= 1
                 self._cond.notify_all()
-
-    @property
-    def busy(self) -> int:
-        """Slots held now."""
-        return self._busy

@@ -25,10 +25,10 @@ def api():
 def app():
     """An app whose dashboard sessions (at most 4) have no 3D scene, without its lifespan: the
     sessions compute in their own threads."""
-    from jik.app.dashboard.sessions import SessionLimits, SessionStore
+    from jik.app.dashboard.sessions import SessionStore
 
     app = create_app()
-    app.state.sessions = SessionStore(SessionLimits(max_sessions=4))
+    app.state.sessions = SessionStore(Settings(max_sessions=4))
     yield app
     app.state.sessions.close()
 

@@ -19,7 +19,7 @@ from jik.app.compute.atlas_schemas import AtlasRequest
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.pool import pool_in_thread
 from jik.app.compute.settings import Settings
-from jik.app.dashboard.sessions import SessionLimits, SessionStore
+from jik.app.dashboard.sessions import SessionStore
 from jik.engine.atlas_run import run_atlas
 from jik.engine.registry import robot_spec
 from tests.app.conftest import messages
@@ -47,7 +47,7 @@ LONG = body(starts=20000, cycles=5, arc=None)
 def app():
     app = create_app()
     app.state.atlas_jobs = AtlasJobs(AtlasLimits(max_jobs=3, per_client=1))
-    app.state.sessions = SessionStore(SessionLimits(max_sessions=4))
+    app.state.sessions = SessionStore(Settings(max_sessions=4))
     yield app
     app.state.atlas_jobs.close()
     app.state.sessions.close()

@@ -15,7 +15,8 @@ from jik.app.api.factory import create_app
 from jik.app.compute.atlas_jobs import AtlasJobs
 from jik.app.compute.atlas_plan import AtlasLimits, planned
 from jik.app.compute.atlas_schemas import AtlasRequest
-from jik.app.dashboard.sessions import SessionLimits, SessionStore
+from jik.app.compute.settings import Settings
+from jik.app.dashboard.sessions import SessionStore
 from jik.engine.atlas_run import run_atlas
 from jik.engine.exports import csv_rows
 from tests.app.test_atlas_api import LONG, body, wait_until_ended
@@ -28,7 +29,7 @@ TEXT = {"algorithm", "path", "start", "cycle", "leg", "success"}
 def app():
     app = create_app()
     app.state.atlas_jobs = AtlasJobs(AtlasLimits(max_jobs=4, per_client=2))
-    app.state.sessions = SessionStore(SessionLimits(max_sessions=4))
+    app.state.sessions = SessionStore(Settings(max_sessions=4))
     yield app
     app.state.atlas_jobs.close()
     app.state.sessions.close()

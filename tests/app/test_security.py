@@ -129,11 +129,12 @@ def test_a_scene_server_takes_only_the_relay(tmp_path):
     (its Origin, a rebound Host), a local program without the relay's key and a plain request
     for viser's page are all refused at the handshake, and the session's state is unchanged;
     the relay (/api/sessions/{id}/scene) still reaches the scene."""
-    from jik.app.dashboard.sessions import SessionLimits, SessionStore
+    from jik.app.compute.settings import Settings
+    from jik.app.dashboard.sessions import SessionStore
     from jik.app.scene import start_scene
 
     app = create_app()
-    app.state.sessions = SessionStore(SessionLimits(max_sessions=2), scene_factory=start_scene)
+    app.state.sessions = SessionStore(Settings(max_sessions=2), scene_factory=start_scene)
     try:
         client = TestClient(app)
         created = client.post("/api/sessions", json={"state": {}}).json()

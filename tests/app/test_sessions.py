@@ -11,9 +11,10 @@ from fastapi.testclient import TestClient
 from starlette.websockets import WebSocketDisconnect
 
 from jik.app.api.factory import create_app
+from jik.app.compute.settings import Settings
 from jik.app.dashboard.algorithms import COLORS
 from jik.app.dashboard.plotting import PANELS
-from jik.app.dashboard.sessions import SessionLimits, SessionNotFound, SessionsFull, SessionStore
+from jik.app.dashboard.sessions import SessionNotFound, SessionsFull, SessionStore
 from jik.engine.registry import ALGORITHMS
 
 JSON = {"content-type": "application/json"}
@@ -139,7 +140,7 @@ def test_unknown_and_deleted_sessions_are_404(client):
 
 
 def test_a_full_store_evicts_the_idlest_unused_session_or_refuses():
-    store = SessionStore(SessionLimits(max_sessions=2))
+    store = SessionStore(Settings(max_sessions=2))
     try:
         a = store.create()
         b = store.create()
@@ -157,7 +158,7 @@ def test_a_full_store_evicts_the_idlest_unused_session_or_refuses():
 
 def test_a_full_store_answers_503(app, client):
     app.state.sessions.close()
-    app.state.sessions = store = SessionStore(SessionLimits(max_sessions=1))
+    app.state.sessions = store = SessionStore(Settings(max_sessions=1))
     session = _open(client)
     store.get(session["id"]).users = 1
     r = client.post("/api/sessions", json={"state": {}})
@@ -166,7 +167,7 @@ def test_a_full_store_answers_503(app, client):
 
 
 def test_idle_sessions_expire_by_themselves():
-    store = SessionStore(SessionLimits(idle_seconds=1.0))
+    store = SessionStore(Settings(session_idle_seconds=1.0))
     try:
         kept, idle = store.create(), store.create()
         kept.users = 1

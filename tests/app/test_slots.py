@@ -11,7 +11,7 @@ from jik.app.dashboard.slots import FairSlots
 
 def test_at_most_n_hold_a_slot_and_turns_go_in_the_order_asked():
     slots = FairSlots(2)
-    held, order, peak = threading.Semaphore(0), [], [0]
+    held, order, peak, busy = threading.Semaphore(0), [], [0], [0]
     release = threading.Event()
     lock = threading.Lock()
 
@@ -19,9 +19,12 @@ def test_at_most_n_hold_a_slot_and_turns_go_in_the_order_asked():
         with slots.slot():
             with lock:
                 order.append(k)
-                peak[0] = max(peak[0], slots.busy)
+                busy[0] += 1
+                peak[0] = max(peak[0], busy[0])
             held.release()
             release.wait(10)
+            with lock:
+                busy[0] -= 1
 
     first = [threading.Thread(target=work, args=(k,)) for k in (0, 1)]
     for t in first:
