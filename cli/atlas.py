@@ -30,12 +30,13 @@ import time
 from pathlib import Path
 from typing import Any
 
+from ..engine.exports import json_values
 from .algorithm_options import (
     ALGORITHM_NAMES,
     add_algorithm_parameter_options,
     algorithm_parameters,
 )
-from .atlas_output import CsvWriter, Gathered, listed, write_figure
+from .atlas_output import CsvWriter, Gathered, write_figure
 from .robot_commands import add_task_option, refused, robot_with_task
 
 #: Atlases of more runs than this write their arrays to the CSV only (the JSON keeps a summary).
@@ -282,13 +283,13 @@ def _run(args: argparse.Namespace) -> int:
     }
     if keep:
         squeeze = (lambda a: a[0]) if P == 1 else (lambda a: a)
-        doc["parameter"] = listed(plan.parameter(np.arange(N)))
-        doc["starts"] = listed(squeeze(arrays.starts))
+        doc["parameter"] = json_values(plan.parameter(np.arange(N)))
+        doc["starts"] = json_values(squeeze(arrays.starts))
         doc["results"] = {
             alg: {
-                "drift": listed(squeeze(arrays.drift[a])),
+                "drift": json_values(squeeze(arrays.drift[a])),
                 "success": squeeze(arrays.success[a]).tolist(),
-                "leg_ends": None if arrays.legs is None else listed(squeeze(arrays.legs[a])),
+                "leg_ends": None if arrays.legs is None else json_values(squeeze(arrays.legs[a])),
                 "failures": {
                     str(run): why for (b, run), why in sorted(arrays.failures.items()) if b == a
                 },

@@ -10,14 +10,7 @@ from typing import Any
 
 from jik import install_hint
 
-
-def listed(a) -> Any:
-    """Nested lists with NaN as null (JSON has no NaN)."""
-    import numpy as np
-
-    a = np.asarray(a, dtype=float)
-    listed: Any = np.where(np.isfinite(a), a.astype(object), None)
-    return listed.tolist()
+from ..engine.exports import json_values
 
 
 class Gathered:
@@ -79,8 +72,8 @@ class Gathered:
             alg: {
                 "converged_runs": int(self.count[a, 0]),
                 "failed_runs": sum(1 for (b, _) in self.failures if b == a),
-                "mean_drift": listed(mean[a]),
-                "max_drift": listed(self.worst[a]),
+                "mean_drift": json_values(mean[a]),
+                "max_drift": json_values(self.worst[a]),
                 **({} if self.outside is None else {"outside_limits": int(self.outside[a])}),
             }
             for a, alg in enumerate(self.plan.algorithms)

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 from typing import TYPE_CHECKING
 
@@ -139,18 +138,6 @@ def _inverse(robot, args: argparse.Namespace, x0):
     )
 
 
-def _nan_as_null(value):
-    """``value`` with NaN and infinities as null (JSON has no NaN, as ``jik atlas`` writes it):
-    a failed leg's configurations and drift."""
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
-    if isinstance(value, dict):
-        return {k: _nan_as_null(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_nan_as_null(v) for v in value]
-    return value
-
-
 def _document(robot, result, report, as_json: bool) -> None:
     """The result in the engine's names (``as_dict()``: x0, y_d or targets, x, legs, ...) with
     the robot, its limits' report, notes and the units of x and y; printed as JSON, or its
@@ -163,7 +150,7 @@ def _document(robot, result, report, as_json: bool) -> None:
         "units": robot.units.summary(),
     }
     if as_json:
-        print(json.dumps(_nan_as_null(out), allow_nan=False))
+        print(json.dumps(out, allow_nan=False))  # (as_dict: NaN as None)
     else:
         print(f"{out['robot']}, {out['algorithm']}: {result.message}")
         for note in out.get("notes", ()):

@@ -64,7 +64,7 @@ Errors (jik.engine.exceptions)
     JikError                    the base of every error below
     InvalidInputError, FormulaError  bad input (``error.field`` names it); a formula's syntax
     SingularConfigurationError, KinematicSingularityError, AlgorithmicSingularityError,
-    OneFormUndefinedError       J# undefined at a configuration (``error.x`` names it)
+    OneFormUndefinedError       J# undefined at ``error.configuration`` (``error.field``: its input)
     RunCancelled                a Progress said the work is no longer wanted
 
 Every numeric function takes a leading batch axis. Robots, maps and inverses print as what they

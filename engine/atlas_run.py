@@ -21,7 +21,7 @@ from .atlas import AtlasPlan
 from .atlas_backends import Backend, backend_for
 from .atlas_table import atlas_columns
 from .exceptions import InvalidInputError, SingularConfigurationError
-from .exports import Columns, csv_text, dataframe
+from .exports import Columns, csv_text, dataframe, json_values
 from .inverses import Inverse
 from .limits import robot_limits, starts_outside
 from .posture_at_start import PostureAtStart
@@ -260,25 +260,30 @@ class AtlasResult(Columns):
     def as_dict(self, leg_ends: bool = False) -> dict:
         """JSON-friendly: the labels, paths, arc lengths, starts, drift, success, the failures
         (a list of ``{"algorithm", "path", "start", "message"}``), outside_limits and, with
-        ``leg_ends``, every leg's end (A P N cycles L p numbers)."""
-        return {
-            "algorithms": list(self.algorithms),
-            "paths": self.paths.tolist(),
-            "parameter": None if self.parameter is None else self.parameter.tolist(),
-            "starts": self.starts.tolist(),
-            "drift": self.drift.tolist(),
-            "success": self.success.tolist(),
-            "failures": [
-                {"algorithm": self.algorithms[a], "path": j, "start": i, "message": why}
-                for (a, j, i), why in sorted(self.failures.items())
-            ],
-            "outside_limits": None if self.outside_limits is None else self.outside_limits.tolist(),
-            **(
-                {"leg_ends": None if self.leg_ends is None else self.leg_ends.tolist()}
-                if leg_ends
-                else {}
-            ),
-        }
+        ``leg_ends``, every leg's end (A P N cycles L p numbers); None for NaN (a failed leg's
+        drift: :func:`~jik.engine.exports.json_values`)."""
+        return json_values(
+            {
+                "algorithms": list(self.algorithms),
+                "paths": self.paths.tolist(),
+                "parameter": None if self.parameter is None else self.parameter.tolist(),
+                "starts": self.starts.tolist(),
+                "drift": self.drift.tolist(),
+                "success": self.success.tolist(),
+                "failures": [
+                    {"algorithm": self.algorithms[a], "path": j, "start": i, "message": why}
+                    for (a, j, i), why in sorted(self.failures.items())
+                ],
+                "outside_limits": None
+                if self.outside_limits is None
+                else self.outside_limits.tolist(),
+                **(
+                    {"leg_ends": None if self.leg_ends is None else self.leg_ends.tolist()}
+                    if leg_ends
+                    else {}
+                ),
+            }
+        )
 
 
 def iter_atlas(

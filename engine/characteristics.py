@@ -237,12 +237,14 @@ class CharacteristicsMap(AugmentingMap):
                     f"into a near-zero of the kernel component {self.fixed_index} (0-based) of "
                     f"{self.kinematics.name}, where omega and dz/ds blow up",
                     x,
+                    "x",
                 )
             raise OneFormUndefinedError(
                 f"h(x) is undefined: along its characteristic (28), at s = {s:.3g}, "
                 f"Phi_s = {format_vector(phi)}, the kernel component {self.fixed_index} "
                 f"(0-based) of {self.kinematics.name} vanishes, so omega cannot be normalised",
                 x,
+                "x",
             )
 
     def value(self, x: FloatArray) -> FloatArray:

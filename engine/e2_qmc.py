@@ -49,7 +49,8 @@ def e2_qmc(
     amap : AugmentingMap
         The map h (its gradient, :meth:`~jik.engine.augmentations.AugmentingMap.gradient_masked`).
     region : mapping name -> (lo, hi)
-        The joint variables integrated over; the others are held at ``fixed``.
+        The joint variables integrated over; the others are held at ``fixed`` (default
+        :func:`jik.engine.kinematics.held_values`: the robot's home).
     nodes : int
         A power of two (a Sobol rule's balance needs it).
     seed : int
@@ -89,7 +90,7 @@ def e2_qmc(
         m = kinematics.manipulability(x)
         if np.any(m < 1e-9):
             raise KinematicSingularityError(
-                "the region contains a kinematic singularity", x[int(np.argmin(m))]
+                "the region contains a kinematic singularity", x[int(np.argmin(m))], "region"
             )
         K, Jp = kernel_frame(kinematics, x)
         k = K[..., 0]  # (n, p)

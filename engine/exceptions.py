@@ -56,10 +56,15 @@ class SingularConfigurationError(JikError):
         What is singular and what to do about it.
     configuration : array_like, shape (p,)
         The offending configuration.
+    field : str, optional
+        The input it came from, as :class:`InvalidInputError`'s ``field``: ``"x0"`` a solve's
+        start, ``"region"`` a point of a synthesis region, ``"x"`` the argument of an inverse's
+        ``apply`` or ``matrix``; a web client marks that input.
     """
 
-    def __init__(self, message: str, configuration) -> None:
+    def __init__(self, message: str, configuration, field: str | None = None) -> None:
         self.configuration = np.asarray(configuration, dtype=float)
+        self.field = field
         super().__init__(f"{message} at x = {format_vector(self.configuration)}")
 
 

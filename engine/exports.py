@@ -75,6 +75,28 @@ def short_value(v: Any) -> str:
     return repr(v)
 
 
+def json_values(v: Any) -> Any:
+    """``v`` as JSON values, the one rule of every ``as_dict()``: arrays become nested lists,
+    numpy scalars Python ones, and a missing value (NaN, or an infinity) None, as ``null``
+    in JSON, which has neither; through dicts, lists and tuples. A table
+    (:meth:`Columns.columns`, ``to_dataframe()``) keeps NaN, as pandas does."""
+    if isinstance(v, dict):
+        return {k: json_values(x) for k, x in v.items()}
+    if isinstance(v, list | tuple):
+        return [json_values(x) for x in v]
+    if isinstance(v, np.ndarray) and v.dtype.kind == "f":
+        if np.isfinite(v).all():
+            return v.tolist()
+        out = v.astype(object)
+        out[~np.isfinite(v)] = None
+        return out.tolist()
+    if isinstance(v, np.ndarray | np.generic):
+        return json_values(v.tolist()) if v.dtype.kind in "fO" else v.tolist()
+    if isinstance(v, float):
+        return v if np.isfinite(v) else None
+    return v
+
+
 def call_repr(name: str, *args: Any, **kwargs: Any) -> str:
     """``name(arg, ..., key=value, ...)`` with each value by :func:`short_value` (positional
     arguments that are already text are kept as they are)."""

@@ -14,7 +14,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from .augmentations import AugmentingMap
-from .exceptions import AlgorithmicSingularityError, InvalidInputError
+from .exceptions import AlgorithmicSingularityError, InvalidInputError, SingularConfigurationError
 from .inverses import (
     SINGULAR_EXTENDED,
     Inverse,
@@ -104,7 +104,7 @@ class VectorExtendedInverse(Inverse):
         rhs[..., :r, :] = np.eye(r)
         return np.linalg.solve(Jbar, rhs)
 
-    def singular_error(self, x: FloatArray) -> Exception:
+    def singular_error(self, x: FloatArray) -> SingularConfigurationError:
         at = np.asarray(x, dtype=float)[None]
         undefined = [
             f"h_{i + 1} = {m!r}"

@@ -2,9 +2,9 @@
 
 Both are integrals over a box of the joint space. The box is given by the variables that are
 integrated over (``region``); every other joint variable is held at a fixed value (``fixed``,
-default 0) and not integrated over, as in the paper's reduction h = h(x2, x3) for Manipulator 2.
-A tensor Gauss-Legendre rule with ``nodes`` points per integrated variable is evaluated in one
-batch.
+by default the robot's home: :func:`~jik.engine.kinematics.held_values`) and not integrated
+over, as in the paper's reduction h = h(x2, x3) for Manipulator 2. A tensor Gauss-Legendre
+rule with ``nodes`` points per integrated variable is evaluated in one batch.
 
 Orientation of K: ``Kinematics.kernel`` returns the unit kernel vector with the paper's sign
 (last component positive for Manipulators 1 and 2). E1 does not depend on it; E2 does, through
@@ -20,6 +20,7 @@ import numpy as np
 
 from .augmentations import AugmentingMap
 from .exceptions import InvalidInputError
+from .exports import json_values
 from .inverses import (
     extended_determinant,
     extended_inverse,
@@ -27,7 +28,7 @@ from .inverses import (
     pseudoinverse,
     require_compatible,
 )
-from .kinematics import Kinematics
+from .kinematics import Kinematics, held_values
 from .validation import FloatArray, check_box_region, check_memory, count, finite
 
 # name -> (lo, hi); any two-item sequence (JSON gives lists), validated by check_region.
@@ -80,17 +81,20 @@ class FunctionalValue:
         )
 
     def as_dict(self) -> dict:
-        """JSON-friendly form."""
-        return {
-            "value": self.value,
-            "region": {k: list(v) for k, v in self.region.items()},
-            "fixed": dict(self.fixed),
-            "n_points": self.n_points,
-            "n_singular": int(self.singular_points.shape[0]),
-            "singular_points": self.singular_points.tolist(),
-            "min_abs_dh_k": self.min_abs_dh_k,
-            "divergent": self.divergent,
-        }
+        """JSON-friendly form (:func:`~jik.engine.exports.json_values`: a divergent E1's value
+        None)."""
+        return json_values(
+            {
+                "value": self.value,
+                "region": {k: list(v) for k, v in self.region.items()},
+                "fixed": dict(self.fixed),
+                "n_points": self.n_points,
+                "n_singular": int(self.singular_points.shape[0]),
+                "singular_points": self.singular_points.tolist(),
+                "min_abs_dh_k": self.min_abs_dh_k,
+                "divergent": self.divergent,
+            }
+        )
 
 
 def check_region(
@@ -102,10 +106,10 @@ def check_region(
     Returns
     -------
     region : dict name -> (lo, hi), in the kinematics' variable order
-    fixed : dict name -> value for every variable not in ``region`` (default 0)
+    fixed : dict name -> value for every variable not in ``region`` (default: held_values)
     """
     names = tuple(kinematics.variable_names) or tuple(f"x{i + 1}" for i in range(kinematics.p))
-    return check_box_region(names, region, fixed)
+    return check_box_region(names, region, fixed, list(held_values(kinematics)))
 
 
 def point_bytes(kinematics: Kinematics) -> float:
@@ -229,7 +233,7 @@ def _evaluate(
 ) -> FunctionalValue:
     require_compatible(kinematics, augmenting_map, "the error functionals")
     x, w, box, fix = quadrature(kinematics, region, nodes, fixed)
-    kinematics.require_regular(x, "integration region (a quadrature point)")
+    kinematics.require_regular(x, "integration region (a quadrature point)", "region")
     J = kinematics.jacobian(x)
     with np.errstate(all="ignore"):
         dh = np.asarray(augmenting_map.gradient(x), dtype=float)

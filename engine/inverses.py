@@ -19,6 +19,7 @@ from .exceptions import (
     AlgorithmicSingularityError,
     InvalidInputError,
     KinematicSingularityError,
+    SingularConfigurationError,
 )
 from .exports import call_repr, short_value
 from .kinematics import SINGULAR_MANIPULABILITY, Kinematics
@@ -208,7 +209,7 @@ class Inverse(abc.ABC):
         """J#(x): (..., p) -> (..., p, r); raises a typed error at a singular configuration."""
 
     @abc.abstractmethod
-    def singular_error(self, x: FloatArray) -> Exception:
+    def singular_error(self, x: FloatArray) -> SingularConfigurationError:
         """The typed error describing a singularity of this inverse at configuration ``x``."""
 
     def augmenting_value(self, x: FloatArray) -> FloatArray | None:
@@ -232,9 +233,11 @@ class Inverse(abc.ABC):
     def _raise_if(self, x: FloatArray, bad: FloatArray) -> None:
         bad = np.atleast_1d(bad)
         if np.any(bad):
-            raise self.singular_error(
+            error = self.singular_error(
                 np.reshape(x, (-1, x.shape[-1]))[np.flatnonzero(bad.ravel())[0]]
             )
+            error.field = "x"
+            raise error
 
 
 class Pseudoinverse(Inverse):
@@ -258,7 +261,7 @@ class Pseudoinverse(Inverse):
         self._raise_if(x, np.isnan(out[..., 0, 0]))
         return out
 
-    def singular_error(self, x: FloatArray) -> Exception:
+    def singular_error(self, x: FloatArray) -> SingularConfigurationError:
         return KinematicSingularityError(
             f"the pseudoinverse (8) of {self.kinematics.name} is undefined: J J^T is singular; "
             "start away from the singular set",
@@ -319,7 +322,7 @@ class ExtendedInverse(Inverse):
         self._raise_if(x, ~np.isfinite(out[..., 0, 0]))
         return out
 
-    def singular_error(self, x: FloatArray) -> Exception:
+    def singular_error(self, x: FloatArray) -> SingularConfigurationError:
         if self.map_undefined(np.asarray(x, dtype=float)[None])[0]:
             return AlgorithmicSingularityError(
                 f"the augmenting map {self.augmenting_map.name!r} is undefined (its gradient "

@@ -104,6 +104,9 @@ class Kinematics(abc.ABC):
     #: Joint limits (p, 2), [lower, upper] per variable (+-inf: no bound), or None: the runs
     #: report whether they stayed within them (:mod:`jik.engine.limits`).
     joint_limits: FloatArray | None = None
+    #: The robot's home configuration (p,), within its joint limits, or None: where syntheses
+    #: hold the variables outside their region (:func:`held_values`).
+    home: tuple[float, ...] | None = None
 
     @abc.abstractmethod
     def forward(self, x: FloatArray) -> FloatArray:
@@ -180,8 +183,11 @@ class Kinematics(abc.ABC):
         """Boolean mask (...,): where m(x) < tol, i.e. J(x) loses rank."""
         return self.manipulability(x) < tol
 
-    def require_regular(self, x: FloatArray, what: str = "configuration") -> None:
-        """Raise :class:`KinematicSingularityError` naming the first singular configuration."""
+    def require_regular(
+        self, x: FloatArray, what: str = "configuration", field: str | None = None
+    ) -> None:
+        """Raise :class:`KinematicSingularityError` naming the first singular configuration
+        (its ``field``: the input ``x`` came from)."""
         bad = np.atleast_1d(self.is_singular(x))
         if np.any(bad):
             xb = np.reshape(x, (-1, self.p))[np.flatnonzero(bad.ravel())[0]]
@@ -189,7 +195,21 @@ class Kinematics(abc.ABC):
                 f"the {what} is a kinematic singularity of {self.name} (J loses rank, "
                 f"m(x) < {SINGULAR_MANIPULABILITY:g}); move it away from the singular set",
                 xb,
+                field,
             )
+
+
+def held_values(kinematics: Kinematics) -> FloatArray:
+    """Where E1, E2 and their syntheses hold the variables outside their region by default,
+    shape (p,): the kinematics' home (a catalogue arm's or a URDF's, within its joint limits;
+    the dashboard's default start), else 0 moved into the joint limits."""
+    if kinematics.home is not None:
+        return np.asarray(kinematics.home, dtype=float)
+    zero = np.zeros(kinematics.p)
+    if kinematics.joint_limits is None:
+        return zero
+    lo, hi = np.asarray(kinematics.joint_limits, dtype=float).T
+    return np.clip(zero, lo, hi)
 
 
 class Manipulator1(Kinematics):

@@ -130,6 +130,7 @@ def undefined_error(kinematics, x, bad, fixed_index, where=""):
         f"the one-form omega (omega J^T = 0) of {kinematics.name} cannot be normalised by its "
         f"component {fixed_index} (0-based): that kernel component vanishes{where}",
         xb,
+        "x",
     )
 
 

@@ -159,7 +159,9 @@ def picard_path(
                 first = False
                 at_start = bad.reshape(m, nn)[:, 0]
                 if at_start.any():
-                    raise inverse.singular_error(x0[act[np.argmax(at_start)]])
+                    error = inverse.singular_error(x0[act[np.argmax(at_start)]])
+                    error.field = "x0"
+                    raise error
             Xn = base - half * (S @ v.reshape(m, nn, p))  # S (nn, nn) @ (m, nn, p)
             # (ndarray methods and in-place ufuncs: this loop is mostly per-call overhead)
             change = np.abs(Xn - Xw)

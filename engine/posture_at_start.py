@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .exceptions import SingularConfigurationError
 from .inverses import Inverse
 from .kinematics import Kinematics
 from .practical_inverses import PostureInverse
@@ -67,7 +68,7 @@ class PostureAtStart(Inverse):
         J = self.posture.matrix(x[..., : self.posture.kinematics.p])
         return np.concatenate([J, np.zeros_like(J)], axis=-2)
 
-    def singular_error(self, x: FloatArray) -> Exception:
+    def singular_error(self, x: FloatArray) -> SingularConfigurationError:
         return self.posture.singular_error(np.asarray(x)[..., : self.posture.kinematics.p])
 
     @staticmethod

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .exceptions import InvalidInputError, KinematicSingularityError
+from .exceptions import InvalidInputError, KinematicSingularityError, SingularConfigurationError
 from .inverses import Inverse, Pseudoinverse, require_kinematics
 from .kinematics import SINGULAR_MANIPULABILITY, Kinematics
 from .limits import limit_names, robot_limits
@@ -146,7 +146,7 @@ class DampedInverse(Inverse):
         self._raise_if(x, bad)
         return out
 
-    def singular_error(self, x: FloatArray) -> Exception:
+    def singular_error(self, x: FloatArray) -> SingularConfigurationError:
         return _singular(self.kinematics, x, "the undamped least-squares inverse")
 
 
@@ -237,7 +237,7 @@ class WeightedInverse(Inverse):
         self._raise_if(x, bad)
         return np.swapaxes(Jw, -1, -2) @ np.linalg.inv(M)
 
-    def singular_error(self, x: FloatArray) -> Exception:
+    def singular_error(self, x: FloatArray) -> SingularConfigurationError:
         x = np.asarray(x, dtype=float)
         out = np.flatnonzero(~((x > self.limits[:, 0]) & (x < self.limits[:, 1])))
         if out.size:
@@ -326,5 +326,5 @@ class PostureInverse(Inverse):
         """J#(x) of the task part (the pseudoinverse); the pull is not linear in e."""
         return self._plain.matrix(x)
 
-    def singular_error(self, x: FloatArray) -> Exception:
+    def singular_error(self, x: FloatArray) -> SingularConfigurationError:
         return self._plain.singular_error(x)

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from .exports import Columns, coordinate_columns, short_text, short_vector
+from .exports import Columns, coordinate_columns, json_values, short_text, short_vector
 from .results import SolveResult
 from .run_settings import RunSettings
 from .validation import FloatArray
@@ -106,20 +106,23 @@ class RepeatabilityResult(Columns):
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-friendly: the algorithm, the inverse as printed, mode, gamma, tol,
-        max_iterations, x0, the legs' targets, leg ends, cycle ends, drift, success, message."""
+        max_iterations, x0, the legs' targets, leg ends, cycle ends, drift (None after a failed
+        leg: :func:`~jik.engine.exports.json_values`), success, message."""
         s = self.settings
-        return {
-            "algorithm": s.algorithm,
-            "inverse": s.inverse,
-            "mode": s.mode,
-            "gamma": s.gamma,
-            "tol": s.tol,
-            "max_iterations": s.max_iterations,
-            "x0": self.x0.tolist(),
-            "targets": self.targets.tolist(),
-            "legs": self.legs.tolist(),
-            "cycle_end": self.cycle_end.tolist(),
-            "drift": self.drift.tolist(),
-            "success": np.asarray(self.success).tolist(),
-            "message": self.message if isinstance(self.message, str) else list(self.message),
-        }
+        return json_values(
+            {
+                "algorithm": s.algorithm,
+                "inverse": s.inverse,
+                "mode": s.mode,
+                "gamma": s.gamma,
+                "tol": s.tol,
+                "max_iterations": s.max_iterations,
+                "x0": self.x0.tolist(),
+                "targets": self.targets.tolist(),
+                "legs": self.legs.tolist(),
+                "cycle_end": self.cycle_end.tolist(),
+                "drift": self.drift.tolist(),
+                "success": np.asarray(self.success).tolist(),
+                "message": self.message if isinstance(self.message, str) else list(self.message),
+            }
+        )

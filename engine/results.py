@@ -1,11 +1,12 @@
 """Results of the continuation algorithm (7): a solve, a batch of solves, a trajectory.
 
 They borrow SciPy's vocabulary (``x``, ``success``, ``message``, ``nit``), print on one line
-(``print(result)``) and export their numbers: :meth:`as_dict` gives JSON-friendly values, and
-``to_dataframe()`` a pandas DataFrame (pandas is optional: ``columns()`` gives the same columns
-as plain arrays). Column names follow :mod:`jik.engine.exports`: ``x0_k`` a start, ``x_k`` the
-row's configuration, ``y_k`` its task point, ``y_d_k`` a target. A repeatability run's result
-is :class:`jik.engine.repeatability_result.RepeatabilityResult`.
+(``print(result)``) and export their numbers: :meth:`as_dict` gives JSON-friendly values (None
+where a number is missing, NaN in the arrays), and ``to_dataframe()`` a pandas DataFrame, with
+NaN there (pandas is optional: ``columns()`` gives the same columns as plain arrays). Column
+names follow :mod:`jik.engine.exports`: ``x0_k`` a start, ``x_k`` the row's configuration,
+``y_k`` its task point, ``y_d_k`` a target. A repeatability run's result is
+:class:`jik.engine.repeatability_result.RepeatabilityResult`.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from .exceptions import InvalidInputError
-from .exports import Columns, coordinate_columns, short_text, short_vector
+from .exports import Columns, coordinate_columns, json_values, short_text, short_vector
 from .inverses import Inverse
 from .solve_rules import Status
 from .validation import FloatArray
@@ -69,14 +70,18 @@ class Trajectory(Columns):
         return out
 
     def as_dict(self) -> dict[str, Any]:
-        """JSON-friendly: ``theta``, ``x`` (m lists of p), ``y``, ``error``, ``h`` (or None)."""
-        return {
-            "theta": np.asarray(self.theta).tolist(),
-            "x": np.asarray(self.x).tolist(),
-            "y": np.asarray(self.y).tolist(),
-            "error": np.asarray(self.error).tolist(),
-            "h": None if self.h is None else np.asarray(self.h).tolist(),
-        }
+        """JSON-friendly (:func:`~jik.engine.exports.json_values`: NaN as None): ``theta``,
+        ``x`` (m lists of p), ``y``, ``error``, ``h`` (None without a map, or where h is
+        undefined)."""
+        return json_values(
+            {
+                "theta": np.asarray(self.theta),
+                "x": np.asarray(self.x),
+                "y": np.asarray(self.y),
+                "error": np.asarray(self.error),
+                "h": None if self.h is None else np.asarray(self.h),
+            }
+        )
 
 
 @dataclass(frozen=True)
@@ -159,7 +164,8 @@ class SolveResult(Columns):
         return out
 
     def as_dict(self, trajectory: bool = False) -> dict[str, Any]:
-        """JSON-friendly fields; with ``trajectory``, also :meth:`Trajectory.as_dict`."""
+        """JSON-friendly fields (:func:`~jik.engine.exports.json_values`: NaN as None); with
+        ``trajectory``, also :meth:`Trajectory.as_dict`."""
         out: dict[str, Any] = {
             "algorithm": self.algorithm,
             "inverse": self.inverse,
@@ -177,7 +183,7 @@ class SolveResult(Columns):
         }
         if trajectory:
             out["trajectory"] = None if self.trajectory is None else self.trajectory.as_dict()
-        return out
+        return json_values(out)
 
 
 @dataclass(frozen=True)
@@ -233,23 +239,25 @@ class BatchSolveResult(Columns):
         return out
 
     def as_dict(self) -> dict[str, Any]:
-        """JSON-friendly: the settings and, per member, x0, y_d, x, y, error, success, nit,
-        message, status."""
-        return {
-            "algorithm": self.algorithm,
-            "inverse": repr(self._inverse),
-            "mode": self.mode,
-            "gamma": self.gamma,
-            "x0": np.asarray(self.x0).tolist(),
-            "y_d": np.asarray(self.y_d).tolist(),
-            "x": self.x.tolist(),
-            "y": self.y.tolist(),
-            "error": self.error.tolist(),
-            "success": np.asarray(self.success, dtype=bool).tolist(),
-            "nit": np.asarray(self.nit, dtype=int).tolist(),
-            "message": list(self.message),
-            "status": list(self.status),
-        }
+        """JSON-friendly (:func:`~jik.engine.exports.json_values`: NaN as None): the settings
+        and, per member, x0, y_d, x, y, error, success, nit, message, status."""
+        return json_values(
+            {
+                "algorithm": self.algorithm,
+                "inverse": repr(self._inverse),
+                "mode": self.mode,
+                "gamma": self.gamma,
+                "x0": np.asarray(self.x0).tolist(),
+                "y_d": np.asarray(self.y_d).tolist(),
+                "x": self.x.tolist(),
+                "y": self.y.tolist(),
+                "error": self.error.tolist(),
+                "success": np.asarray(self.success, dtype=bool).tolist(),
+                "nit": np.asarray(self.nit, dtype=int).tolist(),
+                "message": list(self.message),
+                "status": list(self.status),
+            }
+        )
 
     @property
     def status(self) -> tuple[str, ...]:

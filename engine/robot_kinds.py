@@ -182,7 +182,11 @@ AUGMENTATIONS: dict[str, tuple[DefinitionField, ...]] = {
             12,
         ),
         DefinitionField(
-            "fixed", "mapping", False, "values of the variables outside the region (default 0)"
+            "fixed",
+            "mapping",
+            False,
+            "values of the variables outside the region (default: the home, else 0 within the "
+            "joint limits)",
         ),
         DefinitionField(
             "frame_axes",

@@ -115,7 +115,9 @@ def _check_start(inverse, x0, e0, which) -> None:
     if len(x):
         _, bad = inverse.apply_masked(x, e)
         if bad.any():
-            raise inverse.singular_error(x[np.flatnonzero(bad)[0]])
+            error = inverse.singular_error(x[np.flatnonzero(bad)[0]])
+            error.field = "x0"
+            raise error
 
 
 def _discrete(inverse, x0, y_d, gamma, tol, max_iterations, record):

@@ -213,6 +213,7 @@ class _Rule:
                     "the synthesis region contains a kinematic singularity; choose a region "
                     "without one",
                     bad,
+                    "region",
                 )
             K, Jp = kernel_frame(self.kin, x, self.axes)
             P = Jp @ np.swapaxes(Jp, -1, -2) + K @ np.swapaxes(K, -1, -2)
@@ -242,7 +243,8 @@ def synthesize_e2_nd(
     kinematics : Kinematics
         With p - r >= 1.
     region : mapping name -> (lo, hi)
-        Any number of joint variables (h depends on these); the others are held at ``fixed``.
+        Any number of joint variables (h depends on these); the others are held at ``fixed``,
+        by default the robot's home, within its joint limits (:func:`~.kinematics.held_values`).
     degree : int
         Total degree of the polynomial basis.
     nodes : int
@@ -387,11 +389,8 @@ def e2_of_gradients(rule: _Rule, index: np.ndarray, C: FloatArray) -> float:
 
 
 def _single_joint(rule: _Rule, diag: FloatArray, load: FloatArray, c0: float) -> dict[str, dict]:
-    """E2 of h = s x_j, s = +-1 the better sign, for each joint j of the region (p - r = 1).
-
-    ``diag`` and ``load`` are the integrals of R_jj and f_j per unit of the reference coordinate
-    t, and ``c0`` that of m: dh/dt_j = half_j for h = x_j.
-    """
+    """E2 of h = s x_j, s = +-1 the better sign, for each joint j of the region (p - r = 1);
+    ``diag``, ``load``, ``c0``: the integrals of R_jj, f_j, m per unit of t (dh/dt_j = half_j)."""
     out = {}
     for k, name in enumerate(rule.box):
         s = 1.0 if load[k] >= 0 else -1.0

@@ -88,6 +88,7 @@ class UrdfChain(Kinematics):
     """
 
     name = "urdf"
+    home: tuple[float, ...]
 
     def __init__(
         self,

@@ -34,13 +34,27 @@ def field_for(name: str, field: str | None = None) -> str | None:
 
 
 def as_numbers(x, name: str, field: str | None = None) -> FloatArray:
-    """``x`` as a float array (NaN and inf allowed), or an error naming ``name``."""
+    """``x`` as a float array (NaN and inf allowed), or an error naming ``name``: numbers,
+    not text that reads as one (``"1"``) nor booleans, as :func:`finite` takes them."""
     try:
-        return np.asarray(x, dtype=float)
+        a = np.asarray(x)
+        if a.dtype.kind not in "iuf" and not _numbers(a):
+            raise TypeError(f"{a.dtype} entries")
+        return a.astype(float, copy=False)
     except (TypeError, ValueError, OverflowError) as exc:
         raise InvalidInputError(
             f"{name} must be numeric, got {x!r:.80}", field_for(name, field)
         ) from exc
+
+
+def _numbers(a: np.ndarray) -> bool:
+    """Whether an array that is not of integers or floats holds only numbers (an object
+    array of Python numbers); text, booleans and bytes are not."""
+    return a.dtype.kind == "O" and all(_is_number(v) for v in a.ravel())
+
+
+def _is_number(v) -> bool:
+    return not isinstance(v, str | bytes | bool | np.bool_)
 
 
 def as_points(x, size: int, name: str, field: str | None = None) -> FloatArray:
@@ -52,12 +66,7 @@ def as_points(x, size: int, name: str, field: str | None = None) -> FloatArray:
         On a wrong trailing dimension or a NaN/inf entry, naming ``name`` (field:
         :func:`field_for`).
     """
-    try:
-        a = np.asarray(x, dtype=float)
-    except (TypeError, ValueError, OverflowError) as exc:
-        raise InvalidInputError(
-            f"{name} must be numeric, got {x!r:.80}", field_for(name, field)
-        ) from exc
+    a = as_numbers(x, name, field)
     if a.ndim == 0 or a.shape[-1] != size:
         raise InvalidInputError(
             f"{name} must have shape (..., {size}) (a vector of length {size}), got shape "
@@ -86,8 +95,8 @@ def as_box(box, p: int, name: str = "box", *, finite: bool = True) -> FloatArray
     """Check that ``box`` is ``p`` pairs (low, high) with low < high, no NaN, and finite unless
     ``finite`` is False (then an infinite end leaves its variable unbounded); return it (p, 2)."""
     try:
-        b = np.array(box, dtype=float)
-    except (TypeError, ValueError, OverflowError):
+        b = as_numbers(box, name).copy()
+    except InvalidInputError:
         b = np.empty(0)
     bad = b.shape != (p, 2) or np.isnan(b).any() or (finite and not np.isfinite(b).all())
     if bad or np.any(b[..., 0] >= b[..., 1]):
@@ -137,8 +146,11 @@ def positive(value, name: str, field: str | None = None) -> float:
 
 
 def finite(value, name: str, field: str | None = None) -> float:
-    """Check that ``value`` is a finite real number."""
+    """Check that ``value`` is a finite real number (a number, not text that reads as one,
+    ``"1"``, nor a boolean)."""
     try:
+        if not _is_number(value):
+            raise TypeError(type(value).__name__)
         v = float(value)
     except (TypeError, ValueError, OverflowError) as exc:
         raise InvalidInputError(
@@ -228,11 +240,14 @@ def json_number(value, name: str, field: str | None = None) -> float:
 
 
 def check_box_region(
-    names: Sequence[str], region, fixed: Mapping[str, float] | None = None
+    names: Sequence[str],
+    region,
+    fixed: Mapping[str, float] | None = None,
+    held: Sequence[float] | None = None,
 ) -> tuple[dict[str, tuple[float, float]], dict[str, float]]:
     """Validate a box region over some of the variables ``names`` (name -> (lo, hi), lo < hi,
-    finite) and the fixed values of the others (name -> value, default 0): the design region
-    of sec. 5, where E1 (13) and E2 (18) are taken.
+    finite) and the fixed values of the others (name -> value; default ``held``, one value
+    per name, else 0): the design region of sec. 5, where E1 (13) and E2 (18) are taken.
 
     Returns
     -------
@@ -270,5 +285,10 @@ def check_box_region(
                 f"region[{name!r}] must have lo < hi, got ({lo}, {hi})", f"region.{name}"
             )
         box[name] = (lo, hi)
-    fix = {n: finite(fixed.get(n, 0.0), f"fixed {n}", f"fixed.{n}") for n in names if n not in box}
+    rest = dict(zip(names, held, strict=True)) if held is not None else {}
+    fix = {
+        n: finite(fixed.get(n, rest.get(n, 0.0)), f"fixed {n}", f"fixed.{n}")
+        for n in names
+        if n not in box
+    }
     return box, fix

@@ -158,7 +158,7 @@ class _Problem:
             x[:, i] = fix[n] if n in fix else 0.0
         for k, v in enumerate(self.variables):
             x[:, v] = 0.5 * (lo[k] + hi[k]) + grids[k].ravel() / self.scale[k]
-        kinematics.require_regular(x, "synthesis region (a quadrature point)")
+        kinematics.require_regular(x, "synthesis region (a quadrature point)", "region")
         J = kinematics.jacobian(x)
         K = kinematics.kernel(x)
         m = kinematics.manipulability(x)
@@ -293,7 +293,7 @@ def synthesize_e2(
         With one degree of redundancy (p - r = 1).
     region : mapping name -> (lo, hi)
         Two or three integrated joint variables (h depends on these only); the others are held
-        at ``fixed`` (default 0), as in the paper's reduction h = h(x2, x3) for Manipulator 2.
+        at ``fixed`` (default: the robot's home, :func:`~.kinematics.held_values`).
     degree : int or sequence of int, optional
         Legendre degree per variable (the error decays exponentially with it for smooth data);
         default :data:`DEFAULT_DEGREE` of the region's number of variables.

@@ -34,7 +34,7 @@ function slider(c, value, send) {
   });
   box.addEventListener("change", () => {
     const v = parseNumber(box.value);
-    if (v === null) { fieldError(c.key, box.value, "is not a number; nothing was sent"); return; }
+    if (v === null) { notANumber(c, box.value); return; }
     input.value = toPos(v);
     send(v, box.value);
   });
@@ -53,6 +53,15 @@ function fieldError(key, typed, message) {
   if (!note) { note = el("span", { className: "field-error", role: "alert" }); row.append(note); }
   note.textContent = typed === undefined ? message : `“${typed}” ${message}`;
   return true;
+}
+
+// Text typed into a number box that is not a number: said beside the control and, replacing
+// an earlier refusal there, in the page's header (``onNotSent``: main.js's status).
+let notSent = () => {};
+export function onNotSent(show) { notSent = show; }
+function notANumber(c, typed) {
+  fieldError(c.key, typed, "is not a number; nothing was sent");
+  notSent(`not sent (here): ${c.label}: “${typed}” is not a number`);
 }
 
 // A refusal of the server (its field, a dotted path) shown beside the control it is about,
@@ -133,7 +142,7 @@ function vector(c, value, send) {
     box.addEventListener("change", () => {
       const values = boxes.map((b) => parseNumber(b.value));
       const bad = boxes.find((b, k) => values[k] === null);
-      if (bad) { fieldError(c.key, bad.value, "is not a number; nothing was sent"); return; }
+      if (bad) { notANumber(c, bad.value); return; }
       send(values, boxes.map((b) => b.value.trim()).join(", "));
     });
     return box;

@@ -2,7 +2,7 @@
 // builds its controls from the session's control specification, follows the session's events
 // and draws its panels; the 3D scene (iframe, viser) shows and changes the same session.
 import { change, endOnClose, follow, openSession, session, api } from "./api.js";
-import { showControls, showRefusal } from "./controls.js";
+import { onNotSent, showControls, showRefusal } from "./controls.js";
 import { $, el, fmt } from "./dom.js";
 import { robotEditor } from "./editor.js";
 import { algorithmKey, applyFunctionals, drawFigures, layoutPanels, markStale, onAhead, setExportNote, showChosen } from "./panels.js";
@@ -147,7 +147,7 @@ function exportLinks(generation, why = "") {
       a.title = why;
       a.textContent = `export ${kind} (off: ${why})`;
     } else {
-      a.href = api(path);
+      a.href = api(`${path}?generation=${generation}`); // (the file is the one named)
       a.removeAttribute("aria-disabled");
       a.title = `generation ${generation}: the plots on screen, with its state, verdict, drift and leg ends`;
       a.textContent = `export ${kind} (generation ${generation})`;
@@ -266,6 +266,7 @@ async function main() {
   for (const [a, c] of Object.entries(page.config.colors)) document.documentElement.style.setProperty(`--${a}`, c);
   layoutPanels(page.config.panels, page.config);
   page.editor = robotEditor(page.config.robot_kinds, send);
+  onNotSent((text) => setStatus(text, true));
   // The sticky header's height, for the scene below it (style.css --header-h).
   new ResizeObserver(([entry]) => document.documentElement.style.setProperty("--header-h", `${Math.ceil(entry.target.getBoundingClientRect().height)}px`)).observe($("header"));
   $("#legend").replaceChildren(algorithmKey(true));

@@ -9,20 +9,14 @@ from typing import Any
 import numpy as np
 import pydantic_core
 
+from ...engine.exports import json_values
 from ...engine.limits import run_report
 from . import schemas as S
 
 
 def nullable(a) -> Any:
-    """ndarray -> nested lists with None where not finite (JSON has no NaN)."""
-    a = np.asarray(a, dtype=float)
-    if a.ndim == 0:
-        return float(a) if np.isfinite(a) else None
-    if np.isfinite(a).all():
-        return a.tolist()
-    obj = a.astype(object)
-    obj[~np.isfinite(a)] = None
-    return obj.tolist()
+    """Numbers -> nested lists with None where not finite (:func:`json_values`)."""
+    return json_values(np.asarray(a, dtype=float))
 
 
 def downsample(m: int, limit: int = S.MAX_TRAJECTORY_POINTS) -> np.ndarray:

@@ -15,7 +15,7 @@ from typing import Any, cast
 
 import numpy as np
 
-from ...engine.exceptions import JikError, SingularConfigurationError
+from ...engine.exceptions import JikError
 from ...engine.limits import robot_limits
 from ...engine.registry import RobotSpec
 from ...engine.repeatability import repeatability, repeatable
@@ -75,10 +75,8 @@ _REQUEST_NAMES = {"tol": "tolerance", "y_d": "target"}
 def engine_error(exc: JikError) -> RequestError:
     """An engine error as a RequestError at the request's name of the field the engine's error
     carries (:attr:`InvalidInputError.field <jik.engine.exceptions.InvalidInputError>`:
-    ``tol`` is ``tolerance``, ``path.1`` ``path[1]``); a singular configuration at ``x0``;
-    an error about no field of the request at ``request``, in the engine's words."""
-    if isinstance(exc, SingularConfigurationError):
-        return RequestError("x0", str(exc))
+    ``tol`` is ``tolerance``, ``path.1`` ``path[1]``; a singular start's is ``x0``); an
+    error about no field of the request at ``request``, in the engine's words."""
     field = getattr(exc, "field", None) or ""
     head, dot, tail = field.partition(".")
     name = _REQUEST_NAMES.get(head, head)

@@ -48,11 +48,12 @@ def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
                 n = len(params["rest"])
                 raise refused(key, f"rest has {n} coordinates")
             params["rest"][int(index)] = value
-        elif not rest:
+        elif key == "path" and isinstance(value, str):  # (the text shown: the path in force)
             size = len(state.target) if "robot" not in patch else None
-            out[key] = (
-                parse_path_text(value, size) if key == "path" and isinstance(value, str) else value
-            )
+            same = size is not None and value.strip() == path_text(state.path)
+            out[key] = state.path if same else parse_path_text(value, size)
+        elif not rest:
+            out[key] = value
         elif head in ("robot_parameters", "augmentation_parameters", "algorithm_parameters"):
             out.setdefault(head, {})[rest] = value
         elif head in ("x0", "target") and rest.isdigit():
@@ -70,14 +71,15 @@ def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
 
 
 def path_text(path) -> str:
-    """A path as text, :data:`PATH_FORMAT`, each coordinate in the fewest digits that give it
-    back exactly (what is shown is what is in force)."""
+    """A path as text, :data:`PATH_FORMAT`, each coordinate as a user types it: to 4 decimals,
+    as the page's number boxes show them (a computed 1.29e-17 as 0). Sent back unchanged, it
+    leaves the path in force exact (:func:`expand`)."""
     return "; ".join(", ".join(_number(v) for v in p) for p in path)
 
 
 def _number(v: float) -> str:
-    text = repr(float(v))
-    return text[:-2] if text.endswith(".0") else text
+    text = f"{float(v):.4f}".rstrip("0").rstrip(".")
+    return "0" if text == "-0" else text
 
 
 def parse_path_text(text: str, size: int | None = None) -> list[list[float]]:

@@ -30,6 +30,7 @@ SYMBOLS = {
     "rest": "x_rest: the rest configuration of the posture inverse J^P# dy + (I − J^P# J) "
     "k (x_rest − x) ‖dy‖ (Liégeois 1977): inside the self-motion the joints are pulled toward it "
     "at gain k",
-    "x0": "x0: the start configuration (for the unicycle, the control parameters λ10, λ11, "
-    "λ20, λ21 of eq. (41): u1 = λ10 + λ11 sin t, u2 = λ20 + λ21 sin t)",
+    "x0": "x0: the start configuration (for the unicycle, the control parameters lambda10, "
+    "lambda11, lambda20, lambda21 of eq. (41): u1 = lambda10 + lambda11 sin t, u2 = lambda20 "
+    "+ lambda21 sin t)",
 }

@@ -9,10 +9,8 @@ from collections import OrderedDict
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-import numpy as np
-
 from ...engine.augmentations import h_change
-from ..compute.documents import nullable
+from ...engine.exports import json_values as finite
 from .joint_limits import limits_summary
 from .runs import DashboardResult
 
@@ -76,23 +74,10 @@ def digest(text: str) -> str:
 
 
 def to_json(obj) -> str:
-    """``obj`` as JSON, NaN and infinities as null (:func:`finite`): the one place where a
-    dashboard's results become JSON (events, exports), so that an undefined h or a diverged
+    """``obj`` as JSON, NaN and infinities as null (the engine's ``json_values``): the one place
+    where a dashboard's results become JSON (events, exports), so that an undefined h or a diverged
     iterate never reaches an encoder that refuses it."""
     return json.dumps(finite(obj), separators=(",", ":"), allow_nan=False)
-
-
-def finite(v):
-    """``v`` as JSON data: every non-finite float (NaN, inf) made None, through dicts, lists,
-    tuples and numpy arrays (a float array becomes a list with None where it is not finite;
-    other arrays and numpy scalars, lists and Python numbers)."""
-    if isinstance(v, dict):
-        return {k: finite(x) for k, x in v.items()}
-    if isinstance(v, list | tuple):
-        return [finite(x) for x in v]
-    if isinstance(v, float | np.floating) or (isinstance(v, np.ndarray) and v.dtype.kind == "f"):
-        return nullable(v)
-    return v.tolist() if isinstance(v, np.ndarray | np.generic) else v
 
 
 def with_figures(message: dict, figures: Mapping[str, str]) -> str:

@@ -65,6 +65,38 @@ class Session:
             self.scene.stop()
         self.dashboard.stop()
 
+    def exported(self, generation: int | None, wait: float) -> tuple[Any, Any]:
+        """The result to export and its functionals: with ``generation``, that generation's,
+        the result on screen that the page's link names, at once; else the current state's,
+        once in (waiting up to ``wait`` seconds), never an older result in its place.
+
+        Raises
+        ------
+        ExportUnavailable
+            409 when ``generation`` is no longer the result on screen, or the current state's
+            computation failed (the message says which generation and why); 503 when it has
+            not finished in time.
+        """
+        dashboard = self.dashboard
+        result, functionals = dashboard.result, dashboard.functionals
+        if generation is not None:
+            if result is None or result.generation != generation:
+                shown = "none" if result is None else f"generation {result.generation}"
+                detail = f"generation {generation} is not the result on screen ({shown})"
+                raise ExportUnavailable(409, f"{detail}; export again")
+            return result, functionals
+        done = dashboard.wait(None, wait)
+        error = dashboard.snapshot()["error"]
+        if error is not None:
+            raise ExportUnavailable(
+                409,
+                f"generation {error.get('generation')} failed: {error.get('message')}; there is "
+                "no result of the current state to export (change the state, then export)",
+            )
+        if not done or dashboard.result is None:
+            raise ExportUnavailable(503, "no result of the current state computed yet; retry")
+        return dashboard.result, dashboard.functionals
+
 
 class SessionStore:
     """The server's sessions, by id.

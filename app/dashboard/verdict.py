@@ -162,17 +162,17 @@ def _undefined_why(result: DashboardResult, run: AlgorithmRun) -> list[Sentence]
     a = float(state.augmentation_parameters.get("a", 1.0))
     before, after = float(run.x[-2][0]), float(run.x[-1][0])
     which = f"iteration {len(run.x) - 1}" if state.mode == "discrete" else "the run's last step"
-    step = f"{which} took λ10 from {g(before)} to {g(after)}"
+    step = f"{which} took lambda10 from {g(before)} to {g(after)}"
     if after * a <= 0:
         left = (
-            f"{step}, across λ10 = 0 and out of the domain of the map's foliation (λ10 of "
-            f"the sign of a = {g(a)}: ω is undefined on λ10 = 0)"
+            f"{step}, across lambda10 = 0 and out of the domain of the map's foliation "
+            f"(lambda10 of the sign of a = {g(a)}: ω is undefined on lambda10 = 0)"
         )
     else:
         left = step
     text = (
-        f"Why: h is defined by the characteristic (28) from λ to the reference leaf "
-        f"λ10 = a (eq. (29)); {left}. From there the characteristic runs into a zero of the "
+        f"Why: h is defined by the characteristic (28) from x to the reference leaf "
+        f"lambda10 = a (eq. (29)); {left}. From there the characteristic runs into a zero of the "
         "kernel component that normalises ω (J11 J24 − J14 J21 = 0), where ω and dz/ds "
         "blow up, so h, and with it the extended Jacobian inverse (47), is undefined."
     )

@@ -141,7 +141,7 @@ class SceneControls:
 
 def as_text(value) -> str:
     """A text input's value: the path's text, or a vector's numbers as the path writes a point
-    (each in the fewest digits that give it back exactly: what is shown is what is in force)."""
+    (:func:`~jik.app.dashboard.control_changes.path_text`: as a user types it)."""
     return value if isinstance(value, str) else path_text([value])
 
 

@@ -51,6 +51,8 @@ def test_ranges_and_labels_come_from_the_registry(robot):
         assert c.help.startswith(p.description)  # (then the paper's symbol explained)
     for i, name in enumerate(spec.variable_names):
         assert by_key[f"x0.{i}"].label == f"x0: {name}"
+        # (its help names the variables as the labels do: the unicycle's lambda10, not λ10)
+        assert "λ1" not in by_key[f"x0.{i}"].help and "λ2" not in by_key[f"x0.{i}"].help
     assert [v for v, _ in by_key["robot"].options] == [*ROBOTS, *ARMS]  # (then the arms)
     assert [v for v, _ in by_key["augmentation"].options] == [a.name for a in spec.augmentations]
     aug = spec.augmentation(state.augmentation)
@@ -77,6 +79,18 @@ def test_control_keys_expand_into_state_fields():
     assert expand(state, {"robot_parameters.l": 1.2}) == {"robot_parameters": {"l": 1.2}}
     assert expand(state, {"path": "1, 1; 1, 2"}) == {"path": [[1.0, 1.0], [1.0, 2.0]]}
     assert parse_path_text(path_text(state.path)) == [list(p) for p in state.path]
+
+
+def test_a_computed_path_is_shown_as_a_user_types_it_and_stays_exact():
+    """A catalogue arm's path is computed (its pose coordinates 1.29e-17 where 0 is meant):
+    its box shows 4 decimals, 0 for those, and the shown text sent back keeps the exact
+    path; an edited text is what is typed."""
+    state = default_state("panda")
+    text = control_values(state)["path"]
+    assert "e-" not in text and text.startswith("0.3034, 0.0459, 0.5903, 0, 0, -0.15; ")
+    assert updated_state(state, {"path": text}).path == state.path
+    edited = updated_state(state, {"path": text.replace("-0.15", "-0.1")})
+    assert edited.path[0] == (0.3034, 0.0459, 0.5903, 0.0, 0.0, -0.1)
     with pytest.raises(InvalidInputError) as bad:
         expand(state, {"x0.7": 1.0})
     assert bad.value.field == "x0.7"

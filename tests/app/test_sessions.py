@@ -270,3 +270,44 @@ def test_an_export_after_a_failure_is_409_never_the_previous_result(app, client,
     r = client.get(f"/api/sessions/{sid}/export.json")
     assert r.status_code == 200
     client.delete(f"/api/sessions/{sid}")
+
+
+def test_an_export_of_a_named_generation_is_that_one_while_a_newer_computes(
+    app, client, monkeypatch
+):
+    """The page's export link names the generation on screen: while a newer state computes,
+    its file is the one it names, at once (not, after a wait, the newer one), and once that is
+    replaced the link's generation is refused, 409, naming the one on screen."""
+    import threading
+
+    import jik.app.dashboard.session as session
+
+    real, release = session.compute, threading.Event()
+
+    def slow(state, *args, **kwargs):
+        if state.gamma == 1.5:
+            release.wait(60)
+        return real(state, *args, **kwargs)
+
+    monkeypatch.setattr(session, "compute", slow)
+    sid = client.post("/api/sessions", json={}).json()["id"]
+    try:
+        first = client.get(f"/api/sessions/{sid}/export.json").json()["generation"]
+        assert client.post(f"/api/sessions/{sid}/state", json={"gamma": 1.5}).status_code == 200
+        named = {"generation": first}
+        body = client.get(f"/api/sessions/{sid}/export.json", params=named).json()
+        assert body["generation"] == first and body["state"]["gamma"] == 1.0
+        csv = client.get(f"/api/sessions/{sid}/export.csv", params=named)
+        assert csv.text.startswith(f"# jik export of generation {first}")
+        release.set()
+        newer = client.get(f"/api/sessions/{sid}/export.json").json()  # (the current state's)
+        assert newer["generation"] > first and newer["state"]["gamma"] == 1.5
+        r = client.get(f"/api/sessions/{sid}/export.json", params=named)
+        assert r.status_code == 409, r.text
+        assert r.json()["detail"] == (
+            f"generation {first} is not the result on screen (generation "
+            f"{newer['generation']}); export again"
+        )
+    finally:
+        release.set()
+        client.delete(f"/api/sessions/{sid}")

@@ -40,7 +40,7 @@ def test_unicycle_from_b_reports_the_engines_message():
     assert "undefined" in texts(result) and "stopped" in texts(result)
     # Why, and that this is the paper's run B with its erratum (none of it where the run stopped
     # where it started, below).
-    assert "iteration 3 took λ10 from 0.0659 to -0.0777, across λ10 = 0" in texts(result)
+    assert "iteration 3 took lambda10 from 0.0659 to -0.0777, across lambda10 = 0" in texts(result)
     assert "run from q0 = B (sec. 6.2, Figs. 13 (J^P#) and 14 (J^E#))" in texts(result)
     assert "docs/paper-errata.md" in texts(result)
     # The why follows the engine's status of the run ("undefined": h undefined where it stopped),

@@ -117,6 +117,10 @@ def test_errors_show_beside_their_control_in_the_users_text(tabs):
         "“abc” is not a number; nothing was sent"
     )
     assert tab.snapshot()["generation"] == generation  # (not sent as 0)
+    # The header says what is wrong now, not the path's earlier refusal.
+    expect(page.locator("#status-text")).to_have_text(
+        re.compile(r"^not sent \(here\): .+: “abc” is not a number$")
+    )
     expect(row.locator(".field-error")).to_have_count(0)  # (the path row is gone, or clear)
 
     # Every slider has a box for an exact value.

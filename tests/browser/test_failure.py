@@ -8,12 +8,13 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from pathlib import Path
 from urllib.parse import quote
 
 import pytest
 
 from tests.browser.conftest import ROOT, Tab, Tabs, _free_port, get_json, poll
-from tests.browser.failing_serve import MESSAGE
+from tests.browser.failing_serve import MESSAGE, SLOW_GAMMA
 
 expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
 # A display check: in CI's slow step, to keep the default run under 8 minutes.
@@ -92,3 +93,24 @@ def test_a_failure_names_the_result_still_on_screen(failing_tabs):
     expect(failure).to_have_count(0)
     expect(page.locator("#panels")).to_have_class("panels")
     expect(export).to_contain_text(f"(generation {tab.generation})")
+
+
+def test_an_export_while_a_newer_generation_computes_is_the_one_its_link_names(failing_tabs):
+    """The footer's export link names the generation on screen; clicked while a newer one
+    computes (gamma 2.25, late), it downloads the generation it names, at once, not the newer
+    one once that is in; the link then names the newer one."""
+    tab = failing_tabs.open()
+    page = tab.page
+    export = page.locator("#export-json")
+    expect(export).to_have_text("export JSON (generation 1)")
+    gamma = page.locator("#ctl-gamma-value")
+    gamma.fill(str(SLOW_GAMMA))
+    generation = tab.posting(lambda: gamma.dispatch_event("change")).json()["generation"]
+    expect(export).to_have_text("export JSON (generation 1)")  # (the plots on screen)
+    with page.expect_download() as saved:
+        export.click()
+    data = json.loads(Path(saved.value.path()).read_text())
+    assert data["generation"] == 1 and data["state"]["gamma"] == 1.0
+    assert tab.snapshot()["computed_generation"] == 1  # (the newer one was not in yet)
+    tab.wait_drawn(generation)
+    expect(export).to_have_text(f"export JSON (generation {generation})")

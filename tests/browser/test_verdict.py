@@ -29,7 +29,7 @@ def test_unicycle_from_b_shows_the_engines_message(tabs):
     # Why, and that this is the paper's run (Figs. 13-14) with its erratum.
     why = verdict.locator("p.why.e")
     expect(why).to_contain_text("characteristic (28)")
-    expect(why).to_contain_text("iteration 3 took λ10 from 0.0659 to -0.0777, across λ10 = 0")
+    expect(why).to_contain_text("took lambda10 from 0.0659 to -0.0777, across lambda10 = 0")
     expect(why).to_contain_text("out of the domain of the map's foliation")
     note = verdict.locator("p.note.e")
     expect(note).to_contain_text("the paper's run from q0 = B (sec. 6.2, Figs. 13")

@@ -208,6 +208,7 @@ def test_a_start_singular_for_one_inverse_fails_alone():
     res = run_atlas(plan_atlas(inverse, path, starts=starts, cycles=1, chunk=4))
     assert not res.success[0, 0, 1]
     assert "singular" in res.failures[(0, 0, 1)]
+    assert res.as_dict()["drift"][0][0][1] == [None]  # (a failed leg's NaN: JSON's null)
     for i in (0, 2, 3):
         one = repeatability(inverse, starts[i], path[1:], cycles=1)
         np.testing.assert_allclose(res.drift[0, 0, i], one.drift, rtol=0, atol=1e-10)

@@ -74,8 +74,9 @@ def test_one_form_annihilates_jacobian_transpose(kin):
 
 def test_one_form_undefined_names_configuration(kin):
     """With u1 = 0 (lambda10 = lambda11 = 0) the lambda11-component of the kernel vanishes."""
-    with pytest.raises(OneFormUndefinedError, match=r"x = \(0, 0, 0.2, 0.1\)"):
+    with pytest.raises(OneFormUndefinedError, match=r"x = \(0, 0, 0.2, 0.1\)") as info:
         one_form(kin, [[0.5, 0.1, 0.2, 0.1], [0.0, 0.0, 0.2, 0.1]], 1)
+    assert info.value.field == "x"  # (the argument, as an InvalidInputError names it)
 
 
 def test_cofactor_and_one_form_derivatives_against_fd(kin):
@@ -190,8 +191,9 @@ def test_generic_map_on_another_kinematics():
 def test_undefined_along_characteristic_raises(kin):
     """Reference leaf at lambda10 = 0: the characteristic ends at a kinematic singularity."""
     m = CharacteristicsMap(kin, [0.0, 0.0, 0.0, 0.0], fixed_index=1)
-    with pytest.raises(OneFormUndefinedError, match="characteristic"):
+    with pytest.raises(OneFormUndefinedError, match="characteristic") as info:
         m.value(LAMBDA0)
+    assert info.value.field == "x"
     masked = CharacteristicsMap(kin, [0.0, 0.0, 0.0, 0.0], fixed_index=1, on_undefined="nan")
     assert np.isnan(masked.value(LAMBDA0))
     assert np.all(np.isnan(masked.gradient(LAMBDA0)))

@@ -111,6 +111,7 @@ def test_singular_points_are_reported_not_dropped_silently():
     assert e1.singular_points.shape == (nodes, 3)
     np.testing.assert_allclose(e1.singular_points[:, 2], c, atol=1e-15)
     assert e1.value == np.inf and e1.divergent
+    assert e1.as_dict()["value"] is None  # (JSON-ready: no Infinity)
     assert e1.min_abs_dh_k == pytest.approx(0.0, abs=1e-15)
     assert e2.singular_points.shape == (nodes, 3) and np.isfinite(e2.value)
     assert not e2.divergent

@@ -38,6 +38,16 @@ REFUSALS = {
     "solve mode": (lambda: jik.solve(P, X0, [1, 1], mode="euler"), "mode"),
     "solve method": (lambda: jik.solve(P, X0, [1, 1], method="rk4"), "method"),
     "solve tol 0": (lambda: jik.solve(P, X0, [1, 1], tol=0), "tol"),
+    "solve gamma a number as text": (lambda: jik.solve(P, X0, [1, 1], gamma="1"), "gamma"),
+    "solve gamma a boolean": (lambda: jik.solve(P, X0, [1, 1], gamma=True), "gamma"),
+    "solve tol a number as text": (lambda: jik.solve(P, X0, [1, 1], tol="1e-10"), "tol"),
+    "solve x0 numbers as text": (lambda: jik.solve(P, ["0", "0", "1.5"], [1, 1]), "x0"),
+    "solve y_d numbers as text": (lambda: jik.solve(P, X0, np.array(["1", "1"])), "y_d"),
+    "E1Optimal C1 a number as text": (lambda: jik.E1Optimal(C1="1"), "C1"),
+    "synthesize_e2 region bound as text": (
+        lambda: jik.synthesize_e2(ARM, {"x2": ("0", 1), "x3": (1, 2)}, degree=2),
+        "region.x2",
+    ),
     "solve tol tiny": (lambda: jik.solve(P, X0, [1, 1], tol=1e-20), "tol"),
     "solve max_iterations": (lambda: jik.solve(P, X0, [1, 1], max_iterations=-5), "max_iterations"),
     "solve guess in discrete mode": (
@@ -414,3 +424,22 @@ def test_refused_starts_say_why_each_start_of_a_batch_cannot_run():
         "choose a start where both are finite (below about 1.8e308)"
     )
     assert "J J^T is singular" in refused[2] and refused[2].endswith("; move the start")
+
+
+def test_a_singular_configuration_names_its_input_as_invalid_input_does():
+    """A singular start is ``x0``'s, a point handed to an inverse ``x``'s, a singular point of
+    a synthesis region ``region``'s: ``error.field``, as an InvalidInputError's."""
+    chain = jik.PlanarChain("RRR", [1, 1, 1])
+    inverse, stretched = jik.Pseudoinverse(chain), [0.0, 0.0, 0.0]  # J loses rank there
+    region = {"x2": (-1, 1)}  # (x1 = x3 = 0 held; 17 Gauss nodes have x2 = 0)
+    cases = [
+        (lambda: jik.solve(inverse, stretched, [1, 1]), "x0"),
+        (lambda: jik.solve(inverse, stretched, [1, 1], mode="discrete", gamma=0.5), "x0"),
+        (lambda: inverse.apply(np.array(stretched), np.array([1.0, 1.0])), "x"),
+        (lambda: jik.error_functional_e2(chain, jik.PaperCubic(), region, nodes=17), "region"),
+    ]
+    for call, field in cases:
+        with pytest.raises(jik.KinematicSingularityError) as info:
+            call()
+        assert info.value.field == field, str(info.value)
+        np.testing.assert_allclose(info.value.configuration.shape, (3,))

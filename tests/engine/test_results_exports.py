@@ -321,3 +321,20 @@ def test_a_functional_value_prints_in_one_line():
     assert "x2 in [-1, 1], x3 in [0, 3], held x1=0, 256 points, 0 singular" in e2
     e1 = repr(jik.error_functional_e1(ARM, jik.PaperCubic(), region))
     assert e1.startswith("FunctionalValue(inf (divergent), "), e1
+
+
+def test_as_dict_gives_none_for_a_missing_number_as_the_cli_prints_null():
+    """A failed leg leaves NaN in the drift and the leg ends: ``as_dict()`` (the values for
+    JSON, ``json.dumps`` strict) has None there, ``jik repeatability --json`` prints the
+    same dict, and the table keeps NaN (a DataFrame's missing value)."""
+    x0 = [0.2398, -0.6496, 0.8637]  # the extended inverse stops at once here
+    run = jik.repeatability(jik.ExtendedInverse(ARM, jik.PaperCubic()), x0, PATH, cycles=1)
+    d = run.as_dict()
+    json.dumps(d, allow_nan=False)
+    assert d["drift"] == [None] and d["legs"][0] == [None, None, None]
+    assert math.isnan(run.columns()["drift"][0])
+    trajectory = jik.solve(jik.ExtendedInverse(ARM, jik.PaperCubic()), X0, (1, 1)).trajectory
+    assert trajectory is not None
+    nan_h = jik.Trajectory(**{**vars(trajectory), "h": np.full(len(trajectory), np.nan)})
+    assert set(nan_h.as_dict()["h"]) == {None}
+    assert set(jik_exports.json_values([np.nan, np.float64("inf"), (1.5,)])[:2]) == {None}

@@ -203,3 +203,25 @@ def test_cancel_stops_between_chunks():
             Manipulator2(1.0), MANIPULATOR2_REGION, degree=6, nodes=2**13, progress=progress
         )
     assert len(calls) == 2
+
+
+def test_the_joints_outside_the_region_are_held_at_home_within_the_joint_limits():
+    """Not told ``fixed``, a synthesis holds the other joints at the robot's home (the
+    dashboard's default start; the Panda's joint 4 limits exclude 0), and a robot without a
+    home at 0 moved into its joint limits."""
+    from jik.engine.functionals import check_region
+    from jik.engine.kinematics import held_values
+    from jik.engine.robot_spec import load_robot
+
+    panda = load_robot("panda")
+    kin, home = panda.kinematics, np.array(panda.spec.default_x0)
+    region = {"x1": (-0.2, 0.2), "x2": (home[1] - 0.2, home[1] + 0.2)}
+    res = synthesize_e2_nd(kin, region, degree=1, nodes=64)
+    held = np.array([res.fixed[n] for n in ("x3", "x4", "x5", "x6", "x7")])
+    np.testing.assert_allclose(held, home[2:], rtol=0, atol=1e-15)
+    lo, hi = np.asarray(kin.joint_limits).T
+    assert np.all((lo <= held_values(kin)) & (held_values(kin) <= hi))
+    bounded = PlanarChain("RRR", [1, 1, 1])
+    bounded.joint_limits = np.array([[0.5, 1.0], [-1.0, 1.0], [-2.0, -1.0]])
+    assert check_region(bounded, {"x2": (-1, 1)})[1] == {"x1": 0.5, "x3": -1.0}
+    assert check_region(Manipulator2(), {"x2": (-1, 1)})[1] == {"x1": 0.0, "x3": 0.0}

@@ -28,7 +28,7 @@ from ...dashboard.controls import controls_message
 from ...dashboard.messages import LatestEvents
 from ...dashboard.patch import StatePatch, parse_patch, patch_of
 from ...dashboard.robots import vet_definition
-from ...dashboard.sessions import ExportUnavailable, Session, SessionNotFound
+from ...dashboard.sessions import Session, SessionNotFound
 from ..dependencies import Pool, Store
 from ..errors import unparsed_body_response
 from ..security import close_websocket
@@ -224,7 +224,10 @@ class CSVResponse(PlainTextResponse):
 
 #: An export with no result of the current state (:class:`ExportUnavailable`).
 _NO_EXPORT: dict[int | str, dict] = {
-    409: {"description": "the current state's computation failed: nothing current to export"},
+    409: {
+        "description": "the current state's computation failed, or the generation asked is "
+        "no longer on screen: nothing current to export"
+    },
     503: {"description": "the current state's result is not computed yet"},
 }
 #: A session that is not there (expired, deleted, never created).
@@ -272,42 +275,19 @@ async def events(session_id: str, store: Store):
     return EventSourceResponse(stream(), ping=HEARTBEAT, sep="\n")
 
 
-async def _finished(session: Session):
-    """The session's dashboard once its current state's result is in (waiting up to
-    :data:`EXPORT_WAIT`); never an older result in its place.
-
-    Raises
-    ------
-    ExportUnavailable
-        409 when the current state's computation failed (the message says which generation and
-        why), 503 when it has not finished in time.
-    """
-    dashboard = session.dashboard
-    done = await asyncio.to_thread(dashboard.wait, None, EXPORT_WAIT)
-    snapshot = dashboard.snapshot()
-    if snapshot["error"] is not None:
-        error = snapshot["error"]
-        raise ExportUnavailable(
-            409,
-            (
-                f"generation {error.get('generation')} failed: {error.get('message')}; there is no "
-                "result of the current state to export (change the state, then export)"
-            ),
-        )
-    if not done or dashboard.result is None:
-        raise ExportUnavailable(503, "no result of the current state computed yet; retry")
-    return dashboard
-
-
 @router.get(
     "/api/sessions/{session_id}/export.json",
     operation_id="export_json",
     responses={**_NO_EXPORT, **_NOT_FOUND},
 )
-async def export_result_json(session_id: str, store: Store) -> JSONResponse:
-    """The session's result as JSON: every point of each run; units keyed by column names."""
-    dashboard = await _finished(store.get(session_id))
-    body, name = export_file(dashboard.result, "json", dashboard.functionals)
+async def export_result_json(
+    session_id: str, store: Store, generation: int | None = None
+) -> JSONResponse:
+    """The session's result as JSON: every point of each run; units keyed by column names.
+    With ``generation`` (the page's link), that generation's result, on screen."""
+    session = store.get(session_id)
+    result, functionals = await asyncio.to_thread(session.exported, generation, EXPORT_WAIT)
+    body, name = export_file(result, "json", functionals)
     return JSONResponse(body, headers={"Content-Disposition": f'attachment; filename="{name}"'})
 
 
@@ -321,11 +301,13 @@ async def export_result_json(session_id: str, store: Store) -> JSONResponse:
         **_NOT_FOUND,
     },
 )
-async def export_result_csv(session_id: str, store: Store):
+async def export_result_csv(session_id: str, store: Store, generation: int | None = None):
     """The session's result as CSV: '#' lines (units per column, the coordinates' names), then
-    a row per point of each run: algorithm, cycle, leg, theta, x_1.., y_1.., error, h."""
-    dashboard = await _finished(store.get(session_id))
-    body, name = export_file(dashboard.result, "csv")
+    a row per point of each run: algorithm, cycle, leg, theta, x_1.., y_1.., error, h. With
+    ``generation``, as the JSON export."""
+    session = store.get(session_id)
+    result, _ = await asyncio.to_thread(session.exported, generation, EXPORT_WAIT)
+    body, name = export_file(result, "csv")
     return CSVResponse(body, headers={"Content-Disposition": f'attachment; filename="{name}"'})
 
 
