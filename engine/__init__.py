@@ -46,10 +46,12 @@ Solving (the continuation algorithm, eq. (7))
 Repeatability (sec. 5.2.1, Table 1)
     repeatability               drive a closed path cycle after cycle -> RepeatabilityResult
     repeatable, h_change        whether every cycle came back to x0; how much h changed, eq. (12)
+    run_findings, extended_why  what a run found, and why (h kept, eq. (12)), in sentences
     Resume, Leg                 an earlier run to go on from (as x0); a leg as a progress sees it
     Progress, ProgressCallbacks what a long computation reports, and how to cancel it
 Functionals and synthesis (secs. 3-4)
     error_functional_e1, error_functional_e2  E1, eq. (14), and E2, eq. (19), on a region
+    functionals_report          both as data on a region of any dimension (Sobol rule past 3)
     synthesize_e2               the E2-optimal h by a Ritz method, eq. (20) -> SynthesisResult
     synthesize_e2_nd            E2-optimal h of all joints, p - r >= 1 -> TotalDegreeSynthesis
     map_singularities           where h or [J; dh] (10) is singular in a box -> MapSingularities
@@ -133,11 +135,14 @@ _EXPORTS = {
     "Leg": "repeatability",
     "repeatable": "repeatability",
     "h_change": "augmentations",
+    "run_findings": "findings",
+    "extended_why": "findings",
     "Progress": "progress",
     "ProgressCallbacks": "progress",
     # functionals and synthesis
     "error_functional_e1": "functionals",
     "error_functional_e2": "functionals",
+    "functionals_report": "functional_report",
     "synthesize_e2": "variational",
     "synthesize_e2_nd": "synthesis_nd",
     "TotalDegreeSynthesis": "synthesis_nd",
@@ -217,6 +222,8 @@ __all__ = [
     "WeightedInverse",
     "error_functional_e1",
     "error_functional_e2",
+    "extended_why",
+    "functionals_report",
     "h_change",
     "inert_variables",
     "iter_atlas",
@@ -231,6 +238,7 @@ __all__ = [
     "robot_from_dict",
     "robot_units",
     "run_atlas",
+    "run_findings",
     "solve",
     "solve_batch",
     "synthesize_e2",
@@ -288,7 +296,9 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
         SingularConfigurationError,
     )
     from .extended_vector import VectorExtendedInverse
+    from .findings import extended_why, run_findings
     from .formula_kinematics import FormulaKinematics, FormulaMap
+    from .functional_report import functionals_report
     from .functionals import error_functional_e1, error_functional_e2
     from .inverses import ExtendedInverse, Inverse, Pseudoinverse
     from .kinematics import Kinematics, Manipulator1, Manipulator2

@@ -13,6 +13,7 @@ import numpy as np
 from .augmentations import AugmentingMap
 from .exceptions import JikError
 from .inverses import require_map
+from .progress import ProgressCallbacks
 from .validation import FloatArray, check_box_region, count
 
 #: Seeded samples of the box on which :func:`grid_axes` compares h's partial derivatives.
@@ -155,3 +156,46 @@ def map_grid(
                 except JikError:
                     pass
     return MapGrid({axes[0]: a, axes[1]: b}, h)
+
+
+def _batched(amap: AugmentingMap, x: FloatArray, batch: int, on_batch) -> tuple:
+    """(h, dh) at ``x`` (n, p) of a map that solves a problem per point, ``batch`` points at a
+    time (its ``evaluate_batches``), ``on_batch(done, total)`` after each batch."""
+    return amap.evaluate_batches(x, batch, ProgressCallbacks(on_advance=on_batch))  # type: ignore[attr-defined]
+
+
+def axes_along(
+    amap: AugmentingMap, x: FloatArray, batch: int = 45, on_batch=None
+) -> tuple[int, int]:
+    """The two joint variables h depends on most along the configurations ``x`` (n, p), their
+    spread counted (:func:`varying_most`). A map that solves a problem per point
+    (:attr:`~jik.engine.augmentations.AugmentingMap.solves_per_point`) is evaluated ``batch``
+    points at a time, ``on_batch(done, total)`` after each batch."""
+    with np.errstate(all="ignore"):
+        if amap.solves_per_point:
+            dh = _batched(amap, x, batch, on_batch)[1]
+        else:
+            dh = amap.gradient(x)
+    return varying_most(dh, np.ptp(x, axis=0))
+
+
+def slice_values(
+    amap: AugmentingMap, base, axes, box, n: int, batch: int = 45, on_batch=None
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """h on an ``n`` x ``n`` grid over the variables ``axes`` = (i, j) of x on ``box`` =
+    ((lo_i, hi_i), (lo_j, hi_j)), ends included, the others at ``base`` (p,): (u, v, H), H[b,
+    a] at x_i = u[a], x_j = v[b]; NaN where h is not finite. A map that solves a problem per
+    point is evaluated as in :func:`axes_along`."""
+    (i, j), p = axes, len(base)
+    (lo_u, hi_u), (lo_v, hi_v) = box
+    u, v = np.linspace(lo_u, hi_u, n), np.linspace(lo_v, hi_v, n)
+    x = np.broadcast_to(np.asarray(base, dtype=float), (n, n, p)).copy()
+    x[..., i] = u[None, :]
+    x[..., j] = v[:, None]
+    with np.errstate(all="ignore"):
+        if amap.solves_per_point:  # (maps that can be undefined at some points)
+            h = _batched(amap, x.reshape(-1, p), batch, on_batch)[0]
+        else:
+            h = amap.value(x.reshape(-1, p))
+    h = np.asarray(h, dtype=float).reshape(n, n)
+    return u, v, np.where(np.isfinite(h), h, np.nan)

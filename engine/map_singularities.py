@@ -80,6 +80,19 @@ class MapSingularities:
             f"{self.nodes}^{len(self.region)} grid points)"
         )
 
+    def warning(self, map_name: str, parameters: Mapping[str, float]) -> str:
+        """The warning that the map ``map_name`` (with its ``parameters``) is singular in the
+        design region it was searched on, saying where (:meth:`__str__`), so that a large E1
+        (13) or E2 (18) there is not read as a bad fit."""
+        box = ", ".join(f"{k} ∈ [{lo:.3g}, {hi:.3g}]" for k, (lo, hi) in self.region.items())
+        params = ", ".join(f"{k} = {v:.3g}" for k, v in parameters.items())
+        return (
+            f"Warning: the augmenting map {map_name}"
+            + (f" ({params})" if params else "")
+            + f" is singular in the design region {box}: {self}. E1 and E2 there are not a "
+            "measure of fit, and the extended Jacobian is undefined where a run crosses it."
+        )
+
     def as_dict(self) -> dict:
         """JSON-friendly form."""
         return {

@@ -36,7 +36,7 @@ import numpy as np
 from scipy.integrate import DOP853, OdeSolution
 from scipy.optimize import brentq
 
-from .exceptions import InvalidInputError
+from .exceptions import InvalidInputError, JikError
 from .inverses import Pseudoinverse
 from .kinematics import Kinematics
 from .urdf import UrdfChain
@@ -61,6 +61,12 @@ CLOSE_TOL = 1e-6
 CLOSE_PER_TOL = 1e3
 #: Brent's tolerance on s where an event is located (``solve_ivp``'s).
 EVENT_TOL = 4 * np.finfo(float).eps
+#: A curve drawn (:func:`drawn_curves`) is traced this many box diagonals each way (to a
+#: drawing's tolerance) and drawn with a point every SPACING of them.
+ARC_SPANS, SPACING, DRAW_TOL = 3.2, 0.02, 1e-6
+#: Integrator steps each way of a drawn curve: a smooth one takes under ten; one that runs
+#: into a configuration where k is undefined creeps there and is drawn up to it.
+DRAW_STEPS = 1000
 
 
 @dataclass(frozen=True)
@@ -343,3 +349,36 @@ def _leg(kinematics, base, end, leaves, watch, periodic, tol, max_steps) -> _Leg
     if ts[-1] == 0:
         return _Leg(0.0, None, steps, cut, False)
     return _Leg(float(ts[-1]), OdeSolution(np.array(ts), interpolants), steps, cut, closed)
+
+
+def drawn_curves(kinematics: Kinematics, seeds: FloatArray, lo, hi) -> list[FloatArray]:
+    """Points of the self-motion manifolds k(x) = k(seed) through ``seeds`` (n, p), (m, p)
+    each: a polyline with a point every :data:`SPACING` diagonals of the box [``lo``, ``hi``]
+    (p,), within that box widened by half its width each way (and to the seeds); none for a
+    seed where the curve cannot be traced.
+
+    Notes
+    -----
+    Each curve is :func:`trace`'s, to a drawing's tolerance :data:`DRAW_TOL`: the orbit of the
+    unit kernel K(x) both ways from its seed over an arc of :data:`ARC_SPANS` box diagonals,
+    stopped where any variable (a freely turning joint's angle too) leaves the widened box,
+    after one turn of a closed curve or after :data:`DRAW_STEPS` steps, its points projected
+    onto k(x) = y by the pseudoinverse (8).
+    """
+    span = hi - lo
+    defined = seeds[np.isfinite(seeds).all(axis=1)]  # (a seed beyond x_range widens the box)
+    low = np.minimum(lo - 0.5 * span, np.min(defined, axis=0, initial=np.inf))
+    high = np.maximum(hi + 0.5 * span, np.max(defined, axis=0, initial=-np.inf))
+    diagonal = float(np.linalg.norm(span))
+    arc = min(ARC_SPANS * diagonal, MAX_ARC)
+    box = list(zip(low.tolist(), high.tolist(), strict=True))
+    curves = []
+    for seed in seeds:
+        try:
+            curve = trace(kinematics, seed, (-arc, arc), box, DRAW_TOL, True, DRAW_STEPS)
+        except JikError:  # (a singular seed: no kernel to follow)
+            curves.append(np.empty((0, kinematics.p)))
+            continue
+        n = int(np.ceil((curve.arc[1] - curve.arc[0]) / (SPACING * diagonal or 1.0))) + 1
+        curves.append(curve.sample(max(n, 2)))
+    return curves

@@ -130,6 +130,19 @@ class RobotUnits:
             **dict(zip(coordinate_names("y", len(self.task)), self.task, strict=True)),
         }
 
+    def trajectory_units(self, mode: str) -> dict[str, str]:
+        """The unit of each column of a run's table
+        (:meth:`jik.engine.results.Trajectory.columns`), spelled out: ``theta`` (iterations in
+        ``mode`` "discrete", else dimensionless), ``x_k`` and ``y_k`` (:meth:`columns`), the
+        task ``error`` (a norm of y, :func:`norm_unit`) and ``h``."""
+        spelled = {"": "as the definition's formulas", "1": "dimensionless"}
+        return {
+            "theta": "iterations" if mode == "discrete" else "dimensionless",
+            **{k: spelled.get(c.unit, c.unit) for k, c in self.columns().items()},
+            "error": norm_unit(self.y).strip("[]") or "as y",
+            "h": "the unit of the map's formula",
+        }
+
     def summary(self) -> dict:
         """``{"x": units of x, "y": units of y, "lengths": ...}``, JSON-friendly: what a run's
         document says of its configurations x and task points y."""
@@ -142,6 +155,16 @@ class RobotUnits:
             "task": [c.as_dict() for c in self.task],
             "lengths": self.lengths,
         }
+
+
+def norm_unit(unit_names: Sequence[str]) -> str:
+    """The unit of a Euclidean norm of coordinates in ``unit_names`` (a drift ||x - x0||, a
+    task error): one unit, or the units it mixes said so ("1": dimensionless); "" when none is
+    stated."""
+    names = [("dimensionless" if u == "1" else u) for u in dict.fromkeys(unit_names) if u]
+    if len(names) <= 1:
+        return f"[{names[0]}]" if names else ""
+    return f"[{' and '.join(names)} mixed]"
 
 
 def _units(kinematics, task_names: Sequence[str]) -> tuple[tuple[str, ...], tuple[str, ...], str]:

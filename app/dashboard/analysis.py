@@ -9,26 +9,10 @@ from collections.abc import Callable, Mapping
 import numpy as np
 
 from ...engine.exceptions import JikError
-from ...engine.map_grid import varying_most
-from ...engine.progress import ProgressCallbacks
+from ...engine.map_grid import axes_along, slice_values
 from .model import DashboardState
 from .robots import state_kinematics, state_spec
 from .runs import AlgorithmRun
-
-
-def augmenting_axes(amap, x: np.ndarray, on_batch=None) -> tuple[int, int]:
-    """The two joint variables h depends on most along the configurations ``x`` (n, p), their
-    spread counted (:func:`jik.engine.map_grid.varying_most`).
-
-    ``on_batch(done, total)``: after each batch of :data:`GRID_BATCH` points of an expensive
-    map (:func:`expensive_map`), whose gradient solves a problem per point.
-    """
-    with np.errstate(all="ignore"):
-        if expensive_map(amap):
-            dh = amap.evaluate_batches(x, GRID_BATCH, ProgressCallbacks(on_advance=on_batch))[1]
-        else:
-            dh = amap.gradient(x)
-    return varying_most(dh, np.ptp(x, axis=0))
 
 
 def kinematics_and_map(state: DashboardState, kin=None):
@@ -132,7 +116,7 @@ def augmenting_grid(
         def step(offset: int):
             return lambda done, _: progress(offset + done, total)
 
-        i, j = augmenting_axes(amap, xs, step(0))
+        i, j = axes_along(amap, xs, GRID_BATCH, step(0))
         low, high = runs_box(state, runs)
         box = [(float(low[k]), float(high[k])) for k in (i, j)]
         # (fewer for a map that solves a collocation problem per point)
@@ -146,21 +130,11 @@ def augmenting_grid(
             )
             if inside:
                 box = [tuple(b) for b in before["box"]]
-        u, v = np.linspace(*box[0], n), np.linspace(*box[1], n)
-        X = np.broadcast_to(np.asarray(state.x0, dtype=float), (n, n, kin.p)).copy()
-        X[..., i] = u[None, :]
-        X[..., j] = v[:, None]
-        with np.errstate(all="ignore"):
-            if expensive_map(amap):  # (maps that can be undefined at some points)
-                on = ProgressCallbacks(on_advance=step(along))
-                H = amap.evaluate_batches(X.reshape(-1, kin.p), GRID_BATCH, on)[0]
-            else:
-                H = amap.value(X.reshape(-1, kin.p))
-                progress(total, total)
-        H = np.asarray(H, dtype=float).reshape(n, n)
+        u, v, H = slice_values(amap, state.x0, (i, j), box, n, GRID_BATCH, step(along))
+        if not expensive_map(amap):
+            progress(total, total)
     except (JikError, ValueError, ArithmeticError):
         return None
-    H = np.where(np.isfinite(H), H, np.nan)
     return {
         "axes": (i, j),
         "u": u,

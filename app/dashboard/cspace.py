@@ -13,8 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...engine.exceptions import JikError
-from ...engine.self_motion import MAX_ARC
-from ...engine.self_motion import trace as trace_curve
+from ...engine.self_motion import drawn_curves
 from .algorithms import COLORS, DASH, LABELS, STYLES
 from .analysis import expensive_map, kinematics_and_map, runs_box
 from .plotting import corner_names, figure, trace
@@ -22,12 +21,6 @@ from .runs import DashboardResult
 
 #: Points per run drawn; level-surface grid.
 MAX_POINTS, GRID = 1500, 16
-#: A self-motion manifold is traced this many box diagonals each way (to a drawing's tolerance)
-#: and drawn with a point every SPACING of them.
-ARC_SPANS, SPACING, DRAW_TOL = 3.2, 0.02, 1e-6
-#: Integrator steps each way of a traced manifold: a smooth one takes under ten; one that runs
-#: into a configuration where k is undefined creeps there and is drawn up to it.
-MAX_TRACE_STEPS = 1000
 CSPACE_HEIGHT = 520
 #: The layout key of the panel's 3D axes (not "scene": see :func:`cspace_spec`).
 SCENE = "scene2"
@@ -38,40 +31,6 @@ def axes_of(result: DashboardResult) -> tuple[int, int, int]:
     ``cspace_axes``: "012", "013", "023" or "123"; none: the first three)."""
     choice = result.state.cspace_axes or "012"
     return tuple(int(c) for c in choice)  # type: ignore[return-value]
-
-
-def self_motion(kin, seeds: np.ndarray, lo, hi) -> list[np.ndarray]:
-    """Points of the self-motion manifolds k(x) = k(seed) through ``seeds``, (m, p) each: a
-    polyline with a point every :data:`SPACING` box diagonals, within the box widened by half
-    its width each way (none for a seed where the curve cannot be traced).
-
-    Notes
-    -----
-    Each curve is the engine's (:func:`jik.engine.self_motion.trace`, to a drawing's tolerance
-    :data:`DRAW_TOL`): the orbit of the unit kernel K(x) both ways from its seed over an arc of
-    :data:`ARC_SPANS` box diagonals, stopped where any variable (a freely turning joint's angle
-    too) leaves the widened box, after one turn of a closed curve or after
-    :data:`MAX_TRACE_STEPS` steps, its points projected onto k(x) = y by the pseudoinverse (8).
-    """
-    span = hi - lo
-    finite = seeds[np.isfinite(seeds).all(axis=1)]  # (a seed beyond x_range widens the box)
-    low = np.minimum(lo - 0.5 * span, np.min(finite, axis=0, initial=np.inf))
-    high = np.maximum(hi + 0.5 * span, np.max(finite, axis=0, initial=-np.inf))
-    diagonal = float(np.linalg.norm(span))
-    arc = min(ARC_SPANS * diagonal, MAX_ARC)
-    box = list(zip(low.tolist(), high.tolist(), strict=True))
-    curves = []
-    for seed in seeds:
-        try:
-            curve = trace_curve(
-                kin, seed, (-arc, arc), box, DRAW_TOL, True, max_steps=MAX_TRACE_STEPS
-            )
-        except JikError:  # (a singular seed: no kernel to follow)
-            curves.append(np.empty((0, kin.p)))
-            continue
-        n = int(np.ceil((curve.arc[1] - curve.arc[0]) / (SPACING * diagonal or 1.0))) + 1
-        curves.append(curve.sample(max(n, 2)))
-    return curves
 
 
 def _level_surface(result: DashboardResult, amap, axes, lo, hi) -> dict | str:
@@ -141,7 +100,7 @@ def cspace_spec(result: DashboardResult) -> dict:
         notes.append(f"self-motion manifolds {kin.p - kin.r}-dimensional: not drawn")
     elif len(seeds) == L:
         with np.errstate(all="ignore"):
-            curves = self_motion(kin, seeds, lo, hi)
+            curves = drawn_curves(kin, seeds, lo, hi)
         for k, (curve, name) in enumerate(zip(curves, corner_names(result), strict=True)):
             data.append(
                 trace(

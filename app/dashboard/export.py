@@ -21,7 +21,6 @@ from ...engine.results import Trajectory
 from ...engine.units import robot_units
 from .algorithms import posture_rest
 from .messages import h_change, to_json
-from .plotting import norm_unit
 from .robots import state_kinematics
 from .runs import DashboardResult
 from .verdict import verdict
@@ -29,23 +28,15 @@ from .verdict import verdict
 
 def described(result: DashboardResult) -> dict:
     """What an export says of its columns (:func:`run_columns`): ``units``, the unit of every
-    column by its name (theta, the joint variables x_k and the task coordinates y_k as the
-    engine's :meth:`jik.engine.units.RobotUnits.columns` give them, the task error (a norm of
-    y) and h); ``length_unit``, what the robot's length unit m stands for (the paper states
-    none); ``coordinates``, what each coordinate column is (``{"x_1": <the first joint's
-    name>, ..., "y_1": <the first task coordinate's>, ...}``)."""
-    spelled = {"": "as the definition's formulas", "1": "dimensionless"}
+    column by its name (:meth:`jik.engine.units.RobotUnits.trajectory_units`); ``length_unit``,
+    what the robot's length unit m stands for (the paper states none); ``coordinates``, what
+    each coordinate column is (``{"x_1": <the first joint's name>, ..., "y_1": <the first task
+    coordinate's>, ...}``)."""
     units = robot_units(state_kinematics(result.state), result.task_names)
-    columns = units.columns()
     return {
-        "units": {
-            "theta": "iterations" if result.state.mode == "discrete" else "dimensionless",
-            **{k: spelled.get(c.unit, c.unit) for k, c in columns.items()},
-            "error": norm_unit(units.y).strip("[]") or "as y",
-            "h": "the unit of the map's formula",
-        },
+        "units": units.trajectory_units(result.state.mode),
         "length_unit": units.lengths,
-        "coordinates": {k: c.name for k, c in columns.items()},
+        "coordinates": {k: c.name for k, c in units.columns().items()},
     }
 
 

@@ -9,13 +9,16 @@ from __future__ import annotations
 import json
 from collections.abc import Callable
 
-import numpy as np
-
 from ...engine.dependence import inert_variables
-from ...engine.exceptions import JikError
-from ...engine.functionals import error_functional_e1, error_functional_e2, parameter_sensitivity
+from ...engine.exceptions import JikError, RunCancelled
+from ...engine.functional_report import (
+    MAX_TENSOR_VARIABLES,
+    functionals_report,
+    maps_report,
+    parameters_report,
+)
+from ...engine.progress import ProgressCallbacks
 from .analysis import expensive_map, kinematics_and_map, vector_note
-from .arm_e2 import qmc_functionals, single_joint_sensitivity
 from .model import DashboardState, cache_key, robot_and_map
 from .robots import state_spec
 from .runs import Cancelled, DashboardResult
@@ -58,9 +61,10 @@ def functionals_key(state: DashboardState) -> str:
     return json.dumps(robot_and_map(state) | {"fixed": fixed}, sort_keys=True)
 
 
-#: E1 and E2 are taken by a tensor Gauss rule over at most this many region variables, of this
-#: many nodes per variable (fewer for a map that solves a problem per point).
-MAX_QUADRATURE_VARIABLES, NODES, EXPENSIVE_NODES = 3, 12, 6
+#: E1 and E2 are taken by a tensor Gauss rule (over at most
+#: :data:`~jik.engine.functional_report.MAX_TENSOR_VARIABLES` region variables) of this many
+#: nodes per variable (fewer for a map that solves a problem per point).
+NODES, EXPENSIVE_NODES = 12, 6
 
 
 def error_functionals(
@@ -74,8 +78,8 @@ def error_functionals(
     ``jik reproduce`` uses) where it has one, so the values do not move with the start point and
     a synthesized map is judged on the box it was built for; else over the heat-map box.
     ``on_step()`` after each of the two (progress; what it raises stops them). Over more than
-    three variables, E2 by a Sobol rule (:func:`~jik.app.dashboard.arm_e2.qmc_functionals`,
-    polling ``cancelled``).
+    three variables, E2 by a Sobol rule
+    (:func:`~jik.engine.functional_report.functionals_report`, polling ``cancelled``).
     """
     grid = result.augmenting
     if grid is None:
@@ -92,27 +96,12 @@ def error_functionals(
         "nodes": nodes,
         "design_region": bool(design),
     }
-    if len(region) > MAX_QUADRATURE_VARIABLES:  # (nodes ** 7 points for a 7-joint arm)
-        return qmc_functionals(grid, region, fixed, out, cancelled, on_step)
-    for key in ("E1", "E2"):
-        out |= _functional(key, grid["kinematics"], grid["map"], region, nodes, fixed)
-        on_step()
-    return out
-
-
-def _functional(key: str, kin, amap, region: dict, nodes: int, fixed: dict) -> dict:
-    """``{key: E1 (13) or E2 (18), or None where undefined}`` with its singular points, and
-    ``key_divergent`` (E1 = inf) or ``key_error`` (why it could not be evaluated) if so."""
-    fn = error_functional_e1 if key == "E1" else error_functional_e2
+    report = ProgressCallbacks(is_cancelled=cancelled)
     try:
-        value = fn(kin, amap, region, nodes=nodes, fixed=fixed)
-    except (JikError, ValueError, ArithmeticError) as exc:
-        return {key: None, f"{key}_error": str(exc)}
-    out = {
-        key: float(value.value) if np.isfinite(value.value) else None,
-        f"{key}_singular_points": int(value.singular_points.shape[0]),
-    }
-    return out | ({f"{key}_divergent": True} if value.divergent else {})
+        kin, amap = grid["kinematics"], grid["map"]
+        return out | functionals_report(kin, amap, region, fixed, nodes, on_step, report)
+    except RunCancelled:
+        raise Cancelled from None
 
 
 #: Values of each parameter in the E1/E2 sweep of the dashboard (over v - 1 .. v + 1).
@@ -127,7 +116,7 @@ def sensitivity_evaluations(state: DashboardState, amap) -> int:
     if amap is None or expensive_map(amap):
         return 0
     spec = state_spec(state)
-    if len(spec.functional_region) > MAX_QUADRATURE_VARIABLES:
+    if len(spec.functional_region) > MAX_TENSOR_VARIABLES:
         return 0
     params = spec.augmentation(state.augmentation).parameters
     if params:
@@ -182,36 +171,32 @@ def sensitivity(
             raise Cancelled
         return other.build(kin, **params)
 
-    total = sensitivity_evaluations(state, grid["map"])
     try:
         if aug.parameters:
-            out: dict = {"kind": "parameters", "parameters": dict(state.augmentation_parameters)}
-            for k, key in enumerate(("E1", "E2")):
-
-                def evaluated(done: int, n: int, k: int = k) -> None:
-                    progress(k * n + done, total)
-
-                out[key] = parameter_sensitivity(
-                    kin,
-                    lambda **p: build(aug, **p),
-                    state.augmentation_parameters,
-                    region,
-                    functional=key.lower(),
-                    samples=SENSITIVITY_SAMPLES,
-                    nodes=nodes,
-                    fixed=fixed,
-                    on_evaluation=evaluated,
-                )
-            return out
-        maps = []
-        for m, other in enumerate(spec.augmentations):
-            amap = build(other, **{p.name: p.default for p in other.parameters})
-            if not expensive_map(amap):  # (no value of a map that solves per point)
-                row: dict = {"name": other.name, "current": other.name == aug.name}
-                for key in ("E1", "E2"):
-                    row[key] = _functional(key, kin, amap, region, nodes, fixed)[key]
-                maps.append(row)
-            progress(2 * m + 2, total)
-        return {"kind": "alternatives", "maps": maps}
+            factory, samples = (lambda **p: build(aug, **p)), SENSITIVITY_SAMPLES
+            params = state.augmentation_parameters
+            return parameters_report(kin, factory, params, region, nodes, fixed, samples, progress)
+        maps = [
+            (m.name, lambda m=m: build(m, **{p.name: p.default for p in m.parameters}))
+            for m in spec.augmentations
+        ]
+        return maps_report(kin, maps, aug.name, region, nodes, fixed, progress)
     except (JikError, ValueError, ArithmeticError) as exc:
         return {"kind": "unavailable", "reason": str(exc)}
+
+
+def single_joint_sensitivity(functionals: dict) -> dict:
+    """The E1/E2 panel's data for a map whose E2 came from a Sobol rule
+    (:func:`~jik.engine.functional_report.functionals_report`): E2 of the map and of h = s x_j
+    for each joint, ``{"kind": "single_joint", "E2", "maps": [{"name", "E2", "current"}],
+    "nodes"}``."""
+    maps = [{"name": "h (current)", "E2": functionals["E2"], "current": True}]
+    for name, row in functionals["E2_single_joint"].items():
+        sign = "+" if row["sign"] > 0 else "−"
+        maps.append({"name": f"h = {sign}{name}", "E2": row["e2"], "current": False})
+    return {
+        "kind": "single_joint",
+        "E2": functionals["E2"],
+        "maps": maps,
+        "nodes": functionals["E2_rule"]["nodes"],
+    }

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from ...engine.limits import LimitsReport, legs_report, limit_names, robot_limits
-from .robots import state_kinematics, state_spec
+from .robots import state_kinematics
 
 
 def state_limits(state) -> np.ndarray | None:
@@ -42,28 +42,17 @@ def run_limits(result, algorithm: str) -> LimitsReport | None:
     return legs_report(limits, np.asarray(state.x0, dtype=float), legs, L, names)
 
 
+def limits_reports(result) -> dict[str, LimitsReport]:
+    """Per algorithm, the limits report of its run (:func:`run_limits`: the verdict says its
+    :meth:`~jik.engine.limits.LimitsReport.sentence`); empty for a robot without limits."""
+    reports = {algorithm: run_limits(result, algorithm) for algorithm in result.runs}
+    return {a: report for a, report in reports.items() if report is not None}
+
+
 def limits_summary(result) -> dict[str, Any]:
     """Per algorithm, ``{"within": bool, "violation": {...} or None}`` (the REST API's
     ``limits``); empty for a robot without limits."""
-    out = {}
-    for algorithm in result.runs:
-        report = run_limits(result, algorithm)
-        if report is not None:
-            out[algorithm] = report.as_dict()
-    return out
-
-
-def limits_texts(result, names: dict[str, str]) -> list[tuple[str, str, bool]]:
-    """The verdict's sentences on the limits (:meth:`jik.engine.limits.LimitsReport.sentence`):
-    (text, algorithm, within) per algorithm, named by ``names`` (the verdict's names)."""
-    title = state_spec(result.state).title
-    out = []
-    for algorithm in result.runs:
-        report = run_limits(result, algorithm)
-        if report is not None:
-            text = report.sentence(names.get(algorithm, algorithm), title)
-            out.append((text, algorithm, report.within))
-    return out
+    return {a: report.as_dict() for a, report in limits_reports(result).items()}
 
 
 def outside_joints(limits: np.ndarray | None, x) -> np.ndarray:

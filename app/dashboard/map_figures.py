@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from ...engine.functional_report import region_words, report_words
 from .algorithms import COLORS, DASH, LABELS
 from .analysis import vector_note
 from .functionals import state_inert_variables
@@ -138,28 +139,9 @@ def augmenting_title(
     waiting = "E1, E2: not computed (cancelled)" if cancelled else "E1, E2: computing…"
     sub = [] if functionals else [waiting]
     if functionals:
-        values = {k: functionals.get(k) for k in ("E1", "E2")}
-        where = "the plotted box"
-        if functionals.get("design_region"):
-            where = ", ".join(
-                f"{k} ∈ [{lo:.3g}, {hi:.3g}]" for k, (lo, hi) in functionals["region"].items()
-            )
-        if functionals.get("note"):
-            sub.append(functionals["note"])
-        elif all(v is None for v in values.values()):
-            sub.append(f"E1, E2 undefined: h is not defined on all of {where}")
-        else:
-            sub.append(
-                ", ".join(
-                    f"{k} = {v:.4g}"
-                    if v is not None
-                    else f"{k} = ∞ (dh K = 0 inside)"
-                    if functionals.get(f"{k}_divergent")
-                    else f"{k} undefined"
-                    for k, v in values.items()
-                )
-                + f" on {where}"
-            )
+        design = functionals.get("design_region")
+        where = region_words(functionals["region"]) if design else "the plotted box"
+        sub.append(report_words(functionals, where))
     # The slice's other variables, unless neither h nor J depends on them (Manipulator 2's x1
     # for h(x2, x3)): their values would say nothing, and the title would change with them.
     inert = state_inert_variables(result.state)
@@ -341,7 +323,8 @@ def _bars(maps: list[dict], key: str, names: list[str]) -> dict:
 
 def single_joint_spec(sens: dict, aug: str, log: dict) -> dict:
     """E2 (18) of the map (outlined) beside E2 of h = s x_j for each joint, on a log scale: a
-    map over many joints, its E2 by a Sobol rule (:mod:`jik.app.dashboard.arm_e2`)."""
+    map over many joints, its E2 by a Sobol rule
+    (:func:`jik.engine.functional_report.functionals_report`)."""
     maps = sens["maps"]
     values = [m["E2"] for m in maps]
     data = [_bars(maps, "E2", [m["name"] for m in maps])]

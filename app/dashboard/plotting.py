@@ -10,6 +10,8 @@ import math
 
 import numpy as np
 
+from ...engine.reproductions.table1 import corner_letters
+from ...engine.units import norm_unit as norm_unit  # (the panels' and the atlas's)
 from ...engine.units import robot_units
 from .robots import state_kinematics
 from .runs import DashboardResult
@@ -70,15 +72,6 @@ def label(name: str, unit: str) -> str:
     return f"{name} [{unit}]" if unit else name
 
 
-def norm_unit(unit_names) -> str:
-    """The unit of a Euclidean norm of coordinates in ``unit_names``: one unit, or the units
-    it mixes said so ("1": dimensionless)."""
-    names = [("dimensionless" if u == "1" else u) for u in dict.fromkeys(unit_names) if u]
-    if len(names) <= 1:
-        return f"[{names[0]}]" if names else ""
-    return f"[{' and '.join(names)} mixed]"
-
-
 def is_unicycle(result: DashboardResult) -> bool:
     """Results with platform paths (the unicycle) get the platform figures."""
     return any(r.platform is not None for r in result.runs.values())
@@ -92,22 +85,11 @@ def theta_axis(result: DashboardResult) -> dict:
     return dict(title=title, range=nice_range(theta, from_zero=True))
 
 
-def leg_names(n: int) -> list[str]:
-    return [chr(ord("A") + i) if i < 26 else f"P{i + 1}" for i in range(n)]
-
-
 def corner_names(result: DashboardResult) -> list[str]:
-    """The letters of the task's corners (its targets, in order), as Table 1 names its rows: a
-    closed path that ends where it starts, at k(x0), has its start as A (Manipulator 2: A =
-    k(x0) = (0, 1), then B = (1, 1), C, D, and A again); any other task letters its targets
-    from A."""
-    targets = np.asarray(result.targets, dtype=float)
-    n = len(targets)
+    """The letters of the task's corners
+    (:func:`jik.engine.reproductions.table1.corner_letters`)."""
     start = next(iter(result.runs.values())).y[0]
-    if result.state.task == "path" and n > 1 and np.allclose(targets[-1], start, atol=1e-6):
-        names = leg_names(n)
-        return names[1:] + names[:1]
-    return leg_names(n)
+    return corner_letters(result.targets, start, result.state.task == "path")
 
 
 def trace(kind: str, **props) -> dict:

@@ -49,15 +49,9 @@ def _find(state: DashboardState) -> MapSingularities | None:
 
 
 def singular_sentence(state: DashboardState) -> str | None:
-    """The warning the verdict shows when h is singular in the design region, saying where."""
+    """The warning the verdict shows when h is singular in the design region, saying where
+    (:meth:`jik.engine.map_singularities.MapSingularities.warning`)."""
     found = singular_points(state)
-    if found is None:
-        return None
-    box = ", ".join(f"{k} ∈ [{lo:.3g}, {hi:.3g}]" for k, (lo, hi) in found.region.items())
-    params = ", ".join(f"{k} = {v:.3g}" for k, v in state.augmentation_parameters.items())
     return (
-        f"Warning: the augmenting map {state.augmentation}"
-        + (f" ({params})" if params else "")
-        + f" is singular in the design region {box}: {found}. E1 and E2 there are not a "
-        "measure of fit, and the extended Jacobian is undefined where a run crosses it."
+        None if found is None else found.warning(state.augmentation, state.augmentation_parameters)
     )

@@ -13,14 +13,14 @@ from __future__ import annotations
 import numpy as np
 
 from ...engine.reproductions.table1 import (
-    ERRATUM,
     PRINTED,
-    ROWS_NOTE,
     cell,
     differing,
     is_experiment,
+    not_table1,
     row_labels,
 )
+from ...engine.reproductions.table1 import notes as table1_notes
 from .algorithms import STYLES
 from .plotting import corner_names, figure, trace
 from .runs import DashboardResult
@@ -92,7 +92,6 @@ def table1_spec(result: DashboardResult) -> dict:
     rows = max(len(e) for e in ends.values())
     table = _Table("row", row_labels(rows))
     differs: list[list] = []
-    counts = {}
     for a in PAPER:
         printed = np.asarray(PRINTED[a], dtype=float)
         mask = differing(a, ends[a])
@@ -100,57 +99,14 @@ def table1_spec(result: DashboardResult) -> dict:
         differs += [
             [first + int(k), int(r), cell(printed[r, k], 0)] for k, r in np.argwhere(mask.T)
         ]
-        counts[a] = int(mask.sum())
         table.add(names, ends[a], FILLS[a], f"{SHORT[a]} {{}} (jik)")
         table.add(names, printed, FILLS["printed"], f"{SHORT[a]} {{}} (printed)")
     others = [a for a in result.runs if a not in PAPER]
     for a in others:  # the other chosen algorithms: jik's columns only (the paper has none)
         table.add(names, ends[a], FILLS[a], f"{SHORT[a]} {{}} (jik)")
-    notes = [
-        f"Beside each of jik's columns, the paper's printed column (continuous algorithm (7), "
-        f"one cycle). Highlighted: jik's cells that differ from the print in the fourth decimal "
-        f"(pseudoinverse: {counts['pseudoinverse']} of 15, extended Jacobian: "
-        f"{counts['extended']} of 15).",
-        ROWS_NOTE,
-    ]
-    if others:
-        shown = ", ".join(SHORT[a] for a in others)
-        notes.append(
-            f"Then jik's columns of {shown}: the paper's Table 1 prints the "
-            "pseudoinverse and the extended Jacobian only."
-        )
+    shown = ", ".join(SHORT[a] for a in others)
     state = result.state
-    if state.augmentation == "paper_cubic":
-        notes.append(ERRATUM)
-    else:
-        notes.append(
-            f"The extended columns here use the augmenting map {state.augmentation}; "
-            "the paper's were computed with the cubic (38) (choose paper_cubic to "
-            "compare)."
-        )
-    if state.mode == "discrete":
-        gap = max(
-            (
-                float(np.max(np.abs(ends[a][: len(PRINTED[a])] - np.asarray(PRINTED[a]))))
-                for a in PAPER
-                if len(ends[a]) >= len(PRINTED[a])
-            ),
-            default=None,
-        )
-        where = (
-            "stopped before the end of the first cycle"
-            if gap is None
-            else f"ends its legs elsewhere (up to {gap:.3g} from the printed values)"
-        )
-        notes.append(
-            f"Discrete mode changes the numbers: the paper's Table 1 is the continuous "
-            f"algorithm (7); the iteration with step γ = {state.gamma:.3g} {where}. Choose "
-            "mode = continuous to compare with the print."
-        )
-    else:
-        notes.append(
-            "Continuous mode, as in the paper: the columns do not depend on γ (it only rescales θ)."
-        )
+    notes = table1_notes(ends, state.augmentation, state.mode, state.gamma, shown)
     return _spec(TABLE1_TITLE, table, notes, differs)
 
 
@@ -167,18 +123,9 @@ def leg_ends_spec(result: DashboardResult) -> dict:
     for a in result.runs:
         table.add(result.variable_names, _ends(result, a), FILLS[a], f"{SHORT[a]} {{}}")
     notes = []
-    paper = " and ".join(STYLES[a].short for a in PAPER)
-    if _on_experiment(result.state):
-        notes.append(
-            f"Not Table 1: the paper's Table 1 compares {paper} on this experiment; choose both "
-            "to compare with the printed values."
-        )
-    elif result.state.robot == "manipulator2":
-        notes.append(
-            "Not Table 1: the paper's Table 1 is Manipulator 2 (l = 1) from x0 = "
-            "(0, 0, π/2) on the closed path (1, 1), (1, 2), (0, 2), (0, 1); set those "
-            "to compare with the printed values."
-        )
+    on = _on_experiment(result.state)
+    if on or result.state.robot == "manipulator2":
+        notes.append(not_table1(on, " and ".join(STYLES[a].short for a in PAPER)))
     return _spec(LEG_ENDS_TITLE, table, notes, [])
 
 

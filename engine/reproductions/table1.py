@@ -61,6 +61,19 @@ def row_labels(n: int) -> list[str]:
     return [f"{'ABCD'[k % 4]}  x{k}f" if k else "A  x0" for k in range(n)]
 
 
+def corner_letters(targets, start, closed: bool) -> list[str]:
+    """The letters of a task's corners (its ``targets`` (L, r), in order), as Table 1 names its
+    rows: a ``closed`` path that ends where it starts, at k(x0) = ``start`` (r,), has its start
+    as A (Manipulator 2: A = k(x0) = (0, 1), then B = (1, 1), C, D, and A again); any other
+    task letters its targets from A (past Z: P27, P28, ...)."""
+    targets = np.asarray(targets, dtype=float)
+    n = len(targets)
+    names = [chr(ord("A") + i) if i < 26 else f"P{i + 1}" for i in range(n)]
+    if closed and n > 1 and np.allclose(targets[-1], start, atol=1e-6):
+        return names[1:] + names[:1]
+    return names
+
+
 def is_experiment(length: float, x0, path) -> bool:
     """Whether Manipulator 2 with arm length l = ``length`` from ``x0`` on ``path`` is Table 1's
     run: l = 1, x0 = :data:`X0`, the closed path :data:`PATH`."""
@@ -142,3 +155,73 @@ def format_text(result: dict) -> str:
     out.append("(0,2), (0,1). The extended column of the paper is not reproduced by (38): see")
     out.append("docs/paper-errata.md.")
     return "\n".join(out)
+
+
+def not_table1(on_experiment: bool, algorithms: str) -> str:
+    """Why a table of Manipulator 2's leg ends is not Table 1: on its experiment
+    (``on_experiment``) without both of its algorithms (named ``algorithms``), else not on it."""
+    if on_experiment:
+        return (
+            f"Not Table 1: the paper's Table 1 compares {algorithms} on this experiment; choose "
+            "both to compare with the printed values."
+        )
+    return (
+        "Not Table 1: the paper's Table 1 is Manipulator 2 (l = 1) from x0 = "
+        "(0, 0, π/2) on the closed path (1, 1), (1, 2), (0, 2), (0, 1); set those "
+        "to compare with the printed values."
+    )
+
+
+def notes(rows: dict, augmentation: str, mode: str, gamma: float, others: str = "") -> list[str]:
+    """What a table of jik's leg ends beside the printed Table 1 needs said under it: how many
+    cells differ from the print in the fourth decimal (:func:`differing`) of the ``rows`` of
+    each printed algorithm (x0 and the leg ends, (n, 3)), the printed labels
+    (:data:`ROWS_NOTE`), that the columns of the ``others`` algorithms (their names, if any)
+    have no printed counterpart, the erratum of the cubic (38) (:data:`ERRATUM`) or which map
+    ``augmentation`` was used instead, and whether the ``mode`` (with step ``gamma``) is the
+    paper's continuous algorithm (7)."""
+    counts = {a: int(differing(a, rows[a]).sum()) for a in PRINTED}
+    out = [
+        f"Beside each of jik's columns, the paper's printed column (continuous algorithm (7), "
+        f"one cycle). Highlighted: jik's cells that differ from the print in the fourth decimal "
+        f"(pseudoinverse: {counts['pseudoinverse']} of 15, extended Jacobian: "
+        f"{counts['extended']} of 15).",
+        ROWS_NOTE,
+    ]
+    if others:
+        out.append(
+            f"Then jik's columns of {others}: the paper's Table 1 prints the "
+            "pseudoinverse and the extended Jacobian only."
+        )
+    if augmentation == "paper_cubic":
+        out.append(ERRATUM)
+    else:
+        out.append(
+            f"The extended columns here use the augmenting map {augmentation}; "
+            "the paper's were computed with the cubic (38) (choose paper_cubic to "
+            "compare)."
+        )
+    if mode != "discrete":
+        out.append(
+            "Continuous mode, as in the paper: the columns do not depend on γ (it only rescales θ)."
+        )
+        return out
+    gap = max(
+        (
+            float(np.max(np.abs(np.asarray(rows[a])[: len(p)] - np.asarray(p))))
+            for a, p in PRINTED.items()
+            if len(rows[a]) >= len(p)
+        ),
+        default=None,
+    )
+    where = (
+        "stopped before the end of the first cycle"
+        if gap is None
+        else f"ends its legs elsewhere (up to {gap:.3g} from the printed values)"
+    )
+    out.append(
+        f"Discrete mode changes the numbers: the paper's Table 1 is the continuous "
+        f"algorithm (7); the iteration with step γ = {gamma:.3g} {where}. Choose "
+        "mode = continuous to compare with the print."
+    )
+    return out

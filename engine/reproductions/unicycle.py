@@ -271,3 +271,54 @@ def format_text(result: dict) -> str:
             )
         out.append("")
     return "\n".join(out)
+
+
+#: The figures of the paper's pseudoinverse and extended runs from each start of sec. 6.2.
+FIGURES = {"A": "Figs. 11 (J^P#) and 12 (J^E#)", "B": "Figs. 13 (J^P#) and 14 (J^E#)"}
+
+
+def paper_start(q0) -> str | None:
+    """The start of sec. 6.2 ("A", "B") whose pose is ``q0`` (3,), None if none."""
+    q0 = np.asarray(q0, dtype=float)
+    for name, pose in STARTS.items():
+        if q0.shape == (3,) and np.allclose(q0, pose, atol=1e-9):
+            return name
+    return None
+
+
+def undefined_why(q0, a: float, lam10: tuple[float, float], step: str, discrete: bool) -> list[str]:
+    """Why the characteristics map (29) became undefined along an extended run: the ``step``
+    ("iteration 3") took lambda10 from ``lam10[0]`` to ``lam10[1]``, out of the foliation's
+    domain when across 0 (lambda10 of the sign of the reference leaf's ``a``, omega being
+    undefined on lambda10 = 0), and the characteristic (28) from there runs into a zero of the
+    kernel component that normalises omega; for a start ``q0`` of the paper's (sec. 6.2), that
+    this is its Figs. 11-14's run and docs/paper-errata.md's finding (``discrete``: that the
+    continuous run from there converges)."""
+    before, after = lam10
+    moved = f"{step} took lambda10 from {before:.3g} to {after:.3g}"
+    if after * a <= 0:
+        moved += (
+            f", across lambda10 = 0 and out of the domain of the map's foliation "
+            f"(lambda10 of the sign of a = {a:.3g}: ω is undefined on lambda10 = 0)"
+        )
+    out = [
+        f"Why: h is defined by the characteristic (28) from x to the reference leaf "
+        f"lambda10 = a (eq. (29)); {moved}. From there the characteristic runs into a zero of the "
+        "kernel component that normalises ω (J11 J24 − J14 J21 = 0), where ω and dz/ds "
+        "blow up, so h, and with it the extended Jacobian inverse (47), is undefined."
+    ]
+    paper = paper_start(q0)
+    if paper is not None:
+        note = (
+            f"This is the paper's run from q0 = {paper} (sec. 6.2, {FIGURES[paper]}). Where the "
+            "paper plots the extended run to its end, jik finds that it leaves the domain "
+            'of h: docs/paper-errata.md (Unicycle, "Section 6.2, what jik finds") '
+            "explains it, with a command that shows it."
+        )
+        if discrete:
+            note += (
+                " In mode continuous h is conserved exactly and the extended run from "
+                f"q0 = {paper} converges."
+            )
+        out.append(note)
+    return out

@@ -444,8 +444,9 @@ def test_cspace_draws_each_corners_self_motion_manifold_through_its_leg_end(path
     the extended run's leg end there), a point every SPACING box diagonals, inside the box
     widened by half (up to the drawing's tolerance: the ends are where the curve leaves it)."""
     from jik.app.dashboard.analysis import runs_box
-    from jik.app.dashboard.cspace import SPACING, cspace_spec
+    from jik.app.dashboard.cspace import cspace_spec
     from jik.app.dashboard.robots import state_kinematics
+    from jik.engine.self_motion import SPACING
 
     kin = state_kinematics(path_result.state)
     curves = [t for t in cspace_spec(path_result)["data"] if t.get("legendgroup") == "fibres"]
@@ -509,7 +510,7 @@ def test_the_configuration_space_of_a_robot_undefined_on_its_fibres_is_drawn(mon
     from scipy.integrate import DOP853
 
     import jik.engine.self_motion as self_motion
-    from jik.app.dashboard.cspace import MAX_TRACE_STEPS
+    from jik.engine.self_motion import DRAW_STEPS as MAX_TRACE_STEPS
 
     class Guard(DOP853):
         steps = 0

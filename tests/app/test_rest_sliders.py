@@ -13,7 +13,7 @@ import pytest
 
 from jik.app.dashboard.controls import control_values, controls
 from jik.app.dashboard.model import default_state, updated_state
-from jik.app.dashboard.verdict_algorithms import _posture
+from jik.app.dashboard.verdict import _posture
 from jik.engine.exceptions import InvalidInputError
 
 REST = "algorithm_parameters.rest"

@@ -6,7 +6,7 @@ import pytest
 
 from jik.engine.augmentations import PaperCubic
 from jik.engine.exceptions import JikError
-from jik.engine.map_grid import grid_axes, map_grid, varying_most
+from jik.engine.map_grid import axes_along, grid_axes, map_grid, slice_values, varying_most
 
 NAMES = ("x1", "x2", "x3")
 BOX = {"x1": (-1.0, 1.0), "x2": (0.4, 2.0), "x3": (0.4, 2.0)}
@@ -85,3 +85,37 @@ def test_a_grid_prints_on_one_line_as_what_it_holds():
 
 def test_a_box_of_one_variable_has_no_grid():
     assert map_grid(PaperCubic(), NAMES, {"x2": (0.4, 2.0)}) is None
+
+
+def test_a_slice_holds_h_at_its_points_and_its_axes_follow_the_runs():
+    """The cubic (38) on a slice over (x2, x3) at x1 = 0.3: H[b, a] is h at x2 = u[a],
+    x3 = v[b]; along configurations that move x2 and x3, those are the axes; a map that
+    solves per point is evaluated in batches, each reported."""
+    h = PaperCubic()
+    u, v, H = slice_values(h, [0.3, 0.0, 0.0], (1, 2), ((-1.0, 1.0), (0.5, 2.0)), 5)
+    np.testing.assert_allclose(u, np.linspace(-1, 1, 5))
+    np.testing.assert_allclose(H[3, 1], h.value(np.array([0.3, u[1], v[3]])))
+    x = np.column_stack([np.zeros(9), np.linspace(-1, 1, 9), np.linspace(0.5, 2, 9)])
+    assert axes_along(h, x) == (1, 2)
+
+    class Batched(PaperCubic):
+        solves_per_point = True
+
+        def evaluate_batches(self, x, batch, progress):
+            for k in range(0, len(x), batch):
+                progress.advance(k // batch + 1, -(-len(x) // batch))
+            return self.value(x), self.gradient(x), np.zeros(len(x), bool)
+
+    told = []
+    slow = slice_values(
+        Batched(),
+        [0.3, 0.0, 0.0],
+        (1, 2),
+        ((-1.0, 1.0), (0.5, 2.0)),
+        5,
+        10,
+        lambda done, total: told.append((done, total)),
+    )
+    np.testing.assert_allclose(slow[2], H)
+    assert told == [(1, 3), (2, 3), (3, 3)]
+    assert axes_along(Batched(), x, 4, lambda *_: None) == (1, 2)

@@ -42,6 +42,17 @@ def test_e1_optimal_map_with_a_vanishing_g_is_singular_where_g_vanishes(C2):
     assert found.region == MANIPULATOR1_REGION and found.nodes == 25
 
 
+def test_the_warning_names_the_map_its_parameters_the_region_and_where():
+    found = map_singularities(Manipulator1(), E1Optimal(1.0, -1.0), MANIPULATOR1_REGION)
+    said = found.warning("e1_optimal", {"C1": 1.0, "C2": -1.0})
+    box = ", ".join(f"{k} ∈ [{lo:.3g}, {hi:.3g}]" for k, (lo, hi) in MANIPULATOR1_REGION.items())
+    assert said.startswith(
+        f"Warning: the augmenting map e1_optimal (C1 = 1, C2 = -1) is singular "
+        f"in the design region {box}: {found}. E1 and E2 there are not"
+    )
+    assert "(C" not in found.warning("h", {})
+
+
 def test_g_vanishing_on_a_face_makes_h_undefined_there():
     """C2 = 0: g(0) = 0, so h and dh are not finite on the face x1 = 0 (1 of 25 lines)."""
     found = map_singularities(Manipulator1(), E1Optimal(1.0, 0.0), MANIPULATOR1_REGION)

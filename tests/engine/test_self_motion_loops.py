@@ -15,7 +15,14 @@ from jik.engine.exceptions import InvalidInputError
 from jik.engine.inverses import Pseudoinverse
 from jik.engine.kinematics import Kinematics, Manipulator2
 from jik.engine.planar_chain import PlanarChain
-from jik.engine.self_motion import MAX_ARC, MAX_STEPS, periodic_joints, trace
+from jik.engine.self_motion import (
+    MAX_ARC,
+    MAX_STEPS,
+    SPACING,
+    drawn_curves,
+    periodic_joints,
+    trace,
+)
 
 ARM4 = Path(__file__).parents[1] / "data" / "arm4.urdf"
 #: A planar 3R arm's link lengths, and a base configuration whose fibre of the end point is a
@@ -380,3 +387,19 @@ def test_trace_is_bounded_by_default_and_the_bound_holds_a_smooth_curve_of_the_l
 def test_max_steps_must_be_a_positive_integer(max_steps):
     with pytest.raises(InvalidInputError, match="max_steps"):
         trace(Circles(), [1.0, 0.0], (-1.0, 1.0), max_steps=max_steps)
+
+
+def test_drawn_curves_lie_on_their_fibres_a_point_every_spacing_within_the_widened_box():
+    """Manipulator 2's fibres through two seeds, drawn in the box [lo, hi]: every point on
+    k(x) = k(seed), a point every SPACING box diagonals, inside the box widened by half."""
+    kin = Manipulator2()
+    seeds = np.array([[0.0, 0.0, math.pi / 2], [0.3, 0.5, 1.0]])
+    lo, hi = np.array([-1.0, -1.0, 0.0]), np.array([1.0, 1.0, 3.0])
+    diagonal = float(np.linalg.norm(hi - lo))
+    for seed, x in zip(seeds, drawn_curves(kin, seeds, lo, hi), strict=True):
+        assert len(x) > 20
+        np.testing.assert_allclose(
+            kin.forward(x), np.broadcast_to(kin.forward(seed), (len(x), 2)), atol=1e-9
+        )
+        assert np.all(np.linalg.norm(np.diff(x, axis=0), axis=1) <= SPACING * diagonal * 1.001)
+        assert np.all(x >= lo - 0.5 * (hi - lo) - 1e-5) and np.all(x <= hi + 0.5 * (hi - lo) + 1e-5)

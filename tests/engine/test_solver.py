@@ -11,8 +11,12 @@ from jik.engine.reproductions.table1 import (
     ERRATUM,
     PATH,
     PRINTED,
+    ROWS_NOTE,
+    corner_letters,
     differing,
     is_experiment,
+    not_table1,
+    notes,
     row_labels,
 )
 from jik.engine.reproductions.table1 import run as table1
@@ -46,6 +50,42 @@ def test_table1_cells_that_differ_from_the_print_in_the_fourth_decimal():
     with pytest.raises(InvalidInputError, match="algorithm must be one of") as info:
         differing("posture", result["pseudoinverse"])
     assert info.value.field == "algorithm"
+
+
+def test_table1_notes_count_the_differing_cells_and_say_what_the_settings_change():
+    """Under jik's columns beside the print: the count of differing cells (the cubic (38)'s
+    six), the labels, the other algorithms' columns, the erratum or the map used instead, and
+    how far a discrete run (or one that stopped before a cycle) ends from the print."""
+    result = table1()
+    said = notes(result, "paper_cubic", "continuous", 1.0, others="DLS")
+    assert "(pseudoinverse: 0 of 15, extended Jacobian: 6 of 15)" in said[0]
+    assert said[1:4] == [ROWS_NOTE, said[2], ERRATUM] and said[2].startswith(
+        "Then jik's columns of DLS"
+    )
+    assert said[-1].startswith("Continuous mode, as in the paper")
+    off = {a: np.asarray(PRINTED[a]) + 0.01 for a in PRINTED}
+    said = notes(off, "e2_synthesized", "discrete", 0.5)
+    assert "augmenting map e2_synthesized;" in said[2]
+    assert "step γ = 0.5 ends its legs elsewhere (up to 0.01 from the printed values)" in said[-1]
+    short = {a: np.asarray(PRINTED[a])[:2] for a in PRINTED}
+    assert "stopped before the end of the first cycle" in notes(short, "h", "discrete", 1.0)[-1]
+
+
+def test_a_table_of_leg_ends_says_why_it_is_not_table1():
+    assert not_table1(True, "J^P# and J^E#") == (
+        "Not Table 1: the paper's Table 1 compares J^P# and J^E# on this experiment; choose "
+        "both to compare with the printed values."
+    )
+    assert "from x0 = (0, 0, π/2) on the closed path (1, 1), (1, 2)" in not_table1(False, "")
+
+
+def test_corner_letters_start_at_k_x0_on_a_closed_path_as_table1_does():
+    """Table 1's path (1, 1), (1, 2), (0, 2), (0, 1) from k(x0) = (0, 1): A is the start, so
+    the corners are B, C, D, A; a path that does not close there, or one target, from A."""
+    assert corner_letters(PATH, (0.0, 1.0), closed=True) == ["B", "C", "D", "A"]
+    assert corner_letters(PATH, (0.0, 1.0), closed=False) == ["A", "B", "C", "D"]
+    assert corner_letters(PATH[:3], (0.0, 1.0), closed=True) == ["A", "B", "C"]
+    assert corner_letters(np.zeros((28, 2)), (5.0, 5.0), True)[25:] == ["Z", "P27", "P28"]
 
 
 def test_table1_erratum_states_what_the_cubic_38_gives():

@@ -10,7 +10,8 @@ import pytest
 
 import jik.engine as jik
 from jik.engine.arms import ARMS
-from jik.engine.units import robot_units
+from jik.engine.kinematics import Manipulator1
+from jik.engine.units import norm_unit, robot_units
 
 ARM4 = Path(__file__).resolve().parents[1] / "data" / "arm4.urdf"
 
@@ -136,3 +137,20 @@ def test_the_columns_name_each_coordinate_as_the_engines_tables_do():
     inverse = m1.inverse("pseudoinverse")
     trajectory = jik.solve(inverse, (0.5, 0.25, 1.0), (0.5, 0.5), record=True).trajectory
     assert list(trajectory.columns())[1:-1] == list(columns)
+
+
+def test_a_norm_has_one_unit_or_says_which_it_mixes():
+    assert norm_unit(("rad", "rad")) == "[rad]"
+    assert norm_unit(("m", "m", "1")) == "[m and dimensionless mixed]"
+    assert norm_unit(("", "")) == ""
+
+
+def test_a_trajectory_s_columns_have_their_units_spelled_out():
+    """Manipulator 1: theta, x_1..x_3 (m, m, dimensionless), y_1, y_2 in m, the error a norm
+    of y in m, h in the map's unit; in discrete mode theta counts iterations."""
+    units = robot_units(Manipulator1())
+    said = units.trajectory_units("continuous")
+    assert list(said) == ["theta", "x_1", "x_2", "x_3", "y_1", "y_2", "error", "h"]
+    assert said["x_3"] == "dimensionless" and said["y_1"] == "m" and said["error"] == "m"
+    assert said["theta"] == "dimensionless"
+    assert units.trajectory_units("discrete")["theta"] == "iterations"

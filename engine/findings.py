@@ -1,0 +1,254 @@
+"""What a run of the repeatability test found, and why, in sentences a reader can take as they
+are (the dashboard's verdict, a notebook's summary).
+
+Repeatability (section 2 of the paper): a closed task path driven from x0 gives a closed joint
+path, ``x`` back at ``x0`` after each cycle. The extended Jacobian inverse (11) is repeatable
+because its runs stay on the level set h(x) = h(x0) (eq. (12)); the continuous algorithm (7)
+keeps h exactly, the discrete iteration ``x <- x - gamma J# e`` only to first order per step
+(each step moves along the level set's tangent), and for gamma near 2 the iteration is at the
+edge of convergence (the task error is multiplied by about ``1 - gamma`` per step).
+
+Beside the paper's two inverses: how far the posture inverse's null-space pull (Liegeois 1977)
+toward its rest x_rest (named with its numbers) brings the drift of the pseudoinverse (8) down,
+and that it does not reach the extended Jacobian's repeatability (11); the task error damped
+least squares is left with where it damps (it is not a right inverse, J J# != I); whether the
+weighted least-norm inverse (Chan and Dubey 1995) kept every joint within its limits.
+
+Each function returns ``(text, role)`` pairs, ``role`` one of "finding" (what the run did),
+"why", "note" or "failure".
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .augmentations import H_CONSERVED, h_change
+from .repeatability import REPEATABLE_DRIFT, repeatable
+
+#: In discrete mode, a gamma at or above this is "near 2" (the iteration's stability limit).
+GAMMA_NEAR_TWO = 1.5
+
+
+def g(v: float) -> str:
+    """A number in 3 significant digits."""
+    return f"{v:.3g}"
+
+
+def _cycles(n: int) -> str:
+    return f"{n} cycle{'s' if n > 1 else ''}"
+
+
+def drift_sentence(name: str, drift, unit: str) -> str:
+    """Whether the run named ``name`` was repeatable, from its ``drift`` ||x - x0|| after each
+    cycle (cycles,) in ``unit``: the largest drift if so (below
+    :data:`~jik.engine.repeatability.REPEATABLE_DRIFT`), else the last and how it grew."""
+    d = np.asarray(drift, dtype=float)
+    n = len(d)
+    if repeatable(d):
+        return (
+            f"{name}: repeatable. After each of {_cycles(n)} the joints came back "
+            f"to x0 within {g(float(d.max()))} {unit} (‖x − x0‖ below {g(REPEATABLE_DRIFT)})."
+        )
+    trend = ""
+    if n > 1:
+        grows = d[-1] > d[0] * 1.05
+        trend = (
+            f", growing from {g(float(d[0]))} after cycle 1"
+            if grows
+            else f" (after cycle 1: {g(float(d[0]))})"
+        )
+    return (
+        f"{name}: not repeatable. After {_cycles(n)} the joints end "
+        f"‖x − x0‖ = {g(float(d[-1]))} {unit} away from x0{trend}."
+    )
+
+
+def run_findings(
+    name: str, drift, success: bool, message: str, closed: bool, unit: str
+) -> list[tuple[str, str]]:
+    """What the run named ``name`` did: on a closed path (``closed``) with completed cycles
+    (``drift`` (cycles,)) its :func:`drift_sentence`, else the solver's ``message`` when it
+    succeeded; and, when it did not, where it stopped ("failure")."""
+    n = len(drift)
+    out = []
+    if closed and n:
+        out.append((drift_sentence(name, drift, unit), "finding"))
+    elif success:
+        out.append((f"{name}: {message}.", "finding"))
+    if not success:
+        done = f" (after {n} completed cycle{'s' if n > 1 else ''})" if closed and n else ""
+        out.append((f"{name} stopped{done}: {message}", "failure"))
+    return out
+
+
+def pseudoinverse_why(drift) -> str | None:
+    """Why the pseudoinverse (8) drifted, or that it happened to come back, from its ``drift``
+    after each cycle; None without a completed cycle."""
+    if repeatable(drift) is False:
+        return (
+            "Why: J^P# picks the minimum-norm joint velocity, which has no memory of the start "
+            "(it keeps nothing like h constant), so a closed task path need not close in the "
+            "joints."
+        )
+    if repeatable(drift):
+        return (
+            "The pseudoinverse happens to come back on this path: its joint flow closes here, "
+            "which it does not in general."
+        )
+    return None
+
+
+def extended_why(
+    h, drift, success: bool, closed: bool, mode: str, gamma: float
+) -> list[tuple[str, str]]:
+    """Why the extended Jacobian inverse (11) was repeatable or not, from h along its run
+    (:func:`~jik.engine.augmentations.h_change` against
+    :data:`~jik.engine.augmentations.H_CONSERVED`, eq. (12)) and its ``drift`` on a ``closed``
+    path; in discrete ``mode`` that the iteration keeps h only approximately. None for a run
+    without h, or stopped before it moved."""
+    dh = h_change(h)
+    if dh is None or (not success and dh == 0):
+        return []
+    closed = closed and len(drift) > 0
+    kept = dh < H_CONSERVED
+    if kept:
+        tail = (
+            ", so each task point has one configuration on that level set, and the closed "
+            "task path gave a closed joint path."
+            if closed and repeatable(drift)
+            else "."
+        )
+        text = (
+            f"Why: J^E# adds the equation h(x) = h(x0) (eq. (12)); h changed by only {g(dh)} "
+            f"along its run{tail}"
+        )
+    else:
+        lost = (
+            " A closed task path gives a closed joint path only while h stays at h(x0): "
+            "here it did not, so the joints did not come back."
+            if closed and not repeatable(drift)
+            else ""
+        )
+        text = f"h was not conserved: it changed by {g(dh)} along the extended Jacobian's run."
+        text += lost
+    out = [(text, "why")]
+    if mode == "discrete" and not kept:
+        out.append(
+            (
+                "The discrete algorithm x ← x − γ J^E# e keeps h only approximately: each step "
+                "moves along the tangent of the level set h = h(x0), not on it, so h changes by "
+                "an amount that grows with γ (the continuous algorithm (7) keeps h exactly).",
+                "note",
+            )
+        )
+    return out
+
+
+def gamma_note(mode: str, gamma: float) -> str | None:
+    """In discrete mode, that a ``gamma`` of at least :data:`GAMMA_NEAR_TWO` is near the
+    iteration's limit 2 (the task error is multiplied by about 1 - gamma per step)."""
+    if mode != "discrete" or gamma < GAMMA_NEAR_TWO:
+        return None
+    return (
+        f"γ = {g(gamma)} is near 2, the limit of the discrete iteration: the task "
+        f"error is multiplied by about 1 − γ = {g(1 - gamma)} per step, so the "
+        "iterates overshoot back and forth and h is far from conserved; at γ ≥ 2 the "
+        "iteration diverges."
+    )
+
+
+def leg_end_errors(error, leg) -> np.ndarray:
+    """The task error at the last point of each leg of a run: ``error`` (m,) and ``leg`` (m,)
+    the leg of every point."""
+    leg = np.asarray(leg)
+    if not len(leg):
+        return np.zeros(0)
+    last = np.r_[np.flatnonzero(np.diff(leg)), len(leg) - 1]
+    return np.asarray(error, dtype=float)[last]
+
+
+def posture_findings(
+    name: str, gain: float, rest: str, drift, unit: str, pinv_drift=None, ext_drift=None
+) -> list[tuple[str, str]]:
+    """How far the posture inverse's null-space pull (Liegeois 1977) toward its rest (``rest``:
+    x_rest in words) at gain ``gain`` brought its ``drift`` after each cycle down against the
+    pseudoinverse's (8) ``pinv_drift``, and that it does not reach the extended Jacobian's
+    (11) repeatability (``ext_drift``); none without a completed cycle."""
+    n = len(drift)
+    if not n:
+        return []
+    d = float(drift[-1])
+    head = f"{name}, gain k = {g(gain)}, {rest}: after {_cycles(n)}"
+    if gain == 0:
+        return [(f"{head} it is the pseudoinverse (k = 0), drift {g(d)} {unit}.", "why")]
+    parts = []
+    if pinv_drift is not None and len(pinv_drift) >= n:
+        dp = float(pinv_drift[n - 1])
+        than = "less than" if d < dp else "not less than"
+        parts.append(f"it drifts {g(d)} {unit}, {than} the pseudoinverse's {g(dp)}")
+    else:
+        parts.append(f"it drifts {g(d)} {unit}")
+    if d >= REPEATABLE_DRIFT:
+        reach = (
+            f"the extended Jacobian's {g(float(ext_drift[n - 1]))}"
+            if ext_drift is not None and len(ext_drift) >= n
+            else "repeatability"
+        )
+        parts.append(
+            f"but does not reach {reach}: the pull toward x_rest moves the joints inside the "
+            "self-motion and slows the drift, yet the end of a cycle does not come back to x0"
+        )
+    else:
+        parts.append("and came back to x0 within round-off on this path")
+    return [(f"{head} " + ", ".join(parts) + ".", "why")]
+
+
+def damped_findings(
+    name: str, damping: float, threshold: float, tol: float, run, pinv=None
+) -> list[tuple[str, str]]:
+    """The task error damped least squares (damping ``damping``, adaptive where sigma_min(J)
+    < ``threshold`` if positive) is left with at the end of its legs, since it is not a right
+    inverse (J J# != I), and how it fared where the pseudoinverse (8) stopped. ``run`` and
+    ``pinv`` carry ``error``, ``leg`` and ``success`` (a run point by point)."""
+    ends = leg_end_errors(run.error, run.leg)
+    if not len(ends):
+        return []
+    worst = int(np.argmax(ends))
+    where = "adaptive, where σ_min(J) < " + g(threshold) if threshold > 0 else "constant"
+    text = (
+        f"{name} (λ = {g(damping)}, {where}): task error at the end of its legs up to "
+        f"{g(float(ends[worst]))} (leg {worst + 1}; tolerance {g(tol)}). Damping "
+        "bounds the joint speed near singularities at the price of tracking (J J# ≠ I)"
+    )
+    if pinv is not None and not pinv.success and run.success:
+        text += "; it went through where the pseudoinverse stopped"
+    elif pinv is not None and not pinv.success and run.error[-1] < pinv.error[-1]:
+        text += (
+            f"; where the pseudoinverse stalled at task error {g(float(pinv.error[-1]))}, "
+            f"it got to {g(float(run.error[-1]))}"
+        )
+    elif not run.success:
+        text += f"; it stopped with task error {g(float(run.error[-1]))}"
+    return [(text + ".", "why")]
+
+
+def weighted_findings(name: str, x, limits, names) -> list[tuple[str, str]]:
+    """Whether the weighted least-norm inverse (Chan and Dubey 1995) kept every joint of its
+    run ``x`` (m, p) within the box ``limits`` (p, 2) it took for limits (a robot without
+    joint limits: its configuration box x_range), and its closest approach, or which left."""
+    lo, hi = limits[:, 0], limits[:, 1]
+    below, above = x < lo, x > hi
+    bounds = "; ".join(f"{names[k]} in [{g(lo[k])}, {g(hi[k])}]" for k in range(len(lo)))
+    bounds += "; the robot has no joint limits: its configuration box x_range"
+    if not (below.any() or above.any()):
+        margin = np.minimum(x - lo, hi - x).min(axis=0)
+        k = int(np.argmin(margin))
+        return [
+            (
+                f"{name}: every joint stayed within its limits ({bounds}); "
+                f"closest: {names[k]}, {g(float(margin[k]))} from a limit.",
+                "why",
+            )
+        ]
+    out = sorted({names[k] for k in np.flatnonzero((below | above).any(axis=0))})
+    return [(f"{name}: left its limits ({bounds}): {', '.join(out)}.", "failure")]

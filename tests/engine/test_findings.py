@@ -1,0 +1,137 @@
+"""A run's findings in sentences (jik.engine.findings) and why the unicycle's map of
+characteristics became undefined (jik.engine.reproductions.unicycle.undefined_why)."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+
+import jik.engine as jik
+from jik.engine.findings import (
+    damped_findings,
+    drift_sentence,
+    gamma_note,
+    leg_end_errors,
+    posture_findings,
+    pseudoinverse_why,
+    weighted_findings,
+)
+from jik.engine.registry import POSE_A, POSE_B
+from jik.engine.reproductions.unicycle import paper_start, undefined_why
+
+
+def _runs():
+    """Manipulator 2 on the paper's closed path, two cycles, with both inverses."""
+    arm = jik.Manipulator2()
+    x0, path = [0, 0, np.pi / 2], [(1, 1), (1, 2), (0, 2)]
+    pinv = jik.repeatability(jik.Pseudoinverse(arm), x0, path, cycles=2)
+    ext = jik.repeatability(jik.ExtendedInverse(arm, jik.PaperCubic()), x0, path, cycles=2)
+    return arm, pinv, ext
+
+
+def test_the_pseudoinverse_drifts_and_the_extended_inverse_comes_back_in_words():
+    """Table 1's finding said by the engine: J^P# not repeatable, with its drift growing;
+    J^E# repeatable within round-off, because h stayed at h(x0) (eq. (12))."""
+    _, pinv, ext = _runs()
+    said = jik.run_findings("J^P#", pinv.drift, True, "", closed=True, unit="[m]")
+    assert said == [(drift_sentence("J^P#", pinv.drift, "[m]"), "finding")]
+    assert said[0][0].startswith("J^P#: not repeatable. After 2 cycles the joints end ‖x − x0‖ =")
+    assert f"growing from {pinv.drift[0]:.3g} after cycle 1" in said[0][0]
+    text = drift_sentence("J^E#", ext.drift, "[m]")
+    assert text.startswith("J^E#: repeatable. After each of 2 cycles the joints came back")
+    assert "(‖x − x0‖ below 1e-06)" in text
+    assert "no memory of the start" in pseudoinverse_why(pinv.drift)
+    assert "happens to come back" in pseudoinverse_why(ext.drift)
+    assert pseudoinverse_why([]) is None
+    h = np.full(20, 0.5) + 1e-12 * np.arange(20)  # (h kept to round-off along the run)
+    why = jik.extended_why(h, ext.drift, True, True, "continuous", 1.0)
+    assert why == [
+        (
+            "Why: J^E# adds the equation h(x) = h(x0) (eq. (12)); h changed by only 1.9e-11 "
+            "along its run, so each task point has one configuration on that level set, and "
+            "the closed task path gave a closed joint path.",
+            "why",
+        )
+    ]
+
+
+def test_a_run_that_lost_h_says_so_and_discrete_mode_says_why():
+    """h changed by 0.1 along a discrete run that did not come back: not conserved, the
+    discrete step keeps h to first order only, and near gamma = 2 a note on the iteration."""
+    h = np.linspace(0.0, 0.1, 5)
+    why = jik.extended_why(h, [0.2, 0.4], True, True, "discrete", 1.8)
+    assert [role for _, role in why] == ["why", "note"]
+    assert why[0][0].startswith("h was not conserved: it changed by 0.1 along")
+    assert "the joints did not come back" in why[0][0]
+    assert "keeps h only approximately" in why[1][0]
+    assert "1 − γ = -0.8 per step" in gamma_note("discrete", 1.8)
+    assert gamma_note("discrete", 1.0) is None and gamma_note("continuous", 1.8) is None
+    assert jik.extended_why(None, [], True, False, "continuous", 1.0) == []
+    assert jik.extended_why(np.zeros(3), [], False, False, "continuous", 1.0) == []  # (stopped)
+
+
+def test_a_failed_run_says_where_it_stopped_after_its_completed_cycles():
+    said = jik.run_findings("J^E#", [1e-15], False, "cycle 2, leg 1: singular", True, "[rad]")
+    assert [role for _, role in said] == ["finding", "failure"]
+    assert said[1][0] == "J^E# stopped (after 1 completed cycle): cycle 2, leg 1: singular"
+    assert jik.run_findings("J^P#", [], True, "converged", False, "") == [
+        ("J^P#: converged.", "finding")
+    ]
+
+
+def test_the_unicycle_runs_of_the_paper_are_named_and_their_undefined_map_explained():
+    """Start B's discrete extended run leaves the domain of the characteristics map: the
+    sentence says which step crossed lambda10 = 0 and that this is Figs. 13-14's run."""
+    assert paper_start(POSE_A) == "A" and paper_start(POSE_B) == "B"
+    assert paper_start((0.0, 0.0, 0.0)) is None and paper_start(()) is None
+    why, note = undefined_why(POSE_B, 1.0, (0.0659, -0.0777), "iteration 3", discrete=True)
+    assert "iteration 3 took lambda10 from 0.0659 to -0.0777, across lambda10 = 0" in why
+    assert "(sec. 6.2, Figs. 13 (J^P#) and 14 (J^E#))" in note
+    assert note.endswith("the extended run from q0 = B converges.")
+    (alone,) = undefined_why((1.0, 2.0, 0.0), 1.0, (0.5, 0.4), "the run's last step", False)
+    assert "the run's last step took lambda10 from 0.5 to 0.4. From there" in alone
+
+
+def test_the_posture_inverse_drifts_less_than_the_pseudoinverse_but_is_not_repeatable():
+    """Its sentence compares its drift after the last cycle with the pseudoinverse's and the
+    extended Jacobian's after as many cycles; gain 0 is the pseudoinverse."""
+    arm, pinv, ext = _runs()
+    x0, path = [0, 0, np.pi / 2], [(1, 1), (1, 2), (0, 2)]
+    post = jik.repeatability(jik.PostureInverse(arm, rest=x0, gain=1.0), x0, path, cycles=2)
+    ((text, role),) = posture_findings(
+        "J^N#", 1.0, "x_rest = x0", post.drift, "[m]", pinv.drift, ext.drift
+    )
+    assert role == "why" and text.startswith("J^N#, gain k = 1, x_rest = x0: after 2 cycles")
+    assert f"less than the pseudoinverse's {pinv.drift[1]:.3g}" in text
+    assert f"but does not reach the extended Jacobian's {ext.drift[1]:.3g}" in text
+    ((zero, _),) = posture_findings("J^N#", 0.0, "x_rest = x0", [0.5], "[m]")
+    assert zero == (
+        "J^N#, gain k = 0, x_rest = x0: after 1 cycle it is the pseudoinverse (k = 0), "
+        "drift 0.5 [m]."
+    )
+    assert posture_findings("J^N#", 1.0, "x_rest = x0", [], "[m]") == []
+
+
+def test_damped_least_squares_says_its_worst_leg_end_and_where_the_pseudoinverse_stalled():
+    run = SimpleNamespace(error=np.array([1.0, 0.2, 0.8, 0.5]), leg=np.array([0, 0, 1, 1]))
+    run.success = False
+    stalled = SimpleNamespace(error=np.array([1.0, 1.22]), success=False)
+    np.testing.assert_allclose(leg_end_errors(run.error, run.leg), [0.2, 0.5])
+    ((text, _),) = damped_findings("DLS", 0.1, 0.05, 1e-10, run, stalled)
+    assert text.startswith("DLS (λ = 0.1, adaptive, where σ_min(J) < 0.05): task error at")
+    assert "up to 0.5 (leg 2; tolerance 1e-10)" in text
+    assert text.endswith("where the pseudoinverse stalled at task error 1.22, it got to 0.5.")
+    run.success = True
+    assert damped_findings("DLS", 0.1, 0.0, 1e-10, run, stalled)[0][0].endswith(
+        "; it went through where the pseudoinverse stopped."
+    )
+
+
+def test_the_weighted_inverse_says_whether_its_joints_stayed_within_the_box():
+    limits = np.array([[-1.0, 1.0], [0.0, 2.0]])
+    inside = np.array([[0.0, 1.0], [0.9, 0.5]])
+    ((text, role),) = weighted_findings("W", inside, limits, ("a", "b"))
+    assert role == "why" and "closest: a, 0.1 from a limit." in text
+    ((text, role),) = weighted_findings("W", inside - 0.6, limits, ("a", "b"))
+    assert role == "failure" and text.endswith(": b.")
