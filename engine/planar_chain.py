@@ -132,6 +132,17 @@ class PlanarChain(Kinematics):
         zero = np.zeros((*steps.shape[:-2], 1, 2))
         return np.concatenate([zero, np.cumsum(steps, axis=-2)], axis=-2)
 
+    def drawn_points(self, x: FloatArray) -> FloatArray:
+        """The chain as a polyline through its links: its :meth:`points`, from its first joint
+        at the base (as :meth:`UrdfChain.drawn_points <jik.engine.urdf.UrdfChain.drawn_points>`
+        draws an arm)."""
+        return self.points(x)
+
+    @property
+    def joint_points(self) -> dict[int, int]:
+        """Which point of :meth:`drawn_points` is each joint variable's joint: joint i at i."""
+        return {i: i for i in range(self.p)}
+
     def forward(self, x: FloatArray) -> FloatArray:
         """k(x): (..., p) -> (..., r)."""
         pts = self.points(x)

@@ -249,6 +249,28 @@ class UrdfChain(Kinematics):
         o, _, T = self.frames(x)
         return np.concatenate([o, T[..., None, :3, 3]], axis=-2)
 
+    @property
+    def base_offset(self) -> bool:
+        """Whether the first joint lies away from the base frame's origin (the Panda's stands
+        0.333 m above it): that fixed offset, which no joint moves, is the arm's first link."""
+        return bool(np.linalg.norm(self.chain[0].origin[:3, 3]) > 1e-9)
+
+    def drawn_points(self, x: FloatArray) -> FloatArray:
+        """The arm as a polyline through its links, base frame: (..., p) -> (..., m, 3): the base
+        frame's origin when the first joint lies away from it (:attr:`base_offset`), then
+        :meth:`points`."""
+        pts = self.points(x)
+        if not self.base_offset:
+            return pts
+        return np.concatenate([np.zeros((*pts.shape[:-2], 1, 3)), pts], axis=-2)
+
+    @property
+    def joint_points(self) -> dict[int, int]:
+        """Which point of :meth:`drawn_points` is each joint variable's joint, by its index in x
+        (the chain's joints in order, fixed ones included)."""
+        first = int(self.base_offset)
+        return {j.index: first + k for k, j in enumerate(self.chain) if j.index >= 0}
+
     def forward(self, x: FloatArray) -> FloatArray:
         """k(x): the task's coordinates of the end link's pose: (..., p) -> (..., r)."""
         R, t = self.compiled.pose(x)

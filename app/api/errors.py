@@ -15,7 +15,7 @@ that is not there is 404, too many atlas jobs 429 with Retry-After. The dashboar
 errors come here too: a refused value (the field it names) is 422, a session that is not there
 404, a full session store 503 with Retry-After, an export with no result of the current state
 409 (its computation failed) or 503 (not yet). A body over the size limit is 413 ``{"detail":
-"request body of ... bytes is larger ..."}`` (:class:`jik.app.api.body_limit.BodyLimit`). The
+"request body of ... bytes is larger ..."}`` (:mod:`jik.app.api.security`). The
 messages of validation errors are written by :mod:`jik.app.api.validation`.
 """
 
@@ -161,8 +161,8 @@ def _error(description: str, schema: str = "ErrorResponse") -> dict:
     return {"description": description, "content": {"application/json": {"schema": ref}}}
 
 
-#: The errors that checks before the routes answer (:mod:`jik.app.api.security`, :class:`BodyLimit`,
-#: the session store), as the OpenAPI document lists them for each operation they apply to.
+#: The errors that checks before the routes answer (:mod:`jik.app.api.security`, the
+#: session store), as the OpenAPI document lists them for each operation they apply to.
 _ANY_OPERATION = {"400": _error("a host name the server does not answer to")}
 _WITH_BODY = {
     "403": _error("a change asked from another origin"),

@@ -15,7 +15,6 @@ from jik import __version__
 
 from ..compute.pool import ComputePool
 from ..compute.settings import Settings
-from .body_limit import BodyLimit
 from .errors import add_error_handlers
 from .fastpath import SolveFastPath
 from .routes import (
@@ -30,24 +29,16 @@ from .routes import (
     solve,
     synthesize,
 )
-from .security import SecurityMiddleware, allowed_hosts_from_env
-
-#: Largest request body accepted (413 beyond): the largest valid request is a few kilobytes.
-MAX_BODY_BYTES = 1 << 20
+from .security import LOOPBACK_HOSTS, SecurityMiddleware
 
 
-def create_app(
-    settings: Settings | None = None,
-    fast_solve: bool | None = None,
-    allowed_hosts: tuple[str, ...] | None = None,
-) -> FastAPI:
-    """The jik REST API. ``settings`` (default: from the environment) sizes the compute pool;
-    ``fast_solve`` serves well-formed /solve requests on a short path (:mod:`jik.app.api.fastpath`;
-    default on, ``JIK_FAST_SOLVE=0`` turns it off); ``allowed_hosts``: the host names it answers
-    to besides the loopback names (default: ``JIK_ALLOWED_HOSTS``, :mod:`jik.app.api.security`)."""
+def create_app(settings: Settings | None = None, allowed_hosts: tuple[str, ...] = ()) -> FastAPI:
+    """The jik REST API. ``settings`` (default: from the environment) sizes the compute pool and
+    says whether well-formed /solve requests take a short path (:mod:`jik.app.api.fastpath`;
+    ``fast_solve``, on unless ``JIK_FAST_SOLVE=0``); the server answers to the loopback names,
+    ``settings.host_names`` (``JIK_ALLOWED_HOSTS``) and ``allowed_hosts``
+    (:mod:`jik.app.api.security`)."""
     settings = settings or Settings()  # (the environment, read here once for the app)
-    if fast_solve is None:
-        fast_solve = settings.fast_solve
     pool = ComputePool(settings)
 
     @asynccontextmanager
@@ -79,10 +70,9 @@ def create_app(
     routes = (health, robots, solve, repeatability, synthesize, kinematics, dashboard, sessions)
     for module in (*routes, atlas, session_atlas):
         app.include_router(module.router)
-    if fast_solve:
+    if settings.fast_solve:
         app.add_middleware(SolveFastPath, pool=pool)
-    app.add_middleware(BodyLimit, limit=MAX_BODY_BYTES)  # before any body is read
-    # Outermost: hosts, origins and content types are checked before anything else runs.
-    hosts = allowed_hosts_from_env(allowed_hosts or (), settings)
+    # Outermost: hosts, origins, content types and sizes are checked before anything else runs.
+    hosts = (*LOOPBACK_HOSTS, *settings.host_names, *allowed_hosts)
     app.add_middleware(SecurityMiddleware, allowed_hosts=hosts)
     return app

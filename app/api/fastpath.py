@@ -17,6 +17,7 @@ import json
 from typing import Any
 
 from pydantic import TypeAdapter, ValidationError
+from starlette.requests import ClientDisconnect, Request
 from starlette.responses import Response
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
@@ -59,15 +60,10 @@ class SolveFastPath:
         if not (solve and scope["method"] == "POST"):
             await self.app(scope, receive, send)
             return
-        chunks = []
-        while True:
-            message = await receive()
-            if message["type"] == "http.disconnect":
-                return
-            chunks.append(message.get("body", b""))
-            if not message.get("more_body", False):
-                break
-        body = b"".join(chunks)
+        try:
+            body = await Request(scope, receive).body()
+        except ClientDisconnect:
+            return
         try:
             req = _SOLVE_BODY.validate_python(json.loads(body))  # as FastAPI reads the body
         except (ValueError, RecursionError, ValidationError):  # the route says what is wrong

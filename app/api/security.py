@@ -1,4 +1,5 @@
-"""Who may talk to the server: allowed hosts, same-origin changes, JSON bodies, safe headers.
+"""Who may talk to the server: allowed hosts, same-origin changes, JSON bodies of a bounded size,
+safe headers.
 
 One ASGI middleware, outermost, in front of every route, the fast path and the scene's
 websocket relay (docs/security.md has the threat model):
@@ -13,6 +14,8 @@ websocket relay (docs/security.md has the threat model):
   4403). Requests without ``Origin`` (curl, scripts) are not browsers' and pass.
 - **Content type.** A POST or PUT body must be JSON (``application/json``), else 415: a form or
   ``text/plain`` post from another site (which browsers send without asking) is never parsed.
+- **Size.** A body over :data:`MAX_BODY_BYTES` is answered 413 (JSON): a ``Content-Length``
+  over it before the body is read, a body sent without one as it crosses the limit.
 - **Headers.** Every response says ``X-Content-Type-Options: nosniff``, ``Referrer-Policy:
   no-referrer``, and a ``Content-Security-Policy`` with ``frame-ancestors 'self'`` (with
   ``X-Frame-Options: SAMEORIGIN``): only our own page may frame the dashboard and its scene.
@@ -25,12 +28,13 @@ from __future__ import annotations
 from collections.abc import Iterable
 from urllib.parse import urlsplit
 
+from fastapi import HTTPException
 from starlette.responses import JSONResponse
 from starlette.routing import Match
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from ..compute.settings import Settings
-
+#: Largest request body accepted (413 beyond): the largest valid request is a few kilobytes.
+MAX_BODY_BYTES = 1 << 20
 #: Host names allowed by default: the loopback names.
 LOOPBACK_HOSTS = ("localhost", "127.0.0.1", "[::1]", "::1")
 #: Methods that change something, whose body must be JSON and whose origin must be ours.
@@ -52,14 +56,6 @@ _SCENE_POLICY = (
 )
 # The API's documentation pages (Swagger UI, ReDoc): their bootstrap is an inline script.
 _DOCS_POLICY = _SCENE_POLICY
-
-
-def allowed_hosts_from_env(
-    extra: Iterable[str] = (), settings: Settings | None = None
-) -> tuple[str, ...]:
-    """The loopback names, ``settings.allowed_hosts`` (``JIK_ALLOWED_HOSTS``, comma-separated)
-    and ``extra``."""
-    return (*LOOPBACK_HOSTS, *(settings or Settings()).host_names, *extra)
 
 
 def _host_name(host: str) -> str:
@@ -97,7 +93,7 @@ class SecurityMiddleware:
         if refusal is not None:
             status, message = refusal
             if websocket:
-                await _close_websocket(receive, send, 4000 + status, message)
+                await close_websocket(receive, send, 4000 + status, message)
                 return
             await _refused(status, message)(scope, receive, send)
             return
@@ -105,9 +101,13 @@ class SecurityMiddleware:
             await self.app(scope, receive, send)
             return
         policy = _policy(scope.get("path", "")).encode()
+        started = False
+        seen = 0
 
         async def secured(message: Message) -> None:
+            nonlocal started
             if message["type"] == "http.response.start":
+                started = True
                 extra = [
                     (b"x-content-type-options", b"nosniff"),
                     (b"referrer-policy", b"no-referrer"),
@@ -117,7 +117,23 @@ class SecurityMiddleware:
                 message["headers"] = [*message.get("headers", []), *extra]
             await send(message)
 
-        await self.app(scope, receive, secured)
+        async def counted() -> Message:
+            nonlocal seen
+            message = await receive()
+            seen += len(message.get("body", b""))
+            if seen > MAX_BODY_BYTES:
+                raise _TooLarge(413, _too_large(f"more than {MAX_BODY_BYTES}"))
+            return message
+
+        length = headers.get("content-length", "")
+        try:
+            if length.isdigit() and int(length) > MAX_BODY_BYTES:
+                raise _TooLarge(413, _too_large(str(int(length))))
+            await self.app(scope, counted, secured)
+        except _TooLarge as exc:  # (its length, or its body read past the limit by the fast path)
+            if started:
+                raise
+            await JSONResponse({"detail": exc.detail}, 413)(scope, receive, secured)
 
     def _refusal(self, scope: Scope, headers: dict, host: str, websocket: bool):
         """(status, message) of a refused request, or None."""
@@ -141,6 +157,18 @@ class SecurityMiddleware:
         return None
 
 
+class _TooLarge(HTTPException):
+    """Raised while reading an over-long body; an HTTPException so that FastAPI's routes pass it
+    on (to their 413 handler) instead of reporting a body they could not parse."""
+
+
+def _too_large(size: str) -> str:
+    return (
+        f"request body of {size} bytes is larger than the limit of {MAX_BODY_BYTES} bytes; "
+        "send a smaller request"
+    )
+
+
 def _routed(scope: Scope) -> bool:
     """Whether a route of the app takes this method at this path (else the router answers,
     404 or 405 with its Allow header, whatever the body)."""
@@ -151,9 +179,10 @@ def _routed(scope: Scope) -> bool:
     return any(route.matches(scope)[0] == Match.FULL for route in routes)
 
 
-async def _close_websocket(receive: Receive, send: Send, code: int, reason: str) -> None:
-    """Accept, then close with ``code`` (4400, 4403): a refused handshake reaches a browser's
-    script only as 1006, a close code as itself. Nothing the client sends is read."""
+async def close_websocket(receive: Receive, send: Send, code: int, reason: str) -> None:
+    """Accept, then close with ``code`` (4400, 4403; the scene's relay: 4404, 1011): a refused
+    handshake reaches a browser's script only as 1006, a close code as itself. Nothing the
+    client sends is read."""
     if (await receive())["type"] != "websocket.connect":
         return
     await send({"type": "websocket.accept"})

@@ -77,25 +77,6 @@ def target_fixtures(
     return out
 
 
-def base_link(kin: Any) -> bool:
-    """Whether the scene draws a URDF arm's base link: the segment from its base frame's origin to
-    its first joint, where that joint lies away from the origin (the Panda's first joint stands
-    0.333 m above it): its origin's fixed offset from the base frame (no joint moves it)."""
-    chain = getattr(kin, "chain", None)
-    return chain is not None and bool(np.linalg.norm(chain[0].origin[:3, 3]) > 1e-9)
-
-
-def joint_points(kin: Any) -> dict[int, int]:
-    """Which drawn point (of :func:`~jik.app.scene.mechanisms.chain_points`) is each joint
-    variable's joint: a URDF chain's joints in chain order (fixed ones included) after its base
-    (:func:`base_link`), a planar chain's joint i at point i."""
-    chain = getattr(kin, "chain", None)
-    if chain is None:
-        return {i: i for i in range(kin.p)}
-    first = int(base_link(kin))
-    return {int(j.index): first + k for k, j in enumerate(chain) if getattr(j, "index", -1) >= 0}
-
-
 def end_frame(kin: Any, x) -> tuple[tuple[float, ...], tuple[float, ...]]:
     """(position, wxyz) of a URDF arm's end link at ``x`` (p,)."""
     R, t = kin.end_pose(np.asarray(x, dtype=float))

@@ -23,7 +23,7 @@ import numpy as np
 
 from ..dashboard.robots import state_kinematics
 from .arm_marks import AXES_FRACTION
-from .mechanisms import CHAINS, chain_points, drawn_points, extent_of
+from .mechanisms import CHAINS, chain_points, extent_of, runs_points
 
 #: Unit vector from the point looked at to the camera: in front of the task plane, tilted.
 VIEW_DIRECTION = np.array([0.0, -0.75, 1.05]) / math.hypot(0.75, 1.05)
@@ -50,7 +50,7 @@ def view_of(result) -> tuple[np.ndarray, float]:
         home = chain_points(kin, np.asarray(state.x0, dtype=float), 0.0)  # (n + 1, 3)
         base = home[0]
         reach = float(np.linalg.norm(np.diff(home, axis=0), axis=1).sum())
-        drawn = drawn_points(result, kin)
+        drawn = runs_points(result, kin)
         radius = max(reach, float(np.linalg.norm(drawn - base, axis=1).max()))
         if np.ptp(drawn[:, 2]) > 0:  # (an arm standing in space)
             # The box of its drawn configurations, not its whole reach around the base.

@@ -7,9 +7,11 @@ import threading
 import time
 from collections.abc import Callable
 
+import numpy as np
 import viser
+from viser.transforms import SO3
 
-from .pose import gizmo_pose, quaternion_yaw, start_from_gizmo, yaw_quaternion
+from .pose import gizmo_pose, start_from_gizmo
 
 #: Seconds between two changes of the start point while its gizmo is dragged (each starts a
 #: computation; the dashboard solves only the newest state, but every change is an event).
@@ -63,7 +65,7 @@ class StartGizmo:
             self.handle.on_update(self.on_drag)
         self.handle.visible = True
         self.handle.position = (X, Y, 0.3)
-        self.handle.wxyz = yaw_quaternion(yaw)
+        self.handle.wxyz = SO3.from_z_radians(yaw).wxyz
 
     def on_drag(self, event) -> None:
         """The gizmo pressed, moved or released: the start point follows.
@@ -106,5 +108,5 @@ class StartGizmo:
         position, wxyz = pose
         if counts:
             self._last = time.monotonic()
-        state = self._state()
-        self._send(start_from_gizmo(state.robot, position[:2], quaternion_yaw(wxyz), state))
+        state, yaw = self._state(), float(SO3(np.asarray(wxyz)).compute_yaw_radians())
+        self._send(start_from_gizmo(state.robot, position[:2], yaw, state))

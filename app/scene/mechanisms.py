@@ -20,9 +20,10 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
+from viser.transforms import SO3
 
 from ...engine.arms import ARMS
 from ..dashboard.algorithms import COLORS, STYLES
@@ -31,14 +32,12 @@ from ..dashboard.robots import state_kinematics
 from .arm_marks import (
     AXES_FRACTION,
     OUTSIDE_COLOR,
-    base_link,
     end_frame,
     has_pose,
-    joint_points,
     target_fixtures,
     target_pose,
 )
-from .pose import NORMAL_FORM, yaw_quaternion
+from .pose import NORMAL_FORM
 from .traces import polyline, rgb, trace_tolerance, unicycle_traces
 
 HOME_COLOR = (150, 150, 150)
@@ -113,7 +112,7 @@ class Gantry(Mechanism):
         (lo, hi), _ = self.extent
         self.beam.position = ((lo + hi) / 2, float(x[0]), self.z)
         self.carriage.position = (float(x[1]), float(x[0]), self.z + 0.05)
-        self.carriage.wxyz = yaw_quaternion(float(x[2]))
+        self.carriage.wxyz = SO3.from_z_radians(float(x[2])).wxyz
 
 
 class NormalForm(Mechanism):
@@ -151,7 +150,7 @@ class NormalForm(Mechanism):
         self.runner.position = (x1, (lo + hi) / 2, self.z)
         self.slider.position = (0.0, x2, self.z)
         self.lever.position = (0.0, x2, self.z)
-        self.lever.wxyz = yaw_quaternion(math.atan(x3))
+        self.lever.wxyz = SO3.from_z_radians(math.atan(x3)).wxyz
         W = NORMAL_FORM.forward(np.asarray(x, dtype=float))
         self.point.position = (float(W[0]), float(W[1]), self.z + 0.08)
 
@@ -171,7 +170,7 @@ class Platform(Mechanism):
 
     def pose(self, q) -> None:
         self.frame.position = (float(q[0]), float(q[1]), 0.5 * self.z)
-        self.frame.wxyz = yaw_quaternion(float(q[2]))
+        self.frame.wxyz = SO3.from_z_radians(float(q[2])).wxyz
 
 
 class Chain(Mechanism):
@@ -193,9 +192,8 @@ class Chain(Mechanism):
         )
         # Joints sized to the arm: a sixtieth of its reach from its first joint (0.04 for an arm
         # of reach 2.4); the base link is not part of the reach.
-        reach = float(
-            np.linalg.norm(np.diff(home[int(base_link(self.kin)) :], axis=0), axis=1).sum()
-        )
+        links = np.diff(self.kin.points(np.asarray(self.state.x0, dtype=float)), axis=0)
+        reach = float(np.linalg.norm(links, axis=1).sum())
         ball = max(reach, 1e-3) / 60
         self.joints = [self.ball(f"joint{i}", ball if i < n - 1 else 1.5 * ball) for i in range(n)]
         # The end link's frame when the task holds its orientation (a pose task).
@@ -210,8 +208,8 @@ class Chain(Mechanism):
         """Follow a new state: its kinematics, its joint limits and which drawn joint is each
         variable's (coloured when outside)."""
         super().resize(state, extent)
-        self.kin = state_kinematics(state)
-        self.limits, self.at = state_limits(state), joint_points(self.kin)
+        self.kin = cast(Any, state_kinematics(state))  # (a PlanarChain or a UrdfChain)
+        self.limits, self.at = state_limits(state), self.kin.joint_points
         self.marked: set[int] = set()
 
     def pose(self, x) -> None:
@@ -228,19 +226,16 @@ class Chain(Mechanism):
 
 
 def chain_points(kin: Any, x: np.ndarray, z: float) -> np.ndarray:
-    """The points of a chain (..., m, 3) in the scene: a planar one at height ``z``; an arm in
-    space where it is, from its base frame's origin when its first joint lies away from it
-    (:func:`~jik.app.scene.arm_marks.base_link`; its end on its pose targets: the copies
-    overlap, red translucent)."""
-    pts = np.asarray(kin.points(x), dtype=float)  # (PlanarChain, UrdfChain)
+    """The points of a chain (..., m, 3) in the scene, its ``drawn_points`` (PlanarChain,
+    UrdfChain): a planar one at height ``z``; an arm in space where it is (its end on its pose
+    targets: the copies overlap, red translucent)."""
+    pts = np.asarray(kin.drawn_points(x), dtype=float)
     if pts.shape[-1] == 2:
         return np.concatenate([pts, np.full((*pts.shape[:-1], 1), z)], axis=-1)
-    if base_link(kin):
-        return np.concatenate([np.zeros((*pts.shape[:-2], 1, 3)), pts], axis=-2)
     return pts
 
 
-def drawn_points(result, kin: Any) -> np.ndarray:
+def runs_points(result, kin: Any) -> np.ndarray:
     """The points (n, 3) of a chain in the configurations of ``result``'s runs (about 200 of
     them, evenly spaced), at height 0: what the scene's box and camera must hold."""
     xs = np.concatenate([r.x for r in result.runs.values()])
@@ -350,7 +345,7 @@ def extent_of(result) -> tuple[tuple[float, float], tuple[float, float]]:
         ys = np.vstack([*(r.platform.reshape(-1, 3) for r in runs), [result.state.target]])
         lo, hi = ys.min(axis=0)[:2] - 1.0, ys.max(axis=0)[:2] + 1.0
     elif robot in CHAINS:  # (the whole arm, not only its end)
-        pts = drawn_points(result, state_kinematics(result.state))
+        pts = runs_points(result, state_kinematics(result.state))
         lo, hi = pts.min(axis=0)[:2] - 0.3, pts.max(axis=0)[:2] + 0.3
     elif robot not in MECHANISMS:  # (a formula robot: its paths, of any size)
         ys = np.vstack([*(r.y[:, :2] for r in runs), np.asarray(result.targets)[:, :2]])

@@ -102,8 +102,8 @@ class NodeSets:
             copies = {a: (rgb(COLORS[a]), STYLES[a].opacity, STYLES[a].z) for a in result.runs}
             for part, styles in (("still", still), ("mechanisms", copies)):
                 entry[part] = {
-                    name: cls(scene, f"{root}/{name}", *style, state, extent)
-                    for name, style in styles.items()
+                    name: cls(scene, f"{root}/{name}", color, opacity, z, state, extent)
+                    for name, (color, opacity, z) in styles.items()
                 }
         self._place_fixtures(result, extent, root, entry["fixtures"])
         self.sets[set_key(state)] = entry

@@ -77,9 +77,8 @@ class Playback:
     def _scrubbed(self, _) -> None:
         if self._syncing or self.timeline is None:
             return
-        self.playing = False
-        self.play.label = "Play"
-        self._scene_status["playing"] = False
+        if self.playing:  # (a scrub pauses)
+            self._toggle(None)
         self._s = float(self.scrub.value) * self.timeline.length
 
     def _pose(self, s: float) -> None:

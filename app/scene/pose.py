@@ -16,17 +16,6 @@ NORMAL_FORM = Manipulator1()
 UNICYCLE_SHOWN = 10
 
 
-def yaw_quaternion(angle: float) -> tuple[float, float, float, float]:
-    """wxyz of a rotation by ``angle`` [rad] about the z axis."""
-    return (math.cos(angle / 2), 0.0, 0.0, math.sin(angle / 2))
-
-
-def quaternion_yaw(wxyz) -> float:
-    """Rotation about z of a quaternion (its other rotations are ignored)."""
-    w, x, y, z = (float(v) for v in wxyz)
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-
 def gizmo_pose(robot: str, x0, robot_parameters: dict) -> tuple[tuple[float, float], float]:
     """Where the start-point gizmo sits: ((X, Y), yaw) in the task plane.
 

@@ -4,6 +4,7 @@ their algorithm's colour."""
 from __future__ import annotations
 
 import numpy as np
+from plotly.colors import hex_to_rgb as rgb  # ((r, g, b) of "#rrggbb", as viser takes it)
 
 from ..dashboard.algorithms import COLORS, STYLES
 from .pose import shown_iterations
@@ -11,12 +12,6 @@ from .pose import shown_iterations
 #: Largest distance of a drawn trace from the computed path, as a fraction of the scene's size
 #: (about a third of a pixel at the dashboard's size).
 TRACE_TOLERANCE = 1e-3
-
-
-def rgb(hex_color: str) -> tuple[int, int, int]:
-    """The (r, g, b) of a colour ``#rrggbb``, as viser takes it."""
-    h = hex_color.lstrip("#")
-    return int(h[0:2], 16), int(h[2:4], 16), int(h[4:6], 16)
 
 
 def simplify(points: np.ndarray, tol: float) -> np.ndarray:

@@ -18,7 +18,6 @@ from jik.app.dashboard.results import compute
 from jik.app.dashboard.robots import state_kinematics
 from jik.app.dashboard.session import Dashboard
 from jik.app.scene import DashboardScene
-from jik.app.scene.arm_marks import base_link, joint_points
 from jik.app.scene.camera import (
     INITIAL_ASPECT,
     PANEL_PX,
@@ -107,12 +106,12 @@ def test_the_pandas_drawn_chain_starts_at_its_base():
     pts = chain_points(kin, np.zeros(kin.p), 0.0)
     np.testing.assert_allclose(pts[:2], [[0, 0, 0], [0, 0, 0.333]], atol=1e-12)
     assert len(pts) == len(kin.points(np.zeros(kin.p))) + 1
-    assert joint_points(kin)[0] == 1
+    assert kin.joint_points[0] == 1
     text = (Path(__file__).parents[1] / "data" / "arm4.urdf").read_text()
     at_origin = UrdfChain(text.replace('<origin xyz="0 0 0.05"/>', "<origin/>", 1), "tool")
-    assert not base_link(at_origin)
+    assert not at_origin.base_offset
     np.testing.assert_allclose(chain_points(at_origin, np.zeros(4), 0.0)[0], 0, atol=1e-15)
-    assert joint_points(at_origin)[0] == 0
+    assert at_origin.joint_points[0] == 0
 
 
 ALL_FIVE = ["pseudoinverse", "extended", "damped", "weighted", "posture"]

@@ -27,7 +27,7 @@ from jik.app.dashboard.runs import Cancelled
 from jik.app.dashboard.session import Dashboard
 from jik.app.dashboard.verdict import verdict
 from jik.app.scene import DashboardScene
-from jik.app.scene.arm_marks import OUTSIDE_COLOR, end_frame, joint_points, target_pose
+from jik.app.scene.arm_marks import OUTSIDE_COLOR, end_frame, target_pose
 from jik.app.scene.mechanisms import Chain, fixtures_of
 from jik.engine.arms import ARMS
 from jik.engine.atlas_run import run_atlas
@@ -82,7 +82,7 @@ def test_a_run_outside_the_limits_is_said_in_words_and_marked():
     assert report["violation"]["joint"] == 3 and report["violation"]["cycle"] == 0
     kin = state_kinematics(state)
     assert list(outside_joints(state_limits(state), state.x0)) == [3]
-    assert joint_points(kin)[3] == 4  # (its base link, then x1..x4: no fixed joint before x4)
+    assert kin.joint_points[3] == 4  # (its base link, then x1..x4: no fixed joint before x4)
     assert not len(outside_joints(state_limits(_panda()), _panda().x0))
 
 
@@ -236,7 +236,7 @@ def test_the_scene_colours_a_joint_while_it_is_outside_its_limits():
         )
         arm.pose(state.x0)
         colours = [tuple(ball.color) for ball in arm.joints]
-        assert colours[joint_points(arm.kin)[3]] == OUTSIDE_COLOR
+        assert colours[arm.kin.joint_points[3]] == OUTSIDE_COLOR
         assert colours.count(OUTSIDE_COLOR) == 1
         arm.pose(_panda().x0)
         assert all(tuple(ball.color) == (10, 20, 30) for ball in arm.joints)

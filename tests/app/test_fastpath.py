@@ -67,7 +67,7 @@ def _fast_path(app) -> SolveFastPath:
 @pytest.fixture(scope="module")
 def clients():
     fast = TestClient(create_app(Settings(workers=1, timeout=60.0)))
-    slow = TestClient(create_app(Settings(workers=1, timeout=60.0), fast_solve=False))
+    slow = TestClient(create_app(Settings(workers=1, timeout=60.0, fast_solve=False)))
     with fast, slow:
         yield fast, slow
 

@@ -10,6 +10,7 @@ import time
 import numpy as np
 import pytest
 import viser
+from viser.transforms import SO3
 
 from jik.app.dashboard import Dashboard, compute, default_state, updated_state
 from jik.app.dashboard.algorithms import DEFAULT_ALGORITHMS
@@ -19,9 +20,7 @@ from jik.app.scene.mechanisms import extent_of
 from jik.app.scene.pose import (
     Timeline,
     gizmo_pose,
-    quaternion_yaw,
     start_from_gizmo,
-    yaw_quaternion,
 )
 from jik.app.scene.traces import TRACE_TOLERANCE, polyline, simplify
 from jik.engine.registry import ROBOTS
@@ -43,7 +42,7 @@ def test_the_start_point_gizmo_round_trips(robot, x0):
     if x0 is not None:
         state = updated_state(state, {"x0": list(x0)})
     xy, yaw = gizmo_pose(robot, state.x0, state.robot_parameters)
-    yaw = quaternion_yaw(yaw_quaternion(yaw))
+    yaw = float(SO3.from_z_radians(yaw).compute_yaw_radians())
     patch = start_from_gizmo(robot, xy, yaw, state)
     assert updated_state(state, patch) == state
 
@@ -79,7 +78,7 @@ def test_viser_gui_and_drag_change_the_one_state():
         assert dashboard.scene_status["robot"] == "manipulator2"
         scene.controls.inputs["gamma"].value = 2.5  # what a slider move in the viser GUI does
         assert dashboard.state.gamma == 2.5
-        target = SimpleNamespace(position=(0.4, 0.25, 0.3), wxyz=yaw_quaternion(1.7))
+        target = SimpleNamespace(position=(0.4, 0.25, 0.3), wxyz=SO3.from_z_radians(1.7).wxyz)
         scene.gizmo.on_drag(SimpleNamespace(phase="end", target=target))
         np.testing.assert_allclose(dashboard.state.x0, (0.25, 0.4, 1.7), atol=1e-12)
         # A press where the gizmo is changes nothing; the first move
@@ -88,10 +87,10 @@ def test_viser_gui_and_drag_change_the_one_state():
         generation = dashboard.generation
         scene.gizmo.on_drag(SimpleNamespace(phase="start", target=target))
         assert dashboard.generation == generation
-        moved = SimpleNamespace(position=(0.5, 0.25, 0.3), wxyz=yaw_quaternion(1.7))
+        moved = SimpleNamespace(position=(0.5, 0.25, 0.3), wxyz=SO3.from_z_radians(1.7).wxyz)
         scene.gizmo.on_drag(SimpleNamespace(phase="update", target=moved))
         np.testing.assert_allclose(dashboard.state.x0, (0.25, 0.5, 1.7), atol=1e-12)
-        rest = SimpleNamespace(position=(0.55, 0.3, 0.3), wxyz=yaw_quaternion(1.7))
+        rest = SimpleNamespace(position=(0.55, 0.3, 0.3), wxyz=SO3.from_z_radians(1.7).wxyz)
         scene.gizmo.on_drag(SimpleNamespace(phase="update", target=rest))
         assert dashboard.state.x0[1] == pytest.approx(0.5)  # (deferred)
         deadline = time.monotonic() + DRAG_INTERVAL + 10.0  # (a loaded machine is slow)

@@ -160,3 +160,27 @@ def test_a_bad_urdf_is_reported_once_and_not_logged_as_an_error(caplog, capfd):
         parse_urdf("0")
     assert not [r for r in caplog.records if r.name.startswith("yourdfpy")]
     assert "parsing approach" not in capfd.readouterr().err
+
+
+def test_the_drawn_arm_starts_at_its_base_and_places_each_joint(arm):
+    """arm4's first joint stands 0.05 m above its base frame's origin: the drawn polyline starts
+    at the origin (that offset is a link), then the joint origins and the end; each joint
+    variable's point is its joint's origin. An arm whose first joint is at the origin and a
+    planar chain are drawn from their first joint."""
+    from jik.engine.planar_chain import PlanarChain
+
+    x = RNG.uniform(-1.0, 1.0, (5, 4))
+    drawn, (origins, _, _) = arm.drawn_points(x), arm.frames(x)
+    assert arm.base_offset and drawn.shape == (5, len(arm.chain) + 2, 3)
+    np.testing.assert_allclose(drawn[:, 0], 0.0, atol=1e-15)
+    np.testing.assert_allclose(drawn[:, 1:], arm.points(x), atol=1e-15)
+    for index, point in arm.joint_points.items():
+        k = next(k for k, j in enumerate(arm.chain) if j.index == index)
+        np.testing.assert_allclose(drawn[:, point], origins[:, k], atol=1e-15)
+    assert sorted(arm.joint_points) == [0, 1, 2, 3]
+    at_origin = UrdfChain(TEXT.replace('<origin xyz="0 0 0.05"/>', "<origin/>", 1), "tool")
+    assert not at_origin.base_offset and at_origin.joint_points[0] == 0
+    np.testing.assert_allclose(at_origin.drawn_points(x), at_origin.points(x), atol=0)
+    planar = PlanarChain("RRR", [1.0, 0.8, 0.6])
+    np.testing.assert_allclose(planar.drawn_points(x[:, :3]), planar.points(x[:, :3]), atol=0)
+    assert planar.joint_points == {0: 0, 1: 1, 2: 2}

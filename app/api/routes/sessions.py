@@ -31,6 +31,7 @@ from ...dashboard.robots import vet_definition
 from ...dashboard.sessions import Session, SessionNotFound
 from ..dependencies import Pool, Store
 from ..errors import unparsed_body_response
+from ..security import close_websocket
 
 router = APIRouter(tags=["dashboard sessions"])
 #: Seconds between keep-alive comments on the event stream.
@@ -307,11 +308,7 @@ async def export_result_csv(session_id: str, store: Store, generation: int | Non
     session = store.get(session_id)
     result, _ = await asyncio.to_thread(session.exported, generation, EXPORT_WAIT)
     body, name = export_file(result, "csv")
-    return PlainTextResponse(
-        body,
-        media_type="text/csv",
-        headers={"Content-Disposition": f'attachment; filename="{name}"'},
-    )
+    return CSVResponse(body, headers={"Content-Disposition": f'attachment; filename="{name}"'})
 
 
 @router.websocket("/api/sessions/{session_id}/scene")
@@ -326,12 +323,16 @@ async def scene_socket(websocket: WebSocket, session_id: str) -> None:
     except SessionNotFound:
         session = None
     if session is None or session.scene is None:
-        await _close(websocket, 4404, "no such session (it expired or was deleted)")
+        await close_websocket(
+            websocket.receive, websocket.send, 4404, "no such session (it expired or was deleted)"
+        )
         return
     try:
         upstream = await session.scene.connect(websocket.scope.get("subprotocols", []))
     except (OSError, websockets.exceptions.WebSocketException, TimeoutError):
-        await _close(websocket, 1011, "the session's scene is not reachable")
+        await close_websocket(
+            websocket.receive, websocket.send, 1011, "the session's scene is not reachable"
+        )
         return
     await websocket.accept(subprotocol=upstream.subprotocol)
     session.users += 1
@@ -341,13 +342,6 @@ async def scene_socket(websocket: WebSocket, session_id: str) -> None:
         session.users -= 1
         session.touch()
         await upstream.close()
-
-
-async def _close(websocket: WebSocket, code: int, reason: str) -> None:
-    """Accept, then close with ``code``: a refused handshake reaches a browser's script only as
-    1006, a close code as itself."""
-    await websocket.accept()
-    await websocket.close(code=code, reason=reason)
 
 
 async def _relay(websocket: WebSocket, upstream) -> None:
