@@ -55,10 +55,11 @@ def map_response(
     req, robot_used, kin, amap, box, notes: list[str], **fields
 ) -> S.SynthesizeResponse:
     """The response of a synthesis whose map h is ``amap`` on ``box`` (the variables' names,
-    the region, the values of the others, default 0): h on the grid and where it is singular,
-    the message ``notes`` and what the search says, with the method's own ``fields``."""
+    the region, the values of the others: :func:`jik.engine.functionals.check_region`'s): h
+    on the grid and where it is singular, the message ``notes`` and what the search says, with
+    the method's own ``fields``."""
     names, region, fixed = box
-    all_fixed = {n: float(fixed.get(n, 0.0)) for n in names if n not in region}
+    all_fixed = {n: float(fixed[n]) for n in names if n not in region}
     found, said, searched = singularities(kin, amap, region, all_fixed, req.nodes)
     return S.SynthesizeResponse(
         robot=robot_used,
