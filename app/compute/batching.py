@@ -13,8 +13,9 @@ idle workers and dispatch.
 from __future__ import annotations
 
 import asyncio
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -25,7 +26,7 @@ from .requests import batch_key
 from .worker import solve_batch
 
 if TYPE_CHECKING:
-    from .pool import ComputePool
+    from .settings import Settings
     from .worker import Worker
 
 
@@ -45,90 +46,103 @@ class _Pending:
 
 
 class SolveBatching:
-    """The micro-batched :meth:`solve` of a :class:`~jik.app.compute.pool.ComputePool` (on
-    its event loop, settings, stats, idle workers and dispatch): the pool's ``solve``."""
+    """The micro-batched :meth:`solve` of :class:`~jik.app.compute.pool.ComputePool` (which
+    provides the members declared here)."""
 
-    def __init__(self, pool: ComputePool) -> None:
-        self.pool = pool
-        #: The requests waiting for a worker, by batch key (emptied when the pool binds a loop).
-        self.pending: dict[str, list[_Pending]] = {}
+    if TYPE_CHECKING:
+        settings: Settings
+        stats: dict[str, int]
+        _pending: dict[str, list[_Pending]]
+
+        @property
+        def _bound_loop(self) -> asyncio.AbstractEventLoop: ...
+        @property
+        def _bound_idle(self) -> asyncio.Queue[Worker]: ...
+        def _bind(self) -> asyncio.Queue[Worker]: ...
+        def _busy(self) -> ServiceUnavailable: ...
+        def _spawn(self, coro) -> asyncio.Task: ...
+        async def _acquire(self, deadline: float) -> Worker: ...
+        async def run(self, fn: Callable, *args: Any) -> Any: ...
+        async def _dispatch_retried(
+            self, fn: Callable, args: tuple, worker: Worker | None = None
+        ): ...
+        @staticmethod
+        def _unwrap(msg): ...
 
     async def solve(self, req: S.SolveRequest) -> bytes:
         """One /solve request (JSON response bytes); micro-batched with compatible ones."""
         precheck(req)
-        self.pool._bind()
+        self._bind()
         payload = req.model_dump_json().encode()
-        if not self.pool.settings.batching:
-            self.pool.stats["solve_calls"] += 1
-            self.pool.stats["solve_requests"] += 1
-            (res,) = await self.pool.run(solve_batch, [payload])
-            return self.pool._unwrap(res)
-        loop = self.pool._bound_loop
-        entry = _Pending(payload, loop.create_future(), loop.time() + self.pool.settings.timeout)
+        if not self.settings.batching:
+            self.stats["solve_calls"] += 1
+            self.stats["solve_requests"] += 1
+            (res,) = await self.run(solve_batch, [payload])
+            return self._unwrap(res)
+        loop = self._bound_loop
+        entry = _Pending(payload, loop.create_future(), loop.time() + self.settings.timeout)
         entry.future.add_done_callback(_retrieve)
         key = batch_key(req)
-        queue = self.pending.setdefault(key, [])
+        queue = self._pending.setdefault(key, [])
         queue.append(entry)
         if len(queue) == 1:
-            self.pool._spawn(self._flush(key, first=True))
+            self._spawn(self._flush(key, first=True))
         try:
-            return self.pool._unwrap(
+            return self._unwrap(
                 await asyncio.wait_for(asyncio.shield(entry.future), entry.deadline - loop.time())
             )
         except TimeoutError:
             if entry.dispatched:  # computing: bounded by the computation's own time limit
-                return self.pool._unwrap(await entry.future)
+                return self._unwrap(await entry.future)
             entry.abandoned = True
-            raise self.pool._busy() from None
+            raise self._busy() from None
 
     async def _flush(self, key: str, first: bool) -> None:
-        if first and self.pool.settings.batch_window > 0:
-            await asyncio.sleep(self.pool.settings.batch_window)
-        queue = [p for p in self.pending.get(key, []) if not p.abandoned]
+        if first and self.settings.batch_window > 0:
+            await asyncio.sleep(self.settings.batch_window)
+        queue = [p for p in self._pending.get(key, []) if not p.abandoned]
         if not queue:
-            self.pending.pop(key, None)
+            self._pending.pop(key, None)
             return
         try:
-            worker = await self.pool._acquire(max(p.deadline for p in queue))
+            worker = await self._acquire(max(p.deadline for p in queue))
         except ServiceUnavailable:
-            for p in self.pending.pop(key, []):
+            for p in self._pending.pop(key, []):
                 p.abandoned = True
                 if not p.future.done():
-                    p.future.set_exception(self.pool._busy())
+                    p.future.set_exception(self._busy())
             return
         # Everything compatible that arrived while we waited for the worker joins the batch.
-        queue = [p for p in self.pending.pop(key, []) if not p.abandoned]
-        items, rest = queue[: self.pool.settings.max_batch], queue[self.pool.settings.max_batch :]
+        queue = [p for p in self._pending.pop(key, []) if not p.abandoned]
+        items, rest = queue[: self.settings.max_batch], queue[self.settings.max_batch :]
         if rest:
-            self.pending[key] = rest
-            self.pool._spawn(self._flush(key, first=False))
+            self._pending[key] = rest
+            self._spawn(self._flush(key, first=False))
         if not items:
-            self.pool._bound_idle.put_nowait(worker)
+            self._bound_idle.put_nowait(worker)
             return
         # A large batch is shared among the workers that are idle right now: two half batches on
         # two cores finish sooner than one whole batch on one.
         workers = [worker]
         while (
-            len(items) >= (len(workers) + 1) * self.pool.settings.min_share
-            and not self.pool._bound_idle.empty()
+            len(items) >= (len(workers) + 1) * self.settings.min_share
+            and not self._bound_idle.empty()
         ):
-            workers.append(self.pool._bound_idle.get_nowait())
+            workers.append(self._bound_idle.get_nowait())
         for p in items:
             p.dispatched = True
-        self.pool.stats["solve_calls"] += len(workers)
-        self.pool.stats["solve_requests"] += len(items)
+        self.stats["solve_calls"] += len(workers)
+        self.stats["solve_requests"] += len(items)
         shares = np.array_split(np.arange(len(items)), len(workers))
         for w, share in zip(workers[1:], shares[1:], strict=True):
-            self.pool._spawn(self._solve_share(w, [items[i] for i in share]))
+            self._spawn(self._solve_share(w, [items[i] for i in share]))
         await self._solve_share(workers[0], [items[i] for i in shares[0]])
 
     async def _solve_share(self, worker: Worker, items: list[_Pending]) -> None:
         """Solve ``items`` in ONE engine call on ``worker`` and hand each its result."""
         try:
-            msg = await self.pool._dispatch_retried(
-                solve_batch, ([p.payload for p in items],), worker
-            )
-            results = self.pool._unwrap(msg)
+            msg = await self._dispatch_retried(solve_batch, ([p.payload for p in items],), worker)
+            results = self._unwrap(msg)
         except Exception as exc:  # handed to every request of the batch
             for p in items:
                 if not p.future.done():

@@ -18,14 +18,13 @@ import threading
 from collections.abc import Callable, Iterator
 from typing import Any
 
-from .batching import SolveBatching
+from .batching import SolveBatching, _Pending
 from .exceptions import (
     ComputeError,
     RequestError,
     ServiceUnavailable,
     WorkerLost,
 )
-from .schemas import SolveRequest
 from .settings import Settings
 from .settings import settings as environment_settings
 from .worker import Worker, frame_header, work_of
@@ -35,7 +34,7 @@ from .worker import Worker, frame_header, work_of
 HUNG = 0.1
 
 
-class ComputePool:
+class ComputePool(SolveBatching):
     """Worker processes with a bound on concurrent computations and a time limit per request.
 
     At most ``settings.workers`` computations run at once. A request that gets no worker within
@@ -55,7 +54,7 @@ class ComputePool:
         )
         self._loop: asyncio.AbstractEventLoop | None = None
         self._idle: asyncio.Queue[Worker] | None = None
-        self.batching = SolveBatching(self)
+        self._pending: dict[str, list[_Pending]] = {}
         self._tasks: set[asyncio.Task] = set()
         self._closed = False
         #: Engine calls made and requests served by them (for tests and the benchmark).
@@ -87,7 +86,7 @@ class ComputePool:
             self.start()
             self._loop = loop
             self._idle = asyncio.Queue()
-            self.batching.pending = {}
+            self._pending = {}
             for w in self._workers:
                 self._idle.put_nowait(w)
         return self._idle
@@ -271,10 +270,6 @@ class ComputePool:
         if status == "request_error":
             raise RequestError(*value)
         raise ComputeError(value)
-
-    async def solve(self, req: SolveRequest) -> bytes:
-        """One /solve request (JSON response bytes), micro-batched (:class:`SolveBatching`)."""
-        return await self.batching.solve(req)
 
     async def run(self, fn: Callable, *args: Any) -> Any:
         """``fn(*args)`` in a worker, ``fn`` a :func:`~jik.app.compute.worker.task` (waits and
