@@ -24,6 +24,7 @@ import numpy as np
 
 from ..characteristics import UnicycleCharacteristics
 from ..exceptions import JikError
+from ..exports import json_values
 from ..inverses import ExtendedInverse, Pseudoinverse
 from ..registry import POSE_A, POSE_B
 from ..solver import solve
@@ -46,13 +47,8 @@ PATH_POINTS = 101
 
 
 def _floats(a) -> list:
-    """A numpy array as nested lists of floats, with None for NaN (valid JSON)."""
-    a = np.asarray(a, dtype=float)
-    return (
-        [None if not np.isfinite(v) else float(v) for v in a]
-        if a.ndim == 1
-        else [_floats(row) for row in a]
-    )
+    """A numpy array as nested lists of floats, None where missing (:func:`json_values`)."""
+    return json_values(np.asarray(a, dtype=float))
 
 
 def _inverses(q0):
