@@ -25,17 +25,8 @@ from .synthesis_total import map_response, total_degree_response
 def synthesis_methods() -> S.SynthesisMethodsResponse:
     return S.SynthesisMethodsResponse(
         methods=list(get_args(S.SynthesisMethod)),
-        notes={
-            "evaluate": "any map of the catalogue (GET /robots): h on a grid of the box, "
-            "polynomial coefficients, E1 and E2 on the box",
-            "e2_variational": "minimise E2 (eq. (19)) over h of the box variables (Ritz method, "
-            "engine.variational.synthesize_e2)",
-            "e2_total_degree": "minimise E2 over h of any number of box variables, and h_1 ... "
-            "h_(p-r) for p - r >= 2, on a total-degree Legendre basis with a scrambled Sobol "
-            "rule (engine.synthesis_nd.synthesize_e2_nd): E2 on the fitting and on an "
-            "independent rule, its convergence with the degree and the nodes",
-            "error_functionals": "E1 (13) and E2 (18) by Gauss quadrature (engine.functionals)",
-        },
+        notes=S.METHODS
+        | {"error_functionals": "E1 (13) and E2 (18) by Gauss quadrature (engine.functionals)"},
     )
 
 

@@ -73,6 +73,7 @@ from .runs import (
     Trajectory,
 )
 from .synthesis import (
+    METHODS,
     FunctionalInfo,
     MapSingularitiesInfo,
     SynthesisGrid,

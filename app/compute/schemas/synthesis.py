@@ -14,6 +14,17 @@ from .robots import AnyAugmentation, AnyRobot, AugmentationUsed, RobotUsed
 from .variants import narrowed, per_robot
 
 SynthesisMethod = Literal["evaluate", "e2_variational", "e2_total_degree"]
+#: What each method does: the ``method`` field's description and ``GET /synthesize``'s notes.
+METHODS = {
+    "evaluate": "any map of the catalogue (GET /robots; analytic or already synthesized): h on "
+    "a grid of the box, polynomial coefficients, E1 and E2 on the box",
+    "e2_variational": "minimise E2 (eq. (19)) over h of the box variables by the Ritz method on "
+    "a tensor Legendre basis of 2 or 3 variables (engine.variational.synthesize_e2)",
+    "e2_total_degree": "minimise E2 over h of any number of box variables, and h_1 ... h_(p-r) "
+    "for p - r >= 2, on a total-degree Legendre basis with a scrambled Sobol rule "
+    "(engine.synthesis_nd.synthesize_e2_nd): E2 on the fitting and on an independent rule, its "
+    "convergence with the degree and the nodes",
+}
 #: Sobol nodes of a total-degree synthesis (a power of two): bounds (default: the engine's).
 MIN_QMC_NODES, MAX_QMC_NODES = 64, 2**17
 
@@ -25,12 +36,7 @@ class SynthesizeRequest(BaseModel):
 
     robot: AnyRobot
     method: SynthesisMethod = Field(
-        "evaluate",
-        description="'evaluate': a catalogue map (analytic or already synthesized) on the box; "
-        "'e2_variational': minimise E2 (eq. (19)) by the Ritz method on a tensor Legendre basis "
-        "of 2 or 3 variables (engine.variational); 'e2_total_degree': the same functional over "
-        "any number of variables on a total-degree Legendre basis with a scrambled Sobol rule, "
-        "and for p - r >= 2 the maps h_1 ... h_(p-r) (engine.synthesis_nd)",
+        "evaluate", description="; ".join(f"'{k}': {v}" for k, v in METHODS.items())
     )
     augmentation: AnyAugmentation | None = Field(
         None, description="for 'evaluate': the map and its parameters (default: the robot's)"
