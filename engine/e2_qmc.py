@@ -76,7 +76,7 @@ def e2_qmc(
     nodes = count(nodes, "nodes", 64, MAX_NODES)
     if nodes & (nodes - 1):
         raise InvalidInputError(f"nodes must be a power of two, got {nodes}", "nodes")
-    names = tuple(kinematics.variable_names) or tuple(f"x{i + 1}" for i in range(kinematics.p))
+    names = kinematics.names
     idx = np.array([names.index(n) for n in box])
     lo, hi = np.array(list(box.values()), dtype=float).T
     t = 2.0 * qmc.Sobol(len(box), scramble=True, seed=seed).random(nodes) - 1.0

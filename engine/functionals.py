@@ -108,7 +108,7 @@ def check_region(
     region : dict name -> (lo, hi), in the kinematics' variable order
     fixed : dict name -> value for every variable not in ``region`` (default: held_values)
     """
-    names = tuple(kinematics.variable_names) or tuple(f"x{i + 1}" for i in range(kinematics.p))
+    names = kinematics.names
     return check_box_region(names, region, fixed, list(held_values(kinematics)))
 
 
@@ -147,7 +147,7 @@ def quadrature(
         "use fewer nodes or region variables (synthesize_e2_nd integrates E2 over many "
         "variables by a Sobol rule)",
     )
-    names = tuple(kinematics.variable_names) or tuple(f"x{i + 1}" for i in range(kinematics.p))
+    names = kinematics.names
     t, tw = np.polynomial.legendre.leggauss(nodes)
     axes, weights = [], []
     for lo, hi in box.values():
@@ -184,7 +184,7 @@ def _e1_diverges(
     points moved onto each face of the box (a zero on a face is outside the
     Gauss-Legendre points but makes the integral diverge all the same). Points where dh is
     not defined, and face points where J loses rank, do not count."""
-    names = list(kinematics.variable_names) or [f"x{i + 1}" for i in range(kinematics.p)]
+    names = kinematics.names
     faces = []
     for name, ends in box.items():
         for end in ends:

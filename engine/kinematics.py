@@ -119,6 +119,11 @@ class Kinematics(abc.ABC):
     def jacobian(self, x: FloatArray) -> FloatArray:
         """J(x) = dk/dx: (..., p) -> (..., r, p)."""
 
+    @property
+    def names(self) -> tuple[str, ...]:
+        """The variables' names, ``x1`` ... ``xp`` for a kinematics that gives none."""
+        return tuple(self.variable_names) or tuple(f"x{i + 1}" for i in range(self.p))
+
     def forward_jacobian(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
         """k(x) and J(x) of eq. (4) together; a subclass that has both from one pass (a serial
         chain's) implements its own."""

@@ -212,7 +212,7 @@ def map_singularities(
             "nodes or region variables",
             "nodes",
         )
-    names = list(kinematics.variable_names) or [f"x{i + 1}" for i in range(kinematics.p)]
+    names = kinematics.names
     axes = [names.index(n) for n in box]
     mesh = np.meshgrid(*(np.linspace(lo, hi, nodes) for lo, hi in box.values()), indexing="ij")
     shape = mesh[0].shape

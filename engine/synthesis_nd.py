@@ -97,7 +97,7 @@ def best_frame_axes(kin: Kinematics, box: Mapping, fix: Mapping) -> list[int]:
     """The p - r joints (1-based) whose axes give the best-conditioned kernel frame at the box's
     centre: the largest least eigenvalue of E^T N E (:func:`kernel_frame`;
     the frame is degenerate where it is 0), over every choice of p - r joints at once."""
-    names = list(kin.variable_names) or [f"x{i + 1}" for i in range(kin.p)]
+    names = kin.names
     x = np.array([fix.get(n, 0.0) for n in names], dtype=float)
     for n, (lo, hi) in box.items():
         x[names.index(n)] = 0.5 * (lo + hi)
@@ -190,7 +190,7 @@ class _Rule:
 
     def __init__(self, kinematics, box, fix, nodes, seed, axes, chunk=CHUNK):
         self.kin, self.box, self.axes, self.chunk = kinematics, box, axes, chunk
-        names = tuple(kinematics.variable_names) or tuple(f"x{i + 1}" for i in range(kinematics.p))
+        names = kinematics.names
         self.variables = [names.index(n) for n in box]
         lo = np.array([v[0] for v in box.values()])
         hi = np.array([v[1] for v in box.values()])
