@@ -36,7 +36,7 @@ from scipy import linalg
 
 from .augmentations import Polynomial2
 from .exceptions import InvalidInputError
-from .exports import Columns
+from .exports import Columns, json_values
 from .functionals import Region, check_region, error_functional_e2
 from .inverses import pseudoinverse, require_kinematics
 from .kinematics import Kinematics, Manipulator2
@@ -121,17 +121,17 @@ class SynthesisResult(Columns):
         }
 
     def as_dict(self) -> dict:
-        """JSON-friendly summary: e2, degree, region, fixed, convergence, the cubic fit's E2 and
-        coefficients (no basis coefficients; :attr:`grid` holds h on a grid)."""
-        return {
-            "e2": self.e2,
-            "degree": self.degree,
-            "region": {k: list(v) for k, v in self.region.items()},
-            "fixed": dict(self.fixed),
-            "convergence": list(self.convergence),
-            "polynomial_e2": None if np.isnan(self.polynomial_e2) else self.polynomial_e2,
-            "polynomial_coefficients": self.polynomial_coefficients(),
-        }
+        """JSON values (None for a divergent E2): e2, degree, the cubic fit's E2, region, fixed,
+        convergence, the cubic's coefficients (not the basis's; :attr:`grid` holds h)."""
+        return json_values(
+            {
+                **{key: getattr(self, key) for key in ("e2", "degree", "polynomial_e2")},
+                "region": {k: list(v) for k, v in self.region.items()},
+                "fixed": dict(self.fixed),
+                "convergence": list(self.convergence),
+                "polynomial_coefficients": self.polynomial_coefficients(),
+            }
+        )
 
     def polynomial_coefficients(self) -> dict[str, float]:
         """Cubic coefficients keyed like ``"x2^2 x3^1"`` (JSON-friendly)."""

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
+import json
 
 import numpy as np
 import pytest
@@ -167,3 +169,14 @@ def test_a_map_of_two_degrees_prints_each():
     assert repr(synthesize_e2(Manipulator2(), box, degree=4)).startswith(
         "SynthesisResult(E2 = 0.443087, degree 4, x2 in [-1, 1]"
     )
+
+
+def test_as_dict_is_strict_json_for_a_divergent_e2():
+    """A divergent E2 (inf) or no cubic fit's E2 (NaN) is null in as_dict(), the rule of every
+    result's as_dict(), so json.dumps(..., allow_nan=False) takes it."""
+    res = synthesize_e2(Manipulator2(), {"x2": (-1.0, 1.0), "x3": (0.5, 2.0)}, degree=3)
+    broken = dataclasses.replace(res, e2=np.inf, polynomial_e2=np.nan)
+    d = json.loads(json.dumps(broken.as_dict(), allow_nan=False))
+    assert d["e2"] is None and d["polynomial_e2"] is None
+    assert d["degree"] == 3 and d["region"] == {"x2": [-1.0, 1.0], "x3": [0.5, 2.0]}
+    assert json.loads(json.dumps(res.as_dict(), allow_nan=False))["e2"] == pytest.approx(res.e2)
