@@ -44,15 +44,37 @@ function slider(c, value, send) {
 }
 
 const rows = new Map(); // control key -> its label (where its errors show)
+// Whether the control ``key`` is about ``field`` (a dotted path): the field, a coordinate of it
+// (x0.1 of x0), or the vector control holding it; the first such control.
+const about = (key, field) => key === field || field.startsWith(`${key}.`) || key.startsWith(`${field}.`);
+const firstKey = (field) => [...rows.keys()].find((k) => about(k, field));
 
-// An error beside the control ``key``, quoting what the user wrote.
-function fieldError(key, typed, message) {
+// An error beside the control ``key``, quoting what the user wrote; every control of ``field``
+// (the key's own, or all of x0's) is marked invalid while the note stays (``clear``).
+function fieldError(key, typed, message, field = key) {
   const row = rows.get(key);
-  if (!row) return false;
+  if (!row) return null;
   let note = row.querySelector(":scope > .field-error");
-  if (!note) { note = el("span", { className: "field-error", role: "alert" }); row.append(note); }
+  if (note) invalid(note.dataset.field, false);
+  else { note = el("span", { className: "field-error", role: "alert" }); row.append(note); }
   note.textContent = typed === undefined ? message : `“${typed}” ${message}`;
-  return true;
+  note.dataset.field = field;
+  invalid(field, true);
+  return note;
+}
+
+function invalid(field, on) {
+  for (const [key, row] of rows) {
+    if (!about(key, field)) continue;
+    for (const input of row.querySelectorAll("input, select, button")) {
+      if (on) input.setAttribute("aria-invalid", "true"); else input.removeAttribute("aria-invalid");
+    }
+  }
+}
+
+function clear(note) {
+  invalid(note.dataset.field, false);
+  note.remove();
 }
 
 // Text typed into a number box that is not a number: said beside the control and, replacing
@@ -68,21 +90,32 @@ function notANumber(c, typed) {
 // with the text the user typed there when there was one; whether a control was found.
 const typedText = new Map(); // control key -> the text last sent from a box
 export function showRefusal(field, message) {
-  const key = [...rows.keys()].find((k) => k === field || field.startsWith(`${k}.`) || k.startsWith(`${field}.`));
+  const key = firstKey(field);
   if (!key) return false;
   const typed = typedText.get(key);
-  return fieldError(key, typed, typed === undefined ? message : `was refused: ${message}`);
+  return fieldError(key, typed, typed === undefined ? message : `was refused: ${message}`, field) !== null;
 }
 
-// A control's error, once its value changed (in the 3D scene, another client): what it
-// quoted is no longer what the control holds.
+// The inputs where a result's runs stopped (a run's ``field``: x0, a singular start), marked as
+// a refusal is, with the runs' messages, until they change or a result without them comes.
+export function showStopped(summary) {
+  document.querySelectorAll("#controls .field-error[data-run]").forEach(clear);
+  const messages = new Map(); // field -> the messages of the runs stopped there
+  for (const run of Object.values(summary)) if (run.field) messages.set(run.field, [...(messages.get(run.field) || []), run.message]);
+  for (const [field, said] of messages) {
+    const note = firstKey(field) && fieldError(firstKey(field), undefined, said.join("; "), field);
+    if (note) note.dataset.run = "";
+  }
+}
+
+// The errors about a control, once its value changed (here, in the 3D scene, another client):
+// what they quoted is no longer what the control holds.
 function clearFieldError(key) {
-  const note = rows.has(key) && rows.get(key).querySelector(":scope > .field-error");
-  if (note) note.remove();
+  for (const note of document.querySelectorAll("#controls .field-error")) if (about(key, note.dataset.field)) clear(note);
 }
 
 export function clearFieldErrors() {
-  for (const note of document.querySelectorAll("#controls .field-error")) note.remove();
+  document.querySelectorAll("#controls .field-error").forEach(clear);
 }
 
 // A select shown as buttons (c.inline): every option one click away.

@@ -2,7 +2,7 @@
 // builds its controls from the session's control specification, follows the session's events
 // and draws its panels; the 3D scene (iframe, viser) shows and changes the same session.
 import { change, endOnClose, follow, openSession, session, api } from "./api.js";
-import { onNotSent, showControls, showRefusal } from "./controls.js";
+import { onNotSent, showControls, showRefusal, showStopped } from "./controls.js";
 import { $, el, fmt } from "./dom.js";
 import { robotEditor } from "./editor.js";
 import { algorithmKey, applyFunctionals, drawFigures, layoutPanels, markStale, onAhead, setExportNote, showChosen } from "./panels.js";
@@ -86,6 +86,7 @@ async function onResult(msg) {
   document.body.dataset.robot = msg.state.robot;
   showProgress(1, 0);
   renderVerdict(msg);
+  showStopped(msg.generation === session.generation ? msg.summary : {}); // (not the controls' state: none)
   $("#panels").classList.remove("outdated");
   delete document.body.dataset.failed;
   exportLinks(msg.generation);

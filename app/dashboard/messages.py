@@ -101,6 +101,7 @@ def summary(result: DashboardResult) -> dict:
             "points": len(run.theta),
             "seconds": round(run.seconds, 4),
             "cached": bool(result.cached.get(a, False)),
+            "field": run.field,
         }
     for a, report in limits_summary(result).items():
         out[a]["limits"] = report

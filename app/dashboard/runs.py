@@ -62,6 +62,8 @@ class AlgorithmRun:
         The engine's record of the inverse, targets and settings of the legs
         (:attr:`jik.engine.results.RepeatabilityResult.settings`): a run going on from this
         one must have the same.
+    field : str or None
+        The input its first leg's error names (``x0``: a singular start), which the page marks.
     """
 
     algorithm: str
@@ -79,6 +81,7 @@ class AlgorithmRun:
     status: str = "converged"
     platform: np.ndarray | None = None
     settings: RunSettings | None = None
+    field: str | None = None
 
 
 @dataclass(frozen=True)
@@ -143,6 +146,7 @@ def algorithm_run(
     L = len(targets)
     parts: list[tuple] = []  # (theta, x, y, error, h, leg index) of every leg
     offset, last, failure = 0.0, "", ""  # (the last leg's message; what stopped the run)
+    start_field: str | None = None
     status = "converged"  # (the last leg's)
     earlier = None
     if resume is not None:
@@ -153,7 +157,7 @@ def algorithm_run(
         earlier = Resume(x0, resume.leg_end, guides, resume.settings)
 
     def on_leg(leg: Leg) -> None:
-        nonlocal offset, last, failure, status
+        nonlocal offset, last, failure, status, start_field
         res = cast(SolveResult, leg.result)  # (one start, recorded)
         status = res.status
         tr = cast(Trajectory, res.trajectory)
@@ -162,6 +166,8 @@ def algorithm_run(
         where = f"cycle {leg.cycle + 1}, leg {leg.index + 1}"
         if leg.stopped_by is not None:
             failure = f"{where} stopped: {leg.stopped_by}"
+            if leg.cycle == leg.index == 0:  # (a leg from x0: the error's input is the state's)
+                start_field = getattr(leg.stopped_by, "field", None)
         elif not res.success:
             failure = f"{where}: {_leg_message(res, cap, inverse.kinematics)}"
         else:
@@ -205,6 +211,7 @@ def algorithm_run(
         seconds=time.perf_counter() - t0,
         status=status,
         settings=run.settings,
+        field=start_field,
     )
     t = platform_time(kin)
     return out if t is None else replace(out, platform=kin.path(out.x, t))

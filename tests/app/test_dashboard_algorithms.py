@@ -212,6 +212,18 @@ def test_damped_goes_through_a_singular_start_where_the_pseudoinverse_stops():
     assert "it went through where the pseudoinverse stopped" in said[("damped", "why")]
 
 
+def test_a_run_stopped_at_a_singular_start_names_the_field_x0():
+    """The stretched 3R arm's first leg starts singular for the pseudoinverse: its run and its
+    summary name x0 (the engine's field), for the page to mark the start's controls; damped
+    least squares goes through and names none."""
+    from jik.app.dashboard.messages import summary
+
+    result, _ = _damped_beside_pseudoinverse([0.0, 0.0, 0.0], [2.0, 1.0])
+    said = summary(result)
+    assert said["pseudoinverse"]["field"] == "x0" and said["damped"]["field"] is None
+    assert "J J^T is singular" in said["pseudoinverse"]["message"]
+
+
 def test_damped_reports_its_task_error_at_the_reach_boundary():
     """A target beyond reach: the pseudoinverse stalls at 1.22, damped least squares stretches
     the arm to the singular configuration and is left with 0.5; both numbers are said."""

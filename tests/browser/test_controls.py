@@ -164,3 +164,32 @@ def test_a_refusal_beside_a_control_goes_when_its_value_changes_elsewhere(tabs):
     tab.wait_drawn(generation)
     expect(box).to_have_value("2.000")
     expect(error).to_have_count(0)
+
+
+@pytest.mark.slow
+def test_a_singular_start_is_marked_at_the_starts_controls(tabs):
+    """A link to the 3R arm stretched out, x0 = (0, 0, 0), where J J^T is singular: the runs stop
+    at their first leg, and the start's controls are marked as a refused value's are (the
+    engine's message beside them, each coordinate invalid); a coordinate moved off the
+    singular set takes every mark away."""
+    from urllib.parse import quote
+
+    chain = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 1.0, 1.0]}
+    state = {"robot": "planar_chain", "robot_definition": chain, "x0": [0.0, 0.0, 0.0]}
+    state |= {"task": "target", "target": [2.0, 1.0]}
+    tab = tabs.open("/?state=" + quote(json.dumps(state)))
+    page = tab.page
+    boxes = [page.locator(f"#ctl-x0-{i}-value") for i in range(3)]
+    note = page.locator("label", has=boxes[0]).locator(".field-error")
+    expect(note).to_contain_text("J J^T is singular")
+    expect(note).to_contain_text("at x = (0, 0, 0)")
+    for i, box in enumerate(boxes):
+        expect(box).to_have_attribute("aria-invalid", "true")
+        expect(page.locator(f"#ctl-x0-{i}")).to_have_attribute("aria-invalid", "true")
+    assert tab.snapshot()["summary"]["pseudoinverse"]["field"] == "x0"
+
+    boxes[1].fill("0.5")
+    tab.change(lambda: boxes[1].dispatch_event("change"))
+    assert tab.snapshot()["summary"]["pseudoinverse"]["success"]
+    expect(page.locator("#controls .field-error")).to_have_count(0)
+    expect(page.locator("#controls [aria-invalid]")).to_have_count(0)
