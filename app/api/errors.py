@@ -35,7 +35,7 @@ from ...engine.exceptions import InvalidInputError
 from ..compute.atlas_jobs import AtlasJobNotFound, AtlasJobsFull
 from ..compute.exceptions import ComputeError, RequestError, ServiceUnavailable
 from ..compute.schemas import ErrorResponse
-from ..compute.schemas.wording import field_loc
+from ..compute.schemas.wording import field_loc, field_text, without_field
 from ..dashboard.sessions import ExportUnavailable, SessionNotFound, SessionsFull
 from .validation import validation_detail
 
@@ -57,8 +57,11 @@ def _refused(loc: list[str | int], msg: str, kind: str = "value_error") -> JSONR
 
 def field_error_response(exc: RequestError | InvalidInputError) -> JSONResponse:
     """422 for a value the request's checks, the dashboard's model or the engine refused, at
-    the field it names."""
-    return _refused(field_loc(exc.field or ""), str(exc))
+    the field it names, the message led by that field whoever wrote it (the engine's own
+    mention of it, in any notation, dropped: :func:`without_field`)."""
+    field = exc.field or ""
+    said = f"{field_text(field)}: {without_field(str(exc), field)}" if field else str(exc)
+    return _refused(field_loc(field), said)
 
 
 #: What FastAPI says of a body it could not parse (a JSON nested too deep, bytes that are not

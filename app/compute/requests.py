@@ -67,8 +67,12 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
     return _Setup(built.spec, built.kinematics, inverse, run, head)
 
 
-#: A run's arguments in the engine that are a request's fields, by the request's names.
-_ENGINE_FIELDS = ("x0", "target", "gamma", "tolerance", "max_iterations", "path", "cycles", "mode")
+#: A run's or a synthesis' arguments in the engine that are a request's fields, by the
+#: request's names.
+_ENGINE_FIELDS = (
+    *("x0", "target", "gamma", "tolerance", "max_iterations", "path", "cycles", "mode"),
+    *("region", "fixed"),
+)
 _REQUEST_NAMES = {"tol": "tolerance", "y_d": "target"}
 
 

@@ -93,12 +93,22 @@ def test_a_link_state_opens_a_session_with_that_state(app, client):
 
 @pytest.mark.parametrize(
     ("state", "field"),
-    [({"gamma": -1}, "gamma"), ({"robot": "nope"}, "robot"), ({"cycles": 0}, "cycles")],
+    [
+        ({"gamma": -1}, "gamma"),
+        ({"robot": "nope"}, "robot"),
+        ({"cycles": 0}, "cycles"),
+        ({"x0": [1, 2]}, "x0"),
+        ({"robot_parameters": {"l": -1}}, "robot_parameters.l"),
+    ],
 )
 def test_a_bad_link_state_is_refused_with_its_field(client, state, field):
+    """At ``state.<field>``, the message led by it once, whichever check refused it."""
     r = client.post("/api/sessions", json={"state": state})
     assert r.status_code == 422, r.text
-    assert r.json()["detail"][0]["loc"] == ["body", "state", field]
+    detail = r.json()["detail"][0]
+    assert detail["loc"] == ["body", "state", *field.split(".")]
+    assert detail["msg"].startswith(f"state.{field}: ")
+    assert not detail["msg"].startswith(f"state.{field}: {field}")
 
 
 def test_bad_changes_name_their_field_and_leave_the_state(client):

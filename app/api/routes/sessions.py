@@ -23,6 +23,7 @@ from sse_starlette import EventSourceResponse, ServerSentEvent
 
 from ....engine.exceptions import InvalidInputError
 from ...compute.schemas import INTEGRAL
+from ...compute.schemas.wording import refused, without_field
 from ...dashboard import export_file
 from ...dashboard.controls import controls_message
 from ...dashboard.messages import LatestEvents
@@ -97,8 +98,7 @@ async def create_session(body: SessionCreate, store: Store, pool: Pool) -> JSONR
         await vet_definition(pool, patch)
         session = await asyncio.to_thread(store.create, patch, body.low_end)
     except InvalidInputError as exc:  # (the link's state is the body's "state")
-        exc.field = f"state.{exc.field}" if exc.field else "state"
-        raise
+        raise refused(f"state.{exc.field or ''}", without_field(str(exc), exc.field)) from None
     return JSONResponse(status_code=201, content=_created(session))
 
 

@@ -52,7 +52,9 @@ def without_field(text: str, field: str | None) -> str:
     """An engine message without its leading mention of ``field`` (``lengths[1] must be ...``
     -> ``must be ...``): the error's prefix names the field, in the request's words."""
     if field:
-        for name in dict.fromkeys((field, field_text(field))):
+        head, *rest = _parts(field)  # (and as Python subscripts it: ``region['x2']``)
+        python = head + "".join(f"[{int(p)}]" if p.isdigit() else f"[{p!r}]" for p in rest)
+        for name in dict.fromkeys((field, field_text(field), python)):
             if text.startswith(name) and text[len(name) : len(name) + 1] in (":", " "):
                 return text[len(name) :].lstrip(":").lstrip()
     return text
