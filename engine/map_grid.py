@@ -1,6 +1,7 @@
 """An augmenting map h on a plane of a box of the joint space: the slice that shows h over the
 design region of sec. 5 (where E1 (13) and E2 (18) are taken), along the two variables of the
-box that h varies most with, the others held at the box's centre or at given values.
+box that h varies most with, the others held at the box's centre, at given values or where E1,
+E2 and their syntheses hold them (:func:`jik.engine.kinematics.held_values`).
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ import numpy as np
 from .augmentations import AugmentingMap
 from .exceptions import JikError
 from .inverses import require_map
+from .kinematics import Kinematics, held_values
 from .progress import ProgressCallbacks
 from .validation import FloatArray, check_box_region, count
 
@@ -95,7 +97,7 @@ def grid_axes(
 
 def map_grid(
     amap: AugmentingMap,
-    variable_names: Sequence[str],
+    kinematics: Kinematics | Sequence[str],
     region: Mapping[str, tuple[float, float]],
     fixed: Mapping[str, float] | None = None,
     n: int = 21,
@@ -107,12 +109,14 @@ def map_grid(
     ----------
     amap : AugmentingMap
         The map h of eq. (9), of the configurations x (..., p).
-    variable_names : sequence of str, length p
-        The robot's variable names, in x's order.
+    kinematics : Kinematics or sequence of str, length p
+        The robot (its variables' names, in x's order), or the names alone.
     region : dict name -> (lo, hi)
         The box; its variables other than the two axes are held at their centre.
     fixed : dict name -> value, optional
-        The values of variables outside the box (default 0).
+        The values of variables outside the box; by default a robot's
+        :func:`~jik.engine.kinematics.held_values` (those of E1 (13), E2 (18) and their
+        syntheses over the same box), 0 for names alone.
     n : int
         Grid points per axis, 2 to :data:`MAX_N`.
 
@@ -125,12 +129,14 @@ def map_grid(
     Raises
     ------
     InvalidInputError
-        A region or fixed value that is not one of ``variable_names``' (field ``region.<name>``,
+        A region or fixed value that is not one of the variables' (field ``region.<name>``,
         ``fixed``), an empty or reversed interval, or ``n`` out of range.
     """
-    names = list(variable_names)
+    robot = kinematics if isinstance(kinematics, Kinematics) else None
+    names = list(kinematics.names if robot is not None else kinematics)
     amap = require_map(amap, names, "amap")
-    region, held = check_box_region(names, region, fixed)
+    default = None if robot is None else list(held_values(robot))
+    region, held = check_box_region(names, region, fixed, default)
     n = count(n, "n", 2, MAX_N)
     if len(region) < 2:
         return None

@@ -6,6 +6,8 @@ import pytest
 
 from jik.engine.augmentations import PaperCubic
 from jik.engine.exceptions import JikError
+from jik.engine.functionals import check_region
+from jik.engine.kinematics import Manipulator2
 from jik.engine.map_grid import axes_along, grid_axes, map_grid, slice_values, varying_most
 
 NAMES = ("x1", "x2", "x3")
@@ -31,6 +33,25 @@ def test_the_grid_holds_h_at_its_points_the_others_at_the_box_centre_or_fixed():
             assert grid.h[i, j] == pytest.approx(
                 float(amap.value(np.array([0.7, a, b]))), abs=1e-14
             )
+
+
+def test_a_robots_grid_holds_the_others_where_e1_e2_and_the_syntheses_do():
+    """Manipulator 2's cubic (38) over a box of x1, x2: x3 is held at the robot's start pi/2
+    (held_values), the plane on which E1, E2 and the syntheses of that box take h, not at 0
+    (where h's extended Jacobian is singular); a fixed value still wins, and a map of names
+    alone holds them at 0."""
+    kin, amap = Manipulator2(1.0), PaperCubic()
+    box = {"x1": (-1.0, 1.0), "x2": (0.4, 2.0)}
+    x3 = check_region(kin, box)[1]["x3"]
+    assert x3 == pytest.approx(np.pi / 2)
+    for robot, fixed, at in ((kin, None, x3), (kin, {"x3": 0.3}, 0.3), (NAMES, None, 0.0)):
+        grid = map_grid(amap, robot, box, fixed=fixed, n=3)
+        assert grid is not None
+        want = [
+            [float(amap.value(np.array([a, b, at]))) for b in grid.axes["x2"]]
+            for a in grid.axes["x1"]
+        ]
+        np.testing.assert_allclose(grid.h, want, atol=1e-14)
 
 
 def test_axes_of_a_box_of_three_follow_the_largest_partial_derivatives():
