@@ -132,10 +132,11 @@ def map_grid(
         A region or fixed value that is not one of the variables' (field ``region.<name>``,
         ``fixed``), an empty or reversed interval, or ``n`` out of range.
     """
-    robot = kinematics if isinstance(kinematics, Kinematics) else None
-    names = list(kinematics.names if robot is not None else kinematics)
+    if isinstance(kinematics, Kinematics):
+        names, default = list(kinematics.names), list(held_values(kinematics))
+    else:
+        names, default = list(kinematics), None
     amap = require_map(amap, names, "amap")
-    default = None if robot is None else list(held_values(robot))
     region, held = check_box_region(names, region, fixed, default)
     n = count(n, "n", 2, MAX_N)
     if len(region) < 2:
