@@ -146,10 +146,12 @@ class RepeatabilityResult(Columns):
         Examples
         --------
         >>> import numpy as np, jik.engine as jik
-        >>> arm = jik.Manipulator2()
-        >>> run = jik.repeatability(jik.Pseudoinverse(arm), [0, 0, np.pi / 2], [(1, 1)], 2)
-        >>> print(run.findings()[0].text)  # doctest: +ELLIPSIS
-        pseudoinverse J^P#: not repeatable. After 2 cycles the joints end ‖x − x0‖ = ...
+        >>> arm, path = jik.Manipulator2(), [(1, 1), (1, 2), (0, 2)]
+        >>> run = jik.repeatability(jik.Pseudoinverse(arm), [0, 0, np.pi / 2], path, 2)
+        >>> for finding in run.findings("[m and rad mixed]"):
+        ...     print(finding.role, "|", finding.text[:60])
+        finding | pseudoinverse J^P#: not repeatable. After 2 cycles the joint
+        why | Why: J^P# picks the minimum-norm joint velocity, which has n
         """
         from .findings import verdict
 

@@ -3,6 +3,7 @@ characteristics became undefined (jik.engine.reproductions.unicycle.undefined_wh
 
 from __future__ import annotations
 
+import doctest
 from types import SimpleNamespace
 
 import numpy as np
@@ -165,6 +166,14 @@ def test_a_result_says_its_own_findings_with_its_settings():
         f"{pinv.drift[-1]:.3g} away from x0, growing from {pinv.drift[0]:.3g} after cycle 1."
     )
     assert why == (pseudoinverse_why(pinv.drift), "why", "pseudoinverse")
+
+
+def test_the_findings_example_runs():
+    """RepeatabilityResult.findings' docstring example prints what it says."""
+    (test,) = doctest.DocTestFinder().find(jik.RepeatabilityResult.findings, "findings")
+    runner = doctest.DocTestRunner()
+    runner.run(test)
+    assert runner.summarize(verbose=False) == (0, 4)
 
 
 def test_a_discrete_run_near_gamma_two_says_h_was_lost_and_why():
