@@ -43,8 +43,9 @@ NAMES = {
 
 
 class Finding(NamedTuple):
-    """One sentence: its ``text``, its ``role`` ("finding", "why", "note" or "failure") and
-    the ``algorithm`` it is about (None: the run's settings, not one inverse)."""
+    """One sentence: its ``text``, its ``role`` ("finding", "why", "note" or "failure"; the
+    dashboard adds "warning") and the ``algorithm`` it is about (None: the run's settings, not
+    one inverse)."""
 
     text: str
     role: str = "finding"
@@ -305,8 +306,8 @@ def verdict(
         The drift's unit, e.g. "[rad]" (:func:`jik.engine.units.norm_unit`); "" unstated.
     undefined : sequence of Finding
         Why the extended inverse's map became undefined along its run, said instead of its why
-        and the gamma note (the unicycle's map (29): :func:`jik.engine.reproductions.unicycle.
-        undefined_why`).
+        and the gamma note (the unicycle's map (29):
+        :func:`jik.engine.reproductions.unicycle.undefined_why`).
     """
     out = [
         Finding(text, role, a)
