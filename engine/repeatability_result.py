@@ -8,7 +8,7 @@ what it found, and why, in sentences (:meth:`RepeatabilityResult.findings`).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -126,7 +126,8 @@ class RepeatabilityResult(Columns):
         came back to x0 after every cycle (sec. 5.2.1, Table 1; ‖x − x0‖ below
         :data:`~jik.engine.repeatability.REPEATABLE_DRIFT`), where a failed leg stopped; for
         the pseudoinverse (8) why it drifts, for the extended Jacobian inverse (11) whether h
-        stayed at h(x0) (eq. (12), from h after each leg) and, in discrete mode, that the
+        stayed at h(x0) (eq. (12), from h at every point of legs recorded with ``record=True``,
+        else from h after each leg) and, in discrete mode, that the
         iteration keeps h only approximately and what a gamma near 2 does.
 
         Parameters
@@ -167,6 +168,9 @@ class RepeatabilityResult(Columns):
         drift = self.drift[i]
         done = drift[: np.cumprod(np.isfinite(drift)).sum()]  # (the cycles that ended)
         h = None if self.h is None else self.h[i]
+        along = [None if leg.trajectory is None else leg.trajectory.h for leg in self.leg_results]
+        if h is not None and along and all(a is not None for a in along):
+            h = np.concatenate(cast(list, along))  # (every recorded point, as the dashboard's)
         run = _Member(done, bool(np.asarray(self.success)[i]), str(np.asarray(self.message)[i]), h)
         return verdict({self.algorithm: run}, True, self.mode, self.gamma, unit)
 

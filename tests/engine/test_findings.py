@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import jik.engine as jik
+from jik.engine.augmentations import h_change
 from jik.engine.findings import (
     NAMES,
     damped_findings,
@@ -193,6 +194,22 @@ def test_a_discrete_run_near_gamma_two_says_h_was_lost_and_why():
     assert said[2].text.startswith("The discrete algorithm x ← x − γ J^E# e keeps h only")
     assert said[3] == (gamma_note("discrete", 1.89), "note", None)
     assert "1 − γ = -0.89 per step" in said[3].text
+
+
+def test_recorded_legs_judge_h_at_every_point_as_the_dashboard_does():
+    """With record=True the change of h is taken over every point of the legs, the dashboard's
+    verdict's measure, not only at the legs' ends: the discrete overshoot at gamma = 1.89 moves
+    h further between the ends than at them."""
+    inverse = jik.ExtendedInverse(jik.Manipulator2(), jik.PaperCubic())
+    path, x0 = [(1, 1), (1, 2), (0, 2)], [0, 0, np.pi / 2]
+    runs = [
+        jik.repeatability(inverse, x0, path, 3, mode="discrete", gamma=1.89, record=record)
+        for record in (False, True)
+    ]
+    along = np.concatenate([leg.trajectory.h for leg in runs[1].leg_results])
+    assert h_change(along) > h_change(runs[0].h)
+    assert f"changed by {h_change(along):.3g} along" in runs[1].findings()[1].text
+    assert f"changed by {h_change(runs[0].h):.3g} along" in runs[0].findings()[1].text
 
 
 def test_a_batch_says_the_findings_of_the_start_asked_for():
