@@ -138,13 +138,15 @@ def _inverse(robot, args: argparse.Namespace, x0):
     )
 
 
-def _document(robot, result, report, as_json: bool) -> None:
+def _document(robot, result, report, as_json: bool, findings=()) -> None:
     """The result in the engine's names (``as_dict()``: x0, y_d or targets, x, legs, ...) with
-    the robot, its limits' report, notes and the units of x and y; printed as JSON, or its
+    the robot, its limits' report, notes and the units of x and y (and a repeatability run's
+    ``findings``, :meth:`~jik.engine.RepeatabilityResult.findings`); printed as JSON, or its
     first lines as text."""
     out = {
         "robot": robot.spec.title,
         **result.as_dict(),
+        **({"findings": [{"text": f.text, "role": f.role} for f in findings]} if findings else {}),
         **({} if report is None else {"limits": report.as_dict()}),
         **_notes(robot),
         "units": robot.units.summary(),
@@ -179,6 +181,7 @@ def solve_command(args: argparse.Namespace) -> int:
 def repeatability_command(args: argparse.Namespace) -> int:
     from ..engine.limits import repeatability_report, robot_limits
     from ..engine.repeatability import repeatability
+    from ..engine.units import norm_unit
 
     robot, x0, settings = _setup(args)
     path = parse_path(args.path, "--path") if args.path else robot.spec.default_loop("--path")
@@ -186,13 +189,15 @@ def repeatability_command(args: argparse.Namespace) -> int:
     record = robot_limits(robot.kinematics) is not None  # (limits: check whole legs)
     rep = repeatability(inverse, x0, path, cycles=args.cycles, record=record, **settings)
     report = _limits(robot, lambda limits, names: repeatability_report(limits, rep, names))
-    _document(robot, rep, report, args.json)
+    findings = rep.findings(norm_unit(robot.units.x))
+    _document(robot, rep, report, args.json, findings)
     if not args.json:
         print(f"  x0 = {_fmt(x0)}; {len(rep.targets)} legs a cycle")
         for c, (end, drift) in enumerate(zip(rep.cycle_end, rep.drift, strict=True)):
             print(f"  cycle {c + 1}: x = {_fmt(end)}, |x - x0| = {drift:.3e}")
         if report is not None:
             print(f"  joint limits: {report}")
+        print("\n".join(f"  {f.text}" for f in findings))
     return 0 if rep.success else 1
 
 

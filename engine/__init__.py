@@ -46,7 +46,9 @@ Solving (the continuation algorithm, eq. (7))
 Repeatability (sec. 5.2.1, Table 1)
     repeatability               drive a closed path cycle after cycle -> RepeatabilityResult
     repeatable, h_change        whether every cycle came back to x0; how much h changed, eq. (12)
-    run_findings, extended_why  what a run found, and why (h kept, eq. (12)), in sentences
+    RepeatabilityResult.findings  what a run found, and why (h kept, eq. (12)), in sentences
+    Finding                     one such sentence: text, role, algorithm
+    run_findings, extended_why  the same from a run's pieces (drift, h, mode, gamma)
     Resume, Leg                 an earlier run to go on from (as x0); a leg as a progress sees it
     Progress, ProgressCallbacks what a long computation reports, and how to cancel it
 Functionals and synthesis (secs. 3-4)
@@ -136,6 +138,7 @@ _EXPORTS = {
     "repeatable": "repeatability",
     "h_change": "augmentations",
     "run_findings": "findings",
+    "Finding": "findings",
     "extended_why": "findings",
     "Progress": "progress",
     "ProgressCallbacks": "progress",
@@ -184,6 +187,7 @@ __all__ = [
     "E1Optimal",
     "E2Optimal",
     "ExtendedInverse",
+    "Finding",
     "FormulaError",
     "FormulaKinematics",
     "FormulaMap",
@@ -296,7 +300,7 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
         SingularConfigurationError,
     )
     from .extended_vector import VectorExtendedInverse
-    from .findings import extended_why, run_findings
+    from .findings import Finding, extended_why, run_findings
     from .formula_kinematics import FormulaKinematics, FormulaMap
     from .functional_report import functionals_report
     from .functionals import error_functional_e1, error_functional_e2

@@ -15,10 +15,15 @@ least squares is left with where it damps (it is not a right inverse, J J# != I)
 weighted least-norm inverse (Chan and Dubey 1995) kept every joint within its limits.
 
 Each function returns ``(text, role)`` pairs, ``role`` one of "finding" (what the run did),
-"why", "note" or "failure".
+"why", "note" or "failure"; :func:`verdict` gathers the paper's part of them for runs of several
+inverses as :class:`Finding` s (:meth:`RepeatabilityResult.findings
+<jik.engine.repeatability_result.RepeatabilityResult.findings>` for one run).
 """
 
 from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -27,6 +32,24 @@ from .repeatability import REPEATABLE_DRIFT, repeatable
 
 #: In discrete mode, a gamma at or above this is "near 2" (the iteration's stability limit).
 GAMMA_NEAR_TWO = 1.5
+#: Each algorithm's name in the sentences.
+NAMES = {
+    "pseudoinverse": "pseudoinverse J^P#",
+    "extended": "extended Jacobian J^E#",
+    "damped": "damped least squares J^DLS",
+    "weighted": "weighted least-norm J^W#",
+    "posture": "posture inverse (J^P# with a null-space pull)",
+}
+
+
+class Finding(NamedTuple):
+    """One sentence: its ``text``, its ``role`` ("finding", "why", "note" or "failure"; the
+    dashboard adds "warning") and the ``algorithm`` it is about (None: the run's settings, not
+    one inverse)."""
+
+    text: str
+    role: str = "finding"
+    algorithm: str | None = None
 
 
 def g(v: float) -> str:
@@ -38,6 +61,10 @@ def _cycles(n: int) -> str:
     return f"{n} cycle{'s' if n > 1 else ''}"
 
 
+def _amount(v: float, unit: str) -> str:
+    return f"{g(v)} {unit}" if unit else g(v)
+
+
 def drift_sentence(name: str, drift, unit: str) -> str:
     """Whether the run named ``name`` was repeatable, from its ``drift`` ||x - x0|| after each
     cycle (cycles,) in ``unit``: the largest drift if so (below
@@ -47,7 +74,7 @@ def drift_sentence(name: str, drift, unit: str) -> str:
     if repeatable(d):
         return (
             f"{name}: repeatable. After each of {_cycles(n)} the joints came back "
-            f"to x0 within {g(float(d.max()))} {unit} (‖x − x0‖ below {g(REPEATABLE_DRIFT)})."
+            f"to x0 within {_amount(float(d.max()), unit)} (‖x − x0‖ below {g(REPEATABLE_DRIFT)})."
         )
     trend = ""
     if n > 1:
@@ -59,7 +86,7 @@ def drift_sentence(name: str, drift, unit: str) -> str:
         )
     return (
         f"{name}: not repeatable. After {_cycles(n)} the joints end "
-        f"‖x − x0‖ = {g(float(d[-1]))} {unit} away from x0{trend}."
+        f"‖x − x0‖ = {_amount(float(d[-1]), unit)} away from x0{trend}."
     )
 
 
@@ -252,3 +279,51 @@ def weighted_findings(name: str, x, limits, names) -> list[tuple[str, str]]:
         ]
     out = sorted({names[k] for k in np.flatnonzero((below | above).any(axis=0))})
     return [(f"{name}: left its limits ({bounds}): {', '.join(out)}.", "failure")]
+
+
+def verdict(
+    runs: Mapping[str, Any],
+    closed: bool = True,
+    mode: str = "continuous",
+    gamma: float = 1.0,
+    unit: str = "",
+    undefined: Sequence[Finding] = (),
+) -> list[Finding]:
+    """What runs of the paper's test found and why: each run's :func:`run_findings`, then why
+    the pseudoinverse (8) drifted (:func:`pseudoinverse_why`), why the extended Jacobian inverse
+    (11) kept or lost h(x0) (:func:`extended_why`, eq. (12)) and :func:`gamma_note`.
+
+    Parameters
+    ----------
+    runs : mapping of str to run
+        By algorithm (a key of :data:`NAMES`), in order: objects with ``drift`` (cycles,),
+        ``success``, ``message`` and ``h`` (m,) or (m, p - r), h along the run (None without h).
+    closed : bool
+        A closed path driven cycle after cycle (False: one solve to a target).
+    mode, gamma : str, float
+        The algorithm (7), "continuous", or its discrete iteration with step ``gamma``.
+    unit : str
+        The drift's unit, e.g. "[rad]" (:func:`jik.engine.units.norm_unit`); "" unstated.
+    undefined : sequence of Finding
+        Why the extended inverse's map became undefined along its run, said instead of its why
+        and the gamma note (the unicycle's map (29):
+        :func:`jik.engine.reproductions.unicycle.undefined_why`).
+    """
+    out = [
+        Finding(text, role, a)
+        for a, run in runs.items()
+        for text, role in run_findings(NAMES[a], run.drift, run.success, run.message, closed, unit)
+    ]
+    if (
+        closed
+        and "pseudoinverse" in runs
+        and (why := pseudoinverse_why(runs["pseudoinverse"].drift))
+    ):
+        out.append(Finding(why, "why", "pseudoinverse"))
+    if "extended" in runs:
+        e = runs["extended"]
+        found = extended_why(e.h, e.drift, e.success, closed, mode, gamma)
+        out += undefined or [Finding(text, role, "extended") for text, role in found]
+        if not undefined and found and (note := gamma_note(mode, gamma)):
+            out.append(Finding(note, "note"))
+    return out

@@ -345,21 +345,7 @@ def repeatability(
                 legs[ids[k], c * L + j] = np.nan
             if progress is not None:
                 progress.leg(Leg(c, j, ids, res, stopped))
-    cycle_end = legs[:, L - 1 :: L]
-    drift = np.linalg.norm(cycle_end - xb[:, None, :], axis=-1)
-    if single:
-        return RepeatabilityResult(
-            xb[0],
-            targets[0],
-            legs[0],
-            cycle_end[0],
-            drift[0],
-            bool(alive[0]),
-            messages[0],
-            leg_results,
-            run,
-        )
-    return RepeatabilityResult(xb, targets, legs, cycle_end, drift, alive, tuple(messages), [], run)
+    return RepeatabilityResult.of_run(inverse, xb, targets, legs, alive, messages, leg_results, run)
 
 
 def _between(progress, where: str):

@@ -1,20 +1,26 @@
 """The result of driving a closed path cycle after cycle (eq. (7) leg by leg): the legs' ends,
 each cycle's end and its drift from the start, the quantity repeatability is judged by.
 
-It prints on one line and exports its numbers as :mod:`jik.engine.results`' results do.
+It prints on one line, exports its numbers as :mod:`jik.engine.results`' results do, and says
+what it found, and why, in sentences (:meth:`RepeatabilityResult.findings`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
+from .exceptions import InvalidInputError
 from .exports import Columns, coordinate_columns, json_values, short_text, short_vector
 from .results import SolveResult
 from .run_settings import RunSettings
-from .validation import FloatArray
+from .validation import FloatArray, count
+
+if TYPE_CHECKING:
+    from .findings import Finding
+    from .inverses import Inverse
 
 
 def _plural(n: int, noun: str) -> str:
@@ -42,6 +48,9 @@ class RepeatabilityResult(Columns):
     settings : RunSettings
         The inverse (``settings.algorithm``, ``settings.inverse``), mode, gamma, tol and
         max_iterations of every leg; also ``algorithm``, ``inverse``, ``mode`` and ``gamma``.
+    h : ndarray, shape (1 + cycles * L,) or (n, 1 + cycles * L), or None
+        The augmenting map h (9) at x0 and after each leg (a column per map when p - r > 1;
+        NaN after a failed leg); None for an inverse without h.
     """
 
     x0: FloatArray
@@ -53,6 +62,29 @@ class RepeatabilityResult(Columns):
     message: str | tuple[str, ...]
     leg_results: list[SolveResult]
     settings: RunSettings
+    h: FloatArray | None = None
+
+    @classmethod
+    def of_run(cls, inverse: Inverse, x0, targets, legs, alive, messages, leg_results, settings):
+        """The result of :func:`jik.engine.repeatability.repeatability` from its batch arrays:
+        ``x0`` (n, p), ``targets`` (n, L, r), ``legs`` (n, cycles * L, p), ``alive`` (n,) and
+        ``messages``; one start's (shapes without n) when ``leg_results`` or n is 1 and
+        ``targets`` of ``settings`` is (L, r)."""
+        cycle_end = legs[:, targets.shape[1] - 1 :: targets.shape[1]]
+        drift = np.linalg.norm(cycle_end - x0[:, None, :], axis=-1)  # (n, cycles)
+        points = np.concatenate([x0[:, None, :], legs], axis=1)
+        known = np.all(np.isfinite(points), axis=-1)
+        h = inverse.augmenting_value(points[known])
+        if h is not None:
+            h = np.asarray(h, dtype=float)
+            full = np.full(points.shape[:2] + h.shape[1:], np.nan)
+            full[known], h = h, full
+        if np.ndim(settings.targets) == 2:
+            one = None if h is None else h[0]
+            ends = (cycle_end[0], drift[0], bool(alive[0]), messages[0])
+            return cls(x0[0], targets[0], legs[0], *ends, leg_results, settings, one)
+        ends = (cycle_end, drift, alive, tuple(messages))
+        return cls(x0, targets, legs, *ends, [], settings, h)
 
     @property
     def algorithm(self) -> str:
@@ -88,6 +120,59 @@ class RepeatabilityResult(Columns):
             f"{_plural(cycles, 'cycle')} of {self.targets.shape[1]} legs, largest drift after "
             f"the last cycle {worst:.3g})"
         )
+
+    def findings(self, unit: str = "", start: int | None = None) -> list[Finding]:
+        """What the run found and why, in sentences (the dashboard's verdict): whether the joints
+        came back to x0 after every cycle (sec. 5.2.1, Table 1; ‖x − x0‖ below
+        :data:`~jik.engine.repeatability.REPEATABLE_DRIFT`), where a failed leg stopped; for
+        the pseudoinverse (8) why it drifts, for the extended Jacobian inverse (11) whether h
+        stayed at h(x0) (eq. (12), from h at every point of legs recorded with ``record=True``,
+        else from h after each leg) and, in discrete mode, that the
+        iteration keeps h only approximately and what a gamma near 2 does.
+
+        Parameters
+        ----------
+        unit : str
+            The drift's unit in the sentences, e.g. "[rad]" (a robot's:
+            ``norm_unit(robot.units.x)``, :func:`jik.engine.units.norm_unit`); "" unstated.
+        start : int, optional
+            A batch's member (from 0); required for a batch.
+
+        Returns
+        -------
+        list of Finding
+            ``(text, role, algorithm)`` (:class:`jik.engine.findings.Finding`), ``role`` one of
+            "finding", "why", "note" or "failure".
+
+        Examples
+        --------
+        >>> import numpy as np, jik.engine as jik
+        >>> arm, path = jik.Manipulator2(), [(1, 1), (1, 2), (0, 2)]
+        >>> run = jik.repeatability(jik.Pseudoinverse(arm), [0, 0, np.pi / 2], path, 2)
+        >>> for finding in run.findings("[m and rad mixed]"):
+        ...     print(finding.role, "|", finding.text[:60])
+        finding | pseudoinverse J^P#: not repeatable. After 2 cycles the joint
+        why | Why: J^P# picks the minimum-norm joint velocity, which has n
+        """
+        from .findings import verdict
+
+        i: Any = ()
+        if np.ndim(self.success) == 0 and start is not None:
+            raise InvalidInputError("start: one start's result takes no start", "start")
+        if np.ndim(self.success):
+            if start is None:
+                raise InvalidInputError(
+                    f"start: a batch of {len(self.x0)} starts needs start", "start"
+                )
+            i = count(start, "start", 0, len(self.x0) - 1)
+        drift = self.drift[i]
+        done = drift[: np.cumprod(np.isfinite(drift)).sum()]  # (the cycles that ended)
+        h = None if self.h is None else self.h[i]
+        along = [None if leg.trajectory is None else leg.trajectory.h for leg in self.leg_results]
+        if h is not None and along and all(a is not None for a in along):
+            h = np.concatenate(cast(list, along))  # (every recorded point, as the dashboard's)
+        run = _Member(done, bool(np.asarray(self.success)[i]), str(np.asarray(self.message)[i]), h)
+        return verdict({self.algorithm: run}, True, self.mode, self.gamma, unit)
 
     def columns(self) -> dict[str, Any]:
         """A row per cycle (and start): ``start`` (a batch's member, from 0), ``cycle`` (from
@@ -126,3 +211,14 @@ class RepeatabilityResult(Columns):
                 "message": self.message if isinstance(self.message, str) else list(self.message),
             }
         )
+
+
+@dataclass(frozen=True)
+class _Member:
+    """One start's run as :func:`jik.engine.findings.verdict` reads it: the drift of the
+    cycles that ended."""
+
+    drift: FloatArray
+    success: bool
+    message: str
+    h: FloatArray | None

@@ -3,7 +3,8 @@
 The path (1,1) -> (1,2) -> (0,2) -> back to (0,1) starts at x0 = (0, 0, pi/2), whose image is
 (0, 1). The pseudoinverse (8) comes back to a different configuration (it is not repeatable);
 the extended Jacobian inverse (11) with the paper's cubic (38) comes back to x0. More cycles show
-the pseudoinverse's drift growing cycle after cycle.
+the pseudoinverse's drift growing cycle after cycle; each run says what it found and why (for
+the extended inverse: h stayed at h(x0), eq. (12)).
 
     python examples/01_table1.py [--cycles N]
 """
@@ -39,3 +40,7 @@ print(f"\nDrift ||x - x0|| after each of {args.cycles} cycles")
 for name, run in runs.items():
     print(f"  {name:14s} " + " ".join(f"{d:9.2e}" for d in run.drift))
     print(f"  {'':14s} {run}")
+
+print("\nWhat each run found, and why (x1, x2 in m, x3 in rad)")
+for run in runs.values():
+    print("\n".join(f"  {finding.text}" for finding in run.findings("[m and rad mixed]")))

@@ -45,8 +45,11 @@ def test_table1():
     text = run("01_table1.py")
     assert "B    0.1132    0.5379    1.0904" in text  # (the pseudoinverse's first leg)
     assert "A    0.0529    0.3210    1.8976" in text  # (its end of the first cycle)
-    drift = {line.split()[0]: numbers(line) for line in text.splitlines() if "e-" in line}
+    table, said = text.split("What each run found, and why")
+    drift = {line.split()[0]: numbers(line) for line in table.splitlines() if "e-" in line}
     assert max(drift["extended"]) < 1e-12 and min(drift["pseudoinverse"]) > 0.4
+    assert "pseudoinverse J^P#: not repeatable. After 2 cycles" in said
+    assert "extended Jacobian J^E#: repeatable." in said and "h(x) = h(x0) (eq. (12))" in said
 
 
 def test_your_own_arm():

@@ -206,3 +206,18 @@ def test_bad_input_exits_2_with_the_message(capsys, arm_file, argv, message):
 def test_unknown_robot_exits_2(capsys):
     _, err = run(capsys, "repeatability", "--robot", "scara.json", code=2)
     assert "neither a file nor a built-in robot" in err and "(field robot)" in err
+
+
+def test_repeatability_says_what_it_found_and_why(capsys):
+    """``jik repeatability`` ends its text with the run's findings (the engine's sentences, in
+    the robot's unit) and gives them in --json as {text, role}: J^E# (11) on Table 1's path
+    came back because h stayed at h(x0), eq. (12); J^P# (8) drifted, and why."""
+    argv = ["repeatability", "--robot", "manipulator2", "--cycles", "2", "--algorithm"]
+    text, _ = run(capsys, *argv, "extended")
+    assert "\n  extended Jacobian J^E#: repeatable. After each of 2 cycles" in text
+    assert "[m and rad mixed]" in text and "\n  Why: J^E# adds the equation h(x) = h(x0)" in text
+    out, _ = run(capsys, *argv, "pseudoinverse", "--json")
+    found, why = json.loads(out)["findings"]
+    assert found["role"] == "finding" and why["role"] == "why" and set(found) == {"text", "role"}
+    assert found["text"].startswith("pseudoinverse J^P#: not repeatable. After 2 cycles")
+    assert "no memory of the start" in why["text"]

@@ -21,6 +21,7 @@ from ...engine.registry import RobotSpec
 from ...engine.repeatability import repeatability, repeatable
 from ...engine.solve_rules import refused_starts
 from ...engine.solver import solve_batch as engine_solve_batch
+from ...engine.units import norm_unit, robot_units
 from . import schemas as S
 from .documents import limits_document, nullable, solve_response_json
 from .exceptions import RequestError
@@ -169,6 +170,7 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
     except JikError as exc:
         raise engine_error(exc) from None
     drift = np.asarray(res.drift, dtype=float)
+    unit = norm_unit(robot_units(setup.kinematics).x)  # (the drift's, in the sentences)
     return S.RepeatabilityResponse(
         **setup.head,
         cycles=req.cycles,
@@ -180,5 +182,6 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
         repeatable=bool(res.success) and repeatable(drift) is True,
         success=bool(res.success),
         message=cast(str, res.message),  # one start configuration: one message
+        findings=[S.Sentence.model_validate(f._asdict()) for f in res.findings(unit)],
         **limits_document(setup.kinematics, res),
     )

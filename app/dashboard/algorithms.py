@@ -63,16 +63,15 @@ DEFAULT_BOX = (-10.0, 10.0)
 @dataclass(frozen=True)
 class Style:
     """How one algorithm is drawn: ``color`` everywhere, ``dash`` (plotly's) and ``symbol``
-    (a marker) in the plots, ``label``/``short`` its names, ``named`` its name in the
-    verdict's sentences, ``line``/``robot`` the key's words, and its copy in the 3D scene:
-    ``opacity`` (None: solid) at height ``z``."""
+    (a marker) in the plots, ``label``/``short`` its names (in the verdict's sentences:
+    :data:`jik.engine.findings.NAMES`), ``line``/``robot`` the key's words, and its copy in the
+    3D scene: ``opacity`` (None: solid) at height ``z``."""
 
     color: str
     dash: str
     symbol: str
     label: str
     short: str
-    named: str
     line: str
     robot: str
     opacity: float | None
@@ -87,7 +86,6 @@ STYLES: dict[str, Style] = {
         "circle",
         "pseudoinverse J^P# (8)",
         "J^P# (8)",
-        "pseudoinverse J^P#",
         "solid line",
         "translucent robot",
         0.55,
@@ -100,7 +98,6 @@ STYLES: dict[str, Style] = {
         "diamond",
         "extended Jacobian J^E# (11)",
         "J^E# (11)",
-        "extended Jacobian J^E#",
         "dashed line",
         "opaque robot",
         None,
@@ -110,7 +107,6 @@ STYLES: dict[str, Style] = {
         "#ff7f0e",
         "dot",
         "square",
-        "damped least squares J^DLS",
         "DLS",
         "damped least squares J^DLS",
         "dotted line",
@@ -123,7 +119,6 @@ STYLES: dict[str, Style] = {
         "#8c564b",
         "dashdot",
         "triangle-up",
-        "weighted least-norm J^W#",
         "J^W#",
         "weighted least-norm J^W#",
         "dash-dotted line",
@@ -138,7 +133,6 @@ STYLES: dict[str, Style] = {
         "star",
         "posture J^P# + null space k(x_rest - x)",
         "posture",
-        "posture inverse (J^P# with a null-space pull)",
         "long-dashed line",
         "translucent teal robot",
         0.6,

@@ -8,42 +8,20 @@ it, and what the practical inverses beside the paper's two did; the unicycle's u
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
-
 import numpy as np
 
-from ...engine.findings import (
-    damped_findings,
-    extended_why,
-    gamma_note,
-    posture_findings,
-    pseudoinverse_why,
-    run_findings,
-    weighted_findings,
-)
+from ...engine.findings import NAMES, Finding, damped_findings, posture_findings, weighted_findings
+from ...engine.findings import verdict as run_verdict
 from ...engine.reproductions.unicycle import undefined_why
-from .algorithms import STYLES, rest_words, scalar
+from .algorithms import rest_words, scalar
 from .joint_limits import state_limits
 from .plotting import norm_unit, units
 from .robots import state_inverse, state_kinematics, state_spec
 from .runs import AlgorithmRun, DashboardResult
 from .singular import singular_sentence
 
-#: The algorithms' names in the verdict's sentences.
-NAMES = {a: s.named for a, s in STYLES.items()}
 
-
-@dataclass(frozen=True)
-class Sentence:
-    """One sentence: its ``text``, the algorithm it is about (None: both or neither) and its
-    ``role``: "finding" (what the run did), "why", "note" or "failure"."""
-
-    text: str
-    algorithm: str | None = None
-    role: str = "finding"
-
-
-def _undefined_why(result: DashboardResult, run: AlgorithmRun) -> list[Sentence]:
+def _undefined_why(result: DashboardResult, run: AlgorithmRun) -> list[Finding]:
     """Why the unicycle's map of characteristics (29) became undefined along the extended run
     (:func:`jik.engine.reproductions.unicycle.undefined_why`)."""
     state = result.state
@@ -60,7 +38,7 @@ def _undefined_why(result: DashboardResult, run: AlgorithmRun) -> list[Sentence]
     q0 = state.robot_parameters.get("q0", ())
     lam10 = (float(run.x[-2][0]), float(run.x[-1][0]))
     texts = undefined_why(q0, a, lam10, step, discrete)
-    return [Sentence(t, "extended", r) for t, r in zip(texts, ("why", "note"), strict=False)]
+    return [Finding(t, r, "extended") for t, r in zip(texts, ("why", "note"), strict=False)]
 
 
 def _posture(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
@@ -101,31 +79,22 @@ def _weighted(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
 
 
 def verdict(result: DashboardResult) -> list[dict]:
-    """The sentences the page shows above the plots for ``result`` (:class:`Sentence` dicts):
-    each chosen algorithm's finding, then why; failures with the engine's message."""
-    runs = result.runs
-    out: list[Sentence] = []
-    path = result.state.task == "path"
+    """The sentences the page shows above the plots for ``result`` (:class:`Finding` dicts):
+    each chosen algorithm's finding, then why (:func:`jik.engine.findings.verdict`); failures
+    with the engine's message."""
+    runs, state = result.runs, result.state
+    path = state.task == "path"
     unit = norm_unit(units(result)[0])
-    for algorithm, run in runs.items():
-        found = run_findings(NAMES[algorithm], run.drift, run.success, run.message, path, unit)
-        out += [Sentence(text, algorithm, role) for text, role in found]
-    if path and "pseudoinverse" in runs and (why := pseudoinverse_why(runs["pseudoinverse"].drift)):
-        out.append(Sentence(why, "pseudoinverse", "why"))
-    if "extended" in runs:
-        e, state = runs["extended"], result.state
-        undefined = _undefined_why(result, e)
-        found = extended_why(e.h, e.drift, e.success, path, state.mode, state.gamma)
-        out += undefined or [Sentence(text, "extended", role) for text, role in found]
-        if not undefined and found and (note := gamma_note(state.mode, state.gamma)):
-            out.append(Sentence(note, None, "note"))
+    e = runs.get("extended")
+    undefined = [] if e is None else _undefined_why(result, e)
+    out = run_verdict(runs, path, state.mode, state.gamma, unit, undefined)
     practical = {"posture": _posture, "damped": _damped, "weighted": _weighted}
     for a in (a for a in runs if a in practical):
-        out += [Sentence(text, a, role) for text, role in practical[a](result, unit)]
-    robot = state_spec(result.state).title
+        out += [Finding(text, role, a) for text, role in practical[a](result, unit)]
+    robot = state_spec(state).title
     for a, report in result.limits.items():
         role = "note" if report.within else "warning"
-        out.append(Sentence(report.sentence(NAMES[a], robot), a, role))
-    if "extended" in runs and (warning := singular_sentence(result.state)):
-        out.append(Sentence(warning, "extended", "warning"))
-    return [asdict(s) for s in out]
+        out.append(Finding(report.sentence(NAMES[a], robot), role, a))
+    if e is not None and (warning := singular_sentence(state)):
+        out.append(Finding(warning, "warning", "extended"))
+    return [s._asdict() for s in out]

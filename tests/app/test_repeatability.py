@@ -68,3 +68,29 @@ def test_unicycle_like_defaults_come_from_the_registry(api):
         ),
     ).json()
     assert b["mode"] == "continuous" and b["gamma"] == 1.0
+
+
+def test_the_response_says_what_the_run_found_and_why(api):
+    """``findings``: the engine's sentences (RepeatabilityResult.findings) in the robot's unit
+    of the drift; J^P# drifts and says why, J^E# (11) comes back because h stayed at h(x0)
+    (eq. (12)); a discrete J^E# run at gamma = 1.89 lost h and says gamma is near 2. The
+    OpenAPI schema documents the list and its roles."""
+    pinv = api.post("/repeatability", json=_body(cycles=2)).json()
+    assert [f["role"] for f in pinv["findings"]] == ["finding", "why"]
+    assert pinv["findings"][0]["text"].startswith(
+        "pseudoinverse J^P#: not repeatable. After 2 cycles the joints end ‖x − x0‖ = "
+        f"{pinv['drift'][-1]:.3g} [m and rad mixed] away from x0"
+    )
+    assert "no memory of the start" in pinv["findings"][1]["text"]
+    ext = api.post("/repeatability", json=_body(algorithm="extended", cycles=2)).json()
+    assert ext["findings"][0]["text"].startswith("extended Jacobian J^E#: repeatable.")
+    assert ext["findings"][1]["text"].startswith("Why: J^E# adds the equation h(x) = h(x0)")
+    fast = _body(algorithm="extended", cycles=3, mode="discrete", gamma=1.89)
+    said = api.post("/repeatability", json=fast).json()["findings"]
+    assert [f["role"] for f in said] == ["finding", "why", "note", "note"]
+    assert said[1]["text"].startswith("h was not conserved")
+    assert "1 − γ = -0.89 per step" in said[3]["text"]
+    schema = api.get("/openapi.json").json()["components"]["schemas"]
+    field = schema["RepeatabilityResponse"]["properties"]["findings"]
+    assert "h stayed at h(x0), eq. (12)" in field["description"]
+    assert schema["Sentence"]["properties"]["role"]["enum"] == ["finding", "why", "note", "failure"]

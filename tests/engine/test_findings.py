@@ -3,12 +3,16 @@ characteristics became undefined (jik.engine.reproductions.unicycle.undefined_wh
 
 from __future__ import annotations
 
+import doctest
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 
 import jik.engine as jik
+from jik.engine.augmentations import h_change
 from jik.engine.findings import (
+    NAMES,
     damped_findings,
     drift_sentence,
     gamma_note,
@@ -135,3 +139,104 @@ def test_the_weighted_inverse_says_whether_its_joints_stayed_within_the_box():
     assert role == "why" and "closest: a, 0.1 from a limit." in text
     ((text, role),) = weighted_findings("W", inside - 0.6, limits, ("a", "b"))
     assert role == "failure" and text.endswith(": b.")
+
+
+def test_a_result_says_its_own_findings_with_its_settings():
+    """RepeatabilityResult.findings: Table 1's path on Manipulator 2, three cycles. J^E# (11)
+    with the cubic (38) comes back to x0 and says why (h kept at h(x0), eq. (12), from h after
+    each leg); J^P# (8) drifts and says why; both in the unit given."""
+    arm = jik.Manipulator2()
+    x0, path = [0, 0, np.pi / 2], [(1, 1), (1, 2), (0, 2)]
+    ext = jik.repeatability(jik.ExtendedInverse(arm, jik.PaperCubic()), x0, path, cycles=3)
+    legs = np.vstack([x0, ext.legs])  # (1 + 3 * 4, 3)
+    np.testing.assert_allclose(ext.h, jik.PaperCubic().value(legs), rtol=0, atol=1e-15)
+    (found, why) = ext.findings("[m and rad mixed]")
+    assert found == (
+        drift_sentence(NAMES["extended"], ext.drift, "[m and rad mixed]"),
+        "finding",
+        "extended",
+    )
+    assert found.text.startswith("extended Jacobian J^E#: repeatable. After each of 3 cycles")
+    assert why.role == "why" and why.text.startswith("Why: J^E# adds the equation h(x) = h(x0)")
+    assert "the closed task path gave a closed joint path" in why.text
+    pinv = jik.repeatability(jik.Pseudoinverse(arm), x0, path, cycles=3)
+    assert pinv.h is None
+    (found, why) = pinv.findings()
+    assert found.text == (
+        f"pseudoinverse J^P#: not repeatable. After 3 cycles the joints end ‖x − x0‖ = "
+        f"{pinv.drift[-1]:.3g} away from x0, growing from {pinv.drift[0]:.3g} after cycle 1."
+    )
+    assert why == (pseudoinverse_why(pinv.drift), "why", "pseudoinverse")
+
+
+def test_the_findings_example_runs():
+    """RepeatabilityResult.findings' docstring example prints what it says."""
+    (test,) = doctest.DocTestFinder().find(jik.RepeatabilityResult.findings, "findings")
+    runner = doctest.DocTestRunner()
+    runner.run(test)
+    assert runner.summarize(verbose=False) == (0, 4)
+
+
+def test_a_discrete_run_near_gamma_two_says_h_was_lost_and_why():
+    """The discrete iteration with gamma = 1.89 (its result's own mode and gamma): J^E#
+    overshoots, loses h(x0) and does not come back; the result says so, that the discrete
+    algorithm keeps h only approximately, and that gamma is near 2 (1 - gamma = -0.89)."""
+    arm = jik.Manipulator2()
+    inverse = jik.ExtendedInverse(arm, jik.PaperCubic())
+    run = jik.repeatability(
+        inverse, [0, 0, np.pi / 2], [(1, 1), (1, 2), (0, 2)], 3, mode="discrete", gamma=1.89
+    )
+    said = run.findings()
+    assert [f.role for f in said] == ["finding", "why", "note", "note"]
+    assert said[0].text.startswith("extended Jacobian J^E#: not repeatable. After 3 cycles")
+    assert said[1].text.startswith("h was not conserved: it changed by ")
+    assert "so the joints did not come back" in said[1].text
+    assert said[2].text.startswith("The discrete algorithm x ← x − γ J^E# e keeps h only")
+    assert said[3] == (gamma_note("discrete", 1.89), "note", None)
+    assert "1 − γ = -0.89 per step" in said[3].text
+
+
+def test_recorded_legs_judge_h_at_every_point_as_the_dashboard_does():
+    """With record=True the change of h is taken over every point of the legs, the dashboard's
+    verdict's measure, not only at the legs' ends: the discrete overshoot at gamma = 1.89 moves
+    h further between the ends than at them."""
+    inverse = jik.ExtendedInverse(jik.Manipulator2(), jik.PaperCubic())
+    path, x0 = [(1, 1), (1, 2), (0, 2)], [0, 0, np.pi / 2]
+    runs = [
+        jik.repeatability(inverse, x0, path, 3, mode="discrete", gamma=1.89, record=record)
+        for record in (False, True)
+    ]
+    along = np.concatenate([leg.trajectory.h for leg in runs[1].leg_results])
+    assert h_change(along) > h_change(runs[0].h)
+    assert f"changed by {h_change(along):.3g} along" in runs[1].findings()[1].text
+    assert f"changed by {h_change(runs[0].h):.3g} along" in runs[0].findings()[1].text
+
+
+def test_a_batch_says_the_findings_of_the_start_asked_for():
+    """A batch's findings are per start (``start``, checked); one start's takes none. A start
+    whose leg failed says where it stopped."""
+    arm = jik.Manipulator2()
+    inverse = jik.ExtendedInverse(arm, jik.PaperCubic())
+    path = [(1, 1), (1, 2), (0, 2)]
+    batch = jik.repeatability(inverse, [[0, 0, np.pi / 2], [0.1, 0, 1.5]], path, cycles=2)
+    assert batch.h.shape == (2, 1 + 2 * 4)
+    one = jik.repeatability(inverse, [0.1, 0, 1.5], path, cycles=2)
+    assert [f.text[:40] for f in batch.findings(start=1)] == [f.text[:40] for f in one.findings()]
+    for bad, words in ((None, "a batch of 2 starts needs start"), (2, "between 0 and 1")):
+        with pytest.raises(jik.InvalidInputError, match=words) as caught:
+            batch.findings(start=bad)
+        assert caught.value.field == "start"
+    with pytest.raises(jik.InvalidInputError, match="takes no start"):
+        one.findings(start=0)
+    capped = jik.repeatability(
+        jik.Pseudoinverse(arm),
+        [0, 0, np.pi / 2],
+        path,
+        mode="discrete",
+        gamma=1.9,
+        max_iterations=10,
+    )
+    ((text, role, _),) = capped.findings()
+    assert role == "failure" and text.startswith(
+        "pseudoinverse J^P# stopped: cycle 1, leg 1 failed"
+    )

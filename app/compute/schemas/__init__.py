@@ -67,6 +67,7 @@ from .runs import (
     RepeatabilityBody,
     RepeatabilityRequest,
     RepeatabilityResponse,
+    Sentence,
     SolveBody,
     SolveRequest,
     SolveResponse,

@@ -180,6 +180,15 @@ class SolveResponse(_RunResponse):
     limits: RunLimits = None
 
 
+class Sentence(BaseModel):
+    """One sentence of what a run found (:meth:`jik.engine.RepeatabilityResult.findings`)."""
+
+    text: str
+    role: Literal["finding", "why", "note", "failure"] = Field(
+        description="finding: what the run did; why; note; failure: where it stopped"
+    )
+
+
 class RepeatabilityResponse(_RunResponse):
     cycles: int
     targets: list[list[float]] = Field(description="task point of each leg of one cycle (closed)")
@@ -194,6 +203,10 @@ class RepeatabilityResponse(_RunResponse):
     )
     success: bool
     message: str
+    findings: list[Sentence] = Field(
+        description="what the run found and why, the dashboard's sentences: repeatable or not; "
+        "for J^E# (11) whether h stayed at h(x0), eq. (12); in discrete mode what gamma did"
+    )
     limits: RunLimits = None
 
 
