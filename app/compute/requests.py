@@ -68,8 +68,7 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
     return _Setup(built.spec, built.kinematics, inverse, run, head)
 
 
-#: A run's or a synthesis' arguments in the engine that are a request's fields, by the
-#: request's names.
+#: The engine's arguments that are a request's fields (a run's, a synthesis'), by its names.
 _ENGINE_FIELDS = (
     *("x0", "target", "gamma", "tolerance", "max_iterations", "path", "cycles", "mode"),
     *("region", "fixed"),
