@@ -84,6 +84,10 @@ class Trajectory(Columns):
         )
 
 
+#: The fields of a solve's ``as_dict()``, in order; a batch's hold one value per member.
+AS_DICT = tuple("algorithm inverse mode gamma x0 y_d x y error success nit message status".split())
+
+
 @dataclass(frozen=True)
 class SolveResult(Columns):
     """Result of one solve, in SciPy's vocabulary (``x``, ``success``, ``message``, ``nit``).
@@ -166,21 +170,7 @@ class SolveResult(Columns):
     def as_dict(self, trajectory: bool = False) -> dict[str, Any]:
         """JSON-friendly fields (:func:`~jik.engine.exports.json_values`: NaN as None); with
         ``trajectory``, also :meth:`Trajectory.as_dict`."""
-        out: dict[str, Any] = {
-            "algorithm": self.algorithm,
-            "inverse": self.inverse,
-            "mode": self.mode,
-            "gamma": self.gamma,
-            "x0": np.asarray(self.x0).tolist(),
-            "y_d": np.asarray(self.y_d).tolist(),
-            "x": self.x.tolist(),
-            "y": self.y.tolist(),
-            "error": self.error,
-            "success": self.success,
-            "nit": self.nit,
-            "message": self.message,
-            "status": self.status,
-        }
+        out = {key: getattr(self, key) for key in AS_DICT}
         if trajectory:
             out["trajectory"] = None if self.trajectory is None else self.trajectory.as_dict()
         return json_values(out)
@@ -216,6 +206,11 @@ class BatchSolveResult(Columns):
     def __len__(self) -> int:
         return len(self.x)
 
+    @property
+    def inverse(self) -> str:
+        """The inverse as printed, as :attr:`SolveResult.inverse`."""
+        return repr(self._inverse)
+
     def __repr__(self) -> str:
         return (
             f"BatchSolveResult({self.algorithm}, {self.mode}, {len(self)} solves, "
@@ -241,23 +236,9 @@ class BatchSolveResult(Columns):
     def as_dict(self) -> dict[str, Any]:
         """JSON-friendly (:func:`~jik.engine.exports.json_values`: NaN as None): the settings
         and, per member, x0, y_d, x, y, error, success, nit, message, status."""
-        return json_values(
-            {
-                "algorithm": self.algorithm,
-                "inverse": repr(self._inverse),
-                "mode": self.mode,
-                "gamma": self.gamma,
-                "x0": np.asarray(self.x0).tolist(),
-                "y_d": np.asarray(self.y_d).tolist(),
-                "x": self.x.tolist(),
-                "y": self.y.tolist(),
-                "error": self.error.tolist(),
-                "success": np.asarray(self.success, dtype=bool).tolist(),
-                "nit": np.asarray(self.nit, dtype=int).tolist(),
-                "message": list(self.message),
-                "status": list(self.status),
-            }
-        )
+        out = {key: getattr(self, key) for key in AS_DICT}
+        out |= {"success": np.asarray(self.success, dtype=bool), "nit": np.asarray(self.nit, int)}
+        return json_values(out)
 
     @property
     def status(self) -> tuple[str, ...]:
