@@ -259,14 +259,16 @@ def damped_findings(
     return [(text + ".", "why")]
 
 
-def weighted_findings(name: str, x, limits, names) -> list[tuple[str, str]]:
+def weighted_findings(name: str, x, limits, names, box: bool = True) -> list[tuple[str, str]]:
     """Whether the weighted least-norm inverse (Chan and Dubey 1995) kept every joint of its
-    run ``x`` (m, p) within the box ``limits`` (p, 2) it took for limits (a robot without
-    joint limits: its configuration box x_range), and its closest approach, or which left."""
+    run ``x`` (m, p) within the ``limits`` (p, 2) it took (``box``: said to be the
+    configuration box x_range of a robot without joint limits), and its closest approach, or
+    which left."""
     lo, hi = limits[:, 0], limits[:, 1]
     below, above = x < lo, x > hi
     bounds = "; ".join(f"{names[k]} in [{g(lo[k])}, {g(hi[k])}]" for k in range(len(lo)))
-    bounds += "; the robot has no joint limits: its configuration box x_range"
+    if box:
+        bounds += "; the robot has no joint limits: its configuration box x_range"
     if not (below.any() or above.any()):
         margin = np.minimum(x - lo, hi - x).min(axis=0)
         k = int(np.argmin(margin))
@@ -279,6 +281,62 @@ def weighted_findings(name: str, x, limits, names) -> list[tuple[str, str]]:
         ]
     out = sorted({names[k] for k in np.flatnonzero((below | above).any(axis=0))})
     return [(f"{name}: left its limits ({bounds}): {', '.join(out)}.", "failure")]
+
+
+#: The posture inverse's default rest when the robot has a home configuration, in words.
+HOME = "the robot's home"
+
+
+def rest_words(inverse, x0) -> str:
+    """The posture inverse's rest in words, for :func:`posture_findings`: ``x_rest = the
+    robot's home (...)`` or ``x_rest = x0 (...)`` for the default
+    (:func:`~jik.engine.algorithm_registry.default_rest`), else ``x_rest = x0 (...)`` when the
+    rest given is the start ``x0``, or the numbers given, ``x_rest = (...) (set)``."""
+    rest = [float(v) for v in inverse.rest]
+    shown = "(" + ", ".join(f"{v:.4g}" for v in rest) + ")"
+    if not inverse.rest_given:
+        home = getattr(inverse.kinematics, "home", None) is not None
+        return f"x_rest = {HOME if home else 'x0'} {shown}"
+    return f"x_rest = x0 {shown}" if rest == [float(v) for v in x0] else f"x_rest = {shown} (set)"
+
+
+#: The practical inverses beside the paper's two, which :func:`practical_findings` speaks of.
+PRACTICAL = ("damped", "weighted", "posture")
+
+
+def practical_findings(
+    inverse,
+    run,
+    unit: str,
+    tol: float,
+    runs: Mapping[str, Any] | None = None,
+    rest=None,
+    box: bool = False,
+) -> list[tuple[str, str]]:
+    """What a practical inverse beside the paper's two did on ``run``, from its parameters:
+    :func:`posture_findings` (its rest in ``rest``, else :func:`rest_words` of the run's
+    start), :func:`damped_findings`, :func:`weighted_findings` (against the limits it was
+    given; ``box``: the configuration box of a robot without limits); none for the paper's
+    inverses.
+
+    ``run`` carries ``drift`` (cycles,), ``success``, ``x`` (m, p) the configurations it went
+    through, ``error`` and ``leg`` (m',) the task error and leg of points of it, at least of
+    each leg's end; ``runs`` the other inverses' runs by algorithm, which the posture and
+    damped sentences compare with (the pseudoinverse's, the extended Jacobian's).
+    """
+    name, runs = NAMES.get(inverse.name, inverse.name), runs or {}
+    if inverse.name == "posture":
+        p, e = runs.get("pseudoinverse"), runs.get("extended")
+        words = rest or rest_words(inverse, run.x[0])
+        drifts = [None if other is None else other.drift for other in (p, e)]
+        return posture_findings(name, inverse.gain, words, run.drift, unit, *drifts)
+    if inverse.name == "damped":
+        lam, eps = inverse.damping, inverse.damping_threshold
+        return damped_findings(name, lam, eps, tol, run, runs.get("pseudoinverse"))
+    if inverse.name == "weighted":
+        names = inverse.kinematics.names
+        return weighted_findings(name, run.x, inverse.limits, names, box)
+    return []
 
 
 def verdict(

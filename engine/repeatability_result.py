@@ -8,7 +8,7 @@ what it found, and why, in sentences (:meth:`RepeatabilityResult.findings`).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, cast
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -51,6 +51,8 @@ class RepeatabilityResult(Columns):
     h : ndarray, shape (1 + cycles * L,) or (n, 1 + cycles * L), or None
         The augmenting map h (9) at x0 and after each leg (a column per map when p - r > 1;
         NaN after a failed leg); None for an inverse without h.
+    used : Inverse or None
+        The inverse J# the legs ran with (whose parameters :meth:`findings` reads).
     """
 
     x0: FloatArray
@@ -63,6 +65,7 @@ class RepeatabilityResult(Columns):
     leg_results: list[SolveResult]
     settings: RunSettings
     h: FloatArray | None = None
+    used: Inverse | None = None
 
     @classmethod
     def of_run(cls, inverse: Inverse, x0, targets, legs, alive, messages, leg_results, settings):
@@ -82,9 +85,9 @@ class RepeatabilityResult(Columns):
         if np.ndim(settings.targets) == 2:
             one = None if h is None else h[0]
             ends = (cycle_end[0], drift[0], bool(alive[0]), messages[0])
-            return cls(x0[0], targets[0], legs[0], *ends, leg_results, settings, one)
+            return cls(x0[0], targets[0], legs[0], *ends, leg_results, settings, one, inverse)
         ends = (cycle_end, drift, alive, tuple(messages))
-        return cls(x0, targets, legs, *ends, [], settings, h)
+        return cls(x0, targets, legs, *ends, [], settings, h, inverse)
 
     @property
     def algorithm(self) -> str:
@@ -128,7 +131,10 @@ class RepeatabilityResult(Columns):
         the pseudoinverse (8) why it drifts, for the extended Jacobian inverse (11) whether h
         stayed at h(x0) (eq. (12), from h at every point of legs recorded with ``record=True``,
         else from h after each leg) and, in discrete mode, that the
-        iteration keeps h only approximately and what a gamma near 2 does.
+        iteration keeps h only approximately and what a gamma near 2 does; for the practical
+        inverses what their parameters did (:func:`jik.engine.findings.practical_findings`:
+        the posture inverse's drift, damped least squares' task error at the legs' ends, the
+        weighted inverse's joints against its limits).
 
         Parameters
         ----------
@@ -154,7 +160,7 @@ class RepeatabilityResult(Columns):
         finding | pseudoinverse J^P#: not repeatable. After 2 cycles the joint
         why | Why: J^P# picks the minimum-norm joint velocity, which has n
         """
-        from .findings import verdict
+        from .findings import Finding, practical_findings, verdict
 
         i: Any = ()
         if np.ndim(self.success) == 0 and start is not None:
@@ -168,11 +174,31 @@ class RepeatabilityResult(Columns):
         drift = self.drift[i]
         done = drift[: np.cumprod(np.isfinite(drift)).sum()]  # (the cycles that ended)
         h = None if self.h is None else self.h[i]
-        along = [None if leg.trajectory is None else leg.trajectory.h for leg in self.leg_results]
-        if h is not None and along and all(a is not None for a in along):
-            h = np.concatenate(cast(list, along))  # (every recorded point, as the dashboard's)
-        run = _Member(done, bool(np.asarray(self.success)[i]), str(np.asarray(self.message)[i]), h)
-        return verdict({self.algorithm: run}, True, self.mode, self.gamma, unit)
+        legs = [leg.trajectory for leg in self.leg_results if leg.trajectory is not None]
+        if legs and len(legs) == len(self.leg_results):  # (every recorded point, as the page)
+            x, error = np.concatenate([t.x for t in legs]), np.concatenate([t.error for t in legs])
+            leg = np.concatenate([np.full(len(t.x), j) for j, t in enumerate(legs)])
+            if h is not None and all(t.h is not None for t in legs):
+                h = np.concatenate([t.h for t in legs])
+        else:  # (the leg ends reached)
+            ends = self.legs[i][np.isfinite(self.legs[i]).all(axis=-1)]
+            x, leg = np.vstack([self.x0[i], ends]), np.arange(len(ends))
+            error = self._errors(ends, self.targets[i])
+        success, message = bool(np.asarray(self.success)[i]), str(np.asarray(self.message)[i])
+        run = _Member(done, success, message, h, x, error, leg)
+        out = verdict({self.algorithm: run}, True, self.mode, self.gamma, unit)
+        if self.used is None:
+            return out
+        found = practical_findings(self.used, run, unit, self.settings.tol)
+        return out + [Finding(text, role, self.algorithm) for text, role in found]
+
+    def _errors(self, ends: FloatArray, targets: FloatArray) -> FloatArray:
+        """||k(x) - target|| at the leg ends reached, ``ends`` (m, p), for the legs' targets
+        ``targets`` (L, r) cycle after cycle; empty without the inverse's robot."""
+        if self.used is None or not len(ends):
+            return np.zeros(len(ends))
+        goals = np.resize(targets, (len(ends), targets.shape[-1]))
+        return np.linalg.norm(self.used.kinematics.forward(ends) - goals, axis=-1)
 
     def columns(self) -> dict[str, Any]:
         """A row per cycle (and start): ``start`` (a batch's member, from 0), ``cycle`` (from
@@ -215,10 +241,15 @@ class RepeatabilityResult(Columns):
 
 @dataclass(frozen=True)
 class _Member:
-    """One start's run as :func:`jik.engine.findings.verdict` reads it: the drift of the
-    cycles that ended."""
+    """One start's run as :func:`jik.engine.findings.verdict` and
+    :func:`~jik.engine.findings.practical_findings` read it: the drift of the cycles that
+    ended, h, and the configurations, task errors and legs of its recorded points (else its
+    leg ends)."""
 
     drift: FloatArray
     success: bool
     message: str
     h: FloatArray | None
+    x: FloatArray
+    error: FloatArray
+    leg: FloatArray

@@ -25,6 +25,7 @@ import numpy as np
 
 from ...engine.algorithm_registry import default_rest
 from ...engine.exceptions import InvalidInputError
+from ...engine.findings import rest_words as engine_rest_words
 from ...engine.limits import limited_box, robot_limits
 from ...engine.practical_inverses import check_rest
 from ...engine.registry import ALGORITHMS as REGISTRY
@@ -272,17 +273,16 @@ def editable_rest(state: ChosenState, spec, kin) -> list[float]:
     return [float(v) for v in np.clip(rest, lo, hi)]
 
 
-def rest_words(state: ChosenState, spec, kin) -> str:
-    """The rest in force in words, for the verdict: ``x_rest = the robot's home (0, -0.785,
-    ...)``, ``x_rest = x0 (...)`` (set so, or the default), or the numbers set; a default
-    outside the rest's sliders (:func:`joint_box`: the joint limits) says what moving one of
-    them makes of it (:func:`editable_rest`)."""
+def rest_words(state: ChosenState, spec, inverse) -> str:
+    """The rest in force in words, for the verdict (the engine's
+    :func:`~jik.engine.findings.rest_words` for the posture ``inverse``); a default outside
+    the rest's sliders (:func:`joint_box`: the joint limits) says what moving one of them makes
+    of it (:func:`editable_rest`)."""
+    words = engine_rest_words(inverse, state.x0)
+    kin = inverse.kinematics
     rest, source = posture_rest(state, kin)
-    shown = "(" + ", ".join(f"{v:.4g}" for v in rest) + ")"
     if source == "set":
-        return f"x_rest = x0 {shown}" if rest == list(state.x0) else f"x_rest = {shown} (set)"
-    named = "the robot's home" if source == "home" else "x0"
-    words = f"x_rest = {named} {shown}"
+        return words
     near = editable_rest(state, spec, kin)
     moved = [
         f"{n} = {b:.4g}" for n, r, b in zip(spec.variable_names, rest, near, strict=True) if r != b

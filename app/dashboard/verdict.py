@@ -8,15 +8,13 @@ it, and what the practical inverses beside the paper's two did; the unicycle's u
 
 from __future__ import annotations
 
-import numpy as np
-
-from ...engine.findings import NAMES, Finding, damped_findings, posture_findings, weighted_findings
+from ...engine.findings import NAMES, PRACTICAL, Finding, practical_findings
 from ...engine.findings import verdict as run_verdict
 from ...engine.reproductions.unicycle import undefined_why
-from .algorithms import rest_words, scalar
+from .algorithms import rest_words
 from .joint_limits import state_limits
 from .plotting import norm_unit, units
-from .robots import state_inverse, state_kinematics, state_spec
+from .robots import state_inverse, state_spec
 from .runs import AlgorithmRun, DashboardResult
 from .singular import singular_sentence
 
@@ -41,41 +39,21 @@ def _undefined_why(result: DashboardResult, run: AlgorithmRun) -> list[Finding]:
     return [Finding(t, r, "extended") for t, r in zip(texts, ("why", "note"), strict=False)]
 
 
-def _posture(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
-    runs, state = result.runs, result.state
-    if state.task != "path":
-        return []
-    rest = rest_words(state, state_spec(state), state_kinematics(state))
-    p, e = runs.get("pseudoinverse"), runs.get("extended")
-    return posture_findings(
-        NAMES["posture"],
-        scalar(state, "gain"),
-        rest,
-        runs["posture"].drift,
-        unit,
-        None if p is None else p.drift,
-        None if e is None else e.drift,
-    )
-
-
-def _damped(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
-    state = result.state
-    lam, eps = scalar(state, "damping"), scalar(state, "damping_threshold")
-    run, p = result.runs["damped"], result.runs.get("pseudoinverse")
-    return damped_findings(NAMES["damped"], lam, eps, state.tolerance, run, p)
-
-
-def _weighted(result: DashboardResult, unit: str) -> list[tuple[str, str]]:
-    """Within the box the weighted inverse took for limits (a robot that declares joint
-    limits has its sentence from :attr:`~jik.app.dashboard.runs.DashboardResult.limits`)."""
-    if state_limits(result.state) is not None:
-        return []
-    run = result.runs["weighted"]
-    inverse = state_inverse(result.state, "weighted")
-    limits = np.asarray(getattr(inverse, "limits", ()), dtype=float)
-    if limits.shape != (run.x.shape[1], 2):
-        return []
-    return weighted_findings(NAMES["weighted"], run.x, limits, result.variable_names)
+def _practical(result: DashboardResult, unit: str) -> list[Finding]:
+    """What the practical inverses' parameters did
+    (:func:`jik.engine.findings.practical_findings`), the posture inverse's rest in the page's
+    words; the weighted inverse's only within the box it took for a robot without joint limits
+    (a robot that declares some has its sentence from
+    :attr:`~jik.app.dashboard.runs.DashboardResult.limits`)."""
+    state, out = result.state, []
+    for a in (a for a in result.runs if a in PRACTICAL):
+        if a == "weighted" and state_limits(state) is not None:
+            continue
+        inverse, run = state_inverse(state, a), result.runs[a]
+        rest = rest_words(state, state_spec(state), inverse) if a == "posture" else None
+        found = practical_findings(inverse, run, unit, state.tolerance, result.runs, rest, True)
+        out += [Finding(text, role, a) for text, role in found]
+    return out
 
 
 def verdict(result: DashboardResult) -> list[dict]:
@@ -88,9 +66,7 @@ def verdict(result: DashboardResult) -> list[dict]:
     e = runs.get("extended")
     undefined = [] if e is None else _undefined_why(result, e)
     out = run_verdict(runs, path, state.mode, state.gamma, unit, undefined)
-    practical = {"posture": _posture, "damped": _damped, "weighted": _weighted}
-    for a in (a for a in runs if a in practical):
-        out += [Finding(text, role, a) for text, role in practical[a](result, unit)]
+    out += _practical(result, unit)
     robot = state_spec(state).title
     for a, report in result.limits.items():
         role = "note" if report.within else "warning"

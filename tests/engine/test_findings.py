@@ -19,6 +19,7 @@ from jik.engine.findings import (
     leg_end_errors,
     posture_findings,
     pseudoinverse_why,
+    rest_words,
     weighted_findings,
 )
 from jik.engine.registry import POSE_A, POSE_B
@@ -239,4 +240,51 @@ def test_a_batch_says_the_findings_of_the_start_asked_for():
     ((text, role, _),) = capped.findings()
     assert role == "failure" and text.startswith(
         "pseudoinverse J^P# stopped: cycle 1, leg 1 failed"
+    )
+
+
+def test_a_result_of_a_practical_inverse_says_what_its_parameters_did():
+    """RepeatabilityResult.findings for the practical inverses, from the inverse the legs ran
+    with: the posture inverse's drift with its rest and gain, damped least squares' worst task
+    error at a leg's end (the same from recorded legs as from the legs' ends), the weighted
+    inverse's joints against the limits it was given (no box note: they are the user's)."""
+    arm = jik.Manipulator2()
+    x0, path = [0, 0, np.pi / 2], [(1, 1), (1, 2), (0, 2)]
+    post = jik.repeatability(jik.PostureInverse(arm, rest=x0, gain=1.0), x0, path, cycles=2)
+    (_, why) = post.findings("[m]")
+    assert why == (
+        posture_findings(NAMES["posture"], 1.0, "x_rest = x0 (0, 0, 1.571)", post.drift, "[m]")[0]
+        + ("posture",)
+    )
+    damped = jik.DampedInverse(arm, 0.05, 0.01)
+    runs = [jik.repeatability(damped, x0, path, 2, record=record) for record in (False, True)]
+    ends = [run.findings()[1].text for run in runs]
+    assert ends[0].startswith("damped least squares J^DLS (λ = 0.05, adaptive, where σ_min(J)")
+    errors = np.linalg.norm(arm.forward(runs[0].legs) - np.resize(runs[0].targets, (8, 2)), axis=1)
+    assert f"up to {errors.max():.3g} (leg {np.argmax(errors) + 1};" in ends[0]
+    assert ends[0] == ends[1]
+    limits = [[-4.0, 4.0]] * 3
+    weighted = jik.repeatability(jik.WeightedInverse(arm, limits), x0, path, cycles=2)
+    (_, why) = weighted.findings()
+    assert why.role == "why" and why.text.startswith(
+        "weighted least-norm J^W#: every joint stayed within its limits (x1 in [-4, 4]; x2 in"
+    )
+    assert "x_range" not in why.text
+    batch = jik.repeatability(damped, [x0, [0.1, 0, 1.5]], path, cycles=2)
+    assert batch.findings(start=0)[1].text == ends[0]
+
+
+def test_the_posture_inverses_default_rest_is_named_in_words():
+    """rest_words: a default rest is the robot's home (a catalogue arm) or the start; a rest
+    given is the start's words when it is the start, else its numbers, set."""
+    arm = jik.Manipulator2()
+    x0 = [0.0, 0.0, 1.5]
+    default = jik.make_inverse(arm, "posture", x0=x0, robot="manipulator2")
+    assert rest_words(default, x0) == "x_rest = x0 (0, 0, 1.5)"
+    assert rest_words(jik.PostureInverse(arm, x0), x0) == "x_rest = x0 (0, 0, 1.5)"
+    assert rest_words(jik.PostureInverse(arm, [0, 1, 2]), x0) == "x_rest = (0, 1, 2) (set)"
+    panda = jik.load_robot("panda").kinematics
+    home = jik.make_inverse(panda, "posture", robot="panda", x0=[0.0] * 7)
+    assert rest_words(home, [0.0] * 7) == (
+        "x_rest = the robot's home (0, -0.7854, 0, -2.356, 0, 1.571, 0.7854)"
     )

@@ -205,7 +205,8 @@ class RepeatabilityResponse(_RunResponse):
     message: str
     findings: list[Sentence] = Field(
         description="what the run found and why, the dashboard's sentences: repeatable or not; "
-        "for J^E# (11) whether h stayed at h(x0), eq. (12); in discrete mode what gamma did"
+        "for J^E# (11) whether h stayed at h(x0), eq. (12); in discrete mode what gamma did; "
+        "for the damped, weighted and posture inverses what their parameters did"
     )
     limits: RunLimits = None
 
