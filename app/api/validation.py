@@ -69,6 +69,12 @@ def validation_detail(errors) -> list[dict]:
             name = robot.get("name") if isinstance(robot, dict) else None
             if isinstance(body, dict) and "robot" not in body:
                 msg = "Field required"
+            elif isinstance(robot, str):  # (the command line's and load_robot's way to name one)
+                known = robot if robot in ROBOT_NAMES else ROBOT_NAMES[0]
+                msg = (
+                    f'must be an object such as {{"name": "{known}"}}, not the string '
+                    f"{robot[:40]!r}; names: {ROBOT_NAMES}"
+                )
             elif name is None:
                 msg = f"give the robot, with a name among {ROBOT_NAMES}"
             else:

@@ -27,6 +27,14 @@ def _rep(**over) -> dict:
         (solve_body(x0="abc"), "x0: Input should be a valid list"),
         (solve_body(robot={"name": "puma560"}), "robot: unknown name 'puma560'; choose one of"),
         (solve_body(robot={"l": 1.0}), "robot: give the robot, with a name among"),
+        (
+            solve_body(robot="manipulator2"),
+            """robot: must be an object such as {"name": "manipulator2"}, not the string""",
+        ),
+        (
+            solve_body(robot="puma560"),
+            """robot: must be an object such as {"name": "manipulator1"}, not the string 'puma""",
+        ),
         (solve_body(robot={"name": "manipulator2", "l": 9}), "robot.l: Input should be less than"),
         (solve_body(robot={"name": "manipulator2", "q": 1}), "robot.q: unknown field"),
         (solve_body(algorithm="transpose"), "algorithm: Input should be 'pseudoinverse', 'ext"),
