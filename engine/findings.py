@@ -207,14 +207,14 @@ def posture_findings(
     d = float(drift[-1])
     head = f"{name}, gain k = {g(gain)}, {rest}: after {_cycles(n)}"
     if gain == 0:
-        return [(f"{head} it is the pseudoinverse (k = 0), drift {g(d)} {unit}.", "why")]
+        return [(f"{head} it is the pseudoinverse (k = 0), drift {_amount(d, unit)}.", "why")]
     parts = []
     if pinv_drift is not None and len(pinv_drift) >= n:
         dp = float(pinv_drift[n - 1])
         than = "less than" if d < dp else "not less than"
-        parts.append(f"it drifts {g(d)} {unit}, {than} the pseudoinverse's {g(dp)}")
+        parts.append(f"it drifts {_amount(d, unit)}, {than} the pseudoinverse's {g(dp)}")
     else:
-        parts.append(f"it drifts {g(d)} {unit}")
+        parts.append(f"it drifts {_amount(d, unit)}")
     if d >= REPEATABLE_DRIFT:
         reach = (
             f"the extended Jacobian's {g(float(ext_drift[n - 1]))}"
@@ -231,20 +231,24 @@ def posture_findings(
 
 
 def damped_findings(
-    name: str, damping: float, threshold: float, tol: float, run, pinv=None
+    name: str, damping: float, threshold: float, tol: float, run, pinv=None, legs: int = 0
 ) -> list[tuple[str, str]]:
     """The task error damped least squares (damping ``damping``, adaptive where sigma_min(J)
     < ``threshold`` if positive) is left with at the end of its legs, since it is not a right
     inverse (J J# != I), and how it fared where the pseudoinverse (8) stopped. ``run`` and
-    ``pinv`` carry ``error``, ``leg`` and ``success`` (a run point by point)."""
+    ``pinv`` carry ``error``, ``leg`` and ``success`` (a run point by point; ``leg`` counts
+    the legs of the whole run from 0). With ``legs`` (legs per cycle) the worst leg is named
+    as the failures and the limits name one, "cycle 2, leg 1"; else by its place in the run."""
     ends = leg_end_errors(run.error, run.leg)
     if not len(ends):
         return []
     worst = int(np.argmax(ends))
+    cycle, leg = divmod(worst, legs) if legs > 0 else (-1, worst)
+    at = f"cycle {cycle + 1}, leg {leg + 1}" if legs > 0 else f"leg {worst + 1}"
     where = "adaptive, where σ_min(J) < " + g(threshold) if threshold > 0 else "constant"
     text = (
         f"{name} (λ = {g(damping)}, {where}): task error at the end of its legs up to "
-        f"{g(float(ends[worst]))} (leg {worst + 1}; tolerance {g(tol)}). Damping "
+        f"{g(float(ends[worst]))} ({at}; tolerance {g(tol)}). Damping "
         "bounds the joint speed near singularities at the price of tracking (J J# ≠ I)"
     )
     if pinv is not None and not pinv.success and run.success:
@@ -312,12 +316,14 @@ def practical_findings(
     runs: Mapping[str, Any] | None = None,
     rest=None,
     box: bool = False,
+    legs: int = 0,
 ) -> list[tuple[str, str]]:
     """What a practical inverse beside the paper's two did on ``run``, from its parameters:
     :func:`posture_findings` (its rest in ``rest``, else :func:`rest_words` of the run's
     start), :func:`damped_findings`, :func:`weighted_findings` (against the limits it was
     given; ``box``: the configuration box of a robot without limits); none for the paper's
-    inverses.
+    inverses. ``legs``: the legs of a cycle, by which damped least squares names its worst leg
+    (cycle and leg).
 
     ``run`` carries ``drift`` (cycles,), ``success``, ``x`` (m, p) the configurations it went
     through, ``error`` and ``leg`` (m',) the task error and leg of points of it, at least of
@@ -332,7 +338,7 @@ def practical_findings(
         return posture_findings(name, inverse.gain, words, run.drift, unit, *drifts)
     if inverse.name == "damped":
         lam, eps = inverse.damping, inverse.damping_threshold
-        return damped_findings(name, lam, eps, tol, run, runs.get("pseudoinverse"))
+        return damped_findings(name, lam, eps, tol, run, runs.get("pseudoinverse"), legs)
     if inverse.name == "weighted":
         names = inverse.kinematics.names
         return weighted_findings(name, run.x, inverse.limits, names, box)

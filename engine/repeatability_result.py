@@ -189,7 +189,8 @@ class RepeatabilityResult(Columns):
         out = verdict({self.algorithm: run}, True, self.mode, self.gamma, unit)
         if self.used is None:
             return out
-        found = practical_findings(self.used, run, unit, self.settings.tol)
+        per_cycle = self.targets.shape[-2]  # (the legs of a cycle)
+        found = practical_findings(self.used, run, unit, self.settings.tol, legs=per_cycle)
         return out + [Finding(text, role, self.algorithm) for text, role in found]
 
     def _errors(self, ends: FloatArray, targets: FloatArray) -> FloatArray:

@@ -129,6 +129,8 @@ def test_verdict_reports_damped_tracking_error_and_weighted_limits():
         ]
     ]
     assert f"task error at the end of its legs up to {ends.max():.3g}" in texts["damped"]
+    cycle, leg = divmod(int(np.argmax(ends)), len(result.targets))  # (as the export counts)
+    assert f"(cycle {cycle + 1}, leg {leg + 1}; tolerance" in texts["damped"]
     assert "stayed within its limits" in texts["weighted"]
     assert "no joint limits: its configuration box x_range" in texts["weighted"]
 

@@ -261,7 +261,8 @@ def test_a_result_of_a_practical_inverse_says_what_its_parameters_did():
     ends = [run.findings()[1].text for run in runs]
     assert ends[0].startswith("damped least squares J^DLS (λ = 0.05, adaptive, where σ_min(J)")
     errors = np.linalg.norm(arm.forward(runs[0].legs) - np.resize(runs[0].targets, (8, 2)), axis=1)
-    assert f"up to {errors.max():.3g} (leg {np.argmax(errors) + 1};" in ends[0]
+    cycle, leg = divmod(int(np.argmax(errors)), 4)
+    assert f"up to {errors.max():.3g} (cycle {cycle + 1}, leg {leg + 1};" in ends[0]
     assert ends[0] == ends[1]
     limits = [[-4.0, 4.0]] * 3
     weighted = jik.repeatability(jik.WeightedInverse(arm, limits), x0, path, cycles=2)
@@ -272,6 +273,42 @@ def test_a_result_of_a_practical_inverse_says_what_its_parameters_did():
     assert "x_range" not in why.text
     batch = jik.repeatability(damped, [x0, [0.1, 0, 1.5]], path, cycles=2)
     assert batch.findings(start=0)[1].text == ends[0]
+
+
+def test_a_drift_without_a_unit_reads_as_a_number_not_a_number_and_a_blank():
+    """findings() without a unit (its default) writes the posture inverse's drift as the other
+    sentences do, "drifts 0.0625, but", not "drifts 0.0625 , but"; gain 0 likewise."""
+    arm = jik.Manipulator2()
+    x0, path = [0, 0, np.pi / 2], [(1, 1), (1, 2), (0, 2)]
+    post = jik.repeatability(jik.PostureInverse(arm, rest=x0), x0, path, cycles=2)
+    (_, why) = post.findings()
+    assert f"it drifts {post.drift[-1]:.3g}, but does not reach" in why.text
+    ((zero, _),) = posture_findings("J^N#", 0.0, "x_rest = x0", [0.5], "")
+    assert zero.endswith("it is the pseudoinverse (k = 0), drift 0.5.")
+    ((text, _),) = posture_findings("J^N#", 1.0, "x_rest = x0", [0.5], "", [0.9])
+    assert "it drifts 0.5, less than the pseudoinverse's 0.9" in text
+
+
+def test_damped_least_squares_names_its_worst_leg_by_cycle_and_leg():
+    """A run of 2 cycles of 3 legs whose worst leg end is its 4th leg says "cycle 2, leg 1", as
+    the failures and the limits report count legs, not "leg 4" of a cycle of three."""
+    run = SimpleNamespace(error=np.array([0.1, 0.2, 0.1, 0.9, 0.1, 0.1]), leg=np.arange(6))
+    run.success = True
+    ((text, _),) = damped_findings("DLS", 0.1, 0.0, 1e-10, run, legs=3)
+    assert "up to 0.9 (cycle 2, leg 1; tolerance 1e-10)" in text
+    ((text, _),) = damped_findings("DLS", 0.1, 0.0, 1e-10, run)
+    assert "up to 0.9 (leg 4; tolerance 1e-10)" in text
+    panda = jik.load_robot("panda")
+    home = np.array(panda.spec.default_x0)
+    loop = panda.kinematics.forward(home) + [[0.08, 0, 0, 0, 0, 0.2], [0.08, 0.08, 0, 0.15, 0, 0.2]]
+    rep = jik.repeatability(panda.inverse("damped"), home, loop, cycles=2)
+    legs = rep.targets.shape[0]
+    ends = np.linalg.norm(
+        panda.kinematics.forward(rep.legs) - np.resize(rep.targets, rep.legs.shape[:1] + (6,)),
+        axis=1,
+    )
+    cycle, leg = divmod(int(np.argmax(ends)), legs)
+    assert f"(cycle {cycle + 1}, leg {leg + 1};" in rep.findings()[1].text
 
 
 def test_the_posture_inverses_default_rest_is_named_in_words():
