@@ -28,7 +28,7 @@ from .posture_at_start import PostureAtStart
 from .practical_inverses import PostureInverse
 from .progress import Progress, check_cancelled, check_progress
 from .repeatability import repeatability
-from .validation import FloatArray, check_memory, flag
+from .validation import FloatArray, check_memory, flag, of_type
 
 #: Starts per batched repeatability() call within a chunk: the working set of the Picard sweeps
 #: then stays in cache (``jik bench atlas``, docs/benchmarks.md: 512 is faster than 2048),
@@ -302,6 +302,7 @@ def iter_atlas(
         ``progress.cancelled()`` returned True (polled after every chunk); work not yet done is
         dropped.
     """
+    plan = of_type(plan, AtlasPlan, "plan", "an AtlasPlan (plan_atlas)")
     progress = check_progress(progress)
     tasks = (
         chunk_task(plan, lo, min(lo + plan.chunk, plan.size))
@@ -351,6 +352,7 @@ def run_atlas(
         atlas with :func:`iter_atlas`, or keep the drift alone.
     """
     progress, keep_leg_ends = check_progress(progress), flag(keep_leg_ends, "keep_leg_ends")
+    plan = of_type(plan, AtlasPlan, "plan", "an AtlasPlan (plan_atlas)")
     A, P, N = len(plan.inverses), len(plan.paths), plan.n_starts
     p = plan.inverses[0].kinematics.p
     leg_ends = A * plan.cycles * plan.legs * p if keep_leg_ends else 0

@@ -23,6 +23,7 @@ import json
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
+from os import PathLike
 from pathlib import Path
 from typing import Any
 
@@ -44,6 +45,7 @@ from .robot_augmentations import augmentations_from_dict
 from .robot_defaults import defaults, points
 from .robot_synthesis import arm_augmentations, missing_map
 from .units import RobotUnits, robot_units
+from .validation import of_type
 
 #: Largest robot file read by :func:`load_robot` [bytes].
 MAX_FILE_BYTES = 2_000_000
@@ -309,7 +311,8 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
 
 def load_robot(source: str | Path) -> Robot:
     """A robot from a JSON or YAML file (``.yaml``/``.yml``, needs PyYAML), or a built-in name."""
-    path = Path(source)
+    wanted = "a file's path or a robot's name (a dict: robot_from_dict)"
+    path = Path(of_type(source, (str, PathLike), "robot", wanted))
     if not path.is_file():
         if str(source) in ROBOTS or str(source) in ARMS:
             return robot_from_dict({"name": str(source)})

@@ -185,6 +185,15 @@ def flag(value, name: str) -> bool:
     raise InvalidInputError(f"{name} must be True or False, got {value!r:.40}", name)
 
 
+def of_type(value, kind, name: str, wanted: str):
+    """``value`` if it is a ``kind`` (a type or a tuple of types), else an InvalidInputError
+    naming ``name`` that says what is ``wanted`` and what was given."""
+    if isinstance(value, kind):
+        return value
+    got = f"{type(value).__name__} {value!r:.60}"
+    raise InvalidInputError(f"{name} must be {wanted}, got {got}", name)
+
+
 def check_memory(n: int, each: float, field: str, what: str, instead: str) -> None:
     """Refuse a call of ``n`` items of ``each`` bytes (its estimated peak memory) when they
     exceed :data:`MEMORY_LIMIT`.

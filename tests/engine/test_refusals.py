@@ -304,6 +304,10 @@ REFUSALS = {
         "progress",
     ),
     "h_change h text": (lambda: jik.h_change("abc"), "h"),
+    "run_atlas an inverse for its plan": (lambda: jik.run_atlas(P), "plan"),
+    "iter_atlas a dict for its plan": (lambda: next(jik.iter_atlas({"path": LOOP})), "plan"),
+    "load_robot a number": (lambda: jik.load_robot(3), "robot"),
+    "load_robot a dict": (lambda: jik.load_robot({"name": "panda"}), "robot"),
 }
 
 
