@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import os
 import sys
 import time
@@ -152,12 +151,12 @@ class Progress:
         if self.quiet:
             return
         t = time.perf_counter() - self.t0
-        left = t * (total - done) / done if done else math.nan
+        left = f"{t * (total - done) / done:.0f}" if done else "?"
         bar = "#" * int(30 * done / total)
         A = self.algorithms
         sys.stderr.write(
             f"\r  atlas [{bar:<30}] {A * done}/{A * total} runs ({total} starts x {A} "
-            f"algorithm{'' if A == 1 else 's'}), {t:.1f} s, {left:.0f} s left "
+            f"algorithm{'' if A == 1 else 's'}), {t:.1f} s, {left} s left "
         )
         if done >= total:
             sys.stderr.write("\n")
@@ -241,6 +240,7 @@ def _run(args: argparse.Namespace) -> int:
     arrays = Gathered(plan, keep, every, legs=not args.no_leg_ends)
     progress = Progress(args.quiet, A)
     t0 = time.perf_counter()
+    progress(0, plan.size)  # (the size at once: the first chunk may take minutes)
     with CsvWriter(csv_path, plan, legs=not args.no_leg_ends) as rows:
         for task, chunk in iter_atlas(plan, backend):
             arrays.add(task, chunk)

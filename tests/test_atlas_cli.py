@@ -503,3 +503,24 @@ def test_the_progress_bar_counts_the_runs_of_every_algorithm(tmp_path, capsys):
     assert main(argv) == 0
     err = capsys.readouterr().err
     assert "24/24 runs (8 starts x 3 algorithms)" in err and "8/8 runs" not in err
+
+
+def test_the_progress_bar_says_the_atlas_s_size_before_its_first_chunk(
+    tmp_path, monkeypatch, capsys
+):
+    """An atlas whose first chunk takes minutes is not silent until then: the bar starts at 0
+    runs of its whole size, its time left not yet known ("?", not "nan")."""
+    shown = []
+
+    def first_chunk(plan, backend=None, progress=None):
+        shown.append(capsys.readouterr().err)
+        raise KeyboardInterrupt  # (stop before any work)
+        yield
+
+    monkeypatch.setattr("jik.engine.atlas_run.iter_atlas", first_chunk)
+    argv = ["atlas", "--robot", "manipulator2", "--starts", "300", "--no-figure"]
+    out = ["--out", str(tmp_path / "a.json")]
+    with pytest.raises(KeyboardInterrupt):
+        main([*argv, *out, "--algorithm", "pseudoinverse", "--algorithm", "extended"])
+    assert "atlas [" in shown[0] and "] 0/600 runs (300 starts x 2 algorithms)" in shown[0]
+    assert "? s left" in shown[0] and "nan" not in shown[0]
