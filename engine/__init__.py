@@ -49,6 +49,7 @@ Repeatability (sec. 5.2.1, Table 1)
     RepeatabilityResult.findings  what a run found, and why (h kept, eq. (12)), in sentences
     Finding                     one such sentence: text, role, algorithm
     run_findings, extended_why  the same from a run's pieces (drift, h, mode, gamma)
+    practical_findings          what a damped, weighted or posture inverse's parameters did
     Resume, Leg                 an earlier run to go on from (as x0); a leg as a progress sees it
     Progress, ProgressCallbacks what a long computation reports, and how to cancel it
 Functionals and synthesis (secs. 3-4)
@@ -140,6 +141,7 @@ _EXPORTS = {
     "run_findings": "findings",
     "Finding": "findings",
     "extended_why": "findings",
+    "practical_findings": "findings",
     "Progress": "progress",
     "ProgressCallbacks": "progress",
     # functionals and synthesis
@@ -237,6 +239,7 @@ __all__ = [
     "map_grid",
     "map_singularities",
     "plan_atlas",
+    "practical_findings",
     "repeatability",
     "repeatable",
     "robot_from_dict",
@@ -300,7 +303,7 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
         SingularConfigurationError,
     )
     from .extended_vector import VectorExtendedInverse
-    from .findings import Finding, extended_why, run_findings
+    from .findings import Finding, extended_why, practical_findings, run_findings
     from .formula_kinematics import FormulaKinematics, FormulaMap
     from .functional_report import functionals_report
     from .functionals import error_functional_e1, error_functional_e2

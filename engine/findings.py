@@ -28,6 +28,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from .augmentations import H_CONSERVED, h_change
+from .limits import limit_names
 from .repeatability import REPEATABLE_DRIFT, repeatable
 
 #: In discrete mode, a gamma at or above this is "near 2" (the iteration's stability limit).
@@ -340,7 +341,7 @@ def practical_findings(
         lam, eps = inverse.damping, inverse.damping_threshold
         return damped_findings(name, lam, eps, tol, run, runs.get("pseudoinverse"), legs)
     if inverse.name == "weighted":
-        names = inverse.kinematics.names
+        names = limit_names(inverse.kinematics)
         return weighted_findings(name, run.x, inverse.limits, names, box)
     return []
 

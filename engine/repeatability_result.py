@@ -134,7 +134,8 @@ class RepeatabilityResult(Columns):
         iteration keeps h only approximately and what a gamma near 2 does; for the practical
         inverses what their parameters did (:func:`jik.engine.findings.practical_findings`:
         the posture inverse's drift, damped least squares' task error at the legs' ends, the
-        weighted inverse's joints against its limits).
+        weighted inverse's joints against its limits, at every recorded point, else at the legs'
+        ends).
 
         Parameters
         ----------

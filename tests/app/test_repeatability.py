@@ -94,3 +94,27 @@ def test_the_response_says_what_the_run_found_and_why(api):
     field = schema["RepeatabilityResponse"]["properties"]["findings"]
     assert "h stayed at h(x0), eq. (12)" in field["description"]
     assert schema["Sentence"]["properties"]["role"]["enum"] == ["finding", "why", "note", "failure"]
+
+
+def test_a_practical_inverse_says_what_its_parameters_did(api):
+    """``findings`` of the damped, posture and weighted inverses add what their parameters did
+    (jik.engine.findings.practical_findings): damped least squares' damping and task error at
+    its legs' ends, the posture inverse's gain and rest (the default: x0), the weighted
+    inverse's joints against the limits it took."""
+    said = {}
+    for algorithm, parameters in (
+        ("damped", {"damping": 0.05}),
+        ("posture", {"gain": 2.0}),
+        ("weighted", {"limits": [[-4, 4]] * 3}),
+    ):
+        body = _body(algorithm=algorithm, cycles=2, algorithm_parameters=parameters)
+        found = api.post("/repeatability", json=body).json()["findings"]
+        assert [f["role"] for f in found] == ["finding", "why"], found
+        said[algorithm] = found[1]["text"]
+    assert said["damped"].startswith("damped least squares J^DLS (λ = 0.05, constant): task")
+    assert said["posture"].startswith(
+        "posture inverse (J^P# with a null-space pull), gain k = 2, x_rest = x0 (0, 0, 1.571)"
+    )
+    assert said["weighted"].startswith(
+        "weighted least-norm J^W#: every joint stayed within its limits (x1 in [-4, 4];"
+    )
