@@ -264,7 +264,15 @@ def __getattr__(name: str) -> Any:
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+    """The API, the submodules imported so far and the module's dunders; not the names this
+    file imports for its own machinery (``Any``, ``importlib``, ``sys``, ...)."""
+    inside = f"{__name__}."
+    mine = {
+        name
+        for name, value in globals().items()
+        if name.startswith("__") or getattr(value, "__name__", "").startswith(inside)
+    }
+    return sorted(mine | set(__all__))
 
 
 class _Engine(types.ModuleType):

@@ -70,6 +70,10 @@ def test_every_exported_name_is_its_modules_object_with_a_docstring():
             assert (obj.__doc__ or "").strip(), f"{name} has no docstring"
         assert name in jik.__doc__, f"{name} is not in the module's table"
     assert set(jik.__all__) <= set(dir(jik))
+    machinery = {"Any", "TYPE_CHECKING", "annotations", "importlib", "sys", "types"}
+    assert not machinery & set(dir(jik)), "a notebook's completion lists the front door's imports"
+    importlib.import_module("jik.engine.solver")
+    assert "solver" in dir(jik) and "__doc__" in dir(jik)
     with pytest.raises(AttributeError, match="no attribute 'solve_ik'"):
         _ = jik.solve_ik
 
