@@ -199,7 +199,8 @@ def make_inverse(
     if algorithm == "damped":
         return pinv.DampedInverse(kinematics, values["damping"], values["damping_threshold"])
     if algorithm == "weighted":
-        limits = vectors.get("limits", _robot_limits(kinematics, spec, robot))
+        given_limits = vectors.get("limits")  # (the default only without them: it may not exist)
+        limits = _robot_limits(kinematics, spec, robot) if given_limits is None else given_limits
         return pinv.WeightedInverse(kinematics, limits)
     if algorithm == "posture":
         if "rest" in vectors:

@@ -292,6 +292,17 @@ def test_weighted_refuses_a_start_past_a_limit_naming_the_joint():
         solve(inv, X0, (1.0, 1.0))
 
 
+def test_limits_given_to_make_inverse_serve_a_robot_without_limits_of_its_own():
+    """A planar chain built directly has no limits and no configuration box; the weighted
+    inverse takes the limits given in algorithm_parameters (the default was computed, and
+    refused, even when they were given)."""
+    chain = PlanarChain(joints="RRR", lengths=[1.0, 0.8, 0.6])
+    limits = [[-2.0, 2.0], [-1.5, 1.5], [-2.5, 2.5]]
+    inv = make_inverse(chain, "weighted", algorithm_parameters={"limits": limits})
+    np.testing.assert_allclose(inv.limits, limits)
+    assert solve(inv, [0.3, 1.0, 1.0], [1.0, 1.3]).success
+
+
 @pytest.mark.parametrize("width", [1e308, np.finfo(float).max, np.inf])
 def test_a_joint_whose_limits_are_huge_or_infinite_has_weight_one(width):
     """Limits [-w, w] with w near the largest float: (hi - lo)^2 would overflow, yet the joint
