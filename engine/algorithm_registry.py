@@ -133,7 +133,9 @@ def _robot_limits(kinematics: Kinematics, spec: RobotSpec | None, robot: str | N
     if declared is not None and np.isfinite(declared).all():
         return declared
     raise InvalidInputError(
-        f"{kinematics.name} has no joint limits: give limits for the weighted inverse", "limits"
+        f"{kinematics.name} has no joint limits: give the weighted inverse its limits, "
+        "algorithm_parameters={'limits': [[lo, hi], ...]} (or WeightedInverse(robot, limits))",
+        "limits",
     )
 
 
@@ -157,7 +159,11 @@ def default_rest(
         spec = spec or ROBOTS.get(robot or kinematics.name)
         x0 = getattr(spec, "default_x0", None) or None
     if x0 is None:
-        raise InvalidInputError(f"{kinematics.name} has no home posture: give rest", "rest")
+        raise InvalidInputError(
+            f"{kinematics.name} has no home posture: give the run's start x0=[...] or the rest, "
+            "algorithm_parameters={'rest': [...]} (or PostureInverse(robot, rest))",
+            "rest",
+        )
     return [float(v) for v in as_vector(x0, kinematics.p, "x0")], "x0"
 
 

@@ -328,6 +328,23 @@ def test_plan_atlas_names_both_missing_arguments():
     assert "reference, a configuration (3 numbers" in str(info.value)
 
 
+def test_a_practical_inverse_without_its_default_says_how_to_give_it():
+    """A planar chain has neither joint limits nor a home: make_inverse names the argument that
+    gives each (make_inverse takes no ``limits=`` or ``rest=``), and the message's call works."""
+    chain = jik.PlanarChain(joints="RRR", lengths=[1.0, 0.8, 0.6])
+    for algorithm, field, given in (
+        ("weighted", "limits", {"algorithm_parameters": {"limits": [[-2.0, 2.0]] * 3}}),
+        ("posture", "rest", {"algorithm_parameters": {"rest": [0.3, 1.0, 1.0]}}),
+        ("posture", "rest", {"x0": [0.3, 1.0, 1.0]}),
+    ):
+        with pytest.raises(InvalidInputError) as info:
+            jik.make_inverse(chain, algorithm)
+        assert info.value.field == field
+        assert f"algorithm_parameters={{'{field}': [" in str(info.value)
+        assert ("x0=[...]" in str(info.value)) == (field == "rest")
+        assert jik.make_inverse(chain, algorithm, **given).name == algorithm
+
+
 def test_texts_for_objects_say_how_to_make_them():
     """A robot's or a formula's name where an object belongs: the message shows the call."""
     with pytest.raises(InvalidInputError, match=r"robot_from_dict\(\{'name': 'manipulator2'\}\)"):
