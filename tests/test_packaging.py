@@ -266,3 +266,13 @@ def test_every_install_hint_names_this_distribution_and_its_extras():
             ):
                 wrong.append(f"{path.relative_to(ROOT)}: {name}[{extras}]")
     assert not wrong, wrong
+
+
+def test_the_readme_says_every_extra_a_user_installs():
+    """README's "Installing" names each extra with its pip command, so that to_dataframe()'s
+    pandas (``dataframes``) or the API reference's tools (``docs``) are not found only by the
+    ImportError that asks for them."""
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = readme.split("## Installing", 1)[1].split("\n## ", 1)[0]
+    said = {extra for _, extras in INSTALL_HINT.findall(section) for extra in extras.split(",")}
+    assert set(PYPROJECT["project"]["optional-dependencies"]) <= said, said
