@@ -66,7 +66,7 @@ The atlas (drift over many starts and paths)
     AtlasPlan, AtlasResult      the plan and the gathered result
     manifold_starts             starts on a self-motion manifold of p - r > 1 (no curve)
 Errors (jik.engine.exceptions)
-    JikError                    the base of every error below
+    JikError                    the base of every error below but RunCancelled
     InvalidInputError, FormulaError  bad input (``error.field`` names it); a formula's syntax
     SingularConfigurationError, KinematicSingularityError, AlgorithmicSingularityError,
     OneFormUndefinedError       J# undefined at ``error.configuration`` (``error.field``: its input)

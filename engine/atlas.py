@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from .exceptions import InvalidInputError, SingularConfigurationError, format_vector
+from .exports import plural
 from .inverses import Inverse, Pseudoinverse, algorithm_labels
 from .repeatability import MAX_CYCLES, MAX_PATH_POINTS, open_loop
 from .self_motion import SelfMotionManifold, project, trace
@@ -98,9 +99,9 @@ class AtlasPlan:
 
     def __repr__(self) -> str:
         return (
-            f"AtlasPlan({'/'.join(self.algorithms)}, {len(self.paths)} paths x {self.n_starts} "
-            f"starts x {self.cycles} cycles of {self.legs} legs, {self.size} runs in chunks of "
-            f"{self.chunk})"
+            f"AtlasPlan({'/'.join(self.algorithms)}, {plural(len(self.paths), 'path')} x "
+            f"{plural(self.n_starts, 'start')} x {plural(self.cycles, 'cycle')} of "
+            f"{plural(self.legs, 'leg')}, {self.size} runs in chunks of {self.chunk})"
         )
 
     @property

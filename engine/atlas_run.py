@@ -21,7 +21,7 @@ from .atlas import AtlasPlan
 from .atlas_backends import Backend, backend_for
 from .atlas_table import atlas_columns
 from .exceptions import InvalidInputError, SingularConfigurationError
-from .exports import Columns, csv_text, dataframe, json_values
+from .exports import Columns, csv_text, dataframe, json_values, plural
 from .inverses import Inverse
 from .limits import robot_limits, starts_outside
 from .posture_at_start import PostureAtStart
@@ -200,7 +200,8 @@ class AtlasResult(Columns):
         )
         drifts = f", largest drift after the last cycle: {drifts}" if drifts else ""
         return (
-            f"AtlasResult({'/'.join(self.algorithms)}, {P} paths x {N} starts x {cycles} cycles, "
+            f"AtlasResult({'/'.join(self.algorithms)}, {plural(P, 'path')} x "
+            f"{plural(N, 'start')} x {plural(cycles, 'cycle')}, "
             f"{int(np.count_nonzero(self.success))} of {self.success.size} runs completed"
             f"{drifts})"
         )
@@ -360,7 +361,7 @@ def run_atlas(
         P * N,
         8.0 * (p + A * plan.cycles + leg_ends + 1) + 2 * A,
         "n_starts" if plan.explicit is None else "starts",
-        f"runs of a gathered atlas ({P} paths x {N} starts)",
+        f"runs of a gathered atlas ({plural(P, 'path')} x {plural(N, 'start')})",
         "stream it chunk by chunk with iter_atlas"
         + (", keep the drift alone (keep_leg_ends=False)" if keep_leg_ends else "")
         + ", or ask for fewer starts, paths or cycles",

@@ -45,6 +45,11 @@ def short_vector(v, digits: int = 4) -> str:
     return "[" + ", ".join(items) + "]"
 
 
+def plural(n: int, noun: str) -> str:
+    """``1 cycle``, ``2 cycles``: a count with its noun."""
+    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
+
+
 def short_text(text: str, width: int = 60) -> str:
     """``text`` cut to ``width`` characters, quoted."""
     return repr(text if len(text) <= width else text[: width - 3] + "...")

@@ -28,6 +28,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from .augmentations import H_CONSERVED, h_change
+from .exports import plural
 from .limits import limit_names
 from .repeatability import REPEATABLE_DRIFT, repeatable
 
@@ -58,10 +59,6 @@ def g(v: float) -> str:
     return f"{v:.3g}"
 
 
-def _cycles(n: int) -> str:
-    return f"{n} cycle{'s' if n > 1 else ''}"
-
-
 def _amount(v: float, unit: str) -> str:
     return f"{g(v)} {unit}" if unit else g(v)
 
@@ -73,8 +70,9 @@ def drift_sentence(name: str, drift, unit: str) -> str:
     d = np.asarray(drift, dtype=float)
     n = len(d)
     if repeatable(d):
+        each = "each of " if n > 1 else ""
         return (
-            f"{name}: repeatable. After each of {_cycles(n)} the joints came back "
+            f"{name}: repeatable. After {each}{plural(n, 'cycle')} the joints came back "
             f"to x0 within {_amount(float(d.max()), unit)} (‖x − x0‖ below {g(REPEATABLE_DRIFT)})."
         )
     trend = ""
@@ -86,7 +84,7 @@ def drift_sentence(name: str, drift, unit: str) -> str:
             else f" (after cycle 1: {g(float(d[0]))})"
         )
     return (
-        f"{name}: not repeatable. After {_cycles(n)} the joints end "
+        f"{name}: not repeatable. After {plural(n, 'cycle')} the joints end "
         f"‖x − x0‖ = {_amount(float(d[-1]), unit)} away from x0{trend}."
     )
 
@@ -206,7 +204,7 @@ def posture_findings(
     if not n:
         return []
     d = float(drift[-1])
-    head = f"{name}, gain k = {g(gain)}, {rest}: after {_cycles(n)}"
+    head = f"{name}, gain k = {g(gain)}, {rest}: after {plural(n, 'cycle')}"
     if gain == 0:
         return [(f"{head} it is the pseudoinverse (k = 0), drift {_amount(d, unit)}.", "why")]
     parts = []

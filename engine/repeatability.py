@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from .exceptions import InvalidInputError, JikError, format_vector
+from .exports import plural
 from .inverses import Inverse
 from .picard_guesses import chain_guesses
 from .progress import Progress, check_cancelled, check_progress, stops_at
@@ -236,7 +237,7 @@ def repeatability(
         len(xb),
         run_bytes(kin, cycles, L, mode, record and single, gamma, tol, cap),
         "x0",
-        f"starts of a repeatability run ({cycles} cycles x {L} legs)",
+        f"starts of a repeatability run ({plural(cycles, 'cycle')} x {plural(L, 'leg')})",
         "run them in smaller batches, with fewer cycles, or as an atlas streamed by iter_atlas",
     )
     chunked = progress is not None and mode == "discrete" and single

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .exceptions import InvalidInputError
-from .exports import Columns, coordinate_columns, json_values, short_text, short_vector
+from .exports import Columns, coordinate_columns, json_values, plural, short_text, short_vector
 from .results import SolveResult
 from .run_settings import RunSettings
 from .validation import FloatArray, count
@@ -21,10 +21,6 @@ from .validation import FloatArray, count
 if TYPE_CHECKING:
     from .findings import Finding
     from .inverses import Inverse
-
-
-def _plural(n: int, noun: str) -> str:
-    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
 
 
 @dataclass(frozen=True)
@@ -112,7 +108,7 @@ class RepeatabilityResult(Columns):
             last = f"{self.drift[-1]:.3g}" if cycles else "none"
             return (
                 f"RepeatabilityResult({how}, success={self.success}, "
-                f"{_plural(cycles, 'cycle')} of {len(self.targets)} legs, "
+                f"{plural(cycles, 'cycle')} of {plural(len(self.targets), 'leg')}, "
                 f"x0={short_vector(self.x0)}, drift after the last cycle {last}, "
                 f"message={short_text(str(self.message))})"
             )
@@ -120,8 +116,8 @@ class RepeatabilityResult(Columns):
         worst = float(np.nanmax(self.drift[:, -1])) if np.any(self.success) else float("nan")
         return (
             f"RepeatabilityResult({how}, {len(self.x0)} starts, {ok} completed, "
-            f"{_plural(cycles, 'cycle')} of {self.targets.shape[1]} legs, largest drift after "
-            f"the last cycle {worst:.3g})"
+            f"{plural(cycles, 'cycle')} of {plural(self.targets.shape[1], 'leg')}, largest "
+            f"drift after the last cycle {worst:.3g})"
         )
 
     def findings(self, unit: str = "", start: int | None = None) -> list[Finding]:

@@ -289,7 +289,7 @@ def _batch(inverse, x0, y_d, gamma, mode, tol, max_iterations, record, method, g
         else:
             raise InvalidInputError(
                 f"x0 has {len(xb)} configurations but y_d has {len(np.atleast_2d(y_d))} targets",
-                "y_d",
+                "x0" if len(xb) == 0 else "y_d",
             )
     mode, gamma, tol, cap = check_settings(mode, gamma, tol, max_iterations, method)
     record = flag(record, "record")

@@ -76,7 +76,7 @@ def test_e2_synthesis():
 def test_atlas():
     text = run("04_atlas.py")
     assert "12 of 12 runs" in text  # (the progress, as chunks end)
-    assert "AtlasResult(pseudoinverse/extended, 1 paths x 12 starts x 1 cycles" in text
+    assert "AtlasResult(pseudoinverse/extended, 1 path x 12 starts x 1 cycle" in text
     pinv = next(line for line in text.splitlines() if line.startswith("pseudoinverse"))
     ext = next(line for line in text.splitlines() if line.startswith("extended"))
     assert "12 of 12 runs completed" in pinv and numbers(pinv)[0] > 0.1
@@ -88,7 +88,7 @@ def test_dask_atlas():
     """A local Dask cluster gives the numbers of a run in this process."""
     pytest.importorskip("distributed", reason="the atlas extra (Dask) is not installed")
     text = run("05_dask_atlas.py")
-    assert "1 paths x 16 starts x 2 cycles, 16 of 16 runs completed" in text
+    assert "1 path x 16 starts x 2 cycles, 16 of 16 runs completed" in text
     assert "The same numbers as in this process: True" in text
 
 

@@ -325,3 +325,16 @@ def test_the_posture_inverses_default_rest_is_named_in_words():
     assert rest_words(home, [0.0] * 7) == (
         "x_rest = the robot's home (0, -0.7854, 0, -2.356, 0, 1.571, 0.7854)"
     )
+
+
+def test_one_cycle_is_said_as_one():
+    """One cycle reads "After 1 cycle", not "After each of 1 cycle"; the result prints "1 cycle
+    of 4 legs"."""
+    arm = jik.Manipulator2()
+    run = jik.repeatability(
+        jik.ExtendedInverse(arm, jik.PaperCubic()), [0, 0, np.pi / 2], [(1, 1), (1, 2), (0, 2)], 1
+    )
+    assert run.findings()[0].text.startswith(
+        "extended Jacobian J^E#: repeatable. After 1 cycle the joints came back to x0 within"
+    )
+    assert "1 cycle of 4 legs" in repr(run)

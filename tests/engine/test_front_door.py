@@ -155,11 +155,11 @@ def test_results_print_on_one_line_with_their_numbers():
 
 
 def test_an_atlas_and_a_synthesis_print_on_one_line():
-    _one_line(_plan(), "AtlasPlan(pseudoinverse, 1 paths x 2 starts x 2 cycles of 4 legs, 2 runs")
+    _one_line(_plan(), "AtlasPlan(pseudoinverse, 1 path x 2 starts x 2 cycles of 4 legs, 2 runs")
     atlas = _atlas()
     _one_line(
         atlas,
-        "AtlasResult(pseudoinverse, 1 paths x 2 starts x 2 cycles, 2 of 2 runs",
+        "AtlasResult(pseudoinverse, 1 path x 2 starts x 2 cycles, 2 of 2 runs",
         f"pseudoinverse {np.max(atlas.drift[..., -1]):.3g}",
     )
     synthesis = jik.synthesize_e2(jik.Manipulator2(), {"x2": (-1, 1), "x3": (0, 3)}, degree=4)

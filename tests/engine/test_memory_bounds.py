@@ -44,7 +44,7 @@ def test_a_repeatability_batch_beyond_the_bound_is_refused_before_it_allocates()
         text = _refused(
             lambda n=n: jik.repeatability(P, _starts(n), PATH),
             "x0",
-            f"{n} starts of a repeatability run (1 cycles x 4 legs)",
+            f"{n} starts of a repeatability run (1 cycle x 4 legs)",
             "smaller batches",
             "iter_atlas",
         )
@@ -143,7 +143,7 @@ def test_explicit_starts_name_starts(monkeypatch):
     """An atlas of explicit starts too large to gather names ``starts``."""
     plan = jik.plan_atlas(P, LOOP, starts=[X0], shifts=np.zeros((10**4, 2)))
     monkeypatch.setattr(validation, "MEMORY_LIMIT", 10**5)
-    _refused(lambda: jik.run_atlas(plan), "starts", "10000 paths x 1 starts")
+    _refused(lambda: jik.run_atlas(plan), "starts", "10000 paths x 1 start")
 
 
 def test_a_chunk_too_large_for_the_bound_is_refused_by_plan_atlas(monkeypatch):

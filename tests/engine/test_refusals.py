@@ -464,3 +464,15 @@ def test_a_singular_configuration_names_its_input_as_invalid_input_does():
             call()
         assert info.value.field == field, str(info.value)
         np.testing.assert_allclose(info.value.configuration.shape, (3,))
+
+
+def test_a_batch_without_starts_names_x0():
+    """solve_batch with no start at all: the fault is x0's (it has 0 configurations), not the
+    one target's; a count that differs otherwise names y_d."""
+    inverse = jik.Pseudoinverse(jik.Manipulator2())
+    with pytest.raises(jik.InvalidInputError, match="x0 has 0 configurations") as empty:
+        jik.solve_batch(inverse, np.zeros((0, 3)), [1, 1])
+    assert empty.value.field == "x0"
+    with pytest.raises(jik.InvalidInputError) as counts:
+        jik.solve_batch(inverse, np.zeros((2, 3)), np.ones((3, 2)))
+    assert counts.value.field == "y_d"
