@@ -17,9 +17,15 @@ import numpy as np
 
 from .e2_qmc import e2_qmc
 from .exceptions import JikError
-from .functionals import error_functional_e1, error_functional_e2, parameter_sensitivity
-from .progress import Progress
+from .functionals import (
+    check_region,
+    error_functional_e1,
+    error_functional_e2,
+    parameter_sensitivity,
+)
+from .progress import Progress, check_cancelled, check_progress
 from .robot_synthesis import TOTAL_NODES as QMC_NODES
+from .validation import count
 
 #: The most region variables of a tensor Gauss rule.
 MAX_TENSOR_VARIABLES = 3
@@ -47,26 +53,39 @@ def functionals_report(
     kinematics,
     amap,
     region: Mapping,
-    fixed: Mapping,
-    nodes: int,
-    on_step: Callable[[], None] = lambda: None,
+    fixed: Mapping | None = None,
+    nodes: int = 12,
     progress: Progress | None = None,
 ) -> dict:
     """E1 and E2 of ``amap`` on ``region`` (name -> (lo, hi)), the other variables at
-    ``fixed``, as the module's notes say: by the tensor rule (:func:`functional_value` of each,
-    ``nodes`` per variable), else by the Sobol rule of :data:`QMC_NODES` nodes: ``E2``,
-    ``E2_single_joint`` (name -> {"sign", "e2"}) and ``E2_rule``, ``E1`` None and a ``note``
-    saying why and how (E2's ``E2_error`` when it could not be evaluated).
+    ``fixed`` (default: :func:`~jik.engine.robot_defaults.held_values`), as the module's notes
+    say: by the tensor rule (:func:`functional_value` of each, ``nodes`` per variable), else by
+    the Sobol rule of :data:`QMC_NODES` nodes: ``E2``, ``E2_single_joint`` (name -> {"sign",
+    "e2"}) and ``E2_rule``, ``E1`` None and a ``note`` saying why and how. A functional that
+    cannot be evaluated on a valid region (h undefined there) is reported as data
+    (``E1_error``, ``E2_error``); invalid input raises.
 
-    ``on_step()`` after each of the two functionals (what it raises stops them); ``progress``
-    is polled between the Sobol rule's chunks of nodes (its cancellation raises
-    :class:`~jik.engine.exceptions.RunCancelled`).
+    ``progress`` (:class:`~jik.engine.progress.Progress`) is told ``advance(k, 2)`` after each
+    of the two functionals (what it raises stops them), and the Sobol rule's fraction of nodes
+    done; its ``cancelled()`` is polled between them and between the Sobol rule's chunks of
+    nodes (:class:`~jik.engine.exceptions.RunCancelled`).
+
+    Raises
+    ------
+    InvalidInputError
+        ``region`` or ``fixed`` not a box of the robot's variables and values of the others
+        (:func:`~jik.engine.functionals.check_region`), ``nodes`` not 1 to 400, ``progress``
+        not a Progress.
     """
+    region, fixed = check_region(kinematics, region, fixed)
+    nodes, progress = count(nodes, "nodes", 1, 400), check_progress(progress)
     if len(region) <= MAX_TENSOR_VARIABLES:
         out: dict = {}
-        for key in ("E1", "E2"):
+        for k, key in enumerate(("E1", "E2"), start=1):
+            check_cancelled(progress, "E1, E2")
             out |= functional_value(key, kinematics, amap, region, nodes, fixed)
-            on_step()
+            if progress is not None:
+                progress.advance(k, 2)
         return out
     large = f"a tensor rule over the {len(region)} variables of the design region is too large"
     if kinematics.p - kinematics.r != 1:
@@ -77,8 +96,8 @@ def functionals_report(
         )
     except (JikError, ValueError, ArithmeticError) as exc:
         e2 = {"E2": None, "error": str(exc)}
-    on_step()
-    on_step()
+    if progress is not None:
+        progress.advance(2, 2)
     if "error" in e2:
         return {
             "E1": None,

@@ -69,7 +69,7 @@ NODES, EXPENSIVE_NODES = 12, 6
 
 def error_functionals(
     result: DashboardResult,
-    on_step: Callable[[], None] = lambda: None,
+    on_advance: Callable[[float, float], None] | None = None,
     cancelled: Callable[[], bool] = lambda: False,
 ) -> dict | None:
     """E1 (13) and E2 (18) of the current map, or None if unavailable.
@@ -77,9 +77,9 @@ def error_functionals(
     Over the robot's design region from the registry (the boxes of sec. 5, the ones
     ``jik reproduce`` uses) where it has one, so the values do not move with the start point and
     a synthesized map is judged on the box it was built for; else over the heat-map box.
-    ``on_step()`` after each of the two (progress; what it raises stops them). Over more than
-    three variables, E2 by a Sobol rule
-    (:func:`~jik.engine.functional_report.functionals_report`, polling ``cancelled``).
+    ``on_advance(done, total)`` as the engine's
+    :func:`~jik.engine.functional_report.functionals_report` advances (what it raises stops
+    it), ``cancelled`` polled; over more than three variables, E2 by a Sobol rule.
     """
     grid = result.augmenting
     if grid is None:
@@ -96,10 +96,10 @@ def error_functionals(
         "nodes": nodes,
         "design_region": bool(design),
     }
-    report = ProgressCallbacks(is_cancelled=cancelled)
+    report = ProgressCallbacks(on_advance=on_advance, is_cancelled=cancelled)
     try:
         kin, amap = grid["kinematics"], grid["map"]
-        return out | functionals_report(kin, amap, region, fixed, nodes, on_step, report)
+        return out | functionals_report(kin, amap, region, fixed, nodes, report)
     except RunCancelled:
         raise Cancelled from None
 

@@ -10,7 +10,6 @@ of :func:`cancelled_figures` say so instead of showing stale values.
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
@@ -75,13 +74,13 @@ class SecondPhase:
         self.what = GRID if grid else FUNCTIONALS
         self.fraction = 0.0
 
-    def _step(self, what: str, before: int) -> Callable[[int, int], None]:
+    def _step(self, what: str, before: int) -> Callable[[float, float], None]:
         """The progress callback of a stage that starts after ``before`` steps: ``(done, _)``
         of its own steps. It reports the fraction of the whole phase and raises
         :class:`Cancelled` when the phase is cancelled."""
         whole = max(1, sum(self.steps.values()))
 
-        def step(done: int, _total: int) -> None:
+        def step(done: float, _total: float) -> None:
             self.what = what
             self.fraction = min(1.0, (before + done) / whole)
             self._progress(self.fraction, what)
@@ -107,10 +106,9 @@ class SecondPhase:
         if self.cached:
             return self.cached
         grid = self.steps[GRID]
-        one = self._step(FUNCTIONALS, grid)
-        done = itertools.count(1)
+        one = self._step(FUNCTIONALS, grid)  # (two steps: E1, E2)
         functionals = error_functionals(
-            self.result, on_step=lambda: one(next(done), 2), cancelled=self._cancelled
+            self.result, lambda done, total: one(2 * done / total, 2), self._cancelled
         )
         sens = sensitivity(
             self.result, functionals, self._cancelled, progress=self._step(FUNCTIONALS, grid + 2)

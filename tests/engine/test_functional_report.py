@@ -6,7 +6,7 @@ import pytest
 
 from jik.engine.augmentations import E2Optimal, PaperCubic
 from jik.engine.e2_qmc import e2_qmc
-from jik.engine.exceptions import RunCancelled
+from jik.engine.exceptions import InvalidInputError, RunCancelled
 from jik.engine.functional_report import (
     QMC_NODES,
     QMC_SEED,
@@ -29,18 +29,27 @@ from tests.engine.test_e2_qmc import CHAIN, REGION
 
 def test_a_small_region_gets_both_functionals_by_the_tensor_rule():
     """Manipulator 2's cubic (38) on a box of two variables: E1 and E2 are the engine's
-    functionals there, with their singular points counted; ``on_step`` after each."""
+    functionals there, with their singular points counted; the progress advances after each.
+    A box of its variables that is not one is refused, naming the field, as a bad ``nodes``."""
     kin, h = Manipulator2(), PaperCubic()
     region, fixed = {"x2": (-0.5, 0.5), "x3": (1.0, 2.0)}, {"x1": 0.0}
     steps = []
-    out = functionals_report(kin, h, region, fixed, 8, lambda: steps.append(1))
+    told = ProgressCallbacks(on_advance=lambda done, total: steps.append((done, total)))
+    out = functionals_report(kin, h, region, fixed, 8, told)
     e1 = error_functional_e1(kin, h, region, nodes=8, fixed=fixed)
     e2 = error_functional_e2(kin, h, region, nodes=8, fixed=fixed)
     assert out["E1"] == pytest.approx(float(e1.value)) and out["E2"] == pytest.approx(e2.value)
     assert out["E1_singular_points"] == e1.singular_points.shape[0]
-    assert len(steps) == 2 and "note" not in out
-    bad = functionals_report(kin, h, {"x2": (1.0, 0.0), "x3": (1.0, 2.0)}, fixed, 8)
-    assert bad["E1"] is None and "E1_error" in bad
+    assert steps == [(1, 2), (2, 2)] and "note" not in out
+    assert functionals_report(kin, h, region) == functionals_report(kin, h, region, None, 12)
+    for bad, field in (
+        (lambda: functionals_report(kin, h, {"x2": (1.0, 0.0), "x3": (1.0, 2.0)}, fixed), "region"),
+        (lambda: functionals_report(kin, h, region, fixed, 0), "nodes"),
+        (lambda: functionals_report(kin, h, region, fixed, 8, print), "progress"),
+    ):
+        with pytest.raises(InvalidInputError) as refused:
+            bad()
+        assert refused.value.field.startswith(field), refused.value.field
 
 
 def test_a_region_of_four_joints_gets_e2_by_the_sobol_rule_and_no_e1():
