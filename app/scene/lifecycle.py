@@ -18,6 +18,7 @@ from collections.abc import Sequence
 from viser import FrameHandle
 
 from ...engine.exceptions import InvalidInputError
+from ...engine.exports import plural
 from ..dashboard import COLORS, LABELS, Dashboard, Event, runs_key
 from ..dashboard.algorithms import DEFAULT_ALGORITHMS, STYLES
 from ..dashboard.controls import PROGRESS_AFTER
@@ -166,7 +167,7 @@ class DashboardScene:
             n = len(next(iter(runs.values())).drift)
             drifts = ", ".join(f"{a} **{r.drift[-1]:.3g}**" for a, r in runs.items())
             self.status.content = (
-                f"generation {result.generation}: drift after {n} cycles — {drifts}"
+                f"generation {result.generation}: drift after {plural(n, 'cycle')} — {drifts}"
             )
         else:
             messages = "; ".join(r.message for r in runs.values())

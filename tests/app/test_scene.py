@@ -281,7 +281,7 @@ def test_the_scene_shows_the_runs_progress_not_the_second_phases():
         assert dashboard.wait(1, timeout=60)
         scene._show_status(dashboard.result)
         drawn = scene.status.content
-        assert drawn.startswith("generation 1:")
+        assert drawn.startswith("generation 1: drift after 1 cycle —")  # one cycle, not "cycles"
 
         def progress(phase: str) -> Event:
             return Event(
