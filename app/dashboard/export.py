@@ -145,9 +145,11 @@ def csv_context(result: DashboardResult, when: datetime | None = None) -> list[s
     for a, run in result.runs.items():
         ends = "; ".join(", ".join(f"{v:.6g}" for v in e) for e in run.leg_end)
         lines.append(f"# {a}: success {str(run.success).lower()}; {run.message}")
-        lines.append(f"# {a} drift after each cycle: {', '.join(f'{d:.6g}' for d in run.drift)}")
+        drift = ", ".join(f"{d:.6g}" for d in run.drift) or "none (no closed path was driven)"
+        lines.append(f"# {a} drift after each cycle: {drift}")
         dh = h_change(run.h)
-        lines.append(f"# {a} h changed by: {'' if dh is None else f'{dh:.6g}'}")
+        change = "not recorded (this run has no h)" if dh is None else f"{dh:.6g}"
+        lines.append(f"# {a} h changed by: {change}")
         lines.append(f"# {a} leg ends (x after each leg): {ends}")
         if a == "posture":
             rest, source = posture_rest(result.state, kin)

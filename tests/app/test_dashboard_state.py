@@ -197,6 +197,8 @@ def test_export_has_every_point_of_both_runs():
     )
     assert context[4] == "# coordinates: x_1 x1; x_2 x2; x_3 x3; y_1 y1; y_2 y2"
     assert any(r.startswith("# extended leg ends") for r in context)
+    assert not [r for r in context if r.rstrip().endswith(":")]  # every line has its value
+    assert "# pseudoinverse h changed by: not recorded (this run has no h)" in context
     rows = lines[len(context) :]
     assert rows[0] == "algorithm,cycle,leg,theta,x_1,x_2,x_3,y_1,y_2,error,h"
     n = sum(len(r.theta) for r in result.runs.values())
