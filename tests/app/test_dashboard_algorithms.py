@@ -485,3 +485,14 @@ def test_a_rest_outside_a_chain_s_joint_limits_is_refused_in_the_engine_s_words(
     assert "at most 1.2 (the joint limits of the planar_chain), got 2" in str(refused.value)
     outside = updated_state(state, {"x0": [1.5, 0.2, 0.3]})
     assert list(state_inverse(outside, "posture").rest) == [1.5, 0.2, 0.3]
+
+
+def test_each_algorithms_label_is_its_long_name_and_short_its_symbol():
+    """The controls and the key show ``label`` (the long name), the table's headers and the
+    task-space plot's key ``short``: the short name is part of the long one, never the reverse
+    (DLS's label was "DLS" and its short "damped least squares J^DLS")."""
+    for a, style in STYLES.items():
+        assert style.short.split(" (")[0] in style.label, a
+        assert len(style.short) < len(style.label), a
+    assert STYLES["damped"].label == "damped least squares J^DLS"
+    assert STYLES["weighted"].short == "J^W#"
