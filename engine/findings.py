@@ -242,8 +242,10 @@ def damped_findings(
     if not len(ends):
         return []
     worst = int(np.argmax(ends))
-    cycle, leg = divmod(worst, legs) if legs > 0 else (-1, worst)
-    at = f"cycle {cycle + 1}, leg {leg + 1}" if legs > 0 else f"leg {worst + 1}"
+    at = f"leg {worst + 1}"
+    if legs > 0:
+        cycle, leg = divmod(worst, legs)
+        at = f"cycle {cycle + 1}, leg {leg + 1}"
     where = "adaptive, where σ_min(J) < " + g(threshold) if threshold > 0 else "constant"
     text = (
         f"{name} (λ = {g(damping)}, {where}): task error at the end of its legs up to "

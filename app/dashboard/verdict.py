@@ -51,9 +51,8 @@ def _practical(result: DashboardResult, unit: str) -> list[Finding]:
             continue
         inverse, run = state_inverse(state, a), result.runs[a]
         rest = rest_words(state, state_spec(state), inverse) if a == "posture" else None
-        found = practical_findings(
-            inverse, run, unit, state.tolerance, result.runs, rest, True, len(result.targets)
-        )
+        tol, legs = state.tolerance, len(result.targets)
+        found = practical_findings(inverse, run, unit, tol, result.runs, rest, box=True, legs=legs)
         out += [Finding(text, role, a) for text, role in found]
     return out
 
