@@ -165,9 +165,10 @@ class DashboardScene:
         runs = result.runs
         if state.task == "path" and all(len(r.drift) for r in runs.values()):
             n = len(next(iter(runs.values())).drift)
-            drifts = ", ".join(f"{a} **{r.drift[-1]:.3g}**" for a, r in runs.items())
+            drifts = ", ".join(f"{STYLES[a].short} **{r.drift[-1]:.3g}**" for a, r in runs.items())
             self.status.content = (
-                f"generation {result.generation}: drift after {plural(n, 'cycle')} — {drifts}"
+                f"generation {result.generation}: drift ‖x − x0‖ after the last cycle "
+                f"({plural(n, 'cycle')}) — {drifts}"
             )
         else:
             messages = "; ".join(r.message for r in runs.values())

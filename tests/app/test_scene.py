@@ -281,7 +281,12 @@ def test_the_scene_shows_the_runs_progress_not_the_second_phases():
         assert dashboard.wait(1, timeout=60)
         scene._show_status(dashboard.result)
         drawn = scene.status.content
-        assert drawn.startswith("generation 1: drift after 1 cycle —")  # one cycle, not "cycles"
+        # (the last cycle's drift, as the verdict's "not repeatable" sentence gives it; one
+        # cycle, not "cycles"; the algorithms by the symbols of the page's key)
+        assert drawn.startswith(
+            "generation 1: drift ‖x − x0‖ after the last cycle (1 cycle) — J^P# (8) **"
+        )
+        assert ", J^E# (11) **" in drawn
 
         def progress(phase: str) -> Event:
             return Event(
