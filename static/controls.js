@@ -103,7 +103,8 @@ export function showStopped(summary) {
   const messages = new Map(); // field -> the messages of the runs stopped there
   for (const run of Object.values(summary)) if (run.field) messages.set(run.field, [...(messages.get(run.field) || []), run.message]);
   for (const [field, said] of messages) {
-    const note = firstKey(field) && fieldError(firstKey(field), undefined, said.join("; "), field);
+    const key = firstKey(field);
+    const note = key && fieldError(key, undefined, said.join("; "), field);
     if (note) note.dataset.run = "";
   }
 }
