@@ -124,7 +124,7 @@ def build_robot(req_robot) -> tuple[RobotSpec, Any, S.RobotUsed]:
         for k, v in params.items()
     }
     units = S.UnitsInfo(**robot_units(kin, spec.task_names).summary())
-    return spec, kin, S.RobotUsed(name=spec.name, parameters=used, units=units)
+    return spec, kin, S.RobotUsed(name=spec.name, title=spec.title, parameters=used, units=units)
 
 
 def build_augmentation(spec: RobotSpec, kin, req_aug):

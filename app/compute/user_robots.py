@@ -79,6 +79,7 @@ def user_robot(req_robot: Any, augmentation: Any = None) -> tuple[Robot, S.Robot
     spec = robot.spec
     used = S.RobotUsed(
         name=spec.name,
+        title=spec.title,
         parameters={},
         definition=echo(req_robot.model_dump(exclude_none=True)),
         p=spec.p,

@@ -21,6 +21,7 @@ import numpy as np
 from ...engine.exceptions import InvalidInputError
 from ...engine.redundant_starts import manifold_starts
 from ..compute.atlas_schemas import AtlasRequest
+from ..compute.schemas import RobotUsed
 from .algorithms import STYLES, inverse_parameters
 from .model import DashboardState
 from .plotting import AXIS, figure, norm_unit
@@ -100,19 +101,17 @@ def request_robot(state: DashboardState) -> tuple[dict, dict | None]:
     return definition, None if chosen is None else {k: v for k, v in chosen.items() if k != "label"}
 
 
-def atlas_figure(
-    result: dict[str, Any], request: AtlasRequest, x_units: Sequence[str] = ()
-) -> dict:
+def atlas_figure(result: dict[str, Any], request: AtlasRequest, robot: RobotUsed) -> dict:
     """The heatmap of a finished atlas of :func:`atlas_request`'s ``request`` (the ``result``
     of ``GET /atlas/{id}``): for each algorithm, log10 of the drift ||x after cycle c - x0||
     over the starts' arc length s (columns) and the cycles (rows; per path scale when
     several), one colour scale for both.
-    A cell's ``customdata`` is its run, path * N + start (for a click); ``x_units``, the
-    units of x (the job's ``robot.units.x``), give the arc length's."""
+    A cell's ``customdata`` is its run, path * N + start (for a click); ``robot``, the robot
+    the job used, gives the title its name and the arc length its unit."""
     algorithms = result["algorithms"]
     s = np.asarray(result["parameter"], dtype=float)  # (N,)
     scales = request.scales or [1.0]
-    unit = norm_unit(x_units)
+    unit = norm_unit(robot.units.x)
     x_title, hover, at_x0 = f"arc length s of the start {unit}", "s = %{x:.3f}", 0.0
     if result.get("period") is not None:  # (a closed curve: the starts cover one turn)
         x_title = f"arc length s of the start {unit}, one turn of {result['period']:.4g}"
@@ -204,7 +203,7 @@ def atlas_figure(
     assert request.gamma is not None and request.mode is not None
     title = (
         f"Drift after each cycle from {N} starts on k(x) = k(x0) (dotted: x0), "
-        f"{request.robot.name}, γ = {request.gamma:g}, {request.mode} mode"
+        f"{robot.title}, γ = {request.gamma:g}, {request.mode} mode"
     )
     logs = np.concatenate([np.ravel(t["z"]) for t in data])
     logs = logs[np.isfinite(logs)]

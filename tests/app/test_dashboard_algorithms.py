@@ -241,9 +241,13 @@ def test_the_atlas_figure_has_a_heatmap_per_algorithm_on_one_colour_scale(three)
     colour axis spanning all, each titled in its algorithm's colour (plotly validates it)."""
     import plotly.graph_objects as go
 
+    from jik.app.compute.schemas import RobotUsed, UnitsInfo
     from jik.app.dashboard.atlas import atlas_figure
+    from jik.engine import robot_from_dict
 
     request = atlas_request(three.state, 4, cycles=2)
+    units = UnitsInfo(**robot_from_dict({"name": "manipulator2"}).units.summary())
+    robot = RobotUsed(name="manipulator2", title="Manipulator 2", parameters={}, units=units)
     decades = {"pseudoinverse": -1.0, "extended": -15.0, "posture": -3.0}
     result = {
         "algorithms": THREE,
@@ -251,7 +255,8 @@ def test_the_atlas_figure_has_a_heatmap_per_algorithm_on_one_colour_scale(three)
         "paths": [request.path],
         "drift": {a: np.full((1, 4, 2), 10.0**d).tolist() for a, d in decades.items()},
     }
-    spec = atlas_figure(result, request)
+    spec = atlas_figure(result, request, robot)
+    assert "Manipulator 2, γ = " in spec["layout"]["title"]["text"]
     maps = [t for t in spec["data"] if t["type"] == "heatmap"]
     assert [t["coloraxis"] for t in maps] == ["coloraxis"] * 3
     assert [t["xaxis"] for t in maps] == ["x", "x2", "x3"]

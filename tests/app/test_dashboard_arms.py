@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from jik.app.compute.atlas_plan import AtlasLimits, planned
+from jik.app.compute.schemas import RobotUsed, UnitsInfo
 from jik.app.dashboard.atlas import atlas_figure, atlas_request
 from jik.app.dashboard.controls import controls
 from jik.app.dashboard.export import described, export_csv
@@ -29,6 +30,7 @@ from jik.app.dashboard.verdict import verdict
 from jik.app.scene import DashboardScene
 from jik.app.scene.arm_marks import OUTSIDE_COLOR, end_frame, target_pose
 from jik.app.scene.mechanisms import Chain, fixtures_of
+from jik.engine import robot_from_dict
 from jik.engine.arms import ARMS
 from jik.engine.atlas_run import run_atlas
 from jik.engine.units import robot_units
@@ -200,7 +202,12 @@ def test_the_atlas_of_an_arm_asks_for_its_definition_and_counts_the_limits():
         "drift": {"pseudoinverse": drift, "extended": drift},
         "outside_limits": {"pseudoinverse": 2, "extended": 0},
     }
-    notes = [a["text"] for a in atlas_figure(result, req)["layout"]["annotations"]]
+    units = UnitsInfo(**robot_from_dict({"name": "panda"}).units.summary())
+    panda = RobotUsed(name="panda", title="Franka Panda", parameters={}, units=units)
+    figure = atlas_figure(result, req, panda)
+    assert figure["layout"]["title"]["text"].startswith("Drift after each cycle")
+    assert "Franka Panda, γ = " in figure["layout"]["title"]["text"]
+    notes = [a["text"] for a in figure["layout"]["annotations"]]
     assert "2 of 3 runs left the joint limits" in notes[0]
     assert "0 of 3 runs left the joint limits" in notes[1]
     arm = {
@@ -267,7 +274,8 @@ def test_the_atlas_of_a_robot_with_two_degrees_of_redundancy():
     kin = state_kinematics(state)
     assert X.shape == (12, 4) and np.allclose(X[0], state.x0)
     np.testing.assert_allclose(kin.forward(X), kin.forward(X[:1]).repeat(12, 0), atol=1e-12)
-    res = run_atlas(planned(req, AtlasLimits())[0])
+    plan, (robot, _) = planned(req, AtlasLimits())
+    res = run_atlas(plan)
     drift = {a: res.drift[k] for k, a in enumerate(res.algorithms)}  # (P, N, C)
     assert np.nanmax(drift["extended"]) < 1e-9 and np.nanmin(drift["pseudoinverse"]) > 1e-6
     result = {
@@ -276,7 +284,7 @@ def test_the_atlas_of_a_robot_with_two_degrees_of_redundancy():
         "paths": res.paths.tolist(),
         "drift": {a: d.tolist() for a, d in drift.items()},
     }
-    figure = atlas_figure(result, req)
+    figure = atlas_figure(result, req, robot)
     assert list(figure["data"][0]["x"]) == list(range(1, 13))
     assert figure["layout"]["xaxis"]["title"]["text"].startswith("start")
 

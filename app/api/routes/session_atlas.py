@@ -83,7 +83,7 @@ async def read_session_atlas(session_id: str, job_id: str, store: Store, jobs: J
     job = _own_job(store, jobs, session_id, job_id)
     body = jobs.response(job).model_dump(mode="json", exclude={"result"})
     if job.status == "done" and job.result is not None:
-        figure = await run_in_threadpool(atlas_figure, job.result, job.request, job.used[0].units.x)
+        figure = await run_in_threadpool(atlas_figure, job.result, job.request, job.used[0])
         body.update(
             figure=json.loads(figure_json(figure)),
             starts=job.result["starts"],

@@ -348,6 +348,7 @@ class RobotUsed(BaseModel):
     """The robot a run used, with every parameter (defaults filled in)."""
 
     name: str
+    title: str = Field(description="the robot's name for a reader (Manipulator 2, Franka Panda)")
     parameters: dict[str, float | list[float]]
     definition: dict[str, Any] | None = Field(
         default=None,
