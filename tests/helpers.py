@@ -1,8 +1,9 @@
-"""Shared test utilities: central finite differences, Picard sweep counts."""
+"""Shared test utilities: central finite differences, Picard sweep counts, approximate JSON."""
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 
 def central_difference(f, x: np.ndarray, eps: float = 1e-6) -> np.ndarray:
@@ -30,3 +31,16 @@ def count_picard_sweeps(monkeypatch) -> list[int]:
 
     monkeypatch.setattr(engine_solver, "picard_path", counted)
     return sweeps
+
+
+def approx_tree(expected, **tolerance):
+    """``pytest.approx`` through a JSON-like tree: every number of ``expected`` (dicts and lists
+    nested to any depth) compared within ``tolerance``, everything else exactly. pytest's own
+    approx compares one level and refuses a dict whose values are lists."""
+    if isinstance(expected, dict):
+        return {k: approx_tree(v, **tolerance) for k, v in expected.items()}
+    if isinstance(expected, list | tuple):
+        return [approx_tree(v, **tolerance) for v in expected]
+    if isinstance(expected, int | float) and not isinstance(expected, bool):
+        return pytest.approx(expected, **tolerance)
+    return expected

@@ -10,6 +10,7 @@ import pytest
 from jik.cli import main
 from jik.cli.robot_commands import parse_path, parse_vector
 from jik.engine.reproductions.table1 import PRINTED
+from tests.helpers import approx_tree
 
 ARM4 = Path(__file__).resolve().parent / "data" / "arm4.urdf"
 ARM3R = {
@@ -66,7 +67,7 @@ def test_json_outputs_are_the_engine_results_dicts(capsys):
     printed = json.loads(out)
     assert "target" not in printed and printed["robot"] == "Manipulator 2"
     assert printed["units"]["x"] == ["m", "m", "rad"] and printed["units"]["y"] == ["m", "m"]
-    assert {k: printed[k] for k in engine} == pytest.approx(engine, abs=1e-12)
+    assert {k: printed[k] for k in engine} == approx_tree(engine, abs=1e-12)
     out, _ = run(capsys, "repeatability", "--robot", "manipulator2", "--cycles", "2", "--json")
     path = [(1, 1), (1, 2), (0, 2), (0, 1)]
     engine = json.loads(json.dumps(repeatability(inverse, x0, path, cycles=2).as_dict()))
