@@ -170,10 +170,12 @@ _EXPONENT = -1.0 / 8.0  # error estimator of order 7
 #: Tolerances of the continuous integrator on x (relative and absolute).
 RTOL = 1e-12
 ATOL = 1e-12
-#: A run whose task error fell by less than this fraction over :data:`PLATEAU_TAU` of tau has
-#: stalled: its error has settled at a point it cannot leave (damped least squares at the
-#: point nearest a target out of reach, where the flow is stiff and its steps are short).
+#: A run whose task error fell by less than the fraction :data:`PLATEAU_DECREASE` over
+#: :data:`PLATEAU_TAU` of tau while x moved by less than :data:`PLATEAU_MOVE` (1 + ||x||) has
+#: stalled: it has settled at a point it cannot leave (damped least squares at the point nearest
+#: a target out of reach, where the flow is stiff and its steps are short).
 PLATEAU_DECREASE = 1e-9
+PLATEAU_MOVE = 1e-10
 PLATEAU_TAU = 5.0
 
 
@@ -227,7 +229,8 @@ def integrate(inverse, x0, y_d, tol, max_steps, record, tau0, rtol=RTOL, atol=AT
     # exp(-tau) decay: tau_needed = ln(err0 / tol); far past that the run has stalled.
     tau_cap = tau0 + np.log(np.maximum(err0, tol) / tol) + 40.0
     err_now = err0.copy()
-    plateau_tau, plateau_err = tau0 + PLATEAU_TAU, err0.copy()  # (the error's last checkpoint)
+    # (the last checkpoint of each run's error and x)
+    plateau_tau, plateau_err, plateau_x = tau0 + PLATEAU_TAU, err0.copy(), x0.copy()
     h = _initial_step(inverse, x, f, y_d, rtol, atol)
     nsteps = np.zeros(n, dtype=int)
     last_bad = np.zeros(n, dtype=bool)
@@ -283,9 +286,13 @@ def integrate(inverse, x0, y_d, tol, max_steps, record, tau0, rtol=RTOL, atol=AT
         status[run[tiny & ~last_bad[run]]] = Status.STALLED
         status[run[tau[run] > tau_cap[run]]] = Status.STALLED
         due = run[tau[run] >= plateau_tau[run]]
-        settled = err_now[due] > (1.0 - PLATEAU_DECREASE) * plateau_err[due]
+        moved = np.linalg.norm(x[due] - plateau_x[due], axis=-1)
+        settled = (err_now[due] > (1.0 - PLATEAU_DECREASE) * plateau_err[due]) & (
+            moved <= PLATEAU_MOVE * (1.0 + np.linalg.norm(x[due], axis=-1))
+        )
         status[due[settled]] = Status.STALLED
-        plateau_tau[due], plateau_err[due] = tau[due] + PLATEAU_TAU, err_now[due]
+        plateau_tau[due] = tau[due] + PLATEAU_TAU
+        plateau_err[due], plateau_x[due] = err_now[due], x[due]
         status[run[np.linalg.norm(x[run], axis=-1) > DIVERGED_NORM]] = Status.DIVERGED
         status[run[(nsteps[run] >= max_steps) & (status[run] == Status.RUNNING)]] = Status.MAX_STEPS
     return x, tau, status, nsteps, rec

@@ -113,10 +113,12 @@ def test_a_rotation_vector_longer_than_a_half_turn_is_out_of_reach():
 def test_damped_least_squares_stops_once_its_error_settles_at_the_nearest_point():
     """Damped least squares toward a target out of reach settles at the point of the reach
     nearest it (task error 5 - 2.4 = 2.6), where its flow is stiff and its steps short: the run
-    stops when the error no longer falls (dop853.PLATEAU_DECREASE over PLATEAU_TAU), in 486
-    steps rather than the 1,743 that the bound on tau alone allowed."""
+    stops when neither its error nor x moves any more (dop853.PLATEAU_DECREASE and PLATEAU_MOVE
+    over PLATEAU_TAU), in 718 steps rather than the 1,743 that the bound on tau alone allowed,
+    stretched toward the target to 1e-12."""
     result = e.solve(e.DampedInverse(ARM, damping=0.1), X0, [5.0, 0.0])
     assert result.status == "stalled"
     assert result.error == pytest.approx(2.6, abs=1e-12)
     assert result.nit < 1000
+    np.testing.assert_allclose(result.x, 0.0, atol=1e-12)
     assert "beyond the arm's reach 2.4" in result.message
