@@ -11,7 +11,7 @@ holding a single joint. E1 has no such rule and is not computed.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -23,7 +23,7 @@ from .functionals import (
     error_functional_e2,
     parameter_sensitivity,
 )
-from .progress import Progress, check_cancelled, check_progress
+from .progress import Progress, check_cancelled, check_progress, part
 from .robot_synthesis import TOTAL_NODES as QMC_NODES
 from .validation import count
 
@@ -150,19 +150,16 @@ def parameters_report(
     nodes: int,
     fixed,
     samples: int,
-    on_evaluation: Callable[[int, int], None] = lambda done, total: None,
+    progress: Progress | None = None,
 ) -> dict:
     """How E1 (13) and E2 (18) of the map ``factory(**parameters)`` change with its parameters:
     ``{"kind": "parameters", "parameters", "E1", "E2"}``, each functional's
     :func:`~jik.engine.functionals.parameter_sensitivity` (its value, gradient and a sweep of
     ``samples`` values of every parameter over v - 1 .. v + 1) by a tensor rule of ``nodes``;
-    ``on_evaluation(done, total)`` after each evaluation of either functional."""
+    ``progress`` told after each evaluation of either functional (E1's sweep its first half) and
+    polled before each (:class:`~jik.engine.exceptions.RunCancelled`)."""
     out: dict = {"kind": "parameters", "parameters": dict(parameters)}
     for k, key in enumerate(("E1", "E2")):
-
-        def evaluated(done: int, n: int, k: int = k) -> None:
-            on_evaluation(k * n + done, 2 * n)
-
         out[key] = parameter_sensitivity(
             kinematics,
             factory,
@@ -172,7 +169,7 @@ def parameters_report(
             samples=samples,
             nodes=nodes,
             fixed=fixed,
-            on_evaluation=evaluated,
+            progress=part(progress, k, 2),
         )
     return out
 
@@ -184,19 +181,22 @@ def maps_report(
     region: Mapping,
     nodes: int,
     fixed,
-    on_map: Callable[[int, int], None] = lambda done, total: None,
+    progress: Progress | None = None,
 ) -> dict:
     """E1 (13) and E2 (18) of each of ``maps`` ((name, build) pairs, ``build()`` the map):
     ``{"kind": "alternatives", "maps": [{"name", "current", "E1", "E2"}]}`` (``current``: the
     map named so), by :func:`functional_value`, none of a map that solves a problem per point;
-    ``on_map(done, total)`` after each map, two evaluations a map."""
+    ``progress`` told after each map (two evaluations a map) and polled before each
+    (:class:`~jik.engine.exceptions.RunCancelled`)."""
     rows = []
     for m, (name, build) in enumerate(maps):
+        check_cancelled(progress, "E1, E2 of the robot's maps")
         amap = build()
         if not amap.solves_per_point:
             row: dict = {"name": name, "current": name == current}
             for key in ("E1", "E2"):
                 row[key] = functional_value(key, kinematics, amap, region, nodes, fixed)[key]
             rows.append(row)
-        on_map(2 * m + 2, 2 * len(maps))
+        if progress is not None:
+            progress.advance(2 * m + 2, 2 * len(maps))
     return {"kind": "alternatives", "maps": rows}

@@ -29,6 +29,7 @@ from .inverses import (
     require_compatible,
 )
 from .kinematics import Kinematics, held_values
+from .progress import Progress, check_cancelled
 from .validation import FloatArray, check_box_region, check_memory, count, finite
 
 # name -> (lo, hi); any two-item sequence (JSON gives lists), validated by check_region.
@@ -331,7 +332,7 @@ def parameter_sensitivity(
     samples: int = 21,
     nodes: int = 16,
     fixed: Mapping[str, float] | None = None,
-    on_evaluation: Callable[[int, int], None] | None = None,
+    progress: Progress | None = None,
 ) -> dict:
     """The value of E1 or E2 at the given parameters and how it changes as each one moves.
 
@@ -345,9 +346,10 @@ def parameter_sensitivity(
     span, samples : float, int
         Each parameter is swept over [v - span, v + span] with ``samples`` values, the others
         held; parameter values where the map cannot be built are reported as None.
-    on_evaluation : callable, optional
-        ``on_evaluation(done, total)`` after each of the ``1 + len(parameters) (2 + samples)``
-        evaluations of the functional (a caller's progress; what it raises stops the sweep).
+    progress : Progress, optional
+        Told ``advance(done, total)`` after each of the ``1 + len(parameters) (2 + samples)``
+        evaluations of the functional, and polled before each: ``cancelled()`` True stops the
+        sweep with :class:`~jik.engine.exceptions.RunCancelled`.
 
     Returns
     -------
@@ -367,6 +369,7 @@ def parameter_sensitivity(
 
     def at(params: dict) -> float | None:
         nonlocal done
+        check_cancelled(progress, f"the sweep of {functional.upper()}")
         try:
             amap = factory(**params)
         except InvalidInputError:
@@ -374,8 +377,8 @@ def parameter_sensitivity(
         else:
             v = evaluate(kinematics, amap, region, nodes=nodes, fixed=fixed).value
         done += 1
-        if on_evaluation is not None:
-            on_evaluation(done, total)
+        if progress is not None:
+            progress.advance(done, total)
         return v if np.isfinite(v) else None
 
     out: dict = {"value": at(base), "gradient": {}, "sweeps": {}}

@@ -105,6 +105,18 @@ def stops_at(progress: Progress | None, error: JikError) -> bool:
     return progress is not None and bool(getattr(progress, "stop_at_error", False))
 
 
+def part(progress: Progress | None, k: int, parts: int) -> Progress | None:
+    """Piece ``k`` (from 0) of ``parts`` equal pieces of ``progress``'s work, as a Progress of
+    its own: its ``advance(done, total)`` is ``progress.advance(k total + done, parts total)``,
+    its ``cancelled()`` is ``progress``'s; None without a progress."""
+    if progress is None:
+        return None
+    return ProgressCallbacks(
+        on_advance=lambda done, total: progress.advance(k * total + done, parts * total),
+        is_cancelled=progress.cancelled,
+    )
+
+
 def check_cancelled(progress: Progress | None, what: str) -> None:
     """Raise :class:`RunCancelled` ("<what>") when ``progress`` says the work is not wanted."""
     if progress is not None and progress.cancelled():

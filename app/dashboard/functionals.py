@@ -128,7 +128,7 @@ def sensitivity(
     result: DashboardResult,
     functionals: dict | None,
     cancelled: Callable[[], bool] = lambda: False,
-    progress: Callable[[int, int], None] = lambda done, total: None,
+    progress: Callable[[float, float], None] = lambda done, total: None,
 ) -> dict:
     """How E1 (13) and E2 (18) change with the parameters of the current map.
 
@@ -166,21 +166,19 @@ def sensitivity(
     region = {k: tuple(v) for k, v in functionals["region"].items()}
     aug = spec.augmentation(state.augmentation)
 
-    def build(other, **params):
-        if cancelled():
-            raise Cancelled
-        return other.build(kin, **params)
-
+    told = ProgressCallbacks(on_advance=progress, is_cancelled=cancelled)
     try:
         if aug.parameters:
-            factory, samples = (lambda **p: build(aug, **p)), SENSITIVITY_SAMPLES
+            factory, samples = (lambda **p: aug.build(kin, **p)), SENSITIVITY_SAMPLES
             params = state.augmentation_parameters
-            return parameters_report(kin, factory, params, region, nodes, fixed, samples, progress)
+            return parameters_report(kin, factory, params, region, nodes, fixed, samples, told)
         maps = [
-            (m.name, lambda m=m: build(m, **{p.name: p.default for p in m.parameters}))
+            (m.name, lambda m=m: m.build(kin, **{p.name: p.default for p in m.parameters}))
             for m in spec.augmentations
         ]
-        return maps_report(kin, maps, aug.name, region, nodes, fixed, progress)
+        return maps_report(kin, maps, aug.name, region, nodes, fixed, told)
+    except RunCancelled:
+        raise Cancelled from None
     except (JikError, ValueError, ArithmeticError) as exc:
         return {"kind": "unavailable", "reason": str(exc)}
 

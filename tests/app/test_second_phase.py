@@ -78,6 +78,10 @@ def test_the_sweep_of_a_map_with_parameters_is_counted_evaluation_by_evaluation(
     assert sensitivity_evaluations(state, amap) == 54
     assert len(seen) == 56 and seen[-1][0] == pytest.approx(1.0)
     assert sens == sensitivity(result, error_functionals(result))
+    polls = []
+    with pytest.raises(Cancelled):  # (polled before each evaluation: the fourth is not made)
+        sensitivity(result, error_functionals(result), lambda: polls.append(1) or len(polls) == 4)
+    assert len(polls) == 4
 
 
 def test_cancelled_during_the_grid_nothing_is_shown_as_computed():

@@ -83,9 +83,8 @@ def test_the_parameters_report_sweeps_both_functionals_and_counts_every_evaluati
     engine's parameter_sensitivity; the progress runs over both functionals' evaluations."""
     kin, region, params = Manipulator1(), {"x1": (0.0, 1.0), "x2": (0.0, 1.0)}, {"a": 1.0, "b": 0.5}
     told = []
-    out = parameters_report(
-        kin, E2Optimal, params, region, 6, {"x3": 1.0}, 3, lambda *d: told.append(d)
-    )
+    progress = ProgressCallbacks(on_advance=lambda *d: told.append(d))
+    out = parameters_report(kin, E2Optimal, params, region, 6, {"x3": 1.0}, 3, progress)
     e1 = parameter_sensitivity(
         kin, E2Optimal, params, region, functional="e1", samples=3, nodes=6, fixed={"x3": 1.0}
     )
@@ -98,7 +97,11 @@ def test_the_maps_report_gives_each_map_its_functionals_and_marks_the_current_on
     kin, region = Manipulator2(), {"x2": (-0.5, 0.5), "x3": (1.0, 2.0)}
     told = []
     maps = [("cubic", PaperCubic), ("again", PaperCubic)]
-    out = maps_report(kin, maps, "again", region, 6, {"x1": 0.0}, lambda *d: told.append(d))
+    progress = ProgressCallbacks(on_advance=lambda *d: told.append(d))
+    out = maps_report(kin, maps, "again", region, 6, {"x1": 0.0}, progress)
     e2 = error_functional_e2(kin, PaperCubic(), region, nodes=6, fixed={"x1": 0.0}).value
     assert [(m["name"], m["current"]) for m in out["maps"]] == [("cubic", False), ("again", True)]
     assert out["maps"][0]["E2"] == pytest.approx(e2) and told == [(2, 4), (4, 4)]
+    cancel = ProgressCallbacks(on_advance=lambda *d: told.append(d), is_cancelled=lambda: True)
+    with pytest.raises(RunCancelled, match="maps"):
+        maps_report(kin, maps, "again", region, 6, {"x1": 0.0}, cancel)

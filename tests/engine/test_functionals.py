@@ -7,7 +7,7 @@ import pytest
 from scipy import integrate
 
 from jik.engine.augmentations import AugmentingMap, E1Optimal, E2Optimal, PaperCubic, Polynomial2
-from jik.engine.exceptions import InvalidInputError
+from jik.engine.exceptions import InvalidInputError, RunCancelled
 from jik.engine.formula_kinematics import FormulaMap
 from jik.engine.functionals import (
     e1_integrand,
@@ -19,6 +19,7 @@ from jik.engine.functionals import (
 )
 from jik.engine.inverses import pseudoinverse
 from jik.engine.kinematics import Manipulator1, Manipulator2
+from jik.engine.progress import ProgressCallbacks
 
 REGION1 = {"x1": (0.0, 1.0), "x2": (0.0, 1.0), "x3": (0.5, 1.5)}
 REGION2 = {"x2": (-1.0, 1.0), "x3": (0.0, np.pi)}
@@ -193,7 +194,7 @@ def test_parameter_sensitivity_matches_closed_form_derivative():
 
 def test_parameter_sensitivity_reports_each_evaluation():
     """1 + 2 (2 + samples) evaluations of E2 for (a, b): each reported, in order, the last at
-    the total; what the callback raises stops the sweep."""
+    the total; a cancel stops the sweep before the next evaluation (RunCancelled)."""
     seen = []
     parameter_sensitivity(
         Manipulator1(),
@@ -202,15 +203,15 @@ def test_parameter_sensitivity_reports_each_evaluation():
         REGION1,
         span=0.5,
         samples=3,
-        on_evaluation=lambda done, total: seen.append((done, total)),
+        progress=ProgressCallbacks(on_advance=lambda done, total: seen.append((done, total))),
     )
     assert seen == [(k, 11) for k in range(1, 12)]
-
-    def stop(done, total):
-        if done == 4:
-            raise KeyboardInterrupt
-
-    with pytest.raises(KeyboardInterrupt):
+    seen.clear()
+    stop = ProgressCallbacks(
+        on_advance=lambda *d: seen.append(d), is_cancelled=lambda: len(seen) == 4
+    )
+    with pytest.raises(RunCancelled, match="the sweep of E2"):
         parameter_sensitivity(
-            Manipulator1(), E2Optimal, {"a": 0.0, "b": 1.0}, REGION1, samples=3, on_evaluation=stop
+            Manipulator1(), E2Optimal, {"a": 0.0, "b": 1.0}, REGION1, samples=3, progress=stop
         )
+    assert len(seen) == 4
