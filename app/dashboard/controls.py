@@ -216,7 +216,8 @@ def controls(state) -> list[Control]:
                 "closed path",
                 "text",
                 "start",
-                "task points visited in order; the path closes back to k(x0)",
+                f"task points visited in order, a point per line ({PATH_FORMAT}); the path "
+                "closes back to k(x0)",
                 format=PATH_FORMAT,
             )
         )

@@ -131,10 +131,13 @@ class SceneControls:
             handle = add(
                 control.label, tuple(value), min=lo, max=hi, step=control.step, hint=control.help
             )
-        else:  # text (the path), or a vector of another size: as text, parsed by the server
-            hint = f"{control.help} ({control.format})" if control.format else control.help
+        else:  # text (the path, a point per line), or a vector of another size: as text, parsed
+            # by the server
             sent, self._shown[key] = str, as_text
-            handle = gui.add_text(control.label, as_text(value), hint=hint)
+            multiline = control.kind == "text"
+            handle = gui.add_text(
+                control.label, as_text(value), hint=control.help, multiline=multiline
+            )
         handle.on_update(lambda e: self._change({key: sent(e.target.value)}))
         self.inputs[key] = handle
 
