@@ -45,7 +45,8 @@ function slider(c, value, send) {
 
 const rows = new Map(); // control key -> its label (where its errors show)
 // Whether the control ``key`` is about ``field`` (a dotted path): the field, a coordinate of it
-// (x0.1 of x0), or the vector control holding it; the first such control.
+// (x0.1 of x0), or the vector control holding it (the rule of about() in
+// app/dashboard/controls.py, which marks the 3D scene's inputs); the first such control.
 const about = (key, field) => key === field || field.startsWith(`${key}.`) || key.startsWith(`${field}.`);
 const firstKey = (field) => [...rows.keys()].find((k) => about(k, field));
 

@@ -336,6 +336,12 @@ def element_id(key: str) -> str:
     return "ctl-" + short.replace(".", "-")
 
 
+def about(key: str, field: str) -> bool:
+    """Whether the control ``key`` is about ``field`` (a refusal's dotted path): the field, a
+    coordinate of it (``x0.1`` of ``x0``) or its vector; as ``about`` in static/controls.js."""
+    return key == field or field.startswith(f"{key}.") or key.startswith(f"{field}.")
+
+
 def control_values(state, spec: list[Control] | None = None) -> dict[str, Any]:
     """Each control's value as shown (the path as text), by key; ``spec``: the state's
     :func:`controls` when the caller has them."""

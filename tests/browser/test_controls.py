@@ -10,6 +10,8 @@ import urllib.request
 import numpy as np
 import pytest
 
+from jik.app.scene.controls import REFUSED_MARK
+
 expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
 pytestmark = pytest.mark.browser
 
@@ -25,8 +27,8 @@ def refused_path(point: str) -> str:
 @pytest.mark.slow
 def test_a_refused_value_shows_in_both_with_the_value_in_force(tabs):
     """An unreadable closed path typed on the page, then in the scene, is refused: the page's
-    status and the scene's status say so, and the page's box, the scene's box and the server
-    keep the path in force."""
+    status and the scene's status say so, the scene's path box is marked (its label), and the
+    page's box, the scene's box and the server keep the path in force."""
     tabs.allow_console(r"status of 422")  # the page's POST of the refused value
     tab = tabs.open()
     tab.wait_scene_drawn(1)
@@ -44,12 +46,13 @@ def test_a_refused_value_shows_in_both_with_the_value_in_force(tabs):
     expect(status).to_have_class(re.compile(r"\berror\b"))
     tab.wait_scene_text(f"refused: {refused_path('1, x')}")
     expect(path).to_have_value(in_force)
-    assert tab.scene_control("closed path")["value"] == in_force
+    marked = REFUSED_MARK + "closed path"
+    assert tab.scene_control(marked)["value"] == in_force
 
-    tab.scene_input("closed path").fill("2, y")
+    tab.scene_input(marked).fill("2, y")
     expect(status).to_have_text(f"refused (in the 3D scene): {refused_path('2, y')}")
     tab.wait_scene_text(f"refused: {refused_path('2, y')}")
-    assert tab.scene_control("closed path", like=in_force)["value"] == in_force
+    assert tab.scene_control(marked, like=in_force)["value"] == in_force
     expect(path).to_have_value(in_force)
 
     snapshot = tab.snapshot()
