@@ -45,7 +45,8 @@ function slider(c, value, send) {
 
 const rows = new Map(); // control key -> its label (where its errors show)
 // Whether the control ``key`` is about ``field`` (a dotted path): the field, a coordinate of it
-// (x0.1 of x0), or the vector control holding it; the first such control.
+// (x0.1 of x0), or the vector control holding it (the rule of about() in
+// app/dashboard/controls.py, which marks the 3D scene's inputs); the first such control.
 const about = (key, field) => key === field || field.startsWith(`${key}.`) || key.startsWith(`${field}.`);
 const firstKey = (field) => [...rows.keys()].find((k) => about(k, field));
 
@@ -66,7 +67,7 @@ function fieldError(key, typed, message, field = key) {
 function invalid(field, on) {
   for (const [key, row] of rows) {
     if (!about(key, field)) continue;
-    for (const input of row.querySelectorAll("input, select, button")) {
+    for (const input of row.querySelectorAll("input, textarea, select, button")) {
       if (on) input.setAttribute("aria-invalid", "true"); else input.removeAttribute("aria-invalid");
     }
   }
@@ -186,11 +187,32 @@ function vector(c, value, send) {
   return el("label", { title: c.help }, c.label, group);
 }
 
+// A text (the closed path, which the server writes a point per line): a box as tall as its
+// lines and as wide as its longest, so that the whole path shows. Enter sends it, as in a
+// one-line box; Shift+Enter starts a new line (a point).
 function text(c, value, send) {
-  const input = el("input", { type: "text", id: c.id, value, placeholder: c.format });
-  input.addEventListener("change", () => send(input.value, input.value));
-  input.setValue = (v) => { input.value = v; };
-  return el("label", { title: `${c.help} (${c.format})` }, c.label, input);
+  const box = el("textarea", { id: c.id, value, placeholder: c.format, spellcheck: false });
+  const fit = () => { // (where the browser does not size it by its text: style.css)
+    const lines = box.value.split("\n");
+    box.rows = lines.length;
+    box.cols = Math.max(12, ...lines.map((line) => line.length)) + 1;
+  };
+  let sent = value; // (a change and the Enter before it send once)
+  const commit = () => {
+    if (box.value === sent) return;
+    sent = box.value;
+    send(box.value, box.value);
+  };
+  box.addEventListener("keydown", (e) => {
+    if (e.key !== "Enter" || e.shiftKey || e.isComposing) return;
+    e.preventDefault();
+    commit();
+  });
+  box.addEventListener("change", commit);
+  box.addEventListener("input", fit);
+  box.setValue = (v) => { box.value = v; sent = v; fit(); };
+  fit();
+  return el("label", { title: c.help }, c.label, box);
 }
 
 function preset(c, send) {
@@ -228,7 +250,7 @@ export function showControls(msg, change, force = false) {
         if (c.kind === "preset") { set.append(preset(c, send)); continue; }
         const label = BUILD[c.kind](c, msg.values[c.key], send);
         rows.set(c.key, label);
-        inputs.set(c.key, label.querySelector(".slider,.vector,.choice,input,select"));
+        inputs.set(c.key, label.querySelector(".slider,.vector,.choice,input,textarea,select"));
         set.append(label);
       }
       return set;

@@ -6,12 +6,13 @@
 inverse's rest (``{"algorithm_parameters.rest.1": 0.4}``) or the rest set to the start
 (``{"algorithm_parameters.rest": "x0"}``) included; :func:`path_text` and
 :func:`parse_path_text` write a closed path as text and read it back (:data:`PATH_FORMAT`), the
-one text format of the path box on the page and in the scene.
+one text format of the path box on the page and in the scene: a point per line.
 """
 
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping
 from typing import Any
 
@@ -20,8 +21,12 @@ from ..compute.schemas.wording import refused
 from .algorithms import editable_rest
 from .robots import state_kinematics, state_spec
 
-#: How a closed path is written in a text box: points separated by ';', coordinates by ','.
+#: How a closed path is written in a text box: points separated by ';' (or a new line),
+#: coordinates by ','.
 PATH_FORMAT = "y1, y2; y1, y2; ..."
+#: Between two points of a path's text: the separator, and a new line (a box shows a point per
+#: line, as many lines as points).
+POINT_SEPARATOR = ";\n"
 #: Switching to discrete mode takes gamma down to this when it is above (the full Newton step).
 DISCRETE_GAMMA_ON_SWITCH = 1.0
 
@@ -50,7 +55,7 @@ def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
             params["rest"][int(index)] = value
         elif key == "path" and isinstance(value, str):  # (the text shown: the path in force)
             size = len(state.target) if "robot" not in patch else None
-            same = size is not None and value.strip() == path_text(state.path)
+            same = size is not None and value.split() == path_text(state.path).split()
             out[key] = state.path if same else parse_path_text(value, size)
         elif not rest:
             out[key] = value
@@ -71,10 +76,11 @@ def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
 
 
 def path_text(path) -> str:
-    """A path as text, :data:`PATH_FORMAT`, each coordinate as a user types it: to 4 decimals,
-    as the page's number boxes show them (a computed 1.29e-17 as 0). Sent back unchanged, it
-    leaves the path in force exact (:func:`expand`)."""
-    return "; ".join(", ".join(_number(v) for v in p) for p in path)
+    """A path as text, :data:`PATH_FORMAT` with a point per line (:data:`POINT_SEPARATOR`),
+    each coordinate as a user types it: to 4 decimals, as the page's number boxes show them (a
+    computed 1.29e-17 as 0). Sent back unchanged, or spaced otherwise, it leaves the path in
+    force exact (:func:`expand`)."""
+    return POINT_SEPARATOR.join(", ".join(_number(v) for v in p) for p in path)
 
 
 def _number(v: float) -> str:
@@ -83,10 +89,11 @@ def _number(v: float) -> str:
 
 
 def parse_path_text(text: str, size: int | None = None) -> list[list[float]]:
-    """The points of a path written as :data:`PATH_FORMAT`; ``size``: the task's dimension,
-    which every point must have. A refusal quotes the point as the user wrote it."""
+    """The points of a path written as :data:`PATH_FORMAT`, a new line separating points as a
+    ';' does; ``size``: the task's dimension, which every point must have. A refusal quotes the
+    point as the user wrote it."""
     points = []
-    parts = [p for p in text.split(";") if p.strip()]
+    parts = [p for p in re.split(r"[;\n]", text) if p.strip()]
     for k, part in enumerate(parts, start=1):
         where = f"point {k} of {len(parts)}, '{part.strip()}',"
         try:

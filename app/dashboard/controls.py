@@ -216,7 +216,8 @@ def controls(state) -> list[Control]:
                 "closed path",
                 "text",
                 "start",
-                "task points visited in order; the path closes back to k(x0)",
+                f"task points visited in order, a point per line ({PATH_FORMAT}); the path "
+                "closes back to k(x0)",
                 format=PATH_FORMAT,
             )
         )
@@ -333,6 +334,12 @@ def element_id(key: str) -> str:
         .replace("algorithm_parameters.", "alg-")
     )
     return "ctl-" + short.replace(".", "-")
+
+
+def about(key: str, field: str) -> bool:
+    """Whether the control ``key`` is about ``field`` (a refusal's dotted path): the field, a
+    coordinate of it (``x0.1`` of ``x0``) or its vector; as ``about`` in static/controls.js."""
+    return key == field or field.startswith(f"{key}.") or key.startswith(f"{field}.")
 
 
 def control_values(state, spec: list[Control] | None = None) -> dict[str, Any]:

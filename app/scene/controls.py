@@ -1,6 +1,7 @@
 """The scene's GUI controls, built from the dashboard's control specification
 (:func:`jik.app.dashboard.controls.controls`, from which the page builds its own): the same
-controls, labels, ranges and values. A change is sent by its control key, as the page sends it."""
+controls, labels, ranges and values. A change is sent by its control key, as the page sends it;
+the inputs a refused change was about are marked until a change is accepted."""
 
 from __future__ import annotations
 
@@ -11,7 +12,10 @@ from typing import Any
 import viser
 
 from ..dashboard.control_changes import path_text
-from ..dashboard.controls import GROUPS, Control, control_values, controls
+from ..dashboard.controls import GROUPS, Control, about, control_values, controls
+
+#: Before the label of an input whose value the dashboard refused (its hint says why).
+REFUSED_MARK = "⚠ "
 
 
 class Syncing:
@@ -50,20 +54,27 @@ class SceneControls:
         self.folders: list = []
         # control key -> its value as its input takes it (a select's label, a vector's tuple)
         self._shown: dict[str, Callable[[Any], Any]] = {}
+        # control key -> its viser elements (a checks control's boxes) with their label and hint
+        self._plain: dict[str, list[tuple[Any, str, str]]] = {}
+        self._marked: list[str] = []  # the keys of the inputs marked refused
         self._shape: list[dict] | None = None  # the specification on screen
         self.syncing = Syncing()
         self._lock = threading.RLock()
 
     def show(self, state) -> None:
-        """Show ``state``: the inputs are built anew when its controls differ from those on
-        screen (another robot, map, mode or task), else set to its values."""
+        """Show ``state``, a change accepted: the inputs are built anew when its controls differ
+        from those on screen (another robot, map, mode or task), else set to its values; a
+        refusal's marks go."""
         spec = controls(state)
         shape = [c.as_dict() for c in spec]
         with self._lock:
             if shape != self._shape:
+                # (new inputs, unmarked: the old ones get no update, which viser's client would
+                # apply after their removal in the same batch)
                 self._shape = shape
                 self._build(spec, control_values(state, spec))
             else:
+                self.clear_marks()
                 self.sync(state)
 
     def sync(self, state) -> None:
@@ -77,10 +88,31 @@ class SceneControls:
                 except (ValueError, AssertionError):
                     pass
 
+    def mark_refused(self, field: str | None, message: str) -> None:
+        """Mark the inputs about ``field``, the field of a refused change (:func:`about`):
+        :data:`REFUSED_MARK` before the label, the refusal as the hint, until a change is
+        accepted (:meth:`show`) or another is refused."""
+        with self._lock:
+            self.clear_marks()
+            self._marked = [key for key in self.inputs if field and about(key, field)]
+            for key in self._marked:
+                for element, label, _ in self._plain[key]:
+                    element.label = REFUSED_MARK + label
+                    element.hint = f"refused: {message}"
+
+    def clear_marks(self) -> None:
+        """The marked inputs' labels and hints as the specification writes them."""
+        with self._lock:
+            for key in self._marked:
+                for element, label, hint in self._plain.get(key, ()):
+                    element.label, element.hint = label, hint
+            self._marked = []
+
     def _build(self, spec: list[Control], values: dict[str, Any]) -> None:
         for folder in self.folders:
             folder.remove()
-        self.folders, self.inputs, self._shown = [], {}, {}
+        self.folders, self.inputs, self._shown, self._plain = [], {}, {}, {}
+        self._marked = []
         with self.syncing:
             for order, (group, title) in enumerate(GROUPS, start=2):
                 with self._gui.add_folder(title, order=order) as folder:
@@ -104,7 +136,10 @@ class SceneControls:
             button.on_click(lambda _: self._change({key: control.value}))
             return
         if control.kind == "checks":
-            self.inputs[key] = Checks(gui, control, value, lambda v: self._change({key: v}))
+            checks = self.inputs[key] = Checks(
+                gui, control, value, lambda v: self._change({key: v})
+            )
+            self._plain[key] = [(box, box.label, control.help) for box in checks.boxes.values()]
             return
         if control.kind == "select":
             sent = {label: v for v, label in control.options}.__getitem__
@@ -131,12 +166,16 @@ class SceneControls:
             handle = add(
                 control.label, tuple(value), min=lo, max=hi, step=control.step, hint=control.help
             )
-        else:  # text (the path), or a vector of another size: as text, parsed by the server
-            hint = f"{control.help} ({control.format})" if control.format else control.help
+        else:  # text (the path, a point per line), or a vector of another size: as text, parsed
+            # by the server
             sent, self._shown[key] = str, as_text
-            handle = gui.add_text(control.label, as_text(value), hint=hint)
+            multiline = control.kind == "text"
+            handle = gui.add_text(
+                control.label, as_text(value), hint=control.help, multiline=multiline
+            )
         handle.on_update(lambda e: self._change({key: sent(e.target.value)}))
         self.inputs[key] = handle
+        self._plain[key] = [(handle, control.label, control.help)]
 
 
 def as_text(value) -> str:

@@ -100,10 +100,13 @@ class DashboardScene:
             elif event.kind == "ahead" and event.result is not None:
                 self._prebuild(event.result)
             elif event.kind in ("refused", "error"):
+                msg = json.loads(event.data)
                 self.controls.sync(self.dashboard.state)
+                if event.kind == "refused":  # (its field's inputs say so, as the page's do)
+                    self.controls.mark_refused(msg.get("field"), msg["message"])
                 # (a refusal stops no computation: its progress bar stays)
                 self.progress.visible &= event.kind == "refused"
-                self.status.content = f"**{event.kind}:** {json.loads(event.data)['message']}"
+                self.status.content = f"**{event.kind}:** {msg['message']}"
         except Exception as exc:  # never let a drawing error kill the worker thread
             self.status.content = f"**scene error:** {type(exc).__name__}: {exc}"
 

@@ -81,14 +81,28 @@ def test_control_keys_expand_into_state_fields():
     assert parse_path_text(path_text(state.path)) == [list(p) for p in state.path]
 
 
+def test_a_path_is_written_a_point_per_line_and_read_back_from_lines():
+    """The path's text has a line per point (the page's box shows as many lines as points); a
+    new line separates points as ';' does, so a point added on a line of its own, without a
+    ';', is a point."""
+    state = default_state("manipulator2")
+    assert path_text(state.path) == "1, 1;\n1, 2;\n0, 2;\n0, 1"
+    assert parse_path_text("1, 1\n1, 2;\n0, 2\n\n") == [[1.0, 1.0], [1.0, 2.0], [0.0, 2.0]]
+    with pytest.raises(InvalidInputError) as bad:
+        parse_path_text("1, 1\n1", size=2)
+    assert str(bad.value).startswith("path: point 2 of 2, '1', has 1 coordinate; each point")
+
+
 def test_a_computed_path_is_shown_as_a_user_types_it_and_stays_exact():
     """A catalogue arm's path is computed (its pose coordinates 1.29e-17 where 0 is meant):
     its box shows 4 decimals, 0 for those, and the shown text sent back keeps the exact
     path; an edited text is what is typed."""
     state = default_state("panda")
     text = control_values(state)["path"]
-    assert "e-" not in text and text.startswith("0.3034, 0.0459, 0.5903, 0, 0, -0.15; ")
+    assert "e-" not in text and text.startswith("0.3034, 0.0459, 0.5903, 0, 0, -0.15;\n")
     assert updated_state(state, {"path": text}).path == state.path
+    # (the same text on one line, as typed into a one-line box: no change either)
+    assert updated_state(state, {"path": " ".join(text.split())}).path == state.path
     edited = updated_state(state, {"path": text.replace("-0.15", "-0.1")})
     assert edited.path[0] == (0.3034, 0.0459, 0.5903, 0.0, 0.0, -0.1)
     with pytest.raises(InvalidInputError) as bad:

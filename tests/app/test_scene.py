@@ -522,6 +522,58 @@ def test_a_vector_shown_as_text_stays_text_in_force():
         dashboard.stop()
 
 
+def test_a_refused_value_marks_its_inputs_in_the_scene_until_one_is_accepted():
+    """A closed path the dashboard refuses, typed in the scene's GUI, marks the scene's path
+    input (REFUSED_MARK before its label, the refusal as its hint) and no other, as the page
+    marks its box; the next value accepted takes the mark away. A refusal from elsewhere (the
+    page) marks the scene's inputs too: each of x0's sliders, each algorithm's checkbox."""
+    from jik.app.dashboard import LABELS
+    from jik.app.dashboard.control_changes import path_text
+    from jik.app.dashboard.controls import controls
+    from jik.app.scene.controls import REFUSED_MARK
+    from jik.engine.exceptions import InvalidInputError
+
+    dashboard = Dashboard(default_state("manipulator2"))
+    scene = DashboardScene(dashboard)
+    inputs = scene.controls.inputs
+
+    def marked() -> dict[str, str]:
+        elements = {k: [h] for k, h in inputs.items() if k != "algorithms"}
+        elements |= {f"algorithms.{a}": [b] for a, b in inputs["algorithms"].boxes.items()}
+        return {
+            k: h.hint for k, (h,) in elements.items() if h.label.startswith(REFUSED_MARK.strip())
+        }
+
+    try:
+        path = inputs["path"]
+        plain = (path.label, path.hint)
+        (spec,) = [c for c in controls(dashboard.state) if c.key == "path"]
+        assert plain == (spec.label, spec.help)
+        path.value = "1, x"  # (what a user's typing in the viser GUI does)
+        assert path.value == path_text(dashboard.state.path)  # (the path in force)
+        assert path.label == REFUSED_MARK + "closed path"
+        assert marked() == {
+            "path": "refused: path: point 1 of 1, '1, x', is not numbers separated by ',' "
+            "(write 'y1, y2; y1, y2; ...')"
+        }
+        inputs["gamma"].value = 2.0
+        assert dashboard.state.gamma == 2.0
+        assert (path.label, path.hint) == plain and marked() == {}
+
+        with pytest.raises(InvalidInputError):
+            dashboard.update({"x0": [1.0, 2.0]})  # (the page's change, refused)
+        assert sorted(marked()) == ["x0.0", "x0.1", "x0.2"]
+        with pytest.raises(InvalidInputError):
+            dashboard.update({"algorithms": []})
+        assert sorted(marked()) == [f"algorithms.{a}" for a in sorted(inputs["algorithms"].boxes)]
+        dashboard.update({"cycles": 2})
+        assert marked() == {}
+        assert inputs["algorithms"].boxes["extended"].label == LABELS["extended"]
+    finally:
+        scene.stop()
+        dashboard.stop()
+
+
 class _RecordingScene:
     """A stand-in for viser's scene API: ``add_<kind>(name, ...)`` makes a node whose later
     assignments (node updates, each a message to every client) are recorded."""

@@ -298,9 +298,11 @@ class Tab:
         return handle.json_value()
 
     def scene_input(self, label: str):
-        """A locator of the input in the row of the scene's GUI labelled ``label``."""
+        """A locator of the input (a text box: its textarea) in the row of the scene's GUI
+        labelled ``label``."""
         row = f"//label[normalize-space()='{label}']/ancestor::div[contains(@class,'Flex-root')][1]"
-        return self.page.frame_locator("#scene").locator(f"xpath={row}//input[not(@type='hidden')]")
+        box = "[self::input[not(@type='hidden')] or self::textarea]"
+        return self.page.frame_locator("#scene").locator(f"xpath={row}//*{box}")
 
     def wait_scene_text(self, text: str, timeout: float = TIMEOUT) -> None:
         """Wait until the scene's GUI shows ``text`` (its status, a label)."""

@@ -31,7 +31,7 @@ def test_the_panda_with_its_pose_task(tabs):
     path = page.locator("#ctl-path")
     assert len(path.input_value().split(";")[0].split(",")) == 6
     # As a user types them: the rotation vector's computed 1.29e-17 shows as 0.
-    expect(path).to_have_value(re.compile(r"^0\.3034, 0\.0459, 0\.5903, 0, 0, -0\.15; "))
+    expect(path).to_have_value(re.compile(r"^0\.3034, 0\.0459, 0\.5903, 0, 0, -0\.15;\n"))
 
     summary = snapshot["summary"]
     assert summary["pseudoinverse"]["drift"][-1] > 1e-5  # the pseudoinverse drifts

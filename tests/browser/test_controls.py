@@ -7,7 +7,10 @@ import json
 import re
 import urllib.request
 
+import numpy as np
 import pytest
+
+from jik.app.scene.controls import REFUSED_MARK
 
 expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
 pytestmark = pytest.mark.browser
@@ -24,13 +27,13 @@ def refused_path(point: str) -> str:
 @pytest.mark.slow
 def test_a_refused_value_shows_in_both_with_the_value_in_force(tabs):
     """An unreadable closed path typed on the page, then in the scene, is refused: the page's
-    status and the scene's status say so, and the page's box, the scene's box and the server
-    keep the path in force."""
+    status and the scene's status say so, the scene's path box is marked (its label), and the
+    page's box, the scene's box and the server keep the path in force."""
     tabs.allow_console(r"status of 422")  # the page's POST of the refused value
     tab = tabs.open()
     tab.wait_scene_drawn(1)
     in_force = tab.controls()["ctl-path"]
-    assert in_force == "1, 1; 1, 2; 0, 2; 0, 1"
+    assert in_force == "1, 1;\n1, 2;\n0, 2;\n0, 1"  # (a point per line)
     assert tab.scene_control("closed path")["value"] == in_force
     generation = tab.snapshot()["generation"]
     status = tab.page.locator("#status-text")
@@ -43,12 +46,13 @@ def test_a_refused_value_shows_in_both_with_the_value_in_force(tabs):
     expect(status).to_have_class(re.compile(r"\berror\b"))
     tab.wait_scene_text(f"refused: {refused_path('1, x')}")
     expect(path).to_have_value(in_force)
-    assert tab.scene_control("closed path")["value"] == in_force
+    marked = REFUSED_MARK + "closed path"
+    assert tab.scene_control(marked)["value"] == in_force
 
-    tab.scene_input("closed path").fill("2, y")
+    tab.scene_input(marked).fill("2, y")
     expect(status).to_have_text(f"refused (in the 3D scene): {refused_path('2, y')}")
     tab.wait_scene_text(f"refused: {refused_path('2, y')}")
-    assert tab.scene_control("closed path", like=in_force)["value"] == in_force
+    assert tab.scene_control(marked, like=in_force)["value"] == in_force
     expect(path).to_have_value(in_force)
 
     snapshot = tab.snapshot()
@@ -193,3 +197,36 @@ def test_a_singular_start_is_marked_at_the_starts_controls(tabs):
     assert tab.snapshot()["summary"]["pseudoinverse"]["success"]
     expect(page.locator("#controls .field-error")).to_have_count(0)
     expect(page.locator("#controls [aria-invalid]")).to_have_count(0)
+
+
+def test_a_pose_path_shows_whole_a_point_per_line(tabs):
+    """The Franka Panda's closed path has 6 coordinates a point (x y z rx ry rz): its box shows
+    every point whole, a line each, nothing scrolled out of sight and within the controls; a
+    point added on a new line (Shift+Enter) and sent with Enter, as a one-line box is sent,
+    becomes the path's last point, and the box grows to show it."""
+    tab = tabs.open()
+    page = tab.page
+    tab.select("#ctl-robot", "panda")
+    points = tab.snapshot()["state"]["path"]
+    path = page.locator("#ctl-path")
+    lines = path.input_value().split("\n")
+    assert len(lines) == len(points) >= 3
+    assert all(len(line.rstrip(";").split(",")) == 6 for line in lines)
+    hidden = "b => [b.scrollWidth - b.clientWidth, b.scrollHeight - b.clientHeight]"
+    assert path.evaluate(hidden) == [0, 0]
+    box, form = path.bounding_box(), page.locator("#controls").bounding_box()
+    assert box is not None and form is not None
+    assert box["x"] + box["width"] <= form["x"] + form["width"]
+    height = box["height"]
+
+    path.click()
+    path.press("Control+End")
+    path.press("Shift+Enter")
+    path.press_sequentially("0.31, 0.05, 0.6, 0, 0, 0")
+    tab.change(lambda: path.press("Enter"))
+    # (the points as shown: to 4 decimals)
+    shown = [*points, [0.31, 0.05, 0.6, 0.0, 0.0, 0.0]]
+    np.testing.assert_allclose(tab.snapshot()["state"]["path"], shown, atol=1e-4)
+    assert path.evaluate(hidden) == [0, 0]
+    grown = path.bounding_box()
+    assert grown is not None and grown["height"] > height

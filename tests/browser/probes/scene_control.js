@@ -12,7 +12,7 @@
   if (!row) return null;
   const slider = row.querySelector(".mantine-Slider-root");
   const select = row.querySelector(".mantine-Select-input");
-  const text = row.querySelector(".mantine-TextInput-input");
+  const text = row.querySelector(".mantine-TextInput-input, .mantine-Textarea-input");
   let control = null;
   if (slider) {
     const track = slider.querySelector(".mantine-Slider-trackContainer") || slider;
