@@ -38,11 +38,16 @@ def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
     coordinate of the posture inverse's rest in force (a default outside the joint limits
     brought into them first, :func:`~jik.app.dashboard.algorithms.editable_rest`),
     ``{"algorithm_parameters.rest": "x0"}`` the rest at the start x0 (the patch's, else the
-    state's). Switching to discrete mode without a gamma takes gamma down to
+    state's), ``{"target": "0.3, 0, 0.6, 0, 0, 0"}`` a vector from its text
+    (:func:`parse_vector_text`: the scene's box of a vector of more than three numbers).
+    Switching to discrete mode without a gamma takes gamma down to
     :data:`DISCRETE_GAMMA_ON_SWITCH` when it is above."""
     out: dict[str, Any] = {}
     for key, value in patch.items():
         head, _, rest = key.partition(".")
+        if isinstance(value, str) and (key == "target" or head == "robot_parameters"):
+            current = _in_force(state, key)
+            value = value if current is None else parse_vector_text(value, current, key)
         if head == "algorithm_parameters" and rest.startswith("rest."):
             params = out.setdefault(head, {})
             if not isinstance(params.get("rest"), list | tuple):
@@ -73,6 +78,30 @@ def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
     if out.get("mode") == "discrete" and "gamma" not in out and state.mode != "discrete":
         out["gamma"] = min(state.gamma, DISCRETE_GAMMA_ON_SWITCH)
     return out
+
+
+def _in_force(state, key: str) -> list | None:
+    """The vector in force at ``key`` (``target``, ``robot_parameters.<name>``), None for a
+    key that holds none (a scalar parameter)."""
+    value: Any = state.as_dict()
+    for part in key.split("."):
+        value = value.get(part) if isinstance(value, dict) else None
+    return list(value) if isinstance(value, list | tuple) else None
+
+
+def parse_vector_text(text: str, current, key: str) -> list[float]:
+    """A vector written as text, its numbers separated by ',' (as a point of
+    :data:`PATH_FORMAT`), of the size of ``current``, the vector in force at ``key``; the text
+    the box shows (:func:`path_text` of it) gives ``current`` itself, exact."""
+    if text.split() == path_text([current]).split():
+        return list(current)
+    try:
+        vector = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise refused(key, f"'{text.strip()}' is not numbers separated by ','") from None
+    if len(vector) != len(current) or not all(math.isfinite(v) for v in vector):
+        raise refused(key, f"write {len(current)} finite numbers separated by ','")
+    return vector
 
 
 def path_text(path) -> str:

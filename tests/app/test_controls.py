@@ -113,6 +113,23 @@ def test_a_computed_path_is_shown_as_a_user_types_it_and_stays_exact():
     assert text.value.field == "path" and "y1, y2; y1, y2" in str(text.value)
 
 
+def test_a_vector_typed_as_text_is_its_numbers_and_the_shown_text_keeps_it_exact():
+    """A pose target (6 numbers) is a text box in the 3D scene, which sends its text: the
+    dashboard reads the numbers (it refused any text before: 'Input should be a valid tuple');
+    the text shown sent back keeps the target in force exact; a wrong text is refused naming
+    the target."""
+    state = updated_state(default_state("panda"), {"task": "target"})
+    shown = path_text([state.target])
+    assert shown == "0.3034, 0.0459, 0.5903, 0, 0, 0"
+    assert updated_state(state, {"target": shown}).target == state.target
+    edited = updated_state(state, {"target": "0.3, 0.05, 0.6, 0, 0, 0.1"})
+    assert edited.target == (0.3, 0.05, 0.6, 0.0, 0.0, 0.1)
+    for text, says in (("0.3, x", "is not numbers"), ("0.3, 0.1", "write 6 finite numbers")):
+        with pytest.raises(InvalidInputError) as bad:
+            updated_state(state, {"target": text})
+        assert bad.value.field == "target" and says in str(bad.value)
+
+
 @pytest.mark.parametrize(
     ("patch", "field"),
     [
