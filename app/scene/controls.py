@@ -1,7 +1,8 @@
 """The scene's GUI controls, built from the dashboard's control specification
 (:func:`jik.app.dashboard.controls.controls`, from which the page builds its own): the same
-controls, labels, ranges and values. A change is sent by its control key, as the page sends it;
-the inputs a refused change was about are marked until a change is accepted."""
+controls, labels, ranges and values. A change is sent by its control key, as the page sends it
+(a text box's by its "apply" button, as the page's by Enter); the inputs a refused change was
+about are marked until a change is accepted."""
 
 from __future__ import annotations
 
@@ -57,6 +58,7 @@ class SceneControls:
         # control key -> its viser elements (a checks control's boxes) with their label and hint
         self._plain: dict[str, list[tuple[Any, str, str]]] = {}
         self._marked: list[str] = []  # the keys of the inputs marked refused
+        self.applies: dict[str, Any] = {}  # control key -> the button that sends its text
         self._shape: list[dict] | None = None  # the specification on screen
         self.syncing = Syncing()
         self._lock = threading.RLock()
@@ -112,6 +114,7 @@ class SceneControls:
         for folder in self.folders:
             folder.remove()
         self.folders, self.inputs, self._shown, self._plain = [], {}, {}, {}
+        self.applies = {}
         self._marked = []
         with self.syncing:
             for order, (group, title) in enumerate(GROUPS, start=2):
@@ -167,12 +170,20 @@ class SceneControls:
                 control.label, tuple(value), min=lo, max=hi, step=control.step, hint=control.help
             )
         else:  # text (the path, a point per line), or a vector of another size: as text, parsed
-            # by the server
-            sent, self._shown[key] = str, as_text
+            # by the server, sent by its button: viser's box sends every keystroke, and a
+            # half-typed path would be refused and reset while the user types
+            self._shown[key] = as_text
             multiline = control.kind == "text"
-            handle = gui.add_text(
+            text = gui.add_text(
                 control.label, as_text(value), hint=control.help, multiline=multiline
             )
+            self.applies[key] = gui.add_button(
+                f"apply {control.label}", hint=f"send the {control.label} typed above"
+            )
+            self.applies[key].on_click(lambda _: self._change({key: text.value}))
+            self.inputs[key] = text
+            self._plain[key] = [(text, control.label, control.help)]
+            return
         handle.on_update(lambda e: self._change({key: sent(e.target.value)}))
         self.inputs[key] = handle
         self._plain[key] = [(handle, control.label, control.help)]

@@ -515,8 +515,13 @@ def test_a_vector_shown_as_text_stays_text_in_force():
         dashboard.update({"target": target})
         assert text.value == path_text([target])
         before = dashboard.state
-        text.value = text.value  # (a user's Enter in it, delivered as viser's thread does)
+        scene.controls.applies["target"].value = True  # (a click on its "apply target")
         assert dashboard.state == before
+        typed = path_text([[*target[:-1], target[-1] + 0.1]])
+        text.value = typed  # (typing: nothing is sent until the button is pressed)
+        assert dashboard.state == before
+        scene.controls.applies["target"].value = True
+        assert dashboard.state.target[-1] == pytest.approx(target[-1] + 0.1)
     finally:
         scene.stop()
         dashboard.stop()
@@ -549,7 +554,9 @@ def test_a_refused_value_marks_its_inputs_in_the_scene_until_one_is_accepted():
         plain = (path.label, path.hint)
         (spec,) = [c for c in controls(dashboard.state) if c.key == "path"]
         assert plain == (spec.label, spec.help)
-        path.value = "1, x"  # (what a user's typing in the viser GUI does)
+        path.value = "1, x"  # (what a user's typing in the viser GUI does: nothing sent)
+        assert path.label == "closed path"
+        scene.controls.applies["path"].value = True  # (a click on "apply closed path")
         assert path.value == path_text(dashboard.state.path)  # (the path in force)
         assert path.label == REFUSED_MARK + "closed path"
         assert marked() == {

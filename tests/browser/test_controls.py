@@ -50,6 +50,7 @@ def test_a_refused_value_shows_in_both_with_the_value_in_force(tabs):
     assert tab.scene_control(marked)["value"] == in_force
 
     tab.scene_input(marked).fill("2, y")
+    tab.page.frame_locator("#scene").get_by_role("button", name="apply closed path").click()
     expect(status).to_have_text(f"refused (in the 3D scene): {refused_path('2, y')}")
     tab.wait_scene_text(f"refused: {refused_path('2, y')}")
     assert tab.scene_control(marked, like=in_force)["value"] == in_force
