@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 import viser
@@ -133,7 +134,7 @@ class SceneControls:
         what it sends of its own (``sent``)."""
         gui, key = self._gui, control.key
         handle: Any
-        sent: Callable[[Any], Any]
+        sent: Callable[[Any], Any]  # (None: nothing to send)
         if control.kind == "preset":
             button = gui.add_button(control.label, hint=control.help)
             button.on_click(lambda _: self._change({key: control.value}))
@@ -152,7 +153,7 @@ class SceneControls:
                 control.label, list(labels.values()), initial_value=labels[value], hint=control.help
             )
         elif control.kind == "slider":
-            sent = round if control.integer else float  # (viser's slider gives a float)
+            sent = partial(slider_value, control)
             handle = gui.add_slider(
                 control.label,
                 min=control.minimum,
@@ -184,9 +185,26 @@ class SceneControls:
             self.inputs[key] = text
             self._plain[key] = [(text, control.label, control.help)]
             return
-        handle.on_update(lambda e: self._change({key: sent(e.target.value)}))
+
+        def update(event) -> None:
+            value = sent(event.target.value)
+            if value is not None:
+                self._change({key: value})
+
+        handle.on_update(update)
         self.inputs[key] = handle
         self._plain[key] = [(handle, control.label, control.help)]
+
+
+def slider_value(control: Control, value: float) -> float | int | None:
+    """What a slider of ``control`` sends of its ``value``: an integer for an integer control
+    (viser's slider gives a float), and None for a value off its range, a number being typed in
+    the slider's box, which viser sends at every keystroke ("5" on the way to "500"; a refusal
+    would reset the box under the typing): the box brings it into the range when it loses focus,
+    and sends that."""
+    if not control.minimum <= value <= control.maximum:
+        return None
+    return round(value) if control.integer else float(value)
 
 
 def as_text(value) -> str:

@@ -15,6 +15,7 @@ from viser.transforms import SO3
 from jik.app.dashboard import Dashboard, compute, default_state, updated_state
 from jik.app.dashboard.algorithms import DEFAULT_ALGORITHMS
 from jik.app.scene import DashboardScene
+from jik.app.scene.controls import REFUSED_MARK
 from jik.app.scene.gizmo import DRAG_INTERVAL
 from jik.app.scene.mechanisms import extent_of
 from jik.app.scene.pose import (
@@ -112,11 +113,14 @@ def test_viser_gui_and_drag_change_the_one_state():
         assert scene.controls.inputs["gamma"].value == 0.5
         assert dashboard.wait(generation, timeout=60)
         _drawn(scene, generation)  # (its status drawn: the refusal's below is not overwritten)
-        # A value the dashboard refuses puts the GUI back to the value in force and says so.
-        scene.controls.inputs["gamma"].value = -1.0
-        assert dashboard.state.gamma == 0.5
-        assert scene.controls.inputs["gamma"].value == 0.5
-        assert "refused" in scene.status.content and "gamma" in scene.status.content
+        # A value the dashboard refuses (no algorithm left) puts the GUI back to the value in
+        # force and says so.
+        boxes = scene.controls.inputs["algorithms"].boxes
+        boxes["pseudoinverse"].value = False
+        boxes["extended"].value = False
+        assert dashboard.state.algorithms == ("extended",)
+        assert boxes["extended"].value is True
+        assert "refused" in scene.status.content and "algorithms" in scene.status.content
         # A user's change while another thread sets the GUI's values (the animation's
         # position slider, the worker's sync) is kept: only that thread's callbacks are its own.
         syncing, release = threading.Event(), threading.Event()
@@ -263,6 +267,33 @@ def test_the_scenes_integer_sliders_send_integers():
         scene.controls.show(dashboard.state)
         scene.controls.inputs["cycles"].value = 4.0  # what a move of the slider gives
         assert dashboard.state.cycles == 4 and isinstance(dashboard.state.cycles, int)
+    finally:
+        scene.stop()
+        dashboard.stop()
+
+
+def test_a_number_typed_in_a_sliders_box_is_sent_once_within_its_range():
+    """viser's box beside a slider sends every keystroke: "5" on the way to "500" iterations,
+    "0" on the way to γ = 0.25. Those values off the slider's range are not sent (the dashboard
+    would refuse them and reset the box under the typing, which then read "020000" or 0.251);
+    the box brings a value left off the range into it when it loses focus, and sends that."""
+    dashboard = Dashboard(default_state("manipulator2"))
+    scene = DashboardScene(dashboard)
+    inputs = scene.controls.inputs
+    try:
+        scene.controls.show(dashboard.state)
+        generation = dashboard.generation
+        for typed in (5.0, 50.0, 500.0):  # (what viser's box sends as "500" is typed)
+            inputs["max_iterations"].value = typed
+        assert dashboard.state.max_iterations == 500
+        assert dashboard.generation == generation + 2  # (50, 500)
+        for typed in (0.0, 0.2, 0.25):
+            inputs["gamma"].value = typed
+        assert dashboard.state.gamma == 0.25
+        assert "refused" not in scene.status.content
+        assert not inputs["gamma"].label.startswith(REFUSED_MARK)
+        inputs["gamma"].value = 50.0  # (left typed: the box sends its maximum on blur)
+        assert dashboard.state.gamma == 0.25
     finally:
         scene.stop()
         dashboard.stop()
@@ -535,7 +566,6 @@ def test_a_refused_value_marks_its_inputs_in_the_scene_until_one_is_accepted():
     from jik.app.dashboard import LABELS
     from jik.app.dashboard.control_changes import path_text
     from jik.app.dashboard.controls import controls
-    from jik.app.scene.controls import REFUSED_MARK
     from jik.engine.exceptions import InvalidInputError
 
     dashboard = Dashboard(default_state("manipulator2"))
