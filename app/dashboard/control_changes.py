@@ -27,6 +27,9 @@ PATH_FORMAT = "y1, y2; y1, y2; ..."
 #: Between two points of a path's text: the separator, and a new line (a box shows a point per
 #: line, as many lines as points).
 POINT_SEPARATOR = ";\n"
+#: Decimals of a number as a user types it: the path's text, the page's vector boxes and the
+#: scene's vector boxes (which take no more decimals than they show).
+DECIMALS = 4
 #: Switching to discrete mode takes gamma down to this when it is above (the full Newton step).
 DISCRETE_GAMMA_ON_SWITCH = 1.0
 
@@ -106,14 +109,14 @@ def parse_vector_text(text: str, current, key: str) -> list[float]:
 
 def path_text(path) -> str:
     """A path as text, :data:`PATH_FORMAT` with a point per line (:data:`POINT_SEPARATOR`),
-    each coordinate as a user types it: to 4 decimals, as the page's number boxes show them (a
-    computed 1.29e-17 as 0). Sent back unchanged, or spaced otherwise, it leaves the path in
+    each coordinate as a user types it: to :data:`DECIMALS`, as the page's number boxes show
+    them (a computed 1.29e-17 as 0). Sent back unchanged, or spaced otherwise, it leaves the path in
     force exact (:func:`expand`)."""
     return POINT_SEPARATOR.join(", ".join(_number(v) for v in p) for p in path)
 
 
 def _number(v: float) -> str:
-    text = f"{float(v):.4f}".rstrip("0").rstrip(".")
+    text = f"{float(v):.{DECIMALS}f}".rstrip("0").rstrip(".")
     return "0" if text == "-0" else text
 
 

@@ -13,7 +13,7 @@ from typing import Any
 
 import viser
 
-from ..dashboard.control_changes import path_text
+from ..dashboard.control_changes import DECIMALS, path_text
 from ..dashboard.controls import GROUPS, Control, about, control_values, controls
 
 #: Before the label of an input whose value the dashboard refused (its hint says why).
@@ -170,6 +170,9 @@ class SceneControls:
             handle = add(
                 control.label, tuple(value), min=lo, max=hi, step=control.step, hint=control.help
             )
+            # (viser's boxes show, and take as typed, only the decimals of the step and the
+            # first value: else Manipulator 2's target (0, 2) by 0.1 took 0.25 as 0.2)
+            handle.precision = max(handle.precision, DECIMALS)
         else:  # text (the path, a point per line), or a vector of another size: as text, parsed
             # by the server, sent by its button: viser's box sends every keystroke, and a
             # half-typed path would be refused and reset while the user types

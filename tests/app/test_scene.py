@@ -299,6 +299,25 @@ def test_a_number_typed_in_a_sliders_box_is_sent_once_within_its_range():
         dashboard.stop()
 
 
+def test_a_vector_box_takes_and_shows_the_decimals_the_page_does():
+    """Manipulator 2's target (0, 2), by steps of 0.1: viser's boxes would show and take one
+    decimal (0.25 typed became 0.2, the page's 0.375 showed as 0.4); the scene's take and show
+    the page's DECIMALS, and a first value with more keeps them all."""
+    from jik.app.dashboard.control_changes import DECIMALS
+
+    state = updated_state(default_state("manipulator2"), {"task": "target"})
+    dashboard = Dashboard(state)
+    scene = DashboardScene(dashboard)
+    try:
+        scene.controls.show(dashboard.state)
+        assert scene.controls.inputs["target"].precision == DECIMALS
+        dashboard.update({"robot": "unicycle"})  # (its q0, (5, 0, pi/2): 7 decimals)
+        assert scene.controls.inputs["robot_parameters.q0"].precision == 7
+    finally:
+        scene.stop()
+        dashboard.stop()
+
+
 def test_the_scene_shows_the_runs_progress_not_the_second_phases():
     """The scene's status keeps the drawn result's line while E1, E2 (which it does not draw)
     are computed; a new state's runs show their progress there, until a failure."""
