@@ -318,7 +318,9 @@ class PostureInverse(Inverse):
         z = rest - x
         u, _ = solve_small(G, np.einsum("...ij,...j->...i", J, z))
         null = z - _jt(J, u)  # (I - J# J) (x_rest - x)
-        v = _jt(J, w) - self.gain * np.linalg.norm(e, axis=-1)[..., None] * null
+        # (a diverged iterate, a Picard sweep's, overflows here: marked bad below, not warned)
+        with np.errstate(over="ignore", invalid="ignore"):
+            v = _jt(J, w) - self.gain * np.linalg.norm(e, axis=-1)[..., None] * null
         bad |= ~np.isfinite(v).all(axis=-1)
         return (np.where(bad[..., None], 0.0, v) if bad.any() else v), bad
 

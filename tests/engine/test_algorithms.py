@@ -154,6 +154,19 @@ STRETCHED = np.zeros(3)
 ARM3R = PlanarChain("RRR", [1.0, 1.0, 1.0])
 
 
+@pytest.mark.filterwarnings("error")
+def test_posture_pull_of_a_diverged_iterate_is_marked_bad_without_a_warning():
+    """A continuous run's Picard sweeps may diverge (the Panda with k = 60 did): the pull of
+    such an iterate overflows, and is marked bad (the sweep gives up) with no RuntimeWarning,
+    which ``jik serve`` would print to its log."""
+    inv = PostureInverse(KIN, X0, gain=60.0)
+    x = np.array([[1e160, -1e160, 1.0], [0.1, 0.2, 1.0]])
+    e = np.array([[1e150, 1.0], [0.1, 0.1]])
+    v, bad = inv.apply_masked(x, e)
+    assert bad.tolist() == [True, False]
+    assert np.isfinite(v).all()
+
+
 def test_damped_leaves_a_singular_start_where_the_pseudoinverse_cannot():
     """The 3R arm stretched (J of rank 1): damped least squares moves off and converges."""
     with pytest.raises(KinematicSingularityError):
