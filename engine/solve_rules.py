@@ -182,7 +182,8 @@ def stop_message(status, nit, err, tol, mode, gamma, x, inverse, max_iterations,
     ``x`` on its way to ``target``, says: a stall says why
     (:func:`jik.engine.stall.stall_reason`); a run that diverged or ran out of steps says
     whether the target is out of reach (:func:`jik.engine.stall.reach_note`), else what to
-    change: a discrete run that diverged a lower gamma (shorter steps), one out of iterations
+    change: a discrete run that diverged a lower gamma (shorter steps) and, for the posture
+    inverse, a lower gain k (its null-space pull grows with k ||e||), one out of iterations
     gamma nearer 1 (near a solution the error shrinks by |1 - gamma| per iteration, eq. (5));
     in continuous mode gamma only rescales theta, so more steps, not another gamma."""
     steps = counted(nit, mode)
@@ -197,7 +198,9 @@ def stop_message(status, nit, err, tol, mode, gamma, x, inverse, max_iterations,
     out, _ = reach_note(inverse.kinematics, target)
     nearer = mode == "discrete" and gamma != 1.0
     if status == Status.DIVERGED:
-        advice = out or ("lower gamma" if mode == "discrete" else "the target may be unreachable")
+        gain = getattr(inverse, "gain", None)  # (the posture inverse's k)
+        lower = "lower gamma" + ("" if gain is None else f" or the posture gain k ({gain:g})")
+        advice = out or (lower if mode == "discrete" else "the target may be unreachable")
         return f"diverged after {steps} (error {err:.3g}); {advice}"
     advice = out or "raise max_iterations" + (", or take gamma nearer 1" if nearer else "")
     return (

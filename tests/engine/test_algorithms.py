@@ -406,3 +406,15 @@ def test_limited_box_narrows_a_box_to_the_limits_keeping_its_width_beyond_one():
     want = [[-1.0, 1.0], [-3.0, 1.2], [2.0, 4.0], [-3.0, 3.0]]
     np.testing.assert_array_equal(limited_box(box, limits), want)
     np.testing.assert_array_equal(limited_box(box, None), box)
+
+
+def test_a_diverged_posture_run_names_its_gain_beside_gamma():
+    """The posture inverse's null-space pull grows with k ||e||: a discrete run with a large
+    gain that diverges says to lower gamma or the gain, naming k."""
+    chain = PlanarChain("RRR", [1.0, 1.0, 1.0])
+    posture = make_inverse(
+        chain, "posture", algorithm_parameters={"gain": 20.0, "rest": [2, -2, 2]}
+    )
+    res = solve(posture, [0.3, 0.4, 0.5], [1.5, 1.0], mode="discrete", gamma=1.0)
+    assert res.status == "diverged"
+    assert res.message.endswith("; lower gamma or the posture gain k (20)")
