@@ -200,6 +200,9 @@ def test_a_singular_start_is_marked_at_the_starts_controls(tabs):
     expect(page.locator("#controls [aria-invalid]")).to_have_count(0)
 
 
+# (CI's slow step: the Panda's runs take most of its 20 s; tests/app/test_controls.py checks the
+# path's text a point per line in the default run)
+@pytest.mark.slow
 def test_a_pose_path_shows_whole_a_point_per_line(tabs):
     """The Franka Panda's closed path has 6 coordinates a point (x y z rx ry rz): its box shows
     every point whole, a line each, nothing scrolled out of sight and within the controls; a
