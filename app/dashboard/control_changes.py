@@ -83,12 +83,21 @@ def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
     return out
 
 
+def lookup(state: Mapping[str, Any], key: str) -> Any:
+    """The value at a dotted key of a state's dict."""
+    value: Any = state
+    for part in key.split("."):
+        value = value[int(part)] if isinstance(value, list) else value[part]
+    return value
+
+
 def _in_force(state, key: str) -> list | None:
     """The vector in force at ``key`` (``target``, ``robot_parameters.<name>``), None for a
     key that holds none (a scalar parameter)."""
-    value: Any = state.as_dict()
-    for part in key.split("."):
-        value = value.get(part) if isinstance(value, dict) else None
+    try:
+        value = lookup(state.as_dict(), key)
+    except (KeyError, IndexError, TypeError, ValueError):
+        return None
     return list(value) if isinstance(value, list | tuple) else None
 
 

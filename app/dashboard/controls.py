@@ -17,7 +17,6 @@ text).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -25,7 +24,7 @@ from ...engine.arms import ARMS
 from ...engine.registry import ROBOTS
 from ...engine.solve_rules import DISCRETE_GAMMA_BOUND, MAX_ITERATIONS, MAX_STEPS
 from .algorithms import STYLES, joint_box, posture_rest, scalar_parameters
-from .control_changes import PATH_FORMAT, path_text
+from .control_changes import PATH_FORMAT, lookup, path_text
 from .glossary import PARAMETER_LABELS, SYMBOLS
 from .robots import state_kinematics, state_spec
 
@@ -361,14 +360,6 @@ def control_values(state, spec: list[Control] | None = None) -> dict[str, Any]:
         else:
             values[c.key] = path_text(state.path) if c.key == "path" else lookup(d, c.key)
     return values
-
-
-def lookup(state: Mapping[str, Any], key: str) -> Any:
-    """The value at a dotted key of a state's dict."""
-    value: Any = state
-    for part in key.split("."):
-        value = value[int(part)] if isinstance(value, list) else value[part]
-    return value
 
 
 def controls_message(state) -> dict[str, Any]:
