@@ -5,7 +5,7 @@
 (:func:`jik.app.dashboard.model.updated_state` applies it), one coordinate of the posture
 inverse's rest (``{"algorithm_parameters.rest.1": 0.4}``) or the rest set to the start
 (``{"algorithm_parameters.rest": "x0"}``) included; :func:`path_text` and
-:func:`parse_path_text` write a closed path as text and read it back (:data:`PATH_FORMAT`), the
+:func:`parse_path_text` write a closed path as text and read it back (:func:`path_format`), the
 one text format of the path box on the page and in the scene: a point per line.
 """
 
@@ -21,9 +21,6 @@ from ..compute.schemas.wording import refused
 from .algorithms import editable_rest
 from .robots import state_kinematics, state_spec
 
-#: How a closed path is written in a text box: points separated by ';' (or a new line),
-#: coordinates by ','.
-PATH_FORMAT = "y1, y2; y1, y2; ..."
 #: Between two points of a path's text: the separator, and a new line (a box shows a point per
 #: line, as many lines as points).
 POINT_SEPARATOR = ";\n"
@@ -37,7 +34,7 @@ DISCRETE_GAMMA_ON_SWITCH = 1.0
 def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
     """A patch of control keys as a patch of the state's fields: ``{"x0.1": v}`` sets one
     coordinate of x0, ``{"robot_parameters.l": v}`` one parameter, ``{"path": "1, 1; 1, 2"}``
-    the path from its text (:data:`PATH_FORMAT`), ``{"algorithm_parameters.rest.1": v}`` one
+    the path from its text (:func:`path_format`), ``{"algorithm_parameters.rest.1": v}`` one
     coordinate of the posture inverse's rest in force (a default outside the joint limits
     brought into them first, :func:`~jik.app.dashboard.algorithms.editable_rest`),
     ``{"algorithm_parameters.rest": "x0"}`` the rest at the start x0 (the patch's, else the
@@ -103,7 +100,7 @@ def _in_force(state, key: str) -> list | None:
 
 def parse_vector_text(text: str, current, key: str) -> list[float]:
     """A vector written as text, its numbers separated by ',' (as a point of
-    :data:`PATH_FORMAT`), of the size of ``current``, the vector in force at ``key``; the text
+    :func:`path_format`), of the size of ``current``, the vector in force at ``key``; the text
     the box shows (:func:`path_text` of it) gives ``current`` itself, exact."""
     if text.split() == path_text([current]).split():
         return list(current)
@@ -117,7 +114,7 @@ def parse_vector_text(text: str, current, key: str) -> list[float]:
 
 
 def path_text(path) -> str:
-    """A path as text, :data:`PATH_FORMAT` with a point per line (:data:`POINT_SEPARATOR`),
+    """A path as text, :func:`path_format` with a point per line (:data:`POINT_SEPARATOR`),
     each coordinate as a user types it: to :data:`DECIMALS`, as the page's number boxes show
     them (a computed 1.29e-17 as 0). Sent back unchanged, or spaced otherwise, it leaves the path in
     force exact (:func:`expand`)."""
@@ -129,26 +126,35 @@ def _number(v: float) -> str:
     return "0" if text == "-0" else text
 
 
+def path_format(size: int | None = None) -> str:
+    """How a closed path of points with ``size`` coordinates (2 when not known) is written in a
+    text box: points separated by ';' (or a new line), coordinates by ','."""
+    n = size or 2
+    point = ", ".join(f"y{i}" for i in range(1, n + 1)) if n <= 3 else f"y1, ..., y{n}"
+    return f"{point}; {point}; ..."
+
+
 def parse_path_text(text: str, size: int | None = None) -> list[list[float]]:
-    """The points of a path written as :data:`PATH_FORMAT`, a new line separating points as a
+    """The points of a path written as :func:`path_format`, a new line separating points as a
     ';' does; ``size``: the task's dimension, which every point must have. A refusal quotes the
     point as the user wrote it."""
     points = []
     parts = [p for p in re.split(r"[;\n]", text) if p.strip()]
+    written = path_format(size)
     for k, part in enumerate(parts, start=1):
         where = f"point {k} of {len(parts)}, '{part.strip()}',"
         try:
             point = [float(v) for v in part.split(",")]
         except ValueError:
             raise InvalidInputError(
-                f"path: {where} is not numbers separated by ',' (write '{PATH_FORMAT}')", "path"
+                f"path: {where} is not numbers separated by ',' (write '{written}')", "path"
             ) from None
         if not all(math.isfinite(v) for v in point):
             raise InvalidInputError(f"path: {where} has a coordinate that is not finite", "path")
         if size is not None and len(point) != size:
             raise InvalidInputError(
                 f"path: {where} has {len(point)} coordinate{'s' if len(point) > 1 else ''}; "
-                f"each point needs {size} (write '{PATH_FORMAT}')",
+                f"each point needs {size} (write '{written}')",
                 "path",
             )
         points.append(point)

@@ -24,7 +24,7 @@ from ...engine.arms import ARMS
 from ...engine.registry import ROBOTS
 from ...engine.solve_rules import DISCRETE_GAMMA_BOUND, MAX_ITERATIONS, MAX_STEPS
 from .algorithms import STYLES, joint_box, posture_rest, scalar_parameters
-from .control_changes import PATH_FORMAT, lookup, path_text
+from .control_changes import lookup, path_format, path_text
 from .glossary import PARAMETER_LABELS, SYMBOLS
 from .robots import state_kinematics, state_spec
 
@@ -209,15 +209,16 @@ def controls(state) -> list[Control]:
             )
         )
     if state.task == "path":
+        written = path_format(len(state.target))
         out.append(
             Control(
                 "path",
                 "closed path",
                 "text",
                 "start",
-                f"task points visited in order, a point per line ({PATH_FORMAT}); the path "
-                "closes back to k(x0)",
-                format=PATH_FORMAT,
+                f"task points visited in order, a point per line ({written}); the path closes "
+                "back to k(x0)",
+                format=written,
             )
         )
         cycles = Control(

@@ -110,7 +110,14 @@ def test_a_computed_path_is_shown_as_a_user_types_it_and_stays_exact():
     assert bad.value.field == "x0.7"
     with pytest.raises(InvalidInputError) as text:
         updated_state(state, {"path": "1, 1; one, 2"})
-    assert text.value.field == "path" and "y1, y2; y1, y2" in str(text.value)
+    # (the way to write it names a pose point's 6 coordinates, as the box's placeholder does)
+    assert text.value.field == "path" and "(write 'y1, ..., y6; y1, ..., y6; ...')" in str(
+        text.value
+    )
+    (box,) = [c for c in controls(state) if c.key == "path"]
+    assert box.format == "y1, ..., y6; y1, ..., y6; ..." and box.format in box.help
+    (planar,) = [c for c in controls(default_state("manipulator2")) if c.key == "path"]
+    assert planar.format == "y1, y2; y1, y2; ..."
 
 
 def test_a_vector_typed_as_text_is_its_numbers_and_the_shown_text_keeps_it_exact():
