@@ -26,7 +26,8 @@ import pytest
 
 #: Builds and installs into fresh environments (a minute or more): out of the default run,
 #: in CI's slow step.
-pytestmark = pytest.mark.slow
+# (one worker under pytest-xdist: the tests share one wheel, built in the source tree)
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("install")]
 
 ROOT = Path(__file__).resolve().parents[1]
 #: Packages of the ``app`` extra that the engine alone must not need.
