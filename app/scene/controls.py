@@ -2,12 +2,13 @@
 (:func:`jik.app.dashboard.controls.controls`, from which the page builds its own): the same
 controls, labels, ranges and values. A change is sent by its control key, as the page sends it
 (a text box's by its "apply" button, as the page's by Enter); the inputs a refused change was
-about are marked until a change is accepted."""
+about are marked until a change is accepted, and those where the runs on screen stopped (a
+singular start) until the next result, as the page marks its boxes."""
 
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from functools import partial
 from typing import Any
 
@@ -16,8 +17,9 @@ import viser
 from ..dashboard.control_changes import DECIMALS, path_text
 from ..dashboard.controls import GROUPS, Control, about, control_values, controls
 
-#: Before the label of an input whose value the dashboard refused (its hint says why).
-REFUSED_MARK = "⚠ "
+#: Before the label of an input the dashboard refused a value of, or where a run stopped (its
+#: hint says which and why).
+MARK = "⚠ "
 
 
 class Syncing:
@@ -58,7 +60,9 @@ class SceneControls:
         self._shown: dict[str, Callable[[Any], Any]] = {}
         # control key -> its viser elements (a checks control's boxes) with their label and hint
         self._plain: dict[str, list[tuple[Any, str, str]]] = {}
-        self._marked: list[str] = []  # the keys of the inputs marked refused
+        # "refused" / "stopped" -> control key -> the message its input's hint says
+        self._notes: dict[str, dict[str, str]] = {"refused": {}, "stopped": {}}
+        self._marked: set[str] = set()  # the keys of the inputs marked
         self.applies: dict[str, Any] = {}  # control key -> the button that sends its text
         self._shape: list[dict] | None = None  # the specification on screen
         self.syncing = Syncing()
@@ -77,7 +81,7 @@ class SceneControls:
                 self._shape = shape
                 self._build(spec, control_values(state, spec))
             else:
-                self.clear_marks()
+                self.mark("refused", ())
                 self.sync(state)
 
     def sync(self, state) -> None:
@@ -91,32 +95,35 @@ class SceneControls:
                 except (ValueError, AssertionError):
                     pass
 
-    def mark_refused(self, field: str | None, message: str) -> None:
-        """Mark the inputs about ``field``, the field of a refused change (:func:`about`):
-        :data:`REFUSED_MARK` before the label, the refusal as the hint, until a change is
-        accepted (:meth:`show`) or another is refused."""
+    def mark(self, kind: str, fields: Iterable[tuple[str | None, str]]) -> None:
+        """Mark the inputs about each ``(field, message)`` of ``fields`` (:func:`about`), as
+        ``kind``: ``"refused"``, a refused change's field (until a change is accepted or another
+        is refused), or ``"stopped"``, where a run of the result on screen stopped (until the
+        next result). A marked input has :data:`MARK` before its label and "<kind>: <message>"
+        as its hint."""
         with self._lock:
-            self.clear_marks()
-            self._marked = [key for key in self.inputs if field and about(key, field)]
-            for key in self._marked:
-                for element, label, _ in self._plain[key]:
-                    element.label = REFUSED_MARK + label
-                    element.hint = f"refused: {message}"
-
-    def clear_marks(self) -> None:
-        """The marked inputs' labels and hints as the specification writes them."""
-        with self._lock:
-            for key in self._marked:
+            notes: dict[str, list[str]] = {}
+            for field, message in fields:
+                for key in self.inputs:
+                    if field and about(key, field) and message not in notes.get(key, []):
+                        notes.setdefault(key, []).append(message)
+            self._notes[kind] = {key: "; ".join(said) for key, said in notes.items()}
+            hints: dict[str, list[str]] = {}
+            for k, kind_notes in self._notes.items():
+                for key, message in kind_notes.items():
+                    hints.setdefault(key, []).append(f"{k}: {message}")
+            for key in self._marked | set(hints):
                 for element, label, hint in self._plain.get(key, ()):
-                    element.label, element.hint = label, hint
-            self._marked = []
+                    element.label = MARK + label if key in hints else label
+                    element.hint = "; ".join(hints[key]) if key in hints else hint
+            self._marked = set(hints)
 
     def _build(self, spec: list[Control], values: dict[str, Any]) -> None:
         for folder in self.folders:
             folder.remove()
         self.folders, self.inputs, self._shown, self._plain = [], {}, {}, {}
         self.applies = {}
-        self._marked = []
+        self._notes, self._marked = {"refused": {}, "stopped": {}}, set()
         with self.syncing:
             for order, (group, title) in enumerate(GROUPS, start=2):
                 with self._gui.add_folder(title, order=order) as folder:

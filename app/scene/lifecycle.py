@@ -103,7 +103,7 @@ class DashboardScene:
                 msg = json.loads(event.data)
                 self.controls.sync(self.dashboard.state)
                 if event.kind == "refused":  # (its field's inputs say so, as the page's do)
-                    self.controls.mark_refused(msg.get("field"), msg["message"])
+                    self.controls.mark("refused", [(msg.get("field"), msg["message"])])
                 # (a refusal stops no computation: its progress bar stays)
                 self.progress.visible &= event.kind == "refused"
                 self.status.content = f"**{event.kind}:** {msg['message']}"
@@ -129,6 +129,7 @@ class DashboardScene:
             # is sent but the status (a redraw would make every client render anew).
             with self._lock:  # (the timeline on screen plays the same legs)
                 self.controls.sync(self.dashboard.state)
+                self.controls.mark("stopped", stops(result))
                 self.dashboard.scene_status.update(generation=result.generation)
             self._show_status(result)
             return
@@ -145,6 +146,7 @@ class DashboardScene:
                 self.camera.frame(result)
             self.playback.show(timeline, self.nodes.mechanisms)
             self.controls.sync(self.dashboard.state)
+            self.controls.mark("stopped", stops(result))
             first = next(iter(self.nodes.mechanisms.values()), None)
             self.dashboard.scene_status.update(
                 generation=result.generation,
@@ -176,6 +178,12 @@ class DashboardScene:
         else:
             messages = "; ".join(r.message for r in runs.values())
             self.status.content = f"generation {result.generation}: {messages}"
+
+
+def stops(result) -> list[tuple[str, str]]:
+    """Where the runs of ``result`` stopped: each stopped run's field (x0, a singular start)
+    and message."""
+    return [(run.field, run.message) for run in result.runs.values() if run.field]
 
 
 def legend(algorithms) -> str:

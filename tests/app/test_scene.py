@@ -15,7 +15,7 @@ from viser.transforms import SO3
 from jik.app.dashboard import Dashboard, compute, default_state, updated_state
 from jik.app.dashboard.algorithms import DEFAULT_ALGORITHMS
 from jik.app.scene import DashboardScene
-from jik.app.scene.controls import REFUSED_MARK
+from jik.app.scene.controls import MARK
 from jik.app.scene.gizmo import DRAG_INTERVAL
 from jik.app.scene.mechanisms import extent_of
 from jik.app.scene.pose import (
@@ -291,7 +291,7 @@ def test_a_number_typed_in_a_sliders_box_is_sent_once_within_its_range():
             inputs["gamma"].value = typed
         assert dashboard.state.gamma == 0.25
         assert "refused" not in scene.status.content
-        assert not inputs["gamma"].label.startswith(REFUSED_MARK)
+        assert not inputs["gamma"].label.startswith(MARK)
         inputs["gamma"].value = 50.0  # (left typed: the box sends its maximum on blur)
         assert dashboard.state.gamma == 0.25
     finally:
@@ -579,7 +579,7 @@ def test_a_vector_shown_as_text_stays_text_in_force():
 
 def test_a_refused_value_marks_its_inputs_in_the_scene_until_one_is_accepted():
     """A closed path the dashboard refuses, typed in the scene's GUI, marks the scene's path
-    input (REFUSED_MARK before its label, the refusal as its hint) and no other, as the page
+    input (MARK before its label, the refusal as its hint) and no other, as the page
     marks its box; the next value accepted takes the mark away. A refusal from elsewhere (the
     page) marks the scene's inputs too: each of x0's sliders, each algorithm's checkbox."""
     from jik.app.dashboard import LABELS
@@ -594,9 +594,7 @@ def test_a_refused_value_marks_its_inputs_in_the_scene_until_one_is_accepted():
     def marked() -> dict[str, str]:
         elements = {k: [h] for k, h in inputs.items() if k != "algorithms"}
         elements |= {f"algorithms.{a}": [b] for a, b in inputs["algorithms"].boxes.items()}
-        return {
-            k: h.hint for k, (h,) in elements.items() if h.label.startswith(REFUSED_MARK.strip())
-        }
+        return {k: h.hint for k, (h,) in elements.items() if h.label.startswith(MARK.strip())}
 
     try:
         path = inputs["path"]
@@ -607,7 +605,7 @@ def test_a_refused_value_marks_its_inputs_in_the_scene_until_one_is_accepted():
         assert path.label == "closed path"
         scene.controls.applies["path"].value = True  # (a click on "apply closed path")
         assert path.value == path_text(dashboard.state.path)  # (the path in force)
-        assert path.label == REFUSED_MARK + "closed path"
+        assert path.label == MARK + "closed path"
         assert marked() == {
             "path": "refused: path: point 1 of 1, '1, x', is not numbers separated by ',' "
             "(write 'y1, y2; y1, y2; ...')"
@@ -625,6 +623,43 @@ def test_a_refused_value_marks_its_inputs_in_the_scene_until_one_is_accepted():
         dashboard.update({"cycles": 2})
         assert marked() == {}
         assert inputs["algorithms"].boxes["extended"].label == LABELS["extended"]
+    finally:
+        scene.stop()
+        dashboard.stop()
+
+
+def test_a_singular_start_marks_the_starts_inputs_in_the_scene_until_a_result_without_it():
+    """The 3R arm stretched out, x0 = (0, 0, 0), where J J^T is singular: the runs stop at their
+    first leg, and the scene's x0 sliders are marked (MARK, the engine's message as their
+    hint), as the page marks its boxes; a refusal meanwhile adds its own hint and leaves that
+    mark; a start off the singular set gives a result without it, and every mark goes."""
+    from jik.app.dashboard.controls import controls
+    from jik.engine.exceptions import InvalidInputError
+
+    chain = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 1.0, 1.0]}
+    state = updated_state(
+        default_state("manipulator2"),
+        {"robot": "planar_chain", "robot_definition": chain, "x0": [0.0, 0.0, 0.0]},
+    )
+    dashboard = Dashboard(updated_state(state, {"task": "target", "target": [2.0, 1.0]}))
+    scene = DashboardScene(dashboard)
+    inputs = scene.controls.inputs
+    try:
+        assert dashboard.wait(1, timeout=60)
+        _drawn(scene, 1)
+        marked = {k: h.hint for k, h in inputs.items() if h.label.startswith(MARK)}
+        assert sorted(marked) == ["x0.0", "x0.1", "x0.2"]
+        assert all(h.startswith("stopped: ") and "J J^T is singular" in h for h in marked.values())
+        with pytest.raises(InvalidInputError):
+            dashboard.update({"x0": [1.0, 2.0]})
+        assert inputs["x0.1"].hint.startswith("refused: ") and "; stopped: " in inputs["x0.1"].hint
+
+        generation, _ = dashboard.update({"x0.1": 0.5})
+        assert dashboard.wait(generation, timeout=60)
+        _drawn(scene, generation)
+        assert not [k for k, h in inputs.items() if h.label.startswith(MARK)]
+        (spec,) = [c for c in controls(dashboard.state) if c.key == "x0.1"]
+        assert (inputs["x0.1"].label, inputs["x0.1"].hint) == (spec.label, spec.help)
     finally:
         scene.stop()
         dashboard.stop()

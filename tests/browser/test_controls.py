@@ -10,7 +10,7 @@ import urllib.request
 import numpy as np
 import pytest
 
-from jik.app.scene.controls import REFUSED_MARK
+from jik.app.scene.controls import MARK
 
 expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
 pytestmark = pytest.mark.browser
@@ -46,7 +46,7 @@ def test_a_refused_value_shows_in_both_with_the_value_in_force(tabs):
     expect(status).to_have_class(re.compile(r"\berror\b"))
     tab.wait_scene_text(f"refused: {refused_path('1, x')}")
     expect(path).to_have_value(in_force)
-    marked = REFUSED_MARK + "closed path"
+    marked = MARK + "closed path"
     assert tab.scene_control(marked)["value"] == in_force
 
     tab.scene_input(marked).fill("2, y")
@@ -175,8 +175,8 @@ def test_a_refusal_beside_a_control_goes_when_its_value_changes_elsewhere(tabs):
 def test_a_singular_start_is_marked_at_the_starts_controls(tabs):
     """A link to the 3R arm stretched out, x0 = (0, 0, 0), where J J^T is singular: the runs stop
     at their first leg, and the start's controls are marked as a refused value's are (the
-    engine's message beside them, each coordinate invalid); a coordinate moved off the
-    singular set takes every mark away."""
+    engine's message beside them, each coordinate invalid), in the page and in the 3D scene; a
+    coordinate moved off the singular set takes every mark away."""
     from urllib.parse import quote
 
     chain = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 1.0, 1.0]}
@@ -192,12 +192,14 @@ def test_a_singular_start_is_marked_at_the_starts_controls(tabs):
         expect(box).to_have_attribute("aria-invalid", "true")
         expect(page.locator(f"#ctl-x0-{i}")).to_have_attribute("aria-invalid", "true")
     assert tab.snapshot()["summary"]["pseudoinverse"]["field"] == "x0"
+    tab.scene_control(MARK + "x0: x2")  # (the scene marks its sliders too)
 
     boxes[1].fill("0.5")
     tab.change(lambda: boxes[1].dispatch_event("change"))
     assert tab.snapshot()["summary"]["pseudoinverse"]["success"]
     expect(page.locator("#controls .field-error")).to_have_count(0)
     expect(page.locator("#controls [aria-invalid]")).to_have_count(0)
+    tab.scene_control("x0: x2")
 
 
 # (CI's slow step: the Panda's runs take most of its 20 s; tests/app/test_controls.py checks the
