@@ -187,14 +187,6 @@ def checked(algorithms: tuple[str, ...], given: Mapping[str, Any]) -> dict[str, 
     return {"algorithms": ordered, "algorithm_parameters": values}
 
 
-def scalar(state: ChosenState, name: str) -> float:
-    """The scalar parameter ``name`` of a chosen algorithm (0 when none is chosen that has it)."""
-    value = state.algorithm_parameters.get(name, 0.0)
-    if not isinstance(value, int | float):
-        raise TypeError(f"algorithm_parameters.{name} is not a number: {value!r}")
-    return float(value)
-
-
 def joint_box(spec, kin) -> tuple[tuple[float, float], ...]:
     """The range of each slider of a joint configuration, x0's and the posture rest's (what
     :func:`checked_rest` accepts): the robot's joint limits
