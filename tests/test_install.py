@@ -25,8 +25,8 @@ import httpx
 import pytest
 
 #: Builds and installs into fresh environments (a minute or more): out of the default run,
-#: in CI's slow step.
-# (one worker under pytest-xdist: the tests share one wheel, built in the source tree)
+#: in CI's slow step; in one worker under pytest-xdist (the tests share one wheel, built in the
+#: source tree).
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("install")]
 
 ROOT = Path(__file__).resolve().parents[1]
