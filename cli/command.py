@@ -1,5 +1,5 @@
 """The ``jik`` command (also ``python -m jik``): ``jik serve``, ``jik reproduce NAME [--json]``,
-``jik bench [NAME]``.
+``jik errata``, ``jik bench [NAME]``.
 
 Only ``serve`` needs the web parts (the ``app`` extra); the others run on the engine alone,
 so this module imports nothing of :mod:`jik.app` until ``serve`` asks for it.
@@ -54,6 +54,13 @@ def reproduce(args: argparse.Namespace) -> int:
         print(json.dumps(result))
     else:
         print(module.format_text(result))
+    return 0
+
+
+def errata(args: argparse.Namespace) -> int:
+    from ..docs import paper_errata
+
+    print(paper_errata(), end="")
     return 0
 
 
@@ -159,6 +166,13 @@ def main(argv: list[str] | None = None) -> int:
         help="table1 only: use the printed j32, j33 of (39) instead of the gradient of (38)",
     )
     p.set_defaults(func=reproduce)
+
+    p = sub.add_parser(
+        "errata",
+        help="print where the printed paper and jik disagree, each with the command that shows "
+        "it (docs/paper-errata.md, Markdown)",
+    )
+    p.set_defaults(func=errata)
 
     add_atlas_parser(sub)
 

@@ -4,9 +4,9 @@
 #      localhost/python:3.11-slim (skipped when that image already exists);
 #   2. buildah bud --isolation chroot --build-arg BASE=localhost/python:3.11-slim -t jik .
 #   3. inside a working container (buildah run --isolation chroot), as the image's user: run
-#      `jik reproduce table1`, start `jik serve`, fetch /health, /robots, /solve and /docs, wait
-#      for the dashboard's first result over HTTP, and stop the server with SIGTERM (what
-#      `docker stop` sends), checking that it exits cleanly.
+#      `jik reproduce table1` and `jik errata`, start `jik serve`, fetch /health, /robots, /solve,
+#      /docs and /errata, wait for the dashboard's first result over HTTP, and stop the server
+#      with SIGTERM (what `docker stop` sends), checking that it exits cleanly.
 # Usage: scripts/docker-smoke.sh [IMAGE]   (default IMAGE=localhost/jik:smoke)
 #   JIK_SMOKE_REBUILD_BASE=1 rebuilds the base image; JIK_SMOKE_BASE_ONLY=1 stops after it.
 # Not run in CI (slow); CI only lints the Dockerfile (tests/app/test_docker.py).
@@ -85,6 +85,8 @@ PORT=${JIK_SMOKE_PORT:-18000}
 buildah run --isolation chroot --user 10001:10001 "$CTR" -- sh -c "
   id
   jik reproduce table1 || exit 1
+  jik errata >/tmp/errata.md || exit 1
+  head -n 1 /tmp/errata.md
   jik serve --host 127.0.0.1 --port $PORT >/tmp/serve.log 2>&1 &
   pid=\$!
   python - <<PY
@@ -107,6 +109,8 @@ for _ in range(120):
         with urllib.request.urlopen('http://127.0.0.1:$PORT/docs', timeout=10) as r:
             page = r.read().decode()
             print('GET /docs ->', r.status, 'cdn' not in page.lower() and 'assets served locally')
+        with urllib.request.urlopen('http://127.0.0.1:$PORT/errata', timeout=10) as r:
+            print('GET /errata ->', r.status, '<h1>Paper errata</h1>' in r.read().decode())
         req = urllib.request.Request(
             'http://127.0.0.1:$PORT/api/sessions', data=json.dumps({'state': {}}).encode(),
             headers={'content-type': 'application/json'})

@@ -147,6 +147,8 @@ def test_wheel_installs_one_package_and_serves(wheel, tmp_path):
         assert snapshot["summary"], snapshot
         docs = httpx.get(f"http://127.0.0.1:{port}/docs", timeout=10)
         assert docs.status_code == 200 and "cdn" not in docs.text.lower(), docs.text[:500]
+        errata = httpx.get(f"http://127.0.0.1:{port}/errata", timeout=10)
+        assert errata.status_code == 200 and "<h1>Paper errata</h1>" in errata.text
     finally:
         server.terminate()
         output = server.communicate(timeout=60)[0]
@@ -191,6 +193,8 @@ def test_engine_alone_reproduces_table1(wheel, tmp_path):
     )
     table = json.loads(run(bin_dir / "python", "-c", script, cwd=tmp_path))
     assert len(table["pseudoinverse"]) == 5, table
+    errata = (ROOT / "docs" / "paper-errata.md").read_text(encoding="utf-8")
+    assert run(bin_dir / "jik", "errata", cwd=tmp_path) == errata
     serve = subprocess.run(
         [bin_dir / "jik", "serve"], cwd=tmp_path, capture_output=True, text=True, timeout=60
     )
@@ -200,7 +204,8 @@ def test_engine_alone_reproduces_table1(wheel, tmp_path):
 
 def test_sdist_builds_the_same_wheel_without_tests_or_docs(wheel, tmp_path):
     """The sdist holds what builds the wheel, and the wheel pip builds from it is the one built
-    from the tree; the tests, docs, scripts and harnesses stay in the repository."""
+    from the tree; the tests, docs (but for the errata the wheel ships), scripts and harnesses
+    stay in the repository."""
     pytest.importorskip("build", reason="the build package (of the test extra) builds sdists")
     run(
         sys.executable,
@@ -215,9 +220,12 @@ def test_sdist_builds_the_same_wheel_without_tests_or_docs(wheel, tmp_path):
     )
     (sdist,) = tmp_path.glob("jik_lab-*.tar.gz")
     with tarfile.open(sdist) as tar:
-        folders = {Path(*Path(n).parts[1:3]) for n in tar.getnames() if len(Path(n).parts) > 2}
-    left_in = {f for f in folders if f.parts[0] in ("tests", "docs", "scripts", ".ci")}
+        names = tar.getnames()
+    folders = {Path(*Path(n).parts[1:3]) for n in names if len(Path(n).parts) > 2}
+    left_in = {f for f in folders if f.parts[0] in ("tests", "scripts", ".ci")}
     assert not left_in and Path("benchmarks/harness") not in folders, sorted(left_in)
+    docs = {Path(*Path(n).parts[1:]) for n in names if Path(n).parts[1:2] == ("docs",)}
+    assert docs - {Path("docs")} == {Path("docs/__init__.py"), Path("docs/paper-errata.md")}
     assert {Path("engine/reproductions"), Path("app/api")} <= folders, sorted(folders)
     out = tmp_path / "from-sdist"
     run(

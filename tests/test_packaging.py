@@ -22,6 +22,7 @@ SETUPTOOLS = PYPROJECT["tool"]["setuptools"]
 EXTRA_OF = {
     "jik": None,
     "cli": None,
+    "docs": None,
     "engine": None,
     "app": "app",
     "static": "app",

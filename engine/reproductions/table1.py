@@ -153,7 +153,7 @@ def format_text(result: dict) -> str:
         out.append("")
     out.append("Rows: x0 = (0, 0, pi/2) (task point (0, 1)), then after the legs to (1,1), (1,2),")
     out.append("(0,2), (0,1). The extended column of the paper is not reproduced by (38): see")
-    out.append("docs/paper-errata.md.")
+    out.append("docs/paper-errata.md (`jik errata` prints it).")
     return "\n".join(out)
 
 

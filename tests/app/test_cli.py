@@ -2,12 +2,15 @@
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from jik.cli import main
 from jik.engine.reproductions.table1 import PRINTED
+
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def run_cli(capsys, *argv):
@@ -31,6 +34,13 @@ def test_table1_text_has_both_columns_and_printed_values(capsys):
     # Rows D and A of the extended column have x2 = 0 up to round-off (about -1e-16), printed
     # as a zero without a sign.
     assert "-0.0000" not in out and " 0.0000" in out
+
+
+def test_errata_prints_the_errata_page(capsys):
+    """``jik errata`` prints docs/paper-errata.md as it is; ``jik reproduce table1`` names both."""
+    out = run_cli(capsys, "errata")
+    assert out == (ROOT / "docs" / "paper-errata.md").read_text(encoding="utf-8")
+    assert "`jik errata`" in run_cli(capsys, "reproduce", "table1")
 
 
 def test_manipulator1_json_contract(capsys):

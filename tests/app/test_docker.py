@@ -6,6 +6,7 @@ from __future__ import annotations
 import shutil
 import subprocess
 import sys
+import tomllib
 from pathlib import Path
 
 import pytest
@@ -32,3 +33,16 @@ def test_dockerfile_contract():
     assert user and user[-1].split()[1].split(":")[0] not in ("0", "root")
     ignored = (ROOT / ".dockerignore").read_text().split()
     assert ".git" in ignored and "tests" in ignored
+
+
+def test_the_build_context_holds_every_folder_the_wheel_ships():
+    """The image builds its wheel from what .dockerignore leaves of the context: a folder that
+    pyproject.toml maps into the package is either kept or lets its package's files through
+    (docs/: the errata the wheel ships)."""
+    setuptools = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+    ignored = (ROOT / ".dockerignore").read_text().split()
+    for package, folder in setuptools["package-dir"].items():
+        if folder not in ignored:
+            continue
+        shipped = ["__init__.py", *setuptools["package-data"].get(package, [])]
+        assert all(f"!{folder}/{name}" in ignored for name in shipped), (folder, shipped)
