@@ -15,3 +15,9 @@ export const el = (tag, attrs = {}, ...children) => {
 // A number as shown beside a control or in the verdict: 3 decimals, exponent when tiny or huge.
 export const fmt = (v, d = 3) =>
   (Math.abs(v) >= 1e4 || (Math.abs(v) < 1e-3 && v !== 0) ? v.toExponential(2) : (+v).toFixed(d));
+
+// A server's sentence with each mention of the errata's file as a link to the errata page
+// (/errata), opened beside the dashboard.
+const ERRATA_FILE = "docs/paper-errata.md";
+export const withErrataLinks = (text) => text.split(ERRATA_FILE).flatMap((part, i) => (
+  i ? [el("a", { href: "/errata", target: "_blank", rel: "noopener", className: "errata-link" }, ERRATA_FILE), part] : [part]));

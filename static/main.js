@@ -3,7 +3,7 @@
 // and draws its panels; the 3D scene (iframe, viser) shows and changes the same session.
 import { change, endOnClose, follow, openSession, session, api } from "./api.js";
 import { onNotSent, showControls, showRefusal, showStopped } from "./controls.js";
-import { $, el, fmt } from "./dom.js";
+import { $, el, fmt, withErrataLinks } from "./dom.js";
 import { robotEditor } from "./editor.js";
 import { algorithmKey, applyFunctionals, drawFigures, layoutPanels, markStale, onAhead, setExportNote, showChosen } from "./panels.js";
 import { atlasPanel, atlasState } from "./atlas.js";
@@ -106,7 +106,7 @@ function renderVerdict(msg) {
     const p = el("p", {
       className: [s.role, s.algorithm ? ALGORITHM_CLASS[s.algorithm] || "" : ""].join(" ").trim(),
       dataset: s.algorithm ? { algorithm: s.algorithm } : {},
-    }, s.text);
+    }, ...withErrataLinks(s.text));
     if (s.algorithm) p.style.setProperty("--alg", `var(--${s.algorithm})`);
     return p;
   }));

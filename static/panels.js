@@ -1,6 +1,6 @@
 // The plotly panels: drawn from the figures of a session's results, moved in place when only
 // their data, ranges, title or shapes changed, and drawn ahead (off screen) for a robot switch.
-import { el } from "./dom.js";
+import { el, withErrataLinks } from "./dom.js";
 
 export const PLOT_CONFIG = { responsive: true, displaylogo: false };
 
@@ -76,7 +76,7 @@ function drawTable(div, fig, key) {
   div.replaceChildren(
     el("h3", { className: "table-title" }, title),
     el("div", { className: "table-scroll" }, el("table", {}, el("thead", {}, head), el("tbody", {}, ...body))),
-    ...(meta.notes || []).map((n) => el("p", { className: "table-note" }, n)),
+    ...(meta.notes || []).map((n) => el("p", { className: "table-note" }, ...withErrataLinks(n))),
   );
   panelHead(div, key, false);
 }

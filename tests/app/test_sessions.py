@@ -60,6 +60,21 @@ def test_page_static_files_and_config():
     assert scene.status_code == 200 and "<script" in scene.text
 
 
+def test_the_errata_page_is_the_errata_file_as_html():
+    """GET /errata: docs/paper-errata.md as a page (headings, tables, the commands), linked from
+    the page's About; no script, nothing from another origin."""
+    client = TestClient(create_app())
+    errata = client.get("/errata")
+    assert errata.status_code == 200 and errata.headers["content-type"].startswith("text/html")
+    html = errata.text
+    assert "<title>jik: Paper errata</title>" in html and "<h1>Paper errata</h1>" in html
+    assert "<h2>Table 1 and the cubic (38) (Manipulator 2)</h2>" in html
+    assert "<td>(0.0637, 0.6487, 1.2119)</td>" in html  # (a table of the file, as a table)
+    assert "<code>jik reproduce table1</code>" in html
+    assert "<script" not in html and "http" not in re.sub(r"<a [^>]*>", "", html)
+    assert 'href="/errata"' in client.get("/").text
+
+
 def test_each_session_has_its_own_state(app, client):
     """A change in one session never reaches another; a new one starts from the defaults."""
     one, two = _open(client), _open(client)

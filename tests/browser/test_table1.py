@@ -33,6 +33,13 @@ def test_table1_beside_the_printed_values(tabs):
     expect(table).to_contain_text("Erratum")
     expect(table).to_contain_text("the printed j32, j33 of (39) are not the gradient of (38)")
     expect(table).to_contain_text("Row labels as printed: A, B, C, D, A")
+    # The note's mention of the errata's file opens the errata page beside the dashboard.
+    link = table.locator(".table-note a.errata-link")
+    expect(link).to_have_text("docs/paper-errata.md")
+    with tab.page.context.expect_page() as opened:
+        link.click()
+    expect(opened.value.locator("h1")).to_have_text("Paper errata")
+    opened.value.close()
     table.scroll_into_view_if_needed()
     tab.screenshots("table1")
 

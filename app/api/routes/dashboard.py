@@ -1,4 +1,5 @@
-"""The dashboard page: ``/``, its static files, and the viser client's page for its 3D scene.
+"""The dashboard page: ``/``, its static files, the viser client's page for its 3D scene, and the
+paper's errata (``/errata``, ``docs/paper-errata.md`` as HTML).
 
 ``GET /`` serves ``static/index.html``; plotly.js comes from the installed plotly package and the
 scene's page (``/scene/``) from the installed viser package: nothing is fetched from the network.
@@ -7,14 +8,18 @@ Each tab's state lives in its own session (:mod:`jik.app.api.routes.sessions`).
 
 from __future__ import annotations
 
+from functools import cache
+from html import escape
 from pathlib import Path
 
 import plotly
 import viser
 from fastapi import APIRouter
-from fastapi.responses import FileResponse, JSONResponse, Response
+from fastapi.responses import FileResponse, HTMLResponse, JSONResponse, Response
+from markdown_it import MarkdownIt
 
 from .... import static
+from ....docs import paper_errata
 from ...dashboard.help import page_config
 
 router = APIRouter(tags=["dashboard"])
@@ -55,6 +60,27 @@ async def scene_page() -> FileResponse:
     """The viser client's page; the dashboard frames it with ``?websocket=`` set to its
     session's scene (``/api/sessions/{id}/scene``)."""
     return FileResponse(VISER_CLIENT, media_type="text/html")
+
+
+@cache
+def _errata_page() -> str:
+    text = paper_errata()
+    title = escape(text.partition("\n")[0].lstrip("# ").strip())
+    body = MarkdownIt("commonmark", {"html": False}).enable("table").render(text)
+    return (
+        f'<!doctype html><html lang="en"><head><meta charset="utf-8"><title>jik: {title}</title>'
+        '<meta name="viewport" content="width=device-width, initial-scale=1">'
+        '<link rel="icon" href="/static/favicon.svg">'
+        '<link rel="stylesheet" href="/static/style.css">'
+        f'</head><body class="document"><main>{body}</main></body></html>'
+    )
+
+
+@router.get("/errata", response_class=HTMLResponse, tags=["dashboard"])
+async def errata() -> HTMLResponse:
+    """Where the printed paper and jik disagree, each with the command that shows it: the
+    repository's ``docs/paper-errata.md`` as a page (``jik errata`` prints its Markdown)."""
+    return HTMLResponse(_errata_page())
 
 
 @router.get("/api/dashboard/config")
