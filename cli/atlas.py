@@ -117,12 +117,19 @@ def add_atlas_parser(sub) -> None:
 
 
 def _numbers(text: str, what: str) -> list[float]:
+    from ..engine.exceptions import InvalidInputError
+
     try:
         return [float(t) for t in text.split(",")]
     except ValueError:
-        raise SystemExit(
-            f"jik atlas: {what} must be comma-separated numbers, got {text!r}"
+        raise InvalidInputError(
+            f"{what} must be comma-separated numbers, got {text!r}", _field(what)
         ) from None
+
+
+def _field(option: str) -> str:
+    """The field an option's refusal names: ``param`` of ``--param l``."""
+    return option.lstrip("-").split()[0]
 
 
 def _points(text: str, what: str) -> list[list[float]]:
@@ -170,6 +177,9 @@ def atlas_command(args: argparse.Namespace) -> int:
         return _run(args)
     except InvalidInputError as error:
         return refused("atlas", error)
+    except OSError as error:  # (a Dask scheduler out of reach, an output that cannot be written)
+        sys.stderr.write(f"jik atlas: {error}\n")
+        return 2
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -337,7 +347,9 @@ def _writable(out: Path) -> Path:
 
 
 def _param(text: str) -> tuple[str, float]:
+    from ..engine.exceptions import InvalidInputError
+
     name, eq, value = text.partition("=")
     if not eq:
-        raise SystemExit(f"jik atlas: --param must be NAME=VALUE, got {text!r}")
+        raise InvalidInputError(f"--param must be NAME=VALUE, got {text!r}", "param")
     return name.strip(), _numbers(value, f"--param {name}")[0]

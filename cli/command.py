@@ -87,6 +87,8 @@ def serve(args: argparse.Namespace) -> int:
         from ..app.api.server import PortInUse, run_server
     except ModuleNotFoundError as error:
         return missing_app_extra(error)
+    from ..engine.exceptions import InvalidInputError
+
     problem = listen_problem(args.host, args.port)
     if problem:
         sys.stderr.write(f"jik serve: {problem}\n")
@@ -100,8 +102,8 @@ def serve(args: argparse.Namespace) -> int:
             allowed_hosts=tuple(args.allowed_host),
             forwarded_allow_ips=args.forwarded_allow_ips,
         )
-    except PortInUse as busy:
-        sys.stderr.write(f"jik serve: {busy}\n")
+    except (PortInUse, InvalidInputError) as refused:
+        sys.stderr.write(f"jik serve: {refused}\n")
         return 2
     finally:
         announcer.stop()

@@ -175,6 +175,8 @@ def test_arc_and_sampling_set_the_starts(tmp_path):
         (["--dask", "local:0"], "local Dask cluster is 'local:N'"),
         (["--cycles", "0"], "cycles must be between 1 and 1000, got 0 (field cycles)"),
         (["--arc", "1,2"], "lo <= 0 <= hi"),
+        (["--param", "l"], "--param must be NAME=VALUE, got 'l' (field param)"),
+        (["--arc", "1,a"], "--arc must be comma-separated numbers, got '1,a' (field arc)"),
     ],
 )
 def test_bad_input_exits_2_and_names_it(tmp_path, capsys, extra, text):
@@ -209,9 +211,24 @@ def test_an_out_that_cannot_be_written_is_refused_before_computing(
     assert err.count("\n") == 1 and "Traceback" not in err
 
 
-def test_a_path_that_is_not_numbers_is_refused(tmp_path):
-    with pytest.raises(SystemExit, match="--path must be comma-separated numbers"):
-        main(["atlas", "--path", "1,a; 2,2", "--out", str(tmp_path / "x.json")])
+def test_a_path_that_is_not_numbers_is_refused(tmp_path, capsys):
+    assert main(["atlas", "--path", "1,a; 2,2", "--out", str(tmp_path / "x.json")]) == 2
+    assert "--path must be comma-separated numbers" in capsys.readouterr().err
+
+
+def test_a_dask_scheduler_out_of_reach_is_one_line_and_exit_2(tmp_path, capsys, monkeypatch):
+    """A scheduler that does not answer (Dask's connect timeout, an OSError) is said in one
+    line, not a traceback."""
+    from jik.engine import atlas_backends
+
+    def unreachable(*args, **kwargs):
+        raise OSError("Timed out trying to connect to tcp://nosuchhost:1 after 30 s")
+
+    monkeypatch.setattr(atlas_backends.Dask, "__enter__", unreachable)
+    argv = ["atlas", "--path", TABLE1, "--quiet", "--dask", "nosuchhost:1"]
+    assert main([*argv, "--out", str(tmp_path / "x.json")]) == 2
+    err = capsys.readouterr().err
+    assert err == "jik atlas: Timed out trying to connect to tcp://nosuchhost:1 after 30 s\n"
 
 
 ARM = {

@@ -14,7 +14,7 @@ import socket
 
 import uvicorn
 
-from ..compute.settings import Settings
+from ..compute.settings import read_environment
 from ..dashboard.sessions import SessionStore
 from ..scene import start_scene
 from .factory import create_app
@@ -74,9 +74,11 @@ def run_server(
     ------
     PortInUse
         If the port is taken, before anything is started.
+    InvalidInputError
+        If a ``JIK_*`` variable is not valid (its ``field`` names it), before anything starts.
     """
+    settings = read_environment()  # (once; a bad JIK_* variable is refused by its name)
     sock = bind(host, port, "--port")
-    settings = Settings()  # (the environment, read once)
     app = create_app(settings, allowed_hosts=allowed_hosts)
     # The sessions share the app's compute pool (JIK_WORKERS processes) with the API.
     app.state.sessions = SessionStore(settings, scene_factory=start_scene, pool=app.state.pool)

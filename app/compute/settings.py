@@ -9,8 +9,10 @@ from __future__ import annotations
 import functools
 import os
 
-from pydantic import AliasChoices, Field, field_validator
+from pydantic import AliasChoices, Field, ValidationError, field_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
+
+from ...engine.exceptions import InvalidInputError
 
 
 def cpu_count() -> int:
@@ -84,7 +86,34 @@ class Settings(BaseSettings):
         return tuple(h.strip() for h in self.allowed_hosts.split(",") if h.strip())
 
 
+def environment_variable(name: str) -> str:
+    """The ``JIK_*`` variable of the setting ``name`` (``JIK_BATCH`` of ``batching``)."""
+    field = Settings.model_fields.get(name)
+    alias = field.validation_alias if field else None
+    choices = alias.choices if isinstance(alias, AliasChoices) else []
+    named = [c for c in choices if isinstance(c, str) and c.startswith("JIK_")]
+    return named[0] if named else f"JIK_{name.upper()}"
+
+
+def read_environment() -> Settings:
+    """The settings of the ``JIK_*`` environment variables.
+
+    Raises
+    ------
+    InvalidInputError
+        If a variable's value is not valid; its ``field`` is the variable (``JIK_WORKERS``).
+    """
+    try:
+        return Settings()
+    except ValidationError as error:
+        first = error.errors()[0]
+        variable = environment_variable(str(first["loc"][0]) if first["loc"] else "")
+        raise InvalidInputError(
+            f"{variable}={first.get('input')!r}: {first['msg']}", field=variable
+        ) from None
+
+
 @functools.cache
 def settings() -> Settings:
-    """The settings of the environment, read once."""
-    return Settings()
+    """The settings of the environment, read once (:func:`read_environment`)."""
+    return read_environment()

@@ -120,3 +120,21 @@ def test_serve_on_a_busy_port_says_so_and_names_the_option():
     assert "choose another with --port PORT" in out.stderr
     assert "startup complete" not in out.stdout + out.stderr
     assert "viser" not in out.stdout + out.stderr
+
+
+@pytest.mark.parametrize(
+    ("variable", "value", "said"),
+    [
+        ("JIK_WORKERS", "abc", "JIK_WORKERS='abc': Input should be a valid integer"),
+        ("JIK_TIMEOUT", "-5", "JIK_TIMEOUT='-5': Input should be greater than 0"),
+        ("JIK_BATCH", "maybe", "JIK_BATCH='maybe': Input should be a valid boolean"),
+        ("JIK_WORKER_MEMORY_MB", "x", "JIK_WORKER_MEMORY_MB='x': Input should be a valid integer"),
+    ],
+)
+def test_serve_with_a_bad_setting_names_the_variable(monkeypatch, capsys, variable, value, said):
+    """A JIK_* variable that is not valid is one line naming the variable as the user set it
+    (an alias too), exit status 2, before a port is taken or anything starts."""
+    monkeypatch.setenv(variable, value)
+    assert main(["serve", "--port", "1"]) == 2  # (port 1 is never bound: the setting is first)
+    err = capsys.readouterr().err
+    assert err.startswith(f"jik serve: {said}") and err.count("\n") == 1, err
