@@ -117,14 +117,18 @@ ALGORITHMS: dict[str, AlgorithmSpec] = {
 
 
 def _robot_limits(kinematics: Kinematics, spec: RobotSpec | None, robot: str | None):
-    """The weighted inverse's default limits, finite: the robot's configuration box (a URDF
-    arm's joint ranges, else the catalogue's ``x_range``) narrowed to its declared joint limits
+    """The weighted inverse's default limits: the robot's configuration box (a URDF arm's
+    joint ranges, else the catalogue's ``x_range``) narrowed to its declared joint limits
     (:func:`~jik.engine.limits.robot_limits`, a planar chain's or formula robot's ``limits``) by
-    :func:`~jik.engine.limits.limited_box`; limits finite on every side without a box."""
+    :func:`~jik.engine.limits.limited_box`; limits finite on every side without a box. Finite
+    but for a URDF arm's continuous joints, which have no limits (weight 1)."""
     from .registry import ROBOTS  # the robots' catalogue imports this module
 
     declared = robot_limits(kinematics)
     box = getattr(kinematics, "limits", None)
+    if box is not None and declared is not None:  # (a URDF arm: a continuous joint is free)
+        free = np.all(np.isinf(declared), axis=1)
+        return np.where(free[:, None], declared, limited_box(box, declared))
     if box is None:
         spec = spec or ROBOTS.get(robot or kinematics.name)
         box = getattr(spec, "x_range", None) or None

@@ -418,3 +418,22 @@ def test_a_diverged_posture_run_names_its_gain_beside_gamma():
     res = solve(posture, [0.3, 0.4, 0.5], [1.5, 1.0], mode="discrete", gamma=1.0)
     assert res.status == "diverged"
     assert res.message.endswith("; lower gamma or the posture gain k (20)")
+
+
+@pytest.mark.parametrize("name", ["panda", "iiwa14", "gen3", "ur5e"])
+def test_the_weighted_inverse_runs_from_each_catalogue_arm_s_default_start(name):
+    """The weighted inverse's default limits of a URDF arm: its joint limits, none for a
+    continuous joint (Gen3's joints 1, 3, 5 and 7, whose default start has x3 = pi: a limit
+    there made the catalogue's own default run refuse its start)."""
+    pytest.importorskip("yourdfpy")
+    from jik.engine.robot_spec import robot_from_dict
+
+    robot = robot_from_dict({"name": name})
+    inv = robot.inverse("weighted")
+    free = np.isinf(robot.kinematics.joint_limits).all(axis=1)
+    assert np.isinf(inv.limits[free]).all() and np.isfinite(inv.limits[~free]).all()
+    x0 = np.asarray(robot.spec.default_x0)
+    target = robot.kinematics.forward(x0 + 0.05)
+    res = solve(inv, x0, target)
+    assert res.success, res.message
+    assert name != "gen3" or free.sum() == 4 and math.isclose(x0[2], math.pi)
