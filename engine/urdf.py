@@ -303,20 +303,34 @@ def _unit(axis, name: str) -> FloatArray:
     return a / n
 
 
+def _declared(joint) -> tuple[float, float] | None:
+    """The joint's URDF limits [rad or m], or None for a continuous joint or one whose limits
+    are missing or empty (lower = upper).
+
+    Raises
+    ------
+    InvalidInputError
+        If its lower limit is above its upper one (field ``urdf``, naming the joint).
+    """
+    lim = joint.limit
+    if joint.type == "continuous" or lim is None or lim.lower is None or lim.upper is None:
+        return None
+    lo, hi = float(lim.lower), float(lim.upper)
+    if lo > hi:
+        raise InvalidInputError(
+            f"joint {joint.name!r} has its lower limit {lo:g} above its upper limit {hi:g}",
+            "urdf",
+        )
+    return (lo, hi) if lo < hi else None
+
+
 def _bounds(joint) -> tuple[float, float]:
     """The joint's limits [rad or m]: its URDF limits, unbounded for a continuous joint (or a
     joint whose limits are missing or empty)."""
-    lim = joint.limit
-    if joint.type == "continuous" or lim is None or lim.lower is None or lim.upper is None:
-        return (-math.inf, math.inf)
-    lo, hi = float(lim.lower), float(lim.upper)
-    return (lo, hi) if lo < hi else (-math.inf, math.inf)
+    return _declared(joint) or (-math.inf, math.inf)
 
 
 def _limits(joint) -> tuple[float, float]:
-    """The joint's range [rad or m]: its URDF limits, or (-pi, pi) for a continuous joint."""
-    lim = joint.limit
-    if joint.type == "continuous" or lim is None or lim.lower is None or lim.upper is None:
-        return (-math.pi, math.pi) if joint.type != "prismatic" else (-1.0, 1.0)
-    lo, hi = float(lim.lower), float(lim.upper)
-    return (lo, hi) if lo < hi else (-math.pi, math.pi)
+    """The joint's range [rad or m]: its URDF limits, or (-pi, pi) for a continuous joint
+    ((-1, 1) m for a prismatic one without limits)."""
+    return _declared(joint) or ((-math.pi, math.pi) if joint.type != "prismatic" else (-1.0, 1.0))

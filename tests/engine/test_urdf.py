@@ -142,6 +142,16 @@ def test_repeatability_pseudoinverse_drifts_extended_returns(arm):
             "urdf",
             "DOCTYPE",
         ),
+        (
+            {
+                "end_link": "tool",
+                "urdf": TEXT.replace(
+                    '<limit lower="-2.0" upper="2.0"', '<limit lower="2.0" upper="-2.0"'
+                ),
+            },
+            "urdf",
+            "joint 'shoulder' has its lower limit 2 above its upper limit -2",
+        ),
     ],
 )
 def test_bad_definitions_name_the_field(kwargs, field, text):
