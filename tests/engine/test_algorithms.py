@@ -436,4 +436,4 @@ def test_the_weighted_inverse_runs_from_each_catalogue_arm_s_default_start(name)
     target = robot.kinematics.forward(x0 + 0.05)
     res = solve(inv, x0, target)
     assert res.success, res.message
-    assert name != "gen3" or free.sum() == 4 and math.isclose(x0[2], math.pi)
+    assert name != "gen3" or (free.sum() == 4 and math.isclose(x0[2], math.pi))
