@@ -139,16 +139,18 @@ def default_degree(variables: int, k: int) -> int:
 def arm_augmentations(kin: Kinematics, d: Mapping) -> list:
     """The maps of an arm with a home (a catalogue arm, or a URDF given with ``home``): by
     default, with one degree of redundancy (a 7-joint arm's pose task), one E2-optimal over all
-    its joints, +-ARM_BOX around home within the joint limits. A definition's own maps replace
-    it; an e2_synthesized one of them without a region (a scalar or, for p - r >= 2, a vector
-    map) takes that box."""
+    its joints, +-ARM_BOX around home within the joint limits; a home beyond a limit (accepted,
+    as a start beyond one is) keeps at least ARM_BOX / 2 inside that limit.
+    A definition's own maps replace it; an e2_synthesized one of them without a region (a
+    scalar or, for p - r >= 2, a vector map) takes that box."""
     given = d.get("augmentations", [])
     if not isinstance(given, list):
         return given
     home = np.asarray(d["home"], dtype=float)
     lo, hi = np.asarray(kin.joint_limits, dtype=float).T
+    centre = np.clip(home, lo - ARM_BOX / 2, hi + ARM_BOX / 2)
     box = {
-        n: [float(max(lo[i], home[i] - ARM_BOX)), float(min(hi[i], home[i] + ARM_BOX))]
+        n: [float(max(lo[i], centre[i] - ARM_BOX)), float(min(hi[i], centre[i] + ARM_BOX))]
         for i, n in enumerate(kin.variable_names)
     }
     if "augmentations" not in d:

@@ -243,3 +243,29 @@ def test_the_default_path_is_a_loop_the_pseudoinverse_drifts_on(name, task):
     inverse = make_inverse(robot.kinematics, "pseudoinverse")
     run = repeatability(inverse, spec.default_x0, spec.default_path, 1, mode="continuous")
     assert run.drift[-1] > 1e-6
+
+
+@pytest.mark.parametrize(
+    ("home1", "box1"),
+    [
+        (0.0, [-0.3, 0.3]),  # (+-ARM_BOX around home)
+        (2.8, [2.5, 2.8973]),  # (cut at the limit 2.8973)
+        (2.9, [2.6, 2.8973]),  # (home beyond the limit by less than ARM_BOX / 2)
+        (10.0, [2.7473, 2.8973]),  # (far beyond: ARM_BOX / 2 inside the limit)
+        (-10.0, [-2.8973, -2.7473]),
+    ],
+)
+def test_an_arm_s_synthesis_box_lies_within_its_limits_wherever_its_home(home1, box1):
+    """An arm's default map is synthesized on +-ARM_BOX around its home within the joint
+    limits; a home beyond a limit (accepted) keeps ARM_BOX / 2 inside it: a home 10 rad past
+    the Panda's first limit was refused as an empty region of its map ('augmentation.region')."""
+    from jik.engine.robot_synthesis import arm_augmentations
+
+    home = [home1, 0, 0, -1, 0, 1, 0]
+    kin = robot_from_dict(
+        {"name": "panda", "home": home, "augmentations": [{"name": "formula", "h": "x1"}]}
+    ).kinematics
+    (item,) = arm_augmentations(kin, {"home": home})
+    np.testing.assert_allclose(item["region"]["x1"], box1, atol=1e-12)
+    assert item["region"]["x2"] == pytest.approx([-0.3, 0.3])
+    assert robot_from_dict({"name": "panda", "home": home}).kinematics.home[0] == home1
