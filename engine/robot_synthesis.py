@@ -168,8 +168,15 @@ def arm_augmentations(kin: Kinematics, d: Mapping) -> list:
 def missing_map(name: str, p: int, r: int, arm: bool) -> str:
     """What the extended inverse (11) of a robot without an augmenting map needs: p - r maps h
     (eq. (9)), a formula or an E2 synthesis; an arm with a home (``arm``) has one by default
-    only for p = r + 1 (:func:`arm_augmentations`). ``name``: the robot's kind or name."""
+    only for p = r + 1 (:func:`arm_augmentations`); a robot with p = r has no room for one.
+    ``name``: the robot's kind or name."""
     k = p - r
+    if k == 0:
+        return (
+            f"the extended inverse needs redundancy (p > r), and this {name} has p = r = {p}: "
+            "its Jacobian is square, so no augmenting map can be added; choose another "
+            "algorithm (the pseudoinverse is then J^-1)"
+        )
     if k == 1:
         return (
             "the extended inverse needs an augmenting map: {'name': 'formula', 'h': ...} or "

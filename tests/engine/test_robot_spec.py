@@ -171,6 +171,21 @@ def test_a_builtin_robots_defaults_given_in_its_definition_are_used_and_checked(
         assert err.value.field == key
 
 
+def test_a_chain_without_redundancy_runs_but_its_extended_inverse_says_why_not():
+    """p = r (a 2R chain in the plane): the pseudoinverse is J^-1 and runs; the extended inverse
+    has no room for a map, and says so instead of asking for 'p - r = 0' maps."""
+    robot = robot_from_dict({"name": "planar_chain", "joints": "RR", "lengths": [1, 1]})
+    x0 = np.array([0.3, 0.5])
+    assert solve(robot.inverse("pseudoinverse"), x0, robot.kinematics.forward(x0 + 0.1)).success
+    with pytest.raises(
+        InvalidInputError,
+        match=r"needs redundancy \(p > r\), and this "
+        r"planar_chain has p = r = 2",
+    ) as err:
+        robot.inverse("extended")
+    assert err.value.field == "augmentation" and "0 augmenting maps" not in str(err.value)
+
+
 def test_more_than_one_degree_of_redundancy_takes_a_vector_of_formula_maps():
     chain = {
         "name": "planar_chain",
