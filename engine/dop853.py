@@ -217,8 +217,10 @@ def _combine(weights: FloatArray, K: FloatArray) -> FloatArray:
 
 
 def integrate(inverse, x0, y_d, tol, max_steps, record, tau0, rtol=RTOL, atol=ATOL):
-    """Batched DOP853 on dx/dtau = -J# e from tau = tau0 until ||e|| < tol."""
+    """Batched DOP853 on dx/dtau = -J# e from tau = tau0 until ||e|| < tol, at most
+    ``max_steps`` steps (an int, or one per member: shape (n,))."""
     n, p = x0.shape
+    cap = np.broadcast_to(np.asarray(max_steps), (n,))
     x = x0.copy()
     tau = tau0.copy()
     f, e, bad = _rhs(inverse, x, y_d)
@@ -294,5 +296,5 @@ def integrate(inverse, x0, y_d, tol, max_steps, record, tau0, rtol=RTOL, atol=AT
         plateau_tau[due] = tau[due] + PLATEAU_TAU
         plateau_err[due], plateau_x[due] = err_now[due], x[due]
         status[run[np.linalg.norm(x[run], axis=-1) > DIVERGED_NORM]] = Status.DIVERGED
-        status[run[(nsteps[run] >= max_steps) & (status[run] == Status.RUNNING)]] = Status.MAX_STEPS
+        status[run[(nsteps[run] >= cap[run]) & (status[run] == Status.RUNNING)]] = Status.MAX_STEPS
     return x, tau, status, nsteps, rec

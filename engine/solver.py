@@ -43,7 +43,8 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto", guess=N
 
     Members that Picard integrates to sigma = 1 with error < tol are done. The others (an
     unresolved path near a singularity, or an end-point error above a very small tol) continue
-    with DOP853 on (7) itself from their last point, at tau = -ln(1 - sigma) (or ln(e0 / e)).
+    with DOP853 on (7) itself from their last point, at tau = -ln(1 - sigma) (or ln(e0 / e)),
+    for the steps that Picard's sweeps left of ``max_steps``.
     """
     n = len(x0)
     if not inverse.right_inverse:
@@ -97,10 +98,15 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto", guess=N
     good = done & (err1 < tol)
     if rec is not None:
         rec.append((moving[good], tau_end[good], x1[good]))
-    rest = moving[~good]
+    # The cap counts Picard's sweeps and DOP853's steps together: DOP853 gets what is left.
+    left = max_steps - sweeps
+    spent = ~good & (left <= 0)
+    status[moving[spent]] = Status.MAX_STEPS
+    more = ~good & ~spent
+    rest = moving[more]
     if rest.size:
         xr, taur, st, steps, rrec = integrate(
-            inverse, x1[~good], y_d[rest], tol, max_steps, record, tau_end[~good]
+            inverse, x1[more], y_d[rest], tol, left[more], record, tau_end[more]
         )
         x[rest], tau[rest], status[rest] = xr, taur, st
         nit[rest] += steps

@@ -203,6 +203,22 @@ def test_iteration_cap_gives_failure_with_message():
     assert solve(Pseudoinverse(Manipulator2()), X0, [1, 1]).status == "converged"
 
 
+@pytest.mark.parametrize("cap", [1, 3, 10])
+def test_the_continuous_cap_counts_picard_sweeps_and_dop853_steps_together(cap):
+    """max_iterations caps a continuous solve's steps (Picard's sweeps, then DOP853's steps
+    for the members Picard leaves): 40 seeded targets of Manipulator 2, none past the cap, and
+    the message counts what nit says (DOP853 got a cap of its own: nit reached twice it)."""
+    rng = np.random.default_rng(5)
+    targets = rng.uniform(-1.5, 1.5, (40, 2))
+    for inv in (Pseudoinverse(Manipulator2()), ExtendedInverse(Manipulator2(), PaperCubic())):
+        batch = solve_batch(inv, np.tile(X0, (40, 1)), targets, max_iterations=cap)
+        nit = np.array([r.nit for r in batch])
+        assert nit.max() <= cap
+        stopped = [r for r in batch if r.status == "max_steps"]
+        assert stopped and all(r.nit == cap for r in stopped)
+        assert all(f"within {cap} step" in r.message for r in stopped)
+
+
 def test_unreachable_pass_through_algorithmic_singularity_stops_with_message():
     """(36) with a = 1, b = 0 is singular on x1 = 0: driving x1 across 0 must stop, not hang;
     where it stops, h is defined and [J; dh] singular: status "singular", not "undefined"."""
