@@ -45,9 +45,16 @@ def loop_joints(kin: Kinematics, x0: np.ndarray, step: np.ndarray) -> tuple[int,
     return int(min(i, j)), int(max(i, j))
 
 
+#: Points of a Halton sequence over the box tried as the default start of a robot whose task is
+#: undefined at the box's centre (``log(x1 - 1)`` at x1 = 0.5).
+START_CANDIDATES = 256
+
+
 def defaults(kin: Kinematics, d: Mapping, box, base: RobotSpec | None = None) -> tuple:
-    """x0 (given, else a URDF arm's home if given, else 0.5 in each range), a target and a
-    closed path reachable from it; a built-in robot's (``base``) where its definition has none."""
+    """x0 (given, else a URDF arm's home if given, else 0.5 in each range, or where the task is
+    undefined there or along the default path, the first point of a Halton sequence over the
+    box where it is defined), a target and a closed path reachable from it; a built-in robot's
+    (``base``) where its definition has none."""
     lo, hi = np.array(box).T
     if "x0" in d:
         x0 = points(d["x0"], kin.p, "x0")
@@ -62,22 +69,25 @@ def defaults(kin: Kinematics, d: Mapping, box, base: RobotSpec | None = None) ->
     if base is not None:
         target, path = d.get("target", base.default_target), d.get("path", base.default_path)
     else:
-        with np.errstate(all="ignore"):
-            y0 = kin.forward(x0)
-        if not np.isfinite(y0).all() and not ("target" in d and "path" in d):
-            k = int(np.flatnonzero(~np.isfinite(y0))[0])
+        step = 0.15 * np.minimum(1.0, hi - lo)
+        task = _default_task(kin, x0, step)
+        if task is None and "x0" not in d and "home" not in d:
+            x0, task = _defined_start(kin, lo, hi, step, x0)
+        if task is None and not ("target" in d and "path" in d):
+            with np.errstate(all="ignore"):
+                y0 = kin.forward(x0)
+            bad = np.flatnonzero(~np.isfinite(y0))
+            where = f" (k{bad[0] + 1} = {y0[bad[0]]:g})" if bad.size else " or near it"
+            searched = (
+                "" if "x0" in d or "home" in d else f" or at {START_CANDIDATES} points of x_range"
+            )
             raise InvalidInputError(
-                f"the task k(x0) is undefined at x0 = ({', '.join(f'{v:g}' for v in x0)}) "
-                f"(k{k + 1} = {y0[k]:g}): give an x0 where it is defined",
+                f"the task k(x) is undefined at x0 = ({', '.join(f'{v:g}' for v in x0)})"
+                f"{where}{searched}: give an x0 where it is defined",
                 "x0",
             )
-        step = 0.15 * np.minimum(1.0, hi - lo)
-        i, j = loop_joints(kin, x0, step)
-        moves = np.zeros((3, kin.p))
-        moves[0, i] = moves[1, i] = step[i]
-        moves[1, j] = moves[2, j] = step[j]
-        target = d.get("target", kin.forward(x0 + moves[1]))
-        path = d.get("path", kin.forward(x0 + moves))
+        target = d.get("target", task[1] if task is not None else None)
+        path = d.get("path", task if task is not None else None)
     target, path = points(target, kin.r, "target"), points(path, kin.r, "path")
     if target.ndim != 1:
         raise InvalidInputError(f"target must be one task point ({kin.r} numbers)", "target")
@@ -86,6 +96,36 @@ def defaults(kin: Kinematics, d: Mapping, box, base: RobotSpec | None = None) ->
             f"path must be a list of 1 to {MAX_PATH_POINTS} task points", "path"
         )
     return tuple(x0.tolist()), tuple(target.tolist()), tuple(map(tuple, path.tolist()))
+
+
+def _default_task(kin: Kinematics, x0: np.ndarray, step: np.ndarray) -> np.ndarray | None:
+    """The default closed path from ``x0`` (shape (3, r): the moves of two joints by ``step``,
+    :func:`loop_joints`; its second point is the default target), or None where the task is
+    undefined at x0 or on the path."""
+    with np.errstate(all="ignore"):
+        if not np.isfinite(kin.forward(x0)).all():
+            return None
+        i, j = loop_joints(kin, x0, step)
+        moves = np.zeros((3, kin.p))
+        moves[0, i] = moves[1, i] = step[i]
+        moves[1, j] = moves[2, j] = step[j]
+        path = kin.forward(x0 + moves)
+    return path if np.isfinite(path).all() else None
+
+
+def _defined_start(kin, lo, hi, step, centre) -> tuple[np.ndarray, np.ndarray | None]:
+    """The first of :data:`START_CANDIDATES` Halton points over the box [lo, hi] where the task
+    and its default path are defined, with that path; ``centre`` and None where none is."""
+    from scipy.stats import qmc
+
+    candidates = lo + (hi - lo) * qmc.Halton(kin.p, scramble=False).random(START_CANDIDATES)
+    with np.errstate(all="ignore"):
+        defined = np.isfinite(kin.forward(candidates)).all(axis=-1)
+    for x0 in candidates[defined]:  # (the first usually is; only a robot the centre failed)
+        task = _default_task(kin, x0, step)
+        if task is not None:
+            return x0, task
+    return centre, None
 
 
 #: sigma_min / sigma_max of J's columns of the joints h leaves free, at x0, above which the

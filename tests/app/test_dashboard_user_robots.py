@@ -95,12 +95,13 @@ def test_a_definition_is_state_with_its_defaults_and_a_map():
                 "robot": "formula",
                 "robot_definition": {
                     "name": "formula",
-                    "task": ["sqrt(x1 - 1)", "x2 + x3"],
+                    "task": ["sqrt(x1 - 10)", "x2 + x3"],
                     "variables": ["x1", "x2", "x3"],
                 },
             },
             "robot_definition.x0",
-            "the task k(x0) is undefined at x0 = (0.5, 0.5, 0.5) (k1 = nan)",
+            "the task k(x) is undefined at x0 = (0.5, 0.5, 0.5) (k1 = nan) or at 256 points of "
+            "x_range",
         ),
     ],
 )

@@ -171,6 +171,18 @@ def test_a_builtin_robots_defaults_given_in_its_definition_are_used_and_checked(
         assert err.value.field == key
 
 
+def test_a_task_undefined_at_the_box_centre_starts_where_it_is_defined():
+    """log(a - 1) is undefined at a = 0.5: the default start is the first point of a Halton
+    sequence over x_range where the task and its default path are (it was refused, asking for
+    an x0 the REST API's robot has no place for); a given x0 there is still refused."""
+    d = {"name": "formula", "variables": ["a", "b"], "task": ["log(a - 1)"]}
+    spec = robot_from_dict(d).spec
+    assert spec.default_x0[0] > 1 and np.isfinite(spec.default_path).all()
+    assert spec.default_x0 == robot_from_dict(d).spec.default_x0  # (deterministic)
+    with pytest.raises(InvalidInputError, match=r"undefined at x0 = \(0, 0\) \(k1 = nan\): "):
+        robot_from_dict({**d, "x0": [0, 0]})
+
+
 def test_a_chain_without_redundancy_runs_but_its_extended_inverse_says_why_not():
     """p = r (a 2R chain in the plane): the pseudoinverse is J^-1 and runs; the extended inverse
     has no room for a map, and says so instead of asking for 'p - r = 0' maps."""
