@@ -66,6 +66,7 @@ def as_points(x, size: int, name: str, field: str | None = None) -> FloatArray:
         On a wrong trailing dimension or a NaN/inf entry, naming ``name`` (field:
         :func:`field_for`).
     """
+    _check_point_sizes(x, size, name, field)
     a = as_numbers(x, name, field)
     if a.ndim == 0 or a.shape[-1] != size:
         raise InvalidInputError(
@@ -78,6 +79,22 @@ def as_points(x, size: int, name: str, field: str | None = None) -> FloatArray:
             f"{name} contains NaN or infinite values; give finite numbers", field_for(name, field)
         )
     return a
+
+
+def _check_point_sizes(x, size: int, name: str, field: str | None) -> None:
+    """A list of points whose sizes differ: the first point of another size than ``size``,
+    named (``path[1] must have 2 numbers``) rather than the list called not numeric."""
+    if not isinstance(x, list | tuple) or not all(isinstance(p, list | tuple) for p in x):
+        return
+    if len({len(p) for p in x}) < 2:  # (one size for all: the shape's own message)
+        return
+    for i, point in enumerate(x):
+        if len(point) != size:
+            base = field_for(name, field)
+            raise InvalidInputError(
+                f"{name}[{i}] must have {size} numbers, got {len(point)}",
+                None if base is None else f"{base}.{i}",
+            )
 
 
 def as_vector(x, size: int, name: str, field: str | None = None) -> FloatArray:

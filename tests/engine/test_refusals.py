@@ -319,6 +319,14 @@ def test_a_refused_argument_is_the_errors_field(case):
     assert info.value.field == field, str(info.value)
 
 
+def test_a_path_point_of_another_size_is_named_with_its_index():
+    """A path whose points differ in size names the first point of the wrong size (it was
+    called "not numeric", quoting the whole path)."""
+    with pytest.raises(InvalidInputError, match=r"^path\[1\] must have 2 numbers, got 3$") as e:
+        jik.repeatability(P, X0, [(1, 1), (1, 2, 3)])
+    assert e.value.field == "path.1"
+
+
 def test_plan_atlas_names_both_missing_arguments():
     """n_starts alone: the message names arc and reference, and what each is."""
     with pytest.raises(InvalidInputError) as info:
