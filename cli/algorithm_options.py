@@ -31,8 +31,41 @@ def add_algorithm_parameter_options(p: argparse.ArgumentParser) -> None:
     )
 
 
+#: Each algorithm option's destination and its flag.
+OPTIONS = {
+    "damping": "--damping",
+    "damping_threshold": "--damping-threshold",
+    "gain": "--gain",
+    "rest": "--rest",
+    "limits": "--limits",
+}
+
+
+def refuse_unused_options(args: argparse.Namespace, algorithms: list[str]) -> None:
+    """Refuse an algorithm option given that none of the chosen ``algorithms`` takes (as the
+    REST API refuses an unknown parameter): ``--damping`` with the pseudoinverse alone."""
+    from ..engine.exceptions import InvalidInputError
+    from ..engine.registry import ALGORITHMS
+
+    for dest, flag in OPTIONS.items():
+        if getattr(args, dest, None) is None:
+            continue
+        takers = [
+            name
+            for name, spec in ALGORITHMS.items()
+            if dest in spec.vectors or dest in {p.name for p in spec.parameters}
+        ]
+        if not set(takers) & set(algorithms):
+            raise InvalidInputError(
+                f"{flag} is a parameter of {' and '.join(takers)}, not of "
+                f"{', '.join(algorithms)}: choose it with --algorithm {takers[0]}",
+                dest,
+            )
+
+
 def algorithm_parameters(args: argparse.Namespace, algorithm: str) -> dict:
-    """The options given that belong to ``algorithm`` (the others are ignored for it); without
+    """The options given that belong to ``algorithm`` (the others are another chosen
+    algorithm's: :func:`refuse_unused_options` refuses those no chosen one takes); without
     ``--rest``, the posture inverse's rest is the engine's default (``Robot.inverse``'s
     ``x0``)."""
     from ..engine.registry import ALGORITHMS

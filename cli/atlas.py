@@ -34,6 +34,7 @@ from .algorithm_options import (
     ALGORITHM_NAMES,
     add_algorithm_parameter_options,
     algorithm_parameters,
+    refuse_unused_options,
 )
 from .atlas_output import CsvWriter, Gathered, write_figure
 from .robot_commands import add_task_option, refused, robot_with_task
@@ -133,7 +134,11 @@ def _field(option: str) -> str:
 
 
 def _points(text: str, what: str) -> list[list[float]]:
-    return [_numbers(t, what) for t in text.split(";") if t.strip()]
+    """``"1,1; 1,2"`` -> [[1, 1], [1, 2]]; a trailing ``;`` ends the list."""
+    points = text.split(";")
+    if len(points) > 1 and not points[-1].strip():
+        points.pop()
+    return [_numbers(t, what) for t in points]
 
 
 def backend_option(args: argparse.Namespace) -> str:
@@ -195,6 +200,7 @@ def _run(args: argparse.Namespace) -> int:
 
     out = _writable(Path(args.out))
     algorithms = args.algorithm or ["pseudoinverse"]
+    refuse_unused_options(args, algorithms)
     # a user's robot or a catalogue arm (--task given: it must be one)
     if args.task is not None or Path(args.robot).is_file() or args.robot in ARMS:
         robot = robot_with_task(args.robot, args.task)
@@ -221,9 +227,11 @@ def _run(args: argparse.Namespace) -> int:
             )
             for a in algorithms
         ]
-    path = _points(args.path, "--path") if args.path else spec.default_loop("--path")
-    arc = _numbers(args.arc, "--arc") if args.arc else [-MAX_ARC, MAX_ARC]
-    reference = _numbers(args.reference, "--reference") if args.reference else spec.default_x0
+    path = _points(args.path, "--path") if args.path is not None else spec.default_loop("--path")
+    arc = _numbers(args.arc, "--arc") if args.arc is not None else [-MAX_ARC, MAX_ARC]
+    reference = (
+        _numbers(args.reference, "--reference") if args.reference is not None else spec.default_x0
+    )
     backend = backend_option(args)
     backend_for(backend)  # (a bad option fails here, before the curves are traced)
     plan = plan_atlas(
@@ -270,7 +278,7 @@ def _run(args: argparse.Namespace) -> int:
         "starts": N,
         "sampling": args.sampling,
         "seed": args.seed,
-        "arc": arc if args.arc else None,
+        "arc": arc if args.arc is not None else None,
         "reference": list(reference),
         "shifts": [_numbers(t, "--shift") for t in args.shift],
         "scales": args.scale or [1.0],

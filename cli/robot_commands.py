@@ -19,6 +19,7 @@ from .algorithm_options import (
     ALGORITHM_NAMES,
     add_algorithm_parameter_options,
     algorithm_parameters,
+    refuse_unused_options,
 )
 
 if TYPE_CHECKING:
@@ -38,8 +39,11 @@ def _split(text: str, sep: str) -> list[str]:
 
 def parse_vector(text: str, option: str) -> list[float]:
     """``"0, 0, pi/2"`` -> [0.0, 0.0, 1.5707963267948966]; each entry a constant formula."""
+    from ..engine.exceptions import InvalidInputError
     from ..engine.formula import parse_formula
 
+    if not text.strip():
+        raise InvalidInputError(f"{option} is empty: give numbers 'a, b, ...'", option)
     out = []
     for i, part in enumerate(_split(text, ",")):
         value = parse_formula(part.strip(), {}, f"{option}[{i}]")
@@ -48,8 +52,12 @@ def parse_vector(text: str, option: str) -> list[float]:
 
 
 def parse_path(text: str, option: str) -> list[list[float]]:
-    """``"1,1; 1,2; 0,2"`` -> [[1, 1], [1, 2], [0, 2]]."""
-    return [parse_vector(p, f"{option}[{i}]") for i, p in enumerate(_split(text, ";")) if p.strip()]
+    """``"1,1; 1,2; 0,2"`` -> [[1, 1], [1, 2], [0, 2]]; a trailing ``;`` ends the path, an empty
+    point elsewhere is refused (naming it)."""
+    points = _split(text, ";")
+    if len(points) > 1 and not points[-1].strip():
+        points.pop()
+    return [parse_vector(p, f"{option}[{i}]") for i, p in enumerate(points)]
 
 
 def add_task_option(p: argparse.ArgumentParser) -> None:
@@ -101,7 +109,7 @@ def _common(p: argparse.ArgumentParser) -> None:
 
 def _setup(args: argparse.Namespace) -> tuple[Robot, list[float], dict]:
     robot = robot_with_task(args.robot, args.task)
-    x0 = parse_vector(args.x0, "--x0") if args.x0 else list(robot.spec.default_x0)
+    x0 = parse_vector(args.x0, "--x0") if args.x0 is not None else list(robot.spec.default_x0)
     settings = {
         "mode": args.mode or robot.spec.default_mode,
         "gamma": args.gamma if args.gamma is not None else robot.spec.default_gamma,
@@ -130,6 +138,7 @@ def _fmt(v) -> str:
 def _inverse(robot, args: argparse.Namespace, x0):
     """The inverse the command line asks for (the posture's default rest: the robot's home,
     else x0)."""
+    refuse_unused_options(args, [args.algorithm])
     return robot.inverse(
         args.algorithm,
         args.augmentation,
@@ -164,7 +173,11 @@ def solve_command(args: argparse.Namespace) -> int:
     from ..engine.solver import solve
 
     robot, x0, settings = _setup(args)
-    target = parse_vector(args.target, "--target") if args.target else robot.spec.default_target
+    target = (
+        parse_vector(args.target, "--target")
+        if args.target is not None
+        else robot.spec.default_target
+    )
     res = solve(_inverse(robot, args, x0), x0, target, record=True, **settings)
     report = _limits(robot, lambda limits, names: solve_report(limits, res, names))
     _document(robot, res, report, args.json)
@@ -184,7 +197,11 @@ def repeatability_command(args: argparse.Namespace) -> int:
     from ..engine.units import norm_unit
 
     robot, x0, settings = _setup(args)
-    path = parse_path(args.path, "--path") if args.path else robot.spec.default_loop("--path")
+    path = (
+        parse_path(args.path, "--path")
+        if args.path is not None
+        else robot.spec.default_loop("--path")
+    )
     inverse = _inverse(robot, args, x0)
     record = robot_limits(robot.kinematics) is not None  # (limits: check whole legs)
     rep = repeatability(inverse, x0, path, cycles=args.cycles, record=record, **settings)

@@ -197,11 +197,31 @@ def test_urdf_robot_from_a_yaml_file(capsys, tmp_path):
         (["--x0", "0, x1, 0"], "--x0[1]: unknown name 'x1'"),
         (["--target", "1, 2, 3"], "target y_d must have shape (..., 2)"),
         (["--algorithm", "extended", "--augmentation", "nope"], "unknown augmentation 'nope'"),
+        (["--x0", ""], "--x0 is empty: give numbers"),
+        (
+            ["--damping", "1"],
+            "--damping is a parameter of damped, not of pseudoinverse: choose it with "
+            "--algorithm damped (field damping)",
+        ),
+        (["--algorithm", "damped", "--gain", "2"], "--gain is a parameter of posture, not of"),
     ],
 )
 def test_bad_input_exits_2_with_the_message(capsys, arm_file, argv, message):
     _, err = run(capsys, "solve", "--robot", arm_file, *argv, code=2)
     assert err.startswith("jik solve: ") and message in err
+
+
+@pytest.mark.parametrize(
+    ("path", "message"), [("1,1;;1,2;0,2", "--path[1] is empty"), ("", "--path[0] is empty")]
+)
+def test_an_empty_path_point_is_refused_and_a_trailing_semicolon_ends_the_path(
+    capsys, path, message
+):
+    _, err = run(capsys, "repeatability", "--robot", "manipulator2", "--path", path, code=2)
+    assert message in err
+    path = ["--path", "1,1; 1,2; 0,2; 0,1;"]
+    out, _ = run(capsys, "repeatability", "--robot", "manipulator2", *path, "--json")
+    assert json.loads(out)["targets"] == [[1, 1], [1, 2], [0, 2], [0, 1]]
 
 
 def test_unknown_robot_exits_2(capsys):
