@@ -243,3 +243,15 @@ def test_an_arm_without_a_map_for_its_task_is_told_the_map_that_works(api):
     assert ok.json()["augmentation"]["definition"]["region"].keys() == {
         f"x{i}" for i in range(1, 8)
     }
+
+
+def test_each_arm_s_schema_says_its_own_default_task():
+    """The catalogue arms' request models reuse the URDF robot's field texts; their task's says
+    the arm's default (pose; the UR5e's x y z rx ry), not a URDF's (xyz)."""
+    from jik.app.compute.schemas.robots import USER_ROBOT_MODELS
+    from jik.engine.arms import ARMS
+
+    for arm in ARMS.values():
+        model = USER_ROBOT_MODELS[arm.name]
+        task = model.model_fields["task"]
+        assert task.default == arm.task and task.description.endswith(f"(default {arm.task})")

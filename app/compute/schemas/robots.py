@@ -265,9 +265,12 @@ def _arm_model(arm: Arm) -> type[BaseModel]:
     fields: dict[str, Any] = {"name": (Literal[arm.name], ...)}
     for key in ("task", "reference", "home", "title"):
         info = UrdfRobot.model_fields[key]
+        text = info.description or ""
+        if key == "task":  # (a URDF's default task is xyz; the arm's is its own)
+            text = text.replace("(default xyz)", f"(default {arm.task})")
         fields[key] = (
             info.annotation,
-            Field(arm.task if key == "task" else None, description=info.description),
+            Field(arm.task if key == "task" else None, description=text),
         )
     return create_model(
         f"{_camel(arm.name)}Arm",
