@@ -140,7 +140,7 @@ class UrdfChain(Kinematics):
         for i, name in enumerate(active):
             if name not in movable:
                 raise InvalidInputError(
-                    f"active_joints[{i}] = {name!r} is not a movable joint on the chain from "
+                    f"active_joints[{i}]: {name!r} is not a movable joint on the chain from "
                     f"{self.base_link!r} to {end_link!r}; those are {movable}",
                     f"active_joints.{i}",
                 )

@@ -283,6 +283,14 @@ def test_a_robot_past_the_joint_cap_is_refused_by_the_cap(api, path):
     )
 
 
+def test_an_unknown_active_joint_is_named_with_its_value(api):
+    """The engine's "active_joints[0]: 'j9' is not ..." loses its field's prefix to the
+    request's, and keeps nothing of it ("robot.active_joints[0]: = 'j9'" before)."""
+    robot = {"name": "urdf", "urdf": _chain_urdf(3), "end_link": "l3", "active_joints": ["j9"]}
+    (msg,) = messages(api.post("/kinematics", json={"robot": robot, "x": [0.1]}))
+    assert msg.startswith("robot.active_joints[0]: 'j9' is not a movable joint on the chain")
+
+
 def test_a_missing_atlas_job_says_why_it_is_missing(api):
     """An id of an earlier server process is a job lost in the restart; one of this server's
     was cancelled or dropped; anything else was never an id (all were answered "it was
