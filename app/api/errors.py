@@ -21,7 +21,9 @@ messages of validation errors are written by :mod:`jik.app.api.validation`.
 
 from __future__ import annotations
 
+import json
 import logging
+import sys
 from collections.abc import Callable
 from typing import Any
 
@@ -76,6 +78,9 @@ def unparsed_body_response(exc: Exception) -> JSONResponse:
         why = "its arrays or objects are nested too deep"
     elif isinstance(cause, UnicodeDecodeError):
         why = "it is not UTF-8 text"
+    elif isinstance(cause, ValueError) and not isinstance(cause, json.JSONDecodeError):
+        # (json's one other error: Python's bound on converting a long integer)
+        why = f"it holds an integer of more than {sys.get_int_max_str_digits()} digits"
     else:
         why = "it is not valid JSON"
     return _refused(["body"], f"body: the body cannot be read as JSON: {why}", "json_invalid")

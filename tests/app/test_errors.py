@@ -231,7 +231,11 @@ def test_bad_session_changes_are_422_naming_the_field(api):
 
 @pytest.mark.parametrize(
     ("body", "says"),
-    [(b'{"robot": ', "not valid JSON at character 10"), (b'{"robot": "\xff"}', "not UTF-8")],
+    [
+        (b'{"robot": ', "not valid JSON at character 10"),
+        (b'{"robot": "\xff"}', "not UTF-8"),
+        (b'{"cycles": ' + b"1" * 5000 + b"}", "it holds an integer of more than 4300 digits"),
+    ],
 )
 def test_a_body_that_is_not_json_says_why(api, body, says):
     """(FastAPI answered these with an undocumented 400 'There was an error parsing the body'.)"""
