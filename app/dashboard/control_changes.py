@@ -134,15 +134,23 @@ def path_format(size: int | None = None) -> str:
     return f"{point}; {point}; ..."
 
 
+#: Characters of a user's text a refusal quotes (a longer text is cut, with "...").
+QUOTED = 60
+
+
+def _quoted(text: str) -> str:
+    return text if len(text) <= QUOTED else f"{text[: QUOTED - 3]}..."
+
+
 def parse_path_text(text: str, size: int | None = None) -> list[list[float]]:
     """The points of a path written as :func:`path_format`, a new line separating points as a
     ';' does; ``size``: the task's dimension, which every point must have. A refusal quotes the
-    point as the user wrote it."""
+    point as the user wrote it (its first :data:`QUOTED` characters)."""
     points = []
     parts = [p for p in re.split(r"[;\n]", text) if p.strip()]
     written = path_format(size)
     for k, part in enumerate(parts, start=1):
-        where = f"point {k} of {len(parts)}, '{part.strip()}',"
+        where = f"point {k} of {len(parts)}, '{_quoted(part.strip())}',"
         try:
             point = [float(v) for v in part.split(",")]
         except ValueError:

@@ -136,7 +136,12 @@ def test_bad_changes_name_their_field_and_leave_the_state(client):
         "msg": "gamma: Input should be greater than or equal to 0.000001",
         "type": "value_error",
     }
-    assert client.post(url, content=b"[1]", headers=JSON).status_code == 422
+    not_an_object = client.post(url, content=b"[1]", headers=JSON)
+    assert not_an_object.status_code == 422
+    assert not_an_object.json()["detail"][0]["loc"] == ["body"]  # (not ["body", "body"])
+    # A refusal quotes what the user wrote, its first 60 characters.
+    long = client.post(url, json={"path": "1," * 5000}).json()["detail"][0]["msg"]
+    assert f"'{'1,' * 28}1...'," in long and len(long) < 200
     assert client.get(f"/api/sessions/{session['id']}").json()["state"] == session["state"]
 
 

@@ -44,8 +44,10 @@ def field_text(field: str) -> str:
 
 
 def field_loc(field: str) -> list[str | int]:
-    """A field's path as FastAPI's ``loc`` of a body field: ``["body", "rest", 3]``."""
-    return ["body", *(int(p) if p.isdigit() else p for p in _parts(field))]
+    """A field's path as FastAPI's ``loc`` of a body field: ``["body", "rest", 3]``; ``body``
+    is the body itself (``["body"]``: a body that is not an object)."""
+    parts = [] if field == "body" else _parts(field)
+    return ["body", *(int(p) if p.isdigit() else p for p in parts)]
 
 
 def without_field(text: str, field: str | None) -> str:
