@@ -69,7 +69,13 @@ def reference_rotation(value, field: str = "reference") -> FloatArray:
             field,
         )
     if a.shape == (3,):
-        return so3.exp(a)
+        with np.errstate(all="ignore"):
+            R = so3.exp(a)
+        if not np.isfinite(R).all():  # (a length whose square overflows: past ~1.3e154)
+            raise InvalidInputError(
+                f"{field}: a rotation vector must be shorter than 1e154 rad", field
+            )
+        return R
     if a.shape == (4,):
         if abs(np.linalg.norm(a) - 1.0) > 1e-6:
             raise InvalidInputError(

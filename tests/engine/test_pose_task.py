@@ -112,6 +112,7 @@ def test_reference_forms_agree_and_home_has_zero_rotation():
         ([0, 0, 0, 2], "norm 1"),
         (np.diag([1, 1, -1]), "rotation"),
         ([[1, 0, 0], [0, 1, 0], [0, 0, float("nan")]], "rotation vector"),
+        ([1e308, 0, 0], "shorter than 1e154 rad"),  # (it was an arm whose task is undefined)
     ],
 )
 def test_bad_references_name_the_field(value, text):
