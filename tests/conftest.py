@@ -1,7 +1,9 @@
 """Settings of the whole suite."""
 
 import os
+import zlib
 
+import numpy as np
 import pytest
 
 # Starlette's TestClient sends "Host: testserver": a name the server answers to only in tests
@@ -17,3 +19,16 @@ def pytest_collection_modifyitems(items):
     for item in items:
         if item.get_closest_marker("browser"):
             item.add_marker(pytest.mark.xdist_group("browser"))
+
+
+@pytest.fixture(autouse=True)
+def _module_rng_per_test(request):
+    """A module's seeded ``RNG`` starts anew for each test, from the module's seed and the
+    test's name: a test draws the same numbers whichever of the module's tests ran before it
+    in its process (pytest-xdist spreads a module's tests over workers differently each run)."""
+    module = request.module
+    rng = getattr(module, "RNG", None)
+    if isinstance(rng, np.random.Generator):
+        seed = module.__dict__.setdefault("_RNG_SEED", rng.bit_generator.seed_seq.entropy)
+        module.RNG = np.random.default_rng([seed, zlib.crc32(request.node.name.encode())])
+    yield

@@ -83,8 +83,14 @@ def test_bad_tasks_name_the_field(task):
     ],
 )
 def test_jacobian_matches_finite_differences(end, task):
+    """At seeded configurations whose rotation from R0 is below 0.9 pi: away from the rotation
+    coordinates' singularity at pi, where central differences lose their accuracy (a turn of
+    0.99 pi gave a difference of 2e-7)."""
     kin = UrdfChain(ARM4, end, task=task)
-    x = RNG.uniform(-1.5, 1.5, (25, kin.p))
+    x = RNG.uniform(-1.5, 1.5, (60, kin.p))
+    turn = np.linalg.norm(UrdfChain(ARM4, end, task="rx ry rz").forward(x), axis=-1)
+    x = x[turn < 0.9 * np.pi][:25]
+    assert len(x) == 25
     J = kin.jacobian(x)
     np.testing.assert_allclose(J, central_difference(kin.forward, x), atol=1e-8)
     k = kin.forward(x)
