@@ -31,35 +31,22 @@ def add_algorithm_parameter_options(p: argparse.ArgumentParser) -> None:
     )
 
 
-#: Each algorithm option's destination and its flag.
-OPTIONS = {
-    "damping": "--damping",
-    "damping_threshold": "--damping-threshold",
-    "gain": "--gain",
-    "rest": "--rest",
-    "limits": "--limits",
-}
-
-
 def refuse_unused_options(args: argparse.Namespace, algorithms: list[str]) -> None:
     """Refuse an algorithm option given that none of the chosen ``algorithms`` takes (as the
     REST API refuses an unknown parameter): ``--damping`` with the pseudoinverse alone."""
     from ..engine.exceptions import InvalidInputError
     from ..engine.registry import ALGORITHMS
 
-    for dest, flag in OPTIONS.items():
-        if getattr(args, dest, None) is None:
-            continue
-        takers = [
-            name
-            for name, spec in ALGORITHMS.items()
-            if dest in spec.vectors or dest in {p.name for p in spec.parameters}
-        ]
-        if not set(takers) & set(algorithms):
+    takers: dict[str, list[str]] = {}  # option (its dest) -> the algorithms that take it
+    for name, spec in ALGORITHMS.items():
+        for option in (*(p.name for p in spec.parameters), *spec.vectors):
+            takers.setdefault(option, []).append(name)
+    for option, names in takers.items():
+        if getattr(args, option, None) is not None and not set(names) & set(algorithms):
             raise InvalidInputError(
-                f"{flag} is a parameter of {' and '.join(takers)}, not of "
-                f"{', '.join(algorithms)}: choose it with --algorithm {takers[0]}",
-                dest,
+                f"--{option.replace('_', '-')} is a parameter of {' and '.join(names)}, not of "
+                f"{', '.join(algorithms)}: choose it with --algorithm {names[0]}",
+                option,
             )
 
 

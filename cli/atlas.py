@@ -37,7 +37,7 @@ from .algorithm_options import (
     refuse_unused_options,
 )
 from .atlas_output import CsvWriter, Gathered, write_figure
-from .robot_commands import add_task_option, refused, robot_with_task
+from .robot_commands import add_task_option, point_texts, refused, robot_with_task
 
 #: Atlases of more runs than this write their arrays to the CSV only (the JSON keeps a summary).
 JSON_RUNS = 20000
@@ -135,10 +135,7 @@ def _field(option: str) -> str:
 
 def _points(text: str, what: str) -> list[list[float]]:
     """``"1,1; 1,2"`` -> [[1, 1], [1, 2]]; a trailing ``;`` ends the list."""
-    points = text.split(";")
-    if len(points) > 1 and not points[-1].strip():
-        points.pop()
-    return [_numbers(t, what) for t in points]
+    return [_numbers(t, what) for t in point_texts(text)]
 
 
 def backend_option(args: argparse.Namespace) -> str:

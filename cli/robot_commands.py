@@ -54,10 +54,16 @@ def parse_vector(text: str, option: str) -> list[float]:
 def parse_path(text: str, option: str) -> list[list[float]]:
     """``"1,1; 1,2; 0,2"`` -> [[1, 1], [1, 2], [0, 2]]; a trailing ``;`` ends the path, an empty
     point elsewhere is refused (naming it)."""
+    return [parse_vector(p, f"{option}[{i}]") for i, p in enumerate(point_texts(text))]
+
+
+def point_texts(text: str) -> list[str]:
+    """A path's text split into its points at ';' (outside parentheses); a trailing ';' ends
+    the path, an empty point elsewhere stays (for its parser to refuse)."""
     points = _split(text, ";")
     if len(points) > 1 and not points[-1].strip():
         points.pop()
-    return [parse_vector(p, f"{option}[{i}]") for i, p in enumerate(points)]
+    return points
 
 
 def add_task_option(p: argparse.ArgumentParser) -> None:

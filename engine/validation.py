@@ -66,8 +66,11 @@ def as_points(x, size: int, name: str, field: str | None = None) -> FloatArray:
         On a wrong trailing dimension or a NaN/inf entry, naming ``name`` (field:
         :func:`field_for`).
     """
-    _check_point_sizes(x, size, name, field)
-    a = as_numbers(x, name, field)
+    try:
+        a = as_numbers(x, name, field)
+    except InvalidInputError:
+        _check_point_sizes(x, size, name, field)  # (a ragged list: name its first odd point)
+        raise
     if a.ndim == 0 or a.shape[-1] != size:
         raise InvalidInputError(
             f"{name} must have shape (..., {size}) (a vector of length {size}), got shape "
@@ -82,8 +85,9 @@ def as_points(x, size: int, name: str, field: str | None = None) -> FloatArray:
 
 
 def _check_point_sizes(x, size: int, name: str, field: str | None) -> None:
-    """A list of points whose sizes differ: the first point of another size than ``size``,
-    named (``path[1] must have 2 numbers``) rather than the list called not numeric."""
+    """A list of points whose sizes differ, which :func:`as_numbers` refused: the first point
+    of another size than ``size``, named (``path[1] must have 2 numbers``) rather than the list
+    called not numeric."""
     if not isinstance(x, list | tuple) or not all(isinstance(p, list | tuple) for p in x):
         return
     if len({len(p) for p in x}) < 2:  # (one size for all: the shape's own message)
