@@ -16,7 +16,7 @@ import uvicorn
 
 from ..compute.settings import read_environment
 from ..dashboard.sessions import SessionStore
-from ..scene import start_scene
+from ..scene import DashboardScene
 from .factory import create_app
 from .protocol import with_read_deadline
 
@@ -81,7 +81,7 @@ def run_server(
     sock = bind(host, port, "--port")
     app = create_app(settings, allowed_hosts=allowed_hosts)
     # The sessions share the app's compute pool (JIK_WORKERS processes) with the API.
-    app.state.sessions = SessionStore(settings, scene_factory=start_scene, pool=app.state.pool)
+    app.state.sessions = SessionStore(settings, scene_factory=DashboardScene, pool=app.state.pool)
     # uvicorn shuts down gracefully on SIGINT and SIGTERM (the lifespan stops the sessions and
     # the workers), restores the handlers it found and then raises the signal again. With these
     # handlers that second signal only ends the wait, and the command exits 0, as a server asked

@@ -109,7 +109,7 @@ class SessionStore:
         algorithm's runs are the compute pool's); default: the environment's.
     scene_factory : callable, optional
         ``scene_factory(dashboard, low_end)`` starts the 3D scene of a new session (``jik
-        serve`` gives :func:`jik.app.scene.start_scene`: a viser server on a loopback port);
+        serve`` gives :class:`jik.app.scene.DashboardScene`: a viser server on a loopback port);
         without it sessions have no scene.
     pool : ComputePool, optional
         The server's compute pool (:class:`jik.app.compute.pool.ComputePool`), which the

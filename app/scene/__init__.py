@@ -1,5 +1,5 @@
-"""The dashboard's 3D scene (viser), one per session: :func:`start_scene`."""
+"""The dashboard's 3D scene (viser), one per session: :class:`DashboardScene`."""
 
-from .lifecycle import DashboardScene, start_scene
+from .lifecycle import DashboardScene
 
-__all__ = ["DashboardScene", "start_scene"]
+__all__ = ["DashboardScene"]

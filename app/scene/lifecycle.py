@@ -123,39 +123,37 @@ class DashboardScene:
     def _draw(self, result) -> None:
         state = result.state
         drawn = runs_key(state)
-        if drawn == self._drawn_runs:
-            # The same configurations (gamma in continuous mode only rescales theta; the
-            # animation runs per leg): nothing in the scene changes but its status, so nothing
-            # is sent but the status (a redraw would make every client render anew).
-            with self._lock:  # (the timeline on screen plays the same legs)
-                self.controls.sync(self.dashboard.state)
-                self.controls.mark("stopped", stops(result))
-                self.dashboard.scene_status.update(generation=result.generation)
-            self._show_status(result)
-            return
         with self._lock, self.server.atomic():
-            self._drawn_runs = drawn
-            timeline = Timeline(result)
-            # The start-point gizmo moves with the drawing it belongs to, in the same batch: the
-            # client shows the start point and the paths that leave it together, never one
-            # without the other.
-            self.gizmo.place(state)
-            self.nodes.show(result)
-            if self._framed != layout_name(state):  # another robot: frame its reach
-                self._framed = layout_name(state)
-                self.camera.frame(result)
-            self.playback.show(timeline, self.nodes.mechanisms)
+            # The same configurations (gamma in continuous mode only rescales theta; the
+            # animation runs per leg) change nothing in the scene but its controls' marks and its
+            # status (a redraw would make every client render anew).
+            if drawn != self._drawn_runs:
+                self._drawn_runs = drawn
+                # The start-point gizmo moves with the drawing it belongs to, in the same batch:
+                # the client shows the start point and the paths that leave it together, never
+                # one without the other.
+                self.gizmo.place(state)
+                self.nodes.show(result)
+                if self._framed != layout_name(state):  # another robot: frame its reach
+                    self._framed = layout_name(state)
+                    self.camera.frame(result)
+                self.playback.show(Timeline(result), self.nodes.mechanisms)
+                first = next(iter(self.nodes.mechanisms.values()), None)
+                self.dashboard.scene_status.update(
+                    robot=state.robot,
+                    playing=self.playback.playing,
+                    mechanism=type(first).__name__,
+                    joints=len(getattr(first, "joints", ())),
+                    pose_frames=sum(
+                        isinstance(h, FrameHandle) for h in self.nodes.fixtures.values()
+                    ),
+                )
             self.controls.sync(self.dashboard.state)
-            self.controls.mark("stopped", stops(result))
-            first = next(iter(self.nodes.mechanisms.values()), None)
-            self.dashboard.scene_status.update(
-                generation=result.generation,
-                robot=state.robot,
-                playing=self.playback.playing,
-                mechanism=type(first).__name__,
-                joints=len(getattr(first, "joints", ())),
-                pose_frames=sum(isinstance(h, FrameHandle) for h in self.nodes.fixtures.values()),
+            # (each stopped run's field, x0 at a singular start, and message)
+            self.controls.mark(
+                "stopped", [(r.field, r.message) for r in result.runs.values() if r.field]
             )
+            self.dashboard.scene_status.update(generation=result.generation)
         self._show_status(result)
 
     def _prebuild(self, result) -> None:
@@ -180,12 +178,6 @@ class DashboardScene:
             self.status.content = f"generation {result.generation}: {messages}"
 
 
-def stops(result) -> list[tuple[str, str]]:
-    """Where the runs of ``result`` stopped: each stopped run's field (x0, a singular start)
-    and message."""
-    return [(run.field, run.message) for run in result.runs.values() if run.field]
-
-
 def legend(algorithms) -> str:
     """The scene's key: each chosen algorithm's colour, name and copy, and the grey start."""
     keys = " · ".join(
@@ -194,8 +186,3 @@ def legend(algorithms) -> str:
     )
     lines = " and ".join(STYLES[a].line for a in algorithms)
     return f"{keys} · grey: start x0 (the plots: {lines})"
-
-
-def start_scene(dashboard: Dashboard, low_end: bool = False) -> DashboardScene:
-    """Start the viser scene for one session's ``dashboard``, on a free loopback port."""
-    return DashboardScene(dashboard, low_end=low_end)

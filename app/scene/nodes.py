@@ -53,7 +53,9 @@ class NodeSets:
             entry["frame"].visible = key == layout  # (viser sends only a change)
         if layout in self.sets:
             entry = self.sets[layout]
-            self._update(entry, result, extent)
+            for m in (*entry["mechanisms"].values(), *entry["still"].values()):
+                m.resize(result.state, extent)
+            self._place_fixtures(result, extent, entry["root"], entry["fixtures"])
         else:
             entry = self._build(result, extent, visible=True)
         self.fixtures, self.mechanisms = entry["fixtures"], entry["mechanisms"]
@@ -108,11 +110,6 @@ class NodeSets:
         self._place_fixtures(result, extent, root, entry["fixtures"])
         self.sets[set_key(state)] = entry
         return entry
-
-    def _update(self, entry: dict[str, Any], result, extent) -> None:
-        for m in (*entry["mechanisms"].values(), *entry["still"].values()):
-            m.resize(result.state, extent)
-        self._place_fixtures(result, extent, entry["root"], entry["fixtures"])
 
     def _place_fixtures(self, result, extent, root: str, fixtures: dict[str, Any]) -> None:
         """Give the fixtures under ``root`` (their handles in ``fixtures``) the values of

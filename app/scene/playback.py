@@ -44,18 +44,14 @@ class Playback:
         self.playing = True
         self.timeline: Timeline | None = None
         self._mechanisms: Mapping[str, Mechanism] = {}
-        self._s = 0.0
+        #: Where the playback is along the timeline (0 to its length).
+        self.position = 0.0
         self._posed: tuple[Timeline | None, float] = (None, 0.0)  # what the mechanisms show
         self._stopped = False
         self.play.on_click(self._toggle)
         self.scrub.on_update(self._scrubbed)
         self._thread = threading.Thread(target=self._animate, name="jik-scene", daemon=True)
         self._thread.start()
-
-    @property
-    def position(self) -> float:
-        """Where the playback is along the timeline (0 to its length)."""
-        return self._s
 
     def stop(self) -> None:
         self._stopped = True
@@ -65,8 +61,8 @@ class Playback:
         """Play ``timeline`` on ``mechanisms`` (call under the scene's lock): from the start
         when playing; paused, at the end, where the drift of J^P# shows."""
         self.timeline, self._mechanisms = timeline, mechanisms
-        self._s = 0.0 if self.playing else timeline.length
-        self._pose(self._s)
+        self.position = 0.0 if self.playing else timeline.length
+        self._pose(timeline, self.position)
         self._show_position(timeline)
 
     def _toggle(self, _) -> None:
@@ -79,21 +75,19 @@ class Playback:
             return
         if self.playing:  # (a scrub pauses)
             self._toggle(None)
-        self._s = float(self.scrub.value) * self.timeline.length
+        self.position = float(self.scrub.value) * self.timeline.length
 
-    def _pose(self, s: float) -> None:
-        if self.timeline is None:
-            return
-        self._posed = (self.timeline, s)
-        configs = self.timeline.at(s)
+    def _pose(self, timeline: Timeline, s: float) -> None:
+        self._posed = (timeline, s)
+        configs = timeline.at(s)
         for a, m in self._mechanisms.items():
             m.pose(configs[a])
 
     def _show_position(self, timeline: Timeline) -> None:
         """The position slider at the playback position (not a change of it by the user)."""
         with self._syncing:
-            self.scrub.value = round(min(self._s / timeline.length, 1.0), 3)  # type: ignore[misc]  # viser: settable
-            counter = timeline.counter(self._s)
+            self.scrub.value = round(min(self.position / timeline.length, 1.0), 3)  # type: ignore[misc]  # viser: settable
+            counter = timeline.counter(self.position)
             if self.counter.content != counter:
                 self.counter.content = counter
 
@@ -111,12 +105,12 @@ class Playback:
                     continue
                 moving = self.playing
                 if moving:
-                    self._s += dt * float(self.speed.value) / SECONDS_PER_LEG
-                    if self._s > timeline.length + 0.5:  # hold the end a moment, then loop
-                        self._s = 0.0
+                    self.position += dt * float(self.speed.value) / SECONDS_PER_LEG
+                    if self.position > timeline.length + 0.5:  # hold the end a moment, then loop
+                        self.position = 0.0
                 # Paused: nothing to send until scrubbed (or drawn, which poses too).
-                if self._posed != (timeline, self._s):
-                    self._pose(self._s)
+                if self._posed != (timeline, self.position):
+                    self._pose(timeline, self.position)
             if not moving:
                 continue
             if now - last_gui > 0.25:

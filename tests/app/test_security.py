@@ -131,10 +131,10 @@ def test_a_scene_server_takes_only_the_relay(tmp_path):
     the relay (/api/sessions/{id}/scene) still reaches the scene."""
     from jik.app.compute.settings import Settings
     from jik.app.dashboard.sessions import SessionStore
-    from jik.app.scene import start_scene
+    from jik.app.scene import DashboardScene
 
     app = create_app()
-    app.state.sessions = SessionStore(Settings(max_sessions=2), scene_factory=start_scene)
+    app.state.sessions = SessionStore(Settings(max_sessions=2), scene_factory=DashboardScene)
     try:
         client = TestClient(app)
         created = client.post("/api/sessions", json={"state": {}}).json()
