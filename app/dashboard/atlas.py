@@ -22,9 +22,9 @@ from ...engine.exceptions import InvalidInputError
 from ...engine.redundant_starts import manifold_starts
 from ..compute.atlas_schemas import AtlasRequest
 from ..compute.schemas import RobotUsed
-from .algorithms import STYLES, inverse_parameters
+from .algorithms import STYLES
 from .model import DashboardState
-from .plotting import AXIS, figure, norm_unit
+from .plotting import figure, norm_unit, note
 from .robots import state_kinematics, state_spec, user_robot
 
 #: Drift below this is drawn as this (the extended Jacobian's drift is round-off, ~1e-13).
@@ -48,12 +48,7 @@ def atlas_request(
     home = np.asarray(kin.forward(np.asarray(state.x0, dtype=float)), dtype=float)
     # The atlas's posture inverse, without rest, pulls each run toward its own start (the
     # state's rest is for the runs from x0; the heatmap's title says so).
-    params = {
-        k: v
-        for a in state.algorithms
-        for k, v in inverse_parameters(state, a).items()
-        if k != "rest"
-    }
+    params = {k: v for k, v in state.algorithm_parameters.items() if k != "rest"}
     points = None
     if kin.p - kin.r > 1:  # (its self-motion manifolds are not curves: starts given)
         box = state_spec(state).x_range
@@ -119,18 +114,15 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest, robot: RobotUsed
     if request.start_points:
         s = np.arange(1.0, len(request.start_points) + 1)
         x_title, hover, at_x0 = "start, farther from x0 to the right", "start %{x}", 1.0
-    rows, labels = [], []
     P, N = len(result["paths"]), len(s)
-    for j in range(P):
-        for c in range(request.cycles):
-            rows.append((j, c))
-            labels.append(f"×{scales[j]:g}, cycle {c + 1}" if P > 1 else f"cycle {c + 1}")
+    rows = [(j, c) for j in range(P) for c in range(request.cycles)]
+    labels = [f"×{scales[j]:g}, cycle {c + 1}" if P > 1 else f"cycle {c + 1}" for j, c in rows]
     runs = np.array([[j * N + i for i in range(N)] for j, _ in rows])
     data: list[dict] = []
     layout: dict[str, Any] = {"shapes": [], "annotations": []}
     gap = 0.06
     width = (0.92 - gap * (len(algorithms) - 1)) / len(algorithms)
-    outside = outside_counts(result)
+    outside = result.get("outside_limits") or {}  # (runs that left the joint limits)
     for k, a in enumerate(algorithms):
         d = np.array(result["drift"][a], dtype=float)  # (P, N, C), NaN after a failure
         z = np.array([d[j, :, c] for j, c in rows])  # (rows, N)
@@ -153,12 +145,7 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest, robot: RobotUsed
             }
         )
         lo = k * (width + gap)
-        layout[f"xaxis{axis}"] = {
-            **AXIS,
-            "domain": [lo, lo + width],
-            "anchor": f"y{axis}",
-            "title": {"text": x_title},
-        }
+        layout[f"xaxis{axis}"] = dict(domain=[lo, lo + width], anchor=f"y{axis}", title=x_title)
         # s = 0 is x0, the start of the state the atlas was asked for
         layout["shapes"].append(
             {
@@ -172,13 +159,8 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest, robot: RobotUsed
                 "line": {"color": "#fff", "width": 1.5, "dash": "dot"},
             }
         )
-        layout[f"yaxis{axis}"] = {
-            **AXIS,
-            "anchor": f"x{axis}",
-            "autorange": "reversed",
-            "showticklabels": k == 0,
-            "type": "category",
-        }
+        ticks = dict(showticklabels=k == 0, type="category")
+        layout[f"yaxis{axis}"] = dict(anchor=f"x{axis}", autorange="reversed", **ticks)
         name = STYLES[a].label
         if a == "extended" and request.augmentation is not None:
             name += f"<br>h = {request.augmentation.name}"
@@ -186,18 +168,9 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest, robot: RobotUsed
         name += f", {failed} starts failed (blank)" if failed else ""
         if a in outside:
             name += f"<br>{outside[a]} of {P * N} runs left the joint limits"
+        where = dict(xanchor="center", yanchor="bottom")
         layout["annotations"].append(
-            {
-                "text": name,
-                "x": lo + width / 2,
-                "y": 1.0,
-                "xref": "paper",
-                "yref": "paper",
-                "xanchor": "center",
-                "yanchor": "bottom",
-                "showarrow": False,
-                "font": {"size": 11, "color": STYLES[a].color},
-            }
+            note(name, lo + width / 2, 1.0, color=STYLES[a].color, **where)
         )
     # (a session's atlas, whose request atlas_request made: gamma and mode the state's)
     assert request.gamma is not None and request.mode is not None
@@ -235,17 +208,6 @@ def _rest_used(request: AtlasRequest) -> str:
     if rest is None:
         return "x_rest = each run's start"
     return "x_rest = (" + ", ".join(f"{v:.4g}" for v in rest) + ")"
-
-
-def outside_counts(result: dict[str, Any]) -> dict[str, int]:
-    """How many runs of each algorithm left the robot's joint limits (an atlas of a robot with
-    limits reports them as ``outside_limits``: a count, or a flag per run); empty without."""
-    reported = result.get("outside_limits") or {}
-    return {
-        a: int(v) if isinstance(v, int | float) else int(np.count_nonzero(v))
-        for a, v in reported.items()
-        if v is not None
-    }
 
 
 __all__ = ["atlas_figure", "atlas_request"]

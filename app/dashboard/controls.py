@@ -60,9 +60,9 @@ class Control:
     key: str
     label: str
     kind: str
-    group: str
     help: str = ""
     options: tuple[tuple[str, str], ...] = ()
+    group: str = "algorithm"
     minimum: Any = None
     maximum: Any = None
     step: float | None = None
@@ -101,42 +101,31 @@ def controls(state) -> list[Control]:
     spec = state_spec(state)
     aug = spec.augmentation(state.augmentation)
     lo, hi = GAMMA_RANGE[state.mode]
+    robots = [(name, ROBOTS[name].title) for name in ROBOTS]
+    robots += [(name, f"{arm.title} (arm)") for name, arm in ARMS.items()]
+    if state.robot not in (*ROBOTS, *ARMS):
+        robots.append((state.robot, f"your robot: {spec.title}"))
     out = [
-        Control(
-            "robot",
-            "robot",
-            "select",
-            "algorithm",
-            "the robot (section 6 of the paper)",
-            options=tuple((name, ROBOTS[name].title) for name in ROBOTS)
-            + tuple((name, f"{arm.title} (arm)") for name, arm in ARMS.items())
-            + (
-                ((state.robot, f"your robot: {spec.title}"),)
-                if state.robot not in (*ROBOTS, *ARMS)
-                else ()
-            ),
-        ),
+        Control("robot", "robot", "select", "the robot (section 6 of the paper)", tuple(robots)),
         Control(
             "mode",
             "mode",
             "select",
-            "algorithm",
             "continuous: the ODE (7); discrete: the iteration x <- x - gamma J# e",
-            options=tuple((m, m) for m in MODES),
+            tuple((m, m) for m in MODES),
         ),
         Control(
             "gamma",
             "γ (decay rate)",
             "slider",
-            "algorithm",
             SYMBOLS["gamma"],
             minimum=lo,
             maximum=hi,
             step=GAMMA_STEP,
             log=True,
         ),
+        iterations_control(state),
     ]
-    out.append(iterations_control(state))
     out += _sliders("robot_parameters", spec.parameters)
     for v in spec.vector_parameters:
         out.append(
@@ -144,7 +133,6 @@ def controls(state) -> list[Control]:
                 f"robot_parameters.{v.name}",
                 v.name,
                 "vector",
-                "algorithm",
                 explained(v.name, v.description),
                 minimum=list(v.minimum),
                 maximum=list(v.maximum),
@@ -160,9 +148,8 @@ def controls(state) -> list[Control]:
             "augmentation",
             "augmenting map h",
             "select",
-            "algorithm",
             SYMBOLS["h"] + "; one button per map of the paper for this robot",
-            options=tuple((a.name, _map_label(a)) for a in spec.augmentations),
+            tuple((a.name, _map_label(a)) for a in spec.augmentations),
             inline=True,
         )
     )
@@ -172,9 +159,8 @@ def controls(state) -> list[Control]:
             "algorithms",
             "algorithms",
             "checks",
-            "algorithm",
             "the inverses J# run side by side, one colour each (at least one)",
-            options=tuple((a, s.label) for a, s in STYLES.items()),
+            tuple((a, s.label) for a, s in STYLES.items()),
             inline=True,
         )
     )
@@ -190,24 +176,16 @@ def controls(state) -> list[Control]:
                 "cspace_axes",
                 "configuration-space axes",
                 "select",
-                "start",
                 "the three coordinates the configuration-space panel shows",
-                options=tuple(
+                tuple(
                     (c, ", ".join(names[int(k)] for k in c)) for c in ("012", "013", "023", "123")
                 ),
+                group="start",
             )
         )
     if spec.default_path:
-        out.append(
-            Control(
-                "task",
-                "task",
-                "select",
-                "start",
-                "drive a closed path cycle after cycle, or solve for one target",
-                options=TASKS,
-            )
-        )
+        text = "drive a closed path cycle after cycle, or solve for one target"
+        out.append(Control("task", "task", "select", text, TASKS, group="start"))
     if state.task == "path":
         written = path_format(len(state.target))
         out.append(
@@ -215,36 +193,29 @@ def controls(state) -> list[Control]:
                 "path",
                 "closed path",
                 "text",
-                "start",
                 f"task points visited in order, a point per line ({written}); the path closes "
                 "back to k(x0)",
                 format=written,
+                group="start",
             )
         )
-        cycles = Control(
-            "cycles",
-            "cycles",
-            "slider",
-            "start",
-            "times around the path",
-            minimum=1,
-            maximum=MAX_DASHBOARD_CYCLES,
-            step=1,
-            integer=True,
-        )
-        out.append(cycles)
-    else:
         out.append(
             Control(
-                "target",
-                "target",
-                "vector",
-                "start",
-                f"target task point ({', '.join(spec.task_names)})",
-                step=0.1,
-                size=len(spec.task_names),
+                "cycles",
+                "cycles",
+                "slider",
+                "times around the path",
+                minimum=1,
+                maximum=MAX_DASHBOARD_CYCLES,
+                step=1,
+                integer=True,
+                group="start",
             )
         )
+    else:
+        text = f"target task point ({', '.join(spec.task_names)})"
+        size = len(spec.task_names)
+        out.append(Control("target", "target", "vector", text, step=0.1, size=size, group="start"))
     return out
 
 
@@ -272,7 +243,7 @@ def preset_button(key: str, name: str, value, text: str, numbers: bool = False) 
     shown = f" ({', '.join(f'{t:.2f}' for t in value)})" if numbers else ""
     value = value if isinstance(value, str) else [float(t) for t in value]
     label, button = f"{short} = {name}{shown}", f"ctl-preset-{short}-{name}"
-    return Control(key, label, "preset", "algorithm", text, value=value, id=button)
+    return Control(key, label, "preset", text, value=value, id=button)
 
 
 def joint_sliders(key: str, group: str, spec, text: str, box) -> list[Control]:
@@ -284,8 +255,8 @@ def joint_sliders(key: str, group: str, spec, text: str, box) -> list[Control]:
             f"{key}.{i}",
             f"{short}: {name}",
             "slider",
-            group,
             text.format(name),
+            group=group,
             minimum=lo,
             maximum=hi,
             step=(hi - lo) / X0_STEPS,
@@ -307,7 +278,6 @@ def iterations_control(state) -> Control:
         "max_iterations",
         f"max {what} per leg",
         "slider",
-        "algorithm",
         f"a leg that has not reached its target after this many {what} stops and "
         "says so (raise it for far targets or small γ; the work grows with it)",
         minimum=MIN_ITERATIONS,
@@ -382,7 +352,6 @@ def _sliders(head: str, parameters) -> list[Control]:
             f"{head}.{p.name}",
             PARAMETER_LABELS.get(p.name, p.name),
             "slider",
-            "algorithm",
             explained(p.name, p.description),
             minimum=p.minimum,
             maximum=p.maximum,

@@ -28,6 +28,7 @@ from .plotting import (
     log_range,
     nice_range,
     norm_unit,
+    note,
     side_by_side,
     stacked_axes,
     theta_axis,
@@ -219,17 +220,9 @@ def _platform(result: DashboardResult) -> dict:
                 hovertemplate="%{text}: (%{x:.3f}, %{y:.3f})<extra></extra>",
             )
         )
+        where = f"{xa} domain", f"{ya} domain"
         annotations.append(
-            dict(
-                text=STYLES[a].short,
-                xref=f"{xa} domain",
-                yref=f"{ya} domain",
-                x=0.5,
-                y=1.0,
-                yanchor="bottom",
-                showarrow=False,
-                font=dict(size=11, color=COLORS[a]),
-            )
+            note(STYLES[a].short, 0.5, 1.0, *where, color=COLORS[a], yanchor="bottom")
         )
     return figure(
         data,

@@ -172,10 +172,7 @@ def sensitivity(
             factory, samples = (lambda **p: aug.build(kin, **p)), SENSITIVITY_SAMPLES
             params = state.augmentation_parameters
             return parameters_report(kin, factory, params, region, nodes, fixed, samples, told)
-        maps = [
-            (m.name, lambda m=m: m.build(kin, **{p.name: p.default for p in m.parameters}))
-            for m in spec.augmentations
-        ]
+        maps = [(m.name, lambda m=m: m.build(kin)) for m in spec.augmentations]  # (defaults)
         return maps_report(kin, maps, aug.name, region, nodes, fixed, told)
     except RunCancelled:
         raise Cancelled from None

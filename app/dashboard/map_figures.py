@@ -13,7 +13,7 @@ from ...engine.functional_report import region_words, report_words
 from .algorithms import COLORS, DASH, LABELS
 from .analysis import vector_note
 from .functionals import state_inert_variables
-from .plotting import NO_LEGEND, figure, label, side_by_side, trace, units
+from .plotting import NO_LEGEND, figure, label, note, side_by_side, trace, units
 from .robots import state_spec
 from .runs import DashboardResult
 
@@ -186,17 +186,7 @@ def message_figure(title: str, message: str) -> dict:
         title,
         xaxis=hidden,
         yaxis=hidden,
-        annotations=[
-            dict(
-                text="<br>".join(lines),
-                xref="paper",
-                yref="paper",
-                x=0.5,
-                y=0.5,
-                showarrow=False,
-                font=dict(size=12, color="#555"),
-            )
-        ],
+        annotations=[note("<br>".join(lines), 0.5, 0.5, size=12, color="#555")],
     )
 
 
@@ -294,15 +284,12 @@ def sensitivity_spec(
         layout["yaxis" if c == 0 else f"yaxis{c + 1}"] = dict(
             anchor=xa, **log, **log_ticks(ys), **({"title": "E (log)"} if c == 0 else {})
         )
-    slopes = []
-    for k in ("E1", "E2"):
-        g = sens[k]["gradient"]
-        slopes.append(
-            ", ".join(
-                f"∂{k}/∂{p} = {g[p]:.3g}" if g.get(p) is not None else f"∂{k}/∂{p} undefined"
-                for p in names
-            )
-        )
+
+    def slope(k: str, p: str) -> str:
+        g = sens[k]["gradient"].get(p)
+        return f"∂{k}/∂{p} undefined" if g is None else f"∂{k}/∂{p} = {g:.3g}"
+
+    slopes = [", ".join(slope(k, p) for p in names) for k in ("E1", "E2")]
     at = ", ".join(f"{p} = {v:.3g}" for p, v in params.items())
     sub = "".join(f"<br><sup>{line}</sup>" for line in wrap([f"at {at} (circles)", *slopes]))
     return figure(data, f"E1 (13), E2 (18) as the parameters of {aug} move{sub}", **layout)

@@ -154,10 +154,10 @@ def default_state(
         # ranges: the definition is what the user can change.
         first = exc.errors()[0]
         where = field_text(".".join(str(p) for p in first["loc"]))
-        raise InvalidInputError(
-            f"robot_definition: the robot's default {where} is refused by the dashboard "
-            f"({first['msg']}); change the definition (its start x0 or its parameters)",
+        raise refused(
             "robot_definition",
+            f"the robot's default {where} is refused by the dashboard ({first['msg']}); change "
+            "the definition (its start x0 or its parameters)",
         ) from None
 
 
@@ -166,16 +166,12 @@ def _user_definition(robot: str, definition: Mapping[str, Any] | None) -> Mappin
     own (:func:`~jik.app.dashboard.robots.default_definition`); refused naming its field."""
     definition = default_definition(robot) if definition is None else definition
     if not isinstance(definition, Mapping):
-        raise InvalidInputError(
-            f"robot_definition: a {robot} robot needs its definition (the robot editor's fields)",
-            "robot_definition",
+        raise refused(
+            "robot_definition", f"a {robot} robot needs its definition (the robot editor's fields)"
         )
     if definition.get("name") != robot:
-        raise InvalidInputError(
-            f"robot_definition.name: must be the robot's kind {robot!r}, got "
-            f"{definition.get('name')!r}",
-            "robot_definition.name",
-        )
+        problem = f"must be the robot's kind {robot!r}, got {definition.get('name')!r}"
+        raise refused("robot_definition.name", problem)
     return definition
 
 
@@ -196,16 +192,11 @@ def updated_state(state: DashboardState, patch: Mapping[str, object]) -> Dashboa
     robot = patch.get("robot", state.robot)
     definition = patch.get("robot_definition", state.robot_definition)
     if definition is not None and not isinstance(definition, Mapping):
-        raise InvalidInputError(
-            "robot_definition: give an object (the robot editor's fields)", "robot_definition"
-        )
+        raise refused("robot_definition", "give an object (the robot editor's fields)")
     if robot != state.robot or definition != state.robot_definition:
         if not isinstance(robot, str) or robot not in (*ROBOTS, *USER_KINDS):
-            raise InvalidInputError(
-                f"robot: unknown robot {robot!r}; choose one of "
-                f"{sorted(ROBOTS)} or a kind {list(USER_KINDS)}",
-                "robot",
-            )
+            known = f"{sorted(ROBOTS)} or a kind {list(USER_KINDS)}"
+            raise refused("robot", f"unknown robot {robot!r}; choose one of {known}")
         if robot != state.robot and "robot_definition" not in patch:
             definition = None  # (another robot chosen: the definition was the other's)
         # (the chosen algorithms and their numbers stay: the new robot's defaults are for

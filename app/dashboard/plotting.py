@@ -96,6 +96,13 @@ def trace(kind: str, **props) -> dict:
     return {"type": kind, **props}
 
 
+def note(text: str, x, y, xref="paper", yref="paper", color=None, size=11, **more) -> dict:
+    """A text without an arrow at (x, y) of ``xref``, ``yref`` (the figure's paper, an axis or
+    its domain), in ``color`` (plotly's default: None); ``more``: its other properties."""
+    font = dict(size=size) if color is None else dict(size=size, color=color)
+    return dict(text=text, x=x, y=y, xref=xref, yref=yref, showarrow=False, font=font, **more)
+
+
 #: Layout of the panels whose traces are the two algorithms: no legend (the page's header
 #: names the colours; a legend costs a fifth of a panel's redraw in the browser test), the
 #: other marks named in the title, and the bottom margin the legend took given back.
@@ -256,13 +263,9 @@ def side_by_side(n: int, gap: float) -> list[list[float]]:
 
 def stacked_axes(n: int) -> dict:
     """Layout of n y-axes stacked over one shared x-axis (instead of make_subplots), 0.04 of
-    the height between them."""
-    gap = 0.04
-    h = (1.0 - gap * (n - 1)) / n
+    the height between them (:func:`side_by_side`'s domains, top down)."""
     out = {}
-    for k in range(n):
-        top = 1.0 - k * (h + gap)
-        lo, hi = max(0.0, round(top - h, 6)), min(1.0, round(top, 6))
-        out["yaxis" if k == 0 else f"yaxis{k + 1}"] = dict(domain=[lo, hi], anchor="x")
+    for k, domain in enumerate(reversed(side_by_side(n, 0.04))):
+        out["yaxis" if k == 0 else f"yaxis{k + 1}"] = dict(domain=domain, anchor="x")
     out["xaxis"] = dict(anchor=f"y{n}" if n > 1 else "y")
     return out

@@ -19,6 +19,7 @@ from .plotting import (
     figure,
     label,
     nice_range,
+    note,
     stacked_axes,
     theta_axis,
     trace,
@@ -119,16 +120,7 @@ def pose_task_spec(result: DashboardResult) -> dict:
         )
     # The targets' letters above the top row, at the end of their legs (never over a line).
     axes["annotations"] = [
-        dict(
-            text=str(t),
-            x=float(x),
-            xref="x",
-            y=1.0,
-            yref="y domain",
-            yanchor="bottom",
-            showarrow=False,
-            font=dict(size=11),
-        )
+        note(str(t), float(x), 1.0, "x", "y domain", yanchor="bottom")
         for t, x in zip(letters, first.theta[ends], strict=True)
     ]
     axes["xaxis"].update(theta_axis(result))

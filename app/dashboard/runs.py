@@ -226,11 +226,8 @@ def _leg_message(res: SolveResult, cap: int, kinematics) -> str:
         what = "iterations" if res.mode == "discrete" else "integrator steps"
         advice, _ = reach_note(kinematics, res.y_d)
         if advice is None:
-            nearer = res.mode == "discrete" and res.gamma != 1.0
-            advice = f"raise “max {what} per leg” (a control above)" + (
-                ", take γ nearer 1" if nearer else ""
-            )
-            advice += " or move the start"
+            nearer = ", take γ nearer 1" if res.mode == "discrete" and res.gamma != 1.0 else ""
+            advice = f"raise “max {what} per leg” (a control above){nearer} or move the start"
         return f"did not converge within {cap} {what} (error {res.error:.3g}); {advice}"
     if res.mode == "continuous" or not res.success:
         return res.message

@@ -125,17 +125,8 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
         raise it."""
         with self._cond:
             generation, state = self._generation, self._state
-        self._emit(
-            Event.of(
-                "refused",
-                generation,
-                source=source,
-                field=refusal.field,
-                message=str(refusal),
-                state=state.as_dict(),
-                **controls_message(state),
-            )
-        )
+        fields = dict(field=refusal.field, message=str(refusal))
+        self._emit(self._state_event(generation, state, source, "refused", **fields))
         raise refusal
 
     def update(
@@ -185,10 +176,12 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
             )
 
     # -- worker -----------------------------------------------------------------------------
-    def _state_event(self, generation: int, state: DashboardState, source: str) -> Event:
-        return Event.of(
-            "state", generation, state=state.as_dict(), source=source, **controls_message(state)
-        )
+    def _state_event(
+        self, generation: int, state: DashboardState, source: str, kind: str = "state", **more
+    ) -> Event:
+        """A ``state`` event (or ``kind``, with ``more``): the state and its controls."""
+        data = dict(state=state.as_dict(), source=source, **more, **controls_message(state))
+        return Event.of(kind, generation, **data)
 
     def _work(self) -> None:
         while True:
@@ -222,11 +215,9 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
     def _failure(self, generation: int, message: str) -> None:
         """Announce that ``generation`` failed with ``message``, and which result (if any)
         stays on screen: its generation and state (``shown``, None when there is none)."""
-        on_screen = self.result
+        res = self.result
         shown = (
-            None
-            if on_screen is None
-            else {"generation": on_screen.generation, "state": on_screen.state.as_dict()}
+            None if res is None else {"generation": res.generation, "state": res.state.as_dict()}
         )
         self._emit(Event.of("error", generation, message=message, shown=shown))
         self._finish(generation)
@@ -328,8 +319,8 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
                 "figures": ready - t0 - result.seconds,
                 "server_total": ready - started,
             },
+            "stale": sorted(stale),
         }
-        head["stale"] = sorted(stale)
         data = with_figures(head, texts)
         with self._cond:
             if self.result is None or self.result.state.robot != state.robot:
