@@ -17,18 +17,7 @@ from ..compute.pool import ComputePool
 from ..compute.settings import Settings
 from .errors import add_error_handlers
 from .fastpath import SolveFastPath
-from .routes import (
-    atlas,
-    dashboard,
-    health,
-    kinematics,
-    repeatability,
-    robots,
-    session_atlas,
-    sessions,
-    solve,
-    synthesize,
-)
+from .routes import atlas, computing, dashboard, session_atlas, sessions
 from .security import LOOPBACK_HOSTS, SecurityMiddleware
 
 
@@ -67,8 +56,7 @@ def create_app(settings: Settings | None = None, allowed_hosts: tuple[str, ...] 
     app.state.pool = pool
 
     add_error_handlers(app)
-    routes = (health, robots, solve, repeatability, synthesize, kinematics, dashboard, sessions)
-    for module in (*routes, atlas, session_atlas):
+    for module in (computing, dashboard, sessions, atlas, session_atlas):
         app.include_router(module.router)
     if settings.fast_solve:
         app.add_middleware(SolveFastPath, pool=pool)

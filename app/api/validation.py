@@ -46,23 +46,15 @@ def validation_detail(errors) -> list[dict]:
     """FastAPI's list of errors, ``{"loc", "msg", "type"}``, each message naming its field."""
     detail = []
     for e in errors:
+        kind, ctx = e.get("type"), e.get("ctx") or {}
         loc = _location(e.get("loc", ()))
         msg = refusal(e)
-        if e.get("type") == "json_invalid":  # (loc: the body and the character's position)
-            ctx = e.get("ctx") or {}
+        if kind == "json_invalid":  # (loc: the body and the character's position)
             where = f" at character {loc[1]}" if len(loc) > 1 else ""
-            detail.append(
-                {
-                    "loc": ["body"],
-                    "type": "json_invalid",
-                    "msg": f"body: not valid JSON{where}: {ctx.get('error', msg)}",
-                }
-            )
-            continue
-        elif e.get("type") == "union_tag_invalid":
-            ctx = e.get("ctx") or {}
+            loc, msg = ["body"], f"not valid JSON{where}: {ctx.get('error', msg)}"
+        elif kind == "union_tag_invalid":
             msg = f"unknown name {ctx.get('tag')!r}; choose one of {ctx.get('expected_tags')}"
-        elif e.get("type") == "unknown_robot":  # (the request's variant, chosen by robot.name)
+        elif kind == "unknown_robot":  # (the request's variant, chosen by robot.name)
             loc = [*loc, "robot"]
             body = e.get("input")
             robot = body.get("robot") if isinstance(body, dict) else None
@@ -79,9 +71,9 @@ def validation_detail(errors) -> list[dict]:
                 msg = f"give the robot, with a name among {ROBOT_NAMES}"
             else:
                 msg = f"unknown name {name!r}; choose one of {ROBOT_NAMES}"
-        elif e.get("type") in ("too_short", "too_long"):
-            msg = _length_message(e.get("loc", ()), e.get("ctx") or {}) or msg
-        detail.append({"loc": loc, "msg": f"{_field(loc)}: {msg}", "type": str(e.get("type"))})
+        elif kind in ("too_short", "too_long"):
+            msg = _length_message(e.get("loc", ()), ctx) or msg
+        detail.append({"loc": loc, "msg": f"{_field(loc)}: {msg}", "type": str(kind)})
     return detail
 
 

@@ -27,7 +27,8 @@ def downsample(m: int, limit: int = S.MAX_TRAJECTORY_POINTS) -> np.ndarray:
 
 
 def trajectory_document(traj) -> dict[str, Any]:
-    """A run's trajectory as JSON-ready data (the fields of ``S.Trajectory``), downsampled."""
+    """A run's trajectory as JSON-ready data, downsampled (the fields of
+    :class:`~jik.app.compute.schemas.runs.Trajectory`)."""
     m = len(traj.theta)
     idx = downsample(m)
     return {

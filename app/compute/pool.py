@@ -19,12 +19,7 @@ from collections.abc import Callable, Iterator
 from typing import Any
 
 from .batching import SolveBatching, _Pending
-from .exceptions import (
-    ComputeError,
-    RequestError,
-    ServiceUnavailable,
-    WorkerLost,
-)
+from .exceptions import ComputeError, RequestError, ServiceUnavailable, WorkerLost
 from .settings import Settings
 from .settings import settings as environment_settings
 from .worker import Worker, frame_header, work_of

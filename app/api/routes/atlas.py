@@ -19,11 +19,9 @@ from ....engine.exceptions import InvalidInputError
 from ...compute.atlas_jobs import AtlasJob, AtlasJobs
 from ...compute.atlas_plan import AtlasLimits, plan_task
 from ...compute.atlas_schemas import AtlasBody, AtlasJobResponse
-from ...compute.exceptions import RequestError
 from ...compute.pool import ComputePool
 from ...compute.schemas import ErrorResponse
 from ...compute.schemas.examples import openapi_examples
-from ...compute.schemas.wording import without_field
 
 router = APIRouter(tags=["atlas"])
 #: The body, with every robot's example in the document (Swagger UI starts from the first).
@@ -50,10 +48,7 @@ async def start_job(
     pool: ComputePool = request.app.state.pool
     plan, refused = await pool.run(plan_task, req.model_dump_json(), jobs.limits)
     if refused is not None:  # (the engine's message and field)
-        message, field = refused
-        if field is None:
-            raise InvalidInputError(message)
-        raise RequestError(field, without_field(message, field))
+        raise InvalidInputError(*refused)
     job = await run_in_threadpool(jobs.start, client, req, plan, session)
     response.headers["Location"] = f"/atlas/{job.id}"
     return jobs.response(job)

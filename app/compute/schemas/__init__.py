@@ -7,21 +7,18 @@
 - :mod:`.runs`: ``/solve`` and ``/repeatability``; :mod:`.synthesis`: ``/synthesize``;
 - :mod:`.info`: ``/robots``, ``/health`` and the error body.
 
-Everything is re-exported here, by the imports below: ``from jik.app.compute import schemas as
-S`` (their names are this package's API; ``pyproject.toml`` lets ruff keep them unused here).
+What the other modules use is re-exported here, by the imports below: ``from jik.app.compute
+import schemas as S`` (``pyproject.toml`` lets ruff keep them unused here); the rest is imported
+from its module.
 """
 
-from .algorithms import Algorithm, AlgorithmParameters
+from .algorithms import Algorithm
 from .fields import (
-    COORDINATE_BOUND,
-    GAMMA_MIN,
     INTEGRAL,
     MAX_DIMENSION,
     MAX_ITERATIONS,
     MAX_TRAJECTORY_POINTS,
-    Bound,
     Coordinate,
-    FiniteFloat,
     Gamma,
     MaybeFloat,
     Mode,
@@ -31,39 +28,25 @@ from .fields import (
 from .info import (
     BUSY,
     AlgorithmInfo,
-    AugmentationInfo,
     ErrorResponse,
     HealthResponse,
     Limits,
-    ParameterInfo,
     RobotInfo,
     RobotsResponse,
 )
 from .robots import (
     AUGMENTATION_MODELS,
-    MAX_FORMULA_CHARS,
-    MAX_URDF_CHARS,
     ROBOT_MODELS,
     ROBOT_NAMES,
     USER_AUGMENTATION_MODELS,
     USER_ROBOT_MODELS,
     AnyAugmentation,
     AnyRobot,
-    Augmentation,
     AugmentationUsed,
-    E2SynthesisAugmentation,
-    FormulaMapAugmentation,
-    FormulaRobot,
-    PlanarChainRobot,
-    Robot,
     RobotUsed,
     UnitsInfo,
-    UrdfRobot,
-    UserAugmentation,
 )
 from .runs import (
-    LimitsInfo,
-    LimitViolationInfo,
     RepeatabilityBody,
     RepeatabilityRequest,
     RepeatabilityResponse,
@@ -71,7 +54,6 @@ from .runs import (
     SolveBody,
     SolveRequest,
     SolveResponse,
-    Trajectory,
 )
 from .synthesis import (
     METHODS,
