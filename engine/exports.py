@@ -151,13 +151,13 @@ def csv_rows(columns: dict[str, Any], block: int = 1024) -> Iterator[tuple[str, 
         yield from zip(*(cells(a[lo : lo + block]) for a in arrays), strict=True)
 
 
-def csv_text(blocks: Iterable[dict[str, Any]]) -> Iterator[str]:
+def csv_text(blocks: Iterable[dict[str, Any]], newline: str = "\r\n") -> Iterator[str]:
     """The CSV text of a table given as blocks of its rows (each a :meth:`Columns.columns`
     dict, all with the same columns): the header (the column names) and the first block's rows,
     then each further block's rows, one block's text at a time (cells by :func:`csv_rows`,
-    lines ended by ``\\r\\n`` as :func:`csv.writer` ends them)."""
+    lines ended by ``newline``, by default ``\\r\\n`` as :func:`csv.writer` ends them)."""
     buffer = io.StringIO()
-    writer = csv.writer(buffer)
+    writer = csv.writer(buffer, lineterminator=newline)
     for k, block in enumerate(blocks):
         if k == 0:
             writer.writerow(list(block))

@@ -5,12 +5,12 @@ events), so that a switch of robot only draws."""
 from __future__ import annotations
 
 import logging
-import threading
 from collections.abc import Callable
 
 from ...engine.exceptions import InvalidInputError, JikError
 from .algorithms import cache_key
 from .analysis import expensive_map, kinematics_and_map
+from .listeners import Listeners
 from .messages import Event, with_figures
 from .model import DashboardState, updated_state
 from .plotting import PANELS
@@ -24,21 +24,16 @@ log = logging.getLogger("jik.dashboard")
 PREFETCH_ROBOTS = ("manipulator1", "manipulator2")
 
 
-class SolvingAhead:
+class SolvingAhead(Listeners):
     """The dashboard's work while idle (a part of
     :class:`~jik.app.dashboard.session.Dashboard`, run by its worker thread)."""
 
-    _cond: threading.Condition
-    _generation: int
     _stopped: bool
-    _state: DashboardState
     _cache: dict
     # When each robot's result solved ahead went to the page (the value of _robot_since then),
-    # the latest by robot, and since when the robot on screen is (its first result's generation).
+    # and since when the robot on screen is (its first result's generation).
     _ahead_sent: dict[str, int]
-    _latest_ahead: dict[str, Event]
     _robot_since: int
-    _emit: Callable[[Event], None]
     _solved: Callable[..., DashboardResult]
     _known_functionals: Callable[[DashboardState], tuple[tuple | None, set[str]]]
     _panel_texts: Callable[..., dict[str, str]]

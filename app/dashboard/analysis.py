@@ -1,6 +1,9 @@
 """What the h panel shows beside the runs: the state's augmenting map h, built from the registry,
 and h on a grid over the two joint variables it depends on most (its box following the runs).
-The error functionals E1 (13), E2 (18) on that grid are :mod:`jik.app.dashboard.functionals`."""
+The error functionals E1 (13), E2 (18) on that grid are :mod:`jik.app.dashboard.functionals`.
+A catalogue arm's map (or a definition's ``e2_synthesized`` one) is synthesized on first use,
+eq. (19) (:mod:`jik.engine.robot_synthesis`): :func:`built_map` shows its progress and stops it
+on a newer change; once built, the map is kept with the robot."""
 
 from __future__ import annotations
 
@@ -8,11 +11,13 @@ from collections.abc import Callable, Mapping
 
 import numpy as np
 
-from ...engine.exceptions import JikError
+from ...engine.exceptions import JikError, RunCancelled
 from ...engine.map_grid import axes_along, slice_values
+from ...engine.progress import ProgressCallbacks
+from ...engine.robot_synthesis import synthesis_progress
 from .model import DashboardState
-from .robots import state_kinematics, state_spec
-from .runs import AlgorithmRun
+from .robots import state_kinematics, state_robot, state_spec
+from .runs import AlgorithmRun, Cancelled
 
 
 def kinematics_and_map(state: DashboardState, kin=None):
@@ -22,22 +27,40 @@ def kinematics_and_map(state: DashboardState, kin=None):
     panels of one scalar h, E1 (13) and E2 (18) do not apply)."""
     spec = state_spec(state)
     kin = state_kinematics(state) if kin is None else kin
-    if vector_map(state):
+    if spec.p - spec.r > 1:
         return kin, None
     return kin, spec.augmentation(state.augmentation).build(kin, **state.augmentation_parameters)
 
 
-def vector_map(state: DashboardState) -> bool:
-    """Whether the state's robot has p - r > 1 degrees of redundancy (h a vector of maps)."""
-    spec = state_spec(state)
-    return spec.p - spec.r > 1
+#: What the progress of a synthesis says on the page.
+SYNTHESIZING = "synthesizing h (E2, eq. (19))"
+
+
+def built_map(state, progress: Callable[..., None], cancelled: Callable[[], bool]) -> tuple:
+    """:func:`~jik.app.dashboard.analysis.kinematics_and_map` of ``state``, a synthesis on the
+    way reporting ``progress(fraction, SYNTHESIZING)`` and stopped by ``cancelled()`` (then
+    :class:`Cancelled`, nothing kept)."""
+    report = ProgressCallbacks(
+        on_advance=lambda done, total: progress(min(done / total, 1.0), SYNTHESIZING),
+        is_cancelled=cancelled,
+    )
+    try:
+        with synthesis_progress(report):
+            kin, amap = kinematics_and_map(state)
+            if amap is None:  # (p - r > 1: a synthesized vector, built)
+                maps = state_robot(state).map_vectors.get(state.augmentation)
+                if callable(maps):
+                    maps()
+            return kin, amap
+    except RunCancelled:
+        raise Cancelled from None
 
 
 def vector_note(state: DashboardState) -> str | None:
     """What the panels of one scalar h say for a robot with p - r > 1 (None for p = r + 1)."""
-    if not vector_map(state):
-        return None
     spec = state_spec(state)
+    if spec.p - spec.r <= 1:
+        return None
     h = spec.augmentation(state.augmentation).description
     return (
         f"{h}: a vector of p − r = {spec.p - spec.r} maps, each kept constant by the "

@@ -26,13 +26,6 @@ CSPACE_HEIGHT = 520
 SCENE = "scene2"
 
 
-def axes_of(result: DashboardResult) -> tuple[int, int, int]:
-    """The three coordinates shown: all three for p = 3, else the state's choice (of its
-    ``cspace_axes``: "012", "013", "023" or "123"; none: the first three)."""
-    choice = result.state.cspace_axes or "012"
-    return tuple(int(c) for c in choice)  # type: ignore[return-value]
-
-
 def _level_surface(result: DashboardResult, amap, axes, lo, hi) -> dict | str:
     """h (of p = 3 variables, a cheap map) on a grid of the box, as an isosurface at h(x0); or
     why there is none."""
@@ -73,8 +66,8 @@ def _thin(x: np.ndarray) -> np.ndarray:
 def cspace_spec(result: DashboardResult) -> dict:
     """The configuration-space panel (see the module's docstring)."""
     names = result.variable_names
-    axes = axes_of(result)
-    a, b, c = axes
+    # (all three for p = 3, else the state's choice: "012", "013", "023" or "123"; none: "012")
+    axes = a, b, c = tuple(int(k) for k in result.state.cspace_axes or "012")
     data = []
     notes = []
     try:
@@ -161,7 +154,7 @@ def cspace_spec(result: DashboardResult) -> dict:
     # with the id of the page's 3D scene, #scene)
     for t in data:
         t["scene"] = SCENE
-    spec = figure(
+    return figure(
         data,
         f"Configuration space ({shown})<br><sup>{sub}</sup>",
         **{SCENE: scene},
@@ -170,4 +163,3 @@ def cspace_spec(result: DashboardResult) -> dict:
         legend=dict(orientation="h", x=0, y=0, yanchor="top", font=dict(size=10)),
         margin=dict(l=0, r=0, t=40, b=40),
     )
-    return spec

@@ -6,8 +6,6 @@ the algorithms' settings (map h, mode), the generation and that time."""
 
 from __future__ import annotations
 
-import csv
-import io
 import json
 import re
 from datetime import UTC, datetime
@@ -16,7 +14,7 @@ import numpy as np
 
 from jik import __version__
 
-from ...engine.exports import csv_rows
+from ...engine.exports import csv_text
 from ...engine.results import Trajectory
 from ...engine.units import robot_units
 from .algorithms import posture_rest
@@ -161,15 +159,8 @@ def export_csv(result: DashboardResult, when: datetime | None = None) -> str:
     """The context (:func:`csv_context`, '#' lines), then one row per trajectory point of each
     run: the columns of :func:`run_columns` (``algorithm, cycle, leg, theta, x_1.., y_1..,
     error, h``)."""
-    out = io.StringIO()
-    out.write("\n".join(csv_context(result, when)) + "\n")
-    writer = csv.writer(out, lineterminator="\n")
-    for i, a in enumerate(result.runs):
-        table = run_columns(result, a)
-        if i == 0:
-            writer.writerow(list(table))
-        writer.writerows(csv_rows(table))
-    return out.getvalue()
+    context = "".join(f"{line}\n" for line in csv_context(result, when))
+    return context + "".join(csv_text((run_columns(result, a) for a in result.runs), "\n"))
 
 
 def export_file(

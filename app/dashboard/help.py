@@ -60,6 +60,7 @@ ATLAS_HELP = (
 def page_config() -> dict:
     """What the page needs before its session: the algorithms' colours, labels and styles,
     the panels (ids, sizes, help), and when a computation shows its progress."""
+    kinds, arm = robot_kinds(), [asdict(f) for f in ARM]
     return {
         "colors": COLORS,
         "labels": LABELS,
@@ -73,13 +74,5 @@ def page_config() -> dict:
         "tools": [{"id": "atlas", "help": ATLAS_HELP}],
         # (the robot editor's fields: one description, the engine's; a catalogue arm is a kind
         # of its own, whose definition changes its task, reference, home or maps)
-        "robot_kinds": editor_kinds(),
+        "robot_kinds": {**kinds, "kinds": {**kinds["kinds"], **dict.fromkeys(ARMS, arm)}},
     }
-
-
-def editor_kinds() -> dict:
-    """The robot editor's kinds (:func:`jik.engine.robot_kinds.robot_kinds`) and the catalogue's
-    arms, each with the fields of :data:`jik.engine.robot_kinds.ARM`."""
-    kinds = robot_kinds()
-    arm = [asdict(f) for f in ARM]
-    return {**kinds, "kinds": {**kinds["kinds"], **dict.fromkeys(ARMS, arm)}}

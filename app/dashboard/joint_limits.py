@@ -10,8 +10,6 @@ joint while it is outside its limits (:func:`outside_joints`).
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 from ...engine.limits import LimitsReport, legs_report, limit_names, robot_limits
@@ -40,13 +38,6 @@ def run_limits(result, algorithm: str) -> LimitsReport | None:
     names = limit_names(state_kinematics(state))
     L = max(1, len(result.targets))
     return legs_report(limits, np.asarray(state.x0, dtype=float), legs, L, names)
-
-
-def limits_summary(result) -> dict[str, Any]:
-    """Per algorithm, ``{"within": bool, "violation": {...} or None}`` (the REST API's
-    ``limits``, of the reports ``result.limits`` the verdict says too); empty for a robot
-    without limits."""
-    return {a: report.as_dict() for a, report in result.limits.items()}
 
 
 def outside_joints(limits: np.ndarray | None, x) -> np.ndarray:

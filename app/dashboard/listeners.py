@@ -13,7 +13,8 @@ from .model import DashboardState
 
 class Listeners:
     """Subscribers and the latest events of a dashboard (a part of
-    :class:`~jik.app.dashboard.session.Dashboard`)."""
+    :class:`~jik.app.dashboard.session.Dashboard`, and the base of its other parts: its lock,
+    state and generation are theirs too)."""
 
     _cond: threading.Condition
     _listeners: list[Callable[[Event], None]]

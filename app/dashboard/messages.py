@@ -11,7 +11,6 @@ from dataclasses import dataclass
 
 from ...engine.augmentations import h_change
 from ...engine.exports import json_values as finite
-from .joint_limits import limits_summary
 from .runs import DashboardResult
 
 
@@ -103,6 +102,6 @@ def summary(result: DashboardResult) -> dict:
             "cached": bool(result.cached.get(a, False)),
             "field": run.field,
         }
-    for a, report in limits_summary(result).items():
-        out[a]["limits"] = report
+    for a, report in result.limits.items():  # ({"within": bool, "violation": {...} or None})
+        out[a]["limits"] = report.as_dict()
     return out

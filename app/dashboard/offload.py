@@ -6,14 +6,18 @@ computes the other: on two cores a change costs the slower of the two instead of
 Each dashboard has a lane (:class:`OffloadLane`); a newer change of its state gives up the
 lane's older runs (their workers finish them and are given back). If a worker dies, or the pool
 runs on no event loop (an app without its lifespan), the run is computed in the calling thread.
+The computations in the sessions' own threads take turns (:class:`FairSlots`): at most ``n`` at
+once, in the order they asked (a session that changes its state again waits behind the others).
 """
 
 from __future__ import annotations
 
+import collections
 import concurrent.futures
+import contextlib
 import logging
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any
 
 from ..compute.exceptions import ServiceUnavailable
@@ -82,3 +86,32 @@ class OffloadLane:
             running = list(self._running)
         for future in running:
             future.cancel()
+
+
+class FairSlots:
+    """``n`` slots handed out first come, first served."""
+
+    def __init__(self, n: int) -> None:
+        if n < 1:
+            raise ValueError(f"n must be >= 1, got {n}")
+        self.n = n
+        self._cond = threading.Condition()
+        self._queue: collections.deque[object] = collections.deque()
+        self._busy = 0
+
+    @contextlib.contextmanager
+    def slot(self) -> Iterator[None]:
+        """Hold a slot for the block (waiting for the turn of this thread's request)."""
+        me = object()
+        with self._cond:
+            self._queue.append(me)
+            self._cond.wait_for(lambda: self._queue[0] is me and self._busy < self.n)
+            self._queue.popleft()
+            self._busy += 1
+            self._cond.notify_all()
+        try:
+            yield
+        finally:
+            with self._cond:
+                self._busy -= 1
+                self._cond.notify_all()

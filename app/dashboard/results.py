@@ -40,9 +40,7 @@ def other_cycles(cache: dict, state: DashboardState, algorithm: str, legs: int):
         if c != state.cycles and run is not None and run.success and run.platform is None:
             found[c] = run
     more = [c for c in found if c > state.cycles]
-    if more:
-        return found[min(more)]
-    return found[max(found)] if found else None
+    return found[min(more) if more else max(found)] if found else None
 
 
 def compute(
@@ -130,22 +128,18 @@ def compute(
                 kin,
                 resume=other[algorithm],
             )
-    if offload is not None and remote is not None and away is not None:
+    if remote is not None and offload is not None and away is not None:
         cache[keys[away]] = offload.result(
             remote,
             lambda: algorithm_run(
                 state, away, targets, cycles, cancelled=cancelled, kin=kin, resume=other[away]
             ),
         )
-    runs: dict[str, AlgorithmRun] = {}
-    for algorithm in algorithms:
-        run = cache[keys[algorithm]]
-        if state.mode == "continuous":
-            run = replace(run, theta=run.theta / state.gamma)
-        runs[algorithm] = run
-    if len(cache) > 64:
-        for k in list(cache)[: len(cache) - 64]:
-            del cache[k]
+    runs: dict[str, AlgorithmRun] = {a: cache[keys[a]] for a in algorithms}
+    if state.mode == "continuous":
+        runs = {a: replace(run, theta=run.theta / state.gamma) for a, run in runs.items()}
+    for k in list(cache)[:-64]:  # (the 64 newest kept)
+        del cache[k]
     return DashboardResult(
         state=state,
         generation=generation,

@@ -3,9 +3,9 @@ listeners (the page's event stream, the scene) it tells.
 
 Every change is validated (:mod:`jik.app.dashboard.model`), bumps a generation counter and wakes
 the worker, which solves both algorithms (:func:`jik.app.dashboard.results.compute`), builds the
-figures once (:mod:`jik.app.dashboard.panel_texts`) and pushes them to every listener; a newer
+figures once (:meth:`Dashboard._panel_texts`) and pushes them to every listener; a newer
 change cancels a stale computation between legs. After each result the worker runs its second
-phase (:mod:`jik.app.dashboard.second_control`); idle, it solves the other manipulator ahead for
+phase (:mod:`jik.app.dashboard.second_phase`); idle, it solves the other manipulator ahead for
 a switch (:mod:`jik.app.dashboard.ahead`). Those parts share this class's lock, generation and
 caches, and live in their modules as the mixins :class:`Dashboard` is made of.
 """
@@ -23,20 +23,17 @@ from typing import Any, NoReturn
 from ...engine.exceptions import InvalidInputError, JikError
 from .ahead import SolvingAhead
 from .algorithms import COLORS, LABELS, cache_key, runs_key
-from .analysis import expensive_map
+from .analysis import built_map, expensive_map
 from .controls import controls_message
-from .figures import gamma_free_panels
-from .listeners import Listeners
-from .map_synthesis import built_map
+from .figures import figure_specs, gamma_free_panels
+from .functionals import functionals_key
 from .messages import Event, finite, summary, with_figures
 from .model import DashboardState, default_state, updated_state, validate
-from .offload import OffloadLane
-from .panel_texts import PanelTexts
-from .plotting import PANELS
+from .offload import FairSlots, OffloadLane
+from .plotting import PANELS, figure_json, keep_ranges
 from .results import compute
 from .runs import Cancelled, DashboardResult
-from .second_control import SecondPhaseControl
-from .slots import FairSlots
+from .second_phase import SecondPhaseControl
 from .verdict import verdict
 
 log = logging.getLogger("jik.dashboard")
@@ -45,7 +42,7 @@ log = logging.getLogger("jik.dashboard")
 DEBOUNCE = 0.002
 
 
-class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
+class Dashboard(SecondPhaseControl, SolvingAhead):
     """One session's live dashboard: one state, a worker thread, and subscribers.
 
     Parameters
@@ -80,7 +77,9 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
         # (what the parts share, each typed and described where its part declares it)
         self._listeners, self._fast = [], 0  # (Listeners)
         self._latest = {"state": self._state_event(1, self._state, "initial")}
-        self._layouts, self._functionals_cache = {}, {}  # (PanelTexts)
+        self._layouts: dict[str, tuple[tuple, dict]] = {}  # panel -> (robot, task), last layout
+        # key -> (E1/E2 functionals or None, their sensitivity)
+        self._functionals_cache: dict[str, tuple[dict | None, dict]] = {}
         self._ahead_sent, self._latest_ahead, self._robot_since = {}, {}, 0  # (SolvingAhead)
         self.result, self.functionals, self._grid_before = None, None, None  # (SecondPhaseControl)
         self._second_running = self._second_cancelled = self._rerun = None
@@ -265,6 +264,30 @@ class Dashboard(SecondPhaseControl, SolvingAhead, PanelTexts, Listeners):
                 )
 
         return report
+
+    def _known_functionals(self, state: DashboardState) -> tuple[tuple | None, set[str]]:
+        """E1/E2 and their sensitivity for ``state`` when known (same map, same fixed
+        variables), and the panels that wait for the second phase: the E1/E2 panel unless
+        known (the page dims it meanwhile instead of redrawing a placeholder, 20-40 ms of its
+        redraw)."""
+        cached = self._functionals_cache.get(functionals_key(state))
+        return cached, (set() if cached else {"sensitivity"})
+
+    def _panel_texts(
+        self, result: DashboardResult, functionals, sens, todo: set[str], remember: bool
+    ) -> dict[str, str]:
+        """The JSON of the panels in ``todo``, with sticky axes (keep_ranges): against the
+        layout each panel last went out with, for the same robot and task. ``remember``: these
+        panels go out now (a result, not one solved ahead)."""
+        layout_key = (result.state.robot, result.state.task)
+        texts = {}
+        for k, f in figure_specs(result, functionals, todo, sensitivity=sens).items():
+            shown = self._layouts.get(k)
+            keep_ranges(f, shown[1] if shown is not None and shown[0] == layout_key else None)
+            if remember:
+                self._layouts[k] = (layout_key, f["layout"])
+            texts[k] = figure_json(f)
+        return texts
 
     def _compute(self, generation: int, state: DashboardState) -> None:
 

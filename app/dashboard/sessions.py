@@ -10,7 +10,7 @@ makes room; if every session is in use the new one is refused (the route answers
 The sessions' computations share the server's one compute pool with the REST API: one
 algorithm of each run goes to its worker processes (each dashboard's
 :class:`~jik.app.dashboard.offload.OffloadLane`, first come first served), and the other is
-computed in the session's own thread, in turns of :class:`~jik.app.dashboard.slots.FairSlots`
+computed in the session's own thread, in turns of :class:`~jik.app.dashboard.offload.FairSlots`
 (at most ``dashboard_computations`` at once, in the order asked).
 """
 
@@ -25,8 +25,8 @@ from typing import Any
 
 from ..compute.settings import Settings
 from .model import default_state, updated_state
+from .offload import FairSlots
 from .session import Dashboard
-from .slots import FairSlots
 
 
 class ExportUnavailable(Exception):

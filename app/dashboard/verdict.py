@@ -3,20 +3,59 @@ was repeatable on the closed path and by how much, how much h changed along the 
 Jacobian's run, and why, in sentences the page shows as they are (the engine's
 :mod:`jik.engine.findings`, which says what repeatability is and why the extended Jacobian has
 it, and what the practical inverses beside the paper's two did; the unicycle's undefined map:
-:func:`jik.engine.reproductions.unicycle.undefined_why`).
+:func:`jik.engine.reproductions.unicycle.undefined_why`), and a warning when h is singular in the
+robot's design region (:func:`singular_points`), so that a large E1 or E2 is not read as a bad fit.
 """
 
 from __future__ import annotations
 
+import json
+
+from ...engine.exceptions import JikError
 from ...engine.findings import NAMES, PRACTICAL, Finding, practical_findings
 from ...engine.findings import verdict as run_verdict
+from ...engine.map_singularities import MapSingularities, map_singularities
 from ...engine.reproductions.unicycle import undefined_why
 from .algorithms import rest_words
+from .analysis import expensive_map, kinematics_and_map
 from .joint_limits import state_limits
+from .model import DashboardState, robot_and_map
 from .plotting import norm_unit, units
 from .robots import state_inverse, state_spec
 from .runs import AlgorithmRun, DashboardResult
-from .singular import singular_sentence
+
+
+def singular_points(state: DashboardState) -> MapSingularities | None:
+    """Where h or the extended Jacobian (10) is singular in the robot's design region; None
+    when it has none, the map is expensive to evaluate (it solves a problem per point), the
+    region's grid is too large (a 7-joint arm's) or h is regular there. Cached by what it
+    depends on: the robot, its map and their parameters, and x0."""
+    key = (json.dumps(robot_and_map(state), sort_keys=True), tuple(state.x0))
+    if key not in _CACHE:
+        if len(_CACHE) > 64:
+            _CACHE.clear()
+        _CACHE[key] = _find(state)
+    return _CACHE[key]
+
+
+_CACHE: dict[tuple[str, tuple[float, ...]], MapSingularities | None] = {}
+
+
+def _find(state: DashboardState) -> MapSingularities | None:
+    spec = state_spec(state)
+    region = dict(spec.functional_region)
+    if not region:
+        return None
+    try:
+        kin, amap = kinematics_and_map(state)
+        if amap is None or expensive_map(amap):
+            return None
+        fixed = {
+            n: v for n, v in zip(spec.variable_names, state.x0, strict=True) if n not in region
+        }
+        return map_singularities(kin, amap, region, fixed=fixed)
+    except (JikError, ValueError):
+        return None
 
 
 def _undefined_why(result: DashboardResult, run: AlgorithmRun) -> list[Finding]:
@@ -72,6 +111,7 @@ def verdict(result: DashboardResult) -> list[dict]:
     for a, report in result.limits.items():
         role = "note" if report.within else "warning"
         out.append(Finding(report.sentence(NAMES[a], robot), role, a))
-    if e is not None and (warning := singular_sentence(state)):
+    if e is not None and (found := singular_points(state)):
+        warning = found.warning(state.augmentation, state.augmentation_parameters)
         out.append(Finding(warning, "warning", "extended"))
     return [s._asdict() for s in out]

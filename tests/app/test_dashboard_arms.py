@@ -13,12 +13,12 @@ import pytest
 
 from jik.app.compute.atlas_plan import AtlasLimits, planned
 from jik.app.compute.schemas import RobotUsed, UnitsInfo
+from jik.app.dashboard.analysis import built_map
 from jik.app.dashboard.atlas import atlas_figure, atlas_request
 from jik.app.dashboard.controls import controls
 from jik.app.dashboard.export import described, export_csv
-from jik.app.dashboard.joint_limits import limits_summary, outside_joints, state_limits
+from jik.app.dashboard.joint_limits import outside_joints, state_limits
 from jik.app.dashboard.map_figures import augmenting_spec
-from jik.app.dashboard.map_synthesis import built_map
 from jik.app.dashboard.messages import summary
 from jik.app.dashboard.model import default_state, updated_state
 from jik.app.dashboard.plotting import units
@@ -80,7 +80,7 @@ def test_a_run_outside_the_limits_is_said_in_words_and_marked():
         "its upper limit -0.0698" in t
         for t in texts
     )
-    report = limits_summary(result)["pseudoinverse"]
+    report = result.limits["pseudoinverse"].as_dict()
     assert report["violation"]["joint"] == 3 and report["violation"]["cycle"] == 0
     kin = state_kinematics(state)
     assert list(outside_joints(state_limits(state), state.x0)) == [3]
@@ -99,10 +99,10 @@ def test_a_leg_leaving_the_limits_names_its_cycle_and_leg():
     }
     state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": arm})
     result = compute(state)
-    violation = limits_summary(result)["pseudoinverse"]["violation"]
+    violation = result.limits["pseudoinverse"].as_dict()["violation"]
     assert violation is not None and violation["cycle"] >= 1 and violation["leg"] >= 1
     with patch("jik.app.dashboard.joint_limits.legs_report") as legs_report:
-        verdict(result), summary(result)  # (the reports built once, by limits_summary above)
+        verdict(result), summary(result)  # (the reports built once, by result.limits above)
     legs_report.assert_not_called()
     x = result.runs["pseudoinverse"].x
     first = int(np.flatnonzero((x[:, 1] < 0.3) | (x[:, 1] > 0.55))[0])

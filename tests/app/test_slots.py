@@ -1,4 +1,4 @@
-"""Fair turns for the sessions' computations (jik.app.dashboard.slots)."""
+"""Fair turns for the sessions' computations (jik.app.dashboard.offload)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import threading
 
 import pytest
 
-from jik.app.dashboard.slots import FairSlots
+from jik.app.dashboard.offload import FairSlots
 
 
 def test_at_most_n_hold_a_slot_and_turns_go_in_the_order_asked():
