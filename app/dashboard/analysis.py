@@ -37,7 +37,7 @@ SYNTHESIZING = "synthesizing h (E2, eq. (19))"
 
 
 def built_map(state, progress: Callable[..., None], cancelled: Callable[[], bool]) -> tuple:
-    """:func:`~jik.app.dashboard.analysis.kinematics_and_map` of ``state``, a synthesis on the
+    """:func:`kinematics_and_map` of ``state``, a synthesis on the
     way reporting ``progress(fraction, SYNTHESIZING)`` and stopped by ``cancelled()`` (then
     :class:`Cancelled`, nothing kept)."""
     report = ProgressCallbacks(

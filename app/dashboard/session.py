@@ -268,8 +268,7 @@ class Dashboard(SecondPhaseControl, SolvingAhead):
     def _known_functionals(self, state: DashboardState) -> tuple[tuple | None, set[str]]:
         """E1/E2 and their sensitivity for ``state`` when known (same map, same fixed
         variables), and the panels that wait for the second phase: the E1/E2 panel unless
-        known (the page dims it meanwhile instead of redrawing a placeholder, 20-40 ms of its
-        redraw)."""
+        known (the page dims it meanwhile instead of redrawing a placeholder)."""
         cached = self._functionals_cache.get(functionals_key(state))
         return cached, (set() if cached else {"sensitivity"})
 
