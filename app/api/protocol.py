@@ -66,7 +66,6 @@ class ReadDeadlineProtocol(HttpToolsProtocol):
 
     def connection_made(self, transport: asyncio.Transport) -> None:  # type: ignore[override]
         self._read_timer: asyncio.TimerHandle | None = None
-        self._headers_read = False
         self._header_bytes = 0  # of the request being read, up to its blank line
         self._cycles: list[RequestResponseCycle] = []  # requests read and not yet answered
         super().connection_made(transport)

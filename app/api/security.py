@@ -47,15 +47,14 @@ _PAGE_POLICY = (
     "object-src 'none'"
 )
 # viser's client: one HTML file whose packed bundle is an inline script that unpacks itself
-# (eval of its own code), with workers and textures from blob: URLs and its websocket to us.
+# (eval of its own code), with workers and textures from blob: URLs and its websocket to us;
+# the API's documentation pages (Swagger UI, ReDoc), whose bootstrap is an inline script.
 _SCENE_POLICY = (
     "default-src 'self'; script-src 'self' 'unsafe-inline' 'unsafe-eval' blob:; "
     "style-src 'self' 'unsafe-inline'; img-src 'self' data: blob:; font-src 'self' data:; "
     "connect-src 'self' data: blob:; worker-src 'self' blob:; frame-ancestors 'self'; "
     "base-uri 'none'; form-action 'none'; object-src 'none'"
 )
-# The API's documentation pages (Swagger UI, ReDoc): their bootstrap is an inline script.
-_DOCS_POLICY = _SCENE_POLICY
 
 
 def _host_name(host: str) -> str:
@@ -66,10 +65,8 @@ def _host_name(host: str) -> str:
 
 
 def _policy(path: str) -> str:
-    if path.startswith("/scene/"):
+    if path.startswith(("/scene/", "/static-offline-docs")) or path == "/docs":
         return _SCENE_POLICY
-    if path == "/docs" or path.startswith("/static-offline-docs"):
-        return _DOCS_POLICY
     return _PAGE_POLICY
 
 

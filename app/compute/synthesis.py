@@ -76,6 +76,8 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
             f"extended inverse {spec.p - spec.r} formula maps instead ({{'name': 'formula', "
             "'h': [...]}})",
         )
+    if req.method != "evaluate" and req.augmentation is not None:
+        raise RequestError("augmentation", f"'{req.method}' synthesizes h; give no map")
     names, region, fixed = synthesis_region(spec, kin, req)
     if req.method == "e2_total_degree":
         return total_degree_response(req, kin, robot_used, (names, region, fixed))
@@ -83,8 +85,6 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
     coefficients: dict[str, float] = {}
     notes: list[str] = []
     if req.method == "e2_variational":
-        if req.augmentation is not None:
-            raise RequestError("augmentation", "'e2_variational' synthesizes h; give no map")
         try:
             result = synthesize_e2(kin, region, degree=req.degree, fixed=fixed)
         except JikError as exc:

@@ -81,8 +81,6 @@ def total_degree_response(
     fitting rule and on an independent one, its convergence with the degree and the nodes,
     h_1 on a grid, the basis and coefficients."""
     names, region, fixed = box
-    if req.augmentation is not None:
-        raise RequestError("augmentation", "'e2_total_degree' synthesizes h; give no map")
     degree = TOTAL_DEGREE if req.degree is None else req.degree
     try:
         res = synthesize_e2_nd(

@@ -55,13 +55,10 @@ def work_of(fn: Callable) -> tuple[str, str]:
 def solve_batch(items: list[bytes]) -> list[tuple[str, Any]]:
     """/solve requests (JSON) solved by one engine call: each one's (status, response)."""
     reqs = [S.SolveRequest.model_validate_json(b) for b in items]
-    out: list[tuple[str, Any]] = []
-    for res in solve_batch_json(reqs):
-        if isinstance(res, RequestError):
-            out.append(("request_error", (res.field, res.message)))
-        else:
-            out.append(("ok", res))
-    return out
+    return [
+        ("request_error", (r.field, r.message)) if isinstance(r, RequestError) else ("ok", r)
+        for r in solve_batch_json(reqs)
+    ]
 
 
 @task("cycles", "fewer cycles or path points, a lower max_iterations")
