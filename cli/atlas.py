@@ -243,7 +243,7 @@ def _run(args: argparse.Namespace) -> int:
         box=None if args.arc or not spec.x_range else spec.x_range,
         shifts=[_numbers(s, "--shift") for s in args.shift] or None,
         scales=args.scale or None,
-        chunk=args.chunk or None,
+        chunk=args.chunk,
         gamma=spec.default_gamma,
         mode=spec.default_mode,
     )

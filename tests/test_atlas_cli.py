@@ -216,6 +216,16 @@ def test_a_path_that_is_not_numbers_is_refused(tmp_path, capsys):
     assert "--path must be comma-separated numbers" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("chunk", ["0", "-3"])
+def test_a_chunk_below_one_is_refused_as_the_engine_says(tmp_path, capsys, chunk):
+    """--chunk 0 is refused like any chunk outside 1 to 65536, not taken as the default."""
+    assert (
+        main(["atlas", "--path", TABLE1, "--chunk", chunk, "--out", str(tmp_path / "x.json")]) == 2
+    )
+    err = capsys.readouterr().err
+    assert err == f"jik atlas: chunk must be between 1 and 65536, got {chunk} (field chunk)\n"
+
+
 def test_a_dask_scheduler_out_of_reach_is_one_line_and_exit_2(tmp_path, capsys, monkeypatch):
     """A scheduler that does not answer (Dask's connect timeout, an OSError) is said in one
     line, not a traceback."""
