@@ -31,7 +31,7 @@ from .repeatability import MAX_CYCLES, MAX_PATH_POINTS, open_loop
 from .self_motion import SelfMotionManifold, project, trace
 from .solve_rules import MAX_ITERATIONS_LIMIT, MODES, check_gamma, chunk_limit
 from .solver import solve_batch
-from .validation import FloatArray, as_points, count, positive
+from .validation import FloatArray, as_points, as_series, check_seed, count, positive
 
 #: Largest number of starts per path, of paths in a family, and of starts in a chunk. A chunk
 #: must also fit in the memory bound (:func:`~jik.engine.solve_rules.chunk_limit`); the starts
@@ -288,15 +288,11 @@ def plan_atlas(
         if shifts is None
         else _checked(lambda: as_points(shifts, kin.r, "shifts"), "shifts")
     )
-    scale = (
-        np.ones(1)
-        if scales is None
-        else _checked(lambda: np.asarray(scales, dtype=float), "scales")
-    )
-    if shift.ndim != 2 or scale.ndim != 1 or not len(shift) or not len(scale):
-        raise InvalidInputError("shifts must be (S, r) and scales (Q,), both non-empty", "shifts")
-    if not np.all(np.isfinite(scale) & (scale > 0)):
-        raise InvalidInputError("scales must be finite and > 0", field="scales")
+    scale = np.ones(1) if scales is None else as_series(scales, "scales")
+    if shift.ndim != 2 or not len(shift):
+        raise InvalidInputError(f"shifts must be one or more task points (S, {kin.r})", "shifts")
+    if not len(scale) or not np.all(np.isfinite(scale) & (scale > 0)):
+        raise InvalidInputError("scales must be finite and > 0, one or more of them", "scales")
     if len(shift) * len(scale) > MAX_PATHS:
         raise InvalidInputError(f"at most {MAX_PATHS} paths (shifts x scales)", field="shifts")
     paths = family(base_path, shift, scale)
@@ -342,7 +338,7 @@ def plan_atlas(
         raise InvalidInputError(
             f"sampling must be 'grid' or 'sample', got {sampling!r}", "sampling"
         )
-    seed = _checked(lambda: count(seed, "seed", 0, 2**63 - 1), "seed")
+    seed = check_seed(seed)
     ref = _checked(lambda: kin.check(reference, "reference"), "reference")
     if ref.ndim != 1:
         raise InvalidInputError(f"reference must be one configuration ({kin.p},)", "reference")

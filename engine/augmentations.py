@@ -2,22 +2,25 @@
 
 The paper's analytic maps: Manipulator 1, (32) ``e1_optimal``, (33) ``e1_taylor``, (36)
 ``e2_optimal``; Manipulator 2, (38) ``paper_cubic`` as printed. A map is evaluated batched:
-``value`` (..., p) -> (...,), ``gradient`` (..., p) -> (..., p).
+``value`` (..., p) -> (...,), ``gradient`` (..., p) -> (..., p); each checks that its ``x`` has
+p columns, at the base class (:class:`AugmentingMap`).
 """
 
 from __future__ import annotations
 
 import abc
 from collections.abc import Mapping
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
 from .exceptions import InvalidInputError
-from .validation import FloatArray, as_numbers, finite
+from .validation import FloatArray, as_numbers, as_points, checked_points, finite
 
 #: h counts as conserved along a run when it changed by less than this (:func:`h_change`).
 H_CONSERVED = 1e-6
+#: The evaluations of a map, each of which checks its ``x`` (:meth:`AugmentingMap.check`).
+CHECKED = ("value", "gradient", "value_masked", "gradient_masked")
 
 
 def h_change(h) -> float | None:
@@ -46,7 +49,20 @@ def h_change(h) -> float | None:
 
 
 class AugmentingMap(abc.ABC):
-    """h: R^p -> R^(p-r) with p - r = 1, eq. (9); dh/dx is its exact gradient."""
+    """h: R^p -> R^(p-r) with p - r = 1, eq. (9); dh/dx is its exact gradient.
+
+    Each of :data:`CHECKED` a subclass defines is wrapped, when the class is made, by the check
+    of ``x`` (:meth:`check`: numbers of shape (..., p), :class:`InvalidInputError` with field
+    ``"x"`` otherwise), as the kinematics' evaluations are; a float array of p columns passes
+    in about a microsecond.
+    """
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        for name in CHECKED:
+            core = cls.__dict__.get(name)
+            if core is not None and not getattr(core, "__isabstractmethod__", False):
+                setattr(cls, name, checked_points(core, finite=False))
 
     name: ClassVar[str]
     p: int
@@ -62,6 +78,11 @@ class AugmentingMap(abc.ABC):
     @abc.abstractmethod
     def gradient(self, x: FloatArray) -> FloatArray:
         """dh/dx: (..., p) -> (..., p)."""
+
+    def check(self, x, name: str = "x", field: str | None = None) -> FloatArray:
+        """Validate configurations: numbers of shape (..., p); NaN and inf are let through (h
+        is undefined there, as at a diverged solver's iterate)."""
+        return as_points(x, self.p, name, field, finite=False)
 
     def value_masked(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
         """h(x) and where it is undefined (NaN there), without raising."""

@@ -58,14 +58,14 @@ class VectorExtendedInverse(Inverse):
             raise InvalidInputError(
                 f"the extended inverse of {kinematics.name} needs p - r = "
                 f"{kinematics.p - kinematics.r} augmenting maps, got {len(maps)}",
-                "augmentation",
+                "augmenting_maps",
             )
         for i, m in enumerate(maps):
             if m.p != kinematics.p:
                 raise InvalidInputError(
                     f"augmenting map {i} is defined on R^{m.p}, but "
                     f"{kinematics.name} has p = {kinematics.p}",
-                    "augmentation",
+                    f"augmenting_maps.{i}",
                 )
         self.kinematics = kinematics
         self.augmenting_maps = maps

@@ -31,6 +31,7 @@ from .augmentations import H_CONSERVED, h_change
 from .exports import plural
 from .limits import limit_names
 from .repeatability import REPEATABLE_DRIFT, repeatable
+from .validation import as_series, flag, of_type
 
 #: In discrete mode, a gamma at or above this is "near 2" (the iteration's stability limit).
 GAMMA_NEAR_TWO = 1.5
@@ -94,8 +95,12 @@ def run_findings(
 ) -> list[tuple[str, str]]:
     """What the run named ``name`` did: on a closed path (``closed``) with completed cycles
     (``drift`` (cycles,)) its :func:`drift_sentence`, else the solver's ``message`` when it
-    succeeded; and, when it did not, where it stopped ("failure")."""
-    n = len(drift)
+    succeeded; and, when it did not, where it stopped ("failure"). ``name``, ``message`` and
+    ``unit`` are strings, ``success`` and ``closed`` booleans (InvalidInputError otherwise)."""
+    for text, field in ((name, "name"), (message, "message"), (unit, "unit")):
+        of_type(text, str, field, "a string")
+    drift, success = as_series(drift, "drift"), flag(success, "success")
+    closed, n = flag(closed, "closed"), len(drift)
     out = []
     if closed and n:
         out.append((drift_sentence(name, drift, unit), "finding"))

@@ -8,16 +8,14 @@ which check their inputs at their own entry, call the unchecked cores (``forward
 from __future__ import annotations
 
 import abc
-import functools
 import math
-from collections.abc import Callable
 from typing import Any, ClassVar
 
 import numpy as np
 
 from .exceptions import InvalidInputError, KinematicSingularityError
 from .exports import call_repr
-from .validation import FloatArray, as_points, positive
+from .validation import FloatArray, as_points, checked_points, positive
 
 #: m(x) below this counts as a kinematic singularity.
 SINGULAR_MANIPULABILITY = 1e-9
@@ -49,29 +47,6 @@ def kernel_cofactors(J: FloatArray) -> FloatArray:
     return minors * signs
 
 
-def _checked(core: Callable[..., Any]) -> Callable[..., Any]:
-    """``core(self, x)`` behind the check of ``x`` (:meth:`Kinematics.check`).
-
-    The common case costs about a microsecond: a float array of the right width whose sum is
-    finite is finite; anything else (a sum that overflows, a list, a wrong shape, NaN) takes
-    the full check, which raises or returns the array.
-    """
-
-    @functools.wraps(core)
-    def evaluation(self, x, *args, **kwargs):
-        if not (
-            type(x) is np.ndarray
-            and x.dtype == np.float64
-            and x.ndim
-            and x.shape[-1] == self.p
-            and math.isfinite(np.add.reduce(x, axis=None))
-        ):
-            x = self.check(x, "x")
-        return core(self, x, *args, **kwargs)
-
-    return evaluation
-
-
 class Kinematics(abc.ABC):
     """k: R^p -> R^r with p - r degrees of redundancy (paper, eq. (4)).
 
@@ -92,7 +67,7 @@ class Kinematics(abc.ABC):
             if core is None or getattr(core, "__isabstractmethod__", False):
                 continue
             setattr(cls, f"{name}_unchecked", core)
-            setattr(cls, name, _checked(core))
+            setattr(cls, name, checked_points(core))
 
     name: ClassVar[str]
     p: int  # configuration-space dimension

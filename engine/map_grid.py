@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .augmentations import AugmentingMap
-from .exceptions import JikError
+from .exceptions import InvalidInputError, JikError
 from .inverses import require_map
 from .kinematics import Kinematics, held_values
 from .progress import ProgressCallbacks
@@ -130,13 +130,19 @@ def map_grid(
     ------
     InvalidInputError
         A region or fixed value that is not one of the variables' (field ``region.<name>``,
-        ``fixed``), an empty or reversed interval, or ``n`` out of range.
+        ``fixed``), an empty or reversed interval, ``n`` out of range, or ``kinematics`` not a
+        robot nor names, or of another number of variables than the map's p.
     """
     if isinstance(kinematics, Kinematics):
         names, default = list(kinematics.names), list(held_values(kinematics))
     else:
-        names, default = list(kinematics), None
+        names, default = _names(kinematics), None
     amap = require_map(amap, names, "amap")
+    if len(names) != amap.p:
+        raise InvalidInputError(
+            f"kinematics must have the map's p = {amap.p} variables, got {len(names)}: {names}",
+            "kinematics",
+        )
     region, held = check_box_region(names, region, fixed, default)
     n = count(n, "n", 2, MAX_N)
     if len(region) < 2:
@@ -163,6 +169,19 @@ def map_grid(
                 except JikError:
                     pass
     return MapGrid({axes[0]: a, axes[1]: b}, h)
+
+
+def _names(kinematics) -> list[str]:
+    """The variables' names given instead of a robot: a list of strings, else an
+    InvalidInputError naming ``kinematics``."""
+    if isinstance(kinematics, Sequence) and not isinstance(kinematics, str):
+        if all(isinstance(n, str) for n in kinematics):
+            return list(kinematics)
+    raise InvalidInputError(
+        "kinematics must be a Kinematics or its variables' names (a list of strings), got "
+        f"{type(kinematics).__name__} {kinematics!r:.60}",
+        "kinematics",
+    )
 
 
 def _batched(amap: AugmentingMap, x: FloatArray, batch: int, on_batch) -> tuple:

@@ -25,7 +25,7 @@ from .inverses import Inverse, Pseudoinverse, require_kinematics
 from .kinematics import SINGULAR_MANIPULABILITY, Kinematics
 from .limits import limit_names, robot_limits
 from .linalg import gram, solve_small
-from .validation import FloatArray, finite, within
+from .validation import FloatArray, as_box, finite, flag, within
 
 #: Largest damping lambda and damping threshold accepted.
 MAX_DAMPING = 10.0
@@ -194,16 +194,7 @@ class WeightedInverse(Inverse):
 
     def __init__(self, kinematics: Kinematics, limits) -> None:
         self.kinematics = kinematics = require_kinematics(kinematics)
-        lim = np.asarray(limits, dtype=float)
-        if (
-            lim.shape != (kinematics.p, 2)
-            or np.isnan(lim).any()
-            or not np.all(lim[:, 0] < lim[:, 1])
-        ):
-            raise InvalidInputError(
-                f"limits must be {kinematics.p} pairs [lo, hi] with lo < hi", "limits"
-            )
-        self.limits = lim
+        self.limits = as_box(limits, kinematics.p, "limits", finite=False)
 
     @property
     def parameters(self) -> dict[str, object]:
@@ -233,7 +224,7 @@ class WeightedInverse(Inverse):
         winv = self.weights_inverse(x)
         Jw = J * winv[..., None, :]
         M = Jw @ np.swapaxes(J, -1, -2)
-        bad = ~(np.abs(np.linalg.det(M)) >= SINGULAR_MANIPULABILITY**2)
+        bad = ~(np.abs(np.linalg.det(M)) >= SINGULAR_MANIPULABILITY**2) | self.outside(x)
         self._raise_if(x, bad)
         return np.swapaxes(Jw, -1, -2) @ np.linalg.inv(M)
 
@@ -291,7 +282,7 @@ class PostureInverse(Inverse):
         self, kinematics: Kinematics, rest, gain: float = 1.0, rest_given: bool = True
     ) -> None:
         self.kinematics = kinematics = require_kinematics(kinematics)
-        self.rest_given = rest_given
+        self.rest_given = rest_given = flag(rest_given, "rest_given")
         self.rest = check_rest(kinematics, rest, limited=rest_given)
         self.gain = _nonnegative(gain, "gain", MAX_GAIN)
         self._plain = Pseudoinverse(kinematics)

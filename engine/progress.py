@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from .exceptions import InvalidInputError, JikError, RunCancelled
+from .validation import flag
 
 if TYPE_CHECKING:
     from .repeatability import Leg
@@ -86,6 +87,16 @@ class ProgressCallbacks(Progress):
     on_advance: Callable[[float, float], None] | None = None
     is_cancelled: Callable[[], bool] | None = None
     stop_at_error: bool = False
+
+    def __post_init__(self) -> None:
+        for name in ("on_leg", "on_advance", "is_cancelled"):
+            value = getattr(self, name)
+            if value is not None and not callable(value):
+                raise InvalidInputError(
+                    f"{name} must be a function or None, got {type(value).__name__} {value!r:.60}",
+                    name,
+                )
+        flag(self.stop_at_error, "stop_at_error")
 
     def leg(self, leg: Leg) -> None:
         if self.on_leg is not None:

@@ -13,7 +13,7 @@ from .exceptions import InvalidInputError
 from .inverses import require_kinematics
 from .kinematics import Kinematics
 from .self_motion import project
-from .validation import FloatArray, as_box, finite
+from .validation import FloatArray, as_box, check_seed, positive
 
 #: Starts on a self-motion manifold lie within this fraction of the box's width around x0.
 START_SPREAD = 0.15
@@ -40,9 +40,9 @@ def manifold_starts(
     box : sequence of p (low, high)
         The configurations allowed (the robot's ``x_range``); starts outside are left out.
     spread : float
-        The farthest step, as a fraction of the box's narrowest finite width.
+        The farthest step, as a fraction (0, 1] of the box's narrowest finite width.
     seed : int
-        The random directions' seed: the same starts for the same arguments.
+        The random directions' seed, 0 to 2^63 - 1: the same starts for the same arguments.
 
     Returns
     -------
@@ -58,6 +58,11 @@ def manifold_starts(
     if isinstance(n, bool) or not isinstance(n, int | np.integer) or not 1 <= n <= 10**5:
         raise InvalidInputError(f"n must be an integer from 1 to 100000, got {n!r}", "n")
     lim = as_box(box, kinematics.p, finite=False)
+    spread, seed = positive(spread, "spread"), check_seed(seed)
+    if spread > 1:
+        raise InvalidInputError(
+            f"spread must be a fraction of the box, in (0, 1], got {spread:g}", "spread"
+        )
     y0 = kinematics.forward(x0)
     J = np.asarray(kinematics.jacobian(x0), dtype=float)
     null = np.eye(kinematics.p) - np.linalg.pinv(J) @ J
@@ -65,7 +70,7 @@ def manifold_starts(
     d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
     widths = lim[:, 1] - lim[:, 0]
     width = float(np.min(widths[np.isfinite(widths)], initial=2 * np.pi))
-    step = finite(spread, "spread") * width * np.linspace(0.0, 1.0, n)
+    step = spread * width * np.linspace(0.0, 1.0, n)
     X = project(kinematics, x0 + step[:, None] * d, y0)
     X[0] = x0
     ok = (np.linalg.norm(kinematics.forward(X) - y0, axis=1) < 1e-10) & np.all(

@@ -43,7 +43,7 @@ from .total_degree import (
     basis_size,
     total_degree_indices,
 )
-from .validation import FloatArray, count
+from .validation import FloatArray, check_seed, count
 
 #: Largest basis the synthesis assembles (its stiffness matrix is dense, unknowns^2 floats).
 MAX_UNKNOWNS = 4000
@@ -251,7 +251,7 @@ def synthesize_e2_nd(
         Quadrature nodes: a power of two (a Sobol rule's balance needs it), at least twice the
         number of unknowns.
     seed : int
-        Seed of the scrambling (the result is a deterministic function of it).
+        Seed of the scrambling, 0 to 2^63 - 1 (the result is a deterministic function of it).
     frame_axes : sequence of int, optional
         1-based joints whose axes fix the kernel frame for p - r >= 2 (:func:`kernel_frame`);
         default: the best conditioned at the box's centre (:func:`best_frame_axes`).
@@ -271,7 +271,7 @@ def synthesize_e2_nd(
         raise InvalidInputError(f"{kinematics.name} has no redundancy (p = r)", "robot")
     (box, fix), progress = check_region(kinematics, region, fixed), check_progress(progress)
     d = len(box)
-    degree = count(degree, "degree", 1, 32)
+    degree, seed = count(degree, "degree", 1, 32), check_seed(seed)
     nodes = count(nodes, "nodes", 64, MAX_NODES)
     if nodes & (nodes - 1):
         raise InvalidInputError(f"nodes must be a power of two, got {nodes}", "nodes")

@@ -24,11 +24,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .exceptions import InvalidInputError
 from .exports import coordinate_names
 from .inverses import require_kinematics
 from .limits import robot_limits
 from .planar_chain import PlanarChain
 from .urdf import UrdfChain
+from .validation import of_type
 
 #: The unit of each task coordinate of a pose task (:mod:`jik.engine.pose_task`) and of a
 #: planar chain's (x, y, the end's angle phi).
@@ -193,12 +195,17 @@ def robot_units(kinematics, task_names: Sequence[str] | None = None) -> RobotUni
     task_names : sequence of str, shape (r,), optional
         The task coordinates' names (a spec's ``task_names``); default: the kinematics' own
         (a URDF arm's), else ``y1 .. yr``.
+
+    Raises
+    ------
+    InvalidInputError
+        ``kinematics`` not a Kinematics; ``task_names`` not r strings.
     """
     kinematics = require_kinematics(kinematics)
     if task_names is None:
         default = tuple(f"y{i + 1}" for i in range(kinematics.r))
         task_names = getattr(kinematics, "task_names", None) or default
-    names = tuple(task_names)
+    names = _task_names(task_names, kinematics.r)
     x, y, lengths = _units(kinematics, names)
     limits = robot_limits(kinematics)
     bounds = [None] * kinematics.p if limits is None else [_bounds(b) for b in limits]
@@ -211,6 +218,18 @@ def robot_units(kinematics, task_names: Sequence[str] | None = None) -> RobotUni
     )
     task = tuple(Coordinate(n, u) for n, u in zip(names, y, strict=True))
     return RobotUnits(variables, task, lengths)
+
+
+def _task_names(task_names, r: int) -> tuple[str, ...]:
+    """``task_names`` as a tuple of r strings, else an InvalidInputError naming it."""
+    names = of_type(task_names, Sequence, "task_names", f"a list of {r} names")
+    if isinstance(names, str) or len(names) != r or not all(isinstance(n, str) for n in names):
+        raise InvalidInputError(
+            f"task_names must be {r} strings, one per task coordinate (r = {r}), got "
+            f"{task_names!r:.80}",
+            "task_names",
+        )
+    return tuple(names)
 
 
 def _bounds(pair) -> tuple[float | None, float | None]:

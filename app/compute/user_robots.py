@@ -39,6 +39,8 @@ def request_field(field: str | None, robot_keys: Sequence[str]) -> str:
     parts = (field or "").split(".")
     if parts[0] == "augmentations":
         parts = ["augmentation", *parts[2:]]
+    elif parts[0] == "augmenting_maps":  # (a vector of maps, VectorExtendedInverse's argument)
+        parts = ["augmentation"]
     elif parts[0] in robot_keys:
         parts = ["robot", *parts]
     elif parts[0] != "augmentation":
