@@ -21,13 +21,14 @@ from .validation import FloatArray, as_points, as_vector, count, positive
 PANEL_NODES = 16
 #: Largest phase change [rad] of q3 (and of sin t) allowed within one panel.
 PANEL_PHASE = 8.0
-#: Nodes of the single Gauss-Legendre rule on [0, T]: ceil(NODES_PER_RAD * phase / 2) + MARGIN.
-NODES_PER_RAD = 1.25
-NODES_MARGIN = 16
-#: Most nodes of that rule, and of a path's composite rule: (|l20| + |l21| + 1) T up to about
-#: 13,000 rad, every start the API takes at T = 2 pi. Beyond it the quadrature's arrays (and the
-#: time to compute the rule) grow with the controls' size, which a diverging solve can make
-#: arbitrarily large: without this bound one request can take tens of GB.
+#: Error bound, relative to each moment's scale, that the single rule on [0, T] is sized for.
+QUADRATURE_TOL = 1e-15
+#: Half-widths b in t of the Bernstein ellipses tried when sizing that rule (:func:`nodes_for`).
+HALF_WIDTHS = np.geomspace(1e-4, 40.0, 256)
+#: Most nodes of that rule, and of a path's composite rule: every start the API takes at
+#: T = 2 pi (|l20|, |l21| up to 1000). Beyond it the quadrature's arrays (and the time to compute
+#: the rule) grow with the controls' size, which a diverging solve can make arbitrarily large:
+#: without this bound one request can take tens of GB.
 MAX_NODES = 8192
 #: Largest rule computed by numpy's Golub-Welsch (a dense n x n eigenproblem, O(n^2) memory);
 #: larger ones by scipy's banded solver, O(n) memory (the two agree to 1e-13).
@@ -70,7 +71,8 @@ def _moment_basis(T: float, nodes: int) -> tuple[FloatArray, FloatArray, FloatAr
 
 
 def _phase(lam: FloatArray, length: float) -> float:
-    """Bound on the phase advance of the integrands over ``length``, batch maximum."""
+    """Bound on the phase advance of the integrands over ``length``, batch maximum (sizes the
+    panels of a path: over a panel's few radians the largest rate bounds the phase)."""
     lam = np.asarray(lam, dtype=float)
     return (1.0 + float(np.max(np.abs(lam[..., 2]) + np.abs(lam[..., 3]), initial=0.0))) * length
 
@@ -80,15 +82,48 @@ def nodes_for(lam: FloatArray, T: float) -> int:
 
     Notes
     -----
-    The integrands are products of cos q3 / sin q3 with polynomials in t and sin t, cos t.
-    Their phase advances at most Phi = (|l20| + |l21| + 1) T over [0, T], because
-    |dq3/dt| = |u2| <= |l20| + |l21| and sin t, cos t have unit frequency. An N-point
-    Gauss-Legendre rule integrates e^(i w t) on an interval of half-phase Phi / 2 with an error
-    that falls super-exponentially once N exceeds about e Phi / 4; N = ceil(1.25 Phi / 2) + 16
-    gave <= 1e-12 against solve_ivp for |l20|, |l21| up to 30 (and the tests check 1e-9). The
-    count is the batch maximum, so one rule (cached) serves the whole batch.
+    The integrands of eq. (42) and of its derivatives are f(t) = P(t) g(t) exp(+-i q3(t)):
+    P a polynomial of degree <= 2 in t, g a product of at most three of sin t and 1 - cos t, and
+    q3 = l20 t + l21 (1 - cos t). With t = T (xi + 1) / 2, f is entire in xi; on the Bernstein
+    ellipse E_rho, of half-width b = T (rho - 1/rho) / 4 in t,
+    |exp(+-i q3)| <= exp(|l20| b + |l21| sinh b), |g| <= (2 cosh b)^3 and
+    |P / P's scale| <= ((rho + 1/rho) / 2 + 1)^2 / 4. An N-point Gauss-Legendre rule errs by at
+    most 64 M rho^(-2N) / (15 (rho^2 - 1)) for |f| <= M on E_rho (Trefethen, Approximation
+    Theory and Approximation Practice, Theorem 19.3); N is the least count that brings this
+    under :data:`QUADRATURE_TOL` for the best of the ellipses :data:`HALF_WIDTHS`.
+
+    The sinh b term holds the sidebands of l21 cos t (Bessel orders beyond |l21|): over horizons
+    of many periods a count from the largest rate |dq3/dt| <= |l20| + |l21| alone is too small.
+    The count is for the batch's largest |l20|, |l21|, rounded up to steps of 2^(1/16) so that
+    nearby controls (a solver's iterates) share one cached count and one cached rule.
     """
-    return _bounded(np.ceil(NODES_PER_RAD * 0.5 * _phase(lam, T)) + NODES_MARGIN, lam, T)
+    lam = np.asarray(lam, dtype=float)
+    l20, l21 = np.max(np.abs(lam[..., 2:4]).reshape(-1, 2), axis=0, initial=0.0)
+    return _bounded(_rule_size(_round_up(l20), _round_up(l21), float(T)), lam, T)
+
+
+def _round_up(v: float) -> float:
+    """``v`` >= 0 rounded up to the grid 2^(k/16); 0, inf and NaN as they are."""
+    if not 0.0 < v < np.inf:
+        return float(v)
+    return float(2.0 ** (np.ceil(16.0 * np.log2(v)) / 16.0))
+
+
+@functools.lru_cache(maxsize=1024)
+def _rule_size(l20: float, l21: float, T: float) -> float:
+    """The least N of :func:`nodes_for`'s bound for |l20|, |l21| over [0, T] (inf for NaN)."""
+    if not (np.isfinite(l20) and np.isfinite(l21)):
+        return np.inf
+    b = HALF_WIDTHS
+    rho = 2.0 * b / T + np.sqrt((2.0 * b / T) ** 2 + 1.0)
+    log_m = (
+        l20 * b
+        + l21 * np.sinh(b)
+        + 3.0 * np.log(2.0 * np.cosh(b))
+        + 2.0 * np.log(0.5 * (0.5 * (rho + 1.0 / rho) + 1.0))
+    )
+    n = (log_m + np.log(64.0 / (15.0 * (rho * rho - 1.0) * QUADRATURE_TOL))) / (2.0 * np.log(rho))
+    return float(np.ceil(np.min(n)))
 
 
 def panels_for(lam: FloatArray, length: float) -> int:
