@@ -172,7 +172,7 @@ class UrdfChain(Kinematics):
             ChainJoint(
                 j.name,
                 {"fixed": "fixed", "prismatic": "prismatic"}.get(j.type, "revolute"),
-                np.eye(4) if j.origin is None else np.asarray(j.origin, dtype=float),
+                _origin(j),
                 np.array([1.0, 0.0, 0.0]) if j.type == "fixed" else _unit(j.axis, j.name),
                 active.index(j.name) if j.name in active else -1,
                 float(locked.get(j.name, 0.0)),
@@ -303,6 +303,14 @@ def _unit(axis, name: str) -> FloatArray:
     return a / n
 
 
+def _origin(joint) -> FloatArray:
+    """The joint's fixed origin (4, 4): identity when the URDF gives none."""
+    origin = np.eye(4) if joint.origin is None else np.asarray(joint.origin, dtype=float)
+    if not np.all(np.isfinite(origin)):
+        raise InvalidInputError(f"joint {joint.name!r} has a NaN or infinite origin", "urdf")
+    return origin
+
+
 def _declared(joint) -> tuple[float, float] | None:
     """The joint's URDF limits [rad or m], or None for a continuous joint or one whose limits
     are missing or empty (lower = upper).
@@ -310,12 +318,15 @@ def _declared(joint) -> tuple[float, float] | None:
     Raises
     ------
     InvalidInputError
-        If its lower limit is above its upper one (field ``urdf``, naming the joint).
+        If a limit is NaN or its lower limit is above its upper one (field ``urdf``, naming
+        the joint).
     """
     lim = joint.limit
     if joint.type == "continuous" or lim is None or lim.lower is None or lim.upper is None:
         return None
     lo, hi = float(lim.lower), float(lim.upper)
+    if math.isnan(lo) or math.isnan(hi):
+        raise InvalidInputError(f"joint {joint.name!r} has a NaN limit", "urdf")
     if lo > hi:
         raise InvalidInputError(
             f"joint {joint.name!r} has its lower limit {lo:g} above its upper limit {hi:g}",

@@ -141,6 +141,10 @@ def parse_urdf(text, field: str = "urdf"):
             build_collision_scene_graph=False,
             load_collision_meshes=False,
         )
+    except KeyError as exc:  # an element without an attribute yourdfpy reads
+        raise InvalidInputError(
+            f"{field}: not a valid URDF (an element lacks its {exc} attribute)", field
+        ) from None
     except Exception as exc:  # yourdfpy raises whatever its XML walk meets
         raise InvalidInputError(f"{field}: not a valid URDF ({exc})", field) from None
     if model.robot is None or not model.robot.links:

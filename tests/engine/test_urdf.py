@@ -152,6 +152,24 @@ def test_repeatability_pseudoinverse_drifts_extended_returns(arm):
             "urdf",
             "joint 'shoulder' has its lower limit 2 above its upper limit -2",
         ),
+        (
+            {
+                "end_link": "tool",
+                "urdf": TEXT.replace('<limit lower="-2.0"', '<limit lower="nan"'),
+            },
+            "urdf",
+            "joint 'shoulder' has a NaN limit",
+        ),
+        (
+            {"end_link": "tool", "urdf": TEXT.replace('xyz="0 0 0.2" rpy', 'xyz="0 inf 0.2" rpy')},
+            "urdf",
+            "joint 'shoulder' has a NaN or infinite origin",
+        ),
+        (
+            {"end_link": "tool", "urdf": TEXT.replace('<robot name="arm4">', "<robot>")},
+            "urdf",
+            "an element lacks its 'name' attribute",
+        ),
     ],
 )
 def test_bad_definitions_name_the_field(kwargs, field, text):
