@@ -99,7 +99,11 @@ def _common(p: argparse.ArgumentParser) -> None:
         "with --task)",
     )
     add_task_option(p)
-    p.add_argument("--x0", help="start configuration, e.g. '0, 0, pi/2' (default: the robot's)")
+    p.add_argument(
+        "--x0",
+        help="start configuration, e.g. '0, 0, pi/2' (a leading minus: --x0=-1,0,0; default: "
+        "the robot's)",
+    )
     p.add_argument("--algorithm", choices=ALGORITHM_NAMES, default="pseudoinverse")
     p.add_argument("--augmentation", help="augmenting map of the extended inverse (its name)")
     add_algorithm_parameter_options(p)
@@ -110,6 +114,15 @@ def _common(p: argparse.ArgumentParser) -> None:
         help="algorithm (7) continuous (ODE) or discrete (default: the robot's)",
     )
     p.add_argument("--gamma", type=float, default=None, help="decay rate (discrete: step)")
+    p.add_argument(
+        "--tol", type=float, default=None, help="task error at which a solve stops (default 1e-10)"
+    )
+    p.add_argument(
+        "--max-iterations",
+        type=int,
+        default=None,
+        help="most steps (continuous) or iterations (discrete) per solve (default: the engine's)",
+    )
     p.add_argument("--json", action="store_true", help="print machine-readable JSON")
 
 
@@ -119,6 +132,8 @@ def _setup(args: argparse.Namespace) -> tuple[Robot, list[float], dict]:
     settings = {
         "mode": args.mode or robot.spec.default_mode,
         "gamma": args.gamma if args.gamma is not None else robot.spec.default_gamma,
+        "max_iterations": args.max_iterations,
+        **({} if args.tol is None else {"tol": args.tol}),
     }
     return robot, x0, settings
 
@@ -248,14 +263,16 @@ def add_robot_commands(sub) -> None:
     """Register ``solve`` and ``repeatability`` on the ``jik`` command's subparsers."""
     p = sub.add_parser("solve", help="solve k(x) = target for a robot (file or built-in name)")
     _common(p)
-    p.add_argument("--target", help="task point, e.g. '1, 1.5' (default: the robot's)")
+    p.add_argument(
+        "--target", help="task point, e.g. '1, 1.5' (--target=-1,1.5; default: the robot's)"
+    )
     p.set_defaults(func=_guarded(solve_command))
 
     p = sub.add_parser("repeatability", help="drive a robot around a closed task path")
     _common(p)
     p.add_argument(
         "--path",
-        help="task points 'y1,y2; y1,y2; ...' (default: the robot's); "
+        help="task points 'y1,y2; y1,y2; ...' (--path='-1,1; 1,1'; default: the robot's); "
         "the return leg to k(x0) closes it",
     )
     p.add_argument("--cycles", type=int, default=1, help="number of cycles (default 1)")

@@ -204,6 +204,9 @@ def test_urdf_robot_from_a_yaml_file(capsys, tmp_path):
             "--algorithm damped (field damping)",
         ),
         (["--algorithm", "damped", "--gain", "2"], "--gain is a parameter of posture, not of"),
+        (["--max-iterations", "0"], "max_iterations must be between 1 and"),
+        (["--tol", "0"], "tol must be"),
+        (["--target=1e300,1"], "target y_d has a coordinate of 1e+300"),
     ],
 )
 def test_bad_input_exits_2_with_the_message(capsys, arm_file, argv, message):
@@ -242,3 +245,13 @@ def test_repeatability_says_what_it_found_and_why(capsys):
     assert found["role"] == "finding" and why["role"] == "why" and set(found) == {"text", "role"}
     assert found["text"].startswith("pseudoinverse J^P#: not repeatable. After 2 cycles")
     assert "no memory of the start" in why["text"]
+
+
+def test_the_step_cap_and_tolerance_are_options_the_advice_can_name(capsys):
+    """A run out of steps says "raise max_iterations": --max-iterations is that option, and
+    --tol the error at which a solve stops."""
+    slow = ["solve", "--robot", "manipulator1", "--mode", "discrete", "--gamma", "0.1"]
+    out, _ = run(capsys, *slow, "--max-iterations", "3", code=1)
+    assert "did not converge within 3 iterations" in out and "raise max_iterations" in out
+    out, _ = run(capsys, *slow, "--tol", "1e-3")
+    assert "< 0.001 after" in out
