@@ -15,7 +15,7 @@ import numpy as np
 
 from .exceptions import InvalidInputError, KinematicSingularityError
 from .exports import call_repr
-from .validation import FloatArray, as_points, checked_points, positive
+from .validation import FloatArray, as_points, bounded, checked_points, positive
 
 #: m(x) below this counts as a kinematic singularity.
 SINGULAR_MANIPULABILITY = 1e-9
@@ -139,8 +139,14 @@ class Kinematics(abc.ABC):
         return as_points(x, self.p, name, field)
 
     def check_task(self, y, name: str = "y", field: str | None = None) -> FloatArray:
-        """Validate task-space points: finite, shape (..., r)."""
-        return as_points(y, self.r, name, field)
+        """Validate task-space points: finite, shape (..., r), coordinates within
+        :data:`~jik.engine.validation.MAX_COORDINATE`."""
+        return bounded(as_points(y, self.r, name, field), name, field)
+
+    def check_start(self, x, name: str = "x0") -> FloatArray:
+        """Validate a solve's starts: :meth:`check`, coordinates within
+        :data:`~jik.engine.validation.MAX_COORDINATE`."""
+        return bounded(self.check(x, name), name)
 
     def kernel(self, x: FloatArray) -> FloatArray:
         """Unit kernel vector K(x) of J(x), shape (..., p) (one degree of redundancy).

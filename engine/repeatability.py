@@ -100,8 +100,9 @@ def closed_path(kinematics, x0: FloatArray, path: FloatArray) -> FloatArray:
         i = int(np.flatnonzero(bad)[0])
         shown = ", ".join(f"{v:.6g}" for v in home[i])
         raise InvalidInputError(
-            f"x0: the kinematics overflow at the start {format_vector(x0[i])}: k(x0) = ({shown}), "
-            "which closes the path; choose a start where k is finite (below about 1.8e308)",
+            f"x0: the kinematics are not finite at the start {format_vector(x0[i])}: k(x0) = "
+            f"({shown}), which closes the path (the task is undefined there, or overflows); "
+            "choose a start where k is finite",
             "x0",
         )
     pts = np.broadcast_to(path, (len(x0), *path.shape[-2:]))
@@ -212,7 +213,7 @@ def repeatability(
     """
     kin, progress = check_inverse(inverse), check_progress(progress)
     resume = x0 if isinstance(x0, Resume) else None
-    x0 = kin.check(x0 if resume is None else resume.x0, "x0")
+    x0 = kin.check_start(x0 if resume is None else resume.x0)
     path = kin.check_task(path, "path")
     if path.ndim not in (2, 3) or path.shape[-2] < 1:
         raise InvalidInputError(

@@ -75,7 +75,7 @@ def solve_in_chunks(
     the results agree bit for bit.
     """
     kin = inverse.kinematics
-    x = kin.check(x0, "x0")
+    x = kin.check_start(x0)
     y_d = kin.check_task(y_d, "target y_d", "y_d")
     if x.ndim != 1 or y_d.ndim != 1:
         raise InvalidInputError(

@@ -120,20 +120,23 @@ def refused_starts(inverse: Inverse, x0: FloatArray) -> dict[int, str]:
     """
     x0 = np.atleast_2d(validation.as_points(x0, check_inverse(inverse).p, "x0"))
     _, bad = inverse.apply_masked(x0, np.ones((len(x0), inverse.kinematics.r)))
-    return {int(i): _start_problem(inverse, x0[i]) for i in np.flatnonzero(np.atleast_1d(bad))}
+    with np.errstate(all="ignore"):
+        bad = bad | ~np.isfinite(inverse.kinematics.forward_unchecked(x0)).all(axis=-1)
+    return {int(i): start_problem(inverse, x0[i]) for i in np.flatnonzero(np.atleast_1d(bad))}
 
 
-def _start_problem(inverse: Inverse, x: FloatArray) -> str:
-    """Why J#(x) is undefined at the start ``x`` (p,): overflow, else a singularity."""
+def start_problem(inverse: Inverse, x: FloatArray) -> str:
+    """Why eq. (7) cannot start at ``x`` (p,): k(x) or its Jacobian not finite (the task
+    undefined or overflowing there), else J#(x) singular."""
     with np.errstate(all="ignore"):
         y = np.asarray(inverse.kinematics.forward(x), dtype=float)
         jacobian = np.asarray(inverse.kinematics.jacobian(x), dtype=float)
     if not (np.all(np.isfinite(y)) and np.all(np.isfinite(jacobian))):
         shown = ", ".join(f"{v:.6g}" for v in y)
         return (
-            f"the kinematics overflow at the start: k(x0) = ({shown}), its Jacobian "
-            f"{'finite' if np.all(np.isfinite(jacobian)) else 'not finite'}; choose a start "
-            "where both are finite (below about 1.8e308)"
+            f"the kinematics are not finite at the start: k(x0) = ({shown}), its Jacobian "
+            f"{'finite' if np.all(np.isfinite(jacobian)) else 'not finite'} (the task is "
+            "undefined there, or overflows); choose a start where both are finite"
         )
     return f"{inverse.singular_error(x)}; move the start"
 

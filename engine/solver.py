@@ -30,6 +30,7 @@ from .solve_rules import (
     check_inverse,
     check_settings,
     solve_bytes,
+    start_problem,
     stop_message,
 )
 from .validation import check_memory, flag
@@ -51,7 +52,7 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto", guess=N
         method = "dop853"  # the homotopy form needs e = e0 exp(-tau), which J J# != I breaks
     e0 = inverse.kinematics.forward_unchecked(x0) - y_d
     err0 = np.linalg.norm(e0, axis=-1)
-    moving = np.flatnonzero(~(err0 < tol))  # (a NaN error, k undefined at x0, is not arrived)
+    moving = np.flatnonzero(~(err0 < tol))
     # A singular start raises. Picard's first sweep evaluates J# at every moving start: only
     # the members already at their target (and every start for DOP853 alone) are checked here.
     _check_start(inverse, x0, e0, slice(None) if method == "dop853" else err0 < tol)
@@ -116,14 +117,21 @@ def _continuous(inverse, x0, y_d, tol, max_steps, record, method="auto", guess=N
 
 
 def _check_start(inverse, x0, e0, which) -> None:
-    """Raise the inverse's typed error at the first singular start among ``x0[which]``."""
-    x, e = x0[which], e0[which]
-    if len(x):
-        _, bad = inverse.apply_masked(x, e)
+    """Raise the inverse's typed error at the first singular start among ``x0[which]`` and the
+    starts where k is not finite (e0 NaN or inf); at none singular, an InvalidInputError
+    (field ``x0``) at the first where k is not finite."""
+    undefined = ~np.isfinite(e0).all(axis=-1)
+    checked = np.zeros(len(x0), dtype=bool)
+    checked[which] = True
+    idx = np.flatnonzero(checked | undefined)
+    if idx.size:
+        _, bad = inverse.apply_masked(x0[idx], np.where(undefined[idx, None], 1.0, e0[idx]))
         if bad.any():
-            error = inverse.singular_error(x[np.flatnonzero(bad)[0]])
+            error = inverse.singular_error(x0[idx[np.flatnonzero(bad)[0]]])
             error.field = "x0"
             raise error
+    if undefined.any():
+        raise InvalidInputError(start_problem(inverse, x0[np.flatnonzero(undefined)[0]]), "x0")
 
 
 def _discrete(inverse, x0, y_d, gamma, tol, max_iterations, record):
@@ -221,7 +229,7 @@ def solve(
         When the start configuration is singular for ``inverse``.
     """
     kin = check_inverse(inverse)
-    x0 = kin.check(x0, "x0")
+    x0 = kin.check_start(x0)
     y_d = kin.check_task(y_d, "target y_d", "y_d")
     if x0.ndim != 1 or y_d.ndim != 1:
         raise InvalidInputError(
@@ -281,22 +289,21 @@ def solve_batch(
 def _batch(inverse, x0, y_d, gamma, mode, tol, max_iterations, record, method, guess, single):
     """:func:`solve_batch`; with ``single``, ``guess`` is one start's Trajectory (or None)."""
     kin = check_inverse(inverse)
-    x0 = kin.check(x0, "x0")
+    x0 = kin.check_start(x0)
     y_d = kin.check_task(y_d, "target y_d", "y_d")
     if x0.ndim > 2 or y_d.ndim > 2:
         raise InvalidInputError(
             "x0 and y_d must be one point or a 2-D batch of points", "x0" if x0.ndim > 2 else "y_d"
         )
-    xb = np.atleast_2d(x0)
-    yb = np.broadcast_to(np.atleast_2d(y_d), (max(len(xb), len(np.atleast_2d(y_d))), kin.r))
-    if len(xb) != len(yb):
-        if len(xb) == 1:
-            xb = np.broadcast_to(xb, (len(yb), kin.p))
-        else:
-            raise InvalidInputError(
-                f"x0 has {len(xb)} configurations but y_d has {len(np.atleast_2d(y_d))} targets",
-                "x0" if len(xb) == 0 else "y_d",
-            )
+    xb, yb = np.atleast_2d(x0), np.atleast_2d(y_d)
+    n = max(len(xb), len(yb))
+    if len(xb) not in (1, n) or len(yb) not in (1, n):
+        raise InvalidInputError(
+            f"x0 has {len(xb)} configurations but y_d has {len(yb)} targets: give as many of "
+            "each, or one of either",
+            "x0" if len(xb) == 0 else "y_d",
+        )
+    xb, yb = np.broadcast_to(xb, (n, kin.p)), np.broadcast_to(yb, (n, kin.r))
     mode, gamma, tol, cap = check_settings(mode, gamma, tol, max_iterations, method)
     record = flag(record, "record")
     if guess is not None and mode != "continuous":

@@ -90,6 +90,25 @@ def as_points(
     return a
 
 
+#: Largest magnitude of a coordinate of a solve's start or target (rad, m or the robot's own
+#: units): at 1e6 the spacing of doubles (1.2e-10) passes the default tolerance of 1e-10, and far
+#: beyond it the task error's norm overflows (a target of 1e200 ran 20,000 steps at error inf).
+MAX_COORDINATE = 1e6
+
+
+def bounded(a: FloatArray, name: str, field: str | None = None) -> FloatArray:
+    """``a`` (finite) if no entry exceeds :data:`MAX_COORDINATE` in magnitude; else an
+    InvalidInputError naming ``name``."""
+    if a.size and (a.max() > MAX_COORDINATE or a.min() < -MAX_COORDINATE):  # (no copy of a)
+        worst = a.max() if a.max() > MAX_COORDINATE else a.min()
+        raise InvalidInputError(
+            f"{name} has a coordinate of {worst:.3g}; a solve takes coordinates up "
+            f"to {MAX_COORDINATE:g} in magnitude",
+            field_for(name, field),
+        )
+    return a
+
+
 def checked_points(core: Callable[..., Any], finite: bool = True) -> Callable[..., Any]:
     """The method ``core(self, x, ...)`` behind ``self.check(x, "x")``, the check of ``x``
     against the shape (..., ``self.p``) (a kinematics' or an augmenting map's).

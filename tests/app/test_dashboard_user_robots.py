@@ -150,7 +150,7 @@ def test_an_overflow_at_the_start_is_called_an_overflow():
     with pytest.raises(InvalidInputError) as err:
         compute(state)
     assert err.value.field == "x0"
-    assert "the kinematics overflow at the start" in str(err.value)
+    assert "the kinematics are not finite at the start" in str(err.value)
 
 
 def _formula_robot(task: list[str]) -> DashboardState:

@@ -330,8 +330,9 @@ def test_an_overflow_at_the_start_is_called_an_overflow(api, path):
     body.update({"target": [1.0, 1.0]} if path == "/solve" else {"path": [[1.0, 1.0]]})
     (msg,) = messages(api.post(path, json=body))
     assert msg == (
-        "x0: the kinematics overflow at the start: k(x0) = (inf, 0.5), its Jacobian not "
-        "finite; choose a start where both are finite (below about 1.8e308)"
+        "x0: the kinematics are not finite at the start: k(x0) = (inf, 0.5), its Jacobian not "
+        "finite (the task is undefined there, or overflows); choose a start where both are "
+        "finite"
     )
 
 

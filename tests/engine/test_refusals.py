@@ -24,6 +24,8 @@ ARM = jik.Manipulator2()
 P = jik.Pseudoinverse(ARM)
 NAMES = ARM.variable_names
 PANDA_TASK = jik.load_robot("panda").kinematics.pose_task
+#: A task undefined for x1 <= 0 whose Jacobian is finite there (log(-1) is NaN, 1/x1 is not).
+LOG_ARM = jik.FormulaKinematics(["x1", "x2", "x3"], ["log(x1)", "x2 + x3"])
 
 #: (call, expected field): each call refuses one argument.
 REFUSALS = {
@@ -34,6 +36,25 @@ REFUSALS = {
     "solve y_d wrong length": (lambda: jik.solve(P, X0, [1, 1, 1]), "y_d"),
     "solve y_d infinite": (lambda: jik.solve(P, X0, [np.inf, 1]), "y_d"),
     "solve y_d a batch": (lambda: jik.solve(P, X0, [[1, 1], [1, 2]]), "y_d"),
+    # (beyond MAX_COORDINATE the error's norm overflowed: 20,000 steps at error inf)
+    "solve y_d beyond the coordinate bound": (lambda: jik.solve(P, X0, [1e200, 1]), "y_d"),
+    "solve x0 beyond the coordinate bound": (lambda: jik.solve(P, [1e7, 0, 1], [1, 1]), "x0"),
+    "solve_batch more starts than targets": (
+        lambda: jik.solve_batch(P, [X0] * 3, [[1, 1]] * 2),
+        "y_d",
+    ),
+    "solve k undefined at x0": (
+        lambda: jik.solve(jik.Pseudoinverse(LOG_ARM), [-1, 0, 0], [1, 1]),
+        "x0",
+    ),
+    "solve k undefined at x0, discrete": (
+        lambda: jik.solve(jik.Pseudoinverse(LOG_ARM), [-1, 0, 0], [1, 1], mode="discrete"),
+        "x0",
+    ),
+    "repeatability path beyond the coordinate bound": (
+        lambda: jik.repeatability(P, X0, [(1, 1), (2e6, 1)]),
+        "path",
+    ),
     "solve gamma": (lambda: jik.solve(P, X0, [1, 1], gamma=-1), "gamma"),
     "solve mode": (lambda: jik.solve(P, X0, [1, 1], mode="euler"), "mode"),
     "solve method": (lambda: jik.solve(P, X0, [1, 1], method="rk4"), "method"),
@@ -448,9 +469,10 @@ def test_refused_starts_say_why_each_start_of_a_batch_cannot_run():
         jik.Pseudoinverse(arm), [[0.1, 0.5, 0.5], [800.0, 0.5, 0.5], [0.1, 0.0, 0.5]]
     )
     assert sorted(refused) == [1, 2]
+    assert list(refused_starts(jik.Pseudoinverse(LOG_ARM), [[-1, 0, 0], [1, 0, 0]])) == [0]
     assert refused[1] == (
-        "the kinematics overflow at the start: k(x0) = (inf, 0.25), its Jacobian not finite; "
-        "choose a start where both are finite (below about 1.8e308)"
+        "the kinematics are not finite at the start: k(x0) = (inf, 0.25), its Jacobian not "
+        "finite (the task is undefined there, or overflows); choose a start where both are finite"
     )
     assert "J J^T is singular" in refused[2] and refused[2].endswith("; move the start")
 
