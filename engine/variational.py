@@ -55,6 +55,8 @@ MANIPULATOR2_REGION: dict[str, tuple[float, float]] = {"x2": (-1.0, 1.0), "x3": 
 #: docs/paper-errata.md), 10 over three (17^3 unknowns at 16 would take Ritz matrices of about
 #: 2 GB on (16 + 8)^3 quadrature points; 11^3 take 0.2 GB).
 DEFAULT_DEGREE = {2: 16, 3: 10}
+#: Largest Legendre degree per variable over two and over three variables.
+MAX_DEGREE = {2: 64, 3: 16}
 
 #: Basis degree (per variable) of the Manipulator 2 synthesis: the default over two variables.
 MANIPULATOR2_DEGREE = DEFAULT_DEGREE[2]
@@ -334,7 +336,7 @@ def synthesize_e2(
         raise InvalidInputError(
             f"degree needs one value per region variable ({d}), got {degree}", "degree"
         )
-    degs = [count(n, "degree", 1, 64 if d == 2 else 16) for n in degs]
+    degs = [count(n, "degree", 1, MAX_DEGREE[d]) for n in degs]
     levels = sorted(
         {
             count(n, "convergence degree", 1, max(degs), "convergence_degrees")

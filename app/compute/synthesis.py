@@ -87,8 +87,9 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
     if req.method == "e2_variational":
         try:
             result = synthesize_e2(kin, region, degree=req.degree, fixed=fixed)
-        except JikError as exc:
-            raise RequestError("region", str(exc)) from None
+        except JikError as exc:  # (the degree's bound depends on the region's variables)
+            field = "degree" if getattr(exc, "field", None) == "degree" else "region"
+            raise RequestError(field, str(exc)) from None
         amap = result.augmenting_map
         aug_used = S.AugmentationUsed(name=getattr(amap, "name", "e2_synthesized"), parameters={})
         convergence = [

@@ -119,6 +119,10 @@ def test_synthesize_bad_input(api):
         )
     assert msg({"robot": m2, "grid": 1000}).startswith("grid | grid: Input should be less than")
     assert msg({"robot": m2, "method": "magic"}).startswith("method | method: Input should be")
+    three = {"x1": [0, 1], "x2": [0, 1], "x3": [0, 1]}  # (at most 16 per variable over three)
+    assert msg({"robot": m2, "method": "e2_variational", "region": three, "degree": 17}) == (
+        "degree | degree: degree must be between 1 and 16, got 17"
+    )
 
 
 def test_fixed_values_and_a_formula_robot_s_constants_are_coordinates_within_1000(api):

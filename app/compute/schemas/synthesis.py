@@ -8,7 +8,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from ....engine.registry import RobotSpec
 from ....engine.robot_synthesis import TOTAL_DEGREE, TOTAL_NODES
-from ....engine.variational import DEFAULT_DEGREE
+from ....engine.variational import DEFAULT_DEGREE, MAX_DEGREE
 from .fields import INTEGRAL, MAX_DIMENSION, Bound, Coordinate, FrameAxes, MaybeFloat, Seed
 from .robots import AnyAugmentation, AnyRobot, AugmentationUsed, RobotUsed
 from .variants import narrowed, per_robot
@@ -66,7 +66,7 @@ class SynthesizeRequest(BaseModel):
         None,
         description="'e2_variational': Legendre degree per variable (default: "
         f"{DEFAULT_DEGREE[2]} over two variables, {DEFAULT_DEGREE[3]} over three, "
-        "engine.variational.DEFAULT_DEGREE); "
+        f"engine.variational.DEFAULT_DEGREE; at most {MAX_DEGREE[3]} over three); "
         f"'e2_total_degree': total degree of the basis (default {TOTAL_DEGREE})",
     )
     qmc_nodes: Annotated[int, Field(strict=True, ge=MIN_QMC_NODES, le=MAX_QMC_NODES), INTEGRAL] = (
