@@ -41,8 +41,8 @@ def augmentations_from_dict(kin: Kinematics, items, key: str | None = None):
                 "{'name': 'e2_synthesized', 'region': {...}}",
                 where,
             )
-        label = item.get("label", item["name"])
-        if not isinstance(label, str) or label in {s.name for s in specs}:
+        label = robot_kinds.one_line(item.get("label", item["name"]), f"{where}.label")
+        if label in {s.name for s in specs}:
             raise InvalidInputError(
                 f"{where}.label must be a new name, got {label!r}", f"{where}.label"
             )
@@ -138,7 +138,8 @@ def _region(kin: Kinematics, item: Mapping, where: str):
     try:
         box, fix = check_region(kin, item.get("region", {}), item.get("fixed"))
     except InvalidInputError as exc:
-        raise InvalidInputError(f"{where}.region: {exc}", f"{where}.region") from None
+        field = f"{where}.{exc.field or 'region'}"  # (region.x2, fixed.x1)
+        raise InvalidInputError(f"{field}: {exc}", field) from None
     if len(box) < 2:
         raise InvalidInputError(
             f"{where}.region must have at least two variables", f"{where}.region"

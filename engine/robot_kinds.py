@@ -9,7 +9,36 @@ numbers), ``"points"`` (a list of lists of numbers), ``"integer"``, ``"augmentat
 
 from __future__ import annotations
 
+import re
 from dataclasses import asdict, dataclass
+
+from .exceptions import InvalidInputError
+
+#: Longest ``title`` of a robot, and ``label`` of one of its maps [characters].
+MAX_TITLE_CHARS = 100
+#: What a text shown on one line (a title, a label: in the page, a command's output, a CSV
+#: export's header) may not hold: control characters (line breaks, tabs, escapes), Unicode's
+#: line and paragraph separators, and lone surrogates (which no UTF-8 file can hold).
+_NOT_ONE_LINE = re.compile("[\x00-\x1f\x7f-\x9f\u2028\u2029\ud800-\udfff]")
+
+
+def one_line(value, field: str, most: int = MAX_TITLE_CHARS) -> str:
+    """``value``, a text of 1 to ``most`` characters shown on one line; else an
+    InvalidInputError with ``field`` that shows its first character not printable on one line
+    as an escape (``'\\n'``)."""
+    if not isinstance(value, str):
+        raise InvalidInputError(f"{field} must be a text, got {value!r:.80}", field)
+    if not 1 <= len(value) <= most:
+        raise InvalidInputError(
+            f"{field} must have 1 to {most} characters, got {len(value)}", field
+        )
+    if bad := _NOT_ONE_LINE.search(value):
+        raise InvalidInputError(
+            f"{field} must be one line of printable text, got {bad.group()!a} at "
+            f"character {bad.start()}",
+            field,
+        )
+    return value
 
 
 @dataclass(frozen=True)
@@ -136,7 +165,9 @@ COMMON = (
         "the kind: planar_chain, formula, urdf, a "
         "catalogue arm (panda, iiwa14, gen3, ur5e) or a built-in robot's name",
     ),
-    DefinitionField("title", "string", False, "a name to show"),
+    DefinitionField(
+        "title", "string", False, f"a name to show: one line, 1 to {MAX_TITLE_CHARS} characters"
+    ),
     DefinitionField(
         "x_range",
         "points",
@@ -170,7 +201,11 @@ AUGMENTATIONS: dict[str, tuple[DefinitionField, ...]] = {
         ),
         DefinitionField("parameters", "mapping", False, "named constants of h"),
         DefinitionField(
-            "label", "string", False, "its name among the robot's maps (default formula)"
+            "label",
+            "string",
+            False,
+            "its name among the robot's maps (default formula): one line, 1 to "
+            f"{MAX_TITLE_CHARS} characters",
         ),
     ),
     "e2_synthesized": (
@@ -207,7 +242,11 @@ AUGMENTATIONS: dict[str, tuple[DefinitionField, ...]] = {
             "h_1..h_(p-r), docs/e2-vector.md (default: the best-conditioned at the box's centre)",
         ),
         DefinitionField(
-            "label", "string", False, "its name among the robot's maps (default e2_synthesized)"
+            "label",
+            "string",
+            False,
+            "its name among the robot's maps (default e2_synthesized): one line, 1 to "
+            f"{MAX_TITLE_CHARS} characters",
         ),
     ),
 }

@@ -12,7 +12,8 @@ A definition::
      "augmentations": [{"name": "e2_synthesized", "region": {"x2": [0.4, 2], "x3": [0.4, 2]}},
                        {"name": "formula", "h": "x3"}]}
 
-with optional ``x_range`` (one [lo, hi] per variable), ``x0``, ``target``, ``path``, ``title``.
+with optional ``x_range`` (one [lo, hi] per variable), ``x0``, ``target``, ``path``, ``title``
+(one line of at most ``robot_kinds.MAX_TITLE_CHARS`` characters, as a map's ``label``).
 For p - r > 1 a formula augmentation's ``"h"`` is a list of p - r formulas (the extended inverse
 of :mod:`jik.engine.extended_vector`); the E2 synthesis needs p = r + 1 and says so.
 """
@@ -43,12 +44,10 @@ from .planar_chain import PlanarChain
 from .registry import ROBOTS, RobotSpec, make_inverse
 from .robot_augmentations import augmentations_from_dict
 from .robot_defaults import defaults, points
+from .robot_file import read_robot_file, read_text
 from .robot_synthesis import arm_augmentations, missing_map
 from .units import RobotUnits, robot_units
 from .validation import of_type
-
-#: Largest robot file read by :func:`load_robot` [bytes].
-MAX_FILE_BYTES = 2_000_000
 
 
 @dataclass(frozen=True)
@@ -186,9 +185,7 @@ def _urdf_file(d: Mapping, base_dir: Path | None) -> str:
     path = (base_dir / name).resolve()
     if not path.is_relative_to(base_dir.resolve()) or not path.is_file():
         raise InvalidInputError(f"urdf_file {name!r} is not a file inside {base_dir}", "urdf_file")
-    if path.stat().st_size > MAX_URDF_BYTES:
-        raise InvalidInputError(f"urdf_file is larger than {MAX_URDF_BYTES} bytes", "urdf_file")
-    return path.read_text(encoding="utf-8")
+    return read_text(path, "urdf_file", MAX_URDF_BYTES)
 
 
 def _x_range(kin: Kinematics, d: Mapping) -> tuple[tuple[float, float], ...]:
@@ -242,6 +239,8 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
         raise InvalidInputError(
             f"unknown key {key!r} for a {kind} robot; known: {sorted(allowed)}", key
         )
+    if "title" in d:  # (shown on one line: in the page, a command's output, a CSV's header)
+        robot_kinds.one_line(d["title"], "title")
     if kind in ROBOTS:
         base = ROBOTS[kind]
         try:
@@ -310,7 +309,9 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
 
 
 def load_robot(source: str | Path) -> Robot:
-    """A robot from a JSON or YAML file (``.yaml``/``.yml``, needs PyYAML), or a built-in name."""
+    """A robot from a JSON or YAML file (``.yaml``/``.yml``, needs PyYAML; read by
+    :func:`~jik.engine.robot_file.read_robot_file`: UTF-8, bounded in size and nesting, no YAML
+    aliases), or a built-in name."""
     wanted = "a file's path or a robot's name (a dict: robot_from_dict)"
     path = Path(of_type(source, (str, PathLike), "robot", wanted))
     if not path.is_file():
@@ -321,24 +322,5 @@ def load_robot(source: str | Path) -> Robot:
             f"({sorted(ROBOTS)}) or catalogue arm ({sorted(ARMS)})",
             "robot",
         )
-    if path.stat().st_size > MAX_FILE_BYTES:
-        raise InvalidInputError(f"robot file larger than {MAX_FILE_BYTES} bytes", "robot")
-    text = path.read_text(encoding="utf-8")
-    if path.suffix.lower() in (".yaml", ".yml"):
-        try:
-            import yaml
-        except ImportError:  # PyYAML is optional
-            raise InvalidInputError(
-                "YAML robot files need PyYAML (pip install pyyaml); or write the robot as JSON",
-                "robot",
-            ) from None
-        try:
-            data = yaml.safe_load(text)
-        except yaml.YAMLError as exc:
-            raise InvalidInputError(f"{path.name} is not valid YAML: {exc}", "robot") from None
-    else:
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise InvalidInputError(f"{path.name} is not valid JSON: {exc}", "robot") from None
+    data = read_robot_file(path)
     return robot_from_dict(data, base_dir=path.parent)

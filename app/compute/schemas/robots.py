@@ -17,7 +17,7 @@ from ....engine import robot_synthesis as synthesis
 from ....engine.arms import ARMS, Arm
 from ....engine.formula import MAX_LENGTH as MAX_FORMULA_CHARS  # (the engine's bound)
 from ....engine.registry import ROBOTS, AugmentationSpec, RobotSpec
-from ....engine.robot_kinds import AUGMENTATIONS, COMMON, KINDS
+from ....engine.robot_kinds import AUGMENTATIONS, COMMON, KINDS, MAX_TITLE_CHARS
 from .fields import (
     INTEGRAL,
     MAX_DIMENSION,
@@ -128,7 +128,9 @@ FormulaText = Annotated[str, Field(min_length=1, max_length=MAX_FORMULA_CHARS)]
 #: Named constants of a formula robot or map (lengths, offsets): numbers within +-1000, as
 #: coordinates are (beyond that the kinematics only overflow).
 Constants = Annotated[dict[Name, Coordinate], Field(max_length=32)]
-Title = Annotated[str, Field(min_length=1, max_length=100)]
+#: A robot's title: its length bounded here, its one line (no control characters) checked by
+#: the engine when the robot is built (robot_kinds.one_line).
+Title = Annotated[str, Field(min_length=1, max_length=MAX_TITLE_CHARS)]
 
 
 #: Optional joint limits of a planar chain or a formula robot (a URDF's come from its joints).
