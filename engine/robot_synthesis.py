@@ -22,6 +22,7 @@ from .augmentations import AugmentingMap
 from .kinematics import Kinematics
 from .progress import Progress
 from .synthesis_nd import synthesize_e2_nd
+from .validation import MAX_REGION_BOUND
 from .variational import synthesize_e2
 
 if TYPE_CHECKING:
@@ -111,7 +112,8 @@ def default_box(
     """The box of a synthesis given none: the robot's design region (``functional_region``,
     the box of sec. 5 over which E1, eq. (13), and E2, eq. (18), are compared) when it has
     ``size`` variables, none of them ``fixed``; else the last ``size`` variables not ``fixed``,
-    each over a tenth of its ``x_range`` either side of the default start, within the range.
+    each over a tenth of its ``x_range`` (within :data:`~jik.engine.validation.MAX_REGION_BOUND`)
+    either side of the default start, within that range.
 
     The variables outside the box are held at the default start, where the robot's maps are
     defined (not at 0): :func:`~jik.engine.kinematics.held_values`.
@@ -123,7 +125,10 @@ def default_box(
     box = {}
     for n in [n for n in names if n not in fixed][-size:]:
         i = names.index(n)
-        lo, hi = spec.x_range[i]
+        lo, hi = (
+            max(spec.x_range[i][0], -MAX_REGION_BOUND),
+            min(spec.x_range[i][1], MAX_REGION_BOUND),
+        )
         c, w = spec.default_x0[i], 0.1 * (hi - lo)
         box[n] = (max(lo, c - w), min(hi, c + w))
     return box

@@ -335,6 +335,11 @@ def json_number(value, name: str, field: str | None = None) -> float:
         raise InvalidInputError(str(exc), field or name) from None
 
 
+#: Largest |bound| of a box region (a synthesis's, E1's and E2's, a map's grid): no joint
+#: ranges further, and on a box of 1e200 the Ritz solve's matrices overflow.
+MAX_REGION_BOUND = 100.0
+
+
 def check_box_region(
     names: Sequence[str],
     region,
@@ -342,8 +347,9 @@ def check_box_region(
     held: Sequence[float] | None = None,
 ) -> tuple[dict[str, tuple[float, float]], dict[str, float]]:
     """Validate a box region over some of the variables ``names`` (name -> (lo, hi), lo < hi,
-    finite) and the fixed values of the others (name -> value; default ``held``, one value
-    per name, else 0): the design region of sec. 5, where E1 (13) and E2 (18) are taken.
+    within :data:`MAX_REGION_BOUND`) and the fixed values of the others (name -> value;
+    default ``held``, one value per name, else 0): the design region of sec. 5, where E1 (13)
+    and E2 (18) are taken.
 
     Returns
     -------
@@ -378,9 +384,11 @@ def check_box_region(
             ) from exc
         lo = finite(lo, f"lower bound of {name}", f"region.{name}")
         hi = finite(hi, f"upper bound of {name}", f"region.{name}")
-        if not lo < hi:
+        if not -MAX_REGION_BOUND <= lo < hi <= MAX_REGION_BOUND:
             raise InvalidInputError(
-                f"region[{name!r}] must have lo < hi, got ({lo}, {hi})", f"region.{name}"
+                f"region[{name!r}] must have lo < hi within +-{MAX_REGION_BOUND:g}, got "
+                f"({lo}, {hi})",
+                f"region.{name}",
             )
         box[name] = (lo, hi)
     rest = dict(zip(names, held, strict=True)) if held is not None else {}

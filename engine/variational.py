@@ -46,7 +46,6 @@ from .validation import FloatArray, count
 
 #: Extra Gauss points per variable beyond the basis degree (R is not polynomial, e.g. cos 2 x3).
 EXTRA_NODES = 8
-
 #: Default region of Manipulator 2 (sec. 5.2).
 MANIPULATOR2_REGION: dict[str, tuple[float, float]] = {"x2": (-1.0, 1.0), "x3": (0.0, np.pi)}
 
@@ -57,7 +56,6 @@ MANIPULATOR2_REGION: dict[str, tuple[float, float]] = {"x2": (-1.0, 1.0), "x3": 
 DEFAULT_DEGREE = {2: 16, 3: 10}
 #: Largest Legendre degree per variable over two and over three variables.
 MAX_DEGREE = {2: 64, 3: 16}
-
 #: Basis degree (per variable) of the Manipulator 2 synthesis: the default over two variables.
 MANIPULATOR2_DEGREE = DEFAULT_DEGREE[2]
 

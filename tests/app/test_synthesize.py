@@ -112,7 +112,7 @@ def test_synthesize_bad_input(api):
     chain = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 1.0, 1.0]}
     for robot in (m2, chain):
         assert msg({"robot": robot, "region": {"x2": [1, 0], "x3": [0, 1]}}) == (
-            "region.x2 | region.x2: must have lo < hi, got (1.0, 0.0)"
+            "region.x2 | region.x2: must have lo < hi within +-100, got (1.0, 0.0)"
         )
         assert msg({"robot": robot, "region": REGION, "fixed": {"x2": 0.0}}) == (
             "fixed.x2 | fixed.x2: variables ['x2'] are both integrated over and fixed"
@@ -208,3 +208,26 @@ def test_the_singularities_field_is_documented(api):
     assert "singularities" in schemas["SynthesizeResponse"]["required"]
     info = schemas["MapSingularitiesInfo"]["properties"]
     assert set(info) == {"where", "fraction", "reasons", "nodes"}
+
+
+def test_a_urdf_arm_with_huge_limits_synthesizes_over_a_box_within_the_bound(api):
+    """Limits of +-1e200 (an arm "without" limits) made the default box +-2e199 wide and the
+    Ritz solve's matrices not finite (HTTP 500): the default box keeps within the engine's
+    region bound, and an explicit region beyond it is refused at its field."""
+    joint = (
+        '<joint name="j{i}" type="revolute"><parent link="l{i}"/><child link="l{j}"/>'
+        '<origin xyz="1 0 0"/><axis xyz="0 0 1"/><limit lower="-1e200" upper="1e200"/></joint>'
+    )
+    urdf = (
+        '<robot name="a">'
+        + "".join(f'<link name="l{i}"/>' for i in range(4))
+        + "".join(joint.format(i=i, j=i + 1) for i in range(3))
+        + "</robot>"
+    )
+    robot = {"name": "urdf", "end_link": "l3", "task": "xy", "urdf": urdf}
+    body = {"robot": robot, "method": "e2_variational", "degree": 4, "nodes": 12}
+    r = api.post("/synthesize", json=body)
+    assert r.status_code == 200, r.text
+    assert all(-100 <= lo < hi <= 100 for lo, hi in r.json()["region"].values())
+    r = api.post("/synthesize", json={**body, "region": {"x2": [-1e3, 1], "x3": [0, 1]}})
+    assert r.status_code == 422 and r.json()["detail"][0]["loc"][1:3] == ["region", "x2"]

@@ -260,7 +260,7 @@ def test_more_than_one_degree_of_redundancy_takes_a_vector_of_formula_maps():
         ),
         (
             {**ARM3R, "augmentations": [{"name": "e2_synthesized", "region": {"x9": [0, 1]}}]},
-            "augmentations.0.region",
+            "augmentations.0.region.x9",
             "unknown joint variable 'x9'",
         ),
         (

@@ -11,6 +11,7 @@ from typing import Annotated, Any, Literal, Union
 from pydantic import BeforeValidator, Discriminator, Field, Tag
 
 from ....engine.solve_rules import GAMMA_MAX, GAMMA_MIN, TOL_MIN
+from ....engine.validation import MAX_REGION_BOUND
 
 #: Largest configuration / task dimension accepted before the registry check.
 MAX_DIMENSION = 16
@@ -70,8 +71,11 @@ FrameAxes = Annotated[
 Gamma = Annotated[float, Field(strict=True, ge=GAMMA_MIN, le=GAMMA_MAX, allow_inf_nan=False)]
 #: The task error at which a solve stops.
 Tolerance = Annotated[float, Field(strict=True, ge=TOL_MIN, le=1.0, allow_inf_nan=False)]
-#: A bound of a synthesis box.
-Bound = Annotated[float, Field(strict=True, ge=-100.0, le=100.0, allow_inf_nan=False)]
+#: A bound of a synthesis box (the engine's bound on a box region).
+Bound = Annotated[
+    float,
+    Field(strict=True, ge=-MAX_REGION_BOUND, le=MAX_REGION_BOUND, allow_inf_nan=False),
+]
 
 
 #: The labels of a one-or-many union's members in pydantic's error locations: written as type
