@@ -70,7 +70,7 @@ def test_robots_list_every_algorithm(api):
             ["algorithm_parameters", "rest"],
             "rest: must have shape",
         ),
-        ("weighted", {"limits": [[1.0, 0.0]] * 3}, ["algorithm_parameters", "limits"], "lo < hi"),
+        ("weighted", {"limits": [[1.0, 0.0]] * 3}, ["algorithm_parameters", "limits"], "< high"),
         ("posture", {"speed": 1.0}, ["algorithm_parameters", "speed"], "unknown field"),
         ("newton", None, ["algorithm"], "Input should be"),
         ("extended", {"gain": 1.0}, ["algorithm_parameters"], "the extended inverse takes none"),

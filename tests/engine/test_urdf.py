@@ -172,6 +172,7 @@ def test_repeatability_pseudoinverse_drifts_extended_returns(arm):
         ),
     ],
 )
+@pytest.mark.filterwarnings("ignore:invalid value encountered:RuntimeWarning")  # (yourdfpy's NaN)
 def test_bad_definitions_name_the_field(kwargs, field, text):
     with pytest.raises(InvalidInputError) as err:
         UrdfChain(**{"urdf": TEXT, **kwargs})
