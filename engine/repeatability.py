@@ -200,7 +200,9 @@ def repeatability(
     Raises
     ------
     InvalidInputError
-        Bad shapes or settings (``error.field`` names the argument), a :class:`Resume` that is
+        Bad shapes or settings, coordinates beyond
+        :data:`~jik.engine.validation.MAX_COORDINATE` (``error.field`` names the argument), a
+        start where k is not finite (``x0``), a :class:`Resume` that is
         not whole cycles of this run or is of another run (its settings: the message names the
         field that differs), or, before any work, starts whose estimated memory
         (:func:`jik.engine.solve_rules.run_bytes`) exceeds

@@ -223,8 +223,10 @@ def solve(
     Raises
     ------
     InvalidInputError
-        Wrong shapes (a batch of starts or targets), non-finite values, gamma out of range,
-        bad tol, mode, method or max_iterations; ``error.field`` names the argument.
+        Wrong shapes (a batch of starts or targets), non-finite values or coordinates beyond
+        :data:`~jik.engine.validation.MAX_COORDINATE`, gamma out of range, bad tol, mode,
+        method or max_iterations, a start where k is not finite; ``error.field`` names the
+        argument.
     KinematicSingularityError, AlgorithmicSingularityError
         When the start configuration is singular for ``inverse``.
     """
