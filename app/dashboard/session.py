@@ -71,6 +71,7 @@ class Dashboard(SecondPhaseControl, SolvingAhead):
         self._state = validate((state or default_state()).as_dict())
         self._generation = 1
         self._done = 0  # last generation whose computation finished (or failed)
+        self._announced = 1  # last generation whose state event went out (see update)
         self._changed_at = {1: time.perf_counter()}
         self._cache: dict = {}
         self._figures: dict[tuple[str, str], str] = {}  # (panel, key) -> figure JSON
@@ -151,7 +152,12 @@ class Dashboard(SecondPhaseControl, SolvingAhead):
                 self._cond.notify_all()
         if refusal is not None:
             self.refuse(refusal, source)
-        self._emit(self._state_event(generation, state, source))
+        try:
+            self._emit(self._state_event(generation, state, source))
+        finally:
+            with self._cond:  # (the worker waits for this: its events follow the state's)
+                self._announced = max(self._announced, generation)
+                self._cond.notify_all()
         self.start()
         return generation, state
 
@@ -200,6 +206,11 @@ class Dashboard(SecondPhaseControl, SolvingAhead):
                         self._cond.wait(DEBOUNCE)
                         if self._generation == seen or self._stopped:
                             break
+                # A generation's result or error never goes out before its state event (a
+                # page ignores an error of a generation it has not heard of).
+                self._cond.wait_for(lambda: self._announced >= self._generation or self._stopped)
+                if self._stopped:
+                    return
                 generation, state = self._generation, self._state
             try:
                 if rerun is not None:

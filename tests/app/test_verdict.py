@@ -108,6 +108,42 @@ def test_a_failed_generation_names_the_result_on_screen(monkeypatch):
         dash.stop()
 
 
+def test_a_generations_error_never_goes_out_before_its_state(monkeypatch):
+    """The state event of a change is sent by the thread that made it, after the worker was
+    woken: on a loaded machine the worker's error came first, and the page, which had not
+    heard of that generation, ignored it for good. The worker now waits for the state event:
+    a listener slow on it (it waits up to 1 s for the error) sees the error only after it."""
+    import threading
+
+    dash = Dashboard()
+    try:
+        assert dash.wait(1, timeout=120)
+        real = session_module.compute
+
+        def failing(state, *args, **kwargs):
+            if state.gamma == 2.5:
+                raise JikError("the start is singular")
+            return real(state, *args, **kwargs)
+
+        monkeypatch.setattr(session_module, "compute", failing)
+        seen, errored = [], threading.Event()
+
+        def listener(event):  # (slow to take the state of generation 2)
+            if event.kind == "state" and event.generation == 2:
+                errored.wait(1.0)  # (an error sent meanwhile overtakes this state)
+            seen.append((event.kind, event.generation))
+            if event.kind == "error":
+                errored.set()
+
+        dash.subscribe(listener)
+        generation, _ = dash.update({"gamma": 2.5})
+        assert dash.wait(generation, timeout=120)
+        mine = [e for e in seen if e[1] == 2]
+        assert mine.index(("state", 2)) < mine.index(("error", 2)), seen
+    finally:
+        dash.stop()
+
+
 ARM = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]}
 
 
