@@ -239,7 +239,7 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
         raise InvalidInputError(
             f"unknown key {key!r} for a {kind} robot; known: {sorted(allowed)}", key
         )
-    if "title" in d:  # (shown on one line: in the page, a command's output, a CSV's header)
+    if "title" in d:  # (one line: shown in the page, a command's output, a CSV's header)
         robot_kinds.one_line(d["title"], "title")
     if kind in ROBOTS:
         base = ROBOTS[kind]
@@ -254,7 +254,7 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
             box = _x_range(kin, d) if "x_range" in d else base.x_range
             x0, target, path = defaults(kin, d, box, base)
             kin.start = tuple(x0)  # (where its syntheses hold the joints outside their box)
-            title = _get(d, "title", str, "a string", base.title)
+            title = d.get("title", base.title)  # (checked above)
             spec = replace(spec, title=title, x_range=box, default_x0=x0, default_target=target)
             spec = replace(spec, default_path=path)
         extra, _, _ = augmentations_from_dict(kin, d.get("augmentations", []))
@@ -277,7 +277,7 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
         {k: v for k, v in d.items() if k != "augmentations"}, sort_keys=True, default=str
     )
     augmentations, region, vectors = augmentations_from_dict(kin, d.get("augmentations", []), key)
-    title = _get(d, "title", str, "a string", kind.replace("_", " "))
+    title = d.get("title", kind.replace("_", " "))  # (checked above)
     task_names = {
         "planar_chain": ("x", "y", "phi")[: kin.r],
         "formula": tuple(f"y{i + 1}" for i in range(kin.r)),

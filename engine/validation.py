@@ -99,11 +99,11 @@ MAX_COORDINATE = 1e6
 def bounded(a: FloatArray, name: str, field: str | None = None) -> FloatArray:
     """``a`` (finite) if no entry exceeds :data:`MAX_COORDINATE` in magnitude; else an
     InvalidInputError naming ``name``."""
-    if a.size and (a.max() > MAX_COORDINATE or a.min() < -MAX_COORDINATE):  # (no copy of a)
-        worst = a.max() if a.max() > MAX_COORDINATE else a.min()
+    hi, lo = (a.max(), a.min()) if a.size else (0.0, 0.0)  # (no copy of a, as abs would make)
+    if max(hi, -lo) > MAX_COORDINATE:
         raise InvalidInputError(
-            f"{name} has a coordinate of {worst:.3g}; a solve takes coordinates up "
-            f"to {MAX_COORDINATE:g} in magnitude",
+            f"{name} has a coordinate of {hi if hi > -lo else lo:.3g}; a solve takes "
+            f"coordinates up to {MAX_COORDINATE:g} in magnitude",
             field_for(name, field),
         )
     return a
