@@ -33,11 +33,13 @@ def add_algorithm_parameter_options(p: argparse.ArgumentParser) -> None:
 
 def refuse_unused_options(args: argparse.Namespace, algorithms: list[str]) -> None:
     """Refuse an algorithm option given that none of the chosen ``algorithms`` takes (as the
-    REST API refuses an unknown parameter): ``--damping`` with the pseudoinverse alone."""
+    REST API refuses an unknown parameter): ``--damping`` with the pseudoinverse alone, an
+    ``--augmentation`` without the extended inverse."""
     from ..engine.exceptions import InvalidInputError
     from ..engine.registry import ALGORITHMS
 
-    takers: dict[str, list[str]] = {}  # option (its dest) -> the algorithms that take it
+    # option (its dest) -> the algorithms that take it
+    takers: dict[str, list[str]] = {"augmentation": ["extended"]}
     for name, spec in ALGORITHMS.items():
         for option in (*(p.name for p in spec.parameters), *spec.vectors):
             takers.setdefault(option, []).append(name)

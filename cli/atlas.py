@@ -141,7 +141,7 @@ def _points(text: str, what: str) -> list[list[float]]:
 def backend_option(args: argparse.Namespace) -> str:
     if args.processes is not None:
         return f"processes:{args.processes}"
-    if args.dask:
+    if args.dask is not None:
         return f"dask:{args.dask}"
     return "inprocess"
 
@@ -178,7 +178,7 @@ def atlas_command(args: argparse.Namespace) -> int:
     try:
         return _run(args)
     except InvalidInputError as error:
-        return refused("atlas", error)
+        return refused("atlas", error, args)
     except OSError as error:  # (a Dask scheduler out of reach, an output that cannot be written)
         sys.stderr.write(f"jik atlas: {error}\n")
         return 2

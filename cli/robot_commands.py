@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import sys
 from typing import TYPE_CHECKING
 
@@ -239,10 +240,28 @@ def repeatability_command(args: argparse.Namespace) -> int:
     return 0 if rep.success else 1
 
 
-def refused(command: str, error: Exception) -> int:
-    """Say on stderr why ``jik command`` refused its input, and the field; the exit status 2."""
-    field = getattr(error, "field", None)
-    where = f" (field {field})" if field else ""
+#: The engine's names of inputs that the command line takes under another option's name.
+OPTION_OF_FIELD = {
+    "y_d": "target",
+    "targets": "path",
+    "n_starts": "starts",
+    "shifts": "shift",
+    "scales": "scale",
+}
+
+
+def refused(command: str, error: Exception, args: argparse.Namespace | None = None) -> int:
+    """Say on stderr why ``jik command`` refused its input, and the option it is about (of
+    ``args``'s options; else the engine's field); the exit status 2."""
+    field = getattr(error, "field", None) or ""
+    head = re.split(r"[.\[]", field.lstrip("-"))[0]
+    option = OPTION_OF_FIELD.get(head, head)
+    if head == "backend":  # (jik atlas's --processes or --dask)
+        option = "dask" if getattr(args, "dask", None) is not None else "processes"
+    if field and option in vars(args or argparse.Namespace()):
+        where = f" (option --{option.replace('_', '-')})"
+    else:
+        where = f" (field {field})" if field else ""
     sys.stderr.write(f"jik {command}: {error}{where}\n")
     return 2
 
@@ -254,7 +273,7 @@ def _guarded(command):
         try:
             return command(args)
         except JikError as exc:
-            return refused(args.command, exc)
+            return refused(args.command, exc, args)
 
     return run
 

@@ -158,7 +158,14 @@ class Dask:
                 )
             self._client = Client(self._cluster)
         else:
-            self._client = Client(self.address)
+            try:
+                self._client = Client(self.address)
+            except ValueError as error:  # (OSError: a scheduler out of reach, said as it is)
+                raise InvalidInputError(
+                    f"a Dask scheduler's address is 'HOST:PORT' or 'tcp://HOST:PORT' (or "
+                    f"'local:N'), got {self.address!r}: {error}",
+                    field="backend",
+                ) from error
             self.workers = max(1, len(self._client.scheduler_info().get("workers", {})))
         return self
 

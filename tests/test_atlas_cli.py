@@ -173,10 +173,14 @@ def test_arc_and_sampling_set_the_starts(tmp_path):
     ("extra", "text"),
     [
         (["--dask", "local:0"], "local Dask cluster is 'local:N'"),
-        (["--cycles", "0"], "cycles must be between 1 and 1000, got 0 (field cycles)"),
+        (["--dask", "foo bar"], "a Dask scheduler's address is 'HOST:PORT'"),
+        (["--dask", ""], "got 'dask:' (option --dask)"),
+        (["--processes", "0"], "got 'processes:0' (option --processes)"),
+        (["--starts", "0"], "n_starts must be between 1 and 1000000000, got 0 (option --starts)"),
+        (["--cycles", "0"], "cycles must be between 1 and 1000, got 0 (option --cycles)"),
         (["--arc", "1,2"], "lo <= 0 <= hi"),
-        (["--param", "l"], "--param must be NAME=VALUE, got 'l' (field param)"),
-        (["--arc", "1,a"], "--arc must be comma-separated numbers, got '1,a' (field arc)"),
+        (["--param", "l"], "--param must be NAME=VALUE, got 'l' (option --param)"),
+        (["--arc", "1,a"], "--arc must be comma-separated numbers, got '1,a' (option --arc)"),
     ],
 )
 def test_bad_input_exits_2_and_names_it(tmp_path, capsys, extra, text):
@@ -223,7 +227,7 @@ def test_a_chunk_below_one_is_refused_as_the_engine_says(tmp_path, capsys, chunk
         main(["atlas", "--path", TABLE1, "--chunk", chunk, "--out", str(tmp_path / "x.json")]) == 2
     )
     err = capsys.readouterr().err
-    assert err == f"jik atlas: chunk must be between 1 and 65536, got {chunk} (field chunk)\n"
+    assert err == f"jik atlas: chunk must be between 1 and 65536, got {chunk} (option --chunk)\n"
 
 
 def test_a_dask_scheduler_out_of_reach_is_one_line_and_exit_2(tmp_path, capsys, monkeypatch):
@@ -502,7 +506,7 @@ def test_without_path_the_robot_s_closed_path_is_the_loop(tmp_path, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert "unicycle has no default closed path: its default path" in err
-    assert "not a loop: give --path (field --path)" in err
+    assert "not a loop: give --path (option --path)" in err
 
 
 def test_the_progress_bar_counts_the_runs_of_every_algorithm(tmp_path, capsys):

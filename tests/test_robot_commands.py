@@ -201,12 +201,13 @@ def test_urdf_robot_from_a_yaml_file(capsys, tmp_path):
         (
             ["--damping", "1"],
             "--damping is a parameter of damped, not of pseudoinverse: choose it with "
-            "--algorithm damped (field damping)",
+            "--algorithm damped (option --damping)",
         ),
         (["--algorithm", "damped", "--gain", "2"], "--gain is a parameter of posture, not of"),
         (["--max-iterations", "0"], "max_iterations must be between 1 and"),
         (["--tol", "0"], "tol must be"),
-        (["--target=1e300,1"], "target y_d has a coordinate of 1e+300"),
+        (["--target=1e300,1"], "in magnitude (option --target)"),
+        (["--augmentation", "paper_cubic"], "--augmentation is a parameter of extended, not of"),
     ],
 )
 def test_bad_input_exits_2_with_the_message(capsys, arm_file, argv, message):
@@ -229,7 +230,7 @@ def test_an_empty_path_point_is_refused_and_a_trailing_semicolon_ends_the_path(
 
 def test_unknown_robot_exits_2(capsys):
     _, err = run(capsys, "repeatability", "--robot", "scara.json", code=2)
-    assert "neither a file nor a built-in robot" in err and "(field robot)" in err
+    assert "neither a file nor a built-in robot" in err and "(option --robot)" in err
 
 
 def test_repeatability_says_what_it_found_and_why(capsys):
