@@ -154,6 +154,7 @@ class Progress:
         self.quiet = quiet
         self.algorithms = algorithms
         self.t0 = time.perf_counter()
+        self.open = False  # (a bar is on stderr's last line, not ended by a newline)
 
     def __call__(self, done: int, total: int) -> None:
         """``done`` of ``total`` starts (times paths), each run by every algorithm."""
@@ -167,9 +168,16 @@ class Progress:
             f"\r  atlas [{bar:<30}] {A * done}/{A * total} runs ({total} starts x {A} "
             f"algorithm{'' if A == 1 else 's'}), {t:.1f} s, {left} s left "
         )
+        self.open = True
         if done >= total:
-            sys.stderr.write("\n")
+            self.end()
         sys.stderr.flush()
+
+    def end(self) -> None:
+        """End the bar's line (a message after it starts on a line of its own)."""
+        if self.open:
+            sys.stderr.write("\n")
+            self.open = False
 
 
 def atlas_command(args: argparse.Namespace) -> int:
@@ -256,11 +264,14 @@ def _run(args: argparse.Namespace) -> int:
     progress = Progress(args.quiet, A)
     t0 = time.perf_counter()
     progress(0, plan.size)  # (the size at once: the first chunk may take minutes)
-    with CsvWriter(csv_path, plan, legs=not args.no_leg_ends) as rows:
-        for task, chunk in iter_atlas(plan, backend):
-            arrays.add(task, chunk)
-            rows.add(task, chunk)
-            progress(arrays.done, plan.size)
+    try:
+        with CsvWriter(csv_path, plan, legs=not args.no_leg_ends) as rows:
+            for task, chunk in iter_atlas(plan, backend):
+                arrays.add(task, chunk)
+                rows.add(task, chunk)
+                progress(arrays.done, plan.size)
+    finally:
+        progress.end()
     elapsed = time.perf_counter() - t0
     inputs = {
         "robot": spec.name,

@@ -220,6 +220,22 @@ def test_a_path_that_is_not_numbers_is_refused(tmp_path, capsys):
     assert "--path must be comma-separated numbers" in capsys.readouterr().err
 
 
+def test_a_refusal_after_the_progress_bar_starts_on_a_line_of_its_own(tmp_path, capsys):
+    """The bar is drawn before the backend starts; its refusal ends the bar's line."""
+    argv = [
+        "atlas",
+        "--robot",
+        "manipulator2",
+        "--dask",
+        "foo bar",
+        "--out",
+        str(tmp_path / "x.json"),
+    ]
+    assert main(argv) == 2
+    bar, said = capsys.readouterr().err.split("\n")[:2]
+    assert bar.startswith("\r  atlas [") and said.startswith("jik atlas: a Dask scheduler's")
+
+
 @pytest.mark.parametrize("chunk", ["0", "-3"])
 def test_a_chunk_below_one_is_refused_as_the_engine_says(tmp_path, capsys, chunk):
     """--chunk 0 is refused like any chunk outside 1 to 65536, not taken as the default."""
