@@ -84,6 +84,20 @@ def test_bad_parameters_are_422_naming_the_field(api, algorithm, params, loc, te
     assert got[: len(loc)] == loc, r.text
 
 
+@pytest.mark.parametrize("algorithm", ["pseudoinverse", "damped", "weighted", "posture"])
+def test_an_augmenting_map_given_to_another_algorithm_is_422(api, algorithm):
+    """The map is the extended inverse's: given with another algorithm it was dropped silently
+    (the response said augmentation null); it is refused as the extended inverse's
+    algorithm_parameters are."""
+    body = solve_body(algorithm=algorithm, augmentation={"name": "paper_cubic"})
+    r = api.post("/solve", json=body)
+    assert r.status_code == 422, r.text
+    (said,) = r.json()["detail"]
+    assert said["loc"] == ["body", "augmentation"]
+    assert f"the {algorithm} inverse takes none (the extended inverse does)" in said["msg"]
+    assert api.post("/solve", json=solve_body(algorithm=algorithm)).status_code == 200
+
+
 def test_atlas_compares_algorithms_over_the_same_starts():
     req = AtlasRequest.model_validate(
         {

@@ -70,7 +70,7 @@ class _Request(RunSettings):
     augmentation: AnyAugmentation | None = Field(
         None,
         description="augmenting map h of the extended inverse with its parameters; "
-        "default: the robot's default augmentation (ignored by the pseudoinverse)",
+        "default: the robot's default augmentation (the other algorithms take none)",
     )
     x0: Vector = Field(description="start configuration, length p of the robot")
     max_iterations: Annotated[int, Field(strict=True, ge=1, le=MAX_ITERATIONS), INTEGRAL] | None = (
