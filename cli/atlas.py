@@ -215,7 +215,11 @@ def _run(args: argparse.Namespace) -> int:
             )
         spec, kin = robot.spec, robot.kinematics
         inverses = [
-            robot.inverse(a, args.augmentation, algorithm_parameters=algorithm_parameters(args, a))
+            robot.inverse(
+                a,
+                args.augmentation if a == "extended" else None,
+                algorithm_parameters=algorithm_parameters(args, a),
+            )
             for a in algorithms
         ]
     else:
@@ -225,7 +229,7 @@ def _run(args: argparse.Namespace) -> int:
             make_inverse(
                 kin,
                 a,
-                args.augmentation,
+                args.augmentation if a == "extended" else None,
                 None,
                 spec.name,
                 algorithm_parameters=algorithm_parameters(args, a),

@@ -193,11 +193,18 @@ def make_inverse(
     the posture inverse (given: within the robot's joint limits if it has some,
     :func:`~jik.engine.practical_inverses.check_rest`; default :func:`default_rest`, the
     robot's home, else the run's start ``x0``, else its default start, not checked against
-    the limits; in an atlas each run's own start, :mod:`jik.engine.posture_at_start`).
+    the limits; in an atlas each run's own start, :mod:`jik.engine.posture_at_start`). An
+    ``augmentation`` (or its parameters) is the extended inverse's: another algorithm refuses it.
     """
     if algorithm not in ALGORITHMS:
         raise InvalidInputError(
             f"algorithm must be one of {list(ALGORITHMS)}, got {algorithm!r}", "algorithm"
+        )
+    if algorithm != "extended" and (augmentation is not None or augmentation_parameters):
+        raise InvalidInputError(
+            f"augmentation: the {algorithm} inverse takes no augmenting map (the extended "
+            f"inverse does), got {augmentation!r}",
+            "augmentation",
         )
     aspec_ = ALGORITHMS[algorithm]
     given = dict(algorithm_parameters or {})

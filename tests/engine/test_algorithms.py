@@ -263,6 +263,16 @@ def test_bad_parameters_name_their_field(name, params, field):
         make_inverse(KIN, name, algorithm_parameters=params)
 
 
+@pytest.mark.parametrize("name", ["pseudoinverse", "damped", "weighted", "posture"])
+def test_an_augmenting_map_is_the_extended_inverses_alone(name):
+    """A map given to another algorithm is refused, not dropped (the caller meant one)."""
+    with pytest.raises(InvalidInputError, match="takes no augmenting map") as refused:
+        make_inverse(KIN, name, "paper_cubic")
+    assert refused.value.field == "augmentation"
+    with pytest.raises(InvalidInputError, match="takes no augmenting map"):
+        make_inverse(KIN, name, None, {"a": 1.0})
+
+
 def test_reproduction_table_has_every_algorithm():
     """`jik reproduce algorithms`, shortened to 2 cycles: one row per algorithm, in order."""
     from jik.engine.reproductions import algorithms as repro

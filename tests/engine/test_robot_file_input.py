@@ -73,7 +73,7 @@ def test_a_bad_robot_file_exits_2_with_one_line_naming_it(capsys, tmp_path, suff
     robot = tmp_path / f"robot{suffix}"
     robot.write_bytes(text.encode("latin-1"))
     err = _cli_refusal(capsys, robot)
-    assert f"robot{suffix}" in err and words in err and err.endswith("(field robot)\n")
+    assert f"robot{suffix}" in err and words in err and err.endswith("(option --robot)\n")
 
 
 def test_a_urdf_file_that_is_not_utf8_is_refused_naming_urdf_file(tmp_path):
