@@ -50,10 +50,6 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
             "algorithm_parameters",
             "the extended inverse takes none (its augmenting map's parameters go in augmentation)",
         )
-    if req.algorithm != "extended" and req.augmentation is not None:
-        raise RequestError(
-            "augmentation", f"the {req.algorithm} inverse takes none (the extended inverse does)"
-        )
     built = request_robot(
         req.robot, req.augmentation, [req.algorithm], req.algorithm_parameters, req.x0
     )

@@ -54,9 +54,10 @@ def request_robot(
     the robot's default), the others with ``parameters`` (``algorithm_parameters``; posture's
     rest defaults to the robot's home, else ``x0``), each with only its own if ``own`` (then a
     parameter of none of them is refused, :func:`_belong`). The
-    robot has its map if the extended inverse or ``with_map`` asks for one; a map given but
-    not used is checked all the same (a catalogue map's parameters, a formula map's formulas),
-    except a map to synthesize. Refusals are :class:`RequestError` naming the request's field."""
+    robot has its map if the extended inverse or ``with_map`` asks for one; a map given to
+    algorithms none of which is the extended inverse is refused; one given for no algorithm is
+    checked all the same (a catalogue map's parameters, a formula map's formulas), except a map
+    to synthesize. Refusals are :class:`RequestError` naming the request's field."""
 
     def given(algorithm: str) -> dict:
         names = ALGORITHMS[algorithm].names
@@ -65,6 +66,10 @@ def request_robot(
     if own:
         _belong(used(parameters), algorithms)
     extended, aug_used = "extended" in algorithms, None
+    if augmentation is not None and algorithms and not (extended or with_map):
+        names = " and ".join(algorithms)
+        takes = "inverses take" if len(algorithms) > 1 else "inverse takes"
+        raise RequestError("augmentation", f"the {names} {takes} none (the extended inverse does)")
     if req_robot.name in S.USER_ROBOT_MODELS:
         # A formula map no chosen algorithm uses is built all the same, to be checked (its
         # formulas' derivatives, within the build budget); a map to synthesize is not.

@@ -12,6 +12,8 @@ case in tests/app/test_errors.py, test_synthesize.py and test_sessions.py):
   rule has a power of two of nodes, at least twice the basis' unknowns (at most 4000), and its
   kernel frame (p - r >= 2) p - r distinct joints;
 - discrete mode (asked for, or the robot's default) needs ``gamma < 2``;
+- an ``augmentation`` goes with the extended inverse: a run or atlas of other algorithms alone
+  takes none;
 - the chosen inverse must be defined at ``x0`` (the engine says so: a singular start, by the
   server's own test);
 - a user robot (``planar_chain``, ``formula``, ``urdf``) is a definition: its formulas'
