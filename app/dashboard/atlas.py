@@ -59,7 +59,7 @@ def atlas_request(
             "robot": robot,
             "algorithms": list(state.algorithms),
             "algorithm_parameters": params or None,
-            "augmentation": augmentation,
+            "augmentation": augmentation if "extended" in state.algorithms else None,
             "path": [home.tolist(), *[list(p) for p in state.path]],
             "starts": starts,
             "cycles": cycles or state.cycles,

@@ -144,6 +144,18 @@ def test_the_atlas_compares_the_chosen_algorithms(three):
     assert request.algorithm_parameters.rest is None
 
 
+def test_an_atlas_without_the_extended_inverse_is_planned_without_a_map():
+    """The map is the extended inverse's: an atlas of the others alone sends none (the server
+    refuses one there), and the server plans it."""
+    from jik.app.compute.atlas_plan import AtlasLimits, planned
+
+    state = updated_state(default_state(), {"algorithms": ["pseudoinverse", "damped"]})
+    request = atlas_request(state, 4, cycles=1)
+    assert request.augmentation is None and request.algorithms == ["pseudoinverse", "damped"]
+    planned(request, AtlasLimits())
+    assert atlas_request(updated_state(state, {"algorithms": THREE}), 4).augmentation is not None
+
+
 def test_the_session_api_takes_the_choice(client):
     """POST /api/sessions/{id}/state chooses three algorithms; a bad choice is a 422 naming its
     field, and the state stays."""
