@@ -44,37 +44,35 @@ function slider(c, value, send) {
 }
 
 const rows = new Map(); // control key -> its label (where its errors show)
-// Whether the control ``key`` is about ``field`` (a dotted path): the field, a coordinate of it
-// (x0.1 of x0), or the vector control holding it (the rule of about() in
-// app/dashboard/controls.py, which marks the 3D scene's inputs); the first such control.
-const about = (key, field) => key === field || field.startsWith(`${key}.`) || key.startsWith(`${field}.`);
-const firstKey = (field) => [...rows.keys()].find((k) => about(k, field));
+// The controls a refused field is about (the server's list, by app/dashboard/controls.py's
+// about(): the field, its coordinates, or the vector holding it) that are on this page.
+const onPage = (keys) => (keys || []).filter((k) => rows.has(k));
+const keysOf = (note) => note.dataset.controls.split(" ");
 
-// An error beside the control ``key``, quoting what the user wrote; every control of ``field``
-// (the key's own, or all of x0's) is marked invalid while the note stays (``clear``).
-function fieldError(key, typed, message, field = key) {
-  const row = rows.get(key);
+// An error beside the first control of ``keys``, quoting what the user wrote; every control of
+// ``keys`` (the key's own, or all of x0's) is marked invalid while the note stays (``clear``).
+function fieldError(keys, typed, message) {
+  const row = rows.get(keys[0]);
   if (!row) return null;
   let note = row.querySelector(":scope > .field-error");
-  if (note) invalid(note.dataset.field, false);
+  if (note) invalid(keysOf(note), false);
   else { note = el("span", { className: "field-error", role: "alert" }); row.append(note); }
   note.textContent = typed === undefined ? message : `“${typed}” ${message}`;
-  note.dataset.field = field;
-  invalid(field, true);
+  note.dataset.controls = keys.join(" ");
+  invalid(keys, true);
   return note;
 }
 
-function invalid(field, on) {
-  for (const [key, row] of rows) {
-    if (!about(key, field)) continue;
-    for (const input of row.querySelectorAll("input, textarea, select, button")) {
+function invalid(keys, on) {
+  for (const key of keys) {
+    for (const input of rows.get(key)?.querySelectorAll("input, textarea, select, button") || []) {
       if (on) input.setAttribute("aria-invalid", "true"); else input.removeAttribute("aria-invalid");
     }
   }
 }
 
 function clear(note) {
-  invalid(note.dataset.field, false);
+  invalid(keysOf(note), false);
   note.remove();
 }
 
@@ -83,29 +81,31 @@ function clear(note) {
 let notSent = () => {};
 export function onNotSent(show) { notSent = show; }
 function notANumber(c, typed) {
-  fieldError(c.key, typed, "is not a number; nothing was sent");
+  fieldError([c.key], typed, "is not a number; nothing was sent");
   notSent(`not sent (here): ${c.label}: “${typed}” is not a number`);
 }
 
-// A refusal of the server (its field, a dotted path) shown beside the control it is about,
-// with the text the user typed there when there was one; whether a control was found.
+// A refusal of the server shown beside the controls it is about (``about``: their keys), with
+// the text the user typed there when there was one; whether a control was found.
 const typedText = new Map(); // control key -> the text last sent from a box
-export function showRefusal(field, message) {
-  const key = firstKey(field);
-  if (!key) return false;
-  const typed = typedText.get(key);
-  return fieldError(key, typed, typed === undefined ? message : `was refused: ${message}`, field) !== null;
+export function showRefusal(about, message) {
+  const keys = onPage(about);
+  if (!keys.length) return false;
+  const typed = typedText.get(keys[0]);
+  return fieldError(keys, typed, typed === undefined ? message : `was refused: ${message}`) !== null;
 }
 
 // The inputs where a result's runs stopped (a run's ``field``: x0, a singular start), marked as
 // a refusal is, with the runs' messages, until they change or a result without them comes.
 export function showStopped(summary) {
   document.querySelectorAll("#controls .field-error[data-run]").forEach(clear);
-  const messages = new Map(); // field -> the messages of the runs stopped there
-  for (const run of Object.values(summary)) if (run.field) messages.set(run.field, [...(messages.get(run.field) || []), run.message]);
-  for (const [field, said] of messages) {
-    const key = firstKey(field);
-    const note = key && fieldError(key, undefined, said.join("; "), field);
+  const messages = new Map(); // keys of the controls about a field -> the messages of the runs stopped there
+  for (const run of Object.values(summary)) {
+    const keys = onPage(run.controls).join(" ");
+    if (keys) messages.set(keys, [...(messages.get(keys) || []), run.message]);
+  }
+  for (const [keys, said] of messages) {
+    const note = fieldError(keys.split(" "), undefined, said.join("; "));
     if (note) note.dataset.run = "";
   }
 }
@@ -113,7 +113,7 @@ export function showStopped(summary) {
 // The errors about a control, once its value changed (here, in the 3D scene, another client):
 // what they quoted is no longer what the control holds.
 function clearFieldError(key) {
-  for (const note of document.querySelectorAll("#controls .field-error")) if (about(key, note.dataset.field)) clear(note);
+  for (const note of document.querySelectorAll("#controls .field-error")) if (keysOf(note).includes(key)) clear(note);
 }
 
 export function clearFieldErrors() {

@@ -69,7 +69,7 @@ function onRefused(msg) {
   onState(msg, true);
   const where = msg.source === "scene" ? "in the 3D scene" : "here";
   setStatus(`refused (${where}): ${msg.message}`, true);
-  if (msg.field && !page.editor.refused(msg.field, msg.message)) showRefusal(msg.field, msg.message);
+  if (msg.field && !page.editor.refused(msg.field, msg.message)) showRefusal(msg.about, msg.message);
 }
 
 async function onResult(msg) {

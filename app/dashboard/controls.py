@@ -308,8 +308,16 @@ def element_id(key: str) -> str:
 
 def about(key: str, field: str) -> bool:
     """Whether the control ``key`` is about ``field`` (a refusal's dotted path): the field, a
-    coordinate of it (``x0.1`` of ``x0``) or its vector; as ``about`` in static/controls.js."""
+    coordinate of it (``x0.1`` of ``x0``) or its vector. The page gets the keys it marks from
+    :func:`controls_about`."""
     return key == field or field.startswith(f"{key}.") or key.startswith(f"{field}.")
+
+
+def controls_about(spec: list[Control], field: str | None) -> list[str]:
+    """The keys of the controls of ``spec`` about ``field`` (:func:`about`), in the panel's
+    order: where the page shows a refusal of ``field`` or a run that stopped there (none for
+    None)."""
+    return [c.key for c in spec if field and about(c.key, field)]
 
 
 def control_values(state, spec: list[Control] | None = None) -> dict[str, Any]:
@@ -333,15 +341,16 @@ def control_values(state, spec: list[Control] | None = None) -> dict[str, Any]:
     return values
 
 
-def controls_message(state) -> dict[str, Any]:
+def controls_message(state, field: str | None = None) -> dict[str, Any]:
     """What a page needs to show the controls of ``state``: the controls, grouped, and their
-    values."""
+    values; with a refused ``field``, the keys of the controls it is about ("about")."""
     spec = controls(state)
-    return {
+    message = {
         "groups": [list(g) for g in GROUPS],
         "controls": [c.as_dict() for c in spec],
         "values": control_values(state, spec),
     }
+    return message | ({"about": controls_about(spec, field)} if field else {})
 
 
 def _sliders(head: str, parameters) -> list[Control]:

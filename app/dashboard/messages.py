@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 from ...engine.augmentations import h_change
 from ...engine.exports import json_values as finite
+from .controls import controls, controls_about
 from .runs import DashboardResult
 
 
@@ -88,8 +89,11 @@ def with_figures(message: dict, figures: Mapping[str, str]) -> str:
 
 
 def summary(result: DashboardResult) -> dict:
-    """Numbers shown beside the plots: per algorithm success, message, drift, final x."""
+    """Numbers shown beside the plots: per algorithm success, message, drift, final x; where a
+    run stopped at an input, its ``field`` and the keys of the controls about it."""
     out = {}
+    stopped = any(run.field for run in result.runs.values())
+    spec = controls(result.state) if stopped else []
     for a, run in result.runs.items():
         out[a] = {
             "success": run.success,
@@ -101,6 +105,7 @@ def summary(result: DashboardResult) -> dict:
             "seconds": round(run.seconds, 4),
             "cached": bool(result.cached.get(a, False)),
             "field": run.field,
+            "controls": controls_about(spec, run.field),
         }
     for a, report in result.limits.items():  # ({"within": bool, "violation": {...} or None})
         out[a]["limits"] = report.as_dict()

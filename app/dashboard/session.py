@@ -185,7 +185,8 @@ class Dashboard(SecondPhaseControl, SolvingAhead):
         self, generation: int, state: DashboardState, source: str, kind: str = "state", **more
     ) -> Event:
         """A ``state`` event (or ``kind``, with ``more``): the state and its controls."""
-        data = dict(state=state.as_dict(), source=source, **more, **controls_message(state))
+        message = controls_message(state, more.get("field"))
+        data = dict(state=state.as_dict(), source=source, **more, **message)
         return Event.of(kind, generation, **data)
 
     def _work(self) -> None:

@@ -4,6 +4,8 @@ shown the same in the page and the scene, turned into state changes in one place
 
 from __future__ import annotations
 
+import json
+
 import pytest
 
 from jik.app.dashboard import default_state, updated_state
@@ -162,6 +164,36 @@ def test_refusals_carry_their_field(patch, field):
     with pytest.raises(InvalidInputError) as refused:
         updated_state(default_state("manipulator2"), patch)
     assert refused.value.field == field
+
+
+@pytest.mark.parametrize(
+    ("field", "keys"),
+    [
+        ("x0", ["x0.0", "x0.1", "x0.2"]),  # (a vector: each of its coordinates' sliders)
+        ("x0.1", ["x0.1"]),
+        ("robot_parameters.l", ["robot_parameters.l"]),
+        ("path.2.1", ["path"]),  # (a coordinate of a point of the path: the path's box)
+        ("gamma", ["gamma"]),
+        ("nonsense", []),
+    ],
+)
+def test_a_refusal_names_the_controls_it_is_about(field, keys):
+    """The keys the page marks for a refused field, as the scene marks its inputs (one rule,
+    ``about``); a refused change's event carries them."""
+    from jik.app.dashboard import Dashboard
+    from jik.app.dashboard.controls import controls_about
+
+    state = default_state("manipulator2")
+    assert controls_about(controls(state), field) == keys
+    dashboard, seen = Dashboard(state), []
+    dashboard.subscribe(seen.append)
+    try:
+        with pytest.raises(InvalidInputError):
+            dashboard.update({"x0": [1, 2]})
+    finally:
+        dashboard.stop()
+    (refused,) = [json.loads(e.data) for e in seen if e.kind == "refused"]
+    assert refused["field"] == "x0" and refused["about"] == ["x0.0", "x0.1", "x0.2"]
 
 
 def test_the_scene_and_the_page_show_the_same_controls():

@@ -228,13 +228,15 @@ def test_damped_goes_through_a_singular_start_where_the_pseudoinverse_stops():
 
 def test_a_run_stopped_at_a_singular_start_names_the_field_x0():
     """The stretched 3R arm's first leg starts singular for the pseudoinverse: its run and its
-    summary name x0 (the engine's field), for the page to mark the start's controls; damped
-    least squares goes through and names none."""
+    summary name x0 (the engine's field) and the keys of its controls, which the page marks;
+    damped least squares goes through and names none."""
     from jik.app.dashboard.messages import summary
 
     result, _ = _damped_beside_pseudoinverse([0.0, 0.0, 0.0], [2.0, 1.0])
     said = summary(result)
     assert said["pseudoinverse"]["field"] == "x0" and said["damped"]["field"] is None
+    assert said["pseudoinverse"]["controls"] == ["x0.0", "x0.1", "x0.2"]
+    assert said["damped"]["controls"] == []
     assert "J J^T is singular" in said["pseudoinverse"]["message"]
 
 
