@@ -201,7 +201,9 @@ def make_inverse(
             f"algorithm must be one of {list(ALGORITHMS)}, got {algorithm!r}", "algorithm"
         )
     if algorithm != "extended" and (augmentation is not None or augmentation_parameters):
-        given_map = augmentation if augmentation is not None else dict(augmentation_parameters)
+        given_map = (
+            augmentation if augmentation is not None else dict(augmentation_parameters or {})
+        )
         raise InvalidInputError(
             f"augmentation: the {algorithm} inverse takes no augmenting map (the extended "
             f"inverse does), got {given_map!r}",

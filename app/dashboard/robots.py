@@ -138,5 +138,11 @@ def state_inverse(state, algorithm: str, kin: Kinematics | None = None) -> Inver
     inverse's default rest at the state's start x0)."""
     robot = state_robot(state, kin)
     params = inverse_parameters(state, algorithm)
-    aug = (state.augmentation, state.augmentation_parameters) if algorithm == "extended" else ()
-    return robot.inverse(algorithm, *aug, algorithm_parameters=params, x0=state.x0)
+    extended = algorithm == "extended"  # (the map is the extended inverse's alone)
+    return robot.inverse(
+        algorithm,
+        state.augmentation if extended else None,
+        state.augmentation_parameters if extended else None,
+        algorithm_parameters=params,
+        x0=state.x0,
+    )
