@@ -1,8 +1,7 @@
 """Why a continuous run of eq. (7) stalled: the target beyond the robot's reach, a kinematic
 singularity (J loses rank), an algorithmic one of the extended Jacobian (10) (J regular,
-[J; dh] singular), or a local minimum of the task error; and whether a target is out of reach
-or at the half turn where a pose task's rotation coordinates jump, which a run that diverged or
-ran out of steps says too.
+[J; dh] singular), or a local minimum of the task error; and whether a target is out of reach,
+which a run that diverged or ran out of steps says too.
 
 The integrator only sees its step size collapse; the robot's workspace and the Jacobians where
 the run stopped tell which. A planar chain of revolute joints reaches the annulus between
@@ -23,9 +22,6 @@ from .planar_chain import PlanarChain
 SINGULAR_RATIO = 1e-3
 #: ||J#|| sigma_min(J) above this (J regular): the extended Jacobian is near singular.
 ALGORITHMIC_RATIO = 1e2
-#: A pose target whose rotation vector is longer than pi minus this (rad) is near the half
-#: turn from R0 where the rotation coordinates jump: a run that fails there is told so.
-HALF_TURN_MARGIN = 0.01
 
 
 def reach(kinematics) -> tuple[float, float] | None:
@@ -57,23 +53,13 @@ def rotation_rows(kinematics) -> list[int] | None:
 
 
 def half_turn_note(kinematics, target) -> str | None:
-    """Why a pose task's run to ``target`` fails, or None: its rotation vector is longer than
-    pi, which the rotation coordinates (the principal log, :mod:`jik.engine.so3`) never are (out
-    of reach); or within :data:`HALF_TURN_MARGIN` of pi, where they jump (a half turn has two
-    rotation vectors) and the task error is not continuous."""
+    """Why a pose task's target is out of reach, or None: its rotation vector is longer than
+    pi, which the rotation coordinates (the principal log, :mod:`jik.engine.so3`) never are."""
     rows = rotation_rows(kinematics)
     if rows is None:
         return None
     r = np.asarray(target, dtype=float)[rows]
     length = float(np.linalg.norm(r))
-    if np.pi - HALF_TURN_MARGIN < length <= np.pi + 1e-9:
-        return (
-            f"the target's orientation is {'a' if length > np.pi - 1e-9 else 'nearly a'} half "
-            f"turn from the reference R0 (its rotation vector has length {length:.6g}), where "
-            "the rotation coordinates (the principal log of R0^T R) jump between two rotation "
-            "vectors and the task error is not continuous; choose a reference orientation "
-            "nearer the target's"
-        )
     if not length > np.pi + 1e-9:
         return None
     same = ", ".join(_g(v + 0.0) for v in r * (1.0 - 2.0 * np.pi / length))  # (no -0)
@@ -85,9 +71,8 @@ def half_turn_note(kinematics, target) -> str | None:
 
 
 def reach_note(kinematics, target) -> tuple[str | None, str]:
-    """(why ``target`` is out of the robot's reach or at a half turn of its rotation
-    coordinates, :func:`half_turn_note`, or None; a clause saying it is within reach, or ""
-    when the reach is not known)."""
+    """(why ``target`` is out of the robot's reach, or None; a clause saying it is within
+    reach, or "" when the reach is not known)."""
     rotation = half_turn_note(kinematics, target)
     if rotation is not None:
         return rotation, ""
