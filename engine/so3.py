@@ -56,15 +56,17 @@ def log(R: FloatArray) -> FloatArray:
 
     Notes
     -----
-    Away from 0 and pi, phi = theta / (2 sin theta) vee(R - R^T) with cos theta = (tr R - 1)/2.
-    Near 0 the factor's series 1/2 + theta^2/12; near pi the axis a is read from the symmetric
-    part, a a^T = ((R + R^T)/2 - cos theta I) / (1 - cos theta), its sign from vee(R - R^T).
+    phi = theta / (2 sin theta) vee(R - R^T), with sin theta = |vee(R - R^T)| / 2, cos theta =
+    (tr R - 1) / 2 and theta = atan2(sin, cos): accurate to rounding at every angle, where
+    arccos(cos) loses half the digits near pi (1e-8 rad at pi, 2e-9 at 1e-3 from it). Near 0
+    the factor's series 1/2 + theta^2/12; near pi the axis a is read from the symmetric part,
+    a a^T = ((R + R^T)/2 - cos theta I) / (1 - cos theta), its sign from vee(R - R^T).
     """
     R = np.asarray(R, dtype=float)
-    c = np.clip((np.trace(R, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0)
-    theta = np.arccos(c)
+    c = (np.trace(R, axis1=-2, axis2=-1) - 1.0) / 2.0
     v = R.reshape(*R.shape[:-2], 9) @ _VEE  # vee(R - R^T) = 2 sin(theta) a
-    s = np.sin(theta)
+    s = 0.5 * np.linalg.norm(v, axis=-1)
+    theta = np.arctan2(s, c)
     small = theta < SMALL_ANGLE
     factor = np.where(small, 0.5 + theta**2 / 12.0, theta / (2.0 * np.where(small, 1.0, s)))
     phi = factor[..., None] * v
@@ -86,8 +88,9 @@ def left_jacobian_inverse(phi: FloatArray) -> FloatArray:
     """Jl^-1(phi) (..., 3, 3): the map from R0^T omega to dphi/dt for phi = log(R0^T R).
 
     ``Jl^-1 = I - [phi]x / 2 + (1/theta^2 - (1 + cos theta) / (2 theta sin theta)) [phi]x^2``,
-    theta = |phi|; the last coefficient's series near 0 is 1/12 + theta^2/720. It grows without
-    bound as theta -> pi.
+    theta = |phi|; the last coefficient's series near 0 is 1/12 + theta^2/720. It is bounded
+    up to theta = pi (||Jl^-1|| = pi/2 there) and grows without bound toward 2 pi, beyond the
+    principal log's range.
     """
     phi = np.asarray(phi, dtype=float)
     theta = np.linalg.norm(phi, axis=-1)[..., None, None]
@@ -108,15 +111,15 @@ def log_and_jacobian(R: FloatArray) -> tuple[FloatArray, FloatArray]:
     a few dozen of them); near pi it defers to :func:`log`.
     """
     (a, b, c), (d, e, f), (g, h, i) = R.tolist()
-    cos = min(1.0, max(-1.0, (a + e + i - 1.0) / 2.0))
-    theta = math.acos(cos)
+    cos = (a + e + i - 1.0) / 2.0
+    sin = 0.5 * math.sqrt((h - f) ** 2 + (c - g) ** 2 + (d - b) ** 2)
+    theta = math.atan2(sin, cos)  # (as in log)
     if theta > math.pi - NEAR_PI:
         phi = log(R)
         return phi, left_jacobian_inverse(phi)
     if theta < SMALL_ANGLE:
         factor, beta = 0.5 + theta * theta / 12.0, 1.0 / 12.0 + theta * theta / 720.0
     else:
-        sin = math.sin(theta)
         factor = theta / (2.0 * sin)
         beta = 1.0 / (theta * theta) - (1.0 + cos) / (2.0 * theta * sin)
     x, y, z = factor * (h - f), factor * (c - g), factor * (d - b)
