@@ -99,25 +99,34 @@ class LimitViolation:
         }
 
 
+#: What a report of a run that was not recorded checked.
+_ENDS = "at its start and its legs' ends (the steps between were not recorded: record=True)"
+
+
 @dataclass(frozen=True)
 class LimitsReport:
-    """Whether a run stayed within the limits, and if not its first violation."""
+    """Whether a run stayed within the limits, and if not its first violation;
+    ``every_step``: whether every step of the run was checked (it was recorded), else only its
+    start and its legs' ends."""
 
     within: bool
     violation: LimitViolation | None = None
+    every_step: bool = True
 
     def __str__(self) -> str:
-        return (
-            "within the joint limits" if self.within else f"left the joint limits {self.violation}"
-        )
+        if not self.within:
+            return f"left the joint limits {self.violation}"
+        return "within the joint limits" + ("" if self.every_step else f" {_ENDS}")
 
     def sentence(self, run: str, robot: str) -> str:
         """The report as a sentence on the run named ``run`` of ``robot`` (values to four
-        digits): it "stayed within the joint limits of the <robot> all along its run", or "left
-        the joint limits of the <robot>" and where first (its start, or a cycle and leg)."""
+        digits): it "stayed within the joint limits of the <robot> all along its run" (or, not
+        recorded, at its start and its legs' ends), or "left the joint limits of the <robot>"
+        and where first (its start, or a cycle and leg)."""
         v = self.violation
         if v is None:
-            return f"{run}: stayed within the joint limits of the {robot} all along its run."
+            along = "all along its run" if self.every_step else _ENDS
+            return f"{run}: stayed within the joint limits of the {robot} {along}."
         where = "its start x0 is already outside them" if v.cycle == 0 else f"first {v.where}"
         return (
             f"{run}: left the joint limits of the {robot}: {where}, joint {v.name} = "
@@ -190,20 +199,30 @@ def legs_report(
 
 
 def solve_report(limits: FloatArray, result, names: Sequence[str]) -> LimitsReport:
-    """A solve (one leg, cycle 1): its recorded trajectory from its start, else its end."""
+    """A solve (one leg, cycle 1): its recorded trajectory from its start, else its start and
+    end."""
     traj = getattr(result, "trajectory", None)
-    X = traj.x if traj is not None else np.atleast_2d(result.x)
-    return legs_report(limits, X[0], [X], 1, names)
+    if traj is None:
+        X = np.stack([np.asarray(result.x0, dtype=float), np.asarray(result.x, dtype=float)])
+        return replace(legs_report(limits, X[0], [X[1:]], 1, names), every_step=False)
+    return legs_report(limits, traj.x[0], [traj.x], 1, names)
 
 
 def repeatability_report(limits: FloatArray, result, names: Sequence[str]) -> LimitsReport:
-    """A single start's repeatability run: every leg's trajectory when recorded, else its end."""
+    """A single start's repeatability run: every leg's trajectory when recorded, else its start
+    and legs' ends. A resumed run's legs (``leg_results``, the new cycles only) are numbered
+    from the first new cycle; the earlier cycles are checked at their legs' ends."""
     L = len(result.targets)
-    if result.leg_results:
-        legs = [r.trajectory.x if r.trajectory is not None else r.x for r in result.leg_results]
-    else:
-        legs = list(np.asarray(result.legs, dtype=float))
-    return legs_report(limits, result.x0, legs, L, names)
+    recorded = [r.trajectory.x for r in result.leg_results if r.trajectory is not None]
+    ends = np.asarray(result.legs, dtype=float)
+    if not recorded or len(recorded) != len(result.leg_results):
+        return replace(legs_report(limits, result.x0, list(ends), L, names), every_step=False)
+    # The legs run: those with an end, and a failed one (recorded; its end is NaN).
+    finite = np.all(np.isfinite(ends), axis=-1)
+    run = (len(ends) if finite.all() else int(np.argmin(finite))) + (not result.success)
+    before = list(ends[: max(0, run - len(recorded))])  # (the cycles a resumed run took over)
+    report = legs_report(limits, result.x0, [*before, *recorded], L, names)
+    return replace(report, every_step=not before) if report.within else report
 
 
 def run_report(kinematics, result) -> LimitsReport | None:

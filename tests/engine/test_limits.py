@@ -217,3 +217,43 @@ def test_a_report_says_in_a_sentence_where_its_run_left_the_limits():
     )
     within = legs_report(LIMITS, [0, 0, 1], legs[:1], 2, NAMES).sentence("J^P#", "arm")
     assert within == "J^P#: stayed within the joint limits of the arm all along its run."
+
+
+CHAIN = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 0.8, 0.6]}
+
+
+def test_a_run_not_recorded_says_it_was_checked_at_its_legs_ends():
+    """x3 dips to -0.0017 on the way and ends at +0.018 (limits [0, 2.5]): a repeatability run
+    without record=True has only its legs' ends to check, and its report says so instead of
+    "within the joint limits" all along; recorded, the dip is found."""
+    robot = robot_from_dict({**CHAIN, "limits": [[-3, 3], [-3, 3], [0.0, 2.5]]})
+    inverse = robot.inverse("pseudoinverse")
+    x0, target = [0.88341231, -0.95254394, 0.02701882], [[1.62633533, 1.37832725]]
+    ends = robot.limits_report(repeatability(inverse, x0, target, cycles=1))
+    assert ends.within and not ends.every_step
+    assert str(ends) == (
+        "within the joint limits at its start and its legs' ends (the steps between were not "
+        "recorded: record=True)"
+    )
+    assert ends.sentence("J#", "arm").endswith(
+        "arm at its start and its legs' ends (the steps between were not recorded: record=True)."
+    )
+    every = robot.limits_report(repeatability(inverse, x0, target, cycles=1, record=True))
+    assert not every.within and every.violation.value < 0
+    assert not robot.limits_report(solve(inverse, x0, target[0], record=True)).within
+    assert not robot.limits_report(solve(inverse, x0, target[0], record=False)).every_step
+
+
+def test_a_resumed_run_numbers_its_cycles_from_its_start():
+    """A run resumed after 2 cycles to 4 (leg_results: the new legs) reports the violation in
+    cycle 3, as the whole run does; the cycles it took over are checked at their legs' ends."""
+    from jik.engine.run_settings import Resume
+
+    robot = robot_from_dict({**CHAIN, "limits": [[-3, 3], [-3, 3], [-3, 1.085]]})
+    inverse = robot.inverse("pseudoinverse")
+    x0, path = [0.3, 1.0, 1.0], [[1.0, 1.3], [1.0, 1.7], [0.6, 1.7]]
+    whole = robot.limits_report(repeatability(inverse, x0, path, cycles=4, record=True))
+    two = repeatability(inverse, x0, path, cycles=2, record=True)
+    resumed = robot.limits_report(repeatability(inverse, Resume.of(two), path, 4, record=True))
+    assert (whole.violation.cycle, whole.violation.leg) == (3, 1)
+    assert resumed == whole
