@@ -143,6 +143,12 @@ class Kinematics(abc.ABC):
         :data:`~jik.engine.validation.MAX_COORDINATE`."""
         return bounded(as_points(y, self.r, name, field), name, field)
 
+    def check_target(self, y, name: str = "target", field: str | None = None) -> FloatArray:
+        """Validate targets (a solve's y_d, a path's points): :meth:`check_task`, and within
+        the task's range where that is known without solving (a pose task's rotation
+        coordinates, :meth:`jik.engine.pose_task.PoseTask.check_reachable`)."""
+        return self.check_task(y, name, field)
+
     def check_start(self, x, name: str = "x0") -> FloatArray:
         """Validate a solve's starts: :meth:`check`, coordinates within
         :data:`~jik.engine.validation.MAX_COORDINATE`."""

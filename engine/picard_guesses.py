@@ -98,7 +98,7 @@ def chain_guesses(inverse: Inverse, x0, y_d, *, gamma: float = 1.0) -> list[Traj
     """
     kin = inverse.kinematics
     x0 = kin.check(x0, "x0")
-    y_d = kin.check_task(y_d, "y_d")
+    y_d = kin.check_target(y_d, "y_d")
     gamma = check_gamma(gamma, "continuous")
     if x0.ndim != 1 or y_d.ndim != 2 or len(y_d) == 0:
         raise InvalidInputError(

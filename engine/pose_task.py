@@ -15,7 +15,7 @@ import numpy as np
 
 from . import so3
 from .exceptions import InvalidInputError
-from .validation import FloatArray, as_points
+from .validation import FloatArray, as_points, field_for
 
 COORDINATES = ("x", "y", "z", "rx", "ry", "rz")
 _TOKEN = re.compile(r"r[xyz]|[xyz]")
@@ -119,6 +119,30 @@ class PoseTask:
         if self.rotation:
             parts.append(so3.log(self.reference_T @ R)[..., self.rotation_rows])
         return np.concatenate(parts, axis=-1)[..., self.order]
+
+    def check_reachable(self, y: FloatArray, name: str, field: str | None = None) -> None:
+        """Refuse task points ``y`` (..., r) whose rotation coordinates no configuration gives:
+        the rotation coordinates are the principal log of R0^T R (:func:`jik.engine.so3.log`),
+        so their length is at most pi (a subset's too). The refusal gives the same orientation
+        within a half turn when the task holds all three."""
+        if not self.rotation:
+            return
+        rows = [i for i, n in enumerate(self.names) if len(n) == 2]
+        r = np.asarray(y, dtype=float)[..., rows]
+        length = np.linalg.norm(r, axis=-1)
+        far = np.argwhere(length > np.pi + 1e-9)
+        if len(far) == 0:
+            return
+        at = tuple(far[0])
+        where = f" point {', '.join(map(str, at))}" if length.size > 1 else ""
+        same = ", ".join(f"{v + 0.0:.3g}" for v in r[at] * (1.0 - 2.0 * np.pi / length[at]))
+        coords = ", ".join(n for n in self.names if len(n) == 2)
+        raise InvalidInputError(
+            f"{name}{where} is out of reach: its rotation coordinates ({coords}) have length "
+            f"{length[at]:.6g} > pi, and the rotation coordinates (the principal log of R0^T R) "
+            "never exceed pi" + (f"; the same orientation is ({same})" if len(rows) == 3 else ""),
+            field_for(name, field),
+        )
 
     def pose_of(self, y: FloatArray) -> tuple[FloatArray | None, FloatArray | None]:
         """Where task coordinates y (..., r) put the end link, the inverse of :meth:`value` on

@@ -216,7 +216,7 @@ def repeatability(
     kin, progress = check_inverse(inverse), check_progress(progress)
     resume = x0 if isinstance(x0, Resume) else None
     x0 = kin.check_start(x0 if resume is None else resume.x0)
-    path = kin.check_task(path, "path")
+    path = kin.check_target(path, "path")
     if path.ndim not in (2, 3) or path.shape[-2] < 1:
         raise InvalidInputError(
             "path must be a list of task points, shape (L, r) with L >= 1", "path"

@@ -76,7 +76,7 @@ def solve_in_chunks(
     """
     kin = inverse.kinematics
     x = kin.check_start(x0)
-    y_d = kin.check_task(y_d, "target y_d", "y_d")
+    y_d = kin.check_target(y_d, "target y_d", "y_d")
     if x.ndim != 1 or y_d.ndim != 1:
         raise InvalidInputError(
             f"solve_in_chunks takes one start (p,) and one target (r,); got shapes {x.shape} "

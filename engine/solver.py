@@ -232,7 +232,7 @@ def solve(
     """
     kin = check_inverse(inverse)
     x0 = kin.check_start(x0)
-    y_d = kin.check_task(y_d, "target y_d", "y_d")
+    y_d = kin.check_target(y_d, "target y_d", "y_d")
     if x0.ndim != 1 or y_d.ndim != 1:
         raise InvalidInputError(
             f"solve takes one start x0 (p,) and one target y_d (r,), got shapes {x0.shape} and "
@@ -292,7 +292,7 @@ def _batch(inverse, x0, y_d, gamma, mode, tol, max_iterations, record, method, g
     """:func:`solve_batch`; with ``single``, ``guess`` is one start's Trajectory (or None)."""
     kin = check_inverse(inverse)
     x0 = kin.check_start(x0)
-    y_d = kin.check_task(y_d, "target y_d", "y_d")
+    y_d = kin.check_target(y_d, "target y_d", "y_d")
     if x0.ndim > 2 or y_d.ndim > 2:
         raise InvalidInputError(
             "x0 and y_d must be one point or a 2-D batch of points", "x0" if x0.ndim > 2 else "y_d"

@@ -5,9 +5,9 @@ which a run that diverged or ran out of steps says too.
 
 The integrator only sees its step size collapse; the robot's workspace and the Jacobians where
 the run stopped tell which. A planar chain of revolute joints reaches the annulus between
-max(0, 2 max l - sum l) and sum l around its base (l its link lengths); a pose task's rotation
-coordinates, the principal log (|r| <= pi), never reach a rotation vector longer than pi; for
-other robots the reach is not known in closed form and only the Jacobians speak.
+max(0, 2 max l - sum l) and sum l around its base (l its link lengths); for other robots the
+reach is not known in closed form (a pose task's rotation coordinates longer than pi are refused
+as input, :meth:`jik.engine.pose_task.PoseTask.check_reachable`) and only the Jacobians speak.
 """
 
 from __future__ import annotations
@@ -44,38 +44,9 @@ def _g(v: float) -> str:
     return f"{v:.3g}"
 
 
-def rotation_rows(kinematics) -> list[int] | None:
-    """The rows of rx, ry, rz in a pose task that holds all three (a URDF arm's), else None."""
-    names = tuple(getattr(getattr(kinematics, "pose_task", None), "names", ()))
-    if not {"rx", "ry", "rz"} <= set(names):
-        return None
-    return [names.index(n) for n in ("rx", "ry", "rz")]
-
-
-def half_turn_note(kinematics, target) -> str | None:
-    """Why a pose task's target is out of reach, or None: its rotation vector is longer than
-    pi, which the rotation coordinates (the principal log, :mod:`jik.engine.so3`) never are."""
-    rows = rotation_rows(kinematics)
-    if rows is None:
-        return None
-    r = np.asarray(target, dtype=float)[rows]
-    length = float(np.linalg.norm(r))
-    if not length > np.pi + 1e-9:
-        return None
-    same = ", ".join(_g(v + 0.0) for v in r * (1.0 - 2.0 * np.pi / length))  # (no -0)
-    return (
-        f"the target is out of reach: its rotation vector (rx, ry, rz) has length {length:.6g} "
-        "> pi, and the rotation coordinates (the principal log of R0^T R) never exceed pi; "
-        f"the same orientation is ({same})"
-    )
-
-
 def reach_note(kinematics, target) -> tuple[str | None, str]:
     """(why ``target`` is out of the robot's reach, or None; a clause saying it is within
     reach, or "" when the reach is not known)."""
-    rotation = half_turn_note(kinematics, target)
-    if rotation is not None:
-        return rotation, ""
     bounds = reach(kinematics)
     if bounds is None:
         return None, ""

@@ -271,6 +271,13 @@ class UrdfChain(Kinematics):
         first = int(self.base_offset)
         return {j.index: first + k for k, j in enumerate(self.chain) if j.index >= 0}
 
+    def check_target(self, y, name: str = "target", field: str | None = None) -> FloatArray:
+        """:meth:`Kinematics.check_target`: the rotation coordinates' length at most pi
+        (:meth:`~jik.engine.pose_task.PoseTask.check_reachable`)."""
+        y = self.check_task(y, name, field)
+        self.pose_task.check_reachable(y, name, field)
+        return y
+
     def forward(self, x: FloatArray) -> FloatArray:
         """k(x): the task's coordinates of the end link's pose: (..., p) -> (..., r)."""
         R, t = self.compiled.pose(x)

@@ -123,9 +123,12 @@ def solve_batch_json(reqs: list[S.SolveRequest]) -> list[bytes | RequestError]:
         try:
             check_configuration(setup.spec, r.x0)
             check_length(setup.spec, r.target, "target")
+            setup.kinematics.check_target(r.target, "target")
             ok.append(i)
         except RequestError as exc:
             out[i] = exc
+        except JikError as exc:
+            out[i] = engine_error(exc)
     if ok:
         x0 = np.array([reqs[i].x0 for i in ok], dtype=float)
         y_d = np.array([reqs[i].target for i in ok], dtype=float)

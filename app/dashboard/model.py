@@ -257,9 +257,9 @@ def validate(data: Mapping[str, Any]) -> DashboardState:
         ).model_dump(exclude={"name"})
         kin = _registered(lambda: spec.build(**params), "robot_parameters")
     _registered(lambda: kin.check(state.x0, "x0"), "x0")
-    _registered(lambda: kin.check_task(state.target, "target"), "target")
+    _registered(lambda: kin.check_target(state.target, "target"), "target")
     if state.path:
-        _registered(lambda: kin.check_task(state.path, "path"), "path")
+        _registered(lambda: kin.check_target(state.path, "path"), "path")
     elif state.task == "path":
         raise InvalidInputError("path: a closed-path task needs at least one path point", "path")
     if (why := gamma_problem(state.gamma, state.mode)) is not None:

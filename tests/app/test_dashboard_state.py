@@ -566,3 +566,15 @@ def test_another_number_of_cycles_reuses_the_cycles_already_solved(mode):
             assert (got.success, got.message) == (want.success, want.message)
             assert got.settings is not None and want.settings is not None
             assert got.settings.difference(want.settings) is None  # (the engine checked it)
+
+
+def test_a_pose_target_beyond_a_half_turn_is_refused_at_the_target():
+    """A Panda target whose rotation vector is longer than pi is refused as the state changes
+    (field target, the engine's reason), not run until the time limit."""
+    pytest.importorskip("yourdfpy")
+    state = updated_state(default_state("panda"), {"task": "target"})
+    target = list(state.target[:3]) + [3.0, 0.0, 1.0]
+    with pytest.raises(InvalidInputError) as err:
+        updated_state(state, {"target": target})
+    assert err.value.field == "target"
+    assert "rotation coordinates (rx, ry, rz) have length 3.16228 > pi" in str(err.value)

@@ -92,22 +92,41 @@ def test_a_chain_with_an_orientation_task_claims_no_reach():
     assert "within reach" not in message and "out of reach" not in message
 
 
-def test_a_rotation_vector_longer_than_a_half_turn_is_out_of_reach():
-    """A pose task's rotation coordinates are the principal log (|r| <= pi): a target whose
-    rotation vector is longer is never reached, and the message gives the same orientation
-    within a half turn; one within it gets no such note."""
+def test_a_rotation_vector_longer_than_a_half_turn_is_refused():
+    """A pose task's rotation coordinates are the principal log (|r| <= pi): a target, or a
+    path point, whose rotation vector is longer is never reached, so it is refused before a run
+    (field y_d or path), with the same orientation within a half turn; one within it runs."""
     pytest.importorskip("yourdfpy")
     panda = e.robot_from_dict({"name": "panda", "task": "pose"})
     home = np.array(panda.spec.default_x0)
     target = panda.kinematics.forward(home) + [0, 0, 0, 3.0, 0, 1.0]  # |r| = sqrt(10)
-    res = e.solve(panda.inverse(), home, target, mode="discrete", gamma=0.5, max_iterations=50)
-    assert not res.success
-    assert (
-        "the target is out of reach: its rotation vector (rx, ry, rz) has length 3.16228 > pi"
-        in res.message
+    with pytest.raises(e.InvalidInputError) as err:
+        e.solve(panda.inverse(), home, target, mode="discrete", gamma=0.5, max_iterations=50)
+    assert err.value.field == "y_d"
+    assert str(err.value) == (
+        "target y_d is out of reach: its rotation coordinates (rx, ry, rz) have length 3.16228 "
+        "> pi, and the rotation coordinates (the principal log of R0^T R) never exceed pi; "
+        "the same orientation is (-2.96, 0, -0.987)"
     )
-    assert res.message.endswith("the same orientation is (-2.96, 0, -0.987)")
-    assert reach_note(panda.kinematics, target - [0, 0, 0, 0.1, 0, 0.1]) == (None, "")
+    with pytest.raises(e.InvalidInputError, match=r"^path point 1 is out of reach") as err:
+        e.repeatability(panda.inverse(), home, [target - [0, 0, 0, 0.1, 0, 0.1], target])
+    assert err.value.field == "path"
+    ok = e.solve(panda.inverse(), home, target - [0, 0, 0, 0.1, 0, 0.1], max_iterations=50)
+    assert np.linalg.norm(ok.y_d[3:]) < np.pi
+    assert reach_note(panda.kinematics, target) == (None, "")
+
+
+def test_a_subset_of_the_rotation_coordinates_longer_than_pi_is_refused():
+    """Any subset of the rotation coordinates is no longer than the whole rotation vector, so
+    rz alone beyond pi is refused too; the message then gives no 'same orientation' (the
+    coordinates left free decide it). A planar chain's targets have no such rule."""
+    pytest.importorskip("yourdfpy")
+    arm = e.robot_from_dict({"name": "panda", "task": "x y z rz"})
+    with pytest.raises(e.InvalidInputError) as err:
+        arm.kinematics.check_target([0.3, 0, 0.5, -3.5], "target")
+    assert str(err.value).endswith("never exceed pi") and err.value.field == "target"
+    arm.kinematics.check_target([0.3, 0, 0.5, -np.pi], "target")
+    e.PlanarChain("RRR", [1, 1, 1]).check_target([0, 9], "target")
 
 
 def test_damped_least_squares_stops_once_its_error_settles_at_the_nearest_point():
