@@ -206,10 +206,10 @@ def checked_rest(value, spec, kin, x0) -> tuple[float, ...] | None:
     finite numbers, within the robot's joint limits if it has some (the engine's
     :func:`~jik.engine.practical_inverses.check_rest`, in its words) and within the range of
     its sliders (:func:`joint_box`; the only bound of a robot without limits, whose REST API
-    runs take any finite rest); None when it is the default in force
-    (:func:`~jik.engine.algorithm_registry.default_rest`: the robot's home, else the start
-    ``x0``, taken as it is, like the engine's default), which the state then follows, as it
-    does without a rest.
+    runs take any finite rest); None when it is the robot's home, the default in force
+    (:func:`~jik.engine.algorithm_registry.default_rest`), so the state holds no copy of it.
+    A rest equal to the start ``x0`` (the default of a robot without a home) stays set: the
+    default would follow the start as it moves, the rest set does not.
 
     Raises
     ------
@@ -227,7 +227,7 @@ def checked_rest(value, spec, kin, x0) -> tuple[float, ...] | None:
         if not math.isfinite(v):
             raise refused(f"{field}.{i}", "Input should be a finite number")
     rest = tuple(float(v) for v in value)
-    if list(rest) == default_rest(kin, x0)[0]:
+    if default_rest(kin, x0) == (list(rest), "home"):
         return None
     try:
         check_rest(kin, rest)

@@ -16,6 +16,7 @@ import re
 from collections.abc import Mapping
 from typing import Any
 
+from ...engine.algorithm_registry import default_rest
 from ...engine.exceptions import InvalidInputError
 from ..compute.schemas.wording import refused
 from .algorithms import editable_rest
@@ -38,8 +39,9 @@ def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
     coordinate of the posture inverse's rest in force (a default outside the joint limits
     brought into them first, :func:`~jik.app.dashboard.algorithms.editable_rest`),
     ``{"algorithm_parameters.rest": "x0"}`` the rest at the start x0 (the patch's, else the
-    state's), ``{"target": "0.3, 0, 0.6, 0, 0, 0"}`` a vector from its text
-    (:func:`parse_vector_text`: the scene's box of a vector of more than three numbers).
+    state's): None, the default that follows x0, on a robot without a home,
+    ``{"target": "0.3, 0, 0.6, 0, 0, 0"}`` a vector from its text (:func:`parse_vector_text`:
+    the scene's box of a vector of more than three numbers).
     Switching to discrete mode without a gamma takes gamma down to
     :data:`DISCRETE_GAMMA_ON_SWITCH` when it is above."""
     out: dict[str, Any] = {}
@@ -74,7 +76,9 @@ def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
         else:
             raise InvalidInputError(f"unknown dashboard control {key!r}", key)
     if out.get("algorithm_parameters", {}).get("rest") == "x0":
-        out["algorithm_parameters"]["rest"] = list(out.get("x0", state.x0))
+        x0 = list(out.get("x0", state.x0))
+        follows = default_rest(state_kinematics(state), x0)[1] == "x0"
+        out["algorithm_parameters"]["rest"] = None if follows else x0
     if out.get("mode") == "discrete" and "gamma" not in out and state.mode != "discrete":
         out["gamma"] = min(state.gamma, DISCRETE_GAMMA_ON_SWITCH)
     return out

@@ -225,6 +225,8 @@ def updated_state(state: DashboardState, patch: Mapping[str, object]) -> Dashboa
             if not isinstance(value, Mapping):
                 raise refused(key, "give an object of parameters")
             value = {**data[key], **value}
+            if value.get("rest", ()) is None:  # (the posture rest's default: none set)
+                del value["rest"]
         data[key] = value
     return validate(data)
 

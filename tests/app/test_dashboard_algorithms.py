@@ -16,7 +16,7 @@ from jik.app.dashboard.controls import control_values, controls
 from jik.app.dashboard.figures import figure_specs
 from jik.app.dashboard.model import default_state, updated_state
 from jik.app.dashboard.results import compute
-from jik.app.dashboard.robots import state_inverse
+from jik.app.dashboard.robots import state_inverse, state_kinematics
 from jik.app.dashboard.verdict import verdict
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ALGORITHMS
@@ -367,15 +367,29 @@ def test_setting_the_rest_changes_the_posture_run_and_only_it():
     assert f"x_rest = x0 (0, 0, {state.x0[2]:.4g})" in said
 
 
-def test_a_rest_equal_to_the_default_is_the_default():
-    """'rest = x0' (and a rest sent back as shown) on a robot without home is the default,
-    which follows x0; a rest set elsewhere stays when x0 moves."""
+def test_rest_x0_is_the_default_and_a_rest_set_stays_set():
+    """'rest = x0' on a robot without home is the default, which follows x0 (null too); a rest
+    set stays when x0 moves, even once x0 has moved onto it (it was dropped as the default then,
+    and followed x0 from there)."""
     state = _posture()
     moved = updated_state(state, {f"{REST}.1": 0.5})
     assert updated_state(moved, {REST: "x0"}) == state
+    assert updated_state(moved, {"algorithm_parameters": {"rest": None}}) == state
     assert updated_state(moved, {"x0.2": 1.0}).algorithm_parameters["rest"][2] == state.x0[2]
-    values = control_values(state)
-    assert updated_state(state, {k: v for k, v in values.items() if k.startswith(REST)}) == state
+    onto = updated_state(moved, {"x0.1": 0.5})
+    assert onto.algorithm_parameters["rest"] == tuple(onto.x0)
+    assert updated_state(onto, {"x0.1": 0.2}).algorithm_parameters["rest"][1] == 0.5
+
+
+def test_a_rest_equal_to_the_home_is_the_default():
+    """On an arm with a home (the default rest), a rest set to it is the default: the state
+    holds no copy; 'rest = x0' there sets the rest to the start's values."""
+    pytest.importorskip("yourdfpy")
+    state = _posture("panda")
+    home = list(state_kinematics(state).home)
+    assert "rest" not in updated_state(state, {REST: home}).algorithm_parameters
+    x0 = updated_state(state, {"x0.0": 0.5})
+    assert updated_state(x0, {REST: "x0"}).algorithm_parameters["rest"] == tuple(x0.x0)
 
 
 @pytest.mark.parametrize(
@@ -431,7 +445,6 @@ def test_the_api_and_the_dashboard_take_the_same_default_rest():
     from jik.app.compute.requests import solve_batch_json
     from jik.app.compute.schemas import SolveRequest
     from jik.app.dashboard.algorithms import posture_rest
-    from jik.app.dashboard.robots import state_kinematics
     from jik.engine.algorithm_registry import default_rest
 
     state = updated_state(_posture(), {"x0.0": 0.25})
