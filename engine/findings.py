@@ -204,7 +204,9 @@ def posture_findings(
     """How far the posture inverse's null-space pull (Liegeois 1977) toward its rest (``rest``:
     x_rest in words) at gain ``gain`` brought its ``drift`` after each cycle down against the
     pseudoinverse's (8) ``pinv_drift``, and that it does not reach the extended Jacobian's
-    (11) repeatability (``ext_drift``); none without a completed cycle."""
+    (11) repeatability (``ext_drift``); none without a completed cycle. The pull is said to
+    slow the drift only where the drift is below the pseudoinverse's (a high gain can make it
+    larger)."""
     n = len(drift)
     if not n:
         return []
@@ -212,10 +214,11 @@ def posture_findings(
     head = f"{name}, gain k = {g(gain)}, {rest}: after {plural(n, 'cycle')}"
     if gain == 0:
         return [(f"{head} it is the pseudoinverse (k = 0), drift {_amount(d, unit)}.", "why")]
-    parts = []
+    parts, slower = [], True
     if pinv_drift is not None and len(pinv_drift) >= n:
         dp = float(pinv_drift[n - 1])
-        than = "less than" if d < dp else "not less than"
+        slower = d < dp
+        than = "less than" if slower else "not less than"
         parts.append(f"it drifts {_amount(d, unit)}, {than} the pseudoinverse's {g(dp)}")
     else:
         parts.append(f"it drifts {_amount(d, unit)}")
@@ -225,9 +228,14 @@ def posture_findings(
             if ext_drift is not None and len(ext_drift) >= n
             else "repeatability"
         )
+        pull = (
+            "the pull toward x_rest moves the joints inside the self-motion and slows the drift"
+            if slower
+            else "on this path the pull toward x_rest does not slow the drift"
+        )
         parts.append(
-            f"but does not reach {reach}: the pull toward x_rest moves the joints inside the "
-            "self-motion and slows the drift, yet the end of a cycle does not come back to x0"
+            f"but does not reach {reach}: {pull}, yet the end of a cycle does not come back "
+            "to x0"
         )
     else:
         parts.append("and came back to x0 within round-off on this path")

@@ -287,6 +287,16 @@ def test_a_drift_without_a_unit_reads_as_a_number_not_a_number_and_a_blank():
     assert zero.endswith("it is the pseudoinverse (k = 0), drift 0.5.")
     ((text, _),) = posture_findings("J^N#", 1.0, "x_rest = x0", [0.5], "", [0.9])
     assert "it drifts 0.5, less than the pseudoinverse's 0.9" in text
+    assert "slows the drift" in text
+
+
+def test_a_posture_drift_above_the_pseudoinverse_s_is_not_said_to_be_slowed():
+    """Where the posture inverse drifts more than the pseudoinverse (a high gain), its sentence
+    says so and does not credit the pull with slowing the drift."""
+    ((text, _),) = posture_findings("J^N#", 50.0, "x_rest = x0", [0.65], "", [0.001], [1e-12])
+    assert "it drifts 0.65, not less than the pseudoinverse's 0.001" in text
+    assert "slows" not in text
+    assert "on this path the pull toward x_rest does not slow the drift" in text
 
 
 def test_damped_least_squares_names_its_worst_leg_by_cycle_and_leg():
