@@ -234,8 +234,7 @@ def posture_findings(
             else "on this path the pull toward x_rest does not slow the drift"
         )
         parts.append(
-            f"but does not reach {reach}: {pull}, yet the end of a cycle does not come back "
-            "to x0"
+            f"but does not reach {reach}: {pull}, yet the end of a cycle does not come back to x0"
         )
     else:
         parts.append("and came back to x0 within round-off on this path")
@@ -250,19 +249,23 @@ def damped_findings(
     inverse (J J# != I), and how it fared where the pseudoinverse (8) stopped. ``run`` and
     ``pinv`` carry ``error``, ``leg`` and ``success`` (a run point by point; ``leg`` counts
     the legs of the whole run from 0). With ``legs`` (legs per cycle) the worst leg is named
-    as the failures and the limits name one, "cycle 2, leg 1"; else by its place in the run."""
+    as the failures and the limits name one, "cycle 2, leg 1"; else by its place in the run; a
+    run of one leg (a single target) names none."""
     ends = leg_end_errors(run.error, run.leg)
     if not len(ends):
         return []
     worst = int(np.argmax(ends))
-    at = f"leg {worst + 1}"
+    at = f"leg {worst + 1}; "
     if legs > 0:
         cycle, leg = divmod(worst, legs)
-        at = f"cycle {cycle + 1}, leg {leg + 1}"
+        at = f"cycle {cycle + 1}, leg {leg + 1}; "
+    ended = "at the end of its legs up to"
+    if len(ends) == 1:  # (one leg: a single target's run)
+        at, ended = "", "at its end"
     where = "adaptive, where σ_min(J) < " + g(threshold) if threshold > 0 else "constant"
     text = (
-        f"{name} (λ = {g(damping)}, {where}): task error at the end of its legs up to "
-        f"{g(float(ends[worst]))} ({at}; tolerance {g(tol)}). Damping "
+        f"{name} (λ = {g(damping)}, {where}): task error {ended} "
+        f"{g(float(ends[worst]))} ({at}tolerance {g(tol)}). Damping "
         "bounds the joint speed near singularities at the price of tracking (J J# ≠ I)"
     )
     if pinv is not None and not pinv.success and run.success:

@@ -163,13 +163,15 @@ def algorithm_run(
         tr = cast(Trajectory, res.trajectory)
         parts.append((tr.theta + offset, tr.x, tr.y, tr.error, tr.h, leg.cycle * L + leg.index))
         offset += float(tr.theta[-1])
-        where = f"cycle {leg.cycle + 1}, leg {leg.index + 1}"
+        # (a single target's run is one leg: no cycle or leg to name)
+        where = "" if state.task == "target" else f"cycle {leg.cycle + 1}, leg {leg.index + 1}"
         if leg.stopped_by is not None:
-            failure = f"{where} stopped: {leg.stopped_by}"
+            failure = f"{where} stopped: {leg.stopped_by}".lstrip()
             if leg.cycle == leg.index == 0:  # (a leg from x0: the error's input is the state's)
                 start_field = getattr(leg.stopped_by, "field", None)
         elif not res.success:
-            failure = f"{where}: {_leg_message(res, cap, inverse.kinematics)}"
+            message = _leg_message(res, cap, inverse.kinematics)
+            failure = f"{where}: {message}" if where else message
         else:
             last = _leg_message(res, cap, inverse.kinematics)
         progress()

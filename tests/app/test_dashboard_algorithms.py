@@ -246,7 +246,7 @@ def test_damped_reports_its_task_error_at_the_reach_boundary():
     result, said = _damped_beside_pseudoinverse([0.3, 0.3, 0.3], [3.5, 0.0])
     assert result.runs["damped"].error[-1] == pytest.approx(0.5, abs=1e-6)
     why = said[("damped", "why")]
-    assert "task error at the end of its legs up to 0.5" in why
+    assert "task error at its end 0.5 (tolerance" in why
     assert "where the pseudoinverse stalled at task error 1.22, it got to 0.5" in why
 
 

@@ -23,11 +23,14 @@ from jik.app.dashboard import (
 from jik.app.dashboard.functionals import functionals_key
 from jik.app.dashboard.model import cache_key
 from jik.app.dashboard.robots import state_kinematics
+from jik.app.dashboard.verdict import verdict
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.registry import ROBOTS, make_inverse, robot_spec
 from jik.engine.repeatability import repeatability
 from jik.engine.solver import solve
 from tests.helpers import count_picard_sweeps
+
+DLS = ["pseudoinverse", "damped"]
 
 
 @pytest.mark.parametrize("robot", sorted(ROBOTS))
@@ -578,3 +581,14 @@ def test_a_pose_target_beyond_a_half_turn_is_refused_at_the_target():
         updated_state(state, {"target": target})
     assert err.value.field == "target"
     assert "rotation coordinates (rx, ry, rz) have length 3.16228 > pi" in str(err.value)
+
+
+def test_a_single_target_s_messages_name_no_cycle_or_leg():
+    """A target task runs one leg: its failure and its damped sentence say no 'cycle 1, leg 1'
+    (a closed path's say which leg)."""
+    patch = {"task": "target", "target": [9.0, 9.0], "max_iterations": 10}
+    result = compute(updated_state(default_state("manipulator2"), patch | {"algorithms": DLS}))
+    said = [result.runs[a].message for a in DLS] + [f["text"] for f in verdict(result)]
+    assert all("did not converge within 10" in m for m in said[:2])
+    assert not [s for s in said if "leg" in s.replace("per leg", "")]
+    assert "task error at its end 9.29" in said[-1]

@@ -308,6 +308,9 @@ def test_damped_least_squares_names_its_worst_leg_by_cycle_and_leg():
     assert "up to 0.9 (cycle 2, leg 1; tolerance 1e-10)" in text
     ((text, _),) = damped_findings("DLS", 0.1, 0.0, 1e-10, run)
     assert "up to 0.9 (leg 4; tolerance 1e-10)" in text
+    one = SimpleNamespace(error=np.array([0.5, 0.3]), leg=np.zeros(2, int), success=True)
+    ((text, _),) = damped_findings("DLS", 0.1, 0.0, 1e-10, one, legs=1)
+    assert "task error at its end 0.3 (tolerance 1e-10)" in text and "leg" not in text
     panda = jik.load_robot("panda")
     home = np.array(panda.spec.default_x0)
     loop = panda.kinematics.forward(home) + [[0.08, 0, 0, 0, 0, 0.2], [0.08, 0.08, 0, 0.15, 0, 0.2]]
