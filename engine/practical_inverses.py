@@ -87,6 +87,8 @@ class DampedInverse(Inverse):
         epsilon >= 0. When positive, the adaptive damping of Nakamura and Hanafusa (1986):
         lambda(x)^2 = lambda^2 (1 - s(x) / epsilon)^2 where the smallest singular value s(x) of
         J(x) is below epsilon, and 0 elsewhere (the pseudoinverse away from singularities).
+        A tiny epsilon (even a subnormal one) is meaningful: it damps only where J is singular
+        to within epsilon, and is computed without overflow.
 
     Notes
     -----
@@ -119,7 +121,10 @@ class DampedInverse(Inverse):
         lam2 = np.full(J.shape[:-2], self.damping**2)
         if self.damping_threshold > 0.0:
             s = np.linalg.svd(J, compute_uv=False)[..., -1]
-            near = np.clip(1.0 - s / self.damping_threshold, 0.0, None)
+            eps = self.damping_threshold
+            # (eps - s)^+ / eps = (1 - s / eps)^+ lies in [0, 1]; s / eps itself overflows
+            # where s dwarfs a tiny eps (1e-320, or 1e-300 with s > 1e8)
+            near = np.clip(eps - s, 0.0, None) / eps
             lam2 = lam2 * near**2
         return lam2
 

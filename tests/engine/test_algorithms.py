@@ -4,6 +4,7 @@ pseudoinverse (8), the extended inverse (11) and independent integrations of the
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -202,6 +203,20 @@ def test_adaptive_damping_is_zero_away_from_singularities():
     v, _ = inv.apply_masked(x[:1], e[:1])
     v0, _ = make_inverse(ARM3R, "pseudoinverse").apply_masked(x[:1], e[:1])
     np.testing.assert_allclose(v, v0, atol=1e-14)
+
+
+@pytest.mark.parametrize("threshold", [1e-320, 1e-300])
+def test_a_tiny_damping_threshold_damps_only_a_singular_jacobian_without_overflow(threshold):
+    """epsilon subnormal, or s(x) / epsilon beyond the float range (s = 1e10): lambda(x) = 0
+    where s(x) > epsilon and lambda where J is exactly singular, with no RuntimeWarning."""
+    inv = DampedInverse(ARM3R, 0.2, damping_threshold=threshold)
+    J = np.array([[[1e10, 0.0, 0.0], [0.0, 1e10, 0.0]], [[1.0, 1.0, 1.0], [0.0, 0.0, 0.0]]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lam2 = inv.damping_squared(J)
+        res = solve(inv, (0.3, 0.4, 0.5), (1.0, 1.5))
+    np.testing.assert_allclose(lam2, [0.0, 0.04], rtol=1e-15, atol=0)
+    assert res.success
 
 
 def test_limit_gradient_matches_finite_differences():
