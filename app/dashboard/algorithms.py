@@ -152,6 +152,24 @@ def scalar_parameters(algorithms) -> tuple:
     return tuple(p for a in algorithms for p in REGISTRY[a].parameters)
 
 
+def check_names(given: Mapping[str, Any]) -> None:
+    """Refuse a name of ``algorithm_parameters`` no dashboard control sets: the weighted
+    inverse's ``limits``, which the REST API takes, are the robot's here (its definition's
+    ``limits``, a URDF's joints)."""
+    known = {p.name for p in scalar_parameters(CHOICES)} | set(VECTORS)
+    for name in given:
+        if name == "limits":
+            why = (
+                "the dashboard's weighted inverse keeps to the robot's own joint limits; give "
+                "them in the robot's definition (limits, or a URDF's joints)"
+            )
+        elif name not in known:
+            why = f"no algorithm has this parameter; known: {sorted(known)}"
+        else:
+            continue
+        raise refused(f"algorithm_parameters.{name}", why)
+
+
 def checked(algorithms: tuple[str, ...], given: Mapping[str, Any]) -> dict[str, Any]:
     """The chosen algorithms in the catalogue's order and their scalar parameters (the given
     ones checked against the engine's ranges, the others at their defaults; parameters of
@@ -167,14 +185,7 @@ def checked(algorithms: tuple[str, ...], given: Mapping[str, Any]) -> dict[str, 
     twice = sorted({a for a in algorithms if algorithms.count(a) > 1})
     if twice:
         raise InvalidInputError(f"algorithms: {twice} chosen twice; choose each once", "algorithms")
-    known = {p.name for p in scalar_parameters(CHOICES)} | set(VECTORS)
-    for name in given:
-        if name not in known:
-            raise InvalidInputError(
-                f"algorithm_parameters.{name}: no algorithm has this parameter; known: "
-                f"{sorted(known)}",
-                f"algorithm_parameters.{name}",
-            )
+    check_names(given)
     ordered = tuple(a for a in CHOICES if a in algorithms)
     values = {}
     for p in scalar_parameters(ordered):

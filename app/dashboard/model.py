@@ -31,7 +31,14 @@ from ..compute.schemas import (
 )
 from ..compute.schemas.algorithms import Algorithm
 from ..compute.schemas.wording import field_text, refusal, refused, without_field
-from .algorithms import CHOICES, DEFAULT_ALGORITHMS, check_inverses, checked, checked_rest
+from .algorithms import (
+    CHOICES,
+    DEFAULT_ALGORITHMS,
+    check_inverses,
+    check_names,
+    checked,
+    checked_rest,
+)
 from .algorithms import cache_key as cache_key  # (re-exported: the figures' caches import it)
 from .control_changes import expand
 from .controls import (
@@ -241,6 +248,8 @@ def validate(data: Mapping[str, Any]) -> DashboardState:
     InvalidInputError
         With the first refused field as ``field`` and the message starting with it.
     """
+    if isinstance(names := data.get("algorithm_parameters"), Mapping):
+        check_names(names)  # (before the model's types: a name's refusal says what it is)
     state = _model(DashboardState, data, ())
     if state.robot_definition is not None or state.robot in USER_KINDS:
         spec, kin, params, aug_params = _user_robot(state)

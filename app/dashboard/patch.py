@@ -20,6 +20,7 @@ from ..compute.schemas import (
     Coordinate,
 )
 from ..compute.schemas.wording import refusal, refused
+from .algorithms import check_names
 from .model import DashboardState, Number, Numbers, Point, error_location
 from .robots import USER_KINDS
 
@@ -86,6 +87,8 @@ def parse_patch(body: Any) -> dict[str, Any]:
         Naming the field: the first the patch's types refuse (a member of a union, labelled by
         its type in pydantic's location, is left out of the name: :func:`error_location`).
     """
+    if isinstance(body, dict) and isinstance(names := body.get("algorithm_parameters"), dict):
+        check_names(names)  # (before the types: a name's refusal says what it is)
     try:
         return patch_of(StatePatch.model_validate(body))
     except ValidationError as exc:

@@ -528,3 +528,20 @@ def test_each_algorithms_label_is_its_long_name_and_short_its_symbol():
         assert len(style.short) < len(style.label), a
     assert STYLES["damped"].label == "damped least squares J^DLS"
     assert STYLES["weighted"].short == "J^W#"
+
+
+@pytest.mark.parametrize("limits", [[[-1.0, 1.0]] * 7, 3.0])
+def test_the_weighted_inverse_s_limits_are_the_robot_s_on_the_dashboard(client, limits):
+    """The REST API's weighted inverse takes ``limits``; the dashboard's keeps to the robot's,
+    and says so at the field (not "Input should be a valid number")."""
+    pytest.importorskip("yourdfpy")
+    state = {"robot": "panda", "algorithms": ["pseudoinverse", "weighted"]}
+    session = client.post("/api/sessions", json={"state": state}).json()
+    bad = client.post(
+        f"/api/sessions/{session['id']}/state", json={"algorithm_parameters": {"limits": limits}}
+    )
+    assert bad.status_code == 422
+    assert [d["msg"] for d in bad.json()["detail"]] == [
+        "algorithm_parameters.limits: the dashboard's weighted inverse keeps to the robot's own "
+        "joint limits; give them in the robot's definition (limits, or a URDF's joints)"
+    ]
