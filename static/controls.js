@@ -163,7 +163,8 @@ function select(c, value, send) {
   if (c.inline) return choice(c, value, send);
   const s = el("select", { id: c.id });
   for (const [v, text] of c.options) s.append(el("option", { value: v, selected: v === value }, text));
-  s.addEventListener("change", () => send(s.value));
+  // (the option's value as the specification gives it: a number stays a number)
+  s.addEventListener("change", () => send(c.options.find(([v]) => String(v) === s.value)[0]));
   s.setValue = (v) => { s.value = v; };
   return el("label", { title: c.help }, c.label, s);
 }

@@ -17,12 +17,13 @@ text).
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass
 from typing import Any
 
 from ...engine.arms import ARMS
 from ...engine.registry import ROBOTS
-from ...engine.solve_rules import DISCRETE_GAMMA_BOUND, MAX_ITERATIONS, MAX_STEPS
+from ...engine.solve_rules import DISCRETE_GAMMA_BOUND, MAX_ITERATIONS, MAX_STEPS, TOL_MIN
 from .algorithms import STYLES, joint_box, posture_rest, scalar_parameters
 from .control_changes import lookup, path_format, path_text
 from .glossary import PARAMETER_LABELS, SYMBOLS
@@ -61,7 +62,7 @@ class Control:
     label: str
     kind: str
     help: str = ""
-    options: tuple[tuple[str, str], ...] = ()
+    options: tuple[tuple[Any, str], ...] = ()  # (value: text, or a number, label)
     group: str = "algorithm"
     minimum: Any = None
     maximum: Any = None
@@ -125,6 +126,7 @@ def controls(state) -> list[Control]:
             log=True,
         ),
         iterations_control(state),
+        tolerance_control(state),
     ]
     out += _sliders("robot_parameters", spec.parameters)
     for v in spec.vector_parameters:
@@ -285,6 +287,22 @@ def iterations_control(state) -> Control:
         step=1,
         log=True,
         integer=True,
+    )
+
+
+def tolerance_control(state) -> Control:
+    """The tolerance of every leg, a power of ten from 1e-4 down to the engine's
+    :data:`~jik.engine.solve_rules.TOL_MIN`, and the state's own when it is another (a link
+    or the session API may set any the model takes)."""
+    decades = [10.0**-k for k in range(4, 1 - int(math.log10(TOL_MIN)))]
+    values = sorted({*decades, float(state.tolerance)}, reverse=True)
+    return Control(
+        "tolerance",
+        "tolerance",
+        "select",
+        "a leg stops once its task error ||k(x) − y_d|| is below this; lower asks for more "
+        "digits, and more steps",
+        tuple((v, f"{v:g}") for v in values),
     )
 
 

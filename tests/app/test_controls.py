@@ -262,3 +262,36 @@ def test_the_algorithms_parameters_are_labelled_with_the_verdicts_symbols():
     assert labels["algorithm_parameters.damping"] == "λ (damping)"
     assert labels["algorithm_parameters.damping_threshold"] == "damping threshold (σ_min)"
     assert labels["algorithm_parameters.gain"] == "k (null-space gain)"
+
+
+def test_the_tolerance_is_a_control_of_the_page_and_the_scene():
+    """The tolerance, which decides where every leg stops, is a select of powers of ten (the
+    state's own value too when it is another); chosen in the scene, it changes the state and
+    the runs: a discrete leg at 1e-4 stops sooner, with a larger error, than at 1e-12."""
+    from jik.app.dashboard import Dashboard, compute
+    from jik.app.scene import DashboardScene
+
+    state = default_state("manipulator2")
+    (tol,) = [c for c in controls(state) if c.key == "tolerance"]
+    assert [v for v, _ in tol.options] == [float(f"1e-{k}") for k in range(4, 15)]
+    assert control_values(state)["tolerance"] == 1e-10
+    odd = updated_state(state, {"tolerance": 3e-9})
+    (tol,) = [c for c in controls(odd) if c.key == "tolerance"]
+    assert (3e-9, "3e-09") in tol.options
+    dashboard = Dashboard(state)
+    scene = DashboardScene(dashboard)
+    try:
+        scene.controls.show(dashboard.state)
+        box = scene.controls.inputs["tolerance"]
+        assert box.value == "1e-10" and "1e-12" in box.options
+        box.value = "0.0001"  # (viser's thread, for a user)
+        assert dashboard.state.tolerance == 1e-4
+    finally:
+        scene.stop()
+        dashboard.stop()
+    discrete = {"task": "target", "mode": "discrete", "gamma": 0.5}  # (error halves a step)
+    coarse = compute(updated_state(state, {"tolerance": 1e-4, **discrete}))
+    fine = compute(updated_state(state, {"tolerance": 1e-12, **discrete}))
+    for a in coarse.runs:
+        assert 1e-12 <= coarse.runs[a].error[-1] < 1e-4 and fine.runs[a].error[-1] < 1e-12
+        assert len(coarse.runs[a].error) < len(fine.runs[a].error)

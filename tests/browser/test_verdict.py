@@ -78,6 +78,10 @@ def test_the_verdict_follows_the_numbers(tabs):
     expect(verdict).to_contain_text(re.compile(r"γ = 1\.\d+ is near 2"))
     expect(verdict).to_contain_text(f"‖x − x0‖ = {_extended_drift(tab):.3g}")
 
+    # the tolerance, a select of numbers, is sent as a number
+    tab.select("#ctl-tolerance", "1e-06")
+    assert tab.snapshot()["state"]["tolerance"] == 1e-6
+
 
 def test_an_unreachable_target_is_named_by_the_reach(tabs):
     """A planar 3R arm (reach 2.4) asked for a target 5 from its base: the verdict says the
