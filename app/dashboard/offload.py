@@ -27,7 +27,8 @@ from .runs import AlgorithmRun, Cancelled, algorithm_run
 log = logging.getLogger("jik.dashboard")
 
 
-@task("cycles", "fewer cycles, a larger gamma or another start")
+# (max_iterations: the one control of a run's work that both tasks, a path and a target, show)
+@task("max_iterations", "a lower “max … per leg”, fewer cycles or another start")
 def run_offloaded(state, algorithm, targets, cycles, resume=None) -> AlgorithmRun:
     """:func:`algorithm_run` in a compute worker."""
     return algorithm_run(state, algorithm, targets, cycles, resume=resume)

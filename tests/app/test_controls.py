@@ -295,3 +295,17 @@ def test_the_tolerance_is_a_control_of_the_page_and_the_scene():
     for a in coarse.runs:
         assert 1e-12 <= coarse.runs[a].error[-1] < 1e-4 and fine.runs[a].error[-1] < 1e-12
         assert len(coarse.runs[a].error) < len(fine.runs[a].error)
+
+
+@pytest.mark.parametrize("task", ["target", "path"])
+def test_a_run_over_the_time_limit_is_refused_at_a_control_the_task_shows(task):
+    """A dashboard run the compute pool stops at its time limit is refused at the field its
+    task names (:func:`jik.app.compute.worker.work_of`): a control on screen for a single
+    target as for a closed path (cycles is not one for a target), and its advice names it."""
+    from jik.app.compute.worker import work_of
+    from jik.app.dashboard.offload import run_offloaded
+
+    field, less = work_of(run_offloaded)
+    state = updated_state(default_state("manipulator2"), {"task": task})
+    (control,) = [c for c in controls(state) if c.key == field]
+    assert control.label.startswith("max ") and "“max … per leg”" in less
