@@ -161,10 +161,15 @@ def default_state(
         # ranges: the definition is what the user can change.
         first = exc.errors()[0]
         where = field_text(".".join(str(p) for p in first["loc"]))
+        head = str(first["loc"][0])
+        value = first.get("input")
+        shown = f"{value:.4g}" if isinstance(value, float | int) else f"{value!r:.40}"
+        fields = ", ".join(k for k in definition or {} if k != "name")
         raise refused(
             "robot_definition",
-            f"the robot's default {where} is refused by the dashboard ({first['msg']}); change "
-            "the definition (its start x0 or its parameters)",
+            f"the robot's default {head}{' k(x0)' if head == 'target' else ''} has {where} = "
+            f"{shown}, which the dashboard refuses ({first['msg']}); change the definition "
+            f"({fields})",
         ) from None
 
 

@@ -88,7 +88,9 @@ def test_a_definition_is_state_with_its_defaults_and_a_map():
                 },
             },
             "robot_definition",
-            "the robot's default target[0] is refused by the dashboard",
+            "the robot's default target k(x0) has target[0] = 6.5e+299, which the dashboard "
+            "refuses (Input should be less than or equal to 1000); change the definition (task, "
+            "variables, parameters)",
         ),
         (
             {
