@@ -177,6 +177,16 @@ ATOL = 1e-12
 PLATEAU_DECREASE = 1e-9
 PLATEAU_MOVE = 1e-10
 PLATEAU_TAU = 5.0
+#: A run's step budget is cut into :data:`PACE_WINDOWS` windows, and at the end of each the run
+#: compares the fall of ln ||e|| over it (its pace; Delta tau for a right inverse, eq. (5)) with
+#: the window before. A pace that fell and that, kept for every step left, would not bring
+#: ||e|| below tol, has stalled: the flow is
+#: nearing a point where J# is undefined (a kinematic singularity, or a joint pressed against
+#: its limit by the weighted inverse) in a finite tau that its shrinking steps approach but do
+#: not reach, and the steps left would be spent there. A run that is only slow keeps its pace.
+#: Only a right inverse's pace says so: damped least squares (J J# != I) settles at a task error
+#: above 0 by design, where the plateau rule stops it.
+PACE_WINDOWS = 20
 
 
 def _rhs(inverse: Inverse, x: FloatArray, y_d: FloatArray):
@@ -216,6 +226,19 @@ def _combine(weights: FloatArray, K: FloatArray) -> FloatArray:
     return out
 
 
+def _pace_stall(status, run, nsteps, cap, window, err, tol, pace_step, pace_err, pace) -> None:
+    """Mark STALLED the members of ``run`` whose pace window (``window`` steps, a
+    :data:`PACE_WINDOWS`-th of their budget ``cap``) ended with a pace (the fall of ln ||e||
+    over it) below the window before's and too slow for the steps left to bring ||e|| below
+    ``tol``; then start their next window. Updates in place."""
+    due = run[(nsteps[run] >= pace_step[run]) & (status[run] == Status.RUNNING)]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        now = np.log(pace_err[due] / err[due])
+        short = now * (cap[due] - nsteps[due]) < np.log(err[due] / tol) * window[due]
+    status[due[(now < pace[due]) & short]] = Status.STALLED
+    pace[due], pace_err[due], pace_step[due] = now, err[due], nsteps[due] + window[due]
+
+
 def integrate(inverse, x0, y_d, tol, max_steps, record, tau0, rtol=RTOL, atol=ATOL):
     """Batched DOP853 on dx/dtau = -J# e from tau = tau0 until ||e|| < tol, at most
     ``max_steps`` steps (an int, or one per member: shape (n,))."""
@@ -233,6 +256,10 @@ def integrate(inverse, x0, y_d, tol, max_steps, record, tau0, rtol=RTOL, atol=AT
     err_now = err0.copy()
     # (the last checkpoint of each run's error and x)
     plateau_tau, plateau_err, plateau_x = tau0 + PLATEAU_TAU, err0.copy(), x0.copy()
+    # (the step and error at the start of each run's pace window, the pace of the window
+    # before: NaN, which no pace falls below, before the first)
+    window = np.maximum(cap // PACE_WINDOWS, 1)
+    pace_step, pace_err, pace = window.copy(), err0.copy(), np.full(n, np.nan)
     h = _initial_step(inverse, x, f, y_d, rtol, atol)
     nsteps = np.zeros(n, dtype=int)
     last_bad = np.zeros(n, dtype=bool)
@@ -295,6 +322,8 @@ def integrate(inverse, x0, y_d, tol, max_steps, record, tau0, rtol=RTOL, atol=AT
         status[due[settled]] = Status.STALLED
         plateau_tau[due] = tau[due] + PLATEAU_TAU
         plateau_err[due], plateau_x[due] = err_now[due], x[due]
+        if inverse.right_inverse:
+            _pace_stall(status, run, nsteps, cap, window, err_now, tol, pace_step, pace_err, pace)
         status[run[np.linalg.norm(x[run], axis=-1) > DIVERGED_NORM]] = Status.DIVERGED
         status[run[(nsteps[run] >= cap[run]) & (status[run] == Status.RUNNING)]] = Status.MAX_STEPS
     return x, tau, status, nsteps, rec

@@ -16,6 +16,7 @@ from . import validation
 from .exceptions import InvalidInputError
 from .inverses import Inverse
 from .kinematics import Kinematics
+from .limit_stall import pressed_joint
 from .picard import DEGREE
 from .stall import reach_note, stall_reason
 from .validation import FloatArray, check_memory, count, positive
@@ -188,7 +189,9 @@ def stop_message(status, nit, err, tol, mode, gamma, x, inverse, max_iterations,
     change: a discrete run that diverged a lower gamma (shorter steps) and, for the posture
     inverse, a lower gain k (its null-space pull grows with k ||e||), one out of iterations
     gamma nearer 1 (near a solution the error shrinks by |1 - gamma| per iteration, eq. (5));
-    in continuous mode gamma only rescales theta, so more steps, not another gamma."""
+    in continuous mode gamma only rescales theta, so more steps, not another gamma. A run of
+    the weighted inverse blocked at a joint limit says so instead, stalled or out of steps
+    (:func:`jik.engine.limit_stall.pressed_joint`): more steps do not help it."""
     steps = counted(nit, mode)
     if status == Status.CONVERGED:
         if nit == 0:
@@ -196,8 +199,10 @@ def stop_message(status, nit, err, tol, mode, gamma, x, inverse, max_iterations,
         return f"converged: task error {err:.3g} < {tol:g} after {steps}"
     if status in (Status.SINGULAR, Status.UNDEFINED):
         return str(inverse.singular_error(x)) + "; the run stopped there"
+    pressed = pressed_joint(inverse, target, x)
     if status == Status.STALLED:
-        return f"stalled after {steps} at error {err:.3g}: {stall_reason(inverse, target, x)}"
+        why = pressed or stall_reason(inverse, target, x)
+        return f"stalled after {steps} at error {err:.3g}: {why}"
     out, _ = reach_note(inverse.kinematics, target)
     nearer = mode == "discrete" and gamma != 1.0
     if status == Status.DIVERGED:
@@ -205,7 +210,9 @@ def stop_message(status, nit, err, tol, mode, gamma, x, inverse, max_iterations,
         lower = "lower gamma" + ("" if gain is None else f" or the posture gain k ({gain:g})")
         advice = out or (lower if mode == "discrete" else "the target may be unreachable")
         return f"diverged after {steps} (error {err:.3g}); {advice}"
-    advice = out or "raise max_iterations" + (", or take gamma nearer 1" if nearer else "")
+    advice = (
+        out or pressed or "raise max_iterations" + (", or take gamma nearer 1" if nearer else "")
+    )
     return (
         f"did not converge within {counted(max_iterations, mode)} (error {err:.3g} >= {tol:g}); "
         + advice
