@@ -180,10 +180,10 @@ PLATEAU_TAU = 5.0
 #: A run's step budget is cut into :data:`PACE_WINDOWS` windows, and at the end of each the run
 #: compares the fall of ln ||e|| over it (its pace; Delta tau for a right inverse, eq. (5)) with
 #: the window before. A pace that fell and that, kept for every step left, would not bring
-#: ||e|| below tol, has stalled: the flow is
-#: nearing a point where J# is undefined (a kinematic singularity, or a joint pressed against
-#: its limit by the weighted inverse) in a finite tau that its shrinking steps approach but do
-#: not reach, and the steps left would be spent there. A run that is only slow keeps its pace.
+#: ||e|| below tol, has stalled: the flow nears a point where J# is undefined (a kinematic
+#: singularity, or a joint pressed against its limit by the weighted inverse) in a finite tau
+#: that its shrinking steps approach but do not reach, and the steps left would be spent there.
+#: A run that is only slow keeps its pace.
 #: Only a right inverse's pace says so: damped least squares (J J# != I) settles at a task error
 #: above 0 by design, where the plateau rule stops it.
 PACE_WINDOWS = 20
