@@ -1,5 +1,6 @@
 """The options of ``jik solve``, ``jik repeatability`` and ``jik atlas`` that choose an inverse
-J# and its parameters (the engine's catalogue :data:`jik.engine.registry.ALGORITHMS`)."""
+J# and its parameters (the engine's catalogue :data:`jik.engine.registry.ALGORITHMS`), and how
+each leg runs: eq. (7)'s mode and gamma, the tolerance and the cap on steps."""
 
 from __future__ import annotations
 
@@ -29,6 +30,37 @@ def add_algorithm_parameter_options(p: argparse.ArgumentParser) -> None:
         help="weighted: joint limits 'lo,hi; lo,hi; ...' (default: the "
         "robot's limits, else its configuration box)",
     )
+
+
+def add_run_options(p: argparse.ArgumentParser) -> None:
+    """--mode, --gamma, --tol, --max-iterations: how each solve (each leg of a path) runs."""
+    p.add_argument(
+        "--mode",
+        choices=("continuous", "discrete"),
+        default=None,
+        help="algorithm (7) continuous (ODE) or discrete (default: the robot's)",
+    )
+    p.add_argument("--gamma", type=float, default=None, help="decay rate (discrete: step)")
+    p.add_argument(
+        "--tol", type=float, default=None, help="task error at which a solve stops (default 1e-10)"
+    )
+    p.add_argument(
+        "--max-iterations",
+        type=int,
+        default=None,
+        help="most steps (continuous) or iterations (discrete) per solve (default: the engine's)",
+    )
+
+
+def run_settings(args: argparse.Namespace, spec) -> dict:
+    """The engine's keywords of :func:`add_run_options` (``spec``: the robot's defaults of mode
+    and gamma)."""
+    return {
+        "mode": args.mode or spec.default_mode,
+        "gamma": args.gamma if args.gamma is not None else spec.default_gamma,
+        "max_iterations": args.max_iterations,
+        **({} if args.tol is None else {"tol": args.tol}),
+    }
 
 
 def refuse_unused_options(args: argparse.Namespace, algorithms: list[str]) -> None:

@@ -33,8 +33,10 @@ from ..engine.exports import json_values
 from .algorithm_options import (
     ALGORITHM_NAMES,
     add_algorithm_parameter_options,
+    add_run_options,
     algorithm_parameters,
     refuse_unused_options,
+    run_settings,
 )
 from .atlas_output import CsvWriter, Gathered, write_figure
 from .robot_commands import add_task_option, point_texts, refused, robot_with_task
@@ -81,6 +83,7 @@ def add_atlas_parser(sub) -> None:
         help="repeat for several, compared over the same starts (default pseudoinverse)",
     )
     add_algorithm_parameter_options(p)
+    add_run_options(p)
     p.add_argument("--augmentation", help="augmenting map of the extended inverse")
     p.add_argument(
         "--shift",
@@ -256,8 +259,7 @@ def _run(args: argparse.Namespace) -> int:
         shifts=[_numbers(s, "--shift") for s in args.shift] or None,
         scales=args.scale or None,
         chunk=args.chunk,
-        gamma=spec.default_gamma,
-        mode=spec.default_mode,
+        **run_settings(args, spec),
     )
     big = plan.size > JSON_RUNS
     csv_path = out.with_suffix(".csv") if big or args.csv else None
@@ -298,6 +300,7 @@ def _run(args: argparse.Namespace) -> int:
         "gamma": plan.settings["gamma"],
         "mode": plan.settings["mode"],
         "tol": plan.settings["tol"],
+        "max_iterations": plan.settings["max_iterations"],
         "backend": backend,
     }
     doc: dict[str, Any] = {

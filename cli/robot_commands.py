@@ -19,8 +19,10 @@ from typing import TYPE_CHECKING
 from .algorithm_options import (
     ALGORITHM_NAMES,
     add_algorithm_parameter_options,
+    add_run_options,
     algorithm_parameters,
     refuse_unused_options,
+    run_settings,
 )
 
 if TYPE_CHECKING:
@@ -108,35 +110,14 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--algorithm", choices=ALGORITHM_NAMES, default="pseudoinverse")
     p.add_argument("--augmentation", help="augmenting map of the extended inverse (its name)")
     add_algorithm_parameter_options(p)
-    p.add_argument(
-        "--mode",
-        choices=("continuous", "discrete"),
-        default=None,
-        help="algorithm (7) continuous (ODE) or discrete (default: the robot's)",
-    )
-    p.add_argument("--gamma", type=float, default=None, help="decay rate (discrete: step)")
-    p.add_argument(
-        "--tol", type=float, default=None, help="task error at which a solve stops (default 1e-10)"
-    )
-    p.add_argument(
-        "--max-iterations",
-        type=int,
-        default=None,
-        help="most steps (continuous) or iterations (discrete) per solve (default: the engine's)",
-    )
+    add_run_options(p)
     p.add_argument("--json", action="store_true", help="print machine-readable JSON")
 
 
 def _setup(args: argparse.Namespace) -> tuple[Robot, list[float], dict]:
     robot = robot_with_task(args.robot, args.task)
     x0 = parse_vector(args.x0, "--x0") if args.x0 is not None else list(robot.spec.default_x0)
-    settings = {
-        "mode": args.mode or robot.spec.default_mode,
-        "gamma": args.gamma if args.gamma is not None else robot.spec.default_gamma,
-        "max_iterations": args.max_iterations,
-        **({} if args.tol is None else {"tol": args.tol}),
-    }
-    return robot, x0, settings
+    return robot, x0, run_settings(args, robot.spec)
 
 
 def _limits(robot: Robot, report):

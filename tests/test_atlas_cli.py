@@ -571,3 +571,15 @@ def test_the_progress_bar_says_the_atlas_s_size_before_its_first_chunk(
         main([*argv, *out, "--algorithm", "pseudoinverse", "--algorithm", "extended"])
     assert "atlas [" in shown[0] and "] 0/600 runs (300 starts x 2 algorithms)" in shown[0]
     assert "? s left" in shown[0] and "nan" not in shown[0]
+
+
+def test_the_run_options_are_a_solve_s(tmp_path):
+    """--mode, --gamma, --tol and --max-iterations run every leg as they run jik solve's, and
+    the inputs record them: discrete legs at gamma 0.5 given 3 iterations fail, saying so."""
+    doc = run(tmp_path, "--mode", "discrete", "--gamma", "0.5", "--max-iterations", "3")
+    inputs = doc["inputs"]
+    assert (inputs["mode"], inputs["gamma"], inputs["max_iterations"]) == ("discrete", 0.5, 3)
+    failures = doc["results"]["pseudoinverse"]["failures"]
+    assert len(failures) == 12
+    assert all("did not converge within 3 iterations" in why for why in failures.values())
+    assert run(tmp_path, "--tol", "1e-6")["inputs"]["tol"] == 1e-6

@@ -113,6 +113,7 @@ def _plan(req: AtlasRequest, spec, inverses, path, gamma, mode) -> AtlasPlan:
         gamma=gamma,
         mode=mode,
         tol=req.tolerance,
+        max_iterations=req.max_iterations,
     )
 
 

@@ -3,7 +3,8 @@ heatmap.
 
 The atlas itself is the REST API's (:mod:`jik.app.compute.atlas_jobs`: the same request model,
 the same jobs and limits); :func:`atlas_request` only says which atlas a state asks for: its
-robot, map, gamma, mode and tolerance, its chosen algorithms and their parameters, and the
+robot, map, gamma, mode, tolerance and cap on steps per leg, its chosen algorithms and their
+parameters, and the
 loop the dashboard drives, from k(x0) through the path's points, with the starts on the
 self-motion curve of k(x0) and s = 0 at
 x0. :func:`atlas_figure` draws a finished atlas: drift per cycle (and per path scale, when
@@ -37,9 +38,10 @@ def atlas_request(
     cycles: int | None = None,
     scales: Sequence[float] | None = None,
 ) -> AtlasRequest:
-    """The atlas of ``state`` (its closed path, robot, map, gamma, mode and tolerance), with
-    ``starts`` starts and ``cycles`` cycles (default: the state's); InvalidInputError naming
-    the field when the state has no closed path or the request is refused."""
+    """The atlas of ``state`` (its closed path, robot, map, gamma, mode, tolerance and cap on
+    steps per leg), with ``starts`` starts and ``cycles`` cycles (default: the state's);
+    InvalidInputError naming the field when the state has no closed path or the request is
+    refused."""
     if state.task != "path" or not state.path:
         raise InvalidInputError(
             "task: the atlas drives a closed path; choose the closed-path task first", "task"
@@ -69,6 +71,7 @@ def atlas_request(
             "gamma": state.gamma,
             "mode": state.mode,
             "tolerance": state.tolerance,
+            "max_iterations": state.max_iterations,
         }
     )
 

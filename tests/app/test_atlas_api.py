@@ -220,7 +220,8 @@ def test_a_session_atlas_is_the_atlas_of_its_state(client):
     """POST /api/sessions/{id}/atlas: a job of the same jobs, whose request is the session's
     state (the loop from k(x0) through its path, s = 0 at x0, its gamma and mode); once done,
     GET gives the heatmap (log10 drift, a cell's customdata its run) and the starts."""
-    sid = _session(client, mode="discrete", gamma=0.5, cycles=2)  # (5.0: JSON's integer 5)
+    # (5.0: JSON's integer 5)
+    sid = _session(client, mode="discrete", gamma=0.5, cycles=2, max_iterations=60)
     r = client.post(f"/api/sessions/{sid}/atlas", json={"starts": 5.0, "scales": [1, 0.5]})
     assert r.status_code == 202, r.text
     assert r.headers["location"] == f"/atlas/{r.json()['id']}"
@@ -235,6 +236,7 @@ def test_a_session_atlas_is_the_atlas_of_its_state(client):
         0.5,
         2,
     )
+    assert (req["tolerance"], req["max_iterations"]) == (1e-10, 60)
     starts = np.array(body["starts"])  # (P, N, p)
     assert starts.shape == (2, 5, 3)
     kin = robot_spec("manipulator2").build(l=1.0)
@@ -422,3 +424,19 @@ def test_every_catalogue_arm_has_a_default_atlas_and_the_unicycle_says_why_not(c
     robots = {r["name"]: r for r in client.get("/robots").json()["robots"]}
     assert robots["unicycle"]["default_path_loops"] is False
     assert robots["manipulator2"]["default_path_loops"] is True
+
+
+def test_an_atlas_takes_the_cap_on_steps_as_a_solve_does(client):
+    """max_iterations caps every leg of an atlas as it caps a /solve: discrete legs at gamma 0.5
+    given 3 iterations fail, and say so; beyond the API's bound it is refused by name."""
+    over = {"mode": "discrete", "gamma": 0.5, "max_iterations": 3}
+    r = client.post("/atlas", json=body(**over))
+    assert r.status_code == 202, r.text
+    done = wait_until_ended(client, r.json()["id"])
+    assert done["status"] == "done", done["error"]
+    failures = done["result"]["failures"]["pseudoinverse"]
+    assert len(failures) == 6
+    assert all("did not converge within 3 iterations" in why for why in failures.values())
+    assert messages(client.post("/atlas", json=body(max_iterations=10**6)))[0].startswith(
+        "max_iterations: Input should be less than or equal to"
+    )

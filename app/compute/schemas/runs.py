@@ -54,6 +54,13 @@ class RunSettings(BaseModel):
         None, description="'continuous' (ODE) or 'discrete' (iterations); default: the robot's"
     )
     tolerance: Tolerance = Field(1e-10, description="stop when ||k(x) - target|| < tolerance")
+    max_iterations: Annotated[int, Field(strict=True, ge=1, le=MAX_ITERATIONS), INTEGRAL] | None = (
+        Field(
+            None,
+            description="cap on integrator steps (continuous) or iterations (discrete) per solve "
+            "(per leg of a path); default: the engine's for the mode",
+        )
+    )
 
 
 class _Request(RunSettings):
@@ -73,12 +80,6 @@ class _Request(RunSettings):
         "default: the robot's default augmentation (the other algorithms take none)",
     )
     x0: Vector = Field(description="start configuration, length p of the robot")
-    max_iterations: Annotated[int, Field(strict=True, ge=1, le=MAX_ITERATIONS), INTEGRAL] | None = (
-        Field(
-            None,
-            description="cap on integrator steps (continuous) or iterations (discrete) per solve",
-        )
-    )
 
 
 class SolveRequest(_Request):
