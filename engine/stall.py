@@ -1,7 +1,7 @@
 """Why a continuous run of eq. (7) stalled: the target beyond the robot's reach, a kinematic
 singularity (J loses rank), an algorithmic one of the extended Jacobian (10) (J regular,
-[J; dh] singular), or a local minimum of the task error; and whether a target is out of reach,
-which a run that diverged or ran out of steps says too.
+[J; dh] singular), or, J regular, steps collapsing where the error still falls; and whether a
+target is out of reach, which a run that diverged or ran out of steps says too.
 
 The integrator only sees its step size collapse; the robot's workspace and the Jacobians where
 the run stopped tell which. A planar chain of revolute joints reaches the annulus between
@@ -75,8 +75,10 @@ def stall_reason(inverse: Inverse, target, x) -> str:
     sigma_min(J) / sigma_max(J) < :data:`SINGULAR_RATIO`; else, for the extended Jacobian
     (11), an algorithmic singularity when ||J^E#(x)|| sigma_min(J(x)) exceeds
     :data:`ALGORITHMIC_RATIO` (a right inverse of J has ||J#|| >= 1 / sigma_min(J), with
-    equality for the pseudoinverse (8)) or J^E# is undefined there; else a local minimum of
-    the task error.
+    equality for the pseudoinverse (8)) or J^E# is undefined there; else the integrator's steps
+    collapsed: where J has full rank the task error has no local minimum to stop at (a right
+    inverse's falls as exp(-theta), eq. (5); damped least squares' as fast as
+    sigma_min^2 / (sigma_min^2 + lambda^2) at least).
     """
     out, within = reach_note(inverse.kinematics, target)
     if out is not None:
@@ -106,6 +108,7 @@ def stall_reason(inverse: Inverse, target, x) -> str:
             "set h = h(x0) does not lead to the target from this start"
         )
     return (
-        f"{within}J is regular there (σ_min/σ_max = {_g(ratio)}): the task error stopped at "
-        "a local minimum; move the start or the target"
+        f"{within}J is regular there (σ_min/σ_max = {_g(ratio)}), so the task error still "
+        "falls there (eq. (5)): the integrator's steps collapsed, as near a singularity of J#; "
+        "move the start or the target"
     )
