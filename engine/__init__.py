@@ -141,7 +141,7 @@ _EXPORTS = {
     "run_findings": "findings",
     "Finding": "findings",
     "extended_why": "findings",
-    "practical_findings": "findings",
+    "practical_findings": "practical_findings",
     "Progress": "progress",
     "ProgressCallbacks": "progress",
     # functionals and synthesis
@@ -311,7 +311,7 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
         SingularConfigurationError,
     )
     from .extended_vector import VectorExtendedInverse
-    from .findings import Finding, extended_why, practical_findings, run_findings
+    from .findings import Finding, extended_why, run_findings
     from .formula_kinematics import FormulaKinematics, FormulaMap
     from .functional_report import functionals_report
     from .functionals import error_functional_e1, error_functional_e2
@@ -321,6 +321,7 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
     from .map_grid import MapGrid, map_grid
     from .map_singularities import MapSingularities, map_singularities
     from .planar_chain import PlanarChain
+    from .practical_findings import practical_findings
     from .practical_inverses import DampedInverse, PostureInverse, WeightedInverse
     from .progress import Progress, ProgressCallbacks
     from .registry import ALGORITHMS, ROBOTS, make_inverse

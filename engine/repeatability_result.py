@@ -128,7 +128,8 @@ class RepeatabilityResult(Columns):
         stayed at h(x0) (eq. (12), from h at every point of legs recorded with ``record=True``,
         else from h after each leg) and, in discrete mode, that the
         iteration keeps h only approximately and what a gamma near 2 does; for the practical
-        inverses what their parameters did (:func:`jik.engine.findings.practical_findings`:
+        inverses what their parameters did
+        (:func:`jik.engine.practical_findings.practical_findings`:
         the posture inverse's drift, damped least squares' task error at the legs' ends, the
         weighted inverse's joints against its limits, at every recorded point, else at the legs'
         ends).
@@ -157,7 +158,8 @@ class RepeatabilityResult(Columns):
         finding | pseudoinverse J^P#: not repeatable. After 2 cycles the joint
         why | Why: J^P# picks the minimum-norm joint velocity, which has n
         """
-        from .findings import Finding, practical_findings, verdict
+        from .findings import Finding, verdict
+        from .practical_findings import practical_findings
 
         i: Any = ()
         if np.ndim(self.success) == 0 and start is not None:
@@ -240,7 +242,7 @@ class RepeatabilityResult(Columns):
 @dataclass(frozen=True)
 class _Member:
     """One start's run as :func:`jik.engine.findings.verdict` and
-    :func:`~jik.engine.findings.practical_findings` read it: the drift of the cycles that
+    :func:`~jik.engine.practical_findings.practical_findings` read it: the drift of the cycles that
     ended, h, and the configurations, task errors and legs of its recorded points (else its
     leg ends)."""
 

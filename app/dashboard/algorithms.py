@@ -25,8 +25,8 @@ import numpy as np
 
 from ...engine.algorithm_registry import default_rest
 from ...engine.exceptions import InvalidInputError
-from ...engine.findings import rest_words as engine_rest_words
 from ...engine.limits import limited_box, robot_limits
+from ...engine.practical_findings import rest_words as engine_rest_words
 from ...engine.practical_inverses import check_rest
 from ...engine.registry import ALGORITHMS as REGISTRY
 from ...engine.validation import within
@@ -272,9 +272,9 @@ def editable_rest(state: ChosenState, spec, kin) -> list[float]:
 
 def rest_words(state: ChosenState, spec, inverse) -> str:
     """The rest in force in words, for the verdict (the engine's
-    :func:`~jik.engine.findings.rest_words` for the posture ``inverse``); a default outside
-    the rest's sliders (:func:`joint_box`: the joint limits) says what moving one of them makes
-    of it (:func:`editable_rest`)."""
+    :func:`~jik.engine.practical_findings.rest_words` for the posture ``inverse``); a default
+    outside the rest's sliders (:func:`joint_box`: the joint limits) says what moving one of
+    them makes of it (:func:`editable_rest`)."""
     words = engine_rest_words(inverse, state.x0)
     kin = inverse.kinematics
     rest, source = posture_rest(state, kin)

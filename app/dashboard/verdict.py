@@ -12,9 +12,10 @@ from __future__ import annotations
 import json
 
 from ...engine.exceptions import JikError
-from ...engine.findings import NAMES, PRACTICAL, Finding, practical_findings
+from ...engine.findings import NAMES, Finding
 from ...engine.findings import verdict as run_verdict
 from ...engine.map_singularities import MapSingularities, map_singularities
+from ...engine.practical_findings import PRACTICAL, practical_findings
 from ...engine.reproductions.unicycle import undefined_why
 from .algorithms import rest_words
 from .analysis import expensive_map, kinematics_and_map
@@ -80,9 +81,9 @@ def _undefined_why(result: DashboardResult, run: AlgorithmRun) -> list[Finding]:
 
 def _practical(result: DashboardResult, unit: str) -> list[Finding]:
     """What the practical inverses' parameters did
-    (:func:`jik.engine.findings.practical_findings`), the posture inverse's rest in the page's
-    words; the weighted inverse's only within the box it took for a robot without joint limits
-    (a robot that declares some has its sentence from
+    (:func:`jik.engine.practical_findings.practical_findings`), the posture inverse's rest in
+    the page's words; the weighted inverse's only within the box it took for a robot without
+    joint limits (a robot that declares some has its sentence from
     :attr:`~jik.app.dashboard.runs.DashboardResult.limits`)."""
     state, out = result.state, []
     for a in (a for a in result.runs if a in PRACTICAL):

@@ -98,8 +98,8 @@ def test_the_response_says_what_the_run_found_and_why(api):
 
 def test_a_practical_inverse_says_what_its_parameters_did(api):
     """``findings`` of the damped, posture and weighted inverses add what their parameters did
-    (jik.engine.findings.practical_findings): damped least squares' damping and task error at
-    its legs' ends, the posture inverse's gain and rest (the default: x0), the weighted
+    (jik.engine.practical_findings.practical_findings): damped least squares' damping and task
+    error at its legs' ends, the posture inverse's gain and rest (the default: x0), the weighted
     inverse's joints against the limits it took."""
     said = {}
     for algorithm, parameters in (

@@ -11,14 +11,11 @@ import pytest
 
 import jik.engine as jik
 from jik.engine.augmentations import h_change
-from jik.engine.findings import (
-    NAMES,
+from jik.engine.findings import NAMES, drift_sentence, gamma_note, pseudoinverse_why
+from jik.engine.practical_findings import (
     damped_findings,
-    drift_sentence,
-    gamma_note,
     leg_end_errors,
     posture_findings,
-    pseudoinverse_why,
     rest_words,
     weighted_findings,
 )
