@@ -294,15 +294,15 @@ def tolerance_control(state) -> Control:
     """The tolerance of every leg, a power of ten from 1e-4 down to the engine's
     :data:`~jik.engine.solve_rules.TOL_MIN`, and the state's own when it is another (a link
     or the session API may set any the model takes)."""
-    decades = [10.0**-k for k in range(4, 1 - int(math.log10(TOL_MIN)))]
-    values = sorted({*decades, float(state.tolerance)}, reverse=True)
+    decades = {float(f"1e-{k}"): f"1e-{k}" for k in range(4, 1 - int(math.log10(TOL_MIN)))}
+    shown = {**decades, float(state.tolerance): f"{state.tolerance:.6g}", **decades}
     return Control(
         "tolerance",
         "tolerance",
         "select",
         "a leg stops once its task error ||k(x) − y_d|| is below this; lower asks for more "
         "digits, and more steps",
-        tuple((v, f"{v:g}") for v in values),
+        tuple(sorted(shown.items(), reverse=True)),
     )
 
 

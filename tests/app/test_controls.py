@@ -277,14 +277,14 @@ def test_the_tolerance_is_a_control_of_the_page_and_the_scene():
     assert control_values(state)["tolerance"] == 1e-10
     odd = updated_state(state, {"tolerance": 3e-9})
     (tol,) = [c for c in controls(odd) if c.key == "tolerance"]
-    assert (3e-9, "3e-09") in tol.options
+    assert (3e-9, "3e-09") in tol.options and (1e-10, "1e-10") in tol.options
     dashboard = Dashboard(state)
     scene = DashboardScene(dashboard)
     try:
         scene.controls.show(dashboard.state)
         box = scene.controls.inputs["tolerance"]
         assert box.value == "1e-10" and "1e-12" in box.options
-        box.value = "0.0001"  # (viser's thread, for a user)
+        box.value = "1e-4"  # (viser's thread, for a user)
         assert dashboard.state.tolerance == 1e-4
     finally:
         scene.stop()
