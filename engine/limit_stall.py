@@ -8,7 +8,7 @@ settle in. Its weight 1 + |dH/dx_i| grows without bound as joint i nears a limit
 target needs that joint to go on and the other joints cannot move the task that way, the
 weighted Jacobian J W^(-1/2) loses rank at the limit, though J does not; the flow reaches that
 point in a finite tau, with ever shorter steps, and stalls there
-(:data:`jik.engine.dop853.PACE_WINDOW`). More steps do not help: the start, the target or the
+(:data:`jik.engine.dop853.PACE_WINDOWS`). More steps do not help: the start, the target or the
 limits must change.
 """
 
