@@ -16,6 +16,8 @@ case in tests/app/test_errors.py, test_synthesize.py and test_sessions.py):
   takes none;
 - the chosen inverse must be defined at ``x0`` (the engine says so: a singular start, by the
   server's own test);
+- a pose task's target or path point has rotation coordinates at most pi long (the principal
+  log never exceeds it: the engine's own check, ``check_target``);
 - a user robot (``planar_chain``, ``formula``, ``urdf``) is a definition: its formulas'
   grammar, its URDF text, lengths one per joint, and what follows from them (p and r, so the
   lengths of ``x0``, ``target`` and ``path``; the variables of a map's box) no JSON Schema can
@@ -224,6 +226,7 @@ def _run_ok(body: dict, path: str) -> bool:
         points = run.path if isinstance(run, S.RepeatabilityRequest) else [run.target]
         for i, point in enumerate(points):
             check_length(setup.spec, point, f"path[{i}]")
+        setup.kinematics.check_target(points, "path")  # (a pose's rotation within pi)
         # (the server's own test of a singular start, which a nearly singular J J^T fails)
         setup.inverse.matrix(np.asarray(run.x0, dtype=float))
         if refused_starts(setup.inverse, np.asarray([run.x0], dtype=float)):
