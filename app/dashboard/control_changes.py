@@ -63,7 +63,7 @@ def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
         elif key == "path" and isinstance(value, str):  # (the text shown: the path in force)
             size = len(state.target) if "robot" not in patch else None
             same = size is not None and value.split() == path_text(state.path).split()
-            out[key] = state.path if same else parse_path_text(value, size)
+            out[key] = state.path if same else parse_path_text(value, size, state.path)
         elif not rest:
             out[key] = value
         elif head in ("robot_parameters", "augmentation_parameters", "algorithm_parameters"):
@@ -146,14 +146,20 @@ def _quoted(text: str) -> str:
     return text if len(text) <= QUOTED else f"{text[: QUOTED - 3]}..."
 
 
-def parse_path_text(text: str, size: int | None = None) -> list[list[float]]:
+def parse_path_text(text: str, size: int | None = None, current=()) -> list[list[float]]:
     """The points of a path written as :func:`path_format`, a new line separating points as a
-    ';' does; ``size``: the task's dimension, which every point must have. A refusal quotes the
-    point as the user wrote it (its first :data:`QUOTED` characters)."""
+    ';' does; ``size``: the task's dimension, which every point must have. A point written as
+    :func:`path_text` shows a point of ``current`` (the path in force) is that point, exact: a
+    point added or edited leaves the others as they were, not rounded to the decimals shown. A
+    refusal quotes the point as the user wrote it (its first :data:`QUOTED` characters)."""
     points = []
     parts = [p for p in re.split(r"[;\n]", text) if p.strip()]
     written = path_format(size)
+    shown = {"".join(path_text([p]).split()): list(p) for p in current}
     for k, part in enumerate(parts, start=1):
+        if (exact := shown.get("".join(part.split()))) is not None:
+            points.append(exact)
+            continue
         where = f"point {k} of {len(parts)}, '{_quoted(part.strip())}',"
         try:
             point = [float(v) for v in part.split(",")]

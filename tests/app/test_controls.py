@@ -98,7 +98,7 @@ def test_a_path_is_written_a_point_per_line_and_read_back_from_lines():
 def test_a_computed_path_is_shown_as_a_user_types_it_and_stays_exact():
     """A catalogue arm's path is computed (its pose coordinates 1.29e-17 where 0 is meant):
     its box shows 4 decimals, 0 for those, and the shown text sent back keeps the exact
-    path; an edited text is what is typed."""
+    path; an edited point is what is typed, the others stay exact."""
     state = default_state("panda")
     text = control_values(state)["path"]
     assert "e-" not in text and text.startswith("0.3034, 0.0459, 0.5903, 0, 0, -0.15;\n")
@@ -107,6 +107,10 @@ def test_a_computed_path_is_shown_as_a_user_types_it_and_stays_exact():
     assert updated_state(state, {"path": " ".join(text.split())}).path == state.path
     edited = updated_state(state, {"path": text.replace("-0.15", "-0.1")})
     assert edited.path[0] == (0.3034, 0.0459, 0.5903, 0.0, 0.0, -0.1)
+    # (the points not edited, and those of a point added, stay exact, not rounded as shown)
+    assert edited.path[1:] == state.path[1:]
+    longer = updated_state(state, {"path": text + ";\n0.31, 0, 0.59, 0, 0, 0.1"})
+    assert longer.path == (*state.path, (0.31, 0.0, 0.59, 0.0, 0.0, 0.1))
     with pytest.raises(InvalidInputError) as bad:
         expand(state, {"x0.7": 1.0})
     assert bad.value.field == "x0.7"
