@@ -41,12 +41,12 @@ export async function openSession(state, onRefusedLink) {
 // the request itself goes to onError (the session's "refused" event covers the rest).
 let queued = {};
 let inFlight = false;
-export function change(patch, onError) {
+export function change(patch, onError, onAccepted = () => {}) {
   Object.assign(queued, patch);
-  if (!inFlight) flush(onError);
+  if (!inFlight) flush(onError, onAccepted);
 }
 
-async function flush(onError) {
+async function flush(onError, onAccepted) {
   const patch = queued;
   queued = {};
   if (!Object.keys(patch).length) return;
@@ -56,11 +56,13 @@ async function flush(onError) {
       method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(patch),
     });
     const body = await res.json();
-    if (res.ok) session.generation = Math.max(session.generation, body.generation);
-    else if (res.status !== 422) onError(detail(body));
+    if (res.ok) {
+      session.generation = Math.max(session.generation, body.generation);
+      onAccepted(body);
+    } else if (res.status !== 422) onError(detail(body));
   } finally {
     inFlight = false;
-    if (Object.keys(queued).length) flush(onError);
+    if (Object.keys(queued).length) flush(onError, onAccepted);
   }
 }
 

@@ -169,14 +169,18 @@ function select(c, value, send) {
   return el("label", { title: c.help }, c.label, s);
 }
 
-// A vector: one box per coordinate; a change sends the whole vector, unless a box does not
-// hold a number (then it says so beside the control, in the user's text).
+// A vector: one box per coordinate, each showing its value to 4 decimals; a change sends the
+// whole vector, the boxes the user did not edit at their exact values (not the 4 decimals
+// shown), unless a box does not hold a number (then it says so beside the control, in the
+// user's text).
 function vector(c, value, send) {
+  const short = (v) => String(+(+v).toFixed(4));
+  let exact = [...value];
   const boxes = value.map((v, i) => {
-    const box = el("input", { type: "text", inputMode: "decimal", id: `${c.id}-${i}`, className: "coordinate", value: +(+v).toFixed(4) });
+    const box = el("input", { type: "text", inputMode: "decimal", id: `${c.id}-${i}`, className: "coordinate", value: short(v) });
     box.setAttribute("aria-label", `${c.label}, coordinate ${i + 1}`);
     box.addEventListener("change", () => {
-      const values = boxes.map((b) => parseNumber(b.value));
+      const values = boxes.map((b, k) => (b.value === short(exact[k]) ? exact[k] : parseNumber(b.value)));
       const bad = boxes.find((b, k) => values[k] === null);
       if (bad) { notANumber(c, bad.value); return; }
       send(values, boxes.map((b) => b.value.trim()).join(", "));
@@ -184,7 +188,7 @@ function vector(c, value, send) {
     return box;
   });
   const group = el("span", { className: "vector" }, ...boxes);
-  group.setValue = (v) => v.forEach((x, i) => { boxes[i].value = +(+x).toFixed(4); });
+  group.setValue = (v) => { exact = [...v]; v.forEach((x, i) => { boxes[i].value = short(x); }); };
   return el("label", { title: c.help }, c.label, group);
 }
 

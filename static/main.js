@@ -11,7 +11,13 @@ import { afterSecond, cancelSecond, clearCancelled, secondWanted } from "./secon
 
 // second: the generation whose second phase runs (its progress came, its functionals not yet).
 const page = { config: null, state: null, shown: 0, shownState: null, editor: null, second: null };
-const send = (patch) => { setNotice(""); change(patch, (message) => setStatus(message, true)); };
+const send = (patch) => { setNotice(""); change(patch, (message) => setStatus(message, true), accepted); };
+
+// A change accepted without a new generation (the values in force typed back after a refusal):
+// the result on screen is the state's, and the header says so instead of the old refusal.
+function accepted(body) {
+  if (body.generation === page.shown && session.generation === page.shown) setStatus(`up to date (generation ${page.shown})`);
+}
 
 function setStatus(text, error = false) {
   const s = $("#status-text");

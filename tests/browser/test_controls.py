@@ -236,3 +236,38 @@ def test_a_pose_path_shows_whole_a_point_per_line(tabs):
     assert path.evaluate(hidden) == [0, 0]
     grown = path.bounding_box()
     assert grown is not None and grown["height"] > height
+
+
+def test_one_coordinate_edited_leaves_the_others_exact_and_a_value_typed_back_clears(tabs):
+    """A target of many decimals, shown to 4: editing its second coordinate sends the first as
+    it is, not as shown. A refused gamma, then the value in force typed back: the header says
+    the result is up to date instead of keeping the refusal (no new generation comes)."""
+    tabs.allow_console(r"status of 422")
+    tab = tabs.open()
+    page = tab.page
+    tab.select("#ctl-task", "target")
+    exact = 1.123456789
+    request = urllib.request.Request(
+        f"{tab.base}/api/sessions/{tab.session_id}/state",
+        data=json.dumps({"target": [exact, 1.0]}).encode(),
+        headers={"Content-Type": "application/json"},
+    )
+    tab.wait_drawn(json.loads(urllib.request.urlopen(request, timeout=30).read())["generation"])
+    first = page.locator("#ctl-target-0")
+    expect(first).to_have_value("1.1235")
+    second = page.locator("#ctl-target-1")
+    second.fill("1.5")
+    tab.change(lambda: second.press("Enter"))
+    assert tab.snapshot()["state"]["target"] == [exact, 1.5]
+
+    status = page.locator("#status-text")
+    box = page.locator("#ctl-gamma-value")
+    in_force = box.input_value()
+    box.fill("-1")
+    assert tab.posting(lambda: box.press("Enter")).status == 422
+    expect(status).to_contain_text("refused (here): gamma")
+    generation = tab.snapshot()["generation"]
+    box.fill(str(float(in_force)))  # (the value in force, as typed: "1.0" where "1.000" shows)
+    assert tab.posting(lambda: box.press("Enter")).json()["generation"] == generation
+    expect(status).to_have_text(f"up to date (generation {generation})")
+    expect(page.locator("#controls .field-error")).to_have_count(0)
