@@ -40,11 +40,27 @@ function showProgress(body) {
     : `computing ${pct}% (${body.runs_done} of ${body.runs} starts, ${fmt(body.elapsed_s, 1)} s)`;
 }
 
+// The number in a box of the panel, null when it is empty (``empty``: allowed); else the box is
+// marked and its refusal said in the panel's status: nothing is sent with a value the user did
+// not type (a number box holds "" for any text that is not a number).
+function boxNumber(id, label, empty) {
+  const box = $(id);
+  const text = box.value.trim();
+  const ok = !box.validity.badInput && (text !== "" || empty);
+  if (ok) { box.removeAttribute("aria-invalid"); return text === "" ? null : Number(text); }
+  box.setAttribute("aria-invalid", "true");
+  throw new Error(`${label}: ${box.validity.badInput ? "what is typed is not a number" : "give a number"}; nothing was sent`);
+}
+
 async function start(state) {
-  const number = (id) => ($(id).value.trim() === "" ? null : Number($(id).value));
   const scales = $("#atlas-scales").value.trim();
-  const body = { starts: number("#atlas-starts"), cycles: number("#atlas-cycles") };
-  if (body.starts === null) delete body.starts;
+  let body;
+  try {
+    body = { starts: boxNumber("#atlas-starts", "starts", false), cycles: boxNumber("#atlas-cycles", "cycles", true) };
+  } catch (err) {
+    say(err.message, true);
+    return;
+  }
   if (scales) body.scales = scales.split(/[,;\s]+/).filter(Boolean).map(Number);
   const token = ++atlas.token;
   say("starting the atlas…");

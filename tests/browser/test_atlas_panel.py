@@ -134,6 +134,29 @@ def test_an_atlas_the_state_cannot_have_is_refused_in_words_in_the_panel(tabs):
     expect(tab.page.locator("#atlas-progress-box")).to_be_hidden()
 
 
+def test_an_empty_or_unreadable_count_is_refused_not_taken_as_the_default(tabs):
+    """The starts box emptied, or text in the cycles box that is not a number (a number box
+    then holds ""): the panel says which box and sends nothing, instead of an atlas of 256
+    starts or of the controls' cycles the user did not ask for."""
+    tab = tabs.open()
+    page = tab.page
+    requests = []
+    page.on("request", lambda r: r.method == "POST" and "/atlas" in r.url and requests.append(r))
+    status, starts = page.locator("#atlas-status"), page.locator("#atlas-starts")
+    starts.fill("")
+    page.click("#atlas-compute")
+    expect(status).to_have_text("starts: give a number; nothing was sent")
+    expect(status).to_have_class(re.compile("error"))
+    expect(starts).to_have_attribute("aria-invalid", "true")
+    starts.fill("8")
+    page.locator("#atlas-cycles").press_sequentially("2e")  # (no exponent: not a number)
+    page.click("#atlas-compute")
+    expect(status).to_have_text("cycles: what is typed is not a number; nothing was sent")
+    expect(starts).not_to_have_attribute("aria-invalid", "true")
+    expect(page.locator("#atlas-progress-box")).to_be_hidden()
+    assert requests == []
+
+
 # (CI's slow step: among the longest browser checks; the default run stays under 8 minutes)
 @pytest.mark.slow
 def test_an_atlas_after_a_cancel_starts_at_once(tabs):
