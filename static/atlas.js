@@ -6,7 +6,8 @@
 // CSV button downloads the table of the atlas shown (GET .../atlas/{job}/table.csv: the engine's
 // AtlasResult.columns(), a row per start, algorithm and cycle).
 import { api } from "./api.js";
-import { $, el, fmt } from "./dom.js";
+import { parseNumber } from "./controls.js";
+import { $, el, fieldNote, fmt, markInvalid } from "./dom.js";
 import { PLOT_CONFIG, panelHead } from "./panels.js";
 
 const POLL_MS = 250;
@@ -40,28 +41,60 @@ function showProgress(body) {
     : `computing ${pct}% (${body.runs_done} of ${body.runs} starts, ${fmt(body.elapsed_s, 1)} s)`;
 }
 
-// The number in a box of the panel, null when it is empty (``empty``: allowed); else the box is
-// marked and its refusal said in the panel's status: nothing is sent with a value the user did
-// not type (a number box holds "" for any text that is not a number).
-function boxNumber(id, label, empty) {
-  const box = $(id);
-  const text = box.value.trim();
-  const ok = !box.validity.badInput && (text !== "" || empty);
-  if (ok) { box.removeAttribute("aria-invalid"); return text === "" ? null : Number(text); }
-  box.setAttribute("aria-invalid", "true");
-  throw new Error(`${label}: ${box.validity.badInput ? "what is typed is not a number" : "give a number"}; nothing was sent`);
+// The request of the panel's boxes, or null when a box does not hold what it should: each such
+// box is marked as a refused control is (controls.js), quoting the text, and the status says
+// which; nothing is sent with a value the user did not type. An empty starts box is refused (not
+// taken as the server's 256); an empty cycles or scales box is the controls' cycles, the path
+// as it is.
+function request() {
+  const body = {};
+  const refused = [];
+  for (const name of ["starts", "cycles"]) {
+    const typed = $(`#atlas-${name}`).value.trim();
+    const n = parseNumber(typed);
+    if (n !== null) body[name] = n;
+    else if (typed) refused.push([name, `“${typed}” is not a number`]);
+    else if (name === "starts") refused.push([name, "give the number of starts"]);
+  }
+  const scales = $("#atlas-scales").value.split(/[,;\s]+/).filter(Boolean);
+  const bad = scales.find((s) => parseNumber(s) === null);
+  if (bad !== undefined) refused.push(["scales", `“${bad}” is not a number`]);
+  else if (scales.length) body.scales = scales.map(Number);
+  for (const [name, why] of refused) refuse(name, `${why}; nothing was sent`);
+  if (!refused.length) return body;
+  say(`not sent: ${refused.map(([name, why]) => `${name}: ${why}`).join("; ")}`, true);
+  return null;
+}
+
+// A box of the panel (``name``: starts, cycles, scales) refused, here or by the server.
+function refuse(name, text) {
+  const row = $(`#atlas-${name}`).closest("label");
+  fieldNote(row, text);
+  markInvalid(row, true);
+}
+
+function clearRefusals() {
+  for (const note of document.querySelectorAll(".atlas-bar .field-error")) {
+    markInvalid(note.parentElement, false);
+    note.remove();
+  }
+}
+
+// The server's refusal of the request: beside the boxes it is about (its fields, by their
+// location in the body), with what was typed there.
+const BOXES = ["starts", "cycles", "scales"];
+function refusedBoxes(body) {
+  for (const d of Array.isArray(body.detail) ? body.detail : []) {
+    const name = d.loc?.[0] === "body" ? d.loc[1] : null;
+    const box = BOXES.includes(name) && $(`#atlas-${name}`);
+    if (box) refuse(name, `“${box.value.trim()}” was refused: ${d.msg}`);
+  }
 }
 
 async function start(state) {
-  const scales = $("#atlas-scales").value.trim();
-  let body;
-  try {
-    body = { starts: boxNumber("#atlas-starts", "starts", false), cycles: boxNumber("#atlas-cycles", "cycles", true) };
-  } catch (err) {
-    say(err.message, true);
-    return;
-  }
-  if (scales) body.scales = scales.split(/[,;\s]+/).filter(Boolean).map(Number);
+  clearRefusals();
+  const body = request();
+  if (!body) return;
   const token = ++atlas.token;
   say("starting the atlas…");
   showProgress({ status: "running", progress: 0, runs_done: 0, runs: body.starts || 0, elapsed_s: 0 });
@@ -71,7 +104,10 @@ async function start(state) {
     });
     const job = await res.json();
     if (token !== atlas.token) return;
-    if (!res.ok) throw new Error(`the atlas was refused: ${detail(job)}`);
+    if (!res.ok) {
+      refusedBoxes(job);
+      throw new Error(`the atlas was refused: ${detail(job)}`);
+    }
     atlas.job = job.id;
     await follow(job.id, token, atlasKey(state()));
   } catch (err) {
@@ -192,8 +228,10 @@ export function atlasPanel(state, send) {
   atlas.send = send;
   atlas.state = state;
   const field = (label, input, help) => el("label", { title: help }, el("span", {}, label), input);
-  const starts = el("input", { type: "number", id: "atlas-starts", min: 2, max: 4096, step: 1, value: 256 });
-  const cycles = el("input", { type: "number", id: "atlas-cycles", min: 1, max: 50, step: 1, placeholder: "as above" });
+  // (text boxes, as the controls' exact values: a refusal quotes what was typed, which a number
+  // box does not keep when it is not a number)
+  const starts = el("input", { type: "text", inputMode: "numeric", id: "atlas-starts", value: "256" });
+  const cycles = el("input", { type: "text", inputMode: "numeric", id: "atlas-cycles", placeholder: "as above" });
   const scales = el("input", { type: "text", id: "atlas-scales", placeholder: "1 (e.g. 0.5, 1, 1.5)" });
   const compute = el("button", { type: "button", id: "atlas-compute", onclick: () => start(state) }, "Compute atlas");
   const stop = el("button", { type: "button", id: "atlas-cancel", onclick: cancel, title: "stop this atlas" }, "Cancel");

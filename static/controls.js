@@ -1,7 +1,7 @@
 // The page's controls, built from the session's control specification (app/dashboard/controls.py, sent
 // with every state): the same controls, labels, ranges and values as the 3D scene's panel. A
 // control's change is sent by its key ({"x0.1": 0.4}); the server turns it into a state change.
-import { el, fmt } from "./dom.js";
+import { el, fieldNote, fmt, markInvalid } from "./dom.js";
 
 let shape = null; // JSON of the controls on screen: rebuilt only when it changes
 const inputs = new Map(); // control key -> element with setValue()
@@ -54,21 +54,16 @@ const keysOf = (note) => note.dataset.controls.split(" ");
 function fieldError(keys, typed, message) {
   const row = rows.get(keys[0]);
   if (!row) return null;
-  let note = row.querySelector(":scope > .field-error");
-  if (note) invalid(keysOf(note), false);
-  else { note = el("span", { className: "field-error", role: "alert" }); row.append(note); }
-  note.textContent = typed === undefined ? message : `“${typed}” ${message}`;
+  const was = row.querySelector(":scope > .field-error");
+  if (was) invalid(keysOf(was), false);
+  const note = fieldNote(row, typed === undefined ? message : `“${typed}” ${message}`);
   note.dataset.controls = keys.join(" ");
   invalid(keys, true);
   return note;
 }
 
 function invalid(keys, on) {
-  for (const key of keys) {
-    for (const input of rows.get(key)?.querySelectorAll("input, textarea, select, button") || []) {
-      if (on) input.setAttribute("aria-invalid", "true"); else input.removeAttribute("aria-invalid");
-    }
-  }
+  for (const key of keys) if (rows.has(key)) markInvalid(rows.get(key), on);
 }
 
 function clear(note) {
@@ -180,7 +175,7 @@ function vector(c, value, send) {
     const box = el("input", { type: "text", inputMode: "decimal", id: `${c.id}-${i}`, className: "coordinate", value: short(v) });
     box.setAttribute("aria-label", `${c.label}, coordinate ${i + 1}`);
     box.addEventListener("change", () => {
-      const values = boxes.map((b, k) => (b.value === short(exact[k]) ? exact[k] : parseNumber(b.value)));
+      const values = boxes.map((b, k) => (b.value.trim() === short(exact[k]) ? exact[k] : parseNumber(b.value)));
       const bad = boxes.find((b, k) => values[k] === null);
       if (bad) { notANumber(c, bad.value); return; }
       send(values, boxes.map((b) => b.value.trim()).join(", "));

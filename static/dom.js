@@ -12,6 +12,23 @@ export const el = (tag, attrs = {}, ...children) => {
   return e;
 };
 
+// A value refused at a field of the page (``row``: the label holding its inputs): a note at the
+// end of the label says why (read out as it appears: role alert), made or reused, and
+// markInvalid marks the field's inputs (aria-invalid) while the note stays. The page's controls
+// (controls.js) and the atlas panel's boxes (atlas.js) show their refusals this way.
+export function fieldNote(row, text) {
+  let note = row.querySelector(":scope > .field-error");
+  if (!note) { note = el("span", { className: "field-error", role: "alert" }); row.append(note); }
+  note.textContent = text;
+  return note;
+}
+
+export function markInvalid(row, on) {
+  for (const input of row.querySelectorAll("input, textarea, select, button")) {
+    if (on) input.setAttribute("aria-invalid", "true"); else input.removeAttribute("aria-invalid");
+  }
+}
+
 // A number as shown beside a control or in the verdict: 3 decimals, exponent when tiny or huge.
 export const fmt = (v, d = 3) =>
   (Math.abs(v) >= 1e4 || (Math.abs(v) < 1e-3 && v !== 0) ? v.toExponential(2) : (+v).toFixed(d));

@@ -135,26 +135,50 @@ def test_an_atlas_the_state_cannot_have_is_refused_in_words_in_the_panel(tabs):
 
 
 def test_an_empty_or_unreadable_count_is_refused_not_taken_as_the_default(tabs):
-    """The starts box emptied, or text in the cycles box that is not a number (a number box
-    then holds ""): the panel says which box and sends nothing, instead of an atlas of 256
-    starts or of the controls' cycles the user did not ask for."""
+    """The starts box emptied, or text in the cycles box that is not a number: the box is
+    marked as a refused control is (its note beside it, quoting the text; aria-invalid), the
+    panel's status names it, and nothing is sent, instead of an atlas of 256 starts or of the
+    controls' cycles the user did not ask for. A count the server refuses is marked at its box
+    too."""
+    tabs.allow_console(r"status of 422")
     tab = tabs.open()
     page = tab.page
     requests = []
     page.on("request", lambda r: r.method == "POST" and "/atlas" in r.url and requests.append(r))
-    status, starts = page.locator("#atlas-status"), page.locator("#atlas-starts")
+    status = page.locator("#atlas-status")
+    starts, cycles = page.locator("#atlas-starts"), page.locator("#atlas-cycles")
+    note = {
+        box: page.locator("#atlas label", has=page.locator(box)).locator(".field-error")
+        for box in ("#atlas-starts", "#atlas-cycles")
+    }
     starts.fill("")
     page.click("#atlas-compute")
-    expect(status).to_have_text("starts: give a number; nothing was sent")
+    expect(status).to_have_text("not sent: starts: give the number of starts")
     expect(status).to_have_class(re.compile("error"))
+    expect(note["#atlas-starts"]).to_have_text("give the number of starts; nothing was sent")
     expect(starts).to_have_attribute("aria-invalid", "true")
     starts.fill("8")
-    page.locator("#atlas-cycles").press_sequentially("2e")  # (no exponent: not a number)
+    cycles.fill("2e")
     page.click("#atlas-compute")
-    expect(status).to_have_text("cycles: what is typed is not a number; nothing was sent")
+    expect(status).to_have_text("not sent: cycles: “2e” is not a number")
+    expect(note["#atlas-cycles"]).to_have_text("“2e” is not a number; nothing was sent")
+    expect(cycles).to_have_attribute("aria-invalid", "true")
+    expect(note["#atlas-starts"]).to_have_count(0)
     expect(starts).not_to_have_attribute("aria-invalid", "true")
     expect(page.locator("#atlas-progress-box")).to_be_hidden()
     assert requests == []
+
+    cycles.fill("")
+    starts.fill("1")
+    with page.expect_response(lambda r: r.request.method == "POST" and "/atlas" in r.url) as sent:
+        page.click("#atlas-compute")
+    assert sent.value.status == 422
+    expect(note["#atlas-starts"]).to_have_text(
+        "“1” was refused: starts: Input should be greater than or equal to 2"
+    )
+    expect(starts).to_have_attribute("aria-invalid", "true")
+    expect(note["#atlas-cycles"]).to_have_count(0)
+    expect(status).to_contain_text("the atlas was refused: starts:")
 
 
 # (CI's slow step: among the longest browser checks; the default run stays under 8 minutes)
