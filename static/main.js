@@ -9,14 +9,18 @@ import { algorithmKey, applyFunctionals, drawFigures, layoutPanels, markStale, o
 import { atlasPanel, atlasState } from "./atlas.js";
 import { afterSecond, cancelSecond, clearCancelled, secondWanted } from "./second.js";
 
-// second: the generation whose second phase runs (its progress came, its functionals not yet).
-const page = { config: null, state: null, shown: 0, shownState: null, editor: null, second: null };
+// second: the generation whose second phase runs (its progress came, its functionals not yet);
+// stopped: the runs of the result on screen, where they stopped (controls.js's showStopped).
+const page = { config: null, state: null, shown: 0, shownState: null, editor: null, second: null, stopped: {} };
 const send = (patch) => { setNotice(""); change(patch, (message) => setStatus(message, true), accepted); };
 
 // A change accepted without a new generation (the values in force typed back after a refusal):
-// the result on screen is the state's, and the header says so instead of the old refusal.
+// the result on screen is the state's, and the header and the controls say so instead of the
+// old refusal (the send took every note away: the marks of the result's stopped runs are back).
 function accepted(body) {
-  if (body.generation === page.shown && session.generation === page.shown) setStatus(`up to date (generation ${page.shown})`);
+  if (body.generation !== page.shown || session.generation !== page.shown) return;
+  setStatus(`up to date (generation ${page.shown})`);
+  showStopped(page.stopped);
 }
 
 function setStatus(text, error = false) {
@@ -92,7 +96,8 @@ async function onResult(msg) {
   document.body.dataset.robot = msg.state.robot;
   showProgress(1, 0);
   renderVerdict(msg);
-  showStopped(msg.generation === session.generation ? msg.summary : {}); // (not the controls' state: none)
+  page.stopped = msg.generation === session.generation ? msg.summary : {}; // (not the controls' state: none)
+  showStopped(page.stopped);
   $("#panels").classList.remove("outdated");
   delete document.body.dataset.failed;
   exportLinks(msg.generation);

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import re
 import urllib.request
+from urllib.parse import quote
 
 import numpy as np
 import pytest
@@ -177,8 +178,6 @@ def test_a_singular_start_is_marked_at_the_starts_controls(tabs):
     at their first leg, and the start's controls are marked as a refused value's are (the
     engine's message beside them, each coordinate invalid), in the page and in the 3D scene; a
     coordinate moved off the singular set takes every mark away."""
-    from urllib.parse import quote
-
     chain = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 1.0, 1.0]}
     state = {"robot": "planar_chain", "robot_definition": chain, "x0": [0.0, 0.0, 0.0]}
     state |= {"task": "target", "target": [2.0, 1.0]}
@@ -238,11 +237,9 @@ def test_a_pose_path_shows_whole_a_point_per_line(tabs):
     assert grown is not None and grown["height"] > height
 
 
-def test_one_coordinate_edited_leaves_the_others_exact_and_a_value_typed_back_clears(tabs):
+def test_one_coordinate_edited_leaves_the_others_exact(tabs):
     """A target of many decimals, shown to 4: editing its second coordinate sends the first as
-    it is, not as shown. A refused gamma, then the value in force typed back: the header says
-    the result is up to date instead of keeping the refusal (no new generation comes)."""
-    tabs.allow_console(r"status of 422")
+    it is, not as shown."""
     tab = tabs.open()
     page = tab.page
     tab.select("#ctl-task", "target")
@@ -260,14 +257,35 @@ def test_one_coordinate_edited_leaves_the_others_exact_and_a_value_typed_back_cl
     tab.change(lambda: second.press("Enter"))
     assert tab.snapshot()["state"]["target"] == [exact, 1.5]
 
+
+def test_a_value_in_force_typed_back_after_a_refusal_says_the_result_is_current(tabs):
+    """A start where the runs stop (the 3R arm stretched out), its controls marked; a refused
+    gamma, then the value in force typed back, which the server accepts without a new
+    generation: the header says the result on screen is up to date instead of keeping the
+    refusal, gamma's note is gone, and the start's marks of the stopped runs are back."""
+    tabs.allow_console(r"status of 422")
+    chain = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 1.0, 1.0]}
+    state = {"robot": "planar_chain", "robot_definition": chain, "x0": [0.0, 0.0, 0.0]}
+    state |= {"task": "target", "target": [2.0, 1.0]}
+    tab = tabs.open("/?state=" + quote(json.dumps(state)))
+    page = tab.page
+    start = page.locator("label", has=page.locator("#ctl-x0-0-value")).locator(".field-error")
+    expect(start).to_contain_text("J J^T is singular")
+
     status = page.locator("#status-text")
     box = page.locator("#ctl-gamma-value")
+    gamma = page.locator("label", has=box).locator(".field-error")
     in_force = box.input_value()
     box.fill("-1")
     assert tab.posting(lambda: box.press("Enter")).status == 422
     expect(status).to_contain_text("refused (here): gamma")
+    expect(gamma).to_contain_text("“-1” was refused")
     generation = tab.snapshot()["generation"]
     box.fill(str(float(in_force)))  # (the value in force, as typed: "1.0" where "1.000" shows)
     assert tab.posting(lambda: box.press("Enter")).json()["generation"] == generation
     expect(status).to_have_text(f"up to date (generation {generation})")
-    expect(page.locator("#controls .field-error")).to_have_count(0)
+    expect(status).not_to_have_class(re.compile(r"\berror\b"))
+    expect(gamma).to_have_count(0)
+    expect(box).not_to_have_attribute("aria-invalid", "true")
+    expect(start).to_contain_text("J J^T is singular")
+    expect(page.locator("#ctl-x0-2-value")).to_have_attribute("aria-invalid", "true")
