@@ -135,12 +135,15 @@ class PoseTask:
             return
         at = tuple(far[0])
         where = f" point {', '.join(map(str, at))}" if length.size > 1 else ""
-        same = ", ".join(f"{v + 0.0:.3g}" for v in r[at] * (1.0 - 2.0 * np.pi / length[at]))
         coords = ", ".join(n for n in self.names if len(n) == 2)
+        same = ""
+        if len(rows) == 3:  # (the principal rotation vector of that rotation, whatever its turns)
+            same = ", ".join(f"{v + 0.0:.3g}" for v in so3.log(so3.exp(r[at])))
+            same = f"; the same orientation is ({same})"
         raise InvalidInputError(
             f"{name}{where} is out of reach: its rotation coordinates ({coords}) have length "
             f"{length[at]:.6g} > pi, and the rotation coordinates (the principal log of R0^T R) "
-            "never exceed pi" + (f"; the same orientation is ({same})" if len(rows) == 3 else ""),
+            f"never exceed pi{same}",
             field_for(name, field),
         )
 

@@ -112,6 +112,9 @@ def test_a_rotation_vector_longer_than_a_half_turn_is_refused():
     with pytest.raises(e.InvalidInputError, match=r"^path point 1 is out of reach") as err:
         e.repeatability(panda.inverse(), home, [target - [0, 0, 0, 0.1, 0, 0.1], target])
     assert err.value.field == "path"
+    turns = panda.kinematics.forward(home) + [0, 0, 0, 0, 0, 10.0]  # (1.59 turns about z)
+    with pytest.raises(e.InvalidInputError, match=r"the same orientation is \(0, 0, -2\.57\)$"):
+        panda.kinematics.check_target(turns, "target")
     ok = e.solve(panda.inverse(), home, target - [0, 0, 0, 0.1, 0, 0.1], max_iterations=50)
     assert np.linalg.norm(ok.y_d[3:]) < np.pi
     assert reach_note(panda.kinematics, target) == (None, "")
