@@ -417,13 +417,17 @@ class Tabs:
         page.on("websocket", lambda ws: self._request(ws.url))
         return page
 
-    def open(self, url: str = "/", **options) -> Tab:
+    def open(self, url: str = "/", *, playing: bool = False, **options) -> Tab:
         """The dashboard at ``url`` (a path or a whole link) in a new context, its first
-        generation drawn."""
+        generation drawn; its scene's playback paused unless ``playing`` (the tests of the
+        animation): a scene animating in software WebGL takes most of two cores, which the
+        page and the server under test then lack."""
         page = self.new_page(self.context(**options))
         page.goto(url if "://" in url else self.base + url)
         tab = Tab(page, self.base)
         tab.wait_drawn(1)
+        if not playing:
+            tab.pause_scene()
         return tab
 
     def _request(self, url: str) -> None:

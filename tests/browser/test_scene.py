@@ -12,7 +12,7 @@ pytestmark = pytest.mark.browser
 def test_the_animation_plays_on_while_the_page_is_edited(tabs):
     """With the pointer and the focus on the page's controls, and a slider changed there, the
     scene's position slider keeps advancing: nothing holds the animation."""
-    tab = tabs.open()
+    tab = tabs.open(playing=True)
     assert tab.wait_scene_drawn(1)["playing"] is True
     tab.scene_control("position", unlike=tab.scene_control("position")["value"])
 
@@ -29,7 +29,7 @@ def test_the_animation_plays_on_while_the_page_is_edited(tabs):
 def test_pause_and_play_in_the_scene(tabs):
     """The scene's Pause button stops the animation (the session's scene says it is not
     playing), Play starts it again (the position slider advances)."""
-    tab = tabs.open()
+    tab = tabs.open(playing=True)
     assert tab.wait_scene_drawn(1)["playing"] is True
     scene = tab.page.frame_locator("#scene")
     tab.pause_scene()
@@ -45,7 +45,7 @@ def test_pause_and_play_in_the_scene(tabs):
 def test_the_scene_offers_no_share_link(tabs):
     """viser's own share button (a public link to the viser instance, next to the page's "copy
     link") is not in the scene."""
-    tab = tabs.open()
+    tab = tabs.open(playing=True)
     tab.wait_scene_drawn(1)
     scene = tab.page.frame_locator("#scene")
     expect(scene.get_by_role("button", name="Pause")).to_be_visible()

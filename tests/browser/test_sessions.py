@@ -51,7 +51,6 @@ def test_changes_in_one_tab_leave_another_as_it_was(tabs):
     assert seen(b) == before
 
     a.wait_scene_drawn(generation)
-    a.pause_scene()  # (a still scene: quicker to find the gizmo in and to drag it)
     assert seen(b) == before
     x0 = a.snapshot()["state"]["x0"]
     a.drag_start_point()
