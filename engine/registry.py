@@ -9,7 +9,6 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
-from typing import Literal
 
 from . import augmentations as aug
 from .algorithm_registry import ALGORITHMS as ALGORITHMS
@@ -21,6 +20,7 @@ from .exceptions import InvalidInputError
 from .kinematics import Kinematics, Manipulator1, Manipulator2
 from .parameters import Parameter as Parameter
 from .parameters import check_params as _check_params
+from .solve_rules import Mode
 from .unicycle import Unicycle
 from .validation import finite
 from .variational import MANIPULATOR2_REGION, default_manipulator2_synthesis
@@ -109,7 +109,7 @@ class RobotSpec:
     #: Whether ``default_path`` is a closed task path to drive cycle after cycle (False: the
     #: targets of an experiment, the unicycle's of sec. 6.2, which a platform reaches once).
     default_path_loops: bool = True
-    default_mode: Literal["continuous", "discrete"] = "continuous"
+    default_mode: Mode = "continuous"
     default_gamma: float = 1.0
     x_range: tuple[tuple[float, float], ...] = ()
     augmentations: tuple[AugmentationSpec, ...] = ()

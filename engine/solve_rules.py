@@ -9,6 +9,7 @@ request schemas and dashboard, which word their errors with :func:`gamma_problem
 from __future__ import annotations
 
 import math
+from typing import Literal, get_args
 
 import numpy as np
 
@@ -31,7 +32,8 @@ MAX_ITERATIONS_LIMIT = 10**6
 #: Largest |x| before a run counts as diverged.
 DIVERGED_NORM = 1e8
 #: The modes of eq. (7): its ODE (continuous), or the iteration x <- x - gamma J# e (discrete).
-MODES = ("continuous", "discrete")
+Mode = Literal["continuous", "discrete"]
+MODES: tuple[Mode, ...] = get_args(Mode)
 #: The integrators of continuous mode (:func:`jik.engine.solver.solve`'s ``method``).
 METHODS = ("auto", "picard", "dop853")
 #: The decay rate gamma of eq. (5) that the engine, the API and the dashboard accept. Continuous

@@ -8,6 +8,7 @@ from ...engine.arms import ARMS
 from ...engine.registry import ALGORITHMS, ROBOTS
 from ...engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS
 from ...engine.robot_spec import Robot, robot_from_dict
+from ...engine.solve_rules import MODES
 from . import schemas as S
 
 
@@ -28,7 +29,7 @@ def robots_response(timeout: float) -> S.RobotsResponse:
             **robot.spec.as_dict(),
             **robot.units.as_dict(),
             algorithms=list(S.Algorithm.__args__),  # type: ignore[attr-defined]
-            modes=["continuous", "discrete"],
+            modes=list(MODES),
         )
         for robot in _robots()
     ]

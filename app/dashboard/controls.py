@@ -23,7 +23,7 @@ from typing import Any
 
 from ...engine.arms import ARMS
 from ...engine.registry import ROBOTS
-from ...engine.solve_rules import DISCRETE_GAMMA_BOUND, MAX_ITERATIONS, MAX_STEPS, TOL_MIN
+from ...engine.solve_rules import DISCRETE_GAMMA_BOUND, MAX_ITERATIONS, MAX_STEPS, MODES, TOL_MIN
 from .algorithms import STYLES, joint_box, posture_rest, scalar_parameters
 from .control_changes import lookup, path_format, path_text
 from .glossary import PARAMETER_LABELS, SYMBOLS
@@ -42,8 +42,6 @@ MIN_ITERATIONS, MAX_ITERATIONS_CAP = 10, 200_000
 SLIDER_STEPS, X0_STEPS = 200, 400
 #: A computation shows its progress once it has run this long [s].
 PROGRESS_AFTER = 0.5
-#: The modes of eq. (7): the ODE, or its Euler iteration with step gamma.
-MODES = ("continuous", "discrete")
 #: What the task selector offers.
 TASKS = (("path", "closed path"), ("target", "single target"))
 #: The groups (fieldsets of the page, folders of the scene), in order.

@@ -12,6 +12,7 @@ import schemas as S`` (``pyproject.toml`` lets ruff keep them unused here); the 
 from its module.
 """
 
+from ....engine.solve_rules import Mode
 from .algorithms import Algorithm
 from .fields import (
     INTEGRAL,
@@ -21,7 +22,6 @@ from .fields import (
     Coordinate,
     Gamma,
     MaybeFloat,
-    Mode,
     Tolerance,
     Vector,
 )

@@ -6,7 +6,7 @@ size bounds. The dashboard's state (:mod:`jik.app.dashboard.model`) uses the sam
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Literal, Union
+from typing import Annotated, Any, Union
 
 from pydantic import BeforeValidator, Discriminator, Field, Tag
 
@@ -38,7 +38,6 @@ INTEGRAL = BeforeValidator(_integral)
 #: A float that is null where the engine produced NaN or inf (a failed or diverged run).
 MaybeFloat = float | None
 
-Mode = Literal["continuous", "discrete"]
 #: Largest |coordinate| of a configuration or task point (radians, lengths, control amplitudes):
 #: beyond it the kinematics only overflow, and the unicycle's quadrature would need huge grids.
 COORDINATE_BOUND = 1000.0

@@ -6,8 +6,8 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, Field
 
+from ....engine.solve_rules import Mode
 from .algorithms import Algorithm
-from .fields import Mode
 
 
 class ParameterInfo(BaseModel):

@@ -12,14 +12,13 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from ....engine.registry import RobotSpec
 from ....engine.repeatability import MAX_CYCLES, MAX_PATH_POINTS, REPEATABLE_DRIFT
-from ....engine.solve_rules import DISCRETE_GAMMA_BOUND, Status
+from ....engine.solve_rules import DISCRETE_GAMMA_BOUND, Mode, Status
 from .algorithms import Algorithm, AlgorithmParameters
 from .fields import (
     INTEGRAL,
     MAX_ITERATIONS,
     Gamma,
     MaybeFloat,
-    Mode,
     Tolerance,
     Vector,
     coordinates,
