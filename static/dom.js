@@ -12,10 +12,11 @@ export const el = (tag, attrs = {}, ...children) => {
   return e;
 };
 
-// A value refused at a field of the page (``row``: the label holding its inputs): a note at the
-// end of the label says why (read out as it appears: role alert), made or reused, and
+// A value refused at a field of the page (``row``: the element holding its inputs): a note at
+// the end of the row says why (read out as it appears: role alert), made or reused, and
 // markInvalid marks the field's inputs (aria-invalid) while the note stays. The page's controls
-// (controls.js) and the atlas panel's boxes (atlas.js) show their refusals this way.
+// (controls.js), the atlas panel's boxes (atlas.js) and the robot editor's fields (editor.js)
+// show their refusals this way.
 export function fieldNote(row, text) {
   let note = row.querySelector(":scope > .field-error");
   if (!note) { note = el("span", { className: "field-error", role: "alert" }); row.append(note); }

@@ -2,7 +2,7 @@
 // Its fields come from the server's description of each kind (engine/robot_kinds.py, in the
 // page's config as robot_kinds), never written here; applying sends the definition as the
 // session's robot_definition, and a refusal is shown next to the field it names.
-import { $, el } from "./dom.js";
+import { $, el, fieldNote, markInvalid } from "./dom.js";
 
 // How a field's text becomes JSON, by the description's type. A value that does not parse is
 // sent as typed: the server says what is wrong with it, next to the field.
@@ -36,7 +36,7 @@ export function robotEditor(kinds, send) {
   const fields = el("div", { id: "robot-fields", className: "robot-fields" });
   const apply = el("button", { type: "button", id: "robot-apply", disabled: true }, "apply");
   const note = el("p", { id: "robot-note", className: "note" });
-  const inputs = new Map(); // field name -> [input, description, error note]
+  const inputs = new Map(); // field name -> [input, description, its row]
   // What the user typed, by kind (kept across a change of kind, a refusal and the session's
   // state events until a definition is applied), and whether the fields shown hold typing.
   const typed = new Map();
@@ -58,11 +58,11 @@ export function robotEditor(kinds, send) {
       if (f.type === "boolean") input = el("input", { type: "checkbox", id, checked: value === true });
       else if (MULTILINE.has(f.type)) input = el("textarea", { id, rows: f.type === "text" ? 6 : 2, value: text });
       else input = el("input", { type: "text", id, value: text });
-      const error = el("span", { className: "field-error", id: `${id}-error`, role: "alert", hidden: true });
-      inputs.set(f.name, [input, f, error]);
       const label = el("label", { title: f.help, htmlFor: id }, `${f.name}${f.required ? " *" : ""}`);
-      return el("div", { className: "robot-field", dataset: { field: f.name } }, label, input,
-        el("small", {}, f.help), error);
+      const row = el("div", { className: "robot-field", dataset: { field: f.name } }, label, input,
+        el("small", {}, f.help));
+      inputs.set(f.name, [input, f, row]);
+      return row;
     }));
   }
 
@@ -96,7 +96,7 @@ export function robotEditor(kinds, send) {
   }
 
   function clearErrors() {
-    for (const [, [input, , error]] of inputs) { error.hidden = true; error.textContent = ""; input.removeAttribute("aria-invalid"); }
+    for (const [, [, , row]] of inputs) { row.querySelector(":scope > .field-error")?.remove(); markInvalid(row, false); }
     note.textContent = "";
   }
 
@@ -142,11 +142,10 @@ export function robotEditor(kinds, send) {
       const entry = inputs.get(name);
       if (!entry) { note.textContent = `not applied: ${message}`; return true; }
       note.textContent = `not applied: see the field ${name}`;
-      entry[2].hidden = false;
       // (the message names the field under the definition: "robot_definition.lengths[1]: ...")
       const own = message.startsWith("robot_definition.");
-      entry[2].textContent = own ? message.slice("robot_definition.".length) : message;
-      entry[0].setAttribute("aria-invalid", "true");
+      fieldNote(entry[2], own ? message.slice("robot_definition.".length) : message);
+      markInvalid(entry[2], true);
       entry[0].scrollIntoView({ block: "nearest" });
       return true;
     },

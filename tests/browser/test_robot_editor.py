@@ -23,15 +23,17 @@ def test_a_planar_rrr_arm_from_the_editor(tabs):
     page.fill("#robot-field-lengths", "1, 0.8")  # one length short
     response = tab.posting(lambda: page.click("#robot-apply"))
     assert response.status == 422
-    error = page.locator("#robot-field-lengths-error")
+    error = page.locator("[data-field=lengths] .field-error")
     expect(error).to_be_visible()
     expect(error).to_contain_text("one entry per joint (3), got 2")
+    expect(page.locator("#robot-field-lengths")).to_have_attribute("aria-invalid", "true")
     expect(page.locator("#robot-note")).to_contain_text("not applied")
     tab.screenshots("robot-editor-refused")
 
     page.fill("#robot-field-lengths", "1, 0.8, 0.6")
     generation = tab.change(lambda: page.click("#robot-apply"))
     expect(error).to_be_hidden()
+    expect(page.locator("#robot-field-lengths")).not_to_have_attribute("aria-invalid", "true")
     assert tab.robot == "planar_chain"
     snapshot = tab.wait_settled(lambda s: s["state"]["robot"] == "planar_chain", "the new arm")
     state = snapshot["state"]
@@ -91,7 +93,7 @@ def test_a_refused_definition_keeps_what_was_typed(tabs):
     page.fill("#robot-field-lengths", "1, -0.8, 0.6")
     page.fill("#robot-field-title", "my arm")
     assert tab.posting(lambda: page.click("#robot-apply")).status == 422
-    expect(page.locator("#robot-field-lengths-error")).to_contain_text(
+    expect(page.locator("[data-field=lengths] .field-error")).to_contain_text(
         "lengths[1]: must be positive (a link's length), got -0.8"
     )
     expect(page.locator("#robot-field-lengths")).to_have_value("1, -0.8, 0.6")
@@ -107,10 +109,10 @@ def test_a_refused_definition_keeps_what_was_typed(tabs):
     page.fill("#robot-field-task", "a +* b\nc")
     page.fill("#robot-field-title", "by formula")
     assert tab.posting(lambda: page.click("#robot-apply")).status == 422
-    expect(page.locator("#robot-field-task-error")).to_have_text(
+    expect(page.locator("[data-field=task] .field-error")).to_have_text(
         "task[0]: expected a number, a name or '(' at position 3"
     )
-    expect(page.locator("#robot-field-task-error")).to_be_visible()
+    expect(page.locator("[data-field=task] .field-error")).to_be_visible()
     expect(page.locator("#robot-kind")).to_have_value("formula")
     expect(page.locator("#robot-field-variables")).to_have_value("a, b, c")
     expect(page.locator("#robot-field-task")).to_have_value("a +* b\nc")
@@ -122,7 +124,7 @@ def test_a_refused_definition_keeps_what_was_typed(tabs):
     page.select_option("#robot-kind", "urdf")
     page.fill("#robot-field-urdf", urdf)
     assert tab.posting(lambda: page.click("#robot-apply")).status == 422
-    expect(page.locator("#robot-field-end_link-error")).to_contain_text("is not a link")
+    expect(page.locator("[data-field=end_link] .field-error")).to_contain_text("is not a link")
     expect(page.locator("#robot-field-urdf")).to_have_value(urdf)
 
     # Back to the formula: what was typed there is still there.
@@ -158,6 +160,6 @@ def test_a_planar_4r_chain_runs_with_two_degrees_of_redundancy(tabs):
 
     page.fill("#robot-field-augmentations", '[{"name": "formula", "h": "x4"}]')
     assert tab.posting(lambda: page.click("#robot-apply")).status == 422
-    error = page.locator("#robot-field-augmentations-error")
+    error = page.locator("[data-field=augmentations] .field-error")
     expect(error).to_contain_text("must be a list of 2 formulas (p - r = 2")
     expect(page.locator("#robot-field-joints")).to_have_value("RRRR")
