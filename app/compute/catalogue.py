@@ -36,7 +36,7 @@ def robots_response(timeout: float) -> S.RobotsResponse:
     limits = S.Limits(
         max_cycles=MAX_CYCLES,
         max_path_points=MAX_PATH_POINTS,
-        max_iterations=S.MAX_ITERATIONS,
+        max_iterations=S.MAX_ITERATIONS_CAP,
         max_trajectory_points=S.MAX_TRAJECTORY_POINTS,
         request_timeout_s=float(timeout),
     )

@@ -24,6 +24,7 @@ from typing import Any
 from ...engine.arms import ARMS
 from ...engine.registry import ROBOTS
 from ...engine.solve_rules import DISCRETE_GAMMA_BOUND, MAX_ITERATIONS, MAX_STEPS, MODES, TOL_MIN
+from ..compute.schemas import MAX_ITERATIONS_CAP
 from .algorithms import STYLES, joint_box, posture_rest, scalar_parameters
 from .control_changes import lookup, path_format, path_text
 from .glossary import PARAMETER_LABELS, SYMBOLS
@@ -36,8 +37,9 @@ GAMMA_STEP = 0.001
 GAMMA_RANGE = {"continuous": (0.01, 10.0), "discrete": (0.01, DISCRETE_GAMMA_BOUND - 0.01)}
 #: Largest number of cycles offered by the dashboard (the engine accepts more).
 MAX_DASHBOARD_CYCLES = 20
-#: The range of the cap on iterations (or integrator steps) per leg.
-MIN_ITERATIONS, MAX_ITERATIONS_CAP = 10, 200_000
+#: The lower end of the cap's slider (the state takes any cap from 1, as a request does): a
+#: digit typed on the way to "500" in the scene's box is then no run of its own.
+SLIDER_MIN_ITERATIONS = 10
 #: Positions of a slider between its ends (x0's: finer).
 SLIDER_STEPS, X0_STEPS = 200, 400
 #: A computation shows its progress once it has run this long [s].
@@ -280,7 +282,7 @@ def iterations_control(state) -> Control:
         "slider",
         f"a leg that has not reached its target after this many {what} stops and "
         "says so (raise it for far targets or small γ; the work grows with it)",
-        minimum=MIN_ITERATIONS,
+        minimum=SLIDER_MIN_ITERATIONS,
         maximum=MAX_ITERATIONS_CAP,
         step=1,
         log=True,

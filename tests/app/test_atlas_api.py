@@ -18,6 +18,7 @@ from jik.app.compute.atlas_pool import PoolBackend
 from jik.app.compute.atlas_schemas import AtlasRequest
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.pool import pool_in_thread
+from jik.app.compute.schemas import MAX_ITERATIONS_CAP
 from jik.app.compute.settings import Settings
 from jik.app.dashboard.sessions import SessionStore
 from jik.engine.atlas_run import run_atlas
@@ -437,6 +438,19 @@ def test_an_atlas_takes_the_cap_on_steps_as_a_solve_does(client):
     failures = done["result"]["failures"]["pseudoinverse"]
     assert len(failures) == 6
     assert all("did not converge within 3 iterations" in why for why in failures.values())
-    assert messages(client.post("/atlas", json=body(max_iterations=10**6)))[0].startswith(
-        "max_iterations: Input should be less than or equal to"
+    too_many = body(max_iterations=MAX_ITERATIONS_CAP + 1)
+    assert messages(client.post("/atlas", json=too_many))[0].startswith(
+        f"max_iterations: Input should be less than or equal to {MAX_ITERATIONS_CAP}"
     )
+
+
+def test_a_session_with_the_pages_largest_cap_gets_its_atlas(client):
+    """The page's cap on steps goes up to the bound a request takes: a session whose state
+    asks for the largest gets its atlas, as a /solve gets its run."""
+    sid = _session(client, max_iterations=MAX_ITERATIONS_CAP)
+    r = client.post(f"/api/sessions/{sid}/atlas", json={"starts": 2})
+    assert r.status_code == 202, r.text
+    done = wait_until_ended(client, r.json()["id"])
+    assert done["status"] == "done", done["error"]
+    shown = client.get(f"/api/sessions/{sid}/atlas/{done['id']}").json()
+    assert shown["request"]["max_iterations"] == MAX_ITERATIONS_CAP

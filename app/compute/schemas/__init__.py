@@ -17,10 +17,11 @@ from .algorithms import Algorithm
 from .fields import (
     INTEGRAL,
     MAX_DIMENSION,
-    MAX_ITERATIONS,
+    MAX_ITERATIONS_CAP,
     MAX_TRAJECTORY_POINTS,
     Coordinate,
     Gamma,
+    IterationCap,
     MaybeFloat,
     Tolerance,
     Vector,

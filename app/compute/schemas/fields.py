@@ -15,8 +15,10 @@ from ....engine.validation import MAX_REGION_BOUND
 
 #: Largest configuration / task dimension accepted before the registry check.
 MAX_DIMENSION = 16
-#: Largest step / iteration cap a request may ask for.
-MAX_ITERATIONS = 20000
+#: Largest cap on a leg's integrator steps or iterations that a request, the dashboard's state
+#: and its page may ask for (a far target at a small gamma needs many; a run's time limit stops
+#: it sooner).
+MAX_ITERATIONS_CAP = 200_000
 #: Trajectories longer than this are downsampled (first and last points kept).
 MAX_TRAJECTORY_POINTS = 2000
 
@@ -33,6 +35,9 @@ def _integral(value: Any) -> Any:
 #: string. Written ``Annotated[int, Field(strict=True, ...), INTEGRAL]`` (after the Field, or
 #: the schema loses its bounds); ``tests/app/test_integers.py`` holds every route to it.
 INTEGRAL = BeforeValidator(_integral)
+
+#: A cap on a leg's integrator steps (continuous) or iterations (discrete).
+IterationCap = Annotated[int, Field(strict=True, ge=1, le=MAX_ITERATIONS_CAP), INTEGRAL]
 
 
 #: A float that is null where the engine produced NaN or inf (a failed or diverged run).

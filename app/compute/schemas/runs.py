@@ -16,8 +16,8 @@ from ....engine.solve_rules import DISCRETE_GAMMA_BOUND, Mode, Status
 from .algorithms import Algorithm, AlgorithmParameters
 from .fields import (
     INTEGRAL,
-    MAX_ITERATIONS,
     Gamma,
+    IterationCap,
     MaybeFloat,
     Tolerance,
     Vector,
@@ -53,12 +53,10 @@ class RunSettings(BaseModel):
         None, description="'continuous' (ODE) or 'discrete' (iterations); default: the robot's"
     )
     tolerance: Tolerance = Field(1e-10, description="stop when ||k(x) - target|| < tolerance")
-    max_iterations: Annotated[int, Field(strict=True, ge=1, le=MAX_ITERATIONS), INTEGRAL] | None = (
-        Field(
-            None,
-            description="cap on integrator steps (continuous) or iterations (discrete) per solve "
-            "(per leg of a path); default: the engine's for the mode",
-        )
+    max_iterations: IterationCap | None = Field(
+        None,
+        description="cap on integrator steps (continuous) or iterations (discrete) per solve "
+        "(per leg of a path); default: the engine's for the mode",
     )
 
 
