@@ -11,11 +11,12 @@ job does not belong to a connection: it runs on when its client goes away, and i
 ``keep_for`` seconds after it ends (or when cancelled).
 
 Limits: at most ``max_running`` atlases compute at once (the others wait, queued), at most
-``max_jobs`` are kept in all and ``per_client`` queued or running for one client, and one job's
+``max_jobs`` are kept in all and ``per_client`` queued or running for one client, one job's
 work (legs: runs x cycles x legs x algorithms) is at most ``max_work``, ``max_leg_ends`` with the
-leg ends in the result. A done job keeps its result document and the engine's atlas it was made
-from (its table's source, :meth:`~jik.engine.atlas_run.AtlasResult.csv_text`): drift and success
-of at most ``max_work`` runs x cycles x algorithms, the starts, and the leg ends only when asked.
+leg ends in the result, and it computes for at most ``max_seconds`` (then it fails and says
+so). A done job keeps its result document and the engine's atlas it was made from (its table's
+source, :meth:`~jik.engine.atlas_run.AtlasResult.csv_text`): drift and success of at most
+``max_work`` runs x cycles x algorithms, the starts, and the leg ends only when asked.
 """
 
 from __future__ import annotations
@@ -242,6 +243,8 @@ class AtlasJobs:
         try:
             job.status = "running"
             job.started = time.monotonic()
+            deadline = job.started + self.limits.max_seconds
+            stop = lambda: job.cancel.is_set() or time.monotonic() > deadline  # noqa: E731
 
             def progress(done: float, _total: float) -> None:
                 job.runs_done = int(done)
@@ -250,7 +253,7 @@ class AtlasJobs:
             res = run_atlas(
                 job.plan,
                 backend,
-                progress=ProgressCallbacks(on_advance=progress, is_cancelled=job.cancel.is_set),
+                progress=ProgressCallbacks(on_advance=progress, is_cancelled=stop),
                 keep_leg_ends=job.request.leg_ends,
             )
             curve = job.plan.manifolds[0] if job.plan.manifolds else None  # (explicit starts)
@@ -258,7 +261,16 @@ class AtlasJobs:
             job.atlas, job.result = res, result_document(res, arc, job.request.leg_ends, period)
             self._end(job, "done")
         except RunCancelled:
-            self._end(job, "cancelled")
+            if job.cancel.is_set():
+                self._end(job, "cancelled")
+            else:
+                job.error = (
+                    f"starts: the atlas reached the server's time limit of "
+                    f"{self.limits.max_seconds:g} s after {job.runs_done} of {job.plan.size} "
+                    "runs; ask for fewer starts or cycles or a lower max_iterations (or run "
+                    "`jik atlas` for larger atlases)"
+                )
+                self._end(job, "failed")
         except Exception as error:  # (a job's failure is its result, read by GET)
             job.error = f"{type(error).__name__}: {error}"
             self._end(job, "failed")

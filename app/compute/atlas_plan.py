@@ -42,6 +42,9 @@ class AtlasLimits:
     max_leg_ends: int = 200_000
     #: seconds a job is kept after it ends
     keep_for: float = 600.0
+    #: seconds a job may compute (then it fails, naming ``starts``: its legs may each run up to
+    #: ``max_iterations`` steps, which ``max_work`` does not count)
+    max_seconds: float = 600.0
 
 
 def planned(req: AtlasRequest, limits: AtlasLimits) -> tuple[AtlasPlan, Used]:

@@ -120,6 +120,27 @@ def test_delete_cancels_a_running_job_and_forgets_it(client):
     assert again.status_code == 202, again.text
 
 
+def test_a_job_past_its_time_limit_fails_and_says_so(app, client):
+    """An atlas computes for at most the limits' max_seconds (its legs may each take up to
+    max_iterations steps, which the bound on legs does not count): then it fails, naming
+    starts and the runs done, and the client's slot is free again."""
+    app.state.atlas_jobs = AtlasJobs(AtlasLimits(per_client=1, max_seconds=0.5))
+    try:
+        job = client.post("/atlas", json=LONG).json()
+        done = wait_until_ended(client, job["id"])
+        assert done["status"] == "failed" and done["result"] is None
+        assert re.fullmatch(
+            r"starts: the atlas reached the server's time limit of 0\.5 s after \d+ of 20000 "
+            r"runs; ask for fewer starts or cycles or a lower max_iterations \(or run `jik "
+            r"atlas` for larger atlases\)",
+            done["error"],
+        ), done["error"]
+        assert done["runs_done"] < 20000
+        assert client.post("/atlas", json=body()).status_code == 202
+    finally:
+        app.state.atlas_jobs.close()
+
+
 def test_one_client_may_run_one_job_at_a_time_here(client):
     first = client.post("/atlas", json=LONG).json()
     r = client.post("/atlas", json=body())
