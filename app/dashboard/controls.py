@@ -37,9 +37,10 @@ GAMMA_STEP = 0.001
 GAMMA_RANGE = {"continuous": (0.01, 10.0), "discrete": (0.01, DISCRETE_GAMMA_BOUND - 0.01)}
 #: Largest number of cycles offered by the dashboard (the engine accepts more).
 MAX_DASHBOARD_CYCLES = 20
-#: The lower end of the cap's slider (the state takes any cap from 1, as a request does): a
-#: digit typed on the way to "500" in the scene's box is then no run of its own.
-SLIDER_MIN_ITERATIONS = 10
+#: The least cap on a leg's steps that the page offers and the state takes (a request takes 1):
+#: a digit typed on the way to "500" in the scene's box is then no run of its own, and the
+#: scene's slider, which cannot show a value below its range, shows every state's.
+MIN_ITERATIONS = 10
 #: Positions of a slider between its ends (x0's: finer).
 SLIDER_STEPS, X0_STEPS = 200, 400
 #: A computation shows its progress once it has run this long [s].
@@ -282,7 +283,7 @@ def iterations_control(state) -> Control:
         "slider",
         f"a leg that has not reached its target after this many {what} stops and "
         "says so (raise it for far targets or small γ; the work grows with it)",
-        minimum=SLIDER_MIN_ITERATIONS,
+        minimum=MIN_ITERATIONS,
         maximum=MAX_ITERATIONS_CAP,
         step=1,
         log=True,

@@ -23,10 +23,10 @@ from ..compute.schemas import (
     AUGMENTATION_MODELS,
     INTEGRAL,
     MAX_DIMENSION,
+    MAX_ITERATIONS_CAP,
     ROBOT_MODELS,
     Coordinate,
     Gamma,
-    IterationCap,
     Mode,
     Tolerance,
 )
@@ -44,6 +44,7 @@ from .algorithms import cache_key as cache_key  # (re-exported: the figures' cac
 from .control_changes import expand
 from .controls import (
     MAX_DASHBOARD_CYCLES,
+    MIN_ITERATIONS,
     max_iterations,
 )
 from .robots import USER_KINDS, default_definition, state_inverse, state_spec, user_robot
@@ -90,7 +91,10 @@ class DashboardState(BaseModel):
     cspace_axes: Literal["012", "013", "023", "123"] | None = None
     #: Cap on each leg's iterations (discrete) or integrator steps (continuous); None: the
     #: engine's default (:func:`jik.engine.solver.solve`).
-    max_iterations: IterationCap | None = None
+    max_iterations: (
+        Annotated[int, Field(strict=True, ge=MIN_ITERATIONS, le=MAX_ITERATIONS_CAP), INTEGRAL]
+        | None
+    ) = None
     #: The inverses run side by side, and the parameters of those chosen
     #: (:mod:`jik.app.dashboard.algorithms`): numbers, and the posture inverse's ``rest``.
     algorithms: Annotated[tuple[Algorithm, ...], Field(min_length=1, max_length=len(CHOICES))] = (

@@ -20,6 +20,7 @@ from jik.app.compute.exceptions import RequestError
 from jik.app.compute.pool import pool_in_thread
 from jik.app.compute.schemas import MAX_ITERATIONS_CAP
 from jik.app.compute.settings import Settings
+from jik.app.dashboard.controls import MIN_ITERATIONS
 from jik.app.dashboard.sessions import SessionStore
 from jik.engine.atlas_run import run_atlas
 from jik.engine.registry import robot_spec
@@ -467,7 +468,13 @@ def test_an_atlas_takes_the_cap_on_steps_as_a_solve_does(client):
 
 def test_a_session_with_the_pages_largest_cap_gets_its_atlas(client):
     """The page's cap on steps goes up to the bound a request takes: a session whose state
-    asks for the largest gets its atlas, as a /solve gets its run."""
+    asks for the largest gets its atlas, as a /solve gets its run. Its least is the page's
+    slider's (the scene's slider shows no value below its range)."""
+    low = client.post("/api/sessions", json={"state": {"max_iterations": MIN_ITERATIONS - 1}})
+    assert low.status_code == 422
+    assert messages(low)[0].startswith(
+        f"state.max_iterations: Input should be greater than or equal to {MIN_ITERATIONS}"
+    ), messages(low)
     sid = _session(client, max_iterations=MAX_ITERATIONS_CAP)
     r = client.post(f"/api/sessions/{sid}/atlas", json={"starts": 2})
     assert r.status_code == 202, r.text
