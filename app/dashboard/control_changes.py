@@ -62,8 +62,7 @@ def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
             params["rest"][int(index)] = value
         elif key == "path" and isinstance(value, str):  # (the text shown: the path in force)
             size = len(state.target) if "robot" not in patch else None
-            same = size is not None and value.split() == path_text(state.path).split()
-            out[key] = state.path if same else parse_path_text(value, size, state.path)
+            out[key] = parse_path_text(value, size, state.path)
         elif not rest:
             out[key] = value
         elif head in ("robot_parameters", "augmentation_parameters", "algorithm_parameters"):

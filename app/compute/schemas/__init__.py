@@ -21,7 +21,6 @@ from .fields import (
     MAX_TRAJECTORY_POINTS,
     Coordinate,
     Gamma,
-    IterationCap,
     MaybeFloat,
     Tolerance,
     Vector,
