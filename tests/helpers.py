@@ -1,6 +1,10 @@
-"""Shared test utilities: central finite differences, Picard sweep counts, approximate JSON."""
+"""Shared test utilities: central finite differences, Picard sweep counts, approximate JSON,
+coroutines run to the end."""
 
 from __future__ import annotations
+
+import asyncio
+import concurrent.futures
 
 import numpy as np
 import pytest
@@ -14,6 +18,19 @@ def central_difference(f, x: np.ndarray, eps: float = 1e-6) -> np.ndarray:
         d[i] = eps
         cols.append((np.asarray(f(x + d)) - np.asarray(f(x - d))) / (2 * eps))
     return np.stack(cols, axis=-1)
+
+
+def run_async(coro, new_loop=asyncio.new_event_loop):
+    """``asyncio.run(coro)`` on a loop made by ``new_loop``, in a thread of its own: in a worker
+    that ran the browser tests, Playwright's loop is running in the main thread, where
+    ``asyncio.run`` refuses to start another."""
+
+    def run():
+        with asyncio.Runner(loop_factory=new_loop) as runner:
+            return runner.run(coro)
+
+    with concurrent.futures.ThreadPoolExecutor(1) as thread:
+        return thread.submit(run).result()
 
 
 def count_picard_sweeps(monkeypatch) -> list[int]:

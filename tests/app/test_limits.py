@@ -10,6 +10,7 @@ import httpx
 from jik.app.api.factory import create_app
 from jik.app.compute.settings import Settings
 from tests.app.conftest import TABLE1_PATH, X0_M2, solve_body
+from tests.helpers import run_async
 
 HEAVY = {
     "robot": {"name": "manipulator2"},
@@ -45,7 +46,7 @@ def test_overrun_is_stopped_and_health_stays_responsive():
     replaced, and the solve queued behind it is then served. /health answers quickly meanwhile."""
     app = create_app(Settings(workers=1, timeout=1.5))
     try:
-        heavy, queued, health = asyncio.run(_overrun(app))
+        heavy, queued, health = run_async(_overrun(app))
         stats = app.state.pool.stats
     finally:
         app.state.pool.close()
@@ -79,7 +80,7 @@ def test_no_free_slot_is_busy_503():
     """Every worker busy for longer than the limit: 503 'server busy' for each request kind."""
     app = create_app(Settings(workers=1, timeout=0.5))
     try:
-        solve, rep, health = asyncio.run(_held(app))
+        solve, rep, health = run_async(_held(app))
     finally:
         app.state.pool.close()
     assert health.status_code == 200

@@ -17,6 +17,7 @@ import pytest
 from jik.app.compute.pool import ComputePool
 from jik.app.compute.settings import Settings
 from jik.app.compute.worker import frame_header, ping, repeatability_json
+from tests.helpers import run_async
 
 LOOPS = ["asyncio"] + (["uvloop"] if importlib.util.find_spec("uvloop") else [])
 
@@ -27,13 +28,8 @@ def _run(coro, loop_kind: str):
     if loop_kind == "uvloop":
         import uvloop
 
-        loop = uvloop.new_event_loop()
-    else:
-        loop = asyncio.new_event_loop()
-    try:
-        return loop.run_until_complete(coro)
-    finally:
-        loop.close()
+        return run_async(coro, uvloop.new_event_loop)
+    return run_async(coro)
 
 
 class _FakeWorker:
@@ -172,7 +168,7 @@ def test_a_cancelled_request_gives_its_worker_back_after_the_reply():
         finally:
             pool.close()
 
-    pid, pids, stats = asyncio.run(main())
+    pid, pids, stats = run_async(main())
     assert pids == [pid] and stats["exceeded"] == 0
 
 

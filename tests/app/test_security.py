@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import asyncio
 import contextlib
 import struct
 import threading
@@ -21,6 +20,7 @@ from fastapi.testclient import TestClient
 from starlette.websockets import WebSocketDisconnect
 
 from jik.app.api.factory import create_app
+from tests.helpers import run_async
 
 FOREIGN = "http://evil.example"
 
@@ -111,10 +111,10 @@ def test_a_real_server_closes_refused_scene_sockets_with_the_documented_codes(ap
     session = client.post("/api/sessions", json={"state": {}}).json()["id"]
     with _serving(app) as port:
         url = f"ws://127.0.0.1:{port}/api/sessions/{session}/scene"
-        assert asyncio.run(_close_code(url, Origin=FOREIGN)) == 4403
-        assert asyncio.run(_close_code(url, Host="attacker.example")) == 4400
+        assert run_async(_close_code(url, Origin=FOREIGN)) == 4403
+        assert run_async(_close_code(url, Host="attacker.example")) == 4400
         unknown = f"ws://127.0.0.1:{port}/api/sessions/nope/scene"
-        assert asyncio.run(_close_code(unknown)) == 4404
+        assert run_async(_close_code(unknown)) == 4404
 
 
 def _viser_messages(frame: bytes) -> list[dict]:
@@ -153,12 +153,12 @@ def test_a_scene_server_takes_only_the_relay(tmp_path):
             except websockets.exceptions.InvalidStatus as refused:
                 return refused.response.status_code
 
-        assert asyncio.run(attack(Origin=FOREIGN, Host="attacker.example")) == 403
+        assert run_async(attack(Origin=FOREIGN, Host="attacker.example")) == 403
         assert (
-            asyncio.run(attack(Origin=f"http://127.0.0.1:{session.scene.server.get_port()}")) == 403
+            run_async(attack(Origin=f"http://127.0.0.1:{session.scene.server.get_port()}")) == 403
         )
-        assert asyncio.run(attack()) == 403  # (a local program without the relay's key)
-        assert asyncio.run(attack(Authorization="Bearer guessed")) == 403
+        assert run_async(attack()) == 403  # (a local program without the relay's key)
+        assert run_async(attack(Authorization="Bearer guessed")) == 403
         page = httpx.get(f"http://127.0.0.1:{session.scene.server.get_port()}/", timeout=10)
         assert page.status_code == 403
         assert session.dashboard.state.gamma == created["state"]["gamma"]

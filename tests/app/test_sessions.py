@@ -16,6 +16,7 @@ from jik.app.dashboard.algorithms import COLORS
 from jik.app.dashboard.plotting import PANELS
 from jik.app.dashboard.sessions import SessionNotFound, SessionsFull, SessionStore
 from jik.engine.registry import ALGORITHMS
+from tests.helpers import run_async
 
 JSON = {"content-type": "application/json"}
 
@@ -248,7 +249,6 @@ def test_a_listener_that_never_reads_holds_one_event_of_each_kind(app, client):
     """The event stream of a page that stops reading buffers the newest event of each kind, not
     one per change (about 0.45 MB per change, never released)."""
     import asyncio
-    import concurrent.futures
 
     from jik.app.dashboard.messages import LatestEvents
 
@@ -266,9 +266,7 @@ def test_a_listener_that_never_reads_holds_one_event_of_each_kind(app, client):
         held = len(buffer)
         return held, [await buffer.get() for _ in range(held)]
 
-    # (in a thread of its own: the loop of a browser test may run in this one)
-    with concurrent.futures.ThreadPoolExecutor(1) as thread:
-        held, events = thread.submit(asyncio.run, changes()).result()
+    held, events = run_async(changes())
     kinds = [e.kind for e in events]
     assert held <= 7 and len(set(kinds)) == len(kinds), kinds
     result = next(e for e in events if e.kind == "result")

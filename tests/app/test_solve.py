@@ -13,6 +13,7 @@ import pytest
 from jik.app.api.factory import create_app
 from jik.app.compute.settings import Settings
 from tests.app.conftest import X0_M2, solve_body
+from tests.helpers import run_async
 
 # Table 1, pseudoinverse column, first leg: x1f after (0, 1) -> (1, 1).
 X1F = [0.1132, 0.5379, 1.0904]
@@ -111,7 +112,7 @@ def _post_concurrently(settings: Settings, bodies: list[dict]):
     """POST every body at once to a fresh app with ``settings``; its responses and pool stats."""
     app = create_app(settings)
     try:
-        return asyncio.run(_concurrent(app, bodies)), dict(app.state.pool.stats)
+        return run_async(_concurrent(app, bodies)), dict(app.state.pool.stats)
     finally:
         app.state.pool.close()
 
