@@ -69,6 +69,8 @@ class DashboardScene:
         self.camera = CameraFraming(self.server)
         add_floor_grid(self.server.scene)
         self.nodes = NodeSets(self.server.scene)
+        self.server.on_client_connect(self._count_viewers)
+        self.server.on_client_disconnect(self._count_viewers)
         self._unsubscribe = dashboard.subscribe(self._on_event, last=True)
 
     def connect(self, subprotocols: Sequence[str] | None):
@@ -109,6 +111,11 @@ class DashboardScene:
                 self.status.content = f"**{event.kind}:** {msg['message']}"
         except Exception as exc:  # never let a drawing error kill the worker thread
             self.status.content = f"**scene error:** {type(exc).__name__}: {exc}"
+
+    def _count_viewers(self, _client) -> None:
+        """The scene's status counts the browsers showing it: viser counts a client once its
+        camera reported, and until then drops its clicks and edits."""
+        self.dashboard.scene_status["viewers"] = len(self.server.get_clients())
 
     def _send(self, patch: dict) -> None:
         """A change from the GUI or the gizmo. A refused one needs nothing here: the

@@ -25,6 +25,7 @@ from jik.app.scene.pose import (
 )
 from jik.app.scene.traces import TRACE_TOLERANCE, polyline, simplify
 from jik.engine.registry import ROBOTS
+from tests.helpers import run_async
 
 
 @pytest.mark.parametrize(
@@ -396,7 +397,8 @@ def test_the_camera_frames_each_robots_reach_for_each_client():
     that fills the view: a formula robot of a few centimetres is not tiny in a corner, an arm's
     whole reach (the length of its links around its base) is in view; a client reporting a
     tall, narrow view is framed farther away than the initial camera (framed for a canvas
-    0.4 times as wide as high, INITIAL_ASPECT)."""
+    0.4 times as wide as high, INITIAL_ASPECT). The session's scene status counts the client
+    as a viewer while it is connected."""
     import asyncio
 
     import msgspec
@@ -446,11 +448,16 @@ def test_the_camera_frames_each_robots_reach_for_each_client():
                     if clients and np.allclose(clients[0].camera.look_at, 0.0, atol=1e-9):
                         seen = clients[0].camera
                         if np.linalg.norm(seen.position - (0.0, -5.0, 5.0)) > 1e-6:
+                            assert dashboard.scene_status["viewers"] == 1  # (the session's)
                             return float(np.linalg.norm(seen.position - seen.look_at))
                     assert time.monotonic() < deadline, "the client was not framed"
                     await asyncio.sleep(0.05)
 
-        narrow = asyncio.run(tall_client())
+        narrow = run_async(tall_client())
+        deadline = time.monotonic() + 30
+        while dashboard.scene_status["viewers"] != 0:  # (the client left)
+            assert time.monotonic() < deadline, "the scene still counts a viewer that left"
+            time.sleep(0.05)
         horizontal = math.atan(math.tan(0.5) / 3)  # (half the width's angle)
         assert narrow * math.sin(horizontal) == pytest.approx(1.15 * 2.4, rel=1e-6)
     finally:

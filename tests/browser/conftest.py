@@ -426,6 +426,8 @@ class Tabs:
         page.goto(url if "://" in url else self.base + url)
         tab = Tab(page, self.base)
         tab.wait_drawn(1)
+        # (viser takes a client's clicks and edits only once its camera reported)
+        tab.wait_snapshot(lambda s: s["scene"].get("viewers", 0) >= 1, "the scene's viewer")
         if not playing:
             tab.pause_scene()
         return tab
