@@ -19,7 +19,6 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 import numpy as np
-from scipy.stats import qmc
 
 from .augmentations import AugmentingMap
 from .exceptions import InvalidInputError, KinematicSingularityError
@@ -79,6 +78,8 @@ def e2_qmc(
     names = kinematics.names
     idx = np.array([names.index(n) for n in box])
     lo, hi = np.array(list(box.values()), dtype=float).T
+    from scipy.stats import qmc  # (on use: slow to import)
+
     t = 2.0 * qmc.Sobol(len(box), scramble=True, seed=seed).random(nodes) - 1.0
     base = np.array([fix.get(n, 0.0) for n in names])
     total, undefined = 0.0, 0

@@ -29,7 +29,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import linalg
-from scipy.stats import qmc
 
 from .exceptions import InvalidInputError, KinematicSingularityError
 from .exports import Columns
@@ -196,6 +195,8 @@ class _Rule:
         hi = np.array([v[1] for v in box.values()])
         self.center, self.half = 0.5 * (lo + hi), 0.5 * (hi - lo)
         self.volume = float(np.prod(hi - lo))
+        from scipy.stats import qmc  # (on use: slow to import)
+
         self.t = 2.0 * qmc.Sobol(len(box), scramble=True, seed=seed).random(nodes) - 1.0
         self.base = np.array([fix.get(n, 0.0) for n in names])
 
