@@ -44,6 +44,8 @@ ARGS = [
     "--no-default-browser-check",
 ]
 VIEWPORT = {"width": 1600, "height": 1000}
+#: The page's 3D scene (its iframe's viser client), left out by ``Tabs.open(scene=False)``.
+SCENE_FRAME = re.compile(r"^http://127\.0\.0\.1:\d+/scene/")
 #: Milliseconds a wait in a page may take: two cores and software WebGL, with other pages open.
 TIMEOUT = 60_000
 #: The window sizes of the screenshots in tests/artifacts (800 wide: a narrow window).
@@ -153,9 +155,10 @@ def config(server) -> dict:
 class Tab:
     """One dashboard page in its own browser context, hence its own session."""
 
-    def __init__(self, page, base: str) -> None:
+    def __init__(self, page, base: str, *, scene: bool = True) -> None:
         self.page = page
         self.base = base
+        self.has_scene = scene  # (whether the page loaded its 3D scene's frame)
 
     # -- the page and its session -----------------------------------------------------------
     @property
@@ -280,6 +283,7 @@ class Tab:
     @property
     def scene(self):
         """The scene's frame (for evaluate and wait_for_function)."""
+        assert self.has_scene, "this tab was opened without its scene (Tabs.open(scene=False))"
         frame = self.page.locator("#scene").element_handle().content_frame()
         assert frame is not None, "the scene's iframe has no frame"
         return frame
@@ -417,19 +421,25 @@ class Tabs:
         page.on("websocket", lambda ws: self._request(ws.url))
         return page
 
-    def open(self, url: str = "/", *, playing: bool = False, **options) -> Tab:
+    def open(self, url: str = "/", *, playing: bool = False, scene: bool = True, **options) -> Tab:
         """The dashboard at ``url`` (a path or a whole link) in a new context, its first
         generation drawn; its scene's playback paused unless ``playing`` (the tests of the
         animation): a scene animating in software WebGL takes most of two cores, which the
-        page and the server under test then lack."""
-        page = self.new_page(self.context(**options))
+        page and the server under test then lack. ``scene=False``: the page without its 3D
+        scene's frame (the tests of the page's own controls and panels; loading the frame's
+        viser client costs software WebGL about 5 s of CPU)."""
+        context = self.context(**options)
+        if not scene:
+            context.route(SCENE_FRAME, lambda route: route.abort())
+        page = self.new_page(context)
         page.goto(url if "://" in url else self.base + url)
-        tab = Tab(page, self.base)
+        tab = Tab(page, self.base, scene=scene)
         tab.wait_drawn(1)
-        # (viser takes a client's clicks and edits only once its camera reported)
-        tab.wait_snapshot(lambda s: s["scene"].get("viewers", 0) >= 1, "the scene's viewer")
-        if not playing:
-            tab.pause_scene()
+        if scene:
+            # (viser takes a client's clicks and edits only once its camera reported)
+            tab.wait_snapshot(lambda s: s["scene"].get("viewers", 0) >= 1, "the scene's viewer")
+            if not playing:
+                tab.pause_scene()
         return tab
 
     def _request(self, url: str) -> None:

@@ -19,7 +19,7 @@ THREE = ["pseudoinverse", "extended", "posture"]
 
 
 def test_three_algorithms_chosen_in_the_page(tabs, config):
-    tab = tabs.open()
+    tab = tabs.open(scene=False)
     page = tab.page
     posture = page.locator("#ctl-algorithms-posture")
     expect(posture).to_have_attribute("aria-pressed", "false")
@@ -64,7 +64,7 @@ def test_the_posture_rest_in_the_page(tabs, config):
     new posture line in the drift panel, the others' stay (cached), and the verdict names the
     rest. A second tab of the same browser has its own session: its rest is the default, and
     its change does not reach the first."""
-    tab = tabs.open()
+    tab = tabs.open(scene=False)
     page = tab.page
     expect(page.locator("#ctl-alg-rest-0")).to_have_count(0)
     tab.change(lambda: page.locator("#ctl-algorithms-posture").click())
@@ -118,7 +118,7 @@ def test_a_rest_outside_the_box_is_refused_beside_its_slider(tabs):
     """A rest coordinate typed beyond its range: the page says why beside that slider, in the
     server's words naming the field, and the state keeps its rest."""
     tabs.allow_console("422")
-    tab = tabs.open()
+    tab = tabs.open(scene=False)
     page = tab.page
     tab.change(lambda: page.locator("#ctl-algorithms-posture").click())
     response = tab.posting(
@@ -152,7 +152,7 @@ def test_the_rest_sliders_of_a_chain_with_limits(tabs):
         "x0": [1.5, 0.3, 0.3],
     }
     state = {"robot": "planar_chain", "robot_definition": chain, "algorithms": THREE}
-    tab = tabs.open("/?state=" + quote(json.dumps(state)))
+    tab = tabs.open("/?state=" + quote(json.dumps(state)), scene=False)
     page = tab.page
     rest = [page.locator(f"#ctl-alg-rest-{i}") for i in range(3)]
     spans = [(r.get_attribute("min"), r.get_attribute("max")) for r in rest]

@@ -79,7 +79,7 @@ def test_the_panda_with_a_position_task_and_four_formula_maps(tabs):
     """p - r = 4: from the robot editor, the Panda's task "xyz" with h = (x2, x3, x5, x7); a
     closed path of 3-coordinate points typed in the path box; the extended inverse comes back,
     the pseudoinverse does not, and the h panel says what it shows for p - r > 1."""
-    tab = tabs.open()
+    tab = tabs.open(scene=False)
     page = tab.page
     tab.select("#ctl-robot", "panda")
     page.click("#robot-editor-open")

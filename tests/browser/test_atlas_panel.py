@@ -123,7 +123,7 @@ def test_an_atlas_the_state_cannot_have_is_refused_in_words_in_the_panel(tabs):
     """A single target is no closed path: the panel says so where it is, and shows no
     progress."""
     tabs.allow_console("422")  # (chromium logs the refused POST)
-    tab = tabs.open()
+    tab = tabs.open(scene=False)
     tab.select("#ctl-task", "target")
     tab.page.click("#atlas-compute")
     status = tab.page.locator("#atlas-status")
@@ -141,7 +141,7 @@ def test_an_empty_or_unreadable_count_is_refused_not_taken_as_the_default(tabs):
     controls' cycles the user did not ask for. A count the server refuses is marked at its box
     too."""
     tabs.allow_console(r"status of 422")
-    tab = tabs.open()
+    tab = tabs.open(scene=False)
     page = tab.page
     requests = []
     page.on("request", lambda r: r.method == "POST" and "/atlas" in r.url and requests.append(r))
@@ -187,7 +187,7 @@ def test_an_atlas_after_a_cancel_starts_at_once(tabs):
     """Cancel an atlas while its workers compute a chunk: the next atlas starts at once (its
     job running within seconds, the panel never saying it waits for another atlas), not after
     the cancelled job's chunks in flight end."""
-    tab = tabs.open()
+    tab = tabs.open(scene=False)
     page = tab.page
     page.locator("#atlas").scroll_into_view_if_needed()
     text = page.locator("#atlas-progress-text")
@@ -216,7 +216,7 @@ def test_the_atlas_panels_csv_downloads_the_table_of_the_atlas_shown(tabs):
     """Its CSV button, off until an atlas is drawn, downloads that atlas's table: the header
     the engine's AtlasResult.columns() of the same request, a row per start, algorithm and
     cycle, the same file as the REST API's table of the job."""
-    tab = tabs.open()
+    tab = tabs.open(scene=False)
     page = tab.page
     page.locator("#atlas").scroll_into_view_if_needed()
     button = page.locator("#atlas-csv")
@@ -242,7 +242,7 @@ def test_a_click_in_a_scaled_band_keeps_the_atlas_current(tabs):
     """An atlas of two path scales (0.5, 1): a click on a cell of the 0.5 band moves the main
     view to that start with the path scaled by 0.5, a state the atlas holds, so the panel does
     not call it an atlas of an earlier state."""
-    tab = tabs.open()
+    tab = tabs.open(scene=False)
     page = tab.page
     page.fill("#atlas-scales", "0.5, 1")
     start_atlas(tab, 8, 1)

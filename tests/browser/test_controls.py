@@ -209,7 +209,7 @@ def test_a_pose_path_shows_whole_a_point_per_line(tabs):
     every point whole, a line each, nothing scrolled out of sight and within the controls; a
     point added on a new line (Shift+Enter) and sent with Enter, as a one-line box is sent,
     becomes the path's last point, and the box grows to show it."""
-    tab = tabs.open()
+    tab = tabs.open(scene=False)
     page = tab.page
     tab.select("#ctl-robot", "panda")
     points = tab.snapshot()["state"]["path"]
@@ -240,7 +240,7 @@ def test_a_pose_path_shows_whole_a_point_per_line(tabs):
 def test_one_coordinate_edited_leaves_the_others_exact(tabs):
     """A target of many decimals, shown to 4: editing its second coordinate sends the first as
     it is, not as shown."""
-    tab = tabs.open()
+    tab = tabs.open(scene=False)
     page = tab.page
     tab.select("#ctl-task", "target")
     exact = 1.123456789
@@ -267,7 +267,7 @@ def test_a_value_in_force_typed_back_after_a_refusal_says_the_result_is_current(
     chain = {"name": "planar_chain", "joints": "RRR", "lengths": [1.0, 1.0, 1.0]}
     state = {"robot": "planar_chain", "robot_definition": chain, "x0": [0.0, 0.0, 0.0]}
     state |= {"task": "target", "target": [2.0, 1.0]}
-    tab = tabs.open("/?state=" + quote(json.dumps(state)))
+    tab = tabs.open("/?state=" + quote(json.dumps(state)), scene=False)
     page = tab.page
     start = page.locator("label", has=page.locator("#ctl-x0-0-value")).locator(".field-error")
     expect(start).to_contain_text("J J^T is singular")

@@ -99,7 +99,7 @@ def test_an_export_while_a_newer_generation_computes_is_the_one_its_link_names(f
     """The footer's export link names the generation on screen; clicked while a newer one
     computes (gamma 2.25, late), it downloads the generation it names, at once, not the newer
     one once that is in; the link then names the newer one."""
-    tab = failing_tabs.open()
+    tab = failing_tabs.open(scene=False)
     page = tab.page
     export = page.locator("#export-json")
     expect(export).to_have_text("export JSON (generation 1)")

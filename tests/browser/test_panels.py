@@ -24,7 +24,7 @@ NAMED = r"jik-manipulator2-{}paper_cubic-continuous-g{}-\d{{8}}T\d{{6}}Z\.{}"
 def test_every_panel_is_drawn_and_saves_as_png(tabs, config):
     """Each panel that /api/dashboard/config lists is drawn (plotly's SVG, or an HTML table for
     the table), and a panel's PNG button downloads jik-<robot>-<panel>-<map>-...-<time>.png."""
-    tab = tabs.open()
+    tab = tabs.open(scene=False)
     panels = [p["id"] for p in config["panels"]]
     assert "table" in panels and len(panels) > 1
     for panel in panels:
@@ -40,7 +40,7 @@ def test_every_panel_is_drawn_and_saves_as_png(tabs, config):
 def test_exports_download_the_sessions_data(tabs):
     """The footer's export links download this session's result: CSV, one row per point of
     either run, and JSON, with the session's state and drifts."""
-    tab = tabs.open()
+    tab = tabs.open(scene=False)
     tab.set_slider("#ctl-cycles", 2)
     snapshot = tab.snapshot()
     summary = snapshot["summary"]
@@ -79,7 +79,7 @@ def test_the_unicycle_shows_its_computations_on_their_way(tabs, config):
     """A switch to the unicycle shows "computing generation N…" until its plots are drawn; a
     smaller gamma (ten times the iterations, a few seconds) also shows the progress bar while it
     runs past config.progress_after, and hides it once drawn."""
-    tab = tabs.open()
+    tab = tabs.open(scene=False)
     tab.watch_header()
     generation = tab.select("#ctl-robot", "unicycle")
     assert tab.robot == "unicycle" and tab.snapshot()["state"]["mode"] == "discrete"
@@ -106,7 +106,7 @@ def test_the_table_saves_as_csv_with_its_notes_and_state(tabs):
     """The table panel's CSV button saves Table 1 as on screen, after '#' lines with the state
     it shows, its notes (the erratum) and the cells that differ from the print; the footer's
     export links name the generation they export."""
-    tab = tabs.open()
+    tab = tabs.open(scene=False)
     with tab.page.expect_download() as saved:
         tab.page.locator("#plot-table .panel-tools button", has_text="CSV").click()
     assert re.fullmatch(NAMED.format("table-", 1, "csv"), saved.value.suggested_filename)
@@ -129,7 +129,7 @@ def test_a_saved_svg_holds_its_legend_and_whole_caption(tabs, panel):
     (the state of a link with a long name makes the caption longer than a line). The h panel,
     whose runs are shapes without legend entries, names the algorithms in their colours in the
     caption instead."""
-    tab = tabs.open()
+    tab = tabs.open(scene=False)
     with tab.page.expect_download() as saved:
         tab.page.locator(f"#plot-{panel} .panel-tools button", has_text="SVG").click()
     svg = Path(saved.value.path()).read_text()

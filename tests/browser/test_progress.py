@@ -19,7 +19,7 @@ def test_a_long_computation_shows_progress_and_can_be_cancelled(tabs):
     """Unicycle, closed path, gamma = 0.01 (ten times the iterations, many seconds): the
     progress bar shows; cancel stops it, the controls and the session go back to the values of
     the result on screen, and the header says which generation was cancelled."""
-    tab = tabs.open()
+    tab = tabs.open(scene=False)
     tab.select("#ctl-robot", "unicycle")
     shown = tab.select("#ctl-task", "path")
     second_phase_done(tab, shown)  # (else the bar below may be its E1/E2's, and cancel stop that)
@@ -43,7 +43,7 @@ def test_a_long_computation_shows_progress_and_can_be_cancelled(tabs):
 def test_the_iteration_cap_is_a_control_the_message_names(tabs):
     """A cap of 10 integrator steps stops every leg; the verdict names the control, and raising
     it (its number box) gives converged legs."""
-    tab = tabs.open()
+    tab = tabs.open(scene=False)
     cap = tab.page.locator("#ctl-max_iterations-value")
     expect(cap).to_have_value("20000")
     cap.fill("10")

@@ -86,7 +86,7 @@ def test_a_refused_definition_keeps_what_was_typed(tabs):
     than the robot in force included: a formula robot, a pasted URDF), with the error beside
     the field it names; a zero or negative link length is refused beside ``lengths``."""
     tabs.allow_console(r"status of 422")
-    tab = tabs.open()
+    tab = tabs.open(scene=False)
     page = tab.page
     page.click("#robot-editor-open")
     page.select_option("#robot-kind", "planar_chain")

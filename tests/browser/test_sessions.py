@@ -70,7 +70,7 @@ def test_changes_in_one_tab_leave_another_as_it_was(tabs):
 def test_a_copied_link_opens_the_same_view(tabs):
     """The link that #copy-link puts on the clipboard opens, in a fresh browser, a new session
     with the same state, the same controls and the same numbers."""
-    a = tabs.open(permissions=["clipboard-read", "clipboard-write"])
+    a = tabs.open(permissions=["clipboard-read", "clipboard-write"], scene=False)
     a.set_slider("#ctl-x0-0", 0.45)
     a.set_slider("#ctl-cycles", 4)
     a.page.click("#copy-link")
@@ -78,7 +78,7 @@ def test_a_copied_link_opens_the_same_view(tabs):
     link = a.page.evaluate("navigator.clipboard.readText()")
     assert link == a.page.url
 
-    d = tabs.open(link)
+    d = tabs.open(link, scene=False)
     assert d.session_id != a.session_id
     state = a.snapshot()["state"]
     assert state["cycles"] == 4 and state["x0"][0] == pytest.approx(0.45, abs=1e-12)
@@ -126,7 +126,7 @@ def test_a_tab_whose_session_ended_opens_a_new_one_with_its_state(tabs):
 def test_a_link_whose_state_is_not_an_object_says_so(tabs, text):
     """A link's ?state= that is JSON but not an object of the state's fields opens the
     defaults and says why beside the status, as a link that is not JSON does."""
-    tab = tabs.open(f"/?state={text}")
+    tab = tabs.open(f"/?state={text}", scene=False)
     expect(tab.page.locator("#notice")).to_have_text(
         f"the link's state is not an object of the state's fields ({text}); showing the defaults"
     )

@@ -58,7 +58,7 @@ def test_the_corner_letters_are_table_1s(tabs):
     """The task panel letters the closed path's corners as Table 1 labels its rows: A = k(x0)
     = (0, 1), then B = (1, 1), C = (1, 2), D = (0, 2); the leg-end table of another robot uses
     the task panel's letters."""
-    tab = tabs.open()
+    tab = tabs.open(scene=False)
     targets = tab.page.locator("#plot-task .scatterlayer .textpoint text")
     expect(targets).to_have_count(4)
     task = tab.page.evaluate(probe("target_letters"), "plot-task")

@@ -93,7 +93,7 @@ def test_an_unreachable_target_is_named_by_the_reach(tabs):
         "task": "target",
         "target": [5.0, 0.0],
     }
-    tab = tabs.open("/?state=" + quote(json.dumps(state)))
+    tab = tabs.open("/?state=" + quote(json.dumps(state)), scene=False)
     tab.wait_settled(lambda s: s["state"]["robot"] == "planar_chain", "the arm's result")
     verdict = tab.page.locator("#verdict")
     expect(verdict.locator("p.failure.p")).to_contain_text(
