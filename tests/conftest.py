@@ -14,10 +14,14 @@ os.environ["JIK_ALLOWED_HOSTS"] = ",".join(
 
 
 def pytest_collection_modifyitems(items):
-    """Under pytest-xdist (``-n``), the browser tests run in one worker, one after another: they
-    share one server and one chromium (``tests/browser/conftest.py``), as in a serial run."""
+    """Under pytest-xdist (``-n``), the default run's browser tests run in one worker, one after
+    another: they share one server and one chromium (``tests/browser/conftest.py``), and the
+    other workers share the rest of the suite. The slow browser tests spread over the workers
+    (each then starts its own server and chromium): beside them the slow step has only a few
+    long tests (the random search, the wheel's installs), which left the other worker idle
+    while one ran every browser test."""
     for item in items:
-        if item.get_closest_marker("browser"):
+        if item.get_closest_marker("browser") and not item.get_closest_marker("slow"):
             item.add_marker(pytest.mark.xdist_group("browser"))
 
 
