@@ -426,8 +426,8 @@ class Tabs:
         generation drawn; its scene's playback paused unless ``playing`` (the tests of the
         animation): a scene animating in software WebGL takes most of two cores, which the
         page and the server under test then lack. ``scene=False``: the page without its 3D
-        scene's frame (the tests of the page's own controls and panels; loading the frame's
-        viser client costs software WebGL about 5 s of CPU)."""
+        scene's frame (the tests of the page's own controls and panels: the frame's viser client
+        is the heaviest part of the page to load and draw in software WebGL)."""
         context = self.context(**options)
         if not scene:
             context.route(SCENE_FRAME, lambda route: route.abort())
