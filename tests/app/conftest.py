@@ -8,10 +8,30 @@ import pytest
 from fastapi.testclient import TestClient
 
 from jik.app.api.factory import create_app
+from jik.app.compute.pool import ComputePool
 from jik.app.compute.settings import Settings
 
 X0_M2 = [0.0, 0.0, math.pi / 2]
 TABLE1_PATH = [[1.0, 1.0], [1.0, 2.0], [0.0, 2.0], [0.0, 1.0]]
+
+
+@pytest.fixture(autouse=True)
+def _pools_end_with_their_test(monkeypatch):
+    """The compute pools a test makes stop their workers when it ends: an app used without its
+    lifespan never closes its pool, whose workers would otherwise stay, idle, until pytest's
+    process exits (by the dozen, with their memory). Pools of broader fixtures, made before
+    this one, are theirs to close."""
+    made: list[ComputePool] = []
+    init = ComputePool.__init__
+
+    def recorded(self, *args, **kwargs):
+        init(self, *args, **kwargs)
+        made.append(self)
+
+    monkeypatch.setattr(ComputePool, "__init__", recorded)
+    yield
+    for pool in made:
+        pool.close()
 
 
 @pytest.fixture(scope="session")
