@@ -26,6 +26,7 @@ from .functionals import Region, check_region
 from .kinematics import Kinematics
 from .progress import Progress, check_cancelled, check_progress
 from .synthesis_nd import CHUNK, MAX_NODES, kernel_frame
+from .total_degree import sobol_nodes
 from .validation import count
 
 
@@ -78,9 +79,7 @@ def e2_qmc(
     names = kinematics.names
     idx = np.array([names.index(n) for n in box])
     lo, hi = np.array(list(box.values()), dtype=float).T
-    from scipy.stats import qmc  # (on use: slow to import)
-
-    t = 2.0 * qmc.Sobol(len(box), scramble=True, seed=seed).random(nodes) - 1.0
+    t = sobol_nodes(len(box), nodes, seed)
     base = np.array([fix.get(n, 0.0) for n in names])
     total, undefined = 0.0, 0
     c0, diag, load = 0.0, np.zeros(len(idx)), np.zeros(len(idx))

@@ -40,6 +40,7 @@ from .total_degree import (
     TotalDegreeMap,
     basis_gradients,
     basis_size,
+    sobol_nodes,
     total_degree_indices,
 )
 from .validation import FloatArray, check_seed, count
@@ -195,9 +196,7 @@ class _Rule:
         hi = np.array([v[1] for v in box.values()])
         self.center, self.half = 0.5 * (lo + hi), 0.5 * (hi - lo)
         self.volume = float(np.prod(hi - lo))
-        from scipy.stats import qmc  # (on use: slow to import)
-
-        self.t = 2.0 * qmc.Sobol(len(box), scramble=True, seed=seed).random(nodes) - 1.0
+        self.t = sobol_nodes(len(box), nodes, seed)
         self.base = np.array([fix.get(n, 0.0) for n in names])
 
     def chunks(self):

@@ -50,6 +50,14 @@ def _legendre(t: FloatArray, n: int) -> tuple[FloatArray, FloatArray]:
     return V * s, (V @ D) * s
 
 
+def sobol_nodes(d: int, nodes: int, seed) -> FloatArray:
+    """``nodes`` points of a scrambled Sobol rule on [-1, 1]^d, where the basis lives: the
+    quadrature of E2 (18) by :mod:`jik.engine.synthesis_nd` and :mod:`jik.engine.e2_qmc`."""
+    from scipy.stats import qmc  # (on use: slow to import, and every compute worker imports this)
+
+    return 2.0 * qmc.Sobol(d, scramble=True, seed=seed).random(nodes) - 1.0
+
+
 def basis_gradients(t: FloatArray, index: np.ndarray) -> tuple[FloatArray, FloatArray]:
     """Basis values (N, nb) and gradients with respect to t (N, nb, d) at reference points t."""
     N, d = t.shape
