@@ -59,6 +59,7 @@ class DashboardScene:
         self.server.gui.main_panel.dock_right()
         self.server.gui.main_panel.set_width(300)
         self._lock = threading.RLock()
+        self._stopped = False
         self._drawn_runs: tuple[str, ...] | None = None  # runs_key of what the scene shows
         self._framed: str | None = None  # layout_name of the robot the camera frames
         self.legend = self.server.gui.add_markdown(order=0, content=legend(DEFAULT_ALGORITHMS))
@@ -79,11 +80,18 @@ class DashboardScene:
 
     def stop(self) -> None:
         self._unsubscribe()
+        with self._lock:  # (an event being shown ends first: nothing is sent to a stopped server)
+            self._stopped = True
         self.playback.stop()
         self.server.stop()
 
     # -- events ---------------------------------------------------------------------------
     def _on_event(self, event: Event) -> None:
+        with self._lock:
+            if not self._stopped:
+                self._show_event(event)
+
+    def _show_event(self, event: Event) -> None:
         try:
             if event.kind == "state":
                 self.controls.show(self.dashboard.state)

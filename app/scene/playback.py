@@ -111,7 +111,7 @@ class Playback:
                 # Paused: nothing to send until scrubbed (or drawn, which poses too).
                 if self._posed != (timeline, self.position):
                     self._pose(timeline, self.position)
-            if not moving:
+            if not moving or self._stopped:
                 continue
             if now - last_gui > 0.25:
                 last_gui = now
