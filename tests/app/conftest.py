@@ -1,4 +1,5 @@
-"""Shared fixtures of the API tests: one app (and its two worker processes) per session."""
+"""Shared fixtures of the API tests: an app with its lifespan per session (``api``), an app
+per module whose tests each have their own sessions and atlas jobs (``app``)."""
 
 from __future__ import annotations
 
@@ -41,16 +42,27 @@ def api():
         yield client
 
 
+@pytest.fixture(scope="module")
+def module_app():
+    """One app for a module's tests, without its lifespan: its compute pool serves them all (a
+    pool's worker takes about a second of imports to start)."""
+    app = create_app()
+    yield app
+    app.state.pool.close()
+
+
 @pytest.fixture
-def app():
-    """An app whose dashboard sessions (at most 4) have no 3D scene, without its lifespan: the
-    sessions compute in their own threads."""
+def app(module_app):
+    """The module's app with this test's own dashboard sessions (at most 4, no 3D scene: they
+    compute in their own threads) and atlas jobs (made on first use)."""
     from jik.app.dashboard.sessions import SessionStore
 
-    app = create_app()
-    app.state.sessions = SessionStore(Settings(max_sessions=4))
-    yield app
-    app.state.sessions.close()
+    module_app.state.sessions = SessionStore(Settings(max_sessions=4))
+    module_app.state.atlas_jobs = None
+    yield module_app
+    module_app.state.sessions.close()
+    if module_app.state.atlas_jobs is not None:
+        module_app.state.atlas_jobs.close()
 
 
 @pytest.fixture

@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
-from jik.app.api.factory import create_app
 from jik.app.compute.atlas_jobs import AtlasJobNotFound, AtlasJobs
 from jik.app.compute.atlas_plan import AtlasLimits, planned
 from jik.app.compute.atlas_pool import PoolBackend
@@ -46,13 +45,15 @@ LONG = body(starts=20000, cycles=5, arc=None)
 
 
 @pytest.fixture
-def app():
-    app = create_app()
-    app.state.atlas_jobs = AtlasJobs(AtlasLimits(max_jobs=3, per_client=1))
-    app.state.sessions = SessionStore(Settings(max_sessions=4))
-    yield app
-    app.state.atlas_jobs.close()
-    app.state.sessions.close()
+def app(module_app):
+    """The module's app (tests/app/conftest.py) with this test's own atlas jobs and sessions."""
+    jobs = AtlasJobs(AtlasLimits(max_jobs=3, per_client=1))
+    module_app.state.atlas_jobs = jobs
+    module_app.state.sessions = SessionStore(Settings(max_sessions=4))
+    yield module_app
+    jobs.close()
+    module_app.state.atlas_jobs.close()
+    module_app.state.sessions.close()
 
 
 @pytest.fixture

@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
-from jik.app.api.factory import create_app
 from jik.app.compute.atlas_jobs import AtlasJobs
 from jik.app.compute.atlas_plan import AtlasLimits, planned
 from jik.app.compute.atlas_schemas import AtlasRequest
@@ -26,13 +25,15 @@ TEXT = {"algorithm", "path", "start", "cycle", "leg", "success"}
 
 
 @pytest.fixture
-def app():
-    app = create_app()
-    app.state.atlas_jobs = AtlasJobs(AtlasLimits(max_jobs=4, per_client=2))
-    app.state.sessions = SessionStore(Settings(max_sessions=4))
-    yield app
-    app.state.atlas_jobs.close()
-    app.state.sessions.close()
+def app(module_app):
+    """The module's app (tests/app/conftest.py) with this test's own atlas jobs and sessions."""
+    jobs = AtlasJobs(AtlasLimits(max_jobs=4, per_client=2))
+    module_app.state.atlas_jobs = jobs
+    module_app.state.sessions = SessionStore(Settings(max_sessions=4))
+    yield module_app
+    jobs.close()
+    module_app.state.atlas_jobs.close()
+    module_app.state.sessions.close()
 
 
 @pytest.fixture
