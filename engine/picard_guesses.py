@@ -10,9 +10,10 @@ import numpy as np
 
 from .exceptions import InvalidInputError
 from .inverses import Inverse
-from .picard import Guess, picard_chain
+from .picard import CHAIN_SWEEPS, Guess, picard_chain
 from .results import Trajectory
-from .solve_rules import check_gamma
+from .solve_rules import MAX_ITERATIONS_LIMIT, check_gamma
+from .validation import count
 
 
 def picard_guesses(
@@ -71,7 +72,9 @@ def picard_guesses(
     return out
 
 
-def chain_guesses(inverse: Inverse, x0, y_d, *, gamma: float = 1.0) -> list[Trajectory] | None:
+def chain_guesses(
+    inverse: Inverse, x0, y_d, *, gamma: float = 1.0, max_sweeps: int = CHAIN_SWEEPS
+) -> list[Trajectory] | None:
     """Guesses for solving legs of eq. (7) one after another in continuous mode: leg j from
     where leg j - 1 ends, to ``y_d[j]`` (a closed path's legs, cycle after cycle).
 
@@ -89,12 +92,14 @@ def chain_guesses(inverse: Inverse, x0, y_d, *, gamma: float = 1.0) -> list[Traj
         The legs' targets.
     gamma : float
         The decay rate the legs will be solved with (it only sets their theta).
+    max_sweeps : int
+        The most sweeps the chain may take (a run's cap on a leg's steps bounds its chain too).
 
     Returns
     -------
     list of L Trajectory (at the Chebyshev nodes of each leg), or None when the legs
     cannot all be swept on one segment each (a singular J# on the way, a path that needs finer
-    segments): solve them without guesses then.
+    segments) within ``max_sweeps``: solve them without guesses then.
     """
     kin = inverse.kinematics
     x0 = kin.check(x0, "x0")
@@ -105,7 +110,8 @@ def chain_guesses(inverse: Inverse, x0, y_d, *, gamma: float = 1.0) -> list[Traj
             f"x0 must be one configuration (p,) and y_d the legs' targets (L, r), L >= 1; "
             f"got shapes {x0.shape} and {y_d.shape}"
         )
-    chained = picard_chain(inverse, x0, y_d)
+    max_sweeps = count(max_sweeps, "max_sweeps", 1, MAX_ITERATIONS_LIMIT)
+    chained = picard_chain(inverse, x0, y_d, min(max_sweeps, CHAIN_SWEEPS))
     if chained is None:
         return None
     sigma, X = chained

@@ -22,6 +22,7 @@ import numpy as np
 from .exceptions import InvalidInputError, JikError, format_vector
 from .exports import plural
 from .inverses import Inverse
+from .picard import CHAIN_SWEEPS
 from .picard_guesses import chain_guesses
 from .progress import Progress, check_cancelled, check_progress, stops_at
 from .repeatability_result import RepeatabilityResult
@@ -119,7 +120,12 @@ def open_loop(path: FloatArray) -> FloatArray:
 
 
 def cycle_guesses(
-    inverse: Inverse, start, targets, guides: list[Trajectory | None], gamma: float = 1.0
+    inverse: Inverse,
+    start,
+    targets,
+    guides: list[Trajectory | None],
+    gamma: float = 1.0,
+    max_sweeps: int = CHAIN_SWEEPS,
 ) -> list[Trajectory | None]:
     """Picard guesses for one cycle's legs of a closed path from ``start`` (continuous mode,
     one start): the ``guess`` of each leg's :func:`jik.engine.solver.solve`, eq. (7).
@@ -131,7 +137,9 @@ def cycle_guesses(
     ``start`` (:func:`jik.engine.picard_guesses.chain_guesses`), one or two sweeps a leg instead of
     about ten, and a cycle's numbers depend only on its start. A chain evaluates J# about three
     times as often as the legs would, so it pays only where an evaluation costs little beyond
-    numpy's per-call overhead: not for the unicycle.
+    numpy's per-call overhead: not for the unicycle. The chain takes at most ``max_sweeps``
+    sweeps, the run's cap on a leg's steps: a cap that a leg's solve cannot meet is not met by
+    sweeping the cycle's legs together either.
     """
     if (
         inverse.name != "extended"
@@ -139,7 +147,7 @@ def cycle_guesses(
         and len(targets) > 1
         and not isinstance(inverse.kinematics, Unicycle)
     ):
-        chained = chain_guesses(inverse, start, targets, gamma=gamma)
+        chained = chain_guesses(inverse, start, targets, gamma=gamma, max_sweeps=max_sweeps)
         if chained is not None:
             return list(chained)
     # A leg that started at its target recorded its start alone: nothing to sweep from.
@@ -291,7 +299,9 @@ def repeatability(
     for c in range(first, cycles):
         if not alive.any():
             break
-        guesses = cycle_guesses(inverse, current[0], targets[0], guides, gamma) if guided else []
+        guesses = []
+        if guided:
+            guesses = cycle_guesses(inverse, current[0], targets[0], guides, gamma, cap)
         for j in range(L):
             ids = np.flatnonzero(alive)
             if ids.size == 0:

@@ -384,3 +384,20 @@ def test_repeatable_judges_the_cycles_that_ended():
     ext = repeatability(_inverse("extended"), TABLE1_X0, TABLE1_PATH, cycles=2)
     pinv = repeatability(_inverse("pseudoinverse"), TABLE1_X0, TABLE1_PATH, cycles=2)
     assert repeatable(ext.drift) is True and repeatable(pinv.drift) is False
+
+
+@pytest.mark.parametrize("algorithm", ["pseudoinverse", "extended"])
+def test_a_leg_is_capped_as_its_solve_is(algorithm):
+    """max_iterations bounds a leg of a single start's run as it bounds the leg's solve: the
+    chain that guesses a cycle's legs sweeps no more often than a leg may step. A cap that
+    the first leg's solve cannot meet stops the run there; the default cap gives the run."""
+    kin = Manipulator2()
+    inv = Pseudoinverse(kin) if algorithm == "pseudoinverse" else ExtendedInverse(kin, PaperCubic())
+    x0 = np.array([0, 0, math.pi / 2])
+    path = [(1, 1), (1, 2), (0, 2), (0, 1)]
+    leg = solve(inv, x0, path[0], max_iterations=3)
+    assert leg.status == "max_steps"
+    run = repeatability(inv, x0, path, cycles=2, max_iterations=3)
+    assert not run.success
+    assert run.message.startswith("cycle 1, leg 1"), run.message
+    assert repeatability(inv, x0, path, cycles=2).success
