@@ -173,8 +173,8 @@ def check_names(given: Mapping[str, Any]) -> None:
 def checked(algorithms: tuple[str, ...], given: Mapping[str, Any]) -> dict[str, Any]:
     """The chosen algorithms in the catalogue's order and their scalar parameters (the given
     ones checked against the engine's ranges, the others at their defaults; parameters of
-    algorithms not chosen are dropped). A vector parameter (:data:`VECTORS`) is kept as given
-    when its algorithm is chosen: its check needs the robot (:func:`checked_rest`).
+    algorithms not chosen are checked, then dropped). A vector parameter (:data:`VECTORS`) is
+    kept as given when its algorithm is chosen: its check needs the robot (:func:`checked_rest`).
 
     Raises
     ------
@@ -188,12 +188,16 @@ def checked(algorithms: tuple[str, ...], given: Mapping[str, Any]) -> dict[str, 
     check_names(given)
     ordered = tuple(a for a in CHOICES if a in algorithms)
     values = {}
-    for p in scalar_parameters(ordered):
-        try:
-            values[p.name] = p.check(given.get(p.name, p.default))
-        except InvalidInputError as exc:
-            field = f"algorithm_parameters.{p.name}"
-            raise refused(field, without_field(str(exc), exc.field)) from None
+    chosen = scalar_parameters(ordered)
+    for p in scalar_parameters(CHOICES):
+        if p in chosen or p.name in given:
+            try:
+                value = p.check(given.get(p.name, p.default))
+            except InvalidInputError as exc:
+                field = f"algorithm_parameters.{p.name}"
+                raise refused(field, without_field(str(exc), exc.field)) from None
+            if p in chosen:
+                values[p.name] = value
     values.update({k: given[k] for k, a in VECTORS.items() if a in ordered and k in given})
     return {"algorithms": ordered, "algorithm_parameters": values}
 

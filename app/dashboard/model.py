@@ -280,10 +280,14 @@ def validate(data: Mapping[str, Any]) -> DashboardState:
         raise InvalidInputError("path: a closed-path task needs at least one path point", "path")
     if (why := gamma_problem(state.gamma, state.mode)) is not None:
         raise InvalidInputError(f"gamma: {why}", "gamma")
-    state = state.model_copy(update=checked(state.algorithms, state.algorithm_parameters))
+    given = state.algorithm_parameters
+    # (a rest is checked whether or not the posture inverse is chosen; kept only if it is)
+    rest = checked_rest(given["rest"], spec, kin, state.x0) if "rest" in given else None
+    state = state.model_copy(update=checked(state.algorithms, given))
     if "rest" in state.algorithm_parameters:
         chosen = dict(state.algorithm_parameters)
-        if (rest := checked_rest(chosen.pop("rest"), spec, kin, state.x0)) is not None:
+        del chosen["rest"]
+        if rest is not None:
             chosen["rest"] = rest
         state = state.model_copy(update={"algorithm_parameters": chosen})
     check_inverses(state, lambda a: state_inverse(state, a, kin))

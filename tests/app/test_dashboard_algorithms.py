@@ -60,6 +60,9 @@ def test_choosing_algorithms_fills_their_parameters_from_the_engine():
             "algorithm_parameters.damping",
         ),
         ({"algorithm_parameters": {"lambda": 1.0}}, "algorithm_parameters.lambda"),
+        # (a parameter of an algorithm not chosen: checked, though it would then be dropped)
+        ({"algorithm_parameters": {"damping": -1.0}}, "algorithm_parameters.damping"),
+        ({"algorithm_parameters": {"rest": [1e308] * 3}}, "algorithm_parameters.rest.0"),
     ],
 )
 def test_a_bad_choice_is_refused_naming_its_field(patch, field):
