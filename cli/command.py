@@ -16,7 +16,7 @@ from typing import Any
 
 from jik import install_hint
 
-from .robot_commands import add_robot_commands
+from .robot_commands import add_robot_commands, guarded
 from .serve_address import Announcer, listen_problem, port_number
 
 #: Reproductions: name -> module in jik.engine.reproductions with run() and format_text().
@@ -36,9 +36,12 @@ WEB_PACKAGES = frozenset(
 
 
 def _progress(fraction: float) -> None:
-    sys.stderr.write(f"\r  progress {100 * fraction:5.1f}%")
-    if fraction >= 1:
-        sys.stderr.write("\n")
+    """The progress on stderr: rewritten in place on a terminal, a line each in a log."""
+    text = f"  progress {100 * fraction:5.1f}%"
+    if not sys.stderr.isatty():
+        sys.stderr.write(text + "\n")
+    else:
+        sys.stderr.write("\r" + text + ("\n" if fraction >= 1 else ""))
     sys.stderr.flush()
 
 
@@ -130,7 +133,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--version", action="version", version=f"jik {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
-    p = sub.add_parser("serve", help="start the REST API and the dashboard")
+    p = sub.add_parser(
+        "serve",
+        help="start the REST API and the dashboard",
+        description="Serve the dashboard (open the address it prints) and the REST API (its "
+        "reference at /docs), on 127.0.0.1 unless --host says otherwise.",
+    )
     p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
     p.add_argument(
         "--port",
@@ -167,7 +175,7 @@ def main(argv: list[str] | None = None) -> int:
         action="store_true",
         help="table1 only: use the printed j32, j33 of (39) instead of the gradient of (38)",
     )
-    p.set_defaults(func=reproduce)
+    p.set_defaults(func=guarded(reproduce))
 
     p = sub.add_parser(
         "errata",
@@ -179,7 +187,11 @@ def main(argv: list[str] | None = None) -> int:
     add_atlas_parser(sub)
 
     p = sub.add_parser("bench", help="run the benchmarks (medians, ratios to straightforward code)")
-    p.add_argument("names", nargs="*", help="benchmarks to run (default: all)")
+    from ..benchmarks import available
+
+    p.add_argument(
+        "names", nargs="*", help=f"benchmarks to run (default: all): {', '.join(available())}"
+    )
     p.add_argument("--quick", action="store_true", help="fewer repetitions, for a smoke test")
     p.set_defaults(func=bench)
 

@@ -69,6 +69,22 @@ def point_texts(text: str) -> list[str]:
     return points
 
 
+#: The built-in robots' and the catalogue arms' names (the engine's; a test checks they agree).
+BUILT_IN_ROBOTS = ("manipulator1", "manipulator2", "unicycle")
+CATALOGUE_ARMS = ("panda", "iiwa14", "gen3", "ur5e")
+
+
+def add_robot_option(p: argparse.ArgumentParser, **kwargs) -> None:
+    """--robot: a robot file or a built-in robot's or catalogue arm's name."""
+    p.add_argument(
+        "--robot",
+        help=f"a robot file (.json, .yaml), a built-in robot ({', '.join(BUILT_IN_ROBOTS)}) or a "
+        f"catalogue arm ({', '.join(CATALOGUE_ARMS)}: its default task; another with --task)",
+        **kwargs,
+    )
+    add_task_option(p)
+
+
 def add_task_option(p: argparse.ArgumentParser) -> None:
     """--task: a catalogue arm's task (:func:`robot_with_task`)."""
     p.add_argument(
@@ -94,14 +110,7 @@ def robot_with_task(source: str, task: str | None) -> Robot:
 
 
 def _common(p: argparse.ArgumentParser) -> None:
-    p.add_argument(
-        "--robot",
-        required=True,
-        help="a robot file (.json, .yaml), a built-in robot's name or a catalogue "
-        "arm's (panda, iiwa14, gen3, ur5e: its default task; for another, a file "
-        "with --task)",
-    )
-    add_task_option(p)
+    add_robot_option(p, required=True)
     p.add_argument(
         "--x0",
         help="start configuration, e.g. '0, 0, pi/2' (a leading minus: --x0=-1,0,0; default: "
@@ -247,7 +256,9 @@ def refused(command: str, error: Exception, args: argparse.Namespace | None = No
     return 2
 
 
-def _guarded(command):
+def guarded(command):
+    """``command`` with the engine's refusals said in one line (:func:`refused`)."""
+
     def run(args: argparse.Namespace) -> int:
         from ..engine.exceptions import JikError
 
@@ -266,7 +277,7 @@ def add_robot_commands(sub) -> None:
     p.add_argument(
         "--target", help="task point, e.g. '1, 1.5' (--target=-1,1.5; default: the robot's)"
     )
-    p.set_defaults(func=_guarded(solve_command))
+    p.set_defaults(func=guarded(solve_command))
 
     p = sub.add_parser("repeatability", help="drive a robot around a closed task path")
     _common(p)
@@ -276,4 +287,4 @@ def add_robot_commands(sub) -> None:
         "the return leg to k(x0) closes it",
     )
     p.add_argument("--cycles", type=int, default=1, help="number of cycles (default 1)")
-    p.set_defaults(func=_guarded(repeatability_command))
+    p.set_defaults(func=guarded(repeatability_command))

@@ -19,6 +19,7 @@ from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from typing import Any, Protocol
 
+from .. import install_hint
 from .exceptions import InvalidInputError
 
 #: Chunks in flight per worker: one running, one queued so a worker never waits for the caller.
@@ -144,7 +145,7 @@ class Dask:
             from dask.distributed import Client, LocalCluster, as_completed
         except ImportError as error:
             raise InvalidInputError(
-                f"a Dask backend needs dask.distributed ({error}); pip install 'jik-lab[atlas]'",
+                f"a Dask backend needs dask.distributed ({error}); {install_hint('atlas')}",
                 field="backend",
             ) from error
         self._as_completed = as_completed

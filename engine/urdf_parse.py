@@ -17,6 +17,7 @@ import io
 import logging
 import re
 
+from .. import install_hint
 from .exceptions import InvalidInputError
 
 #: Largest URDF text accepted [bytes].
@@ -28,7 +29,7 @@ def _yourdfpy():
         import yourdfpy
     except ImportError:  # the `urdf` extra is not installed
         raise InvalidInputError(
-            "URDF robots need the yourdfpy package: pip install 'jik-lab[urdf]'", "urdf"
+            f"URDF robots need the yourdfpy package: {install_hint('urdf')}"
         ) from None
     # yourdfpy logs each text it cannot parse as an ERROR ("Using different parsing approach."),
     # which a server printed for every bad URDF a user sent: parse_urdf reports it, in words
@@ -43,7 +44,7 @@ def _etree():
         from lxml import etree
     except ImportError:  # the `urdf` extra is not installed
         raise InvalidInputError(
-            "URDF robots need the yourdfpy package: pip install 'jik-lab[urdf]'", "urdf"
+            f"URDF robots need the yourdfpy package: {install_hint('urdf')}"
         ) from None
     return etree
 

@@ -85,20 +85,22 @@ def run(
     "success", "message"}] on Table 1's loop, "cycles", "x0", "path", and with "panda" in
     ``loops`` "panda": the same on the Panda's pose loop, with its "x0" and "path"}."""
     out: dict = {"cycles": cycles, "x0": list(X0), "path": [list(p) for p in PATH]}
+    unknown = sorted(set(loops) - set(LOOPS))
+    if unknown:
+        raise ValueError(f"unknown loop {unknown[0]!r}; known: {LOOPS}")
+    if "panda" in loops:  # (built first: without the urdf extra, refused before any run)
+        from ..robot_spec import robot_from_dict
+
+        panda = robot_from_dict(PANDA)
     for k, loop in enumerate(loops):
         step = None if progress is None else _part(progress, k, len(loops))
         if loop == "manipulator2":
             kin = Manipulator2()
             out["algorithms"] = _rows(partial(make_inverse, kin), X0, PATH, cycles, loop, step)
-        elif loop == "panda":
-            from ..robot_spec import robot_from_dict
-
-            robot = robot_from_dict(PANDA)
-            x0, path = robot.spec.default_x0, robot.spec.default_path
-            rows = _rows(robot.inverse, x0, path, cycles, loop, step)
-            out["panda"] = {"algorithms": rows, "x0": list(x0), "path": [list(p) for p in path]}
         else:
-            raise ValueError(f"unknown loop {loop!r}; known: {LOOPS}")
+            x0, path = panda.spec.default_x0, panda.spec.default_path
+            rows = _rows(panda.inverse, x0, path, cycles, loop, step)
+            out["panda"] = {"algorithms": rows, "x0": list(x0), "path": [list(p) for p in path]}
     return out
 
 

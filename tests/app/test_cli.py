@@ -73,6 +73,23 @@ def test_unknown_reproduction_is_rejected(capsys):
     assert "invalid choice" in capsys.readouterr().err
 
 
+def test_a_reproduction_that_needs_an_extra_says_so_before_it_runs():
+    """Without yourdfpy (an install without the urdf extra), `jik reproduce algorithms`, whose
+    second table is the Panda's, says in one line what to install, before it computes."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys; sys.modules['yourdfpy'] = None; from jik.cli import main; "
+        "raise SystemExit(main(['reproduce', 'algorithms']))"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2, done.stderr
+    assert done.stdout == "" and "Traceback" not in done.stderr
+    assert done.stderr.startswith("jik reproduce: URDF robots need the yourdfpy package: pip")
+    assert "[urdf]" in done.stderr and done.stderr.count("\n") == 1
+
+
 def test_only_the_printing_commands_die_quietly_on_a_closed_pipe(monkeypatch):
     """`jik reproduce ... | head` ends quietly; `jik serve` keeps Python's handling of SIGPIPE
     (a worker or client that goes away must not end the server), and main() leaves the
