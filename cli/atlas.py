@@ -29,7 +29,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from ..engine.exports import json_values
+from ..engine.exports import json_values, plural
 from .algorithm_options import (
     ALGORITHM_NAMES,
     add_algorithm_parameter_options,
@@ -39,7 +39,7 @@ from .algorithm_options import (
     run_settings,
 )
 from .atlas_output import CsvWriter, Gathered, write_figure
-from .robot_commands import add_task_option, point_texts, refused, robot_with_task
+from .robot_commands import add_robot_option, point_texts, refused, robot_with_task
 
 #: Atlases of more runs than this write their arrays to the CSV only (the JSON keeps a summary).
 JSON_RUNS = 20000
@@ -54,10 +54,7 @@ def add_atlas_parser(sub) -> None:
         help="repeatability atlas: drift after each cycle over many starts (and paths)",
         description=__doc__.split("\n\n")[2],
     )
-    p.add_argument(
-        "--robot", default="manipulator2", help="a built-in robot, or a robot file (.json, .yaml)"
-    )
-    add_task_option(p)
+    add_robot_option(p, default="manipulator2")
     p.add_argument(
         "--param",
         action="append",
@@ -69,13 +66,18 @@ def add_atlas_parser(sub) -> None:
         "--path", help='task points "y1,y2; y1,y2; ...", a loop (default: the robot\'s closed path)'
     )
     p.add_argument("--starts", type=int, default=256, help="starts per path (default 256)")
-    p.add_argument("--sampling", choices=("grid", "sample"), default="grid")
-    p.add_argument("--seed", type=int, default=0, help="seed of --sampling sample")
+    p.add_argument(
+        "--sampling",
+        choices=("grid", "sample"),
+        default="grid",
+        help="the starts' arc lengths on an even grid, or drawn at random (default grid)",
+    )
+    p.add_argument("--seed", type=int, default=0, help="seed of --sampling sample (default 0)")
     p.add_argument(
         "--arc", help='"lo,hi" (--arc=-1,2): arc lengths of the starts (default: the box)'
     )
     p.add_argument("--reference", help='"x1,x2,...": where s = 0 comes from (robot default)')
-    p.add_argument("--cycles", type=int, default=3)
+    p.add_argument("--cycles", type=int, default=3, help="cycles of each run (default 3)")
     p.add_argument(
         "--algorithm",
         action="append",
@@ -150,8 +152,8 @@ def backend_option(args: argparse.Namespace) -> str:
 
 
 class Progress:
-    """A progress bar on stderr: runs done over every algorithm, elapsed time and the time
-    left."""
+    """A progress bar on stderr (rewritten in place on a terminal, a line each in a log): runs
+    done over every algorithm, elapsed time and the time left."""
 
     def __init__(self, quiet: bool, algorithms: int = 1) -> None:
         self.quiet = quiet
@@ -167,13 +169,17 @@ class Progress:
         left = f"{t * (total - done) / done:.0f}" if done else "?"
         bar = "#" * int(30 * done / total)
         A = self.algorithms
-        sys.stderr.write(
-            f"\r  atlas [{bar:<30}] {A * done}/{A * total} runs ({total} starts x {A} "
+        text = (
+            f"  atlas [{bar:<30}] {A * done}/{A * total} runs ({total} starts x {A} "
             f"algorithm{'' if A == 1 else 's'}), {t:.1f} s, {left} s left "
         )
-        self.open = True
-        if done >= total:
-            self.end()
+        if not sys.stderr.isatty():  # (a log: a line each)
+            sys.stderr.write(text.rstrip() + "\n")
+        else:
+            sys.stderr.write("\r" + text)
+            self.open = True
+            if done >= total:
+                self.end()
         sys.stderr.flush()
 
     def end(self) -> None:
@@ -334,7 +340,8 @@ def _run(args: argparse.Namespace) -> int:
     out.write_text(json.dumps(doc), encoding="utf-8")
     written = ", ".join(str(f) for f in (out, csv_path, figure) if f)
     sys.stderr.write(
-        f"jik atlas: {A} x {plan.size} runs x {C} cycles in {elapsed:.1f} s: {written}\n"
+        f"jik atlas: {plural(A, 'algorithm')} x {plural(plan.size, 'start')} x "
+        f"{plural(C, 'cycle')} in {elapsed:.1f} s: {written}\n"
     )
     if plan.manifolds[0].period is not None:
         sys.stderr.write(

@@ -220,8 +220,15 @@ def test_a_path_that_is_not_numbers_is_refused(tmp_path, capsys):
     assert "--path must be comma-separated numbers" in capsys.readouterr().err
 
 
-def test_a_refusal_after_the_progress_bar_starts_on_a_line_of_its_own(tmp_path, capsys):
-    """The bar is drawn before the backend starts; its refusal ends the bar's line."""
+@pytest.mark.parametrize("terminal", [True, False], ids=["terminal", "log"])
+def test_a_refusal_after_the_progress_bar_starts_on_a_line_of_its_own(
+    tmp_path, capsys, monkeypatch, terminal
+):
+    """The bar is drawn before the backend starts; its refusal ends the bar's line. On a
+    terminal the bar is redrawn in place, in a log it is a line each time."""
+    import sys
+
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: terminal)
     argv = [
         "atlas",
         "--robot",
@@ -233,7 +240,8 @@ def test_a_refusal_after_the_progress_bar_starts_on_a_line_of_its_own(tmp_path, 
     ]
     assert main(argv) == 2
     bar, said = capsys.readouterr().err.split("\n")[:2]
-    assert bar.startswith("\r  atlas [") and said.startswith("jik atlas: a Dask scheduler's")
+    assert bar.startswith("\r  atlas [" if terminal else "  atlas [")
+    assert said.startswith("jik atlas: a Dask scheduler's")
 
 
 @pytest.mark.parametrize("chunk", ["0", "-3"])

@@ -316,10 +316,14 @@ def test_reproduction_table_of_the_panda_pose_loop():
     )
 
 
-def test_cli_algorithm_names_are_the_catalogue():
+def test_cli_algorithm_and_robot_names_are_the_catalogue():
     from jik.cli.algorithm_options import ALGORITHM_NAMES
+    from jik.cli.robot_commands import BUILT_IN_ROBOTS, CATALOGUE_ARMS
+    from jik.engine.arms import ARMS
+    from jik.engine.registry import ROBOTS
 
     assert list(ALGORITHM_NAMES) == list(ALGORITHMS)
+    assert list(BUILT_IN_ROBOTS) == list(ROBOTS) and list(CATALOGUE_ARMS) == list(ARMS)
 
 
 def test_weighted_refuses_a_start_past_a_limit_naming_the_joint():
