@@ -51,10 +51,10 @@ START_CANDIDATES = 256
 
 
 def defaults(kin: Kinematics, d: Mapping, box, base: RobotSpec | None = None) -> tuple:
-    """x0 (given, else a URDF arm's home if given, else 0.5 in each range, or where the task is
-    undefined there or along the default path, the first point of a Halton sequence over the
-    box where it is defined), a target and a closed path reachable from it; a built-in robot's
-    (``base``) where its definition has none."""
+    """x0 (given, else a URDF arm's home if given, else 0.5 in each range that holds it and the
+    range's middle in the others, or where the task is undefined there or along the default
+    path, the first point of a Halton sequence over the box where it is defined), a target and a
+    closed path reachable from it; a built-in robot's (``base``) where its definition has none."""
     lo, hi = np.array(box).T
     if "x0" in d:
         x0 = points(d["x0"], kin.p, "x0")
@@ -64,8 +64,8 @@ def defaults(kin: Kinematics, d: Mapping, box, base: RobotSpec | None = None) ->
         x0 = np.array(base.default_x0, dtype=float)
     elif "home" in d:
         x0 = np.array(kin.parameters["home"], dtype=float)
-    else:
-        x0 = np.clip(0.5, lo, hi)
+    else:  # (0.5, or the middle of a range without it: a start on a limit leaves it at once)
+        x0 = np.where((lo < 0.5) & (0.5 < hi), 0.5, (lo + hi) / 2)
     if base is not None:
         target, path = d.get("target", base.default_target), d.get("path", base.default_path)
     else:

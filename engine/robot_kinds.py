@@ -109,9 +109,7 @@ FORMULA = (
 )
 
 URDF = (
-    DefinitionField(
-        "urdf", "text", True, "the URDF text (no DOCTYPE; at most 1 MB; meshes are not loaded)"
-    ),
+    DefinitionField("urdf", "text", True, "the URDF text (no DOCTYPE; meshes are not loaded)"),
     DefinitionField(
         "urdf_file",
         "string",
@@ -176,7 +174,12 @@ COMMON = (
         "[-pi, pi] for a continuous or revolute joint, +-length for a prismatic one; a planar "
         "chain's or formula robot's limits do not narrow it: a start outside them is reported)",
     ),
-    DefinitionField("x0", "numbers", False, "start configuration (default 0.5 in each range)"),
+    DefinitionField(
+        "x0",
+        "numbers",
+        False,
+        "start configuration (default 0.5, or the middle of a range without it)",
+    ),
     DefinitionField("target", "numbers", False, "default target of a solve"),
     DefinitionField("path", "points", False, "default closed path (task points)"),
     DefinitionField(

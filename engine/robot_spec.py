@@ -161,7 +161,7 @@ def _kinematics(kind: str, d: Mapping, base_dir: Path | None) -> Kinematics:
     text = _urdf_file(d, base_dir) if "urdf_file" in d else _get(d, "urdf", str, "URDF text")
     return UrdfChain(
         text,
-        _get(d, "end_link", str, "the name of the end link"),
+        d.get("end_link"),  # (refused by the chain if missing, with the URDF's links)
         d.get("active_joints"),
         d.get("task", "xyz"),
         _get(d, "locked", dict, "a mapping of joint names to values", {}),

@@ -93,7 +93,7 @@ class UrdfChain(Kinematics):
     def __init__(
         self,
         urdf: str,
-        end_link: str,
+        end_link: str | None,
         active_joints: Sequence[str] | None = None,
         task: str | Sequence[str] = "xyz",
         locked: Mapping[str, float] | None = None,
@@ -103,6 +103,11 @@ class UrdfChain(Kinematics):
         model = parse_urdf(urdf)
         self.robot_name = str(model.robot.name)
         links = {link.name for link in model.robot.links}
+        if end_link is None:
+            raise InvalidInputError(
+                f"end_link is required (the name of the end link); links: {sorted(links)}",
+                "end_link",
+            )
         if not isinstance(end_link, str) or end_link not in links:
             raise InvalidInputError(
                 f"end_link {end_link!r} is not a link of the URDF; links: {sorted(links)}",

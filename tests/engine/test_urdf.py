@@ -110,6 +110,7 @@ def test_repeatability_pseudoinverse_drifts_extended_returns(arm):
     ("kwargs", "field", "text"),
     [
         ({"end_link": "hand"}, "end_link", "'hand' is not a link"),
+        ({"end_link": None}, "end_link", "is required (the name of the end link); links: ['base"),
         (
             {"end_link": "tool", "active_joints": ["shoulder", "finger_slide"]},
             "active_joints.1",
@@ -213,3 +214,18 @@ def test_the_drawn_arm_starts_at_its_base_and_places_each_joint(arm):
     planar = PlanarChain("RRR", [1.0, 0.8, 0.6])
     np.testing.assert_allclose(planar.drawn_points(x[:, :3]), planar.points(x[:, :3]), atol=0)
     assert planar.joint_points == {0: 0, 1: 1, 2: 2}
+
+
+def test_the_default_start_is_inside_every_joints_range():
+    """Without x0 or home, a URDF arm starts at 0.5 in each joint's range that holds it and in
+    the middle of the others: not on a limit, which the default path's first leg would leave."""
+    from jik.engine.robot_spec import robot_from_dict
+
+    text = TEXT.replace('<limit lower="-2.0" upper="2.0"', '<limit lower="-2.0" upper="0.0"')
+    robot = robot_from_dict({"name": "urdf", "urdf": text, "end_link": "tool"})
+    assert robot.spec.default_x0 == (0.5, -1.0, 0.5, 0.5)
+    run = repeatability(
+        robot.inverse("pseudoinverse"), robot.spec.default_x0, robot.spec.default_path
+    )
+    report = robot.limits_report(run)
+    assert run.success and report is not None and report.within, report
