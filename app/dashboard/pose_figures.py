@@ -84,7 +84,12 @@ def pose_task_spec(result: DashboardResult) -> dict:
     for row, k in enumerate(order):
         yaxis = "y" if row == 0 else f"y{row + 1}"
         name = names[k]
-        data += [theta_line(a, r, r.y[:, k], name, row, legs=True) for a, r in result.runs.items()]
+        # (each entry once in a legend, the saved panel's: the top row's)
+        once = dict(showlegend=row == 0)
+        data += [
+            theta_line(a, r, r.y[:, k], name, row, legs=True, legendgroup=a, **once)
+            for a, r in result.runs.items()
+        ]
         data.append(
             trace(
                 "scatter",
@@ -97,6 +102,8 @@ def pose_task_spec(result: DashboardResult) -> dict:
                 text=letters.tolist(),
                 marker=dict(color="black", size=8, symbol="x"),
                 hovertemplate=f"%{{text}}: {name} = %{{y:.4f}}<extra></extra>",
+                legendgroup="targets",
+                **once,
             )
         )
         data.append(
@@ -110,6 +117,8 @@ def pose_task_spec(result: DashboardResult) -> dict:
                 yaxis=yaxis,
                 marker=dict(color="#2ca02c", size=10, symbol="circle-open", line=dict(width=2)),
                 hovertemplate=f"start {name} = %{{y:.4f}}<extra></extra>",
+                legendgroup="start",
+                **once,
             )
         )
         values = np.concatenate([r.y[:, k] for r in runs] + [targets[:, k]])

@@ -12,6 +12,7 @@ import numpy as np
 import plotly.graph_objects as go
 import pytest
 
+from jik.app.dashboard.algorithms import LABELS
 from jik.app.dashboard.figures import figure_specs, gamma_free_panels
 from jik.app.dashboard.model import default_state, updated_state
 from jik.app.dashboard.results import compute
@@ -153,6 +154,9 @@ def test_a_pose_task_shows_position_and_rotation_against_theta():
     assert all(np.ptp(layout[f"yaxis{k}"]["range"]) >= 0.02 for k in (4, 5))
     np.testing.assert_allclose(targets[5]["y"][:4], np.asarray(result.targets)[:, 5])
     assert "task" not in gamma_free_panels(result)
+    # A legend (a saved panel's) names each algorithm, the targets and the start once.
+    named = [t["name"] for t in spec["data"] if t.get("showlegend", True)]
+    assert sorted(named) == sorted([*(LABELS[a] for a in result.runs), "targets", "start k(x0)"])
 
 
 def test_the_task_panels_subtitle_wraps_with_five_algorithms():
