@@ -80,6 +80,16 @@ class _Token:
     position: int
 
 
+#: Values a formula must not hold, in the user's words (SymPy's zoo is 1/0).
+REFUSED_VALUES = (
+    (sp.zoo, "an undefined constant: a division by zero"),
+    (sp.nan, "an undefined constant such as 0/0"),
+    (sp.oo, "an infinite constant"),
+    (-sp.oo, "an infinite constant"),
+    (sp.I, "a complex constant such as sqrt(-1)"),
+)
+
+
 def _tokens(text: str, field: str) -> list[_Token]:
     out, i = [], 0
     while i < len(text):
@@ -300,10 +310,9 @@ def parse_formula(text, names: Mapping[str, sp.Expr], field: str = "formula") ->
         raise FormulaError(
             f"{field}: cannot build the formula ({type(exc).__name__})", field, 0
         ) from None
-    if e.has(sp.zoo, sp.oo, -sp.oo, sp.nan) or e.has(sp.I):
-        raise FormulaError(
-            f"{field}: the formula has an undefined or complex constant ({e})", field, 0
-        )
+    for constant, words in REFUSED_VALUES:
+        if e.has(constant):
+            raise FormulaError(f"{field}: the formula has {words}", field, 0)
     for pw in e.atoms(sp.Pow):
         if pw.exp.is_number and not abs(float(sp.re(pw.exp))) <= MAX_EXPONENT:
             raise FormulaError(

@@ -7,14 +7,17 @@ let shape = null; // JSON of the controls on screen: rebuilt only when it change
 const inputs = new Map(); // control key -> element with setValue()
 const inForce = new Map(); // control key -> JSON of its value in the last state shown
 
-// A number as the user wrote it, or null when it is not one ("abc", "", "1,5").
+// A number as the user wrote it, or null when it is not a finite one ("abc", "", "1,5", "1e400").
 export function parseNumber(text) {
   const t = String(text).trim();
-  return /^[-+]?(\d+\.?\d*|\.\d+)(e[-+]?\d+)?$/i.test(t) ? Number(t) : null;
+  const n = /^[-+]?(\d+\.?\d*|\.\d+)(e[-+]?\d+)?$/i.test(t) ? Number(t) : null;
+  return Number.isFinite(n) ? n : null;
 }
 
-// A slider and a box for an exact value: the box sends what is typed (the server checks it
-// against the same range), the slider lands on the specification's step.
+// A slider and a box for an exact value: the slider lands on the specification's step within
+// its range; the box sends what is typed, which the server checks as the REST API does (gamma
+// in continuous mode, a start outside the joint limits: the box takes values beyond the
+// slider's ends, and the slider then rests at its end).
 function slider(c, value, send) {
   const toPos = (v) => (c.log ? Math.log10(v) : v);
   const fromPos = (p) => (c.log ? 10 ** p : p);
