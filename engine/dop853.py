@@ -294,8 +294,14 @@ def integrate(inverse, x0, y_d, tol, max_steps, record, tau0, rtol=RTOL, atol=AT
                 _MAX_FACTOR,
                 np.clip(_SAFETY * enorm**_EXPONENT, _MIN_FACTOR, _MAX_FACTOR),
             )
-        accept = (enorm < 1.0) & ~stage_bad
+        # A right inverse's task error falls along (7) as exp(-tau) (eq. (5)): a step that
+        # raised it is refused, however small its error in x (a task of large ||J|| turns an
+        # error in x within RTOL into a task error above tol, near the end of a run).
+        err_new = np.linalg.norm(e_new, axis=-1)
+        grew = (err_new > err_now[idx]) & bool(inverse.right_inverse)
+        accept = (enorm < 1.0) & ~stage_bad & ~grew
         factor = np.where(accept, factor, np.minimum(factor, 1.0))
+        factor = np.where(grew, np.minimum(factor, 0.5), factor)
         factor = np.where(stage_bad, _MIN_FACTOR, factor)
         last_bad[idx] = stage_bad
         h[idx] = hs * factor
@@ -307,7 +313,7 @@ def integrate(inverse, x0, y_d, tol, max_steps, record, tau0, rtol=RTOL, atol=AT
         nsteps[idx] += 1
         if rec is not None:
             rec.append((ai, tau[ai].copy(), x[ai].copy()))
-        err_now[ai] = np.linalg.norm(e_new[accept], axis=-1)
+        err_now[ai] = err_new[accept]
         status[ai[err_now[ai] < tol]] = Status.CONVERGED
         run = idx[status[idx] == Status.RUNNING]
         tiny = h[run] < 1e-12 * (1.0 + tau[run])

@@ -145,3 +145,19 @@ def test_damped_least_squares_stops_once_its_error_settles_at_the_nearest_point(
     assert result.nit < 1000
     np.testing.assert_allclose(result.x, 0.0, atol=1e-12)
     assert "beyond the arm's reach 2.4" in result.message
+
+
+@pytest.mark.parametrize("method", ["auto", "dop853"])
+@pytest.mark.parametrize(
+    ("task", "x0", "target"),
+    [(["x1**16", "x3"], [1.1, 0, 0], [1000, 0]), (["tan(x1)", "x3"], [0, 0, 0], [900, 0])],
+    ids=["x1^16", "tan"],
+)
+def test_a_task_of_large_jacobian_converges_and_is_not_called_singular(method, task, x0, target):
+    """J = diag-like with ||J|| up to 8e5 and full rank: the task error falls along (7) as
+    exp(-theta) (eq. (5)), so DOP853 refuses a step that raises it; a step whose error in x
+    was within tolerance had thrown the error from 3e-10 back to 1e-8 near the end, and the
+    run stopped there as stalled "at a kinematic singularity"."""
+    robot = e.robot_from_dict({"name": "formula", "variables": ["x1", "x2", "x3"], "task": task})
+    res = e.solve(e.Pseudoinverse(robot.kinematics), x0, target, method=method)
+    assert res.success and res.error < 1e-10, res.message
