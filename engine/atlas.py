@@ -24,20 +24,20 @@ from typing import Any
 
 import numpy as np
 
-from .exceptions import InvalidInputError, SingularConfigurationError, format_vector
+from .atlas_paths import base_manifolds, checked, path_family
+from .exceptions import InvalidInputError
 from .exports import plural
-from .inverses import Inverse, Pseudoinverse, algorithm_labels
+from .inverses import Inverse, algorithm_labels
 from .repeatability import MAX_CYCLES, MAX_PATH_POINTS, open_loop
-from .self_motion import SelfMotionManifold, project, trace
+from .self_motion import SelfMotionManifold
 from .solve_rules import MAX_ITERATIONS_LIMIT, MODES, check_gamma, chunk_limit
-from .solver import solve_batch
-from .validation import FloatArray, as_points, as_series, check_seed, count, positive
+from .validation import FloatArray, as_points, check_seed, count, positive
 
-#: Largest number of starts per path, of paths in a family, and of starts in a chunk. A chunk
-#: must also fit in the memory bound (:func:`~jik.engine.solve_rules.chunk_limit`); the starts
-#: need not, when the atlas is streamed (``iter_atlas``).
+#: Largest number of starts per path and of starts in a chunk (of paths in a family:
+#: :data:`~jik.engine.atlas_paths.MAX_PATHS`). A chunk must also fit in the memory bound
+#: (:func:`~jik.engine.solve_rules.chunk_limit`); the starts need not, when the atlas is
+#: streamed (``iter_atlas``).
 MAX_STARTS = 10**9
-MAX_PATHS = 10**4
 MAX_CHUNK = 65536
 #: Largest number of starts in a chunk by default, the unit of work handed to a backend: about a
 #: second of work for the paper's robots, few tasks for a scheduler.
@@ -177,16 +177,6 @@ def arc_lengths(
     return np.clip(lo + (hi - lo) * u, lo, hi)
 
 
-def family(base_path: FloatArray, shifts: FloatArray, scales: FloatArray) -> FloatArray:
-    """Paths (P, L0, r): every shift with every scale, shift-major; a scale acts about the path's
-    first point (the starts' task point), a shift moves the whole path."""
-    rel = base_path - base_path[0]
-    first = base_path[0] + shifts  # (S, r)
-    return (first[:, None, None, :] + scales[None, :, None, None] * rel).reshape(
-        -1, *base_path.shape
-    )
-
-
 def plan_atlas(
     inverses: Inverse | Sequence[Inverse],
     path,
@@ -256,7 +246,7 @@ def plan_atlas(
     kin = invs[0].kinematics
     if any(i.kinematics is not kin for i in invs):
         raise InvalidInputError("all inverses must share one kinematics", field="inverses")
-    base_path = _checked(lambda: as_points(path, kin.r, "path"), "path")
+    base_path = checked(lambda: as_points(path, kin.r, "path"), "path")
     if base_path.ndim != 2:
         raise InvalidInputError(f"path must be a list of task points (L, {kin.r})", field="path")
     base_path = open_loop(base_path)
@@ -266,36 +256,22 @@ def plan_atlas(
             f"{len(base_path)}",
             field="path",
         )
-    cycles = _checked(lambda: count(cycles, "cycles", 1, MAX_CYCLES), "cycles")
-    chunk = (
-        None if chunk is None else _checked(lambda: count(chunk, "chunk", 1, MAX_CHUNK), "chunk")
-    )
+    cycles = checked(lambda: count(cycles, "cycles", 1, MAX_CYCLES), "cycles")
+    chunk = None if chunk is None else checked(lambda: count(chunk, "chunk", 1, MAX_CHUNK), "chunk")
     if mode not in MODES:
         raise InvalidInputError(f"mode must be 'continuous' or 'discrete', got {mode!r}", "mode")
     settings = {
-        "gamma": _checked(lambda: check_gamma(gamma, mode), "gamma"),
+        "gamma": checked(lambda: check_gamma(gamma, mode), "gamma"),
         "mode": mode,
-        "tol": _checked(lambda: positive(tol, "tol"), "tol"),
+        "tol": checked(lambda: positive(tol, "tol"), "tol"),
         "max_iterations": None
         if max_iterations is None
-        else _checked(
+        else checked(
             lambda: count(max_iterations, "max_iterations", 1, MAX_ITERATIONS_LIMIT),
             "max_iterations",
         ),
     }
-    shift = (
-        np.zeros((1, kin.r))
-        if shifts is None
-        else _checked(lambda: as_points(shifts, kin.r, "shifts"), "shifts")
-    )
-    scale = np.ones(1) if scales is None else as_series(scales, "scales")
-    if shift.ndim != 2 or not len(shift):
-        raise InvalidInputError(f"shifts must be one or more task points (S, {kin.r})", "shifts")
-    if not len(scale) or not np.all(np.isfinite(scale) & (scale > 0)):
-        raise InvalidInputError("scales must be finite and > 0, one or more of them", "scales")
-    if len(shift) * len(scale) > MAX_PATHS:
-        raise InvalidInputError(f"at most {MAX_PATHS} paths (shifts x scales)", field="shifts")
-    paths = family(base_path, shift, scale)
+    paths, per_shift = path_family(kin, base_path, shifts, scales)
 
     fits = chunk_limit(kin, len(invs), cycles, paths.shape[1], settings, chunk)
 
@@ -306,7 +282,7 @@ def plan_atlas(
         return replace(plan, chunk=min(auto_chunk(plan.size), fits) if chunk is None else chunk)
 
     if starts is not None:
-        x = _checked(lambda: as_points(starts, kin.p, "starts"), "starts")
+        x = checked(lambda: as_points(starts, kin.p, "starts"), "starts")
         if x.ndim != 2 or not 1 <= len(x) <= MAX_STARTS:
             raise InvalidInputError(f"starts must be a list (N, {kin.p}), N >= 1", "starts")
         off = np.linalg.norm(kin.forward(x)[None] - paths[:, None, 0], axis=-1).max(axis=0)
@@ -333,64 +309,20 @@ def plan_atlas(
             "first point, where s = 0",
             missing[0],
         )
-    n = _checked(lambda: count(n_starts, "n_starts", 1, MAX_STARTS), "n_starts")
+    n = checked(lambda: count(n_starts, "n_starts", 1, MAX_STARTS), "n_starts")
     if sampling not in ("grid", "sample"):
         raise InvalidInputError(
             f"sampling must be 'grid' or 'sample', got {sampling!r}", "sampling"
         )
     seed = check_seed(seed)
-    ref = _checked(lambda: kin.check(reference, "reference"), "reference")
+    ref = checked(lambda: kin.check(reference, "reference"), "reference")
     if ref.ndim != 1:
         raise InvalidInputError(f"reference must be one configuration ({kin.p},)", "reference")
     if box is not None:
-        box = _checked(lambda: as_points(box, 2, "box"), "box")
+        box = checked(lambda: as_points(box, 2, "box"), "box")
         if box.shape != (kin.p, 2) or np.any(box[:, 0] >= box[:, 1]):
             raise InvalidInputError(f"box must be {kin.p} pairs (low, high), low < high", "box")
     if not isinstance(arc, Sequence) or len(arc) != 2:
         raise InvalidInputError("arc must be a pair (lo, hi) with lo <= 0 <= hi", field="arc")
-    manifolds = _checked(lambda: _manifolds(kin, paths, ref, arc, box), "reference")
+    manifolds = checked(lambda: base_manifolds(kin, paths, ref, arc, box, per_shift), "reference")
     return make(n_starts=n, sampling=(sampling, seed), manifolds=manifolds, explicit=None)
-
-
-def _manifolds(kin, paths, reference, arc, box) -> tuple[SelfMotionManifold, ...]:
-    """Each path's self-motion curve over one arc: the base path's, cut by ``box``."""
-    y0 = paths[:, 0]
-    try:
-        res = solve_batch(
-            Pseudoinverse(kin),
-            np.broadcast_to(reference, (len(y0), kin.p)),
-            y0,
-            tol=1e-12,
-            record=False,
-        )
-    except SingularConfigurationError as error:
-        raise InvalidInputError(str(error), field="reference") from None
-    if not np.all(res.success):  # (the path's point is at fault, not the reference: a default)
-        j = int(np.argmin(res.success))
-        raise InvalidInputError(
-            f"path {j}'s first point {format_vector(y0[j])} is out of reach: {res.message[j]}",
-            field="path",
-        )
-    bases = project(kin, res.x, y0)
-    try:
-        first = trace(kin, bases[0], arc, box)
-    except InvalidInputError as error:
-        if error.field != "base":
-            raise
-        where = str(error).partition(": ")[2]
-        raise InvalidInputError(
-            f"the path's first point {format_vector(y0[0])} is out of reach in the box (x_range, "
-            f"joint limits): eq. (7) from the reference reaches it only where {where}",
-            field="path",
-        ) from None
-    return (first, *(trace(kin, b, first.arc) for b in bases[1:]))
-
-
-def _checked(check, name: str):
-    """Run ``check`` and tag an InvalidInputError it raises with the field ``name``."""
-    try:
-        return check()
-    except InvalidInputError as error:
-        if error.field is None:
-            error.field = name
-        raise

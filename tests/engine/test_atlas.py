@@ -396,3 +396,33 @@ def test_sized_chunks_hold_about_a_second_of_runs(monkeypatch, seconds_per_run, 
     assert atlas_run.sized_chunks(plan).chunk == min(chunk, 188)
     assert sum(runs) == probed
     assert atlas_run.sized_chunks(dataclasses.replace(plan, chunk=2048)).chunk == chunk
+
+
+@pytest.mark.parametrize(
+    ("shifts", "field", "words"),
+    [
+        (
+            [[0.0, 0.0], [10.0, 10.0]],
+            "shifts.1",
+            "shifts[1] moves the path's first point to (11, 11), out of reach",
+        ),
+        ([[1e7, 1e7]], "shifts", "beyond 1e+06 in magnitude"),
+    ],
+)
+def test_a_shift_that_moves_the_path_out_of_reach_is_named(shifts, field, words):
+    """The family's paths share a shift's first point: a shift that moves it out of the arm's
+    reach (a planar 3R chain reaches 3) is refused naming that shift, not the path."""
+    from jik.engine.planar_chain import PlanarChain
+
+    arm = PlanarChain("RRR", [1.0, 1.0, 1.0])
+    with pytest.raises(InvalidInputError) as refused:
+        plan_atlas(
+            Pseudoinverse(arm),
+            [(1.0, 1.0), (1.5, 1.0), (1.5, 1.5)],
+            n_starts=4,
+            arc=(-0.5, 0.5),
+            reference=[0.3, 0.5, 0.7],
+            shifts=shifts,
+            scales=[1.0, 0.5],
+        )
+    assert refused.value.field == field and words in str(refused.value), refused.value

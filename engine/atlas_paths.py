@@ -1,0 +1,118 @@
+"""An atlas's paths and the self-motion curves its starts lie on.
+
+The family of paths (:func:`path_family`: every shift of a base path with every scale about its
+first point) and, for starts on the self-motion manifold k(x) = path[0] of each path's first point
+(sec. 2: one-dimensional, p - r = 1), those curves traced over one arc
+(:func:`base_manifolds`, :mod:`jik.engine.self_motion`), s = 0 where eq. (7) with the
+pseudoinverse (8) from a reference configuration reaches the point.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .exceptions import InvalidInputError, SingularConfigurationError, format_vector
+from .inverses import Pseudoinverse
+from .self_motion import SelfMotionManifold, project, trace
+from .solver import solve_batch
+from .validation import MAX_COORDINATE, FloatArray, as_points, as_series
+
+#: Largest number of paths in a family (shifts x scales).
+MAX_PATHS = 10**4
+
+
+def family(base_path: FloatArray, shifts: FloatArray, scales: FloatArray) -> FloatArray:
+    """Paths (P, L0, r): every shift with every scale, shift-major; a scale acts about the path's
+    first point (the starts' task point), a shift moves the whole path."""
+    rel = base_path - base_path[0]
+    first = base_path[0] + shifts  # (S, r)
+    return (first[:, None, None, :] + scales[None, :, None, None] * rel).reshape(
+        -1, *base_path.shape
+    )
+
+
+def path_family(kin, base_path: FloatArray, shifts, scales) -> tuple[FloatArray, int | None]:
+    """The family of ``base_path`` (L0, r) by ``shifts`` (S, r) and ``scales`` (Q,), checked
+    (None: no shift, scale 1), and how many of its paths share each shift's first point (Q;
+    None without shifts).
+
+    Raises
+    ------
+    InvalidInputError
+        ``shifts`` or ``scales`` malformed, more than :data:`MAX_PATHS` paths, or a path
+        moved beyond the task coordinates a solve takes.
+    """
+    shift = (
+        np.zeros((1, kin.r))
+        if shifts is None
+        else checked(lambda: as_points(shifts, kin.r, "shifts"), "shifts")
+    )
+    scale = np.ones(1) if scales is None else as_series(scales, "scales")
+    if shift.ndim != 2 or not len(shift):
+        raise InvalidInputError(f"shifts must be one or more task points (S, {kin.r})", "shifts")
+    if not len(scale) or not np.all(np.isfinite(scale) & (scale > 0)):
+        raise InvalidInputError("scales must be finite and > 0, one or more of them", "scales")
+    if len(shift) * len(scale) > MAX_PATHS:
+        raise InvalidInputError(f"at most {MAX_PATHS} paths (shifts x scales)", field="shifts")
+    paths = family(base_path, shift, scale)
+    if not np.all(np.abs(paths) <= MAX_COORDINATE):  # (a solve's bound on task coordinates)
+        raise InvalidInputError(
+            f"shifts and scales move the path to task coordinates beyond {MAX_COORDINATE:g} in "
+            "magnitude, which a solve does not take",
+            field="shifts" if shifts is not None else "scales",
+        )
+    return paths, None if shifts is None else len(scale)
+
+
+def base_manifolds(
+    kin, paths, reference, arc, box, per_shift: int | None = None
+) -> tuple[SelfMotionManifold, ...]:
+    """Each path's self-motion curve over one arc: the base path's, cut by ``box``. With
+    shifts, ``per_shift`` paths (one per scale) share each shift's first point: a first point
+    out of reach is that shift's fault."""
+    y0 = paths[:, 0]
+    try:
+        res = solve_batch(
+            Pseudoinverse(kin),
+            np.broadcast_to(reference, (len(y0), kin.p)),
+            y0,
+            tol=1e-12,
+            record=False,
+        )
+    except SingularConfigurationError as error:
+        raise InvalidInputError(str(error), field="reference") from None
+    if not np.all(res.success):  # (the path's point is at fault, not the reference: a default)
+        j = int(np.argmin(res.success))
+        point, why = format_vector(y0[j]), res.message[j]
+        if per_shift is None:
+            raise InvalidInputError(
+                f"path: its first point {point} is out of reach: {why}", field="path"
+            )
+        raise InvalidInputError(
+            f"shifts[{j // per_shift}] moves the path's first point to {point}, out of reach: "
+            f"{why}",
+            field=f"shifts.{j // per_shift}",
+        )
+    bases = project(kin, res.x, y0)
+    try:
+        first = trace(kin, bases[0], arc, box)
+    except InvalidInputError as error:
+        if error.field != "base":
+            raise
+        where = str(error).partition(": ")[2]
+        raise InvalidInputError(
+            f"the path's first point {format_vector(y0[0])} is out of reach in the box (x_range, "
+            f"joint limits): eq. (7) from the reference reaches it only where {where}",
+            field="path",
+        ) from None
+    return (first, *(trace(kin, b, first.arc) for b in bases[1:]))
+
+
+def checked(check, name: str):
+    """Run ``check`` and tag an InvalidInputError it raises with the field ``name``."""
+    try:
+        return check()
+    except InvalidInputError as error:
+        if error.field is None:
+            error.field = name
+        raise
