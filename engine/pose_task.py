@@ -133,8 +133,11 @@ class PoseTask:
         far = np.argwhere(length > np.pi + 1e-9)
         if len(far) == 0:
             return
-        at = tuple(far[0])
-        where = f" point {', '.join(map(str, at))}" if length.size > 1 else ""
+        at = tuple(int(i) for i in far[0])
+        base, where = field_for(name, field), ""
+        if length.size > 1:  # (the point, by its index from 0 as a field names it: path[1])
+            where = f"[{', '.join(map(str, at))}]"
+            base = None if base is None else ".".join([base, *map(str, at)])
         coords = ", ".join(n for n in self.names if len(n) == 2)
         same = ""
         if len(rows) == 3:  # (the principal rotation vector of that rotation, whatever its turns)
@@ -144,7 +147,7 @@ class PoseTask:
             f"{name}{where} is out of reach: its rotation coordinates ({coords}) have length "
             f"{length[at]:.6g} > pi, and the rotation coordinates (the principal log of R0^T R) "
             f"never exceed pi{same}",
-            field_for(name, field),
+            base,
         )
 
     def pose_of(self, y: FloatArray) -> tuple[FloatArray | None, FloatArray | None]:
