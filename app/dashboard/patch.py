@@ -92,7 +92,11 @@ def parse_patch(body: Any) -> dict[str, Any]:
     try:
         return patch_of(StatePatch.model_validate(body))
     except ValidationError as exc:
-        error = exc.errors()[0]
+        errors = exc.errors()
+        # (of a union's refusals, the one of the member the value is: a text path too long is
+        # that, not "should be a valid tuple")
+        same = [e for e in errors if e["loc"][:1] == errors[0]["loc"][:1]]
+        error = next((e for e in same if not e["type"].endswith("_type")), same[0])
         field = ".".join(error_location(body, error)) or "body"
         raise refused(field, refusal(error)) from None
 

@@ -170,6 +170,17 @@ def test_refusals_carry_their_field(patch, field):
     assert refused.value.field == field
 
 
+def test_a_text_path_too_long_is_refused_for_its_length():
+    """A path given as text past its bound is refused for that, not as "a valid tuple" (the
+    other member of its type)."""
+    from jik.app.dashboard.patch import parse_patch
+
+    with pytest.raises(InvalidInputError) as refused:
+        parse_patch({"path": "1, 1; " * 3000})
+    assert refused.value.field == "path"
+    assert str(refused.value) == "path: String should have at most 10000 characters"
+
+
 @pytest.mark.parametrize(
     ("field", "keys"),
     [
