@@ -163,4 +163,7 @@ def _spec(title: str, table: _Table, notes: list[str], differs: list[list]) -> d
 
 
 def _point(p) -> str:
-    return "(" + ", ".join(f"{v:.3g}" for v in p) + ")"
+    """A task point to three digits, a coordinate of round-off (1e-12 of the point's size) as 0,
+    as the path's box shows it."""
+    tiny = 1e-12 * max(1.0, *(abs(v) for v in p))
+    return "(" + ", ".join(f"{(v if abs(v) > tiny else 0.0) + 0.0:.3g}" for v in p) + ")"

@@ -314,6 +314,15 @@ def test_table1_gives_each_chosen_algorithm_its_column_group(three):
     )
 
 
+def test_the_tables_task_points_show_round_off_as_zero():
+    """A leg's target labelled in the table as the path's box shows it: a coordinate of
+    round-off (an arm's rz of -9.18e-18) as 0, never "-0"."""
+    from jik.app.dashboard.table import _point
+
+    assert _point([0.3, -9.18e-18, -4.06e-33, 1.5, -0.0]) == "(0.3, 0, 0, 1.5, 0)"
+    assert _point([1e-13, 2e-13]) == "(0, 0)" and _point([0.001234, 5.0]) == "(0.00123, 5)"
+
+
 # -- the posture inverse's rest x_rest -------------------------------------------------------------
 
 
