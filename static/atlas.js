@@ -166,9 +166,12 @@ async function draw(body, key) {
   }
   showProgress(null);
   $("#atlas-csv").disabled = false;
-  // body.runs counts the starts (times the paths); every chosen algorithm runs each of them.
+  // body.runs counts the starts times the paths (a path per scale); every chosen algorithm runs
+  // each of them.
   const k = body.request.algorithms.length;
-  const per = `${body.runs} start${body.runs === 1 ? "" : "s"} x ${k} algorithm${k === 1 ? "" : "s"}`;
+  const paths = (body.request.scales || [1]).length;
+  const count = (n, noun) => `${n} ${noun}${n === 1 ? "" : "s"}`;
+  const per = [count(body.runs / paths, "start"), ...(paths > 1 ? [count(paths, "path scale")] : []), count(k, "algorithm")].join(" x ");
   say(`Atlas done: ${body.runs * k} runs (${per}) of ${body.request.cycles} cycles in ${fmt(body.elapsed_s, 1)} s. Click a cell to move the main view to that start.`);
   div.dataset.runs = body.runs;
 }

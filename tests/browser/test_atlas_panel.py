@@ -248,6 +248,8 @@ def test_a_click_in_a_scaled_band_keeps_the_atlas_current(tabs):
     start_atlas(tab, 8, 1)
     status = page.locator("#atlas-status")
     expect(status).to_contain_text("Atlas done", timeout=120_000)
+    # (the runs counted as the plot's title counts the starts: 8 each, on two paths)
+    expect(status).to_contain_text("(8 starts x 2 path scales x 2 algorithms)")
     drag = page.locator("#plot-atlas .xy .nsewdrag")
     drag.scroll_into_view_if_needed()
     cell = drag.bounding_box()
