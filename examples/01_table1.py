@@ -34,7 +34,8 @@ runs = {
 for name, run in runs.items():
     print(f"  {name}")
     for corner, x in zip(["A", "B", "C", "D", "A"], [x0, *run.legs[: len(path)]], strict=True):
-        print(f"    {corner}  " + "  ".join(f"{v:8.4f}" for v in x))
+        # (rounded first: a round-off of -1e-17 prints as 0.0000, as the paper's table does)
+        print(f"    {corner}  " + "  ".join(f"{round(v, 4) + 0.0:8.4f}" for v in x))
 
 print(f"\nDrift ||x - x0|| after each of {args.cycles} cycles")
 for name, run in runs.items():
