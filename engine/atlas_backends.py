@@ -19,7 +19,8 @@ from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from typing import Any, Protocol
 
-from .. import install_hint
+from jik import install_hint
+
 from .exceptions import InvalidInputError
 
 #: Chunks in flight per worker: one running, one queued so a worker never waits for the caller.

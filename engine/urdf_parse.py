@@ -17,7 +17,8 @@ import io
 import logging
 import re
 
-from .. import install_hint
+from jik import install_hint
+
 from .exceptions import InvalidInputError
 
 #: Largest URDF text accepted [bytes].
