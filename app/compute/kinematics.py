@@ -72,7 +72,8 @@ class KinematicsResponse(BaseModel):
         description="k(x): r numbers, or one row per configuration (null where not finite)"
     )
     J: list[list[float | None]] | list[list[list[float | None]]] = Field(
-        description="J(x) = dk/dx: r rows of p, or one such matrix per configuration"
+        description="J(x) = dk/dx: r rows of p, or one such matrix per configuration (a row "
+        "null where its k is not: a derivative of an undefined coordinate is none)"
     )
 
 
@@ -85,6 +86,7 @@ def kinematics_request(req: KinematicsRequest) -> KinematicsResponse:
         check_length(spec, row, f"x[{i}]" if many else "x", "p")
     x = np.asarray(req.x, dtype=float)
     k, J = kin.forward_jacobian(x)
+    J = np.where(np.isfinite(k)[..., None], J, np.nan)  # (log(x1) at x1 = -1: no dk/dx either)
     return KinematicsResponse(
         robot=robot.robot,
         variable_names=list(spec.variable_names),

@@ -50,6 +50,15 @@ def test_a_user_robot(api):
     np.testing.assert_allclose(body["k"], [1.8, 0.0], atol=1e-15)
 
 
+def test_where_a_coordinate_is_undefined_so_is_its_row_of_j(api):
+    """log(x1) at x1 = -1 has no real value: k's coordinate is null, and so is its row of J
+    (its formula's derivative, 1/x1, would be -1); the other row stays."""
+    robot = {"name": "formula", "variables": ["x1", "x2", "x3"], "task": ["log(x1)", "x3"]}
+    body = _ok(api.post("/kinematics", json={"robot": robot, "x": [-1.0, 0.0, 0.5]}))
+    assert body["k"] == [None, 0.5]
+    assert body["J"] == [[None, None, None], [0.0, 0.0, 1.0]]
+
+
 @pytest.mark.parametrize(
     ("body", "field", "text"),
     [
