@@ -1,6 +1,6 @@
-"""Picard guesses for the continuous solves of eq. (7): from earlier trajectories, and chained
-over a closed path's legs (:mod:`jik.engine.picard`); :func:`solve` is
-:func:`jik.engine.solver.solve`."""
+"""Picard guesses for the continuous solves of eq. (7): from earlier trajectories, chained
+over a closed path's legs (:mod:`jik.engine.picard`), and a repeatability run's guesses for one
+cycle (:func:`cycle_guesses`); :func:`solve` is :func:`jik.engine.solver.solve`."""
 
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ from .inverses import Inverse
 from .picard import CHAIN_SWEEPS, Guess, picard_chain
 from .results import Trajectory
 from .solve_rules import MAX_ITERATIONS_LIMIT, check_gamma
+from .unicycle import Unicycle
 from .validation import count
 
 
@@ -125,3 +126,38 @@ def chain_guesses(
         Trajectory(theta=theta, x=X[j], y=y[j], error=error[j], h=inverse.augmenting_value(X[j]))
         for j in range(len(X))
     ]
+
+
+def cycle_guesses(
+    inverse: Inverse,
+    start,
+    targets,
+    guides: list[Trajectory | None],
+    gamma: float = 1.0,
+    max_sweeps: int = CHAIN_SWEEPS,
+) -> list[Trajectory | None]:
+    """Picard guesses for one cycle's legs of a closed path from ``start`` (continuous mode,
+    one start): the ``guess`` of each leg's :func:`jik.engine.solver.solve`, eq. (7).
+
+    The extended inverse is repeatable: a leg repeats the same leg of the cycle before, so
+    ``guides`` (those legs' trajectories, None in the first cycle) are its guesses, and a leg
+    then takes one or two sweeps. The pseudoinverse (and the other right inverses, weighted and
+    posture) drifts, so the cycle before saves almost nothing: its legs are swept together from
+    ``start`` (:func:`jik.engine.picard_guesses.chain_guesses`), one or two sweeps a leg instead of
+    about ten, and a cycle's numbers depend only on its start. A chain evaluates J# about three
+    times as often as the legs would, so it pays only where an evaluation costs little beyond
+    numpy's per-call overhead: not for the unicycle. The chain takes at most ``max_sweeps``
+    sweeps, the run's cap on a leg's steps: a cap that a leg's solve cannot meet is not met by
+    sweeping the cycle's legs together either.
+    """
+    if (
+        inverse.name != "extended"
+        and inverse.right_inverse
+        and len(targets) > 1
+        and not isinstance(inverse.kinematics, Unicycle)
+    ):
+        chained = chain_guesses(inverse, start, targets, gamma=gamma, max_sweeps=max_sweeps)
+        if chained is not None:
+            return list(chained)
+    # A leg that started at its target recorded its start alone: nothing to sweep from.
+    return [g if g is not None and len(g.theta) >= 2 else None for g in guides]

@@ -22,8 +22,7 @@ import numpy as np
 from .exceptions import InvalidInputError, JikError, format_vector
 from .exports import plural
 from .inverses import Inverse
-from .picard import CHAIN_SWEEPS
-from .picard_guesses import chain_guesses
+from .picard_guesses import cycle_guesses
 from .progress import Progress, check_cancelled, check_progress, stops_at
 from .repeatability_result import RepeatabilityResult
 from .results import BatchSolveResult, SolveResult, Trajectory
@@ -31,7 +30,6 @@ from .run_settings import Resume, RunSettings, inverse_fingerprint, resumed_legs
 from .solve_chunks import solve_in_chunks
 from .solve_rules import check_inverse, check_settings, run_bytes
 from .solver import solve, solve_batch
-from .unicycle import Unicycle
 from .validation import FloatArray, as_numbers, check_memory, count, flag
 
 #: A run is called repeatable when its joints come back to x0 within this after every cycle
@@ -117,41 +115,6 @@ def open_loop(path: FloatArray) -> FloatArray:
     back to k(x): without a last point repeating the first, when more than two remain."""
     closes = len(path) > 2 and np.linalg.norm(path[-1] - path[0]) <= CLOSE_TOL
     return path[:-1] if closes else path
-
-
-def cycle_guesses(
-    inverse: Inverse,
-    start,
-    targets,
-    guides: list[Trajectory | None],
-    gamma: float = 1.0,
-    max_sweeps: int = CHAIN_SWEEPS,
-) -> list[Trajectory | None]:
-    """Picard guesses for one cycle's legs of a closed path from ``start`` (continuous mode,
-    one start): the ``guess`` of each leg's :func:`jik.engine.solver.solve`, eq. (7).
-
-    The extended inverse is repeatable: a leg repeats the same leg of the cycle before, so
-    ``guides`` (those legs' trajectories, None in the first cycle) are its guesses, and a leg
-    then takes one or two sweeps. The pseudoinverse (and the other right inverses, weighted and
-    posture) drifts, so the cycle before saves almost nothing: its legs are swept together from
-    ``start`` (:func:`jik.engine.picard_guesses.chain_guesses`), one or two sweeps a leg instead of
-    about ten, and a cycle's numbers depend only on its start. A chain evaluates J# about three
-    times as often as the legs would, so it pays only where an evaluation costs little beyond
-    numpy's per-call overhead: not for the unicycle. The chain takes at most ``max_sweeps``
-    sweeps, the run's cap on a leg's steps: a cap that a leg's solve cannot meet is not met by
-    sweeping the cycle's legs together either.
-    """
-    if (
-        inverse.name != "extended"
-        and inverse.right_inverse
-        and len(targets) > 1
-        and not isinstance(inverse.kinematics, Unicycle)
-    ):
-        chained = chain_guesses(inverse, start, targets, gamma=gamma, max_sweeps=max_sweeps)
-        if chained is not None:
-            return list(chained)
-    # A leg that started at its target recorded its start alone: nothing to sweep from.
-    return [g if g is not None and len(g.theta) >= 2 else None for g in guides]
 
 
 def repeatability(
@@ -258,6 +221,7 @@ def repeatability(
         targets = np.broadcast_to(path, (len(xb), *path.shape[-2:]))
     n, L = targets.shape[:2]
     legs = np.full((n, cycles * L, kin.p), np.nan)
+    stopped_at = np.full((n, kin.p), np.nan)  # (where a failed leg stopped)
     alive = np.ones(n, dtype=bool)
     messages = ["repeatability run completed"] * n
     current = xb.copy()
@@ -356,10 +320,13 @@ def repeatability(
                 messages[ids[k]] = f"cycle {c + 1}, leg {j + 1} " + (
                     f"stopped: {stopped}" if stopped is not None else f"failed: {why[k]}"
                 )
+                stopped_at[ids[k]] = xs[k]
                 legs[ids[k], c * L + j] = np.nan
             if progress is not None:
                 progress.leg(Leg(c, j, ids, res, stopped))
-    return RepeatabilityResult.of_run(inverse, xb, targets, legs, alive, messages, leg_results, run)
+    return RepeatabilityResult.of_run(
+        inverse, xb, targets, legs, alive, messages, leg_results, run, stopped_at
+    )
 
 
 def _between(progress, where: str):

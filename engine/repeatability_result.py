@@ -49,6 +49,9 @@ class RepeatabilityResult(Columns):
         NaN after a failed leg); None for an inverse without h.
     used : Inverse or None
         The inverse J# the legs ran with (whose parameters :meth:`findings` reads).
+    stopped : ndarray, shape (p,) or (n, p), or None
+        Where a failed leg stopped (its ``legs`` entry is NaN: it reached no leg end); NaN for
+        a run that completed.
     """
 
     x0: FloatArray
@@ -62,13 +65,16 @@ class RepeatabilityResult(Columns):
     settings: RunSettings
     h: FloatArray | None = None
     used: Inverse | None = None
+    stopped: FloatArray | None = None
 
     @classmethod
-    def of_run(cls, inverse: Inverse, x0, targets, legs, alive, messages, leg_results, settings):
+    def of_run(
+        cls, inverse: Inverse, x0, targets, legs, alive, messages, leg_results, settings, stopped
+    ):
         """The result of :func:`jik.engine.repeatability.repeatability` from its batch arrays:
-        ``x0`` (n, p), ``targets`` (n, L, r), ``legs`` (n, cycles * L, p), ``alive`` (n,) and
-        ``messages``; one start's (shapes without n) when ``leg_results`` or n is 1 and
-        ``targets`` of ``settings`` is (L, r)."""
+        ``x0`` (n, p), ``targets`` (n, L, r), ``legs`` (n, cycles * L, p), ``alive`` (n,),
+        ``messages`` and ``stopped`` (n, p); one start's (shapes without n) when
+        ``leg_results`` or n is 1 and ``targets`` of ``settings`` is (L, r)."""
         cycle_end = legs[:, targets.shape[1] - 1 :: targets.shape[1]]
         drift = np.linalg.norm(cycle_end - x0[:, None, :], axis=-1)  # (n, cycles)
         points = np.concatenate([x0[:, None, :], legs], axis=1)
@@ -81,9 +87,11 @@ class RepeatabilityResult(Columns):
         if np.ndim(settings.targets) == 2:
             one = None if h is None else h[0]
             ends = (cycle_end[0], drift[0], bool(alive[0]), messages[0])
-            return cls(x0[0], targets[0], legs[0], *ends, leg_results, settings, one, inverse)
+            return cls(
+                x0[0], targets[0], legs[0], *ends, leg_results, settings, one, inverse, stopped[0]
+            )
         ends = (cycle_end, drift, alive, tuple(messages))
-        return cls(x0, targets, legs, *ends, [], settings, h, inverse)
+        return cls(x0, targets, legs, *ends, [], settings, h, inverse, stopped)
 
     @property
     def algorithm(self) -> str:
@@ -218,7 +226,8 @@ class RepeatabilityResult(Columns):
     def as_dict(self) -> dict[str, Any]:
         """JSON-friendly: the algorithm, the inverse as printed, mode, gamma, tol,
         max_iterations, x0, the legs' targets, leg ends, cycle ends, drift (None after a failed
-        leg: :func:`~jik.engine.exports.json_values`), success, message."""
+        leg: :func:`~jik.engine.exports.json_values`), success, message, and where a failed leg
+        stopped (``stopped_at``, None for a run that completed)."""
         s = self.settings
         return json_values(
             {
@@ -235,6 +244,7 @@ class RepeatabilityResult(Columns):
                 "drift": self.drift.tolist(),
                 "success": np.asarray(self.success).tolist(),
                 "message": self.message if isinstance(self.message, str) else list(self.message),
+                "stopped_at": None if self.stopped is None else self.stopped.tolist(),
             }
         )
 

@@ -143,7 +143,7 @@ class Resume:
         (every leg converged) from the same x0, path and settings.
     guides : sequence of L Trajectory or None
         Continuous mode, one start: the trajectories of cycle c's legs, each the Picard guess of
-        the same leg of the next cycle (:func:`jik.engine.repeatability.cycle_guesses`).
+        the same leg of the next cycle (:func:`jik.engine.picard_guesses.cycle_guesses`).
         Without them the extended inverse's next cycle starts its sweeps cold: the same legs to
         the sweep tolerance.
     settings : RunSettings or None

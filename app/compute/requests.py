@@ -184,6 +184,7 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
         repeatable=bool(res.success) and repeatable(drift) is True,
         success=bool(res.success),
         message=cast(str, res.message),  # one start configuration: one message
+        stopped_at=None if res.success or res.stopped is None else nullable(res.stopped),
         findings=[S.Sentence.model_validate(f._asdict()) for f in res.findings(unit)],
         **limits_document(setup.kinematics, res),
     )

@@ -31,6 +31,16 @@ def test_table1_pseudoinverse_column(api):
     np.testing.assert_allclose(b["drift"][0], np.linalg.norm(np.subtract(b["legs"][-1], X0_M2)))
     assert b["drift"][0] > 0.3  # the pseudoinverse is not repeatable
     assert b["repeatable"] is False and b["success"] is True
+    assert b["stopped_at"] is None  # (every leg reached its target)
+
+
+def test_a_failed_leg_says_where_it_stopped(api):
+    """The extended inverse stalls at an algorithmic singularity on its first leg: no leg end
+    (null), but the configuration where the leg stopped, beside the message."""
+    b = api.post("/repeatability", json=_body(algorithm="extended", x0=[0, -0.69, 0.675])).json()
+    assert b["success"] is False and b["message"].startswith("cycle 1, leg 1 failed: stalled")
+    assert b["legs"][0] == [None] * 3
+    assert 1e-4 < np.linalg.norm(np.subtract(b["stopped_at"], [0, -0.69, 0.675])) < 1e-3
 
 
 def test_pseudoinverse_drift_grows_over_cycles(api):

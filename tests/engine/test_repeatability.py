@@ -401,3 +401,21 @@ def test_a_leg_is_capped_as_its_solve_is(algorithm):
     assert not run.success
     assert run.message.startswith("cycle 1, leg 1"), run.message
     assert repeatability(inv, x0, path, cycles=2).success
+
+
+def test_a_failed_leg_says_where_it_stopped():
+    """A run stopped by a failed leg keeps no leg end for it (NaN), but says where the leg
+    stopped (stopped, as_dict's stopped_at): the extended inverse's stall at an algorithmic
+    singularity of Manipulator 2, 2.7e-4 from its start. A batch says it per start (NaN for
+    the starts that completed)."""
+    inv = ExtendedInverse(Manipulator2(), PaperCubic())
+    x0, path = np.array([0.0, -0.69, 0.675]), [(1, 1), (1, 2), (0, 2), (0, 1)]
+    run = repeatability(inv, x0, path)
+    assert not run.success and np.isnan(run.legs[0]).all()
+    assert run.message.startswith("cycle 1, leg 1 failed: stalled")
+    assert 1e-4 < np.linalg.norm(run.stopped - x0) < 1e-3
+    assert run.as_dict()["stopped_at"] == run.stopped.tolist()
+    batch = repeatability(inv, np.array([x0, [0.0, 0.0, math.pi / 2]]), path)
+    assert list(batch.success) == [False, True]
+    np.testing.assert_allclose(batch.stopped[0], run.stopped, atol=1e-9)
+    assert np.isnan(batch.stopped[1]).all()

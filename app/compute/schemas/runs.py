@@ -201,6 +201,11 @@ class RepeatabilityResponse(_RunResponse):
     )
     success: bool
     message: str
+    stopped_at: list[MaybeFloat] | None = Field(
+        None,
+        description="where a failed leg stopped, the configuration it reached (its legs entry "
+        "is null); null for a run that completed",
+    )
     findings: list[Sentence] = Field(
         description="what the run found and why, the dashboard's sentences: repeatable or not; "
         "for J^E# (11) whether h stayed at h(x0), eq. (12); in discrete mode what gamma did; "
