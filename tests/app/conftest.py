@@ -52,17 +52,22 @@ def module_app():
 
 
 @pytest.fixture
-def app(module_app):
+def app(module_app, request):
     """The module's app with this test's own dashboard sessions (at most 4, no 3D scene: they
-    compute in their own threads) and atlas jobs (made on first use)."""
+    compute in their own threads) and atlas jobs: made on first use, or by the module's
+    ``ATLAS_LIMITS`` (jobs that run in the test's process)."""
+    from jik.app.compute.atlas_jobs import AtlasJobs
     from jik.app.dashboard.sessions import SessionStore
 
+    limits = getattr(request.module, "ATLAS_LIMITS", None)
+    made = None if limits is None else AtlasJobs(limits)
     module_app.state.sessions = SessionStore(Settings(max_sessions=4))
-    module_app.state.atlas_jobs = None
+    module_app.state.atlas_jobs = made
     yield module_app
     module_app.state.sessions.close()
-    if module_app.state.atlas_jobs is not None:
-        module_app.state.atlas_jobs.close()
+    for jobs in (made, module_app.state.atlas_jobs):  # (a test may have put its own)
+        if jobs is not None:
+            jobs.close()
 
 
 @pytest.fixture

@@ -20,7 +20,6 @@ from jik.app.compute.pool import pool_in_thread
 from jik.app.compute.schemas import MAX_ITERATIONS_CAP
 from jik.app.compute.settings import Settings
 from jik.app.dashboard.controls import MIN_ITERATIONS
-from jik.app.dashboard.sessions import SessionStore
 from jik.engine.atlas_run import run_atlas
 from jik.engine.registry import robot_spec
 from tests.app.conftest import messages
@@ -44,16 +43,8 @@ def body(**over) -> dict:
 LONG = body(starts=20000, cycles=5, arc=None)
 
 
-@pytest.fixture
-def app(module_app):
-    """The module's app (tests/app/conftest.py) with this test's own atlas jobs and sessions."""
-    jobs = AtlasJobs(AtlasLimits(max_jobs=3, per_client=1))
-    module_app.state.atlas_jobs = jobs
-    module_app.state.sessions = SessionStore(Settings(max_sessions=4))
-    yield module_app
-    jobs.close()
-    module_app.state.atlas_jobs.close()
-    module_app.state.sessions.close()
+#: The atlas jobs of each test's app (tests/app/conftest.py's ``app``).
+ATLAS_LIMITS = AtlasLimits(max_jobs=3, per_client=1)
 
 
 @pytest.fixture

@@ -11,11 +11,8 @@ import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
-from jik.app.compute.atlas_jobs import AtlasJobs
 from jik.app.compute.atlas_plan import AtlasLimits, planned
 from jik.app.compute.atlas_schemas import AtlasRequest
-from jik.app.compute.settings import Settings
-from jik.app.dashboard.sessions import SessionStore
 from jik.engine.atlas_run import run_atlas
 from jik.engine.exports import csv_rows
 from tests.app.test_atlas_api import LONG, body, wait_until_ended
@@ -24,16 +21,8 @@ from tests.app.test_atlas_api import LONG, body, wait_until_ended
 TEXT = {"algorithm", "path", "start", "cycle", "leg", "success"}
 
 
-@pytest.fixture
-def app(module_app):
-    """The module's app (tests/app/conftest.py) with this test's own atlas jobs and sessions."""
-    jobs = AtlasJobs(AtlasLimits(max_jobs=4, per_client=2))
-    module_app.state.atlas_jobs = jobs
-    module_app.state.sessions = SessionStore(Settings(max_sessions=4))
-    yield module_app
-    jobs.close()
-    module_app.state.atlas_jobs.close()
-    module_app.state.sessions.close()
+#: The atlas jobs of each test's app (tests/app/conftest.py's ``app``).
+ATLAS_LIMITS = AtlasLimits(max_jobs=4, per_client=2)
 
 
 @pytest.fixture
