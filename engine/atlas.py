@@ -31,7 +31,7 @@ from .inverses import Inverse, algorithm_labels
 from .repeatability import MAX_CYCLES, MAX_PATH_POINTS, open_loop
 from .self_motion import SelfMotionManifold
 from .solve_rules import MAX_ITERATIONS_LIMIT, MODES, check_gamma, chunk_limit
-from .validation import FloatArray, as_points, check_seed, count, positive
+from .validation import FloatArray, as_points, bounded, check_seed, count, positive
 
 #: Largest number of starts per path and of starts in a chunk (of paths in a family:
 #: :data:`~jik.engine.atlas_paths.MAX_PATHS`). A chunk must also fit in the memory bound
@@ -315,7 +315,7 @@ def plan_atlas(
             f"sampling must be 'grid' or 'sample', got {sampling!r}", "sampling"
         )
     seed = check_seed(seed)
-    ref = checked(lambda: kin.check(reference, "reference"), "reference")
+    ref = checked(lambda: bounded(kin.check(reference, "reference"), "reference"), "reference")
     if ref.ndim != 1:
         raise InvalidInputError(f"reference must be one configuration ({kin.p},)", "reference")
     if box is not None:

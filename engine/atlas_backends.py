@@ -222,7 +222,13 @@ def backend_for(option: str | Backend | None) -> Backend:
     if option is None or option == "inprocess":
         return InProcess()
     if not isinstance(option, str):
-        return option
+        if all(hasattr(option, a) for a in ("__enter__", "__exit__", "imap_unordered")):
+            return option
+        raise InvalidInputError(
+            "backend must be 'inprocess', 'processes:N', 'dask:ADDRESS', 'dask:local:N' or a "
+            f"Backend (a context manager with imap_unordered), got {type(option).__name__}",
+            field="backend",
+        )
     kind, _, rest = option.partition(":")
     if kind == "processes":
         if not rest.isdigit() or not 1 <= int(rest) <= MAX_WORKERS:

@@ -15,7 +15,7 @@ from .exceptions import InvalidInputError, SingularConfigurationError, format_ve
 from .inverses import Pseudoinverse
 from .self_motion import SelfMotionManifold, project, trace
 from .solver import solve_batch
-from .validation import MAX_COORDINATE, FloatArray, as_points, as_series
+from .validation import MAX_COORDINATE, FloatArray, as_points, as_series, bounded
 
 #: Largest number of paths in a family (shifts x scales).
 MAX_PATHS = 10**4
@@ -54,6 +54,7 @@ def path_family(kin, base_path: FloatArray, shifts, scales) -> tuple[FloatArray,
         raise InvalidInputError("scales must be finite and > 0, one or more of them", "scales")
     if len(shift) * len(scale) > MAX_PATHS:
         raise InvalidInputError(f"at most {MAX_PATHS} paths (shifts x scales)", field="shifts")
+    bounded(base_path, "path")
     paths = family(base_path, shift, scale)
     if not np.all(np.abs(paths) <= MAX_COORDINATE):  # (a solve's bound on task coordinates)
         raise InvalidInputError(

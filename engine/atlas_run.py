@@ -216,7 +216,7 @@ class AtlasResult(Columns):
         cycle) and ``x_k`` the leg's end. ``runs``: the rows of those runs alone (run = path *
         N + start), a block of the table."""
         A, P, N, C = self.drift.shape
-        runs = slice(None) if runs is None else runs
+        runs = slice(None) if runs is None else of_type(runs, slice, "runs", "a slice of runs")
         path, start = np.divmod(np.arange(P * N)[runs], N)
         legs = self.leg_ends
         return atlas_columns(

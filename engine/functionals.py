@@ -30,7 +30,8 @@ from .inverses import (
 )
 from .kinematics import Kinematics, held_values
 from .progress import Progress, check_cancelled
-from .validation import FloatArray, check_box_region, check_memory, count, finite
+from .regions import check_box_region
+from .validation import FloatArray, check_memory, count, finite
 
 # name -> (lo, hi); any two-item sequence (JSON gives lists), validated by check_region.
 Region = Mapping[str, Sequence[float]]
@@ -102,7 +103,7 @@ def check_region(
     kinematics: Kinematics, region: Region, fixed: Mapping[str, float] | None = None
 ) -> tuple[dict[str, tuple[float, float]], dict[str, float]]:
     """Validate a box region of the kinematics' variables and the fixed values of the others
-    (:func:`jik.engine.validation.check_box_region`).
+    (:func:`jik.engine.regions.check_box_region`).
 
     Returns
     -------
@@ -280,7 +281,8 @@ def error_functional_e1(
     nodes : int
         Gauss-Legendre points per integrated variable.
     fixed : mapping name -> value, optional
-        Values of the variables not integrated over (default 0).
+        Values of the variables not integrated over (default: the robot's held values,
+        :func:`~jik.engine.kinematics.held_values`: its home, else its start).
 
     Returns
     -------

@@ -20,7 +20,7 @@ from .validation import FloatArray, as_points, bounded, checked_points, positive
 #: m(x) below this counts as a kinematic singularity.
 SINGULAR_MANIPULABILITY = 1e-9
 #: The evaluations that a subclass of :class:`Kinematics` implements and that check ``x``.
-CHECKED = ("forward", "jacobian", "forward_jacobian")
+CHECKED = ("forward", "jacobian", "forward_jacobian", "manipulability")
 
 
 def kernel_cofactors(J: FloatArray) -> FloatArray:
@@ -164,6 +164,11 @@ class Kinematics(abc.ABC):
         chosen so that the last component of K is positive, the paper's convention (sec. 5),
         which matters for the term -2 dh K of E2, eq. (19).
         """
+        if self.p != self.r + 1:
+            raise InvalidInputError(
+                f"K(x) is the kernel of J of a robot with one degree of redundancy (p = r + 1); "
+                f"{self.name} has p = {self.p}, r = {self.r}"
+            )
         c = self.kernel_orientation * kernel_cofactors(self.jacobian(x))
         norm = np.linalg.norm(c, axis=-1, keepdims=True)
         with np.errstate(invalid="ignore", divide="ignore"):

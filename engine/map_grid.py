@@ -16,7 +16,8 @@ from .exceptions import InvalidInputError, JikError
 from .inverses import require_map
 from .kinematics import Kinematics, held_values
 from .progress import ProgressCallbacks
-from .validation import FloatArray, check_box_region, count
+from .regions import check_box_region
+from .validation import FloatArray, count
 
 #: Seeded samples of the box on which :func:`grid_axes` compares h's partial derivatives.
 AXIS_SAMPLES = 64

@@ -179,7 +179,8 @@ def map_singularities(
         The box, e.g. a robot's design region ``{"x1": (0, 1), "x3": (0.5, 1.5)}``, as for
         :func:`~jik.engine.functionals.error_functional_e1`.
     fixed : mapping name -> value, optional
-        Values of the variables not in the box (default 0), e.g. a start configuration x0's.
+        Values of the variables not in the box, e.g. a start configuration x0's (default: the
+        robot's held values, :func:`~jik.engine.kinematics.held_values`).
     nodes : int
         Grid points per region variable, ends included (at most ``MAX_GRID_POINTS`` in all).
 

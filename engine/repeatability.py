@@ -257,6 +257,16 @@ def repeatability(
             )
         done, given = resumed_legs(resume, n, L, kin.p, cycles)
         first = done.shape[1] // L
+        # (legs that did not reach their targets are no run's: 100 tol leaves room for round-off)
+        off = np.linalg.norm(kin.forward(done) - np.tile(targets, (1, first, 1)), axis=-1)
+        if not np.all(off < 100 * tol):
+            i, j = np.unravel_index(int(np.argmax(off)), off.shape)
+            raise InvalidInputError(
+                f"x0: resume.legs are not this run's: resume.legs[{f'{i}, ' * (n > 1)}{j}] ends "
+                f"{off[i, j]:.3g} from its target (more than 100 tol); go on only from a run of "
+                "this path",
+                "x0",
+            )
         legs[:, : first * L] = done
         current = done[:, -1].copy()
         guides = given or guides

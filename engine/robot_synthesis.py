@@ -21,8 +21,8 @@ import numpy as np
 from .augmentations import AugmentingMap
 from .kinematics import Kinematics
 from .progress import Progress
+from .regions import MAX_REGION_BOUND
 from .synthesis_nd import synthesize_e2_nd
-from .validation import MAX_REGION_BOUND
 from .variational import synthesize_e2
 
 if TYPE_CHECKING:
@@ -112,7 +112,7 @@ def default_box(
     """The box of a synthesis given none: the robot's design region (``functional_region``,
     the box of sec. 5 over which E1, eq. (13), and E2, eq. (18), are compared) when it has
     ``size`` variables, none of them ``fixed``; else the last ``size`` variables not ``fixed``,
-    each over a tenth of its ``x_range`` (within :data:`~jik.engine.validation.MAX_REGION_BOUND`)
+    each over a tenth of its ``x_range`` (within :data:`~jik.engine.regions.MAX_REGION_BOUND`)
     either side of the default start, within that range.
 
     The variables outside the box are held at the default start, where the robot's maps are

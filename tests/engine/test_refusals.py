@@ -329,7 +329,26 @@ REFUSALS = {
     "iter_atlas a dict for its plan": (lambda: next(jik.iter_atlas({"path": LOOP})), "plan"),
     "load_robot a number": (lambda: jik.load_robot(3), "robot"),
     "load_robot a dict": (lambda: jik.load_robot({"name": "panda"}), "robot"),
+    "error_functional_e2 fixed text": (
+        lambda: jik.error_functional_e2(ARM, jik.PaperCubic(), BOX, fixed="abc"),
+        "fixed",
+    ),
+    "synthesize_e2 fixed text": (lambda: jik.synthesize_e2(ARM, BOX, fixed="abc"), "fixed"),
+    "run_atlas a number for its backend": (lambda: jik.run_atlas(_plan(), 3), "backend"),
+    "AtlasResult.columns runs text": (lambda: jik.run_atlas(_plan()).columns(runs="a"), "runs"),
+    "plan_atlas reference beyond the bound": (
+        lambda: jik.plan_atlas(P, LOOP, n_starts=4, arc=(-1, 1), reference=[0, 0, 1e300]),
+        "reference",
+    ),
+    "plan_atlas path beyond the bound": (
+        lambda: jik.plan_atlas(P, [(0, 1), (1e300, 1)], n_starts=4, arc=(-1, 1), reference=X0),
+        "path",
+    ),
 }
+
+
+def _plan():
+    return jik.plan_atlas(P, LOOP, n_starts=4, arc=(-1, 1), reference=X0)
 
 
 @pytest.mark.parametrize("case", REFUSALS, ids=str)
@@ -410,14 +429,16 @@ def _robots():
 
 
 def _methods(kin):
-    names = ["forward", "jacobian"] + ["forward_jacobian"] * hasattr(kin, "forward_jacobian")
+    names = ["forward", "jacobian", "manipulability", "is_singular"]
+    names += ["forward_jacobian"] * hasattr(kin, "forward_jacobian")
     return [getattr(kin, n) for n in names]
 
 
 @pytest.mark.parametrize("kin", _robots(), ids=lambda k: f"{k.name}-p{k.p}-r{k.r}")
 def test_every_kinematics_checks_x_at_its_public_methods(kin):
     """Wrong width (short, long, a matrix's rows), a scalar, NaN, inf and text: InvalidInputError
-    with field "x", for forward, jacobian and forward_jacobian alike."""
+    with field "x", for forward, jacobian, forward_jacobian, manipulability and is_singular alike
+    (Manipulators 1 and 2 give m(x) in closed form: a wrong width gave a number)."""
     p = kin.p
     bad = [np.zeros(p - 1), np.zeros(p + 2), np.zeros((4, p + 1)), 0.5, [np.nan] * p, "x1"]
     bad.append(np.r_[np.full(p - 1, 0.1), np.inf])

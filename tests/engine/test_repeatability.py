@@ -419,3 +419,15 @@ def test_a_failed_leg_says_where_it_stopped():
     assert list(batch.success) == [False, True]
     np.testing.assert_allclose(batch.stopped[0], run.stopped, atol=1e-9)
     assert np.isnan(batch.stopped[1]).all()
+
+
+def test_a_resume_whose_legs_miss_their_targets_is_refused():
+    """A Resume's legs must be legs of this run: configurations that do not reach the path's
+    targets (here zeros, k = (1, 0)) are refused, not taken as cycles done."""
+    inv, x0 = Pseudoinverse(Manipulator2()), [0.0, 0.0, math.pi / 2]
+    path = [(1, 1), (1, 2), (0, 2)]
+    with pytest.raises(InvalidInputError, match=r"resume.legs\[2\] ends 2.24 from its target"):
+        repeatability(inv, Resume(x0, np.zeros((4, 3))), path, cycles=2)
+    first = repeatability(inv, x0, path)
+    resumed = repeatability(inv, Resume(x0, first.legs), path, cycles=3)
+    np.testing.assert_allclose(resumed.drift, repeatability(inv, x0, path, cycles=3).drift)

@@ -196,6 +196,8 @@ def test_a_chain_without_redundancy_runs_but_its_extended_inverse_says_why_not()
     ) as err:
         robot.inverse("extended")
     assert err.value.field == "augmentation" and "0 augmenting maps" not in str(err.value)
+    with pytest.raises(InvalidInputError, match=r"one degree of redundancy \(p = r \+ 1\); planar"):
+        robot.kinematics.kernel(x0)  # (K(x), of E1 and E2, has no meaning here either)
 
 
 def test_more_than_one_degree_of_redundancy_takes_a_vector_of_formula_maps():

@@ -10,8 +10,8 @@ from typing import Annotated, Any, Union
 
 from pydantic import BeforeValidator, Discriminator, Field, Tag
 
+from ....engine.regions import MAX_REGION_BOUND
 from ....engine.solve_rules import GAMMA_MAX, GAMMA_MIN, TOL_MIN
-from ....engine.validation import MAX_REGION_BOUND
 
 #: Largest configuration / task dimension accepted before the registry check.
 MAX_DIMENSION = 16
