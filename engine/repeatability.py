@@ -260,11 +260,11 @@ def repeatability(
         # (legs that did not reach their targets are no run's: 100 tol leaves room for round-off)
         off = np.linalg.norm(kin.forward(done) - np.tile(targets, (1, first, 1)), axis=-1)
         if not np.all(off < 100 * tol):
-            i, j = np.unravel_index(int(np.argmax(off)), off.shape)
+            bad = np.unravel_index(int(np.argmax(off)), off.shape)
+            at = f"{bad[0]}, {bad[1]}" if n > 1 else f"{bad[1]}"
             raise InvalidInputError(
-                f"x0: resume.legs are not this run's: resume.legs[{f'{i}, ' * (n > 1)}{j}] ends "
-                f"{off[i, j]:.3g} from its target (more than 100 tol); go on only from a run of "
-                "this path",
+                f"x0: resume.legs are not this run's: resume.legs[{at}] ends {off[bad]:.3g} from "
+                "its target (more than 100 tol); go on only from a run of this path",
                 "x0",
             )
         legs[:, : first * L] = done
