@@ -329,8 +329,9 @@ class Dashboard(SecondPhaseControl, SolvingAhead):
         except (JikError, ValueError) as exc:
             self._failure(generation, str(exc))
             return
-        # Panels that do not depend on gamma are reused from the last result with the same key.
-        key = "|".join((cache_key(state, "extended"), *runs_key(state)))  # (the map, every run)
+        # Panels that do not depend on gamma are reused from the last result with the same key
+        # (the map, every run, and the axes the configuration space is drawn on).
+        key = "|".join((cache_key(state, "extended"), *runs_key(state), str(state.cspace_axes)))
         reuse = {k for k in gamma_free_panels(result) if (k, key) in self._figures}
         texts = {k: self._figures[(k, key)] for k in reuse}
         cached, stale = self._known_functionals(state)

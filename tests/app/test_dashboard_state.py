@@ -592,3 +592,28 @@ def test_a_single_target_s_messages_name_no_cycle_or_leg():
     assert all("did not converge within 10" in m for m in said[:2])
     assert not [s for s in said if "leg" in s.replace("per leg", "")]
     assert "task error at its end 9.29" in said[-1]
+
+
+def test_other_configuration_space_axes_redraw_their_panel():
+    """A change of the configuration-space axes alone keeps the runs (and, in continuous mode,
+    the panels that do not depend on gamma) but draws the configuration space anew on the
+    axes chosen: it was reused, drawn on the axes before."""
+    chain = {"name": "planar_chain", "joints": "RRRR", "lengths": [1.0, 0.8, 0.6, 0.4]}
+    state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": chain})
+    dashboard, titles, done = Dashboard(state), {}, threading.Event()
+
+    def listener(event):
+        if event.kind == "result":
+            titles[event.generation] = json.loads(event.data)["figures"]["cspace"]["layout"]
+        if event.kind == "result" and event.generation == 2:
+            done.set()
+
+    dashboard.subscribe(listener)
+    try:
+        assert dashboard.wait(1, timeout=60)
+        dashboard.update({"cspace_axes": "013"})
+        assert done.wait(60)
+    finally:
+        dashboard.stop()
+    assert titles[2]["title"]["text"].startswith("Configuration space (x1, x2, x4)")
+    assert titles[2]["scene2"]["zaxis"]["title"]["text"] == "x4"
