@@ -17,6 +17,7 @@ text).
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import asdict, dataclass
 from typing import Any
@@ -181,7 +182,8 @@ def controls(state) -> list[Control]:
                 "select",
                 "the three coordinates the configuration-space panel shows",
                 tuple(
-                    (c, ", ".join(names[int(k)] for k in c)) for c in ("012", "013", "023", "123")
+                    ("".join(f"{k:x}" for k in c), ", ".join(names[k] for k in c))
+                    for c in itertools.combinations(range(len(names)), 3)
                 ),
                 group="start",
             )

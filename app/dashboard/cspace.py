@@ -66,8 +66,8 @@ def _thin(x: np.ndarray) -> np.ndarray:
 def cspace_spec(result: DashboardResult) -> dict:
     """The configuration-space panel (see the module's docstring)."""
     names = result.variable_names
-    # (all three for p = 3, else the state's choice: "012", "013", "023" or "123"; none: "012")
-    axes = a, b, c = tuple(int(k) for k in result.state.cspace_axes or "012")
+    # (all three for p = 3, else the state's choice, hexadecimal digits: "013"; none: "012")
+    axes = a, b, c = tuple(int(k, 16) for k in result.state.cspace_axes or "012")
     data = []
     notes = []
     try:

@@ -87,8 +87,9 @@ class DashboardState(BaseModel):
     path: Annotated[tuple[Point, ...], Field(max_length=MAX_PATH_POINTS)]
     cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_DASHBOARD_CYCLES), INTEGRAL]
     tolerance: Tolerance = 1e-10
-    #: The three coordinates the configuration-space panel shows (p = 4): "012" is x1, x2, x3.
-    cspace_axes: Literal["012", "013", "023", "123"] | None = None
+    #: The three coordinates the configuration-space panel shows (p > 3), their indices as
+    #: hexadecimal digits in increasing order: "012" is x1, x2, x3, "06a" x1, x7, x11.
+    cspace_axes: Annotated[str, Field(pattern=r"^[0-9a-f]{3}$")] | None = None
     #: Cap on each leg's iterations (discrete) or integrator steps (continuous); None: the
     #: engine's default (:func:`jik.engine.solver.solve`).
     max_iterations: (
@@ -280,6 +281,10 @@ def validate(data: Mapping[str, Any]) -> DashboardState:
         raise InvalidInputError("path: a closed-path task needs at least one path point", "path")
     if (why := gamma_problem(state.gamma, state.mode)) is not None:
         raise InvalidInputError(f"gamma: {why}", "gamma")
+    if state.cspace_axes is not None:
+        a, b, c = (int(k, 16) for k in state.cspace_axes)
+        if not a < b < c < kin.p:
+            raise refused("cspace_axes", f"give three of x1..x{kin.p} in increasing order")
     given = state.algorithm_parameters
     # (a rest is checked whether or not the posture inverse is chosen; kept only if it is)
     rest = checked_rest(given["rest"], spec, kin, state.x0) if "rest" in given else None

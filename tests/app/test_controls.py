@@ -324,3 +324,23 @@ def test_a_run_over_the_time_limit_is_refused_at_a_control_the_task_shows(task):
     state = updated_state(default_state("manipulator2"), {"task": task})
     (control,) = [c for c in controls(state) if c.key == field]
     assert control.label.startswith("max ") and "“max … per leg”" in less
+
+
+def test_any_three_joints_of_an_arm_can_be_the_configuration_space_axes():
+    """A 7-joint chain offers every three of its joints, in order (35 choices, hexadecimal
+    digits as the state writes them: up to 16 joints); the panel draws the three chosen, and a
+    choice out of order or past p is refused naming the control."""
+    from jik.app.dashboard.cspace import cspace_spec
+    from jik.app.dashboard.results import compute
+
+    chain = {"name": "planar_chain", "joints": "R" * 7, "lengths": [0.3] * 7}
+    state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": chain})
+    (axes,) = [c for c in controls(state) if c.key == "cspace_axes"]
+    assert len(axes.options) == 35 and axes.options[-1] == ("456", "x5, x6, x7")
+    chosen = updated_state(state, {"cspace_axes": "046"})
+    title = cspace_spec(compute(chosen, 2))["layout"]["title"]["text"]
+    assert title.startswith("Configuration space (x1, x5, x7)")
+    for bad in ("064", "047", "0a1"):
+        with pytest.raises(InvalidInputError) as refused:
+            updated_state(state, {"cspace_axes": bad})
+        assert refused.value.field == "cspace_axes"
