@@ -129,6 +129,10 @@ export function robotEditor(kinds, send) {
       }
       // (a catalogue arm has a definition too, its name and task: the robot picker's)
       const editable = state.robot in kinds.kinds;
+      // Another robot chosen in the picker: the definition shown is kept here, not in use.
+      if (!editable && note.textContent.startsWith("applied: ")) {
+        note.textContent = "not in use (another robot is chosen): apply to use it again";
+      }
       if (editable && state.robot_definition && state.robot !== shownKind && !edited) {
         kind.value = state.robot;
         build(state.robot, state.robot_definition);

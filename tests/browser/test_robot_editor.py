@@ -102,6 +102,13 @@ def test_a_refused_definition_keeps_what_was_typed(tabs):
     page.fill("#robot-field-lengths", "1, 0.8, 0.6")
     tab.change(lambda: page.click("#robot-apply"))  # a planar chain in force
     expect(page.locator("#robot-note")).to_contain_text("applied: planar_chain")
+    # Another robot picked: the editor keeps the definition, and says it is not in use.
+    tab.change(lambda: page.select_option("#ctl-robot", "manipulator1"))
+    expect(page.locator("#robot-note")).to_have_text(
+        "not in use (another robot is chosen): apply to use it again"
+    )
+    tab.change(lambda: page.click("#robot-apply"))
+    expect(page.locator("#robot-note")).to_contain_text("applied: planar_chain")
 
     # A formula robot with a bad formula: refused while the planar chain stays in force.
     page.select_option("#robot-kind", "formula")
