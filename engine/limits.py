@@ -147,7 +147,8 @@ def check_limits(limits, p: int, field: str = "limits") -> FloatArray:
         box = np.zeros((0, 2))
     if box.shape != (p, 2) or np.isnan(box).any() or not np.all(box[:, 0] < box[:, 1]):
         raise InvalidInputError(
-            f"{field} must be {p} pairs [lower, upper] with lower < upper (null: no bound)", field
+            f"{field} must be {p} pairs [lower, upper] with lower < upper (a bound null: none)",
+            field,
         )
     return box
 

@@ -58,8 +58,8 @@ LIMITS = DefinitionField(
     "limits",
     "points",
     False,
-    "joint limits, one [lower, upper] per variable (null: no bound); runs report whether they "
-    "stayed within them",
+    "joint limits, one [lower, upper] per variable (a bound null: none, as [null, 1.5]); runs "
+    "report whether they stayed within them",
 )
 
 PLANAR_CHAIN = (

@@ -227,7 +227,9 @@ async function onFunctionals(msg) {
 function rememberInUrl(state) {
   const url = new URL(location.href);
   url.searchParams.set("state", JSON.stringify(state));
+  if (url.href === location.href) return;
   history.replaceState(null, "", url);
+  $("#copy-link").textContent = "copy link"; // (a link copied before is of another state)
 }
 
 function stateFromUrl() {

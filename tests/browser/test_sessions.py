@@ -96,6 +96,9 @@ def test_a_copied_link_opens_the_same_view(tabs):
         assert theirs[algorithm]["x_final"] == pytest.approx(
             ours[algorithm]["x_final"], rel=1e-9, abs=1e-12
         )
+    # A change after the copy: the link copied is of the state before, the button says so no more.
+    a.set_slider("#ctl-cycles", 3)
+    expect(a.page.locator("#copy-link")).to_have_text("copy link")
 
 
 # (CI's slow step: among the longest browser checks; the default run stays under 8 minutes)
