@@ -162,8 +162,13 @@ def require_compatible(kinematics: Kinematics, augmenting_map: AugmentingMap, wh
     augmenting_map = require_map(augmenting_map, kinematics)
     if kinematics.p - kinematics.r != 1:
         raise InvalidInputError(
-            f"{what} here needs one degree of redundancy (p - r = 1); {kinematics.name} has "
-            f"p - r = {kinematics.p - kinematics.r} (VectorExtendedInverse takes p - r maps)",
+            f"{what}: one augmenting map needs one degree of redundancy (p - r = 1); "
+            f"{kinematics.name} has p - r = {kinematics.p - kinematics.r}"
+            + (
+                " (VectorExtendedInverse takes p - r maps)"
+                if kinematics.p > kinematics.r + 1
+                else ""
+            ),
             "kinematics",
         )
     if augmenting_map.p != kinematics.p:

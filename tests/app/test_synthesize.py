@@ -188,7 +188,8 @@ def test_a_synthesized_map_is_searched_and_a_vector_of_maps_is_said_not_to_be(ap
     b = api.post("/synthesize", json=body).json()
     assert b["singularities"] is None and b["singularities_searched"] is False
     assert (
-        "singularities of h not searched: map_singularities here needs one degree" in (b["message"])
+        "singularities of h not searched: map_singularities: one augmenting map needs one degree"
+        in b["message"]
     )
 
 
