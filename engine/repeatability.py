@@ -148,7 +148,7 @@ def repeatability(
     gamma, mode, tol, max_iterations
         As in :func:`jik.engine.solver.solve` (a leg's cap).
     record : bool
-        Keep every leg's trajectory (single start only).
+        Keep every leg's trajectory (one start only: a batch's record=True is refused).
     close : bool
         False: the legs are the points of ``path`` as given, without the return leg to k(x0)
         (one solve to a target is the run of one such leg).
@@ -198,6 +198,8 @@ def repeatability(
         )
     cycles, record = count(cycles, "cycles", 1, MAX_CYCLES), flag(record, "record")
     single = x0.ndim == 1
+    if record and not single:
+        raise InvalidInputError("record: a batch of starts records no trajectories", "record")
     xb = np.atleast_2d(x0)
     if xb.ndim != 2:
         raise InvalidInputError("x0 must be one configuration or a 2-D batch", "x0")

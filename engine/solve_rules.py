@@ -167,6 +167,11 @@ def check_settings(
         raise InvalidInputError(
             f"method must be 'auto', 'picard' or 'dop853', got {method!r}", "method"
         )
+    if method != "auto" and mode == "discrete":
+        raise InvalidInputError(
+            f"method {method!r} integrates (7) in continuous mode; a discrete run iterates",
+            "method",
+        )
     default = MAX_STEPS if mode == "continuous" else MAX_ITERATIONS
     cap = count(
         default if max_iterations is None else max_iterations,

@@ -203,11 +203,12 @@ def solve(
     record : bool
         Keep the whole trajectory.
     method : {"auto", "picard", "dop853"}
-        Continuous mode only: Chebyshev-Picard with a sweep budget and DOP853 after it
-        ("auto"), Picard alone (DOP853 only where it fails), or DOP853 alone. "dop853" suits
-        maps that are expensive per point (the unicycle's characteristics map). An inverse that
-        is not a right inverse (``inverse.right_inverse`` False: damped least squares) always
-        takes DOP853, since Picard's homotopy form needs J J# = I.
+        Continuous mode only ("auto" in discrete mode; another is refused): Chebyshev-Picard
+        with a sweep budget and DOP853 after it ("auto"), Picard alone (DOP853 only where it
+        fails), or DOP853 alone. "dop853" suits maps that are expensive per point (the
+        unicycle's characteristics map). An inverse that is not a right inverse
+        (``inverse.right_inverse`` False: damped least squares) always takes DOP853, since
+        Picard's homotopy form needs J J# = I.
     guess : Trajectory, optional
         Continuous mode: the trajectory of a nearby earlier solve with the same gamma, such as
         the same leg in the previous cycle of a closed path. Picard starts its sweeps from it

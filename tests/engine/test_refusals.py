@@ -336,6 +336,14 @@ REFUSALS = {
     "synthesize_e2 fixed text": (lambda: jik.synthesize_e2(ARM, BOX, fixed="abc"), "fixed"),
     "run_atlas a number for its backend": (lambda: jik.run_atlas(_plan(), 3), "backend"),
     "AtlasResult.columns runs text": (lambda: jik.run_atlas(_plan()).columns(runs="a"), "runs"),
+    "repeatability record for a batch": (
+        lambda: jik.repeatability(P, [X0, X0], PATH, record=True),
+        "record",
+    ),
+    "solve a method in discrete mode": (
+        lambda: jik.solve(P, X0, [1, 1], mode="discrete", gamma=0.5, method="picard"),
+        "method",
+    ),
     "plan_atlas reference beyond the bound": (
         lambda: jik.plan_atlas(P, LOOP, n_starts=4, arc=(-1, 1), reference=[0, 0, 1e300]),
         "reference",
