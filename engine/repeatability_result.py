@@ -226,8 +226,9 @@ class RepeatabilityResult(Columns):
     def as_dict(self) -> dict[str, Any]:
         """JSON-friendly: the algorithm, the inverse as printed, mode, gamma, tol,
         max_iterations, x0, the legs' targets, leg ends, cycle ends, drift (None after a failed
-        leg: :func:`~jik.engine.exports.json_values`), success, message, and where a failed leg
-        stopped (``stopped_at``, None for a run that completed)."""
+        leg: :func:`~jik.engine.exports.json_values`), success, message, where a failed leg
+        stopped (``stopped_at``, None for a run that completed) and h at x0 and after each leg
+        (``h``, eq. (12)'s evidence: None for an inverse without a map)."""
         s = self.settings
         return json_values(
             {
@@ -245,6 +246,7 @@ class RepeatabilityResult(Columns):
                 "success": np.asarray(self.success).tolist(),
                 "message": self.message if isinstance(self.message, str) else list(self.message),
                 "stopped_at": None if self.stopped is None else self.stopped.tolist(),
+                "h": None if self.h is None else self.h.tolist(),
             }
         )
 

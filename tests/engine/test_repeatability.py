@@ -415,6 +415,11 @@ def test_a_failed_leg_says_where_it_stopped():
     assert run.message.startswith("cycle 1, leg 1 failed: stalled")
     assert 1e-4 < np.linalg.norm(run.stopped - x0) < 1e-3
     assert run.as_dict()["stopped_at"] == run.stopped.tolist()
+    # (h after a failed leg is not known: NaN, None in JSON; at x0 it is)
+    assert (
+        run.as_dict()["h"][0] == pytest.approx(float(inv.augmenting_value(x0)))
+        and None in (run.as_dict()["h"])
+    )
     batch = repeatability(inv, np.array([x0, [0.0, 0.0, math.pi / 2]]), path)
     assert list(batch.success) == [False, True]
     np.testing.assert_allclose(batch.stopped[0], run.stopped, atol=1e-9)
@@ -431,3 +436,13 @@ def test_a_resume_whose_legs_miss_their_targets_is_refused():
     first = repeatability(inv, x0, path)
     resumed = repeatability(inv, Resume(x0, first.legs), path, cycles=3)
     np.testing.assert_allclose(resumed.drift, repeatability(inv, x0, path, cycles=3).drift)
+
+
+def test_the_json_of_a_run_holds_h_after_every_leg():
+    """eq. (12)'s evidence goes with the numbers: the extended inverse's as_dict holds h at x0
+    and after each leg, constant to round-off; an inverse without a map has none."""
+    x0, path = [0.0, 0.0, math.pi / 2], [(1, 1), (1, 2), (0, 2)]
+    ext = repeatability(ExtendedInverse(Manipulator2(), PaperCubic()), x0, path, cycles=2)
+    h = np.asarray(ext.as_dict()["h"])
+    assert h.shape == (1 + 2 * 4,) and np.ptp(h) < 1e-12
+    assert repeatability(Pseudoinverse(Manipulator2()), x0, path).as_dict()["h"] is None
