@@ -30,8 +30,8 @@ from .exports import plural
 from .inverses import Inverse, algorithm_labels
 from .repeatability import MAX_CYCLES, MAX_PATH_POINTS, open_loop
 from .self_motion import SelfMotionManifold
-from .solve_rules import MAX_ITERATIONS_LIMIT, MODES, check_gamma, chunk_limit
-from .validation import FloatArray, as_points, bounded, check_seed, count, positive
+from .solve_rules import check_settings, chunk_limit
+from .validation import FloatArray, as_points, bounded, check_seed, count
 
 #: Largest number of starts per path and of starts in a chunk (of paths in a family:
 #: :data:`~jik.engine.atlas_paths.MAX_PATHS`). A chunk must also fit in the memory bound
@@ -258,18 +258,12 @@ def plan_atlas(
         )
     cycles = checked(lambda: count(cycles, "cycles", 1, MAX_CYCLES), "cycles")
     chunk = None if chunk is None else checked(lambda: count(chunk, "chunk", 1, MAX_CHUNK), "chunk")
-    if mode not in MODES:
-        raise InvalidInputError(f"mode must be 'continuous' or 'discrete', got {mode!r}", "mode")
+    mode, gamma, tol, cap = check_settings(mode, gamma, tol, max_iterations)
     settings = {
-        "gamma": checked(lambda: check_gamma(gamma, mode), "gamma"),
+        "gamma": gamma,
         "mode": mode,
-        "tol": checked(lambda: positive(tol, "tol"), "tol"),
-        "max_iterations": None
-        if max_iterations is None
-        else checked(
-            lambda: count(max_iterations, "max_iterations", 1, MAX_ITERATIONS_LIMIT),
-            "max_iterations",
-        ),
+        "tol": tol,
+        "max_iterations": None if max_iterations is None else cap,
     }
     paths, per_shift = path_family(kin, base_path, shifts, scales)
 

@@ -22,8 +22,9 @@ from .picard import DEGREE
 from .stall import reach_note, stall_reason
 from .validation import FloatArray, check_memory, count, positive
 
-#: The smallest task-error tolerance ``tol`` of a solve (double precision).
-TOL_MIN = 1e-14
+#: The task-error tolerance ``tol`` of a solve: its smallest (double precision) and largest
+#: (a larger one stops every run at its start, far from the task).
+TOL_MIN, TOL_MAX = 1e-14, 1.0
 #: Default caps of :func:`solve`: integrator steps (continuous), iterations (discrete).
 MAX_STEPS = 20000
 MAX_ITERATIONS = 2000
@@ -159,9 +160,10 @@ def check_settings(
         raise InvalidInputError(f"mode must be 'continuous' or 'discrete', got {mode!r}", "mode")
     gamma = check_gamma(gamma, mode)
     tol = positive(tol, "tol")
-    if tol < TOL_MIN:
+    if not TOL_MIN <= tol <= TOL_MAX:
         raise InvalidInputError(
-            f"tol must be >= {TOL_MIN:g} (double precision), got {tol:g}", "tol"
+            f"tol must be between {TOL_MIN:g} (double precision) and {TOL_MAX:g}, got {tol:g}",
+            "tol",
         )
     if method not in METHODS:
         raise InvalidInputError(

@@ -70,6 +70,7 @@ REFUSALS = {
         "region.x2",
     ),
     "solve tol tiny": (lambda: jik.solve(P, X0, [1, 1], tol=1e-20), "tol"),
+    "solve tol huge": (lambda: jik.solve(P, X0, [1, 1], tol=1e300), "tol"),
     "solve max_iterations": (lambda: jik.solve(P, X0, [1, 1], max_iterations=-5), "max_iterations"),
     "solve guess in discrete mode": (
         lambda: jik.solve(
@@ -205,6 +206,7 @@ REFUSALS = {
         "reference",
     ),
     "plan_atlas no starts at all": (lambda: jik.plan_atlas(P, LOOP), "starts"),
+    "plan_atlas tol tiny": (lambda: jik.plan_atlas(P, LOOP, starts=[X0], tol=1e-20), "tol"),
     "plan_atlas first point out of reach": (
         lambda: jik.plan_atlas(
             P, [(5, 5), (1, 1)], n_starts=4, arc=(-1, 1), reference=X0, box=[(-3, 3)] * 3

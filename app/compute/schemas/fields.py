@@ -11,7 +11,7 @@ from typing import Annotated, Any, Union
 from pydantic import BeforeValidator, Discriminator, Field, Tag
 
 from ....engine.regions import MAX_REGION_BOUND
-from ....engine.solve_rules import GAMMA_MAX, GAMMA_MIN, TOL_MIN
+from ....engine.solve_rules import GAMMA_MAX, GAMMA_MIN, TOL_MAX, TOL_MIN
 
 #: Largest configuration / task dimension accepted before the registry check.
 MAX_DIMENSION = 16
@@ -74,7 +74,7 @@ FrameAxes = Annotated[
 #: engine.solve_rules.gamma_problem).
 Gamma = Annotated[float, Field(strict=True, ge=GAMMA_MIN, le=GAMMA_MAX, allow_inf_nan=False)]
 #: The task error at which a solve stops.
-Tolerance = Annotated[float, Field(strict=True, ge=TOL_MIN, le=1.0, allow_inf_nan=False)]
+Tolerance = Annotated[float, Field(strict=True, ge=TOL_MIN, le=TOL_MAX, allow_inf_nan=False)]
 #: A bound of a synthesis box (the engine's bound on a box region).
 Bound = Annotated[
     float,
