@@ -77,7 +77,11 @@ ALGORITHMS: dict[str, AlgorithmSpec] = {
             "damped least squares: bounded joint speed through singularities, at a task error",
             (
                 Parameter(
-                    "damping", 0.1, 0.0, pinv.MAX_DAMPING, "damping lambda (0: the pseudoinverse)"
+                    "damping",
+                    pinv.DAMPING,
+                    0.0,
+                    pinv.MAX_DAMPING,
+                    "damping lambda (0: the pseudoinverse)",
                 ),
                 Parameter(
                     "damping_threshold",
@@ -104,7 +108,7 @@ ALGORITHMS: dict[str, AlgorithmSpec] = {
             (
                 Parameter(
                     "gain",
-                    1.0,
+                    pinv.GAIN,
                     0.0,
                     pinv.MAX_GAIN,
                     "null-space gain k per unit of path length (0: the pseudoinverse)",

@@ -27,10 +27,10 @@ from .limits import limit_names, robot_limits
 from .linalg import gram, solve_small
 from .validation import FloatArray, as_box, finite, flag, within
 
-#: Largest damping lambda and damping threshold accepted.
-MAX_DAMPING = 10.0
-#: Largest null-space gain k of the posture inverse.
-MAX_GAIN = 100.0
+#: Default and largest damping lambda (the largest also bounds the damping threshold).
+DAMPING, MAX_DAMPING = 0.1, 10.0
+#: Default and largest null-space gain k of the posture inverse.
+GAIN, MAX_GAIN = 1.0, 100.0
 
 
 def _nonnegative(value, name: str, maximum: float) -> float:
@@ -81,7 +81,7 @@ class DampedInverse(Inverse):
     ----------
     kinematics : Kinematics
     damping : float
-        lambda >= 0. With ``damping_threshold`` 0 the damping is constant; lambda = 0 is the
+        lambda >= 0, default :data:`DAMPING`. With ``damping_threshold`` 0 the damping is constant; lambda = 0 is the
         pseudoinverse (8), bit for bit (the same code runs).
     damping_threshold : float
         epsilon >= 0. When positive, the adaptive damping of Nakamura and Hanafusa (1986):
@@ -103,7 +103,7 @@ class DampedInverse(Inverse):
     right_inverse = False
 
     def __init__(
-        self, kinematics: Kinematics, damping: float = 0.0, damping_threshold: float = 0.0
+        self, kinematics: Kinematics, damping: float = DAMPING, damping_threshold: float = 0.0
     ) -> None:
         self.kinematics = require_kinematics(kinematics)
         self.damping = _nonnegative(damping, "damping", MAX_DAMPING)
@@ -258,7 +258,7 @@ class PostureInverse(Inverse):
         The rest posture x_rest; given (``rest_given``), it must lie within the robot's joint
         limits if it has some (:func:`check_rest`).
     gain : float
-        k >= 0; 0 is the pseudoinverse (8), bit for bit (the same code runs).
+        k >= 0, default :data:`GAIN`; 0 is the pseudoinverse (8), bit for bit (the same code runs).
     rest_given : bool
         False: ``rest`` is a default (:func:`~jik.engine.algorithm_registry.default_rest`: the
         robot's home, else the run's start), not checked against the limits (a start outside
@@ -284,7 +284,7 @@ class PostureInverse(Inverse):
     name = "posture"
 
     def __init__(
-        self, kinematics: Kinematics, rest, gain: float = 1.0, rest_given: bool = True
+        self, kinematics: Kinematics, rest, gain: float = GAIN, rest_given: bool = True
     ) -> None:
         self.kinematics = kinematics = require_kinematics(kinematics)
         self.rest_given = rest_given = flag(rest_given, "rest_given")

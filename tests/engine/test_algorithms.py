@@ -43,6 +43,13 @@ def test_catalogue_lists_all_five_with_parameters():
     assert ALGORITHMS["posture"].vectors == ("rest",)
 
 
+def test_the_classes_defaults_are_the_catalogue_s():
+    """DampedInverse(robot) is make_inverse(robot, "damped"): one default of each parameter."""
+    assert DampedInverse(KIN).parameters == _inverse("damped").parameters
+    assert PostureInverse(KIN, X0).parameters["gain"] == _inverse("posture").parameters["gain"]
+    assert _inverse("damped").parameters["damping"] > 0
+
+
 @pytest.mark.parametrize("mode", ["continuous", "discrete"])
 @pytest.mark.parametrize("name, params", [("damped", {"damping": 0.0}), ("posture", {"gain": 0.0})])
 def test_zero_parameter_is_the_pseudoinverse(name, params, mode):
