@@ -161,9 +161,10 @@ def _run_one(kin, inverse, strict, mode) -> dict:
 
 
 def _compare(runs: dict) -> dict:
-    """How similar the pseudoinverse and extended results are (the paper's remark, sec. 6.2)."""
+    """How similar the pseudoinverse and extended results are (the paper's remark, sec. 6.2):
+    None where either run did not converge (a stopped run's controls are no result)."""
     p, e = runs["pseudoinverse"], runs["extended"]
-    if not (p.get("platform_path") and e.get("platform_path")):
+    if not (p["success"] and e["success"] and p.get("platform_path") and e.get("platform_path")):
         return {"platform_path_max_distance": None, "final_lambda_distance": None}
     qp, qe = np.array(p["platform_path"]), np.array(e["platform_path"])
     return {
@@ -261,9 +262,11 @@ def format_text(result: dict) -> str:
                     out.append(f"{'':10}-> {r['message']}")
             cmp_ = result["comparison"][start]["discrete" if block is None else "continuous"]
             d = cmp_["platform_path_max_distance"]
+            paths = f"{'':10}platform paths q(t) of the two inverses"
             out.append(
-                f"{'':10}platform paths q(t) of the two inverses differ by at most "
-                + ("n/a" if d is None else f"{d:.3f} m")
+                f"{paths}: not compared, a run did not converge"
+                if d is None
+                else f"{paths} differ by at most {d:.3f} m"
             )
         out.append("")
     return "\n".join(out)

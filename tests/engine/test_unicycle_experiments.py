@@ -72,6 +72,8 @@ def test_paths_similar_from_a_not_from_b(result):
     b = result["comparison"]["B"]["continuous"]["platform_path_max_distance"]
     assert a < 0.5
     assert b > 2.0
+    # (from B the extended discrete run stopped: its controls are compared with nothing)
+    assert result["comparison"]["B"]["discrete"]["platform_path_max_distance"] is None
 
 
 def test_format_text_mentions_every_run(result):
