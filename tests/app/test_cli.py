@@ -52,6 +52,12 @@ def test_manipulator1_json_contract(capsys):
     # E1 of (36) with a = 0, b = 1 has the closed form 1 - pi/4 on this region.
     assert out["E1"]["e2_optimal"] == pytest.approx(1 - math.pi / 4, abs=1e-8)
     assert "symbolic" in out
+    # The E2 minimum is a Ritz value (an upper bound, falling with the degree), given with its
+    # degrees, not as the minimum itself.
+    box = out["e2_minimum_on_box"]
+    values = [c["e2"] for c in box["convergence"]]
+    assert values == sorted(values, reverse=True) and values[-1] == box["E2"]
+    assert box["E2"] < 0.0162 < values[0]
 
 
 def test_manipulator2_json_contract(capsys):
