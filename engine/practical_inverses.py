@@ -81,8 +81,8 @@ class DampedInverse(Inverse):
     ----------
     kinematics : Kinematics
     damping : float
-        lambda >= 0, default :data:`DAMPING`. With ``damping_threshold`` 0 the damping is constant; lambda = 0 is the
-        pseudoinverse (8), bit for bit (the same code runs).
+        lambda >= 0, default :data:`DAMPING`. With ``damping_threshold`` 0 the damping is
+        constant; lambda = 0 is the pseudoinverse (8), bit for bit (the same code runs).
     damping_threshold : float
         epsilon >= 0. When positive, the adaptive damping of Nakamura and Hanafusa (1986):
         lambda(x)^2 = lambda^2 (1 - s(x) / epsilon)^2 where the smallest singular value s(x) of
