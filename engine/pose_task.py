@@ -89,6 +89,22 @@ def reference_rotation(value, field: str = "reference") -> FloatArray:
     return a
 
 
+#: How near a half turn from R0 a target or a start is on the rotation coordinates' cut [rad]:
+#: far beyond the error of the log there (1e-13), far below an orientation one means to reach.
+CUT_MARGIN = 1e-6
+
+
+def on_the_cut() -> str:
+    """Why a point on the rotation coordinates' cut is refused, and what to do instead."""
+    return (
+        "on the cut of the rotation coordinates, where they jump to the opposite rotation "
+        "vector (a run there can end whole turns of the joints away while its task error "
+        "converges); choose a reference orientation R0 (the robot's `reference`) within a half "
+        "turn of the task's orientations, such as the orientation at the start (a URDF arm's "
+        "default: at its home)"
+    )
+
+
 class PoseTask:
     """The rows of a pose task: position and rotation coordinates of (R, t) and their Jacobian.
 
@@ -121,16 +137,20 @@ class PoseTask:
         return np.concatenate(parts, axis=-1)[..., self.order]
 
     def check_reachable(self, y: FloatArray, name: str, field: str | None = None) -> None:
-        """Refuse task points ``y`` (..., r) whose rotation coordinates no configuration gives:
-        the rotation coordinates are the principal log of R0^T R (:func:`jik.engine.so3.log`),
-        so their length is at most pi (a subset's too). The refusal gives the same orientation
-        within a half turn when the task holds all three."""
+        """Refuse task points ``y`` (..., r) whose rotation coordinates no configuration gives,
+        or that lie on their cut. The rotation coordinates are the principal log of R0^T R
+        (:func:`jik.engine.so3.log`), so their length is at most pi (a subset's too); at pi they
+        jump to the opposite rotation vector, so a point within :data:`CUT_MARGIN` of it is
+        reached from one side and left from the other, and a run toward it turns the wrist by
+        whole turns while its error says "converged". The refusal of a point beyond pi gives the
+        same orientation within a half turn when the task holds all three and that one is off
+        the cut."""
         if not self.rotation:
             return
         rows = [i for i, n in enumerate(self.names) if len(n) == 2]
         r = np.asarray(y, dtype=float)[..., rows]
         length = np.linalg.norm(r, axis=-1)
-        far = np.argwhere(length > np.pi + 1e-9)
+        far = np.argwhere(length > np.pi - CUT_MARGIN)
         if len(far) == 0:
             return
         at = tuple(int(i) for i in far[0])
@@ -139,15 +159,41 @@ class PoseTask:
             where = f"[{', '.join(map(str, at))}]"
             base = None if base is None else ".".join([base, *map(str, at)])
         coords = ", ".join(n for n in self.names if len(n) == 2)
+        if length[at] <= np.pi + CUT_MARGIN:
+            raise InvalidInputError(
+                f"{name}{where} is a half turn from the reference orientation R0 (its rotation "
+                f"coordinates ({coords}) have length {length[at]:.9g}), {on_the_cut()}",
+                base,
+            )
         same = ""
         if len(rows) == 3:  # (the principal rotation vector of that rotation, whatever its turns)
-            same = ", ".join(f"{v + 0.0:.3g}" for v in so3.log(so3.exp(r[at])))
-            same = f"; the same orientation is ({same})"
+            equal = so3.log(so3.exp(r[at]))
+            if np.linalg.norm(equal) <= np.pi - CUT_MARGIN:
+                same = "; the same orientation is (" + ", ".join(f"{v + 0.0:.6g}" for v in equal)
+                same += ")"
         raise InvalidInputError(
             f"{name}{where} is out of reach: its rotation coordinates ({coords}) have length "
             f"{length[at]:.6g} > pi, and the rotation coordinates (the principal log of R0^T R) "
             f"never exceed pi{same}",
             base,
+        )
+
+    def check_start(self, R: FloatArray, name: str) -> None:
+        """Refuse starts whose end-link orientations R (..., 3, 3) lie on the rotation
+        coordinates' cut (a half turn from R0, within :data:`CUT_MARGIN`), where the
+        coordinates of k(x0) are either of two opposite rotation vectors."""
+        if not self.rotation:
+            return
+        length = np.linalg.norm(so3.log(self.reference_T @ R), axis=-1)
+        near = np.argwhere(length > np.pi - CUT_MARGIN)
+        if len(near) == 0:
+            return
+        at = tuple(int(i) for i in near[0])
+        where = f"[{', '.join(map(str, at))}]" if length.size > 1 else ""
+        raise InvalidInputError(
+            f"{name}{where} puts the end link a half turn from the reference orientation R0 "
+            f"({length[at]:.9g} rad), {on_the_cut()}",
+            name,
         )
 
     def pose_of(self, y: FloatArray) -> tuple[FloatArray | None, FloatArray | None]:

@@ -283,6 +283,13 @@ class UrdfChain(Kinematics):
         self.pose_task.check_reachable(y, name, field)
         return y
 
+    def check_start(self, x, name: str = "x0") -> FloatArray:
+        """:meth:`Kinematics.check_start`: not on the rotation coordinates' cut
+        (:meth:`~jik.engine.pose_task.PoseTask.check_start`)."""
+        x = super().check_start(x, name)
+        self.pose_task.check_start(self.compiled.pose(x)[0], name)
+        return x
+
     def forward(self, x: FloatArray) -> FloatArray:
         """k(x): the task's coordinates of the end link's pose: (..., p) -> (..., r)."""
         R, t = self.compiled.pose(x)
