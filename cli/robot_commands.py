@@ -248,6 +248,8 @@ def refused(command: str, error: Exception, args: argparse.Namespace | None = No
     option = OPTION_OF_FIELD.get(head, head)
     if head == "backend":  # (jik atlas's --processes or --dask)
         option = "dask" if getattr(args, "dask", None) is not None else "processes"
+    if head == "active_joints" and getattr(args, "task", None) is not None:
+        option = "task"  # (a catalogue arm's joints against the task that --task gave it)
     if field and option in vars(args or argparse.Namespace()):
         where = f" (option --{option.replace('_', '-')})"
     else:

@@ -256,3 +256,13 @@ def test_the_step_cap_and_tolerance_are_options_the_advice_can_name(capsys):
     assert "did not converge within 3 iterations" in out and "raise max_iterations" in out
     out, _ = run(capsys, *slow, "--tol", "1e-3")
     assert "< 0.001 after" in out
+
+
+def test_a_catalogue_arm_without_redundancy_for_its_task_names_the_task_option(capsys):
+    """UR5e's 6 joints and --task pose's 6 coordinates: the option to change is --task (the
+    arm's active_joints are the catalogue's, no option of the command)."""
+    pytest.importorskip("yourdfpy")
+    _, err = run(capsys, "solve", "--robot", "ur5e", "--task", "pose", code=2)
+    assert "6 active joints for a task of 6 coordinates" in err and err.endswith(
+        "(option --task)\n"
+    )
