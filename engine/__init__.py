@@ -150,7 +150,7 @@ _EXPORTS = {
     "functionals_report": "functional_report",
     "synthesize_e2": "variational",
     "synthesize_e2_nd": "synthesis_nd",
-    "TotalDegreeSynthesis": "synthesis_nd",
+    "TotalDegreeSynthesis": "synthesis_nd_result",
     "SynthesisResult": "variational",
     "map_singularities": "map_singularities",
     "inert_variables": "dependence",
@@ -331,7 +331,8 @@ if TYPE_CHECKING:  # what the names are, for type checkers and editors (no impor
     from .robot_spec import Robot, load_robot, robot_from_dict
     from .run_settings import Resume
     from .solver import solve, solve_batch
-    from .synthesis_nd import TotalDegreeSynthesis, synthesize_e2_nd
+    from .synthesis_nd import synthesize_e2_nd
+    from .synthesis_nd_result import TotalDegreeSynthesis
     from .unicycle import Unicycle
     from .units import RobotUnits, robot_units
     from .urdf import UrdfChain

@@ -25,17 +25,16 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import linalg
 
 from .exceptions import InvalidInputError, KinematicSingularityError
-from .exports import Columns
 from .functionals import Region, check_region
 from .inverses import pseudoinverse, require_kinematics
 from .kinematics import Kinematics
 from .progress import Progress, check_cancelled, check_progress
+from .synthesis_nd_result import TotalDegreeSynthesis
 from .total_degree import (
     TotalDegreeMap,
     basis_gradients,
@@ -53,6 +52,9 @@ MAX_NODES = 2**17
 CHUNK = 1024
 #: Bytes of the basis gradients (nodes, unknowns, variables) held for one chunk of nodes.
 CHUNK_BYTES = 2**24
+#: Share of a synthesis's progress for assembling the Ritz system; the rest is the check of E2
+#: on a second rule, about a quarter of the time.
+MAIN_PASS = 0.75
 
 
 def chunk_for(unknowns: int, variables: int) -> int:
@@ -106,83 +108,6 @@ def best_frame_axes(kin: Kinematics, box: Mapping, fix: Mapping) -> list[int]:
     choices = np.array(list(itertools.combinations(range(kin.p), kin.p - kin.r)))
     least = np.linalg.eigvalsh(N[choices[:, :, None], choices[:, None, :]])[:, 0]
     return [int(a) + 1 for a in choices[int(np.argmax(least))]]
-
-
-@dataclass(frozen=True, repr=False)
-class TotalDegreeSynthesis(Columns):
-    """The E2-optimal map(s) on a box and what they achieve.
-
-    Attributes
-    ----------
-    maps : tuple of TotalDegreeMap
-        One per degree of redundancy (h_1, ..., h_(p-r)).
-    e2 : float
-        E2 of the maps on the fitting rule (the Ritz value).
-    e2_check : float
-        E2 of the maps on an independent scrambled Sobol rule of as many nodes: the value to
-        trust; its distance to ``e2`` measures the quadrature error.
-    convergence : list of dict
-        ``{"degree", "nodes", "unknowns", "e2"}``: the Ritz value with the degree at all the nodes,
-        then with the nodes (the leading 2^k nodes of the rule, 2^k >= 1024 and twice the
-        unknowns) at the final degree.
-    single_joint : dict name -> dict
-        E2 of the common choice h = s x_j for each joint of the region, with the better sign s
-        (one degree of redundancy only; empty otherwise).
-    region, fixed : dict
-    degree, nodes, seed : int
-    frame_axes : tuple of int
-        The kernel frame's axes (p - r >= 2), 0-based.
-    """
-
-    maps: tuple[TotalDegreeMap, ...]
-    e2: float
-    e2_check: float
-    convergence: list[dict]
-    single_joint: dict[str, dict]
-    region: dict[str, tuple[float, float]]
-    fixed: dict[str, float]
-    degree: int
-    nodes: int
-    seed: int
-    frame_axes: tuple[int, ...] = field(default=())
-
-    @property
-    def augmenting_map(self) -> TotalDegreeMap:
-        """The map, for one degree of redundancy."""
-        if len(self.maps) != 1:
-            raise InvalidInputError(f"there are {len(self.maps)} maps; use .maps")
-        return self.maps[0]
-
-    def __repr__(self) -> str:
-        return (
-            f"TotalDegreeSynthesis(e2={self.e2:.6g}, e2_check={self.e2_check:.6g}, "
-            f"maps={len(self.maps)}, variables={len(self.region)}, degree={self.degree}, "
-            f"unknowns={len(self.maps[0].index)}, nodes={self.nodes})"
-        )
-
-    def columns(self) -> dict[str, FloatArray]:
-        """A row per Ritz value computed (:attr:`convergence`), the last the result:
-        ``degree``, ``nodes``, ``unknowns``, ``e2``."""
-        return {
-            key: np.array([row[key] for row in self.convergence])
-            for key in ("degree", "nodes", "unknowns", "e2")
-        }
-
-    def as_dict(self) -> dict:
-        """JSON-friendly summary (without the coefficients)."""
-        return {
-            "e2": self.e2,
-            "e2_check": self.e2_check,
-            "degree": self.degree,
-            "nodes": self.nodes,
-            "seed": self.seed,
-            "unknowns": len(self.maps[0].index),
-            "region": {k: list(v) for k, v in self.region.items()},
-            "fixed": dict(self.fixed),
-            "convergence": list(self.convergence),
-            "single_joint": dict(self.single_joint),
-            "frame_axes": [a + 1 for a in self.frame_axes],
-        }
 
 
 class _Rule:
@@ -327,7 +252,7 @@ def synthesize_e2_nd(
         if done < nodes and done >= max(2 * nb, CHUNK) and done & (done - 1) == 0:
             snapshots.append((done, A.copy(), B.copy(), c0))
         if progress is not None:
-            progress.advance(0.9 * done / nodes, 1.0)
+            progress.advance(MAIN_PASS * done / nodes, 1.0)
     w = rule.volume / nodes
     A, B, c0 = A * w, B * w, c0 * w
     A = 0.5 * (A + A.T)
@@ -357,7 +282,7 @@ def synthesize_e2_nd(
         TotalDegreeMap(index, C[:, i], box, rule.variables, kinematics.p) for i in range(m_red)
     )
     check = _Rule(kinematics, box, fix, nodes, seed + 1, axes, chunk)
-    e2_check = e2_of_gradients(check, index, C)
+    e2_check = e2_of_gradients(check, index, C, progress)
     single = _single_joint(rule, diag * w, load * w, c0) if m_red == 1 else {}
     if progress is not None:
         progress.advance(1.0, 1.0)
@@ -376,10 +301,17 @@ def synthesize_e2_nd(
     )
 
 
-def e2_of_gradients(rule: _Rule, index: np.ndarray, C: FloatArray) -> float:
-    """E2 of the maps with coefficients C (nb, p - r) on ``rule``: tr(dh R dh^T - 2 dh f) + m."""
-    total = 0.0
+def e2_of_gradients(
+    rule: _Rule, index: np.ndarray, C: FloatArray, progress: Progress | None = None
+) -> float:
+    """E2 of the maps with coefficients C (nb, p - r) on ``rule``: tr(dh R dh^T - 2 dh f) + m
+    (the last 1 - MAIN_PASS of a synthesis's ``progress``, cancelled between chunks)."""
+    total, done = 0.0, 0
     for t, R, f, m in rule.chunks():
+        check_cancelled(progress, "the E2 synthesis was cancelled")
+        done += len(t)
+        if progress is not None:
+            progress.advance(MAIN_PASS + (1.0 - MAIN_PASS) * done / len(rule.t), 1.0)
         _, G = basis_gradients(t, index)
         dh = np.einsum("nbk,bi->nik", G, C)  # (n, p - r, d), with respect to t
         quad = np.einsum("nik,nkl,nil->n", dh, R, dh)

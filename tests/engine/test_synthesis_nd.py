@@ -11,7 +11,7 @@ from jik.engine.functionals import error_functional_e2
 from jik.engine.kinematics import Kinematics, Manipulator2
 from jik.engine.planar_chain import PlanarChain
 from jik.engine.progress import ProgressCallbacks
-from jik.engine.synthesis_nd import chunk_for, kernel_frame, synthesize_e2_nd
+from jik.engine.synthesis_nd import MAIN_PASS, chunk_for, kernel_frame, synthesize_e2_nd
 from jik.engine.total_degree import basis_size, total_degree_indices
 from jik.engine.variational import MANIPULATOR2_REGION, synthesize_e2
 
@@ -203,6 +203,21 @@ def test_cancel_stops_between_chunks():
             Manipulator2(1.0), MANIPULATOR2_REGION, degree=6, nodes=2**13, progress=progress
         )
     assert len(calls) == 2
+
+
+def test_cancel_stops_the_check_of_e2_too():
+    """After the Ritz system (progress MAIN_PASS) E2 is checked on a second rule, a quarter of
+    the time: progress goes on there, and a cancel there stops the synthesis too."""
+    calls = []
+    progress = ProgressCallbacks(
+        on_advance=lambda done, total: calls.append(done),
+        is_cancelled=lambda: bool(calls) and MAIN_PASS < calls[-1] < 1.0,
+    )
+    with pytest.raises(RunCancelled):
+        synthesize_e2_nd(
+            Manipulator2(1.0), MANIPULATOR2_REGION, degree=6, nodes=2**13, progress=progress
+        )
+    assert MAIN_PASS in calls and MAIN_PASS < calls[-1] < 1.0 and calls == sorted(calls)
 
 
 def test_the_joints_outside_the_region_are_held_at_home_within_the_joint_limits():

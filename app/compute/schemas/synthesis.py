@@ -151,7 +151,7 @@ class SynthesisGrid(BaseModel):
 
 
 class TotalDegreeInfo(BaseModel):
-    """A total-degree synthesis (engine.synthesis_nd.TotalDegreeSynthesis)."""
+    """A total-degree synthesis (engine.synthesis_nd_result.TotalDegreeSynthesis)."""
 
     e2: float = Field(description="E2 of the maps on the fitting rule (the Ritz value)")
     e2_check: float = Field(
