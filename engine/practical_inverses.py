@@ -241,8 +241,9 @@ class WeightedInverse(Inverse):
             lo, hi = self.limits[i]
             return KinematicSingularityError(
                 f"the weighted inverse of {self.kinematics.name} is undefined: joint {i + 1} "
-                f"is at or past its limits [{lo:g}, {hi:g}] (x{i + 1} = {x[i]:.6g}); start "
-                "inside the limits (a discrete step can also cross one: lower gamma)",
+                f"is at or past its limits [{lo:g}, {hi:g}] (x{i + 1} = {x[i]:.6g}), where its "
+                "weight is infinite: a start must lie inside the limits, and a discrete step "
+                "can cross one (lower gamma)",
                 x,
             )
         return _singular(self.kinematics, x, "the weighted inverse (J W^-1 J^T singular)")
