@@ -122,6 +122,7 @@ def solve_batch_json(reqs: list[S.SolveRequest]) -> list[bytes | RequestError]:
     for i, r in enumerate(reqs):
         try:
             check_configuration(setup.spec, r.x0)
+            setup.kinematics.check_start(r.x0, "x0")  # (the engine's batch would refuse all)
             check_length(setup.spec, r.target, "target")
             setup.kinematics.check_target(r.target, "target")
             ok.append(i)

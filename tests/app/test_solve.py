@@ -213,6 +213,31 @@ def test_service_batch_isolates_a_bad_first_member():
     np.testing.assert_allclose(json.loads(out[2])["y"], [0.5, 1.5], atol=1e-9)
 
 
+def test_a_start_on_the_rotation_coordinates_cut_spoils_only_its_own_request():
+    """A Panda start a half turn from R0 (the base frame: home, flange down) is refused by the
+    engine's check of starts, which refuses a whole batch: each member is checked alone."""
+    pytest.importorskip("yourdfpy")
+    from jik.app.compute.exceptions import RequestError
+    from jik.app.compute.requests import solve_batch_json
+    from jik.app.compute.schemas import SolveRequest
+    from jik.engine import robot_from_dict
+
+    robot = {"name": "panda", "task": "pose", "reference": [0, 0, 0]}
+    panda = robot_from_dict(robot)
+    home = np.array(panda.spec.default_x0)
+    near = home + [0, 0, 0, 0, 0, 0.3, 0]
+    body = {"robot": robot, "algorithm": "pseudoinverse", "x0": list(near)}
+    target = list(panda.kinematics.forward(near) + [0.02, 0, 0, 0, 0, 0])
+    reqs = [
+        SolveRequest.model_validate({**body, "target": target}),
+        SolveRequest.model_validate({**body, "x0": list(home), "target": target}),
+    ]
+    first, second = solve_batch_json(reqs)
+    assert isinstance(second, RequestError) and second.field == "x0"
+    assert "a half turn from the reference orientation R0" in str(second)
+    np.testing.assert_allclose(json.loads(first)["y"], target, atol=1e-9)
+
+
 @pytest.mark.parametrize(
     "over",
     [
