@@ -50,6 +50,8 @@ def solve_response_json(setup, res) -> bytes:
         {
             **setup.head,
             "tolerance": float(setup.run["tol"]),
+            "x0": res.x0.tolist(),
+            "target": res.y_d.tolist(),
             "x": nullable(res.x),
             "y": nullable(res.y),
             "error": nullable(res.error),

@@ -10,6 +10,7 @@ catalogue arms alike); results become JSON by :mod:`jik.app.compute.documents`.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, cast
 
@@ -89,6 +90,11 @@ def engine_error(exc: JikError) -> RequestError:
     return RequestError(name + dot + tail, without_field(str(exc), field))
 
 
+def _given(value: list[float] | None, default: Sequence[float]) -> list[float]:
+    """A request's start or target, or the robot's when it gives none."""
+    return list(default) if value is None else value
+
+
 def batch_key(req: S.SolveRequest) -> str:
     """Requests with equal keys can share one batched engine call: their x0 apart, except
     for a posture inverse without a rest, whose rest may be the run's start."""
@@ -119,20 +125,22 @@ def solve_batch_json(reqs: list[S.SolveRequest]) -> list[bytes | RequestError]:
         return [exc] * len(reqs)
     out: list[bytes | RequestError | None] = [None] * len(reqs)
     ok: list[int] = []
-    for i, r in enumerate(reqs):
+    starts = [_given(r.x0, setup.spec.default_x0) for r in reqs]
+    targets = [_given(r.target, setup.spec.default_target) for r in reqs]
+    for i in range(len(reqs)):
         try:
-            check_configuration(setup.spec, r.x0)
-            setup.kinematics.check_start(r.x0, "x0")  # (the engine's batch would refuse all)
-            check_length(setup.spec, r.target, "target")
-            setup.kinematics.check_target(r.target, "target")
+            check_configuration(setup.spec, starts[i])
+            setup.kinematics.check_start(starts[i], "x0")  # (the engine's batch would refuse all)
+            check_length(setup.spec, targets[i], "target")
+            setup.kinematics.check_target(targets[i], "target")
             ok.append(i)
         except RequestError as exc:
             out[i] = exc
         except JikError as exc:
             out[i] = engine_error(exc)
     if ok:
-        x0 = np.array([reqs[i].x0 for i in ok], dtype=float)
-        y_d = np.array([reqs[i].target for i in ok], dtype=float)
+        x0 = np.array([starts[i] for i in ok], dtype=float)
+        y_d = np.array([targets[i] for i in ok], dtype=float)
         refused = refused_starts(setup.inverse, x0)
         for k, why in refused.items():
             out[ok[k]] = RequestError("x0", why)
@@ -155,17 +163,22 @@ def solve_batch_json(reqs: list[S.SolveRequest]) -> list[bytes | RequestError]:
 def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityResponse:
     """The closed path of ``req`` driven ``req.cycles`` times (Table 1); drift per cycle."""
     setup = _setup(req)
-    check_configuration(setup.spec, req.x0)
-    for i, pt in enumerate(req.path):
+    start = _given(req.x0, setup.spec.default_x0)
+    try:
+        path = setup.spec.default_loop() if req.path is None else req.path
+    except JikError as exc:  # (a robot without a closed path of its own)
+        raise engine_error(exc) from None
+    check_configuration(setup.spec, start)
+    for i, pt in enumerate(path):
         check_length(setup.spec, pt, f"path[{i}]")
-    x0 = np.array(req.x0, dtype=float)
+    x0 = np.array(start, dtype=float)
     if refused := refused_starts(setup.inverse, x0[None]):
         raise RequestError("x0", refused[0])
     try:
         res = repeatability(
             setup.inverse,
             x0,
-            np.array(req.path, dtype=float),
+            np.array(path, dtype=float),
             cycles=req.cycles,
             **setup.run,
             record=robot_limits(setup.kinematics) is not None,  # (limits: check whole legs)
@@ -177,6 +190,7 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
     return S.RepeatabilityResponse(
         **setup.head,
         cycles=req.cycles,
+        x0=x0.tolist(),
         targets=np.asarray(res.targets, dtype=float).tolist(),
         legs=nullable(res.legs),
         cycle_end=nullable(res.cycle_end),

@@ -222,14 +222,20 @@ def _run_ok(body: dict, path: str) -> bool:
         model = S.SolveRequest if path == "/solve" else S.RepeatabilityRequest
         run = model.model_validate(body)
         setup = _setup(run)
-        check_configuration(setup.spec, run.x0)
-        points = run.path if isinstance(run, S.RepeatabilityRequest) else [run.target]
+        spec = setup.spec  # (a start, target or path not given: the robot's)
+        x0 = list(spec.default_x0) if run.x0 is None else run.x0
+        check_configuration(spec, x0)
+        setup.kinematics.check_start(x0, "x0")  # (not on a pose's rotation cut)
+        if isinstance(run, S.RepeatabilityRequest):
+            points = spec.default_loop() if run.path is None else run.path
+        else:
+            points = [list(spec.default_target) if run.target is None else run.target]
         for i, point in enumerate(points):
-            check_length(setup.spec, point, f"path[{i}]")
+            check_length(spec, point, f"path[{i}]")
         setup.kinematics.check_target(points, "path")  # (a pose's rotation within pi)
         # (the server's own test of a singular start, which a nearly singular J J^T fails)
-        setup.inverse.matrix(np.asarray(run.x0, dtype=float))
-        if refused_starts(setup.inverse, np.asarray([run.x0], dtype=float)):
+        setup.inverse.matrix(np.asarray(x0, dtype=float))
+        if refused_starts(setup.inverse, np.asarray([x0], dtype=float)):
             return False
     except (RequestError, JikError, ValidationError):
         return False

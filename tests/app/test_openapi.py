@@ -30,19 +30,26 @@ def _variants(document, path: str) -> dict[str, dict]:
     return out
 
 
+def _given(field: dict) -> dict:
+    """The schema of a field given (x0, target, path: each may be left out, the robot's)."""
+    (given,) = [s for s in field["anyOf"] if s.get("type") != "null"]
+    assert field.get("default", None) is None
+    return given
+
+
 def test_each_robot_has_its_own_vector_lengths(document):
     solve, repeatability = _variants(document, "/solve"), _variants(document, "/repeatability")
     assert set(solve) == set(repeatability) == {*ROBOTS, *USER_ROBOT_MODELS}
     for kind in USER_ROBOT_MODELS:  # (p and r follow from the definition: 1 to 16)
-        x0 = solve[kind]["properties"]["x0"]
+        x0 = _given(solve[kind]["properties"]["x0"])
         assert (x0["minItems"], x0["maxItems"]) == (1, 16), kind
     for name, spec in ROBOTS.items():
         r = len(spec.task_names)
-        x0 = solve[name]["properties"]["x0"]
+        x0 = _given(solve[name]["properties"]["x0"])
         assert (x0["minItems"], x0["maxItems"]) == (spec.p, spec.p), name
-        target = solve[name]["properties"]["target"]
+        target = _given(solve[name]["properties"]["target"])
         assert (target["minItems"], target["maxItems"]) == (r, r), name
-        point = repeatability[name]["properties"]["path"]["items"]
+        point = _given(repeatability[name]["properties"]["path"])["items"]
         assert (point["minItems"], point["maxItems"]) == (r, r), name
 
 

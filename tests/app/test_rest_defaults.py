@@ -134,3 +134,29 @@ def test_an_e2_map_without_region_of_a_robot_without_a_home_asks_for_one(client)
     r = client.post("/solve", json=body)
     assert r.json()["detail"][0]["loc"] == ["body", "augmentation", "region"]
     assert "only an arm with a home has a default box" in messages(r)[0]
+
+
+@pytest.mark.parametrize("robot", [PANDA, {"name": "manipulator2"}])
+def test_a_run_without_start_target_or_path_takes_the_robot_s_and_says_so(api, robot):
+    """As the command line and /atlas do: the robot's start, target and closed path, echoed in
+    the response (x0, target; targets)."""
+    spec = robot_from_dict(robot).spec
+    body = {"robot": robot, "algorithm": "pseudoinverse"}
+    solved = api.post("/solve", json=body)
+    assert solved.status_code == 200, solved.text
+    out = solved.json()
+    assert out["x0"] == list(spec.default_x0) and out["target"] == list(spec.default_target)
+    assert out["converged"] and out["trajectory"]["x"][0] == list(spec.default_x0)
+    driven = api.post("/repeatability", json={**body, "cycles": 1})
+    assert driven.status_code == 200, driven.text
+    loop = driven.json()
+    assert loop["x0"] == list(spec.default_x0) and loop["success"]
+    assert loop["targets"][:3] == spec.default_loop()[:3]
+
+
+def test_a_robot_without_a_closed_path_needs_one(api):
+    """The unicycle's default path is its experiment's targets, not a loop: 422 at path."""
+    body = {"robot": {"name": "unicycle"}, "algorithm": "pseudoinverse"}
+    r = api.post("/repeatability", json=body)
+    assert r.status_code == 422
+    assert messages(r)[0].startswith("path: unicycle has no default closed path")

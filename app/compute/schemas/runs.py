@@ -33,6 +33,13 @@ from .robots import (
 )
 from .variants import per_robot
 
+#: What a run takes when its request gives no start, target or path.
+DEFAULT_X0 = "default: the robot's start (GET /robots: default_x0)"
+DEFAULT_TARGET = "default: the robot's target (GET /robots: default_target)"
+DEFAULT_PATH = (
+    "default: the robot's closed path (GET /robots: default_path, where default_path_loops)"
+)
+
 
 class RunSettings(BaseModel):
     """What every run of a request shares (a solve's, a repeatability's, an atlas's legs)."""
@@ -76,20 +83,26 @@ class _Request(RunSettings):
         description="augmenting map h of the extended inverse with its parameters; "
         "default: the robot's default augmentation (the other algorithms take none)",
     )
-    x0: Vector = Field(description="start configuration, length p of the robot")
+    x0: Vector | None = Field(
+        None, description=f"start configuration, length p of the robot; {DEFAULT_X0}"
+    )
 
 
 class SolveRequest(_Request):
     """One run of the continuation algorithm (7) from x0 to a target task point."""
 
-    target: Vector = Field(description="target task point, length r of the robot")
+    target: Vector | None = Field(
+        None, description=f"target task point, length r of the robot; {DEFAULT_TARGET}"
+    )
 
 
 class RepeatabilityRequest(_Request):
     """Drive the robot ``cycles`` times around a closed task-space path (Table 1)."""
 
-    path: Annotated[list[Vector], Field(min_length=1, max_length=MAX_PATH_POINTS)] = Field(
-        description=f"task points visited in order, 1 to {MAX_PATH_POINTS}; k(x0) closes it"
+    path: Annotated[list[Vector], Field(min_length=1, max_length=MAX_PATH_POINTS)] | None = Field(
+        None,
+        description=f"task points visited in order, 1 to {MAX_PATH_POINTS}; k(x0) closes it; "
+        f"{DEFAULT_PATH}",
     )
     cycles: Annotated[int, Field(strict=True, ge=1, le=MAX_CYCLES), INTEGRAL] = Field(
         1, description=f"1 to {MAX_CYCLES}"
@@ -161,6 +174,8 @@ assert set(RunStatus.__args__) == set(Status.NAMES) - {"running"}  # type: ignor
 
 class SolveResponse(_RunResponse):
     tolerance: float
+    x0: list[float] = Field(description="the start configuration (the robot's, if not given)")
+    target: list[float] = Field(description="the target task point (the robot's, if not given)")
     x: list[MaybeFloat] = Field(
         description="final configuration (null entries if the run diverged)"
     )
@@ -189,6 +204,7 @@ class Sentence(BaseModel):
 
 class RepeatabilityResponse(_RunResponse):
     cycles: int
+    x0: list[float] = Field(description="the start configuration (the robot's, if not given)")
     targets: list[list[float]] = Field(description="task point of each leg of one cycle (closed)")
     legs: list[list[MaybeFloat]] = Field(
         description="configuration after each leg, all cycles (null after a failed leg)"
@@ -217,8 +233,10 @@ class RepeatabilityResponse(_RunResponse):
 def _run_fields(spec: RobotSpec) -> dict[str, Any]:
     return {
         "x0": (
-            coordinates(spec.p),
-            Field(description=f"start configuration {list(spec.variable_names)}"),
+            coordinates(spec.p) | None,
+            Field(
+                None, description=f"start configuration {list(spec.variable_names)}; {DEFAULT_X0}"
+            ),
         ),
     }
 
@@ -228,7 +246,10 @@ SolveBody = per_robot(
     SolveRequest,
     lambda spec: {
         **_run_fields(spec),
-        "target": (coordinates(spec.r), Field(description=f"target {list(spec.task_names)}")),
+        "target": (
+            coordinates(spec.r) | None,
+            Field(None, description=f"target {list(spec.task_names)}; {DEFAULT_TARGET}"),
+        ),
     },
 )
 #: ``POST /repeatability``'s body: a :class:`RepeatabilityRequest` with its robot's lengths.
@@ -237,10 +258,11 @@ RepeatabilityBody = per_robot(
     lambda spec: {
         **_run_fields(spec),
         "path": (
-            points(spec.r, 1, MAX_PATH_POINTS),
+            points(spec.r, 1, MAX_PATH_POINTS) | None,
             Field(
+                None,
                 description=f"task points {list(spec.task_names)} visited in order, 1 to "
-                f"{MAX_PATH_POINTS}; k(x0) closes it"
+                f"{MAX_PATH_POINTS}; k(x0) closes it; {DEFAULT_PATH}",
             ),
         ),
     },
