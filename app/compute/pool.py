@@ -16,6 +16,7 @@ import os
 import pickle
 import threading
 from collections.abc import Callable, Iterator
+from multiprocessing.reduction import ForkingPickler
 from typing import Any
 
 from .batching import SolveBatching, _Pending
@@ -148,8 +149,13 @@ class ComputePool(SolveBatching):
                 await loop.run_in_executor(self._threads, worker.wait_ready)
             deadline = loop.time() + self.settings.timeout
             cpu = worker.cpu_seconds()
+            try:  # (pickled first: a task that cannot be pickled leaves the worker free)
+                task = ForkingPickler.dumps((fn, args))
+            except BaseException:
+                self._bound_idle.put_nowait(worker)
+                raise
             os.set_blocking(worker.conn.fileno(), True)  # uvloop's add_reader made it non-blocking
-            worker.conn.send((fn, args))
+            worker.conn.send_bytes(task)
             sent = True
             msg = await self._reply(worker, deadline, buf)
         except TimeoutError:

@@ -26,6 +26,7 @@ from ..compute.schemas import (
     MAX_ITERATIONS_CAP,
     ROBOT_MODELS,
     Coordinate,
+    FreeObject,
     Gamma,
     Mode,
     Tolerance,
@@ -76,7 +77,7 @@ class DashboardState(BaseModel):
     #: A robot given by a definition (:mod:`jik.app.dashboard.robots`), whose ``name`` is
     #: ``robot``: a kind of :mod:`jik.engine.robot_kinds` or a catalogue arm; None for the
     #: paper's robots.
-    robot_definition: Annotated[dict[str, Any], Field(max_length=32)] | None = None
+    robot_definition: FreeObject | None = None
     augmentation: str
     augmentation_parameters: dict[str, Any]
     gamma: Gamma

@@ -218,3 +218,23 @@ def test_a_hung_worker_is_the_servers_fault_503_not_the_requests_422():
         assert r.status_code == 503, r.text
         assert "server's compute worker stopped responding" in r.json()["detail"]
         assert client.post("/solve", json=solve_body()).status_code == 200
+
+
+def test_a_task_that_cannot_be_pickled_leaves_its_worker_free():
+    """A task the pool cannot send (a deeply nested argument ran pickle out of stack) fails
+    alone: its worker stays in the pool, which goes on serving (it had been lost for good, and
+    with it, after as many such tasks as workers, every later request)."""
+    from jik.app.dashboard.robots import check_definition
+
+    deep: list = []
+    for _ in range(5000):
+        deep = [deep]
+    definition = {"name": "formula", "variables": ["x1", "x2", "x3"], "task": ["x1", "x2"]}
+    with _client(Settings(workers=1, timeout=60.0)) as client:
+        pool = client.app.state.pool
+        (worker,) = pool._workers
+        for _ in range(2):
+            with pytest.raises(RecursionError):
+                pool.submit(check_definition, {**definition, "title": deep}).result(30)
+        assert pool.submit(check_definition, definition).result(30) is None
+        assert pool._workers == [worker]

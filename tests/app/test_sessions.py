@@ -107,6 +107,10 @@ def test_a_link_state_opens_a_session_with_that_state(app, client):
     assert a == b and a["extended"]["success"]
 
 
+#: A value nested 480 lists deep (1 KB of JSON).
+DEEP = json.loads("[" * 480 + "1" + "]" * 480)
+
+
 @pytest.mark.parametrize(
     ("state", "field"),
     [
@@ -115,6 +119,10 @@ def test_a_link_state_opens_a_session_with_that_state(app, client):
         ({"cycles": 0}, "cycles"),
         ({"x0": [1, 2]}, "x0"),
         ({"robot_parameters": {"l": -1}}, "robot_parameters.l"),
+        (  # (a robot definition nested 480 deep jammed the compute pool: 500, then 503s)
+            {"robot": "formula", "robot_definition": {"name": "formula", "title": DEEP}},
+            "robot_definition",
+        ),
     ],
 )
 def test_a_bad_link_state_is_refused_with_its_field(client, state, field):

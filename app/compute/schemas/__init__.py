@@ -20,6 +20,7 @@ from .fields import (
     MAX_ITERATIONS_CAP,
     MAX_TRAJECTORY_POINTS,
     Coordinate,
+    FreeObject,
     Gamma,
     MaybeFloat,
     Tolerance,

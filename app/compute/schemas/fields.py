@@ -8,7 +8,8 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Union
 
-from pydantic import BeforeValidator, Discriminator, Field, Tag
+from pydantic import AfterValidator, BeforeValidator, Discriminator, Field, Tag
+from pydantic_core import PydanticCustomError
 
 from ....engine.regions import MAX_REGION_BOUND
 from ....engine.solve_rules import GAMMA_MAX, GAMMA_MIN, TOL_MAX, TOL_MIN
@@ -101,3 +102,27 @@ def one_or_many(one: Any, many: Any) -> Any:
         Union[Annotated[one, Tag(ONE)], Annotated[many, Tag(MANY)]],  # noqa: UP007
         Discriminator(_shape),
     ]
+
+
+#: How deep a JSON object of free form (a dashboard's robot definition) may nest: a definition's
+#: deepest part, a URDF arm's limits or a map's list of formulas, is 3 deep.
+MAX_OBJECT_DEPTH = 12
+
+
+def _shallow(value: dict) -> dict:
+    """``value`` if it nests at most :data:`MAX_OBJECT_DEPTH` deep (deeper, it could not even be
+    passed to a compute worker: pickling it ran out of stack)."""
+    level, depth = [value], 1
+    while level:
+        if depth > MAX_OBJECT_DEPTH:
+            raise PydanticCustomError(
+                "too_deep", f"nests deeper than {MAX_OBJECT_DEPTH} levels of lists and objects"
+            )
+        inner = [v for item in level for v in (item.values() if isinstance(item, dict) else item)]
+        level, depth = [v for v in inner if isinstance(v, dict | list)], depth + 1
+    return value
+
+
+#: A JSON object of free form (checked by the engine, as a robot definition is), of at most 32
+#: keys and :data:`MAX_OBJECT_DEPTH` levels.
+FreeObject = Annotated[dict[str, Any], Field(max_length=32), AfterValidator(_shallow)]
