@@ -112,7 +112,8 @@ MAX_OBJECT_DEPTH = 12
 def _shallow(value: dict) -> dict:
     """``value`` if it nests at most :data:`MAX_OBJECT_DEPTH` deep (deeper, it could not even be
     passed to a compute worker: pickling it ran out of stack)."""
-    level, depth = [value], 1
+    level: list[dict | list] = [value]
+    depth = 1
     while level:
         if depth > MAX_OBJECT_DEPTH:
             raise PydanticCustomError(
