@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import json
 import logging
+import math
 import threading
 import time
 from collections.abc import Callable, Mapping
@@ -64,9 +65,13 @@ class Dashboard(SecondPhaseControl, SolvingAhead):
         *,
         pool: Any = None,
         slots: FairSlots | None = None,
+        time_limit: float | None = None,
     ) -> None:
         self._cond = threading.Condition()
         self._slots = slots
+        #: Seconds each algorithm's runs of a state may take (the server's request time limit;
+        #: None: no limit), after which the computation stops with an error.
+        self._time_limit = time_limit
         self._offload = OffloadLane(pool) if pool is not None else None
         self._state = validate((state or default_state()).as_dict())
         self._generation = 1
@@ -114,6 +119,7 @@ class Dashboard(SecondPhaseControl, SolvingAhead):
             if self._stopped:
                 return
             self._stopped = True
+            self._generation += 1  # (every computation of the session sees itself superseded)
             self._cond.notify_all()
         if self._offload is not None:
             self._offload.close()
@@ -245,14 +251,26 @@ class Dashboard(SecondPhaseControl, SolvingAhead):
         with self._slots.slot() if self._slots is not None else contextlib.nullcontext():
             if self._generation != generation:
                 raise Cancelled
-            return compute(
-                state,
-                generation,
-                cancelled=lambda: self._generation != generation,
-                cache=self._cache,
-                offload=self._offload,
-                **more,
-            )
+            limit = None if self._time_limit is None else self._time_limit * len(state.algorithms)
+            deadline = math.inf if limit is None else time.monotonic() + limit
+            try:
+                return compute(
+                    state,
+                    generation,
+                    cancelled=lambda: self._generation != generation or time.monotonic() > deadline,
+                    cache=self._cache,
+                    offload=self._offload,
+                    **more,
+                )
+            except Cancelled:
+                if self._generation != generation or time.monotonic() <= deadline:
+                    raise
+                raise InvalidInputError(
+                    f"the computation exceeded the time limit of {limit:g} s ("
+                    f"{self._time_limit:g} s per algorithm) and was stopped; ask for less work "
+                    "(a lower max_iterations, a larger tolerance or fewer cycles)",
+                    "max_iterations",
+                ) from None
 
     def _reporter(self, generation: int, phase: str) -> Callable[..., None]:
         """``report(fraction, what="the runs")``: a ``progress`` event of ``phase`` ("runs", or

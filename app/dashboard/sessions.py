@@ -153,7 +153,9 @@ class SessionStore:
             if len(self._sessions) >= self.settings.max_sessions:
                 self._evict_idlest()
             session_id = secrets.token_urlsafe(16)
-            dashboard = Dashboard(state, pool=self._pool, slots=self._slots)
+            dashboard = Dashboard(
+                state, pool=self._pool, slots=self._slots, time_limit=self.settings.timeout
+            )
             session = Session(session_id, dashboard)
             self._sessions[session_id] = session
         if self._scene_factory is not None:
