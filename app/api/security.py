@@ -25,6 +25,7 @@ websocket relay (docs/security.md has the threat model):
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable
 from urllib.parse import urlsplit
 
@@ -57,11 +58,15 @@ _SCENE_POLICY = (
 )
 
 
+#: A Host header: a name or an IPv6 address in brackets, and an optional port of digits.
+_HOST = re.compile(r"(\[[0-9A-Fa-f:.]+\]|[^:\[\]]+)(?::[0-9]{1,5})?")
+
+
 def _host_name(host: str) -> str:
-    """``example.org:8000`` -> ``example.org``; ``[::1]:8000`` -> ``[::1]``."""
-    if host.startswith("["):
-        return host[: host.find("]") + 1] if "]" in host else host
-    return host.rsplit(":", 1)[0] if host.count(":") == 1 else host
+    """``example.org:8000`` -> ``example.org``; ``[::1]:8000`` -> ``[::1]``; a header of
+    another form (``127.0.0.1:80@evil``, ``localhost:``) whole, which no allowed name is."""
+    match = _HOST.fullmatch(host)
+    return match.group(1) if match else host
 
 
 def _policy(path: str) -> str:

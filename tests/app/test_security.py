@@ -37,6 +37,9 @@ def test_an_unknown_host_is_refused_on_http_and_websocket(app):
     assert closed.value.code == 4400
     for name in ("localhost:8000", "127.0.0.1", "[::1]:8000"):
         assert TestClient(app, base_url=f"http://{name}").get("/health").status_code == 200
+    client = TestClient(app, base_url="http://127.0.0.1")
+    for malformed in ("127.0.0.1:8741@evil", "[::1]evil", "localhost:", "127.0.0.1:abc"):
+        assert client.get("/health", headers={"host": malformed}).status_code == 400, malformed
 
 
 def test_allowed_hosts_come_from_the_environment(monkeypatch):
