@@ -25,7 +25,6 @@ websocket relay (docs/security.md has the threat model):
 
 from __future__ import annotations
 
-import re
 from collections.abc import Iterable
 from urllib.parse import urlsplit
 
@@ -33,6 +32,8 @@ from fastapi import HTTPException
 from starlette.responses import JSONResponse
 from starlette.routing import Match
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+from ..compute.settings import host_name
 
 #: Largest request body accepted (413 beyond): the largest valid request is a few kilobytes.
 MAX_BODY_BYTES = 1 << 20
@@ -56,17 +57,6 @@ _SCENE_POLICY = (
     "connect-src 'self' data: blob:; worker-src 'self' blob:; frame-ancestors 'self'; "
     "base-uri 'none'; form-action 'none'; object-src 'none'"
 )
-
-
-#: A Host header: a name or an IPv6 address in brackets, and an optional port of digits.
-_HOST = re.compile(r"(\[[0-9A-Fa-f:.]+\]|[^:\[\]]+)(?::[0-9]{1,5})?")
-
-
-def _host_name(host: str) -> str:
-    """``example.org:8000`` -> ``example.org``; ``[::1]:8000`` -> ``[::1]``; a header of
-    another form (``127.0.0.1:80@evil``, ``localhost:``) whole, which no allowed name is."""
-    match = _HOST.fullmatch(host)
-    return match.group(1) if match else host
 
 
 def _policy(path: str) -> str:
@@ -139,7 +129,7 @@ class SecurityMiddleware:
 
     def _refusal(self, scope: Scope, headers: dict, host: str, websocket: bool):
         """(status, message) of a refused request, or None."""
-        if not self.any_host and _host_name(host).lower() not in self.hosts:
+        if not self.any_host and host_name(host).lower() not in self.hosts:
             return 400, (
                 f"host {host!r} is not allowed: the server answers to {sorted(self.hosts)} "
                 "(add names with JIK_ALLOWED_HOSTS or jik serve --allowed-host)"

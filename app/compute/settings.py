@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import functools
 import os
+import re
 
 from pydantic import AliasChoices, Field, ValidationError, field_validator
 from pydantic_settings import BaseSettings, SettingsConfigDict
@@ -117,3 +118,15 @@ def read_environment() -> Settings:
 def settings() -> Settings:
     """The settings of the environment, read once (:func:`read_environment`)."""
     return read_environment()
+
+
+#: A Host header: a name or an IPv6 address in brackets, and an optional port of digits.
+_HOST = re.compile(r"(\[[0-9A-Fa-f:.]+\]|[^:\[\]]+)(?::[0-9]{1,5})?")
+
+
+def host_name(host: str) -> str:
+    """The name of a Host header, which the server's hosts (loopback, ``allowed_hosts``) are
+    compared with: ``example.org:8000`` -> ``example.org``, ``[::1]:8000`` -> ``[::1]``; a
+    header of another form (``127.0.0.1:80@evil``, ``localhost:``) whole, which no name is."""
+    match = _HOST.fullmatch(host)
+    return match.group(1) if match else host

@@ -40,6 +40,8 @@ import websockets.asyncio.client
 import websockets.asyncio.server
 from websockets.typing import Subprotocol
 
+from ..compute.settings import host_name
+
 #: The key the relay presents to the scenes' servers (one per process, see the module's text).
 SCENE_KEY = secrets.token_urlsafe(32)
 _AUTHORIZATION = f"Bearer {SCENE_KEY}"
@@ -55,8 +57,7 @@ def handshake_refusal(headers: Any) -> str | None:
         return "a scene server takes no browser's request: use /api/sessions/{id}/scene"
     hosts = headers.get_all("Host")
     host = hosts[0] if len(hosts) == 1 else ""
-    name = host[: host.find("]") + 1] if host.startswith("[") else host.rsplit(":", 1)[0]
-    if name.lower() not in _LOOPBACK:
+    if host_name(host).lower() not in _LOOPBACK:
         return "a scene server answers to loopback names only"
     keys = headers.get_all("Authorization")
     key = keys[0] if len(keys) == 1 else ""
