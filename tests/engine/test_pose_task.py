@@ -158,15 +158,16 @@ def test_panda_pose_task_equals_pinocchio_through_jlog3():
         np.testing.assert_allclose(kin.jacobian(xi), Ji, atol=1e-12)
 
 
-def test_a_target_a_half_turn_from_the_reference_is_reached():
-    """The Panda's flange turned by pi about z from its home (rotation coordinates (0, 0, pi)):
-    every algorithm converges. With the log's rounding near pi (1e-8 in k) damped least
-    squares ran out of its 20,000 steps at error 1.5e-8."""
+def test_a_target_nearly_a_half_turn_from_the_reference_is_reached():
+    """The Panda's flange turned by pi - 1e-3 about z from its home: every algorithm converges.
+    (At pi itself, the rotation coordinates' cut, a target is refused:
+    tests/engine/test_stall.py.) With the log's rounding near pi (1e-8 in k) damped least
+    squares had run out of its 20,000 steps at error 1.5e-8."""
     from jik.engine import robot_from_dict, solve
 
     panda = robot_from_dict({"name": "panda", "task": "pose"})
     home = np.array(panda.spec.default_x0)
-    target = panda.kinematics.forward(home) + [0, 0, 0, 0, 0, np.pi]
+    target = panda.kinematics.forward(home) + [0, 0, 0, 0, 0, np.pi - 1e-3]
     for algorithm in ("pseudoinverse", "damped", "weighted", "posture"):
         res = solve(panda.inverse(algorithm), home, target, max_iterations=2000)
         assert res.success, (algorithm, res.message)
