@@ -8,6 +8,7 @@ Jacobian (Jv, Jw) of the chain: ``dp/dx = Jv`` and ``dphi/dx = Jl^-1(phi) R0^T J
 
 from __future__ import annotations
 
+import itertools
 import re
 from collections.abc import Sequence
 
@@ -227,3 +228,28 @@ class PoseTask:
         k = np.concatenate(values, axis=-1)[..., self.order]
         J = np.concatenate(rows, axis=-2)[..., self.order, :]
         return k, J
+
+
+def cut_notes(kinematics, x0, targets) -> list[str]:
+    """Sentences on the legs of a path from ``x0`` through ``targets`` (L, r) whose rotation
+    coordinates go the long way round: a leg moves along a straight line of the coordinates
+    (eq. (5)), so two orientations a little apart on either side of the cut (a half turn from
+    R0) are joined by nearly a whole turn of the end link. Empty for a task without all three
+    rotation coordinates (what a subset turns by depends on the coordinates left free)."""
+    task = getattr(kinematics, "pose_task", None)
+    if task is None or task.rotation_rows.size != 3:
+        return []
+    rows = [i for i, n in enumerate(task.names) if len(n) == 2]
+    r = np.vstack([kinematics.forward(np.asarray(x0, dtype=float)), targets])[:, rows]
+    out = []
+    for leg, (a, b) in enumerate(itertools.pairwise(r), start=1):
+        along = float(np.linalg.norm(b - a))
+        apart = float(np.linalg.norm(so3.log(so3.exp(a).T @ so3.exp(b))))
+        if along - apart > np.pi / 2:
+            out.append(
+                f"Leg {leg} moves the rotation coordinates by {along:.3g} rad between "
+                f"orientations {apart:.3g} rad apart: it crosses their cut (a half turn from R0) "
+                "the long way round. A reference orientation R0 (`reference`) nearer the path's "
+                "orientations makes the leg short."
+            )
+    return out

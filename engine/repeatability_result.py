@@ -167,6 +167,7 @@ class RepeatabilityResult(Columns):
         why | Why: J^P# picks the minimum-norm joint velocity, which has n
         """
         from .findings import Finding, verdict
+        from .pose_task import cut_notes
         from .practical_findings import practical_findings
 
         i: Any = ()
@@ -196,6 +197,8 @@ class RepeatabilityResult(Columns):
         out = verdict({self.algorithm: run}, True, self.mode, self.gamma, unit)
         if self.used is None:
             return out
+        targets = self.targets if self.targets.ndim == 2 else self.targets[i]
+        out += [Finding(t, "note") for t in cut_notes(self.used.kinematics, self.x0[i], targets)]
         per_cycle = self.targets.shape[-2]  # (the legs of a cycle)
         found = practical_findings(self.used, run, unit, self.settings.tol, legs=per_cycle)
         return out + [Finding(text, role, self.algorithm) for text, role in found]

@@ -15,6 +15,7 @@ from ...engine.exceptions import JikError
 from ...engine.findings import NAMES, Finding
 from ...engine.findings import verdict as run_verdict
 from ...engine.map_singularities import MapSingularities, map_singularities
+from ...engine.pose_task import cut_notes
 from ...engine.practical_findings import PRACTICAL, practical_findings
 from ...engine.reproductions.unicycle import undefined_why
 from .algorithms import rest_words
@@ -22,7 +23,7 @@ from .analysis import expensive_map, kinematics_and_map
 from .joint_limits import state_limits
 from .model import DashboardState, robot_and_map
 from .plotting import norm_unit, units
-from .robots import state_inverse, state_spec
+from .robots import state_inverse, state_kinematics, state_spec
 from .runs import AlgorithmRun, DashboardResult
 
 
@@ -108,6 +109,9 @@ def verdict(result: DashboardResult) -> list[dict]:
     undefined = [] if e is None else _undefined_why(result, e)
     out = run_verdict(runs, path, state.mode, state.gamma, unit, undefined)
     out += _practical(result, unit)
+    if path:  # (a leg the long way round a pose task's rotation coordinates)
+        kin = state_kinematics(state)
+        out += [Finding(t, "note") for t in cut_notes(kin, state.x0, result.targets)]
     robot = state_spec(state).title
     for a, report in result.limits.items():
         role = "note" if report.within else "warning"

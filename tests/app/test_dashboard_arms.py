@@ -88,6 +88,20 @@ def test_a_run_outside_the_limits_is_said_in_words_and_marked():
     assert not len(outside_joints(state_limits(_panda()), _panda().x0))
 
 
+def test_a_leg_the_long_way_round_the_rotation_coordinates_is_noted():
+    """Two orientations 0.08 rad apart on either side of the cut (rz -3.1 and +3.1): the leg
+    between them turns the end link by 6.2 rad (a straight line of the coordinates), which the
+    verdict says beside the drift, as the engine's findings do."""
+    x0 = np.array(_panda().x0)
+    x0[6] -= 2.9
+    y0 = state_kinematics(_panda()).forward(x0)
+    path = [[*y0[:5], -3.1], [*y0[:5], 3.1]]
+    state = updated_state(_panda(), {"x0": list(x0), "path": path, "cycles": 1})
+    notes = [s["text"] for s in verdict(compute(state)) if s["role"] == "note"]
+    assert any(t.startswith("Leg 2 moves the rotation coordinates by 6.2 rad") for t in notes)
+    assert not any("Leg" in s["text"] for s in verdict(compute(_panda())))
+
+
 def test_a_leg_leaving_the_limits_names_its_cycle_and_leg():
     """A planar chain with limits on x2: the path takes x2 past its bound on a leg after the
     start; the violation names that cycle and leg."""

@@ -194,3 +194,21 @@ def test_a_task_of_large_jacobian_converges_and_is_not_called_singular(method, t
     robot = e.robot_from_dict({"name": "formula", "variables": ["x1", "x2", "x3"], "task": task})
     res = e.solve(e.Pseudoinverse(robot.kinematics), x0, target, method=method)
     assert res.success and res.error < 1e-10, res.message
+
+
+def test_a_leg_the_long_way_round_the_rotation_coordinates_is_a_note():
+    """rz -3.1 then +3.1: orientations 0.083 rad apart that the coordinates join by 6.2 rad;
+    the run's findings say so, naming the leg and `reference`; a path that stays clear of the
+    cut gets no such note."""
+    pytest.importorskip("yourdfpy")
+    panda = e.robot_from_dict({"name": "panda", "task": "pose"})
+    x0 = np.array(panda.spec.default_x0)
+    x0[6] -= 2.9
+    y0 = panda.kinematics.forward(x0)
+    run = e.repeatability(panda.inverse(), x0, [np.r_[y0[:5], -3.1], np.r_[y0[:5], 3.1]])
+    notes = [f.text for f in run.findings() if f.role == "note"]
+    assert notes[0].startswith("Leg 2 moves the rotation coordinates by 6.2 rad between ")
+    assert "0.0832 rad apart" in notes[0] and "`reference`" in notes[0]
+    home = np.array(panda.spec.default_x0)
+    calm = e.repeatability(panda.inverse(), home, panda.spec.default_loop())
+    assert not [f for f in calm.findings() if f.text.startswith("Leg ")]
