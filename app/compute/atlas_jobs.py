@@ -21,6 +21,7 @@ source, :meth:`~jik.engine.atlas_run.AtlasResult.csv_text`): drift and success o
 
 from __future__ import annotations
 
+import contextlib
 import re
 import secrets
 import threading
@@ -206,6 +207,14 @@ class AtlasJobs:
         with self._lock:
             self._jobs.pop(job_id, None)
         self._release(job)
+
+    def cancel_session(self, session: str) -> None:
+        """Cancel the jobs a dashboard session started (it ended: nobody follows them)."""
+        with self._lock:
+            ids = [j.id for j in self._jobs.values() if j.session == session]
+        for job_id in ids:
+            with contextlib.suppress(AtlasJobNotFound):  # (ended meanwhile)
+                self.cancel(job_id)
 
     def _release(self, job: AtlasJob) -> None:
         """Give back ``job``'s slot if it still holds it."""

@@ -130,6 +130,9 @@ class SessionStore:
         self._slots = FairSlots(self.settings.dashboard_computations)
         self._closed = threading.Event()
         self._reaper: threading.Thread | None = None
+        #: Called with a session's id when it ends (deleted, expired, evicted, closed): what
+        #: else it started stops too (its atlas jobs, :meth:`when_ended`).
+        self._ended: dict[Callable[[str], None], None] = {}
 
     def __len__(self) -> int:
         return len(self._sessions)
@@ -188,12 +191,21 @@ class SessionStore:
         session.touch()
         return session
 
+    def when_ended(self, callback: Callable[[str], None]) -> None:
+        """Call ``callback(session_id)`` when a session ends (once per callback)."""
+        self._ended[callback] = None
+
+    def _end(self, session: Session) -> None:
+        session.stop()
+        for callback in list(self._ended):
+            callback(session.id)
+
     def delete(self, session_id: str) -> None:
         with self._lock:
             session = self._sessions.pop(session_id, None)
         if session is None:
             raise SessionNotFound(session_id)
-        session.stop()
+        self._end(session)
 
     def expire(self) -> int:
         """Stop the sessions idle for longer than the limit; how many were stopped."""
@@ -203,7 +215,7 @@ class SessionStore:
             for session in old:
                 del self._sessions[session.id]
         for session in old:
-            session.stop()
+            self._end(session)
         return len(old)
 
     def _evict_idlest(self) -> None:
@@ -216,7 +228,9 @@ class SessionStore:
             )
         oldest = min(idle, key=lambda s: s.touched)
         del self._sessions[oldest.id]
-        threading.Thread(target=oldest.stop, name="jik-session-stop", daemon=True).start()
+        threading.Thread(
+            target=self._end, args=(oldest,), name="jik-session-stop", daemon=True
+        ).start()
 
     def close(self) -> None:
         """Stop every session (the compute pool is the app's, closed with it)."""
@@ -224,4 +238,4 @@ class SessionStore:
         with self._lock:
             sessions, self._sessions = list(self._sessions.values()), {}
         for session in sessions:
-            session.stop()
+            self._end(session)

@@ -267,6 +267,19 @@ def test_a_session_atlas_is_the_atlas_of_its_state(client):
     assert np.min(drift) > 1e-4
 
 
+def test_ending_a_session_cancels_its_atlas(client):
+    """A deleted tab's atlas had run on to its limit, holding the pool's workers (and the
+    client's one running job) for nobody: it ends with the session, and the next can start."""
+    mine, other = _session(client, cycles=20), _session(client, cycles=20)
+    job = client.post(f"/api/sessions/{mine}/atlas", json={"starts": 4096})
+    assert job.status_code == 202, job.text
+    assert client.delete(f"/api/sessions/{mine}").status_code == 204
+    assert client.get(f"/atlas/{job.json()['id']}").status_code == 404
+    after = client.post(f"/api/sessions/{other}/atlas", json={"starts": 4096})
+    assert after.status_code == 202, after.text
+    assert client.delete(f"/atlas/{after.json()['id']}").status_code == 204
+
+
 @pytest.mark.parametrize(
     ("state", "over", "field", "text"),
     [

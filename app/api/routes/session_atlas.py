@@ -72,6 +72,7 @@ async def start_session_atlas(
         error = exc.errors()[0]
         name = ".".join(str(p) for p in error["loc"]) or "state"
         raise refused(name, error["msg"]) from None
+    store.when_ended(jobs.cancel_session)  # (the session's jobs end with it)
     return await start_job(jobs, request, response, req, session_id)
 
 
