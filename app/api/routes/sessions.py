@@ -287,7 +287,7 @@ async def export_result_json(
     With ``generation`` (the page's link), that generation's result, on screen."""
     session = store.get(session_id)
     result, functionals = await asyncio.to_thread(session.exported, generation, EXPORT_WAIT)
-    body, name = export_file(result, "json", functionals)
+    body, name = await asyncio.to_thread(export_file, result, "json", functionals)
     return JSONResponse(body, headers={"Content-Disposition": f'attachment; filename="{name}"'})
 
 
@@ -307,7 +307,7 @@ async def export_result_csv(session_id: str, store: Store, generation: int | Non
     ``generation``, as the JSON export."""
     session = store.get(session_id)
     result, _ = await asyncio.to_thread(session.exported, generation, EXPORT_WAIT)
-    body, name = export_file(result, "csv")
+    body, name = await asyncio.to_thread(export_file, result, "csv")  # (off the event loop)
     return CSVResponse(body, headers={"Content-Disposition": f'attachment; filename="{name}"'})
 
 
