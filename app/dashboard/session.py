@@ -69,8 +69,8 @@ class Dashboard(SecondPhaseControl, SolvingAhead):
     ) -> None:
         self._cond = threading.Condition()
         self._slots = slots
-        #: Seconds each algorithm's runs of a state may take (the server's request time limit;
-        #: None: no limit), after which the computation stops with an error.
+        #: Seconds the runs of a state may take, all its algorithms together (the server's
+        #: request time limit; None: no limit), after which the computation stops with an error.
         self._time_limit = time_limit
         self._offload = OffloadLane(pool) if pool is not None else None
         self._state = validate((state or default_state()).as_dict())
@@ -251,7 +251,7 @@ class Dashboard(SecondPhaseControl, SolvingAhead):
         with self._slots.slot() if self._slots is not None else contextlib.nullcontext():
             if self._generation != generation:
                 raise Cancelled
-            limit = None if self._time_limit is None else self._time_limit * len(state.algorithms)
+            limit = self._time_limit
             deadline = math.inf if limit is None else time.monotonic() + limit
             try:
                 return compute(
@@ -266,9 +266,9 @@ class Dashboard(SecondPhaseControl, SolvingAhead):
                 if self._generation != generation or time.monotonic() <= deadline:
                     raise
                 raise InvalidInputError(
-                    f"the computation exceeded the time limit of {limit:g} s ("
-                    f"{self._time_limit:g} s per algorithm) and was stopped; ask for less work "
-                    "(a lower max_iterations, a larger tolerance or fewer cycles)",
+                    f"the computation exceeded the time limit of {limit:g} s and was stopped; "
+                    "ask for less work (a lower max_iterations, a larger tolerance, fewer cycles "
+                    "or algorithms)",
                     "max_iterations",
                 ) from None
 

@@ -41,7 +41,7 @@ def test_a_computation_past_the_time_limit_stops_with_an_error():
         assert dashboard.wait(1, timeout=60)
         (error,) = [e for e in events if e.kind == "error"]
         message = json.loads(error.data)["message"]
-        assert "exceeded the time limit of 1 s (1 s per algorithm)" in message
+        assert "exceeded the time limit of 1 s and was stopped" in message
         assert "max_iterations" in message
         assert not [e for e in events if e.kind == "result"]
     finally:
