@@ -129,4 +129,5 @@ def host_name(host: str) -> str:
     compared with: ``example.org:8000`` -> ``example.org``, ``[::1]:8000`` -> ``[::1]``; a
     header of another form (``127.0.0.1:80@evil``, ``localhost:``) whole, which no name is."""
     match = _HOST.fullmatch(host)
-    return match.group(1) if match else host
+    port = host[match.end(1) + 1 :] if match else ""
+    return match.group(1) if match and (not port or int(port) < 65536) else host

@@ -38,7 +38,13 @@ def test_an_unknown_host_is_refused_on_http_and_websocket(app):
     for name in ("localhost:8000", "127.0.0.1", "[::1]:8000"):
         assert TestClient(app, base_url=f"http://{name}").get("/health").status_code == 200
     client = TestClient(app, base_url="http://127.0.0.1")
-    for malformed in ("127.0.0.1:8741@evil", "[::1]evil", "localhost:", "127.0.0.1:abc"):
+    for malformed in (
+        "127.0.0.1:8741@evil",
+        "[::1]evil",
+        "localhost:",
+        "127.0.0.1:abc",
+        "localhost:99999",
+    ):
         assert client.get("/health", headers={"host": malformed}).status_code == 400, malformed
 
 
