@@ -24,6 +24,7 @@ from ...engine.unicycle import Unicycle
 from .controls import max_iterations
 from .joint_limits import run_limits
 from .model import DashboardState
+from .platform import PlatformPaths
 from .robots import state_inverse, state_kinematics
 
 #: Time grid points of one unicycle platform path q(t).
@@ -53,8 +54,9 @@ class AlgorithmRun:
     leg_end : ndarray, shape (n_legs_done, p)
     drift : ndarray, shape (cycles_done,)
         ||x at the end of cycle c - x0|| (closed-path task only, else empty).
-    platform : ndarray, shape (m, T, 3) or None
-        Unicycle only: the platform path q(t) for the controls of every iteration.
+    platform : PlatformPaths or None
+        Unicycle only: the platform path q(t) for the controls of every iteration, (m, T, 3),
+        computed as drawn.
     status : str
         Why its last leg stopped, the engine's :attr:`~jik.engine.results.SolveResult.status`
         ("converged"; "undefined": its augmenting map h undefined there; ...).
@@ -79,7 +81,7 @@ class AlgorithmRun:
     message: str
     seconds: float
     status: str = "converged"
-    platform: np.ndarray | None = None
+    platform: PlatformPaths | None = None
     settings: RunSettings | None = None
     field: str | None = None
 
@@ -216,7 +218,7 @@ def algorithm_run(
         field=start_field,
     )
     t = platform_time(kin)
-    return out if t is None else replace(out, platform=kin.path(out.x, t))
+    return out if t is None else replace(out, platform=PlatformPaths(kin, out.x, t))
 
 
 def _leg_message(res: SolveResult, cap: int, kinematics) -> str:

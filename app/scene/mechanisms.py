@@ -29,6 +29,7 @@ from ...engine.arms import ARMS
 from ..dashboard.algorithms import COLORS, STYLES
 from ..dashboard.joint_limits import outside_joints, state_limits
 from ..dashboard.robots import state_kinematics
+from ..dashboard.runs import spaced_iterations
 from .arm_marks import (
     AXES_FRACTION,
     OUTSIDE_COLOR,
@@ -342,7 +343,8 @@ def extent_of(result) -> tuple[tuple[float, float], tuple[float, float]]:
     """Box of the task plane used by the mechanisms (rails, runner), covering both runs."""
     runs, robot = result.runs.values(), result.state.robot
     if any(r.platform is not None for r in runs):
-        ys = np.vstack([*(r.platform.reshape(-1, 3) for r in runs), [result.state.target]])
+        drawn = [r.platform[i] for r in runs for i in spaced_iterations(len(r.platform), 64)]
+        ys = np.vstack([*drawn, [result.state.target]])
         lo, hi = ys.min(axis=0)[:2] - 1.0, ys.max(axis=0)[:2] + 1.0
     elif robot in CHAINS:  # (the whole arm, not only its end)
         pts = runs_points(result, state_kinematics(result.state))

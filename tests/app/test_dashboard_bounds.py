@@ -60,3 +60,37 @@ def test_ending_a_session_stops_its_computation():
     thread.join(30)
     assert not thread.is_alive()
     assert [e.kind for e in events][-1] == "closed"
+
+
+def test_a_long_unicycle_run_computes_only_the_platform_paths_it_draws():
+    """A discrete run of thousands of iterations: the task panel and the export draw a few
+    platform paths q(t), each as Unicycle.path gives it; computing all of them had taken the
+    server gigabytes (0.4 MB and 1.4 ms an iteration)."""
+    import numpy as np
+
+    from jik.app.dashboard.export import export_file
+    from jik.app.dashboard.figures import figure_specs
+    from jik.app.dashboard.results import compute
+    from jik.app.dashboard.robots import state_kinematics
+    from jik.app.dashboard.runs import platform_time
+
+    state = updated_state(
+        default_state(),
+        {
+            "robot": "unicycle",
+            "gamma": 0.002,
+            "max_iterations": 20_000,
+            "algorithms": ["pseudoinverse"],
+        },
+    )
+    result = compute(state)
+    run = result.runs["pseudoinverse"]
+    assert len(run.platform) > 5000 and run.platform.shape[1:] == (96, 3)
+    figure_specs(result, None, {"task"})
+    export_file(result, "json")
+    assert 0 < len(run.platform._kept) <= 20
+    kin = state_kinematics(state)
+    np.testing.assert_array_equal(run.platform[-1], kin.path(run.x[-1], platform_time(kin)))
+    np.testing.assert_array_equal(
+        run.platform[3, :, 0], kin.path(run.x[3], platform_time(kin))[:, 0]
+    )
