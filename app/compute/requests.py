@@ -51,9 +51,18 @@ def _setup(req: S.SolveRequest | S.RepeatabilityRequest) -> _Setup:
             "algorithm_parameters",
             "the extended inverse takes none (its augmenting map's parameters go in augmentation)",
         )
-    built = request_robot(
-        req.robot, req.augmentation, [req.algorithm], req.algorithm_parameters, req.x0
-    )
+    try:
+        built = request_robot(
+            req.robot, req.augmentation, [req.algorithm], req.algorithm_parameters, req.x0
+        )
+    except MemoryError:  # (a worker's limit: the robot, or the map synthesized for it)
+        if req.augmentation is None:
+            raise RequestError("robot", "building the robot ran out of memory") from None
+        raise RequestError(
+            "augmentation",
+            "building the augmenting map ran out of memory; ask for a lower degree or a "
+            "smaller region",
+        ) from None
     (inverse,) = built.inverses
     gamma, mode = gamma_and_mode(built.spec, req)
     aug = built.augmentation

@@ -121,6 +121,25 @@ def test_a_computation_over_the_worker_memory_limit_is_422_and_the_worker_lives_
         assert "a smaller region, fewer nodes or qmc_nodes, a smaller grid" in error["msg"]
         assert client.app.state.pool._workers[0] is worker  # (not killed)
         assert client.get("/robots").status_code == 200
+        # A map synthesized for a solve that runs out: the augmentation's fault, not the run's
+        # (max_iterations, the solve's own measure of work).
+        box = {name: [0.1, 0.9] for name in ("x1", "x2", "x3")}
+        solve = {
+            "robot": {
+                "name": "formula",
+                "variables": ["x1", "x2", "x3", "x4"],
+                "task": ["x1 + x2*x3", "x2 + x4*x1", "x3*x1 + x4"],
+            },
+            "algorithm": "extended",
+            "augmentation": {"name": "e2_synthesized", "region": box, "degree": 16},
+            "x0": [0.5] * 4,
+            "target": [0.8] * 3,
+        }
+        r = client.post("/solve", json=solve)
+        assert r.status_code == 422, r.text
+        (error,) = r.json()["detail"]
+        assert error["loc"] == ["body", "augmentation"], error
+        assert "ran out of memory; ask for a lower degree or a smaller region" in error["msg"]
 
 
 #: An atlas that runs for about a minute of one core (cancelled long before).
