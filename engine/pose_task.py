@@ -95,15 +95,14 @@ def reference_rotation(value, field: str = "reference") -> FloatArray:
 CUT_MARGIN = 1e-6
 
 
-def on_the_cut() -> str:
-    """Why a point on the rotation coordinates' cut is refused, and what to do instead."""
-    return (
-        "on the cut of the rotation coordinates, where they jump to the opposite rotation "
-        "vector (a run there can end whole turns of the joints away while its task error "
-        "converges); choose a reference orientation R0 (the robot's `reference`) within a half "
-        "turn of the task's orientations, such as the orientation at the start (a URDF arm's "
-        "default: at its home)"
-    )
+#: Why a point on the rotation coordinates' cut is refused, and what to do instead.
+ON_THE_CUT = (
+    "on the cut of the rotation coordinates, where they jump to the opposite rotation vector "
+    "(a run there can end whole turns of the joints away while its task error converges); "
+    "choose a reference orientation R0 (the robot's `reference`) within a half turn of the "
+    "task's orientations, such as the orientation at the start (a URDF arm's default: at its "
+    "home)"
+)
 
 
 class PoseTask:
@@ -126,6 +125,8 @@ class PoseTask:
         computed = [n for n in names if len(n) == 1] + [n for n in names if len(n) == 2]
         self.order = np.array([computed.index(n) for n in names])
         self.rotation = self.rotation_rows.size > 0
+        #: Where the rotation coordinates sit among the task's coordinates, in its order.
+        self.rotation_columns = [i for i, n in enumerate(self.names) if len(n) == 2]
         #: All six in the order x y z rx ry rz: no row is picked or moved.
         self.full = self.names == COORDINATES
         self.reference_T = np.ascontiguousarray(self.reference.T)
@@ -148,8 +149,7 @@ class PoseTask:
         the cut."""
         if not self.rotation:
             return
-        rows = [i for i, n in enumerate(self.names) if len(n) == 2]
-        r = np.asarray(y, dtype=float)[..., rows]
+        r = np.asarray(y, dtype=float)[..., self.rotation_columns]
         length = np.linalg.norm(r, axis=-1)
         far = np.argwhere(length > np.pi - CUT_MARGIN)
         if len(far) == 0:
@@ -163,11 +163,12 @@ class PoseTask:
         if length[at] <= np.pi + CUT_MARGIN:
             raise InvalidInputError(
                 f"{name}{where} is a half turn from the reference orientation R0 (its rotation "
-                f"coordinates ({coords}) have length {length[at]:.9g}), {on_the_cut()}",
+                f"coordinates ({coords}) have length {length[at]:.9g}), {ON_THE_CUT}",
                 base,
             )
         same = ""
-        if len(rows) == 3:  # (the principal rotation vector of that rotation, whatever its turns)
+        # (the principal rotation vector of that rotation, whatever its turns)
+        if len(self.rotation_columns) == 3:
             equal = so3.log(so3.exp(r[at]))
             if np.linalg.norm(equal) <= np.pi - CUT_MARGIN:
                 same = "; the same orientation is (" + ", ".join(f"{v + 0.0:.6g}" for v in equal)
@@ -193,7 +194,7 @@ class PoseTask:
         where = f"[{', '.join(map(str, at))}]" if length.size > 1 else ""
         raise InvalidInputError(
             f"{name}{where} puts the end link a half turn from the reference orientation R0 "
-            f"({length[at]:.9g} rad), {on_the_cut()}",
+            f"({length[at]:.9g} rad), {ON_THE_CUT}",
             name,
         )
 
@@ -239,8 +240,8 @@ def cut_notes(kinematics, x0, targets) -> list[str]:
     task = getattr(kinematics, "pose_task", None)
     if task is None or task.rotation_rows.size != 3:
         return []
-    rows = [i for i, n in enumerate(task.names) if len(n) == 2]
-    r = np.vstack([kinematics.forward(np.asarray(x0, dtype=float)), targets])[:, rows]
+    y = np.vstack([kinematics.forward(np.asarray(x0, dtype=float)), targets])
+    r = y[:, task.rotation_columns]
     out = []
     for leg, (a, b) in enumerate(itertools.pairwise(r), start=1):
         along = float(np.linalg.norm(b - a))

@@ -119,14 +119,24 @@ def refused_starts(inverse: Inverse, x0: FloatArray) -> dict[int, str]:
     -------
     dict int -> str
         Index in ``x0`` -> why: the kinematics overflow there (k(x0) or its Jacobian not
-        finite), or J#(x0) is undefined (the inverse's singular error). Empty when every start
+        finite), J#(x0) is undefined (the inverse's singular error), or the kinematics' check
+        of starts refuses it (a pose task's rotation cut). Empty when every start
         can run; :func:`jik.engine.solver.solve_batch` raises at the first refused one.
     """
     x0 = np.atleast_2d(validation.as_points(x0, check_inverse(inverse).p, "x0"))
     _, bad = inverse.apply_masked(x0, np.ones((len(x0), inverse.kinematics.r)))
     with np.errstate(all="ignore"):
         bad = bad | ~np.isfinite(inverse.kinematics.forward_unchecked(x0)).all(axis=-1)
-    return {int(i): start_problem(inverse, x0[i]) for i in np.flatnonzero(np.atleast_1d(bad))}
+    out = {int(i): start_problem(inverse, x0[i]) for i in np.flatnonzero(np.atleast_1d(bad))}
+    try:  # (the kinematics' own check of starts, all at once: a pose task's rotation cut)
+        inverse.kinematics.check_start(x0)
+    except InvalidInputError:
+        for i in set(range(len(x0))) - out.keys():  # (which: one by one)
+            try:
+                inverse.kinematics.check_start(x0[i], "the start")
+            except InvalidInputError as exc:
+                out[i] = str(exc)
+    return dict(sorted(out.items()))
 
 
 def start_problem(inverse: Inverse, x: FloatArray) -> str:

@@ -225,7 +225,6 @@ def _run_ok(body: dict, path: str) -> bool:
         spec = setup.spec  # (a start, target or path not given: the robot's)
         x0 = list(spec.default_x0) if run.x0 is None else run.x0
         check_configuration(spec, x0)
-        setup.kinematics.check_start(x0, "x0")  # (not on a pose's rotation cut)
         if isinstance(run, S.RepeatabilityRequest):
             points = spec.default_loop() if run.path is None else run.path
         else:
