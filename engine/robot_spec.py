@@ -207,6 +207,13 @@ def _x_range(kin: Kinematics, d: Mapping) -> tuple[tuple[float, float], ...]:
     return ((-math.pi, math.pi),) * kin.p
 
 
+def _key(d: Mapping) -> str:
+    """What a robot's synthesized maps are kept under: its definition without its maps."""
+    return json.dumps(
+        {k: v for k, v in d.items() if k != "augmentations"}, sort_keys=True, default=str
+    )
+
+
 def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
     """Build and validate a robot from its definition (see the module docstring).
 
@@ -257,7 +264,7 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
             title = d.get("title", base.title)  # (checked above)
             spec = replace(spec, title=title, x_range=box, default_x0=x0, default_target=target)
             spec = replace(spec, default_path=path)
-        extra, _, _ = augmentations_from_dict(kin, d.get("augmentations", []))
+        extra, _, _ = augmentations_from_dict(kin, d.get("augmentations", []), _key(d))
         spec = replace(spec, augmentations=(*base.augmentations, *extra)) if extra else spec
         return Robot(spec, kin, dict(d))
     if kind in ARMS:  # the catalogue's URDF, end link and home, with the definition's keys
@@ -273,10 +280,9 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
     box = _x_range(kin, d)
     x0, target, path = defaults(kin, d, box)
     kin.start = tuple(x0)  # (where its syntheses hold the joints outside their box, homeless)
-    key = json.dumps(
-        {k: v for k, v in d.items() if k != "augmentations"}, sort_keys=True, default=str
+    augmentations, region, vectors = augmentations_from_dict(
+        kin, d.get("augmentations", []), _key(d)
     )
-    augmentations, region, vectors = augmentations_from_dict(kin, d.get("augmentations", []), key)
     title = d.get("title", kind.replace("_", " "))  # (checked above)
     task_names = {
         "planar_chain": ("x", "y", "phi")[: kin.r],

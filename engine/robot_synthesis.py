@@ -55,6 +55,8 @@ def _maps(kin, box, fix, degree, key, axes) -> tuple[AugmentingMap, ...]:
     cache_key = None if key is None else (key, json.dumps([box, fix, degree, axes], sort_keys=True))
     if cache_key is not None and cache_key in _SYNTHESIZED:
         return _SYNTHESIZED[cache_key]
+    if _ELSEWHERE.get():
+        raise SynthesisElsewhere("this map is synthesized in another process")
     progress = _PROGRESS.get()  # (a RunCancelled it raises leaves nothing cached)
     maps: tuple[AugmentingMap, ...]
     if len(box) <= 3 and kin.p - kin.r == 1:
@@ -72,10 +74,52 @@ def _maps(kin, box, fix, degree, key, axes) -> tuple[AugmentingMap, ...]:
             progress=progress,
         ).maps
     if cache_key is not None:
+        keep_syntheses({cache_key: maps})
+        made = _MADE.get()
+        if made is not None:
+            made[cache_key] = maps
+    return maps
+
+
+class SynthesisElsewhere(Exception):
+    """A map not yet synthesized in this process was needed within
+    :func:`synthesized_elsewhere`."""
+
+
+@contextlib.contextmanager
+def synthesized_elsewhere() -> Iterator[None]:
+    """Within it, a robot's map not yet synthesized in this process is not computed here:
+    :class:`SynthesisElsewhere` is raised where it would be. A server computes it in a worker
+    process (within :func:`recorded_syntheses` there) and keeps it with :func:`keep_syntheses`,
+    so that the worker's memory and time limits bound the synthesis."""
+    token = _ELSEWHERE.set(True)
+    try:
+        yield
+    finally:
+        _ELSEWHERE.reset(token)
+
+
+@contextlib.contextmanager
+def recorded_syntheses() -> Iterator[dict]:
+    """Within it, the robots' maps synthesized (not those found already made) are also put in
+    the dict it gives: picklable, for :func:`keep_syntheses` in another process."""
+    made: dict = {}
+    token = _MADE.set(made)
+    try:
+        yield made
+    finally:
+        _MADE.reset(token)
+
+
+def keep_syntheses(made: Mapping) -> None:
+    """Keep maps synthesized elsewhere (a :func:`recorded_syntheses` dict) as if synthesized in
+    this process: the robots whose definitions they belong to use them (a process keeps its
+    16 most recent)."""
+    for cache_key, maps in made.items():
+        _SYNTHESIZED.pop(cache_key, None)
         while len(_SYNTHESIZED) >= 16:
             _SYNTHESIZED.pop(next(iter(_SYNTHESIZED)))
         _SYNTHESIZED[cache_key] = maps
-    return maps
 
 
 @contextlib.contextmanager
@@ -93,6 +137,12 @@ def synthesis_progress(progress: Progress | None) -> Iterator[None]:
 
 _PROGRESS: contextvars.ContextVar[Progress | None] = contextvars.ContextVar(
     "synthesis_progress", default=None
+)
+_ELSEWHERE: contextvars.ContextVar[bool] = contextvars.ContextVar(
+    "synthesized_elsewhere", default=False
+)
+_MADE: contextvars.ContextVar[dict | None] = contextvars.ContextVar(
+    "recorded_syntheses", default=None
 )
 #: Synthesized maps by the robot definition they belong to (a process's few most recent).
 _SYNTHESIZED: dict[tuple[str, str], tuple[AugmentingMap, ...]] = {}

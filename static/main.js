@@ -56,11 +56,12 @@ function showProgress(fraction, elapsed, phase = "runs", what = "") {
   button.disabled = runs && !page.shownState;
   button.title = runs ? "stop this computation and go back to the values of the result on screen"
     : `stop computing ${what}: the result on screen stays, without E1, E2 and their sensitivity`;
-  const percent = Math.round(100 * fraction);
-  $("#progress-bar").style.width = `${percent}%`;
+  // (a fraction null is work whose progress is not known: a synthesis in a compute worker)
+  const percent = fraction === null ? null : Math.round(100 * fraction);
+  $("#progress-bar").style.width = `${percent ?? 0}%`;
   // (the runs of a new state may first wait for their map's synthesis, which says so)
   const doing = runs && (!what || what === "the runs") ? "computing" : `computing ${what}`;
-  $("#progress-text").textContent = `${doing} ${percent}%`;
+  $("#progress-text").textContent = percent === null ? `${doing}…` : `${doing} ${percent}%`;
 }
 
 function onState(msg, force = false) {

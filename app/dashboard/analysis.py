@@ -2,8 +2,9 @@
 and h on a grid over the two joint variables it depends on most (its box following the runs).
 The error functionals E1 (13), E2 (18) on that grid are :mod:`jik.app.dashboard.functionals`.
 A catalogue arm's map (or a definition's ``e2_synthesized`` one) is synthesized on first use,
-eq. (19) (:mod:`jik.engine.robot_synthesis`): :func:`built_map` shows its progress and stops it
-on a newer change; once built, the map is kept with the robot."""
+eq. (19) (:mod:`jik.engine.robot_synthesis`), in a compute worker when the server runs its pool
+(:func:`synthesized_maps`): :func:`built_map` shows its progress and stops it on a newer change;
+once built, the map is kept with the robot."""
 
 from __future__ import annotations
 
@@ -14,7 +15,13 @@ import numpy as np
 from ...engine.exceptions import JikError, RunCancelled
 from ...engine.map_grid import axes_along, slice_values
 from ...engine.progress import ProgressCallbacks
-from ...engine.robot_synthesis import synthesis_progress
+from ...engine.robot_synthesis import (
+    SynthesisElsewhere,
+    recorded_syntheses,
+    synthesis_progress,
+    synthesized_elsewhere,
+)
+from ..compute.worker import task
 from .model import DashboardState
 from .robots import state_kinematics, state_robot, state_spec
 from .runs import AlgorithmRun, Cancelled
@@ -36,22 +43,57 @@ def kinematics_and_map(state: DashboardState, kin=None):
 SYNTHESIZING = "synthesizing h (E2, eq. (19))"
 
 
-def built_map(state, progress: Callable[..., None], cancelled: Callable[[], bool]) -> tuple:
-    """:func:`kinematics_and_map` of ``state``, a synthesis on the
-    way reporting ``progress(fraction, SYNTHESIZING)`` and stopped by ``cancelled()`` (then
-    :class:`Cancelled`, nothing kept)."""
+def state_maps(state: DashboardState) -> tuple:
+    """:func:`kinematics_and_map` of ``state``, its vector of maps built too (p - r > 1)."""
+    kin, amap = kinematics_and_map(state)
+    if amap is None:  # (p - r > 1: a synthesized vector, built)
+        maps = state_robot(state).map_vectors.get(state.augmentation)
+        if callable(maps):
+            maps()
+    return kin, amap
+
+
+@task("augmentation", "a lower degree or a smaller region of the map's E2 synthesis")
+def synthesized_maps(state: DashboardState) -> dict:
+    """The E2 syntheses that the state's map needs, made in a compute worker (within its memory
+    and time limits) for :func:`~jik.engine.robot_synthesis.keep_syntheses` in the server."""
+    with recorded_syntheses() as made:
+        state_maps(state)
+    return made
+
+
+def built_map(
+    state,
+    progress: Callable[..., None],
+    cancelled: Callable[[], bool],
+    elsewhere: Callable[[DashboardState, Callable[[], bool]], bool] | None = None,
+) -> tuple:
+    """:func:`state_maps` of ``state``, a synthesis on the way reporting
+    ``progress(fraction, SYNTHESIZING)`` and stopped by ``cancelled()`` (then
+    :class:`Cancelled`, nothing kept).
+
+    With ``elsewhere`` (the dashboard's lane of the compute pool,
+    :meth:`~jik.app.dashboard.offload.OffloadLane.synthesize`), a synthesis is made there
+    (its progress not known: ``progress(None, ...)``) and kept in this process; only where it
+    returns False (no pool running) is it made here."""
     report = ProgressCallbacks(
         on_advance=lambda done, total: progress(min(done / total, 1.0), SYNTHESIZING),
         is_cancelled=cancelled,
     )
     try:
         with synthesis_progress(report):
-            kin, amap = kinematics_and_map(state)
-            if amap is None:  # (p - r > 1: a synthesized vector, built)
-                maps = state_robot(state).map_vectors.get(state.augmentation)
-                if callable(maps):
-                    maps()
-            return kin, amap
+            if elsewhere is not None:
+                try:
+                    with synthesized_elsewhere():
+                        return state_maps(state)
+                except SynthesisElsewhere:
+
+                    def waiting() -> bool:  # (polled while the worker synthesizes)
+                        progress(None, f"{SYNTHESIZING} in a compute worker")
+                        return cancelled()
+
+                    elsewhere(state, waiting)
+            return state_maps(state)
     except RunCancelled:
         raise Cancelled from None
 

@@ -1,6 +1,9 @@
 """The dashboards' share of the server's one compute pool (:class:`jik.app.compute.pool.
 ComputePool`, whose worker processes also serve the REST API, first come first served).
 
+A map that a change needs synthesized (a definition's ``e2_synthesized``, a catalogue arm's
+default) is made there (:meth:`OffloadLane.synthesize`), within a worker's memory limit.
+
 :func:`jik.app.dashboard.results.compute` runs one algorithm there while the session's thread
 computes the other: on two cores a change costs the slower of the two instead of their sum.
 Each dashboard has a lane (:class:`OffloadLane`); a newer change of its state gives up the
@@ -15,13 +18,16 @@ from __future__ import annotations
 import collections
 import concurrent.futures
 import contextlib
+import json
 import logging
 import threading
 from collections.abc import Callable, Iterator
 from typing import Any
 
+from ...engine.robot_synthesis import keep_syntheses
 from ..compute.exceptions import ServiceUnavailable
 from ..compute.worker import task
+from .analysis import synthesized_maps
 from .runs import AlgorithmRun, Cancelled, algorithm_run
 
 log = logging.getLogger("jik.dashboard")
@@ -35,12 +41,64 @@ def run_offloaded(state, algorithm, targets, cycles, resume=None) -> AlgorithmRu
 
 
 class OffloadLane:
-    """One dashboard's runs in the pool, and their cancellation by a newer generation."""
+    """One dashboard's runs and map syntheses in the pool, and their cancellation."""
 
     def __init__(self, pool: Any) -> None:
         self._pool = pool
         self._lock = threading.Lock()
         self._running: dict[concurrent.futures.Future, int] = {}  # future -> its generation
+        self._syntheses: dict[str, concurrent.futures.Future] = {}  # maps' key -> future
+
+    def synthesize(self, state, cancelled: Callable[[], bool]) -> bool:
+        """Make the E2 syntheses that ``state``'s map needs in the pool
+        (:func:`~jik.app.dashboard.analysis.synthesized_maps`, within a worker's memory and
+        time limits) and keep them in this process. False when the pool is not running (the
+        caller makes them itself).
+
+        While it waits, ``cancelled()`` is polled every 0.1 s: True raises :class:`Cancelled`;
+        the synthesis goes on for the next change that needs the same maps (one of other maps
+        gives it up).
+
+        Raises
+        ------
+        RequestError
+            Naming ``augmentation``: the synthesis ran out of the worker's memory or time.
+        ServiceUnavailable
+            No worker became free within the time limit, or the worker died.
+        """
+        key = json.dumps(
+            [state.robot, state.robot_parameters, state.robot_definition, state.augmentation],
+            sort_keys=True,
+            default=str,
+        )
+        with self._lock:
+            for other in [f for k, f in self._syntheses.items() if k != key]:
+                other.cancel()
+            future = self._syntheses.get(key)
+            if future is None:
+                try:
+                    future = self._pool.submit(synthesized_maps, state)
+                except ServiceUnavailable:
+                    return False
+                self._syntheses = {key: future}
+                future.add_done_callback(lambda f: self._synthesized(key, f))
+        while True:
+            try:
+                keep_syntheses(future.result(timeout=0.1))
+                return True
+            except concurrent.futures.TimeoutError:
+                if cancelled():
+                    raise Cancelled from None
+            except concurrent.futures.CancelledError:
+                raise Cancelled from None
+
+    def _synthesized(self, key: str, future: concurrent.futures.Future) -> None:
+        """A synthesis ended: its maps are kept here, whether or not a change still waits."""
+        with self._lock:
+            if self._syntheses.get(key) is future:
+                del self._syntheses[key]
+        if not future.cancelled() and future.exception() is None:
+            keep_syntheses(future.result())
 
     def newest(self, generation: int) -> None:
         """The dashboard's newest generation: its runs of older ones are given up."""
@@ -84,7 +142,7 @@ class OffloadLane:
     def close(self) -> None:
         """Give up every run still going (the dashboard stopped)."""
         with self._lock:
-            running = list(self._running)
+            running = [*self._running, *self._syntheses.values()]
         for future in running:
             future.cancel()
 

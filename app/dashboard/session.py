@@ -22,6 +22,7 @@ from collections.abc import Callable, Mapping
 from typing import Any, NoReturn
 
 from ...engine.exceptions import InvalidInputError, JikError
+from ..compute.exceptions import ServiceUnavailable
 from .ahead import SolvingAhead
 from .algorithms import COLORS, LABELS, cache_key, runs_key
 from .analysis import built_map, expensive_map
@@ -275,12 +276,14 @@ class Dashboard(SecondPhaseControl, SolvingAhead):
     def _reporter(self, generation: int, phase: str) -> Callable[..., None]:
         """``report(fraction, what="the runs")``: a ``progress`` event of ``phase`` ("runs", or
         "second": :meth:`_second_phase`) at most every 0.1 s, and at the end of the runs (the
-        page then hides its bar; a second phase ends with its ``functionals`` event)."""
+        page then hides its bar; a second phase ends with its ``functionals`` event). A
+        fraction None is work whose progress is not known (a synthesis in a compute worker)."""
         t0, last = time.perf_counter(), [0.0]
 
-        def report(fraction: float, what: str = "the runs") -> None:
+        def report(fraction: float | None, what: str = "the runs") -> None:
             now = time.perf_counter()
-            if now - last[0] > 0.1 or (fraction >= 1 and phase == "runs"):
+            end = fraction is not None and fraction >= 1 and phase == "runs"
+            if now - last[0] > 0.1 or end:
                 last[0] = now
                 self._emit(
                     Event.of(
@@ -333,7 +336,12 @@ class Dashboard(SecondPhaseControl, SolvingAhead):
             else None
         )
         try:
-            kin, amap = built_map(state, progress, lambda: self._generation != generation)
+            kin, amap = built_map(
+                state,
+                progress,
+                lambda: self._generation != generation,
+                None if self._offload is None else self._offload.synthesize,
+            )
             deferred = expensive_map(amap)
             result = self._solved(
                 state,
@@ -344,7 +352,7 @@ class Dashboard(SecondPhaseControl, SolvingAhead):
             )
         except Cancelled:
             return
-        except (JikError, ValueError) as exc:
+        except (JikError, ValueError, ServiceUnavailable) as exc:
             self._failure(generation, str(exc))
             return
         # Panels that do not depend on gamma are reused from the last result with the same key

@@ -102,9 +102,11 @@ class DashboardScene:
                 runs = msg.get("phase") == "runs"
                 now = event.generation == self.dashboard.generation
                 if runs and now and msg["elapsed"] > PROGRESS_AFTER:
-                    self.progress.visible = msg["fraction"] < 1
-                    self.progress.value = min(100.0, 100.0 * msg["fraction"])  # type: ignore[misc]  # viser: settable
-                    self.status.content = f"computing… {100 * msg['fraction']:.0f}%"
+                    fraction = msg["fraction"]  # (None: not known)
+                    self.progress.visible = fraction is None or fraction < 1
+                    self.progress.value = min(100.0, 100.0 * (fraction or 0.0))  # type: ignore[misc]  # viser: settable
+                    done = "" if fraction is None else f" {100 * fraction:.0f}%"
+                    self.status.content = f"computing…{done}"
             elif event.kind == "result" and event.result is not None:
                 self._draw(event.result)
             elif event.kind == "ahead" and event.result is not None:

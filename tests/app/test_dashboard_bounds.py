@@ -94,3 +94,56 @@ def test_a_long_unicycle_run_computes_only_the_platform_paths_it_draws():
     np.testing.assert_array_equal(
         run.platform[3, :, 0], kin.path(run.x[3], platform_time(kin))[:, 0]
     )
+
+
+def _synthesis_state(degree: int):
+    definition = {
+        "name": "planar_chain",
+        "joints": "RRR",
+        "lengths": [1, 1, 1],
+        "augmentations": [
+            {
+                "name": "e2_synthesized",
+                "degree": degree,
+                "region": {"x1": [0, 1], "x2": [0.2, 1], "x3": [0.2, 1]},
+            }
+        ],
+    }
+    state = updated_state(
+        default_state(), {"robot": "planar_chain", "robot_definition": definition}
+    )
+    return updated_state(state, {"augmentation": "e2_synthesized"})
+
+
+def test_a_map_synthesis_is_made_in_a_worker_within_its_memory_limit(monkeypatch):
+    """With the server's pool, a definition's E2 synthesis is made in a compute worker and kept
+    in the server's process, which synthesizes nothing itself; one too large for a worker's
+    memory (a three-variable map of degree 16, about 2.8 GB) is refused naming
+    ``augmentation``."""
+    import jik.engine.robot_synthesis as synthesis
+    from jik.app.compute.pool import pool_in_thread
+    from jik.app.compute.settings import Settings
+    from jik.app.dashboard.analysis import state_maps
+
+    def here(*args, **kwargs):
+        raise AssertionError("a map was synthesized in the server's process")
+
+    monkeypatch.setattr(synthesis, "synthesize_e2", here)
+    with pool_in_thread(Settings(workers=1, timeout=60, worker_memory=1024)) as pool:
+        for degree, kind in ((4, "result"), (16, "error")):
+            events: list = []
+            dashboard = Dashboard(_synthesis_state(degree), pool=pool)
+            dashboard.subscribe(events.append)
+            dashboard.start()
+            try:
+                assert dashboard.wait(1, timeout=120)
+                (done,) = [e for e in events if e.kind in ("result", "error")]
+                assert done.kind == kind, done.data
+            finally:
+                dashboard.stop()
+        message = json.loads(done.data)["message"]
+        assert message.startswith("augmentation: the computation ran out of memory")
+        assert "a lower degree or a smaller region" in message
+    # The kept map is the worker's: the server's state builds it without synthesizing.
+    _, amap = state_maps(_synthesis_state(4))
+    assert amap.name == "e2_synthesized"
