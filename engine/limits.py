@@ -1,4 +1,5 @@
-"""Joint limits: whether a run stayed within a robot's limits, and its first violation.
+"""Joint limits: whether a run stayed within a robot's limits; if not, its first violation, its
+farthest excursion and whether it ends outside them.
 
 A robot's limits are a (p, 2) array of [lower, upper] per joint variable, -inf/+inf where a
 joint has none (a continuous joint). A URDF arm reads them from its file; a planar chain or a
@@ -105,24 +106,42 @@ _ENDS = "at its start and its legs' ends (the steps between were not recorded: r
 
 @dataclass(frozen=True)
 class LimitsReport:
-    """Whether a run stayed within the limits, and if not its first violation;
+    """Whether a run stayed within the limits, and if not its first violation, its farthest
+    excursion (the joint furthest beyond a limit, and where) and whether it ends outside them;
     ``every_step``: whether every step of the run was checked (it was recorded), else only its
     start and its legs' ends."""
 
     within: bool
     violation: LimitViolation | None = None
     every_step: bool = True
+    farthest: LimitViolation | None = None
+    ends_outside: bool = False
 
     def __str__(self) -> str:
         if not self.within:
-            return f"left the joint limits {self.violation}"
+            return f"left the joint limits {self.violation}{self._farthest(6)}{self._end()}"
         return "within the joint limits" + ("" if self.every_step else f" {_ENDS}")
+
+    def _farthest(self, digits: int) -> str:
+        """ "; farthest <where>: ..." when the farthest excursion is not the first violation."""
+        f, v = self.farthest, self.violation
+        if f is None or v is None or (f.joint, f.value) == (v.joint, v.value):
+            return ""
+        beyond = abs(f.value - f.limit)
+        return (
+            f"; farthest {f.where}: {f.name} = {f.value:.{digits}g}, {beyond:.{digits}g} "
+            f"{f.side} limit {f.limit:.{digits}g}"
+        )
+
+    def _end(self) -> str:
+        return "; it ends outside them" if self.ends_outside else "; it ends within them"
 
     def sentence(self, run: str, robot: str) -> str:
         """The report as a sentence on the run named ``run`` of ``robot`` (values to four
         digits): it "stayed within the joint limits of the <robot> all along its run" (or, not
         recorded, at its start and its legs' ends), or "left the joint limits of the <robot>"
-        and where first (its start, or a cycle and leg)."""
+        and where first (its start, or a cycle and leg), where farthest, and whether it ends
+        outside them."""
         v = self.violation
         if v is None:
             along = "all along its run" if self.every_step else _ENDS
@@ -130,12 +149,18 @@ class LimitsReport:
         where = "its start x0 is already outside them" if v.cycle == 0 else f"first {v.where}"
         return (
             f"{run}: left the joint limits of the {robot}: {where}, joint {v.name} = "
-            f"{v.value:.4g}, {v.side} limit {v.limit:.4g}."
+            f"{v.value:.4g}, {v.side} limit {v.limit:.4g}{self._farthest(4)}{self._end()}."
         )
 
     def as_dict(self) -> dict:
         first = None if self.violation is None else self.violation.as_dict()
-        return {"within": self.within, "violation": first}
+        farthest = None if self.farthest is None else self.farthest.as_dict()
+        return {
+            "within": self.within,
+            "violation": first,
+            "farthest": farthest,
+            "ends_outside": self.ends_outside,
+        }
 
 
 def check_limits(limits, p: int, field: str = "limits") -> FloatArray:
@@ -183,20 +208,38 @@ def legs_report(
     legs_per_cycle: int,
     names: Sequence[str],
 ) -> LimitsReport:
-    """The first violation of a run: the start x0 (p,), then each leg's configurations in order
-    (a leg's trajectory (m, p), or its end (1, p)), leg k of cycle k // L + 1."""
-    x0 = np.asarray(x0, dtype=float)
-    found = _first(limits, x0[None])
-    if found is not None:
-        return LimitsReport(False, _violation(limits, x0, found[1], 0, 0, names))
-    for k, X in enumerate(legs):
-        X = np.atleast_2d(np.asarray(X, dtype=float))
-        found = _first(limits, X)
+    """The first violation of a run, its farthest excursion and whether it ends outside the
+    limits: the start x0 (p,), then each leg's configurations in order (a leg's trajectory
+    (m, p), or its end (1, p)), leg k of cycle k // L + 1; the run ends at its last finite
+    configuration."""
+    single = len(legs) == 1
+    rows = [(0, 0, np.asarray(x0, dtype=float)[None])]
+    rows += [
+        (k // legs_per_cycle + 1, k % legs_per_cycle + 1, np.atleast_2d(np.asarray(X, float)))
+        for k, X in enumerate(legs)
+    ]
+    first: LimitViolation | None = None
+    farthest, beyond = None, 0.0
+    for cycle, leg, X in rows:
+        found = _first(limits, X) if first is None else None
         if found is not None:
-            cycle, leg = divmod(k, legs_per_cycle)
-            v = _violation(limits, X[found[0]], found[1], cycle + 1, leg + 1, names)
-            return LimitsReport(False, replace(v, single=len(legs) == 1))
-    return LimitsReport(True)
+            first = _violation(limits, X[found[0]], found[1], cycle, leg, names)
+        # (fmax: a failed leg's NaN end is no excursion)
+        excess = np.fmax(np.fmax(limits[:, 0] - X, X - limits[:, 1]), 0.0)
+        if excess.size and excess.max() > beyond:
+            i, j = np.unravel_index(int(np.argmax(excess)), excess.shape)
+            farthest = _violation(limits, X[i], int(j), cycle, leg, names)
+            beyond = float(excess[i, j])
+    if first is None:
+        return LimitsReport(True)
+    ends = np.concatenate([X for _, _, X in rows])
+    ends = ends[np.all(np.isfinite(ends), axis=-1)]
+    return LimitsReport(
+        False,
+        replace(first, single=single),
+        farthest=None if farthest is None else replace(farthest, single=single),
+        ends_outside=bool(outside(limits, ends[-1])),
+    )
 
 
 def solve_report(limits: FloatArray, result, names: Sequence[str]) -> LimitsReport:

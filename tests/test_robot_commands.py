@@ -151,7 +151,12 @@ def test_a_catalogue_arm_by_name_with_its_pose_task(capsys):
     assert result["robot"] == "Franka Panda" and result["success"]
     assert len(result["x0"]) == 7 and len(result["targets"][0]) == 6
     assert 1e-5 < result["drift"][-1] < 1e-2
-    assert result["limits"] == {"within": True, "violation": None}
+    assert result["limits"] == {
+        "within": True,
+        "violation": None,
+        "farthest": None,
+        "ends_outside": False,
+    }
     out, _ = run(capsys, "solve", "--robot", "panda", "--target", "-0.3, 0, 0.5, 0, 0, 0")
     assert "joint limits: left the joint limits on the way to the target: x2 (panda_joint2)" in out
 

@@ -236,7 +236,12 @@ def test_the_weighted_inverse_defaults_to_a_chain_s_own_limits(api, limits, used
     assert r.status_code == 200, r.text
     np.testing.assert_allclose(r.json()["algorithm_parameters"]["limits"], used)
     if limits[0][0] == 0.2:
-        assert r.json()["limits"] == {"within": True, "violation": None}
+        assert r.json()["limits"] == {
+            "within": True,
+            "violation": None,
+            "farthest": None,
+            "ends_outside": False,
+        }
 
 
 @pytest.mark.parametrize(

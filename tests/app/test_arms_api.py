@@ -164,7 +164,12 @@ def test_a_solve_reports_its_first_violation_and_the_paper_robots_none(api):
             },
         )
     )
-    assert ok["limits"] == {"within": True, "violation": None}
+    assert ok["limits"] == {
+        "within": True,
+        "violation": None,
+        "farthest": None,
+        "ends_outside": False,
+    }
     m2 = _ok(
         api.post(
             "/solve",

@@ -59,7 +59,12 @@ def test_the_panda_is_picked_by_name_with_its_pose_task(app, client):
     summary = client.get(f"/api/sessions/{session['id']}").json()["summary"]
     assert summary["pseudoinverse"]["drift"][-1] > 1e-5
     assert max(summary["extended"]["drift"]) < 1e-9
-    assert summary["extended"]["limits"] == {"within": True, "violation": None}
+    assert summary["extended"]["limits"] == {
+        "within": True,
+        "violation": None,
+        "farthest": None,
+        "ends_outside": False,
+    }
     again = _open(client, state)  # (the page's link holds the definition)
     assert again["state"] == state
     export = client.get(f"/api/sessions/{session['id']}/export.json").json()

@@ -37,7 +37,12 @@ def test_the_panda_with_its_pose_task(tabs):
     assert summary["pseudoinverse"]["drift"][-1] > 1e-5  # the pseudoinverse drifts
     assert max(summary["extended"]["drift"]) < 1e-9  # the synthesized map keeps x0
     for a in ("pseudoinverse", "extended"):
-        assert summary[a]["limits"] == {"within": True, "violation": None}
+        assert summary[a]["limits"] == {
+            "within": True,
+            "violation": None,
+            "farthest": None,
+            "ends_outside": False,
+        }
     verdict = page.locator("#verdict")
     expect(verdict).to_contain_text("pseudoinverse J^P#: not repeatable")
     expect(verdict).to_contain_text("extended Jacobian J^E#: repeatable")

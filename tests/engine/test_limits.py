@@ -35,7 +35,8 @@ def test_the_first_violation_is_found_in_order():
     v = report.violation
     assert (v.cycle, v.leg, v.joint, v.value, v.limit, v.bound) == (1, 2, 2, 2.5, 2.0, "upper")
     assert (
-        str(report) == "left the joint limits at cycle 1, leg 2: x3 = 2.5, above its upper limit 2"
+        str(report) == "left the joint limits at cycle 1, leg 2: x3 = 2.5, above its upper limit "
+        "2; it ends outside them"
     )
     assert legs_report(LIMITS, [0, 0, 1], legs[:1], 2, NAMES) == LimitsReport(True)
 
@@ -156,6 +157,40 @@ def test_a_robot_reports_its_runs_limits():
     assert run_report(panda.kinematics, res) == panda.limits_report(res)
 
 
+def test_a_report_says_where_its_run_went_farthest_and_whether_it_ends_outside():
+    """The first violation can be a small one: the report also names the farthest excursion
+    (when it is another) and whether the run ends outside the limits. A Panda run in discrete
+    mode at gamma = 1 toward a half turn of rz first passes joint 7's limit by 0.55 rad, goes
+    89 rad below joint 1's, and converges there."""
+    legs = [np.array([[0.0, 0, 1.1], [-3.0, 0, 1.0], [0.5, 0, 1.0]])]
+    back = legs_report(LIMITS, [0, 0, 1], legs, 1, NAMES)
+    assert (back.violation.name, back.farthest.name, back.ends_outside) == ("x1", "x1", False)
+    assert str(back) == (
+        "left the joint limits on the way to the target: x1 = -3, below its lower limit -1; it "
+        "ends within them"
+    )
+    panda = robot_from_dict({"name": "panda"})
+    x0 = np.asarray(panda.spec.default_x0)
+    target = panda.kinematics.forward(x0[None])[0]
+    target[5] = 3.14
+    run = solve(panda.inverse("pseudoinverse"), x0, target, mode="discrete", gamma=1.0)
+    report = panda.limits_report(run)
+    assert run.success and report.ends_outside
+    first, far = report.violation, report.farthest
+    assert (first.name, first.bound) == ("x7 (panda_joint7)", "upper")
+    assert (far.name, far.bound, far.value) == (
+        "x1 (panda_joint1)",
+        "lower",
+        run.trajectory.x[:, 0].min(),
+    )
+    assert far.value < -90
+    assert report.sentence("J^P#", "Franka Panda").endswith(
+        f"farthest on the way to the target: x1 (panda_joint1) = {far.value:.4g}, "
+        f"{far.limit - far.value:.4g} below its lower limit -2.897; it ends outside them."
+    )
+    assert report.as_dict()["farthest"]["joint"] == 0
+
+
 CHAIN = {"name": "planar_chain", "joints": "RRR", "lengths": [1, 0.8, 0.6]}
 
 
@@ -192,7 +227,8 @@ def test_a_one_leg_run_says_on_the_way_to_the_target():
     one = legs_report(limits, x0, [leg], 1, ["x1", "x2"])
     assert (
         str(one)
-        == "left the joint limits on the way to the target: x2 = 1.5, above its upper limit 1"
+        == "left the joint limits on the way to the target: x2 = 1.5, above its upper limit 1; "
+        "it ends outside them"
     )
     assert one.violation.as_dict()["cycle"] == 1 and "single" not in one.violation.as_dict()
     two = legs_report(limits, x0, [leg[:1], leg], 2, ["x1", "x2"])
@@ -208,12 +244,12 @@ def test_a_report_says_in_a_sentence_where_its_run_left_the_limits():
     out = legs_report(LIMITS, [0, 0, 1], legs, 2, NAMES).sentence("J^P#", "planar chain")
     assert out == (
         "J^P#: left the joint limits of the planar chain: first at cycle 1, leg 2, joint x3 = "
-        "2.123, above its upper limit 2."
+        "2.123, above its upper limit 2; it ends outside them."
     )
     start = legs_report(LIMITS, [-1.2, 0, 1], [], 1, NAMES).sentence("J^E#", "arm")
     assert start == (
         "J^E#: left the joint limits of the arm: its start x0 is already outside them, joint "
-        "x1 = -1.2, below its lower limit -1."
+        "x1 = -1.2, below its lower limit -1; it ends outside them."
     )
     within = legs_report(LIMITS, [0, 0, 1], legs[:1], 2, NAMES).sentence("J^P#", "arm")
     assert within == "J^P#: stayed within the joint limits of the arm all along its run."

@@ -142,6 +142,10 @@ class LimitsInfo(BaseModel):
 
     within: bool
     violation: LimitViolationInfo | None = Field(description="the first violation, if any")
+    farthest: LimitViolationInfo | None = Field(
+        description="the farthest excursion beyond a limit (the joint and where), if any"
+    )
+    ends_outside: bool = Field(description="whether the run's last configuration is outside")
 
 
 class _RunResponse(BaseModel):
