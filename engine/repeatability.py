@@ -28,7 +28,13 @@ from .repeatability_result import RepeatabilityResult
 from .results import BatchSolveResult, SolveResult, Trajectory
 from .run_settings import Resume, RunSettings, inverse_fingerprint, resumed_legs
 from .solve_chunks import solve_in_chunks
-from .solve_rules import check_inverse, check_settings, run_bytes
+from .solve_rules import (
+    check_inverse,
+    check_settings,
+    map_value_error,
+    map_value_undefined,
+    run_bytes,
+)
 from .solver import solve, solve_batch
 from .validation import FloatArray, as_numbers, check_memory, count, flag
 
@@ -180,7 +186,8 @@ def repeatability(
         :data:`jik.engine.validation.MEMORY_LIMIT` (field ``x0``).
     JikError
         A leg's solve raised (a singular start configuration) and the progress, if any, did not
-        stop the run there.
+        stop the run there; the map has no value at a start
+        (:func:`~jik.engine.solve_rules.map_value_undefined`, field ``x0``).
     RunCancelled
         ``progress.cancelled()`` returned True.
     """
@@ -208,6 +215,8 @@ def repeatability(
             f"{len(path)} paths given for {len(xb)} start configurations", "path"
         )
     mode, gamma, tol, cap = check_settings(mode, gamma, tol, max_iterations)
+    if (no_h := np.flatnonzero(map_value_undefined(inverse, xb))).size:
+        raise map_value_error(inverse, xb[no_h[0]])
     L = path.shape[-2] + int(flag(close, "close"))  # (at most: k(x0) is added when needed)
     check_memory(
         len(xb),

@@ -14,7 +14,7 @@ from typing import Literal, get_args
 import numpy as np
 
 from . import validation
-from .exceptions import InvalidInputError
+from .exceptions import AlgorithmicSingularityError, InvalidInputError
 from .inverses import Inverse
 from .kinematics import Kinematics
 from .limit_stall import pressed_joint
@@ -119,14 +119,16 @@ def refused_starts(inverse: Inverse, x0: FloatArray) -> dict[int, str]:
     -------
     dict int -> str
         Index in ``x0`` -> why: the kinematics overflow there (k(x0) or its Jacobian not
-        finite), J#(x0) is undefined (the inverse's singular error), or the kinematics' check
-        of starts refuses it (a pose task's rotation cut). Empty when every start
+        finite), J#(x0) is undefined (the inverse's singular error), h(x0) has no value
+        (:func:`map_value_undefined`), or the kinematics' check of starts refuses it (a pose
+        task's rotation cut). Empty when every start
         can run; :func:`jik.engine.solver.solve_batch` raises at the first refused one.
     """
     x0 = np.atleast_2d(validation.as_points(x0, check_inverse(inverse).p, "x0"))
     _, bad = inverse.apply_masked(x0, np.ones((len(x0), inverse.kinematics.r)))
     with np.errstate(all="ignore"):
         bad = bad | ~np.isfinite(inverse.kinematics.forward_unchecked(x0)).all(axis=-1)
+    bad = bad | map_value_undefined(inverse, x0)
     out = {int(i): start_problem(inverse, x0[i]) for i in np.flatnonzero(np.atleast_1d(bad))}
     try:  # (the kinematics' own check of starts, all at once: a pose task's rotation cut)
         inverse.kinematics.check_start(x0)
@@ -152,7 +154,39 @@ def start_problem(inverse: Inverse, x: FloatArray) -> str:
             f"{'finite' if np.all(np.isfinite(jacobian)) else 'not finite'} (the task is "
             "undefined there, or overflows); choose a start where both are finite"
         )
+    if map_value_undefined(inverse, x[None])[0]:
+        return str(map_value_error(inverse, x))
     return f"{inverse.singular_error(x)}; move the start"
+
+
+def map_value_undefined(inverse: Inverse, x0: FloatArray) -> FloatArray:
+    """Where the extended inverse's augmenting map has no finite value at the starts ``x0``
+    (n, p): bool (n,). A run uses only dh (eq. (11)), so it would run from there, yet what the
+    inverse keeps, h(x) = h(x0) (eq. (9)), means nothing (a formula such as
+    ``log(-1 - x1**2)``, whose gradient is real). All False for an inverse without a map, and
+    for a map that solves a problem per point (the unicycle's characteristics map)."""
+    x0 = np.asarray(x0, dtype=float)
+    maps = getattr(inverse, "augmenting_maps", None) or (getattr(inverse, "augmenting_map", None),)
+    if maps[0] is None or any(getattr(m, "solves_per_point", False) for m in maps):
+        return np.zeros(len(x0), dtype=bool)
+    with np.errstate(all="ignore"):
+        h = np.asarray(inverse.augmenting_value(x0), dtype=float).reshape(len(x0), -1)
+    return ~np.isfinite(h).all(axis=-1)
+
+
+def map_value_error(inverse: Inverse, x: FloatArray) -> AlgorithmicSingularityError:
+    """The error of a start ``x`` (p,) where :func:`map_value_undefined`."""
+    with np.errstate(all="ignore"):
+        h = np.asarray(inverse.augmenting_value(np.asarray(x, dtype=float)[None]), dtype=float)
+    h = np.ravel(h)  # (one value, or p - r)
+    shown = ", ".join(f"{v:.6g}" for v in h)
+    return AlgorithmicSingularityError(
+        f"the augmenting map has no real value at the start (h(x0) = {shown}): the "
+        "extended inverse (11) keeps h(x) = h(x0), which means nothing there; choose a start "
+        "where h is defined, or another map",
+        x,
+        "x0",
+    )
 
 
 def check_settings(
