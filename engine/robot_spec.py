@@ -37,7 +37,7 @@ from .exceptions import InvalidInputError
 from .exports import call_repr
 from .extended_vector import VectorExtendedInverse
 from .formula_kinematics import FormulaKinematics
-from .inverses import Inverse
+from .inverses import ExtendedInverse, Inverse
 from .kinematics import Kinematics
 from .limits import LimitsReport, check_limits, run_report
 from .planar_chain import PlanarChain
@@ -48,6 +48,9 @@ from .robot_file import read_robot_file, read_text
 from .robot_synthesis import arm_augmentations, missing_map
 from .units import RobotUnits, robot_units
 from .validation import of_type
+
+#: The name of an E2-optimal augmenting map in a definition (``{"name": "e2_synthesized"}``).
+SYNTHESIZED = "e2_synthesized"
 
 
 @dataclass(frozen=True)
@@ -109,6 +112,10 @@ class Robot:
         or the extended inverse (11) with one of its augmenting maps (a
         :class:`~jik.engine.extended_vector.VectorExtendedInverse` for p - r > 1)."""
         spec = self.spec
+        named = {a.name for a in spec.augmentations}
+        if algorithm == "extended" and augmentation == SYNTHESIZED and SYNTHESIZED not in named:
+            if "home" in self.definition:  # (an arm: its map is built here on demand)
+                return self._synthesized_inverse()
         if algorithm == "extended" and not spec.augmentations:
             arm = "home" in self.definition
             raise InvalidInputError(missing_map(spec.name, spec.p, spec.r, arm), "augmentation")
@@ -127,6 +134,22 @@ class Robot:
             algorithm_parameters=algorithm_parameters,
             x0=x0,
         )
+
+    def _synthesized_inverse(self) -> Inverse:
+        """The extended inverse of an arm's E2-optimal map (or p - r of them) over all its
+        joints around its home (:func:`~jik.engine.robot_synthesis.arm_augmentations`), for an
+        arm whose definition gives no map of that name: ``inverse("extended", "e2_synthesized")``
+        asks for what ``{"augmentations": [{"name": "e2_synthesized"}]}`` in its definition
+        gives. The synthesis is kept per process for the definition, as a definition's."""
+        kin = self.kinematics
+        wanted = arm_augmentations(
+            kin, {**self.definition, "augmentations": [{"name": SYNTHESIZED}]}
+        )
+        specs, _, vectors = augmentations_from_dict(kin, wanted, _key(self.definition))
+        if SYNTHESIZED in vectors:
+            maps = vectors[SYNTHESIZED]
+            return VectorExtendedInverse(kin, maps() if callable(maps) else maps)
+        return ExtendedInverse(kin, specs[0].build(kin))
 
 
 def _get(d: Mapping, key: str, kind: type, what: str, default: Any = None) -> Any:

@@ -242,9 +242,9 @@ def missing_map(name: str, p: int, r: int, arm: bool) -> str:
     if arm:
         return (
             f"the extended inverse needs p - r = {k} augmenting maps, and this {name} "
-            f"(p = {p}, r = {r}) has a default map only when p = r + 1: give "
-            f"{{'name': 'e2_synthesized'}} (E2-optimal over all its joints, +-{ARM_BOX:g} "
-            f"around its home) or {formulas}"
+            f"(p = {p}, r = {r}) has a default map only when p = r + 1: ask for "
+            f"'e2_synthesized' (E2-optimal over all its joints, +-{ARM_BOX:g} around its home; "
+            f"{{'name': 'e2_synthesized'}} in a definition or a request) or give {formulas}"
         )
     return (
         f"the extended inverse needs p - r = {k} augmenting maps: give {formulas} or "

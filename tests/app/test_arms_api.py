@@ -239,9 +239,10 @@ def test_an_arm_without_a_map_for_its_task_is_told_the_map_that_works(api):
     (msg,) = [e["msg"] for e in r.json()["detail"]]
     assert msg == (
         "augmentation: the extended inverse needs p - r = 4 augmenting maps, and this panda "
-        "(p = 7, r = 3) has a default map only when p = r + 1: give {'name': 'e2_synthesized'} "
-        "(E2-optimal over all its joints, +-0.3 around its home) or {'name': 'formula', 'h': "
-        "[...]} (4 formulas, one per degree of redundancy)"
+        "(p = 7, r = 3) has a default map only when p = r + 1: ask for 'e2_synthesized' "
+        "(E2-optimal over all its joints, +-0.3 around its home; {'name': 'e2_synthesized'} in a "
+        "definition or a request) or give {'name': 'formula', 'h': [...]} (4 formulas, one per "
+        "degree of redundancy)"
     )
     ok = api.post("/solve", json=XYZ | {"augmentation": {"name": "e2_synthesized"}})
     assert ok.status_code == 200, ok.text

@@ -3,8 +3,10 @@
 import numpy as np
 import pytest
 
+from jik.engine.arms import ARMS
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.repeatability import repeatability
+from jik.engine.robot_spec import SYNTHESIZED as SYNTH
 from jik.engine.robot_spec import robot_from_dict
 from jik.engine.synthesis_nd import synthesize_e2_nd
 
@@ -98,6 +100,25 @@ def test_the_default_frame_of_a_vector_synthesis_is_the_best_conditioned():
         return np.linalg.eigvalsh(N[np.ix_(ix, ix)])[0]
 
     assert least([4, 5, 6, 7]) < 1e-12 < 0.5 < least(axes)
+
+
+def test_an_arm_gives_its_synthesized_map_by_name_as_its_definition_does():
+    """``inverse("extended", "e2_synthesized")`` of the Panda with a position task (p - r = 4,
+    no map by default) is the extended inverse of the maps that
+    ``{"augmentations": [{"name": "e2_synthesized"}]}`` in its definition gives; a robot
+    without a home still needs its region."""
+    from jik.engine.extended_vector import VectorExtendedInverse
+
+    by_name = robot_from_dict({"name": "panda", "task": "xyz"}).inverse("extended", SYNTH)
+    defined = robot_from_dict(
+        {"name": "panda", "task": "xyz", "augmentations": [{"name": SYNTH}]}
+    ).inverse("extended", SYNTH)
+    assert isinstance(by_name, VectorExtendedInverse)
+    x = np.array(ARMS["panda"].home) + 0.1
+    np.testing.assert_array_equal(by_name.augmenting_value(x), defined.augmenting_value(x))
+    chain = robot_from_dict({"name": "planar_chain", "joints": "RRRR", "lengths": [1] * 4})
+    with pytest.raises(InvalidInputError, match="'region'"):
+        chain.inverse("extended", SYNTH)
 
 
 def test_a_synthesis_without_a_degree_takes_the_basis_its_box_and_redundancy_call_for():
