@@ -139,8 +139,10 @@ URDF = (
         "home",
         "numbers",
         False,
-        "a reference configuration, one value per "
-        "active joint (default: zero, clipped into the joint limits); also the default start",
+        "a reference configuration, one value per active joint (default: zero, clipped "
+        "into the joint limits): R0's default and the posture inverse's default rest; when "
+        "given, also the default start (else 0.5 in each joint's range that holds it, the "
+        "middle of the others)",
     ),
     DefinitionField(
         "reference",
