@@ -62,7 +62,45 @@ def path_family(kin, base_path: FloatArray, shifts, scales) -> tuple[FloatArray,
             "magnitude, which a solve does not take",
             field="shifts" if shifts is not None else "scales",
         )
+    _check_reachable(kin, base_path, shift, scale, shifts is not None, scales is not None)
     return paths, None if shifts is None else len(scale)
+
+
+def _check_reachable(kin, base_path, shift, scale, shifted: bool, scaled: bool) -> None:
+    """Refuse a family whose shift or scale moves a point of the path out of the task's range
+    where that is known without solving (a pose task's rotation coordinates beyond pi:
+    :meth:`~jik.engine.kinematics.Kinematics.check_target`), naming ``shifts.s`` or
+    ``scales.q`` (a scale when it alone moves the point out) and the point; the base path is
+    checked as ``path``."""
+    paths = family(base_path, shift, scale)
+    if not _fails(kin, paths):
+        return
+    for j, path in enumerate(paths):
+        try:
+            kin.check_target(path, "path")
+        except InvalidInputError as error:
+            s, q = divmod(j, len(scale))
+            alone = scaled and (
+                not shifted or _fails(kin, family(base_path, 0 * shift[:1], scale[q : q + 1]))
+            )
+            field = f"scales.{q}" if alone else f"shifts.{s}"
+            point = int((error.field or "path.0").rpartition(".")[2])
+            why = str(error).partition(": ")[2] or str(error)
+            raise InvalidInputError(
+                f"{field.replace('.', '[')}] moves the path's point {point} to "
+                f"{format_vector(path[point])}: {why}",
+                field,
+            ) from None
+
+
+def _fails(kin, paths: FloatArray) -> bool:
+    """Whether :meth:`~jik.engine.kinematics.Kinematics.check_target` refuses a point of
+    ``paths`` (P, L0, r)."""
+    try:
+        kin.check_target(paths.reshape(-1, kin.r), "path")
+    except InvalidInputError:
+        return True
+    return False
 
 
 def base_manifolds(

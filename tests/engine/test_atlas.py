@@ -21,6 +21,7 @@ from jik.engine.inverses import ExtendedInverse, Pseudoinverse, extended_singula
 from jik.engine.kinematics import Manipulator1, Manipulator2
 from jik.engine.progress import ProgressCallbacks
 from jik.engine.repeatability import open_loop, repeatability
+from jik.engine.robot_spec import robot_from_dict
 from jik.engine.self_motion import trace
 from jik.engine.solver import solve_batch
 
@@ -426,3 +427,36 @@ def test_a_shift_that_moves_the_path_out_of_reach_is_named(shifts, field, words)
             scales=[1.0, 0.5],
         )
     assert refused.value.field == field and words in str(refused.value), refused.value
+
+
+@pytest.mark.parametrize(
+    ("shifts", "scales", "field", "words"),
+    [
+        (None, [1, 2, 30], "scales.2", "scales[2] moves the path's point 1 to"),
+        ([[0] * 6, [0, 0, 0, 0, 0, 3.0]], None, "shifts.1", "shifts[1] moves the path's point 1"),
+        ([[0] * 6, [0, 0, 0, 0, 0, 3.0]], [1, 2], "shifts.1", "shifts[1] moves the path's point 1"),
+        (
+            [[0] * 6, [0, 0, 0, 0, 0, 0.1]],
+            [1, 30],
+            "scales.1",
+            "scales[1] moves the path's point 1",
+        ),
+    ],
+)
+def test_a_shift_or_scale_that_turns_a_pose_past_the_cut_is_named(shifts, scales, field, words):
+    """A scale or a shift that moves a later point of a pose path past a half turn of its
+    rotation coordinates is refused when the atlas is planned (not when its runs meet it),
+    naming that scale or shift and the point; a scale is named when it alone does it."""
+    panda = robot_from_dict({"name": "panda", "task": "pose"})
+    home = panda.kinematics.forward(np.asarray(panda.spec.default_x0))
+    path = [home + [0, 0, 0, 0, 0, rz] for rz in (0.0, 0.15, -0.1)]
+    with pytest.raises(InvalidInputError) as refused:
+        plan_atlas(
+            panda.inverse("pseudoinverse"),
+            path,
+            starts=[panda.spec.default_x0],
+            shifts=shifts,
+            scales=scales,
+        )
+    assert refused.value.field == field and str(refused.value).startswith(words), refused.value
+    assert "rotation coordinates (rx, ry, rz) have length" in str(refused.value)
