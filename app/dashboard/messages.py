@@ -6,7 +6,7 @@ import asyncio
 import hashlib
 import json
 from collections import OrderedDict
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 
 from ...engine.augmentations import h_change
@@ -14,10 +14,13 @@ from ...engine.exports import json_values as finite
 from .controls import controls, controls_about
 from .runs import DashboardResult
 
+#: Characters of an event's data in each piece of its server-sent event (:func:`sse_pieces`).
+PIECE = 64 * 1024
+
 
 @dataclass(frozen=True)
 class Event:
-    """A message to the subscribers: ``data`` is the JSON sent to the page."""
+    """A message to the subscribers: ``data`` is the JSON sent to the page, on one line."""
 
     #: "state" | "progress" | "result" | "functionals" | "error" | "ahead" | "refused" |
     #: "closed" (the dashboard stopped)
@@ -67,6 +70,20 @@ class LatestEvents:
             self._ready.clear()
             await self._ready.wait()
         return self._events.popitem(last=False)[1]
+
+
+def sse_pieces(event: Event) -> Iterator[bytes]:
+    """``event`` as a server-sent event (its ``id`` the generation, one ``data`` line), in pieces
+    of at most :data:`PIECE` characters of its data: each encoded when it is asked for, so that
+    the streams that send a large event share its text and hold no copy of it."""
+    data = event.data
+    text = f"id: {event.generation}\nevent: {event.kind}\ndata: "
+    for start in range(0, len(data), PIECE):
+        text += data[start : start + PIECE]
+        if start + PIECE >= len(data):
+            text += "\n\n"
+        yield text.encode()
+        text = ""
 
 
 def digest(text: str) -> str:

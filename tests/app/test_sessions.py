@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import asyncio
 import json
 import re
 import time
@@ -256,8 +257,6 @@ def test_the_scene_socket_refuses_other_origins_and_unknown_sessions(client):
 def test_a_listener_that_never_reads_holds_one_event_of_each_kind(app, client):
     """The event stream of a page that stops reading buffers the newest event of each kind, not
     one per change (about 0.45 MB per change, never released)."""
-    import asyncio
-
     from jik.app.dashboard.messages import LatestEvents
 
     session = _open(client)
@@ -347,3 +346,101 @@ def test_an_export_of_a_named_generation_is_that_one_while_a_newer_computes(
     finally:
         release.set()
         client.delete(f"/api/sessions/{sid}")
+
+
+def _events_scope(session_id: str) -> dict:
+    """The ASGI scope of ``GET /api/sessions/{session_id}/events``, as uvicorn gives it."""
+    path = f"/api/sessions/{session_id}/events"
+    return {
+        "type": "http",
+        "asgi": {"version": "3.0"},
+        "http_version": "1.1",
+        "method": "GET",
+        "scheme": "http",
+        "path": path,
+        "raw_path": path.encode(),
+        "root_path": "",
+        "query_string": b"",
+        "headers": [(b"host", b"127.0.0.1")],
+        "client": ("127.0.0.1", 50000),
+        "server": ("127.0.0.1", 8000),
+    }
+
+
+async def _connected() -> dict:
+    """An ASGI ``receive`` of a client that stays connected and sends nothing."""
+    await asyncio.Event().wait()
+    return {}
+
+
+def _latest_result(dashboard):
+    events: list = []
+    dashboard.subscribe(events.append)()  # (the latest events, replayed)
+    return next(e for e in events if e.kind == "result")
+
+
+def test_a_stream_whose_client_does_not_read_holds_a_piece_of_an_event_then_ends(
+    app, client, monkeypatch
+):
+    """uvicorn keeps what a response sends until the client takes it, and pauses the response
+    (its next send waits) once it holds HIGH_WATER_LIMIT bytes: a stream whose client did not
+    read held a whole result (40 such streams on a 67 MB result: 2.5 GB) and stayed open. It
+    holds one piece of an event more, and ends after SEND_TIMEOUT, its session unused again."""
+    from uvicorn.protocols.http.flow_control import HIGH_WATER_LIMIT
+
+    from jik.app.api.routes import sessions as routes
+    from jik.app.dashboard.messages import PIECE
+
+    monkeypatch.setattr(routes, "SEND_TIMEOUT", 0.2)
+    session = _open(client)
+    _computed(app, session["id"])
+    stored = app.state.sessions.get(session["id"])
+    assert len(_latest_result(stored.dashboard).data) > 3 * PIECE
+
+    async def unread() -> tuple[list[bytes], bool]:
+        sent: list[bytes] = []
+
+        async def send(message) -> None:  # (uvicorn's, to a client that reads nothing)
+            if sum(map(len, sent)) > HIGH_WATER_LIMIT:
+                await asyncio.Event().wait()
+            sent.append(message.get("body", b""))
+
+        task = asyncio.ensure_future(app(_events_scope(session["id"]), _connected, send))
+        done, _ = await asyncio.wait({task}, timeout=10)
+        task.cancel()
+        return sent, bool(done)
+
+    sent, ended = run_async(unread())
+    assert sum(map(len, sent)) < HIGH_WATER_LIMIT + PIECE + 1024, sum(map(len, sent))
+    assert ended and stored.users == 0
+
+
+def test_a_stream_sends_large_events_whole_and_a_comment_when_idle(app, client, monkeypatch):
+    """An event sent in pieces reads as one; an idle stream sends a comment every HEARTBEAT
+    seconds (proxies keep the connection)."""
+    from jik.app.api.routes import sessions as routes
+
+    monkeypatch.setattr(routes, "HEARTBEAT", 0.05)
+    session = _open(client)
+    _computed(app, session["id"])
+    result = _latest_result(app.state.sessions.get(session["id"]).dashboard)
+
+    async def read() -> bytes:
+        sent: list[bytes] = []
+        pinged = asyncio.Event()
+
+        async def send(message) -> None:
+            sent.append(message.get("body", b""))
+            if sent[-1].startswith(b": ping"):
+                pinged.set()
+
+        task = asyncio.ensure_future(app(_events_scope(session["id"]), _connected, send))
+        await asyncio.wait_for(pinged.wait(), 10)
+        task.cancel()
+        return b"".join(sent)
+
+    blocks = re.split(r"\r?\n\r?\n", run_async(read()).decode())
+    fields = [dict(line.split(": ", 1) for line in b.splitlines()) for b in blocks if b]
+    (sent,) = [f for f in fields if f.get("event") == "result"]
+    assert sent["data"] == result.data and sent["id"] == str(result.generation)
+    assert fields[-1] == {"": "ping"}

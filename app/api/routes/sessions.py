@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import math
 from typing import Annotated
 
 import websockets
@@ -20,13 +21,15 @@ from fastapi import APIRouter, Request, WebSocket
 from fastapi.responses import JSONResponse, PlainTextResponse
 from pydantic import BaseModel, ConfigDict, Field
 from sse_starlette import EventSourceResponse, ServerSentEvent
+from sse_starlette.sse import SendTimeoutError
+from starlette.types import Receive, Scope, Send
 
 from ....engine.exceptions import InvalidInputError
 from ...compute.schemas import INTEGRAL
 from ...compute.schemas.wording import refused, without_field
 from ...dashboard import export_file
 from ...dashboard.controls import controls_message
-from ...dashboard.messages import LatestEvents
+from ...dashboard.messages import LatestEvents, sse_pieces
 from ...dashboard.patch import StatePatch, parse_patch, patch_of
 from ...dashboard.robots import vet_definition
 from ...dashboard.sessions import Session, SessionNotFound
@@ -35,8 +38,11 @@ from ..errors import unparsed_body_response
 from ..security import close_websocket
 
 router = APIRouter(tags=["dashboard sessions"])
-#: Seconds between keep-alive comments on the event stream.
+#: Seconds between keep-alive comments on an idle event stream.
 HEARTBEAT = 15.0
+#: Seconds a client has to take a piece of an event (or a keep-alive comment) before its stream
+#: is closed; the page's EventSource then reconnects and gets the latest events again.
+SEND_TIMEOUT = 30.0
 #: The events the page follows.
 PAGE_EVENTS = ("state", "progress", "result", "functionals", "error", "ahead", "refused")
 #: Seconds an export waits for the session's first result.
@@ -260,19 +266,37 @@ async def events(session_id: str, store: Store):
         try:
             yield ServerSentEvent(retry=1000)  # (the page reconnects after 1 s)
             while True:
-                event = await queue.get()
+                try:
+                    event = await asyncio.wait_for(queue.get(), HEARTBEAT)
+                except TimeoutError:  # (a comment, so that proxies keep the connection)
+                    yield ServerSentEvent(comment="ping")
+                    continue
                 if event.kind == "closed":  # (the session ended: the page opens a new one)
                     return
                 if event.kind in PAGE_EVENTS:
-                    yield ServerSentEvent(event.data, event=event.kind, id=str(event.generation))
+                    for piece in sse_pieces(event):
+                        yield piece
         finally:
             unsubscribe()
             session.users -= 1
             session.touch()
 
-    # sse-starlette frames the events, sends a comment every HEARTBEAT seconds (proxies keep
-    # the connection), and ends the stream when the client leaves or the server stops.
-    return EventSourceResponse(stream(), ping=HEARTBEAT, sep="\n")
+    # uvicorn keeps what it is sent until the client takes it: an event goes in pieces, each
+    # sent once uvicorn's buffer has room, and a stream whose client takes nothing for
+    # SEND_TIMEOUT seconds ends, as when the client leaves or the server stops. sse-starlette's
+    # pings, which could land between two pieces, are off (ping=0 spins before its 3.4.9).
+    return _EventStream(stream(), ping=math.inf, sep="\n", send_timeout=SEND_TIMEOUT)
+
+
+class _EventStream(EventSourceResponse):
+    """sse-starlette's response, ended without a traceback when a send times out (a client that
+    does not read): uvicorn then closes the connection, logging that the response was cut."""
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        try:
+            await super().__call__(scope, receive, send)
+        except* SendTimeoutError:  # (in an exception group from older sse-starlette)
+            pass
 
 
 @router.get(
