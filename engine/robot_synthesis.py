@@ -55,7 +55,7 @@ def _maps(kin, box, fix, degree, key, axes) -> tuple[AugmentingMap, ...]:
     cache_key = None if key is None else (key, json.dumps([box, fix, degree, axes], sort_keys=True))
     if cache_key is not None and cache_key in _SYNTHESIZED:
         return _SYNTHESIZED[cache_key]
-    if _ELSEWHERE.get():
+    if cache_key is not None and _ELSEWHERE.get():  # (one without a key is made here)
         raise SynthesisElsewhere("this map is synthesized in another process")
     progress = _PROGRESS.get()  # (a RunCancelled it raises leaves nothing cached)
     maps: tuple[AugmentingMap, ...]
