@@ -223,8 +223,8 @@ class SessionStore:
         idle = [s for s in self._sessions.values() if s.users == 0]
         if not idle:
             raise SessionsFull(
-                f"the server has {len(self._sessions)} dashboard sessions in use, its limit; "
-                "close a tab or try again later"
+                f"the server has {len(self._sessions)} dashboard sessions in use, its limit "
+                "(JIK_MAX_SESSIONS); close a tab or try again later"
             )
         oldest = min(idle, key=lambda s: s.touched)
         del self._sessions[oldest.id]

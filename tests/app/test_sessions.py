@@ -190,7 +190,7 @@ def test_a_full_store_evicts_the_idlest_unused_session_or_refuses():
             store.get(a.id)
         assert len(store) == 2
         b.users = c.users = 1  # both followed by a tab
-        with pytest.raises(SessionsFull, match="2 dashboard sessions in use"):
+        with pytest.raises(SessionsFull, match=r"2 dashboard sessions in use, its limit \(JIK_MAX"):
             store.create()
     finally:
         store.close()
