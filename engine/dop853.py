@@ -212,6 +212,20 @@ def _initial_step(inverse, x, f, y_d, rtol, atol):
     return np.minimum(100 * h0, h1)
 
 
+def _decay_rate(inverse: Inverse, x: FloatArray) -> FloatArray:
+    """The rate at which the task error of (7) falls at the starts ``x`` (n, p) under an
+    inverse that is not a right inverse: along de/dtau = -J J# e, ||e|| falls at least at the
+    least eigenvalue of the symmetric part of J J# (damped least squares: sigma^2 / (sigma^2 +
+    lambda^2) for the least singular value sigma of J); within [1e-3, 1], 1 where unknown."""
+    n, r = len(x), inverse.kinematics.r
+    J = inverse.kinematics.jacobian_unchecked(x)
+    columns = [inverse.apply_masked(x, np.broadcast_to(np.eye(r)[i], (n, r)))[0] for i in range(r)]
+    M = J @ np.stack(columns, axis=-1)  # (n, r, r): J J#
+    with np.errstate(all="ignore"):
+        least = np.linalg.eigvalsh(0.5 * (M + np.swapaxes(M, -1, -2)))[..., 0]
+    return np.where(np.isfinite(least), np.clip(least, 1e-3, 1.0), 1.0)
+
+
 def _combine(weights: FloatArray, K: FloatArray) -> FloatArray:
     """sum_j weights[j] K[j] over the stages K (s, n, p), term by term in a fixed order.
 
@@ -251,8 +265,10 @@ def integrate(inverse, x0, y_d, tol, max_steps, record, tau0, rtol=RTOL, atol=AT
     status = np.full(n, Status.RUNNING)
     status[bad] = Status.SINGULAR
     status[err0 < tol] = Status.CONVERGED
-    # exp(-tau) decay: tau_needed = ln(err0 / tol); far past that the run has stalled.
-    tau_cap = tau0 + np.log(np.maximum(err0, tol) / tol) + 40.0
+    # exp(-rate tau) decay: tau_needed = ln(err0 / tol) / rate; far past that the run has
+    # stalled (rate 1 for a right inverse, eq. (5)).
+    rate = 1.0 if inverse.right_inverse else _decay_rate(inverse, x0)
+    tau_cap = tau0 + (np.log(np.maximum(err0, tol) / tol) + 40.0) / rate
     err_now = err0.copy()
     # (the last checkpoint of each run's error and x)
     plateau_tau, plateau_err, plateau_x = tau0 + PLATEAU_TAU, err0.copy(), x0.copy()

@@ -184,6 +184,16 @@ def test_damped_leaves_a_singular_start_where_the_pseudoinverse_cannot():
     assert ARM3R.manipulability(res.x[None])[0] > 0.1  # ends away from the singularity
 
 
+@pytest.mark.parametrize("damping", [2.0, 4.0, 10.0])
+def test_a_large_damping_converges_slower_and_is_no_stall(damping):
+    """Under damped least squares the task error falls at sigma^2 / (sigma^2 + lambda^2), not
+    exp(-tau): with lambda = 2 to 10 on Manipulator 2 from Table 1's start a run needs tau of
+    100 to 2,000 and converges (it was called a stall near a singularity of J# at tau = 64)."""
+    res = solve(DampedInverse(Manipulator2(), damping), (0.0, 0.0, math.pi / 2), (1.0, 1.0))
+    assert res.success and res.error < 1e-10, res.message
+    assert res.trajectory is not None and res.trajectory.theta[-1] > 100
+
+
 @pytest.mark.parametrize("threshold", [0.0, 0.3])
 def test_damped_reaches_the_singularity_and_reports_its_task_error(threshold):
     """A target beyond reach: the pseudoinverse stalls short of the boundary, damped least
