@@ -120,6 +120,8 @@ function screenEntry(fig, figShape, held, shown) {
     shape: figShape, ranges: JSON.stringify(held), held, shown,
     shapes: JSON.stringify(fig.layout.shapes || []),
     data: fig.data.map((t) => (moves(t) ? JSON.stringify(DATA_KEYS.map((k) => t[k])) : null)),
+    // (lines without points: an algorithm's run that stopped before a cycle ended)
+    empty: fig.data.map((t) => moves(t) && Array.isArray(t.x) && t.x.length === 0),
   };
 }
 
@@ -148,6 +150,9 @@ function plan(div, key, fig) {
   if (newRanges && Object.keys(fig.layout).some((k) => isAxis(k) && fig.layout[k].scaleanchor)) return null;
   // Only the lines that changed move (a new map leaves the pseudoinverse's as they are).
   const changed = traces.filter((i) => entry.data[i] !== last.data[i]);
+  // A line that loses or gains all its points is drawn anew: Plotly.animate then drops the
+  // figure's scatter layer, every line of it.
+  if (changed.some((i) => entry.empty[i] || last.empty[i])) return null;
   const frame = changed.length ? moveFrame(fig.data, changed) : null;
   // Before the move, a relayout: a new title text (the h panel's E1/E2), and the new axis
   // ranges, as a zoom sets them (the ranges of an animation frame miss stacked axes): only the

@@ -37,6 +37,9 @@ def test_c1_c2_one_click_away_and_a_singular_map_says_where(tabs):
     warning = verdict.locator(".warning")
     expect(warning).to_contain_text("e1_optimal (C1 = 1, C2 = -1) is singular in the design region")
     expect(warning).to_contain_text(re.compile(r"at x1 ∈ \[0\.4\d*, 0\.5\d*\], any x2, any x3"))
+    # The extended run stops on its third leg (no drift to draw): the pseudoinverse's three
+    # cycles stay drawn in the drift panel.
+    expect(page.locator("#plot-drift .scatterlayer .trace .points path")).to_have_count(3)
     tab.screenshots("singular-map")
 
     c2.fill("1")
