@@ -2,7 +2,24 @@
 // their data, ranges, title or shapes changed, and drawn ahead (off screen) for a robot switch.
 import { el, withErrataLinks } from "./dom.js";
 
-export const PLOT_CONFIG = { responsive: true, displaylogo: false };
+// (not plotly's `responsive`: its resize sizes a figure to its panel, height too, and a panel's
+// height follows its figure, so every figure fell to the panel's least height)
+export const PLOT_CONFIG = { responsive: false, displaylogo: false };
+
+// A window resize gives each drawn panel's figure its panel's new width, its own height kept,
+// once per frame.
+let resizing = false;
+window.addEventListener("resize", () => {
+  if (resizing) return;
+  resizing = true;
+  requestAnimationFrame(() => {
+    resizing = false;
+    for (const div of document.querySelectorAll(".panels .js-plotly-plot")) {
+      const width = parseFloat(getComputedStyle(div).width);
+      if (width && div.layout) Plotly.relayout(div, { width, height: div.layout.height });
+    }
+  });
+});
 
 // The page's configuration (/api/dashboard/config): colours, labels, line styles, panels' help.
 let CONFIG = { colors: {}, labels: {}, styles: {}, panels: [] };

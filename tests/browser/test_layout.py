@@ -89,3 +89,29 @@ def test_the_scenes_panel_never_covers_the_robot(tabs, size):
             assert found["n"] > 50, (w, h, algorithm, found)
     tab.page.set_viewport_size({"width": width, "height": height})
     tab.screenshots(f"scene-panel-{width}")
+
+
+def test_a_window_resize_keeps_each_figure_s_height_and_takes_the_new_width(tabs):
+    """After the window narrows and widens again, each panel is as tall as before (its
+    figure's own height: an arm's joints panel is taller than the others) and its plot as wide
+    as the panel (as plotly measures it); plotly's own resize had shrunk every figure to the panels' least height."""
+    tab = tabs.open(viewport={"width": 1400, "height": 1000}, scene=False)
+    page = tab.page
+    sizes = (
+        "() => [...document.querySelectorAll('.panels .js-plotly-plot')].map(p => [p.id, "
+        "Math.round(p.getBoundingClientRect().height), parseFloat(getComputedStyle(p).width), "
+        "Math.round(p.querySelector('.main-svg').getBoundingClientRect().width)])"
+    )
+    fitted = (
+        "() => [...document.querySelectorAll('.panels .js-plotly-plot')].every(p => "
+        "Math.abs(parseFloat(getComputedStyle(p).width) - "
+        "p.querySelector('.main-svg').getBoundingClientRect().width) < 1)"
+    )
+    before = page.evaluate(sizes)
+    assert len(before) >= 5
+    for width in (1000, 1400):
+        page.set_viewport_size({"width": width, "height": 1000})
+        page.wait_for_function(fitted, timeout=TIMEOUT)
+    after = page.evaluate(sizes)
+    assert [(p, h) for p, h, *_ in after] == [(p, h) for p, h, *_ in before]
+    assert all(abs(panel - plot) < 1 for _, _, panel, plot in after)
