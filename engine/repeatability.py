@@ -186,8 +186,9 @@ def repeatability(
         :data:`jik.engine.validation.MEMORY_LIMIT` (field ``x0``).
     JikError
         A leg's solve raised (a singular start configuration) and the progress, if any, did not
-        stop the run there; the map has no value at a start
-        (:func:`~jik.engine.solve_rules.map_value_undefined`, field ``x0``).
+        stop the run there (the map having no value at the start
+        (:func:`~jik.engine.solve_rules.map_value_undefined`, field ``x0``) stops its first
+        leg; a batch with such a start is refused).
     RunCancelled
         ``progress.cancelled()`` returned True.
     """
@@ -215,7 +216,9 @@ def repeatability(
             f"{len(path)} paths given for {len(xb)} start configurations", "path"
         )
     mode, gamma, tol, cap = check_settings(mode, gamma, tol, max_iterations)
-    if (no_h := np.flatnonzero(map_value_undefined(inverse, xb))).size:
+    # (a start where h has no value: a batch is refused, one start's first leg stops there)
+    no_h = np.flatnonzero(map_value_undefined(inverse, xb) & (resume is None))
+    if len(no_h) and not single:
         raise map_value_error(inverse, xb[no_h[0]])
     L = path.shape[-2] + int(flag(close, "close"))  # (at most: k(x0) is added when needed)
     check_memory(
@@ -295,6 +298,8 @@ def repeatability(
             check_cancelled(progress, f"repeatability run cancelled before {where}")
             stopped = None
             try:
+                if len(no_h) and c == j == 0:
+                    raise map_value_error(inverse, xb[0])
                 if chunked:  # (one start, with a progress)
                     res: SolveResult | BatchSolveResult = solve_in_chunks(
                         inverse,

@@ -7,9 +7,10 @@ and ``to_json``, on every change of a control.
 Colours, line styles and markers are fixed per algorithm
 (:data:`jik.app.dashboard.algorithms.STYLES`), the same as in the 3D scene and the atlas; every
 panel draws the state's chosen algorithms (``result.runs``, in the catalogue's order).
-The figures follow the paper: task-space paths (Figs. 5, 6), joint trajectories against theta
-(Figs. 7-9), the repeatability drift per cycle with the Table 1 numbers, and for the unicycle the
-platform paths in the (q1, q2) plane and the controls against the iteration (Figs. 11-14).
+The figures follow the paper: task-space paths (Figs. 5, 6, of Manipulator 2), joint
+trajectories against theta (Figs. 7-9), the repeatability drift per cycle with the Table 1
+numbers, and for the unicycle the platform paths in the (q1, q2) plane and the controls against
+the iteration (Figs. 11-14).
 """
 
 from __future__ import annotations
@@ -88,7 +89,7 @@ def _task_space(result: DashboardResult) -> dict:
     points = np.vstack([r.y[:, :2] for r in result.runs.values()] + [tg[:, :2]])
     return figure(
         data,
-        "Task-space paths (Figs. 5, 6)<br><sup>"
+        f"Task-space paths{_cited(result, 'Figs. 5, 6')}<br><sup>"
         + algorithms_key(result)
         + (" · " if len(result.runs) <= 2 else "</sup><br><sup>")
         + "× targets of the legs · ○ start k(x0)</sup>",
@@ -98,6 +99,12 @@ def _task_space(result: DashboardResult) -> dict:
             title=label(n2, tu[1]), range=nice_range(points[:, 1]), scaleanchor="x", scaleratio=1
         ),
     )
+
+
+def _cited(result: DashboardResult, figures: str) -> str:
+    """`` (Figs. ...)`` for Manipulator 2, the robot of the paper's Figs. 5-9 (sec. 5.2.1); the
+    panels of another robot cite none."""
+    return f" ({figures})" if result.state.robot == "manipulator2" else ""
 
 
 def _joints(result: DashboardResult) -> dict:
@@ -118,7 +125,7 @@ def _joints(result: DashboardResult) -> dict:
     title = (
         "Controls λ against the iteration (Figs. 11-14 b, c)"
         if is_unicycle(result)
-        else "Joint trajectories (Figs. 7-9)"
+        else f"Joint trajectories{_cited(result, 'Figs. 7-9')}"
     )
     return figure(data, title, height=120 * len(names) + 100, **NO_LEGEND, **axes)
 

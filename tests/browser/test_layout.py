@@ -94,7 +94,8 @@ def test_the_scenes_panel_never_covers_the_robot(tabs, size):
 def test_a_window_resize_keeps_each_figure_s_height_and_takes_the_new_width(tabs):
     """After the window narrows and widens again, each panel is as tall as before (its
     figure's own height: an arm's joints panel is taller than the others) and its plot as wide
-    as the panel (as plotly measures it); plotly's own resize had shrunk every figure to the panels' least height."""
+    as the panel (as plotly measures it); plotly's own resize had shrunk every figure to the
+    panels' least height."""
     tab = tabs.open(viewport={"width": 1400, "height": 1000}, scene=False)
     page = tab.page
     sizes = (

@@ -541,8 +541,9 @@ def test_a_batch_without_starts_names_x0():
 
 def test_a_map_without_a_real_value_at_the_start_is_refused():
     """h = log(-1 - x2**2) + x3 has a real gradient (a run would go) and no real value: what the
-    extended inverse keeps, h(x) = h(x0), means nothing, so a repeatability run and the check of
-    a batch's starts refuse it (x0); h = log(x2) + x3 only where x2 <= 0."""
+    extended inverse keeps, h(x) = h(x0), means nothing, so a repeatability run (or its first
+    leg) and the check of a batch's starts refuse it (x0); h = log(x2) + x3 only where
+    x2 <= 0."""
     nowhere = jik.FormulaMap("log(-1 - x2**2) + x3", NAMES)
     inverse = jik.ExtendedInverse(ARM, nowhere)
     with pytest.raises(jik.AlgorithmicSingularityError) as info:
@@ -552,6 +553,12 @@ def test_a_map_without_a_real_value_at_the_start_is_refused():
         "the augmenting map has no real value at the start (h(x0) = nan): the extended inverse "
         "(11) keeps h(x) = h(x0), which means nothing there"
     )
+    # With a progress that stops a run at an error (the dashboard's), its first leg stops.
+    stopping = jik.ProgressCallbacks(stop_at_error=True)
+    run = jik.repeatability(inverse, X0, PATH, cycles=2, progress=stopping)
+    assert not run.success and "no real value at the start" in run.message
+    with pytest.raises(jik.AlgorithmicSingularityError):  # (a batch: refused)
+        jik.repeatability(inverse, [X0, X0], PATH, cycles=2)
     somewhere = jik.ExtendedInverse(ARM, jik.FormulaMap("log(x2) + x3", NAMES))
     refused = refused_starts(somewhere, [[0, 0.5, 1.0], [0, -0.5, 1.0]])
     assert list(refused) == [1] and "no real value" in refused[1]
