@@ -27,7 +27,7 @@ from ...engine.registry import ROBOTS
 from ...engine.solve_rules import DISCRETE_GAMMA_BOUND, MAX_ITERATIONS, MAX_STEPS, MODES, TOL_MIN
 from ..compute.schemas import MAX_ITERATIONS_CAP
 from .algorithms import STYLES, joint_box, posture_rest, scalar_parameters
-from .control_changes import lookup, path_format, path_text
+from .control_changes import DISCRETE_GAMMA_ON_SWITCH, lookup, path_format, path_text
 from .glossary import PARAMETER_LABELS, SYMBOLS
 from .robots import state_kinematics, state_spec
 
@@ -114,7 +114,9 @@ def controls(state) -> list[Control]:
             "mode",
             "mode",
             "select",
-            "continuous: the ODE (7); discrete: the iteration x <- x - gamma J# e",
+            "continuous: the ODE (7); discrete: the iteration x <- x - gamma J# e (switching "
+            f"to it takes a gamma above {DISCRETE_GAMMA_ON_SWITCH:g}, the full Newton step, down "
+            "to it)",
             tuple((m, m) for m in MODES),
         ),
         Control(
