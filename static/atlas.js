@@ -172,7 +172,7 @@ async function draw(body, key) {
   const paths = (body.request.scales || [1]).length;
   const count = (n, noun) => `${n} ${noun}${n === 1 ? "" : "s"}`;
   const per = [count(body.runs / paths, "start"), ...(paths > 1 ? [count(paths, "path scale")] : []), count(k, "algorithm")].join(" x ");
-  say(`Atlas done: ${body.runs * k} runs (${per}) of ${body.request.cycles} cycles in ${fmt(body.elapsed_s, 1)} s. Click a cell to move the main view to that start.`);
+  say(`Atlas done: ${body.runs * k} runs (${per}) of ${count(body.request.cycles, "cycle")} in ${fmt(body.elapsed_s, 1)} s. Click a cell to move the main view to that start.`);
   div.dataset.runs = body.runs;
 }
 

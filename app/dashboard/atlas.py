@@ -166,7 +166,8 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest, robot: RobotUsed
         if a == "extended" and request.augmentation is not None:
             name += f"<br>h = {request.augmentation.name}"
         name += f"<br>{_rest_used(request)}" if a == "posture" else ""
-        name += f", {failed} starts failed (blank)" if failed else ""
+        what = "run" if P > 1 else "start"  # (with scales: a start on one scaled path)
+        name += f", {failed} {what}{'' if failed == 1 else 's'} failed (blank)" if failed else ""
         if a in outside:
             name += f"<br>{outside[a]} of {P * N} runs left the joint limits"
         where = dict(xanchor="center", yanchor="bottom")
