@@ -185,9 +185,9 @@ def maps_report(
 ) -> dict:
     """E1 (13) and E2 (18) of each of ``maps`` ((name, build) pairs, ``build()`` the map):
     ``{"kind": "alternatives", "maps": [{"name", "current", "E1", "E2"}]}`` (``current``: the
-    map named so), by :func:`functional_value`, none of a map that solves a problem per point;
-    ``progress`` told after each map (two evaluations a map) and polled before each
-    (:class:`~jik.engine.exceptions.RunCancelled`)."""
+    map named so; ``E1_divergent`` True where E1 = inf), by :func:`functional_value`, none of a
+    map that solves a problem per point; ``progress`` told after each map (two evaluations a
+    map) and polled before each (:class:`~jik.engine.exceptions.RunCancelled`)."""
     rows = []
     for m, (name, build) in enumerate(maps):
         check_cancelled(progress, "E1, E2 of the robot's maps")
@@ -195,7 +195,10 @@ def maps_report(
         if not amap.solves_per_point:
             row: dict = {"name": name, "current": name == current}
             for key in ("E1", "E2"):
-                row[key] = functional_value(key, kinematics, amap, region, nodes, fixed)[key]
+                value = functional_value(key, kinematics, amap, region, nodes, fixed)
+                row[key] = value[key]
+                if value.get(f"{key}_divergent"):  # (E1 = inf: dh K = 0 inside)
+                    row[f"{key}_divergent"] = True
             rows.append(row)
         if progress is not None:
             progress.advance(2 * m + 2, 2 * len(maps))

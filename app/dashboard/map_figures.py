@@ -228,11 +228,26 @@ def sensitivity_spec(
         maps = sens["maps"]
         names = [m["name"] + (" (current)" if m["current"] else "") for m in maps]
         data = [_bars(maps, k, names) for k in ("E1", "E2")]
+        # (a functional without a bar says why at its map's foot: ∞, or undefined)
+        missing = [
+            note(
+                f"{k} {'= ∞' if m.get(f'{k}_divergent') else 'undefined'}",
+                n,
+                0,
+                color=E_COLORS[k],
+                xref="x",
+                yanchor="bottom",
+            )
+            for m, n in zip(maps, names, strict=True)
+            for k in ("E1", "E2")
+            if m[k] is None
+        ]
         return figure(
             data,
             f"E1 (13), E2 (18) of the maps of this robot<br><sup>{aug} has no parameters: "
             "the alternatives on the same box</sup>",
             barmode="group",
+            annotations=missing,
             yaxis=dict(
                 title="E (log)", **log, **log_ticks([m[k] for m in maps for k in ("E1", "E2")])
             ),

@@ -298,6 +298,10 @@ def test_sensitivity_without_parameters_compares_the_alternatives(path_result):
     fig = panel(path_result, "sensitivity", sensitivity=sens)
     go.Figure(fig.to_dict())
     assert "no parameters" in fig.layout.title.text
+    # E1 of paper_cubic diverges (dh K = 0 inside): no bar, and its map's foot says so.
+    assert current["E1"] is None and current["E1_divergent"]
+    assert [a.text for a in fig.layout.annotations] == ["E1 = ∞"]
+    assert fig.layout.annotations[0].x == "paper_cubic (current)"
     assert [t.name for t in fig.data] == ["E1", "E2"]
     assert "computing" in panel(path_result, "sensitivity", sensitivity=None).layout.title.text
 
