@@ -180,7 +180,9 @@ COMMON = (
         "x0",
         "numbers",
         False,
-        "start configuration (default 0.5, or the middle of a range without it)",
+        "start configuration (default 0.5, or the middle of a range without it; where the "
+        "task is undefined or overflows there, the first point of the ranges' Halton sequence "
+        "where it is defined)",
     ),
     DefinitionField("target", "numbers", False, "default target of a solve"),
     DefinitionField("path", "points", False, "default closed path (task points)"),
