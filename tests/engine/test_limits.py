@@ -160,8 +160,10 @@ def test_a_robot_reports_its_runs_limits():
 def test_a_report_says_where_its_run_went_farthest_and_whether_it_ends_outside():
     """The first violation can be a small one: the report also names the farthest excursion
     (when it is another) and whether the run ends outside the limits. A Panda run in discrete
-    mode at gamma = 1 toward a half turn of rz first passes joint 7's limit by 0.55 rad, goes
-    89 rad below joint 1's, and converges there."""
+    mode at gamma = 1 toward a half turn of rz first passes joint 7's upper limit by 0.55 rad,
+    then goes tens of radians beyond a limit (which joint, and where it converges, depends on
+    the round-off of numpy's versions: Newton steps of radians near the rotation cut) and ends
+    there."""
     legs = [np.array([[0.0, 0, 1.1], [-3.0, 0, 1.0], [0.5, 0, 1.0]])]
     back = legs_report(LIMITS, [0, 0, 1], legs, 1, NAMES)
     assert (back.violation.name, back.farthest.name, back.ends_outside) == ("x1", "x1", False)
@@ -175,20 +177,23 @@ def test_a_report_says_where_its_run_went_farthest_and_whether_it_ends_outside()
     target[5] = 3.14
     run = solve(panda.inverse("pseudoinverse"), x0, target, mode="discrete", gamma=1.0)
     report = panda.limits_report(run)
-    assert run.success and report.ends_outside
-    first, far = report.violation, report.farthest
+    assert run.success and run.trajectory is not None
+    X, (lo, hi) = run.trajectory.x, panda.kinematics.joint_limits.T
+    excess = np.maximum(np.maximum(lo - X, X - hi), 0.0)
+    i, j = np.unravel_index(int(np.argmax(excess)), excess.shape)
+    far = report.farthest
+    assert (far.joint, far.value) == (j, X[i, j]) and excess[i, j] > 10
+    assert report.ends_outside == bool(np.any((X[-1] < lo) | (X[-1] > hi)))
+    assert report.ends_outside
+    first = report.violation
     assert (first.name, first.bound) == ("x7 (panda_joint7)", "upper")
-    assert (far.name, far.bound, far.value) == (
-        "x1 (panda_joint1)",
-        "lower",
-        run.trajectory.x[:, 0].min(),
-    )
-    assert far.value < -90
+    assert first.value == pytest.approx(3.444, abs=1e-3)
+    beyond = abs(far.value - far.limit)
     assert report.sentence("J^P#", "Franka Panda").endswith(
-        f"farthest on the way to the target: x1 (panda_joint1) = {far.value:.4g}, "
-        f"{far.limit - far.value:.4g} below its lower limit -2.897; it ends outside them."
+        f"farthest on the way to the target: {far.name} = {far.value:.4g}, {beyond:.4g} "
+        f"{far.side} limit {far.limit:.4g}; it ends outside them."
     )
-    assert report.as_dict()["farthest"]["joint"] == 0
+    assert report.as_dict()["farthest"]["joint"] == j
 
 
 CHAIN = {"name": "planar_chain", "joints": "RRR", "lengths": [1, 0.8, 0.6]}
