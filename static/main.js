@@ -5,7 +5,8 @@ import { change, endOnClose, follow, openSession, session, api } from "./api.js"
 import { onNotSent, showControls, showRefusal, showStopped } from "./controls.js";
 import { $, el, fmt, withErrataLinks } from "./dom.js";
 import { robotEditor } from "./editor.js";
-import { algorithmKey, applyFunctionals, drawFigures, layoutPanels, markStale, onAhead, setExportNote, showChosen } from "./panels.js";
+import { setExportNote } from "./panel_exports.js";
+import { algorithmKey, applyFunctionals, drawFigures, layoutPanels, markStale, onAhead, showChosen } from "./panels.js";
 import { atlasPanel, atlasState } from "./atlas.js";
 import { afterSecond, cancelSecond, clearCancelled, secondWanted } from "./second.js";
 
