@@ -4,23 +4,18 @@ import { el, withErrataLinks } from "./dom.js";
 import { saveImage, saveTable } from "./panel_exports.js";
 
 // (not plotly's `responsive`: its resize sizes a figure to its panel, height too, and a panel's
-// height follows its figure, so every figure fell to the panel's least height)
+// height follows its figure, so every figure fell to the panel's least height: followWidth)
 export const PLOT_CONFIG = { responsive: false, displaylogo: false };
 
-// A window resize gives each drawn panel's figure its panel's new width, its own height kept,
-// once per frame.
-let resizing = false;
-window.addEventListener("resize", () => {
-  if (resizing) return;
-  resizing = true;
-  requestAnimationFrame(() => {
-    resizing = false;
-    for (const div of document.querySelectorAll(".panels .js-plotly-plot")) {
-      const width = parseFloat(getComputedStyle(div).width);
-      if (width && div.layout) Plotly.relayout(div, { width, height: div.layout.height });
+// A drawn figure follows its panel's width (``measure(div)``), its own height kept.
+export function followWidth(div, measure) {
+  new ResizeObserver(() => {
+    const width = measure(div);
+    if (div.layout && div._fullLayout && width && Math.abs(div._fullLayout.width - width) > 1) {
+      Plotly.relayout(div, { width, height: div.layout.height });
     }
-  });
-});
+  }).observe(div);
+}
 
 // The page's configuration (/api/dashboard/config): colours, labels, line styles, panels' help.
 let CONFIG = { colors: {}, labels: {}, styles: {}, panels: [] };
@@ -210,7 +205,13 @@ export function panelHead(div, key, plot = true, legend = null) {
     info, ...(plot ? [save("png"), save("svg")] : [csv]));
   div.prepend(el("div", { className: "panel-head" }, legend || algorithmKey(), tools), help);
 }
-const panelTools = (div, key) => panelHead(div, key, true);
+// A plot's head, and its width following the panel's (as plotly measures a panel when it draws).
+function panelTools(div, key) {
+  panelHead(div, key, true);
+  if (div.dataset.follows) return;
+  div.dataset.follows = "on";
+  followWidth(div, (d) => parseFloat(getComputedStyle(d).width));
+}
 
 export const drawn = {}; // panel -> digest of the figure on screen
 export async function drawFigures(figures, digests = {}, robot = null) {
