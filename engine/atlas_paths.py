@@ -62,17 +62,16 @@ def path_family(kin, base_path: FloatArray, shifts, scales) -> tuple[FloatArray,
             "magnitude, which a solve does not take",
             field="shifts" if shifts is not None else "scales",
         )
-    _check_reachable(kin, base_path, shift, scale, shifts is not None, scales is not None)
+    _check_reachable(kin, paths, base_path, scale, shifts is not None, scales is not None)
     return paths, None if shifts is None else len(scale)
 
 
-def _check_reachable(kin, base_path, shift, scale, shifted: bool, scaled: bool) -> None:
+def _check_reachable(kin, paths, base_path, scale, shifted: bool, scaled: bool) -> None:
     """Refuse a family whose shift or scale moves a point of the path out of the task's range
     where that is known without solving (a pose task's rotation coordinates beyond pi:
     :meth:`~jik.engine.kinematics.Kinematics.check_target`), naming ``shifts.s`` or
     ``scales.q`` (a scale when it alone moves the point out) and the point; the base path is
-    checked as ``path``."""
-    paths = family(base_path, shift, scale)
+    checked as ``path``; ``paths``: the family (:func:`family`)."""
     if not _fails(kin, paths):
         return
     for j, path in enumerate(paths):
@@ -81,7 +80,8 @@ def _check_reachable(kin, base_path, shift, scale, shifted: bool, scaled: bool) 
         except InvalidInputError as error:
             s, q = divmod(j, len(scale))
             alone = scaled and (
-                not shifted or _fails(kin, family(base_path, 0 * shift[:1], scale[q : q + 1]))
+                not shifted
+                or _fails(kin, family(base_path, np.zeros((1, kin.r)), scale[q : q + 1]))
             )
             field = f"scales.{q}" if alone else f"shifts.{s}"
             point = int((error.field or "path.0").rpartition(".")[2])

@@ -217,10 +217,11 @@ def _decay_rate(inverse: Inverse, x: FloatArray) -> FloatArray:
     inverse that is not a right inverse: along de/dtau = -J J# e, ||e|| falls at least at the
     least eigenvalue of the symmetric part of J J# (damped least squares: sigma^2 / (sigma^2 +
     lambda^2) for the least singular value sigma of J); within [1e-3, 1], 1 where unknown."""
-    n, r = len(x), inverse.kinematics.r
+    (n, p), r = x.shape, inverse.kinematics.r
     J = inverse.kinematics.jacobian_unchecked(x)
-    columns = [inverse.apply_masked(x, np.broadcast_to(np.eye(r)[i], (n, r)))[0] for i in range(r)]
-    M = J @ np.stack(columns, axis=-1)  # (n, r, r): J J#
+    # J# e_i for each unit task vector e_i, in one batch: row (k, i) is start k's column i
+    columns = inverse.apply_masked(np.repeat(x, r, axis=0), np.tile(np.eye(r), (n, 1)))[0]
+    M = J @ np.swapaxes(columns.reshape(n, r, p), -1, -2)  # (n, r, r): J J#
     with np.errstate(all="ignore"):
         least = np.linalg.eigvalsh(0.5 * (M + np.swapaxes(M, -1, -2)))[..., 0]
     return np.where(np.isfinite(least), np.clip(least, 1e-3, 1.0), 1.0)

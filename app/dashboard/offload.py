@@ -83,7 +83,7 @@ class OffloadLane:
                 self._syntheses = {key: future}
                 future.add_done_callback(lambda f: self._synthesized(key, f))
         while True:
-            try:
+            try:  # (kept here too: the done callback may run after this wait returns)
                 keep_syntheses(future.result(timeout=0.1))
                 return True
             except concurrent.futures.TimeoutError:
