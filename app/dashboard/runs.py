@@ -1,10 +1,12 @@
 """One algorithm driven through the legs of a task, point by point, by the engine's one cycle
-loop (:func:`jik.engine.repeatability.repeatability`, legs by eq. (7)), and the result of both
-algorithms for one state (:class:`DashboardResult`)."""
+loop (:func:`jik.engine.repeatability.repeatability`, legs by eq. (7)), the unicycle's platform
+paths of a run (:class:`PlatformPaths`), and the result of every chosen algorithm for one state
+(:class:`DashboardResult`)."""
 
 from __future__ import annotations
 
 import functools
+import operator
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
@@ -24,15 +26,48 @@ from ...engine.unicycle import Unicycle
 from .controls import max_iterations
 from .joint_limits import run_limits
 from .model import DashboardState
-from .platform import PlatformPaths
 from .robots import state_inverse, state_kinematics
 
 #: Time grid points of one unicycle platform path q(t).
 UNICYCLE_TIME_POINTS = 96
+#: Paths kept per run: the task panel and the scene draw a few spaced iterations.
+KEPT = 256
 
 
 class Cancelled(Exception):
     """A newer change superseded the computation."""
+
+
+class PlatformPaths:
+    """q(t) on the time grid ``t`` for the controls of each iteration ``x`` (m, 4) of a run,
+    indexed like an array of shape (m, T, 3): ``P[i]``, ``P[i, :, 0]``, ``P[-1]``, ``len(P)``.
+    A path is computed (:meth:`jik.engine.unicycle.Unicycle.path`) when its iteration is first
+    asked for, and kept (:data:`KEPT` of them): a long discrete run has 10^5 iterations, of
+    which a dozen are drawn."""
+
+    def __init__(self, kinematics, x: np.ndarray, t: np.ndarray) -> None:
+        self._kinematics, self._x, self._t = kinematics, np.asarray(x), np.asarray(t)
+        self._kept: dict[int, np.ndarray] = {}
+
+    def __len__(self) -> int:
+        return len(self._x)
+
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        return len(self._x), len(self._t), 3
+
+    def __getitem__(self, key):
+        i, rest = (key[0], key[1:]) if isinstance(key, tuple) else (key, ())
+        i = operator.index(i)
+        i += len(self) if i < 0 else 0
+        if not 0 <= i < len(self):
+            raise IndexError(f"iteration {i} of a run of {len(self)}")
+        path = self._kept.get(i)
+        if path is None:
+            path = self._kinematics.path(self._x[i], self._t)
+            if len(self._kept) < KEPT:
+                self._kept[i] = path
+        return path[rest] if rest else path
 
 
 @dataclass(frozen=True)
