@@ -18,8 +18,9 @@ from ...engine.functional_report import (
     parameters_report,
 )
 from ...engine.progress import ProgressCallbacks
+from .algorithms import cache_key
 from .analysis import expensive_map, kinematics_and_map, vector_note
-from .model import DashboardState, cache_key, robot_and_map
+from .model import DashboardState, robot_and_map
 from .robots import state_spec
 from .runs import Cancelled, DashboardResult
 

@@ -86,10 +86,6 @@ def sse_pieces(event: Event) -> Iterator[bytes]:
         text = ""
 
 
-def digest(text: str) -> str:
-    return hashlib.md5(text.encode()).hexdigest()[:16]
-
-
 def to_json(obj) -> str:
     """``obj`` as JSON, NaN and infinities as null (the engine's ``json_values``): the one place
     where a dashboard's results become JSON (events, exports), so that an undefined h or a diverged
@@ -100,7 +96,8 @@ def to_json(obj) -> str:
 def with_figures(message: dict, figures: Mapping[str, str]) -> str:
     """The JSON of ``message`` with the "digests" of already serialized figures (the page
     redraws a panel only when its digest changed) and a "figures" object of them."""
-    message = {**message, "digests": {k: digest(t) for k, t in figures.items()}}
+    digests = {k: hashlib.md5(t.encode()).hexdigest()[:16] for k, t in figures.items()}
+    message = {**message, "digests": digests}
     body = ",".join(f'"{k}":{t}' for k, t in figures.items())
     return to_json(message)[:-1] + ',"figures":{' + body + "}}"
 

@@ -41,7 +41,6 @@ from .algorithms import (
     checked,
     checked_rest,
 )
-from .algorithms import cache_key as cache_key  # (re-exported: the figures' caches import it)
 from .control_changes import expand
 from .controls import (
     MAX_DASHBOARD_CYCLES,

@@ -222,8 +222,13 @@ class SecondPhaseControl(Listeners):
             self._grid_before = grid_before
         try:
             functionals, sens = phase.run()
-        except Cancelled:
-            self._second_stopped(generation, phase)
+        except Cancelled:  # (by a newer change, whose result follows, or cancelled)
+            with self._cond:
+                if self._generation != generation:
+                    return
+                self.result = phase.result  # (the grid kept when it was done)
+                self._second_cancelled = generation
+            self._emit(Event("functionals", generation, cancelled_message(phase, generation)))
             return
         finally:
             with self._cond:
@@ -237,17 +242,6 @@ class SecondPhaseControl(Listeners):
             self.result, self.functionals = phase.result, functionals
         data = finished_message(phase, generation, functionals, sens)
         self._emit(Event("functionals", generation, data))
-
-    def _second_stopped(self, generation: int, phase: SecondPhase) -> None:
-        """A second phase stopped: by a newer change (nothing to say: its result follows), or
-        cancelled (:meth:`cancel_second_phase`): a ``functionals`` event that says so, the grid
-        kept when it was done (:func:`cancelled_message`)."""
-        with self._cond:
-            if self._generation != generation:
-                return
-            self.result = phase.result
-            self._second_cancelled = generation
-        self._emit(Event("functionals", generation, cancelled_message(phase, generation)))
 
     def cancel_second_phase(self, generation: int) -> bool:
         """Stop the second phase of ``generation`` (E1, E2, their sensitivity, h on a grid) at

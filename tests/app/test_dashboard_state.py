@@ -20,8 +20,8 @@ from jik.app.dashboard import (
     runs_key,
     updated_state,
 )
+from jik.app.dashboard.algorithms import cache_key
 from jik.app.dashboard.functionals import functionals_key
-from jik.app.dashboard.model import cache_key
 from jik.app.dashboard.robots import state_kinematics
 from jik.app.dashboard.verdict import verdict
 from jik.engine.exceptions import InvalidInputError
