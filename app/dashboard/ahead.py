@@ -39,18 +39,14 @@ class SolvingAhead(Listeners):
     _panel_texts: Callable[..., dict[str, str]]
 
     def _prefetch(self, generation: int) -> None:
-        """While no change comes, solve the other robots' default states into the run cache:
-        switching robot starts from those defaults (:func:`updated_state`), so the switch then
-        only draws (Manipulator 1: ~90 ms of computation less in the browser test).
+        """While no change comes, solve the other robots' (:data:`PREFETCH_ROBOTS`) default
+        states into the run cache, any change cancelling it between legs: a switch of robot
+        starts from those defaults (:func:`updated_state`), so it then only draws.
 
-        Each is announced by an ``ahead`` event with the figures the switch will show: the
-        page draws them off screen and shows them on the switch (when they are the same), the
-        3D scene builds the robot's nodes, hidden (from the event's result, given when the
-        runs were solved now). A robot is announced again after every switch of robot (the
-        page has shown what it drew ahead); meanwhile its figures stay the same (no sticky
-        axes or known E1/E2 carry over from another robot) and nothing is done again.
-
-        Only :data:`PREFETCH_ROBOTS`; any change cancels it between legs.
+        Each is announced by an ``ahead`` event with the figures the switch will show (the
+        page draws them off screen; the 3D scene builds the robot's nodes, hidden, from the
+        event's result, given when the runs were solved now), again after every switch of
+        robot; meanwhile its figures stay the same and nothing is done again.
         """
 
         for robot in PREFETCH_ROBOTS:
@@ -68,8 +64,6 @@ class SolvingAhead(Listeners):
             try:
                 _, amap = kinematics_and_map(state)
                 result = self._solved(state, generation, with_augmenting=not expensive_map(amap))
-                # The figures as the switch will make them (see _compute; no panel to reuse
-                # from another robot).
                 cached, stale = self._known_functionals(state)
                 functionals, sens = cached or (None, None)
                 texts = self._panel_texts(

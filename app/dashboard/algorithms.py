@@ -1,16 +1,8 @@
 """Which inverses J# the dashboard runs: the chosen algorithms of the engine's catalogue
-(:data:`jik.engine.registry.ALGORITHMS`), their parameters, and how each is drawn everywhere.
-
-A state chooses one to five algorithms (``algorithms``, default the paper's two, eqs. (8) and
-(11)) and holds the scalar parameters of the chosen ones (``algorithm_parameters``: ``damping``
-and ``damping_threshold`` of damped least squares, ``gain`` of the posture inverse), with their
-ranges from the engine's :class:`~jik.engine.parameters.Parameter` (:func:`checked`), and the
-posture inverse's rest x_rest (``rest``: :func:`checked_rest`, :func:`editable_rest`); an
-algorithm the robot cannot run (the weighted inverse without joint limits) is refused by
-:func:`check_inverses`.
-:data:`STYLES` gives each algorithm one colour, line style, marker, label and 3D copy, used by
-the scene, every plot, the drift panel and the atlas. :func:`cache_key` says what one
-algorithm's run depends on (its own parameters included).
+(:data:`jik.engine.registry.ALGORITHMS`, default the paper's two, eqs. (8) and (11)), their
+parameters (the scalars with the engine's ranges, :func:`checked`; the posture inverse's rest
+x_rest, :func:`checked_rest`), how each is drawn everywhere (:data:`STYLES`), and what one
+algorithm's run depends on (:func:`cache_key`).
 """
 
 from __future__ import annotations
@@ -204,13 +196,8 @@ def checked(algorithms: tuple[str, ...], given: Mapping[str, Any]) -> dict[str, 
 
 def joint_box(spec, kin) -> tuple[tuple[float, float], ...]:
     """The range of each slider of a joint configuration, x0's and the posture rest's (what
-    :func:`checked_rest` accepts): the robot's joint limits
-    (:func:`~jik.engine.limits.robot_limits`), its ``x_range`` (an arm's joint limits) else
-    :data:`DEFAULT_BOX` on a side without a limit (a continuous joint; the whole range for a
-    robot without limits), or that range's width beyond a finite limit it lies on the other
-    side of (:func:`~jik.engine.limits.limited_box`). A start outside the limits, which the
-    engine accepts and reports as leaving them at cycle 0 (:mod:`jik.engine.limits`), is typed
-    in x0's exact-value boxes."""
+    :func:`checked_rest` accepts): the robot's joint limits, its ``x_range`` else
+    :data:`DEFAULT_BOX` on a side without a limit (:func:`~jik.engine.limits.limited_box`)."""
     x_range = spec.x_range or (DEFAULT_BOX,) * len(spec.variable_names)
     box = limited_box(x_range, robot_limits(kin))
     return tuple((float(a), float(b)) for a, b in box)
@@ -219,12 +206,9 @@ def joint_box(spec, kin) -> tuple[tuple[float, float], ...]:
 def checked_rest(value, spec, kin, x0) -> tuple[float, ...] | None:
     """The posture inverse's rest x_rest as set (``algorithm_parameters.rest``), checked: p
     finite numbers, within the robot's joint limits if it has some (the engine's
-    :func:`~jik.engine.practical_inverses.check_rest`, in its words) and within the range of
-    its sliders (:func:`joint_box`; the only bound of a robot without limits, whose REST API
-    runs take any finite rest); None when it is the robot's home, the default in force
-    (:func:`~jik.engine.algorithm_registry.default_rest`), so the state holds no copy of it.
-    A rest equal to the start ``x0`` (the default of a robot without a home) stays set: the
-    default would follow the start as it moves, the rest set does not.
+    :func:`~jik.engine.practical_inverses.check_rest`) and within the range of its sliders
+    (:func:`joint_box`); None when it is the robot's home, the default in force. A rest equal
+    to the start ``x0`` stays set: the default would follow the start as it moves.
 
     Raises
     ------
@@ -264,9 +248,8 @@ def posture_rest(state: ChosenState, kin) -> tuple[list[float], str]:
 
 def editable_rest(state: ChosenState, spec, kin) -> list[float]:
     """The rest that one rest slider moved changes: the state's, else the default in force
-    brought into the sliders' range (:func:`joint_box`), as the sliders show it. A default
-    outside the joint limits (a start outside them) is accepted as it is, but a rest set is
-    checked: the coordinates the user did not touch take the nearest value accepted."""
+    brought into the sliders' range (:func:`joint_box`), as the sliders show it (a rest set is
+    checked: the coordinates the user did not touch take the nearest value accepted)."""
     rest, source = posture_rest(state, kin)
     if source == "set":
         return rest
@@ -299,8 +282,7 @@ def rest_words(state: ChosenState, spec, inverse) -> str:
 
 def inverse_parameters(state: ChosenState, algorithm: str) -> dict[str, Any]:
     """What the engine's ``make_inverse`` takes for ``algorithm``: its scalars, and the posture
-    inverse's rest when the state sets one (else the engine's default at the state's start:
-    :func:`~jik.app.dashboard.robots.state_inverse` passes it)."""
+    inverse's rest when the state sets one."""
     names = REGISTRY[algorithm].names
     return {k: v for k, v in state.algorithm_parameters.items() if k in names}
 
@@ -335,9 +317,6 @@ def cache_key(state: ChosenState, algorithm: str) -> str:
 
 
 def runs_key(state: ChosenState) -> tuple[str, ...]:
-    """Everything the runs of the chosen algorithms depend on, up to the scale of theta.
-
-    Two states with the same key have the same configurations along the same legs (in
-    continuous mode gamma only divides theta).
-    """
+    """Everything the runs of the chosen algorithms depend on, up to the scale of theta (in
+    continuous mode gamma only divides theta)."""
     return tuple(cache_key(state, a) for a in state.algorithms)

@@ -1,12 +1,6 @@
-"""A change of the dashboard's controls as a change of its state.
-
-:func:`expand` turns a patch keyed by control keys (``{"x0.1": 0.4}``,
-``{"robot_parameters.l": 1.2}``, ``{"path": "1, 1; 1, 2"}``) into a patch of the state's fields
-(:func:`jik.app.dashboard.model.updated_state` applies it), one coordinate of the posture
-inverse's rest (``{"algorithm_parameters.rest.1": 0.4}``) or the rest set to the start
-(``{"algorithm_parameters.rest": "x0"}``) included; :func:`path_text` and
-:func:`parse_path_text` write a closed path as text and read it back (:func:`path_format`), the
-one text format of the path box on the page and in the scene: a point per line.
+"""A change of the dashboard's controls as a change of its state (:func:`expand`), and the one
+text format of a closed path, in the page's and the scene's path box (:func:`path_text`,
+:func:`parse_path_text`, :func:`path_format`): a point per line.
 """
 
 from __future__ import annotations
@@ -33,17 +27,15 @@ DISCRETE_GAMMA_ON_SWITCH = 1.0
 
 
 def expand(state, patch: Mapping[str, object]) -> dict[str, object]:
-    """A patch of control keys as a patch of the state's fields: ``{"x0.1": v}`` sets one
-    coordinate of x0, ``{"robot_parameters.l": v}`` one parameter, ``{"path": "1, 1; 1, 2"}``
-    the path from its text (:func:`path_format`), ``{"algorithm_parameters.rest.1": v}`` one
-    coordinate of the posture inverse's rest in force (a default outside the joint limits
-    brought into them first, :func:`~jik.app.dashboard.algorithms.editable_rest`),
-    ``{"algorithm_parameters.rest": "x0"}`` the rest at the start x0 (the patch's, else the
-    state's): None, the default that follows x0, on a robot without a home,
-    ``{"target": "0.3, 0, 0.6, 0, 0, 0"}`` a vector from its text (:func:`parse_vector_text`:
-    the scene's box of a vector of more than three numbers).
-    Switching to discrete mode without a gamma takes gamma down to
-    :data:`DISCRETE_GAMMA_ON_SWITCH` when it is above."""
+    """A patch of control keys as a patch of the state's fields (which
+    :func:`jik.app.dashboard.model.updated_state` applies): ``{"x0.1": v}`` sets one coordinate
+    of x0, ``{"robot_parameters.l": v}`` one parameter, ``{"path": "1, 1; 1, 2"}`` the path from
+    its text, ``{"algorithm_parameters.rest.1": v}`` one coordinate of the posture inverse's rest
+    in force (:func:`~jik.app.dashboard.algorithms.editable_rest`),
+    ``{"algorithm_parameters.rest": "x0"}`` the rest at the start x0 (None, the default that
+    follows x0, on a robot without a home), ``{"target": "0.3, 0, 0.6, 0, 0, 0"}`` a vector from
+    its text (:func:`parse_vector_text`). Switching to discrete mode without a gamma takes gamma
+    down to :data:`DISCRETE_GAMMA_ON_SWITCH` when it is above."""
     out: dict[str, Any] = {}
     for key, value in patch.items():
         head, _, rest = key.partition(".")
@@ -117,10 +109,9 @@ def parse_vector_text(text: str, current, key: str) -> list[float]:
 
 
 def path_text(path) -> str:
-    """A path as text, :func:`path_format` with a point per line (:data:`POINT_SEPARATOR`),
-    each coordinate as a user types it: to :data:`DECIMALS`, as the page's number boxes show
-    them (a computed 1.29e-17 as 0). Sent back unchanged, or spaced otherwise, it leaves the path in
-    force exact (:func:`expand`)."""
+    """A path as text, :func:`path_format` with a point per line, each coordinate to
+    :data:`DECIMALS` as the page's number boxes show them (a computed 1.29e-17 as 0). Sent back
+    unchanged, or spaced otherwise, it leaves the path in force exact (:func:`expand`)."""
     return POINT_SEPARATOR.join(", ".join(_number(v) for v in p) for p in path)
 
 

@@ -1,6 +1,6 @@
 """The listeners of a :class:`~jik.app.dashboard.session.Dashboard` (the page's event stream,
 the 3D scene): subscribing with the latest events replayed, telling every listener of an event,
-and waiting for a generation's computation. A part of the dashboard, sharing its lock."""
+and waiting for a generation's computation."""
 
 from __future__ import annotations
 

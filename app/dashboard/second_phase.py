@@ -37,25 +37,12 @@ FUNCTIONALS = "E1/E2 and their sensitivity"
 
 
 class SecondPhase:
-    """The second phase of ``result``: run it with :meth:`run`.
-
-    Parameters
-    ----------
-    kin, amap : the state's kinematics and augmenting map h
-    result : DashboardResult
-        Its runs; without h on a grid when ``deferred``.
-    deferred : bool
-        h on a grid is computed here (an expensive map).
-    cached : tuple or None
-        E1/E2 and their sensitivity when already known for this state: not computed again.
-    grid_before : dict or None
-        The grid on screen, whose box the new one keeps while it fits.
-    progress : callable
-        ``progress(fraction, what)`` after each step: the fraction of the whole phase done, and
-        :data:`GRID` or :data:`FUNCTIONALS`.
-    cancelled : callable
-        Polled after each step (and before every map the sensitivity builds); True stops the
-        phase with :class:`Cancelled`.
+    """The second phase of ``result`` (its runs, without h on a grid when ``deferred``: an
+    expensive map ``amap``, whose grid is computed here, its box kept from ``grid_before`` while
+    it fits), run by :meth:`run`. ``cached``: E1/E2 and their sensitivity when already known, not
+    computed again. ``progress(fraction, what)`` after each step: the fraction of the whole phase
+    done, and :data:`GRID` or :data:`FUNCTIONALS`; ``cancelled()`` is polled after each step (and
+    before every map the sensitivity builds): True stops the phase with :class:`Cancelled`.
     """
 
     def __init__(
@@ -80,9 +67,8 @@ class SecondPhase:
         self.fraction = 0.0
 
     def _step(self, what: str, before: int) -> Callable[[float, float], None]:
-        """The progress callback of a stage that starts after ``before`` steps: ``(done, _)``
-        of its own steps. It reports the fraction of the whole phase and raises
-        :class:`Cancelled` when the phase is cancelled."""
+        """The progress callback ``(done, _)`` of a stage that starts after ``before`` steps;
+        it raises :class:`Cancelled` when the phase is cancelled."""
         whole = max(1, sum(self.steps.values()))
 
         def step(done: float, _total: float) -> None:
@@ -202,12 +188,10 @@ class SecondPhaseControl(Listeners):
         cached,
         grid_before: dict | None,
     ) -> None:
-        """h on a grid when it is expensive, then E1 and E2 (quadrature) and their sensitivity
-        (:class:`SecondPhase`), unless a newer change comes meanwhile: ``progress`` events
-        (``"phase": "second"``, what is computed) and a ``functionals`` event at the end, or,
-        when :meth:`cancel_second_phase` stopped it, one that says so (``cancelled``); see
-        :func:`~jik.app.dashboard.second_phase.finished_message` for known functionals.
-        """
+        """Run :class:`SecondPhase`, unless a newer change comes meanwhile: ``progress`` events
+        (``"phase": "second"``) and a ``functionals`` event at the end (:func:`finished_message`),
+        or, when :meth:`cancel_second_phase` stopped it, one that says so
+        (:func:`cancelled_message`)."""
         phase = SecondPhase(
             kin,
             amap,
