@@ -1,10 +1,7 @@
-"""What the h panel shows beside the runs: the state's augmenting map h, built from the registry,
-and h on a grid over the two joint variables it depends on most (its box following the runs).
-The error functionals E1 (13), E2 (18) on that grid are :mod:`jik.app.dashboard.functionals`.
-A catalogue arm's map (or a definition's ``e2_synthesized`` one) is synthesized on first use,
-eq. (19) (:mod:`jik.engine.robot_synthesis`), in a compute worker when the server runs its pool
-(:func:`synthesized_maps`): :func:`built_map` shows its progress and stops it on a newer change;
-once built, the map is kept with the robot."""
+"""What the h panel shows beside the runs: the state's augmenting map h, built from the registry
+(a synthesized map, eq. (19), made on first use by :func:`built_map`, in a compute worker when
+the server runs its pool), and h on a grid over the two joint variables it depends on most (its
+box following the runs)."""
 
 from __future__ import annotations
 
@@ -70,12 +67,9 @@ def built_map(
 ) -> tuple:
     """:func:`state_maps` of ``state``, a synthesis on the way reporting
     ``progress(fraction, SYNTHESIZING)`` and stopped by ``cancelled()`` (then
-    :class:`Cancelled`, nothing kept).
-
-    With ``elsewhere`` (the dashboard's lane of the compute pool,
-    :meth:`~jik.app.dashboard.offload.OffloadLane.synthesize`), a synthesis is made there
-    (its progress not known: ``progress(None, ...)``) and kept in this process; only where it
-    returns False (no pool running) is it made here."""
+    :class:`Cancelled`, nothing kept). With ``elsewhere``
+    (:meth:`~jik.app.dashboard.offload.OffloadLane.synthesize`) a synthesis is made there, its
+    progress not known (``progress(None, ...)``), unless that returns False (no pool running)."""
     report = ProgressCallbacks(
         on_advance=lambda done, total: progress(min(done / total, 1.0), SYNTHESIZING),
         is_cancelled=cancelled,
@@ -159,17 +153,13 @@ def augmenting_grid(
     before: dict | None = None,
     progress: Callable[[int, int], None] = lambda done, total: None,
 ):
-    """h on a grid over the two variables it depends on most, other variables at x0.
+    """h on a grid over the two variables it depends on most, other variables at x0; None when
+    h cannot be evaluated on the grid.
 
-    The box covers both trajectories with a margin, clipped to the robot's x_range. The box of
-    ``before`` (the grid on screen) is kept while the trajectories lie inside it and span at
-    least :data:`BOX_FILL` of it, like the other panels' axes
-    (:func:`jik.app.dashboard.plotting.keep_ranges`): a small change then gives the same grid,
-    often the same h, and the page moves only the trajectories. Returns None when h cannot be
-    evaluated on the grid.
-
-    ``progress(done, total)``: after each of the :func:`grid_batches` steps; what it raises
-    (:class:`~jik.app.dashboard.runs.Cancelled`) stops the grid there.
+    The box is :func:`runs_box`'s; the box of ``before`` (the grid on screen) is kept while the
+    trajectories lie inside it and span at least :data:`BOX_FILL` of it, like the other panels'
+    axes (:func:`jik.app.dashboard.plotting.keep_ranges`). ``progress(done, total)``: after each
+    of the :func:`grid_batches` steps; what it raises (:class:`Cancelled`) stops the grid there.
     """
     try:
         _, amap = kinematics_and_map(state, kin)
@@ -184,7 +174,6 @@ def augmenting_grid(
         i, j = axes_along(amap, xs, GRID_BATCH, step(0))
         low, high = runs_box(state, runs)
         box = [(float(low[k]), float(high[k])) for k in (i, j)]
-        # (fewer for a map that solves a collocation problem per point)
         n = EXPENSIVE_GRID_POINTS if expensive_map(amap) else GRID_POINTS
         if before is not None and tuple(before["axes"]) == (i, j) and before["n"] == n:
             inside = all(

@@ -2,10 +2,7 @@
 
 A change (:func:`updated_state`) is a patch of state fields or of control keys
 (:func:`jik.app.dashboard.control_changes.expand`); each refusal names its field
-(:attr:`jik.engine.exceptions.InvalidInputError.field`). The chosen algorithms and their
-parameters are checked by :mod:`jik.app.dashboard.algorithms`, which also says what a run
-depends on (``cache_key``, ``runs_key``); a change's request body is
-:mod:`jik.app.dashboard.patch`.
+(:attr:`jik.engine.exceptions.InvalidInputError.field`).
 """
 
 from __future__ import annotations
@@ -42,11 +39,7 @@ from .algorithms import (
     checked_rest,
 )
 from .control_changes import expand
-from .controls import (
-    MAX_DASHBOARD_CYCLES,
-    MIN_ITERATIONS,
-    max_iterations,
-)
+from .controls import MAX_DASHBOARD_CYCLES, MIN_ITERATIONS, max_iterations
 from .robots import USER_KINDS, default_definition, state_inverse, state_spec, user_robot
 
 DEFAULT_ROBOT = "manipulator2"

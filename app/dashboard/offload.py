@@ -1,16 +1,11 @@
 """The dashboards' share of the server's one compute pool (:class:`jik.app.compute.pool.
 ComputePool`, whose worker processes also serve the REST API, first come first served).
 
-A map that a change needs synthesized (a definition's ``e2_synthesized``, a catalogue arm's
-default) is made there (:meth:`OffloadLane.synthesize`), within a worker's memory limit.
-
-:func:`jik.app.dashboard.results.compute` runs one algorithm there while the session's thread
-computes the other: on two cores a change costs the slower of the two instead of their sum.
-Each dashboard has a lane (:class:`OffloadLane`); a newer change of its state gives up the
-lane's older runs (their workers finish them and are given back). If a worker dies, or the pool
-runs on no event loop (an app without its lifespan), the run is computed in the calling thread.
-The computations in the sessions' own threads take turns (:class:`FairSlots`): at most ``n`` at
-once, in the order they asked (a session that changes its state again waits behind the others).
+Each dashboard has a lane (:class:`OffloadLane`): the maps a change needs synthesized are made
+there, and :func:`jik.app.dashboard.results.compute` runs one algorithm there while the
+session's thread computes the others; a newer change gives up the lane's older runs. If a worker
+dies, or the pool runs on no event loop, the run is computed in the calling thread. The
+computations in the sessions' own threads take turns (:class:`FairSlots`).
 """
 
 from __future__ import annotations
@@ -51,13 +46,10 @@ class OffloadLane:
 
     def synthesize(self, state, cancelled: Callable[[], bool]) -> bool:
         """Make the E2 syntheses that ``state``'s map needs in the pool
-        (:func:`~jik.app.dashboard.analysis.synthesized_maps`, within a worker's memory and
-        time limits) and keep them in this process. False when the pool is not running (the
-        caller makes them itself).
-
-        While it waits, ``cancelled()`` is polled every 0.1 s: True raises :class:`Cancelled`;
-        the synthesis goes on for the next change that needs the same maps (one of other maps
-        gives it up).
+        (:func:`~jik.app.dashboard.analysis.synthesized_maps`) and keep them in this process;
+        False when the pool is not running (the caller makes them itself). ``cancelled()`` is
+        polled every 0.1 s: True raises :class:`Cancelled`, the synthesis going on for the next
+        change that needs the same maps.
 
         Raises
         ------

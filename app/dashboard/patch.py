@@ -14,11 +14,7 @@ from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, ValidationError,
 from ...engine.exceptions import InvalidInputError
 from ...engine.registry import ROBOTS
 from ...engine.repeatability import MAX_PATH_POINTS
-from ..compute.schemas import (
-    AUGMENTATION_MODELS,
-    USER_AUGMENTATION_MODELS,
-    Coordinate,
-)
+from ..compute.schemas import AUGMENTATION_MODELS, USER_AUGMENTATION_MODELS, Coordinate
 from ..compute.schemas.wording import refusal, refused
 from .algorithms import check_names
 from .model import DashboardState, Number, Numbers, Point, error_location

@@ -1,15 +1,9 @@
-"""The robot of a dashboard state: one of the paper's, or one given by a definition.
-
-A state names one of the paper's robots (``robot``, with ``robot_parameters``), or a kind of
-:mod:`jik.engine.robot_kinds` or a catalogue arm (:mod:`jik.engine.arms`) with its definition
-(``robot_definition``, built by :func:`jik.engine.robot_spec.robot_from_dict`; an arm picked by
-name starts from ``{"name": arm, "task": its default task}``). Every part of the dashboard
-asks here for the state's :class:`~jik.engine.registry.RobotSpec`, its kinematics and its
-inverses, so the two cases differ in this module only. A definition's refusal names its field under
-``robot_definition`` (``robot_definition.lengths.1``), which the page's robot editor shows next
-to the field. A definition that a change brings is first built in a compute worker
-(:func:`vet_definition`), within the workers' time and memory limits and the build budget, so
-that a formula too costly to differentiate is refused before the server builds it itself.
+"""The robot of a dashboard state: one of the paper's (``robot``, with ``robot_parameters``), or
+a kind of :mod:`jik.engine.robot_kinds` or a catalogue arm with its definition
+(``robot_definition``). Every part of the dashboard asks here for the state's
+:class:`~jik.engine.registry.RobotSpec`, its kinematics and its inverses, so the two cases differ
+in this module only. A definition's refusal names its field under ``robot_definition``
+(``robot_definition.lengths.1``).
 """
 
 from __future__ import annotations

@@ -18,12 +18,7 @@ from typing import Any
 
 from .analysis import augmenting_grid, expensive_map, grid_batches, kinematics_and_map
 from .figures import figure_specs
-from .functionals import (
-    error_functionals,
-    functionals_key,
-    sensitivity,
-    sensitivity_evaluations,
-)
+from .functionals import error_functionals, functionals_key, sensitivity, sensitivity_evaluations
 from .listeners import Listeners
 from .map_figures import augmenting_title
 from .messages import Event, with_figures

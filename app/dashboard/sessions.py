@@ -1,17 +1,10 @@
 """Dashboard sessions: one :class:`~jik.app.dashboard.Dashboard` (and its 3D scene) per tab.
 
 Every browser tab creates its own session from the state in its URL; the session's id is a
-random token that only that tab holds, so nobody else sees or changes its state. Sessions are
-bounded in number (``max_sessions`` of :class:`~jik.app.compute.settings.Settings`) and expire
-when idle: a session with no page listening (event stream) and no scene connected, untouched
-for ``session_idle_seconds``, is stopped. When the store is full, the session idle the longest
-makes room; if every session is in use the new one is refused (the route answers 503).
-
-The sessions' computations share the server's one compute pool with the REST API: one
-algorithm of each run goes to its worker processes (each dashboard's
-:class:`~jik.app.dashboard.offload.OffloadLane`, first come first served), and the other is
-computed in the session's own thread, in turns of :class:`~jik.app.dashboard.offload.FairSlots`
-(at most ``dashboard_computations`` at once, in the order asked).
+random token that only that tab holds. Sessions are bounded in number (``max_sessions``) and
+expire when idle: a session with no page listening (event stream) and no scene connected,
+untouched for ``session_idle_seconds``, is stopped. When the store is full, the session idle the
+longest makes room; if every session is in use the new one is refused (the route answers 503).
 """
 
 from __future__ import annotations

@@ -1,10 +1,8 @@
-"""What the page writes above the plots, computed from the result: for each algorithm whether it
-was repeatable on the closed path and by how much, how much h changed along the extended
-Jacobian's run, and why, in sentences the page shows as they are (the engine's
-:mod:`jik.engine.findings`, which says what repeatability is and why the extended Jacobian has
-it, and what the practical inverses beside the paper's two did; the unicycle's undefined map:
-:func:`jik.engine.reproductions.unicycle.undefined_why`), and a warning when h is singular in the
-robot's design region (:func:`singular_points`), so that a large E1 or E2 is not read as a bad fit.
+"""What the page writes above the plots, computed from the result in the engine's sentences
+(:mod:`jik.engine.findings`): for each algorithm whether it was repeatable on the closed path
+and by how much, how much h changed along the extended Jacobian's run, and why, and a warning
+when h is singular in the robot's design region (:func:`singular_points`), so that a large E1 or
+E2 is not read as a bad fit.
 """
 
 from __future__ import annotations
@@ -82,9 +80,8 @@ def _undefined_why(result: DashboardResult, run: AlgorithmRun) -> list[Finding]:
 
 def _practical(result: DashboardResult, unit: str) -> list[Finding]:
     """What the practical inverses' parameters did
-    (:func:`jik.engine.practical_findings.practical_findings`), the posture inverse's rest in
-    the page's words; the weighted inverse's only within the box it took for a robot without
-    joint limits (a robot that declares some has its sentence from
+    (:func:`jik.engine.practical_findings.practical_findings`); the weighted inverse's only for
+    a robot without joint limits (one with some has its sentence from
     :attr:`~jik.app.dashboard.runs.DashboardResult.limits`)."""
     state, out = result.state, []
     for a in (a for a in result.runs if a in PRACTICAL):
