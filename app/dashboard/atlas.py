@@ -1,13 +1,6 @@
-"""The dashboard's atlas panel: a repeatability atlas of the session's current state, and its
-heatmap.
-
-The atlas itself is the REST API's (:mod:`jik.app.compute.atlas_jobs`: the same request model,
-the same jobs and limits); :func:`atlas_request` only says which atlas a state asks for: its
-robot, map, gamma, mode, tolerance and cap on steps per leg, its chosen algorithms and their
-parameters, and the loop the dashboard drives, from k(x0) through the path's points, with the
-starts on the self-motion curve of k(x0) and s = 0 at x0. :func:`atlas_figure` draws a finished
-atlas: drift per cycle (and per path scale, when swept) over the arc length s of the starts, one
-heatmap per algorithm side by side, under one colour scale.
+"""The dashboard's atlas panel: the REST API's repeatability atlas
+(:mod:`jik.app.compute.atlas_jobs`) of the session's current state (:func:`atlas_request`), and
+its heatmap (:func:`atlas_figure`).
 """
 
 from __future__ import annotations

@@ -2,10 +2,6 @@
 unicycle's four), both algorithms' joint paths x(theta), the level surface h(x) = h(x0) that the
 extended Jacobian keeps (eq. (12)), and the self-motion manifolds k(x) = y of the targets of the
 legs (the path's corners): one-dimensional, since p - r = 1 (sec. 2).
-
-A repeatable algorithm's closed task path is a closed curve on the level surface, crossing each
-corner's self-motion manifold where the surface cuts it; the pseudoinverse's path slides along
-those manifolds from cycle to cycle.
 """
 
 from __future__ import annotations

@@ -1,8 +1,6 @@
-"""A dashboard result exported: every point of both runs, as JSON or CSV, with the state that
-produced it, what the page says about it (the verdict), each run's drift and leg ends (and the
-posture inverse's rest x_rest in force, with what it is: set, the home or x0), the units
-of its columns, the jik version and the time of the export; its file is named after the robot,
-the algorithms' settings (map h, mode), the generation and that time."""
+"""A dashboard result exported as JSON or CSV: every point of every run, with the state that
+produced it, the verdict, each run's drift and leg ends, the units of its columns, the jik
+version and the time of the export (:func:`export_file`)."""
 
 from __future__ import annotations
 

@@ -1,16 +1,9 @@
-"""Plotly figures of a dashboard result: pure functions ``DashboardResult -> figure dict``.
-
-Each figure is built as a plain figure dict first (its "spec"): the dashboard serializes those
-directly (:func:`figure_specs`, :func:`figure_json`), 5x faster than through ``go.Figure``
-and ``to_json``, on every change of a control.
-
-Colours, line styles and markers are fixed per algorithm
-(:data:`jik.app.dashboard.algorithms.STYLES`), the same as in the 3D scene and the atlas; every
-panel draws the state's chosen algorithms (``result.runs``, in the catalogue's order).
-The figures follow the paper: task-space paths (Figs. 5, 6, of Manipulator 2), joint
-trajectories against theta (Figs. 7-9), the repeatability drift per cycle with the Table 1
-numbers, and for the unicycle the platform paths in the (q1, q2) plane and the controls against
-the iteration (Figs. 11-14).
+"""Plotly figures of a dashboard result: pure functions ``DashboardResult -> figure dict`` (a
+plain dict, which :func:`~jik.app.dashboard.plotting.figure_json` serializes), each chosen
+algorithm in its style (:data:`jik.app.dashboard.algorithms.STYLES`). They follow the paper:
+task-space paths (Figs. 5, 6, of Manipulator 2), joint trajectories against theta (Figs. 7-9),
+the repeatability drift per cycle, and for the unicycle the platform paths in the (q1, q2)
+plane and the controls against the iteration (Figs. 11-14).
 """
 
 from __future__ import annotations

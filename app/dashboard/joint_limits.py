@@ -1,11 +1,6 @@
 """Whether each run of a dashboard result stayed within its robot's joint limits, and where it
-first left them (:mod:`jik.engine.limits`), for the verdict, the summary and the 3D scene.
-
-The paper's algorithms, eq. (7), know nothing of joint limits: a run is what it is, and the
-dashboard says in words whether it stayed within the limits the robot declares (a URDF arm's, a
-catalogue arm's, a planar chain's or formula robot's ``limits``) and, if not, the first
-violation: the cycle, the leg, the joint, its value and the limit it passed. The scene colours a
-joint while it is outside its limits (:func:`outside_joints`).
+first left them (:mod:`jik.engine.limits`), for the verdict, the summary and the 3D scene (the
+paper's algorithms, eq. (7), know nothing of joint limits).
 """
 
 from __future__ import annotations

@@ -21,17 +21,13 @@ from .runs import DashboardResult
 def augmenting_spec(
     result: DashboardResult, functionals: dict | None = None, cancelled: str | None = None
 ) -> dict:
-    """Contours of the augmenting map h over two joint variables with both trajectories on top.
+    """Contours of the augmenting map h over two joint variables with the runs on top (the
+    extended Jacobian's follows a level curve, eq. (12)); the title carries E1 (13) and E2 (18).
 
-    The extended Jacobian keeps h constant (eq. (12)), so its trajectory follows a level curve;
-    the pseudoinverse crosses them. The title carries E1 (13) and E2 (18) over the plotted box.
-
-    The trajectories and the start x0 are layout shapes over the contour trace, not traces: a
-    change that keeps h on its box then moves them by a relayout of the shapes, a few ms in the
-    page, and the contours stay (plotly's animation of traces would drop a contour's layer, and
-    drawing the panel anew takes ten times as long). Hover gives h; the joint values along
-    the runs are in the joint panel. ``cancelled``: the second phase was cancelled (how), so
-    E1, E2 (and h, without its grid) were not computed.
+    The runs and the start x0 are layout shapes over the contour trace, not traces: a change
+    that keeps h on its box then moves them by a relayout, and the contours stay (plotly's
+    animation of traces would drop a contour's layer). ``cancelled``: the second phase was
+    cancelled (how), so E1, E2 (and h, without its grid) were not computed.
     """
     ju, _ = units(result)
     grid = result.augmenting

@@ -1,11 +1,7 @@
-"""The task-space panel of an arm in space: every task coordinate against the leg's parameter.
-
-An arm's task may hold its end link's position ``x y z`` and orientation ``rx ry rz`` (the
-rotation vector log(R0^T R), :mod:`jik.engine.pose_task`). A plane (x, y) would hide z and the
-orientation (a path that only turns the end link is a point there): instead, one row per task
-coordinate against theta (continuation parameter, or the iteration), positions above
-rotations, like the paper's joint trajectories (Figs. 7-9) for the task space; the legs'
-targets are marked where each leg ends, lettered above the top row.
+"""The task-space panel of an arm in space, whose task may hold its end link's position ``x y z``
+and orientation ``rx ry rz`` (:mod:`jik.engine.pose_task`), which a plane (x, y) would hide: one
+row per task coordinate against theta, positions above rotations, like the paper's joint
+trajectories (Figs. 7-9).
 """
 
 from __future__ import annotations

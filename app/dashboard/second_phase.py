@@ -1,13 +1,8 @@
 """A result's second phase, after its runs are on screen: h on a grid when each value of h solves
 a problem (the unicycle's characteristics, eqs. (28), (29)), then E1 (13), E2 (18) and their
-sensitivity. It runs in steps of about the same cost (a batch of the grid's points, one value of
-a functional), after each of which it reports its progress and may be cancelled.
-
-A cancelled phase keeps what it finished: h on its grid when the grid was done
-(:attr:`SecondPhase.result`); E1, E2 and their sensitivity are then not computed, and the figures
-of :func:`cancelled_message` say so instead of showing stale values. :class:`SecondPhaseControl`
-is the phase as a :class:`~jik.app.dashboard.session.Dashboard` runs it: after each result,
-cancelled and run again on the page's request.
+sensitivity, in steps after each of which it reports its progress and may be cancelled. A
+cancelled phase keeps h on its grid when the grid was done; the figures of
+:func:`cancelled_message` say what was not computed.
 """
 
 from __future__ import annotations
