@@ -73,11 +73,8 @@ def error_functionals(
     on_advance: Callable[[float, float], None] | None = None,
     cancelled: Callable[[], bool] = lambda: False,
 ) -> dict | None:
-    """E1 (13) and E2 (18) of the current map, or None if unavailable.
-
-    Over the robot's design region from the registry (the boxes of sec. 5, the ones
-    ``jik reproduce`` uses) where it has one, so the values do not move with the start point and
-    a synthesized map is judged on the box it was built for; else over the heat-map box.
+    """E1 (13) and E2 (18) of the current map, or None if unavailable: over the robot's design
+    region from the registry (the boxes of sec. 5) where it has one, else over the heat-map box.
     ``on_advance(done, total)`` as the engine's
     :func:`~jik.engine.functional_report.functionals_report` advances (what it raises stops
     it), ``cancelled`` polled; over more than three variables, E2 by a Sobol rule.

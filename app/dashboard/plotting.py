@@ -172,11 +172,9 @@ def figure_json(spec: dict) -> str:
 
 def nice_range(values, pad: float = 0.05, from_zero: bool = False) -> list[float] | None:
     """An axis range around ``values``: padded by ``pad`` of their span, then widened to
-    multiples of a 1-2-5 step near a tenth of the span (``from_zero``: from 0, unpadded).
-
-    Nearby data give the same range, so a small change of a control leaves the figure's layout
-    unchanged and the page moves only the traces (``Plotly.animate`` in static/panels.js, a third
-    of a full redraw). None when there is nothing finite to show (plotly then autoranges).
+    multiples of a 1-2-5 step near a tenth of the span (``from_zero``: from 0, unpadded), so
+    that nearby data give the same range and the page only moves the traces. None when there is
+    nothing finite to show (plotly then autoranges).
     """
     v = np.asarray(values, dtype=float)
     v = v[np.isfinite(v)]
@@ -231,9 +229,8 @@ def axis_data(spec: dict) -> dict[str, list]:
 def keep_ranges(spec: dict, before: dict | None) -> dict:
     """Sticky axes: an axis of the figure dict ``spec`` takes the range it had in ``before``
     (the layout of the panel on screen) when the new data lie inside it and span at least
-    :data:`KEEP_FILL` of it. Dragging a slider then does not make the axes jump, and the page
-    moves the lines without redrawing the panel (static/panels.js). Axes with a fixed tick step
-    (the cycles of the drift panel), without a range or with categories are left alone."""
+    :data:`KEEP_FILL` of it. Axes with a fixed tick step (the cycles of the drift panel),
+    without a range or with categories are left alone."""
     if not before:
         return spec
     layout = spec["layout"]
