@@ -1,11 +1,8 @@
 """The dashboard's controls, described once: the page and the 3D scene are both built from this.
 
-:func:`controls` lists the controls of a dashboard state (its robot, augmenting map, mode and
-task), generated from the engine's registry: keys, labels, help text, kinds, ranges (gamma's per
-mode), steps and options. :func:`control_values` gives each control's value as shown, and
-:func:`controls_message` both, for a page. A change of controls becomes a change of the state in
-:mod:`jik.app.dashboard.control_changes`. Neither the page (``static/controls.js``) nor the scene
-(:mod:`jik.app.scene`) knows a range, a label or a text format of its own.
+:func:`controls` lists the controls of a dashboard state, generated from the engine's registry:
+keys, labels, help text, kinds, ranges, steps and options; :func:`control_values` gives each
+control's value as shown, and :func:`controls_message` both, for a page.
 
 A control's ``key`` is a dotted path into the state: ``gamma``, ``x0.1`` (one coordinate of the
 start x0), ``robot_parameters.l``, ``robot_parameters.q0`` (a vector parameter, edited whole),

@@ -2,12 +2,10 @@
 listeners (the page's event stream, the scene) it tells.
 
 Every change is validated (:mod:`jik.app.dashboard.model`), bumps a generation counter and wakes
-the worker, which solves both algorithms (:func:`jik.app.dashboard.results.compute`), builds the
-figures once (:meth:`Dashboard._panel_texts`) and pushes them to every listener; a newer
-change cancels a stale computation between legs. After each result the worker runs its second
-phase (:mod:`jik.app.dashboard.second_phase`); idle, it solves the other manipulator ahead for
-a switch (:mod:`jik.app.dashboard.ahead`). Those parts share this class's lock, generation and
-caches, and live in their modules as the mixins :class:`Dashboard` is made of.
+the worker, which solves the chosen algorithms (:func:`jik.app.dashboard.results.compute`),
+builds the figures once and pushes them to every listener; a newer change cancels a stale
+computation between legs. The second phase (:mod:`.second_phase`) and solving ahead
+(:mod:`.ahead`) are the mixins :class:`Dashboard` is made of, sharing its lock and generation.
 """
 
 from __future__ import annotations
