@@ -10,8 +10,7 @@ from collections.abc import Callable
 from ...engine.exceptions import InvalidInputError, JikError
 from .algorithms import cache_key
 from .analysis import expensive_map, kinematics_and_map
-from .listeners import Listeners
-from .messages import Event, with_figures
+from .messages import Event, Listeners, with_figures
 from .model import DashboardState, updated_state
 from .plotting import PANELS
 from .runs import Cancelled, DashboardResult

@@ -14,9 +14,8 @@ from typing import Any
 from .analysis import augmenting_grid, expensive_map, grid_batches, kinematics_and_map
 from .figures import figure_specs
 from .functionals import error_functionals, functionals_key, sensitivity, sensitivity_evaluations
-from .listeners import Listeners
 from .map_figures import augmenting_title
-from .messages import Event, with_figures
+from .messages import Event, Listeners, with_figures
 from .model import DashboardState
 from .plotting import figure_json
 from .runs import Cancelled, DashboardResult
