@@ -5,8 +5,9 @@ Modules: :mod:`~jik.app.dashboard.controls` (the controls, described once),
 state), :mod:`.algorithms` (the chosen algorithms, one style each), :mod:`.runs` and
 :mod:`.results` (a state solved), :mod:`.offload` (the shared compute processes),
 :mod:`.analysis` (h on a grid), :mod:`.functionals` (E1/E2), :mod:`.figures` (plotly panels),
-:mod:`.messages` (events), :mod:`.session` (the live :class:`Dashboard`), :mod:`.sessions` (one
-per tab, bounded), :mod:`.export` (JSON and CSV). The names below are the public surface.
+:mod:`.messages` (events and listeners), :mod:`.session` (the live :class:`Dashboard`),
+:mod:`.sessions` (one per tab, bounded), :mod:`.export` (JSON and CSV). The names below are the
+public surface.
 """
 
 from .algorithms import COLORS, LABELS, runs_key

@@ -41,8 +41,7 @@ class Event:
 class LatestEvents:
     """The events a listener has not taken yet, at most one of each kind (the newest; of
     ``ahead``, one per robot): a listener that reads slowly, or never, holds a bounded amount of
-    memory, and gets the newest of each kind when it reads. The page needs no more: a newer
-    state, result or progress replaces the older one.
+    memory, and gets the newest of each kind when it reads.
 
     :meth:`put` may be called from any thread; :meth:`get` is awaited on ``loop``.
     """
