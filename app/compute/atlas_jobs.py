@@ -26,16 +26,44 @@ import re
 import secrets
 import threading
 import time
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
 from ...engine.atlas import AtlasPlan
+from ...engine.atlas_backends import IN_FLIGHT, bounded_imap
 from ...engine.atlas_run import AtlasResult, run_atlas
 from ...engine.exceptions import RunCancelled
 from ...engine.progress import ProgressCallbacks
 from .atlas_plan import AtlasLimits, Used, result_document
-from .atlas_pool import PoolBackend
 from .atlas_schemas import AtlasJobResponse, AtlasRequest
+from .worker import task
+
+
+@task("starts", "fewer starts or cycles")
+def atlas_chunk(fn: Callable[[Any], Any], chunk: Any) -> Any:
+    """``fn(chunk)``: one chunk of an atlas in a compute worker."""
+    return fn(chunk)
+
+
+class PoolBackend:
+    """An atlas backend (:class:`jik.engine.atlas_backends.Backend`) on the server's compute
+    pool (a :class:`~jik.app.compute.pool.ComputePool`): at most ``IN_FLIGHT`` chunks per worker
+    submitted at once, results in the order they finish; leaving gives up the chunks in flight."""
+
+    def __init__(self, pool: Any) -> None:
+        self.pool = pool
+        self.workers = pool.settings.workers
+
+    def __enter__(self) -> PoolBackend:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        return None
+
+    def imap_unordered(self, fn: Callable[[Any], Any], tasks: Iterable[Any]) -> Iterator[Any]:
+        submit = lambda chunk: self.pool.submit(atlas_chunk, fn, chunk)  # noqa: E731
+        yield from bounded_imap(submit, tasks, IN_FLIGHT * self.workers)
 
 
 class AtlasJobNotFound(LookupError):

@@ -18,7 +18,6 @@ from ...engine.exceptions import InvalidInputError
 from ...engine.repeatability import open_loop
 from ...engine.self_motion import MAX_ARC
 from . import schemas as S
-from .atlas_pool import CHUNK_SECONDS
 from .atlas_schemas import AtlasRequest
 from .documents import nullable
 from .exceptions import RequestError
@@ -26,6 +25,10 @@ from .robot_requests import check_length, gamma_and_mode, request_robot
 from .schemas.wording import without_field
 from .worker import task
 
+#: Seconds of work in one chunk of a server's atlas (:func:`jik.engine.atlas_run.sized_chunks`):
+#: the compute workers serve the API's requests between chunks, first come first served, and a
+#: chunk stays far within their time limit.
+CHUNK_SECONDS = 1.0
 #: What an atlas job's response repeats of its request: the robot used, the map used.
 Used = tuple[S.RobotUsed, S.AugmentationUsed | None]
 
@@ -87,7 +90,24 @@ def planned(req: AtlasRequest, limits: AtlasLimits) -> tuple[AtlasPlan, Used]:
             "response carries; ask for the drift alone or a smaller atlas",
         )
     try:
-        return _plan(req, spec, inverses, path, gamma, mode), (robot.robot, robot.augmentation)
+        plan = plan_atlas(
+            inverses,
+            path,
+            cycles=req.cycles,
+            n_starts=req.starts,
+            starts=req.start_points,
+            arc=req.arc or (-MAX_ARC, MAX_ARC),
+            sampling=req.sampling,
+            seed=req.seed,
+            reference=req.reference or spec.default_x0,
+            box=None if req.arc else spec.x_range,
+            shifts=req.shifts,
+            scales=req.scales,
+            gamma=gamma,
+            mode=mode,
+            tol=req.tolerance,
+            max_iterations=req.max_iterations,
+        )
     except InvalidInputError as exc:
         head, dot, index = (exc.field or "").partition(".")
         if head != "starts":
@@ -97,27 +117,7 @@ def planned(req: AtlasRequest, limits: AtlasLimits) -> tuple[AtlasPlan, Used]:
             raise RequestError("starts", text) from None
         # (the engine's starts are the request's start_points: its field names the entry)
         raise RequestError("start_points" + dot + index, without_field(text, exc.field)) from None
-
-
-def _plan(req: AtlasRequest, spec, inverses, path, gamma, mode) -> AtlasPlan:
-    return plan_atlas(
-        inverses,
-        path,
-        cycles=req.cycles,
-        n_starts=req.starts,
-        starts=req.start_points,
-        arc=req.arc or (-MAX_ARC, MAX_ARC),
-        sampling=req.sampling,
-        seed=req.seed,
-        reference=req.reference or spec.default_x0,
-        box=None if req.arc else spec.x_range,
-        shifts=req.shifts,
-        scales=req.scales,
-        gamma=gamma,
-        mode=mode,
-        tol=req.tolerance,
-        max_iterations=req.max_iterations,
-    )
+    return plan, (robot.robot, robot.augmentation)
 
 
 @task(

@@ -11,9 +11,8 @@ import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
-from jik.app.compute.atlas_jobs import AtlasJobNotFound, AtlasJobs
+from jik.app.compute.atlas_jobs import AtlasJobNotFound, AtlasJobs, PoolBackend
 from jik.app.compute.atlas_plan import AtlasLimits, planned
-from jik.app.compute.atlas_pool import PoolBackend
 from jik.app.compute.atlas_schemas import AtlasRequest
 from jik.app.compute.exceptions import RequestError
 from jik.app.compute.pool import pool_in_thread
