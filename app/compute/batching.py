@@ -21,8 +21,7 @@ import numpy as np
 
 from . import schemas as S
 from .exceptions import ServiceUnavailable
-from .precheck import precheck
-from .requests import batch_key
+from .requests import batch_key, precheck
 from .worker import solve_batch
 
 if TYPE_CHECKING:

@@ -1,4 +1,5 @@
-"""Requests to engine calls: solve, its batches, and repeatability.
+"""Requests to engine calls: solve, its batches, and repeatability; the checks of a request
+made before it is queued (:func:`precheck`).
 
 Plain synchronous functions (``solve_batch_json``, ``repeatability_request``) turn
 a request model into engine calls and the result into a response model. They raise
@@ -18,7 +19,7 @@ import numpy as np
 
 from ...engine.exceptions import JikError
 from ...engine.limits import robot_limits
-from ...engine.registry import RobotSpec
+from ...engine.registry import ROBOTS, RobotSpec
 from ...engine.repeatability import repeatability, repeatable
 from ...engine.solve_rules import refused_starts
 from ...engine.solver import solve_batch as engine_solve_batch
@@ -29,6 +30,25 @@ from .exceptions import RequestError
 from .robot_requests import check_configuration, check_length, gamma_and_mode, request_robot
 from .schemas.algorithms import parameters_of, used
 from .schemas.wording import without_field
+from .synthesis import synthesis_region
+
+
+def precheck(req: S.SolveRequest | S.RepeatabilityRequest | S.SynthesizeRequest) -> None:
+    """The registry checks that need no numerics and that a route's model (exact for its robot:
+    names, maps, the lengths of x0, target and path) cannot make: a discrete gamma's bound, a
+    synthesis' box.
+
+    Run on the event loop before a request is sent to a worker, so bad requests are answered at
+    once even when every worker is busy. The workers repeat them (the plain service functions
+    are complete on their own).
+    """
+    if req.robot.name in S.USER_ROBOT_MODELS:
+        return  # (p and r follow from the definition: built and checked in a worker)
+    spec = ROBOTS[req.robot.name]
+    if isinstance(req, S.SynthesizeRequest):
+        synthesis_region(spec, spec.build(), req)
+    else:
+        gamma_and_mode(spec, req)
 
 
 @dataclass

@@ -14,7 +14,7 @@ from fastapi import APIRouter, Body, Response
 
 from ...compute.catalogue import robots_response
 from ...compute.kinematics import KinematicsBody, KinematicsResponse, kinematics_task
-from ...compute.precheck import precheck
+from ...compute.requests import precheck
 from ...compute.schemas import (
     BUSY,
     HealthResponse,
