@@ -55,14 +55,6 @@ def _robot(name: str) -> tuple[dict[str, Any], RobotSpec, Any]:
     return robot, built.spec, built.kinematics
 
 
-def _map(name: str, spec: RobotSpec) -> dict[str, Any]:
-    """The augmenting map a synthesis example evaluates: a catalogue robot's default map; for a
-    user robot, h the last joint variable (robot_kinds' example of a formula map)."""
-    if name in ROBOTS:
-        return {"name": spec.default_augmentation}
-    return {"name": "formula", "h": spec.variable_names[-1]}
-
-
 def _loop(name: str) -> list[list[float]]:
     """An atlas's loop as the dashboard drives it: from k(x0) through the robot's closed path
     (its starts then lie on the self-motion curve through x0, the default reference)."""
@@ -84,8 +76,11 @@ def example(route: str, name: str) -> dict[str, Any]:
         return {"robot": robot, "algorithm": "pseudoinverse", "x0": x0, "target": target}
     if route == "repeatability":
         return {"robot": robot, "algorithm": "pseudoinverse", "x0": x0, "path": path, "cycles": 2}
-    if route == "synthesize":
-        return {"robot": robot, "method": "evaluate", "augmentation": _map(name, spec)}
+    if route == "synthesize":  # (a user robot's map: h the last joint variable)
+        amap = {"name": "formula", "h": spec.variable_names[-1]}
+        if name in ROBOTS:
+            amap = {"name": spec.default_augmentation}
+        return {"robot": robot, "method": "evaluate", "augmentation": amap}
     if route == "kinematics":
         return {"robot": robot, "x": x0}
     if route == "atlas":

@@ -303,21 +303,15 @@ ROBOT_NAMES = [*ROBOTS, *USER_ROBOT_MODELS]
 if TYPE_CHECKING:
     # Generated from the catalogue and robot_kinds at import time (above), so their fields are
     # invisible to a static checker: type them as Any there.
-    Robot: TypeAlias = Any
-    Augmentation: TypeAlias = Any
     AnyRobot: TypeAlias = Any
     AnyAugmentation: TypeAlias = Any
     UserAugmentation: TypeAlias = Any
 else:
-    #: A catalogue robot and one of its maps (what the atlas takes).
-    Robot = _union(list(ROBOT_MODELS.values()))
-    Augmentation = _union(list(AUGMENTATION_MODELS.values()))
-    #: Any robot and map of a solve, repeatability or synthesis: the base request models, which
-    #: the workers validate with, take them all; the routes take the exact per-robot members
-    #: of :func:`per_robot`.
+    #: Any robot and map of a request: the base request models, which the workers validate
+    #: with, take them all; the routes take the exact per-robot members of :func:`per_robot`.
     AnyRobot = _union([*ROBOT_MODELS.values(), *USER_ROBOT_MODELS.values()])
     UserAugmentation = _union(list(USER_AUGMENTATION_MODELS.values()))
-    AnyAugmentation = Augmentation | UserAugmentation
+    AnyAugmentation = _union(list(AUGMENTATION_MODELS.values())) | UserAugmentation
 
 
 def _absent(value: Any) -> bool:

@@ -35,10 +35,6 @@ def _object(body: Any) -> Any:
     return body
 
 
-#: Checks a body before its robot's variant is chosen (:func:`_object`).
-OBJECT_BODY = BeforeValidator(_object)
-
-
 def narrowed(base: type[BaseModel], name: str, annotation: Any) -> tuple[Any, Any]:
     """The field ``name`` of ``base`` with another type (a robot's lengths, its maps), its
     default and description kept, its constraints the new type's: a field of
@@ -54,7 +50,8 @@ def per_robot(base: type[BaseModel], fields: Any, user_fields: Any = None) -> An
     (``fields(spec)``: the other fields that differ from ``base``'s), and one per kind of user
     robot (``user_fields(kind)``; default: its maps, :func:`user_maps`). Their union is what the
     route takes and what its OpenAPI document shows, each member with its robot's example
-    (:mod:`.examples`); each member is still a ``base``."""
+    (:mod:`.examples`); each member is still a ``base``. A body must be a JSON object, and an
+    unknown name is refused naming every robot a request may give."""
     route = base.__name__.removesuffix("Request")
 
     def member(name: str, robot: Any, title: Any, about: Any, more: dict[str, Any]) -> Any:
@@ -86,7 +83,15 @@ def per_robot(base: type[BaseModel], fields: Any, user_fields: Any = None) -> An
         # checked against the built robot (a 422 naming the field and the robot's p, r).
         more = (user_fields or (lambda kind: user_maps(base)))(kind)
         members.append(member(kind, model, model.model_config.get("title"), model.__doc__, more))
-    return robot_union(members)
+    return Annotated[
+        Union[tuple(members)],  # noqa: UP007
+        Discriminator(
+            _robot_name,
+            custom_error_type="unknown_robot",
+            custom_error_message=f"give a robot whose name is one of {ROBOT_NAMES}",
+        ),
+        BeforeValidator(_object),
+    ]
 
 
 def user_maps(base: type[BaseModel]) -> dict[str, Any]:
@@ -102,21 +107,6 @@ def user_maps(base: type[BaseModel]) -> dict[str, Any]:
             ),
         )
     }
-
-
-def robot_union(members: list[Any]) -> Any:
-    """A body that is one of ``members`` (each tagged by its robot's name), chosen by
-    ``robot.name``; a JSON object (:data:`OBJECT_BODY`), and an unknown name refused naming
-    every robot a request may give."""
-    return Annotated[
-        Union[tuple(members)],  # noqa: UP007
-        Discriminator(
-            _robot_name,
-            custom_error_type="unknown_robot",
-            custom_error_message=f"give a robot whose name is one of {ROBOT_NAMES}",
-        ),
-        OBJECT_BODY,
-    ]
 
 
 #: What the augmentation of a user robot's request is for, by request.
