@@ -38,17 +38,9 @@ def _expired(signum: int, frame: object) -> None:
 
 @contextlib.contextmanager
 def time_budget(seconds: float, field: str, what: str) -> Iterator[None]:
-    """Run the block within ``seconds``; past them, :class:`RequestError` naming ``field``.
-
-    Parameters
-    ----------
-    seconds : float
-        The budget (0 or less: none).
-    field : str
-        The request's field whose content the block works on (``"robot"``).
-    what : str
-        What the block does, for the message ("building the robot's formulas").
-    """
+    """Run the block within ``seconds`` (0 or less: no budget); past them, :class:`RequestError`
+    naming ``field`` (the request's field the block works on, ``"robot"``) and saying that
+    ``what`` ("building the robot's formulas") took too long."""
     timer = getattr(signal, "setitimer", None)
     if seconds <= 0 or timer is None or threading.current_thread() is not threading.main_thread():
         yield

@@ -19,18 +19,14 @@ def nullable(a) -> Any:
     return json_values(np.asarray(a, dtype=float))
 
 
-def downsample(m: int, limit: int = S.MAX_TRAJECTORY_POINTS) -> np.ndarray:
-    """Indices of at most ``limit`` of ``m`` points, evenly spread, first and last kept."""
-    if m <= limit:
-        return np.arange(m)
-    return np.unique(np.linspace(0, m - 1, limit).round().astype(int))
-
-
 def trajectory_document(traj) -> dict[str, Any]:
-    """A run's trajectory as JSON-ready data, downsampled (the fields of
+    """A run's trajectory as JSON-ready data, downsampled to at most ``MAX_TRAJECTORY_POINTS``
+    evenly spread, first and last kept (the fields of
     :class:`~jik.app.compute.schemas.runs.Trajectory`)."""
-    m = len(traj.theta)
-    idx = downsample(m)
+    m, limit = len(traj.theta), S.MAX_TRAJECTORY_POINTS
+    idx = np.arange(m)
+    if m > limit:
+        idx = np.unique(np.linspace(0, m - 1, limit).round().astype(int))
     return {
         "theta": nullable(traj.theta[idx]),
         "x": nullable(traj.x[idx]),

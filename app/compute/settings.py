@@ -87,28 +87,25 @@ class Settings(BaseSettings):
         return tuple(h.strip() for h in self.allowed_hosts.split(",") if h.strip())
 
 
-def environment_variable(name: str) -> str:
-    """The ``JIK_*`` variable of the setting ``name`` (``JIK_BATCH`` of ``batching``)."""
-    field = Settings.model_fields.get(name)
-    alias = field.validation_alias if field else None
-    choices = alias.choices if isinstance(alias, AliasChoices) else []
-    named = [c for c in choices if isinstance(c, str) and c.startswith("JIK_")]
-    return named[0] if named else f"JIK_{name.upper()}"
-
-
 def read_environment() -> Settings:
     """The settings of the ``JIK_*`` environment variables.
 
     Raises
     ------
     InvalidInputError
-        If a variable's value is not valid; its ``field`` is the variable (``JIK_WORKERS``).
+        If a variable's value is not valid; its ``field`` is the variable (``JIK_WORKERS``, or
+        a setting's own alias: ``JIK_BATCH`` of ``batching``).
     """
     try:
         return Settings()
     except ValidationError as error:
         first = error.errors()[0]
-        variable = environment_variable(str(first["loc"][0]) if first["loc"] else "")
+        name = str(first["loc"][0]) if first["loc"] else ""
+        field = Settings.model_fields.get(name)
+        alias = field.validation_alias if field else None
+        choices = alias.choices if isinstance(alias, AliasChoices) else []
+        named = [c for c in choices if isinstance(c, str) and c.startswith("JIK_")]
+        variable = named[0] if named else f"JIK_{name.upper()}"
         raise InvalidInputError(
             f"{variable}={first.get('input')!r}: {first['msg']}", field=variable
         ) from None

@@ -81,8 +81,16 @@ def ping() -> str:
     return "pong"
 
 
-def _worker_main(conn) -> None:
-    """Worker process loop: say "ready", then (task, args) in, (status, result) out."""
+def _worker_entry(fd: int, memory_mb: int = 0, build_seconds: float = 0.0) -> None:
+    """Entry point of a worker process started by :class:`Worker` (``python -c``): its address
+    space limited to ``memory_mb`` (0: none), so that a computation too large for it raises
+    MemoryError (a 422) instead of taking the machine's memory; robots built within
+    ``build_seconds`` (:func:`jik.app.compute.budget.build_seconds`; 0: the environment's).
+    Then its loop: say "ready", then (task, args) in, (status, result) out."""
+    limit_memory(memory_mb)
+    if build_seconds > 0:
+        budget.BUILD_SECONDS = build_seconds
+    conn = Connection(fd)
     conn.send(("ready", None))
     while True:
         try:
@@ -104,17 +112,6 @@ def _worker_main(conn) -> None:
         except Exception as exc:  # reported to the client as a 500 with its text
             msg = ("error", f"{type(exc).__name__}: {exc}")
         conn.send(msg)
-
-
-def _worker_entry(fd: int, memory_mb: int = 0, build_seconds: float = 0.0) -> None:
-    """Entry point of a worker process started by :class:`Worker` (``python -c``): its address
-    space limited to ``memory_mb`` (0: none), so that a computation too large for it raises
-    MemoryError (a 422) instead of taking the machine's memory; robots built within
-    ``build_seconds`` (:func:`jik.app.compute.budget.build_seconds`; 0: the environment's)."""
-    limit_memory(memory_mb)
-    if build_seconds > 0:
-        budget.BUILD_SECONDS = build_seconds
-    _worker_main(Connection(fd))
 
 
 #: Longest wait for a new worker to import the engine (not counted in a request's time limit).
