@@ -1,10 +1,6 @@
-"""``POST /kinematics``: k(x) and J(x) of any robot at one configuration or a list of them.
-
-A user checks a model against their own tools before trusting a run: the same robot models as
-``/solve`` (a catalogue robot, a catalogue arm, or a definition), the engine's kinematics, eq. (4),
-and its analytic Jacobian. It runs in the compute workers (a robot's build is bounded there) as
-the task :func:`kinematics_task`.
-"""
+"""``POST /kinematics``: k(x) and J(x) of any robot at one configuration or a list of them, to
+check a model against other tools: the same robots as ``/solve``, the engine's kinematics, eq.
+(4), and its analytic Jacobian, in a compute worker (:func:`kinematics_task`)."""
 
 from __future__ import annotations
 
@@ -77,8 +73,11 @@ class KinematicsResponse(BaseModel):
     )
 
 
-def kinematics_request(req: KinematicsRequest) -> KinematicsResponse:
-    """The robot of ``req`` built, and its k and J at ``req.x``; raises :class:`RequestError`."""
+@task("x", "fewer configurations or a simpler robot")
+def kinematics_task(body: bytes) -> bytes:
+    """The worker's task: a request (JSON) in, its robot built and its k and J at its x, the
+    response (JSON) out; raises :class:`RequestError`."""
+    req = KinematicsRequest.model_validate_json(body)
     robot = request_robot(req.robot)
     spec, kin = robot.spec, robot.kinematics
     many = isinstance(req.x[0], list)
@@ -87,17 +86,11 @@ def kinematics_request(req: KinematicsRequest) -> KinematicsResponse:
     x = np.asarray(req.x, dtype=float)
     k, J = kin.forward_jacobian(x)
     J = np.where(np.isfinite(k)[..., None], J, np.nan)  # (log(x1) at x1 = -1: no dk/dx either)
-    return KinematicsResponse(
+    response = KinematicsResponse(
         robot=robot.robot,
         variable_names=list(spec.variable_names),
         task_names=list(spec.task_names),
         k=nullable(k),
         J=nullable(J),
     )
-
-
-@task("x", "fewer configurations or a simpler robot")
-def kinematics_task(body: bytes) -> bytes:
-    """The worker's task: request JSON in, response JSON out."""
-    response = kinematics_request(KinematicsRequest.model_validate_json(body))
     return response.model_dump_json().encode()

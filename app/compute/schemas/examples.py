@@ -1,9 +1,5 @@
 """The request examples of the OpenAPI document, one per robot and route, made from the engine's
-defaults so that they cannot drift from the robots: a catalogue robot's parameters, default x0,
-target, closed path (Manipulator 2's: the paper's Table 1); a catalogue arm's home and task; a
-planar chain's and a formula robot's definition from the examples of
-:mod:`jik.engine.robot_kinds`; a URDF robot as the Panda's definition. A user robot's x0,
-target and path are those its build gives (:func:`jik.engine.robot_spec.robot_from_dict`).
+defaults so that they cannot drift from the robots (:func:`example`).
 
 Each per-robot request model carries its robot's example (``json_schema_extra``, filled in
 when the document is made) and each route lists every robot's (``Body(openapi_examples=...)``):
@@ -20,8 +16,11 @@ from typing import Any
 
 import numpy as np
 
+from ....engine import robot_kinds
 from ....engine.arms import ARMS
-from ....engine.registry import ROBOTS, RobotSpec
+from ....engine.registry import ALGORITHMS, ROBOTS, RobotSpec
+from ....engine.robot_spec import robot_from_dict
+from .robots import ROBOT_NAMES
 
 #: The routes whose bodies have examples, by the name :func:`example` takes.
 ROUTES = ("solve", "repeatability", "synthesize", "kinematics", "atlas")
@@ -33,11 +32,10 @@ ALGORITHMS_ROBOT = "manipulator2"
 
 @functools.cache
 def _robot(name: str) -> tuple[dict[str, Any], RobotSpec, Any]:
-    """The robot ``name`` (a catalogue robot, arm or kind of user robot) as a request gives it,
-    its spec (a user robot's as its build makes it) and its kinematics."""
-    from ....engine import robot_kinds
-    from ....engine.robot_spec import robot_from_dict
-
+    """The robot ``name`` as a request gives it (a catalogue robot with its default parameters,
+    an arm with its task, a URDF robot as the Panda's definition, another kind from the examples
+    of :mod:`jik.engine.robot_kinds`), its spec (a user robot's as its build makes it: its x0,
+    target and path) and its kinematics."""
     if name in ROBOTS:
         spec = ROBOTS[name]
         robot: dict[str, Any] = {"name": name}
@@ -101,8 +99,6 @@ def schema_examples(route: str, name: str) -> Callable[[dict[str, Any]], None]:
 def openapi_examples(route: str) -> dict[str, dict[str, Any]]:
     """``Body(openapi_examples=...)`` of ``route``: the example of every robot a request may
     name, by its name."""
-    from .robots import ROBOT_NAMES
-
     out = {}
     for name in ROBOT_NAMES:
         out[name] = {"summary": _robot(name)[1].title, "value": copy.deepcopy(example(route, name))}
@@ -115,8 +111,6 @@ def _algorithm_examples(route: str) -> dict[str, dict[str, Any]]:
     """A run of :data:`ALGORITHMS_ROBOT` by each other algorithm, with its scalar parameters at
     the engine's defaults (:data:`jik.engine.registry.ALGORITHMS`) and, for the extended
     inverse, the robot's default map."""
-    from ....engine.registry import ALGORITHMS
-
     out = {}
     base = example(route, ALGORITHMS_ROBOT)
     spec = ROBOTS[ALGORITHMS_ROBOT]

@@ -107,8 +107,6 @@ for _spec in ROBOTS.values():
 AUGMENTATION_MODELS: dict[str, type[BaseModel]] = {
     name: _augmentation_model(name, specs) for name, specs in _by_name.items()
 }
-for _m in (*ROBOT_MODELS.values(), *AUGMENTATION_MODELS.values()):
-    globals()[_m.__name__] = _m  # importable by name (pickling, introspection)
 
 
 # --------------------------------------------------------------------------------------------
@@ -290,7 +288,7 @@ USER_ROBOT_MODELS: dict[str, type[BaseModel]] = {
     "urdf": UrdfRobot,
     **{name: _arm_model(arm) for name, arm in ARMS.items()},
 }
-for _m in USER_ROBOT_MODELS.values():
+for _m in (*ROBOT_MODELS.values(), *AUGMENTATION_MODELS.values(), *USER_ROBOT_MODELS.values()):
     globals()[_m.__name__] = _m  # importable by name (pickling, introspection)
 #: The augmenting maps a user robot takes, by name.
 USER_AUGMENTATION_MODELS: dict[str, type[BaseModel]] = {
