@@ -1,22 +1,17 @@
 """Atlas jobs of the REST API: started by a request, run in the background, read back later.
 
-An atlas (:mod:`jik.engine.atlas`) takes seconds to minutes, longer than a request may wait, so
-``POST /atlas`` only checks the request and plans the atlas
-(:func:`~jik.app.compute.atlas_plan.planned`, in a compute worker: its time and memory limits
-hold for the tracing), then
+An atlas (:mod:`jik.engine.atlas`) takes longer than a request may wait, so ``POST /atlas`` only
+checks and plans it (:func:`~jik.app.compute.atlas_plan.planned`, in a compute worker), then
 :class:`AtlasJobs` runs it in a thread of its own that hands its chunks to the server's compute
-pool (:class:`PoolBackend`: the same worker processes as the API's requests, with their time
-and memory limits, queued first come first served with them; they stop with the server). A
-job does not belong to a connection: it runs on when its client goes away, and is dropped
-``keep_for`` seconds after it ends (or when cancelled).
+pool (:class:`PoolBackend`: the API's workers and their time and memory limits, first come first
+served with its requests; they stop with the server). A job runs on when its client goes away,
+and is dropped ``keep_for`` seconds after it ends (or when cancelled).
 
-Limits: at most ``max_running`` atlases compute at once (the others wait, queued), at most
-``max_jobs`` are kept in all and ``per_client`` queued or running for one client, one job's
-work (legs: runs x cycles x legs x algorithms) is at most ``max_work``, ``max_leg_ends`` with the
-leg ends in the result, and it computes for at most ``max_seconds`` (then it fails and says
-so). A done job keeps its result document and the engine's atlas it was made from (its table's
-source, :meth:`~jik.engine.atlas_run.AtlasResult.csv_text`): drift and success of at most
-``max_work`` runs x cycles x algorithms, the starts, and the leg ends only when asked.
+Limits (:class:`~jik.app.compute.atlas_plan.AtlasLimits`): at most ``max_running`` atlases
+compute at once (the others wait, queued), ``max_jobs`` are kept in all and ``per_client`` queued
+or running for one client, and a job computes for at most ``max_seconds`` (then it fails and
+says so). A done job keeps its result document and the engine's atlas it was made from (its
+table's source, :meth:`~jik.engine.atlas_run.AtlasResult.csv_text`).
 """
 
 from __future__ import annotations

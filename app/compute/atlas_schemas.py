@@ -1,9 +1,6 @@
-"""Request and response models of the atlas jobs (``POST /atlas``, ``GET /atlas/{id}``).
-
-They reuse the field types of :mod:`jik.app.compute.schemas` (robots and maps generated from the
-catalogue, coordinates, vectors, algorithms); what needs the registry or the engine (vector
-lengths, a path the curve tracing refuses, the size of the work) is checked by
-:mod:`jik.app.compute.atlas_jobs` and :func:`jik.engine.atlas.plan_atlas`, which name the field.
+"""Request and response models of the atlas jobs (``POST /atlas``, ``GET /atlas/{id}``); what
+needs the registry or the engine (vector lengths, a path the curve tracing refuses, the size of
+the work) is checked by :func:`jik.app.compute.atlas_plan.planned`, which names the field.
 """
 
 from __future__ import annotations

@@ -1,12 +1,7 @@
-"""Requests to engine calls: solve, its batches, and repeatability; the checks of a request
-made before it is queued (:func:`precheck`).
-
-Plain synchronous functions (``solve_batch_json``, ``repeatability_request``) turn
-a request model into engine calls and the result into a response model. They raise
-:class:`RequestError` naming the offending field. The robot, map and inverse a request names are
-built by :func:`jik.app.compute.robot_requests.request_robot` (catalogue robots, definitions,
-catalogue arms alike); results become JSON by :mod:`jik.app.compute.documents`.
-:class:`jik.app.compute.pool.ComputePool` runs these for the HTTP API in worker processes.
+"""Requests to engine calls: solve, its batches, and repeatability (``solve_batch_json``,
+``repeatability_request``: a request model in, a response out, :class:`RequestError` naming the
+field of a refusal; run in the workers by :class:`jik.app.compute.pool.ComputePool`), and the
+checks of a request made before it is queued (:func:`precheck`).
 """
 
 from __future__ import annotations
@@ -34,14 +29,10 @@ from .synthesis import synthesis_region
 
 
 def precheck(req: S.SolveRequest | S.RepeatabilityRequest | S.SynthesizeRequest) -> None:
-    """The registry checks that need no numerics and that a route's model (exact for its robot:
-    names, maps, the lengths of x0, target and path) cannot make: a discrete gamma's bound, a
-    synthesis' box.
-
-    Run on the event loop before a request is sent to a worker, so bad requests are answered at
-    once even when every worker is busy. The workers repeat them (the plain service functions
-    are complete on their own).
-    """
+    """The registry checks that need no numerics and that a route's model (exact for its robot)
+    cannot make: a discrete gamma's bound, a synthesis' box. Run on the event loop before a
+    request is queued, so that a bad one is answered at once even when every worker is busy;
+    the workers repeat them."""
     if req.robot.name in S.USER_ROBOT_MODELS:
         return  # (p and r follow from the definition: built and checked in a worker)
     spec = ROBOTS[req.robot.name]

@@ -1,8 +1,6 @@
-"""Synthesis over a box: a catalogue map evaluated, or an E2-optimal one synthesized (section 3).
-
-:func:`synthesize_request` turns a ``SynthesizeRequest`` into engine calls
-(:mod:`jik.engine.functionals`, :mod:`jik.engine.variational`) and the result into a
-``SynthesizeResponse``: h on a grid of the box, its coefficients, E1 and E2.
+"""Synthesis over a box (section 3): a catalogue map evaluated, or an E2-optimal one synthesized
+(:mod:`jik.engine.functionals`, :mod:`jik.engine.variational`): h on a grid of the box, its
+coefficients, E1 and E2 (:func:`synthesize_request`).
 """
 
 from __future__ import annotations

@@ -1,16 +1,10 @@
-"""A request's user robot: its definition built by the engine, its errors renamed (the half of
-:func:`jik.app.compute.robot_requests.request_robot` for definitions and catalogue arms).
-
-A request may give, instead of a catalogue robot, a definition of one of the kinds of
-:mod:`jik.engine.robot_kinds` (``planar_chain``, ``formula``, ``urdf``), and for its extended
-inverse a map ``{"name": "formula", "h": ...}`` or ``{"name": "e2_synthesized", "region":
-{...}}``. :func:`user_robot` builds both with :func:`jik.engine.robot_spec.robot_from_dict`
-(the safe formula parser, the URDF reader) and renames each refusal's field to the request's
-(``lengths.1`` -> ``robot.lengths[1]``, ``augmentations.0.h`` -> ``augmentation.h``). p and r
-follow from the definition: :mod:`jik.app.compute.requests` checks the lengths of ``x0``,
-``target`` and ``path`` against the built robot. Everything runs in the compute workers,
-under their time and memory limits; the build itself within ``Settings.build_budget`` (a
-formula too slow to differentiate is refused naming the robot, not the computation's field).
+"""A request's user robot (a definition of a kind of :mod:`jik.engine.robot_kinds`, or a
+catalogue arm) and its map (``{"name": "formula", "h": ...}`` or ``{"name": "e2_synthesized",
+...}``), built by :func:`jik.engine.robot_spec.robot_from_dict` in a compute worker, within
+``Settings.build_budget`` (a formula too slow to differentiate is refused naming the robot);
+each refusal's field renamed to the request's (``lengths.1`` -> ``robot.lengths[1]``,
+``augmentations.0.h`` -> ``augmentation.h``). The half of
+:func:`jik.app.compute.robot_requests.request_robot` for these robots.
 """
 
 from __future__ import annotations
@@ -62,13 +56,8 @@ def _built(definition: str) -> Robot:
 
 def user_robot(req_robot: Any, augmentation: Any = None) -> tuple[Robot, S.RobotUsed]:
     """The robot a request defines, with ``augmentation`` (a request's map model, or None) as
-    its only augmenting map; what it used.
-
-    Raises
-    ------
-    RequestError
-        The engine refused the definition or the map; the field is the request's.
-    """
+    its only augmenting map; what it used. RequestError, naming the request's field, when the
+    engine refuses the definition or the map."""
     definition = req_robot.model_dump(exclude_none=True)
     if augmentation is not None:
         given = augmentation.model_dump(exclude_none=True)
