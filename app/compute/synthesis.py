@@ -1,23 +1,29 @@
 """Synthesis over a box (section 3): a catalogue map evaluated, or an E2-optimal one synthesized
 (:mod:`jik.engine.functionals`, :mod:`jik.engine.variational`): h on a grid of the box, its
-coefficients, E1 and E2 (:func:`synthesize_request`).
+coefficients, E1 and E2 (:func:`synthesize_request`). With ``'e2_total_degree'``, E2-optimal
+maps over any number of joint variables (:func:`jik.engine.synthesis_nd.synthesize_e2_nd`, eq.
+(19) on a total-degree Legendre basis with a scrambled Sobol rule; for p - r >= 2 the maps h_1
+... h_(p-r) of the functional generalised in ``docs/e2-vector.md``).
 """
 
 from __future__ import annotations
 
-from typing import get_args
+from typing import Any, get_args
 
 from ...engine.augmentations import Polynomial2
 from ...engine.exceptions import JikError
 from ...engine.functionals import check_region, error_functional_e1, error_functional_e2
 from ...engine.kinematics import Kinematics
+from ...engine.map_grid import map_grid
+from ...engine.map_singularities import map_singularities
 from ...engine.registry import RobotSpec
-from ...engine.robot_synthesis import default_box
+from ...engine.robot_synthesis import TOTAL_DEGREE, default_box
+from ...engine.synthesis_nd import synthesize_e2_nd
 from ...engine.variational import synthesize_e2
 from . import schemas as S
+from .documents import nullable
 from .exceptions import RequestError
 from .robot_requests import request_robot
-from .synthesis_total import map_response, total_degree_response
 
 
 def synthesis_methods() -> S.SynthesisMethodsResponse:
@@ -119,4 +125,128 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         functionals=functionals,
         convergence=convergence,
         total_degree=None,
+    )
+
+
+#: The engine's fields of a total-degree synthesis, as the request names them (others: region).
+_FIELDS = {"degree": "degree", "nodes": "qmc_nodes", "frame_axes": "frame_axes"}
+
+
+def grid(amap, names, region, fixed, n: int) -> S.SynthesisGrid | None:
+    """h on the response's grid (:func:`jik.engine.map_grid.map_grid`); None for one variable."""
+    found = map_grid(amap, names, region, fixed, n)
+    if found is None:
+        return None
+    return S.SynthesisGrid(axes={k: v.tolist() for k, v in found.axes.items()}, h=nullable(found.h))
+
+
+def singularities(
+    kin, amap, region, fixed, nodes: int
+) -> tuple[S.MapSingularitiesInfo | None, list[str], bool]:
+    """Where h is singular in the box (:func:`jik.engine.map_singularities.map_singularities`
+    on a grid of ``nodes`` points per variable, as many as E1's and E2's Gauss rule: a
+    polynomial map costs as much there), what the response's message says of it, and whether
+    it was searched: not for a map that solves a problem per point (a characteristic's, eq.
+    (28): seconds for a grid), as the dashboard does not either, nor where the search does
+    not apply (a vector of maps, too large a grid)."""
+    if amap.solves_per_point:
+        return None, ["singularities of h not searched: each value of h solves a problem"], False
+    try:
+        found = map_singularities(kin, amap, region, fixed=fixed, nodes=nodes)
+    except JikError as exc:
+        return None, [f"singularities of h not searched: {exc}"], False
+    if found is None:
+        return None, [], True
+    info = S.MapSingularitiesInfo.model_validate(found.as_dict())
+    return info, [f"h is singular in the box: {found}"], True
+
+
+def map_response(
+    req, robot_used, kin, amap, box, notes: list[str], **fields
+) -> S.SynthesizeResponse:
+    """The response of a synthesis whose map h is ``amap`` on ``box`` (the variables' names,
+    the region, the values of the others: :func:`jik.engine.functionals.check_region`'s): h
+    on the grid and where it is singular, the message ``notes`` and what the search says, with
+    the method's own ``fields``."""
+    names, region, fixed = box
+    all_fixed = {n: float(fixed[n]) for n in names if n not in region}
+    found, said, searched = singularities(kin, amap, region, all_fixed, req.nodes)
+    return S.SynthesizeResponse(
+        robot=robot_used,
+        method=req.method,
+        region={k: [float(lo), float(hi)] for k, (lo, hi) in region.items()},
+        fixed=all_fixed,
+        grid=grid(amap, names, region, all_fixed, req.grid),
+        singularities=found,
+        singularities_searched=searched,
+        message="; ".join(notes + said) or "ok",
+        **fields,
+    )
+
+
+def total_degree_response(
+    req: S.SynthesizeRequest, kin, robot_used: S.RobotUsed, box: tuple[list[str], dict, dict]
+) -> S.SynthesizeResponse:
+    """The E2-optimal map(s) of ``req`` on its box (names, region, fixed values): E2 on the
+    fitting rule and on an independent one, its convergence with the degree and the nodes,
+    h_1 on a grid, the basis and coefficients."""
+    names, region, fixed = box
+    degree = TOTAL_DEGREE if req.degree is None else req.degree
+    try:
+        res = synthesize_e2_nd(
+            kin,
+            region,
+            degree=degree,
+            nodes=req.qmc_nodes,
+            fixed=fixed,
+            seed=req.seed,
+            frame_axes=req.frame_axes,
+            convergence_degrees=range(1, degree),
+        )
+    except JikError as exc:
+        raise RequestError(
+            _FIELDS.get(getattr(exc, "field", None) or "", "region"), str(exc)
+        ) from None
+    info: dict[str, Any] = {
+        k: v for k, v in res.as_dict().items() if k not in ("region", "fixed", "convergence")
+    }
+    info["basis"] = res.maps[0].index.tolist()
+    info["coefficients"] = [m.coefficients.tolist() for m in res.maps]
+    notes = [
+        f"E2 {res.e2:.6g} on the fitting rule, {res.e2_check:.6g} on an independent rule "
+        f"of {res.nodes} nodes ({len(info['coefficients'][0])} unknowns per map)"
+    ]
+    if res.single_joint:
+        j, best = min(res.single_joint.items(), key=lambda item: item[1]["e2"])
+        notes.append(
+            f"the best single joint, h = {'-' if best['sign'] < 0 else ''}{j}, has "
+            f"E2 {best['e2']:.6g}"
+        )
+    if len(res.maps) > 1:
+        notes.append(f"{len(res.maps)} maps h_1 ... h_{len(res.maps)}; the grid shows h_1")
+    notes.append("E1 is not evaluated (its Gauss rule grows as nodes^d)")
+    return map_response(
+        req,
+        robot_used,
+        kin,
+        res.maps[0],
+        (names, res.region, {**fixed, **res.fixed}),
+        notes,
+        augmentation=S.AugmentationUsed(
+            name=res.maps[0].name,
+            parameters={
+                "degree": float(degree),
+                "unknowns": float(len(res.maps[0].index)),
+                "maps": float(len(res.maps)),
+            },
+        ),
+        coefficients={},
+        functionals={
+            "e1": None,
+            "e2": S.FunctionalInfo(
+                value=nullable(res.e2_check), n_points=res.nodes, n_singular=0, min_abs_dh_k=None
+            ),
+        },
+        convergence=[{k: float(v) for k, v in row.items()} for row in res.convergence],
+        total_degree=S.TotalDegreeInfo(**info),
     )
