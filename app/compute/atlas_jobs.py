@@ -23,7 +23,7 @@ import threading
 import time
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any
 
 from ...engine.atlas import AtlasPlan
 from ...engine.atlas_backends import IN_FLIGHT, bounded_imap
@@ -31,7 +31,7 @@ from ...engine.atlas_run import AtlasResult, run_atlas
 from ...engine.exceptions import RunCancelled
 from ...engine.progress import ProgressCallbacks
 from .atlas_plan import AtlasLimits, Used, result_document
-from .atlas_schemas import AtlasJobResponse, AtlasRequest
+from .atlas_schemas import AtlasJobResponse, AtlasRequest, Status
 from .worker import task
 
 
@@ -67,9 +67,6 @@ class AtlasJobNotFound(LookupError):
 
 class AtlasJobsFull(RuntimeError):
     """Too many jobs in all or for this client: HTTP 429 with Retry-After."""
-
-
-Status = Literal["queued", "running", "done", "failed", "cancelled"]
 
 
 @dataclass

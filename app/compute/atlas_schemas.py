@@ -145,11 +145,15 @@ class AtlasResult(BaseModel):
     )
 
 
+#: An atlas job's state.
+Status = Literal["queued", "running", "done", "failed", "cancelled"]
+
+
 class AtlasJobResponse(BaseModel):
     """An atlas job: its state, progress and, once done, its result."""
 
     id: str
-    status: Literal["queued", "running", "done", "failed", "cancelled"]
+    status: Status
     runs: int = Field(description="runs per algorithm: paths x starts")
     runs_done: int
     progress: float = Field(description="runs_done / runs")

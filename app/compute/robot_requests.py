@@ -86,7 +86,7 @@ def request_robot(
     out: list[Any] = []
     for algorithm in algorithms:
         if algorithm == "extended":
-            _, amap, aug_used = build_augmentation(spec, kin, augmentation)
+            amap, aug_used = build_augmentation(spec, kin, augmentation)
             try:
                 out.append(ExtendedInverse(kin, amap))
             except InvalidInputError as exc:
@@ -98,7 +98,7 @@ def request_robot(
         except InvalidInputError as exc:
             raise RequestError(field_of(exc.field), without_field(str(exc), exc.field)) from None
     built = spec, kin, tuple(out), robot_used, aug_used
-    return RequestRobot(*built, lambda: build_augmentation(spec, kin, augmentation)[1:])
+    return RequestRobot(*built, lambda: build_augmentation(spec, kin, augmentation))
 
 
 def _belong(given: dict, algorithms: Sequence[str]) -> None:
@@ -132,14 +132,15 @@ def build_robot(req_robot) -> tuple[RobotSpec, Any, S.RobotUsed]:
     return spec, kin, S.RobotUsed(name=spec.name, title=spec.title, parameters=used, units=units)
 
 
-def build_augmentation(spec: RobotSpec, kin, req_aug):
-    """The augmenting map named in the request (or the robot's default), built and checked."""
+def build_augmentation(spec: RobotSpec, kin, req_aug) -> tuple[Any, S.AugmentationUsed]:
+    """The augmenting map named in the request (or the robot's default), built and checked;
+    what it used."""
     aspec, values = checked_augmentation(spec, req_aug)
     try:
         amap = aspec.build(kin, **values)
     except InvalidInputError as exc:
         raise RequestError("augmentation", str(exc)) from None
-    return aspec, amap, S.AugmentationUsed(name=aspec.name, parameters=values)
+    return amap, S.AugmentationUsed(name=aspec.name, parameters=values)
 
 
 def checked_augmentation(spec: RobotSpec, req_aug) -> tuple[Any, dict]:
