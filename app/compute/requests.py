@@ -6,7 +6,6 @@ checks of a request made before it is queued (:func:`precheck`).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, cast
 
@@ -110,11 +109,6 @@ def engine_error(exc: JikError) -> RequestError:
     return RequestError(name + dot + tail, without_field(str(exc), field))
 
 
-def _given(value: list[float] | None, default: Sequence[float]) -> list[float]:
-    """A request's start or target, or the robot's when it gives none."""
-    return list(default) if value is None else value
-
-
 def batch_key(req: S.SolveRequest) -> str:
     """Requests with equal keys can share one batched engine call: their x0 apart, except
     for a posture inverse without a rest, whose rest may be the run's start."""
@@ -145,8 +139,8 @@ def solve_batch_json(reqs: list[S.SolveRequest]) -> list[bytes | RequestError]:
         return [exc] * len(reqs)
     out: list[bytes | RequestError | None] = [None] * len(reqs)
     ok: list[int] = []
-    starts = [_given(r.x0, setup.spec.default_x0) for r in reqs]
-    targets = [_given(r.target, setup.spec.default_target) for r in reqs]
+    starts = [r.x0 or setup.spec.default_x0 for r in reqs]
+    targets = [r.target or setup.spec.default_target for r in reqs]
     for i in range(len(reqs)):
         try:
             check_configuration(setup.spec, starts[i])
@@ -182,7 +176,7 @@ def solve_batch_json(reqs: list[S.SolveRequest]) -> list[bytes | RequestError]:
 def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityResponse:
     """The closed path of ``req`` driven ``req.cycles`` times (Table 1); drift per cycle."""
     setup = _setup(req)
-    start = _given(req.x0, setup.spec.default_x0)
+    start = req.x0 or setup.spec.default_x0
     try:
         path = setup.spec.default_loop() if req.path is None else req.path
     except JikError as exc:  # (a robot without a closed path of its own)
