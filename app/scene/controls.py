@@ -42,14 +42,8 @@ class Syncing:
 
 
 class SceneControls:
-    """The inputs of one scene's GUI, one folder per group of the specification.
-
-    Parameters
-    ----------
-    gui : viser.GuiApi
-    send : callable
-        ``send(patch)`` with a patch keyed by control keys (``{"x0.1": 0.4}``).
-    """
+    """The inputs of one scene's GUI, one folder per group of the specification; a change is
+    ``send(patch)``, keyed by control keys (``{"x0.1": 0.4}``)."""
 
     def __init__(self, gui: viser.GuiApi, send: Callable[[dict], None]) -> None:
         self._gui = gui

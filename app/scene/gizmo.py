@@ -19,16 +19,8 @@ DRAG_INTERVAL = 0.15
 
 
 class StartGizmo:
-    """The gizmo of one scene: placed at a state's start point, dragged to change it.
-
-    Parameters
-    ----------
-    scene : viser.SceneApi
-    state : callable
-        The dashboard's state in force.
-    send : callable
-        ``send(patch)``: a state change.
-    """
+    """The gizmo of one scene: placed at a state's start point, dragged to change it
+    (``send(patch)``, from the state in force, ``state()``)."""
 
     def __init__(self, scene: viser.SceneApi, state: Callable, send: Callable[[dict], None]):
         self._scene = scene

@@ -11,6 +11,7 @@ controls. The task plane is the world XY plane (z up). The viser server is a
 
 from __future__ import annotations
 
+import contextlib
 import json
 import threading
 from collections.abc import Sequence
@@ -33,22 +34,14 @@ from .server import SceneServer
 
 
 class DashboardScene:
-    """A viser server showing the dashboard's current result and editing its state.
-
-    Parameters
-    ----------
-    dashboard : Dashboard
-    low_end : bool
-        Draw for a software renderer: no shadows, no environment map.
-    """
+    """A viser server showing the dashboard's current result and editing its state;
+    ``low_end``: drawn for a software renderer (no shadows, no environment map)."""
 
     def __init__(self, dashboard: Dashboard, low_end: bool = False) -> None:
         self.dashboard = dashboard
         self.server = SceneServer()  # (on a free loopback port: the page reaches it by the relay)
         self.server.scene.set_up_direction("+z")
-        if low_end:
-            # Without shadows and the environment map a frame costs a software renderer far
-            # less (the page asks for this only when its browser renders WebGL without a GPU).
+        if low_end:  # (the page asks for it only when its browser renders WebGL without a GPU)
             self.server.scene.configure_default_lights(cast_shadow=False)
             self.server.scene.configure_environment_map(hdri=None)
         # (no share button: a share link would open the scene to anyone; jik's page has its own
@@ -85,42 +78,40 @@ class DashboardScene:
         self.playback.stop()
         self.server.stop()
 
-    # -- events ---------------------------------------------------------------------------
     def _on_event(self, event: Event) -> None:
         with self._lock:
-            if not self._stopped:
-                self._show_event(event)
-
-    def _show_event(self, event: Event) -> None:
-        try:
-            if event.kind == "state":
-                self.controls.show(self.dashboard.state)
-            elif event.kind == "progress":
-                msg = json.loads(event.data)
-                # (the runs only: the scene draws no E1, E2, and its status keeps the drawn
-                # result's while the page shows their progress)
-                runs = msg.get("phase") == "runs"
-                now = event.generation == self.dashboard.generation
-                if runs and now and msg["elapsed"] > PROGRESS_AFTER:
-                    fraction = msg["fraction"]  # (None: not known)
-                    self.progress.visible = fraction is None or fraction < 1
-                    self.progress.value = min(100.0, 100.0 * (fraction or 0.0))  # type: ignore[misc]  # viser: settable
-                    done = "" if fraction is None else f" {100 * fraction:.0f}%"
-                    self.status.content = f"computing…{done}"
-            elif event.kind == "result" and event.result is not None:
-                self._draw(event.result)
-            elif event.kind == "ahead" and event.result is not None:
-                self._prebuild(event.result)
-            elif event.kind in ("refused", "error"):
-                msg = json.loads(event.data)
-                self.controls.sync(self.dashboard.state)
-                if event.kind == "refused":  # (its field's inputs say so, as the page's do)
-                    self.controls.mark("refused", [(msg.get("field"), msg["message"])])
-                # (a refusal stops no computation: its progress bar stays)
-                self.progress.visible &= event.kind == "refused"
-                self.status.content = f"**{event.kind}:** {msg['message']}"
-        except Exception as exc:  # never let a drawing error kill the worker thread
-            self.status.content = f"**scene error:** {type(exc).__name__}: {exc}"
+            if self._stopped:
+                return
+            try:
+                if event.kind == "state":
+                    self.controls.show(self.dashboard.state)
+                elif event.kind == "progress":
+                    msg = json.loads(event.data)
+                    # (the runs only: the scene draws no E1, E2, and its status keeps the drawn
+                    # result's while the page shows their progress)
+                    runs = msg.get("phase") == "runs"
+                    now = event.generation == self.dashboard.generation
+                    if runs and now and msg["elapsed"] > PROGRESS_AFTER:
+                        fraction = msg["fraction"]  # (None: not known)
+                        self.progress.visible = fraction is None or fraction < 1
+                        self.progress.value = min(100.0, 100.0 * (fraction or 0.0))  # type: ignore[misc]  # viser: settable
+                        done = "" if fraction is None else f" {100 * fraction:.0f}%"
+                        self.status.content = f"computing…{done}"
+                elif event.kind == "result" and event.result is not None:
+                    self._draw(event.result)
+                elif event.kind == "ahead" and event.result is not None:
+                    with self.server.atomic():  # (the hidden nodes of a result solved ahead)
+                        self.nodes.prebuild(event.result)
+                elif event.kind in ("refused", "error"):
+                    msg = json.loads(event.data)
+                    self.controls.sync(self.dashboard.state)
+                    if event.kind == "refused":  # (its field's inputs say so, as the page's do)
+                        self.controls.mark("refused", [(msg.get("field"), msg["message"])])
+                    # (a refusal stops no computation: its progress bar stays)
+                    self.progress.visible &= event.kind == "refused"
+                    self.status.content = f"**{event.kind}:** {msg['message']}"
+            except Exception as exc:  # never let a drawing error kill the worker thread
+                self.status.content = f"**scene error:** {type(exc).__name__}: {exc}"
 
     def _count_viewers(self, _client) -> None:
         """The scene's status counts the browsers showing it: viser counts a client once its
@@ -131,12 +122,9 @@ class DashboardScene:
         """A change from the GUI or the gizmo. A refused one needs nothing here: the
         dashboard's "refused" event shows it in the scene and on the page, and the controls go
         back to the values in force."""
-        try:
+        with contextlib.suppress(InvalidInputError):
             self.dashboard.update(patch, source="scene")
-        except InvalidInputError:
-            return
 
-    # -- drawing --------------------------------------------------------------------------
     def _draw(self, result) -> None:
         state = result.state
         drawn = runs_key(state)
@@ -172,11 +160,6 @@ class DashboardScene:
             )
             self.dashboard.scene_status.update(generation=result.generation)
         self._show_status(result)
-
-    def _prebuild(self, result) -> None:
-        """Build the hidden nodes of a result solved ahead (``Dashboard._prefetch``)."""
-        with self._lock, self.server.atomic():
-            self.nodes.prebuild(result)
 
     def _show_status(self, result) -> None:
         state = result.state

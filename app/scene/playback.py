@@ -20,16 +20,9 @@ SECONDS_PER_LEG = 1.6
 
 
 class Playback:
-    """The "Playback" folder of a viser ``gui`` and the animation of the mechanisms shown.
-
-    Parameters
-    ----------
-    gui : viser GUI API
-    lock : threading.RLock
-        The scene's lock: the timeline and the mechanisms change under it.
-    status : dict
-        The dashboard's ``scene_status``, whose ``playing`` this keeps.
-    """
+    """The "Playback" folder of a viser ``gui`` and the animation of the mechanisms shown:
+    they and the timeline change under ``lock`` (the scene's); ``status`` is the dashboard's
+    ``scene_status``, whose ``playing`` this keeps."""
 
     def __init__(self, gui: viser.GuiApi, lock: threading.RLock, status: dict) -> None:
         self._lock, self._scene_status = lock, status

@@ -14,6 +14,7 @@ from viser.transforms import SO3
 
 from jik.app.dashboard import Dashboard, compute, default_state, updated_state
 from jik.app.dashboard.algorithms import DEFAULT_ALGORITHMS
+from jik.app.dashboard.messages import Event
 from jik.app.scene import DashboardScene
 from jik.app.scene.controls import MARK
 from jik.app.scene.gizmo import DRAG_INTERVAL
@@ -214,7 +215,7 @@ def test_scene_follows_a_new_result_in_place():
         assert all(scene.nodes.mechanisms[k] is v for k, v in mechanisms.items())
         # A result solved ahead: its nodes are built hidden, and shown by its result.
         other = compute(updated_state(default_state("manipulator1"), {"task": "target"}), 108)
-        scene._prebuild(other)
+        scene._on_event(Event("ahead", 108, "{}", other))
         ahead = scene.nodes.sets[("manipulator1", "target", DEFAULT_ALGORITHMS)]
         assert ahead["frame"].visible is False and ahead["mechanisms"]
         scene._draw(other)
@@ -323,8 +324,6 @@ def test_the_scene_shows_the_runs_progress_not_the_second_phases():
     """The scene's status keeps the drawn result's line while E1, E2 (which it does not draw)
     are computed; a new state's runs show their progress there, until a failure."""
     import json
-
-    from jik.app.dashboard.messages import Event
 
     dashboard = Dashboard(updated_state(default_state("manipulator2"), {"cycles": 1}))
     scene = DashboardScene(dashboard)
