@@ -17,7 +17,7 @@ from ..compute.pool import ComputePool
 from ..compute.settings import Settings
 from .errors import add_error_handlers
 from .fastpath import SolveFastPath
-from .routes import atlas, computing, dashboard, session_atlas, sessions
+from .routes import atlas, computing, dashboard, sessions
 from .security import LOOPBACK_HOSTS, SecurityMiddleware
 
 
@@ -56,8 +56,9 @@ def create_app(settings: Settings | None = None, allowed_hosts: tuple[str, ...] 
     app.state.pool = pool
 
     add_error_handlers(app)
-    for module in (computing, dashboard, sessions, atlas, session_atlas):
+    for module in (computing, dashboard, sessions, atlas):
         app.include_router(module.router)
+    app.include_router(atlas.session_router)
     if settings.fast_solve:
         app.add_middleware(SolveFastPath, pool=pool)
     # Outermost: hosts, origins, content types and sizes are checked before anything else runs.
