@@ -44,7 +44,7 @@ from .validation import validation_detail
 log = logging.getLogger("jik.api")
 
 
-def _detail(status: int, detail: str, retry_after: str | None = None) -> JSONResponse:
+def _detail(status: int, detail: object, retry_after: str | None = None) -> JSONResponse:
     """``{"detail": detail}`` with ``status`` (and Retry-After, in seconds, when given)."""
     headers = None if retry_after is None else {"Retry-After": retry_after}
     return JSONResponse(status_code=status, content={"detail": detail}, headers=headers)
@@ -52,9 +52,7 @@ def _detail(status: int, detail: str, retry_after: str | None = None) -> JSONRes
 
 def _refused(loc: list[str | int], msg: str, kind: str = "value_error") -> JSONResponse:
     """422 in FastAPI's list format, one error at ``loc``."""
-    return JSONResponse(
-        status_code=422, content={"detail": [{"loc": loc, "msg": msg, "type": kind}]}
-    )
+    return _detail(422, [{"loc": loc, "msg": msg, "type": kind}])
 
 
 def field_error_response(exc: RequestError | InvalidInputError) -> JSONResponse:
@@ -91,11 +89,7 @@ def http_error_response(exc: StarletteHTTPException) -> JSONResponse:
     but its unparsed-body 400 as :func:`unparsed_body_response`."""
     if exc.status_code == 400 and exc.detail == _UNPARSED:
         return unparsed_body_response(exc)
-    return JSONResponse(
-        status_code=exc.status_code,
-        content={"detail": exc.detail},
-        headers=getattr(exc, "headers", None),
-    )
+    return JSONResponse({"detail": exc.detail}, exc.status_code, headers=exc.headers)
 
 
 def compute_error_response(exc: ComputeError) -> JSONResponse:
@@ -111,9 +105,7 @@ def unexpected_error_response(exc: Exception) -> JSONResponse:
 
 #: Every expected error and its response; anything else is :func:`unexpected_error_response`.
 _RESPONSES: dict[type[Exception], Callable[[Any], JSONResponse]] = {
-    RequestValidationError: lambda exc: JSONResponse(
-        status_code=422, content={"detail": validation_detail(exc.errors())}
-    ),
+    RequestValidationError: lambda exc: _detail(422, validation_detail(exc.errors())),
     RequestError: field_error_response,
     ServiceUnavailable: lambda exc: _detail(503, str(exc), retry_after="1"),
     ComputeError: compute_error_response,

@@ -32,7 +32,7 @@ from ...dashboard.controls import controls_message
 from ...dashboard.messages import LatestEvents, sse_pieces
 from ...dashboard.patch import StatePatch, parse_patch, patch_of
 from ...dashboard.robots import vet_definition
-from ...dashboard.sessions import Session, SessionNotFound
+from ...dashboard.sessions import SessionNotFound
 from ..dependencies import Pool, Store
 from ..errors import unparsed_body_response
 from ..security import close_websocket
@@ -85,17 +85,6 @@ _SESSION_LINKS = {
 }
 
 
-def _created(session: Session) -> dict:
-    dashboard = session.dashboard
-    return {
-        "id": session.id,
-        "generation": dashboard.generation,
-        "state": dashboard.state.as_dict(),
-        "scene": session.scene is not None,
-        **controls_message(dashboard.state),
-    }
-
-
 @router.post("/api/sessions", status_code=201, responses={201: {"links": _SESSION_LINKS}})
 async def create_session(body: SessionCreate, store: Store, pool: Pool) -> JSONResponse:
     """A new session whose state is the defaults changed by ``state`` (a link's state)."""
@@ -105,7 +94,15 @@ async def create_session(body: SessionCreate, store: Store, pool: Pool) -> JSONR
         session = await asyncio.to_thread(store.create, patch, body.low_end)
     except InvalidInputError as exc:  # (the link's state is the body's "state")
         raise refused(f"state.{exc.field or ''}", without_field(str(exc), exc.field)) from None
-    return JSONResponse(status_code=201, content=_created(session))
+    dashboard = session.dashboard
+    created = {
+        "id": session.id,
+        "generation": dashboard.generation,
+        "state": dashboard.state.as_dict(),
+        "scene": session.scene is not None,
+        **controls_message(dashboard.state),
+    }
+    return JSONResponse(status_code=201, content=created)
 
 
 @router.get("/api/sessions/{session_id}", operation_id="get_session")
