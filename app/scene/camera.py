@@ -22,8 +22,7 @@ from typing import Any
 import numpy as np
 
 from ..dashboard.robots import state_kinematics
-from .arm_marks import AXES_FRACTION
-from .mechanisms import CHAINS, chain_points, extent_of, runs_points
+from .mechanisms import AXES_FRACTION, CHAINS, chain_points, extent_of, runs_points
 
 #: Unit vector from the point looked at to the camera: in front of the task plane, tilted.
 VIEW_DIRECTION = np.array([0.0, -0.75, 1.05]) / math.hypot(0.75, 1.05)

@@ -25,8 +25,9 @@ from ..dashboard.algorithms import DEFAULT_ALGORITHMS, STYLES
 from ..dashboard.controls import PROGRESS_AFTER
 from .camera import CameraFraming
 from .controls import SceneControls
+from .fixtures import add_floor_grid
 from .gizmo import StartGizmo
-from .mechanisms import add_floor_grid, layout_name
+from .mechanisms import layout_name
 from .nodes import NodeSets
 from .playback import Playback
 from .pose import Timeline

@@ -1,5 +1,5 @@
-"""The scene's nodes: the mechanisms of the robots (one copy per algorithm and a grey one at the
-start x0), the floor grid, and the fixtures of a result (rails or guide, traces, targets).
+"""The scene's mechanisms: the robots' copies (one per algorithm and a grey one at the start x0),
+and the task-plane box they span (:func:`extent_of`).
 
 - Manipulator 2 (37): an XY gantry, a beam at height x1 on two rails, a carriage at x2 on the
   beam, and a revolute arm of length l at angle x3; the end effector is the task point.
@@ -7,8 +7,10 @@ start x0), the floor grid, and the fixtures of a result (rails or guide, traces,
   x2 on the vertical guide, a lever of slope x3 pivoting on it, and a vertical runner at x1;
   the task point W = (x1, x2 + x1 x3) is where the lever crosses the runner.
 - The unicycle (40): a platform with two wheels and a heading nose at the pose q(t).
-- A user's planar chain or URDF arm: links as lines between its joints' points,
-  joints as spheres (:class:`Chain`); a formula robot has no drawing, only its task path.
+- A user's planar chain or URDF arm: links as lines between its joints' points, joints as
+  spheres, orange outside their limits, and the end link's frame (axes triad: x red, y green,
+  z blue) when the task holds its orientation (:class:`Chain`); a formula robot has no
+  drawing, only its task path.
 
 One copy per chosen algorithm, in its colour, opacity and height
 (:data:`jik.app.dashboard.algorithms.STYLES`: the pseudoinverse the translucent red ghost, the
@@ -26,22 +28,17 @@ import numpy as np
 from viser.transforms import SO3
 
 from ...engine.arms import ARMS
-from ..dashboard.algorithms import COLORS, STYLES
+from ...engine.pose_task import COORDINATES
 from ..dashboard.joint_limits import outside_joints, state_limits
 from ..dashboard.robots import state_kinematics
 from ..dashboard.runs import spaced_iterations
-from .arm_marks import (
-    AXES_FRACTION,
-    OUTSIDE_COLOR,
-    end_frame,
-    has_pose,
-    target_fixtures,
-    target_pose,
-)
 from .pose import NORMAL_FORM
-from .traces import polyline, rgb, trace_tolerance, unicycle_traces
 
 HOME_COLOR = (150, 150, 150)
+#: A joint's colour while its value is outside the robot's limits.
+OUTSIDE_COLOR = (255, 140, 0)
+#: Length of a target's and of the end link's axes, as a fraction of the arm's reach.
+AXES_FRACTION = 0.12
 
 
 class Mechanism:
@@ -243,6 +240,23 @@ def runs_points(result, kin: Any) -> np.ndarray:
     return chain_points(kin, xs[:: max(1, len(xs) // 200)], 0.0).reshape(-1, 3)
 
 
+def wxyz(R) -> tuple[float, float, float, float]:
+    """The unit quaternion (w, x, y, z) of a rotation matrix (3, 3)."""
+    q = SO3.from_matrix(np.asarray(R, dtype=float)).wxyz
+    return tuple(float(v) for v in q)  # type: ignore[return-value]
+
+
+def has_pose(kin: Any) -> bool:
+    """Whether the task gives a whole frame: position and the three rotation coordinates."""
+    return set(getattr(kin, "task_names", ())) == set(COORDINATES)
+
+
+def end_frame(kin: Any, x) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """(position, wxyz) of a URDF arm's end link at ``x`` (p,)."""
+    R, t = kin.end_pose(np.asarray(x, dtype=float))
+    return tuple(float(v) for v in t), wxyz(R)
+
+
 #: The robots drawn as a serial chain of links (:class:`Chain`): a user's and the catalogue's arms.
 CHAINS = ("planar_chain", "urdf", *ARMS)
 MECHANISMS: dict[str, type[Mechanism]] = dict.fromkeys(CHAINS, Chain)
@@ -256,87 +270,6 @@ def layout_name(state) -> str:
         return state.robot
     text = json.dumps(state.robot_definition, sort_keys=True).encode()
     return f"{state.robot}-{hashlib.sha256(text).hexdigest()[:12]}"
-
-
-# Every line (traces, grid) is sized in pixels: viser's world-unit lines solve a ray-segment
-# distance per fragment and redraw each line in a second blended pass, for no visible gain at
-# the dashboard's zoom (frame costs: docs/benchmarks.md, "Dashboard latency").
-
-
-def add_floor_grid(scene) -> None:
-    """A grid on the task plane (z slightly below 0), 20 x 20 with cells of 0.5 and section
-    lines every 1, drawn as two sets of line segments.
-
-    viser's ``add_grid`` shades every pixel of its plane; line segments draw the same grid at
-    the cost of its lines only.
-    """
-    ticks = 0.5 * np.arange(-20, 21)  # (every other one a section line, from -10 to 10)
-    for name, where, color in (
-        ("cells", ticks[1::2], (200, 200, 200)),
-        ("sections", ticks[::2], (140, 140, 140)),
-    ):
-        at, span = np.broadcast_arrays(where[:, None], [-10.0, 10.0])  # (n, 2)
-        z = np.full(at.shape, -0.06)
-        lines = np.concatenate([np.stack([at, span, z], -1), np.stack([span, at, z], -1)])
-        scene.add_line_segments(  # (along y at x = where, then along x at y = where)
-            f"/grid/{name}", lines, color, thickness=1.0, thickness_units="screen"
-        )
-
-
-def fixtures_of(result, extent, root: str) -> dict[str, tuple[str, dict, dict]]:
-    """The parts of a robot's scene besides the mechanisms, by node name: (kind, the values
-    that follow the result, the fixed style), made by viser's ``add_<kind>``. The rails
-    (Manipulator 2) or the guide (Manipulator 1) span the task-plane box; the task paths of both
-    algorithms, and for Manipulator 2 the carriage paths (x2, x1), which are the joint paths:
-    closed for J^E#, not for J^P#; the targets of the path's legs. The unicycle's: its paths
-    (:func:`~jik.app.scene.traces.unicycle_traces`)."""
-    (xlo, xhi), (ylo, yhi) = extent
-    tol = trace_tolerance(extent)
-    if result.state.robot == "unicycle":
-        return unicycle_traces(result, root, tol)
-    # Heights and balls at the manipulators' scale, smaller in a smaller scene (a formula
-    # robot's paths may span a few millimetres).
-    scale = min(1.0, max(xhi - xlo, yhi - ylo) / 2.0)
-    robot = result.state.robot
-    out: dict[str, tuple[str, dict, dict]] = {}
-    rails = {
-        "manipulator2": {"rails/left": xlo, "rails/right": xhi},
-        "manipulator1": {"guide": 0.0},
-    }
-    for name, x in rails.get(robot, {}).items():  # (grey boxes along y, at x)
-        rail = {"dimensions": (0.06, yhi - ylo, 0.05), "position": (x, (ylo + yhi) / 2, -0.02)}
-        out[f"{root}/{name}"] = ("box", rail, {"color": (90, 90, 90)})
-    chain = robot in CHAINS
-    kin = state_kinematics(result.state) if chain else None
-    for a, run in result.runs.items():
-        line = {"colors": rgb(COLORS[a]), "thickness_units": "screen"}  # pixels, see above
-        if chain:  # (the end point's path: a URDF arm's task may be some of x, y, z)
-            task = chain_points(kin, run.x, (STYLES[a].z + 0.16) * scale)[:, -1]
-        else:
-            z = np.full(len(run.y), (STYLES[a].z + 0.16) * scale)
-            task = np.column_stack([run.y[:, 0], run.y[:, 1], z])
-        out[f"{root}/trace/{a}/task"] = (
-            "line_segments",
-            {"points": polyline(task, tol)},
-            {**line, "thickness": 3.0 if a == "pseudoinverse" else 2.0},
-        )
-        if robot == "manipulator2":
-            joints = np.column_stack(
-                [run.x[:, 1], run.x[:, 0], np.full(len(run.x), STYLES[a].z + 0.1)]
-            )
-            out[f"{root}/trace/{a}/joints"] = (
-                "line_segments",
-                {"points": polyline(joints, tol)},
-                {**line, "thickness": 1.2},
-            )
-    size = 0.0  # (of a target's axes)
-    if chain and robot != "planar_chain":  # (a frame or a point, see target_pose)
-        size = AXES_FRACTION * float(np.linalg.norm(np.ptp(np.reshape(extent, (2, 2)), axis=1))) / 2
-        poses, radius = [target_pose(kin, t) for t in result.targets], 0.15 * size
-    else:
-        poses = [((float(t[0]), float(t[1]), 0.2 * scale), None) for t in result.targets]
-        radius = 0.05 * scale
-    return {**out, **target_fixtures(poses, root, radius, size)}
 
 
 def extent_of(result) -> tuple[tuple[float, float], tuple[float, float]]:

@@ -1,7 +1,7 @@
 """The scene's node sets: one per robot layout, kept and moved.
 
 A layout's set (its mechanisms, the grey copy at the start, the unicycle's target, and the
-fixtures of :func:`~jik.app.scene.mechanisms.fixtures_of`, under a frame of their own) is built
+fixtures of :func:`~jik.app.scene.fixtures.fixtures_of`, under a frame of their own) is built
 when its layout (robot and task) is first shown, or ahead (:meth:`NodeSets.prebuild`), and then
 kept, hidden when another layout is on screen: showing it again moves its nodes, which costs the
 client far less than mounting new ones.
@@ -15,15 +15,8 @@ import numpy as np
 
 from ..dashboard.algorithms import COLORS, DEFAULT_ALGORITHMS, STYLES
 from ..dashboard.plotting import corner_names
-from .mechanisms import (
-    HOME_COLOR,
-    MECHANISMS,
-    Mechanism,
-    extent_of,
-    fixtures_of,
-    layout_name,
-    rgb,
-)
+from .fixtures import fixtures_of, rgb
+from .mechanisms import HOME_COLOR, MECHANISMS, Mechanism, extent_of, layout_name
 from .pose import Timeline
 
 

@@ -181,7 +181,7 @@ def test_the_scene_draws_a_robot_per_chosen_algorithm(three):
     the paper's two alone come back to the default set."""
     from jik.app.dashboard import Dashboard
     from jik.app.scene import DashboardScene
-    from jik.app.scene.mechanisms import rgb
+    from jik.app.scene.fixtures import rgb
 
     dashboard = Dashboard(default_state())
     scene = DashboardScene(dashboard)

@@ -28,8 +28,8 @@ from jik.app.dashboard.runs import Cancelled
 from jik.app.dashboard.session import Dashboard
 from jik.app.dashboard.verdict import verdict
 from jik.app.scene import DashboardScene
-from jik.app.scene.arm_marks import OUTSIDE_COLOR, end_frame, target_pose
-from jik.app.scene.mechanisms import Chain, fixtures_of
+from jik.app.scene.fixtures import fixtures_of, target_pose
+from jik.app.scene.mechanisms import OUTSIDE_COLOR, Chain, end_frame
 from jik.engine import robot_from_dict
 from jik.engine.arms import ARMS
 from jik.engine.atlas_run import run_atlas

@@ -17,6 +17,7 @@ from jik.app.dashboard.algorithms import DEFAULT_ALGORITHMS
 from jik.app.dashboard.messages import Event
 from jik.app.scene import DashboardScene
 from jik.app.scene.controls import MARK
+from jik.app.scene.fixtures import TRACE_TOLERANCE, polyline, simplify
 from jik.app.scene.gizmo import DRAG_INTERVAL
 from jik.app.scene.mechanisms import extent_of
 from jik.app.scene.pose import (
@@ -24,7 +25,6 @@ from jik.app.scene.pose import (
     gizmo_pose,
     start_from_gizmo,
 )
-from jik.app.scene.traces import TRACE_TOLERANCE, polyline, simplify
 from jik.engine.registry import ROBOTS
 from tests.helpers import run_async
 
