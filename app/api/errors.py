@@ -31,7 +31,6 @@ from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
-from starlette.routing import Match
 
 from ...engine.exceptions import InvalidInputError
 from ..compute.atlas_jobs import AtlasJobNotFound, AtlasJobsFull
@@ -39,6 +38,7 @@ from ..compute.exceptions import ComputeError, RequestError, ServiceUnavailable
 from ..compute.schemas import ErrorResponse
 from ..compute.schemas.wording import field_loc, field_text, without_field
 from ..dashboard.sessions import ExportUnavailable, SessionNotFound, SessionsFull
+from .security import routed
 from .validation import validation_detail
 
 log = logging.getLogger("jik.api")
@@ -134,14 +134,8 @@ def error_response(exc: Exception) -> JSONResponse | None:
 def _allowed_methods(request: Request) -> str:
     """Every method some route takes at the request's path (routes are one per method, and the
     framework's 405 names only the first one's)."""
-    routes = request.app.router.routes
-    return ", ".join(
-        method
-        for method in ("DELETE", "GET", "HEAD", "OPTIONS", "PATCH", "POST", "PUT")
-        if any(
-            route.matches({**request.scope, "method": method})[0] == Match.FULL for route in routes
-        )
-    )
+    methods = ("DELETE", "GET", "HEAD", "OPTIONS", "PATCH", "POST", "PUT")
+    return ", ".join(m for m in methods if routed({**request.scope, "method": m}))
 
 
 def _handler(respond: Callable[[Any], JSONResponse]):

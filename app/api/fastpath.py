@@ -56,8 +56,7 @@ class SolveFastPath:
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         # (a body that is not JSON never gets here: the security middleware, outside, answers 415)
-        solve = scope["type"] == "http" and scope["path"] == "/solve"
-        if not (solve and scope["method"] == "POST"):
+        if scope["type"] != "http" or scope["path"] != "/solve" or scope["method"] != "POST":
             await self.app(scope, receive, send)
             return
         try:

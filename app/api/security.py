@@ -86,8 +86,8 @@ class SecurityMiddleware:
             status, message = refusal
             if websocket:
                 await close_websocket(receive, send, 4000 + status, message)
-                return
-            await _refused(status, message)(scope, receive, send)
+            else:
+                await _refused(status, message)(scope, receive, send)
             return
         if websocket:
             await self.app(scope, receive, send)
@@ -139,7 +139,7 @@ class SecurityMiddleware:
         if (websocket or method in CHANGES) and origin is not None:
             if origin == "null" or urlsplit(origin).netloc.lower() != host.lower():
                 return 403, f"a request from another origin ({origin}) may not change anything"
-        if method in _BODIES and _routed(scope):
+        if method in _BODIES and routed(scope):
             kind = headers.get("content-type", "").split(";")[0].strip().lower()
             if kind != "application/json" and not kind.endswith("+json"):
                 return 415, (
@@ -161,7 +161,7 @@ def _too_large(size: str) -> str:
     )
 
 
-def _routed(scope: Scope) -> bool:
+def routed(scope: Scope) -> bool:
     """Whether a route of the app takes this method at this path (else the router answers,
     404 or 405 with its Allow header, whatever the body)."""
     app = scope.get("app")

@@ -89,6 +89,3 @@ async def config() -> dict:
     order), and when a computation shows its progress. (Each session's controls come with its
     state.)"""
     return page_config()
-
-
-__all__ = ["router"]
