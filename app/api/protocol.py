@@ -34,8 +34,6 @@ import asyncio
 
 from uvicorn.protocols.http.httptools_impl import HttpToolsProtocol, RequestResponseCycle
 
-#: Default seconds a client has to send a whole request (``JIK_READ_SECONDS``).
-READ_SECONDS = 10.0
 #: Largest request line and headers [bytes]; 431 beyond, as soon as they cross it.
 MAX_HEADER_BYTES = 64 * 1024
 
@@ -61,8 +59,8 @@ class ReadDeadlineProtocol(HttpToolsProtocol):
     """uvicorn's httptools protocol with a deadline on reading each request (see the module)."""
 
     #: Seconds from a request's first byte (or the connection) to its last
-    #: (:func:`with_read_deadline` sets it).
-    read_seconds: float = READ_SECONDS
+    #: (``JIK_READ_SECONDS``, which :func:`with_read_deadline` sets).
+    read_seconds: float
 
     def connection_made(self, transport: asyncio.Transport) -> None:  # type: ignore[override]
         self._read_timer: asyncio.TimerHandle | None = None
@@ -139,7 +137,6 @@ class ReadDeadlineProtocol(HttpToolsProtocol):
 
 
 def with_read_deadline(seconds: float) -> type[ReadDeadlineProtocol]:
-    """The protocol class for uvicorn's ``http=`` option, with ``seconds`` to read a request."""
-    if not seconds > 0:
-        raise ValueError(f"JIK_READ_SECONDS must be positive, got {seconds}")
+    """The protocol class for uvicorn's ``http=`` option, with ``seconds`` (positive, as
+    :class:`~jik.app.compute.settings.Settings` checks it) to read a request."""
     return type("ReadDeadlineProtocol", (ReadDeadlineProtocol,), {"read_seconds": float(seconds)})

@@ -25,8 +25,8 @@ class PortInUse(RuntimeError):
     """A port that ``jik serve`` needs is taken; the message names the option that changes it."""
 
 
-def bind(host: str, port: int, option: str) -> socket.socket:
-    """A listening TCP socket on ``host:port``; :class:`PortInUse` naming ``option`` if taken."""
+def bind(host: str, port: int) -> socket.socket:
+    """A listening TCP socket on ``host:port``; :class:`PortInUse` naming ``--port`` if taken."""
     family = socket.AF_INET6 if ":" in host else socket.AF_INET
     sock = socket.socket(family, socket.SOCK_STREAM)
     sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
@@ -37,7 +37,7 @@ def bind(host: str, port: int, option: str) -> socket.socket:
         if error.errno in (errno.EADDRINUSE, errno.EACCES):
             raise PortInUse(
                 f"port {port} on {host} is in use or not allowed ({error.strerror}); "
-                f"choose another with {option} PORT"
+                "choose another with --port PORT"
             ) from None
         raise
     sock.listen(2048)
@@ -78,7 +78,7 @@ def run_server(
         If a ``JIK_*`` variable is not valid (its ``field`` names it), before anything starts.
     """
     settings = read_environment()  # (once; a bad JIK_* variable is refused by its name)
-    sock = bind(host, port, "--port")
+    sock = bind(host, port)
     app = create_app(settings, allowed_hosts=allowed_hosts)
     # The sessions share the app's compute pool (JIK_WORKERS processes) with the API.
     app.state.sessions = SessionStore(settings, scene_factory=DashboardScene, pool=app.state.pool)

@@ -162,6 +162,8 @@ class SecondPhaseRequest(BaseModel):
     )
 
 
+#: A session that is not there (expired, deleted, never created).
+_NOT_FOUND: dict[int | str, dict] = {404: {"description": "no such session"}}
 #: A second phase that is not in the state a request needs.
 _SECOND_PHASE_CONFLICT: dict[int | str, dict] = {
     409: {
@@ -175,7 +177,7 @@ _SECOND_PHASE_CONFLICT: dict[int | str, dict] = {
     "/api/sessions/{session_id}/functionals/cancel",
     status_code=202,
     operation_id="cancel_functionals",
-    responses={**_SECOND_PHASE_CONFLICT, 404: {"description": "no such session"}},
+    responses={**_SECOND_PHASE_CONFLICT, **_NOT_FOUND},
 )
 async def cancel_functionals(
     session_id: str, body: SecondPhaseRequest, store: Store
@@ -195,7 +197,7 @@ async def cancel_functionals(
     "/api/sessions/{session_id}/functionals",
     status_code=202,
     operation_id="compute_functionals",
-    responses={**_SECOND_PHASE_CONFLICT, 404: {"description": "no such session"}},
+    responses={**_SECOND_PHASE_CONFLICT, **_NOT_FOUND},
 )
 async def compute_functionals(
     session_id: str, body: SecondPhaseRequest, store: Store
@@ -233,8 +235,6 @@ _NO_EXPORT: dict[int | str, dict] = {
     },
     503: {"description": "the current state's result is not computed yet"},
 }
-#: A session that is not there (expired, deleted, never created).
-_NOT_FOUND: dict[int | str, dict] = {404: {"description": "no such session"}}
 
 
 @router.get(
