@@ -23,7 +23,7 @@ from plotly.colors import hex_to_rgb as rgb  # ((r, g, b) of "#rrggbb", as viser
 from ..dashboard.algorithms import COLORS, STYLES
 from ..dashboard.robots import state_kinematics
 from .mechanisms import AXES_FRACTION, CHAINS, chain_points, wxyz
-from .pose import shown_iterations
+from .playback import shown_iterations
 
 #: Largest distance of a drawn trace from the computed path, as a fraction of the scene's size
 #: (about a third of a pixel at the dashboard's size).
@@ -66,8 +66,9 @@ def polyline(points: np.ndarray, tol: float) -> np.ndarray:
 
 
 def unicycle_traces(result, root: str, tol: float) -> dict[str, tuple[str, dict, dict]]:
-    """The unicycle's paths at its shown iterations (:func:`~jik.app.scene.pose.shown_iterations`)
-    as fixtures: each algorithm's the paler the earlier, the last in its colour and thicker."""
+    """The unicycle's paths at its shown iterations
+    (:func:`~jik.app.scene.playback.shown_iterations`) as fixtures: each algorithm's the paler
+    the earlier, the last in its colour and thicker."""
     shown = shown_iterations(result)
     out: dict[str, tuple[str, dict, dict]] = {}
     for a, run in result.runs.items():

@@ -1,8 +1,9 @@
 """The draggable start point: a transform gizmo in the task plane whose pose is the start x0
-(or the unicycle's initial pose q0), see :func:`jik.app.scene.pose.gizmo_pose`."""
+(or the unicycle's initial pose q0): :func:`gizmo_pose`, and back, :func:`start_from_gizmo`."""
 
 from __future__ import annotations
 
+import math
 import threading
 import time
 from collections.abc import Callable
@@ -11,11 +12,56 @@ import numpy as np
 import viser
 from viser.transforms import SO3
 
-from .pose import gizmo_pose, start_from_gizmo
+from .mechanisms import NORMAL_FORM
 
 #: Seconds between two changes of the start point while its gizmo is dragged (each starts a
 #: computation; the dashboard solves only the newest state, but every change is an event).
 DRAG_INTERVAL = 0.15
+
+
+def gizmo_pose(robot: str, x0, robot_parameters: dict) -> tuple[tuple[float, float], float]:
+    """Where the start-point gizmo sits: ((X, Y), yaw) in the task plane.
+
+    Manipulator 2: the carriage (x2, x1), yaw x3. Manipulator 1: the task point
+    W = (x1, x2 + x1 x3), yaw atan(x3) (the lever's slope). Unicycle: the initial pose q0.
+    """
+    if robot == "manipulator2":
+        return (x0[1], x0[0]), x0[2]
+    if robot == "manipulator1":
+        X, Y = (float(v) for v in NORMAL_FORM.forward(np.asarray(x0, dtype=float)))
+        return (X, Y), math.atan(x0[2])
+    q0 = robot_parameters["q0"]
+    return (q0[0], q0[1]), q0[2]
+
+
+#: Coordinates of a start point from the gizmo that differ from the state's by no more than this
+#: keep the state's value: the round trip through the gizmo's pose (a quaternion, a rotation of
+#: the axes) is exact only to rounding, and a press on the gizmo must not be a change.
+GIZMO_ROUNDING = 1e-9
+
+
+def _snapped(values, before) -> list[float]:
+    pairs = zip(values, map(float, before), strict=True)
+    return [b if abs(v - b) <= GIZMO_ROUNDING else v for v, b in pairs]
+
+
+def start_from_gizmo(robot: str, xy, yaw: float, state) -> dict:
+    """The dashboard change for a gizmo moved to ``xy`` with rotation ``yaw`` (inverse of above).
+
+    Manipulator 1 keeps x3 = tan(yaw) within a slope of +-20 (the lever cannot turn vertical).
+    Coordinates within :data:`GIZMO_ROUNDING` of the state's keep their value: a gizmo where
+    the state puts it gives the state's start point exactly.
+    """
+    X, Y = float(xy[0]), float(xy[1])
+    if robot == "manipulator2":
+        x3 = float(state.x0[2]) + math.remainder(yaw - float(state.x0[2]), 2 * math.pi)
+        return {"x0": _snapped([Y, X, x3], state.x0)}
+    if robot == "manipulator1":
+        x3 = math.tan(max(-1.52, min(1.52, yaw)))
+        return {"x0": _snapped([X, Y - X * x3, x3], state.x0)}
+    q0 = list(state.robot_parameters["q0"])
+    q3 = q0[2] + math.remainder(yaw - q0[2], 2 * math.pi)
+    return {"robot_parameters": {"q0": _snapped([X, Y, q3], q0)}}
 
 
 class StartGizmo:

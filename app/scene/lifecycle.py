@@ -29,8 +29,7 @@ from .fixtures import add_floor_grid
 from .gizmo import StartGizmo
 from .mechanisms import layout_name
 from .nodes import NodeSets
-from .playback import Playback
-from .pose import Timeline
+from .playback import Playback, Timeline
 from .server import SceneServer
 
 

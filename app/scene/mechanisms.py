@@ -28,12 +28,14 @@ import numpy as np
 from viser.transforms import SO3
 
 from ...engine.arms import ARMS
+from ...engine.kinematics import Manipulator1
 from ...engine.pose_task import COORDINATES
 from ..dashboard.joint_limits import outside_joints, state_limits
 from ..dashboard.robots import state_kinematics
 from ..dashboard.runs import spaced_iterations
-from .pose import NORMAL_FORM
 
+#: Manipulator 1's kinematics k(x) = (x1, x2 + x1 x3), eq. (30): where its task point W is.
+NORMAL_FORM = Manipulator1()
 HOME_COLOR = (150, 150, 150)
 #: A joint's colour while its value is outside the robot's limits.
 OUTSIDE_COLOR = (255, 140, 0)

@@ -17,7 +17,7 @@ from ..dashboard.algorithms import COLORS, DEFAULT_ALGORITHMS, STYLES
 from ..dashboard.plotting import corner_names
 from .fixtures import fixtures_of, rgb
 from .mechanisms import HOME_COLOR, MECHANISMS, Mechanism, extent_of, layout_name
-from .pose import Timeline
+from .playback import Timeline
 
 
 def set_key(state) -> tuple:

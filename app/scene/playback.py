@@ -1,5 +1,6 @@
-"""The scene's playback: its GUI folder (play, speed, position, the step on show, the status)
-and the thread that animates the mechanisms along the result's :class:`Timeline`."""
+"""The scene's playback: the animation's :class:`Timeline` (both algorithms' configurations as
+functions of one playback position), its GUI folder (play, speed, position, the step on show,
+the status) and the thread that animates the mechanisms along it."""
 
 from __future__ import annotations
 
@@ -7,16 +8,74 @@ import threading
 import time
 from collections.abc import Mapping
 
+import numpy as np
 import viser
 
+from ..dashboard.runs import spaced_iterations
 from .controls import Syncing
 from .mechanisms import Mechanism
-from .pose import Timeline
 
 #: Frames per second of the animation (poses sent to the clients).
 FPS = 25.0
 #: Seconds of animation per leg (manipulators) or per shown iteration (unicycle) at speed 1.
 SECONDS_PER_LEG = 1.6
+#: Unicycle iterations shown in the animation (geometrically spaced, the last always).
+UNICYCLE_SHOWN = 10
+
+
+def shown_iterations(result) -> np.ndarray:
+    """The unicycle's iterations that the animation and the traces show: :data:`UNICYCLE_SHOWN`
+    geometrically spaced ones, the first and the last always."""
+    return spaced_iterations(max(len(r.platform) for r in result.runs.values()), UNICYCLE_SHOWN)
+
+
+class Timeline:
+    """Configurations of both algorithms as functions of one playback position s in [0, length]."""
+
+    def __init__(self, result) -> None:
+        self.result = result
+        self.unicycle = any(r.platform is not None for r in result.runs.values())
+        if self.unicycle:
+            self.shown = shown_iterations(result)
+            self.length = float(len(self.shown))
+        else:
+            theta_end = max(float(r.theta[-1]) for r in result.runs.values())
+            legs = int(max(r.leg.max() for r in result.runs.values())) + 1
+            self.leg_theta = theta_end / legs
+            self.length = float(legs)
+
+    def at(self, s: float) -> dict[str, np.ndarray]:
+        """Per algorithm: the configuration x (manipulators) or pose q (unicycle) at ``s``."""
+        s = min(max(s, 0.0), self.length)
+        out = {}
+        if self.unicycle:
+            i = min(int(s), len(self.shown) - 1)
+            frac = s - i if s < self.length else 1.0
+            for a, run in self.result.runs.items():
+                P = run.platform[min(self.shown[i], len(run.platform) - 1)]
+                j = frac * (len(P) - 1)
+                j0 = min(int(j), len(P) - 2)
+                out[a] = P[j0] + (j - j0) * (P[j0 + 1] - P[j0])
+            return out
+        theta = s * self.leg_theta
+        for a, run in self.result.runs.items():
+            out[a] = np.array(
+                [np.interp(theta, run.theta, run.x[:, k]) for k in range(run.x.shape[1])]
+            )
+        return out
+
+    def counter(self, s: float) -> str:
+        """What the animation shows at ``s``: the unicycle's iteration (of the discrete
+        algorithm), or the leg of the closed path (its cycle)."""
+        if self.unicycle:
+            k = int(self.shown[min(int(s), len(self.shown) - 1)])
+            last = max(len(r.platform) for r in self.result.runs.values()) - 1
+            return f"**iteration {k}** of {last}"
+        legs = max(round(self.length), 1)
+        j = min(int(s), legs - 1)
+        per = len(self.result.targets)
+        cycle = f" (cycle {j // per + 1}, leg {j % per + 1} of {per})" if per < legs else ""
+        return f"**leg {j + 1}** of {legs}{cycle}"
 
 
 class Playback:

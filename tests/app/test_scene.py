@@ -18,13 +18,9 @@ from jik.app.dashboard.messages import Event
 from jik.app.scene import DashboardScene
 from jik.app.scene.controls import MARK
 from jik.app.scene.fixtures import TRACE_TOLERANCE, polyline, simplify
-from jik.app.scene.gizmo import DRAG_INTERVAL
+from jik.app.scene.gizmo import DRAG_INTERVAL, gizmo_pose, start_from_gizmo
 from jik.app.scene.mechanisms import extent_of
-from jik.app.scene.pose import (
-    Timeline,
-    gizmo_pose,
-    start_from_gizmo,
-)
+from jik.app.scene.playback import Timeline
 from jik.engine.registry import ROBOTS
 from tests.helpers import run_async
 
@@ -527,7 +523,7 @@ def test_the_unicycles_nodes_are_kept_and_moved():
     traces (one per algorithm and shown iteration, the last thicker) instead of drawing them
     anew; the grey platform stands at the start q0, the black one at the target."""
     from jik.app.scene.nodes import set_key
-    from jik.app.scene.pose import shown_iterations
+    from jik.app.scene.playback import shown_iterations
 
     state = default_state("unicycle")
     dashboard = Dashboard(default_state("manipulator2"))
