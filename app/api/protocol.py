@@ -1,31 +1,24 @@
-"""The HTTP protocol ``jik serve`` runs under uvicorn: uvicorn's own, with a deadline for reading
-and a cap on the size of a request's headers.
+"""The HTTP protocol ``jik serve`` runs under uvicorn: uvicorn's httptools protocol, with a
+deadline for reading and a cap on the size of a request's headers (why uvicorn's own options do
+neither, and the figures: ``docs/benchmarks.md``, "Slow and oversized requests").
 
 uvicorn times out an idle keep-alive connection but not one that is sending a request: a client
 that opens a connection and sends nothing, or half of its headers, or part of a declared body,
-keeps a socket and a task for ever (a "slowloris"; 1,000 such connections stayed open). Here every
-request must arrive whole, headers and body, within ``read_seconds`` of its first byte (or of the
-connection, for the first request), however slowly the bytes trickle in:
+keeps a socket and a task for ever (a "slowloris"). Here every request must arrive whole,
+headers and body, within ``read_seconds`` of its first byte (or of the connection, for the first
+request), however slowly the bytes trickle in:
 
 - headers not complete by then: the connection is answered ``408 Request Timeout`` and closed;
 - headers complete, body not: the connection is closed (the application, still waiting for the
   body, sees the client disconnect; no response can be sent through it any more).
 
 Headers longer than :data:`MAX_HEADER_BYTES` are answered ``431 Request Header Fields Too Large``
-at once and the connection is closed (uvicorn's httptools protocol has no such limit: the parser
-kept a 48 MB header in memory and the request was served; h11's ``h11_max_incomplete_event_size``
-answers a bare 400, and h11 parses slower).
-
-WebSocket upgrades and responses that take long to compute are not affected: the deadline stops
-when the request has been read.
+at once and the connection is closed. WebSocket upgrades and responses that take long to compute
+are not affected: the deadline stops when the request has been read.
 
 A client that pipelines requests and goes away: every request it left unanswered sees the
 disconnect (uvicorn tells only the newest one, and the older one being answered wrote to a closed
 transport, logging a traceback).
-
-uvicorn offers neither: ``timeout_keep_alive`` counts only the idle time between requests, and
-``limit_concurrency`` caps connections (slow ones included) rather than freeing them. The figures
-are in ``docs/benchmarks.md`` ("Slow and oversized requests").
 """
 
 from __future__ import annotations
@@ -71,9 +64,7 @@ class ReadDeadlineProtocol(HttpToolsProtocol):
 
     def connection_lost(self, exc: Exception | None) -> None:
         self._stop_reading()
-        # uvicorn marks only the newest request as disconnected; with pipelined requests the
-        # one being answered is an older one, whose response then went to a closed transport
-        # ("Exception in ASGI application"). Every unanswered request is told here.
+        # Every unanswered request is told, not only the newest as uvicorn does (see the module).
         for cycle in self._cycles:
             if not cycle.response_complete:
                 cycle.disconnected = True
