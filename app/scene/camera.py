@@ -47,13 +47,10 @@ def view_of(result) -> tuple[np.ndarray, float]:
     if state.robot in CHAINS:
         kin = state_kinematics(state)
         home = chain_points(kin, np.asarray(state.x0, dtype=float), 0.0)  # (n + 1, 3)
-        base = home[0]
         reach = float(np.linalg.norm(np.diff(home, axis=0), axis=1).sum())
         drawn = runs_points(result, kin)
-        radius = max(reach, float(np.linalg.norm(drawn - base, axis=1).max()))
         if np.ptp(drawn[:, 2]) > 0:  # (an arm standing in space)
-            # The box of its drawn configurations, not its whole reach around the base.
-            # (and the targets' positions, where its pose frames are drawn).
+            # (and the targets' positions, where its pose frames are drawn)
             targets = np.asarray(result.targets, dtype=float)
             if targets.ndim == 2 and targets.shape[1] >= 3:
                 drawn = np.vstack([drawn, targets[:, :3]])
@@ -61,7 +58,8 @@ def view_of(result) -> tuple[np.ndarray, float]:
             radius = float(np.linalg.norm(drawn - center, axis=1).max())
             # (and the end link's frame, its axes AXES_FRACTION of the reach long).
             return center, max(radius + AXES_FRACTION * reach, 1e-3)
-        return base, max(radius, 1e-3)
+        radius = max(reach, float(np.linalg.norm(drawn - home[0], axis=1).max()))
+        return home[0], max(radius, 1e-3)
     (xlo, xhi), (ylo, yhi) = extent_of(result)
     center = np.array([(xlo + xhi) / 2, (ylo + yhi) / 2, 0.0])
     return center, max(math.hypot(xhi - xlo, yhi - ylo) / 2, 1e-3)
