@@ -38,7 +38,7 @@ from ..compute.exceptions import ComputeError, RequestError, ServiceUnavailable
 from ..compute.schemas import ErrorResponse
 from ..compute.schemas.wording import field_loc, field_text, without_field
 from ..dashboard.sessions import ExportUnavailable, SessionNotFound, SessionsFull
-from .security import routed
+from .security import BODIES, CHANGES, routed
 from .validation import validation_detail
 
 log = logging.getLogger("jik.api")
@@ -158,8 +158,8 @@ def _error(description: str, schema: str = "ErrorResponse") -> dict:
 #: The errors that checks before the routes answer (:mod:`jik.app.api.security`, the
 #: session store), as the OpenAPI document lists them for each operation they apply to.
 _ANY_OPERATION = {"400": _error("a host name the server does not answer to")}
+_CHANGE = {"403": _error("a change asked from another origin")}
 _WITH_BODY = {
-    "403": _error("a change asked from another origin"),
     "413": _error("a body over 1 MiB"),
     "415": _error("a body that is not JSON (application/json)", "HTTPValidationError"),
 }
@@ -180,10 +180,10 @@ def document_errors(app: FastAPI) -> None:
                 for method, operation in operations.items():
                     responses = operation.setdefault("responses", {})
                     extra = dict(_ANY_OPERATION)
-                    if method in ("post", "put", "patch", "delete"):
-                        extra |= {
-                            k: v for k, v in _WITH_BODY.items() if method != "delete" or k == "403"
-                        }
+                    if method.upper() in CHANGES:
+                        extra |= _CHANGE
+                    if method.upper() in BODIES:
+                        extra |= _WITH_BODY
                     if "{session_id}" in path:
                         extra |= _IN_SESSION
                     for status, response in extra.items():

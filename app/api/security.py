@@ -39,9 +39,10 @@ from ..compute.settings import host_name
 MAX_BODY_BYTES = 1 << 20
 #: Host names allowed by default: the loopback names.
 LOOPBACK_HOSTS = ("localhost", "127.0.0.1", "[::1]", "::1")
-#: Methods that change something, whose body must be JSON and whose origin must be ours.
+#: Methods that change something, whose origin must be ours.
 CHANGES = frozenset({"POST", "PUT", "PATCH", "DELETE"})
-_BODIES = frozenset({"POST", "PUT", "PATCH"})
+#: Methods whose body must be JSON.
+BODIES = frozenset({"POST", "PUT", "PATCH"})
 _PAGE_POLICY = (
     "default-src 'self'; script-src 'self'; style-src 'self' 'unsafe-inline'; "
     "img-src 'self' data: blob:; connect-src 'self'; worker-src 'self' blob:; "
@@ -139,7 +140,7 @@ class SecurityMiddleware:
         if (websocket or method in CHANGES) and origin is not None:
             if origin == "null" or urlsplit(origin).netloc.lower() != host.lower():
                 return 403, f"a request from another origin ({origin}) may not change anything"
-        if method in _BODIES and routed(scope):
+        if method in BODIES and routed(scope):
             kind = headers.get("content-type", "").split(";")[0].strip().lower()
             if kind != "application/json" and not kind.endswith("+json"):
                 return 415, (
