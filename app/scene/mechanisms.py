@@ -180,25 +180,23 @@ class Chain(Mechanism):
 
     def build(self) -> None:
         self.resize(self.state, self.extent)  # (its kinematics and limits; no node is sized)
-        home = chain_points(self.kin, np.asarray(self.state.x0, dtype=float), 0.0)
-        n = home.shape[0]
-        width = 5.0 if self.opacity is None else 3.5
+        x0 = np.asarray(self.state.x0, dtype=float)
+        n = len(self.kin.drawn_points(x0))
         self.links = self.scene.add_line_segments(
             f"{self.root}/links",
             np.zeros((n - 1, 2, 3)),
             self.color,
-            thickness=width,
+            thickness=5.0 if self.opacity is None else 3.5,
             thickness_units="screen",
         )
         # Joints sized to the arm: a sixtieth of its reach from its first joint (0.04 for an arm
         # of reach 2.4); the base link is not part of the reach.
-        links = np.diff(self.kin.points(np.asarray(self.state.x0, dtype=float)), axis=0)
-        reach = float(np.linalg.norm(links, axis=1).sum())
+        reach = float(np.linalg.norm(np.diff(self.kin.points(x0), axis=0), axis=1).sum())
         ball = max(reach, 1e-3) / 60
         self.joints = [self.ball(f"joint{i}", ball if i < n - 1 else 1.5 * ball) for i in range(n)]
-        # The end link's frame when the task holds its orientation (a pose task).
+        # The end link's frame when the task gives a whole frame (position and rotation).
         self.end = None
-        if has_pose(self.kin):
+        if set(getattr(self.kin, "task_names", ())) == set(COORDINATES):
             size = AXES_FRACTION * reach
             self.end = self.scene.add_frame(
                 f"{self.root}/end", axes_length=size, axes_radius=0.06 * size
@@ -246,11 +244,6 @@ def wxyz(R) -> tuple[float, float, float, float]:
     """The unit quaternion (w, x, y, z) of a rotation matrix (3, 3)."""
     q = SO3.from_matrix(np.asarray(R, dtype=float)).wxyz
     return tuple(float(v) for v in q)  # type: ignore[return-value]
-
-
-def has_pose(kin: Any) -> bool:
-    """Whether the task gives a whole frame: position and the three rotation coordinates."""
-    return set(getattr(kin, "task_names", ())) == set(COORDINATES)
 
 
 def end_frame(kin: Any, x) -> tuple[tuple[float, ...], tuple[float, ...]]:
