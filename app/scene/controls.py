@@ -22,23 +22,22 @@ from ..dashboard.controls import GROUPS, Control, about, control_values, control
 MARK = "⚠ "
 
 
-class Syncing:
+class Syncing(threading.local):
     """Whether this thread is setting a GUI's inputs to the values in force (``with syncing:``
     while it does, ``if syncing:`` in the inputs' callbacks): the callbacks viser calls from
     within an assignment are then not a user's change. Per thread: a user's change, which
     viser's thread delivers, is never dropped while another thread syncs."""
 
-    def __init__(self) -> None:
-        self._local = threading.local()
+    depth = 0  # (nested syncs of this thread)
 
     def __bool__(self) -> bool:
-        return getattr(self._local, "depth", 0) > 0
+        return self.depth > 0
 
     def __enter__(self) -> None:
-        self._local.depth = getattr(self._local, "depth", 0) + 1
+        self.depth += 1
 
     def __exit__(self, *_) -> None:
-        self._local.depth -= 1
+        self.depth -= 1
 
 
 class SceneControls:
