@@ -60,12 +60,6 @@ _SCENE_POLICY = (
 )
 
 
-def _policy(path: str) -> str:
-    if path.startswith(("/scene/", "/static-offline-docs")) or path == "/docs":
-        return _SCENE_POLICY
-    return _PAGE_POLICY
-
-
 class SecurityMiddleware:
     """See the module's docstring. ``allowed_hosts``: host names (no port), ``*`` for any."""
 
@@ -93,7 +87,9 @@ class SecurityMiddleware:
         if websocket:
             await self.app(scope, receive, send)
             return
-        policy = _policy(scope.get("path", "")).encode()
+        path = scope.get("path", "")
+        scene_or_docs = path.startswith(("/scene/", "/static-offline-docs")) or path == "/docs"
+        policy = (_SCENE_POLICY if scene_or_docs else _PAGE_POLICY).encode()
         started = False
         seen = 0
 
