@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -25,8 +25,22 @@ from ...engine.validation import within
 from ..compute.schemas.algorithms import Algorithm
 from ..compute.schemas.wording import refused, without_field
 
-if TYPE_CHECKING:  # (the model imports this module)
-    from .model import DashboardState
+
+class ChosenState(Protocol):
+    """What these functions read of a :class:`jik.app.dashboard.model.DashboardState` (which
+    imports this module: importing it here, even for the type checker, is a cycle)."""
+
+    @property
+    def algorithms(self) -> Sequence[str]: ...
+    @property
+    def algorithm_parameters(self) -> Mapping[str, Any]: ...
+    @property
+    def x0(self) -> Sequence[float]: ...
+    @property
+    def mode(self) -> str: ...
+
+    def as_dict(self) -> dict: ...
+
 
 #: Every algorithm a state may choose, in the catalogue's order (the order they are drawn in).
 CHOICES = tuple(REGISTRY)
@@ -223,16 +237,16 @@ def checked_rest(value, spec, kin, x0) -> tuple[float, ...] | None:
     return rest
 
 
-def posture_rest(state: DashboardState, kin) -> tuple[list[float], str]:
+def posture_rest(state: ChosenState, kin) -> tuple[list[float], str]:
     """The posture inverse's rest in force and what it is: "set" (the state's), else the
     default's "home" or "x0" (:func:`~jik.engine.algorithm_registry.default_rest`)."""
     given = state.algorithm_parameters.get("rest")
     if given is not None:
-        return np.asarray(given, dtype=float).tolist(), "set"
+        return [float(v) for v in given], "set"
     return default_rest(kin, state.x0)
 
 
-def editable_rest(state: DashboardState, spec, kin) -> list[float]:
+def editable_rest(state: ChosenState, spec, kin) -> list[float]:
     """The rest that one rest slider moved changes: the state's, else the default in force
     brought into the sliders' range (:func:`joint_box`), as the sliders show it (a rest set is
     checked: the coordinates the user did not touch take the nearest value accepted)."""
@@ -243,7 +257,7 @@ def editable_rest(state: DashboardState, spec, kin) -> list[float]:
     return [float(v) for v in np.clip(rest, lo, hi)]
 
 
-def rest_words(state: DashboardState, spec, inverse) -> str:
+def rest_words(state: ChosenState, spec, inverse) -> str:
     """The rest in force in words, for the verdict (the engine's
     :func:`~jik.engine.practical_findings.rest_words` for the posture ``inverse``); a default
     outside the rest's sliders (:func:`joint_box`: the joint limits) says what moving one of
@@ -266,14 +280,14 @@ def rest_words(state: DashboardState, spec, inverse) -> str:
     )
 
 
-def inverse_parameters(state: DashboardState, algorithm: str) -> dict[str, Any]:
+def inverse_parameters(state: ChosenState, algorithm: str) -> dict[str, Any]:
     """What the engine's ``make_inverse`` takes for ``algorithm``: its scalars, and the posture
     inverse's rest when the state sets one."""
     names = REGISTRY[algorithm].names
     return {k: v for k, v in state.algorithm_parameters.items() if k in names}
 
 
-def check_inverses(state: DashboardState, build) -> None:
+def check_inverses(state: ChosenState, build) -> None:
     """Build the chosen algorithms other than the paper's two (``build(algorithm)``, cheap),
     so that a robot without joint limits refuses the weighted inverse here, naming
     ``algorithms``."""
@@ -286,7 +300,7 @@ def check_inverses(state: DashboardState, build) -> None:
             raise refused("algorithms", f"{a} cannot run on this robot: {exc}") from None
 
 
-def cache_key(state: DashboardState, algorithm: str) -> str:
+def cache_key(state: ChosenState, algorithm: str) -> str:
     """Everything one algorithm's run depends on: the state without what only a panel shows,
     the other algorithms' parameters, the map (but for the extended inverse) and gamma in
     continuous mode (see :mod:`jik.app.dashboard.results`)."""
@@ -302,7 +316,7 @@ def cache_key(state: DashboardState, algorithm: str) -> str:
     return json.dumps(d, sort_keys=True)
 
 
-def runs_key(state: DashboardState) -> tuple[str, ...]:
+def runs_key(state: ChosenState) -> tuple[str, ...]:
     """Everything the runs of the chosen algorithms depend on, up to the scale of theta (in
     continuous mode gamma only divides theta)."""
     return tuple(cache_key(state, a) for a in state.algorithms)
