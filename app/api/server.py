@@ -56,15 +56,26 @@ def run_server(
 ) -> None:
     """Serve the API and the dashboard on ``host:port`` until interrupted (SIGINT or SIGTERM).
 
-    ``host``: 127.0.0.1 by default (0.0.0.0 in a container); ``port``: the API's (OpenAPI docs
-    at /docs), the page's and its scenes'. ``allowed_hosts``: host names the server answers to
-    besides the loopback names and ``JIK_ALLOWED_HOSTS``. ``forwarded_allow_ips``: the reverse
-    proxies whose ``X-Forwarded-For`` and ``X-Forwarded-Proto`` are believed (comma-separated,
-    ``*`` for any; uvicorn's ``forwarded_allow_ips``); None: no proxy, the client is the
-    socket's peer whatever the headers say (the per-client limits count peers).
+    Parameters
+    ----------
+    host : str
+        Address to bind; 127.0.0.1 by default (use 0.0.0.0 in a container).
+    port : int
+        HTTP port of the API (OpenAPI docs at /docs), the page and its scenes.
+    allowed_hosts : tuple of str
+        Host names the server answers to besides the loopback names and ``JIK_ALLOWED_HOSTS``.
+    forwarded_allow_ips : str or None
+        Addresses of the reverse proxies whose ``X-Forwarded-For`` and ``X-Forwarded-Proto``
+        are believed (comma-separated, ``*`` for any; uvicorn's ``forwarded_allow_ips``). None:
+        no proxy; the client is the socket's peer, whatever the headers say (the per-client
+        limits count peers).
 
-    Raises :class:`PortInUse` if the port is taken, and ``InvalidInputError`` if a ``JIK_*``
-    variable is not valid (its ``field`` names it), before anything is started.
+    Raises
+    ------
+    PortInUse
+        If the port is taken, before anything is started.
+    InvalidInputError
+        If a ``JIK_*`` variable is not valid (its ``field`` names it), before anything starts.
     """
     settings = read_environment()  # (once; a bad JIK_* variable is refused by its name)
     sock = bind(host, port)
