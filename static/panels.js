@@ -5,7 +5,17 @@ import { saveImage, saveTable } from "./panel_exports.js";
 
 // (not plotly's `responsive`: its resize sizes a figure to its panel, height too, and a panel's
 // height follows its figure, so every figure fell to the panel's least height: followWidth)
-export const PLOT_CONFIG = { responsive: false, displaylogo: false };
+export const PLOT_CONFIG = {
+  responsive: false,
+  displaylogo: false,
+  modeBarButtonsToRemove: ["toImage", "select2d", "lasso2d"],
+};
+
+// Plotly's toolbar stands upright in the right margin, from the top of the plots down (style.css
+// places it by this variable), so that it covers neither the title above nor the plots.
+export function toolbarBesidePlots(div) {
+  if (div._fullLayout) div.style.setProperty("--toolbar-top", `${div._fullLayout.margin.t}px`);
+}
 
 // A drawn figure follows its panel's width (``measure(div)``), its own height kept.
 export function followWidth(div, measure) {
@@ -239,6 +249,7 @@ export async function drawFigures(figures, digests = {}, robot = null) {
         : Plotly.react(div, fig.data, fig.layout, PLOT_CONFIG);
       panelTools(div, key);
       return p.then(() => {
+        toolbarBesidePlots(div);
         if (onScreen[key] && onScreen[key].shown === null) onScreen[key].shown = JSON.stringify(axisRanges(div.layout));
       });
     }));
@@ -281,6 +292,7 @@ export async function onAhead(msg, shownRobot) {
     div.style.width = `${width}px`;
     box.append(div);
     await Plotly.react(div, fig.data, fig.layout, PLOT_CONFIG);
+    toolbarBesidePlots(div);
     panels[key] = { div, digest: msg.digests[key], width };
   }
   if (token === ahead.tokens[msg.robot] && msg.robot !== shownRobot()) ahead.robots[msg.robot] = panels;

@@ -16,7 +16,7 @@ from ..compute.atlas_schemas import AtlasRequest
 from ..compute.schemas import RobotUsed
 from .algorithms import STYLES
 from .model import DashboardState
-from .plotting import figure, norm_unit, note
+from .plotting import RIGHT, figure, norm_unit, note
 from .robots import state_kinematics, state_spec, user_robot
 
 #: Drift below this is drawn as this (the extended Jacobian's drift is round-off, ~1e-13).
@@ -192,7 +192,7 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest, robot: RobotUsed
         title,
         height=height,
         showlegend=False,
-        margin=dict(l=110, r=20, t=84, b=56),
+        margin=dict(l=110, r=RIGHT, t=84, b=56),
         **layout,
     )
 

@@ -17,6 +17,7 @@ from .cspace import cspace_spec
 from .map_figures import augmenting_spec, sensitivity_spec
 from .plotting import (
     NO_LEGEND,
+    RIGHT,
     corner_names,
     figure,
     is_unicycle,
@@ -346,7 +347,7 @@ def _platform(result: DashboardResult) -> dict:
         **axes,
         annotations=annotations,
         showlegend=False,  # (each plot is named above it)
-        margin=dict(l=64, r=20, t=64, b=48),
+        margin=dict(l=64, r=RIGHT, t=64, b=48),
     )
 
 

@@ -51,14 +51,19 @@ TEMPLATE = dict(
         colorway=["#d62728", "#1f77b4", "#2ca02c", "#9467bd"],
     )
 )
+#: A panel's right margin: room for plotly's toolbar, drawn upright beside the plots (below;
+#: the page starts it at the plots' top) so that it covers neither the title nor the plots.
+RIGHT = 30
+
 LAYOUT = dict(
     template=TEMPLATE,
     height=PANEL_HEIGHT,
-    margin=dict(l=64, r=20, t=40, b=100),
+    margin=dict(l=64, r=RIGHT, t=40, b=100),
     legend=dict(orientation="h", yanchor="top", y=-0.2, xanchor="left", x=0, font=dict(size=10)),
     font=dict(size=11),
     hovermode="closest",
     uirevision="keep",  # keep the user's zoom across updates of the same robot
+    modebar=dict(orientation="v"),
 )
 
 
@@ -106,7 +111,7 @@ def note(text: str, x, y, xref="paper", yref="paper", color=None, size=11, **mor
 #: Layout of the panels whose traces are the two algorithms: no legend (the page's header
 #: names the colours; a legend costs a fifth of a panel's redraw in the browser test), the
 #: other marks named in the title, and the bottom margin the legend took given back.
-NO_LEGEND = dict(showlegend=False, margin=dict(l=64, r=20, t=48, b=48))
+NO_LEGEND = dict(showlegend=False, margin=dict(l=64, r=RIGHT, t=48, b=48))
 
 
 def figure(data: list, title: str, **layout) -> dict:

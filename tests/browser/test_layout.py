@@ -1,7 +1,8 @@
 """The page at 1280x720: the scene fits below the sticky header, panel titles are not under their
-buttons, tick labels do not overlap, subtitles are not cut off, a panel with nothing to plot
-says why, and the unicycle's animation shows its iteration; at every size the scene's control
-panel sits beside the 3D view, never over the robot."""
+buttons nor under plotly's toolbar (which leaves the plots clear too), tick labels do not
+overlap, subtitles are not cut off, a panel with nothing to plot says why, and the unicycle's
+animation shows its iteration; at every size the scene's control panel sits beside the 3D view,
+never over the robot."""
 
 from __future__ import annotations
 
@@ -24,6 +25,8 @@ def _check_panels(tab, panels) -> None:
         assert seen["titleBelowHead"], f"{panel}: its title is under the panel's buttons"
         assert seen["titleAbovePlot"], f"{panel}: its title runs into the plot"
         assert not seen["notesOverlap"], f"{panel}: its annotations overlap"
+        assert seen["toolbarClearOfTitle"], f"{panel}: plotly's toolbar covers its title"
+        assert seen["toolbarClearOfPlots"], f"{panel}: plotly's toolbar covers its plots"
 
 
 def test_layout_at_1280x720(tabs):
@@ -46,7 +49,7 @@ def test_layout_at_1280x720(tabs):
 
     tab.select("#ctl-robot", "unicycle")
     page.wait_for_selector("#plot-sensitivity:not(.stale) .annotation-text")
-    _check_panels(tab, ["task", "augmenting", "sensitivity"])
+    _check_panels(tab, ["task", "joints", "augmenting", "sensitivity"])
     seen = page.evaluate(probe("overlaps"), "sensitivity")
     assert any("collocation" in a for a in seen["annotations"])
     tab.wait_scene_text("iteration ")

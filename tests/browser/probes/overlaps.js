@@ -1,5 +1,6 @@
-// Pairs of tick labels of a panel whose boxes intersect (their texts), and whether the panel's
-// title lines fit its width: what a reader sees as overlapping or cut off.
+// Pairs of tick labels of a panel whose boxes intersect (their texts), whether the panel's
+// title lines fit its width, and whether plotly's toolbar (shown while the mouse is over the
+// panel) leaves the title and the plots clear: what a reader sees as overlapping or cut off.
 (panel) => {
   const div = document.getElementById(`plot-${panel}`);
   const box = div.getBoundingClientRect();
@@ -18,6 +19,9 @@
   const head = div.querySelector(".panel-head");
   const plots = [...div.querySelectorAll(".nsewdrag")].map((d) => d.getBoundingClientRect().top);
   const notes = [...div.querySelectorAll(".annotation")].map((a) => a.getBoundingClientRect()).filter((r) => r.width > 0);
+  const bar = div.querySelector(".modebar");
+  const b = bar ? bar.getBoundingClientRect() : null;
+  const drags = [...div.querySelectorAll(".nsewdrag")].map((d) => d.getBoundingClientRect());
   let notesOverlap = false;
   for (let i = 0; i < notes.length; i++) for (let j = i + 1; j < notes.length; j++) notesOverlap ||= hit(notes[i], notes[j]);
   return {
@@ -25,6 +29,8 @@
     titleFits: !t || (t.left >= box.left - 1 && t.right <= box.right + 1),
     titleAbovePlot: !t || !plots.length || t.bottom <= Math.min(...plots) + 1,
     notesOverlap,
+    toolbarClearOfTitle: !t || !b || !hit(t, b),
+    toolbarClearOfPlots: !b || !drags.some((d) => hit(d, b)),
     titleBelowHead: !t || !head || t.top >= head.getBoundingClientRect().bottom - 1,
     annotations: [...div.querySelectorAll(".annotation-text")].map((a) => a.textContent),
   };
