@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import jik.engine as jik
-from jik.app.compute.user_robots import request_field
+from jik.app.compute.robot_requests import request_field
 from jik.engine.exceptions import InvalidInputError, KinematicSingularityError
 
 ARM = jik.PlanarChain("RRR", [1.0, 0.8, 0.6])

@@ -23,8 +23,8 @@ from ...engine.robot_kinds import KINDS
 from ...engine.robot_spec import Robot
 from ..compute.budget import build_seconds, time_budget
 from ..compute.exceptions import RequestError
+from ..compute.robot_requests import built
 from ..compute.schemas.wording import refused, without_field
-from ..compute.user_robots import built
 from ..compute.worker import task
 from .algorithms import inverse_parameters
 

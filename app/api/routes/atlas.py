@@ -30,10 +30,10 @@ from ...compute.atlas_jobs import AtlasJob, AtlasJobNotFound, AtlasJobs
 from ...compute.atlas_plan import AtlasLimits, plan_task
 from ...compute.atlas_schemas import MAX_CYCLES, MAX_FAMILY, AtlasBody, AtlasJobResponse, Scale
 from ...compute.pool import ComputePool
+from ...compute.robot_requests import echo
 from ...compute.schemas import INTEGRAL, ErrorResponse
 from ...compute.schemas.examples import openapi_examples
 from ...compute.schemas.wording import refused
-from ...compute.user_robots import echo
 from ...dashboard.atlas import atlas_figure, atlas_request
 from ...dashboard.plotting import figure_json
 from ..dependencies import Store
@@ -239,6 +239,6 @@ def _own_job(store: Store, jobs: Jobs, session_id: str, job_id: str) -> AtlasJob
 
 def _echoed(request: dict) -> dict:
     """The request as a response repeats it: a URDF robot's text named by its size and SHA-256
-    (:func:`jik.app.compute.user_robots.echo`), never sent back."""
+    (:func:`jik.app.compute.robot_requests.echo`), never sent back."""
     robot = request.get("robot")
     return {**request, "robot": echo(robot)} if isinstance(robot, dict) else request
