@@ -136,6 +136,7 @@ class CsvWriter:
                 chunk.success[:, runs],
                 chunk.leg_ends[:, runs] if self.legs else None,
                 self.legs,
+                self.plan.family,
             )
             if chunk.lo == 0 and lo == 0:  # (the first rows: the header, the column names)
                 self.writer.writerow(list(table))

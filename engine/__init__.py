@@ -163,7 +163,7 @@ _EXPORTS = {
     "run_atlas": "atlas_run",
     "iter_atlas": "atlas_run",
     "manifold_starts": "redundant_starts",
-    "AtlasResult": "atlas_run",
+    "AtlasResult": "atlas_table",
     # errors
     "JikError": "exceptions",
     "InvalidInputError": "exceptions",
@@ -296,7 +296,8 @@ sys.modules[__name__].__class__ = _Engine
 if TYPE_CHECKING:  # what the names are, for type checkers and editors (no import at run time)
     from .arms import ARMS
     from .atlas import AtlasPlan, plan_atlas
-    from .atlas_run import AtlasResult, iter_atlas, run_atlas
+    from .atlas_run import iter_atlas, run_atlas
+    from .atlas_table import AtlasResult
     from .augmentations import AugmentingMap, E1Optimal, E2Optimal, PaperCubic, h_change
     from .characteristics import CharacteristicsMap, UnicycleCharacteristics
     from .dependence import inert_variables

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from .atlas_paths import base_manifolds, checked, path_family
+from .atlas_paths import Family, base_manifolds, checked, path_family
 from .exceptions import InvalidInputError
 from .exports import plural
 from .inverses import Inverse, algorithm_labels
@@ -85,6 +85,9 @@ class AtlasPlan:
     chunk : int
     settings : dict
         gamma, mode, tol and max_iterations of every leg (:func:`jik.engine.solver.solve`).
+    family : Family or None
+        Each path's scale (P,) and shift (P, r) when the paths are a family of shifts and
+        scales (:func:`~jik.engine.atlas_paths.path_family`); None for the base path as given.
     """
 
     inverses: tuple[Inverse, ...]
@@ -96,6 +99,7 @@ class AtlasPlan:
     explicit: FloatArray | None
     chunk: int
     settings: dict = field(default_factory=dict)
+    family: Family | None = None
 
     def __repr__(self) -> str:
         return (
@@ -265,13 +269,19 @@ def plan_atlas(
         "tol": tol,
         "max_iterations": None if max_iterations is None else cap,
     }
-    paths, per_shift = path_family(kin, base_path, shifts, scales)
+    paths, per_shift, placed = path_family(kin, base_path, shifts, scales)
 
     fits = chunk_limit(kin, len(invs), cycles, paths.shape[1], settings, chunk)
 
     def make(**starts_: Any) -> AtlasPlan:
         plan = AtlasPlan(
-            inverses=invs, paths=paths, cycles=cycles, chunk=1, settings=settings, **starts_
+            inverses=invs,
+            paths=paths,
+            cycles=cycles,
+            chunk=1,
+            settings=settings,
+            family=placed,
+            **starts_,
         )
         return replace(plan, chunk=min(auto_chunk(plan.size), fits) if chunk is None else chunk)
 

@@ -9,6 +9,8 @@ pseudoinverse (8) from a reference configuration reaches the point.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from .exceptions import InvalidInputError, SingularConfigurationError, format_vector
@@ -21,6 +23,14 @@ from .validation import MAX_COORDINATE, FloatArray, as_points, as_series, bounde
 MAX_PATHS = 10**4
 
 
+class Family(NamedTuple):
+    """Where each path of a family comes from: its ``scale`` (P,) about the base path's first
+    point and its ``shift`` (P, r) of the whole path."""
+
+    scale: FloatArray
+    shift: FloatArray
+
+
 def family(base_path: FloatArray, shifts: FloatArray, scales: FloatArray) -> FloatArray:
     """Paths (P, L0, r): every shift with every scale, shift-major; a scale acts about the path's
     first point (the starts' task point), a shift moves the whole path."""
@@ -31,10 +41,12 @@ def family(base_path: FloatArray, shifts: FloatArray, scales: FloatArray) -> Flo
     )
 
 
-def path_family(kin, base_path: FloatArray, shifts, scales) -> tuple[FloatArray, int | None]:
+def path_family(
+    kin, base_path: FloatArray, shifts, scales
+) -> tuple[FloatArray, int | None, Family | None]:
     """The family of ``base_path`` (L0, r) by ``shifts`` (S, r) and ``scales`` (Q,), checked
-    (None: no shift, scale 1), and how many of its paths share each shift's first point (Q;
-    None without shifts).
+    (None: no shift, scale 1), how many of its paths share each shift's first point (Q; None
+    without shifts), and each path's scale and shift (None when neither was given).
 
     Raises
     ------
@@ -63,7 +75,10 @@ def path_family(kin, base_path: FloatArray, shifts, scales) -> tuple[FloatArray,
             field="shifts" if shifts is not None else "scales",
         )
     _check_reachable(kin, paths, base_path, scale, shifts is not None, scales is not None)
-    return paths, None if shifts is None else len(scale)
+    placed = None
+    if shifts is not None or scales is not None:  # (shift-major, as family() lays the paths)
+        placed = Family(np.tile(scale, len(shift)), np.repeat(shift, len(scale), axis=0))
+    return paths, None if shifts is None else len(scale), placed
 
 
 def _check_reachable(kin, paths, base_path, scale, shifted: bool, scaled: bool) -> None:

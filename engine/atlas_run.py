@@ -19,9 +19,9 @@ import numpy as np
 
 from .atlas import AtlasPlan
 from .atlas_backends import Backend, backend_for
-from .atlas_table import atlas_columns
-from .exceptions import InvalidInputError, SingularConfigurationError
-from .exports import Columns, csv_text, dataframe, json_values, plural
+from .atlas_table import AtlasResult
+from .exceptions import SingularConfigurationError
+from .exports import plural
 from .inverses import Inverse
 from .limits import robot_limits, starts_outside
 from .posture_at_start import PostureAtStart
@@ -158,135 +158,6 @@ def _runs(inverse: Inverse, task: ChunkTask, ids: np.ndarray):
     yield ids, res, ""
 
 
-@dataclass(frozen=True)
-class AtlasResult(Columns):
-    """An atlas: for every inverse a, path j and start i, the drift after each cycle.
-
-    Attributes
-    ----------
-    algorithms : tuple of str, length A
-        A distinct label per inverse: its name, with the parameters that tell it apart from
-        another of the same name (``damped(damping=0.01)``; :func:`jik.engine.inverses.
-        algorithm_labels`).
-    paths : ndarray, shape (P, L0, r)
-    parameter : ndarray, shape (N,) or None
-        Arc length s of each start on its path's self-motion curve (None: explicit starts).
-    starts : ndarray, shape (P, N, p)
-    drift : ndarray, shape (A, P, N, cycles)
-    leg_ends : ndarray, shape (A, P, N, cycles * L, p), or None when not kept
-    success : ndarray of bool, shape (A, P, N)
-    failures : dict
-        (a, j, i) -> why that run failed.
-    outside_limits : ndarray of bool, shape (A, P, N), or None
-        The runs whose start or some leg end left the joint limits (None: the robot has none).
-    """
-
-    algorithms: tuple[str, ...]
-    paths: FloatArray
-    parameter: FloatArray | None
-    starts: FloatArray
-    drift: FloatArray
-    leg_ends: FloatArray | None
-    success: FloatArray
-    failures: dict[tuple[int, int, int], str]
-    outside_limits: FloatArray | None = None
-
-    def __repr__(self) -> str:
-        _, P, N, cycles = self.drift.shape
-        last = self.drift[..., -1]
-        worst = np.max(np.where(np.isfinite(last), last, -np.inf), axis=(1, 2))
-        drifts = ", ".join(
-            f"{a} {w:.3g}" for a, w in zip(self.algorithms, worst, strict=True) if np.isfinite(w)
-        )
-        drifts = f", largest drift after the last cycle: {drifts}" if drifts else ""
-        return (
-            f"AtlasResult({'/'.join(self.algorithms)}, {plural(P, 'path')} x "
-            f"{plural(N, 'start')} x {plural(cycles, 'cycle')}, "
-            f"{int(np.count_nonzero(self.success))} of {self.success.size} runs completed"
-            f"{drifts})"
-        )
-
-    def columns(self, every_leg: bool = False, runs: slice | None = None) -> dict[str, FloatArray]:
-        """A row per path, start, algorithm and cycle (long format, run order:
-        :func:`jik.engine.atlas_table.atlas_columns`, the table ``jik atlas`` streams to its
-        CSV): ``algorithm`` (its label), ``path``, ``start`` (both from 0), ``s`` (arc length, NaN
-        for given starts), ``cycle`` (from 1), ``drift``, ``success`` (the run's), the start
-        ``x0_1``..``x0_p`` and, when the leg ends were kept, the configuration at the cycle's end
-        ``x_1``..``x_p``. ``every_leg``: a row per leg instead, with ``leg`` (from 1 within its
-        cycle) and ``x_k`` the leg's end. ``runs``: the rows of those runs alone (run = path *
-        N + start), a block of the table."""
-        A, P, N, C = self.drift.shape
-        runs = slice(None) if runs is None else of_type(runs, slice, "runs", "a slice of runs")
-        path, start = np.divmod(np.arange(P * N)[runs], N)
-        legs = self.leg_ends
-        return atlas_columns(
-            self.algorithms,
-            path,
-            start,
-            None if self.parameter is None else np.asarray(self.parameter)[start],
-            self.starts.reshape(P * N, -1)[runs],
-            self.drift.reshape(A, P * N, C)[:, runs],
-            self.success.reshape(A, P * N)[:, runs],
-            None if legs is None else legs.reshape(A, P * N, *legs.shape[3:])[:, runs],
-            every_leg,
-        )
-
-    def csv_text(self, every_leg: bool = False, rows: int = 8192) -> Iterator[str]:
-        """:meth:`columns` as CSV text (:func:`jik.engine.exports.csv_text`: the header, then
-        the rows), made a block of about ``rows`` rows (whole runs) at a time: the memory a
-        download takes is a block's, never the whole table's text.
-
-        Raises
-        ------
-        InvalidInputError
-            At the call, with field ``every_leg``, when a row per leg is asked for and the leg
-            ends were not kept.
-        """
-        A, P, N, C = self.drift.shape
-        if every_leg and self.leg_ends is None:
-            raise InvalidInputError(
-                "a row per leg needs the leg ends, and this atlas did not keep them",
-                "every_leg",
-            )
-        legs = self.leg_ends.shape[3] // C if every_leg and self.leg_ends is not None else 1
-        block = max(1, rows // (A * C * legs))
-        return csv_text(
-            self.columns(every_leg, slice(lo, lo + block)) for lo in range(0, P * N, block)
-        )
-
-    def to_dataframe(self, every_leg: bool = False):
-        """:meth:`columns` as a pandas DataFrame (needs pandas: the ``dataframes`` extra)."""
-        return dataframe(self.columns(every_leg))
-
-    def as_dict(self, leg_ends: bool = False) -> dict:
-        """JSON-friendly: the labels, paths, arc lengths, starts, drift, success, the failures
-        (a list of ``{"algorithm", "path", "start", "message"}``), outside_limits and, with
-        ``leg_ends``, every leg's end (A P N cycles L p numbers); None for NaN (a failed leg's
-        drift: :func:`~jik.engine.exports.json_values`)."""
-        return json_values(
-            {
-                "algorithms": list(self.algorithms),
-                "paths": self.paths.tolist(),
-                "parameter": None if self.parameter is None else self.parameter.tolist(),
-                "starts": self.starts.tolist(),
-                "drift": self.drift.tolist(),
-                "success": self.success.tolist(),
-                "failures": [
-                    {"algorithm": self.algorithms[a], "path": j, "start": i, "message": why}
-                    for (a, j, i), why in sorted(self.failures.items())
-                ],
-                "outside_limits": None
-                if self.outside_limits is None
-                else self.outside_limits.tolist(),
-                **(
-                    {"leg_ends": None if self.leg_ends is None else self.leg_ends.tolist()}
-                    if leg_ends
-                    else {}
-                ),
-            }
-        )
-
-
 def iter_atlas(
     plan: AtlasPlan,
     backend: str | Backend | None = None,
@@ -396,4 +267,5 @@ def run_atlas(
         success.reshape(A, P, N),
         failures,
         None if outside is None else outside.reshape(A, P, N),
+        plan.family,
     )

@@ -79,7 +79,8 @@ def test_json_holds_inputs_starts_drift_and_leg_ends(tmp_path):
 
 
 def test_a_large_atlas_streams_to_csv_and_the_json_keeps_a_summary(tmp_path, monkeypatch):
-    """Past JSON_RUNS the arrays go to the CSV, in run order, whatever order chunks finish in."""
+    """Past JSON_RUNS the arrays go to the CSV, in run order, whatever order chunks finish in;
+    each row names its path's scale and shift."""
     monkeypatch.setattr(atlas_cli, "JSON_RUNS", 10)
     doc = run(
         tmp_path,
@@ -100,6 +101,10 @@ def test_a_large_atlas_streams_to_csv_and_the_json_keeps_a_summary(tmp_path, mon
     assert [(int(r["path"]), int(r["start"])) for r in rows[::2]] == [
         (j, i) for j in range(2) for i in range(12)
     ]  # (run order; a run's rows: its 2 cycles)
+    assert {(r["path"], r["scale"], r["shift_1"], r["shift_2"]) for r in rows} == {
+        ("0", "1.0", "0.0", "0.0"),
+        ("1", "1.0", "0.2", "0.0"),
+    }
     drift = [float(r["drift"] or "nan") for r in rows if r["algorithm"] == "pseudoinverse"]
     assert np.nanmax(drift) == pytest.approx(max(doc["summary"]["pseudoinverse"]["max_drift"]))
 

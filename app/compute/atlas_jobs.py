@@ -11,7 +11,7 @@ Limits (:class:`~jik.app.compute.atlas_plan.AtlasLimits`): at most ``max_running
 compute at once (the others wait, queued), ``max_jobs`` are kept in all and ``per_client`` queued
 or running for one client, and a job computes for at most ``max_seconds`` (then it fails and
 says so). A done job keeps its result document and the engine's atlas it was made from (its
-table's source, :meth:`~jik.engine.atlas_run.AtlasResult.csv_text`).
+table's source, :meth:`~jik.engine.atlas_table.AtlasResult.csv_text`).
 """
 
 from __future__ import annotations
@@ -27,7 +27,8 @@ from typing import Any
 
 from ...engine.atlas import AtlasPlan
 from ...engine.atlas_backends import IN_FLIGHT, bounded_imap
-from ...engine.atlas_run import AtlasResult, run_atlas
+from ...engine.atlas_run import run_atlas
+from ...engine.atlas_table import AtlasResult
 from ...engine.exceptions import RunCancelled
 from ...engine.progress import ProgressCallbacks
 from .atlas_plan import AtlasLimits, Used, result_document

@@ -13,7 +13,8 @@ from typing import Any
 import numpy as np
 
 from ...engine.atlas import AtlasPlan, plan_atlas
-from ...engine.atlas_run import AtlasResult, sized_chunks
+from ...engine.atlas_run import sized_chunks
+from ...engine.atlas_table import AtlasResult
 from ...engine.exceptions import InvalidInputError
 from ...engine.repeatability import open_loop
 from ...engine.self_motion import MAX_ARC

@@ -47,6 +47,25 @@ def reference_atlas():
     return plan, run_atlas(plan)
 
 
+def test_each_row_of_a_family_names_its_path_s_scale_and_shift(reference_atlas):
+    """A family's table carries each path's scale and shift, and they make that path from the
+    base path (scaled about its first point, then moved); an atlas of one path given as is has
+    no such columns."""
+    plan, res = reference_atlas
+    table = res.columns()
+    assert list(table)[:5] == ["algorithm", "path", "scale", "shift_1", "shift_2"]
+    base = np.array(LOOP)
+    for j in (0, 1):
+        rows = table["path"] == j
+        (scale,) = set(table["scale"][rows])
+        (shift,) = set(zip(table["shift_1"][rows], table["shift_2"][rows], strict=True))
+        assert (scale, shift) == (0.5, ((0.0, 0.0), (0.3, -0.2))[j])
+        made = base[0] + np.array(shift) + scale * (base - base[0])
+        np.testing.assert_allclose(plan.paths[j], made, rtol=0, atol=1e-15)
+    single = run_atlas(small_plan(n_starts=2, cycles=1))
+    assert "scale" not in single.columns() and single.family is None
+
+
 def test_drift_at_sampled_starts_equals_single_start_repeatability(reference_atlas):
     """Each run of the atlas is repeatability() from that start around that path: drift and
     leg ends agree to 1e-10 (a single start guesses its legs' Picard sweeps, a batch does not)."""

@@ -16,7 +16,7 @@ import pytest
 
 import jik.engine as jik
 from jik.engine import _EXPORTS
-from jik.engine.atlas_run import AtlasResult
+from jik.engine.atlas_table import AtlasResult
 from jik.engine.solve_rules import DISCRETE_GAMMA_BOUND, check_gamma, gamma_problem
 
 X0 = np.array([0.0, 0.0, math.pi / 2])

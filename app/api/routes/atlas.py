@@ -100,7 +100,7 @@ TABLE: dict[int | str, dict] = {
 
 
 def table_response(jobs: AtlasJobs, job: AtlasJob, every_leg: bool) -> Response:
-    """The done job's table as CSV (:meth:`jik.engine.atlas_run.AtlasResult.csv_text`,
+    """The done job's table as CSV (:meth:`jik.engine.atlas_table.AtlasResult.csv_text`,
     streamed a block of rows at a time from the atlas the job keeps); before that, the job's
     state (JSON, as ``GET /atlas/{job_id}`` answers it)."""
     if job.status != "done" or job.atlas is None:
