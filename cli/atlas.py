@@ -13,7 +13,8 @@ beside it for large atlases (or with ``--csv``), and an HTML figure of the drift
 plotly is installed. The CSV is the engine's atlas table (``AtlasResult.columns``), written
 chunk by chunk: a row per run, algorithm, cycle and leg (per cycle with ``--no-leg-ends``),
 columns ``algorithm, path, start, s, cycle, leg, drift, success, x0_1..x0_p, x_1..x_p`` (x0 the
-start, x the leg's end); the JSON's ``variable_names`` name the coordinates k.
+start, x the leg's end; with ``--shift`` or ``--scale``, each path's ``scale`` and
+``shift_1..shift_r`` after ``path``); the JSON's ``variable_names`` name the coordinates k.
 ``--robot`` is a built-in robot's name (``--param`` sets its parameters), a catalogue arm's
 (``panda``, with its default task) or a user's robot file
 (:func:`jik.engine.robot_spec.load_robot`, as for ``jik solve``).

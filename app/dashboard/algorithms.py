@@ -197,7 +197,8 @@ def checked(algorithms: tuple[str, ...], given: Mapping[str, Any]) -> dict[str, 
 def joint_box(spec, kin) -> tuple[tuple[float, float], ...]:
     """The range of each slider of a joint configuration, x0's and the posture rest's (what
     :func:`checked_rest` accepts): the robot's joint limits, its ``x_range`` else
-    :data:`DEFAULT_BOX` on a side without a limit (:func:`~jik.engine.limits.limited_box`)."""
+    :data:`DEFAULT_BOX` on a side without a limit, or that range's width beyond a finite limit
+    it lies on the other side of (:func:`~jik.engine.limits.limited_box`)."""
     x_range = spec.x_range or (DEFAULT_BOX,) * len(spec.variable_names)
     box = limited_box(x_range, robot_limits(kin))
     return tuple((float(a), float(b)) for a, b in box)

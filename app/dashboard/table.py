@@ -1,6 +1,7 @@
 """The table of leg ends: the configuration after every leg for each chosen algorithm, and on the
-paper's experiment Table 1 of the paper, with the printed columns beside jik's and the cells
-that differ marked.
+paper's experiment (Manipulator 2, l = 1, from x0 = (0, 0, pi/2) on the path (1, 1), (1, 2),
+(0, 2), (0, 1)) Table 1 of the paper, with the printed columns beside jik's, the cells that differ
+marked, and the errata entry (docs/paper-errata.md) in words.
 
 The page draws the figure as an HTML table (static/panels.js): ``layout.meta`` carries the notes
 shown under it (``notes``) and the cells that differ from the printed value (``differs``:
