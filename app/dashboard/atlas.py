@@ -16,7 +16,7 @@ from ..compute.atlas_schemas import AtlasRequest
 from ..compute.schemas import RobotUsed
 from .algorithms import STYLES
 from .model import DashboardState
-from .plotting import RIGHT, figure, norm_unit, note
+from .plotting import COLORBAR, RIGHT, figure, norm_unit, note
 from .robots import state_kinematics, state_spec, user_robot
 
 #: Drift below this is drawn as this (the extended Jacobian's drift is round-off, ~1e-13).
@@ -115,7 +115,7 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest, robot: RobotUsed
     data: list[dict] = []
     layout: dict[str, Any] = {"shapes": [], "annotations": []}
     gap = 0.06
-    width = (0.92 - gap * (len(algorithms) - 1)) / len(algorithms)
+    width = (1.0 - gap * (len(algorithms) - 1)) / len(algorithms)
     outside = result.get("outside_limits") or {}  # (runs that left the joint limits)
     for k, a in enumerate(algorithms):
         d = np.array(result["drift"][a], dtype=float)  # (P, N, C), NaN after a failure
@@ -182,17 +182,18 @@ def atlas_figure(result: dict[str, Any], request: AtlasRequest, robot: RobotUsed
         "cmax": float(max(cmax, cmin + 1)),
         "colorbar": {
             "title": {"text": f"log10 ‖x − x0‖<br>{unit}", "side": "right"},
-            "x": 0.94,
             "len": 0.9,
+            "x": 1.0,  # (beside the plots, as thin as h's: COLORBAR holds it)
+            "thickness": 12,
         },
     }
-    height = max(260, 120 + 22 * len(rows))
+    height = max(280, 120 + 22 * len(rows))  # (room for the toolbar beside the plots)
     return figure(
         data,
         title,
         height=height,
         showlegend=False,
-        margin=dict(l=110, r=RIGHT, t=84, b=56),
+        margin=dict(l=110, r=RIGHT + COLORBAR, t=84, b=56),  # (the colour bar beside them)
         **layout,
     )
 

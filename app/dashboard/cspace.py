@@ -12,7 +12,7 @@ from ...engine.exceptions import JikError
 from ...engine.self_motion import drawn_curves
 from .algorithms import COLORS, DASH, LABELS, STYLES
 from .analysis import expensive_map, kinematics_and_map, runs_box
-from .plotting import corner_names, figure, trace
+from .plotting import RIGHT, corner_names, figure, trace
 from .runs import DashboardResult
 
 #: Points per run drawn; level-surface grid.
@@ -157,5 +157,5 @@ def cspace_spec(result: DashboardResult) -> dict:
         height=CSPACE_HEIGHT,
         showlegend=True,
         legend=dict(orientation="h", x=0, y=0, yanchor="top", font=dict(size=10)),
-        margin=dict(l=0, r=0, t=40, b=40),
+        margin=dict(l=0, r=RIGHT, t=40, b=40),  # (the toolbar beside the scene)
     )

@@ -13,7 +13,7 @@ from ...engine.functional_report import region_words, report_words
 from .algorithms import COLORS, DASH, LABELS
 from .analysis import vector_note
 from .functionals import state_inert_variables
-from .plotting import NO_LEGEND, figure, label, note, side_by_side, trace, units
+from .plotting import COLORBAR, NO_LEGEND, RIGHT, figure, label, note, side_by_side, trace, units
 from .robots import state_spec
 from .runs import DashboardResult
 
@@ -97,7 +97,8 @@ def augmenting_spec(
     return figure(
         data,
         augmenting_title(result, functionals, cancelled),
-        **NO_LEGEND,
+        showlegend=False,
+        margin={**NO_LEGEND["margin"], "r": RIGHT + COLORBAR},  # (the colour bar beside h)
         shapes=shapes,
         xaxis=dict(title=label(ni, ju[i])),
         yaxis=dict(title=label(nj, ju[j])),

@@ -54,6 +54,9 @@ TEMPLATE = dict(
 #: A panel's right margin: room for plotly's toolbar, drawn upright beside the plots (below;
 #: the page starts it at the plots' top) so that it covers neither the title nor the plots.
 RIGHT = 30
+#: The right margin's room for a colour bar beside the plots (its bar, ticks and title), left of
+#: the toolbar's.
+COLORBAR = 96
 
 LAYOUT = dict(
     template=TEMPLATE,

@@ -16,7 +16,7 @@ import pytest
 from jik.app.compute.atlas_plan import AtlasLimits, planned
 from jik.app.compute.atlas_schemas import AtlasRequest
 from jik.engine.atlas_run import run_atlas
-from tests.browser.conftest import ARTIFACTS, SCREEN_SIZES, get_json, poll
+from tests.browser.conftest import ARTIFACTS, SCREEN_SIZES, get_json, poll, probe
 
 expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
 pytestmark = pytest.mark.browser
@@ -94,6 +94,9 @@ def test_the_atlas_computes_cancels_and_moves_the_main_view_to_a_clicked_start(t
     expect(heatmaps).to_have_count(2)
     expect(page.locator("#plot-atlas .colorbar")).to_have_count(1)
     expect(page.locator("#plot-atlas .panel-head")).to_contain_text("log10 of the drift")
+    seen = page.evaluate(probe("overlaps"), "atlas")
+    clear = seen["toolbarClearOfTitle"] and seen["toolbarClearOfPlots"]
+    assert clear, f"plotly's toolbar {seen['toolbar']} covers the title or plots {seen['plots']}"
     screenshots(page, "atlas")
 
     atlas = get_json(f"{tab.base}/api/sessions/{tab.session_id}/atlas/{job}")

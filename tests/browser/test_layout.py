@@ -39,7 +39,7 @@ def test_layout_at_1280x720(tabs):
     scene = page.locator("#scene").bounding_box()
     assert scene is not None
     assert scene["y"] >= header["height"] - 1 and scene["y"] + scene["height"] <= 720 + 1
-    _check_panels(tab, ["task", "drift", "joints", "augmenting", "sensitivity"])
+    _check_panels(tab, ["task", "drift", "joints", "augmenting", "sensitivity", "cspace"])
     tab.page.evaluate("() => window.scrollTo(0, 0)")
 
     tab.select("#ctl-robot", "manipulator1")

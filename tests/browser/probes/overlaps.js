@@ -21,7 +21,8 @@
   const notes = [...div.querySelectorAll(".annotation")].map((a) => a.getBoundingClientRect()).filter((r) => r.width > 0);
   const bar = div.querySelector(".modebar");
   const b = bar ? bar.getBoundingClientRect() : null;
-  const drags = [...div.querySelectorAll(".nsewdrag")].map((d) => d.getBoundingClientRect());
+  // (the plots: 2D plot areas, colour bars, 3D scenes)
+  const drags = [...div.querySelectorAll(".nsewdrag, .colorbar, .gl-container > div")].map((d) => d.getBoundingClientRect());
   let notesOverlap = false;
   for (let i = 0; i < notes.length; i++) for (let j = i + 1; j < notes.length; j++) notesOverlap ||= hit(notes[i], notes[j]);
   return {
@@ -31,6 +32,8 @@
     notesOverlap,
     toolbarClearOfTitle: !t || !b || !hit(t, b),
     toolbarClearOfPlots: !b || !drags.some((d) => hit(d, b)),
+    toolbar: b && [b.left, b.top, b.right, b.bottom],
+    plots: drags.map((d) => [d.left, d.top, d.right, d.bottom]),
     titleBelowHead: !t || !head || t.top >= head.getBoundingClientRect().bottom - 1,
     annotations: [...div.querySelectorAll(".annotation-text")].map((a) => a.textContent),
   };
