@@ -13,7 +13,17 @@ from ...engine.functional_report import region_words, report_words
 from .algorithms import COLORS, DASH, LABELS
 from .analysis import vector_note
 from .functionals import state_inert_variables
-from .plotting import COLORBAR, NO_LEGEND, RIGHT, figure, label, note, side_by_side, trace, units
+from .plotting import (
+    COLORBAR,
+    NO_LEGEND_MARGIN,
+    RIGHT,
+    figure,
+    label,
+    note,
+    side_by_side,
+    trace,
+    units,
+)
 from .robots import state_spec
 from .runs import DashboardResult
 
@@ -98,7 +108,7 @@ def augmenting_spec(
         data,
         augmenting_title(result, functionals, cancelled),
         showlegend=False,
-        margin={**NO_LEGEND["margin"], "r": RIGHT + COLORBAR},  # (the colour bar beside h)
+        margin={**NO_LEGEND_MARGIN, "r": RIGHT + COLORBAR},  # (the colour bar beside h)
         shapes=shapes,
         xaxis=dict(title=label(ni, ju[i])),
         yaxis=dict(title=label(nj, ju[j])),

@@ -114,7 +114,8 @@ def note(text: str, x, y, xref="paper", yref="paper", color=None, size=11, **mor
 #: Layout of the panels whose traces are the two algorithms: no legend (the page's header
 #: names the colours; a legend costs a fifth of a panel's redraw in the browser test), the
 #: other marks named in the title, and the bottom margin the legend took given back.
-NO_LEGEND = dict(showlegend=False, margin=dict(l=64, r=RIGHT, t=48, b=48))
+NO_LEGEND_MARGIN = dict(l=64, r=RIGHT, t=48, b=48)
+NO_LEGEND = dict(showlegend=False, margin=NO_LEGEND_MARGIN)
 
 
 def figure(data: list, title: str, **layout) -> dict:
