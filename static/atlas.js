@@ -8,7 +8,7 @@
 import { api } from "./api.js";
 import { parseNumber } from "./controls.js";
 import { $, el, fieldNote, fmt, markInvalid } from "./dom.js";
-import { PLOT_CONFIG, followWidth, panelHead, toolbarBesidePlots } from "./panels.js";
+import { drawFigure, followWidth, panelHead } from "./panels.js";
 
 const POLL_MS = 250;
 // token: bumped to stop following a job; job: the one followed; shown: the atlas on screen;
@@ -154,8 +154,7 @@ async function draw(body, key) {
   // Its height is the figure's (rows of cycles and scales); the width follows the window.
   // (plotly's responsive mode would take the height from the box too.)
   const layout = { ...body.figure.layout, width: div.clientWidth };
-  await Plotly.react(div, body.figure.data, layout, PLOT_CONFIG);
-  toolbarBesidePlots(div);
+  await drawFigure(div, body.figure.data, layout);
   // (plotly puts its plot first: the head and its help go back above it)
   div.prepend(...div.querySelectorAll(":scope > .panel-head, :scope > .panel-help"));
   if (!div.dataset.clicks) {

@@ -5,7 +5,7 @@ import { saveImage, saveTable } from "./panel_exports.js";
 
 // (not plotly's `responsive`: its resize sizes a figure to its panel, height too, and a panel's
 // height follows its figure, so every figure fell to the panel's least height: followWidth)
-export const PLOT_CONFIG = {
+const PLOT_CONFIG = {
   responsive: false,
   displaylogo: false,
   modeBarButtonsToRemove: ["toImage", "select2d", "lasso2d"],
@@ -13,8 +13,14 @@ export const PLOT_CONFIG = {
 
 // Plotly's toolbar stands upright in the right margin, from the top of the plots down (style.css
 // places it by this variable), so that it covers neither the title above nor the plots.
-export function toolbarBesidePlots(div) {
+function toolbarBesidePlots(div) {
   if (div._fullLayout) div.style.setProperty("--toolbar-top", `${div._fullLayout.margin.t}px`);
+}
+
+// A figure drawn anew (Plotly.react), its toolbar beside its plots.
+export async function drawFigure(div, data, layout) {
+  await Plotly.react(div, data, layout, PLOT_CONFIG);
+  toolbarBesidePlots(div);
 }
 
 // A drawn figure follows its panel's width (``measure(div)``), its own height kept.
@@ -291,8 +297,7 @@ export async function onAhead(msg, shownRobot) {
     const width = visible.getBoundingClientRect().width; // (fractional, as plotly takes it; shown only at this width)
     div.style.width = `${width}px`;
     box.append(div);
-    await Plotly.react(div, fig.data, fig.layout, PLOT_CONFIG);
-    toolbarBesidePlots(div);
+    await drawFigure(div, fig.data, fig.layout);
     panels[key] = { div, digest: msg.digests[key], width };
   }
   if (token === ahead.tokens[msg.robot] && msg.robot !== shownRobot()) ahead.robots[msg.robot] = panels;
