@@ -9,6 +9,7 @@ reached only through the API's proxy (:mod:`jik.app.api.routes.sessions`).
 from __future__ import annotations
 
 import errno
+import logging
 import signal
 import socket
 
@@ -42,6 +43,18 @@ def bind(host: str, port: int) -> socket.socket:
         raise
     sock.listen(2048)
     return sock
+
+
+class _NoSocketLines(logging.Filter):
+    """Drops uvicorn's line for each websocket (``127.0.0.1:5000 - "WebSocket
+    /api/sessions/{id}/scene" [accepted]``), which it writes to its error log whatever
+    ``access_log`` says: its path holds the session's id, the one key to the session."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return not str(record.msg).startswith('%s - "WebSocket %s"')
+
+
+_NO_SOCKET_LINES = _NoSocketLines()
 
 
 def _stopped(signum: int, frame: object) -> None:
@@ -103,6 +116,8 @@ def run_server(
             proxy_headers=forwarded_allow_ips is not None,
             forwarded_allow_ips=forwarded_allow_ips or "",
         )
+        # (after the Config, which sets up uvicorn's loggers; no access log: no request's path)
+        logging.getLogger("uvicorn.error").addFilter(_NO_SOCKET_LINES)
         uvicorn.Server(config).run(sockets=[sock])
     finally:
         for sig, handler in previous.items():
