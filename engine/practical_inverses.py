@@ -219,7 +219,10 @@ class WeightedInverse(Inverse):
         Jw = J * np.sqrt(winv)[..., None, :]
         w, d = solve_small(gram(Jw), e)  # (J W^-1 J^T) w = e
         bad = ~(np.abs(d) >= SINGULAR_MANIPULABILITY**2) | self.outside(x)
-        v = winv * _jt(J, w)
+        # (a trial point at a limit: weight 0 times J^T w of a singular J W^-1 J^T; marked bad
+        # below, not warned)
+        with np.errstate(invalid="ignore"):
+            v = winv * _jt(J, w)
         bad |= ~np.isfinite(v).all(axis=-1)
         return (np.where(bad[..., None], 0.0, v) if bad.any() else v), bad
 

@@ -175,6 +175,17 @@ def test_posture_pull_of_a_diverged_iterate_is_marked_bad_without_a_warning():
     assert np.isfinite(v).all()
 
 
+@pytest.mark.filterwarnings("error")
+def test_weighted_run_whose_trial_points_reach_a_limit_does_not_warn():
+    """A Picard sweep of the 3R arm toward (0, 2.5) within [-1, 1] per joint evaluates trial
+    points at a limit, where two weights are 0 and J W^-1 J^T is singular: those members are
+    marked bad with no RuntimeWarning (under ``-W error`` the run raised)."""
+    inv = WeightedInverse(ARM3R, [[-1.0, 1.0]] * 3)
+    res = solve(inv, (0.3, 0.4, 0.5), (0.0, 2.5))
+    assert res.success and res.error < 1e-10
+    assert not inv.outside(res.x)
+
+
 def test_damped_leaves_a_singular_start_where_the_pseudoinverse_cannot():
     """The 3R arm stretched (J of rank 1): damped least squares moves off and converges."""
     with pytest.raises(KinematicSingularityError):
