@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...engine.reproductions.table1 import FIGS_5_9_TARGET, X0
 from .algorithms import COLORS, DASH, LABELS, STYLES
 from .cspace import cspace_spec
 from .map_figures import augmenting_spec, sensitivity_spec
@@ -212,9 +213,18 @@ def _task_space(result: DashboardResult) -> dict:
 
 
 def _cited(result: DashboardResult, figures: str) -> str:
-    """`` (Figs. ...)`` for Manipulator 2, the robot of the paper's Figs. 5-9 (sec. 5.2.1); the
-    panels of another robot cite none."""
-    return f" ({figures})" if result.state.robot == "manipulator2" else ""
+    """`` (Figs. ...)`` on the run of the paper's Figs. 5-9 (sec. 5.2.1): Manipulator 2 (l = 1)
+    from x0 = (0, 0, pi/2) to the one target y_d = (0, 2). Other runs cite none: Table 1's closed
+    path, another start, target or robot is not what those figures show."""
+    s = result.state
+    shown = (
+        s.robot == "manipulator2"
+        and s.task == "target"
+        and s.robot_parameters.get("l", 1.0) == 1.0
+        and np.allclose(s.x0, X0, rtol=0, atol=1e-9)
+        and np.allclose(s.target, FIGS_5_9_TARGET, rtol=0, atol=1e-9)
+    )
+    return f" ({figures})" if shown else ""
 
 
 def _joints(result: DashboardResult) -> dict:

@@ -17,9 +17,11 @@ from .plotting import PANEL_SIZES
 
 #: What each panel shows, and how to read it.
 PANEL_HELP = {
-    "task": "The end effector's path in the task space for each chosen algorithm (paper, Figs. "
-    "5 and 6): × marks the targets of the legs, ○ the start k(x0). The algorithms follow the "
-    "same task path; they differ in the joints.",
+    "task": "The end effector's path in the task space for each chosen algorithm: × marks the "
+    "targets of the legs, ○ the start k(x0). The algorithms follow the same task path; they "
+    "differ in the joints. The paper's Figs. 5 and 6 (and 7-9 for the joints) are Manipulator "
+    "2's single target (0, 2) from x0 = (0, 0, π/2), its defaults with the task “single "
+    "target”; the panels cite them there.",
     "drift": "Repeatability: after each cycle of the closed path, how far the joints are from "
     "where they started, ‖x − x0‖ (the Euclidean norm of the joint vector, whose coordinates "
     "can mix units, e.g. m and rad). A repeatable algorithm stays near 0 (log scale). For a "

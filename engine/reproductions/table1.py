@@ -20,6 +20,8 @@ from ..validation import as_points
 
 X0 = (0.0, 0.0, math.pi / 2)
 PATH = ((1.0, 1.0), (1.0, 2.0), (0.0, 2.0), (0.0, 1.0))
+#: The one target of the paper's Figs. 5-9 (sec. 5.2.1), solved for from X0.
+FIGS_5_9_TARGET = (0.0, 2.0)
 #: Table 1 as printed (rows x0, x1f, ..., x4f).
 PRINTED = {
     "pseudoinverse": [

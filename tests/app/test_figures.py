@@ -154,6 +154,19 @@ def test_single_target_shows_convergence_instead_of_drift(target_result):
         assert t.y[-1] < 1e-9 and t.y[0] > 0.1
 
 
+def test_the_papers_figures_5_to_9_are_cited_on_their_run_only(path_result):
+    """Figs. 5-9 show Manipulator 2's single target (0, 2) from x0 = (0, 0, pi/2) (sec. 5.2.1);
+    Table 1's closed path, which the paper draws in no figure, and another target cite none."""
+    m2 = default_state("manipulator2")
+    figs = compute(updated_state(m2, {"task": "target"}))
+    assert "(Figs. 5, 6)" in panel(figs, "task").layout.title.text
+    assert "(Figs. 7-9)" in panel(figs, "joints").layout.title.text
+    other_target = compute(updated_state(m2, {"task": "target", "target": [1.0, 1.0]}))
+    for result in (path_result, other_target):
+        assert "Figs." not in panel(result, "task").layout.title.text
+        assert "Figs." not in panel(result, "joints").layout.title.text
+
+
 def test_every_panel_serialises_to_plotly_json(path_result, target_result):
     for result in (path_result, target_result):
         figs = figures_for(result)
