@@ -95,7 +95,11 @@ def theta_axis(result: DashboardResult) -> dict:
 
 def corner_names(result: DashboardResult) -> list[str]:
     """The letters of the task's corners
-    (:func:`jik.engine.reproductions.table1.corner_letters`)."""
+    (:func:`jik.engine.reproductions.table1.corner_letters`); a single target is "target" (a
+    letter would clash with the paper's: its A is (1, 1) of Manipulator 2 and a start of the
+    unicycle)."""
+    if result.state.task == "target":
+        return ["target"]
     start = next(iter(result.runs.values())).y[0]
     return corner_letters(result.targets, start, result.state.task == "path")
 

@@ -167,6 +167,16 @@ def test_the_papers_figures_5_to_9_are_cited_on_their_run_only(path_result):
         assert "Figs." not in panel(result, "joints").layout.title.text
 
 
+def test_a_single_target_is_named_target_not_a_corner_letter():
+    """The paper's letters are Manipulator 2's corners (A = (1, 1)) and the unicycle's starts
+    (q0 = A): a single target lettered A was read as one of them."""
+    result = compute(updated_state(default_state("manipulator2"), {"task": "target"}))
+    (marks,) = [t for t in panel(result, "task").data if t.name == "targets"]
+    assert list(marks.text) == ["target"]
+    rows = panel(result, "table").data[0].cells.values[0]
+    assert list(rows) == ["start x0", "cycle 1, leg to target (0, 2)"]
+
+
 def test_every_panel_serialises_to_plotly_json(path_result, target_result):
     for result in (path_result, target_result):
         figs = figures_for(result)
