@@ -25,6 +25,14 @@ def test_the_api_reference_builds_strictly_with_local_assets_only(tmp_path):
     solving = (site / "api" / "solving" / "index.html").read_text(encoding="utf-8")
     assert "solve_batch" in solving and "BatchSolveResult" in solving
     assert "Wazewski" in solving or "continuation" in solving
+    # the docstrings' Sphinx roles are links (or code), never the text ":func:" before a name
+    link = re.search(
+        r'<a class="autorefs[^"]*"[^>]*href="([^"]+)"><code>solve_batch</code></a>', solving
+    )
+    assert link and link.group(1) == "#jik.engine.solver.solve_batch"
+    for page in site.joinpath("api").rglob("*.html"):
+        roles = re.findall(r":(?:func|class|data|mod|meth|attr|exc):", page.read_text("utf-8"))
+        assert roles == [], page
     pages = [p.read_text(encoding="utf-8") for p in site.rglob("*.html")]
     assert len(pages) >= 9 and (site / "index.html").is_file()
     for page in pages:
