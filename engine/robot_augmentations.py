@@ -149,7 +149,7 @@ def _region(kin: Kinematics, item: Mapping, where: str):
         raise InvalidInputError(
             f"{where}.region must vary at least p - r = {k} of the joints "
             f"{list(kin.variable_names)}, got {sorted(box)}: maps h_1..h_{k} of fewer have a "
-            "derivative dh of rank below p - r, so the extended Jacobian [J; dh] of eq. (11) is "
+            "derivative dh of rank below p - r, so the extended Jacobian [J; dh] of eq. (10) is "
             "singular everywhere",
             f"{where}.region",
         )

@@ -162,7 +162,7 @@ def start_problem(inverse: Inverse, x: FloatArray) -> str:
 def map_value_undefined(inverse: Inverse, x0: FloatArray) -> FloatArray:
     """Where the extended inverse's augmenting map has no finite value at the starts ``x0``
     (n, p): bool (n,). A run uses only dh (eq. (11)), so it would run from there, yet what the
-    inverse keeps, h(x) = h(x0) (eq. (9)), means nothing (a formula such as
+    inverse keeps, h(x) = h(x0) (eq. (12)), means nothing (a formula such as
     ``log(-1 - x1**2)``, whose gradient is real). All False for an inverse without a map, and
     for a map that solves a problem per point (the unicycle's characteristics map)."""
     x0 = np.asarray(x0, dtype=float)

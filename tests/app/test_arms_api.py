@@ -230,6 +230,7 @@ def test_a_region_of_fewer_joints_than_p_minus_r_is_refused_at_the_region(api):
     assert error["msg"].startswith(
         "augmentation.region: must vary at least p - r = 4 of the joints"
     )
+    assert "the extended Jacobian [J; dh] of eq. (10) is singular" in error["msg"]
 
 
 def test_an_arm_without_a_map_for_its_task_is_told_the_map_that_works(api):
