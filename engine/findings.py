@@ -146,8 +146,9 @@ def extended_why(
             else "."
         )
         text = (
-            f"Why: J^E# adds the equation h(x) = h(x0) (eq. (12)); h changed by only {g(dh)} "
-            f"along its run{tail}"
+            "Why: J^E# adds the equation h(x) = h(x0) (eq. (12)); "
+            + ("h did not change" if dh == 0 else f"h changed by only {g(dh)}")
+            + f" along its run{tail}"
         )
     else:
         lost = (

@@ -56,6 +56,8 @@ def test_the_pseudoinverse_drifts_and_the_extended_inverse_comes_back_in_words()
             "why",
         )
     ]
+    (exact,) = jik.extended_why(np.full(5, 0.5), [], True, False, "continuous", 1.0)
+    assert "; h did not change along its run." in exact[0]  # (not "changed by only 0")
 
 
 def test_a_run_that_lost_h_says_so_and_discrete_mode_says_why():
