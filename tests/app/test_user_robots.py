@@ -260,6 +260,15 @@ def test_vector_lengths_are_checked_against_the_built_robot(api):
             "'c' is not a link",
         ),
         ({"name": "urdf", "urdf": "not xml", "end_link": "c"}, "robot.urdf", "not a valid URDF"),
+        (
+            {
+                "name": "urdf",
+                "urdf": ARM4.read_text().replace('<axis xyz="0 1 0"/>', '<axis xyz="0 1"/>'),
+                "end_link": "tool",
+            },
+            "robot.urdf",
+            "joint 'shoulder' has an axis of 2 numbers, not 3",
+        ),
     ],
 )
 def test_bad_definitions_are_422_naming_the_field(api, robot, field, text):

@@ -167,6 +167,19 @@ def test_repeatability_pseudoinverse_drifts_extended_returns(arm):
             "joint 'shoulder' has a NaN or infinite origin",
         ),
         (
+            {"end_link": "tool", "urdf": TEXT.replace('<axis xyz="0 1 0"/>', '<axis xyz="0 1"/>')},
+            "urdf",
+            "joint 'shoulder' has an axis of 2 numbers, not 3",
+        ),
+        (
+            {
+                "end_link": "tool",
+                "urdf": TEXT.replace('<axis xyz="0 1 0"/>', '<axis xyz="0 1 0 0"/>'),
+            },
+            "urdf",
+            "joint 'shoulder' has an axis of 4 numbers, not 3",
+        ),
+        (
             {"end_link": "tool", "urdf": TEXT.replace('<robot name="arm4">', "<robot>")},
             "urdf",
             "an element lacks its 'name' attribute",
