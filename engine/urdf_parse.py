@@ -112,6 +112,44 @@ def _hardened_parse(data: bytes, field: str):
     return tree.getroot()
 
 
+def _check_tree(root, field: str) -> None:
+    """Refuse what yourdfpy would read silently or with a message about its own code: a root
+    other than ``<robot>``, two links or two joints of one name, a joint without its parent or
+    child link, a link that is the child of two joints (a URDF is a tree) and a joint origin
+    whose ``xyz`` or ``rpy`` is not 3 numbers (yourdfpy drops a fourth)."""
+    if root.tag != "robot":
+        raise InvalidInputError(f"{field}: the root element is <{root.tag}>, not <robot>", field)
+    for kind in ("link", "joint"):
+        seen: set[str | None] = set()
+        for element in root.iterfind(kind):
+            if (name := element.get("name")) in seen:
+                raise InvalidInputError(f"{field}: two {kind}s are named {name!r}", field)
+            seen.add(name)
+    parent_joint: dict[str, str] = {}
+    for joint in root.iterfind("joint"):
+        name = joint.get("name")
+        for role in ("parent", "child"):
+            if joint.find(role) is None or joint.find(role).get("link") is None:
+                raise InvalidInputError(
+                    f'{field}: joint {name!r} has no <{role} link="..."/>', field
+                )
+        child = joint.find("child").get("link")
+        if child in parent_joint:
+            raise InvalidInputError(
+                f"{field}: link {child!r} is the child of two joints, {parent_joint[child]!r} "
+                f"and {name!r} (a URDF is a tree)",
+                field,
+            )
+        parent_joint[child] = name
+        origin = joint.find("origin")
+        for attr in ("xyz", "rpy"):
+            value = None if origin is None else origin.get(attr)
+            if value is not None and len(value.split()) != 3:
+                raise InvalidInputError(
+                    f"{field}: joint {name!r} has origin {attr}={value!r}, not 3 numbers", field
+                )
+
+
 def parse_urdf(text, field: str = "urdf"):
     """Parse URDF text with yourdfpy (no meshes loaded); a ``yourdfpy.URDF``.
 
@@ -122,7 +160,7 @@ def parse_urdf(text, field: str = "urdf"):
     ------
     InvalidInputError
         Not a string, over ``MAX_URDF_BYTES``, a declared encoding other than UTF-8, a DTD or
-        entity, not a URDF; the message names ``field``.
+        entity, not a URDF (:func:`_check_tree`); the message names ``field``.
     """
     if not isinstance(text, str) or not text.strip():
         raise InvalidInputError(f"{field} must be the text of a URDF file", field)
@@ -133,7 +171,9 @@ def parse_urdf(text, field: str = "urdf"):
         )
     if re.search(rb"<!\s*(DOCTYPE|ENTITY)", data, re.IGNORECASE):
         raise InvalidInputError(f"{field}: a URDF with a DOCTYPE or ENTITY is refused", field)
-    clean = _etree().tostring(_hardened_parse(data, field), encoding="utf-8")
+    root = _hardened_parse(data, field)
+    _check_tree(root, field)
+    clean = _etree().tostring(root, encoding="utf-8")
     yourdfpy = _yourdfpy()
     try:
         model = yourdfpy.URDF.load(

@@ -106,6 +106,59 @@ def test_repeatability_pseudoinverse_drifts_extended_returns(arm):
     assert np.max(ext.drift) < 1e-9
 
 
+#: A second joint onto the tool: the tool link then has two parents.
+SECOND_PARENT = (
+    '<joint name="tool_too" type="fixed"><parent link="forearm"/><child link="tool"/></joint>'
+)
+
+
+@pytest.mark.parametrize(
+    ("urdf", "text"),
+    [
+        (
+            TEXT.replace("<robot name", "<robt name").replace("</robot>", "</robt>"),
+            "urdf: the root element is <robt>, not <robot>",
+        ),
+        (
+            TEXT.replace('<joint name="elbow"', '<joint name="shoulder"'),
+            "two joints are named 'shoulder'",
+        ),
+        (
+            TEXT.replace('<link name="finger">', '<link name="wrist">'),
+            "two links are named 'wrist'",
+        ),
+        (
+            TEXT.replace("</robot>", SECOND_PARENT + "</robot>"),
+            "link 'tool' is the child of two joints, 'tool_mount' and 'tool_too'",
+        ),
+        (
+            TEXT.replace('<child link="forearm"/>', ""),
+            "joint 'elbow' has no <child link=\"...\"/>",
+        ),
+        (
+            TEXT.replace('xyz="0 0 0.2" rpy="0 0 0"', 'xyz="0 0" rpy="0 0 0"'),
+            "joint 'shoulder' has origin xyz='0 0', not 3 numbers",
+        ),
+        (
+            TEXT.replace('xyz="0 0 0.2" rpy="0 0 0"', 'xyz="0 0 0.2 1" rpy="0 0 0"'),
+            "joint 'shoulder' has origin xyz='0 0 0.2 1', not 3 numbers",
+        ),
+        (
+            TEXT.replace('xyz="0 0 0.2" rpy="0 0 0"', 'xyz="0 0 0.2" rpy="0 0"'),
+            "joint 'shoulder' has origin rpy='0 0', not 3 numbers",
+        ),
+    ],
+)
+def test_a_urdf_that_is_not_a_tree_of_unique_names_is_refused_naming_what(urdf, text):
+    """What yourdfpy reads without a word (a fourth origin number, a second parent, a second
+    joint of one name: the chain then takes one of them) or with a message about its own code
+    (a joint without its child) is refused, saying what is wrong."""
+    with pytest.raises(InvalidInputError) as err:
+        UrdfChain(urdf, "tool")
+    assert err.value.field == "urdf"
+    assert text in str(err.value)
+
+
 @pytest.mark.parametrize(
     ("kwargs", "field", "text"),
     [
