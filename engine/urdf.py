@@ -364,6 +364,11 @@ def _bounds(joint) -> tuple[float, float]:
 
 
 def _limits(joint) -> tuple[float, float]:
-    """The joint's range [rad or m]: its URDF limits, or (-pi, pi) for a continuous joint
-    ((-1, 1) m for a prismatic one without limits)."""
-    return _declared(joint) or ((-math.pi, math.pi) if joint.type != "prismatic" else (-1.0, 1.0))
+    """The joint's range [rad or m], finite: its URDF limits, or (-pi, pi) for a continuous
+    joint ((-1, 1) m for a prismatic one without limits); a side declared infinite lies a
+    turn (2 m) from the other, and both infinite are as no limits."""
+    lo, hi = _bounds(joint)
+    width = 2.0 if joint.type == "prismatic" else 2 * math.pi
+    if math.isinf(lo) and math.isinf(hi):
+        return -width / 2, width / 2
+    return (hi - width if math.isinf(lo) else lo), (lo + width if math.isinf(hi) else hi)

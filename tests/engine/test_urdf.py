@@ -295,3 +295,21 @@ def test_the_default_start_is_inside_every_joints_range():
     )
     report = robot.limits_report(run)
     assert run.success and report is not None and report.within, report
+
+
+def test_limits_declared_infinite_give_a_finite_range():
+    """A joint whose URDF limits are -inf and inf (as exporters write "no limits") ranges over a
+    turn like a continuous one, and one infinite side lies a turn from the other: the range
+    (sliders, default start, an atlas's box) stays finite; the limits checked stay as declared."""
+    from jik.engine.robot_spec import robot_from_dict
+
+    text = TEXT.replace('<limit lower="-2.0" upper="2.0"', '<limit lower="-inf" upper="inf"')
+    text = text.replace('<limit lower="-2.5" upper="2.5"', '<limit lower="-inf" upper="1.0"')
+    robot = robot_from_dict({"name": "urdf", "urdf": text, "end_link": "tool"})
+    pi = np.pi
+    np.testing.assert_allclose(
+        robot.spec.x_range, [(-3, 3), (-pi, pi), (1 - 2 * pi, 1), (-pi, pi)], rtol=0, atol=0
+    )
+    assert np.all(np.isfinite(robot.spec.default_x0))
+    np.testing.assert_array_equal(robot.kinematics.joint_limits[1:3, 0], [-np.inf, -np.inf])
+    assert list(robot.kinematics.joint_limits[1:3, 1]) == [np.inf, 1.0]
