@@ -70,7 +70,7 @@ function onState(msg, force = false) {
   session.generation = Math.max(session.generation, msg.generation);
   showControls(msg, send, force);
   page.editor.show(msg.state, msg.type === "refused");
-  rememberInUrl(msg.state);
+  rememberInUrl(msg.state).catch((err) => console.warn("the link's state:", err));
   atlasState(msg.state);
   if (msg.generation > page.shown) setStatus(`computing generation ${msg.generation}…`);
 }
@@ -225,17 +225,49 @@ async function onFunctionals(msg) {
 
 // ---------------------------------------------------------------- the session and its link
 // The page's URL holds the state (?state=<JSON of the dashboard's fields>): a copied link, or a
-// reload, starts a new session with the same state.
-function rememberInUrl(state) {
+// reload, starts a new session with the same state. A state whose JSON is longer than
+// PLAIN_STATE (a pasted URDF of tens of kB, which the server's cap on a request's headers, 64 kB,
+// refused with 431 on a reload) is held deflated: ?z=<base64url of its JSON, deflate-raw>.
+const PLAIN_STATE = 16 * 1024;
+let remembering = 0; // the newest state written (a deflation finishes later than it starts)
+
+async function rememberInUrl(state) {
+  const turn = ++remembering;
+  const text = JSON.stringify(state);
   const url = new URL(location.href);
-  url.searchParams.set("state", JSON.stringify(state));
-  if (url.href === location.href) return;
+  url.searchParams.delete("state");
+  url.searchParams.delete("z");
+  if (encodeURIComponent(text).length <= PLAIN_STATE) url.searchParams.set("state", text);
+  else url.searchParams.set("z", await deflated(text));
+  if (turn !== remembering || url.href === location.href) return;
   history.replaceState(null, "", url);
   $("#copy-link").textContent = "copy link"; // (a link copied before is of another state)
 }
 
-function stateFromUrl() {
-  const text = new URL(location.href).searchParams.get("state");
+async function deflated(text) {
+  const stream = new Blob([text]).stream().pipeThrough(new CompressionStream("deflate-raw"));
+  const bytes = new Uint8Array(await new Response(stream).arrayBuffer());
+  let binary = "";
+  for (const b of bytes) binary += String.fromCharCode(b);
+  return btoa(binary).replaceAll("+", "-").replaceAll("/", "_").replace(/=+$/, "");
+}
+
+async function inflated(z) {
+  const bytes = Uint8Array.from(atob(z.replaceAll("-", "+").replaceAll("_", "/")), (c) => c.charCodeAt(0));
+  return new Response(new Blob([bytes]).stream().pipeThrough(new DecompressionStream("deflate-raw"))).text();
+}
+
+async function stateFromUrl() {
+  const params = new URL(location.href).searchParams;
+  let text = params.get("state");
+  if (params.has("z")) {
+    try {
+      text = await inflated(params.get("z"));
+    } catch (err) {
+      setNotice(`the link's state is not a deflated state (${err.message}); showing the defaults`);
+      return {};
+    }
+  }
   if (!text) return {};
   try {
     const state = JSON.parse(text);
@@ -287,7 +319,7 @@ async function main() {
   new ResizeObserver(([entry]) => document.documentElement.style.setProperty("--header-h", `${Math.ceil(entry.target.getBoundingClientRect().height)}px`)).observe($("header"));
   $("#legend").replaceChildren(algorithmKey(true));
   $("#controls").addEventListener("submit", (ev) => ev.preventDefault()); // (Enter in a box)
-  const opened = await openSession(stateFromUrl(),
+  const opened = await openSession(await stateFromUrl(),
     (message) => setNotice(`the link's state was refused (${message}); showing the defaults`));
   $("#copy-link").addEventListener("click", copyLink);
   $("#cancel").addEventListener("click", cancel);

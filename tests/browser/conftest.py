@@ -25,6 +25,7 @@ import subprocess
 import sys
 import time
 import urllib.request
+import zlib
 from pathlib import Path
 from urllib.parse import parse_qs, unquote, urlsplit
 
@@ -176,8 +177,14 @@ class Tab:
         return get_json(f"{self.base}/api/sessions/{self.session_id}")
 
     def url_state(self) -> dict:
-        """The state the page keeps in its URL (``?state=<JSON>``)."""
-        return json.loads(parse_qs(urlsplit(self.page.url).query)["state"][0])
+        """The state the page keeps in its URL (``?state=<JSON>``, or ``?z=`` its JSON deflated
+        and in base64url when long)."""
+        query = parse_qs(urlsplit(self.page.url).query)
+        if "z" in query:
+            z = query["z"][0]
+            raw = base64.urlsafe_b64decode(z + "=" * (-len(z) % 4))
+            return json.loads(zlib.decompress(raw, wbits=-15))
+        return json.loads(query["state"][0])
 
     def wait_snapshot(self, condition, what: str) -> dict:
         """Wait until ``condition(snapshot)`` holds for the session's snapshot; return it."""

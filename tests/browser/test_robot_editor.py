@@ -81,6 +81,32 @@ def test_a_urdf_arm_from_a_link_is_drawn_in_the_scene(tabs):
     tab.screenshots("robot-editor-urdf")
 
 
+def test_a_long_urdf_pasted_in_the_editor_survives_a_reload(tabs):
+    """A URDF of some tens of kB (a real robot's) made the page's address, which holds the
+    state, longer than the server takes (431 on a reload or a copied link): such a state is held
+    deflated (?z=), and a reload opens the same robot."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "data" / "arm4.urdf").read_text()
+    pads = "".join(f'<link name="pad_{i:05d}"/>' for i in range(2500))  # (60 kB)
+    urdf = text.replace("</robot>", pads + "</robot>")
+    tab = tabs.open(scene=False)
+    page = tab.page
+    page.click("#robot-editor-open")
+    page.select_option("#robot-kind", "urdf")
+    page.fill("#robot-field-urdf", urdf)
+    page.fill("#robot-field-end_link", "tool")
+    tab.change(lambda: page.click("#robot-apply"))
+    tab.wait_settled(lambda s: s["state"]["robot"] == "urdf", "the long URDF arm")
+    assert "z=" in page.url and len(page.url) < 16 * 1024, len(page.url)
+    assert tab.url_state()["robot_definition"]["urdf"] == urdf
+
+    assert page.reload().status == 200
+    tab.wait_drawn(1)  # (the new session's first generation)
+    snapshot = tab.wait_settled(lambda s: s["state"]["robot"] == "urdf", "the arm, reloaded")
+    assert snapshot["state"]["robot_definition"]["urdf"] == urdf
+
+
 def test_a_refused_definition_keeps_what_was_typed(tabs):
     """A definition the session refuses leaves the editor as the user typed it (another kind
     than the robot in force included: a formula robot, a pasted URDF), with the error beside
