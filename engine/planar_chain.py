@@ -20,10 +20,7 @@ import numpy as np
 
 from .exceptions import InvalidInputError
 from .kinematics import Kinematics
-from .validation import FloatArray, json_number
-
-#: Most joints a chain may have (the REST boundary refuses bigger robots).
-MAX_JOINTS = 32
+from .validation import MAX_JOINTS, FloatArray, json_number
 
 
 class PlanarChain(Kinematics):

@@ -19,7 +19,7 @@ from .kinematics import Kinematics
 from .pose_task import PoseTask, parse_task, reference_rotation, task_text
 from .serial_chain import ChainStep, CompiledChain
 from .urdf_parse import MAX_URDF_BYTES, mesh_note, parse_urdf
-from .validation import FloatArray, as_vector, json_number
+from .validation import MAX_JOINTS, FloatArray, as_vector, json_number
 
 __all__ = ["MAX_URDF_BYTES", "ChainJoint", "UrdfChain", "mesh_note", "parse_urdf"]
 
@@ -151,6 +151,13 @@ class UrdfChain(Kinematics):
                 )
         if len(set(active)) != len(active):
             raise InvalidInputError(f"active_joints repeats a joint: {active}", "active_joints")
+        if len(active) > MAX_JOINTS:
+            raise InvalidInputError(
+                f"active_joints: the chain from {self.base_link!r} to {end_link!r} has "
+                f"{len(active)} movable joints; at most {MAX_JOINTS} can be active (list them "
+                "in active_joints; the others stay at 0 or at their locked values)",
+                "active_joints",
+            )
         joint_names = {j.name for j in model.robot.joints}
         if locked is not None and not isinstance(locked, Mapping):
             raise InvalidInputError("locked must map joint names to values", "locked")

@@ -313,3 +313,23 @@ def test_limits_declared_infinite_give_a_finite_range():
     assert np.all(np.isfinite(robot.spec.default_x0))
     np.testing.assert_array_equal(robot.kinematics.joint_limits[1:3, 0], [-np.inf, -np.inf])
     assert list(robot.kinematics.joint_limits[1:3, 1]) == [np.inf, 1.0]
+
+
+def _long_chain(n: int) -> str:
+    joints = "".join(
+        f'<link name="l{i}"/><joint name="j{i}" type="revolute"><parent link="l{i - 1}"/>'
+        f'<child link="l{i}"/><origin xyz="0 0 0.01"/><axis xyz="0 {i % 2} {1 - i % 2}"/>'
+        '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+        for i in range(1, n + 1)
+    )
+    return f'<robot name="snake"><link name="l0"/>{joints}</robot>'
+
+
+def test_a_chain_of_more_joints_than_a_robot_may_have_is_refused_at_once():
+    """A 3000-joint chain (a 640 kB URDF) is refused before anything is built for it (the
+    dashboard built its maps and took the server past 24 GB); 4 of its joints may be active."""
+    urdf = _long_chain(3000)
+    with pytest.raises(InvalidInputError, match="has 3000 movable joints; at most 32") as info:
+        UrdfChain(urdf, "l3000")
+    assert info.value.field == "active_joints"
+    assert UrdfChain(urdf, "l3000", active_joints=["j1", "j2", "j3", "j4"]).p == 4
