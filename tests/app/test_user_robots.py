@@ -51,6 +51,14 @@ def test_planar_3r_solve_reaches_the_target(api):
         ]
     )
     np.testing.assert_allclose(y, [1.0, 1.3], atol=1e-9)
+    lower = {**ARM, "joints": "rrr"}  # (the engine's PlanarChain takes either case)
+    same = _ok(
+        api.post(
+            "/solve",
+            json={"robot": lower, "algorithm": "pseudoinverse", "x0": X0, "target": [1.0, 1.3]},
+        )
+    )
+    assert same["x"] == b["x"]
 
 
 def test_planar_3r_pseudoinverse_legs_match_an_independent_solve_ivp(api):
