@@ -393,3 +393,14 @@ def test_a_refused_map_is_named_once_by_the_requests_field(api):
     r = api.post("/solve", json=body)
     assert r.status_code == 422
     assert messages(r) == ["augmentation.h: must be a formula (a string), got list"]
+
+
+def test_a_urdf_over_100_kb_is_taken_as_in_python_and_the_dashboard(api):
+    """A real robot's URDF (Talos' is 111 kB) is taken up to the engine's MAX_URDF_BYTES, the
+    bound of Python and the dashboard, whose atlas sends its robot through this API."""
+    pytest.importorskip("yourdfpy")
+    text = ARM4.read_text().replace("<robot", "<!--" + "pad " * 40_000 + "-->\n<robot", 1)
+    assert len(text) > 150_000
+    robot = {"name": "urdf", "urdf": text, "end_link": "tool"}
+    body = _ok(api.post("/kinematics", json={"robot": robot, "x": [0.3, 0.5, 0.8, 0.6]}))
+    assert body["robot"]["definition"]["urdf_bytes"] == len(text)

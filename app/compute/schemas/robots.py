@@ -18,6 +18,7 @@ from ....engine.arms import ARMS, Arm
 from ....engine.formula import MAX_LENGTH as MAX_FORMULA_CHARS  # (the engine's bound)
 from ....engine.registry import ROBOTS, AugmentationSpec, RobotSpec
 from ....engine.robot_kinds import AUGMENTATIONS, COMMON, KINDS, MAX_TITLE_CHARS
+from ....engine.urdf import MAX_URDF_BYTES
 from .fields import (
     INTEGRAL,
     MAX_DIMENSION,
@@ -115,11 +116,6 @@ AUGMENTATION_MODELS: dict[str, type[BaseModel]] = {
 # the joints' letters); the formulas' grammar, the URDF text and what follows from them (p, r,
 # the lengths of x0, target and path) are checked when the robot is built, naming the field.
 
-#: Longest URDF text a request carries [characters]: a tenth of the 1 MiB body limit, room for
-#: an arm of dozens of links (the shipped 4-joint arm is 2 kB). A larger file goes through the
-#: CLI (``jik solve --robot arm.json`` with ``urdf_file``; the engine's bound is 1 MB). A 1 MB
-#: bound here lets a request's text cost the parser gigabytes of memory.
-MAX_URDF_CHARS = 100_000
 #: A variable's, a parameter's or a joint's name.
 Name = Annotated[str, Field(pattern=r"^[A-Za-z][A-Za-z0-9_]{0,31}$")]
 FormulaText = Annotated[str, Field(min_length=1, max_length=MAX_FORMULA_CHARS)]
@@ -169,7 +165,7 @@ _ENTRIES: dict[str, dict[str, tuple[Any, Any]]] = {
         "limits": (JointLimits | None, None),
     },
     "urdf": {
-        "urdf": (Annotated[str, Field(min_length=1, max_length=MAX_URDF_CHARS)], ...),
+        "urdf": (Annotated[str, Field(min_length=1, max_length=MAX_URDF_BYTES)], ...),
         "end_link": (LinkName, ...),
         "active_joints": (
             Annotated[list[LinkName], Field(min_length=1, max_length=MAX_DIMENSION)] | None,
