@@ -22,7 +22,7 @@ from .augmentations import AugmentingMap
 from .exceptions import FormulaError, InvalidInputError
 from .formula import MAX_NAMES, check_name, parse_formula
 from .kinematics import Kinematics
-from .validation import FloatArray, json_number
+from .validation import MAX_JOINTS, FloatArray, json_number
 
 #: Largest average size (tree nodes) of a formula's first or second derivatives, per entry. The
 #: derivative of an ordinary formula is about as large as the formula (a 16-link chain's
@@ -73,9 +73,9 @@ def derivatives(
 def _names(variables, parameters, what: str) -> tuple[list[str], dict[str, float]]:
     if isinstance(variables, str) or not isinstance(variables, Sequence):
         raise InvalidInputError(f"variables must be a list of names for {what}", "variables")
-    if not 1 <= len(variables) <= MAX_NAMES:
+    if not 1 <= len(variables) <= MAX_JOINTS:
         raise InvalidInputError(
-            f"variables: give 1 to {MAX_NAMES} names, got {len(variables)}", "variables"
+            f"variables: give 1 to {MAX_JOINTS} names, got {len(variables)}", "variables"
         )
     names = [check_name(v, f"variables.{i}") for i, v in enumerate(variables)]
     if len(set(names)) != len(names):

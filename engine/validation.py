@@ -90,9 +90,10 @@ def as_points(
     return a
 
 
-#: Most joint variables p of a robot: a planar chain's joints, a formula robot's variables, a
-#: URDF chain's active joints (the REST API and the dashboard take 16, ``MAX_DIMENSION``).
-MAX_JOINTS = 32
+#: Most joint variables p of a robot (a planar chain's joints, a formula robot's variables, a
+#: URDF chain's active joints), in Python, over REST (the most components of a vector) and in
+#: the dashboard.
+MAX_JOINTS = 16
 
 #: Largest magnitude of a coordinate of a solve's start or target (rad, m or the robot's own
 #: units): at 1e6 the spacing of doubles (1.2e-10) passes the default tolerance of 1e-10, and far

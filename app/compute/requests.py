@@ -21,7 +21,7 @@ from ...engine.units import norm_unit, robot_units
 from . import schemas as S
 from .documents import limits_document, nullable, solve_response_json
 from .exceptions import RequestError
-from .robot_requests import check_configuration, check_length, gamma_and_mode, request_robot
+from .robot_requests import check_length, gamma_and_mode, request_robot
 from .schemas.algorithms import parameters_of, used
 from .schemas.wording import without_field
 from .synthesis import synthesis_region
@@ -143,7 +143,7 @@ def solve_batch_json(reqs: list[S.SolveRequest]) -> list[bytes | RequestError]:
     targets = [r.target or setup.spec.default_target for r in reqs]
     for i in range(len(reqs)):
         try:
-            check_configuration(setup.spec, starts[i])
+            check_length(setup.spec, starts[i], "x0", "p")
             check_length(setup.spec, targets[i], "target")
             setup.kinematics.check_target(targets[i], "target")
             ok.append(i)
@@ -181,7 +181,7 @@ def repeatability_request(req: S.RepeatabilityRequest) -> S.RepeatabilityRespons
         path = setup.spec.default_loop() if req.path is None else req.path
     except JikError as exc:  # (a robot without a closed path of its own)
         raise engine_error(exc) from None
-    check_configuration(setup.spec, start)
+    check_length(setup.spec, start, "x0", "p")
     for i, pt in enumerate(path):
         check_length(setup.spec, pt, f"path[{i}]")
     x0 = np.array(start, dtype=float)

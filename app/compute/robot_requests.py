@@ -196,23 +196,6 @@ def check_length(spec: RobotSpec, vector, field: str, what: str = "r") -> None:
         raise RequestError(field, problem)
 
 
-def check_configuration(spec: RobotSpec, x0) -> None:
-    """The robot has at most the API's p, and ``x0`` has p components."""
-    if spec.p > S.MAX_DIMENSION:
-        joints = (
-            "; name at most that many in active_joints (the others stay at their value in "
-            "locked, default 0)"
-            if spec.name == "urdf"
-            else ""
-        )
-        raise RequestError(
-            "robot",
-            f"this {spec.name} robot has p = {spec.p} moving joints; the API takes at "
-            f"most {S.MAX_DIMENSION} (the cap on x0's components){joints}",
-        )
-    check_length(spec, x0, "x0", "p")
-
-
 def gamma_and_mode(spec: RobotSpec, req) -> tuple[float, S.Mode]:
     """The request's gamma of eq. (5) and mode, the robot's where not given; RequestError at
     ``gamma`` when it does not suit the mode (:func:`~jik.engine.solve_rules.gamma_problem`)."""

@@ -66,7 +66,7 @@ from ...app.compute.atlas_plan import AtlasLimits, planned
 from ...app.compute.atlas_schemas import AtlasRequest
 from ...app.compute.exceptions import RequestError
 from ...app.compute.requests import _setup
-from ...app.compute.robot_requests import check_configuration, check_length, request_robot
+from ...app.compute.robot_requests import check_length, request_robot
 from ...app.compute.synthesis import synthesis_region
 from ...app.dashboard.model import default_state, updated_state
 from ...app.dashboard.patch import StatePatch, patch_of
@@ -224,7 +224,7 @@ def _run_ok(body: dict, path: str) -> bool:
         setup = _setup(run)
         spec = setup.spec  # (a start, target or path not given: the robot's)
         x0 = list(spec.default_x0) if run.x0 is None else run.x0
-        check_configuration(spec, x0)
+        check_length(spec, x0, "x0", "p")
         if isinstance(run, S.RepeatabilityRequest):
             points = spec.default_loop() if run.path is None else run.path
         else:

@@ -273,15 +273,16 @@ def _chain_urdf(joints: int) -> str:
 @pytest.mark.parametrize("path", ["/solve", "/repeatability"])
 def test_a_robot_past_the_joint_cap_is_refused_by_the_cap(api, path):
     """A 400-joint URDF chain was answered "x0 must have 400 components", which no x0 can have
-    (x0 takes at most 16): the answer names the cap and how to stay under it."""
+    (x0 takes at most 16): the answer names the cap and how to stay under it, before the
+    robot is built."""
     robot = {"name": "urdf", "urdf": _chain_urdf(400), "end_link": "l400", "task": "xy"}
     body = {"robot": robot, "algorithm": "pseudoinverse", "x0": [0.1] * 16}
     body.update({"target": [1.0, 1.0]} if path == "/solve" else {"path": [[1.0, 1.0]]})
     (msg,) = messages(api.post(path, json=body))
     assert msg == (
-        "robot: this urdf robot has p = 400 moving joints; the API takes at most 16 (the cap on "
-        "x0's components); name at most that many in active_joints (the others stay at their "
-        "value in locked, default 0)"
+        "robot: the chain from 'l0' to 'l400' has 400 movable joints; at most 16 "
+        "can be active (list them in active_joints; the others stay at 0 or at their locked "
+        "values)"
     )
 
 

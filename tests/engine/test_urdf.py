@@ -329,7 +329,7 @@ def test_a_chain_of_more_joints_than_a_robot_may_have_is_refused_at_once():
     """A 3000-joint chain (a 640 kB URDF) is refused before anything is built for it (the
     dashboard built its maps and took the server past 24 GB); 4 of its joints may be active."""
     urdf = _long_chain(3000)
-    with pytest.raises(InvalidInputError, match="has 3000 movable joints; at most 32") as info:
+    with pytest.raises(InvalidInputError, match="has 3000 movable joints; at most 16") as info:
         UrdfChain(urdf, "l3000")
     assert info.value.field == "active_joints"
     assert UrdfChain(urdf, "l3000", active_joints=["j1", "j2", "j3", "j4"]).p == 4

@@ -13,9 +13,10 @@ from pydantic_core import PydanticCustomError
 
 from ....engine.regions import MAX_REGION_BOUND
 from ....engine.solve_rules import GAMMA_MAX, GAMMA_MIN, TOL_MAX, TOL_MIN
+from ....engine.validation import MAX_JOINTS
 
 #: Largest configuration / task dimension accepted before the registry check.
-MAX_DIMENSION = 16
+MAX_DIMENSION = MAX_JOINTS
 #: Largest cap on a leg's integrator steps or iterations that a request, the dashboard's state
 #: and its page may ask for (a far target at a small gamma needs many; a run's time limit stops
 #: it sooner).
