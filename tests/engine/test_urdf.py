@@ -327,7 +327,7 @@ def _long_chain(n: int) -> str:
 
 def test_a_chain_of_more_joints_than_a_robot_may_have_is_refused_at_once():
     """A 3000-joint chain (a 640 kB URDF) is refused before anything is built for it (the
-    dashboard built its maps and took the server past 24 GB); 4 of its joints may be active."""
+    dashboard's validation of a state holding it grew past 24 GB); 4 of its joints may be active."""
     urdf = _long_chain(3000)
     with pytest.raises(InvalidInputError, match="has 3000 movable joints; at most 16") as info:
         UrdfChain(urdf, "l3000")
