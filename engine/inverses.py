@@ -23,7 +23,7 @@ from .exceptions import (
 )
 from .exports import call_repr, short_value
 from .kinematics import SINGULAR_MANIPULABILITY, Kinematics
-from .linalg import gram, solve_small
+from .linalg import min_norm_matrix, min_norm_solve, solve_small
 from .validation import FloatArray
 
 #: |det [J; dh]| / (product of its row norms) below this counts as an algorithmic singularity.
@@ -49,14 +49,11 @@ def pseudoinverse(J: FloatArray) -> FloatArray:
     Returns
     -------
     ndarray, shape (..., p, r)
-        Computed as J^T solve(J J^T, I); NaN where J J^T is singular.
+        By :func:`~jik.engine.linalg.min_norm_matrix` (Gram-Schmidt on J's rows); NaN
+        where m(x) < SINGULAR_MANIPULABILITY.
     """
-    Jt = np.swapaxes(J, -1, -2)
-    M = J @ Jt
-    r = J.shape[-2]
-    bad = np.abs(np.linalg.det(M)) < SINGULAR_MANIPULABILITY**2
-    W = _safe_solve(M, np.broadcast_to(np.eye(r), M.shape).copy(), bad)
-    out = Jt @ W
+    out, det = min_norm_matrix(J)
+    bad = ~(det >= SINGULAR_MANIPULABILITY**2)
     return np.where(bad[..., None, None], np.nan, out)
 
 
@@ -255,9 +252,8 @@ class Pseudoinverse(Inverse):
 
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
         J = self.kinematics.jacobian_unchecked(x)
-        w, d = solve_small(gram(J), e)  # (J J^T) w = e
-        bad = ~(np.abs(d) >= SINGULAR_MANIPULABILITY**2)  # m = sqrt(det); also catches NaN
-        v = np.einsum("...ji,...j->...i", J, w)  # J^T w
+        v, d = min_norm_solve(J, e)  # J^T (J J^T)^-1 e and det(J J^T) = m^2
+        bad = ~(d >= SINGULAR_MANIPULABILITY**2)  # also catches NaN
         return (np.where(bad[..., None], 0.0, v) if bad.any() else v), bad
 
     def matrix(self, x: FloatArray) -> FloatArray:

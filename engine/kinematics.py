@@ -15,6 +15,7 @@ import numpy as np
 
 from .exceptions import InvalidInputError, KinematicSingularityError
 from .exports import call_repr
+from .linalg import min_norm_solve
 from .validation import FloatArray, as_points, bounded, checked_points, positive
 
 #: m(x) below this counts as a kinematic singularity.
@@ -175,9 +176,11 @@ class Kinematics(abc.ABC):
             return c / norm
 
     def manipulability(self, x: FloatArray) -> FloatArray:
-        """m(x) = sqrt(det J J^T), shape (...,) (paper, after eq. (18))."""
+        """m(x) = sqrt(det J J^T), shape (...,) (paper, after eq. (18)), as the product of the
+        diagonal of R in J^T = Q R (:func:`~jik.engine.linalg.min_norm_solve`): accurate to
+        ~ eps |J|^r absolutely, where det(J J^T) by elimination loses ~ eps |J|^2r."""
         J = self.jacobian(x)
-        return np.sqrt(np.maximum(np.linalg.det(J @ np.swapaxes(J, -1, -2)), 0.0))
+        return np.sqrt(min_norm_solve(J, np.zeros(J.shape[:-1]))[1])
 
     def is_singular(self, x: FloatArray, tol: float = SINGULAR_MANIPULABILITY) -> FloatArray:
         """Boolean mask (...,): where m(x) < tol, i.e. J(x) loses rank."""

@@ -70,3 +70,59 @@ def solve_small(A: FloatArray, b: FloatArray) -> tuple[FloatArray, FloatArray]:
     safe = np.where(ok[..., None, None], A, np.eye(n))
     z = np.linalg.solve(safe, b[..., None])[..., 0]
     return np.where(ok[..., None], z, np.nan), d
+
+
+def min_norm_solve(J: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """J^T (J J^T)^-1 e, eq. (8), for a batch J (..., r, p) and e (..., r); returns it (..., p)
+    and det(J J^T) = m(x)^2 (...,).
+
+    Modified Gram-Schmidt on J's rows: J = L U with L unit lower triangular and U's rows u_i
+    orthogonal (u_i / |u_i| are the columns of Q and |u_i| the diagonal of R in J^T = Q R), so
+    the step is sum_i z_i u_i / |u_i|^2 with L z = e, and det(J J^T) = prod |u_i|^2. Unlike
+    Cramer's rule on the normal equations (error ~ kappa(J)^2 eps) the step is accurate to
+    ~ kappa(J) eps, and m = sqrt(det) to ~ eps |J|^r absolutely. Members with a zero row u_i
+    get non-finite steps and det 0 (NaN only from a non-finite J): callers mask them with det.
+    The rows are moved to the front so that each operation runs over the batch's contiguous
+    lanes.
+    """
+    nd = J.ndim
+    lead = tuple(range(nd - 2))
+    rows = J.transpose(nd - 2, nd - 1, *lead).astype(float, order="C")  # (r, p, ...)
+    z = np.asarray(e, dtype=float).transpose(nd - 2, *lead).copy()  # (r, ...)
+    v, det = _orthogonal_solve(rows, z)
+    return v.transpose(*range(1, nd - 1), 0), det
+
+
+def min_norm_matrix(J: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """J^T (J J^T)^-1, eq. (8), shape (..., p, r), and det(J J^T) (...,): :func:`min_norm_solve`
+    with e the r columns of the identity, in one factorisation."""
+    nd, r = J.ndim, J.shape[-2]
+    lead = tuple(range(nd - 2))
+    rows = J.transpose(nd - 2, nd - 1, *lead)[:, :, None].astype(float, order="C")
+    z = np.broadcast_to(np.eye(r).reshape(r, r, *(1,) * (nd - 2)), (r, r, *J.shape[:-2]))
+    v, det = _orthogonal_solve(rows, z.copy())  # v: (p, r, ...)
+    return v.transpose(*range(2, nd), 0, 1), det[0]
+
+
+def _orthogonal_solve(rows: FloatArray, z: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Gram-Schmidt of :func:`min_norm_solve` on ``rows`` (r, p, ...), overwritten, with L z = e
+    solved in place in ``z`` (r, ...; broadcast against rows[i]'s batch axes); returns
+    sum_i z_i u_i / |u_i|^2 and prod |u_i|^2."""
+    r = rows.shape[0]
+    s = np.empty((r, *rows.shape[2:]))
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        for i in range(r):
+            u = rows[i]
+            s[i] = np.einsum("k...,k...->...", u, u)
+            if i + 1 < r:  # the rows after i lose their component along u_i
+                c = np.einsum("jk...,k...->j...", rows[i + 1 :], u) / s[i]
+                rows[i + 1 :] -= c[:, None] * u
+                z[i + 1 :] -= c * z[i]
+        z /= s
+        v, det = rows[0] * z[0], s[0]
+        for i in range(1, r):
+            v += rows[i] * z[i]
+            det = det * s[i]
+    if np.isnan(det).any():  # a zero row u_i (0/0 in the rows after it): J J^T is singular
+        det = np.where(np.any(s == 0, axis=0), 0.0, det)
+    return v, det

@@ -24,7 +24,7 @@ from .exceptions import InvalidInputError, KinematicSingularityError, SingularCo
 from .inverses import Inverse, Pseudoinverse, require_kinematics
 from .kinematics import SINGULAR_MANIPULABILITY, Kinematics
 from .limits import limit_names, robot_limits
-from .linalg import gram, solve_small
+from .linalg import gram, min_norm_solve, solve_small
 from .validation import FloatArray, as_box, finite, flag, within
 
 #: Default and largest damping lambda (the largest also bounds the damping threshold).
@@ -216,13 +216,15 @@ class WeightedInverse(Inverse):
     def apply_masked(self, x: FloatArray, e: FloatArray) -> tuple[FloatArray, FloatArray]:
         J = self.kinematics.jacobian_unchecked(x)
         winv = self.weights_inverse(x)
-        Jw = J * np.sqrt(winv)[..., None, :]
-        w, d = solve_small(gram(Jw), e)  # (J W^-1 J^T) w = e
-        bad = ~(np.abs(d) >= SINGULAR_MANIPULABILITY**2) | self.outside(x)
-        # (a trial point at a limit: weight 0 times J^T w of a singular J W^-1 J^T; marked bad
+        sw = np.sqrt(winv)
+        Jw = J * sw[..., None, :]
+        # W^-1 J^T (J W^-1 J^T)^-1 e = W^-1/2 Jw^T (Jw Jw^T)^-1 e with Jw = J W^-1/2
+        u, d = min_norm_solve(Jw, e)
+        bad = ~(d >= SINGULAR_MANIPULABILITY**2) | self.outside(x)
+        # (a trial point at a limit: weight 0 times the step of a singular Jw; marked bad
         # below, not warned)
         with np.errstate(invalid="ignore"):
-            v = winv * _jt(J, w)
+            v = sw * u
         bad |= ~np.isfinite(v).all(axis=-1)
         return (np.where(bad[..., None], 0.0, v) if bad.any() else v), bad
 
@@ -312,15 +314,13 @@ class PostureInverse(Inverse):
         if self.gain == 0.0:
             return self._plain.apply_masked(x, e)
         J = self.kinematics.jacobian_unchecked(x)
-        G = gram(J)
-        w, d = solve_small(G, e)  # (J J^T) w = e
-        bad = ~(np.abs(d) >= SINGULAR_MANIPULABILITY**2)
-        z = rest - x
-        u, _ = solve_small(G, np.einsum("...ij,...j->...i", J, z))
-        null = z - _jt(J, u)  # (I - J# J) (x_rest - x)
+        # J# e - g (I - J# J) z = J# (e + g J z) - g z, g = gain |e|, z = x_rest - x
         # (a diverged iterate, a Picard sweep's, overflows here: marked bad below, not warned)
         with np.errstate(over="ignore", invalid="ignore"):
-            v = _jt(J, w) - self.gain * np.linalg.norm(e, axis=-1)[..., None] * null
+            gz = self.gain * np.linalg.norm(e, axis=-1)[..., None] * (rest - x)
+            u, d = min_norm_solve(J, e + np.einsum("...ij,...j->...i", J, gz))
+            v = u - gz
+        bad = ~(d >= SINGULAR_MANIPULABILITY**2)
         bad |= ~np.isfinite(v).all(axis=-1)
         return (np.where(bad[..., None], 0.0, v) if bad.any() else v), bad
 
