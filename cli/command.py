@@ -29,9 +29,11 @@ REPRODUCTIONS = {
 }
 
 
-#: The top-level modules of the ``app`` extra (a benchmark of the web parts needs them).
+#: The top-level modules that the web parts and the benchmarks import and only the ``app``
+#: extra installs (tests/test_packaging.py checks the list against their imports).
 WEB_PACKAGES = frozenset(
-    {"fastapi", "fastapi_offline", "starlette", "uvicorn", "viser", "plotly", "httpx"}
+    "fastapi fastapi_offline starlette sse_starlette uvicorn httpx pydantic pydantic_core "
+    "pydantic_settings psutil websockets viser plotly rich markdown_it".split()
 )
 
 

@@ -277,3 +277,22 @@ def test_the_readme_says_every_extra_a_user_installs():
     section = readme.split("## Installing", 1)[1].split("\n## ", 1)[0]
     said = {extra for _, extras in INSTALL_HINT.findall(section) for extra in extras.split(",")}
     assert set(PYPROJECT["project"]["optional-dependencies"]) <= said, said
+
+
+def test_every_package_the_web_parts_import_is_named_by_the_app_extras_message():
+    """Without the ``app`` extra, ``jik serve`` and ``jik bench`` say which command installs it
+    when the missing module is one of the web parts' (``jik.cli.command.WEB_PACKAGES``); any
+    other missing module is re-raised as a fault. Each module that app/ and benchmarks/ import
+    and the plain install lacks must be there: ``jik bench dashboard`` after ``pip install
+    jik-lab`` printed pydantic's ModuleNotFoundError as a traceback."""
+    from jik.cli.command import WEB_PACKAGES
+
+    plain = _runtime_distributions(None)
+    providers = metadata.packages_distributions()
+    web = {
+        module
+        for folder in ("app", "static", "benchmarks")
+        for module in _third_party_imports(folder)
+        if not {_name(d) for d in providers.get(module, [module])} & plain
+    }
+    assert web - WEB_PACKAGES == set()
