@@ -40,3 +40,19 @@ def test_the_figures_benchmark_decodes_every_typed_array():
         data = np.array([1, 2, 3], dtype=np.dtype(dtype).newbyteorder("<"))
         typed = {"dtype": dtype, "bdata": base64.b64encode(data.tobytes()).decode()}
         assert _values({"x": typed}) == {"x": [1.0, 2.0, 3.0]}
+
+
+def test_the_atlas_benchmark_times_dask_only_where_it_is_installed(monkeypatch, capsys):
+    """Without the ``atlas`` extra, ``jik bench atlas`` (and so ``jik bench``) timed the
+    in-process and 2-process atlases, then died with a traceback at the Dask backend; it now
+    times those two and says what installs Dask."""
+    import importlib.util
+
+    from jik.benchmarks import bench_atlas
+
+    assert bench_atlas.backends() == ("inprocess", "processes:2", "dask:local:2")
+    real = importlib.util.find_spec
+    monkeypatch.setattr(
+        importlib.util, "find_spec", lambda name, *a: None if name == "distributed" else real(name)
+    )
+    assert bench_atlas.backends() == ("inprocess", "processes:2")
