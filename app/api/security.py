@@ -51,7 +51,7 @@ _PAGE_POLICY = (
 )
 # viser's client: one HTML file whose packed bundle is an inline script that unpacks itself
 # (eval of its own code), with workers and textures from blob: URLs and its websocket to us;
-# the API's documentation pages (Swagger UI, ReDoc), whose bootstrap is an inline script.
+# the API's documentation page (Swagger UI), whose bootstrap is an inline script.
 _SCENE_POLICY = (
     "default-src 'self'; script-src 'self' 'unsafe-inline' 'unsafe-eval' blob:; "
     "style-src 'self' 'unsafe-inline'; img-src 'self' data: blob:; font-src 'self' data:; "
