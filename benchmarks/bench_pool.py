@@ -22,6 +22,8 @@ import multiprocessing
 import time
 from typing import Any
 
+from jik import install_hint
+
 from .bench_load import CLIENTS, _bodies, _summary
 
 DURATION = 10.0
@@ -67,12 +69,12 @@ async def _jik(duration: float, clients: int, batching: bool) -> dict:
 async def _pebble(duration: float, clients: int, batching: bool) -> dict:
     try:
         import pebble
-    except ImportError:  # (the comparison's library only: pip install pebble)
+    except ImportError:  # (the comparison's library only: the bench extra)
         return {
             "throughput_rps": float("nan"),
             "p50_ms": float("nan"),
             "p99_ms": float("nan"),
-            "errors": "pebble is not installed",
+            "errors": f"pebble is not installed: {install_hint('bench')}",
         }
 
     from ..app.compute.worker import solve_batch
