@@ -118,6 +118,13 @@ URDF = (
     ),
     DefinitionField("end_link", "string", True, "the link whose origin is the end point", "tool"),
     DefinitionField(
+        "base_link",
+        "string",
+        False,
+        "the link whose frame is the base frame, an ancestor of end_link (default: the URDF's "
+        "root; name the link past a floating joint, e.g. a humanoid's torso)",
+    ),
+    DefinitionField(
         "active_joints",
         "names",
         False,

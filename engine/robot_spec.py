@@ -190,6 +190,7 @@ def _kinematics(kind: str, d: Mapping, base_dir: Path | None) -> Kinematics:
         _get(d, "locked", dict, "a mapping of joint names to values", {}),
         d.get("home"),
         d.get("reference"),
+        d.get("base_link"),
     )
 
 

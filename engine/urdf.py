@@ -56,7 +56,7 @@ class UrdfChain(Kinematics):
     urdf : str
         URDF text (at most ``MAX_URDF_BYTES``).
     end_link : str
-        The link whose origin is the end point; the chain runs from the root link to it.
+        The link whose origin is the end point; the chain runs from ``base_link`` to it.
     active_joints : sequence of str, optional
         The joints that are the variables x1..xp, in this order; default: every revolute,
         continuous or prismatic joint on the chain, base first.
@@ -77,6 +77,10 @@ class UrdfChain(Kinematics):
         (:mod:`jik.engine.so3`): keep the task's orientations well within a half turn of R0.
         The base frame (``[0, 0, 0]``) is a half turn from a Panda's home, whose flange points
         down: there k jumps and the solves stall.
+    base_link : str, optional
+        The link whose frame is the base frame, an ancestor of ``end_link``: default the URDF's
+        root. A link above a floating or planar joint (a mobile or humanoid robot's) makes the
+        chain start past it: a torso for an arm, a mobile base for its manipulator.
 
     Notes
     -----
@@ -99,6 +103,7 @@ class UrdfChain(Kinematics):
         locked: Mapping[str, float] | None = None,
         home: Sequence[float] | None = None,
         reference=None,
+        base_link: str | None = None,
     ) -> None:
         model = parse_urdf(urdf)
         self.robot_name = str(model.robot.name)
@@ -113,23 +118,35 @@ class UrdfChain(Kinematics):
                 f"end_link {end_link!r} is not a link of the URDF; links: {sorted(links)}",
                 "end_link",
             )
+        if base_link is not None and (not isinstance(base_link, str) or base_link not in links):
+            raise InvalidInputError(
+                f"base_link {base_link!r} is not a link of the URDF; links: {sorted(links)}",
+                "base_link",
+            )
         parent_joint = {j.child: j for j in model.robot.joints}
         chain, link = [], end_link
-        while link in parent_joint:
+        while link in parent_joint and link != base_link:
             joint = parent_joint[link]
             chain.append(joint)
             link = joint.parent
             if len(chain) > len(model.robot.joints):
                 raise InvalidInputError("urdf: the joints form a loop", "urdf")
         chain.reverse()
+        if base_link is not None and link != base_link:
+            above = [link, *(j.child for j in chain)]
+            raise InvalidInputError(
+                f"base_link {base_link!r} is not on the chain from the root to {end_link!r}; "
+                f"its links are {above}",
+                "base_link",
+            )
         self.base_link, self.end_link = link, end_link
         movable = [j.name for j in chain if j.type in MOVABLE]
         for j in chain:
             if j.type not in (*MOVABLE, "fixed"):
                 raise InvalidInputError(
-                    f"joint {j.name!r} on the chain is {j.type}; only "
-                    "revolute, continuous, prismatic and fixed joints are "
-                    "supported",
+                    f"joint {j.name!r} on the chain is {j.type}; only revolute, continuous, "
+                    "prismatic and fixed joints are supported (start the chain past it: "
+                    f"base_link {j.child!r})",
                     "urdf",
                 )
             if j.mimic is not None and j.type in MOVABLE:
@@ -223,6 +240,7 @@ class UrdfChain(Kinematics):
             "locked": dict(self.locked),
             "home": list(self.home),
             "reference": self.reference.tolist(),
+            "base_link": self.base_link,
         }
 
     def _described(self) -> dict[str, object]:

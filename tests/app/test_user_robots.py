@@ -404,3 +404,18 @@ def test_a_urdf_over_100_kb_is_taken_as_in_python_and_the_dashboard(api):
     robot = {"name": "urdf", "urdf": text, "end_link": "tool"}
     body = _ok(api.post("/kinematics", json={"robot": robot, "x": [0.3, 0.5, 0.8, 0.6]}))
     assert body["robot"]["definition"]["urdf_bytes"] == len(text)
+
+
+def test_a_urdf_chain_starts_at_the_base_link_it_is_given(api):
+    """base_link starts the chain past a floating root (a humanoid's torso): refused without
+    it, naming the link to give, and answered with it."""
+    pytest.importorskip("yourdfpy")
+    from tests.engine.test_urdf import _FLOATING
+
+    robot = {"name": "urdf", "urdf": _FLOATING, "end_link": "hand", "task": "xy"}
+    body = {"robot": robot, "x": [0.3, -0.4, 0.5]}
+    (error,) = api.post("/kinematics", json=body).json()["detail"]
+    assert "joint 'root' on the chain is floating" in error["msg"]
+    assert "base_link 'torso'" in error["msg"]
+    answer = _ok(api.post("/kinematics", json={**body, "robot": {**robot, "base_link": "torso"}}))
+    assert answer["robot"]["p"] == 3 and answer["robot"]["definition"]["base_link"] == "torso"

@@ -333,3 +333,43 @@ def test_a_chain_of_more_joints_than_a_robot_may_have_is_refused_at_once():
         UrdfChain(urdf, "l3000")
     assert info.value.field == "active_joints"
     assert UrdfChain(urdf, "l3000", active_joints=["j1", "j2", "j3", "j4"]).p == 4
+
+
+_FLOATING = """<robot name="humanoid"><link name="world"/><link name="torso"/>
+<joint name="root" type="floating"><parent link="world"/><child link="torso"/></joint>
+<link name="l1"/><link name="l2"/><link name="l3"/><link name="hand"/>
+<joint name="j1" type="revolute"><parent link="torso"/><child link="l1"/>
+<origin xyz="0 0.2 0.3"/><axis xyz="0 0 1"/><limit lower="-2" upper="2" effort="1" velocity="1"/>
+</joint>
+<joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/>
+<origin xyz="0.3 0 0"/><axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="1" velocity="1"/>
+</joint>
+<joint name="j3" type="revolute"><parent link="l2"/><child link="l3"/>
+<origin xyz="0.3 0 0"/><axis xyz="0 0 1"/><limit lower="-2" upper="2" effort="1" velocity="1"/>
+</joint>
+<joint name="j4" type="fixed"><parent link="l3"/><child link="hand"/><origin xyz="0.1 0 0"/></joint>
+</robot>"""
+
+
+def test_base_link_starts_the_chain_past_a_floating_joint():
+    """A humanoid's arm below its floating root: refused from the root, naming base_link; from
+    base_link "torso" its positions are in the torso's frame, as of the URDF rooted there."""
+    with pytest.raises(InvalidInputError, match="joint 'root' on the chain is floating") as info:
+        UrdfChain(_FLOATING, "hand", task="xy")
+    assert "base_link 'torso'" in str(info.value)
+    arm = UrdfChain(_FLOATING, "hand", task="xy", base_link="torso")
+    assert arm.joint_names == ("j1", "j2", "j3") and arm.base_link == "torso"
+    rooted = _FLOATING.replace('<link name="world"/>', "").split("</joint>", 1)[1]
+    alone = UrdfChain('<robot name="arm"><link name="torso"/>' + rooted, "hand", task="xy")
+    x = np.array([[0.3, -0.4, 0.5], [1.0, 0.2, -0.7]])
+    np.testing.assert_allclose(arm.forward(x), alone.forward(x), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(arm.jacobian(x), central_difference(arm.forward, x), atol=1e-8)
+    head = _FLOATING.replace(
+        "</robot>",
+        '<link name="head"/><joint name="neck" type="fixed"><parent link="torso"/>'
+        '<child link="head"/></joint></robot>',
+    )
+    for base, said in (("l9", "is not a link of the URDF"), ("head", "is not on the chain")):
+        with pytest.raises(InvalidInputError, match=said) as info:
+            UrdfChain(head, "hand", task="xy", base_link=base)
+        assert info.value.field == "base_link"

@@ -167,6 +167,7 @@ _ENTRIES: dict[str, dict[str, tuple[Any, Any]]] = {
     "urdf": {
         "urdf": (Annotated[str, Field(min_length=1, max_length=MAX_URDF_BYTES)], ...),
         "end_link": (LinkName, ...),
+        "base_link": (LinkName | None, None),
         "active_joints": (
             Annotated[list[LinkName], Field(min_length=1, max_length=MAX_DIMENSION)] | None,
             None,
