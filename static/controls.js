@@ -242,6 +242,8 @@ export function showControls(msg, change, force = false) {
     inForce.clear();
     Object.keys(msg.values).forEach(changed);
     const form = document.getElementById("controls");
+    // (the control that had the focus, a select changed by keyboard, has it again: by its id)
+    const focused = form.contains(document.activeElement) ? document.activeElement.id : "";
     form.replaceChildren(...msg.groups.map(([group, title]) => {
       const set = el("fieldset", { dataset: { group } }, el("legend", {}, title));
       for (const c of msg.controls.filter((k) => k.group === group)) {
@@ -258,6 +260,7 @@ export function showControls(msg, change, force = false) {
       }
       return set;
     }));
+    if (focused) document.getElementById(focused)?.focus();
     return;
   }
   for (const [key, input] of inputs) {

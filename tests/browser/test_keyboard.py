@@ -1,0 +1,29 @@
+"""The page by keyboard: a change made by keyboard that rebuilds the controls leaves the focus
+where it was."""
+
+from __future__ import annotations
+
+import pytest
+
+expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
+pytestmark = pytest.mark.browser
+
+
+def test_a_keyboard_change_that_rebuilds_the_controls_keeps_the_focus(tabs):
+    """Another robot (or mode) brings other controls: the one changed by keyboard keeps the
+    focus, so the next arrow key changes it again instead of scrolling the page."""
+    tab = tabs.open(scene=False)
+    page = tab.page
+    robot = page.locator("#ctl-robot")
+    robot.focus()
+    tab.change(lambda: page.keyboard.press("ArrowDown"))
+    expect(robot).to_have_value("unicycle")
+    expect(robot).to_be_focused()
+    tab.change(lambda: page.keyboard.press("ArrowUp"))
+    expect(robot).to_have_value("manipulator2")
+    expect(robot).to_be_focused()
+    mode = page.locator("#ctl-mode")
+    mode.focus()
+    tab.change(lambda: page.keyboard.press("ArrowDown"))
+    expect(mode).to_have_value("discrete")
+    expect(mode).to_be_focused()
