@@ -282,8 +282,8 @@ export async function onAhead(msg, shownRobot) {
   delete ahead.robots[msg.robot];
   let box = document.querySelector(".ahead");
   if (!box) {
-    box = el("div", { className: "ahead", style: "position:absolute;left:-10000px;top:0" });
-    box.setAttribute("aria-hidden", "true");
+    // (inert: its plots' toolbars are out of the Tab order and of screen readers)
+    box = el("div", { className: "ahead", inert: true, style: "position:absolute;left:-10000px;top:0" });
     document.body.append(box);
   }
   const panels = {};

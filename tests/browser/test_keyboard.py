@@ -1,5 +1,5 @@
 """The page by keyboard: a change made by keyboard that rebuilds the controls leaves the focus
-where it was."""
+where it was, and Tab never lands on a control drawn off screen."""
 
 from __future__ import annotations
 
@@ -27,3 +27,22 @@ def test_a_keyboard_change_that_rebuilds_the_controls_keeps_the_focus(tabs):
     tab.change(lambda: page.keyboard.press("ArrowDown"))
     expect(mode).to_have_value("discrete")
     expect(mode).to_be_focused()
+
+
+def test_tab_never_lands_on_a_control_off_screen(tabs):
+    """Past the page's last control, Tab does not walk through the toolbars of the panels
+    drawn off screen ahead of a switch of robot: every control it reaches is on the page."""
+    tab = tabs.open(scene=False)
+    page = tab.page
+    # (another robot's panels, drawn off screen while the page is idle)
+    page.wait_for_selector(".ahead .modebar-btn", state="attached")
+    page.locator("#copy-link").focus()
+    for _ in range(10):
+        page.keyboard.press("Tab")
+        box = page.evaluate(
+            "() => document.activeElement === document.body ? null"
+            " : document.activeElement.getBoundingClientRect().toJSON()"
+        )
+        if box is None:
+            break
+        assert box["x"] + box["width"] > 0, f"Tab reached a control off screen at {box}"
