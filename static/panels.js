@@ -100,7 +100,8 @@ function drawTable(div, fig, key) {
   div.classList.add("html-table");
   div.replaceChildren(
     el("h3", { className: "table-title" }, title),
-    el("div", { className: "table-scroll" }, el("table", {}, el("thead", {}, head), el("tbody", {}, ...body))),
+    // (a region with the focus: a table wider than its panel scrolls by the arrow keys too)
+    el("div", { className: "table-scroll", role: "region", tabIndex: 0, ariaLabel: title }, el("table", {}, el("thead", {}, head), el("tbody", {}, ...body))),
     ...(meta.notes || []).map((n) => el("p", { className: "table-note" }, ...withErrataLinks(n))),
   );
   panelHead(div, key, false);

@@ -1,5 +1,6 @@
 """The page by keyboard: a change made by keyboard that rebuilds the controls leaves the focus
-where it was, and Tab never lands on a control drawn off screen."""
+where it was, Tab never lands on a control drawn off screen, and a table wider than its panel
+scrolls by keyboard."""
 
 from __future__ import annotations
 
@@ -46,3 +47,25 @@ def test_tab_never_lands_on_a_control_off_screen(tabs):
         if box is None:
             break
         assert box["x"] + box["width"] > 0, f"Tab reached a control off screen at {box}"
+
+
+def test_a_table_wider_than_its_panel_scrolls_by_keyboard(tabs):
+    """Table 1 at 1366x768 is wider than its panel: its box is reached with Tab (named by its
+    title) and the arrow keys bring its last column into view."""
+    tab = tabs.open(scene=False, viewport={"width": 1366, "height": 768})
+    page = tab.page
+    panel = page.locator("#plot-table")
+    last = panel.locator("thead th").last
+    expect(last).to_contain_text("(printed)")
+    scroller = page.get_by_role("region", name="Table 1 of the paper")
+    panel.get_by_role("button", name="CSV").focus()
+    page.keyboard.press("Tab")
+    expect(scroller).to_be_focused()
+    for _ in range(20):
+        page.keyboard.press("ArrowRight")
+    # (the box scrolls smoothly: its last column comes into view within its right edge)
+    page.wait_for_function(
+        "([box, cell]) => cell.getBoundingClientRect().right"
+        " <= box.getBoundingClientRect().right + 1",
+        arg=[scroller.element_handle(), last.element_handle()],
+    )
