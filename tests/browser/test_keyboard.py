@@ -1,6 +1,6 @@
-"""The page by keyboard: a change made by keyboard that rebuilds the controls leaves the focus
-where it was, Tab never lands on a control drawn off screen, and a table wider than its panel
-scrolls by keyboard."""
+"""The page by keyboard and screen reader: a change made by keyboard that rebuilds the controls
+leaves the focus where it was, Tab never lands on a control drawn off screen, a table wider
+than its panel scrolls by keyboard, and the status line is read out as it changes."""
 
 from __future__ import annotations
 
@@ -69,3 +69,11 @@ def test_a_table_wider_than_its_panel_scrolls_by_keyboard(tabs):
         " <= box.getBoundingClientRect().right + 1",
         arg=[scroller.element_handle(), last.element_handle()],
     )
+
+
+def test_the_status_line_is_read_out(tabs):
+    """The header's status is a live region: a screen reader says "up to date" or what failed
+    when it changes, without the user going to it."""
+    tab = tabs.open(scene=False)
+    status = tab.page.get_by_role("status").filter(has_text="up to date")
+    expect(status).to_have_text(f"up to date (generation {tab.generation})")
