@@ -129,8 +129,25 @@ function choice(c, value, send) {
     return b;
   });
   group.append(...buttons);
-  group.setValue = (v) => buttons.forEach((b) => b.setAttribute("aria-checked", String(b.dataset.value === v)));
+  // One Tab stop, the option chosen (the first when none is); the arrow keys choose the next or
+  // the previous option, as in any radio group.
+  group.setValue = (v) => {
+    const some = buttons.some((b) => b.dataset.value === v);
+    buttons.forEach((b, i) => {
+      b.setAttribute("aria-checked", String(b.dataset.value === v));
+      b.tabIndex = b.dataset.value === v || (!some && i === 0) ? 0 : -1;
+    });
+  };
   group.setValue(value);
+  group.addEventListener("keydown", (e) => {
+    const step = { ArrowRight: 1, ArrowDown: 1, ArrowLeft: -1, ArrowUp: -1 }[e.key];
+    const at = buttons.indexOf(document.activeElement);
+    if (!step || at < 0) return;
+    e.preventDefault();
+    const next = buttons[(at + step + buttons.length) % buttons.length];
+    next.focus();
+    next.click();
+  });
   // (a div, not a label: a click on a label's text would press its first button)
   return el("div", { className: "ctl", title: c.help }, el("span", {}, c.label), group);
 }

@@ -1,6 +1,7 @@
 """The page by keyboard and screen reader: a change made by keyboard that rebuilds the controls
 leaves the focus where it was, Tab never lands on a control drawn off screen, a table wider
-than its panel scrolls by keyboard, and the status line is read out as it changes."""
+than its panel scrolls by keyboard, the status line is read out as it changes, and the arrow
+keys choose in a radio group."""
 
 from __future__ import annotations
 
@@ -77,3 +78,26 @@ def test_the_status_line_is_read_out(tabs):
     tab = tabs.open(scene=False)
     status = tab.page.get_by_role("status").filter(has_text="up to date")
     expect(status).to_have_text(f"up to date (generation {tab.generation})")
+
+
+def test_the_arrow_keys_choose_in_a_radio_group(tabs):
+    """The augmenting map's options are a radio group: one Tab stop, the map chosen, and the
+    arrow keys choose the next or previous map, which is computed as a click's would be."""
+    tab = tabs.open(scene=False)
+    page = tab.page
+    first = page.get_by_role("radio", name="paper_cubic")
+    second = page.get_by_role("radio", name="e2_synthesized")
+    page.locator("#ctl-l-value").focus()
+    page.keyboard.press("Tab")
+    expect(first).to_be_focused()
+    tab.change(lambda: page.keyboard.press("ArrowRight"))
+    expect(second).to_be_checked()
+    expect(second).to_be_focused()
+    assert tab.snapshot()["state"]["augmentation"] == "e2_synthesized"
+    page.keyboard.press("Tab")  # (past the group: the first algorithm's button)
+    expect(page.locator("#ctl-algorithms-pseudoinverse")).to_be_focused()
+    page.keyboard.press("Shift+Tab")
+    expect(second).to_be_focused()
+    tab.change(lambda: page.keyboard.press("ArrowLeft"))
+    expect(first).to_be_checked()
+    assert tab.snapshot()["state"]["augmentation"] == "paper_cubic"
