@@ -235,13 +235,14 @@ def sensitivity_spec(
         maps = sens["maps"]
         names = [m["name"] + (" (current)" if m["current"] else "") for m in maps]
         data = [_bars(maps, k, names) for k in ("E1", "E2")]
-        # (a functional without a bar says why at its map's foot: ∞, or undefined)
+        # (a functional without a bar says why at its map's foot: ∞, or undefined; in the
+        # notes' grey, which small text can be read in, unlike the bars' green and purple)
         missing = [
             note(
                 f"{k} {'= ∞' if m.get(f'{k}_divergent') else 'undefined'}",
                 n,
                 0,
-                color=E_COLORS[k],
+                color="#555",
                 xref="x",
                 yanchor="bottom",
             )

@@ -8,6 +8,8 @@ from pathlib import Path
 
 import pytest
 
+from tests.browser.conftest import probe
+
 expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
 # A display check: in CI's slow step, to keep the default run under 8 minutes.
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
@@ -65,3 +67,14 @@ def test_controls_explain_the_papers_symbols_and_about_links(tabs):
     tab.screenshots("about")
     docs = page.request.get(tab.base + "/docs")
     assert docs.ok
+
+
+def test_the_plots_texts_are_readable(tabs):
+    """Every text of the plots, their notes included (the sensitivity panel's "E1 = ∞" under
+    the map whose E1 diverges), has a contrast of at least 4.5:1 on the plots' white."""
+    tab = tabs.open(scene=False)
+    page = tab.page
+    expect(page.locator("#plot-sensitivity:not(.stale) .annotation-text").first).to_contain_text(
+        "= ∞"
+    )
+    assert page.evaluate(probe("low_contrast")) == []
