@@ -200,10 +200,13 @@ function plan(div, key, fig) {
 // (legend: a key of the panel's own, instead of the algorithms'.)
 export function panelHead(div, key, plot = true, legend = null) {
   if (div.querySelector(":scope > .panel-head")) return;
-  const help = el("p", { className: "panel-help", id: `help-${key}` }, ([...CONFIG.panels, ...(CONFIG.tools || [])].find((p) => p.id === key) || {}).help || "");
+  const text = ([...CONFIG.panels, ...(CONFIG.tools || [])].find((p) => p.id === key) || {}).help || "";
+  const help = el("p", { className: "panel-help", id: `help-${key}` }, text);
   help.hidden = true;
+  // (named for a screen reader by what the help says first: "Repeatability", "Table 1 ...")
   const info = el("button", {
     type: "button", className: "tool info", title: "what this panel shows",
+    "aria-label": `what this panel shows: ${text.split(/[:.(]/)[0].trim() || key}`,
     onclick: () => { help.hidden = !help.hidden; info.setAttribute("aria-expanded", String(!help.hidden)); },
   }, "?");
   info.setAttribute("aria-controls", help.id);

@@ -101,3 +101,15 @@ def test_the_arrow_keys_choose_in_a_radio_group(tabs):
     tab.change(lambda: page.keyboard.press("ArrowLeft"))
     expect(first).to_be_checked()
     assert tab.snapshot()["state"]["augmentation"] == "paper_cubic"
+
+
+def test_each_panels_help_button_is_named_for_its_panel(tabs):
+    """A screen reader hears what each "?" is about ("what this panel shows: Repeatability"),
+    not seven buttons named "?"."""
+    page = tabs.open(scene=False).page
+    buttons = page.locator(".panel-head button.info")
+    expect(buttons.first).to_be_attached()
+    names = [b.get_attribute("aria-label") for b in buttons.all()]
+    assert len(names) >= 7 and len(set(names)) == len(names), names
+    assert all(n.startswith("what this panel shows: ") and len(n) > 24 for n in names), names
+    expect(page.get_by_role("button", name="what this panel shows: Repeatability")).to_be_visible()
