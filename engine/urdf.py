@@ -340,10 +340,9 @@ class UrdfChain(Kinematics):
 
 
 def _unit(axis, name: str) -> FloatArray:
-    """The joint's axis normalised (x when the URDF gives none): 3 finite numbers, not all 0."""
+    """The joint's axis normalised (x when the URDF gives none; 3 numbers, :func:`parse_urdf`
+    checks): finite, not all 0."""
     a = np.array([1.0, 0.0, 0.0]) if axis is None else np.asarray(axis, dtype=float)
-    if a.shape != (3,):
-        raise InvalidInputError(f"joint {name!r} has an axis of {a.size} numbers, not 3", "urdf")
     n = float(np.linalg.norm(a))
     if not n > 0 or not np.all(np.isfinite(a)):
         raise InvalidInputError(f"joint {name!r} has a zero or invalid axis", "urdf")

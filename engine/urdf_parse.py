@@ -115,8 +115,9 @@ def _hardened_parse(data: bytes, field: str):
 def _check_tree(root, field: str) -> None:
     """Refuse what yourdfpy would read silently or with a message about its own code: a root
     other than ``<robot>``, two links or two joints of one name, a joint without its parent or
-    child link, a link that is the child of two joints (a URDF is a tree) and a joint origin
-    whose ``xyz`` or ``rpy`` is not 3 numbers (yourdfpy drops a fourth)."""
+    child link, a link that is the child of two joints (a URDF is a tree) and a joint's origin,
+    axis or limit whose numbers are not numbers or not as many as the spec says (yourdfpy
+    drops a fourth number of an origin, and names no joint for ``lower="zz"``)."""
     if root.tag != "robot":
         raise InvalidInputError(f"{field}: the root element is <{root.tag}>, not <robot>", field)
     for kind in ("link", "joint"):
@@ -141,13 +142,35 @@ def _check_tree(root, field: str) -> None:
                 field,
             )
         parent_joint[child] = name
-        origin = joint.find("origin")
-        for attr in ("xyz", "rpy"):
-            value = None if origin is None else origin.get(attr)
-            if value is not None and len(value.split()) != 3:
+        for tag, attr, n in _JOINT_NUMBERS:
+            element = joint.find(tag)
+            value = None if element is None else element.get(attr)
+            if value is not None and not _numbers(value, n):
                 raise InvalidInputError(
-                    f"{field}: joint {name!r} has origin {attr}={value!r}, not 3 numbers", field
+                    f"{field}: joint {name!r} has {tag} {attr}={value!r}, not "
+                    + ("a number" if n == 1 else f"{n} numbers"),
+                    field,
                 )
+
+
+#: A joint's numeric attributes: (element, attribute, how many numbers).
+_JOINT_NUMBERS = (
+    ("origin", "xyz", 3),
+    ("origin", "rpy", 3),
+    ("axis", "xyz", 3),
+    *(("limit", attr, 1) for attr in ("lower", "upper", "effort", "velocity")),
+)
+
+
+def _numbers(text: str, n: int) -> bool:
+    """Whether ``text`` is ``n`` numbers separated by white space (as the URDF spec writes
+    them; inf and nan are numbers here, their meaning is judged later)."""
+    parts = text.split()
+    try:
+        [float(v) for v in parts]
+    except ValueError:
+        return False
+    return len(parts) == n
 
 
 def parse_urdf(text, field: str = "urdf"):

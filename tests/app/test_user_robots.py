@@ -275,7 +275,7 @@ def test_vector_lengths_are_checked_against_the_built_robot(api):
                 "end_link": "tool",
             },
             "robot.urdf",
-            "joint 'shoulder' has an axis of 2 numbers, not 3",
+            "joint 'shoulder' has axis xyz='0 1', not 3 numbers",
         ),
     ],
 )

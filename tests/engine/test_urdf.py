@@ -147,6 +147,14 @@ SECOND_PARENT = (
             TEXT.replace('xyz="0 0 0.2" rpy="0 0 0"', 'xyz="0 0 0.2" rpy="0 0"'),
             "joint 'shoulder' has origin rpy='0 0', not 3 numbers",
         ),
+        (
+            TEXT.replace('<axis xyz="0 1 0"/>', '<axis xyz="0 1 x"/>'),
+            "joint 'shoulder' has axis xyz='0 1 x', not 3 numbers",
+        ),
+        (
+            TEXT.replace('lower="', 'lower="zz', 1),
+            "joint 'base_yaw' has limit lower='zz-3.0', not a number",
+        ),
     ],
 )
 def test_a_urdf_that_is_not_a_tree_of_unique_names_is_refused_naming_what(urdf, text):
@@ -222,7 +230,7 @@ def test_a_urdf_that_is_not_a_tree_of_unique_names_is_refused_naming_what(urdf, 
         (
             {"end_link": "tool", "urdf": TEXT.replace('<axis xyz="0 1 0"/>', '<axis xyz="0 1"/>')},
             "urdf",
-            "joint 'shoulder' has an axis of 2 numbers, not 3",
+            "joint 'shoulder' has axis xyz='0 1', not 3 numbers",
         ),
         (
             {
@@ -230,7 +238,7 @@ def test_a_urdf_that_is_not_a_tree_of_unique_names_is_refused_naming_what(urdf, 
                 "urdf": TEXT.replace('<axis xyz="0 1 0"/>', '<axis xyz="0 1 0 0"/>'),
             },
             "urdf",
-            "joint 'shoulder' has an axis of 4 numbers, not 3",
+            "joint 'shoulder' has axis xyz='0 1 0 0', not 3 numbers",
         ),
         (
             {"end_link": "tool", "urdf": TEXT.replace('<robot name="arm4">', "<robot>")},
