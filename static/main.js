@@ -227,19 +227,28 @@ async function onFunctionals(msg) {
 // The page's URL holds the state (?state=<JSON of the dashboard's fields>): a copied link, or a
 // reload, starts a new session with the same state. A state whose JSON is longer than
 // PLAIN_STATE (a pasted URDF of tens of kB, which the server's cap on a request's headers, 64 kB,
-// refused with 431 on a reload) is held deflated: ?z=<base64url of its JSON, deflate-raw>.
+// refused with 431 on a reload) is held deflated: ?z=<base64url of its JSON, deflate-raw>. One
+// still longer than LINK_STATE (a URDF of some hundreds of kB) stays in this tab
+// (sessionStorage, ?tab): a reload opens it, and "copy link" says the state is too large for one.
 const PLAIN_STATE = 16 * 1024;
+const LINK_STATE = 48 * 1024;
+const TAB_STATE = "jik-state";
 let remembering = 0; // the newest state written (a deflation finishes later than it starts)
 
 async function rememberInUrl(state) {
   const turn = ++remembering;
   const text = JSON.stringify(state);
   const url = new URL(location.href);
-  url.searchParams.delete("state");
-  url.searchParams.delete("z");
-  if (encodeURIComponent(text).length <= PLAIN_STATE) url.searchParams.set("state", text);
-  else url.searchParams.set("z", await deflated(text));
-  if (turn !== remembering || url.href === location.href) return;
+  for (const key of ["state", "z", "tab"]) url.searchParams.delete(key);
+  const z = encodeURIComponent(text).length <= PLAIN_STATE ? null : await deflated(text);
+  if (turn !== remembering) return;
+  if (z === null) url.searchParams.set("state", text);
+  else if (z.length <= LINK_STATE) url.searchParams.set("z", z);
+  else {
+    sessionStorage.setItem(TAB_STATE, text);
+    url.searchParams.set("tab", "");
+  }
+  if (url.href === location.href) return;
   history.replaceState(null, "", url);
   $("#copy-link").textContent = "copy link"; // (a link copied before is of another state)
 }
@@ -260,6 +269,13 @@ async function inflated(z) {
 async function stateFromUrl() {
   const params = new URL(location.href).searchParams;
   let text = params.get("state");
+  if (params.has("tab")) {
+    text = sessionStorage.getItem(TAB_STATE);
+    if (text === null) {
+      setNotice("the link's state was too large for a link and stays in the tab that made it; showing the defaults");
+      return {};
+    }
+  }
   if (params.has("z")) {
     try {
       text = await inflated(params.get("z"));
@@ -282,6 +298,10 @@ async function stateFromUrl() {
 
 function copyLink() {
   const button = $("#copy-link");
+  if (new URL(location.href).searchParams.has("tab")) {
+    button.textContent = "too large for a link";
+    return;
+  }
   navigator.clipboard.writeText(location.href).then(
     () => { button.textContent = "link copied"; },
     () => { button.textContent = "copy the address bar"; },

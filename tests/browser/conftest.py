@@ -178,8 +178,11 @@ class Tab:
 
     def url_state(self) -> dict:
         """The state the page keeps in its URL (``?state=<JSON>``, or ``?z=`` its JSON deflated
-        and in base64url when long)."""
-        query = parse_qs(urlsplit(self.page.url).query)
+        and in base64url when long, or ``?tab``: in the tab's sessionStorage when too long for a
+        link)."""
+        query = parse_qs(urlsplit(self.page.url).query, keep_blank_values=True)
+        if "tab" in query:
+            return json.loads(self.page.evaluate("sessionStorage.getItem('jik-state')"))
         if "z" in query:
             z = query["z"][0]
             raw = base64.urlsafe_b64decode(z + "=" * (-len(z) % 4))

@@ -107,6 +107,38 @@ def test_a_long_urdf_pasted_in_the_editor_survives_a_reload(tabs):
     assert snapshot["state"]["robot_definition"]["urdf"] == urdf
 
 
+def test_a_urdf_too_long_for_a_link_stays_in_its_tab(tabs):
+    """A URDF whose state is longer than a link can carry even deflated (the server refuses a
+    request line over 64 kB) stays in the tab: a reload opens it, "copy link" says it is too
+    large, and the same address in another tab says where the state is."""
+    import random
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "data" / "arm4.urdf").read_text()
+    noise = random.Random(7).randbytes(60_000).hex()  # (120 kB that deflate cannot shorten)
+    urdf = text.replace("</robot>", f"<!-- {noise} --></robot>")
+    tab = tabs.open(scene=False)
+    page = tab.page
+    page.click("#robot-editor-open")
+    page.select_option("#robot-kind", "urdf")
+    page.fill("#robot-field-urdf", urdf)
+    page.fill("#robot-field-end_link", "tool")
+    tab.change(lambda: page.click("#robot-apply"))
+    tab.wait_settled(lambda s: s["state"]["robot"] == "urdf", "the long URDF arm")
+    page.wait_for_url("**?*tab*")
+    assert len(page.url) < 4096 and tab.url_state()["robot_definition"]["urdf"] == urdf
+    page.click("#copy-link")
+    expect(page.locator("#copy-link")).to_have_text("too large for a link")
+
+    address = page.url
+    assert page.reload().status == 200
+    tab.wait_drawn(1)  # (the new session's first generation)
+    snapshot = tab.wait_settled(lambda s: s["state"]["robot"] == "urdf", "the arm, reloaded")
+    assert snapshot["state"]["robot_definition"]["urdf"] == urdf
+    other = tabs.open(address, scene=False)
+    expect(other.page.locator("#notice")).to_contain_text("stays in the tab that made it")
+
+
 def test_a_refused_definition_keeps_what_was_typed(tabs):
     """A definition the session refuses leaves the editor as the user typed it (another kind
     than the robot in force included: a formula robot, a pasted URDF), with the error beside
