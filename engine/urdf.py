@@ -170,9 +170,10 @@ class UrdfChain(Kinematics):
             raise InvalidInputError(f"active_joints repeats a joint: {active}", "active_joints")
         if len(active) > MAX_JOINTS:
             raise InvalidInputError(
-                f"active_joints: the chain from {self.base_link!r} to {end_link!r} has "
-                f"{len(active)} movable joints; at most {MAX_JOINTS} can be active (list them "
-                "in active_joints; the others stay at 0 or at their locked values)",
+                f"active_joints: {len(active)} of the {len(movable)} movable joints on the chain "
+                f"from {self.base_link!r} to {end_link!r} would be active; at most "
+                f"{MAX_JOINTS} can be (name at most that many in active_joints; the others stay "
+                "at 0 or at their locked values)",
                 "active_joints",
             )
         joint_names = {j.name for j in model.robot.joints}

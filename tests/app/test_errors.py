@@ -280,9 +280,9 @@ def test_a_robot_past_the_joint_cap_is_refused_by_the_cap(api, path):
     body.update({"target": [1.0, 1.0]} if path == "/solve" else {"path": [[1.0, 1.0]]})
     (msg,) = messages(api.post(path, json=body))
     assert msg == (
-        "robot: the chain from 'l0' to 'l400' has 400 movable joints; at most 16 "
-        "can be active (list them in active_joints; the others stay at 0 or at their locked "
-        "values)"
+        "robot: 400 of the 400 movable joints on the chain from 'l0' to 'l400' would be "
+        "active; at most 16 can be (name at most that many in active_joints; the others stay "
+        "at 0 or at their locked values)"
     )
 
 

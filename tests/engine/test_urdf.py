@@ -337,10 +337,20 @@ def test_a_chain_of_more_joints_than_a_robot_may_have_is_refused_at_once():
     """A 3000-joint chain (a 640 kB URDF) is refused before anything is built for it (the
     dashboard's validation of a state holding it grew past 24 GB); 4 of its joints may be active."""
     urdf = _long_chain(3000)
-    with pytest.raises(InvalidInputError, match="has 3000 movable joints; at most 16") as info:
+    with pytest.raises(InvalidInputError, match="3000 of the 3000 movable joints") as info:
         UrdfChain(urdf, "l3000")
     assert info.value.field == "active_joints"
     assert UrdfChain(urdf, "l3000", active_joints=["j1", "j2", "j3", "j4"]).p == 4
+
+
+def test_too_many_active_joints_named_are_counted_as_named():
+    """17 joints named in active_joints of a 20-joint chain were answered "the chain has 17
+    movable joints ... (list them in active_joints)": both the counts are now right."""
+    names = [f"j{i}" for i in range(1, 18)]
+    with pytest.raises(InvalidInputError) as info:
+        UrdfChain(_long_chain(20), "l20", active_joints=names)
+    assert info.value.field == "active_joints"
+    assert "17 of the 20 movable joints on the chain from 'l0' to 'l20'" in str(info.value)
 
 
 _FLOATING = """<robot name="humanoid"><link name="world"/><link name="torso"/>
