@@ -1,7 +1,9 @@
-"""Small batched linear solves with few numpy calls (the solver's hot path).
+"""Small batched linear algebra with few numpy calls (the solver's hot path).
 
-``np.linalg.solve`` on (n, 2, 2) or (n, 3, 3) stacks spends most of its time in per-call overhead;
-Cramer's rule written out is exact for these sizes and several times faster.
+The pseudoinverse's step J^T (J J^T)^-1 e, eq. (8), by Gram-Schmidt on J's rows
+(:func:`min_norm_solve`, accurate to ~ kappa(J) eps); square systems by Cramer's rule written
+out (:func:`solve_small`): ``np.linalg.solve`` on (n, 2, 2) or (n, 3, 3) stacks spends most of
+its time in per-call overhead, and the rule written out is several times faster.
 """
 
 from __future__ import annotations

@@ -152,7 +152,7 @@ LinkName = Annotated[str, Field(min_length=1, max_length=200)]
 #: not a request's.
 _ENTRIES: dict[str, dict[str, tuple[Any, Any]]] = {
     "planar_chain": {
-        "joints": (Annotated[str, Field(pattern=r"^[RPrp]{1,16}$")], ...),
+        "joints": (Annotated[str, Field(pattern=rf"^[RPrp]{{1,{MAX_DIMENSION}}}$")], ...),
         "lengths": (Vector, ...),
         "offsets": (Vector | None, None),
         "orientation": (Annotated[bool, Field(strict=True)], False),
