@@ -81,15 +81,13 @@ def test_a_urdf_arm_from_a_link_is_drawn_in_the_scene(tabs):
     tab.screenshots("robot-editor-urdf")
 
 
-def test_a_long_urdf_pasted_in_the_editor_survives_a_reload(tabs):
-    """A URDF of some tens of kB (a real robot's) made the page's address, which holds the
-    state, longer than the server takes (431 on a reload or a copied link): such a state is held
-    deflated (?z=), and a reload opens the same robot."""
+def _pasted_arm(tabs, extra: str):
+    """A page whose robot is the 4-joint test arm's URDF with ``extra`` before ``</robot>``,
+    pasted in the editor and applied; its tab and that URDF."""
     from pathlib import Path
 
     text = (Path(__file__).resolve().parents[1] / "data" / "arm4.urdf").read_text()
-    pads = "".join(f'<link name="pad_{i:05d}"/>' for i in range(2500))  # (60 kB)
-    urdf = text.replace("</robot>", pads + "</robot>")
+    urdf = text.replace("</robot>", extra + "</robot>")
     tab = tabs.open(scene=False)
     page = tab.page
     page.click("#robot-editor-open")
@@ -98,6 +96,16 @@ def test_a_long_urdf_pasted_in_the_editor_survives_a_reload(tabs):
     page.fill("#robot-field-end_link", "tool")
     tab.change(lambda: page.click("#robot-apply"))
     tab.wait_settled(lambda s: s["state"]["robot"] == "urdf", "the long URDF arm")
+    return tab, urdf
+
+
+def test_a_long_urdf_pasted_in_the_editor_survives_a_reload(tabs):
+    """A URDF of some tens of kB (a real robot's) made the page's address, which holds the
+    state, longer than the server takes (431 on a reload or a copied link): such a state is held
+    deflated (?z=), and a reload opens the same robot."""
+    pads = "".join(f'<link name="pad_{i:05d}"/>' for i in range(2500))  # (60 kB)
+    tab, urdf = _pasted_arm(tabs, pads)
+    page = tab.page
     assert "z=" in page.url and len(page.url) < 16 * 1024, len(page.url)
     assert tab.url_state()["robot_definition"]["urdf"] == urdf
 
@@ -112,19 +120,10 @@ def test_a_urdf_too_long_for_a_link_stays_in_its_tab(tabs):
     request line over 64 kB) stays in the tab: a reload opens it, "copy link" says it is too
     large, and the same address in another tab says where the state is."""
     import random
-    from pathlib import Path
 
-    text = (Path(__file__).resolve().parents[1] / "data" / "arm4.urdf").read_text()
     noise = random.Random(7).randbytes(60_000).hex()  # (120 kB that deflate cannot shorten)
-    urdf = text.replace("</robot>", f"<!-- {noise} --></robot>")
-    tab = tabs.open(scene=False)
+    tab, urdf = _pasted_arm(tabs, f"<!-- {noise} -->")
     page = tab.page
-    page.click("#robot-editor-open")
-    page.select_option("#robot-kind", "urdf")
-    page.fill("#robot-field-urdf", urdf)
-    page.fill("#robot-field-end_link", "tool")
-    tab.change(lambda: page.click("#robot-apply"))
-    tab.wait_settled(lambda s: s["state"]["robot"] == "urdf", "the long URDF arm")
     page.wait_for_url("**?*tab*")
     assert len(page.url) < 4096 and tab.url_state()["robot_definition"]["urdf"] == urdf
     page.click("#copy-link")
