@@ -193,6 +193,8 @@ class WeightedInverse(Inverse):
     continuous and discrete mode. J J# = I_r, so the task error decays as in eq. (5). A
     configuration at or past a limit is a singular one for this inverse: a start there raises,
     and a discrete run whose step crosses a limit stops there with a message naming the joint.
+    So is one where J is regular but joints so near their limits that J W^-1 J^T is singular
+    (a continuous run pressed against them stops there): its error names the nearest joint.
     """
 
     name = "weighted"
@@ -249,6 +251,21 @@ class WeightedInverse(Inverse):
                 f"is at or past its limits [{lo:g}, {hi:g}] (x{i + 1} = {x[i]:.6g}), where its "
                 "weight is infinite: a start must lie inside the limits, and a discrete step "
                 "can cross one (lower gamma)",
+                x,
+            )
+        J = self.kinematics.jacobian_unchecked(x)
+        if min_norm_solve(J, np.zeros(J.shape[-2]))[1] >= SINGULAR_MANIPULABILITY**2:
+            # J regular: the weights make J W^-1 J^T singular, the largest (nearest its limit)
+            winv = self.weights_inverse(x)
+            i = int(np.argmin(winv))
+            lo, hi = self.limits[i]
+            side, limit = ("upper", hi) if hi - x[i] < x[i] - lo else ("lower", lo)
+            return SingularConfigurationError(
+                f"the weighted inverse of {self.kinematics.name} is undefined: J is regular but "
+                f"J W^-1 J^T is singular: joint {i + 1}, {limit_names(self.kinematics)[i]} = "
+                f"{x[i]:.9g}, is {abs(limit - x[i]):.3g} from its {side} limit {limit:g}, where "
+                f"its weight 1 + |dH/dx| is {1 / winv[i]:.3g}, and the other joints cannot move "
+                "the task in every direction: move the start or the target, or widen the limits",
                 x,
             )
         return _singular(self.kinematics, x, "the weighted inverse (J W^-1 J^T singular)")

@@ -54,3 +54,20 @@ def test_a_pace_stalls_only_if_it_fell_and_cannot_reach_tol_in_the_steps_left():
     assert list(status) == [Status.STALLED, Status.RUNNING, Status.RUNNING, Status.RUNNING]
     np.testing.assert_allclose(pace, [0.5, 2.0, 0.5, 0.5], rtol=1e-12)
     assert list(pace_step) == [1100] * n
+
+
+def test_the_weighted_inverse_singular_at_its_limits_where_j_is_regular_says_so():
+    """The Panda (pose) where a continuous weighted run around a loop stopped: x1 and x7 within
+    2e-7 of their upper limit 2.8973, J regular (sigma_min / sigma_max 0.07) but J W^-1 J^T
+    singular. Its error names the joint and the limit, not 'J J^T is singular ... add damping'
+    (damping does not apply to the weighted inverse, and J is regular)."""
+    pytest.importorskip("yourdfpy")
+    panda = e.robot_from_dict({"name": "panda", "task": "pose"})
+    x = np.array([2.8973 - 1.2e-7, -0.5741, -1.8763, -2.1827, -0.7175, 2.2345, 2.8973 - 1.6e-7])
+    with pytest.raises(e.SingularConfigurationError) as info:
+        e.solve(panda.inverse("weighted"), x, panda.kinematics.forward(x) + 0.01)
+    message = str(info.value)
+    assert not isinstance(info.value, e.KinematicSingularityError)
+    assert "J J^T is singular" not in message and "damping" not in message
+    assert "J is regular but J W^-1 J^T is singular: joint 1, x1 (panda_joint1)" in message
+    assert "1.2e-07 from its upper limit 2.8973" in message
