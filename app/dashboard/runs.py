@@ -20,7 +20,6 @@ from ...engine.progress import ProgressCallbacks
 from ...engine.repeatability import Leg, Resume, closed_path, repeatability
 from ...engine.results import SolveResult, Trajectory
 from ...engine.run_settings import RunSettings
-from ...engine.solve_rules import counted
 from ...engine.stall import reach_note
 from ...engine.unicycle import Unicycle
 from .controls import max_iterations
@@ -257,10 +256,9 @@ def algorithm_run(
 
 
 def _leg_message(res: SolveResult, cap: int, kinematics) -> str:
-    """A leg's message in the dashboard's words: a discrete leg in iterations (not tol), and a
-    leg stopped by the cap (``cap``, :attr:`~jik.engine.results.SolveResult.status`
-    "max_steps") naming the control that sets it, or the target out of reach
-    (:func:`jik.engine.stall.reach_note`)."""
+    """A leg's message: the engine's (the REST API's), but for a leg stopped by the cap
+    (``cap``, :attr:`~jik.engine.results.SolveResult.status` "max_steps"), which names the
+    control that sets it, or the target out of reach (:func:`jik.engine.stall.reach_note`)."""
     if res.status == "max_steps":
         what = "iterations" if res.mode == "discrete" else "integrator steps"
         advice, _ = reach_note(kinematics, res.y_d)
@@ -268,9 +266,7 @@ def _leg_message(res: SolveResult, cap: int, kinematics) -> str:
             nearer = ", take γ nearer 1" if res.mode == "discrete" and res.gamma != 1.0 else ""
             advice = f"raise “max {what} per leg” (a control above){nearer} or move the start"
         return f"did not converge within {cap} {what} (error {res.error:.3g}); {advice}"
-    if res.mode == "continuous" or not res.success:
-        return res.message
-    return f"converged: task error {res.error:.3g} after {counted(res.nit, res.mode)}"
+    return res.message
 
 
 def _leg_trajectory(run: AlgorithmRun, k: int) -> Trajectory | None:

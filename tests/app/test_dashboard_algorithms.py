@@ -557,3 +557,20 @@ def test_the_weighted_inverse_s_limits_are_the_robot_s_on_the_dashboard(client, 
         "algorithm_parameters.limits: the dashboard's weighted inverse keeps to the robot's own "
         "joint limits; give them in the robot's definition (limits, or a URDF's joints)"
     ]
+
+
+def test_a_discrete_target_run_says_what_the_engine_and_the_rest_api_say():
+    """A single target in discrete mode: each algorithm's run in the dashboard ends where the
+    engine's solve (the REST API's /solve) ends, and with the same message, tolerance and all
+    ("converged: task error 7.1e-11 < 1e-10 after 34 iterations"), as in continuous mode."""
+    from jik.engine.solver import solve
+
+    state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": CHAIN})
+    change = {"task": "target", "target": [1.5, 1.0], "mode": "discrete", "gamma": 0.5}
+    state = updated_state(state, {**change, "algorithms": ["pseudoinverse", "damped", "posture"]})
+    result = compute(state)
+    for name, run in result.runs.items():
+        res = solve(state_inverse(state, name), state.x0, state.target, gamma=0.5, mode="discrete")
+        assert res.success and res.message.startswith("converged: task error ")
+        np.testing.assert_array_equal(run.x[-1], res.x)
+        assert run.message == res.message
