@@ -5,9 +5,12 @@ target is out of reach, which a run that diverged or ran out of steps says too.
 
 The integrator only sees its step size collapse; the robot's workspace and the Jacobians where
 the run stopped tell which. A planar chain of revolute joints reaches the annulus between
-max(0, 2 max l - sum l) and sum l around its base (l its link lengths); for other robots the
-reach is not known in closed form (a pose task's rotation coordinates longer than pi are refused
-as input, :meth:`jik.engine.pose_task.PoseTask.check_reachable`) and only the Jacobians speak.
+max(0, 2 max l - sum l) and sum l around its base (l its link lengths). A URDF arm of revolute
+joints keeps its end within the sum of its links' lengths (joint to joint, then to the end) of
+its first joint: a target's position farther than that is out of reach, though one nearer may be
+too. For other robots the reach is not known in closed form (a pose task's rotation coordinates
+longer than pi are refused as input, :meth:`jik.engine.pose_task.PoseTask.check_reachable`) and
+only the Jacobians speak.
 """
 
 from __future__ import annotations
@@ -17,6 +20,7 @@ import numpy as np
 from .exceptions import JikError
 from .inverses import Inverse
 from .planar_chain import PlanarChain
+from .urdf import UrdfChain
 
 #: sigma_min / sigma_max of J below this: the robot is at a kinematic singularity.
 SINGULAR_RATIO = 1e-3
@@ -47,6 +51,8 @@ def _g(v: float) -> str:
 def reach_note(kinematics, target) -> tuple[str | None, str]:
     """(why ``target`` is out of the robot's reach, or None; a clause saying it is within
     reach, or "" when the reach is not known)."""
+    if isinstance(kinematics, UrdfChain):
+        return _arm_reach_note(kinematics, target), ""
     bounds = reach(kinematics)
     if bounds is None:
         return None, ""
@@ -64,6 +70,29 @@ def reach_note(kinematics, target) -> tuple[str | None, str]:
             f"inner reach {_g(inner)} (2 max l − sum l)"
         ), ""
     return None, f"the target is within reach ({_g(d)} from the base, reach {_g(outer)}); "
+
+
+def _arm_reach_note(arm: UrdfChain, target) -> str | None:
+    """Why ``target`` is out of the reach of a URDF arm of revolute joints, or None: its
+    position coordinates (those of the task, a subset of x y z) farther from the first joint's
+    than the sum of the distances from joint to joint and from the last joint to the end link,
+    which no configuration exceeds (the triangle inequality). None for an arm with a prismatic
+    joint or a task without a position coordinate."""
+    chain = arm.compiled
+    rows = [(i, "xyz".index(n)) for i, n in enumerate(arm.task_names) if n in ("x", "y", "z")]
+    if chain.prismatic.any() or not rows:
+        return None
+    links = np.linalg.norm(chain.origins[1:, :3, 3], axis=-1).sum()
+    outer = float(links + np.linalg.norm(chain.tip[:3, 3]))
+    y, first = np.asarray(target, dtype=float), chain.origins[0, :3, 3]
+    d = float(np.linalg.norm([y[i] - first[k] for i, k in rows]))
+    if d <= outer + 1e-9 * max(1.0, outer):
+        return None
+    least = "" if len(rows) == 3 else "at least "
+    return (
+        f"the target is out of reach: its position is {least}{_g(d)} from the first joint, "
+        f"beyond the arm's reach {_g(outer)} (the sum of its links' lengths)"
+    )
 
 
 def stall_reason(inverse: Inverse, target, x) -> str:

@@ -212,3 +212,24 @@ def test_a_leg_the_long_way_round_the_rotation_coordinates_is_a_note():
     home = np.array(panda.spec.default_x0)
     calm = e.repeatability(panda.inverse(), home, panda.spec.default_loop())
     assert not [f for f in calm.findings() if f.text.startswith("Leg ")]
+
+
+@pytest.mark.parametrize("task", ["pose", "xyz", "x z"])
+def test_an_arm_target_beyond_the_sum_of_its_links_is_out_of_reach(task):
+    """The Panda's end lies within 0.986 m of its first joint (0.333 m above the base): the sum
+    of its links' lengths, joint to joint and to the flange. A target 2 m away in x is out of
+    reach for any orientation: a discrete run out of iterations says so, not "raise
+    max_iterations, or take gamma nearer 1", and so does a stall; a target within that distance
+    claims nothing (the sum bounds the reach, it does not give it)."""
+    pytest.importorskip("yourdfpy")
+    panda = e.robot_from_dict({"name": "panda", "task": task})
+    home = np.array(panda.spec.default_x0)
+    y = panda.kinematics.forward(home)
+    far = y + np.eye(len(y))[0] * 2.0  # (x is the first coordinate of each task)
+    inverse = panda.inverse("pseudoinverse")
+    res = e.solve(inverse, home, far, mode="discrete", gamma=0.5, max_iterations=50)
+    assert not res.success and "the target is out of reach" in res.message, res.message
+    assert "beyond the arm's reach 0.986 (the sum of its links' lengths)" in res.message
+    assert "gamma" not in res.message and "raise max_iterations" not in res.message
+    assert "the target is out of reach" in stall_reason(inverse, far, home)
+    assert reach_note(panda.kinematics, y) == (None, "")
