@@ -14,9 +14,9 @@ request that finds no free compute slot within the time limit is 503 ``{"detail"
 that is not there is 404, too many atlas jobs 429 with Retry-After. The dashboard sessions'
 errors come here too: a refused value (the field it names) is 422, a session that is not there
 404, a full session store 503 with Retry-After, an export with no result of the current state
-409 (its computation failed) or 503 (not yet). A body over the size limit is 413 ``{"detail":
-"request body of ... bytes is larger ..."}`` (:mod:`jik.app.api.security`). The
-messages of validation errors are written by :mod:`jik.app.api.validation`.
+409 (its computation failed) or 503 (not yet, with Retry-After). A body over the size limit is
+413 ``{"detail": "request body of ... bytes is larger ..."}`` (:mod:`jik.app.api.security`).
+The messages of validation errors are written by :mod:`jik.app.api.validation`.
 """
 
 from __future__ import annotations
@@ -117,7 +117,9 @@ _RESPONSES: dict[type[Exception], Callable[[Any], JSONResponse]] = {
         "reload the page to start a new one",
     ),
     SessionsFull: lambda exc: _detail(503, str(exc), retry_after="30"),
-    ExportUnavailable: lambda exc: _detail(exc.status, str(exc)),
+    ExportUnavailable: lambda exc: _detail(
+        exc.status, str(exc), "1" if exc.status == 503 else None
+    ),
     AtlasJobNotFound: lambda exc: _detail(404, f"no atlas job {exc.args[0]!r}: {exc.args[1]}"),
     AtlasJobsFull: lambda exc: _detail(429, str(exc), retry_after="10"),
 }
@@ -164,10 +166,13 @@ _WITH_BODY = {
     "415": _error("a body that is not JSON (application/json)", "HTTPValidationError"),
 }
 _IN_SESSION = {"404": _error("no such session (it expired or never existed)")}
+_NEW_SESSION = {"503": _error("every session is in use (JIK_MAX_SESSIONS)")}
+_RETRY_AFTER = {"description": "seconds to wait before asking again", "schema": {"type": "integer"}}
 
 
 def document_errors(app: FastAPI) -> None:
-    """Make the app's OpenAPI document list the errors above with the operations' own."""
+    """Make the app's OpenAPI document list the errors above with the operations' own, each
+    error with its JSON body, a 429 or 503 with its Retry-After."""
     make = app.openapi
 
     def openapi() -> dict[str, Any]:
@@ -186,8 +191,15 @@ def document_errors(app: FastAPI) -> None:
                         extra |= _WITH_BODY
                     if "{session_id}" in path:
                         extra |= _IN_SESSION
+                    if path == "/api/sessions":
+                        extra |= _NEW_SESSION
                     for status, response in extra.items():
                         responses.setdefault(status, response)
+                    for status, response in responses.items():  # (every error is JSON)
+                        if status[0] in "45":
+                            response.setdefault("content", _error("")["content"])
+                        if status in ("429", "503"):
+                            response.setdefault("headers", {"Retry-After": _RETRY_AFTER})
             app.openapi_schema = schema
         return app.openapi_schema
 

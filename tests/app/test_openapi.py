@@ -85,6 +85,23 @@ def test_the_errors_checked_before_the_routes_are_documented(document):
                 assert "404" in codes, (method, path)
 
 
+def test_every_error_documents_its_body_and_the_headers_sent_with_it(document):
+    """A client generated from the document read a session's 404, an export's 409 and 503 as
+    bodiless, a 429's or 503's Retry-After and a started atlas's Location as not sent, and knew
+    of no 503 from POST /api/sessions: each is documented as the server sends it."""
+    for path, operations in document["paths"].items():
+        for method, operation in operations.items():
+            for status, response in operation["responses"].items():
+                where = (method, path, status)
+                if status[0] in "45":
+                    assert "application/json" in response.get("content", {}), where
+                if status in ("429", "503"):
+                    assert response["headers"]["Retry-After"]["schema"] == {"type": "integer"}
+    for path in ("/atlas", "/api/sessions/{session_id}/atlas"):
+        assert "Location" in document["paths"][path]["post"]["responses"]["202"]["headers"]
+    assert "503" in document["paths"]["/api/sessions"]["post"]["responses"]
+
+
 def test_a_405_allows_every_method_of_the_path(client):
     assert client.options("/synthesize").headers["allow"] == "GET, POST"
     assert client.put("/api/sessions/abc").headers["allow"] == "DELETE, GET"

@@ -307,6 +307,30 @@ def test_an_export_after_a_failure_is_409_never_the_previous_result(app, client,
     client.delete(f"/api/sessions/{sid}")
 
 
+def test_an_export_not_computed_yet_is_503_with_retry_after(app, client, monkeypatch):
+    """The 503 of an export asked before its result said "retry" in words only: a client
+    waiting as the document says (Retry-After) had no header to read."""
+    import threading
+
+    import jik.app.api.routes.sessions as routes
+    import jik.app.dashboard.session as session
+
+    release, real = threading.Event(), session.compute
+
+    def held(state, *args, **kwargs):
+        release.wait(30)
+        return real(state, *args, **kwargs)
+
+    monkeypatch.setattr(session, "compute", held)
+    monkeypatch.setattr(routes, "EXPORT_WAIT", 0.0)
+    sid = client.post("/api/sessions", json={}).json()["id"]
+    r = client.get(f"/api/sessions/{sid}/export.csv")
+    release.set()
+    assert r.status_code == 503, r.text
+    assert r.headers["retry-after"] == "1" and "computed yet" in r.json()["detail"]
+    client.delete(f"/api/sessions/{sid}")
+
+
 def test_an_export_of_a_named_generation_is_that_one_while_a_newer_computes(
     app, client, monkeypatch
 ):

@@ -78,6 +78,10 @@ ERRORS: dict[int | str, dict] = {
     },
     429: {"model": ErrorResponse, "description": "too many atlas jobs; retry later"},
 }
+#: The 202 of a started job: its address in Location.
+STARTED: dict[int | str, dict] = {
+    202: {"headers": {"Location": {"description": "/atlas/{job_id}", "schema": {"type": "string"}}}}
+}
 EveryLeg = Annotated[
     bool,
     Query(
@@ -119,7 +123,9 @@ def table_response(jobs: AtlasJobs, job: AtlasJob, every_leg: bool) -> Response:
     )
 
 
-@router.post("/atlas", status_code=202, response_model=AtlasJobResponse, responses=ERRORS)
+@router.post(
+    "/atlas", status_code=202, response_model=AtlasJobResponse, responses={**ERRORS, **STARTED}
+)
 async def start_atlas(req: AtlasExamples, request: Request, response: Response, jobs: Jobs):
     """Plan the atlas (the self-motion curves are traced here) and start it as a job."""
     return await start_job(jobs, request, response, req)
@@ -174,7 +180,7 @@ class SessionAtlas(BaseModel):
     "/api/sessions/{session_id}/atlas",
     status_code=202,
     response_model=AtlasJobResponse,
-    responses={**ERRORS, **_NOT_FOUND},
+    responses={**ERRORS, **_NOT_FOUND, **STARTED},
 )
 async def start_session_atlas(
     session_id: str,

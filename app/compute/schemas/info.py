@@ -107,7 +107,7 @@ class RobotsResponse(BaseModel):
 
 
 class ErrorResponse(BaseModel):
-    """A request that could not be served now (503) or an unexpected failure (500)."""
+    """An error in words: every status but 422 and 415, whose detail lists the fields."""
 
     detail: str
 
