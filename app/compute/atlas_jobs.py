@@ -5,13 +5,15 @@ checks and plans it (:func:`~jik.app.compute.atlas_plan.planned`, in a compute w
 :class:`AtlasJobs` runs it in a thread of its own that hands its chunks to the server's compute
 pool (:class:`PoolBackend`: the API's workers and their time and memory limits, first come first
 served with its requests; they stop with the server). A job runs on when its client goes away,
-and is dropped ``keep_for`` seconds after it ends (or when cancelled).
+and is dropped ``keep_for`` seconds after it ends (or when cancelled, or sooner when a new job
+needs its room: the job that ended first goes).
 
 Limits (:class:`~jik.app.compute.atlas_plan.AtlasLimits`): at most ``max_running`` atlases
-compute at once (the others wait, queued), ``max_jobs`` are kept in all and ``per_client`` queued
-or running for one client, and a job computes for at most ``max_seconds`` (then it fails and
-says so). A done job keeps its result document and the engine's atlas it was made from (its
-table's source, :meth:`~jik.engine.atlas_table.AtlasResult.csv_text`).
+compute at once (the others wait, queued), ``max_jobs`` are kept in all (queued, running or
+ended) and ``per_client`` queued or running for one client, and a job computes for at most
+``max_seconds`` (then it fails and says so). A done job keeps its result document and the
+engine's atlas it was made from (its table's source,
+:meth:`~jik.engine.atlas_table.AtlasResult.csv_text`).
 """
 
 from __future__ import annotations
@@ -161,25 +163,31 @@ class AtlasJobs:
         self.check_room(client)
         job = AtlasJob(self.run + secrets.token_urlsafe(12), client, req, *plan, session=session)
         with self._lock:
-            self._room(client)
+            ended = self._room(client)
+            if len(self._jobs) >= self.limits.max_jobs:  # (the job that ended first makes room)
+                del self._jobs[ended[0].id]
             self._jobs[job.id] = job
         threading.Thread(
             target=self._run, args=(job,), name=f"jik-atlas-{job.id}", daemon=True
         ).start()
         return job
 
-    def _room(self, client: str) -> None:
+    def _room(self, client: str) -> list[AtlasJob]:
+        """Raise :class:`AtlasJobsFull` if no job of ``client`` can start now; else the ended
+        jobs, the first ended first. Under the lock."""
         jobs = self._jobs.values()
-        if len(self._jobs) >= self.limits.max_jobs:
-            raise AtlasJobsFull(
-                f"the server keeps at most {self.limits.max_jobs} atlas jobs; "
-                "retry when one has ended and expired"
-            )
         if sum(j.active and j.client == client for j in jobs) >= self.limits.per_client:
             raise AtlasJobsFull(
                 f"at most {self.limits.per_client} atlas jobs per client run at "
                 "once; wait for one to end or cancel it"
             )
+        ended = sorted((j for j in jobs if j.ended is not None), key=lambda j: j.ended or 0.0)
+        if len(self._jobs) >= self.limits.max_jobs and not ended:
+            raise AtlasJobsFull(
+                f"the server has at most {self.limits.max_jobs} atlas jobs queued or running; "
+                "retry when one has ended"
+            )
+        return ended
 
     def response(self, job: AtlasJob) -> AtlasJobResponse:
         """``job``'s state, with the jobs queued or running before it when it waits."""
@@ -209,8 +217,8 @@ class AtlasJobs:
         """Why no job has the id ``job_id``."""
         if job_id.startswith(self.run):
             return (
-                f"it was cancelled, or it ended more than {self.limits.keep_for:g} s ago "
-                "and was dropped"
+                f"it was cancelled, or it ended and was dropped ({self.limits.keep_for:g} s "
+                f"after, or sooner to make room: the server keeps {self.limits.max_jobs} jobs)"
             )
         if re.fullmatch(r"[0-9a-f]{6}[A-Za-z0-9_-]{16}", job_id):
             return (

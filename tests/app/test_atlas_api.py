@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
-from jik.app.compute.atlas_jobs import AtlasJobNotFound, AtlasJobs, PoolBackend
+from jik.app.compute.atlas_jobs import AtlasJobNotFound, AtlasJobs, AtlasJobsFull, PoolBackend
 from jik.app.compute.atlas_plan import AtlasLimits, planned
 from jik.app.compute.atlas_schemas import AtlasRequest
 from jik.app.compute.exceptions import RequestError
@@ -217,6 +217,33 @@ def test_ended_jobs_are_dropped_after_keep_for():
     assert job.status == "done"
     with pytest.raises(AtlasJobNotFound):
         jobs.get(job.id)
+
+
+def test_a_full_table_of_jobs_drops_the_one_that_ended_first():
+    """A script that ran atlases one after another, each to its end, got 429 "retry when one has
+    ended and expired" on the job after max_jobs, for keep_for seconds (600), whatever its
+    Retry-After (10 s) said, and so did every other client: now the job that ended first makes
+    room, and only a table of queued or running jobs is full."""
+    jobs = AtlasJobs(AtlasLimits(max_jobs=2, per_client=2))
+    req = AtlasRequest.model_validate(body(starts=2, cycles=1))
+    started = []
+    for _ in range(3):
+        started.append(jobs.start("me", req, planned(req, jobs.limits)))
+        end = time.monotonic() + 300
+        while started[-1].ended is None and time.monotonic() < end:
+            time.sleep(0.05)
+    with pytest.raises(AtlasJobNotFound, match="room"):
+        jobs.get(started[0].id)
+    assert [jobs.get(j.id).status for j in started[1:]] == ["done", "done"]
+    long = AtlasRequest.model_validate(LONG)
+    plan = planned(long, jobs.limits)
+    running = [jobs.start(client, long, plan) for client in ("a", "b")]
+    try:
+        with pytest.raises(AtlasJobsFull, match="at most 2 atlas jobs queued or running"):
+            jobs.start("c", req, planned(req, jobs.limits))
+    finally:
+        jobs.close()
+    assert all(j.cancel.is_set() for j in running)
 
 
 def test_reference_must_be_a_configuration(client):
