@@ -88,6 +88,18 @@ class Robot:
             maps=tuple(a.name for a in spec.augmentations) + tuple(self.map_vectors),
         )
 
+    def __reduce__(self):
+        """Pickled as its definition, which :func:`robot_from_dict` builds again (its spec holds
+        functions that do not pickle): a catalogue arm by its name, a URDF by its text."""
+        d, name = dict(self.definition), getattr(self.kinematics, "name", "")
+        if "urdf_file" in d:  # (relative to a folder the copy need not see)
+            del d["urdf_file"]
+            d["urdf"] = self.kinematics.urdf  # type: ignore[attr-defined]
+        if name in ARMS:  # (the keys it shares with the catalogue's entry come from there)
+            own = ARMS[name].definition()
+            d = {k: v for k, v in d.items() if own.get(k) != v} | {"name": name}
+        return robot_from_dict, (d,)
+
     @property
     def units(self) -> RobotUnits:
         """Its joint variables and task coordinates with their units (:mod:`jik.engine.units`),

@@ -2,6 +2,7 @@
 
 import importlib.util
 import json
+import pickle
 import shutil
 from pathlib import Path
 
@@ -359,3 +360,42 @@ def test_hostile_values_in_any_entry_fail_only_with_invalid_input(kind):
             except Exception as exc:  # collected, to report every crash at once
                 crashes.append(f"{key}={value!r:.40}: {type(exc).__name__}: {exc}")
     assert crashes == []
+
+
+@pytest.mark.parametrize(
+    "definition",
+    [
+        {"name": "manipulator2", "parameters": {"l": 1.5}},
+        {"name": "unicycle"},
+        {"name": "planar_chain", "joints": "RRR", "lengths": [1, 0.8, 0.6]},
+        {"name": "panda", "task": "xyz"},
+    ],
+    ids=lambda d: d["name"],
+)
+def test_a_robot_pickles_as_its_definition_and_runs_the_same(definition):
+    """A notebook sends a robot to multiprocessing or joblib workers, or saves it: it pickles,
+    and the copy is the same robot (name, defaults, maps) with bit-identical runs."""
+    robot = robot_from_dict(definition)
+    copy = pickle.loads(pickle.dumps(robot))
+    assert repr(copy) == repr(robot) and copy.kinematics.name == robot.kinematics.name
+    spec = robot.spec
+    path = spec.default_path if spec.default_path_loops else spec.default_path[:1]
+    runs = [
+        repeatability(r.inverse("pseudoinverse"), spec.default_x0, path, 1, mode=spec.default_mode)
+        for r in (robot, copy)
+    ]
+    assert np.array_equal(runs[0].legs, runs[1].legs)
+
+
+def test_a_robot_whose_urdf_came_from_a_file_pickles_with_its_text(tmp_path):
+    """``urdf_file`` is relative to the robot file's folder, unknown where the copy is built:
+    the pickle carries the URDF's text."""
+    (tmp_path / "arm.urdf").write_text(ARM4.read_text())
+    (tmp_path / "arm.json").write_text(
+        json.dumps({"name": "urdf", "urdf_file": "arm.urdf", "end_link": "tool"})
+    )
+    robot = load_robot(tmp_path / "arm.json")
+    copy = pickle.loads(pickle.dumps(robot))
+    assert copy.kinematics.joint_names == robot.kinematics.joint_names
+    x = np.array([0.3, 0.5, 0.8, 0.6])
+    assert np.array_equal(copy.kinematics.forward(x), robot.kinematics.forward(x))
