@@ -23,6 +23,7 @@ from .functionals import (
     error_functional_e2,
     parameter_sensitivity,
 )
+from .inverses import require_kinematics, require_map
 from .progress import Progress, check_cancelled, check_progress, part
 from .robot_synthesis import TOTAL_NODES as QMC_NODES
 from .validation import count
@@ -73,10 +74,13 @@ def functionals_report(
     Raises
     ------
     InvalidInputError
-        ``region`` or ``fixed`` not a box of the robot's variables and values of the others
+        ``kinematics`` not a Kinematics, ``amap`` not an AugmentingMap, ``region`` or
+        ``fixed`` not a box of the robot's variables and values of the others
         (:func:`~jik.engine.functionals.check_region`), ``nodes`` not 1 to 400, ``progress``
         not a Progress.
     """
+    kinematics = require_kinematics(kinematics)
+    amap = require_map(amap, kinematics, "amap")
     region, fixed = check_region(kinematics, region, fixed)
     nodes, progress = count(nodes, "nodes", 1, 400), check_progress(progress)
     if len(region) <= MAX_TENSOR_VARIABLES:

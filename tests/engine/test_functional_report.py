@@ -30,7 +30,9 @@ from tests.engine.test_e2_qmc import CHAIN, REGION
 def test_a_small_region_gets_both_functionals_by_the_tensor_rule():
     """Manipulator 2's cubic (38) on a box of two variables: E1 and E2 are the engine's
     functionals there, with their singular points counted; the progress advances after each.
-    A box of its variables that is not one is refused, naming the field, as a bad ``nodes``."""
+    A box of its variables that is not one is refused, naming the field, as a bad ``nodes``, a
+    robot that is not a Kinematics or a map that is not an AugmentingMap (not a traceback, and
+    not an ``E1_error`` in the returned data)."""
     kin, h = Manipulator2(), PaperCubic()
     region, fixed = {"x2": (-0.5, 0.5), "x3": (1.0, 2.0)}, {"x1": 0.0}
     steps = []
@@ -46,6 +48,9 @@ def test_a_small_region_gets_both_functionals_by_the_tensor_rule():
         (lambda: functionals_report(kin, h, {"x2": (1.0, 0.0), "x3": (1.0, 2.0)}, fixed), "region"),
         (lambda: functionals_report(kin, h, region, fixed, 0), "nodes"),
         (lambda: functionals_report(kin, h, region, fixed, 8, print), "progress"),
+        (lambda: functionals_report("manipulator2", h, region), "kinematics"),
+        (lambda: functionals_report(kin, None, region), "amap"),
+        (lambda: functionals_report(kin, "x3", region), "amap"),
     ):
         with pytest.raises(InvalidInputError) as refused:
             bad()
