@@ -113,6 +113,22 @@ class RobotUnits:
     task: tuple[Coordinate, ...]
     lengths: str
 
+    def __repr__(self) -> str:
+        """One line: each coordinate with its unit (where stated) and a variable's joint, and
+        whether any variable has limits and a home."""
+
+        def words(coordinates: tuple[Coordinate, ...]) -> str:
+            said = ((c.name, f"[{c.unit}]" if c.unit else "", c.joint or "") for c in coordinates)
+            return "(" + ", ".join(" ".join(filter(None, each)) for each in said) + ")"
+
+        has = {
+            k: any(getattr(c, k) is not None for c in self.variables) for k in ("limits", "home")
+        }
+        return (
+            f"RobotUnits(x={words(self.variables)}, y={words(self.task)}, "
+            f"limits={has['limits']}, home={has['home']})"
+        )
+
     @property
     def x(self) -> tuple[str, ...]:
         """The unit of each joint variable, (p,)."""

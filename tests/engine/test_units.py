@@ -154,3 +154,20 @@ def test_a_trajectory_s_columns_have_their_units_spelled_out():
     assert said["x_3"] == "dimensionless" and said["y_1"] == "m" and said["error"] == "m"
     assert said["theta"] == "dimensionless"
     assert units.trajectory_units("discrete")["theta"] == "iterations"
+
+
+def test_robot_units_print_on_one_short_line_with_every_coordinate_and_unit():
+    """A notebook cell showing a Panda's units printed 1,200 characters of Coordinate(...) fields;
+    the repr is one line with each coordinate and its unit, a joint's name, and which limits
+    and home it has."""
+    panda = robot_units(jik.robot_from_dict({"name": "panda", "task": "pose"}).kinematics)
+    text = repr(panda)
+    assert "\n" not in text and len(text) < 400, text
+    assert text.startswith("RobotUnits(x=(x1 [rad] panda_joint1, x2 [rad] panda_joint2,")
+    assert "y=(x [m], y [m], z [m], rx [rad], ry [rad], rz [rad])" in text
+    assert text.endswith("limits=True, home=True)")
+    m2 = repr(robot_units(jik.Manipulator2()))
+    assert (
+        m2
+        == "RobotUnits(x=(x1 [m], x2 [m], x3 [rad]), y=(y1 [m], y2 [m]), limits=False, home=False)"
+    )
