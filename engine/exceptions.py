@@ -67,6 +67,12 @@ class SingularConfigurationError(JikError):
         self.field = field
         super().__init__(f"{message} at x = {format_vector(self.configuration)}")
 
+    def __reduce__(self):
+        """Pickled as its class, message and attributes, so that the error of a worker process
+        reaches its parent whole (``__init__`` wants the configuration, and would add it to the
+        message a second time)."""
+        return _unpickled, (type(self), self.args), self.__dict__
+
 
 class KinematicSingularityError(SingularConfigurationError):
     """The Jacobian J(x) loses rank: m(x) = sqrt(det J J^T) vanishes (eq. (8) undefined)."""
@@ -86,6 +92,13 @@ class RunCancelled(Exception):
     Not a :class:`JikError`: nothing is wrong with the run's input, and code that turns engine
     errors into failed results (a leg that stops a run, an HTTP 422) must let it through.
     """
+
+
+def _unpickled(cls: type[SingularConfigurationError], args: tuple) -> SingularConfigurationError:
+    """An error of ``cls`` with its ``args`` as they were; pickle then sets its attributes."""
+    error = Exception.__new__(cls)
+    error.args = args
+    return error
 
 
 def format_vector(v) -> str:

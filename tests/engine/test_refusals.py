@@ -3,6 +3,7 @@ InvalidInputError whose ``field`` names it; the kinematics check ``x`` at their 
 and the inverses check what they are built from."""
 
 import math
+import pickle
 from pathlib import Path
 
 import numpy as np
@@ -563,3 +564,23 @@ def test_a_map_without_a_real_value_at_the_start_is_refused():
     refused = refused_starts(somewhere, [[0, 0.5, 1.0], [0, -0.5, 1.0]])
     assert list(refused) == [1] and "no real value" in refused[1]
     assert not refused_starts(jik.Pseudoinverse(ARM), [[0, -0.5, 1.0]])
+
+
+@pytest.mark.parametrize(
+    "error",
+    [
+        jik.SingularConfigurationError,
+        jik.KinematicSingularityError,
+        jik.AlgorithmicSingularityError,
+        jik.OneFormUndefinedError,
+    ],
+)
+def test_a_singular_configuration_error_crosses_to_another_process_whole(error):
+    """A notebook's multiprocessing pool whose worker met a singular start hung for good: its
+    result thread could not unpickle the error (``__init__`` wants the configuration). It
+    pickles with its message, configuration and field, the message not repeated."""
+    raised = error("J loses rank", [0.0, 1.0, math.pi / 2], "x0")
+    copy = pickle.loads(pickle.dumps(raised))
+    assert type(copy) is error and str(copy) == str(raised) == "J loses rank at x = (0, 1, 1.5708)"
+    assert copy.field == "x0" and np.array_equal(copy.configuration, raised.configuration)
+    assert isinstance(copy, jik.JikError)
