@@ -328,11 +328,12 @@ def _size(n: float) -> str:
 
 
 def json_number(value, name: str, field: str | None = None) -> float:
-    """A finite JSON number: an int or a float, not a boolean or a numeric string.
+    """A finite JSON number: an int or a float (numpy's too, from Python), not a boolean or a
+    numeric string.
 
     The error carries ``field`` (default ``name``), for a client to mark the entry.
     """
-    if isinstance(value, bool) or not isinstance(value, int | float):
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
         raise InvalidInputError(f"{name} must be a number, got {value!r:.80}", field or name)
     try:
         return finite(value, name)

@@ -134,3 +134,20 @@ def test_robot_units_needs_one_name_per_task_coordinate(names):
 )
 def test_run_findings_refuses_what_is_not_a_run(args, field):
     refuses(lambda: jik.run_findings(*args), field)
+
+
+@pytest.mark.parametrize("dtype", [np.int64, np.float32], ids=lambda t: t.__name__)
+def test_numpy_numbers_are_numbers_for_lengths_offsets_and_parameters(dtype):
+    """A notebook's lengths, offsets or formula parameters from numpy (np.ones(3, np.float32),
+    np.int64(2)) were refused as "must be a number"; they are the same robot and map as with
+    Python numbers. A boolean is still no number."""
+    lengths, offsets = np.array([1, 1, 2], dtype=dtype), np.zeros(3, dtype=dtype)
+    chain = jik.PlanarChain("RRR", lengths, offsets=offsets)
+    assert repr(chain) == repr(jik.PlanarChain("RRR", [1.0, 1.0, 2.0], offsets=[0.0] * 3))
+    task = ["x2 + l*cos(x3)", "x1 + l*sin(x3)"]
+    robot = jik.FormulaKinematics(["x1", "x2", "x3"], task, parameters={"l": dtype(2)})
+    x = np.array([0.1, 0.2, 0.3])
+    assert np.array_equal(robot.forward(x), jik.Manipulator2(l=2.0).forward(x))
+    h = jik.FormulaMap("x3 + a*x2", ["x1", "x2", "x3"], {"a": dtype(2)})
+    assert h.value(x) == jik.FormulaMap("x3 + a*x2", ["x1", "x2", "x3"], {"a": 2.0}).value(x)
+    refuses(lambda: jik.PlanarChain("RRR", [1.0, np.bool_(True), 1.0]), "lengths.1")
