@@ -151,3 +151,16 @@ def test_numpy_numbers_are_numbers_for_lengths_offsets_and_parameters(dtype):
     h = jik.FormulaMap("x3 + a*x2", ["x1", "x2", "x3"], {"a": dtype(2)})
     assert h.value(x) == jik.FormulaMap("x3 + a*x2", ["x1", "x2", "x3"], {"a": 2.0}).value(x)
     refuses(lambda: jik.PlanarChain("RRR", [1.0, np.bool_(True), 1.0]), "lengths.1")
+
+
+def test_an_atlas_arc_from_numpy_is_the_same_plan():
+    """plan_atlas's arc as a numpy pair (np.array([-0.5, 0.5]), np.linspace's ends) was refused
+    as "arc must be a pair"; it plans the same starts as the tuple. A pair of pairs is not."""
+    m2 = jik.Pseudoinverse(jik.Manipulator2())
+    path, x0 = [(1, 1), (1, 2), (0, 2)], [0.0, 0.0, np.pi / 2]
+
+    def plan(arc):
+        return jik.plan_atlas([m2], path, n_starts=4, arc=arc, reference=x0)
+
+    assert np.array_equal(plan(np.array([-0.5, 0.5])).starts(0, 4), plan((-0.5, 0.5)).starts(0, 4))
+    refuses(lambda: plan(np.zeros((2, 2))), "arc")
