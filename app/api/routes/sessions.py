@@ -251,7 +251,9 @@ async def events(session_id: str, store: Store):
     ``error``, ``ahead``, ``refused``.
 
     Each event's data is JSON; a ``result`` carries every panel as a plotly figure, an
-    ``ahead`` the panels of another robot's default state, solved ahead for a switch.
+    ``ahead`` the panels of another robot's default state, solved ahead for a switch. An event's
+    id is the state's generation; a client that connects again gets the latest event of each
+    kind again (``Last-Event-ID`` is not read).
     """
     session = store.get(session_id)
     dashboard = session.dashboard

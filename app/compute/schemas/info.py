@@ -78,7 +78,10 @@ class RobotInfo(BaseModel):
 
 
 class Limits(BaseModel):
-    max_cycles: int
+    """The bounds of ``/solve`` and ``/repeatability`` requests (an atlas's own, smaller, are
+    in ``AtlasRequest``'s schema)."""
+
+    max_cycles: int = Field(description="most cycles of a /repeatability run")
     max_path_points: int
     max_iterations: int
     max_trajectory_points: int
