@@ -67,14 +67,26 @@ async function flush(onError, onAccepted) {
 }
 
 // Follow the session's events: handlers by kind, each given the parsed data. "lost" is called
-// when the connection drops (the browser reconnects by itself).
+// when the connection drops (the browser reconnects by itself). A hidden tab lets go of its
+// stream and follows again when shown (the server sends a new listener the latest event of each
+// kind): a stream holds one of the six connections a browser keeps to one server, so a seventh
+// tab of the dashboard, or any request of the six, would wait for one of them to close.
 export function follow(handlers, lost) {
-  const source = new EventSource(api("/events"));
-  for (const [kind, fn] of Object.entries(handlers)) {
-    source.addEventListener(kind, (ev) => { if (ev.data !== undefined) fn(JSON.parse(ev.data)); });
-  }
-  source.addEventListener("error", (ev) => { if (ev.data === undefined) lost(); });
-  return source;
+  let source = null;
+  const open = () => {
+    source = new EventSource(api("/events"));
+    for (const [kind, fn] of Object.entries(handlers)) {
+      source.addEventListener(kind, (ev) => { if (ev.data !== undefined) fn(JSON.parse(ev.data)); });
+    }
+    source.addEventListener("error", (ev) => { if (ev.data === undefined) lost(); });
+  };
+  document.addEventListener("visibilitychange", () => {
+    if (document.hidden && source) {
+      source.close();
+      source = null;
+    } else if (!document.hidden && !source) open();
+  });
+  if (!document.hidden) open();
 }
 
 // A closing tab ends its session at once (otherwise it expires when idle).

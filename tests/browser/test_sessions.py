@@ -7,6 +7,8 @@ import re
 
 import pytest
 
+from tests.browser.conftest import SCENE_FRAME, Tab, probe
+
 expect = pytest.importorskip("playwright.sync_api", reason="playwright not installed").expect
 pytestmark = pytest.mark.browser
 
@@ -134,3 +136,26 @@ def test_a_link_whose_state_is_not_an_object_says_so(tabs, text):
         f"the link's state is not an object of the state's fields ({text}); showing the defaults"
     )
     assert tab.snapshot()["state"]["robot"] == "manipulator2"
+
+
+@pytest.mark.slow
+def test_seven_tabs_of_one_browser_each_draw_when_hidden_tabs_let_go(tabs):
+    """A browser keeps six connections to one server, and each tab's event stream holds one: a
+    seventh dashboard tab of one browser stayed at "connecting…" while six were open. A hidden
+    tab lets go of its stream; shown again, it follows its session again and draws its next
+    change."""
+    context = tabs.context()
+    context.route(SCENE_FRAME, lambda route: route.abort())  # (the page's own connections)
+    opened = []
+    for _ in range(7):
+        page = tabs.new_page(context)
+        page.goto(tabs.base + "/")
+        tab = Tab(page, tabs.base, scene=False)
+        tab.wait_drawn(1)
+        page.evaluate(probe("set_hidden"), True)  # (the next tab opens in front of it)
+        opened.append(tab)
+    first = opened[0]
+    first.page.evaluate(probe("set_hidden"), False)
+    first.select("#ctl-robot", "manipulator1")
+    assert first.robot == "manipulator1"
+    assert all(t.robot == "manipulator2" for t in opened[1:])
