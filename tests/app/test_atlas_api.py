@@ -306,6 +306,24 @@ def test_ending_a_session_cancels_its_atlas(client):
     assert client.delete(f"/atlas/{after.json()['id']}").status_code == 204
 
 
+def test_tabs_behind_one_address_each_have_their_own_atlas_limit(client):
+    """Students reaching a shared server through one address (SSH tunnels, a NAT) were one
+    client: while one tab's atlas ran, every other tab's was refused with 429 "at most 1 atlas
+    jobs per client". A dashboard session is the client of its atlases: each tab has its own
+    limit, and a second of the same tab is still refused."""
+    mine, other = _session(client, cycles=20), _session(client, cycles=20)
+    started = [
+        client.post(f"/api/sessions/{s}/atlas", json={"starts": 4096}) for s in (mine, other)
+    ]
+    try:
+        assert [r.status_code for r in started] == [202, 202], [r.text for r in started]
+        again = client.post(f"/api/sessions/{mine}/atlas", json={"starts": 4096})
+        assert again.status_code == 429 and "at most 1 atlas jobs per client" in again.text
+    finally:
+        for r in started:
+            client.delete(f"/atlas/{r.json().get('id')}")
+
+
 @pytest.mark.parametrize(
     ("state", "over", "field", "text"),
     [

@@ -8,9 +8,9 @@ cancelled by DELETE (204). The jobs live in the app's
 id is a random token: whoever has it reads the job, and no one else.
 
 A session's atlas is a job like the API's, with its request model and limits (jobs per client,
-one computing at once): the session only says which atlas its state asks for
-(:func:`jik.app.dashboard.atlas.atlas_request`), and its GET gives the heatmap once done. A
-session reads its own jobs alone: another tab's atlas is not there for it.
+the session being its client, one computing at once): the session only says which atlas its
+state asks for (:func:`jik.app.dashboard.atlas.atlas_request`), and its GET gives the heatmap
+once done. A session reads its own jobs alone: another tab's atlas is not there for it.
 """
 
 from __future__ import annotations
@@ -57,9 +57,11 @@ async def start_job(
 ) -> AtlasJobResponse:
     """Plan ``req`` in a worker of the app's compute pool (tracing the self-motion curves solves
     eq. (7): within the workers' time and memory limits, like any computation a request asks
-    for), then start it as a job of the client's (``session``: of that dashboard session's);
-    the 202's body, its ``Location`` the job's ``/atlas/{job_id}``."""
-    client = request.client.host if request.client else "unknown"
+    for), then start it as a job of the client's: the address's, or ``session``'s, a dashboard
+    tab's (tabs behind one address, SSH tunnels or a NAT, each have their own limit); the 202's
+    body, its ``Location`` the job's ``/atlas/{job_id}``."""
+    address = request.client.host if request.client else "unknown"
+    client = f"session {session}" if session else address
     jobs.check_room(client)  # (before the work)
     pool: ComputePool = request.app.state.pool
     plan, refused = await pool.run(plan_task, req.model_dump_json(), jobs.limits)
