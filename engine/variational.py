@@ -51,8 +51,8 @@ MANIPULATOR2_REGION: dict[str, tuple[float, float]] = {"x2": (-1.0, 1.0), "x3": 
 
 #: Default Legendre degree per variable of :func:`synthesize_e2`, by the region's number of
 #: variables: 16 over two (Manipulator 2's E2 4.9e-9 above its degree-40 minimum,
-#: docs/paper-errata.md), 10 over three (17^3 unknowns at 16 would take Ritz matrices of about
-#: 2 GB on (16 + 8)^3 quadrature points; 11^3 take 0.2 GB).
+#: docs/paper-errata.md), 10 over three (11^3 unknowns, a 14 MB Ritz matrix; 17^3 at 16 take
+#: 0.2 GB, and its dense solve takes most of the time).
 DEFAULT_DEGREE = {2: 16, 3: 10}
 #: Largest Legendre degree per variable over two and over three variables.
 MAX_DEGREE = {2: 64, 3: 16}
@@ -142,26 +142,20 @@ class _Problem:
     """Quadrature data of E2 on a box: R = m P and f = m K restricted to the region's variables."""
 
     def __init__(self, kinematics: Kinematics, box: dict, fix: dict, nodes: Sequence[int]):
-        names = tuple(kinematics.variable_names)
-        self.names = names
+        self.names = names = tuple(kinematics.variable_names)
         self.box, self.fix = box, fix
         self.variables = [names.index(n) for n in box]
-        lo = np.array([v[0] for v in box.values()])
-        hi = np.array([v[1] for v in box.values()])
-        self.scale = 2.0 / (hi - lo)
+        lo, hi = np.array(list(box.values()), dtype=float).T
+        self.scale, self.center = 2.0 / (hi - lo), 0.5 * (lo + hi)
+        self.base = np.array([fix.get(n, 0.0) for n in names])
         rules = [L.leggauss(n) for n in nodes]
         self.t = [r[0] for r in rules]
-        grids = np.meshgrid(*self.t, indexing="ij")
         w = functools.reduce(np.multiply.outer, [r[1] for r in rules]) / np.prod(self.scale)
-        x = np.empty((w.size, kinematics.p))
-        for i, n in enumerate(names):
-            x[:, i] = fix[n] if n in fix else 0.0
-        for k, v in enumerate(self.variables):
-            x[:, v] = 0.5 * (lo[k] + hi[k]) + grids[k].ravel() / self.scale[k]
+        self.x = x = self.points(
+            np.stack(np.meshgrid(*self.t, indexing="ij"), axis=-1).reshape(w.size, -1)
+        )
         kinematics.require_regular(x, "synthesis region (a quadrature point)", "region")
-        J = kinematics.jacobian(x)
-        K = kinematics.kernel(x)
-        m = kinematics.manipulability(x)
+        J, K, m = kinematics.jacobian(x), kinematics.kernel(x), kinematics.manipulability(x)
         Jp = pseudoinverse(J)
         P = Jp @ np.swapaxes(Jp, -1, -2) + K[:, :, None] * K[:, None, :]  # (n, p, p)
         idx = np.array(self.variables)
@@ -170,21 +164,39 @@ class _Problem:
         self.f = (m[:, None] * K)[:, idx]  # (n, d)
         self.constant = float(np.dot(self.w, m))  # E2 of h = const
 
+    def points(self, t: FloatArray) -> FloatArray:
+        """The configurations (n, p) at reference points t (n, d) of [-1, 1]^d of the box."""
+        x = np.tile(self.base, (len(t), 1))
+        x[:, self.variables] = self.center + t / self.scale
+        return x
+
     def system(self, degrees: Sequence[int]) -> tuple[FloatArray, FloatArray]:
-        """Stiffness A (nb, nb) and load b (nb,) over the full tensor basis (constant included)."""
-        d = len(degrees)
+        """Stiffness A (nb, nb) and load b (nb,) over the full tensor basis (constant included),
+        contracted one variable at a time (basis and rule are tensor products), added into A in
+        place: the memory is that of A and one block, not the basis' gradients at all nodes."""
+        d, sizes = len(degrees), tuple(n + 1 for n in degrees)
         bases = [legendre_vander(t, n) for t, n in zip(self.t, degrees, strict=True)]
-        G = []
-        for k in range(d):
-            mats = [dV if i == k else V for i, (V, dV) in enumerate(bases)]
-            G.append(functools.reduce(np.kron, mats) * self.scale[k])  # (n_q, nb)
-        A = np.zeros((G[0].shape[1],) * 2)
+        # grads[k][j]: the factor of variable j in d(phi)/dx_k, (nodes_j, n_j + 1)
+        grads = [
+            [dV * k_scale if j == k else V for j, (V, dV) in enumerate(bases)]
+            for k, k_scale in enumerate(self.scale)
+        ]
+        nb, shape = int(np.prod(sizes)), [len(x) for x in self.t]
+        A, rhs = np.zeros((nb, nb)), np.zeros(nb)
+        A_st = A.reshape(sizes + sizes)  # a view, axes (s_1 .. s_d, t_1 .. t_d)
+        s, t = list(range(0, 2 * d, 2)), list(range(1, 2 * d, 2))
         for a in range(d):
             for b in range(a, d):
-                blk = G[a].T @ ((self.w * self.R[:, a, b])[:, None] * G[b])
-                A += blk if a == b else blk + blk.T
-        # A zero-vector start (not sum()'s int 0) keeps b typed as an array; same values.
-        rhs = sum((G[a].T @ (self.w * self.f[:, a]) for a in range(d)), np.zeros(A.shape[0]))
+                T = (self.w * self.R[:, a, b]).reshape(shape)
+                for ga, gb in zip(grads[a], grads[b], strict=True):  # -> (s_1, t_1, ..., t_d)
+                    T = np.tensordot(T, ga[:, :, None] * gb[:, None, :], (0, 0))
+                A_st += T.transpose(s + t)
+                if a != b:
+                    A_st += T.transpose(t + s)
+            T = (self.w * self.f[:, a]).reshape(shape)
+            for ga in grads[a]:
+                T = np.tensordot(T, ga, (0, 0))
+            rhs += T.ravel()
         return A, rhs
 
 
@@ -207,8 +219,9 @@ def _solve(
 ) -> tuple[FloatArray, float]:
     """Ritz minimiser of E2: coefficients (n_1 + 1, ..., n_d + 1) and its E2 value."""
     A_full, b_full, full = system
-    idx = _sub_basis(full, degrees)
-    A, b = A_full[np.ix_(idx, idx)], b_full[idx]
+    idx = None if list(degrees) == list(full) else _sub_basis(full, degrees)
+    # (the final degree's system is A itself: the largest matrix is not copied)
+    A, b = (A_full, b_full) if idx is None else (A_full[np.ix_(idx, idx)], b_full[idx])
     shape = tuple(n + 1 for n in degrees)
     if dirichlet is None:
         # Drop the constant mode: mean(h) = 0 over the box, A is then positive definite.
@@ -223,14 +236,7 @@ def _solve(
             lambda X, Y: np.einsum("ni,nj->nij", X, Y).reshape(X.shape[0], -1),
             [L.legvander(tb[:, k], n) for k, n in enumerate(degrees)],
         )
-        x = np.empty((tb.shape[0], kinematics.p))
-        names = tuple(kinematics.variable_names)
-        for i, n in enumerate(names):
-            x[:, i] = problem.fix.get(n, 0.0)
-        lo = np.array([v[0] for v in problem.box.values()])
-        hi = np.array([v[1] for v in problem.box.values()])
-        for k, v in enumerate(problem.variables):
-            x[:, v] = 0.5 * (lo[k] + hi[k]) + tb[:, k] / problem.scale[k]
+        x = problem.points(tb)
         g = np.asarray(dirichlet(x), dtype=float).reshape(-1)
         if g.shape[0] != x.shape[0] or not np.all(np.isfinite(g)):
             raise InvalidInputError("dirichlet must give one finite value per point", "dirichlet")
@@ -243,21 +249,14 @@ def _solve(
 
 def _cubic_fit(amap: SynthesizedMap, problem: _Problem) -> Polynomial2:
     """L2(region) least-squares fit of h by a cubic in two variables, like (38)."""
-    u = problem.box
-    (_, (alo, ahi)), (_, (blo, bhi)) = list(u.items())
-    ta, tb = np.meshgrid(*problem.t, indexing="ij")
-    xa = 0.5 * (alo + ahi) + 0.5 * (ahi - alo) * ta.ravel()
-    xb = 0.5 * (blo + bhi) + 0.5 * (bhi - blo) * tb.ravel()
-    x = np.zeros((xa.size, amap.p))
-    x[:, problem.variables[0]], x[:, problem.variables[1]] = xa, xb
-    for name, val in problem.fix.items():
-        x[:, problem.names.index(name)] = val
+    va, vb = problem.variables  # two region variables (the caller checks d == 2)
+    x = problem.x
+    xa, xb = x[:, va], x[:, vb]
     powers = [(i, j) for i in range(4) for j in range(4) if i + j <= 3]
     M = np.stack([xa**i * xb**j for i, j in powers], axis=1)
     sw = np.sqrt(problem.w)
     coef, *_ = np.linalg.lstsq(M * sw[:, None], amap.value(x) * sw, rcond=None)
     coefficients = dict(zip(powers, coef.tolist(), strict=True))
-    va, vb = problem.variables  # two region variables (the caller checks d == 2)
     return Polynomial2(coefficients, (va, vb), amap.p)
 
 
