@@ -19,7 +19,7 @@ from ...engine.map_singularities import map_singularities
 from ...engine.registry import RobotSpec
 from ...engine.robot_synthesis import TOTAL_DEGREE, default_box
 from ...engine.synthesis_nd import synthesize_e2_nd
-from ...engine.variational import synthesize_e2
+from ...engine.variational import DEFAULT_DEGREE, synthesize_e2
 from . import schemas as S
 from .documents import nullable
 from .exceptions import RequestError
@@ -90,7 +90,9 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
     notes: list[str] = []
     if req.method == "e2_variational":
         try:
-            result = synthesize_e2(kin, region, degree=req.degree, fixed=fixed)
+            top = req.degree or DEFAULT_DEGREE.get(len(region), 1)  # (even degrees below it)
+            steps = range(2, top, 2)
+            result = synthesize_e2(kin, region, degree=top, fixed=fixed, convergence_degrees=steps)
         except JikError as exc:  # (the degree's bound depends on the region's variables)
             field = "degree" if getattr(exc, "field", None) == "degree" else "region"
             raise RequestError(field, str(exc)) from None

@@ -96,6 +96,23 @@ def test_e2_variational_defaults_to_the_engine_s_degree_and_reports_its_own_e2(a
     assert b["functionals"]["e2"]["value"] == pytest.approx(e2, abs=1e-12)
 
 
+def test_e2_variational_shows_e2_against_the_degree_as_the_python_synthesis_does(api):
+    """'convergence' is E2 against the Legendre degree (its description), as e2_total_degree's
+    and synthesize_e2's convergence_degrees give it: it held the requested degree alone."""
+    from jik.engine.variational import synthesize_e2
+
+    body = {"robot": {"name": "manipulator2"}, "method": "e2_variational", "region": REGION}
+    r = api.post("/synthesize", json=body | {"degree": 8})
+    assert r.status_code == 200, r.text
+    rows = r.json()["convergence"]
+    box = {k: tuple(v) for k, v in REGION.items()}
+    own = synthesize_e2(Manipulator2(1.0), box, degree=8, convergence_degrees=(2, 4, 6))
+    assert [row["degree"] for row in rows] == [2, 4, 6, 8]
+    assert [row["unknowns"] for row in rows] == [9, 25, 49, 81]
+    np.testing.assert_allclose([row["e2"] for row in rows], own.columns()["e2"], rtol=1e-12)
+    assert rows[0]["e2"] > rows[1]["e2"] > rows[2]["e2"] > rows[3]["e2"]
+
+
 def test_synthesize_bad_input(api):
     def msg(body):
         r = api.post("/synthesize", json=body)
