@@ -105,7 +105,8 @@ def _formula_maps(kin: Kinematics, item: Mapping, where: str) -> tuple[FormulaMa
 
 
 def _frame_axes(kin: Kinematics, axes, field: str) -> list[int] | None:
-    """The 1-based joints whose axes fix a vector map's kernel frame (None: the last p - r)."""
+    """The 1-based joints whose axes fix a vector map's kernel frame (None: the synthesis'
+    best conditioned, :func:`~.synthesis_nd.best_frame_axes`)."""
     if axes is None:
         return None
     k = kin.p - kin.r

@@ -113,6 +113,26 @@ def test_e2_variational_shows_e2_against_the_degree_as_the_python_synthesis_does
     assert rows[0]["e2"] > rows[1]["e2"] > rows[2]["e2"] > rows[3]["e2"]
 
 
+def test_default_frame_axes_are_the_best_conditioned_as_the_schema_says(api):
+    """Without frame_axes a p - r = 2 synthesis takes the joints best conditioned at the box's
+    centre (here 2 and 4, not the last two); the field's description said 'the last p - r'."""
+    from jik.engine.robot_spec import robot_from_dict
+    from jik.engine.synthesis_nd import best_frame_axes
+
+    robot = {"name": "formula", "variables": ["a", "b", "c", "d"]}
+    robot["task"] = [f"{f}(a)+{f}(a+b)+{f}(a+b+c)+0.7*{f}(a+b+c+d)" for f in ("cos", "sin")]
+    box = {"a": [-0.3, 0.3], "b": [0.5, 1.1], "c": [0.4, 1.0], "d": [0.3, 0.9]}
+    body = {"robot": robot, "method": "e2_total_degree", "region": box, "degree": 2}
+    r = api.post("/synthesize", json=body | {"qmc_nodes": 256})
+    assert r.status_code == 200, r.text
+    kin = robot_from_dict(robot).kinematics
+    best = best_frame_axes(kin, {k: tuple(v) for k, v in box.items()}, {})
+    assert r.json()["total_degree"]["frame_axes"] == best == [2, 4]
+    field = api.get("/openapi.json").json()["components"]["schemas"]["SynthesizeFormulaRequest"]
+    described = field["properties"]["frame_axes"]["description"]
+    assert "best conditioned" in described and "last p - r" not in described
+
+
 def test_synthesize_bad_input(api):
     def msg(body):
         r = api.post("/synthesize", json=body)
