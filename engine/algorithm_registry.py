@@ -223,9 +223,11 @@ def make_inverse(
     if algorithm == "damped":
         return pinv.DampedInverse(kinematics, values["damping"], values["damping_threshold"])
     if algorithm == "weighted":
-        given_limits = vectors.get("limits")  # (the default only without them: it may not exist)
-        limits = _robot_limits(kinematics, spec, robot) if given_limits is None else given_limits
-        return pinv.WeightedInverse(kinematics, limits)
+        if vectors.get("limits") is not None:  # (the default only without them: it may not exist)
+            return pinv.WeightedInverse(kinematics, vectors["limits"])
+        declared = robot_limits(kinematics)
+        box = declared is None or not np.isfinite(declared).any()
+        return pinv.WeightedInverse(kinematics, _robot_limits(kinematics, spec, robot), box)
     if algorithm == "posture":
         if "rest" in vectors:
             return pinv.PostureInverse(kinematics, vectors["rest"], values["gain"])

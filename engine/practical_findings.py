@@ -166,13 +166,13 @@ def practical_findings(
     tol: float,
     runs: Mapping[str, Any] | None = None,
     rest=None,
-    box: bool = False,
     legs: int = 0,
 ) -> list[tuple[str, str]]:
     """What a practical inverse beside the paper's two did on ``run``, from its parameters:
     :func:`posture_findings` (its rest in ``rest``, else :func:`rest_words` of the run's
     start), :func:`damped_findings`, :func:`weighted_findings` (against the limits it was
-    given; ``box``: the configuration box of a robot without limits); none for the paper's
+    given, said to be the configuration box of a robot without limits where they are,
+    :attr:`~jik.engine.practical_inverses.WeightedInverse.box`); none for the paper's
     inverses. ``legs``: the legs of a cycle, by which damped least squares names its worst leg
     (cycle and leg).
 
@@ -192,5 +192,5 @@ def practical_findings(
         return damped_findings(name, lam, eps, tol, run, runs.get("pseudoinverse"), legs)
     if inverse.name == "weighted":
         names = limit_names(inverse.kinematics)
-        return weighted_findings(name, run.x, inverse.limits, names, box)
+        return weighted_findings(name, run.x, inverse.limits, names, inverse.box)
     return []

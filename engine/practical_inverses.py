@@ -183,6 +183,10 @@ class WeightedInverse(Inverse):
     kinematics : Kinematics
     limits : array_like, shape (p, 2)
         [lo, hi] per joint (inf for an unlimited joint).
+    box : bool
+        The limits are the configuration box x_range of a robot that has no joint limits (its
+        default limits, :func:`~jik.engine.algorithm_registry.make_inverse`): its findings say
+        so, not that the robot's joints have these limits.
 
     Notes
     -----
@@ -199,9 +203,10 @@ class WeightedInverse(Inverse):
 
     name = "weighted"
 
-    def __init__(self, kinematics: Kinematics, limits) -> None:
+    def __init__(self, kinematics: Kinematics, limits, box: bool = False) -> None:
         self.kinematics = kinematics = require_kinematics(kinematics)
         self.limits = as_box(limits, kinematics.p, "limits", finite=False)
+        self.box = flag(box, "box")
 
     @property
     def parameters(self) -> dict[str, object]:

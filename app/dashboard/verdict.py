@@ -90,7 +90,7 @@ def _practical(result: DashboardResult, unit: str) -> list[Finding]:
         inverse, run = state_inverse(state, a), result.runs[a]
         rest = rest_words(state, state_spec(state), inverse) if a == "posture" else None
         tol, legs = state.tolerance, len(result.targets)
-        found = practical_findings(inverse, run, unit, tol, result.runs, rest, box=True, legs=legs)
+        found = practical_findings(inverse, run, unit, tol, result.runs, rest, legs=legs)
         out += [Finding(text, role, a) for text, role in found]
     return out
 

@@ -274,6 +274,21 @@ def test_a_result_of_a_practical_inverse_says_what_its_parameters_did():
     assert batch.findings(start=0)[1].text == ends[0]
 
 
+def test_the_weighted_inverse_on_the_default_box_of_a_robot_without_limits_says_so():
+    """A robot without joint limits (Manipulator 2) gives the weighted inverse its configuration
+    box by default: its findings say so, as the dashboard's verdict does for the same run, and
+    do not read as joint limits of the robot; limits the user gives stay without the note."""
+    arm = jik.Manipulator2()
+    x0, path = [0, 0, np.pi / 2], [(1, 1), (1, 2), (0, 2)]
+    weighted = jik.make_inverse(arm, "weighted")
+    (_, why) = jik.repeatability(weighted, x0, path, cycles=1).findings()
+    assert why.text.startswith(
+        "weighted least-norm J^W#: every joint stayed within its limits (x1 in [-3, 3]; x2 in "
+        "[-3, 3]; x3 in [-3.14, 6.28]; the robot has no joint limits: its configuration box "
+        "x_range); closest:"
+    ), why.text
+
+
 def test_a_drift_without_a_unit_reads_as_a_number_not_a_number_and_a_blank():
     """findings() without a unit (its default) writes the posture inverse's drift as the other
     sentences do, "drifts 0.0625, but", not "drifts 0.0625 , but"; gain 0 likewise."""
