@@ -230,10 +230,14 @@ async function onFunctionals(msg) {
 // refused with 431 on a reload) is held deflated: ?z=<base64url of its JSON, deflate-raw>. One
 // still longer than LINK_STATE (a URDF of some hundreds of kB) stays in this tab
 // (sessionStorage, ?tab): a reload opens it, and "copy link" says the state is too large for one.
+// Each change is an entry of the tab's history (the state with it): back and forward bring the
+// session to that entry's state. Changes of the same single field in a row (a slider's drag)
+// make one entry; the first state, and the one that back or forward brought, make none.
 const PLAIN_STATE = 16 * 1024;
 const LINK_STATE = 48 * 1024;
 const TAB_STATE = "jik-state";
 let remembering = 0; // the newest state written (a deflation finishes later than it starts)
+const written = { state: null, field: null }; // the history's newest state, its one changed field
 
 async function rememberInUrl(state) {
   const turn = ++remembering;
@@ -248,8 +252,14 @@ async function rememberInUrl(state) {
     sessionStorage.setItem(TAB_STATE, text);
     url.searchParams.set("tab", "");
   }
-  if (url.href === location.href) return;
-  history.replaceState(null, "", url);
+  const before = written.state || state;
+  const fields = Object.keys(state).filter((k) => JSON.stringify(state[k]) !== JSON.stringify(before[k]));
+  const field = fields.length === 1 ? fields[0] : null;
+  const push = fields.length > 0 && !(field && field === written.field);
+  Object.assign(written, { state, field: fields.length ? field : written.field });
+  if (url.href === location.href && history.state) return;
+  if (push) history.pushState({ state }, "", url);
+  else history.replaceState({ state }, "", url);
   $("#copy-link").textContent = "copy link"; // (a link copied before is of another state)
 }
 
@@ -342,6 +352,11 @@ async function main() {
   const opened = await openSession(await stateFromUrl(),
     (message) => setNotice(`the link's state was refused (${message}); showing the defaults`));
   $("#copy-link").addEventListener("click", copyLink);
+  addEventListener("popstate", (ev) => {
+    if (!ev.state) return;
+    Object.assign(written, { state: ev.state.state, field: null });
+    send(ev.state.state);
+  });
   $("#cancel").addEventListener("click", cancel);
   atlasPanel(() => page.state, send);
   onState(opened);

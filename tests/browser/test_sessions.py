@@ -159,3 +159,32 @@ def test_seven_tabs_of_one_browser_each_draw_when_hidden_tabs_let_go(tabs):
     first.select("#ctl-robot", "manipulator1")
     assert first.robot == "manipulator1"
     assert all(t.robot == "manipulator2" for t in opened[1:])
+
+
+@pytest.mark.slow
+def test_back_and_forward_bring_the_previous_states_back(tabs):
+    """Each change is an entry of the tab's history: back brings the session, controls and
+    verdict of the state before, forward the one after, and a slider's drag is one entry."""
+    tab = tabs.open(scene=False)
+    page = tab.page
+    seen = [(tab.url_state(), tab.controls())]
+    tab.select("#ctl-robot", "manipulator1")
+    seen.append((tab.url_state(), tab.controls()))
+    length = page.evaluate("history.length")
+    for position in (0.3, 0.5):  # (one drag, two steps)
+        tab.set_slider("#ctl-x0-0", position)
+    seen.append((tab.url_state(), tab.controls()))
+    assert page.evaluate("history.length") == length + 1
+
+    def travel(go) -> None:
+        tab.change(go)
+        tab.wait_settled(lambda s: True, "the state of the history's entry")
+
+    for before in (seen[1], seen[0]):
+        travel(page.go_back)
+        assert (tab.url_state(), tab.controls()) == before
+        assert tab.snapshot()["state"] == before[0]
+    travel(page.go_forward)
+    travel(page.go_forward)
+    assert (tab.url_state(), tab.controls()) == seen[2]
+    assert tab.snapshot()["state"]["robot"] == "manipulator1"
