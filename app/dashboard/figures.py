@@ -281,7 +281,8 @@ def _drift(result: DashboardResult) -> dict:
     else:
         title, norm, xaxis = "Convergence: task error", "‖k(x) − y_d‖", theta_axis(result)
     unit = norm_unit(units(result)[0 if closed else 1])
-    yaxis = dict(title=f"{norm} {unit} (log)", type="log", exponentformat="power")
+    title_words = " ".join(w for w in (norm, unit, "(log)") if w)  # (a formula robot: no unit)
+    yaxis = dict(title=title_words, type="log", exponentformat="power")
     return figure(data, title, **NO_LEGEND, xaxis=xaxis, yaxis=yaxis | {"range": log_range(ys)})
 
 

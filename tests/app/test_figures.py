@@ -517,6 +517,19 @@ def test_the_configuration_space_says_why_it_draws_no_level_surface():
     assert "point by point" not in title
 
 
+def test_the_drift_axis_of_a_robot_without_units_has_no_empty_unit():
+    """A formula robot states no unit: its drift axis reads "‖x(end of cycle) − x0‖ (log)",
+    not with a blank where the unit would be."""
+    definition = {
+        "name": "formula",
+        "variables": ["x1", "x2", "x3"],
+        "task": ["x2 + cos(x3)", "x1 + sin(x3)"],
+    }
+    state = updated_state(default_state("formula", definition), {"cycles": 1})
+    yaxis = figure_specs(compute(state), only={"drift"})["drift"]["layout"]["yaxis"]
+    assert yaxis["title"]["text"] == "‖x(end of cycle) − x0‖ (log)"
+
+
 def test_table1_of_discrete_runs_that_stop_in_the_first_cycle():
     """The paper's experiment in discrete mode with a step (gamma = 1.99) at which neither run
     finishes its first leg: the table still shows (x0 and the printed columns) and says the
