@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...engine.reproductions.table1 import FIGS_5_9_TARGET, X0
+from ...engine.reproductions.unicycle import figs_11_14
 from .algorithms import COLORS, DASH, LABELS, STYLES
 from .cspace import cspace_spec
 from .map_figures import augmenting_spec, sensitivity_spec
@@ -213,14 +214,16 @@ def _task_space(result: DashboardResult) -> dict:
 
 
 def _cited(result: DashboardResult, figures: str) -> str:
-    """`` (Figs. ...)`` on the run of the paper's Figs. 5-9 (sec. 5.2.1): Manipulator 2 (l = 1)
-    from x0 = (0, 0, pi/2) to the one target y_d = (0, 2). Other runs cite none: Table 1's closed
-    path, another start, target or robot is not what those figures show."""
-    s = result.state
-    shown = (
-        s.robot == "manipulator2"
-        and s.task == "target"
-        and s.robot_parameters.get("l", 1.0) == 1.0
+    """`` (Figs. ...)`` on the runs the paper draws: Manipulator 2 (l = 1) from x0 = (0, 0, pi/2)
+    to the one target y_d = (0, 2) (Figs. 5-9, sec. 5.2.1), the unicycle's of Figs. 11-14
+    (:func:`~jik.engine.reproductions.unicycle.figs_11_14`). Other runs cite none."""
+    s, p = result.state, result.state.robot_parameters
+    a = s.augmentation_parameters.get("a")
+    shown = s.task == "target" and (
+        figs_11_14(p["q0"], p["T"], a, s.x0, s.target, s.gamma, s.mode)
+        if s.robot == "unicycle"
+        else s.robot == "manipulator2"
+        and p.get("l", 1.0) == 1.0
         and np.allclose(s.x0, X0, rtol=0, atol=1e-9)
         and np.allclose(s.target, FIGS_5_9_TARGET, rtol=0, atol=1e-9)
     )
@@ -243,7 +246,7 @@ def _joints(result: DashboardResult) -> dict:
         axis["range"] = nice_range(np.concatenate([r.x[:, k] for r in runs]))
     axes["xaxis"].update(theta_axis(result))
     title = (
-        "Controls λ against the iteration (Figs. 11-14 b, c)"
+        f"Controls λ against the iteration{_cited(result, 'Figs. 11-14 b, c')}"
         if is_unicycle(result)
         else f"Joint trajectories{_cited(result, 'Figs. 7-9')}"
     )
@@ -354,7 +357,7 @@ def _platform(result: DashboardResult) -> dict:
         )
     return figure(
         data,
-        "Platform paths q(t) per iteration (Figs. 11-14 a)",
+        f"Platform paths q(t) per iteration{_cited(result, 'Figs. 11-14 a')}",
         **axes,
         annotations=annotations,
         showlegend=False,  # (each plot is named above it)

@@ -17,6 +17,7 @@ domain (the leaves E_{a,alpha} need lambda10 != 0).
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 
@@ -283,6 +284,20 @@ def paper_start(q0) -> str | None:
         if q0.shape == (3,) and np.allclose(q0, pose, atol=1e-9):
             return name
     return None
+
+
+def figs_11_14(q0, period: float, a, x0, target, gamma: float, mode: str) -> bool:
+    """Whether a unicycle run is one that sec. 6.2 draws in Figs. 11-14: from pose A or B
+    (:func:`paper_start`) with the horizon T = 2 pi and lambda0 = (0.5, -0.25, 0.3, -0.25) to
+    y_d = (1, 0, -pi/2), by the discrete algorithm (7) with gamma = 0.1, the map (29) of a = 1."""
+    close = functools.partial(np.allclose, rtol=0, atol=1e-9)
+    return (
+        paper_start(q0) is not None
+        and (mode, gamma, a) == ("discrete", GAMMA, A_PARAMETER)
+        and close(period, T)
+        and close(x0, LAMBDA0)
+        and close(target, Y_D)
+    )
 
 
 def undefined_why(q0, a: float, lam10: tuple[float, float], step: str, discrete: bool) -> list[str]:

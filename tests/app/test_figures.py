@@ -167,6 +167,19 @@ def test_the_papers_figures_5_to_9_are_cited_on_their_run_only(path_result):
         assert "Figs." not in panel(result, "joints").layout.title.text
 
 
+def test_the_papers_figures_11_to_14_are_cited_on_the_unicycles_runs_of_them_only():
+    """Figs. 11-14 show the unicycle from pose A or B, lambda0 = (0.5, -0.25, 0.3, -0.25), to
+    y_d = (1, 0, -pi/2) by the discrete algorithm with gamma = 0.1 (sec. 6.2); another gamma,
+    mode or start is not what they show and cites none."""
+    unicycle = default_state("unicycle")
+    for patch, cited in (({}, True), ({"gamma": 0.5}, False), ({"mode": "continuous"}, False)):
+        result = compute(updated_state(unicycle, patch))
+        titles = [panel(result, k).layout.title.text for k in ("task", "joints")]
+        assert [("(Figs. 11-14 a)" in titles[0]), ("(Figs. 11-14 b, c)" in titles[1])] == [
+            cited
+        ] * 2, (patch, titles)
+
+
 def test_a_single_target_is_named_target_not_a_corner_letter():
     """The paper's letters are Manipulator 2's corners (A = (1, 1)) and the unicycle's starts
     (q0 = A): a single target lettered A was read as one of them."""
