@@ -118,8 +118,8 @@ def _synthesis_state(degree: int):
 def test_a_map_synthesis_is_made_in_a_worker_within_its_memory_limit(monkeypatch):
     """With the server's pool, a definition's E2 synthesis is made in a compute worker and kept
     in the server's process, which synthesizes nothing itself; one too large for a worker's
-    memory (a three-variable map of degree 16, about 2.8 GB) is refused naming
-    ``augmentation``."""
+    memory (512 MB here: a three-variable map of degree 16, whose Ritz matrix alone is 0.2 GB,
+    takes more with its solve) is refused naming ``augmentation``."""
     import jik.engine.robot_synthesis as synthesis
     from jik.app.compute.pool import pool_in_thread
     from jik.app.compute.settings import Settings
@@ -129,7 +129,7 @@ def test_a_map_synthesis_is_made_in_a_worker_within_its_memory_limit(monkeypatch
         raise AssertionError("a map was synthesized in the server's process")
 
     monkeypatch.setattr(synthesis, "synthesize_e2", here)
-    with pool_in_thread(Settings(workers=1, timeout=60, worker_memory=1024)) as pool:
+    with pool_in_thread(Settings(workers=1, timeout=60, worker_memory=512)) as pool:
         for degree, kind in ((4, "result"), (16, "error")):
             events: list = []
             dashboard = Dashboard(_synthesis_state(degree), pool=pool)
