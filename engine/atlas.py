@@ -326,7 +326,8 @@ def plan_atlas(
         box = checked(lambda: as_points(box, 2, "box"), "box")
         if box.shape != (kin.p, 2) or np.any(box[:, 0] >= box[:, 1]):
             raise InvalidInputError(f"box must be {kin.p} pairs (low, high), low < high", "box")
-    if not isinstance(arc, Sequence | np.ndarray) or len(arc) != 2:
+    pair = isinstance(arc, Sequence) and len(arc) == 2
+    if not (arc.shape == (2,) if isinstance(arc, np.ndarray) else pair):
         raise InvalidInputError("arc must be a pair (lo, hi) with lo <= 0 <= hi", field="arc")
     manifolds = checked(lambda: base_manifolds(kin, paths, ref, arc, box, per_shift), "reference")
     return make(n_starts=n, sampling=(sampling, seed), manifolds=manifolds, explicit=None)

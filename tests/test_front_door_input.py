@@ -164,3 +164,12 @@ def test_an_atlas_arc_from_numpy_is_the_same_plan():
 
     assert np.array_equal(plan(np.array([-0.5, 0.5])).starts(0, 4), plan((-0.5, 0.5)).starts(0, 4))
     refuses(lambda: plan(np.zeros((2, 2))), "arc")
+
+
+@pytest.mark.parametrize("arc", [np.array(0.5), np.zeros(3), 0.5], ids=["0-d", "three", "float"])
+def test_an_atlas_arc_that_is_no_pair_is_refused_naming_arc(arc):
+    """A numpy scalar as plan_atlas's arc (np.array(0.5), a slip for a half-width) met a
+    TypeError (len() of unsized object) where any other wrong arc is refused naming arc."""
+    m2 = jik.Pseudoinverse(jik.Manipulator2())
+    path, x0 = [(1, 1), (1, 2), (0, 2)], [0.0, 0.0, np.pi / 2]
+    refuses(lambda: jik.plan_atlas([m2], path, n_starts=4, arc=arc, reference=x0), "arc")
