@@ -96,8 +96,8 @@ class Robot:
             del d["urdf_file"]
             d["urdf"] = self.kinematics.urdf  # type: ignore[attr-defined]
         if name in ARMS:  # (the keys it shares with the catalogue's entry come from there)
-            own = ARMS[name].definition()
-            d = {k: v for k, v in d.items() if own.get(k) != v} | {"name": name}
+            own = ARMS[name].definition()  # (repr: a value may be an ndarray, a home)
+            d = {k: v for k, v in d.items() if repr(own.get(k)) != repr(v)} | {"name": name}
         return robot_from_dict, (d,)
 
     @property

@@ -399,3 +399,13 @@ def test_a_robot_whose_urdf_came_from_a_file_pickles_with_its_text(tmp_path):
     assert copy.kinematics.joint_names == robot.kinematics.joint_names
     x = np.array([0.3, 0.5, 0.8, 0.6])
     assert np.array_equal(copy.kinematics.forward(x), robot.kinematics.forward(x))
+
+
+def test_a_catalogue_arm_with_a_numpy_home_pickles():
+    """A Panda given its home as an ndarray (robot_from_dict takes it) met "The truth value of
+    an array ... is ambiguous" when pickled; the copy has that home."""
+    pytest.importorskip("yourdfpy")
+    home = np.array(robot_from_dict({"name": "panda"}).spec.default_x0) + 0.01
+    robot = robot_from_dict({"name": "panda", "home": home})
+    copy = pickle.loads(pickle.dumps(robot))
+    assert np.array_equal(copy.spec.default_x0, robot.spec.default_x0)
