@@ -257,7 +257,7 @@ async function rememberInUrl(state) {
   const field = fields.length === 1 ? fields[0] : null;
   const push = fields.length > 0 && !(field && field === written.field);
   Object.assign(written, { state, field: fields.length ? field : written.field });
-  if (url.href === location.href && history.state) return;
+  if (!fields.length && url.href === location.href && history.state) return; // (?tab: one address)
   if (push) history.pushState({ state }, "", url);
   else history.replaceState({ state }, "", url);
   $("#copy-link").textContent = "copy link"; // (a link copied before is of another state)

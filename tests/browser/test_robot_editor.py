@@ -227,3 +227,23 @@ def test_a_planar_4r_chain_runs_with_two_degrees_of_redundancy(tabs):
     error = page.locator("[data-field=augmentations] .field-error")
     expect(error).to_contain_text("must be a list of 2 formulas (p - r = 2")
     expect(page.locator("#robot-field-joints")).to_have_value("RRRR")
+
+
+def test_back_after_a_change_of_a_state_held_in_its_tab_brings_that_state_back(tabs):
+    """A state too long for a link has the same address (?tab) whatever its values: a change of
+    it made no history entry and left the entry's state the one before, so back left the arm
+    altogether (to the state before it was pasted). Each change is an entry here too."""
+    import random
+
+    noise = random.Random(7).randbytes(60_000).hex()
+    tab, urdf = _pasted_arm(tabs, f"<!-- {noise} -->")
+    page = tab.page
+    page.wait_for_url("**?*tab*")
+    before, length = tab.url_state(), page.evaluate("history.length")
+    task = "target" if before["task"] != "target" else "path"
+    tab.select("#ctl-task", task)
+    assert page.evaluate("history.length") == length + 1
+    assert page.evaluate("history.state.state.task") == task
+    tab.change(page.go_back)
+    snapshot = tab.wait_settled(lambda s: s["state"]["task"] == before["task"], "the state before")
+    assert snapshot["state"]["robot_definition"]["urdf"] == urdf
