@@ -225,9 +225,10 @@ def make_inverse(
     if algorithm == "weighted":
         if vectors.get("limits") is not None:  # (the default only without them: it may not exist)
             return pinv.WeightedInverse(kinematics, vectors["limits"])
-        declared = robot_limits(kinematics)
-        box = declared is None or not np.isfinite(declared).any()
-        return pinv.WeightedInverse(kinematics, _robot_limits(kinematics, spec, robot), box)
+        limits, declared = _robot_limits(kinematics, spec, robot), robot_limits(kinematics)
+        # (the box, where no limit is declared: a URDF arm of continuous joints has none)
+        box = (declared is None or not np.isfinite(declared).any()) and np.isfinite(limits).any()
+        return pinv.WeightedInverse(kinematics, limits, bool(box))
     if algorithm == "posture":
         if "rest" in vectors:
             return pinv.PostureInverse(kinematics, vectors["rest"], values["gain"])

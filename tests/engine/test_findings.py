@@ -365,3 +365,23 @@ def test_one_cycle_is_said_as_one():
         "extended Jacobian J^E#: repeatable. After 1 cycle the joints came back to x0 within"
     )
     assert "1 cycle of 4 legs" in repr(run)
+
+
+def test_the_weighted_inverse_of_an_arm_of_continuous_joints_names_no_box():
+    """A URDF arm whose joints are all continuous has no limits and the weighted inverse takes
+    none (weight 1 each), yet its findings said "x1 in [-inf, inf]; ... the robot has no joint
+    limits: its configuration box x_range", a box it did not use."""
+    pytest.importorskip("yourdfpy")
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "data" / "arm4.urdf").read_text()
+    arm = jik.robot_from_dict(
+        {"name": "urdf", "urdf": text.replace('"revolute"', '"continuous"'), "end_link": "tool"}
+    )
+    weighted = arm.inverse("weighted")
+    assert np.isinf(weighted.limits).all() and not weighted.box
+    x = np.array([[0.3, 0.5, 0.8, 0.6]])
+    ((text, _),) = weighted_findings(
+        "J^W#", x, weighted.limits, ["x1", "x2", "x3", "x4"], weighted.box
+    )
+    assert "x_range" not in text
