@@ -6,11 +6,12 @@ checks and plans it (:func:`~jik.app.compute.atlas_plan.planned`, in a compute w
 pool (:class:`PoolBackend`: the API's workers and their time and memory limits, first come first
 served with its requests; they stop with the server). A job runs on when its client goes away,
 and is dropped ``keep_for`` seconds after it ends (or when cancelled, or sooner when a new job
-needs its room: the job that ended first goes).
+needs its room: the job that ended first goes, once kept ``min_keep`` seconds).
 
 Limits (:class:`~jik.app.compute.atlas_plan.AtlasLimits`): at most ``max_running`` atlases
 compute at once (the others wait, queued), ``max_jobs`` are kept in all (queued, running or
-ended) and ``per_client`` queued or running for one client, and a job computes for at most
+ended), ``per_client`` queued or running for one client (an address's REST requests, or one
+dashboard session) and ``per_address`` for one address in all, and a job computes for at most
 ``max_seconds`` (then it fails and says so). A done job keeps its result document and the
 engine's atlas it was made from (its table's source,
 :meth:`~jik.engine.atlas_table.AtlasResult.csv_text`).
@@ -129,6 +130,10 @@ class AtlasJob:
         return self.status in ("queued", "running")
 
 
+def _ended(job: AtlasJob) -> float:
+    return job.ended or 0.0
+
+
 class AtlasJobs:
     """The API's atlas jobs (see the module docstring)."""
 
@@ -144,11 +149,12 @@ class AtlasJobs:
         #: earlier server process, lost when it stopped (jobs live in memory).
         self.run = secrets.token_hex(3)
 
-    def check_room(self, client: str) -> None:
-        """Raise :class:`AtlasJobsFull` if no job of ``client`` can start now."""
+    def check_room(self, client: str, session: str | None = None) -> None:
+        """Raise :class:`AtlasJobsFull` if no job of ``client`` (an address; ``session``: of
+        that dashboard session's) can start now."""
         self.sweep()
         with self._lock:
-            self._room(client)
+            self._room(client, session)
 
     def start(
         self,
@@ -160,10 +166,10 @@ class AtlasJobs:
         """Start the request's atlas as a job: ``plan`` is its plan and what it used
         (:func:`~jik.app.compute.atlas_plan.planned`); raises before anything is kept when
         there is no room; ``session``: the dashboard session that asks for it."""
-        self.check_room(client)
+        self.check_room(client, session)
         job = AtlasJob(self.run + secrets.token_urlsafe(12), client, req, *plan, session=session)
         with self._lock:
-            ended = self._room(client)
+            ended = self._room(client, session)
             if len(self._jobs) >= self.limits.max_jobs:  # (the job that ended first makes room)
                 del self._jobs[ended[0].id]
             self._jobs[job.id] = job
@@ -172,16 +178,24 @@ class AtlasJobs:
         ).start()
         return job
 
-    def _room(self, client: str) -> list[AtlasJob]:
-        """Raise :class:`AtlasJobsFull` if no job of ``client`` can start now; else the ended
-        jobs, the first ended first. Under the lock."""
-        jobs = self._jobs.values()
-        if sum(j.active and j.client == client for j in jobs) >= self.limits.per_client:
+    def _room(self, client: str, session: str | None) -> list[AtlasJob]:
+        """Raise :class:`AtlasJobsFull` if no job of ``client`` and ``session`` can start now;
+        else the ended jobs that may make room (kept ``min_keep`` s), the first ended first.
+        Under the lock."""
+        jobs, limits = self._jobs.values(), self.limits
+        mine = [j for j in jobs if j.active and j.client == client]
+        if sum(j.session == session for j in mine) >= limits.per_client:
             raise AtlasJobsFull(
-                f"at most {self.limits.per_client} atlas jobs per client run at "
+                f"at most {limits.per_client} atlas jobs per client run at "
                 "once; wait for one to end or cancel it"
             )
-        ended = sorted((j for j in jobs if j.ended is not None), key=lambda j: j.ended or 0.0)
+        if len(mine) >= limits.per_address:
+            raise AtlasJobsFull(
+                f"at most {limits.per_address} atlas jobs of one address (its tabs together) "
+                "run at once; wait for one to end"
+            )
+        kept = time.monotonic() - limits.min_keep
+        ended = sorted((j for j in jobs if j.ended is not None and j.ended <= kept), key=_ended)
         if len(self._jobs) >= self.limits.max_jobs and not ended:
             raise AtlasJobsFull(
                 f"the server has at most {self.limits.max_jobs} atlas jobs queued or running; "

@@ -38,7 +38,10 @@ Used = tuple[S.RobotUsed, S.AugmentationUsed | None]
 class AtlasLimits:
     max_jobs: int = 16
     max_running: int = 1
+    #: queued or running jobs of one REST client (an address), or of one dashboard session
     per_client: int = 2
+    #: queued or running jobs of one address, its REST requests and its sessions together
+    per_address: int = 8
     #: legs of one job, runs x cycles x legs x algorithms (under a minute of one core at 0.04 ms
     #: a leg, ``jik bench atlas``)
     max_work: int = 1_200_000
@@ -46,6 +49,8 @@ class AtlasLimits:
     max_leg_ends: int = 200_000
     #: seconds a job is kept after it ends
     keep_for: float = 600.0
+    #: seconds an ended job is kept at least, even when a new job needs its room
+    min_keep: float = 60.0
     #: seconds a job may compute (then it fails, naming ``starts``: its legs may each run up to
     #: ``max_iterations`` steps, which ``max_work`` does not count)
     max_seconds: float = 600.0

@@ -223,9 +223,21 @@ def test_a_full_table_of_jobs_drops_the_one_that_ended_first():
     """A script that ran atlases one after another, each to its end, got 429 "retry when one has
     ended and expired" on the job after max_jobs, for keep_for seconds (600), whatever its
     Retry-After (10 s) said, and so did every other client: now the job that ended first makes
-    room, and only a table of queued or running jobs is full."""
-    jobs = AtlasJobs(AtlasLimits(max_jobs=2, per_client=2))
+    room once kept ``min_keep`` seconds (another client's result that has just ended is not
+    taken from under it), and only a table of queued or running jobs is full."""
     req = AtlasRequest.model_validate(body(starts=2, cycles=1))
+    kept = AtlasJobs(AtlasLimits(max_jobs=1))
+    try:
+        first = kept.start("me", req, planned(req, kept.limits))
+        end = time.monotonic() + 300
+        while first.ended is None and time.monotonic() < end:
+            time.sleep(0.05)
+        with pytest.raises(AtlasJobsFull, match="at most 1 atlas jobs queued or running"):
+            kept.start("you", req, planned(req, kept.limits))
+        assert kept.get(first.id).status == "done"
+    finally:
+        kept.close()
+    jobs = AtlasJobs(AtlasLimits(max_jobs=2, per_client=2, min_keep=0.0))
     started = []
     for _ in range(3):
         started.append(jobs.start("me", req, planned(req, jobs.limits)))
@@ -244,6 +256,24 @@ def test_a_full_table_of_jobs_drops_the_one_that_ended_first():
     finally:
         jobs.close()
     assert all(j.cancel.is_set() for j in running)
+
+
+def test_the_sessions_of_one_address_hold_at_most_per_address_jobs():
+    """A session is a client of its own (per_client each), but the sessions of one address hold
+    at most per_address jobs together: one address opening many tabs cannot take every slot."""
+    jobs = AtlasJobs(AtlasLimits(max_jobs=8, per_client=1, per_address=3))
+    long = AtlasRequest.model_validate(LONG)
+    plan = planned(long, jobs.limits)
+    try:
+        for k in range(3):
+            jobs.start("10.0.0.1", long, plan, session=f"tab{k}")
+        with pytest.raises(AtlasJobsFull, match="at most 3 atlas jobs of one address"):
+            jobs.start("10.0.0.1", long, plan, session="tab3")
+        jobs.start("10.0.0.2", long, plan, session="other")
+        with pytest.raises(AtlasJobsFull, match="at most 1 atlas jobs per client"):
+            jobs.start("10.0.0.2", long, plan, session="other")
+    finally:
+        jobs.close()
 
 
 def test_reference_must_be_a_configuration(client):

@@ -57,12 +57,12 @@ async def start_job(
 ) -> AtlasJobResponse:
     """Plan ``req`` in a worker of the app's compute pool (tracing the self-motion curves solves
     eq. (7): within the workers' time and memory limits, like any computation a request asks
-    for), then start it as a job of the client's: the address's, or ``session``'s, a dashboard
-    tab's (tabs behind one address, SSH tunnels or a NAT, each have their own limit); the 202's
-    body, its ``Location`` the job's ``/atlas/{job_id}``."""
-    address = request.client.host if request.client else "unknown"
-    client = f"session {session}" if session else address
-    jobs.check_room(client)  # (before the work)
+    for), then start it as a job of the client's address (``session``: of that dashboard
+    session's, which tabs behind one address, SSH tunnels or a NAT, each have: see
+    :class:`~jik.app.compute.atlas_plan.AtlasLimits`); the 202's body, its ``Location`` the
+    job's ``/atlas/{job_id}``."""
+    client = request.client.host if request.client else "unknown"
+    jobs.check_room(client, session)  # (before the work)
     pool: ComputePool = request.app.state.pool
     plan, refused = await pool.run(plan_task, req.model_dump_json(), jobs.limits)
     if refused is not None:  # (the engine's message and field)
