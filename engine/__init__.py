@@ -53,7 +53,8 @@ Repeatability (sec. 5.2.1, Table 1)
     Resume, Leg                 an earlier run to go on from (as x0); a leg as a progress sees it
     Progress, ProgressCallbacks what a long computation reports, and how to cancel it
 Functionals and synthesis (secs. 3-4)
-    error_functional_e1, error_functional_e2  E1, eq. (14), and E2, eq. (19), on a region
+    error_functional_e1, error_functional_e2  E1, eq. (14), and E2, eq. (19), on a region,
+                                of one map h or a vector of p - r maps (E2 in a kernel frame)
     functionals_report          both as data on a region of any dimension (Sobol rule past 3)
     synthesize_e2               the E2-optimal h by a Ritz method, eq. (20) -> SynthesisResult
     synthesize_e2_nd            E2-optimal h of all joints, p - r >= 1 -> TotalDegreeSynthesis

@@ -3,8 +3,9 @@
 The paper treats one degree of redundancy; with p - r of them the augmenting map is a vector
 h = (h_1, ..., h_(p-r)), the extended Jacobian is [J; dh_1; ...; dh_(p-r)] (p x p) and its inverse's
 first r columns are the extended inverse J^E#: J J^E# = I_r and dh_i J^E# = 0 for every i, so
-each h_i is constant along eq. (7) and the algorithm is repeatable, as for p - r = 1. The E1/E2
-functionals and the synthesis of h stay those of one degree of redundancy.
+each h_i is constant along eq. (7) and the algorithm is repeatable, as for p - r = 1. E1 (13) and
+E2 (18) of such a vector (:mod:`jik.engine.functionals`) and its E2 synthesis
+(:mod:`jik.engine.synthesis_nd`) are derived in ``docs/e2-vector.md``.
 """
 
 from __future__ import annotations
@@ -14,15 +15,15 @@ from collections.abc import Sequence
 import numpy as np
 
 from .augmentations import AugmentingMap
-from .exceptions import AlgorithmicSingularityError, InvalidInputError, SingularConfigurationError
+from .exceptions import AlgorithmicSingularityError, SingularConfigurationError
 from .inverses import (
     SINGULAR_EXTENDED,
     Inverse,
     extended_singularity,
     require_kinematics,
-    require_map,
     solve_extended,
 )
+from .kernel_frame import maps_gradient, require_maps
 from .kinematics import Kinematics
 from .validation import FloatArray
 
@@ -42,31 +43,7 @@ class VectorExtendedInverse(Inverse):
 
     def __init__(self, kinematics: Kinematics, augmenting_maps: Sequence[AugmentingMap]) -> None:
         kinematics = require_kinematics(kinematics)
-        if isinstance(augmenting_maps, AugmentingMap | str):
-            augmenting_maps = [augmenting_maps]  # (one map: refused below unless p - r = 1)
-        if not isinstance(augmenting_maps, Sequence):
-            raise InvalidInputError(
-                f"augmenting_maps must be a list of p - r augmenting maps, got "
-                f"{type(augmenting_maps).__name__}",
-                "augmenting_maps",
-            )
-        maps = tuple(
-            require_map(m, kinematics, f"augmenting_maps.{i}")
-            for i, m in enumerate(augmenting_maps)
-        )
-        if len(maps) != kinematics.p - kinematics.r:
-            raise InvalidInputError(
-                f"the extended inverse of {kinematics.name} needs p - r = "
-                f"{kinematics.p - kinematics.r} augmenting maps, got {len(maps)}",
-                "augmenting_maps",
-            )
-        for i, m in enumerate(maps):
-            if m.p != kinematics.p:
-                raise InvalidInputError(
-                    f"augmenting map {i} is defined on R^{m.p}, but "
-                    f"{kinematics.name} has p = {kinematics.p}",
-                    f"augmenting_maps.{i}",
-                )
+        maps = require_maps(kinematics, augmenting_maps, "the extended inverse", "augmenting_maps")
         self.kinematics = kinematics
         self.augmenting_maps = maps
 
@@ -80,9 +57,7 @@ class VectorExtendedInverse(Inverse):
 
     def _extended(self, x: FloatArray) -> tuple[FloatArray, FloatArray]:
         """[J; dh] (..., p, p) (undefined rows zeroed) and where some h_i is undefined."""
-        grads = [m.gradient_masked(x) for m in self.augmenting_maps]
-        dh = np.stack([g for g, _ in grads], axis=-2)  # (..., p - r, p)
-        undefined = np.any(np.stack([u for _, u in grads], axis=-1), axis=-1)
+        dh, undefined = maps_gradient(self.augmenting_maps, x)  # (..., p - r, p)
         dh = np.where(undefined[..., None, None], 0.0, dh)
         return np.concatenate([self.kinematics.jacobian_unchecked(x), dh], axis=-2), undefined
 

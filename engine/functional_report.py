@@ -1,32 +1,32 @@
-"""E1 (13) and E2 (18) of a map on a region as plain data, whatever the region's dimension (what
-the dashboard's E1/E2 panel and its export show).
+"""E1 (13) and E2 (18) of a map, or a vector of p - r maps, on a region as plain data, whatever
+the region's dimension (what the dashboard's E1/E2 panel and its export show), and how they change
+with a map's parameters.
 
 Over at most :data:`MAX_TENSOR_VARIABLES` variables both are taken by the tensor Gauss rule of
 :mod:`jik.engine.functionals`, each with its singular points. Over more, a tensor rule is too
-large (``nodes ** 7`` points for a 7-joint arm): for one degree of redundancy, E2 is taken by the
-scrambled Sobol rule of the total-degree synthesis (:func:`jik.engine.e2_qmc.e2_qmc`,
-docs/e2-vector.md), with E2 of h = s x_j for each joint beside it, which compares the map with
-holding a single joint. E1 has no such rule and is not computed.
+large (``nodes ** 7`` points for a 7-joint arm): E2 is taken by the scrambled Sobol rule of the
+total-degree synthesis (:func:`jik.engine.e2_qmc.e2_qmc`, docs/e2-vector.md), for one degree of
+redundancy with E2 of h = s x_j for each joint beside it, which compares the map with holding a
+single joint. E1 has no such rule and is not computed. E2 of a vector of maps depends on the
+kernel frame (:mod:`jik.engine.kernel_frame`), which the report names.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 
 import numpy as np
 
+from .augmentations import AugmentingMap
 from .e2_qmc import e2_qmc
-from .exceptions import JikError
-from .functionals import (
-    check_region,
-    error_functional_e1,
-    error_functional_e2,
-    parameter_sensitivity,
-)
-from .inverses import require_kinematics, require_map
+from .exceptions import InvalidInputError, JikError
+from .functionals import Region, check_region, error_functional_e1, error_functional_e2
+from .inverses import require_kinematics
+from .kernel_frame import frame_axes_of, require_maps
+from .kinematics import Kinematics
 from .progress import Progress, check_cancelled, check_progress, part
 from .robot_synthesis import TOTAL_NODES as QMC_NODES
-from .validation import count
+from .validation import count, finite
 
 #: The most region variables of a tensor Gauss rule.
 MAX_TENSOR_VARIABLES = 3
@@ -34,19 +34,29 @@ MAX_TENSOR_VARIABLES = 3
 QMC_SEED = 1
 
 
-def functional_value(key: str, kinematics, amap, region: Mapping, nodes: int, fixed) -> dict:
-    """``{key: E1 (13) or E2 (18) (``key`` "E1" or "E2") of ``amap`` on ``region`` by a tensor
-    rule of ``nodes`` per variable, or None where undefined}`` with its singular points, and
-    ``key_divergent`` (E1 = inf) or ``key_error`` (why it could not be evaluated) if so."""
-    fn = error_functional_e1 if key == "E1" else error_functional_e2
+def functional_value(
+    key: str, kinematics, amap, region: Mapping, nodes: int, fixed, frame_axes=None
+) -> dict:
+    """``{key: E1 (13) or E2 (18) (``key`` "E1" or "E2") of ``amap`` (a map, or a vector of
+    p - r maps) on ``region`` by a tensor rule of ``nodes`` per variable, or None where
+    undefined}`` with its singular points, ``key_divergent`` (E1 = inf) or ``key_error`` (why it
+    could not be evaluated) if so, and E2's ``E2_frame_axes`` for a vector (``frame_axes``, else
+    the best conditioned)."""
     try:
-        value = fn(kinematics, amap, region, nodes=nodes, fixed=fixed)
+        if key == "E1":
+            value = error_functional_e1(kinematics, amap, region, nodes=nodes, fixed=fixed)
+        else:
+            value = error_functional_e2(
+                kinematics, amap, region, nodes=nodes, fixed=fixed, frame_axes=frame_axes
+            )
     except (JikError, ValueError, ArithmeticError) as exc:
         return {key: None, f"{key}_error": str(exc)}
-    out = {
+    out: dict = {
         key: float(value.value) if np.isfinite(value.value) else None,
         f"{key}_singular_points": int(value.singular_points.shape[0]),
     }
+    if value.frame_axes:
+        out[f"{key}_frame_axes"] = list(value.frame_axes)
     return out | ({f"{key}_divergent": True} if value.divergent else {})
 
 
@@ -57,12 +67,16 @@ def functionals_report(
     fixed: Mapping | None = None,
     nodes: int = 12,
     progress: Progress | None = None,
+    frame_axes=None,
 ) -> dict:
-    """E1 and E2 of ``amap`` on ``region`` (name -> (lo, hi)), the other variables at
-    ``fixed`` (default: :func:`~jik.engine.robot_defaults.held_values`), as the module's notes
-    say: by the tensor rule (:func:`functional_value` of each, ``nodes`` per variable), else by
-    the Sobol rule of :data:`QMC_NODES` nodes: ``E2``, ``E2_single_joint`` (name -> {"sign",
-    "e2"}) and ``E2_rule``, ``E1`` None and a ``note`` saying why and how. A functional that
+    """E1 and E2 of ``amap`` (a map, or for p - r >= 2 a vector of p - r maps) on ``region``
+    (name -> (lo, hi)), the other variables at ``fixed`` (default:
+    :func:`~jik.engine.robot_defaults.held_values`), as the module's notes say: by the tensor
+    rule (:func:`functional_value` of each, ``nodes`` per variable), else by the Sobol rule of
+    :data:`QMC_NODES` nodes: ``E2``, ``E2_single_joint`` (name -> {"sign", "e2"}; for one
+    degree of redundancy) and ``E2_rule``, ``E1`` None and a ``note`` saying why and how. For a
+    vector, ``E2_frame_axes``: the 1-based joints fixing the kernel frame E2 depends on
+    (``frame_axes``, default the best conditioned at the box's centre). A functional that
     cannot be evaluated on a valid region (h undefined there) is reported as data
     (``E1_error``, ``E2_error``); invalid input raises.
 
@@ -74,29 +88,36 @@ def functionals_report(
     Raises
     ------
     InvalidInputError
-        ``kinematics`` not a Kinematics, ``amap`` not an AugmentingMap, ``region`` or
-        ``fixed`` not a box of the robot's variables and values of the others
-        (:func:`~jik.engine.functionals.check_region`), ``nodes`` not 1 to 400, ``progress``
-        not a Progress.
+        ``kinematics`` not a Kinematics, ``amap`` not an AugmentingMap or p - r of them,
+        ``region`` or ``fixed`` not a box of the robot's variables and values of the others
+        (:func:`~jik.engine.functionals.check_region`), ``nodes`` not 1 to 400, ``frame_axes``
+        not p - r distinct joints, ``progress`` not a Progress.
     """
     kinematics = require_kinematics(kinematics)
-    amap = require_map(amap, kinematics, "amap")
+    amap = require_maps(kinematics, amap, "E1, E2", "amap")
     region, fixed = check_region(kinematics, region, fixed)
     nodes, progress = count(nodes, "nodes", 1, 400), check_progress(progress)
+    axes = frame_axes_of(kinematics, region, fixed, frame_axes)
+    frame = None if axes is None else [a + 1 for a in axes]
     if len(region) <= MAX_TENSOR_VARIABLES:
         out: dict = {}
         for k, key in enumerate(("E1", "E2"), start=1):
             check_cancelled(progress, "E1, E2")
-            out |= functional_value(key, kinematics, amap, region, nodes, fixed)
+            out |= functional_value(key, kinematics, amap, region, nodes, fixed, frame)
             if progress is not None:
                 progress.advance(k, 2)
         return out
     large = f"a tensor rule over the {len(region)} variables of the design region is too large"
-    if kinematics.p - kinematics.r != 1:
-        return {"E1": None, "E2": None, "note": f"E1, E2 not computed: {large}"}
     try:
         e2 = e2_qmc(
-            kinematics, amap, region, fixed=fixed, nodes=QMC_NODES, seed=QMC_SEED, progress=progress
+            kinematics,
+            amap,
+            region,
+            fixed=fixed,
+            nodes=QMC_NODES,
+            seed=QMC_SEED,
+            frame_axes=frame,
+            progress=progress,
         )
     except (JikError, ValueError, ArithmeticError) as exc:
         e2 = {"E2": None, "error": str(exc)}
@@ -110,14 +131,88 @@ def functionals_report(
             "note": f"E1 not computed: {large}; E2 not computed: {e2['error']}",
         }
     value = "undefined (h is not defined on all of it)" if e2["E2"] is None else (f"{e2['E2']:.4g}")
+    frame_words = "" if frame is None else f", kernel frame on joints {frame}"
     return {
         "E1": None,
         "E2": e2["E2"],
-        "E2_single_joint": e2["single_joint"],
+        "E2_single_joint": e2["single_joint"] or None,
         "E2_rule": {"kind": "sobol", "nodes": QMC_NODES, "seed": QMC_SEED},
-        "note": f"E2 = {value} on the design box (Sobol rule, {QMC_NODES} nodes); "
-        f"E1 not computed over {len(region)} joints",
-    }
+        "note": f"E2 = {value} on the design box (Sobol rule, {QMC_NODES} nodes"
+        f"{frame_words}); E1 not computed over {len(region)} joints",
+    } | ({} if frame is None else {"E2_frame_axes": frame})
+
+
+def parameter_sensitivity(
+    kinematics: Kinematics,
+    factory: Callable[..., AugmentingMap],
+    parameters: Mapping[str, float],
+    region: Region,
+    *,
+    functional: str = "e2",
+    span: float = 1.0,
+    samples: int = 21,
+    nodes: int = 16,
+    fixed: Mapping[str, float] | None = None,
+    progress: Progress | None = None,
+) -> dict:
+    """The value of E1 or E2 at the given parameters and how it changes as each one moves.
+
+    Parameters
+    ----------
+    factory : callable
+        ``factory(**parameters) -> AugmentingMap``, e.g. ``E2Optimal`` or ``E1Optimal``.
+    parameters : mapping name -> value
+        The current parameters (C1, C2 or a, b).
+    functional : {"e1", "e2"}
+    span, samples : float, int
+        Each parameter is swept over [v - span, v + span] with ``samples`` values, the others
+        held; parameter values where the map cannot be built are reported as None.
+    progress : Progress, optional
+        Told ``advance(done, total)`` after each of the ``1 + len(parameters) (2 + samples)``
+        evaluations of the functional, and polled before each: ``cancelled()`` True stops the
+        sweep with :class:`~jik.engine.exceptions.RunCancelled`.
+
+    Returns
+    -------
+    dict
+        ``{"value", "gradient": {name: dE/dname (central differences, step 1e-4)},
+        "sweeps": {name: {"values": [...], "functional": [...]}}}``.
+    """
+    if functional not in ("e1", "e2"):
+        raise InvalidInputError(
+            f"functional must be 'e1' or 'e2', got {functional!r}", "functional"
+        )
+    samples = count(samples, "samples", 2, 201)
+    span = finite(span, "span")
+    evaluate = error_functional_e1 if functional == "e1" else error_functional_e2
+    base = {k: finite(v, k) for k, v in parameters.items()}
+    total, done = 1 + len(base) * (2 + samples), 0
+
+    def at(params: dict) -> float | None:
+        nonlocal done
+        check_cancelled(progress, f"the sweep of {functional.upper()}")
+        try:
+            amap = factory(**params)
+        except InvalidInputError:
+            v = np.nan
+        else:
+            v = evaluate(kinematics, amap, region, nodes=nodes, fixed=fixed).value
+        done += 1
+        if progress is not None:
+            progress.advance(done, total)
+        return v if np.isfinite(v) else None
+
+    out: dict = {"value": at(base), "gradient": {}, "sweeps": {}}
+    step = 1e-4
+    for name, v in base.items():
+        hi, lo = at({**base, name: v + step}), at({**base, name: v - step})
+        out["gradient"][name] = None if hi is None or lo is None else (hi - lo) / (2 * step)
+        grid = np.linspace(v - span, v + span, samples)
+        out["sweeps"][name] = {
+            "values": grid.tolist(),
+            "functional": [at({**base, name: float(g)}) for g in grid],
+        }
+    return out
 
 
 def region_words(region: Mapping) -> str:
@@ -158,7 +253,7 @@ def parameters_report(
 ) -> dict:
     """How E1 (13) and E2 (18) of the map ``factory(**parameters)`` change with its parameters:
     ``{"kind": "parameters", "parameters", "E1", "E2"}``, each functional's
-    :func:`~jik.engine.functionals.parameter_sensitivity` (its value, gradient and a sweep of
+    :func:`parameter_sensitivity` (its value, gradient and a sweep of
     ``samples`` values of every parameter over v - 1 .. v + 1) by a tensor rule of ``nodes``;
     ``progress`` told after each evaluation of either functional (E1's sweep its first half) and
     polled before each (:class:`~jik.engine.exceptions.RunCancelled`)."""

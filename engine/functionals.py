@@ -9,29 +9,33 @@ rule with ``nodes`` points per integrated variable is evaluated in one batch.
 Orientation of K: ``Kinematics.kernel`` returns the unit kernel vector with the paper's sign
 (last component positive for Manipulators 1 and 2). E1 does not depend on it; E2 does, through
 the term -2 dh K of (19), so flipping the sign of h changes E2 unless K is flipped too.
+
+With p - r >= 2 degrees of redundancy h is a vector of p - r maps and K a p x (p - r) kernel
+frame (:mod:`jik.engine.kernel_frame`); both functionals are then those of ``docs/e2-vector.md``,
+E2 depending on the frame, E1 not. How E1 and E2 change with a map's parameters:
+:func:`jik.engine.functional_report.parameter_sensitivity`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .augmentations import AugmentingMap
-from .exceptions import InvalidInputError
 from .exports import json_values
 from .inverses import (
     extended_determinant,
     extended_inverse,
     extended_jacobian,
     pseudoinverse,
-    require_compatible,
+    require_kinematics,
 )
+from .kernel_frame import frame_axes_of, kernel_frame, maps_gradient, require_maps
 from .kinematics import Kinematics, held_values
-from .progress import Progress, check_cancelled
 from .regions import check_box_region
-from .validation import FloatArray, check_memory, count, finite
+from .validation import FloatArray, check_memory, count
 
 # name -> (lo, hi); any two-item sequence (JSON gives lists), validated by check_region.
 Region = Mapping[str, Sequence[float]]
@@ -56,13 +60,17 @@ class FunctionalValue:
     fixed : dict
         Values of the joint variables not integrated over.
     min_abs_dh_k : float
-        min |dh K| over the quadrature points: E1 is singular where dh K = 0 (eq. (14)), and a
-        sign change of dh K inside the region makes E1 infinite.
+        min |det(dh K)| over the quadrature points (|dh K| for one map): E1 is singular where
+        it is 0 (eq. (14)), and a sign change inside the region makes E1 infinite.
     divergent : bool
-        For E1: dh K vanishes inside the region, so the integral (14) diverges and ``value`` is
-        ``inf``. Found by the sign of det [J; dh] = +-(dh K) sqrt(det J J^T) (continuous on the
-        box, unlike dh K, whose sign follows K's orientation): zero, or of both signs, over the
-        quadrature points and the box's faces. Always False for E2, finite everywhere.
+        For E1: det(dh K) vanishes inside the region, so the integral (14) diverges and
+        ``value`` is ``inf``. Found by the sign of det [J; dh] = +-det(dh K) sqrt(det J J^T)
+        (continuous on the box, unlike dh K, whose sign follows K's orientation): zero, or of
+        both signs, over the quadrature points and the box's faces. Always False for E2,
+        finite everywhere.
+    frame_axes : tuple of int
+        For E2 of a vector of p - r >= 2 maps: the joints (1-based) whose axes fix the kernel
+        frame K it depends on (:func:`~jik.engine.kernel_frame.kernel_frame`); else empty.
     """
 
     value: float
@@ -72,6 +80,7 @@ class FunctionalValue:
     fixed: dict[str, float] = field(default_factory=dict)
     min_abs_dh_k: float = float("nan")
     divergent: bool = False
+    frame_axes: tuple[int, ...] = ()
 
     def __repr__(self) -> str:
         box = ", ".join(f"{k} in [{lo:.4g}, {hi:.4g}]" for k, (lo, hi) in self.region.items())
@@ -79,7 +88,8 @@ class FunctionalValue:
         return (
             f"FunctionalValue({self.value:.10g}{' (divergent)' if self.divergent else ''}, "
             f"{box}{f', held {held}' if held else ''}, {self.n_points} points, "
-            f"{int(self.singular_points.shape[0])} singular)"
+            f"{int(self.singular_points.shape[0])} singular"
+            f"{f', frame axes {list(self.frame_axes)}' if self.frame_axes else ''})"
         )
 
     def as_dict(self) -> dict:
@@ -95,6 +105,7 @@ class FunctionalValue:
                 "singular_points": self.singular_points.tolist(),
                 "min_abs_dh_k": self.min_abs_dh_k,
                 "divergent": self.divergent,
+                "frame_axes": list(self.frame_axes) or None,
             }
         )
 
@@ -174,16 +185,16 @@ def quadrature(
 
 def _e1_diverges(
     kinematics: Kinematics,
-    augmenting_map: AugmentingMap,
+    maps: tuple[AugmentingMap, ...],
     x: FloatArray,
     J: FloatArray,
     dh: FloatArray,
     box: dict[str, tuple[float, float]],
 ) -> bool:
-    """Whether dh K vanishes on the box, so that E1 (14) diverges: [J; dh] is singular (as
+    """Whether det(dh K) vanishes on the box, so that E1 (14) diverges: [J; dh] is singular (as
     :func:`~jik.engine.inverses.extended_determinant` says) at, or det [J; dh] (continuous,
-    +-(dh K) sqrt(det J J^T)) is of both signs over, the quadrature points ``x`` and the same
-    points moved onto each face of the box (a zero on a face is outside the
+    +-det(dh K) sqrt(det J J^T)) is of both signs over, the quadrature points ``x`` and the
+    same points moved onto each face of the box (a zero on a face is outside the
     Gauss-Legendre points but makes the integral diverge all the same). Points where dh is
     not defined, and face points where J loses rank, do not count."""
     names = kinematics.names
@@ -196,31 +207,36 @@ def _e1_diverges(
     xf = np.concatenate(faces)
     xf = xf[~np.atleast_1d(kinematics.is_singular(xf))]
     with np.errstate(all="ignore"):
-        dhf = np.asarray(augmenting_map.gradient(xf), dtype=float).reshape(len(xf), -1)
+        dhf = maps_gradient(maps, xf)[0]
     det, singular = extended_determinant(
         np.concatenate([J, kinematics.jacobian(xf)]), np.concatenate([dh, dhf])
     )
     defined = np.isfinite(det)
-    if np.any(singular & defined):  # (dh K = 0 at a point)
+    if np.any(singular & defined):  # (det(dh K) = 0 at a point)
         return True
     det = det[defined]
     return bool(det.size) and bool(np.min(det) < 0.0 < np.max(det))
 
 
 def e1_integrand(J: FloatArray, dh: FloatArray) -> FloatArray:
-    """||J^P# - J^E#||_F^2 of eq. (13), shape (...,); NaN where [J; dh] is singular."""
+    """||J^P# - J^E#||_F^2 of eq. (13), shape (...,); NaN where [J; dh] is singular. ``dh``:
+    (..., p) for one map, (..., p - r, p) for a vector of maps."""
     D = pseudoinverse(J) - extended_inverse(J, dh)
     return np.sum(D**2, axis=(-1, -2))
 
 
 def e2_integrand(J: FloatArray, K: FloatArray, m: FloatArray, dh: FloatArray) -> FloatArray:
-    """||E1^(-1) E2 - I||_F^2 m of eq. (18), shape (...,).
+    """||E1^(-1) E2 - I||_F^2 m of eq. (18), shape (...,). ``K``, ``dh``: the unit kernel
+    vector (..., p) and one map's gradient (..., p), or a kernel frame (..., p, p - r) and a
+    vector of maps' gradients (..., p - r, p).
 
     E1^(-1) = [J; dh] (16) and E2 = [J^P#, K] (17), so no inverse of the extended Jacobian is
-    needed: the integrand equals (dh P dh^T - 2 dh K + 1) m, eq. (19), and is finite everywhere.
+    needed: the integrand equals tr(dh P dh^T - 2 dh K + I) m, eq. (19), and is finite
+    everywhere.
     """
     Jbar = extended_jacobian(J, dh)  # (..., p, p)
-    E2 = np.concatenate([pseudoinverse(J), K[..., :, None]], axis=-1)  # (..., p, p)
+    frame = K if K.ndim == J.ndim else K[..., :, None]
+    E2 = np.concatenate([pseudoinverse(J), frame], axis=-1)  # (..., p, p)
     D = Jbar @ E2 - np.eye(J.shape[-1])
     return np.sum(D**2, axis=(-1, -2)) * m
 
@@ -228,25 +244,29 @@ def e2_integrand(J: FloatArray, K: FloatArray, m: FloatArray, dh: FloatArray) ->
 def _evaluate(
     which: str,
     kinematics: Kinematics,
-    augmenting_map: AugmentingMap,
+    augmenting_map,
     region: Region,
     nodes: int,
     fixed: Mapping[str, float] | None,
+    frame_axes: Sequence[int] | None = None,
 ) -> FunctionalValue:
-    require_compatible(kinematics, augmenting_map, "the error functionals")
+    kinematics = require_kinematics(kinematics)
+    maps = require_maps(kinematics, augmenting_map, "E1, E2")
     x, w, box, fix = quadrature(kinematics, region, nodes, fixed)
     kinematics.require_regular(x, "integration region (a quadrature point)", "region")
+    axes = frame_axes_of(kinematics, box, fix, frame_axes)
     J = kinematics.jacobian(x)
     with np.errstate(all="ignore"):
-        dh = np.asarray(augmenting_map.gradient(x), dtype=float)
+        dh = maps_gradient(maps, x)[0]  # (n, p - r, p)
     bad = extended_determinant(J, dh)[1]
-    dh_safe = np.where(bad[:, None], 0.0, dh)
-    K = kinematics.kernel(x)
-    dhk = np.einsum("np,np->n", dh_safe, K)
+    dh_safe = np.where(bad[:, None, None], 0.0, dh)
+    K = kernel_frame(kinematics, x, axes)[0]  # (n, p, p - r)
+    dhk = np.linalg.det(dh_safe @ K)
     divergent = False
     if which == "e1":
-        f = np.where(bad, 0.0, e1_integrand(J, np.where(bad[:, None], K, dh_safe)))
-        divergent = _e1_diverges(kinematics, augmenting_map, x, J, dh, box)
+        regular = np.where(bad[:, None, None], np.swapaxes(K, -1, -2), dh_safe)
+        f = np.where(bad, 0.0, e1_integrand(J, regular))
+        divergent = _e1_diverges(kinematics, maps, x, J, dh, box)
     else:
         f = e2_integrand(J, K, kinematics.manipulability(x), dh_safe)
     return FunctionalValue(
@@ -257,12 +277,13 @@ def _evaluate(
         singular_points=x[bad],
         fixed=fix,
         min_abs_dh_k=float(np.min(np.abs(np.where(bad, 0.0, dhk)))),
+        frame_axes=() if axes is None or which == "e1" else tuple(a + 1 for a in axes),
     )
 
 
 def error_functional_e1(
     kinematics: Kinematics,
-    augmenting_map: AugmentingMap,
+    augmenting_map: AugmentingMap | Sequence[AugmentingMap],
     region: Region,
     *,
     nodes: int = 16,
@@ -273,9 +294,11 @@ def error_functional_e1(
     Parameters
     ----------
     kinematics : Kinematics
-        With one degree of redundancy.
-    augmenting_map : AugmentingMap
-        h, eq. (9); only its gradient enters.
+        With p > r.
+    augmenting_map : AugmentingMap, or a sequence of p - r of them
+        h, eq. (9): one map for one degree of redundancy, the vector (h_1, ..., h_(p-r)) of
+        :class:`~jik.engine.extended_vector.VectorExtendedInverse` for more; only the gradient
+        enters.
     region : mapping name -> (lo, hi)
         The integrated variables, e.g. ``{"x1": (0, 1), "x3": (0.5, 1.5)}``.
     nodes : int
@@ -288,109 +311,45 @@ def error_functional_e1(
     -------
     FunctionalValue
         Quadrature points where [J; dh] is singular are excluded from the value and listed in
-        ``singular_points``; where dh K vanishes inside the region, the value is ``inf`` and
-        ``divergent`` is set.
+        ``singular_points``; where det(dh K) vanishes inside the region, the value is ``inf``
+        and ``divergent`` is set.
 
     Notes
     -----
-    J^P# - J^E# = K W with W = (dh K)^(-1) dh J^P#, so the integrand is
-    dh P dh^T / (dh K)^2 - 1: it blows up like (dh K)^(-2) where dh K = 0 (non-integrable if
-    dh K changes sign inside the region); ``min_abs_dh_k`` reports how close the region is.
-    E1 is invariant under h -> phi(h) for monotone phi and does not depend on K's orientation.
+    J^P# - J^E# = K W with W = (dh K)^(-1) dh J^P#, K an orthonormal kernel frame, so the
+    integrand is tr(W W^T) of eq. (14), for one map dh P dh^T / (dh K)^2 - 1: it blows up where
+    det(dh K) = 0 (non-integrable if it changes sign inside the region); ``min_abs_dh_k``
+    reports how close the region is. E1 is invariant under h -> phi(h) for a diffeomorphism phi
+    (monotone, for one map) and does not depend on the frame K (K -> K Q changes W to Q^T W).
     """
     return _evaluate("e1", kinematics, augmenting_map, region, nodes, fixed)
 
 
 def error_functional_e2(
     kinematics: Kinematics,
-    augmenting_map: AugmentingMap,
+    augmenting_map: AugmentingMap | Sequence[AugmentingMap],
     region: Region,
     *,
     nodes: int = 16,
     fixed: Mapping[str, float] | None = None,
+    frame_axes: Sequence[int] | None = None,
 ) -> FunctionalValue:
     """E2(h) = integral of ||E1^(-1) E2 - I||_F^2 m(x) over a box, eq. (18) (= (19)).
 
-    Parameters are as in :func:`error_functional_e1`.
+    Parameters are as in :func:`error_functional_e1`, and
+
+    frame_axes : sequence of int, optional
+        For p - r >= 2: the p - r joints (1-based) whose axes fix the kernel frame K
+        (:func:`~jik.engine.kernel_frame.kernel_frame`); default: the best conditioned at the
+        box's centre (:func:`~jik.engine.kernel_frame.best_frame_axes`), as the E2 synthesis
+        over all joints takes it. Reported in the result's ``frame_axes``.
 
     Notes
     -----
-    The integrand (dh P dh^T - 2 dh K + 1) m with P = J^P# J^P#^T + K K^T, eq. (19), is a
+    The integrand tr(dh P dh^T - 2 dh K + I) m with P = J^P# J^P#^T + K K^T, eq. (19), is a
     quadratic in dh; it is finite where [J; dh] is singular, so such points are included in
-    the value and reported. K is the unit kernel with the paper's orientation (last component
-    positive for Manipulators 1 and 2); E2 is not invariant under h -> -h.
+    the value and reported. For one map K is the unit kernel with the paper's orientation (last
+    component positive for Manipulators 1 and 2); E2 is not invariant under h -> -h, and for
+    p - r >= 2 it depends on the frame (``docs/e2-vector.md``).
     """
-    return _evaluate("e2", kinematics, augmenting_map, region, nodes, fixed)
-
-
-def parameter_sensitivity(
-    kinematics: Kinematics,
-    factory: Callable[..., AugmentingMap],
-    parameters: Mapping[str, float],
-    region: Region,
-    *,
-    functional: str = "e2",
-    span: float = 1.0,
-    samples: int = 21,
-    nodes: int = 16,
-    fixed: Mapping[str, float] | None = None,
-    progress: Progress | None = None,
-) -> dict:
-    """The value of E1 or E2 at the given parameters and how it changes as each one moves.
-
-    Parameters
-    ----------
-    factory : callable
-        ``factory(**parameters) -> AugmentingMap``, e.g. ``E2Optimal`` or ``E1Optimal``.
-    parameters : mapping name -> value
-        The current parameters (C1, C2 or a, b).
-    functional : {"e1", "e2"}
-    span, samples : float, int
-        Each parameter is swept over [v - span, v + span] with ``samples`` values, the others
-        held; parameter values where the map cannot be built are reported as None.
-    progress : Progress, optional
-        Told ``advance(done, total)`` after each of the ``1 + len(parameters) (2 + samples)``
-        evaluations of the functional, and polled before each: ``cancelled()`` True stops the
-        sweep with :class:`~jik.engine.exceptions.RunCancelled`.
-
-    Returns
-    -------
-    dict
-        ``{"value", "gradient": {name: dE/dname (central differences, step 1e-4)},
-        "sweeps": {name: {"values": [...], "functional": [...]}}}``.
-    """
-    if functional not in ("e1", "e2"):
-        raise InvalidInputError(
-            f"functional must be 'e1' or 'e2', got {functional!r}", "functional"
-        )
-    samples = count(samples, "samples", 2, 201)
-    span = finite(span, "span")
-    evaluate = error_functional_e1 if functional == "e1" else error_functional_e2
-    base = {k: finite(v, k) for k, v in parameters.items()}
-    total, done = 1 + len(base) * (2 + samples), 0
-
-    def at(params: dict) -> float | None:
-        nonlocal done
-        check_cancelled(progress, f"the sweep of {functional.upper()}")
-        try:
-            amap = factory(**params)
-        except InvalidInputError:
-            v = np.nan
-        else:
-            v = evaluate(kinematics, amap, region, nodes=nodes, fixed=fixed).value
-        done += 1
-        if progress is not None:
-            progress.advance(done, total)
-        return v if np.isfinite(v) else None
-
-    out: dict = {"value": at(base), "gradient": {}, "sweeps": {}}
-    step = 1e-4
-    for name, v in base.items():
-        hi, lo = at({**base, name: v + step}), at({**base, name: v - step})
-        out["gradient"][name] = None if hi is None or lo is None else (hi - lo) / (2 * step)
-        grid = np.linspace(v - span, v + span, samples)
-        out["sweeps"][name] = {
-            "values": grid.tolist(),
-            "functional": [at({**base, name: float(g)}) for g in grid],
-        }
-    return out
+    return _evaluate("e2", kinematics, augmenting_map, region, nodes, fixed, frame_axes)

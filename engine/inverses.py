@@ -58,8 +58,10 @@ def pseudoinverse(J: FloatArray) -> FloatArray:
 
 
 def extended_jacobian(J: FloatArray, dh: FloatArray) -> FloatArray:
-    """The extended Jacobian [J; dh] of l = (k, h), eq. (10): shape (..., p, p)."""
-    return np.concatenate([J, dh[..., None, :]], axis=-2)
+    """The extended Jacobian [J; dh] of l = (k, h), eq. (10): shape (..., p, p). ``dh`` is the
+    gradient of one map, (..., p), or of a vector of p - r maps, (..., p - r, p)."""
+    rows = dh if dh.ndim == J.ndim else dh[..., None, :]
+    return np.concatenate([J, rows], axis=-2)
 
 
 def extended_singularity(Jbar: FloatArray, det: FloatArray | None = None) -> FloatArray:
@@ -72,19 +74,22 @@ def extended_singularity(Jbar: FloatArray, det: FloatArray | None = None) -> Flo
 
 
 def extended_determinant(J: FloatArray, dh: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """det [J; dh] of eq. (10), and where [J; dh] is singular.
+    """det [J; dh] of eq. (10), and where [J; dh] is singular (``dh`` as
+    :func:`extended_jacobian` takes it).
 
     Returns
     -------
     det : ndarray, shape (...,)
-        NaN where dh is not finite. det [J; dh] = +-(dh K) sqrt(det J J^T) is continuous
-        where J and dh are, so a sign change between two points is a rank loss between them.
+        NaN where dh is not finite. det [J; dh] = +-det(dh K) sqrt(det J J^T) (K an orthonormal
+        kernel frame) is continuous where J and dh are, so a sign change between two points is
+        a rank loss between them.
     singular : ndarray of bool, shape (...,)
         dh not finite, or the Hadamard ratio (:func:`extended_singularity`) below
         :data:`SINGULAR_EXTENDED`: eq. (11) is undefined there.
     """
-    defined = np.all(np.isfinite(dh), axis=-1)
-    Jbar = extended_jacobian(J, np.where(defined[..., None], dh, 0.0))
+    rows = dh if dh.ndim == J.ndim else dh[..., None, :]  # (..., p - r, p)
+    defined = np.all(np.isfinite(rows), axis=(-2, -1))
+    Jbar = extended_jacobian(J, np.where(defined[..., None, None], rows, 0.0))
     det = np.linalg.det(Jbar)
     singular = ~defined | ~(extended_singularity(Jbar, det) >= SINGULAR_EXTENDED)
     return np.where(defined, det, np.nan), singular
@@ -96,7 +101,7 @@ def extended_inverse(J: FloatArray, dh: FloatArray) -> FloatArray:
     Parameters
     ----------
     J : ndarray, shape (..., r, p)
-    dh : ndarray, shape (..., p)
+    dh : ndarray, shape (..., p), or (..., p - r, p) for a vector of maps
 
     Returns
     -------

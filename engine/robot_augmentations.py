@@ -106,7 +106,7 @@ def _formula_maps(kin: Kinematics, item: Mapping, where: str) -> tuple[FormulaMa
 
 def _frame_axes(kin: Kinematics, axes, field: str) -> list[int] | None:
     """The 1-based joints whose axes fix a vector map's kernel frame (None: the synthesis'
-    best conditioned, :func:`~.synthesis_nd.best_frame_axes`)."""
+    best conditioned, :func:`~.kernel_frame.best_frame_axes`)."""
     if axes is None:
         return None
     k = kin.p - kin.r

@@ -46,7 +46,7 @@ def vector_synthesis(
     """The E2-optimal maps h_1, ..., h_(p-r) on ``box`` (p - r >= 2; docs/e2-vector.md), by the
     total-degree synthesis in the kernel frame of the 1-based joints ``axes`` (default: the
     best-conditioned at the box's centre,
-    :func:`~jik.engine.synthesis_nd.best_frame_axes`), computed on first call."""
+    :func:`~jik.engine.kernel_frame.best_frame_axes`), computed on first call."""
     return functools.cache(lambda: _maps(kin, box, fix, degree, key, axes))
 
 

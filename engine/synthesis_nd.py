@@ -15,7 +15,7 @@ E1^-1 E2 - I_p of eq. (18) is [[0, 0], [dh J^#, dh K - I]], so eq. (18) is
 tr(dh P dh^T - 2 dh K + I) m: a sum over the components h_i of the scalar functional with the load
 m K_i, each minimised independently (they share the stiffness matrix). Its Euler equations are the
 p - r decoupled linear elliptic equations (20). The frame is not unique; the one used here is given
-by :func:`kernel_frame` (``docs/e2-vector.md`` derives all of this).
+by :func:`~jik.engine.kernel_frame.kernel_frame` (``docs/e2-vector.md`` derives all of this).
 
 The constant mode is left out (E2 depends on dh only): each h_i has zero mean over the rule's
 nodes up to the quadrature error. Natural boundary conditions, as in :mod:`jik.engine.variational`.
@@ -23,7 +23,6 @@ nodes up to the quadrature error. Natural boundary conditions, as in :mod:`jik.e
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -31,7 +30,8 @@ from scipy import linalg
 
 from .exceptions import InvalidInputError, KinematicSingularityError
 from .functionals import Region, check_region
-from .inverses import pseudoinverse, require_kinematics
+from .inverses import require_kinematics
+from .kernel_frame import frame_axes_of, kernel_frame
 from .kinematics import Kinematics
 from .progress import Progress, check_cancelled, check_progress
 from .synthesis_nd_result import TotalDegreeSynthesis
@@ -63,51 +63,6 @@ def chunk_for(unknowns: int, variables: int) -> int:
     :data:`CHUNK_BYTES` (at least 64 nodes)."""
     fits = CHUNK_BYTES // (8 * unknowns * variables)
     return max(64, min(CHUNK, 1 << max(0, int(fits).bit_length() - 1)))
-
-
-def kernel_frame(kinematics: Kinematics, x: FloatArray, axes: Sequence[int] | None = None):
-    """An orthonormal frame K(x) (..., p, p - r) of the kernel of J(x), and J(x)'s pseudoinverse.
-
-    One degree of redundancy: K is the robot's unit kernel vector (:meth:`Kinematics.kernel`,
-    the paper's orientation). More: K = N E (E^T N E)^(-1/2), with N = I - J^# J the kernel
-    projector and E the coordinate axes ``axes`` (default: the last p - r joints). Among the
-    orthonormal frames of the kernel it is the one closest to E in the Frobenius norm (the polar
-    factor of N E); it is smooth wherever E^T N E is invertible and reduces to the paper's
-    convention (last component positive) for p - r = 1 with E = e_p.
-    """
-    J = kinematics.jacobian(x)
-    Jp = pseudoinverse(J)
-    p, m = kinematics.p, kinematics.p - kinematics.r
-    if m == 1:
-        return kinematics.kernel(x)[..., None], Jp
-    axes = list(range(p - m, p)) if axes is None else [int(a) for a in axes]
-    Nproj = np.eye(p) - Jp @ J
-    NE = Nproj[..., :, axes]  # (..., p, m)
-    G = NE[..., axes, :]  # E^T N E, (..., m, m), symmetric positive semidefinite
-    lam, U = np.linalg.eigh(G)
-    if np.any(lam <= 1e-12):
-        raise InvalidInputError(
-            f"the kernel frame on joints {[a + 1 for a in axes]} is degenerate in the region "
-            "(the kernel has no component along them); choose other frame axes",
-            "frame_axes",
-        )
-    inv_sqrt = (U / np.sqrt(lam)[..., None, :]) @ np.swapaxes(U, -1, -2)
-    return NE @ inv_sqrt, Jp
-
-
-def best_frame_axes(kin: Kinematics, box: Mapping, fix: Mapping) -> list[int]:
-    """The p - r joints (1-based) whose axes give the best-conditioned kernel frame at the box's
-    centre: the largest least eigenvalue of E^T N E (:func:`kernel_frame`;
-    the frame is degenerate where it is 0), over every choice of p - r joints at once."""
-    names = kin.names
-    x = np.array([fix.get(n, 0.0) for n in names], dtype=float)
-    for n, (lo, hi) in box.items():
-        x[names.index(n)] = 0.5 * (lo + hi)
-    J = np.asarray(kin.jacobian(x), dtype=float)
-    N = np.eye(kin.p) - np.linalg.pinv(J) @ J
-    choices = np.array(list(itertools.combinations(range(kin.p), kin.p - kin.r)))
-    least = np.linalg.eigvalsh(N[choices[:, :, None], choices[:, None, :]])[:, 0]
-    return [int(a) + 1 for a in choices[int(np.argmax(least))]]
 
 
 class _Rule:
@@ -178,8 +133,10 @@ def synthesize_e2_nd(
     seed : int
         Seed of the scrambling, 0 to 2^63 - 1 (the result is a deterministic function of it).
     frame_axes : sequence of int, optional
-        1-based joints whose axes fix the kernel frame for p - r >= 2 (:func:`kernel_frame`);
-        default: the best conditioned at the box's centre (:func:`best_frame_axes`).
+        1-based joints whose axes fix the kernel frame for p - r >= 2
+        (:func:`~jik.engine.kernel_frame.kernel_frame`);
+        default: the best conditioned at the box's centre
+        (:func:`~jik.engine.kernel_frame.best_frame_axes`).
     convergence_degrees : sequence of int
         Lower total degrees whose Ritz values are reported too.
     progress : Progress, optional
@@ -213,15 +170,7 @@ def synthesize_e2_nd(
             f"variables, got {nodes}",
             "nodes",
         )
-    axes = None
-    if m_red > 1:
-        axes = (
-            [a - 1 for a in best_frame_axes(kinematics, box, fix)]
-            if frame_axes is None
-            else [count(a, "frame_axes", 1, kinematics.p) - 1 for a in frame_axes]
-        )
-        if len(set(axes)) != m_red:
-            raise InvalidInputError(f"frame_axes needs {m_red} distinct joints", "frame_axes")
+    axes = frame_axes_of(kinematics, box, fix, frame_axes)
     levels = sorted(
         {
             count(n, "convergence degree", 1, degree, "convergence_degrees")

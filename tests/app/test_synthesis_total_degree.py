@@ -9,8 +9,9 @@ import math
 import numpy as np
 import pytest
 
+from jik.engine.kernel_frame import best_frame_axes
 from jik.engine.robot_spec import robot_from_dict
-from jik.engine.synthesis_nd import best_frame_axes, synthesize_e2_nd
+from jik.engine.synthesis_nd import synthesize_e2_nd
 from jik.engine.total_degree import TotalDegreeMap
 from tests.app.conftest import messages
 

@@ -116,8 +116,8 @@ def test_e2_variational_shows_e2_against_the_degree_as_the_python_synthesis_does
 def test_default_frame_axes_are_the_best_conditioned_as_the_schema_says(api):
     """Without frame_axes a p - r = 2 synthesis takes the joints best conditioned at the box's
     centre (here 2 and 4, not the last two); the field's description said 'the last p - r'."""
+    from jik.engine.kernel_frame import best_frame_axes
     from jik.engine.robot_spec import robot_from_dict
-    from jik.engine.synthesis_nd import best_frame_axes
 
     robot = {"name": "formula", "variables": ["a", "b", "c", "d"]}
     robot["task"] = [f"{f}(a)+{f}(a+b)+{f}(a+b+c)+0.7*{f}(a+b+c+d)" for f in ("cos", "sin")]

@@ -47,17 +47,20 @@ def test_closed_form_of_a_linear_map():
 
 
 def test_bad_input_names_its_field_and_cancel_stops():
+    res = synthesize_e2_nd(CHAIN, REGION, degree=2, nodes=2**12)
+    with pytest.raises(InvalidInputError, match="needs p - r = 2 augmenting maps, got 1") as err:
+        e2_qmc(Linear(np.eye(2, 4)), res.maps[0], {"x1": (0, 1)})
+    assert err.value.field == "amap"
     with pytest.raises(InvalidInputError) as err:
-        e2_qmc(Linear(np.eye(2, 4)), None, {"x1": (0, 1)})
-    assert err.value.field == "robot"
+        e2_qmc(CHAIN, None, REGION)
+    assert err.value.field == "amap"
     with pytest.raises(InvalidInputError) as err:
-        e2_qmc(CHAIN, None, REGION, nodes=1000)
+        e2_qmc(CHAIN, res.maps[0], REGION, nodes=1000)
     assert err.value.field == "nodes"
     calls = []
     progress = ProgressCallbacks(
         on_advance=lambda done, total: calls.append(done), is_cancelled=lambda: len(calls) >= 2
     )
-    res = synthesize_e2_nd(CHAIN, REGION, degree=2, nodes=2**12)
     with pytest.raises(RunCancelled):
         e2_qmc(CHAIN, res.maps[0], REGION, nodes=2**12, progress=progress)
     assert len(calls) == 2

@@ -12,15 +12,12 @@ from jik.engine.functional_report import (
     QMC_SEED,
     functionals_report,
     maps_report,
+    parameter_sensitivity,
     parameters_report,
     region_words,
     report_words,
 )
-from jik.engine.functionals import (
-    error_functional_e1,
-    error_functional_e2,
-    parameter_sensitivity,
-)
+from jik.engine.functionals import error_functional_e1, error_functional_e2
 from jik.engine.kinematics import Manipulator1, Manipulator2
 from jik.engine.progress import ProgressCallbacks
 from jik.engine.synthesis_nd import synthesize_e2_nd

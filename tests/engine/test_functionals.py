@@ -9,12 +9,12 @@ from scipy import integrate
 from jik.engine.augmentations import AugmentingMap, E1Optimal, E2Optimal, PaperCubic, Polynomial2
 from jik.engine.exceptions import InvalidInputError, RunCancelled
 from jik.engine.formula_kinematics import FormulaMap
+from jik.engine.functional_report import parameter_sensitivity
 from jik.engine.functionals import (
     e1_integrand,
     e2_integrand,
     error_functional_e1,
     error_functional_e2,
-    parameter_sensitivity,
     quadrature,
 )
 from jik.engine.inverses import pseudoinverse

@@ -86,7 +86,7 @@ def test_a_definitions_vector_map_is_synthesized_and_repeatable():
 def test_the_default_frame_of_a_vector_synthesis_is_the_best_conditioned():
     """The Panda with a position task (p - r = 4): the last four joints' frame is degenerate at
     home (the kernel has no component along them), the default frame is not."""
-    from jik.engine.synthesis_nd import best_frame_axes
+    from jik.engine.kernel_frame import best_frame_axes
 
     robot = robot_from_dict({"name": "panda", "task": "xyz"})
     kin, x = robot.kinematics, np.array(robot.spec.default_x0)

@@ -8,10 +8,11 @@ import pytest
 from jik.engine import synthesis_nd
 from jik.engine.exceptions import InvalidInputError, RunCancelled
 from jik.engine.functionals import error_functional_e2
+from jik.engine.kernel_frame import kernel_frame
 from jik.engine.kinematics import Kinematics, Manipulator2
 from jik.engine.planar_chain import PlanarChain
 from jik.engine.progress import ProgressCallbacks
-from jik.engine.synthesis_nd import MAIN_PASS, chunk_for, kernel_frame, synthesize_e2_nd
+from jik.engine.synthesis_nd import MAIN_PASS, chunk_for, synthesize_e2_nd
 from jik.engine.total_degree import basis_size, total_degree_indices
 from jik.engine.variational import MANIPULATOR2_REGION, synthesize_e2
 

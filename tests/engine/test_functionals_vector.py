@@ -1,0 +1,121 @@
+"""E1 (13) and E2 (18) of a vector of p - r >= 2 maps (docs/e2-vector.md): by the tensor Gauss
+rule and the Sobol rule, against the definitions computed another way (a dense inverse of
+[J; dh], the kernel frame by an SVD), with the frame E2 depends on named."""
+
+import numpy as np
+import pytest
+
+from jik.engine.e2_qmc import e2_qmc
+from jik.engine.exceptions import InvalidInputError
+from jik.engine.formula_kinematics import FormulaMap
+from jik.engine.functional_report import functionals_report
+from jik.engine.functionals import error_functional_e1, error_functional_e2, quadrature
+from jik.engine.kernel_frame import best_frame_axes
+from jik.engine.planar_chain import PlanarChain
+from jik.engine.synthesis_nd import synthesize_e2_nd
+
+CHAIN = PlanarChain("RRRR", [1.0, 1.0, 1.0, 1.0])  # a position task: p - r = 2
+NAMES = list(CHAIN.names)
+MAPS = [FormulaMap("x3 + 0.1*x1**2", NAMES), FormulaMap("x4 - 0.2*sin(x2)", NAMES)]
+REGION = {"x2": (0.3, 1.2), "x3": (0.4, 1.3), "x4": (0.2, 1.0)}
+
+
+def by_definition(maps, region, axes, nodes=8):
+    """E1 = sum w ||J^# - [J; dh]^-1 [I_r; 0]||^2 and E2 = sum w ||[J; dh] [J^#, K] - I||^2 m
+    on the Gauss rule, with K the polar factor of N E by an SVD (E: the 1-based ``axes``)."""
+    x, w, _, _ = quadrature(CHAIN, region, nodes)
+    J = CHAIN.jacobian(x)
+    dh = np.stack([m.gradient(x) for m in maps], axis=-2)
+    Jbar = np.concatenate([J, dh], axis=-2)
+    Jp = np.linalg.pinv(J)
+    e1 = np.sum((Jp - np.linalg.inv(Jbar)[..., :, : CHAIN.r]) ** 2, axis=(-1, -2))
+    NE = (np.eye(CHAIN.p) - Jp @ J)[..., :, [a - 1 for a in axes]]
+    U, _, Vt = np.linalg.svd(NE, full_matrices=False)
+    E2 = np.concatenate([Jp, U @ Vt], axis=-1)
+    m = np.sqrt(np.linalg.det(J @ np.swapaxes(J, -1, -2)))
+    e2 = np.sum((Jbar @ E2 - np.eye(CHAIN.p)) ** 2, axis=(-1, -2)) * m
+    return float(w @ e1), float(w @ e2)
+
+
+@pytest.mark.parametrize("axes", [[3, 4], [2, 4], [1, 3]])
+def test_both_functionals_are_their_definitions_in_any_frame(axes):
+    e1 = error_functional_e1(CHAIN, MAPS, REGION, nodes=8)
+    e2 = error_functional_e2(CHAIN, MAPS, REGION, nodes=8, frame_axes=axes)
+    want1, want2 = by_definition(MAPS, REGION, axes)
+    assert e1.value == pytest.approx(want1, rel=1e-12)
+    assert e2.value == pytest.approx(want2, rel=1e-12)
+    assert e2.frame_axes == tuple(axes) and e1.frame_axes == ()
+    assert f"frame axes {axes}" in repr(e2) and e2.as_dict()["frame_axes"] == axes
+
+
+def test_e2_depends_on_the_frame_and_takes_the_best_conditioned_by_default():
+    values = {
+        tuple(a): error_functional_e2(CHAIN, MAPS, REGION, nodes=8, frame_axes=a).value
+        for a in ([3, 4], [2, 4], [1, 3])
+    }
+    assert max(values.values()) > 2 * min(values.values())  # (not a choice that can be hidden)
+    default = error_functional_e2(CHAIN, MAPS, REGION, nodes=8)
+    best = best_frame_axes(CHAIN, REGION, {"x1": 0.0})
+    assert list(default.frame_axes) == best
+    assert default.value == values[tuple(best)]
+
+
+def test_the_sobol_rule_is_the_vector_synthesis_rule():
+    """On the synthesis's check rule (seed 1) and frame, E2 of the synthesized maps is its
+    ``e2_check``; the tensor rule gives E2 within the quadrature error, E1 below the formulas'."""
+    res = synthesize_e2_nd(CHAIN, REGION, degree=3, nodes=2**12)
+    axes = [a + 1 for a in res.frame_axes]
+    q = e2_qmc(CHAIN, res.maps, REGION, nodes=2**12, seed=1, frame_axes=axes)
+    assert q["E2"] == pytest.approx(res.e2_check, rel=1e-12)
+    assert q["frame_axes"] == axes and q["single_joint"] == {}
+    tensor = error_functional_e2(CHAIN, res.maps, REGION, nodes=12, frame_axes=axes)
+    assert tensor.value == pytest.approx(res.e2_check, rel=1e-3)
+    formulas = error_functional_e2(CHAIN, MAPS, REGION, nodes=12, frame_axes=axes)
+    assert tensor.value < formulas.value
+
+
+def test_e1_diverges_where_the_extended_jacobian_loses_rank_inside():
+    """dh_2 = (x3 - 0.8) e_3 vanishes on x3 = 0.8, inside the box: [J; dh] is singular there."""
+    maps = [MAPS[0], FormulaMap("(x3 - 0.8)**2 / 2", NAMES)]
+    e1 = error_functional_e1(CHAIN, maps, REGION, nodes=8)
+    assert e1.divergent and e1.value == float("inf")
+    assert not error_functional_e1(CHAIN, MAPS, REGION, nodes=8).divergent
+
+
+def test_the_report_names_the_frame_by_either_rule():
+    tensor = functionals_report(CHAIN, MAPS, REGION, nodes=8)
+    want1, want2 = by_definition(MAPS, REGION, tensor["E2_frame_axes"])
+    assert tensor["E1"] == pytest.approx(want1, rel=1e-12)
+    assert tensor["E2"] == pytest.approx(want2, rel=1e-12)
+    whole = dict(REGION, x1=(-0.3, 0.3))
+    sobol = functionals_report(CHAIN, MAPS, whole, nodes=8, frame_axes=[3, 4])
+    assert sobol["E1"] is None and sobol["E2_single_joint"] is None
+    assert sobol["E2_frame_axes"] == [3, 4] and "kernel frame on joints [3, 4]" in sobol["note"]
+    assert sobol["E2"] == pytest.approx(
+        e2_qmc(CHAIN, MAPS, whole, frame_axes=[3, 4])["E2"], rel=1e-15
+    )
+
+
+@pytest.mark.parametrize(
+    "call, field, words",
+    [
+        (lambda: error_functional_e2(CHAIN, MAPS[:1], REGION), "augmenting_map", "got 1"),
+        (
+            lambda: error_functional_e1(CHAIN, [MAPS[0], "x4"], REGION),
+            "augmenting_map.1",
+            "Formula",
+        ),
+        (
+            lambda: error_functional_e2(CHAIN, MAPS, REGION, frame_axes=[3, 3]),
+            "frame_axes",
+            "2 dis",
+        ),
+        (lambda: error_functional_e2(CHAIN, MAPS, REGION, frame_axes=[3, 9]), "frame_axes", "4"),
+        (lambda: error_functional_e2(CHAIN, MAPS, REGION, frame_axes="34"), "frame_axes", "list"),
+        (lambda: functionals_report(CHAIN, MAPS[0], REGION), "amap", "p - r = 2"),
+    ],
+)
+def test_refusals_name_the_argument(call, field, words):
+    with pytest.raises(InvalidInputError, match=words) as err:
+        call()
+    assert err.value.field == field
