@@ -133,7 +133,7 @@ def sensitivity(
     Over the same box and fixed variables as ``functionals`` (see :func:`error_functionals`):
 
     * a map with parameters (C1, C2 or a, b): ``{"kind": "parameters", "parameters": {...},
-      "E1": ..., "E2": ...}``, each from :func:`jik.engine.functionals.parameter_sensitivity`
+      "E1": ..., "E2": ...}``, each from :func:`jik.engine.functional_report.parameter_sensitivity`
       (the value, the gradient and a sweep of every parameter over v - 1 .. v + 1);
     * a map without parameters: ``{"kind": "alternatives", "maps": [{"name", "E1", "E2",
       "current"}]}``, the functionals of every map the robot offers, at their defaults;

@@ -81,7 +81,7 @@ class SynthesizeRequest(BaseModel):
         None,
         description="'e2_total_degree' with p - r >= 2: the p - r joints (1-based) whose axes "
         "fix the kernel frame (default: those best conditioned at the box's centre, "
-        "engine.synthesis_nd.best_frame_axes; total_degree.frame_axes says which)",
+        "engine.kernel_frame.best_frame_axes; total_degree.frame_axes says which)",
     )
     grid: Annotated[int, Field(strict=True, ge=3, le=61), INTEGRAL] = Field(
         21, description="grid points per axis for h"
