@@ -311,7 +311,8 @@ def user_inverse(robot: Robot, algorithm: str, algorithm_parameters: dict | None
 
 
 def user_map(robot: Robot) -> tuple[Any, S.AugmentationUsed]:
-    """The one map h a user robot's 'evaluate' request gives, built; what it used."""
+    """The map h a user robot's 'evaluate' request gives, built (for p - r >= 2 the tuple of
+    its p - r maps, a synthesis made here); what it used."""
     spec = robot.spec
     if not spec.augmentations:
         raise RequestError(
@@ -319,14 +320,13 @@ def user_map(robot: Robot) -> tuple[Any, S.AugmentationUsed]:
             "'evaluate' needs the map to evaluate: {'name': "
             "'formula', 'h': ...} or {'name': 'e2_synthesized', 'region': {...}}",
         )
-    if spec.p != spec.r + 1:
-        raise RequestError(
-            "augmentation",
-            f"'evaluate' takes one map h and E1, E2 need p = r + 1; this {spec.name} robot has "
-            f"p = {spec.p}, r = {spec.r}",
-        )
+    amap: Any
     try:
-        amap = spec.augmentations[0].build(robot.kinematics)
+        if spec.p > spec.r + 1:
+            vector = robot.map_vectors[spec.augmentations[0].name]
+            amap = tuple(vector() if callable(vector) else vector)
+        else:
+            amap = spec.augmentations[0].build(robot.kinematics)
     except JikError as exc:
         raise RequestError(request_field(getattr(exc, "field", None), ()), str(exc)) from None
     return amap, cast(S.AugmentationUsed, map_used(robot))  # (the robot has a map: above)

@@ -24,6 +24,7 @@ from . import schemas as S
 from .documents import nullable
 from .exceptions import RequestError
 from .robot_requests import request_robot
+from .schemas.wording import without_field
 
 
 def synthesis_methods() -> S.SynthesisMethodsResponse:
@@ -53,16 +54,28 @@ def synthesis_region(spec: RobotSpec, kin: Kinematics, req: S.SynthesizeRequest)
     return list(spec.variable_names), region, fixed
 
 
-def _functionals(kin, amap, region, fixed, nodes) -> tuple[dict, list[str]]:
+def _functionals(kin, amap, region, fixed, nodes, frame_axes=None) -> tuple[dict, list[str]]:
+    """E1 (13) and E2 (18) of ``amap`` (a map, or a tuple of p - r maps: E2 in the kernel frame
+    of ``frame_axes``, default the best conditioned) by the Gauss rule, and what the message
+    says of them."""
     notes: list[str] = []
     out: dict[str, S.FunctionalInfo | None] = {}
-    for label, fn in (("e1", error_functional_e1), ("e2", error_functional_e2)):
+    for label in ("e1", "e2"):
         try:
-            value = fn(kin, amap, region, nodes=nodes, fixed=fixed)
+            if label == "e1":
+                value = error_functional_e1(kin, amap, region, nodes=nodes, fixed=fixed)
+            else:
+                value = error_functional_e2(
+                    kin, amap, region, nodes=nodes, fixed=fixed, frame_axes=frame_axes
+                )
             out[label] = S.FunctionalInfo.model_validate(value.as_dict())
             if value.divergent:
-                notes.append(f"{label.upper()} diverges: dh K vanishes inside the region")
+                notes.append(f"{label.upper()} diverges: det(dh K) vanishes inside the region")
+            if value.frame_axes:
+                notes.append(f"E2 in the kernel frame of joints {list(value.frame_axes)}")
         except JikError as exc:
+            if getattr(exc, "field", None) == "frame_axes":
+                raise RequestError("frame_axes", without_field(str(exc), "frame_axes")) from None
             out[label] = None
             notes.append(f"{label.upper()} not evaluated: {exc}")
     return out, notes
@@ -114,7 +127,7 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         amap, aug_used = robot.augmenting_map()  # (the request's map, else the robot's default)
         coefficients = amap.monomials() if isinstance(amap, Polynomial2) else {}
         nodes = req.nodes
-    functionals, more = _functionals(kin, amap, region, fixed, nodes)
+    functionals, more = _functionals(kin, amap, region, fixed, nodes, req.frame_axes)
     return map_response(
         req,
         robot_used,
@@ -151,6 +164,8 @@ def singularities(
     it was searched: not for a map that solves a problem per point (a characteristic's, eq.
     (28): seconds for a grid), as the dashboard does not either, nor where the search does
     not apply (a vector of maps, too large a grid)."""
+    if isinstance(amap, tuple):
+        return None, ["singularities of h not searched: h is a vector of maps"], False
     if amap.solves_per_point:
         return None, ["singularities of h not searched: each value of h solves a problem"], False
     try:
@@ -169,10 +184,13 @@ def map_response(
     """The response of a synthesis whose map h is ``amap`` on ``box`` (the variables' names,
     the region, the values of the others: :func:`jik.engine.functionals.check_region`'s): h
     on the grid and where it is singular, the message ``notes`` and what the search says, with
-    the method's own ``fields``."""
+    the method's own ``fields``. A tuple of p - r maps shows h_1 on the grid, unsearched."""
     names, region, fixed = box
     all_fixed = {n: float(fixed[n]) for n in names if n not in region}
     found, said, searched = singularities(kin, amap, region, all_fixed, req.nodes)
+    if isinstance(amap, tuple):  # (p - r >= 2: a vector of maps)
+        notes = [*notes, f"{len(amap)} maps h_1 ... h_{len(amap)}; the grid shows h_1"]
+        amap = amap[0]
     return S.SynthesizeResponse(
         robot=robot_used,
         method=req.method,
@@ -206,9 +224,8 @@ def total_degree_response(
             convergence_degrees=range(1, degree),
         )
     except JikError as exc:
-        raise RequestError(
-            _FIELDS.get(getattr(exc, "field", None) or "", "region"), str(exc)
-        ) from None
+        field = getattr(exc, "field", None) or ""
+        raise RequestError(_FIELDS.get(field, "region"), without_field(str(exc), field)) from None
     info: dict[str, Any] = {
         k: v for k, v in res.as_dict().items() if k not in ("region", "fixed", "convergence")
     }
@@ -224,14 +241,12 @@ def total_degree_response(
             f"the best single joint, h = {'-' if best['sign'] < 0 else ''}{j}, has "
             f"E2 {best['e2']:.6g}"
         )
-    if len(res.maps) > 1:
-        notes.append(f"{len(res.maps)} maps h_1 ... h_{len(res.maps)}; the grid shows h_1")
     notes.append("E1 is not evaluated (its Gauss rule grows as nodes^d)")
     return map_response(
         req,
         robot_used,
         kin,
-        res.maps[0],
+        res.maps if len(res.maps) > 1 else res.maps[0],
         (names, res.region, {**fixed, **res.fixed}),
         notes,
         augmentation=S.AugmentationUsed(
@@ -246,7 +261,11 @@ def total_degree_response(
         functionals={
             "e1": None,
             "e2": S.FunctionalInfo(
-                value=nullable(res.e2_check), n_points=res.nodes, n_singular=0, min_abs_dh_k=None
+                value=nullable(res.e2_check),
+                n_points=res.nodes,
+                n_singular=0,
+                min_abs_dh_k=None,
+                frame_axes=[a + 1 for a in res.frame_axes] or None,
             ),
         },
         convergence=[{k: float(v) for k, v in row.items()} for row in res.convergence],

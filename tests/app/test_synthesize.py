@@ -133,6 +133,46 @@ def test_default_frame_axes_are_the_best_conditioned_as_the_schema_says(api):
     assert "best conditioned" in described and "last p - r" not in described
 
 
+def test_evaluate_takes_a_vector_of_maps_and_names_the_frame_of_e2(api):
+    """A planar 4R chain with a position task (p - r = 2) and two formula maps: E1 and E2 as the
+    engine gives them, E2 in the best-conditioned frame or the one asked for; frame_axes wrong
+    is a 422 at its field."""
+    from jik.engine.formula_kinematics import FormulaMap
+    from jik.engine.functionals import error_functional_e1
+    from jik.engine.planar_chain import PlanarChain
+
+    h = ["x3 + 0.1*x1**2", "x4 - 0.2*sin(x2)"]
+    box = {"x2": [0.3, 1.2], "x3": [0.4, 1.3], "x4": [0.2, 1.0]}
+    body = {
+        "robot": {"name": "planar_chain", "joints": "RRRR", "lengths": [1.0] * 4},
+        "method": "evaluate",
+        "augmentation": {"name": "formula", "h": h},
+        "region": box,
+        "fixed": {"x1": 0.0},
+    }
+    kin = PlanarChain("RRRR", [1.0] * 4)
+    maps = [FormulaMap(f, kin.names) for f in h]
+    for axes in (None, [3, 4]):
+        r = api.post("/synthesize", json=body | ({"frame_axes": axes} if axes else {}))
+        assert r.status_code == 200, r.text
+        b = r.json()
+        e2 = error_functional_e2(kin, maps, box, nodes=8, fixed={"x1": 0.0}, frame_axes=axes)
+        assert b["functionals"]["e2"]["value"] == e2.value
+        assert b["functionals"]["e2"]["frame_axes"] == list(e2.frame_axes) == (axes or [2, 4])
+        assert b["functionals"]["e1"]["value"] == error_functional_e1(kin, maps, box, nodes=8).value
+        assert (
+            f"E2 in the kernel frame of joints {e2.frame_axes and list(e2.frame_axes)}"
+            in (b["message"])
+        )
+        assert "2 maps h_1 ... h_2; the grid shows h_1" in b["message"]
+        assert b["singularities_searched"] is False and list(b["grid"]["axes"]) == ["x2", "x3"]
+    for axes, words in (([3, 3], "needs 2 distinct joints"), ([3, 9], "between 1 and 4")):
+        r = api.post("/synthesize", json=body | {"frame_axes": axes})
+        assert r.status_code == 422, r.text
+        detail = r.json()["detail"][0]
+        assert detail["loc"] == ["body", "frame_axes"] and words in detail["msg"]
+
+
 def test_synthesize_bad_input(api):
     def msg(body):
         r = api.post("/synthesize", json=body)
@@ -224,10 +264,7 @@ def test_a_synthesized_map_is_searched_and_a_vector_of_maps_is_said_not_to_be(ap
     body = {"robot": chain, "method": "e2_total_degree", "degree": 2, "qmc_nodes": 256}
     b = api.post("/synthesize", json=body).json()
     assert b["singularities"] is None and b["singularities_searched"] is False
-    assert (
-        "singularities of h not searched: map_singularities: one augmenting map needs one degree"
-        in b["message"]
-    )
+    assert "singularities of h not searched: h is a vector of maps" in b["message"]
 
 
 def test_a_map_that_solves_a_problem_per_point_is_not_searched(api):

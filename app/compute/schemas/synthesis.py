@@ -79,9 +79,10 @@ class SynthesizeRequest(BaseModel):
     seed: Seed = Field(0, description="'e2_total_degree': seed of the Sobol rule's scrambling")
     frame_axes: FrameAxes | None = Field(
         None,
-        description="'e2_total_degree' with p - r >= 2: the p - r joints (1-based) whose axes "
-        "fix the kernel frame (default: those best conditioned at the box's centre, "
-        "engine.kernel_frame.best_frame_axes; total_degree.frame_axes says which)",
+        description="p - r >= 2, 'e2_total_degree' and 'evaluate': the p - r joints (1-based) "
+        "whose axes fix the kernel frame of E2 (default: those best conditioned at the box's "
+        "centre, engine.kernel_frame.best_frame_axes; functionals.e2.frame_axes and "
+        "total_degree.frame_axes say which)",
     )
     grid: Annotated[int, Field(strict=True, ge=3, le=61), INTEGRAL] = Field(
         21, description="grid points per axis for h"
@@ -122,7 +123,12 @@ class FunctionalInfo(BaseModel):
     min_abs_dh_k: MaybeFloat
     divergent: bool = Field(
         default=False,
-        description="E1 diverges: dh K vanishes inside the region (eq. (14)); value is null",
+        description="E1 diverges: det(dh K) vanishes inside the region (eq. (14)); value is null",
+    )
+    frame_axes: list[int] | None = Field(
+        None,
+        description="E2 of a vector of p - r >= 2 maps: the joints (1-based) whose axes fix the "
+        "kernel frame E2 depends on (engine.kernel_frame); null otherwise",
     )
 
 
