@@ -107,7 +107,7 @@ def functionals_report(
             if progress is not None:
                 progress.advance(k, 2)
         return out
-    large = f"a tensor rule over the {len(region)} variables of the design region is too large"
+    large = f"a tensor rule over the {len(region)} variables of the region is too large"
     try:
         e2 = e2_qmc(
             kinematics,
@@ -137,7 +137,7 @@ def functionals_report(
         "E2": e2["E2"],
         "E2_single_joint": e2["single_joint"] or None,
         "E2_rule": {"kind": "sobol", "nodes": QMC_NODES, "seed": QMC_SEED},
-        "note": f"E2 = {value} on the design box (Sobol rule, {QMC_NODES} nodes"
+        "note": f"E2 = {value} on the region (Sobol rule, {QMC_NODES} nodes"
         f"{frame_words}); E1 not computed over {len(region)} joints",
     } | ({} if frame is None else {"E2_frame_axes": frame})
 

@@ -40,13 +40,19 @@ def kinematics_and_map(state: DashboardState, kin=None):
 SYNTHESIZING = "synthesizing h (E2, eq. (19))"
 
 
+def vector_maps(state: DashboardState) -> tuple | None:
+    """For p - r > 1, the state's vector of p - r maps (h_1, ..., h_(p-r)), built (a synthesis
+    on its first use); None for one map."""
+    spec = state_spec(state)
+    maps = state_robot(state).map_vectors.get(state.augmentation) if spec.p > spec.r + 1 else None
+    return None if maps is None else tuple(maps() if callable(maps) else maps)
+
+
 def state_maps(state: DashboardState) -> tuple:
     """:func:`kinematics_and_map` of ``state``, its vector of maps built too (p - r > 1)."""
     kin, amap = kinematics_and_map(state)
-    if amap is None:  # (p - r > 1: a synthesized vector, built)
-        maps = state_robot(state).map_vectors.get(state.augmentation)
-        if callable(maps):
-            maps()
+    if amap is None:
+        vector_maps(state)
     return kin, amap
 
 
@@ -93,15 +99,16 @@ def built_map(
 
 
 def vector_note(state: DashboardState) -> str | None:
-    """What the panels of one scalar h say for a robot with p - r > 1 (None for p = r + 1)."""
+    """What the h panel, drawn for one scalar h, says for a robot with p - r > 1 (None for
+    p = r + 1)."""
     spec = state_spec(state)
     if spec.p - spec.r <= 1:
         return None
     h = spec.augmentation(state.augmentation).description
     return (
         f"{h}: a vector of p − r = {spec.p - spec.r} maps, each kept constant by the "
-        "extended inverse (eq. (12)); the h panel, E1 (13) and E2 (18) are for one "
-        "degree of redundancy (p = r + 1)"
+        "extended inverse (eq. (12)); the h panel draws one map (p = r + 1), the E1/E2 "
+        "panel scores the vector"
     )
 
 

@@ -19,9 +19,9 @@ from ...engine.functional_report import (
 )
 from ...engine.progress import ProgressCallbacks
 from .algorithms import cache_key
-from .analysis import expensive_map, kinematics_and_map, vector_note
+from .analysis import expensive_map, kinematics_and_map, runs_box, vector_maps
 from .model import DashboardState, robot_and_map
-from .robots import state_spec
+from .robots import state_kinematics, state_spec
 from .runs import Cancelled, DashboardResult
 
 _inert_cache: dict[str, frozenset[int]] = {}
@@ -74,20 +74,29 @@ def error_functionals(
     cancelled: Callable[[], bool] = lambda: False,
 ) -> dict | None:
     """E1 (13) and E2 (18) of the current map, or None if unavailable: over the robot's design
-    region from the registry (the boxes of sec. 5) where it has one, else over the heat-map box.
+    region from the registry (the boxes of sec. 5) where it has one, else over the heat-map box;
+    a vector of p - r > 1 maps (E2 in the kernel frame the report names) over every joint, in
+    the box of the runs (:func:`~jik.app.dashboard.analysis.runs_box`).
     ``on_advance(done, total)`` as the engine's
     :func:`~jik.engine.functional_report.functionals_report` advances (what it raises stops
     it), ``cancelled`` polled; over more than three variables, E2 by a Sobol rule.
     """
-    grid = result.augmenting
-    if grid is None:
+    grid, state, names = result.augmenting, result.state, result.variable_names
+    vector = vector_maps(state)
+    if grid is None and vector is None:
         return None
-    nodes = EXPENSIVE_NODES if expensive_map(grid["map"]) else NODES
-    names = result.variable_names
-    i, j = grid["axes"]
-    design = state_spec(result.state).functional_region
-    region = dict(design) or {names[i]: tuple(grid["box"][0]), names[j]: tuple(grid["box"][1])}
-    fixed = {n: float(result.state.x0[k]) for k, n in enumerate(names) if n not in region}
+    if vector is not None:  # (p - r > 1: over every joint, the Sobol rule past three)
+        kin, amap, nodes = state_kinematics(state), vector, NODES
+        low, high = runs_box(state, result.runs)
+        box = {n: (float(low[k]), float(high[k])) for k, n in enumerate(names)}
+    elif grid is not None:
+        kin, amap = grid["kinematics"], grid["map"]
+        nodes = EXPENSIVE_NODES if expensive_map(amap) else NODES
+        i, j = grid["axes"]
+        box = {names[i]: tuple(grid["box"][0]), names[j]: tuple(grid["box"][1])}
+    design = state_spec(state).functional_region
+    region = dict(design) or box
+    fixed = {n: float(state.x0[k]) for k, n in enumerate(names) if n not in region}
     out = {
         "region": {k: list(v) for k, v in region.items()},
         "fixed": fixed,
@@ -96,7 +105,6 @@ def error_functionals(
     }
     report = ProgressCallbacks(on_advance=on_advance, is_cancelled=cancelled)
     try:
-        kin, amap = grid["kinematics"], grid["map"]
         return out | functionals_report(kin, amap, region, fixed, nodes, report)
     except RunCancelled:
         raise Cancelled from None
@@ -137,17 +145,20 @@ def sensitivity(
       (the value, the gradient and a sweep of every parameter over v - 1 .. v + 1);
     * a map without parameters: ``{"kind": "alternatives", "maps": [{"name", "E1", "E2",
       "current"}]}``, the functionals of every map the robot offers, at their defaults;
+    * a vector of p - r > 1 maps: ``{"kind": "vector"}`` and ``functionals`` (no sweep: the
+      robot's maps are vectors of formulas or a synthesis);
     * ``{"kind": "unavailable", "reason": ...}`` when they cannot be evaluated here.
 
     ``cancelled`` is polled before every evaluation of a functional (raises :class:`Cancelled`);
     ``progress(done, total)`` follows each of the :func:`sensitivity_evaluations`.
     """
     grid = result.augmenting
-    if grid is None:
-        note = vector_note(result.state)
-        return {"kind": "unavailable", "reason": note or "h could not be evaluated on a grid"}
+    if grid is None and functionals is None:
+        return {"kind": "unavailable", "reason": "h could not be evaluated on a grid"}
     if functionals is None:
         return {"kind": "unavailable", "reason": "E1, E2 could not be evaluated"}
+    if grid is None:  # (a vector of maps)
+        return {"kind": "vector"} | functionals
     if functionals.get("E2_single_joint") is not None:  # (E2 by a Sobol rule, many joints)
         return single_joint_sensitivity(functionals)
     state = result.state

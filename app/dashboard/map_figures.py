@@ -231,6 +231,8 @@ def sensitivity_spec(
     log = dict(type="log", exponentformat="power")
     if sens["kind"] == "single_joint":
         return single_joint_spec(sens, aug, log)
+    if sens["kind"] == "vector":
+        return vector_spec(sens, map_name(result), log)
     if sens["kind"] == "alternatives":
         maps = sens["maps"]
         names = [m["name"] + (" (current)" if m["current"] else "") for m in maps]
@@ -352,3 +354,36 @@ def single_joint_spec(sens: dict, aug: str, log: dict) -> dict:
     lo, hi = (np.log10(min(known)) - 1, np.log10(max(known)) + 0.2) if known else (-3, 0)
     yaxis = dict(title="E2 (log)", range=[float(lo), float(hi)], **log, **log_ticks(values))
     return figure(data, title, yaxis=yaxis)
+
+
+def vector_spec(sens: dict, name: str, log: dict) -> dict:
+    """E1 (13) and E2 (18) of a vector of p - r > 1 maps ``name`` as two bars on a log scale,
+    the box, the rule and the kernel frame E2 was taken in (E1 by a tensor rule only, over at
+    most three joints: a missing bar says why)."""
+    values = {k: sens.get(k) for k in ("E1", "E2")}
+    data = [
+        trace(
+            "bar",
+            x=[f"{k} ({eq})"],
+            y=[values[k]],
+            name=k,
+            marker=dict(color=E_COLORS[k]),
+            hovertemplate=f"{k} = %{{y:.4g}}<extra></extra>",
+        )
+        for k, eq in (("E1", 13), ("E2", 18))
+    ]
+    n = len(sens["region"])
+    missing = {"E1": f"not computed over {n} joints" if n > 3 else "undefined", "E2": "undefined"}
+    if sens.get("E1_divergent"):
+        missing["E1"] = "= ∞ (det(dh K) = 0 inside)"
+    words = [
+        note(f"{k} {missing[k]}", f"{k} ({eq})", 0, color="#555", xref="x", yanchor="bottom")
+        for k, eq in (("E1", 13), ("E2", 18))
+        if values[k] is None
+    ]
+    where = region_words(sens["region"]) if sens["design_region"] else "the box of the runs"
+    frame = sens.get("E2_frame_axes")
+    sub = [f"on {where}"] + ([f"E2 in the kernel frame of joints {frame}"] if frame else [])
+    title = f"E1, E2 of the vector {name}" + "".join(f"<br><sup>{x}</sup>" for x in wrap(sub))
+    yaxis = dict(title="E (log)", **log, **log_ticks(values.values()))
+    return figure(data, title, showlegend=False, annotations=words, yaxis=yaxis)

@@ -11,7 +11,13 @@ from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
 
-from .analysis import augmenting_grid, expensive_map, grid_batches, kinematics_and_map
+from .analysis import (
+    augmenting_grid,
+    expensive_map,
+    grid_batches,
+    kinematics_and_map,
+    vector_note,
+)
 from .figures import figure_specs
 from .functionals import error_functionals, functionals_key, sensitivity, sensitivity_evaluations
 from .map_figures import augmenting_title
@@ -107,8 +113,8 @@ def finished_message(
     titles = {}
     if phase.deferred:  # the h panel was a placeholder: the whole figure
         panels.add("augmenting")
-    elif functionals is not None:  # h is on screen: only its title changes (no redraw)
-        titles["augmenting"] = augmenting_title(phase.result, functionals)
+    elif functionals is not None and phase.result.augmenting is not None:  # (h on screen)
+        titles["augmenting"] = augmenting_title(phase.result, functionals)  # (not redrawn)
     specs = figure_specs(phase.result, functionals, panels, sensitivity=sens)
     return _message(generation, functionals, sens, specs, titles=titles or None)
 
@@ -124,7 +130,7 @@ def cancelled_message(phase: SecondPhase, generation: int) -> str:
         panels.add("augmenting")
     specs = figure_specs(phase.result, None, panels, cancelled=note)
     titles = {}
-    if not phase.deferred and not phase.cached:
+    if not phase.deferred and not phase.cached and vector_note(phase.result.state) is None:
         titles["augmenting"] = augmenting_title(phase.result, None, note)
     shown = sorted(set(specs) | set(titles))
     cancelled = {"what": phase.what, "fraction": phase.fraction, "panels": shown}

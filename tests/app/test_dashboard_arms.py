@@ -163,7 +163,7 @@ def test_vector_maps_run_for_p_minus_r_two():
         assert result.runs["pseudoinverse"].drift[-1] > 1e-5
         assert max(result.runs["extended"].drift) < 1e-9
         panel = json.dumps(augmenting_spec(result), ensure_ascii=False).replace("<br>", " ")
-        assert "a vector of p − r = 2 maps" in panel and "for one degree of redundancy" in panel
+        assert "a vector of p − r = 2 maps" in panel and "the h panel draws one map" in panel
 
 
 def test_the_synthesis_reports_progress_and_a_newer_change_stops_it():

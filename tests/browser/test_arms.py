@@ -83,7 +83,8 @@ def test_the_panda_with_its_pose_task(tabs):
 def test_the_panda_with_a_position_task_and_four_formula_maps(tabs):
     """p - r = 4: from the robot editor, the Panda's task "xyz" with h = (x2, x3, x5, x7); a
     closed path of 3-coordinate points typed in the path box; the extended inverse comes back,
-    the pseudoinverse does not, and the h panel says what it shows for p - r > 1."""
+    the pseudoinverse does not, the h panel says what it shows for p - r > 1 and the E1/E2
+    panel gives E2 of the vector."""
     tab = tabs.open(scene=False)
     page = tab.page
     tab.select("#ctl-robot", "panda")
@@ -101,3 +102,8 @@ def test_the_panda_with_a_position_task_and_four_formula_maps(tabs):
     assert max(summary["extended"]["drift"]) < 1e-9
     assert summary["extended"]["h_change"] < 1e-9  # (each of the four components is conserved)
     expect(page.locator("#plot-augmenting")).to_contain_text("a vector of p − r = 4")
+    # The E1/E2 panel scores the vector: E2 over the seven joints, in the frame it names.
+    sensitivity = page.locator("#plot-sensitivity")
+    expect(sensitivity).to_contain_text("E1, E2 of the vector formula: h = x2, x3, x5, x7")
+    expect(sensitivity).to_contain_text("E2 in the kernel frame of joints [1, 5, 6, 7]")
+    expect(sensitivity).to_contain_text("E1 not computed over 7 joints")
