@@ -1,4 +1,5 @@
-"""E2, eq. (18), of a map over many joints by a quasi-Monte Carlo rule, beside single joints.
+"""E1 (13) and E2 (18) of a map over many joints by a quasi-Monte Carlo rule, E2 beside single
+joints.
 
 A tensor Gauss rule over d variables has n^d nodes (12^7 = 3.6e7 for a 7-joint arm): jik's
 :mod:`jik.engine.functionals` stops at three. E2 is the integral over the region of
@@ -12,7 +13,7 @@ nodes times the region's volume: the rule and the nodes of
 ``e2_check``), in the same kernel frame K (:mod:`jik.engine.kernel_frame`) for p - r >= 2. For
 one degree of redundancy, with it, E2 of the common choice h = s x_j (one joint held, s = +-1 the
 better sign: the one of the integral of m K_j) for each joint of the region, as
-``TotalDegreeSynthesis.single_joint`` gives them.
+``TotalDegreeSynthesis.single_joint`` gives them. :func:`e1_qmc` takes E1 on the same nodes.
 """
 
 from __future__ import annotations
@@ -23,8 +24,8 @@ import numpy as np
 
 from .augmentations import AugmentingMap
 from .exceptions import InvalidInputError, KinematicSingularityError
-from .functionals import Region, check_region
-from .inverses import require_kinematics
+from .functionals import Region, check_region, e1_integrand
+from .inverses import extended_determinant, require_kinematics
 from .kernel_frame import frame_axes_of, kernel_frame, maps_gradient, require_maps
 from .kinematics import Kinematics
 from .progress import Progress, check_cancelled, check_progress
@@ -77,29 +78,12 @@ def e2_qmc(
     """
     kinematics = require_kinematics(kinematics)
     maps = require_maps(kinematics, amap, "E2", "amap")
-    box, fix = check_region(kinematics, region, fixed)
-    progress = check_progress(progress)
-    nodes = count(nodes, "nodes", 64, MAX_NODES)
-    if nodes & (nodes - 1):
-        raise InvalidInputError(f"nodes must be a power of two, got {nodes}", "nodes")
-    axes = frame_axes_of(kinematics, box, fix, frame_axes)
+    rule = _Rule(kinematics, region, fixed, nodes, seed, "E2")
+    axes = frame_axes_of(kinematics, rule.box, rule.fix, frame_axes)
     k_red = len(maps)
-    names = kinematics.names
-    idx = np.array([names.index(n) for n in box])
-    lo, hi = np.array(list(box.values()), dtype=float).T
-    t = sobol_nodes(len(box), nodes, seed)
-    base = np.array([fix.get(n, 0.0) for n in names])
     total, undefined = 0.0, 0
-    c0, diag, load = 0.0, np.zeros(len(idx)), np.zeros(len(idx))
-    for start in range(0, nodes, CHUNK):
-        check_cancelled(progress, "the E2 rule was cancelled")
-        x = np.broadcast_to(base, (len(t[start : start + CHUNK]), base.size)).copy()
-        x[:, idx] = 0.5 * (lo + hi) + 0.5 * (hi - lo) * t[start : start + CHUNK]
-        m = kinematics.manipulability(x)
-        if np.any(m < 1e-9):
-            raise KinematicSingularityError(
-                "the region contains a kinematic singularity", x[int(np.argmin(m))], "region"
-            )
+    c0, diag, load = 0.0, np.zeros(len(rule.idx)), np.zeros(len(rule.idx))
+    for x, m in rule.chunks(progress):
         K, Jp = kernel_frame(kinematics, x, axes)  # (n, p, p - r)
         P = Jp @ np.swapaxes(Jp, -1, -2) + K @ np.swapaxes(K, -1, -2)
         dh, bad = maps_gradient(maps, x)  # (n, p - r, p)
@@ -108,15 +92,13 @@ def e2_qmc(
         integrand = m * (quad - 2.0 * np.einsum("nik,nki->n", dh, K) + k_red)
         total += float(np.sum(integrand[~bad]))
         c0 += float(m.sum())
-        diag += np.einsum("n,nk->k", m, P[:, idx, idx])
-        load += np.einsum("n,nk->k", m, K[:, idx, 0])
-        if progress is not None:
-            progress.advance(min(start + CHUNK, nodes) / nodes, 1.0)
-    w = float(np.prod(hi - lo)) / nodes
+        diag += np.einsum("n,nk->k", m, P[:, rule.idx, rule.idx])
+        load += np.einsum("n,nk->k", m, K[:, rule.idx, 0])
+    w = rule.weight
     sign = np.where(load >= 0, 1.0, -1.0)
     single = {
         name: {"sign": float(sign[j]), "e2": float(w * (c0 + diag[j] - 2.0 * sign[j] * load[j]))}
-        for j, name in enumerate(box)
+        for j, name in enumerate(rule.box)
         if k_red == 1
     }
     e2 = None if undefined else float(w * total)
@@ -124,7 +106,99 @@ def e2_qmc(
         "E2": e2,
         "undefined_points": undefined,
         "single_joint": single,
-        "nodes": nodes,
+        "nodes": rule.nodes,
         "seed": seed,
         "frame_axes": None if axes is None else [a + 1 for a in axes],
     }
+
+
+def e1_qmc(
+    kinematics: Kinematics,
+    amap: AugmentingMap | Sequence[AugmentingMap],
+    region: Region,
+    *,
+    fixed: Mapping[str, float] | None = None,
+    nodes: int = 2**13,
+    seed: int = 1,
+    progress: Progress | None = None,
+) -> dict:
+    """E1 (13) of ``amap`` on ``region`` by the scrambled Sobol rule of :func:`e2_qmc` (the
+    same parameters, no frame: E1 does not depend on it).
+
+    The integrand ||J^P# - J^E#||_F^2 = tr(W W^T), W = (dh K)^(-1) dh J^P# (eq. (14)), blows up
+    where det [J; dh] = +-det(dh K) sqrt(det J J^T) vanishes; E1 is infinite (``divergent``)
+    when that determinant is zero at a node (:func:`~jik.engine.inverses.extended_determinant`)
+    or of both signs among them (a zero between), as the Gauss rule of
+    :func:`~jik.engine.functionals.error_functional_e1` decides at its points (without the
+    box's faces: a zero there between nodes is found by the sign change).
+
+    Returns
+    -------
+    dict
+        ``{"E1": float, inf when divergent, or None (h undefined at some node), "divergent",
+        "undefined_points", "min_abs_dh_k": min |det(dh K)| over the nodes, "nodes", "seed"}``.
+    """
+    kinematics = require_kinematics(kinematics)
+    maps = require_maps(kinematics, amap, "E1", "amap")
+    rule = _Rule(kinematics, region, fixed, nodes, seed, "E1")
+    total, undefined, singular = 0.0, 0, False
+    lo_det, hi_det, least = np.inf, -np.inf, np.inf
+    for x, m in rule.chunks(progress):
+        J = kinematics.jacobian(x)
+        dh, bad = maps_gradient(maps, x)
+        undefined += int(np.count_nonzero(bad))
+        det, rank_loss = extended_determinant(J, dh)
+        singular |= bool(np.any(rank_loss & ~bad))
+        if np.any(~bad):  # (|det(dh K)| = |det [J; dh]| / m, whatever the frame)
+            lo_det, hi_det = min(lo_det, np.min(det[~bad])), max(hi_det, np.max(det[~bad]))
+            least = min(least, float(np.min(np.abs(det[~bad]) / m[~bad])))
+        ok = ~bad & ~rank_loss
+        total += float(np.sum(e1_integrand(J[ok], dh[ok])))
+    divergent = singular or bool(lo_det < 0.0 < hi_det)
+    e1 = None if undefined else (np.inf if divergent else float(rule.weight * total))
+    return {
+        "E1": e1,
+        "divergent": divergent,
+        "undefined_points": undefined,
+        "min_abs_dh_k": float(least),
+        "nodes": rule.nodes,
+        "seed": seed,
+    }
+
+
+class _Rule:
+    """The scrambled Sobol rule of ``nodes`` (a power of two) on ``region``, the others held at
+    ``fixed``: its configurations and manipulability by chunks of nodes (:meth:`chunks`), the
+    weight of a node (the region's volume / nodes); ``what`` names the functional."""
+
+    def __init__(self, kinematics, region, fixed, nodes, seed, what: str) -> None:
+        self.kin, self.what = kinematics, what
+        self.box, self.fix = check_region(kinematics, region, fixed)
+        self.nodes = count(nodes, "nodes", 64, MAX_NODES)
+        if self.nodes & (self.nodes - 1):
+            raise InvalidInputError(f"nodes must be a power of two, got {self.nodes}", "nodes")
+        names = kinematics.names
+        self.idx = np.array([names.index(n) for n in self.box])
+        self.lo, self.hi = np.array(list(self.box.values()), dtype=float).T
+        self.t = sobol_nodes(len(self.box), self.nodes, seed)
+        self.base = np.array([self.fix.get(n, 0.0) for n in names])
+        self.weight = float(np.prod(self.hi - self.lo)) / self.nodes
+
+    def chunks(self, progress: Progress | None):
+        """(x, m) per chunk of nodes; told ``progress`` the fraction done, polled for a cancel
+        (:class:`~jik.engine.exceptions.RunCancelled`); a kinematic singularity in the region
+        (m < 1e-9 at a node) is a KinematicSingularityError."""
+        progress = check_progress(progress)
+        for start in range(0, self.nodes, CHUNK):
+            check_cancelled(progress, f"the {self.what} rule was cancelled")
+            t = self.t[start : start + CHUNK]
+            x = np.broadcast_to(self.base, (len(t), self.base.size)).copy()
+            x[:, self.idx] = 0.5 * (self.lo + self.hi) + 0.5 * (self.hi - self.lo) * t
+            m = self.kin.manipulability(x)
+            if np.any(m < 1e-9):
+                raise KinematicSingularityError(
+                    "the region contains a kinematic singularity", x[int(np.argmin(m))], "region"
+                )
+            yield x, m
+            if progress is not None:
+                progress.advance(min(start + CHUNK, self.nodes) / self.nodes, 1.0)

@@ -4,11 +4,11 @@ with a map's parameters.
 
 Over at most :data:`MAX_TENSOR_VARIABLES` variables both are taken by the tensor Gauss rule of
 :mod:`jik.engine.functionals`, each with its singular points. Over more, a tensor rule is too
-large (``nodes ** 7`` points for a 7-joint arm): E2 is taken by the scrambled Sobol rule of the
-total-degree synthesis (:func:`jik.engine.e2_qmc.e2_qmc`, docs/e2-vector.md), for one degree of
+large (``nodes ** 7`` points for a 7-joint arm): both are taken by the scrambled Sobol rule of
+the total-degree synthesis (:mod:`jik.engine.e2_qmc`, docs/e2-vector.md), for one degree of
 redundancy with E2 of h = s x_j for each joint beside it, which compares the map with holding a
-single joint. E1 has no such rule and is not computed. E2 of a vector of maps depends on the
-kernel frame (:mod:`jik.engine.kernel_frame`), which the report names.
+single joint. E2 of a vector of maps depends on the kernel frame (:mod:`jik.engine.kernel_frame`),
+which the report names.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from collections.abc import Callable, Mapping
 import numpy as np
 
 from .augmentations import AugmentingMap
-from .e2_qmc import e2_qmc
+from .e2_qmc import e1_qmc, e2_qmc
 from .exceptions import InvalidInputError, JikError
 from .functionals import Region, check_region, error_functional_e1, error_functional_e2
 from .inverses import require_kinematics
@@ -73,8 +73,8 @@ def functionals_report(
     (name -> (lo, hi)), the other variables at ``fixed`` (default:
     :func:`~jik.engine.robot_defaults.held_values`), as the module's notes say: by the tensor
     rule (:func:`functional_value` of each, ``nodes`` per variable), else by the Sobol rule of
-    :data:`QMC_NODES` nodes: ``E2``, ``E2_single_joint`` (name -> {"sign", "e2"}; for one
-    degree of redundancy) and ``E2_rule``, ``E1`` None and a ``note`` saying why and how. For a
+    :data:`QMC_NODES` nodes: ``E1``, ``E2``, ``E2_single_joint`` (name -> {"sign", "e2"}; for
+    one degree of redundancy), ``E2_rule`` (the rule of both) and a ``note`` saying how. For a
     vector, ``E2_frame_axes``: the 1-based joints fixing the kernel frame E2 depends on
     (``frame_axes``, default the best conditioned at the box's centre). A functional that
     cannot be evaluated on a valid region (h undefined there) is reported as data
@@ -107,39 +107,30 @@ def functionals_report(
             if progress is not None:
                 progress.advance(k, 2)
         return out
-    large = f"a tensor rule over the {len(region)} variables of the region is too large"
+    rule: dict = {"fixed": fixed, "nodes": QMC_NODES, "seed": QMC_SEED}
+    out = {"E2_rule": {"kind": "sobol", "nodes": QMC_NODES, "seed": QMC_SEED}}
+    try:
+        e1 = e1_qmc(kinematics, amap, region, progress=part(progress, 0, 2), **rule)
+        out |= {"E1": None if e1["E1"] is None or e1["divergent"] else e1["E1"]}
+        out |= {"E1_divergent": True} if e1["divergent"] else {}
+    except (JikError, ValueError, ArithmeticError) as exc:
+        out |= {"E1": None, "E1_error": str(exc)}
     try:
         e2 = e2_qmc(
-            kinematics,
-            amap,
-            region,
-            fixed=fixed,
-            nodes=QMC_NODES,
-            seed=QMC_SEED,
-            frame_axes=frame,
-            progress=progress,
+            kinematics, amap, region, frame_axes=frame, progress=part(progress, 1, 2), **rule
         )
+        out |= {"E2": e2["E2"], "E2_single_joint": e2["single_joint"] or None}
     except (JikError, ValueError, ArithmeticError) as exc:
-        e2 = {"E2": None, "error": str(exc)}
+        out |= {"E2": None, "E2_error": str(exc)}
     if progress is not None:
         progress.advance(2, 2)
-    if "error" in e2:
-        return {
-            "E1": None,
-            "E2": None,
-            "E2_error": e2["error"],
-            "note": f"E1 not computed: {large}; E2 not computed: {e2['error']}",
-        }
-    value = "undefined (h is not defined on all of it)" if e2["E2"] is None else (f"{e2['E2']:.4g}")
-    frame_words = "" if frame is None else f", kernel frame on joints {frame}"
-    return {
-        "E1": None,
-        "E2": e2["E2"],
-        "E2_single_joint": e2["single_joint"] or None,
-        "E2_rule": {"kind": "sobol", "nodes": QMC_NODES, "seed": QMC_SEED},
-        "note": f"E2 = {value} on the region (Sobol rule, {QMC_NODES} nodes"
-        f"{frame_words}); E1 not computed over {len(region)} joints",
-    } | ({} if frame is None else {"E2_frame_axes": frame})
+    frame_words = "" if frame is None else f", E2 in the kernel frame of joints {frame}"
+    how = f"(Sobol rule, {QMC_NODES} nodes{frame_words})"
+    if "E1_error" in out and out.get("E2_error") == out["E1_error"]:
+        out["note"] = f"E1, E2 not computed: {out['E1_error']}"
+    else:
+        out["note"] = f"{report_words(out, 'the region')} {how}"
+    return out | ({} if frame is None else {"E2_frame_axes": frame})
 
 
 def parameter_sensitivity(

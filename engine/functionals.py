@@ -254,21 +254,20 @@ def _evaluate(
     maps = require_maps(kinematics, augmenting_map, "E1, E2")
     x, w, box, fix = quadrature(kinematics, region, nodes, fixed)
     kinematics.require_regular(x, "integration region (a quadrature point)", "region")
-    axes = frame_axes_of(kinematics, box, fix, frame_axes)
     J = kinematics.jacobian(x)
     with np.errstate(all="ignore"):
         dh = maps_gradient(maps, x)[0]  # (n, p - r, p)
-    bad = extended_determinant(J, dh)[1]
-    dh_safe = np.where(bad[:, None, None], 0.0, dh)
-    K = kernel_frame(kinematics, x, axes)[0]  # (n, p, p - r)
-    dhk = np.linalg.det(dh_safe @ K)
-    divergent = False
-    if which == "e1":
-        regular = np.where(bad[:, None, None], np.swapaxes(K, -1, -2), dh_safe)
-        f = np.where(bad, 0.0, e1_integrand(J, regular))
-        divergent = _e1_diverges(kinematics, maps, x, J, dh, box)
-    else:
-        f = e2_integrand(J, K, kinematics.manipulability(x), dh_safe)
+        det, bad = extended_determinant(J, dh)
+        dh_safe = np.where(bad[:, None, None], 0.0, dh)
+        m = kinematics.manipulability(x)
+        dhk = np.where(bad, 0.0, np.abs(det) / m)  # |det(dh K)|, whatever the frame
+        axes, divergent = None, False
+        if which == "e1":  # (no frame: E1 does not depend on it)
+            f = np.where(bad, 0.0, e1_integrand(J, dh_safe))
+            divergent = _e1_diverges(kinematics, maps, x, J, dh, box)
+        else:
+            axes = frame_axes_of(kinematics, box, fix, frame_axes)
+            f = e2_integrand(J, kernel_frame(kinematics, x, axes)[0], m, dh_safe)
     return FunctionalValue(
         value=float("inf") if divergent else float(np.dot(w, f)),
         divergent=divergent,
@@ -276,8 +275,8 @@ def _evaluate(
         n_points=int(w.size),
         singular_points=x[bad],
         fixed=fix,
-        min_abs_dh_k=float(np.min(np.abs(np.where(bad, 0.0, dhk)))),
-        frame_axes=() if axes is None or which == "e1" else tuple(a + 1 for a in axes),
+        min_abs_dh_k=float(np.min(dhk)),
+        frame_axes=() if axes is None else tuple(a + 1 for a in axes),
     )
 
 

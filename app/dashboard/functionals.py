@@ -192,14 +192,16 @@ def sensitivity(
 def single_joint_sensitivity(functionals: dict) -> dict:
     """The E1/E2 panel's data for a map whose E2 came from a Sobol rule
     (:func:`~jik.engine.functional_report.functionals_report`): E2 of the map and of h = s x_j
-    for each joint, ``{"kind": "single_joint", "E2", "maps": [{"name", "E2", "current"}],
-    "nodes"}``."""
+    for each joint, E1 of the map, ``{"kind": "single_joint", "E1", "E1_divergent", "E2",
+    "maps": [{"name", "E2", "current"}], "nodes"}``."""
     maps = [{"name": "h (current)", "E2": functionals["E2"], "current": True}]
     for name, row in functionals["E2_single_joint"].items():
         sign = "+" if row["sign"] > 0 else "−"
         maps.append({"name": f"h = {sign}{name}", "E2": row["e2"], "current": False})
     return {
         "kind": "single_joint",
+        "E1": functionals["E1"],
+        "E1_divergent": bool(functionals.get("E1_divergent")),
         "E2": functionals["E2"],
         "maps": maps,
         "nodes": functionals["E2_rule"]["nodes"],

@@ -334,8 +334,8 @@ def _bars(maps: list[dict], key: str, names: list[str]) -> dict:
 
 
 def single_joint_spec(sens: dict, aug: str, log: dict) -> dict:
-    """E2 (18) of the map (outlined) beside E2 of h = s x_j for each joint, on a log scale: a
-    map over many joints, its E2 by a Sobol rule
+    """E2 (18) of the map (outlined) beside E2 of h = s x_j for each joint, on a log scale, E1
+    (13) of the map in the title: a map over many joints, both by a Sobol rule
     (:func:`jik.engine.functional_report.functionals_report`)."""
     maps = sens["maps"]
     values = [m["E2"] for m in maps]
@@ -344,9 +344,11 @@ def single_joint_spec(sens: dict, aug: str, log: dict) -> dict:
     ratio = ""
     if sens["E2"]:
         ratio = f": {best['E2'] / sens['E2']:.3g} × E2 of h"
+    e1 = sens["E1"]
+    e1 = f"{e1:.4g}" if e1 is not None else "∞" if sens["E1_divergent"] else "undefined"
     title = (
         f"E2 (18) of {aug} and of a single joint held<br><sup>a scrambled Sobol rule of "
-        f"{sens['nodes']} nodes on the design box; E1 (13) not computed</sup>"
+        f"{sens['nodes']} nodes on the design box; E1 (13) of h = {e1}</sup>"
         f"<br><sup>the best single joint, {best['name']}{ratio}</sup>"
     )
     known = [v for v in values if v is not None and v > 0]
@@ -357,9 +359,8 @@ def single_joint_spec(sens: dict, aug: str, log: dict) -> dict:
 
 
 def vector_spec(sens: dict, name: str, log: dict) -> dict:
-    """E1 (13) and E2 (18) of a vector of p - r > 1 maps ``name`` as two bars on a log scale,
-    the box, the rule and the kernel frame E2 was taken in (E1 by a tensor rule only, over at
-    most three joints: a missing bar says why)."""
+    """E1 (13) and E2 (18) of a vector of p - r > 1 maps ``name`` as two bars on a log scale
+    (a missing bar says why), the box and the kernel frame E2 was taken in."""
     values = {k: sens.get(k) for k in ("E1", "E2")}
     data = [
         trace(
@@ -372,8 +373,7 @@ def vector_spec(sens: dict, name: str, log: dict) -> dict:
         )
         for k, eq in (("E1", 13), ("E2", 18))
     ]
-    n = len(sens["region"])
-    missing = {"E1": f"not computed over {n} joints" if n > 3 else "undefined", "E2": "undefined"}
+    missing = {"E1": "undefined", "E2": "undefined"}
     if sens.get("E1_divergent"):
         missing["E1"] = "= ∞ (det(dh K) = 0 inside)"
     words = [

@@ -55,12 +55,13 @@ def test_the_panda_with_its_pose_task(tabs):
     assert scene["pose_frames"] == 4  # the path's three pose targets and k(x0)
     tab.screenshots("arm-panda")
     # The task panel: position and rotation vector against theta; E2 of the 7-joint map beside
-    # E2 of each single joint (the second phase's Sobol rule).
+    # E2 of each single joint, and its E1 (the second phase's Sobol rule).
     expect(page.locator("#plot-task")).to_contain_text("rz [rad]")
     sensitivity = page.locator("#plot-sensitivity")
     expect(sensitivity).to_contain_text("of a single joint held", timeout=120_000)
     expect(sensitivity).to_contain_text("h = +x1")
-    expect(page.locator("#plot-augmenting")).to_contain_text("E2 = 0.000173")
+    expect(sensitivity).to_contain_text("E1 (13) of h = 0.002346")  # (on the same nodes)
+    expect(page.locator("#plot-augmenting")).to_contain_text("E1 = 0.002346, E2 = 0.0001731")
 
     # Its atlas: 16 starts on the self-motion curve of k(x0), two cycles, both algorithms.
     page.locator("#atlas").scroll_into_view_if_needed()
@@ -102,8 +103,7 @@ def test_the_panda_with_a_position_task_and_four_formula_maps(tabs):
     assert max(summary["extended"]["drift"]) < 1e-9
     assert summary["extended"]["h_change"] < 1e-9  # (each of the four components is conserved)
     expect(page.locator("#plot-augmenting")).to_contain_text("a vector of p − r = 4")
-    # The E1/E2 panel scores the vector: E2 over the seven joints, in the frame it names.
+    # The E1/E2 panel scores the vector over the seven joints, E2 in the frame it names.
     sensitivity = page.locator("#plot-sensitivity")
     expect(sensitivity).to_contain_text("E1, E2 of the vector formula: h = x2, x3, x5, x7")
     expect(sensitivity).to_contain_text("E2 in the kernel frame of joints [1, 5, 6, 7]")
-    expect(sensitivity).to_contain_text("E1 not computed over 7 joints")

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from jik.engine.augmentations import E2Optimal, PaperCubic
-from jik.engine.e2_qmc import e2_qmc
+from jik.engine.e2_qmc import e1_qmc, e2_qmc
 from jik.engine.exceptions import InvalidInputError, RunCancelled
 from jik.engine.functional_report import (
     QMC_NODES,
@@ -54,13 +54,16 @@ def test_a_small_region_gets_both_functionals_by_the_tensor_rule():
         assert refused.value.field.startswith(field), refused.value.field
 
 
-def test_a_region_of_four_joints_gets_e2_by_the_sobol_rule_and_no_e1():
+def test_a_region_of_four_joints_gets_both_by_the_sobol_rule():
     h = synthesize_e2_nd(CHAIN, REGION, degree=2, nodes=2**10).maps[0]
     out = functionals_report(CHAIN, h, REGION, {}, 12)
     rule = e2_qmc(CHAIN, h, REGION, nodes=QMC_NODES, seed=QMC_SEED)
-    assert out["E1"] is None and out["E2"] == pytest.approx(rule["E2"], rel=1e-12)
+    e1 = e1_qmc(CHAIN, h, REGION, nodes=QMC_NODES, seed=QMC_SEED)
+    assert out["E2"] == pytest.approx(rule["E2"], rel=1e-12) and out["E1"] == e1["E1"]
     assert out["E2_single_joint"] == rule["single_joint"]
-    assert out["note"].endswith("nodes); E1 not computed over 4 joints")
+    assert out["note"] == (
+        f"E1 = {e1['E1']:.4g}, E2 = {rule['E2']:.4g} on the region (Sobol rule, {QMC_NODES} nodes)"
+    )
     with pytest.raises(RunCancelled):
         functionals_report(
             CHAIN, h, REGION, {}, 12, progress=ProgressCallbacks(is_cancelled=lambda: True)

@@ -5,7 +5,7 @@ rule and the Sobol rule, against the definitions computed another way (a dense i
 import numpy as np
 import pytest
 
-from jik.engine.e2_qmc import e2_qmc
+from jik.engine.e2_qmc import e1_qmc, e2_qmc
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.formula_kinematics import FormulaMap
 from jik.engine.functional_report import functionals_report
@@ -13,6 +13,7 @@ from jik.engine.functionals import error_functional_e1, error_functional_e2, qua
 from jik.engine.kernel_frame import best_frame_axes
 from jik.engine.planar_chain import PlanarChain
 from jik.engine.synthesis_nd import synthesize_e2_nd
+from jik.engine.total_degree import sobol_nodes
 
 CHAIN = PlanarChain("RRRR", [1.0, 1.0, 1.0, 1.0])  # a position task: p - r = 2
 NAMES = list(CHAIN.names)
@@ -89,8 +90,8 @@ def test_the_report_names_the_frame_by_either_rule():
     assert tensor["E2"] == pytest.approx(want2, rel=1e-12)
     whole = dict(REGION, x1=(-0.3, 0.3))
     sobol = functionals_report(CHAIN, MAPS, whole, nodes=8, frame_axes=[3, 4])
-    assert sobol["E1"] is None and sobol["E2_single_joint"] is None
-    assert sobol["E2_frame_axes"] == [3, 4] and "kernel frame on joints [3, 4]" in sobol["note"]
+    assert sobol["E1"] == e1_qmc(CHAIN, MAPS, whole)["E1"] and sobol["E2_single_joint"] is None
+    assert sobol["E2_frame_axes"] == [3, 4] and "kernel frame of joints [3, 4]" in sobol["note"]
     assert sobol["E2"] == pytest.approx(
         e2_qmc(CHAIN, MAPS, whole, frame_axes=[3, 4])["E2"], rel=1e-15
     )
@@ -119,3 +120,28 @@ def test_refusals_name_the_argument(call, field, words):
     with pytest.raises(InvalidInputError, match=words) as err:
         call()
     assert err.value.field == field
+
+
+def test_e1_by_the_sobol_rule_is_its_definition_on_the_rule_and_near_the_gauss_value():
+    """On the rule's own nodes, E1 is the volume times the mean of ||J^# - [J; dh]^-1 [I; 0]||^2
+    (a dense inverse); it agrees with the Gauss rule's E1 to its quadrature error."""
+    nodes = 2**12
+    q = e1_qmc(CHAIN, MAPS, REGION, nodes=nodes, fixed={"x1": 0.0})
+    t = sobol_nodes(3, nodes, 1)
+    lo, hi = np.array(list(REGION.values())).T
+    x = np.zeros((nodes, 4))
+    x[:, 1:] = 0.5 * (lo + hi) + 0.5 * (hi - lo) * t
+    J = CHAIN.jacobian(x)
+    Jbar = np.concatenate([J, np.stack([m.gradient(x) for m in MAPS], axis=-2)], axis=-2)
+    e1 = np.sum((np.linalg.pinv(J) - np.linalg.inv(Jbar)[..., :, :2]) ** 2, axis=(-1, -2))
+    assert q["E1"] == pytest.approx(np.prod(hi - lo) * e1.mean(), rel=1e-12)
+    assert not q["divergent"] and q["min_abs_dh_k"] > 0.1
+    gauss = error_functional_e1(CHAIN, MAPS, REGION, nodes=16)
+    assert q["E1"] == pytest.approx(gauss.value, rel=1e-3)
+    assert q["min_abs_dh_k"] == pytest.approx(gauss.min_abs_dh_k, rel=0.05)
+
+
+def test_e1_by_the_sobol_rule_diverges_where_the_extended_jacobian_loses_rank():
+    maps = [MAPS[0], FormulaMap("(x3 - 0.8)**2 / 2", NAMES)]
+    q = e1_qmc(CHAIN, maps, REGION, nodes=2**10)
+    assert q["divergent"] and q["E1"] == float("inf")
