@@ -34,30 +34,76 @@ MAX_TENSOR_VARIABLES = 3
 QMC_SEED = 1
 
 
-def functional_value(
-    key: str, kinematics, amap, region: Mapping, nodes: int, fixed, frame_axes=None
+def functional_info(
+    key: str,
+    kinematics,
+    amap,
+    region: Mapping,
+    fixed,
+    nodes: int = 12,
+    frame_axes=None,
+    progress=None,
 ) -> dict:
-    """``{key: E1 (13) or E2 (18) (``key`` "E1" or "E2") of ``amap`` (a map, or a vector of
-    p - r maps) on ``region`` by a tensor rule of ``nodes`` per variable, or None where
-    undefined}`` with its singular points, ``key_divergent`` (E1 = inf) or ``key_error`` (why it
-    could not be evaluated) if so, and E2's ``E2_frame_axes`` for a vector (``frame_axes``, else
-    the best conditioned)."""
-    try:
+    """E1 (13) or E2 (18) (``key`` "E1" or "E2") of ``amap`` (a map, or a vector of p - r maps)
+    on ``region`` by the rule its size calls for: the Gauss rule of ``nodes`` per variable
+    (:mod:`jik.engine.functionals`) over at most :data:`MAX_TENSOR_VARIABLES` variables, else
+    the Sobol rule of :data:`QMC_NODES` nodes (:mod:`jik.engine.e2_qmc`). ``{"value": float, or
+    None where infinite or undefined, "divergent", "n_points", "n_singular" (points where
+    [J; dh] is singular; of the Sobol rule, where h is undefined), "min_abs_dh_k" (None for E2
+    by the Sobol rule), "frame_axes" (E2 of a vector: 1-based, else None), "rule": "gauss" or
+    "sobol"}``, and E2's ``single_joint`` by the Sobol rule (one degree of redundancy).
+    ``progress`` follows the Sobol rule's nodes. Raises what the functional raises."""
+    if len(region) <= MAX_TENSOR_VARIABLES:
         if key == "E1":
             value = error_functional_e1(kinematics, amap, region, nodes=nodes, fixed=fixed)
         else:
             value = error_functional_e2(
                 kinematics, amap, region, nodes=nodes, fixed=fixed, frame_axes=frame_axes
             )
+        info = value.as_dict()
+        return {k: info[k] for k in _INFO} | {"rule": "gauss"}
+    rule: dict = {"fixed": fixed, "nodes": QMC_NODES, "seed": QMC_SEED, "progress": progress}
+    out = {"n_points": QMC_NODES, "rule": "sobol", "frame_axes": None}
+    if key == "E1":
+        e1 = e1_qmc(kinematics, amap, region, **rule)
+        return out | {
+            "value": None if e1["divergent"] else e1["E1"],
+            "divergent": e1["divergent"],
+            "n_singular": e1["undefined_points"],
+            "min_abs_dh_k": e1["min_abs_dh_k"],
+        }
+    e2 = e2_qmc(kinematics, amap, region, frame_axes=frame_axes, **rule)
+    return out | {
+        "value": e2["E2"],
+        "divergent": False,
+        "n_singular": e2["undefined_points"],
+        "min_abs_dh_k": None,
+        "frame_axes": e2["frame_axes"],
+        "single_joint": e2["single_joint"] or None,
+    }
+
+
+#: The fields of :meth:`~jik.engine.functionals.FunctionalValue.as_dict` a functional's info keeps.
+_INFO = ("value", "divergent", "n_points", "n_singular", "min_abs_dh_k", "frame_axes")
+
+
+def functional_value(
+    key: str, kinematics, amap, region: Mapping, nodes: int, fixed, frame_axes=None, progress=None
+) -> dict:
+    """``{key: E1 or E2 of :func:`functional_info`, or None where undefined}`` with its singular
+    points, ``key_divergent`` (E1 = inf) or ``key_error`` (why it could not be evaluated) if so,
+    E2's ``E2_frame_axes`` for a vector (``frame_axes``, else the best conditioned) and, by the
+    Sobol rule, ``E2_single_joint``."""
+    try:
+        info = functional_info(key, kinematics, amap, region, fixed, nodes, frame_axes, progress)
     except (JikError, ValueError, ArithmeticError) as exc:
         return {key: None, f"{key}_error": str(exc)}
-    out: dict = {
-        key: float(value.value) if np.isfinite(value.value) else None,
-        f"{key}_singular_points": int(value.singular_points.shape[0]),
-    }
-    if value.frame_axes:
-        out[f"{key}_frame_axes"] = list(value.frame_axes)
-    return out | ({f"{key}_divergent": True} if value.divergent else {})
+    out: dict = {key: info["value"], f"{key}_singular_points": info["n_singular"]}
+    if info["frame_axes"]:
+        out[f"{key}_frame_axes"] = info["frame_axes"]
+    if "single_joint" in info:
+        out["E2_single_joint"] = info["single_joint"]
+    return out | ({f"{key}_divergent": True} if info["divergent"] else {})
 
 
 def functionals_report(
@@ -71,11 +117,11 @@ def functionals_report(
 ) -> dict:
     """E1 and E2 of ``amap`` (a map, or for p - r >= 2 a vector of p - r maps) on ``region``
     (name -> (lo, hi)), the other variables at ``fixed`` (default:
-    :func:`~jik.engine.robot_defaults.held_values`), as the module's notes say: by the tensor
-    rule (:func:`functional_value` of each, ``nodes`` per variable), else by the Sobol rule of
-    :data:`QMC_NODES` nodes: ``E1``, ``E2``, ``E2_single_joint`` (name -> {"sign", "e2"}; for
-    one degree of redundancy), ``E2_rule`` (the rule of both) and a ``note`` saying how. For a
-    vector, ``E2_frame_axes``: the 1-based joints fixing the kernel frame E2 depends on
+    :func:`~jik.engine.robot_defaults.held_values`), each by :func:`functional_value` (the
+    Gauss rule of ``nodes`` per variable over at most three variables, else the Sobol rule of
+    :data:`QMC_NODES` nodes, with ``E2_single_joint`` (name -> {"sign", "e2"}; for one degree
+    of redundancy), ``E2_rule`` (the rule of both) and a ``note`` saying how). For a vector,
+    ``E2_frame_axes``: the 1-based joints fixing the kernel frame E2 depends on
     (``frame_axes``, default the best conditioned at the box's centre). A functional that
     cannot be evaluated on a valid region (h undefined there) is reported as data
     (``E1_error``, ``E2_error``); invalid input raises.
@@ -99,38 +145,24 @@ def functionals_report(
     nodes, progress = count(nodes, "nodes", 1, 400), check_progress(progress)
     axes = frame_axes_of(kinematics, region, fixed, frame_axes)
     frame = None if axes is None else [a + 1 for a in axes]
-    if len(region) <= MAX_TENSOR_VARIABLES:
-        out: dict = {}
-        for k, key in enumerate(("E1", "E2"), start=1):
-            check_cancelled(progress, "E1, E2")
-            out |= functional_value(key, kinematics, amap, region, nodes, fixed, frame)
-            if progress is not None:
-                progress.advance(k, 2)
-        return out
-    rule: dict = {"fixed": fixed, "nodes": QMC_NODES, "seed": QMC_SEED}
-    out = {"E2_rule": {"kind": "sobol", "nodes": QMC_NODES, "seed": QMC_SEED}}
-    try:
-        e1 = e1_qmc(kinematics, amap, region, progress=part(progress, 0, 2), **rule)
-        out |= {"E1": None if e1["E1"] is None or e1["divergent"] else e1["E1"]}
-        out |= {"E1_divergent": True} if e1["divergent"] else {}
-    except (JikError, ValueError, ArithmeticError) as exc:
-        out |= {"E1": None, "E1_error": str(exc)}
-    try:
-        e2 = e2_qmc(
-            kinematics, amap, region, frame_axes=frame, progress=part(progress, 1, 2), **rule
+    out: dict = {}
+    for k, key in enumerate(("E1", "E2")):
+        check_cancelled(progress, "E1, E2")
+        out |= functional_value(
+            key, kinematics, amap, region, nodes, fixed, frame, part(progress, k, 2)
         )
-        out |= {"E2": e2["E2"], "E2_single_joint": e2["single_joint"] or None}
-    except (JikError, ValueError, ArithmeticError) as exc:
-        out |= {"E2": None, "E2_error": str(exc)}
-    if progress is not None:
-        progress.advance(2, 2)
+        if progress is not None:
+            progress.advance(k + 1, 2)
+    if len(region) <= MAX_TENSOR_VARIABLES:
+        return out
+    out["E2_rule"] = {"kind": "sobol", "nodes": QMC_NODES, "seed": QMC_SEED}
     frame_words = "" if frame is None else f", E2 in the kernel frame of joints {frame}"
-    how = f"(Sobol rule, {QMC_NODES} nodes{frame_words})"
     if "E1_error" in out and out.get("E2_error") == out["E1_error"]:
         out["note"] = f"E1, E2 not computed: {out['E1_error']}"
     else:
+        how = f"(Sobol rule, {QMC_NODES} nodes{frame_words})"
         out["note"] = f"{report_words(out, 'the region')} {how}"
-    return out | ({} if frame is None else {"E2_frame_axes": frame})
+    return out
 
 
 def parameter_sensitivity(

@@ -12,7 +12,8 @@ from typing import Any, get_args
 
 from ...engine.augmentations import Polynomial2
 from ...engine.exceptions import JikError
-from ...engine.functionals import check_region, error_functional_e1, error_functional_e2
+from ...engine.functional_report import functional_info
+from ...engine.functionals import check_region
 from ...engine.kinematics import Kinematics
 from ...engine.map_grid import map_grid
 from ...engine.map_singularities import map_singularities
@@ -44,11 +45,11 @@ def synthesis_region(spec: RobotSpec, kin: Kinematics, req: S.SynthesizeRequest)
         region = default_box(spec, size, req.fixed or {})
     else:
         region = {k: (float(lo), float(hi)) for k, (lo, hi) in req.region.items()}
-    if len(region) > 3 and req.method != "e2_total_degree":
+    if len(region) > 3 and req.method == "e2_variational":
         raise RequestError(
             "region",
-            f"'{req.method}' takes 1 to 3 variables (2 or 3 for 'e2_variational'), got "
-            f"{len(region)}; 'e2_total_degree' synthesizes h of any number",
+            f"'e2_variational' takes 2 or 3 variables, got {len(region)}; 'e2_total_degree' "
+            "synthesizes h of any number",
         )
     region, fixed = check_region(kin, region, req.fixed)
     return list(spec.variable_names), region, fixed
@@ -56,23 +57,18 @@ def synthesis_region(spec: RobotSpec, kin: Kinematics, req: S.SynthesizeRequest)
 
 def _functionals(kin, amap, region, fixed, nodes, frame_axes=None) -> tuple[dict, list[str]]:
     """E1 (13) and E2 (18) of ``amap`` (a map, or a tuple of p - r maps: E2 in the kernel frame
-    of ``frame_axes``, default the best conditioned) by the Gauss rule, and what the message
-    says of them."""
+    of ``frame_axes``, default the best conditioned) by the rule the region's size calls for
+    (:func:`~jik.engine.functional_report.functional_info`), and what the message says."""
     notes: list[str] = []
     out: dict[str, S.FunctionalInfo | None] = {}
     for label in ("e1", "e2"):
         try:
-            if label == "e1":
-                value = error_functional_e1(kin, amap, region, nodes=nodes, fixed=fixed)
-            else:
-                value = error_functional_e2(
-                    kin, amap, region, nodes=nodes, fixed=fixed, frame_axes=frame_axes
-                )
-            out[label] = S.FunctionalInfo.model_validate(value.as_dict())
-            if value.divergent:
+            info = functional_info(label.upper(), kin, amap, region, fixed, nodes, frame_axes)
+            out[label] = S.FunctionalInfo.model_validate(info)
+            if info["divergent"]:
                 notes.append(f"{label.upper()} diverges: det(dh K) vanishes inside the region")
-            if value.frame_axes:
-                notes.append(f"E2 in the kernel frame of joints {list(value.frame_axes)}")
+            if info["frame_axes"]:
+                notes.append(f"E2 in the kernel frame of joints {info['frame_axes']}")
         except JikError as exc:
             if getattr(exc, "field", None) == "frame_axes":
                 raise RequestError("frame_axes", without_field(str(exc), "frame_axes")) from None
@@ -265,6 +261,7 @@ def total_degree_response(
                 n_points=res.nodes,
                 n_singular=0,
                 min_abs_dh_k=None,
+                rule="sobol",
                 frame_axes=[a + 1 for a in res.frame_axes] or None,
             ),
         },

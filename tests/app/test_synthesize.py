@@ -173,6 +173,28 @@ def test_evaluate_takes_a_vector_of_maps_and_names_the_frame_of_e2(api):
         assert detail["loc"] == ["body", "frame_axes"] and words in detail["msg"]
 
 
+def test_evaluate_over_every_joint_of_an_arm_takes_the_sobol_rule_as_the_dashboard(api):
+    """The Panda's pose task and h = x1 over its seven joints: E1 and E2 by the Sobol rule, the
+    numbers the engine's report (the dashboard's E1/E2 panel) gives on the same box;
+    'e2_variational' is still refused past three variables."""
+    from jik.engine.formula_kinematics import FormulaMap
+    from jik.engine.functional_report import functionals_report
+    from jik.engine.robot_spec import robot_from_dict
+
+    arm, h = {"name": "panda", "task": "pose"}, {"name": "formula", "h": "x1"}
+    kin = robot_from_dict(arm).kinematics
+    box = {n: [x - 0.3, x + 0.3] for n, x in zip(kin.names, kin.home, strict=True)}
+    body = {"robot": arm, "method": "evaluate", "augmentation": h, "region": box}
+    r = api.post("/synthesize", json=body)
+    assert r.status_code == 200, r.text
+    f = r.json()["functionals"]
+    want = functionals_report(kin, FormulaMap("x1", kin.names), box, {})
+    assert f["e1"]["value"] == want["E1"] and f["e2"]["value"] == want["E2"]
+    assert f["e1"]["rule"] == f["e2"]["rule"] == "sobol" and f["e1"]["n_points"] == 8192
+    r = api.post("/synthesize", json={"robot": arm, "method": "e2_variational", "region": box})
+    assert r.status_code == 422 and "takes 2 or 3 variables, got 7" in r.text
+
+
 def test_synthesize_bad_input(api):
     def msg(body):
         r = api.post("/synthesize", json=body)

@@ -44,8 +44,9 @@ class SynthesizeRequest(BaseModel):
     region: dict[str, tuple[Bound, Bound]] | None = Field(
         None,
         max_length=MAX_DIMENSION,
-        description="box {variable: [lo, hi]} (1 to 3 variables; any number for "
-        "'e2_total_degree'); default: the last 3 (2 for 'e2_variational', all for "
+        description="box {variable: [lo, hi]} (2 or 3 variables for 'e2_variational'; any "
+        "number for 'evaluate', E1 and E2 by a Sobol rule past three, and 'e2_total_degree'); "
+        "default: the last 3 (2 for 'e2_variational', all for "
         "'e2_total_degree') variables: the robot's design region (functional_region of "
         "/robots) when it has that many, else each over a tenth of its x_range either side "
         "of the robot's default start",
@@ -100,9 +101,9 @@ def _synthesis_fields(spec: RobotSpec) -> dict[str, Any]:
             | None,
             Field(
                 None,
-                description=f"box {{variable: [lo, hi]}}, lo < hi, of 1 to 3 of "
-                f"{list(names)} (2 or 3 draw a grid of h; 'e2_variational' needs 2 or 3; "
-                "'e2_total_degree' takes any number), none of them fixed; default: the last 3 "
+                description=f"box {{variable: [lo, hi]}}, lo < hi, of {list(names)} (2 or "
+                "more draw a grid of h; 'e2_variational' needs 2 or 3; 'evaluate' and "
+                "'e2_total_degree' take any number), none of them fixed; default: the last 3 "
                 "(2 for 'e2_variational', all for 'e2_total_degree') not fixed: the robot's "
                 "design region when it has that many, else each over a tenth of its range "
                 "either side of the default start",
@@ -119,8 +120,16 @@ SynthesizeBody = per_robot(SynthesizeRequest, _synthesis_fields)
 class FunctionalInfo(BaseModel):
     value: MaybeFloat = Field(description="the integral; null where it is not finite")
     n_points: int
-    n_singular: int
+    n_singular: int = Field(
+        description="quadrature points where [J; dh] is singular (of the Sobol rule: where h is "
+        "undefined)"
+    )
     min_abs_dh_k: MaybeFloat
+    rule: Literal["gauss", "sobol"] = Field(
+        "gauss",
+        description="the Gauss-Legendre rule of 'nodes' per variable over at most three "
+        "variables, else a scrambled Sobol rule of n_points (engine.functional_report)",
+    )
     divergent: bool = Field(
         default=False,
         description="E1 diverges: det(dh K) vanishes inside the region (eq. (14)); value is null",
