@@ -123,7 +123,9 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         amap, aug_used = robot.augmenting_map()  # (the request's map, else the robot's default)
         coefficients = amap.monomials() if isinstance(amap, Polynomial2) else {}
         nodes = req.nodes
-    functionals, more = _functionals(kin, amap, region, fixed, nodes, req.frame_axes)
+    own = (getattr(aug_used, "definition", None) or {}).get("frame_axes")  # (its synthesis's)
+    own = own if isinstance(amap, tuple) else None  # (a vector's; one map has none)
+    functionals, more = _functionals(kin, amap, region, fixed, nodes, req.frame_axes or own)
     return map_response(
         req,
         robot_used,

@@ -21,7 +21,7 @@ from ...engine.progress import ProgressCallbacks
 from .algorithms import cache_key
 from .analysis import expensive_map, kinematics_and_map, runs_box, vector_maps
 from .model import DashboardState, robot_and_map
-from .robots import state_kinematics, state_spec
+from .robots import state_kinematics, state_robot, state_spec
 from .runs import Cancelled, DashboardResult
 
 _inert_cache: dict[str, frozenset[int]] = {}
@@ -75,8 +75,10 @@ def error_functionals(
 ) -> dict | None:
     """E1 (13) and E2 (18) of the current map, or None if unavailable: over the robot's design
     region from the registry (the boxes of sec. 5) where it has one, else over the heat-map box;
-    a vector of p - r > 1 maps (E2 in the kernel frame the report names) over every joint, in
-    the box of the runs (:func:`~jik.app.dashboard.analysis.runs_box`).
+    a vector of p - r > 1 maps (E2 in the kernel frame the report names: the ``frame_axes`` of
+    the robot's first e2_synthesized map, in which its E2 is minimal, else the best
+    conditioned) over every joint, in the box of the runs
+    (:func:`~jik.app.dashboard.analysis.runs_box`).
     ``on_advance(done, total)`` as the engine's
     :func:`~jik.engine.functional_report.functionals_report` advances (what it raises stops
     it), ``cancelled`` polled; over more than three variables, E2 by a Sobol rule.
@@ -97,6 +99,9 @@ def error_functionals(
     design = state_spec(state).functional_region
     region = dict(design) or box
     fixed = {n: float(state.x0[k]) for k, n in enumerate(names) if n not in region}
+    items = (state_robot(state).definition.get("augmentations") or []) if vector else []
+    synthesized = [a for a in items if isinstance(a, dict) and a.get("name") == "e2_synthesized"]
+    frame = synthesized[0].get("frame_axes") if synthesized else None
     out = {
         "region": {k: list(v) for k, v in region.items()},
         "fixed": fixed,
@@ -105,7 +110,7 @@ def error_functionals(
     }
     report = ProgressCallbacks(on_advance=on_advance, is_cancelled=cancelled)
     try:
-        return out | functionals_report(kin, amap, region, fixed, nodes, report)
+        return out | functionals_report(kin, amap, region, fixed, nodes, report, frame)
     except RunCancelled:
         raise Cancelled from None
 

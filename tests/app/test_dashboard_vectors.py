@@ -78,6 +78,24 @@ def test_a_synthesized_vector_on_its_design_box_has_both_and_beats_the_formulas(
     assert f["E2"] < other["E2"] and f["E1"] < other["E1"]
 
 
+def test_a_vector_synthesized_in_a_chosen_frame_is_scored_in_it_and_so_are_the_formulas():
+    """The design synthesis asks for the frame of joints 3, 4: its E2 (minimal in that frame) and
+    the formulas' are taken in it, not in the best-conditioned (2, 4), where the synthesis
+    scored 13.3, worse than the formulas' 9.6."""
+    synthesized = {"name": "e2_synthesized", "region": BOX, "frame_axes": [3, 4]}
+    result = result_of(synthesized, FORMULAS)
+    f = error_functionals(result)
+    kin, fixed = kinematics_and_map(result.state)[0], f["fixed"]
+    e2 = error_functional_e2(
+        kin, vector_maps(result.state), BOX, nodes=12, fixed=fixed, frame_axes=[3, 4]
+    )
+    assert f["E2_frame_axes"] == [3, 4] and f["E2"] == e2.value
+    other = error_functionals(
+        compute(updated_state(result.state, {"augmentation": FORMULAS["name"]}))
+    )
+    assert other["E2_frame_axes"] == [3, 4] and f["E2"] < other["E2"]
+
+
 @pytest.mark.parametrize("cancelled", [False, True])
 def test_the_h_panel_keeps_its_note_when_the_phase_ends(cancelled):
     """The h panel of a vector is a note, not h on a grid: the phase's end, done or cancelled,
