@@ -49,8 +49,10 @@ class FunctionalValue:
     ----------
     value : float
         The integral; for E1, quadrature points where [J; dh] is singular are excluded (the
-        integrand is infinite there), for E2 they are included (the integrand (19) is finite).
-        E1 is ``inf`` when it diverges (``divergent``).
+        integrand is infinite there), for E2 they are included (the integrand (19) is finite),
+        and E2 is NaN where h is undefined at one (dh not finite), as
+        :func:`~jik.engine.e2_qmc.e2_qmc` says None. E1 is ``inf`` when it diverges
+        (``divergent``).
     region : dict
         ``{"x2": (lo, hi), ...}``: the integrated variables.
     n_points : int
@@ -267,7 +269,7 @@ def _evaluate(
             divergent = _e1_diverges(kinematics, maps, x, J, dh, box)
         else:
             axes = frame_axes_of(kinematics, box, fix, frame_axes)
-            f = e2_integrand(J, kernel_frame(kinematics, x, axes)[0], m, dh_safe)
+            f = e2_integrand(J, kernel_frame(kinematics, x, axes)[0], m, dh)  # (NaN: undefined)
     return FunctionalValue(
         value=float("inf") if divergent else float(np.dot(w, f)),
         divergent=divergent,
@@ -347,8 +349,9 @@ def error_functional_e2(
     -----
     The integrand tr(dh P dh^T - 2 dh K + I) m with P = J^P# J^P#^T + K K^T, eq. (19), is a
     quadratic in dh; it is finite where [J; dh] is singular, so such points are included in
-    the value and reported. For one map K is the unit kernel with the paper's orientation (last
-    component positive for Manipulators 1 and 2); E2 is not invariant under h -> -h, and for
-    p - r >= 2 it depends on the frame (``docs/e2-vector.md``).
+    the value and reported; where h is undefined (dh not finite) the value is NaN. For one map
+    K is the unit kernel with the paper's orientation (last component positive for
+    Manipulators 1 and 2); E2 is not invariant under h -> -h, and for p - r >= 2 it depends on
+    the frame (``docs/e2-vector.md``).
     """
     return _evaluate("e2", kinematics, augmenting_map, region, nodes, fixed, frame_axes)

@@ -69,6 +69,8 @@ def _functionals(kin, amap, region, fixed, nodes, frame_axes=None) -> tuple[dict
                 notes.append(f"{label.upper()} diverges: det(dh K) vanishes inside the region")
             if info["frame_axes"]:
                 notes.append(f"E2 in the kernel frame of joints {info['frame_axes']}")
+            if info["value"] is None and not info["divergent"]:
+                notes.append(f"{label.upper()} undefined: h is not defined on all of the region")
         except JikError as exc:
             if getattr(exc, "field", None) == "frame_axes":
                 raise RequestError("frame_axes", without_field(str(exc), "frame_axes")) from None

@@ -216,6 +216,24 @@ def test_evaluate_takes_e2_of_a_synthesized_vector_in_the_frame_it_was_synthesiz
     assert e2["[2, 4]"]["frame_axes"] == [2, 4] and e2["[2, 4]"]["value"] > 10 * e2["None"]["value"]
 
 
+def test_evaluate_says_e2_is_undefined_where_a_map_is(api):
+    """h_2 = sqrt(x4 - 0.5) is undefined on part of the box: E2 is null and the message says
+    why (it was a number, dh taken as 0 there); E1 keeps the points where h is defined."""
+    body = {
+        "robot": {"name": "planar_chain", "joints": "RRRR", "lengths": [1.0] * 4},
+        "method": "evaluate",
+        "augmentation": {"name": "formula", "h": ["x3", "sqrt(x4 - 0.5)"]},
+        "region": {"x2": [0.3, 1.2], "x3": [0.4, 1.3], "x4": [0.2, 1.0]},
+        "fixed": {"x1": 0.0},
+    }
+    r = api.post("/synthesize", json=body)
+    assert r.status_code == 200, r.text
+    b = r.json()
+    assert b["functionals"]["e2"]["value"] is None and b["functionals"]["e2"]["n_singular"] > 0
+    assert b["functionals"]["e1"]["value"] is not None
+    assert "E2 undefined: h is not defined on all of the region" in b["message"]
+
+
 def test_synthesize_bad_input(api):
     def msg(body):
         r = api.post("/synthesize", json=body)

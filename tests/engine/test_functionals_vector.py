@@ -29,7 +29,7 @@ def by_definition(maps, region, axes, nodes=8):
     dh = np.stack([m.gradient(x) for m in maps], axis=-2)
     Jbar = np.concatenate([J, dh], axis=-2)
     Jp = np.linalg.pinv(J)
-    e1 = np.sum((Jp - np.linalg.inv(Jbar)[..., :, : CHAIN.r]) ** 2, axis=(-1, -2))
+    e1 = np.sum((Jp - np.linalg.pinv(Jbar)[..., :, : CHAIN.r]) ** 2, axis=(-1, -2))
     NE = (np.eye(CHAIN.p) - Jp @ J)[..., :, [a - 1 for a in axes]]
     U, _, Vt = np.linalg.svd(NE, full_matrices=False)
     E2 = np.concatenate([Jp, U @ Vt], axis=-1)
@@ -59,6 +59,21 @@ def test_e2_depends_on_the_frame_and_takes_the_best_conditioned_by_default():
     best = best_frame_axes(CHAIN, REGION, {"x1": 0.0})
     assert list(default.frame_axes) == best
     assert default.value == values[tuple(best)]
+
+
+def test_e2_takes_dh_where_the_extended_jacobian_is_singular_and_no_value_where_h_is_undefined():
+    """The integrand (19) of E2 is finite where [J; dh] is singular: at the 25 of 125 Gauss
+    points where dh_2 of h = (x3, (x4 - 0.6)^2) vanishes, E2 took dh = 0 for both maps (6.06,
+    not 5.49). Where h is undefined it took dh = 0 too and gave a number where the Sobol rule
+    (e2_qmc) gives None."""
+    maps = [FormulaMap("x3", NAMES), FormulaMap("(x4 - 0.6)**2", NAMES)]
+    e2 = error_functional_e2(CHAIN, maps, REGION, nodes=5, frame_axes=[3, 4])
+    assert len(e2.singular_points) == 25
+    assert e2.value == pytest.approx(by_definition(maps, REGION, [3, 4], nodes=5)[1], rel=1e-12)
+    undefined = [FormulaMap("x3", NAMES), FormulaMap("sqrt(x4 - 0.5)", NAMES)]
+    assert np.isnan(error_functional_e2(CHAIN, undefined, REGION, nodes=5).value)
+    assert functionals_report(CHAIN, undefined, REGION, nodes=5)["E2"] is None
+    assert e2_qmc(CHAIN, undefined, REGION, nodes=64)["E2"] is None
 
 
 def test_the_sobol_rule_is_the_vector_synthesis_rule():
