@@ -328,8 +328,8 @@ JOINTS_FIELD = {"planar_chain": "joints", "formula": "variables", "urdf": "activ
 
 def _redundant_robot(definition: Mapping[str, Any]):
     """The user robot of ``definition`` if the dashboard shows it: task paths in a plane or
-    space (r >= 2) and redundancy (p > r; the panels of one scalar h, E1 and E2 need p = r + 1,
-    and say so otherwise). Refused naming the field that sets p."""
+    space (r >= 2) and redundancy (p > r; the h panel draws one scalar h, p = r + 1, and says
+    so otherwise). Refused naming the field that sets p."""
     robot = user_robot(definition)
     p, r = robot.spec.p, robot.spec.r
     if r < 2 or p <= r:
