@@ -191,17 +191,18 @@ def _second_phase(result, cancelled=lambda: False):
 def test_the_e1_e2_panel_shows_e2_of_a_7_joint_map_beside_single_joints():
     """The Panda's synthesized map (7 joints, p - r = 1): the second phase takes its E2 by the
     synthesis's Sobol rule (its independent check rule: docs/e2-vector.md), with E2 of
-    h = s x_j for each joint; the E1/E2 panel draws them as bars (the map outlined, first), the
-    h panel's title says E2; a cancelled phase raises Cancelled."""
+    h = s x_j for each joint, and E1 on the same nodes; the E1/E2 panel draws them as bars (the
+    map outlined, first), its title and the h panel's say E1; a cancelled phase raises
+    Cancelled."""
     from jik.app.dashboard.runs import Cancelled
     from jik.app.dashboard.second_phase import FUNCTIONALS, GRID
 
     result = compute(_panda())
     phase = _second_phase(result)
-    assert phase.steps == {GRID: 0, FUNCTIONALS: 2}  # (E2's rule; no sweep over 7 joints)
+    assert phase.steps == {GRID: 0, FUNCTIONALS: 2}  # (E1, E2 by a rule; no sweep over 7 joints)
     functionals, sens = phase.run()
     assert phase.fraction == 1.0
-    assert functionals["E1"] is None and 1.6e-4 < functionals["E2"] < 1.8e-4
+    assert 2.3e-3 < functionals["E1"] < 2.4e-3 and 1.6e-4 < functionals["E2"] < 1.8e-4
     single = functionals["E2_single_joint"]
     assert set(single) == {f"x{i}" for i in range(1, 8)}
     assert single["x1"]["e2"] == pytest.approx(1.78e-3, rel=1e-2)  # (the docs' table)
@@ -217,6 +218,7 @@ def test_the_e1_e2_panel_shows_e2_of_a_7_joint_map_beside_single_joints():
     )
     low = specs["sensitivity"]["layout"]["yaxis"]["range"][0]
     assert low <= np.log10(functionals["E2"]) - 1  # (the map's bar stands out of the axis)
-    assert "E2 = 0.000173" in specs["augmenting"]["layout"]["title"]["text"]
+    assert "E1 = 0.002346, E2 = 0.0001731" in specs["augmenting"]["layout"]["title"]["text"]
+    assert "E1 (13) of h = 0.002346" in specs["sensitivity"]["layout"]["title"]["text"]
     with pytest.raises(Cancelled):
         _second_phase(compute(_panda()), cancelled=iter([False] * 3 + [True] * 99).__next__).run()
