@@ -67,26 +67,39 @@ def best_frame_axes(kin: Kinematics, box: Mapping, fix: Mapping) -> list[int]:
     return [int(a) + 1 for a in choices[int(np.argmax(least))]]
 
 
+def check_frame_axes(kin: Kinematics, frame_axes, field: str = "frame_axes") -> list[int] | None:
+    """``frame_axes`` as p - r distinct 1-based joints (1 to p), or None when not given; an
+    InvalidInputError naming ``field`` otherwise, and for a robot with one degree of redundancy
+    (its frame is its kernel vector: the joints would choose nothing)."""
+    if frame_axes is None:
+        return None
+    m = kin.p - kin.r
+    if m < 2:
+        raise InvalidInputError(
+            f"{field}: the kernel frame of {kin.name} (p - r = {m}) is its kernel vector; "
+            "frame axes choose the frame of p - r >= 2 degrees of redundancy",
+            field,
+        )
+    if isinstance(frame_axes, str | bytes) or not isinstance(frame_axes, Sequence | np.ndarray):
+        raise InvalidInputError(
+            f"{field} must be a list of {m} joints (1 to {kin.p}), got {frame_axes!r}", field
+        )
+    axes = [count(a, field, 1, kin.p, field) for a in frame_axes]
+    if len(set(axes)) != m or len(axes) != m:
+        raise InvalidInputError(f"{field} must name {m} distinct joints, got {axes}", field)
+    return axes
+
+
 def frame_axes_of(
     kin: Kinematics, box: Mapping, fix: Mapping, frame_axes: Sequence[int] | None
 ) -> list[int] | None:
     """The 0-based frame axes of :func:`kernel_frame` on ``box`` (held ``fix``): None for one
-    degree of redundancy (the robot's own kernel vector), else ``frame_axes`` (1-based, p - r
-    distinct joints) or, without them, :func:`best_frame_axes`."""
-    m = kin.p - kin.r
-    if m < 2:
+    degree of redundancy (the robot's own kernel vector), else ``frame_axes``
+    (:func:`check_frame_axes`) or, without them, :func:`best_frame_axes`."""
+    axes = check_frame_axes(kin, frame_axes)
+    if kin.p - kin.r < 2:
         return None
-    if frame_axes is None:
-        return [a - 1 for a in best_frame_axes(kin, box, fix)]
-    if isinstance(frame_axes, str | bytes) or not isinstance(frame_axes, Sequence | np.ndarray):
-        raise InvalidInputError(
-            f"frame_axes must be a list of {m} joints (1 to {kin.p}), got {frame_axes!r}",
-            "frame_axes",
-        )
-    axes = [count(a, "frame_axes", 1, kin.p) - 1 for a in frame_axes]
-    if len(set(axes)) != m or len(axes) != m:
-        raise InvalidInputError(f"frame_axes needs {m} distinct joints", "frame_axes")
-    return axes
+    return [a - 1 for a in (best_frame_axes(kin, box, fix) if axes is None else axes)]
 
 
 def require_maps(

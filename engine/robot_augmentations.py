@@ -10,6 +10,7 @@ from .augmentations import AugmentingMap
 from .exceptions import InvalidInputError
 from .formula_kinematics import FormulaMap
 from .functionals import check_region
+from .kernel_frame import check_frame_axes
 from .kinematics import Kinematics
 from .registry import AugmentationSpec
 from .robot_synthesis import (
@@ -71,10 +72,10 @@ def augmentations_from_dict(kin: Kinematics, items, key: str | None = None):
                     f"E2-optimal h of {len(box)} joints on {box}: Ritz solve of (19) in a "
                     f"total-degree {degree} basis on a Sobol rule"
                 )
+            axes = check_frame_axes(kin, item.get("frame_axes"), f"{where}.frame_axes")
             if k == 1:
                 factory = synthesis(box, fix, degree, key)
             else:
-                axes = _frame_axes(kin, item.get("frame_axes"), f"{where}.frame_axes")
                 vectors[label] = vector_synthesis(kin, box, fix, degree, key, axes)
                 factory = _vector_only(label)
                 text = text.replace("E2-optimal h", f"E2-optimal h_1..h_{k}")
@@ -102,20 +103,6 @@ def _formula_maps(kin: Kinematics, item: Mapping, where: str) -> tuple[FormulaMa
     names, params = kin.variable_names, item.get("parameters")
     fields = [f"{where}.h"] if k == 1 else [f"{where}.h.{j}" for j in range(k)]
     return tuple(FormulaMap(t, names, params, field=f) for t, f in zip(texts, fields, strict=True))
-
-
-def _frame_axes(kin: Kinematics, axes, field: str) -> list[int] | None:
-    """The 1-based joints whose axes fix a vector map's kernel frame (None: the synthesis'
-    best conditioned, :func:`~.kernel_frame.best_frame_axes`)."""
-    if axes is None:
-        return None
-    k = kin.p - kin.r
-    if not isinstance(axes, list) or len(axes) != k:
-        raise InvalidInputError(f"{field} must be a list of {k} joints (1 to {kin.p})", field)
-    chosen = [count(a, field, 1, kin.p, field) for a in axes]
-    if len(set(chosen)) != k:
-        raise InvalidInputError(f"{field} must name {k} distinct joints", field)
-    return chosen
 
 
 def _vector_only(label: str) -> Callable[..., AugmentingMap]:

@@ -166,8 +166,14 @@ def test_evaluate_takes_a_vector_of_maps_and_names_the_frame_of_e2(api):
         )
         assert "2 maps h_1 ... h_2; the grid shows h_1" in b["message"]
         assert b["singularities_searched"] is False and list(b["grid"]["axes"]) == ["x2", "x3"]
-    for axes, words in (([3, 3], "needs 2 distinct joints"), ([3, 9], "between 1 and 4")):
-        r = api.post("/synthesize", json=body | {"frame_axes": axes})
+    m2 = {"robot": {"name": "manipulator2"}}  # (p - r = 1: its frame is its kernel vector)
+    for request, words in (
+        (body | {"frame_axes": [3, 3]}, "must name 2 distinct joints"),
+        (body | {"frame_axes": [3, 9]}, "between 1 and 4"),
+        (m2 | {"frame_axes": [2, 3]}, "is its kernel vector"),
+        (m2 | {"frame_axes": [1], "method": "e2_total_degree", "degree": 2}, "kernel vector"),
+    ):
+        r = api.post("/synthesize", json=request)
         assert r.status_code == 422, r.text
         detail = r.json()["detail"][0]
         assert detail["loc"] == ["body", "frame_axes"] and words in detail["msg"]

@@ -5,12 +5,14 @@ rule and the Sobol rule, against the definitions computed another way (a dense i
 import numpy as np
 import pytest
 
+from jik.engine.augmentations import PaperCubic
 from jik.engine.e2_qmc import e1_qmc, e2_qmc
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.formula_kinematics import FormulaMap
 from jik.engine.functional_report import functionals_report
 from jik.engine.functionals import error_functional_e1, error_functional_e2, quadrature
 from jik.engine.kernel_frame import best_frame_axes
+from jik.engine.kinematics import Manipulator2
 from jik.engine.planar_chain import PlanarChain
 from jik.engine.synthesis_nd import synthesize_e2_nd
 from jik.engine.total_degree import sobol_nodes
@@ -19,6 +21,8 @@ CHAIN = PlanarChain("RRRR", [1.0, 1.0, 1.0, 1.0])  # a position task: p - r = 2
 NAMES = list(CHAIN.names)
 MAPS = [FormulaMap("x3 + 0.1*x1**2", NAMES), FormulaMap("x4 - 0.2*sin(x2)", NAMES)]
 REGION = {"x2": (0.3, 1.2), "x3": (0.4, 1.3), "x4": (0.2, 1.0)}
+#: One degree of redundancy: frame axes choose nothing, and are refused.
+M2, CUBIC, M2_BOX = Manipulator2(), PaperCubic(), {"x2": (-1.0, 1.0), "x3": (0.0, 3.0)}
 
 
 def by_definition(maps, region, axes, nodes=8):
@@ -129,6 +133,12 @@ def test_the_report_names_the_frame_by_either_rule():
         (lambda: error_functional_e2(CHAIN, MAPS, REGION, frame_axes=[3, 9]), "frame_axes", "4"),
         (lambda: error_functional_e2(CHAIN, MAPS, REGION, frame_axes="34"), "frame_axes", "list"),
         (lambda: functionals_report(CHAIN, MAPS[0], REGION), "amap", "p - r = 2"),
+        (
+            lambda: error_functional_e2(M2, PaperCubic(), M2_BOX, frame_axes=[9]),
+            "frame_axes",
+            "vector",
+        ),
+        (lambda: synthesize_e2_nd(M2, M2_BOX, frame_axes=[1]), "frame_axes", "kernel vector"),
     ],
 )
 def test_refusals_name_the_argument(call, field, words):

@@ -81,9 +81,10 @@ class SynthesizeRequest(BaseModel):
     frame_axes: FrameAxes | None = Field(
         None,
         description="p - r >= 2, 'e2_total_degree' and 'evaluate': the p - r joints (1-based) "
-        "whose axes fix the kernel frame of E2 (default: those best conditioned at the box's "
-        "centre, engine.kernel_frame.best_frame_axes; functionals.e2.frame_axes and "
-        "total_degree.frame_axes say which)",
+        "whose axes fix the kernel frame of E2 (default: a synthesized vector's own, else those "
+        "best conditioned at the box's centre, engine.kernel_frame.best_frame_axes; "
+        "functionals.e2.frame_axes and total_degree.frame_axes say which); refused for p - r = "
+        "1, whose frame is its kernel vector",
     )
     grid: Annotated[int, Field(strict=True, ge=3, le=61), INTEGRAL] = Field(
         21, description="grid points per axis for h"
