@@ -9,8 +9,8 @@ case in tests/app/test_errors.py, test_synthesize.py and test_sessions.py):
   is left for the box; ``e2_variational`` synthesizes h on a box of 2 or 3 variables, so it
   takes no ``augmentation``;
 - ``e2_total_degree`` takes any number of box variables and no ``augmentation``; its Sobol
-  rule has a power of two of nodes, at least twice the basis' unknowns (at most 4000), and its
-  kernel frame (p - r >= 2) p - r distinct joints;
+  rule has a power of two of nodes, at least twice the basis' unknowns (at most 4000);
+- a kernel frame (``frame_axes``) is p - r distinct joints, for p - r >= 2 only;
 - discrete mode (asked for, or the robot's default) needs ``gamma < 2``;
 - an ``augmentation`` goes with the extended inverse: a run or atlas of other algorithms alone
   takes none;
@@ -168,7 +168,9 @@ def _user_robot_ok(body: dict, path: str) -> bool:
             if req.method == "e2_total_degree":
                 _, region, _ = synthesis_region(spec, robot.kinematics, req)
                 return _total_degree_ok(body, len(region), spec.p, spec.r)
-            if spec.p != spec.r + 1 or (evaluate and req.augmentation is None):
+            if not _frame_ok(body.get("frame_axes"), spec.p, spec.r):
+                return False
+            if (spec.p != spec.r + 1 and not evaluate) or (evaluate and req.augmentation is None):
                 return False
             _, region, _ = synthesis_region(spec, robot.kinematics, req)
             return len(region) >= 2 or evaluate
@@ -180,21 +182,26 @@ def _user_robot_ok(body: dict, path: str) -> bool:
 def _total_degree_ok(body: dict, d: int, p: int, r: int) -> bool:
     """The rules of a total-degree synthesis of ``d`` variables (see the module docstring)."""
     nodes, degree = int(body.get("qmc_nodes", TOTAL_NODES)), int(body.get("degree") or TOTAL_DEGREE)
-    axes = body.get("frame_axes")
-    frame_ok = axes is None or p - r < 2 or (len(set(axes)) == p - r and max(axes) <= p)
     unknowns = basis_size(d, degree)
     return (
         d >= 1
         and not body.get("augmentation")
-        and frame_ok
+        and _frame_ok(body.get("frame_axes"), p, r)
         and not nodes & (nodes - 1)
         and unknowns <= MAX_UNKNOWNS
         and nodes >= 2 * unknowns
     )
 
 
+def _frame_ok(axes, p: int, r: int) -> bool:
+    """A kernel frame's joints: none, or p - r >= 2 distinct joints of the robot."""
+    return axes is None or (p - r >= 2 and len(set(axes)) == len(axes) == p - r and max(axes) <= p)
+
+
 def _synthesis_ok(body: dict) -> bool:
     spec = ROBOTS[body["robot"]["name"]]
+    if not _frame_ok(body.get("frame_axes"), spec.p, spec.r):
+        return False
     fixed = body.get("fixed") or {}
     if body.get("method") == "e2_total_degree":
         try:
@@ -210,9 +217,7 @@ def _synthesis_ok(body: dict) -> bool:
     region = body["region"]
     if any(not lo < hi for lo, hi in region.values()) or set(region) & set(fixed):
         return False
-    if len(region) > 3:  # (the unicycle's four lambdas: the total-degree synthesis' alone)
-        return False
-    return not synthesis or (len(region) >= 2 and not body.get("augmentation"))
+    return not synthesis or (2 <= len(region) <= 3 and not body.get("augmentation"))
 
 
 def _run_ok(body: dict, path: str) -> bool:
