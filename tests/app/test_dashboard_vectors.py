@@ -81,7 +81,7 @@ def test_a_synthesized_vector_on_its_design_box_has_both_and_beats_the_formulas(
 def test_a_vector_synthesized_in_a_chosen_frame_is_scored_in_it_and_so_are_the_formulas():
     """The design synthesis asks for the frame of joints 3, 4: its E2 (minimal in that frame) and
     the formulas' are taken in it, not in the best-conditioned (2, 4), where the synthesis
-    scored 13.3, worse than the formulas' 9.6."""
+    scores 13.3, worse than the formulas' 9.6."""
     synthesized = {"name": "e2_synthesized", "region": BOX, "frame_axes": [3, 4]}
     result = result_of(synthesized, FORMULAS)
     f = error_functionals(result)

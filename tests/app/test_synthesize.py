@@ -202,9 +202,9 @@ def test_evaluate_over_every_joint_of_an_arm_takes_the_sobol_rule_as_the_dashboa
 
 
 def test_evaluate_takes_e2_of_a_synthesized_vector_in_the_frame_it_was_synthesized_in(api):
-    """A vector synthesized in the kernel frame of joints 3, 4 minimises E2 in that frame; scored
-    in the best-conditioned one (2, 4) its E2 was 13.3, above two formula maps' 9.57, against
-    0.113 in its own. 'evaluate' takes its frame unless the request names another."""
+    """A vector synthesized in the kernel frame of joints 3, 4 minimises E2 in that frame (0.113);
+    in the best-conditioned one (2, 4) its E2 is 13.3, above two formula maps' 9.57. 'evaluate'
+    takes its frame unless the request names another."""
     box = {"x2": [0.3, 1.2], "x3": [0.4, 1.3], "x4": [0.2, 1.0]}
     body = {
         "robot": {"name": "planar_chain", "joints": "RRRR", "lengths": [1.0] * 4},
@@ -223,8 +223,8 @@ def test_evaluate_takes_e2_of_a_synthesized_vector_in_the_frame_it_was_synthesiz
 
 
 def test_evaluate_says_e2_is_undefined_where_a_map_is(api):
-    """h_2 = sqrt(x4 - 0.5) is undefined on part of the box: E2 is null and the message says
-    why (it was a number, dh taken as 0 there); E1 keeps the points where h is defined."""
+    """h_2 = sqrt(x4 - 0.5) is undefined on part of the box: E2 is null (no dh is made up there)
+    and the message says why; E1 keeps the points where h is defined."""
     body = {
         "robot": {"name": "planar_chain", "joints": "RRRR", "lengths": [1.0] * 4},
         "method": "evaluate",

@@ -67,9 +67,9 @@ def test_e2_depends_on_the_frame_and_takes_the_best_conditioned_by_default():
 
 def test_e2_takes_dh_where_the_extended_jacobian_is_singular_and_no_value_where_h_is_undefined():
     """The integrand (19) of E2 is finite where [J; dh] is singular: at the 25 of 125 Gauss
-    points where dh_2 of h = (x3, (x4 - 0.6)^2) vanishes, E2 took dh = 0 for both maps (6.06,
-    not 5.49). Where h is undefined it took dh = 0 too and gave a number where the Sobol rule
-    (e2_qmc) gives None."""
+    points where dh_2 of h = (x3, (x4 - 0.6)^2) vanishes, E2 takes dh itself (5.49; dh = 0 for
+    both maps there would give 6.06). Where h is undefined E2 has no value, as the Sobol rule
+    (e2_qmc) has none."""
     maps = [FormulaMap("x3", NAMES), FormulaMap("(x4 - 0.6)**2", NAMES)]
     e2 = error_functional_e2(CHAIN, maps, REGION, nodes=5, frame_axes=[3, 4])
     assert len(e2.singular_points) == 25
