@@ -55,13 +55,16 @@ def synthesis_region(spec: RobotSpec, kin: Kinematics, req: S.SynthesizeRequest)
     return list(spec.variable_names), region, fixed
 
 
-def _functionals(kin, amap, region, fixed, nodes, frame_axes=None) -> tuple[dict, list[str]]:
-    """E1 (13) and E2 (18) of ``amap`` (a map, or a tuple of p - r maps: E2 in the kernel frame
-    of ``frame_axes``, default the best conditioned) by the rule the region's size calls for
-    (:func:`~jik.engine.functional_report.functional_info`), and what the message says."""
+def _functionals(
+    kin, amap, region, fixed, nodes, frame_axes=None, labels=("e1", "e2")
+) -> tuple[dict, list[str]]:
+    """E1 (13) and E2 (18) (those of ``labels``) of ``amap`` (a map, or a tuple of p - r maps:
+    E2 in the kernel frame of ``frame_axes``, default the best conditioned) by the rule the
+    region's size calls for (:func:`~jik.engine.functional_report.functional_info`), and what
+    the message says."""
     notes: list[str] = []
     out: dict[str, S.FunctionalInfo | None] = {}
-    for label in ("e1", "e2"):
+    for label in labels:
         try:
             info = functional_info(label.upper(), kin, amap, region, fixed, nodes, frame_axes)
             out[label] = S.FunctionalInfo.model_validate(info)
@@ -207,9 +210,9 @@ def map_response(
 def total_degree_response(
     req: S.SynthesizeRequest, kin, robot_used: S.RobotUsed, box: tuple[list[str], dict, dict]
 ) -> S.SynthesizeResponse:
-    """The E2-optimal map(s) of ``req`` on its box (names, region, fixed values): E2 on the
-    fitting rule and on an independent one, its convergence with the degree and the nodes,
-    h_1 on a grid, the basis and coefficients."""
+    """The E2-optimal map(s) of ``req`` on its box (names, region, fixed values): E1 (by the rule
+    the box's size calls for) and E2 on the fitting rule and on an independent one, its
+    convergence with the degree and the nodes, h_1 on a grid, the basis and coefficients."""
     names, region, fixed = box
     degree = TOTAL_DEGREE if req.degree is None else req.degree
     try:
@@ -241,14 +244,15 @@ def total_degree_response(
             f"the best single joint, h = {'-' if best['sign'] < 0 else ''}{j}, has "
             f"E2 {best['e2']:.6g}"
         )
-    notes.append("E1 is not evaluated (its Gauss rule grows as nodes^d)")
+    amap = res.maps if len(res.maps) > 1 else res.maps[0]
+    e1, more = _functionals(kin, amap, res.region, res.fixed, req.nodes, labels=("e1",))
     return map_response(
         req,
         robot_used,
         kin,
-        res.maps if len(res.maps) > 1 else res.maps[0],
+        amap,
         (names, res.region, {**fixed, **res.fixed}),
-        notes,
+        notes + more,
         augmentation=S.AugmentationUsed(
             name=res.maps[0].name,
             parameters={
@@ -259,7 +263,7 @@ def total_degree_response(
         ),
         coefficients={},
         functionals={
-            "e1": None,
+            "e1": e1["e1"],
             "e2": S.FunctionalInfo(
                 value=nullable(res.e2_check),
                 n_points=res.nodes,

@@ -9,6 +9,7 @@ import math
 import numpy as np
 import pytest
 
+from jik.engine.e2_qmc import e1_qmc
 from jik.engine.kernel_frame import best_frame_axes
 from jik.engine.robot_spec import robot_from_dict
 from jik.engine.synthesis_nd import synthesize_e2_nd
@@ -83,6 +84,9 @@ def test_a_7_joint_arm_over_all_its_joints_is_the_engines_synthesis(api):
     np.testing.assert_allclose(
         info["coefficients"][0], ref.maps[0].coefficients, rtol=1e-8, atol=1e-10
     )
+    e1 = e1_qmc(robot_from_dict(PANDA).kinematics, ref.maps[0], ref.region, fixed=ref.fixed)
+    assert b["functionals"]["e1"]["rule"] == "sobol" and not e1["divergent"]
+    assert math.isclose(b["functionals"]["e1"]["value"], e1["E1"], rel_tol=1e-9)
     assert set(info["single_joint"]) == set(b["region"])
     assert min(j["e2"] for j in info["single_joint"].values()) > info["e2"]
     # the grid is h of the basis and coefficients reported, on two of the box's axes
@@ -106,6 +110,13 @@ def test_two_degrees_of_redundancy_give_two_maps(api):
     assert np.shape(info["coefficients"]) == (2, 34) and info["frame_axes"] == best
     assert info["single_joint"] == {} and b["augmentation"]["parameters"]["maps"] == 2
     assert math.isclose(info["e2_check"], ref.e2_check, rel_tol=1e-10)
+    # E1 of the two maps over the four joints, by the Sobol rule (E1 takes no frame): the
+    # E2-optimal maps make [J; dh] singular inside this box (det(dh K) changes sign).
+    e1 = e1_qmc(robot_from_dict(RRRR).kinematics, ref.maps, ref.region, fixed=ref.fixed)
+    got = b["functionals"]["e1"]
+    assert got["rule"] == "sobol" and got["n_points"] == 8192
+    assert got["divergent"] is e1["divergent"] is True and got["value"] is None
+    assert "E1 diverges" in b["message"] and b["functionals"]["e2"]["frame_axes"] == best
     other = _ok(
         api,
         {
