@@ -81,7 +81,7 @@ def error_functionals(
     (:func:`~jik.app.dashboard.analysis.runs_box`).
     ``on_advance(done, total)`` as the engine's
     :func:`~jik.engine.functional_report.functionals_report` advances (what it raises stops
-    it), ``cancelled`` polled; over more than three variables, E2 by a Sobol rule.
+    it), ``cancelled`` polled; over more than three variables, E1 and E2 by a Sobol rule.
     """
     grid, state, names = result.augmenting, result.state, result.variable_names
     vector = vector_maps(state)
@@ -122,7 +122,7 @@ SENSITIVITY_SAMPLES = 11
 def sensitivity_evaluations(state: DashboardState, amap) -> int:
     """How many values of E1 or E2 :func:`sensitivity` computes for ``state`` and its map
     ``amap`` (its steps of progress): none for an expensive map or a design region over more
-    variables than a tensor rule takes (E2 from a Sobol rule alone, no sweep); else both
+    variables than a tensor rule takes (E1 and E2 by a Sobol rule, no sweep); else both
     functionals at every point of the parameters' sweeps, or of each of the robot's maps."""
     if amap is None or expensive_map(amap):
         return 0
