@@ -135,7 +135,8 @@ def e1_qmc(
     Returns
     -------
     dict
-        ``{"E1": float, inf when divergent, or None (h undefined at some node), "divergent",
+        ``{"E1": float, inf when divergent, or None (h undefined at some node; then not
+        "divergent" either), "divergent",
         "undefined_points", "min_abs_dh_k": min |det(dh K)| over the nodes, "nodes", "seed"}``.
     """
     kinematics = require_kinematics(kinematics)
@@ -154,7 +155,7 @@ def e1_qmc(
             least = min(least, float(np.min(np.abs(det[~bad]) / m[~bad])))
         ok = ~bad & ~rank_loss
         total += float(np.sum(e1_integrand(J[ok], dh[ok])))
-    divergent = singular or bool(lo_det < 0.0 < hi_det)
+    divergent = not undefined and (singular or bool(lo_det < 0.0 < hi_det))
     e1 = None if undefined else (np.inf if divergent else float(rule.weight * total))
     return {
         "E1": e1,

@@ -49,10 +49,9 @@ class FunctionalValue:
     ----------
     value : float
         The integral; for E1, quadrature points where [J; dh] is singular are excluded (the
-        integrand is infinite there), for E2 they are included (the integrand (19) is finite),
-        and E2 is NaN where h is undefined at one (dh not finite), as
-        :func:`~jik.engine.e2_qmc.e2_qmc` says None. E1 is ``inf`` when it diverges
-        (``divergent``).
+        integrand is infinite there), for E2 they are included (the integrand (19) is finite).
+        Either is NaN where h is undefined at a point (dh not finite), as the Sobol rule of
+        :mod:`jik.engine.e2_qmc` says None. E1 is ``inf`` when it diverges (``divergent``).
     region : dict
         ``{"x2": (lo, hi), ...}``: the integrated variables.
     n_points : int
@@ -264,9 +263,10 @@ def _evaluate(
         m = kinematics.manipulability(x)
         dhk = np.where(bad, 0.0, np.abs(det) / m)  # |det(dh K)|, whatever the frame
         axes, divergent = None, False
-        if which == "e1":  # (no frame: E1 does not depend on it)
+        if which == "e1":  # (no frame: E1 does not depend on it; NaN where h is undefined)
             f = np.where(bad, 0.0, e1_integrand(J, dh_safe))
-            divergent = _e1_diverges(kinematics, maps, x, J, dh, box)
+            f = np.where(np.isnan(det), np.nan, f)
+            divergent = not np.isnan(det).any() and _e1_diverges(kinematics, maps, x, J, dh, box)
         else:
             axes = frame_axes_of(kinematics, box, fix, frame_axes)
             f = e2_integrand(J, kernel_frame(kinematics, x, axes)[0], m, dh)  # (NaN: undefined)
@@ -313,7 +313,7 @@ def error_functional_e1(
     FunctionalValue
         Quadrature points where [J; dh] is singular are excluded from the value and listed in
         ``singular_points``; where det(dh K) vanishes inside the region, the value is ``inf``
-        and ``divergent`` is set.
+        and ``divergent`` is set; where h is undefined at a point, the value is NaN.
 
     Notes
     -----

@@ -223,8 +223,8 @@ def test_evaluate_takes_e2_of_a_synthesized_vector_in_the_frame_it_was_synthesiz
 
 
 def test_evaluate_says_e2_is_undefined_where_a_map_is(api):
-    """h_2 = sqrt(x4 - 0.5) is undefined on part of the box: E2 is null (no dh is made up there)
-    and the message says why; E1 keeps the points where h is defined."""
+    """h_2 = sqrt(x4 - 0.5) is undefined on part of the box: E1 and E2 are null (no dh is made
+    up there, no point left out) and the message says why."""
     body = {
         "robot": {"name": "planar_chain", "joints": "RRRR", "lengths": [1.0] * 4},
         "method": "evaluate",
@@ -236,7 +236,8 @@ def test_evaluate_says_e2_is_undefined_where_a_map_is(api):
     assert r.status_code == 200, r.text
     b = r.json()
     assert b["functionals"]["e2"]["value"] is None and b["functionals"]["e2"]["n_singular"] > 0
-    assert b["functionals"]["e1"]["value"] is not None
+    assert b["functionals"]["e1"]["value"] is None and not b["functionals"]["e1"]["divergent"]
+    assert "E1 undefined: h is not defined on all of the region" in b["message"]
     assert "E2 undefined: h is not defined on all of the region" in b["message"]
 
 

@@ -68,8 +68,8 @@ def test_e2_depends_on_the_frame_and_takes_the_best_conditioned_by_default():
 def test_e2_takes_dh_where_the_extended_jacobian_is_singular_and_no_value_where_h_is_undefined():
     """The integrand (19) of E2 is finite where [J; dh] is singular: at the 25 of 125 Gauss
     points where dh_2 of h = (x3, (x4 - 0.6)^2) vanishes, E2 takes dh itself (5.49; dh = 0 for
-    both maps there would give 6.06). Where h is undefined E2 has no value, as the Sobol rule
-    (e2_qmc) has none."""
+    both maps there would give 6.06). Where h is undefined E1 and E2 have no value, as by the
+    Sobol rule."""
     maps = [FormulaMap("x3", NAMES), FormulaMap("(x4 - 0.6)**2", NAMES)]
     e2 = error_functional_e2(CHAIN, maps, REGION, nodes=5, frame_axes=[3, 4])
     assert len(e2.singular_points) == 25
@@ -78,6 +78,12 @@ def test_e2_takes_dh_where_the_extended_jacobian_is_singular_and_no_value_where_
     assert np.isnan(error_functional_e2(CHAIN, undefined, REGION, nodes=5).value)
     assert functionals_report(CHAIN, undefined, REGION, nodes=5)["E2"] is None
     assert e2_qmc(CHAIN, undefined, REGION, nodes=64)["E2"] is None
+    # E1 too: an integral over the points where h is defined would be over a smaller box.
+    e1 = error_functional_e1(CHAIN, undefined, REGION, nodes=5)
+    assert np.isnan(e1.value) and not e1.divergent
+    assert functionals_report(CHAIN, undefined, REGION, nodes=5)["E1"] is None
+    q = e1_qmc(CHAIN, undefined, REGION, nodes=64)
+    assert q["E1"] is None and not q["divergent"]
 
 
 def test_the_sobol_rule_is_the_vector_synthesis_rule():
