@@ -53,6 +53,8 @@ def functional_info(
     by the Sobol rule), "frame_axes" (E2 of a vector: 1-based, else None), "rule": "gauss" or
     "sobol"}``, and E2's ``single_joint`` by the Sobol rule (one degree of redundancy).
     ``progress`` follows the Sobol rule's nodes. Raises what the functional raises."""
+    if key not in ("E1", "E2"):
+        raise InvalidInputError(f"key must be 'E1' or 'E2', got {key!r}", "key")
     if len(region) <= MAX_TENSOR_VARIABLES:
         if key == "E1":
             value = error_functional_e1(kinematics, amap, region, nodes=nodes, fixed=fixed)

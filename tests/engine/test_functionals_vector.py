@@ -9,7 +9,7 @@ from jik.engine.augmentations import PaperCubic
 from jik.engine.e2_qmc import e1_qmc, e2_qmc
 from jik.engine.exceptions import InvalidInputError
 from jik.engine.formula_kinematics import FormulaMap
-from jik.engine.functional_report import functionals_report
+from jik.engine.functional_report import functional_info, functionals_report
 from jik.engine.functionals import error_functional_e1, error_functional_e2, quadrature
 from jik.engine.kernel_frame import best_frame_axes
 from jik.engine.kinematics import Manipulator2
@@ -139,6 +139,7 @@ def test_the_report_names_the_frame_by_either_rule():
         (lambda: error_functional_e2(CHAIN, MAPS, REGION, frame_axes=[3, 9]), "frame_axes", "4"),
         (lambda: error_functional_e2(CHAIN, MAPS, REGION, frame_axes="34"), "frame_axes", "list"),
         (lambda: functionals_report(CHAIN, MAPS[0], REGION), "amap", "p - r = 2"),
+        (lambda: functional_info("E3", CHAIN, MAPS, REGION, {}), "key", "'E1' or 'E2'"),
         (
             lambda: error_functional_e2(M2, PaperCubic(), M2_BOX, frame_axes=[9]),
             "frame_axes",
