@@ -105,8 +105,11 @@ async function onResult(msg) {
   exportLinks(msg.generation);
   const t = msg.timing;
   $("#timing").textContent = `generation ${msg.generation}: compute ${Math.round(1000 * t.compute)} ms, figures ${Math.round(1000 * t.figures)} ms`;
-  const note = page.cancelled ? `; generation ${page.cancelled.running} was cancelled` : "";
-  page.cancelled = null;
+  // (the note goes with the result that follows the cancel: the cancelled generation's own
+  // result can still come first, when its last leg was running)
+  const after = page.cancelled && msg.generation > page.cancelled.running;
+  const note = after ? `; generation ${page.cancelled.running} was cancelled` : "";
+  if (after) page.cancelled = null;
   setStatus(msg.generation < session.generation ? `computing generation ${session.generation}…` : `up to date (generation ${msg.generation})${note}`);
 }
 
