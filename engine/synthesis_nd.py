@@ -246,7 +246,7 @@ def synthesize_e2_nd(
         degree=degree,
         nodes=nodes,
         seed=seed,
-        frame_axes=tuple(axes or ()),
+        frame_axes=tuple(a + 1 for a in axes or ()),
     )
 
 

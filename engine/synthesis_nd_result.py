@@ -36,7 +36,8 @@ class TotalDegreeSynthesis(Columns):
     region, fixed : dict
     degree, nodes, seed : int
     frame_axes : tuple of int
-        The kernel frame's axes (p - r >= 2), 0-based.
+        The 1-based joints whose axes fix the kernel frame (p - r >= 2), as the synthesis's
+        ``frame_axes`` parameter takes them; empty for one degree of redundancy.
     """
 
     maps: tuple[TotalDegreeMap, ...]
@@ -62,7 +63,8 @@ class TotalDegreeSynthesis(Columns):
         return (
             f"TotalDegreeSynthesis(e2={self.e2:.6g}, e2_check={self.e2_check:.6g}, "
             f"maps={len(self.maps)}, variables={len(self.region)}, degree={self.degree}, "
-            f"unknowns={len(self.maps[0].index)}, nodes={self.nodes})"
+            f"unknowns={len(self.maps[0].index)}, nodes={self.nodes}"
+            f"{f', frame_axes={list(self.frame_axes)}' if self.frame_axes else ''})"
         )
 
     def columns(self) -> dict[str, FloatArray]:
@@ -86,5 +88,5 @@ class TotalDegreeSynthesis(Columns):
             "fixed": dict(self.fixed),
             "convergence": list(self.convergence),
             "single_joint": dict(self.single_joint),
-            "frame_axes": [a + 1 for a in self.frame_axes],
+            "frame_axes": list(self.frame_axes),
         }

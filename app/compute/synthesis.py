@@ -270,7 +270,7 @@ def total_degree_response(
                 n_singular=0,
                 min_abs_dh_k=None,
                 rule="sobol",
-                frame_axes=[a + 1 for a in res.frame_axes] or None,
+                frame_axes=list(res.frame_axes) or None,
             ),
         },
         convergence=[{k: float(v) for k, v in row.items()} for row in res.convergence],

@@ -160,7 +160,14 @@ def test_vector_h_of_a_linear_map_is_the_kernel_frame():
     res = synthesize_e2_nd(kin, region, degree=2, nodes=2**10)
     assert len(res.maps) == 2
     assert abs(res.e2) < 1e-10 and abs(res.e2_check) < 1e-10
-    K, _ = kernel_frame(kin, np.zeros((1, 4)), res.frame_axes)
+    # (1-based, as the parameter takes them and every other door reports them)
+    assert list(res.frame_axes) == res.as_dict()["frame_axes"] == [1, 3]
+    assert (
+        res.frame_axes
+        == synthesize_e2_nd(kin, region, degree=2, nodes=2**10, frame_axes=[1, 3]).frame_axes
+    )
+    assert "frame_axes=[1, 3]" in repr(res)
+    K, _ = kernel_frame(kin, np.zeros((1, 4)), [a - 1 for a in res.frame_axes])
     x = np.random.default_rng(1).uniform(-1, 1, (6, 4))
     for i, h in enumerate(res.maps):
         assert np.allclose(h.gradient(x), K[0, :, i], atol=1e-10)
