@@ -72,18 +72,20 @@ def e2_qmc(
     Returns
     -------
     dict
-        ``{"E2": float or None (h undefined at some node), "undefined_points": int,
-        "single_joint": {name: {"sign", "e2"}} (empty for p - r >= 2), "nodes", "seed",
-        "frame_axes": 1-based list, or None for one degree of redundancy}``.
+        ``{"E2": float or None (h undefined at some node), "E2_half": the same rule's value on
+        its first half of the nodes (a Sobol rule of nodes / 2; :func:`error_estimate`),
+        "undefined_points": int, "single_joint": {name: {"sign", "e2"}} (empty for
+        p - r >= 2), "nodes", "seed", "frame_axes": 1-based list, or None for one degree of
+        redundancy}``.
     """
     kinematics = require_kinematics(kinematics)
     maps = require_maps(kinematics, amap, "E2", "amap")
     rule = _Rule(kinematics, region, fixed, nodes, seed, "E2")
     axes = frame_axes_of(kinematics, rule.box, rule.fix, frame_axes)
     k_red = len(maps)
-    total, undefined = 0.0, 0
+    total, half, undefined = 0.0, 0.0, 0
     c0, diag, load = 0.0, np.zeros(len(rule.idx)), np.zeros(len(rule.idx))
-    for x, m in rule.chunks(progress):
+    for first, x, m in rule.chunks(progress):
         K, Jp = kernel_frame(kinematics, x, axes)  # (n, p, p - r)
         P = Jp @ np.swapaxes(Jp, -1, -2) + K @ np.swapaxes(K, -1, -2)
         dh, bad = maps_gradient(maps, x)  # (n, p - r, p)
@@ -91,6 +93,7 @@ def e2_qmc(
         quad = np.einsum("nik,nkl,nil->n", dh, P, dh)
         integrand = m * (quad - 2.0 * np.einsum("nik,nki->n", dh, K) + k_red)
         total += float(np.sum(integrand[~bad]))
+        half += float(np.sum(integrand[~bad & first]))
         c0 += float(m.sum())
         diag += np.einsum("n,nk->k", m, P[:, rule.idx, rule.idx])
         load += np.einsum("n,nk->k", m, K[:, rule.idx, 0])
@@ -104,6 +107,7 @@ def e2_qmc(
     e2 = None if undefined else float(w * total)
     return {
         "E2": e2,
+        "E2_half": None if undefined else float(2.0 * w * half),
         "undefined_points": undefined,
         "single_joint": single,
         "nodes": rule.nodes,
@@ -136,15 +140,16 @@ def e1_qmc(
     -------
     dict
         ``{"E1": float, inf when divergent, or None (h undefined at some node; then not
-        "divergent" either), "divergent",
-        "undefined_points", "min_abs_dh_k": min |det(dh K)| over the nodes, "nodes", "seed"}``.
+        "divergent" either), "E1_half": the same on the rule's first half of the nodes
+        (:func:`error_estimate`), "divergent", "undefined_points", "min_abs_dh_k":
+        min |det(dh K)| over the nodes, "nodes", "seed"}``.
     """
     kinematics = require_kinematics(kinematics)
     maps = require_maps(kinematics, amap, "E1", "amap")
     rule = _Rule(kinematics, region, fixed, nodes, seed, "E1")
-    total, undefined, singular = 0.0, 0, False
+    total, half, undefined, singular = 0.0, 0.0, 0, False
     lo_det, hi_det, least = np.inf, -np.inf, np.inf
-    for x, m in rule.chunks(progress):
+    for first, x, m in rule.chunks(progress):
         J = kinematics.jacobian(x)
         dh, bad = maps_gradient(maps, x)
         undefined += int(np.count_nonzero(bad))
@@ -154,11 +159,14 @@ def e1_qmc(
             lo_det, hi_det = min(lo_det, np.min(det[~bad])), max(hi_det, np.max(det[~bad]))
             least = min(least, float(np.min(np.abs(det[~bad]) / m[~bad])))
         ok = ~bad & ~rank_loss
-        total += float(np.sum(e1_integrand(J[ok], dh[ok])))
+        integrand = e1_integrand(J[ok], dh[ok])
+        total += float(np.sum(integrand))
+        half += float(np.sum(integrand[first[ok]]))
     divergent = not undefined and (singular or bool(lo_det < 0.0 < hi_det))
     e1 = None if undefined else (np.inf if divergent else float(rule.weight * total))
     return {
         "E1": e1,
+        "E1_half": e1 if e1 is None or divergent else float(2.0 * rule.weight * half),
         "divergent": divergent,
         "undefined_points": undefined,
         "min_abs_dh_k": float(least),
@@ -186,9 +194,10 @@ class _Rule:
         self.weight = float(np.prod(self.hi - self.lo)) / self.nodes
 
     def chunks(self, progress: Progress | None):
-        """(x, m) per chunk of nodes; told ``progress`` the fraction done, polled for a cancel
-        (:class:`~jik.engine.exceptions.RunCancelled`); a kinematic singularity in the region
-        (m < 1e-9 at a node) is a KinematicSingularityError."""
+        """(first, x, m) per chunk of nodes, ``first`` marking the nodes of the rule's first
+        half (their own Sobol rule of nodes / 2); told ``progress`` the fraction done, polled
+        for a cancel (:class:`~jik.engine.exceptions.RunCancelled`); a kinematic singularity in
+        the region (m < 1e-9 at a node) is a KinematicSingularityError."""
         progress = check_progress(progress)
         for start in range(0, self.nodes, CHUNK):
             check_cancelled(progress, f"the {self.what} rule was cancelled")
@@ -200,6 +209,18 @@ class _Rule:
                 raise KinematicSingularityError(
                     "the region contains a kinematic singularity", x[int(np.argmin(m))], "region"
                 )
-            yield x, m
+            yield start + np.arange(len(t)) < self.nodes // 2, x, m
             if progress is not None:
                 progress.advance(min(start + CHUNK, self.nodes) / self.nodes, 1.0)
+
+
+def error_estimate(value: float | None, half: float | None) -> float | None:
+    """An estimate of the size of the quadrature error of a Sobol rule's ``value``: its
+    difference from the same rule on its first half of the nodes, ``half`` (:func:`e1_qmc`,
+    :func:`e2_qmc`). Where the rule converges (its error shrinks as the nodes double) this is
+    about the half rule's error, mostly more than the whole rule's; an estimate, not a bound
+    (``docs/e2-vector.md`` compares it with the error against a rule of 16 times the nodes).
+    None where either value is not finite."""
+    if value is None or half is None or not (np.isfinite(value) and np.isfinite(half)):
+        return None
+    return abs(value - half)

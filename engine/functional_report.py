@@ -18,7 +18,7 @@ from collections.abc import Callable, Mapping
 import numpy as np
 
 from .augmentations import AugmentingMap
-from .e2_qmc import e1_qmc, e2_qmc
+from .e2_qmc import e1_qmc, e2_qmc, error_estimate
 from .exceptions import InvalidInputError, JikError
 from .functionals import Region, check_region, error_functional_e1, error_functional_e2
 from .inverses import require_kinematics
@@ -51,7 +51,9 @@ def functional_info(
     None where infinite or undefined, "divergent", "n_points", "n_singular" (points where
     [J; dh] is singular; of the Sobol rule, where h is undefined), "min_abs_dh_k" (None for E2
     by the Sobol rule), "frame_axes" (E2 of a vector: 1-based, else None), "rule": "gauss" or
-    "sobol"}``, and E2's ``single_joint`` by the Sobol rule (one degree of redundancy).
+    "sobol", "error_estimate" (the Sobol rule's, :func:`~jik.engine.e2_qmc.error_estimate`;
+    None for the Gauss rule)}``, and E2's ``single_joint`` by the Sobol rule (one degree of
+    redundancy).
     ``progress`` follows the Sobol rule's nodes. Raises what the functional raises."""
     if key not in ("E1", "E2"):
         raise InvalidInputError(f"key must be 'E1' or 'E2', got {key!r}", "key")
@@ -63,13 +65,14 @@ def functional_info(
                 kinematics, amap, region, nodes=nodes, fixed=fixed, frame_axes=frame_axes
             )
         info = value.as_dict()
-        return {k: info[k] for k in _INFO} | {"rule": "gauss"}
+        return {k: info[k] for k in _INFO} | {"rule": "gauss", "error_estimate": None}
     rule: dict = {"fixed": fixed, "nodes": QMC_NODES, "seed": QMC_SEED, "progress": progress}
     out = {"n_points": QMC_NODES, "rule": "sobol", "frame_axes": None}
     if key == "E1":
         e1 = e1_qmc(kinematics, amap, region, **rule)
         return out | {
             "value": None if e1["divergent"] else e1["E1"],
+            "error_estimate": error_estimate(e1["E1"], e1["E1_half"]),
             "divergent": e1["divergent"],
             "n_singular": e1["undefined_points"],
             "min_abs_dh_k": e1["min_abs_dh_k"],
@@ -77,6 +80,7 @@ def functional_info(
     e2 = e2_qmc(kinematics, amap, region, frame_axes=frame_axes, **rule)
     return out | {
         "value": e2["E2"],
+        "error_estimate": error_estimate(e2["E2"], e2["E2_half"]),
         "divergent": False,
         "n_singular": e2["undefined_points"],
         "min_abs_dh_k": None,
@@ -93,7 +97,8 @@ def functional_value(
     key: str, kinematics, amap, region: Mapping, nodes: int, fixed, frame_axes=None, progress=None
 ) -> dict:
     """``{key: E1 or E2 of :func:`functional_info`, or None where undefined}`` with its singular
-    points, ``key_divergent`` (E1 = inf) or ``key_error`` (why it could not be evaluated) if so,
+    points, the Sobol rule's ``key_error_estimate``, ``key_divergent`` (E1 = inf) or
+    ``key_error`` (why it could not be evaluated) if so,
     E2's ``E2_frame_axes`` for a vector (``frame_axes``, else the best conditioned) and, by the
     Sobol rule, ``E2_single_joint``."""
     try:
@@ -101,6 +106,8 @@ def functional_value(
     except (JikError, ValueError, ArithmeticError) as exc:
         return {key: None, f"{key}_error": str(exc)}
     out: dict = {key: info["value"], f"{key}_singular_points": info["n_singular"]}
+    if info["error_estimate"] is not None:
+        out[f"{key}_error_estimate"] = info["error_estimate"]
     if info["frame_axes"]:
         out[f"{key}_frame_axes"] = info["frame_axes"]
     if "single_joint" in info:
@@ -247,7 +254,8 @@ def region_words(region: Mapping) -> str:
 
 def report_words(report: Mapping, where: str) -> str:
     """A :func:`functionals_report` in words, on ``where`` (the box, in words): its note if it
-    has one, else each functional's value, ∞ where E1 diverges (dh K = 0 inside) or undefined."""
+    has one, else each functional's value (± the Sobol rule's error estimate), ∞ where E1
+    diverges (dh K = 0 inside) or undefined."""
     if report.get("note"):
         return report["note"]
     values = {k: report.get(k) for k in ("E1", "E2")}
@@ -255,7 +263,7 @@ def report_words(report: Mapping, where: str) -> str:
         return f"E1, E2 undefined: h is not defined on all of {where}"
     return (
         ", ".join(
-            f"{k} = {v:.4g}"
+            f"{k} = {v:.4g}{plus_minus(report.get(f'{k}_error_estimate'))}"
             if v is not None
             else f"{k} = ∞ (dh K = 0 inside)"
             if report.get(f"{k}_divergent")
@@ -264,6 +272,11 @@ def report_words(report: Mapping, where: str) -> str:
         )
         + f" on {where}"
     )
+
+
+def plus_minus(estimate: float | None) -> str:
+    """ " ± e" of a functional's error estimate ``estimate`` (one digit), "" without one."""
+    return "" if estimate is None else f" ± {estimate:.1g}"
 
 
 def parameters_report(

@@ -271,6 +271,7 @@ def total_degree_response(
                 min_abs_dh_k=None,
                 rule="sobol",
                 frame_axes=list(res.frame_axes) or None,
+                error_estimate=None,  # (total_degree's e2 and e2_check, two rules, say it)
             ),
         },
         convergence=[{k: float(v) for k, v in row.items()} for row in res.convergence],

@@ -198,7 +198,8 @@ def single_joint_sensitivity(functionals: dict) -> dict:
     """The E1/E2 panel's data for a map whose E2 came from a Sobol rule
     (:func:`~jik.engine.functional_report.functionals_report`): E2 of the map and of h = s x_j
     for each joint, E1 of the map, ``{"kind": "single_joint", "E1", "E1_divergent", "E2",
-    "maps": [{"name", "E2", "current"}], "nodes"}``."""
+    "maps": [{"name", "E2", "current"}], "nodes"}`` and the rule's error estimates of E1 and E2
+    (``E1_error_estimate``, ``E2_error_estimate``; None where not finite)."""
     maps = [{"name": "h (current)", "E2": functionals["E2"], "current": True}]
     for name, row in functionals["E2_single_joint"].items():
         sign = "+" if row["sign"] > 0 else "−"
@@ -208,6 +209,7 @@ def single_joint_sensitivity(functionals: dict) -> dict:
         "E1": functionals["E1"],
         "E1_divergent": bool(functionals.get("E1_divergent")),
         "E2": functionals["E2"],
+        **{f"{k}_error_estimate": functionals.get(f"{k}_error_estimate") for k in ("E1", "E2")},
         "maps": maps,
         "nodes": functionals["E2_rule"]["nodes"],
     }

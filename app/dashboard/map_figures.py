@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from ...engine.functional_report import region_words, report_words
+from ...engine.functional_report import plus_minus, region_words, report_words
 from .algorithms import COLORS, DASH, LABELS
 from .analysis import vector_note
 from .functionals import state_inert_variables
@@ -344,11 +344,13 @@ def single_joint_spec(sens: dict, aug: str, log: dict) -> dict:
     ratio = ""
     if sens["E2"]:
         ratio = f": {best['E2'] / sens['E2']:.3g} × E2 of h"
-    e1 = sens["E1"]
+    e1, e2 = sens["E1"], sens["E2"]
     e1 = f"{e1:.4g}" if e1 is not None else "∞" if sens["E1_divergent"] else "undefined"
+    e1 += plus_minus(sens.get("E1_error_estimate"))
+    e2 = "undefined" if e2 is None else f"{e2:.4g}{plus_minus(sens.get('E2_error_estimate'))}"
     title = (
         f"E2 (18) of {aug} and of a single joint held<br><sup>a scrambled Sobol rule of "
-        f"{sens['nodes']} nodes on the design box; E1 (13) of h = {e1}</sup>"
+        f"{sens['nodes']} nodes on the design box; E1 (13) of h = {e1}, E2 = {e2}</sup>"
         f"<br><sup>the best single joint, {best['name']}{ratio}</sup>"
     )
     known = [v for v in values if v is not None and v > 0]
@@ -362,6 +364,7 @@ def vector_spec(sens: dict, name: str, log: dict) -> dict:
     """E1 (13) and E2 (18) of a vector of p - r > 1 maps ``name`` as two bars on a log scale
     (a missing bar says why), the box and the kernel frame E2 was taken in."""
     values = {k: sens.get(k) for k in ("E1", "E2")}
+    errors = {k: sens.get(f"{k}_error_estimate") for k in ("E1", "E2")}
     data = [
         trace(
             "bar",
@@ -369,7 +372,8 @@ def vector_spec(sens: dict, name: str, log: dict) -> dict:
             y=[values[k]],
             name=k,
             marker=dict(color=E_COLORS[k]),
-            hovertemplate=f"{k} = %{{y:.4g}}<extra></extra>",
+            hovertemplate=f"{k} = %{{y:.4g}}{plus_minus(errors[k])}<extra></extra>",
+            **({"error_y": dict(type="data", array=[errors[k]])} if errors[k] else {}),
         )
         for k, eq in (("E1", 13), ("E2", 18))
     ]
@@ -384,6 +388,11 @@ def vector_spec(sens: dict, name: str, log: dict) -> dict:
     where = region_words(sens["region"]) if sens["design_region"] else "the box of the runs"
     frame = sens.get("E2_frame_axes")
     sub = [f"on {where}"] + ([f"E2 in the kernel frame of joints {frame}"] if frame else [])
+    if any(errors.values()):
+        sub.append(
+            "by a Sobol rule of "
+            + ", ".join(f"{k} = {values[k]:.4g}{plus_minus(e)}" for k, e in errors.items() if e)
+        )
     title = f"E1, E2 of the vector {name}" + "".join(f"<br><sup>{x}</sup>" for x in wrap(sub))
     yaxis = dict(title="E (log)", **log, **log_ticks(values.values()))
     return figure(data, title, showlegend=False, annotations=words, yaxis=yaxis)

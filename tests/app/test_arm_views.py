@@ -218,7 +218,12 @@ def test_the_e1_e2_panel_shows_e2_of_a_7_joint_map_beside_single_joints():
     )
     low = specs["sensitivity"]["layout"]["yaxis"]["range"][0]
     assert low <= np.log10(functionals["E2"]) - 1  # (the map's bar stands out of the axis)
-    assert "E1 = 0.002346, E2 = 0.0001731" in specs["augmenting"]["layout"]["title"]["text"]
-    assert "E1 (13) of h = 0.002346" in specs["sensitivity"]["layout"]["title"]["text"]
+    # (± the Sobol rule's error estimate: its difference from the rule's first half of the nodes)
+    assert functionals["E1_error_estimate"] == pytest.approx(1.5e-6, rel=0.05)
+    assert functionals["E2_error_estimate"] == pytest.approx(1.3e-7, rel=0.05)
+    pm = "E1 = 0.002346 ± 1e-06, E2 = 0.0001731 ± 1e-07"
+    assert pm in specs["augmenting"]["layout"]["title"]["text"]
+    pm = "E1 (13) of h = 0.002346 ± 1e-06, E2 = 0.0001731 ± 1e-07"
+    assert pm in specs["sensitivity"]["layout"]["title"]["text"]
     with pytest.raises(Cancelled):
         _second_phase(compute(_panda()), cancelled=iter([False] * 3 + [True] * 99).__next__).run()

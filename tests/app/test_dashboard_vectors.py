@@ -56,6 +56,11 @@ def test_formula_maps_are_scored_over_the_box_of_the_runs():
     assert "on the box of the runs" in title and "kernel frame of joints [2, 4]" in title
     assert [d["y"] for d in spec["data"]] == [[f["E1"]], [f["E2"]]]
     assert spec["layout"]["annotations"] == []
+    # The Sobol rule's error estimates: error bars, the hover and the title say them.
+    errors = [want["E1_error_estimate"], want["E2_error_estimate"]]
+    assert [d["error_y"]["array"] for d in spec["data"]] == [[e] for e in errors]
+    assert f"E1 = {f['E1']:.4g} ± {errors[0]:.1g}" in title
+    assert f"± {errors[1]:.1g}<extra>" in spec["data"][1]["hovertemplate"]
 
 
 def test_a_synthesized_vector_on_its_design_box_has_both_and_beats_the_formulas():

@@ -197,6 +197,11 @@ def test_evaluate_over_every_joint_of_an_arm_takes_the_sobol_rule_as_the_dashboa
     want = functionals_report(kin, FormulaMap("x1", kin.names), box, {})
     assert f["e1"]["value"] == want["E1"] and f["e2"]["value"] == want["E2"]
     assert f["e1"]["rule"] == f["e2"]["rule"] == "sobol" and f["e1"]["n_points"] == 8192
+    for k in ("e1", "e2"):  # (the same error estimates; the Gauss rule's is null)
+        assert f[k]["error_estimate"] == want[f"{k.upper()}_error_estimate"] > 0
+    small = {**body, "region": dict(list(box.items())[:2])}
+    r = api.post("/synthesize", json=small)
+    assert r.status_code == 200 and r.json()["functionals"]["e1"]["error_estimate"] is None
     r = api.post("/synthesize", json={"robot": arm, "method": "e2_variational", "region": box})
     assert r.status_code == 422 and "takes 2 or 3 variables, got 7" in r.text
 

@@ -60,8 +60,10 @@ def test_the_panda_with_its_pose_task(tabs):
     sensitivity = page.locator("#plot-sensitivity")
     expect(sensitivity).to_contain_text("of a single joint held", timeout=120_000)
     expect(sensitivity).to_contain_text("h = +x1")
-    expect(sensitivity).to_contain_text("E1 (13) of h = 0.002346")  # (on the same nodes)
-    expect(page.locator("#plot-augmenting")).to_contain_text("E1 = 0.002346, E2 = 0.0001731")
+    expect(sensitivity).to_contain_text("E1 (13) of h = 0.002346 ± 1e-06")  # (the same nodes)
+    expect(page.locator("#plot-augmenting")).to_contain_text(
+        "E1 = 0.002346 ± 1e-06, E2 = 0.0001731 ± 1e-07"
+    )
 
     # Its atlas: 16 starts on the self-motion curve of k(x0), two cycles, both algorithms.
     page.locator("#atlas").scroll_into_view_if_needed()

@@ -64,3 +64,30 @@ def test_bad_input_names_its_field_and_cancel_stops():
     with pytest.raises(RunCancelled):
         e2_qmc(CHAIN, res.maps[0], REGION, nodes=2**12, progress=progress)
     assert len(calls) == 2
+
+
+def test_the_error_estimate_is_the_difference_from_the_rules_first_half():
+    """E1 and E2 on the rule's first half of the nodes are the rules of half the nodes (the same
+    scrambled sequence), within one chunk of nodes and across four; the estimate is their
+    difference from the whole rule's, and it shrinks as the nodes grow; the Gauss rule has none."""
+    from jik.engine.e2_qmc import e1_qmc, error_estimate
+    from jik.engine.functional_report import functional_info
+
+    h = synthesize_e2_nd(CHAIN, REGION, degree=3, nodes=2**11).maps[0]
+    estimates = {}
+    for nodes in (2**8, 2**12):
+        for rule, key in ((e1_qmc, "E1"), (e2_qmc, "E2")):
+            whole = rule(CHAIN, h, REGION, nodes=nodes)
+            half = rule(CHAIN, h, REGION, nodes=nodes // 2)[key]
+            assert whole[f"{key}_half"] == pytest.approx(half, rel=1e-12)
+            estimates[key, nodes] = error_estimate(whole[key], whole[f"{key}_half"])
+            assert estimates[key, nodes] == abs(whole[key] - half)
+    for key in ("E1", "E2"):
+        assert 0 < estimates[key, 2**12] < estimates[key, 2**8] / 4
+    info = functional_info("E2", CHAIN, h, REGION, None)
+    assert info["rule"] == "sobol" and info["error_estimate"] == error_estimate(
+        *(e2_qmc(CHAIN, h, REGION, nodes=info["n_points"])[k] for k in ("E2", "E2_half"))
+    )
+    box = {"x3": (0.4, 1.0), "x4": (0.3, 0.9)}
+    assert functional_info("E1", CHAIN, h, box, {"x1": 0.0, "x2": 0.8})["error_estimate"] is None
+    assert error_estimate(None, 1.0) is None and error_estimate(np.inf, 1.0) is None

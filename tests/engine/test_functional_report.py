@@ -61,8 +61,11 @@ def test_a_region_of_four_joints_gets_both_by_the_sobol_rule():
     e1 = e1_qmc(CHAIN, h, REGION, nodes=QMC_NODES, seed=QMC_SEED)
     assert out["E2"] == pytest.approx(rule["E2"], rel=1e-12) and out["E1"] == e1["E1"]
     assert out["E2_single_joint"] == rule["single_joint"]
+    errors = [abs(e1["E1"] - e1["E1_half"]), abs(rule["E2"] - rule["E2_half"])]
+    assert [out["E1_error_estimate"], out["E2_error_estimate"]] == errors
     assert out["note"] == (
-        f"E1 = {e1['E1']:.4g}, E2 = {rule['E2']:.4g} on the region (Sobol rule, {QMC_NODES} nodes)"
+        f"E1 = {e1['E1']:.4g} ± {errors[0]:.1g}, E2 = {rule['E2']:.4g} ± {errors[1]:.1g} on the "
+        f"region (Sobol rule, {QMC_NODES} nodes)"
     )
     with pytest.raises(RunCancelled):
         functionals_report(
@@ -80,6 +83,8 @@ def test_a_report_in_words_gives_its_note_or_each_value_on_the_box():
     diverges["E2"] = 1.0
     assert report_words(diverges, "B") == "E1 = ∞ (dh K = 0 inside), E2 = 1 on B"
     assert report_words({"E1": None, "E2": 1.0}, "B") == "E1 undefined, E2 = 1 on B"
+    sobol = {"E1": 0.5, "E1_error_estimate": 0.0123, "E2": 0.25}
+    assert report_words(sobol, "B") == "E1 = 0.5 ± 0.01, E2 = 0.25 on B"
     assert report_words({"E2": 1.0, "note": "by a Sobol rule"}, "B") == "by a Sobol rule"
 
 

@@ -140,6 +140,13 @@ class FunctionalInfo(BaseModel):
         description="E2 of a vector of p - r >= 2 maps: the joints (1-based) whose axes fix the "
         "kernel frame E2 depends on (engine.kernel_frame); null otherwise",
     )
+    error_estimate: MaybeFloat = Field(
+        None,
+        description="of the Sobol rule: |value - the same rule on its first half of the nodes|, "
+        "an estimate of the quadrature error (engine.e2_qmc.error_estimate); null for the Gauss "
+        "rule, where value is null, and for a total-degree synthesis's E2 (total_degree's e2 "
+        "and e2_check, on two independent rules, say how far apart they are)",
+    )
 
 
 class MapSingularitiesInfo(BaseModel):
