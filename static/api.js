@@ -41,6 +41,8 @@ export async function openSession(state, onRefusedLink) {
 // the request itself goes to onError (the session's "refused" event covers the rest).
 let queued = {};
 let inFlight = false;
+let posts = 0; // the POSTs of changes started; onAccepted is told which one it answers
+export const changesPosted = () => posts;
 export function change(patch, onError, onAccepted = () => {}) {
   Object.assign(queued, patch);
   if (!inFlight) flush(onError, onAccepted);
@@ -51,6 +53,7 @@ async function flush(onError, onAccepted) {
   queued = {};
   if (!Object.keys(patch).length) return;
   inFlight = true;
+  const post = ++posts;
   try {
     const res = await fetch(api("/state"), {
       method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(patch),
@@ -58,7 +61,7 @@ async function flush(onError, onAccepted) {
     const body = await res.json();
     if (res.ok) {
       session.generation = Math.max(session.generation, body.generation);
-      onAccepted(body);
+      onAccepted(body, post);
     } else if (res.status !== 422) onError(detail(body));
   } finally {
     inFlight = false;

@@ -1,7 +1,7 @@
 // jik dashboard: one session per tab. The page opens its session from the state in its URL,
 // builds its controls from the session's control specification, follows the session's events
 // and draws its panels; the 3D scene (iframe, viser) shows and changes the same session.
-import { change, endOnClose, follow, openSession, session, api } from "./api.js";
+import { change, changesPosted, endOnClose, follow, openSession, session, api } from "./api.js";
 import { onNotSent, showControls, showRefusal, showStopped } from "./controls.js";
 import { $, el, fmt, withErrataLinks } from "./dom.js";
 import { robotEditor } from "./editor.js";
@@ -18,7 +18,8 @@ const send = (patch) => { setNotice(""); change(patch, (message) => setStatus(me
 // A change accepted without a new generation (the values in force typed back after a refusal):
 // the result on screen is the state's, and the header and the controls say so instead of the
 // old refusal (the send took every note away: the marks of the result's stopped runs are back).
-function accepted(body) {
+function accepted(body, post) {
+  if (travelled && travelled.generation === null && post > travelled.after) travelled.generation = body.generation;
   if (body.generation !== page.shown || session.generation !== page.shown) return;
   setStatus(`up to date (generation ${page.shown})`);
   showStopped(page.stopped);
@@ -70,7 +71,7 @@ function onState(msg, force = false) {
   session.generation = Math.max(session.generation, msg.generation);
   showControls(msg, send, force);
   page.editor.show(msg.state, msg.type === "refused");
-  rememberInUrl(msg.state).catch((err) => console.warn("the link's state:", err));
+  if (inHistory(msg)) rememberInUrl(msg.state).catch((err) => console.warn("the link's state:", err));
   atlasState(msg.state);
   if (msg.generation > page.shown) setStatus(`computing generation ${msg.generation}…`);
 }
@@ -266,6 +267,20 @@ async function rememberInUrl(state) {
   $("#copy-link").textContent = "copy link"; // (a link copied before is of another state)
 }
 
+// Back or forward while a change was still being posted: that change's state (an older
+// generation than the one the entry's state gets) must not become a new entry, which would
+// drop the entries ahead of this one. Until the entry's state arrives, or the first POST after
+// the travel is answered, the states of older generations go unwritten; a refusal ends the wait.
+let travelled = null; // { state: the entry's, after: POSTs started before, generation: of the next }
+
+function inHistory(msg) {
+  if (!travelled) return true;
+  const arrived = msg.type === "refused" || JSON.stringify(msg.state) === JSON.stringify(travelled.state);
+  if (!arrived && (travelled.generation === null || msg.generation < travelled.generation)) return false;
+  travelled = null;
+  return true;
+}
+
 async function deflated(text) {
   const stream = new Blob([text]).stream().pipeThrough(new CompressionStream("deflate-raw"));
   const bytes = new Uint8Array(await new Response(stream).arrayBuffer());
@@ -357,6 +372,7 @@ async function main() {
   $("#copy-link").addEventListener("click", copyLink);
   addEventListener("popstate", (ev) => {
     if (!ev.state) return;
+    travelled = { state: ev.state.state, after: changesPosted(), generation: null };
     Object.assign(written, { state: ev.state.state, field: null });
     send(ev.state.state);
   });

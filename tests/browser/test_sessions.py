@@ -165,6 +165,32 @@ def test_seven_tabs_of_one_browser_each_draw_when_hidden_tabs_let_go(tabs):
 
 
 @pytest.mark.slow
+def test_back_while_a_change_is_posted_keeps_the_entry_ahead(tabs):
+    """Back pressed while a change is still being posted (its POST held here until then): the
+    session, address and controls come back to the entry's state, and forward still brings the
+    entry that was ahead (the change's state, answered after the back, took its place)."""
+    tab = tabs.open(scene=False)
+    page = tab.page
+    first = (tab.url_state(), tab.controls())
+    tab.select("#ctl-robot", "manipulator1")
+    ahead = (tab.url_state(), tab.controls())
+    length = page.evaluate("history.length")
+    held: list = []  # (the first POST of a change is held; the next ones go)
+    posts = re.compile(r"/api/sessions/[^/]+/state$")
+    page.route(posts, lambda route: route.continue_() if held else held.append(route))
+    with page.expect_request(lambda r: r.method == "POST" and posts.search(r.url)):
+        page.select_option("#ctl-mode", "discrete")
+    page.go_back()
+    tab.change(held[0].continue_)  # (the back's own POST follows the held one)
+    tab.wait_settled(lambda s: s["state"] == first[0], "the state before, after the change")
+    assert (tab.url_state(), tab.controls()) == first
+    assert page.evaluate("history.length") == length  # (no entry made, none dropped)
+    tab.change(page.go_forward)
+    tab.wait_settled(lambda s: s["state"] == ahead[0], "the entry ahead")
+    assert (tab.url_state(), tab.controls()) == ahead
+
+
+@pytest.mark.slow
 def test_back_and_forward_bring_the_previous_states_back(tabs):
     """Each change is an entry of the tab's history: back brings the session, controls and
     verdict of the state before, forward the one after, and a slider's drag is one entry."""
