@@ -19,8 +19,9 @@ function softwareRenderer() {
 const detail = (body) => (Array.isArray(body.detail) ? body.detail.map((d) => d.msg).join("; ") : body.detail);
 
 // A new session with ``state`` (a link's); a refused link state falls back to the defaults,
-// calling onRefusedLink(message).
-export async function openSession(state, onRefusedLink) {
+// calling onRefusedLink(message). While every session of the server is in use (503), it asks
+// again after the response's Retry-After, calling onFull(message, seconds) each time.
+export async function openSession(state, onRefusedLink, onFull) {
   const res = await fetch("/api/sessions", {
     method: "POST", headers: { "Content-Type": "application/json" },
     body: JSON.stringify({ state, low_end: softwareRenderer() }),
@@ -28,7 +29,13 @@ export async function openSession(state, onRefusedLink) {
   const body = await res.json();
   if (res.status === 422 && Object.keys(state).length) {
     onRefusedLink(detail(body));
-    return openSession({}, onRefusedLink);
+    return openSession({}, onRefusedLink, onFull);
+  }
+  if (res.status === 503) {
+    const seconds = Number(res.headers.get("Retry-After")) || 5;
+    onFull(detail(body), seconds);
+    await new Promise((resolve) => { setTimeout(resolve, 1000 * seconds); });
+    return openSession(state, onRefusedLink, onFull);
   }
   if (!res.ok) throw new Error(detail(body));
   session.id = body.id;

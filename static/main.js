@@ -368,7 +368,8 @@ async function main() {
   $("#legend").replaceChildren(algorithmKey(true));
   $("#controls").addEventListener("submit", (ev) => ev.preventDefault()); // (Enter in a box)
   const opened = await openSession(await stateFromUrl(),
-    (message) => setNotice(`the link's state was refused (${message}); showing the defaults`));
+    (message) => setNotice(`the link's state was refused (${message}); showing the defaults`),
+    (message, seconds) => setStatus(`${message}; trying again every ${seconds} s…`, true));
   $("#copy-link").addEventListener("click", copyLink);
   addEventListener("popstate", (ev) => {
     if (!ev.state) return;

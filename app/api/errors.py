@@ -116,7 +116,8 @@ _RESPONSES: dict[type[Exception], Callable[[Any], JSONResponse]] = {
         f"no dashboard session {exc.args[0]!r} (it expired or never existed); "
         "reload the page to start a new one",
     ),
-    SessionsFull: lambda exc: _detail(503, str(exc), retry_after="30"),
+    # (a tab closed or hidden lets go of its session, which a new one may then take at once)
+    SessionsFull: lambda exc: _detail(503, str(exc), retry_after="5"),
     ExportUnavailable: lambda exc: _detail(
         exc.status, str(exc), "1" if exc.status == 503 else None
     ),

@@ -203,7 +203,7 @@ def test_a_full_store_answers_503(app, client):
     store.get(session["id"]).users = 1
     r = client.post("/api/sessions", json={"state": {}})
     assert r.status_code == 503 and "in use" in r.json()["detail"]
-    assert r.headers["retry-after"] == "30"
+    assert r.headers["retry-after"] == "5"  # (a tab closed or hidden frees a slot at once)
 
 
 def test_idle_sessions_expire_by_themselves():

@@ -165,6 +165,32 @@ def test_seven_tabs_of_one_browser_each_draw_when_hidden_tabs_let_go(tabs):
 
 
 @pytest.mark.slow
+def test_a_tab_the_full_server_refused_opens_when_a_session_is_free(tabs):
+    """Every session of the server in use (503, Retry-After: its first answers are made so
+    here): the header says so and when it asks again, and the tab opens when one is free."""
+    tabs.allow_console(r"status of 503")
+    full = {"detail": "the server has 32 dashboard sessions in use, its limit (JIK_MAX_SESSIONS)"}
+    refused: list = []
+
+    def answer(route) -> None:
+        if route.request.method != "POST" or len(refused) == 2:
+            route.continue_()
+            return
+        refused.append(route.request.url)
+        route.fulfill(status=503, headers={"Retry-After": "1"}, json=full)
+
+    context = tabs.context()
+    context.route(re.compile(r"/api/sessions$"), answer)
+    page = tabs.new_page(context)
+    page.goto(tabs.base + "/")
+    expect(page.locator("#status-text")).to_have_text(f"{full['detail']}; trying again every 1 s…")
+    tab = Tab(page, tabs.base)
+    tab.wait_drawn(1)
+    assert len(refused) == 2 and tab.status().startswith("up to date")
+    assert tab.snapshot()["state"] == tab.url_state()
+
+
+@pytest.mark.slow
 def test_back_while_a_change_is_posted_keeps_the_entry_ahead(tabs):
     """Back pressed while a change is still being posted (its POST held here until then): the
     session, address and controls come back to the entry's state, and forward still brings the
