@@ -45,17 +45,19 @@ export async function openSession(state, onRefusedLink, onFull) {
 
 // Changes are posted at once; while a POST is in flight, newer changes are merged and sent when
 // it returns (a slider drag sends one request at a time, never a stale backlog). A refusal of
-// the request itself goes to onError (the session's "refused" event covers the rest).
+// the request itself goes to onError; onRefused is told which POST the session refused (422, its
+// "refused" event says why).
 let queued = {};
 let inFlight = false;
-let posts = 0; // the POSTs of changes started; onAccepted is told which one it answers
+let posts = 0; // the POSTs of changes started; onAccepted and onRefused are told which one
 export const changesPosted = () => posts;
-export function change(patch, onError, onAccepted = () => {}) {
+export function change(patch, onError, onAccepted = () => {}, onRefused = () => {}) {
   Object.assign(queued, patch);
-  if (!inFlight) flush(onError, onAccepted);
+  if (!inFlight) flush(onError, onAccepted, onRefused);
 }
 
-async function flush(onError, onAccepted) {
+async function flush(...callbacks) {
+  const [onError, onAccepted, onRefused] = callbacks;
   const patch = queued;
   queued = {};
   if (!Object.keys(patch).length) return;
@@ -69,10 +71,11 @@ async function flush(onError, onAccepted) {
     if (res.ok) {
       session.generation = Math.max(session.generation, body.generation);
       onAccepted(body, post);
-    } else if (res.status !== 422) onError(detail(body));
+    } else if (res.status === 422) onRefused(post);
+    else onError(detail(body));
   } finally {
     inFlight = false;
-    if (Object.keys(queued).length) flush(onError, onAccepted);
+    if (Object.keys(queued).length) flush(...callbacks);
   }
 }
 

@@ -13,7 +13,7 @@ import { afterSecond, cancelSecond, clearCancelled, secondWanted } from "./secon
 // second: the generation whose second phase runs (its progress came, its functionals not yet);
 // stopped: the runs of the result on screen, where they stopped (controls.js's showStopped).
 const page = { config: null, state: null, shown: 0, shownState: null, editor: null, second: null, stopped: {} };
-const send = (patch) => { setNotice(""); change(patch, (message) => setStatus(message, true), accepted); };
+const send = (patch) => { setNotice(""); change(patch, (message) => setStatus(message, true), accepted, refusedPost); };
 
 // A change accepted without a new generation (the values in force typed back after a refusal):
 // the result on screen is the state's, and the header and the controls say so instead of the
@@ -270,15 +270,24 @@ async function rememberInUrl(state) {
 // Back or forward while a change was still being posted: that change's state (an older
 // generation than the one the entry's state gets) must not become a new entry, which would
 // drop the entries ahead of this one. Until the entry's state arrives, or the first POST after
-// the travel is answered, the states of older generations go unwritten; a refusal ends the wait.
+// the travel is answered, the states of older generations go unwritten (a refusal of a change
+// posted before the travel too); the refusal of a POST after it ends the wait (refusedPost).
 let travelled = null; // { state: the entry's, after: POSTs started before, generation: of the next }
 
 function inHistory(msg) {
   if (!travelled) return true;
-  const arrived = msg.type === "refused" || JSON.stringify(msg.state) === JSON.stringify(travelled.state);
+  const arrived = JSON.stringify(msg.state) === JSON.stringify(travelled.state);
   if (!arrived && (travelled.generation === null || msg.generation < travelled.generation)) return false;
   travelled = null;
   return true;
+}
+
+// The POST of a change sent after the travel refused: the entry's state will not come, and the
+// state in force (its "refused" event's, written whenever it arrives) is the address's.
+function refusedPost(post) {
+  if (!travelled || post <= travelled.after) return;
+  travelled = null;
+  rememberInUrl(page.state).catch((err) => console.warn("the link's state:", err));
 }
 
 async function deflated(text) {

@@ -217,6 +217,35 @@ def test_back_while_a_change_is_posted_keeps_the_entry_ahead(tabs):
 
 
 @pytest.mark.slow
+def test_back_while_a_refused_change_is_posted_keeps_the_entry_ahead(tabs):
+    """Back pressed while a change the session refuses is being posted (its POST held here until
+    then): the refusal's state, the one in force before the back, makes no entry either, and
+    forward still brings the entry that was ahead."""
+    tabs.allow_console(r"status of 422")
+    tab = tabs.open(scene=False)
+    page = tab.page
+    first = tab.url_state()
+    tab.select("#ctl-robot", "manipulator1")
+    ahead = tab.url_state()
+    length = page.evaluate("history.length")
+    held: list = []  # (the first POST of a change is held; the next ones go)
+    posts = re.compile(r"/api/sessions/[^/]+/state$")
+    page.route(posts, lambda route: route.continue_() if held else held.append(route))
+    cycles = page.locator("#ctl-cycles-value")
+    with page.expect_request(lambda r: r.method == "POST" and posts.search(r.url)):
+        cycles.fill("50")
+        cycles.press("Enter")
+    page.go_back()
+    with page.expect_response(lambda r: bool(posts.search(r.url)) and r.status == 422):
+        held[0].continue_()
+    tab.wait_settled(lambda s: s["state"] == first, "the state before, after the refusal")
+    assert page.evaluate("history.length") == length  # (no entry made, none dropped)
+    tab.change(page.go_forward)
+    tab.wait_settled(lambda s: s["state"] == ahead, "the entry ahead")
+    assert tab.url_state() == ahead
+
+
+@pytest.mark.slow
 def test_back_and_forward_bring_the_previous_states_back(tabs):
     """Each change is an entry of the tab's history: back brings the session, controls and
     verdict of the state before, forward the one after, and a slider's drag is one entry."""
