@@ -1,10 +1,11 @@
 // jik dashboard: one session per tab. The page opens its session from the state in its URL,
 // builds its controls from the session's control specification, follows the session's events
 // and draws its panels; the 3D scene (iframe, viser) shows and changes the same session.
-import { change, changesPosted, endOnClose, follow, openSession, session, api } from "./api.js";
+import { change, endOnClose, follow, openSession, session, api } from "./api.js";
 import { onNotSent, showControls, showRefusal, showStopped } from "./controls.js";
 import { $, el, fmt, withErrataLinks } from "./dom.js";
 import { robotEditor } from "./editor.js";
+import { acceptedPost, copyLink, followHistory, refusedPost, remember, stateFromUrl } from "./link.js";
 import { setExportNote } from "./panel_exports.js";
 import { algorithmKey, applyFunctionals, drawFigures, layoutPanels, markStale, onAhead, showChosen } from "./panels.js";
 import { atlasPanel, atlasState } from "./atlas.js";
@@ -13,13 +14,16 @@ import { afterSecond, cancelSecond, clearCancelled, secondWanted } from "./secon
 // second: the generation whose second phase runs (its progress came, its functionals not yet);
 // stopped: the runs of the result on screen, where they stopped (controls.js's showStopped).
 const page = { config: null, state: null, shown: 0, shownState: null, editor: null, second: null, stopped: {} };
-const send = (patch) => { setNotice(""); change(patch, (message) => setStatus(message, true), accepted, refusedPost); };
+const send = (patch) => {
+  setNotice("");
+  change(patch, (message) => setStatus(message, true), accepted, (post) => refusedPost(post, page.state));
+};
 
 // A change accepted without a new generation (the values in force typed back after a refusal):
 // the result on screen is the state's, and the header and the controls say so instead of the
 // old refusal (the send took every note away: the marks of the result's stopped runs are back).
 function accepted(body, post) {
-  if (travelled && travelled.generation === null && post > travelled.after) travelled.generation = body.generation;
+  acceptedPost(body, post);
   if (body.generation !== page.shown || session.generation !== page.shown) return;
   setStatus(`up to date (generation ${page.shown})`);
   showStopped(page.stopped);
@@ -71,7 +75,7 @@ function onState(msg, force = false) {
   session.generation = Math.max(session.generation, msg.generation);
   showControls(msg, send, force);
   page.editor.show(msg.state, msg.type === "refused");
-  if (inHistory(msg)) rememberInUrl(msg.state).catch((err) => console.warn("the link's state:", err));
+  remember(msg);
   atlasState(msg.state);
   if (msg.generation > page.shown) setStatus(`computing generation ${msg.generation}…`);
 }
@@ -227,124 +231,6 @@ async function onFunctionals(msg) {
   afterSecond(msg, msg.generation === session.generation ? setStatus : null);
 }
 
-// ---------------------------------------------------------------- the session and its link
-// The page's URL holds the state (?state=<JSON of the dashboard's fields>): a copied link, or a
-// reload, starts a new session with the same state. A state whose JSON is longer than
-// PLAIN_STATE (a pasted URDF of tens of kB, which the server's cap on a request's headers, 64 kB,
-// refused with 431 on a reload) is held deflated: ?z=<base64url of its JSON, deflate-raw>. One
-// still longer than LINK_STATE (a URDF of some hundreds of kB) stays in this tab
-// (sessionStorage, ?tab): a reload opens it, and "copy link" says the state is too large for one.
-// Each change is an entry of the tab's history (the state with it): back and forward bring the
-// session to that entry's state. Changes of the same single field in a row (a slider's drag)
-// make one entry; the first state, and the one that back or forward brought, make none.
-const PLAIN_STATE = 16 * 1024;
-const LINK_STATE = 48 * 1024;
-const TAB_STATE = "jik-state";
-let remembering = 0; // the newest state written (a deflation finishes later than it starts)
-const written = { state: null, field: null }; // the history's newest state, its one changed field
-
-async function rememberInUrl(state) {
-  const turn = ++remembering;
-  const text = JSON.stringify(state);
-  const url = new URL(location.href);
-  for (const key of ["state", "z", "tab"]) url.searchParams.delete(key);
-  const z = encodeURIComponent(text).length <= PLAIN_STATE ? null : await deflated(text);
-  if (turn !== remembering) return;
-  if (z === null) url.searchParams.set("state", text);
-  else if (z.length <= LINK_STATE) url.searchParams.set("z", z);
-  else {
-    sessionStorage.setItem(TAB_STATE, text);
-    url.searchParams.set("tab", "");
-  }
-  const before = written.state || state;
-  const fields = Object.keys(state).filter((k) => JSON.stringify(state[k]) !== JSON.stringify(before[k]));
-  const field = fields.length === 1 ? fields[0] : null;
-  const push = fields.length > 0 && !(field && field === written.field);
-  Object.assign(written, { state, field: fields.length ? field : written.field });
-  if (!fields.length && url.href === location.href && history.state) return; // (?tab: one address)
-  if (push) history.pushState({ state }, "", url);
-  else history.replaceState({ state }, "", url);
-  $("#copy-link").textContent = "copy link"; // (a link copied before is of another state)
-}
-
-// Back or forward while a change was still being posted: that change's state (an older
-// generation than the one the entry's state gets) must not become a new entry, which would
-// drop the entries ahead of this one. Until the entry's state arrives, or the first POST after
-// the travel is answered, the states of older generations go unwritten (a refusal of a change
-// posted before the travel too); the refusal of a POST after it ends the wait (refusedPost).
-let travelled = null; // { state: the entry's, after: POSTs started before, generation: of the next }
-
-function inHistory(msg) {
-  if (!travelled) return true;
-  const arrived = JSON.stringify(msg.state) === JSON.stringify(travelled.state);
-  if (!arrived && (travelled.generation === null || msg.generation < travelled.generation)) return false;
-  travelled = null;
-  return true;
-}
-
-// The POST of a change sent after the travel refused: the entry's state will not come, and the
-// state in force (its "refused" event's, written whenever it arrives) is the address's.
-function refusedPost(post) {
-  if (!travelled || post <= travelled.after) return;
-  travelled = null;
-  rememberInUrl(page.state).catch((err) => console.warn("the link's state:", err));
-}
-
-async function deflated(text) {
-  const stream = new Blob([text]).stream().pipeThrough(new CompressionStream("deflate-raw"));
-  const bytes = new Uint8Array(await new Response(stream).arrayBuffer());
-  let binary = "";
-  for (const b of bytes) binary += String.fromCharCode(b);
-  return btoa(binary).replaceAll("+", "-").replaceAll("/", "_").replace(/=+$/, "");
-}
-
-async function inflated(z) {
-  const bytes = Uint8Array.from(atob(z.replaceAll("-", "+").replaceAll("_", "/")), (c) => c.charCodeAt(0));
-  return new Response(new Blob([bytes]).stream().pipeThrough(new DecompressionStream("deflate-raw"))).text();
-}
-
-async function stateFromUrl() {
-  const params = new URL(location.href).searchParams;
-  let text = params.get("state");
-  if (params.has("tab")) {
-    text = sessionStorage.getItem(TAB_STATE);
-    if (text === null) {
-      setNotice("the link's state was too large for a link and stays in the tab that made it; showing the defaults");
-      return {};
-    }
-  }
-  if (params.has("z")) {
-    try {
-      text = await inflated(params.get("z"));
-    } catch (err) {
-      setNotice(`the link's state is not a deflated state (${err.message}); showing the defaults`);
-      return {};
-    }
-  }
-  if (!text) return {};
-  try {
-    const state = JSON.parse(text);
-    if (state && typeof state === "object" && !Array.isArray(state)) return state;
-    setNotice(`the link's state is not an object of the state's fields (${text}); showing the defaults`);
-    return {};
-  } catch (err) {
-    setNotice(`the link's state is not valid JSON (${err.message}); showing the defaults`);
-    return {};
-  }
-}
-
-function copyLink() {
-  const button = $("#copy-link");
-  if (new URL(location.href).searchParams.has("tab")) {
-    button.textContent = "too large for a link";
-    return;
-  }
-  navigator.clipboard.writeText(location.href).then(
-    () => { button.textContent = "link copied"; },
-    () => { button.textContent = "copy the address bar"; },
-  );
-}
-
 function showScene(hasScene) {
   const frame = $("#scene");
   if (hasScene) {
@@ -376,16 +262,11 @@ async function main() {
   new ResizeObserver(([entry]) => document.documentElement.style.setProperty("--header-h", `${Math.ceil(entry.target.getBoundingClientRect().height)}px`)).observe($("header"));
   $("#legend").replaceChildren(algorithmKey(true));
   $("#controls").addEventListener("submit", (ev) => ev.preventDefault()); // (Enter in a box)
-  const opened = await openSession(await stateFromUrl(),
+  const opened = await openSession(await stateFromUrl(setNotice),
     (message) => setNotice(`the link's state was refused (${message}); showing the defaults`),
     (message, seconds) => setStatus(`${message}; trying again every ${seconds} s…`, true));
   $("#copy-link").addEventListener("click", copyLink);
-  addEventListener("popstate", (ev) => {
-    if (!ev.state) return;
-    travelled = { state: ev.state.state, after: changesPosted(), generation: null };
-    Object.assign(written, { state: ev.state.state, field: null });
-    send(ev.state.state);
-  });
+  followHistory(send);
   $("#cancel").addEventListener("click", cancel);
   atlasPanel(() => page.state, send);
   onState(opened);
