@@ -373,7 +373,7 @@ def vector_spec(sens: dict, name: str, log: dict) -> dict:
             name=k,
             marker=dict(color=E_COLORS[k]),
             hovertemplate=f"{k} = %{{y:.4g}}{plus_minus(errors[k])}<extra></extra>",
-            **({"error_y": dict(type="data", array=[errors[k]])} if errors[k] else {}),
+            **({} if errors[k] is None else {"error_y": dict(type="data", array=[errors[k]])}),
         )
         for k, eq in (("E1", 13), ("E2", 18))
     ]
@@ -388,11 +388,9 @@ def vector_spec(sens: dict, name: str, log: dict) -> dict:
     where = region_words(sens["region"]) if sens["design_region"] else "the box of the runs"
     frame = sens.get("E2_frame_axes")
     sub = [f"on {where}"] + ([f"E2 in the kernel frame of joints {frame}"] if frame else [])
-    if any(errors.values()):
-        sub.append(
-            "by a Sobol rule of "
-            + ", ".join(f"{k} = {values[k]:.4g}{plus_minus(e)}" for k, e in errors.items() if e)
-        )
+    told = [f"{k} = {values[k]:.4g}{plus_minus(e)}" for k, e in errors.items() if e is not None]
+    if told:
+        sub.append("by a Sobol rule: " + ", ".join(told))
     title = f"E1, E2 of the vector {name}" + "".join(f"<br><sup>{x}</sup>" for x in wrap(sub))
     yaxis = dict(title="E (log)", **log, **log_ticks(values.values()))
     return figure(data, title, showlegend=False, annotations=words, yaxis=yaxis)
