@@ -209,7 +209,11 @@ def _initial_step(inverse, x, f, y_d, rtol, atol):
     dm = np.maximum(d1, d2)
     with np.errstate(divide="ignore"):
         h1 = np.where(dm <= 1e-15, np.maximum(1e-6, h0 * 1e-3), (0.01 / dm) ** (1.0 / 8.0))
-    return np.minimum(100 * h0, h1)
+    h = np.minimum(100 * h0, h1)
+    # A trial point where k is not finite (a formula's log or sqrt past its domain) gives no
+    # estimate (NaN, a step never accepted nor shrunk): start from h0, which the step control
+    # shrinks until the stages are finite.
+    return np.where(np.isfinite(h) & (h > 0), h, np.where(np.isfinite(h0) & (h0 > 0), h0, 1e-6))
 
 
 def _decay_rate(inverse: Inverse, x: FloatArray) -> FloatArray:

@@ -54,3 +54,35 @@ def test_one_step_matches_scipy_solve_ivp():
     x1 = x0 + h * dop853.B @ K
     ref = solve_ivp(f, (0, h), x0, method="DOP853", rtol=1e-13, atol=1e-13).y[:, -1]
     np.testing.assert_allclose(x1, ref, rtol=0, atol=1e-12)
+
+
+def _log_robot():
+    """A formula robot whose task log(a) + c is undefined for a <= 0."""
+    from jik.engine.formula_kinematics import FormulaKinematics
+    from jik.engine.inverses import Pseudoinverse
+
+    kin = FormulaKinematics(variables=["a", "b", "c"], task=["log(a) + c", "b + sqrt(c)"])
+    return Pseudoinverse(kin)
+
+
+def test_initial_step_is_finite_where_its_trial_point_leaves_the_domain():
+    """At a = 0.0015 the first trial step h0 f lands at a < 0, where k is NaN: the starting
+    step is h0 (the step control shrinks it), not NaN, which no step would ever replace."""
+    inverse = _log_robot()
+    x = np.array([[0.0015115, 0.21282092, 0.6196509]])
+    y_d = np.array([[-10.0, 1.0]])
+    f, _, _ = dop853._rhs(inverse, x, y_d)
+    h = dop853._initial_step(inverse, x, f, y_d, dop853.RTOL, dop853.ATOL)
+    assert np.isfinite(h).all() and (h > 0).all()
+    _, _, status, steps, _ = dop853.integrate(inverse, x, y_d, 1e-10, 500, False, np.zeros(1))
+    assert status[0] == dop853.Status.CONVERGED and steps[0] < 100
+
+
+def test_solve_hands_over_to_dop853_near_the_edge_of_the_domain():
+    """Picard's sweeps stop at a = 0.0015, near log's edge; DOP853 goes on from there to the
+    target (it used to spin there on a NaN step until max_iterations)."""
+    from jik.engine.solver import solve
+
+    result = solve(_log_robot(), [1.0, 0.0, 1.0], [-10.0, 1.0], max_iterations=500)
+    assert result.success, result.message
+    assert result.error < 1e-10
