@@ -85,7 +85,8 @@ class Robot:
             p=spec.p,
             r=spec.r,
             task=" ".join(spec.task_names),
-            maps=tuple(a.name for a in spec.augmentations) + tuple(self.map_vectors),
+            # (a vector of maps, p - r > 1, is one of spec.augmentations and of map_vectors)
+            maps=tuple(dict.fromkeys([*(a.name for a in spec.augmentations), *self.map_vectors])),
         )
 
     def __reduce__(self):

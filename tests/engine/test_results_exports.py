@@ -152,6 +152,18 @@ def test_a_robot_prints_on_one_line():
     assert repr(robot) == (
         "Robot('planar_chain', title='planar chain', p=3, r=2, task='x y', maps=['formula'])"
     )
+    vectors = jik.robot_from_dict(
+        {
+            "name": "planar_chain",
+            "joints": "RRRR",
+            "lengths": [1, 0.8, 0.6, 0.4],
+            "augmentations": [
+                {"name": "formula", "h": ["x3", "x4"]},
+                {"name": "formula", "label": "other", "h": ["x1", "x4"]},
+            ],
+        }
+    )
+    assert repr(vectors).endswith("maps=['formula', 'other'])"), repr(vectors)
     panda = jik.robot_from_dict({"name": "panda", "task": "pose"})
     text = repr(panda)
     assert len(text) < 200 and "<?xml" not in text and "\n" not in text, text
