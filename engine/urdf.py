@@ -192,10 +192,11 @@ class UrdfChain(Kinematics):
         self.joint_names = tuple(active)
         self.p, self.r = len(active), len(names)
         if self.p <= self.r:
+            # (the field the caller gave: the task, when the active joints are the chain's)
             raise InvalidInputError(
                 f"{self.p} active joints for a task of {self.r} coordinates: a redundant robot "
                 "needs more joints than task coordinates",
-                "active_joints",
+                "task" if active_joints is None else "active_joints",
             )
         self.variable_names = tuple(f"x{i + 1}" for i in range(self.p))
         self.chain = tuple(

@@ -200,8 +200,13 @@ def test_known_home_positions():
 def test_the_ur5e_has_no_redundancy_for_a_full_pose():
     from jik.engine.exceptions import InvalidInputError
 
-    with pytest.raises(InvalidInputError, match="6 active joints for a task of 6 coordinates"):
+    with pytest.raises(InvalidInputError, match="6 active joints for a task of 6 coordinates") as e:
         robot_from_dict({"name": "ur5e", "task": "pose"})
+    assert e.value.field == "task"  # (the active joints are the chain's: the task is too long)
+    few = {"name": "panda", "task": "pose", "active_joints": ["panda_joint1", "panda_joint2"]}
+    with pytest.raises(InvalidInputError, match="2 active joints for a task of 6") as e:
+        robot_from_dict(few)
+    assert e.value.field == "active_joints"
 
 
 def test_an_arm_equals_its_urdf_definition():
