@@ -43,6 +43,9 @@ def as_numbers(x, name: str, field: str | None = None) -> FloatArray:
         a = np.asarray(x)
         if a.dtype.kind not in "iuf" and not _numbers(a):
             raise TypeError(f"{a.dtype} entries")
+        # (numpy reads [True, 0, 1.5] as numbers: a JSON true, or YAML's yes, became 1.0)
+        if isinstance(x, list | tuple) and _holds_bool(x):
+            raise TypeError("boolean entries")
         return a.astype(float, copy=False)
     except (TypeError, ValueError, OverflowError) as exc:
         raise InvalidInputError(
@@ -58,6 +61,22 @@ def _numbers(a: np.ndarray) -> bool:
 
 def _is_number(v) -> bool:
     return not isinstance(v, str | bytes | bool | np.bool_)
+
+
+def _holds_bool(x: list | tuple) -> bool:
+    """Whether nested lists or tuples hold a boolean anywhere (plain floats and ints, most
+    entries, are passed over first: as fast as numpy's own reading of the list)."""
+    stack = [x]
+    while stack:
+        for v in stack.pop():
+            kind = type(v)
+            if kind is float or kind is int:
+                continue
+            if kind is list or kind is tuple or isinstance(v, list | tuple):
+                stack.append(v)
+            elif isinstance(v, bool | np.bool_):
+                return True
+    return False
 
 
 def as_points(

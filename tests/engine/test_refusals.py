@@ -65,6 +65,19 @@ REFUSALS = {
     "solve tol a number as text": (lambda: jik.solve(P, X0, [1, 1], tol="1e-10"), "tol"),
     "solve x0 numbers as text": (lambda: jik.solve(P, ["0", "0", "1.5"], [1, 1]), "x0"),
     "solve y_d numbers as text": (lambda: jik.solve(P, X0, np.array(["1", "1"])), "y_d"),
+    # (numpy reads a boolean among numbers as 0 or 1: a JSON true, or YAML's yes, ran as 1.0)
+    "solve x0 a boolean among numbers": (lambda: jik.solve(P, [True, 0, 1.5], [1, 1]), "x0"),
+    "solve_batch y_d a boolean in a row": (
+        lambda: jik.solve_batch(P, X0, [[1, 1], [1, np.True_]]),
+        "y_d",
+    ),
+    "repeatability path a boolean": (lambda: jik.repeatability(P, X0, [(1, 1), (1, True)]), "path"),
+    "robot x0 a boolean": (
+        lambda: jik.robot_from_dict(
+            {"name": "planar_chain", "joints": "RRR", "lengths": [1, 1, 1], "x0": [True, 1, 1]}
+        ),
+        "x0",
+    ),
     "E1Optimal C1 a number as text": (lambda: jik.E1Optimal(C1="1"), "C1"),
     "synthesize_e2 region bound as text": (
         lambda: jik.synthesize_e2(ARM, {"x2": ("0", 1), "x3": (1, 2)}, degree=2),
