@@ -343,12 +343,13 @@ class UrdfChain(Kinematics):
 
 def _unit(axis, name: str) -> FloatArray:
     """The joint's axis normalised (x when the URDF gives none; 3 numbers, :func:`parse_urdf`
-    checks): finite, not all 0."""
+    checks): finite, not all 0. It is scaled by its largest component first, so that a norm
+    of 1e200-sized or 1e-200-sized numbers neither overflows nor underflows."""
     a = np.array([1.0, 0.0, 0.0]) if axis is None else np.asarray(axis, dtype=float)
-    n = float(np.linalg.norm(a))
-    if not n > 0 or not np.all(np.isfinite(a)):
+    m = float(np.max(np.abs(a)))
+    if not (0 < m < np.inf) or not np.all(np.isfinite(a)):
         raise InvalidInputError(f"joint {name!r} has a zero or invalid axis", "urdf")
-    return a / n
+    return (a / m) / np.linalg.norm(a / m)
 
 
 def _origin(joint) -> FloatArray:

@@ -115,6 +115,20 @@ def test_a_fixed_joints_axis_is_ignored():
     )
 
 
+@pytest.mark.parametrize("axis", ["0 0 1e200", "0 0 1e-200", "1e308 1e308 0", "0 0 7"])
+def test_an_axis_of_any_finite_size_is_the_same_unit_axis(axis):
+    """An axis is a direction: '0 0 1e200' (whose plain norm overflows to inf, which divided
+    the axis to zero and froze the joint) and '0 0 1e-200' (whose norm underflows to 0) are
+    the unit axis of '0 0 1', and '1e308 1e308 0' is that of '1 1 0'."""
+    x = np.array([0.1, 0.2, 0.3, 0.4])
+    unit = "1 1 0" if axis.startswith("1e308") else "0 0 1"
+    scaled = UrdfChain(TEXT.replace('<axis xyz="0 0 1"/>', f'<axis xyz="{axis}"/>', 1), "tool")
+    plain = UrdfChain(TEXT.replace('<axis xyz="0 0 1"/>', f'<axis xyz="{unit}"/>', 1), "tool")
+    np.testing.assert_allclose(scaled.forward(x), plain.forward(x), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(scaled.jacobian(x), plain.jacobian(x), rtol=0, atol=1e-15)
+    assert np.abs(scaled.jacobian(x)[:, 0]).max() > 0.1  # (the joint moves the end)
+
+
 @pytest.mark.parametrize(
     "name",
     [
