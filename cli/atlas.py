@@ -40,7 +40,13 @@ from .algorithm_options import (
     run_settings,
 )
 from .atlas_output import CsvWriter, Gathered, write_figure
-from .robot_commands import add_robot_option, point_texts, refused, robot_with_task
+from .robot_commands import (
+    RobotFileError,
+    add_robot_option,
+    point_texts,
+    refused,
+    robot_with_task,
+)
 
 #: Atlases of more runs than this write their arrays to the CSV only (the JSON keeps a summary).
 JSON_RUNS = 20000
@@ -195,7 +201,7 @@ def atlas_command(args: argparse.Namespace) -> int:
 
     try:
         return _run(args)
-    except InvalidInputError as error:
+    except (InvalidInputError, RobotFileError) as error:
         return refused("atlas", error, args)
     except OSError as error:  # (a Dask scheduler out of reach, an output that cannot be written)
         sys.stderr.write(f"jik atlas: {error}\n")

@@ -94,6 +94,15 @@ def add_task_option(p: argparse.ArgumentParser) -> None:
     )
 
 
+class RobotFileError(Exception):
+    """An entry of the robot file ``source`` refused, under its ``field`` in the file (such as
+    ``task.0`` or ``limits``): no option of the command, though some share its name."""
+
+    def __init__(self, message: str, field: str, source: str) -> None:
+        super().__init__(message)
+        self.field, self.source = field, source
+
+
 def robot_with_task(source: str, task: str | None) -> Robot:
     """The robot of ``--robot`` (a file or a name), a catalogue arm with ``--task`` if given."""
     from ..engine.arms import ARMS
@@ -101,7 +110,12 @@ def robot_with_task(source: str, task: str | None) -> Robot:
     from ..engine.robot_spec import load_robot, robot_from_dict
 
     if task is None:
-        return load_robot(source)
+        try:
+            return load_robot(source)
+        except InvalidInputError as error:
+            if error.field in (None, "robot"):  # (the file as a whole: --robot's)
+                raise
+            raise RobotFileError(str(error), error.field, source) from None
     if source not in ARMS:
         raise InvalidInputError(
             f"--task is for a catalogue arm ({sorted(ARMS)}); a robot file holds its task", "task"
@@ -250,7 +264,9 @@ def refused(command: str, error: Exception, args: argparse.Namespace | None = No
         option = "dask" if getattr(args, "dask", None) is not None else "processes"
     if head == "active_joints" and getattr(args, "task", None) is not None:
         option = "task"  # (a catalogue arm's joints against the task that --task gave it)
-    if field and option in vars(args or argparse.Namespace()):
+    if isinstance(error, RobotFileError):
+        where = f" (field {field} of the robot file {error.source})"
+    elif field and option in vars(args or argparse.Namespace()):
         where = f" (option --{option.replace('_', '-')})"
     else:
         where = f" (field {field})" if field else ""
@@ -266,7 +282,7 @@ def guarded(command):
 
         try:
             return command(args)
-        except JikError as exc:
+        except (JikError, RobotFileError) as exc:
             return refused(args.command, exc, args)
 
     return run

@@ -238,6 +238,30 @@ def test_unknown_robot_exits_2(capsys):
     assert "neither a file nor a built-in robot" in err and "(option --robot)" in err
 
 
+@pytest.mark.parametrize(
+    ("entry", "field"),
+    [
+        ({"task": ["x2 + os(x3)", "x1 + sin(x3)"]}, "task.0"),
+        ({"limits": [[1, 0], [None, None], [None, None]]}, "limits"),
+    ],
+)
+@pytest.mark.parametrize("command", ["solve", "repeatability", "atlas"])
+def test_a_robot_files_refused_entry_is_named_as_the_files_not_an_options(
+    capsys, tmp_path, entry, field, command
+):
+    """A formula robot file's task or limits share their names with --task and --limits,
+    options the user did not give and that could not change the file: the message names the
+    entry of the file."""
+    robot = {"name": "formula", "variables": ["x1", "x2", "x3"]}
+    robot |= {"task": ["x2 + cos(x3)", "x1 + sin(x3)"], **entry}
+    path = tmp_path / "m2.json"
+    path.write_text(json.dumps(robot))
+    out = ["--out", str(tmp_path / "a.json")] if command == "atlas" else []
+    _, err = run(capsys, command, "--robot", str(path), *out, code=2)
+    assert err.startswith(f"jik {command}: {field}")
+    assert err.endswith(f"(field {field} of the robot file {path})\n") and "option" not in err
+
+
 def test_repeatability_says_what_it_found_and_why(capsys):
     """``jik repeatability`` ends its text with the run's findings (the engine's sentences, in
     the robot's unit) and gives them in --json as {text, role}: J^E# (11) on Table 1's path

@@ -100,7 +100,7 @@ def test_a_synthesis_region_beyond_the_bound_is_refused_as_the_api_refuses_it(ca
     path = tmp_path / "r.json"
     path.write_text(json.dumps(robot))
     assert main(["solve", "--robot", str(path), "--algorithm", "extended"]) == 2
-    assert "(field augmentations.0.region.x2)" in capsys.readouterr().err
+    assert f"(field augmentations.0.region.x2 of the robot file {path})" in capsys.readouterr().err
     edge = {"x2": [-MAX_REGION_BOUND, MAX_REGION_BOUND], "x3": [0, 1]}
     robot["augmentations"][0]["region"] = edge
     assert robot_from_dict(robot).spec.functional_region["x2"] == tuple(edge["x2"])
