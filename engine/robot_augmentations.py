@@ -42,6 +42,13 @@ def augmentations_from_dict(kin: Kinematics, items, key: str | None = None):
                 "{'name': 'e2_synthesized', 'region': {...}}",
                 where,
             )
+        if k == 0:
+            raise InvalidInputError(
+                f"{where}: an augmenting map needs redundancy (p > r), and this robot has "
+                f"p = r = {kin.p}: its Jacobian is square, so no map can be added; remove it "
+                "(the pseudoinverse is then J^-1)",
+                where,
+            )
         label = robot_kinds.one_line(item.get("label", item["name"]), f"{where}.label")
         if label in {s.name for s in specs}:
             raise InvalidInputError(

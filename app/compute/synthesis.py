@@ -90,9 +90,13 @@ def synthesize_request(req: S.SynthesizeRequest) -> S.SynthesizeResponse:
         raise RequestError(
             "method",
             f"'e2_variational' synthesizes one map h, which needs one degree of redundancy "
-            f"(p = r + 1); this {spec.name} robot has p = {spec.p}, r = {spec.r}: give its "
-            f"extended inverse {spec.p - spec.r} formula maps instead ({{'name': 'formula', "
-            "'h': [...]}})",
+            f"(p = r + 1); this {spec.name} robot has p = {spec.p}, r = {spec.r}: "
+            + (
+                "its Jacobian is square, so it has no room for a map"
+                if spec.p == spec.r
+                else f"give its extended inverse {spec.p - spec.r} formula maps instead "
+                "({'name': 'formula', 'h': [...]})"
+            ),
         )
     if req.method != "evaluate" and req.augmentation is not None:
         raise RequestError("augmentation", f"'{req.method}' synthesizes h; give no map")

@@ -136,6 +136,24 @@ def test_more_than_one_degree_of_redundancy_is_refused_by_e2_variational(api):
     assert "p = 4, r = 2" in msg
 
 
+@pytest.mark.parametrize(
+    "augmentation", [{"name": "formula", "h": "x1"}, {"name": "e2_synthesized", "region": REGION}]
+)
+def test_a_chain_without_redundancy_refuses_a_map_saying_why(api, augmentation):
+    """p = r (a 2R chain): no map fits, as Robot.inverse('extended') says; the answer said
+    'must be a list of 0 formulas' (and asked e2_variational for '0 formula maps instead')."""
+    arm = {"name": "planar_chain", "joints": "RR", "lengths": [1.0, 1.0]}
+    body = {"robot": arm, "algorithm": "extended", "augmentation": augmentation}
+    (msg,) = messages(api.post("/solve", json=body))
+    assert msg.startswith("augmentation: an augmenting map needs redundancy (p > r)")
+    assert "p = r = 2" in msg and "0 formulas" not in msg
+    region = {"x1": [0, 1], "x2": [0, 1]}
+    body = {"robot": arm, "method": "e2_variational", "region": region}
+    (msg,) = messages(api.post("/synthesize", json=body))
+    assert msg.startswith("method: 'e2_variational' synthesizes one map h")
+    assert "p = 2, r = 2: its Jacobian is square" in msg and "0 formula maps" not in msg
+
+
 def test_formula_manipulator2_equals_the_builtin(api):
     """Manipulator 2 written as formulas gives the built-in's Table 1 run to 1e-9."""
     for algorithm, aug in (("pseudoinverse", None), ("extended", "x3 - 0.7501*x2*x3")):

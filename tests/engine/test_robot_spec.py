@@ -201,6 +201,23 @@ def test_a_chain_without_redundancy_runs_but_its_extended_inverse_says_why_not()
         robot.kinematics.kernel(x0)  # (K(x), of E1 and E2, has no meaning here either)
 
 
+@pytest.mark.parametrize(
+    "augmentation",
+    [
+        {"name": "formula", "h": "x1"},
+        {"name": "formula", "h": []},
+        {"name": "e2_synthesized", "region": {"x1": [0, 1], "x2": [0, 1]}},
+    ],
+)
+def test_a_chain_without_redundancy_refuses_an_augmenting_map(augmentation):
+    """p = r: a map of the definition is refused as Robot.inverse('extended') is, not taken as
+    'a list of 0 formulas' (h = [] built an 'extended' inverse that was J^-1 under its name)."""
+    chain = {"name": "planar_chain", "joints": "RR", "lengths": [1, 1]}
+    with pytest.raises(InvalidInputError, match=r"needs redundancy \(p > r\).*p = r = 2") as err:
+        robot_from_dict({**chain, "augmentations": [augmentation]})
+    assert err.value.field == "augmentations.0"
+
+
 def test_more_than_one_degree_of_redundancy_takes_a_vector_of_formula_maps():
     chain = {
         "name": "planar_chain",
