@@ -48,6 +48,13 @@ def _progress(fraction: float) -> None:
 
 
 def reproduce(args: argparse.Namespace) -> int:
+    if args.printed_gradient and args.name != "table1":
+        from ..engine.exceptions import InvalidInputError
+
+        raise InvalidInputError(
+            f"--printed-gradient is for table1 (the printed j32, j33 of (39)), not {args.name}",
+            "printed_gradient",
+        )
     module = importlib.import_module(f"..engine.reproductions.{args.name}", __package__)
     kwargs: dict[str, Any] = {}
     if args.name == "table1" and args.printed_gradient:

@@ -295,3 +295,16 @@ def test_a_catalogue_arm_without_redundancy_for_its_task_names_the_task_option(c
     assert "6 active joints for a task of 6 coordinates" in err and err.endswith(
         "(option --task)\n"
     )
+
+
+@pytest.mark.parametrize("name", ["manipulator1", "manipulator2", "unicycle", "algorithms"])
+def test_the_printed_gradient_option_is_refused_outside_table1(capsys, name):
+    """--printed-gradient changes Table 1 alone; another reproduction ran without it and said
+    nothing, as if the option had been used."""
+    _, err = run(capsys, "reproduce", name, "--printed-gradient", code=2)
+    assert err == (
+        f"jik reproduce: --printed-gradient is for table1 (the printed j32, j33 of (39)), not "
+        f"{name} (option --printed-gradient)\n"
+    )
+    out, _ = run(capsys, "reproduce", "table1", "--printed-gradient", "--json")
+    assert json.loads(out)
