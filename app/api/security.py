@@ -65,7 +65,9 @@ class SecurityMiddleware:
 
     def __init__(self, app: ASGIApp, allowed_hosts: Iterable[str] = LOOPBACK_HOSTS) -> None:
         self.app = app
-        hosts = {h.lower() for h in allowed_hosts}
+        # (a name given with its port, 'lab.example:8000', is the name, which Host headers are
+        # compared with; an empty one names no host, as in JIK_ALLOWED_HOSTS)
+        hosts = {host_name(h.strip()).lower() for h in allowed_hosts if h.strip()}
         self.any_host = "*" in hosts
         self.hosts = frozenset(hosts)
 

@@ -57,6 +57,20 @@ def test_allowed_hosts_come_from_the_environment(monkeypatch):
     assert TestClient(create_app(), base_url="http://any.example").get("/health").status_code == 200
 
 
+def test_an_allowed_host_given_with_its_port_or_empty_is_taken_as_its_name():
+    """`jik serve --allowed-host lab.example:8000` answers to lab.example on any port (it
+    refused every request to lab.example:8000, naming 'lab.example:8000' among the hosts it
+    answers to); `--allowed-host ""` lets no request without a Host header through."""
+    app = create_app(allowed_hosts=("lab.example:8000", " ", "", " other.example "))
+    for base in ("http://lab.example:8000", "http://lab.example", "http://other.example"):
+        assert TestClient(app, base_url=base).get("/health").status_code == 200, base
+    client = TestClient(app, base_url="http://127.0.0.1")
+    for host in ("", " "):
+        r = client.get("/health", headers={"host": host})
+        assert r.status_code == 400 and "'lab.example'" in r.json()["detail"]
+        assert "lab.example:8000" not in r.json()["detail"]
+
+
 def test_a_change_from_another_origin_is_refused(app, client):
     r = client.post("/api/sessions", json={"state": {}}, headers={"origin": FOREIGN})
     assert r.status_code == 403 and FOREIGN in r.json()["detail"]
