@@ -32,13 +32,16 @@ def one_line(value, field: str, most: int = MAX_TITLE_CHARS) -> str:
         raise InvalidInputError(
             f"{field} must have 1 to {most} characters, got {len(value)}", field
         )
-    if bad := _NOT_ONE_LINE.search(value):
-        raise InvalidInputError(
-            f"{field} must be one line of printable text, got {bad.group()!a} at "
-            f"character {bad.start()}",
-            field,
-        )
+    if fault := one_line_fault(value):
+        raise InvalidInputError(f"{field} must be one line of printable text, got {fault}", field)
     return value
+
+
+def one_line_fault(value: str) -> str | None:
+    """The first character of ``value`` that is not printable on one line, as an escape and its
+    place (``"'\\n' at character 3"``); None when there is none."""
+    bad = _NOT_ONE_LINE.search(value)
+    return None if bad is None else f"{bad.group()!a} at character {bad.start()}"
 
 
 @dataclass(frozen=True)

@@ -20,6 +20,7 @@ import re
 from jik import install_hint
 
 from .exceptions import InvalidInputError
+from .robot_kinds import one_line_fault
 
 #: Largest URDF text accepted [bytes].
 MAX_URDF_BYTES = 1_000_000
@@ -125,6 +126,12 @@ def _check_tree(root, field: str) -> None:
         for element in root.iterfind(kind):
             if (name := element.get("name")) in seen:
                 raise InvalidInputError(f"{field}: two {kind}s are named {name!r}", field)
+            if name is not None and (fault := one_line_fault(name)):  # (&#10; is a line break)
+                raise InvalidInputError(
+                    f"{field}: a {kind}'s name must be one line of printable text, got {fault} "
+                    f"of {name!a:.80}",
+                    field,
+                )
             seen.add(name)
     parent_joint: dict[str, str] = {}
     for joint in root.iterfind("joint"):

@@ -82,3 +82,17 @@ def test_the_parser_itself_refuses_a_dtd_past_the_text_check():
     with pytest.raises(InvalidInputError, match="DTD") as err:
         _hardened_parse(f'<!DOCTYPE r [<!ENTITY x "{SECRET}">]><r>&x;</r>'.encode(), "urdf")
     assert SECRET not in str(err.value)
+
+
+@pytest.mark.parametrize("reference", ["&#10;", "&#13;", "&#x2028;", "&#9;", "&#133;"])
+@pytest.mark.parametrize("kind", ["joint", "link"])
+def test_a_name_holding_a_line_break_or_control_character_is_refused(reference, kind):
+    """A character reference (no entity) put a line break in a joint's name, which the
+    verdicts print: a dashboard export's '#' header line broke and the text after it became a
+    CSV row of its own ('pseudoinverse,1,1,=HYPERLINK(1)')."""
+    old = 'name="shoulder"' if kind == "joint" else 'name="forearm"'
+    name = old[:-1] + reference + 'pseudoinverse,1,1,=HYPERLINK(1)"'
+    text = TEXT.replace(old, name).replace('link="forearm"', name.replace("name", "link"))
+    with pytest.raises(InvalidInputError, match=f"a {kind}'s name must be one line") as err:
+        UrdfChain(text, "tool")
+    assert err.value.field == "urdf"
