@@ -78,9 +78,9 @@ def kinematics_task(body: bytes) -> bytes:
     """The worker's task: a request (JSON) in, its robot built and its k and J at its x, the
     response (JSON) out; raises :class:`RequestError`."""
     req = KinematicsRequest.model_validate_json(body)
-    robot = request_robot(req.robot)
-    spec, kin = robot.spec, robot.kinematics
     many = isinstance(req.x[0], list)
+    robot = request_robot(req.robot, x0=req.x[0] if many else req.x)
+    spec, kin = robot.spec, robot.kinematics
     for i, row in enumerate(req.x if many else [req.x]):
         check_length(spec, row, f"x[{i}]" if many else "x", "p")
     x = np.asarray(req.x, dtype=float)

@@ -83,7 +83,7 @@ def request_robot(
         # A formula map no chosen algorithm uses is built all the same, to be checked (its
         # formulas' derivatives, within the build budget); a map to synthesize is not.
         checked = extended or with_map or getattr(augmentation, "name", None) == "formula"
-        robot, robot_used = user_robot(req_robot, augmentation if checked else None)
+        robot, robot_used = user_robot(req_robot, augmentation if checked else None, x0)
         kin = robot.kinematics
         inverses = tuple(user_inverse(robot, a, given(a), x0) for a in algorithms)
         aug_used = map_used(robot) if extended else None
@@ -236,10 +236,14 @@ def _built(definition: str) -> Robot:
     return robot_from_dict(json.loads(definition))
 
 
-def user_robot(req_robot: Any, augmentation: Any = None) -> tuple[Robot, S.RobotUsed]:
+def user_robot(
+    req_robot: Any, augmentation: Any = None, start: Sequence[float] | None = None
+) -> tuple[Robot, S.RobotUsed]:
     """The robot a request defines, with ``augmentation`` (a request's map model, or None) as
     its only augmenting map; what it used. RequestError, naming the request's field, when the
-    engine refuses the definition or the map."""
+    engine refuses the definition or the map. A definition takes no x0: where the engine
+    refuses its default start (a task undefined there and across its box, as log(x1 - 100)),
+    the request's ``start`` (its x0) is the robot's start if given."""
     definition = req_robot.model_dump(exclude_none=True)
     if augmentation is not None:
         given = augmentation.model_dump(exclude_none=True)
@@ -248,7 +252,10 @@ def user_robot(req_robot: Any, augmentation: Any = None) -> tuple[Robot, S.Robot
         with time_budget(build_seconds(), "robot", "building the robot's formulas"):
             robot = built(definition)
     except InvalidInputError as exc:
-        raise RequestError(request_field(exc.field, list(definition)), _text(exc)) from None
+        started = _started(definition, start) if exc.field == "x0" else None
+        if started is None:
+            raise RequestError(request_field(exc.field, list(definition)), _text(exc)) from None
+        robot = started
     spec = robot.spec
     used = S.RobotUsed(
         name=spec.name,
@@ -261,6 +268,18 @@ def user_robot(req_robot: Any, augmentation: Any = None) -> tuple[Robot, S.Robot
         units=S.UnitsInfo(**robot.units.summary()),
     )
     return robot, used
+
+
+def _started(definition: dict, start: Sequence[float] | None) -> Robot | None:
+    """The robot of ``definition`` started at ``start``; None without one, or if the engine
+    refuses that too (the first refusal is then the one to report)."""
+    if start is None:
+        return None
+    try:
+        with time_budget(build_seconds(), "robot", "building the robot's formulas"):
+            return built({**definition, "x0": [float(v) for v in start]})
+    except InvalidInputError:
+        return None
 
 
 def map_used(robot: Robot) -> S.AugmentationUsed | None:

@@ -154,6 +154,25 @@ def test_a_chain_without_redundancy_refuses_a_map_saying_why(api, augmentation):
     assert "p = 2, r = 2: its Jacobian is square" in msg and "0 formula maps" not in msg
 
 
+def test_a_formula_robot_undefined_at_the_default_start_runs_from_the_requests_x0(api):
+    """log(x1 - 100) is undefined at the default start (0.5, 0.5, 0.5) and across the default
+    box: the robot was refused ('give an x0 where it is defined') though the request gave one,
+    and a definition over REST takes no x0 ('unknown field'). The request's x0 starts it, as
+    the definition's x0 does in Python."""
+    robot = {"name": "formula", "variables": ["x1", "x2", "x3"]}
+    robot["task"] = ["log(x1 - 100) + x3", "x2"]
+    body = {"robot": robot, "algorithm": "pseudoinverse", "x0": [200, 0, 0], "target": [4.7, 0.1]}
+    res = _ok(api.post("/solve", json=body))
+    assert res["converged"] and np.allclose(res["y"], [4.7, 0.1], atol=1e-9)
+    assert "x0" not in res["robot"]["definition"]  # (the definition as given)
+    k = _ok(api.post("/kinematics", json={"robot": robot, "x": [[200, 0, 0], [300, 0, 1]]}))
+    assert np.allclose(k["k"], [[math.log(100), 0], [math.log(200) + 1, 0]])
+    (msg,) = messages(api.post("/solve", json={**body, "x0": None}))  # (no start: refused)
+    assert msg.startswith("robot: the task k(x) is undefined at x0 = (0.5, 0.5, 0.5)")
+    (msg,) = messages(api.post("/solve", json={**body, "x0": [50, 0, 0]}))  # (undefined there)
+    assert msg.startswith("robot: the task k(x) is undefined at x0 = (0.5, 0.5, 0.5)")
+
+
 def test_formula_manipulator2_equals_the_builtin(api):
     """Manipulator 2 written as formulas gives the built-in's Table 1 run to 1e-9."""
     for algorithm, aug in (("pseudoinverse", None), ("extended", "x3 - 0.7501*x2*x3")):
