@@ -191,8 +191,7 @@ class UrdfChain(Kinematics):
         self.task, self.task_names = task_text(names), names
         self.joint_names = tuple(active)
         self.p, self.r = len(active), len(names)
-        if self.p <= self.r:
-            # (the field the caller gave: the task, when the active joints are the chain's)
+        if self.p <= self.r:  # (naming what the caller gave: the task, or the active joints)
             raise InvalidInputError(
                 f"{self.p} active joints for a task of {self.r} coordinates: a redundant robot "
                 "needs more joints than task coordinates",
