@@ -15,7 +15,7 @@ import numpy as np
 
 from .exceptions import InvalidInputError, SingularConfigurationError, format_vector
 from .inverses import Pseudoinverse
-from .self_motion import SelfMotionManifold, project, trace
+from .self_motion import SelfMotionManifold, periodic_joints, project, trace
 from .solver import solve_batch
 from .validation import MAX_COORDINATE, FloatArray, as_points, as_series, bounded
 
@@ -154,12 +154,28 @@ def base_manifolds(
         if error.field != "base":
             raise
         where = str(error).partition(": ")[2]
+        if _outside(kin, np.asarray(reference, dtype=float), box):
+            raise InvalidInputError(
+                f"the reference {format_vector(reference)} lies outside the box (x_range, joint "
+                f"limits): eq. (7) from it reaches the path's first point {format_vector(y0[0])} "
+                f"only where {where}",
+                field="reference",
+            ) from None
         raise InvalidInputError(
             f"the path's first point {format_vector(y0[0])} is out of reach in the box (x_range, "
             f"joint limits): eq. (7) from the reference reaches it only where {where}",
             field="path",
         ) from None
     return (first, *(trace(kin, b, first.arc) for b in bases[1:]))
+
+
+def _outside(kin, x: FloatArray, box) -> bool:
+    """Whether ``x`` lies outside ``box`` in a variable that is not a freely turning angle
+    (:func:`~jik.engine.self_motion.periodic_joints`, which a box does not bound)."""
+    if box is None:
+        return False
+    lo, hi = np.asarray(box, dtype=float).T
+    return bool(np.any(((x < lo) | (x > hi)) & ~periodic_joints(kin)))
 
 
 def checked(check, name: str):

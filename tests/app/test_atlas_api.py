@@ -510,6 +510,15 @@ def test_a_first_point_out_of_reach_is_refused_at_path(client):
     )
 
 
+def test_a_reference_outside_the_box_is_refused_at_reference(client):
+    """A given reference outside the box is at fault, not the default path it was sent with."""
+    body = {"robot": {"name": "manipulator2"}, "reference": [100, 100, 100], "starts": 4}
+    r = client.post("/atlas", json=body)
+    (error,) = r.json()["detail"]
+    assert r.status_code == 422 and error["loc"] == ["body", "reference"], r.text
+    assert error["msg"].startswith("reference: the reference (100, 100, 100) lies outside the box")
+
+
 def test_every_catalogue_arm_has_a_default_atlas_and_the_unicycle_says_why_not(client):
     """A catalogue arm's atlas with nothing but its name runs (the Gen3's continuous joints
     turn past the box's pi: a window on one turn, not a limit); the unicycle's default path is

@@ -285,10 +285,17 @@ def test_cancelled_stops_between_chunks():
         ({"shifts": [(0.0, 0.0, 1.0)]}, "shifts", "shape (..., 2)"),
         ({"reference": (0.0, math.nan, 1.0)}, "reference", "NaN"),
         (
-            {"box": [(-5.0, 5.0), (-5.0, 5.0), (2.0, 3.0)]},
+            {"box": [(-5.0, 5.0), (-5.0, 5.0), (2.0, 3.0)], "reference": (4.0, 4.0, 2.5)},
             "path",
             "the path's first point (0, 1) is out of reach in the box (x_range, joint limits): "
-            "eq. (7) from the reference reaches it only where x3 = 1.5708 is not in [2, 3]",
+            "eq. (7) from the reference reaches it only where x3 = 3.82069 is not in [2, 3]",
+        ),
+        (  # (the reference itself outside the box: it is at fault, not the path)
+            {"box": [(-5.0, 5.0), (-5.0, 5.0), (2.0, 3.0)]},
+            "reference",
+            "the reference (0, 0, 1.5708) lies outside the box (x_range, joint limits): eq. (7) "
+            "from it reaches the path's first point (0, 1) only where x3 = 1.5708 is not in "
+            "[2, 3]",
         ),
         ({"starts": [(0.0, 0.0, 1.0)]}, "starts.0", "not on the self-motion manifold"),
         ({"gamma": 0}, "gamma", "gamma must be > 0"),
