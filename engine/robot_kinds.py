@@ -18,8 +18,11 @@ from .exceptions import InvalidInputError
 MAX_TITLE_CHARS = 100
 #: What a text shown on one line (a title, a label: in the page, a command's output, a CSV
 #: export's header) may not hold: control characters (line breaks, tabs, escapes), Unicode's
-#: line and paragraph separators, and lone surrogates (which no UTF-8 file can hold).
-_NOT_ONE_LINE = re.compile("[\x00-\x1f\x7f-\x9f\u2028\u2029\ud800-\udfff]")
+#: line and paragraph separators, its bidirectional controls (which reorder the rest of the
+#: line it is printed on), and lone surrogates (which no UTF-8 file can hold).
+_NOT_ONE_LINE = re.compile(
+    "[\x00-\x1f\x7f-\x9f\u061c\u200e\u200f\u2028-\u202e\u2066-\u2069\ud800-\udfff]"
+)
 
 
 def one_line(value, field: str, most: int = MAX_TITLE_CHARS) -> str:

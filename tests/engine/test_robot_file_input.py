@@ -112,6 +112,7 @@ def test_a_synthesis_region_beyond_the_bound_is_refused_as_the_api_refuses_it(ca
         ({**CHAIN, "title": "arm\r\n# injected line"}, "title"),
         ({**CHAIN, "title": "tab\there"}, "title"),
         ({**CHAIN, "title": "line\u2028separator"}, "title"),
+        ({**CHAIN, "title": "arm \u202egnp.exe"}, "title"),  # (right-to-left override)
         ({**CHAIN, "title": "x" * (MAX_TITLE_CHARS + 1)}, "title"),
         ({**CHAIN, "title": ""}, "title"),
         ({"name": "manipulator2", "title": "two\nlines"}, "title"),
@@ -124,12 +125,14 @@ def test_a_synthesis_region_beyond_the_bound_is_refused_as_the_api_refuses_it(ca
 )
 def test_a_title_or_label_is_one_line_of_bounded_length(robot, field):
     """A title or a map's label with a line break, a tab or a Unicode line separator (which
-    would split a CSV export's '#' header line), empty, or too long is refused by name."""
+    would split a CSV export's '#' header line), a bidirectional control (which reorders the
+    rest of its line), empty, or too long is refused by name."""
     assert _refusal(lambda: robot_from_dict(robot)).field == field
 
 
 def test_a_one_line_title_and_label_are_kept():
     title = "Bras à trois segments — " + "x" * (MAX_TITLE_CHARS - 24)
+    assert robot_from_dict({**FORMULA, "title": "ذراع ثلاثي"}).spec.title == "ذراع ثلاثي"
     robot = {**FORMULA, "title": title}
     robot["augmentations"] = [{"name": "formula", "h": "x3", "label": "h = x3 (ω)"}]
     spec = robot_from_dict(robot).spec
