@@ -267,7 +267,8 @@ def _check_exponent(exponent: sp.Expr, error) -> None:
     else:
         value = complex(exponent.evalf(15)).real if exponent.is_real else float("nan")
     if not abs(value) <= MAX_EXPONENT:
-        raise error(f"exponent out of range (|exponent| <= {MAX_EXPONENT}, got {exponent})")
+        shown = str(exponent) if len(str(exponent)) <= 20 else str(sp.N(exponent, 6))
+        raise error(f"exponent out of range (|exponent| <= {MAX_EXPONENT}, got {shown})")
 
 
 def parse_formula(text, names: Mapping[str, sp.Expr], field: str = "formula") -> sp.Expr:
