@@ -30,9 +30,8 @@ from .run_settings import Resume, RunSettings, inverse_fingerprint, resumed_legs
 from .solve_chunks import solve_in_chunks
 from .solve_rules import (
     check_inverse,
+    check_map_value,
     check_settings,
-    map_value_error,
-    map_value_undefined,
     run_bytes,
 )
 from .solver import solve, solve_batch
@@ -187,7 +186,7 @@ def repeatability(
     JikError
         A leg's solve raised (a singular start configuration) and the progress, if any, did not
         stop the run there (the map having no value at the start
-        (:func:`~jik.engine.solve_rules.map_value_undefined`, field ``x0``) stops its first
+        (:func:`~jik.engine.solve_rules.check_map_value`, field ``x0``) stops its first
         leg; a batch with such a start is refused).
     RunCancelled
         ``progress.cancelled()`` returned True.
@@ -216,10 +215,8 @@ def repeatability(
             f"{len(path)} paths given for {len(xb)} start configurations", "path"
         )
     mode, gamma, tol, cap = check_settings(mode, gamma, tol, max_iterations)
-    # (a start where h has no value: a batch is refused, one start's first leg stops there)
-    no_h = np.flatnonzero(map_value_undefined(inverse, xb) & (resume is None))
-    if len(no_h) and not single:
-        raise map_value_error(inverse, xb[no_h[0]])
+    if not single and resume is None:  # (one start: its first leg's solve refuses it)
+        check_map_value(inverse, xb)
     L = path.shape[-2] + int(flag(close, "close"))  # (at most: k(x0) is added when needed)
     check_memory(
         len(xb),
@@ -298,8 +295,6 @@ def repeatability(
             check_cancelled(progress, f"repeatability run cancelled before {where}")
             stopped = None
             try:
-                if len(no_h) and c == j == 0:
-                    raise map_value_error(inverse, xb[0])
                 if chunked:  # (one start, with a progress)
                     res: SolveResult | BatchSolveResult = solve_in_chunks(
                         inverse,

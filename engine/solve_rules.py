@@ -174,6 +174,15 @@ def map_value_undefined(inverse: Inverse, x0: FloatArray) -> FloatArray:
     return ~np.isfinite(h).all(axis=-1)
 
 
+def check_map_value(inverse: Inverse, x0: FloatArray) -> None:
+    """Refuse the starts ``x0`` (n, p) if the augmenting map has no real value at one of them
+    (:func:`map_value_undefined`): raise :func:`map_value_error` at the first such start (a
+    solve, a batch and a repeatability run alike)."""
+    undefined = np.flatnonzero(map_value_undefined(inverse, x0))
+    if undefined.size:
+        raise map_value_error(inverse, x0[undefined[0]])
+
+
 def map_value_error(inverse: Inverse, x: FloatArray) -> AlgorithmicSingularityError:
     """The error of a start ``x`` (p,) where :func:`map_value_undefined`."""
     with np.errstate(all="ignore"):

@@ -28,6 +28,7 @@ from .solve_rules import (
     Record,
     Status,
     check_inverse,
+    check_map_value,
     check_settings,
     solve_bytes,
     start_problem,
@@ -229,7 +230,9 @@ def solve(
         method or max_iterations, a start where k is not finite; ``error.field`` names the
         argument.
     KinematicSingularityError, AlgorithmicSingularityError
-        When the start configuration is singular for ``inverse``.
+        When the start configuration is singular for ``inverse``; the latter also (field
+        ``x0``) where the extended inverse's augmenting map has no real value at the start
+        (:func:`~jik.engine.solve_rules.check_map_value`: h(x) = h(x0) means nothing there).
     """
     kin = check_inverse(inverse)
     x0 = kin.check_start(x0)
@@ -281,7 +284,8 @@ def solve_batch(
     Raises
     ------
     InvalidInputError, KinematicSingularityError, AlgorithmicSingularityError
-        As :func:`solve` (the first singular start names its configuration); also, before any
+        As :func:`solve` (the first singular start, or start where the augmenting map has no
+        real value, names its configuration: the whole batch is refused); also, before any
         work, a batch whose estimated memory (:func:`jik.engine.solve_rules.solve_bytes`)
         exceeds :data:`jik.engine.validation.MEMORY_LIMIT`, naming ``x0`` (``y_d`` for a batch
         of targets from one start) and how many starts fit.
@@ -319,6 +323,7 @@ def _batch(inverse, x0, y_d, gamma, mode, tol, max_iterations, record, method, g
         "solve them in smaller batches" + (", or with record=False" if record else ""),
     )
     xb, yb = np.array(xb), np.array(yb)
+    check_map_value(inverse, xb)
     guesses = picard_guesses(guess, len(xb), kin.p, gamma, single)
 
     if mode == "continuous":

@@ -174,6 +174,24 @@ def test_a_bad_member_does_not_spoil_its_batch():
     assert math.isclose(responses[0].json()["x"][0], 0.8, abs_tol=1e-9)
 
 
+def test_a_start_where_the_map_has_no_real_value_is_a_422_naming_x0(api):
+    """h = log(x3) at x3 = -1 (its gradient 1/x3 finite): the engine's solve refuses the start,
+    and so does the answer, naming x0, as /repeatability's does."""
+    robot = {"name": "formula", "variables": ["x1", "x2", "x3"], "task": ["x1 + x3", "x2"]}
+    body = {
+        "robot": robot,
+        "algorithm": "extended",
+        "augmentation": {"name": "formula", "h": "log(x3)"},
+        "x0": [0.0, 0.0, -1.0],
+    }
+    for route, more in (("/solve", {"target": [1, 1]}), ("/repeatability", {"path": [[1, 1]]})):
+        r = api.post(route, json={**body, **more})
+        assert r.status_code == 422, r.text
+        (detail,) = r.json()["detail"]
+        assert detail["loc"] == ["body", "x0"], r.text
+        assert "the augmenting map has no real value at the start" in detail["msg"]
+
+
 def test_every_registered_robot_solves_with_its_defaults(api):
     """Default start and target of every robot in the registry, its default mode and gamma
     (continuous, 1 for the manipulators; discrete, 0.1 for the unicycle once registered)."""

@@ -579,6 +579,25 @@ def test_a_map_without_a_real_value_at_the_start_is_refused():
     assert not refused_starts(jik.Pseudoinverse(ARM), [[0, -0.5, 1.0]])
 
 
+@pytest.mark.parametrize("mode", ["continuous", "discrete"])
+def test_a_solve_from_a_start_without_a_real_map_value_is_refused_as_repeatability_does(mode):
+    """h = log(x3) at x3 = -1: dh = 1/x3 is finite, so a run would go, but h(x) = h(x0) means
+    nothing; solve refuses the start as repeatability does (the same error, field x0), and a
+    batch with such a start is refused whole, as a repeatability batch is."""
+    inverse = jik.ExtendedInverse(ARM, jik.FormulaMap("log(x3)", NAMES))
+    gamma = 0.5 if mode == "discrete" else 1.0
+    with pytest.raises(jik.AlgorithmicSingularityError) as run:
+        jik.repeatability(inverse, [0, 0, -1.0], [(1, 1)], mode=mode, gamma=gamma)
+    with pytest.raises(jik.AlgorithmicSingularityError) as one:
+        jik.solve(inverse, [0, 0, -1.0], [1, 1], mode=mode, gamma=gamma)
+    with pytest.raises(jik.AlgorithmicSingularityError) as batch:
+        jik.solve_batch(inverse, [[0, 0, 1.0], [0, 0, -1.0]], [1, 1], mode=mode, gamma=gamma)
+    for info in (one, batch):
+        assert info.value.field == "x0" and str(info.value) == str(run.value)
+        np.testing.assert_allclose(info.value.configuration, [0, 0, -1.0])
+    assert jik.solve(inverse, [0, 0, 1.0], [1, 1], mode=mode, gamma=gamma).success
+
+
 @pytest.mark.parametrize(
     "error",
     [
