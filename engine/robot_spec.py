@@ -62,7 +62,9 @@ class Robot:
     spec : RobotSpec
     kinematics : Kinematics
     definition : dict
-        The definition it was built from (JSON-friendly; :func:`robot_from_dict` rebuilds it).
+        The definition it was built from (JSON-friendly; :func:`robot_from_dict` rebuilds it),
+        with the maps it was given by default (an arm's E2 synthesis around its home); a
+        catalogue arm's names the arm, without the keys whose values are the catalogue's.
     map_vectors : mapping label -> tuple of AugmentingMap, or a function giving one
         For p - r > 1: the augmentations that are vectors of p - r maps (formulas, or an E2
         synthesis computed on first use).
@@ -92,14 +94,19 @@ class Robot:
     def __reduce__(self):
         """Pickled as its definition, which :func:`robot_from_dict` builds again (its spec holds
         functions that do not pickle): a catalogue arm by its name, a URDF by its text."""
-        d, name = dict(self.definition), getattr(self.kinematics, "name", "")
+        d = dict(self.definition)
         if "urdf_file" in d:  # (relative to a folder the copy need not see)
             del d["urdf_file"]
             d["urdf"] = self.kinematics.urdf  # type: ignore[attr-defined]
-        if name in ARMS:  # (the keys it shares with the catalogue's entry come from there)
-            own = ARMS[name].definition()  # (repr: a value may be an ndarray, a home)
-            d = {k: v for k, v in d.items() if repr(own.get(k)) != repr(v)} | {"name": name}
         return robot_from_dict, (d,)
+
+    def _expanded(self) -> dict:
+        """:attr:`definition` as it was built: a catalogue arm's with the catalogue's URDF, end
+        link and home (:func:`_catalogue_keys_left_out` undone)."""
+        name = self.definition.get("name")
+        if name not in ARMS:
+            return self.definition
+        return {**ARMS[name].definition(), **self.definition, "name": "urdf"}
 
     @property
     def units(self) -> RobotUnits:
@@ -127,10 +134,10 @@ class Robot:
         spec = self.spec
         named = {a.name for a in spec.augmentations}
         if algorithm == "extended" and augmentation == SYNTHESIZED and SYNTHESIZED not in named:
-            if "home" in self.definition:  # (an arm: its map is built here on demand)
+            if "home" in self._expanded():  # (an arm: its map is built here on demand)
                 return self._synthesized_inverse()
         if algorithm == "extended" and not spec.augmentations:
-            arm = "home" in self.definition
+            arm = "home" in self._expanded()
             raise InvalidInputError(missing_map(spec.name, spec.p, spec.r, arm), "augmentation")
         if algorithm == "extended" and self.map_vectors:
             name = augmentation or self.spec.default_augmentation
@@ -154,11 +161,9 @@ class Robot:
         arm whose definition gives no map of that name: ``inverse("extended", "e2_synthesized")``
         asks for what ``{"augmentations": [{"name": "e2_synthesized"}]}`` in its definition
         gives. The synthesis is kept per process for the definition, as a definition's."""
-        kin = self.kinematics
-        wanted = arm_augmentations(
-            kin, {**self.definition, "augmentations": [{"name": SYNTHESIZED}]}
-        )
-        specs, _, vectors = augmentations_from_dict(kin, wanted, _key(self.definition))
+        kin, built = self.kinematics, self._expanded()
+        wanted = arm_augmentations(kin, {**built, "augmentations": [{"name": SYNTHESIZED}]})
+        specs, _, vectors = augmentations_from_dict(kin, wanted, _key(built))
         if SYNTHESIZED in vectors:
             maps = vectors[SYNTHESIZED]
             return VectorExtendedInverse(kin, maps() if callable(maps) else maps)
@@ -348,7 +353,17 @@ def robot_from_dict(d: Mapping, base_dir: str | Path | None = None) -> Robot:
         default_augmentation=augmentations[0].name if augmentations else "",
         functional_region=region,
     )
-    return Robot(spec, kin, dict(d), vectors)
+    return Robot(spec, kin, _catalogue_keys_left_out(kind, d), vectors)
+
+
+def _catalogue_keys_left_out(kind: str, d: Mapping) -> dict:
+    """The definition ``d`` of a robot of ``kind`` as :attr:`Robot.definition` keeps it: a
+    catalogue arm's by the arm's name, without the keys whose values are the catalogue's (its
+    URDF text, end link, home), so that :func:`robot_from_dict` rebuilds the same arm."""
+    if kind not in ARMS:
+        return dict(d)
+    own = ARMS[kind].definition()  # (repr: a value may be an ndarray, a home)
+    return {"name": kind} | {k: v for k, v in d.items() if repr(own.get(k)) != repr(v)}
 
 
 def load_robot(source: str | Path) -> Robot:

@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from ...engine.arms import ARMS
 from ...engine.exceptions import InvalidInputError
 from ...engine.redundant_starts import manifold_starts
 from ..compute.atlas_schemas import AtlasRequest
@@ -78,9 +79,10 @@ def request_robot(state: DashboardState) -> tuple[dict, dict | None]:
             {"name": state.augmentation, **state.augmentation_parameters},
         )
     definition = dict(state.robot_definition)
-    if not definition.get("augmentations"):  # (the map the dashboard adds, if it added one)
+    # (the map the dashboard adds, if it added one; a catalogue arm's is its own default)
+    if not definition.get("augmentations") and definition.get("name") not in ARMS:
         built = user_robot(definition).definition
-        if built.get("name") == definition.get("name") and built.get("augmentations"):
+        if built.get("augmentations"):
             definition["augmentations"] = built["augmentations"]
     entries = definition.pop("augmentations", None) or []
     if state.augmentation == state_spec(state).default_augmentation:

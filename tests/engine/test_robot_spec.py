@@ -20,6 +20,8 @@ from jik.engine.robot_spec import load_robot, robot_from_dict
 from jik.engine.solver import solve
 
 ARM4 = Path(__file__).resolve().parents[1] / "data" / "arm4.urdf"
+#: A home of the iiwa14 other than its catalogue's (within its joint limits).
+HOME_IIWA = [0.1, 0.5, 0.0, -1.5, 0.0, 1.0, 0.2]
 ARM3R = {
     "name": "planar_chain",
     "joints": "RRR",
@@ -426,3 +428,27 @@ def test_a_catalogue_arm_with_a_numpy_home_pickles():
     robot = robot_from_dict({"name": "panda", "home": home})
     copy = pickle.loads(pickle.dumps(robot))
     assert np.array_equal(copy.spec.default_x0, robot.spec.default_x0)
+
+
+@pytest.mark.parametrize(
+    "given",
+    [{"name": "panda"}, {"name": "iiwa14", "task": "xyz", "title": "arm", "home": HOME_IIWA}],
+)
+def test_a_catalogue_arm_s_definition_rebuilds_the_same_arm(given):
+    """Robot.definition is documented as what robot_from_dict rebuilds: a catalogue arm's was
+    the expanded URDF definition (name 'urdf', its kinematics named 'urdf'); it names the arm,
+    keeps what was given and the default map, and rebuilds (and pickles) the same arm."""
+    pytest.importorskip("yourdfpy")
+    robot = robot_from_dict(given)
+    assert robot.definition["name"] == given["name"] and "urdf" not in robot.definition
+    assert {k: robot.definition[k] for k in given} == given
+    one = robot.spec.p - robot.spec.r == 1  # (an arm's default map: one degree of redundancy)
+    maps = [a["name"] for a in robot.definition.get("augmentations", [])]
+    assert maps == (["e2_synthesized"] if one else [])
+    for copy in (robot_from_dict(robot.definition), pickle.loads(pickle.dumps(robot))):
+        assert copy.definition == robot.definition
+        assert copy.spec.name == copy.kinematics.name == given["name"]
+        assert (copy.spec.title, copy.spec.task_names) == (robot.spec.title, robot.spec.task_names)
+        assert copy.spec.default_x0 == robot.spec.default_x0
+        x = np.array(robot.spec.default_x0) + 0.1
+        assert np.array_equal(copy.kinematics.forward(x), robot.kinematics.forward(x))
