@@ -150,7 +150,10 @@ def synthesize_e2_nd(
     kinematics = require_kinematics(kinematics)
     m_red = kinematics.p - kinematics.r
     if m_red < 1:
-        raise InvalidInputError(f"{kinematics.name} has no redundancy (p = r)", "robot")
+        raise InvalidInputError(
+            f"{kinematics.name} has no redundancy (p = r): synthesize_e2_nd needs p - r >= 1",
+            "kinematics",
+        )
     (box, fix), progress = check_region(kinematics, region, fixed), check_progress(progress)
     d = len(box)
     degree, seed = count(degree, "degree", 1, 32), check_seed(seed)

@@ -278,6 +278,10 @@ REFUSALS = {
         "dirichlet",
     ),
     "synthesize_e2_nd robot None": (lambda: jik.synthesize_e2_nd(None, BOX), "kinematics"),
+    "synthesize_e2_nd no redundancy": (
+        lambda: jik.synthesize_e2_nd(jik.PlanarChain("RR", [1, 1]), {"x1": (0, 1)}),
+        "kinematics",
+    ),
     "inert_variables robot by name": (
         lambda: jik.inert_variables("manipulator2", None, [(0, 1)] * 3),
         "kinematics",
