@@ -13,7 +13,7 @@ from .exceptions import InvalidInputError
 from .inverses import require_kinematics
 from .kinematics import Kinematics
 from .self_motion import project
-from .validation import FloatArray, as_box, check_seed, positive
+from .validation import FloatArray, as_box, check_seed, positive, within
 
 #: Starts on a self-motion manifold lie within this fraction of the box's width around x0.
 START_SPREAD = 0.15
@@ -35,6 +35,7 @@ def manifold_starts(
     ----------
     kinematics : Kinematics
     x0 : array_like, shape (p,)
+        The first start, within ``box``.
     n : int
         Starts asked for (1 to 10^5), x0 among them.
     box : sequence of p (low, high)
@@ -58,6 +59,8 @@ def manifold_starts(
     if isinstance(n, bool) or not isinstance(n, int | np.integer) or not 1 <= n <= 10**5:
         raise InvalidInputError(f"n must be an integer from 1 to 100000, got {n!r}", "n")
     lim = as_box(box, kinematics.p, finite=False)
+    # (x0 is the first start: outside the box, every start would be left out)
+    within(x0, lim, "x0", kinematics.variable_names, "the box, where the starts lie", "x0")
     spread, seed = positive(spread, "spread"), check_seed(seed)
     if spread > 1:
         raise InvalidInputError(

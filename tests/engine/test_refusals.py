@@ -260,6 +260,11 @@ REFUSALS = {
         "bound_free_joints",
     ),
     "manifold_starts box": (lambda: jik.manifold_starts(ARM, X0, 4, box=[(0, 1)]), "box"),
+    # (x0 outside the box: every start was left out, an empty array and no word of why)
+    "manifold_starts x0 outside the box": (
+        lambda: jik.manifold_starts(ARM, [5, 0.8, 0.9], 5, [(-3, 3)] * 3),
+        "x0.0",
+    ),
     "refused_starts x0 NaN": (lambda: refused_starts(P, [[0, np.nan, 1]]), "x0"),
     "refused_starts x0 wrong length": (lambda: refused_starts(P, [[0, 1]]), "x0"),
     "pose_of y wrong length": (lambda: PANDA_TASK.pose_of(np.zeros(5)), "y"),
