@@ -42,7 +42,7 @@ from .inverses import pseudoinverse, require_kinematics
 from .kinematics import Kinematics, Manipulator2
 from .legendre_map import SynthesizedMap, legendre_vander, lgl_nodes
 from .progress import Progress, check_cancelled, check_progress
-from .validation import FloatArray, count
+from .validation import FloatArray, as_numbers, count
 
 #: Extra Gauss points per variable beyond the basis degree (R is not polynomial, e.g. cos 2 x3).
 EXTRA_NODES = 8
@@ -237,7 +237,7 @@ def _solve(
             [L.legvander(tb[:, k], n) for k, n in enumerate(degrees)],
         )
         x = problem.points(tb)
-        g = np.asarray(dirichlet(x), dtype=float).reshape(-1)
+        g = as_numbers(dirichlet(x), "dirichlet's values", "dirichlet").reshape(-1)
         if g.shape[0] != x.shape[0] or not np.all(np.isfinite(g)):
             raise InvalidInputError("dirichlet must give one finite value per point", "dirichlet")
         nc = C.shape[0]

@@ -282,6 +282,14 @@ REFUSALS = {
         lambda: jik.synthesize_e2(ARM, BOX, degree=2, dirichlet="x2"),
         "dirichlet",
     ),
+    "synthesize_e2 dirichlet gives text": (
+        lambda: jik.synthesize_e2(ARM, BOX, degree=2, dirichlet=lambda x: "a"),
+        "dirichlet",
+    ),
+    "synthesize_e2 dirichlet gives a value per point as text": (
+        lambda: jik.synthesize_e2(ARM, BOX, degree=2, dirichlet=lambda x: ["1"] * len(x)),
+        "dirichlet",
+    ),
     "synthesize_e2_nd robot None": (lambda: jik.synthesize_e2_nd(None, BOX), "kinematics"),
     "synthesize_e2_nd no redundancy": (
         lambda: jik.synthesize_e2_nd(jik.PlanarChain("RR", [1, 1]), {"x1": (0, 1)}),
