@@ -12,9 +12,9 @@ names follow :mod:`jik.engine.exports`: ``x0_k`` a start, ``x_k`` the row's conf
 from __future__ import annotations
 
 import operator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cached_property
-from typing import Any
+from typing import Any, overload
 
 import numpy as np
 
@@ -178,7 +178,8 @@ class SolveResult(Columns):
 
 @dataclass(frozen=True)
 class BatchSolveResult(Columns):
-    """Results of a batch of solves; index it for a :class:`SolveResult` with its trajectory.
+    """Results of a batch of solves; index it for a :class:`SolveResult` with its trajectory
+    (slice it for a batch of those members).
 
     ``x0`` (n, p) and ``y_d`` (n, r) are each member's start and target; the other fields are
     those of :class:`SolveResult`, one per member.
@@ -279,7 +280,31 @@ class BatchSolveResult(Columns):
         bounds = np.searchsorted(self._rec_member, np.arange(len(self.x) + 1))  # sorted members
         return ys, None if h is None else np.asarray(h), err, bounds
 
-    def __getitem__(self, i: int) -> SolveResult:
+    def _members(self, key: slice) -> BatchSolveResult:
+        """The members ``key`` selects, as a batch numbered from 0 (their steps kept)."""
+        idx = np.arange(len(self))[key]
+        arrays = ("x", "y", "error", "success", "nit", "y_d", "x0", "_status")
+        kept: dict[str, Any] = {k: getattr(self, k)[idx] for k in arrays}
+        kept["message"] = tuple(self.message[i] for i in idx)
+        if self._rec_member is not None and self._rec_theta is not None and self._rec_x is not None:
+            new = np.full(len(self), len(idx))  # (a member left out: past the new ones)
+            new[idx] = np.arange(len(idx))
+            member = new[self._rec_member]
+            order = np.argsort(member, kind="stable")
+            order = order[member[order] < len(idx)]
+            kept |= {"_rec_member": member[order], "_rec_theta": self._rec_theta[order]}
+            kept["_rec_x"] = self._rec_x[order]
+        return replace(self, **kept)
+
+    @overload
+    def __getitem__(self, i: int) -> SolveResult: ...
+    @overload
+    def __getitem__(self, i: slice) -> BatchSolveResult: ...
+    def __getitem__(self, i):
+        """Member ``i``'s :class:`SolveResult`; a slice gives the members it selects as a
+        :class:`BatchSolveResult`."""
+        if isinstance(i, slice):
+            return self._members(i)
         i = self._member(i)
         return SolveResult(
             x=self.x[i],

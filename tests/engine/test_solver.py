@@ -194,6 +194,28 @@ def test_a_batch_member_counted_from_the_end_is_that_member_with_its_trajectory(
         batch.trajectory(-4)
 
 
+@pytest.mark.parametrize("key", [slice(1, None), slice(None, None, -1), slice(0, 3, 2)])
+@pytest.mark.parametrize("record", [True, False])
+def test_a_slice_of_a_batch_is_the_batch_of_those_members(key, record):
+    """batch[1:] is a BatchSolveResult of those members (it raised TypeError), each the same
+    SolveResult, trajectory and all, as the whole batch's member; an empty slice, none."""
+    kin = Manipulator2()
+    x0 = np.array([X0, [0.1, 0.2, 1.4], [0.3, 0.1, 1.2]])
+    batch = solve_batch(Pseudoinverse(kin), x0, [[1, 1], [1, 2], [0, 2]], record=record)
+    part, members = batch[key], range(3)[key]
+    assert isinstance(part, type(batch)) and len(part) == len(members)
+    for k, i in enumerate(members):
+        assert part[k].message == batch[i].message and part[k].status == batch[i].status
+        np.testing.assert_array_equal(part[k].x0, x0[i])
+        np.testing.assert_array_equal(part[k].x, batch[i].x)
+        if record:
+            np.testing.assert_array_equal(part[k].trajectory.x, batch[i].trajectory.x)
+            np.testing.assert_array_equal(part[k].trajectory.error, batch[i].trajectory.error)
+        else:
+            assert part[k].trajectory is None
+    assert len(batch[5:]) == 0
+
+
 def test_iteration_cap_gives_failure_with_message():
     res = solve(
         Pseudoinverse(Manipulator2()), X0, [1, 1], gamma=0.01, mode="discrete", max_iterations=3
