@@ -80,8 +80,9 @@ class Kinematics(abc.ABC):
     #: Joint limits (p, 2), [lower, upper] per variable (+-inf: no bound), or None: the runs
     #: report whether they stayed within them (:mod:`jik.engine.limits`).
     joint_limits: FloatArray | None = None
-    #: The robot's home configuration (p,), within its joint limits, or None: where syntheses
-    #: hold the variables outside their region (:func:`held_values`).
+    #: The robot's home configuration (p,) or None: where syntheses hold the variables outside
+    #: their region (:func:`held_values`). A catalogue arm's lies within its joint limits; a
+    #: URDF's given ``home`` may not (taken, as a start outside them is, and reported by runs).
     home: tuple[float, ...] | None = None
     #: The default start (p,) of a robot without a home (a catalogue manipulator's, a robot
     #: definition's ``x0``), or None: where syntheses hold them then (:func:`held_values`).
@@ -205,8 +206,8 @@ class Kinematics(abc.ABC):
 def held_values(kinematics: Kinematics) -> FloatArray:
     """Where E1, E2 and their syntheses hold the variables outside their region by default,
     shape (p,): the robot's default start, where its maps are defined (the dashboard's, and
-    ``POST /synthesize``'s): the kinematics' home (a catalogue arm's or a URDF's, within its
-    joint limits), else its ``start`` (Manipulator 2's paper cubic is singular at
+    ``POST /synthesize``'s): the kinematics' home (a catalogue arm's or a URDF's, as given),
+    else its ``start`` (Manipulator 2's paper cubic is singular at
     x3 = 0), else 0 moved into the joint limits."""
     for given in (kinematics.home, kinematics.start):
         if given is not None:

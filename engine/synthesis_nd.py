@@ -124,7 +124,7 @@ def synthesize_e2_nd(
         With p - r >= 1.
     region : mapping name -> (lo, hi)
         Any number of joint variables (h depends on these); the others are held at ``fixed``,
-        by default the robot's home, within its joint limits (:func:`~.kinematics.held_values`).
+        by default the robot's home, else its start (:func:`~.kinematics.held_values`).
     degree : int
         Total degree of the polynomial basis.
     nodes : int
