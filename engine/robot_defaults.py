@@ -86,6 +86,7 @@ def defaults(kin: Kinematics, d: Mapping, box, base: RobotSpec | None = None) ->
                 f"{where}{searched}: give an x0 where it is defined",
                 "x0",
             )
+        _check_rank(kin, lo, hi, "joints" if d.get("name") == "planar_chain" else "task")
         target = d.get("target", task[1] if task is not None else None)
         path = d.get("path", task if task is not None else None)
     target, path = points(target, kin.r, "target"), points(path, kin.r, "path")
@@ -160,3 +161,39 @@ def kept_variables(kin: Kinematics, x0) -> list[int]:
     first = int(np.flatnonzero((driven == np.arange(r)).all(axis=1))[0])
     best = first if ratio[first] > REGULAR else int(np.argmax(ratio))
     return [i for i in range(p) if i not in driven[best]]
+
+
+#: Configurations of a Halton sequence over the box at which a robot defined by data must have
+#: a Jacobian of full rank r at least once (:func:`_check_rank`), and the ratio
+#: sigma_min / sigma_max of J, each row scaled by its largest entry, below which it has not.
+RANK_POINTS, RANK_RATIO = 32, 1e-10
+
+
+def _check_rank(kin: Kinematics, lo, hi, field: str) -> None:
+    """Refuse a robot whose Jacobian J (r, p) has rank < r at each of :data:`RANK_POINTS`
+    configurations spread over its box [lo, hi]: its task cannot move in every direction
+    anywhere (a planar chain of prismatic joints only, which moves along one line; a formula
+    task whose coordinates depend on each other), so no inverse can follow it and every start is
+    singular. A robot singular on a set of measure zero passes."""
+    from scipy.stats import qmc
+
+    x = lo + (hi - lo) * qmc.Halton(kin.p, scramble=False).random(RANK_POINTS + 1)[1:]
+    with np.errstate(all="ignore"):
+        J = np.asarray(kin.jacobian(x), dtype=float)
+    J = J[np.isfinite(J).all(axis=(1, 2))]
+    if not len(J):
+        return
+    rows = np.max(np.abs(J), axis=2, keepdims=True)  # (each coordinate in its own unit)
+    s = np.linalg.svd(J / np.where(rows > 0, rows, 1.0), compute_uv=False)  # (n, r), descending
+    full = s[:, -1] > RANK_RATIO * np.maximum(s[:, 0], 1e-300)
+    if np.any(full):
+        return
+    rank = int(np.max(np.sum(s > RANK_RATIO * np.maximum(s[:, :1], 1e-300), axis=1)))
+    raise InvalidInputError(
+        f"the task cannot move in every direction: J has rank {rank} < r = {kin.r} at each of "
+        f"{len(J)} configurations spread over x_range, so no inverse can follow it and every "
+        "start is singular (its coordinates depend on each other, or the joints move it along "
+        f"fewer directions, as prismatic joints alone do); give a task of {rank} "
+        f"coordinate{'s' if rank != 1 else ''} or other joints",
+        field,
+    )

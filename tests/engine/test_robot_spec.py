@@ -452,3 +452,37 @@ def test_a_catalogue_arm_s_definition_rebuilds_the_same_arm(given):
         assert copy.spec.default_x0 == robot.spec.default_x0
         x = np.array(robot.spec.default_x0) + 0.1
         assert np.array_equal(copy.kinematics.forward(x), robot.kinematics.forward(x))
+
+
+@pytest.mark.parametrize(
+    ("definition", "field", "rank"),
+    [
+        ({"name": "planar_chain", "joints": "PPP", "lengths": [1, 1, 1]}, "joints", 1),
+        (
+            {"name": "planar_chain", "joints": "RPP", "lengths": [1, 1, 1], "orientation": True},
+            "joints",
+            2,
+        ),
+        (
+            {"name": "formula", "variables": ["a", "b", "c"], "task": ["a + b", "2*a + 2*b"]},
+            "task",
+            1,
+        ),
+    ],
+)
+def test_a_robot_whose_task_cannot_move_in_every_direction_is_refused(definition, field, rank):
+    """J of rank < r at every configuration (prismatic joints alone move a planar chain along one
+    line; a formula task whose coordinates depend on each other): refused when defined, naming
+    the field, instead of every start being called singular."""
+    with pytest.raises(InvalidInputError, match=f"J has rank {rank} < r") as err:
+        robot_from_dict(definition)
+    assert err.value.field == field
+
+
+def test_a_badly_scaled_task_of_full_rank_is_kept():
+    """Rank is judged on J with each row scaled by its largest entry: a coordinate 1e300 times
+    another's is no dependence; a chain singular on a set of measure zero passes."""
+    scaled = {"name": "formula", "variables": ["x1", "x2", "x3"], "task": ["x1 * a", "x2"]}
+    assert robot_from_dict({**scaled, "parameters": {"a": 1e300}}).spec.r == 2
+    chain = {"name": "planar_chain", "joints": "PRP", "lengths": [1, 1, 1], "orientation": True}
+    assert robot_from_dict(chain).spec.p == 3
