@@ -24,6 +24,8 @@ const send = (patch) => {
 // old refusal (the send took every note away: the marks of the result's stopped runs are back).
 function accepted(body, post) {
   acceptedPost(body, post);
+  // (a definition applied that is the one in force makes no new state event: its note says so)
+  page.editor.show(body.state);
   if (body.generation !== page.shown || session.generation !== page.shown) return;
   setStatus(`up to date (generation ${page.shown})`);
   showStopped(page.stopped);

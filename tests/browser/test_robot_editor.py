@@ -247,3 +247,19 @@ def test_back_after_a_change_of_a_state_held_in_its_tab_brings_that_state_back(t
     tab.change(page.go_back)
     snapshot = tab.wait_settled(lambda s: s["state"]["task"] == before["task"], "the state before")
     assert snapshot["state"]["robot_definition"]["urdf"] == urdf
+
+
+def test_applying_the_definition_in_force_again_says_it_is_applied(tabs):
+    """Apply pressed twice on the same definition: the second changes nothing (no new
+    generation, no state event), and the note says the definition is applied, not
+    "applying…" for ever."""
+    tab = tabs.open(scene=False)
+    page = tab.page
+    page.click("#robot-editor-open")
+    page.select_option("#robot-kind", "planar_chain")
+    generation = tab.change(lambda: page.click("#robot-apply"))
+    expect(page.locator("#robot-note")).to_have_text("applied: planar_chain")
+    response = tab.posting(lambda: page.click("#robot-apply"))
+    assert response.ok and response.json()["generation"] == generation
+    expect(page.locator("#robot-note")).to_have_text("applied: planar_chain")
+    assert tab.generation == generation
