@@ -56,6 +56,12 @@ function inHistory(msg) {
   return true;
 }
 
+// Whether ``msg`` brings the state of the entry that back or forward went to: the controls then
+// show it all, the one with the focus too (what it holds was left for the history's entry).
+export function travelledTo(msg) {
+  return travelled !== null && JSON.stringify(msg.state) === JSON.stringify(travelled.state);
+}
+
 // A session's state (an event's) into the address and the history, unless a travel waits.
 export function remember(msg) {
   if (inHistory(msg)) rememberInUrl(msg.state).catch((err) => console.warn("the link's state:", err));

@@ -5,7 +5,7 @@ import { change, endOnClose, follow, openSession, session, api } from "./api.js"
 import { onNotSent, showControls, showRefusal, showStopped } from "./controls.js";
 import { $, el, fmt, withErrataLinks } from "./dom.js";
 import { robotEditor } from "./editor.js";
-import { acceptedPost, copyLink, followHistory, refusedPost, remember, stateFromUrl } from "./link.js";
+import { acceptedPost, copyLink, followHistory, refusedPost, remember, stateFromUrl, travelledTo } from "./link.js";
 import { setExportNote } from "./panel_exports.js";
 import { algorithmKey, applyFunctionals, drawFigures, layoutPanels, markStale, onAhead, showChosen } from "./panels.js";
 import { atlasPanel, atlasState } from "./atlas.js";
@@ -75,7 +75,7 @@ function showProgress(fraction, elapsed, phase = "runs", what = "") {
 function onState(msg, force = false) {
   page.state = msg.state;
   session.generation = Math.max(session.generation, msg.generation);
-  showControls(msg, send, force);
+  showControls(msg, send, force || travelledTo(msg));
   page.editor.show(msg.state, msg.type === "refused");
   remember(msg);
   atlasState(msg.state);

@@ -272,3 +272,19 @@ def test_back_and_forward_bring_the_previous_states_back(tabs):
     travel(page.go_forward)
     assert (tab.url_state(), tab.controls()) == seen[2]
     assert tab.snapshot()["state"]["robot"] == "manipulator1"
+
+
+def test_back_after_a_typed_value_shows_the_entry_s_value_in_its_box(tabs):
+    """A value typed in a box and sent with Enter keeps the focus there; back then brings the
+    state before, and that box and its slider show the entry's value, not the typed one."""
+    tab = tabs.open(scene=False)
+    page = tab.page
+    before = (tab.url_state(), tab.controls())
+    box = page.locator("#ctl-gamma-value")
+    box.fill("0.5")
+    tab.change(lambda: box.press("Enter"))
+    expect(box).to_be_focused()
+    tab.change(page.go_back)
+    tab.wait_settled(lambda s: s["state"] == before[0], "the state before the typed value")
+    expect(box).to_be_focused()
+    assert tab.controls() == before[1]
