@@ -38,9 +38,10 @@ class Trajectory(Columns):
         k(x).
     error : ndarray, shape (m,)
         ||k(x) - y_d||.
-    h : ndarray, shape (m,) or None
-        h(x) for the extended inverse (constant along the continuous flow, eq. (12)); NaN at a
-        point where h is undefined (a run stopped there).
+    h : ndarray, shape (m,), (m, p - r) or None
+        h(x) for the extended inverse (constant along the continuous flow, eq. (12)), one
+        column per map of a vector of p - r maps; NaN at a point where h is undefined (a run
+        stopped there).
     """
 
     theta: FloatArray
@@ -61,12 +62,14 @@ class Trajectory(Columns):
 
     def columns(self) -> dict[str, FloatArray]:
         """A row per point: ``theta``, the point ``x_1``..``x_p``, its task point
-        ``y_1``..``y_r``, ``error`` and, for an extended inverse, ``h``."""
+        ``y_1``..``y_r``, ``error`` and, for an extended inverse, ``h`` (a vector of p - r
+        maps: ``h_1``..``h_(p-r)``, one column each)."""
         out = {"theta": np.asarray(self.theta, dtype=float)}
         out |= coordinate_columns("x", self.x) | coordinate_columns("y", self.y)
         out["error"] = np.asarray(self.error, dtype=float)
         if self.h is not None:
-            out["h"] = np.asarray(self.h, dtype=float)
+            h = np.asarray(self.h, dtype=float)
+            out |= {"h": h} if h.ndim == 1 else coordinate_columns("h", h)
         return out
 
     def as_dict(self) -> dict[str, Any]:

@@ -29,21 +29,33 @@ def described(result: DashboardResult) -> dict:
     each coordinate column is (``{"x_1": <the first joint's name>, ..., "y_1": <the first task
     coordinate's>, ...}``)."""
     units = robot_units(state_kinematics(result.state), result.task_names)
+    columns = units.trajectory_units(result.state.mode)
+    maps = h_shape(result)
+    if maps:  # (a vector of maps: a column and a unit for each, as Trajectory.columns names them)
+        said = columns.pop("h")
+        columns |= {f"h_{k}": said for k in range(1, maps[0] + 1)}
     return {
-        "units": units.trajectory_units(result.state.mode),
+        "units": columns,
         "length_unit": units.lengths,
         "coordinates": {k: c.name for k, c in units.columns().items()},
     }
+
+
+def h_shape(result: DashboardResult) -> tuple[int, ...]:
+    """The shape of h at one point of the result's runs: ``()`` for one map (or none),
+    ``(p - r,)`` for a vector of maps."""
+    shapes = [np.shape(run.h)[1:] for run in result.runs.values() if run.h is not None]
+    return shapes[0] if shapes else ()
 
 
 def run_columns(result: DashboardResult, algorithm: str) -> dict[str, np.ndarray]:
     """A run's table, a row per point: ``algorithm``, ``cycle`` and ``leg`` (both from 1, the
     leg within its cycle), then the engine's trajectory columns
     (:meth:`jik.engine.results.Trajectory.columns`: ``theta``, ``x_k``, ``y_k``, ``error``, ``h``;
-    ``h`` NaN for an inverse without a map)."""
+    ``h``, or ``h_1``.. for a vector of maps; NaN for an inverse without a map)."""
     run = result.runs[algorithm]
     m, legs = len(run.theta), max(1, len(result.targets))
-    h = run.h if run.h is not None else np.full(m, np.nan)
+    h = run.h if run.h is not None else np.full((m, *h_shape(result)), np.nan)
     cycle, leg = np.divmod(np.asarray(run.leg, dtype=int), legs)
     return {
         "algorithm": np.full(m, algorithm),

@@ -617,3 +617,24 @@ def test_other_configuration_space_axes_redraw_their_panel():
         dashboard.stop()
     assert titles[2]["title"]["text"].startswith("Configuration space (x1, x2, x4)")
     assert titles[2]["scene2"]["zaxis"]["title"]["text"] == "x4"
+
+
+def test_an_export_of_a_vector_of_maps_has_a_column_per_map():
+    """A planar 4R chain (p - r = 2, two formula maps): the CSV has the columns h_1 and h_2, a
+    number in each cell of the extended run's rows and empty ones in the pseudoinverse's, and
+    the units (the CSV's line, the JSON's keys) name those columns."""
+    chain = {"name": "planar_chain", "joints": "RRRR", "lengths": [1.0, 1.0, 1.0, 1.0]}
+    state = updated_state(default_state(), {"robot": "planar_chain", "robot_definition": chain})
+    result = compute(updated_state(state, {"cycles": 1}))
+    lines = export_csv(result).splitlines()
+    header, *rows = [r.split(",") for r in lines if not r.startswith("#")]
+    assert header[-3:] == ["error", "h_1", "h_2"]
+    assert {len(r) for r in rows} == {len(header)}
+    extended = np.array([r[-2:] for r in rows if r[0] == "extended"], dtype=float)
+    np.testing.assert_allclose(extended, result.runs["extended"].h, atol=1e-12)
+    assert {tuple(r[-2:]) for r in rows if r[0] == "pseudoinverse"} == {("", "")}
+    units = next(r for r in lines if r.startswith("# units: "))
+    assert units.endswith(
+        "h_1 [the unit of the map's formula]; h_2 [the unit of the map's formula]"
+    )
+    assert list(export_json(result)["units"])[-3:] == ["error", "h_1", "h_2"]

@@ -89,3 +89,21 @@ def test_the_error_names_the_undefined_map_or_says_singular():
     with pytest.raises(AlgorithmicSingularityError, match=r"\] of .* is singular \(") as info:
         VectorExtendedInverse(CHAIN, same).matrix(X0)
     assert "undefined" not in str(info.value)
+
+
+def test_a_run_with_a_vector_of_maps_is_a_table_of_one_number_per_cell():
+    """The trajectory of p - r = 3 maps has a column per map, h_1..h_3, each h_i(x) along the
+    run, so that its table (and a DataFrame or CSV of it) holds numbers, not a list per cell."""
+    from jik.engine.exports import csv_text
+    from jik.engine.solver import solve
+
+    inv = VectorExtendedInverse(CHAIN, MAPS)
+    trajectory = solve(inv, X0, CHAIN.forward(X0) + 0.05).trajectory
+    columns = trajectory.columns()
+    assert list(columns)[-4:] == ["error", "h_1", "h_2", "h_3"]
+    assert all(np.ndim(c) == 1 for c in columns.values())
+    for i, h in enumerate(MAPS):
+        np.testing.assert_allclose(columns[f"h_{i + 1}"], h.value(trajectory.x), atol=1e-12)
+    header, first = "".join(csv_text([columns], "\n")).splitlines()[:2]
+    assert header.split(",")[-3:] == ["h_1", "h_2", "h_3"]
+    assert [float(v) for v in first.split(",")[-3:]] == pytest.approx(trajectory.h[0])
