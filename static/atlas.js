@@ -163,7 +163,7 @@ async function draw(body, key) {
     followWidth(div, (d) => d.clientWidth);
   }
   showProgress(null);
-  $("#atlas-csv").disabled = false;
+  for (const button of div.querySelectorAll(".panel-tools .tool")) button.disabled = false;
   // body.runs counts the starts times the paths (a path per scale); every chosen algorithm runs
   // each of them.
   const k = body.request.algorithms.length;
@@ -250,6 +250,8 @@ export function atlasPanel(state, send) {
     type: "button", className: "tool", id: "atlas-csv", disabled: true, onclick: saveTable,
     title: "save the table of this atlas as CSV: a row per start, algorithm and cycle, with its drift",
   }, "CSV"));
+  // (no atlas to save before the first is drawn: PNG and SVG are off until then, as CSV is)
+  for (const button of plot.querySelectorAll(".panel-tools .tool:not(.info)")) button.disabled = true;
   $("#atlas").replaceChildren(
     el("h2", {}, "Repeatability atlas"),
     el("div", { className: "atlas-bar" },

@@ -261,3 +261,23 @@ def test_a_click_in_a_scaled_band_keeps_the_atlas_current(tabs):
     expect(status).to_contain_text("path ×0.5")
     tab.wait_settled(lambda s: s["state"]["path"][0] == [0.5, 1.0], "the path scaled by 0.5")
     expect(page.locator("#atlas-outdated")).to_be_hidden()
+
+
+def test_the_atlas_panels_image_buttons_are_off_until_an_atlas_is_drawn(tabs):
+    """Before any atlas, its panel has nothing to save: PNG and SVG are off (as CSV is), not
+    buttons that do nothing; once an atlas is drawn, PNG saves it."""
+    tab = tabs.open(scene=False)
+    page = tab.page
+    page.locator("#atlas").scroll_into_view_if_needed()
+    tools = page.locator("#plot-atlas .panel-tools")
+    for name in ("PNG", "SVG", "CSV"):
+        expect(tools.get_by_role("button", name=name, exact=True)).to_be_disabled()
+    expect(tools.get_by_role("button", name="what this panel shows", exact=False)).to_be_enabled()
+    start_atlas(tab, 4, 1)
+    expect(page.locator("#atlas-status")).to_contain_text("Atlas done", timeout=120_000)
+    for name in ("PNG", "SVG", "CSV"):
+        expect(tools.get_by_role("button", name=name, exact=True)).to_be_enabled()
+    with page.expect_download() as saved:
+        tools.get_by_role("button", name="PNG", exact=True).click()
+    assert saved.value.suggested_filename.startswith("jik-manipulator2-atlas-")
+    assert saved.value.suggested_filename.endswith(".png")
