@@ -42,6 +42,7 @@ export function robotEditor(kinds, send) {
   const typed = new Map();
   let shownKind = "";
   let edited = false;
+  let inForce; // JSON of the session's robot_definition last shown
 
   function build(k, values = {}) {
     shownKind = k;
@@ -122,7 +123,8 @@ export function robotEditor(kinds, send) {
     // refusal, which is not what was applied).
     show(state, refused = false) {
       const applying = note.textContent === "applying…" && !refused;
-      if (state.robot_definition && applying && state.robot === shownKind) {
+      const applied = state.robot_definition && applying && state.robot === shownKind;
+      if (applied) {
         typed.delete(shownKind);
         edited = false;
         note.textContent = `applied: ${state.robot}`;
@@ -133,9 +135,15 @@ export function robotEditor(kinds, send) {
       if (!editable && note.textContent.startsWith("applied: ")) {
         note.textContent = "not in use (another robot is chosen): apply to use it again";
       }
-      if (editable && state.robot_definition && state.robot !== shownKind && !edited) {
+      // Another definition in force that was not applied here (back or forward, a catalogue
+      // arm picked): the fields show it, unless they hold typing, and no note says otherwise.
+      const definition = JSON.stringify(state.robot_definition ?? null);
+      const arrived = definition !== inForce;
+      inForce = definition;
+      if (editable && state.robot_definition && (state.robot !== shownKind || arrived) && !edited) {
         kind.value = state.robot;
         build(state.robot, state.robot_definition);
+        if (!applied && !applying) note.textContent = "";
       }
     },
     // A refused field under robot_definition: its message next to it; whether it was shown.

@@ -263,3 +263,33 @@ def test_applying_the_definition_in_force_again_says_it_is_applied(tabs):
     assert response.ok and response.json()["generation"] == generation
     expect(page.locator("#robot-note")).to_have_text("applied: planar_chain")
     assert tab.generation == generation
+
+
+def test_back_to_another_definition_shows_it_in_the_editor(tabs):
+    """Back brings a definition other than the one the editor last applied: the editor's
+    fields show the definition in force, and its note no longer says that the one applied is
+    (nor, back from a robot of the picker, that the definition is not in use)."""
+    tab = tabs.open(scene=False)
+    page = tab.page
+    page.click("#robot-editor-open")
+    page.select_option("#robot-kind", "planar_chain")
+    tab.change(lambda: page.click("#robot-apply"))  # the example: RRR, 1, 0.8, 0.6
+    page.fill("#robot-field-joints", "RRRR")
+    page.fill("#robot-field-lengths", "1, 1, 1, 1")
+    tab.change(lambda: page.click("#robot-apply"))
+    expect(page.locator("#robot-note")).to_have_text("applied: planar_chain")
+    tab.change(page.go_back)
+    tab.wait_settled(lambda s: s["state"]["robot_definition"]["joints"] == "RRR", "the RRR arm")
+    expect(page.locator("#robot-field-joints")).to_have_value("RRR")
+    expect(page.locator("#robot-field-lengths")).to_have_value("1, 0.8, 0.6")
+    expect(page.locator("#robot-note")).to_have_text("")
+
+    tab.change(lambda: page.select_option("#ctl-robot", "manipulator1"))
+    page.fill("#robot-field-lengths", "1, 0.9, 0.6")
+    tab.change(lambda: page.click("#robot-apply"))
+    tab.change(lambda: page.select_option("#ctl-robot", "manipulator1"))
+    expect(page.locator("#robot-note")).to_contain_text("not in use")
+    tab.change(page.go_back)
+    tab.wait_settled(lambda s: s["state"]["robot"] == "planar_chain", "the arm applied")
+    expect(page.locator("#robot-field-lengths")).to_have_value("1, 0.9, 0.6")
+    expect(page.locator("#robot-note")).not_to_contain_text("not in use")
