@@ -212,6 +212,9 @@ function moveTo(point) {
     patch.path = given.map((p) => p.map((v, d) => home[d] + scale * (v - home[d])));
   }
   atlas.covers.add(atlasKey({ ...atlas.state(), ...patch })); // (still this atlas: its band)
+  // (plotly's click keeps the focus where it was: a control left with it, an x0 box typed in,
+  // would keep its text and not show the start clicked)
+  if ($("#controls").contains(document.activeElement)) document.activeElement.blur();
   atlas.send(patch);
   const s = body.request.scales ? `, path ×${scale}` : "";
   say(`Moved the main view to start ${i + 1} of ${n} (s = ${fmt(Number(point.x))}${s}): x0 = (${x0.map((v) => fmt(v)).join(", ")}).`);

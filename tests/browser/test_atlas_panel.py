@@ -281,3 +281,27 @@ def test_the_atlas_panels_image_buttons_are_off_until_an_atlas_is_drawn(tabs):
         tools.get_by_role("button", name="PNG", exact=True).click()
     assert saved.value.suggested_filename.startswith("jik-manipulator2-atlas-")
     assert saved.value.suggested_filename.endswith(".png")
+
+
+def test_a_click_on_a_cell_shows_its_start_in_the_x0_box_typed_in_before(tabs):
+    """An x0 coordinate typed and sent with Enter keeps the focus in its box, which a click in
+    the heatmap does not take: the box then shows the start clicked, as the session has it,
+    not the value typed before."""
+    tab = tabs.open(scene=False)
+    page = tab.page
+    page.locator("#atlas").scroll_into_view_if_needed()
+    start_atlas(tab, 16, 1)
+    expect(page.locator("#atlas-status")).to_contain_text("Atlas done", timeout=120_000)
+    box = page.locator("#ctl-x0-0-value")
+    box.fill("0.1")
+    tab.change(lambda: box.press("Enter"))
+    expect(box).to_be_focused()
+    drag = page.locator("#plot-atlas .xy .nsewdrag")
+    drag.scroll_into_view_if_needed()
+    cell = drag.bounding_box()
+    assert cell is not None
+    tab.change(
+        lambda: page.mouse.click(cell["x"] + 0.7 * cell["width"], cell["y"] + 0.5 * cell["height"])
+    )
+    x0 = tab.wait_settled(lambda s: s["state"]["x0"][0] != 0.1, "the start clicked")["state"]["x0"]
+    assert float(box.input_value()) == pytest.approx(x0[0], abs=6e-4)  # (3 decimals)
