@@ -126,13 +126,15 @@ def pseudoinverse_why(drift) -> str | None:
 
 
 def extended_why(
-    h, drift, success: bool, closed: bool, mode: str, gamma: float
+    h, drift, success: bool, closed: bool, mode: str, gamma: float, ends: bool = False
 ) -> list[tuple[str, str]]:
     """Why the extended Jacobian inverse (11) was repeatable or not, from h along its run
     (:func:`~jik.engine.augmentations.h_change` against
     :data:`~jik.engine.augmentations.H_CONSERVED`, eq. (12)) and its ``drift`` on a ``closed``
     path; in discrete ``mode`` that the iteration keeps h only approximately. None for a run
-    without h, or stopped before it moved."""
+    without h, or stopped before it moved. ``ends``: ``h`` is h at the start and the legs' ends
+    only (a run not recorded), and the sentences say so: h may have moved further between."""
+    along = "from its start to its legs' ends" if ends else "along its run"
     dh = h_change(h)
     if dh is None or (not success and dh == 0):
         return []
@@ -148,7 +150,7 @@ def extended_why(
         text = (
             "Why: J^E# adds the equation h(x) = h(x0) (eq. (12)); "
             + ("h did not change" if dh == 0 else f"h changed by only {g(dh)}")
-            + f" along its run{tail}"
+            + f" {along}{tail}"
         )
     else:
         lost = (
@@ -157,7 +159,8 @@ def extended_why(
             if closed and not repeatable(drift)
             else ""
         )
-        text = f"h was not conserved: it changed by {g(dh)} along the extended Jacobian's run."
+        run = "the extended Jacobian's " + ("start to its legs' ends" if ends else "run")
+        text = f"h was not conserved: it changed by {g(dh)} {'from' if ends else 'along'} {run}."
         text += lost
     out = [(text, "why")]
     if mode == "discrete" and not kept:
@@ -226,7 +229,8 @@ def verdict(
         out.append(Finding(why, "why", "pseudoinverse"))
     if "extended" in runs:
         e = runs["extended"]
-        found = extended_why(e.h, e.drift, e.success, closed, mode, gamma)
+        ends = bool(getattr(e, "h_at_ends", False))
+        found = extended_why(e.h, e.drift, e.success, closed, mode, gamma, ends)
         out += undefined or [Finding(text, role, "extended") for text, role in found]
         if not undefined and found and (note := gamma_note(mode, gamma)):
             out.append(Finding(note, "note"))

@@ -134,7 +134,7 @@ class RepeatabilityResult(Columns):
         :data:`~jik.engine.repeatability.REPEATABLE_DRIFT`), where a failed leg stopped; for
         the pseudoinverse (8) why it drifts, for the extended Jacobian inverse (11) whether h
         stayed at h(x0) (eq. (12), from h at every point of legs recorded with ``record=True``,
-        else from h after each leg) and, in discrete mode, that the
+        else from h after each leg, as its sentence says) and, in discrete mode, that the
         iteration keeps h only approximately and what a gamma near 2 does; for the practical
         inverses what their parameters did
         (:func:`jik.engine.practical_findings.practical_findings`:
@@ -183,17 +183,18 @@ class RepeatabilityResult(Columns):
         done = drift[: np.cumprod(np.isfinite(drift)).sum()]  # (the cycles that ended)
         h = None if self.h is None else self.h[i]
         legs = [leg.trajectory for leg in self.leg_results if leg.trajectory is not None]
+        ends = h is not None  # (h at the start and the legs' ends, unless recorded)
         if legs and len(legs) == len(self.leg_results):  # (every recorded point, as the page)
             x, error = np.concatenate([t.x for t in legs]), np.concatenate([t.error for t in legs])
             leg = np.concatenate([np.full(len(t.x), j) for j, t in enumerate(legs)])
             if h is not None and all(t.h is not None for t in legs):
-                h = np.concatenate([t.h for t in legs])
+                h, ends = np.concatenate([t.h for t in legs]), False
         else:  # (the leg ends reached)
-            ends = self.legs[i][np.isfinite(self.legs[i]).all(axis=-1)]
-            x, leg = np.vstack([self.x0[i], ends]), np.arange(len(ends))
-            error = self._errors(ends, self.targets[i])
+            reached = self.legs[i][np.isfinite(self.legs[i]).all(axis=-1)]
+            x, leg = np.vstack([self.x0[i], reached]), np.arange(len(reached))
+            error = self._errors(reached, self.targets[i])
         success, message = bool(np.asarray(self.success)[i]), str(np.asarray(self.message)[i])
-        run = _Member(done, success, message, h, x, error, leg)
+        run = _Member(done, success, message, h, x, error, leg, ends)
         out = verdict({self.algorithm: run}, True, self.mode, self.gamma, unit)
         if self.used is None:
             return out
@@ -268,3 +269,5 @@ class _Member:
     x: FloatArray
     error: FloatArray
     leg: FloatArray
+    #: h is h at the start and the legs' ends only (the legs were not recorded).
+    h_at_ends: bool = False
