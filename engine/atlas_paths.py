@@ -64,6 +64,16 @@ def path_family(
         raise InvalidInputError(f"shifts must be one or more task points (S, {kin.r})", "shifts")
     if not len(scale) or not np.all(np.isfinite(scale) & (scale > 0)):
         raise InvalidInputError("scales must be finite and > 0, one or more of them", "scales")
+    for name, values in (("shifts", shift.reshape(len(shift), -1)), ("scales", scale[:, None])):
+        _, first = np.unique(values, axis=0, return_index=True)
+        if len(first) < len(values):  # (a path twice: the same band drawn twice, twice the work)
+            j = int(np.setdiff1d(np.arange(len(values)), first)[0])
+            i = int(np.flatnonzero((values[:j] == values[j]).all(axis=1))[0])
+            shown = format_vector(values[j]) if name == "shifts" else f"{values[j, 0]:g}"
+            raise InvalidInputError(
+                f"{name} must be distinct: {shown} is given twice (entries {i} and {j})",
+                f"{name}.{j}",
+            )
     if len(shift) * len(scale) > MAX_PATHS:
         raise InvalidInputError(f"at most {MAX_PATHS} paths (shifts x scales)", field="shifts")
     bounded(base_path, "path")

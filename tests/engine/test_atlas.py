@@ -283,6 +283,8 @@ def test_cancelled_stops_between_chunks():
         ({"sampling": "sobol"}, "sampling", "'grid' or 'sample'"),
         ({"scales": [1.0, -2.0]}, "scales", "scales must be finite and > 0"),
         ({"shifts": [(0.0, 0.0, 1.0)]}, "shifts", "shape (..., 2)"),
+        ({"scales": [1.0, 0.5, 1.0]}, "scales.2", "1 is given twice (entries 0 and 2)"),
+        ({"shifts": [(0.0, 0.0), (0.1, 0.0), (0.1, 0.0)]}, "shifts.2", "(0.1, 0) is given twice"),
         ({"reference": (0.0, math.nan, 1.0)}, "reference", "NaN"),
         (
             {"box": [(-5.0, 5.0), (-5.0, 5.0), (2.0, 3.0)], "reference": (4.0, 4.0, 2.5)},
