@@ -205,7 +205,8 @@ COMMON = (
         False,
         "augmenting maps of the extended "
         "inverse: {name: formula, h: ...} (h a list of p - r formulas when "
-        "p - r > 1) or {name: e2_synthesized, region: {...}} (p = r + 1)",
+        "p - r > 1) or {name: e2_synthesized, region: {...}} (p = r + 1); a second map of "
+        "one kind needs a label of its own (label: ...), its name in the page",
     ),
 )
 
