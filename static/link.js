@@ -117,8 +117,9 @@ export async function stateFromUrl(onNotice) {
   if (params.has("z")) {
     try {
       text = await inflated(params.get("z"));
-    } catch (err) {
-      onNotice(`the link's state is not a deflated state (${err.message}); showing the defaults`);
+    } catch {
+      // (the browser's own words for a broken stream, "Failed to fetch", read as a network error)
+      onNotice("the link's state is damaged: it does not inflate (a link cut short or changed); showing the defaults");
       return {};
     }
   }

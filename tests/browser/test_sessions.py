@@ -139,6 +139,19 @@ def test_a_link_whose_state_is_not_an_object_says_so(tabs, text):
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize("z", ["abc", "not base64!"])
+def test_a_link_whose_deflated_state_is_damaged_says_so(tabs, z):
+    """A ?z= link cut short or changed opens the defaults and says that the link is damaged, in
+    the page's words, not the browser's ("Failed to fetch" read as a network error)."""
+    tab = tabs.open(f"/?z={z}", scene=False)
+    expect(tab.page.locator("#notice")).to_have_text(
+        "the link's state is damaged: it does not inflate (a link cut short or changed); "
+        "showing the defaults"
+    )
+    assert tab.snapshot()["state"]["robot"] == "manipulator2"
+
+
+@pytest.mark.slow
 def test_seven_tabs_of_one_browser_each_draw_when_hidden_tabs_let_go(tabs):
     """A browser keeps six connections to one server, and each tab's event stream holds one: a
     seventh dashboard tab of one browser stayed at "connecting…" while six were open. A hidden
