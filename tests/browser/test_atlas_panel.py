@@ -283,6 +283,7 @@ def test_the_atlas_panels_image_buttons_are_off_until_an_atlas_is_drawn(tabs):
     assert saved.value.suggested_filename.endswith(".png")
 
 
+@pytest.mark.slow  # (CI's slow step: the default run stays under 8 minutes)
 def test_a_click_on_a_cell_shows_its_start_in_the_x0_box_typed_in_before(tabs):
     """An x0 coordinate typed and sent with Enter keeps the focus in its box, which a click in
     the heatmap does not take: the box then shows the start clicked, as the session has it,

@@ -249,6 +249,7 @@ def test_back_after_a_change_of_a_state_held_in_its_tab_brings_that_state_back(t
     assert snapshot["state"]["robot_definition"]["urdf"] == urdf
 
 
+@pytest.mark.slow  # (CI's slow step: the default run stays under 8 minutes)
 def test_applying_the_definition_in_force_again_says_it_is_applied(tabs):
     """Apply pressed twice on the same definition: the second changes nothing (no new
     generation, no state event), and the note says the definition is applied, not
@@ -265,6 +266,7 @@ def test_applying_the_definition_in_force_again_says_it_is_applied(tabs):
     assert tab.generation == generation
 
 
+@pytest.mark.slow  # (CI's slow step: the default run stays under 8 minutes)
 def test_back_to_another_definition_shows_it_in_the_editor(tabs):
     """Back brings a definition other than the one the editor last applied: the editor's
     fields show the definition in force, and its note no longer says that the one applied is

@@ -287,6 +287,7 @@ def test_back_and_forward_bring_the_previous_states_back(tabs):
     assert tab.snapshot()["state"]["robot"] == "manipulator1"
 
 
+@pytest.mark.slow  # (CI's slow step: the default run stays under 8 minutes)
 def test_back_after_a_typed_value_shows_the_entry_s_value_in_its_box(tabs):
     """A value typed in a box and sent with Enter keeps the focus there; back then brings the
     state before, and that box and its slider show the entry's value, not the typed one."""
