@@ -141,7 +141,7 @@ def test_an_atlas_too_large_to_gather_is_refused_by_run_atlas_but_streams():
 
 def test_explicit_starts_name_starts(monkeypatch):
     """An atlas of explicit starts too large to gather names ``starts``."""
-    plan = jik.plan_atlas(P, LOOP, starts=[X0], shifts=np.zeros((10**4, 2)))
+    plan = jik.plan_atlas(P, LOOP, starts=[X0], scales=np.linspace(0.5, 1.0, 10**4))
     monkeypatch.setattr(validation, "MEMORY_LIMIT", 10**5)
     _refused(lambda: jik.run_atlas(plan), "starts", "10000 paths x 1 start")
 
