@@ -263,6 +263,7 @@ def test_a_click_in_a_scaled_band_keeps_the_atlas_current(tabs):
     expect(page.locator("#atlas-outdated")).to_be_hidden()
 
 
+@pytest.mark.slow  # (CI's slow step: the default run stays under 8 minutes)
 def test_the_atlas_panels_image_buttons_are_off_until_an_atlas_is_drawn(tabs):
     """Before any atlas, its panel has nothing to save: PNG and SVG are off (as CSV is), not
     buttons that do nothing; once an atlas is drawn, PNG saves it."""
